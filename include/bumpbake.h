@@ -1,0 +1,413 @@
+/* bumpbake.h: bake normal maps, self-shadowed bump maps and ambient occlusion
+ * from height maps.
+ *
+ * Conventions, fixed once for the whole API:
+ * - Images are bb_image: float32 pixels, row-major, channels interleaved,
+ *   row 0 is the TOP row of the picture, column 0 the left column.
+ * - Tangent frame: x = column (right), y = row (DOWN), z = up out of the
+ *   surface ("DirectX style", Source engine). --normal-y up flips y on output.
+ * - Heights: a height image holds normalised heights h (integer inputs are
+ *   value / max code, so h is in [0, 1]; float inputs are used as they are).
+ *   Geometry is in texels: texel (x, y) is the vertex (x, y, height_scale*h).
+ * - Surface model: two triangles per cell, (x,y)-(x+1,y)-(x,y+1) and
+ *   (x+1,y)-(x+1,y+1)-(x,y+1), split along the (x+1,y)-(x,y+1) diagonal
+ *   (Valve's mesh). Addressing is periodic (the texture tiles) unless
+ *   BB_ADDRESS_CLAMP extends the border texels.
+ * - Normals are unit vectors in [-1, 1]; integer files store 0.5 + 0.5*N,
+ *   float files store N. Visibility, ssbump, weights and ao are in [0, 1];
+ *   integer files store value * max code, float files store the value.
+ * - Half-Life 2 basis: B0 = (sqrt(2/3), 0, 1/sqrt(3)),
+ *   B1 = (-1/sqrt(6), 1/sqrt(2), 1/sqrt(3)), B2 = (-1/sqrt(6), -1/sqrt(2),
+ *   1/sqrt(3)); optional B3 = (0, 0, 1).
+ * - Errors: fallible calls return bb_status and, when err is not NULL, write
+ *   a one-line message into it. There is no global error state.
+ * - Ownership: a function that fills a bb_image allocates its pixels; the
+ *   caller frees them with bb_image_free().
+ */
+#ifndef BUMPBAKE_H
+#define BUMPBAKE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define BB_VERSION_STRING "0.1.0"
+
+/* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
+ * most BB_MAX_PIXELS texels in all (8192 x 8192), checked before allocating. */
+#define BB_MAX_DIMENSION 65536
+#define BB_MAX_PIXELS (8192L * 8192L)
+
+typedef enum bb_status {
+  BB_OK = 0,          /* success */
+  BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
+  BB_ERR_IO,          /* a file is missing, unreadable or unwritable */
+  BB_ERR_FORMAT,      /* corrupt, truncated or unsupported image; unknown extension */
+  BB_ERR_SIZE,        /* zero width or height, or over the documented maximum */
+  BB_ERR_VALUE,       /* NaN or infinite value where a finite one is needed */
+  BB_ERR_MEMORY       /* an allocation failed */
+} bb_status;
+
+/* Caller-owned error message, filled where the error is detected. */
+typedef struct bb_error {
+  char message[512];
+} bb_error;
+
+/* Short name of a status ("ok", "bad argument", ...); never NULL. */
+const char *bb_status_name(bb_status status);
+
+/* ------------------------------------------------------------------ images */
+
+typedef struct bb_image {
+  int width;      /* texels */
+  int height;     /* texels */
+  int channels;   /* interleaved floats per texel */
+  float *pixels;  /* width*height*channels floats, row 0 at the top */
+} bb_image;
+
+/* Allocates a zeroed image. Rejects sizes <= 0, over BB_MAX_DIMENSION or
+ * BB_MAX_PIXELS, and channel counts outside 1..64 (overflow-checked).
+ * Returns BB_ERR_SIZE, BB_ERR_ARGUMENT or BB_ERR_MEMORY on failure, leaving
+ * img->pixels NULL. */
+bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
+                         bb_error *err);
+
+/* Frees the pixels and zeroes the struct; safe on a zeroed struct. */
+void bb_image_free(bb_image *img);
+
+/* Pointer to texel (x, y), channel 0. No bounds check beyond debug asserts. */
+float *bb_image_texel(const bb_image *img, int x, int y);
+
+/* Addressing of texels outside the image. */
+typedef enum bb_addressing {
+  BB_ADDRESS_PERIODIC = 0, /* the texture tiles: h(x + W, y) = h(x, y) */
+  BB_ADDRESS_CLAMP         /* border texels extend outwards */
+} bb_addressing;
+
+/* -------------------------------------------------------------- image I/O */
+
+/* What a file held, beyond its pixels. */
+typedef struct bb_image_info {
+  int alpha_channel;    /* index of the alpha channel, or -1 */
+  int is_float;         /* 1 when the file stores float or half samples */
+  int bits_per_sample;  /* 8, 16, 32 (float or int), ... */
+  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ... */
+  char *description;    /* bumpbake provenance or ImageDescription, malloc'd, or NULL */
+} bb_image_info;
+
+/* Frees info->description and clears it. */
+void bb_image_info_free(bb_image_info *info);
+
+/* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
+ * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
+ * Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not an image,
+ * truncated, corrupt), BB_ERR_SIZE (zero or over the maximum). */
+bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
+                        bb_error *err);
+
+/* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
+ * float32 for exr. */
+typedef enum bb_depth {
+  BB_DEPTH_DEFAULT = 0,
+  BB_DEPTH_8,     /* png, tga, tif */
+  BB_DEPTH_16,    /* png, tif */
+  BB_DEPTH_HALF,  /* exr */
+  BB_DEPTH_FLOAT  /* exr, tif */
+} bb_depth;
+
+/* How float values map to integer codes. */
+typedef enum bb_range {
+  BB_RANGE_UNIT = 0, /* [0, 1] stored as value * max code (ssbump, ao, height) */
+  BB_RANGE_SIGNED    /* [-1, 1] stored as (0.5 + 0.5 * value) * max code (normals) */
+} bb_range;
+
+typedef struct bb_write_options {
+  bb_depth depth;
+  bb_range range;
+  const char *description; /* provenance text stored in the file, or NULL */
+} bb_write_options;
+
+/* Writes img to path; the format comes from the extension (.png .tga .tif
+ * .tiff .exr). Integer formats clamp to the code range and round to nearest.
+ * The file is written to a temporary file in the destination directory and
+ * renamed into place, so a failure leaves no partial file. Errors:
+ * BB_ERR_FORMAT (unknown extension, depth not supported by the format),
+ * BB_ERR_IO (cannot write). */
+bb_status bb_image_write(const char *path, const bb_image *img,
+                         const bb_write_options *options, bb_error *err);
+
+/* True (1) when the extension of path names a format bb_image_write knows. */
+int bb_path_is_writable_format(const char *path);
+
+/* ----------------------------------------------------------- height input */
+
+/* Which channel of a colour image becomes the height. */
+typedef enum bb_channel {
+  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B */
+  BB_CHANNEL_R,
+  BB_CHANNEL_G,
+  BB_CHANNEL_B,
+  BB_CHANNEL_A,
+  BB_CHANNEL_LUMA,     /* Rec. 709: 0.2126 R + 0.7152 G + 0.0722 B */
+  BB_CHANNEL_MEAN      /* (R + G + B) / 3, computed in double */
+} bb_channel;
+
+/* Parses "r", "g", "b", "a", "luma", "mean", "auto"; returns 0 on success. */
+int bb_channel_parse(const char *name, bb_channel *out);
+
+/* Extracts a 1-channel height field from a decoded image by the channel rule.
+ * Rejects NaN or infinite heights (BB_ERR_VALUE, naming the first bad texel)
+ * and channels the image does not have (BB_ERR_ARGUMENT). alpha_channel is
+ * the image's alpha index or -1 (from bb_image_info). */
+bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
+                               bb_channel channel, bb_image *height,
+                               bb_error *err);
+
+/* bb_image_read followed by bb_height_from_image; messages name the file. */
+bb_status bb_height_load(const char *path, bb_channel channel,
+                         bb_image *height, bb_error *err);
+
+/* -------------------------------------------------------------- smoothing */
+
+typedef struct bb_smooth_options {
+  int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
+  float threshold;       /* T in normalised height units, > 0. Default 2/255 */
+  bb_addressing addressing;
+} bb_smooth_options;
+
+void bb_smooth_options_init(bb_smooth_options *o);
+
+/* Valve's tileable bilateral filter (CONVENTIONS.md "Smoothing") of every
+ * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
+ * with in's size and channels. */
+bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
+                              const bb_smooth_options *o, bb_image *out,
+                              bb_error *err);
+
+/* ---------------------------------------------------------------- normals */
+
+typedef enum bb_normal_filter {
+  BB_NORMAL_VALVE = 0, /* mean of the 18 triangle normals of the 9 cells */
+  BB_NORMAL_CENTRAL,   /* central differences */
+  BB_NORMAL_SOBEL      /* 3x3 Sobel gradient */
+} bb_normal_filter;
+
+/* Parses "valve", "central", "sobel"; returns 0 on success. */
+int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
+const char *bb_normal_filter_name(bb_normal_filter f);
+
+/* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
+ * height: 1 channel; out: allocated, 3 channels. */
+bb_status bb_normals_compute(const bb_image *height, float height_scale,
+                             bb_normal_filter filter, bb_addressing addressing,
+                             bb_image *out, bb_error *err);
+
+/* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
+void bb_image_flip_green(bb_image *img);
+
+/* ---------------------------------------------------------------- pyramid */
+
+/* Max-mip pyramid over the surface z = height_texels(x, y): opaque, built
+ * once per bake, read-only afterwards and safe to share between threads. */
+typedef struct bb_pyramid bb_pyramid;
+
+/* Builds the pyramid of a 1-channel field of heights in texels (already
+ * multiplied by the height scale). The field is copied. */
+bb_status bb_pyramid_build(const bb_image *height_texels,
+                           bb_addressing addressing, bb_pyramid **out,
+                           bb_error *err);
+
+void bb_pyramid_free(bb_pyramid *p);
+
+/* Number of levels (level 0 = one node per cell, the last = one root node). */
+int bb_pyramid_levels(const bb_pyramid *p);
+
+/* Max over the surface of node (x, y) of a level: testing aid. */
+float bb_pyramid_node_max(const bb_pyramid *p, int level, int x, int y);
+
+/* ----------------------------------------------------------------- tracer */
+
+/* A ray in texel space: origin and direction (need not be unit; z > 0). */
+typedef struct bb_ray {
+  double origin[3];
+  double direction[3];
+} bb_ray;
+
+/* 1 when the ray meets the surface at a distance > 0, else 0. Rays have no
+ * maximum length: periodic rays wrap as often as needed. Max-mip march. */
+int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
+
+/* The same answer by the brute-force twin: a 2D DDA through every cell with
+ * the same exact cell test and no pyramid. Slow; for tests and benchmarks. */
+int bb_ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray);
+
+/* ---------------------------------------------------------------- ray set */
+
+#define BB_MAX_BASIS 4
+
+/* Basis the occlusion is projected on. */
+typedef enum bb_basis {
+  BB_BASIS_HL2 = 0,   /* B0, B1, B2 */
+  BB_BASIS_HL2_Z      /* B0, B1, B2 and B3 = (0, 0, 1) */
+} bb_basis;
+
+int bb_basis_parse(const char *name, bb_basis *out); /* "hl2", "hl2+z" */
+const char *bb_basis_name(bb_basis b);
+int bb_basis_count(bb_basis b);
+/* Unit vector of basis direction index (0..3) into v. */
+void bb_basis_vector(int index, double v[3]);
+
+/* The directions traced from every texel, organised as azimuth slices: slice
+ * s holds rays slice_start[s] .. slice_start[s+1]-1, all with the horizontal
+ * direction slice_dir[s], sorted by rising elevation. */
+typedef struct bb_rayset {
+  int ray_count;
+  int slice_count;
+  int basis_count;
+  int *slice_start;          /* slice_count + 1 entries */
+  double *slice_dir;         /* 2 per slice: unit (dx, dy) */
+  double *tan_elevation;     /* per ray: dz / |(dx, dy)|, rising within a slice */
+  double *direction;         /* 3 per ray: unit direction */
+  double *weight_ao;         /* per ray: estimator weight of ao */
+  double *weight_basis;      /* basis_count per ray: estimator weights of vis_c */
+  double total_ao;           /* sum of weight_ao */
+  double total_basis[BB_MAX_BASIS]; /* sums of weight_basis per channel */
+  char id[64];               /* names the set and its parameters, for provenance */
+} bb_rayset;
+
+/* Builds the default ray set: rays >= 1 directions, power >= 1. */
+bb_status bb_rayset_make(int rays, double power, bb_basis basis,
+                         bb_rayset *out, bb_error *err);
+void bb_rayset_free(bb_rayset *rs);
+
+/* ------------------------------------------------------------------ trace */
+
+/* Progress callback: done out of total work units; return nonzero to go on. */
+typedef void (*bb_progress_fn)(void *user, long done, long total);
+
+typedef struct bb_trace_options {
+  double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
+  int threads;          /* 0 = all cores */
+  int jitter;           /* 1 = rotate the ray set per texel (statistical) */
+  bb_progress_fn progress; /* may be NULL; called from one thread */
+  void *progress_user;
+} bb_trace_options;
+
+void bb_trace_options_init(bb_trace_options *o);
+
+/* Traces every texel of the pyramid against the ray set. Allocates vis with
+ * 1 + rs->basis_count channels: ao, vis_0, vis_1, ... in [0, 1]. The result
+ * is bit-identical for any thread count. rays_traced (may be NULL) receives
+ * texels * ray_count. */
+bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
+                             const bb_trace_options *o, bb_image *vis,
+                             double *rays_traced, bb_error *err);
+
+/* ----------------------------------------------------------------- derive */
+
+/* weights w_c = sat(N.B_c)^2 / sum_k sat(N.B_k)^2 (3 channels). */
+bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *err);
+
+/* ssbump s_c = max(0, N.B_c) * vis_c, for the basis_count channels of vis
+ * after ao (vis as bb_trace_occlusion makes it). */
+bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
+                           bb_image *out, bb_error *err);
+
+/* ao as a 1-channel image (channel 0 of vis). */
+bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err);
+
+/* Bent normal normalize(sum_c s_c B_c) (3 channels; +Y down). */
+bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err);
+
+/* ------------------------------------------------------------------- bake */
+
+typedef struct bb_bake_options {
+  float height_scale;         /* S, texels per unit of h, > 0 */
+  int rays;                   /* per texel, default 256 */
+  bb_smooth_options smooth;   /* filter radius/threshold/addressing */
+  bb_trace_options trace;     /* bias, threads, jitter, progress */
+  double power;               /* P >= 1, default 1 */
+  bb_basis basis;             /* default BB_BASIS_HL2 */
+  bb_normal_filter normal_filter; /* default BB_NORMAL_VALVE */
+  int normal_y_up;            /* 1 flips green of normal and bent */
+  int want_trace;             /* 0: only normals/weights/filtered are made */
+} bb_bake_options;
+
+void bb_bake_options_init(bb_bake_options *o);
+
+/* Everything one bake makes. Images not made are zeroed (pixels NULL). */
+typedef struct bb_bake_result {
+  bb_image filtered;   /* smoothed h, 1 channel */
+  bb_image normal;     /* 3 channels */
+  bb_image weights;    /* 3 channels */
+  bb_image vis;        /* 1 + basis channels: ao, vis_c (when traced) */
+  bb_image ssbump;     /* basis channels (when traced) */
+  bb_image ao;         /* 1 channel (when traced) */
+  bb_image bent;       /* 3 channels (when traced) */
+  double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
+  double rays_traced;
+  char rayset_id[64];
+} bb_bake_result;
+
+/* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
+ * field (normalised h). Fills result; free it with bb_bake_result_free. */
+bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
+                  bb_bake_result *result, bb_error *err);
+
+void bb_bake_result_free(bb_bake_result *r);
+
+/* ---------------------------------------------------------------- compare */
+
+typedef struct bb_compare_stats {
+  double mean_abs, rms, max_abs;
+  int worst_x, worst_y, worst_channel;
+  long pixels;
+  long over_fail, over_warn;  /* pixels with any channel over the threshold */
+} bb_compare_stats;
+
+/* Channel-by-channel comparison of two images of equal size and channels
+ * (BB_ERR_SIZE otherwise). A pixel counts as over a threshold when any of
+ * its channels differs by more than it. diff (may be NULL) receives |a - b|. */
+bb_status bb_compare_images(const bb_image *a, const bb_image *b,
+                            double fail_threshold, double warn_threshold,
+                            bb_compare_stats *stats, bb_image *diff,
+                            bb_error *err);
+
+/* ------------------------------------------------------------- provenance */
+
+/* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
+uint64_t bb_image_hash(const bb_image *img);
+
+/* How an output was made. Every field that affects pixels is here. */
+typedef struct bb_provenance {
+  const char *command;        /* the command line, or NULL */
+  const char *input_name;     /* input file name (no directory), or NULL */
+  uint64_t input_hash;        /* bb_image_hash of the decoded input pixels */
+  const char *output_kind;    /* "normal", "ssbump", "ao", ... */
+  const bb_bake_options *options;
+  bb_channel channel;         /* height channel rule used */
+  const char *rayset_id;      /* bb_rayset.id, or NULL when nothing was traced */
+} bb_provenance;
+
+/* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
+ * output, scale, rays, rayset, filter_radius, filter_threshold, bias, power,
+ * basis, normal_filter, normal_y, addressing, channel), malloc'd; the caller
+ * frees it. Returns NULL when out of memory. */
+char *bb_provenance_format(const bb_provenance *p);
+
+/* Writes into out (capacity cap) the keys whose values differ between two
+ * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
+ * when either text is NULL). Keys "command" and "output" are ignored. Returns
+ * the number of differing keys. */
+int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
+
+const char *bb_channel_name(bb_channel c);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BUMPBAKE_H */

@@ -1,0 +1,56 @@
+/* internal.h: helpers shared between bumpbake's source files (not public). */
+#ifndef BB_INTERNAL_H
+#define BB_INTERNAL_H
+
+#include "bumpbake.h"
+
+#include <assert.h>
+#include <stdarg.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Writes a printf-style message into err (when not NULL) and returns status,
+ * so error paths read: return bb__fail(err, BB_ERR_IO, "%s: ...", path); */
+bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Non-negative remainder: the periodic index of i in [0, n). */
+static inline int bb__wrap(int i, int n) {
+  int r = i % n;
+  return r < 0 ? r + n : r;
+}
+
+static inline int bb__clampi(int i, int lo, int hi) {
+  return i < lo ? lo : (i > hi ? hi : i);
+}
+
+/* Texel index for addressing mode a (periodic wrap or clamp to the border). */
+static inline int bb__address(int i, int n, bb_addressing a) {
+  return a == BB_ADDRESS_PERIODIC ? bb__wrap(i, n) : bb__clampi(i, 0, n - 1);
+}
+
+/* Number of worker threads to use for a request of `threads` (0 = all cores). */
+int bb__thread_count(int threads);
+
+/* Runs fn(user, item) for item = 0 .. items-1 on `threads` threads; items
+ * are handed out in order from a shared counter. Each item's result must
+ * depend only on the item, which keeps outputs identical for any thread
+ * count. progress (may be NULL) is called from the calling thread. */
+typedef void (*bb__work_fn)(void *user, int item);
+bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
+                           bb_progress_fn progress, void *progress_user,
+                           bb_error *err);
+
+/* Monotonic wall-clock seconds. */
+double bb__now_seconds(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_INTERNAL_H */
