@@ -19,6 +19,9 @@
  * kernel needlessly large. */
 #define MAX_RADIUS BB_MAX_DIMENSION
 
+/* Largest cut reach: sqrt(2 * MAX_RADIUS * 0.033 * ln(1e7)) = 264.2. */
+#define MAX_REACH 265
+
 /* Most channels bb_image_alloc accepts; sizes the per-texel accumulator. */
 #define MAX_CHANNELS 64
 
@@ -54,6 +57,7 @@ static int cut_reach(int radius) {
 
 static bb_status kernel_make(int radius, cut_kernel *k, bb_error *err) {
   k->reach = cut_reach(radius);
+  assert(k->reach <= MAX_REACH);
   int side = 2 * k->reach + 1;
   k->taps = malloc((size_t)side * (size_t)side * sizeof *k->taps);
   if (!k->taps) return bb__fail(err, BB_ERR_MEMORY, "cannot allocate the filter kernel");
@@ -79,34 +83,42 @@ typedef struct smooth_job {
   const int *column;
 } smooth_job;
 
+/* One texel: the taps in their fixed order; row[] holds the offset of the
+ * first texel of each kernel row (dy = -reach .. reach) in the image. */
+static void smooth_texel(const smooth_job *job, const size_t *row, int x, double centre,
+                         float *out) {
+  const bb_image *in = job->in;
+  const int channels = in->channels;
+  const size_t in_stride = (size_t)channels, guide_stride = (size_t)job->guide->channels;
+  const cut_kernel *k = job->kernel;
+  const int *column = job->column + x + k->reach;
+  double acc[MAX_CHANNELS];
+  double weight_sum = 0.0;
+  memset(acc, 0, (size_t)channels * sizeof acc[0]);
+  for (int t = 0; t < k->count; t++) {
+    const kernel_tap *tap = &k->taps[t];
+    size_t texel = row[tap->dy + k->reach] + (size_t)column[tap->dx];
+    double h = (double)job->guide->pixels[texel * guide_stride];
+    /* s = max(0, ...) without a branch: a zero weight adds exactly 0. */
+    double w = fmax(0.0, 1.0 - fabs(h - centre) / job->threshold) * tap->weight;
+    const float *q = in->pixels + texel * in_stride;
+    for (int c = 0; c < channels; c++) acc[c] += w * (double)q[c];
+    weight_sum += w;
+  }
+  /* The centre tap has s = g = 1, so weight_sum >= 1. */
+  for (int c = 0; c < channels; c++) out[c] = (float)(acc[c] / weight_sum);
+}
+
 static void smooth_row(void *user, int y) {
   const smooth_job *job = user;
-  const bb_image *in = job->in;
-  const int width = in->width, channels = in->channels;
-  const size_t in_stride = (size_t)in->channels, guide_stride = (size_t)job->guide->channels;
-  const cut_kernel *k = job->kernel;
-  double acc[MAX_CHANNELS];
-
-  for (int x = 0; x < width; x++) {
-    const double centre = (double)*bb_image_texel(job->guide, x, y);
-    double weight_sum = 0.0;
-    memset(acc, 0, (size_t)channels * sizeof acc[0]);
-    for (int t = 0; t < k->count; t++) {
-      const kernel_tap *tap = &k->taps[t];
-      size_t row = (size_t)bb__address(y + tap->dy, in->height, job->addressing);
-      size_t texel = row * (size_t)width + (size_t)job->column[x + tap->dx + k->reach];
-      double h = (double)job->guide->pixels[texel * guide_stride];
-      double range = 1.0 - fabs(h - centre) / job->threshold;
-      if (range <= 0.0) continue; /* s = max(0, ...) */
-      double w = range * tap->weight;
-      const float *q = in->pixels + texel * in_stride;
-      for (int c = 0; c < channels; c++) acc[c] += w * (double)q[c];
-      weight_sum += w;
-    }
-    /* The centre tap has s = g = 1, so weight_sum >= 1. */
-    float *p = bb_image_texel(job->out, x, y);
-    for (int c = 0; c < channels; c++) p[c] = (float)(acc[c] / weight_sum);
-  }
+  const int reach = job->kernel->reach;
+  size_t row[2 * (MAX_REACH) + 1];
+  for (int dy = -reach; dy <= reach; dy++)
+    row[dy + reach] = (size_t)bb__address(y + dy, job->in->height, job->addressing) *
+                      (size_t)job->in->width;
+  for (int x = 0; x < job->in->width; x++)
+    smooth_texel(job, row, x, (double)*bb_image_texel(job->guide, x, y),
+                 bb_image_texel(job->out, x, y));
 }
 
 static bb_status check_arguments(const bb_image *in, const bb_image *guide,

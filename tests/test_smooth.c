@@ -257,3 +257,10 @@ Test(smooth, rejects_output_aliasing_input) {
   cr_assert_not_null(h.pixels, "the input must survive");
   bb_image_free(&h);
 }
+
+/* The largest radius builds the largest cut kernel; one more is refused. */
+Test(smooth, radius_limit) {
+  bb_error err = {{0}};
+  cr_assert_eq(smooth_with(BB_MAX_DIMENSION, 0.01f, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(smooth_with(BB_MAX_DIMENSION + 1, 0.01f, NULL, &err), BB_ERR_ARGUMENT);
+}
