@@ -13,9 +13,11 @@ int bb_normal_filter_parse(const char *name, bb_normal_filter *out) {
   static const struct {
     const char *name;
     bb_normal_filter filter;
-  } names[] = {
-      {"valve", BB_NORMAL_VALVE}, {"central", BB_NORMAL_CENTRAL}, {"sobel", BB_NORMAL_SOBEL}};
-  if (!name || !out) return -1;
+  } names[] = {{"valve", BB_NORMAL_VALVE},
+               {"central", BB_NORMAL_CENTRAL},
+               {"sobel", BB_NORMAL_SOBEL}};
+  if (!name || !out)
+    return -1;
   for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
     if (strcmp(name, names[i].name) == 0) {
       *out = names[i].filter;
@@ -26,9 +28,12 @@ int bb_normal_filter_parse(const char *name, bb_normal_filter *out) {
 
 const char *bb_normal_filter_name(bb_normal_filter f) {
   switch (f) {
-  case BB_NORMAL_VALVE: return "valve";
-  case BB_NORMAL_CENTRAL: return "central";
-  case BB_NORMAL_SOBEL: return "sobel";
+  case BB_NORMAL_VALVE:
+    return "valve";
+  case BB_NORMAL_CENTRAL:
+    return "central";
+  case BB_NORMAL_SOBEL:
+    return "sobel";
   }
   return "unknown";
 }
@@ -63,7 +68,8 @@ static void add_unit(double sum[3], double nx, double ny, double nz) {
 static void normal_valve(const normal_job *job, int x, int y, double n[3]) {
   double z[4][4]; /* z[j][i] = z(x - 1 + i, y - 1 + j) */
   for (int j = 0; j < 4; j++)
-    for (int i = 0; i < 4; i++) z[j][i] = z_at(job, x - 1 + i, y - 1 + j);
+    for (int i = 0; i < 4; i++)
+      z[j][i] = z_at(job, x - 1 + i, y - 1 + j);
   n[0] = n[1] = n[2] = 0.0;
   for (int j = 0; j < 3; j++)
     for (int i = 0; i < 3; i++) {
@@ -84,9 +90,12 @@ static void normal_central(const normal_job *job, int x, int y, double n[3]) {
 static void normal_sobel(const normal_job *job, int x, int y, double n[3]) {
   double z[3][3]; /* z[j][i] = z(x - 1 + i, y - 1 + j) */
   for (int j = 0; j < 3; j++)
-    for (int i = 0; i < 3; i++) z[j][i] = z_at(job, x - 1 + i, y - 1 + j);
-  double gx = ((z[0][2] + 2.0 * z[1][2] + z[2][2]) - (z[0][0] + 2.0 * z[1][0] + z[2][0])) / 8.0;
-  double gy = ((z[2][0] + 2.0 * z[2][1] + z[2][2]) - (z[0][0] + 2.0 * z[0][1] + z[0][2])) / 8.0;
+    for (int i = 0; i < 3; i++)
+      z[j][i] = z_at(job, x - 1 + i, y - 1 + j);
+  double gx =
+      ((z[0][2] + 2.0 * z[1][2] + z[2][2]) - (z[0][0] + 2.0 * z[1][0] + z[2][0])) / 8.0;
+  double gy =
+      ((z[2][0] + 2.0 * z[2][1] + z[2][2]) - (z[0][0] + 2.0 * z[0][1] + z[0][2])) / 8.0;
   n[0] = -gx;
   n[1] = -gy;
   n[2] = 1.0;
@@ -97,14 +106,21 @@ static void normal_row(void *user, int y) {
   for (int x = 0; x < job->height->width; x++) {
     double n[3] = {0.0, 0.0, 1.0}; /* filter was validated; this quiets -Wuninitialized */
     switch (job->filter) {
-    case BB_NORMAL_VALVE: normal_valve(job, x, y, n); break;
-    case BB_NORMAL_CENTRAL: normal_central(job, x, y, n); break;
-    case BB_NORMAL_SOBEL: normal_sobel(job, x, y, n); break;
+    case BB_NORMAL_VALVE:
+      normal_valve(job, x, y, n);
+      break;
+    case BB_NORMAL_CENTRAL:
+      normal_central(job, x, y, n);
+      break;
+    case BB_NORMAL_SOBEL:
+      normal_sobel(job, x, y, n);
+      break;
     }
     /* n.z > 0 in every estimator, so the length is never zero. */
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     float *p = bb_image_texel(job->out, x, y);
-    for (int c = 0; c < 3; c++) p[c] = (float)(n[c] / len);
+    for (int c = 0; c < 3; c++)
+      p[c] = (float)(n[c] / len);
   }
 }
 
@@ -120,7 +136,8 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
                     height->channels);
   if (!isfinite(height_scale))
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: height scale is not finite");
-  if (filter != BB_NORMAL_VALVE && filter != BB_NORMAL_CENTRAL && filter != BB_NORMAL_SOBEL)
+  if (filter != BB_NORMAL_VALVE && filter != BB_NORMAL_CENTRAL &&
+      filter != BB_NORMAL_SOBEL)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: unknown filter %d", (int)filter);
   if (addressing != BB_ADDRESS_PERIODIC && addressing != BB_ADDRESS_CLAMP)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: unknown addressing mode %d",
@@ -128,7 +145,8 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
   for (int y = 0; y < height->height; y++)
     for (int x = 0; x < height->width; x++)
       if (!isfinite(*bb_image_texel(height, x, y)))
-        return bb__fail(err, BB_ERR_VALUE, "normals: height at (%d, %d) is not finite", x, y);
+        return bb__fail(err, BB_ERR_VALUE, "normals: height at (%d, %d) is not finite", x,
+                        y);
   return BB_OK;
 }
 
@@ -136,11 +154,14 @@ bb_status bb_normals_compute(const bb_image *height, float height_scale,
                              bb_normal_filter filter, bb_addressing addressing,
                              bb_image *out, bb_error *err) {
   bb_status st = check_arguments(height, height_scale, filter, addressing, out, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   st = bb_image_alloc(out, height->width, height->height, 3, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   normal_job job = {height, (double)height_scale, filter, addressing, out};
   st = bb__parallel_for(height->height, 0, normal_row, &job, NULL, NULL, err);
-  if (st != BB_OK) bb_image_free(out);
+  if (st != BB_OK)
+    bb_image_free(out);
   return st;
 }

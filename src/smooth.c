@@ -1,4 +1,5 @@
-/* smooth.c: Valve's tileable bilateral filter of a height field (CONVENTIONS "Smoothing").
+/* smooth.c: Valve's tileable bilateral filter of a height field (CONVENTIONS
+ * "Smoothing").
  *
  * Invariant: every output texel is the sum over the same cut kernel, taken in
  * the same fixed order, of values read at fixed offsets from it. So the
@@ -51,7 +52,8 @@ static double spatial_weight(int dx, int dy, int radius) {
 /* Largest |d| along an axis whose weight survives the cut (<= radius). */
 static int cut_reach(int radius) {
   int reach = 0;
-  while (reach < radius && spatial_weight(reach + 1, 0, radius) >= CUT_FRACTION) reach++;
+  while (reach < radius && spatial_weight(reach + 1, 0, radius) >= CUT_FRACTION)
+    reach++;
   return reach;
 }
 
@@ -60,12 +62,14 @@ static bb_status kernel_make(int radius, cut_kernel *k, bb_error *err) {
   assert(k->reach <= MAX_REACH);
   int side = 2 * k->reach + 1;
   k->taps = malloc((size_t)side * (size_t)side * sizeof *k->taps);
-  if (!k->taps) return bb__fail(err, BB_ERR_MEMORY, "cannot allocate the filter kernel");
+  if (!k->taps)
+    return bb__fail(err, BB_ERR_MEMORY, "cannot allocate the filter kernel");
   k->count = 0;
   for (int dy = -k->reach; dy <= k->reach; dy++)
     for (int dx = -k->reach; dx <= k->reach; dx++) {
       double g = spatial_weight(dx, dy, radius);
-      if (g < CUT_FRACTION) continue;
+      if (g < CUT_FRACTION)
+        continue;
       k->taps[k->count++] = (kernel_tap){dx, dy, g};
     }
   return BB_OK;
@@ -102,11 +106,13 @@ static void smooth_texel(const smooth_job *job, const size_t *row, int x, double
     /* s = max(0, ...) without a branch: a zero weight adds exactly 0. */
     double w = fmax(0.0, 1.0 - fabs(h - centre) / job->threshold) * tap->weight;
     const float *q = in->pixels + texel * in_stride;
-    for (int c = 0; c < channels; c++) acc[c] += w * (double)q[c];
+    for (int c = 0; c < channels; c++)
+      acc[c] += w * (double)q[c];
     weight_sum += w;
   }
   /* The centre tap has s = g = 1, so weight_sum >= 1. */
-  for (int c = 0; c < channels; c++) out[c] = (float)(acc[c] / weight_sum);
+  for (int c = 0; c < channels; c++)
+    out[c] = (float)(acc[c] / weight_sum);
 }
 
 static void smooth_row(void *user, int y) {
@@ -151,29 +157,33 @@ static bb_status check_guide_finite(const bb_image *guide, bb_error *err) {
   for (int y = 0; y < guide->height; y++)
     for (int x = 0; x < guide->width; x++)
       if (!isfinite(*bb_image_texel(guide, x, y)))
-        return bb__fail(err, BB_ERR_VALUE, "smooth: guide height at (%d, %d) is not finite",
-                        x, y);
+        return bb__fail(err, BB_ERR_VALUE,
+                        "smooth: guide height at (%d, %d) is not finite", x, y);
   return BB_OK;
 }
 
 static bb_status copy_image(const bb_image *in, bb_image *out, bb_error *err) {
   bb_status st = bb_image_alloc(out, in->width, in->height, in->channels, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   size_t count = (size_t)in->width * (size_t)in->height * (size_t)in->channels;
   memcpy(out->pixels, in->pixels, count * sizeof(float));
   return BB_OK;
 }
 
 bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
-                              const bb_smooth_options *o, bb_image *out,
-                              bb_error *err) {
+                              const bb_smooth_options *o, bb_image *out, bb_error *err) {
   bb_status st = check_arguments(in, guide, o, out, err);
-  if (st != BB_OK) return st;
-  if (o->radius_texels == 0) return copy_image(in, out, err);
-  if ((st = check_guide_finite(guide, err)) != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
+  if (o->radius_texels == 0)
+    return copy_image(in, out, err);
+  if ((st = check_guide_finite(guide, err)) != BB_OK)
+    return st;
 
   cut_kernel kernel;
-  if ((st = kernel_make(o->radius_texels, &kernel, err)) != BB_OK) return st;
+  if ((st = kernel_make(o->radius_texels, &kernel, err)) != BB_OK)
+    return st;
   int *column = malloc((size_t)(in->width + 2 * kernel.reach) * sizeof *column);
   if (!column) {
     free(kernel.taps);
@@ -184,9 +194,11 @@ bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
 
   st = bb_image_alloc(out, in->width, in->height, in->channels, err);
   if (st == BB_OK) {
-    smooth_job job = {in, guide, out, &kernel, (double)o->threshold, o->addressing, column};
+    smooth_job job = {in,    guide, out, &kernel, (double)o->threshold, o->addressing,
+                      column};
     st = bb__parallel_for(in->height, 0, smooth_row, &job, NULL, NULL, err);
-    if (st != BB_OK) bb_image_free(out);
+    if (st != BB_OK)
+      bb_image_free(out);
   }
   free(column);
   free(kernel.taps);

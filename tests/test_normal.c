@@ -13,7 +13,8 @@ static const bb_normal_filter all_filters[] = {BB_NORMAL_VALVE, BB_NORMAL_CENTRA
                                                BB_NORMAL_SOBEL};
 
 static void fill_constant(bb_image *h, float value) {
-  for (int i = 0; i < h->width * h->height; i++) h->pixels[i] = value;
+  for (int i = 0; i < h->width * h->height; i++)
+    h->pixels[i] = value;
 }
 
 static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addressing a,
@@ -28,7 +29,8 @@ static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addre
 Test(normal, filter_names_round_trip) {
   for (size_t i = 0; i < 3; i++) {
     bb_normal_filter parsed = (bb_normal_filter)-1;
-    cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed), 0);
+    cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed),
+                 0);
     cr_assert_eq(parsed, all_filters[i]);
   }
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_VALVE), "valve");
@@ -72,7 +74,8 @@ static void check_sine(bb_normal_filter f, int along_y, double tolerance) {
   cr_assert_eq(bb_image_alloc(&h, w, hgt, 1, NULL), BB_OK);
   for (int y = 0; y < hgt; y++)
     for (int x = 0; x < w; x++)
-      bb_image_texel(&h, x, y)[0] = (float)(0.5 + 0.5 * sin(2.0 * PI * (along_y ? y : x) / period));
+      bb_image_texel(&h, x, y)[0] =
+          (float)(0.5 + 0.5 * sin(2.0 * PI * (along_y ? y : x) / period));
   compute(&h, (float)scale, f, BB_ADDRESS_PERIODIC, &n);
   const double offset = f == BB_NORMAL_VALVE ? 0.5 : 0.0;
   for (int y = 0; y < hgt; y++)
@@ -83,19 +86,32 @@ static void check_sine(bb_normal_filter f, int along_y, double tolerance) {
       double len = sqrt(1.0 + slope * slope);
       const float *got = bb_image_texel(&n, x, y);
       for (int c = 0; c < 3; c++)
-        cr_assert(fabs(got[c] - want[c] / len) < tolerance, "%s (%d,%d) c%d: got %.5f want %.5f",
-                  bb_normal_filter_name(f), x, y, c, (double)got[c], want[c] / len);
+        cr_assert(fabs(got[c] - want[c] / len) < tolerance,
+                  "%s (%d,%d) c%d: got %.5f want %.5f", bb_normal_filter_name(f), x, y, c,
+                  (double)got[c], want[c] / len);
     }
   bb_image_free(&h);
   bb_image_free(&n);
 }
 
-Test(normal, sine_along_x_valve) { check_sine(BB_NORMAL_VALVE, 0, 0.015); }
-Test(normal, sine_along_y_valve) { check_sine(BB_NORMAL_VALVE, 1, 0.015); }
-Test(normal, sine_along_x_central) { check_sine(BB_NORMAL_CENTRAL, 0, 0.004); }
-Test(normal, sine_along_y_central) { check_sine(BB_NORMAL_CENTRAL, 1, 0.004); }
-Test(normal, sine_along_x_sobel) { check_sine(BB_NORMAL_SOBEL, 0, 0.004); }
-Test(normal, sine_along_y_sobel) { check_sine(BB_NORMAL_SOBEL, 1, 0.004); }
+Test(normal, sine_along_x_valve) {
+  check_sine(BB_NORMAL_VALVE, 0, 0.015);
+}
+Test(normal, sine_along_y_valve) {
+  check_sine(BB_NORMAL_VALVE, 1, 0.015);
+}
+Test(normal, sine_along_x_central) {
+  check_sine(BB_NORMAL_CENTRAL, 0, 0.004);
+}
+Test(normal, sine_along_y_central) {
+  check_sine(BB_NORMAL_CENTRAL, 1, 0.004);
+}
+Test(normal, sine_along_x_sobel) {
+  check_sine(BB_NORMAL_SOBEL, 0, 0.004);
+}
+Test(normal, sine_along_y_sobel) {
+  check_sine(BB_NORMAL_SOBEL, 1, 0.004);
+}
 
 /* h = gx * x + gy * y: every estimator is exact on a plane away from the
  * clamped border, and the signs follow the frame (x right, y DOWN). */
@@ -104,16 +120,20 @@ static void check_plane(double gx, double gy) {
   bb_image h = {0}, n = {0};
   cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
-    for (int x = 0; x < 8; x++) bb_image_texel(&h, x, y)[0] = (float)(gx * x + gy * y);
+    for (int x = 0; x < 8; x++)
+      bb_image_texel(&h, x, y)[0] = (float)(gx * x + gy * y);
   double sx = -scale * gx, sy = -scale * gy, len = sqrt(sx * sx + sy * sy + 1.0);
   for (size_t i = 0; i < 3; i++) {
     compute(&h, scale, all_filters[i], BB_ADDRESS_CLAMP, &n);
     for (int y = 1; y < 6; y++) /* Valve reads up to x+2, y+2 */
       for (int x = 1; x < 6; x++) {
         const float *got = bb_image_texel(&n, x, y);
-        cr_assert_float_eq(got[0], sx / len, 1e-6, "%s", bb_normal_filter_name(all_filters[i]));
-        cr_assert_float_eq(got[1], sy / len, 1e-6, "%s", bb_normal_filter_name(all_filters[i]));
-        cr_assert_float_eq(got[2], 1.0 / len, 1e-6, "%s", bb_normal_filter_name(all_filters[i]));
+        cr_assert_float_eq(got[0], sx / len, 1e-6, "%s",
+                           bb_normal_filter_name(all_filters[i]));
+        cr_assert_float_eq(got[1], sy / len, 1e-6, "%s",
+                           bb_normal_filter_name(all_filters[i]));
+        cr_assert_float_eq(got[2], 1.0 / len, 1e-6, "%s",
+                           bb_normal_filter_name(all_filters[i]));
       }
     bb_image_free(&n);
   }
@@ -125,7 +145,8 @@ Test(normal, plane_rising_down_the_rows_tilts_y_negative) {
   bb_image h = {0}, n = {0};
   cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
-    for (int x = 0; x < 8; x++) bb_image_texel(&h, x, y)[0] = 0.1f * (float)y;
+    for (int x = 0; x < 8; x++)
+      bb_image_texel(&h, x, y)[0] = 0.1f * (float)y;
   compute(&h, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_CLAMP, &n);
   /* Height rises towards +y (down), so the surface faces up the image. */
   cr_assert_lt(bb_image_texel(&n, 3, 3)[1], -0.05f);
@@ -145,11 +166,13 @@ Test(normal, clamp_and_periodic_borders) {
   bb_image h = {0}, clamp = {0}, periodic = {0};
   cr_assert_eq(bb_image_alloc(&h, 8, 3, 1, NULL), BB_OK);
   for (int y = 0; y < 3; y++)
-    for (int x = 0; x < 8; x++) bb_image_texel(&h, x, y)[0] = 0.1f * (float)x;
+    for (int x = 0; x < 8; x++)
+      bb_image_texel(&h, x, y)[0] = 0.1f * (float)x;
   compute(&h, 2.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_CLAMP, &clamp);
   compute(&h, 2.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_PERIODIC, &periodic);
   double half = -2.0 * 0.1 / 2.0; /* (z(1) - z(0)) / 2 */
-  cr_assert_float_eq(bb_image_texel(&clamp, 0, 1)[0], half / sqrt(half * half + 1.0), 1e-6);
+  cr_assert_float_eq(bb_image_texel(&clamp, 0, 1)[0], half / sqrt(half * half + 1.0),
+                     1e-6);
   /* Periodic: z(-1) = z(7) = 1.4, so the slope at x = 0 is negative. */
   cr_assert_gt(bb_image_texel(&periodic, 0, 1)[0], 0.5f);
   bb_image_free(&h);
@@ -166,7 +189,8 @@ Test(normal, unit_length_and_facing_up_on_noise) {
   bb_image h = {0}, n = {0};
   uint64_t state = 11;
   cr_assert_eq(bb_image_alloc(&h, 31, 17, 1, NULL), BB_OK);
-  for (int i = 0; i < 31 * 17; i++) h.pixels[i] = (float)next_random(&state);
+  for (int i = 0; i < 31 * 17; i++)
+    h.pixels[i] = (float)next_random(&state);
   for (size_t i = 0; i < 3; i++) {
     compute(&h, 30.0f, all_filters[i], BB_ADDRESS_PERIODIC, &n);
     for (int k = 0; k < 31 * 17; k++) {
@@ -198,7 +222,8 @@ Test(normal, periodic_shift_is_exact) {
     for (int y = 0; y < hgt; y++)
       for (int x = 0; x < w; x++)
         cr_assert_eq(memcmp(bb_image_texel(&a, x, y),
-                            bb_image_texel(&b, (x + dx) % w, (y + dy) % hgt), 3 * sizeof(float)),
+                            bb_image_texel(&b, (x + dx) % w, (y + dy) % hgt),
+                            3 * sizeof(float)),
                      0, "%s (%d,%d)", bb_normal_filter_name(all_filters[i]), x, y);
     bb_image_free(&a);
     bb_image_free(&b);
@@ -212,20 +237,26 @@ Test(normal, rejects_bad_arguments) {
   bb_error err = {{0}};
   cr_assert_eq(bb_image_alloc(&h, 4, 4, 1, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&rgb, 4, 4, 3, NULL), BB_OK);
-  cr_assert_eq(bb_normals_compute(&rgb, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
-               BB_ERR_ARGUMENT);
+  cr_assert_eq(
+      bb_normals_compute(&rgb, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
+      BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "channels") != NULL, "%s", err.message);
-  cr_assert_eq(bb_normals_compute(&h, NAN, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
-               BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_normals_compute(&h, INFINITY, BB_NORMAL_SOBEL, BB_ADDRESS_CLAMP, &n, &err),
-               BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_normals_compute(&h, 1.0f, (bb_normal_filter)7, BB_ADDRESS_PERIODIC, &n, &err),
-               BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_normals_compute(&h, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &h, &err),
-               BB_ERR_ARGUMENT);
+  cr_assert_eq(
+      bb_normals_compute(&h, NAN, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
+      BB_ERR_ARGUMENT);
+  cr_assert_eq(
+      bb_normals_compute(&h, INFINITY, BB_NORMAL_SOBEL, BB_ADDRESS_CLAMP, &n, &err),
+      BB_ERR_ARGUMENT);
+  cr_assert_eq(
+      bb_normals_compute(&h, 1.0f, (bb_normal_filter)7, BB_ADDRESS_PERIODIC, &n, &err),
+      BB_ERR_ARGUMENT);
+  cr_assert_eq(
+      bb_normals_compute(&h, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &h, &err),
+      BB_ERR_ARGUMENT);
   bb_image_texel(&h, 2, 1)[0] = NAN;
-  cr_assert_eq(bb_normals_compute(&h, 1.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_PERIODIC, &n, &err),
-               BB_ERR_VALUE);
+  cr_assert_eq(
+      bb_normals_compute(&h, 1.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_PERIODIC, &n, &err),
+      BB_ERR_VALUE);
   cr_assert(strstr(err.message, "(2, 1)") != NULL, "%s", err.message);
   cr_assert_null(n.pixels);
   bb_image_free(&h);

@@ -29,7 +29,8 @@ static void fill_test_field(bb_image *img, uint64_t seed) {
 }
 
 static int address(int i, int n, bb_addressing a) {
-  if (a == BB_ADDRESS_PERIODIC) return ((i % n) + n) % n;
+  if (a == BB_ADDRESS_PERIODIC)
+    return ((i % n) + n) % n;
   return i < 0 ? 0 : (i >= n ? n - 1 : i);
 }
 
@@ -42,7 +43,8 @@ static double brute_force(const bb_image *in, const bb_image *guide, int x, int 
     for (int ix = -radius; ix <= radius; ix++) {
       int qx = address(x + ix, in->width, a), qy = address(y + iy, in->height, a);
       double g = exp(-(double)(ix * ix + iy * iy) / (2.0 * radius * 0.033));
-      double s = fmax(0.0, 1.0 - fabs(bb_image_texel(guide, qx, qy)[0] - centre) / threshold);
+      double s =
+          fmax(0.0, 1.0 - fabs(bb_image_texel(guide, qx, qy)[0] - centre) / threshold);
       num += s * g * bb_image_texel(in, qx, qy)[c];
       den += s * g;
     }
@@ -67,7 +69,8 @@ static void check_against_brute_force(int radius, bb_addressing a) {
       double got = bb_image_texel(&out, x, y)[0];
       cr_assert(fabs(got - want) < 1e-6, "R=%d texel (%d,%d): got %.9f want %.9f", radius,
                 x, y, got, want);
-      if (got != bb_image_texel(&h, x, y)[0]) changed++;
+      if (got != bb_image_texel(&h, x, y)[0])
+        changed++;
     }
   /* The field must actually be smoothed, or the comparison proves little.
    * (At R = 1 Valve's g is 2.6e-7 at one texel, so floats barely move.) */
@@ -86,12 +89,24 @@ Test(smooth, options_defaults) {
   cr_assert_eq(o.addressing, BB_ADDRESS_PERIODIC);
 }
 
-Test(smooth, brute_force_r1_periodic) { check_against_brute_force(1, BB_ADDRESS_PERIODIC); }
-Test(smooth, brute_force_r1_clamp) { check_against_brute_force(1, BB_ADDRESS_CLAMP); }
-Test(smooth, brute_force_r3_periodic) { check_against_brute_force(3, BB_ADDRESS_PERIODIC); }
-Test(smooth, brute_force_r3_clamp) { check_against_brute_force(3, BB_ADDRESS_CLAMP); }
-Test(smooth, brute_force_r10_periodic) { check_against_brute_force(10, BB_ADDRESS_PERIODIC); }
-Test(smooth, brute_force_r10_clamp) { check_against_brute_force(10, BB_ADDRESS_CLAMP); }
+Test(smooth, brute_force_r1_periodic) {
+  check_against_brute_force(1, BB_ADDRESS_PERIODIC);
+}
+Test(smooth, brute_force_r1_clamp) {
+  check_against_brute_force(1, BB_ADDRESS_CLAMP);
+}
+Test(smooth, brute_force_r3_periodic) {
+  check_against_brute_force(3, BB_ADDRESS_PERIODIC);
+}
+Test(smooth, brute_force_r3_clamp) {
+  check_against_brute_force(3, BB_ADDRESS_CLAMP);
+}
+Test(smooth, brute_force_r10_periodic) {
+  check_against_brute_force(10, BB_ADDRESS_PERIODIC);
+}
+Test(smooth, brute_force_r10_clamp) {
+  check_against_brute_force(10, BB_ADDRESS_CLAMP);
+}
 
 /* R = 25 reaches past the 19-texel height: periodic wrapping and clamping of
  * offsets larger than the image must still agree with the direct sum. */
@@ -148,14 +163,15 @@ Test(smooth, keeps_edges_above_threshold) {
   bb_image h = {0}, out = {0};
   cr_assert_eq(bb_image_alloc(&h, 32, 8, 1, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
-    for (int x = 0; x < 32; x++) bb_image_texel(&h, x, y)[0] = x < 16 ? 0.25f : 0.75f;
+    for (int x = 0; x < 32; x++)
+      bb_image_texel(&h, x, y)[0] = x < 16 ? 0.25f : 0.75f;
   bb_smooth_options o;
   bb_smooth_options_init(&o);
   cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 32; x++)
-      cr_assert_float_eq(bb_image_texel(&out, x, y)[0], bb_image_texel(&h, x, y)[0], 1e-7f,
-                         "(%d,%d)", x, y);
+      cr_assert_float_eq(bb_image_texel(&out, x, y)[0], bb_image_texel(&h, x, y)[0],
+                         1e-7f, "(%d,%d)", x, y);
   bb_image_free(&h);
   bb_image_free(&out);
 }
@@ -169,7 +185,8 @@ Test(smooth, periodic_shift_is_exact) {
   fill_test_field(&h, 99);
   for (int y = 0; y < hgt; y++)
     for (int x = 0; x < w; x++)
-      bb_image_texel(&shifted, (x + dx) % w, (y + dy) % hgt)[0] = bb_image_texel(&h, x, y)[0];
+      bb_image_texel(&shifted, (x + dx) % w, (y + dy) % hgt)[0] =
+          bb_image_texel(&h, x, y)[0];
   bb_smooth_options o;
   bb_smooth_options_init(&o);
   cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, NULL), BB_OK);
@@ -212,7 +229,8 @@ static bb_status smooth_with(int radius, float threshold, const bb_image *guide,
   o.radius_texels = radius;
   o.threshold = threshold;
   bb_status st = bb_smooth_bilateral(&h, guide ? guide : &h, &o, &out, err);
-  if (st != BB_OK) cr_assert_null(out.pixels, "a failed call must leave no output");
+  if (st != BB_OK)
+    cr_assert_null(out.pixels, "a failed call must leave no output");
   bb_image_free(&h);
   bb_image_free(&out);
   return st;
@@ -261,6 +279,7 @@ Test(smooth, rejects_output_aliasing_input) {
 /* The largest radius builds the largest cut kernel; one more is refused. */
 Test(smooth, radius_limit) {
   bb_error err = {{0}};
-  cr_assert_eq(smooth_with(BB_MAX_DIMENSION, 0.01f, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(smooth_with(BB_MAX_DIMENSION, 0.01f, NULL, &err), BB_OK, "%s",
+               err.message);
   cr_assert_eq(smooth_with(BB_MAX_DIMENSION + 1, 0.01f, NULL, &err), BB_ERR_ARGUMENT);
 }
