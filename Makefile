@@ -8,7 +8,7 @@ BUILD   := build/debug
 OPT     := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer
 else
 BUILD   := build
-OPT     := -O2 -g -DNDEBUG
+OPT     := -O3 -g -DNDEBUG
 endif
 
 CC      ?= cc

@@ -29,27 +29,33 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Walking state: the current cell in unwrapped coordinates (ix, iy), its
- * addressed index (cx, cy), the distance t at which the ray entered it and
- * the distances to its exit edges. */
+/* Per-direction constants of a march (shared by all texels of a slice). */
+typedef struct direction {
+  double dx, dy;             /* unit horizontal direction */
+  double inv_dx, inv_dy;     /* 1/dx, 1/dy; +inf when 0 (never crosses those lines) */
+  double inv_dsum;           /* 1/(dx+dy), 0 when the ray is parallel to the diagonals */
+  int sx, sy;                /* step direction per axis, +1 or -1 */
+} direction;
+
+/* Walking state: the cell (ix, iy) the ray is in, unwrapped, its addressed
+ * index (cx, cy), and the distance t at which the ray got there. */
 typedef struct walker {
   const bb_pyramid *p;
-  bb__march_ray r;
-  double inv_dx, inv_dy, inv_dsum; /* reciprocals; 0 where the component is 0 */
-  double osum;                     /* ox + oy, for the diagonals x + y = k */
-  int sx, sy;                      /* step direction, +1 or -1 */
+  direction d;
+  double ox, oy, oz, osum;
   int ix, iy, cx, cy;
-  double t, tnx, tny;
-  double margin;                   /* slack of every skip test, >> rounding */
+  double t;
+  double margin; /* slack of every skip test, far beyond rounding */
 } walker;
 
-/* Distance along the ray to the vertical line x = X (infinite if parallel). */
-static inline double cross_x(const walker *w, int X) {
-  return w->r.dx == 0.0 ? INFINITY : ((double)X - w->r.ox) * w->inv_dx;
-}
-
-static inline double cross_y(const walker *w, int Y) {
-  return w->r.dy == 0.0 ? INFINITY : ((double)Y - w->r.oy) * w->inv_dy;
+static void direction_init(direction *d, double dx, double dy) {
+  d->dx = dx;
+  d->dy = dy;
+  d->sx = dx < 0 ? -1 : 1;
+  d->sy = dy < 0 ? -1 : 1;
+  d->inv_dx = dx != 0.0 ? 1.0 / dx : INFINITY;
+  d->inv_dy = dy != 0.0 ? 1.0 / dy : INFINITY;
+  d->inv_dsum = (dx + dy) != 0.0 ? 1.0 / (dx + dy) : 0.0;
 }
 
 /* floor() without the libm call the x86-64 baseline makes of it. */
@@ -58,149 +64,14 @@ static inline int fast_floor(double v) {
   return (double)i > v ? i - 1 : i;
 }
 
+/* The cell index along an axis of a point moving with step sign s: on a
+ * cell edge, the cell the ray is about to enter. */
+static inline int cell_along(double v, int s) {
+  return s > 0 ? fast_floor(v) : -fast_floor(-v) - 1;
+}
+
 static inline int is_periodic(const walker *w) {
   return w->p->addressing == BB_ADDRESS_PERIODIC;
-}
-
-static inline int address(const walker *w, int i, int n) {
-  return is_periodic(w) ? bb__wrap(i, n) : bb__clampi(i, 0, n - 1);
-}
-
-/* Clamp mode only: a cell outside the image is the border extruded. */
-static inline int is_inside(const walker *w) {
-  return is_periodic(w) ||
-         (w->ix >= 0 && w->ix < w->p->width && w->iy >= 0 && w->iy < w->p->height);
-}
-
-static void update_exits(walker *w) {
-  w->tnx = cross_x(w, w->sx > 0 ? w->ix + 1 : w->ix);
-  w->tny = cross_y(w, w->sy > 0 ? w->iy + 1 : w->iy);
-}
-
-static void set_cell(walker *w, int ix, int iy) {
-  w->ix = ix;
-  w->iy = iy;
-  w->cx = address(w, ix, w->p->width);
-  w->cy = address(w, iy, w->p->height);
-  update_exits(w);
-}
-
-/* The first cell is the one the ray enters from its origin: an origin on a
- * cell edge belongs to the cell on the side the ray goes. */
-static void walker_init(walker *w, const bb_pyramid *p, const bb__march_ray *r) {
-  memset(w, 0, sizeof *w);
-  w->p = p;
-  w->r = *r;
-  w->sx = r->dx < 0 ? -1 : 1;
-  w->sy = r->dy < 0 ? -1 : 1;
-  w->inv_dx = r->dx != 0.0 ? 1.0 / r->dx : 0.0;
-  w->inv_dy = r->dy != 0.0 ? 1.0 / r->dy : 0.0;
-  w->inv_dsum = (r->dx + r->dy) != 0.0 ? 1.0 / (r->dx + r->dy) : 0.0;
-  w->osum = r->ox + r->oy;
-  w->margin = 1e-7 * (1.0 + fabs((double)p->global_max) + fabs((double)p->global_min) +
-                      fabs(r->oz));
-  int ix = (int)floor(r->ox), iy = (int)floor(r->oy);
-  if (r->dx < 0 && (double)ix == r->ox) ix--;
-  if (r->dy < 0 && (double)iy == r->oy) iy--;
-  w->t = 0.0;
-  set_cell(w, ix, iy);
-}
-
-/* Number of thresholds (from b on) that slope s blocks, plus b. */
-static inline int raise_horizon(const double *tan_el, int n, int b, double s) {
-  while (b < n && s >= tan_el[b]) b++;
-  return b;
-}
-
-static inline double clamp01(double v) {
-  return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
-}
-
-/* The exact cell test: the slopes of the diagonal crossing inside the current
- * cell and of the exit crossing. The entry crossing is the previous cell's
- * exit, so each breakpoint is tested once. Returns the new blocked count. */
-static int process_cell(const walker *w, const double *tan_el, int n, int b) {
-  const bb_pyramid *p = w->p;
-  const int wd = p->width;
-  const int x0 = w->cx, y0 = w->cy;
-  const int x1 = is_periodic(w) ? (x0 + 1 == wd ? 0 : x0 + 1) : bb__clampi(w->ix + 1, 0, wd - 1);
-  const int y1 = is_periodic(w) ? (y0 + 1 == p->height ? 0 : y0 + 1)
-                                : bb__clampi(w->iy + 1, 0, p->height - 1);
-  const float *row0 = p->z + (size_t)y0 * (size_t)wd, *row1 = p->z + (size_t)y1 * (size_t)wd;
-  const double z00 = row0[x0], z10 = row0[x1], z01 = row1[x0], z11 = row1[x1];
-  const double t_out = w->tnx < w->tny ? w->tnx : w->tny;
-
-  if (w->inv_dsum != 0.0) { /* diagonal from (ix+1, iy) to (ix, iy+1) */
-    double td = ((double)(w->ix + w->iy + 1) - w->osum) * w->inv_dsum;
-    if (td > w->t && td < t_out) {
-      double u = clamp01(w->r.oy + td * w->r.dy - (double)w->iy);
-      double surface = z10 + (z01 - z10) * u;
-      b = raise_horizon(tan_el, n, b, (surface - w->r.oz) / td);
-      if (b == n) return b;
-    }
-  }
-  double surface;
-  if (w->tnx <= w->tny) { /* leaves through a vertical edge */
-    double v = clamp01(w->r.oy + t_out * w->r.dy - (double)w->iy);
-    double za = w->sx > 0 ? z10 : z00, zb = w->sx > 0 ? z11 : z01;
-    surface = za + (zb - za) * v;
-  } else { /* through a horizontal edge */
-    double u = clamp01(w->r.ox + t_out * w->r.dx - (double)w->ix);
-    double za = w->sy > 0 ? z01 : z00, zb = w->sy > 0 ? z11 : z10;
-    surface = za + (zb - za) * u;
-  }
-  return raise_horizon(tan_el, n, b, (surface - w->r.oz) / t_out);
-}
-
-static inline int wrap_step(int c, int s, int n) {
-  c += s;
-  return c == n ? 0 : (c < 0 ? n - 1 : c);
-}
-
-/* The 2D DDA step to the next cell; a corner crossing moves diagonally. */
-static void step_cell(walker *w) {
-  const int move_x = w->tnx <= w->tny, move_y = w->tny <= w->tnx;
-  w->t = move_x ? w->tnx : w->tny;
-  if (move_x) {
-    w->ix += w->sx;
-    w->cx = is_periodic(w) ? wrap_step(w->cx, w->sx, w->p->width)
-                           : bb__clampi(w->ix, 0, w->p->width - 1);
-    w->tnx = cross_x(w, w->sx > 0 ? w->ix + 1 : w->ix);
-  }
-  if (move_y) {
-    w->iy += w->sy;
-    w->cy = is_periodic(w) ? wrap_step(w->cy, w->sy, w->p->height)
-                           : bb__clampi(w->iy, 0, w->p->height - 1);
-    w->tny = cross_y(w, w->sy > 0 ? w->iy + 1 : w->iy);
-  }
-}
-
-/* The column the ray is in at distance t, by the same comparisons the DDA
- * makes, so a jump over a node lands in the cell the DDA would reach. */
-static int locate_x(const walker *w, double t, int ix) {
-  if (w->r.dx == 0.0) return ix;
-  ix = fast_floor(w->r.ox + t * w->r.dx);
-  if (w->sx > 0) {
-    while (cross_x(w, ix + 1) <= t) ix++;
-    while (cross_x(w, ix) > t) ix--;
-  } else {
-    while (cross_x(w, ix) <= t) ix--;
-    while (cross_x(w, ix + 1) > t) ix++;
-  }
-  return ix;
-}
-
-static int locate_y(const walker *w, double t, int iy) {
-  if (w->r.dy == 0.0) return iy;
-  iy = fast_floor(w->r.oy + t * w->r.dy);
-  if (w->sy > 0) {
-    while (cross_y(w, iy + 1) <= t) iy++;
-    while (cross_y(w, iy) > t) iy--;
-  } else {
-    while (cross_y(w, iy) <= t) iy--;
-    while (cross_y(w, iy + 1) > t) iy++;
-  }
-  return iy;
 }
 
 /* Periodic index of c, known to lie within a few periods of [0, n). */
@@ -210,58 +81,241 @@ static inline int rewrap(int c, int n) {
   return c;
 }
 
-/* set_cell() for a nearby cell, without the divisions of bb__wrap. */
+/* Addressed column / row of vertex i, which lies near the current cell. */
+static inline int vertex_col(const walker *w, int i) {
+  return is_periodic(w) ? rewrap(w->cx + (i - w->ix), w->p->width)
+                        : bb__clampi(i, 0, w->p->width - 1);
+}
+
+static inline int vertex_row(const walker *w, int i) {
+  return is_periodic(w) ? rewrap(w->cy + (i - w->iy), w->p->height)
+                        : bb__clampi(i, 0, w->p->height - 1);
+}
+
+static inline double vertex_z(const walker *w, int x, int y) {
+  return w->p->z[(size_t)vertex_row(w, y) * (size_t)w->p->width + (size_t)vertex_col(w, x)];
+}
+
+/* Clamp mode only: a cell outside the image is the border extruded. */
+static inline int is_inside(const walker *w) {
+  return is_periodic(w) ||
+         (w->ix >= 0 && w->ix < w->p->width && w->iy >= 0 && w->iy < w->p->height);
+}
+
+static void set_cell(walker *w, int ix, int iy) {
+  w->ix = ix;
+  w->iy = iy;
+  w->cx = is_periodic(w) ? bb__wrap(ix, w->p->width) : bb__clampi(ix, 0, w->p->width - 1);
+  w->cy = is_periodic(w) ? bb__wrap(iy, w->p->height) : bb__clampi(iy, 0, w->p->height - 1);
+}
+
 static void move_to(walker *w, int ix, int iy) {
   if (is_periodic(w)) {
     w->cx = rewrap(w->cx + (ix - w->ix), w->p->width);
     w->cy = rewrap(w->cy + (iy - w->iy), w->p->height);
     w->ix = ix;
     w->iy = iy;
-    update_exits(w);
   } else {
     set_cell(w, ix, iy);
   }
 }
 
-/* Moves the walker to the first cell past the level-k node holding it. */
-static void skip_node(walker *w, int k) {
+static void walker_init(walker *w, const bb_pyramid *p, const direction *d, double ox,
+                        double oy, double oz) {
+  w->p = p;
+  w->d = *d;
+  w->ox = ox;
+  w->oy = oy;
+  w->oz = oz;
+  w->osum = ox + oy;
+  w->margin = 1e-7 * (1.0 + fabs((double)p->global_max) + fabs((double)p->global_min) + fabs(oz));
+  w->t = 0.0;
+  set_cell(w, cell_along(ox, d->sx), cell_along(oy, d->sy));
+}
+
+/* Number of thresholds (from b on) that slope s, met at distance t, blocks,
+ * plus b; *raised_at records where the horizon last rose. */
+static inline int raise_horizon(const double *tan_el, int n, int b, double s, double t,
+                                double *raised_at) {
+  if (b < n && s >= tan_el[b]) {
+    *raised_at = t;
+    do b++;
+    while (b < n && s >= tan_el[b]);
+  }
+  return b;
+}
+
+static inline double clamp01(double v) {
+  return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+}
+
+/* ---- breakpoints: each a pure function of its line and the ray ---------- */
+
+/* The four corner heights of the walker's cell, read once per cell test;
+ * vertices outside the cell (rare) are read through the addressing. */
+typedef struct corners {
+  const walker *w;
+  double z00, z10, z01, z11; /* (ix, iy), (ix+1, iy), (ix, iy+1), (ix+1, iy+1) */
+} corners;
+
+static inline void corners_load(corners *c, const walker *w) {
+  const bb_pyramid *p = w->p;
+  int x1, y1;
+  if (is_periodic(w)) {
+    x1 = w->cx + 1 == p->width ? 0 : w->cx + 1;
+    y1 = w->cy + 1 == p->height ? 0 : w->cy + 1;
+  } else {
+    x1 = bb__clampi(w->ix + 1, 0, p->width - 1);
+    y1 = bb__clampi(w->iy + 1, 0, p->height - 1);
+  }
+  const float *r0 = p->z + (size_t)w->cy * (size_t)p->width;
+  const float *r1 = p->z + (size_t)y1 * (size_t)p->width;
+  c->w = w;
+  c->z00 = r0[w->cx];
+  c->z10 = r0[x1];
+  c->z01 = r1[w->cx];
+  c->z11 = r1[x1];
+}
+
+/* Height of vertex (x, y), from the cache when it is a corner of the cell. */
+static inline double corner_z(const corners *c, int x, int y) {
+  const int dx = x - c->w->ix, dy = y - c->w->iy;
+  if ((unsigned)dx <= 1u && (unsigned)dy <= 1u)
+    return dy ? (dx ? c->z11 : c->z01) : (dx ? c->z10 : c->z00);
+  return vertex_z(c->w, x, y);
+}
+
+/* Where the ray crosses the vertical line x = X: the surface there lies on
+ * the edge from (X, row) to (X, row + 1). Returns the distance, or 0 if the
+ * crossing is not in (0, t_max], and the surface height in *z. */
+static inline double cross_vertical(const corners *c, double t_max, int X, double *z) {
+  const walker *w = c->w;
+  const double t = ((double)X - w->ox) * w->d.inv_dx;
+  if (!(t > 0.0) || t > t_max) return 0.0;
+  const double y = w->oy + t * w->d.dy;
+  const int row = fast_floor(y);
+  const double za = corner_z(c, X, row), zb = corner_z(c, X, row + 1);
+  *z = za + (zb - za) * clamp01(y - (double)row);
+  return t;
+}
+
+static inline double cross_horizontal(const corners *c, double t_max, int Y, double *z) {
+  const walker *w = c->w;
+  const double t = ((double)Y - w->oy) * w->d.inv_dy;
+  if (!(t > 0.0) || t > t_max) return 0.0;
+  const double x = w->ox + t * w->d.dx;
+  const int col = fast_floor(x);
+  const double za = corner_z(c, col, Y), zb = corner_z(c, col + 1, Y);
+  *z = za + (zb - za) * clamp01(x - (double)col);
+  return t;
+}
+
+/* The diagonal x + y = K: in cell (c, K-1-c) it runs from (c+1, K-1-c) to
+ * (c, K-c), the split of Valve's two triangles. */
+static inline double cross_diagonal(const corners *c, double t_max, int K, double *z) {
+  const walker *w = c->w;
+  const double t = ((double)K - w->osum) * w->d.inv_dsum;
+  if (!(t > 0.0) || t > t_max) return 0.0;
+  const int col = fast_floor(w->ox + t * w->d.dx), row = K - 1 - col;
+  const double za = corner_z(c, col + 1, row), zb = corner_z(c, col, row + 1);
+  *z = za + (zb - za) * clamp01(w->oy + t * w->d.dy - (double)row);
+  return t;
+}
+
+/* The exact cell test: the breakpoints on the current cell's exit edges and
+ * its diagonal. Its entry edges are the exit edges of the cell before, or lie
+ * on the boundary of a node skipped just before (whose max bounds them), or
+ * hold the origin. */
+static inline int test_cell(const walker *w, const double *tan_el, int n, int b,
+                            double *raised_at) {
+  const int X = w->ix + (w->d.sx > 0), Y = w->iy + (w->d.sy > 0);
+  /* Lines of this cell crossed far beyond it (by a nearly parallel ray) are
+   * other cells' business; the slack keeps every crossing of this one. */
+  const double exit_x = ((double)X - w->ox) * w->d.inv_dx;
+  const double exit_y = ((double)Y - w->oy) * w->d.inv_dy;
+  const double t_max = (exit_x < exit_y ? exit_x : exit_y) + 1.0;
+  corners c;
+  corners_load(&c, w);
+  double z, t;
+  if ((t = cross_vertical(&c, t_max, X, &z)) > 0.0)
+    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
+  if ((t = cross_horizontal(&c, t_max, Y, &z)) > 0.0)
+    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
+  if ((t = cross_diagonal(&c, t_max, w->ix + w->iy + 1, &z)) > 0.0)
+    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
+  return b;
+}
+
+/* ---- traversal ----------------------------------------------------------- */
+
+/* Moves the walker past the level-k node holding it (k = 0: the next cell).
+ * The axis it leaves by advances exactly; the other is located by floor,
+ * which rounding may put a hair off near a corner: harmless, since a cell
+ * touched only within ~1e-12 texel of a corner of the node just skipped
+ * holds nothing above that node's max by more than the skip margin. */
+static void advance(walker *w, int k) {
   const int span = 1 << k, mask = span - 1;
-  const int bx = w->ix - (w->cx & mask), by = w->iy - (w->cy & mask);
-  const int X = w->sx > 0 ? bx + span : bx, Y = w->sy > 0 ? by + span : by;
-  const double tx = cross_x(w, X), ty = cross_y(w, Y);
-  const double t = tx < ty ? tx : ty;
+  const int X = w->ix - (w->cx & mask) + (w->d.sx > 0 ? span : 0);
+  const int Y = w->iy - (w->cy & mask) + (w->d.sy > 0 ? span : 0);
+  const double tx = ((double)X - w->ox) * w->d.inv_dx;
+  const double ty = ((double)Y - w->oy) * w->d.inv_dy;
   int ix, iy;
-  if (tx <= ty) ix = w->sx > 0 ? X : X - 1;
-  else ix = locate_x(w, t, w->ix);
-  if (ty <= tx) iy = w->sy > 0 ? Y : Y - 1;
-  else iy = locate_y(w, t, w->iy);
-  w->t = t;
+  if (tx < ty) {
+    w->t = tx;
+    ix = w->d.sx > 0 ? X : X - 1;
+    iy = cell_along(w->oy + tx * w->d.dy, w->d.sy);
+  } else if (ty < tx) {
+    w->t = ty;
+    iy = w->d.sy > 0 ? Y : Y - 1;
+    ix = cell_along(w->ox + ty * w->d.dx, w->d.sx);
+  } else { /* through a corner */
+    w->t = tx;
+    ix = w->d.sx > 0 ? X : X - 1;
+    iy = w->d.sy > 0 ? Y : Y - 1;
+  }
   move_to(w, ix, iy);
+}
+
+/* Puts the walker in the cell the ray is in at distance t. */
+static void jump_to(walker *w, double t) {
+  w->t = t;
+  move_to(w, cell_along(w->ox + t * w->d.dx, w->d.sx), cell_along(w->oy + t * w->d.dy, w->d.sy));
 }
 
 static inline float node_max(const bb_pyramid *p, int k, int cx, int cy) {
   return p->level_max[k][(size_t)(cy >> k) * (size_t)p->level_width[k] + (size_t)(cx >> k)];
 }
 
-int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el, int n) {
-  if (n <= 0) return 0;
+/* The march proper, for the ray from (ox, oy, oz) along d, against the n
+ * rising tangents tan_el. *hint (may be NULL) is in: a distance where a
+ * nearby parallel ray met its horizon (0 for none); out: where this one did.
+ * That cell is tested first: the order in which breakpoints are tested does
+ * not change the answer, but a horizon found early raises the threshold and
+ * with it the height below which whole nodes are skipped. */
+static int march(const bb_pyramid *p, const direction *d, double ox, double oy, double oz,
+                 const double *tan_el, int n, double *hint) {
   walker w;
-  walker_init(&w, p, r);
+  walker_init(&w, p, d, ox, oy, oz);
   const int top = p->levels - 1;
   int b = 0, k = 0;
-  for (;;) {
+  double raised_at = 0.0;
+  if (hint && *hint > 0.0) {
+    walker probe = w;
+    jump_to(&probe, *hint);
+    b = test_cell(&probe, tan_el, n, b, &raised_at);
+  }
+  while (b < n) {
     /* Nothing under the ray below this height can block ray b or above. */
-    const double limit = w.r.oz + w.t * tan_el[b] - w.margin;
+    const double limit = w.oz + w.t * tan_el[b] - w.margin;
     if (!is_inside(&w)) { /* clamp mode, past the border: never comes back */
-      if ((double)p->border_max < limit) return b;
-      b = process_cell(&w, tan_el, n, b);
-      if (b == n) return n;
-      step_cell(&w);
+      if ((double)p->border_max < limit) break;
+      b = test_cell(&w, tan_el, n, b, &raised_at);
+      advance(&w, 0);
       continue;
     }
     if ((double)node_max(p, k, w.cx, w.cy) < limit) {
-      if (k == top) return b; /* above the global maximum for good */
-      skip_node(&w, k);
+      if (k == top) break; /* above the global maximum for good */
+      advance(&w, k);
       k++;
       continue;
     }
@@ -269,24 +323,129 @@ int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
       k--;
       continue;
     }
-    b = process_cell(&w, tan_el, n, b);
-    if (b == n) return n;
-    step_cell(&w);
+    b = test_cell(&w, tan_el, n, b, &raised_at);
+    advance(&w, 0);
   }
+  if (hint) *hint = raised_at;
+  return b;
+}
+
+static inline int wrap_near(int c, int n) {
+  while (c >= n) c -= n;
+  while (c < 0) c += n;
+  return c;
+}
+
+/* march() through the bands of the ray's own direction instead of the
+ * square nodes: bands are thin along the path, so they bound it tighter and
+ * let the ray skip further. Levels gallop, up after a skip and down after a
+ * miss, since a band can start at any cell. x_major and periodic are
+ * constants at each call, so each of the four variants compiles to a tight
+ * loop with the walker's state in registers. */
+static inline __attribute__((always_inline)) int
+march_band_impl(const bb_pyramid *p, const bb__band *band, const direction *d, double ox,
+                double oy, double oz, const double *tan_el, int n, double *hint,
+                const int x_major, const int periodic) {
+  walker w;
+  walker_init(&w, p, d, ox, oy, oz);
+  const int W = p->width, H = p->height, top = band->levels - 1;
+  const int sx = d->sx, sy = d->sy;
+  const double gmax = (double)p->global_max, margin = w.margin;
+  const float *cells = p->level_max[0];
+  int ix = w.ix, iy = w.iy, cx = w.cx, cy = w.cy;
+  double t = 0.0;
+  int b = 0, k = 0;
+  double raised_at = 0.0;
+  if (*hint > 0.0) {
+    walker probe = w;
+    jump_to(&probe, *hint);
+    b = test_cell(&probe, tan_el, n, b, &raised_at);
+  }
+  while (b < n) {
+    const double limit = oz + t * tan_el[b] - margin;
+    if (gmax < limit) break; /* above everything for good */
+    const int inside = periodic || (ix >= 0 && ix < W && iy >= 0 && iy < H);
+    if (inside && (double)band->level_max[k][(size_t)cy * (size_t)W + (size_t)cx] < limit) {
+      const int span = 1 << k; /* skip the 2^k cells along the major axis */
+      if (x_major) {
+        ix += sx * span;
+        t = ((double)(sx > 0 ? ix : ix + 1) - ox) * d->inv_dx;
+        const int row = cell_along(oy + t * d->dy, sy);
+        cx = periodic ? wrap_near(cx + sx * span, W) : bb__clampi(ix, 0, W - 1);
+        cy = periodic ? wrap_near(cy + (row - iy), H) : bb__clampi(row, 0, H - 1);
+        iy = row;
+      } else {
+        iy += sy * span;
+        t = ((double)(sy > 0 ? iy : iy + 1) - oy) * d->inv_dy;
+        const int col = cell_along(ox + t * d->dx, sx);
+        cy = periodic ? wrap_near(cy + sy * span, H) : bb__clampi(iy, 0, H - 1);
+        cx = periodic ? wrap_near(cx + (col - ix), W) : bb__clampi(col, 0, W - 1);
+        ix = col;
+      }
+      if (k < top) k++;
+      continue;
+    }
+    if (inside && k > 0) {
+      k--;
+      continue;
+    }
+    /* Past the border (clamp) only border_max bounds the cells; inside, the
+     * band's four rows are not all on the path, so the cell alone may pass. */
+    const double bound = inside ? (double)cells[(size_t)cy * (size_t)W + (size_t)cx]
+                                : (double)p->border_max;
+    if (!inside && bound < limit) break; /* never comes back */
+    if (bound >= limit) {
+      w.ix = ix, w.iy = iy, w.cx = cx, w.cy = cy, w.t = t;
+      b = test_cell(&w, tan_el, n, b, &raised_at);
+    }
+    /* DDA step to the next cell; through a corner, diagonally. */
+    const double tx = ((double)(sx > 0 ? ix + 1 : ix) - ox) * d->inv_dx;
+    const double ty = ((double)(sy > 0 ? iy + 1 : iy) - oy) * d->inv_dy;
+    if (tx <= ty) {
+      ix += sx;
+      cx = periodic ? wrap_near(cx + sx, W) : bb__clampi(ix, 0, W - 1);
+    }
+    if (ty <= tx) {
+      iy += sy;
+      cy = periodic ? wrap_near(cy + sy, H) : bb__clampi(iy, 0, H - 1);
+    }
+    t = tx < ty ? tx : ty;
+  }
+  *hint = raised_at;
+  return b;
+}
+
+static int march_band(const bb_pyramid *p, const bb__band *band, const direction *d,
+                      double ox, double oy, double oz, const double *tan_el, int n,
+                      double *hint) {
+  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
+  if (band->major_x)
+    return periodic ? march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 1, 1)
+                    : march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 1, 0);
+  return periodic ? march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 0, 1)
+                  : march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 0, 0);
+}
+
+int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el, int n) {
+  direction d;
+  direction_init(&d, r->dx, r->dy);
+  return n > 0 ? march(p, &d, r->ox, r->oy, r->oz, tan_el, n, NULL) : 0;
 }
 
 int bb__march_brute(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
                     int n) {
-  if (n <= 0) return 0;
+  direction d;
+  direction_init(&d, r->dx, r->dy);
   walker w;
-  walker_init(&w, p, r);
+  walker_init(&w, p, &d, r->ox, r->oy, r->oz);
   int b = 0;
-  for (;;) {
-    if ((double)p->global_max < w.r.oz + w.t * tan_el[b] - w.margin) return b;
-    b = process_cell(&w, tan_el, n, b);
-    if (b == n) return n;
-    step_cell(&w);
+  double raised_at;
+  while (b < n) {
+    if ((double)p->global_max < w.oz + w.t * tan_el[b] - w.margin) break;
+    b = test_cell(&w, tan_el, n, b, &raised_at);
+    advance(&w, 0);
   }
+  return b;
 }
 
 /* Splits a 3D ray into the march's horizontal line and tangent. Returns 0 for
@@ -328,23 +487,32 @@ typedef struct trace_job {
   const bb_pyramid *p;
   const bb_rayset *rs;
   const bb_trace_options *o;
-  int channels;        /* 1 + basis_count */
-  double *unblocked;   /* channels * (ray_count + slice_count) */
+  int channels;           /* 1 + basis_count */
+  double *unblocked;      /* channels * (ray_count + slice_count) */
   double total[1 + BB_MAX_BASIS];
+  direction *slice_dir;   /* per slice */
+  double *sums;           /* band path: per texel and channel, unblocked weight so far */
+  const bb__band *band;   /* band path: the bands of slice `slice` */
+  int slice;
   float *vis;
 } trace_job;
 
 static double ray_weight(const bb_rayset *rs, int c, int ray) {
-  return c == 0 ? rs->weight_ao[ray] : rs->weight_basis[(size_t)ray * (size_t)rs->basis_count + (size_t)(c - 1)];
+  return c == 0 ? rs->weight_ao[ray]
+                : rs->weight_basis[(size_t)ray * (size_t)rs->basis_count + (size_t)(c - 1)];
 }
 
 /* Suffix sums, and totals taken as the same sums in the same order, so a
  * texel with nothing blocked gets exactly 1. */
-static bb_status prepare_sums(trace_job *job, bb_error *err) {
+static bb_status prepare_job(trace_job *job, bb_error *err) {
   const bb_rayset *rs = job->rs;
   const size_t stride = (size_t)(rs->ray_count + rs->slice_count);
   job->unblocked = malloc((size_t)job->channels * stride * sizeof(double));
-  if (!job->unblocked) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  job->slice_dir = malloc((size_t)rs->slice_count * sizeof(direction));
+  if (!job->unblocked || !job->slice_dir)
+    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  for (int s = 0; s < rs->slice_count; s++)
+    direction_init(&job->slice_dir[s], rs->slice_dir[2 * s], rs->slice_dir[2 * s + 1]);
   for (int c = 0; c < job->channels; c++) {
     double *u = job->unblocked + (size_t)c * stride;
     job->total[c] = 0.0;
@@ -359,32 +527,104 @@ static bb_status prepare_sums(trace_job *job, bb_error *err) {
   return BB_OK;
 }
 
-static void trace_row(void *user, int y) {
+static void release_job(trace_job *job) {
+  free(job->unblocked);
+  free(job->slice_dir);
+  free(job->sums);
+}
+
+/* Adds slice s's unblocked weight for `blocked` blocked rays to sum[]. */
+static inline void add_slice(const trace_job *job, int s, int blocked, double *sum) {
+  const size_t stride = (size_t)(job->rs->ray_count + job->rs->slice_count);
+  const size_t at = (size_t)(job->rs->slice_start[s] + s + blocked);
+  for (int c = 0; c < job->channels; c++) sum[c] += job->unblocked[(size_t)c * stride + at];
+}
+
+static void store_texel(const trace_job *job, size_t texel, const double *sum) {
+  float *out = job->vis + texel * (size_t)job->channels;
+  for (int c = 0; c < job->channels; c++)
+    out[c] = job->total[c] > 0.0 ? (float)(sum[c] / job->total[c]) : 1.0f;
+}
+
+static inline double origin_z(const trace_job *job, int x, int y) {
+  return (double)job->p->z[(size_t)y * (size_t)job->p->width + (size_t)x] + job->o->bias_texels;
+}
+
+/* Band path: one slice over one row; the texels' sums grow slice by slice,
+ * always in slice order, so the result does not depend on threads. */
+static void trace_slice_row(void *user, int y) {
   const trace_job *job = user;
-  const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
-  const size_t stride = (size_t)(rs->ray_count + rs->slice_count);
-  for (int x = 0; x < p->width; x++) {
-    double sum[1 + BB_MAX_BASIS] = {0};
-    bb__march_ray r = {.ox = x, .oy = y};
-    r.oz = (double)p->z[(size_t)y * (size_t)p->width + (size_t)x] + job->o->bias_texels;
-    for (int s = 0; s < rs->slice_count; s++) {
-      const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
-      r.dx = rs->slice_dir[2 * s];
-      r.dy = rs->slice_dir[2 * s + 1];
-      const int blocked = bb__march(p, &r, rs->tan_elevation + start, count);
-      for (int c = 0; c < job->channels; c++)
-        sum[c] += job->unblocked[(size_t)c * stride + (size_t)(start + s + blocked)];
-    }
-    float *out = job->vis + ((size_t)y * (size_t)p->width + (size_t)x) * (size_t)job->channels;
-    for (int c = 0; c < job->channels; c++)
-      out[c] = job->total[c] > 0.0 ? (float)(sum[c] / job->total[c]) : 1.0f;
+  const int s = job->slice, start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+  double hint = 0.0; /* where the previous texel's horizon was */
+  for (int x = 0; x < job->p->width; x++) {
+    const int blocked = march_band(job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
+                                   rs->tan_elevation + start, count, &hint);
+    add_slice(job, s, blocked, job->sums + ((size_t)y * (size_t)job->p->width + (size_t)x) * (size_t)job->channels);
   }
 }
 
-bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
-                             const bb_trace_options *o, bb_image *vis,
-                             double *rays_traced, bb_error *err) {
+static void finish_row(void *user, int y) {
+  const trace_job *job = user;
+  for (int x = 0; x < job->p->width; x++) {
+    size_t texel = (size_t)y * (size_t)job->p->width + (size_t)x;
+    store_texel(job, texel, job->sums + texel * (size_t)job->channels);
+  }
+}
+
+/* Square path: every slice of a texel through the square nodes. */
+static void trace_row(void *user, int y) {
+  const trace_job *job = user;
+  const bb_rayset *rs = job->rs;
+  double hint[256] = {0}; /* per slice: where the previous texel's horizon was */
+  for (int x = 0; x < job->p->width; x++) {
+    double sum[1 + BB_MAX_BASIS] = {0};
+    for (int s = 0; s < rs->slice_count; s++) {
+      const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+      add_slice(job, s, march(job->p, &job->slice_dir[s], x, y, origin_z(job, x, y),
+                              rs->tan_elevation + start, count, &hint[s]), sum);
+    }
+    store_texel(job, (size_t)y * (size_t)job->p->width + (size_t)x, sum);
+  }
+}
+
+/* Progress over all slices of the band path. */
+typedef struct slice_progress {
+  const bb_trace_options *o;
+  long base, total;
+} slice_progress;
+
+static void report_slice_progress(void *user, long done, long total) {
+  (void)total;
+  const slice_progress *sp = user;
+  sp->o->progress(sp->o->progress_user, sp->base + done, sp->total);
+}
+
+static bb_status trace_bands(trace_job *job, bb_error *err) {
+  const bb_pyramid *p = job->p;
+  const size_t values = (size_t)p->width * (size_t)p->height * (size_t)job->channels;
+  job->sums = calloc(values, sizeof(double));
+  if (!job->sums) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  slice_progress sp = {.o = job->o, .total = (long)job->rs->slice_count * p->height};
+  bb_status st = BB_OK;
+  for (int s = 0; st == BB_OK && s < job->rs->slice_count; s++) {
+    bb__band band;
+    st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads, &band, err);
+    if (st != BB_OK) break;
+    job->band = &band;
+    job->slice = s;
+    sp.base = (long)s * p->height;
+    st = bb__parallel_for(p->height, job->o->threads, trace_slice_row, job,
+                          job->o->progress ? report_slice_progress : NULL, &sp, err);
+    bb__band_free(&band);
+  }
+  if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, finish_row, job, NULL, NULL, err);
+  return st;
+}
+
+bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
+                                   const bb_trace_options *o, int use_bands, bb_image *vis,
+                                   bb_error *err) {
   memset(vis, 0, sizeof *vis);
   if (!p || !rs || !o || rs->ray_count < 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing pyramid, ray set or options");
@@ -394,17 +634,27 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
   if (o->jitter)
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: --jitter is not implemented yet");
   trace_job job = {.p = p, .rs = rs, .o = o, .channels = 1 + rs->basis_count};
-  bb_status st = prepare_sums(&job, err);
-  if (st != BB_OK) return st;
-  st = bb_image_alloc(vis, p->width, p->height, job.channels, err);
+  bb_status st = prepare_job(&job, err);
+  if (st == BB_OK) st = bb_image_alloc(vis, p->width, p->height, job.channels, err);
   if (st == BB_OK) {
     job.vis = vis->pixels;
-    st = bb__parallel_for(p->height, o->threads, trace_row, &job, o->progress,
-                          o->progress_user, err);
+    st = use_bands ? trace_bands(&job, err)
+                   : bb__parallel_for(p->height, o->threads, trace_row, &job, o->progress,
+                                      o->progress_user, err);
   }
-  free(job.unblocked);
+  release_job(&job);
   if (st != BB_OK) bb_image_free(vis);
-  else if (rays_traced)
+  return st;
+}
+
+bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
+                             const bb_trace_options *o, bb_image *vis,
+                             double *rays_traced, bb_error *err) {
+  /* The bands cost one float per texel and level, and the sums one double
+   * per texel and channel: past 4096 x 4096 the square nodes do without. */
+  const int use_bands = p && (long)p->width * p->height <= 4096L * 4096L;
+  bb_status st = bb__trace_occlusion_path(p, rs, o, use_bands, vis, err);
+  if (st == BB_OK && rays_traced)
     *rays_traced = (double)p->width * (double)p->height * (double)rs->ray_count;
   return st;
 }

@@ -37,4 +37,25 @@ int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
 int bb__march_brute(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
                     int n);
 
+/* bb_trace_occlusion with the choice of march made by the caller: through
+ * direction bands (use_bands = 1) or square nodes (0). For tests. */
+bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
+                                   const bb_trace_options *o, int use_bands, bb_image *vis,
+                                   bb_error *err);
+
+/* Directional max bands of the pyramid's cells for one azimuth (band.c). */
+typedef struct bb__band {
+  int levels;                      /* level k spans 2^k cells along the major axis */
+  int major_x, major_y;            /* unit cell step along the major axis */
+  int minor_x, minor_y;            /* unit cell step along the minor axis */
+  double slope;                    /* |minor / major| <= 1 */
+  float *level_max[BB__MAX_LEVELS]; /* per level, one bound per cell, row-major */
+} bb__band;
+
+/* Builds the bands of direction (dx, dy) over p's cells, rows on `threads`
+ * threads. Free with bb__band_free. */
+bb_status bb__band_build(const bb_pyramid *p, double dx, double dy, int threads,
+                         bb__band *band, bb_error *err);
+void bb__band_free(bb__band *band);
+
 #endif /* BB_TRACE_INTERNAL_H */

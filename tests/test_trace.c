@@ -293,3 +293,35 @@ Test(trace, rejects_negative_bias) {
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
+
+/* The batch trace through direction bands must give, bit for bit, what the
+ * square-node march gives (which the tests above tie to brute force), in
+ * both addressing modes, on odd and non-square sizes. */
+Test(trace, band_march_equals_square_march) {
+  const int sizes[][2] = {{1, 1}, {5, 3}, {17, 17}, {40, 23}, {64, 64}};
+  rng_state = 4242;
+  for (int a = 0; a < 2; a++)
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++)
+      for (int kind = 0; kind < 3; kind++) {
+        bb_image z = random_field(sizes[si][0], sizes[si][1], 3.0f + 20.0f * (float)kind, kind);
+        bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
+        bb_rayset rs;
+        cr_assert_eq(bb_rayset_make(144, 1.0, BB_BASIS_HL2_Z, &rs, NULL), BB_OK);
+        bb_trace_options o;
+        bb_trace_options_init(&o);
+        o.bias_texels = kind == 1 ? 0.0 : 0.55;
+        bb_image bands, square;
+        bb_error err;
+        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, 1, &bands, &err), BB_OK, "%s", err.message);
+        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, 0, &square, &err), BB_OK, "%s", err.message);
+        size_t n = (size_t)z.width * (size_t)z.height * 5;
+        for (size_t i = 0; i < n; i++)
+          cr_assert_eq(bands.pixels[i], square.pixels[i], "%dx%d %s kind %d: texel %zu channel %zu",
+                       z.width, z.height, a ? "clamp" : "periodic", kind, i / 5, i % 5);
+        bb_image_free(&bands);
+        bb_image_free(&square);
+        bb_rayset_free(&rs);
+        bb_pyramid_free(p);
+        bb_image_free(&z);
+      }
+}
