@@ -240,7 +240,7 @@ std::vector<T> quantise_image(const bb_image *img, bb_range range) {
 // Writes img to file_name (a temporary name whose extension picks the format).
 // Returns "" on success, else OIIO's reason.
 std::string write_with_oiio(const std::string &file_name, const bb_image *img, bb_depth depth,
-                            const bb_write_options *options) {
+                            bb_range range, const char *description) {
   TypeDesc file_type = depth == BB_DEPTH_8      ? TypeDesc::UINT8
                        : depth == BB_DEPTH_16   ? TypeDesc::UINT16
                        : depth == BB_DEPTH_HALF ? TypeDesc::HALF
@@ -248,7 +248,7 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
   ImageSpec spec(img->width, img->height, img->channels, file_type);
   spec.attribute("oiio:UnassociatedAlpha", 1);
   spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
-  if (options->description) spec.attribute("ImageDescription", options->description);
+  if (description) spec.attribute("ImageDescription", description);
   if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
 
   auto out = ImageOutput::create(file_name);
@@ -257,17 +257,21 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
 
   bool ok;
   if (depth == BB_DEPTH_8) {
-    std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(img, options->range);
+    std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(img, range);
     ok = out->write_image(TypeDesc::UINT8, codes.data());
   } else if (depth == BB_DEPTH_16) {
-    std::vector<std::uint16_t> codes = quantise_image<std::uint16_t>(img, options->range);
+    std::vector<std::uint16_t> codes = quantise_image<std::uint16_t>(img, range);
     ok = out->write_image(TypeDesc::UINT16, codes.data());
   } else {
     ok = out->write_image(TypeDesc::FLOAT, img->pixels);
   }
   // close() flushes, so its failure (a full disk) matters as much as the write's.
   ok = out->close() && ok;
-  if (!ok || out->has_error()) return one_line(out->geterror());
+  // Trust the return values, not the error queue: OIIO 2.4's TIFF writer
+  // queues "failed TIFFWriteCustomDirectory() of the Exif data" on every
+  // successful write. Reading the queue also clears it.
+  std::string why = out->geterror();
+  if (!ok) return one_line(why);
   return std::string();
 }
 
@@ -277,10 +281,28 @@ bb_status check_image_arg(const char *path, const bb_image *img, bb_error *err) 
   return BB_OK;
 }
 
+// C callers may store any int in an enum field, and loading an out-of-range
+// enum is undefined in C++: read the field as the int it is.
+template <typename E> int raw_enum(const E &field) {
+  static_assert(sizeof(E) == sizeof(int), "C enums are int-sized here");
+  int value;
+  std::memcpy(&value, &field, sizeof value);
+  return value;
+}
+
+bb_status check_options(const char *path, const bb_write_options &o, bb_error *err) {
+  int depth = raw_enum(o.depth), range = raw_enum(o.range);
+  if (depth < BB_DEPTH_DEFAULT || depth > BB_DEPTH_FLOAT)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown sample depth %d", path, depth);
+  if (range != BB_RANGE_UNIT && range != BB_RANGE_SIGNED)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown value range %d", path, range);
+  return BB_OK;
+}
+
 bb_status resolve_depth(const char *path, const format_rule &f, const bb_write_options &o,
                         int channels, bb_depth *depth, bb_error *err) {
   *depth = o.depth == BB_DEPTH_DEFAULT ? f.default_depth : o.depth;
-  if ((unsigned)*depth > (unsigned)BB_DEPTH_FLOAT || !(f.allowed & bit(*depth)))
+  if (!(f.allowed & bit(*depth)))
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s samples are not supported by %s files", path,
                     depth_name(*depth), f.ext);
   if (channels > f.max_channels)
@@ -295,6 +317,9 @@ bb_status write_image(const char *path, const bb_image *img, const bb_write_opti
   if (st != BB_OK) return st;
   const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
   const bb_write_options &o = options ? *options : defaults;
+
+  st = check_options(path, o, err);
+  if (st != BB_OK) return st;
 
   std::string ext = extension_of(path);
   const format_rule *f = find_format(ext);
@@ -311,7 +336,7 @@ bb_status write_image(const char *path, const bb_image *img, const bb_write_opti
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
   std::string why;
   try {
-    why = write_with_oiio(tmp, img, depth, &o);
+    why = write_with_oiio(tmp, img, depth, o.range, o.description);
   } catch (...) {
     unlink(tmp.c_str());
     throw;
