@@ -566,6 +566,7 @@ Test(io, truncated_png_is_a_format_error) { check_truncation_detected("cut.png",
 Test(io, truncated_png_tail_is_a_format_error) { check_truncation_detected("cut2.png", 0.97); }
 Test(io, truncated_exr_is_a_format_error) { check_truncation_detected("cut.exr", 0.8); }
 Test(io, truncated_tif_is_a_format_error) { check_truncation_detected("cut.tif", 0.6); }
+Test(io, truncated_tga_is_a_format_error) { check_truncation_detected("cut.tga", 0.5); }
 
 /* --------------------------------------------------------- size limits */
 
