@@ -1,0 +1,408 @@
+// io_oiio.cpp: reading and writing image files through OpenImageIO (the only C++ file).
+//
+// This file is a firewall: OpenImageIO is included nowhere else, and every
+// extern "C" function catches all exceptions and turns them, like OIIO's own
+// error strings, into a bb_status with a one-line message that names the file.
+//
+// Alpha is never premultiplied or divided out: bumpbake's channels are data
+// (heights, ssbump, ao), so both directions ask for unassociated alpha.
+#include "internal.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fcntl.h>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+namespace {
+
+// OIIO error strings may hold several lines; bb_error holds one.
+std::string one_line(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  std::string out;
+  for (char c : s) {
+    if (c == '\n')
+      out += "; ";
+    else if (c != '\r')
+      out += c;
+  }
+  return out.empty() ? std::string("unknown OpenImageIO error") : out;
+}
+
+// ------------------------------------------------------------------ reading
+
+void clear_info(bb_image_info *info) {
+  if (!info) return;
+  std::memset(info, 0, sizeof *info);
+  info->alpha_channel = -1;
+}
+
+// Distinguishes "missing" and "unreadable" from "not an image" before OIIO
+// sees the file, since OIIO reports all three as a failed open.
+bb_status check_readable(const char *path, bb_error *err) {
+  struct stat st;
+  if (stat(path, &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR)
+      return bb__fail(err, BB_ERR_IO, "%s: no such file", path);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(errno));
+  }
+  if (S_ISDIR(st.st_mode)) return bb__fail(err, BB_ERR_IO, "%s: is a directory", path);
+  int fd = open(path, O_RDONLY);
+  if (fd < 0)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(errno));
+  close(fd);
+  return BB_OK;
+}
+
+bb_status check_spec_size(const char *path, const ImageSpec &spec, bb_error *err) {
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    return bb__fail(err, BB_ERR_SIZE, "%s: zero or negative image size %dx%d, %d channels",
+                    path, spec.width, spec.height, spec.nchannels);
+  if (spec.depth > 1)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: volume images (depth %d) are not supported",
+                    path, spec.depth);
+  if (spec.nchannels > 64)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %d channels (at most 64 are supported)", path,
+                    spec.nchannels);
+  return BB_OK;
+}
+
+bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *info,
+                    const char *path, bb_error *err) {
+  if (!info) return BB_OK;
+  info->alpha_channel = spec.alpha_channel;
+  info->is_float = spec.format.is_floating_point() ? 1 : 0;
+  // oiio:BitsPerSample tells 1-, 2-, 4-, 10- or 12-bit files from their carrier type.
+  info->bits_per_sample =
+      spec.get_int_attribute("oiio:BitsPerSample", (int)spec.format.size() * 8);
+  std::snprintf(info->format_name, sizeof info->format_name, "%s", in.format_name());
+  std::string desc = spec.get_string_attribute("ImageDescription");
+  if (!desc.empty()) {
+    info->description = static_cast<char *>(std::malloc(desc.size() + 1));
+    if (!info->description)
+      return bb__fail(err, BB_ERR_MEMORY, "%s: cannot allocate the description", path);
+    std::memcpy(info->description, desc.c_str(), desc.size() + 1);
+  }
+  return BB_OK;
+}
+
+bb_status read_image(const char *path, bb_image *out, bb_image_info *info, bb_error *err) {
+  bb_status st = check_readable(path, err);
+  if (st != BB_OK) return st;
+
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = ImageInput::open(path, &config);
+  if (!in)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                    one_line(OIIO::geterror()).c_str());
+  const ImageSpec spec = in->spec();
+  st = check_spec_size(path, spec, err);
+  if (st != BB_OK) return st;
+
+  bb_error alloc_err;
+  st = bb_image_alloc(out, spec.width, spec.height, spec.nchannels, &alloc_err);
+  if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
+
+  // A truncated file must fail, not come back as zeros: check both the return
+  // value and the error queue, since some readers only record a warning.
+  bool ok = in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, out->pixels);
+  if (!ok || in->has_error()) {
+    std::string why = in->geterror();
+    bb_image_free(out);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
+                    one_line(why).c_str());
+  }
+  st = fill_info(*in, spec, info, path, err);
+  if (st != BB_OK) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+  }
+  return st;
+}
+
+// ------------------------------------------------------------------ writing
+
+struct format_rule {
+  const char *ext;      // lower case, with the dot
+  bb_depth default_depth;
+  unsigned allowed;     // bit (1 << bb_depth) per allowed depth
+  int max_channels;
+};
+
+constexpr unsigned bit(bb_depth d) { return 1u << d; }
+
+const format_rule FORMATS[] = {
+    {".png", BB_DEPTH_8, bit(BB_DEPTH_8) | bit(BB_DEPTH_16), 4},
+    {".tga", BB_DEPTH_8, bit(BB_DEPTH_8), 4},
+    {".tif", BB_DEPTH_8, bit(BB_DEPTH_8) | bit(BB_DEPTH_16) | bit(BB_DEPTH_FLOAT), 64},
+    {".tiff", BB_DEPTH_8, bit(BB_DEPTH_8) | bit(BB_DEPTH_16) | bit(BB_DEPTH_FLOAT), 64},
+    {".exr", BB_DEPTH_FLOAT, bit(BB_DEPTH_HALF) | bit(BB_DEPTH_FLOAT), 64},
+};
+
+const char *depth_name(bb_depth d) {
+  switch (d) {
+  case BB_DEPTH_DEFAULT: return "default";
+  case BB_DEPTH_8: return "8-bit";
+  case BB_DEPTH_16: return "16-bit";
+  case BB_DEPTH_HALF: return "half float";
+  case BB_DEPTH_FLOAT: return "float";
+  }
+  return "unknown";
+}
+
+// Lower-case extension of the last path component, with the dot, or "".
+std::string extension_of(const char *path) {
+  const char *slash = std::strrchr(path, '/');
+  const char *base = slash ? slash + 1 : path;
+  const char *dot = std::strrchr(base, '.');
+  if (!dot) return std::string();
+  std::string ext(dot);
+  for (char &c : ext) c = (char)std::tolower((unsigned char)c);
+  return ext;
+}
+
+const format_rule *find_format(const std::string &ext) {
+  for (const format_rule &f : FORMATS)
+    if (ext == f.ext) return &f;
+  return nullptr;
+}
+
+std::string directory_of(const char *path) {
+  const char *slash = std::strrchr(path, '/');
+  if (!slash) return ".";
+  if (slash == path) return "/";
+  return std::string(path, (size_t)(slash - path));
+}
+
+// Creates an empty temporary file "DIR/.bb-tmp-XXXXXX.ext" with mode 0666 less
+// the umask (mkstemps would make it 0600, and the rename keeps the mode).
+// Returns its name, or "" with errno set.
+std::string create_temp_file(const std::string &dir, const std::string &ext) {
+  static const char ALNUM[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+  static std::uint64_t counter = 0;
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  std::uint64_t seed = (std::uint64_t)ts.tv_nsec ^ ((std::uint64_t)ts.tv_sec << 30) ^
+                       ((std::uint64_t)getpid() << 16);
+  for (int attempt = 0; attempt < 100; attempt++) {
+    // splitmix64 step: a fresh, well mixed value per attempt and per call.
+    std::uint64_t z = (seed += 0x9E3779B97F4A7C15ull + __atomic_fetch_add(&counter, 1, __ATOMIC_RELAXED));
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    std::string name = dir + "/.bb-tmp-";
+    for (int i = 0; i < 6; i++, z /= 62) name += ALNUM[z % 62];
+    name += ext;
+    int fd = open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      close(fd);
+      return name;
+    }
+    if (errno != EEXIST) return std::string();
+  }
+  errno = EEXIST;
+  return std::string();
+}
+
+// Round-half-up quantisation of v (after the range mapping) to 0..max_code.
+// NaN becomes 0 so that it cannot reach an undefined float-to-int cast.
+std::uint32_t quantise(float v, bb_range range, double max_code) {
+  double u = range == BB_RANGE_SIGNED ? 0.5 + 0.5 * (double)v : (double)v;
+  if (!(u > 0.0)) u = 0.0;
+  if (u > 1.0) u = 1.0;
+  return (std::uint32_t)std::floor(u * max_code + 0.5);
+}
+
+template <typename T>
+std::vector<T> quantise_image(const bb_image *img, bb_range range) {
+  const double max_code = (double)(T)~(T)0;
+  size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+  std::vector<T> codes(n);
+  for (size_t i = 0; i < n; i++) codes[i] = (T)quantise(img->pixels[i], range, max_code);
+  return codes;
+}
+
+// Writes img to file_name (a temporary name whose extension picks the format).
+// Returns "" on success, else OIIO's reason.
+std::string write_with_oiio(const std::string &file_name, const bb_image *img, bb_depth depth,
+                            bb_range range, const char *description) {
+  TypeDesc file_type = depth == BB_DEPTH_8      ? TypeDesc::UINT8
+                       : depth == BB_DEPTH_16   ? TypeDesc::UINT16
+                       : depth == BB_DEPTH_HALF ? TypeDesc::HALF
+                                                : TypeDesc::FLOAT;
+  ImageSpec spec(img->width, img->height, img->channels, file_type);
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
+  if (description) spec.attribute("ImageDescription", description);
+  if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
+
+  auto out = ImageOutput::create(file_name);
+  if (!out) return one_line(OIIO::geterror());
+  if (!out->open(file_name, spec)) return one_line(out->geterror());
+
+  bool ok;
+  if (depth == BB_DEPTH_8) {
+    std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(img, range);
+    ok = out->write_image(TypeDesc::UINT8, codes.data());
+  } else if (depth == BB_DEPTH_16) {
+    std::vector<std::uint16_t> codes = quantise_image<std::uint16_t>(img, range);
+    ok = out->write_image(TypeDesc::UINT16, codes.data());
+  } else {
+    ok = out->write_image(TypeDesc::FLOAT, img->pixels);
+  }
+  // close() flushes, so its failure (a full disk) matters as much as the write's.
+  ok = out->close() && ok;
+  // Trust the return values, not the error queue: OIIO 2.4's TIFF writer
+  // queues "failed TIFFWriteCustomDirectory() of the Exif data" on every
+  // successful write. Reading the queue also clears it.
+  std::string why = out->geterror();
+  if (!ok) return one_line(why);
+  return std::string();
+}
+
+bb_status check_image_arg(const char *path, const bb_image *img, bb_error *err) {
+  if (!img || !img->pixels || img->width <= 0 || img->height <= 0 || img->channels <= 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: nothing to write (empty image)", path);
+  return BB_OK;
+}
+
+// C callers may store any int in an enum field, and loading an out-of-range
+// enum is undefined in C++: read the field as the int it is.
+template <typename E> int raw_enum(const E &field) {
+  static_assert(sizeof(E) == sizeof(int), "C enums are int-sized here");
+  int value;
+  std::memcpy(&value, &field, sizeof value);
+  return value;
+}
+
+bb_status check_options(const char *path, const bb_write_options &o, bb_error *err) {
+  int depth = raw_enum(o.depth), range = raw_enum(o.range);
+  if (depth < BB_DEPTH_DEFAULT || depth > BB_DEPTH_FLOAT)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown sample depth %d", path, depth);
+  if (range != BB_RANGE_UNIT && range != BB_RANGE_SIGNED)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown value range %d", path, range);
+  return BB_OK;
+}
+
+bb_status resolve_depth(const char *path, const format_rule &f, const bb_write_options &o,
+                        int channels, bb_depth *depth, bb_error *err) {
+  *depth = o.depth == BB_DEPTH_DEFAULT ? f.default_depth : o.depth;
+  if (!(f.allowed & bit(*depth)))
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s samples are not supported by %s files", path,
+                    depth_name(*depth), f.ext);
+  if (channels > f.max_channels)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s files hold at most %d channels, not %d", path,
+                    f.ext, f.max_channels, channels);
+  return BB_OK;
+}
+
+bb_status write_image(const char *path, const bb_image *img, const bb_write_options *options,
+                      bb_error *err) {
+  bb_status st = check_image_arg(path, img, err);
+  if (st != BB_OK) return st;
+  const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
+  const bb_write_options &o = options ? *options : defaults;
+
+  st = check_options(path, o, err);
+  if (st != BB_OK) return st;
+
+  std::string ext = extension_of(path);
+  const format_rule *f = find_format(ext);
+  if (!f)
+    return bb__fail(err, BB_ERR_FORMAT,
+                    "%s: unknown output format '%s' (use .png, .tga, .tif, .tiff or .exr)", path,
+                    ext.c_str());
+  bb_depth depth;
+  st = resolve_depth(path, *f, o, img->channels, &depth, err);
+  if (st != BB_OK) return st;
+
+  std::string tmp = create_temp_file(directory_of(path), ext);
+  if (tmp.empty())
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
+  std::string why;
+  try {
+    why = write_with_oiio(tmp, img, depth, o.range, o.description);
+  } catch (...) {
+    unlink(tmp.c_str());
+    throw;
+  }
+  if (why.empty() && std::rename(tmp.c_str(), path) != 0)
+    why = std::strerror(errno);
+  if (!why.empty()) {
+    unlink(tmp.c_str());
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  return BB_OK;
+}
+
+} // namespace
+
+extern "C" {
+
+void bb_image_info_free(bb_image_info *info) {
+  if (!info) return;
+  std::free(info->description);
+  info->description = nullptr;
+}
+
+bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info, bb_error *err) {
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read: out is NULL");
+  std::memset(out, 0, sizeof *out);
+  clear_info(info);
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read: path is NULL");
+  try {
+    return read_image(path, out, info, err);
+  } catch (const std::bad_alloc &) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
+  } catch (const std::exception &e) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+}
+
+bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_options *options,
+                         bb_error *err) {
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write: path is NULL");
+  try {
+    return write_image(path, img, options, err);
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
+  } catch (const std::exception &e) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
+  }
+}
+
+int bb_path_is_writable_format(const char *path) {
+  if (!path) return 0;
+  try {
+    return find_format(extension_of(path)) != nullptr;
+  } catch (...) {
+    return 0;
+  }
+}
+
+} // extern "C"
