@@ -577,7 +577,7 @@ static void progress_draw(void *user, long done, long total) {
   p->last_draw_seconds = now;
   double frac = done <= 0 ? 0.0 : (double)done / (double)total;
   if (frac > 1.0) frac = 1.0;
-  int filled = (int)(frac * PROGRESS_BAR_WIDTH + 0.5);
+  int filled = (int)(frac * PROGRESS_BAR_WIDTH); /* full only when done */
   char bar[PROGRESS_BAR_WIDTH + 1];
   for (int i = 0; i < PROGRESS_BAR_WIDTH; i++) bar[i] = i < filled ? '#' : '.';
   bar[PROGRESS_BAR_WIDTH] = '\0';
