@@ -27,36 +27,76 @@ static const output_kind output_kinds[] = {
 enum { OUTPUT_KIND_COUNT = sizeof output_kinds / sizeof output_kinds[0] };
 
 static const bb_image *result_image(const bb_bake_result *r, int kind) {
-  return (const bb_image *)(const void *)((const char *)r + output_kinds[kind].result_offset);
+  return (const bb_image *)(const void *)((const char *)r +
+                                          output_kinds[kind].result_offset);
 }
 
 static const cli_option opt_prefix = {
-    CLI_OPT_OUTPUT, "output", 'o', "PREFIX", NULL, NULL,
-    "write PREFIX_normal.png, PREFIX_ssbump.png and PREFIX_ao.png"};
-static const cli_option opt_out_normal = {CLI_OPT_OUT_NORMAL, "normal", 0, "FILE", NULL, NULL,
-                                          "write the normal map"};
-static const cli_option opt_out_weights = {CLI_OPT_OUT_WEIGHTS, "weights", 0, "FILE", NULL,
-                                           NULL, "write the basis weights (normal2ssbump)"};
-static const cli_option opt_out_ssbump = {CLI_OPT_OUT_SSBUMP, "ssbump", 0, "FILE", NULL, NULL,
-                                          "write the self-shadowed bump map (traces)"};
-static const cli_option opt_out_ao = {CLI_OPT_OUT_AO, "ao", 0, "FILE", NULL, NULL,
-                                      "write the ambient occlusion (traces)"};
-static const cli_option opt_out_bent = {CLI_OPT_OUT_BENT, "bent", 0, "FILE", NULL, NULL,
-                                        "write the bent normal (traces)"};
-static const cli_option opt_out_filtered = {CLI_OPT_OUT_FILTERED, "filtered", 0, "FILE", NULL,
-                                            NULL, "write the smoothed height"};
-static const cli_option opt_json = {CLI_OPT_JSON, "json", 0, NULL, NULL, NULL,
-                                    "print one JSON line describing the bake on stdout"};
-static const cli_option opt_quiet = {CLI_OPT_QUIET, "quiet", 'q', NULL, NULL, NULL,
-                                     "no progress bar, no list of files written"};
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "PREFIX",
+    .help = "write PREFIX_normal.png, PREFIX_ssbump.png and PREFIX_ao.png"};
+static const cli_option opt_out_normal = {.id = CLI_OPT_OUT_NORMAL,
+                                          .long_name = "normal",
+                                          .value_name = "FILE",
+                                          .help = "write the normal map"};
+static const cli_option opt_out_weights = {.id = CLI_OPT_OUT_WEIGHTS,
+                                           .long_name = "weights",
+                                           .value_name = "FILE",
+                                           .help =
+                                               "write the basis weights (normal2ssbump)"};
+static const cli_option opt_out_ssbump = {
+    .id = CLI_OPT_OUT_SSBUMP,
+    .long_name = "ssbump",
+    .value_name = "FILE",
+    .help = "write the self-shadowed bump map (traces)"};
+static const cli_option opt_out_ao = {.id = CLI_OPT_OUT_AO,
+                                      .long_name = "ao",
+                                      .value_name = "FILE",
+                                      .help = "write the ambient occlusion (traces)"};
+static const cli_option opt_out_bent = {.id = CLI_OPT_OUT_BENT,
+                                        .long_name = "bent",
+                                        .value_name = "FILE",
+                                        .help = "write the bent normal (traces)"};
+static const cli_option opt_out_filtered = {.id = CLI_OPT_OUT_FILTERED,
+                                            .long_name = "filtered",
+                                            .value_name = "FILE",
+                                            .help = "write the smoothed height"};
+static const cli_option opt_json = {
+    .id = CLI_OPT_JSON,
+    .long_name = "json",
+    .help = "print one JSON line describing the bake on stdout"};
+static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
+                                     .long_name = "quiet",
+                                     .short_name = 'q',
+                                     .help = "no progress bar, no list of files written"};
 
 static const cli_option *const bake_options[] = {
-    &cli_opt_scale,    &cli_opt_rays,          &cli_opt_filter_radius, &cli_opt_filter_threshold,
-    &cli_opt_bias,     &cli_opt_power,         &cli_opt_basis,         &cli_opt_normal_filter,
-    &cli_opt_normal_y, &cli_opt_threads,       &cli_opt_clamp,         &cli_opt_jitter,
-    &cli_opt_channel,  &cli_opt_depth,         &opt_out_normal,        &opt_out_weights,
-    &opt_out_ssbump,   &opt_out_ao,            &opt_out_bent,          &opt_out_filtered,
-    &opt_prefix,       &opt_json,              &opt_quiet,             &cli_opt_help,
+    &cli_opt_scale,
+    &cli_opt_rays,
+    &cli_opt_filter_radius,
+    &cli_opt_filter_threshold,
+    &cli_opt_bias,
+    &cli_opt_power,
+    &cli_opt_basis,
+    &cli_opt_normal_filter,
+    &cli_opt_normal_y,
+    &cli_opt_threads,
+    &cli_opt_clamp,
+    &cli_opt_jitter,
+    &cli_opt_channel,
+    &cli_opt_depth,
+    &opt_out_normal,
+    &opt_out_weights,
+    &opt_out_ssbump,
+    &opt_out_ao,
+    &opt_out_bent,
+    &opt_out_filtered,
+    &opt_prefix,
+    &opt_json,
+    &opt_quiet,
+    &cli_opt_help,
 };
 
 static const cli_command bake_command = {
@@ -71,7 +111,7 @@ static const cli_command bake_command = {
 
 typedef struct bake_args {
   cli_settings settings;
-  const char *paths[OUTPUT_KIND_COUNT]; /* NULL = not written */
+  const char *paths[OUTPUT_KIND_COUNT];  /* NULL = not written */
   char *prefix_paths[OUTPUT_KIND_COUNT]; /* malloc'd paths made from -o */
   const char *prefix;
   int json, quiet;
@@ -84,22 +124,31 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
     return 0;
   }
   switch (opt->id) {
-  case CLI_OPT_OUTPUT: a->prefix = arg; return 0;
-  case CLI_OPT_JSON: a->json = 1; return 0;
-  case CLI_OPT_QUIET: a->quiet = 1; return 0;
-  default: break;
+  case CLI_OPT_OUTPUT:
+    a->prefix = arg;
+    return 0;
+  case CLI_OPT_JSON:
+    a->json = 1;
+    return 0;
+  case CLI_OPT_QUIET:
+    a->quiet = 1;
+    return 0;
+  default:
+    break;
   }
   int rc = cli_settings_apply(bake_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(bake_command.name, "internal error: option %s unhandled",
-                                  opt->long_name)
+  return rc < 0 ? cli_usage_error(bake_command.name,
+                                  "internal error: option %s unhandled", opt->long_name)
                 : rc;
 }
 
 /* -o PREFIX names the outputs not given one by one. */
 static int expand_prefix(bake_args *a) {
-  if (!a->prefix) return 0;
+  if (!a->prefix)
+    return 0;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!output_kinds[k].from_prefix || a->paths[k]) continue;
+    if (!output_kinds[k].from_prefix || a->paths[k])
+      continue;
     size_t len = strlen(a->prefix) + strlen(output_kinds[k].kind) + sizeof "_.png";
     a->prefix_paths[k] = malloc(len);
     if (!a->prefix_paths[k]) {
@@ -116,31 +165,37 @@ static int expand_prefix(bake_args *a) {
 static int check_outputs(const bake_args *a, const char *input) {
   int any = 0;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k]) continue;
+    if (!a->paths[k])
+      continue;
     any = 1;
     for (int j = 0; j < k; j++)
       if (a->paths[j] && !strcmp(a->paths[j], a->paths[k]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
                                output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
-    if (rc) return rc;
+    if (rc)
+      return rc;
   }
   if (!any)
-    return cli_usage_error(bake_command.name,
-                           "nothing to write: give -o PREFIX or at least one of --normal, "
-                           "--weights, --ssbump, --ao, --bent, --filtered");
+    return cli_usage_error(
+        bake_command.name,
+        "nothing to write: give -o PREFIX or at least one of --normal, "
+        "--weights, --ssbump, --ao, --bent, --filtered");
   return 0;
 }
 
 static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
   int first = 0;
   int rc = cli_parse_options(&bake_command, argc, argv, bake_option, a, &first);
-  if (!rc) rc = cli_expect_positionals(&bake_command, argc, argv, first, 1, "HEIGHT");
-  if (rc) return rc;
+  if (!rc)
+    rc = cli_expect_positionals(&bake_command, argc, argv, first, 1, "HEIGHT");
+  if (rc)
+    return rc;
   *input = argv[first];
   if (!a->settings.scale_given)
-    return cli_usage_error(bake_command.name,
-                           "--scale is required (texels of displacement per unit of height)");
+    return cli_usage_error(
+        bake_command.name,
+        "--scale is required (texels of displacement per unit of height)");
   rc = expand_prefix(a);
   return rc ? rc : check_outputs(a, *input);
 }
@@ -189,7 +244,8 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_number(&j, "rays_traced", r->rays_traced);
   cli_json_open(&j, "outputs", '[');
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k]) continue;
+    if (!a->paths[k])
+      continue;
     cli_json_open(&j, NULL, '{');
     cli_json_string(&j, "kind", output_kinds[k].kind);
     cli_json_string(&j, "path", a->paths[k]);
@@ -203,18 +259,22 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
 /* Writes every requested output; stops at the first failure. */
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r) {
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k]) continue;
+    if (!a->paths[k])
+      continue;
     int rc = cli_write_output(run, output_kinds[k].kind, a->paths[k], result_image(r, k),
                               output_kinds[k].range);
-    if (rc) return rc;
-    if (!a->json && !a->quiet) printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
+    if (rc)
+      return rc;
+    if (!a->json && !a->quiet)
+      printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
   }
   return 0;
 }
 
 static int needs_trace(const bake_args *a) {
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
-    if (a->paths[k] && output_kinds[k].needs_trace) return 1;
+    if (a->paths[k] && output_kinds[k].needs_trace)
+      return 1;
   return 0;
 }
 
@@ -235,13 +295,15 @@ static int bake_run(int argc, char **argv, bake_args *a, const char *input) {
     rc = cli_run_bake(input, &height, &a->settings.bake, &result);
     cli_progress_finish(&progress);
   }
-  if (!rc) rc = cli_run_init(&run, argc, argv, input, &height, &a->settings);
+  if (!rc)
+    rc = cli_run_init(&run, argc, argv, input, &height, &a->settings);
   if (!rc) {
     run.rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
     rc = write_outputs(a, &run, &result);
     t.write = run.seconds_write;
   }
-  if (!rc && a->json) print_json(a, input, &height, &result, &t);
+  if (!rc && a->json)
+    print_json(a, input, &height, &result, &t);
   cli_run_free(&run);
   bb_bake_result_free(&result);
   bb_image_free(&height);
@@ -254,8 +316,11 @@ int bb_cli_bake(int argc, char **argv) {
   cli_settings_init(&a.settings);
   const char *input = NULL;
   int rc = bake_parse(argc, argv, &a, &input);
-  if (rc < 0) rc = BB_EXIT_OK; /* --help */
-  else if (rc == 0) rc = bake_run(argc, argv, &a, input);
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) free(a.prefix_paths[k]);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = bake_run(argc, argv, &a, input);
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    free(a.prefix_paths[k]);
   return rc;
 }

@@ -19,45 +19,83 @@
 
 /* ------------------------------------------------------- shared option rows */
 
-const cli_option cli_opt_help = {CLI_OPT_HELP, "help", 'h', NULL, NULL, NULL,
-                                 "print this help and exit"};
+const cli_option cli_opt_help = {.id = CLI_OPT_HELP,
+                                 .long_name = "help",
+                                 .short_name = 'h',
+                                 .help = "print this help and exit"};
 const cli_option cli_opt_scale = {
-    CLI_OPT_SCALE, "scale", 0, "S", "(required)", "> 0",
-    "height scale: texels of displacement per unit of normalised height"};
-const cli_option cli_opt_rays = {CLI_OPT_RAYS, "rays", 0, "N", NULL, "1..65536",
-                                 "rays traced per texel"};
+    .id = CLI_OPT_SCALE,
+    .long_name = "scale",
+    .value_name = "S",
+    .default_text = "(required)",
+    .range_text = "> 0",
+    .help = "height scale: texels of displacement per unit of normalised height"};
+const cli_option cli_opt_rays = {.id = CLI_OPT_RAYS,
+                                 .long_name = "rays",
+                                 .value_name = "N",
+                                 .range_text = "1..65536",
+                                 .help = "rays traced per texel"};
 const cli_option cli_opt_filter_radius = {
-    CLI_OPT_FILTER_RADIUS, "filter-radius", 0, "R", NULL, ">= 0 (integer)",
-    "bilateral smoothing radius in texels, 0 = off"};
+    .id = CLI_OPT_FILTER_RADIUS,
+    .long_name = "filter-radius",
+    .value_name = "R",
+    .range_text = ">= 0 (integer)",
+    .help = "bilateral smoothing radius in texels, 0 = off"};
 const cli_option cli_opt_filter_threshold = {
-    CLI_OPT_FILTER_THRESHOLD, "filter-threshold", 0, "T", NULL, "> 0",
-    "smoothing range threshold in normalised height (2/255 = 0.00784)"};
+    .id = CLI_OPT_FILTER_THRESHOLD,
+    .long_name = "filter-threshold",
+    .value_name = "T",
+    .range_text = "> 0",
+    .help = "smoothing range threshold in normalised height (2/255 = 0.00784)"};
 const cli_option cli_opt_bias = {
-    CLI_OPT_BIAS, "bias", 0, "B", NULL, ">= 0",
-    "ray origin lift above the vertex in texels (0.55 = Valve's offset)"};
-const cli_option cli_opt_power = {CLI_OPT_POWER, "power", 0, "P", NULL, ">= 1",
-                                  "exponent of the basis lobes max(0, w.B)^P"};
-const cli_option cli_opt_basis = {CLI_OPT_BASIS, "basis", 0, "hl2|hl2+z", NULL,
-                                  NULL, "directions occlusion is projected on"};
+    .id = CLI_OPT_BIAS,
+    .long_name = "bias",
+    .value_name = "B",
+    .range_text = ">= 0",
+    .help = "ray origin lift above the vertex in texels (0.55 = Valve's offset)"};
+const cli_option cli_opt_power = {.id = CLI_OPT_POWER,
+                                  .long_name = "power",
+                                  .value_name = "P",
+                                  .range_text = ">= 1",
+                                  .help = "exponent of the basis lobes max(0, w.B)^P"};
+const cli_option cli_opt_basis = {.id = CLI_OPT_BASIS,
+                                  .long_name = "basis",
+                                  .value_name = "hl2|hl2+z",
+                                  .help = "directions occlusion is projected on"};
 const cli_option cli_opt_normal_filter = {
-    CLI_OPT_NORMAL_FILTER, "normal-filter", 0, "valve|central|sobel", NULL, NULL,
-    "normal estimator (valve: mean of the 18 triangle normals)"};
+    .id = CLI_OPT_NORMAL_FILTER,
+    .long_name = "normal-filter",
+    .value_name = "valve|central|sobel",
+    .help = "normal estimator (valve: mean of the 18 triangle normals)"};
 const cli_option cli_opt_normal_y = {
-    CLI_OPT_NORMAL_Y, "normal-y", 0, "down|up", NULL, NULL,
-    "green axis: down = Source/DirectX, up = OpenGL (flips green)"};
-const cli_option cli_opt_threads = {CLI_OPT_THREADS, "threads", 0, "N", NULL,
-                                    "0..4096", "worker threads, 0 = all cores"};
-const cli_option cli_opt_clamp = {CLI_OPT_CLAMP, "clamp", 0, NULL, "periodic",
-                                  NULL, "extend border texels instead of tiling"};
+    .id = CLI_OPT_NORMAL_Y,
+    .long_name = "normal-y",
+    .value_name = "down|up",
+    .help = "green axis: down = Source/DirectX, up = OpenGL (flips green)"};
+const cli_option cli_opt_threads = {.id = CLI_OPT_THREADS,
+                                    .long_name = "threads",
+                                    .value_name = "N",
+                                    .range_text = "0..4096",
+                                    .help = "worker threads, 0 = all cores"};
+const cli_option cli_opt_clamp = {.id = CLI_OPT_CLAMP,
+                                  .long_name = "clamp",
+                                  .default_text = "periodic",
+                                  .help = "extend border texels instead of tiling"};
 const cli_option cli_opt_jitter = {
-    CLI_OPT_JITTER, "jitter", 0, NULL, "off", NULL,
-    "rotate the ray set per texel (less banding, not shift-invariant)"};
+    .id = CLI_OPT_JITTER,
+    .long_name = "jitter",
+    .default_text = "off",
+    .help = "rotate the ray set per texel (less banding, not shift-invariant)"};
 const cli_option cli_opt_channel = {
-    CLI_OPT_CHANNEL, "channel", 0, "r|g|b|a|luma|mean", NULL, NULL,
-    "height channel (auto: grey, or mean of R, G, B)"};
+    .id = CLI_OPT_CHANNEL,
+    .long_name = "channel",
+    .value_name = "r|g|b|a|luma|mean",
+    .help = "height channel (auto: grey, or mean of R, G, B)"};
 const cli_option cli_opt_depth = {
-    CLI_OPT_DEPTH, "depth", 0, "8|16|half|float", NULL, NULL,
-    "sample depth (default: 8 for png/tga/tif, float for exr)"};
+    .id = CLI_OPT_DEPTH,
+    .long_name = "depth",
+    .value_name = "8|16|half|float",
+    .help = "sample depth (default: 8 for png/tga/tif, float for exr)"};
 
 /* ----------------------------------------------------------------- errors */
 
@@ -76,7 +114,8 @@ void cli_file_error(const char *path, const char *reason) {
   char line[sizeof(((bb_error *)0)->message)];
   snprintf(line, sizeof line, "%s", reason && *reason ? reason : "unknown error");
   for (char *c = line; *c; c++)
-    if (*c == '\n' || *c == '\r') *c = ' ';
+    if (*c == '\n' || *c == '\r')
+      *c = ' ';
   size_t n = strlen(path);
   if (strncmp(line, path, n) == 0 && line[n] == ':')
     fprintf(stderr, "bumpbake: %s\n", line);
@@ -102,8 +141,8 @@ int cli_parse_double(const char *command, const char *option, const char *text,
   return 0;
 }
 
-int cli_parse_int(const char *command, const char *option, const char *text,
-                  long min, long max, int *out) {
+int cli_parse_int(const char *command, const char *option, const char *text, long min,
+                  long max, int *out) {
   char *end = NULL;
   errno = 0;
   long v = strtol(text, &end, 10);
@@ -112,8 +151,8 @@ int cli_parse_int(const char *command, const char *option, const char *text,
   if (errno == ERANGE || v < min || v > max) {
     if (max == INT_MAX)
       return cli_usage_error(command, "%s must be >= %ld (got %s)", option, min, text);
-    return cli_usage_error(command, "%s must be in %ld..%ld (got %s)", option, min,
-                           max, text);
+    return cli_usage_error(command, "%s must be in %ld..%ld (got %s)", option, min, max,
+                           text);
   }
   *out = (int)v;
   return 0;
@@ -145,20 +184,41 @@ static const char *settings_default_text(int id, const cli_settings *d, char *bu
                                          size_t cap) {
   const bb_bake_options *b = &d->bake;
   switch (id) {
-  case CLI_OPT_RAYS: snprintf(buf, cap, "%d", b->rays); break;
-  case CLI_OPT_FILTER_RADIUS: snprintf(buf, cap, "%d", b->smooth.radius_texels); break;
-  case CLI_OPT_FILTER_THRESHOLD: snprintf(buf, cap, "%.5g", (double)b->smooth.threshold); break;
-  case CLI_OPT_BIAS: snprintf(buf, cap, "%.5g", b->trace.bias_texels); break;
-  case CLI_OPT_POWER: snprintf(buf, cap, "%.5g", b->power); break;
-  case CLI_OPT_BASIS: snprintf(buf, cap, "%s", bb_basis_name(b->basis)); break;
+  case CLI_OPT_RAYS:
+    snprintf(buf, cap, "%d", b->rays);
+    break;
+  case CLI_OPT_FILTER_RADIUS:
+    snprintf(buf, cap, "%d", b->smooth.radius_texels);
+    break;
+  case CLI_OPT_FILTER_THRESHOLD:
+    snprintf(buf, cap, "%.5g", (double)b->smooth.threshold);
+    break;
+  case CLI_OPT_BIAS:
+    snprintf(buf, cap, "%.5g", b->trace.bias_texels);
+    break;
+  case CLI_OPT_POWER:
+    snprintf(buf, cap, "%.5g", b->power);
+    break;
+  case CLI_OPT_BASIS:
+    snprintf(buf, cap, "%s", bb_basis_name(b->basis));
+    break;
   case CLI_OPT_NORMAL_FILTER:
     snprintf(buf, cap, "%s", bb_normal_filter_name(b->normal_filter));
     break;
-  case CLI_OPT_NORMAL_Y: snprintf(buf, cap, "%s", b->normal_y_up ? "up" : "down"); break;
-  case CLI_OPT_THREADS: snprintf(buf, cap, "%d", b->trace.threads); break;
-  case CLI_OPT_CHANNEL: snprintf(buf, cap, "%s", bb_channel_name(d->channel)); break;
-  case CLI_OPT_DEPTH: snprintf(buf, cap, "by format"); break;
-  default: return NULL;
+  case CLI_OPT_NORMAL_Y:
+    snprintf(buf, cap, "%s", b->normal_y_up ? "up" : "down");
+    break;
+  case CLI_OPT_THREADS:
+    snprintf(buf, cap, "%d", b->trace.threads);
+    break;
+  case CLI_OPT_CHANNEL:
+    snprintf(buf, cap, "%s", bb_channel_name(d->channel));
+    break;
+  case CLI_OPT_DEPTH:
+    snprintf(buf, cap, "by format");
+    break;
+  default:
+    return NULL;
   }
   return buf;
 }
@@ -172,16 +232,21 @@ static void print_help(const cli_command *cmd) {
     const cli_option *o = cmd->options[i];
     char flags[64], dflt[64];
     int n = 0;
-    if (o->short_name) n += snprintf(flags + n, sizeof flags - (size_t)n, "-%c", o->short_name);
+    if (o->short_name)
+      n += snprintf(flags + n, sizeof flags - (size_t)n, "-%c", o->short_name);
     if (o->long_name)
       n += snprintf(flags + n, sizeof flags - (size_t)n, "%s--%s", n ? ", " : "",
                     o->long_name);
-    if (o->value_name) snprintf(flags + n, sizeof flags - (size_t)n, " %s", o->value_name);
-    const char *d = o->default_text ? o->default_text
-                                    : settings_default_text(o->id, &defaults, dflt, sizeof dflt);
+    if (o->value_name)
+      snprintf(flags + n, sizeof flags - (size_t)n, " %s", o->value_name);
+    const char *d = o->default_text
+                        ? o->default_text
+                        : settings_default_text(o->id, &defaults, dflt, sizeof dflt);
     printf("  %-36s %s", flags, o->help);
-    if (d) printf("; default %s", d);
-    if (o->range_text) printf("; range %s", o->range_text);
+    if (d)
+      printf("; default %s", d);
+    if (o->range_text)
+      printf("; range %s", o->range_text);
     putchar('\n');
   }
 }
@@ -204,7 +269,8 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
       longopts[nl++] = (struct option){o->long_name, has_arg, NULL, o->id};
     if (o->short_name) {
       shortopts[ns++] = o->short_name;
-      if (has_arg) shortopts[ns++] = ':';
+      if (has_arg)
+        shortopts[ns++] = ':';
     }
   }
   longopts[nl] = (struct option){NULL, 0, NULL, 0};
@@ -214,7 +280,8 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   optind = 1;
   for (;;) {
     int c = getopt_long(argc, argv, shortopts, longopts, NULL);
-    if (c == -1) break;
+    if (c == -1)
+      break;
     if (c == '?') {
       char name[64];
       const cli_option *known = find_option(cmd, optopt);
@@ -234,13 +301,15 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
                                : argv[optind - 1]);
     }
     const cli_option *o = find_option(cmd, c);
-    if (!o) return cli_usage_error(cmd->name, "internal: unhandled option %d", c);
+    if (!o)
+      return cli_usage_error(cmd->name, "internal: unhandled option %d", c);
     if (o->id == CLI_OPT_HELP) {
       print_help(cmd);
       return -1;
     }
     int rc = on_option(ctx, o, optarg);
-    if (rc) return rc;
+    if (rc)
+      return rc;
   }
   *first_positional = optind;
   return 0;
@@ -269,8 +338,13 @@ void cli_settings_init(cli_settings *s) {
 }
 
 static int parse_depth(const char *text, bb_depth *out) {
-  static const struct { const char *name; bb_depth depth; } depths[] = {
-      {"8", BB_DEPTH_8}, {"16", BB_DEPTH_16}, {"half", BB_DEPTH_HALF}, {"float", BB_DEPTH_FLOAT}};
+  static const struct {
+    const char *name;
+    bb_depth depth;
+  } depths[] = {{"8", BB_DEPTH_8},
+                {"16", BB_DEPTH_16},
+                {"half", BB_DEPTH_HALF},
+                {"float", BB_DEPTH_FLOAT}};
   for (size_t i = 0; i < sizeof depths / sizeof depths[0]; i++)
     if (strcmp(text, depths[i].name) == 0) {
       *out = depths[i].depth;
@@ -284,7 +358,8 @@ static int parse_depth(const char *text, bb_depth *out) {
 static int bad_choice(const char *command, const cli_option *opt, const char *arg) {
   char name[64];
   return cli_usage_error(command, "%s must be one of %s (got '%s')",
-                         option_display_name(opt, name, sizeof name), opt->value_name, arg);
+                         option_display_name(opt, name, sizeof name), opt->value_name,
+                         arg);
 }
 
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
@@ -302,32 +377,44 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
       s->scale_given = 1;
     }
     return rc;
-  case CLI_OPT_RAYS: return cli_parse_int(command, name, arg, 1, 65536, &b->rays);
+  case CLI_OPT_RAYS:
+    return cli_parse_int(command, name, arg, 1, 65536, &b->rays);
   case CLI_OPT_FILTER_RADIUS:
     /* Beyond a few hundred texels the window covers any texture anyway. */
     return cli_parse_int(command, name, arg, 0, 4096, &b->smooth.radius_texels);
   case CLI_OPT_FILTER_THRESHOLD:
     rc = cli_parse_double(command, name, arg, 0.0, 1, (double)FLT_MAX, &d);
-    if (!rc) b->smooth.threshold = (float)d;
+    if (!rc)
+      b->smooth.threshold = (float)d;
     return rc;
   case CLI_OPT_BIAS:
     return cli_parse_double(command, name, arg, 0.0, 0, 1.0e6, &b->trace.bias_texels);
-  case CLI_OPT_POWER: return cli_parse_double(command, name, arg, 1.0, 0, 1.0e6, &b->power);
-  case CLI_OPT_THREADS: return cli_parse_int(command, name, arg, 0, 4096, &b->trace.threads);
+  case CLI_OPT_POWER:
+    return cli_parse_double(command, name, arg, 1.0, 0, 1.0e6, &b->power);
+  case CLI_OPT_THREADS:
+    return cli_parse_int(command, name, arg, 0, 4096, &b->trace.threads);
   case CLI_OPT_BASIS:
     return bb_basis_parse(arg, &b->basis) ? bad_choice(command, opt, arg) : 0;
   case CLI_OPT_NORMAL_FILTER:
-    return bb_normal_filter_parse(arg, &b->normal_filter) ? bad_choice(command, opt, arg) : 0;
+    return bb_normal_filter_parse(arg, &b->normal_filter) ? bad_choice(command, opt, arg)
+                                                          : 0;
   case CLI_OPT_NORMAL_Y:
-    if (strcmp(arg, "down") && strcmp(arg, "up")) return bad_choice(command, opt, arg);
+    if (strcmp(arg, "down") && strcmp(arg, "up"))
+      return bad_choice(command, opt, arg);
     b->normal_y_up = strcmp(arg, "up") == 0;
     return 0;
   case CLI_OPT_CHANNEL:
     return bb_channel_parse(arg, &s->channel) ? bad_choice(command, opt, arg) : 0;
-  case CLI_OPT_DEPTH: return parse_depth(arg, &s->depth) ? bad_choice(command, opt, arg) : 0;
-  case CLI_OPT_CLAMP: b->smooth.addressing = BB_ADDRESS_CLAMP; return 0;
-  case CLI_OPT_JITTER: b->trace.jitter = 1; return 0;
-  default: return -1;
+  case CLI_OPT_DEPTH:
+    return parse_depth(arg, &s->depth) ? bad_choice(command, opt, arg) : 0;
+  case CLI_OPT_CLAMP:
+    b->smooth.addressing = BB_ADDRESS_CLAMP;
+    return 0;
+  case CLI_OPT_JITTER:
+    b->trace.jitter = 1;
+    return 0;
+  default:
+    return -1;
   }
 }
 
@@ -353,22 +440,32 @@ static int depth_fits_format(bb_depth depth, const char *ext) {
   int png = !strcmp(ext, "png"), tga = !strcmp(ext, "tga");
   int tif = !strcmp(ext, "tif") || !strcmp(ext, "tiff"), exr = !strcmp(ext, "exr");
   switch (depth) {
-  case BB_DEPTH_DEFAULT: return 1;
-  case BB_DEPTH_8: return png || tga || tif;
-  case BB_DEPTH_16: return png || tif;
-  case BB_DEPTH_HALF: return exr;
-  case BB_DEPTH_FLOAT: return exr || tif;
+  case BB_DEPTH_DEFAULT:
+    return 1;
+  case BB_DEPTH_8:
+    return png || tga || tif;
+  case BB_DEPTH_16:
+    return png || tif;
+  case BB_DEPTH_HALF:
+    return exr;
+  case BB_DEPTH_FLOAT:
+    return exr || tif;
   }
   return 0;
 }
 
 static const char *depth_name(bb_depth d) {
   switch (d) {
-  case BB_DEPTH_8: return "8";
-  case BB_DEPTH_16: return "16";
-  case BB_DEPTH_HALF: return "half";
-  case BB_DEPTH_FLOAT: return "float";
-  case BB_DEPTH_DEFAULT: break;
+  case BB_DEPTH_8:
+    return "8";
+  case BB_DEPTH_16:
+    return "16";
+  case BB_DEPTH_HALF:
+    return "half";
+  case BB_DEPTH_FLOAT:
+    return "float";
+  case BB_DEPTH_DEFAULT:
+    break;
   }
   return "default";
 }
@@ -397,7 +494,8 @@ static int check_output_directory(const char *path) {
   struct stat st;
   if (stat(dir, &st) != 0) {
     char reason[PATH_MAX + 128];
-    snprintf(reason, sizeof reason, "cannot write: directory %s: %s", dir, strerror(errno));
+    snprintf(reason, sizeof reason, "cannot write: directory %s: %s", dir,
+             strerror(errno));
     cli_file_error(path, reason);
     return BB_EXIT_FAILURE;
   }
@@ -410,13 +508,13 @@ static int check_output_directory(const char *path) {
   return 0;
 }
 
-int cli_check_output(const char *command, const char *input_path,
-                     const char *output_path, bb_depth depth) {
+int cli_check_output(const char *command, const char *input_path, const char *output_path,
+                     bb_depth depth) {
   char ext[16];
   if (!bb_path_is_writable_format(output_path))
-    return cli_usage_error(command,
-                           "%s: unknown output format '.%s' (use .png, .tga, .tif or .exr)",
-                           output_path, path_extension(output_path, ext, sizeof ext));
+    return cli_usage_error(
+        command, "%s: unknown output format '.%s' (use .png, .tga, .tif or .exr)",
+        output_path, path_extension(output_path, ext, sizeof ext));
   if (!depth_fits_format(depth, path_extension(output_path, ext, sizeof ext)))
     return cli_usage_error(command, "%s: --depth %s is not available in .%s files",
                            output_path, depth_name(depth), ext);
@@ -436,7 +534,8 @@ int cli_run_init(cli_run *run, int argc, char **argv, const char *input_path,
                  const bb_image *height, const cli_settings *settings) {
   memset(run, 0, sizeof *run);
   size_t len = strlen("bumpbake") + 1;
-  for (int i = 0; i < argc; i++) len += strlen(argv[i]) + 1;
+  for (int i = 0; i < argc; i++)
+    len += strlen(argv[i]) + 1;
   run->command_line = malloc(len);
   if (!run->command_line) {
     cli_file_error(input_path, "out of memory");
@@ -460,8 +559,9 @@ void cli_run_free(cli_run *run) {
 
 int cli_write_output(cli_run *run, const char *kind, const char *path,
                      const bb_image *img, bb_range range) {
-  bb_provenance p = {run->command_line, file_name_of(run->input_path), run->input_hash,
-                     kind, &run->settings->bake, run->settings->channel, run->rayset_id};
+  bb_provenance p = {
+      run->command_line,    file_name_of(run->input_path), run->input_hash, kind,
+      &run->settings->bake, run->settings->channel,        run->rayset_id};
   char *description = bb_provenance_format(&p);
   if (!description) {
     cli_file_error(path, "out of memory");
@@ -524,7 +624,8 @@ static void json_quoted(FILE *f, const char *s) {
 
 /* The separator and "key": that precede every value. */
 static void json_begin_value(cli_json *j, const char *key) {
-  if (j->need_comma) fputc(',', j->f);
+  if (j->need_comma)
+    fputc(',', j->f);
   if (key) {
     json_quoted(j->f, key);
     fputc(':', j->f);
@@ -573,16 +674,20 @@ static void progress_draw(void *user, long done, long total) {
   cli_progress *p = user;
   double now = cli_now_seconds(), elapsed = now - p->start_seconds;
   /* Short bakes stay silent; long ones redraw ten times a second at most. */
-  if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1) return;
+  if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1)
+    return;
   p->last_draw_seconds = now;
   double frac = done <= 0 ? 0.0 : (double)done / (double)total;
-  if (frac > 1.0) frac = 1.0;
+  if (frac > 1.0)
+    frac = 1.0;
   int filled = (int)(frac * PROGRESS_BAR_WIDTH); /* full only when done */
   char bar[PROGRESS_BAR_WIDTH + 1];
-  for (int i = 0; i < PROGRESS_BAR_WIDTH; i++) bar[i] = i < filled ? '#' : '.';
+  for (int i = 0; i < PROGRESS_BAR_WIDTH; i++)
+    bar[i] = i < filled ? '#' : '.';
   bar[PROGRESS_BAR_WIDTH] = '\0';
   fprintf(stderr, "\r%s [%s] %3d%%", p->label, bar, (int)(frac * 100.0));
-  if (frac > 0.0) fprintf(stderr, " ETA %.1fs", elapsed * (1.0 - frac) / frac);
+  if (frac > 0.0)
+    fprintf(stderr, " ETA %.1fs", elapsed * (1.0 - frac) / frac);
   fputs("\033[K", stderr); /* erase what a longer previous line left */
   fflush(stderr);
   p->shown = 1;
@@ -593,13 +698,15 @@ void cli_progress_attach(cli_progress *p, const char *label, int quiet,
   memset(p, 0, sizeof *p);
   p->label = label;
   p->start_seconds = cli_now_seconds();
-  if (quiet || !isatty(STDERR_FILENO)) return;
+  if (quiet || !isatty(STDERR_FILENO))
+    return;
   trace->progress = progress_draw;
   trace->progress_user = p;
 }
 
 void cli_progress_finish(cli_progress *p) {
-  if (!p->shown) return;
+  if (!p->shown)
+    return;
   fputs("\r\033[K", stderr);
   fflush(stderr);
   p->shown = 0;

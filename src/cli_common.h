@@ -30,8 +30,8 @@ typedef enum cli_opt_id {
   CLI_OPT_JITTER,
   CLI_OPT_CHANNEL,
   CLI_OPT_DEPTH,
-  CLI_OPT_OUTPUT,       /* -o: the output file (normal) or prefix (bake) */
-  CLI_OPT_OUT_NORMAL,   /* bake's per-kind outputs, in bake_output_kinds order */
+  CLI_OPT_OUTPUT,     /* -o: the output file (normal) or prefix (bake) */
+  CLI_OPT_OUT_NORMAL, /* bake's per-kind outputs, in bake_output_kinds order */
   CLI_OPT_OUT_WEIGHTS,
   CLI_OPT_OUT_SSBUMP,
   CLI_OPT_OUT_AO,
@@ -66,9 +66,9 @@ typedef struct cli_settings cli_settings;
 
 /* A subcommand's command-line description. */
 typedef struct cli_command {
-  const char *name;         /* "normal", "bake", ... */
-  const char *synopsis;     /* usage line after "bumpbake NAME " */
-  const char *summary;      /* one line for --help */
+  const char *name;                 /* "normal", "bake", ... */
+  const char *synopsis;             /* usage line after "bumpbake NAME " */
+  const char *summary;              /* one line for --help */
   const cli_option *const *options; /* rows, shared rows by address */
   int option_count;
   /* Fills the command's default settings; --help prints the defaults of the
@@ -108,8 +108,8 @@ void cli_file_error(const char *path, const char *reason);
  * (for "> 0"). */
 int cli_parse_double(const char *command, const char *option, const char *text,
                      double min, int min_exclusive, double max, double *out);
-int cli_parse_int(const char *command, const char *option, const char *text,
-                  long min, long max, int *out);
+int cli_parse_int(const char *command, const char *option, const char *text, long min,
+                  long max, int *out);
 
 /* ------------------------------------------------- bake settings (shared) */
 
@@ -145,17 +145,17 @@ extern const cli_option cli_opt_scale, cli_opt_rays, cli_opt_filter_radius,
  * extension bb_image_write does not know or a depth its format cannot hold;
  * BB_EXIT_FAILURE when it names the input file or its directory does not
  * exist. Prints the error. Returns 0 when the path looks writable. */
-int cli_check_output(const char *command, const char *input_path,
-                     const char *output_path, bb_depth depth);
+int cli_check_output(const char *command, const char *input_path, const char *output_path,
+                     bb_depth depth);
 
 /* What every output of one run shares, for its provenance. */
 typedef struct cli_run {
-  char *command_line;       /* "bumpbake " + argv joined with spaces */
+  char *command_line; /* "bumpbake " + argv joined with spaces */
   const char *input_path;
-  uint64_t input_hash;      /* bb_image_hash of the decoded height */
+  uint64_t input_hash; /* bb_image_hash of the decoded height */
   const cli_settings *settings;
-  const char *rayset_id;    /* NULL when nothing was traced */
-  double seconds_write;     /* summed over cli_write_output calls */
+  const char *rayset_id; /* NULL when nothing was traced */
+  double seconds_write;  /* summed over cli_write_output calls */
 } cli_run;
 
 /* Fills run (the command line is malloc'd; free it with cli_run_free).

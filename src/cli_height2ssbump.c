@@ -11,23 +11,41 @@
 /* Valve's defaults: 250 rays (-r), filter radius 10 (-f). */
 enum { VALVE_RAYS = 250, VALVE_FILTER_RADIUS = 10 };
 
-static const cli_option opt_rays = {CLI_OPT_RAYS, NULL, 'r', "N", NULL, "1..65536",
-                                    "rays traced per texel"};
-static const cli_option opt_radius = {CLI_OPT_FILTER_RADIUS, NULL, 'f', "R", NULL,
-                                      ">= 0 (integer)",
-                                      "bilateral smoothing radius in texels, 0 = off"};
-static const cli_option opt_normal = {CLI_OPT_VALVE_NORMAL, NULL, 'n', NULL, "off", NULL,
-                                      "write FILE-bump.tga: RGB = normal map (0.5 + 0.5 N)"};
-static const cli_option opt_ao_alpha = {CLI_OPT_VALVE_AO_ALPHA, NULL, 'A', NULL, "off", NULL,
-                                        "put ambient occlusion in alpha, not the height"};
-static const cli_option opt_dump = {CLI_OPT_VALVE_DUMP, NULL, 'D', NULL, "off", NULL,
-                                    "also write the filtered height as ./filtered.tga"};
+static const cli_option opt_rays = {.id = CLI_OPT_RAYS,
+                                    .short_name = 'r',
+                                    .value_name = "N",
+                                    .range_text = "1..65536",
+                                    .help = "rays traced per texel"};
+static const cli_option opt_radius = {
+    .id = CLI_OPT_FILTER_RADIUS,
+    .short_name = 'f',
+    .value_name = "R",
+    .range_text = ">= 0 (integer)",
+    .help = "bilateral smoothing radius in texels, 0 = off"};
+static const cli_option opt_normal = {
+    .id = CLI_OPT_VALVE_NORMAL,
+    .short_name = 'n',
+    .default_text = "off",
+    .help = "write FILE-bump.tga: RGB = normal map (0.5 + 0.5 N)"};
+static const cli_option opt_ao_alpha = {
+    .id = CLI_OPT_VALVE_AO_ALPHA,
+    .short_name = 'A',
+    .default_text = "off",
+    .help = "put ambient occlusion in alpha, not the height"};
+static const cli_option opt_dump = {
+    .id = CLI_OPT_VALVE_DUMP,
+    .short_name = 'D',
+    .default_text = "off",
+    .help = "also write the filtered height as ./filtered.tga"};
 static const cli_option opt_detail = {
-    CLI_OPT_VALVE_DETAIL, NULL, 'd', NULL, "off", NULL,
-    "detail variant: RGB times (R+G+B)/sqrt(3) of the filtered input colour"};
+    .id = CLI_OPT_VALVE_DETAIL,
+    .short_name = 'd',
+    .default_text = "off",
+    .help = "detail variant: RGB times (R+G+B)/sqrt(3) of the filtered input colour"};
 
 static const cli_option *const h2s_options[] = {
-    &opt_rays, &opt_normal, &opt_ao_alpha, &opt_radius, &opt_dump, &opt_detail, &cli_opt_help,
+    &opt_rays, &opt_normal, &opt_ao_alpha, &opt_radius,
+    &opt_dump, &opt_detail, &cli_opt_help,
 };
 
 static void h2s_settings_init(cli_settings *s) {
@@ -60,15 +78,24 @@ static const char dump_path[] = "filtered.tga";
 static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
   h2s_args *a = ctx;
   switch (opt->id) {
-  case CLI_OPT_VALVE_NORMAL: a->normal_map = 1; return 0;
-  case CLI_OPT_VALVE_AO_ALPHA: a->ao_in_alpha = 1; return 0;
-  case CLI_OPT_VALVE_DUMP: a->dump_filtered = 1; return 0;
-  case CLI_OPT_VALVE_DETAIL: a->detail = 1; return 0;
-  default: break;
+  case CLI_OPT_VALVE_NORMAL:
+    a->normal_map = 1;
+    return 0;
+  case CLI_OPT_VALVE_AO_ALPHA:
+    a->ao_in_alpha = 1;
+    return 0;
+  case CLI_OPT_VALVE_DUMP:
+    a->dump_filtered = 1;
+    return 0;
+  case CLI_OPT_VALVE_DETAIL:
+    a->detail = 1;
+    return 0;
+  default:
+    break;
   }
   int rc = cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(h2s_command.name, "internal error: option -%c unhandled",
-                                  opt->short_name)
+  return rc < 0 ? cli_usage_error(h2s_command.name,
+                                  "internal error: option -%c unhandled", opt->short_name)
                 : rc;
 }
 
@@ -79,26 +106,31 @@ static char *output_path_for(const char *input, const char *suffix) {
   size_t stem = dot ? (size_t)(dot - input) : strlen(input);
   size_t len = stem + strlen(suffix) + 1;
   char *path = malloc(len);
-  if (path) snprintf(path, len, "%.*s%s", (int)stem, input, suffix);
+  if (path)
+    snprintf(path, len, "%.*s%s", (int)stem, input, suffix);
   return path;
 }
 
 static int h2s_parse(int argc, char **argv, h2s_args *a) {
   int first = 0;
   int rc = cli_parse_options(&h2s_command, argc, argv, h2s_option, a, &first);
-  if (!rc) rc = cli_expect_positionals(&h2s_command, argc, argv, first, 2, "FILE BUMPSCALE");
-  if (rc) return rc;
+  if (!rc)
+    rc = cli_expect_positionals(&h2s_command, argc, argv, first, 2, "FILE BUMPSCALE");
+  if (rc)
+    return rc;
   a->input = argv[first];
   double scale;
   rc = cli_parse_double(h2s_command.name, "BUMPSCALE", argv[first + 1], 0.0, 1,
                         (double)FLT_MAX, &scale);
-  if (rc) return rc;
+  if (rc)
+    return rc;
   a->settings.bake.height_scale = (float)scale;
   a->settings.scale_given = 1;
   /* The detail factor scales light response; on an encoded normal map it
    * would only corrupt the vectors. */
   if (a->detail && a->normal_map)
-    return cli_usage_error(h2s_command.name, "-d makes a detail ssbump; it cannot be used with -n");
+    return cli_usage_error(h2s_command.name,
+                           "-d makes a detail ssbump; it cannot be used with -n");
 
   a->output = output_path_for(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
   if (!a->output) {
@@ -115,14 +147,19 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
  * fail) the mean of R, G, B, which we say on stderr so nobody is surprised. */
 static bb_channel valve_height_channel(const char *path, const bb_image *img,
                                        const bb_image_info *info) {
-  if (info->alpha_channel >= 0) return BB_CHANNEL_A;
+  if (info->alpha_channel >= 0)
+    return BB_CHANNEL_A;
   if (img->channels >= 3) {
-    fprintf(stderr, "bumpbake height2ssbump: %s has no alpha channel; using the mean of "
-                    "R, G, B as the height\n", path);
+    fprintf(stderr,
+            "bumpbake height2ssbump: %s has no alpha channel; using the mean of "
+            "R, G, B as the height\n",
+            path);
     return BB_CHANNEL_MEAN;
   }
-  fprintf(stderr, "bumpbake height2ssbump: %s has no alpha channel; using its grey "
-                  "channel as the height\n", path);
+  fprintf(stderr,
+          "bumpbake height2ssbump: %s has no alpha channel; using its grey "
+          "channel as the height\n",
+          path);
   return BB_CHANNEL_AUTO;
 }
 
@@ -152,7 +189,8 @@ static bb_status filtered_colour(const bb_image *img, const bb_image *height,
                                  bb_error *err) {
   bb_image rgb = {0};
   bb_status st = bb_image_alloc(&rgb, img->width, img->height, 3, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   /* With 3+ channels R, G, B are the first three; with 1 or 2 (grey,
    * grey + alpha) grey is channel 0. */
   int colour_channels = img->channels >= 3 ? 3 : 1;
@@ -174,7 +212,8 @@ static void apply_detail(bb_image *rgba, const bb_image *colour) {
   for (size_t i = 0; i < texels; i++) {
     const float *c = colour->pixels + i * 3;
     float factor = (c[0] + c[1] + c[2]) * inv_sqrt3;
-    for (int k = 0; k < 3; k++) rgba->pixels[i * 4 + (size_t)k] *= factor;
+    for (int k = 0; k < 3; k++)
+      rgba->pixels[i * 4 + (size_t)k] *= factor;
   }
 }
 
@@ -185,7 +224,8 @@ static bb_status compose_rgba(const h2s_args *a, const bb_bake_result *r, bb_ima
   const bb_image *rgb = a->normal_map ? &r->normal : &r->ssbump;
   const bb_image *alpha = a->ao_in_alpha ? &r->ao : &r->filtered;
   bb_status st = bb_image_alloc(out, rgb->width, rgb->height, 4, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   size_t texels = (size_t)rgb->width * (size_t)rgb->height;
   for (size_t i = 0; i < texels; i++) {
     for (int c = 0; c < 3; c++) {
@@ -201,8 +241,10 @@ static bb_status compose_rgba(const h2s_args *a, const bb_bake_result *r, bb_ima
 }
 
 static const char *output_kind(const h2s_args *a) {
-  if (a->normal_map) return a->ao_in_alpha ? "normal+ao" : "normal+height";
-  if (a->detail) return a->ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
+  if (a->normal_map)
+    return a->ao_in_alpha ? "normal+ao" : "normal+height";
+  if (a->detail)
+    return a->ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
   return a->ao_in_alpha ? "ssbump+ao" : "ssbump+height";
 }
 
@@ -214,7 +256,8 @@ static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *hei
   if (st == BB_OK && a->detail) {
     bb_image colour = {0};
     st = filtered_colour(img, height, &a->settings.bake.smooth, &colour, &err);
-    if (st == BB_OK) apply_detail(rgba, &colour);
+    if (st == BB_OK)
+      apply_detail(rgba, &colour);
     bb_image_free(&colour);
   }
   if (st != BB_OK) {
@@ -239,8 +282,10 @@ static int h2s_run(int argc, char **argv, h2s_args *a) {
     rc = cli_run_bake(a->input, &height, &a->settings.bake, &result);
     cli_progress_finish(&progress);
   }
-  if (!rc) rc = make_rgba(a, &img, &height, &result, &rgba);
-  if (!rc) rc = cli_run_init(&run, argc, argv, a->input, &height, &a->settings);
+  if (!rc)
+    rc = make_rgba(a, &img, &height, &result, &rgba);
+  if (!rc)
+    rc = cli_run_init(&run, argc, argv, a->input, &height, &a->settings);
   if (!rc) {
     run.rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
     rc = cli_write_output(&run, output_kind(a), a->output, &rgba, BB_RANGE_UNIT);
@@ -260,8 +305,10 @@ int bb_cli_height2ssbump(int argc, char **argv) {
   memset(&a, 0, sizeof a);
   h2s_settings_init(&a.settings);
   int rc = h2s_parse(argc, argv, &a);
-  if (rc < 0) rc = BB_EXIT_OK; /* --help */
-  else if (rc == 0) rc = h2s_run(argc, argv, &a);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = h2s_run(argc, argv, &a);
   free(a.output);
   return rc;
 }

@@ -24,17 +24,15 @@ static const subcommand subcommands[] = {
 enum { SUBCOMMAND_COUNT = sizeof subcommands / sizeof subcommands[0] };
 
 static void print_usage(FILE *f) {
-  fprintf(f,
-          "usage: bumpbake COMMAND [OPTIONS] ...\n"
-          "Bakes normal maps, self-shadowed bump maps (Valve ssbump) and ambient\n"
-          "occlusion from height maps.\n\ncommands:\n");
+  fprintf(f, "usage: bumpbake COMMAND [OPTIONS] ...\n"
+             "Bakes normal maps, self-shadowed bump maps (Valve ssbump) and ambient\n"
+             "occlusion from height maps.\n\ncommands:\n");
   for (int i = 0; i < SUBCOMMAND_COUNT; i++)
     fprintf(f, "  %-14s %s\n", subcommands[i].name, subcommands[i].summary);
-  fprintf(f,
-          "\n'bumpbake COMMAND --help' lists a command's options.\n"
-          "  --help       print this help\n"
-          "  --version    print the version\n"
-          "exit codes: 0 ok, 1 failure (file or image), 2 usage error\n");
+  fprintf(f, "\n'bumpbake COMMAND --help' lists a command's options.\n"
+             "  --help       print this help\n"
+             "  --version    print the version\n"
+             "exit codes: 0 ok, 1 failure (file or image), 2 usage error\n");
 }
 
 int main(int argc, char **argv) {
@@ -52,7 +50,8 @@ int main(int argc, char **argv) {
     return BB_EXIT_OK;
   }
   for (int i = 0; i < SUBCOMMAND_COUNT; i++)
-    if (!strcmp(name, subcommands[i].name)) return subcommands[i].run(argc - 1, argv + 1);
+    if (!strcmp(name, subcommands[i].name))
+      return subcommands[i].run(argc - 1, argv + 1);
   fprintf(stderr, "bumpbake: unknown %s '%s' (see bumpbake --help)\n",
           name[0] == '-' ? "option" : "command", name);
   return BB_EXIT_USAGE;

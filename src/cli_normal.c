@@ -4,13 +4,23 @@
 
 #include <string.h>
 
-static const cli_option opt_output = {CLI_OPT_OUTPUT, "output", 'o', "OUT", NULL, NULL,
-                                      "normal map to write (.png .tga .tif .exr); required"};
+static const cli_option opt_output = {
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "OUT",
+    .help = "normal map to write (.png .tga .tif .exr); required"};
 
 static const cli_option *const normal_options[] = {
-    &opt_output,        &cli_opt_scale,         &cli_opt_filter_radius,
-    &cli_opt_filter_threshold, &cli_opt_normal_filter, &cli_opt_normal_y,
-    &cli_opt_clamp,     &cli_opt_channel,       &cli_opt_depth,
+    &opt_output,
+    &cli_opt_scale,
+    &cli_opt_filter_radius,
+    &cli_opt_filter_threshold,
+    &cli_opt_normal_filter,
+    &cli_opt_normal_y,
+    &cli_opt_clamp,
+    &cli_opt_channel,
+    &cli_opt_depth,
     &cli_opt_help,
 };
 
@@ -36,8 +46,8 @@ static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
     return 0;
   }
   int rc = cli_settings_apply(normal_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(normal_command.name, "internal error: option %s unhandled",
-                                  opt->long_name)
+  return rc < 0 ? cli_usage_error(normal_command.name,
+                                  "internal error: option %s unhandled", opt->long_name)
                 : rc;
 }
 
@@ -45,14 +55,18 @@ static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
 static int normal_parse(int argc, char **argv, normal_args *a, const char **input) {
   int first = 0;
   int rc = cli_parse_options(&normal_command, argc, argv, normal_option, a, &first);
-  if (rc) return rc;
+  if (rc)
+    return rc;
   rc = cli_expect_positionals(&normal_command, argc, argv, first, 1, "HEIGHT");
-  if (rc) return rc;
+  if (rc)
+    return rc;
   *input = argv[first];
-  if (!a->output) return cli_usage_error(normal_command.name, "-o OUT is required");
+  if (!a->output)
+    return cli_usage_error(normal_command.name, "-o OUT is required");
   if (!a->settings.scale_given)
-    return cli_usage_error(normal_command.name,
-                           "--scale is required (texels of displacement per unit of height)");
+    return cli_usage_error(
+        normal_command.name,
+        "--scale is required (texels of displacement per unit of height)");
   return cli_check_output(normal_command.name, *input, a->output, a->settings.depth);
 }
 
@@ -63,16 +77,20 @@ int bb_cli_normal(int argc, char **argv) {
   a.settings.bake.want_trace = 0; /* a normal map needs no rays */
   const char *input = NULL;
   int rc = normal_parse(argc, argv, &a, &input);
-  if (rc) return rc < 0 ? BB_EXIT_OK : rc;
+  if (rc)
+    return rc < 0 ? BB_EXIT_OK : rc;
 
   bb_image height = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   cli_run run = {0};
   rc = cli_load_height(input, &a.settings, &height);
-  if (!rc) rc = cli_run_bake(input, &height, &a.settings.bake, &result);
-  if (!rc) rc = cli_run_init(&run, argc, argv, input, &height, &a.settings);
-  if (!rc) rc = cli_write_output(&run, "normal", a.output, &result.normal, BB_RANGE_SIGNED);
+  if (!rc)
+    rc = cli_run_bake(input, &height, &a.settings.bake, &result);
+  if (!rc)
+    rc = cli_run_init(&run, argc, argv, input, &height, &a.settings);
+  if (!rc)
+    rc = cli_write_output(&run, "normal", a.output, &result.normal, BB_RANGE_SIGNED);
   cli_run_free(&run);
   bb_bake_result_free(&result);
   bb_image_free(&height);

@@ -20,9 +20,9 @@
 /* ------------------------------------------------------- running the CLI */
 
 typedef struct cli_result {
-  int code;   /* exit code, or 128 + signal when it crashed */
-  char *out;  /* all of stdout, NUL-terminated */
-  char *err;  /* all of stderr */
+  int code;  /* exit code, or 128 + signal when it crashed */
+  char *out; /* all of stdout, NUL-terminated */
+  char *err; /* all of stderr */
 } cli_result;
 
 static void cli_result_free(cli_result *r) {
@@ -48,7 +48,8 @@ static const char *cli_binary(void) {
   static char path[4096];
   if (!path[0]) {
     const char *bin = getenv("BB_BIN");
-    if (!bin || !*bin) bin = "build/bumpbake";
+    if (!bin || !*bin)
+      bin = "build/bumpbake";
     cr_assert(realpath(bin, path) != NULL, "BB_BIN %s not found", bin);
   }
   return path;
@@ -70,7 +71,8 @@ static cli_result run_in(const char *cwd, const char *const *args) {
   if (pid == 0) {
     dup2(fileno(out), STDOUT_FILENO);
     dup2(fileno(err), STDERR_FILENO);
-    if (cwd && chdir(cwd) != 0) _exit(126);
+    if (cwd && chdir(cwd) != 0)
+      _exit(126);
     execv(cli_binary(), (char *const *)argv);
     _exit(127);
   }
@@ -92,7 +94,8 @@ static cli_result run_in(const char *cwd, const char *const *args) {
 
 static int count_lines(const char *s) {
   int n = 0;
-  for (; *s; s++) n += *s == '\n';
+  for (; *s; s++)
+    n += *s == '\n';
   return n;
 }
 
@@ -103,8 +106,8 @@ static char tmpdir[64];
 static char *tmp_paths[256];
 static int tmp_path_count;
 
-
-static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw) {
+static int remove_entry(const char *path, const struct stat *st, int flag,
+                        struct FTW *ftw) {
   (void)st, (void)flag, (void)ftw;
   return remove(path);
 }
@@ -115,9 +118,11 @@ static void make_tmpdir(void) {
 }
 
 static void remove_tmpdir(void) {
-  if (tmpdir[0]) nftw(tmpdir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+  if (tmpdir[0])
+    nftw(tmpdir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
   tmpdir[0] = '\0';
-  while (tmp_path_count > 0) free(tmp_paths[--tmp_path_count]);
+  while (tmp_path_count > 0)
+    free(tmp_paths[--tmp_path_count]);
 }
 
 /* Path of name inside the temporary directory, valid until the test ends. */
@@ -152,7 +157,8 @@ static unsigned char *read_bytes(const char *path, size_t *size) {
 static void write_bytes(const char *path, const void *data, size_t size) {
   FILE *f = fopen(path, "wb");
   cr_assert_not_null(f);
-  if (size) cr_assert_eq(fwrite(data, 1, size, f), size);
+  if (size)
+    cr_assert_eq(fwrite(data, 1, size, f), size);
   fclose(f);
 }
 
@@ -167,7 +173,8 @@ static void write_image(const char *path, int w, int h, int channels, texel_fn v
   cr_assert_eq(bb_image_alloc(&img, w, h, channels, &err), BB_OK);
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++)
-      for (int c = 0; c < channels; c++) bb_image_texel(&img, x, y)[c] = value(x, y, c);
+      for (int c = 0; c < channels; c++)
+        bb_image_texel(&img, x, y)[c] = value(x, y, c);
   bb_write_options o = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
   cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
@@ -210,14 +217,18 @@ static void expect_uniform8(const char *path, int channels, const int *codes, in
     for (int x = 0; x < img.width; x++)
       for (int c = 0; c < channels; c++) {
         int got = code8(&img, x, y, c);
-        cr_assert(abs(got - codes[c]) <= tol, "%s (%d,%d) channel %d: %d, expected %d", path,
-                  x, y, c, got, codes[c]);
+        cr_assert(abs(got - codes[c]) <= tol, "%s (%d,%d) channel %d: %d, expected %d",
+                  path, x, y, c, got, codes[c]);
       }
   bb_image_free(&img);
 }
 
-static void setup(void) { make_tmpdir(); }
-static void teardown(void) { remove_tmpdir(); }
+static void setup(void) {
+  make_tmpdir();
+}
+static void teardown(void) {
+  remove_tmpdir();
+}
 
 TestSuite(cli, .init = setup, .fini = teardown, .timeout = 120);
 
@@ -226,7 +237,8 @@ TestSuite(cli, .init = setup, .fini = teardown, .timeout = 120);
 Test(cli, help_and_version) {
   cli_result r = RUN("--help");
   cr_expect_eq(r.code, 0);
-  cr_expect(strstr(r.out, "normal") && strstr(r.out, "bake") && strstr(r.out, "height2ssbump"),
+  cr_expect(strstr(r.out, "normal") && strstr(r.out, "bake") &&
+                strstr(r.out, "height2ssbump"),
             "%s", r.out);
   cli_result_free(&r);
 
@@ -238,8 +250,9 @@ Test(cli, help_and_version) {
   /* A command's help lists every option with its default. */
   r = RUN("bake", "--help");
   cr_expect_eq(r.code, 0);
-  const char *expected[] = {"--scale", "--rays", "256", "--filter-radius", "--bias", "0.55",
-                            "--power", "--basis", "hl2", "--threads", "--json", "--bent"};
+  const char *expected[] = {"--scale", "--rays",    "256",     "--filter-radius",
+                            "--bias",  "0.55",      "--power", "--basis",
+                            "hl2",     "--threads", "--json",  "--bent"};
   for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++)
     cr_expect(strstr(r.out, expected[i]), "bake --help lacks %s", expected[i]);
   cli_result_free(&r);
@@ -269,10 +282,14 @@ Test(cli, usage_errors_exit_2_with_a_message) {
       {{"normal", in, "-o", out, "--scale", "0"}, "--scale must be > 0"},
       {{"normal", in, "-o", out, "--scale", "-1"}, "--scale must be > 0 (got -1)"},
       {{"normal", in, "-o", out, "--scale", "abc"}, "abc"},
-      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "-1"}, "--filter-radius"},
-      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "2.5"}, "--filter-radius"},
-      {{"normal", in, "-o", out, "--scale", "1", "--filter-threshold", "0"}, "--filter-threshold"},
-      {{"normal", in, "-o", out, "--scale", "1", "--normal-filter", "fancy"}, "--normal-filter"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "-1"},
+       "--filter-radius"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "2.5"},
+       "--filter-radius"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-threshold", "0"},
+       "--filter-threshold"},
+      {{"normal", in, "-o", out, "--scale", "1", "--normal-filter", "fancy"},
+       "--normal-filter"},
       {{"normal", in, "-o", out, "--scale", "1", "--normal-y", "sideways"}, "--normal-y"},
       {{"normal", in, "-o", out, "--scale", "1", "--channel", "q"}, "--channel"},
       {{"normal", in, "--scale", "1"}, "-o"},
@@ -294,12 +311,14 @@ Test(cli, usage_errors_exit_2_with_a_message) {
   unsigned char *before = read_bytes(in, &before_size);
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     cli_result r = run_in(NULL, cases[i].args);
-    cr_expect_eq(r.code, 2, "case %zu (%s %s ...): exit %d, stderr: %s", i, cases[i].args[0],
-                 cases[i].args[1] ? cases[i].args[1] : "", r.code, r.err);
-    cr_expect_eq(count_lines(r.err), 1, "case %zu: stderr should be one line: %s", i, r.err);
+    cr_expect_eq(r.code, 2, "case %zu (%s %s ...): exit %d, stderr: %s", i,
+                 cases[i].args[0], cases[i].args[1] ? cases[i].args[1] : "", r.code,
+                 r.err);
+    cr_expect_eq(count_lines(r.err), 1, "case %zu: stderr should be one line: %s", i,
+                 r.err);
     cr_expect(strncmp(r.err, "bumpbake", 8) == 0, "case %zu: %s", i, r.err);
-    cr_expect(strstr(r.err, cases[i].message_part), "case %zu: message '%s' lacks '%s'", i,
-              r.err, cases[i].message_part);
+    cr_expect(strstr(r.err, cases[i].message_part), "case %zu: message '%s' lacks '%s'",
+              i, r.err, cases[i].message_part);
     cr_expect_str_empty(r.out, "case %zu", i);
     cli_result_free(&r);
     /* Nothing was written: no output, no prefix output, no temporary file. */
@@ -340,14 +359,15 @@ static void expect_failure(const char *const *args, const char *named_file,
 
 Test(cli, missing_input) {
   const char *in = tmp("nothere.png"), *out = tmp("o.png");
-  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL}, "nothere.png",
-                 out, in);
+  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL},
+                 "nothere.png", out, in);
   expect_failure((const char *[]){"height2ssbump", in, "2", NULL}, "nothere.png",
                  tmp("nothere-ssbump.tga"), in);
 }
 
 Test(cli, corrupt_and_empty_inputs) {
-  const char *corrupt = tmp("corrupt.png"), *empty = tmp("empty.png"), *out = tmp("o.png");
+  const char *corrupt = tmp("corrupt.png"), *empty = tmp("empty.png"),
+             *out = tmp("o.png");
   /* A PNG signature followed by garbage: a reader must look inside. */
   const unsigned char junk[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
                                 1,    2,   3,   4,   5,    6,    7,    8};
@@ -355,26 +375,27 @@ Test(cli, corrupt_and_empty_inputs) {
   write_bytes(empty, "", 0);
   expect_failure((const char *[]){"normal", corrupt, "-o", out, "--scale", "2", NULL},
                  "corrupt.png", out, corrupt);
-  expect_failure((const char *[]){"bake", empty, "--scale", "2", "--ao", out, NULL}, "empty.png",
-                 out, empty);
+  expect_failure((const char *[]){"bake", empty, "--scale", "2", "--ao", out, NULL},
+                 "empty.png", out, empty);
 }
 
 Test(cli, nan_heights) {
   const char *in = tmp("nan.exr"), *out = tmp("o.png");
   write_image(in, 8, 8, 1, not_a_number);
-  expect_failure((const char *[]){"bake", in, "--scale", "2", "--normal", out, NULL}, "nan.exr",
-                 out, in);
+  expect_failure((const char *[]){"bake", in, "--scale", "2", "--normal", out, NULL},
+                 "nan.exr", out, in);
 }
 
 Test(cli, output_equal_to_input) {
   const char *in = tmp("h.png");
   write_image(in, 8, 8, 1, mid_grey);
-  expect_failure((const char *[]){"normal", in, "-o", in, "--scale", "2", NULL}, "h.png", in, in);
+  expect_failure((const char *[]){"normal", in, "-o", in, "--scale", "2", NULL}, "h.png",
+                 in, in);
   /* The same file under another spelling is caught too (realpath). */
   char other[300];
   snprintf(other, sizeof other, "%s/./h.png", tmpdir);
-  expect_failure((const char *[]){"bake", in, "--scale", "2", "--ao", other, NULL}, "h.png", in,
-                 in);
+  expect_failure((const char *[]){"bake", in, "--scale", "2", "--ao", other, NULL},
+                 "h.png", in, in);
 }
 
 Test(cli, unwritable_output_directory) {
@@ -384,8 +405,8 @@ Test(cli, unwritable_output_directory) {
   write_bytes(afile, "x", 1);
   char out[300];
   snprintf(out, sizeof out, "%s/out.png", afile);
-  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL}, "afile/out.png",
-                 out, in);
+  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL},
+                 "afile/out.png", out, in);
 }
 
 /* ------------------------------------------------------------------ normal */
@@ -402,7 +423,8 @@ Test(cli, normal_of_flat_map_points_up) {
 Test(cli, normal_y_up_flips_green) {
   const char *in = tmp("ramp.exr"), *down = tmp("down.png"), *up = tmp("up.png");
   write_image(in, 16, 16, 1, ramp_down);
-  cli_result r = RUN("normal", in, "-o", down, "--scale", "20", "--filter-radius", "0", "--clamp");
+  cli_result r =
+      RUN("normal", in, "-o", down, "--scale", "20", "--filter-radius", "0", "--clamp");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   r = RUN("normal", in, "-o", up, "--scale", "20", "--filter-radius", "0", "--clamp",
@@ -414,7 +436,8 @@ Test(cli, normal_y_up_flips_green) {
    * to -y: green below 0.5; --normal-y up mirrors it. Red is untouched. */
   int g_down = code8(&a, 8, 8, 1), g_up = code8(&b, 8, 8, 1);
   cr_expect_lt(g_down, 110, "green (+Y down) %d", g_down);
-  cr_expect(abs((g_down + g_up) - 255) <= 1, "green %d and %d are not mirrored", g_down, g_up);
+  cr_expect(abs((g_down + g_up) - 255) <= 1, "green %d and %d are not mirrored", g_down,
+            g_up);
   cr_expect_eq(code8(&a, 8, 8, 0), code8(&b, 8, 8, 0));
   cr_expect_eq(code8(&a, 8, 8, 2), code8(&b, 8, 8, 2));
   bb_image_free(&a);
@@ -426,7 +449,8 @@ Test(cli, normal_y_up_flips_green) {
 Test(cli, bake_of_flat_map) {
   const char *in = tmp("flat.png"), *ss = tmp("ss.png"), *ao = tmp("ao.png");
   write_image(in, 16, 16, 1, mid_grey);
-  cli_result r = RUN("bake", in, "--scale", "8", "--rays", "64", "--ssbump", ss, "--ao", ao);
+  cli_result r =
+      RUN("bake", in, "--scale", "8", "--rays", "64", "--ssbump", ss, "--ao", ao);
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_expect_eq(count_lines(r.out), 2, "one line per output: %s", r.out);
   cr_expect(strstr(r.out, ss) && strstr(r.out, ao), "%s", r.out);
@@ -439,7 +463,8 @@ Test(cli, bake_of_flat_map) {
   bb_image_info info;
   bb_image img = read_image(ss, &info);
   cr_expect(info.description && strstr(info.description, "flat.png"),
-            "provenance should name the input: %s", info.description ? info.description : "(none)");
+            "provenance should name the input: %s",
+            info.description ? info.description : "(none)");
   bb_image_info_free(&info);
   bb_image_free(&img);
 }
@@ -447,7 +472,8 @@ Test(cli, bake_of_flat_map) {
 Test(cli, bake_prefix_and_quiet) {
   const char *in = tmp("flat.png");
   write_image(in, 8, 8, 1, mid_grey);
-  cli_result r = RUN("bake", in, "--scale", "4", "--rays", "16", "-o", tmp("rock"), "--quiet");
+  cli_result r =
+      RUN("bake", in, "--scale", "4", "--rays", "16", "-o", tmp("rock"), "--quiet");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_expect_str_empty(r.out);
   cr_expect_str_empty(r.err);
@@ -462,19 +488,23 @@ Test(cli, bake_prefix_and_quiet) {
 static const char *json_value(const char *p);
 
 static const char *json_ws(const char *p) {
-  while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r') p++;
+  while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r')
+    p++;
   return p;
 }
 
 static const char *json_string(const char *p) {
-  if (*p++ != '"') return NULL;
+  if (*p++ != '"')
+    return NULL;
   for (; *p != '"'; p++) {
-    if (!*p || (unsigned char)*p < 0x20) return NULL;
+    if (!*p || (unsigned char)*p < 0x20)
+      return NULL;
     if (*p == '\\') {
       p++;
       if (*p == 'u') {
         for (int i = 1; i <= 4; i++)
-          if (!isxdigit((unsigned char)p[i])) return NULL;
+          if (!isxdigit((unsigned char)p[i]))
+            return NULL;
         p += 4;
       } else if (!strchr("\"\\/bfnrt", *p) || !*p) {
         return NULL;
@@ -486,50 +516,72 @@ static const char *json_string(const char *p) {
 
 static const char *json_number(const char *p) {
   const char *start = p;
-  if (*p == '-') p++;
-  if (!isdigit((unsigned char)*p)) return NULL;
-  if (*p == '0') p++;
-  else while (isdigit((unsigned char)*p)) p++;
+  if (*p == '-')
+    p++;
+  if (!isdigit((unsigned char)*p))
+    return NULL;
+  if (*p == '0')
+    p++;
+  else
+    while (isdigit((unsigned char)*p))
+      p++;
   if (*p == '.') {
     p++;
-    if (!isdigit((unsigned char)*p)) return NULL;
-    while (isdigit((unsigned char)*p)) p++;
+    if (!isdigit((unsigned char)*p))
+      return NULL;
+    while (isdigit((unsigned char)*p))
+      p++;
   }
   if (*p == 'e' || *p == 'E') {
     p++;
-    if (*p == '+' || *p == '-') p++;
-    if (!isdigit((unsigned char)*p)) return NULL;
-    while (isdigit((unsigned char)*p)) p++;
+    if (*p == '+' || *p == '-')
+      p++;
+    if (!isdigit((unsigned char)*p))
+      return NULL;
+    while (isdigit((unsigned char)*p))
+      p++;
   }
   return p > start ? p : NULL;
 }
 
 static const char *json_members(const char *p, char close, int keyed) {
   p = json_ws(p);
-  if (*p == close) return p + 1;
+  if (*p == close)
+    return p + 1;
   for (;;) {
     if (keyed) {
       p = json_string(json_ws(p));
-      if (!p) return NULL;
+      if (!p)
+        return NULL;
       p = json_ws(p);
-      if (*p++ != ':') return NULL;
+      if (*p++ != ':')
+        return NULL;
     }
     p = json_value(p);
-    if (!p) return NULL;
+    if (!p)
+      return NULL;
     p = json_ws(p);
-    if (*p == close) return p + 1;
-    if (*p++ != ',') return NULL;
+    if (*p == close)
+      return p + 1;
+    if (*p++ != ',')
+      return NULL;
   }
 }
 
 static const char *json_value(const char *p) {
   p = json_ws(p);
-  if (*p == '{') return json_members(p + 1, '}', 1);
-  if (*p == '[') return json_members(p + 1, ']', 0);
-  if (*p == '"') return json_string(p);
-  if (!strncmp(p, "true", 4)) return p + 4;
-  if (!strncmp(p, "false", 5)) return p + 5;
-  if (!strncmp(p, "null", 4)) return p + 4;
+  if (*p == '{')
+    return json_members(p + 1, '}', 1);
+  if (*p == '[')
+    return json_members(p + 1, ']', 0);
+  if (*p == '"')
+    return json_string(p);
+  if (!strncmp(p, "true", 4))
+    return p + 4;
+  if (!strncmp(p, "false", 5))
+    return p + 5;
+  if (!strncmp(p, "null", 4))
+    return p + 4;
   return json_number(p);
 }
 
@@ -552,18 +604,23 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
   const char *end = json_value(r.out);
   cr_assert_not_null(end, "not JSON: %s", r.out);
   cr_expect_str_eq(json_ws(end), "", "trailing text after the JSON value: %s", r.out);
-  const char *keys[] = {"input", "width", "height", "parameters", "scale", "rays", "rayset",
-                        "filter_radius", "filter_threshold", "bias", "power", "basis",
-                        "normal_filter", "normal_y", "addressing", "channel", "threads",
-                        "seconds", "load", "smooth", "pyramid", "trace", "derive", "write",
-                        "rays_traced", "outputs", "kind", "path"};
+  const char *keys[] = {"input",         "width",         "height",
+                        "parameters",    "scale",         "rays",
+                        "rayset",        "filter_radius", "filter_threshold",
+                        "bias",          "power",         "basis",
+                        "normal_filter", "normal_y",      "addressing",
+                        "channel",       "threads",       "seconds",
+                        "load",          "smooth",        "pyramid",
+                        "trace",         "derive",        "write",
+                        "rays_traced",   "outputs",       "kind",
+                        "path"};
   for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
     char quoted[64];
     snprintf(quoted, sizeof quoted, "\"%s\":", keys[i]);
     cr_expect(strstr(r.out, quoted), "JSON lacks %s: %s", keys[i], r.out);
   }
-  cr_expect(strstr(r.out, "\"kind\":\"ao\"") && strstr(r.out, "\"kind\":\"normal\""), "%s",
-            r.out);
+  cr_expect(strstr(r.out, "\"kind\":\"ao\"") && strstr(r.out, "\"kind\":\"normal\""),
+            "%s", r.out);
   cr_expect(strstr(r.out, "\"rays_traced\":1024"), "8x8 texels x 16 rays: %s", r.out);
   cli_result_free(&r);
 }
@@ -617,7 +674,8 @@ Test(cli, height2ssbump_flags) {
 
 Test(cli, height2ssbump_dump_writes_filtered_in_cwd) {
   write_image(tmp("wall.tga"), 16, 16, 4, grey_with_low_alpha);
-  run_ok_in(tmpdir, (const char *[]){"height2ssbump", "-D", "-r", "16", "wall.tga", "4", NULL});
+  run_ok_in(tmpdir,
+            (const char *[]){"height2ssbump", "-D", "-r", "16", "wall.tga", "4", NULL});
   cr_expect(file_exists(tmp("wall-ssbump.tga")));
   bb_image f = read_image(tmp("filtered.tga"), NULL);
   cr_expect_eq(code8(&f, 5, 5, 0), 64);
