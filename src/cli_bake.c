@@ -278,11 +278,10 @@ static int needs_trace(const bake_args *a) {
   return 0;
 }
 
-static int bake_run(int argc, char **argv, bake_args *a, const char *input) {
+static int bake_run(cli_run *run, bake_args *a, const char *input) {
   bb_image height = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
-  cli_run run = {0};
   bake_timing t = {0, 0};
   a->settings.bake.want_trace = needs_trace(a);
 
@@ -295,22 +294,23 @@ static int bake_run(int argc, char **argv, bake_args *a, const char *input) {
     rc = cli_run_bake(input, &height, &a->settings.bake, &result);
     cli_progress_finish(&progress);
   }
-  if (!rc)
-    rc = cli_run_init(&run, argc, argv, input, &height, &a->settings);
   if (!rc) {
-    run.rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
-    rc = write_outputs(a, &run, &result);
-    t.write = run.seconds_write;
+    cli_run_set_input(run, input, &height, &a->settings);
+    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    rc = write_outputs(a, run, &result);
+    t.write = run->seconds_write;
   }
   if (!rc && a->json)
     print_json(a, input, &height, &result, &t);
-  cli_run_free(&run);
   bb_bake_result_free(&result);
   bb_image_free(&height);
   return rc;
 }
 
 int bb_cli_bake(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
   bake_args a;
   memset(&a, 0, sizeof a);
   cli_settings_init(&a.settings);
@@ -319,8 +319,9 @@ int bb_cli_bake(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = bake_run(argc, argv, &a, input);
+    rc = bake_run(&run, &a, input);
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     free(a.prefix_paths[k]);
+  cli_run_free(&run);
   return rc;
 }

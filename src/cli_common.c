@@ -530,15 +530,14 @@ static const char *file_name_of(const char *path) {
   return slash ? slash + 1 : path;
 }
 
-int cli_run_init(cli_run *run, int argc, char **argv, const char *input_path,
-                 const bb_image *height, const cli_settings *settings) {
+int cli_run_init(cli_run *run, int argc, char **argv) {
   memset(run, 0, sizeof *run);
   size_t len = strlen("bumpbake") + 1;
   for (int i = 0; i < argc; i++)
     len += strlen(argv[i]) + 1;
   run->command_line = malloc(len);
   if (!run->command_line) {
-    cli_file_error(input_path, "out of memory");
+    fprintf(stderr, "bumpbake: out of memory\n");
     return BB_EXIT_FAILURE;
   }
   strcpy(run->command_line, "bumpbake");
@@ -546,10 +545,14 @@ int cli_run_init(cli_run *run, int argc, char **argv, const char *input_path,
     strcat(run->command_line, " ");
     strcat(run->command_line, argv[i]);
   }
+  return 0;
+}
+
+void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *height,
+                       const cli_settings *settings) {
   run->input_path = input_path;
   run->input_hash = bb_image_hash(height);
   run->settings = settings;
-  return 0;
 }
 
 void cli_run_free(cli_run *run) {

@@ -158,10 +158,15 @@ typedef struct cli_run {
   double seconds_write;  /* summed over cli_write_output calls */
 } cli_run;
 
-/* Fills run (the command line is malloc'd; free it with cli_run_free).
- * Returns BB_EXIT_FAILURE when out of memory, after printing why. */
-int cli_run_init(cli_run *run, int argc, char **argv, const char *input_path,
-                 const bb_image *height, const cli_settings *settings);
+/* Starts a run: records the command line, so it must be called before
+ * cli_parse_options (getopt_long permutes argv). The command line is
+ * malloc'd; free it with cli_run_free. Returns BB_EXIT_FAILURE when out of
+ * memory, after printing why. */
+int cli_run_init(cli_run *run, int argc, char **argv);
+/* Records the input once it is loaded: its path, the hash of its decoded
+ * height and the settings the outputs are made with. */
+void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *height,
+                       const cli_settings *settings);
 void cli_run_free(cli_run *run);
 
 /* Writes img to path with the run's depth, the given range and a provenance

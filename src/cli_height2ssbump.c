@@ -267,11 +267,10 @@ static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *hei
   return 0;
 }
 
-static int h2s_run(int argc, char **argv, h2s_args *a) {
+static int h2s_run(cli_run *run, h2s_args *a) {
   bb_image img = {0}, height = {0}, rgba = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
-  cli_run run = {0};
   /* Only the -n map with the height in alpha needs no rays. */
   a->settings.bake.want_trace = !a->normal_map || a->ao_in_alpha;
 
@@ -284,15 +283,13 @@ static int h2s_run(int argc, char **argv, h2s_args *a) {
   }
   if (!rc)
     rc = make_rgba(a, &img, &height, &result, &rgba);
-  if (!rc)
-    rc = cli_run_init(&run, argc, argv, a->input, &height, &a->settings);
   if (!rc) {
-    run.rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
-    rc = cli_write_output(&run, output_kind(a), a->output, &rgba, BB_RANGE_UNIT);
+    cli_run_set_input(run, a->input, &height, &a->settings);
+    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    rc = cli_write_output(run, output_kind(a), a->output, &rgba, BB_RANGE_UNIT);
   }
   if (!rc && a->dump_filtered)
-    rc = cli_write_output(&run, "filtered", dump_path, &result.filtered, BB_RANGE_UNIT);
-  cli_run_free(&run);
+    rc = cli_write_output(run, "filtered", dump_path, &result.filtered, BB_RANGE_UNIT);
   bb_image_free(&rgba);
   bb_bake_result_free(&result);
   bb_image_free(&height);
@@ -301,6 +298,9 @@ static int h2s_run(int argc, char **argv, h2s_args *a) {
 }
 
 int bb_cli_height2ssbump(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
   h2s_args a;
   memset(&a, 0, sizeof a);
   h2s_settings_init(&a.settings);
@@ -308,7 +308,8 @@ int bb_cli_height2ssbump(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = h2s_run(argc, argv, &a);
+    rc = h2s_run(&run, &a);
   free(a.output);
+  cli_run_free(&run);
   return rc;
 }

@@ -70,29 +70,36 @@ static int normal_parse(int argc, char **argv, normal_args *a, const char **inpu
   return cli_check_output(normal_command.name, *input, a->output, a->settings.depth);
 }
 
+static int normal_run(cli_run *run, normal_args *a, const char *input) {
+  bb_image height = {0};
+  bb_bake_result result;
+  memset(&result, 0, sizeof result);
+  int rc = cli_load_height(input, &a->settings, &height);
+  if (!rc)
+    rc = cli_run_bake(input, &height, &a->settings.bake, &result);
+  if (!rc) {
+    cli_run_set_input(run, input, &height, &a->settings);
+    rc = cli_write_output(run, "normal", a->output, &result.normal, BB_RANGE_SIGNED);
+  }
+  bb_bake_result_free(&result);
+  bb_image_free(&height);
+  return rc;
+}
+
 int bb_cli_normal(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
   normal_args a;
   memset(&a, 0, sizeof a);
   cli_settings_init(&a.settings);
   a.settings.bake.want_trace = 0; /* a normal map needs no rays */
   const char *input = NULL;
   int rc = normal_parse(argc, argv, &a, &input);
-  if (rc)
-    return rc < 0 ? BB_EXIT_OK : rc;
-
-  bb_image height = {0};
-  bb_bake_result result;
-  memset(&result, 0, sizeof result);
-  cli_run run = {0};
-  rc = cli_load_height(input, &a.settings, &height);
-  if (!rc)
-    rc = cli_run_bake(input, &height, &a.settings.bake, &result);
-  if (!rc)
-    rc = cli_run_init(&run, argc, argv, input, &height, &a.settings);
-  if (!rc)
-    rc = cli_write_output(&run, "normal", a.output, &result.normal, BB_RANGE_SIGNED);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = normal_run(&run, &a, input);
   cli_run_free(&run);
-  bb_bake_result_free(&result);
-  bb_image_free(&height);
   return rc;
 }

@@ -459,9 +459,14 @@ Test(cli, bake_of_flat_map) {
   expect_uniform8(ss, 3, (const int[]){s, s, s}, 1);
   expect_uniform8(ao, 1, (const int[]){255}, 0);
 
-  /* Provenance travels with the file. */
+  /* Provenance travels with the file, with the command line as typed (not
+   * as getopt_long permuted it). */
   bb_image_info info;
   bb_image img = read_image(ss, &info);
+  char command[512];
+  snprintf(command, sizeof command, "command=bumpbake bake %s --scale 8 --rays 64", in);
+  cr_expect(info.description && strstr(info.description, command), "%s lacks '%s'",
+            info.description ? info.description : "(none)", command);
   cr_expect(info.description && strstr(info.description, "flat.png"),
             "provenance should name the input: %s",
             info.description ? info.description : "(none)");
