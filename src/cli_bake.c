@@ -136,10 +136,7 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   default:
     break;
   }
-  int rc = cli_settings_apply(bake_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(bake_command.name,
-                                  "internal error: option %s unhandled", opt->long_name)
-                : rc;
+  return cli_settings_apply(bake_command.name, &a->settings, opt, arg);
 }
 
 /* -o PREFIX names the outputs not given one by one. */

@@ -123,6 +123,13 @@ void cli_file_error(const char *path, const char *reason) {
     fprintf(stderr, "bumpbake: %s: %s\n", path, line);
 }
 
+int cli_status_exit(const char *path, bb_status status, const bb_error *err) {
+  if (status == BB_OK)
+    return 0;
+  cli_file_error(path, err->message[0] ? err->message : bb_status_name(status));
+  return BB_EXIT_FAILURE;
+}
+
 /* ---------------------------------------------------------------- numbers */
 
 int cli_parse_double(const char *command, const char *option, const char *text,
@@ -413,8 +420,8 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_JITTER:
     b->trace.jitter = 1;
     return 0;
-  default:
-    return -1;
+  default: /* a table row whose subcommand forgot to handle it */
+    return cli_usage_error(command, "internal error: option %s has no handler", name);
   }
 }
 
@@ -576,32 +583,20 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
   bb_status st = bb_image_write(path, img, &wo, &err);
   run->seconds_write += cli_now_seconds() - t0;
   free(description);
-  if (st != BB_OK) {
-    cli_file_error(path, err.message[0] ? err.message : bb_status_name(st));
-    return BB_EXIT_FAILURE;
-  }
-  return 0;
+  return cli_status_exit(path, st, &err);
 }
 
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
   bb_error err = {{0}};
   bb_status st = bb_height_load(path, s->channel, height, &err);
-  if (st != BB_OK) {
-    cli_file_error(path, err.message[0] ? err.message : bb_status_name(st));
-    return BB_EXIT_FAILURE;
-  }
-  return 0;
+  return cli_status_exit(path, st, &err);
 }
 
 int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options *o,
                  bb_bake_result *result) {
   bb_error err = {{0}};
   bb_status st = bb_bake(height, o, result, &err);
-  if (st != BB_OK) {
-    cli_file_error(path, err.message[0] ? err.message : bb_status_name(st));
-    return BB_EXIT_FAILURE;
-  }
-  return 0;
+  return cli_status_exit(path, st, &err);
 }
 
 double cli_now_seconds(void) {

@@ -102,6 +102,11 @@ int cli_usage_error(const char *command, const char *fmt, ...)
  * messages often start with the file name already; it is not repeated. */
 void cli_file_error(const char *path, const char *reason);
 
+/* The exit code of a library call about path: 0 for BB_OK, else
+ * BB_EXIT_FAILURE after printing err's message (or the status name when the
+ * message is empty) as a file error. */
+int cli_status_exit(const char *path, bb_status status, const bb_error *err);
+
 /* Strict number parsing for option values: the whole text must be a finite
  * number inside the range, else a usage error naming the option is printed
  * and BB_EXIT_USAGE returned. min_exclusive makes the lower bound strict
@@ -127,8 +132,9 @@ void cli_settings_init(cli_settings *s);
 
 /* Applies one of the options every baking command shares (scale, rays,
  * filter radius/threshold, bias, power, basis, normal filter and y, threads,
- * clamp, jitter, channel, depth). Returns 0 when applied, BB_EXIT_USAGE after
- * a usage error, or -1 when opt is not one of them. */
+ * clamp, jitter, channel, depth): subcommands hand it every option they do
+ * not handle themselves. Returns 0 when applied, else BB_EXIT_USAGE after a
+ * usage error (also for an option it does not know: an internal error). */
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
                        const char *arg);
 

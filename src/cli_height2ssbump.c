@@ -93,10 +93,7 @@ static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
   default:
     break;
   }
-  int rc = cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(h2s_command.name,
-                                  "internal error: option -%c unhandled", opt->short_name)
-                : rc;
+  return cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
 }
 
 /* FILE without its extension, plus suffix: "rock.png" -> "rock-ssbump.tga". */
@@ -174,11 +171,7 @@ static int load_input(h2s_args *a, bb_image *img, bb_image *height) {
     st = bb_height_from_image(img, info.alpha_channel, a->settings.channel, height, &err);
   }
   bb_image_info_free(&info);
-  if (st != BB_OK) {
-    cli_file_error(a->input, err.message[0] ? err.message : bb_status_name(st));
-    return BB_EXIT_FAILURE;
-  }
-  return 0;
+  return cli_status_exit(a->input, st, &err);
 }
 
 /* The RGB colour of the input (alpha dropped; grey replicated), smoothed by
@@ -260,11 +253,7 @@ static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *hei
       apply_detail(rgba, &colour);
     bb_image_free(&colour);
   }
-  if (st != BB_OK) {
-    cli_file_error(a->input, err.message[0] ? err.message : bb_status_name(st));
-    return BB_EXIT_FAILURE;
-  }
-  return 0;
+  return cli_status_exit(a->input, st, &err);
 }
 
 static int h2s_run(cli_run *run, h2s_args *a) {

@@ -45,10 +45,7 @@ static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
     a->output = arg;
     return 0;
   }
-  int rc = cli_settings_apply(normal_command.name, &a->settings, opt, arg);
-  return rc < 0 ? cli_usage_error(normal_command.name,
-                                  "internal error: option %s unhandled", opt->long_name)
-                : rc;
+  return cli_settings_apply(normal_command.name, &a->settings, opt, arg);
 }
 
 /* Parses and validates the whole command line; *input receives HEIGHT. */
