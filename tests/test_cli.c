@@ -63,6 +63,10 @@ static cli_result run_in(const char *cwd, const char *const *args) {
     cr_assert_lt(i, 62, "too many arguments");
     argv[i + 1] = args[i];
   }
+  /* Resolved here, not in the child: the child may chdir first, and a
+   * failed assertion there would report from a process Criterion does not
+   * know. */
+  const char *binary = cli_binary();
   FILE *out = tmpfile(), *err = tmpfile();
   cr_assert(out && err);
   fflush(NULL);
@@ -73,7 +77,7 @@ static cli_result run_in(const char *cwd, const char *const *args) {
     dup2(fileno(err), STDERR_FILENO);
     if (cwd && chdir(cwd) != 0)
       _exit(126);
-    execv(cli_binary(), (char *const *)argv);
+    execv(binary, (char *const *)argv);
     _exit(127);
   }
   int status = 0;
