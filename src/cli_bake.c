@@ -1,0 +1,324 @@
+/* cli_bake.c: `bumpbake bake`, every map from one height map in one pass
+ * (one bb_bake call, so ssbump, ao and bent share a single trace). */
+#include "cli_common.h"
+
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The maps bake can write, in CLI_OPT_OUT_* order. */
+typedef struct output_kind {
+  const char *kind;     /* name in provenance, messages and JSON */
+  bb_range range;       /* how integer files encode it */
+  int needs_trace;      /* made only when bb_bake traces */
+  int from_prefix;      /* written by -o PREFIX (as PREFIX_kind.png) */
+  size_t result_offset; /* where bb_bake_result holds it */
+} output_kind;
+
+static const output_kind output_kinds[] = {
+    {"normal", BB_RANGE_SIGNED, 0, 1, offsetof(bb_bake_result, normal)},
+    {"weights", BB_RANGE_UNIT, 0, 0, offsetof(bb_bake_result, weights)},
+    {"ssbump", BB_RANGE_UNIT, 1, 1, offsetof(bb_bake_result, ssbump)},
+    {"ao", BB_RANGE_UNIT, 1, 1, offsetof(bb_bake_result, ao)},
+    {"bent", BB_RANGE_SIGNED, 1, 0, offsetof(bb_bake_result, bent)},
+    {"filtered", BB_RANGE_UNIT, 0, 0, offsetof(bb_bake_result, filtered)},
+};
+
+enum { OUTPUT_KIND_COUNT = sizeof output_kinds / sizeof output_kinds[0] };
+
+static const bb_image *result_image(const bb_bake_result *r, int kind) {
+  return (const bb_image *)(const void *)((const char *)r +
+                                          output_kinds[kind].result_offset);
+}
+
+static const cli_option opt_prefix = {
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "PREFIX",
+    .help = "write PREFIX_normal.png, PREFIX_ssbump.png and PREFIX_ao.png"};
+static const cli_option opt_out_normal = {.id = CLI_OPT_OUT_NORMAL,
+                                          .long_name = "normal",
+                                          .value_name = "FILE",
+                                          .help = "write the normal map"};
+static const cli_option opt_out_weights = {.id = CLI_OPT_OUT_WEIGHTS,
+                                           .long_name = "weights",
+                                           .value_name = "FILE",
+                                           .help =
+                                               "write the basis weights (normal2ssbump)"};
+static const cli_option opt_out_ssbump = {
+    .id = CLI_OPT_OUT_SSBUMP,
+    .long_name = "ssbump",
+    .value_name = "FILE",
+    .help = "write the self-shadowed bump map (traces)"};
+static const cli_option opt_out_ao = {.id = CLI_OPT_OUT_AO,
+                                      .long_name = "ao",
+                                      .value_name = "FILE",
+                                      .help = "write the ambient occlusion (traces)"};
+static const cli_option opt_out_bent = {.id = CLI_OPT_OUT_BENT,
+                                        .long_name = "bent",
+                                        .value_name = "FILE",
+                                        .help = "write the bent normal (traces)"};
+static const cli_option opt_out_filtered = {.id = CLI_OPT_OUT_FILTERED,
+                                            .long_name = "filtered",
+                                            .value_name = "FILE",
+                                            .help = "write the smoothed height"};
+static const cli_option opt_json = {
+    .id = CLI_OPT_JSON,
+    .long_name = "json",
+    .help = "print one JSON line describing the bake on stdout"};
+static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
+                                     .long_name = "quiet",
+                                     .short_name = 'q',
+                                     .help = "no progress bar, no list of files written"};
+
+static const cli_option *const bake_options[] = {
+    &cli_opt_scale,
+    &cli_opt_rays,
+    &cli_opt_filter_radius,
+    &cli_opt_filter_threshold,
+    &cli_opt_bias,
+    &cli_opt_power,
+    &cli_opt_basis,
+    &cli_opt_normal_filter,
+    &cli_opt_normal_y,
+    &cli_opt_threads,
+    &cli_opt_clamp,
+    &cli_opt_jitter,
+    &cli_opt_channel,
+    &cli_opt_depth,
+    &opt_out_normal,
+    &opt_out_weights,
+    &opt_out_ssbump,
+    &opt_out_ao,
+    &opt_out_bent,
+    &opt_out_filtered,
+    &opt_prefix,
+    &opt_json,
+    &opt_quiet,
+    &cli_opt_help,
+};
+
+static const cli_command bake_command = {
+    "bake",
+    "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ...)",
+    "Bakes the requested maps from HEIGHT in one pass; tracing runs only when\n"
+    "ssbump, ao or bent is asked for.",
+    bake_options,
+    (int)(sizeof bake_options / sizeof bake_options[0]),
+    cli_settings_init,
+};
+
+typedef struct bake_args {
+  cli_settings settings;
+  const char *paths[OUTPUT_KIND_COUNT];  /* NULL = not written */
+  char *prefix_paths[OUTPUT_KIND_COUNT]; /* malloc'd paths made from -o */
+  const char *prefix;
+  int json, quiet;
+} bake_args;
+
+static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
+  bake_args *a = ctx;
+  if (opt->id >= CLI_OPT_OUT_NORMAL && opt->id <= CLI_OPT_OUT_FILTERED) {
+    a->paths[opt->id - CLI_OPT_OUT_NORMAL] = arg;
+    return 0;
+  }
+  switch (opt->id) {
+  case CLI_OPT_OUTPUT:
+    a->prefix = arg;
+    return 0;
+  case CLI_OPT_JSON:
+    a->json = 1;
+    return 0;
+  case CLI_OPT_QUIET:
+    a->quiet = 1;
+    return 0;
+  default:
+    break;
+  }
+  return cli_settings_apply(bake_command.name, &a->settings, opt, arg);
+}
+
+/* -o PREFIX names the outputs not given one by one. */
+static int expand_prefix(bake_args *a) {
+  if (!a->prefix)
+    return 0;
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
+    if (!output_kinds[k].from_prefix || a->paths[k])
+      continue;
+    size_t len = strlen(a->prefix) + strlen(output_kinds[k].kind) + sizeof "_.png";
+    a->prefix_paths[k] = malloc(len);
+    if (!a->prefix_paths[k]) {
+      cli_file_error(a->prefix, "out of memory");
+      return BB_EXIT_FAILURE;
+    }
+    snprintf(a->prefix_paths[k], len, "%s_%s.png", a->prefix, output_kinds[k].kind);
+    a->paths[k] = a->prefix_paths[k];
+  }
+  return 0;
+}
+
+/* Every output is checked before the (possibly long) bake starts. */
+static int check_outputs(const bake_args *a, const char *input) {
+  int any = 0;
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
+    if (!a->paths[k])
+      continue;
+    any = 1;
+    for (int j = 0; j < k; j++)
+      if (a->paths[j] && !strcmp(a->paths[j], a->paths[k]))
+        return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
+                               output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
+    int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
+    if (rc)
+      return rc;
+  }
+  if (!any)
+    return cli_usage_error(
+        bake_command.name,
+        "nothing to write: give -o PREFIX or at least one of --normal, "
+        "--weights, --ssbump, --ao, --bent, --filtered");
+  return 0;
+}
+
+static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
+  int first = 0;
+  int rc = cli_parse_options(&bake_command, argc, argv, bake_option, a, &first);
+  if (!rc)
+    rc = cli_expect_positionals(&bake_command, argc, argv, first, 1, "HEIGHT");
+  if (rc)
+    return rc;
+  *input = argv[first];
+  if (!a->settings.scale_given)
+    return cli_usage_error(
+        bake_command.name,
+        "--scale is required (texels of displacement per unit of height)");
+  rc = expand_prefix(a);
+  return rc ? rc : check_outputs(a, *input);
+}
+
+/* Timings the CLI measures around the library's own. */
+typedef struct bake_timing {
+  double load, write;
+} bake_timing;
+
+static void print_json(const bake_args *a, const char *input, const bb_image *height,
+                       const bb_bake_result *r, const bake_timing *t) {
+  const bb_bake_options *b = &a->settings.bake;
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "input", input);
+  cli_json_number(&j, "width", height->width);
+  cli_json_number(&j, "height", height->height);
+
+  cli_json_open(&j, "parameters", '{');
+  cli_json_number(&j, "scale", (double)b->height_scale);
+  cli_json_number(&j, "rays", b->rays);
+  cli_json_string(&j, "rayset", b->want_trace ? r->rayset_id : NULL);
+  cli_json_number(&j, "filter_radius", b->smooth.radius_texels);
+  cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
+  cli_json_number(&j, "bias", b->trace.bias_texels);
+  cli_json_number(&j, "power", b->power);
+  cli_json_string(&j, "basis", bb_basis_name(b->basis));
+  cli_json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
+  cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
+  cli_json_string(&j, "addressing",
+                  b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+  cli_json_string(&j, "channel", bb_channel_name(a->settings.channel));
+  cli_json_number(&j, "threads", b->trace.threads);
+  cli_json_bool(&j, "jitter", b->trace.jitter);
+  cli_json_close(&j, '}');
+
+  cli_json_open(&j, "seconds", '{');
+  cli_json_number(&j, "load", t->load);
+  cli_json_number(&j, "smooth", r->seconds_smooth);
+  cli_json_number(&j, "pyramid", r->seconds_pyramid);
+  cli_json_number(&j, "trace", r->seconds_trace);
+  cli_json_number(&j, "derive", r->seconds_derive);
+  cli_json_number(&j, "write", t->write);
+  cli_json_close(&j, '}');
+
+  cli_json_number(&j, "rays_traced", r->rays_traced);
+  cli_json_open(&j, "outputs", '[');
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
+    if (!a->paths[k])
+      continue;
+    cli_json_open(&j, NULL, '{');
+    cli_json_string(&j, "kind", output_kinds[k].kind);
+    cli_json_string(&j, "path", a->paths[k]);
+    cli_json_close(&j, '}');
+  }
+  cli_json_close(&j, ']');
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
+}
+
+/* Writes every requested output; stops at the first failure. */
+static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r) {
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
+    if (!a->paths[k])
+      continue;
+    int rc = cli_write_output(run, output_kinds[k].kind, a->paths[k], result_image(r, k),
+                              output_kinds[k].range);
+    if (rc)
+      return rc;
+    if (!a->json && !a->quiet)
+      printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
+  }
+  return 0;
+}
+
+static int needs_trace(const bake_args *a) {
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    if (a->paths[k] && output_kinds[k].needs_trace)
+      return 1;
+  return 0;
+}
+
+static int bake_run(cli_run *run, bake_args *a, const char *input) {
+  bb_image height = {0};
+  bb_bake_result result;
+  memset(&result, 0, sizeof result);
+  bake_timing t = {0, 0};
+  a->settings.bake.want_trace = needs_trace(a);
+
+  double t0 = cli_now_seconds();
+  int rc = cli_load_height(input, &a->settings, &height);
+  t.load = cli_now_seconds() - t0;
+  if (!rc) {
+    cli_progress progress;
+    cli_progress_attach(&progress, "bake", a->quiet, &a->settings.bake.trace);
+    rc = cli_run_bake(input, &height, &a->settings.bake, &result);
+    cli_progress_finish(&progress);
+  }
+  if (!rc) {
+    cli_run_set_input(run, input, &height, &a->settings);
+    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    rc = write_outputs(a, run, &result);
+    t.write = run->seconds_write;
+  }
+  if (!rc && a->json)
+    print_json(a, input, &height, &result, &t);
+  bb_bake_result_free(&result);
+  bb_image_free(&height);
+  return rc;
+}
+
+int bb_cli_bake(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
+  bake_args a;
+  memset(&a, 0, sizeof a);
+  cli_settings_init(&a.settings);
+  const char *input = NULL;
+  int rc = bake_parse(argc, argv, &a, &input);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = bake_run(&run, &a, input);
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    free(a.prefix_paths[k]);
+  cli_run_free(&run);
+  return rc;
+}

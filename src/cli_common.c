@@ -1,0 +1,711 @@
+/* cli_common.c: option parsing, errors, output writing, JSON and progress
+ * shared by the bumpbake subcommands, so none of them repeats another's. */
+/* realpath() is an XSI function, outside plain POSIX.1-2008. */
+#define _XOPEN_SOURCE 700
+
+#include "cli_common.h"
+
+#include <errno.h>
+#include <float.h>
+#include <getopt.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------- shared option rows */
+
+const cli_option cli_opt_help = {.id = CLI_OPT_HELP,
+                                 .long_name = "help",
+                                 .short_name = 'h',
+                                 .help = "print this help and exit"};
+const cli_option cli_opt_scale = {
+    .id = CLI_OPT_SCALE,
+    .long_name = "scale",
+    .value_name = "S",
+    .default_text = "(required)",
+    .range_text = "> 0",
+    .help = "height scale: texels of displacement per unit of normalised height"};
+const cli_option cli_opt_rays = {.id = CLI_OPT_RAYS,
+                                 .long_name = "rays",
+                                 .value_name = "N",
+                                 .range_text = "1..65536",
+                                 .help = "rays traced per texel"};
+const cli_option cli_opt_filter_radius = {
+    .id = CLI_OPT_FILTER_RADIUS,
+    .long_name = "filter-radius",
+    .value_name = "R",
+    .range_text = ">= 0 (integer)",
+    .help = "bilateral smoothing radius in texels, 0 = off"};
+const cli_option cli_opt_filter_threshold = {
+    .id = CLI_OPT_FILTER_THRESHOLD,
+    .long_name = "filter-threshold",
+    .value_name = "T",
+    .range_text = "> 0",
+    .help = "smoothing range threshold in normalised height (2/255 = 0.00784)"};
+const cli_option cli_opt_bias = {
+    .id = CLI_OPT_BIAS,
+    .long_name = "bias",
+    .value_name = "B",
+    .range_text = ">= 0",
+    .help = "ray origin lift above the vertex in texels (0.55 = Valve's offset)"};
+const cli_option cli_opt_power = {.id = CLI_OPT_POWER,
+                                  .long_name = "power",
+                                  .value_name = "P",
+                                  .range_text = ">= 1",
+                                  .help = "exponent of the basis lobes max(0, w.B)^P"};
+const cli_option cli_opt_basis = {.id = CLI_OPT_BASIS,
+                                  .long_name = "basis",
+                                  .value_name = "hl2|hl2+z",
+                                  .help = "directions occlusion is projected on"};
+const cli_option cli_opt_normal_filter = {
+    .id = CLI_OPT_NORMAL_FILTER,
+    .long_name = "normal-filter",
+    .value_name = "valve|central|sobel",
+    .help = "normal estimator (valve: mean of the 18 triangle normals)"};
+const cli_option cli_opt_normal_y = {
+    .id = CLI_OPT_NORMAL_Y,
+    .long_name = "normal-y",
+    .value_name = "down|up",
+    .help = "green axis: down = Source/DirectX, up = OpenGL (flips green)"};
+const cli_option cli_opt_threads = {.id = CLI_OPT_THREADS,
+                                    .long_name = "threads",
+                                    .value_name = "N",
+                                    .range_text = "0..4096",
+                                    .help = "worker threads, 0 = all cores"};
+const cli_option cli_opt_clamp = {.id = CLI_OPT_CLAMP,
+                                  .long_name = "clamp",
+                                  .default_text = "periodic",
+                                  .help = "extend border texels instead of tiling"};
+const cli_option cli_opt_jitter = {
+    .id = CLI_OPT_JITTER,
+    .long_name = "jitter",
+    .default_text = "off",
+    .help = "rotate the ray set per texel (less banding, not shift-invariant)"};
+const cli_option cli_opt_channel = {
+    .id = CLI_OPT_CHANNEL,
+    .long_name = "channel",
+    .value_name = "r|g|b|a|luma|mean",
+    .help = "height channel (auto: grey, or mean of R, G, B)"};
+const cli_option cli_opt_depth = {
+    .id = CLI_OPT_DEPTH,
+    .long_name = "depth",
+    .value_name = "8|16|half|float",
+    .help = "sample depth (default: 8 for png/tga/tif, float for exr)"};
+
+/* ----------------------------------------------------------------- errors */
+
+int cli_usage_error(const char *command, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  fprintf(stderr, "bumpbake %s: ", command);
+  vfprintf(stderr, fmt, ap);
+  fputc('\n', stderr);
+  va_end(ap);
+  return BB_EXIT_USAGE;
+}
+
+void cli_file_error(const char *path, const char *reason) {
+  /* Errors are one line, whatever a lower layer put in its message. */
+  char line[sizeof(((bb_error *)0)->message)];
+  snprintf(line, sizeof line, "%s", reason && *reason ? reason : "unknown error");
+  for (char *c = line; *c; c++)
+    if (*c == '\n' || *c == '\r')
+      *c = ' ';
+  size_t n = strlen(path);
+  if (strncmp(line, path, n) == 0 && line[n] == ':')
+    fprintf(stderr, "bumpbake: %s\n", line);
+  else
+    fprintf(stderr, "bumpbake: %s: %s\n", path, line);
+}
+
+int cli_status_exit(const char *path, bb_status status, const bb_error *err) {
+  if (status == BB_OK)
+    return 0;
+  cli_file_error(path, err->message[0] ? err->message : bb_status_name(status));
+  return BB_EXIT_FAILURE;
+}
+
+/* ---------------------------------------------------------------- numbers */
+
+int cli_parse_double(const char *command, const char *option, const char *text,
+                     double min, int min_exclusive, double max, double *out) {
+  char *end = NULL;
+  errno = 0;
+  double v = strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
+    return cli_usage_error(command, "%s needs a number (got '%s')", option, text);
+  if (min_exclusive ? !(v > min) : !(v >= min))
+    return cli_usage_error(command, "%s must be %s %.9g (got %s)", option,
+                           min_exclusive ? ">" : ">=", min, text);
+  if (v > max)
+    return cli_usage_error(command, "%s must be <= %.9g (got %s)", option, max, text);
+  *out = v;
+  return 0;
+}
+
+int cli_parse_int(const char *command, const char *option, const char *text, long min,
+                  long max, int *out) {
+  char *end = NULL;
+  errno = 0;
+  long v = strtol(text, &end, 10);
+  if (end == text || *end != '\0')
+    return cli_usage_error(command, "%s needs an integer (got '%s')", option, text);
+  if (errno == ERANGE || v < min || v > max) {
+    if (max == INT_MAX)
+      return cli_usage_error(command, "%s must be >= %ld (got %s)", option, min, text);
+    return cli_usage_error(command, "%s must be in %ld..%ld (got %s)", option, min, max,
+                           text);
+  }
+  *out = (int)v;
+  return 0;
+}
+
+/* ------------------------------------------------------- option parsing */
+
+/* How an option is named in messages: "--scale", or "-r" when short-only. */
+static const char *option_display_name(const cli_option *opt, char *buf, size_t cap) {
+  if (opt->long_name)
+    snprintf(buf, cap, "--%s", opt->long_name);
+  else
+    snprintf(buf, cap, "-%c", opt->short_name);
+  return buf;
+}
+
+static const cli_option *find_option(const cli_command *cmd, int getopt_value) {
+  for (int i = 0; i < cmd->option_count; i++) {
+    const cli_option *o = cmd->options[i];
+    if (o->id == getopt_value || (o->short_name && o->short_name == getopt_value))
+      return o;
+  }
+  return NULL;
+}
+
+/* The default of a shared setting, formatted from the command's own
+ * initialised settings; NULL when the option has no such default. */
+static const char *settings_default_text(int id, const cli_settings *d, char *buf,
+                                         size_t cap) {
+  const bb_bake_options *b = &d->bake;
+  switch (id) {
+  case CLI_OPT_RAYS:
+    snprintf(buf, cap, "%d", b->rays);
+    break;
+  case CLI_OPT_FILTER_RADIUS:
+    snprintf(buf, cap, "%d", b->smooth.radius_texels);
+    break;
+  case CLI_OPT_FILTER_THRESHOLD:
+    snprintf(buf, cap, "%.5g", (double)b->smooth.threshold);
+    break;
+  case CLI_OPT_BIAS:
+    snprintf(buf, cap, "%.5g", b->trace.bias_texels);
+    break;
+  case CLI_OPT_POWER:
+    snprintf(buf, cap, "%.5g", b->power);
+    break;
+  case CLI_OPT_BASIS:
+    snprintf(buf, cap, "%s", bb_basis_name(b->basis));
+    break;
+  case CLI_OPT_NORMAL_FILTER:
+    snprintf(buf, cap, "%s", bb_normal_filter_name(b->normal_filter));
+    break;
+  case CLI_OPT_NORMAL_Y:
+    snprintf(buf, cap, "%s", b->normal_y_up ? "up" : "down");
+    break;
+  case CLI_OPT_THREADS:
+    snprintf(buf, cap, "%d", b->trace.threads);
+    break;
+  case CLI_OPT_CHANNEL:
+    snprintf(buf, cap, "%s", bb_channel_name(d->channel));
+    break;
+  case CLI_OPT_DEPTH:
+    snprintf(buf, cap, "by format");
+    break;
+  default:
+    return NULL;
+  }
+  return buf;
+}
+
+static void print_help(const cli_command *cmd) {
+  cli_settings defaults;
+  cmd->init_settings(&defaults);
+  printf("usage: bumpbake %s %s\n%s\n\noptions:\n", cmd->name, cmd->synopsis,
+         cmd->summary);
+  for (int i = 0; i < cmd->option_count; i++) {
+    const cli_option *o = cmd->options[i];
+    char flags[64], dflt[64];
+    int n = 0;
+    if (o->short_name)
+      n += snprintf(flags + n, sizeof flags - (size_t)n, "-%c", o->short_name);
+    if (o->long_name)
+      n += snprintf(flags + n, sizeof flags - (size_t)n, "%s--%s", n ? ", " : "",
+                    o->long_name);
+    if (o->value_name)
+      snprintf(flags + n, sizeof flags - (size_t)n, " %s", o->value_name);
+    const char *d = o->default_text
+                        ? o->default_text
+                        : settings_default_text(o->id, &defaults, dflt, sizeof dflt);
+    printf("  %-36s %s", flags, o->help);
+    if (d)
+      printf("; default %s", d);
+    if (o->range_text)
+      printf("; range %s", o->range_text);
+    putchar('\n');
+  }
+}
+
+int cli_parse_options(const cli_command *cmd, int argc, char **argv,
+                      cli_option_fn on_option, void *ctx, int *first_positional) {
+  enum { MAX_OPTIONS = 48 };
+  struct option longopts[MAX_OPTIONS + 1];
+  /* Leading '+' would stop at the first positional; we want GNU permutation
+   * (options after the file name), and ':' to report missing values. */
+  char shortopts[2 * MAX_OPTIONS + 2];
+  int nl = 0, ns = 0;
+  if (cmd->option_count > MAX_OPTIONS)
+    return cli_usage_error(cmd->name, "internal error: too many options");
+  shortopts[ns++] = ':';
+  for (int i = 0; i < cmd->option_count; i++) {
+    const cli_option *o = cmd->options[i];
+    int has_arg = o->value_name ? required_argument : no_argument;
+    if (o->long_name)
+      longopts[nl++] = (struct option){o->long_name, has_arg, NULL, o->id};
+    if (o->short_name) {
+      shortopts[ns++] = o->short_name;
+      if (has_arg)
+        shortopts[ns++] = ':';
+    }
+  }
+  longopts[nl] = (struct option){NULL, 0, NULL, 0};
+  shortopts[ns] = '\0';
+
+  opterr = 0; /* our messages, in our format */
+  optind = 1;
+  for (;;) {
+    int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+    if (c == -1)
+      break;
+    if (c == '?') {
+      char name[64];
+      const cli_option *known = find_option(cmd, optopt);
+      if (optopt > 0 && optopt < 256 && !known)
+        return cli_usage_error(cmd->name, "unknown option '-%c' (see --help)", optopt);
+      if (known) /* glibc reports "--flag=value" for a flag this way */
+        return cli_usage_error(cmd->name, "%s takes no value",
+                               option_display_name(known, name, sizeof name));
+      return cli_usage_error(cmd->name, "unknown or ambiguous option '%s' (see --help)",
+                             argv[optind - 1]);
+    }
+    if (c == ':') {
+      const cli_option *o = find_option(cmd, optopt);
+      char name[64];
+      return cli_usage_error(cmd->name, "%s needs a value",
+                             o ? option_display_name(o, name, sizeof name)
+                               : argv[optind - 1]);
+    }
+    const cli_option *o = find_option(cmd, c);
+    if (!o)
+      return cli_usage_error(cmd->name, "internal: unhandled option %d", c);
+    if (o->id == CLI_OPT_HELP) {
+      print_help(cmd);
+      return -1;
+    }
+    int rc = on_option(ctx, o, optarg);
+    if (rc)
+      return rc;
+  }
+  *first_positional = optind;
+  return 0;
+}
+
+int cli_expect_positionals(const cli_command *cmd, int argc, char **argv, int first,
+                           int expected, const char *names) {
+  int got = argc - first;
+  if (got < expected)
+    return cli_usage_error(cmd->name, "missing %s (usage: bumpbake %s %s)", names,
+                           cmd->name, cmd->synopsis);
+  if (got > expected)
+    return cli_usage_error(cmd->name, "unexpected argument '%s' (expected only %s)",
+                           argv[first + expected], names);
+  return 0;
+}
+
+/* --------------------------------------------------------------- settings */
+
+void cli_settings_init(cli_settings *s) {
+  memset(s, 0, sizeof *s);
+  bb_bake_options_init(&s->bake);
+  s->channel = BB_CHANNEL_AUTO;
+  s->depth = BB_DEPTH_DEFAULT;
+  s->scale_given = 0;
+}
+
+static int parse_depth(const char *text, bb_depth *out) {
+  static const struct {
+    const char *name;
+    bb_depth depth;
+  } depths[] = {{"8", BB_DEPTH_8},
+                {"16", BB_DEPTH_16},
+                {"half", BB_DEPTH_HALF},
+                {"float", BB_DEPTH_FLOAT}};
+  for (size_t i = 0; i < sizeof depths / sizeof depths[0]; i++)
+    if (strcmp(text, depths[i].name) == 0) {
+      *out = depths[i].depth;
+      return 0;
+    }
+  return -1;
+}
+
+/* Applies a choice-valued option ("--basis hl2"); a usage error names the
+ * accepted words, which the row's value_name lists. */
+static int bad_choice(const char *command, const cli_option *opt, const char *arg) {
+  char name[64];
+  return cli_usage_error(command, "%s must be one of %s (got '%s')",
+                         option_display_name(opt, name, sizeof name), opt->value_name,
+                         arg);
+}
+
+int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
+                       const char *arg) {
+  bb_bake_options *b = &s->bake;
+  char name[64];
+  option_display_name(opt, name, sizeof name);
+  double d;
+  int rc;
+  switch (opt->id) {
+  case CLI_OPT_SCALE:
+    rc = cli_parse_double(command, name, arg, 0.0, 1, (double)FLT_MAX, &d);
+    if (!rc) {
+      b->height_scale = (float)d;
+      s->scale_given = 1;
+    }
+    return rc;
+  case CLI_OPT_RAYS:
+    return cli_parse_int(command, name, arg, 1, 65536, &b->rays);
+  case CLI_OPT_FILTER_RADIUS:
+    /* Beyond a few hundred texels the window covers any texture anyway. */
+    return cli_parse_int(command, name, arg, 0, 4096, &b->smooth.radius_texels);
+  case CLI_OPT_FILTER_THRESHOLD:
+    rc = cli_parse_double(command, name, arg, 0.0, 1, (double)FLT_MAX, &d);
+    if (!rc)
+      b->smooth.threshold = (float)d;
+    return rc;
+  case CLI_OPT_BIAS:
+    return cli_parse_double(command, name, arg, 0.0, 0, 1.0e6, &b->trace.bias_texels);
+  case CLI_OPT_POWER:
+    return cli_parse_double(command, name, arg, 1.0, 0, 1.0e6, &b->power);
+  case CLI_OPT_THREADS:
+    return cli_parse_int(command, name, arg, 0, 4096, &b->trace.threads);
+  case CLI_OPT_BASIS:
+    return bb_basis_parse(arg, &b->basis) ? bad_choice(command, opt, arg) : 0;
+  case CLI_OPT_NORMAL_FILTER:
+    return bb_normal_filter_parse(arg, &b->normal_filter) ? bad_choice(command, opt, arg)
+                                                          : 0;
+  case CLI_OPT_NORMAL_Y:
+    if (strcmp(arg, "down") && strcmp(arg, "up"))
+      return bad_choice(command, opt, arg);
+    b->normal_y_up = strcmp(arg, "up") == 0;
+    return 0;
+  case CLI_OPT_CHANNEL:
+    return bb_channel_parse(arg, &s->channel) ? bad_choice(command, opt, arg) : 0;
+  case CLI_OPT_DEPTH:
+    return parse_depth(arg, &s->depth) ? bad_choice(command, opt, arg) : 0;
+  case CLI_OPT_CLAMP:
+    b->smooth.addressing = BB_ADDRESS_CLAMP;
+    return 0;
+  case CLI_OPT_JITTER:
+    b->trace.jitter = 1;
+    return 0;
+  default: /* a table row whose subcommand forgot to handle it */
+    return cli_usage_error(command, "internal error: option %s has no handler", name);
+  }
+}
+
+/* ---------------------------------------------------------------- outputs */
+
+/* Lower-case extension of path's last component, without the dot ("" when
+ * none), into buf. */
+static const char *path_extension(const char *path, char *buf, size_t cap) {
+  const char *slash = strrchr(path, '/');
+  const char *dot = strrchr(slash ? slash + 1 : path, '.');
+  size_t n = 0;
+  if (dot)
+    for (const char *c = dot + 1; *c && n + 1 < cap; c++)
+      buf[n++] = (char)((*c >= 'A' && *c <= 'Z') ? *c - 'A' + 'a' : *c);
+  buf[n] = '\0';
+  return buf;
+}
+
+/* Whether the format of ext can hold depth, as bumpbake.h documents for
+ * bb_image_write (8: png tga tif; 16: png tif; half: exr; float: exr tif).
+ * Checked here so a bad combination fails before a long bake, not after. */
+static int depth_fits_format(bb_depth depth, const char *ext) {
+  int png = !strcmp(ext, "png"), tga = !strcmp(ext, "tga");
+  int tif = !strcmp(ext, "tif") || !strcmp(ext, "tiff"), exr = !strcmp(ext, "exr");
+  switch (depth) {
+  case BB_DEPTH_DEFAULT:
+    return 1;
+  case BB_DEPTH_8:
+    return png || tga || tif;
+  case BB_DEPTH_16:
+    return png || tif;
+  case BB_DEPTH_HALF:
+    return exr;
+  case BB_DEPTH_FLOAT:
+    return exr || tif;
+  }
+  return 0;
+}
+
+static const char *depth_name(bb_depth d) {
+  switch (d) {
+  case BB_DEPTH_8:
+    return "8";
+  case BB_DEPTH_16:
+    return "16";
+  case BB_DEPTH_HALF:
+    return "half";
+  case BB_DEPTH_FLOAT:
+    return "float";
+  case BB_DEPTH_DEFAULT:
+    break;
+  }
+  return "default";
+}
+
+/* 1 when a and b name the same file: by realpath when both exist (so
+ * "./h.png" and "h.png" match), else by spelling. */
+static int same_file(const char *a, const char *b) {
+  char *ra = realpath(a, NULL), *rb = realpath(b, NULL);
+  int same = (ra && rb) ? strcmp(ra, rb) == 0 : strcmp(a, b) == 0;
+  free(ra);
+  free(rb);
+  return same;
+}
+
+/* 0 when the directory part of path exists and is a directory; else prints
+ * why not and returns BB_EXIT_FAILURE. */
+static int check_output_directory(const char *path) {
+  const char *slash = strrchr(path, '/');
+  char dir[PATH_MAX];
+  if (!slash)
+    snprintf(dir, sizeof dir, ".");
+  else if (slash == path)
+    snprintf(dir, sizeof dir, "/");
+  else
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+  struct stat st;
+  if (stat(dir, &st) != 0) {
+    char reason[PATH_MAX + 128];
+    snprintf(reason, sizeof reason, "cannot write: directory %s: %s", dir,
+             strerror(errno));
+    cli_file_error(path, reason);
+    return BB_EXIT_FAILURE;
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    char reason[PATH_MAX + 128];
+    snprintf(reason, sizeof reason, "cannot write: %s is not a directory", dir);
+    cli_file_error(path, reason);
+    return BB_EXIT_FAILURE;
+  }
+  return 0;
+}
+
+int cli_check_output(const char *command, const char *input_path, const char *output_path,
+                     bb_depth depth) {
+  char ext[16];
+  if (!bb_path_is_writable_format(output_path))
+    return cli_usage_error(
+        command, "%s: unknown output format '.%s' (use .png, .tga, .tif or .exr)",
+        output_path, path_extension(output_path, ext, sizeof ext));
+  if (!depth_fits_format(depth, path_extension(output_path, ext, sizeof ext)))
+    return cli_usage_error(command, "%s: --depth %s is not available in .%s files",
+                           output_path, depth_name(depth), ext);
+  if (same_file(input_path, output_path)) {
+    cli_file_error(output_path, "output would overwrite the input file");
+    return BB_EXIT_FAILURE;
+  }
+  return check_output_directory(output_path);
+}
+
+static const char *file_name_of(const char *path) {
+  const char *slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
+}
+
+int cli_run_init(cli_run *run, int argc, char **argv) {
+  memset(run, 0, sizeof *run);
+  size_t len = strlen("bumpbake") + 1;
+  for (int i = 0; i < argc; i++)
+    len += strlen(argv[i]) + 1;
+  run->command_line = malloc(len);
+  if (!run->command_line) {
+    fprintf(stderr, "bumpbake: out of memory\n");
+    return BB_EXIT_FAILURE;
+  }
+  strcpy(run->command_line, "bumpbake");
+  for (int i = 0; i < argc; i++) {
+    strcat(run->command_line, " ");
+    strcat(run->command_line, argv[i]);
+  }
+  return 0;
+}
+
+void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *height,
+                       const cli_settings *settings) {
+  run->input_path = input_path;
+  run->input_hash = bb_image_hash(height);
+  run->settings = settings;
+}
+
+void cli_run_free(cli_run *run) {
+  free(run->command_line);
+  run->command_line = NULL;
+}
+
+int cli_write_output(cli_run *run, const char *kind, const char *path,
+                     const bb_image *img, bb_range range) {
+  bb_provenance p = {
+      run->command_line,    file_name_of(run->input_path), run->input_hash, kind,
+      &run->settings->bake, run->settings->channel,        run->rayset_id};
+  char *description = bb_provenance_format(&p);
+  if (!description) {
+    cli_file_error(path, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  bb_write_options wo = {run->settings->depth, range, description};
+  bb_error err = {{0}};
+  double t0 = cli_now_seconds();
+  bb_status st = bb_image_write(path, img, &wo, &err);
+  run->seconds_write += cli_now_seconds() - t0;
+  free(description);
+  return cli_status_exit(path, st, &err);
+}
+
+int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
+  bb_error err = {{0}};
+  bb_status st = bb_height_load(path, s->channel, height, &err);
+  return cli_status_exit(path, st, &err);
+}
+
+int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options *o,
+                 bb_bake_result *result) {
+  bb_error err = {{0}};
+  bb_status st = bb_bake(height, o, result, &err);
+  return cli_status_exit(path, st, &err);
+}
+
+double cli_now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------- JSON */
+
+static void json_quoted(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+    if (*c == '"' || *c == '\\')
+      fprintf(f, "\\%c", *c);
+    else if (*c < 0x20)
+      fprintf(f, "\\u%04x", *c);
+    else
+      fputc(*c, f);
+  }
+  fputc('"', f);
+}
+
+/* The separator and "key": that precede every value. */
+static void json_begin_value(cli_json *j, const char *key) {
+  if (j->need_comma)
+    fputc(',', j->f);
+  if (key) {
+    json_quoted(j->f, key);
+    fputc(':', j->f);
+  }
+  j->need_comma = 1;
+}
+
+void cli_json_open(cli_json *j, const char *key, char open) {
+  json_begin_value(j, key);
+  fputc(open, j->f);
+  j->need_comma = 0;
+}
+
+void cli_json_close(cli_json *j, char close) {
+  fputc(close, j->f);
+  j->need_comma = 1;
+}
+
+void cli_json_string(cli_json *j, const char *key, const char *value) {
+  json_begin_value(j, key);
+  if (value)
+    json_quoted(j->f, value);
+  else
+    fputs("null", j->f);
+}
+
+void cli_json_number(cli_json *j, const char *key, double value) {
+  json_begin_value(j, key);
+  /* JSON has no NaN or infinity; no value the CLI prints should be one. */
+  if (isfinite(value))
+    fprintf(j->f, "%.9g", value);
+  else
+    fputs("null", j->f);
+}
+
+void cli_json_bool(cli_json *j, const char *key, int value) {
+  json_begin_value(j, key);
+  fputs(value ? "true" : "false", j->f);
+}
+
+/* --------------------------------------------------------------- progress */
+
+enum { PROGRESS_BAR_WIDTH = 20 };
+
+static void progress_draw(void *user, long done, long total) {
+  cli_progress *p = user;
+  double now = cli_now_seconds(), elapsed = now - p->start_seconds;
+  /* Short bakes stay silent; long ones redraw ten times a second at most. */
+  if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1)
+    return;
+  p->last_draw_seconds = now;
+  double frac = done <= 0 ? 0.0 : (double)done / (double)total;
+  if (frac > 1.0)
+    frac = 1.0;
+  int filled = (int)(frac * PROGRESS_BAR_WIDTH); /* full only when done */
+  char bar[PROGRESS_BAR_WIDTH + 1];
+  for (int i = 0; i < PROGRESS_BAR_WIDTH; i++)
+    bar[i] = i < filled ? '#' : '.';
+  bar[PROGRESS_BAR_WIDTH] = '\0';
+  fprintf(stderr, "\r%s [%s] %3d%%", p->label, bar, (int)(frac * 100.0));
+  if (frac > 0.0)
+    fprintf(stderr, " ETA %.1fs", elapsed * (1.0 - frac) / frac);
+  fputs("\033[K", stderr); /* erase what a longer previous line left */
+  fflush(stderr);
+  p->shown = 1;
+}
+
+void cli_progress_attach(cli_progress *p, const char *label, int quiet,
+                         bb_trace_options *trace) {
+  memset(p, 0, sizeof *p);
+  p->label = label;
+  p->start_seconds = cli_now_seconds();
+  if (quiet || !isatty(STDERR_FILENO))
+    return;
+  trace->progress = progress_draw;
+  trace->progress_user = p;
+}
+
+void cli_progress_finish(cli_progress *p) {
+  if (!p->shown)
+    return;
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+  p->shown = 0;
+}

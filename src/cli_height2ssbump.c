@@ -1,0 +1,304 @@
+/* cli_height2ssbump.c: `bumpbake height2ssbump`, a drop-in for Valve's tool
+ * of that name (CONVENTIONS.md "Valve compatibility"): same flags, same
+ * defaults, same output files (FILE-ssbump.tga or FILE-bump.tga, RGBA). */
+#include "cli_common.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Valve's defaults: 250 rays (-r), filter radius 10 (-f). */
+enum { VALVE_RAYS = 250, VALVE_FILTER_RADIUS = 10 };
+
+static const cli_option opt_rays = {.id = CLI_OPT_RAYS,
+                                    .short_name = 'r',
+                                    .value_name = "N",
+                                    .range_text = "1..65536",
+                                    .help = "rays traced per texel"};
+static const cli_option opt_radius = {
+    .id = CLI_OPT_FILTER_RADIUS,
+    .short_name = 'f',
+    .value_name = "R",
+    .range_text = ">= 0 (integer)",
+    .help = "bilateral smoothing radius in texels, 0 = off"};
+static const cli_option opt_normal = {
+    .id = CLI_OPT_VALVE_NORMAL,
+    .short_name = 'n',
+    .default_text = "off",
+    .help = "write FILE-bump.tga: RGB = normal map (0.5 + 0.5 N)"};
+static const cli_option opt_ao_alpha = {
+    .id = CLI_OPT_VALVE_AO_ALPHA,
+    .short_name = 'A',
+    .default_text = "off",
+    .help = "put ambient occlusion in alpha, not the height"};
+static const cli_option opt_dump = {
+    .id = CLI_OPT_VALVE_DUMP,
+    .short_name = 'D',
+    .default_text = "off",
+    .help = "also write the filtered height as ./filtered.tga"};
+static const cli_option opt_detail = {
+    .id = CLI_OPT_VALVE_DETAIL,
+    .short_name = 'd',
+    .default_text = "off",
+    .help = "detail variant: RGB times (R+G+B)/sqrt(3) of the filtered input colour"};
+
+static const cli_option *const h2s_options[] = {
+    &opt_rays, &opt_normal, &opt_ao_alpha, &opt_radius,
+    &opt_dump, &opt_detail, &cli_opt_help,
+};
+
+static void h2s_settings_init(cli_settings *s) {
+  cli_settings_init(s);
+  s->bake.rays = VALVE_RAYS;
+  s->bake.smooth.radius_texels = VALVE_FILTER_RADIUS;
+  s->depth = BB_DEPTH_8; /* Valve writes 8-bit RGBA TGA */
+}
+
+static const cli_command h2s_command = {
+    "height2ssbump",
+    "[-r N] [-n] [-A] [-f R] [-D] [-d] FILE BUMPSCALE",
+    "Valve-compatible: bakes FILE-ssbump.tga (RGB = ssbump, A = filtered height)\n"
+    "next to FILE. The height is FILE's alpha channel, or the mean of R, G, B when\n"
+    "it has none. BUMPSCALE (> 0) is the height scale in texels.",
+    h2s_options,
+    (int)(sizeof h2s_options / sizeof h2s_options[0]),
+    h2s_settings_init,
+};
+
+typedef struct h2s_args {
+  cli_settings settings;
+  int normal_map, ao_in_alpha, dump_filtered, detail;
+  const char *input;
+  char *output; /* malloc'd FILE-ssbump.tga or FILE-bump.tga */
+} h2s_args;
+
+static const char dump_path[] = "filtered.tga";
+
+static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
+  h2s_args *a = ctx;
+  switch (opt->id) {
+  case CLI_OPT_VALVE_NORMAL:
+    a->normal_map = 1;
+    return 0;
+  case CLI_OPT_VALVE_AO_ALPHA:
+    a->ao_in_alpha = 1;
+    return 0;
+  case CLI_OPT_VALVE_DUMP:
+    a->dump_filtered = 1;
+    return 0;
+  case CLI_OPT_VALVE_DETAIL:
+    a->detail = 1;
+    return 0;
+  default:
+    break;
+  }
+  return cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
+}
+
+/* FILE without its extension, plus suffix: "rock.png" -> "rock-ssbump.tga". */
+static char *output_path_for(const char *input, const char *suffix) {
+  const char *slash = strrchr(input, '/');
+  const char *dot = strrchr(slash ? slash + 1 : input, '.');
+  size_t stem = dot ? (size_t)(dot - input) : strlen(input);
+  size_t len = stem + strlen(suffix) + 1;
+  char *path = malloc(len);
+  if (path)
+    snprintf(path, len, "%.*s%s", (int)stem, input, suffix);
+  return path;
+}
+
+static int h2s_parse(int argc, char **argv, h2s_args *a) {
+  int first = 0;
+  int rc = cli_parse_options(&h2s_command, argc, argv, h2s_option, a, &first);
+  if (!rc)
+    rc = cli_expect_positionals(&h2s_command, argc, argv, first, 2, "FILE BUMPSCALE");
+  if (rc)
+    return rc;
+  a->input = argv[first];
+  double scale;
+  rc = cli_parse_double(h2s_command.name, "BUMPSCALE", argv[first + 1], 0.0, 1,
+                        (double)FLT_MAX, &scale);
+  if (rc)
+    return rc;
+  a->settings.bake.height_scale = (float)scale;
+  a->settings.scale_given = 1;
+  /* The detail factor scales light response; on an encoded normal map it
+   * would only corrupt the vectors. */
+  if (a->detail && a->normal_map)
+    return cli_usage_error(h2s_command.name,
+                           "-d makes a detail ssbump; it cannot be used with -n");
+
+  a->output = output_path_for(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
+  if (!a->output) {
+    cli_file_error(a->input, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  rc = cli_check_output(h2s_command.name, a->input, a->output, a->settings.depth);
+  if (!rc && a->dump_filtered)
+    rc = cli_check_output(h2s_command.name, a->input, dump_path, a->settings.depth);
+  return rc;
+}
+
+/* Valve's channel rule: alpha when there is one, else (not Valve: it would
+ * fail) the mean of R, G, B, which we say on stderr so nobody is surprised. */
+static bb_channel valve_height_channel(const char *path, const bb_image *img,
+                                       const bb_image_info *info) {
+  if (info->alpha_channel >= 0)
+    return BB_CHANNEL_A;
+  if (img->channels >= 3) {
+    fprintf(stderr,
+            "bumpbake height2ssbump: %s has no alpha channel; using the mean of "
+            "R, G, B as the height\n",
+            path);
+    return BB_CHANNEL_MEAN;
+  }
+  fprintf(stderr,
+          "bumpbake height2ssbump: %s has no alpha channel; using its grey "
+          "channel as the height\n",
+          path);
+  return BB_CHANNEL_AUTO;
+}
+
+/* Reads FILE once: its pixels (for -d) and the height by Valve's rule. */
+static int load_input(h2s_args *a, bb_image *img, bb_image *height) {
+  bb_image_info info;
+  memset(&info, 0, sizeof info);
+  bb_error err = {{0}};
+  bb_status st = bb_image_read(a->input, img, &info, &err);
+  if (st == BB_OK) {
+    a->settings.channel = valve_height_channel(a->input, img, &info);
+    st = bb_height_from_image(img, info.alpha_channel, a->settings.channel, height, &err);
+  }
+  bb_image_info_free(&info);
+  return cli_status_exit(a->input, st, &err);
+}
+
+/* The RGB colour of the input (alpha dropped; grey replicated), smoothed by
+ * the same bilateral filter as the height and guided by it, so the detail
+ * factor follows the same edges. */
+static bb_status filtered_colour(const bb_image *img, const bb_image *height,
+                                 const bb_smooth_options *smooth, bb_image *out,
+                                 bb_error *err) {
+  bb_image rgb = {0};
+  bb_status st = bb_image_alloc(&rgb, img->width, img->height, 3, err);
+  if (st != BB_OK)
+    return st;
+  /* With 3+ channels R, G, B are the first three; with 1 or 2 (grey,
+   * grey + alpha) grey is channel 0. */
+  int colour_channels = img->channels >= 3 ? 3 : 1;
+  size_t texels = (size_t)img->width * (size_t)img->height;
+  for (size_t i = 0; i < texels; i++)
+    for (int c = 0; c < 3; c++)
+      rgb.pixels[i * 3 + (size_t)c] =
+          img->pixels[i * (size_t)img->channels + (size_t)(c < colour_channels ? c : 0)];
+  st = bb_smooth_bilateral(&rgb, height, smooth, out, err);
+  bb_image_free(&rgb);
+  return st;
+}
+
+/* Multiplies RGB of rgba by (R+G+B)/sqrt(3) of the filtered colour, so a
+ * flat unoccluded texel (0.57735) of mid-grey input comes out at 0.5. */
+static void apply_detail(bb_image *rgba, const bb_image *colour) {
+  size_t texels = (size_t)rgba->width * (size_t)rgba->height;
+  const float inv_sqrt3 = (float)(1.0 / sqrt(3.0));
+  for (size_t i = 0; i < texels; i++) {
+    const float *c = colour->pixels + i * 3;
+    float factor = (c[0] + c[1] + c[2]) * inv_sqrt3;
+    for (int k = 0; k < 3; k++)
+      rgba->pixels[i * 4 + (size_t)k] *= factor;
+  }
+}
+
+/* RGB = ssbump (or the encoded normal map), A = filtered height or ao. All
+ * four channels are then written as unit values. */
+static bb_status compose_rgba(const h2s_args *a, const bb_bake_result *r, bb_image *out,
+                              bb_error *err) {
+  const bb_image *rgb = a->normal_map ? &r->normal : &r->ssbump;
+  const bb_image *alpha = a->ao_in_alpha ? &r->ao : &r->filtered;
+  bb_status st = bb_image_alloc(out, rgb->width, rgb->height, 4, err);
+  if (st != BB_OK)
+    return st;
+  size_t texels = (size_t)rgb->width * (size_t)rgb->height;
+  for (size_t i = 0; i < texels; i++) {
+    for (int c = 0; c < 3; c++) {
+      float v = rgb->pixels[i * (size_t)rgb->channels + (size_t)c];
+      /* The normal goes into a unit-range file with a height in alpha, so it
+       * is encoded here rather than by BB_RANGE_SIGNED (which would encode
+       * the alpha too). */
+      out->pixels[i * 4 + (size_t)c] = a->normal_map ? 0.5f + 0.5f * v : v;
+    }
+    out->pixels[i * 4 + 3] = alpha->pixels[i];
+  }
+  return BB_OK;
+}
+
+static const char *output_kind(const h2s_args *a) {
+  if (a->normal_map)
+    return a->ao_in_alpha ? "normal+ao" : "normal+height";
+  if (a->detail)
+    return a->ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
+  return a->ao_in_alpha ? "ssbump+ao" : "ssbump+height";
+}
+
+/* Makes the RGBA image to write from the bake (and for -d the input). */
+static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *height,
+                     const bb_bake_result *r, bb_image *rgba) {
+  bb_error err = {{0}};
+  bb_status st = compose_rgba(a, r, rgba, &err);
+  if (st == BB_OK && a->detail) {
+    bb_image colour = {0};
+    st = filtered_colour(img, height, &a->settings.bake.smooth, &colour, &err);
+    if (st == BB_OK)
+      apply_detail(rgba, &colour);
+    bb_image_free(&colour);
+  }
+  return cli_status_exit(a->input, st, &err);
+}
+
+static int h2s_run(cli_run *run, h2s_args *a) {
+  bb_image img = {0}, height = {0}, rgba = {0};
+  bb_bake_result result;
+  memset(&result, 0, sizeof result);
+  /* Only the -n map with the height in alpha needs no rays. */
+  a->settings.bake.want_trace = !a->normal_map || a->ao_in_alpha;
+
+  int rc = load_input(a, &img, &height);
+  if (!rc) {
+    cli_progress progress;
+    cli_progress_attach(&progress, "height2ssbump", 0, &a->settings.bake.trace);
+    rc = cli_run_bake(a->input, &height, &a->settings.bake, &result);
+    cli_progress_finish(&progress);
+  }
+  if (!rc)
+    rc = make_rgba(a, &img, &height, &result, &rgba);
+  if (!rc) {
+    cli_run_set_input(run, a->input, &height, &a->settings);
+    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    rc = cli_write_output(run, output_kind(a), a->output, &rgba, BB_RANGE_UNIT);
+  }
+  if (!rc && a->dump_filtered)
+    rc = cli_write_output(run, "filtered", dump_path, &result.filtered, BB_RANGE_UNIT);
+  bb_image_free(&rgba);
+  bb_bake_result_free(&result);
+  bb_image_free(&height);
+  bb_image_free(&img);
+  return rc;
+}
+
+int bb_cli_height2ssbump(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
+  h2s_args a;
+  memset(&a, 0, sizeof a);
+  h2s_settings_init(&a.settings);
+  int rc = h2s_parse(argc, argv, &a);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = h2s_run(&run, &a);
+  free(a.output);
+  cli_run_free(&run);
+  return rc;
+}

@@ -1,0 +1,704 @@
+/* test_cli.c: the bumpbake command line, run as a program (BB_BIN, default
+ * build/bumpbake) on inputs the library writes into a temporary directory. */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+
+#include "bumpbake.h"
+
+#include <criterion/criterion.h>
+
+#include <ctype.h>
+#include <fcntl.h>
+#include <ftw.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------- running the CLI */
+
+typedef struct cli_result {
+  int code;  /* exit code, or 128 + signal when it crashed */
+  char *out; /* all of stdout, NUL-terminated */
+  char *err; /* all of stderr */
+} cli_result;
+
+static void cli_result_free(cli_result *r) {
+  free(r->out);
+  free(r->err);
+  memset(r, 0, sizeof *r);
+}
+
+static char *slurp_stream(FILE *f) {
+  fflush(f);
+  long n = ftell(f);
+  cr_assert(n >= 0);
+  char *buf = malloc((size_t)n + 1);
+  cr_assert_not_null(buf);
+  rewind(f);
+  size_t got = fread(buf, 1, (size_t)n, f);
+  buf[got] = '\0';
+  return buf;
+}
+
+/* Absolute path of the binary, so runs with another cwd find it too. */
+static const char *cli_binary(void) {
+  static char path[4096];
+  if (!path[0]) {
+    const char *bin = getenv("BB_BIN");
+    if (!bin || !*bin)
+      bin = "build/bumpbake";
+    cr_assert(realpath(bin, path) != NULL, "BB_BIN %s not found", bin);
+  }
+  return path;
+}
+
+/* Runs bumpbake with args (NULL-terminated, without argv[0]) in cwd (NULL =
+ * ours), through fork + exec: no shell, so nothing is reinterpreted. */
+static cli_result run_in(const char *cwd, const char *const *args) {
+  const char *argv[64] = {"bumpbake"};
+  for (int i = 0; args[i]; i++) {
+    cr_assert_lt(i, 62, "too many arguments");
+    argv[i + 1] = args[i];
+  }
+  /* Resolved here, not in the child: the child may chdir first, and a
+   * failed assertion there would report from a process Criterion does not
+   * know. */
+  const char *binary = cli_binary();
+  FILE *out = tmpfile(), *err = tmpfile();
+  cr_assert(out && err);
+  fflush(NULL);
+  pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    dup2(fileno(out), STDOUT_FILENO);
+    dup2(fileno(err), STDERR_FILENO);
+    if (cwd && chdir(cwd) != 0)
+      _exit(126);
+    execv(binary, (char *const *)argv);
+    _exit(127);
+  }
+  int status = 0;
+  cr_assert(waitpid(pid, &status, 0) == pid);
+  cli_result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  fseek(out, 0, SEEK_END);
+  fseek(err, 0, SEEK_END);
+  r.out = slurp_stream(out);
+  r.err = slurp_stream(err);
+  fclose(out);
+  fclose(err);
+  return r;
+}
+
+#define RUN(...) run_in(NULL, (const char *const[]){__VA_ARGS__, NULL})
+#define RUN_IN(cwd, ...) run_in(cwd, (const char *const[]){__VA_ARGS__, NULL})
+
+static int count_lines(const char *s) {
+  int n = 0;
+  for (; *s; s++)
+    n += *s == '\n';
+  return n;
+}
+
+/* ------------------------------------------------- temporary directory */
+
+static char tmpdir[64];
+/* Paths made by tmp(), freed when the test ends. */
+static char *tmp_paths[256];
+static int tmp_path_count;
+
+static int remove_entry(const char *path, const struct stat *st, int flag,
+                        struct FTW *ftw) {
+  (void)st, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+static void make_tmpdir(void) {
+  snprintf(tmpdir, sizeof tmpdir, "/tmp/bb_cli_XXXXXX");
+  cr_assert_not_null(mkdtemp(tmpdir));
+}
+
+static void remove_tmpdir(void) {
+  if (tmpdir[0])
+    nftw(tmpdir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+  tmpdir[0] = '\0';
+  while (tmp_path_count > 0)
+    free(tmp_paths[--tmp_path_count]);
+}
+
+/* Path of name inside the temporary directory, valid until the test ends. */
+static const char *tmp(const char *name) {
+  cr_assert_lt(tmp_path_count, 256);
+  size_t len = strlen(tmpdir) + strlen(name) + 2;
+  char *path = malloc(len);
+  cr_assert_not_null(path);
+  snprintf(path, len, "%s/%s", tmpdir, name);
+  return tmp_paths[tmp_path_count++] = path;
+}
+
+static int file_exists(const char *path) {
+  struct stat st;
+  return stat(path, &st) == 0;
+}
+
+/* The whole content of a file (malloc'd), its size in *size. */
+static unsigned char *read_bytes(const char *path, size_t *size) {
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "cannot open %s", path);
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  rewind(f);
+  unsigned char *buf = malloc((size_t)n + 1);
+  cr_assert_not_null(buf);
+  *size = fread(buf, 1, (size_t)n, f);
+  fclose(f);
+  return buf;
+}
+
+static void write_bytes(const char *path, const void *data, size_t size) {
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f);
+  if (size)
+    cr_assert_eq(fwrite(data, 1, size, f), size);
+  fclose(f);
+}
+
+/* ------------------------------------------------------- input images */
+
+/* Writes a channels-deep image whose every texel is value(x, y, c). */
+typedef float (*texel_fn)(int x, int y, int c);
+
+static void write_image(const char *path, int w, int h, int channels, texel_fn value) {
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_alloc(&img, w, h, channels, &err), BB_OK);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      for (int c = 0; c < channels; c++)
+        bb_image_texel(&img, x, y)[c] = value(x, y, c);
+  bb_write_options o = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
+  cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  bb_image_free(&img);
+}
+
+static float mid_grey(int x, int y, int c) {
+  (void)x, (void)y, (void)c;
+  return 0.5f;
+}
+
+/* Height rising downwards (+y) by 0.02 per texel. */
+static float ramp_down(int x, int y, int c) {
+  (void)x, (void)c;
+  return 0.02f * (float)y;
+}
+
+static float not_a_number(int x, int y, int c) {
+  (void)c;
+  return (x == 3 && y == 2) ? NAN : 0.25f;
+}
+
+/* Reads an output and returns it (the test fails if it cannot be read). */
+static bb_image read_image(const char *path, bb_image_info *info) {
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, info, &err), BB_OK, "%s: %s", path, err.message);
+  return img;
+}
+
+/* Channel c of texel (x, y) of an 8-bit output, as the integer code. */
+static int code8(const bb_image *img, int x, int y, int c) {
+  return (int)lrintf(bb_image_texel(img, x, y)[c] * 255.0f);
+}
+
+/* Asserts every texel of an 8-bit file has the given codes (+-tol). */
+static void expect_uniform8(const char *path, int channels, const int *codes, int tol) {
+  bb_image img = read_image(path, NULL);
+  cr_assert_eq(img.channels, channels, "%s: %d channels", path, img.channels);
+  for (int y = 0; y < img.height; y++)
+    for (int x = 0; x < img.width; x++)
+      for (int c = 0; c < channels; c++) {
+        int got = code8(&img, x, y, c);
+        cr_assert(abs(got - codes[c]) <= tol, "%s (%d,%d) channel %d: %d, expected %d",
+                  path, x, y, c, got, codes[c]);
+      }
+  bb_image_free(&img);
+}
+
+static void setup(void) {
+  make_tmpdir();
+}
+static void teardown(void) {
+  remove_tmpdir();
+}
+
+TestSuite(cli, .init = setup, .fini = teardown, .timeout = 120);
+
+/* ---------------------------------------------------------- help, version */
+
+Test(cli, help_and_version) {
+  cli_result r = RUN("--help");
+  cr_expect_eq(r.code, 0);
+  cr_expect(strstr(r.out, "normal") && strstr(r.out, "bake") &&
+                strstr(r.out, "height2ssbump"),
+            "%s", r.out);
+  cli_result_free(&r);
+
+  r = RUN("--version");
+  cr_expect_eq(r.code, 0);
+  cr_expect_str_eq(r.out, "bumpbake " BB_VERSION_STRING "\n");
+  cli_result_free(&r);
+
+  /* A command's help lists every option with its default. */
+  r = RUN("bake", "--help");
+  cr_expect_eq(r.code, 0);
+  const char *expected[] = {"--scale", "--rays",    "256",     "--filter-radius",
+                            "--bias",  "0.55",      "--power", "--basis",
+                            "hl2",     "--threads", "--json",  "--bent"};
+  for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++)
+    cr_expect(strstr(r.out, expected[i]), "bake --help lacks %s", expected[i]);
+  cli_result_free(&r);
+
+  r = RUN("height2ssbump", "--help");
+  cr_expect_eq(r.code, 0);
+  cr_expect(strstr(r.out, "250"), "height2ssbump --help should show 250 rays: %s", r.out);
+  cli_result_free(&r);
+}
+
+/* ------------------------------------------------------------ usage errors */
+
+typedef struct usage_case {
+  const char *args[12];
+  const char *message_part; /* the message must name the problem */
+} usage_case;
+
+Test(cli, usage_errors_exit_2_with_a_message) {
+  const char *in = tmp("h.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  const char *out = tmp("o.png");
+  const usage_case cases[] = {
+      {{"frobnicate"}, "frobnicate"},
+      {{"normal", in, "-o", out, "--scale", "1", "--bogus"}, "--bogus"},
+      {{"normal", in, "-o", out, "--scale"}, "--scale"},
+      {{"normal", in, "-o", out}, "--scale"},
+      {{"normal", in, "-o", out, "--scale", "0"}, "--scale must be > 0"},
+      {{"normal", in, "-o", out, "--scale", "-1"}, "--scale must be > 0 (got -1)"},
+      {{"normal", in, "-o", out, "--scale", "abc"}, "abc"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "-1"},
+       "--filter-radius"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-radius", "2.5"},
+       "--filter-radius"},
+      {{"normal", in, "-o", out, "--scale", "1", "--filter-threshold", "0"},
+       "--filter-threshold"},
+      {{"normal", in, "-o", out, "--scale", "1", "--normal-filter", "fancy"},
+       "--normal-filter"},
+      {{"normal", in, "-o", out, "--scale", "1", "--normal-y", "sideways"}, "--normal-y"},
+      {{"normal", in, "-o", out, "--scale", "1", "--channel", "q"}, "--channel"},
+      {{"normal", in, "--scale", "1"}, "-o"},
+      {{"bake", in, "--scale", "1", "--rays", "0", "-o", tmp("p")}, "--rays"},
+      {{"bake", in, "--scale", "1", "--rays", "65537", "-o", tmp("p")}, "--rays"},
+      {{"bake", in, "--scale", "1", "--bias", "-0.1", "-o", tmp("p")}, "--bias"},
+      {{"bake", in, "--scale", "1", "--power", "0.5", "-o", tmp("p")}, "--power"},
+      {{"bake", in, "--scale", "1", "--basis", "hl3", "-o", tmp("p")}, "--basis"},
+      {{"bake", in, "--scale", "1"}, "nothing to write"},
+      {{"bake", in, "--scale", "1", "--ao", tmp("ao.jpg2")}, "ao.jpg2"},
+      {{"bake", in, "--scale", "1", "--ao", tmp("ao.exr"), "--depth", "16"}, "--depth"},
+      {{"bake", "--scale", "1", "-o", tmp("p")}, "HEIGHT"},
+      {{"height2ssbump", in}, "BUMPSCALE"},
+      {{"height2ssbump", in, "0"}, "BUMPSCALE"},
+      {{"height2ssbump", "-r", "0", in, "2"}, "-r"},
+      {{"height2ssbump", "-x", in, "2"}, "-x"},
+  };
+  size_t before_size;
+  unsigned char *before = read_bytes(in, &before_size);
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    cli_result r = run_in(NULL, cases[i].args);
+    cr_expect_eq(r.code, 2, "case %zu (%s %s ...): exit %d, stderr: %s", i,
+                 cases[i].args[0], cases[i].args[1] ? cases[i].args[1] : "", r.code,
+                 r.err);
+    cr_expect_eq(count_lines(r.err), 1, "case %zu: stderr should be one line: %s", i,
+                 r.err);
+    cr_expect(strncmp(r.err, "bumpbake", 8) == 0, "case %zu: %s", i, r.err);
+    cr_expect(strstr(r.err, cases[i].message_part), "case %zu: message '%s' lacks '%s'",
+              i, r.err, cases[i].message_part);
+    cr_expect_str_empty(r.out, "case %zu", i);
+    cli_result_free(&r);
+    /* Nothing was written: no output, no prefix output, no temporary file. */
+    cr_expect(!file_exists(out) && !file_exists(tmp("p_normal.png")) &&
+                  !file_exists(tmp("ao.exr")),
+              "case %zu wrote a file", i);
+  }
+  size_t after_size;
+  unsigned char *after = read_bytes(in, &after_size);
+  cr_expect(before_size == after_size && !memcmp(before, after, before_size));
+  free(before);
+  free(after);
+}
+
+/* ------------------------------------------------------------- bad inputs */
+
+/* Runs args; expects exit 1, one line on stderr naming named_file, the
+ * output not created and the input unchanged. */
+static void expect_failure(const char *const *args, const char *named_file,
+                           const char *output, const char *input) {
+  size_t before_size = 0, after_size = 0;
+  unsigned char *before = file_exists(input) ? read_bytes(input, &before_size) : NULL;
+  cli_result r = run_in(NULL, args);
+  cr_expect_eq(r.code, 1, "%s: exit %d, stderr: %s", named_file, r.code, r.err);
+  cr_expect_eq(count_lines(r.err), 1, "stderr should be one line: '%s'", r.err);
+  cr_expect(strncmp(r.err, "bumpbake: ", 10) == 0, "%s", r.err);
+  cr_expect(strstr(r.err, named_file), "message '%s' should name %s", r.err, named_file);
+  cr_expect(!file_exists(output) || !strcmp(output, input), "%s was written", output);
+  if (before) {
+    unsigned char *after = read_bytes(input, &after_size);
+    cr_expect(before_size == after_size && !memcmp(before, after, before_size),
+              "%s changed", input);
+    free(after);
+  }
+  free(before);
+  cli_result_free(&r);
+}
+
+Test(cli, missing_input) {
+  const char *in = tmp("nothere.png"), *out = tmp("o.png");
+  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL},
+                 "nothere.png", out, in);
+  expect_failure((const char *[]){"height2ssbump", in, "2", NULL}, "nothere.png",
+                 tmp("nothere-ssbump.tga"), in);
+}
+
+Test(cli, corrupt_and_empty_inputs) {
+  const char *corrupt = tmp("corrupt.png"), *empty = tmp("empty.png"),
+             *out = tmp("o.png");
+  /* A PNG signature followed by garbage: a reader must look inside. */
+  const unsigned char junk[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+                                1,    2,   3,   4,   5,    6,    7,    8};
+  write_bytes(corrupt, junk, sizeof junk);
+  write_bytes(empty, "", 0);
+  expect_failure((const char *[]){"normal", corrupt, "-o", out, "--scale", "2", NULL},
+                 "corrupt.png", out, corrupt);
+  expect_failure((const char *[]){"bake", empty, "--scale", "2", "--ao", out, NULL},
+                 "empty.png", out, empty);
+}
+
+Test(cli, nan_heights) {
+  const char *in = tmp("nan.exr"), *out = tmp("o.png");
+  write_image(in, 8, 8, 1, not_a_number);
+  expect_failure((const char *[]){"bake", in, "--scale", "2", "--normal", out, NULL},
+                 "nan.exr", out, in);
+}
+
+Test(cli, output_equal_to_input) {
+  const char *in = tmp("h.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  expect_failure((const char *[]){"normal", in, "-o", in, "--scale", "2", NULL}, "h.png",
+                 in, in);
+  /* The same file under another spelling is caught too (realpath). */
+  char other[300];
+  snprintf(other, sizeof other, "%s/./h.png", tmpdir);
+  expect_failure((const char *[]){"bake", in, "--scale", "2", "--ao", other, NULL},
+                 "h.png", in, in);
+}
+
+Test(cli, unwritable_output_directory) {
+  /* A path under a regular file cannot be created, even by root. */
+  const char *in = tmp("h.png"), *afile = tmp("afile");
+  write_image(in, 8, 8, 1, mid_grey);
+  write_bytes(afile, "x", 1);
+  char out[300];
+  snprintf(out, sizeof out, "%s/out.png", afile);
+  expect_failure((const char *[]){"normal", in, "-o", out, "--scale", "2", NULL},
+                 "afile/out.png", out, in);
+}
+
+/* ------------------------------------------------------------------ normal */
+
+Test(cli, normal_of_flat_map_points_up) {
+  const char *in = tmp("flat.png"), *out = tmp("n.png");
+  write_image(in, 16, 16, 1, mid_grey);
+  cli_result r = RUN("normal", in, "-o", out, "--scale", "8");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  expect_uniform8(out, 3, (const int[]){128, 128, 255}, 0);
+}
+
+Test(cli, normal_y_up_flips_green) {
+  const char *in = tmp("ramp.exr"), *down = tmp("down.png"), *up = tmp("up.png");
+  write_image(in, 16, 16, 1, ramp_down);
+  cli_result r =
+      RUN("normal", in, "-o", down, "--scale", "20", "--filter-radius", "0", "--clamp");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("normal", in, "-o", up, "--scale", "20", "--filter-radius", "0", "--clamp",
+          "--normal-y", "up");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  bb_image a = read_image(down, NULL), b = read_image(up, NULL);
+  /* Height grows with y (down the image), so with +Y down the normal leans
+   * to -y: green below 0.5; --normal-y up mirrors it. Red is untouched. */
+  int g_down = code8(&a, 8, 8, 1), g_up = code8(&b, 8, 8, 1);
+  cr_expect_lt(g_down, 110, "green (+Y down) %d", g_down);
+  cr_expect(abs((g_down + g_up) - 255) <= 1, "green %d and %d are not mirrored", g_down,
+            g_up);
+  cr_expect_eq(code8(&a, 8, 8, 0), code8(&b, 8, 8, 0));
+  cr_expect_eq(code8(&a, 8, 8, 2), code8(&b, 8, 8, 2));
+  bb_image_free(&a);
+  bb_image_free(&b);
+}
+
+/* -------------------------------------------------------------------- bake */
+
+Test(cli, bake_of_flat_map) {
+  const char *in = tmp("flat.png"), *ss = tmp("ss.png"), *ao = tmp("ao.png");
+  write_image(in, 16, 16, 1, mid_grey);
+  cli_result r =
+      RUN("bake", in, "--scale", "8", "--rays", "64", "--ssbump", ss, "--ao", ao);
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(count_lines(r.out), 2, "one line per output: %s", r.out);
+  cr_expect(strstr(r.out, ss) && strstr(r.out, ao), "%s", r.out);
+  cli_result_free(&r);
+  int s = (int)lrint(255.0 / sqrt(3.0)); /* 147 */
+  expect_uniform8(ss, 3, (const int[]){s, s, s}, 1);
+  expect_uniform8(ao, 1, (const int[]){255}, 0);
+
+  /* Provenance travels with the file, with the command line as typed (not
+   * as getopt_long permuted it). */
+  bb_image_info info;
+  bb_image img = read_image(ss, &info);
+  char command[512];
+  snprintf(command, sizeof command, "command=bumpbake bake %s --scale 8 --rays 64", in);
+  cr_expect(info.description && strstr(info.description, command), "%s lacks '%s'",
+            info.description ? info.description : "(none)", command);
+  cr_expect(info.description && strstr(info.description, "flat.png"),
+            "provenance should name the input: %s",
+            info.description ? info.description : "(none)");
+  bb_image_info_free(&info);
+  bb_image_free(&img);
+}
+
+Test(cli, bake_prefix_and_quiet) {
+  const char *in = tmp("flat.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  cli_result r =
+      RUN("bake", in, "--scale", "4", "--rays", "16", "-o", tmp("rock"), "--quiet");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.out);
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+  cr_expect(file_exists(tmp("rock_normal.png")));
+  cr_expect(file_exists(tmp("rock_ssbump.png")));
+  cr_expect(file_exists(tmp("rock_ao.png")));
+}
+
+/* A small JSON checker (RFC 8259 grammar, no semantics): enough to say the
+ * line parses. Returns the position after the value, or NULL. */
+static const char *json_value(const char *p);
+
+static const char *json_ws(const char *p) {
+  while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r')
+    p++;
+  return p;
+}
+
+static const char *json_string(const char *p) {
+  if (*p++ != '"')
+    return NULL;
+  for (; *p != '"'; p++) {
+    if (!*p || (unsigned char)*p < 0x20)
+      return NULL;
+    if (*p == '\\') {
+      p++;
+      if (*p == 'u') {
+        for (int i = 1; i <= 4; i++)
+          if (!isxdigit((unsigned char)p[i]))
+            return NULL;
+        p += 4;
+      } else if (!strchr("\"\\/bfnrt", *p) || !*p) {
+        return NULL;
+      }
+    }
+  }
+  return p + 1;
+}
+
+static const char *json_number(const char *p) {
+  const char *start = p;
+  if (*p == '-')
+    p++;
+  if (!isdigit((unsigned char)*p))
+    return NULL;
+  if (*p == '0')
+    p++;
+  else
+    while (isdigit((unsigned char)*p))
+      p++;
+  if (*p == '.') {
+    p++;
+    if (!isdigit((unsigned char)*p))
+      return NULL;
+    while (isdigit((unsigned char)*p))
+      p++;
+  }
+  if (*p == 'e' || *p == 'E') {
+    p++;
+    if (*p == '+' || *p == '-')
+      p++;
+    if (!isdigit((unsigned char)*p))
+      return NULL;
+    while (isdigit((unsigned char)*p))
+      p++;
+  }
+  return p > start ? p : NULL;
+}
+
+static const char *json_members(const char *p, char close, int keyed) {
+  p = json_ws(p);
+  if (*p == close)
+    return p + 1;
+  for (;;) {
+    if (keyed) {
+      p = json_string(json_ws(p));
+      if (!p)
+        return NULL;
+      p = json_ws(p);
+      if (*p++ != ':')
+        return NULL;
+    }
+    p = json_value(p);
+    if (!p)
+      return NULL;
+    p = json_ws(p);
+    if (*p == close)
+      return p + 1;
+    if (*p++ != ',')
+      return NULL;
+  }
+}
+
+static const char *json_value(const char *p) {
+  p = json_ws(p);
+  if (*p == '{')
+    return json_members(p + 1, '}', 1);
+  if (*p == '[')
+    return json_members(p + 1, ']', 0);
+  if (*p == '"')
+    return json_string(p);
+  if (!strncmp(p, "true", 4))
+    return p + 4;
+  if (!strncmp(p, "false", 5))
+    return p + 5;
+  if (!strncmp(p, "null", 4))
+    return p + 4;
+  return json_number(p);
+}
+
+Test(cli, json_checker_rejects_bad_json) {
+  /* The checker itself must be able to fail, or the JSON test proves nothing. */
+  cr_expect_not_null(json_value("{\"a\":[1,2.5e3,\"x\\n\"],\"b\":{\"c\":null}}"));
+  cr_expect_null(json_value("{\"a\":1,}"));
+  cr_expect_null(json_value("{\"a\" 1}"));
+  cr_expect_null(json_value("{\"a\":nan}"));
+  cr_expect_null(json_value("[1,2"));
+}
+
+Test(cli, bake_json_is_one_line_with_the_keys) {
+  const char *in = tmp("flat.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  cli_result r = RUN("bake", in, "--scale", "4", "--rays", "16", "--ao", tmp("ao.png"),
+                     "--normal", tmp("n.tga"), "--json");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(count_lines(r.out), 1, "%s", r.out);
+  const char *end = json_value(r.out);
+  cr_assert_not_null(end, "not JSON: %s", r.out);
+  cr_expect_str_eq(json_ws(end), "", "trailing text after the JSON value: %s", r.out);
+  const char *keys[] = {"input",         "width",         "height",
+                        "parameters",    "scale",         "rays",
+                        "rayset",        "filter_radius", "filter_threshold",
+                        "bias",          "power",         "basis",
+                        "normal_filter", "normal_y",      "addressing",
+                        "channel",       "threads",       "seconds",
+                        "load",          "smooth",        "pyramid",
+                        "trace",         "derive",        "write",
+                        "rays_traced",   "outputs",       "kind",
+                        "path"};
+  for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+    char quoted[64];
+    snprintf(quoted, sizeof quoted, "\"%s\":", keys[i]);
+    cr_expect(strstr(r.out, quoted), "JSON lacks %s: %s", keys[i], r.out);
+  }
+  cr_expect(strstr(r.out, "\"kind\":\"ao\"") && strstr(r.out, "\"kind\":\"normal\""),
+            "%s", r.out);
+  cr_expect(strstr(r.out, "\"rays_traced\":1024"), "8x8 texels x 16 rays: %s", r.out);
+  cli_result_free(&r);
+}
+
+/* ------------------------------------------------------------ height2ssbump */
+
+/* Mid-grey colour with a height of 0.25 in alpha: RGB and alpha differ, so
+ * the test sees which one became the height. */
+static float grey_with_low_alpha(int x, int y, int c) {
+  (void)x, (void)y;
+  return c == 3 ? 0.25f : 0.5f;
+}
+
+static void run_ok_in(const char *cwd, const char *const *args) {
+  cli_result r = run_in(cwd, args);
+  cr_assert_eq(r.code, 0, "%s: exit %d, stderr: %s", args[0], r.code, r.err);
+  cli_result_free(&r);
+}
+
+Test(cli, height2ssbump_writes_ssbump_with_height_in_alpha) {
+  const char *in = tmp("wall.tga");
+  write_image(in, 16, 16, 4, grey_with_low_alpha);
+  size_t before_size, after_size;
+  unsigned char *before = read_bytes(in, &before_size);
+  cli_result r = RUN("height2ssbump", in, "4");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.err, "alpha present: no note expected");
+  cli_result_free(&r);
+  int s = (int)lrint(255.0 / sqrt(3.0));
+  expect_uniform8(tmp("wall-ssbump.tga"), 4, (const int[]){s, s, s, 64}, 1);
+  unsigned char *after = read_bytes(in, &after_size);
+  cr_expect(before_size == after_size && !memcmp(before, after, before_size));
+  free(before);
+  free(after);
+}
+
+Test(cli, height2ssbump_flags) {
+  const char *in = tmp("wall.tga");
+  write_image(in, 16, 16, 4, grey_with_low_alpha);
+  /* -n: the normal map, height still in alpha. */
+  run_ok_in(NULL, (const char *[]){"height2ssbump", "-n", in, "4", NULL});
+  expect_uniform8(tmp("wall-bump.tga"), 4, (const int[]){128, 128, 255, 64}, 0);
+  /* -A: ao in alpha, 1 on a flat map. */
+  run_ok_in(NULL, (const char *[]){"height2ssbump", "-A", "-r", "32", in, "4", NULL});
+  int s = (int)lrint(255.0 / sqrt(3.0));
+  expect_uniform8(tmp("wall-ssbump.tga"), 4, (const int[]){s, s, s, 255}, 1);
+  /* -d: a flat, unoccluded texel of mid-grey input is 0.5 (mod2x neutral). */
+  run_ok_in(NULL, (const char *[]){"height2ssbump", "-d", "-r", "32", in, "4", NULL});
+  expect_uniform8(tmp("wall-ssbump.tga"), 4, (const int[]){128, 128, 128, 64}, 1);
+}
+
+Test(cli, height2ssbump_dump_writes_filtered_in_cwd) {
+  write_image(tmp("wall.tga"), 16, 16, 4, grey_with_low_alpha);
+  run_ok_in(tmpdir,
+            (const char *[]){"height2ssbump", "-D", "-r", "16", "wall.tga", "4", NULL});
+  cr_expect(file_exists(tmp("wall-ssbump.tga")));
+  bb_image f = read_image(tmp("filtered.tga"), NULL);
+  cr_expect_eq(code8(&f, 5, 5, 0), 64);
+  bb_image_free(&f);
+}
+
+Test(cli, height2ssbump_without_alpha_uses_mean_and_says_so) {
+  const char *in = tmp("rgb.png");
+  write_image(in, 16, 16, 3, mid_grey);
+  cli_result r = RUN("height2ssbump", "-r", "16", in, "4");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(count_lines(r.err), 1, "one note on stderr: %s", r.err);
+  cr_expect(strstr(r.err, "alpha"), "%s", r.err);
+  cli_result_free(&r);
+  int s = (int)lrint(255.0 / sqrt(3.0));
+  expect_uniform8(tmp("rgb-ssbump.tga"), 4, (const int[]){s, s, s, 128}, 1);
+}
