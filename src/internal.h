@@ -19,6 +19,8 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 #endif
     ;
 
+#define BB__PI 3.14159265358979323846
+
 /* Non-negative remainder: the periodic index of i in [0, n). */
 static inline int bb__wrap(int i, int n) {
   int r = i % n;
