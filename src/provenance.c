@@ -45,21 +45,6 @@ uint64_t bb_image_hash(const bb_image *img) {
   return h;
 }
 
-/* ------------------------------------------------------------------ names */
-
-const char *bb_channel_name(bb_channel c) {
-  switch (c) {
-  case BB_CHANNEL_AUTO: return "auto";
-  case BB_CHANNEL_R: return "r";
-  case BB_CHANNEL_G: return "g";
-  case BB_CHANNEL_B: return "b";
-  case BB_CHANNEL_A: return "a";
-  case BB_CHANNEL_LUMA: return "luma";
-  case BB_CHANNEL_MEAN: return "mean";
-  }
-  return "unknown";
-}
-
 /* ---------------------------------------------------------------- format */
 
 /* A growable text buffer; `failed` sticks once an allocation fails. */
