@@ -122,11 +122,31 @@ static int has_extension(const char *path, const char *ext) {
   return n >= m && strcasecmp(path + n - m, ext) == 0;
 }
 
-/* True when a provenance text was written by bumpbake (and is not some other
- * tool's ImageDescription). */
+/* True when a description looks like bumpbake provenance (and is not some
+ * other tool's ImageDescription). */
 static int is_bumpbake_provenance(const char *description) {
   return description && (strncmp(description, "bumpbake_version=", 17) == 0 ||
                          strstr(description, "\nbumpbake_version="));
+}
+
+static int is_key_char(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_';
+}
+
+/* True when every non-empty line is key=value with a lowercase key. Some
+ * formats cut or re-wrap long comments (TGA keeps 4 lines of 80 characters),
+ * and diffing such remains would list keys that never changed. */
+static int is_well_formed_provenance(const char *text) {
+  if (!is_bumpbake_provenance(text)) return 0;
+  for (const char *line = text; *line;) {
+    const char *end = strchr(line, '\n');
+    size_t n = end ? (size_t)(end - line) : strlen(line);
+    size_t k = 0;
+    while (k < n && is_key_char(line[k])) k++;
+    if (n > 0 && (k == 0 || k == n || line[k] != '=')) return 0;
+    line = end ? end + 1 : line + n;
+  }
+  return 1;
 }
 
 /* Writes |A-B|. EXR keeps the raw differences; integer formats would round
@@ -297,6 +317,21 @@ static int report_size_mismatch(const compare_args *a, const bb_image *x,
   return COMPARE_DIFFERENT_SIZE;
 }
 
+/* Says why provenance was not compared when a file has a damaged copy; on
+ * stderr, so --json output stays one line. */
+static void note_malformed_provenance(const compare_args *a, const bb_image_info *ix,
+                                      const bb_image_info *iy) {
+  const char *paths[2] = {a->path_a, a->path_b};
+  const bb_image_info *infos[2] = {ix, iy};
+  for (int i = 0; i < 2; i++)
+    if (is_bumpbake_provenance(infos[i]->description) &&
+        !is_well_formed_provenance(infos[i]->description))
+      fprintf(stderr,
+              "bumpbake: %s: provenance is cut or re-wrapped by the file format; "
+              "not compared\n",
+              paths[i]);
+}
+
 /* Compares two decoded images and reports; returns the exit code. */
 static int compare_loaded(const compare_args *a, const bb_image *x, const bb_image *y,
                           const bb_image_info *ix, const bb_image_info *iy) {
@@ -313,9 +348,12 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
   }
   char prov_diff[4096] = "";
   int prov_count = 0;
-  if (is_bumpbake_provenance(ix->description) && is_bumpbake_provenance(iy->description))
+  if (is_well_formed_provenance(ix->description) &&
+      is_well_formed_provenance(iy->description))
     prov_count = bb_provenance_diff(ix->description, iy->description, prov_diff,
                                     sizeof prov_diff);
+  else
+    note_malformed_provenance(a, ix, iy);
   int code = compare_verdict(a, &stats);
   if (a->json)
     print_json_report(a, x, &stats, prov_diff, code);
@@ -370,7 +408,11 @@ int bb_cli_info(int argc, char **argv) {
          info.bits_per_sample, info.is_float ? "float" : "integer");
   if (info.alpha_channel >= 0) printf("alpha channel: %d\n", info.alpha_channel);
   if (is_bumpbake_provenance(info.description)) {
-    printf("provenance:\n%s", info.description);
+    if (!is_well_formed_provenance(info.description))
+      printf("provenance (cut or re-wrapped by the file format):\n");
+    else
+      printf("provenance:\n");
+    printf("%s", info.description);
     size_t n = strlen(info.description);
     if (n && info.description[n - 1] != '\n') printf("\n");
   } else {

@@ -368,3 +368,44 @@ Test(compare_cli, info_on_unreadable_file_is_one_line_and_exit_1) {
   char *nl = strchr(out, '\n');
   cr_assert(nl && nl[1] == '\0', "one line: %s", out);
 }
+
+Test(compare_cli, damaged_provenance_is_not_diffed) {
+  /* As a TGA comment re-wrapped at 80 columns leaves it: a value split. */
+  const char *cut = "bumpbake_version=0.1.0\nscale=1\n6\nrays=64\n";
+  char *p16 = provenance_with_scale(16);
+  const char *a = write_image("a.exr", 4, 4, 1, ramp, p16);
+  const char *b = write_image("b.exr", 4, 4, 1, ramp, cut);
+  char out[4096];
+  cr_assert_eq(run(out, sizeof out, "compare %s %s", a, b), 0, "%s", out);
+  cr_assert_null(strstr(out, "provenance differs"), "%s", out);
+  cr_assert_not_null(strstr(out, "b.exr: provenance is cut or re-wrapped"), "%s", out);
+  free(p16);
+}
+
+Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
+  float v[256];
+  for (int i = 0; i < 256; i++) v[i] = (float)((i * 37) % 256) / 255.0f;
+  const char *height = write_image("h.png", 16, 16, 1, v, NULL);
+  const char *ssbump = tmp_file("ssbump.exr");
+  char out[4096];
+  int code = run(out, sizeof out,
+                 "bake %s --scale 5 --rays 16 --power 2 --clamp --basis hl2+z --quiet "
+                 "--ssbump %s",
+                 height, ssbump);
+  cr_assert_eq(code, 0, "bake failed: %s", out);
+  cr_assert_eq(run(out, sizeof out, "info %s", ssbump), 0, "%s", out);
+  cr_assert_not_null(strstr(out, "16 x 16, 4 channels, openexr"), "%s", out);
+  static const char *const lines[] = {"\ninput=h.png\n", "\noutput=ssbump\n",
+                                      "\nscale=5\n",      "\nrays=16\n",
+                                      "\npower=2\n",      "\nbasis=hl2+z\n",
+                                      "\naddressing=clamp\n"};
+  for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
+    cr_assert_not_null(strstr(out, lines[i]), "missing %s in:\n%s", lines[i] + 1, out);
+  bb_image img = {0};
+  cr_assert_eq(bb_image_read(height, &img, NULL, NULL), BB_OK);
+  char hash[64];
+  snprintf(hash, sizeof hash, "\ninput_hash=%016llx\n",
+           (unsigned long long)bb_image_hash(&img));
+  bb_image_free(&img);
+  cr_assert_not_null(strstr(out, hash), "input hash of the decoded height: %s", out);
+}

@@ -11,8 +11,11 @@ set -euo pipefail
 
 bin=${1:?usage: tools/goldens.sh BIN regenerate|check}
 mode=${2:?usage: tools/goldens.sh BIN regenerate|check}
-root=$(cd "$(dirname "$0")/.." && pwd)
-fixtures=${BB_FIXTURES:-$root/fixtures}
+# Paths relative to the repository root, so the command lines recorded in
+# the goldens' provenance do not name the machine they were baked on.
+[[ $bin == */* ]] && bin=$(realpath "$bin")
+cd "$(dirname "$0")/.."
+fixtures=${BB_FIXTURES:-fixtures}
 cases=$fixtures/goldens/cases.txt
 golden_limit=$((1024 * 1024)) # bytes; goldens live in git, keep them small
 
