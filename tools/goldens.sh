@@ -54,10 +54,11 @@ regenerate_bake() {
   "$bin" bake "${words[@]}" "${flags[@]}" --quiet
 }
 
-# height2ssbump writes next to its input, so it runs on a copy in a temp dir.
+# height2ssbump writes next to its input, so it runs on a copy in a scratch
+# directory with a fixed name (it is recorded in the provenance).
 regenerate_height2ssbump() {
-  local i=$1 dest=$2 tmp input stem
-  tmp=$(mktemp -d)
+  local i=$1 dest=$2 tmp=build/goldens-scratch input stem
+  rm -rf "$tmp" && mkdir -p "$tmp"
   input=$tmp/${inputs[$i]}
   cp "$fixtures/${inputs[$i]}" "$input"
   mapfile -t words < <(case_words "$i" "$input")
