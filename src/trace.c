@@ -52,6 +52,12 @@ static inline double cross_y(const walker *w, int Y) {
   return w->r.dy == 0.0 ? INFINITY : ((double)Y - w->r.oy) * w->inv_dy;
 }
 
+/* floor() without the libm call the x86-64 baseline makes of it. */
+static inline int fast_floor(double v) {
+  int i = (int)v;
+  return (double)i > v ? i - 1 : i;
+}
+
 static inline int is_periodic(const walker *w) {
   return w->p->addressing == BB_ADDRESS_PERIODIC;
 }
@@ -173,7 +179,7 @@ static void step_cell(walker *w) {
  * makes, so a jump over a node lands in the cell the DDA would reach. */
 static int locate_x(const walker *w, double t, int ix) {
   if (w->r.dx == 0.0) return ix;
-  ix = (int)floor(w->r.ox + t * w->r.dx);
+  ix = fast_floor(w->r.ox + t * w->r.dx);
   if (w->sx > 0) {
     while (cross_x(w, ix + 1) <= t) ix++;
     while (cross_x(w, ix) > t) ix--;
@@ -186,7 +192,7 @@ static int locate_x(const walker *w, double t, int ix) {
 
 static int locate_y(const walker *w, double t, int iy) {
   if (w->r.dy == 0.0) return iy;
-  iy = (int)floor(w->r.oy + t * w->r.dy);
+  iy = fast_floor(w->r.oy + t * w->r.dy);
   if (w->sy > 0) {
     while (cross_y(w, iy + 1) <= t) iy++;
     while (cross_y(w, iy) > t) iy--;
@@ -195,6 +201,26 @@ static int locate_y(const walker *w, double t, int iy) {
     while (cross_y(w, iy + 1) > t) iy++;
   }
   return iy;
+}
+
+/* Periodic index of c, known to lie within a few periods of [0, n). */
+static inline int rewrap(int c, int n) {
+  while (c >= n) c -= n;
+  while (c < 0) c += n;
+  return c;
+}
+
+/* set_cell() for a nearby cell, without the divisions of bb__wrap. */
+static void move_to(walker *w, int ix, int iy) {
+  if (is_periodic(w)) {
+    w->cx = rewrap(w->cx + (ix - w->ix), w->p->width);
+    w->cy = rewrap(w->cy + (iy - w->iy), w->p->height);
+    w->ix = ix;
+    w->iy = iy;
+    update_exits(w);
+  } else {
+    set_cell(w, ix, iy);
+  }
 }
 
 /* Moves the walker to the first cell past the level-k node holding it. */
@@ -210,7 +236,7 @@ static void skip_node(walker *w, int k) {
   if (ty <= tx) iy = w->sy > 0 ? Y : Y - 1;
   else iy = locate_y(w, t, w->iy);
   w->t = t;
-  set_cell(w, ix, iy);
+  move_to(w, ix, iy);
 }
 
 static inline float node_max(const bb_pyramid *p, int k, int cx, int cy) {

@@ -1,0 +1,191 @@
+/* derive.c: the Half-Life 2 basis and the maps derived per texel from normals and
+ * visibility. */
+#include "internal.h"
+
+#include <math.h>
+#include <string.h>
+
+int bb_basis_parse(const char *name, bb_basis *out) {
+  if (!name || !out)
+    return -1;
+  if (strcmp(name, "hl2") == 0) {
+    *out = BB_BASIS_HL2;
+    return 0;
+  }
+  if (strcmp(name, "hl2+z") == 0) {
+    *out = BB_BASIS_HL2_Z;
+    return 0;
+  }
+  return -1;
+}
+
+const char *bb_basis_name(bb_basis b) {
+  switch (b) {
+  case BB_BASIS_HL2:
+    return "hl2";
+  case BB_BASIS_HL2_Z:
+    return "hl2+z";
+  }
+  return "unknown";
+}
+
+/* 3 or 4; 0 for a value that is not a bb_basis. */
+int bb_basis_count(bb_basis b) {
+  switch (b) {
+  case BB_BASIS_HL2:
+    return 3;
+  case BB_BASIS_HL2_Z:
+    return 4;
+  }
+  return 0;
+}
+
+/* CONVENTIONS "Half-Life 2 basis", +Y down; index 3 is the optional (0, 0, 1).
+ * An index outside 0..3 gives the zero vector. */
+void bb_basis_vector(int index, double v[3]) {
+  assert(index >= 0 && index < BB_MAX_BASIS);
+  if (index < 0 || index >= BB_MAX_BASIS) {
+    v[0] = v[1] = v[2] = 0.0;
+    return;
+  }
+  const double side = sqrt(2.0 / 3.0), back = 1.0 / sqrt(6.0), across = 1.0 / sqrt(2.0),
+               up = 1.0 / sqrt(3.0);
+  const double basis[BB_MAX_BASIS][3] = {
+      {side, 0.0, up},      /* B0: light from the right */
+      {-back, across, up},  /* B1: from the bottom-left */
+      {-back, -across, up}, /* B2: from the top-left */
+      {0.0, 0.0, 1.0},      /* B3: light from straight above */
+  };
+  for (int k = 0; k < 3; k++)
+    v[k] = basis[index][k];
+}
+
+static double dot3(const float n[3], const double b[3]) {
+  return (double)n[0] * b[0] + (double)n[1] * b[1] + (double)n[2] * b[2];
+}
+
+static double saturate(double v) {
+  return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+}
+
+static size_t texel_count(const bb_image *img) {
+  return (size_t)img->width * (size_t)img->height;
+}
+
+static bb_status check_image(const bb_image *img, const char *what, int min_channels,
+                             int max_channels, bb_error *err) {
+  if (!img || !img->pixels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: missing %s image", what);
+  if (img->channels < min_channels || img->channels > max_channels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: %s has %d channels, not %d..%d", what,
+                    img->channels, min_channels, max_channels);
+  return BB_OK;
+}
+
+static bb_status check_output(const bb_image *out, const bb_image *a, const bb_image *b,
+                              bb_error *err) {
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: missing output image");
+  if (out == a || out == b)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: the output must be a separate image");
+  return BB_OK;
+}
+
+bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *err) {
+  bb_status st;
+  if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, normals, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, normals->width, normals->height, 3, err)) != BB_OK)
+    return st;
+  double basis[3][3];
+  for (int c = 0; c < 3; c++)
+    bb_basis_vector(c, basis[c]);
+  for (size_t i = 0; i < texel_count(normals); i++) {
+    const float *n = normals->pixels + 3 * i;
+    double w[3], sum = 0.0;
+    for (int c = 0; c < 3; c++) {
+      double s = saturate(dot3(n, basis[c]));
+      w[c] = s * s;
+      sum += w[c];
+    }
+    /* A normal facing away from all three directions has no preferred one. */
+    for (int c = 0; c < 3; c++)
+      out->pixels[3 * i + (size_t)c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / 3.0);
+  }
+  return BB_OK;
+}
+
+bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis, bb_image *out,
+                           bb_error *err) {
+  bb_status st;
+  if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
+    return st;
+  if ((st = check_image(vis, "visibility", 4, 1 + BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if (vis->width != normals->width || vis->height != normals->height)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "derive: visibility is %dx%d but normals are %dx%d", vis->width,
+                    vis->height, normals->width, normals->height);
+  if ((st = check_output(out, normals, vis, err)) != BB_OK)
+    return st;
+  const int count = vis->channels - 1;
+  if ((st = bb_image_alloc(out, vis->width, vis->height, count, err)) != BB_OK)
+    return st;
+  double basis[BB_MAX_BASIS][3];
+  for (int c = 0; c < count; c++)
+    bb_basis_vector(c, basis[c]);
+  for (size_t i = 0; i < texel_count(vis); i++) {
+    const float *n = normals->pixels + 3 * i;
+    const float *v = vis->pixels + (size_t)vis->channels * i + 1; /* skip ao */
+    float *s = out->pixels + (size_t)count * i;
+    for (int c = 0; c < count; c++)
+      s[c] = (float)(fmax(0.0, dot3(n, basis[c])) * (double)v[c]);
+  }
+  return BB_OK;
+}
+
+bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
+  bb_status st;
+  if ((st = check_image(vis, "visibility", 1, 64, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, vis, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, vis->width, vis->height, 1, err)) != BB_OK)
+    return st;
+  for (size_t i = 0; i < texel_count(vis); i++)
+    out->pixels[i] = vis->pixels[(size_t)vis->channels * i];
+  return BB_OK;
+}
+
+bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err) {
+  bb_status st;
+  if ((st = check_image(ssbump, "ssbump", 3, BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, ssbump, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, ssbump->width, ssbump->height, 3, err)) != BB_OK)
+    return st;
+  const int count = ssbump->channels;
+  double basis[BB_MAX_BASIS][3];
+  for (int c = 0; c < count; c++)
+    bb_basis_vector(c, basis[c]);
+  for (size_t i = 0; i < texel_count(ssbump); i++) {
+    const float *s = ssbump->pixels + (size_t)count * i;
+    double b[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < count; c++)
+      for (int k = 0; k < 3; k++)
+        b[k] += (double)s[c] * basis[c][k];
+    double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    float *o = out->pixels + 3 * i;
+    /* Fully shadowed: no light direction to bend towards, so report straight up. */
+    if (!(len > 0.0)) {
+      o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
+      continue;
+    }
+    for (int k = 0; k < 3; k++)
+      o[k] = (float)(b[k] / len);
+  }
+  return BB_OK;
+}
