@@ -221,8 +221,8 @@ static double percent_of(long count, long total) {
 static void print_text_report(const compare_args *a, const bb_image *img,
                               const bb_compare_stats *s, const char *prov_diff,
                               int prov_count, int code) {
-  printf("compare %s %s: %d x %d, %d channels\n", a->path_a, a->path_b, img->width,
-         img->height, img->channels);
+  printf("compare %s %s: %d x %d, %d channel%s\n", a->path_a, a->path_b, img->width,
+         img->height, img->channels, img->channels == 1 ? "" : "s");
   printf("  mean abs error %.6g\n", s->mean_abs);
   printf("  RMS error      %.6g\n", s->rms);
   printf("  max abs error  %.6g", s->max_abs);

@@ -115,8 +115,9 @@ static int run(char *out, size_t cap, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(cmd, sizeof cmd, fmt, ap);
   va_end(ap);
-  strncat(cmd, " 2>&1", sizeof cmd - strlen(cmd) - 1);
-  FILE *p = popen(cmd, "r");
+  char shell[4200];
+  snprintf(shell, sizeof shell, "( %s ) 2>&1", cmd); /* stderr of every command in cmd */
+  FILE *p = popen(shell, "r");
   if (!p) return -1;
   size_t used = strlen(out);
   size_t n = fread(out + used, 1, cap - used - 1, p);
@@ -195,9 +196,14 @@ static void compare_output(const golden_case *c, const char *kind, void *user) {
   if (code == 0) return;
   cmp->failures++;
   size_t used = strlen(cmp->report);
+  /* Same provenance means same input and parameters: the code changed. */
+  const char *hint = code == 2 && !strstr(out, "provenance differs")
+                         ? "(provenance matches: same input and parameters, so the bake's "
+                           "code changed)\n"
+                         : "";
   snprintf(cmp->report + used, sizeof cmp->report - used,
-           "\n--- golden %s, output %s: compare exit %d (tolerance --fail %s)\n%s", c->name,
-           kind, code, tolerance, out);
+           "\n--- golden %s, output %s: compare exit %d (tolerance --fail %s)\n%s%s",
+           c->name, kind, code, tolerance, out, hint);
 }
 
 /* ------------------------------------------------------------------ tests */
