@@ -57,17 +57,22 @@ static int usage_error(const char *what, const char *detail) {
 static int parse_non_negative(const char *s, double *out) {
   char *end;
   double v = strtod(s, &end);
-  if (end == s || *end != '\0' || isnan(v) || v < 0) return 1;
+  if (end == s || *end != '\0' || isnan(v) || v < 0)
+    return 1;
   *out = v;
   return 0;
 }
 
 /* Options that take a number, and where each one's value goes. */
 static double *numeric_option(compare_args *a, const char *name) {
-  if (strcmp(name, "--fail") == 0) return &a->fail_threshold;
-  if (strcmp(name, "--failpercent") == 0) return &a->fail_percent;
-  if (strcmp(name, "--warn") == 0) return &a->warn_threshold;
-  if (strcmp(name, "--warnpercent") == 0) return &a->warn_percent;
+  if (strcmp(name, "--fail") == 0)
+    return &a->fail_threshold;
+  if (strcmp(name, "--failpercent") == 0)
+    return &a->fail_percent;
+  if (strcmp(name, "--warn") == 0)
+    return &a->warn_threshold;
+  if (strcmp(name, "--warnpercent") == 0)
+    return &a->warn_percent;
   return NULL;
 }
 
@@ -80,12 +85,15 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
     const char *arg = argv[i];
     double *target = numeric_option(a, arg);
     if (target) {
-      if (i + 1 >= argc) return usage_error("missing value after", arg);
+      if (i + 1 >= argc)
+        return usage_error("missing value after", arg);
       if (parse_non_negative(argv[++i], target) != 0)
         return usage_error("expected a non-negative number after", arg);
-      if (target == &a->warn_threshold) a->warn_enabled = 1;
+      if (target == &a->warn_threshold)
+        a->warn_enabled = 1;
     } else if (strcmp(arg, "--diff") == 0) {
-      if (i + 1 >= argc) return usage_error("missing value after", arg);
+      if (i + 1 >= argc)
+        return usage_error("missing value after", arg);
       a->diff_path = argv[++i];
     } else if (strcmp(arg, "--json") == 0) {
       a->json = 1;
@@ -100,7 +108,8 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
       return usage_error("too many files:", arg);
     }
   }
-  if (positional != 2) return usage_error("needs two image files", NULL);
+  if (positional != 2)
+    return usage_error("needs two image files", NULL);
   if (a->fail_percent > 100 || a->warn_percent > 100)
     return usage_error("a percentage is over 100", NULL);
   return 0;
@@ -137,13 +146,16 @@ static int is_key_char(char ch) {
  * formats cut or re-wrap long comments (TGA keeps 4 lines of 80 characters),
  * and diffing such remains would list keys that never changed. */
 static int is_well_formed_provenance(const char *text) {
-  if (!is_bumpbake_provenance(text)) return 0;
+  if (!is_bumpbake_provenance(text))
+    return 0;
   for (const char *line = text; *line;) {
     const char *end = strchr(line, '\n');
     size_t n = end ? (size_t)(end - line) : strlen(line);
     size_t k = 0;
-    while (k < n && is_key_char(line[k])) k++;
-    if (n > 0 && (k == 0 || k == n || line[k] != '=')) return 0;
+    while (k < n && is_key_char(line[k]))
+      k++;
+    if (n > 0 && (k == 0 || k == n || line[k] != '='))
+      return 0;
     line = end ? end + 1 : line + n;
   }
   return 1;
@@ -160,8 +172,8 @@ static int write_diff_image(const char *path, bb_image *diff, double max_finite)
   } else if (max_finite > 0) {
     size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
     for (size_t i = 0; i < n; i++)
-      diff->pixels[i] = isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite)
-                                                  : 1.0f;
+      diff->pixels[i] =
+          isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite) : 1.0f;
   }
   bb_error err = {{0}};
   if (bb_image_write(path, diff, &wo, &err) != BB_OK) {
@@ -175,7 +187,8 @@ static double max_finite_value(const bb_image *img) {
   size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
   double m = 0;
   for (size_t i = 0; i < n; i++)
-    if (isfinite(img->pixels[i]) && img->pixels[i] > m) m = img->pixels[i];
+    if (isfinite(img->pixels[i]) && img->pixels[i] > m)
+      m = img->pixels[i];
   return m;
 }
 
@@ -207,9 +220,12 @@ static void json_number(FILE *f, double v) {
 
 static const char *result_name(int code) {
   switch (code) {
-  case COMPARE_PASS: return "PASS";
-  case COMPARE_WARN: return "WARNING";
-  case COMPARE_FAIL: return "FAILURE";
+  case COMPARE_PASS:
+    return "PASS";
+  case COMPARE_WARN:
+    return "WARNING";
+  case COMPARE_FAIL:
+    return "FAILURE";
   }
   return "ERROR";
 }
@@ -234,7 +250,8 @@ static void print_text_report(const compare_args *a, const bb_image *img,
   if (a->warn_enabled)
     printf("  %ld pixels (%.3g%%) over warn %g (allowed %g%%)\n", s->over_warn,
            percent_of(s->over_warn, s->pixels), a->warn_threshold, a->warn_percent);
-  if (prov_count > 0) printf("provenance differs:\n%s", prov_diff);
+  if (prov_count > 0)
+    printf("provenance differs:\n%s", prov_diff);
   printf("%s\n", result_name(code));
 }
 
@@ -246,7 +263,8 @@ static void json_provenance(const char *prov_diff) {
     size_t n = end ? (size_t)(end - line) : strlen(line);
     char buf[600];
     snprintf(buf, sizeof buf, "%.*s", (int)(n < sizeof buf ? n : sizeof buf - 1), line);
-    if (!first) printf(",");
+    if (!first)
+      printf(",");
     json_string(stdout, buf);
     line = end ? end + 1 : line + n;
   }
@@ -254,7 +272,8 @@ static void json_provenance(const char *prov_diff) {
 }
 
 static void print_json_report(const compare_args *a, const bb_image *img,
-                              const bb_compare_stats *s, const char *prov_diff, int code) {
+                              const bb_compare_stats *s, const char *prov_diff,
+                              int code) {
   printf("{\"a\":");
   json_string(stdout, a->path_a);
   printf(",\"b\":");
@@ -287,7 +306,8 @@ static void print_json_report(const compare_args *a, const bb_image *img,
  * exceed its threshold (so with percent 0, a single pixel is enough). */
 static int compare_verdict(const compare_args *a, const bb_compare_stats *s) {
   double pixels = (double)s->pixels;
-  if ((double)s->over_fail > a->fail_percent / 100.0 * pixels) return COMPARE_FAIL;
+  if ((double)s->over_fail > a->fail_percent / 100.0 * pixels)
+    return COMPARE_FAIL;
   if (a->warn_enabled && (double)s->over_warn > a->warn_percent / 100.0 * pixels)
     return COMPARE_WARN;
   return COMPARE_PASS;
@@ -350,8 +370,8 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
   int prov_count = 0;
   if (is_well_formed_provenance(ix->description) &&
       is_well_formed_provenance(iy->description))
-    prov_count = bb_provenance_diff(ix->description, iy->description, prov_diff,
-                                    sizeof prov_diff);
+    prov_count =
+        bb_provenance_diff(ix->description, iy->description, prov_diff, sizeof prov_diff);
   else
     note_malformed_provenance(a, ix, iy);
   int code = compare_verdict(a, &stats);
@@ -361,7 +381,8 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
     print_text_report(a, x, &stats, prov_diff, prov_count, code);
   /* A diff that cannot be written is reported but does not change the
    * verdict: the comparison itself was made. */
-  if (a->diff_path) write_diff_image(a->diff_path, &diff, max_finite_value(&diff));
+  if (a->diff_path)
+    write_diff_image(a->diff_path, &diff, max_finite_value(&diff));
   bb_image_free(&diff);
   return code;
 }
@@ -369,8 +390,10 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
 int bb_cli_compare(int argc, char **argv) {
   compare_args a;
   int parsed = parse_compare_args(argc, argv, &a);
-  if (parsed < 0) return COMPARE_PASS; /* --help */
-  if (parsed > 0) return parsed;
+  if (parsed < 0)
+    return COMPARE_PASS; /* --help */
+  if (parsed > 0)
+    return parsed;
 
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
@@ -401,12 +424,14 @@ int bb_cli_info(int argc, char **argv) {
   const char *path = argv[1];
   bb_image img = {0};
   bb_image_info info = {0};
-  if (read_image(path, &img, &info) != 0) return BB_EXIT_FAILURE;
+  if (read_image(path, &img, &info) != 0)
+    return BB_EXIT_FAILURE;
 
   printf("%s: %d x %d, %d channel%s, %s, %d-bit %s\n", path, img.width, img.height,
          img.channels, img.channels == 1 ? "" : "s", info.format_name,
          info.bits_per_sample, info.is_float ? "float" : "integer");
-  if (info.alpha_channel >= 0) printf("alpha channel: %d\n", info.alpha_channel);
+  if (info.alpha_channel >= 0)
+    printf("alpha channel: %d\n", info.alpha_channel);
   if (is_bumpbake_provenance(info.description)) {
     if (!is_well_formed_provenance(info.description))
       printf("provenance (cut or re-wrapped by the file format):\n");
@@ -414,7 +439,8 @@ int bb_cli_info(int argc, char **argv) {
       printf("provenance:\n");
     printf("%s", info.description);
     size_t n = strlen(info.description);
-    if (n && info.description[n - 1] != '\n') printf("\n");
+    if (n && info.description[n - 1] != '\n')
+      printf("\n");
   } else {
     printf("no bumpbake provenance\n");
     if (info.description && *info.description)

@@ -8,8 +8,10 @@
  * whose subtraction would give NaN) differ by 0; a NaN on either side is the
  * worst possible difference, so a NaN can never hide under a threshold. */
 static double channel_difference(float a, float b) {
-  if (a == b) return 0.0;
-  if (isnan(a) || isnan(b)) return INFINITY;
+  if (a == b)
+    return 0.0;
+  if (isnan(a) || isnan(b))
+    return INFINITY;
   return fabs((double)a - (double)b);
 }
 
@@ -31,17 +33,20 @@ static bb_status check_inputs(const bb_image *a, const bb_image *b, bb_error *er
   return BB_OK;
 }
 
-bb_status bb_compare_images(const bb_image *a, const bb_image *b,
-                            double fail_threshold, double warn_threshold,
-                            bb_compare_stats *stats, bb_image *diff, bb_error *err) {
+bb_status bb_compare_images(const bb_image *a, const bb_image *b, double fail_threshold,
+                            double warn_threshold, bb_compare_stats *stats,
+                            bb_image *diff, bb_error *err) {
   bb_status st = check_inputs(a, b, err);
-  if (st != BB_OK) return st;
-  if (!stats) return bb__fail(err, BB_ERR_ARGUMENT, "compare: stats is NULL");
+  if (st != BB_OK)
+    return st;
+  if (!stats)
+    return bb__fail(err, BB_ERR_ARGUMENT, "compare: stats is NULL");
   if (isnan(fail_threshold) || isnan(warn_threshold))
     return bb__fail(err, BB_ERR_ARGUMENT, "compare: threshold is NaN");
   if (diff) {
     st = bb_image_alloc(diff, a->width, a->height, a->channels, err);
-    if (st != BB_OK) return st;
+    if (st != BB_OK)
+      return st;
   }
 
   memset(stats, 0, sizeof *stats);
@@ -67,12 +72,16 @@ bb_status bb_compare_images(const bb_image *a, const bb_image *b,
         worst_index = p;
         worst_channel = c;
       }
-      if (d > pixel_max) pixel_max = d;
-      if (diff) diff->pixels[p * (size_t)channels + (size_t)c] = (float)d;
+      if (d > pixel_max)
+        pixel_max = d;
+      if (diff)
+        diff->pixels[p * (size_t)channels + (size_t)c] = (float)d;
     }
     /* A pixel is over a threshold when its worst channel is. */
-    if (pixel_max > fail_threshold) over_fail++;
-    if (pixel_max > warn_threshold) over_warn++;
+    if (pixel_max > fail_threshold)
+      over_fail++;
+    if (pixel_max > warn_threshold)
+      over_warn++;
   }
 
   const double values = (double)pixels * (double)channels;

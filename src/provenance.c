@@ -30,7 +30,8 @@ static uint64_t fnv1a_u32(uint64_t h, uint32_t v) {
 
 uint64_t bb_image_hash(const bb_image *img) {
   uint64_t h = FNV64_OFFSET;
-  if (!img) return h;
+  if (!img)
+    return h;
   h = fnv1a_u32(h, (uint32_t)img->width);
   h = fnv1a_u32(h, (uint32_t)img->height);
   h = fnv1a_u32(h, (uint32_t)img->channels);
@@ -55,10 +56,12 @@ typedef struct text {
 } text;
 
 static void text_append(text *t, const char *s, size_t n) {
-  if (t->failed) return;
+  if (t->failed)
+    return;
   if (t->length + n + 1 > t->capacity) {
     size_t cap = t->capacity ? t->capacity : 256;
-    while (t->length + n + 1 > cap) cap *= 2;
+    while (t->length + n + 1 > cap)
+      cap *= 2;
     char *grown = realloc(t->data, cap);
     if (!grown) {
       t->failed = 1;
@@ -95,7 +98,8 @@ static void put_float(text *t, const char *key, float value) {
 static void put_double(text *t, const char *key, double value) {
   char buf[64];
   snprintf(buf, sizeof buf, "%.15g", value);
-  if (strtod(buf, NULL) != value) snprintf(buf, sizeof buf, "%.17g", value);
+  if (strtod(buf, NULL) != value)
+    snprintf(buf, sizeof buf, "%.17g", value);
   put(t, key, buf);
 }
 
@@ -122,7 +126,8 @@ static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
 }
 
 char *bb_provenance_format(const bb_provenance *p) {
-  if (!p) return NULL;
+  if (!p)
+    return NULL;
   text t = {0};
   char hash[32];
   snprintf(hash, sizeof hash, "%016" PRIx64, p->input_hash);
@@ -133,9 +138,11 @@ char *bb_provenance_format(const bb_provenance *p) {
   put(&t, "input_hash", hash);
   put(&t, "output", p->output_kind);
   /* The key order is fixed so two texts line up when read side by side. */
-  if (p->options) put_scale_and_rays(&t, p->options);
+  if (p->options)
+    put_scale_and_rays(&t, p->options);
   put(&t, "rayset", p->rayset_id ? p->rayset_id : "none");
-  if (p->options) put_smoothing_and_tracing(&t, p->options);
+  if (p->options)
+    put_smoothing_and_tracing(&t, p->options);
   put(&t, "channel", bb_channel_name(p->channel));
 
   if (t.failed) {
@@ -157,9 +164,11 @@ typedef struct entry {
  * at the end of the text; lines without '=' come back with key_length 0. */
 static int next_entry(const char **cursor, entry *e) {
   const char *s = *cursor;
-  if (!*s) return 0;
+  if (!*s)
+    return 0;
   const char *end = strchr(s, '\n');
-  if (!end) end = s + strlen(s);
+  if (!end)
+    end = s + strlen(s);
   const char *eq = memchr(s, '=', (size_t)(end - s));
   memset(e, 0, sizeof *e);
   if (eq) {
@@ -167,7 +176,8 @@ static int next_entry(const char **cursor, entry *e) {
     e->key_length = (size_t)(eq - s);
     e->value = eq + 1;
     e->value_length = (size_t)(end - eq - 1);
-    if (e->value_length && e->value[e->value_length - 1] == '\r') e->value_length--;
+    if (e->value_length && e->value[e->value_length - 1] == '\r')
+      e->value_length--;
   }
   *cursor = *end ? end + 1 : end;
   return 1;
@@ -204,17 +214,19 @@ static void append_bounded(char *out, size_t cap, size_t *used, const char *fmt,
     ;
 
 static void append_bounded(char *out, size_t cap, size_t *used, const char *fmt, ...) {
-  if (!out || cap == 0 || *used >= cap - 1) return;
+  if (!out || cap == 0 || *used >= cap - 1)
+    return;
   va_list ap;
   va_start(ap, fmt);
   int n = vsnprintf(out + *used, cap - *used, fmt, ap);
   va_end(ap);
-  if (n < 0) return;
+  if (n < 0)
+    return;
   *used += (size_t)n < cap - *used ? (size_t)n : cap - 1 - *used;
 }
 
-static void report(char *out, size_t cap, size_t *used, const entry *key,
-                   const entry *a, const entry *b) {
+static void report(char *out, size_t cap, size_t *used, const entry *key, const entry *a,
+                   const entry *b) {
   append_bounded(out, cap, used, "%.*s: %.*s -> %.*s\n", (int)key->key_length, key->key,
                  a ? (int)a->value_length : 6, a ? a->value : "(none)",
                  b ? (int)b->value_length : 6, b ? b->value : "(none)");
@@ -227,29 +239,36 @@ static int same_value(const entry *a, const entry *b) {
 
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   size_t used = 0;
-  if (out && cap) out[0] = '\0';
-  if (!a || !b) return 0;
+  if (out && cap)
+    out[0] = '\0';
+  if (!a || !b)
+    return 0;
   int differing = 0;
   entry e, other;
   const char *cursor = a;
   /* Keys of a, in a's order: changed or missing from b. */
   while (next_entry(&cursor, &e)) {
-    if (!e.key_length || is_ignored_key(&e)) continue;
+    if (!e.key_length || is_ignored_key(&e))
+      continue;
     entry first;
     if (find_entry(a, e.key, e.key_length, &first) && first.value != e.value)
       continue; /* a repeated key: only its first occurrence counts */
     int in_b = find_entry(b, e.key, e.key_length, &other);
-    if (in_b && same_value(&e, &other)) continue;
+    if (in_b && same_value(&e, &other))
+      continue;
     report(out, cap, &used, &e, &e, in_b ? &other : NULL);
     differing++;
   }
   /* Keys only b has. */
   cursor = b;
   while (next_entry(&cursor, &e)) {
-    if (!e.key_length || is_ignored_key(&e)) continue;
+    if (!e.key_length || is_ignored_key(&e))
+      continue;
     entry first;
-    if (find_entry(b, e.key, e.key_length, &first) && first.value != e.value) continue;
-    if (find_entry(a, e.key, e.key_length, &other)) continue;
+    if (find_entry(b, e.key, e.key_length, &first) && first.value != e.value)
+      continue;
+    if (find_entry(a, e.key, e.key_length, &other))
+      continue;
     report(out, cap, &used, &e, NULL, &e);
     differing++;
   }

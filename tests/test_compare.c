@@ -1,4 +1,5 @@
-/* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a process. */
+/* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a
+ * process. */
 #include "bumpbake.h"
 
 #include <criterion/criterion.h>
@@ -118,7 +119,8 @@ Test(compare, accumulates_in_double) {
   bb_image a, b;
   cr_assert_eq(bb_image_alloc(&a, W, H, 1, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&b, W, H, 1, NULL), BB_OK);
-  for (size_t i = 0; i < (size_t)W * H; i++) b.pixels[i] = 1e-7f;
+  for (size_t i = 0; i < (size_t)W * H; i++)
+    b.pixels[i] = 1e-7f;
   b.pixels[0] = 2.0f;
   bb_compare_stats s;
   cr_assert_eq(bb_compare_images(&a, &b, 1, 1, &s, NULL, NULL), BB_OK);
@@ -162,7 +164,8 @@ static void make_tmp_dir(void) {
 static void remove_tmp_dir(void) {
   char cmd[128];
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
-  if (system(cmd) != 0) fprintf(stderr, "cannot remove %s\n", tmp_dir);
+  if (system(cmd) != 0)
+    fprintf(stderr, "cannot remove %s\n", tmp_dir);
 }
 
 static const char *tmp_file(const char *name) {
@@ -180,8 +183,8 @@ static const char *write_image(const char *name, int w, int h, int c, const floa
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, w, h, c, NULL), BB_OK);
   memcpy(img.pixels, values, sizeof(float) * (size_t)(w * h * c));
-  bb_write_options wo = {.depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT,
-                         .description = description};
+  bb_write_options wo = {
+      .depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT, .description = description};
   const char *path = tmp_file(name);
   bb_error err = {{0}};
   cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
@@ -194,13 +197,15 @@ static float ramp[16];
 static const char *ramp_with(const char *name, int changed, float delta) {
   float v[16];
   memcpy(v, ramp, sizeof v);
-  for (int i = 0; i < changed; i++) v[i * 5 % 16] += delta;
+  for (int i = 0; i < changed; i++)
+    v[i * 5 % 16] += delta;
   return write_image(name, 4, 4, 1, v, NULL);
 }
 
 static void cli_setup(void) {
   make_tmp_dir();
-  for (int i = 0; i < 16; i++) ramp[i] = (float)i / 16.0f;
+  for (int i = 0; i < 16; i++)
+    ramp[i] = (float)i / 16.0f;
 }
 
 TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 30);
@@ -220,8 +225,8 @@ Test(compare_cli, small_differences_warn_with_exit_1) {
   cr_assert_not_null(strstr(out, "3 pixels (18.8%) over warn"), "%s", out);
   cr_assert_not_null(strstr(out, "WARNING"), "%s", out);
   /* Warnings allowed for up to 20% of the pixels: 3 of 16 is 18.75%. */
-  code = run(out, sizeof out, "compare %s %s --fail 0.1 --warn 0.001 --warnpercent 20",
-             a, b);
+  code = run(out, sizeof out, "compare %s %s --fail 0.1 --warn 0.001 --warnpercent 20", a,
+             b);
   cr_assert_eq(code, 0, "%s", out);
 }
 
@@ -241,7 +246,8 @@ Test(compare_cli, failpercent_allows_that_share_of_pixels) {
   /* 2 of 16 pixels = 12.5%: failure needs MORE than failpercent. */
   cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12.5", a, b), 0, "%s",
                out);
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12", a, b), 2, "%s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12", a, b), 2, "%s",
+               out);
   cr_assert_eq(run(out, sizeof out, "compare %s %s --fail 0.5", a, b), 0,
                "a difference equal to the threshold is not over it: %s", out);
 }
@@ -278,8 +284,8 @@ Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
 Test(compare_cli, diff_exr_holds_raw_absolute_differences) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 2, 0.125f);
   char out[4096];
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --diff %s", a, b, tmp_file("d.exr")), 2,
-               "%s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s --diff %s", a, b, tmp_file("d.exr")),
+               2, "%s", out);
   bb_image d = {0};
   cr_assert_eq(bb_image_read(tmp_file("d.exr"), &d, NULL, NULL), BB_OK);
   cr_assert_eq(d.width, 4);
@@ -327,8 +333,11 @@ static char *provenance_with_scale(float scale) {
   o.height_scale = scale;
   o.rays = 64;
   o.power = 1;
-  bb_provenance p = {.command = "test", .input_name = "ramp.png", .output_kind = "normal",
-                     .options = &o, .rayset_id = "test"};
+  bb_provenance p = {.command = "test",
+                     .input_name = "ramp.png",
+                     .output_kind = "normal",
+                     .options = &o,
+                     .rayset_id = "test"};
   return bb_provenance_format(&p);
 }
 
@@ -384,7 +393,8 @@ Test(compare_cli, damaged_provenance_is_not_diffed) {
 
 Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
   float v[256];
-  for (int i = 0; i < 256; i++) v[i] = (float)((i * 37) % 256) / 255.0f;
+  for (int i = 0; i < 256; i++)
+    v[i] = (float)((i * 37) % 256) / 255.0f;
   const char *height = write_image("h.png", 16, 16, 1, v, NULL);
   const char *ssbump = tmp_file("ssbump.exr");
   char out[4096];
@@ -395,10 +405,9 @@ Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
   cr_assert_eq(code, 0, "bake failed: %s", out);
   cr_assert_eq(run(out, sizeof out, "info %s", ssbump), 0, "%s", out);
   cr_assert_not_null(strstr(out, "16 x 16, 4 channels, openexr"), "%s", out);
-  static const char *const lines[] = {"\ninput=h.png\n", "\noutput=ssbump\n",
-                                      "\nscale=5\n",      "\nrays=16\n",
-                                      "\npower=2\n",      "\nbasis=hl2+z\n",
-                                      "\naddressing=clamp\n"};
+  static const char *const lines[] = {
+      "\ninput=h.png\n", "\noutput=ssbump\n", "\nscale=5\n",         "\nrays=16\n",
+      "\npower=2\n",     "\nbasis=hl2+z\n",   "\naddressing=clamp\n"};
   for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
     cr_assert_not_null(strstr(out, lines[i]), "missing %s in:\n%s", lines[i] + 1, out);
   bb_image img = {0};

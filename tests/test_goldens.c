@@ -1,4 +1,5 @@
-/* test_goldens.c: re-bakes every case of fixtures/goldens/cases.txt and compares it with its golden.
+/* test_goldens.c: re-bakes every case of fixtures/goldens/cases.txt and compares it with
+ * its golden.
  *
  * Tolerances (the bake is deterministic, bit-identical for any thread count,
  * so these only leave room for compiler and libm differences between
@@ -48,10 +49,12 @@ static const char *fixtures_dir(void) {
 /* Copies field s (up to a '|' or the end) into out, trimmed of spaces, and
  * returns the position after the '|' (NULL at the end of the line). */
 static const char *take_field(const char *s, char *out, size_t cap) {
-  while (*s == ' ' || *s == '\t') s++;
+  while (*s == ' ' || *s == '\t')
+    s++;
   const char *end = strchr(s, '|');
   size_t n = end ? (size_t)(end - s) : strlen(s);
-  while (n && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\n' || s[n - 1] == '\r'))
+  while (n &&
+         (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\n' || s[n - 1] == '\r'))
     n--;
   snprintf(out, cap, "%.*s", (int)n, s);
   return end ? end + 1 : NULL;
@@ -60,10 +63,14 @@ static const char *take_field(const char *s, char *out, size_t cap) {
 static int parse_case(const char *line, golden_case *c) {
   memset(c, 0, sizeof *c);
   const char *s = take_field(line, c->name, sizeof c->name);
-  if (s) s = take_field(s, c->input, sizeof c->input);
-  if (s) s = take_field(s, c->command, sizeof c->command);
-  if (s) s = take_field(s, c->arguments, sizeof c->arguments);
-  if (s) s = take_field(s, c->outputs, sizeof c->outputs);
+  if (s)
+    s = take_field(s, c->input, sizeof c->input);
+  if (s)
+    s = take_field(s, c->command, sizeof c->command);
+  if (s)
+    s = take_field(s, c->arguments, sizeof c->arguments);
+  if (s)
+    s = take_field(s, c->outputs, sizeof c->outputs);
   return c->name[0] && c->input[0] && c->command[0] && c->outputs[0];
 }
 
@@ -73,11 +80,13 @@ static int load_cases(golden_case *cases) {
   char path[512], line[1024];
   snprintf(path, sizeof path, "%s/goldens/cases.txt", fixtures_dir());
   FILE *f = fopen(path, "r");
-  if (!f) return -1;
+  if (!f)
+    return -1;
   int n = 0;
   while (fgets(line, sizeof line, f)) {
     const char *s = line + strspn(line, " \t");
-    if (*s == '#' || *s == '\n' || *s == '\0') continue;
+    if (*s == '#' || *s == '\n' || *s == '\0')
+      continue;
     if (n == MAX_CASES || !parse_case(s, &cases[n])) {
       n = -1;
       break;
@@ -101,7 +110,8 @@ static void for_each_output(const golden_case *c,
   char list[FIELD];
   snprintf(list, sizeof list, "%s", c->outputs);
   char *save = NULL;
-  for (char *kind = strtok_r(list, " \t", &save); kind; kind = strtok_r(NULL, " \t", &save))
+  for (char *kind = strtok_r(list, " \t", &save); kind;
+       kind = strtok_r(NULL, " \t", &save))
     fn(c, kind, user);
 }
 
@@ -118,7 +128,8 @@ static int run(char *out, size_t cap, const char *fmt, ...) {
   char shell[4200];
   snprintf(shell, sizeof shell, "( %s ) 2>&1", cmd); /* stderr of every command in cmd */
   FILE *p = popen(shell, "r");
-  if (!p) return -1;
+  if (!p)
+    return -1;
   size_t used = strlen(out);
   size_t n = fread(out + used, 1, cap - used - 1, p);
   out[used + n] = '\0';
@@ -171,10 +182,13 @@ static int rebake(const golden_case *c, const char *dir, char *log, size_t cap) 
   snprintf(copy, sizeof copy, "%s/%s", dir, c->input);
   snprintf(stem, sizeof stem, "%s", copy);
   char *dot = strrchr(stem, '.');
-  if (dot) *dot = '\0';
+  if (dot)
+    *dot = '\0';
   expand_arguments(c, copy, args, sizeof args);
-  return run(log, cap, "cp '%s' '%s' && '%s' height2ssbump%s && mv '%s-ssbump.tga' '%s/%s_ssbump.tga'",
-             input, copy, bin, args, stem, dir, c->name);
+  return run(
+      log, cap,
+      "cp '%s' '%s' && '%s' height2ssbump%s && mv '%s-ssbump.tga' '%s/%s_ssbump.tga'",
+      input, copy, bin, args, stem, dir, c->name);
 }
 
 typedef struct comparison {
@@ -193,14 +207,16 @@ static void compare_output(const golden_case *c, const char *kind, void *user) {
   int code = run(out, sizeof out, "'%s' compare '%s/goldens/%s' '%s/%s' --fail %s",
                  env_or("BB_BIN", "build/bumpbake"), fixtures_dir(), name, cmp->dir, name,
                  tolerance);
-  if (code == 0) return;
+  if (code == 0)
+    return;
   cmp->failures++;
   size_t used = strlen(cmp->report);
   /* Same provenance means same input and parameters: the code changed. */
-  const char *hint = code == 2 && !strstr(out, "provenance differs")
-                         ? "(provenance matches: same input and parameters, so the bake's "
-                           "code changed)\n"
-                         : "";
+  const char *hint =
+      code == 2 && !strstr(out, "provenance differs")
+          ? "(provenance matches: same input and parameters, so the bake's "
+            "code changed)\n"
+          : "";
   snprintf(cmp->report + used, sizeof cmp->report - used,
            "\n--- golden %s, output %s: compare exit %d (tolerance --fail %s)\n%s%s",
            c->name, kind, code, tolerance, out, hint);
@@ -211,7 +227,8 @@ static void compare_output(const golden_case *c, const char *kind, void *user) {
 ParameterizedTestParameters(goldens, rebake_matches_golden) {
   golden_case buffer[MAX_CASES];
   int n = load_cases(buffer);
-  if (n <= 0) return cr_make_param_array(golden_case, NULL, 0);
+  if (n <= 0)
+    return cr_make_param_array(golden_case, NULL, 0);
   /* Criterion copies parameters into each test process: cr_malloc memory. */
   golden_case *cases = cr_malloc(sizeof *cases * (size_t)n);
   memcpy(cases, buffer, sizeof *cases * (size_t)n);
@@ -224,7 +241,8 @@ ParameterizedTest(golden_case *c, goldens, rebake_matches_golden, .timeout = 30)
   char log[8192] = "";
   int code = rebake(c, dir, log, sizeof log);
   comparison cmp = {.dir = dir};
-  if (code == 0) for_each_output(c, compare_output, &cmp);
+  if (code == 0)
+    for_each_output(c, compare_output, &cmp);
   char rm[128] = "";
   run(rm, sizeof rm, "rm -rf '%s'", dir);
   cr_assert_eq(code, 0, "golden %s: re-bake failed (exit %d):\n%s", c->name, code, log);
@@ -243,11 +261,12 @@ static void check_golden_exists(const golden_case *c, const char *kind, void *us
   output_name(c, kind, name, sizeof name);
   snprintf(path, sizeof path, "%s/goldens/%s", fixtures_dir(), name);
   struct stat st;
-  if (stat(path, &st) == 0 && st.st_size > 0 && st.st_size < 1024 * 1024) return;
+  if (stat(path, &st) == 0 && st.st_size > 0 && st.st_size < 1024 * 1024)
+    return;
   e->missing++;
   size_t used = strlen(e->report);
-  snprintf(e->report + used, sizeof e->report - used, "\n  %s (missing, empty or >= 1 MB)",
-           path);
+  snprintf(e->report + used, sizeof e->report - used,
+           "\n  %s (missing, empty or >= 1 MB)", path);
 }
 
 /* Guards the parameterized test: a case list that fails to load would make
@@ -255,7 +274,8 @@ static void check_golden_exists(const golden_case *c, const char *kind, void *us
 Test(goldens, case_list_loads_and_every_golden_exists) {
   golden_case cases[MAX_CASES];
   int n = load_cases(cases);
-  cr_assert_gt(n, 0, "cannot read cases from %s/goldens/cases.txt (or a line is malformed)",
+  cr_assert_gt(n, 0,
+               "cannot read cases from %s/goldens/cases.txt (or a line is malformed)",
                fixtures_dir());
   existence e = {0};
   for (int i = 0; i < n; i++) {

@@ -67,8 +67,8 @@ Test(provenance, hash_is_fnv1a_of_little_endian_size_and_float_bits) {
   float px[2] = {0.5f, -2.0f};
   bb_image img = {.width = 2, .height = 1, .channels = 1, .pixels = px};
   /* 0.5f = 0x3f000000, -2.0f = 0xc0000000, little-endian. */
-  const unsigned char bytes[] = {2, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0,
-                                 0, 0, 0, 0x3f, 0, 0, 0, 0xc0};
+  const unsigned char bytes[] = {2, 0, 0, 0, 1, 0,    0, 0, 1, 0,
+                                 0, 0, 0, 0, 0, 0x3f, 0, 0, 0, 0xc0};
   cr_assert_eq(bb_image_hash(&img), reference_fnv1a(bytes, sizeof bytes));
 }
 
@@ -96,10 +96,23 @@ Test(provenance, format_lists_every_key_in_order) {
   bb_provenance p = sample_provenance(&o);
   char *text = bb_provenance_format(&p);
   cr_assert_not_null(text);
-  static const char *const keys[] = {
-      "bumpbake_version", "command", "input", "input_hash", "output", "scale",
-      "rays", "rayset", "filter_radius", "filter_threshold", "bias", "power",
-      "basis", "normal_filter", "normal_y", "addressing", "channel"};
+  static const char *const keys[] = {"bumpbake_version",
+                                     "command",
+                                     "input",
+                                     "input_hash",
+                                     "output",
+                                     "scale",
+                                     "rays",
+                                     "rayset",
+                                     "filter_radius",
+                                     "filter_threshold",
+                                     "bias",
+                                     "power",
+                                     "basis",
+                                     "normal_filter",
+                                     "normal_y",
+                                     "addressing",
+                                     "channel"};
   const char *line = text;
   for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
     size_t n = strlen(keys[i]);
@@ -111,7 +124,8 @@ Test(provenance, format_lists_every_key_in_order) {
   }
   cr_assert_eq(*line, '\0', "no lines after channel");
   char buf[256];
-  cr_assert_str_eq(value_of(text, "bumpbake_version", buf, sizeof buf), BB_VERSION_STRING);
+  cr_assert_str_eq(value_of(text, "bumpbake_version", buf, sizeof buf),
+                   BB_VERSION_STRING);
   cr_assert_str_eq(value_of(text, "input_hash", buf, sizeof buf), "0123456789abcdef");
   cr_assert_str_eq(value_of(text, "output", buf, sizeof buf), "ssbump");
   cr_assert_str_eq(value_of(text, "scale", buf, sizeof buf), "16");
@@ -140,7 +154,8 @@ Test(provenance, floats_round_trip_exactly) {
   cr_assert_eq(strtof(value_of(text, "scale", buf, sizeof buf), NULL), o.height_scale);
   cr_assert_eq(strtof(value_of(text, "filter_threshold", buf, sizeof buf), NULL),
                o.smooth.threshold);
-  cr_assert_eq(strtod(value_of(text, "bias", buf, sizeof buf), NULL), o.trace.bias_texels);
+  cr_assert_eq(strtod(value_of(text, "bias", buf, sizeof buf), NULL),
+               o.trace.bias_texels);
   cr_assert_str_eq(value_of(text, "power", buf, sizeof buf), "2.5");
   free(text);
 }

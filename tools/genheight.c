@@ -33,8 +33,9 @@ static uint32_t mix32(uint32_t x) {
 
 /* Uniform value in [0, 1) for lattice point (ix, iy) of one octave. */
 static double lattice_value(uint32_t seed, int octave, int ix, int iy) {
-  uint32_t h = mix32(seed ^ mix32((uint32_t)octave * 0x9e3779b9U ^
-                                  mix32((uint32_t)ix ^ mix32((uint32_t)iy + 0x632be5abU))));
+  uint32_t h =
+      mix32(seed ^ mix32((uint32_t)octave * 0x9e3779b9U ^
+                         mix32((uint32_t)ix ^ mix32((uint32_t)iy + 0x632be5abU))));
   return (double)(h >> 8) / 16777216.0;
 }
 
@@ -78,9 +79,12 @@ static double noise_height(int x, int y, int width, int height, uint32_t seed) {
   double sum = 0, amplitude = 1;
   for (int octave = 0; octave < 5; octave++) {
     double per_texel = 4.0 * (1 << octave) / shorter;
-    int cells_x = (int)lround(per_texel * width), cells_y = (int)lround(per_texel * height);
-    if (cells_x < 1) cells_x = 1;
-    if (cells_y < 1) cells_y = 1;
+    int cells_x = (int)lround(per_texel * width),
+        cells_y = (int)lround(per_texel * height);
+    if (cells_x < 1)
+      cells_x = 1;
+    if (cells_y < 1)
+      cells_y = 1;
     sum += amplitude * periodic_value_noise(u, v, cells_x, cells_y, seed, octave);
     amplitude *= 0.5;
   }
@@ -98,8 +102,10 @@ static double noise_height(int x, int y, int width, int height, uint32_t seed) {
  * even, so both the shift pattern and the bricks repeat once per image. */
 static double bricks_height(int x, int y, int width, int height, uint32_t seed) {
   int columns = (int)lround(width / 32.0), rows = 2 * (int)lround(height / 32.0);
-  if (columns < 1) columns = 1;
-  if (rows < 2) rows = 2;
+  if (columns < 1)
+    columns = 1;
+  if (rows < 2)
+    rows = 2;
   double brick_w = (double)width / columns, brick_h = (double)height / rows;
   double px = x + 0.5, py = y + 0.5;
   int row = (int)floor(py / brick_h);
@@ -110,9 +116,11 @@ static double bricks_height(int x, int y, int width, int height, uint32_t seed) 
   double edge = fmin(fmin(u, brick_w - u), fmin(v, brick_h - v));
   /* Each brick face sits at its own height, so bricks are told apart. */
   double face = 0.85 + 0.15 * lattice_value(seed, 99, positive_mod(column, columns), row);
-  if (edge <= MORTAR_HALF_TEXELS) return MORTAR_HEIGHT;
+  if (edge <= MORTAR_HALF_TEXELS)
+    return MORTAR_HEIGHT;
   double t = (edge - MORTAR_HALF_TEXELS) / BEVEL_TEXELS;
-  if (t >= 1) return face;
+  if (t >= 1)
+    return face;
   /* Rounded bevel: quarter circle profile from mortar up to the face. */
   return MORTAR_HEIGHT + (face - MORTAR_HEIGHT) * sqrt(1 - (1 - t) * (1 - t));
 }
@@ -134,9 +142,12 @@ static double pit_height(int x, int y, int width, int height, uint32_t seed) {
 typedef double (*height_fn)(int x, int y, int width, int height, uint32_t seed);
 
 static height_fn generator_named(const char *kind) {
-  if (strcmp(kind, "noise") == 0) return noise_height;
-  if (strcmp(kind, "bricks") == 0) return bricks_height;
-  if (strcmp(kind, "pit") == 0) return pit_height;
+  if (strcmp(kind, "noise") == 0)
+    return noise_height;
+  if (strcmp(kind, "bricks") == 0)
+    return bricks_height;
+  if (strcmp(kind, "pit") == 0)
+    return pit_height;
   return NULL;
 }
 
@@ -148,14 +159,17 @@ static void normalise(bb_image *img) {
     lo = fminf(lo, img->pixels[i]);
     hi = fmaxf(hi, img->pixels[i]);
   }
-  if (hi <= lo) return;
-  for (size_t i = 0; i < n; i++) img->pixels[i] = (img->pixels[i] - lo) / (hi - lo);
+  if (hi <= lo)
+    return;
+  for (size_t i = 0; i < n; i++)
+    img->pixels[i] = (img->pixels[i] - lo) / (hi - lo);
 }
 
 static int parse_side(const char *s, int *out) {
   char *end;
   long v = strtol(s, &end, 10);
-  if (end == s || *end || v < 1 || v > MAX_SIDE) return 1;
+  if (end == s || *end || v < 1 || v > MAX_SIDE)
+    return 1;
   *out = (int)v;
   return 0;
 }
@@ -181,9 +195,11 @@ static int usage(const char *reason) {
 }
 
 int main(int argc, char **argv) {
-  if (argc != 5 && argc != 7) return usage("wrong number of arguments");
+  if (argc != 5 && argc != 7)
+    return usage("wrong number of arguments");
   height_fn fn = generator_named(argv[1]);
-  if (!fn) return usage("unknown kind (noise, bricks, pit)");
+  if (!fn)
+    return usage("unknown kind (noise, bricks, pit)");
   int width, height;
   if (parse_side(argv[2], &width) || parse_side(argv[3], &height))
     return usage("WIDTH and HEIGHT must be 1..4096");
@@ -210,9 +226,10 @@ int main(int argc, char **argv) {
   char description[160];
   snprintf(description, sizeof description, "genheight %s %d %d --seed %lu", argv[1],
            width, height, seed);
-  bb_write_options wo = {.depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT,
-                         .description = description};
-  if (wants_16_bits(out)) wo.depth = BB_DEPTH_16;
+  bb_write_options wo = {
+      .depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT, .description = description};
+  if (wants_16_bits(out))
+    wo.depth = BB_DEPTH_16;
   bb_status st = bb_image_write(out, &img, &wo, &err);
   bb_image_free(&img);
   if (st != BB_OK) {
