@@ -12,8 +12,11 @@
  * The binary comes from BB_BIN (default build/bumpbake), the fixtures from
  * BB_FIXTURES (default fixtures). Regenerate goldens with `make goldens`.
  */
+#include "bumpbake.h"
+
 #include <criterion/criterion.h>
 #include <criterion/parameterized.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -289,4 +292,85 @@ Test(goldens, case_list_loads_and_every_golden_exists) {
     for_each_output(&cases[i], check_golden_exists, &e);
   }
   cr_assert_eq(e.missing, 0, "goldens to regenerate with `make goldens`:%s", e.report);
+}
+
+/* ------------------------------------------------- synthetic fixture maps */
+
+/* build/tools/genheight next to the binary under test. */
+static void genheight_path(char *out, size_t cap) {
+  char bin[512];
+  snprintf(bin, sizeof bin, "%s", env_or("BB_BIN", "build/bumpbake"));
+  char *slash = strrchr(bin, '/');
+  if (slash)
+    slash[1] = '\0';
+  else
+    bin[0] = '\0';
+  snprintf(out, cap, "%stools/genheight", bin);
+}
+
+/* The committed synthetic fixtures are exactly what fixtures/SOURCES.md's
+ * commands make, so anyone can rebuild or extend them. */
+Test(fixtures, genheight_remakes_the_committed_maps_exactly) {
+  static const char *const maps[][3] = {
+      {"noise", "96", "80"}, {"bricks", "128", "64"}, {"pit", "65", "65"}};
+  char dir[] = "/tmp/bb-fixtures-XXXXXX", gen[600], log[8192] = "";
+  cr_assert_not_null(mkdtemp(dir));
+  genheight_path(gen, sizeof gen);
+  for (size_t i = 0; i < sizeof maps / sizeof maps[0]; i++) {
+    char name[64];
+    snprintf(name, sizeof name, "%s_%sx%s.png", maps[i][0], maps[i][1], maps[i][2]);
+    int code = run(log, sizeof log,
+                   "'%s' %s %s %s '%s/%s' && '%s' compare '%s/%s' '%s/%s' --fail 0", gen,
+                   maps[i][0], maps[i][1], maps[i][2], dir, name,
+                   env_or("BB_BIN", "build/bumpbake"), fixtures_dir(), name, dir, name);
+    cr_expect_eq(code, 0, "%s differs from a fresh genheight run:\n%s", name, log);
+  }
+  char rm[128] = "";
+  run(rm, sizeof rm, "rm -rf '%s'", dir);
+}
+
+/* Mean |h(x+1) - h(x)| across the wrap-around edge divided by the mean over
+ * interior steps (and the same for rows): about 1 when the map tiles. */
+static void seam_ratios(const bb_image *h, double *horizontal, double *vertical) {
+  double seam_x = 0, step_x = 0, seam_y = 0, step_y = 0;
+  for (int y = 0; y < h->height; y++)
+    for (int x = 0; x < h->width; x++) {
+      float v = *bb_image_texel(h, x, y);
+      double dx = fabs(*bb_image_texel(h, (x + 1) % h->width, y) - v);
+      double dy = fabs(*bb_image_texel(h, x, (y + 1) % h->height) - v);
+      if (x == h->width - 1)
+        seam_x += dx;
+      else
+        step_x += dx;
+      if (y == h->height - 1)
+        seam_y += dy;
+      else
+        step_y += dy;
+    }
+  *horizontal = (seam_x / h->height) / (step_x / (h->height * (h->width - 1.0)));
+  *vertical = (seam_y / h->width) / (step_y / (h->width * (h->height - 1.0)));
+}
+
+Test(fixtures, genheight_noise_tiles_at_odd_sizes) {
+  static const int sizes[][2] = {{37, 53}, {96, 80}, {129, 31}};
+  char dir[] = "/tmp/bb-fixtures-XXXXXX", gen[600];
+  cr_assert_not_null(mkdtemp(dir));
+  genheight_path(gen, sizeof gen);
+  for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+    char path[700], log[2048] = "";
+    snprintf(path, sizeof path, "%s/n%zu.exr", dir, i);
+    cr_assert_eq(run(log, sizeof log, "'%s' noise %d %d '%s' --seed 3", gen, sizes[i][0],
+                     sizes[i][1], path),
+                 0, "%s", log);
+    bb_image h = {0};
+    cr_assert_eq(bb_image_read(path, &h, NULL, NULL), BB_OK);
+    double rh, rv;
+    seam_ratios(&h, &rh, &rv);
+    bb_image_free(&h);
+    cr_expect(rh > 0.5 && rh < 2 && rv > 0.5 && rv < 2,
+              "%dx%d: seam/interior step ratio %.2f horizontal, %.2f vertical",
+              sizes[i][0], sizes[i][1], rh, rv);
+  }
+  char rm[128] = "";
+  run(rm, sizeof rm, "rm -rf '%s'", dir);
 }
