@@ -1,0 +1,276 @@
+/* provenance.c: how an output was made, as "key=value" lines stored in the file.
+ *
+ * The text is the contract between a bake and a later `bumpbake compare`: a
+ * golden that no longer matches names the parameters that changed. So every
+ * line is "key=value\n", keys are always present in the same order, and
+ * numbers print so that parsing them gives back the same value.
+ */
+#include "internal.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------- hash */
+
+#define FNV64_OFFSET 0xcbf29ce484222325ULL
+#define FNV64_PRIME 0x100000001b3ULL
+
+static uint64_t fnv1a_u32(uint64_t h, uint32_t v) {
+  /* Little-endian byte order whatever the host, so a hash recorded on one
+   * machine can be checked on another. */
+  for (int i = 0; i < 4; i++) {
+    h ^= (v >> (8 * i)) & 0xffu;
+    h *= FNV64_PRIME;
+  }
+  return h;
+}
+
+uint64_t bb_image_hash(const bb_image *img) {
+  uint64_t h = FNV64_OFFSET;
+  if (!img)
+    return h;
+  h = fnv1a_u32(h, (uint32_t)img->width);
+  h = fnv1a_u32(h, (uint32_t)img->height);
+  h = fnv1a_u32(h, (uint32_t)img->channels);
+  if (!img->pixels || img->width <= 0 || img->height <= 0 || img->channels <= 0)
+    return h;
+  size_t count = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+  for (size_t i = 0; i < count; i++) {
+    uint32_t bits;
+    memcpy(&bits, &img->pixels[i], sizeof bits);
+    h = fnv1a_u32(h, bits);
+  }
+  return h;
+}
+
+/* ---------------------------------------------------------------- format */
+
+/* A growable text buffer; `failed` sticks once an allocation fails. */
+typedef struct text {
+  char *data;
+  size_t length, capacity;
+  int failed;
+} text;
+
+static void text_append(text *t, const char *s, size_t n) {
+  if (t->failed)
+    return;
+  if (t->length + n + 1 > t->capacity) {
+    size_t cap = t->capacity ? t->capacity : 256;
+    while (t->length + n + 1 > cap)
+      cap *= 2;
+    char *grown = realloc(t->data, cap);
+    if (!grown) {
+      t->failed = 1;
+      return;
+    }
+    t->data = grown;
+    t->capacity = cap;
+  }
+  memcpy(t->data + t->length, s, n);
+  t->length += n;
+  t->data[t->length] = '\0';
+}
+
+/* Appends "key=value\n". A value with line breaks (a command line pasted
+ * with newlines) would split the record, so they become spaces. */
+static void put(text *t, const char *key, const char *value) {
+  text_append(t, key, strlen(key));
+  text_append(t, "=", 1);
+  for (const char *s = value ? value : ""; *s; s++) {
+    char ch = (*s == '\n' || *s == '\r') ? ' ' : *s;
+    text_append(t, &ch, 1);
+  }
+  text_append(t, "\n", 1);
+}
+
+static void put_float(text *t, const char *key, float value) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%.9g", (double)value); /* 9 digits: any float round-trips */
+  put(t, key, buf);
+}
+
+/* Doubles print in the shortest of %.15g / %.17g that reads back exactly, so
+ * 0.55 stays "0.55" instead of "0.55000000000000004". */
+static void put_double(text *t, const char *key, double value) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%.15g", value);
+  if (strtod(buf, NULL) != value)
+    snprintf(buf, sizeof buf, "%.17g", value);
+  put(t, key, buf);
+}
+
+static void put_int(text *t, const char *key, long value) {
+  char buf[32];
+  snprintf(buf, sizeof buf, "%ld", value);
+  put(t, key, buf);
+}
+
+static void put_scale_and_rays(text *t, const bb_bake_options *o) {
+  put_float(t, "scale", o->height_scale);
+  put_int(t, "rays", o->rays);
+}
+
+static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
+  put_int(t, "filter_radius", o->smooth.radius_texels);
+  put_float(t, "filter_threshold", o->smooth.threshold);
+  put_double(t, "bias", o->trace.bias_texels);
+  put_double(t, "power", o->power);
+  put(t, "basis", bb_basis_name(o->basis));
+  put(t, "normal_filter", bb_normal_filter_name(o->normal_filter));
+  put(t, "normal_y", o->normal_y_up ? "up" : "down");
+  put(t, "addressing", o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+}
+
+char *bb_provenance_format(const bb_provenance *p) {
+  if (!p)
+    return NULL;
+  text t = {0};
+  char hash[32];
+  snprintf(hash, sizeof hash, "%016" PRIx64, p->input_hash);
+
+  put(&t, "bumpbake_version", BB_VERSION_STRING);
+  put(&t, "command", p->command);
+  put(&t, "input", p->input_name);
+  put(&t, "input_hash", hash);
+  put(&t, "output", p->output_kind);
+  /* The key order is fixed so two texts line up when read side by side. */
+  if (p->options)
+    put_scale_and_rays(&t, p->options);
+  put(&t, "rayset", p->rayset_id ? p->rayset_id : "none");
+  if (p->options)
+    put_smoothing_and_tracing(&t, p->options);
+  put(&t, "channel", bb_channel_name(p->channel));
+
+  if (t.failed) {
+    free(t.data);
+    return NULL;
+  }
+  return t.data;
+}
+
+/* ------------------------------------------------------------------ diff */
+
+/* One "key=value" line of a provenance text, as pointers into it. */
+typedef struct entry {
+  const char *key, *value;
+  size_t key_length, value_length;
+} entry;
+
+/* Reads the line starting at *cursor into e and advances past it. Returns 0
+ * at the end of the text; lines without '=' come back with key_length 0. */
+static int next_entry(const char **cursor, entry *e) {
+  const char *s = *cursor;
+  if (!*s)
+    return 0;
+  const char *end = strchr(s, '\n');
+  if (!end)
+    end = s + strlen(s);
+  const char *eq = memchr(s, '=', (size_t)(end - s));
+  memset(e, 0, sizeof *e);
+  if (eq) {
+    e->key = s;
+    e->key_length = (size_t)(eq - s);
+    e->value = eq + 1;
+    e->value_length = (size_t)(end - eq - 1);
+    if (e->value_length && e->value[e->value_length - 1] == '\r')
+      e->value_length--;
+  }
+  *cursor = *end ? end + 1 : end;
+  return 1;
+}
+
+/* The first entry of text whose key is key; 0 when there is none. */
+static int find_entry(const char *text_, const char *key, size_t key_length, entry *out) {
+  entry e;
+  const char *cursor = text_;
+  while (next_entry(&cursor, &e))
+    if (e.key_length == key_length && memcmp(e.key, key, key_length) == 0) {
+      *out = e;
+      return 1;
+    }
+  return 0;
+}
+
+static int is_ignored_key(const entry *e) {
+  /* The command line names temporary paths and "output" the map kind; both
+   * differ between a golden and a re-bake without any pixel changing. */
+  static const char *const ignored[] = {"command", "output"};
+  for (size_t i = 0; i < sizeof ignored / sizeof ignored[0]; i++)
+    if (e->key_length == strlen(ignored[i]) &&
+        memcmp(e->key, ignored[i], e->key_length) == 0)
+      return 1;
+  return 0;
+}
+
+/* Appends to out (capacity cap, always NUL-terminated) without overflowing. */
+static void append_bounded(char *out, size_t cap, size_t *used, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static void append_bounded(char *out, size_t cap, size_t *used, const char *fmt, ...) {
+  if (!out || cap == 0 || *used >= cap - 1)
+    return;
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(out + *used, cap - *used, fmt, ap);
+  va_end(ap);
+  if (n < 0)
+    return;
+  *used += (size_t)n < cap - *used ? (size_t)n : cap - 1 - *used;
+}
+
+static void report(char *out, size_t cap, size_t *used, const entry *key, const entry *a,
+                   const entry *b) {
+  append_bounded(out, cap, used, "%.*s: %.*s -> %.*s\n", (int)key->key_length, key->key,
+                 a ? (int)a->value_length : 6, a ? a->value : "(none)",
+                 b ? (int)b->value_length : 6, b ? b->value : "(none)");
+}
+
+static int same_value(const entry *a, const entry *b) {
+  return a->value_length == b->value_length &&
+         memcmp(a->value, b->value, a->value_length) == 0;
+}
+
+int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
+  size_t used = 0;
+  if (out && cap)
+    out[0] = '\0';
+  if (!a || !b)
+    return 0;
+  int differing = 0;
+  entry e, other;
+  const char *cursor = a;
+  /* Keys of a, in a's order: changed or missing from b. */
+  while (next_entry(&cursor, &e)) {
+    if (!e.key_length || is_ignored_key(&e))
+      continue;
+    entry first;
+    if (find_entry(a, e.key, e.key_length, &first) && first.value != e.value)
+      continue; /* a repeated key: only its first occurrence counts */
+    int in_b = find_entry(b, e.key, e.key_length, &other);
+    if (in_b && same_value(&e, &other))
+      continue;
+    report(out, cap, &used, &e, &e, in_b ? &other : NULL);
+    differing++;
+  }
+  /* Keys only b has. */
+  cursor = b;
+  while (next_entry(&cursor, &e)) {
+    if (!e.key_length || is_ignored_key(&e))
+      continue;
+    entry first;
+    if (find_entry(b, e.key, e.key_length, &first) && first.value != e.value)
+      continue;
+    if (find_entry(a, e.key, e.key_length, &other))
+      continue;
+    report(out, cap, &used, &e, NULL, &e);
+    differing++;
+  }
+  return differing;
+}
