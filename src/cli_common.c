@@ -6,6 +6,7 @@
 #include "cli_common.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <float.h>
 #include <getopt.h>
 #include <limits.h>
@@ -14,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -586,9 +588,36 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
   return cli_status_exit(path, st, &err);
 }
 
+/* libpng, inside OpenImageIO, prints its own "libpng error: ..." line on
+ * stderr for a corrupt PNG before OpenImageIO returns the error we report.
+ * The CLI mutes stderr while decoding so every error stays one line; the
+ * library leaves the process's file descriptors alone. */
+static int mute_stderr(void) {
+  fflush(stderr);
+  int saved = dup(STDERR_FILENO), null_fd = open("/dev/null", O_WRONLY);
+  if (saved >= 0 && null_fd >= 0) dup2(null_fd, STDERR_FILENO);
+  if (null_fd >= 0) close(null_fd);
+  return saved;
+}
+
+static void unmute_stderr(int saved) {
+  if (saved < 0) return;
+  dup2(saved, STDERR_FILENO);
+  close(saved);
+}
+
+bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err) {
+  int saved = mute_stderr();
+  bb_status st = bb_image_read(path, img, info, err);
+  unmute_stderr(saved);
+  return st;
+}
+
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
   bb_error err = {{0}};
+  int saved = mute_stderr();
   bb_status st = bb_height_load(path, s->channel, height, &err);
+  unmute_stderr(saved);
   return cli_status_exit(path, st, &err);
 }
 

@@ -193,6 +193,10 @@ int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options
 /* Monotonic seconds, for the per-stage timings the CLI measures itself. */
 double cli_now_seconds(void);
 
+/* bb_image_read with stderr muted (libpng's own messages on corrupt PNGs
+ * would make an error two lines). */
+bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err);
+
 /* ------------------------------------------------------------------- JSON */
 
 /* A one-line JSON writer: fields are separated by commas automatically.

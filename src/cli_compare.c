@@ -9,6 +9,7 @@
  * compare") makes a broken CI invocation fail loudly instead.
  */
 #include "cli.h"
+#include "cli_common.h"
 
 #include "bumpbake.h"
 
@@ -315,7 +316,7 @@ static int compare_verdict(const compare_args *a, const bb_compare_stats *s) {
 
 static int read_image(const char *path, bb_image *img, bb_image_info *info) {
   bb_error err = {{0}};
-  if (bb_image_read(path, img, info, &err) != BB_OK) {
+  if (cli_read_image(path, img, info, &err) != BB_OK) {
     print_file_error(path, &err);
     return 1;
   }

@@ -165,7 +165,7 @@ static int load_input(h2s_args *a, bb_image *img, bb_image *height) {
   bb_image_info info;
   memset(&info, 0, sizeof info);
   bb_error err = {{0}};
-  bb_status st = bb_image_read(a->input, img, &info, &err);
+  bb_status st = cli_read_image(a->input, img, &info, &err);
   if (st == BB_OK) {
     a->settings.channel = valve_height_channel(a->input, img, &info);
     st = bb_height_from_image(img, info.alpha_channel, a->settings.channel, height, &err);
