@@ -291,7 +291,6 @@ typedef void (*bb_progress_fn)(void *user, long done, long total);
 typedef struct bb_trace_options {
   double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
   int threads;          /* 0 = all cores */
-  int jitter;           /* 1 = rotate the ray set per texel (statistical) */
   bb_progress_fn progress; /* may be NULL; called from one thread */
   void *progress_user;
 } bb_trace_options;
@@ -328,7 +327,7 @@ typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
   int rays;                   /* per texel, default 256 */
   bb_smooth_options smooth;   /* filter radius/threshold/addressing */
-  bb_trace_options trace;     /* bias, threads, jitter, progress */
+  bb_trace_options trace;     /* bias, threads, progress */
   double power;               /* P >= 1, default 1 */
   bb_basis basis;             /* default BB_BASIS_HL2 */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VALVE */

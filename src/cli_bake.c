@@ -84,7 +84,6 @@ static const cli_option *const bake_options[] = {
     &cli_opt_normal_y,
     &cli_opt_threads,
     &cli_opt_clamp,
-    &cli_opt_jitter,
     &cli_opt_channel,
     &cli_opt_depth,
     &opt_out_normal,
@@ -226,7 +225,6 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
                   b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
   cli_json_string(&j, "channel", bb_channel_name(a->settings.channel));
   cli_json_number(&j, "threads", b->trace.threads);
-  cli_json_bool(&j, "jitter", b->trace.jitter);
   cli_json_close(&j, '}');
 
   cli_json_open(&j, "seconds", '{');

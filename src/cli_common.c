@@ -83,11 +83,6 @@ const cli_option cli_opt_clamp = {.id = CLI_OPT_CLAMP,
                                   .long_name = "clamp",
                                   .default_text = "periodic",
                                   .help = "extend border texels instead of tiling"};
-const cli_option cli_opt_jitter = {
-    .id = CLI_OPT_JITTER,
-    .long_name = "jitter",
-    .default_text = "off",
-    .help = "rotate the ray set per texel (less banding, not shift-invariant)"};
 const cli_option cli_opt_channel = {
     .id = CLI_OPT_CHANNEL,
     .long_name = "channel",
@@ -419,9 +414,6 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_CLAMP:
     b->smooth.addressing = BB_ADDRESS_CLAMP;
     return 0;
-  case CLI_OPT_JITTER:
-    b->trace.jitter = 1;
-    return 0;
   default: /* a table row whose subcommand forgot to handle it */
     return cli_usage_error(command, "internal error: option %s has no handler", name);
   }
@@ -686,11 +678,6 @@ void cli_json_number(cli_json *j, const char *key, double value) {
     fprintf(j->f, "%.9g", value);
   else
     fputs("null", j->f);
-}
-
-void cli_json_bool(cli_json *j, const char *key, int value) {
-  json_begin_value(j, key);
-  fputs(value ? "true" : "false", j->f);
 }
 
 /* --------------------------------------------------------------- progress */

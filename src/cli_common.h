@@ -27,7 +27,6 @@ typedef enum cli_opt_id {
   CLI_OPT_NORMAL_Y,
   CLI_OPT_THREADS,
   CLI_OPT_CLAMP,
-  CLI_OPT_JITTER,
   CLI_OPT_CHANNEL,
   CLI_OPT_DEPTH,
   CLI_OPT_OUTPUT,     /* -o: the output file (normal) or prefix (bake) */
@@ -132,7 +131,7 @@ void cli_settings_init(cli_settings *s);
 
 /* Applies one of the options every baking command shares (scale, rays,
  * filter radius/threshold, bias, power, basis, normal filter and y, threads,
- * clamp, jitter, channel, depth): subcommands hand it every option they do
+ * clamp, channel, depth): subcommands hand it every option they do
  * not handle themselves. Returns 0 when applied, else BB_EXIT_USAGE after a
  * usage error (also for an option it does not know: an internal error). */
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
@@ -143,7 +142,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
 extern const cli_option cli_opt_scale, cli_opt_rays, cli_opt_filter_radius,
     cli_opt_filter_threshold, cli_opt_bias, cli_opt_power, cli_opt_basis,
     cli_opt_normal_filter, cli_opt_normal_y, cli_opt_threads, cli_opt_clamp,
-    cli_opt_jitter, cli_opt_channel, cli_opt_depth, cli_opt_help;
+    cli_opt_channel, cli_opt_depth, cli_opt_help;
 
 /* ---------------------------------------------------------------- outputs */
 
@@ -213,7 +212,6 @@ void cli_json_close(cli_json *j, char close);
 /* A string field; value NULL writes null. key NULL inside arrays. */
 void cli_json_string(cli_json *j, const char *key, const char *value);
 void cli_json_number(cli_json *j, const char *key, double value);
-void cli_json_bool(cli_json *j, const char *key, int value);
 
 /* --------------------------------------------------------------- progress */
 

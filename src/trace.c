@@ -631,8 +631,6 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
   if (!(o->bias_texels >= 0.0) || !isfinite(o->bias_texels))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: bias must be finite and >= 0 (got %g)",
                     o->bias_texels);
-  if (o->jitter)
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: --jitter is not implemented yet");
   trace_job job = {.p = p, .rs = rs, .o = o, .channels = 1 + rs->basis_count};
   bb_status st = prepare_job(&job, err);
   if (st == BB_OK) st = bb_image_alloc(vis, p->width, p->height, job.channels, err);
