@@ -13,8 +13,8 @@
  * hm + 1 rows along B (it may have been anywhere in c), so it is in a cell
  * that one of the two shifted halves starts from, give or take the rows M_0
  * adds. Cell indices go through the pyramid's addressing, so bands wrap
- * (periodic) or repeat the border cells (clamp). The last level spans at
- * least one period along A.
+ * (periodic) or repeat the border cells (clamp). Levels stop at a span of
+ * one period along A or 2^(BB__BAND_LEVELS-1) cells, whichever is shorter.
  */
 #include "internal.h"
 #include "trace_internal.h"
@@ -40,6 +40,10 @@ static void set_direction(bb__band *band, const bb_pyramid *p, double dx, double
   const int period = x_major ? p->width : p->height;
   band->levels = 1;
   while ((1L << (band->levels - 1)) < period) band->levels++;
+  /* Spans past 128 cells cost a full-size level each to build and, on the
+   * maps measured (rock06 at scale 128), save no march steps: by then the
+   * ray is high enough for the global maximum test to end it. */
+  if (band->levels > BB__BAND_LEVELS) band->levels = BB__BAND_LEVELS;
 }
 
 /* out[x] = max(out[x], in[addressed(x + offset)]) for a whole row, as

@@ -44,6 +44,7 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
                                    bb_error *err);
 
 /* Directional max bands of the pyramid's cells for one azimuth (band.c). */
+#define BB__BAND_LEVELS 8
 typedef struct bb__band {
   int levels;                      /* level k spans 2^k cells along the major axis */
   int major_x, major_y;            /* unit cell step along the major axis */
