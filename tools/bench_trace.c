@@ -1,7 +1,7 @@
 /* bench_trace.c: times the batch trace, the per-ray max-mip march and the brute-force
  * twin on one map.
  *
- *   bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B]
+ *   bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--peer-ao FILE]
  *   bench_trace --dump-dirs FILE RAYS
  *
  * The first form prepares the map as a bake does (bb_height_load, the default
@@ -13,6 +13,13 @@
  * Prints one JSON line on stdout and a human summary on stderr; exits 1 when
  * the brute-force and max-mip answers disagree on any ray (a benchmark that
  * disagrees is measuring a bug), 2 on a bad command line.
+ *
+ * With --peer-ao FILE nothing is timed: the subset is traced once by the
+ * max-mip march and the ao the Embree peer (valve-embree) would compute from
+ * those answers, sum of unblocked d.z over sum of d.z, is compared with FILE,
+ * the peer's ao of the same (filtered) map, ray set and bias. This separates
+ * "the tracers disagree about a ray" from "the estimators weight rays
+ * differently". Prints one JSON line; exits 0 whatever the differences.
  *
  * The second form writes the ray set's unit directions, one "x y z" per line,
  * so another tracer can be run on exactly the same rays.
@@ -30,12 +37,14 @@
 #define DEFAULT_SUBSET 2000
 #define REPEAT_UNDER_SECONDS 10.0 /* a timing shorter than this is taken 3 times */
 #define MAX_RUNS 3
+#define PEER_AO_TOLERANCE 1e-5 /* one flipped ray moves the peer's ao by >= ~1e-3 */
 
 typedef struct args {
   const char *map;
   double scale;
   int rays, threads, subset;
   double bias;
+  const char *peer_ao; /* --peer-ao FILE, or NULL */
 } args;
 
 /* Everything prepared once and shared by the timed sections. */
@@ -64,7 +73,8 @@ static double now_seconds(void) {
 static int usage(const char *reason) {
   fprintf(stderr,
           "bench_trace: %s\n"
-          "usage: bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B]\n"
+          "usage: bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--peer-ao "
+          "FILE]\n"
           "       bench_trace --dump-dirs FILE RAYS\n",
           reason);
   return 2;
@@ -99,6 +109,7 @@ static int parse_args(int argc, char **argv, args *a) {
   a->map = argv[1];
   a->subset = DEFAULT_SUBSET;
   a->bias = 0.55;
+  a->peer_ao = NULL;
   if (parse_positive(argv[2], &a->scale) || !(a->scale > 0.0))
     return usage("SCALE must be a number > 0");
   if (parse_int(argv[3], 1, 65536, &a->rays))
@@ -114,6 +125,8 @@ static int parse_args(int argc, char **argv, args *a) {
     } else if (!strcmp(argv[i], "--bias")) {
       if (parse_positive(argv[i + 1], &a->bias))
         return usage("--bias must be >= 0");
+    } else if (!strcmp(argv[i], "--peer-ao")) {
+      a->peer_ao = argv[i + 1];
     } else {
       return usage("unknown option");
     }
@@ -298,17 +311,6 @@ static double ao_max_difference(const subset *s, const bb_rayset *rs,
 
 /* ------------------------------------------------------------- output */
 
-typedef struct results {
-  double trace_s, brute_s, maxmip_s, ao_diff;
-  int trace_runs, brute_runs, maxmip_runs;
-  long subset_rays, blocked, disagreements;
-  long maxrss_kib;
-} results;
-
-static double per_second(double work, double seconds) {
-  return seconds > 0.0 ? work / seconds : 0.0;
-}
-
 /* s as a JSON string body: quotes, backslashes and control bytes escaped. */
 static void print_json_string(const char *s) {
   for (; *s; s++) {
@@ -320,6 +322,17 @@ static void print_json_string(const char *s) {
     else
       putchar(c);
   }
+}
+
+typedef struct results {
+  double trace_s, brute_s, maxmip_s, ao_diff;
+  int trace_runs, brute_runs, maxmip_runs;
+  long subset_rays, blocked, disagreements;
+  long maxrss_kib;
+} results;
+
+static double per_second(double work, double seconds) {
+  return seconds > 0.0 ? work / seconds : 0.0;
 }
 
 static void print_json(const args *a, const field *f, const trace_run *t,
@@ -367,6 +380,67 @@ static void print_human(const args *a, const field *f, const trace_run *t,
   fprintf(stderr, "; peak RSS %.1f MiB\n", (double)r->maxrss_kib / 1024.0);
 }
 
+/* ------------------------------------------------- agreement with the peer */
+
+/* The peer's ao at subset texel i from our answers: unblocked d.z / all d.z. */
+static double peer_style_ao(const subset *s, const bb_rayset *rs, int i) {
+  const unsigned char *b = s->blocked + (size_t)i * (size_t)rs->ray_count;
+  double open = 0.0, all = 0.0;
+  for (int k = 0; k < rs->ray_count; k++) {
+    const double dz = rs->direction[3 * (size_t)k + 2];
+    all += dz;
+    if (!b[k])
+      open += dz;
+  }
+  return all > 0.0 ? open / all : 1.0;
+}
+
+/* Traces the subset once and compares the peer-style ao with the peer's file. */
+static int peer_agreement(const args *a, const field *f) {
+  bb_image peer = {0};
+  bb_error err = {{0}};
+  if (bb_image_read(a->peer_ao, &peer, NULL, &err) != BB_OK) {
+    fprintf(stderr, "bench_trace: %s\n", err.message);
+    return 1;
+  }
+  int rc = 0;
+  subset s = {0};
+  if (peer.width != f->z.width || peer.height != f->z.height || peer.channels != 1) {
+    fprintf(stderr, "bench_trace: %s is %dx%d with %d channel(s), the map %dx%d\n",
+            a->peer_ao, peer.width, peer.height, peer.channels, f->z.width, f->z.height);
+    rc = 1;
+  } else if (subset_make(&s, a->subset, f->z.width, f->z.height, f->rs.ray_count)) {
+    fprintf(stderr, "bench_trace: out of memory for the subset\n");
+    rc = 1;
+  } else {
+    subset_run run = {f, &s, a->bias, bb_ray_occluded};
+    run_subset(&run);
+    double worst = 0.0, sum = 0.0;
+    int over = 0;
+    for (int i = 0; i < s.count; i++) {
+      double d = fabs(peer_style_ao(&s, &f->rs, i) -
+                      (double)*bb_image_texel(&peer, s.x[i], s.y[i]));
+      sum += d;
+      if (d > worst)
+        worst = d;
+      over += d > PEER_AO_TOLERANCE;
+    }
+    printf("{\"peer_ao\":\"");
+    print_json_string(a->peer_ao);
+    printf("\",\"subset_texels\":%d,\"mean_abs\":%.3g,\"max_abs\":%.3g,\"tolerance\":%g,"
+           "\"texels_over\":%d}\n",
+           s.count, s.count ? sum / s.count : 0.0, worst, PEER_AO_TOLERANCE, over);
+    fprintf(
+        stderr,
+        "bench_trace: peer-style ao from bumpbake's per-ray answers vs %s at %d texels: "
+        "max |d| %.3g, %d texel(s) over %g\n",
+        a->peer_ao, s.count, worst, over, PEER_AO_TOLERANCE);
+  }
+  subset_free(&s);
+  bb_image_free(&peer);
+  return rc;
+}
+
 /* ------------------------------------------------------------ the runs */
 
 /* Brute force and per-ray max-mip over the subset; fills r. Returns 0 or 1. */
@@ -399,6 +473,11 @@ static int bench(const args *a) {
     fprintf(stderr, "bench_trace: %s\n", err.message);
     field_free(&f);
     return 1;
+  }
+  if (a->peer_ao) {
+    rc = peer_agreement(a, &f);
+    field_free(&f);
+    return rc;
   }
   trace_run t = {.f = &f};
   bb_trace_options_init(&t.options);
