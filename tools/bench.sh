@@ -1,0 +1,450 @@
+#!/usr/bin/env bash
+# bench.sh BIN: times bumpbake's trace and whole bake against brute force and the Embree peer, with accuracy.
+#
+#   tools/bench.sh build/bumpbake        (make bench runs it after make all)
+#
+# Sections: 1 trace benchmark (build/tools/bench_trace), 2 the peer
+# (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
+# 3 full bake, 4 ratios against the targets, 5 accuracy against the peer,
+# then a summary table. Everything it writes goes into build/bench/.
+#
+# Timing rule: a measurement whose first run takes under 10 s is run 3 times
+# and the median is reported, otherwise it is run once; each figure says
+# which. bench_trace applies the same rule inside, to each part it times.
+#
+# Environment, for quick runs on small maps (defaults are the real bench):
+#   BENCH_ROCK=PATH        rock height map (fixtures/rock06_height.png)
+#   BENCH_NOISE_SIZE=N     side of the genheight noise map (1024)
+#   BENCH_SUBSET=N         texels of the brute-force subset (2000)
+#   BENCH_PEER_DIR=DIR     valve-embree sources (../shared/peers/valve-embree)
+#
+# Exits 0 whatever the ratios and whether or not the peer could be built;
+# exits 1 when bumpbake itself fails or brute force and max-mip disagree.
+set -euo pipefail
+
+bin=${1:?usage: tools/bench.sh path/to/bumpbake}
+bin=$(realpath "$bin")
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+tools=$(dirname "$bin")/tools
+out=build/bench
+mkdir -p "$out"
+
+rays=256 bias=0.55 threads=2 repeat_under=10
+rock_scale=128 noise_scale=64
+noise_size=${BENCH_NOISE_SIZE:-1024}
+subset=${BENCH_SUBSET:-2000}
+target_trace=3 target_whole=10 target_brute=20
+failures=() # bumpbake-side failures: they make the bench exit 1
+peer_ok=0 peer_reason="not tried"
+start_all=$(date +%s.%N)
+
+# ------------------------------------------------------------------ helpers
+
+section() { printf '\n== %s ==\n' "$*"; }
+now() { date +%s.%N; }
+fail() { failures+=("$*"); echo "bench: FAILED: $*" >&2; }
+
+# json_num KEY FILE: the number stored under "KEY" in a one-line JSON file.
+json_num() {
+  local v
+  v=$(sed -n "s/.*\"$1\":\(-\{0,1\}[0-9][0-9.eE+-]*\).*/\1/p" "$2" 2>/dev/null | head -n1) || true
+  printf '%s' "${v:-nan}"
+}
+
+# median V...: the middle value (the lower middle for an even count).
+median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+
+# calc EXPR [FORMAT]: awk arithmetic; "n/a" when a term is missing or a divisor is 0.
+calc() {
+  case $1 in *nan* | *n/a*) printf 'n/a'; return ;; esac
+  # mawk prints nan and inf for 0/0 and 1/0 rather than failing
+  awk -v f="${2:-%.3f}" "BEGIN { r = $1; if ((r \"\") ~ /nan|inf/) printf \"n/a\"; else printf f, r }" \
+    2>/dev/null || printf 'n/a'
+}
+
+# ratio A B: A / B to 2 decimals, or n/a.
+ratio() {
+  awk -v a="$1" -v b="$2" 'BEGIN { if (a ~ /^[0-9.eE+-]+$/ && b ~ /^[0-9.eE+-]+$/ && b + 0 > 0)
+    printf "%.2f", a / b; else printf "n/a" }'
+}
+
+# verdict VALUE TARGET: information only.
+verdict() {
+  awk -v v="$1" -v t="$2" 'BEGIN { if (v !~ /^[0-9.]+$/) print "-"; else if (v + 0 >= t + 0)
+    print "meets"; else print "below" }'
+}
+
+# run_once NAME I CMD...: one run; stdout to NAME.I.out, stderr to NAME.I.err,
+# wall seconds to NAME.I.wall, peak RSS (KiB) to NAME.I.rss.
+run_once() {
+  local name=$1 i=$2 t0 rc=0
+  shift 2
+  t0=$(now)
+  if [ -x /usr/bin/time ]; then
+    /usr/bin/time -f '%M' -o "$out/$name.$i.time" "$@" >"$out/$name.$i.out" \
+      2>"$out/$name.$i.err" || rc=$?
+    tail -n1 "$out/$name.$i.time" >"$out/$name.$i.rss"
+  else
+    "$@" >"$out/$name.$i.out" 2>"$out/$name.$i.err" || rc=$?
+    echo nan >"$out/$name.$i.rss"
+  fi
+  calc "$(now) - $t0" '%.3f' >"$out/$name.$i.wall"
+  return "$rc"
+}
+
+# measure NAME CMD...: runs CMD once, and twice more when that took under
+# $repeat_under s; the number of runs goes to NAME.runs. Returns CMD's status.
+measure() {
+  local name=$1 rc=0
+  shift
+  rm -f "$out/$name".*
+  run_once "$name" 1 "$@" || rc=$?
+  local n=1
+  if [ "$rc" = 0 ] && [ "$(calc "($(cat "$out/$name.1.wall") < $repeat_under)" %d)" = 1 ]; then
+    run_once "$name" 2 "$@" || rc=$?
+    [ "$rc" = 0 ] && { run_once "$name" 3 "$@" || rc=$?; }
+    n=3
+  fi
+  echo "$n" >"$out/$name.runs"
+  if [ "$rc" != 0 ]; then sed 's/^/  | /' "$out/$name".*.err | tail -n 5 >&2; fi
+  return "$rc"
+}
+
+# med NAME KEY: median over NAME's runs of KEY in the JSON output, or of the
+# wall / rss files when KEY is @wall / @rss.
+med() {
+  local name=$1 key=$2 n i vals=()
+  n=$(cat "$out/$name.runs" 2>/dev/null || echo 0)
+  [ "$n" -gt 0 ] || { printf 'n/a'; return; }
+  for ((i = 1; i <= n; i++)); do
+    case $key in
+    @*) vals+=("$(cat "$out/$name.$i.${key#@}" 2>/dev/null || echo nan)") ;;
+    *) vals+=("$(json_num "$key" "$out/$name.$i.out")") ;;
+    esac
+  done
+  median "${vals[@]}"
+}
+
+# runs_text NAME: "median of 3" or "1 run".
+runs_text() {
+  local n
+  n=$(cat "$out/$1.runs" 2>/dev/null || echo 0)
+  if [ "$n" = 1 ]; then printf '1 run'; else printf 'median of %s' "$n"; fi
+}
+
+mib() { calc "$1 / 1024" '%.0f'; }
+
+# ------------------------------------------------------------------- inputs
+
+find_rock() {
+  local input=${BENCH_ROCK:-fixtures/rock06_height.png} alt
+  # the shared copy beside the checkout (or beside the worktrees), as demo.sh
+  for alt in ../shared/fixtures ../../shared/fixtures; do
+    [ -f "$input" ] || input=$alt/rock06_height.png
+  done
+  [ -f "$input" ] || { echo "bench: rock06_height.png not found" >&2; exit 1; }
+  printf '%s' "$input"
+}
+
+rock=$(find_rock)
+noise=$out/noise${noise_size}.png
+"$tools/genheight" noise "$noise_size" "$noise_size" "$noise"
+maps=(rock noise)
+declare -A map_path=([rock]=$rock [noise]=$noise)
+declare -A map_scale=([rock]=$rock_scale [noise]=$noise_scale)
+
+section "bumpbake bench"
+echo "commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown), $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo "machine: $(nproc) cores, $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1)," \
+  "load average $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "maps: rock = $rock (scale $rock_scale), noise = $noise (genheight noise, scale $noise_scale)"
+echo "rays $rays per texel, bias $bias; a figure is the median of 3 runs when a run takes" \
+  "under ${repeat_under} s, else 1 run"
+
+# ---------------------------------------------------------- 1. trace bench
+
+# trace_bench MAP THREADS: runs bench_trace into trace_MAP_tTHREADS.json.
+trace_bench() {
+  local m=$1 t=$2 rc=0
+  local json=$out/trace_${m}_t$t.json
+  "$tools/bench_trace" "${map_path[$m]}" "${map_scale[$m]}" "$rays" "$t" --subset "$subset" \
+    --bias "$bias" >"$json" || rc=$?
+  [ "$rc" = 0 ] || fail "bench_trace ${map_path[$m]} with $t thread(s) exited $rc"
+}
+
+# trace_row MAP THREADS: one line of the trace table.
+trace_row() {
+  local j=$out/trace_${1}_t$2.json
+  printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %8s %6s\n' "$1" \
+    "$(json_num width "$j")" "$2" "$(calc "$(json_num trace_s "$j")")" \
+    "($(json_num trace_runs "$j"))" "$(calc "$(json_num trace_rays_per_s "$j") / 1e6" %.2f)" \
+    "$(calc "$(json_num brute_rays_per_s "$j") / 1e6" %.3f)" \
+    "$(calc "$(json_num maxmip_rays_per_s "$j") / 1e6" %.3f)" \
+    "$(calc "$(json_num trace_over_brute "$j")" %.1f)" \
+    "$(calc "$(json_num blocked_fraction "$j") * 100" %.1f)%" \
+    "$(json_num disagreements "$j")" "$(mib "$(json_num maxrss_kib "$j")")"
+}
+
+section "1. Trace benchmark (build/tools/bench_trace)"
+echo "bb_trace_occlusion over every texel; then $subset texels x $rays rays one ray at a time" \
+  "on 1 thread, by brute force (bb_ray_occluded_brute) and by the max-mip march (bb_ray_occluded)."
+for m in "${maps[@]}"; do
+  for t in 1 "$threads"; do trace_bench "$m" "$t"; done
+done
+echo
+printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %8s %6s\n' map size thr trace_s runs \
+  Mrays/s brute_M/s maxmip_M/s tr/brute blocked disagree MiB
+for m in "${maps[@]}"; do
+  for t in 1 "$threads"; do trace_row "$m" "$t"; done
+done
+echo "(trace_s: median over 'runs' runs; Mrays/s = texels x rays / trace_s; tr/brute = trace" \
+  "rays/s over brute-force rays/s; MiB = peak RSS of the process)"
+
+# ----------------------------------------------------------------- 2. peer
+
+# The peer's sources: $BENCH_PEER_DIR when set, else shared/ beside the
+# checkout (or beside the directory of worktrees).
+find_peer_dir() {
+  local d candidates=(../shared/peers/valve-embree ../../shared/peers/valve-embree)
+  [ -z "${BENCH_PEER_DIR:-}" ] || candidates=("$BENCH_PEER_DIR")
+  for d in "${candidates[@]}"; do
+    [ -f "$d/valve-embree.cpp" ] && { (cd "$d" && pwd); return 0; }
+  done
+  return 1
+}
+
+have_embree() { printf '#include <embree3/rtcore.h>\n' | "${CXX:-g++}" -E -x c++ - >/dev/null 2>&1; }
+
+# One attempt at installing Embree; sudo when not root (never waits for a
+# password unless a terminal can answer).
+install_embree() {
+  local sudo=()
+  if [ "$(id -u)" != 0 ]; then
+    command -v sudo >/dev/null || return 1
+    if [ -t 0 ]; then sudo=(sudo); else sudo=(sudo -n); fi
+  fi
+  echo "peer: libembree-dev missing; trying apt-get install -y libembree-dev"
+  ${sudo[@]+"${sudo[@]}"} env DEBIAN_FRONTEND=noninteractive apt-get install -y libembree-dev \
+    >"$out/peer_install.log" 2>&1
+}
+
+# Builds the peer into build/peer/; sets peer, peer_ok and peer_reason.
+build_peer() {
+  local dir
+  if ! dir=$(find_peer_dir); then
+    peer_reason="sources not found (${BENCH_PEER_DIR:-../shared/peers/valve-embree beside the repository})"
+    return
+  fi
+  peer=$root/build/peer/valve-embree
+  local make_peer=(make -C "$dir" BUILD="$root/build/peer" "$peer")
+  if ! have_embree && ! install_embree; then
+    peer_reason="libembree-dev missing and apt-get install failed (see $out/peer_install.log)"
+    return
+  fi
+  if "${make_peer[@]}" >"$out/peer_build.log" 2>&1; then
+    peer_ok=1 peer_reason=""
+    echo "peer: $dir -> build/peer/valve-embree"
+  else
+    peer_reason="build failed: $(grep -m1 -i error "$out/peer_build.log" || tail -n1 "$out/peer_build.log")"
+  fi
+}
+
+# peer_run MAP: the peer on bumpbake's filtered MAP with bumpbake's rays.
+peer_run() {
+  local m=$1
+  measure "peer_$m" "$peer" "$out/${m}_filtered.exr" --scale "${map_scale[$m]}" --rays "$rays" \
+    --bias "$bias" --threads "$threads" --dirs "$out/dirs_$rays.txt" \
+    --ao "$out/${m}_peer_ao.exr" --ssbump "$out/${m}_peer_ssbump.exr"
+}
+
+# Filtered heights for the peer. For rock the same bake also writes the float
+# ao and ssbump that section 5 compares with the peer's.
+make_filtered() {
+  "$tools/bench_trace" --dump-dirs "$out/dirs_$rays.txt" "$rays" || return 1
+  "$bin" bake "$rock" --scale "$rock_scale" --rays "$rays" --bias "$bias" --threads "$threads" \
+    -q --filtered "$out/rock_filtered.exr" --ao "$out/rock_ao.exr" \
+    --ssbump "$out/rock_ssbump.exr" || return 1
+  "$bin" bake "$noise" --scale "$noise_scale" -q --filtered "$out/noise_filtered.exr"
+}
+
+peer_row() {
+  local n=peer_$1
+  printf '%-6s %9s %9s %9s %9s %7s  %s\n' "$1" "$(calc "$(med "$n" build_s)")" \
+    "$(calc "$(med "$n" trace_s)")" "$(calc "$(med "$n" total_s)")" "$(calc "$(med "$n" @wall)")" \
+    "$(mib "$(med "$n" @rss)")" "$(runs_text "$n")"
+}
+
+section "2. Peer: valve-embree (Valve's method on Intel Embree 3)"
+build_peer
+if [ "$peer_ok" = 1 ]; then
+  if ! make_filtered; then
+    fail "bumpbake could not write the filtered heights for the peer"
+    peer_ok=0 peer_reason="no filtered heights to give it"
+  fi
+fi
+if [ "$peer_ok" = 1 ]; then
+  echo "input: bumpbake's filtered height (bake --filtered, radius 10), since the peer does not"
+  echo "smooth; rays: bumpbake's ray set via --dirs $out/dirs_$rays.txt; $threads threads"
+  for m in "${maps[@]}"; do
+    if ! peer_run "$m"; then
+      peer_ok=0 peer_reason="the peer failed on ${m}_filtered.exr (see $out/peer_$m.1.err)"
+      break
+    fi
+  done
+fi
+if [ "$peer_ok" = 1 ]; then
+  printf '%-6s %9s %9s %9s %9s %7s  %s\n' map build_s trace_s total_s wall_s MiB runs
+  for m in "${maps[@]}"; do peer_row "$m"; done
+  echo "(build_s, trace_s, total_s from the peer's JSON; wall_s = the whole process)"
+else
+  echo "peer: not available ($peer_reason)"
+fi
+
+# ------------------------------------------------------------ 3. full bake
+
+section "3. Full bake: bumpbake bake rock, every output, $threads threads"
+full_cmd=("$bin" bake "$rock" --scale "$rock_scale" --rays "$rays" --threads "$threads" --json -q
+  --normal "$out/rock_normal.png" --weights "$out/rock_weights.png"
+  --ssbump "$out/rock_ssbump.png" --ao "$out/rock_ao.png" --bent "$out/rock_bent.png")
+echo "${full_cmd[*]#"$root/"}"
+bake_ok=1
+measure bake_rock "${full_cmd[@]}" || { fail "bumpbake bake exited non-zero"; bake_ok=0; }
+if [ "$bake_ok" = 1 ]; then
+  printf '%-8s' load smooth pyramid trace derive write stages wall MiB
+  echo
+  stage_sum=0
+  for k in load smooth pyramid trace derive write; do
+    v=$(med bake_rock "$k")
+    stage_sum=$(calc "$stage_sum + $v" %.6f)
+    printf '%-8s' "$(calc "$v")"
+  done
+  printf '%-8s%-8s%-8s' "$(calc "$stage_sum")" "$(calc "$(med bake_rock @wall)")" \
+    "$(mib "$(med bake_rock @rss)")"
+  echo
+  echo "($(runs_text bake_rock); seconds; stages = their sum, wall = the whole process)"
+  if [ "$peer_ok" = 1 ]; then
+    echo "peer, whole run on the same map (filtered, so it does no smoothing):" \
+      "wall $(calc "$(med peer_rock @wall)") s (build $(calc "$(med peer_rock build_s)")," \
+      "trace $(calc "$(med peer_rock trace_s)"), total $(calc "$(med peer_rock total_s)");" \
+      "$(runs_text peer_rock))"
+  else
+    echo "peer: not available ($peer_reason)"
+  fi
+fi
+
+# --------------------------------------------------------------- 4. ratios
+
+section "4. Ratios (information only; the bench passes whatever they are)"
+ratio_rows=()
+# add_ratio NAME VALUE TARGET
+add_ratio() { ratio_rows+=("$(printf '%-50s %8s   >= %-4s %s' "$1" "$2" "$3" "$(verdict "$2" "$3")")"); }
+for m in "${maps[@]}"; do
+  j=$out/trace_${m}_t$threads.json
+  if [ "$peer_ok" = 1 ]; then
+    add_ratio "peer trace_s / bumpbake trace_s, $m ($threads thr)" \
+      "$(ratio "$(med "peer_$m" trace_s)" "$(json_num trace_s "$j")")" "$target_trace"
+  fi
+done
+if [ "$peer_ok" = 1 ] && [ "$bake_ok" = 1 ]; then
+  add_ratio "peer whole run / bumpbake whole bake, rock" \
+    "$(ratio "$(med peer_rock @wall)" "$(med bake_rock @wall)")" "$target_whole"
+fi
+for m in "${maps[@]}"; do
+  for t in 1 "$threads"; do
+    j=$out/trace_${m}_t$t.json
+    add_ratio "trace rays/s / brute-force rays/s, $m ($t thr)" \
+      "$(ratio "$(json_num trace_rays_per_s "$j")" "$(json_num brute_rays_per_s "$j")")" \
+      "$target_brute"
+  done
+done
+printf '%-50s %8s   %-7s %s\n' ratio value target ""
+printf '%s\n' "${ratio_rows[@]}"
+[ "$peer_ok" = 1 ] || echo "peer: not available ($peer_reason); its ratios are left out"
+echo "(brute force runs on 1 thread; the $threads-thread ratio includes the parallel speed-up)"
+
+# ------------------------------------------------------------- 5. accuracy
+
+# imgstats_rows KIND: per-channel rows of bumpbake's vs the peer's rock KIND.
+imgstats_rows() {
+  local kind=$1 j=$out/accuracy_$1.json c=0
+  if ! "$tools/imgstats" "$out/rock_$kind.exr" "$out/rock_peer_$kind.exr" >"$j" 2>/dev/null; then
+    echo "$kind: imgstats failed"
+    return
+  fi
+  # one {"mean_abs":..,"p99_abs":..,"max_abs":..} per channel
+  sed 's/.*"channels":\[//; s/\]}$//; s/},{/}\n{/g' "$j" | while IFS= read -r ch; do
+    printf '%s\n' "$ch" >"$out/accuracy_ch.json"
+    printf '%-7s %3d %10s %10s %10s\n' "$kind" "$c" \
+      "$(calc "$(json_num mean_abs "$out/accuracy_ch.json")" %.5f)" \
+      "$(calc "$(json_num p99_abs "$out/accuracy_ch.json")" %.5f)" \
+      "$(calc "$(json_num max_abs "$out/accuracy_ch.json")" %.5f)"
+    c=$((c + 1))
+  done
+}
+
+section "5. Accuracy vs the peer: rock, scale $rock_scale, same filtered map and rays"
+if [ "$peer_ok" = 1 ]; then
+  printf '%-7s %3s %10s %10s %10s\n' image ch mean_abs p99_abs max_abs
+  imgstats_rows ao
+  imgstats_rows ssbump
+  echo "(bumpbake's float EXRs vs the peer's; |difference| per channel over every texel)"
+  echo "The estimators differ: the peer weights ray d by d.z (ao) and max(0, B.d) (ssbump);"
+  echo "bumpbake's rays are cosine-distributed and weighted to undo that density, so these"
+  echo "differences include the estimators'. Ray by ray, the peer's ao formula fed bumpbake's"
+  echo "per-ray answers (bench_trace --peer-ao) against the peer's ao:"
+  if "$tools/bench_trace" "$rock" "$rock_scale" "$rays" 1 --subset "$subset" --bias "$bias" \
+    --peer-ao "$out/rock_peer_ao.exr" >"$out/accuracy_rays.json" 2>/dev/null; then
+    a=$out/accuracy_rays.json
+    echo "  at $(json_num subset_texels "$a") texels: mean |d| $(json_num mean_abs "$a")," \
+      "max |d| $(json_num max_abs "$a"), $(json_num texels_over "$a") texel(s) over" \
+      "$(json_num tolerance "$a") (one ray flipped moves ao by ~1e-3)"
+  else
+    echo "  bench_trace --peer-ao failed"
+  fi
+else
+  echo "peer: not available ($peer_reason)"
+fi
+
+# -------------------------------------------------------------- summary
+
+summary_row() { printf '%-46s %14s  %s\n' "$1" "$2" "${3:-}"; }
+
+section "Summary"
+summary_row figure value note
+for m in "${maps[@]}"; do
+  for t in 1 "$threads"; do
+    j=$out/trace_${m}_t$t.json
+    summary_row "bumpbake trace, $m, $t thr (Mrays/s)" \
+      "$(calc "$(json_num trace_rays_per_s "$j") / 1e6" %.2f)" \
+      "$(calc "$(json_num trace_s "$j")") s, runs $(json_num trace_runs "$j")"
+  done
+  j=$out/trace_${m}_t1.json
+  summary_row "brute force, $m, 1 thr (Mrays/s)" \
+    "$(calc "$(json_num brute_rays_per_s "$j") / 1e6" %.3f)" \
+    "max-mip per ray $(calc "$(json_num maxmip_rays_per_s "$j") / 1e6" %.3f) Mrays/s, $(json_num disagreements "$j") disagreements"
+  if [ "$peer_ok" = 1 ]; then
+    summary_row "peer trace, $m, $threads thr (s)" "$(calc "$(med "peer_$m" trace_s)")" \
+      "build $(calc "$(med "peer_$m" build_s)") s, $(runs_text "peer_$m")"
+  fi
+done
+if [ "$bake_ok" = 1 ]; then
+  summary_row "bumpbake whole bake, rock (s)" "$(calc "$(med bake_rock @wall)")" \
+    "$(runs_text bake_rock), peak $(mib "$(med bake_rock @rss)") MiB"
+fi
+if [ "$peer_ok" = 1 ]; then
+  summary_row "peer whole run, rock (s)" "$(calc "$(med peer_rock @wall)")" \
+    "$(runs_text peer_rock), peak $(mib "$(med peer_rock @rss)") MiB"
+else
+  summary_row "peer" "not available" "$peer_reason"
+fi
+echo
+printf '%-50s %8s   %-7s %s\n' ratio value target ""
+printf '%s\n' "${ratio_rows[@]}"
+echo "bench took $(calc "$(now) - $start_all" %.0f) s; outputs in $out/"
+
+if [ "${#failures[@]}" -gt 0 ]; then
+  printf 'bench: FAILED: %s\n' "${failures[@]}" >&2
+  exit 1
+fi
+exit 0
