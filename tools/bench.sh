@@ -365,10 +365,11 @@ echo "(brute force runs on 1 thread; the $threads-thread ratio includes the para
 
 # ------------------------------------------------------------- 5. accuracy
 
-# imgstats_rows KIND: per-channel rows of bumpbake's vs the peer's rock KIND.
+# imgstats_rows KIND: per-channel rows of bumpbake's vs the peer's rock KIND,
+# the peer tracing its own ray set (see below).
 imgstats_rows() {
   local kind=$1 j=$out/accuracy_$1.json c=0
-  if ! "$tools/imgstats" "$out/rock_$kind.exr" "$out/rock_peer_$kind.exr" >"$j" 2>/dev/null; then
+  if ! "$tools/imgstats" "$out/rock_$kind.exr" "$out/rock_peer_own_$kind.exr" >"$j" 2>/dev/null; then
     echo "$kind: imgstats failed"
     return
   fi
@@ -384,15 +385,24 @@ imgstats_rows() {
 }
 
 section "5. Accuracy vs the peer: rock, scale $rock_scale, same filtered map and rays"
-if [ "$peer_ok" = 1 ]; then
+# Each tool with its own ray set, so each estimator is the consistent one: the
+# peer's weights (d.z, max(0, B.d)) assume directions uniform in solid angle,
+# which its default Fibonacci set is and bumpbake's cosine slices are not.
+peer_own_ok=0
+if [ "$peer_ok" = 1 ] && "$peer" "$out/rock_filtered.exr" --scale "$rock_scale" --rays "$rays" \
+  --bias "$bias" --threads "$threads" --ao "$out/rock_peer_own_ao.exr" \
+  --ssbump "$out/rock_peer_own_ssbump.exr" >"$out/peer_own.out" 2>"$out/peer_own.err"; then
+  peer_own_ok=1
+fi
+if [ "$peer_own_ok" = 1 ]; then
   printf '%-7s %3s %10s %10s %10s\n' image ch mean_abs p99_abs max_abs
   imgstats_rows ao
   imgstats_rows ssbump
-  echo "(bumpbake's float EXRs vs the peer's; |difference| per channel over every texel)"
-  echo "The estimators differ: the peer weights ray d by d.z (ao) and max(0, B.d) (ssbump);"
-  echo "bumpbake's rays are cosine-distributed and weighted to undo that density, so these"
-  echo "differences include the estimators'. Ray by ray, the peer's ao formula fed bumpbake's"
-  echo "per-ray answers (bench_trace --peer-ao) against the peer's ao:"
+  echo "(bumpbake's float EXRs vs the peer's with its own $rays-ray Fibonacci set; |difference|"
+  echo "per channel over every texel: the two differ in ray set, and the peer's mesh stops one"
+  echo "tile out while bumpbake's rays wrap as far as they need)"
+  echo "Ray by ray, the peer's ao formula fed bumpbake's per-ray answers (bench_trace --peer-ao)"
+  echo "against the peer run on bumpbake's own directions (section 2):"
   if "$tools/bench_trace" "$rock" "$rock_scale" "$rays" 1 --subset "$subset" --bias "$bias" \
     --peer-ao "$out/rock_peer_ao.exr" >"$out/accuracy_rays.json" 2>/dev/null; then
     a=$out/accuracy_rays.json
@@ -403,7 +413,7 @@ if [ "$peer_ok" = 1 ]; then
     echo "  bench_trace --peer-ao failed"
   fi
 else
-  echo "peer: not available ($peer_reason)"
+  echo "peer: not available (${peer_reason:-its run with its own ray set failed})"
 fi
 
 # -------------------------------------------------------------- summary
