@@ -395,6 +395,10 @@ if [ "$peer_ok" = 1 ] && "$peer" "$out/rock_filtered.exr" --scale "$rock_scale" 
   peer_own_ok=1
 fi
 if [ "$peer_own_ok" = 1 ]; then
+  own_trace=$(json_num trace_s "$out/peer_own.out")
+  echo "peer with its own ray set (uniform in solid angle, so more grazing rays): trace" \
+    "$(calc "$own_trace") s, build $(calc "$(json_num build_s "$out/peer_own.out")") s;" \
+    "its trace / bumpbake's (rock, $threads thr): $(ratio "$own_trace" "$(json_num trace_s "$out/trace_rock_t$threads.json")")"
   printf '%-7s %3s %10s %10s %10s\n' image ch mean_abs p99_abs max_abs
   imgstats_rows ao
   imgstats_rows ssbump
