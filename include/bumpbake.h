@@ -142,6 +142,11 @@ bb_status bb_image_write(const char *path, const bb_image *img,
 /* True (1) when the extension of path names a format bb_image_write knows. */
 int bb_path_is_writable_format(const char *path);
 
+/* True (1) when bb_image_write can store depth in the format path's extension
+ * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
+ * bad combination before a long bake rather than after it. */
+int bb_path_supports_depth(const char *path, bb_depth depth);
+
 /* ----------------------------------------------------------- height input */
 
 /* Which channel of a colour image becomes the height. */

@@ -434,27 +434,6 @@ static const char *path_extension(const char *path, char *buf, size_t cap) {
   return buf;
 }
 
-/* Whether the format of ext can hold depth, as bumpbake.h documents for
- * bb_image_write (8: png tga tif; 16: png tif; half: exr; float: exr tif).
- * Checked here so a bad combination fails before a long bake, not after. */
-static int depth_fits_format(bb_depth depth, const char *ext) {
-  int png = !strcmp(ext, "png"), tga = !strcmp(ext, "tga");
-  int tif = !strcmp(ext, "tif") || !strcmp(ext, "tiff"), exr = !strcmp(ext, "exr");
-  switch (depth) {
-  case BB_DEPTH_DEFAULT:
-    return 1;
-  case BB_DEPTH_8:
-    return png || tga || tif;
-  case BB_DEPTH_16:
-    return png || tif;
-  case BB_DEPTH_HALF:
-    return exr;
-  case BB_DEPTH_FLOAT:
-    return exr || tif;
-  }
-  return 0;
-}
-
 static const char *depth_name(bb_depth d) {
   switch (d) {
   case BB_DEPTH_8:
@@ -516,9 +495,11 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
     return cli_usage_error(
         command, "%s: unknown output format '.%s' (use .png, .tga, .tif or .exr)",
         output_path, path_extension(output_path, ext, sizeof ext));
-  if (!depth_fits_format(depth, path_extension(output_path, ext, sizeof ext)))
+  /* Checked before baking, so a bad combination fails before a long bake. */
+  if (!bb_path_supports_depth(output_path, depth))
     return cli_usage_error(command, "%s: --depth %s is not available in .%s files",
-                           output_path, depth_name(depth), ext);
+                           output_path, depth_name(depth),
+                           path_extension(output_path, ext, sizeof ext));
   if (same_file(input_path, output_path)) {
     cli_file_error(output_path, "output would overwrite the input file");
     return BB_EXIT_FAILURE;

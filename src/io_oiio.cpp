@@ -399,6 +399,16 @@ bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_o
   }
 }
 
+int bb_path_supports_depth(const char *path, bb_depth depth) {
+  if (!path) return 0;
+  try {
+    const format_rule *f = find_format(extension_of(path));
+    return f && (depth == BB_DEPTH_DEFAULT || (f->allowed & bit(depth)) != 0);
+  } catch (...) {
+    return 0;
+  }
+}
+
 int bb_path_is_writable_format(const char *path) {
   if (!path) return 0;
   try {

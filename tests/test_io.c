@@ -653,3 +653,14 @@ Test(io, read_info_of_grey_alpha_png) {
   bb_image_free(&back);
   bb_image_free(&img);
 }
+
+Test(io, supports_depth_follows_the_format_table) {
+  cr_assert(bb_path_supports_depth("a.png", BB_DEPTH_16));
+  cr_assert(bb_path_supports_depth("a.PNG", BB_DEPTH_DEFAULT));
+  cr_assert_not(bb_path_supports_depth("a.tga", BB_DEPTH_16));
+  cr_assert_not(bb_path_supports_depth("a.png", BB_DEPTH_HALF));
+  cr_assert(bb_path_supports_depth("dir.x/a.exr", BB_DEPTH_HALF));
+  cr_assert(bb_path_supports_depth("a.tiff", BB_DEPTH_FLOAT));
+  cr_assert_not(bb_path_supports_depth("a.jpg", BB_DEPTH_DEFAULT));
+  cr_assert_not(bb_path_supports_depth(NULL, BB_DEPTH_8));
+}
