@@ -274,6 +274,8 @@ typedef struct bb_rayset {
   int basis_count;
   int *slice_start;          /* slice_count + 1 entries */
   double *slice_dir;         /* 2 per slice: unit (dx, dy) */
+  int *slice_step;           /* 2 per slice: the integer lattice step (a, b) the
+                                slice direction follows, (dx, dy) ~ (a, b) */
   double *tan_elevation;     /* per ray: dz / |(dx, dy)|, rising within a slice */
   double *direction;         /* 3 per ray: unit direction */
   double *weight_ao;         /* per ray: estimator weight of ao */

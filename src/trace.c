@@ -248,6 +248,13 @@ static inline int test_cell(const walker *w, const double *tan_el, int n, int b,
 
 /* ---- traversal ----------------------------------------------------------- */
 
+/* A located cell index, never behind the current one: a ray through a
+ * vertex can round to the cell it is leaving, and a walk that steps back
+ * could skip the same node forever. */
+static inline int no_backward(int located, int current, int s) {
+  return s > 0 ? (located < current ? current : located) : (located > current ? current : located);
+}
+
 /* Moves the walker past the level-k node holding it (k = 0: the next cell).
  * The axis it leaves by advances exactly; the other is located by floor,
  * which rounding may put a hair off near a corner: harmless, since a cell
@@ -263,11 +270,11 @@ static void advance(walker *w, int k) {
   if (tx < ty) {
     w->t = tx;
     ix = w->d.sx > 0 ? X : X - 1;
-    iy = cell_along(w->oy + tx * w->d.dy, w->d.sy);
+    iy = no_backward(cell_along(w->oy + tx * w->d.dy, w->d.sy), w->iy, w->d.sy);
   } else if (ty < tx) {
     w->t = ty;
     iy = w->d.sy > 0 ? Y : Y - 1;
-    ix = cell_along(w->ox + ty * w->d.dx, w->d.sx);
+    ix = no_backward(cell_along(w->ox + ty * w->d.dx, w->d.sx), w->ix, w->d.sx);
   } else { /* through a corner */
     w->t = tx;
     ix = w->d.sx > 0 ? X : X - 1;
@@ -370,14 +377,14 @@ march_band_impl(const bb_pyramid *p, const bb__band *band, const direction *d, d
       if (x_major) {
         ix += sx * span;
         t = ((double)(sx > 0 ? ix : ix + 1) - ox) * d->inv_dx;
-        const int row = cell_along(oy + t * d->dy, sy);
+        const int row = no_backward(cell_along(oy + t * d->dy, sy), iy, sy);
         cx = periodic ? wrap_near(cx + sx * span, W) : bb__clampi(ix, 0, W - 1);
         cy = periodic ? wrap_near(cy + (row - iy), H) : bb__clampi(row, 0, H - 1);
         iy = row;
       } else {
         iy += sy * span;
         t = ((double)(sy > 0 ? iy : iy + 1) - oy) * d->inv_dy;
-        const int col = cell_along(ox + t * d->dx, sx);
+        const int col = no_backward(cell_along(ox + t * d->dx, sx), ix, sx);
         cy = periodic ? wrap_near(cy + sy * span, H) : bb__clampi(iy, 0, H - 1);
         cx = periodic ? wrap_near(cx + (col - ix), W) : bb__clampi(col, 0, W - 1);
         ix = col;
@@ -491,7 +498,8 @@ typedef struct trace_job {
   double *unblocked;      /* channels * (ray_count + slice_count) */
   double total[1 + BB_MAX_BASIS];
   direction *slice_dir;   /* per slice */
-  double *sums;           /* band path: per texel and channel, unblocked weight so far */
+  double *sums;           /* slice paths: per texel and channel, unblocked weight so far */
+  uint16_t *blocked;      /* slice paths: per texel, rays of slice `slice` blocked */
   const bb__band *band;   /* band path: the bands of slice `slice` */
   int slice;
   float *vis;
@@ -531,6 +539,7 @@ static void release_job(trace_job *job) {
   free(job->unblocked);
   free(job->slice_dir);
   free(job->sums);
+  free(job->blocked);
 }
 
 /* Adds slice s's unblocked weight for `blocked` blocked rays to sum[]. */
@@ -550,17 +559,25 @@ static inline double origin_z(const trace_job *job, int x, int y) {
   return (double)job->p->z[(size_t)y * (size_t)job->p->width + (size_t)x] + job->o->bias_texels;
 }
 
-/* Band path: one slice over one row; the texels' sums grow slice by slice,
- * always in slice order, so the result does not depend on threads. */
-static void trace_slice_row(void *user, int y) {
+/* Band path: one slice over one row. */
+static void band_slice_row(void *user, int y) {
   const trace_job *job = user;
   const bb_rayset *rs = job->rs;
   const int s = job->slice, start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
   double hint = 0.0; /* where the previous texel's horizon was */
+  for (int x = 0; x < job->p->width; x++)
+    job->blocked[(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
+        job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
+        rs->tan_elevation + start, count, &hint);
+}
+
+/* The texels' sums grow slice by slice, always in slice order, so the
+ * result does not depend on threads. */
+static void add_slice_row(void *user, int y) {
+  const trace_job *job = user;
   for (int x = 0; x < job->p->width; x++) {
-    const int blocked = march_band(job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
-                                   rs->tan_elevation + start, count, &hint);
-    add_slice(job, s, blocked, job->sums + ((size_t)y * (size_t)job->p->width + (size_t)x) * (size_t)job->channels);
+    const size_t texel = (size_t)y * (size_t)job->p->width + (size_t)x;
+    add_slice(job, job->slice, job->blocked[texel], job->sums + texel * (size_t)job->channels);
   }
 }
 
@@ -588,43 +605,47 @@ static void trace_row(void *user, int y) {
   }
 }
 
-/* Progress over all slices of the band path. */
-typedef struct slice_progress {
-  const bb_trace_options *o;
-  long base, total;
-} slice_progress;
-
-static void report_slice_progress(void *user, long done, long total) {
-  (void)total;
-  const slice_progress *sp = user;
-  sp->o->progress(sp->o->progress_user, sp->base + done, sp->total);
+/* Slice s's blocked counts at every texel: by line sweeps (periodic, when
+ * allowed) or by marches through the slice's direction bands. */
+static bb_status blocked_counts(trace_job *job, int s, int sweep, bb_error *err) {
+  const bb_pyramid *p = job->p;
+  const bb_rayset *rs = job->rs;
+  const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+  if (sweep && p->addressing == BB_ADDRESS_PERIODIC)
+    return bb__sweep_slice(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
+                           rs->tan_elevation + start, count, job->o->bias_texels,
+                           job->o->threads, job->blocked, err);
+  bb__band band;
+  bb_status st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads,
+                                &band, err);
+  if (st != BB_OK) return st;
+  job->band = &band;
+  st = bb__parallel_for(p->height, job->o->threads, band_slice_row, job, NULL, NULL, err);
+  bb__band_free(&band);
+  job->band = NULL;
+  return st;
 }
 
-static bb_status trace_bands(trace_job *job, bb_error *err) {
+static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
-  const size_t values = (size_t)p->width * (size_t)p->height * (size_t)job->channels;
-  job->sums = calloc(values, sizeof(double));
-  if (!job->sums) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
-  slice_progress sp = {.o = job->o, .total = (long)job->rs->slice_count * p->height};
+  const size_t texels = (size_t)p->width * (size_t)p->height;
+  job->sums = calloc(texels * (size_t)job->channels, sizeof(double));
+  job->blocked = malloc(texels * sizeof(uint16_t));
+  if (!job->sums || !job->blocked) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
   bb_status st = BB_OK;
   for (int s = 0; st == BB_OK && s < job->rs->slice_count; s++) {
-    bb__band band;
-    st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads, &band, err);
-    if (st != BB_OK) break;
-    job->band = &band;
     job->slice = s;
-    sp.base = (long)s * p->height;
-    st = bb__parallel_for(p->height, job->o->threads, trace_slice_row, job,
-                          job->o->progress ? report_slice_progress : NULL, &sp, err);
-    bb__band_free(&band);
+    st = blocked_counts(job, s, sweep, err);
+    if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, add_slice_row, job, NULL, NULL, err);
+    if (job->o->progress) job->o->progress(job->o->progress_user, s + 1, job->rs->slice_count);
   }
   if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, finish_row, job, NULL, NULL, err);
   return st;
 }
 
 bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
-                                   const bb_trace_options *o, int use_bands, bb_image *vis,
-                                   bb_error *err) {
+                                   const bb_trace_options *o, bb__trace_path path,
+                                   bb_image *vis, bb_error *err) {
   memset(vis, 0, sizeof *vis);
   if (!p || !rs || !o || rs->ray_count < 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing pyramid, ray set or options");
@@ -636,9 +657,10 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
   if (st == BB_OK) st = bb_image_alloc(vis, p->width, p->height, job.channels, err);
   if (st == BB_OK) {
     job.vis = vis->pixels;
-    st = use_bands ? trace_bands(&job, err)
-                   : bb__parallel_for(p->height, o->threads, trace_row, &job, o->progress,
-                                      o->progress_user, err);
+    st = path == BB__TRACE_SQUARE
+             ? bb__parallel_for(p->height, o->threads, trace_row, &job, o->progress,
+                                o->progress_user, err)
+             : trace_slices(&job, path == BB__TRACE_SWEEP, err);
   }
   release_job(&job);
   if (st != BB_OK) bb_image_free(vis);
@@ -648,10 +670,12 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *rays_traced, bb_error *err) {
-  /* The bands cost one float per texel and level, and the sums one double
-   * per texel and channel: past 4096 x 4096 the square nodes do without. */
-  const int use_bands = p && (long)p->width * p->height <= 4096L * 4096L;
-  bb_status st = bb__trace_occlusion_path(p, rs, o, use_bands, vis, err);
+  /* Slice by slice, the sums cost a double per texel and channel (and bands
+   * a float per texel and level): past 4096 x 4096 the square nodes, texel
+   * by texel, do without. */
+  const int by_slice = p && (long)p->width * p->height <= 4096L * 4096L;
+  bb_status st = bb__trace_occlusion_path(p, rs, o, by_slice ? BB__TRACE_SWEEP : BB__TRACE_SQUARE,
+                                          vis, err);
   if (st == BB_OK && rays_traced)
     *rays_traced = (double)p->width * (double)p->height * (double)rs->ray_count;
   return st;

@@ -5,6 +5,8 @@
 
 #include "bumpbake.h"
 
+#include <stdint.h>
+
 #define BB__MAX_LEVELS 32
 
 struct bb_pyramid {
@@ -37,11 +39,23 @@ int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
 int bb__march_brute(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
                     int n);
 
-/* bb_trace_occlusion with the choice of march made by the caller: through
- * direction bands (use_bands = 1) or square nodes (0). For tests. */
+/* How bb_trace_occlusion finds each texel's blocked rays. */
+typedef enum bb__trace_path {
+  BB__TRACE_SQUARE, /* texel by texel, every slice marched through square nodes */
+  BB__TRACE_BANDS,  /* slice by slice, marched through direction bands */
+  BB__TRACE_SWEEP   /* slice by slice, line sweeps (periodic; else bands) */
+} bb__trace_path;
+
+/* bb_trace_occlusion with the path chosen by the caller. For tests. */
 bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
-                                   const bb_trace_options *o, int use_bands, bb_image *vis,
-                                   bb_error *err);
+                                   const bb_trace_options *o, bb__trace_path path,
+                                   bb_image *vis, bb_error *err);
+
+/* Periodic addressing only: for the lattice step (a, b), the number of the n
+ * rising tangents tan_el blocked at every texel (origin lifted by bias),
+ * into blocked (one per texel), by line sweeps (sweep.c). */
+bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_el, int n,
+                          double bias, int threads, uint16_t *blocked, bb_error *err);
 
 /* Directional max bands of the pyramid's cells for one azimuth (band.c). */
 #define BB__BAND_LEVELS 8

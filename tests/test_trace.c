@@ -294,10 +294,10 @@ Test(trace, rejects_negative_bias) {
   bb_image_free(&z);
 }
 
-/* The batch trace through direction bands must give, bit for bit, what the
- * square-node march gives (which the tests above tie to brute force), in
- * both addressing modes, on odd and non-square sizes. */
-Test(trace, band_march_equals_square_march) {
+/* The batch trace by line sweeps and through direction bands must give, bit
+ * for bit, what the square-node march gives (which the tests above tie to
+ * brute force), in both addressing modes, on odd and non-square sizes. */
+Test(trace, sweeps_and_bands_equal_square_march) {
   const int sizes[][2] = {{1, 1}, {5, 3}, {17, 17}, {40, 23}, {64, 64}};
   rng_state = 4242;
   for (int a = 0; a < 2; a++)
@@ -310,14 +310,22 @@ Test(trace, band_march_equals_square_march) {
         bb_trace_options o;
         bb_trace_options_init(&o);
         o.bias_texels = kind == 1 ? 0.0 : 0.55;
-        bb_image bands, square;
+        bb_image sweeps, bands, square;
         bb_error err;
-        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, 1, &bands, &err), BB_OK, "%s", err.message);
-        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, 0, &square, &err), BB_OK, "%s", err.message);
+        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SWEEP, &sweeps, &err), BB_OK,
+                     "%s", err.message);
+        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_BANDS, &bands, &err), BB_OK,
+                     "%s", err.message);
+        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SQUARE, &square, &err), BB_OK,
+                     "%s", err.message);
         size_t n = (size_t)z.width * (size_t)z.height * 5;
-        for (size_t i = 0; i < n; i++)
-          cr_assert_eq(bands.pixels[i], square.pixels[i], "%dx%d %s kind %d: texel %zu channel %zu",
+        for (size_t i = 0; i < n; i++) {
+          cr_assert_eq(bands.pixels[i], square.pixels[i], "bands: %dx%d %s kind %d: texel %zu channel %zu",
                        z.width, z.height, a ? "clamp" : "periodic", kind, i / 5, i % 5);
+          cr_assert_eq(sweeps.pixels[i], square.pixels[i], "sweeps: %dx%d %s kind %d: texel %zu channel %zu",
+                       z.width, z.height, a ? "clamp" : "periodic", kind, i / 5, i % 5);
+        }
+        bb_image_free(&sweeps);
         bb_image_free(&bands);
         bb_image_free(&square);
         bb_rayset_free(&rs);

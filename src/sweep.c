@@ -1,0 +1,243 @@
+/* sweep.c: the horizons of every texel for one lattice slice direction, by
+ * one backward sweep along each line of texels (periodic addressing).
+ *
+ * A slice follows a lattice step (a, b) (coprime integers), so texel P and
+ * P + j (a, b) lie on one line, and so do all the breakpoints of the surface
+ * between them: crossings of vertical lines, horizontal lines and the
+ * diagonals x + y = k of Valve's triangles. Between two texels of the line
+ * the breakpoints sit at the same fractions of the step for every step (the
+ * "template"), so a line is a sequence of points (u, z), u = distance in
+ * steps. A texel's horizon in that direction is the largest slope from its
+ * origin (u_P, z_P + bias) to a point ahead, which is the tangent from the
+ * origin to the upper convex hull of the points ahead: walking the line
+ * backwards, each point is pushed onto a hull stack once, and each texel asks
+ * the stack for its tangent by binary search. The rays of the slice blocked
+ * at a texel are those whose tangent tan_el * |(a, b)| is at most that slope.
+ *
+ * Lines are periodic (the texture tiles), so they are cut into chunks of at
+ * most CHUNK_STEPS texels, each swept with a look-ahead past its end of as
+ * many steps as a ray of the lowest elevation needs to rise above the global
+ * maximum (or one whole period, past which nothing new can come). Chunks are
+ * independent, so they run on all threads with the same result.
+ */
+#include "internal.h"
+#include "trace_internal.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { CHUNK_STEPS = 1024 };
+
+/* A breakpoint of one step, relative to the step's first texel: the surface
+ * there is z(v1) + (z(v2) - z(v1)) * w. */
+typedef struct template_point {
+  double u;       /* fraction of the step, in (0, 1] */
+  int x1, y1, x2, y2;
+  double w;
+} template_point;
+
+typedef struct sweep_job {
+  const bb_pyramid *p;
+  int a, b;
+  template_point *points;
+  int point_count;
+  const int *chunk_x, *chunk_y, *chunk_len; /* first texel and length of each chunk */
+  int lookahead;                            /* steps */
+  double bias;
+  const double *tan_step; /* thresholds on the slope per step: tan_el * |(a, b)| */
+  int n;
+  uint16_t *blocked;      /* per texel */
+  atomic_int out_of_memory;
+} sweep_job;
+
+static int cmp_u(const void *pa, const void *pb) {
+  const double a = ((const template_point *)pa)->u, b = ((const template_point *)pb)->u;
+  return a < b ? -1 : a > b;
+}
+
+/* Breakpoints of the step from (0, 0) to (a, b), sorted by u. For coprime
+ * (a, b) the three families meet only at the step's end, the next texel,
+ * which is kept once, as the vertex itself. */
+static int build_template(int a, int b, template_point *out) {
+  int n = 0;
+  const int ma = abs(a), mb = abs(b), md = abs(a + b);
+  for (int i = 1; i < ma; i++) { /* vertical lines x = X */
+    const double u = (double)i / ma, y = u * b;
+    const int X = i * (a > 0 ? 1 : -1), row = (int)floor(y);
+    out[n++] = (template_point){u, X, row, X, row + 1, y - row};
+  }
+  for (int i = 1; i < mb; i++) { /* horizontal lines y = Y */
+    const double u = (double)i / mb, x = u * a;
+    const int Y = i * (b > 0 ? 1 : -1), col = (int)floor(x);
+    out[n++] = (template_point){u, col, Y, col + 1, Y, x - col};
+  }
+  for (int i = 1; i < md; i++) { /* diagonals x + y = K, from (c+1, K-1-c) to (c, K-c) */
+    const double u = (double)i / md, x = u * a, y = u * b;
+    const int K = i * (a + b > 0 ? 1 : -1), col = (int)floor(x), row = K - 1 - col;
+    out[n++] = (template_point){u, col + 1, row, col, row + 1, y - row};
+  }
+  out[n++] = (template_point){1.0, a, b, a, b, 0.0}; /* the next texel */
+  qsort(out, (size_t)n, sizeof *out, cmp_u);
+  return n;
+}
+
+static inline int wrap_near(int c, int n) {
+  while (c >= n) c -= n;
+  while (c < 0) c += n;
+  return c;
+}
+
+/* Upper hull of the points ahead, nearest last. */
+typedef struct hull {
+  double *u, *z;
+  int size;
+} hull;
+
+/* Pushes a point nearer than all others, dropping those now under the hull. */
+static inline void hull_push(hull *h, double u, double z) {
+  while (h->size >= 2) {
+    const double ua = h->u[h->size - 1], za = h->z[h->size - 1];
+    const double ub = h->u[h->size - 2], zb = h->z[h->size - 2];
+    /* a is on or under the segment from the new point to b */
+    if ((za - z) * (ub - u) <= (zb - z) * (ua - u)) h->size--;
+    else break;
+  }
+  h->u[h->size] = u;
+  h->z[h->size] = z;
+  h->size++;
+}
+
+/* Largest slope from (u0, z0), behind every point, to the hull: slopes to
+ * hull vertices rise, then fall, going away from the origin. */
+static double hull_tangent(const hull *h, double u0, double z0) {
+  int lo = 0, hi = h->size - 1; /* indices counted from the nearest (size - 1) */
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    const int i = h->size - 1 - mid, j = i - 1; /* j is one step farther */
+    /* is the farther vertex steeper? (denominators are positive) */
+    if ((h->z[j] - z0) * (h->u[i] - u0) > (h->z[i] - z0) * (h->u[j] - u0)) lo = mid + 1;
+    else hi = mid;
+  }
+  const int k = h->size - 1 - lo;
+  return (h->z[k] - z0) / (h->u[k] - u0);
+}
+
+static inline double field_z(const bb_pyramid *p, int x, int y) {
+  return (double)p->z[(size_t)wrap_near(y, p->height) * (size_t)p->width +
+                      (size_t)wrap_near(x, p->width)];
+}
+
+static void sweep_chunk(void *user, int chunk) {
+  sweep_job *job = user;
+  const bb_pyramid *p = job->p;
+  const int len = job->chunk_len[chunk], steps = len + job->lookahead;
+  const int x0 = job->chunk_x[chunk], y0 = job->chunk_y[chunk];
+  hull h = {0};
+  const size_t cap = (size_t)steps * (size_t)job->point_count + 1;
+  h.u = malloc(cap * sizeof(double));
+  h.z = malloc(cap * sizeof(double));
+  if (!h.u || !h.z) {
+    atomic_store(&job->out_of_memory, 1);
+    free(h.u);
+    free(h.z);
+    return;
+  }
+  /* the step's first texel, walked backwards, kept in [0, size) */
+  int bx = (int)(((long)x0 + (long)(steps - 1) * job->a) % p->width);
+  int by = (int)(((long)y0 + (long)(steps - 1) * job->b) % p->height);
+  bx = wrap_near(bx, p->width);
+  by = wrap_near(by, p->height);
+  const int back_x = wrap_near(-(job->a % p->width), p->width);
+  const int back_y = wrap_near(-(job->b % p->height), p->height);
+  for (int j = steps - 1; j >= 0; j--, bx = wrap_near(bx + back_x, p->width),
+           by = wrap_near(by + back_y, p->height)) {
+    for (int k = job->point_count - 1; k >= 0; k--) {
+      const template_point *t = &job->points[k];
+      const double za = field_z(p, bx + t->x1, by + t->y1), zb = field_z(p, bx + t->x2, by + t->y2);
+      hull_push(&h, (double)j + t->u, za + (zb - za) * t->w);
+    }
+    if (j < len) {
+      const double z0 = (double)p->z[(size_t)by * (size_t)p->width + (size_t)bx] + job->bias;
+      const double slope = hull_tangent(&h, (double)j, z0);
+      int blocked = 0;
+      while (blocked < job->n && slope >= job->tan_step[blocked]) blocked++;
+      job->blocked[(size_t)by * (size_t)p->width + (size_t)bx] = (uint16_t)blocked;
+    }
+  }
+  free(h.u);
+  free(h.z);
+}
+
+/* Cuts the lines of step (a, b) into chunks: the first texel and length of
+ * each. A line through P closes after `period` steps. */
+static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **cy, int **clen,
+                             int *count, bb_error *err) {
+  const size_t n = (size_t)p->width * (size_t)p->height;
+  unsigned char *seen = calloc(n, 1);
+  *cx = malloc(n * sizeof(int));
+  *cy = malloc(n * sizeof(int));
+  *clen = malloc(n * sizeof(int));
+  if (!seen || !*cx || !*cy || !*clen) {
+    free(seen);
+    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  }
+  int c = 0;
+  for (int y = 0; y < p->height; y++)
+    for (int x = 0; x < p->width; x++) {
+      if (seen[(size_t)y * (size_t)p->width + (size_t)x]) continue;
+      int px = x, py = y, run = 0;
+      while (!seen[(size_t)py * (size_t)p->width + (size_t)px]) {
+        if (run == 0) {
+          (*cx)[c] = px;
+          (*cy)[c] = py;
+        }
+        seen[(size_t)py * (size_t)p->width + (size_t)px] = 1;
+        px = wrap_near(px + a % p->width, p->width);
+        py = wrap_near(py + b % p->height, p->height);
+        if (++run == CHUNK_STEPS) {
+          (*clen)[c++] = run;
+          run = 0;
+        }
+      }
+      if (run) (*clen)[c++] = run;
+    }
+  free(seen);
+  *count = c;
+  return BB_OK;
+}
+
+bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_el, int n,
+                          double bias, int threads, uint16_t *blocked, bb_error *err) {
+  const double step_length = hypot(a, b);
+  template_point pts[4 * 128 + 1];
+  if (abs(a) > 128 || abs(b) > 128 || (a == 0 && b == 0))
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
+  double *tan_step = malloc((size_t)n * sizeof(double));
+  int *cx = NULL, *cy = NULL, *clen = NULL, chunks = 0;
+  bb_status st = tan_step ? make_chunks(p, a, b, &cx, &cy, &clen, &chunks, err)
+                          : bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  if (st == BB_OK) {
+    for (int e = 0; e < n; e++) tan_step[e] = tan_el[e] * step_length;
+    /* Past this many steps the lowest ray is above the global maximum. */
+    const double rise = (double)p->global_max - (double)p->global_min;
+    double reach = tan_el[0] > 0.0 ? ceil(rise / tan_step[0]) + 2.0 : 1e9;
+    const long period = (long)p->width * p->height; /* a line never runs longer */
+    sweep_job job = {.p = p, .a = a, .b = b, .points = pts, .bias = bias,
+                     .tan_step = tan_step, .n = n, .blocked = blocked,
+                     .chunk_x = cx, .chunk_y = cy, .chunk_len = clen};
+    atomic_init(&job.out_of_memory, 0);
+    job.point_count = build_template(a, b, pts);
+    job.lookahead = (int)(reach < (double)period ? reach : (double)period);
+    st = bb__parallel_for(chunks, threads, sweep_chunk, &job, NULL, NULL, err);
+    if (st == BB_OK && atomic_load(&job.out_of_memory))
+      st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
+  }
+  free(tan_step);
+  free(cx);
+  free(cy);
+  free(clen);
+  return st;
+}
