@@ -10,17 +10,22 @@
  * The origin itself (t = 0) never counts: that is the one rule for the ray's
  * start on the surface, and it makes bias 0 well defined.
  *
- * Every breakpoint is computed by process_cell() from the cell's integer
- * position, the origin and the direction only, never from the path that
+ * Every breakpoint is computed (cross_vertical/horizontal/diagonal) from its
+ * line's index, the origin and the direction only, never from the path that
  * reached it. So the max-mip march, the brute-force DDA and a march of a
- * whole azimuth slice compute bit-identical slopes and give identical answers:
- * a skipped node only ever hides breakpoints whose slope is below the
- * threshold by more than `margin`, far beyond rounding.
+ * whole azimuth slice compute bit-identical slopes and give identical answers
+ * whatever order they test breakpoints in: a skipped node only ever hides
+ * breakpoints whose slope is below the threshold by more than `margin`, far
+ * beyond rounding.
  *
  * Slices. All rays of an azimuth slice share the 2D line, so one march that
  * tracks the highest breakpoint slope seen (the horizon) answers all of them:
  * the rays of the slice are sorted by elevation, and the march only looks for
- * breakpoints that would block the lowest ray not yet blocked.
+ * breakpoints that would block the lowest ray not yet blocked. The batch
+ * trace gets each texel's count of blocked rays per slice from line sweeps
+ * (sweep.c) on periodic maps, from marches through direction bands (band.c)
+ * in clamp mode, or, past 4096 x 4096, from marches through square nodes,
+ * texel by texel.
  */
 #include "internal.h"
 #include "trace_internal.h"
