@@ -37,6 +37,7 @@ typedef struct template_point {
   double u;       /* fraction of the step, in (0, 1] */
   int x1, y1, x2, y2;
   double w;
+  long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
 } template_point;
 
 typedef struct sweep_job {
@@ -48,6 +49,7 @@ typedef struct sweep_job {
   int lookahead;                            /* steps */
   double bias;
   const double *tan_step; /* thresholds on the slope per step: tan_el * |(a, b)| */
+  int reach_x, reach_y;   /* how far template vertices lie from a step's texel */
   int n;
   uint16_t *blocked;      /* per texel */
   atomic_int out_of_memory;
@@ -67,21 +69,25 @@ static int build_template(int a, int b, template_point *out) {
   for (int i = 1; i < ma; i++) { /* vertical lines x = X */
     const double u = (double)i / ma, y = u * b;
     const int X = i * (a > 0 ? 1 : -1), row = (int)floor(y);
-    out[n++] = (template_point){u, X, row, X, row + 1, y - row};
+    out[n++] = (template_point){u, X, row, X, row + 1, y - row, 0, 0};
   }
   for (int i = 1; i < mb; i++) { /* horizontal lines y = Y */
     const double u = (double)i / mb, x = u * a;
     const int Y = i * (b > 0 ? 1 : -1), col = (int)floor(x);
-    out[n++] = (template_point){u, col, Y, col + 1, Y, x - col};
+    out[n++] = (template_point){u, col, Y, col + 1, Y, x - col, 0, 0};
   }
   for (int i = 1; i < md; i++) { /* diagonals x + y = K, from (c+1, K-1-c) to (c, K-c) */
     const double u = (double)i / md, x = u * a, y = u * b;
     const int K = i * (a + b > 0 ? 1 : -1), col = (int)floor(x), row = K - 1 - col;
-    out[n++] = (template_point){u, col + 1, row, col, row + 1, y - row};
+    out[n++] = (template_point){u, col + 1, row, col, row + 1, y - row, 0, 0};
   }
-  out[n++] = (template_point){1.0, a, b, a, b, 0.0}; /* the next texel */
+  out[n++] = (template_point){1.0, a, b, a, b, 0.0, 0, 0}; /* the next texel */
   qsort(out, (size_t)n, sizeof *out, cmp_u);
   return n;
+}
+
+static inline int imax(int a, int b) {
+  return a > b ? a : b;
 }
 
 static inline int wrap_near(int c, int n) {
@@ -154,9 +160,20 @@ static void sweep_chunk(void *user, int chunk) {
   const int back_y = wrap_near(-(job->b % p->height), p->height);
   for (int j = steps - 1; j >= 0; j--, bx = wrap_near(bx + back_x, p->width),
            by = wrap_near(by + back_y, p->height)) {
+    /* Away from the edges no vertex wraps, and each is a fixed offset. */
+    const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
+                         by >= job->reach_y && by < p->height - job->reach_y;
+    const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
     for (int k = job->point_count - 1; k >= 0; k--) {
       const template_point *t = &job->points[k];
-      const double za = field_z(p, bx + t->x1, by + t->y1), zb = field_z(p, bx + t->x2, by + t->y2);
+      double za, zb;
+      if (interior) {
+        za = here[t->offset1];
+        zb = here[t->offset2];
+      } else {
+        za = field_z(p, bx + t->x1, by + t->y1);
+        zb = field_z(p, bx + t->x2, by + t->y2);
+      }
       hull_push(&h, (double)j + t->u, za + (zb - za) * t->w);
     }
     if (j < len) {
@@ -230,6 +247,13 @@ bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_e
                      .chunk_x = cx, .chunk_y = cy, .chunk_len = clen};
     atomic_init(&job.out_of_memory, 0);
     job.point_count = build_template(a, b, pts);
+    for (int k = 0; k < job.point_count; k++) {
+      template_point *t = &pts[k];
+      t->offset1 = t->x1 + (long)t->y1 * p->width;
+      t->offset2 = t->x2 + (long)t->y2 * p->width;
+      job.reach_x = imax(job.reach_x, imax(abs(t->x1), abs(t->x2)) + 1);
+      job.reach_y = imax(job.reach_y, imax(abs(t->y1), abs(t->y2)) + 1);
+    }
     job.lookahead = (int)(reach < (double)period ? reach : (double)period);
     st = bb__parallel_for(chunks, threads, sweep_chunk, &job, NULL, NULL, err);
     if (st == BB_OK && atomic_load(&job.out_of_memory))
