@@ -4,6 +4,7 @@
 
 #include <stddef.h>
 #include <stdlib.h>
+#include <pthread.h>
 #include <string.h>
 
 /* The maps bake can write, in CLI_OPT_OUT_* order. */
@@ -252,18 +253,51 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
 }
 
 /* Writes every requested output; stops at the first failure. */
+/* One output written on its own thread: encoding (zlib for PNG) is most of
+ * a write, so the outputs of a bake are written side by side. Each task has
+ * its own copy of the run, which cli_write_output updates. */
+typedef struct write_task {
+  const bake_args *args;
+  const bb_bake_result *result;
+  cli_run run;
+  int kind;
+  int rc;
+} write_task;
+
+static void *write_one(void *arg) {
+  write_task *t = arg;
+  t->rc = cli_write_output(&t->run, output_kinds[t->kind].kind, t->args->paths[t->kind],
+                           result_image(t->result, t->kind), output_kinds[t->kind].range);
+  return NULL;
+}
+
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r) {
+  write_task tasks[OUTPUT_KIND_COUNT];
+  pthread_t threads[OUTPUT_KIND_COUNT];
+  int started[OUTPUT_KIND_COUNT] = {0};
+  const double t0 = cli_now_seconds();
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
     if (!a->paths[k])
       continue;
-    int rc = cli_write_output(run, output_kinds[k].kind, a->paths[k], result_image(r, k),
-                              output_kinds[k].range);
-    if (rc)
-      return rc;
-    if (!a->json && !a->quiet)
+    tasks[k] = (write_task){.args = a, .result = r, .run = *run, .kind = k, .rc = 0};
+    started[k] = pthread_create(&threads[k], NULL, write_one, &tasks[k]) == 0;
+    if (!started[k]) /* no thread to be had: write it here */
+      write_one(&tasks[k]);
+  }
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    if (started[k])
+      pthread_join(threads[k], NULL);
+  run->seconds_write += cli_now_seconds() - t0;
+  int rc = 0;
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
+    if (!a->paths[k])
+      continue;
+    if (tasks[k].rc && !rc)
+      rc = tasks[k].rc;
+    else if (!tasks[k].rc && !a->json && !a->quiet)
       printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
   }
-  return 0;
+  return rc;
 }
 
 static int needs_trace(const bake_args *a) {
