@@ -70,7 +70,7 @@ $(LIB): $(LIB_OBJ)
 $(BIN): $(CLI_OBJ) $(LIB)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS)
 
-$(BUILD)/tools/%: tools/%.c $(LIB) include/bumpbake.h
+$(BUILD)/tools/%: tools/%.c $(wildcard tools/*.h) $(LIB) include/bumpbake.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(LDLIBS) -lstdc++
 

@@ -25,6 +25,7 @@
  * so another tracer can be run on exactly the same rays.
  */
 #include "bumpbake.h"
+#include "json_string.h"
 
 #include <errno.h>
 #include <math.h>
@@ -311,19 +312,6 @@ static double ao_max_difference(const subset *s, const bb_rayset *rs,
 
 /* ------------------------------------------------------------- output */
 
-/* s as a JSON string body: quotes, backslashes and control bytes escaped. */
-static void print_json_string(const char *s) {
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\')
-      printf("\\%c", c);
-    else if (c < 0x20)
-      printf("\\u%04x", c);
-    else
-      putchar(c);
-  }
-}
-
 typedef struct results {
   double trace_s, brute_s, maxmip_s, ao_diff;
   int trace_runs, brute_runs, maxmip_runs;
@@ -340,9 +328,9 @@ static void print_json(const args *a, const field *f, const trace_run *t,
   const double subset_rays = (double)r->subset_rays;
   const double trace_rate = per_second(t->rays_traced, r->trace_s);
   const double brute_rate = per_second(subset_rays, r->brute_s);
-  printf("{\"map\":\"");
+  printf("{\"map\":");
   print_json_string(a->map);
-  printf("\",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"threads\":%d,"
+  printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"threads\":%d,"
          "\"bias\":%g,",
          f->z.width, f->z.height, a->scale, a->rays, a->threads, a->bias);
   printf("\"load_s\":%.6f,\"smooth_s\":%.6f,\"pyramid_s\":%.6f,", f->seconds_load,
@@ -425,9 +413,9 @@ static int peer_agreement(const args *a, const field *f) {
         worst = d;
       over += d > PEER_AO_TOLERANCE;
     }
-    printf("{\"peer_ao\":\"");
+    printf("{\"peer_ao\":");
     print_json_string(a->peer_ao);
-    printf("\",\"subset_texels\":%d,\"mean_abs\":%.3g,\"max_abs\":%.3g,\"tolerance\":%g,"
+    printf(",\"subset_texels\":%d,\"mean_abs\":%.3g,\"max_abs\":%.3g,\"tolerance\":%g,"
            "\"texels_over\":%d}\n",
            s.count, s.count ? sum / s.count : 0.0, worst, PEER_AO_TOLERANCE, over);
     fprintf(

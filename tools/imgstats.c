@@ -13,6 +13,7 @@
  * command line.
  */
 #include "bumpbake.h"
+#include "json_string.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -44,21 +45,6 @@ static channel_stats channel_difference(const bb_image *a, const bb_image *b, in
   size_t rank = (size_t)ceil(0.99 * (double)n);
   channel_stats s = {sum / (double)n, scratch[rank > 0 ? rank - 1 : 0], scratch[n - 1]};
   return s;
-}
-
-/* s as a JSON string body: quotes, backslashes and control bytes escaped. */
-static void print_json_string(const char *s) {
-  putchar('"');
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\')
-      printf("\\%c", c);
-    else if (c < 0x20)
-      printf("\\u%04x", c);
-    else
-      putchar(c);
-  }
-  putchar('"');
 }
 
 static int read_image(const char *path, bb_image *img) {
