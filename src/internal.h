@@ -21,6 +21,9 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 
 #define BB__PI 3.14159265358979323846
 
+/* Largest |a| or |b| of a ray set's lattice steps (and of what sweep.c takes). */
+#define BB__MAX_LATTICE_STEP 128
+
 /* Non-negative remainder: the periodic index of i in [0, n). */
 static inline int bb__wrap(int i, int n) {
   int r = i % n;

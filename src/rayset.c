@@ -65,18 +65,22 @@ static int gcd(int a, int b) {
   return a;
 }
 
-/* The smallest coprime lattice step (a, b) within tolerance of angle phi. */
+/* The smallest coprime lattice step (a, b) within tolerance of angle phi,
+ * or failing that (never seen for up to 65536 rays, whose steps stay under
+ * 100) the closest with |a|, |b| <= BB__MAX_LATTICE_STEP. */
 static void lattice_step(double phi, double tolerance, int step[2]) {
-  for (int q = 1;; q++)
+  double best = INFINITY;
+  for (int q = 1; q <= BB__MAX_LATTICE_STEP; q++)
     for (int a = -q; a <= q; a++)
       for (int b = -q; b <= q; b++) {
         if ((abs(a) != q && abs(b) != q) || gcd(a, b) != 1) continue;
-        double error = fabs(remainder(atan2(b, a) - phi, 2.0 * BB__PI));
-        if (error <= tolerance || q >= 64) {
+        const double error = fabs(remainder(atan2(b, a) - phi, 2.0 * BB__PI));
+        if (error < best) {
+          best = error;
           step[0] = a;
           step[1] = b;
-          if (error <= tolerance) return;
         }
+        if (error <= tolerance) return;
       }
 }
 

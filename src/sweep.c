@@ -229,8 +229,8 @@ static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **
 bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_el, int n,
                           double bias, int threads, uint16_t *blocked, bb_error *err) {
   const double step_length = hypot(a, b);
-  template_point pts[4 * 128 + 1];
-  if (abs(a) > 128 || abs(b) > 128 || (a == 0 && b == 0))
+  template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
+  if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
   double *tan_step = malloc((size_t)n * sizeof(double));
   int *cx = NULL, *cy = NULL, *clen = NULL, chunks = 0;

@@ -3,6 +3,7 @@
 #include <criterion/criterion.h>
 
 #include <math.h>
+#include <stdlib.h>
 
 #include "bumpbake.h"
 
@@ -69,4 +70,23 @@ Test(rayset, rejects_bad_arguments) {
   cr_assert_eq(bb_rayset_make(0, 1.0, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb_rayset_make(16, 0.5, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb_rayset_make(16, NAN, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
+}
+
+/* Slices follow lattice steps close to uniform azimuths, for every ray
+ * count up to the maximum, so line sweeps can serve any bake. */
+Test(rayset, slices_follow_lattice_steps_near_uniform_azimuths) {
+  const int counts[] = {1, 2, 7, 256, 1000, 4096, 65536};
+  for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+    bb_rayset rs;
+    cr_assert_eq(bb_rayset_make(counts[i], 1.0, BB_BASIS_HL2, &rs, NULL), BB_OK);
+    const double spacing = 2 * 3.141592653589793 / rs.slice_count;
+    for (int s = 0; s < rs.slice_count; s++) {
+      const int a = rs.slice_step[2 * s], b = rs.slice_step[2 * s + 1];
+      cr_assert(abs(a) <= 128 && abs(b) <= 128 && (a || b), "%d rays, slice %d: (%d, %d)", counts[i], s, a, b);
+      const double error = fabs(remainder(atan2(b, a) - spacing * (s + 0.5), 2 * 3.141592653589793));
+      cr_assert_leq(error, spacing / 20 + 1e-12, "%d rays, slice %d: off by %g rad", counts[i], s, error);
+      cr_assert_float_eq(atan2(rs.slice_dir[2 * s + 1], rs.slice_dir[2 * s]), atan2(b, a), 1e-12);
+    }
+    bb_rayset_free(&rs);
+  }
 }
