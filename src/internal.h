@@ -30,6 +30,14 @@ static inline int bb__wrap(int i, int n) {
   return r < 0 ? r + n : r;
 }
 
+/* bb__wrap for an index known to lie within a few periods of [0, n):
+ * a subtraction or two instead of a division, for the tracer's inner loops. */
+static inline int bb__wrap_near(int i, int n) {
+  while (i >= n) i -= n;
+  while (i < 0) i += n;
+  return i;
+}
+
 static inline int bb__clampi(int i, int lo, int hi) {
   return i < lo ? lo : (i > hi ? hi : i);
 }

@@ -90,12 +90,6 @@ static inline int imax(int a, int b) {
   return a > b ? a : b;
 }
 
-static inline int wrap_near(int c, int n) {
-  while (c >= n) c -= n;
-  while (c < 0) c += n;
-  return c;
-}
-
 /* Upper hull of the points ahead, nearest last. */
 typedef struct hull {
   double *u, *z;
@@ -132,8 +126,8 @@ static double hull_tangent(const hull *h, double u0, double z0) {
 }
 
 static inline double field_z(const bb_pyramid *p, int x, int y) {
-  return (double)p->z[(size_t)wrap_near(y, p->height) * (size_t)p->width +
-                      (size_t)wrap_near(x, p->width)];
+  return (double)p->z[(size_t)bb__wrap_near(y, p->height) * (size_t)p->width +
+                      (size_t)bb__wrap_near(x, p->width)];
 }
 
 static void sweep_chunk(void *user, int chunk) {
@@ -154,12 +148,12 @@ static void sweep_chunk(void *user, int chunk) {
   /* the step's first texel, walked backwards, kept in [0, size) */
   int bx = (int)(((long)x0 + (long)(steps - 1) * job->a) % p->width);
   int by = (int)(((long)y0 + (long)(steps - 1) * job->b) % p->height);
-  bx = wrap_near(bx, p->width);
-  by = wrap_near(by, p->height);
-  const int back_x = wrap_near(-(job->a % p->width), p->width);
-  const int back_y = wrap_near(-(job->b % p->height), p->height);
-  for (int j = steps - 1; j >= 0; j--, bx = wrap_near(bx + back_x, p->width),
-           by = wrap_near(by + back_y, p->height)) {
+  bx = bb__wrap_near(bx, p->width);
+  by = bb__wrap_near(by, p->height);
+  const int back_x = bb__wrap_near(-(job->a % p->width), p->width);
+  const int back_y = bb__wrap_near(-(job->b % p->height), p->height);
+  for (int j = steps - 1; j >= 0; j--, bx = bb__wrap_near(bx + back_x, p->width),
+           by = bb__wrap_near(by + back_y, p->height)) {
     /* Away from the edges no vertex wraps, and each is a fixed offset. */
     const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
                          by >= job->reach_y && by < p->height - job->reach_y;
@@ -212,8 +206,8 @@ static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **
           (*cy)[c] = py;
         }
         seen[(size_t)py * (size_t)p->width + (size_t)px] = 1;
-        px = wrap_near(px + a % p->width, p->width);
-        py = wrap_near(py + b % p->height, p->height);
+        px = bb__wrap_near(px + a % p->width, p->width);
+        py = bb__wrap_near(py + b % p->height, p->height);
         if (++run == CHUNK_STEPS) {
           (*clen)[c++] = run;
           run = 0;

@@ -79,21 +79,14 @@ static inline int is_periodic(const walker *w) {
   return w->p->addressing == BB_ADDRESS_PERIODIC;
 }
 
-/* Periodic index of c, known to lie within a few periods of [0, n). */
-static inline int rewrap(int c, int n) {
-  while (c >= n) c -= n;
-  while (c < 0) c += n;
-  return c;
-}
-
 /* Addressed column / row of vertex i, which lies near the current cell. */
 static inline int vertex_col(const walker *w, int i) {
-  return is_periodic(w) ? rewrap(w->cx + (i - w->ix), w->p->width)
+  return is_periodic(w) ? bb__wrap_near(w->cx + (i - w->ix), w->p->width)
                         : bb__clampi(i, 0, w->p->width - 1);
 }
 
 static inline int vertex_row(const walker *w, int i) {
-  return is_periodic(w) ? rewrap(w->cy + (i - w->iy), w->p->height)
+  return is_periodic(w) ? bb__wrap_near(w->cy + (i - w->iy), w->p->height)
                         : bb__clampi(i, 0, w->p->height - 1);
 }
 
@@ -116,8 +109,8 @@ static void set_cell(walker *w, int ix, int iy) {
 
 static void move_to(walker *w, int ix, int iy) {
   if (is_periodic(w)) {
-    w->cx = rewrap(w->cx + (ix - w->ix), w->p->width);
-    w->cy = rewrap(w->cy + (iy - w->iy), w->p->height);
+    w->cx = bb__wrap_near(w->cx + (ix - w->ix), w->p->width);
+    w->cy = bb__wrap_near(w->cy + (iy - w->iy), w->p->height);
     w->ix = ix;
     w->iy = iy;
   } else {
@@ -342,12 +335,6 @@ static int march(const bb_pyramid *p, const direction *d, double ox, double oy, 
   return b;
 }
 
-static inline int wrap_near(int c, int n) {
-  while (c >= n) c -= n;
-  while (c < 0) c += n;
-  return c;
-}
-
 /* march() through the bands of the ray's own direction instead of the
  * square nodes: bands are thin along the path, so they bound it tighter and
  * let the ray skip further. Levels gallop, up after a skip and down after a
@@ -383,15 +370,15 @@ march_band_impl(const bb_pyramid *p, const bb__band *band, const direction *d, d
         ix += sx * span;
         t = ((double)(sx > 0 ? ix : ix + 1) - ox) * d->inv_dx;
         const int row = no_backward(cell_along(oy + t * d->dy, sy), iy, sy);
-        cx = periodic ? wrap_near(cx + sx * span, W) : bb__clampi(ix, 0, W - 1);
-        cy = periodic ? wrap_near(cy + (row - iy), H) : bb__clampi(row, 0, H - 1);
+        cx = periodic ? bb__wrap_near(cx + sx * span, W) : bb__clampi(ix, 0, W - 1);
+        cy = periodic ? bb__wrap_near(cy + (row - iy), H) : bb__clampi(row, 0, H - 1);
         iy = row;
       } else {
         iy += sy * span;
         t = ((double)(sy > 0 ? iy : iy + 1) - oy) * d->inv_dy;
         const int col = no_backward(cell_along(ox + t * d->dx, sx), ix, sx);
-        cy = periodic ? wrap_near(cy + sy * span, H) : bb__clampi(iy, 0, H - 1);
-        cx = periodic ? wrap_near(cx + (col - ix), W) : bb__clampi(col, 0, W - 1);
+        cy = periodic ? bb__wrap_near(cy + sy * span, H) : bb__clampi(iy, 0, H - 1);
+        cx = periodic ? bb__wrap_near(cx + (col - ix), W) : bb__clampi(col, 0, W - 1);
         ix = col;
       }
       if (k < top) k++;
@@ -415,11 +402,11 @@ march_band_impl(const bb_pyramid *p, const bb__band *band, const direction *d, d
     const double ty = ((double)(sy > 0 ? iy + 1 : iy) - oy) * d->inv_dy;
     if (tx <= ty) {
       ix += sx;
-      cx = periodic ? wrap_near(cx + sx, W) : bb__clampi(ix, 0, W - 1);
+      cx = periodic ? bb__wrap_near(cx + sx, W) : bb__clampi(ix, 0, W - 1);
     }
     if (ty <= tx) {
       iy += sy;
-      cy = periodic ? wrap_near(cy + sy, H) : bb__clampi(iy, 0, H - 1);
+      cy = periodic ? bb__wrap_near(cy + sy, H) : bb__clampi(iy, 0, H - 1);
     }
     t = tx < ty ? tx : ty;
   }
