@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { CHUNK_STEPS = 1024 };
+enum { CHUNK_STEPS = 4096 };
 
 /* A breakpoint of one step, relative to the step's first texel: the surface
  * there is z(v1) + (z(v2) - z(v1)) * w. */
@@ -150,6 +150,7 @@ static void sweep_chunk(void *user, int chunk) {
   int by = (int)(((long)y0 + (long)(steps - 1) * job->b) % p->height);
   bx = bb__wrap_near(bx, p->width);
   by = bb__wrap_near(by, p->height);
+  const double tan_low = job->tan_step[0];
   const int back_x = bb__wrap_near(-(job->a % p->width), p->width);
   const int back_y = bb__wrap_near(-(job->b % p->height), p->height);
   for (int j = steps - 1; j >= 0; j--, bx = bb__wrap_near(bx + back_x, p->width),
@@ -168,7 +169,16 @@ static void sweep_chunk(void *user, int chunk) {
         za = field_z(p, bx + t->x1, by + t->y1);
         zb = field_z(p, bx + t->x2, by + t->y2);
       }
-      hull_push(&h, (double)j + t->u, za + (zb - za) * t->w);
+      const double u = (double)j + t->u, z = za + (zb - za) * t->w;
+      hull_push(&h, u, z);
+      /* Nothing ahead rises from this point as steeply as the lowest ray:
+       * then for an origin behind it, either this point is steeper than all
+       * of them, or every slope is below the lowest ray. Drop them. */
+      if (h.size >= 2 && h.z[h.size - 2] - z < tan_low * (h.u[h.size - 2] - u)) {
+        h.u[0] = u;
+        h.z[0] = z;
+        h.size = 1;
+      }
     }
     if (j < len) {
       const double z0 = (double)p->z[(size_t)by * (size_t)p->width + (size_t)bx] + job->bias;
