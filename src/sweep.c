@@ -1,5 +1,5 @@
-/* sweep.c: the horizons of every texel for one lattice slice direction, by
- * one backward sweep along each line of texels (periodic addressing).
+/* sweep.c: the horizons of every texel for a lattice slice direction and its
+ * opposite, by sweeps along each line of texels (periodic addressing).
  *
  * A slice follows a lattice step (a, b) (coprime integers), so texel P and
  * P + j (a, b) lie on one line, and so do all the breakpoints of the surface
@@ -7,18 +7,23 @@
  * diagonals x + y = k of Valve's triangles. Between two texels of the line
  * the breakpoints sit at the same fractions of the step for every step (the
  * "template"), so a line is a sequence of points (u, z), u = distance in
- * steps. A texel's horizon in that direction is the largest slope from its
- * origin (u_P, z_P + bias) to a point ahead, which is the tangent from the
- * origin to the upper convex hull of the points ahead: walking the line
- * backwards, each point is pushed onto a hull stack once, and each texel asks
- * the stack for its tangent by binary search. The rays of the slice blocked
- * at a texel are those whose tangent tan_el * |(a, b)| is at most that slope.
+ * steps: the line's profile. A texel's horizon in that direction is the
+ * largest slope from its origin (u_P, z_P + bias) to a point ahead, which is
+ * the tangent from the origin to the upper convex hull of the points ahead:
+ * walking the line backwards, each point is pushed onto a hull stack once,
+ * and each texel asks the stack for its tangent by binary search. The rays
+ * of the slice blocked at a texel are those whose tangent tan_el * |(a, b)|
+ * is at most that slope.
+ *
+ * The opposite direction (-a, -b) runs along the same lines through the same
+ * breakpoints, so one profile serves both: the sweep for (a, b) walks it
+ * backwards, the sweep for (-a, -b) forwards (on mirrored u).
  *
  * Lines are periodic (the texture tiles), so they are cut into chunks of at
- * most CHUNK_STEPS texels, each swept with a look-ahead past its end of as
- * many steps as a ray of the lowest elevation needs to rise above the global
- * maximum (or one whole period, past which nothing new can come). Chunks are
- * independent, so they run on all threads with the same result.
+ * most CHUNK_STEPS texels, each profiled with a look-ahead past both ends of
+ * as many steps as a ray of the lowest elevation needs to rise above the
+ * global maximum (or one whole period, past which nothing new can come).
+ * Chunks are independent, so they run on all threads with the same result.
  */
 #include "internal.h"
 #include "trace_internal.h"
@@ -40,18 +45,24 @@ typedef struct template_point {
   long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
 } template_point;
 
+/* One direction of a sweep (trace_internal.h's bb__sweep_dir) with its
+ * thresholds per step. */
+typedef struct sweep_side {
+  const double *tan_step; /* slopes per step that block: tan_el * |(a, b)|, rising */
+  int n;
+  uint16_t *blocked;      /* per texel; NULL: this direction is not wanted */
+} sweep_side;
+
 typedef struct sweep_job {
   const bb_pyramid *p;
   int a, b;
-  template_point *points;
+  template_point *points;                   /* the step's breakpoints, the next texel last */
   int point_count;
   const int *chunk_x, *chunk_y, *chunk_len; /* first texel and length of each chunk */
-  int lookahead;                            /* steps */
+  int ahead, behind; /* steps profiled past a chunk's end (for (a, b)) and before its start */
   double bias;
-  const double *tan_step; /* thresholds on the slope per step: tan_el * |(a, b)| */
-  int reach_x, reach_y;   /* how far template vertices lie from a step's texel */
-  int n;
-  uint16_t *blocked;      /* per texel */
+  sweep_side side[2]; /* along (a, b) and along (-a, -b) */
+  int reach_x, reach_y; /* how far template vertices lie from a step's texel */
   atomic_int out_of_memory;
 } sweep_job;
 
@@ -130,36 +141,61 @@ static inline double field_z(const bb_pyramid *p, int x, int y) {
                       (size_t)bb__wrap_near(x, p->width)];
 }
 
-static void sweep_chunk(void *user, int chunk) {
-  sweep_job *job = user;
-  const bb_pyramid *p = job->p;
-  const int len = job->chunk_len[chunk], steps = len + job->lookahead;
-  const int x0 = job->chunk_x[chunk], y0 = job->chunk_y[chunk];
-  hull h = {0};
-  const size_t cap = (size_t)steps * (size_t)job->point_count + 1;
-  h.u = malloc(cap * sizeof(double));
-  h.z = malloc(cap * sizeof(double));
-  if (!h.u || !h.z) {
-    atomic_store(&job->out_of_memory, 1);
-    free(h.u);
-    free(h.z);
-    return;
+/* hull_push, then: if nothing ahead rises from the new point as steeply as
+ * the lowest ray (tan_low), drop all but the new point. For an origin behind
+ * it, either the new point is steeper than everything ahead of it, or every
+ * slope is below the lowest ray: the dropped points never decide a count. */
+static inline void hull_push_cut(hull *h, double u, double z, double tan_low) {
+  hull_push(h, u, z);
+  if (h->size >= 2 && h->z[h->size - 2] - z < tan_low * (h->u[h->size - 2] - u)) {
+    h->u[0] = u;
+    h->z[0] = z;
+    h->size = 1;
   }
-  /* the step's first texel, walked backwards, kept in [0, size) */
-  int bx = (int)(((long)x0 + (long)(steps - 1) * job->a) % p->width);
-  int by = (int)(((long)y0 + (long)(steps - 1) * job->b) % p->height);
+}
+
+/* Rays of `side` blocked from (u0, z0), behind every point of the hull. */
+static inline uint16_t count_blocked(const sweep_side *side, const hull *h, double u0,
+                                     double z0) {
+  const double slope = hull_tangent(h, u0, z0);
+  int blocked = 0;
+  while (blocked < side->n && slope >= side->tan_step[blocked]) blocked++;
+  return (uint16_t)blocked;
+}
+
+/* A chunk's profile: step i (i = 0 .. steps-1) starts at texel i - behind of
+ * the chunk, vertex height vz[i] (one more entry: the end of the last step),
+ * then the m = point_count - 1 breakpoints inside it, iz[i * m ..]. */
+typedef struct profile {
+  int steps, m;
+  double *vz, *iz;
+  size_t *texel; /* image index of the chunk's texels */
+} profile;
+
+/* Heights along the chunk's line, from behind its start to ahead of its end. */
+static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
+  const bb_pyramid *p = job->p;
+  const int m = pr->m;
+  const long first = -(long)job->behind;
+  int bx = (int)(((long)job->chunk_x[chunk] + first * job->a) % p->width);
+  int by = (int)(((long)job->chunk_y[chunk] + first * job->b) % p->height);
   bx = bb__wrap_near(bx, p->width);
   by = bb__wrap_near(by, p->height);
-  const double tan_low = job->tan_step[0];
-  const int back_x = bb__wrap_near(-(job->a % p->width), p->width);
-  const int back_y = bb__wrap_near(-(job->b % p->height), p->height);
-  for (int j = steps - 1; j >= 0; j--, bx = bb__wrap_near(bx + back_x, p->width),
-           by = bb__wrap_near(by + back_y, p->height)) {
+  const int step_x = bb__wrap_near(job->a % p->width, p->width);
+  const int step_y = bb__wrap_near(job->b % p->height, p->height);
+  for (int i = 0; i <= pr->steps; i++, bx = bb__wrap_near(bx + step_x, p->width),
+           by = bb__wrap_near(by + step_y, p->height)) {
+    const size_t texel = (size_t)by * (size_t)p->width + (size_t)bx;
+    pr->vz[i] = (double)p->z[texel];
+    const int j = i - job->behind; /* texel of the chunk */
+    if (j >= 0 && j < job->chunk_len[chunk]) pr->texel[j] = texel;
+    if (i == pr->steps) break;
     /* Away from the edges no vertex wraps, and each is a fixed offset. */
     const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
                          by >= job->reach_y && by < p->height - job->reach_y;
-    const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
-    for (int k = job->point_count - 1; k >= 0; k--) {
+    const float *here = p->z + texel;
+    double *out = pr->iz + (size_t)i * (size_t)m;
+    for (int k = 0; k < m; k++) {
       const template_point *t = &job->points[k];
       double za, zb;
       if (interior) {
@@ -169,25 +205,66 @@ static void sweep_chunk(void *user, int chunk) {
         za = field_z(p, bx + t->x1, by + t->y1);
         zb = field_z(p, bx + t->x2, by + t->y2);
       }
-      const double u = (double)j + t->u, z = za + (zb - za) * t->w;
-      hull_push(&h, u, z);
-      /* Nothing ahead rises from this point as steeply as the lowest ray:
-       * then for an origin behind it, either this point is steeper than all
-       * of them, or every slope is below the lowest ray. Drop them. */
-      if (h.size >= 2 && h.z[h.size - 2] - z < tan_low * (h.u[h.size - 2] - u)) {
-        h.u[0] = u;
-        h.z[0] = z;
-        h.size = 1;
-      }
-    }
-    if (j < len) {
-      const double z0 = (double)p->z[(size_t)by * (size_t)p->width + (size_t)bx] + job->bias;
-      const double slope = hull_tangent(&h, (double)j, z0);
-      int blocked = 0;
-      while (blocked < job->n && slope >= job->tan_step[blocked]) blocked++;
-      job->blocked[(size_t)by * (size_t)p->width + (size_t)bx] = (uint16_t)blocked;
+      out[k] = za + (zb - za) * t->w;
     }
   }
+}
+
+/* Along (a, b): walk the profile backwards from its far end. */
+static void sweep_ahead(const sweep_job *job, const profile *pr, int len, hull *h) {
+  const sweep_side *side = &job->side[0];
+  const double tan_low = side->tan_step[0];
+  const int m = pr->m;
+  h->size = 0;
+  hull_push(h, (double)(pr->steps - job->behind), pr->vz[pr->steps]);
+  for (int i = pr->steps - 1; i >= job->behind; i--) {
+    const int j = i - job->behind;
+    for (int k = m - 1; k >= 0; k--)
+      hull_push_cut(h, (double)j + job->points[k].u, pr->iz[(size_t)i * (size_t)m + (size_t)k],
+                    tan_low);
+    if (j < len) side->blocked[pr->texel[j]] = count_blocked(side, h, (double)j, pr->vz[i] + job->bias);
+    hull_push_cut(h, (double)j, pr->vz[i], tan_low);
+  }
+}
+
+/* Along (-a, -b): walk the profile forwards from its near end, on mirrored
+ * u, so the hull code is the same. */
+static void sweep_behind(const sweep_job *job, const profile *pr, int len, hull *h) {
+  const sweep_side *side = &job->side[1];
+  const double tan_low = side->tan_step[0];
+  const int m = pr->m;
+  h->size = 0;
+  for (int i = 0; i < job->behind + len; i++) {
+    const int j = i - job->behind;
+    if (j >= 0) side->blocked[pr->texel[j]] = count_blocked(side, h, -(double)j, pr->vz[i] + job->bias);
+    hull_push_cut(h, -(double)j, pr->vz[i], tan_low);
+    for (int k = 0; k < m; k++)
+      hull_push_cut(h, -((double)j + job->points[k].u), pr->iz[(size_t)i * (size_t)m + (size_t)k],
+                    tan_low);
+  }
+}
+
+static void sweep_chunk(void *user, int chunk) {
+  sweep_job *job = user;
+  const int len = job->chunk_len[chunk];
+  profile pr = {.steps = job->behind + len + job->ahead, .m = job->point_count - 1};
+  const size_t points = (size_t)(pr.steps + 1) * (size_t)job->point_count;
+  hull h = {0};
+  pr.vz = malloc((size_t)(pr.steps + 1) * sizeof(double));
+  pr.iz = malloc((size_t)pr.steps * (size_t)pr.m * sizeof(double) + 1);
+  pr.texel = malloc((size_t)len * sizeof(size_t));
+  h.u = malloc(points * sizeof(double));
+  h.z = malloc(points * sizeof(double));
+  if (pr.vz && pr.iz && pr.texel && h.u && h.z) {
+    profile_fill(job, chunk, &pr);
+    if (job->side[0].blocked) sweep_ahead(job, &pr, len, &h);
+    if (job->side[1].blocked) sweep_behind(job, &pr, len, &h);
+  } else {
+    atomic_store(&job->out_of_memory, 1);
+  }
+  free(pr.vz);
+  free(pr.iz);
+  free(pr.texel);
   free(h.u);
   free(h.z);
 }
@@ -230,26 +307,44 @@ static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **
   return BB_OK;
 }
 
-bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_el, int n,
-                          double bias, int threads, uint16_t *blocked, bb_error *err) {
-  const double step_length = hypot(a, b);
+/* Steps past which the lowest ray of `side` is above the global maximum,
+ * at most one period of the line (nothing new comes after it). */
+static int lookahead_steps(const bb_pyramid *p, const sweep_side *side) {
+  if (!side->blocked) return 0;
+  const double rise = (double)p->global_max - (double)p->global_min;
+  const double reach = side->tan_step[0] > 0.0 ? ceil(rise / side->tan_step[0]) + 2.0 : 1e9;
+  const long period = (long)p->width * p->height;
+  return (int)(reach < (double)period ? reach : (double)period);
+}
+
+static bb_status set_side(const bb__sweep_dir *dir, double step_length, sweep_side *side,
+                          bb_error *err) {
+  if (!dir) return BB_OK;
+  if (dir->n < 1 || !dir->blocked)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a sweep direction needs rays and counts");
+  double *tan_step = malloc((size_t)dir->n * sizeof(double));
+  if (!tan_step) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  for (int e = 0; e < dir->n; e++) tan_step[e] = dir->tan_el[e] * step_length;
+  *side = (sweep_side){tan_step, dir->n, dir->blocked};
+  return BB_OK;
+}
+
+bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                          const bb__sweep_dir *opposite, double bias, int threads,
+                          bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
-  double *tan_step = malloc((size_t)n * sizeof(double));
+  sweep_job job = {.p = p, .a = a, .b = b, .points = pts, .bias = bias};
+  atomic_init(&job.out_of_memory, 0);
   int *cx = NULL, *cy = NULL, *clen = NULL, chunks = 0;
-  bb_status st = tan_step ? make_chunks(p, a, b, &cx, &cy, &clen, &chunks, err)
-                          : bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  bb_status st = set_side(along, hypot(a, b), &job.side[0], err);
+  if (st == BB_OK) st = set_side(opposite, hypot(a, b), &job.side[1], err);
+  if (st == BB_OK) st = make_chunks(p, a, b, &cx, &cy, &clen, &chunks, err);
   if (st == BB_OK) {
-    for (int e = 0; e < n; e++) tan_step[e] = tan_el[e] * step_length;
-    /* Past this many steps the lowest ray is above the global maximum. */
-    const double rise = (double)p->global_max - (double)p->global_min;
-    double reach = tan_el[0] > 0.0 ? ceil(rise / tan_step[0]) + 2.0 : 1e9;
-    const long period = (long)p->width * p->height; /* a line never runs longer */
-    sweep_job job = {.p = p, .a = a, .b = b, .points = pts, .bias = bias,
-                     .tan_step = tan_step, .n = n, .blocked = blocked,
-                     .chunk_x = cx, .chunk_y = cy, .chunk_len = clen};
-    atomic_init(&job.out_of_memory, 0);
+    job.chunk_x = cx;
+    job.chunk_y = cy;
+    job.chunk_len = clen;
     job.point_count = build_template(a, b, pts);
     for (int k = 0; k < job.point_count; k++) {
       template_point *t = &pts[k];
@@ -258,12 +353,14 @@ bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_e
       job.reach_x = imax(job.reach_x, imax(abs(t->x1), abs(t->x2)) + 1);
       job.reach_y = imax(job.reach_y, imax(abs(t->y1), abs(t->y2)) + 1);
     }
-    job.lookahead = (int)(reach < (double)period ? reach : (double)period);
+    job.ahead = lookahead_steps(p, &job.side[0]);
+    job.behind = lookahead_steps(p, &job.side[1]);
     st = bb__parallel_for(chunks, threads, sweep_chunk, &job, NULL, NULL, err);
     if (st == BB_OK && atomic_load(&job.out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
   }
-  free(tan_step);
+  free((void *)job.side[0].tan_step);
+  free((void *)job.side[1].tan_step);
   free(cx);
   free(cy);
   free(clen);

@@ -490,16 +490,45 @@ typedef struct trace_job {
   double *unblocked;      /* channels * (ray_count + slice_count) */
   double total[1 + BB_MAX_BASIS];
   direction *slice_dir;   /* per slice */
+  int *order;             /* slices in the order their weights are summed */
   double *sums;           /* slice paths: per texel and channel, unblocked weight so far */
-  uint16_t *blocked;      /* slice paths: per texel, rays of slice `slice` blocked */
-  const bb__band *band;   /* band path: the bands of slice `slice` */
-  int slice;
+  uint16_t *blocked[2];   /* slice paths: per texel, rays of `slice[k]` blocked */
+  const bb__band *band;   /* band path: the bands of slice `slice[0]` */
+  int slice[2];           /* slice paths: the slices in hand; slice[1] is -1 if none */
   float *vis;
 } trace_job;
 
 static double ray_weight(const bb_rayset *rs, int c, int ray) {
   return c == 0 ? rs->weight_ao[ray]
                 : rs->weight_basis[(size_t)ray * (size_t)rs->basis_count + (size_t)(c - 1)];
+}
+
+static int opposite_steps(const bb_rayset *rs, int s, int t) {
+  return rs->slice_step[2 * s] == -rs->slice_step[2 * t] &&
+         rs->slice_step[2 * s + 1] == -rs->slice_step[2 * t + 1];
+}
+
+/* The order in which every path sums the slices' weights: each slice is
+ * followed by its opposite (lattice step (-a, -b)), when the set has one, so
+ * that one line sweep can serve both. A fixed order keeps the paths' sums,
+ * and so their results, bit-identical. Returns -1 when out of memory. */
+static int order_slices(const bb_rayset *rs, int *order) {
+  unsigned char *placed = calloc((size_t)rs->slice_count, 1);
+  if (!placed) return -1;
+  int n = 0;
+  for (int s = 0; s < rs->slice_count; s++) {
+    if (placed[s]) continue;
+    placed[s] = 1;
+    order[n++] = s;
+    for (int t = s + 1; t < rs->slice_count; t++)
+      if (!placed[t] && opposite_steps(rs, s, t)) {
+        placed[t] = 1;
+        order[n++] = t;
+        break;
+      }
+  }
+  free(placed);
+  return 0;
 }
 
 /* Suffix sums, and totals taken as the same sums in the same order, so a
@@ -509,15 +538,16 @@ static bb_status prepare_job(trace_job *job, bb_error *err) {
   const size_t stride = (size_t)(rs->ray_count + rs->slice_count);
   job->unblocked = malloc((size_t)job->channels * stride * sizeof(double));
   job->slice_dir = malloc((size_t)rs->slice_count * sizeof(direction));
-  if (!job->unblocked || !job->slice_dir)
+  job->order = malloc((size_t)rs->slice_count * sizeof(int));
+  if (!job->unblocked || !job->slice_dir || !job->order || order_slices(rs, job->order) != 0)
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
   for (int s = 0; s < rs->slice_count; s++)
     direction_init(&job->slice_dir[s], rs->slice_dir[2 * s], rs->slice_dir[2 * s + 1]);
   for (int c = 0; c < job->channels; c++) {
     double *u = job->unblocked + (size_t)c * stride;
     job->total[c] = 0.0;
-    for (int s = 0; s < rs->slice_count; s++) {
-      const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+    for (int i = 0; i < rs->slice_count; i++) {
+      const int s = job->order[i], start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
       double *slice = u + start + s;
       slice[count] = 0.0;
       for (int e = count - 1; e >= 0; e--) slice[e] = slice[e + 1] + ray_weight(rs, c, start + e);
@@ -530,8 +560,10 @@ static bb_status prepare_job(trace_job *job, bb_error *err) {
 static void release_job(trace_job *job) {
   free(job->unblocked);
   free(job->slice_dir);
+  free(job->order);
   free(job->sums);
-  free(job->blocked);
+  free(job->blocked[0]);
+  free(job->blocked[1]);
 }
 
 /* Adds slice s's unblocked weight for `blocked` blocked rays to sum[]. */
@@ -555,10 +587,10 @@ static inline double origin_z(const trace_job *job, int x, int y) {
 static void band_slice_row(void *user, int y) {
   const trace_job *job = user;
   const bb_rayset *rs = job->rs;
-  const int s = job->slice, start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+  const int s = job->slice[0], start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
   double hint = 0.0; /* where the previous texel's horizon was */
   for (int x = 0; x < job->p->width; x++)
-    job->blocked[(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
+    job->blocked[0][(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
         job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
         rs->tan_elevation + start, count, &hint);
 }
@@ -569,7 +601,9 @@ static void add_slice_row(void *user, int y) {
   const trace_job *job = user;
   for (int x = 0; x < job->p->width; x++) {
     const size_t texel = (size_t)y * (size_t)job->p->width + (size_t)x;
-    add_slice(job, job->slice, job->blocked[texel], job->sums + texel * (size_t)job->channels);
+    double *sum = job->sums + texel * (size_t)job->channels;
+    add_slice(job, job->slice[0], job->blocked[0][texel], sum);
+    if (job->slice[1] >= 0) add_slice(job, job->slice[1], job->blocked[1][texel], sum);
   }
 }
 
@@ -588,8 +622,9 @@ static void trace_row(void *user, int y) {
   double hint[256] = {0}; /* per slice: where the previous texel's horizon was */
   for (int x = 0; x < job->p->width; x++) {
     double sum[1 + BB_MAX_BASIS] = {0};
-    for (int s = 0; s < rs->slice_count; s++) {
-      const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+    for (int i = 0; i < rs->slice_count; i++) {
+      const int s = job->order[i], start = rs->slice_start[s],
+                count = rs->slice_start[s + 1] - start;
       add_slice(job, s, march(job->p, &job->slice_dir[s], x, y, origin_z(job, x, y),
                               rs->tan_elevation + start, count, &hint[s]), sum);
     }
@@ -597,16 +632,28 @@ static void trace_row(void *user, int y) {
   }
 }
 
-/* Slice s's blocked counts at every texel: by line sweeps (periodic, when
- * allowed) or by marches through the slice's direction bands. */
-static bb_status blocked_counts(trace_job *job, int s, int sweep, bb_error *err) {
+static bb__sweep_dir sweep_dir(const trace_job *job, int k) {
+  const bb_rayset *rs = job->rs;
+  const int s = job->slice[k], start = rs->slice_start[s];
+  return (bb__sweep_dir){rs->tan_elevation + start, rs->slice_start[s + 1] - start,
+                         job->blocked[k]};
+}
+
+/* The blocked counts at every texel of the slices in hand: by line sweeps
+ * (periodic, when allowed), which take a slice and its opposite at once, or
+ * by marches through the slice's direction bands. */
+static bb_status blocked_counts(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
-  const int start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
-  if (sweep && p->addressing == BB_ADDRESS_PERIODIC)
-    return bb__sweep_slice(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
-                           rs->tan_elevation + start, count, job->o->bias_texels,
-                           job->o->threads, job->blocked, err);
+  const int s = job->slice[0];
+  if (sweep && p->addressing == BB_ADDRESS_PERIODIC) {
+    const bb__sweep_dir along = sweep_dir(job, 0);
+    bb__sweep_dir opposite = {0};
+    if (job->slice[1] >= 0) opposite = sweep_dir(job, 1);
+    return bb__sweep_lines(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
+                           job->slice[1] >= 0 ? &opposite : NULL, job->o->bias_texels,
+                           job->o->threads, err);
+  }
   bb__band band;
   bb_status st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads,
                                 &band, err);
@@ -618,18 +665,27 @@ static bb_status blocked_counts(trace_job *job, int s, int sweep, bb_error *err)
   return st;
 }
 
+/* Slices in the summing order, two at a time when the next is the opposite
+ * of the current and sweeps are on. */
 static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
+  const bb_rayset *rs = job->rs;
   const size_t texels = (size_t)p->width * (size_t)p->height;
+  const int pairs = sweep && p->addressing == BB_ADDRESS_PERIODIC;
   job->sums = calloc(texels * (size_t)job->channels, sizeof(double));
-  job->blocked = malloc(texels * sizeof(uint16_t));
-  if (!job->sums || !job->blocked) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  job->blocked[0] = malloc(texels * sizeof(uint16_t));
+  job->blocked[1] = pairs ? malloc(texels * sizeof(uint16_t)) : NULL;
+  if (!job->sums || !job->blocked[0] || (pairs && !job->blocked[1]))
+    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
   bb_status st = BB_OK;
-  for (int s = 0; st == BB_OK && s < job->rs->slice_count; s++) {
-    job->slice = s;
-    st = blocked_counts(job, s, sweep, err);
+  for (int i = 0; st == BB_OK && i < rs->slice_count;) {
+    const int s = job->order[i], next = i + 1 < rs->slice_count ? job->order[i + 1] : -1;
+    job->slice[0] = s;
+    job->slice[1] = pairs && next >= 0 && opposite_steps(rs, s, next) ? next : -1;
+    i += job->slice[1] >= 0 ? 2 : 1;
+    st = blocked_counts(job, sweep, err);
     if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, add_slice_row, job, NULL, NULL, err);
-    if (job->o->progress) job->o->progress(job->o->progress_user, s + 1, job->rs->slice_count);
+    if (job->o->progress) job->o->progress(job->o->progress_user, i, rs->slice_count);
   }
   if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, finish_row, job, NULL, NULL, err);
   return st;

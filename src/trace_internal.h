@@ -51,11 +51,22 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
                                    const bb_trace_options *o, bb__trace_path path,
                                    bb_image *vis, bb_error *err);
 
-/* Periodic addressing only: for the lattice step (a, b), the number of the n
- * rising tangents tan_el blocked at every texel (origin lifted by bias),
- * into blocked (one per texel), by line sweeps (sweep.c). */
-bb_status bb__sweep_slice(const bb_pyramid *p, int a, int b, const double *tan_el, int n,
-                          double bias, int threads, uint16_t *blocked, bb_error *err);
+/* One direction of a line sweep: its n rising tangent thresholds tan_el
+ * (dz per horizontal texel) and where the count of them blocked at each
+ * texel goes (one per texel). */
+typedef struct bb__sweep_dir {
+  const double *tan_el;
+  int n;
+  uint16_t *blocked;
+} bb__sweep_dir;
+
+/* Periodic addressing only: for the lattice step (a, b), the blocked counts
+ * of `along` (rays along (a, b)) and of `opposite` (along (-a, -b)) at every
+ * texel, origins lifted by bias, by line sweeps (sweep.c). Either direction
+ * may be NULL; both share one profile of each line. */
+bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                          const bb__sweep_dir *opposite, double bias, int threads,
+                          bb_error *err);
 
 /* Directional max bands of the pyramid's cells for one azimuth (band.c). */
 #define BB__BAND_LEVELS 8
