@@ -122,18 +122,22 @@ static inline void hull_push(hull *h, double u, double z) {
 }
 
 /* Largest slope from (u0, z0), behind every point, to the hull: slopes to
- * hull vertices rise, then fall, going away from the origin. */
-static double hull_tangent(const hull *h, double u0, double z0) {
-  int lo = 0, hi = h->size - 1; /* indices counted from the nearest (size - 1) */
-  while (lo < hi) {
-    const int mid = (lo + hi) / 2;
-    const int i = h->size - 1 - mid, j = i - 1; /* j is one step farther */
+ * hull vertices rise, then fall, going away from the origin. The hull is
+ * short (hull_push_cut keeps it so: 3.6 vertices on average on rock06) and
+ * the tangent is mostly at the nearest vertex or the next, so a walk from
+ * the near end beats a binary search. */
+static inline double hull_tangent(const hull *h, double u0, double z0) {
+  int i = h->size - 1;
+  double du = h->u[i] - u0, dz = h->z[i] - z0;
+  while (i > 0) {
+    const double du_far = h->u[i - 1] - u0, dz_far = h->z[i - 1] - z0;
     /* is the farther vertex steeper? (denominators are positive) */
-    if ((h->z[j] - z0) * (h->u[i] - u0) > (h->z[i] - z0) * (h->u[j] - u0)) lo = mid + 1;
-    else hi = mid;
+    if (!(dz_far * du > dz * du_far)) break;
+    du = du_far;
+    dz = dz_far;
+    i--;
   }
-  const int k = h->size - 1 - lo;
-  return (h->z[k] - z0) / (h->u[k] - u0);
+  return dz / du;
 }
 
 static inline double field_z(const bb_pyramid *p, int x, int y) {
