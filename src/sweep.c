@@ -11,7 +11,7 @@
  * largest slope from its origin (u_P, z_P + bias) to a point ahead, which is
  * the tangent from the origin to the upper convex hull of the points ahead:
  * walking the line backwards, each point is pushed onto a hull stack once,
- * and each texel asks the stack for its tangent by binary search. The rays
+ * and each texel asks the stack for its tangent by a short walk from its near end. The rays
  * of the slice blocked at a texel are those whose tangent tan_el * |(a, b)|
  * is at most that slope.
  *
