@@ -11,9 +11,9 @@
  * largest slope from its origin (u_P, z_P + bias) to a point ahead, which is
  * the tangent from the origin to the upper convex hull of the points ahead:
  * walking the line backwards, each point is pushed onto a hull stack once,
- * and each texel asks the stack for its tangent by a short walk from its near end. The rays
- * of the slice blocked at a texel are those whose tangent tan_el * |(a, b)|
- * is at most that slope.
+ * and each texel asks the stack for its tangent by a short walk from its
+ * near end. The rays of the slice blocked at a texel are those whose tangent
+ * tan_el * |(a, b)| is at most that slope.
  *
  * The opposite direction (-a, -b) runs along the same lines through the same
  * breakpoints, so one profile serves both: the sweep for (a, b) walks it
