@@ -167,19 +167,56 @@ static inline uint16_t count_blocked(const sweep_side *side, const hull *h, doub
   return (uint16_t)blocked;
 }
 
-/* A chunk's profile: step i (i = 0 .. steps-1) starts at texel i - behind of
- * the chunk, vertex height vz[i] (one more entry: the end of the last step),
- * then the m = point_count - 1 breakpoints inside it, iz[i * m ..]. */
+/* A chunk's profile: step i (i = 0 .. steps-1) starts at texel
+ * j = i - behind of the chunk, whose height is vz[i] (one more entry: the end
+ * of the last step). Its points, by rising u (u = j + the template's
+ * fraction), are the vertices and breakpoints that can matter: pu, pz. */
 typedef struct profile {
-  int steps, m;
-  double *vz, *iz;
+  int steps, count;
+  double *vz;
+  double *pu, *pz;
   size_t *texel; /* image index of the chunk's texels */
 } profile;
+
+/* Keeps the points of a profile that are not convex kinks. A point on or
+ * under the chord of its two neighbours never decides a count: walking
+ * either way, once its nearer neighbour is on the hull it lies under the
+ * hull; and before that, for the one origin queried in between, which sits
+ * at or above that neighbour (bias >= 0), the farther neighbour is at least
+ * as steep. A run of such points lies under the chord of the points kept
+ * around it (the profile is convex along the run), so dropping them all at
+ * once is safe too. About half the points go on rough maps. */
+typedef struct kink_filter {
+  profile *pr;
+  int seen;              /* points offered so far */
+  double ua, za, ub, zb; /* the last two offered: a before b; b is undecided */
+} kink_filter;
+
+static inline void kink_offer(kink_filter *f, double u, double z) {
+  if (f->seen >= 2) {
+    const int keep = (f->zb - f->za) * (u - f->ua) > (z - f->za) * (f->ub - f->ua);
+    f->pr->pu[f->pr->count] = f->ub;
+    f->pr->pz[f->pr->count] = f->zb;
+    f->pr->count += keep;
+  } else if (f->seen == 1) { /* the first point is an end: kept */
+    f->pr->pu[0] = f->ub;
+    f->pr->pz[0] = f->zb;
+    f->pr->count = 1;
+  }
+  f->ua = f->ub, f->za = f->zb;
+  f->ub = u, f->zb = z;
+  f->seen++;
+}
+
+static inline void kink_finish(kink_filter *f) { /* the last point is an end: kept */
+  f->pr->pu[f->pr->count] = f->ub;
+  f->pr->pz[f->pr->count] = f->zb;
+  f->pr->count++;
+}
 
 /* Heights along the chunk's line, from behind its start to ahead of its end. */
 static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
   const bb_pyramid *p = job->p;
-  const int m = pr->m;
   const long first = -(long)job->behind;
   int bx = (int)(((long)job->chunk_x[chunk] + first * job->a) % p->width);
   int by = (int)(((long)job->chunk_y[chunk] + first * job->b) % p->height);
@@ -187,19 +224,21 @@ static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
   by = bb__wrap_near(by, p->height);
   const int step_x = bb__wrap_near(job->a % p->width, p->width);
   const int step_y = bb__wrap_near(job->b % p->height, p->height);
+  kink_filter f = {.pr = pr};
+  pr->count = 0;
   for (int i = 0; i <= pr->steps; i++, bx = bb__wrap_near(bx + step_x, p->width),
            by = bb__wrap_near(by + step_y, p->height)) {
     const size_t texel = (size_t)by * (size_t)p->width + (size_t)bx;
-    pr->vz[i] = (double)p->z[texel];
     const int j = i - job->behind; /* texel of the chunk */
+    pr->vz[i] = (double)p->z[texel];
+    kink_offer(&f, (double)j, pr->vz[i]);
     if (j >= 0 && j < job->chunk_len[chunk]) pr->texel[j] = texel;
     if (i == pr->steps) break;
     /* Away from the edges no vertex wraps, and each is a fixed offset. */
     const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
                          by >= job->reach_y && by < p->height - job->reach_y;
     const float *here = p->z + texel;
-    double *out = pr->iz + (size_t)i * (size_t)m;
-    for (int k = 0; k < m; k++) {
+    for (int k = 0; k < job->point_count - 1; k++) {
       const template_point *t = &job->points[k];
       double za, zb;
       if (interior) {
@@ -209,25 +248,24 @@ static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
         za = field_z(p, bx + t->x1, by + t->y1);
         zb = field_z(p, bx + t->x2, by + t->y2);
       }
-      out[k] = za + (zb - za) * t->w;
+      kink_offer(&f, (double)j + t->u, za + (zb - za) * t->w);
     }
   }
+  kink_finish(&f);
 }
 
-/* Along (a, b): walk the profile backwards from its far end. */
+/* Along (a, b): walk the profile backwards from its far end; origin j asks
+ * once every point beyond it is on the hull. */
 static void sweep_ahead(const sweep_job *job, const profile *pr, int len, hull *h) {
   const sweep_side *side = &job->side[0];
   const double tan_low = side->tan_step[0];
-  const int m = pr->m;
+  int k = pr->count - 1;
   h->size = 0;
-  hull_push(h, (double)(pr->steps - job->behind), pr->vz[pr->steps]);
-  for (int i = pr->steps - 1; i >= job->behind; i--) {
-    const int j = i - job->behind;
-    for (int k = m - 1; k >= 0; k--)
-      hull_push_cut(h, (double)j + job->points[k].u, pr->iz[(size_t)i * (size_t)m + (size_t)k],
-                    tan_low);
-    if (j < len) side->blocked[pr->texel[j]] = count_blocked(side, h, (double)j, pr->vz[i] + job->bias);
-    hull_push_cut(h, (double)j, pr->vz[i], tan_low);
+  for (int j = len - 1 + job->ahead; j >= 0; j--) {
+    for (; k >= 0 && pr->pu[k] > (double)j; k--) hull_push_cut(h, pr->pu[k], pr->pz[k], tan_low);
+    if (j < len)
+      side->blocked[pr->texel[j]] =
+          count_blocked(side, h, (double)j, pr->vz[j + job->behind] + job->bias);
   }
 }
 
@@ -236,30 +274,30 @@ static void sweep_ahead(const sweep_job *job, const profile *pr, int len, hull *
 static void sweep_behind(const sweep_job *job, const profile *pr, int len, hull *h) {
   const sweep_side *side = &job->side[1];
   const double tan_low = side->tan_step[0];
-  const int m = pr->m;
+  int k = 0;
   h->size = 0;
-  for (int i = 0; i < job->behind + len; i++) {
-    const int j = i - job->behind;
-    if (j >= 0) side->blocked[pr->texel[j]] = count_blocked(side, h, -(double)j, pr->vz[i] + job->bias);
-    hull_push_cut(h, -(double)j, pr->vz[i], tan_low);
-    for (int k = 0; k < m; k++)
-      hull_push_cut(h, -((double)j + job->points[k].u), pr->iz[(size_t)i * (size_t)m + (size_t)k],
-                    tan_low);
+  for (int j = -job->behind; j < len; j++) {
+    for (; k < pr->count && pr->pu[k] < (double)j; k++)
+      hull_push_cut(h, -pr->pu[k], pr->pz[k], tan_low);
+    if (j >= 0)
+      side->blocked[pr->texel[j]] =
+          count_blocked(side, h, -(double)j, pr->vz[j + job->behind] + job->bias);
   }
 }
 
 static void sweep_chunk(void *user, int chunk) {
   sweep_job *job = user;
   const int len = job->chunk_len[chunk];
-  profile pr = {.steps = job->behind + len + job->ahead, .m = job->point_count - 1};
+  profile pr = {.steps = job->behind + len + job->ahead};
   const size_t points = (size_t)(pr.steps + 1) * (size_t)job->point_count;
   hull h = {0};
   pr.vz = malloc((size_t)(pr.steps + 1) * sizeof(double));
-  pr.iz = malloc((size_t)pr.steps * (size_t)pr.m * sizeof(double) + 1);
+  pr.pu = malloc(points * sizeof(double));
+  pr.pz = malloc(points * sizeof(double));
   pr.texel = malloc((size_t)len * sizeof(size_t));
   h.u = malloc(points * sizeof(double));
   h.z = malloc(points * sizeof(double));
-  if (pr.vz && pr.iz && pr.texel && h.u && h.z) {
+  if (pr.vz && pr.pu && pr.pz && pr.texel && h.u && h.z) {
     profile_fill(job, chunk, &pr);
     if (job->side[0].blocked) sweep_ahead(job, &pr, len, &h);
     if (job->side[1].blocked) sweep_behind(job, &pr, len, &h);
@@ -267,7 +305,8 @@ static void sweep_chunk(void *user, int chunk) {
     atomic_store(&job->out_of_memory, 1);
   }
   free(pr.vz);
-  free(pr.iz);
+  free(pr.pu);
+  free(pr.pz);
   free(pr.texel);
   free(h.u);
   free(h.z);
