@@ -42,7 +42,7 @@ static void build_cells(bb_pyramid *p) {
     const float *r0 = p->z + (size_t)y * (size_t)w;
     const float *r1 = p->z + (size_t)bb__address(y + 1, h, p->addressing) * (size_t)w;
     for (int x = 0; x < w; x++) {
-      int x1 = bb__address(x + 1, w, p->addressing);
+      int x1 = x + 1 < w ? x + 1 : bb__address(x + 1, w, p->addressing);
       float m = r0[x];
       if (r0[x1] > m) m = r0[x1];
       if (r1[x] > m) m = r1[x];
@@ -52,11 +52,17 @@ static void build_cells(bb_pyramid *p) {
   }
 }
 
-/* Max of row[addressed(i)] for i in [start, start + count). */
+/* Max of row[addressed(i)] for i in [start, start + count). Only the last
+ * node of a row reaches past n, so the addressing is kept for that part. */
 static float addressed_max(const float *row, size_t stride, int n, int start, int count,
                            bb_addressing a) {
+  const int end = start + count, inside = end < n ? end : n;
   float m = -FLT_MAX;
-  for (int i = start; i < start + count; i++) {
+  for (int i = start; i < inside; i++) {
+    float v = row[(size_t)i * stride];
+    if (v > m) m = v;
+  }
+  for (int i = inside; i < end; i++) {
     float v = row[(size_t)bb__address(i, n, a) * stride];
     if (v > m) m = v;
   }
