@@ -68,10 +68,6 @@ static double saturate(double v) {
   return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
 }
 
-static size_t texel_count(const bb_image *img) {
-  return (size_t)img->width * (size_t)img->height;
-}
-
 static bb_status check_image(const bb_image *img, const char *what, int min_channels,
                              int max_channels, bb_error *err) {
   if (!img || !img->pixels)
@@ -91,6 +87,63 @@ static bb_status check_output(const bb_image *out, const bb_image *a, const bb_i
   return BB_OK;
 }
 
+/* max(0, v) with the value glibc's fmax(0.0, v) returns, which the maps have
+ * always used: v < 0 and NaN (a NaN normal) give +0, and -0 stays -0. Inline
+ * because fmax is a library call per texel. */
+static double max0(double v) {
+  return v >= 0.0 ? v : 0.0;
+}
+
+/* The inputs, output and basis of one derive call; each parallel work item is
+ * one row, and each texel depends only on its own inputs. */
+typedef struct derive_job {
+  const bb_image *in, *vis;
+  bb_image *out;
+  int count; /* basis vectors used */
+  double basis[BB_MAX_BASIS][3];
+} derive_job;
+
+static void job_init(derive_job *job, const bb_image *in, const bb_image *vis,
+                     bb_image *out, int count) {
+  job->in = in;
+  job->vis = vis;
+  job->out = out;
+  job->count = count;
+  for (int c = 0; c < count; c++)
+    bb_basis_vector(c, job->basis[c]);
+}
+
+/* Runs fn over the rows of job->out; frees job->out if that fails. */
+static bb_status run_rows(derive_job *job, bb__work_fn fn, bb_error *err) {
+  bb_status st = bb__parallel_for(job->out->height, 0, fn, job, NULL, NULL, err);
+  if (st != BB_OK)
+    bb_image_free(job->out);
+  return st;
+}
+
+/* Flat index of the first texel of row y. */
+static size_t row_start(const bb_image *img, int y) {
+  return (size_t)y * (size_t)img->width;
+}
+
+static void weights_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *normals = job->in;
+  const size_t first = row_start(normals, y), end = first + (size_t)normals->width;
+  for (size_t i = first; i < end; i++) {
+    const float *n = normals->pixels + 3 * i;
+    double w[3], sum = 0.0;
+    for (int c = 0; c < 3; c++) {
+      double s = saturate(dot3(n, job->basis[c]));
+      w[c] = s * s;
+      sum += w[c];
+    }
+    /* A normal facing away from all three directions has no preferred one. */
+    for (int c = 0; c < 3; c++)
+      job->out->pixels[3 * i + (size_t)c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / 3.0);
+  }
+}
+
 bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *err) {
   bb_status st;
   if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
@@ -99,22 +152,23 @@ bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *er
     return st;
   if ((st = bb_image_alloc(out, normals->width, normals->height, 3, err)) != BB_OK)
     return st;
-  double basis[3][3];
-  for (int c = 0; c < 3; c++)
-    bb_basis_vector(c, basis[c]);
-  for (size_t i = 0; i < texel_count(normals); i++) {
-    const float *n = normals->pixels + 3 * i;
-    double w[3], sum = 0.0;
-    for (int c = 0; c < 3; c++) {
-      double s = saturate(dot3(n, basis[c]));
-      w[c] = s * s;
-      sum += w[c];
-    }
-    /* A normal facing away from all three directions has no preferred one. */
-    for (int c = 0; c < 3; c++)
-      out->pixels[3 * i + (size_t)c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / 3.0);
+  derive_job job;
+  job_init(&job, normals, NULL, out, 3);
+  return run_rows(&job, weights_row, err);
+}
+
+static void ssbump_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *vis = job->vis;
+  const int count = job->count;
+  const size_t first = row_start(vis, y), end = first + (size_t)vis->width;
+  for (size_t i = first; i < end; i++) {
+    const float *n = job->in->pixels + 3 * i;
+    const float *v = vis->pixels + (size_t)vis->channels * i + 1; /* skip ao */
+    float *s = job->out->pixels + (size_t)count * i;
+    for (int c = 0; c < count; c++)
+      s[c] = (float)(max0(dot3(n, job->basis[c])) * (double)v[c]);
   }
-  return BB_OK;
 }
 
 bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis, bb_image *out,
@@ -133,17 +187,17 @@ bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis, bb_imag
   const int count = vis->channels - 1;
   if ((st = bb_image_alloc(out, vis->width, vis->height, count, err)) != BB_OK)
     return st;
-  double basis[BB_MAX_BASIS][3];
-  for (int c = 0; c < count; c++)
-    bb_basis_vector(c, basis[c]);
-  for (size_t i = 0; i < texel_count(vis); i++) {
-    const float *n = normals->pixels + 3 * i;
-    const float *v = vis->pixels + (size_t)vis->channels * i + 1; /* skip ao */
-    float *s = out->pixels + (size_t)count * i;
-    for (int c = 0; c < count; c++)
-      s[c] = (float)(fmax(0.0, dot3(n, basis[c])) * (double)v[c]);
-  }
-  return BB_OK;
+  derive_job job;
+  job_init(&job, normals, vis, out, count);
+  return run_rows(&job, ssbump_row, err);
+}
+
+static void ao_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *vis = job->vis;
+  const size_t first = row_start(vis, y), end = first + (size_t)vis->width;
+  for (size_t i = first; i < end; i++)
+    job->out->pixels[i] = vis->pixels[(size_t)vis->channels * i];
 }
 
 bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
@@ -154,9 +208,32 @@ bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
     return st;
   if ((st = bb_image_alloc(out, vis->width, vis->height, 1, err)) != BB_OK)
     return st;
-  for (size_t i = 0; i < texel_count(vis); i++)
-    out->pixels[i] = vis->pixels[(size_t)vis->channels * i];
-  return BB_OK;
+  derive_job job;
+  job_init(&job, NULL, vis, out, 0);
+  return run_rows(&job, ao_row, err);
+}
+
+static void bent_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *ssbump = job->in;
+  const int count = job->count;
+  const size_t first = row_start(ssbump, y), end = first + (size_t)ssbump->width;
+  for (size_t i = first; i < end; i++) {
+    const float *s = ssbump->pixels + (size_t)count * i;
+    double b[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < count; c++)
+      for (int k = 0; k < 3; k++)
+        b[k] += (double)s[c] * job->basis[c][k];
+    double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    float *o = job->out->pixels + 3 * i;
+    /* Fully shadowed: no light direction to bend towards, so report straight up. */
+    if (!(len > 0.0)) {
+      o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
+      continue;
+    }
+    for (int k = 0; k < 3; k++)
+      o[k] = (float)(b[k] / len);
+  }
 }
 
 bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err) {
@@ -167,25 +244,7 @@ bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err) {
     return st;
   if ((st = bb_image_alloc(out, ssbump->width, ssbump->height, 3, err)) != BB_OK)
     return st;
-  const int count = ssbump->channels;
-  double basis[BB_MAX_BASIS][3];
-  for (int c = 0; c < count; c++)
-    bb_basis_vector(c, basis[c]);
-  for (size_t i = 0; i < texel_count(ssbump); i++) {
-    const float *s = ssbump->pixels + (size_t)count * i;
-    double b[3] = {0.0, 0.0, 0.0};
-    for (int c = 0; c < count; c++)
-      for (int k = 0; k < 3; k++)
-        b[k] += (double)s[c] * basis[c][k];
-    double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    float *o = out->pixels + 3 * i;
-    /* Fully shadowed: no light direction to bend towards, so report straight up. */
-    if (!(len > 0.0)) {
-      o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
-      continue;
-    }
-    for (int k = 0; k < 3; k++)
-      o[k] = (float)(b[k] / len);
-  }
-  return BB_OK;
+  derive_job job;
+  job_init(&job, ssbump, NULL, out, ssbump->channels);
+  return run_rows(&job, bent_row, err);
 }

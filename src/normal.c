@@ -46,37 +46,97 @@ typedef struct normal_job {
   bb_image *out;
 } normal_job;
 
+/* Texel rows per parallel work item: the cell rows above and below a band are
+ * computed twice, so a band amortises them over its rows. */
+#define BAND_ROWS 16
+
+/* Texel columns per pass over a band: keeps the three cell rows in L1. */
+#define SPAN 128
+
+/* bb__address for an index at most two texels outside 0 .. n-1 (all the
+ * estimators read), without the division of bb__wrap. */
+static int address_near(int i, int n, bb_addressing a) {
+  return a == BB_ADDRESS_PERIODIC ? bb__wrap_near(i, n) : bb__clampi(i, 0, n - 1);
+}
+
 /* z = scale * h at texel (x, y), addressed. */
 static double z_at(const normal_job *job, int x, int y) {
-  int ax = bb__address(x, job->height->width, job->addressing);
-  int ay = bb__address(y, job->height->height, job->addressing);
-  return job->scale * (double)*bb_image_texel(job->height, ax, ay);
+  const bb_image *h = job->height;
+  int ax = address_near(x, h->width, job->addressing);
+  int ay = address_near(y, h->height, job->addressing);
+  return job->scale * (double)h->pixels[(size_t)ay * (size_t)h->width + (size_t)ax];
 }
 
-static void add_unit(double sum[3], double nx, double ny, double nz) {
+/* The unit normals of the two triangles of one cell, as Valve's estimator
+ * adds them: (v00, v10, v01) first, then (v10, v11, v01). */
+typedef struct cell_normals {
+  double a[3], b[3];
+} cell_normals;
+
+static void unit_normal(double nx, double ny, double nz, double out[3]) {
   double len = sqrt(nx * nx + ny * ny + nz * nz);
-  sum[0] += nx / len;
-  sum[1] += ny / len;
-  sum[2] += nz / len;
+  out[0] = nx / len;
+  out[1] = ny / len;
+  out[2] = nz / len;
 }
 
-/* Valve's estimator: the 18 unit normals of the two triangles of the 9 cells
- * (x0, y0), x0 in x-1..x+1, y0 in y-1..y+1. Cell (x0, y0) spans the corners
- * (x0, y0)..(x0+1, y0+1) and is split along its (x0+1, y0)-(x0, y0+1)
- * diagonal. The 9 cells cover x-1..x+2, so the estimate is centred at
- * (x + 0.5, y + 0.5), as Valve's is. */
-static void normal_valve(const normal_job *job, int x, int y, double n[3]) {
-  double z[4][4]; /* z[j][i] = z(x - 1 + i, y - 1 + j) */
-  for (int j = 0; j < 4; j++)
-    for (int i = 0; i < 4; i++)
-      z[j][i] = z_at(job, x - 1 + i, y - 1 + j);
-  n[0] = n[1] = n[2] = 0.0;
-  for (int j = 0; j < 3; j++)
-    for (int i = 0; i < 3; i++) {
-      double z00 = z[j][i], z10 = z[j][i + 1], z01 = z[j + 1][i], z11 = z[j + 1][i + 1];
-      add_unit(n, -(z10 - z00), -(z01 - z00), 1.0); /* (v00, v10, v01) */
-      add_unit(n, z01 - z11, z10 - z11, 1.0);       /* (v10, v11, v01) */
+/* Cells (x0, y0) for x0 = x_start-1 .. x_start+count-2 into cells[0 .. count-1].
+ * Cell (x0, y0) spans the corners (x0, y0)..(x0+1, y0+1) and is split along
+ * its (x0+1, y0)-(x0, y0+1) diagonal. */
+static void cell_row(const normal_job *job, int y0, int x_start, int count,
+                     cell_normals *cells) {
+  double z00 = z_at(job, x_start - 1, y0), z01 = z_at(job, x_start - 1, y0 + 1);
+  for (int i = 0; i < count; i++) {
+    double z10 = z_at(job, x_start + i, y0), z11 = z_at(job, x_start + i, y0 + 1);
+    unit_normal(-(z10 - z00), -(z01 - z00), 1.0, cells[i].a);
+    unit_normal(z01 - z11, z10 - z11, 1.0, cells[i].b);
+    z00 = z10;
+    z01 = z11;
+  }
+}
+
+/* Writes n / |n| at (x, y). n.z > 0 in every estimator, so |n| is never 0. */
+static void write_unit(const normal_job *job, int x, int y, const double n[3]) {
+  double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  float *p = job->out->pixels + 3 * ((size_t)y * (size_t)job->out->width + (size_t)x);
+  for (int c = 0; c < 3; c++)
+    p[c] = (float)(n[c] / len);
+}
+
+/* Valve's estimator: the mean direction of the 18 unit normals of the two
+ * triangles of the 9 cells (x0, y0), x0 in x-1..x+1, y0 in y-1..y+1. The 9
+ * cells cover x-1..x+2, so the estimate is centred at (x + 0.5, y + 0.5), as
+ * Valve's is.
+ *
+ * Each cell is shared by 9 texels, so its two unit normals (2 square roots,
+ * 6 divisions) are computed once per band and span, in a ring of the three
+ * cell rows y-1, y, y+1. Every texel still adds them in the order of the
+ * direct per-texel sum: cell row j, then cell column i, triangle a before b,
+ * each componentwise, so the floating-point result is bit for bit the same. */
+static void valve_band(const normal_job *job, int y_start, int y_end) {
+  cell_normals ring[3][SPAN + 2]; /* cell row y0 lives in ring[(y0 + 1) % 3] */
+  const int width = job->height->width;
+  for (int x_start = 0; x_start < width; x_start += SPAN) {
+    const int x_end = x_start + SPAN < width ? x_start + SPAN : width;
+    const int count = x_end - x_start + 2; /* cells x_start-1 .. x_end */
+    for (int y0 = y_start - 1; y0 <= y_start; y0++)
+      cell_row(job, y0, x_start, count, ring[(y0 + 1) % 3]);
+    for (int y = y_start; y < y_end; y++) {
+      cell_row(job, y + 1, x_start, count, ring[(y + 2) % 3]);
+      for (int x = x_start; x < x_end; x++) {
+        double n[3] = {0.0, 0.0, 0.0};
+        for (int j = 0; j < 3; j++) {
+          const cell_normals *cells = ring[(y + j) % 3] + (x - x_start);
+          for (int i = 0; i < 3; i++)
+            for (int c = 0; c < 3; c++) {
+              n[c] += cells[i].a[c];
+              n[c] += cells[i].b[c];
+            }
+        }
+        write_unit(job, x, y, n);
+      }
     }
+  }
 }
 
 /* Central differences: N ~ (-dz/dx, -dz/dy, 1) centred on the texel. */
@@ -101,27 +161,25 @@ static void normal_sobel(const normal_job *job, int x, int y, double n[3]) {
   n[2] = 1.0;
 }
 
-static void normal_row(void *user, int y) {
+/* One work item: texel rows band*BAND_ROWS .. +BAND_ROWS-1. */
+static void normal_band(void *user, int band) {
   const normal_job *job = user;
-  for (int x = 0; x < job->height->width; x++) {
-    double n[3] = {0.0, 0.0, 1.0}; /* filter was validated; this quiets -Wuninitialized */
-    switch (job->filter) {
-    case BB_NORMAL_VALVE:
-      normal_valve(job, x, y, n);
-      break;
-    case BB_NORMAL_CENTRAL:
-      normal_central(job, x, y, n);
-      break;
-    case BB_NORMAL_SOBEL:
-      normal_sobel(job, x, y, n);
-      break;
-    }
-    /* n.z > 0 in every estimator, so the length is never zero. */
-    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    float *p = bb_image_texel(job->out, x, y);
-    for (int c = 0; c < 3; c++)
-      p[c] = (float)(n[c] / len);
+  const int y_start = band * BAND_ROWS;
+  const int y_end = y_start + BAND_ROWS < job->height->height ? y_start + BAND_ROWS
+                                                              : job->height->height;
+  if (job->filter == BB_NORMAL_VALVE) {
+    valve_band(job, y_start, y_end);
+    return;
   }
+  for (int y = y_start; y < y_end; y++)
+    for (int x = 0; x < job->height->width; x++) {
+      double n[3];
+      if (job->filter == BB_NORMAL_SOBEL)
+        normal_sobel(job, x, y, n);
+      else
+        normal_central(job, x, y, n);
+      write_unit(job, x, y, n);
+    }
 }
 
 static bb_status check_arguments(const bb_image *height, float height_scale,
@@ -160,7 +218,8 @@ bb_status bb_normals_compute(const bb_image *height, float height_scale,
   if (st != BB_OK)
     return st;
   normal_job job = {height, (double)height_scale, filter, addressing, out};
-  st = bb__parallel_for(height->height, 0, normal_row, &job, NULL, NULL, err);
+  const int bands = height->height / BAND_ROWS + (height->height % BAND_ROWS != 0);
+  st = bb__parallel_for(bands, 0, normal_band, &job, NULL, NULL, err);
   if (st != BB_OK)
     bb_image_free(out);
   return st;

@@ -2,6 +2,7 @@
 #include <criterion/criterion.h>
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "bumpbake.h"
@@ -191,6 +192,76 @@ Test(derive, ao_is_channel_zero) {
   for (int i = 0; i < 6; i++)
     cr_assert_eq(ao.pixels[i], vis.pixels[4 * i]);
   bb_image_free(&vis), bb_image_free(&ao);
+}
+
+/* Deterministic pseudo-random numbers in [0, 1) (64-bit LCG, high bits). */
+static double next_random(uint64_t *state) {
+  *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static int same_bits(float a, float b) {
+  return memcmp(&a, &b, sizeof a) == 0;
+}
+
+/* The maps on many rows (they run row by row on all cores) against direct
+ * per-texel formulas, bit for bit; one normal is NaN, which ssbump maps to 0
+ * as fmax does. */
+static void check_maps_against_formulas(int count) {
+  const int w = 37, h = 29, texels = w * h;
+  bb_image n = {0}, vis = {0}, wt = {0}, s = {0}, ao = {0}, bent = {0};
+  uint64_t state = 21;
+  cr_assert_eq(bb_image_alloc(&n, w, h, 3, NULL), BB_OK);
+  cr_assert_eq(bb_image_alloc(&vis, w, h, 1 + count, NULL), BB_OK);
+  for (int i = 0; i < texels; i++) {
+    set_normal(&n, i, 2.0 * next_random(&state) - 1.0, 2.0 * next_random(&state) - 1.0,
+               next_random(&state) - 0.2);
+    for (int c = 0; c <= count; c++)
+      vis.pixels[(1 + count) * i + c] = (float)next_random(&state);
+  }
+  n.pixels[3 * 100] = NAN;
+  cr_assert_eq(bb_derive_weights(&n, &wt, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ssbump(&n, &vis, &s, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  double b[4][3];
+  for (int c = 0; c < count; c++)
+    bb_basis_vector(c, b[c]);
+  for (int i = 0; i < texels; i++) {
+    const float *ni = n.pixels + 3 * i, *vi = vis.pixels + (1 + count) * i;
+    double d[4], wsum = 0.0, bv[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < count; c++)
+      d[c] = (double)ni[0] * b[c][0] + (double)ni[1] * b[c][1] + (double)ni[2] * b[c][2];
+    for (int c = 0; c < 3; c++) {
+      double sat = d[c] < 0.0 ? 0.0 : (d[c] > 1.0 ? 1.0 : d[c]);
+      wsum += sat * sat;
+    }
+    for (int c = 0; c < 3; c++) {
+      double sat = d[c] < 0.0 ? 0.0 : (d[c] > 1.0 ? 1.0 : d[c]);
+      float want = (float)(wsum > 0.0 ? sat * sat / wsum : 1.0 / 3.0);
+      cr_assert(same_bits(wt.pixels[3 * i + c], want), "weights texel %d", i);
+    }
+    for (int c = 0; c < count; c++) {
+      float want = (float)(fmax(0.0, d[c]) * (double)vi[1 + c]);
+      cr_assert(same_bits(s.pixels[count * i + c], want), "ssbump texel %d", i);
+      for (int k = 0; k < 3; k++)
+        bv[k] += (double)want * b[c][k];
+    }
+    cr_assert(same_bits(ao.pixels[i], vi[0]), "ao texel %d", i);
+    double len = sqrt(bv[0] * bv[0] + bv[1] * bv[1] + bv[2] * bv[2]);
+    for (int k = 0; k < 3; k++) {
+      float want = len > 0.0 ? (float)(bv[k] / len) : (k == 2 ? 1.0f : 0.0f);
+      cr_assert(same_bits(bent.pixels[3 * i + k], want), "bent texel %d", i);
+    }
+  }
+  cr_assert_eq(s.pixels[count * 100], 0.0f, "a NaN normal lights nothing");
+  bb_image_free(&n), bb_image_free(&vis), bb_image_free(&wt);
+  bb_image_free(&s), bb_image_free(&ao), bb_image_free(&bent);
+}
+
+Test(derive, maps_match_per_texel_formulas_bit_for_bit) {
+  check_maps_against_formulas(3);
+  check_maps_against_formulas(4);
 }
 
 Test(derive, rejects_mismatched_inputs) {

@@ -232,6 +232,86 @@ Test(normal, periodic_shift_is_exact) {
   bb_image_free(&shifted);
 }
 
+/* The estimators as direct per-texel sums (the form of CONVENTIONS), kept here
+ * to check the library's per-cell form bit for bit. */
+static double ref_z(const bb_image *h, double scale, int x, int y, bb_addressing a) {
+  int ax, ay;
+  if (a == BB_ADDRESS_PERIODIC) {
+    ax = ((x % h->width) + h->width) % h->width;
+    ay = ((y % h->height) + h->height) % h->height;
+  } else {
+    ax = x < 0 ? 0 : (x >= h->width ? h->width - 1 : x);
+    ay = y < 0 ? 0 : (y >= h->height ? h->height - 1 : y);
+  }
+  return scale * (double)bb_image_texel(h, ax, ay)[0];
+}
+
+static void ref_add_unit(double sum[3], double nx, double ny, double nz) {
+  double len = sqrt(nx * nx + ny * ny + nz * nz);
+  sum[0] += nx / len;
+  sum[1] += ny / len;
+  sum[2] += nz / len;
+}
+
+static void ref_normal(const bb_image *h, double scale, bb_normal_filter f,
+                       bb_addressing a, int x, int y, float out[3]) {
+  double z[4][4]; /* z[j][i] = z(x - 1 + i, y - 1 + j) */
+  for (int j = 0; j < 4; j++)
+    for (int i = 0; i < 4; i++)
+      z[j][i] = ref_z(h, scale, x - 1 + i, y - 1 + j, a);
+  double n[3] = {0.0, 0.0, 1.0};
+  if (f == BB_NORMAL_VALVE) {
+    n[2] = 0.0;
+    for (int j = 0; j < 3; j++)
+      for (int i = 0; i < 3; i++) {
+        double z00 = z[j][i], z10 = z[j][i + 1], z01 = z[j + 1][i], z11 = z[j + 1][i + 1];
+        ref_add_unit(n, -(z10 - z00), -(z01 - z00), 1.0);
+        ref_add_unit(n, z01 - z11, z10 - z11, 1.0);
+      }
+  } else if (f == BB_NORMAL_CENTRAL) {
+    n[0] = -(z[1][2] - z[1][0]) / 2.0;
+    n[1] = -(z[2][1] - z[0][1]) / 2.0;
+  } else {
+    n[0] = -(((z[0][2] + 2.0 * z[1][2] + z[2][2]) - (z[0][0] + 2.0 * z[1][0] + z[2][0])) /
+             8.0);
+    n[1] = -(((z[2][0] + 2.0 * z[2][1] + z[2][2]) - (z[0][0] + 2.0 * z[0][1] + z[0][2])) /
+             8.0);
+  }
+  double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  for (int c = 0; c < 3; c++)
+    out[c] = (float)(n[c] / len);
+}
+
+/* Sizes around the library's band (16 rows) and span (128 columns), and
+ * images smaller than the 4x4 neighbourhood. */
+Test(normal, matches_direct_sums_bit_for_bit) {
+  const int sizes[][2] = {{1, 1}, {2, 3}, {5, 37}, {17, 16}, {130, 33}, {257, 5}};
+  uint64_t state = 5;
+  for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
+    const int w = sizes[s][0], hgt = sizes[s][1];
+    bb_image h = {0}, n = {0};
+    cr_assert_eq(bb_image_alloc(&h, w, hgt, 1, NULL), BB_OK);
+    for (int i = 0; i < w * hgt; i++)
+      h.pixels[i] = (float)next_random(&state);
+    for (size_t f = 0; f < 3; f++)
+      for (int clamp = 0; clamp < 2; clamp++) {
+        bb_addressing a = clamp ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC;
+        compute(&h, 40.0f, all_filters[f], a, &n);
+        for (int y = 0; y < hgt; y++)
+          for (int x = 0; x < w; x++) {
+            float want[3];
+            ref_normal(&h, 40.0, all_filters[f], a, x, y, want);
+            cr_assert_eq(memcmp(bb_image_texel(&n, x, y), want, sizeof want), 0,
+                         "%dx%d %s %s (%d,%d)", w, hgt,
+                         bb_normal_filter_name(all_filters[f]),
+                         clamp ? "clamp" : "periodic", x, y);
+          }
+        bb_image_free(&n);
+      }
+    bb_image_free(&h);
+  }
+}
+
 Test(normal, rejects_bad_arguments) {
   bb_image h = {0}, rgb = {0}, n = {0};
   bb_error err = {{0}};
