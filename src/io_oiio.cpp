@@ -221,19 +221,29 @@ std::string create_temp_file(const std::string &dir, const std::string &ext) {
 
 // Round-half-up quantisation of v (after the range mapping) to 0..max_code.
 // NaN becomes 0 so that it cannot reach an undefined float-to-int cast.
-std::uint32_t quantise(float v, bb_range range, double max_code) {
+// u * max_code + 0.5 lies in [0.5, max_code + 0.5], so truncation is the
+// floor: the same codes as std::floor, without a libm call per sample.
+template <bb_range range> inline std::int32_t quantise(float v, double max_code) {
   double u = range == BB_RANGE_SIGNED ? 0.5 + 0.5 * (double)v : (double)v;
-  if (!(u > 0.0)) u = 0.0;
-  if (u > 1.0) u = 1.0;
-  return (std::uint32_t)std::floor(u * max_code + 0.5);
+  u = u > 0.0 ? u : 0.0;
+  u = u < 1.0 ? u : 1.0;
+  return (std::int32_t)(u * max_code + 0.5);
+}
+
+template <typename T, bb_range range>
+void quantise_all(const float *v, size_t n, T *codes) {
+  const double max_code = (double)(T)~(T)0;
+  for (size_t i = 0; i < n; i++) codes[i] = (T)quantise<range>(v[i], max_code);
 }
 
 template <typename T>
 std::vector<T> quantise_image(const bb_image *img, bb_range range) {
-  const double max_code = (double)(T)~(T)0;
   size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
   std::vector<T> codes(n);
-  for (size_t i = 0; i < n; i++) codes[i] = (T)quantise(img->pixels[i], range, max_code);
+  if (range == BB_RANGE_SIGNED)
+    quantise_all<T, BB_RANGE_SIGNED>(img->pixels, n, codes.data());
+  else
+    quantise_all<T, BB_RANGE_UNIT>(img->pixels, n, codes.data());
   return codes;
 }
 
