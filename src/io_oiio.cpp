@@ -275,6 +275,11 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
     spec.attribute("png:compressionLevel", 1);
     spec.attribute("png:filter", 128); // PNG_FILTER_PAETH
     spec.attribute("compression", "rle");
+  } else if (std::strcmp(out->format_name(), "tiff") == 0) {
+    // TIFF is deflated too (OIIO's default "zip"); level 1 instead of 6 takes
+    // 73% less CPU for 6% more bytes on rock06's 8-bit maps (16-bit: -25%,
+    // +1%; float: -29%, +3%).
+    spec.attribute("tiff:zipquality", 1);
   }
   if (!out->open(file_name, spec)) return one_line(out->geterror());
 
