@@ -174,6 +174,21 @@ Test(io, round_trip_png16) {
   bb_image_free(&img);
 }
 
+/* Big enough for many deflate blocks and rows, with flat runs beside noise:
+ * the PNG and TIFF encoders' speed settings must stay lossless. */
+Test(io, round_trip_large_png_and_tif_with_runs) {
+  bb_image img = make_image(517, 301, 3, 0.0f, 1.0f, 11);
+  for (int y = 0; y < img.height; y += 2)
+    for (int x = 0; x < img.width / 2; x++)
+      for (int c = 0; c < 3; c++)
+        img.pixels[((size_t)y * 517 + (size_t)x) * 3 + (size_t)c] = 0.25f;
+  check_round_trip("big.png", &img, BB_DEPTH_8, HALF_STEP_8, "png", 0, 8);
+  check_round_trip("big16.png", &img, BB_DEPTH_16, HALF_STEP_16, "png", 0, 16);
+  check_round_trip("big.tif", &img, BB_DEPTH_8, HALF_STEP_8, "tiff", 0, 8);
+  check_round_trip("bigf.tif", &img, BB_DEPTH_FLOAT, 0.0, "tiff", 1, 32);
+  bb_image_free(&img);
+}
+
 Test(io, round_trip_tga) {
   bb_image img = make_image(6, 4, 4, 0.0f, 1.0f, 3);
   check_round_trip("a.tga", &img, BB_DEPTH_DEFAULT, HALF_STEP_8, "targa", 0, 8);
