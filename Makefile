@@ -21,6 +21,21 @@ OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 LDLIBS  := $(OIIO_LIBS) -lm -pthread
+
+# Start-up. OpenImageIO on Debian 12 loads 261 shared libraries, and most of
+# bumpbake's ~0.2 s start-up is the dynamic linker looking up symbols: each
+# lookup walks the libraries in load order up to the one defining it, and a
+# few large C++ libraries deep in that order (OpenVDB, GDAL, Xerces, GEOS...)
+# look up tens of thousands of their own symbols. Naming them first on the
+# CLI's link line (they are loaded anyway) makes those walks short: `bumpbake
+# --version` drops from 0.20 to 0.15 s. Only those OpenImageIO already brings
+# in are named (none elsewhere: no change); `make EARLY_LIBS=` turns it off.
+# Deferred (=), so ldd runs only when the CLI is linked.
+EARLY_LIB_PATTERN := ^lib(openvdb|xerces-c|gdal|geos|crypto|proj|poppler|dcmdata|gdcmMSFF|rsvg-2)[.-]
+EARLY_LIBS = $(shell ldd "$$(pkg-config --variable=libdir OpenImageIO)/libOpenImageIO.so" \
+  2>/dev/null | awk '$$1 ~ /$(EARLY_LIB_PATTERN)/ && $$3 ~ /^\// {print $$3}')
+EARLY_LINK = $(if $(strip $(EARLY_LIBS)),-Wl$(comma)--push-state$(comma)--no-as-needed $(EARLY_LIBS) -Wl$(comma)--pop-state)
+comma := ,
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -68,7 +83,7 @@ $(LIB): $(LIB_OBJ)
 	ar rcs $@ $^
 
 $(BIN): $(CLI_OBJ) $(LIB)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK) $(LDLIBS)
 
 $(BUILD)/tools/%: tools/%.c $(wildcard tools/*.h) $(LIB) include/bumpbake.h
 	@mkdir -p $(dir $@)
