@@ -480,6 +480,11 @@ void bb_trace_options_init(bb_trace_options *o) {
   o->bias_texels = 0.55;
 }
 
+/* Slices whose blocked counts are kept at once, 2 bytes per texel each (as
+ * much as the 4 double sums they feed): a 256-ray set (16 slices) is one
+ * batch, added up in one pass with no sums kept between passes. */
+enum { SLICE_BATCH = 16 };
+
 /* Per slice s and channel c, the weight of the rays a march leaves unblocked:
  * unblocked[c][start_s + s + b] = sum of the weights of rays b.. of slice s. */
 typedef struct trace_job {
@@ -491,10 +496,14 @@ typedef struct trace_job {
   double total[1 + BB_MAX_BASIS];
   direction *slice_dir;   /* per slice */
   int *order;             /* slices in the order their weights are summed */
-  double *sums;           /* slice paths: per texel and channel, unblocked weight so far */
-  uint16_t *blocked[2];   /* slice paths: per texel, rays of `slice[k]` blocked */
-  const bb__band *band;   /* band path: the bands of slice `slice[0]` */
-  int slice[2];           /* slice paths: the slices in hand; slice[1] is -1 if none */
+  /* Slice paths: the blocked counts of a batch of slices, then added up. */
+  uint16_t *blocked;      /* SLICE_BATCH planes of one count per texel */
+  int batch[SLICE_BATCH]; /* the batch's slices, plane k holds batch[k]'s counts */
+  int batch_size;
+  int batch_first, batch_last; /* is it the first / last batch of the trace? */
+  double *sums;           /* per texel and channel, weight summed by earlier batches */
+  const bb__band *band;   /* band path: the bands of the slice of plane band_plane */
+  int band_plane;
   float *vis;
 } trace_job;
 
@@ -562,8 +571,7 @@ static void release_job(trace_job *job) {
   free(job->slice_dir);
   free(job->order);
   free(job->sums);
-  free(job->blocked[0]);
-  free(job->blocked[1]);
+  free(job->blocked);
 }
 
 /* Adds slice s's unblocked weight for `blocked` blocked rays to sum[]. */
@@ -579,6 +587,11 @@ static void store_texel(const trace_job *job, size_t texel, const double *sum) {
     out[c] = job->total[c] > 0.0 ? (float)(sum[c] / job->total[c]) : 1.0f;
 }
 
+/* Plane k of the batch's blocked counts. */
+static inline uint16_t *plane(const trace_job *job, int k) {
+  return job->blocked + (size_t)k * (size_t)job->p->width * (size_t)job->p->height;
+}
+
 static inline double origin_z(const trace_job *job, int x, int y) {
   return (double)job->p->z[(size_t)y * (size_t)job->p->width + (size_t)x] + job->o->bias_texels;
 }
@@ -587,31 +600,35 @@ static inline double origin_z(const trace_job *job, int x, int y) {
 static void band_slice_row(void *user, int y) {
   const trace_job *job = user;
   const bb_rayset *rs = job->rs;
-  const int s = job->slice[0], start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+  const int s = job->batch[job->band_plane], start = rs->slice_start[s],
+            count = rs->slice_start[s + 1] - start;
+  uint16_t *blocked = plane(job, job->band_plane);
   double hint = 0.0; /* where the previous texel's horizon was */
   for (int x = 0; x < job->p->width; x++)
-    job->blocked[0][(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
+    blocked[(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
         job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
         rs->tan_elevation + start, count, &hint);
 }
 
-/* The texels' sums grow slice by slice, always in slice order, so the
- * result does not depend on threads. */
-static void add_slice_row(void *user, int y) {
+/* A texel's sums grow batch by batch and, within one, plane by plane:
+ * always in the summing order, so the result does not depend on threads.
+ * The last batch stores the visibility. */
+static void add_batch_row(void *user, int y) {
   const trace_job *job = user;
-  for (int x = 0; x < job->p->width; x++) {
-    const size_t texel = (size_t)y * (size_t)job->p->width + (size_t)x;
-    double *sum = job->sums + texel * (size_t)job->channels;
-    add_slice(job, job->slice[0], job->blocked[0][texel], sum);
-    if (job->slice[1] >= 0) add_slice(job, job->slice[1], job->blocked[1][texel], sum);
-  }
-}
-
-static void finish_row(void *user, int y) {
-  const trace_job *job = user;
-  for (int x = 0; x < job->p->width; x++) {
-    size_t texel = (size_t)y * (size_t)job->p->width + (size_t)x;
-    store_texel(job, texel, job->sums + texel * (size_t)job->channels);
+  const int w = job->p->width, channels = job->channels;
+  const size_t texels = (size_t)w * (size_t)job->p->height;
+  for (int x = 0; x < w; x++) {
+    const size_t texel = (size_t)y * (size_t)w + (size_t)x;
+    double sum[1 + BB_MAX_BASIS] = {0};
+    double *kept = job->sums ? job->sums + texel * (size_t)channels : NULL;
+    if (!job->batch_first)
+      for (int c = 0; c < channels; c++) sum[c] = kept[c];
+    for (int k = 0; k < job->batch_size; k++)
+      add_slice(job, job->batch[k], job->blocked[(size_t)k * texels + texel], sum);
+    if (job->batch_last)
+      store_texel(job, texel, sum);
+    else
+      for (int c = 0; c < channels; c++) kept[c] = sum[c];
   }
 }
 
@@ -634,26 +651,26 @@ static void trace_row(void *user, int y) {
 
 static bb__sweep_dir sweep_dir(const trace_job *job, int k) {
   const bb_rayset *rs = job->rs;
-  const int s = job->slice[k], start = rs->slice_start[s];
+  const int s = job->batch[k], start = rs->slice_start[s];
   return (bb__sweep_dir){rs->tan_elevation + start, rs->slice_start[s + 1] - start,
-                         job->blocked[k]};
+                         plane(job, k)};
 }
 
-/* The blocked counts at every texel of the slices in hand: by line sweeps
- * (periodic, when allowed), which take a slice and its opposite at once, or
- * by marches through the slice's direction bands. */
-static bb_status blocked_counts(trace_job *job, int sweep, bb_error *err) {
+/* The blocked counts at every texel of the batch's planes k (and k + 1 when
+ * `pair`): by line sweeps (periodic, when allowed), which take a slice and
+ * its opposite at once, or by marches through the slice's direction bands. */
+static bb_status blocked_counts(trace_job *job, int k, int pair, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
-  const int s = job->slice[0];
+  const int s = job->batch[k];
   if (sweep && p->addressing == BB_ADDRESS_PERIODIC) {
-    const bb__sweep_dir along = sweep_dir(job, 0);
+    const bb__sweep_dir along = sweep_dir(job, k);
     bb__sweep_dir opposite = {0};
-    if (job->slice[1] >= 0) opposite = sweep_dir(job, 1);
+    if (pair) opposite = sweep_dir(job, k + 1);
     return bb__sweep_lines(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
-                           job->slice[1] >= 0 ? &opposite : NULL, job->o->bias_texels,
-                           job->o->threads, err);
+                           pair ? &opposite : NULL, job->o->bias_texels, job->o->threads, err);
   }
+  job->band_plane = k;
   bb__band band;
   bb_status st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads,
                                 &band, err);
@@ -665,29 +682,53 @@ static bb_status blocked_counts(trace_job *job, int sweep, bb_error *err) {
   return st;
 }
 
-/* Slices in the summing order, two at a time when the next is the opposite
- * of the current and sweeps are on. */
+/* Fills the batch with the slices order[*next ..], a slice and its opposite
+ * side by side when sweeps can take them together (is_pair[k] marks the
+ * first plane of such a pair). */
+static void fill_batch(trace_job *job, int pairs, int *next, int *is_pair) {
+  const bb_rayset *rs = job->rs;
+  job->batch_size = 0;
+  while (*next < rs->slice_count && job->batch_size < SLICE_BATCH) {
+    const int s = job->order[*next];
+    const int t = *next + 1 < rs->slice_count ? job->order[*next + 1] : -1;
+    const int pair = pairs && t >= 0 && opposite_steps(rs, s, t);
+    if (pair && job->batch_size + 2 > SLICE_BATCH) break;
+    is_pair[job->batch_size] = pair;
+    job->batch[job->batch_size++] = s;
+    if (pair) {
+      is_pair[job->batch_size] = 0;
+      job->batch[job->batch_size++] = t;
+    }
+    *next += pair ? 2 : 1;
+  }
+}
+
+/* Slices in the summing order, batch by batch. */
 static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
   const size_t texels = (size_t)p->width * (size_t)p->height;
   const int pairs = sweep && p->addressing == BB_ADDRESS_PERIODIC;
-  job->sums = calloc(texels * (size_t)job->channels, sizeof(double));
-  job->blocked[0] = malloc(texels * sizeof(uint16_t));
-  job->blocked[1] = pairs ? malloc(texels * sizeof(uint16_t)) : NULL;
-  if (!job->sums || !job->blocked[0] || (pairs && !job->blocked[1]))
+  const int planes = rs->slice_count < SLICE_BATCH ? rs->slice_count : SLICE_BATCH;
+  job->blocked = malloc((size_t)planes * texels * sizeof(uint16_t));
+  if (rs->slice_count > SLICE_BATCH) /* more than one batch: sums kept between them */
+    job->sums = malloc(texels * (size_t)job->channels * sizeof(double));
+  if (!job->blocked || (rs->slice_count > SLICE_BATCH && !job->sums))
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
   bb_status st = BB_OK;
-  for (int i = 0; st == BB_OK && i < rs->slice_count;) {
-    const int s = job->order[i], next = i + 1 < rs->slice_count ? job->order[i + 1] : -1;
-    job->slice[0] = s;
-    job->slice[1] = pairs && next >= 0 && opposite_steps(rs, s, next) ? next : -1;
-    i += job->slice[1] >= 0 ? 2 : 1;
-    st = blocked_counts(job, sweep, err);
-    if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, add_slice_row, job, NULL, NULL, err);
-    if (job->o->progress) job->o->progress(job->o->progress_user, i, rs->slice_count);
+  int next = 0, is_pair[SLICE_BATCH];
+  for (job->batch_first = 1; st == BB_OK && next < rs->slice_count; job->batch_first = 0) {
+    fill_batch(job, pairs, &next, is_pair);
+    job->batch_last = next == rs->slice_count;
+    for (int k = 0; st == BB_OK && k < job->batch_size; k += is_pair[k] ? 2 : 1) {
+      st = blocked_counts(job, k, is_pair[k], sweep, err);
+      if (job->o->progress)
+        job->o->progress(job->o->progress_user, next - job->batch_size + k + 1 + is_pair[k],
+                         rs->slice_count);
+    }
+    if (st == BB_OK)
+      st = bb__parallel_for(p->height, job->o->threads, add_batch_row, job, NULL, NULL, err);
   }
-  if (st == BB_OK) st = bb__parallel_for(p->height, job->o->threads, finish_row, job, NULL, NULL, err);
   return st;
 }
 
