@@ -1,5 +1,5 @@
 /* sweep.c: the horizons of every texel for a lattice slice direction and its
- * opposite, by sweeps along each line of texels (periodic addressing).
+ * opposite, by sweeps along each line of texels.
  *
  * A slice follows a lattice step (a, b) (coprime integers), so texel P and
  * P + j (a, b) lie on one line, and so do all the breakpoints of the surface
@@ -19,11 +19,14 @@
  * breakpoints, so one profile serves both: the sweep for (a, b) walks it
  * backwards, the sweep for (-a, -b) forwards (on mirrored u).
  *
- * Lines are periodic (the texture tiles), so they are cut into chunks of at
- * most CHUNK_STEPS texels, each profiled with a look-ahead past both ends of
- * as many steps as a ray of the lowest elevation needs to rise above the
- * global maximum (or one whole period, past which nothing new can come).
- * Chunks are independent, so they run on all threads with the same result.
+ * Lines are cut into chunks of at most CHUNK_STEPS texels, each profiled
+ * with a look-ahead past both ends of as many steps as a ray of the lowest
+ * elevation needs to rise above the global maximum. Periodic lines (the
+ * texture tiles) wrap, and after one whole period nothing new can come; in
+ * clamp mode a line runs from one edge to the other, and past the image the
+ * look-ahead reads the clamped vertices (the border extruded) until the
+ * profile is flat. Chunks are independent, so they run on all threads with
+ * the same result.
  */
 #include "internal.h"
 #include "trace_internal.h"
@@ -140,9 +143,20 @@ static inline double hull_tangent(const hull *h, double u0, double z0) {
   return dz / du;
 }
 
+/* Height of vertex (x, y) through the addressing; periodic coordinates lie
+ * within a few periods of the image, clamped ones anywhere. */
 static inline double field_z(const bb_pyramid *p, int x, int y) {
-  return (double)p->z[(size_t)bb__wrap_near(y, p->height) * (size_t)p->width +
-                      (size_t)bb__wrap_near(x, p->width)];
+  if (p->addressing == BB_ADDRESS_PERIODIC)
+    return (double)p->z[(size_t)bb__wrap_near(y, p->height) * (size_t)p->width +
+                        (size_t)bb__wrap_near(x, p->width)];
+  return (double)p->z[(size_t)bb__clampi(y, 0, p->height - 1) * (size_t)p->width +
+                      (size_t)bb__clampi(x, 0, p->width - 1)];
+}
+
+/* One lattice step along an axis: periodic coordinates stay in [0, n),
+ * clamped ones (clamp mode) run on past the edges. */
+static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
+  return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step % n, n) : v + step;
 }
 
 /* hull_push, then: if nothing ahead rises from the new point as steeply as
@@ -218,26 +232,26 @@ static inline void kink_finish(kink_filter *f) { /* the last point is an end: ke
 static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
   const bb_pyramid *p = job->p;
   const long first = -(long)job->behind;
-  int bx = (int)(((long)job->chunk_x[chunk] + first * job->a) % p->width);
-  int by = (int)(((long)job->chunk_y[chunk] + first * job->b) % p->height);
-  bx = bb__wrap_near(bx, p->width);
-  by = bb__wrap_near(by, p->height);
-  const int step_x = bb__wrap_near(job->a % p->width, p->width);
-  const int step_y = bb__wrap_near(job->b % p->height, p->height);
+  /* The step's first texel; periodic: wrapped; clamp: unwrapped. */
+  long ux = (long)job->chunk_x[chunk] + first * job->a;
+  long uy = (long)job->chunk_y[chunk] + first * job->b;
+  if (p->addressing == BB_ADDRESS_PERIODIC) ux %= p->width, uy %= p->height;
+  int bx = p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near((int)ux, p->width) : (int)ux;
+  int by = p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near((int)uy, p->height) : (int)uy;
   kink_filter f = {.pr = pr};
   pr->count = 0;
-  for (int i = 0; i <= pr->steps; i++, bx = bb__wrap_near(bx + step_x, p->width),
-           by = bb__wrap_near(by + step_y, p->height)) {
-    const size_t texel = (size_t)by * (size_t)p->width + (size_t)bx;
+  for (int i = 0; i <= pr->steps; i++, bx = step_along(p, bx, job->a, p->width),
+           by = step_along(p, by, job->b, p->height)) {
     const int j = i - job->behind; /* texel of the chunk */
-    pr->vz[i] = (double)p->z[texel];
+    pr->vz[i] = field_z(p, bx, by);
     kink_offer(&f, (double)j, pr->vz[i]);
-    if (j >= 0 && j < job->chunk_len[chunk]) pr->texel[j] = texel;
+    if (j >= 0 && j < job->chunk_len[chunk]) pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
     if (i == pr->steps) break;
-    /* Away from the edges no vertex wraps, and each is a fixed offset. */
+    /* Away from the edges no vertex wraps or clamps, and each is a fixed
+     * offset. */
     const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
                          by >= job->reach_y && by < p->height - job->reach_y;
-    const float *here = p->z + texel;
+    const float *here = interior ? p->z + (size_t)by * (size_t)p->width + (size_t)bx : NULL;
     for (int k = 0; k < job->point_count - 1; k++) {
       const template_point *t = &job->points[k];
       double za, zb;
@@ -312,8 +326,29 @@ static void sweep_chunk(void *user, int chunk) {
   free(h.z);
 }
 
+static inline int inside(const bb_pyramid *p, int x, int y) {
+  return x >= 0 && x < p->width && y >= 0 && y < p->height;
+}
+
+/* Clamp mode: a line runs from a texel whose predecessor is outside the
+ * image to the last texel before it leaves. Returns the number of chunks. */
+static int clamped_chunks(const bb_pyramid *p, int a, int b, int *cx, int *cy, int *clen) {
+  int c = 0;
+  for (int y = 0; y < p->height; y++)
+    for (int x = 0; x < p->width; x++) {
+      if (inside(p, x - a, y - b)) continue;
+      int run = 0;
+      for (int px = x, py = y; inside(p, px, py); px += a, py += b) {
+        if (run == 0) cx[c] = px, cy[c] = py;
+        if (++run == CHUNK_STEPS) clen[c++] = run, run = 0;
+      }
+      if (run) clen[c++] = run;
+    }
+  return c;
+}
+
 /* Cuts the lines of step (a, b) into chunks: the first texel and length of
- * each. A line through P closes after `period` steps. */
+ * each. A periodic line closes when it comes back to its first texel. */
 static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **cy, int **clen,
                              int *count, bb_error *err) {
   const size_t n = (size_t)p->width * (size_t)p->height;
@@ -326,6 +361,11 @@ static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   }
   int c = 0;
+  if (p->addressing != BB_ADDRESS_PERIODIC) {
+    free(seen);
+    *count = clamped_chunks(p, a, b, *cx, *cy, *clen);
+    return BB_OK;
+  }
   for (int y = 0; y < p->height; y++)
     for (int x = 0; x < p->width; x++) {
       if (seen[(size_t)y * (size_t)p->width + (size_t)x]) continue;
@@ -351,13 +391,19 @@ static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **
 }
 
 /* Steps past which the lowest ray of `side` is above the global maximum,
- * at most one period of the line (nothing new comes after it). */
+ * and no more than can bring anything new: a periodic line repeats after its
+ * period (at most W * H steps); a clamped one (clamp mode) is flat once every
+ * vertex of its steps is clamped, a step's reach past the image, and on a
+ * flat stretch no point beyond the first can be steeper from behind. */
 static int lookahead_steps(const bb_pyramid *p, const sweep_side *side) {
   if (!side->blocked) return 0;
   const double rise = (double)p->global_max - (double)p->global_min;
   const double reach = side->tan_step[0] > 0.0 ? ceil(rise / side->tan_step[0]) + 2.0 : 1e9;
-  const long period = (long)p->width * p->height;
-  return (int)(reach < (double)period ? reach : (double)period);
+  const long longest = p->width > p->height ? p->width : p->height;
+  const long limit = p->addressing == BB_ADDRESS_PERIODIC
+                         ? (long)p->width * p->height
+                         : longest + 2L * (BB__MAX_LATTICE_STEP + 2);
+  return (int)(reach < (double)limit ? reach : (double)limit);
 }
 
 static bb_status set_side(const bb__sweep_dir *dir, double step_length, sweep_side *side,

@@ -23,9 +23,9 @@
  * the rays of the slice are sorted by elevation, and the march only looks for
  * breakpoints that would block the lowest ray not yet blocked. The batch
  * trace gets each texel's count of blocked rays per slice from line sweeps
- * (sweep.c) on periodic maps, from marches through direction bands (band.c)
- * in clamp mode, or, past 4096 x 4096, from marches through square nodes,
- * texel by texel.
+ * (sweep.c), or, past 4096 x 4096, from marches through square nodes, texel
+ * by texel. Marches through direction bands (band.c) give the same counts;
+ * the tests hold the three paths to each other.
  */
 #include "internal.h"
 #include "trace_internal.h"
@@ -657,13 +657,13 @@ static bb__sweep_dir sweep_dir(const trace_job *job, int k) {
 }
 
 /* The blocked counts at every texel of the batch's planes k (and k + 1 when
- * `pair`): by line sweeps (periodic, when allowed), which take a slice and
- * its opposite at once, or by marches through the slice's direction bands. */
+ * `pair`): by line sweeps, which take a slice and its opposite at once, or
+ * (`sweep` 0) by marches through the slice's direction bands. */
 static bb_status blocked_counts(trace_job *job, int k, int pair, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
   const int s = job->batch[k];
-  if (sweep && p->addressing == BB_ADDRESS_PERIODIC) {
+  if (sweep) {
     const bb__sweep_dir along = sweep_dir(job, k);
     bb__sweep_dir opposite = {0};
     if (pair) opposite = sweep_dir(job, k + 1);
@@ -708,7 +708,7 @@ static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
   const size_t texels = (size_t)p->width * (size_t)p->height;
-  const int pairs = sweep && p->addressing == BB_ADDRESS_PERIODIC;
+  const int pairs = sweep;
   const int planes = rs->slice_count < SLICE_BATCH ? rs->slice_count : SLICE_BATCH;
   job->blocked = malloc((size_t)planes * texels * sizeof(uint16_t));
   if (rs->slice_count > SLICE_BATCH) /* more than one batch: sums kept between them */
@@ -759,9 +759,9 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *rays_traced, bb_error *err) {
-  /* Slice by slice, the sums cost a double per texel and channel (and bands
-   * a float per texel and level): past 4096 x 4096 the square nodes, texel
-   * by texel, do without. */
+  /* Slice by slice, the counts of a batch of slices cost 32 bytes per texel
+   * (and large ray sets as much again for sums): past 4096 x 4096 the square
+   * nodes, texel by texel, do without. */
   const int by_slice = p && (long)p->width * p->height <= 4096L * 4096L;
   bb_status st = bb__trace_occlusion_path(p, rs, o, by_slice ? BB__TRACE_SWEEP : BB__TRACE_SQUARE,
                                           vis, err);

@@ -43,7 +43,7 @@ int bb__march_brute(const bb_pyramid *p, const bb__march_ray *r, const double *t
 typedef enum bb__trace_path {
   BB__TRACE_SQUARE, /* texel by texel, every slice marched through square nodes */
   BB__TRACE_BANDS,  /* slice by slice, marched through direction bands */
-  BB__TRACE_SWEEP   /* slice by slice, line sweeps (periodic; else bands) */
+  BB__TRACE_SWEEP   /* slice by slice, line sweeps */
 } bb__trace_path;
 
 /* bb_trace_occlusion with the path chosen by the caller. For tests. */
@@ -60,7 +60,7 @@ typedef struct bb__sweep_dir {
   uint16_t *blocked;
 } bb__sweep_dir;
 
-/* Periodic addressing only: for the lattice step (a, b), the blocked counts
+/* Either addressing mode: for the lattice step (a, b), the blocked counts
  * of `along` (rays along (a, b)) and of `opposite` (along (-a, -b)) at every
  * texel, origins lifted by bias, by line sweeps (sweep.c). Either direction
  * may be NULL; both share one profile of each line. */
