@@ -5,7 +5,7 @@
 #
 # Sections: 1 trace benchmark (build/tools/bench_trace), 2 the peer
 # (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
-# 3 full bake, 4 ratios against the targets, 5 accuracy against the peer,
+# 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy against the peer,
 # then a summary table. Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -304,25 +304,42 @@ fi
 # ------------------------------------------------------------ 3. full bake
 
 section "3. Full bake: bumpbake bake rock, every output, $threads threads"
-full_cmd=("$bin" bake "$rock" --scale "$rock_scale" --rays "$rays" --threads "$threads" --json -q
-  --normal "$out/rock_normal.png" --weights "$out/rock_weights.png"
-  --ssbump "$out/rock_ssbump.png" --ao "$out/rock_ao.png" --bent "$out/rock_bent.png")
-echo "${full_cmd[*]#"$root/"}"
-bake_ok=1
-measure bake_rock "${full_cmd[@]}" || { fail "bumpbake bake exited non-zero"; bake_ok=0; }
-if [ "$bake_ok" = 1 ]; then
-  printf '%-8s' load smooth pyramid trace derive write stages wall MiB
-  echo
-  stage_sum=0
+# full_cmd ARRAY PREFIX [options]: sets ARRAY to the whole bake of rock, every
+# output under PREFIX
+full_cmd() {
+  local -n cmd=$1
+  local prefix=$2
+  shift 2
+  cmd=("$bin" bake "$rock" --scale "$rock_scale" --rays "$rays" --threads "$threads" --json -q
+    --normal "${prefix}_normal.png" --weights "${prefix}_weights.png"
+    --ssbump "${prefix}_ssbump.png" --ao "${prefix}_ao.png" --bent "${prefix}_bent.png" "$@")
+}
+# stage_row NAME LABEL: the medians of a measured bake, one row
+stage_row() {
+  local name=$1 k v stage_sum=0
+  printf '%-10s' "$2"
   for k in load smooth pyramid trace derive write; do
-    v=$(med bake_rock "$k")
+    v=$(med "$name" "$k")
     stage_sum=$(calc "$stage_sum + $v" %.6f)
     printf '%-8s' "$(calc "$v")"
   done
-  printf '%-8s%-8s%-8s' "$(calc "$stage_sum")" "$(calc "$(med bake_rock @wall)")" \
-    "$(mib "$(med bake_rock @rss)")"
-  echo
-  echo "($(runs_text bake_rock); seconds; stages = their sum, wall = the whole process)"
+  printf '%-8s%-8s%-8s\n' "$(calc "$stage_sum")" "$(calc "$(med "$name" @wall)")" \
+    "$(mib "$(med "$name" @rss)")"
+}
+full_cmd periodic_cmd "$out/rock"
+full_cmd clamp_cmd "$out/rock_clamp" --clamp
+echo "${periodic_cmd[*]#"$root/"}"
+echo "(and the same with --clamp, outputs rock_clamp_*.png)"
+bake_ok=1 clamp_ok=1
+measure bake_rock "${periodic_cmd[@]}" || { fail "bumpbake bake exited non-zero"; bake_ok=0; }
+measure bake_rock_clamp "${clamp_cmd[@]}" || { fail "bumpbake bake --clamp exited non-zero"; clamp_ok=0; }
+printf '%-10s' ""
+printf '%-8s' load smooth pyramid trace derive write stages wall MiB
+echo
+[ "$bake_ok" = 1 ] && stage_row bake_rock periodic
+[ "$clamp_ok" = 1 ] && stage_row bake_rock_clamp --clamp
+echo "($(runs_text bake_rock); seconds; stages = their sum, wall = the whole process)"
+if [ "$bake_ok" = 1 ]; then
   if [ "$peer_ok" = 1 ]; then
     echo "peer, whole run on the same map (filtered, so it does no smoothing):" \
       "wall $(calc "$(med peer_rock @wall)") s (build $(calc "$(med peer_rock build_s)")," \
@@ -445,6 +462,10 @@ done
 if [ "$bake_ok" = 1 ]; then
   summary_row "bumpbake whole bake, rock (s)" "$(calc "$(med bake_rock @wall)")" \
     "$(runs_text bake_rock), peak $(mib "$(med bake_rock @rss)") MiB"
+fi
+if [ "$clamp_ok" = 1 ]; then
+  summary_row "bumpbake whole bake, rock, --clamp (s)" "$(calc "$(med bake_rock_clamp @wall)")" \
+    "$(runs_text bake_rock_clamp), trace $(calc "$(med bake_rock_clamp trace)") s"
 fi
 if [ "$peer_ok" = 1 ]; then
   summary_row "peer whole run, rock (s)" "$(calc "$(med peer_rock @wall)")" \
