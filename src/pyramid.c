@@ -34,21 +34,29 @@ static int ceil_shift(int n, int k) {
   return (int)(((long)n + (1L << k) - 1) >> k);
 }
 
-/* Level 0: the max of each cell's four corners. */
-static void build_cells(bb_pyramid *p) {
+/* The rows of a level's build run on all cores; a max does not depend on
+ * the order it is taken in, so neither does the pyramid. */
+typedef struct build_job {
+  bb_pyramid *p;
+  int k;          /* the level being built */
+  float *row_max; /* level k's nodes along x, for every row of cells */
+} build_job;
+
+/* Level 0, row y: the max of each cell's four corners. */
+static void build_cells_row(void *user, int y) {
+  const build_job *job = user;
+  const bb_pyramid *p = job->p;
   const int w = p->width, h = p->height;
   float *cells = p->level_max[0];
-  for (int y = 0; y < h; y++) {
-    const float *r0 = p->z + (size_t)y * (size_t)w;
-    const float *r1 = p->z + (size_t)bb__address(y + 1, h, p->addressing) * (size_t)w;
-    for (int x = 0; x < w; x++) {
-      int x1 = x + 1 < w ? x + 1 : bb__address(x + 1, w, p->addressing);
-      float m = r0[x];
-      if (r0[x1] > m) m = r0[x1];
-      if (r1[x] > m) m = r1[x];
-      if (r1[x1] > m) m = r1[x1];
-      cells[(size_t)y * (size_t)w + (size_t)x] = m;
-    }
+  const float *r0 = p->z + (size_t)y * (size_t)w;
+  const float *r1 = p->z + (size_t)bb__address(y + 1, h, p->addressing) * (size_t)w;
+  for (int x = 0; x < w; x++) {
+    int x1 = x + 1 < w ? x + 1 : bb__address(x + 1, w, p->addressing);
+    float m = r0[x];
+    if (r0[x1] > m) m = r0[x1];
+    if (r1[x] > m) m = r1[x];
+    if (r1[x1] > m) m = r1[x1];
+    cells[(size_t)y * (size_t)w + (size_t)x] = m;
   }
 }
 
@@ -71,19 +79,34 @@ static float addressed_max(const float *row, size_t stride, int n, int start, in
 
 /* Level k straight from level 0, separably (rows, then columns): every level
  * costs O(W*H) and the wrapped last node needs no special case. */
-static void build_level(bb_pyramid *p, int k, float *row_max) {
-  const int w = p->width, h = p->height;
-  const int lw = p->level_width[k], lh = p->level_height[k];
-  const int span = 1 << k;
-  const float *cells = p->level_max[0];
-  for (int y = 0; y < h; y++)
-    for (int i = 0; i < lw; i++)
-      row_max[(size_t)y * (size_t)lw + (size_t)i] =
-          addressed_max(cells + (size_t)y * (size_t)w, 1, w, i * span, span, p->addressing);
-  for (int j = 0; j < lh; j++)
-    for (int i = 0; i < lw; i++)
-      p->level_max[k][(size_t)j * (size_t)lw + (size_t)i] =
-          addressed_max(row_max + i, (size_t)lw, h, j * span, span, p->addressing);
+static void level_rows(void *user, int y) { /* cells of row y -> row_max */
+  const build_job *job = user;
+  const bb_pyramid *p = job->p;
+  const int w = p->width, lw = p->level_width[job->k], span = 1 << job->k;
+  const float *cells = p->level_max[0] + (size_t)y * (size_t)w;
+  for (int i = 0; i < lw; i++)
+    job->row_max[(size_t)y * (size_t)lw + (size_t)i] =
+        addressed_max(cells, 1, w, i * span, span, p->addressing);
+}
+
+static void level_columns(void *user, int j) { /* row_max -> node row j */
+  const build_job *job = user;
+  const bb_pyramid *p = job->p;
+  const int lw = p->level_width[job->k], span = 1 << job->k;
+  for (int i = 0; i < lw; i++)
+    p->level_max[job->k][(size_t)j * (size_t)lw + (size_t)i] =
+        addressed_max(job->row_max + i, (size_t)lw, p->height, j * span, span, p->addressing);
+}
+
+static bb_status build_levels(bb_pyramid *p, float *row_max, bb_error *err) {
+  build_job job = {p, 0, row_max};
+  bb_status st = bb__parallel_for(p->height, 0, build_cells_row, &job, NULL, NULL, err);
+  for (job.k = 1; st == BB_OK && job.k < p->levels; job.k++) {
+    st = bb__parallel_for(p->height, 0, level_rows, &job, NULL, NULL, err);
+    if (st == BB_OK)
+      st = bb__parallel_for(p->level_height[job.k], 0, level_columns, &job, NULL, NULL, err);
+  }
+  return st;
 }
 
 static float border_max(const bb_pyramid *p) {
@@ -141,9 +164,12 @@ bb_status bb_pyramid_build(const bb_image *height_texels, bb_addressing addressi
     return bb__fail(err, BB_ERR_MEMORY, "pyramid: out of memory for %dx%d", w, h);
   }
   memcpy(p->z, height_texels->pixels, n * sizeof(float));
-  build_cells(p);
-  for (int k = 1; k < levels; k++) build_level(p, k, row_max);
+  st = build_levels(p, row_max, err);
   free(row_max);
+  if (st != BB_OK) {
+    bb_pyramid_free(p);
+    return st;
+  }
   p->global_max = p->level_max[levels - 1][0];
   p->global_min = p->z[0];
   for (size_t i = 1; i < n; i++)
