@@ -28,7 +28,7 @@ LDLIBS  := $(OIIO_LIBS) -lm -pthread
 # few large C++ libraries deep in that order (OpenVDB, GDAL, Xerces, GEOS...)
 # look up tens of thousands of their own symbols. Naming them first on the
 # CLI's link line (they are loaded anyway) makes those walks short: `bumpbake
-# --version` drops from 0.20 to 0.15 s. Only those OpenImageIO already brings
+# --version` drops from 0.20 to 0.14 s. Only those OpenImageIO already brings
 # in are named (none elsewhere: no change); `make EARLY_LIBS=` turns it off.
 # Deferred (=), so ldd runs only when the CLI is linked.
 EARLY_LIB_PATTERN := ^lib(openvdb|xerces-c|gdal|geos|crypto|proj|poppler|dcmdata|gdcmMSFF|rsvg-2)[.-]

@@ -153,8 +153,13 @@ static inline double field_z(const bb_pyramid *p, int x, int y) {
                       (size_t)bb__clampi(x, 0, p->width - 1)];
 }
 
-/* One lattice step along an axis: periodic coordinates stay in [0, n),
- * clamped ones (clamp mode) run on past the edges. */
+/* A coordinate along an axis of n texels, and one lattice step from it:
+ * periodic coordinates stay in [0, n), clamped ones (clamp mode) run on past
+ * the edges. */
+static inline int coordinate_at(const bb_pyramid *p, long v, int n) {
+  return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap((int)(v % n), n) : (int)v;
+}
+
 static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
   return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step % n, n) : v + step;
 }
@@ -231,13 +236,9 @@ static inline void kink_finish(kink_filter *f) { /* the last point is an end: ke
 /* Heights along the chunk's line, from behind its start to ahead of its end. */
 static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
   const bb_pyramid *p = job->p;
-  const long first = -(long)job->behind;
-  /* The step's first texel; periodic: wrapped; clamp: unwrapped. */
-  long ux = (long)job->chunk_x[chunk] + first * job->a;
-  long uy = (long)job->chunk_y[chunk] + first * job->b;
-  if (p->addressing == BB_ADDRESS_PERIODIC) ux %= p->width, uy %= p->height;
-  int bx = p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near((int)ux, p->width) : (int)ux;
-  int by = p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near((int)uy, p->height) : (int)uy;
+  const long first = -(long)job->behind; /* the first step's texel */
+  int bx = coordinate_at(p, (long)job->chunk_x[chunk] + first * job->a, p->width);
+  int by = coordinate_at(p, (long)job->chunk_y[chunk] + first * job->b, p->height);
   kink_filter f = {.pr = pr};
   pr->count = 0;
   for (int i = 0; i <= pr->steps; i++, bx = step_along(p, bx, job->a, p->width),
@@ -245,7 +246,8 @@ static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
     const int j = i - job->behind; /* texel of the chunk */
     pr->vz[i] = field_z(p, bx, by);
     kink_offer(&f, (double)j, pr->vz[i]);
-    if (j >= 0 && j < job->chunk_len[chunk]) pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
+    if (j >= 0 && j < job->chunk_len[chunk])
+      pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
     if (i == pr->steps) break;
     /* Away from the edges no vertex wraps or clamps, and each is a fixed
      * offset. */
@@ -352,20 +354,20 @@ static int clamped_chunks(const bb_pyramid *p, int a, int b, int *cx, int *cy, i
 static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **cy, int **clen,
                              int *count, bb_error *err) {
   const size_t n = (size_t)p->width * (size_t)p->height;
-  unsigned char *seen = calloc(n, 1);
+  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
+  unsigned char *seen = periodic ? calloc(n, 1) : NULL; /* texels already in a line */
   *cx = malloc(n * sizeof(int));
   *cy = malloc(n * sizeof(int));
   *clen = malloc(n * sizeof(int));
-  if (!seen || !*cx || !*cy || !*clen) {
+  if ((periodic && !seen) || !*cx || !*cy || !*clen) {
     free(seen);
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   }
-  int c = 0;
-  if (p->addressing != BB_ADDRESS_PERIODIC) {
-    free(seen);
+  if (!periodic) {
     *count = clamped_chunks(p, a, b, *cx, *cy, *clen);
     return BB_OK;
   }
+  int c = 0;
   for (int y = 0; y < p->height; y++)
     for (int x = 0; x < p->width; x++) {
       if (seen[(size_t)y * (size_t)p->width + (size_t)x]) continue;

@@ -556,7 +556,8 @@ static bb_status prepare_job(trace_job *job, bb_error *err) {
     double *u = job->unblocked + (size_t)c * stride;
     job->total[c] = 0.0;
     for (int i = 0; i < rs->slice_count; i++) {
-      const int s = job->order[i], start = rs->slice_start[s], count = rs->slice_start[s + 1] - start;
+      const int s = job->order[i], start = rs->slice_start[s],
+                count = rs->slice_start[s + 1] - start;
       double *slice = u + start + s;
       slice[count] = 0.0;
       for (int e = count - 1; e >= 0; e--) slice[e] = slice[e + 1] + ray_weight(rs, c, start + e);
@@ -685,13 +686,13 @@ static bb_status blocked_counts(trace_job *job, int k, int pair, int sweep, bb_e
 /* Fills the batch with the slices order[*next ..], a slice and its opposite
  * side by side when sweeps can take them together (is_pair[k] marks the
  * first plane of such a pair). */
-static void fill_batch(trace_job *job, int pairs, int *next, int *is_pair) {
+static void fill_batch(trace_job *job, int sweep, int *next, int *is_pair) {
   const bb_rayset *rs = job->rs;
   job->batch_size = 0;
   while (*next < rs->slice_count && job->batch_size < SLICE_BATCH) {
     const int s = job->order[*next];
     const int t = *next + 1 < rs->slice_count ? job->order[*next + 1] : -1;
-    const int pair = pairs && t >= 0 && opposite_steps(rs, s, t);
+    const int pair = sweep && t >= 0 && opposite_steps(rs, s, t);
     if (pair && job->batch_size + 2 > SLICE_BATCH) break;
     is_pair[job->batch_size] = pair;
     job->batch[job->batch_size++] = s;
@@ -708,7 +709,6 @@ static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   const bb_pyramid *p = job->p;
   const bb_rayset *rs = job->rs;
   const size_t texels = (size_t)p->width * (size_t)p->height;
-  const int pairs = sweep;
   const int planes = rs->slice_count < SLICE_BATCH ? rs->slice_count : SLICE_BATCH;
   job->blocked = malloc((size_t)planes * texels * sizeof(uint16_t));
   if (rs->slice_count > SLICE_BATCH) /* more than one batch: sums kept between them */
@@ -718,7 +718,7 @@ static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
   bb_status st = BB_OK;
   int next = 0, is_pair[SLICE_BATCH];
   for (job->batch_first = 1; st == BB_OK && next < rs->slice_count; job->batch_first = 0) {
-    fill_batch(job, pairs, &next, is_pair);
+    fill_batch(job, sweep, &next, is_pair);
     job->batch_last = next == rs->slice_count;
     for (int k = 0; st == BB_OK && k < job->batch_size; k += is_pair[k] ? 2 : 1) {
       st = blocked_counts(job, k, is_pair[k], sweep, err);
