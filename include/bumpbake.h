@@ -195,12 +195,18 @@ bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
 /* ---------------------------------------------------------------- normals */
 
 typedef enum bb_normal_filter {
-  BB_NORMAL_VALVE = 0, /* mean of the 18 triangle normals of the 9 cells */
+  BB_NORMAL_VALVE = 0, /* Valve's: mean of the 18 triangle normals of the 9 cells
+                          x-1..x+1, y-1..y+1; centred on (x + 1/2, y + 1/2) */
   BB_NORMAL_CENTRAL,   /* central differences */
-  BB_NORMAL_SOBEL      /* 3x3 Sobel gradient */
+  BB_NORMAL_SOBEL,     /* 3x3 Sobel gradient */
+  BB_NORMAL_VERTEX     /* the default: centred on the vertex (x, y) the rays
+                          leave from; the triangle normals of the 16 cells
+                          x-2..x+1, y-2..y+1 weighted (1,2,2,1) x (1,2,2,1),
+                          i.e. Valve's sums at the 4 cell centres around the
+                          vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
 
-/* Parses "valve", "central", "sobel"; returns 0 on success. */
+/* Parses "vertex", "valve", "central", "sobel"; returns 0 on success. */
 int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
 const char *bb_normal_filter_name(bb_normal_filter f);
 
@@ -337,7 +343,7 @@ typedef struct bb_bake_options {
   bb_trace_options trace;     /* bias, threads, progress */
   double power;               /* P >= 1, default 1 */
   bb_basis basis;             /* default BB_BASIS_HL2 */
-  bb_normal_filter normal_filter; /* default BB_NORMAL_VALVE */
+  bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
   int want_trace;             /* 0: only normals/weights/filtered are made */
 } bb_bake_options;

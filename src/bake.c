@@ -15,7 +15,7 @@ void bb_bake_options_init(bb_bake_options *o) {
   bb_trace_options_init(&o->trace);
   o->power = 1.0;
   o->basis = BB_BASIS_HL2;
-  o->normal_filter = BB_NORMAL_VALVE;
+  o->normal_filter = BB_NORMAL_VERTEX;
   o->want_trace = 1;
 }
 

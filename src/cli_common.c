@@ -67,8 +67,8 @@ const cli_option cli_opt_basis = {.id = CLI_OPT_BASIS,
 const cli_option cli_opt_normal_filter = {
     .id = CLI_OPT_NORMAL_FILTER,
     .long_name = "normal-filter",
-    .value_name = "valve|central|sobel",
-    .help = "normal estimator (valve: mean of the 18 triangle normals)"};
+    .value_name = "vertex|valve|central|sobel",
+    .help = "normal estimator (vertex: centred on the ray origin; valve: Valve's)"};
 const cli_option cli_opt_normal_y = {
     .id = CLI_OPT_NORMAL_Y,
     .long_name = "normal-y",

@@ -52,6 +52,7 @@ static void h2s_settings_init(cli_settings *s) {
   cli_settings_init(s);
   s->bake.rays = VALVE_RAYS;
   s->bake.smooth.radius_texels = VALVE_FILTER_RADIUS;
+  s->bake.normal_filter = BB_NORMAL_VALVE; /* parity with Valve's tool */
   s->depth = BB_DEPTH_8; /* Valve writes 8-bit RGBA TGA */
 }
 

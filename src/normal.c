@@ -13,7 +13,8 @@ int bb_normal_filter_parse(const char *name, bb_normal_filter *out) {
   static const struct {
     const char *name;
     bb_normal_filter filter;
-  } names[] = {{"valve", BB_NORMAL_VALVE},
+  } names[] = {{"vertex", BB_NORMAL_VERTEX},
+               {"valve", BB_NORMAL_VALVE},
                {"central", BB_NORMAL_CENTRAL},
                {"sobel", BB_NORMAL_SOBEL}};
   if (!name || !out)
@@ -28,6 +29,8 @@ int bb_normal_filter_parse(const char *name, bb_normal_filter *out) {
 
 const char *bb_normal_filter_name(bb_normal_filter f) {
   switch (f) {
+  case BB_NORMAL_VERTEX:
+    return "vertex";
   case BB_NORMAL_VALVE:
     return "valve";
   case BB_NORMAL_CENTRAL:
@@ -80,14 +83,14 @@ static void unit_normal(double nx, double ny, double nz, double out[3]) {
   out[2] = nz / len;
 }
 
-/* Cells (x0, y0) for x0 = x_start-1 .. x_start+count-2 into cells[0 .. count-1].
+/* Cells (x0, y0) for x0 = first .. first+count-1 into cells[0 .. count-1].
  * Cell (x0, y0) spans the corners (x0, y0)..(x0+1, y0+1) and is split along
  * its (x0+1, y0)-(x0, y0+1) diagonal. */
-static void cell_row(const normal_job *job, int y0, int x_start, int count,
+static void cell_row(const normal_job *job, int y0, int first, int count,
                      cell_normals *cells) {
-  double z00 = z_at(job, x_start - 1, y0), z01 = z_at(job, x_start - 1, y0 + 1);
+  double z00 = z_at(job, first, y0), z01 = z_at(job, first, y0 + 1);
   for (int i = 0; i < count; i++) {
-    double z10 = z_at(job, x_start + i, y0), z11 = z_at(job, x_start + i, y0 + 1);
+    double z10 = z_at(job, first + 1 + i, y0), z11 = z_at(job, first + 1 + i, y0 + 1);
     unit_normal(-(z10 - z00), -(z01 - z00), 1.0, cells[i].a);
     unit_normal(z01 - z11, z10 - z11, 1.0, cells[i].b);
     z00 = z10;
@@ -120,9 +123,9 @@ static void valve_band(const normal_job *job, int y_start, int y_end) {
     const int x_end = x_start + SPAN < width ? x_start + SPAN : width;
     const int count = x_end - x_start + 2; /* cells x_start-1 .. x_end */
     for (int y0 = y_start - 1; y0 <= y_start; y0++)
-      cell_row(job, y0, x_start, count, ring[(y0 + 1) % 3]);
+      cell_row(job, y0, x_start - 1, count, ring[(y0 + 1) % 3]);
     for (int y = y_start; y < y_end; y++) {
-      cell_row(job, y + 1, x_start, count, ring[(y + 2) % 3]);
+      cell_row(job, y + 1, x_start - 1, count, ring[(y + 2) % 3]);
       for (int x = x_start; x < x_end; x++) {
         double n[3] = {0.0, 0.0, 0.0};
         for (int j = 0; j < 3; j++) {
@@ -133,6 +136,60 @@ static void valve_band(const normal_job *job, int y_start, int y_end) {
               n[c] += cells[i].b[c];
             }
         }
+        write_unit(job, x, y, n);
+      }
+    }
+  }
+}
+
+/* (1, 2, 2, 1) weights of the four cells centred 1.5 and 0.5 texels either
+ * side of a vertex, summed in mirror pairs: (first + last) + 2 (middle two).
+ * Adding mirror partners first makes the sum exactly antisymmetric when its
+ * inputs are, which is what gives a symmetric bump's peak N = (0, 0, 1). */
+static void tent4(const double *v0, const double *v1, const double *v2, const double *v3,
+                  double out[3]) {
+  for (int c = 0; c < 3; c++)
+    out[c] = (v0[c] + v3[c]) + 2.0 * (v1[c] + v2[c]);
+}
+
+/* The vertex-centred estimator: the normalised sum of the unit normals of the
+ * two triangles of each of the 16 cells around the vertex (x0 in x-2..x+1,
+ * y0 in y-2..y+1), cells weighted (1, 2, 2, 1) x (1, 2, 2, 1): the sum of
+ * Valve's 9-cell sums at the four cell centres around the vertex. Its
+ * footprint is Valve's widened by one cell and its centre is the vertex the
+ * rays leave from. A half-turn about the vertex maps every cell's triangle a
+ * onto the opposite cell's triangle b with exactly negated x and y, and the
+ * sums pair those cells first, so a point-symmetric bump gives exactly
+ * (0, 0, 1) at its centre.
+ *
+ * Per cell, c = a + b; each cell row is filtered along x once (rows[]), then
+ * each texel filters four filtered rows along y. */
+static void vertex_band(const normal_job *job, int y_start, int y_end) {
+  double rows[4][SPAN][3]; /* x-filtered cell row y0 lives in rows[(y0 + 4) % 4] */
+  cell_normals cells[SPAN + 3];
+  const int width = job->height->width;
+  for (int x_start = 0; x_start < width; x_start += SPAN) {
+    const int x_end = x_start + SPAN < width ? x_start + SPAN : width;
+    const int count = x_end - x_start + 3; /* cells x_start-2 .. x_end */
+    for (int y0 = y_start - 2; y0 <= y_end; y0++) {
+      cell_row(job, y0, x_start - 2, count, cells);
+      double sum[SPAN + 3][3];
+      for (int i = 0; i < count; i++)
+        for (int c = 0; c < 3; c++)
+          sum[i][c] = cells[i].a[c] + cells[i].b[c];
+      double(*row)[3] = rows[(y0 + 4) % 4];
+      for (int x = x_start; x < x_end; x++) {
+        const int i = x - x_start; /* cells x-2 .. x+1 are sum[i .. i+3] */
+        tent4(sum[i], sum[i + 1], sum[i + 2], sum[i + 3], row[i]);
+      }
+      const int y = y0 - 1; /* cell rows y-2 .. y+1 are ready */
+      if (y < y_start)
+        continue;
+      for (int x = x_start; x < x_end; x++) {
+        const int i = x - x_start;
+        double n[3];
+        tent4(rows[(y + 2) % 4][i], rows[(y + 3) % 4][i], rows[(y + 4) % 4][i],
+              rows[(y + 5) % 4][i], n);
         write_unit(job, x, y, n);
       }
     }
@@ -171,6 +228,10 @@ static void normal_band(void *user, int band) {
     valve_band(job, y_start, y_end);
     return;
   }
+  if (job->filter == BB_NORMAL_VERTEX) {
+    vertex_band(job, y_start, y_end);
+    return;
+  }
   for (int y = y_start; y < y_end; y++)
     for (int x = 0; x < job->height->width; x++) {
       double n[3];
@@ -194,8 +255,8 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
                     height->channels);
   if (!isfinite(height_scale))
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: height scale is not finite");
-  if (filter != BB_NORMAL_VALVE && filter != BB_NORMAL_CENTRAL &&
-      filter != BB_NORMAL_SOBEL)
+  if (filter != BB_NORMAL_VERTEX && filter != BB_NORMAL_VALVE &&
+      filter != BB_NORMAL_CENTRAL && filter != BB_NORMAL_SOBEL)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: unknown filter %d", (int)filter);
   if (addressing != BB_ADDRESS_PERIODIC && addressing != BB_ADDRESS_CLAMP)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: unknown addressing mode %d",

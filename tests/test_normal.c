@@ -1,4 +1,5 @@
-/* test_normal.c: the three normal estimators on flat, planar and sine height fields. */
+/* test_normal.c: the normal estimators on flat, planar, sine and symmetric height
+ * fields. */
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -9,8 +10,9 @@
 
 #define PI 3.14159265358979323846
 
-static const bb_normal_filter all_filters[] = {BB_NORMAL_VALVE, BB_NORMAL_CENTRAL,
-                                               BB_NORMAL_SOBEL};
+static const bb_normal_filter all_filters[] = {BB_NORMAL_VERTEX, BB_NORMAL_VALVE,
+                                               BB_NORMAL_CENTRAL, BB_NORMAL_SOBEL};
+#define FILTER_COUNT (sizeof all_filters / sizeof all_filters[0])
 
 static void fill_constant(bb_image *h, float value) {
   for (int i = 0; i < h->width * h->height; i++)
@@ -27,12 +29,13 @@ static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addre
 }
 
 Test(normal, filter_names_round_trip) {
-  for (size_t i = 0; i < 3; i++) {
+  for (size_t i = 0; i < FILTER_COUNT; i++) {
     bb_normal_filter parsed = (bb_normal_filter)-1;
     cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed),
                  0);
     cr_assert_eq(parsed, all_filters[i]);
   }
+  cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_VERTEX), "vertex");
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_VALVE), "valve");
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_CENTRAL), "central");
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_SOBEL), "sobel");
@@ -46,7 +49,7 @@ Test(normal, flat_is_straight_up_exactly) {
   bb_image h = {0}, n = {0};
   cr_assert_eq(bb_image_alloc(&h, 9, 7, 1, NULL), BB_OK);
   fill_constant(&h, 0.37f);
-  for (size_t i = 0; i < 3; i++)
+  for (size_t i = 0; i < FILTER_COUNT; i++)
     for (int a = 0; a < 2; a++) {
       compute(&h, 25.0f, all_filters[i], (bb_addressing)a, &n);
       for (int k = 0; k < 9 * 7; k++) {
@@ -94,6 +97,12 @@ static void check_sine(bb_normal_filter f, int along_y, double tolerance) {
   bb_image_free(&n);
 }
 
+Test(normal, sine_along_x_vertex) {
+  check_sine(BB_NORMAL_VERTEX, 0, 0.016);
+}
+Test(normal, sine_along_y_vertex) {
+  check_sine(BB_NORMAL_VERTEX, 1, 0.016);
+}
 Test(normal, sine_along_x_valve) {
   check_sine(BB_NORMAL_VALVE, 0, 0.015);
 }
@@ -123,10 +132,10 @@ static void check_plane(double gx, double gy) {
     for (int x = 0; x < 8; x++)
       bb_image_texel(&h, x, y)[0] = (float)(gx * x + gy * y);
   double sx = -scale * gx, sy = -scale * gy, len = sqrt(sx * sx + sy * sy + 1.0);
-  for (size_t i = 0; i < 3; i++) {
+  for (size_t i = 0; i < FILTER_COUNT; i++) {
     compute(&h, scale, all_filters[i], BB_ADDRESS_CLAMP, &n);
-    for (int y = 1; y < 6; y++) /* Valve reads up to x+2, y+2 */
-      for (int x = 1; x < 6; x++) {
+    for (int y = 2; y < 6; y++) /* vertex reads x-2..x+2, Valve up to x+2 */
+      for (int x = 2; x < 6; x++) {
         const float *got = bb_image_texel(&n, x, y);
         cr_assert_float_eq(got[0], sx / len, 1e-6, "%s",
                            bb_normal_filter_name(all_filters[i]));
@@ -191,7 +200,7 @@ Test(normal, unit_length_and_facing_up_on_noise) {
   cr_assert_eq(bb_image_alloc(&h, 31, 17, 1, NULL), BB_OK);
   for (int i = 0; i < 31 * 17; i++)
     h.pixels[i] = (float)next_random(&state);
-  for (size_t i = 0; i < 3; i++) {
+  for (size_t i = 0; i < FILTER_COUNT; i++) {
     compute(&h, 30.0f, all_filters[i], BB_ADDRESS_PERIODIC, &n);
     for (int k = 0; k < 31 * 17; k++) {
       const float *p = n.pixels + 3 * k;
@@ -216,7 +225,7 @@ Test(normal, periodic_shift_is_exact) {
       bb_image_texel(&h, x, y)[0] = v;
       bb_image_texel(&shifted, (x + dx) % w, (y + dy) % hgt)[0] = v;
     }
-  for (size_t i = 0; i < 3; i++) {
+  for (size_t i = 0; i < FILTER_COUNT; i++) {
     compute(&h, 10.0f, all_filters[i], BB_ADDRESS_PERIODIC, &a);
     compute(&shifted, 10.0f, all_filters[i], BB_ADDRESS_PERIODIC, &b);
     for (int y = 0; y < hgt; y++)
@@ -260,7 +269,28 @@ static void ref_normal(const bb_image *h, double scale, bb_normal_filter f,
     for (int i = 0; i < 4; i++)
       z[j][i] = ref_z(h, scale, x - 1 + i, y - 1 + j, a);
   double n[3] = {0.0, 0.0, 1.0};
-  if (f == BB_NORMAL_VALVE) {
+  if (f == BB_NORMAL_VERTEX) {
+    /* c[j][i]: triangle a + triangle b of cell (x - 2 + i, y - 2 + j); then
+     * the (1, 2, 2, 1) weights along x, then along y, mirror pairs first. */
+    double c[4][4][3], r[4][3];
+    for (int j = 0; j < 4; j++)
+      for (int i = 0; i < 4; i++) {
+        double z00 = ref_z(h, scale, x - 2 + i, y - 2 + j, a);
+        double z10 = ref_z(h, scale, x - 1 + i, y - 2 + j, a);
+        double z01 = ref_z(h, scale, x - 2 + i, y - 1 + j, a);
+        double z11 = ref_z(h, scale, x - 1 + i, y - 1 + j, a);
+        double ta[3] = {0.0, 0.0, 0.0}, tb[3] = {0.0, 0.0, 0.0};
+        ref_add_unit(ta, -(z10 - z00), -(z01 - z00), 1.0);
+        ref_add_unit(tb, z01 - z11, z10 - z11, 1.0);
+        for (int k = 0; k < 3; k++)
+          c[j][i][k] = ta[k] + tb[k];
+      }
+    for (int j = 0; j < 4; j++)
+      for (int k = 0; k < 3; k++)
+        r[j][k] = (c[j][0][k] + c[j][3][k]) + 2.0 * (c[j][1][k] + c[j][2][k]);
+    for (int k = 0; k < 3; k++)
+      n[k] = (r[0][k] + r[3][k]) + 2.0 * (r[1][k] + r[2][k]);
+  } else if (f == BB_NORMAL_VALVE) {
     n[2] = 0.0;
     for (int j = 0; j < 3; j++)
       for (int i = 0; i < 3; i++) {
@@ -293,7 +323,7 @@ Test(normal, matches_direct_sums_bit_for_bit) {
     cr_assert_eq(bb_image_alloc(&h, w, hgt, 1, NULL), BB_OK);
     for (int i = 0; i < w * hgt; i++)
       h.pixels[i] = (float)next_random(&state);
-    for (size_t f = 0; f < 3; f++)
+    for (size_t f = 0; f < FILTER_COUNT; f++)
       for (int clamp = 0; clamp < 2; clamp++) {
         bb_addressing a = clamp ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC;
         compute(&h, 40.0f, all_filters[f], a, &n);
@@ -310,6 +340,34 @@ Test(normal, matches_direct_sums_bit_for_bit) {
       }
     bb_image_free(&h);
   }
+}
+
+/* A bump symmetric about texel (8, 8): the vertex estimator gives exactly
+ * (0, 0, 1) at its peak (128, 128, 255 in 8 bits), Valve's, centred half a
+ * texel off, leans towards -x and -y (down the bump's +x/+y flank). */
+Test(normal, symmetric_bump_peak_is_straight_up_for_vertex_only) {
+  bb_image h = {0}, n = {0};
+  cr_assert_eq(bb_image_alloc(&h, 17, 17, 1, NULL), BB_OK);
+  for (int y = 0; y < 17; y++)
+    for (int x = 0; x < 17; x++) {
+      double r2 = (x - 8) * (x - 8) + (y - 8) * (y - 8);
+      bb_image_texel(&h, x, y)[0] = (float)exp(-r2 / 8.0);
+    }
+  compute(&h, 4.0f, BB_NORMAL_VERTEX, BB_ADDRESS_PERIODIC, &n);
+  const float *peak = bb_image_texel(&n, 8, 8);
+  cr_assert(peak[0] == 0.0f && peak[1] == 0.0f && peak[2] == 1.0f, "(%g, %g, %g)",
+            (double)peak[0], (double)peak[1], (double)peak[2]);
+  /* The flanks lean away from the peak, symmetrically. */
+  cr_assert_gt(bb_image_texel(&n, 10, 8)[0], 0.1f);
+  cr_assert_eq(bb_image_texel(&n, 10, 8)[0], -bb_image_texel(&n, 6, 8)[0]);
+  cr_assert_gt(bb_image_texel(&n, 8, 10)[1], 0.1f);
+  bb_image_free(&n);
+  compute(&h, 4.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n);
+  peak = bb_image_texel(&n, 8, 8);
+  cr_assert_gt(peak[0], 0.05f, "Valve's estimate sits half a texel towards +x");
+  cr_assert_gt(peak[1], 0.05f);
+  bb_image_free(&n);
+  bb_image_free(&h);
 }
 
 Test(normal, rejects_bad_arguments) {
