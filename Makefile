@@ -1,5 +1,6 @@
 # bumpbake: plain Makefile. `make` builds, `make test` builds and runs every
-# test, `make demo` bakes a fixture into out/, `make bench` measures.
+# test, `make demo` bakes a fixture into out/, `make bench` measures,
+# `make install` installs (PREFIX=/usr/local, DESTDIR= for staging).
 # `make DEBUG=1 ...` builds with assertions and ASan/UBSan into build/debug.
 
 DEBUG ?= 0
@@ -14,32 +15,66 @@ endif
 CC      ?= cc
 CXX     ?= g++
 WARN    := -Wall -Wextra -Wshadow -Wconversion -Wstrict-prototypes -Wmissing-prototypes
+# -MMD -MP: every compile also writes OBJ.d listing the headers it read, so
+# touching a header recompiles exactly what includes it (included below).
+DEPFLAGS:= -MMD -MP
 CFLAGS  += -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(OPT) $(WARN) -Iinclude -Isrc
 CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow -Iinclude -Isrc
+# Library objects go into libbumpbake.so as well as libbumpbake.a, so they
+# are position-independent. -fno-semantic-interposition keeps GCC inlining
+# and calling the library's own global functions directly, as without -fPIC.
+LIB_CFLAGS := -fPIC -fno-semantic-interposition
 PKGS    := OpenImageIO criterion
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 LDLIBS  := $(OIIO_LIBS) -lm -pthread
-
-# Start-up. OpenImageIO on Debian 12 loads 261 shared libraries, and most of
-# bumpbake's ~0.2 s start-up is the dynamic linker looking up symbols: each
-# lookup walks the libraries in load order up to the one defining it, and a
-# few large C++ libraries deep in that order (OpenVDB, GDAL, Xerces, GEOS...)
-# look up tens of thousands of their own symbols. Naming them first on the
-# CLI's link line (they are loaded anyway) makes those walks short: `bumpbake
-# --version` drops from 0.20 to 0.14 s. Only those OpenImageIO already brings
-# in are named (none elsewhere: no change); `make EARLY_LIBS=` turns it off.
-# Deferred (=), so ldd runs only when the CLI is linked.
-EARLY_LIB_PATTERN := ^lib(openvdb|xerces-c|gdal|geos|crypto|proj|poppler|dcmdata|gdcmMSFF|rsvg-2)[.-]
-EARLY_LIBS = $(shell ldd "$$(pkg-config --variable=libdir OpenImageIO)/libOpenImageIO.so" \
-  2>/dev/null | awk '$$1 ~ /$(EARLY_LIB_PATTERN)/ && $$3 ~ /^\// {print $$3}')
-EARLY_LINK = $(if $(strip $(EARLY_LIBS)),-Wl$(comma)--push-state$(comma)--no-as-needed $(EARLY_LIBS) -Wl$(comma)--pop-state)
-comma := ,
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
 
+# ---- version, soname and install layout ------------------------------------
+# The version lives once, in the public header.
+VERSION := $(shell sed -n 's/.*define BB_VERSION_STRING "\(.*\)"$$/\1/p' include/bumpbake.h)
+version_word = $(word $(1),$(subst ., ,$(VERSION)))
+# The soname names the ABI. While the version is 0.x any minor release may
+# change the public structs, so the soname carries major.minor
+# (libbumpbake.so.0.1); from 1.0 on, the major alone. Bump the header's
+# version when a public struct or signature changes.
+SOVERSION := $(if $(filter 0,$(call version_word,1)),0.$(call version_word,2),$(call version_word,1))
+SONAME    := libbumpbake.so.$(SOVERSION)
+SHLIB_REAL:= libbumpbake.so.$(VERSION)
+
+PREFIX     ?= /usr/local
+DESTDIR    ?=
+BINDIR     ?= $(PREFIX)/bin
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+MANDIR     ?= $(PREFIX)/share/man
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+# Refreshes the loader's cache after a real (DESTDIR-less) install as root;
+# `make install LDCONFIG=:` skips it (the install check does).
+LDCONFIG   ?= ldconfig
+
+# ---- start-up: the early-link trick (opt-in) ---------------------------------
+# OpenImageIO on Debian 12 loads 261 shared libraries, and most of bumpbake's
+# ~0.2 s start-up is the dynamic linker looking up symbols: each lookup walks
+# the libraries in load order up to the one defining it, and a few large C++
+# libraries deep in that order (OpenVDB, GDAL, Xerces, GEOS...) look up tens
+# of thousands of their own symbols. Naming them first on the CLI's link line
+# (they are loaded anyway) makes those walks short. It names Debian 12
+# library paths found with ldd at link time, so it is opt-in:
+# `make EARLY_LINK=1`. `make bench` measures start-up both ways.
+EARLY_LINK ?= 0
+EARLY_LIB_PATTERN := ^lib(openvdb|xerces-c|gdal|geos|crypto|proj|poppler|dcmdata|gdcmMSFF|rsvg-2)[.-]
+# Deferred (=), so ldd runs only when a binary is linked with it.
+EARLY_LIBS = $(shell ldd "$$(pkg-config --variable=libdir OpenImageIO)/libOpenImageIO.so" \
+  2>/dev/null | awk '$$1 ~ /$(EARLY_LIB_PATTERN)/ && $$3 ~ /^\// {print $$3}')
+EARLY_LINK_FLAGS = $(if $(strip $(EARLY_LIBS)),-Wl$(comma)--push-state$(comma)--no-as-needed $(EARLY_LIBS) -Wl$(comma)--pop-state)
+CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
+comma := ,
+
+# ---- sources and products ----------------------------------------------------
 LIB_C    := $(filter-out src/cli%.c,$(wildcard src/*.c))
 LIB_CXX  := $(wildcard src/*.cpp)
 CLI_C    := $(wildcard src/cli*.c)
@@ -49,48 +84,119 @@ TOOL_C   := $(wildcard tools/*.c)
 LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
 CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o)
 TEST_OBJ := $(TEST_C:%.c=$(BUILD)/%.o)
+TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
+ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
+SHLIB    := $(BUILD)/$(SHLIB_REAL)
+# The symbols libbumpbake.so exports: bb_* (the public API) and nothing else.
+LIB_MAP  := src/libbumpbake.map
 BIN      := $(BUILD)/bumpbake
 TESTBIN  := $(BUILD)/bb_tests
 TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
+# The CLI linked other ways, for `make bench`'s start-up comparison only.
+BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
-.PHONY: all deps ensure-deps demo test check bench goldens clean format
-all: $(BIN) $(TOOLS)
+.PHONY: all lib deps ensure-deps demo test check check-unit check-install \
+        check-python bench goldens install uninstall clean format FORCE
+all: $(BIN) lib $(TOOLS)
+lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
 # ---- dependencies (Debian packages) ----------------------------------------
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-DEB_PKGS := libopenimageio-dev libcriterion-dev pkg-config g++ make
+# Python: Debian's /usr/bin/python3 with its cffi, numpy and pytest.
+PYTHON   := /usr/bin/python3
+DEB_PKGS := libopenimageio-dev libcriterion-dev pkg-config g++ make \
+            python3 python3-cffi python3-numpy python3-pytest
 deps:
 	$(SUDO) apt-get update
 	DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y --no-install-recommends $(DEB_PKGS)
 
 ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
-	    && command -v $(CXX) >/dev/null 2>&1; then :; \
+	    && command -v $(CXX) >/dev/null 2>&1 \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # ---- build ------------------------------------------------------------------
-$(BUILD)/%.o: %.c include/bumpbake.h src/internal.h
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c $< -o $@
+# Objects and binaries also depend on a record of the flags they were made
+# with, rewritten only when those change: a changed CFLAGS, DEBUG or
+# EARLY_LINK rebuilds what it affects, and stale objects from before a
+# Makefile change (non-PIC ones, say) are never linked into the .so.
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) | $(LIB_CFLAGS)
+LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
+$(BUILD)/compile.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(COMPILE_FLAGS)' | cmp -s - $@ || echo '$(COMPILE_FLAGS)' >$@
+$(BUILD)/link.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(BUILD)/src/%.o: src/%.cpp include/bumpbake.h src/internal.h
-	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) -c $< -o $@
+$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS)
+
+$(BUILD)/%.o: %.c $(BUILD)/compile.flags
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) -c $< -o $@
+
+$(BUILD)/src/%.o: src/%.cpp $(BUILD)/compile.flags
+	@mkdir -p $(@D)
+	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) -c $< -o $@
+
+-include $(ALL_OBJ:.o=.d)
 
 $(LIB): $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BIN): $(CLI_OBJ) $(LIB)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK) $(LDLIBS)
+# The shared library: soname libbumpbake.so.MAJOR[.MINOR], the real file
+# carries the full version, symlinks as ldconfig and -lbumpbake expect.
+$(SHLIB): $(LIB_OBJ) $(LIB_MAP) $(BUILD)/link.flags
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,$(SONAME) -Wl,--version-script=$(LIB_MAP) \
+	  -Wl,-z,defs -Wl,-Bsymbolic-functions -o $@ $(LIB_OBJ) $(LDLIBS)
+$(BUILD)/$(SONAME): $(SHLIB)
+	ln -sf $(SHLIB_REAL) $@
+$(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
+	ln -sf $(SONAME) $@
 
-$(BUILD)/tools/%: tools/%.c $(wildcard tools/*.h) $(LIB) include/bumpbake.h
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(LDLIBS) -lstdc++
+# The CLI links the static library: it starts as fast as with the shared one
+# (`make bench` measures both) and the installed binary finds no library at
+# run time but OpenImageIO's.
+$(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS)
 
-$(TESTBIN): $(TEST_OBJ) $(LIB)
+$(BUILD)/bench/bumpbake-early: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
+	@mkdir -p $(@D)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS)
+$(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
+	@mkdir -p $(@D)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
+
+$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
+
+$(TESTBIN): $(TEST_OBJ) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(LIB) $(CRIT_LIBS) $(LDLIBS)
+
+# ---- install ----------------------------------------------------------------
+# bumpbake.pc is made from bumpbake.pc.in with the install's own paths.
+install: $(BIN) lib
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
+	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
+	install -m 755 $(BIN) $(DESTDIR)$(BINDIR)/bumpbake
+	install -m 755 $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL)
+	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so
+	install -m 644 $(LIB) $(DESTDIR)$(LIBDIR)/libbumpbake.a
+	install -m 644 include/bumpbake.h $(DESTDIR)$(INCLUDEDIR)/bumpbake.h
+	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
+	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
+	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ]; then $(LDCONFIG) || true; fi
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/bumpbake $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL) \
+	  $(DESTDIR)$(LIBDIR)/$(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so \
+	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(DESTDIR)$(INCLUDEDIR)/bumpbake.h \
+	  $(DESTDIR)$(MANDIR)/man1/bumpbake.1 $(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 
 # ---- the README's commands ---------------------------------------------------
 demo: ensure-deps
@@ -100,13 +206,34 @@ demo: ensure-deps
 test: ensure-deps
 	@$(MAKE) --no-print-directory check
 
+# Everything `make test` runs: the Criterion suite, the install check and
+# the Python tests.
+check: check-unit check-install check-python
+
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.
-check: $(BIN) $(TESTBIN) $(TOOLS)
+check-unit: $(BIN) $(TESTBIN) $(TOOLS)
 	BB_BIN=$(BIN) BB_FIXTURES=fixtures ./$(TESTBIN) --jobs 2
 
+# Installs into a temporary prefix, builds tests/install_client.c with
+# pkg-config and runs it; checks the exported symbols and the man page.
+check-install: $(BIN) lib
+	@MAKE="$(MAKE)" DEBUG=$(DEBUG) BUILD=$(BUILD) ./tools/check_install.sh
+
+# The Python package over the shared library (python/bumpbake), against this
+# build's library. A sanitized (DEBUG=1) library needs the sanitizer runtimes
+# preloaded into the (uninstrumented) interpreter.
+# (Python's own allocations are not freed at exit: no leak report.) BB_BIN is
+# the CLI the results are compared with.
+PY_PRELOAD := $(if $(filter 1,$(DEBUG)),$(shell $(CC) -print-file-name=libasan.so) $(shell $(CC) -print-file-name=libubsan.so))
+PY_SANITIZE := $(if $(PY_PRELOAD),LD_PRELOAD="$(PY_PRELOAD)" ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1)
+check-python: $(BIN) lib
+	cd python && BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) BB_BIN=$(abspath $(BIN)) \
+	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
+	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
+
 bench: ensure-deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
 
 goldens: ensure-deps

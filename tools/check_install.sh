@@ -1,0 +1,140 @@
+#!/usr/bin/env bash
+# check_install.sh: `make install` as a user runs it, checked. `make test`
+# runs it (as `make check-install`) after building; it takes a few seconds.
+#
+#   1. installs into a temporary prefix and checks the files and symlinks;
+#   2. builds tests/install_client.c with `pkg-config --cflags --libs
+#      bumpbake` (shared) and with `pkg-config --static --libs` against
+#      libbumpbake.a, runs both and checks they print "ok";
+#   3. checks libbumpbake.so exports exactly the functions of bumpbake.h;
+#   4. checks the man page renders without warnings and names every command
+#      and option the installed bumpbake's --help lists;
+#   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths.
+#
+# Environment: MAKE (make), DEBUG (0), BUILD (build), CC (cc). A DEBUG=1
+# library is sanitized, so the clients are built with the sanitizers too.
+set -euo pipefail
+
+cd "$(dirname "$0")/.."
+make=${MAKE:-make}
+debug=${DEBUG:-0}
+cc=${CC:-cc}
+client_flags=(-std=c11 -Wall -Wextra -Werror)
+[ "$debug" = 1 ] && client_flags+=("-fsanitize=address,undefined")
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/bumpbake-install.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+prefix=$tmp/prefix
+failures=0
+fail() { echo "check_install: FAILED: $*" >&2; failures=$((failures + 1)); }
+pass() { echo "check_install: $*"; }
+
+# ------------------------------------------------------------ 1. install
+if ! "$make" --no-print-directory install DEBUG="$debug" PREFIX="$prefix" LDCONFIG=: \
+  >"$tmp/install.log" 2>&1; then
+  cat "$tmp/install.log" >&2
+  echo "check_install: FAILED: make install PREFIX=$prefix" >&2
+  exit 1
+fi
+for f in bin/bumpbake lib/libbumpbake.a lib/libbumpbake.so include/bumpbake.h \
+  lib/pkgconfig/bumpbake.pc share/man/man1/bumpbake.1; do
+  [ -e "$prefix/$f" ] || fail "make install did not install $f"
+done
+soname=$(readelf -d "$prefix/lib/libbumpbake.so" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')
+{ [ -L "$prefix/lib/$soname" ] && [ -f "$prefix/lib/$soname" ]; } ||
+  fail "lib/$soname (the soname) is not a symlink to the library"
+[ "$(readlink "$prefix/lib/libbumpbake.so")" = "$soname" ] ||
+  fail "lib/libbumpbake.so does not point at $soname"
+version=$("$prefix/bin/bumpbake" --version) || fail "installed bumpbake --version failed"
+pass "installed $version, soname $soname, into a temporary prefix"
+
+# ------------------------------------------------------ 2. pkg-config client
+export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
+cflags=$(pkg-config --cflags bumpbake)
+libs=$(pkg-config --libs bumpbake)
+libdir=$(pkg-config --variable=libdir bumpbake)
+[ "$(pkg-config --modversion bumpbake)" = "${version#bumpbake }" ] ||
+  fail "bumpbake.pc's version $(pkg-config --modversion bumpbake) is not ${version#bumpbake }"
+# The client itself uses libm (exp, sqrt); pkg-config's output is split on purpose.
+# shellcheck disable=SC2086
+"$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client" $libs \
+  -Wl,-rpath,"$libdir" -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
+if [ -x "$tmp/client" ]; then
+  ldd "$tmp/client" | grep -q "$soname => $libdir/" ||
+    fail "the client does not load $libdir/$soname"
+  "$tmp/client" >"$tmp/client.out" 2>&1 || true
+  if [ "$(tail -n1 "$tmp/client.out")" = ok ]; then
+    pass "client built with pkg-config --cflags --libs bumpbake: ok"
+  else
+    cat "$tmp/client.out" >&2
+    fail "the shared client's checks"
+  fi
+fi
+# A static link of libbumpbake.a with what Requires.private/Libs.private add.
+static_libs=$(pkg-config --static --libs bumpbake | sed "s|-lbumpbake|$libdir/libbumpbake.a|")
+# shellcheck disable=SC2086
+"$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client-static" \
+  $static_libs -lm || fail "cc with pkg-config --static --libs bumpbake failed"
+if [ -x "$tmp/client-static" ]; then
+  ! ldd "$tmp/client-static" | grep -q libbumpbake || fail "the static client loads libbumpbake.so"
+  "$tmp/client-static" >"$tmp/client-static.out" 2>&1 || true
+  if [ "$(tail -n1 "$tmp/client-static.out")" = ok ]; then
+    pass "client linked with libbumpbake.a and pkg-config --static: ok"
+  else
+    cat "$tmp/client-static.out" >&2
+    fail "the static client's checks"
+  fi
+fi
+
+# ------------------------------------------------------ 3. exported symbols
+grep -o '\bbb_[a-z0-9_]*[[:space:]]*(' "$prefix/include/bumpbake.h" | tr -d '( ' |
+  sort -u >"$tmp/header.sym"
+nm -D --defined-only "$prefix/lib/libbumpbake.so" | awk '{ print $3 }' | sort -u >"$tmp/so.sym"
+if cmp -s "$tmp/header.sym" "$tmp/so.sym"; then
+  pass "libbumpbake.so exports the $(wc -l <"$tmp/so.sym") functions of bumpbake.h and nothing else"
+else
+  fail "exports differ from bumpbake.h's functions (< header only, > .so only):"
+  diff "$tmp/header.sym" "$tmp/so.sym" | grep '^[<>]' >&2 || true
+fi
+
+# ----------------------------------------------------------- 4. man page
+man_page=$prefix/share/man/man1/bumpbake.1
+if command -v groff >/dev/null 2>&1; then
+  warnings=$(groff -man -ww -z "$man_page" 2>&1)
+  [ -z "$warnings" ] || fail "groff warns about the man page: $warnings"
+  groff -man -Tascii -P-cbou "$man_page" 2>/dev/null >"$tmp/man.txt"
+  bin=$prefix/bin/bumpbake
+  missing=()
+  commands=$("$bin" --help | awk '/^commands:/ { on = 1; next } on && NF == 0 { exit } on { print $1 }')
+  for c in $commands; do
+    grep -q "^ *bumpbake $c\b" "$tmp/man.txt" || missing+=("command $c")
+    # Every option the command's --help names (long ones, and short-only ones).
+    for o in $("$bin" "$c" --help | grep -oE '(^|[[ ])--?[A-Za-z][A-Za-z0-9-]*' | tr -d '[ ' | sort -u); do
+      grep -qe "$o\b" "$tmp/man.txt" || missing+=("$c $o")
+    done
+  done
+  if [ "${#missing[@]}" -eq 0 ]; then
+    pass "man page: no groff warnings; names every command and option of --help"
+  else
+    fail "docs/bumpbake.1 does not describe: ${missing[*]}"
+  fi
+else
+  echo "check_install: groff not found; man page not checked"
+fi
+
+# --------------------------------------------------------- 5. staged install
+stage=$tmp/stage
+"$make" --no-print-directory install DEBUG="$debug" DESTDIR="$stage" PREFIX=/usr \
+  LDCONFIG=: >"$tmp/stage.log" 2>&1 || fail "make install DESTDIR=... PREFIX=/usr"
+if [ -f "$stage/usr/lib/pkgconfig/bumpbake.pc" ] && [ -e "$stage/usr/bin/bumpbake" ] &&
+  grep -qx 'prefix=/usr' "$stage/usr/lib/pkgconfig/bumpbake.pc"; then
+  pass "staged install (DESTDIR, PREFIX=/usr) lands under DESTDIR with /usr paths"
+else
+  fail "staged install: files or bumpbake.pc's prefix not as expected"
+fi
+
+if [ "$failures" -gt 0 ]; then
+  echo "check_install: $failures check(s) failed" >&2
+  exit 1
+fi
