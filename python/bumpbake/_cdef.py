@@ -1,0 +1,128 @@
+"""The part of include/bumpbake.h the Python package calls, for cffi.
+
+Kept to what read(), bake() and normal() need. The structs must match the header
+field for field, since cffi's ABI mode lays them out from these
+declarations: tests/test_cdef.py compiles a C program against the real
+header and checks every size, offset, enum value and function signature
+declared here, so a change to the header fails that test, naming what to
+update. Copy declarations from the header as they are (comments dropped).
+"""
+
+# Types, in header order.
+TYPES = """
+typedef enum bb_status {
+  BB_OK = 0,
+  BB_ERR_ARGUMENT,
+  BB_ERR_IO,
+  BB_ERR_FORMAT,
+  BB_ERR_SIZE,
+  BB_ERR_VALUE,
+  BB_ERR_MEMORY
+} bb_status;
+
+typedef struct bb_error {
+  char message[512];
+} bb_error;
+
+typedef struct bb_image {
+  int width;
+  int height;
+  int channels;
+  float *pixels;
+} bb_image;
+
+typedef struct bb_image_info {
+  int alpha_channel;
+  int is_float;
+  int bits_per_sample;
+  char format_name[32];
+  char *description;
+} bb_image_info;
+
+typedef enum bb_addressing {
+  BB_ADDRESS_PERIODIC = 0,
+  BB_ADDRESS_CLAMP
+} bb_addressing;
+
+typedef enum bb_channel {
+  BB_CHANNEL_AUTO = 0,
+  BB_CHANNEL_R,
+  BB_CHANNEL_G,
+  BB_CHANNEL_B,
+  BB_CHANNEL_A,
+  BB_CHANNEL_LUMA,
+  BB_CHANNEL_MEAN
+} bb_channel;
+
+typedef struct bb_smooth_options {
+  int radius_texels;
+  float threshold;
+  bb_addressing addressing;
+} bb_smooth_options;
+
+typedef enum bb_normal_filter {
+  BB_NORMAL_VALVE = 0,
+  BB_NORMAL_CENTRAL,
+  BB_NORMAL_SOBEL
+} bb_normal_filter;
+
+typedef enum bb_basis {
+  BB_BASIS_HL2 = 0,
+  BB_BASIS_HL2_Z
+} bb_basis;
+
+typedef void (*bb_progress_fn)(void *user, long done, long total);
+
+typedef struct bb_trace_options {
+  double bias_texels;
+  int threads;
+  bb_progress_fn progress;
+  void *progress_user;
+} bb_trace_options;
+
+typedef struct bb_bake_options {
+  float height_scale;
+  int rays;
+  bb_smooth_options smooth;
+  bb_trace_options trace;
+  double power;
+  bb_basis basis;
+  bb_normal_filter normal_filter;
+  int normal_y_up;
+  int want_trace;
+} bb_bake_options;
+
+typedef struct bb_bake_result {
+  bb_image filtered;
+  bb_image normal;
+  bb_image weights;
+  bb_image vis;
+  bb_image ssbump;
+  bb_image ao;
+  bb_image bent;
+  double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
+  double rays_traced;
+  char rayset_id[64];
+} bb_bake_result;
+"""
+
+# Functions, as declared in the header.
+FUNCTIONS = """
+const char *bb_status_name(bb_status status);
+void bb_image_free(bb_image *img);
+void bb_image_info_free(bb_image_info *info);
+bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
+                        bb_error *err);
+int bb_channel_parse(const char *name, bb_channel *out);
+bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
+                               bb_channel channel, bb_image *height,
+                               bb_error *err);
+int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
+int bb_basis_parse(const char *name, bb_basis *out);
+void bb_bake_options_init(bb_bake_options *o);
+bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
+                  bb_bake_result *result, bb_error *err);
+void bb_bake_result_free(bb_bake_result *r);
+"""
+
+CDEF = TYPES + FUNCTIONS

@@ -1,0 +1,236 @@
+"""The Python package against known answers, the command line and its errors.
+
+Run by `make test` (python3 -m pytest in python/); BUMPBAKE_LIBRARY names
+the build's library and BB_BIN the command line, else the source tree's
+build/ is used.
+"""
+
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import bumpbake
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FIXTURES = os.path.join(ROOT, "fixtures")
+BIN = os.environ.get("BB_BIN") or os.path.join(ROOT, "build", "bumpbake")
+SSBUMP_FLAT = 1.0 / math.sqrt(3.0)
+
+
+def bump(side=32, sigma2=18.0):
+    """A round bump of height 1 in the middle of a side x side field."""
+    y, x = np.mgrid[0:side, 0:side].astype(np.float64) - side // 2
+    return np.exp(-(x * x + y * y) / sigma2).astype(np.float32)
+
+
+# ------------------------------------------------------------------ values
+
+def test_flat_field_gives_the_flat_values():
+    maps = bumpbake.bake(np.zeros((16, 20), np.float32), scale=8, outputs=bumpbake.OUTPUTS)
+    assert set(maps) == set(bumpbake.OUTPUTS)
+    assert maps["normal"].shape == (16, 20, 3) and maps["normal"].dtype == np.float32
+    assert maps["ao"].shape == (16, 20) and maps["filtered"].shape == (16, 20)
+    np.testing.assert_array_equal(maps["normal"], np.broadcast_to([0, 0, 1], (16, 20, 3)))
+    np.testing.assert_allclose(maps["ssbump"], SSBUMP_FLAT, atol=1e-6)
+    np.testing.assert_array_equal(maps["ao"], 1.0)
+    np.testing.assert_allclose(maps["weights"], 1.0 / 3.0, atol=1e-6)
+    np.testing.assert_allclose(maps["bent"], np.broadcast_to([0, 0, 1], (16, 20, 3)), atol=1e-6)
+
+
+def test_normals_of_a_bump_lean_away_from_its_top():
+    h = bump()
+    n = bumpbake.normal(h, scale=8)
+    c = 16
+    assert n.shape == (32, 32, 3)
+    assert n[c, c + 3, 0] > 0.3 and n[c, c - 3, 0] < -0.3  # right flank leans +x
+    assert n[c + 3, c, 1] > 0.3 and n[c - 3, c, 1] < -0.3  # y is down: lower flank leans +y
+    np.testing.assert_allclose(np.linalg.norm(n, axis=2), 1.0, atol=1e-5)
+    # Valve's estimator is centred half a texel off the vertex (CONVENTIONS.md);
+    # central differences are symmetric about it, so the top comes out level.
+    central = bumpbake.normal(h, scale=8, normal_filter="central")
+    assert abs(central[c, c, 0]) < 1e-6 and abs(central[c, c, 1]) < 1e-6
+    assert abs(n[c, c, 0]) > 0.1
+    up = bumpbake.normal(h, scale=8, normal_y="up")
+    np.testing.assert_array_equal(up[..., 1], -n[..., 1])
+    np.testing.assert_array_equal(up[..., 0], n[..., 0])
+
+
+def test_ssbump_and_ao_of_a_bump():
+    maps = bumpbake.bake(bump(), scale=8, rays=64, outputs=("ssbump", "ao"))
+    s, ao = maps["ssbump"], maps["ao"]
+    c = 16
+    # The right flank faces +x: red (B0, light from the right) is brightest.
+    assert s[c, c + 3, 0] > s[c, c + 3, 1] and s[c, c + 3, 0] > s[c, c + 3, 2]
+    # At the foot the bump blocks rays; its top sees the whole sky.
+    assert ao[c, c + 5] < 0.95
+    assert ao[c, c] > ao[c, c + 5]
+
+
+def test_integer_heights_are_value_over_max_code():
+    h8 = (bump() * 255).round().astype(np.uint8)
+    a = bumpbake.normal(h8, scale=8)
+    b = bumpbake.normal(h8.astype(np.float32) / np.float32(255), scale=8)
+    np.testing.assert_array_equal(a, b)
+    assert abs(a[16, 19, 0]) > 0.3
+
+
+def test_rgba_heights_follow_the_channel_rule():
+    h = bump()
+    rgba = np.zeros((32, 32, 4), np.float32)
+    rgba[..., 3] = h  # Valve's convention: height in alpha, constant RGB
+    np.testing.assert_array_equal(bumpbake.normal(rgba, 8, channel="a"), bumpbake.normal(h, 8))
+    # auto takes the mean of R, G, B: flat here
+    np.testing.assert_array_equal(bumpbake.normal(rgba, 8)[..., 2], 1.0)
+
+
+def test_same_bits_for_any_thread_count():
+    h = np.random.default_rng(7).random((40, 48), dtype=np.float32)
+    one = bumpbake.bake(h, 16, rays=32, threads=1, outputs=("ssbump", "ao"))
+    two = bumpbake.bake(h, 16, rays=32, threads=2, outputs=("ssbump", "ao"))
+    for k in one:
+        np.testing.assert_array_equal(one[k], two[k])
+
+
+def test_basis_hl2_z_adds_a_fourth_ssbump_channel():
+    s = bumpbake.bake(np.zeros((8, 8)), 4, rays=16, basis="hl2+z", outputs="ssbump")["ssbump"]
+    assert s.shape == (8, 8, 4)
+    np.testing.assert_allclose(s[..., 3], 1.0, atol=1e-6)  # N.B3 = 1 on a flat field
+
+
+@pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
+def test_same_bits_as_the_command_line(tmp_path):
+    """Defaults, reading and every output as `bumpbake bake` makes them."""
+    src = os.path.join(FIXTURES, "rock06_128.png")
+    kinds = bumpbake.OUTPUTS
+    args = [BIN, "bake", src, "--scale", "24", "--quiet"]
+    for k in kinds:
+        args += [f"--{k}", str(tmp_path / f"{k}.exr")]
+    subprocess.run(args, check=True)
+    ours = bumpbake.bake(bumpbake.read(src), scale=24, outputs=kinds)
+    for k in kinds:
+        theirs = bumpbake.read(tmp_path / f"{k}.exr")
+        np.testing.assert_array_equal(ours[k], theirs, err_msg=k)
+
+
+# ------------------------------------------------------------------ errors
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"rays": 0}, "bake: rays must be in 1..65536 (got 0)"),
+    ({"rays": 70000}, "bake: rays must be in 1..65536 (got 70000)"),
+    ({"scale": 0}, "bake: height scale must be > 0 (got 0)"),
+    ({"scale": float("nan")}, "bake: height scale must be > 0"),
+    ({"bias": -1}, "bake: bias must be >= 0 (got -1)"),
+    ({"bias": 2e6}, "bake: bias must be <= 1e+06 (got 2e+06)"),
+    ({"power": 0.5}, "bake: power must be >= 1 (got 0.5)"),
+    ({"power": 2e6}, "bake: power must be <= 1e+06"),
+    ({"filter_threshold": 0}, "smooth: filter threshold 0 must be > 0"),
+    ({"filter_radius": -1}, "bake: filter_radius must be in 0..4096 (got -1)"),
+    ({"filter_radius": 4097}, "bake: filter_radius must be in 0..4096 (got 4097)"),
+    ({"threads": -1}, "bake: threads must be in 0..4096 (got -1)"),
+    ({"rays": 2**40}, "bake: rays 1099511627776 is out of range"),
+    ({"basis": "hl3"}, "bake: basis must be one of hl2|hl2+z (got 'hl3')"),
+    ({"normal_filter": "box"}, "bake: normal_filter must be one of valve|central|sobel"),
+    ({"normal_y": "left"}, "bake: normal_y must be one of down|up (got 'left')"),
+    ({"channel": "z"}, "bake: channel must be one of auto|r|g|b|a|luma|mean (got 'z')"),
+    ({"channel": "a"}, "channel 'a' asked of an image with no alpha (1 channels)"),
+    ({"outputs": ("normal", "shadow")}, "bake: unknown output 'shadow'"),
+    ({"outputs": ()}, "bake: nothing to make: outputs is empty"),
+])
+def test_bad_parameters_raise_with_the_message(kwargs, message):
+    args = {"scale": 8, **kwargs}
+    with pytest.raises(bumpbake.ArgumentError) as e:
+        bumpbake.bake(np.zeros((8, 8), np.float32), **args)
+    assert str(e.value).startswith(message)
+    assert e.value.status == "bad argument"
+    assert isinstance(e.value, ValueError)
+
+
+def test_bad_heights_raise_with_the_message():
+    h = np.zeros((6, 7), np.float32)
+    h[2, 3] = np.nan
+    with pytest.raises(bumpbake.ArgumentError, match=r"height at texel \(3, 2\) is NaN") as e:
+        bumpbake.bake(h, 8)
+    assert e.value.status == "bad value"
+    with pytest.raises(bumpbake.ArgumentError, match="empty image"):
+        bumpbake.normal(np.zeros((0, 5), np.float32), 8)
+    with pytest.raises(bumpbake.ArgumentError, match=r"\(H, W\) or \(H, W, C\)"):
+        bumpbake.normal(np.zeros(5, np.float32), 8)
+    with pytest.raises(TypeError, match="float or unsigned integer"):
+        bumpbake.normal(np.zeros((4, 4), np.int32), 8)
+    with pytest.raises(TypeError, match="rays must be an integer"):
+        bumpbake.bake(np.zeros((4, 4)), 8, rays=2.5)
+
+
+def test_read_errors_carry_the_library_message(tmp_path):
+    missing = tmp_path / "missing.png"
+    with pytest.raises(bumpbake.Error, match="missing.png") as e:
+        bumpbake.read(missing)
+    assert e.value.status == "i/o error"
+    junk = tmp_path / "junk.png"
+    junk.write_bytes(b"not a png at all")
+    with pytest.raises(bumpbake.Error) as e:
+        bumpbake.read(junk)
+    assert e.value.status == "bad image format" and "junk.png" in str(e.value)
+
+
+# -------------------------------------------------------------- threading
+
+def test_the_gil_is_released_while_baking():
+    """A Python thread keeps running while another thread is inside bb_bake:
+    cffi drops the GIL for the call. Were it held, the main loop below would
+    stop for the whole bake."""
+    h = np.random.default_rng(1).random((160, 160), dtype=np.float32)
+    done = threading.Event()
+    baked = {}
+
+    def work():
+        baked.update(bumpbake.bake(h, 24, rays=1024, threads=1, outputs="ao"))
+        done.set()
+
+    worker = threading.Thread(target=work)
+    start = last = time.perf_counter()
+    longest_gap, loops = 0.0, 0
+    worker.start()
+    while not done.is_set():
+        now = time.perf_counter()
+        longest_gap, last, loops = max(longest_gap, now - last), now, loops + 1
+    worker.join()
+    elapsed = time.perf_counter() - start
+    assert baked["ao"].shape == (160, 160)
+    assert elapsed > 0.1, "the bake was too short to tell"
+    assert longest_gap < elapsed / 2, (longest_gap, elapsed, loops)
+
+
+# ---------------------------------------------------------------- loading
+
+def test_docstrings_show_the_library_defaults():
+    assert "default 256, 1..65536" in bumpbake.bake.__doc__
+    assert bumpbake.DEFAULTS["rays"] == 256 and bumpbake.DEFAULTS["bias"] == pytest.approx(0.55)
+
+
+def test_the_library_is_found_in_the_source_tree_build():
+    built = os.path.join(ROOT, "build", bumpbake._library.SONAME)
+    assert bumpbake._library.candidates({})[0] == built
+    if not os.path.exists(built):
+        pytest.skip("no release build in build/")
+    env = {k: v for k, v in os.environ.items() if k != "BUMPBAKE_LIBRARY"}
+    env["PYTHONPATH"] = os.path.join(ROOT, "python")
+    out = subprocess.run([sys.executable, "-c", "import bumpbake; print(bumpbake.library_path)"],
+                         env=env, cwd="/", capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == built
+
+
+def test_a_missing_library_fails_import_with_a_hint(tmp_path):
+    env = dict(os.environ, BUMPBAKE_LIBRARY=str(tmp_path / "nowhere.so"),
+               PYTHONPATH=os.path.join(ROOT, "python"))
+    out = subprocess.run([sys.executable, "-c", "import bumpbake"], env=env, cwd="/",
+                         capture_output=True, text=True)
+    assert out.returncode != 0
+    assert "ImportError: bumpbake: cannot load" in out.stderr
+    assert "nowhere.so (missing)" in out.stderr
