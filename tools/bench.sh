@@ -6,7 +6,8 @@
 # Sections: 1 trace benchmark (build/tools/bench_trace), 2 the peer
 # (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
 # 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy against the peer,
-# then a summary table. Everything it writes goes into build/bench/.
+# 6 start-up (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and
+# linked to libbumpbake.so), then a summary table. Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
 # and the median is reported, otherwise it is run once; each figure says
@@ -437,6 +438,25 @@ else
   echo "peer: not available (${peer_reason:-its run with its own ray set failed})"
 fi
 
+# ------------------------------------------------------------- 6. start-up
+
+section "6. Start-up: bumpbake --version, the CLI linked three ways"
+echo "static: build/bumpbake as built (libbumpbake.a); early: the same with OpenImageIO's"
+echo "heaviest libraries named first (make EARLY_LINK=1); shared: linked to libbumpbake.so."
+startup_ok=0
+startup_bins=(static="$bin")
+for variant in early shared; do
+  b=$(dirname "$bin")/bench/bumpbake-$variant
+  [ -x "$b" ] && startup_bins+=("$variant=$b")
+done
+if tools/bench_startup.sh -n 41 -i "${startup_bins[@]}" | tee "$out/startup.txt"; then
+  startup_ok=1
+else
+  fail "tools/bench_startup.sh failed"
+fi
+# startup_field NAME COLUMN: a column of bench_startup's row for NAME.
+startup_field() { awk -v n="$1" -v c="$2" '$1 == n { print $c }' "$out/startup.txt"; }
+
 # -------------------------------------------------------------- summary
 
 summary_row() { printf '%-46s %14s  %s\n' "$1" "$2" "${3:-}"; }
@@ -472,6 +492,13 @@ if [ "$peer_ok" = 1 ]; then
     "$(runs_text peer_rock), peak $(mib "$(med peer_rock @rss)") MiB"
 else
   summary_row "peer" "not available" "$peer_reason"
+fi
+if [ "$startup_ok" = 1 ]; then
+  for variant in static early shared; do
+    [ -n "$(startup_field "$variant" 2)" ] || continue
+    summary_row "start-up, $variant (s)" "$(startup_field "$variant" 2)" \
+      "x$(startup_field "$variant" 5) of static; $(startup_field "$variant" 6) M instructions"
+  done
 fi
 echo
 printf '%-50s %8s   %-7s %s\n' ratio value target ""
