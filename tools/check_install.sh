@@ -61,8 +61,9 @@ libdir=$(pkg-config --variable=libdir bumpbake)
 "$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client" $libs \
   -Wl,-rpath,"$libdir" -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
 if [ -x "$tmp/client" ]; then
-  ldd "$tmp/client" | grep -q "$soname => $libdir/" ||
-    fail "the client does not load $libdir/$soname"
+  # (ldd's output is kept first: grep -q quitting early would fail the pipe)
+  loaded=$(ldd "$tmp/client")
+  grep -q "$soname => $libdir/" <<<"$loaded" || fail "the client does not load $libdir/$soname"
   "$tmp/client" >"$tmp/client.out" 2>&1 || true
   if [ "$(tail -n1 "$tmp/client.out")" = ok ]; then
     pass "client built with pkg-config --cflags --libs bumpbake: ok"
@@ -77,7 +78,8 @@ static_libs=$(pkg-config --static --libs bumpbake | sed "s|-lbumpbake|$libdir/li
 "$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client-static" \
   $static_libs -lm || fail "cc with pkg-config --static --libs bumpbake failed"
 if [ -x "$tmp/client-static" ]; then
-  ! ldd "$tmp/client-static" | grep -q libbumpbake || fail "the static client loads libbumpbake.so"
+  loaded=$(ldd "$tmp/client-static")
+  ! grep -q libbumpbake <<<"$loaded" || fail "the static client loads libbumpbake.so"
   "$tmp/client-static" >"$tmp/client-static.out" 2>&1 || true
   if [ "$(tail -n1 "$tmp/client-static.out")" = ok ]; then
     pass "client linked with libbumpbake.a and pkg-config --static: ok"
