@@ -81,11 +81,16 @@ def _library_defaults():
         "filter_threshold": o.smooth.threshold,
         "bias": o.trace.bias_texels,
         "power": o.power,
+        "basis": _ffi.string(_lib.bb_basis_name(o.basis)).decode(),
+        "normal_filter": _ffi.string(_lib.bb_normal_filter_name(o.normal_filter)).decode(),
+        "normal_y": "up" if o.normal_y_up else "down",
+        "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP,
         "threads": o.trace.threads,
     }
 
 
-# The library's defaults (bb_bake_options_init), which the CLI uses too.
+# The library's defaults (bb_bake_options_init), which the CLI uses too; a
+# parameter left at None keeps them.
 DEFAULTS = _library_defaults()
 
 
@@ -135,14 +140,17 @@ def _common_options(command, scale, filter_radius, filter_threshold, normal_filt
             command, "filter_radius", _int_value(command, "filter_radius", filter_radius))
     if filter_threshold is not None:
         o.smooth.threshold = float(filter_threshold)
-    o.normal_filter = _choice(command, "normal_filter",
-                              ("bb_normal_filter_parse", "bb_normal_filter"),
-                              normal_filter, "valve|central|sobel")
-    if normal_y not in ("down", "up"):
-        raise ArgumentError(f"{command}: normal_y must be one of down|up (got {normal_y!r})",
-                            "bad argument")
-    o.normal_y_up = normal_y == "up"
-    o.smooth.addressing = _lib.BB_ADDRESS_CLAMP if clamp else _lib.BB_ADDRESS_PERIODIC
+    if normal_filter is not None:
+        o.normal_filter = _choice(command, "normal_filter",
+                                  ("bb_normal_filter_parse", "bb_normal_filter"),
+                                  normal_filter, "vertex|valve|central|sobel")
+    if normal_y is not None:
+        if normal_y not in ("down", "up"):
+            raise ArgumentError(
+                f"{command}: normal_y must be one of down|up (got {normal_y!r})", "bad argument")
+        o.normal_y_up = normal_y == "up"
+    if clamp is not None:
+        o.smooth.addressing = _lib.BB_ADDRESS_CLAMP if clamp else _lib.BB_ADDRESS_PERIODIC
     return o
 
 
@@ -241,8 +249,8 @@ def read(path):
 
 
 def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, filter_radius=None,
-         filter_threshold=None, bias=None, power=None, basis="hl2", normal_filter="valve",
-         normal_y="down", clamp=False, channel="auto", threads=None):
+         filter_threshold=None, bias=None, power=None, basis=None, normal_filter=None,
+         normal_y=None, clamp=None, channel="auto", threads=None):
     """Bakes the maps named in outputs from a height array in one pass and
     returns {name: float32 array}. See the module doc for the conventions."""
     kinds = _output_kinds(outputs)
@@ -256,7 +264,8 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, filter_radius=Non
         o.power = _cli_limit("bake", "power", float(power))
     if threads is not None:
         o.trace.threads = _cli_limit("bake", "threads", _int_value("bake", "threads", threads))
-    o.basis = _choice("bake", "basis", ("bb_basis_parse", "bb_basis"), basis, "hl2|hl2+z")
+    if basis is not None:
+        o.basis = _choice("bake", "basis", ("bb_basis_parse", "bb_basis"), basis, "hl2|hl2+z")
     o.want_trace = any(k in TRACED_OUTPUTS for k in kinds)
     result = _run_bake(height, channel, o, "bake")
     try:
@@ -266,7 +275,7 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, filter_radius=Non
 
 
 def normal(height, scale, *, filter_radius=None, filter_threshold=None,
-           normal_filter="valve", normal_y="down", clamp=False, channel="auto"):
+           normal_filter=None, normal_y=None, clamp=None, channel="auto"):
     """Smooths the height and returns its unit normals, float32 (H, W, 3),
     as `bumpbake normal` makes them (nothing is traced)."""
     o = _common_options("normal", scale, filter_radius, filter_threshold, normal_filter,
@@ -281,7 +290,7 @@ def normal(height, scale, *, filter_radius=None, filter_threshold=None,
 
 _PARAMETERS = f"""
 
-Parameters (as `bumpbake bake --help`; None = the library's default):
+Parameters (as `bumpbake bake --help`; None keeps the library's default):
     height: (H, W) heights, or (H, W, C) with C = 2 grey + alpha, 3 RGB,
         4 RGBA; float arrays are used as they are, unsigned integer ones as
         value / max code.
@@ -295,10 +304,13 @@ Parameters (as `bumpbake bake --help`; None = the library's default):
         {DEFAULTS["filter_threshold"]:.7g}, > 0.
     bias (bake): ray origin lift in texels, default {DEFAULTS["bias"]:g}, 0..1e6.
     power (bake): exponent of the basis lobes, default {DEFAULTS["power"]:g}, 1..1e6.
-    basis (bake): "hl2" (default) or "hl2+z" (4 ssbump channels).
-    normal_filter: "valve" (default), "central" or "sobel".
-    normal_y: "down" (default; Source, DirectX) or "up" (OpenGL).
-    clamp: extend the border texels instead of tiling (default False).
+    basis (bake): "hl2" or "hl2+z" (4 ssbump channels); default
+        "{DEFAULTS["basis"]}".
+    normal_filter: "vertex" (centred on the texel's vertex), "valve"
+        (Valve's), "central" or "sobel"; default "{DEFAULTS["normal_filter"]}".
+    normal_y: "down" (Source, DirectX) or "up" (OpenGL); default
+        "{DEFAULTS["normal_y"]}".
+    clamp: extend the border texels instead of tiling; default {DEFAULTS["clamp"]}.
     channel: "auto" (grey, or the mean of R, G, B), "r", "g", "b", "a",
         "luma" or "mean".
     threads (bake): worker threads, default {DEFAULTS["threads"]} = all cores,

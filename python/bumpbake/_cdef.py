@@ -63,7 +63,8 @@ typedef struct bb_smooth_options {
 typedef enum bb_normal_filter {
   BB_NORMAL_VALVE = 0,
   BB_NORMAL_CENTRAL,
-  BB_NORMAL_SOBEL
+  BB_NORMAL_SOBEL,
+  BB_NORMAL_VERTEX
 } bb_normal_filter;
 
 typedef enum bb_basis {
@@ -118,7 +119,9 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
 int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
+const char *bb_normal_filter_name(bb_normal_filter f);
 int bb_basis_parse(const char *name, bb_basis *out);
+const char *bb_basis_name(bb_basis b);
 void bb_bake_options_init(bb_bake_options *o);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);

@@ -7,6 +7,7 @@ build/ is used.
 
 import math
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -51,11 +52,11 @@ def test_normals_of_a_bump_lean_away_from_its_top():
     assert n[c, c + 3, 0] > 0.3 and n[c, c - 3, 0] < -0.3  # right flank leans +x
     assert n[c + 3, c, 1] > 0.3 and n[c - 3, c, 1] < -0.3  # y is down: lower flank leans +y
     np.testing.assert_allclose(np.linalg.norm(n, axis=2), 1.0, atol=1e-5)
-    # Valve's estimator is centred half a texel off the vertex (CONVENTIONS.md);
-    # central differences are symmetric about it, so the top comes out level.
-    central = bumpbake.normal(h, scale=8, normal_filter="central")
-    assert abs(central[c, c, 0]) < 1e-6 and abs(central[c, c, 1]) < 1e-6
-    assert abs(n[c, c, 0]) > 0.1
+    # The default estimator is centred on the vertex: the top comes out
+    # level. Valve's is centred half a texel off it (CONVENTIONS.md).
+    np.testing.assert_array_equal(n[c, c], [0, 0, 1])
+    valve = bumpbake.normal(h, scale=8, normal_filter="valve")
+    assert valve[c, c, 0] > 0.1 and valve[c, c, 1] > 0.1
     up = bumpbake.normal(h, scale=8, normal_y="up")
     np.testing.assert_array_equal(up[..., 1], -n[..., 1])
     np.testing.assert_array_equal(up[..., 0], n[..., 0])
@@ -135,7 +136,7 @@ def test_same_bits_as_the_command_line(tmp_path):
     ({"threads": -1}, "bake: threads must be in 0..4096 (got -1)"),
     ({"rays": 2**40}, "bake: rays 1099511627776 is out of range"),
     ({"basis": "hl3"}, "bake: basis must be one of hl2|hl2+z (got 'hl3')"),
-    ({"normal_filter": "box"}, "bake: normal_filter must be one of valve|central|sobel"),
+    ({"normal_filter": "box"}, "bake: normal_filter must be one of vertex|valve|central|sobel"),
     ({"normal_y": "left"}, "bake: normal_y must be one of down|up (got 'left')"),
     ({"channel": "z"}, "bake: channel must be one of auto|r|g|b|a|luma|mean (got 'z')"),
     ({"channel": "a"}, "channel 'a' asked of an image with no alpha (1 channels)"),
@@ -211,7 +212,25 @@ def test_the_gil_is_released_while_baking():
 
 def test_docstrings_show_the_library_defaults():
     assert "default 256, 1..65536" in bumpbake.bake.__doc__
+    assert 'default "vertex"' in bumpbake.normal.__doc__
     assert bumpbake.DEFAULTS["rays"] == 256 and bumpbake.DEFAULTS["bias"] == pytest.approx(0.55)
+
+
+@pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
+def test_defaults_are_those_of_the_command_line():
+    """Every default --help prints for bake is DEFAULTS' (the library's)."""
+    text = subprocess.run([BIN, "bake", "--help"], capture_output=True, text=True,
+                          check=True).stdout
+    for name, value in bumpbake.DEFAULTS.items():
+        if name == "clamp":
+            continue  # a flag: --help says "default periodic"
+        option = "--" + name.replace("_", "-")
+        line = next(l for l in text.splitlines() if l.strip().startswith(option + " "))
+        shown = re.search(r"default ([^;]+)", line).group(1)
+        if isinstance(value, str):
+            assert shown == value, option
+        else:
+            assert float(shown) == pytest.approx(value, rel=1e-4), option
 
 
 def test_the_library_is_found_in_the_source_tree_build():

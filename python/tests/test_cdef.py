@@ -73,11 +73,17 @@ def test_structs_and_enums_match_the_header(tmp_path):
     assert enums, "no enum was checked"
 
 
-def _header_struct_fields(name):
-    """Field names of `typedef struct NAME { ... } NAME;` in bumpbake.h, in order."""
+def _header_body(kind, name):
+    """What is between the braces of `typedef KIND NAME { ... } NAME;` in
+    bumpbake.h, without comments."""
     with open(os.path.join(HEADER_DIR, "bumpbake.h")) as f:
         text = re.sub(r"/\*.*?\*/", "", f.read(), flags=re.S)
-    body = re.search(r"typedef struct %s \{(.*?)\} %s;" % (name, name), text, re.S).group(1)
+    return re.search(r"typedef %s %s \{(.*?)\} %s;" % (kind, name, name), text, re.S).group(1)
+
+
+def _header_struct_fields(name):
+    """Field names of `typedef struct NAME { ... } NAME;` in bumpbake.h, in order."""
+    body = _header_body("struct", name)
     fields = []
     for declaration in body.split(";"):
         for part in re.sub(r"\[[^]]*\]", "", declaration).split(","):
@@ -87,13 +93,22 @@ def _header_struct_fields(name):
     return fields
 
 
-def test_struct_fields_are_the_headers():
-    # Sizes and offsets cannot see a trailing field that fits in padding.
+def _header_enum_constants(name):
+    """Constant names of `typedef enum NAME { ... } NAME;` in bumpbake.h."""
+    return re.findall(r"\b(BB_\w+)", _header_body("enum", name))
+
+
+def test_struct_fields_and_enum_constants_are_the_headers():
+    # Sizes and offsets cannot see a trailing field that fits in padding,
+    # nor the C program a constant _cdef.py lacks.
     ffi = _ffi()
     for name in ffi.list_types()[0]:
         t = ffi.typeof(name)
         if t.kind == "struct":
             assert [f for f, _ in t.fields] == _header_struct_fields(name), name
+        elif t.kind == "enum":
+            ours = [t.elements[v] for v in sorted(t.elements)]
+            assert ours == _header_enum_constants(name), name
 
 
 def test_functions_match_the_header(tmp_path):
