@@ -24,11 +24,14 @@ CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow -Iinclude -Isrc
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion
+PKGS    := OpenImageIO criterion assimp
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) -lm -pthread
+# Assimp reads and writes meshes (src/mesh_assimp.cpp only).
+ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
+ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -105,7 +108,7 @@ lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # Python: Debian's /usr/bin/python3 with its cffi, numpy and pytest.
 PYTHON   := /usr/bin/python3
-DEB_PKGS := libopenimageio-dev libcriterion-dev pkg-config g++ make \
+DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest
 deps:
 	$(SUDO) apt-get update
@@ -122,7 +125,7 @@ ensure-deps:
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) | $(LIB_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -139,7 +142,7 @@ $(BUILD)/%.o: %.c $(BUILD)/compile.flags
 
 $(BUILD)/src/%.o: src/%.cpp $(BUILD)/compile.flags
 	@mkdir -p $(@D)
-	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) -c $< -o $@
+	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -c $< -o $@
 
 -include $(ALL_OBJ:.o=.d)
 

@@ -418,6 +418,131 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
 const char *bb_channel_name(bb_channel c);
 
+
+/* ----------------------------------------------------------------- meshes */
+
+/* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
+#define BB_MAX_MESH_ELEMENTS (1UL << 27)
+
+/* A triangle mesh in model units. bb_mesh_load fills one from a file: every
+ * mesh of the file merged, node transforms applied, polygons triangulated,
+ * points and lines dropped. */
+typedef struct bb_mesh {
+  size_t vertex_count;
+  size_t triangle_count;
+  float *positions;  /* 3 floats per vertex: x, y, z in model units */
+  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
+                        a vertex whose normal is zero or not finite has none */
+  uint32_t *indices; /* 3 per triangle, each < vertex_count */
+} bb_mesh;
+
+/* Allocates a zeroed mesh of the given counts (normals only when
+ * with_normals). Rejects counts of 0 vertices or over BB_MAX_MESH_ELEMENTS
+ * (BB_ERR_SIZE) and failed allocations (BB_ERR_MEMORY), leaving m zeroed. */
+bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
+                        int with_normals, bb_error *err);
+
+/* Frees the arrays and zeroes the struct; safe on a zeroed struct. */
+void bb_mesh_free(bb_mesh *m);
+
+/* 64-bit FNV-1a hash of the counts, positions, normals and indices, for
+ * provenance (the input_hash of outputs baked from a mesh). */
+uint64_t bb_mesh_hash(const bb_mesh *m);
+
+/* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
+ * anything Assimp imports), merged as described at bb_mesh. Normals are kept
+ * when any part of the model has them (vertices of parts without are zero).
+ * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
+ * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
+ * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
+bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
+
+/* Writes m through Assimp's exporters; the format comes from the extension:
+ * .obj (without a material file), .ply (binary little-endian), .stl
+ * (binary), .glb. Normals are written when m has them. The file is written
+ * to a temporary name in the destination directory and renamed into place.
+ * Errors: BB_ERR_FORMAT (unknown extension), BB_ERR_ARGUMENT (an index out
+ * of range), BB_ERR_IO (cannot write). */
+bb_status bb_mesh_write(const char *path, const bb_mesh *m, bb_error *err);
+
+/* ------------------------------------------------------ flat render bump */
+
+/* The direction a flat sculpt's front side faces, towards the viewer of an
+ * orthographic projection. Each names a right-handed frame (right, up, out):
+ * image columns run along right, rows run down -up, and out is the height. */
+typedef enum bb_axis {
+  BB_AXIS_NEG_Y = 0, /* DOOM 3's RenderBumpFlat (and Blender's front view):
+                        right +X, up +Z, out -Y */
+  BB_AXIS_POS_Y,     /* right -X, up +Z, out +Y (Blender's back view) */
+  BB_AXIS_POS_Z,     /* right +X, up +Y, out +Z (Blender's top view) */
+  BB_AXIS_NEG_Z,     /* right +X, up -Y, out -Z (Blender's bottom view) */
+  BB_AXIS_POS_X,     /* right +Y, up +Z, out +X (Blender's right view) */
+  BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
+} bb_axis;
+
+/* Parses "-y", "+y", "+z", "-z", "+x", "-x" ("y" means "+y"); 0 on success. */
+int bb_axis_parse(const char *name, bb_axis *out);
+/* "-y", "+z", ...; "unknown" for a value outside the enum. */
+const char *bb_axis_name(bb_axis a);
+/* The model-space unit vectors right, up and out of axis a. */
+void bb_axis_frame(bb_axis a, double right[3], double up[3], double out[3]);
+
+typedef struct bb_renderbump_options {
+  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
+  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
+                         a regular grid; default 4 (DOOM 3's 16x) */
+  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
+  int face_normals;   /* 1: every triangle's own plane normal, even when the
+                         mesh has vertex normals; default 0 */
+  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
+  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
+                         the image, in model units along right and up */
+  int tile;           /* 1: geometry outside the rectangle wraps around into
+                         it (the sculpt tiles with the rectangle as period) */
+  int threads;        /* 0 = all cores; the result is the same for any count */
+} bb_renderbump_options;
+
+void bb_renderbump_options_init(bb_renderbump_options *o);
+
+/* What a flat render bump makes. */
+typedef struct bb_renderbump_result {
+  bb_image normal;   /* 4 channels: unit N in the tangent frame (x right, y
+                        DOWN, z out) and alpha = covered fraction of the
+                        texel's samples; N = (0, 0, 1) where alpha is 0 */
+  bb_image height;   /* 1 channel: h in [0, 1], the texel's mean height of the
+                        front-most surface over its covered samples, 0 where
+                        alpha is 0 */
+  double rect[4];    /* the rectangle used: left, bottom, right, top */
+  double depth_min, depth_max; /* model units along out that h = 0 and 1 are */
+  double texel_size; /* model units per texel: sqrt(texel width * height) */
+  double texel_aspect; /* texel width / texel height (1 = square texels) */
+  double height_scale; /* texels of height per unit of h, (depth_max -
+                          depth_min) / texel_size: bb_bake's height_scale
+                          for this height; 0 when the surface is flat */
+  int used_vertex_normals; /* 1 when some texel used interpolated normals */
+  size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
+} bb_renderbump_result;
+
+/* DOOM 3's RenderBumpFlat on the CPU: projects mesh orthographically along
+ * o->axis onto the rectangle, keeps the front-most surface at each sample
+ * (no culling: the side facing the viewer is taken), and averages the
+ * samples of each texel into result (allocated; free with
+ * bb_renderbump_result_free). Bit-identical for any thread count. Errors:
+ * BB_ERR_ARGUMENT (bad options, an index out of range, a degenerate
+ * rectangle, nothing facing the viewer), BB_ERR_VALUE (a NaN or infinite
+ * coordinate), BB_ERR_SIZE (size over the maximum, or the model covering
+ * the image too many times over with tile), BB_ERR_MEMORY. */
+bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
+                             bb_renderbump_result *result, bb_error *err);
+
+void bb_renderbump_result_free(bb_renderbump_result *r);
+
+/* The "key=value" provenance lines of a render (axis, size, samples,
+ * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
+ * bb_provenance_format's lines; NULL when out of memory. */
+char *bb_renderbump_describe(const bb_renderbump_options *o,
+                             const bb_renderbump_result *r);
+
 #ifdef __cplusplus
 }
 #endif

@@ -59,6 +59,12 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
                            bb_progress_fn progress, void *progress_user,
                            bb_error *err);
 
+/* 64-bit FNV-1a: the hash of an empty input, and one step over the four
+ * bytes of v, little-endian whatever the host (so hashes recorded on one
+ * machine check on another). For bb_image_hash and bb_mesh_hash. */
+#define BB__FNV64_OFFSET 0xcbf29ce484222325ULL
+uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
+
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);
 

@@ -15,10 +15,9 @@
 
 /* ------------------------------------------------------------------- hash */
 
-#define FNV64_OFFSET 0xcbf29ce484222325ULL
 #define FNV64_PRIME 0x100000001b3ULL
 
-static uint64_t fnv1a_u32(uint64_t h, uint32_t v) {
+uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v) {
   /* Little-endian byte order whatever the host, so a hash recorded on one
    * machine can be checked on another. */
   for (int i = 0; i < 4; i++) {
@@ -29,19 +28,19 @@ static uint64_t fnv1a_u32(uint64_t h, uint32_t v) {
 }
 
 uint64_t bb_image_hash(const bb_image *img) {
-  uint64_t h = FNV64_OFFSET;
+  uint64_t h = BB__FNV64_OFFSET;
   if (!img)
     return h;
-  h = fnv1a_u32(h, (uint32_t)img->width);
-  h = fnv1a_u32(h, (uint32_t)img->height);
-  h = fnv1a_u32(h, (uint32_t)img->channels);
+  h = bb__fnv1a_u32(h, (uint32_t)img->width);
+  h = bb__fnv1a_u32(h, (uint32_t)img->height);
+  h = bb__fnv1a_u32(h, (uint32_t)img->channels);
   if (!img->pixels || img->width <= 0 || img->height <= 0 || img->channels <= 0)
     return h;
   size_t count = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
   for (size_t i = 0; i < count; i++) {
     uint32_t bits;
     memcpy(&bits, &img->pixels[i], sizeof bits);
-    h = fnv1a_u32(h, bits);
+    h = bb__fnv1a_u32(h, bits);
   }
   return h;
 }
