@@ -507,6 +507,17 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
   return check_output_directory(output_path);
 }
 
+char *cli_path_with_suffix(const char *path, const char *suffix) {
+  const char *slash = strrchr(path, '/');
+  const char *dot = strrchr(slash ? slash + 1 : path, '.');
+  size_t stem = dot ? (size_t)(dot - path) : strlen(path);
+  size_t len = stem + strlen(suffix) + 1;
+  char *out = malloc(len);
+  if (out)
+    snprintf(out, len, "%.*s%s", (int)stem, path, suffix);
+  return out;
+}
+
 static const char *file_name_of(const char *path) {
   const char *slash = strrchr(path, '/');
   return slash ? slash + 1 : path;

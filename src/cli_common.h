@@ -153,6 +153,11 @@ extern const cli_option cli_opt_scale, cli_opt_rays, cli_opt_filter_radius,
 int cli_check_output(const char *command, const char *input_path, const char *output_path,
                      bb_depth depth);
 
+/* path without the extension of its last component, plus suffix
+ * ("rock.png", "-ssbump.tga" -> "rock-ssbump.tga"), malloc'd; NULL when
+ * out of memory. */
+char *cli_path_with_suffix(const char *path, const char *suffix);
+
 /* What every output of one run shares, for its provenance. */
 typedef struct cli_run {
   char *command_line; /* "bumpbake " + argv joined with spaces */

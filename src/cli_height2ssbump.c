@@ -97,18 +97,6 @@ static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
   return cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
 }
 
-/* FILE without its extension, plus suffix: "rock.png" -> "rock-ssbump.tga". */
-static char *output_path_for(const char *input, const char *suffix) {
-  const char *slash = strrchr(input, '/');
-  const char *dot = strrchr(slash ? slash + 1 : input, '.');
-  size_t stem = dot ? (size_t)(dot - input) : strlen(input);
-  size_t len = stem + strlen(suffix) + 1;
-  char *path = malloc(len);
-  if (path)
-    snprintf(path, len, "%.*s%s", (int)stem, input, suffix);
-  return path;
-}
-
 static int h2s_parse(int argc, char **argv, h2s_args *a) {
   int first = 0;
   int rc = cli_parse_options(&h2s_command, argc, argv, h2s_option, a, &first);
@@ -130,7 +118,7 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
     return cli_usage_error(h2s_command.name,
                            "-d makes a detail ssbump; it cannot be used with -n");
 
-  a->output = output_path_for(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
+  a->output = cli_path_with_suffix(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
   if (!a->output) {
     cli_file_error(a->input, "out of memory");
     return BB_EXIT_FAILURE;

@@ -19,6 +19,7 @@ static const subcommand subcommands[] = {
     {"height2ssbump", bb_cli_height2ssbump, "drop-in for Valve's height2ssbump"},
     {"compare", bb_cli_compare, "compare two images (statistics, provenance diff)"},
     {"info", bb_cli_info, "print an image's size, format and provenance"},
+    {"renderbumpflat", bb_cli_renderbumpflat, "DOOM 3's RenderBumpFlat: a flat sculpt's normal map and height"},
 };
 
 enum { SUBCOMMAND_COUNT = sizeof subcommands / sizeof subcommands[0] };
