@@ -290,6 +290,15 @@ static bb_status bin_triangles(rb_job *job, bb_error *err) {
 
 /* ------------------------------------------------------------ shading */
 
+/* One bin entry made ready for a band: its raster setup and how its
+ * samples are shaded. */
+typedef struct prepared {
+  bb__raster_setup raster;
+  double face[3];      /* plane normal, tangent frame, on the viewer's side */
+  const float *vertex_n[3]; /* unit tangent-frame vertex normals, or NULL */
+  double vertex_sign;  /* -1 when the vertex normals point away from the viewer */
+} prepared;
+
 static void entry_triangle(const rb_job *job, const bin_entry *e, bb__raster_tri *tri) {
   const uint32_t *idx = job->mesh->indices + 3 * (size_t)e->triangle;
   const double su = (double)e->shift_u * job->o->width;
@@ -303,7 +312,7 @@ static void entry_triangle(const rb_job *job, const bin_entry *e, bb__raster_tri
 }
 
 /* The plane normal of triangle t in the tangent frame, on the viewer's side
- * (t[2] > 0): the front-most surface is seen from the front, whatever the
+ * (n[2] >= 0): the front-most surface is seen from the front, whatever the
  * winding. 0 when the triangle is degenerate. */
 static int face_normal(const rb_job *job, uint32_t t, double n[3]) {
   const uint32_t *idx = job->mesh->indices + 3 * (size_t)t;
@@ -330,66 +339,66 @@ static int uses_vertex_normals(const rb_job *job, uint32_t t) {
   return job->has_normal[idx[0]] && job->has_normal[idx[1]] && job->has_normal[idx[2]];
 }
 
-/* The interpolated vertex normal at (u, v), turned to the side the plane
- * normal face (viewer side) is on when the vertex normals point away from
- * the viewer as a whole (a model wound the other way). 0 when it vanishes. */
-static int vertex_normal_at(const rb_job *job, const bin_entry *e, double u, double v,
-                            const double face[3], double n[3]) {
+/* Sets p up for entry e; 0 when it draws nothing (zero area). Vertex
+ * normals pointing away from the viewer as a whole (a model wound the
+ * other way round than its normals) are turned to the plane normal's side. */
+static int prepare(const rb_job *job, const bin_entry *e, prepared *p) {
   bb__raster_tri tri;
   entry_triangle(job, e, &tri);
-  double w[3];
-  if (!bb__raster_weights(&tri, u, v, w))
+  if (!bb__raster_setup_make(&tri, &p->raster) || !face_normal(job, e->triangle, p->face))
     return 0;
+  p->vertex_n[0] = NULL;
+  p->vertex_sign = 1.0;
+  if (!uses_vertex_normals(job, e->triangle))
+    return 1;
   const uint32_t *idx = job->mesh->indices + 3 * (size_t)e->triangle;
-  double sum_vertex = 0.0;
-  for (int c = 0; c < 3; c++) {
-    n[c] = 0.0;
-    for (int k = 0; k < 3; k++) {
-      double nk = (double)job->normal_t[3 * (size_t)idx[k] + (size_t)c];
-      n[c] += w[k] * nk;
-      sum_vertex += nk * face[c];
-    }
-  }
-  if (sum_vertex < 0.0)
+  double towards = 0.0;
+  for (int k = 0; k < 3; k++) {
+    p->vertex_n[k] = job->normal_t + 3 * (size_t)idx[k];
     for (int c = 0; c < 3; c++)
-      n[c] = -n[c];
-  return normalize3(n);
+      towards += (double)p->vertex_n[k][c] * p->face[c];
+  }
+  p->vertex_sign = towards < 0.0 ? -1.0 : 1.0;
+  return 1;
 }
 
-/* The unit normal of the surface e at sample (u, v), tangent frame. */
-static void sample_normal(const rb_job *job, const bin_entry *e, double u, double v,
-                          double n[3]) {
-  double face[3];
-  if (!face_normal(job, e->triangle, face)) {
-    n[0] = n[1] = 0.0, n[2] = 1.0; /* unreachable: zero-area triangles draw nothing */
-    return;
+/* The unit normal of the surface p at sample (u, v), tangent frame: the
+ * interpolated vertex normal, or the plane normal (also where the
+ * interpolation vanishes). */
+static void sample_normal(const prepared *p, double u, double v, double n[3]) {
+  if (p->vertex_n[0]) {
+    double w[3];
+    bb__raster_weights(&p->raster, u, v, w);
+    for (int c = 0; c < 3; c++)
+      n[c] = p->vertex_sign * (w[0] * p->vertex_n[0][c] + w[1] * p->vertex_n[1][c] +
+                               w[2] * p->vertex_n[2][c]);
+    if (normalize3(n))
+      return;
   }
-  if (uses_vertex_normals(job, e->triangle) && vertex_normal_at(job, e, u, v, face, n))
-    return;
-  memcpy(n, face, sizeof face);
+  memcpy(n, p->face, sizeof p->face);
 }
 
 /* ---------------------------------------------------------------- bands */
 
 /* Texel (x, y) from its samples: the mean unit normal (renormalised), the
  * covered fraction, and the mean d (less ref_depth) into the height. */
-static void resolve_texel(const rb_job *job, const bb__sample_band *sb, const bin_entry *bin,
+static void resolve_texel(const rb_job *job, const bb__sample_band *sb, const prepared *entry,
                           int x, int y) {
   const int s = sb->per_texel;
   double sum_n[3] = {0.0, 0.0, 0.0}, sum_d = 0.0;
   int covered = 0;
   for (int j = 0; j < s; j++) {
     const int row = y * s + j;
+    const long base = (long)(row - sb->first_row) * sb->columns + (long)x * s;
     for (int i = 0; i < s; i++) {
-      const int col = x * s + i;
-      const long k = (long)(row - sb->first_row) * sb->columns + col;
-      if (sb->winner[k] < 0)
+      const int32_t w = sb->winner[base + i];
+      if (w < 0)
         continue;
       double n[3];
-      sample_normal(job, &bin[sb->winner[k]], (col + 0.5) / s, (row + 0.5) / s, n);
+      sample_normal(&entry[w], (x * s + i + 0.5) / s, (row + 0.5) / s, n);
       for (int c = 0; c < 3; c++)
         sum_n[c] += n[c];
-      sum_d += sb->depth[k];
+      sum_d += sb->depth[base + i];
       covered++;
     }
   }
@@ -403,31 +412,38 @@ static void resolve_texel(const rb_job *job, const bb__sample_band *sb, const bi
       covered ? (float)(sum_d / covered - job->ref_depth) : 0.0f;
 }
 
+/* Rasterises the band's entries in mesh order, then resolves its texels. */
+static void draw_band(const rb_job *job, bb__sample_band *sb, prepared *entry, int band) {
+  const bin_entry *bin = job->bins + job->bin_start[band];
+  const size_t count = job->bin_start[band + 1] - job->bin_start[band];
+  for (size_t e = 0; e < count; e++)
+    if (prepare(job, &bin[e], &entry[e]))
+      bb__band_draw(sb, &entry[e].raster, (int32_t)e);
+  const int y0 = sb->first_row / sb->per_texel, y1 = y0 + sb->rows / sb->per_texel;
+  for (int y = y0; y < y1; y++)
+    for (int x = 0; x < job->o->width; x++)
+      resolve_texel(job, sb, entry, x, y);
+}
+
 static void band_work(void *user, int band) {
   rb_job *job = user;
-  const int s = job->o->samples, W = job->o->width;
+  const int s = job->o->samples;
   const int y0 = band * job->band_rows;
   const int y1 = y0 + job->band_rows < job->o->height ? y0 + job->band_rows : job->o->height;
-  bb__sample_band sb = {W * s, (y1 - y0) * s, y0 * s, s, NULL, NULL};
+  bb__sample_band sb = {job->o->width * s, (y1 - y0) * s, y0 * s, s, NULL, NULL};
   const size_t n = (size_t)sb.columns * (size_t)sb.rows;
+  const size_t count = job->bin_start[band + 1] - job->bin_start[band];
   sb.depth = malloc(n * sizeof(double));
   sb.winner = malloc(n * sizeof(int32_t));
-  if (!sb.depth || !sb.winner) {
+  prepared *entry = malloc((count ? count : 1) * sizeof(prepared));
+  if (!sb.depth || !sb.winner || !entry) {
     atomic_store(&job->out_of_memory, 1);
   } else {
     for (size_t k = 0; k < n; k++)
       sb.winner[k] = -1;
-    const bin_entry *bin = job->bins + job->bin_start[band];
-    const size_t count = job->bin_start[band + 1] - job->bin_start[band];
-    for (size_t e = 0; e < count; e++) {
-      bb__raster_tri tri;
-      entry_triangle(job, &bin[e], &tri);
-      bb__band_draw(&sb, &tri, (int32_t)e);
-    }
-    for (int y = y0; y < y1; y++)
-      for (int x = 0; x < W; x++)
-        resolve_texel(job, &sb, bin, x, y);
+    draw_band(job, &sb, entry, band);
   }
+  free(entry);
   free(sb.depth);
   free(sb.winner);
 }
