@@ -292,9 +292,9 @@ static void note_texel_aspect(const rbf_args *a, const bb_renderbump_result *r) 
   if (!a->height || fabs(r->texel_aspect - 1.0) <= 0.01)
     return;
   fprintf(stderr,
-          "bumpbake renderbumpflat: note: texels are %.4g times wider than high; the "
-          "height's scale uses their geometric mean (pick -size in the rectangle's "
-          "aspect, %.4g)\n",
+          "bumpbake renderbumpflat: note: texels are %.4g times as wide as high; the "
+          "height's scale uses their geometric mean (square texels need W / H = %.4g "
+          "in -size)\n",
           r->texel_aspect, (r->rect[2] - r->rect[0]) / (r->rect[3] - r->rect[1]));
 }
 

@@ -24,14 +24,16 @@
 
 namespace {
 
-// Assimp's messages may hold line breaks; ours are one line.
+// Assimp's messages may hold line breaks, runs of spaces and bytes of the
+// file itself (a corrupt mesh name); ours are one line of printable ASCII.
 std::string one_line(const char *s) {
   std::string out;
-  for (const char *c = s ? s : ""; *c; c++)
-    if (*c == '\n' || *c == '\r')
-      out += ' ';
-    else
-      out += *c;
+  for (const unsigned char *c = (const unsigned char *)(s ? s : ""); *c; c++) {
+    char ch = (*c < 0x20 || *c > 0x7e) ? (*c == '\n' || *c == '\r' || *c == '\t' ? ' ' : '?')
+                                       : (char)*c;
+    if (ch == ' ' && (out.empty() || out.back() == ' ')) continue;
+    out += ch;
+  }
   while (!out.empty() && out.back() == ' ') out.pop_back();
   return out.empty() ? std::string("unknown Assimp error") : out;
 }

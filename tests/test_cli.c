@@ -702,3 +702,149 @@ Test(cli, height2ssbump_without_alpha_uses_mean_and_says_so) {
   int s = (int)lrint(255.0 / sqrt(3.0));
   expect_uniform8(tmp("rgb-ssbump.tga"), 4, (const int[]){s, s, s, 128}, 1);
 }
+
+/* ---------------------------------------------------------- renderbumpflat */
+
+/* A 16 x 16 plate in the XZ plane (facing -y, DOOM 3's side) with a square
+ * hole over x, z in [6, 10]: four quads, which Assimp triangulates. */
+static const char holey_obj[] =
+    "v 0 0 0\nv 16 0 0\nv 16 0 6\nv 0 0 6\n"
+    "v 0 0 10\nv 16 0 10\nv 16 0 16\nv 0 0 16\n"
+    "v 6 0 6\nv 6 0 10\nv 10 0 6\nv 10 0 10\n"
+    "f 1 2 3 4\nf 5 6 7 8\nf 4 9 10 5\nf 11 3 6 12\n";
+
+/* An 8 x 8 plane whose height (towards -y) rises by 0.25 per unit along +x
+ * and by 0.125 per unit down the image (-z): its normal is
+ * normalize(-0.25, -0.125, 1) in the +Y-down tangent frame. */
+static const char slope_obj[] =
+    "v 0 -1 0\nv 8 -3 0\nv 8 -2 8\nv 0 0 8\nf 1 2 3 4\n";
+
+Test(cli, renderbumpflat_writes_model_local_tga_with_coverage_alpha) {
+  const char *model = tmp("holey.obj"), *out = tmp("holey_local.tga");
+  write_bytes(model, holey_obj, strlen(holey_obj));
+  cli_result r = RUN("renderbumpflat", "-size", "16", "16", model);
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "wrote normal") && strstr(r.out, "holey_local.tga"), "%s", r.out);
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+  bb_image_info info;
+  bb_image img = read_image(out, &info);
+  cr_assert_eq(img.width, 16);
+  cr_assert_eq(img.channels, 4);
+  cr_expect_eq(info.alpha_channel, 3);
+  for (int y = 0; y < 16; y++)
+    for (int x = 0; x < 16; x++) {
+      int hole = x >= 6 && x <= 9 && y >= 6 && y <= 9;
+      cr_expect_eq(code8(&img, x, y, 3), hole ? 0 : 255, "alpha at (%d, %d)", x, y);
+      cr_expect(code8(&img, x, y, 0) == 128 && code8(&img, x, y, 1) == 128 &&
+                    code8(&img, x, y, 2) == 255,
+                "flat normal at (%d, %d)", x, y);
+    }
+  cr_expect(info.description && strstr(info.description, "renderbumpflat"));
+  bb_image_info_free(&info);
+  bb_image_free(&img);
+  /* The default size is DOOM 3's 256 x 256; -o names the file. */
+  run_ok_in(NULL, (const char *[]){"renderbumpflat", model, "-o", tmp("n.png"), "-q", NULL});
+  img = read_image(tmp("n.png"), NULL);
+  cr_expect(img.width == 256 && img.height == 256 && img.channels == 4);
+  bb_image_free(&img);
+}
+
+/* The height's printed scale is stored in its provenance, and `bumpbake
+ * normal` of that height with that scale gives the rendered normal. */
+Test(cli, renderbumpflat_height_and_its_scale_agree_with_normal) {
+  const char *model = tmp("slope.obj"), *height = tmp("slope_h.png");
+  write_bytes(model, slope_obj, strlen(slope_obj));
+  cli_result r = RUN("renderbumpflat", "--size", "8", "8", model, "--height", height, "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  /* texel centres 0.5 .. 7.5: heights 0.1875 .. 2.8125, a range of 2.625 */
+  cr_expect(strstr(r.out, "height scale 2.625 "), "%s", r.out);
+  cr_expect_eq(count_lines(r.out), 1, "-q: only the scale: %s", r.out);
+  cli_result_free(&r);
+  bb_image_info info;
+  bb_image h = read_image(height, &info);
+  cr_expect(info.bits_per_sample == 16, "heights are 16-bit in PNG");
+  cr_expect(info.description && strstr(info.description, "\nscale=2.625\n"), "%s",
+            info.description ? info.description : "(none)");
+  cr_expect_float_eq(bb_image_texel(&h, 0, 0)[0], 0.0f, 1e-9);
+  cr_expect_float_eq(bb_image_texel(&h, 7, 7)[0], 1.0f, 1e-9);
+  bb_image_info_free(&info);
+  bb_image_free(&h);
+
+  run_ok_in(NULL, (const char *[]){"normal", height, "--scale", "2.625", "--filter-radius",
+                                   "0", "--clamp", "-o", tmp("n.png"), NULL});
+  bb_image from_height = read_image(tmp("n.png"), NULL);
+  bb_image rendered = read_image(tmp("slope_local.tga"), NULL);
+  const int expect[3] = {97, 112, 250}; /* 0.5 + 0.5 normalize(-0.25, -0.125, 1) */
+  for (int c = 0; c < 3; c++) {
+    cr_expect(abs(code8(&rendered, 4, 4, c) - expect[c]) <= 1, "rendered channel %d: %d", c,
+              code8(&rendered, 4, 4, c));
+    cr_expect(abs(code8(&from_height, 4, 4, c) - expect[c]) <= 1, "from height %d: %d", c,
+              code8(&from_height, 4, 4, c));
+  }
+  bb_image_free(&from_height);
+  bb_image_free(&rendered);
+}
+
+Test(cli, renderbumpflat_bad_models_fail_with_one_line) {
+  const char *missing = tmp("missing.obj"), *empty = tmp("empty.obj"),
+             *points = tmp("points.obj"), *edge_on = tmp("edge_on.obj"),
+             *junk = tmp("junk.stl");
+  write_bytes(empty, "", 0);
+  const char point_text[] = "v 0 0 0\nv 1 0 0\nv 0 0 1\n";
+  write_bytes(points, point_text, strlen(point_text));
+  /* a quad in the XY plane, seen along -y: a rectangle of zero height */
+  const char edge_text[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+  write_bytes(edge_on, edge_text, strlen(edge_text));
+  const unsigned char junk_bytes[] = {'s', 'o', 'l', 'i', 'd', 0xff, 0, 1, 2, 3};
+  write_bytes(junk, junk_bytes, sizeof junk_bytes);
+  const char *const models[] = {missing, empty, points, edge_on, junk};
+  const char *const names[] = {"missing.obj", "empty.obj", "points.obj", "edge_on.obj",
+                               "junk.stl"};
+  const char *const outputs[] = {tmp("missing_local.tga"), tmp("empty_local.tga"),
+                                 tmp("points_local.tga"), tmp("edge_on_local.tga"),
+                                 tmp("junk_local.tga")};
+  for (int i = 0; i < 5; i++)
+    expect_failure((const char *[]){"renderbumpflat", models[i], "--height", tmp("h.png"),
+                                    NULL},
+                   names[i], outputs[i], models[i]);
+  cr_expect(!file_exists(tmp("h.png")));
+  cli_result r = RUN("renderbumpflat", edge_on);
+  cr_expect(strstr(r.err, "degenerate"), "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("renderbumpflat", points);
+  cr_expect(strstr(r.err, "no triangles"), "%s", r.err);
+  cli_result_free(&r);
+}
+
+Test(cli, renderbumpflat_usage_errors_exit_2) {
+  const char *model = tmp("holey.obj");
+  write_bytes(model, holey_obj, strlen(holey_obj));
+  const usage_case cases[] = {
+      {{"renderbumpflat", "-size", "16", model}, "-size"},
+      {{"renderbumpflat", model, "-size", "16"}, "-size needs 2 values"},
+      {{"renderbumpflat", "-size", "0", "16", model}, "-size W"},
+      {{"renderbumpflat", "-size", "16", "x", model}, "-size H"},
+      {{"renderbumpflat", "-size", "65536", "65536", model}, "texels"},
+      {{"renderbumpflat", model, "--samples", "0"}, "--samples"},
+      {{"renderbumpflat", model, "--samples", "17"}, "--samples"},
+      {{"renderbumpflat", model, "--axis", "w"}, "--axis"},
+      {{"renderbumpflat", model, "--tile"}, "--rect"},
+      {{"renderbumpflat", model, "--rect", "1", "0", "0", "1"}, "L < R"},
+      {{"renderbumpflat", model, "--rect", "0", "0", "1"}, "--rect"},
+      {{"renderbumpflat", model, "--bogus"}, "--bogus"},
+      {{"renderbumpflat", model, "-o", tmp("n.jpg2")}, "n.jpg2"},
+      {{"renderbumpflat", model, "--height", tmp("holey_local.tga")}, "both"},
+      {{"renderbumpflat"}, "MODEL"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    cli_result r = run_in(NULL, cases[i].args);
+    cr_expect_eq(r.code, 2, "case %zu: exit %d, stderr: %s", i, r.code, r.err);
+    cr_expect_eq(count_lines(r.err), 1, "case %zu: %s", i, r.err);
+    cr_expect(strstr(r.err, cases[i].message_part), "case %zu: '%s' lacks '%s'", i, r.err,
+              cases[i].message_part);
+    cr_expect_str_empty(r.out, "case %zu", i);
+    cli_result_free(&r);
+    cr_expect(!file_exists(tmp("holey_local.tga")), "case %zu wrote a file", i);
+  }
+}
