@@ -5,7 +5,10 @@
 // bumpbake sees only bb_mesh.
 #include "internal.h"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Exporter.hpp>
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -18,6 +21,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -42,7 +46,7 @@ std::string one_line(const char *s) {
 
 // "missing", "a directory" and "unreadable" before Assimp sees the file,
 // which reports all of them as a failed open or a missing reader.
-bb_status check_readable(const char *path, bb_error *err) {
+bb_status check_readable(const char *path, size_t *size, bb_error *err) {
   struct stat st;
   if (stat(path, &st) != 0) {
     if (errno == ENOENT || errno == ENOTDIR)
@@ -54,8 +58,63 @@ bb_status check_readable(const char *path, bb_error *err) {
   if (fd < 0) return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(errno));
   close(fd);
   if (st.st_size == 0) return bb__fail(err, BB_ERR_FORMAT, "%s: empty file", path);
+  *size = (size_t)st.st_size;
   return BB_OK;
 }
+
+// A read budget for one import. Assimp 5.2.4's binary PLY reader, given a
+// truncated file, seeks back and re-reads it forever; a real import reads
+// its file about once (format detection adds a few hundred bytes per
+// reader). So reads past a few times the file's size, or many reads at the
+// end of the file, end the import with an exception, which Assimp or
+// bb_mesh_load turn into a one-line error instead of a hang.
+struct read_budget {
+  size_t bytes_left;
+  int empty_reads_left;
+};
+
+class budget_stream : public Assimp::IOStream {
+public:
+  budget_stream(Assimp::IOSystem *owner, Assimp::IOStream *inner, read_budget *budget)
+      : owner_(owner), inner_(inner), budget_(budget) {}
+  ~budget_stream() override { owner_->Close(inner_); }
+  size_t Read(void *buffer, size_t size, size_t count) override {
+    size_t n = inner_->Read(buffer, size, count);
+    size_t bytes = n * size;
+    if (bytes > budget_->bytes_left || (n == 0 && --budget_->empty_reads_left < 0))
+      throw std::runtime_error("the importer kept re-reading the file (corrupt or truncated?)");
+    budget_->bytes_left -= bytes;
+    return n;
+  }
+  size_t Write(const void *, size_t, size_t) override { return 0; }
+  aiReturn Seek(size_t offset, aiOrigin origin) override { return inner_->Seek(offset, origin); }
+  size_t Tell() const override { return inner_->Tell(); }
+  size_t FileSize() const override { return inner_->FileSize(); }
+  void Flush() override {}
+
+private:
+  Assimp::IOSystem *owner_;
+  Assimp::IOStream *inner_;
+  read_budget *budget_;
+};
+
+// Assimp's default file system, read-only, with every stream on the budget.
+class budget_io : public Assimp::IOSystem {
+public:
+  explicit budget_io(size_t file_size) : budget_{4 * file_size + (1u << 20), 1000} {}
+  bool Exists(const char *file) const override { return files_.Exists(file); }
+  char getOsSeparator() const override { return files_.getOsSeparator(); }
+  Assimp::IOStream *Open(const char *file, const char *mode) override {
+    if (!mode || std::strchr(mode, 'w') || std::strchr(mode, 'a')) return nullptr;
+    Assimp::IOStream *inner = files_.Open(file, mode);
+    return inner ? new budget_stream(&files_, inner, &budget_) : nullptr;
+  }
+  void Close(Assimp::IOStream *stream) override { delete stream; }
+
+private:
+  Assimp::DefaultIOSystem files_;
+  read_budget budget_;
+};
 
 // Counts of what the merged mesh will hold.
 struct mesh_counts {
@@ -123,9 +182,11 @@ bb_status scene_to_mesh(const char *path, const aiScene *scene, bb_mesh *out, bb
 }
 
 bb_status load_mesh(const char *path, bb_mesh *out, bb_error *err) {
-  bb_status st = check_readable(path, err);
+  size_t size = 0;
+  bb_status st = check_readable(path, &size, err);
   if (st != BB_OK) return st;
   Assimp::Importer importer;
+  importer.SetIOHandler(new budget_io(size)); // the importer owns and deletes it
   // Validation first (Assimp runs it before the other steps), so a corrupt
   // file is refused before post-processing walks its indices; node
   // transforms are applied and the meshes merged by PreTransformVertices.

@@ -787,34 +787,41 @@ Test(cli, renderbumpflat_height_and_its_scale_agree_with_normal) {
 }
 
 Test(cli, renderbumpflat_bad_models_fail_with_one_line) {
-  const char *missing = tmp("missing.obj"), *empty = tmp("empty.obj"),
-             *points = tmp("points.obj"), *edge_on = tmp("edge_on.obj"),
-             *junk = tmp("junk.stl");
-  write_bytes(empty, "", 0);
   const char point_text[] = "v 0 0 0\nv 1 0 0\nv 0 0 1\n";
-  write_bytes(points, point_text, strlen(point_text));
   /* a quad in the XY plane, seen along -y: a rectangle of zero height */
   const char edge_text[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
-  write_bytes(edge_on, edge_text, strlen(edge_text));
-  const unsigned char junk_bytes[] = {'s', 'o', 'l', 'i', 'd', 0xff, 0, 1, 2, 3};
-  write_bytes(junk, junk_bytes, sizeof junk_bytes);
-  const char *const models[] = {missing, empty, points, edge_on, junk};
-  const char *const names[] = {"missing.obj", "empty.obj", "points.obj", "edge_on.obj",
-                               "junk.stl"};
-  const char *const outputs[] = {tmp("missing_local.tga"), tmp("empty_local.tga"),
-                                 tmp("points_local.tga"), tmp("edge_on_local.tga"),
-                                 tmp("junk_local.tga")};
-  for (int i = 0; i < 5; i++)
-    expect_failure((const char *[]){"renderbumpflat", models[i], "--height", tmp("h.png"),
-                                    NULL},
-                   names[i], outputs[i], models[i]);
-  cr_expect(!file_exists(tmp("h.png")));
-  cli_result r = RUN("renderbumpflat", edge_on);
-  cr_expect(strstr(r.err, "degenerate"), "%s", r.err);
-  cli_result_free(&r);
-  r = RUN("renderbumpflat", points);
-  cr_expect(strstr(r.err, "no triangles"), "%s", r.err);
-  cli_result_free(&r);
+  const char junk_bytes[] = {'s', 'o', 'l', 'i', 'd', (char)0xff, 0, 1, 2, 3};
+  const struct {
+    const char *name, *content;
+    size_t size;
+    const char *reason;
+  } cases[] = {
+      {"missing.obj", NULL, 0, "no such file"},
+      {"empty.obj", "", 0, "empty file"},
+      {"points.obj", point_text, sizeof point_text - 1, "no triangles"},
+      {"edge_on.obj", edge_text, sizeof edge_text - 1, "degenerate"},
+      {"junk.stl", junk_bytes, sizeof junk_bytes, "not a readable model"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    const char *model = tmp(cases[i].name);
+    if (cases[i].content)
+      write_bytes(model, cases[i].content, cases[i].size);
+    cli_result r = RUN("renderbumpflat", model, "--height", tmp("h.png"));
+    cr_expect_eq(r.code, 1, "%s: exit %d, stderr: %s", cases[i].name, r.code, r.err);
+    cr_expect_eq(count_lines(r.err), 1, "%s: %s", cases[i].name, r.err);
+    cr_expect(strncmp(r.err, "bumpbake: ", 10) == 0 && strstr(r.err, cases[i].name) &&
+                  strstr(r.err, cases[i].reason),
+              "%s: '%s' should name the file and say '%s'", cases[i].name, r.err,
+              cases[i].reason);
+    cli_result_free(&r);
+    char *out = malloc(strlen(model) + 16);
+    cr_assert_not_null(out);
+    strcpy(out, model);
+    strcpy(strrchr(out, '.'), "_local.tga");
+    cr_expect(!file_exists(out) && !file_exists(tmp("h.png")), "%s: a file was written",
+              cases[i].name);
+    free(out);
+  }
 }
 
 Test(cli, renderbumpflat_usage_errors_exit_2) {
@@ -827,11 +834,9 @@ Test(cli, renderbumpflat_usage_errors_exit_2) {
       {{"renderbumpflat", "-size", "16", "x", model}, "-size H"},
       {{"renderbumpflat", "-size", "65536", "65536", model}, "texels"},
       {{"renderbumpflat", model, "--samples", "0"}, "--samples"},
-      {{"renderbumpflat", model, "--samples", "17"}, "--samples"},
       {{"renderbumpflat", model, "--axis", "w"}, "--axis"},
       {{"renderbumpflat", model, "--tile"}, "--rect"},
       {{"renderbumpflat", model, "--rect", "1", "0", "0", "1"}, "L < R"},
-      {{"renderbumpflat", model, "--rect", "0", "0", "1"}, "--rect"},
       {{"renderbumpflat", model, "--bogus"}, "--bogus"},
       {{"renderbumpflat", model, "-o", tmp("n.jpg2")}, "n.jpg2"},
       {{"renderbumpflat", model, "--height", tmp("holey_local.tga")}, "both"},

@@ -629,8 +629,10 @@ static bb_status load_status(const char *path, char *message, size_t cap) {
   return st;
 }
 
-Test(renderbump_files, unreadable_empty_and_triangle_free_models_fail) {
+Test(renderbump_files, unreadable_empty_truncated_and_triangle_free_models_fail,
+     .timeout = 20) {
   char path[128], msg[512];
+  bb_error err = {{0}};
   cr_assert_eq(load_status(tmp_path(path, sizeof path, "missing.obj"), msg, sizeof msg),
                BB_ERR_IO);
   cr_assert(strstr(msg, "no such file"), "%s", msg);
@@ -647,6 +649,25 @@ Test(renderbump_files, unreadable_empty_and_triangle_free_models_fail) {
   write_text(tmp_path(path, sizeof path, "line.obj"), "v 0 0 0\nv 1 0 0\nv 0 0 1\nl 1 2\n");
   cr_assert_eq(load_status(path, msg, sizeof msg), BB_ERR_FORMAT);
   cr_assert(strstr(msg, "no triangles"), "%s", msg);
+  /* A binary PLY cut short inside its header: Assimp 5.2.4 alone re-reads
+   * it forever (checked: plain Importer::ReadFile on such a file does not
+   * return); the read budget turns that into an error. */
+  bb_mesh cap;
+  cap_mesh(&cap, 1);
+  char whole[128];
+  cr_assert_eq(bb_mesh_write(tmp_path(whole, sizeof whole, "whole.ply"), &cap, &err), BB_OK);
+  bb_mesh_free(&cap);
+  FILE *f = fopen(whole, "rb");
+  cr_assert_not_null(f);
+  char bytes[4096];
+  size_t got = fread(bytes, 1, sizeof bytes, f);
+  fclose(f);
+  const char *end = strstr(bytes, "end_header\n");
+  cr_assert(end && got == sizeof bytes);
+  size_t cut = (size_t)(end - bytes) + 5; /* "end_h" */
+  f = fopen(tmp_path(path, sizeof path, "cut.ply"), "wb");
+  cr_assert(f && fwrite(bytes, 1, cut, f) == cut && fclose(f) == 0);
+  cr_assert_eq(load_status(path, msg, sizeof msg), BB_ERR_FORMAT, "%s", msg);
   /* A quad is triangulated. */
   write_text(tmp_path(path, sizeof path, "quad.obj"),
              "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3 4\n");
