@@ -64,6 +64,8 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
  * machine check on another). For bb_image_hash and bb_mesh_hash. */
 #define BB__FNV64_OFFSET 0xcbf29ce484222325ULL
 uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
+/* bb__fnv1a_u32 over the bits of n floats. */
+uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n);
 
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);

@@ -36,15 +36,6 @@ void bb_mesh_free(bb_mesh *m) {
   memset(m, 0, sizeof *m);
 }
 
-static uint64_t hash_floats(uint64_t h, const float *v, size_t n) {
-  for (size_t i = 0; i < n; i++) {
-    uint32_t bits;
-    memcpy(&bits, &v[i], sizeof bits);
-    h = bb__fnv1a_u32(h, bits);
-  }
-  return h;
-}
-
 uint64_t bb_mesh_hash(const bb_mesh *m) {
   uint64_t h = BB__FNV64_OFFSET;
   if (!m)
@@ -53,9 +44,9 @@ uint64_t bb_mesh_hash(const bb_mesh *m) {
   h = bb__fnv1a_u32(h, (uint32_t)m->triangle_count);
   h = bb__fnv1a_u32(h, m->normals != NULL);
   if (m->positions)
-    h = hash_floats(h, m->positions, 3 * m->vertex_count);
+    h = bb__fnv1a_floats(h, m->positions, 3 * m->vertex_count);
   if (m->normals)
-    h = hash_floats(h, m->normals, 3 * m->vertex_count);
+    h = bb__fnv1a_floats(h, m->normals, 3 * m->vertex_count);
   if (m->indices)
     for (size_t i = 0; i < 3 * m->triangle_count; i++)
       h = bb__fnv1a_u32(h, m->indices[i]);

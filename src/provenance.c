@@ -27,6 +27,15 @@ uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v) {
   return h;
 }
 
+uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    uint32_t bits;
+    memcpy(&bits, &v[i], sizeof bits);
+    h = bb__fnv1a_u32(h, bits);
+  }
+  return h;
+}
+
 uint64_t bb_image_hash(const bb_image *img) {
   uint64_t h = BB__FNV64_OFFSET;
   if (!img)
@@ -37,12 +46,7 @@ uint64_t bb_image_hash(const bb_image *img) {
   if (!img->pixels || img->width <= 0 || img->height <= 0 || img->channels <= 0)
     return h;
   size_t count = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
-  for (size_t i = 0; i < count; i++) {
-    uint32_t bits;
-    memcpy(&bits, &img->pixels[i], sizeof bits);
-    h = bb__fnv1a_u32(h, bits);
-  }
-  return h;
+  return bb__fnv1a_floats(h, img->pixels, count);
 }
 
 /* ---------------------------------------------------------------- format */
