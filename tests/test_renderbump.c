@@ -372,20 +372,27 @@ static double exact_coverage(int i, int j) {
   return sum / 4096.0;
 }
 
+/* A quad (corners in order, XZ plane) and options rendering the square
+ * [0, side]^2 of X and Z onto side x side texels. */
+static void quad_scene(const float corners[12], int side, bb_mesh *m,
+                       bb_renderbump_options *o) {
+  static const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  cr_assert_eq(bb_mesh_alloc(m, 4, 2, 0, NULL), BB_OK);
+  memcpy(m->positions, corners, 12 * sizeof(float));
+  memcpy(m->indices, tris, sizeof tris);
+  bb_renderbump_options_init(o);
+  o->width = o->height = side;
+  o->rect_given = 1;
+  double rect[4] = {0, 0, side, side};
+  memcpy(o->rect, rect, sizeof rect);
+}
+
 static void coverage_errors(int samples, double *max_err, double *mean_err) {
   static const float quad[12] = {0, 0, 0, 32, 0, 0, 32, 0, 14.6f, 0, 0, 5};
-  static const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
   bb_mesh m;
-  cr_assert_eq(bb_mesh_alloc(&m, 4, 2, 0, NULL), BB_OK);
-  memcpy(m.positions, quad, sizeof quad);
-  memcpy(m.indices, tris, sizeof tris);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
-  o.width = o.height = 32;
+  quad_scene(quad, 32, &m, &o);
   o.samples = samples;
-  o.rect_given = 1;
-  double rect[4] = {0, 0, 32, 32};
-  memcpy(o.rect, rect, sizeof rect);
   bb_renderbump_result r;
   render(&m, &o, &r);
   *max_err = *mean_err = 0.0;
@@ -417,17 +424,9 @@ Test(renderbump, oversampling_smooths_an_edge_that_one_sample_aliases) {
  * without tile, wrapped onto the left edge with it. */
 Test(renderbump, tile_wraps_what_crosses_the_edges) {
   static const float square[12] = {7, 0, 3, 9, 0, 3, 9, 0, 5, 7, 0, 5};
-  static const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
   bb_mesh m;
-  cr_assert_eq(bb_mesh_alloc(&m, 4, 2, 0, NULL), BB_OK);
-  memcpy(m.positions, square, sizeof square);
-  memcpy(m.indices, tris, sizeof tris);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
-  o.width = o.height = 8;
-  o.rect_given = 1;
-  double rect[4] = {0, 0, 8, 8};
-  memcpy(o.rect, rect, sizeof rect);
+  quad_scene(square, 8, &m, &o);
   for (int tile = 0; tile < 2; tile++) {
     o.tile = tile;
     bb_renderbump_result r;
