@@ -149,6 +149,9 @@ static bb_status project_vertices(rb_job *job, bb_error *err) {
     uvd[0] = (dot3(p, job->right) - rect[0]) * texels_u;
     uvd[1] = (rect[3] - dot3(p, job->up)) * texels_v;
     uvd[2] = dot3(p, job->out);
+    if (!isfinite(uvd[0]) || !isfinite(uvd[1]))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "renderbump: the rectangle is too small for the model's coordinates");
     job->ref_depth = fmin(job->ref_depth, uvd[2]);
   }
   return BB_OK;
@@ -194,10 +197,15 @@ static bb_status prepare_normals(rb_job *job, bb_error *err) {
 
 /* ------------------------------------------------------------- binning */
 
-/* Range of whole periods k for which [lo + k n, hi + k n] meets [0, n]. */
-static void period_range(double lo, double hi, int n, long *first, long *last) {
-  *first = (long)ceil(-hi / n);
-  *last = (long)floor((n - lo) / n);
+/* Range of whole periods k for which [lo + k n, hi + k n] meets [0, n];
+ * 0 when it reaches past TILE_REACH_LIMIT periods. */
+static int period_range(double lo, double hi, int n, long *first, long *last) {
+  double f = ceil(-hi / n), l = floor((n - lo) / n);
+  if (!(fabs(f) <= TILE_REACH_LIMIT && fabs(l) <= TILE_REACH_LIMIT))
+    return 0; /* also keeps the conversions below defined */
+  *first = (long)f;
+  *last = (long)l;
+  return 1;
 }
 
 static void triangle_box(const rb_job *job, size_t t, double box[4]) {
@@ -231,10 +239,8 @@ static long bin_pass(rb_job *job, int fill, size_t *count_or_cursor) {
     triangle_box(job, t, box);
     long ku0 = 0, ku1 = 0, kv0 = 0, kv1 = 0;
     if (job->o->tile) {
-      period_range(box[0], box[2], W, &ku0, &ku1);
-      period_range(box[1], box[3], H, &kv0, &kv1);
-      if (labs(ku0) > TILE_REACH_LIMIT || labs(ku1) > TILE_REACH_LIMIT ||
-          labs(kv0) > TILE_REACH_LIMIT || labs(kv1) > TILE_REACH_LIMIT ||
+      if (!period_range(box[0], box[2], W, &ku0, &ku1) ||
+          !period_range(box[1], box[3], H, &kv0, &kv1) ||
           (double)(ku1 - ku0 + 1) * (double)(kv1 - kv0 + 1) > (double)(BIN_LIMIT - total))
         return -1; /* before a loop over that many copies */
     } else if (box[2] < 0.0 || box[0] > W || box[3] < 0.0 || box[1] > H) {

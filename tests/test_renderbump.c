@@ -726,6 +726,12 @@ Test(renderbump, bad_meshes_and_options_are_refused) {
   memcpy(o.rect, too_far, sizeof too_far);
   cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_SIZE);
 
+  /* a rectangle so small that the model's image coordinates overflow */
+  double tiny[4] = {0, 0, 1e-310, 1e-310};
+  memcpy(o.rect, tiny, sizeof tiny);
+  for (o.tile = 0; o.tile < 2; o.tile++)
+    cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT, "tile %d", o.tile);
+
   bb_renderbump_options_init(&o);
   m.positions[4] = NAN;
   cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_VALUE);
