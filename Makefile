@@ -107,16 +107,19 @@ lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 # ---- dependencies (Debian packages) ----------------------------------------
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # Python: Debian's /usr/bin/python3 with its cffi, numpy and pytest.
+# fonts-dejavu-core: the labels of `sheet` and `render --compare` (drawn
+# through OpenImageIO's FreeType text; without a font they are left out).
 PYTHON   := /usr/bin/python3
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
-            python3 python3-cffi python3-numpy python3-pytest
+            python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core
+LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
 	DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y --no-install-recommends $(DEB_PKGS)
 
 ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
-	    && command -v $(CXX) >/dev/null 2>&1 \
+	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 

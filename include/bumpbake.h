@@ -418,7 +418,6 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
 const char *bb_channel_name(bb_channel c);
 
-
 /* ----------------------------------------------------------------- meshes */
 
 /* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
@@ -542,6 +541,210 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
  * bb_provenance_format's lines; NULL when out of memory. */
 char *bb_renderbump_describe(const bb_renderbump_options *o,
                              const bb_renderbump_result *r);
+
+/* ----------------------------------------------------------------- render */
+
+/* Lighting the baked maps as the paper's "Rendering" section (and Source's
+ * shaders) do, per texel, in the tangent frame above (+Y down, viewer
+ * overhead). Inputs: N (unit normal), s_c (ssbump), ao, the bent normal
+ * Nb = normalize(sum_c s_c B_c), an optional albedo A. Lights: a dynamic
+ * light l (unit, towards the light) of colour C, and the three lightmap
+ * colours L_c of Source's static light (the light arriving along B_c).
+ *   mode      static (lightmaps)        dynamic light
+ *   normal    sum_c w_c L_c             max(0, N.l) C
+ *   ao        ao * sum_c w_c L_c        ao * max(0, N.l) C
+ *   ssbump    sum_c s_c L_c             sat(sum_c s_c (l.B_c)) C
+ * with Source's weights w_c = dp_c / sum_k dp_k, dp_c = sat(N.B_c)^2 (the
+ * weights map). Output = A * (static + dynamic) + specular, where the
+ * Blinn-Phong specular of exponent k sums, over every light (d, K) in use
+ * (the dynamic light, and the three B_c with colours L_c when the
+ * lightmaps are on), K * max(0, Ns.h)^k with h = normalize(d + (0, 0, 1)),
+ * counted only where Ns.d > 0; Ns is Nb for ssbump, N otherwise. A flat,
+ * unoccluded texel under an overhead light gives 1 in every mode, the
+ * value of N.L. */
+
+/* What one render shows. New modes are appended. */
+typedef enum bb_render_mode {
+  BB_RENDER_SSBUMP = 0, /* the self-shadowed bump map (needs ssbump) */
+  BB_RENDER_NORMAL,     /* plain normal mapping, no self-shadowing (needs normal) */
+  BB_RENDER_NORMAL_AO   /* normal mapping times ambient occlusion (normal, ao) */
+} bb_render_mode;
+
+/* Parses "ssbump", "normal", "ao"; returns 0 on success. */
+int bb_render_mode_parse(const char *name, bb_render_mode *out);
+
+/* The maps a mode reads, as BB_RENDER_NEEDS_* bits (0 for an unknown mode). */
+#define BB_RENDER_NEEDS_NORMAL 1u
+#define BB_RENDER_NEEDS_SSBUMP 2u
+#define BB_RENDER_NEEDS_AO 4u
+unsigned bb_render_mode_needs(bb_render_mode mode);
+/* The name bb_render_mode_parse accepts; "unknown" for other values. */
+const char *bb_render_mode_name(bb_render_mode mode);
+
+/* Unit direction towards a light at azimuth and elevation in degrees, in the
+ * tangent frame (+Y down): azimuth 0 = from the right (+x), 90 = from the
+ * top of the image (-y), 180 = from the left, 270 = from the bottom,
+ * counter-clockwise as seen on screen; elevation 0 = grazing, 90 = overhead.
+ * dir = (cos(el) cos(az), -cos(el) sin(az), sin(el)), exact at multiples of
+ * 90 degrees. */
+void bb_light_direction(double azimuth_degrees, double elevation_degrees, double dir[3]);
+
+/* The maps a render reads; all of the same width and height. Pointers not
+ * needed by the mode may be NULL. Images may have more channels than used:
+ * channels past the first 3 (1 for ao) are ignored (a height2ssbump TGA
+ * keeps the height in alpha). */
+typedef struct bb_render_maps {
+  const bb_image *normal; /* unit N, >= 3 channels, +Y down */
+  const bb_image *ssbump; /* s_c, >= 3 channels */
+  const bb_image *ao;     /* ao in channel 0 */
+  const bb_image *bent;   /* Nb, >= 3 channels; NULL: computed from ssbump */
+  const bb_image *albedo; /* NULL = white; 1 channel = grey, >= 3 = RGB */
+} bb_render_maps;
+
+typedef struct bb_render_options {
+  bb_render_mode mode;          /* default BB_RENDER_SSBUMP */
+  int dynamic_light;            /* 1: the dynamic light is on (default 1) */
+  double light_azimuth;         /* degrees, any finite value (default 135) */
+  double light_elevation;       /* degrees, 0..90 (default 45) */
+  float light_color[3];         /* C, >= 0 (default 1, 1, 1) */
+  int static_light;             /* 1: the lightmaps are on (default 0) */
+  float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
+                                   three basis directions in three colours */
+  double specular_exponent;     /* k > 0, or 0 = no specular (default 0) */
+  int albedo_mod2x;             /* 1: multiply by 2 * albedo (Source's mod2x
+                                   detail: 0.5 is neutral); default 0 */
+  int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
+  int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
+                                   texels; crop_width 0 = no crop */
+  int threads;                  /* 0 = all cores; results are identical */
+} bb_render_options;
+
+void bb_render_options_init(bb_render_options *o);
+
+/* Renders maps by o into out (allocated: 3 channels, linear values, 1 =
+ * white, not clamped), then tiles and crops it as o says. Bit-identical for
+ * any thread count. Errors: BB_ERR_ARGUMENT (missing map for the mode, too
+ * few channels, maps of different sizes, option out of range: the message
+ * says which), BB_ERR_SIZE, BB_ERR_MEMORY. */
+bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
+                    bb_error *err);
+
+/* "key=value" lines of every option of o that affects pixels (render_mode,
+ * light, light_color, lightmap, specular, albedo_mod2x, tile, crop), for
+ * provenance; malloc'd, the caller frees it. NULL when out of memory. */
+char *bb_render_options_describe(const bb_render_options *o);
+
+/* Decodes a normal map as read by bb_image_read: integer files
+ * (is_float = 0) hold 0.5 + 0.5 N, so N = 2 v - 1; float files hold N.
+ * green_up = 1 flips y (an OpenGL-style map). Each N is renormalised (8-bit
+ * codes are not unit length); a zero vector becomes (0, 0, 1). out gets 3
+ * channels; img needs >= 3. */
+bb_status bb_normals_decode(const bb_image *img, int is_float, int green_up, bb_image *out,
+                            bb_error *err);
+
+/* ----------------------------------------------------------------- panels */
+
+/* Repeats in nx x ny times (nx, ny >= 1) into out. */
+bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out, bb_error *err);
+
+/* The window (x, y, width, height) of in, which must lie inside it, into out. */
+bb_status bb_image_crop(const bb_image *in, int x, int y, int width, int height,
+                        bb_image *out, bb_error *err);
+
+/* Resamples in to width x height by area averaging (each output texel is the
+ * mean of the input area it covers; enlarging repeats texels). */
+bb_status bb_image_resample(const bb_image *in, int width, int height, bb_image *out,
+                            bb_error *err);
+
+/* A map as it looks in an 8-bit file, as 3-channel RGB in [0, 1]: signed
+ * maps (normals) become 0.5 + 0.5 v, unit maps (v - low) / (high - low);
+ * 1- and 2-channel maps become grey (channel 0), others show their first
+ * three channels. Values are clamped to [0, 1]. */
+bb_status bb_image_to_display(const bb_image *map, bb_range range, float low, float high,
+                              bb_image *rgb, bb_error *err);
+
+/* One picture of a panel grid and the label written under it (may be NULL). */
+typedef struct bb_panel {
+  const bb_image *image; /* 3-channel RGB in [0, 1] (bb_image_to_display) */
+  const char *label;
+} bb_panel;
+
+typedef struct bb_panel_layout {
+  int columns;        /* panels per row, >= 1 (default 4) */
+  int panel_width;    /* texels; each panel is resampled to this width keeping its
+                         aspect; 0 = the widest panel's width (default 0) */
+  int gap;            /* texels between panels and around the grid (default 8) */
+  int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
+                         panel width, 12..48 (default 0) */
+  const char *font;   /* font file or name; NULL = look one up (default NULL) */
+} bb_panel_layout;
+
+void bb_panel_layout_init(bb_panel_layout *l);
+
+/* Lays out count panels in a grid on a dark background, each labelled
+ * underneath through OpenImageIO's text rendering. Labels need a font: the
+ * layout's, else $BUMPBAKE_FONT when set (empty: none), else the first of
+ * DejaVu Sans, Liberation Sans, FreeSans, Noto Sans that OpenImageIO finds.
+ * With no usable font the grid is drawn without label rows. *labels_drawn
+ * (may be NULL) receives 1 when labels were drawn, 0 otherwise. out gets 3
+ * channels. */
+bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
+                            bb_image *out, int *labels_drawn, bb_error *err);
+
+/* The paper's comparison: four renders side by side, labelled "normal-mapped",
+ * "ssbump", "ssbump + specular" and "ao" (modes normal, ssbump, ssbump with
+ * the specular exponent of o or 32 when o has none, ao), each by o
+ * otherwise (o->mode is not used). maps needs normal, ssbump and ao. */
+bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
+                            const bb_panel_layout *l, bb_image *out, int *labels_drawn,
+                            bb_error *err);
+
+/* The exponent bb_render_compare uses when o->specular_exponent is 0. */
+#define BB_COMPARE_SPECULAR_EXPONENT 32.0
+
+/* ------------------------------------------------------------------ sheet */
+
+typedef struct bb_sheet_options {
+  bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
+  bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
+} bb_sheet_options;
+
+void bb_sheet_options_init(bb_sheet_options *o);
+
+/* A contact sheet of one bake: height and filtered height (grey, stretched
+ * over the height's range), normal, weights, ssbump, ao, bent normal, and
+ * the ssbump lit by o->lit; labelled as bb_panels_compose does. height is
+ * the bake's input; r a traced bake with normal_y_up = 0. */
+bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
+                        const bb_sheet_options *o, bb_image *out, int *labels_drawn,
+                        bb_error *err);
+
+/* -------------------------------------------------------------- animation */
+
+/* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
+ * channel, a palette per frame). Frames go to a temporary file in the
+ * destination directory; bb_animation_close checks it and renames it into
+ * place, so a failure leaves no partial file. GIF stores no provenance. */
+typedef struct bb_animation bb_animation;
+
+/* Starts path (extension .gif) for frames of width x height, shown at
+ * frames_per_second (1..100). Errors: BB_ERR_FORMAT (not .gif), BB_ERR_IO. */
+bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
+                            bb_animation **out, bb_error *err);
+
+/* Appends a frame: 3 channels, the open size, values in [0, 1]. On failure
+ * the animation stays open; bb_animation_abort it. */
+bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err);
+
+/* Finishes the file, reads it back to check its frame count, renames it into
+ * place and frees a, also on failure (then no file is left). */
+bb_status bb_animation_close(bb_animation *a, bb_error *err);
+
+/* Removes the temporary file and frees a; safe on NULL. */
+void bb_animation_abort(bb_animation *a);
+
+/* Number of subimages (frames) in an image file. */
+bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
 
 #ifdef __cplusplus
 }

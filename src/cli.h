@@ -14,5 +14,7 @@ int bb_cli_height2ssbump(int argc, char **argv);
 int bb_cli_compare(int argc, char **argv);
 int bb_cli_info(int argc, char **argv);
 int bb_cli_renderbumpflat(int argc, char **argv);
+int bb_cli_render(int argc, char **argv);
+int bb_cli_sheet(int argc, char **argv);
 
 #endif /* BB_CLI_H */

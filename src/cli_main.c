@@ -20,6 +20,8 @@ static const subcommand subcommands[] = {
     {"compare", bb_cli_compare, "compare two images (statistics, provenance diff)"},
     {"info", bb_cli_info, "print an image's size, format and provenance"},
     {"renderbumpflat", bb_cli_renderbumpflat, "DOOM 3's RenderBumpFlat: a flat sculpt's normal map and height"},
+    {"render", bb_cli_render, "light the maps as Source does (ssbump, normal, ao; orbit)"},
+    {"sheet", bb_cli_sheet, "one labelled contact sheet of every map of a bake"},
 };
 
 enum { SUBCOMMAND_COUNT = sizeof subcommands / sizeof subcommands[0] };

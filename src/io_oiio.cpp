@@ -8,6 +8,8 @@
 // (heights, ssbump, ao), so both directions ask for unassociated alpha.
 #include "internal.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
@@ -18,6 +20,7 @@
 #include <cstring>
 #include <ctime>
 #include <fcntl.h>
+#include <memory>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -378,6 +381,129 @@ bb_status write_image(const char *path, const bb_image *img, const bb_write_opti
   return BB_OK;
 }
 
+// --------------------------------------------------------------------- text
+
+// OIIO records a failed font lookup in its global error queue; read it so a
+// later, unrelated OIIO error message does not carry it along.
+void drop_global_error() { (void)OIIO::geterror(); }
+
+bool text_size_of(const char *text, int size_px, const char *font, OIIO::ROI *roi) {
+  *roi = OIIO::ImageBufAlgo::text_size(text, size_px, font);
+  if (roi->defined()) return true;
+  drop_global_error();
+  return false;
+}
+
+// ---------------------------------------------------------------- animation
+
+bb_status check_gif_path(const char *path, bb_error *err) {
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "animation: path is NULL");
+  if (extension_of(path) != ".gif")
+    return bb__fail(err, BB_ERR_FORMAT, "%s: animations are written as .gif files", path);
+  return BB_OK;
+}
+
+bb_status count_frames(const char *path, int *frames, bb_error *err) {
+  bb_status st = check_readable(path, err);
+  if (st != BB_OK) return st;
+  auto in = ImageInput::open(path);
+  if (!in)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                    one_line(OIIO::geterror()).c_str());
+  int n = 0;
+  while (n < 1000000 && in->seek_subimage(n, 0)) n++;
+  (void)in->geterror(); // seeking past the last subimage records an error
+  *frames = n;
+  return BB_OK;
+}
+
+} // namespace
+
+// The GIF being written: OIIO's writer holds the temporary file open; the
+// final name appears only once bb_animation_close has checked the file.
+struct bb_animation {
+  std::string path, tmp;
+  std::unique_ptr<ImageOutput> out;
+  ImageSpec spec;
+  int frames = 0;
+};
+
+namespace {
+
+void animation_destroy(bb_animation *a, bool remove_tmp) {
+  if (!a) return;
+  try {
+    if (a->out) a->out->close();
+  } catch (...) {
+  }
+  if (remove_tmp && !a->tmp.empty()) unlink(a->tmp.c_str());
+  delete a;
+}
+
+bb_status animation_open(const char *path, int width, int height, double fps,
+                         bb_animation **out, bb_error *err) {
+  bb_status st = check_gif_path(path, err);
+  if (st != BB_OK) return st;
+  if (width <= 0 || height <= 0 || width > 65535 || height > 65535)
+    return bb__fail(err, BB_ERR_SIZE, "%s: a GIF frame cannot be %dx%d", path, width, height);
+  if (!(fps >= 1.0 && fps <= 100.0))
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: frames per second must be in 1..100 (got %g)",
+                    path, fps);
+  std::unique_ptr<bb_animation> a(new bb_animation);
+  a->path = path;
+  a->tmp = create_temp_file(directory_of(path), ".gif");
+  if (a->tmp.empty())
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
+  a->out = ImageOutput::create(a->tmp);
+  if (!a->out) {
+    std::string why = one_line(OIIO::geterror());
+    unlink(a->tmp.c_str());
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  a->spec = ImageSpec(width, height, 3, TypeDesc::UINT8);
+  // GIF delays are in 1/100 s: a rational of 100 / delay is what OIIO reads.
+  int per_second[2] = {100, (int)std::lround(100.0 / fps)};
+  a->spec.attribute("FramesPerSecond", OIIO::TypeRational, per_second);
+  a->spec.attribute("gif:LoopCount", 0); // loop forever
+  *out = a.release();
+  return BB_OK;
+}
+
+bb_status animation_add(bb_animation *a, const bb_image *frame, bb_error *err) {
+  const char *path = a->path.c_str();
+  if (!frame || !frame->pixels || frame->channels != 3 || frame->width != a->spec.width ||
+      frame->height != a->spec.height)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: frames must be 3-channel %dx%d images", path,
+                    a->spec.width, a->spec.height);
+  ImageOutput::OpenMode mode = a->frames == 0 ? ImageOutput::Create : ImageOutput::AppendSubimage;
+  std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(frame, BB_RANGE_UNIT);
+  if (!a->out->open(a->tmp, a->spec, mode) || !a->out->write_image(TypeDesc::UINT8, codes.data()))
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path,
+                    one_line(a->out->geterror()).c_str());
+  a->frames++;
+  return BB_OK;
+}
+
+// OIIO 2.4's GIF writer does not report a failed fwrite, so the finished
+// temporary file is read back: a short file has fewer frames or none.
+bb_status animation_close(bb_animation *a, bb_error *err) {
+  const char *path = a->path.c_str();
+  if (a->frames == 0) return bb__fail(err, BB_ERR_ARGUMENT, "%s: no frames to write", path);
+  bool closed = a->out->close();
+  std::string why = a->out->geterror();
+  a->out.reset();
+  if (!closed) return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(why).c_str());
+  int frames = 0;
+  bb_error read_err;
+  if (count_frames(a->tmp.c_str(), &frames, &read_err) != BB_OK || frames != a->frames)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: the file holds %d of %d frames", path,
+                    frames, a->frames);
+  if (std::rename(a->tmp.c_str(), path) != 0)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
+  a->tmp.clear(); // renamed: nothing to remove
+  return BB_OK;
+}
+
 } // namespace
 
 extern "C" {
@@ -442,5 +568,100 @@ int bb_path_is_writable_format(const char *path) {
     return 0;
   }
 }
+
+int bb__font_usable(const char *font) {
+  if (!font || !font[0]) return 0;
+  try {
+    OIIO::ROI roi;
+    return text_size_of("Ag", 16, font, &roi) ? 1 : 0;
+  } catch (...) {
+    return 0;
+  }
+}
+
+int bb__text_width(const char *text, int size_px, const char *font) {
+  if (!text || !font) return -1;
+  try {
+    OIIO::ROI roi;
+    return text_size_of(text, size_px, font, &roi) ? roi.width() : -1;
+  } catch (...) {
+    return -1;
+  }
+}
+
+bb_status bb__text_draw(bb_image *img, int center_x, int baseline_y, const char *text,
+                        int size_px, const float color[3], const char *font, bb_error *err) {
+  if (!img || !img->pixels || img->channels != 3 || !text || !font || !color)
+    return bb__fail(err, BB_ERR_ARGUMENT, "text: bad arguments");
+  try {
+    // The ImageBuf wraps img's own pixels: OIIO draws straight into them.
+    ImageSpec spec(img->width, img->height, 3, TypeDesc::FLOAT);
+    OIIO::ImageBuf buf(spec, img->pixels);
+    bool ok = OIIO::ImageBufAlgo::render_text(
+        buf, center_x, baseline_y, text, size_px, font, OIIO::cspan<float>(color, 3),
+        OIIO::ImageBufAlgo::TextAlignX::Center, OIIO::ImageBufAlgo::TextAlignY::Baseline, 0,
+        OIIO::ROI(), 1);
+    if (!ok) {
+      std::string why = buf.geterror();
+      drop_global_error();
+      return bb__fail(err, BB_ERR_FORMAT, "text: cannot draw '%s' with font %s: %s", text,
+                      font, one_line(why).c_str());
+    }
+    return BB_OK;
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "text: out of memory");
+  } catch (...) {
+    return bb__fail(err, BB_ERR_FORMAT, "text: cannot draw '%s'", text);
+  }
+}
+
+bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
+                            bb_animation **out, bb_error *err) {
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_open: out is NULL");
+  *out = nullptr;
+  try {
+    return animation_open(path, width, height, frames_per_second, out, err);
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path ? path : "animation");
+  } catch (...) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path ? path : "animation");
+  }
+}
+
+bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err) {
+  if (!a || !a->out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_add_frame: not open");
+  try {
+    return animation_add(a, frame, err);
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", a->path.c_str());
+  } catch (...) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", a->path.c_str());
+  }
+}
+
+bb_status bb_animation_close(bb_animation *a, bb_error *err) {
+  if (!a) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_close: NULL animation");
+  bb_status st;
+  try {
+    st = animation_close(a, err);
+  } catch (...) {
+    st = bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", a->path.c_str());
+  }
+  animation_destroy(a, true);
+  return st;
+}
+
+void bb_animation_abort(bb_animation *a) { animation_destroy(a, true); }
+
+bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err) {
+  if (!path || !frames) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_frame_count: NULL argument");
+  *frames = 0;
+  try {
+    return count_frames(path, frames, err);
+  } catch (...) {
+    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+}
+
 
 } // extern "C"
