@@ -1,0 +1,144 @@
+/* cli_harness.h: running the bumpbake binary from a Criterion test (fork +
+ * exec, stdout and stderr captured) and a temporary directory per test.
+ * Header-only: each test file that runs the CLI includes it once. */
+#ifndef BB_CLI_HARNESS_H
+#define BB_CLI_HARNESS_H
+
+#include <criterion/criterion.h>
+
+#include <dirent.h>
+#include <ftw.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct cli_result {
+  int code;  /* exit code, or 128 + signal when it crashed */
+  char *out; /* all of stdout, NUL-terminated */
+  char *err; /* all of stderr */
+} cli_result;
+
+static inline void cli_result_free(cli_result *r) {
+  free(r->out);
+  free(r->err);
+  memset(r, 0, sizeof *r);
+}
+
+static inline char *harness_slurp(FILE *f) {
+  fflush(f);
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  cr_assert(n >= 0);
+  char *buf = malloc((size_t)n + 1);
+  cr_assert_not_null(buf);
+  rewind(f);
+  size_t got = fread(buf, 1, (size_t)n, f);
+  buf[got] = '\0';
+  return buf;
+}
+
+/* Absolute path of the binary (BB_BIN, default build/bumpbake). */
+static inline const char *harness_binary(void) {
+  static char path[4096];
+  if (!path[0]) {
+    const char *bin = getenv("BB_BIN");
+    cr_assert(realpath(bin && *bin ? bin : "build/bumpbake", path) != NULL, "BB_BIN not found");
+  }
+  return path;
+}
+
+/* Runs bumpbake with args (NULL-terminated, without argv[0]); no shell. */
+static inline cli_result harness_run(const char *const *args) {
+  const char *argv[64] = {"bumpbake"};
+  for (int i = 0; args[i]; i++) {
+    cr_assert_lt(i, 62, "too many arguments");
+    argv[i + 1] = args[i];
+  }
+  const char *binary = harness_binary();
+  FILE *out = tmpfile(), *err = tmpfile();
+  cr_assert(out && err);
+  fflush(NULL);
+  pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    dup2(fileno(out), STDOUT_FILENO);
+    dup2(fileno(err), STDERR_FILENO);
+    execv(binary, (char *const *)argv);
+    _exit(127);
+  }
+  int status = 0;
+  cr_assert(waitpid(pid, &status, 0) == pid);
+  cli_result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = harness_slurp(out);
+  r.err = harness_slurp(err);
+  fclose(out);
+  fclose(err);
+  return r;
+}
+
+#define RUN(...) harness_run((const char *const[]){__VA_ARGS__, NULL})
+
+static inline int harness_lines(const char *s) {
+  int n = 0;
+  for (; *s; s++)
+    n += *s == '\n';
+  return n;
+}
+
+/* ------------------------------------------------- temporary directory */
+
+static char harness_dir[64];
+static char *harness_paths[256];
+static int harness_path_count;
+
+static inline int harness_remove(const char *path, const struct stat *st, int flag,
+                                 struct FTW *ftw) {
+  (void)st, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+static inline void harness_setup(void) {
+  snprintf(harness_dir, sizeof harness_dir, "/tmp/bb_cli_XXXXXX");
+  cr_assert_not_null(mkdtemp(harness_dir));
+}
+
+static inline void harness_teardown(void) {
+  if (harness_dir[0])
+    nftw(harness_dir, harness_remove, 16, FTW_DEPTH | FTW_PHYS);
+  harness_dir[0] = '\0';
+  while (harness_path_count > 0)
+    free(harness_paths[--harness_path_count]);
+}
+
+/* Path of name inside the test's directory, valid until the test ends. */
+static inline const char *tmp(const char *name) {
+  cr_assert_lt(harness_path_count, 256);
+  size_t len = strlen(harness_dir) + strlen(name) + 2;
+  char *path = malloc(len);
+  cr_assert_not_null(path);
+  snprintf(path, len, "%s/%s", harness_dir, name);
+  return harness_paths[harness_path_count++] = path;
+}
+
+static inline int file_exists(const char *path) {
+  struct stat st;
+  return stat(path, &st) == 0;
+}
+
+/* Number of files in the test's directory whose name starts with prefix
+ * (temporary ".bb-tmp-" files included when prefix asks for them). */
+static inline int files_starting_with(const char *prefix) {
+  DIR *d = opendir(harness_dir);
+  cr_assert_not_null(d);
+  int n = 0;
+  for (struct dirent *e; (e = readdir(d));)
+    n += strncmp(e->d_name, prefix, strlen(prefix)) == 0;
+  closedir(d);
+  return n;
+}
+
+#endif /* BB_CLI_HARNESS_H */
