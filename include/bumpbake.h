@@ -675,7 +675,8 @@ typedef struct bb_panel_layout {
                          aspect; 0 = the widest panel's width (default 0) */
   int gap;            /* texels between panels and around the grid (default 8) */
   int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
-                         panel width, 12..48 (default 0) */
+                         panel width, 12..48 (default 0). Made smaller, down to 6,
+                         until the widest label fits a panel */
   const char *font;   /* font file or name; NULL = look one up (default NULL) */
 } bb_panel_layout;
 
@@ -693,14 +694,14 @@ bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_la
 
 /* The paper's comparison: four renders side by side, labelled "normal-mapped",
  * "ssbump", "ssbump + specular" and "ao" (modes normal, ssbump, ssbump with
- * the specular exponent of o or 32 when o has none, ao), each by o
+ * the specular exponent of o or 64 when o has none, ao), each by o
  * otherwise (o->mode is not used). maps needs normal, ssbump and ao. */
 bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
                             const bb_panel_layout *l, bb_image *out, int *labels_drawn,
                             bb_error *err);
 
 /* The exponent bb_render_compare uses when o->specular_exponent is 0. */
-#define BB_COMPARE_SPECULAR_EXPONENT 32.0
+#define BB_COMPARE_SPECULAR_EXPONENT 64.0
 
 /* ------------------------------------------------------------------ sheet */
 

@@ -271,8 +271,21 @@ static int any_label(const bb_panel *panels, int count) {
   return 0;
 }
 
+/* One size for every label: the planned one, made smaller until the widest
+ * label fits its cell (6 pixels at least); the strip follows it. */
+static void fit_labels(const bb_panel *panels, int count, const char *font, grid *g) {
+  for (int i = 0; i < count; i++) {
+    const char *label = panels[i].label;
+    if (!label || !label[0])
+      continue;
+    while (g->font_size > 6 && bb__text_width(label, g->font_size, font) > g->cell_width)
+      g->font_size--;
+  }
+  g->label_height = (g->font_size * 7 + 3) / 4;
+}
+
 static bb_status grid_plan(const bb_panel *panels, int count, const bb_panel_layout *l,
-                           int labelled, grid *g, bb_error *err) {
+                           int labelled, const char *font, grid *g, bb_error *err) {
   memset(g, 0, sizeof *g);
   g->columns = l->columns < count ? l->columns : count;
   g->rows = (count + g->columns - 1) / g->columns;
@@ -292,7 +305,9 @@ static bb_status grid_plan(const bb_panel *panels, int count, const bb_panel_lay
     g->font_size = g->cell_width / 16;
     g->font_size = g->font_size < 12 ? 12 : (g->font_size > 48 ? 48 : g->font_size);
   }
-  g->label_height = labelled ? (g->font_size * 7 + 3) / 4 : 0;
+  g->label_height = 0;
+  if (labelled)
+    fit_labels(panels, count, font, g);
   long w = g->gap + (long)g->columns * (g->cell_width + g->gap);
   long h = g->gap + (long)g->rows * (g->cell_height + g->label_height + g->gap);
   if (w > BB_MAX_DIMENSION || h > BB_MAX_DIMENSION)
@@ -320,20 +335,17 @@ static bb_status paste_panel(const bb_image *panel, const grid *g, int x, int y,
   return BB_OK;
 }
 
-/* Draws label centred under a cell, shrinking the font until it fits. */
+/* Draws label centred under a cell. */
 static bb_status draw_label(const char *label, const grid *g, const char *font, int x, int y,
                             bb_image *out, bb_error *err) {
   if (!label || !label[0])
     return BB_OK;
-  int size = g->font_size;
-  while (size > 6 && bb__text_width(label, size, font) > g->cell_width)
-    size--;
   const float grey[3] = {LABEL_GREY, LABEL_GREY, LABEL_GREY};
   /* The strip is 1.75 font sizes tall; a baseline 2/3 down centres a line's
    * ascent (~0.75 size) and descent (~0.25) in it. */
   return bb__text_draw(out, x + g->cell_width / 2,
-                       y + g->cell_height + (2 * g->label_height) / 3, label, size, grey, font,
-                       err);
+                       y + g->cell_height + (2 * g->label_height) / 3, label, g->font_size,
+                       grey, font, err);
 }
 
 bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
@@ -349,7 +361,7 @@ bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_la
   char font[1024];
   const int labelled = any_label(panels, count) && find_font(l->font, font, sizeof font);
   grid g;
-  st = grid_plan(panels, count, l, labelled, &g, err);
+  st = grid_plan(panels, count, l, labelled, font, &g, err);
   if (st == BB_OK)
     st = bb_image_alloc(out, g.gap + g.columns * (g.cell_width + g.gap),
                         g.gap + g.rows * (g.cell_height + g.label_height + g.gap), 3, err);

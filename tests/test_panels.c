@@ -131,6 +131,17 @@ static void assert_grid(const bb_image *out, int columns, int rows, int cell_w, 
   cr_assert_eq(out->height, gap + rows * (cell_h + label_h + gap));
 }
 
+/* The label strip of a labelled grid, from its height: 1.75 font sizes for
+ * a font of 6..max_font pixels (labels shrink to fit narrow panels). */
+static int label_strip(const bb_image *out, int rows, int cell_h, int gap, int max_font) {
+  int strip = (out->height - gap - rows * (cell_h + gap)) / rows;
+  int found = 0;
+  for (int size = 6; size <= max_font; size++)
+    found |= strip == (size * 7 + 3) / 4;
+  cr_assert(found, "a %d-pixel label strip fits no font of 6..%d pixels", strip, max_font);
+  return strip;
+}
+
 /* Largest channel value in a window, to find drawn text. */
 static float window_max(const bb_image *img, int x0, int y0, int w, int h) {
   float m = 0;
@@ -142,12 +153,12 @@ static float window_max(const bb_image *img, int x0, int y0, int w, int h) {
 }
 
 Test(panels, compose_with_labels) {
-  bb_image a = filled(20, 10, 1, 0, 0), b = filled(40, 20, 0, 1, 0), c = filled(20, 20, 0, 0, 1);
+  bb_image a = filled(32, 16, 1, 0, 0), b = filled(128, 64, 0, 1, 0), c = filled(64, 64, 0, 0, 1);
   bb_panel p[3] = {{&a, "red"}, {&b, "green"}, {&c, NULL}};
   bb_panel_layout l;
   bb_panel_layout_init(&l);
   l.columns = 2;
-  l.panel_width = 20;
+  l.panel_width = 64;
   l.gap = 4;
   l.font_size = 12;
   bb_image out;
@@ -155,22 +166,27 @@ Test(panels, compose_with_labels) {
   bb_error err = {{0}};
   cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s", err.message);
   cr_assert_eq(labels, 1, "fonts-dejavu-core is a build dependency");
-  const int label_h = (12 * 7 + 3) / 4;
-  assert_grid(&out, 2, 2, 20, 20, label_h, 4);
-  /* Panel a at (4, 4), 20 x 10 (top-aligned in a 20-high cell); b resampled
-   * to 20 x 10 at (28, 4); c at (4, 4 + 20 + label_h + 4). */
+  const int label_h = (12 * 7 + 3) / 4; /* both labels fit 64 pixels at 12 */
+  assert_grid(&out, 2, 2, 64, 64, label_h, 4);
+  /* Panel a enlarged to 64 x 32 at (4, 4), top-aligned in its 64-high cell;
+   * b reduced to 64 x 32 at (72, 4); c at (4, 4 + 64 + label_h + 4). */
   cr_assert_eq(bb_image_texel(&out, 4, 4)[0], 1.0f);
-  cr_assert_eq(bb_image_texel(&out, 23, 13)[0], 1.0f);
-  cr_assert_eq(bb_image_texel(&out, 4, 14)[0], 0.12f, "below a short panel: background");
-  cr_assert_eq(bb_image_texel(&out, 28, 4)[1], 1.0f);
-  cr_assert_eq(bb_image_texel(&out, 47, 13)[1], 1.0f);
-  cr_assert_eq(bb_image_texel(&out, 4, 28 + label_h)[2], 1.0f);
+  cr_assert_eq(bb_image_texel(&out, 67, 35)[0], 1.0f);
+  cr_assert_eq(bb_image_texel(&out, 4, 36)[0], 0.12f, "below a short panel: background");
+  cr_assert_eq(bb_image_texel(&out, 72, 4)[1], 1.0f);
+  cr_assert_eq(bb_image_texel(&out, 135, 35)[1], 1.0f);
+  cr_assert_eq(bb_image_texel(&out, 4, 72 + label_h)[2], 1.0f);
   cr_assert_eq(bb_image_texel(&out, 2, 2)[0], 0.12f, "the gap is background");
   /* Labels are light text in the strip under each labelled panel. */
-  cr_assert_gt(window_max(&out, 4, 24, 20, label_h), 0.5f, "a label is drawn under 'red'");
-  cr_assert_gt(window_max(&out, 28, 24, 20, label_h), 0.5f);
-  cr_assert_lt(window_max(&out, 4, 48 + label_h, 20, label_h), 0.13f,
+  cr_assert_gt(window_max(&out, 4, 68, 64, label_h), 0.5f, "a label is drawn under 'red'");
+  cr_assert_gt(window_max(&out, 72, 68, 64, label_h), 0.5f);
+  cr_assert_lt(window_max(&out, 4, 136 + label_h, 64, label_h), 0.13f,
                "no label under an unlabelled panel");
+  bb_image_free(&out);
+  /* Narrow panels: one smaller size for every label, a thinner strip. */
+  l.panel_width = 16;
+  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s", err.message);
+  cr_assert_lt(label_strip(&out, 2, 16, 4, 12), label_h, "'green' does not fit 16 at 12");
   bb_image_free(&out);
   bb_image_free(&a);
   bb_image_free(&b);
@@ -179,7 +195,7 @@ Test(panels, compose_with_labels) {
 
 /* With no usable font the grid loses its label strips and says so. */
 Test(panels, compose_without_a_font) {
-  bb_image a = filled(16, 16, 0.5f, 0.5f, 0.5f);
+  bb_image a = filled(48, 16, 0.5f, 0.5f, 0.5f);
   bb_panel p[2] = {{&a, "one"}, {&a, "two"}};
   bb_panel_layout l;
   bb_panel_layout_init(&l);
@@ -189,7 +205,7 @@ Test(panels, compose_without_a_font) {
   cr_assert_eq(setenv("BUMPBAKE_FONT", "/nonexistent/font.ttf", 1), 0);
   cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 0);
-  assert_grid(&out, 2, 1, 16, 16, 0, 2);
+  assert_grid(&out, 2, 1, 48, 16, 0, 2);
   bb_image_free(&out);
   cr_assert_eq(setenv("BUMPBAKE_FONT", "", 1), 0);
   cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
@@ -198,7 +214,7 @@ Test(panels, compose_without_a_font) {
   unsetenv("BUMPBAKE_FONT");
   cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 1);
-  assert_grid(&out, 2, 1, 16, 16, (12 * 7 + 3) / 4, 2);
+  assert_grid(&out, 2, 1, 48, 16, (12 * 7 + 3) / 4, 2);
   bb_image_free(&out);
   bb_image_free(&a);
 }
@@ -238,7 +254,7 @@ Test(panels, compare_is_four_renders) {
   int labels = 0;
   cr_assert_eq(bb_render_compare(&m, &o, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 1);
-  assert_grid(&out, 4, 1, 24, 20, (12 * 7 + 3) / 4, 8);
+  assert_grid(&out, 4, 1, 24, 20, label_strip(&out, 1, 20, 8, 12), 8);
   const bb_render_mode modes[4] = {BB_RENDER_NORMAL, BB_RENDER_SSBUMP, BB_RENDER_SSBUMP,
                                    BB_RENDER_NORMAL_AO};
   for (int i = 0; i < 4; i++) {
