@@ -100,7 +100,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python bench goldens install uninstall clean format FORCE
+        check-python bench goldens docs install uninstall clean format FORCE
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
@@ -241,6 +241,11 @@ check-python: $(BIN) lib
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# The README's pictures (docs/*.png, committed); never part of `make test`.
+docs: ensure-deps
+	@$(MAKE) --no-print-directory all
+	@./tools/docs.sh $(BIN)
 
 goldens: ensure-deps
 	@$(MAKE) --no-print-directory all

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # demo.sh BIN: bakes the rock fixture at scale 64 into out/ (normal, ssbump,
 # ao and bent normal as PNG), then renders the rivet panel sculpt's normal
-# map and height and bakes ssbump and ao from that height; says what it
-# wrote. Exits non-zero on failure.
+# map and height and bakes ssbump and ao from that height, and ends by
+# lighting the rock: the paper's comparison from its maps and a contact sheet.
+# Says what it wrote. Exits non-zero on failure.
 set -euo pipefail
 
 bin=${1:?usage: tools/demo.sh path/to/bumpbake}
@@ -49,3 +50,12 @@ fi
 ms=$((($(date +%s%N) - start) / 1000000))
 printf 'demo: done in %d.%03d s; look at out/rivet_panel_local.tga and out/rivet_panel_ssbump.png\n' \
   $((ms / 1000)) $((ms % 1000))
+
+# The rock lit: the paper's four panels from the maps baked above (no second
+# bake), a low light from the right, on a 512 x 512 window; then the contact
+# sheet of every map (this one bakes again).
+"$bin" render --normal out/rock06_normal.png --ssbump out/rock06_ssbump.png \
+  --ao out/rock06_ao.png --bent out/rock06_bent.png \
+  --compare --light 0,20 --crop 256,512,512,512 -o out/rock06_compare.png
+"$bin" sheet "$input" --scale 64 -o out/rock06_sheet.png
+echo "demo: look at out/rock06_compare.png and out/rock06_sheet.png"
