@@ -14,10 +14,10 @@
 enum { MAP_NORMAL, MAP_SSBUMP, MAP_AO, MAP_BENT, MAP_COUNT };
 
 static const struct {
-  const char *name;     /* option name and provenance key */
-  unsigned need;        /* BB_RENDER_NEEDS_* bit, 0 for optional maps */
-  int channels;         /* at least */
-  int is_vector;        /* decoded as a normal map */
+  const char *name; /* option name and provenance key */
+  unsigned need;    /* BB_RENDER_NEEDS_* bit, 0 for optional maps */
+  int channels;     /* at least */
+  int is_vector;    /* decoded as a normal map */
   const char *channels_why;
 } map_kinds[MAP_COUNT] = {
     {"normal", BB_RENDER_NEEDS_NORMAL, 3, 1, "X, Y, Z"},
@@ -34,17 +34,18 @@ static const cli_option opt_in_normal = {
 static const cli_option opt_in_ssbump = {.id = CLI_RENDER_OPT_IN_SSBUMP,
                                          .long_name = "ssbump",
                                          .value_name = "FILE",
-                                         .help = "baked ssbump to light (instead of HEIGHT)"};
+                                         .help =
+                                             "baked ssbump to light (instead of HEIGHT)"};
 static const cli_option opt_in_ao = {.id = CLI_RENDER_OPT_IN_AO,
                                      .long_name = "ao",
                                      .value_name = "FILE",
-                                     .help = "baked ambient occlusion (instead of HEIGHT)"};
-static const cli_option opt_in_bent = {
-    .id = CLI_RENDER_OPT_IN_BENT,
-    .long_name = "bent",
-    .value_name = "FILE",
-    .default_text = "from the ssbump",
-    .help = "baked bent normal for the specular"};
+                                     .help =
+                                         "baked ambient occlusion (instead of HEIGHT)"};
+static const cli_option opt_in_bent = {.id = CLI_RENDER_OPT_IN_BENT,
+                                       .long_name = "bent",
+                                       .value_name = "FILE",
+                                       .default_text = "from the ssbump",
+                                       .help = "baked bent normal for the specular"};
 static const cli_option opt_albedo = {
     .id = CLI_RENDER_OPT_ALBEDO,
     .long_name = "albedo",
@@ -55,7 +56,8 @@ static const cli_option opt_mod2x = {
     .id = CLI_RENDER_OPT_MOD2X,
     .long_name = "mod2x",
     .default_text = "off",
-    .help = "multiply by 2 x albedo, Source's mod2x (0.5 is neutral: a -d detail ssbump)"};
+    .help =
+        "multiply by 2 x albedo, Source's mod2x (0.5 is neutral: a -d detail ssbump)"};
 static const cli_option opt_compare = {
     .id = CLI_RENDER_OPT_COMPARE,
     .long_name = "compare",
@@ -150,7 +152,8 @@ static int parse_crop(render_args *a, const char *arg) {
   }
   if (n < 4 || v[2] == 0 || v[3] == 0)
     return cli_usage_error(render_command.name,
-                           "--crop needs X,Y,W,H: integers >= 0, W and H > 0 (got '%s')", arg);
+                           "--crop needs X,Y,W,H: integers >= 0, W and H > 0 (got '%s')",
+                           arg);
   a->render.crop_x = v[0];
   a->render.crop_y = v[1];
   a->render.crop_width = v[2];
@@ -218,8 +221,9 @@ static int check_inputs(const render_args *a) {
   for (int m = 0; m < MAP_COUNT; m++)
     any_map |= a->map_paths[m] != NULL;
   if (a->height_path && any_map)
-    return cli_usage_error(cmd, "give a HEIGHT to bake or baked maps (--normal, --ssbump, "
-                                "--ao, --bent), not both");
+    return cli_usage_error(cmd,
+                           "give a HEIGHT to bake or baked maps (--normal, --ssbump, "
+                           "--ao, --bent), not both");
   if (a->height_path) {
     if (!a->settings.scale_given)
       return cli_usage_error(cmd, "--scale is required with a HEIGHT (texels of "
@@ -227,12 +231,13 @@ static int check_inputs(const render_args *a) {
     return 0;
   }
   if (!any_map)
-    return cli_usage_error(cmd, "missing HEIGHT or baked maps (usage: bumpbake %s %s)", cmd,
-                           render_command.synopsis);
+    return cli_usage_error(cmd, "missing HEIGHT or baked maps (usage: bumpbake %s %s)",
+                           cmd, render_command.synopsis);
   for (int m = 0; m < MAP_COUNT; m++)
     if ((needed_maps(a) & map_kinds[m].need) && !a->map_paths[m])
       return cli_usage_error(cmd, "%s needs --%s FILE (or a HEIGHT to bake)",
-                             a->compare ? "--compare" : bb_render_mode_name(a->render.mode),
+                             a->compare ? "--compare"
+                                        : bb_render_mode_name(a->render.mode),
                              map_kinds[m].name);
   return 0;
 }
@@ -282,8 +287,10 @@ static int render_parse(int argc, char **argv, render_args *a) {
   if (rc)
     return rc;
   if (argc - first > 1)
-    return cli_usage_error(render_command.name, "unexpected argument '%s' (expected at most "
-                           "one HEIGHT)", argv[first + 1]);
+    return cli_usage_error(render_command.name,
+                           "unexpected argument '%s' (expected at most "
+                           "one HEIGHT)",
+                           argv[first + 1]);
   a->height_path = argc - first == 1 ? argv[first] : NULL;
   /* --normal-y describes input files; a bake on the fly stays +Y down. */
   a->green_up = a->settings.bake.normal_y_up;
@@ -301,8 +308,8 @@ typedef struct render_inputs {
   bb_bake_result bake;
   bb_image maps[MAP_COUNT]; /* read from files */
   bb_image albedo;
-  bb_render_maps view;      /* pointers into the above */
-  char *extra;              /* provenance lines about the inputs, malloc'd */
+  bb_render_maps view; /* pointers into the above */
+  char *extra;         /* provenance lines about the inputs, malloc'd */
 } render_inputs;
 
 static void inputs_free(render_inputs *in) {
@@ -346,8 +353,9 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
   char reason[256];
   if (raw.channels < map_kinds[kind].channels) {
     snprintf(reason, sizeof reason, "%d channel%s; %s %s map needs %d (%s)", raw.channels,
-             raw.channels == 1 ? "" : "s", kind == MAP_AO ? "an" : "a", map_kinds[kind].name,
-             map_kinds[kind].channels, map_kinds[kind].channels_why);
+             raw.channels == 1 ? "" : "s", kind == MAP_AO ? "an" : "a",
+             map_kinds[kind].name, map_kinds[kind].channels,
+             map_kinds[kind].channels_why);
   } else if (*size && (raw.width != (*size)->width || raw.height != (*size)->height)) {
     snprintf(reason, sizeof reason, "%dx%d, but the other maps are %dx%d", raw.width,
              raw.height, (*size)->width, (*size)->height);
@@ -377,11 +385,11 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
 static int check_view(const render_args *a, const bb_image *size) {
   const bb_render_options *o = &a->render;
   long w = (long)size->width * o->tile_x, h = (long)size->height * o->tile_y;
-  if (o->crop_width > 0 && ((long)o->crop_x + o->crop_width > w ||
-                            (long)o->crop_y + o->crop_height > h))
+  if (o->crop_width > 0 &&
+      ((long)o->crop_x + o->crop_width > w || (long)o->crop_y + o->crop_height > h))
     return cli_usage_error(render_command.name,
-                           "--crop %d,%d,%d,%d is not inside the %ldx%ld picture", o->crop_x,
-                           o->crop_y, o->crop_width, o->crop_height, w, h);
+                           "--crop %d,%d,%d,%d is not inside the %ldx%ld picture",
+                           o->crop_x, o->crop_y, o->crop_width, o->crop_height, w, h);
   return 0;
 }
 
@@ -431,8 +439,8 @@ static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
   run->rayset_id = a->settings.bake.want_trace ? in->bake.rayset_id : NULL;
   bb_bake_result *r = &in->bake;
   in->view = (bb_render_maps){&r->normal, r->ssbump.pixels ? &r->ssbump : NULL,
-                              r->ao.pixels ? &r->ao : NULL, r->bent.pixels ? &r->bent : NULL,
-                              NULL};
+                              r->ao.pixels ? &r->ao : NULL,
+                              r->bent.pixels ? &r->bent : NULL, NULL};
   return add_line(in, "render_from", "height");
 }
 
@@ -503,16 +511,17 @@ static char *picture_lines(const render_args *a, const render_inputs *in, double
   return all;
 }
 
-static int write_picture(const render_args *a, const cli_run *run, const render_inputs *in,
-                         double azimuth, int frame, const char *path, const bb_image *img) {
+static int write_picture(const render_args *a, const cli_run *run,
+                         const render_inputs *in, double azimuth, int frame,
+                         const char *path, const bb_image *img) {
   char *extra = picture_lines(a, in, azimuth, frame);
   if (!extra) {
     cli_file_error(path, "out of memory");
     return BB_EXIT_FAILURE;
   }
   const bb_bake_options *bake = a->height_path ? &a->settings.bake : NULL;
-  int rc = cli_render_write(run, bake, extra, a->compare ? "render-compare" : "render", path,
-                            img, a->settings.depth);
+  int rc = cli_render_write(run, bake, extra, a->compare ? "render-compare" : "render",
+                            path, img, a->settings.depth);
   free(extra);
   return rc;
 }
@@ -554,7 +563,8 @@ static int write_frames(const render_args *a, const cli_run *run, const render_i
   for (int f = 0; f < a->orbit && !rc; f++) {
     bb_image picture = {0};
     char *path = frame_path(a->output, f, a->orbit);
-    rc = path ? make_picture(a, in, frame_azimuth(a, f), &picture, labels) : BB_EXIT_FAILURE;
+    rc = path ? make_picture(a, in, frame_azimuth(a, f), &picture, labels)
+              : BB_EXIT_FAILURE;
     if (!rc)
       rc = write_picture(a, run, in, frame_azimuth(a, f), f, path, &picture);
     bb_image_free(&picture);
@@ -566,7 +576,8 @@ static int write_frames(const render_args *a, const cli_run *run, const render_i
     }
   }
   if (!rc && !a->quiet)
-    printf("wrote %d frames %s%s%s\n", a->orbit, first, last ? " .. " : "", last ? last : "");
+    printf("wrote %d frames %s%s%s\n", a->orbit, first, last ? " .. " : "",
+           last ? last : "");
   free(first);
   free(last);
   return rc;

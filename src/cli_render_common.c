@@ -54,8 +54,8 @@ const cli_option cli_render_opt_quiet = {.id = CLI_RENDER_OPT_QUIET,
 
 /* Parses exactly `count` comma-separated finite numbers into out; a usage
  * error names the option. */
-static int parse_numbers(const char *command, const char *option, const char *text, int count,
-                         double *out) {
+static int parse_numbers(const char *command, const char *option, const char *text,
+                         int count, double *out) {
   const char *p = text;
   for (int i = 0; i < count; i++) {
     char *end = NULL;
@@ -117,8 +117,8 @@ int cli_render_apply_lighting(const char *command, bb_render_options *o, int *li
   switch (opt->id) {
   case CLI_RENDER_OPT_MODE:
     if (bb_render_mode_parse(arg, &o->mode))
-      return cli_usage_error(command, "--mode must be one of %s (got '%s')", opt->value_name,
-                             arg);
+      return cli_usage_error(command, "--mode must be one of %s (got '%s')",
+                             opt->value_name, arg);
     return 0;
   case CLI_RENDER_OPT_LIGHT:
     rc = apply_light(command, o, arg);
@@ -170,7 +170,8 @@ static char *describe(const cli_run *run, const bb_bake_options *bake, const cha
 }
 
 int cli_render_write(const cli_run *run, const bb_bake_options *bake, const char *extra,
-                     const char *kind, const char *path, const bb_image *img, bb_depth depth) {
+                     const char *kind, const char *path, const bb_image *img,
+                     bb_depth depth) {
   char *description = describe(run, bake, extra, kind);
   if (!description) {
     cli_file_error(path, "out of memory");

@@ -30,9 +30,9 @@ enum {
 };
 
 /* Rows of the lighting options, shared by both commands' tables. */
-extern const cli_option cli_render_opt_mode, cli_render_opt_light, cli_render_opt_light_color,
-    cli_render_opt_lightmap, cli_render_opt_specular, cli_render_opt_output,
-    cli_render_opt_quiet;
+extern const cli_option cli_render_opt_mode, cli_render_opt_light,
+    cli_render_opt_light_color, cli_render_opt_lightmap, cli_render_opt_specular,
+    cli_render_opt_output, cli_render_opt_quiet;
 
 /* Applies a lighting option (mode, light, light colour, lightmap, specular)
  * to o. Returns 0 when applied, BB_EXIT_USAGE after a usage error, and -1
@@ -46,7 +46,8 @@ int cli_render_apply_lighting(const char *command, bb_render_options *o, int *li
  * the bake options when bake is not NULL, then the lines of extra (may be
  * NULL). Prints the error and returns BB_EXIT_FAILURE on failure. */
 int cli_render_write(const cli_run *run, const bb_bake_options *bake, const char *extra,
-                     const char *kind, const char *path, const bb_image *img, bb_depth depth);
+                     const char *kind, const char *path, const bb_image *img,
+                     bb_depth depth);
 
 /* The note for a picture whose labels could not be drawn. */
 void cli_render_no_font_note(const char *command);

@@ -62,7 +62,8 @@ static int sheet_option(void *ctx, const cli_option *opt, const char *arg) {
     return rc;
   switch (opt->id) {
   case CLI_RENDER_OPT_PANEL_SIZE:
-    return cli_parse_int(cmd, "--panel-size", arg, 16, 4096, &a->sheet.layout.panel_width);
+    return cli_parse_int(cmd, "--panel-size", arg, 16, 4096,
+                         &a->sheet.layout.panel_width);
   case CLI_RENDER_OPT_OUTPUT:
     a->output = arg;
     return 0;
@@ -83,8 +84,9 @@ static int sheet_parse(int argc, char **argv, sheet_args *a, const char **input)
     return rc;
   *input = argv[first];
   if (!a->settings.scale_given)
-    return cli_usage_error(sheet_command.name,
-                           "--scale is required (texels of displacement per unit of height)");
+    return cli_usage_error(
+        sheet_command.name,
+        "--scale is required (texels of displacement per unit of height)");
   if (!a->output)
     return cli_usage_error(sheet_command.name, "-o OUT is required");
   a->sheet.lit.threads = a->settings.bake.trace.threads;
@@ -105,16 +107,16 @@ static int sheet_run(cli_run *run, sheet_args *a, const char *input) {
   int labels = 1;
   if (!rc) {
     bb_error err = {{0}};
-    rc = cli_status_exit(a->output,
-                         bb_sheet_make(&height, &result, &a->sheet, &sheet, &labels, &err),
-                         &err);
+    rc = cli_status_exit(
+        a->output, bb_sheet_make(&height, &result, &a->sheet, &sheet, &labels, &err),
+        &err);
   }
   if (!rc) {
     cli_run_set_input(run, input, &height, &a->settings);
     run->rayset_id = result.rayset_id;
     char *extra = bb_render_options_describe(&a->sheet.lit);
-    rc = extra ? cli_render_write(run, &a->settings.bake, extra, "sheet", a->output, &sheet,
-                                  a->settings.depth)
+    rc = extra ? cli_render_write(run, &a->settings.bake, extra, "sheet", a->output,
+                                  &sheet, a->settings.depth)
                : BB_EXIT_FAILURE;
     if (!extra)
       cli_file_error(a->output, "out of memory");

@@ -15,7 +15,8 @@ static bb_status check_input(const bb_image *in, const bb_image *out, const char
   if (!in || !in->pixels || in->width <= 0 || in->height <= 0 || in->channels <= 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: missing or empty image", what);
   if (in == out)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the output must be a separate image", what);
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the output must be a separate image",
+                    what);
   return BB_OK;
 }
 
@@ -24,15 +25,16 @@ static float *row_of(const bb_image *img, int y) {
   return img->pixels + (size_t)y * (size_t)img->width * (size_t)img->channels;
 }
 
-bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out, bb_error *err) {
+bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out,
+                        bb_error *err) {
   bb_status st = check_input(in, out, "tile", err);
   if (st != BB_OK)
     return st;
   memset(out, 0, sizeof *out);
   if (nx < 1 || ny < 1 || nx > BB_MAX_DIMENSION / in->width ||
       ny > BB_MAX_DIMENSION / in->height)
-    return bb__fail(err, BB_ERR_SIZE, "tile: %dx%d copies of %dx%d is too large or empty", nx,
-                    ny, in->width, in->height);
+    return bb__fail(err, BB_ERR_SIZE, "tile: %dx%d copies of %dx%d is too large or empty",
+                    nx, ny, in->width, in->height);
   st = bb_image_alloc(out, in->width * nx, in->height * ny, in->channels, err);
   if (st != BB_OK)
     return st;
@@ -46,8 +48,8 @@ bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out, bb_er
   return BB_OK;
 }
 
-bb_status bb_image_crop(const bb_image *in, int x, int y, int width, int height, bb_image *out,
-                        bb_error *err) {
+bb_status bb_image_crop(const bb_image *in, int x, int y, int width, int height,
+                        bb_image *out, bb_error *err) {
   bb_status st = check_input(in, out, "crop", err);
   if (st != BB_OK)
     return st;
@@ -129,8 +131,8 @@ static void resample_axis(const bb_image *in, const footprint *f, int horizontal
         double sum = 0.0;
         for (int t = 0; t < f->count[i]; t++) {
           int j = f->first[i] + t;
-          const float *src = horizontal ? row_of(in, y) + (size_t)j * c
-                                        : row_of(in, j) + (size_t)x * c;
+          const float *src =
+              horizontal ? row_of(in, y) + (size_t)j * c : row_of(in, j) + (size_t)x * c;
           sum += f->weight[f->offset[i] + (size_t)t] * (double)src[k];
         }
         dst[k] = (float)sum;
@@ -183,7 +185,8 @@ bb_status bb_image_to_display(const bb_image *map, bb_range range, float low, fl
   st = bb_image_alloc(rgb, map->width, map->height, 3, err);
   if (st != BB_OK)
     return st;
-  const size_t count = (size_t)map->width * (size_t)map->height, c = (size_t)map->channels;
+  const size_t count = (size_t)map->width * (size_t)map->height,
+               c = (size_t)map->channels;
   const int grey = map->channels < 3;
   for (size_t i = 0; i < count; i++)
     for (int k = 0; k < 3; k++) {
@@ -253,13 +256,15 @@ static bb_status check_panels(const bb_panel *panels, int count, const bb_panel_
     return bb__fail(err, BB_ERR_ARGUMENT, "panels: nothing to lay out");
   if (l->columns < 1 || l->panel_width < 0 || l->gap < 0 || l->gap > 4096 ||
       (l->font_size != 0 && (l->font_size < 6 || l->font_size > 512)))
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "panels: bad layout (columns %d, panel width %d, gap %d, font size %d)",
-                    l->columns, l->panel_width, l->gap, l->font_size);
+    return bb__fail(
+        err, BB_ERR_ARGUMENT,
+        "panels: bad layout (columns %d, panel width %d, gap %d, font size %d)",
+        l->columns, l->panel_width, l->gap, l->font_size);
   for (int i = 0; i < count; i++) {
     const bb_image *p = panels[i].image;
     if (!p || !p->pixels || p->channels != 3 || p->width <= 0 || p->height <= 0)
-      return bb__fail(err, BB_ERR_ARGUMENT, "panels: panel %d is not a 3-channel image", i);
+      return bb__fail(err, BB_ERR_ARGUMENT, "panels: panel %d is not a 3-channel image",
+                      i);
   }
   return BB_OK;
 }
@@ -316,14 +321,13 @@ static bb_status grid_plan(const bb_panel *panels, int count, const bb_panel_lay
 }
 
 /* Copies panel (resampled to the cell width when needed) to (x, y) of out. */
-static bb_status paste_panel(const bb_image *panel, const grid *g, int x, int y, bb_image *out,
-                             bb_error *err) {
+static bb_status paste_panel(const bb_image *panel, const grid *g, int x, int y,
+                             bb_image *out, bb_error *err) {
   bb_image scaled = {0};
   const bb_image *src = panel;
   if (panel->width != g->cell_width) {
-    bb_status st =
-        bb_image_resample(panel, g->cell_width, scaled_height(panel, g->cell_width), &scaled,
-                          err);
+    bb_status st = bb_image_resample(panel, g->cell_width,
+                                     scaled_height(panel, g->cell_width), &scaled, err);
     if (st != BB_OK)
       return st;
     src = &scaled;
@@ -336,16 +340,16 @@ static bb_status paste_panel(const bb_image *panel, const grid *g, int x, int y,
 }
 
 /* Draws label centred under a cell. */
-static bb_status draw_label(const char *label, const grid *g, const char *font, int x, int y,
-                            bb_image *out, bb_error *err) {
+static bb_status draw_label(const char *label, const grid *g, const char *font, int x,
+                            int y, bb_image *out, bb_error *err) {
   if (!label || !label[0])
     return BB_OK;
   const float grey[3] = {LABEL_GREY, LABEL_GREY, LABEL_GREY};
   /* The strip is 1.75 font sizes tall; a baseline 2/3 down centres a line's
    * ascent (~0.75 size) and descent (~0.25) in it. */
   return bb__text_draw(out, x + g->cell_width / 2,
-                       y + g->cell_height + (2 * g->label_height) / 3, label, g->font_size,
-                       grey, font, err);
+                       y + g->cell_height + (2 * g->label_height) / 3, label,
+                       g->font_size, grey, font, err);
 }
 
 bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
@@ -363,8 +367,9 @@ bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_la
   grid g;
   st = grid_plan(panels, count, l, labelled, font, &g, err);
   if (st == BB_OK)
-    st = bb_image_alloc(out, g.gap + g.columns * (g.cell_width + g.gap),
-                        g.gap + g.rows * (g.cell_height + g.label_height + g.gap), 3, err);
+    st =
+        bb_image_alloc(out, g.gap + g.columns * (g.cell_width + g.gap),
+                       g.gap + g.rows * (g.cell_height + g.label_height + g.gap), 3, err);
   if (st != BB_OK)
     return st;
   const size_t n = (size_t)out->width * (size_t)out->height * 3;
@@ -416,7 +421,7 @@ bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options 
   for (int i = 0; i < KINDS && st == BB_OK; i++) {
     bb_render_options po = *o;
     po.mode = kinds[i].mode;
-    po.specular_exponent = !kinds[i].specular ? 0.0
+    po.specular_exponent = !kinds[i].specular           ? 0.0
                            : o->specular_exponent > 0.0 ? o->specular_exponent
                                                         : BB_COMPARE_SPECULAR_EXPONENT;
     st = bb_render(maps, &po, &renders[i], err);

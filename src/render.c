@@ -233,7 +233,8 @@ static bb_status check_lights(const bb_render_options *o, bb_error *err) {
         return bb__fail(err, BB_ERR_ARGUMENT,
                         "render: lightmap colour %d must be finite and >= 0", c);
   if (!(o->specular_exponent >= 0.0) || !isfinite(o->specular_exponent))
-    return bb__fail(err, BB_ERR_ARGUMENT, "render: specular exponent must be >= 0 (got %g)",
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: specular exponent must be >= 0 (got %g)",
                     o->specular_exponent);
   return BB_OK;
 }
@@ -244,8 +245,9 @@ static bb_status check_options(const bb_render_options *o, bb_error *err) {
   if (!find_mode(o->mode))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: unknown mode %d", (int)o->mode);
   if (o->tile_x < 1 || o->tile_y < 1 || o->tile_x > 64 || o->tile_y > 64)
-    return bb__fail(err, BB_ERR_ARGUMENT, "render: tile counts must be in 1..64 (got %dx%d)",
-                    o->tile_x, o->tile_y);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: tile counts must be in 1..64 (got %dx%d)", o->tile_x,
+                    o->tile_y);
   if (o->crop_width < 0 || (o->crop_width > 0 && o->crop_height <= 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: crop size must be > 0 (got %dx%d)",
                     o->crop_width, o->crop_height);
@@ -268,8 +270,8 @@ static bb_status check_map(const bb_image *img, const char *what, int min_channe
 }
 
 /* The maps a mode reads, checked; *size receives the first one. */
-static bb_status check_maps(const bb_render_maps *m, unsigned needs, const bb_image **size,
-                            bb_error *err) {
+static bb_status check_maps(const bb_render_maps *m, unsigned needs,
+                            const bb_image **size, bb_error *err) {
   const struct {
     const bb_image *img;
     const char *what;
@@ -316,7 +318,8 @@ static void normalize3(double v[3]) {
     v[k] /= len;
 }
 
-static void add_specular_light(render_job *job, const double dir[3], const float color[3]) {
+static void add_specular_light(render_job *job, const double dir[3],
+                               const float color[3]) {
   int i = job->light_count++;
   for (int k = 0; k < 3; k++) {
     job->light_dir[i][k] = dir[k];
@@ -326,8 +329,8 @@ static void add_specular_light(render_job *job, const double dir[3], const float
   normalize3(job->light_half[i]);
 }
 
-static void job_init(render_job *job, const bb_render_maps *maps, const bb_render_options *o,
-                     bb_image *out) {
+static void job_init(render_job *job, const bb_render_maps *maps,
+                     const bb_render_options *o, bb_image *out) {
   memset(job, 0, sizeof *job);
   job->maps = maps;
   job->o = o;
@@ -529,16 +532,16 @@ char *bb_render_options_describe(const bb_render_options *o) {
 
 /* --------------------------------------------------------- normal maps */
 
-bb_status bb_normals_decode(const bb_image *img, int is_float, int green_up, bb_image *out,
-                            bb_error *err) {
+bb_status bb_normals_decode(const bb_image *img, int is_float, int green_up,
+                            bb_image *out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: out is NULL");
   memset(out, 0, sizeof *out);
   if (!img || !img->pixels)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: missing image");
   if (img->channels < 3)
-    return bb__fail(err, BB_ERR_ARGUMENT, "normals: a normal map needs 3 channels, not %d",
-                    img->channels);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "normals: a normal map needs 3 channels, not %d", img->channels);
   bb_status st = bb_image_alloc(out, img->width, img->height, 3, err);
   if (st != BB_OK)
     return st;

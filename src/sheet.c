@@ -33,12 +33,14 @@ static void height_range(const bb_image *h, float *low, float *high) {
   *high = hi;
 }
 
-static bb_status check_bake(const bb_image *height, const bb_bake_result *r, bb_error *err) {
+static bb_status check_bake(const bb_image *height, const bb_bake_result *r,
+                            bb_error *err) {
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "sheet: need the 1-channel height of the bake");
   if (!r || !r->filtered.pixels || !r->normal.pixels || !r->weights.pixels ||
       !r->ssbump.pixels || !r->ao.pixels || !r->bent.pixels)
-    return bb__fail(err, BB_ERR_ARGUMENT, "sheet: need a traced bake (ssbump, ao and bent)");
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "sheet: need a traced bake (ssbump, ao and bent)");
   if (r->normal.width != height->width || r->normal.height != height->height)
     return bb__fail(err, BB_ERR_ARGUMENT, "sheet: the bake is %dx%d, the height %dx%d",
                     r->normal.width, r->normal.height, height->width, height->height);
@@ -77,7 +79,8 @@ static bb_status lit_panel(const bb_bake_result *r, const bb_render_options *lit
 }
 
 static bb_status make_panels(const bb_image *height, const bb_bake_result *r,
-                             const bb_render_options *lit, sheet_panels *s, bb_error *err) {
+                             const bb_render_options *lit, sheet_panels *s,
+                             bb_error *err) {
   float low, high;
   height_range(height, &low, &high);
   const struct {

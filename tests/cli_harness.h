@@ -45,7 +45,8 @@ static inline const char *harness_binary(void) {
   static char path[4096];
   if (!path[0]) {
     const char *bin = getenv("BB_BIN");
-    cr_assert(realpath(bin && *bin ? bin : "build/bumpbake", path) != NULL, "BB_BIN not found");
+    cr_assert(realpath(bin && *bin ? bin : "build/bumpbake", path) != NULL,
+              "BB_BIN not found");
   }
   return path;
 }

@@ -92,7 +92,8 @@ Test(animation, failures_leave_no_file) {
   snprintf(png, sizeof png, "%s/x.png", dir);
   cr_assert_eq(bb_animation_open(png, 8, 8, 10.0, &a, &err), BB_ERR_FORMAT);
   cr_assert_eq(bb_animation_open(path, 8, 8, 0.5, &a, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_animation_open("/nonexistent-dir/a.gif", 8, 8, 10.0, &a, &err), BB_ERR_IO);
+  cr_assert_eq(bb_animation_open("/nonexistent-dir/a.gif", 8, 8, 10.0, &a, &err),
+               BB_ERR_IO);
   cr_assert_null(a);
   cr_assert_eq(entries_then_clean(), 0, "nothing left behind");
 }

@@ -46,16 +46,16 @@ static void expect_no_new_files(int before) {
 
 /* Bakes the pit fixture's maps as EXR into the test directory. */
 static void bake_pit_maps(void) {
-  cli_result r = RUN("bake", fixture("pit_65x65.png"), "--scale", "8", "--rays", "64", "-q",
-                     "--normal", tmp("n.exr"), "--ssbump", tmp("s.exr"), "--ao", tmp("a.exr"),
-                     "--bent", tmp("b.exr"));
+  cli_result r = RUN("bake", fixture("pit_65x65.png"), "--scale", "8", "--rays", "64",
+                     "-q", "--normal", tmp("n.exr"), "--ssbump", tmp("s.exr"), "--ao",
+                     tmp("a.exr"), "--bent", tmp("b.exr"));
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
 }
 
 Test(cli_render, from_a_height_with_provenance) {
-  cli_result r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "64", "-o",
-                     tmp("pit.png"), "--light", "0,20");
+  cli_result r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "64",
+                     "-o", tmp("pit.png"), "--light", "0,20");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_assert_str_eq(r.err, "");
   cr_assert(strstr(r.out, "wrote render"), "%s", r.out);
@@ -64,12 +64,12 @@ Test(cli_render, from_a_height_with_provenance) {
   bb_image img = read_image(tmp("pit.png"), &info);
   cr_assert_eq(img.width, 65);
   cr_assert_eq(img.channels, 3);
-  const char *keys[] = {"output=render\n", "input=pit_65x65.png\n", "scale=8\n",
-                        "rayset=", "render_from=height\n", "render_mode=ssbump\n",
-                        "light=0,20\n", "specular=0\n"};
+  const char *keys[] = {
+      "output=render\n",      "input=pit_65x65.png\n", "scale=8\n",    "rayset=",
+      "render_from=height\n", "render_mode=ssbump\n",  "light=0,20\n", "specular=0\n"};
   for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
-    cr_assert(info.description && strstr(info.description, keys[i]), "%s missing from: %s",
-              keys[i], info.description);
+    cr_assert(info.description && strstr(info.description, keys[i]),
+              "%s missing from: %s", keys[i], info.description);
   bb_image_info_free(&info);
   bb_image_free(&img);
 }
@@ -78,8 +78,8 @@ Test(cli_render, from_a_height_with_provenance) {
 Test(cli_render, from_baked_maps_as_from_the_height) {
   bake_pit_maps();
   cli_result r = RUN("render", "--normal", tmp("n.exr"), "--ssbump", tmp("s.exr"), "--ao",
-                     tmp("a.exr"), "--bent", tmp("b.exr"), "--compare", "--specular", "20",
-                     "-o", tmp("maps.exr"), "-q");
+                     tmp("a.exr"), "--bent", tmp("b.exr"), "--compare", "--specular",
+                     "20", "-o", tmp("maps.exr"), "-q");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_assert_str_eq(r.out, "");
   cli_result_free(&r);
@@ -88,14 +88,16 @@ Test(cli_render, from_baked_maps_as_from_the_height) {
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   bb_image_info info;
-  bb_image a = read_image(tmp("maps.exr"), &info), b = read_image(tmp("height.exr"), NULL);
+  bb_image a = read_image(tmp("maps.exr"), &info),
+           b = read_image(tmp("height.exr"), NULL);
   cr_assert_eq(a.width, b.width);
   cr_assert_eq(a.height, b.height);
   size_t n = (size_t)a.width * (size_t)a.height * 3;
   for (size_t i = 0; i < n; i++)
     cr_assert_float_eq(a.pixels[i], b.pixels[i], 1e-5, "texel %zu", i / 3);
-  cr_assert(strstr(info.description, "render_from=maps\nmap_normal=n.exr\nmap_ssbump=s.exr\n"),
-            "%s", info.description);
+  cr_assert(
+      strstr(info.description, "render_from=maps\nmap_normal=n.exr\nmap_ssbump=s.exr\n"),
+      "%s", info.description);
   cr_assert(!strstr(info.description, "scale="), "no bake options for baked maps");
   bb_image_info_free(&info);
   bb_image_free(&a);
@@ -112,8 +114,8 @@ Test(cli_render, orbit_as_gif_and_as_frames) {
   cr_assert_eq(bb_image_frame_count(tmp("orbit.gif"), &frames, NULL), BB_OK);
   cr_assert_eq(frames, 5);
 
-  r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16", "--orbit", "3",
-          "--light", "30,25", "-o", tmp("f.png"), "-q");
+  r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16", "--orbit",
+          "3", "--light", "30,25", "-o", tmp("f.png"), "-q");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   cr_assert_eq(files_starting_with("f_"), 3);
@@ -121,7 +123,8 @@ Test(cli_render, orbit_as_gif_and_as_frames) {
   bb_image_info info;
   bb_image img = read_image(tmp("f_002.png"), &info);
   cr_assert(strstr(info.description, "frame=2/3\n"), "%s", info.description);
-  cr_assert(strstr(info.description, "light=270,25\n"), "30 + 2 x 120: %s", info.description);
+  cr_assert(strstr(info.description, "light=270,25\n"), "30 + 2 x 120: %s",
+            info.description);
   bb_image_info_free(&info);
   bb_image_free(&img);
 }
@@ -129,28 +132,31 @@ Test(cli_render, orbit_as_gif_and_as_frames) {
 Test(cli_render, bit_identical_for_any_thread_count) {
   const char *outs[2] = {tmp("t1.png"), tmp("t2.png")};
   for (int i = 0; i < 2; i++) {
-    cli_result r = RUN("render", fixture("noise_96x80.png"), "--scale", "16", "--rays", "32",
-                       "--compare", "--tile", "2", "--lightmap", "basis", "--light", "10,30",
-                       "--threads", i ? "2" : "1", "--depth", "16", "-o", outs[i], "-q");
+    cli_result r =
+        RUN("render", fixture("noise_96x80.png"), "--scale", "16", "--rays", "32",
+            "--compare", "--tile", "2", "--lightmap", "basis", "--light", "10,30",
+            "--threads", i ? "2" : "1", "--depth", "16", "-o", outs[i], "-q");
     cr_assert_eq(r.code, 0, "%s", r.err);
     cli_result_free(&r);
   }
   bb_image a = read_image(outs[0], NULL), b = read_image(outs[1], NULL);
   cr_assert_eq(a.width, b.width);
-  cr_assert_eq(memcmp(a.pixels, b.pixels, sizeof(float) * 3 * (size_t)a.width * (size_t)a.height), 0);
+  cr_assert_eq(
+      memcmp(a.pixels, b.pixels, sizeof(float) * 3 * (size_t)a.width * (size_t)a.height),
+      0);
   bb_image_free(&a);
   bb_image_free(&b);
 }
 
 Test(cli_render, maps_of_different_sizes) {
   bake_pit_maps();
-  cli_result r = RUN("bake", fixture("noise_96x80.png"), "--scale", "8", "--rays", "16", "-q",
-                     "--ao", tmp("ao_noise.png"));
+  cli_result r = RUN("bake", fixture("noise_96x80.png"), "--scale", "8", "--rays", "16",
+                     "-q", "--ao", tmp("ao_noise.png"));
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   int before = files_starting_with("") - 2;
-  r = RUN("render", "--normal", tmp("n.exr"), "--ao", tmp("ao_noise.png"), "--mode", "ao", "-o",
-          tmp("out.png"));
+  r = RUN("render", "--normal", tmp("n.exr"), "--ao", tmp("ao_noise.png"), "--mode", "ao",
+          "-o", tmp("out.png"));
   expect_one_line_error(&r, 1, "96x80, but the other maps are 65x65");
   cr_assert(strstr(r.err, "ao_noise.png"), "names the file: %s", r.err);
   cli_result_free(&r);
@@ -179,14 +185,16 @@ Test(cli_render, usage_errors) {
       {{"render", pit, "-o", tmp("o.png")}, "--scale is required"},
       {{"render", pit, "--scale", "8", "--ssbump", pit, "-o", tmp("o.png")}, "not both"},
       {{"render", "--normal", pit, "-o", tmp("o.png")}, "needs --ssbump"},
-      {{"render", pit, "--scale", "8", "--lightmap", "1,2,3", "-o", tmp("o.png")}, "9 comma"},
+      {{"render", pit, "--scale", "8", "--lightmap", "1,2,3", "-o", tmp("o.png")},
+       "9 comma"},
       {{"render", pit, "--scale", "8", "--lightmap", "basis", "--orbit", "3", "-o",
         tmp("o.gif")},
        "give --light"},
       {{"render", pit, "--scale", "8", "--crop", "60,0,10,10", "-o", tmp("o.png")},
        "not inside the 65x65"},
       {{"render", pit, "--scale", "8"}, "-o OUT is required"},
-      {{"sheet", pit, "--scale", "8", "--panel-size", "4", "-o", tmp("s.png")}, "16..4096"},
+      {{"sheet", pit, "--scale", "8", "--panel-size", "4", "-o", tmp("s.png")},
+       "16..4096"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     cli_result r = harness_run(cases[i].args);
@@ -219,8 +227,8 @@ Test(cli_render, sheet_with_and_without_a_font) {
   bb_image_info_free(&info);
 
   cr_assert_eq(setenv("BUMPBAKE_FONT", "/nonexistent/font.ttf", 1), 0);
-  r = RUN("sheet", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16", "--panel-size",
-          "64", "-o", tmp("bare.png"), "-q");
+  r = RUN("sheet", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16",
+          "--panel-size", "64", "-o", tmp("bare.png"), "-q");
   unsetenv("BUMPBAKE_FONT");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_assert_eq(harness_lines(r.err), 1, "%s", r.err);
@@ -237,7 +245,8 @@ Test(cli_render, help_lists_the_options) {
   cli_result r = RUN("render", "--help");
   cr_assert_eq(r.code, 0);
   const char *words[] = {"--light AZ,EL", "default 135,45", "--lightmap", "--specular",
-                         "--albedo", "--mod2x", "--compare", "--tile", "--orbit", "--crop"};
+                         "--albedo",      "--mod2x",        "--compare",  "--tile",
+                         "--orbit",       "--crop"};
   for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
     cr_assert(strstr(r.out, words[i]), "%s missing", words[i]);
   cli_result_free(&r);

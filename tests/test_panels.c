@@ -76,8 +76,9 @@ Test(panels, resample_by_area) {
   cr_assert_eq(bb_image_resample(&in, 8, 8, &out, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 8; x++)
-      cr_assert_float_eq(bb_image_texel(&out, x, y)[0], bb_image_texel(&in, x / 2, y / 2)[0],
-                         1e-4, "enlarging by 2 repeats texels");
+      cr_assert_float_eq(bb_image_texel(&out, x, y)[0],
+                         bb_image_texel(&in, x / 2, y / 2)[0], 1e-4,
+                         "enlarging by 2 repeats texels");
   bb_image_free(&out);
   cr_assert_eq(bb_image_resample(&in, 3, 1, &out, NULL), BB_OK);
   /* Column means of the ramp: rows average to 150; x covers thirds of 4. */
@@ -125,8 +126,8 @@ Test(panels, display_encodings) {
 
 /* Grid geometry: gap + columns x (cell + gap) wide; each row a cell, a label
  * strip when labelled, a gap. */
-static void assert_grid(const bb_image *out, int columns, int rows, int cell_w, int cell_h,
-                        int label_h, int gap) {
+static void assert_grid(const bb_image *out, int columns, int rows, int cell_w,
+                        int cell_h, int label_h, int gap) {
   cr_assert_eq(out->width, gap + columns * (cell_w + gap));
   cr_assert_eq(out->height, gap + rows * (cell_h + label_h + gap));
 }
@@ -138,7 +139,8 @@ static int label_strip(const bb_image *out, int rows, int cell_h, int gap, int m
   int found = 0;
   for (int size = 6; size <= max_font; size++)
     found |= strip == (size * 7 + 3) / 4;
-  cr_assert(found, "a %d-pixel label strip fits no font of 6..%d pixels", strip, max_font);
+  cr_assert(found, "a %d-pixel label strip fits no font of 6..%d pixels", strip,
+            max_font);
   return strip;
 }
 
@@ -153,7 +155,8 @@ static float window_max(const bb_image *img, int x0, int y0, int w, int h) {
 }
 
 Test(panels, compose_with_labels) {
-  bb_image a = filled(32, 16, 1, 0, 0), b = filled(128, 64, 0, 1, 0), c = filled(64, 64, 0, 0, 1);
+  bb_image a = filled(32, 16, 1, 0, 0), b = filled(128, 64, 0, 1, 0),
+           c = filled(64, 64, 0, 0, 1);
   bb_panel p[3] = {{&a, "red"}, {&b, "green"}, {&c, NULL}};
   bb_panel_layout l;
   bb_panel_layout_init(&l);
@@ -164,7 +167,8 @@ Test(panels, compose_with_labels) {
   bb_image out;
   int labels = -1;
   bb_error err = {{0}};
-  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
+               err.message);
   cr_assert_eq(labels, 1, "fonts-dejavu-core is a build dependency");
   const int label_h = (12 * 7 + 3) / 4; /* both labels fit 64 pixels at 12 */
   assert_grid(&out, 2, 2, 64, 64, label_h, 4);
@@ -178,14 +182,16 @@ Test(panels, compose_with_labels) {
   cr_assert_eq(bb_image_texel(&out, 4, 72 + label_h)[2], 1.0f);
   cr_assert_eq(bb_image_texel(&out, 2, 2)[0], 0.12f, "the gap is background");
   /* Labels are light text in the strip under each labelled panel. */
-  cr_assert_gt(window_max(&out, 4, 68, 64, label_h), 0.5f, "a label is drawn under 'red'");
+  cr_assert_gt(window_max(&out, 4, 68, 64, label_h), 0.5f,
+               "a label is drawn under 'red'");
   cr_assert_gt(window_max(&out, 72, 68, 64, label_h), 0.5f);
   cr_assert_lt(window_max(&out, 4, 136 + label_h, 64, label_h), 0.13f,
                "no label under an unlabelled panel");
   bb_image_free(&out);
   /* Narrow panels: one smaller size for every label, a thinner strip. */
   l.panel_width = 16;
-  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
+               err.message);
   cr_assert_lt(label_strip(&out, 2, 16, 4, 12), label_h, "'green' does not fit 16 at 12");
   bb_image_free(&out);
   bb_image_free(&a);
@@ -263,8 +269,8 @@ Test(panels, compare_is_four_renders) {
     bb_image one;
     cr_assert_eq(bb_render(&m, &o, &one, NULL), BB_OK);
     for (int y = 0; y < 20; y++)
-      cr_assert_eq(memcmp(bb_image_texel(&out, 8 + i * 32, 8 + y), bb_image_texel(&one, 0, y),
-                          sizeof(float) * 3 * 24),
+      cr_assert_eq(memcmp(bb_image_texel(&out, 8 + i * 32, 8 + y),
+                          bb_image_texel(&one, 0, y), sizeof(float) * 3 * 24),
                    0, "panel %d row %d", i, y);
     bb_image_free(&one);
   }

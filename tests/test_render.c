@@ -14,7 +14,8 @@
 /* ----------------------------------------------------------------- helpers */
 
 /* A height field of width x height from f(x, y). */
-static void make_height(bb_image *h, int width, int height, double (*f)(int, int, int, int)) {
+static void make_height(bb_image *h, int width, int height,
+                        double (*f)(int, int, int, int)) {
   cr_assert_eq(bb_image_alloc(h, width, height, 1, NULL), BB_OK);
   for (int y = 0; y < height; y++)
     for (int x = 0; x < width; x++)
@@ -40,17 +41,29 @@ static double pit(int x, int y, int w, int h) {
   return dx * dx + dy * dy < r * r ? 0.0 : 1.0;
 }
 
-static void bake(const bb_image *h, float scale, int rays, bb_bake_result *r) {
+/* A height field baked, and its maps ready to render. */
+typedef struct scene {
+  bb_image height;
+  bb_bake_result bake;
+  bb_render_maps maps;
+} scene;
+
+static void scene_make(scene *s, int width, int height, double (*f)(int, int, int, int),
+                       float scale, int rays) {
+  make_height(&s->height, width, height, f);
   bb_bake_options o;
   bb_bake_options_init(&o);
   o.height_scale = scale;
   o.rays = rays;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(h, &o, r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_bake(&s->height, &o, &s->bake, &err), BB_OK, "%s", err.message);
+  const bb_bake_result *r = &s->bake;
+  s->maps = (bb_render_maps){&r->normal, &r->ssbump, &r->ao, &r->bent, NULL};
 }
 
-static bb_render_maps maps_of(const bb_bake_result *r) {
-  return (bb_render_maps){&r->normal, &r->ssbump, &r->ao, &r->bent, NULL};
+static void scene_free(scene *s) {
+  bb_bake_result_free(&s->bake);
+  bb_image_free(&s->height);
 }
 
 /* Renders and returns the image (the caller frees it). */
@@ -139,12 +152,11 @@ Test(render, light_direction_frame) {
  * overhead, every mode gives N.L = 1; at elevation 30, sin(30) = 0.5 for the
  * ssbump too, since sum_c (1/sqrt 3)(l.B_c) = l.z. */
 Test(render, flat_dynamic_light_is_lambert) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 12, 10, flat);
-  bake(&h, 8.0f, 16, &r);
-  bb_render_maps m = maps_of(&r);
-  const bb_render_mode modes[] = {BB_RENDER_NORMAL, BB_RENDER_NORMAL_AO, BB_RENDER_SSBUMP};
+  scene sc;
+  scene_make(&sc, 12, 10, flat, 8.0f, 16);
+  bb_render_maps m = sc.maps;
+  const bb_render_mode modes[] = {BB_RENDER_NORMAL, BB_RENDER_NORMAL_AO,
+                                  BB_RENDER_SSBUMP};
   const double elevations[] = {90.0, 30.0, 0.0};
   const double expected[] = {1.0, 0.5, 0.0};
   for (int i = 0; i < 3; i++)
@@ -157,18 +169,15 @@ Test(render, flat_dynamic_light_is_lambert) {
       assert_uniform(&img, rgb, 1e-6, bb_render_mode_name(modes[i]));
       bb_image_free(&img);
     }
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* Static light: Source's sum_c s_c L_c = (L0 + L1 + L2) / sqrt(3) for a flat
  * ssbump; its normal-map weights give (L0 + L1 + L2) / 3. */
 Test(render, flat_static_light_is_source) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 9, 9, flat);
-  bake(&h, 4.0f, 16, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 9, 9, flat, 4.0f, 16);
+  bb_render_maps m = sc.maps;
   const float L[3][3] = {{1.0f, 0.2f, 0.0f}, {0.0f, 0.6f, 0.3f}, {0.5f, 0.0f, 0.9f}};
   double sum[3] = {0, 0, 0};
   for (int c = 0; c < 3; c++)
@@ -176,7 +185,10 @@ Test(render, flat_static_light_is_source) {
       sum[k] += L[c][k];
   for (int i = 0; i < 3; i++) {
     bb_render_options o;
-    options(&o, i == 0 ? BB_RENDER_SSBUMP : i == 1 ? BB_RENDER_NORMAL : BB_RENDER_NORMAL_AO,
+    options(&o,
+            i == 0   ? BB_RENDER_SSBUMP
+            : i == 1 ? BB_RENDER_NORMAL
+                     : BB_RENDER_NORMAL_AO,
             0, 0);
     o.dynamic_light = 0;
     o.static_light = 1;
@@ -195,19 +207,16 @@ Test(render, flat_static_light_is_source) {
   double rgb[3] = {1.0 + 1.0 / SQRT3, 1.0 + 1.0 / SQRT3, 1.0 + 1.0 / SQRT3};
   assert_uniform(&img, rgb, 1e-6, "static + dynamic");
   bb_image_free(&img);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* Blinn-Phong with the viewer overhead on a flat map: N.H = cos((90 - el) / 2),
  * added to the diffuse. With the lightmaps on, each basis direction is a
  * light too: N.H_c = cos((90 - 35.26) / 2). */
 Test(render, flat_specular_is_blinn_phong) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 8, 8, flat);
-  bake(&h, 4.0f, 16, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 8, 8, flat, 4.0f, 16);
+  bb_render_maps m = sc.maps;
   const double rad = 3.14159265358979323846 / 180.0;
   for (int mode = 0; mode < 2; mode++) {
     bb_render_options o;
@@ -230,23 +239,22 @@ Test(render, flat_specular_is_blinn_phong) {
   double rgb[3] = {v, v, v};
   assert_uniform(&img, rgb, 1e-5, "specular of the lightmaps");
   bb_image_free(&img);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* Albedo multiplies the diffuse, not the highlight; mod2x doubles it. */
 Test(render, albedo_and_mod2x) {
-  bb_image h, albedo, grey;
-  bb_bake_result r;
-  make_height(&h, 6, 5, flat);
-  bake(&h, 4.0f, 16, &r);
+  bb_image albedo, grey;
+  scene sc;
+  scene_make(&sc, 6, 5, flat, 4.0f, 16);
   cr_assert_eq(bb_image_alloc(&albedo, 6, 5, 3, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&grey, 6, 5, 1, NULL), BB_OK);
   for (int i = 0; i < 30; i++) {
-    albedo.pixels[3 * i] = 0.5f, albedo.pixels[3 * i + 1] = 0.25f, albedo.pixels[3 * i + 2] = 1;
+    albedo.pixels[3 * i] = 0.5f, albedo.pixels[3 * i + 1] = 0.25f,
+                      albedo.pixels[3 * i + 2] = 1;
     grey.pixels[i] = 0.25f;
   }
-  bb_render_maps m = maps_of(&r);
+  bb_render_maps m = sc.maps;
   m.albedo = &albedo;
   bb_render_options o;
   options(&o, BB_RENDER_SSBUMP, 0, 90);
@@ -264,8 +272,7 @@ Test(render, albedo_and_mod2x) {
   bb_image_free(&img);
   bb_image_free(&albedo);
   bb_image_free(&grey);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* ----------------------------------------------------------------- bump */
@@ -273,16 +280,16 @@ Test(render, albedo_and_mod2x) {
 /* A bump lit from the right is brighter on its right flank, lit from below
  * (+y, azimuth 270) brighter on its lower flank: in every mode. */
 Test(render, bump_is_lit_on_the_light_side) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 40, 40, bump);
-  bake(&h, 12.0f, 64, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 40, 40, bump, 12.0f, 64);
+  bb_render_maps m = sc.maps;
   const int c = 20, d = 7;
   for (int mode = 0; mode < 4; mode++) {
     bb_render_options o;
-    options(&o, mode == 1 ? BB_RENDER_NORMAL : mode == 2 ? BB_RENDER_NORMAL_AO
-                                                         : BB_RENDER_SSBUMP,
+    options(&o,
+            mode == 1   ? BB_RENDER_NORMAL
+            : mode == 2 ? BB_RENDER_NORMAL_AO
+                        : BB_RENDER_SSBUMP,
             0, 30);
     o.specular_exponent = mode == 3 ? 16.0 : 0.0;
     bb_image right = render(&m, &o);
@@ -295,8 +302,7 @@ Test(render, bump_is_lit_on_the_light_side) {
                  "mode %d: lit from below (+y), the lower flank is brighter", mode);
     bb_image_free(&below);
   }
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* ------------------------------------------------------------------ pit */
@@ -306,11 +312,9 @@ Test(render, bump_is_lit_on_the_light_side) {
  * plain normal map sees a flat floor there and lights it fully (N.L =
  * sin 20), the ssbump darkens it. */
 Test(render, pit_floor_in_the_shadow_of_its_wall) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 65, 65, pit);
-  bake(&h, 8.0f, 256, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 65, 65, pit, 8.0f, 256);
+  bb_render_maps m = sc.maps;
   bb_render_options o;
   options(&o, BB_RENDER_NORMAL, 0, 20);
   bb_image plain = render(&m, &o);
@@ -323,26 +327,23 @@ Test(render, pit_floor_in_the_shadow_of_its_wall) {
     cr_assert_float_eq(grey_at(&plain, x, 32), lambert, 1e-4,
                        "x = %d: the flat floor is fully lit by N.L", x);
     cr_assert_lt(grey_at(&ss, x, 32), 0.5 * lambert,
-                 "x = %d: the ssbump darkens the floor in the wall's shadow (%g vs %g)", x,
-                 grey_at(&ss, x, 32), lambert);
+                 "x = %d: the ssbump darkens the floor in the wall's shadow (%g vs %g)",
+                 x, grey_at(&ss, x, 32), lambert);
   }
   /* Beside the left wall the floor faces the light over the whole pit. */
   cr_assert_gt(grey_at(&ss, 16, 32), 3.0 * grey_at(&ss, 48, 32),
                "the open floor near the left wall stays lit");
   bb_image_free(&plain);
   bb_image_free(&ss);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* -------------------------------------------------------- determinism */
 
 Test(render, bit_identical_for_any_thread_count) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 37, 29, bump);
-  bake(&h, 6.0f, 32, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 37, 29, bump, 6.0f, 32);
+  bb_render_maps m = sc.maps;
   bb_render_options o;
   options(&o, BB_RENDER_SSBUMP, 33, 21);
   o.static_light = 1;
@@ -357,8 +358,7 @@ Test(render, bit_identical_for_any_thread_count) {
     bb_image_free(&many);
   }
   bb_image_free(&one);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* ------------------------------------------------------- bent and view */
@@ -366,11 +366,9 @@ Test(render, bit_identical_for_any_thread_count) {
 /* Without a bent map the specular normal is the ssbump's bent normal, as
  * bb_derive_bent makes it: the same pixels either way. */
 Test(render, bent_from_the_ssbump_when_missing) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 24, 20, bump);
-  bake(&h, 6.0f, 32, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 24, 20, bump, 6.0f, 32);
+  bb_render_maps m = sc.maps;
   bb_render_options o;
   options(&o, BB_RENDER_SSBUMP, 10, 40);
   o.specular_exponent = 20;
@@ -381,16 +379,13 @@ Test(render, bent_from_the_ssbump_when_missing) {
     cr_assert_float_eq(with.pixels[i], without.pixels[i], 1e-6);
   bb_image_free(&with);
   bb_image_free(&without);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 Test(render, tile_and_crop) {
-  bb_image h;
-  bb_bake_result r;
-  make_height(&h, 10, 8, bump);
-  bake(&h, 4.0f, 16, &r);
-  bb_render_maps m = maps_of(&r);
+  scene sc;
+  scene_make(&sc, 10, 8, bump, 4.0f, 16);
+  bb_render_maps m = sc.maps;
   bb_render_options o;
   options(&o, BB_RENDER_NORMAL, 10, 40);
   bb_image base = render(&m, &o);
@@ -400,14 +395,16 @@ Test(render, tile_and_crop) {
   cr_assert_eq(tiled.height, 16);
   for (int y = 0; y < 16; y++)
     for (int x = 0; x < 20; x++)
-      cr_assert_eq(memcmp(at(&tiled, x, y), at(&base, x % 10, y % 8), 3 * sizeof(float)), 0);
+      cr_assert_eq(memcmp(at(&tiled, x, y), at(&base, x % 10, y % 8), 3 * sizeof(float)),
+                   0);
   o.crop_x = 7, o.crop_y = 5, o.crop_width = 6, o.crop_height = 4;
   bb_image crop = render(&m, &o);
   cr_assert_eq(crop.width, 6);
   cr_assert_eq(crop.height, 4);
   for (int y = 0; y < 4; y++)
     for (int x = 0; x < 6; x++)
-      cr_assert_eq(memcmp(at(&crop, x, y), at(&tiled, 7 + x, 5 + y), 3 * sizeof(float)), 0);
+      cr_assert_eq(memcmp(at(&crop, x, y), at(&tiled, 7 + x, 5 + y), 3 * sizeof(float)),
+                   0);
   o.crop_x = 15; /* 15 + 6 > 20 */
   bb_image bad;
   bb_error err = {{0}};
@@ -416,8 +413,7 @@ Test(render, tile_and_crop) {
   bb_image_free(&base);
   bb_image_free(&tiled);
   bb_image_free(&crop);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+  scene_free(&sc);
 }
 
 /* --------------------------------------------------------- bad arguments */
@@ -472,8 +468,9 @@ Test(render, describe_names_every_option) {
   bb_render_options_init(&o);
   char *text = bb_render_options_describe(&o);
   cr_assert_not_null(text);
-  cr_assert_str_eq(text, "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
-                         "lightmap=none\nspecular=0\nalbedo_mod2x=0\ntile=1x1\ncrop=none\n");
+  cr_assert_str_eq(text,
+                   "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
+                   "lightmap=none\nspecular=0\nalbedo_mod2x=0\ntile=1x1\ncrop=none\n");
   free(text);
   o.dynamic_light = 0;
   o.static_light = 1;

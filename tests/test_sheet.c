@@ -37,13 +37,15 @@ Test(sheet, eight_labelled_panels) {
   o.layout.panel_width = 32;
   int labels = 0;
   bb_error err = {{0}};
-  cr_assert_eq(bb_sheet_make(&h, &r, &o, &sheet, &labels, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_sheet_make(&h, &r, &o, &sheet, &labels, &err), BB_OK, "%s",
+               err.message);
   cr_assert_eq(labels, 1);
   /* Labels shrink to fit 32-pixel panels: a strip of 1.75 x 6..12 pixels. */
   const int label_h = (sheet.height - 8 - 2 * (24 + 8)) / 2;
   cr_assert_eq(sheet.width, 8 + 4 * 40);
   cr_assert_eq(sheet.height, 8 + 2 * (24 + label_h + 8));
-  cr_assert(label_h >= (6 * 7 + 3) / 4 && label_h <= (12 * 7 + 3) / 4, "strip %d", label_h);
+  cr_assert(label_h >= (6 * 7 + 3) / 4 && label_h <= (12 * 7 + 3) / 4, "strip %d",
+            label_h);
   /* The height is stretched over its own range: its lowest texel is black. */
   float lo = h.pixels[0], hi = h.pixels[0];
   int lowest = 0;
