@@ -396,6 +396,8 @@ static int check_view(const render_args *a, const bb_image *size) {
 static int load_maps(const render_args *a, cli_run *run, render_inputs *in) {
   const bb_image *size = NULL;
   int rc = add_line(in, "render_from", "maps");
+  if (!rc && (a->map_paths[MAP_NORMAL] || a->map_paths[MAP_BENT]))
+    rc = add_line(in, "map_normal_y", a->green_up ? "up" : "down");
   for (int m = 0; m < MAP_COUNT && !rc; m++) {
     if (!a->map_paths[m])
       continue;

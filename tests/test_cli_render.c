@@ -96,7 +96,8 @@ Test(cli_render, from_baked_maps_as_from_the_height) {
   for (size_t i = 0; i < n; i++)
     cr_assert_float_eq(a.pixels[i], b.pixels[i], 1e-5, "texel %zu", i / 3);
   cr_assert(
-      strstr(info.description, "render_from=maps\nmap_normal=n.exr\nmap_ssbump=s.exr\n"),
+      strstr(info.description,
+             "render_from=maps\nmap_normal_y=down\nmap_normal=n.exr\nmap_ssbump=s.exr\n"),
       "%s", info.description);
   cr_assert(!strstr(info.description, "scale="), "no bake options for baked maps");
   bb_image_info_free(&info);
