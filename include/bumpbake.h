@@ -555,13 +555,28 @@ char *bb_renderbump_describe(const bb_renderbump_options *o,
  *   ao        ao * sum_c w_c L_c        ao * max(0, N.l) C
  *   ssbump    sum_c s_c L_c             sat(sum_c s_c (l.B_c)) C
  * with Source's weights w_c = dp_c / sum_k dp_k, dp_c = sat(N.B_c)^2 (the
- * weights map). Output = A * (static + dynamic) + specular, where the
+ * weights map). Output = A * (static + dynamic) + specular (A by
+ * bb_albedo_mode; 1 without an albedo), where the
  * Blinn-Phong specular of exponent k sums, over every light (d, K) in use
  * (the dynamic light, and the three B_c with colours L_c when the
  * lightmaps are on), K * max(0, Ns.h)^k with h = normalize(d + (0, 0, 1)),
  * counted only where Ns.d > 0; Ns is Nb for ssbump, N otherwise. A flat,
  * unoccluded texel under an overhead light gives 1 in every mode, the
  * value of N.L. */
+
+/* How the albedo A multiplies the diffuse light (Source's detail blend
+ * modes, common_ps_fxc.h TextureCombine). */
+typedef enum bb_albedo_mode {
+  BB_ALBEDO_MULTIPLY = 0, /* A, per channel */
+  BB_ALBEDO_MOD2X,        /* 2 A per channel ($detailblendmode 0): 0.5 is neutral */
+  BB_ALBEDO_SSBUMP        /* (2/3)(A_r + A_g + A_b), grey: a detail ssbump used as an
+                             albedo (mode 11); a flat, unoccluded height2ssbump -d
+                             detail of mid-grey input (0.5 each) gives 1 */
+} bb_albedo_mode;
+
+/* Parses "multiply", "mod2x", "ssbump"; returns 0 on success. */
+int bb_albedo_mode_parse(const char *name, bb_albedo_mode *out);
+const char *bb_albedo_mode_name(bb_albedo_mode mode);
 
 /* What one render shows. New modes are appended. */
 typedef enum bb_render_mode {
@@ -611,8 +626,8 @@ typedef struct bb_render_options {
   float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
                                    three basis directions in three colours */
   double specular_exponent;     /* k > 0, or 0 = no specular (default 0) */
-  int albedo_mod2x;             /* 1: multiply by 2 * albedo (Source's mod2x
-                                   detail: 0.5 is neutral); default 0 */
+  bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
+                                   default BB_ALBEDO_MULTIPLY */
   int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
   int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
                                    texels; crop_width 0 = no crop */
@@ -630,7 +645,7 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
                     bb_error *err);
 
 /* "key=value" lines of every option of o that affects pixels (render_mode,
- * light, light_color, lightmap, specular, albedo_mod2x, tile, crop), for
+ * light, light_color, lightmap, specular, albedo_mode, tile, crop), for
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 

@@ -52,12 +52,13 @@ static const cli_option opt_albedo = {
     .value_name = "FILE",
     .default_text = "white",
     .help = "colour map multiplying the diffuse light (same size as the maps)"};
-static const cli_option opt_mod2x = {
-    .id = CLI_RENDER_OPT_MOD2X,
-    .long_name = "mod2x",
-    .default_text = "off",
-    .help =
-        "multiply by 2 x albedo, Source's mod2x (0.5 is neutral: a -d detail ssbump)"};
+static const cli_option opt_albedo_mode = {
+    .id = CLI_RENDER_OPT_ALBEDO_MODE,
+    .long_name = "albedo-mode",
+    .value_name = "multiply|mod2x|ssbump",
+    .default_text = "multiply",
+    .help = "mod2x: 2 x albedo (0.5 is neutral); ssbump: a detail ssbump (height2ssbump "
+            "-d) as albedo, x 2/3 (R + G + B)"};
 static const cli_option opt_compare = {
     .id = CLI_RENDER_OPT_COMPARE,
     .long_name = "compare",
@@ -106,7 +107,7 @@ static const cli_option *const render_options[] = {
     &cli_render_opt_lightmap,
     &cli_render_opt_specular,
     &opt_albedo,
-    &opt_mod2x,
+    &opt_albedo_mode,
     &opt_compare,
     &opt_tile,
     &opt_crop,
@@ -177,8 +178,10 @@ static int render_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_RENDER_OPT_ALBEDO:
     a->albedo_path = arg;
     return 0;
-  case CLI_RENDER_OPT_MOD2X:
-    a->render.albedo_mod2x = 1;
+  case CLI_RENDER_OPT_ALBEDO_MODE:
+    if (bb_albedo_mode_parse(arg, &a->render.albedo_mode))
+      return cli_usage_error(cmd, "--albedo-mode must be one of %s (got '%s')",
+                             opt->value_name, arg);
     return 0;
   case CLI_RENDER_OPT_COMPARE:
     a->compare = 1;

@@ -163,6 +163,26 @@ const char *bb_render_mode_name(bb_render_mode mode) {
   return m ? m->name : "unknown";
 }
 
+/* --------------------------------------------------------------- albedo */
+
+static const char *const albedo_mode_names[] = {"multiply", "mod2x", "ssbump"};
+
+int bb_albedo_mode_parse(const char *name, bb_albedo_mode *out) {
+  if (!name || !out)
+    return -1;
+  for (int i = 0; i < 3; i++)
+    if (strcmp(name, albedo_mode_names[i]) == 0) {
+      *out = (bb_albedo_mode)i;
+      return 0;
+    }
+  return -1;
+}
+
+const char *bb_albedo_mode_name(bb_albedo_mode mode) {
+  int i = (int)mode;
+  return i >= 0 && i < 3 ? albedo_mode_names[i] : "unknown";
+}
+
 /* ----------------------------------------------------------------- light */
 
 /* cos and sin of an angle in degrees, exact (0, 1, -1) at multiples of 90
@@ -244,6 +264,9 @@ static bb_status check_options(const bb_render_options *o, bb_error *err) {
     return bb__fail(err, BB_ERR_ARGUMENT, "render: options are NULL");
   if (!find_mode(o->mode))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: unknown mode %d", (int)o->mode);
+  if ((int)o->albedo_mode < 0 || (int)o->albedo_mode > (int)BB_ALBEDO_SSBUMP)
+    return bb__fail(err, BB_ERR_ARGUMENT, "render: unknown albedo mode %d",
+                    (int)o->albedo_mode);
   if (o->tile_x < 1 || o->tile_y < 1 || o->tile_x > 64 || o->tile_y > 64)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "render: tile counts must be in 1..64 (got %dx%d)", o->tile_x,
@@ -368,16 +391,29 @@ static void add_specular(const render_job *job, const double n[3], double rgb[3]
   }
 }
 
+/* The albedo factor of texel i by the albedo mode (Source's TextureCombine:
+ * mod2x is 2 A per channel; an ssbump detail used as an albedo is the grey
+ * dot(A, 2/3)). */
 static void albedo_of(const render_job *job, size_t i, double a[3]) {
   const bb_image *albedo = job->maps->albedo;
-  const double scale = job->o->albedo_mod2x ? 2.0 : 1.0;
   if (!albedo) {
-    a[0] = a[1] = a[2] = scale;
+    a[0] = a[1] = a[2] = 1.0;
     return;
   }
   const float *v = texel_of(albedo, i);
   for (int c = 0; c < 3; c++)
-    a[c] = scale * (double)(albedo->channels >= 3 ? v[c] : v[0]);
+    a[c] = (double)(albedo->channels >= 3 ? v[c] : v[0]);
+  switch (job->o->albedo_mode) {
+  case BB_ALBEDO_MOD2X:
+    for (int c = 0; c < 3; c++)
+      a[c] *= 2.0;
+    break;
+  case BB_ALBEDO_SSBUMP:
+    a[0] = a[1] = a[2] = (2.0 / 3.0) * (a[0] + a[1] + a[2]);
+    break;
+  case BB_ALBEDO_MULTIPLY:
+    break;
+  }
 }
 
 static void shade_texel(const render_job *job, size_t i, float *out) {
@@ -520,8 +556,8 @@ char *bb_render_options_describe(const bb_render_options *o) {
   } else {
     t = append(t, &n, "lightmap=none\n");
   }
-  t = append(t, &n, "specular=%.9g\nalbedo_mod2x=%d\ntile=%dx%d\n", o->specular_exponent,
-             o->albedo_mod2x ? 1 : 0, o->tile_x, o->tile_y);
+  t = append(t, &n, "specular=%.9g\nalbedo_mode=%s\ntile=%dx%d\n", o->specular_exponent,
+             bb_albedo_mode_name(o->albedo_mode), o->tile_x, o->tile_y);
   if (o->crop_width > 0)
     t = append(t, &n, "crop=%d,%d,%d,%d\n", o->crop_x, o->crop_y, o->crop_width,
                o->crop_height);

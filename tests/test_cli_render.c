@@ -246,7 +246,7 @@ Test(cli_render, help_lists_the_options) {
   cli_result r = RUN("render", "--help");
   cr_assert_eq(r.code, 0);
   const char *words[] = {"--light AZ,EL", "default 135,45", "--lightmap", "--specular",
-                         "--albedo",      "--mod2x",        "--compare",  "--tile",
+                         "--albedo",      "--albedo-mode",        "--compare",  "--tile",
                          "--orbit",       "--crop"};
   for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
     cr_assert(strstr(r.out, words[i]), "%s missing", words[i]);

@@ -118,6 +118,11 @@ Test(render, mode_names_and_needs) {
   cr_assert_eq(bb_render_mode_needs(BB_RENDER_NORMAL_AO),
                BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_AO);
   cr_assert_eq(bb_render_mode_needs((bb_render_mode)77), 0u);
+  bb_albedo_mode a = BB_ALBEDO_MULTIPLY;
+  cr_assert_eq(bb_albedo_mode_parse("ssbump", &a), 0);
+  cr_assert_eq(a, BB_ALBEDO_SSBUMP);
+  cr_assert_neq(bb_albedo_mode_parse("mod4x", &a), 0);
+  cr_assert_str_eq(bb_albedo_mode_name(BB_ALBEDO_MOD2X), "mod2x");
 }
 
 /* Azimuth counter-clockwise on screen from the right, +Y down: 90 degrees is
@@ -242,8 +247,9 @@ Test(render, flat_specular_is_blinn_phong) {
   scene_free(&sc);
 }
 
-/* Albedo multiplies the diffuse, not the highlight; mod2x doubles it. */
-Test(render, albedo_and_mod2x) {
+/* Albedo multiplies the diffuse, not the highlight; mod2x doubles it; an
+ * ssbump detail multiplies by the grey dot(A, 2/3). */
+Test(render, albedo_modes) {
   bb_image albedo, grey;
   scene sc;
   scene_make(&sc, 6, 5, flat, 4.0f, 16);
@@ -261,7 +267,20 @@ Test(render, albedo_and_mod2x) {
   bb_image img = render(&m, &o);
   assert_uniform(&img, (double[]){0.5, 0.25, 1.0}, 1e-6, "albedo");
   bb_image_free(&img);
-  o.albedo_mod2x = 1;
+  o.albedo_mode = BB_ALBEDO_MOD2X;
+  img = render(&m, &o);
+  assert_uniform(&img, (double[]){1.0, 0.5, 2.0}, 1e-6, "mod2x");
+  bb_image_free(&img);
+  o.albedo_mode = BB_ALBEDO_SSBUMP;
+  img = render(&m, &o);
+  assert_uniform(&img, (double[]){7.0 / 6.0, 7.0 / 6.0, 7.0 / 6.0}, 1e-6,
+                 "(2/3)(0.5 + 0.25 + 1)");
+  bb_image_free(&img);
+  m.albedo = NULL;
+  img = render(&m, &o);
+  assert_uniform(&img, (double[]){1.0, 1.0, 1.0}, 1e-6, "no albedo: 1 in any mode");
+  bb_image_free(&img);
+  o.albedo_mode = BB_ALBEDO_MOD2X;
   m.albedo = &grey;
   img = render(&m, &o);
   assert_uniform(&img, (double[]){0.5, 0.5, 0.5}, 1e-6, "mod2x grey");
@@ -468,9 +487,9 @@ Test(render, describe_names_every_option) {
   bb_render_options_init(&o);
   char *text = bb_render_options_describe(&o);
   cr_assert_not_null(text);
-  cr_assert_str_eq(text,
-                   "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
-                   "lightmap=none\nspecular=0\nalbedo_mod2x=0\ntile=1x1\ncrop=none\n");
+  cr_assert_str_eq(
+      text, "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
+            "lightmap=none\nspecular=0\nalbedo_mode=multiply\ntile=1x1\ncrop=none\n");
   free(text);
   o.dynamic_light = 0;
   o.static_light = 1;
