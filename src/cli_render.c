@@ -388,6 +388,11 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
 static int check_view(const render_args *a, const bb_image *size) {
   const bb_render_options *o = &a->render;
   long w = (long)size->width * o->tile_x, h = (long)size->height * o->tile_y;
+  if (w > BB_MAX_DIMENSION || h > BB_MAX_DIMENSION || w * h > BB_MAX_PIXELS)
+    return cli_usage_error(
+        render_command.name,
+        "--tile %d makes a %ldx%ld picture, over the maximum (%ld texels)", o->tile_x, w,
+        h, (long)BB_MAX_PIXELS);
   if (o->crop_width > 0 &&
       ((long)o->crop_x + o->crop_width > w || (long)o->crop_y + o->crop_height > h))
     return cli_usage_error(render_command.name,

@@ -205,6 +205,21 @@ Test(cli_render, usage_errors) {
   expect_no_new_files(0);
 }
 
+/* Checked once the size is known, before the bake: 8 x 1025 squared is over
+ * the 8192 x 8192 maximum. */
+Test(cli_render, tiles_over_the_maximum) {
+  bb_image h;
+  cr_assert_eq(bb_image_alloc(&h, 1025, 1025, 1, NULL), BB_OK);
+  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL};
+  cr_assert_eq(bb_image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
+  bb_image_free(&h);
+  cli_result r =
+      RUN("render", tmp("big.png"), "--scale", "8", "--tile", "8", "-o", tmp("o.png"));
+  expect_one_line_error(&r, 2, "8200x8200 picture, over the maximum");
+  cli_result_free(&r);
+  expect_no_new_files(1);
+}
+
 Test(cli_render, albedo_of_another_size) {
   int before = files_starting_with("") - 2;
   cli_result r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16",
@@ -246,7 +261,7 @@ Test(cli_render, help_lists_the_options) {
   cli_result r = RUN("render", "--help");
   cr_assert_eq(r.code, 0);
   const char *words[] = {"--light AZ,EL", "default 135,45", "--lightmap", "--specular",
-                         "--albedo",      "--albedo-mode",        "--compare",  "--tile",
+                         "--albedo",      "--albedo-mode",  "--compare",  "--tile",
                          "--orbit",       "--crop"};
   for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
     cr_assert(strstr(r.out, words[i]), "%s missing", words[i]);
