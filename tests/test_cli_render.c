@@ -149,7 +149,9 @@ Test(cli_render, bit_identical_for_any_thread_count) {
   bb_image_free(&b);
 }
 
-Test(cli_render, maps_of_different_sizes) {
+/* Maps of different sizes, and a 1-channel file as the ssbump: exit 1, one
+ * line naming the file, no output and no temporary file. */
+Test(cli_render, bad_maps) {
   bake_pit_maps();
   cli_result r = RUN("bake", fixture("noise_96x80.png"), "--scale", "8", "--rays", "16",
                      "-q", "--ao", tmp("ao_noise.png"));
@@ -161,14 +163,8 @@ Test(cli_render, maps_of_different_sizes) {
   expect_one_line_error(&r, 1, "96x80, but the other maps are 65x65");
   cr_assert(strstr(r.err, "ao_noise.png"), "names the file: %s", r.err);
   cli_result_free(&r);
-  expect_no_new_files(before);
-}
-
-Test(cli_render, one_channel_ssbump) {
-  bake_pit_maps();
-  int before = files_starting_with("") - 2;
-  cli_result r = RUN("render", "--ssbump", tmp("a.exr"), "-o", tmp("out.png"));
-  expect_one_line_error(&r, 1, "1 channel; a ssbump map needs 3");
+  r = RUN("render", "--ssbump", tmp("a.exr"), "-o", tmp("out.png"));
+  expect_one_line_error(&r, 1, "a.exr: 1 channel; a ssbump map needs 3");
   cli_result_free(&r);
   expect_no_new_files(before);
 }
@@ -181,19 +177,11 @@ Test(cli_render, usage_errors) {
     const char *words;
   } cases[] = {
       {{"render", pit, "--scale", "8", "--light", "0,95", "-o", tmp("o.png")}, "0..90"},
-      {{"render", pit, "--scale", "8", "--light", "0", "-o", tmp("o.png")}, "2 comma"},
       {{"render", pit, "--scale", "8", "-o", tmp("o.gif")}, "--orbit"},
-      {{"render", pit, "-o", tmp("o.png")}, "--scale is required"},
       {{"render", pit, "--scale", "8", "--ssbump", pit, "-o", tmp("o.png")}, "not both"},
       {{"render", "--normal", pit, "-o", tmp("o.png")}, "needs --ssbump"},
-      {{"render", pit, "--scale", "8", "--lightmap", "1,2,3", "-o", tmp("o.png")},
-       "9 comma"},
-      {{"render", pit, "--scale", "8", "--lightmap", "basis", "--orbit", "3", "-o",
-        tmp("o.gif")},
-       "give --light"},
       {{"render", pit, "--scale", "8", "--crop", "60,0,10,10", "-o", tmp("o.png")},
        "not inside the 65x65"},
-      {{"render", pit, "--scale", "8"}, "-o OUT is required"},
       {{"sheet", pit, "--scale", "8", "--panel-size", "4", "-o", tmp("s.png")},
        "16..4096"},
   };
@@ -269,8 +257,5 @@ Test(cli_render, help_lists_the_options) {
   r = RUN("sheet", "--help");
   cr_assert_eq(r.code, 0);
   cr_assert(strstr(r.out, "--panel-size N"));
-  cli_result_free(&r);
-  r = RUN("--help");
-  cr_assert(strstr(r.out, "render") && strstr(r.out, "sheet"));
   cli_result_free(&r);
 }
