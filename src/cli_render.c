@@ -356,9 +356,9 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
   char reason[256];
   if (raw.channels < map_kinds[kind].channels) {
     snprintf(reason, sizeof reason, "%d channel%s; %s %s map needs %d (%s)", raw.channels,
-             raw.channels == 1 ? "" : "s", kind == MAP_AO ? "an" : "a",
-             map_kinds[kind].name, map_kinds[kind].channels,
-             map_kinds[kind].channels_why);
+             raw.channels == 1 ? "" : "s",
+             (kind == MAP_AO || kind == MAP_SSBUMP) ? "an" : "a", map_kinds[kind].name,
+             map_kinds[kind].channels, map_kinds[kind].channels_why);
   } else if (*size && (raw.width != (*size)->width || raw.height != (*size)->height)) {
     snprintf(reason, sizeof reason, "%dx%d, but the other maps are %dx%d", raw.width,
              raw.height, (*size)->width, (*size)->height);

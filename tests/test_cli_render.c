@@ -164,7 +164,7 @@ Test(cli_render, bad_maps) {
   cr_assert(strstr(r.err, "ao_noise.png"), "names the file: %s", r.err);
   cli_result_free(&r);
   r = RUN("render", "--ssbump", tmp("a.exr"), "-o", tmp("out.png"));
-  expect_one_line_error(&r, 1, "a.exr: 1 channel; a ssbump map needs 3");
+  expect_one_line_error(&r, 1, "a.exr: 1 channel; an ssbump map needs 3");
   cli_result_free(&r);
   expect_no_new_files(before);
 }
