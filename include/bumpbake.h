@@ -541,6 +541,180 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
  * bb_provenance_format's lines; NULL when out of memory. */
 char *bb_renderbump_describe(const bb_renderbump_options *o,
                              const bb_renderbump_result *r);
+/* =================================================================
+ * Converting, combining and programming maps (README "Converting and
+ * combining maps"): normal2ssbump, ssbump2normal, combine, DOOM 3's image
+ * programs and flipcode's slope map. Every function here works on decoded
+ * values: normals as N in [-1, 1] (+Y down), ssbump, weights and ao in
+ * [0, 1], colours in [0, 1].
+ * ================================================================= */
+
+/* ------------------------------------------------- normal map decoding */
+
+typedef struct bb_normal_decode_options {
+  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
+  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
+} bb_normal_decode_options;
+
+/* Defaults: +Y down, normalize on. */
+void bb_normal_decode_options_init(bb_normal_decode_options *o);
+
+/* The normals a normal-map file holds, from the values bb_image_read
+ * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
+ * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
+ * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
+ * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
+ * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
+ * texel. Allocates normals: 3 channels, same size. */
+bb_status bb_normal_map_decode(const bb_image *values, int is_float,
+                               const bb_normal_decode_options *o, bb_image *normals,
+                               bb_error *err);
+
+/* ------------------------------------------------------ ssbump to normal */
+
+/* What a three-channel basis map holds. */
+typedef enum bb_ssbump_kind {
+  BB_SSBUMP_LINEAR = 0, /* s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump */
+  BB_SSBUMP_SQUARED     /* w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake --weights */
+} bb_ssbump_kind;
+
+/* The normal of a basis map, the paper's "sum of the basis vectors weighted
+ * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
+ * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
+ * f(s) = s for BB_SSBUMP_LINEAR and sqrt(max(0, s)) for BB_SSBUMP_SQUARED (the
+ * square root undoes normal2ssbump's square, so both kinds give back N
+ * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
+ * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
+bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
+                              bb_image *normals, bb_error *err);
+
+/* ------------------------------------------------------------- combine */
+
+/* The kind of map combine works on; it fixes the operators and the flat,
+ * unoccluded texel (ssbump 1/sqrt(3), weights 1/3, ao 1, normal (0, 0, 1)). */
+typedef enum bb_map_kind {
+  BB_MAP_SSBUMP = 0, /* 3 basis channels (further channels: see bb_combine_detail) */
+  BB_MAP_WEIGHTS,    /* normal2ssbump's weights, 3 basis channels */
+  BB_MAP_AO,         /* 1 channel */
+  BB_MAP_NORMAL      /* decoded unit normals, 3 channels */
+} bb_map_kind;
+
+/* Parses "ssbump", "weights", "ao", "normal"; returns 0 on success. */
+int bb_map_kind_parse(const char *name, bb_map_kind *out);
+const char *bb_map_kind_name(bb_map_kind kind);
+
+/* Channels the kind's operators act on: 3, or 1 for ao. */
+int bb_map_kind_channels(bb_map_kind kind);
+
+/* The flat, unoccluded texel of kind (channels 0..bb_map_kind_channels-1 of
+ * texel) as it reads back from a file of that sample depth: an integer file
+ * of bits_per_sample bits stores it rounded to a code (an 8-bit ssbump holds
+ * 147/255, an 8-bit normal map 128/255, which decodes to x = y = 1/255), a
+ * half-float file (is_float, 16 bits) to 11 significant bits, a float file
+ * exactly (as float). Normals are returned decoded. */
+void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
+                       float texel[3]);
+
+/* Blends two maps of the same size: t = (1 - m) a + m b, m = mask channel 0
+ * at the texel (clamped to [0, 1]) or the constant mix when mask is NULL.
+ * ssbump, weights, ao: every channel, linearly (a and b need the same channel
+ * count). normal: normalize(t) on channels 0..2. m = 0 gives a and m = 1
+ * gives b bit for bit. Allocates out with a's channels (3 for normals). */
+bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
+                           float mix, bb_map_kind kind, bb_image *out, bb_error *err);
+
+/* Overlays a detail map on a base of the same size. flat is the detail's own
+ * flat texel (bb_map_flat_texel of the detail file's depth), or NULL for the
+ * exact flat of the kind; a detail texel equal to it leaves the base texel
+ * unchanged bit for bit.
+ * ssbump, weights, ao: out_c = base_c * detail_c / flat_c on the kind's
+ * channels (visibilities multiply; a flat detail is the identity, on either
+ * side); further base channels (Valve's alpha) are copied.
+ * normal: DOOM 3's addnormals: n = base (z rebuilt as sqrt(1 - x^2 - y^2)
+ * when |n| < 1), n.xy += detail.xy - flat.xy, out = normalize(n).
+ * Allocates out with base's channels. */
+bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
+                            bb_map_kind kind, const float *flat, bb_image *out,
+                            bb_error *err);
+
+/* ---------------------------------------------------- DOOM 3 programs */
+
+/* A parsed DOOM 3 image program, such as "addnormals(a_local.tga,
+ * heightmap(a_h.tga, 4))": opaque, made by bb_program_parse. */
+typedef struct bb_program bb_program;
+
+/* Parses text in DOOM 3's image-program syntax: heightmap(img, scale),
+ * addnormals(a, b), smoothnormals(a), add(a, b), scale(a, r, g, b, a),
+ * invertAlpha(a), invertColor(a), makeIntensity(a), makeAlpha(a), _flat, and
+ * image names (file paths; "double quotes" allow spaces and commas). Function
+ * names are case-insensitive, as in id Tech 4. A syntax error is
+ * BB_ERR_ARGUMENT with a message giving the 1-based column; an unknown
+ * function's message lists the known ones. Free *out with bb_program_free. */
+bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
+
+void bb_program_free(bb_program *program);
+
+/* Reads the image a program names: fills img (any channel count) and info
+ * (may be NULL) as bb_image_read does. */
+typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
+                                     bb_image_info *info, bb_error *err);
+
+typedef struct bb_program_options {
+  const char *base_dir;   /* image names are relative to it; NULL or "" = as given */
+  bb_image_loader loader; /* NULL = bb_image_read */
+  void *loader_user;
+} bb_program_options;
+
+void bb_program_options_init(bb_program_options *o);
+
+/* Evaluates a program as id Tech 4 does (README "program" gives each
+ * formula), in float rather than bytes. Inside, every image is RGBA in
+ * [0, 1] standing for id's bytes / 255 (files are read as value / max code,
+ * clamped; grey gives R = G = B, no alpha gives A = 1), and normal-map
+ * operations decode N = (255 v - 128) / 127 and encode v = (127 N + 128) /
+ * 255, id's own mapping (byte 128 is 0). When the program makes a normal map
+ * (heightmap, addnormals, smoothnormals or _flat anywhere in it, as id marks
+ * TD_BUMP), out holds its decoded N (3 channels, +Y down) and *is_normal_map
+ * is 1; otherwise out holds RGBA colour (4 channels) and *is_normal_map is 0.
+ * Errors name the file or the function and its column. */
+bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
+                         bb_image *out, int *is_normal_map, bb_error *err);
+
+/* --------------------------------------------------- flipcode slope map */
+
+/* Packs slopes dx, dy (each clamped to -7..7) into flipcode's byte: dx in
+ * the low nibble, dy in the high nibble, each as a 4-bit two's complement
+ * number (-1 is 0xF, -7 is 0x9). */
+uint8_t bb_slope_encode(int dx, int dy);
+
+/* Unpacks a slope byte; nibble 0x8 reads as -8 (bb_slope_encode never
+ * writes it). */
+void bb_slope_decode(uint8_t byte, int *dx, int *dy);
+
+/* flipcode's slope map of a 1-channel height field h: for texel (x, y),
+ * dx = S (h(x+1, y) - h(x, y)) and dy = S (h(x, y+1) - h(x, y)) in texels
+ * (S = height_scale; forward differences, neighbours by addressing),
+ * rounded to the nearest integer (halves away from 0) and clamped to -7..7.
+ * Allocates out: 1 channel holding byte / 255, so an 8-bit file stores the
+ * byte itself. */
+bb_status bb_slope_map(const bb_image *height, float height_scale,
+                       bb_addressing addressing, bb_image *out, bb_error *err);
+
+/* Unit vector towards a light at azimuth_degrees (0 = from the right, +x;
+ * 90 = from the bottom, +y, since y is down) and elevation_degrees above the
+ * surface (90 = overhead). */
+void bb_light_direction(double azimuth_degrees, double elevation_degrees,
+                        double light[3]);
+
+/* The 16 x 16 lighting table: table[byte] = max(0, N.L) with N =
+ * normalize(-dx, -dy, 1) for the slopes (dx, dy) the byte decodes to and L
+ * a unit light direction. Row = high nibble (dy), column = low nibble (dx). */
+void bb_slope_table(const double light[3], float table[256]);
+
+/* Lights a slope map through a table: out = table[byte] per texel, byte =
+ * round(255 * slope value). Allocates out: 1 channel. */
+bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image *out,
+                         bb_error *err);
 
 /* ----------------------------------------------------------------- render */
 
