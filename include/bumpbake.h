@@ -625,8 +625,8 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 
 /* Overlays a detail map on a base of the same size. flat is the detail's own
  * flat texel (bb_map_flat_texel of the detail file's depth), or NULL for the
- * exact flat of the kind; a detail texel equal to it leaves the base texel
- * unchanged bit for bit.
+ * exact flat of the kind; a detail texel equal to it (within 1e-6, far
+ * under one 16-bit code) leaves the base texel unchanged bit for bit.
  * ssbump, weights, ao: out_c = base_c * detail_c / flat_c on the kind's
  * channels (visibilities multiply; a flat detail is the identity, on either
  * side); further base channels (Valve's alpha) are copied.
@@ -653,6 +653,13 @@ typedef struct bb_program bb_program;
 bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
 
 void bb_program_free(bb_program *program);
+
+/* The image names a program reads, in the order it reads them (as written,
+ * unquoted; _flat is not a file and is left out): up to cap of them into
+ * names (pointers into the program, valid until bb_program_free). Returns
+ * how many there are, which may exceed cap. For dependency tracking, as
+ * id's timestamps, and to keep an output from replacing an input. */
+size_t bb_program_images(const bb_program *program, const char **names, size_t cap);
 
 /* Reads the image a program names: fills img (any channel count) and info
  * (may be NULL) as bb_image_read does. */

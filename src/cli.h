@@ -16,5 +16,9 @@ int bb_cli_info(int argc, char **argv);
 int bb_cli_renderbumpflat(int argc, char **argv);
 int bb_cli_render(int argc, char **argv);
 int bb_cli_sheet(int argc, char **argv);
+int bb_cli_normal2ssbump(int argc, char **argv);
+int bb_cli_ssbump2normal(int argc, char **argv);
+int bb_cli_combine(int argc, char **argv);
+int bb_cli_program(int argc, char **argv);
 
 #endif /* BB_CLI_H */

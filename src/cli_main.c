@@ -22,6 +22,10 @@ static const subcommand subcommands[] = {
     {"renderbumpflat", bb_cli_renderbumpflat, "DOOM 3's RenderBumpFlat: a flat sculpt's normal map and height"},
     {"render", bb_cli_render, "light the maps as Source does (ssbump, normal, ao; orbit)"},
     {"sheet", bb_cli_sheet, "one labelled contact sheet of every map of a bake"},
+    {"normal2ssbump", bb_cli_normal2ssbump, "Valve's tool: a normal map to basis weights"},
+    {"ssbump2normal", bb_cli_ssbump2normal, "the normal an ssbump (or weights) stands for"},
+    {"combine", bb_cli_combine, "blend two maps, or overlay a detail map"},
+    {"program", bb_cli_program, "evaluate a DOOM 3 image program (heightmap, addnormals...)"},
 };
 
 enum { SUBCOMMAND_COUNT = sizeof subcommands / sizeof subcommands[0] };

@@ -10,13 +10,13 @@
 #define BB__PROGRAM_MAX_DEPTH 64
 
 typedef enum prog_op {
-  PROG_IMAGE = 0,   /* a file; name holds its path */
-  PROG_FLAT,        /* _flat: the flat normal map */
-  PROG_HEIGHTMAP,   /* heightmap(a, scale) */
-  PROG_ADDNORMALS,  /* addnormals(a, b) */
+  PROG_IMAGE = 0,  /* a file; name holds its path */
+  PROG_FLAT,       /* _flat: the flat normal map */
+  PROG_HEIGHTMAP,  /* heightmap(a, scale) */
+  PROG_ADDNORMALS, /* addnormals(a, b) */
   PROG_SMOOTHNORMALS,
-  PROG_ADD,         /* add(a, b) */
-  PROG_SCALE,       /* scale(a, r, g, b, a) */
+  PROG_ADD,   /* add(a, b) */
+  PROG_SCALE, /* scale(a, r, g, b, a) */
   PROG_INVERT_ALPHA,
   PROG_INVERT_COLOR,
   PROG_MAKE_INTENSITY,

@@ -20,7 +20,14 @@
 
 /* ----------------------------------------------------------------- tokens */
 
-typedef enum tok_kind { TOK_END, TOK_OPEN, TOK_CLOSE, TOK_COMMA, TOK_NAME, TOK_QUOTED } tok_kind;
+typedef enum tok_kind {
+  TOK_END,
+  TOK_OPEN,
+  TOK_CLOSE,
+  TOK_COMMA,
+  TOK_NAME,
+  TOK_QUOTED
+} tok_kind;
 
 typedef struct token {
   tok_kind kind;
@@ -31,10 +38,10 @@ typedef struct token {
 
 typedef struct parser {
   const char *text;
-  const char *p;     /* next character to read */
-  token tok;         /* the current token */
+  const char *p; /* next character to read */
+  token tok;     /* the current token */
   bb_error *err;
-  bb_status status;  /* first error, BB_OK while none */
+  bb_status status; /* first error, BB_OK while none */
 } parser;
 
 static int is_space(char c) {
@@ -50,8 +57,8 @@ static void fail_at(parser *ps, int column, const char *fmt, const char *detail)
     return;
   char what[320];
   snprintf(what, sizeof what, fmt, detail);
-  ps->status = bb__fail(ps->err, BB_ERR_ARGUMENT, "syntax error at column %d: %s", column,
-                        what);
+  ps->status =
+      bb__fail(ps->err, BB_ERR_ARGUMENT, "syntax error at column %d: %s", column, what);
 }
 
 /* Reads the next token into ps->tok. */
@@ -175,10 +182,11 @@ static void fail_unknown_function(parser *ps, const token *t) {
     strcat(known, FUNCTIONS[i].name);
     strcat(known, i + 1 < FUNCTION_COUNT ? ", " : "");
   }
-  ps->status = bb__fail(ps->err, BB_ERR_ARGUMENT,
-                        "unknown function '%.*s' at column %d (known: %s, and the image "
-                        "_flat)",
-                        (int)(t->length < 64 ? t->length : 64), t->start, t->column, known);
+  ps->status =
+      bb__fail(ps->err, BB_ERR_ARGUMENT,
+               "unknown function '%.*s' at column %d (known: %s, and the image "
+               "_flat)",
+               (int)(t->length < 64 ? t->length : 64), t->start, t->column, known);
 }
 
 /* --------------------------------------------------------------- the tree */
@@ -255,7 +263,8 @@ static prog_node *parse_call(parser *ps, const function *f, int column, int dept
 
 /* An image name: a path, or _flat. */
 static prog_node *parse_image(parser *ps, const token *t) {
-  int is_flat = t->kind == TOK_NAME && t->length == 5 && strncasecmp(t->start, "_flat", 5) == 0;
+  int is_flat =
+      t->kind == TOK_NAME && t->length == 5 && strncasecmp(t->start, "_flat", 5) == 0;
   prog_node *n = new_node(ps, is_flat ? PROG_FLAT : PROG_IMAGE, t->column);
   if (!n || is_flat)
     return n;
@@ -329,6 +338,25 @@ bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err) {
   p->root = root;
   *out = p;
   return BB_OK;
+}
+
+static size_t collect_images(const prog_node *n, const char **names, size_t cap,
+                             size_t count) {
+  if (!n)
+    return count;
+  if (n->op == PROG_IMAGE) {
+    if (count < cap)
+      names[count] = n->name;
+    return count + 1;
+  }
+  count = collect_images(n->args[0], names, cap, count);
+  return collect_images(n->args[1], names, cap, count);
+}
+
+size_t bb_program_images(const bb_program *program, const char **names, size_t cap) {
+  if (!program)
+    return 0;
+  return collect_images(program->root, names, names ? cap : 0, 0);
 }
 
 void bb_program_free(bb_program *program) {

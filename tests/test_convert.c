@@ -25,7 +25,8 @@ static bb_image gentle_height(int w, int h) {
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++)
       img.pixels[y * w + x] =
-          (float)(0.5 + 0.25 * sin(2 * 3.14159265358979323846 * x / w) * cos(2 * 3.14159265358979323846 * 2 * y / h));
+          (float)(0.5 + 0.25 * sin(2 * 3.14159265358979323846 * x / w) *
+                            cos(2 * 3.14159265358979323846 * 2 * y / h));
   return img;
 }
 
@@ -54,10 +55,10 @@ static double max_difference(const bb_image *a, const bb_image *b) {
 
 Test(convert, integer_codes_decode_with_127_5_as_zero) {
   bb_image v = image(4, 1, 3);
-  set3(&v, 0, 0, 0.5f, 0.5f, 1.0f);                  /* 127.5: exactly flat */
-  set3(&v, 1, 0, 128.0f / 255, 128.0f / 255, 1.0f);  /* DOOM 3's zero */
-  set3(&v, 2, 0, 1.0f, 0.5f, 0.5f);                  /* +x */
-  set3(&v, 3, 0, 0.0f, 0.0f, 0.0f);                  /* (-1, -1, -1) */
+  set3(&v, 0, 0, 0.5f, 0.5f, 1.0f);                 /* 127.5: exactly flat */
+  set3(&v, 1, 0, 128.0f / 255, 128.0f / 255, 1.0f); /* DOOM 3's zero */
+  set3(&v, 2, 0, 1.0f, 0.5f, 0.5f);                 /* +x */
+  set3(&v, 3, 0, 0.0f, 0.0f, 0.0f);                 /* (-1, -1, -1) */
   bb_normal_decode_options o;
   bb_normal_decode_options_init(&o);
   o.normalize = 0;
@@ -142,7 +143,8 @@ Test(convert, ssbump2normal_of_an_unoccluded_bake_is_its_normal) {
   bb_image h = gentle_height(48, 32);
   bb_bake_result r = bake(&h, 2.0f, 1);
   for (int i = 0; i < 48 * 32; i++)
-    cr_assert_eq(r.ao.pixels[i], 1.0f, "texel %d is occluded: not the case under test", i);
+    cr_assert_eq(r.ao.pixels[i], 1.0f, "texel %d is occluded: not the case under test",
+                 i);
   bb_image n;
   bb_error err;
   cr_assert_eq(bb_ssbump_to_normal(&r.ssbump, BB_SSBUMP_LINEAR, &n, &err), BB_OK, "%s",
