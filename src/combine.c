@@ -3,7 +3,7 @@
  *
  * Invariant: an identity input gives the base back bit for bit. A blend
  * factor of exactly 0 (or 1) copies a (or b); a detail texel equal to the
- * detail's flat texel copies the base texel. Every other texel is computed
+ * detail's flat texel (within FLAT_TOLERANCE) copies the base texel. Every other texel is computed
  * in double from its own inputs only. */
 #include "maps_internal.h"
 
@@ -167,6 +167,11 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 
 /* ----------------------------------------------------------------- detail */
 
+/* How close a detail texel must be to flat to count as flat: far below one
+ * 16-bit code (1.5e-5), far above the float rounding by which two ways of
+ * turning the same code into a float may differ. */
+#define FLAT_TOLERANCE 1e-6
+
 static bb_status check_detail(const bb_image *base, const bb_image *detail,
                               bb_map_kind kind, const float *flat, bb_error *err) {
   const int need = bb_map_kind_channels(kind);
@@ -182,8 +187,9 @@ static bb_status check_detail(const bb_image *base, const bb_image *detail,
   if (st == BB_OK && flat && kind != BB_MAP_NORMAL)
     for (int c = 0; c < need; c++)
       if (!(flat[c] > 0.0f) || !isfinite(flat[c]))
-        return bb__fail(err, BB_ERR_ARGUMENT, "detail: flat value %g of channel %d is not > 0",
-                        (double)flat[c], c);
+        return bb__fail(err, BB_ERR_ARGUMENT,
+                        "detail: flat value %g of channel %d is not > 0", (double)flat[c],
+                        c);
   return st;
 }
 
@@ -191,8 +197,9 @@ static void detail_linear_texel(const float *base, const float *detail, const fl
                                 int kind_channels, int channels, float *out) {
   memcpy(out, base, (size_t)channels * sizeof(float));
   for (int c = 0; c < kind_channels; c++) {
-    /* d / f is exactly 1 in double when d == f, and base * 1 is base. */
     double ratio = (double)detail[c] / (double)flat[c];
+    if (fabs(ratio - 1.0) <= FLAT_TOLERANCE)
+      continue; /* a flat detail texel: the base's value stays as it is */
     out[c] = (float)((double)base[c] * ratio);
   }
 }
@@ -202,7 +209,7 @@ static void detail_normal_texel(const float *base, const float *detail, const fl
   memcpy(out, base, (size_t)channels * sizeof(float));
   double dx = (double)detail[0] - (double)flat[0];
   double dy = (double)detail[1] - (double)flat[1];
-  if (dx == 0.0 && dy == 0.0)
+  if (fabs(dx) <= FLAT_TOLERANCE && fabs(dy) <= FLAT_TOLERANCE)
     return; /* adding nothing leaves the base as it is */
   double n[3] = {base[0], base[1], base[2]}, sum[3];
   bb__add_normals(n, dx, dy, sum);

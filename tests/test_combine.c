@@ -39,7 +39,8 @@ static void normalise_all(bb_image *n) {
 static int same_bits(const bb_image *a, const bb_image *b) {
   return a->width == b->width && a->height == b->height && a->channels == b->channels &&
          memcmp(a->pixels, b->pixels,
-                (size_t)a->width * (size_t)a->height * (size_t)a->channels * sizeof(float)) == 0;
+                (size_t)a->width * (size_t)a->height * (size_t)a->channels *
+                    sizeof(float)) == 0;
 }
 
 Test(combine, kind_names) {
@@ -64,7 +65,8 @@ Test(combine, flat_texels_as_files_hold_them) {
   bb_map_flat_texel(BB_MAP_SSBUMP, 32, 1, t);
   cr_assert_eq(t[1], (float)(1.0 / sqrt(3.0)));
   bb_map_flat_texel(BB_MAP_SSBUMP, 16, 1, t);
-  cr_assert_eq(t[0], 1182.0f / 2048.0f, "half: 11 significant bits, got %.9g", (double)t[0]);
+  cr_assert_eq(t[0], 1182.0f / 2048.0f, "half: 11 significant bits, got %.9g",
+               (double)t[0]);
   bb_map_flat_texel(BB_MAP_WEIGHTS, 8, 0, t);
   cr_assert_eq(t[0], 85.0f / 255.0f);
   bb_map_flat_texel(BB_MAP_AO, 8, 0, t);
@@ -77,22 +79,26 @@ Test(combine, flat_texels_as_files_hold_them) {
 }
 
 Test(combine, blend_end_points_are_bit_exact) {
-  bb_image a = noise_map(17, 11, 4, 1, 0.0f, 1.0f), b = noise_map(17, 11, 4, 2, 0.0f, 1.0f);
+  bb_image a = noise_map(17, 11, 4, 1, 0.0f, 1.0f),
+           b = noise_map(17, 11, 4, 2, 0.0f, 1.0f);
   bb_image zero_mask = uniform(17, 11, 1, (const float[]){0.0f}), out;
   cr_assert_eq(bb_combine_blend(&a, &b, NULL, 0.0f, BB_MAP_SSBUMP, &out, NULL), BB_OK);
   cr_assert(same_bits(&out, &a), "mix 0 must give the first map bit for bit");
   bb_image_free(&out);
-  cr_assert_eq(bb_combine_blend(&a, &b, &zero_mask, 0.7f, BB_MAP_SSBUMP, &out, NULL), BB_OK);
+  cr_assert_eq(bb_combine_blend(&a, &b, &zero_mask, 0.7f, BB_MAP_SSBUMP, &out, NULL),
+               BB_OK);
   cr_assert(same_bits(&out, &a), "a zero mask must give the first map bit for bit");
   bb_image_free(&out);
   cr_assert_eq(bb_combine_blend(&a, &b, NULL, 1.0f, BB_MAP_WEIGHTS, &out, NULL), BB_OK);
   cr_assert(same_bits(&out, &b));
   bb_image_free(&out);
 
-  bb_image na = noise_map(17, 11, 3, 3, -1.0f, 1.0f), nb = noise_map(17, 11, 3, 4, -1.0f, 1.0f);
+  bb_image na = noise_map(17, 11, 3, 3, -1.0f, 1.0f),
+           nb = noise_map(17, 11, 3, 4, -1.0f, 1.0f);
   normalise_all(&na);
   normalise_all(&nb);
-  cr_assert_eq(bb_combine_blend(&na, &nb, &zero_mask, 0.5f, BB_MAP_NORMAL, &out, NULL), BB_OK);
+  cr_assert_eq(bb_combine_blend(&na, &nb, &zero_mask, 0.5f, BB_MAP_NORMAL, &out, NULL),
+               BB_OK);
   cr_assert(same_bits(&out, &na), "normals: a zero mask gives the base bit for bit");
   bb_image_free(&out);
   bb_image_free(&na);
@@ -142,8 +148,9 @@ Test(combine, flat_detail_leaves_the_base_bit_for_bit) {
       float flat[3];
       bb_map_flat_texel(kinds[k], bits ? 8 : 32, bits ? 0 : 1, flat);
       bb_image detail = uniform(13, 7, 3, flat);
-      cr_assert_eq(bb_combine_detail(&base, &detail, kinds[k], bits ? flat : NULL, &out, NULL),
-                   BB_OK);
+      cr_assert_eq(
+          bb_combine_detail(&base, &detail, kinds[k], bits ? flat : NULL, &out, NULL),
+          BB_OK);
       cr_assert(same_bits(&out, &base), "%s, %d-bit flat detail changed the base",
                 bb_map_kind_name(kinds[k]), bits ? 8 : 32);
       bb_image_free(&out);
@@ -168,9 +175,11 @@ Test(combine, ssbump_detail_multiplies_relative_to_flat) {
   bb_image_free(&out);
 
   bb_image flat_base = uniform(2, 2, 3, (const float[]){f, f, f});
-  cr_assert_eq(bb_combine_detail(&flat_base, &detail, BB_MAP_SSBUMP, NULL, &out, NULL), BB_OK);
+  cr_assert_eq(bb_combine_detail(&flat_base, &detail, BB_MAP_SSBUMP, NULL, &out, NULL),
+               BB_OK);
   for (int c = 0; c < 3; c++)
-    cr_assert_float_eq(out.pixels[c], detail.pixels[c], 1e-7, "flat base (x) detail = detail");
+    cr_assert_float_eq(out.pixels[c], detail.pixels[c], 1e-7,
+                       "flat base (x) detail = detail");
   bb_image_free(&out);
   bb_image_free(&flat_base);
   bb_image_free(&base);
@@ -201,15 +210,20 @@ Test(combine, mismatches_are_refused) {
   bb_image a = noise_map(4, 4, 3, 1, 0, 1), b = noise_map(5, 4, 3, 2, 0, 1);
   bb_image c4 = noise_map(4, 4, 4, 3, 0, 1), grey = noise_map(4, 4, 1, 4, 0, 1), out;
   bb_error err;
-  cr_assert_eq(bb_combine_blend(&a, &b, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_combine_blend(&a, &b, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err),
+               BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "4x4") && strstr(err.message, "5x4"), "%s", err.message);
   cr_assert_null(out.pixels);
-  cr_assert_eq(bb_combine_blend(&a, &c4, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_combine_blend(&a, &c4, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err),
+               BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "channels"), "%s", err.message);
-  cr_assert_eq(bb_combine_blend(&a, &a, NULL, 1.5f, BB_MAP_SSBUMP, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_combine_detail(&grey, &a, BB_MAP_SSBUMP, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_combine_blend(&a, &a, NULL, 1.5f, BB_MAP_SSBUMP, &out, &err),
+               BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_combine_detail(&grey, &a, BB_MAP_SSBUMP, NULL, &out, &err),
+               BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "base has 1 channel"), "%s", err.message);
-  cr_assert_eq(bb_combine_detail(&a, &b, BB_MAP_NORMAL, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_combine_detail(&a, &b, BB_MAP_NORMAL, NULL, &out, &err),
+               BB_ERR_ARGUMENT);
   a.pixels[5] = NAN;
   cr_assert_eq(bb_combine_detail(&a, &a, BB_MAP_AO, NULL, &out, &err), BB_ERR_VALUE);
   bb_image_free(&a);
