@@ -1,6 +1,7 @@
 /* cli_bake.c: `bumpbake bake`, every map from one height map in one pass
  * (one bb_bake call, so ssbump, ao and bent share a single trace). */
 #include "cli_common.h"
+#include "cli_slope.h"
 
 #include <stddef.h>
 #include <stdlib.h>
@@ -93,6 +94,8 @@ static const cli_option *const bake_options[] = {
     &opt_out_ao,
     &opt_out_bent,
     &opt_out_filtered,
+    &cli_opt_slope,
+    &cli_opt_slope_lit,
     &opt_prefix,
     &opt_json,
     &opt_quiet,
@@ -115,6 +118,7 @@ typedef struct bake_args {
   char *prefix_paths[OUTPUT_KIND_COUNT]; /* malloc'd paths made from -o */
   const char *prefix;
   int json, quiet;
+  cli_slope_args slope; /* --slope FILE, --lit AZ,EL */
 } bake_args;
 
 static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -123,6 +127,8 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
     a->paths[opt->id - CLI_OPT_OUT_NORMAL] = arg;
     return 0;
   }
+  if (cli_slope_owns(opt))
+    return cli_slope_option(bake_command.name, &a->slope, opt, arg);
   switch (opt->id) {
   case CLI_OPT_OUTPUT:
     a->prefix = arg;
@@ -159,8 +165,8 @@ static int expand_prefix(bake_args *a) {
 }
 
 /* Every output is checked before the (possibly long) bake starts. */
-static int check_outputs(const bake_args *a, const char *input) {
-  int any = 0;
+static int check_outputs(bake_args *a, const char *input) {
+  int any = a->slope.path != NULL;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
     if (!a->paths[k])
       continue;
@@ -177,8 +183,8 @@ static int check_outputs(const bake_args *a, const char *input) {
     return cli_usage_error(
         bake_command.name,
         "nothing to write: give -o PREFIX or at least one of --normal, "
-        "--weights, --ssbump, --ao, --bent, --filtered");
-  return 0;
+        "--weights, --ssbump, --ao, --bent, --filtered, --slope");
+  return cli_slope_check(bake_command.name, &a->slope, input, a->settings.depth);
 }
 
 static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
@@ -327,6 +333,8 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
     cli_run_set_input(run, input, &height, &a->settings);
     run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
     rc = write_outputs(a, run, &result);
+    if (!rc)
+      rc = cli_slope_write(run, &a->slope, &result.filtered, a->json || a->quiet);
     t.write = run->seconds_write;
   }
   if (!rc && a->json)
@@ -351,6 +359,7 @@ int bb_cli_bake(int argc, char **argv) {
     rc = bake_run(&run, &a, input);
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     free(a.prefix_paths[k]);
+  cli_slope_free(&a.slope);
   cli_run_free(&run);
   return rc;
 }

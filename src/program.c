@@ -235,7 +235,8 @@ static bb_status smoothnormals(evaluator *ev, value *v) {
       double n[3] = {0.0, 0.0, 0.0};
       for (int dy = -1; dy <= 1; dy++)
         for (int dx = -1; dx <= 1; dx++) {
-          const float *t = bb_image_texel(&orig, bb__wrap(x + dx, w), bb__wrap(y + dy, h));
+          const float *t =
+              bb_image_texel(&orig, bb__wrap(x + dx, w), bb__wrap(y + dy, h));
           if (smooth_skips(t))
             continue;
           for (int k = 0; k < 3; k++)

@@ -58,7 +58,8 @@ bb_status bb_slope_map(const bb_image *height, float height_scale,
       double here = *bb_image_texel(height, x, y);
       double right = *bb_image_texel(height, bb__address(x + 1, w, addressing), y);
       double below = *bb_image_texel(height, x, bb__address(y + 1, h, addressing));
-      uint8_t b = bb_slope_encode(slope_step(s * (right - here)), slope_step(s * (below - here)));
+      uint8_t b =
+          bb_slope_encode(slope_step(s * (right - here)), slope_step(s * (below - here)));
       *bb_image_texel(out, x, y) = (float)b / 255.0f;
     }
   return BB_OK;
@@ -66,7 +67,8 @@ bb_status bb_slope_map(const bb_image *height, float height_scale,
 
 void bb_light_direction(double azimuth_degrees, double elevation_degrees,
                         double light[3]) {
-  const double az = azimuth_degrees * BB__PI / 180.0, el = elevation_degrees * BB__PI / 180.0;
+  const double az = azimuth_degrees * BB__PI / 180.0,
+               el = elevation_degrees * BB__PI / 180.0;
   light[0] = cos(el) * cos(az);
   light[1] = cos(el) * sin(az);
   light[2] = sin(el);

@@ -35,7 +35,8 @@ static bb_status load_from(void *user, const char *path, bb_image *img,
     bb_status st = bb_image_alloc(img, src->width, src->height, src->channels, err);
     if (st == BB_OK)
       memcpy(img->pixels, src->pixels,
-             (size_t)src->width * (size_t)src->height * (size_t)src->channels * sizeof(float));
+             (size_t)src->width * (size_t)src->height * (size_t)src->channels *
+                 sizeof(float));
     if (info) {
       memset(info, 0, sizeof *info);
       info->alpha_channel = -1;
@@ -51,7 +52,8 @@ static void add_image(library *lib, const char *name, int w, int h, int channels
   named_image *it = &lib->items[lib->count++];
   it->name = name;
   cr_assert_eq(bb_image_alloc(&it->img, w, h, channels, NULL), BB_OK);
-  memcpy(it->img.pixels, values, (size_t)w * (size_t)h * (size_t)channels * sizeof(float));
+  memcpy(it->img.pixels, values,
+         (size_t)w * (size_t)h * (size_t)channels * sizeof(float));
 }
 
 static void free_library(library *lib) {
@@ -76,8 +78,8 @@ static bb_image run(library *lib, const char *text, int *is_normal) {
 }
 
 /* The 4 x 4 height case, in id's bytes. */
-static const int HEIGHT_BYTES[16] = {10, 40, 90,  200, 30, 60,  120, 250,
-                                     0,  20, 80,  160, 50, 100, 150, 255};
+static const int HEIGHT_BYTES[16] = {10, 40, 90, 200, 30, 60,  120, 250,
+                                     0,  20, 80, 160, 50, 100, 150, 255};
 
 static void add_heights(library *lib) {
   float v[16];
@@ -192,8 +194,11 @@ Test(program, flat_in_flat_out) {
   library lib = {0};
   float grey[9] = {0.4f, 0.4f, 0.4f, 0.4f, 0.4f, 0.4f, 0.4f, 0.4f, 0.4f};
   add_image(&lib, "grey.png", 3, 3, 1, grey);
-  const char *normal_programs[] = {"heightmap(grey.png, 8)", "_flat", "addnormals(_flat, _flat)",
-                                   "smoothnormals(_flat)", "SmoothNormals(heightmap(grey.png, 2))",
+  const char *normal_programs[] = {"heightmap(grey.png, 8)",
+                                   "_flat",
+                                   "addnormals(_flat, _flat)",
+                                   "smoothnormals(_flat)",
+                                   "SmoothNormals(heightmap(grey.png, 2))",
                                    "addnormals(heightmap(grey.png, 3), _flat)"};
   for (size_t i = 0; i < sizeof normal_programs / sizeof normal_programs[0]; i++) {
     int is_normal = 0;
@@ -207,7 +212,8 @@ Test(program, flat_in_flat_out) {
     bb_image_free(&out);
   }
   int is_normal = 1;
-  bb_image out = run(&lib, "makeintensity(invertColor(invertColor(grey.png)))", &is_normal);
+  bb_image out =
+      run(&lib, "makeintensity(invertColor(invertColor(grey.png)))", &is_normal);
   cr_assert_eq(is_normal, 0);
   cr_assert_eq(out.channels, 4);
   for (int c = 0; c < 4; c++)
@@ -294,8 +300,10 @@ typedef struct syntax_case {
 Test(program, syntax_errors_give_the_column) {
   const syntax_case cases[] = {
       {"", "column 1: empty program"},
-      {"heightmap(h.tga 4)", "column 17: expected ',' and the scale of heightmap, found '4'"},
-      {"heightmap(h.tga, four)", "column 18: heightmap needs a number here, found 'four'"},
+      {"heightmap(h.tga 4)",
+       "column 17: expected ',' and the scale of heightmap, found '4'"},
+      {"heightmap(h.tga, four)",
+       "column 18: heightmap needs a number here, found 'four'"},
       {"heightmap(h.tga, 4", "column 19: expected ')' closing heightmap, found the end"},
       {"add(a.tga b.tga)", "column 11: expected ',' between the images"},
       {"scale(a.tga, 1, 1, 1)", "column 21: expected ',' and the next factor of scale"},
@@ -304,9 +312,10 @@ Test(program, syntax_errors_give_the_column) {
       {"add(, b)", "column 5: expected an image or a function, found ','"},
       {"add(\"a.tga, b)", "column 5: unterminated"},
       {"heightmap(\"\", 4)", "column 11: empty image name"},
-      {"heigthmap(h.tga, 4)", "unknown function 'heigthmap' at column 1 (known: heightmap, "
-                              "addnormals, smoothnormals, add, scale, invertAlpha, invertColor, "
-                              "makeIntensity, makeAlpha, and the image _flat)"},
+      {"heigthmap(h.tga, 4)",
+       "unknown function 'heigthmap' at column 1 (known: heightmap, "
+       "addnormals, smoothnormals, add, scale, invertAlpha, invertColor, "
+       "makeIntensity, makeAlpha, and the image _flat)"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     bb_program *p = (bb_program *)1;

@@ -17,7 +17,8 @@ Test(slope, nibbles_round_trip_and_negatives_are_twos_complement) {
       uint8_t b = bb_slope_encode(dx, dy);
       int gx = 99, gy = 99;
       bb_slope_decode(b, &gx, &gy);
-      cr_assert(gx == dx && gy == dy, "(%d, %d) -> 0x%02x -> (%d, %d)", dx, dy, b, gx, gy);
+      cr_assert(gx == dx && gy == dy, "(%d, %d) -> 0x%02x -> (%d, %d)", dx, dy, b, gx,
+                gy);
     }
   cr_assert_eq(bb_slope_encode(3, -2), 0xE3, "dx in the low nibble, dy in the high one");
   cr_assert_eq(bb_slope_encode(-1, 0), 0x0F);
@@ -41,8 +42,9 @@ Test(slope, bytes_on_a_ramp) {
   for (int k = 1; k <= 3; k++) {
     bb_image slope;
     bb_error err;
-    cr_assert_eq(bb_slope_map(&ramp, 255.0f * (float)k, BB_ADDRESS_PERIODIC, &slope, &err),
-                 BB_OK, "%s", err.message);
+    cr_assert_eq(
+        bb_slope_map(&ramp, 255.0f * (float)k, BB_ADDRESS_PERIODIC, &slope, &err), BB_OK,
+        "%s", err.message);
     cr_assert_eq(slope.channels, 1);
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) {
@@ -51,7 +53,8 @@ Test(slope, bytes_on_a_ramp) {
                      "k %d (%d, %d): byte 0x%02x", k, x, y, byte_at(&slope, x, y));
       }
     bb_image_free(&slope);
-    cr_assert_eq(bb_slope_map(&ramp, 255.0f * (float)k, BB_ADDRESS_CLAMP, &slope, NULL), BB_OK);
+    cr_assert_eq(bb_slope_map(&ramp, 255.0f * (float)k, BB_ADDRESS_CLAMP, &slope, NULL),
+                 BB_OK);
     cr_assert_eq(byte_at(&slope, w - 1, 1), 0, "clamp: the last column is flat");
     cr_assert_eq(byte_at(&slope, w - 2, 1), bb_slope_encode(k, 0));
     bb_image_free(&slope);
@@ -75,7 +78,8 @@ Test(slope, bytes_on_a_ramp) {
 Test(slope, rounding_is_to_nearest_with_halves_away_from_zero) {
   bb_image h;
   cr_assert_eq(bb_image_alloc(&h, 5, 1, 1, NULL), BB_OK);
-  const float heights[5] = {0.0f, 0.5f, 0.0f, 7.6f, 0.0f}; /* scale 1: differences in texels */
+  const float heights[5] = {0.0f, 0.5f, 0.0f, 7.6f,
+                            0.0f}; /* scale 1: differences in texels */
   memcpy(h.pixels, heights, sizeof heights);
   bb_image s;
   cr_assert_eq(bb_slope_map(&h, 1.0f, BB_ADDRESS_PERIODIC, &s, NULL), BB_OK);

@@ -1,0 +1,37 @@
+/* cli_slope.h: bake's --slope FILE and --lit AZ,EL (flipcode's slope map
+ * and its lit preview), kept apart from cli_bake.c. */
+#ifndef BB_CLI_SLOPE_H
+#define BB_CLI_SLOPE_H
+
+#include "cli_maps.h"
+
+typedef struct cli_slope_args {
+  const char *path; /* --slope FILE, or NULL */
+  int lit;          /* --lit given */
+  double azimuth, elevation;
+  char *lit_path; /* malloc'd FILE with "_lit" before its extension */
+} cli_slope_args;
+
+extern const cli_option cli_opt_slope, cli_opt_slope_lit;
+
+/* 1 when opt is one of the rows above. */
+int cli_slope_owns(const cli_option *opt);
+
+/* Applies --slope or --lit; 0, or BB_EXIT_USAGE after a usage error. */
+int cli_slope_option(const char *command, cli_slope_args *a, const cli_option *opt,
+                     const char *arg);
+
+/* Checks the paths before any work: --lit needs --slope, the slope map is
+ * 8-bit (png, tga, tif), the preview path is made and checked. 0 or the exit
+ * code after printing the error. */
+int cli_slope_check(const char *command, cli_slope_args *a, const char *input,
+                    bb_depth depth);
+
+/* Writes the slope map of the smoothed height (and the preview) with the
+ * run's provenance; prints "wrote ..." unless quiet. 0 or BB_EXIT_FAILURE. */
+int cli_slope_write(cli_run *run, const cli_slope_args *a, const bb_image *filtered,
+                    int quiet);
+
+void cli_slope_free(cli_slope_args *a);
+
+#endif /* BB_CLI_SLOPE_H */
