@@ -942,6 +942,43 @@ void bb_animation_abort(bb_animation *a);
 
 /* Number of subimages (frames) in an image file. */
 bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
+/* ------------------------------------------------------------ mip chains */
+
+/* How a mip level is made from the one above it. */
+typedef enum bb_mip_filter {
+  BB_MIP_AVERAGE = 0,  /* box average of every channel: ssbump, weights, ao, heights
+                          (linear in light, so averages light as the paper says) */
+  BB_MIP_RENORMALIZE   /* box average, then channels 0..2 rescaled to unit length
+                          (normal maps; a zero average becomes (0, 0, 1)) */
+} bb_mip_filter;
+
+/* The mip chain of img, down to 1 x 1: level 0 is a copy of img, level k + 1
+ * is level k box-filtered by OpenImageIO's ImageBufAlgo::resize to
+ * max(1, w / 2) x max(1, h / 2) (for even sides exactly the mean of 2 x 2
+ * texels; an odd side's box covers the 3 texels under each output texel),
+ * then renormalised for BB_MIP_RENORMALIZE. *levels is malloc'd with *count
+ * images (1 + floor(log2(max(w, h)))); free it with bb_mip_chain_free. */
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err);
+
+void bb_mip_chain_free(bb_image *levels, int count);
+
+/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr). */
+int bb_path_supports_mips(const char *path);
+
+/* Writes a mip chain (levels[0] the largest, each the halved size of the one
+ * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
+ * OpenEXR file, every level encoded as bb_image_write encodes an image, and
+ * written to a temporary name and renamed as it does. Errors as
+ * bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
+bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
+                              const bb_write_options *options, bb_error *err);
+
+/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
+ * reads level 0. level_count (may be NULL) receives the file's number of
+ * levels; a level past the last is BB_ERR_ARGUMENT. */
+bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
+                            bb_image_info *info, int *level_count, bb_error *err);
 
 #ifdef __cplusplus
 }

@@ -88,6 +88,7 @@ static const cli_option *const bake_options[] = {
     &cli_opt_clamp,
     &cli_opt_channel,
     &cli_opt_depth,
+    &cli_opt_mips,
     &opt_out_normal,
     &opt_out_weights,
     &opt_out_ssbump,
@@ -176,6 +177,8 @@ static int check_outputs(bake_args *a, const char *input) {
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
                                output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
+    if (!rc)
+      rc = cli_check_mips(bake_command.name, &a->settings, a->paths[k]);
     if (rc)
       return rc;
   }

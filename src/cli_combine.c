@@ -41,8 +41,9 @@ static const cli_option opt_normal_y = {
     .help = "green axis of normal maps in and out (up = OpenGL)"};
 
 static const cli_option *const combine_options[] = {
-    &opt_output, &opt_mix,      &opt_mask,           &opt_detail,
-    &opt_kind,   &opt_normal_y, &cli_maps_opt_depth, &cli_opt_help};
+    &opt_output,         &opt_mix,      &opt_mask,
+    &opt_detail,         &opt_kind,     &opt_normal_y,
+    &cli_maps_opt_depth, &cli_opt_mips, &cli_opt_help};
 
 static const cli_command combine_command = {
     "combine",
@@ -114,6 +115,8 @@ static int combine_parse(int argc, char **argv, combine_args *a, const char **in
     rc = cli_check_output(combine_command.name, in[1], a->output, a->settings.depth);
   if (!rc && a->mask)
     rc = cli_check_output(combine_command.name, a->mask, a->output, a->settings.depth);
+  if (!rc)
+    rc = cli_check_mips(combine_command.name, &a->settings, a->output);
   return rc;
 }
 
@@ -191,9 +194,9 @@ static int combine_run(const cli_run *run, combine_args *a, const char *const *i
     if (normal && a->settings.bake.normal_y_up)
       bb_image_flip_green(&out); /* back to the inputs' convention */
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &m[0].info, a->output);
-    rc = cli_maps_write(run, cli_maps_file_name(in[0]), &m[0].file,
-                        bb_map_kind_name(a->kind), a->output, &out,
-                        normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, depth);
+    rc = cli_maps_write(
+        run, cli_maps_file_name(in[0]), &m[0].file, bb_map_kind_name(a->kind), a->output,
+        &out, normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, depth, a->settings.mips);
   }
   if (!rc)
     printf("wrote %s %s\n", bb_map_kind_name(a->kind), a->output);

@@ -88,6 +88,11 @@ const cli_option cli_opt_channel = {
     .long_name = "channel",
     .value_name = "r|g|b|a|luma|mean",
     .help = "height channel (auto: grey, or mean of R, G, B)"};
+const cli_option cli_opt_mips = {
+    .id = CLI_OPT_MIPS,
+    .long_name = "mips",
+    .default_text = "off",
+    .help = "write mip-mapped files (.tif/.exr): each level box-filtered, normals renormalised"};
 const cli_option cli_opt_depth = {
     .id = CLI_OPT_DEPTH,
     .long_name = "depth",
@@ -414,6 +419,9 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_CLAMP:
     b->smooth.addressing = BB_ADDRESS_CLAMP;
     return 0;
+  case CLI_OPT_MIPS:
+    s->mips = 1;
+    return 0;
   default: /* a table row whose subcommand forgot to handle it */
     return cli_usage_error(command, "internal error: option %s has no handler", name);
   }
@@ -518,6 +526,26 @@ char *cli_path_with_suffix(const char *path, const char *suffix) {
   return out;
 }
 
+int cli_check_mips(const char *command, const cli_settings *s, const char *output_path) {
+  if (!s->mips || bb_path_supports_mips(output_path))
+    return 0;
+  return cli_usage_error(command, "%s: --mips needs a .tif or .exr output", output_path);
+}
+
+bb_status cli_write_image(const char *path, const bb_image *img, const bb_write_options *wo,
+                          int mips, bb_error *err) {
+  if (!mips)
+    return bb_image_write(path, img, wo, err);
+  bb_image *levels = NULL;
+  int count = 0;
+  bb_mip_filter filter = wo->range == BB_RANGE_SIGNED ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
+  bb_status st = bb_mip_chain(img, filter, &levels, &count, err);
+  if (st == BB_OK)
+    st = bb_image_write_mips(path, levels, count, wo, err);
+  bb_mip_chain_free(levels, count);
+  return st;
+}
+
 static const char *file_name_of(const char *path) {
   const char *slash = strrchr(path, '/');
   return slash ? slash + 1 : path;
@@ -566,7 +594,7 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
   bb_write_options wo = {run->settings->depth, range, description};
   bb_error err = {{0}};
   double t0 = cli_now_seconds();
-  bb_status st = bb_image_write(path, img, &wo, &err);
+  bb_status st = cli_write_image(path, img, &wo, run->settings->mips, &err);
   run->seconds_write += cli_now_seconds() - t0;
   free(description);
   return cli_status_exit(path, st, &err);

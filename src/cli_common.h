@@ -42,7 +42,8 @@ typedef enum cli_opt_id {
   CLI_OPT_VALVE_NORMAL,   /* -n */
   CLI_OPT_VALVE_AO_ALPHA, /* -A */
   CLI_OPT_VALVE_DUMP,     /* -D */
-  CLI_OPT_VALVE_DETAIL    /* -d */
+  CLI_OPT_VALVE_DETAIL,   /* -d */
+  CLI_OPT_MIPS            /* --mips */
 } cli_opt_id;
 
 /* One row of a subcommand's option table: getopt_long's struct option and
@@ -124,6 +125,7 @@ struct cli_settings {
   bb_channel channel;
   bb_depth depth;
   int scale_given;
+  int mips; /* --mips: outputs are mip-mapped TIFF or EXR files */
 };
 
 /* Library defaults, plus the CLI's own (channel auto, default depth). */
@@ -142,7 +144,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
 extern const cli_option cli_opt_scale, cli_opt_rays, cli_opt_filter_radius,
     cli_opt_filter_threshold, cli_opt_bias, cli_opt_power, cli_opt_basis,
     cli_opt_normal_filter, cli_opt_normal_y, cli_opt_threads, cli_opt_clamp,
-    cli_opt_channel, cli_opt_depth, cli_opt_help;
+    cli_opt_channel, cli_opt_depth, cli_opt_help, cli_opt_mips;
 
 /* ---------------------------------------------------------------- outputs */
 
@@ -157,6 +159,16 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
  * ("rock.png", "-ssbump.tga" -> "rock-ssbump.tga"), malloc'd; NULL when
  * out of memory. */
 char *cli_path_with_suffix(const char *path, const char *suffix);
+
+/* With --mips, an output must be a format that holds mip levels (.tif,
+ * .tiff, .exr): else prints a usage error and returns BB_EXIT_USAGE. */
+int cli_check_mips(const char *command, const cli_settings *s, const char *output_path);
+
+/* bb_image_write, or with mips the file of img's mip chain (bb_mip_chain,
+ * renormalised when wo->range is BB_RANGE_SIGNED, then
+ * bb_image_write_mips). */
+bb_status cli_write_image(const char *path, const bb_image *img, const bb_write_options *wo,
+                          int mips, bb_error *err);
 
 /* What every output of one run shares, for its provenance. */
 typedef struct cli_run {
@@ -180,8 +192,9 @@ void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *hei
 void cli_run_free(cli_run *run);
 
 /* Writes img to path with the run's depth, the given range and a provenance
- * description of kind. Prints "bumpbake: PATH: reason" and returns
- * BB_EXIT_FAILURE on failure, 0 on success. */
+ * description of kind; with --mips, as a mip-mapped file (normal maps,
+ * BB_RANGE_SIGNED, renormalised per level). Prints "bumpbake: PATH: reason"
+ * and returns BB_EXIT_FAILURE on failure, 0 on success. */
 int cli_write_output(cli_run *run, const char *kind, const char *path,
                      const bb_image *img, bb_range range);
 

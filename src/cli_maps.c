@@ -38,7 +38,7 @@ const char *cli_maps_file_name(const char *path) {
 
 int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *input,
                    const char *kind, const char *path, const bb_image *img,
-                   bb_range range, bb_depth depth) {
+                   bb_range range, bb_depth depth, int mips) {
   bb_provenance p = {
       run->command_line, input_name, input ? bb_image_hash(input) : 0, kind, NULL,
       BB_CHANNEL_AUTO,   NULL};
@@ -49,7 +49,7 @@ int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *i
   }
   bb_write_options wo = {depth, range, description};
   bb_error err = {{0}};
-  bb_status st = bb_image_write(path, img, &wo, &err);
+  bb_status st = cli_write_image(path, img, &wo, mips, &err);
   free(description);
   return cli_status_exit(path, st, &err);
 }

@@ -21,6 +21,7 @@ static const cli_option *const normal_options[] = {
     &cli_opt_clamp,
     &cli_opt_channel,
     &cli_opt_depth,
+    &cli_opt_mips,
     &cli_opt_help,
 };
 
@@ -64,7 +65,8 @@ static int normal_parse(int argc, char **argv, normal_args *a, const char **inpu
     return cli_usage_error(
         normal_command.name,
         "--scale is required (texels of displacement per unit of height)");
-  return cli_check_output(normal_command.name, *input, a->output, a->settings.depth);
+  int rc2 = cli_check_output(normal_command.name, *input, a->output, a->settings.depth);
+  return rc2 ? rc2 : cli_check_mips(normal_command.name, &a->settings, a->output);
 }
 
 static int normal_run(cli_run *run, normal_args *a, const char *input) {

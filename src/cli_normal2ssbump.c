@@ -21,8 +21,8 @@ static const cli_option opt_normal_y = {
     .default_text = "down",
     .help = "green axis of NORMAL: down = Source/DirectX, up = OpenGL"};
 
-static const cli_option *const n2s_options[] = {&opt_output, &opt_normal_y,
-                                                &cli_maps_opt_depth, &cli_opt_help};
+static const cli_option *const n2s_options[] = {
+    &opt_output, &opt_normal_y, &cli_maps_opt_depth, &cli_opt_mips, &cli_opt_help};
 
 static const cli_command n2s_command = {
     "normal2ssbump",
@@ -92,7 +92,8 @@ static int n2s_parse(int argc, char **argv, n2s_args *a, const char **input) {
     }
     a->output = a->default_output;
   }
-  return cli_check_output(n2s_command.name, *input, a->output, a->settings.depth);
+  int rc2 = cli_check_output(n2s_command.name, *input, a->output, a->settings.depth);
+  return rc2 ? rc2 : cli_check_mips(n2s_command.name, &a->settings, a->output);
 }
 
 /* Appends the input's alpha (channel 3 of RGBA) to the weights, as Valve's
@@ -136,7 +137,7 @@ static int n2s_run(const cli_run *run, n2s_args *a, const char *input) {
   if (!rc) {
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &info, a->output);
     rc = cli_maps_write(run, cli_maps_file_name(input), &values, "weights", a->output,
-                        &weights, BB_RANGE_UNIT, depth);
+                        &weights, BB_RANGE_UNIT, depth, a->settings.mips);
   }
   if (!rc)
     printf("wrote weights %s\n", a->output);

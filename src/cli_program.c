@@ -25,7 +25,7 @@ static const cli_option opt_depth = {.id = CLI_OPT_DEPTH,
                                      .help = "sample depth of the output"};
 
 static const cli_option *const program_options[] = {&opt_output, &opt_base, &opt_depth,
-                                                    &cli_opt_help};
+                                                    &cli_opt_mips, &cli_opt_help};
 
 static const cli_command program_command = {
     "program",
@@ -102,7 +102,8 @@ static int program_parse(int argc, char **argv, program_args *a, const char **te
   bb_error err = {{0}};
   if (bb_program_parse(*text, program, &err) != BB_OK)
     return cli_usage_error(program_command.name, "%s", err.message);
-  return check_output_against_images(a, *program);
+  rc = check_output_against_images(a, *program);
+  return rc ? rc : cli_check_mips(program_command.name, &a->settings, a->output);
 }
 
 static int program_run(const cli_run *run, const program_args *a, const char *text,
@@ -122,7 +123,8 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   }
   const char *kind = is_normal ? "normal" : "colour";
   int rc = cli_maps_write(run, text, NULL, kind, a->output, &out,
-                          is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth);
+                          is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth,
+                          a->settings.mips);
   if (!rc)
     printf("wrote %s %s\n", kind, a->output);
   bb_image_free(&out);

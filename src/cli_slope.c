@@ -89,13 +89,18 @@ int cli_slope_check(const char *command, cli_slope_args *a, const char *input,
   return cli_check_output(command, input, a->lit_path, depth);
 }
 
-/* cli_write_output at 8 bits whatever --depth says: the bytes are the map. */
-static int write_bytes_map(cli_run *run, const char *path, const bb_image *img) {
-  cli_settings eight = *run->settings;
-  eight.depth = BB_DEPTH_8;
+/* cli_write_output without mip levels (an average of slope bytes means
+ * nothing, and the preview is a picture), the map itself at 8 bits whatever
+ * --depth says: its bytes are the map. */
+static int write_flat(cli_run *run, const char *kind, const char *path,
+                      const bb_image *img, int eight_bit) {
+  cli_settings settings = *run->settings;
+  settings.mips = 0;
+  if (eight_bit)
+    settings.depth = BB_DEPTH_8;
   cli_run copy = *run;
-  copy.settings = &eight;
-  int rc = cli_write_output(&copy, "slope", path, img, BB_RANGE_UNIT);
+  copy.settings = &settings;
+  int rc = cli_write_output(&copy, kind, path, img, BB_RANGE_UNIT);
   run->seconds_write = copy.seconds_write;
   return rc;
 }
@@ -111,7 +116,7 @@ int cli_slope_write(cli_run *run, const cli_slope_args *a, const bb_image *filte
       bb_slope_map(filtered, o->height_scale, o->smooth.addressing, &slope, &err);
   int rc = cli_status_exit(a->path, st, &err);
   if (!rc)
-    rc = write_bytes_map(run, a->path, &slope);
+    rc = write_flat(run, "slope", a->path, &slope, 1);
   if (!rc && !quiet)
     printf("wrote slope %s\n", a->path);
   if (!rc && a->lit) {
@@ -121,7 +126,7 @@ int cli_slope_write(cli_run *run, const cli_slope_args *a, const bb_image *filte
     bb_slope_table(light, table);
     rc = cli_status_exit(a->lit_path, bb_slope_light(&slope, table, &lit, &err), &err);
     if (!rc)
-      rc = cli_write_output(run, "slope_lit", a->lit_path, &lit, BB_RANGE_UNIT);
+      rc = write_flat(run, "slope_lit", a->lit_path, &lit, 0);
     if (!rc && !quiet)
       printf("wrote slope_lit %s\n", a->lit_path);
   }

@@ -25,8 +25,9 @@ static const cli_option opt_normal_y = {
     .default_text = "down",
     .help = "green axis of the output: down = Source/DirectX, up = OpenGL"};
 
-static const cli_option *const s2n_options[] = {&opt_output, &opt_kind, &opt_normal_y,
-                                                &cli_maps_opt_depth, &cli_opt_help};
+static const cli_option *const s2n_options[] = {&opt_output,   &opt_kind,
+                                                &opt_normal_y, &cli_maps_opt_depth,
+                                                &cli_opt_mips, &cli_opt_help};
 
 static const cli_command s2n_command = {
     "ssbump2normal",
@@ -75,7 +76,8 @@ static int s2n_parse(int argc, char **argv, s2n_args *a, const char **input) {
   *input = argv[first];
   if (!a->output)
     return cli_usage_error(s2n_command.name, "-o OUT is required");
-  return cli_check_output(s2n_command.name, *input, a->output, a->settings.depth);
+  int rc2 = cli_check_output(s2n_command.name, *input, a->output, a->settings.depth);
+  return rc2 ? rc2 : cli_check_mips(s2n_command.name, &a->settings, a->output);
 }
 
 static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
@@ -92,7 +94,7 @@ static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
       bb_image_flip_green(&normals);
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &info, a->output);
     rc = cli_maps_write(run, cli_maps_file_name(input), &ssbump, "normal", a->output,
-                        &normals, BB_RANGE_SIGNED, depth);
+                        &normals, BB_RANGE_SIGNED, depth, a->settings.mips);
   }
   if (!rc)
     printf("wrote normal %s\n", a->output);

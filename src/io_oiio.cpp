@@ -7,6 +7,7 @@
 // Alpha is never premultiplied or divided out: bumpbake's channels are data
 // (heights, ssbump, ao), so both directions ask for unassociated alpha.
 #include "internal.h"
+#include "maps_internal.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -504,9 +505,241 @@ bb_status animation_close(bb_animation *a, bb_error *err) {
   return BB_OK;
 }
 
+// ------------------------------------------------------------ mip chains
+
+// Tile size of mip-mapped files: OpenEXR stores mip levels only in tiled
+// files, and TIFF readers expect a tiled pyramid too.
+constexpr int MIP_TILE = 64;
+
+bool format_holds_mips(const std::string &ext) {
+  return ext == ".tif" || ext == ".tiff" || ext == ".exr";
+}
+
+// Encodes the chain into file_name (a temporary name whose extension picks
+// TIFF or OpenEXR), level 0 first, each further level appended as a MIP
+// level. proxy may be null. Returns "" or OpenImageIO's reason.
+std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy *proxy,
+                        const bb_image *levels, int count, bb_depth depth, bb_range range,
+                        const char *description) {
+  TypeDesc file_type = depth == BB_DEPTH_8      ? TypeDesc::UINT8
+                       : depth == BB_DEPTH_16   ? TypeDesc::UINT16
+                       : depth == BB_DEPTH_HALF ? TypeDesc::HALF
+                                                : TypeDesc::FLOAT;
+  auto out = ImageOutput::create(file_name, proxy);
+  if (!out) return one_line(OIIO::geterror());
+  // OpenEXR stores MIP levels; OpenImageIO's TIFF writer does not, but it
+  // reads a "Plain Texture" TIFF's further directories as MIP levels (as
+  // maketx writes them), so TIFF levels are appended as subimages.
+  const bool mip_levels = out->supports("mipmap");
+  if (!out->supports("tiles") || (!mip_levels && !out->supports("multiimage")))
+    return std::string(out->format_name()) + " files cannot hold mip levels";
+  const ImageOutput::OpenMode append =
+      mip_levels ? ImageOutput::AppendMIPLevel : ImageOutput::AppendSubimage;
+  for (int k = 0; k < count; k++) {
+    const bb_image *img = &levels[k];
+    ImageSpec spec(img->width, img->height, img->channels, file_type);
+    spec.tile_width = MIP_TILE;
+    spec.tile_height = MIP_TILE;
+    spec.attribute("textureformat", "Plain Texture");
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
+    if (description) spec.attribute("ImageDescription", description);
+    spec.attribute("compression", "zip");
+    if (!out->open(file_name, spec, k == 0 ? ImageOutput::Create : append))
+      return one_line(out->geterror());
+    bool ok;
+    if (depth == BB_DEPTH_8) {
+      std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(img, range);
+      ok = out->write_image(TypeDesc::UINT8, codes.data());
+    } else if (depth == BB_DEPTH_16) {
+      std::vector<std::uint16_t> codes = quantise_image<std::uint16_t>(img, range);
+      ok = out->write_image(TypeDesc::UINT16, codes.data());
+    } else {
+      ok = out->write_image(TypeDesc::FLOAT, img->pixels);
+    }
+    if (!ok) return one_line(out->geterror());
+  }
+  bool closed = out->close();
+  std::string why = out->geterror(); // read (and cleared) whatever the outcome
+  return closed ? std::string() : one_line(why);
+}
+
+// Every level must be half the one before (floored, at least 1), with the
+// same channels, as bb_mip_chain makes them and as OpenEXR's round-down
+// mode expects.
+bb_status check_chain(const char *path, const bb_image *levels, int count, bb_error *err) {
+  if (!levels || count < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: nothing to write (no mip levels)", path);
+  for (int k = 0; k < count; k++) {
+    bb_status st = check_image_arg(path, &levels[k], err);
+    if (st != BB_OK) return st;
+    if (k == 0) continue;
+    const bb_image &a = levels[k - 1], &b = levels[k];
+    int w = a.width / 2 > 1 ? a.width / 2 : 1, h = a.height / 2 > 1 ? a.height / 2 : 1;
+    if (b.width != w || b.height != h || b.channels != a.channels)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: mip level %d is %dx%dx%d, not %dx%dx%d (half of the level before)",
+                      path, k, b.width, b.height, b.channels, w, h, a.channels);
+  }
+  return BB_OK;
+}
+
+bb_status write_mips(const char *path, const bb_image *levels, int count,
+                     const bb_write_options *options, bb_error *err) {
+  bb_status st = check_chain(path, levels, count, err);
+  if (st != BB_OK) return st;
+  const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
+  const bb_write_options &o = options ? *options : defaults;
+  st = check_options(path, o, err);
+  if (st != BB_OK) return st;
+  std::string ext = extension_of(path);
+  const format_rule *f = find_format(ext);
+  if (!f || !format_holds_mips(ext))
+    return bb__fail(err, BB_ERR_FORMAT, "%s: mip maps need a .tif, .tiff or .exr file", path);
+  bb_depth depth;
+  st = resolve_depth(path, *f, o, levels[0].channels, &depth, err);
+  if (st != BB_OK) return st;
+
+  std::string tmp = create_temp_file(directory_of(path), ext);
+  if (tmp.empty())
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
+  std::string why;
+  try {
+    why = encode_mips(tmp, nullptr, levels, count, depth, o.range, o.description);
+  } catch (...) {
+    unlink(tmp.c_str());
+    throw;
+  }
+  if (why.empty() && std::rename(tmp.c_str(), path) != 0) why = std::strerror(errno);
+  if (!why.empty()) {
+    unlink(tmp.c_str());
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  return BB_OK;
+}
+
+bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
+                   int *level_count, bb_error *err) {
+  bb_status st = check_readable(path, err);
+  if (st != BB_OK) return st;
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = ImageInput::open(path, &config);
+  if (!in)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                    one_line(OIIO::geterror()).c_str());
+  int levels = 0;
+  while (in->seek_subimage(0, levels)) levels++;
+  (void)in->geterror(); // the failed seek past the last level queued a message
+  if (level_count) *level_count = levels;
+  if (level < 0 || level >= levels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: no mip level %d (the file has %d)", path,
+                    level, levels);
+  if (!in->seek_subimage(0, level))
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(in->geterror()).c_str());
+  const ImageSpec spec = in->spec();
+  st = check_spec_size(path, spec, err);
+  if (st != BB_OK) return st;
+  bb_error alloc_err;
+  st = bb_image_alloc(out, spec.width, spec.height, spec.nchannels, &alloc_err);
+  if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
+  bool ok = in->read_image(0, level, 0, spec.nchannels, TypeDesc::FLOAT, out->pixels);
+  if (!ok || in->has_error()) {
+    std::string why = in->geterror();
+    bb_image_free(out);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
+                    one_line(why).c_str());
+  }
+  st = fill_info(*in, spec, info, path, err);
+  if (st != BB_OK) bb_image_free(out);
+  return st;
+}
+
+bb_status resize_box(const bb_image *in, int width, int height, bb_image *out, bb_error *err) {
+  bb_status st = bb_image_alloc(out, width, height, in->channels, err);
+  if (st != BB_OK) return st;
+  // Both buffers are wrapped, not copied: ImageBuf reads and writes the
+  // bb_images' own float pixels.
+  OIIO::ImageBuf src(ImageSpec(in->width, in->height, in->channels, TypeDesc::FLOAT), in->pixels);
+  OIIO::ImageBuf dst(ImageSpec(width, height, in->channels, TypeDesc::FLOAT), out->pixels);
+  if (!OIIO::ImageBufAlgo::resize(dst, src, "box")) {
+    std::string why = dst.geterror();
+    bb_image_free(out);
+    return bb__fail(err, BB_ERR_ARGUMENT, "mip level: %s", one_line(why).c_str());
+  }
+  return BB_OK;
+}
+
 } // namespace
 
 extern "C" {
+
+bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
+                               bb_error *err) {
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "resize: out is NULL");
+  std::memset(out, 0, sizeof *out);
+  if (!in || !in->pixels || in->width <= 0 || in->height <= 0 || in->channels <= 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "resize: empty image");
+  try {
+    return resize_box(in, width, height, out, err);
+  } catch (const std::bad_alloc &) {
+    bb_image_free(out);
+    return bb__fail(err, BB_ERR_MEMORY, "resize: out of memory");
+  } catch (...) {
+    bb_image_free(out);
+    return bb__fail(err, BB_ERR_ARGUMENT, "resize: OpenImageIO failed");
+  }
+}
+
+int bb_path_supports_mips(const char *path) {
+  if (!path) return 0;
+  try {
+    return format_holds_mips(extension_of(path)) ? 1 : 0;
+  } catch (...) {
+    return 0;
+  }
+}
+
+bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
+                              const bb_write_options *options, bb_error *err) {
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
+  try {
+    return write_mips(path, levels, count, options, err);
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
+  } catch (const std::exception &e) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
+  }
+}
+
+bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
+                            int *level_count, bb_error *err) {
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: out is NULL");
+  std::memset(out, 0, sizeof *out);
+  clear_info(info);
+  if (level_count) *level_count = 0;
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: path is NULL");
+  try {
+    bb_status st = read_mip(path, level, out, info, level_count, err);
+    if (st != BB_OK) bb_image_info_free(info);
+    return st;
+  } catch (const std::bad_alloc &) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
+  } catch (const std::exception &e) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+}
+
 
 void bb_image_info_free(bb_image_info *info) {
   if (!info) return;

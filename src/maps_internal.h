@@ -5,6 +5,10 @@
 
 #include "internal.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* BB_ERR_VALUE naming the first texel whose channels 0..channels-1 are not
  * finite; what names the image ("normal map", "detail"). */
 bb_status bb__check_finite(const bb_image *img, int channels, const char *what,
@@ -26,5 +30,14 @@ void bb__normalize3(double v[3]);
  * |n| < 1 (maps that fade to (0, 0, 0) at their edges), n.xy += (dx, dy),
  * out = normalize(n). */
 void bb__add_normals(const double base[3], double dx, double dy, double out[3]);
+
+/* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
+ * (io_oiio.cpp, the only file that sees OpenImageIO). Allocates out. */
+bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
+                               bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* BB_MAPS_INTERNAL_H */
