@@ -142,4 +142,10 @@ static inline int files_starting_with(const char *prefix) {
   return n;
 }
 
+/* Runs args in cwd and expects a refusal: harness_expect_error, and the
+ * temporary directory still holding files_before files (no output, no
+ * temporary file). case_index names the case in messages. */
+void harness_expect_refusal(const char *cwd, const char *const *args, int code,
+                            const char *part, int files_before, size_t case_index);
+
 #endif /* BB_CLI_HARNESS_H */

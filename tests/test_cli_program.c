@@ -95,14 +95,9 @@ Test(cli_program, errors) {
        2,
        "unexpected argument"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    harness_result r = harness_run(harness_tmpdir(), cases[i].args);
-    char what[32];
-    snprintf(what, sizeof what, "case %zu", i);
-    harness_expect_error(&r, cases[i].code, cases[i].part, what);
-    harness_result_free(&r);
-    cr_expect_eq(harness_file_count(), files_before, "%s left a file", what);
-  }
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    harness_expect_refusal(harness_tmpdir(), cases[i].args, cases[i].code, cases[i].part,
+                           files_before, i);
 }
 
 /* ----------------------------------------------------------- bake --slope */
@@ -158,12 +153,6 @@ Test(cli_program, bake_slope_errors) {
       {{"bake", h, "--scale", "4", "--slope", harness_tmp("s.png"), "--lit", "east"},
        "--lit needs AZ,EL"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    harness_result r = harness_run(NULL, cases[i].args);
-    char what[32];
-    snprintf(what, sizeof what, "case %zu", i);
-    harness_expect_error(&r, 2, cases[i].part, what);
-    harness_result_free(&r);
-    cr_expect_eq(harness_file_count(), files_before, "%s left a file", what);
-  }
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    harness_expect_refusal(NULL, cases[i].args, 2, cases[i].part, files_before, i);
 }

@@ -167,6 +167,17 @@ double harness_max_difference(const bb_image *a, const bb_image *b) {
   return worst;
 }
 
+void harness_expect_refusal(const char *cwd, const char *const *args, int code,
+                            const char *part, int files_before, size_t case_index) {
+  harness_result r = harness_run(cwd, args);
+  char what[96];
+  snprintf(what, sizeof what, "case %zu (%s %s)", case_index, args[0],
+           args[1] ? args[1] : "");
+  harness_expect_error(&r, code, part, what);
+  harness_result_free(&r);
+  cr_expect_eq(harness_file_count(), files_before, "%s left a file", what);
+}
+
 void harness_expect_error(const harness_result *r, int code, const char *part,
                           const char *what) {
   cr_expect_eq(r->code, code, "%s: exit %d, stderr: %s", what, r->code, r->err);
