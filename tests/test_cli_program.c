@@ -86,14 +86,7 @@ Test(cli_program, errors) {
       {{"program", "heightmap(missing.png, 4)", "-o", out},
        1,
        "missing.png: no such file"},
-      {{"program", "heightmap(h.png, 4)"}, 2, "-o OUT is required"},
-      {{"program", "heightmap(h.png, 4)", "-o", harness_tmp("x.bmp")},
-       2,
-       "unknown output"},
       {{"program", "add(h.png, h.png)", "-o", h}, 1, "overwrite the input"},
-      {{"program", "_flat", "--base", harness_tmp("nodir"), "-o", out, "extra"},
-       2,
-       "unexpected argument"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     harness_expect_refusal(harness_tmpdir(), cases[i].args, cases[i].code, cases[i].part,
@@ -150,8 +143,6 @@ Test(cli_program, bake_slope_errors) {
        "one byte per texel"},
       {{"bake", h, "--scale", "4", "--slope", harness_tmp("s.png"), "--lit", "0,95"},
        "elevation must be in 0..90"},
-      {{"bake", h, "--scale", "4", "--slope", harness_tmp("s.png"), "--lit", "east"},
-       "--lit needs AZ,EL"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     harness_expect_refusal(NULL, cases[i].args, 2, cases[i].part, files_before, i);
