@@ -5,13 +5,12 @@
 #include <float.h>
 #include <string.h>
 
-static const cli_option opt_output = {.id = CLI_OPT_OUTPUT,
-                                      .long_name = "output",
-                                      .short_name = 'o',
-                                      .value_name = "OUT",
-                                      .default_text = "(required)",
-                                      .help =
-                                          "combined map to write (.png .tga .tif .exr)"};
+static const cli_option opt_output = {
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "OUT",
+    .help = "combined map to write (.png .tga .tif .exr); required"};
 static const cli_option opt_kind = {.id = CLI_OPT_MAP_KIND,
                                     .long_name = "kind",
                                     .value_name = "ssbump|weights|ao|normal",

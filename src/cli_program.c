@@ -5,13 +5,13 @@
 #include <stdio.h>
 #include <string.h>
 
-static const cli_option opt_output = {
-    .id = CLI_OPT_OUTPUT,
-    .long_name = "output",
-    .short_name = 'o',
-    .value_name = "OUT",
-    .default_text = "(required)",
-    .help = "image to write (.png .tga .tif .exr); a normal map as bumpbake writes them"};
+static const cli_option opt_output = {.id = CLI_OPT_OUTPUT,
+                                      .long_name = "output",
+                                      .short_name = 'o',
+                                      .value_name = "OUT",
+                                      .help =
+                                          "image to write (.png .tga .tif .exr); a "
+                                          "normal map as bumpbake writes them; required"};
 static const cli_option opt_base = {
     .id = CLI_OPT_MAP_BASE_DIR,
     .long_name = "base",

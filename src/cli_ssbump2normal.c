@@ -4,13 +4,12 @@
 
 #include <string.h>
 
-static const cli_option opt_output = {.id = CLI_OPT_OUTPUT,
-                                      .long_name = "output",
-                                      .short_name = 'o',
-                                      .value_name = "OUT",
-                                      .default_text = "(required)",
-                                      .help =
-                                          "normal map to write (.png .tga .tif .exr)"};
+static const cli_option opt_output = {
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "OUT",
+    .help = "normal map to write (.png .tga .tif .exr); required"};
 static const cli_option opt_kind = {
     .id = CLI_OPT_MAP_KIND,
     .long_name = "kind",
