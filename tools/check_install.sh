@@ -90,7 +90,9 @@ if [ -x "$tmp/client-static" ]; then
 fi
 
 # ------------------------------------------------------ 3. exported symbols
-grep -o '\bbb_[a-z0-9_]*[[:space:]]*(' "$prefix/include/bumpbake.h" | tr -d '( ' |
+# (typedef lines left out: "typedef bb_status (*name)(...)" is no function.)
+grep -v '^[[:space:]]*typedef' "$prefix/include/bumpbake.h" |
+  grep -o '\bbb_[a-z0-9_]*[[:space:]]*(' | tr -d '( ' |
   sort -u >"$tmp/header.sym"
 nm -D --defined-only "$prefix/lib/libbumpbake.so" | awk '{ print $3 }' | sort -u >"$tmp/so.sym"
 if cmp -s "$tmp/header.sym" "$tmp/so.sym"; then
