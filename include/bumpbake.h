@@ -541,6 +541,7 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
  * bb_provenance_format's lines; NULL when out of memory. */
 char *bb_renderbump_describe(const bb_renderbump_options *o,
                              const bb_renderbump_result *r);
+
 /* =================================================================
  * Converting, combining and programming maps (README "Converting and
  * combining maps"): normal2ssbump, ssbump2normal, combine, DOOM 3's image
