@@ -708,15 +708,10 @@ void bb_slope_decode(uint8_t byte, int *dx, int *dy);
 bb_status bb_slope_map(const bb_image *height, float height_scale,
                        bb_addressing addressing, bb_image *out, bb_error *err);
 
-/* Unit vector towards a light at azimuth_degrees (0 = from the right, +x;
- * 90 = from the bottom, +y, since y is down) and elevation_degrees above the
- * surface (90 = overhead). */
-void bb_light_direction(double azimuth_degrees, double elevation_degrees,
-                        double light[3]);
-
 /* The 16 x 16 lighting table: table[byte] = max(0, N.L) with N =
  * normalize(-dx, -dy, 1) for the slopes (dx, dy) the byte decodes to and L
- * a unit light direction. Row = high nibble (dy), column = low nibble (dx). */
+ * a unit light direction (bb_light_direction makes one from azimuth and
+ * elevation). Row = high nibble (dy), column = low nibble (dx). */
 void bb_slope_table(const double light[3], float table[256]);
 
 /* Lights a slope map through a table: out = table[byte] per texel, byte =

@@ -19,7 +19,7 @@ const cli_option cli_opt_slope_lit = {
     .value_name = "AZ,EL",
     .range_text = "degrees, EL 0..90",
     .help = "also write the slope map lit through its 16x16 table as FILE_lit (AZ 0 = "
-            "light from the right, 90 = from below)"};
+            "light from the right, 90 = from the top, as render's --light)"};
 
 int cli_slope_owns(const cli_option *opt) {
   return opt->id == CLI_OPT_SLOPE || opt->id == CLI_OPT_SLOPE_LIT;

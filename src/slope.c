@@ -65,15 +65,6 @@ bb_status bb_slope_map(const bb_image *height, float height_scale,
   return BB_OK;
 }
 
-void bb_light_direction(double azimuth_degrees, double elevation_degrees,
-                        double light[3]) {
-  const double az = azimuth_degrees * BB__PI / 180.0,
-               el = elevation_degrees * BB__PI / 180.0;
-  light[0] = cos(el) * cos(az);
-  light[1] = cos(el) * sin(az);
-  light[2] = sin(el);
-}
-
 void bb_slope_table(const double light[3], float table[256]) {
   for (int b = 0; b < 256; b++) {
     int dx, dy;

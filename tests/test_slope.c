@@ -94,16 +94,6 @@ Test(slope, rounding_is_to_nearest_with_halves_away_from_zero) {
   bb_image_free(&h);
 }
 
-Test(slope, light_directions) {
-  double l[3];
-  bb_light_direction(0.0, 0.0, l);
-  cr_assert_float_eq(l[0], 1.0, 1e-12, "azimuth 0: from the right");
-  bb_light_direction(90.0, 0.0, l);
-  cr_assert_float_eq(l[1], 1.0, 1e-12, "azimuth 90: from the bottom (+y down)");
-  bb_light_direction(123.0, 90.0, l);
-  cr_assert_float_eq(l[2], 1.0, 1e-12);
-}
-
 Test(slope, table_lights_slopes_facing_the_light) {
   double l[3];
   float table[256];
