@@ -51,8 +51,9 @@ static inline const char *harness_binary(void) {
   return path;
 }
 
-/* Runs bumpbake with args (NULL-terminated, without argv[0]); no shell. */
-static inline cli_result harness_run(const char *const *args) {
+/* Runs bumpbake with args (NULL-terminated, without argv[0]) in directory
+ * cwd (NULL = ours); no shell. */
+static inline cli_result harness_run_in(const char *cwd, const char *const *args) {
   const char *argv[64] = {"bumpbake"};
   for (int i = 0; args[i]; i++) {
     cr_assert_lt(i, 62, "too many arguments");
@@ -67,6 +68,8 @@ static inline cli_result harness_run(const char *const *args) {
   if (pid == 0) {
     dup2(fileno(out), STDOUT_FILENO);
     dup2(fileno(err), STDERR_FILENO);
+    if (cwd && chdir(cwd) != 0)
+      _exit(126);
     execv(binary, (char *const *)argv);
     _exit(127);
   }
@@ -81,7 +84,12 @@ static inline cli_result harness_run(const char *const *args) {
   return r;
 }
 
+static inline cli_result harness_run(const char *const *args) {
+  return harness_run_in(NULL, args);
+}
+
 #define RUN(...) harness_run((const char *const[]){__VA_ARGS__, NULL})
+#define RUN_IN(cwd, ...) harness_run_in(cwd, (const char *const[]){__VA_ARGS__, NULL})
 
 static inline int harness_lines(const char *s) {
   int n = 0;
@@ -142,10 +150,76 @@ static inline int files_starting_with(const char *prefix) {
   return n;
 }
 
+/* Expects exit code `code`, one line on stderr starting "bumpbake" and
+ * holding `part`, and nothing on stdout. */
+static inline void harness_expect_error(const cli_result *r, int code, const char *part,
+                                        const char *what) {
+  cr_expect_eq(r->code, code, "%s: exit %d, stderr: %s", what, r->code, r->err);
+  cr_expect_eq(harness_lines(r->err), 1, "%s: stderr should be one line: %s", what,
+               r->err);
+  cr_expect(strncmp(r->err, "bumpbake", 8) == 0, "%s: %s", what, r->err);
+  cr_expect(strstr(r->err, part), "%s: '%s' lacks '%s'", what, r->err, part);
+  cr_expect_str_empty(r->out, "%s", what);
+}
+
 /* Runs args in cwd and expects a refusal: harness_expect_error, and the
- * temporary directory still holding files_before files (no output, no
+ * test's directory holding as many files as before (no output, no
  * temporary file). case_index names the case in messages. */
-void harness_expect_refusal(const char *cwd, const char *const *args, int code,
-                            const char *part, int files_before, size_t case_index);
+static inline void harness_expect_refusal(const char *cwd, const char *const *args,
+                                          int code, const char *part, size_t case_index) {
+  int before = files_starting_with("");
+  cli_result r = harness_run_in(cwd, args);
+  char what[96];
+  snprintf(what, sizeof what, "case %zu (%s %s)", case_index, args[0],
+           args[1] ? args[1] : "");
+  harness_expect_error(&r, code, part, what);
+  cli_result_free(&r);
+  cr_expect_eq(files_starting_with(""), before, "%s left a file", what);
+}
+
+/* ---------------------------------------- images (for files that include
+ * bumpbake.h first) */
+#ifdef BUMPBAKE_H
+
+/* Writes img with bb_image_write; the test fails if it cannot. */
+static inline void harness_write(const char *path, const bb_image *img, bb_depth depth,
+                                 bb_range range) {
+  bb_write_options o = {depth, range, NULL};
+  bb_error err;
+  cr_assert_eq(bb_image_write(path, img, &o, &err), BB_OK, "%s", err.message);
+}
+
+/* Reads a file back; the test fails if it cannot. */
+static inline bb_image harness_read(const char *path, bb_image_info *info) {
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, info, &err), BB_OK, "%s", err.message);
+  return img;
+}
+
+/* 1 when a and b have the same size, channels and float bits. */
+static inline int harness_same_pixels(const bb_image *a, const bb_image *b) {
+  return a->width == b->width && a->height == b->height && a->channels == b->channels &&
+         memcmp(a->pixels, b->pixels,
+                (size_t)a->width * (size_t)a->height * (size_t)a->channels *
+                    sizeof(float)) == 0;
+}
+
+/* Largest |a - b| over every sample (sizes must match). */
+static inline double harness_max_difference(const bb_image *a, const bb_image *b) {
+  cr_assert(a->width == b->width && a->height == b->height && a->channels == b->channels,
+            "%dx%dx%d vs %dx%dx%d", a->width, a->height, a->channels, b->width, b->height,
+            b->channels);
+  double worst = 0.0;
+  size_t n = (size_t)a->width * (size_t)a->height * (size_t)a->channels;
+  for (size_t i = 0; i < n; i++) {
+    double d = (double)a->pixels[i] - (double)b->pixels[i];
+    d = d < 0 ? -d : d;
+    worst = d > worst ? d : worst;
+  }
+  return worst;
+}
+
+#endif /* BUMPBAKE_H */
 
 #endif /* BB_CLI_HARNESS_H */

@@ -1,5 +1,8 @@
 /* test_cli_combine.c: `bumpbake combine` through files: identities bit for
  * bit at every file depth, the blend and detail formulas, and errors. */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+
+#include "bumpbake.h"
 #include "cli_harness.h"
 
 #include <criterion/criterion.h>
@@ -12,7 +15,7 @@ static void setup(void) {
   harness_setup();
 }
 static void teardown(void) {
-  harness_cleanup();
+  harness_teardown();
 }
 TestSuite(cli_combine, .init = setup, .fini = teardown, .timeout = 60);
 
@@ -49,9 +52,9 @@ static bb_image noise_normals(int w, int h, unsigned seed) {
 }
 
 static void run_ok(const char *const *args) {
-  harness_result r = harness_run(NULL, args);
+  cli_result r = harness_run_in(NULL, args);
   cr_assert_eq(r.code, 0, "%s %s: %s", args[0], args[1], r.err);
-  harness_result_free(&r);
+  cli_result_free(&r);
 }
 
 /* Base read back from OUT must equal base read back from its own file. */
@@ -80,12 +83,12 @@ Test(cli_combine, identities_leave_the_base_bit_for_bit) {
     for (int normal = 0; normal <= 1; normal++) {
       char name[64];
       snprintf(name, sizeof name, "base%zu%d.%s", f, normal, files[f].ext);
-      const char *base = harness_tmp(name);
+      const char *base = tmp(name);
       snprintf(name, sizeof name, "detail%zu%d.%s", f, normal, files[f].ext);
-      const char *detail = harness_tmp(name);
+      const char *detail = tmp(name);
       snprintf(name, sizeof name, "out%zu%d.%s", f, normal, files[f].ext);
-      const char *out = harness_tmp(name);
-      const char *mask = harness_tmp("mask.png");
+      const char *out = tmp(name);
+      const char *mask = tmp("mask.png");
       const bb_range range = normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT;
       bb_image b = normal ? noise_normals(23, 9, 7u + (unsigned)f)
                           : noise(23, 9, 4, 3u + (unsigned)f);
@@ -114,8 +117,7 @@ Test(cli_combine, identities_leave_the_base_bit_for_bit) {
 }
 
 Test(cli_combine, blend_and_detail_formulas) {
-  const char *a = harness_tmp("a.exr"), *b = harness_tmp("b.exr"),
-             *out = harness_tmp("o.exr");
+  const char *a = tmp("a.exr"), *b = tmp("b.exr"), *out = tmp("o.exr");
   bb_image ia = uniform(4, 4, 3, (const float[]){0.2f, 0.5f, 0.8f});
   bb_image ib = uniform(4, 4, 3, (const float[]){0.6f, 0.1f, 0.0f});
   harness_write(a, &ia, BB_DEPTH_FLOAT, BB_RANGE_UNIT);
@@ -137,8 +139,8 @@ Test(cli_combine, blend_and_detail_formulas) {
 }
 
 Test(cli_combine, errors) {
-  const char *a = harness_tmp("a.png"), *small = harness_tmp("small.png");
-  const char *grey = harness_tmp("grey.png"), *out = harness_tmp("out.png");
+  const char *a = tmp("a.png"), *small = tmp("small.png");
+  const char *grey = tmp("grey.png"), *out = tmp("out.png");
   bb_image ia = noise(8, 8, 3, 1), is = noise(4, 8, 3, 2), ig = noise(8, 8, 1, 3);
   harness_write(a, &ia, BB_DEPTH_8, BB_RANGE_UNIT);
   harness_write(small, &is, BB_DEPTH_8, BB_RANGE_UNIT);
@@ -146,7 +148,6 @@ Test(cli_combine, errors) {
   bb_image_free(&ia);
   bb_image_free(&is);
   bb_image_free(&ig);
-  int files_before = harness_file_count();
   struct {
     const char *args[10];
     int code;
@@ -162,6 +163,5 @@ Test(cli_combine, errors) {
       {{"combine", a, small, "--detail", "-o", small}, 1, "overwrite the input"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-    harness_expect_refusal(NULL, cases[i].args, cases[i].code, cases[i].part,
-                           files_before, i);
+    harness_expect_refusal(NULL, cases[i].args, cases[i].code, cases[i].part, i);
 }

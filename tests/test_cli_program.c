@@ -1,5 +1,8 @@
 /* test_cli_program.c: `bumpbake program` and bake's `--slope`/`--lit` run
  * as programs: outputs, exit codes, one-line errors, no file left behind. */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+
+#include "bumpbake.h"
 #include "cli_harness.h"
 
 #include <criterion/criterion.h>
@@ -12,7 +15,7 @@ static void setup(void) {
   harness_setup();
 }
 static void teardown(void) {
-  harness_cleanup();
+  harness_teardown();
 }
 TestSuite(cli_program, .init = setup, .fini = teardown, .timeout = 60);
 
@@ -29,13 +32,13 @@ static void write_heights(const char *path) {
 }
 
 Test(cli_program, heightmap_writes_a_bumpbake_normal_map) {
-  write_heights(harness_tmp("h.tga"));
-  const char *out = harness_tmp("n.exr"), *png = harness_tmp("n.png");
-  harness_result r = HRUN("program", "addnormals(heightmap(h.tga, 4), _flat)", "--base",
-                          harness_tmpdir(), "-o", out);
+  write_heights(tmp("h.tga"));
+  const char *out = tmp("n.exr"), *png = tmp("n.png");
+  cli_result r = RUN("program", "addnormals(heightmap(h.tga, 4), _flat)", "--base",
+                     harness_dir, "-o", out);
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_expect(strstr(r.out, "wrote normal"), "%s", r.out);
-  harness_result_free(&r);
+  cli_result_free(&r);
   bb_image n = harness_read(out, NULL);
   cr_assert(n.channels == 3 && n.width == 4 && n.height == 4);
   for (int i = 0; i < 16; i++) {
@@ -44,9 +47,9 @@ Test(cli_program, heightmap_writes_a_bumpbake_normal_map) {
                        "unit N in EXR");
   }
   /* The same as PNG: 0.5 + 0.5 N, as every bumpbake normal map. */
-  r = HRUN_IN(harness_tmpdir(), "program", "heightmap(h.tga,4)", "-o", png);
+  r = RUN_IN(harness_dir, "program", "heightmap(h.tga,4)", "-o", png);
   cr_assert_eq(r.code, 0, "%s", r.err);
-  harness_result_free(&r);
+  cli_result_free(&r);
   bb_image p = harness_read(png, NULL);
   for (int i = 0; i < 48; i++)
     cr_expect_float_eq(p.pixels[i], 0.5 + 0.5 * n.pixels[i], 0.51 / 255.0, "sample %d",
@@ -56,12 +59,12 @@ Test(cli_program, heightmap_writes_a_bumpbake_normal_map) {
 }
 
 Test(cli_program, colour_programs_write_rgba) {
-  write_heights(harness_tmp("h.png"));
-  const char *out = harness_tmp("c.png");
-  harness_result r =
-      HRUN_IN(harness_tmpdir(), "program", "makeAlpha(invertColor(h.png))", "-o", out);
+  write_heights(tmp("h.png"));
+  const char *out = tmp("c.png");
+  cli_result r =
+      RUN_IN(harness_dir, "program", "makeAlpha(invertColor(h.png))", "-o", out);
   cr_assert_eq(r.code, 0, "%s", r.err);
-  harness_result_free(&r);
+  cli_result_free(&r);
   bb_image c = harness_read(out, NULL);
   cr_assert_eq(c.channels, 4);
   cr_expect_eq(c.pixels[0], 1.0f);
@@ -70,9 +73,8 @@ Test(cli_program, colour_programs_write_rgba) {
 }
 
 Test(cli_program, errors) {
-  const char *h = harness_tmp("h.png"), *out = harness_tmp("out.png");
+  const char *h = tmp("h.png"), *out = tmp("out.png");
   write_heights(h);
-  int files_before = harness_file_count();
   struct {
     const char *args[8];
     int code;
@@ -89,14 +91,13 @@ Test(cli_program, errors) {
       {{"program", "add(h.png, h.png)", "-o", h}, 1, "overwrite the input"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-    harness_expect_refusal(harness_tmpdir(), cases[i].args, cases[i].code, cases[i].part,
-                           files_before, i);
+    harness_expect_refusal(harness_dir, cases[i].args, cases[i].code, cases[i].part, i);
 }
 
 /* ----------------------------------------------------------- bake --slope */
 
 Test(cli_program, bake_slope_bytes_and_lit_preview) {
-  const char *h = harness_tmp("ramp.png"), *slope = harness_tmp("ramp_slope.png");
+  const char *h = tmp("ramp.png"), *slope = tmp("ramp_slope.png");
   bb_image ramp;
   cr_assert_eq(bb_image_alloc(&ramp, 12, 4, 1, NULL), BB_OK);
   for (int y = 0; y < 4; y++)
@@ -104,12 +105,12 @@ Test(cli_program, bake_slope_bytes_and_lit_preview) {
       ramp.pixels[y * 12 + x] = (float)(2 * x) / 255.0f; /* 2 codes per texel */
   harness_write(h, &ramp, BB_DEPTH_8, BB_RANGE_UNIT);
   bb_image_free(&ramp);
-  harness_result r = HRUN("bake", h, "--scale", "255", "--filter-radius", "0", "--clamp",
-                          "--slope", slope, "--lit", "0,45", "--depth", "16");
+  cli_result r = RUN("bake", h, "--scale", "255", "--filter-radius", "0", "--clamp",
+                     "--slope", slope, "--lit", "0,45", "--depth", "16");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cr_expect(strstr(r.out, "wrote slope") && strstr(r.out, "ramp_slope_lit.png"), "%s",
             r.out);
-  harness_result_free(&r);
+  cli_result_free(&r);
   bb_image_info info;
   bb_image s = harness_read(slope, &info);
   cr_expect_eq(info.bits_per_sample, 8, "one byte per texel whatever --depth says");
@@ -118,7 +119,7 @@ Test(cli_program, bake_slope_bytes_and_lit_preview) {
     cr_expect_eq((int)lrintf(s.pixels[12 + x] * 255.0f), x < 11 ? 0x02 : 0x00, "x %d", x);
   bb_image_free(&s);
   bb_image_info_free(&info);
-  bb_image lit = harness_read(harness_tmp("ramp_slope_lit.png"), &info);
+  bb_image lit = harness_read(tmp("ramp_slope_lit.png"), &info);
   cr_expect_eq(info.bits_per_sample, 16, "the preview follows --depth");
   /* Rising to the right faces away from a light from the right. */
   double n = 1.0 / sqrt(5.0), expected = n * cos(0.25 * 3.14159265358979) * -2.0 +
@@ -130,20 +131,18 @@ Test(cli_program, bake_slope_bytes_and_lit_preview) {
 }
 
 Test(cli_program, bake_slope_errors) {
-  const char *h = harness_tmp("h.png");
+  const char *h = tmp("h.png");
   write_heights(h);
-  int files_before = harness_file_count();
   struct {
     const char *args[10];
     const char *part;
   } cases[] = {
-      {{"bake", h, "--scale", "4", "--lit", "0,45", "--normal", harness_tmp("n.png")},
+      {{"bake", h, "--scale", "4", "--lit", "0,45", "--normal", tmp("n.png")},
        "--lit previews the slope map"},
-      {{"bake", h, "--scale", "4", "--slope", harness_tmp("s.exr")},
-       "one byte per texel"},
-      {{"bake", h, "--scale", "4", "--slope", harness_tmp("s.png"), "--lit", "0,95"},
+      {{"bake", h, "--scale", "4", "--slope", tmp("s.exr")}, "one byte per texel"},
+      {{"bake", h, "--scale", "4", "--slope", tmp("s.png"), "--lit", "0,95"},
        "elevation must be in 0..90"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-    harness_expect_refusal(NULL, cases[i].args, 2, cases[i].part, files_before, i);
+    harness_expect_refusal(NULL, cases[i].args, 2, cases[i].part, i);
 }
