@@ -759,16 +759,19 @@ const char *bb_albedo_mode_name(bb_albedo_mode mode);
 typedef enum bb_render_mode {
   BB_RENDER_SSBUMP = 0, /* the self-shadowed bump map (needs ssbump) */
   BB_RENDER_NORMAL,     /* plain normal mapping, no self-shadowing (needs normal) */
-  BB_RENDER_NORMAL_AO   /* normal mapping times ambient occlusion (normal, ao) */
+  BB_RENDER_NORMAL_AO,  /* normal mapping times ambient occlusion (normal, ao) */
+  BB_RENDER_SLOPE       /* flipcode's 1999 slope map lit through its 16 x 16
+                           table (bb_slope_table; needs slope) */
 } bb_render_mode;
 
-/* Parses "ssbump", "normal", "ao"; returns 0 on success. */
+/* Parses "ssbump", "normal", "ao", "slope"; returns 0 on success. */
 int bb_render_mode_parse(const char *name, bb_render_mode *out);
 
 /* The maps a mode reads, as BB_RENDER_NEEDS_* bits (0 for an unknown mode). */
 #define BB_RENDER_NEEDS_NORMAL 1u
 #define BB_RENDER_NEEDS_SSBUMP 2u
 #define BB_RENDER_NEEDS_AO 4u
+#define BB_RENDER_NEEDS_SLOPE 8u
 unsigned bb_render_mode_needs(bb_render_mode mode);
 /* The name bb_render_mode_parse accepts; "unknown" for other values. */
 const char *bb_render_mode_name(bb_render_mode mode);
@@ -791,6 +794,7 @@ typedef struct bb_render_maps {
   const bb_image *ao;     /* ao in channel 0 */
   const bb_image *bent;   /* Nb, >= 3 channels; NULL: computed from ssbump */
   const bb_image *albedo; /* NULL = white; 1 channel = grey, >= 3 = RGB */
+  const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bb_slope_map) */
 } bb_render_maps;
 
 typedef struct bb_render_options {

@@ -11,7 +11,7 @@
 #include <strings.h>
 
 /* The baked maps render can read instead of a height, in this order. */
-enum { MAP_NORMAL, MAP_SSBUMP, MAP_AO, MAP_BENT, MAP_COUNT };
+enum { MAP_NORMAL, MAP_SSBUMP, MAP_AO, MAP_BENT, MAP_SLOPE, MAP_COUNT };
 
 static const struct {
   const char *name; /* option name and provenance key */
@@ -24,6 +24,7 @@ static const struct {
     {"ssbump", BB_RENDER_NEEDS_SSBUMP, 3, 0, "R, G, B = the basis B0, B1, B2"},
     {"ao", BB_RENDER_NEEDS_AO, 1, 0, "grey"},
     {"bent", 0, 3, 1, "X, Y, Z"},
+    {"slope", BB_RENDER_NEEDS_SLOPE, 1, 0, "flipcode's slope byte, as bake --slope writes"},
 };
 
 static const cli_option opt_in_normal = {
@@ -46,6 +47,11 @@ static const cli_option opt_in_bent = {.id = CLI_RENDER_OPT_IN_BENT,
                                        .value_name = "FILE",
                                        .default_text = "from the ssbump",
                                        .help = "baked bent normal for the specular"};
+static const cli_option opt_in_slope = {
+    .id = CLI_RENDER_OPT_IN_SLOPE,
+    .long_name = "slope",
+    .value_name = "FILE",
+    .help = "baked flipcode slope map for --mode slope (instead of HEIGHT)"};
 static const cli_option opt_albedo = {
     .id = CLI_RENDER_OPT_ALBEDO,
     .long_name = "albedo",
@@ -101,6 +107,7 @@ static const cli_option *const render_options[] = {
     &opt_in_ssbump,
     &opt_in_ao,
     &opt_in_bent,
+    &opt_in_slope,
     &cli_render_opt_mode,
     &cli_render_opt_light,
     &cli_render_opt_light_color,
@@ -173,6 +180,7 @@ static int render_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_RENDER_OPT_IN_SSBUMP:
   case CLI_RENDER_OPT_IN_AO:
   case CLI_RENDER_OPT_IN_BENT:
+  case CLI_RENDER_OPT_IN_SLOPE:
     a->map_paths[opt->id - CLI_RENDER_OPT_IN_NORMAL] = arg;
     return 0;
   case CLI_RENDER_OPT_ALBEDO:
@@ -226,7 +234,7 @@ static int check_inputs(const render_args *a) {
   if (a->height_path && any_map)
     return cli_usage_error(cmd,
                            "give a HEIGHT to bake or baked maps (--normal, --ssbump, "
-                           "--ao, --bent), not both");
+                           "--ao, --bent, --slope), not both");
   if (a->height_path) {
     if (!a->settings.scale_given)
       return cli_usage_error(cmd, "--scale is required with a HEIGHT (texels of "
@@ -311,6 +319,7 @@ typedef struct render_inputs {
   bb_bake_result bake;
   bb_image maps[MAP_COUNT]; /* read from files */
   bb_image albedo;
+  bb_image slope;      /* made from the bake's filtered height for --mode slope */
   bb_render_maps view; /* pointers into the above */
   char *extra;         /* provenance lines about the inputs, malloc'd */
 } render_inputs;
@@ -321,6 +330,7 @@ static void inputs_free(render_inputs *in) {
   for (int m = 0; m < MAP_COUNT; m++)
     bb_image_free(&in->maps[m]);
   bb_image_free(&in->albedo);
+  bb_image_free(&in->slope);
   free(in->extra);
 }
 
@@ -428,6 +438,7 @@ static int load_maps(const render_args *a, cli_run *run, render_inputs *in) {
   in->view.ssbump = in->maps[MAP_SSBUMP].pixels ? &in->maps[MAP_SSBUMP] : NULL;
   in->view.ao = in->maps[MAP_AO].pixels ? &in->maps[MAP_AO] : NULL;
   in->view.bent = in->maps[MAP_BENT].pixels ? &in->maps[MAP_BENT] : NULL;
+  in->view.slope = in->maps[MAP_SLOPE].pixels ? &in->maps[MAP_SLOPE] : NULL;
   return 0;
 }
 
@@ -450,7 +461,16 @@ static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
   bb_bake_result *r = &in->bake;
   in->view = (bb_render_maps){&r->normal, r->ssbump.pixels ? &r->ssbump : NULL,
                               r->ao.pixels ? &r->ao : NULL,
-                              r->bent.pixels ? &r->bent : NULL, NULL};
+                              r->bent.pixels ? &r->bent : NULL, NULL, NULL};
+  if (needed_maps(a) & BB_RENDER_NEEDS_SLOPE) {
+    /* The slope map bake --slope would write, from the same filtered height. */
+    bb_error err = {{0}};
+    bb_status st = bb_slope_map(&r->filtered, a->settings.bake.height_scale,
+                                a->settings.bake.smooth.addressing, &in->slope, &err);
+    if (st != BB_OK)
+      return cli_status_exit(a->height_path, st, &err);
+    in->view.slope = &in->slope;
+  }
   return add_line(in, "render_from", "height");
 }
 

@@ -9,9 +9,10 @@
 const cli_option cli_render_opt_mode = {
     .id = CLI_RENDER_OPT_MODE,
     .long_name = "mode",
-    .value_name = "ssbump|normal|ao",
+    .value_name = "ssbump|normal|ao|slope",
     .default_text = "ssbump",
-    .help = "what is lit: the ssbump, the plain normal map, or the normal map times ao"};
+    .help = "what is lit: the ssbump, the plain normal map, the normal map times ao, or "
+            "flipcode's slope map through its 16x16 table"};
 const cli_option cli_render_opt_light = {
     .id = CLI_RENDER_OPT_LIGHT,
     .long_name = "light",

@@ -89,6 +89,10 @@ static int sheet_parse(int argc, char **argv, sheet_args *a, const char **input)
         "--scale is required (texels of displacement per unit of height)");
   if (!a->output)
     return cli_usage_error(sheet_command.name, "-o OUT is required");
+  if (a->sheet.lit.mode == BB_RENDER_SLOPE)
+    return cli_usage_error(sheet_command.name,
+                           "--mode slope is render's (bumpbake render HEIGHT --mode slope); "
+                           "the sheet lights the ssbump, normal or ao");
   a->sheet.lit.threads = a->settings.bake.trace.threads;
   return cli_check_output(sheet_command.name, *input, a->output, a->settings.depth);
 }

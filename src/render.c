@@ -8,7 +8,7 @@
  * else (albedo, colours, specular, tiling) is shared, so a new mode is one
  * function and one row of `modes` below.
  */
-#include "internal.h"
+#include "maps_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,12 +20,13 @@
 enum {
   NEEDS_NORMAL = BB_RENDER_NEEDS_NORMAL,
   NEEDS_SSBUMP = BB_RENDER_NEEDS_SSBUMP,
-  NEEDS_AO = BB_RENDER_NEEDS_AO
+  NEEDS_AO = BB_RENDER_NEEDS_AO,
+  NEEDS_SLOPE = BB_RENDER_NEEDS_SLOPE
 };
 
 /* One texel's inputs; pointers are NULL for maps the mode does not read. */
 typedef struct texel_maps {
-  const float *normal, *ssbump, *ao, *bent;
+  const float *normal, *ssbump, *ao, *bent, *slope;
 } texel_maps;
 
 /* What a mode makes of one texel. */
@@ -40,6 +41,7 @@ typedef struct shade_setup {
   double basis[3][3];
   double light[3];       /* l, towards the dynamic light */
   double light_basis[3]; /* l.B_c */
+  float slope_table[256]; /* flipcode's table for l (bb_slope_table) */
 } shade_setup;
 
 typedef void (*shade_fn)(const shade_setup *s, const texel_maps *t, shade_terms *out);
@@ -118,6 +120,23 @@ static void shade_ssbump(const shade_setup *s, const texel_maps *t, shade_terms 
     out->specular_normal[k] = len > 0.0 ? b[k] / len : (k == 2 ? 1.0 : 0.0);
 }
 
+/* flipcode's slope map: the byte indexes the 16 x 16 table made for the
+ * light (the article's "translation for each of the 256 possible normal
+ * vectors"), which is N.l clamped at 0 for the normal the byte's slopes
+ * give; that normal also takes Source's static weights and the highlight. */
+static void shade_slope(const shade_setup *s, const texel_maps *t, shade_terms *out) {
+  double code = 255.0 * (double)t->slope[0] + 0.5;
+  int byte = code < 0.0 ? 0 : (code > 255.0 ? 255 : (int)code);
+  int dx, dy;
+  bb_slope_decode((uint8_t)byte, &dx, &dy);
+  double n[3] = {-(double)dx, -(double)dy, 1.0};
+  bb__normalize3(n);
+  const float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
+  source_weights(s, nf, out->lightmap_weight);
+  out->dynamic = (double)s->slope_table[byte];
+  copy3f(nf, out->specular_normal);
+}
+
 typedef struct mode_info {
   bb_render_mode mode;
   const char *name;
@@ -129,6 +148,7 @@ static const mode_info modes[] = {
     {BB_RENDER_SSBUMP, "ssbump", NEEDS_SSBUMP, shade_ssbump},
     {BB_RENDER_NORMAL, "normal", NEEDS_NORMAL, shade_normal},
     {BB_RENDER_NORMAL_AO, "ao", NEEDS_NORMAL | NEEDS_AO, shade_normal_ao},
+    {BB_RENDER_SLOPE, "slope", NEEDS_SLOPE, shade_slope},
 };
 
 enum { MODE_COUNT = sizeof modes / sizeof modes[0] };
@@ -304,6 +324,7 @@ static bb_status check_maps(const bb_render_maps *m, unsigned needs,
       {m->normal, "normal", 3, (needs & NEEDS_NORMAL) != 0},
       {m->ao, "ao", 1, (needs & NEEDS_AO) != 0},
       {m->bent, "bent", 3, m->bent != NULL && (needs & NEEDS_SSBUMP)},
+      {m->slope, "slope", 1, (needs & NEEDS_SLOPE) != 0},
       {m->albedo, "albedo", 1, m->albedo != NULL},
   };
   const bb_image *first = NULL;
@@ -335,12 +356,6 @@ typedef struct render_job {
   bb_image *out;
 } render_job;
 
-static void normalize3(double v[3]) {
-  double len = sqrt(dot3d(v, v));
-  for (int k = 0; k < 3; k++)
-    v[k] /= len;
-}
-
 static void add_specular_light(render_job *job, const double dir[3],
                                const float color[3]) {
   int i = job->light_count++;
@@ -349,7 +364,7 @@ static void add_specular_light(render_job *job, const double dir[3],
     job->light_half[i][k] = dir[k] + (k == 2 ? 1.0 : 0.0); /* viewer overhead */
     job->light_color[i][k] = color[k];
   }
-  normalize3(job->light_half[i]);
+  bb__normalize3(job->light_half[i]);
 }
 
 static void job_init(render_job *job, const bb_render_maps *maps,
@@ -367,6 +382,7 @@ static void job_init(render_job *job, const bb_render_maps *maps,
   }
   for (int c = 0; c < 3; c++)
     job->setup.light_basis[c] = dot3d(job->setup.light, job->setup.basis[c]);
+  bb_slope_table(job->setup.light, job->setup.slope_table);
   if (o->static_light)
     for (int c = 0; c < 3; c++)
       add_specular_light(job, job->setup.basis[c], o->lightmap[c]);
@@ -424,6 +440,7 @@ static void shade_texel(const render_job *job, size_t i, float *out) {
       (needs & NEEDS_SSBUMP) ? texel_of(m->ssbump, i) : NULL,
       (needs & NEEDS_AO) ? texel_of(m->ao, i) : NULL,
       (needs & NEEDS_SSBUMP) ? texel_of(m->bent, i) : NULL,
+      (needs & NEEDS_SLOPE) ? texel_of(m->slope, i) : NULL,
   };
   shade_terms terms;
   job->mode->shade(&job->setup, &t, &terms);

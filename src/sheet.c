@@ -63,7 +63,7 @@ static void sheet_panels_free(sheet_panels *s) {
 
 static bb_status lit_panel(const bb_bake_result *r, const bb_render_options *lit,
                            sheet_panels *s, bb_image *rgb, bb_error *err) {
-  bb_render_maps maps = {&r->normal, &r->ssbump, &r->ao, &r->bent, NULL};
+  bb_render_maps maps = {&r->normal, &r->ssbump, &r->ao, &r->bent, NULL, NULL};
   bb_image render = {0};
   bb_status st = bb_render(&maps, lit, &render, err);
   if (st == BB_OK)

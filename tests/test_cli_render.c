@@ -105,6 +105,39 @@ Test(cli_render, from_baked_maps_as_from_the_height) {
   bb_image_free(&b);
 }
 
+/* --mode slope from a height lights the slope map bake --slope writes of the
+ * same height, bit for bit; the sheet refuses the mode in one line. */
+Test(cli_render, slope_mode_from_a_height_as_from_bake_slope) {
+  cli_result r = RUN("bake", fixture("rock06_128.png"), "--scale", "200", "-q", "--slope",
+                     tmp("slope.png"));
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("render", "--slope", tmp("slope.png"), "--mode", "slope", "--light", "30,40",
+          "-o", tmp("from_map.exr"), "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("render", fixture("rock06_128.png"), "--scale", "200", "--mode", "slope",
+          "--light", "30,40", "-o", tmp("from_height.exr"), "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  bb_image a = read_image(tmp("from_map.exr"), NULL),
+           b = read_image(tmp("from_height.exr"), NULL);
+  size_t n = (size_t)a.width * (size_t)a.height * 3, lit_levels = 0;
+  for (size_t i = 0; i < n; i++) {
+    cr_assert_eq(a.pixels[i], b.pixels[i], "texel %zu", i / 3);
+    lit_levels += a.pixels[i] != a.pixels[0];
+  }
+  cr_assert_gt(lit_levels, n / 10, "the rock at scale 200 has slopes, not one flat value");
+  bb_image_free(&a);
+  bb_image_free(&b);
+  int before = files_starting_with("") - 2;
+  r = RUN("sheet", fixture("rock06_128.png"), "--scale", "8", "--mode", "slope", "-o",
+          tmp("sheet.png"));
+  expect_one_line_error(&r, 2, "--mode slope");
+  cli_result_free(&r);
+  expect_no_new_files(before);
+}
+
 Test(cli_render, orbit_as_gif_and_as_frames) {
   cli_result r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16",
                      "--orbit", "5", "--light", "30,25", "-o", tmp("orbit.gif"));

@@ -251,7 +251,7 @@ Test(panels, compare_is_four_renders) {
   bo.rays = 16;
   bb_bake_result r;
   cr_assert_eq(bb_bake(&h, &bo, &r, NULL), BB_OK);
-  bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL};
+  bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL, NULL};
   bb_render_options o;
   bb_render_options_init(&o);
   bb_panel_layout l;

@@ -58,7 +58,7 @@ static void scene_make(scene *s, int width, int height, double (*f)(int, int, in
   bb_error err = {{0}};
   cr_assert_eq(bb_bake(&s->height, &o, &s->bake, &err), BB_OK, "%s", err.message);
   const bb_bake_result *r = &s->bake;
-  s->maps = (bb_render_maps){&r->normal, &r->ssbump, &r->ao, &r->bent, NULL};
+  s->maps = (bb_render_maps){&r->normal, &r->ssbump, &r->ao, &r->bent, NULL, NULL};
 }
 
 static void scene_free(scene *s) {
@@ -118,6 +118,9 @@ Test(render, mode_names_and_needs) {
   cr_assert_eq(bb_render_mode_needs(BB_RENDER_NORMAL_AO),
                BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_AO);
   cr_assert_eq(bb_render_mode_needs((bb_render_mode)77), 0u);
+  cr_assert_eq(bb_render_mode_parse("slope", &m), 0);
+  cr_assert_eq(m, BB_RENDER_SLOPE);
+  cr_assert_eq(bb_render_mode_needs(BB_RENDER_SLOPE), BB_RENDER_NEEDS_SLOPE);
   bb_albedo_mode a = BB_ALBEDO_MULTIPLY;
   cr_assert_eq(bb_albedo_mode_parse("ssbump", &a), 0);
   cr_assert_eq(a, BB_ALBEDO_SSBUMP);
@@ -446,7 +449,7 @@ Test(render, bad_arguments_are_refused) {
   bb_render_options_init(&o);
   bb_error err = {{0}};
 
-  bb_render_maps m = {&n3, NULL, NULL, NULL, NULL};
+  bb_render_maps m = {&n3, NULL, NULL, NULL, NULL, NULL};
   cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "ssbump map is missing"), "%s", err.message);
   m.ssbump = &s1;
@@ -529,4 +532,39 @@ Test(render, normals_decode) {
   cr_assert_eq(bb_image_alloc(&two, 2, 2, 2, NULL), BB_OK);
   cr_assert_eq(bb_normals_decode(&two, 0, 0, &n, NULL), BB_ERR_ARGUMENT);
   bb_image_free(&two);
+}
+
+/* ------------------------------------------------------------ slope map */
+
+/* flipcode's slope map through its table: a flat byte (0) under any light
+ * gives N.L of (0, 0, 1), exactly sin(elevation); a texel whose surface rises
+ * 3 texels to the right (dx = 3, the byte's low nibble) faces left, so a light
+ * from the left (azimuth 180) lights it more than one from the right, and
+ * the value is the table's, normalize(-3, 0, 1).l. No slope map: an error. */
+Test(render, slope_map_through_the_table) {
+  bb_image slope;
+  cr_assert_eq(bb_image_alloc(&slope, 2, 1, 1, NULL), BB_OK);
+  slope.pixels[0] = 0.0f;
+  slope.pixels[1] = (float)bb_slope_encode(3, 0) / 255.0f;
+  bb_render_maps m = {NULL, NULL, NULL, NULL, NULL, &slope};
+  bb_render_options o;
+  options(&o, BB_RENDER_SLOPE, 180.0, 30.0);
+  bb_image left = render(&m, &o);
+  o.light_azimuth = 0.0;
+  bb_image right = render(&m, &o);
+  cr_assert_float_eq(at(&left, 0, 0)[0], 0.5, 1e-6);
+  cr_assert_float_eq(at(&right, 0, 0)[0], 0.5, 1e-6);
+  double l[3], n[3] = {-3.0 / sqrt(10.0), 0.0, 1.0 / sqrt(10.0)};
+  bb_light_direction(180.0, 30.0, l);
+  cr_assert_float_eq(at(&left, 1, 0)[1], n[0] * l[0] + n[2] * l[2], 1e-6);
+  cr_assert_gt(grey_at(&left, 1, 0), 0.8);
+  cr_assert_eq(grey_at(&right, 1, 0), 0.0, "the right-hand light is behind the slope");
+  bb_image_free(&left);
+  bb_image_free(&right);
+  m.slope = NULL;
+  bb_image out = {0};
+  bb_error err = {{0}};
+  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert(strstr(err.message, "slope"), "%s", err.message);
+  bb_image_free(&slope);
 }

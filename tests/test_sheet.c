@@ -67,7 +67,7 @@ Test(sheet, eight_labelled_panels) {
                        bb_image_texel(&r.ao, 9, 3)[0], 1e-6);
   }
   /* The lit panel (7) is the render of o.lit, clamped to [0, 1]. */
-  bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL};
+  bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL, NULL};
   bb_image lit;
   cr_assert_eq(bb_render(&m, &o.lit, &lit, NULL), BB_OK);
   for (int k = 0; k < 3; k++)
