@@ -176,8 +176,10 @@ $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
 
-$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
+# The tools print JSON with the CLI's one writer (src/cli_json.c).
+TOOL_JSON := $(BUILD)/src/cli_json.o
+$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(TOOL_JSON) $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $< $(TOOL_JSON) $(LIB) $(LDLIBS)
 
 $(TESTBIN): $(TEST_OBJ) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(LIB) $(CRIT_LIBS) $(LDLIBS)

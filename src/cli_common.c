@@ -1,4 +1,4 @@
-/* cli_common.c: option parsing, errors, output writing, JSON and progress
+/* cli_common.c: option parsing, errors, output writing and progress
  * shared by the bumpbake subcommands, so none of them repeats another's. */
 /* realpath() is an XSI function, outside plain POSIX.1-2008. */
 #define _XOPEN_SOURCE 700
@@ -616,60 +616,6 @@ double cli_now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ------------------------------------------------------------------- JSON */
-
-static void json_quoted(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
-    if (*c == '"' || *c == '\\')
-      fprintf(f, "\\%c", *c);
-    else if (*c < 0x20)
-      fprintf(f, "\\u%04x", *c);
-    else
-      fputc(*c, f);
-  }
-  fputc('"', f);
-}
-
-/* The separator and "key": that precede every value. */
-static void json_begin_value(cli_json *j, const char *key) {
-  if (j->need_comma)
-    fputc(',', j->f);
-  if (key) {
-    json_quoted(j->f, key);
-    fputc(':', j->f);
-  }
-  j->need_comma = 1;
-}
-
-void cli_json_open(cli_json *j, const char *key, char open) {
-  json_begin_value(j, key);
-  fputc(open, j->f);
-  j->need_comma = 0;
-}
-
-void cli_json_close(cli_json *j, char close) {
-  fputc(close, j->f);
-  j->need_comma = 1;
-}
-
-void cli_json_string(cli_json *j, const char *key, const char *value) {
-  json_begin_value(j, key);
-  if (value)
-    json_quoted(j->f, value);
-  else
-    fputs("null", j->f);
-}
-
-void cli_json_number(cli_json *j, const char *key, double value) {
-  json_begin_value(j, key);
-  /* JSON has no NaN or infinity; no value the CLI prints should be one. */
-  if (isfinite(value))
-    fprintf(j->f, "%.9g", value);
-  else
-    fputs("null", j->f);
 }
 
 /* --------------------------------------------------------------- progress */

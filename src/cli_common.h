@@ -1,11 +1,13 @@
 /* cli_common.h: what the bumpbake subcommands share: option tables and their
- * parsing with range checks, error printing, output writing with provenance,
- * JSON helpers and the progress bar. Nothing here is part of the library. */
+ * parsing with range checks, error printing, output writing with provenance
+ * and the progress bar (the JSON writer is cli_json.h). Nothing here is part
+ * of the library. */
 #ifndef BB_CLI_COMMON_H
 #define BB_CLI_COMMON_H
 
 #include "bumpbake.h"
 #include "cli.h"
+#include "cli_json.h" /* --json output */
 
 #include <stdint.h>
 #include <stdio.h>
@@ -200,23 +202,6 @@ double cli_now_seconds(void);
 /* bb_image_read with stderr muted (libpng's own messages on corrupt PNGs
  * would make an error two lines). */
 bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err);
-
-/* ------------------------------------------------------------------- JSON */
-
-/* A one-line JSON writer: fields are separated by commas automatically.
- * Values are written as they come; nesting is the caller's to balance. */
-typedef struct cli_json {
-  FILE *f;
-  int need_comma; /* a value was written at the current nesting level */
-} cli_json;
-
-/* Opens an object or array; key is its field name, NULL at the top level
- * or inside an array. open is '{' or '['. */
-void cli_json_open(cli_json *j, const char *key, char open);
-void cli_json_close(cli_json *j, char close);
-/* A string field; value NULL writes null. key NULL inside arrays. */
-void cli_json_string(cli_json *j, const char *key, const char *value);
-void cli_json_number(cli_json *j, const char *key, double value);
 
 /* --------------------------------------------------------------- progress */
 
