@@ -108,6 +108,15 @@ void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 
+/* Reads only the header of path: its size, channel count and what
+ * bb_image_info holds, without decoding a pixel (fast on any size; a
+ * truncated pixel stream is not noticed). width, height, channels and info
+ * may each be NULL. Errors as bb_image_read, except that the size limits
+ * BB_MAX_DIMENSION and BB_MAX_PIXELS are not applied (the size is reported,
+ * not allocated). */
+bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
+                             bb_image_info *info, bb_error *err);
+
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
  * float32 for exr. */
 typedef enum bb_depth {
@@ -127,7 +136,11 @@ typedef enum bb_range {
 typedef struct bb_write_options {
   bb_depth depth;
   bb_range range;
-  const char *description; /* provenance text stored in the file, or NULL */
+  const char *description; /* provenance text stored in the file, or NULL.
+                              TGA holds 4 rows of 80 characters: provenance
+                              is fitted with whole key=value lines, keys that
+                              affect pixels first, and what does not fit is
+                              left out (see bb_provenance_classify) */
 } bb_write_options;
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
@@ -388,6 +401,40 @@ bb_status bb_compare_images(const bb_image *a, const bb_image *b,
                             bb_compare_stats *stats, bb_image *diff,
                             bb_error *err);
 
+/* The tolerances of a comparison, as OpenImageIO's idiff takes them (its
+ * -fail, -failpercent, -hardfail, -allowfailures, -warn, -warnpercent,
+ * -hardwarn). Differences are absolute, in the images' float units. */
+typedef struct bb_compare_limits {
+  double fail;          /* a pixel fails when a channel differs by more; 1e-6 */
+  double fail_percent;  /* failing pixels allowed, % of all, 0..100; 0 */
+  double hard_fail;     /* any difference above this fails; infinity */
+  long allow_failures;  /* up to this many failing pixels pass, by any
+                           amount (hard_fail included); 0 */
+  double warn;          /* a pixel warns when a channel differs by more; 1e-6 */
+  double warn_percent;  /* warning pixels allowed, % of all, 0..100; 0 */
+  double hard_warn;     /* any difference above this warns; infinity */
+} bb_compare_limits;
+
+/* Sets idiff's defaults (in the field comments above). */
+void bb_compare_limits_init(bb_compare_limits *limits);
+
+/* A comparison's outcome; the values are idiff's exit codes. */
+typedef enum bb_compare_verdict {
+  BB_COMPARE_PASS = 0,
+  BB_COMPARE_WARN = 1,
+  BB_COMPARE_FAIL = 2
+} bb_compare_verdict;
+
+/* idiff's rule (OpenImageIO 2.4), for stats made by bb_compare_images with
+ * thresholds limits->fail and limits->warn: PASS when at most
+ * allow_failures pixels fail; else FAIL when more than fail_percent % of
+ * the pixels fail or max_abs > hard_fail; else WARN when more than
+ * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
+ * warnings are only reported once some pixel fails: with no failing pixel
+ * the verdict is PASS. */
+bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
+                                    const bb_compare_limits *limits);
+
 /* ------------------------------------------------------------- provenance */
 
 /* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
@@ -415,6 +462,20 @@ char *bb_provenance_format(const bb_provenance *p);
  * when either text is NULL). Keys "command" and "output" are ignored. Returns
  * the number of differing keys. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
+
+/* What an image description holds, for readers of provenance. */
+typedef enum bb_provenance_class {
+  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
+  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
+  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
+                             re-wrapped (by a format or another tool), so a
+                             key-by-key diff would mislead */
+} bb_provenance_class;
+
+/* Classifies a description (NULL is NONE): bumpbake's when it has a
+ * "bumpbake_version=" line; intact when each non-empty line is key=value
+ * with a key of lower-case letters, digits and '_'. */
+bb_provenance_class bb_provenance_classify(const char *description);
 
 const char *bb_channel_name(bb_channel c);
 

@@ -229,7 +229,8 @@ static const char *settings_default_text(int id, const cli_settings *d, char *bu
 
 static void print_help(const cli_command *cmd) {
   cli_settings defaults;
-  cmd->init_settings(&defaults);
+  if (cmd->init_settings)
+    cmd->init_settings(&defaults);
   printf("usage: bumpbake %s %s\n%s\n\noptions:\n", cmd->name, cmd->synopsis,
          cmd->summary);
   for (int i = 0; i < cmd->option_count; i++) {
@@ -238,14 +239,18 @@ static void print_help(const cli_command *cmd) {
     int n = 0;
     if (o->short_name)
       n += snprintf(flags + n, sizeof flags - (size_t)n, "-%c", o->short_name);
+    if (o->long_name && o->single_dash)
+      n += snprintf(flags + n, sizeof flags - (size_t)n, "%s-%s", n ? ", " : "",
+                    o->long_name);
     if (o->long_name)
       n += snprintf(flags + n, sizeof flags - (size_t)n, "%s--%s", n ? ", " : "",
                     o->long_name);
     if (o->value_name)
       snprintf(flags + n, sizeof flags - (size_t)n, " %s", o->value_name);
-    const char *d = o->default_text
-                        ? o->default_text
-                        : settings_default_text(o->id, &defaults, dflt, sizeof dflt);
+    const char *d = o->default_text ? o->default_text
+                    : cmd->init_settings
+                        ? settings_default_text(o->id, &defaults, dflt, sizeof dflt)
+                        : NULL;
     printf("  %-36s %s", flags, o->help);
     if (d)
       printf("; default %s", d);
@@ -266,8 +271,10 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   if (cmd->option_count > MAX_OPTIONS)
     return cli_usage_error(cmd->name, "internal error: too many options");
   shortopts[ns++] = ':';
+  int long_only = 0;
   for (int i = 0; i < cmd->option_count; i++) {
     const cli_option *o = cmd->options[i];
+    long_only |= o->single_dash;
     int has_arg = o->value_name ? required_argument : no_argument;
     if (o->long_name)
       longopts[nl++] = (struct option){o->long_name, has_arg, NULL, o->id};
@@ -283,7 +290,9 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   opterr = 0; /* our messages, in our format */
   optind = 1;
   for (;;) {
-    int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+    int c = long_only
+                ? getopt_long_only(argc, argv, shortopts, longopts, NULL)
+                : getopt_long(argc, argv, shortopts, longopts, NULL);
     if (c == -1)
       break;
     if (c == '?') {
@@ -576,7 +585,7 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
  * stderr for a corrupt PNG before OpenImageIO returns the error we report.
  * The CLI mutes stderr while decoding so every error stays one line; the
  * library leaves the process's file descriptors alone. */
-static int mute_stderr(void) {
+int cli_mute_stderr(void) {
   fflush(stderr);
   int saved = dup(STDERR_FILENO), null_fd = open("/dev/null", O_WRONLY);
   if (saved >= 0 && null_fd >= 0) dup2(null_fd, STDERR_FILENO);
@@ -584,24 +593,24 @@ static int mute_stderr(void) {
   return saved;
 }
 
-static void unmute_stderr(int saved) {
+void cli_unmute_stderr(int saved) {
   if (saved < 0) return;
   dup2(saved, STDERR_FILENO);
   close(saved);
 }
 
 bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err) {
-  int saved = mute_stderr();
+  int saved = cli_mute_stderr();
   bb_status st = bb_image_read(path, img, info, err);
-  unmute_stderr(saved);
+  cli_unmute_stderr(saved);
   return st;
 }
 
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
   bb_error err = {{0}};
-  int saved = mute_stderr();
+  int saved = cli_mute_stderr();
   bb_status st = bb_height_load(path, s->channel, height, &err);
-  unmute_stderr(saved);
+  cli_unmute_stderr(saved);
   return cli_status_exit(path, st, &err);
 }
 

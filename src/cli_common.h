@@ -57,6 +57,11 @@ typedef struct cli_option {
   const char *default_text; /* shown in --help; NULL when there is none */
   const char *range_text;   /* shown in --help; NULL when there is none */
   const char *help;         /* one line */
+  /* 1: also spelled with one dash ("-fail 0.1"), as OpenImageIO's idiff
+   * spells it. A table with such a row is parsed with getopt_long_only, so
+   * all its long options then take one dash; "-x" stays a short option
+   * when no long option starts with x. */
+  int single_dash;
 } cli_option;
 
 /* What a subcommand does with one option: 0 when accepted, BB_EXIT_USAGE
@@ -73,7 +78,8 @@ typedef struct cli_command {
   const cli_option *const *options; /* rows, shared rows by address */
   int option_count;
   /* Fills the command's default settings; --help prints the defaults of the
-   * shared settings from it, so the help cannot drift from the behaviour. */
+   * shared settings from it, so the help cannot drift from the behaviour.
+   * NULL for a command without baking settings (compare, info). */
   void (*init_settings)(cli_settings *s);
 } cli_command;
 
@@ -199,8 +205,13 @@ int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options
 /* Monotonic seconds, for the per-stage timings the CLI measures itself. */
 double cli_now_seconds(void);
 
-/* bb_image_read with stderr muted (libpng's own messages on corrupt PNGs
- * would make an error two lines). */
+/* Mutes stderr (libpng, inside OpenImageIO, prints its own line about a
+ * corrupt PNG, which would make an error two lines) until
+ * cli_unmute_stderr(saved) with what cli_mute_stderr returned. */
+int cli_mute_stderr(void);
+void cli_unmute_stderr(int saved);
+
+/* bb_image_read with stderr muted. */
 bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err);
 
 /* --------------------------------------------------------------- progress */
