@@ -384,6 +384,38 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
 
 void bb_bake_result_free(bb_bake_result *r);
 
+/* ----------------------------------------------------- Valve's RGBA files */
+
+/* What goes into the RGBA file Valve's height2ssbump writes. */
+typedef struct bb_valve_options {
+  int normal_map;  /* 0: RGB = ssbump (FILE-ssbump.tga); 1: RGB = the normal
+                      map, 0.5 + 0.5 N (-n, FILE-bump.tga). Default 0 */
+  int ao_in_alpha; /* 0: A = the filtered height; 1: A = ao (-A). Default 0 */
+} bb_valve_options;
+
+void bb_valve_options_init(bb_valve_options *o);
+
+/* Packs a bake into Valve's RGBA layout: RGB = result->ssbump (its first
+ * three channels) or result->normal encoded as 0.5 + 0.5 N, A =
+ * result->filtered or result->ao. Every channel of out is then a unit value
+ * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
+ * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
+ * want_trace) or has too few channels; BB_ERR_SIZE when sizes differ. */
+bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
+                        bb_image *out, bb_error *err);
+
+/* Valve's detail variant (-d): multiplies R, G, B of rgba (4 channels, as
+ * bb_valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
+ * input colour smoothed like the height: colour is the decoded input (grey
+ * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
+ * ignored), smoothed by bb_smooth_bilateral with smooth and guided by
+ * height (the 1-channel height the bake started from), so the factor
+ * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
+ * input gives 0.5, the neutral value of a mod2x detail texture. All three
+ * images must have the same size (BB_ERR_SIZE). */
+bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
+                          const bb_smooth_options *smooth, bb_error *err);
+
 /* ---------------------------------------------------------------- compare */
 
 typedef struct bb_compare_stats {
