@@ -164,7 +164,9 @@ int bb_path_supports_depth(const char *path, bb_depth depth);
 
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
-  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B */
+  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B;
+                          but alpha when the colour is constant and alpha
+                          varies (see bb_height_channel) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
@@ -175,6 +177,16 @@ typedef enum bb_channel {
 
 /* Parses "r", "g", "b", "a", "luma", "mean", "auto"; returns 0 on success. */
 int bb_channel_parse(const char *name, bb_channel *out);
+
+/* The channel the rule takes from img when asked for `channel`: channel
+ * itself, except BB_CHANNEL_AUTO, which gives BB_CHANNEL_A when img has an
+ * alpha channel (alpha_channel, or the last of 2 or 4 channels), its colour
+ * channels (grey, or R, G and B) are each the same at every texel and alpha
+ * is not: Valve's convention, the height in alpha, which the mean of a
+ * constant colour would bake flat. Otherwise AUTO gives BB_CHANNEL_MEAN
+ * (for a grey image, the grey). A caller can say which was used; reads img
+ * once at most (it stops at the first texel whose colour differs). */
+bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 
 /* Extracts a 1-channel height field from a decoded image by the channel rule.
  * Rejects NaN or infinite heights (BB_ERR_VALUE, naming the first bad texel)

@@ -607,10 +607,22 @@ bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, b
 }
 
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
+  bb_image img = {0};
+  bb_image_info info;
   bb_error err = {{0}};
-  int saved = cli_mute_stderr();
-  bb_status st = bb_height_load(path, s->channel, height, &err);
-  cli_unmute_stderr(saved);
+  bb_status st = cli_read_image(path, &img, &info, &err);
+  if (st == BB_OK) {
+    /* The rule's own choice, so a height found in alpha is said once. */
+    bb_channel used = bb_height_channel(&img, info.alpha_channel, s->channel);
+    if (s->channel == BB_CHANNEL_AUTO && used == BB_CHANNEL_A)
+      fprintf(stderr,
+              "bumpbake: %s: note: the colour is constant and alpha is not; using "
+              "alpha as the height (Valve's convention; --channel chooses)\n",
+              path);
+    st = bb_height_from_image(&img, info.alpha_channel, used, height, &err);
+    bb_image_info_free(&info);
+    bb_image_free(&img);
+  }
   return cli_status_exit(path, st, &err);
 }
 

@@ -194,7 +194,8 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
                      const bb_image *img, bb_range range);
 
 /* Loads the height of path by the settings' channel rule; prints the error
- * and returns BB_EXIT_FAILURE on failure. */
+ * and returns BB_EXIT_FAILURE on failure. When the rule finds the height in
+ * alpha (constant colour, varying alpha) it says so on stderr. */
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height);
 
 /* Runs bb_bake; prints the error (naming path) and returns BB_EXIT_FAILURE on
