@@ -82,14 +82,14 @@ static const cli_option opt_warn_percent = {.id = OPT_WARN_PERCENT,
                                             .default_text = "0",
                                             .range_text = "0..100",
                                             .help = "warning pixels allowed, in % of all",
-    .single_dash = 1};
+                                            .single_dash = 1};
 static const cli_option opt_hard_warn = {.id = OPT_HARD_WARN,
                                          .long_name = "hardwarn",
                                          .value_name = "T",
                                          .default_text = "inf",
                                          .range_text = ">= 0",
                                          .help = "warn when any difference exceeds T",
-    .single_dash = 1};
+                                         .single_dash = 1};
 static const cli_option opt_diff = {
     .id = OPT_DIFF,
     .long_name = "diff",
@@ -106,9 +106,9 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .help = "print no report; the exit code tells"};
 
 static const cli_option *const compare_options[] = {
-    &opt_fail,         &opt_fail_percent, &opt_hard_fail, &opt_allow_failures,
-    &opt_warn,         &opt_warn_percent, &opt_hard_warn, &opt_diff,
-    &opt_json,         &opt_quiet,        &cli_opt_help,
+    &opt_fail, &opt_fail_percent, &opt_hard_fail, &opt_allow_failures,
+    &opt_warn, &opt_warn_percent, &opt_hard_warn, &opt_diff,
+    &opt_json, &opt_quiet,        &cli_opt_help,
 };
 
 static const cli_command compare_command = {
@@ -187,8 +187,8 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
   /* The diff is checked before the (possibly long) reads, and must not
    * overwrite either input. */
   if (a->diff_path) {
-    rc = cli_check_output(compare_command.name, a->path_a, a->diff_path,
-                          BB_DEPTH_DEFAULT);
+    rc =
+        cli_check_output(compare_command.name, a->path_a, a->diff_path, BB_DEPTH_DEFAULT);
     if (!rc)
       rc = cli_check_output(compare_command.name, a->path_b, a->diff_path,
                             BB_DEPTH_DEFAULT);

@@ -78,9 +78,10 @@ static void print_text(const char *path, const file_info *f) {
       printf("description: %s\n", i->description);
     return;
   }
-  printf("%s:\n%s", f->provenance == BB_PROVENANCE_DAMAGED
-                        ? "provenance (cut or re-wrapped by the file format)"
-                        : "provenance",
+  printf("%s:\n%s",
+         f->provenance == BB_PROVENANCE_DAMAGED
+             ? "provenance (cut or re-wrapped by the file format)"
+             : "provenance",
          i->description);
   size_t n = strlen(i->description);
   if (n && i->description[n - 1] != '\n')
@@ -152,7 +153,8 @@ static int info_file(const info_args *a, const char *path, int index) {
   memset(&f, 0, sizeof f);
   bb_error err = {{0}};
   int muted = cli_mute_stderr();
-  bb_status st = bb_image_read_info(path, &f.width, &f.height, &f.channels, &f.info, &err);
+  bb_status st =
+      bb_image_read_info(path, &f.width, &f.height, &f.channels, &f.info, &err);
   cli_unmute_stderr(muted);
   if (st != BB_OK) {
     report_error(a, path, &err);

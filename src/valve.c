@@ -22,8 +22,8 @@ static bb_status check_part(const bb_image *img, const char *what, int channels,
                     "valve pack: the bake has no %s (ssbump and ao need a traced bake)",
                     what);
   if (img->channels < channels)
-    return bb__fail(err, BB_ERR_ARGUMENT, "valve pack: %s has %d channel%s, needs %d", what,
-                    img->channels, img->channels == 1 ? "" : "s", channels);
+    return bb__fail(err, BB_ERR_ARGUMENT, "valve pack: %s has %d channel%s, needs %d",
+                    what, img->channels, img->channels == 1 ? "" : "s", channels);
   return BB_OK;
 }
 
@@ -79,11 +79,12 @@ static bb_status colour_rgb(const bb_image *colour, bb_image *rgb, bb_error *err
 }
 
 static bb_status check_detail_inputs(const bb_image *rgba, const bb_image *colour,
-                                     const bb_image *height, const bb_smooth_options *smooth,
-                                     bb_error *err) {
+                                     const bb_image *height,
+                                     const bb_smooth_options *smooth, bb_error *err) {
   if (!rgba || !colour || !height || !smooth || !rgba->pixels || !colour->pixels ||
       !height->pixels)
-    return bb__fail(err, BB_ERR_ARGUMENT, "valve detail: an image or the options is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "valve detail: an image or the options is NULL");
   if (rgba->channels != 4 || height->channels != 1 || colour->channels < 1)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "valve detail: needs 4-channel RGBA and a 1-channel height (got %d "

@@ -35,8 +35,8 @@ static bb_bake_result hand_result(void) {
 static void expect_texel(const bb_image *img, int x, int y, const float *want) {
   const float *t = bb_image_texel(img, x, y);
   for (int c = 0; c < img->channels; c++)
-    cr_expect_float_eq(t[c], want[c], 1e-7, "texel (%d, %d) channel %d: %g, want %g", x, y,
-                       c, (double)t[c], (double)want[c]);
+    cr_expect_float_eq(t[c], want[c], 1e-7, "texel (%d, %d) channel %d: %g, want %g", x,
+                       y, c, (double)t[c], (double)want[c]);
 }
 
 Test(valve, pack_ssbump_with_height_in_alpha_by_default) {
@@ -142,7 +142,8 @@ Test(valve, detail_of_mid_grey_flat_is_the_mod2x_neutral_half) {
 
 Test(valve, detail_factor_is_the_colour_sum_over_sqrt3) {
   bb_image rgba = filled(5, 4, 4, (float[]){0.2f, 0.4f, 0.6f, 1.0f});
-  bb_image colour = filled(5, 4, 4, (float[]){0.1f, 0.3f, 0.8f, 0.0f}); /* alpha ignored */
+  bb_image colour =
+      filled(5, 4, 4, (float[]){0.1f, 0.3f, 0.8f, 0.0f}); /* alpha ignored */
   bb_image height = filled(5, 4, 1, (float[]){0.0f});
   bb_smooth_options s = smoothing();
   cr_assert_eq(bb_valve_detail(&rgba, &colour, &height, &s, NULL), BB_OK);
