@@ -63,7 +63,9 @@ bool is_targa(const char *format_name) { return std::strcmp(format_name, "targa"
 
 // The ImageDescription to give OpenImageIO for a file (targa: a .tga file).
 std::string description_to_store(bool targa, const char *description) {
-  if (!targa || bb_provenance_classify(description) == BB_PROVENANCE_NONE)
+  // A text that fits the first row comes back as it is.
+  if (!targa || std::strlen(description) <= (size_t)TGA_COMMENT_CHARS ||
+      bb_provenance_classify(description) == BB_PROVENANCE_NONE)
     return description;
   char rows[TGA_COMMENT_ROWS][TGA_COMMENT_CHARS + 1];
   bb__provenance_pack(description, TGA_COMMENT_ROWS, TGA_COMMENT_CHARS, &rows[0][0]);
@@ -75,15 +77,18 @@ std::string description_to_store(bool targa, const char *description) {
   return flat;
 }
 
-// The description as read: a TGA's provenance without its padding lines.
+// The description as read: a TGA's provenance without the blank lines its
+// row padding leaves (the rows' lines, in row order).
 std::string description_as_read(const char *format_name, std::string desc) {
-  if (!is_targa(format_name) || bb_provenance_classify(desc.c_str()) == BB_PROVENANCE_NONE)
+  // Padded rows always leave an empty line; a text stored as it was has none.
+  if (!is_targa(format_name) || desc.find("\n\n") == std::string::npos ||
+      bb_provenance_classify(desc.c_str()) == BB_PROVENANCE_NONE)
     return desc;
   std::string tidy;
   for (char c : desc)
     if (c != '\n' || (!tidy.empty() && tidy.back() != '\n')) tidy += c;
   while (!tidy.empty() && tidy.back() == '\n') tidy.pop_back();
-  return tidy + "\n";
+  return tidy;
 }
 
 // ------------------------------------------------------------------ reading
