@@ -315,22 +315,27 @@ bb_provenance_class bb_provenance_classify(const char *description) {
 /* -------------------------------------------------------------------- pack */
 
 /* The keys in the order a cut copy keeps them: what the pixels depend on
- * first (so two cut copies still diff meaningfully), then what names the
- * file, and the long command line last. Other keys follow, in text order. */
+ * first (so two cut copies still diff meaningfully), then keys of other
+ * producers (renderbumpflat's axis, rect, ...: parameters too), then what
+ * names the file, and the long command line last. NULL marks where the
+ * other keys go; lines of one rank keep their text order. */
 static const char *const PACK_ORDER[] = {
-    "bumpbake_version", "input_hash",       "scale", "rays",  "rayset",
-    "filter_radius",    "filter_threshold", "bias",  "power", "basis",
-    "normal_filter",    "normal_y",         "addressing", "channel", "output",
-    "input",            "command"};
-enum { PACK_KEYS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
+    "bumpbake_version", "input_hash", "scale", "rays",   "rayset",        "filter_radius",
+    "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
+    "addressing",       "channel",    NULL,    "output", "input",         "command"};
+enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
 
-/* Rank of a line's key in PACK_ORDER, or PACK_KEYS for any other line. */
+/* Rank of a line's key in PACK_ORDER (the NULL entry's for other keys). */
 static int pack_rank(const entry *e) {
-  for (int k = 0; k < PACK_KEYS; k++)
-    if (e->key_length == strlen(PACK_ORDER[k]) &&
-        memcmp(e->key, PACK_ORDER[k], e->key_length) == 0)
+  int other = 0;
+  for (int k = 0; k < PACK_RANKS; k++) {
+    if (!PACK_ORDER[k])
+      other = k;
+    else if (e->key_length == strlen(PACK_ORDER[k]) &&
+             memcmp(e->key, PACK_ORDER[k], e->key_length) == 0)
       return k;
-  return PACK_KEYS;
+  }
+  return other;
 }
 
 /* Puts the line [line, line + n) into the first row with room; 0 if none. */
@@ -353,7 +358,7 @@ int bb__provenance_pack(const char *description, int rows, int row_chars, char *
   memset(out, 0, (size_t)rows * (size_t)(row_chars + 1));
   int dropped = 0;
   /* One pass per rank keeps the order stable without sorting or memory. */
-  for (int rank = 0; rank <= PACK_KEYS; rank++) {
+  for (int rank = 0; rank < PACK_RANKS; rank++) {
     const char *cursor = description ? description : "";
     for (const char *line = cursor; *line; line = cursor) {
       entry e;
@@ -361,7 +366,7 @@ int bb__provenance_pack(const char *description, int rows, int row_chars, char *
       size_t n = strcspn(line, "\n");
       if (n && line[n - 1] == '\r')
         n--;
-      if (n == 0 || (e.key_length ? pack_rank(&e) : PACK_KEYS) != rank)
+      if (n == 0 || pack_rank(&e) != rank) /* a line without '=' ranks as other */
         continue;
       if (!pack_line(line, n, rows, row_chars, out))
         dropped++;
