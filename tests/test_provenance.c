@@ -320,6 +320,12 @@ Test(provenance, pack_keeps_whole_lines_pixel_keys_first) {
   cr_assert_str_eq(small[0], "scale=16\nrays=256");
   cr_assert_str_eq(small[1], "filter_radius=10");
   cr_assert_eq(dropped, 14);
+  /* Other commands' keys are parameters too: before the input's name. */
+  char one[1][41];
+  dropped = bb__provenance_pack("bumpbake_version=0.1.0\ninput=x.obj\naxis=-y\nscale=2\n", 1,
+                                40, &one[0][0]);
+  cr_assert_str_eq(one[0], "bumpbake_version=0.1.0\nscale=2\naxis=-y");
+  cr_assert_eq(dropped, 1);
   free(text);
 }
 
