@@ -110,8 +110,11 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # fonts-dejavu-core: the labels of `sheet` and `render --compare` (drawn
 # through OpenImageIO's FreeType text; without a font they are left out).
 PYTHON   := /usr/bin/python3
+# openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
+# check their exit codes agree (skipped without it).
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
-            python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core
+            python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
+            openimageio-tools
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -176,8 +179,10 @@ $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
 
-$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
+# The tools print JSON with the CLI's one writer (src/cli_json.c).
+TOOL_JSON := $(BUILD)/src/cli_json.o
+$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(TOOL_JSON) $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $< $(TOOL_JSON) $(LIB) $(LDLIBS)
 
 $(TESTBIN): $(TEST_OBJ) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(LIB) $(CRIT_LIBS) $(LDLIBS)

@@ -108,6 +108,15 @@ void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 
+/* Reads only the header of path: its size, channel count and what
+ * bb_image_info holds, without decoding a pixel (fast on any size; a
+ * truncated pixel stream is not noticed). width, height, channels and info
+ * may each be NULL. Errors as bb_image_read, except that the size limits
+ * BB_MAX_DIMENSION and BB_MAX_PIXELS are not applied (the size is reported,
+ * not allocated). */
+bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
+                             bb_image_info *info, bb_error *err);
+
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
  * float32 for exr. */
 typedef enum bb_depth {
@@ -127,7 +136,11 @@ typedef enum bb_range {
 typedef struct bb_write_options {
   bb_depth depth;
   bb_range range;
-  const char *description; /* provenance text stored in the file, or NULL */
+  const char *description; /* provenance text stored in the file, or NULL.
+                              TGA holds 4 rows of 80 characters: provenance
+                              is fitted with whole key=value lines, keys that
+                              affect pixels first, and what does not fit is
+                              left out (see bb_provenance_classify) */
 } bb_write_options;
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
@@ -151,7 +164,9 @@ int bb_path_supports_depth(const char *path, bb_depth depth);
 
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
-  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B */
+  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B;
+                          but alpha when the colour is constant and alpha
+                          varies (see bb_height_channel) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
@@ -162,6 +177,16 @@ typedef enum bb_channel {
 
 /* Parses "r", "g", "b", "a", "luma", "mean", "auto"; returns 0 on success. */
 int bb_channel_parse(const char *name, bb_channel *out);
+
+/* The channel the rule takes from img when asked for `channel`: channel
+ * itself, except BB_CHANNEL_AUTO, which gives BB_CHANNEL_A when img has an
+ * alpha channel (alpha_channel, or the last of 2 or 4 channels), its colour
+ * channels (grey, or R, G and B) are each the same at every texel and alpha
+ * is not: Valve's convention, the height in alpha, which the mean of a
+ * constant colour would bake flat. Otherwise AUTO gives BB_CHANNEL_MEAN
+ * (for a grey image, the grey). A caller can say which was used; reads img
+ * once at most (it stops at the first texel whose colour differs). */
+bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 
 /* Extracts a 1-channel height field from a decoded image by the channel rule.
  * Rejects NaN or infinite heights (BB_ERR_VALUE, naming the first bad texel)
@@ -371,6 +396,38 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
 
 void bb_bake_result_free(bb_bake_result *r);
 
+/* ----------------------------------------------------- Valve's RGBA files */
+
+/* What goes into the RGBA file Valve's height2ssbump writes. */
+typedef struct bb_valve_options {
+  int normal_map;  /* 0: RGB = ssbump (FILE-ssbump.tga); 1: RGB = the normal
+                      map, 0.5 + 0.5 N (-n, FILE-bump.tga). Default 0 */
+  int ao_in_alpha; /* 0: A = the filtered height; 1: A = ao (-A). Default 0 */
+} bb_valve_options;
+
+void bb_valve_options_init(bb_valve_options *o);
+
+/* Packs a bake into Valve's RGBA layout: RGB = result->ssbump (its first
+ * three channels) or result->normal encoded as 0.5 + 0.5 N, A =
+ * result->filtered or result->ao. Every channel of out is then a unit value
+ * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
+ * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
+ * want_trace) or has too few channels; BB_ERR_SIZE when sizes differ. */
+bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
+                        bb_image *out, bb_error *err);
+
+/* Valve's detail variant (-d): multiplies R, G, B of rgba (4 channels, as
+ * bb_valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
+ * input colour smoothed like the height: colour is the decoded input (grey
+ * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
+ * ignored), smoothed by bb_smooth_bilateral with smooth and guided by
+ * height (the 1-channel height the bake started from), so the factor
+ * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
+ * input gives 0.5, the neutral value of a mod2x detail texture. All three
+ * images must have the same size (BB_ERR_SIZE). */
+bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
+                          const bb_smooth_options *smooth, bb_error *err);
+
 /* ---------------------------------------------------------------- compare */
 
 typedef struct bb_compare_stats {
@@ -387,6 +444,40 @@ bb_status bb_compare_images(const bb_image *a, const bb_image *b,
                             double fail_threshold, double warn_threshold,
                             bb_compare_stats *stats, bb_image *diff,
                             bb_error *err);
+
+/* The tolerances of a comparison, as OpenImageIO's idiff takes them (its
+ * -fail, -failpercent, -hardfail, -allowfailures, -warn, -warnpercent,
+ * -hardwarn). Differences are absolute, in the images' float units. */
+typedef struct bb_compare_limits {
+  double fail;          /* a pixel fails when a channel differs by more; 1e-6 */
+  double fail_percent;  /* failing pixels allowed, % of all, 0..100; 0 */
+  double hard_fail;     /* any difference above this fails; infinity */
+  long allow_failures;  /* up to this many failing pixels pass, by any
+                           amount (hard_fail included); 0 */
+  double warn;          /* a pixel warns when a channel differs by more; 1e-6 */
+  double warn_percent;  /* warning pixels allowed, % of all, 0..100; 0 */
+  double hard_warn;     /* any difference above this warns; infinity */
+} bb_compare_limits;
+
+/* Sets idiff's defaults (in the field comments above). */
+void bb_compare_limits_init(bb_compare_limits *limits);
+
+/* A comparison's outcome; the values are idiff's exit codes. */
+typedef enum bb_compare_verdict {
+  BB_COMPARE_PASS = 0,
+  BB_COMPARE_WARN = 1,
+  BB_COMPARE_FAIL = 2
+} bb_compare_verdict;
+
+/* idiff's rule (OpenImageIO 2.4), for stats made by bb_compare_images with
+ * thresholds limits->fail and limits->warn: PASS when at most
+ * allow_failures pixels fail; else FAIL when more than fail_percent % of
+ * the pixels fail or max_abs > hard_fail; else WARN when more than
+ * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
+ * warnings are only reported once some pixel fails: with no failing pixel
+ * the verdict is PASS. */
+bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
+                                    const bb_compare_limits *limits);
 
 /* ------------------------------------------------------------- provenance */
 
@@ -415,6 +506,20 @@ char *bb_provenance_format(const bb_provenance *p);
  * when either text is NULL). Keys "command" and "output" are ignored. Returns
  * the number of differing keys. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
+
+/* What an image description holds, for readers of provenance. */
+typedef enum bb_provenance_class {
+  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
+  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
+  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
+                             re-wrapped (by a format or another tool), so a
+                             key-by-key diff would mislead */
+} bb_provenance_class;
+
+/* Classifies a description (NULL is NONE): bumpbake's when it has a
+ * "bumpbake_version=" line; intact when each non-empty line is key=value
+ * with a key of lower-case letters, digits and '_'. */
+bb_provenance_class bb_provenance_classify(const char *description);
 
 const char *bb_channel_name(bb_channel c);
 

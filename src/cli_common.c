@@ -1,4 +1,4 @@
-/* cli_common.c: option parsing, errors, output writing, JSON and progress
+/* cli_common.c: option parsing, errors, output writing and progress
  * shared by the bumpbake subcommands, so none of them repeats another's. */
 /* realpath() is an XSI function, outside plain POSIX.1-2008. */
 #define _XOPEN_SOURCE 700
@@ -234,7 +234,8 @@ static const char *settings_default_text(int id, const cli_settings *d, char *bu
 
 static void print_help(const cli_command *cmd) {
   cli_settings defaults;
-  cmd->init_settings(&defaults);
+  if (cmd->init_settings)
+    cmd->init_settings(&defaults);
   printf("usage: bumpbake %s %s\n%s\n\noptions:\n", cmd->name, cmd->synopsis,
          cmd->summary);
   for (int i = 0; i < cmd->option_count; i++) {
@@ -243,14 +244,18 @@ static void print_help(const cli_command *cmd) {
     int n = 0;
     if (o->short_name)
       n += snprintf(flags + n, sizeof flags - (size_t)n, "-%c", o->short_name);
+    if (o->long_name && o->single_dash)
+      n += snprintf(flags + n, sizeof flags - (size_t)n, "%s-%s", n ? ", " : "",
+                    o->long_name);
     if (o->long_name)
       n += snprintf(flags + n, sizeof flags - (size_t)n, "%s--%s", n ? ", " : "",
                     o->long_name);
     if (o->value_name)
       snprintf(flags + n, sizeof flags - (size_t)n, " %s", o->value_name);
-    const char *d = o->default_text
-                        ? o->default_text
-                        : settings_default_text(o->id, &defaults, dflt, sizeof dflt);
+    const char *d = o->default_text ? o->default_text
+                    : cmd->init_settings
+                        ? settings_default_text(o->id, &defaults, dflt, sizeof dflt)
+                        : NULL;
     printf("  %-36s %s", flags, o->help);
     if (d)
       printf("; default %s", d);
@@ -271,8 +276,10 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   if (cmd->option_count > MAX_OPTIONS)
     return cli_usage_error(cmd->name, "internal error: too many options");
   shortopts[ns++] = ':';
+  int long_only = 0;
   for (int i = 0; i < cmd->option_count; i++) {
     const cli_option *o = cmd->options[i];
+    long_only |= o->single_dash;
     int has_arg = o->value_name ? required_argument : no_argument;
     if (o->long_name)
       longopts[nl++] = (struct option){o->long_name, has_arg, NULL, o->id};
@@ -288,7 +295,9 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   opterr = 0; /* our messages, in our format */
   optind = 1;
   for (;;) {
-    int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+    int c = long_only
+                ? getopt_long_only(argc, argv, shortopts, longopts, NULL)
+                : getopt_long(argc, argv, shortopts, longopts, NULL);
     if (c == -1)
       break;
     if (c == '?') {
@@ -604,7 +613,7 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
  * stderr for a corrupt PNG before OpenImageIO returns the error we report.
  * The CLI mutes stderr while decoding so every error stays one line; the
  * library leaves the process's file descriptors alone. */
-static int mute_stderr(void) {
+int cli_mute_stderr(void) {
   fflush(stderr);
   int saved = dup(STDERR_FILENO), null_fd = open("/dev/null", O_WRONLY);
   if (saved >= 0 && null_fd >= 0) dup2(null_fd, STDERR_FILENO);
@@ -612,24 +621,36 @@ static int mute_stderr(void) {
   return saved;
 }
 
-static void unmute_stderr(int saved) {
+void cli_unmute_stderr(int saved) {
   if (saved < 0) return;
   dup2(saved, STDERR_FILENO);
   close(saved);
 }
 
 bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err) {
-  int saved = mute_stderr();
+  int saved = cli_mute_stderr();
   bb_status st = bb_image_read(path, img, info, err);
-  unmute_stderr(saved);
+  cli_unmute_stderr(saved);
   return st;
 }
 
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
+  bb_image img = {0};
+  bb_image_info info;
   bb_error err = {{0}};
-  int saved = mute_stderr();
-  bb_status st = bb_height_load(path, s->channel, height, &err);
-  unmute_stderr(saved);
+  bb_status st = cli_read_image(path, &img, &info, &err);
+  if (st == BB_OK) {
+    /* The rule's own choice, so a height found in alpha is said once. */
+    bb_channel used = bb_height_channel(&img, info.alpha_channel, s->channel);
+    if (s->channel == BB_CHANNEL_AUTO && used == BB_CHANNEL_A)
+      fprintf(stderr,
+              "bumpbake: %s: note: the colour is constant and alpha is not; using "
+              "alpha as the height (Valve's convention; --channel chooses)\n",
+              path);
+    st = bb_height_from_image(&img, info.alpha_channel, used, height, &err);
+    bb_image_info_free(&info);
+    bb_image_free(&img);
+  }
   return cli_status_exit(path, st, &err);
 }
 
@@ -644,60 +665,6 @@ double cli_now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ------------------------------------------------------------------- JSON */
-
-static void json_quoted(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
-    if (*c == '"' || *c == '\\')
-      fprintf(f, "\\%c", *c);
-    else if (*c < 0x20)
-      fprintf(f, "\\u%04x", *c);
-    else
-      fputc(*c, f);
-  }
-  fputc('"', f);
-}
-
-/* The separator and "key": that precede every value. */
-static void json_begin_value(cli_json *j, const char *key) {
-  if (j->need_comma)
-    fputc(',', j->f);
-  if (key) {
-    json_quoted(j->f, key);
-    fputc(':', j->f);
-  }
-  j->need_comma = 1;
-}
-
-void cli_json_open(cli_json *j, const char *key, char open) {
-  json_begin_value(j, key);
-  fputc(open, j->f);
-  j->need_comma = 0;
-}
-
-void cli_json_close(cli_json *j, char close) {
-  fputc(close, j->f);
-  j->need_comma = 1;
-}
-
-void cli_json_string(cli_json *j, const char *key, const char *value) {
-  json_begin_value(j, key);
-  if (value)
-    json_quoted(j->f, value);
-  else
-    fputs("null", j->f);
-}
-
-void cli_json_number(cli_json *j, const char *key, double value) {
-  json_begin_value(j, key);
-  /* JSON has no NaN or infinity; no value the CLI prints should be one. */
-  if (isfinite(value))
-    fprintf(j->f, "%.9g", value);
-  else
-    fputs("null", j->f);
 }
 
 /* --------------------------------------------------------------- progress */

@@ -1,11 +1,13 @@
 /* cli_common.h: what the bumpbake subcommands share: option tables and their
- * parsing with range checks, error printing, output writing with provenance,
- * JSON helpers and the progress bar. Nothing here is part of the library. */
+ * parsing with range checks, error printing, output writing with provenance
+ * and the progress bar (the JSON writer is cli_json.h). Nothing here is part
+ * of the library. */
 #ifndef BB_CLI_COMMON_H
 #define BB_CLI_COMMON_H
 
 #include "bumpbake.h"
 #include "cli.h"
+#include "cli_json.h" /* --json output */
 
 #include <stdint.h>
 #include <stdio.h>
@@ -56,6 +58,11 @@ typedef struct cli_option {
   const char *default_text; /* shown in --help; NULL when there is none */
   const char *range_text;   /* shown in --help; NULL when there is none */
   const char *help;         /* one line */
+  /* 1: also spelled with one dash ("-fail 0.1"), as OpenImageIO's idiff
+   * spells it. A table with such a row is parsed with getopt_long_only, so
+   * all its long options then take one dash; "-x" stays a short option
+   * when no long option starts with x. */
+  int single_dash;
 } cli_option;
 
 /* What a subcommand does with one option: 0 when accepted, BB_EXIT_USAGE
@@ -72,7 +79,8 @@ typedef struct cli_command {
   const cli_option *const *options; /* rows, shared rows by address */
   int option_count;
   /* Fills the command's default settings; --help prints the defaults of the
-   * shared settings from it, so the help cannot drift from the behaviour. */
+   * shared settings from it, so the help cannot drift from the behaviour.
+   * NULL for a command without baking settings (compare, info). */
   void (*init_settings)(cli_settings *s);
 } cli_command;
 
@@ -199,7 +207,8 @@ int cli_write_output(cli_run *run, const char *kind, const char *path,
                      const bb_image *img, bb_range range);
 
 /* Loads the height of path by the settings' channel rule; prints the error
- * and returns BB_EXIT_FAILURE on failure. */
+ * and returns BB_EXIT_FAILURE on failure. When the rule finds the height in
+ * alpha (constant colour, varying alpha) it says so on stderr. */
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height);
 
 /* Runs bb_bake; prints the error (naming path) and returns BB_EXIT_FAILURE on
@@ -210,26 +219,14 @@ int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options
 /* Monotonic seconds, for the per-stage timings the CLI measures itself. */
 double cli_now_seconds(void);
 
-/* bb_image_read with stderr muted (libpng's own messages on corrupt PNGs
- * would make an error two lines). */
+/* Mutes stderr (libpng, inside OpenImageIO, prints its own line about a
+ * corrupt PNG, which would make an error two lines) until
+ * cli_unmute_stderr(saved) with what cli_mute_stderr returned. */
+int cli_mute_stderr(void);
+void cli_unmute_stderr(int saved);
+
+/* bb_image_read with stderr muted. */
 bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err);
-
-/* ------------------------------------------------------------------- JSON */
-
-/* A one-line JSON writer: fields are separated by commas automatically.
- * Values are written as they come; nesting is the caller's to balance. */
-typedef struct cli_json {
-  FILE *f;
-  int need_comma; /* a value was written at the current nesting level */
-} cli_json;
-
-/* Opens an object or array; key is its field name, NULL at the top level
- * or inside an array. open is '{' or '['. */
-void cli_json_open(cli_json *j, const char *key, char open);
-void cli_json_close(cli_json *j, char close);
-/* A string field; value NULL writes null. key NULL inside arrays. */
-void cli_json_string(cli_json *j, const char *key, const char *value);
-void cli_json_number(cli_json *j, const char *key, double value);
 
 /* --------------------------------------------------------------- progress */
 

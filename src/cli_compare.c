@@ -1,10 +1,11 @@
-/* cli_compare.c: `bumpbake compare` (idiff-style image diff for CI) and `bumpbake info`.
+/* cli_compare.c: `bumpbake compare`, an idiff-style image diff for CI.
  *
- * compare's exit codes are OpenImageIO idiff's, so a CI script written for
- * idiff works unchanged:
- *   0 within tolerance, 1 warning, 2 failure, 3 different size or channel
- *   count, 4 a file cannot be read.
- * Usage errors also exit 4. idiff itself returns 1 (EXIT_FAILURE) for a bad
+ * Options and exit codes are OpenImageIO idiff's (2.4), so a CI script
+ * written for idiff works unchanged: -fail, -failpercent, -hardfail,
+ * -allowfailures, -warn, -warnpercent, -hardwarn (also with two dashes), and
+ *   0 pass, 1 warning, 2 failure, 3 different size or channel count,
+ *   4 a file cannot be read.
+ * Usage errors also exit 4: idiff returns 1 (EXIT_FAILURE) for a bad
  * command line, which a script would take for a mere warning; 4 ("could not
  * compare") makes a broken CI invocation fail loudly instead.
  */
@@ -13,153 +14,193 @@
 
 #include "bumpbake.h"
 
+#include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
+enum { COMPARE_DIFFERENT_SIZE = 3, COMPARE_CANNOT_READ = 4, COMPARE_USAGE = 4 };
+
+/* Option ids of compare alone, above the shared cli_opt_id values (only
+ * unique within one command's table). */
 enum {
-  COMPARE_PASS = 0,
-  COMPARE_WARN = 1,
-  COMPARE_FAIL = 2,
-  COMPARE_DIFFERENT_SIZE = 3,
-  COMPARE_CANNOT_READ = 4,
-  COMPARE_USAGE = 4
+  OPT_FAIL = 0x1000,
+  OPT_FAIL_PERCENT,
+  OPT_HARD_FAIL,
+  OPT_ALLOW_FAILURES,
+  OPT_WARN,
+  OPT_WARN_PERCENT,
+  OPT_HARD_WARN,
+  OPT_DIFF
 };
 
-static const char compare_usage[] =
-    "usage: bumpbake compare A B [--fail T] [--failpercent P] [--warn T]\n"
-    "                            [--warnpercent P] [--diff FILE] [--json]\n"
-    "  fails (exit 2) when more than P% of pixels (default 0) have a channel\n"
-    "  differing by more than T (default 1e-6); --warn likewise (exit 1, off by\n"
-    "  default). Exit 3: different size or channels; 4: unreadable file or bad\n"
-    "  arguments. --diff writes |A-B| (raw in EXR, scaled to max = 1 otherwise).\n";
+static const cli_option opt_fail = {
+    .id = OPT_FAIL,
+    .long_name = "fail",
+    .value_name = "T",
+    .default_text = "1e-06",
+    .range_text = ">= 0",
+    .help = "a pixel fails when a channel differs by more than T",
+    .single_dash = 1};
+static const cli_option opt_fail_percent = {
+    .id = OPT_FAIL_PERCENT,
+    .long_name = "failpercent",
+    .value_name = "P",
+    .default_text = "0",
+    .range_text = "0..100",
+    .help = "failing pixels allowed, in % of all (then a warning)",
+    .single_dash = 1};
+static const cli_option opt_hard_fail = {
+    .id = OPT_HARD_FAIL,
+    .long_name = "hardfail",
+    .value_name = "T",
+    .default_text = "inf",
+    .range_text = ">= 0",
+    .help = "fail when any difference exceeds T, even within -failpercent",
+    .single_dash = 1};
+static const cli_option opt_allow_failures = {
+    .id = OPT_ALLOW_FAILURES,
+    .long_name = "allowfailures",
+    .value_name = "N",
+    .default_text = "0",
+    .range_text = ">= 0 (integer)",
+    .help = "pass when at most N pixels fail, by any amount",
+    .single_dash = 1};
+static const cli_option opt_warn = {
+    .id = OPT_WARN,
+    .long_name = "warn",
+    .value_name = "T",
+    .default_text = "1e-06",
+    .range_text = ">= 0",
+    .help = "a pixel warns when a channel differs by more than T",
+    .single_dash = 1};
+static const cli_option opt_warn_percent = {.id = OPT_WARN_PERCENT,
+                                            .long_name = "warnpercent",
+                                            .value_name = "P",
+                                            .default_text = "0",
+                                            .range_text = "0..100",
+                                            .help = "warning pixels allowed, in % of all",
+                                            .single_dash = 1};
+static const cli_option opt_hard_warn = {.id = OPT_HARD_WARN,
+                                         .long_name = "hardwarn",
+                                         .value_name = "T",
+                                         .default_text = "inf",
+                                         .range_text = ">= 0",
+                                         .help = "warn when any difference exceeds T",
+                                         .single_dash = 1};
+static const cli_option opt_diff = {
+    .id = OPT_DIFF,
+    .long_name = "diff",
+    .value_name = "FILE",
+    .help = "write |A-B| (raw in .exr, scaled to a maximum of 1 otherwise)"};
+static const cli_option opt_json = {.id = CLI_OPT_JSON,
+                                    .long_name = "json",
+                                    .default_text = "off",
+                                    .help = "print the report as one JSON line"};
+static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
+                                     .long_name = "quiet",
+                                     .short_name = 'q',
+                                     .default_text = "off",
+                                     .help = "print no report; the exit code tells"};
+
+static const cli_option *const compare_options[] = {
+    &opt_fail, &opt_fail_percent, &opt_hard_fail, &opt_allow_failures,
+    &opt_warn, &opt_warn_percent, &opt_hard_warn, &opt_diff,
+    &opt_json, &opt_quiet,        &cli_opt_help,
+};
+
+static const cli_command compare_command = {
+    "compare",
+    "A B [OPTIONS]",
+    "Compares two images channel by channel, as OpenImageIO's idiff (whose\n"
+    "single-dash spellings are accepted), and lists differing provenance.\n"
+    "Verdict (idiff 2.4's): pass when at most -allowfailures pixels fail; else\n"
+    "fail when more than -failpercent % fail or any difference > -hardfail; else\n"
+    "warn when more than -warnpercent % warn or any difference > -hardwarn.\n"
+    "Exit: 0 pass, 1 warning, 2 failure, 3 different size or channels,\n"
+    "4 unreadable file or bad arguments.",
+    compare_options,
+    (int)(sizeof compare_options / sizeof compare_options[0]),
+    NULL, /* no baking settings */
+};
 
 typedef struct compare_args {
   const char *path_a, *path_b;
-  double fail_threshold, fail_percent;
-  double warn_threshold, warn_percent;
-  int warn_enabled;
+  bb_compare_limits limits;
   const char *diff_path;
-  int json;
+  int json, quiet;
 } compare_args;
 
 /* ------------------------------------------------------------ arguments */
 
-static int usage_error(const char *what, const char *detail) {
-  fprintf(stderr, "bumpbake: compare: %s%s%s\n", what, detail ? " " : "",
-          detail ? detail : "");
-  fputs(compare_usage, stderr);
-  return COMPARE_USAGE;
+static int compare_option(void *ctx, const cli_option *opt, const char *arg) {
+  compare_args *a = ctx;
+  bb_compare_limits *l = &a->limits;
+  const char *cmd = compare_command.name;
+  char name[64];
+  snprintf(name, sizeof name, "--%s", opt->long_name ? opt->long_name : "");
+  int n = 0, rc = 0;
+  switch (opt->id) {
+  case OPT_FAIL:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->fail);
+  case OPT_FAIL_PERCENT:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, 100.0, &l->fail_percent);
+  case OPT_HARD_FAIL:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->hard_fail);
+  case OPT_ALLOW_FAILURES:
+    rc = cli_parse_int(cmd, name, arg, 0, INT_MAX, &n);
+    l->allow_failures = n;
+    return rc;
+  case OPT_WARN:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->warn);
+  case OPT_WARN_PERCENT:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, 100.0, &l->warn_percent);
+  case OPT_HARD_WARN:
+    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->hard_warn);
+  case OPT_DIFF:
+    a->diff_path = arg;
+    return 0;
+  case CLI_OPT_JSON:
+    a->json = 1;
+    return 0;
+  case CLI_OPT_QUIET:
+    a->quiet = 1;
+    return 0;
+  }
+  return cli_usage_error(cmd, "internal error: option %s has no handler", name);
 }
 
-/* Parses a non-negative number (thresholds, percentages); 0 on success. */
-static int parse_non_negative(const char *s, double *out) {
-  char *end;
-  double v = strtod(s, &end);
-  if (end == s || *end != '\0' || isnan(v) || v < 0)
-    return 1;
-  *out = v;
-  return 0;
-}
-
-/* Options that take a number, and where each one's value goes. */
-static double *numeric_option(compare_args *a, const char *name) {
-  if (strcmp(name, "--fail") == 0)
-    return &a->fail_threshold;
-  if (strcmp(name, "--failpercent") == 0)
-    return &a->fail_percent;
-  if (strcmp(name, "--warn") == 0)
-    return &a->warn_threshold;
-  if (strcmp(name, "--warnpercent") == 0)
-    return &a->warn_percent;
-  return NULL;
-}
-
+/* 0, -1 for --help, or BB_EXIT_USAGE after a one-line usage error. */
 static int parse_compare_args(int argc, char **argv, compare_args *a) {
   memset(a, 0, sizeof *a);
-  a->fail_threshold = 1e-6; /* idiff's default */
-  a->warn_threshold = INFINITY;
-  int positional = 0;
-  for (int i = 1; i < argc; i++) {
-    const char *arg = argv[i];
-    double *target = numeric_option(a, arg);
-    if (target) {
-      if (i + 1 >= argc)
-        return usage_error("missing value after", arg);
-      if (parse_non_negative(argv[++i], target) != 0)
-        return usage_error("expected a non-negative number after", arg);
-      if (target == &a->warn_threshold)
-        a->warn_enabled = 1;
-    } else if (strcmp(arg, "--diff") == 0) {
-      if (i + 1 >= argc)
-        return usage_error("missing value after", arg);
-      a->diff_path = argv[++i];
-    } else if (strcmp(arg, "--json") == 0) {
-      a->json = 1;
-    } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-      fputs(compare_usage, stdout);
-      return -1;
-    } else if (arg[0] == '-' && arg[1] != '\0') {
-      return usage_error("unknown option", arg);
-    } else if (positional < 2) {
-      *(positional++ == 0 ? &a->path_a : &a->path_b) = arg;
-    } else {
-      return usage_error("too many files:", arg);
-    }
+  bb_compare_limits_init(&a->limits);
+  int first = 0;
+  int rc = cli_parse_options(&compare_command, argc, argv, compare_option, a, &first);
+  if (!rc)
+    rc = cli_expect_positionals(&compare_command, argc, argv, first, 2, "A B");
+  if (rc)
+    return rc;
+  a->path_a = argv[first];
+  a->path_b = argv[first + 1];
+  /* The diff is checked before the (possibly long) reads, and must not
+   * overwrite either input. */
+  if (a->diff_path) {
+    rc =
+        cli_check_output(compare_command.name, a->path_a, a->diff_path, BB_DEPTH_DEFAULT);
+    if (!rc)
+      rc = cli_check_output(compare_command.name, a->path_b, a->diff_path,
+                            BB_DEPTH_DEFAULT);
   }
-  if (positional != 2)
-    return usage_error("needs two image files", NULL);
-  if (a->fail_percent > 100 || a->warn_percent > 100)
-    return usage_error("a percentage is over 100", NULL);
-  return 0;
+  return rc;
 }
 
 /* ----------------------------------------------------------------- files */
 
-/* Prints a library error as one "bumpbake: FILE: reason" line; the I/O
- * layer usually names the file itself, so it is not repeated. */
-static void print_file_error(const char *path, const bb_error *err) {
-  if (strstr(err->message, path))
-    fprintf(stderr, "bumpbake: %s\n", err->message);
-  else
-    fprintf(stderr, "bumpbake: %s: %s\n", path, err->message);
-}
-
 static int has_extension(const char *path, const char *ext) {
   size_t n = strlen(path), m = strlen(ext);
   return n >= m && strcasecmp(path + n - m, ext) == 0;
-}
-
-/* True when a description looks like bumpbake provenance (and is not some
- * other tool's ImageDescription). */
-static int is_bumpbake_provenance(const char *description) {
-  return description && (strncmp(description, "bumpbake_version=", 17) == 0 ||
-                         strstr(description, "\nbumpbake_version="));
-}
-
-static int is_key_char(char ch) {
-  return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_';
-}
-
-/* True when every non-empty line is key=value with a lowercase key. Some
- * formats cut or re-wrap long comments (TGA keeps 4 lines of 80 characters),
- * and diffing such remains would list keys that never changed. */
-static int is_well_formed_provenance(const char *text) {
-  if (!is_bumpbake_provenance(text))
-    return 0;
-  for (const char *line = text; *line;) {
-    const char *end = strchr(line, '\n');
-    size_t n = end ? (size_t)(end - line) : strlen(line);
-    size_t k = 0;
-    while (k < n && is_key_char(line[k]))
-      k++;
-    if (n > 0 && (k == 0 || k == n || line[k] != '='))
-      return 0;
-    line = end ? end + 1 : line + n;
-  }
-  return 1;
 }
 
 /* Writes |A-B|. EXR keeps the raw differences; integer formats would round
@@ -177,11 +218,7 @@ static int write_diff_image(const char *path, bb_image *diff, double max_finite)
           isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite) : 1.0f;
   }
   bb_error err = {{0}};
-  if (bb_image_write(path, diff, &wo, &err) != BB_OK) {
-    print_file_error(path, &err);
-    return 1;
-  }
-  return 0;
+  return cli_status_exit(path, bb_image_write(path, diff, &wo, &err), &err);
 }
 
 static double max_finite_value(const bb_image *img) {
@@ -195,37 +232,13 @@ static double max_finite_value(const bb_image *img) {
 
 /* --------------------------------------------------------------- reports */
 
-static void json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (; s && *s; s++) {
-    unsigned char ch = (unsigned char)*s;
-    if (ch == '"' || ch == '\\')
-      fprintf(f, "\\%c", ch);
-    else if (ch == '\n')
-      fputs("\\n", f);
-    else if (ch < 0x20)
-      fprintf(f, "\\u%04x", ch);
-    else
-      fputc(ch, f);
-  }
-  fputc('"', f);
-}
-
-/* JSON has no infinity or NaN: such values are written as null. */
-static void json_number(FILE *f, double v) {
-  if (isfinite(v))
-    fprintf(f, "%.9g", v);
-  else
-    fputs("null", f);
-}
-
-static const char *result_name(int code) {
-  switch (code) {
-  case COMPARE_PASS:
+static const char *verdict_name(bb_compare_verdict v) {
+  switch (v) {
+  case BB_COMPARE_PASS:
     return "PASS";
-  case COMPARE_WARN:
+  case BB_COMPARE_WARN:
     return "WARNING";
-  case COMPARE_FAIL:
+  case BB_COMPARE_FAIL:
     return "FAILURE";
   }
   return "ERROR";
@@ -237,7 +250,8 @@ static double percent_of(long count, long total) {
 
 static void print_text_report(const compare_args *a, const bb_image *img,
                               const bb_compare_stats *s, const char *prov_diff,
-                              int prov_count, int code) {
+                              int prov_count, bb_compare_verdict v) {
+  const bb_compare_limits *l = &a->limits;
   printf("compare %s %s: %d x %d, %d channel%s\n", a->path_a, a->path_b, img->width,
          img->height, img->channels, img->channels == 1 ? "" : "s");
   printf("  mean abs error %.6g\n", s->mean_abs);
@@ -246,81 +260,83 @@ static void print_text_report(const compare_args *a, const bb_image *img,
   if (s->max_abs > 0)
     printf(" at pixel (%d, %d) channel %d", s->worst_x, s->worst_y, s->worst_channel);
   printf("\n");
-  printf("  %ld pixels (%.3g%%) over fail %g (allowed %g%%)\n", s->over_fail,
-         percent_of(s->over_fail, s->pixels), a->fail_threshold, a->fail_percent);
-  if (a->warn_enabled)
-    printf("  %ld pixels (%.3g%%) over warn %g (allowed %g%%)\n", s->over_warn,
-           percent_of(s->over_warn, s->pixels), a->warn_threshold, a->warn_percent);
+  printf("  %ld pixels (%.3g%%) over fail %g (allowed %g%%", s->over_fail,
+         percent_of(s->over_fail, s->pixels), l->fail, l->fail_percent);
+  if (l->allow_failures > 0)
+    printf(", or %ld pixels", l->allow_failures);
+  if (isfinite(l->hard_fail))
+    printf("; hard fail %g", l->hard_fail);
+  printf(")\n");
+  printf("  %ld pixels (%.3g%%) over warn %g (allowed %g%%", s->over_warn,
+         percent_of(s->over_warn, s->pixels), l->warn, l->warn_percent);
+  if (isfinite(l->hard_warn))
+    printf("; hard warn %g", l->hard_warn);
+  printf(")\n");
   if (prov_count > 0)
     printf("provenance differs:\n%s", prov_diff);
-  printf("%s\n", result_name(code));
+  printf("%s\n", verdict_name(v));
 }
 
-static void json_provenance(const char *prov_diff) {
-  printf("[");
-  const char *line = prov_diff;
-  for (int first = 1; line && *line; first = 0) {
+/* The provenance differences, one string per "key: a -> b" line. */
+static void json_provenance(cli_json *j, const char *prov_diff) {
+  cli_json_open(j, "provenance_diff", '[');
+  for (const char *line = prov_diff; line && *line;) {
     const char *end = strchr(line, '\n');
     size_t n = end ? (size_t)(end - line) : strlen(line);
     char buf[600];
     snprintf(buf, sizeof buf, "%.*s", (int)(n < sizeof buf ? n : sizeof buf - 1), line);
-    if (!first)
-      printf(",");
-    json_string(stdout, buf);
+    cli_json_string(j, NULL, buf);
     line = end ? end + 1 : line + n;
   }
-  printf("]");
+  cli_json_close(j, ']');
+}
+
+static void json_paths(cli_json *j, const compare_args *a) {
+  cli_json_string(j, "a", a->path_a);
+  cli_json_string(j, "b", a->path_b);
 }
 
 static void print_json_report(const compare_args *a, const bb_image *img,
                               const bb_compare_stats *s, const char *prov_diff,
-                              int code) {
-  printf("{\"a\":");
-  json_string(stdout, a->path_a);
-  printf(",\"b\":");
-  json_string(stdout, a->path_b);
-  printf(",\"width\":%d,\"height\":%d,\"channels\":%d,\"pixels\":%ld", img->width,
-         img->height, img->channels, s->pixels);
-  printf(",\"mean_abs\":");
-  json_number(stdout, s->mean_abs);
-  printf(",\"rms\":");
-  json_number(stdout, s->rms);
-  printf(",\"max_abs\":");
-  json_number(stdout, s->max_abs);
-  printf(",\"worst\":{\"x\":%d,\"y\":%d,\"channel\":%d}", s->worst_x, s->worst_y,
-         s->worst_channel);
-  printf(",\"fail\":");
-  json_number(stdout, a->fail_threshold);
-  printf(",\"failpercent\":%.9g,\"over_fail\":%ld", a->fail_percent, s->over_fail);
-  printf(",\"warn\":");
-  json_number(stdout, a->warn_enabled ? a->warn_threshold : NAN);
-  printf(",\"warnpercent\":%.9g,\"over_warn\":%ld", a->warn_percent,
-         a->warn_enabled ? s->over_warn : 0L);
-  printf(",\"provenance_diff\":");
-  json_provenance(prov_diff);
-  printf(",\"result\":\"%s\",\"exit\":%d}\n", result_name(code), code);
+                              bb_compare_verdict v) {
+  const bb_compare_limits *l = &a->limits;
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  json_paths(&j, a);
+  cli_json_int(&j, "width", img->width);
+  cli_json_int(&j, "height", img->height);
+  cli_json_int(&j, "channels", img->channels);
+  cli_json_int(&j, "pixels", s->pixels);
+  cli_json_number(&j, "mean_abs", s->mean_abs);
+  cli_json_number(&j, "rms", s->rms);
+  cli_json_number(&j, "max_abs", s->max_abs); /* null when a NaN differs */
+  cli_json_open(&j, "worst", '{');
+  cli_json_int(&j, "x", s->worst_x);
+  cli_json_int(&j, "y", s->worst_y);
+  cli_json_int(&j, "channel", s->worst_channel);
+  cli_json_close(&j, '}');
+  /* Limits under idiff's option names; infinite hard limits are null. */
+  cli_json_number(&j, "fail", l->fail);
+  cli_json_number(&j, "failpercent", l->fail_percent);
+  cli_json_number(&j, "hardfail", l->hard_fail);
+  cli_json_int(&j, "allowfailures", l->allow_failures);
+  cli_json_int(&j, "over_fail", s->over_fail);
+  cli_json_number(&j, "warn", l->warn);
+  cli_json_number(&j, "warnpercent", l->warn_percent);
+  cli_json_number(&j, "hardwarn", l->hard_warn);
+  cli_json_int(&j, "over_warn", s->over_warn);
+  json_provenance(&j, prov_diff);
+  cli_json_string(&j, "result", verdict_name(v));
+  cli_json_int(&j, "exit", (int)v);
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
 }
 
 /* ------------------------------------------------------------- decisions */
 
-/* idiff's rule: a level is reached when MORE than percent % of the pixels
- * exceed its threshold (so with percent 0, a single pixel is enough). */
-static int compare_verdict(const compare_args *a, const bb_compare_stats *s) {
-  double pixels = (double)s->pixels;
-  if ((double)s->over_fail > a->fail_percent / 100.0 * pixels)
-    return COMPARE_FAIL;
-  if (a->warn_enabled && (double)s->over_warn > a->warn_percent / 100.0 * pixels)
-    return COMPARE_WARN;
-  return COMPARE_PASS;
-}
-
 static int read_image(const char *path, bb_image *img, bb_image_info *info) {
   bb_error err = {{0}};
-  if (cli_read_image(path, img, info, &err) != BB_OK) {
-    print_file_error(path, &err);
-    return 1;
-  }
-  return 0;
+  return cli_status_exit(path, cli_read_image(path, img, info, &err), &err);
 }
 
 static int report_size_mismatch(const compare_args *a, const bb_image *x,
@@ -328,25 +344,26 @@ static int report_size_mismatch(const compare_args *a, const bb_image *x,
   fprintf(stderr, "bumpbake: %s: %d x %d, %d channels, but %s is %d x %d, %d channels\n",
           a->path_b, y->width, y->height, y->channels, a->path_a, x->width, x->height,
           x->channels);
-  if (a->json) {
-    printf("{\"a\":");
-    json_string(stdout, a->path_a);
-    printf(",\"b\":");
-    json_string(stdout, a->path_b);
-    printf(",\"result\":\"DIFFERENT SIZE\",\"exit\":%d}\n", COMPARE_DIFFERENT_SIZE);
+  if (a->json && !a->quiet) {
+    cli_json j = {stdout, 0};
+    cli_json_open(&j, NULL, '{');
+    json_paths(&j, a);
+    cli_json_string(&j, "result", "DIFFERENT SIZE");
+    cli_json_int(&j, "exit", COMPARE_DIFFERENT_SIZE);
+    cli_json_close(&j, '}');
+    fputc('\n', stdout);
   }
   return COMPARE_DIFFERENT_SIZE;
 }
 
 /* Says why provenance was not compared when a file has a damaged copy; on
  * stderr, so --json output stays one line. */
-static void note_malformed_provenance(const compare_args *a, const bb_image_info *ix,
-                                      const bb_image_info *iy) {
+static void note_damaged_provenance(const compare_args *a, const bb_image_info *ix,
+                                    const bb_image_info *iy) {
   const char *paths[2] = {a->path_a, a->path_b};
   const bb_image_info *infos[2] = {ix, iy};
   for (int i = 0; i < 2; i++)
-    if (is_bumpbake_provenance(infos[i]->description) &&
-        !is_well_formed_provenance(infos[i]->description))
+    if (bb_provenance_classify(infos[i]->description) == BB_PROVENANCE_DAMAGED)
       fprintf(stderr,
               "bumpbake: %s: provenance is cut or re-wrapped by the file format; "
               "not compared\n",
@@ -361,40 +378,42 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
   bb_compare_stats stats;
   bb_image diff = {0};
   bb_error err = {{0}};
-  bb_status st = bb_compare_images(x, y, a->fail_threshold, a->warn_threshold, &stats,
+  bb_status st = bb_compare_images(x, y, a->limits.fail, a->limits.warn, &stats,
                                    a->diff_path ? &diff : NULL, &err);
   if (st != BB_OK) {
-    fprintf(stderr, "bumpbake: %s: %s\n", a->path_b, err.message);
+    cli_file_error(a->path_b, err.message);
     return st == BB_ERR_SIZE ? COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
   }
   char prov_diff[4096] = "";
   int prov_count = 0;
-  if (is_well_formed_provenance(ix->description) &&
-      is_well_formed_provenance(iy->description))
+  if (bb_provenance_classify(ix->description) == BB_PROVENANCE_INTACT &&
+      bb_provenance_classify(iy->description) == BB_PROVENANCE_INTACT)
     prov_count =
         bb_provenance_diff(ix->description, iy->description, prov_diff, sizeof prov_diff);
   else
-    note_malformed_provenance(a, ix, iy);
-  int code = compare_verdict(a, &stats);
-  if (a->json)
-    print_json_report(a, x, &stats, prov_diff, code);
+    note_damaged_provenance(a, ix, iy);
+  bb_compare_verdict v = bb_compare_judge(&stats, &a->limits);
+  if (a->quiet)
+    ; /* the exit code is the answer */
+  else if (a->json)
+    print_json_report(a, x, &stats, prov_diff, v);
   else
-    print_text_report(a, x, &stats, prov_diff, prov_count, code);
+    print_text_report(a, x, &stats, prov_diff, prov_count, v);
   /* A diff that cannot be written is reported but does not change the
    * verdict: the comparison itself was made. */
   if (a->diff_path)
     write_diff_image(a->diff_path, &diff, max_finite_value(&diff));
   bb_image_free(&diff);
-  return code;
+  return (int)v;
 }
 
 int bb_cli_compare(int argc, char **argv) {
   compare_args a;
   int parsed = parse_compare_args(argc, argv, &a);
   if (parsed < 0)
-    return COMPARE_PASS; /* --help */
+    return BB_EXIT_OK; /* --help */
   if (parsed > 0)
-    return parsed;
+    return COMPARE_USAGE;
 
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
@@ -407,47 +426,4 @@ int bb_cli_compare(int argc, char **argv) {
   bb_image_info_free(&iy);
   fflush(stdout);
   return code;
-}
-
-/* ------------------------------------------------------------------ info */
-
-static const char info_usage[] = "usage: bumpbake info FILE\n";
-
-int bb_cli_info(int argc, char **argv) {
-  if (argc == 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
-    fputs(info_usage, stdout);
-    return BB_EXIT_OK;
-  }
-  if (argc != 2 || (argv[1][0] == '-' && argv[1][1] != '\0')) {
-    fprintf(stderr, "bumpbake: info: needs exactly one image file\n%s", info_usage);
-    return BB_EXIT_USAGE;
-  }
-  const char *path = argv[1];
-  bb_image img = {0};
-  bb_image_info info = {0};
-  if (read_image(path, &img, &info) != 0)
-    return BB_EXIT_FAILURE;
-
-  printf("%s: %d x %d, %d channel%s, %s, %d-bit %s\n", path, img.width, img.height,
-         img.channels, img.channels == 1 ? "" : "s", info.format_name,
-         info.bits_per_sample, info.is_float ? "float" : "integer");
-  if (info.alpha_channel >= 0)
-    printf("alpha channel: %d\n", info.alpha_channel);
-  if (is_bumpbake_provenance(info.description)) {
-    if (!is_well_formed_provenance(info.description))
-      printf("provenance (cut or re-wrapped by the file format):\n");
-    else
-      printf("provenance:\n");
-    printf("%s", info.description);
-    size_t n = strlen(info.description);
-    if (n && info.description[n - 1] != '\n')
-      printf("\n");
-  } else {
-    printf("no bumpbake provenance\n");
-    if (info.description && *info.description)
-      printf("description: %s\n", info.description);
-  }
-  bb_image_free(&img);
-  bb_image_info_free(&info);
-  return BB_EXIT_OK;
 }

@@ -4,7 +4,6 @@
 #include "cli_common.h"
 
 #include <float.h>
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -163,65 +162,6 @@ static int load_input(h2s_args *a, bb_image *img, bb_image *height) {
   return cli_status_exit(a->input, st, &err);
 }
 
-/* The RGB colour of the input (alpha dropped; grey replicated), smoothed by
- * the same bilateral filter as the height and guided by it, so the detail
- * factor follows the same edges. */
-static bb_status filtered_colour(const bb_image *img, const bb_image *height,
-                                 const bb_smooth_options *smooth, bb_image *out,
-                                 bb_error *err) {
-  bb_image rgb = {0};
-  bb_status st = bb_image_alloc(&rgb, img->width, img->height, 3, err);
-  if (st != BB_OK)
-    return st;
-  /* With 3+ channels R, G, B are the first three; with 1 or 2 (grey,
-   * grey + alpha) grey is channel 0. */
-  int colour_channels = img->channels >= 3 ? 3 : 1;
-  size_t texels = (size_t)img->width * (size_t)img->height;
-  for (size_t i = 0; i < texels; i++)
-    for (int c = 0; c < 3; c++)
-      rgb.pixels[i * 3 + (size_t)c] =
-          img->pixels[i * (size_t)img->channels + (size_t)(c < colour_channels ? c : 0)];
-  st = bb_smooth_bilateral(&rgb, height, smooth, out, err);
-  bb_image_free(&rgb);
-  return st;
-}
-
-/* Multiplies RGB of rgba by (R+G+B)/sqrt(3) of the filtered colour, so a
- * flat unoccluded texel (0.57735) of mid-grey input comes out at 0.5. */
-static void apply_detail(bb_image *rgba, const bb_image *colour) {
-  size_t texels = (size_t)rgba->width * (size_t)rgba->height;
-  const float inv_sqrt3 = (float)(1.0 / sqrt(3.0));
-  for (size_t i = 0; i < texels; i++) {
-    const float *c = colour->pixels + i * 3;
-    float factor = (c[0] + c[1] + c[2]) * inv_sqrt3;
-    for (int k = 0; k < 3; k++)
-      rgba->pixels[i * 4 + (size_t)k] *= factor;
-  }
-}
-
-/* RGB = ssbump (or the encoded normal map), A = filtered height or ao. All
- * four channels are then written as unit values. */
-static bb_status compose_rgba(const h2s_args *a, const bb_bake_result *r, bb_image *out,
-                              bb_error *err) {
-  const bb_image *rgb = a->normal_map ? &r->normal : &r->ssbump;
-  const bb_image *alpha = a->ao_in_alpha ? &r->ao : &r->filtered;
-  bb_status st = bb_image_alloc(out, rgb->width, rgb->height, 4, err);
-  if (st != BB_OK)
-    return st;
-  size_t texels = (size_t)rgb->width * (size_t)rgb->height;
-  for (size_t i = 0; i < texels; i++) {
-    for (int c = 0; c < 3; c++) {
-      float v = rgb->pixels[i * (size_t)rgb->channels + (size_t)c];
-      /* The normal goes into a unit-range file with a height in alpha, so it
-       * is encoded here rather than by BB_RANGE_SIGNED (which would encode
-       * the alpha too). */
-      out->pixels[i * 4 + (size_t)c] = a->normal_map ? 0.5f + 0.5f * v : v;
-    }
-    out->pixels[i * 4 + 3] = alpha->pixels[i];
-  }
-  return BB_OK;
-}
-
 static const char *output_kind(const h2s_args *a) {
   if (a->normal_map)
     return a->ao_in_alpha ? "normal+ao" : "normal+height";
@@ -233,15 +173,14 @@ static const char *output_kind(const h2s_args *a) {
 /* Makes the RGBA image to write from the bake (and for -d the input). */
 static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *height,
                      const bb_bake_result *r, bb_image *rgba) {
+  bb_valve_options vo;
+  bb_valve_options_init(&vo);
+  vo.normal_map = a->normal_map;
+  vo.ao_in_alpha = a->ao_in_alpha;
   bb_error err = {{0}};
-  bb_status st = compose_rgba(a, r, rgba, &err);
-  if (st == BB_OK && a->detail) {
-    bb_image colour = {0};
-    st = filtered_colour(img, height, &a->settings.bake.smooth, &colour, &err);
-    if (st == BB_OK)
-      apply_detail(rgba, &colour);
-    bb_image_free(&colour);
-  }
+  bb_status st = bb_valve_pack(r, &vo, rgba, &err);
+  if (st == BB_OK && a->detail)
+    st = bb_valve_detail(rgba, img, height, &a->settings.bake.smooth, &err);
   return cli_status_exit(a->input, st, &err);
 }
 

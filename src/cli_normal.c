@@ -11,6 +11,12 @@ static const cli_option opt_output = {
     .value_name = "OUT",
     .help = "normal map to write (.png .tga .tif .exr); required"};
 
+static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
+                                     .long_name = "quiet",
+                                     .short_name = 'q',
+                                     .default_text = "off",
+                                     .help = "no \"wrote ...\" line"};
+
 static const cli_option *const normal_options[] = {
     &opt_output,
     &cli_opt_scale,
@@ -22,6 +28,7 @@ static const cli_option *const normal_options[] = {
     &cli_opt_channel,
     &cli_opt_depth,
     &cli_opt_mips,
+    &opt_quiet,
     &cli_opt_help,
 };
 
@@ -38,12 +45,17 @@ static const cli_command normal_command = {
 typedef struct normal_args {
   cli_settings settings;
   const char *output;
+  int quiet;
 } normal_args;
 
 static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
   normal_args *a = ctx;
   if (opt->id == CLI_OPT_OUTPUT) {
     a->output = arg;
+    return 0;
+  }
+  if (opt->id == CLI_OPT_QUIET) {
+    a->quiet = 1;
     return 0;
   }
   return cli_settings_apply(normal_command.name, &a->settings, opt, arg);
@@ -80,6 +92,8 @@ static int normal_run(cli_run *run, normal_args *a, const char *input) {
     cli_run_set_input(run, input, &height, &a->settings);
     rc = cli_write_output(run, "normal", a->output, &result.normal, BB_RANGE_SIGNED);
   }
+  if (!rc && !a->quiet) /* as bake says it */
+    printf("wrote normal %s\n", a->output);
   bb_bake_result_free(&result);
   bb_image_free(&height);
   return rc;

@@ -96,3 +96,27 @@ bb_status bb_compare_images(const bb_image *a, const bb_image *b, double fail_th
   stats->over_warn = over_warn;
   return BB_OK;
 }
+
+void bb_compare_limits_init(bb_compare_limits *limits) {
+  limits->fail = 1e-6; /* idiff's defaults */
+  limits->fail_percent = 0.0;
+  limits->hard_fail = INFINITY;
+  limits->allow_failures = 0;
+  limits->warn = 1e-6;
+  limits->warn_percent = 0.0;
+  limits->hard_warn = INFINITY;
+}
+
+bb_compare_verdict bb_compare_judge(const bb_compare_stats *s,
+                                    const bb_compare_limits *l) {
+  /* The order is idiff's: allowed failures pass before anything else is
+   * looked at, so a CI script gets the exit code idiff would give. */
+  const double pixels = (double)s->pixels;
+  if (s->over_fail <= l->allow_failures)
+    return BB_COMPARE_PASS;
+  if ((double)s->over_fail > l->fail_percent / 100.0 * pixels || s->max_abs > l->hard_fail)
+    return BB_COMPARE_FAIL;
+  if ((double)s->over_warn > l->warn_percent / 100.0 * pixels || s->max_abs > l->hard_warn)
+    return BB_COMPARE_WARN;
+  return BB_COMPARE_PASS;
+}

@@ -81,6 +81,14 @@ int bb__text_width(const char *text, int size_px, const char *font);
 bb_status bb__text_draw(bb_image *img, int center_x, int baseline_y, const char *text,
                         int size_px, const float color[3], const char *font, bb_error *err);
 
+/* Fits the "key=value" lines of a provenance text into `rows` rows of at
+ * most `row_chars` characters (TGA's comment field: 4 rows of 80), whole
+ * lines only: the keys that affect pixels first, then the others, each line
+ * in the first row it fits; lines joined by '\n' within a row. Row r is
+ * written NUL-terminated at out + r * (row_chars + 1), which must hold
+ * rows * (row_chars + 1) bytes. Returns how many lines did not fit. */
+int bb__provenance_pack(const char *description, int rows, int row_chars, char *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -47,6 +47,51 @@ std::string one_line(std::string s) {
   return out.empty() ? std::string("unknown OpenImageIO error") : out;
 }
 
+// ------------------------------------------------------------- TGA comments
+//
+// TGA keeps ImageDescription in its extension area's comment field: 4 rows
+// of 80 characters, each NUL-terminated (324 bytes). OpenImageIO 2.4 writes
+// the text flat into those bytes and reads each 81-byte row back as one line,
+// so a provenance text longer than a row came back cut inside values
+// ("input=roc" / "k.tga"). Provenance is therefore fitted to the rows with
+// whole key=value lines (bb__provenance_pack), each row padded to its 81
+// bytes with newlines, and the blank lines the padding leaves are dropped
+// when it is read. Other text is left to OpenImageIO.
+
+constexpr int TGA_COMMENT_ROWS = 4, TGA_COMMENT_CHARS = 80;
+
+bool is_targa(const char *format_name) { return std::strcmp(format_name, "targa") == 0; }
+
+// The ImageDescription to give OpenImageIO for a file (targa: a .tga file).
+std::string description_to_store(bool targa, const char *description) {
+  // A text that fits the first row comes back as it is.
+  if (!targa || std::strlen(description) <= (size_t)TGA_COMMENT_CHARS ||
+      bb_provenance_classify(description) == BB_PROVENANCE_NONE)
+    return description;
+  char rows[TGA_COMMENT_ROWS][TGA_COMMENT_CHARS + 1];
+  bb__provenance_pack(description, TGA_COMMENT_ROWS, TGA_COMMENT_CHARS, &rows[0][0]);
+  std::string flat;
+  for (int r = 0; r < TGA_COMMENT_ROWS && rows[r][0]; r++) {
+    flat.resize((size_t)r * (TGA_COMMENT_CHARS + 1), '\n'); // pad the previous row
+    flat += rows[r];
+  }
+  return flat;
+}
+
+// The description as read: a TGA's provenance without the blank lines its
+// row padding leaves (the rows' lines, in row order).
+std::string description_as_read(const char *format_name, std::string desc) {
+  // Padded rows always leave an empty line; a text stored as it was has none.
+  if (!is_targa(format_name) || desc.find("\n\n") == std::string::npos ||
+      bb_provenance_classify(desc.c_str()) == BB_PROVENANCE_NONE)
+    return desc;
+  std::string tidy;
+  for (char c : desc)
+    if (c != '\n' || (!tidy.empty() && tidy.back() != '\n')) tidy += c;
+  while (!tidy.empty() && tidy.back() == '\n') tidy.pop_back();
+  return tidy;
+}
+
 // ------------------------------------------------------------------ reading
 
 void clear_info(bb_image_info *info) {
@@ -94,7 +139,8 @@ bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *
   info->bits_per_sample =
       spec.get_int_attribute("oiio:BitsPerSample", (int)spec.format.size() * 8);
   std::snprintf(info->format_name, sizeof info->format_name, "%s", in.format_name());
-  std::string desc = spec.get_string_attribute("ImageDescription");
+  std::string desc =
+      description_as_read(in.format_name(), spec.get_string_attribute("ImageDescription"));
   if (!desc.empty()) {
     info->description = static_cast<char *>(std::malloc(desc.size() + 1));
     if (!info->description)
@@ -137,6 +183,27 @@ bb_status read_image(const char *path, bb_image *out, bb_image_info *info, bb_er
     bb_image_info_free(info);
   }
   return st;
+}
+
+// Opens path and reads its header only: no pixel is decoded, so a file of
+// any size costs only its header (and a truncated file is not noticed).
+bb_status read_header(const char *path, int *width, int *height, int *channels,
+                      bb_image_info *info, bb_error *err) {
+  bb_status st = check_readable(path, err);
+  if (st != BB_OK) return st;
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = ImageInput::open(path, &config);
+  if (!in)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                    one_line(OIIO::geterror()).c_str());
+  const ImageSpec spec = in->spec();
+  st = check_spec_size(path, spec, err);
+  if (st != BB_OK) return st;
+  if (width) *width = spec.width;
+  if (height) *height = spec.height;
+  if (channels) *channels = spec.nchannels;
+  return fill_info(*in, spec, info, path, err);
 }
 
 // ------------------------------------------------------------------ writing
@@ -262,7 +329,9 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
   ImageSpec spec(img->width, img->height, img->channels, file_type);
   spec.attribute("oiio:UnassociatedAlpha", 1);
   spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
-  if (description) spec.attribute("ImageDescription", description);
+  if (description)
+    spec.attribute("ImageDescription",
+                   description_to_store(extension_of(file_name.c_str()) == ".tga", description));
   if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
 
   auto out = ImageOutput::create(file_name);
@@ -764,6 +833,26 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info, bb
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
   } catch (...) {
     bb_image_free(out);
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+}
+
+bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
+                             bb_image_info *info, bb_error *err) {
+  clear_info(info);
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_info: path is NULL");
+  try {
+    bb_status st = read_header(path, width, height, channels, info, err);
+    if (st != BB_OK) bb_image_info_free(info);
+    return st;
+  } catch (const std::bad_alloc &) {
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
+  } catch (const std::exception &e) {
+    bb_image_info_free(info);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
     bb_image_info_free(info);
     return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
   }

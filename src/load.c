@@ -109,6 +109,7 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel, bb_channe
     return bb__fail(err, BB_ERR_ARGUMENT, "alpha channel %d of a %d-channel image",
                     alpha_channel, img->channels);
   pick p;
+  channel = bb_height_channel(img, alpha_channel, channel); /* auto: mean or alpha */
   bb_status st = resolve_pick(img, alpha_channel, channel, &p, err);
   if (st != BB_OK) return st;
   st = bb_image_alloc(height, img->width, img->height, 1, err);

@@ -277,3 +277,100 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   }
   return differing;
 }
+
+/* ---------------------------------------------------------------- classify */
+
+static int is_key_char(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_';
+}
+
+/* 1 when the line [line, line + n) is "key=value" or empty. */
+static int is_entry_line(const char *line, size_t n) {
+  size_t k = 0;
+  while (k < n && is_key_char(line[k]))
+    k++;
+  return n == 0 || (k > 0 && k < n && line[k] == '=');
+}
+
+bb_provenance_class bb_provenance_classify(const char *description) {
+  static const char marker[] = "bumpbake_version=";
+  if (!description || (strncmp(description, marker, sizeof marker - 1) != 0 &&
+                       !strstr(description, "\nbumpbake_version=")))
+    return BB_PROVENANCE_NONE;
+  /* A format that cuts or re-wraps long comments (TGA keeps 4 rows of 80
+   * characters; bb_image_write fits whole lines into them, but other tools
+   * may not) leaves lines that are not key=value. */
+  for (const char *line = description; *line;) {
+    const char *end = strchr(line, '\n');
+    size_t n = end ? (size_t)(end - line) : strlen(line);
+    if (n && line[n - 1] == '\r')
+      n--;
+    if (!is_entry_line(line, n))
+      return BB_PROVENANCE_DAMAGED;
+    line = end ? end + 1 : line + n;
+  }
+  return BB_PROVENANCE_INTACT;
+}
+
+/* -------------------------------------------------------------------- pack */
+
+/* The keys in the order a cut copy keeps them: what the pixels depend on
+ * first (so two cut copies still diff meaningfully), then keys of other
+ * producers (renderbumpflat's axis, rect, ...: parameters too), then what
+ * names the file, and the long command line last. NULL marks where the
+ * other keys go; lines of one rank keep their text order. */
+static const char *const PACK_ORDER[] = {
+    "bumpbake_version", "input_hash", "scale", "rays",   "rayset",        "filter_radius",
+    "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
+    "addressing",       "channel",    NULL,    "output", "input",         "command"};
+enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
+
+/* Rank of a line's key in PACK_ORDER (the NULL entry's for other keys). */
+static int pack_rank(const entry *e) {
+  int other = 0;
+  for (int k = 0; k < PACK_RANKS; k++) {
+    if (!PACK_ORDER[k])
+      other = k;
+    else if (e->key_length == strlen(PACK_ORDER[k]) &&
+             memcmp(e->key, PACK_ORDER[k], e->key_length) == 0)
+      return k;
+  }
+  return other;
+}
+
+/* Puts the line [line, line + n) into the first row with room; 0 if none. */
+static int pack_line(const char *line, size_t n, int rows, int row_chars, char *out) {
+  for (int r = 0; r < rows; r++) {
+    char *row = out + (size_t)r * (size_t)(row_chars + 1);
+    size_t used = strlen(row), sep = used ? 1 : 0;
+    if (used + sep + n > (size_t)row_chars)
+      continue;
+    if (sep)
+      row[used++] = '\n';
+    memcpy(row + used, line, n);
+    row[used + n] = '\0';
+    return 1;
+  }
+  return 0;
+}
+
+int bb__provenance_pack(const char *description, int rows, int row_chars, char *out) {
+  memset(out, 0, (size_t)rows * (size_t)(row_chars + 1));
+  int dropped = 0;
+  /* One pass per rank keeps the order stable without sorting or memory. */
+  for (int rank = 0; rank < PACK_RANKS; rank++) {
+    const char *cursor = description ? description : "";
+    for (const char *line = cursor; *line; line = cursor) {
+      entry e;
+      next_entry(&cursor, &e);
+      size_t n = strcspn(line, "\n");
+      if (n && line[n - 1] == '\r')
+        n--;
+      if (n == 0 || pack_rank(&e) != rank) /* a line without '=' ranks as other */
+        continue;
+      if (!pack_line(line, n, rows, row_chars, out))
+        dropped++;
+    }
+  }
+  return dropped;
+}

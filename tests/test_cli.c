@@ -448,6 +448,53 @@ Test(cli, normal_y_up_flips_green) {
   bb_image_free(&b);
 }
 
+Test(cli, normal_says_what_it_wrote_unless_quiet) {
+  const char *in = tmp("flat.png"), *out = tmp("n.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  cli_result r = RUN("normal", in, "-o", out, "--scale", "8");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  char expect[512];
+  snprintf(expect, sizeof expect, "wrote normal %s\n", out);
+  cr_expect_str_eq(r.out, expect, "as bake says it");
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+  r = RUN("normal", in, "-o", out, "--scale", "8", "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.out, "--quiet");
+  cli_result_free(&r);
+}
+
+/* Valve's convention: a white colour and the height (rising down) in alpha. */
+static float white_with_height_in_alpha(int x, int y, int c) {
+  (void)x;
+  return c == 3 ? 0.02f * (float)y : 1.0f;
+}
+
+Test(cli, height_in_alpha_is_found_and_said) {
+  const char *in = tmp("valve.tga"), *out = tmp("n.png"), *ss = tmp("ss.png");
+  write_image(in, 16, 16, 4, white_with_height_in_alpha);
+  cli_result r = RUN("normal", in, "-o", out, "--scale", "20", "--clamp");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(count_lines(r.err), 1, "one note: %s", r.err);
+  cr_expect(strstr(r.err, "valve.tga: note: ") && strstr(r.err, "using alpha as the height"),
+            "%s", r.err);
+  cli_result_free(&r);
+  bb_image n = read_image(out, NULL);
+  cr_expect_lt(code8(&n, 8, 8, 1), 110, "the alpha ramp leans the normal (green %d)",
+               code8(&n, 8, 8, 1));
+  bb_image_free(&n);
+  /* bake too; --channel mean asks for the (flat) colour: no note. */
+  r = RUN("bake", in, "--scale", "20", "--rays", "16", "--ssbump", ss, "--quiet");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.err, "using alpha as the height"), "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("normal", in, "-o", out, "--scale", "20", "--channel", "mean");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+  expect_uniform8(out, 3, (const int[]){128, 128, 255}, 0);
+}
+
 /* -------------------------------------------------------------------- bake */
 
 Test(cli, bake_of_flat_map) {
@@ -601,6 +648,44 @@ Test(cli, json_checker_rejects_bad_json) {
   cr_expect_null(json_value("{\"a\" 1}"));
   cr_expect_null(json_value("{\"a\":nan}"));
   cr_expect_null(json_value("[1,2"));
+}
+
+/* Every line of text is one JSON value; returns the count of lines. */
+static int expect_json_lines(const char *text) {
+  int lines = 0;
+  for (const char *line = text; *line; lines++) {
+    const char *end = json_value(line);
+    cr_assert_not_null(end, "not JSON: %s", line);
+    cr_assert_eq(*end, '\n', "one value per line: %s", line);
+    line = end + 1;
+  }
+  return lines;
+}
+
+Test(cli, info_and_compare_json_parse) {
+  const char *a = tmp("a.png"), *odd = tmp("q\"uo\\te\tx.tga");
+  write_image(a, 8, 8, 1, mid_grey);
+  cli_result r = RUN("bake", a, "--scale", "4", "--rays", "4", "--ao", odd, "--quiet");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("info", "--json", a, odd, tmp("missing.png"));
+  cr_expect_eq(r.code, 1, "%s", r.err);
+  cr_expect_eq(expect_json_lines(r.out), 3, "%s", r.out);
+  cli_result_free(&r);
+  r = RUN("compare", "--json", a, a);
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(expect_json_lines(r.out), 1, "%s", r.out);
+  cli_result_free(&r);
+  r = RUN("compare", "--json", a, odd);
+  cr_expect_eq(r.code, 2, "grey 0.5 against ao 1: %s", r.err);
+  cr_expect_eq(expect_json_lines(r.out), 1, "%s", r.out);
+  cli_result_free(&r);
+  const char *rgb = tmp("rgb.png");
+  write_image(rgb, 8, 8, 3, mid_grey);
+  r = RUN("compare", "--json", a, rgb);
+  cr_expect_eq(r.code, 3, "%s", r.err);
+  cr_expect_eq(expect_json_lines(r.out), 1, "%s", r.out);
+  cli_result_free(&r);
 }
 
 Test(cli, bake_json_is_one_line_with_the_keys) {

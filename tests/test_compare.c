@@ -130,6 +130,78 @@ Test(compare, accumulates_in_double) {
   bb_image_free(&b);
 }
 
+/* --------------------------------------------------------------- verdict */
+
+/* One comparison as idiff 2.4.7 judged it: a 10 x 10 image where 2 pixels
+ * differ by 0.1 and 3 by 0.01 (over_fail and over_warn as
+ * bb_compare_images counts them for the thresholds of the row), and the
+ * exit code `idiff` itself returned for the same options and images. */
+typedef struct verdict_case {
+  const char *idiff_options;
+  double fail, fail_percent, hard_fail, warn, hard_warn;
+  long allow_failures, over_fail, over_warn;
+  bb_compare_verdict expect;
+} verdict_case;
+
+static const verdict_case verdict_cases[] = {
+    {"-fail 0.05", 0.05, 0, INFINITY, 1e-6, INFINITY, 0, 2, 5, BB_COMPARE_FAIL},
+    /* No failing pixel: idiff passes, whatever is over -warn. */
+    {"-fail 0.2", 0.2, 0, INFINITY, 1e-6, INFINITY, 0, 0, 5, BB_COMPARE_PASS},
+    {"-fail 0.2 -hardwarn 0.09", 0.2, 0, INFINITY, 1e-6, 0.09, 0, 0, 5, BB_COMPARE_PASS},
+    {"-fail 0.05 -warn 0.2", 0.05, 0, INFINITY, 0.2, INFINITY, 0, 2, 0, BB_COMPARE_FAIL},
+    /* Failures allowed by -failpercent are reported as a warning. */
+    {"-fail 0.05 -failpercent 2", 0.05, 2, INFINITY, 1e-6, INFINITY, 0, 2, 5,
+     BB_COMPARE_WARN},
+    {"-fail 0.05 -failpercent 1.9", 0.05, 1.9, INFINITY, 1e-6, INFINITY, 0, 2, 5,
+     BB_COMPARE_FAIL},
+    {"-fail 0.05 -failpercent 2 -hardfail 0.09", 0.05, 2, 0.09, 1e-6, INFINITY, 0, 2, 5,
+     BB_COMPARE_FAIL},
+    {"-fail 0.05 -failpercent 2 -hardfail 0.11", 0.05, 2, 0.11, 1e-6, INFINITY, 0, 2, 5,
+     BB_COMPARE_WARN},
+    /* -allowfailures passes before anything else, -hardfail included. */
+    {"-fail 0.05 -allowfailures 2", 0.05, 0, INFINITY, 1e-6, INFINITY, 2, 2, 5,
+     BB_COMPARE_PASS},
+    {"-fail 0.05 -allowfailures 1", 0.05, 0, INFINITY, 1e-6, INFINITY, 1, 2, 5,
+     BB_COMPARE_FAIL},
+    {"-fail 0.05 -allowfailures 2 -hardfail 0.09", 0.05, 0, 0.09, 1e-6, INFINITY, 2, 2, 5,
+     BB_COMPARE_PASS},
+    {"-fail 0.05 -allowfailures 1 -failpercent 2", 0.05, 2, INFINITY, 1e-6, INFINITY, 1, 2,
+     5, BB_COMPARE_WARN},
+};
+
+Test(compare, verdict_follows_idiff_case_by_case) {
+  for (size_t i = 0; i < sizeof verdict_cases / sizeof verdict_cases[0]; i++) {
+    const verdict_case *c = &verdict_cases[i];
+    bb_compare_limits l;
+    bb_compare_limits_init(&l);
+    l.fail = c->fail;
+    l.fail_percent = c->fail_percent;
+    l.hard_fail = c->hard_fail;
+    l.warn = c->warn;
+    l.hard_warn = c->hard_warn;
+    l.allow_failures = c->allow_failures;
+    bb_compare_stats s = {.max_abs = 0.1, .pixels = 100, .over_fail = c->over_fail,
+                          .over_warn = c->over_warn};
+    cr_expect_eq(bb_compare_judge(&s, &l), c->expect, "idiff %s gives %d", c->idiff_options,
+                 (int)c->expect);
+  }
+}
+
+Test(compare, verdict_defaults_are_idiffs) {
+  bb_compare_limits l;
+  bb_compare_limits_init(&l);
+  cr_assert_eq(l.fail, 1e-6);
+  cr_assert_eq(l.warn, 1e-6);
+  cr_assert(isinf(l.hard_fail) && isinf(l.hard_warn));
+  cr_assert_eq(l.fail_percent, 0);
+  cr_assert_eq(l.warn_percent, 0);
+  cr_assert_eq(l.allow_failures, 0);
+  bb_compare_stats same = {.pixels = 16};
+  cr_assert_eq(bb_compare_judge(&same, &l), BB_COMPARE_PASS);
+  bb_compare_stats one = {.max_abs = 1e-5, .pixels = 16, .over_fail = 1, .over_warn = 1};
+  cr_assert_eq(bb_compare_judge(&one, &l), BB_COMPARE_FAIL, "one pixel is enough");
+}
+
 /* ------------------------------------------------------- the binary, run */
 
 static const char *bin_path(void) {
@@ -217,17 +289,74 @@ Test(compare_cli, identical_files_pass_with_exit_0) {
   cr_assert_not_null(strstr(out, "PASS"), "%s", out);
 }
 
-Test(compare_cli, small_differences_warn_with_exit_1) {
+Test(compare_cli, allowed_failures_warn_with_exit_1) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 3, 0.01f);
   char out[4096];
-  int code = run(out, sizeof out, "compare %s %s --fail 0.1 --warn 0.001", a, b);
+  /* 3 of 16 pixels (18.75%) fail, within --failpercent 20: idiff calls that a
+   * warning (the default --warn is 1e-6, as idiff's). */
+  int code = run(out, sizeof out, "compare %s %s --fail 0.001 --failpercent 20", a, b);
   cr_assert_eq(code, 1, "%s", out);
-  cr_assert_not_null(strstr(out, "3 pixels (18.8%) over warn"), "%s", out);
+  cr_assert_not_null(strstr(out, "3 pixels (18.8%) over warn 1e-06"), "%s", out);
   cr_assert_not_null(strstr(out, "WARNING"), "%s", out);
-  /* Warnings allowed for up to 20% of the pixels: 3 of 16 is 18.75%. */
-  code = run(out, sizeof out, "compare %s %s --fail 0.1 --warn 0.001 --warnpercent 20", a,
-             b);
+  code = run(out, sizeof out, "compare %s %s --fail 0.001 --failpercent 20 --warnpercent 20",
+             a, b);
+  cr_assert_eq(code, 0, "warnings allowed for 20%% of the pixels: %s", out);
+  /* As in idiff, no failing pixel means a pass, whatever is over --warn. */
+  code = run(out, sizeof out, "compare %s %s --fail 0.1 --warn 0.001 --hardwarn 0.005", a, b);
   cr_assert_eq(code, 0, "%s", out);
+  cr_assert_not_null(strstr(out, "PASS"), "%s", out);
+}
+
+Test(compare_cli, idiff_spellings_hardfail_and_allowfailures) {
+  const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 2, 0.5f);
+  char out[4096];
+  /* 2 of 16 pixels differ by 0.5. */
+  cr_assert_eq(run(out, sizeof out, "compare -fail 0.1 %s %s", a, b), 2, "%s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s -fail 0.1 -failpercent 12.5", a, b), 1,
+               "%s", out);
+  cr_assert_eq(
+      run(out, sizeof out, "compare %s %s -fail 0.1 -failpercent 12.5 -hardfail 0.4", a, b),
+      2, "a difference over -hardfail fails within -failpercent: %s", out);
+  cr_assert_not_null(strstr(out, "hard fail 0.4"), "%s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s -allowfailures 2", a, b), 0, "%s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s -allowfailures 2 -hardfail 0.1", a, b),
+               0, "-allowfailures passes them by any amount: %s", out);
+  cr_assert_eq(run(out, sizeof out, "compare -q %s %s --allowfailures=1", a, b), 2, "%s",
+               out);
+  cr_assert_eq(out[0], '\0', "-q prints nothing: %s", out);
+  cr_assert_eq(run(out, sizeof out, "compare %s %s -failpercent 101", a, b), 4, "%s", out);
+}
+
+/* The exit codes of `idiff` itself (OpenImageIO's tools, when installed) for
+ * the cases of compare/verdict_follows_idiff_case_by_case, on real files. */
+Test(compare_cli, exit_codes_equal_idiffs) {
+  if (system("command -v idiff >/dev/null 2>&1") != 0)
+    cr_skip_test("idiff (openimageio-tools) is not installed");
+  float va[100], vb[100];
+  for (int i = 0; i < 100; i++)
+    va[i] = vb[i] = 0.5f;
+  vb[0] = vb[1] = 0.625f; /* 2 pixels 0.125 apart, 3 pixels 0.0078125 apart */
+  vb[10] = vb[11] = vb[12] = 0.5078125f;
+  const char *a = write_image("a.exr", 10, 10, 1, va, NULL);
+  const char *b = write_image("b.exr", 10, 10, 1, vb, NULL);
+  /* One case per branch of the rule (the unit test has them all): a process
+   * of each costs about 0.3 s. */
+  static const char *const options[] = {
+      "-fail 0.2 -hardwarn 0.09",                   /* no failure: PASS */
+      "-fail 0.05 -failpercent 2",                  /* allowed failures: WARNING */
+      "-fail 0.05 -failpercent 2 -hardfail 0.09",   /* over -hardfail: FAILURE */
+      "-fail 0.05 -allowfailures 2 -hardfail 0.09", /* -allowfailures first: PASS */
+      "",                                           /* defaults: FAILURE */
+  };
+  char out[4096], cmd[1024];
+  for (size_t i = 0; i < sizeof options / sizeof options[0]; i++) {
+    snprintf(cmd, sizeof cmd, "idiff -q %s '%s' '%s' >/dev/null 2>&1", options[i], a, b);
+    int status = system(cmd);
+    cr_assert(WIFEXITED(status), "%s", cmd);
+    int ours = run(out, sizeof out, "compare %s %s %s", options[i], a, b);
+    cr_expect_eq(ours, WEXITSTATUS(status), "'%s': idiff %d, bumpbake %d\n%s", options[i],
+                 WEXITSTATUS(status), ours, out);
+  }
 }
 
 Test(compare_cli, default_tolerance_fails_with_exit_2_and_names_worst_pixel) {
@@ -243,9 +372,13 @@ Test(compare_cli, default_tolerance_fails_with_exit_2_and_names_worst_pixel) {
 Test(compare_cli, failpercent_allows_that_share_of_pixels) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 2, 0.5f);
   char out[4096];
-  /* 2 of 16 pixels = 12.5%: failure needs MORE than failpercent. */
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12.5", a, b), 0, "%s",
+  /* 2 of 16 pixels = 12.5%: failure needs MORE than failpercent; failures
+   * allowed that way are a warning, as in idiff, unless warnings are too. */
+  cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12.5", a, b), 1, "%s",
                out);
+  cr_assert_eq(
+      run(out, sizeof out, "compare %s %s --failpercent 12.5 --warnpercent 12.5", a, b), 0,
+      "%s", out);
   cr_assert_eq(run(out, sizeof out, "compare %s %s --failpercent 12", a, b), 2, "%s",
                out);
   cr_assert_eq(run(out, sizeof out, "compare %s %s --fail 0.5", a, b), 0,
@@ -275,10 +408,17 @@ Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
   cr_assert_not_null(strstr(out, "bumpbake: "), "%s", out);
   cr_assert_not_null(strstr(out, "missing.exr"), "%s", out);
   cr_assert_eq(run(out, sizeof out, "compare %s %s", junk, a), 4, "%s", out);
-  cr_assert_eq(run(out, sizeof out, "compare %s", a), 4, "one file: %s", out);
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --fail", a, a), 4, "%s", out);
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --fail -1", a, a), 4, "%s", out);
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --bogus", a, a), 4, "%s", out);
+  /* Usage errors: exit 4, one line "bumpbake compare: problem". */
+  static const char *const bad[] = {"%s", "%s %s --fail", "%s %s --fail -1",
+                                    "%s %s --bogus", "%s %s -x", "%s %s -fail nan"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char args[512];
+    snprintf(args, sizeof args, bad[i], a, a);
+    cr_assert_eq(run(out, sizeof out, "compare %s", args), 4, "compare %s: %s", args, out);
+    cr_assert(strncmp(out, "bumpbake compare: ", 18) == 0, "compare %s: %s", args, out);
+    char *nl = strchr(out, '\n');
+    cr_assert(nl && nl[1] == '\0', "one line for compare %s: %s", args, out);
+  }
 }
 
 Test(compare_cli, diff_exr_holds_raw_absolute_differences) {
@@ -417,4 +557,94 @@ Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
            (unsigned long long)bb_image_hash(&img));
   bb_image_free(&img);
   cr_assert_not_null(strstr(out, hash), "input hash of the decoded height: %s", out);
+}
+
+Test(compare_cli, info_takes_several_files_and_reads_headers_only) {
+  char *p16 = provenance_with_scale(16);
+  const char *a = write_image("a.exr", 4, 4, 1, ramp, p16);
+  enum { W = 64, H = 64 };
+  float v[W * H * 2];
+  for (int i = 0; i < W * H * 2; i++)
+    v[i] = (float)((i * 7919) % 251) / 250.0f; /* noise: a long pixel stream */
+  const char *b = write_image("b.tif", W, H, 2, v, NULL);
+  /* The same TIFF cut in the middle of its pixels: header whole, pixels not.
+   * (TIFF, not PNG: libpng's longjmp out of a truncated PNG leaks a few
+   * bytes inside OpenImageIO, which the sanitized build reports.) */
+  const char *cut = tmp_file("cut.tif");
+  struct stat st;
+  cr_assert_eq(stat(b, &st), 0);
+  char cmd[512];
+  snprintf(cmd, sizeof cmd, "head -c %lld '%s' > '%s'", (long long)st.st_size / 2, b, cut);
+  cr_assert_eq(system(cmd), 0);
+  char out[8192];
+  cr_assert_eq(run(out, sizeof out, "compare %s %s", cut, b), 4,
+               "the cut file cannot be decoded: %s", out);
+  cr_assert_eq(run(out, sizeof out, "info %s %s %s", a, b, cut), 0, "%s", out);
+  cr_assert_not_null(strstr(out, "a.exr: 4 x 4, 1 channel, openexr"), "%s", out);
+  cr_assert_not_null(strstr(out, "\n\n"), "a blank line between files: %s", out);
+  cr_assert_not_null(strstr(out, "b.tif: 64 x 64, 2 channels, tiff, 8-bit integer\n"), "%s",
+                     out);
+  cr_assert_not_null(strstr(out, "cut.tif: 64 x 64, 2 channels, tiff"),
+                     "info reads the header alone: %s", out);
+  free(p16);
+}
+
+/* The lines of text that start with '{', in order; returns their count. */
+static int json_lines(char *text, char **lines, int cap) {
+  int n = 0;
+  for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n"))
+    if (line[0] == '{' && n < cap)
+      lines[n++] = line;
+  return n;
+}
+
+Test(compare_cli, info_json_is_one_object_per_file) {
+  char *p16 = provenance_with_scale(16);
+  const char *a = write_image("a.exr", 4, 4, 1, ramp, p16);
+  /* A name JSON must escape: quote, backslash, tab. */
+  const char *odd = write_image("o\"d\\d\t.png", 4, 4, 3, (float[48]){0}, "made elsewhere");
+  const char *missing = tmp_file("missing.png");
+  char out[8192];
+  cr_assert_eq(run(out, sizeof out, "info --json %s '%s' %s", a, odd, missing), 1,
+               "a missing file: exit 1: %s", out);
+  cr_assert_not_null(strstr(out, "bumpbake: "), "its error on stderr: %s", out);
+  char *lines[8];
+  cr_assert_eq(json_lines(out, lines, 8), 3, "one line per file");
+  cr_assert_not_null(strstr(lines[0], "\"width\":4,\"height\":4,\"channels\":1,"
+                                      "\"format\":\"openexr\",\"bits_per_sample\":32,"
+                                      "\"float\":true,"),
+                     "%s", lines[0]);
+  cr_assert_not_null(strstr(lines[0], "\"provenance_state\":\"intact\",\"provenance\":{"
+                                      "\"bumpbake_version\":"),
+                     "%s", lines[0]);
+  cr_assert_not_null(strstr(lines[0], ",\"scale\":\"16\","), "%s", lines[0]);
+  cr_assert_not_null(strstr(lines[1], "o\\\"d\\\\d\\t.png\",\"width\""), "escaped: %s",
+                     lines[1]);
+  cr_assert_not_null(strstr(lines[1], "\"provenance_state\":\"none\",\"provenance\":null,"
+                                      "\"description\":\"made elsewhere\"}"),
+                     "%s", lines[1]);
+  cr_assert_not_null(strstr(lines[2], "missing.png\",\"error\":\""), "%s", lines[2]);
+  free(p16);
+}
+
+Test(compare_cli, tga_provenance_is_compared_key_by_key) {
+  float v[256];
+  for (int i = 0; i < 256; i++)
+    v[i] = (float)((i * 37) % 256) / 255.0f;
+  write_image("h1.png", 16, 16, 1, v, NULL);
+  write_image("h2.png", 16, 16, 1, v, NULL);
+  char out[8192];
+  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 4", tmp_file("h1.png")), 0, "%s",
+               out);
+  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 8", tmp_file("h2.png")), 0, "%s",
+               out);
+  const char *t1 = tmp_file("h1-ssbump.tga"), *t2 = tmp_file("h2-ssbump.tga");
+  cr_assert_eq(run(out, sizeof out, "info %s", t1), 0, "%s", out);
+  cr_assert_not_null(strstr(out, "provenance:\n"), "intact, not cut: %s", out);
+  cr_assert_not_null(strstr(out, "\ninput=h1.png\n"), "%s", out);
+  run(out, sizeof out, "compare %s %s", t1, t2);
+  cr_assert_not_null(strstr(out, "provenance differs:\n"), "%s", out);
+  cr_assert_not_null(strstr(out, "\nscale: 4 -> 8\n"), "%s", out);
+  cr_assert_not_null(strstr(out, "\ninput: h1.png -> h2.png\n"), "%s", out);
+  cr_assert_null(strstr(out, "cut or re-wrapped"), "%s", out);
 }

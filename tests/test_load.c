@@ -198,6 +198,73 @@ Test(load, five_channels_use_flagged_alpha) {
   bb_image_free(&img);
 }
 
+/* Valve's convention: a constant colour (0.75) and the height in the last
+ * channel, alpha = 0.1 x + 0.01 y. */
+static bb_image height_in_alpha(int w, int h, int channels) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, w, h, channels, NULL), BB_OK);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *t = bb_image_texel(&img, x, y);
+      for (int c = 0; c < channels - 1; c++)
+        t[c] = 0.75f;
+      t[channels - 1] = (float)(0.1 * x + 0.01 * y);
+    }
+  return img;
+}
+
+Test(load, auto_takes_alpha_when_only_alpha_varies) {
+  for (int channels = 2; channels <= 4; channels += 2) {
+    bb_image img = height_in_alpha(4, 3, channels);
+    cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+    cr_assert_eq(bb_height_channel(&img, channels - 1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+    check_rule(&img, -1, BB_CHANNEL_A);
+    bb_image h;
+    cr_assert_eq(bb_height_from_image(&img, -1, BB_CHANNEL_AUTO, &h, NULL), BB_OK);
+    for (int y = 0; y < 3; y++)
+      for (int x = 0; x < 4; x++)
+        cr_assert_eq(*bb_image_texel(&h, x, y), bb_image_texel(&img, x, y)[channels - 1],
+                     "%d channels, texel (%d, %d): auto should read alpha", channels, x, y);
+    bb_image_free(&h);
+    /* An explicit request is kept: the mean of the constant colour is flat. */
+    cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_MEAN), BB_CHANNEL_MEAN);
+    cr_assert_eq(bb_height_from_image(&img, -1, BB_CHANNEL_MEAN, &h, NULL), BB_OK);
+    cr_assert_eq(*bb_image_texel(&h, 3, 2), 0.75f);
+    bb_image_free(&h);
+    bb_image_free(&img);
+  }
+}
+
+Test(load, auto_keeps_the_colour_otherwise) {
+  bb_image img = height_in_alpha(4, 3, 4);
+  /* The last texel's green differs: the colour is a height after all. */
+  bb_image_texel(&img, 3, 2)[1] = 0.5f;
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  /* A constant alpha too: nothing varies, nothing to prefer. */
+  bb_image_texel(&img, 3, 2)[1] = 0.75f;
+  for (int i = 0; i < 12; i++)
+    img.pixels[i * 4 + 3] = 0.5f;
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  /* Alpha flagged inside the colour channels, or outside the image. */
+  cr_assert_eq(bb_height_channel(&img, 1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb_height_channel(&img, 7, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  bb_image_free(&img);
+  /* No alpha: a constant RGB image stays the mean. */
+  img = height_in_alpha(4, 3, 3);
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  bb_image_free(&img);
+  /* Five channels: only a flagged alpha counts. */
+  img = height_in_alpha(4, 3, 5);
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb_height_channel(&img, 4, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+  bb_image_free(&img);
+  /* One texel cannot vary. */
+  img = height_in_alpha(1, 1, 4);
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  bb_image_free(&img);
+  cr_assert_eq(bb_height_channel(NULL, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+}
+
 Test(load, nan_height_names_the_first_bad_texel) {
   bb_image img = make_image(4, 3, 1);
   *bb_image_texel(&img, 3, 2) = NAN;
@@ -282,6 +349,15 @@ Test(load, files_with_one_to_four_channels) {
   check_load("rgba.tga", &rgba, BB_CHANNEL_A, STEP_8);
   check_load("rgb.exr", &rgb, BB_CHANNEL_AUTO, 0.0);
   check_load("rgb.exr", &rgb, BB_CHANNEL_G, 0.0);
+  /* A TGA with a constant colour and the height in alpha loads its alpha. */
+  bb_image valve = height_in_alpha(6, 5, 4);
+  write_file("rgba.tga", &valve, BB_DEPTH_DEFAULT);
+  check_load("rgba.tga", &valve, BB_CHANNEL_A, STEP_8);
+  bb_image h;
+  cr_assert_eq(bb_height_load(tmp_path("rgba.tga"), BB_CHANNEL_AUTO, &h, NULL), BB_OK);
+  cr_assert_float_eq(*bb_image_texel(&h, 5, 4), 0.54, STEP_8, "alpha at (5, 4)");
+  bb_image_free(&h);
+  bb_image_free(&valve);
   bb_image_free(&g);
   bb_image_free(&ga);
   bb_image_free(&rgb);

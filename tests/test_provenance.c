@@ -1,5 +1,6 @@
 /* test_provenance.c: image hash, provenance text and its key-by-key diff. */
 #include "bumpbake.h"
+#include "internal.h" /* bb__provenance_pack */
 
 #include <criterion/criterion.h>
 #include <inttypes.h>
@@ -7,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* FNV-1a 64 over a byte string, written from the published definition
  * (offset basis 14695981039346656037, prime 1099511628211), so the test
@@ -246,4 +248,132 @@ Test(provenance, diff_with_null_text_or_tiny_buffer) {
   cr_assert_eq(bb_provenance_diff("a=1\nb=2\n", "a=3\nb=4\n", out, sizeof out), 2);
   cr_assert_eq(strlen(out), sizeof out - 1);
   cr_assert_eq(bb_provenance_diff("a=1\n", "a=2\n", NULL, 0), 1);
+}
+
+Test(provenance, classify_tells_intact_from_damaged_and_foreign_text) {
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  bb_provenance p = sample_provenance(&o);
+  char *text = bb_provenance_format(&p);
+  cr_assert_eq(bb_provenance_classify(text), BB_PROVENANCE_INTACT, "%s", text);
+  free(text);
+  cr_assert_eq(bb_provenance_classify(NULL), BB_PROVENANCE_NONE);
+  cr_assert_eq(bb_provenance_classify(""), BB_PROVENANCE_NONE);
+  cr_assert_eq(bb_provenance_classify("made with GIMP"), BB_PROVENANCE_NONE);
+  /* Blank lines and CRLF do not damage it; a key may come after others. */
+  cr_assert_eq(bb_provenance_classify("scale=1\n\nbumpbake_version=0.1.0\r\nrays=3"),
+               BB_PROVENANCE_INTACT);
+  /* A value split over two lines, as TGA's 80-column rows used to leave it. */
+  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\ninput=roc\nk.tga\n"),
+               BB_PROVENANCE_DAMAGED);
+  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\n=x\n"),
+               BB_PROVENANCE_DAMAGED, "a line needs a key");
+  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\nScale=1\n"),
+               BB_PROVENANCE_DAMAGED, "keys are lower case");
+}
+
+/* ------------------------------------------------- TGA's 4 x 80 comment */
+
+/* 1 when line (n characters) is one whole line of text. */
+static int is_line_of(const char *text, const char *line, size_t n) {
+  for (const char *l = text; *l;) {
+    size_t m = strcspn(l, "\n");
+    if (m == n && memcmp(l, line, n) == 0)
+      return 1;
+    l += m + (l[m] == '\n');
+  }
+  return 0;
+}
+
+/* A provenance with a realistic bake command line (over 80 characters). */
+static char *long_provenance(void) {
+  bb_bake_options o = sample_options();
+  bb_provenance p = sample_provenance(&o);
+  p.command = "bumpbake height2ssbump -r 250 -f 10 textures/rock/rock_height_2048.tga 64";
+  p.input_name = "rock_height_2048.tga";
+  p.output_kind = "ssbump+height";
+  p.rayset_id = "bb-latslices-v1:n250:a16:p1:hl2";
+  return bb_provenance_format(&p);
+}
+
+Test(provenance, pack_keeps_whole_lines_pixel_keys_first) {
+  char *text = long_provenance();
+  char rows[4][81];
+  int dropped = bb__provenance_pack(text, 4, 80, &rows[0][0]);
+  cr_assert_eq(dropped, 1, "only the command line is left out");
+  for (int r = 0; r < 4; r++) {
+    cr_assert_leq(strlen(rows[r]), 80);
+    for (const char *l = rows[r]; *l;) {
+      size_t n = strcspn(l, "\n");
+      cr_assert(is_line_of(text, l, n), "row %d holds '%.*s', not a line of the text", r,
+                (int)n, l);
+      l += n + (l[n] == '\n');
+    }
+  }
+  cr_assert(strncmp(rows[0], "bumpbake_version=0.1.0\ninput_hash=", 34) == 0, "%s",
+            rows[0]);
+  for (int r = 0; r < 4; r++)
+    cr_assert_null(strstr(rows[r], "command="), "row %d: %s", r, rows[r]);
+  /* Two rows of 20: the pixel keys come first, the rest is dropped. */
+  char small[2][21];
+  dropped = bb__provenance_pack(text, 2, 20, &small[0][0]);
+  cr_assert_str_eq(small[0], "scale=16\nrays=256");
+  cr_assert_str_eq(small[1], "filter_radius=10");
+  cr_assert_eq(dropped, 14);
+  /* Other commands' keys are parameters too: before the input's name. */
+  char one[1][41];
+  dropped = bb__provenance_pack("bumpbake_version=0.1.0\ninput=x.obj\naxis=-y\nscale=2\n", 1,
+                                40, &one[0][0]);
+  cr_assert_str_eq(one[0], "bumpbake_version=0.1.0\nscale=2\naxis=-y");
+  cr_assert_eq(dropped, 1);
+  free(text);
+}
+
+Test(provenance, survives_a_tga_file_as_whole_lines) {
+  char *text = long_provenance();
+  char dir[] = "/tmp/bb-prov-XXXXXX";
+  cr_assert_not_null(mkdtemp(dir));
+  char path[64];
+  snprintf(path, sizeof path, "%s/p.tga", dir);
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 4, 4, 4, NULL), BB_OK);
+  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, text};
+  bb_error err = {{0}};
+  cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
+  bb_image back = {0};
+  bb_image_info info;
+  cr_assert_eq(bb_image_read(path, &back, &info, &err), BB_OK, "%s", err.message);
+  cr_assert_not_null(info.description);
+  cr_assert_eq(bb_provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
+               info.description);
+  /* Every line read is a line written; every key but the command is back. */
+  int lines = 0;
+  for (const char *l = info.description; *l; lines++) {
+    size_t n = strcspn(l, "\n");
+    cr_assert(n > 0, "no blank line: %s", info.description);
+    cr_assert(is_line_of(text, l, n), "'%.*s' is not a line written", (int)n, l);
+    l += n + (l[n] == '\n');
+  }
+  cr_assert_eq(lines, 16, "%s", info.description);
+  char a[128], b[128];
+  static const char *const keys[] = {"input", "input_hash", "scale", "rayset", "bias",
+                                     "channel", "output"};
+  for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+    cr_assert_str_eq(value_of(info.description, keys[k], a, sizeof a),
+                     value_of(text, keys[k], b, sizeof b), "%s", keys[k]);
+  cr_assert_null(value_of(info.description, "command", a, sizeof a));
+  /* The same through the header-only read. */
+  bb_image_info head;
+  int w = 0;
+  cr_assert_eq(bb_image_read_info(path, &w, NULL, NULL, &head, &err), BB_OK, "%s",
+               err.message);
+  cr_assert_eq(w, 4);
+  cr_assert_str_eq(head.description, info.description);
+  bb_image_info_free(&head);
+  bb_image_info_free(&info);
+  bb_image_free(&back);
+  bb_image_free(&img);
+  unlink(path);
+  rmdir(dir);
+  free(text);
 }

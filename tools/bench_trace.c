@@ -25,7 +25,7 @@
  * so another tracer can be run on exactly the same rays.
  */
 #include "bumpbake.h"
-#include "json_string.h"
+#include "cli_json.h"
 
 #include <errno.h>
 #include <math.h>
@@ -329,7 +329,7 @@ static void print_json(const args *a, const field *f, const trace_run *t,
   const double trace_rate = per_second(t->rays_traced, r->trace_s);
   const double brute_rate = per_second(subset_rays, r->brute_s);
   printf("{\"map\":");
-  print_json_string(a->map);
+  cli_json_quoted(stdout, a->map);
   printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"threads\":%d,"
          "\"bias\":%g,",
          f->z.width, f->z.height, a->scale, a->rays, a->threads, a->bias);
@@ -414,7 +414,7 @@ static int peer_agreement(const args *a, const field *f) {
       over += d > PEER_AO_TOLERANCE;
     }
     printf("{\"peer_ao\":");
-    print_json_string(a->peer_ao);
+    cli_json_quoted(stdout, a->peer_ao);
     printf(",\"subset_texels\":%d,\"mean_abs\":%.3g,\"max_abs\":%.3g,\"tolerance\":%g,"
            "\"texels_over\":%d}\n",
            s.count, s.count ? sum / s.count : 0.0, worst, PEER_AO_TOLERANCE, over);

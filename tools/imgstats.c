@@ -13,7 +13,7 @@
  * command line.
  */
 #include "bumpbake.h"
-#include "json_string.h"
+#include "cli_json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -63,9 +63,9 @@ static int report(const char *pa, const char *pb, const bb_image *a, const bb_im
     return 1;
   }
   printf("{\"a\":");
-  print_json_string(pa);
+  cli_json_quoted(stdout, pa);
   printf(",\"b\":");
-  print_json_string(pb);
+  cli_json_quoted(stdout, pb);
   printf(",\"width\":%d,\"height\":%d,\"channels\":[", a->width, a->height);
   for (int c = 0; c < a->channels; c++) {
     channel_stats s = channel_difference(a, b, c, scratch);

@@ -311,7 +311,8 @@ Parameters (as `bumpbake bake --help`; None keeps the library's default):
     normal_y: "down" (Source, DirectX) or "up" (OpenGL); default
         "{DEFAULTS["normal_y"]}".
     clamp: extend the border texels instead of tiling; default {DEFAULTS["clamp"]}.
-    channel: "auto" (grey, or the mean of R, G, B), "r", "g", "b", "a",
+    channel: "auto" (grey, or the mean of R, G, B; alpha when the colour is
+        constant and alpha is not, Valve's convention), "r", "g", "b", "a",
         "luma" or "mean".
     threads (bake): worker threads, default {DEFAULTS["threads"]} = all cores,
         0..4096; results are identical for any count.

@@ -86,8 +86,13 @@ def test_rgba_heights_follow_the_channel_rule():
     rgba = np.zeros((32, 32, 4), np.float32)
     rgba[..., 3] = h  # Valve's convention: height in alpha, constant RGB
     np.testing.assert_array_equal(bumpbake.normal(rgba, 8, channel="a"), bumpbake.normal(h, 8))
-    # auto takes the mean of R, G, B: flat here
-    np.testing.assert_array_equal(bumpbake.normal(rgba, 8)[..., 2], 1.0)
+    # auto sees a constant colour and a varying alpha, and takes alpha ...
+    np.testing.assert_array_equal(bumpbake.normal(rgba, 8), bumpbake.normal(h, 8))
+    # ... while the mean of R, G, B, asked for, is flat
+    np.testing.assert_array_equal(bumpbake.normal(rgba, 8, channel="mean")[..., 2], 1.0)
+    rgba[5, 7, 1] = 0.25  # a colour that varies is a height: auto takes its mean
+    assert bumpbake.normal(rgba, 8)[..., 2].min() < 1.0
+    assert not np.array_equal(bumpbake.normal(rgba, 8), bumpbake.normal(h, 8))
 
 
 def test_same_bits_for_any_thread_count():
