@@ -280,9 +280,25 @@ int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
  * the same exact cell test and no pyramid. Slow; for tests and benchmarks. */
 int bb_ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray);
 
-/* ---------------------------------------------------------------- ray set */
+/* The horizon of the ray's vertical half-plane: the largest slope
+ * (surface - origin z) / d, in texels of rise per texel of horizontal
+ * distance, over every breakpoint of the surface (cell edge or diagonal
+ * crossing) at 0 < d <= max_distance along the ray's horizontal direction
+ * (its z is ignored), or 0 when none is positive: a direction is open
+ * exactly when its tangent of elevation exceeds it. max_distance is in
+ * texels, > 0; it may be INFINITY in clamp mode (past the border the surface
+ * turns flat), not in periodic mode, where a ray that never rises above its
+ * origin would wrap for ever. Returns -1 for a bad max_distance or a
+ * vertical direction. Max-mip march. */
+double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance);
+
+/* The same answer by the brute-force twin (every cell, no pyramid). */
+double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance);
+
+/* -------------------------------------------------------------- ray set */
 
 #define BB_MAX_BASIS 4
+#define BB_MAX_SLICES 256
 
 /* Basis the occlusion is projected on. */
 typedef enum bb_basis {
@@ -296,52 +312,79 @@ int bb_basis_count(bb_basis b);
 /* Unit vector of basis direction index (0..3) into v. */
 void bb_basis_vector(int index, double v[3]);
 
-/* The directions traced from every texel, organised as azimuth slices: slice
- * s holds rays slice_start[s] .. slice_start[s+1]-1, all with the horizontal
- * direction slice_dir[s], sorted by rising elevation. */
+/* Azimuth slices a budget of `rays` rays per texel stands for, as Valve's
+ * tool counts rays: round(sqrt(rays)), at least 1 (so -r 250 and 256 both
+ * give 16). */
+int bb_slices_for_rays(int rays);
+
+/* The directions the bake integrates over, and how. ("Ray set" is the
+ * historical name: nothing is sampled in elevation.) Slice s follows the
+ * integer lattice step (a, b) nearest to the azimuth 2 pi (s + 1/2) / A and
+ * stands for the azimuth sector [sector[2s], sector[2s+1]] halfway to its
+ * neighbours. A texel's horizon along the step's direction (tangent t, found
+ * exactly by the tracer) blocks, over the whole sector, the elevations
+ * below atan(max(t, 0)); what that takes from each integral of CONVENTIONS
+ * (ao: w.z; vis_c: max(0, w.B_c)^P) is exact: closed form for ao, tables in
+ * t built here for the lobes (error under 1e-9 of the sector's share). Then
+ *   ao    = 1 - sum_s blocked_ao,s(t_s) / total[0]
+ *   vis_c = 1 - sum_s blocked_c,s(t_s) / total[1 + c]
+ * so an unobstructed texel gets exactly 1. */
 typedef struct bb_rayset {
-  int ray_count;
-  int slice_count;
-  int basis_count;
-  int *slice_start;          /* slice_count + 1 entries */
-  double *slice_dir;         /* 2 per slice: unit (dx, dy) */
-  int *slice_step;           /* 2 per slice: the integer lattice step (a, b) the
-                                slice direction follows, (dx, dy) ~ (a, b) */
-  double *tan_elevation;     /* per ray: dz / |(dx, dy)|, rising within a slice */
-  double *direction;         /* 3 per ray: unit direction */
-  double *weight_ao;         /* per ray: estimator weight of ao */
-  double *weight_basis;      /* basis_count per ray: estimator weights of vis_c */
-  double total_ao;           /* sum of weight_ao */
-  double total_basis[BB_MAX_BASIS]; /* sums of weight_basis per channel */
-  char id[64];               /* names the set and its parameters, for provenance */
+  int slice_count;           /* A, 1..BB_MAX_SLICES */
+  int basis_count;           /* lobes: 3 (hl2) or 4 (hl2+z) */
+  double power;              /* P >= 1 of the lobes */
+  double basis[BB_MAX_BASIS][3]; /* unit lobe directions B_c */
+  int *slice_step;           /* 2 per slice: the lattice step (a, b), coprime */
+  double *slice_dir;         /* 2 per slice: unit (dx, dy) along (a, b) */
+  double *sector;            /* 2 per slice: first and last azimuth, radians */
+  double *half_width;        /* per slice: (last - first) / 2 */
+  double *table;             /* per slice, the lobes' tables (layout internal) */
+  double total[1 + BB_MAX_BASIS]; /* the whole integrals: pi for ao, then each lobe's */
+  char id[64];               /* names the scheme and its parameters, for provenance */
 } bb_rayset;
 
-/* Builds the default ray set: rays >= 1 directions, power >= 1. */
-bb_status bb_rayset_make(int rays, double power, bb_basis basis,
-                         bb_rayset *out, bb_error *err);
+/* Builds the slices and their integration tables: slices in
+ * 1..BB_MAX_SLICES, power >= 1. Allocates; free with bb_rayset_free. */
+bb_status bb_rayset_make(int slices, double power, bb_basis basis, bb_rayset *out,
+                         bb_error *err);
 void bb_rayset_free(bb_rayset *rs);
+
+/* What slice `slice` loses to a horizon of tangent tan_horizon (rise per
+ * horizontal texel; <= 0 loses nothing) from each integral: blocked[0] for
+ * ao, blocked[1 + c] for lobe c (1 + basis_count values). */
+void bb_rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked);
 
 /* ------------------------------------------------------------------ trace */
 
 /* Progress callback: done out of total work units; return nonzero to go on. */
 typedef void (*bb_progress_fn)(void *user, long done, long total);
 
+/* A rectangle of texels, x0..x0+width-1 by y0..y0+height-1. */
+typedef struct bb_region {
+  int x0, y0, width, height;
+} bb_region;
+
 typedef struct bb_trace_options {
   double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
   int threads;          /* 0 = all cores */
+  bb_region region;     /* width 0 (default): every texel, by line sweeps;
+                           else only these texels, by max-mip marches */
   bb_progress_fn progress; /* may be NULL; called from one thread */
   void *progress_user;
 } bb_trace_options;
 
 void bb_trace_options_init(bb_trace_options *o);
 
-/* Traces every texel of the pyramid against the ray set. Allocates vis with
- * 1 + rs->basis_count channels: ao, vis_0, vis_1, ... in [0, 1]. The result
- * is bit-identical for any thread count. rays_traced (may be NULL) receives
- * texels * ray_count. */
+/* Finds every texel's horizon in each slice of rs and integrates it (see
+ * bb_rayset). Allocates vis with 1 + rs->basis_count channels: ao, vis_0,
+ * vis_1, ... in [0, 1], over the whole pyramid or over o->region (which
+ * must lie inside it). Sweeps and marches find the same horizons, so a
+ * region's texels are bit-identical to the same texels of a whole trace,
+ * and the result is bit-identical for any thread count. horizons_found (may
+ * be NULL) receives texels * slices. */
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
-                             double *rays_traced, bb_error *err);
+                             double *horizons_found, bb_error *err);
 
 /* ----------------------------------------------------------------- derive */
 
@@ -363,7 +406,9 @@ bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err);
 
 typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
-  int rays;                   /* per texel, default 256 */
+  int rays;                   /* ray budget, default 256: round(sqrt(rays)) slices */
+  int slices;                 /* azimuth slices, 1..BB_MAX_SLICES; 0 (default):
+                                 from rays */
   bb_smooth_options smooth;   /* filter radius/threshold/addressing */
   bb_trace_options trace;     /* bias, threads, progress */
   double power;               /* P >= 1, default 1 */
@@ -385,7 +430,7 @@ typedef struct bb_bake_result {
   bb_image ao;         /* 1 channel (when traced) */
   bb_image bent;       /* 3 channels (when traced) */
   double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
-  double rays_traced;
+  double horizons_found;   /* texels x slices */
   char rayset_id[64];
 } bb_bake_result;
 

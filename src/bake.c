@@ -34,8 +34,11 @@ static bb_status check_options(const bb_bake_options *o, bb_error *err) {
   if (!(o->height_scale > 0.0f) || !isfinite(o->height_scale))
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: height scale must be > 0 (got %g)",
                     (double)o->height_scale);
-  if (o->want_trace && (o->rays < 1 || o->rays > 65536))
+  if (o->want_trace && !o->slices && (o->rays < 1 || o->rays > 65536))
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: rays must be in 1..65536 (got %d)", o->rays);
+  if (o->want_trace && (o->slices < 0 || o->slices > BB_MAX_SLICES))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: slices must be in 1..%d (got %d)",
+                    BB_MAX_SLICES, o->slices);
   if (!(o->power >= 1.0) || !isfinite(o->power))
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: power must be >= 1 (got %g)", o->power);
   if (!(o->trace.bias_texels >= 0.0) || !isfinite(o->trace.bias_texels))
@@ -64,12 +67,15 @@ static bb_status trace_and_derive(const bb_bake_options *o, bb_bake_result *r,
   bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
   if (st == BB_OK) st = bb_pyramid_build(&z, o->smooth.addressing, &pyramid, err);
   bb_image_free(&z);
-  if (st == BB_OK) st = bb_rayset_make(o->rays, o->power, o->basis, &rays, err);
+  const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
+  if (st == BB_OK) st = bb_rayset_make(slices, o->power, o->basis, &rays, err);
   double t1 = bb__now_seconds();
   r->seconds_pyramid = t1 - t0;
   if (st == BB_OK) {
     snprintf(r->rayset_id, sizeof r->rayset_id, "%s", rays.id);
-    st = bb_trace_occlusion(pyramid, &rays, &o->trace, &r->vis, &r->rays_traced, err);
+    bb_trace_options whole = o->trace;
+    whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
+    st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;

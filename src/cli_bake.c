@@ -223,6 +223,7 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_open(&j, "parameters", '{');
   cli_json_number(&j, "scale", (double)b->height_scale);
   cli_json_number(&j, "rays", b->rays);
+  cli_json_number(&j, "slices", b->slices ? b->slices : bb_slices_for_rays(b->rays));
   cli_json_string(&j, "rayset", b->want_trace ? r->rayset_id : NULL);
   cli_json_number(&j, "filter_radius", b->smooth.radius_texels);
   cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
@@ -246,7 +247,7 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_number(&j, "write", t->write);
   cli_json_close(&j, '}');
 
-  cli_json_number(&j, "rays_traced", r->rays_traced);
+  cli_json_number(&j, "horizons", r->horizons_found);
   cli_json_open(&j, "outputs", '[');
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
     if (!a->paths[k])

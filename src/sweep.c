@@ -1,5 +1,5 @@
 /* sweep.c: the horizons of every texel for a lattice slice direction and its
- * opposite, by sweeps along each line of texels.
+ * opposite, by sweeps along each line of texels, integrated on the spot.
  *
  * A slice follows a lattice step (a, b) (coprime integers), so texel P and
  * P + j (a, b) lie on one line, and so do all the breakpoints of the surface
@@ -12,21 +12,30 @@
  * the tangent from the origin to the upper convex hull of the points ahead:
  * walking the line backwards, each point is pushed onto a hull stack once,
  * and each texel asks the stack for its tangent by a short walk from its
- * near end. The rays of the slice blocked at a texel are those whose tangent
- * tan_el * |(a, b)| is at most that slope.
+ * near end. The tangent's slope is then computed from integers exactly as
+ * the march computes it (trace_internal.h), and what the slice loses to it
+ * is added to the texel's sums: no per-slice buffer is kept.
  *
  * The opposite direction (-a, -b) runs along the same lines through the same
  * breakpoints, so one profile serves both: the sweep for (a, b) walks it
  * backwards, the sweep for (-a, -b) forwards (on mirrored u).
  *
- * Lines are cut into chunks of at most CHUNK_STEPS texels, each profiled
- * with a look-ahead past both ends of as many steps as a ray of the lowest
- * elevation needs to rise above the global maximum. Periodic lines (the
- * texture tiles) wrap, and after one whole period nothing new can come; in
- * clamp mode a line runs from one edge to the other, and past the image the
- * look-ahead reads the clamped vertices (the border extruded) until the
- * profile is flat. Chunks are independent, so they run on all threads with
- * the same result.
+ * Where a line ends:
+ * - Periodic lines close after their period L. A point at u + L is the point
+ *   at u again, farther away, so nothing beyond one period can be steeper.
+ *   Better: nothing beyond the line's highest point P* is steeper than P*
+ *   from behind it, so a line is swept once round, starting at P*, with the
+ *   hull holding P* alone: one period of points, no look-ahead.
+ * - Clamped lines (clamp mode) run from edge to edge; past the image the
+ *   profile reads the clamped vertices (the border extruded) until it turns
+ *   flat, and a flat stretch holds nothing steeper than its first point.
+ * - Periodic lines longer than long_line steps (images whose sides share
+ *   few factors) are cut into chunks with a look-ahead of one chunk each way.
+ *   A texel whose horizon is not clearly above anything the points beyond
+ *   the look-ahead could reach (global max over their nearest distance) is
+ *   marched instead, which gives the same bits.
+ * Lines (and chunks) are independent, so they run on all threads; each
+ * texel is written by one of them per slice, in the slices' fixed order.
  */
 #include "internal.h"
 #include "trace_internal.h"
@@ -38,65 +47,95 @@
 #include <string.h>
 
 enum { CHUNK_STEPS = 4096 };
+/* Periodic lines of more points than this are swept in chunks. */
+#define LONG_LINE_POINTS (1L << 20)
 
 /* A breakpoint of one step, relative to the step's first texel: the surface
- * there is z(v1) + (z(v2) - z(v1)) * w. */
+ * there is bb__lattice_height(z(v1), z(v2), w), w = r / m, at n / m steps
+ * from an origin k whole steps behind the step, n = k m + i. */
 typedef struct template_point {
-  double u;       /* fraction of the step, in (0, 1] */
+  double frac;     /* i / m, in (0, 1]: for ordering and hull geometry */
+  int m, i;        /* m = 1, i = 1: the next texel, a vertex */
+  double inverse_m, w; /* bb__lattice_inverse(m), bb__lattice_weight(r, m) (0: the vertex) */
   int x1, y1, x2, y2;
-  double w;
   long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
 } template_point;
 
-/* One direction of a sweep (trace_internal.h's bb__sweep_dir) with its
- * thresholds per step. */
+/* One direction of a sweep with its slice's step. */
 typedef struct sweep_side {
-  const double *tan_step; /* slopes per step that block: tan_el * |(a, b)|, rising */
-  int n;
-  uint16_t *blocked;      /* per texel; NULL: this direction is not wanted */
+  const bb__sweep_dir *dir; /* NULL: this direction is not wanted */
+  int a, b;                 /* its own lattice step */
+  double inverse_length;    /* bb__step_inverse(a, b) */
+  bb__slice_integral integral;
 } sweep_side;
+
+typedef enum line_kind { LINE_ROUND, LINE_CHUNK, LINE_CLAMPED } line_kind;
 
 typedef struct sweep_job {
   const bb_pyramid *p;
   int a, b;
-  template_point *points;                   /* the step's breakpoints, the next texel last */
+  template_point *points; /* the step's breakpoints, the next texel last */
   int point_count;
-  const int *chunk_x, *chunk_y, *chunk_len; /* first texel and length of each chunk */
-  int ahead, behind; /* steps profiled past a chunk's end (for (a, b)) and before its start */
+  line_kind kind;
+  const int *item_x, *item_y, *item_len; /* first texel and texels of each line or chunk */
+  int item_count;
+  long period;    /* periodic: steps of a line */
+  int lookahead;  /* chunks: steps profiled past each end */
   double bias;
+  int channels;   /* floats per texel in the sums */
   sweep_side side[2]; /* along (a, b) and along (-a, -b) */
   int reach_x, reach_y; /* how far template vertices lie from a step's texel */
+  /* the template's offsets, fractions and weights, each in one array */
+  long offset1[4 * BB__MAX_LATTICE_STEP + 1], offset2[4 * BB__MAX_LATTICE_STEP + 1];
+  double frac[4 * BB__MAX_LATTICE_STEP + 1], weight[4 * BB__MAX_LATTICE_STEP + 1];
+  int min_dx, max_dx, min_dy, max_dy; /* template vertex offsets */
   atomic_int out_of_memory;
 } sweep_job;
 
-static int cmp_u(const void *pa, const void *pb) {
-  const double a = ((const template_point *)pa)->u, b = ((const template_point *)pb)->u;
+static int cmp_frac(const void *pa, const void *pb) {
+  const double a = ((const template_point *)pa)->frac, b = ((const template_point *)pb)->frac;
   return a < b ? -1 : a > b;
 }
 
-/* Breakpoints of the step from (0, 0) to (a, b), sorted by u. For coprime
+static inline long floor_div(long num, long den) { /* den > 0 */
+  const long q = num / den;
+  return q * den > num ? q - 1 : q;
+}
+
+static inline int sign(int v) {
+  return v > 0 ? 1 : (v < 0 ? -1 : 0);
+}
+
+static template_point template_at(int m, int i, long r, int x1, int y1, int x2, int y2) {
+  const double inverse = bb__lattice_inverse(m);
+  return (template_point){(double)i / m, m, i, inverse, bb__lattice_weight(r, inverse),
+                          x1, y1, x2, y2, 0, 0};
+}
+
+/* Breakpoints of the step from (0, 0) to (a, b), sorted by u, computed from
+ * integers as the march computes them (trace.c: lattice_*). For coprime
  * (a, b) the three families meet only at the step's end, the next texel,
  * which is kept once, as the vertex itself. */
 static int build_template(int a, int b, template_point *out) {
   int n = 0;
   const int ma = abs(a), mb = abs(b), md = abs(a + b);
   for (int i = 1; i < ma; i++) { /* vertical lines x = X */
-    const double u = (double)i / ma, y = u * b;
-    const int X = i * (a > 0 ? 1 : -1), row = (int)floor(y);
-    out[n++] = (template_point){u, X, row, X, row + 1, y - row, 0, 0};
+    const long num = (long)i * b, row = floor_div(num, ma);
+    const int X = i * sign(a);
+    out[n++] = template_at(ma, i, num - row * ma, X, (int)row, X, (int)row + 1);
   }
   for (int i = 1; i < mb; i++) { /* horizontal lines y = Y */
-    const double u = (double)i / mb, x = u * a;
-    const int Y = i * (b > 0 ? 1 : -1), col = (int)floor(x);
-    out[n++] = (template_point){u, col, Y, col + 1, Y, x - col, 0, 0};
+    const long num = (long)i * a, col = floor_div(num, mb);
+    const int Y = i * sign(b);
+    out[n++] = template_at(mb, i, num - col * mb, (int)col, Y, (int)col + 1, Y);
   }
   for (int i = 1; i < md; i++) { /* diagonals x + y = K, from (c+1, K-1-c) to (c, K-c) */
-    const double u = (double)i / md, x = u * a, y = u * b;
-    const int K = i * (a + b > 0 ? 1 : -1), col = (int)floor(x), row = K - 1 - col;
-    out[n++] = (template_point){u, col + 1, row, col, row + 1, y - row, 0, 0};
+    const long num = (long)i * a, col = floor_div(num, md);
+    const int row = i * sign(a + b) - 1 - (int)col;
+    out[n++] = template_at(md, i, md - (num - col * md), (int)col + 1, row, (int)col, row + 1);
   }
-  out[n++] = (template_point){1.0, a, b, a, b, 0.0, 0, 0}; /* the next texel */
-  qsort(out, (size_t)n, sizeof *out, cmp_u);
+  out[n++] = template_at(1, 1, 0, a, b, a, b); /* the next texel */
+  qsort(out, (size_t)n, sizeof *out, cmp_frac);
   return n;
 }
 
@@ -104,44 +143,30 @@ static inline int imax(int a, int b) {
   return a > b ? a : b;
 }
 
-/* Upper hull of the points ahead, nearest last. */
-typedef struct hull {
-  double *u, *z;
-  int size;
-} hull;
-
-/* Pushes a point nearer than all others, dropping those now under the hull. */
-static inline void hull_push(hull *h, double u, double z) {
-  while (h->size >= 2) {
-    const double ua = h->u[h->size - 1], za = h->z[h->size - 1];
-    const double ub = h->u[h->size - 2], zb = h->z[h->size - 2];
-    /* a is on or under the segment from the new point to b */
-    if ((za - z) * (ub - u) <= (zb - z) * (ua - u)) h->size--;
-    else break;
-  }
-  h->u[h->size] = u;
-  h->z[h->size] = z;
-  h->size++;
+static inline int imin(int a, int b) {
+  return a < b ? a : b;
 }
 
-/* Largest slope from (u0, z0), behind every point, to the hull: slopes to
- * hull vertices rise, then fall, going away from the origin. The hull is
- * short (hull_push_cut keeps it so: 3.6 vertices on average on rock06) and
- * the tangent is mostly at the nearest vertex or the next, so a walk from
- * the near end beats a binary search. */
-static inline double hull_tangent(const hull *h, double u0, double z0) {
-  int i = h->size - 1;
-  double du = h->u[i] - u0, dz = h->z[i] - z0;
-  while (i > 0) {
-    const double du_far = h->u[i - 1] - u0, dz_far = h->z[i - 1] - z0;
-    /* is the farther vertex steeper? (denominators are positive) */
-    if (!(dz_far * du > dz * du_far)) break;
-    du = du_far;
-    dz = dz_far;
-    i--;
-  }
-  return dz / du;
-}
+/* ------------------------------------------------------------- profiles */
+
+/* A point of a profile: where it is (u, in steps from the line's texel 0),
+ * its height, and for the exact slope the step it belongs to and its
+ * template point. */
+typedef struct point {
+  double u, z;
+  int step, tp;
+} point;
+
+/* The points of a line (or chunk) that can matter, by rising u: step
+ * first_step + s covers u in (first_step + s, first_step + s + 1]. Origins
+ * are the texels 0 .. len-1, of height vz[j] and image index texel[j]. */
+typedef struct profile {
+  int first_step, steps, len;
+  int count;
+  point *pt;
+  double *vz;
+  size_t *texel;
+} profile;
 
 /* Height of vertex (x, y) through the addressing; periodic coordinates lie
  * within a few periods of the image, clamped ones anywhere. */
@@ -160,300 +185,516 @@ static inline int coordinate_at(const bb_pyramid *p, long v, int n) {
   return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap((int)(v % n), n) : (int)v;
 }
 
+/* step is already reduced (|step| < n) in periodic mode */
 static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
-  return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step % n, n) : v + step;
+  return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step, n) : v + step;
 }
 
-/* hull_push, then: if nothing ahead rises from the new point as steeply as
- * the lowest ray (tan_low), drop all but the new point. For an origin behind
- * it, either the new point is steeper than everything ahead of it, or every
- * slope is below the lowest ray: the dropped points never decide a count. */
-static inline void hull_push_cut(hull *h, double u, double z, double tan_low) {
-  hull_push(h, u, z);
-  if (h->size >= 2 && h->z[h->size - 2] - z < tan_low * (h->u[h->size - 2] - u)) {
-    h->u[0] = u;
-    h->z[0] = z;
-    h->size = 1;
-  }
+/* Is t on or under the chord from l to (xu, xz) (l before t before x)? */
+static inline int under_chord(const point *l, const point *t, double xu, double xz) {
+  return (t->z - l->z) * (xu - l->u) <= (xz - l->z) * (t->u - l->u);
 }
 
-/* Rays of `side` blocked from (u0, z0), behind every point of the hull. */
-static inline uint16_t count_blocked(const sweep_side *side, const hull *h, double u0,
-                                     double z0) {
-  const double slope = hull_tangent(h, u0, z0);
-  int blocked = 0;
-  while (blocked < side->n && slope >= side->tan_step[blocked]) blocked++;
-  return (uint16_t)blocked;
-}
-
-/* A chunk's profile: step i (i = 0 .. steps-1) starts at texel
- * j = i - behind of the chunk, whose height is vz[i] (one more entry: the end
- * of the last step). Its points, by rising u (u = j + the template's
- * fraction), are the vertices and breakpoints that can matter: pu, pz. */
-typedef struct profile {
-  int steps, count;
-  double *vz;
-  double *pu, *pz;
-  size_t *texel; /* image index of the chunk's texels */
-} profile;
-
-/* Keeps the points of a profile that are not convex kinks. A point on or
- * under the chord of its two neighbours never decides a count: walking
- * either way, once its nearer neighbour is on the hull it lies under the
- * hull; and before that, for the one origin queried in between, which sits
- * at or above that neighbour (bias >= 0), the farther neighbour is at least
- * as steep. A run of such points lies under the chord of the points kept
- * around it (the profile is convex along the run), so dropping them all at
- * once is safe too. About half the points go on rough maps. */
-typedef struct kink_filter {
-  profile *pr;
-  int seen;              /* points offered so far */
-  double ua, za, ub, zb; /* the last two offered: a before b; b is undecided */
-} kink_filter;
-
-static inline void kink_offer(kink_filter *f, double u, double z) {
-  if (f->seen >= 2) {
-    const int keep = (f->zb - f->za) * (u - f->ua) > (z - f->za) * (f->ub - f->ua);
-    f->pr->pu[f->pr->count] = f->ub;
-    f->pr->pz[f->pr->count] = f->zb;
-    f->pr->count += keep;
-  } else if (f->seen == 1) { /* the first point is an end: kept */
-    f->pr->pu[0] = f->ub;
-    f->pr->pz[0] = f->zb;
-    f->pr->count = 1;
-  }
-  f->ua = f->ub, f->za = f->zb;
-  f->ub = u, f->zb = z;
-  f->seen++;
-}
-
-static inline void kink_finish(kink_filter *f) { /* the last point is an end: kept */
-  f->pr->pu[f->pr->count] = f->ub;
-  f->pr->pz[f->pr->count] = f->zb;
-  f->pr->count++;
-}
-
-/* Heights along the chunk's line, from behind its start to ahead of its end. */
-static void profile_fill(const sweep_job *job, int chunk, profile *pr) {
+/* The points of steps first_step .. first_step + steps - 1 of the line whose
+ * texel 0 is (x0, y0), without those that can never decide a horizon.
+ *
+ * A point T on or under the chord of two points L < T < X never does, as
+ * long as no origin (a vertex) lies strictly between L and X but T itself:
+ * from an origin outside [L, X] the farther of L, X on the side of T's
+ * slope is at least as steep; from an origin at L (or X, looking back),
+ * which sits at or above its vertex (bias >= 0), X (or L) is. So each step's
+ * points (between vertices j and j + 1) are kept as the upper hull of the
+ * step with its two vertices, and a vertex goes when it is under the chord
+ * of its neighbours: a stack like the walks' hulls, whose pops never reach
+ * across a vertex. About a third of the points stay on rough maps. The ends
+ * are kept. */
+static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   const bb_pyramid *p = job->p;
-  const long first = -(long)job->behind; /* the first step's texel */
-  int bx = coordinate_at(p, (long)job->chunk_x[chunk] + first * job->a, p->width);
-  int by = coordinate_at(p, (long)job->chunk_y[chunk] + first * job->b, p->height);
-  kink_filter f = {.pr = pr};
-  pr->count = 0;
-  for (int i = 0; i <= pr->steps; i++, bx = step_along(p, bx, job->a, p->width),
-           by = step_along(p, by, job->b, p->height)) {
-    const int j = i - job->behind; /* texel of the chunk */
-    pr->vz[i] = field_z(p, bx, by);
-    kink_offer(&f, (double)j, pr->vz[i]);
-    if (j >= 0 && j < job->chunk_len[chunk])
+  const int tcount = job->point_count;
+  const long *const off1 = job->offset1, *const off2 = job->offset2;
+  const double *const frac = job->frac, *const weight = job->weight;
+  double zs[4 * BB__MAX_LATTICE_STEP + 1];
+  int bx = coordinate_at(p, (long)x0 + (long)pr->first_step * job->a, p->width);
+  int by = coordinate_at(p, (long)y0 + (long)pr->first_step * job->b, p->height);
+  point *restrict out = pr->pt;
+  int count = 0;
+  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
+  const int sa = periodic ? job->a % p->width : job->a, sb = periodic ? job->b % p->height : job->b;
+  for (int s = 0; s < pr->steps; s++, bx = step_along(p, bx, sa, p->width),
+           by = step_along(p, by, sb, p->height)) {
+    const int j = pr->first_step + s; /* texel of the line at the step's start */
+    if (j >= 0 && j < pr->len) {
+      pr->vz[j] = field_z(p, bx, by);
       pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
-    if (i == pr->steps) break;
-    /* Away from the edges no vertex wraps or clamps, and each is a fixed
-     * offset. */
-    const int interior = bx >= job->reach_x && bx < p->width - job->reach_x &&
-                         by >= job->reach_y && by < p->height - job->reach_y;
-    const float *here = interior ? p->z + (size_t)by * (size_t)p->width + (size_t)bx : NULL;
-    for (int k = 0; k < job->point_count - 1; k++) {
-      const template_point *t = &job->points[k];
-      double za, zb;
-      if (interior) {
-        za = here[t->offset1];
-        zb = here[t->offset2];
-      } else {
-        za = field_z(p, bx + t->x1, by + t->y1);
-        zb = field_z(p, bx + t->x2, by + t->y2);
+    }
+    /* The heights of the step's points. Away from the edges no vertex wraps
+     * or clamps, and each is a fixed offset. */
+    if (bx >= job->reach_x && bx < p->width - job->reach_x && by >= job->reach_y &&
+        by < p->height - job->reach_y) {
+      const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
+      for (int k = 0; k < tcount; k++)
+        zs[k] = bb__lattice_height(here[off1[k]], here[off2[k]], weight[k]);
+    } else {
+      for (int k = 0; k < tcount; k++) {
+        const template_point *t = &job->points[k];
+        zs[k] = bb__lattice_height(field_z(p, bx + t->x1, by + t->y1),
+                                   field_z(p, bx + t->x2, by + t->y2), weight[k]);
       }
-      kink_offer(&f, (double)j + t->u, za + (zb - za) * t->w);
+    }
+    /* Pops stay above `floor`, the index of vertex j (the last point of the
+     * step before; the profile's first point in its first step, an end that
+     * stays); vertex j itself may go while its left neighbour is from vertex
+     * j - 1 on, after which the floor is the point that took it. */
+    int floor = count > 0 ? count - 1 : 0;
+    int vertex_may_go = count >= 2 && out[count - 2].u >= (double)(j - 1);
+    const double ju = (double)j;
+    for (int k = 0; k < tcount; k++) {
+      const double xu = ju + frac[k], xz = zs[k];
+      while (count - 2 >= floor && under_chord(&out[count - 2], &out[count - 1], xu, xz)) count--;
+      if (vertex_may_go && count - 1 == floor && under_chord(&out[floor - 1], &out[floor], xu, xz)) {
+        count--;
+        floor = count;
+        vertex_may_go = 0;
+      }
+      out[count].u = xu;
+      out[count].z = xz;
+      out[count].step = j;
+      out[count].tp = k;
+      count++;
     }
   }
-  kink_finish(&f);
+  pr->count = count;
 }
 
-/* Along (a, b): walk the profile backwards from its far end; origin j asks
- * once every point beyond it is on the hull. */
-static void sweep_ahead(const sweep_job *job, const profile *pr, int len, hull *h) {
-  const sweep_side *side = &job->side[0];
-  const double tan_low = side->tan_step[0];
-  int k = pr->count - 1;
+/* ------------------------------------------------------------------ hulls */
+
+/* Upper hull of the points ahead, nearest last (u may be mirrored). */
+typedef struct hull {
+  point *v;
+  int size;
+} hull;
+
+/* Pushes a point nearer than all others, dropping those now under the hull;
+ * then, if nothing ahead is higher than it, keeps it alone: from any origin
+ * behind it is then either steeper than everything ahead (positive slope,
+ * shorter distance) or everything is below the origin (horizon 0). */
+static inline void hull_push(hull *h, point q) {
+  point *restrict v = h->v;
+  int size = h->size;
+  while (size >= 2) {
+    const point *a = &v[size - 1], *b = &v[size - 2];
+    /* a is on or under the segment from the new point to b */
+    if ((a->z - q.z) * (b->u - q.u) <= (b->z - q.z) * (a->u - q.u)) size--;
+    else break;
+  }
+  if (size >= 1 && v[size - 1].z <= q.z) size = 0;
+  v[size++] = q;
+  h->size = size;
+}
+
+/* Index of the hull vertex of largest slope from (u0, z0), behind every
+ * point: slopes to hull vertices rise, then fall, going away from the
+ * origin. The tangent is mostly at the nearest vertex or the next, so a walk
+ * from the near end beats a binary search. */
+static inline int hull_tangent(const hull *h, double u0, double z0) {
+  const point *v = h->v;
+  int i = h->size - 1;
+  if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
+  double du = v[i].u - u0, dz = v[i].z - z0;
+  while (i > 0) {
+    const double du_far = v[i - 1].u - u0, dz_far = v[i - 1].z - z0;
+    /* is the farther vertex steeper? (denominators are positive) */
+    if (!(dz_far * du > dz * du_far)) break;
+    du = du_far;
+    dz = dz_far;
+    i--;
+  }
+  return i;
+}
+
+/* The canonical slope per step from origin texel j (height oz) to hull
+ * vertex i, ahead of the origin (forward) or behind it. */
+static inline double slope_to(const sweep_job *job, const hull *h, int i, int j, double oz,
+                              int forward) {
+  if (i < 0) return 0.0;
+  const point *v = &h->v[i];
+  const template_point *t = &job->points[v->tp];
+  const long n = forward ? (long)(v->step - j) * t->m + t->i : (long)(j - v->step) * t->m - t->i;
+  return (v->z - oz) / bb__lattice_distance(n, t->inverse_m);
+}
+
+/* A texel's horizon along side k: stored for the tests when asked, and
+ * integrated into its sums. */
+static inline void emit_horizon(const sweep_job *job, int k, size_t texel, float h) {
+  const bb__sweep_dir *dir = job->side[k].dir;
+  if (dir->horizon) dir->horizon[texel] = h;
+  bb__slice_accumulate(&job->side[k].integral, h, dir->sums + texel * (size_t)job->channels);
+}
+
+/* The same from the best slope per step. */
+static inline void emit(const sweep_job *job, int k, size_t texel, double slope) {
+  emit_horizon(job, k, texel,
+               bb__lattice_horizon(slope > 0.0 ? slope : 0.0, job->side[k].inverse_length));
+}
+
+/* ---------------------------------------------------------- line sweeps */
+
+/* Chunks only: is the slope from an origin at oz clearly above anything
+ * beyond the profile, which lies at least `distance` steps away? */
+static int vouched(const sweep_job *job, double slope, double oz, double distance) {
+  const double rise = (double)job->p->global_max - oz;
+  return rise <= 0.0 || slope >= rise / distance * (1.0 + 1e-9) + 1e-12;
+}
+
+/* Origin j of a line (texel j mod L, -L <= j < 2 L) asks the hull for its
+ * horizon. In a chunk, a texel the profile cannot vouch for (the points
+ * beyond it lie at least `beyond` steps away) is marched instead, which
+ * finds the same bits. */
+static inline void query(const sweep_job *job, const profile *pr, const hull *h, int j,
+                         int forward) {
+  const int L = pr->len;
+  const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
+  const double oz = pr->vz[texel_j] + job->bias;
+  const int k = forward ? 0 : 1;
+  const double u0 = forward ? (double)j : -(double)j;
+  const double slope = slope_to(job, h, hull_tangent(h, u0, oz), j, oz, forward);
+  const size_t texel = pr->texel[texel_j];
+  if (job->kind == LINE_CHUNK) {
+    const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
+                                  : (double)(j - pr->first_step);
+    if (!vouched(job, slope, oz, beyond)) {
+      const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
+      emit_horizon(job, k, texel,
+                   bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b));
+      return;
+    }
+  }
+  emit(job, k, texel, slope);
+}
+
+/* A stretch of profile points, pt[from] to pt[to] inclusive (either way
+ * round), moved on by `shift` steps (a whole number of periods). */
+typedef struct stretch {
+  int from, to, shift;
+} stretch;
+
+/* Along (a, b): the points of the stretches by falling u; origins j from
+ * j_high down to j_low, each asking once every point beyond it is on the
+ * hull. */
+static void walk_ahead(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
+                       int stretches, int j_high, int j_low) {
+  int j = j_high;
   h->size = 0;
-  for (int j = len - 1 + job->ahead; j >= 0; j--) {
-    for (; k >= 0 && pr->pu[k] > (double)j; k--) hull_push_cut(h, pr->pu[k], pr->pz[k], tan_low);
-    if (j < len)
-      side->blocked[pr->texel[j]] =
-          count_blocked(side, h, (double)j, pr->vz[j + job->behind] + job->bias);
+  for (int r = 0; r < stretches; r++) {
+    const double du = (double)st[r].shift;
+    const int ds = st[r].shift;
+    for (int q = st[r].from; q >= st[r].to; q--) {
+      point v = pr->pt[q];
+      v.u += du, v.step += ds;
+      for (; (double)j >= v.u; j--) {
+        if (j < j_low) return;
+        query(job, pr, h, j, 1);
+      }
+      hull_push(h, v);
+    }
+  }
+  for (; j >= j_low; j--) query(job, pr, h, j, 1);
+}
+
+/* Along (-a, -b): the points of the stretches by rising u, on mirrored u so
+ * the hull code is the same; origins j from j_low up to j_high. */
+static void walk_behind(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
+                        int stretches, int j_low, int j_high) {
+  int j = j_low;
+  h->size = 0;
+  for (int r = 0; r < stretches; r++) {
+    const double du = (double)st[r].shift;
+    const int ds = st[r].shift;
+    for (int q = st[r].from; q <= st[r].to; q++) {
+      point v = pr->pt[q];
+      v.u = -(v.u + du), v.step += ds;
+      for (; (double)j <= -v.u; j++) {
+        if (j > j_high) return;
+        query(job, pr, h, j, 0);
+      }
+      hull_push(h, v);
+    }
+  }
+  for (; j <= j_high; j++) query(job, pr, h, j, 0);
+}
+
+/* The first point of the highest height in a profile. */
+static int highest_point(const profile *pr) {
+  int best = 0;
+  for (int q = 1; q < pr->count; q++)
+    if (pr->pt[q].z > pr->pt[best].z) best = q;
+  return best;
+}
+
+/* Once round a periodic line of L steps (points in u (0, L]), from its
+ * highest point P* at u*. Along (a, b): from the copy of P* one period on,
+ * backwards, for origins from just below it down to u*, so each sees
+ * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
+ * origins from just above it up to u*, so each sees [u* - L, j). */
+static void walk_round(const sweep_job *job, const profile *pr, hull *h) {
+  const int top = highest_point(pr), n = pr->count, L = pr->len;
+  const double u_top = pr->pt[top].u;
+  if (job->side[0].dir) {
+    const stretch st[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
+    const int first = (int)ceil(u_top);
+    walk_ahead(job, pr, h, st, 2, first + L - 1, first);
+  }
+  if (job->side[1].dir) {
+    const stretch st[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
+    const int last = (int)floor(u_top);
+    walk_behind(job, pr, h, st, 2, last - L + 1, last);
   }
 }
 
-/* Along (-a, -b): walk the profile forwards from its near end, on mirrored
- * u, so the hull code is the same. */
-static void sweep_behind(const sweep_job *job, const profile *pr, int len, hull *h) {
-  const sweep_side *side = &job->side[1];
-  const double tan_low = side->tan_step[0];
-  int k = 0;
-  h->size = 0;
-  for (int j = -job->behind; j < len; j++) {
-    for (; k < pr->count && pr->pu[k] < (double)j; k++)
-      hull_push_cut(h, -pr->pu[k], pr->pz[k], tan_low);
-    if (j >= 0)
-      side->blocked[pr->texel[j]] =
-          count_blocked(side, h, -(double)j, pr->vz[j + job->behind] + job->bias);
+/* A line with ends (a clamped line, or a chunk): every point, every origin. */
+static void walk_line(const sweep_job *job, const profile *pr, hull *h) {
+  const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
+  if (job->side[0].dir) walk_ahead(job, pr, h, &down, 1, pr->len - 1, 0);
+  if (job->side[1].dir) walk_behind(job, pr, h, &up, 1, 0, pr->len - 1);
+}
+
+/* ------------------------------------------------------------ work items */
+
+/* Clamp mode: is the step from texel (x, y) flat, every template vertex
+ * clamped to the same height along each axis the line moves on? */
+static int step_is_flat(const sweep_job *job, long x, long y) {
+  const bb_pyramid *p = job->p;
+  const int flat_x = job->a == 0 || x + job->min_dx >= p->width - 1 || x + job->max_dx <= 0;
+  const int flat_y = job->b == 0 || y + job->min_dy >= p->height - 1 || y + job->max_dy <= 0;
+  return flat_x && flat_y;
+}
+
+/* Clamp mode: steps from texel (x, y), going by (sa, sb) per step, to the
+ * first flat step, inclusive. */
+static int steps_to_flat(const sweep_job *job, long x, long y, int sa, int sb) {
+  int steps = 0;
+  while (!step_is_flat(job, x, y)) x += sa, y += sb, steps++;
+  return steps + 1;
+}
+
+/* The steps a work item profiles, before and after its texels. */
+static void item_extent(const sweep_job *job, int item, int *before, int *after) {
+  const int x = job->item_x[item], y = job->item_y[item], len = job->item_len[item];
+  if (job->kind == LINE_ROUND) {
+    *before = 0, *after = 0;
+  } else if (job->kind == LINE_CHUNK) {
+    *before = job->lookahead, *after = job->lookahead;
+  } else {
+    /* ahead, the steps up to the first flat one, which ends on a flat
+     * vertex; behind, the steps back to the first flat one and one more, so
+     * that its first vertex is in the profile too (a step may hold no other
+     * point than its end) */
+    const long ex = (long)x + (long)(len - 1) * job->a, ey = (long)y + (long)(len - 1) * job->b;
+    *after = steps_to_flat(job, ex, ey, job->a, job->b) - 1;
+    *before = steps_to_flat(job, (long)x - job->a, (long)y - job->b, -job->a, -job->b) + 1;
   }
 }
 
-static void sweep_chunk(void *user, int chunk) {
+/* Lines per work item: neighbouring lines write neighbouring texels, so a
+ * bundle of them fills whole cache lines of the sums on one thread. */
+enum { BUNDLE = 8 };
+
+/* One line (or chunk) of the list, with buffers sized for the longest. */
+static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
+  int before, after;
+  item_extent(job, item, &before, &after);
+  pr->len = job->item_len[item];
+  pr->first_step = -before;
+  pr->steps = before + pr->len + after;
+  profile_fill(job, job->item_x[item], job->item_y[item], pr);
+  if (job->kind == LINE_ROUND)
+    walk_round(job, pr, h);
+  else
+    walk_line(job, pr, h);
+}
+
+static void sweep_bundle(void *user, int bundle) {
   sweep_job *job = user;
-  const int len = job->chunk_len[chunk];
-  profile pr = {.steps = job->behind + len + job->ahead};
-  const size_t points = (size_t)(pr.steps + 1) * (size_t)job->point_count;
+  const int first = bundle * BUNDLE, last = imin(first + BUNDLE, job->item_count);
+  int steps = 0, len = 0;
+  for (int item = first; item < last; item++) {
+    int before, after;
+    item_extent(job, item, &before, &after);
+    steps = imax(steps, before + job->item_len[item] + after);
+    len = imax(len, job->item_len[item]);
+  }
+  const size_t points = (size_t)steps * (size_t)job->point_count + 1;
+  profile pr = {0};
   hull h = {0};
-  pr.vz = malloc((size_t)(pr.steps + 1) * sizeof(double));
-  pr.pu = malloc(points * sizeof(double));
-  pr.pz = malloc(points * sizeof(double));
+  pr.pt = malloc(points * sizeof(point));
+  pr.vz = malloc((size_t)len * sizeof(double));
   pr.texel = malloc((size_t)len * sizeof(size_t));
-  h.u = malloc(points * sizeof(double));
-  h.z = malloc(points * sizeof(double));
-  if (pr.vz && pr.pu && pr.pz && pr.texel && h.u && h.z) {
-    profile_fill(job, chunk, &pr);
-    if (job->side[0].blocked) sweep_ahead(job, &pr, len, &h);
-    if (job->side[1].blocked) sweep_behind(job, &pr, len, &h);
+  h.v = malloc(points * sizeof(point));
+  if (pr.pt && pr.vz && pr.texel && h.v) {
+    for (int item = first; item < last; item++) sweep_one(job, item, &pr, &h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
+  free(pr.pt);
   free(pr.vz);
-  free(pr.pu);
-  free(pr.pz);
   free(pr.texel);
-  free(h.u);
-  free(h.z);
+  free(h.v);
 }
 
-static inline int inside(const bb_pyramid *p, int x, int y) {
+/* A growable list of work items. */
+typedef struct items {
+  int *x, *y, *len;
+  int count, capacity;
+} items;
+
+static int items_add(items *it, int x, int y, int len) {
+  if (it->count == it->capacity) {
+    const int capacity = it->capacity ? 2 * it->capacity : 1024;
+    int *nx = realloc(it->x, (size_t)capacity * sizeof(int));
+    if (nx) it->x = nx;
+    int *ny = realloc(it->y, (size_t)capacity * sizeof(int));
+    if (ny) it->y = ny;
+    int *nl = realloc(it->len, (size_t)capacity * sizeof(int));
+    if (nl) it->len = nl;
+    if (!nx || !ny || !nl) return -1;
+    it->capacity = capacity;
+  }
+  it->x[it->count] = x, it->y[it->count] = y, it->len[it->count] = len;
+  it->count++;
+  return 0;
+}
+
+static void items_free(items *it) {
+  free(it->x);
+  free(it->y);
+  free(it->len);
+}
+
+static inline int inside(const bb_pyramid *p, long x, long y) {
   return x >= 0 && x < p->width && y >= 0 && y < p->height;
 }
 
 /* Clamp mode: a line runs from a texel whose predecessor is outside the
- * image to the last texel before it leaves. Returns the number of chunks. */
-static int clamped_chunks(const bb_pyramid *p, int a, int b, int *cx, int *cy, int *clen) {
-  int c = 0;
+ * image to the last texel before it leaves. */
+static int clamped_lines(const bb_pyramid *p, int a, int b, items *it) {
   for (int y = 0; y < p->height; y++)
     for (int x = 0; x < p->width; x++) {
-      if (inside(p, x - a, y - b)) continue;
-      int run = 0;
-      for (int px = x, py = y; inside(p, px, py); px += a, py += b) {
-        if (run == 0) cx[c] = px, cy[c] = py;
-        if (++run == CHUNK_STEPS) clen[c++] = run, run = 0;
-      }
-      if (run) clen[c++] = run;
+      if (inside(p, (long)x - a, (long)y - b)) continue;
+      int len = 0;
+      for (long px = x, py = y; inside(p, px, py); px += a, py += b) len++;
+      if (items_add(it, x, y, len)) return -1;
     }
-  return c;
+  return 0;
 }
 
-/* Cuts the lines of step (a, b) into chunks: the first texel and length of
- * each. A periodic line closes when it comes back to its first texel. */
-static bb_status make_chunks(const bb_pyramid *p, int a, int b, int **cx, int **cy, int **clen,
-                             int *count, bb_error *err) {
-  const size_t n = (size_t)p->width * (size_t)p->height;
-  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
-  unsigned char *seen = periodic ? calloc(n, 1) : NULL; /* texels already in a line */
-  *cx = malloc(n * sizeof(int));
-  *cy = malloc(n * sizeof(int));
-  *clen = malloc(n * sizeof(int));
-  if ((periodic && !seen) || !*cx || !*cy || !*clen) {
-    free(seen);
-    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+static long gcd_long(long a, long b) {
+  a = a < 0 ? -a : a;
+  b = b < 0 ? -b : b;
+  while (b) {
+    const long r = a % b;
+    a = b;
+    b = r;
   }
-  if (!periodic) {
-    *count = clamped_chunks(p, a, b, *cx, *cy, *clen);
-    return BB_OK;
-  }
-  int c = 0;
-  for (int y = 0; y < p->height; y++)
-    for (int x = 0; x < p->width; x++) {
-      if (seen[(size_t)y * (size_t)p->width + (size_t)x]) continue;
-      int px = x, py = y, run = 0;
-      while (!seen[(size_t)py * (size_t)p->width + (size_t)px]) {
-        if (run == 0) {
-          (*cx)[c] = px;
-          (*cy)[c] = py;
-        }
-        seen[(size_t)py * (size_t)p->width + (size_t)px] = 1;
-        px = bb__wrap_near(px + a % p->width, p->width);
-        py = bb__wrap_near(py + b % p->height, p->height);
-        if (++run == CHUNK_STEPS) {
-          (*clen)[c++] = run;
-          run = 0;
-        }
+  return a;
+}
+
+/* Periodic mode: every line of `period` steps once, whole, or cut into
+ * chunks of chunk_len steps. y mod h, h = gcd(b, H), is the same all along a
+ * line, and a line meets its row y0 < h every H / h steps, x moving on by
+ * (H / h) a each time: so the lines are those through (x0, y0) for y0 < h
+ * and x0 < gcd((H / h) a, W), each exactly once, and neighbours in x come
+ * one after the other. */
+static int periodic_lines(const bb_pyramid *p, int a, int b, long period, int chunk_len,
+                          items *it) {
+  const long W = p->width, H = p->height, h = gcd_long(b, H);
+  const long columns = gcd_long((H / h) * a, W);
+  for (long y0 = 0; y0 < h; y0++)
+    for (long x0 = 0; x0 < columns; x0++) {
+      if (!chunk_len) {
+        if (items_add(it, (int)x0, (int)y0, (int)period)) return -1;
+        continue;
       }
-      if (run) (*clen)[c++] = run;
+      for (long j = 0; j < period; j += chunk_len) {
+        const int x = (int)((x0 + (j % W) * (a % W) % W + W) % W);
+        const int y = (int)((y0 + (j % H) * (b % H) % H + H) % H);
+        if (items_add(it, x, y, (int)(period - j < chunk_len ? period - j : chunk_len))) return -1;
+      }
     }
-  free(seen);
-  *count = c;
-  return BB_OK;
+  return 0;
 }
 
-/* Steps past which the lowest ray of `side` is above the global maximum,
- * and no more than can bring anything new: a periodic line repeats after its
- * period (at most W * H steps); a clamped one (clamp mode) is flat once every
- * vertex of its steps is clamped, a step's reach past the image, and on a
- * flat stretch no point beyond the first can be steeper from behind. */
-static int lookahead_steps(const bb_pyramid *p, const sweep_side *side) {
-  if (!side->blocked) return 0;
-  const double rise = (double)p->global_max - (double)p->global_min;
-  const double reach = side->tan_step[0] > 0.0 ? ceil(rise / side->tan_step[0]) + 2.0 : 1e9;
-  const long longest = p->width > p->height ? p->width : p->height;
-  const long limit = p->addressing == BB_ADDRESS_PERIODIC
-                         ? (long)p->width * p->height
-                         : longest + 2L * (BB__MAX_LATTICE_STEP + 2);
-  return (int)(reach < (double)limit ? reach : (double)limit);
+static void job_template(sweep_job *job, template_point *pts) {
+  const bb_pyramid *p = job->p;
+  job->points = pts;
+  job->point_count = build_template(job->a, job->b, pts);
+  job->min_dx = job->min_dy = 1 << 30;
+  job->max_dx = job->max_dy = -(1 << 30);
+  for (int k = 0; k < job->point_count; k++) {
+    template_point *t = &pts[k];
+    t->offset1 = t->x1 + (long)t->y1 * p->width;
+    t->offset2 = t->x2 + (long)t->y2 * p->width;
+    job->offset1[k] = t->offset1;
+    job->offset2[k] = t->offset2;
+    job->frac[k] = t->frac;
+    job->weight[k] = t->w;
+    job->reach_x = imax(job->reach_x, imax(abs(t->x1), abs(t->x2)) + 1);
+    job->reach_y = imax(job->reach_y, imax(abs(t->y1), abs(t->y2)) + 1);
+    job->min_dx = imin(job->min_dx, imin(t->x1, t->x2));
+    job->max_dx = imax(job->max_dx, imax(t->x1, t->x2));
+    job->min_dy = imin(job->min_dy, imin(t->y1, t->y2));
+    job->max_dy = imax(job->max_dy, imax(t->y1, t->y2));
+  }
+  /* the step's own texel is a vertex of it too */
+  job->min_dx = imin(job->min_dx, 0), job->max_dx = imax(job->max_dx, 0);
+  job->min_dy = imin(job->min_dy, 0), job->max_dy = imax(job->max_dy, 0);
 }
 
-static bb_status set_side(const bb__sweep_dir *dir, double step_length, sweep_side *side,
-                          bb_error *err) {
-  if (!dir) return BB_OK;
-  if (dir->n < 1 || !dir->blocked)
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a sweep direction needs rays and counts");
-  double *tan_step = malloc((size_t)dir->n * sizeof(double));
-  if (!tan_step) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
-  for (int e = 0; e < dir->n; e++) tan_step[e] = dir->tan_el[e] * step_length;
-  *side = (sweep_side){tan_step, dir->n, dir->blocked};
+static bb_status check_dir(const bb__sweep_dir *dir, bb_error *err) {
+  if (dir && (!dir->rs || !dir->sums || dir->slice < 0 || dir->slice >= dir->rs->slice_count))
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a sweep direction needs a slice and sums");
   return BB_OK;
 }
 
 bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
                           const bb__sweep_dir *opposite, double bias, int threads,
-                          bb_error *err) {
+                          long long_line, bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
-  sweep_job job = {.p = p, .a = a, .b = b, .points = pts, .bias = bias};
+  bb_status st = check_dir(along, err);
+  if (st == BB_OK) st = check_dir(opposite, err);
+  if (st != BB_OK || (!along && !opposite)) return st;
+  sweep_job job = {.p = p, .a = a, .b = b, .bias = bias};
+  job.side[0] = (sweep_side){along, a, b, bb__step_inverse(a, b), {0}};
+  job.side[1] = (sweep_side){opposite, -a, -b, bb__step_inverse(a, b), {0}};
+  if (along) job.side[0].integral = bb__slice_integral_of(along->rs, along->slice);
+  if (opposite) job.side[1].integral = bb__slice_integral_of(opposite->rs, opposite->slice);
+  job.channels = 1 + (along ? along : opposite)->rs->basis_count;
   atomic_init(&job.out_of_memory, 0);
-  int *cx = NULL, *cy = NULL, *clen = NULL, chunks = 0;
-  bb_status st = set_side(along, hypot(a, b), &job.side[0], err);
-  if (st == BB_OK) st = set_side(opposite, hypot(a, b), &job.side[1], err);
-  if (st == BB_OK) st = make_chunks(p, a, b, &cx, &cy, &clen, &chunks, err);
+  job_template(&job, pts);
+  items it = {0};
+  int failed;
+  if (p->addressing == BB_ADDRESS_CLAMP) {
+    job.kind = LINE_CLAMPED;
+    failed = clamped_lines(p, a, b, &it);
+  } else {
+    job.period = bb__line_period(p, a, b);
+    if (long_line <= 0) long_line = LONG_LINE_POINTS / job.point_count;
+    job.kind = job.period <= long_line ? LINE_ROUND : LINE_CHUNK;
+    job.lookahead = (int)(long_line < CHUNK_STEPS ? long_line : CHUNK_STEPS);
+    failed = periodic_lines(p, a, b, job.period, job.kind == LINE_CHUNK ? job.lookahead : 0, &it);
+  }
+  if (failed) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   if (st == BB_OK) {
-    job.chunk_x = cx;
-    job.chunk_y = cy;
-    job.chunk_len = clen;
-    job.point_count = build_template(a, b, pts);
-    for (int k = 0; k < job.point_count; k++) {
-      template_point *t = &pts[k];
-      t->offset1 = t->x1 + (long)t->y1 * p->width;
-      t->offset2 = t->x2 + (long)t->y2 * p->width;
-      job.reach_x = imax(job.reach_x, imax(abs(t->x1), abs(t->x2)) + 1);
-      job.reach_y = imax(job.reach_y, imax(abs(t->y1), abs(t->y2)) + 1);
-    }
-    job.ahead = lookahead_steps(p, &job.side[0]);
-    job.behind = lookahead_steps(p, &job.side[1]);
-    st = bb__parallel_for(chunks, threads, sweep_chunk, &job, NULL, NULL, err);
+    job.item_x = it.x;
+    job.item_y = it.y;
+    job.item_len = it.len;
+    job.item_count = it.count;
+    st = bb__parallel_for((it.count + BUNDLE - 1) / BUNDLE, threads, sweep_bundle, &job, NULL,
+                          NULL, err);
     if (st == BB_OK && atomic_load(&job.out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
   }
-  free((void *)job.side[0].tan_step);
-  free((void *)job.side[1].tan_step);
-  free(cx);
-  free(cy);
-  free(clen);
+  items_free(&it);
   return st;
 }

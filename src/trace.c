@@ -1,35 +1,35 @@
-/* trace.c: occlusion of rays over the height field, marched through the
- * max-mip pyramid (no triangle database), and the batch trace of a bake.
+/* trace.c: horizons over the height field, marched through the max-mip
+ * pyramid (no triangle database), and the batch trace of a bake.
  *
- * Exact test. Over a cell the surface is two planar triangles, so along the
- * vertical half-plane of a ray it is piecewise linear in the horizontal
+ * Exact horizons. Over a cell the surface is two planar triangles, so along
+ * the vertical half-plane of a ray it is piecewise linear in the horizontal
  * distance t, with breakpoints where the ray's 2D line crosses a cell edge
  * or a cell's diagonal. On each linear piece (surface(t) - oz) / t is
- * monotone, so the ray of tangent T (rise per horizontal texel) meets the
- * surface iff some breakpoint at t > 0 has slope (surface - oz) / t >= T.
- * The origin itself (t = 0) never counts: that is the one rule for the ray's
- * start on the surface, and it makes bias 0 well defined.
+ * monotone, so the largest slope over the surface ahead (the horizon) is the
+ * largest over the breakpoints at t > 0, and a ray of tangent T is blocked
+ * exactly when it is >= T. The origin itself (t = 0) never counts: that is
+ * the one rule for the ray's start on the surface, and it makes bias 0 well
+ * defined. Horizons below 0 count as 0: H is the upper hemisphere.
  *
- * Every breakpoint is computed (cross_vertical/horizontal/diagonal) from its
- * line's index, the origin and the direction only, never from the path that
- * reached it. So the max-mip march, the brute-force DDA and a march of a
- * whole azimuth slice compute bit-identical slopes and give identical answers
- * whatever order they test breakpoints in: a skipped node only ever hides
- * breakpoints whose slope is below the threshold by more than `margin`, far
- * beyond rounding.
+ * The march keeps the best slope so far and descends only into nodes whose
+ * max could raise it (node max >= oz + t * best at the node's near end, with
+ * a margin far beyond rounding); it stops when nothing ahead can (the root's
+ * max is below that line), past its maximum distance (a periodic lattice
+ * line is new for one period only), or where a clamped surface turns flat.
  *
- * Slices. All rays of an azimuth slice share the 2D line, so one march that
- * tracks the highest breakpoint slope seen (the horizon) answers all of them:
- * the rays of the slice are sorted by elevation, and the march only looks for
- * breakpoints that would block the lowest ray not yet blocked. The batch
- * trace gets each texel's count of blocked rays per slice from line sweeps
- * (sweep.c), or, past 4096 x 4096, from marches through square nodes, texel
- * by texel. Marches through direction bands (band.c) give the same counts;
- * the tests hold the three paths to each other.
+ * Two ways to compute a breakpoint. For any ray (bb_ray_horizon and
+ * bb_ray_occluded) from its line's index, the origin and the direction. For
+ * a bake's slice, which follows an integer lattice step (a, b) from a
+ * vertex, from integers only: the crossing index n and the family's count m
+ * per step (distance n / m steps, interpolation weight r / m), exactly as
+ * the line sweeps compute them from their template (sweep.c). Either way a
+ * breakpoint's slope does not depend on the path that reached it, so the
+ * march, the brute-force DDA and the sweeps find bit-identical horizons.
  */
 #include "internal.h"
 #include "trace_internal.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,15 +42,30 @@ typedef struct direction {
   int sx, sy;                /* step direction per axis, +1 or -1 */
 } direction;
 
+/* A march along lattice step (a, b) from the vertex (x0, y0). */
+typedef struct lattice {
+  int x0, y0, a, b;
+  int ma, mb, md;  /* crossings per step: of vertical lines, horizontal lines, diagonals */
+  int sa, sb, sd;  /* the signs of a, b, a + b */
+  long cap;        /* largest distance considered, in steps */
+  double length, inverse_length; /* |(a, b)| and 1 / |(a, b)| */
+  double inverse_m[3]; /* 1 / ma, 1 / mb, 1 / md */
+} lattice;
+
 /* Walking state: the cell (ix, iy) the ray is in, unwrapped, its addressed
- * index (cx, cy), and the distance t at which the ray got there. */
+ * index (cx, cy), and the distance t at which the ray got there. The best
+ * slope is in texels of rise per texel, or per step in lattice mode. */
 typedef struct walker {
   const bb_pyramid *p;
   direction d;
+  const lattice *lat; /* NULL: any ray */
   double ox, oy, oz, osum;
   int ix, iy, cx, cy;
   double t;
-  double margin; /* slack of every skip test, far beyond rounding */
+  double max_t;       /* no breakpoint beyond this distance counts (any ray) */
+  double margin;      /* slack of every skip test, far beyond rounding */
+  double best;        /* the horizon so far */
+  double raised_at;   /* where it last rose */
 } walker;
 
 static void direction_init(direction *d, double dx, double dy) {
@@ -67,6 +82,11 @@ static void direction_init(direction *d, double dx, double dy) {
 static inline int fast_floor(double v) {
   int i = (int)v;
   return (double)i > v ? i - 1 : i;
+}
+
+static inline long floor_div(long num, long den) { /* den > 0 */
+  const long q = num / den;
+  return q * den > num ? q - 1 : q;
 }
 
 /* The cell index along an axis of a point moving with step sign s: on a
@@ -100,6 +120,18 @@ static inline int is_inside(const walker *w) {
          (w->ix >= 0 && w->ix < w->p->width && w->iy >= 0 && w->iy < w->p->height);
 }
 
+/* Clamp mode only: the ray is past the border (or on its last cells) along
+ * each axis it moves on, going away, so every corner of this cell and of all
+ * cells ahead is clamped to the same heights: the surface is flat under the
+ * ray from here on, and no breakpoint ahead is steeper than one already
+ * tested at the same height. */
+static inline int is_flat_beyond(const walker *w) {
+  const int W = w->p->width, H = w->p->height;
+  const double dx = w->d.dx, dy = w->d.dy;
+  return !is_periodic(w) && (dx == 0.0 || (dx > 0.0 ? w->ix >= W - 1 : w->ix < 0)) &&
+         (dy == 0.0 || (dy > 0.0 ? w->iy >= H - 1 : w->iy < 0));
+}
+
 static void set_cell(walker *w, int ix, int iy) {
   w->ix = ix;
   w->iy = iy;
@@ -118,29 +150,33 @@ static void move_to(walker *w, int ix, int iy) {
   }
 }
 
-static void walker_init(walker *w, const bb_pyramid *p, const direction *d, double ox,
-                        double oy, double oz) {
+static void walker_init(walker *w, const bb_pyramid *p, const direction *d, const lattice *lat,
+                        double ox, double oy, double oz, double best) {
   w->p = p;
   w->d = *d;
+  w->lat = lat;
   w->ox = ox;
   w->oy = oy;
   w->oz = oz;
   w->osum = ox + oy;
   w->margin = 1e-7 * (1.0 + fabs((double)p->global_max) + fabs((double)p->global_min) + fabs(oz));
   w->t = 0.0;
+  w->max_t = INFINITY;
+  w->best = best;
+  w->raised_at = 0.0;
   set_cell(w, cell_along(ox, d->sx), cell_along(oy, d->sy));
 }
 
-/* Number of thresholds (from b on) that slope s, met at distance t, blocks,
- * plus b; *raised_at records where the horizon last rose. */
-static inline int raise_horizon(const double *tan_el, int n, int b, double s, double t,
-                                double *raised_at) {
-  if (b < n && s >= tan_el[b]) {
-    *raised_at = t;
-    do b++;
-    while (b < n && s >= tan_el[b]);
+/* The best slope in texels of rise per texel, for the skip tests. */
+static inline double best_per_texel(const walker *w) {
+  return w->lat ? w->best * w->lat->inverse_length : w->best;
+}
+
+static inline void offer(walker *w, double slope, double t) {
+  if (slope > w->best) {
+    w->best = slope;
+    w->raised_at = t;
   }
-  return b;
 }
 
 static inline double clamp01(double v) {
@@ -183,9 +219,9 @@ static inline double corner_z(const corners *c, int x, int y) {
   return vertex_z(c->w, x, y);
 }
 
-/* Where the ray crosses the vertical line x = X: the surface there lies on
- * the edge from (X, row) to (X, row + 1). Returns the distance, or 0 if the
- * crossing is not in (0, t_max], and the surface height in *z. */
+/* Any ray. Where it crosses the vertical line x = X: the surface there lies
+ * on the edge from (X, row) to (X, row + 1). Returns the distance, or 0 if
+ * the crossing is not in (0, t_max], and the surface height in *z. */
 static inline double cross_vertical(const corners *c, double t_max, int X, double *z) {
   const walker *w = c->w;
   const double t = ((double)X - w->ox) * w->d.inv_dx;
@@ -220,28 +256,76 @@ static inline double cross_diagonal(const corners *c, double t_max, int K, doubl
   return t;
 }
 
+/* A lattice ray's crossings, from integers. Each returns the slope per step,
+ * or -INFINITY when the crossing is behind the origin, past the cap, or
+ * (by the ray's geometry) farther than t_max. */
+static inline double lattice_vertical(const corners *c, double t_max, int X) {
+  const walker *w = c->w;
+  const lattice *L = w->lat;
+  const long n = (long)(X - L->x0) * L->sa;
+  if (L->ma == 0 || n <= 0 || n > L->cap * L->ma) return -INFINITY;
+  if (((double)X - w->ox) * w->d.inv_dx > t_max) return -INFINITY;
+  const long num = n * L->b, row = floor_div(num, L->ma), r = num - row * L->ma;
+  const int Y = L->y0 + (int)row;
+  const double z = bb__lattice_height(corner_z(c, X, Y), corner_z(c, X, Y + 1),
+                                      bb__lattice_weight(r, L->inverse_m[0]));
+  return (z - w->oz) / bb__lattice_distance(n, L->inverse_m[0]);
+}
+
+static inline double lattice_horizontal(const corners *c, double t_max, int Y) {
+  const walker *w = c->w;
+  const lattice *L = w->lat;
+  const long n = (long)(Y - L->y0) * L->sb;
+  if (L->mb == 0 || n <= 0 || n > L->cap * L->mb) return -INFINITY;
+  if (((double)Y - w->oy) * w->d.inv_dy > t_max) return -INFINITY;
+  const long num = n * L->a, col = floor_div(num, L->mb), r = num - col * L->mb;
+  const int X = L->x0 + (int)col;
+  const double z = bb__lattice_height(corner_z(c, X, Y), corner_z(c, X + 1, Y),
+                                      bb__lattice_weight(r, L->inverse_m[1]));
+  return (z - w->oz) / bb__lattice_distance(n, L->inverse_m[1]);
+}
+
+static inline double lattice_diagonal(const corners *c, double t_max, int K) {
+  const walker *w = c->w;
+  const lattice *L = w->lat;
+  const long n = (long)(K - L->x0 - L->y0) * L->sd;
+  if (L->md == 0 || n <= 0 || n > L->cap * L->md) return -INFINITY;
+  if (((double)K - w->osum) * w->d.inv_dsum > t_max) return -INFINITY;
+  const long num = n * L->a, col = floor_div(num, L->md), r = num - col * L->md;
+  const int X = L->x0 + (int)col, row = K - 1 - X;
+  /* from (X + 1, row) to (X, row + 1), at weight 1 - r / md; r = 0 is the
+   * vertex (X, row + 1) */
+  const double zb = corner_z(c, X, row + 1);
+  const double z = r == 0 ? zb
+                          : bb__lattice_height(corner_z(c, X + 1, row), zb,
+                                               bb__lattice_weight(L->md - r, L->inverse_m[2]));
+  return (z - w->oz) / bb__lattice_distance(n, L->inverse_m[2]);
+}
+
 /* The exact cell test: the breakpoints on the current cell's exit edges and
  * its diagonal. Its entry edges are the exit edges of the cell before, or lie
  * on the boundary of a node skipped just before (whose max bounds them), or
  * hold the origin. */
-static inline int test_cell(const walker *w, const double *tan_el, int n, int b,
-                            double *raised_at) {
-  const int X = w->ix + (w->d.sx > 0), Y = w->iy + (w->d.sy > 0);
+static inline void test_cell(walker *w) {
+  const int X = w->ix + (w->d.sx > 0), Y = w->iy + (w->d.sy > 0), K = w->ix + w->iy + 1;
   /* Lines of this cell crossed far beyond it (by a nearly parallel ray) are
    * other cells' business; the slack keeps every crossing of this one. */
   const double exit_x = ((double)X - w->ox) * w->d.inv_dx;
   const double exit_y = ((double)Y - w->oy) * w->d.inv_dy;
-  const double t_max = (exit_x < exit_y ? exit_x : exit_y) + 1.0;
+  double t_max = (exit_x < exit_y ? exit_x : exit_y) + 1.0;
   corners c;
   corners_load(&c, w);
+  if (w->lat) {
+    offer(w, lattice_vertical(&c, t_max, X), w->t);
+    offer(w, lattice_horizontal(&c, t_max, Y), w->t);
+    offer(w, lattice_diagonal(&c, t_max, K), w->t);
+    return;
+  }
+  if (t_max > w->max_t) t_max = w->max_t;
   double z, t;
-  if ((t = cross_vertical(&c, t_max, X, &z)) > 0.0)
-    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
-  if ((t = cross_horizontal(&c, t_max, Y, &z)) > 0.0)
-    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
-  if ((t = cross_diagonal(&c, t_max, w->ix + w->iy + 1, &z)) > 0.0)
-    b = raise_horizon(tan_el, n, b, (z - w->oz) / t, t, raised_at);
-  return b;
+  if ((t = cross_vertical(&c, t_max, X, &z)) > 0.0) offer(w, (z - w->oz) / t, t);
+  if ((t = cross_horizontal(&c, t_max, Y, &z)) > 0.0) offer(w, (z - w->oz) / t, t);
+  if ((t = cross_diagonal(&c, t_max, K, &z)) > 0.0) offer(w, (z - w->oz) / t, t);
 }
 
 /* ---- traversal ----------------------------------------------------------- */
@@ -291,36 +375,47 @@ static inline float node_max(const bb_pyramid *p, int k, int cx, int cy) {
   return p->level_max[k][(size_t)(cy >> k) * (size_t)p->level_width[k] + (size_t)(cx >> k)];
 }
 
-/* The march proper, for the ray from (ox, oy, oz) along d, against the n
- * rising tangents tan_el. *hint (may be NULL) is in: a distance where a
- * nearby parallel ray met its horizon (0 for none); out: where this one did.
- * That cell is tested first: the order in which breakpoints are tested does
- * not change the answer, but a horizon found early raises the threshold and
- * with it the height below which whole nodes are skipped. */
-static int march(const bb_pyramid *p, const direction *d, double ox, double oy, double oz,
-                 const double *tan_el, int n, double *hint) {
-  walker w;
-  walker_init(&w, p, d, ox, oy, oz);
+/* What the march looks for: breakpoints of slope > the best so far and >=
+ * floor (texels per texel), until the best reaches stop_at (native units)
+ * or the walker passes end_t. */
+typedef struct goal {
+  double floor, stop_at, end_t;
+} goal;
+
+/* Height under which nothing can raise the best at distance t. */
+static inline double skip_limit(const walker *w, const goal *g) {
+  const double slope = best_per_texel(w);
+  return w->oz + w->t * (slope > g->floor ? slope : g->floor) - w->margin;
+}
+
+/* The march proper. hint (may be NULL) is in: a distance where a nearby
+ * parallel ray met its horizon (0 for none); out: where this one did. That
+ * cell is tested first: the order in which breakpoints are tested does not
+ * change the answer, but a horizon found early raises the height below which
+ * whole nodes are skipped. */
+static void march(walker *w, const goal *g, double *hint) {
+  const bb_pyramid *p = w->p;
   const int top = p->levels - 1;
-  int b = 0, k = 0;
-  double raised_at = 0.0;
+  int k = 0;
   if (hint && *hint > 0.0) {
-    walker probe = w;
+    walker probe = *w;
     jump_to(&probe, *hint);
-    b = test_cell(&probe, tan_el, n, b, &raised_at);
+    test_cell(&probe);
+    w->best = probe.best;
+    w->raised_at = probe.raised_at;
   }
-  while (b < n) {
-    /* Nothing under the ray below this height can block ray b or above. */
-    const double limit = w.oz + w.t * tan_el[b] - w.margin;
-    if (!is_inside(&w)) { /* clamp mode, past the border: never comes back */
+  while (w->best < g->stop_at && w->t <= g->end_t) {
+    const double limit = skip_limit(w, g);
+    if (!is_inside(w)) { /* clamp mode, past the border: never comes back */
       if ((double)p->border_max < limit) break;
-      b = test_cell(&w, tan_el, n, b, &raised_at);
-      advance(&w, 0);
+      test_cell(w);
+      if (is_flat_beyond(w)) break;
+      advance(w, 0);
       continue;
     }
-    if ((double)node_max(p, k, w.cx, w.cy) < limit) {
-      if (k == top) break; /* above the global maximum for good */
-      advance(&w, k);
+    if ((double)node_max(p, k, w->cx, w->cy) < limit) {
+      if (k == top) break; /* nothing ahead can rise above the best for good */
+      advance(w, k);
       k++;
       continue;
     }
@@ -328,130 +423,80 @@ static int march(const bb_pyramid *p, const direction *d, double ox, double oy, 
       k--;
       continue;
     }
-    b = test_cell(&w, tan_el, n, b, &raised_at);
-    advance(&w, 0);
+    test_cell(w);
+    if (is_flat_beyond(w)) break;
+    advance(w, 0);
   }
-  if (hint) *hint = raised_at;
-  return b;
+  if (hint) *hint = w->raised_at;
 }
 
-/* march() through the bands of the ray's own direction instead of the
- * square nodes: bands are thin along the path, so they bound it tighter and
- * let the ray skip further. Levels gallop, up after a skip and down after a
- * miss, since a band can start at any cell. x_major and periodic are
- * constants at each call, so each of the four variants compiles to a tight
- * loop with the walker's state in registers. */
-static inline __attribute__((always_inline)) int
-march_band_impl(const bb_pyramid *p, const bb__band *band, const direction *d, double ox,
-                double oy, double oz, const double *tan_el, int n, double *hint,
-                const int x_major, const int periodic) {
-  walker w;
-  walker_init(&w, p, d, ox, oy, oz);
-  const int W = p->width, H = p->height, top = band->levels - 1;
-  const int sx = d->sx, sy = d->sy;
-  const double gmax = (double)p->global_max, margin = w.margin;
-  const float *cells = p->level_max[0];
-  int ix = w.ix, iy = w.iy, cx = w.cx, cy = w.cy;
-  double t = 0.0;
-  int b = 0, k = 0;
-  double raised_at = 0.0;
-  if (*hint > 0.0) {
-    walker probe = w;
-    jump_to(&probe, *hint);
-    b = test_cell(&probe, tan_el, n, b, &raised_at);
+/* The brute-force twin: every cell, the same tests and stops, no nodes. */
+static void march_brute(walker *w, const goal *g) {
+  const bb_pyramid *p = w->p;
+  while (w->best < g->stop_at && w->t <= g->end_t) {
+    const double limit = skip_limit(w, g);
+    if ((double)p->global_max < limit) break;
+    if (!is_inside(w) && (double)p->border_max < limit) break;
+    test_cell(w);
+    if (is_flat_beyond(w)) break;
+    advance(w, 0);
   }
-  while (b < n) {
-    const double limit = oz + t * tan_el[b] - margin;
-    if (gmax < limit) break; /* above everything for good */
-    const int inside = periodic || (ix >= 0 && ix < W && iy >= 0 && iy < H);
-    if (inside && (double)band->level_max[k][(size_t)cy * (size_t)W + (size_t)cx] < limit) {
-      const int span = 1 << k; /* skip the 2^k cells along the major axis */
-      if (x_major) {
-        ix += sx * span;
-        t = ((double)(sx > 0 ? ix : ix + 1) - ox) * d->inv_dx;
-        const int row = no_backward(cell_along(oy + t * d->dy, sy), iy, sy);
-        cx = periodic ? bb__wrap_near(cx + sx * span, W) : bb__clampi(ix, 0, W - 1);
-        cy = periodic ? bb__wrap_near(cy + (row - iy), H) : bb__clampi(row, 0, H - 1);
-        iy = row;
-      } else {
-        iy += sy * span;
-        t = ((double)(sy > 0 ? iy : iy + 1) - oy) * d->inv_dy;
-        const int col = no_backward(cell_along(ox + t * d->dx, sx), ix, sx);
-        cy = periodic ? bb__wrap_near(cy + sy * span, H) : bb__clampi(iy, 0, H - 1);
-        cx = periodic ? bb__wrap_near(cx + (col - ix), W) : bb__clampi(col, 0, W - 1);
-        ix = col;
-      }
-      if (k < top) k++;
-      continue;
-    }
-    if (inside && k > 0) {
-      k--;
-      continue;
-    }
-    /* Past the border (clamp) only border_max bounds the cells; inside, the
-     * band's four rows are not all on the path, so the cell alone may pass. */
-    const double bound = inside ? (double)cells[(size_t)cy * (size_t)W + (size_t)cx]
-                                : (double)p->border_max;
-    if (!inside && bound < limit) break; /* never comes back */
-    if (bound >= limit) {
-      w.ix = ix, w.iy = iy, w.cx = cx, w.cy = cy, w.t = t;
-      b = test_cell(&w, tan_el, n, b, &raised_at);
-    }
-    /* DDA step to the next cell; through a corner, diagonally. */
-    const double tx = ((double)(sx > 0 ? ix + 1 : ix) - ox) * d->inv_dx;
-    const double ty = ((double)(sy > 0 ? iy + 1 : iy) - oy) * d->inv_dy;
-    if (tx <= ty) {
-      ix += sx;
-      cx = periodic ? bb__wrap_near(cx + sx, W) : bb__clampi(ix, 0, W - 1);
-    }
-    if (ty <= tx) {
-      iy += sy;
-      cy = periodic ? bb__wrap_near(cy + sy, H) : bb__clampi(iy, 0, H - 1);
-    }
-    t = tx < ty ? tx : ty;
-  }
-  *hint = raised_at;
-  return b;
 }
 
-static int march_band(const bb_pyramid *p, const bb__band *band, const direction *d,
-                      double ox, double oy, double oz, const double *tan_el, int n,
-                      double *hint) {
-  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
-  if (band->major_x)
-    return periodic ? march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 1, 1)
-                    : march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 1, 0);
-  return periodic ? march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 0, 1)
-                  : march_band_impl(p, band, d, ox, oy, oz, tan_el, n, hint, 0, 0);
-}
+/* ---- any ray ------------------------------------------------------------- */
 
-int bb__march(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el, int n) {
+static void ray_walker(walker *w, const bb_pyramid *p, const bb__march_ray *r, double best) {
   direction d;
   direction_init(&d, r->dx, r->dy);
-  return n > 0 ? march(p, &d, r->ox, r->oy, r->oz, tan_el, n, NULL) : 0;
+  walker_init(w, p, &d, NULL, r->ox, r->oy, r->oz, best);
 }
 
-int bb__march_brute(const bb_pyramid *p, const bb__march_ray *r, const double *tan_el,
-                    int n) {
-  direction d;
-  direction_init(&d, r->dx, r->dy);
+static int occluded(const bb_pyramid *p, const bb__march_ray *r, double tan_el, int brute) {
   walker w;
-  walker_init(&w, p, &d, r->ox, r->oy, r->oz);
-  int b = 0;
-  double raised_at;
-  while (b < n) {
-    if ((double)p->global_max < w.oz + w.t * tan_el[b] - w.margin) break;
-    b = test_cell(&w, tan_el, n, b, &raised_at);
-    advance(&w, 0);
-  }
-  return b;
+  ray_walker(&w, p, r, -INFINITY);
+  const goal g = {tan_el, tan_el, INFINITY};
+  if (brute)
+    march_brute(&w, &g);
+  else
+    march(&w, &g, NULL);
+  return w.best >= tan_el;
+}
+
+int bb__march_occluded(const bb_pyramid *p, const bb__march_ray *r, double tan_el) {
+  return occluded(p, r, tan_el, 0);
+}
+
+int bb__march_occluded_brute(const bb_pyramid *p, const bb__march_ray *r, double tan_el) {
+  return occluded(p, r, tan_el, 1);
+}
+
+static double horizon(const bb_pyramid *p, const bb__march_ray *r, double max_distance,
+                      int brute) {
+  walker w;
+  ray_walker(&w, p, r, 0.0);
+  w.max_t = max_distance;
+  const goal g = {0.0, INFINITY, max_distance};
+  if (brute)
+    march_brute(&w, &g);
+  else
+    march(&w, &g, NULL);
+  return w.best;
+}
+
+double bb__march_horizon(const bb_pyramid *p, const bb__march_ray *r, double max_distance) {
+  return horizon(p, r, max_distance, 0);
+}
+
+double bb__march_horizon_brute(const bb_pyramid *p, const bb__march_ray *r,
+                               double max_distance) {
+  return horizon(p, r, max_distance, 1);
 }
 
 /* Splits a 3D ray into the march's horizontal line and tangent. Returns 0 for
- * a vertical ray, which nothing above the origin can block. */
+ * a vertical ray. */
 static int to_march_ray(const bb_ray *ray, bb__march_ray *r, double *tan_el) {
   double h = hypot(ray->direction[0], ray->direction[1]);
-  if (h == 0.0) return 0;
+  if (!(h > 0.0)) return 0;
   r->ox = ray->origin[0];
   r->oy = ray->origin[1];
   r->oz = ray->origin[2];
@@ -461,16 +506,100 @@ static int to_march_ray(const bb_ray *ray, bb__march_ray *r, double *tan_el) {
   return 1;
 }
 
+/* A vertical ray: nothing above the origin can block it. */
 int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray) {
   bb__march_ray r;
   double tan_el;
-  return to_march_ray(ray, &r, &tan_el) ? bb__march(p, &r, &tan_el, 1) : 0;
+  return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded(p, &r, tan_el) : 0;
 }
 
 int bb_ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray) {
   bb__march_ray r;
   double tan_el;
-  return to_march_ray(ray, &r, &tan_el) ? bb__march_brute(p, &r, &tan_el, 1) : 0;
+  return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded_brute(p, &r, tan_el) : 0;
+}
+
+static double ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance,
+                          int brute) {
+  bb__march_ray r;
+  double tan_el;
+  if (!p || !ray || !(max_distance > 0.0) || !to_march_ray(ray, &r, &tan_el)) return -1.0;
+  if (p->addressing == BB_ADDRESS_PERIODIC && !isfinite(max_distance)) return -1.0;
+  return horizon(p, &r, max_distance, brute);
+}
+
+double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
+  return ray_horizon(p, ray, max_distance, 0);
+}
+
+double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
+  return ray_horizon(p, ray, max_distance, 1);
+}
+
+/* ---- lattice slices ------------------------------------------------------ */
+
+static long gcd_long(long a, long b) {
+  a = a < 0 ? -a : a;
+  b = b < 0 ? -b : b;
+  while (b) {
+    const long r = a % b;
+    a = b;
+    b = r;
+  }
+  return a;
+}
+
+long bb__line_period(const bb_pyramid *p, int a, int b) {
+  const long px = p->width / gcd_long(a, p->width), py = p->height / gcd_long(b, p->height);
+  return px / gcd_long(px, py) * py;
+}
+
+static inline int sign(long v) {
+  return v > 0 ? 1 : (v < 0 ? -1 : 0);
+}
+
+/* The lattice state of step (a, b) from vertex (x, y), and its direction. */
+static void lattice_init(lattice *L, direction *d, const bb_pyramid *p, int x, int y, int a,
+                         int b) {
+  L->x0 = x, L->y0 = y, L->a = a, L->b = b;
+  L->ma = abs(a), L->mb = abs(b), L->md = abs(a + b);
+  L->sa = sign(a), L->sb = sign(b), L->sd = sign(a + b);
+  L->length = bb__step_length(a, b);
+  L->inverse_length = bb__step_inverse(a, b);
+  L->inverse_m[0] = bb__lattice_inverse(L->ma ? L->ma : 1);
+  L->inverse_m[1] = bb__lattice_inverse(L->mb ? L->mb : 1);
+  L->inverse_m[2] = bb__lattice_inverse(L->md ? L->md : 1);
+  L->cap = p->addressing == BB_ADDRESS_PERIODIC ? bb__line_period(p, a, b) : (1L << 40);
+  direction_init(d, a / L->length, b / L->length);
+}
+
+/* One slice's horizon from a texel: the march, or the brute-force twin when
+ * brute. hint as in march(). */
+static float slice_horizon(const bb_pyramid *p, int x, int y, double bias, int a, int b,
+                           int brute, double *hint) {
+  lattice L;
+  direction d;
+  lattice_init(&L, &d, p, x, y, a, b);
+  walker w;
+  const double oz = (double)p->z[(size_t)y * (size_t)p->width + (size_t)x] + bias;
+  walker_init(&w, p, &d, &L, x, y, oz, 0.0);
+  /* a breakpoint n / m <= cap steps away lies within cap + 1 steps of geometry */
+  const goal g = {0.0, INFINITY,
+                  p->addressing == BB_ADDRESS_PERIODIC ? ((double)L.cap + 1.0) * L.length
+                                                       : INFINITY};
+  if (brute)
+    march_brute(&w, &g);
+  else
+    march(&w, &g, hint);
+  return bb__lattice_horizon(w.best, L.inverse_length);
+}
+
+float bb__slice_horizon(const bb_pyramid *p, int x, int y, double bias, int a, int b) {
+  return slice_horizon(p, x, y, bias, a, b, 0, NULL);
+}
+
+float bb__slice_horizon_brute(const bb_pyramid *p, int x, int y, double bias, int a, int b) {
+  return slice_horizon(p, x, y, bias, a, b, 1, NULL);
 }
 
 /* ------------------------------------------------------------ batch trace */
@@ -480,47 +609,25 @@ void bb_trace_options_init(bb_trace_options *o) {
   o->bias_texels = 0.55;
 }
 
-/* Slices whose blocked counts are kept at once, 2 bytes per texel each (as
- * much as the 4 double sums they feed): a 256-ray set (16 slices) is one
- * batch, added up in one pass with no sums kept between passes. */
-enum { SLICE_BATCH = 16 };
-
-/* Per slice s and channel c, the weight of the rays a march leaves unblocked:
- * unblocked[c][start_s + s + b] = sum of the weights of rays b.. of slice s. */
 typedef struct trace_job {
   const bb_pyramid *p;
   const bb_rayset *rs;
   const bb_trace_options *o;
-  int channels;           /* 1 + basis_count */
-  double *unblocked;      /* channels * (ray_count + slice_count) */
-  double total[1 + BB_MAX_BASIS];
-  direction *slice_dir;   /* per slice */
-  int *order;             /* slices in the order their weights are summed */
-  /* Slice paths: the blocked counts of a batch of slices, then added up. */
-  uint16_t *blocked;      /* SLICE_BATCH planes of one count per texel */
-  int batch[SLICE_BATCH]; /* the batch's slices, plane k holds batch[k]'s counts */
-  int batch_size;
-  int batch_first, batch_last; /* is it the first / last batch of the trace? */
-  double *sums;           /* per texel and channel, weight summed by earlier batches */
-  const bb__band *band;   /* band path: the bands of the slice of plane band_plane */
-  int band_plane;
-  float *vis;
+  bb_region region;  /* the texels traced; vis is its size */
+  int channels;      /* 1 + basis_count */
+  int *order;        /* slices in the order every path adds them up */
+  float *vis;        /* sums of what the slices lose, then the visibility */
 } trace_job;
-
-static double ray_weight(const bb_rayset *rs, int c, int ray) {
-  return c == 0 ? rs->weight_ao[ray]
-                : rs->weight_basis[(size_t)ray * (size_t)rs->basis_count + (size_t)(c - 1)];
-}
 
 static int opposite_steps(const bb_rayset *rs, int s, int t) {
   return rs->slice_step[2 * s] == -rs->slice_step[2 * t] &&
          rs->slice_step[2 * s + 1] == -rs->slice_step[2 * t + 1];
 }
 
-/* The order in which every path sums the slices' weights: each slice is
- * followed by its opposite (lattice step (-a, -b)), when the set has one, so
- * that one line sweep can serve both. A fixed order keeps the paths' sums,
- * and so their results, bit-identical. Returns -1 when out of memory. */
+/* The order in which every path adds up the slices: each slice is followed
+ * by its opposite (lattice step (-a, -b)), when the set has one, so that one
+ * line sweep can serve both. A fixed order keeps the paths' float sums, and
+ * so their results, bit-identical. Returns -1 when out of memory. */
 static int order_slices(const bb_rayset *rs, int *order) {
   unsigned char *placed = calloc((size_t)rs->slice_count, 1);
   if (!placed) return -1;
@@ -540,232 +647,110 @@ static int order_slices(const bb_rayset *rs, int *order) {
   return 0;
 }
 
-/* Suffix sums, and totals taken as the same sums in the same order, so a
- * texel with nothing blocked gets exactly 1. */
-static bb_status prepare_job(trace_job *job, bb_error *err) {
-  const bb_rayset *rs = job->rs;
-  const size_t stride = (size_t)(rs->ray_count + rs->slice_count);
-  job->unblocked = malloc((size_t)job->channels * stride * sizeof(double));
-  job->slice_dir = malloc((size_t)rs->slice_count * sizeof(direction));
-  job->order = malloc((size_t)rs->slice_count * sizeof(int));
-  if (!job->unblocked || !job->slice_dir || !job->order || order_slices(rs, job->order) != 0)
-    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
-  for (int s = 0; s < rs->slice_count; s++)
-    direction_init(&job->slice_dir[s], rs->slice_dir[2 * s], rs->slice_dir[2 * s + 1]);
-  for (int c = 0; c < job->channels; c++) {
-    double *u = job->unblocked + (size_t)c * stride;
-    job->total[c] = 0.0;
-    for (int i = 0; i < rs->slice_count; i++) {
-      const int s = job->order[i], start = rs->slice_start[s],
-                count = rs->slice_start[s + 1] - start;
-      double *slice = u + start + s;
-      slice[count] = 0.0;
-      for (int e = count - 1; e >= 0; e--) slice[e] = slice[e + 1] + ray_weight(rs, c, start + e);
-      job->total[c] += slice[0];
-    }
+/* A texel's sums of losses become its visibilities: 1 - lost / total. */
+static void finish_texel(const bb_rayset *rs, float *v) {
+  for (int c = 0; c <= rs->basis_count; c++) {
+    const double total = rs->total[c];
+    const double open = total > 0.0 ? 1.0 - (double)v[c] / total : 1.0;
+    v[c] = (float)(open < 0.0 ? 0.0 : open);
   }
-  return BB_OK;
 }
 
-static void release_job(trace_job *job) {
-  free(job->unblocked);
-  free(job->slice_dir);
-  free(job->order);
-  free(job->sums);
-  free(job->blocked);
+static void finish_row(void *user, int y) {
+  const trace_job *job = user;
+  float *v = job->vis + (size_t)y * (size_t)job->region.width * (size_t)job->channels;
+  for (int x = 0; x < job->region.width; x++, v += job->channels) finish_texel(job->rs, v);
 }
 
-/* Adds slice s's unblocked weight for `blocked` blocked rays to sum[]. */
-static inline void add_slice(const trace_job *job, int s, int blocked, double *sum) {
-  const size_t stride = (size_t)(job->rs->ray_count + job->rs->slice_count);
-  const size_t at = (size_t)(job->rs->slice_start[s] + s + blocked);
-  for (int c = 0; c < job->channels; c++) sum[c] += job->unblocked[(size_t)c * stride + at];
-}
-
-static void store_texel(const trace_job *job, size_t texel, const double *sum) {
-  float *out = job->vis + texel * (size_t)job->channels;
-  for (int c = 0; c < job->channels; c++)
-    out[c] = job->total[c] > 0.0 ? (float)(sum[c] / job->total[c]) : 1.0f;
-}
-
-/* Plane k of the batch's blocked counts. */
-static inline uint16_t *plane(const trace_job *job, int k) {
-  return job->blocked + (size_t)k * (size_t)job->p->width * (size_t)job->p->height;
-}
-
-static inline double origin_z(const trace_job *job, int x, int y) {
-  return (double)job->p->z[(size_t)y * (size_t)job->p->width + (size_t)x] + job->o->bias_texels;
-}
-
-/* Band path: one slice over one row. */
-static void band_slice_row(void *user, int y) {
+/* March path: every slice of a texel by the max-mip march, one row of the
+ * region per work item. */
+static void march_row(void *user, int row) {
   const trace_job *job = user;
   const bb_rayset *rs = job->rs;
-  const int s = job->batch[job->band_plane], start = rs->slice_start[s],
-            count = rs->slice_start[s + 1] - start;
-  uint16_t *blocked = plane(job, job->band_plane);
-  double hint = 0.0; /* where the previous texel's horizon was */
-  for (int x = 0; x < job->p->width; x++)
-    blocked[(size_t)y * (size_t)job->p->width + (size_t)x] = (uint16_t)march_band(
-        job->p, job->band, &job->slice_dir[s], x, y, origin_z(job, x, y),
-        rs->tan_elevation + start, count, &hint);
-}
-
-/* A texel's sums grow batch by batch and, within one, plane by plane:
- * always in the summing order, so the result does not depend on threads.
- * The last batch stores the visibility. */
-static void add_batch_row(void *user, int y) {
-  const trace_job *job = user;
-  const int w = job->p->width, channels = job->channels;
-  const size_t texels = (size_t)w * (size_t)job->p->height;
-  for (int x = 0; x < w; x++) {
-    const size_t texel = (size_t)y * (size_t)w + (size_t)x;
-    double sum[1 + BB_MAX_BASIS] = {0};
-    double *kept = job->sums ? job->sums + texel * (size_t)channels : NULL;
-    if (!job->batch_first)
-      for (int c = 0; c < channels; c++) sum[c] = kept[c];
-    for (int k = 0; k < job->batch_size; k++)
-      add_slice(job, job->batch[k], job->blocked[(size_t)k * texels + texel], sum);
-    if (job->batch_last)
-      store_texel(job, texel, sum);
-    else
-      for (int c = 0; c < channels; c++) kept[c] = sum[c];
-  }
-}
-
-/* Square path: every slice of a texel through the square nodes. */
-static void trace_row(void *user, int y) {
-  const trace_job *job = user;
-  const bb_rayset *rs = job->rs;
-  double hint[256] = {0}; /* per slice: where the previous texel's horizon was */
-  for (int x = 0; x < job->p->width; x++) {
-    double sum[1 + BB_MAX_BASIS] = {0};
-    for (int i = 0; i < rs->slice_count; i++) {
-      const int s = job->order[i], start = rs->slice_start[s],
-                count = rs->slice_start[s + 1] - start;
-      add_slice(job, s, march(job->p, &job->slice_dir[s], x, y, origin_z(job, x, y),
-                              rs->tan_elevation + start, count, &hint[s]), sum);
+  const int y = job->region.y0 + row;
+  double hint[BB_MAX_SLICES] = {0}; /* per slice: where the last texel's horizon was */
+  float *v = job->vis + (size_t)row * (size_t)job->region.width * (size_t)job->channels;
+  for (int i = 0; i < job->region.width; i++, v += job->channels) {
+    const int x = job->region.x0 + i;
+    for (int k = 0; k < rs->slice_count; k++) {
+      const int s = job->order[k];
+      const float h = slice_horizon(job->p, x, y, job->o->bias_texels, rs->slice_step[2 * s],
+                                    rs->slice_step[2 * s + 1], 0, &hint[s]);
+      const bb__slice_integral si = bb__slice_integral_of(rs, s);
+      bb__slice_accumulate(&si, h, v);
     }
-    store_texel(job, (size_t)y * (size_t)job->p->width + (size_t)x, sum);
+    finish_texel(rs, v);
   }
 }
 
-static bb__sweep_dir sweep_dir(const trace_job *job, int k) {
+/* Sweep path: slices in the summing order, a slice and its opposite per
+ * sweep when they pair up. */
+static bb_status trace_sweeps(trace_job *job, bb_error *err) {
   const bb_rayset *rs = job->rs;
-  const int s = job->batch[k], start = rs->slice_start[s];
-  return (bb__sweep_dir){rs->tan_elevation + start, rs->slice_start[s + 1] - start,
-                         plane(job, k)};
-}
-
-/* The blocked counts at every texel of the batch's planes k (and k + 1 when
- * `pair`): by line sweeps, which take a slice and its opposite at once, or
- * (`sweep` 0) by marches through the slice's direction bands. */
-static bb_status blocked_counts(trace_job *job, int k, int pair, int sweep, bb_error *err) {
-  const bb_pyramid *p = job->p;
-  const bb_rayset *rs = job->rs;
-  const int s = job->batch[k];
-  if (sweep) {
-    const bb__sweep_dir along = sweep_dir(job, k);
-    bb__sweep_dir opposite = {0};
-    if (pair) opposite = sweep_dir(job, k + 1);
-    return bb__sweep_lines(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
-                           pair ? &opposite : NULL, job->o->bias_texels, job->o->threads, err);
-  }
-  job->band_plane = k;
-  bb__band band;
-  bb_status st = bb__band_build(p, job->slice_dir[s].dx, job->slice_dir[s].dy, job->o->threads,
-                                &band, err);
-  if (st != BB_OK) return st;
-  job->band = &band;
-  st = bb__parallel_for(p->height, job->o->threads, band_slice_row, job, NULL, NULL, err);
-  bb__band_free(&band);
-  job->band = NULL;
-  return st;
-}
-
-/* Fills the batch with the slices order[*next ..], a slice and its opposite
- * side by side when sweeps can take them together (is_pair[k] marks the
- * first plane of such a pair). */
-static void fill_batch(trace_job *job, int sweep, int *next, int *is_pair) {
-  const bb_rayset *rs = job->rs;
-  job->batch_size = 0;
-  while (*next < rs->slice_count && job->batch_size < SLICE_BATCH) {
-    const int s = job->order[*next];
-    const int t = *next + 1 < rs->slice_count ? job->order[*next + 1] : -1;
-    const int pair = sweep && t >= 0 && opposite_steps(rs, s, t);
-    if (pair && job->batch_size + 2 > SLICE_BATCH) break;
-    is_pair[job->batch_size] = pair;
-    job->batch[job->batch_size++] = s;
-    if (pair) {
-      is_pair[job->batch_size] = 0;
-      job->batch[job->batch_size++] = t;
-    }
-    *next += pair ? 2 : 1;
-  }
-}
-
-/* Slices in the summing order, batch by batch. */
-static bb_status trace_slices(trace_job *job, int sweep, bb_error *err) {
-  const bb_pyramid *p = job->p;
-  const bb_rayset *rs = job->rs;
-  const size_t texels = (size_t)p->width * (size_t)p->height;
-  const int planes = rs->slice_count < SLICE_BATCH ? rs->slice_count : SLICE_BATCH;
-  job->blocked = malloc((size_t)planes * texels * sizeof(uint16_t));
-  if (rs->slice_count > SLICE_BATCH) /* more than one batch: sums kept between them */
-    job->sums = malloc(texels * (size_t)job->channels * sizeof(double));
-  if (!job->blocked || (rs->slice_count > SLICE_BATCH && !job->sums))
-    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
   bb_status st = BB_OK;
-  int next = 0, is_pair[SLICE_BATCH];
-  for (job->batch_first = 1; st == BB_OK && next < rs->slice_count; job->batch_first = 0) {
-    fill_batch(job, sweep, &next, is_pair);
-    job->batch_last = next == rs->slice_count;
-    for (int k = 0; st == BB_OK && k < job->batch_size; k += is_pair[k] ? 2 : 1) {
-      st = blocked_counts(job, k, is_pair[k], sweep, err);
-      if (job->o->progress)
-        job->o->progress(job->o->progress_user, next - job->batch_size + k + 1 + is_pair[k],
-                         rs->slice_count);
-    }
-    if (st == BB_OK)
-      st = bb__parallel_for(p->height, job->o->threads, add_batch_row, job, NULL, NULL, err);
+  for (int k = 0; st == BB_OK && k < rs->slice_count;) {
+    const int s = job->order[k];
+    const int pair = k + 1 < rs->slice_count && opposite_steps(rs, s, job->order[k + 1]);
+    const bb__sweep_dir along = {rs, s, job->vis, NULL};
+    const bb__sweep_dir opposite = {rs, pair ? job->order[k + 1] : 0, job->vis, NULL};
+    st = bb__sweep_lines(job->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
+                         pair ? &opposite : NULL, job->o->bias_texels, job->o->threads, 0, err);
+    k += pair ? 2 : 1;
+    if (job->o->progress) job->o->progress(job->o->progress_user, k, rs->slice_count);
   }
+  if (st == BB_OK)
+    st = bb__parallel_for(job->region.height, job->o->threads, finish_row, job, NULL, NULL, err);
   return st;
+}
+
+static bb_status check_trace(const bb_pyramid *p, const bb_rayset *rs, const bb_trace_options *o,
+                             bb_error *err) {
+  if (!p || !rs || !o || rs->slice_count < 1 || rs->slice_count > BB_MAX_SLICES || !rs->table)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing pyramid, ray set or options");
+  if (!(o->bias_texels >= 0.0) || !isfinite(o->bias_texels))
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: bias must be finite and >= 0 (got %g)",
+                    o->bias_texels);
+  const bb_region *r = &o->region;
+  if (r->width != 0 && (r->width < 0 || r->height <= 0 || r->x0 < 0 || r->y0 < 0 ||
+                        r->x0 > p->width - r->width || r->y0 > p->height - r->height))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "trace: region %dx%d at (%d, %d) is not inside the %dx%d image", r->width,
+                    r->height, r->x0, r->y0, p->width, p->height);
+  return BB_OK;
 }
 
 bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
                                    const bb_trace_options *o, bb__trace_path path,
                                    bb_image *vis, bb_error *err) {
   memset(vis, 0, sizeof *vis);
-  if (!p || !rs || !o || rs->ray_count < 1)
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing pyramid, ray set or options");
-  if (!(o->bias_texels >= 0.0) || !isfinite(o->bias_texels))
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: bias must be finite and >= 0 (got %g)",
-                    o->bias_texels);
+  bb_status st = check_trace(p, rs, o, err);
+  if (st != BB_OK) return st;
   trace_job job = {.p = p, .rs = rs, .o = o, .channels = 1 + rs->basis_count};
-  bb_status st = prepare_job(&job, err);
-  if (st == BB_OK) st = bb_image_alloc(vis, p->width, p->height, job.channels, err);
+  job.region = o->region.width ? o->region : (bb_region){0, 0, p->width, p->height};
+  job.order = malloc((size_t)rs->slice_count * sizeof(int));
+  if (!job.order || order_slices(rs, job.order) != 0)
+    st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  if (st == BB_OK)
+    st = bb_image_alloc(vis, job.region.width, job.region.height, job.channels, err);
   if (st == BB_OK) {
     job.vis = vis->pixels;
-    st = path == BB__TRACE_SQUARE
-             ? bb__parallel_for(p->height, o->threads, trace_row, &job, o->progress,
+    st = path == BB__TRACE_MARCH
+             ? bb__parallel_for(job.region.height, o->threads, march_row, &job, o->progress,
                                 o->progress_user, err)
-             : trace_slices(&job, path == BB__TRACE_SWEEP, err);
+             : trace_sweeps(&job, err);
   }
-  release_job(&job);
+  free(job.order);
   if (st != BB_OK) bb_image_free(vis);
   return st;
 }
 
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
-                             double *rays_traced, bb_error *err) {
-  /* Slice by slice, the counts of a batch of slices cost 32 bytes per texel
-   * (and large ray sets as much again for sums): past 4096 x 4096 the square
-   * nodes, texel by texel, do without. */
-  const int by_slice = p && (long)p->width * p->height <= 4096L * 4096L;
-  bb_status st = bb__trace_occlusion_path(p, rs, o, by_slice ? BB__TRACE_SWEEP : BB__TRACE_SQUARE,
+                             double *horizons_found, bb_error *err) {
+  const int whole = o && o->region.width == 0;
+  bb_status st = bb__trace_occlusion_path(p, rs, o, whole ? BB__TRACE_SWEEP : BB__TRACE_MARCH,
                                           vis, err);
-  if (st == BB_OK && rays_traced)
-    *rays_traced = (double)p->width * (double)p->height * (double)rs->ray_count;
+  if (st == BB_OK && horizons_found)
+    *horizons_found = (double)vis->width * (double)vis->height * (double)rs->slice_count;
   return st;
 }

@@ -60,92 +60,171 @@ Test(bake, flat_map_is_neutral_everywhere) {
   bb_image_free(&h);
 }
 
-/* The centre of a cylindrical pit of radius R and depth D sees the sky
- * through a cone of half-angle atan(R / D): ao = sin^2(atan(R / D)). The rim
- * is stair-stepped, so it lies within half a texel of R. */
-Test(bake, cylindrical_pit_centre_ao) {
-  const int size = 96, c = 48;
-  const double radius = 24.0, depth = 20.0;
-  bb_image h = field(size, size);
-  for (int y = 0; y < size; y++)
-    for (int x = 0; x < size; x++)
-      h.pixels[y * size + x] = hypot(x - c, y - c) < radius ? 0.0f : 1.0f;
-  bb_bake_options o = sharp_options((float)depth, 1024);
-  bb_bake_result r = bake(&h, &o);
-  const double expected = pow(sin(atan(radius / depth)), 2.0);
-  cr_assert_float_eq(at(&r.ao, c, c)[0], expected, 0.02, "ao %g, expected %g",
-                     (double)at(&r.ao, c, c)[0], expected);
-  bb_bake_result_free(&r);
-  bb_image_free(&h);
+/* ---- known answers: CONVENTIONS' integrals for a horizon t(phi) ---------
+
+ * With the horizon's tangent t(phi) known in every azimuth, ao and vis_c
+ * are integrals over phi of closed forms in elevation: for ao,
+ * cos^2(atan t) / 2 = 1 / (2 (1 + t^2)); for a lobe max(0, w.B) (power 1),
+ * the integral from max(atan t, where w.B turns positive) to pi/2 of
+ * (a cos + c sin) cos, a = Bx cos(phi) + By sin(phi), c = Bz > 0. The
+ * azimuth integral is a midpoint rule over 7200 azimuths. */
+typedef double (*horizon_fn)(const void *ctx, double phi);
+
+static double lobe_above(const double b[3], double phi, double t) {
+  const double a = b[0] * cos(phi) + b[1] * sin(phi), c = b[2];
+  const double start = fmax(atan(fmax(t, 0.0)), atan2(-a, c)), end = PI / 2;
+  if (start >= end) return 0.0;
+  return a * ((end - start) / 2 + (sin(2 * end) - sin(2 * start)) / 4) +
+         c * (sin(end) * sin(end) - sin(start) * sin(start)) / 2;
 }
 
-/* A floor boxed in by walls of height H whose tops lie at distances
- * (right, left, down, up) from the texel, extended to infinity by clamp
- * addressing. A direction escapes iff it clears the first wall top it meets:
- * tan(elevation) * distance > H. */
-typedef struct box {
-  double right, left, down, up, wall;
-} box;
-
-static int blocked_in_box(const box *b, double dx, double dy, double dz) {
-  const double horizontal = hypot(dx, dy);
-  const double cx = dx / horizontal, cy = dy / horizontal;
-  double t = INFINITY;
-  if (cx > 0) t = fmin(t, b->right / cx);
-  if (cx < 0) t = fmin(t, b->left / -cx);
-  if (cy > 0) t = fmin(t, b->down / cy);
-  if (cy < 0) t = fmin(t, b->up / -cy);
-  return dz / horizontal * t <= b->wall;
-}
-
-/* CONVENTIONS' ao and vis_c (power 1) by a fine midpoint rule over the
- * upper hemisphere. */
-static void box_integrals(const box *b, double *ao, double vis[3]) {
-  double open_ao = 0, all_ao = 0, open_vis[3] = {0}, all_vis[3] = {0};
-  const int nz = 600, nphi = 1200;
-  for (int i = 0; i < nz; i++)
-    for (int j = 0; j < nphi; j++) {
-      const double z = (i + 0.5) / nz, phi = 2 * PI * (j + 0.5) / nphi, r = sqrt(1 - z * z);
-      const double d[3] = {r * cos(phi), r * sin(phi), z};
-      const int open = !blocked_in_box(b, d[0], d[1], d[2]);
-      all_ao += z;
-      open_ao += open * z;
-      for (int c = 0; c < 3; c++) {
-        double bv[3];
-        bb_basis_vector(c, bv);
-        const double lobe = fmax(0.0, d[0] * bv[0] + d[1] * bv[1] + d[2] * bv[2]);
-        all_vis[c] += lobe;
-        open_vis[c] += open * lobe;
-      }
+static void known_answer(horizon_fn horizon, const void *ctx, double *ao, double vis[3]) {
+  const int n = 7200;
+  double open_ao = 0, open_vis[3] = {0}, all_vis[3] = {0};
+  for (int i = 0; i < n; i++) {
+    const double phi = 2 * PI * (i + 0.5) / n, t = fmax(horizon(ctx, phi), 0.0);
+    open_ao += 1.0 / (1.0 + t * t);
+    for (int c = 0; c < 3; c++) {
+      double b[3];
+      bb_basis_vector(c, b);
+      open_vis[c] += lobe_above(b, phi, t);
+      all_vis[c] += lobe_above(b, phi, 0.0);
     }
-  *ao = open_ao / all_ao;
+  }
+  *ao = open_ao / n;
   for (int c = 0; c < 3; c++) vis[c] = open_vis[c] / all_vis[c];
 }
 
-Test(bake, floor_between_walls_matches_the_integrals_per_channel) {
-  const box b = {.right = 4, .left = 9, .down = 6, .up = 14, .wall = 10};
-  const int w = (int)(b.left + b.right) + 1, h = (int)(b.up + b.down) + 1;
-  const int x0 = (int)b.left, y0 = (int)b.up;
+/* ao and vis_c at texel (x, y) of a bake, against the known answer: vis_c
+ * is read through ssbump = max(0, N.B_c) vis_c with the bake's own normal. */
+static void expect_answer(const bb_bake_result *r, int x, int y, double ao, const double vis[3],
+                          double tolerance, const char *what) {
+  const double got_ao = at(&r->ao, x, y)[0];
+  cr_log_info("%s: ao %+.5f", what, got_ao - ao);
+  cr_expect(fabs(got_ao - ao) <= tolerance, "%s: ao %.5f, exact %.5f (tolerance %g)", what, got_ao,
+            ao, tolerance);
+  const float *n = at(&r->normal, x, y);
+  for (int c = 0; c < 3; c++) {
+    double b[3];
+    bb_basis_vector(c, b);
+    const double ndotb = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+    cr_assert_gt(ndotb, 0.1, "%s: the test needs every lobe facing the surface", what);
+    const double got = at(&r->ssbump, x, y)[c] / ndotb;
+    cr_log_info("%s: vis_%d %+.5f", what, c, got - vis[c]);
+    cr_expect(fabs(got - vis[c]) <= tolerance, "%s: vis_%d %.5f, exact %.5f (tolerance %g)", what,
+              c, got, vis[c], tolerance);
+  }
+}
+
+/* The bake at the default 256 rays (16 slices) and at 1024 (32): the only
+ * error left is the horizon of each slice's centre standing for its sector. */
+static const struct {
+  int rays;
+  double tolerance;
+} budgets[] = {{256, 0.005}, {1024, 0.0015}};
+
+/* A trench: a flat floor between two straight walls of height H, d_left and
+ * d_right texels from the texel, running on for ever (clamp mode). Along
+ * phi the nearer wall's top is d / |cos(phi)| away: t = H |cos(phi)| / d,
+ * so ao = (1 / sqrt(1 + (H / d_left)^2) + 1 / sqrt(1 + (H / d_right)^2)) / 2. */
+typedef struct trench {
+  double left, right, wall;
+} trench;
+
+static double trench_horizon(const void *ctx, double phi) {
+  const trench *t = ctx;
+  return t->wall * fabs(cos(phi)) / (cos(phi) < 0 ? t->left : t->right);
+}
+
+Test(bake, trench_floor_matches_the_exact_integrals) {
+  const trench tr = {8, 12, 8}; /* walls at 45 and 34 degrees */
+  const int w = (int)(tr.left + tr.right) + 1, h = 7, x0 = (int)tr.left, y0 = 3;
   bb_image height = field(w, h);
   for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++)
-      height.pixels[y * w + x] = (x == 0 || y == 0 || x == w - 1 || y == h - 1) ? 1.0f : 0.0f;
-  bb_bake_options o = sharp_options((float)b.wall, 1024);
-  o.smooth.addressing = BB_ADDRESS_CLAMP;
-  bb_bake_result r = bake(&height, &o);
+    for (int x = 0; x < w; x++) height.pixels[y * w + x] = (x == 0 || x == w - 1) ? 1.0f : 0.0f;
   double ao, vis[3];
-  box_integrals(&b, &ao, vis);
-  cr_assert_float_eq(at(&r.ao, x0, y0)[0], ao, 0.02, "ao %g, expected %g",
-                     (double)at(&r.ao, x0, y0)[0], ao);
-  for (int c = 0; c < 3; c++) /* flat floor: N = (0, 0, 1), so s_c = vis_c / sqrt(3) */
-    cr_assert_float_eq(at(&r.ssbump, x0, y0)[c] * sqrt(3.0), vis[c], 0.02,
-                       "channel %d: vis %g, expected %g", c,
-                       at(&r.ssbump, x0, y0)[c] * sqrt(3.0), vis[c]);
-  /* The near wall is on the +y (down) side: it darkens B1, whose light comes
-   * from +y, more than B2, whose light comes from -y. */
-  cr_assert_lt(at(&r.ssbump, x0, y0)[1], at(&r.ssbump, x0, y0)[2] - 0.05);
-  bb_bake_result_free(&r);
+  known_answer(trench_horizon, &tr, &ao, vis);
+  const double closed = 0.5 * (1 / sqrt(1 + pow(tr.wall / tr.left, 2)) +
+                               1 / sqrt(1 + pow(tr.wall / tr.right, 2)));
+  cr_assert_float_eq(ao, closed, 1e-6, "the reference itself: %g vs %g", ao, closed);
+  for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
+    bb_bake_options o = sharp_options((float)tr.wall, budgets[i].rays);
+    o.smooth.addressing = BB_ADDRESS_CLAMP;
+    bb_bake_result r = bake(&height, &o);
+    expect_answer(&r, x0, y0, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "trench, 256 rays" : "trench, 1024 rays");
+    bb_bake_result_free(&r);
+  }
   bb_image_free(&height);
+}
+
+/* A plane rising with slope s along +x (clamp mode): from a point on it, the
+ * horizon along phi is the plane itself, t = max(0, s cos(phi)), and
+ * ao = (1 + 1 / sqrt(1 + s^2)) / 2. */
+static double slope_horizon(const void *ctx, double phi) {
+  return *(const double *)ctx * cos(phi);
+}
+
+Test(bake, slope_matches_the_exact_integrals) {
+  const int w = 61, h = 9, x0 = 30, y0 = 4;
+  const float scale = 30.0f; /* z = scale * x / (w - 1): slope 0.5 */
+  const double s = (double)scale / (w - 1);
+  bb_image height = field(w, h);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) height.pixels[y * w + x] = (float)x / (float)(w - 1);
+  double ao, vis[3];
+  known_answer(slope_horizon, &s, &ao, vis);
+  cr_assert_float_eq(ao, 0.5 * (1 + 1 / sqrt(1 + s * s)), 1e-6);
+  for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
+    bb_bake_options o = sharp_options(scale, budgets[i].rays);
+    o.smooth.addressing = BB_ADDRESS_CLAMP;
+    bb_bake_result r = bake(&height, &o);
+    expect_answer(&r, x0, y0, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "slope, 256 rays" : "slope, 1024 rays");
+    bb_bake_result_free(&r);
+  }
+  bb_image_free(&height);
+}
+
+/* The centre of a cylindrical pit of radius R and depth D sees the sky
+ * through a cone of half-angle atan(R / D): ao = sin^2(atan(R / D)) for a
+ * round rim. The mesh's rim is stair-stepped, so the exact answer for this
+ * surface takes its horizon in 7200 azimuths from the brute-force twin;
+ * the round-rim formula is checked loosely beside it. */
+typedef struct pit {
+  const bb_pyramid *p;
+  double x, y;
+} pit;
+
+static double pit_horizon(const void *ctx, double phi) {
+  const pit *pt = ctx;
+  const bb_ray r = {{pt->x, pt->y, 0.0}, {cos(phi), sin(phi), 0.0}};
+  return bb_ray_horizon_brute(pt->p, &r, 100.0);
+}
+
+Test(bake, cylindrical_pit_centre_matches_the_exact_integrals) {
+  const int size = 128, c = 64;
+  const double radius = 40.0, depth = 40.0;
+  bb_image h = field(size, size), z = field(size, size);
+  for (int y = 0; y < size; y++)
+    for (int x = 0; x < size; x++) {
+      h.pixels[y * size + x] = hypot(x - c, y - c) < radius ? 0.0f : 1.0f;
+      z.pixels[y * size + x] = (float)depth * h.pixels[y * size + x];
+    }
+  bb_pyramid *p = NULL;
+  cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  const pit pt = {p, c, c};
+  double ao, vis[3];
+  known_answer(pit_horizon, &pt, &ao, vis);
+  const double round_rim = pow(sin(atan(radius / depth)), 2.0);
+  cr_assert_float_eq(ao, round_rim, 0.02, "stair-stepped %g, round %g", ao, round_rim);
+  for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
+    bb_bake_options o = sharp_options((float)depth, budgets[i].rays);
+    bb_bake_result r = bake(&h, &o);
+    expect_answer(&r, c, c, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "pit, 256 rays" : "pit, 1024 rays");
+    bb_bake_result_free(&r);
+  }
+  bb_pyramid_free(p);
+  bb_image_free(&z);
+  bb_image_free(&h);
 }
 
 static void noise_field(bb_image *h, unsigned seed) {
@@ -173,7 +252,7 @@ Test(bake, periodic_shift_shifts_every_output) {
     bb_bake_options o;
     bb_bake_options_init(&o);
     o.height_scale = 6.0f;
-    o.rays = 64;
+    o.slices = 8;
     o.smooth.radius_texels = radii[ri];
     o.smooth.threshold = 0.2f;
     bb_bake_result ra = bake(&a, &o), rb = bake(&b, &o);
@@ -200,7 +279,7 @@ Test(bake, bit_identical_for_one_two_and_three_threads) {
     bb_bake_options o;
     bb_bake_options_init(&o);
     o.height_scale = 8.0f;
-    o.rays = 100;
+    o.slices = 10;
     o.trace.threads = t + 1;
     r[t] = bake(&h, &o);
   }
@@ -227,5 +306,9 @@ Test(bake, rejects_bad_options) {
   o.power = 1.0;
   o.trace.bias_texels = -0.1;
   cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT);
+  o.trace.bias_texels = 0.55;
+  o.slices = BB_MAX_SLICES + 1;
+  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert(strstr(err.message, "slices") != NULL, "%s", err.message);
   bb_image_free(&h);
 }

@@ -699,14 +699,14 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
   cr_assert_not_null(end, "not JSON: %s", r.out);
   cr_expect_str_eq(json_ws(end), "", "trailing text after the JSON value: %s", r.out);
   const char *keys[] = {"input",         "width",         "height",
-                        "parameters",    "scale",         "rays",
+                        "parameters",    "scale",         "rays",          "slices",
                         "rayset",        "filter_radius", "filter_threshold",
                         "bias",          "power",         "basis",
                         "normal_filter", "normal_y",      "addressing",
                         "channel",       "threads",       "seconds",
                         "load",          "smooth",        "pyramid",
                         "trace",         "derive",        "write",
-                        "rays_traced",   "outputs",       "kind",
+                        "horizons",      "outputs",       "kind",
                         "path"};
   for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
     char quoted[64];
@@ -715,7 +715,7 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
   }
   cr_expect(strstr(r.out, "\"kind\":\"ao\"") && strstr(r.out, "\"kind\":\"normal\""),
             "%s", r.out);
-  cr_expect(strstr(r.out, "\"rays_traced\":1024"), "8x8 texels x 16 rays: %s", r.out);
+  cr_expect(strstr(r.out, "\"horizons\":256"), "8x8 texels x 4 slices (16 rays): %s", r.out);
   cli_result_free(&r);
 }
 

@@ -94,30 +94,50 @@ Test(trace, maxmip_equals_brute_force_on_random_rays) {
   cr_assert(blocked > rays / 5 && blocked < rays * 4 / 5, "blocked %ld of %ld", blocked, rays);
 }
 
-/* One march of a whole slice must answer each of its rays as a march of
- * that ray alone would. */
-Test(trace, slice_march_equals_per_ray_march) {
-  rng_state = 12345;
-  for (int field = 0; field < 40; field++) {
-    bb_image z = random_field(8 + field % 9, 11 + field % 5, 4.0f + (float)field, field % 3);
-    bb_pyramid *p = pyramid_of(&z, field % 2 ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
-    for (int i = 0; i < 300; i++) {
-      bb_ray r0 = random_ray(&z);
-      double phi = atan2(r0.direction[1], r0.direction[0]);
-      bb__march_ray mr = {r0.origin[0], r0.origin[1], r0.origin[2], cos(phi), sin(phi)};
-      double tans[16];
-      for (int e = 0; e < 16; e++) tans[e] = tan((1.0 + 5.5 * e) * 3.14159265 / 180);
-      int slice = bb__march(p, &mr, tans, 16);
-      for (int e = 0; e < 16; e++) {
-        int alone = bb__march(p, &mr, &tans[e], 1);
-        int brute = bb__march_brute(p, &mr, &tans[e], 1);
-        cr_assert_eq(alone, e < slice, "field %d ray %d elevation %d", field, i, e);
-        cr_assert_eq(brute, alone);
+/* The horizon march finds, bit for bit, what the brute-force twin finds,
+ * for rays in any direction from anywhere, in both addressing modes, and a
+ * ray is blocked exactly when its tangent is at or under the horizon. */
+Test(trace, horizon_march_equals_brute_force_on_random_rays) {
+  const int sizes[][2] = {{1, 1}, {2, 3}, {7, 13}, {16, 16}, {31, 33}, {64, 40}};
+  rng_state = 0x5DEECE66DULL;
+  long rays = 0, positive = 0;
+  for (int a = 0; a < 2; a++)
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++)
+      for (int kind = 0; kind < 3; kind++) {
+        bb_image z = random_field(sizes[si][0], sizes[si][1], 4.0f + 20.0f * (float)kind, kind);
+        bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
+        const double reach = 3.0 * (z.width + z.height);
+        for (int i = 0; i < 400; i++, rays++) {
+          bb_ray r = random_ray(&z);
+          const double far = a && i % 2 ? INFINITY : reach * rnd();
+          const double fast = bb_ray_horizon(p, &r, far), slow = bb_ray_horizon_brute(p, &r, far);
+          cr_assert(fast == slow, "%dx%d %s kind %d ray %d: max-mip %.17g, brute force %.17g",
+                    z.width, z.height, a ? "clamp" : "periodic", kind, i, fast, slow);
+          cr_assert_geq(fast, 0.0);
+          positive += fast > 0.0;
+          if (far == INFINITY || (!a && far == reach)) {
+            const double h = hypot(r.direction[0], r.direction[1]);
+            r.direction[2] = fast * h * (1 + 1e-9) + 1e-12;
+            cr_assert_eq(bb_ray_occluded(p, &r), 0, "just above the horizon");
+          }
+        }
+        bb_pyramid_free(p);
+        bb_image_free(&z);
       }
-    }
-    bb_pyramid_free(p);
-    bb_image_free(&z);
-  }
+  cr_assert(positive > rays / 4 && positive < rays, "%ld positive horizons of %ld", positive, rays);
+}
+
+Test(trace, ray_horizon_rejects_what_it_cannot_answer) {
+  bb_image z;
+  cr_assert_eq(bb_image_alloc(&z, 8, 8, 1, NULL), BB_OK);
+  bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
+  bb_ray r = {{1, 1, 0.5}, {1, 0, 0.1}};
+  cr_assert_eq(bb_ray_horizon(p, &r, INFINITY), -1.0, "periodic rays need a finite reach");
+  cr_assert_eq(bb_ray_horizon(p, &r, 0.0), -1.0);
+  r.direction[0] = 0.0;
+  cr_assert_eq(bb_ray_horizon(p, &r, 10.0), -1.0, "vertical");
+  bb_pyramid_free(p);
+  bb_image_free(&z);
 }
 
 static bb_image flat_with_peak(int w, int h, int px, int py, float peak) {
@@ -213,37 +233,110 @@ Test(trace, vertical_ray_is_never_blocked) {
 
 /* ---------------------------------------------------------- batch trace */
 
-static bb_image trace_field(const bb_image *z, bb_addressing a, int threads, int rays) {
-  bb_pyramid *p = pyramid_of(z, a);
+static bb_rayset rayset_of(int slices) {
   bb_rayset rs;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(rays, 1.0, BB_BASIS_HL2, &rs, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_rayset_make(slices, 1.0, BB_BASIS_HL2, &rs, &err), BB_OK, "%s", err.message);
+  return rs;
+}
+
+static bb_image trace_field(const bb_image *z, bb_addressing a, int threads, int slices) {
+  bb_pyramid *p = pyramid_of(z, a);
+  bb_rayset rs = rayset_of(slices);
   bb_trace_options o;
   bb_trace_options_init(&o);
   o.threads = threads;
   bb_image vis;
+  bb_error err;
   cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_OK, "%s", err.message);
   bb_rayset_free(&rs);
   bb_pyramid_free(p);
   return vis;
 }
 
+/* Every texel's horizon in slice s and its opposite by one line sweep. */
+static void sweep_horizons(const bb_pyramid *p, const bb_rayset *rs, int s, int t, double bias,
+                           long long_line, float *along, float *opposite) {
+  const size_t texels = (size_t)p->width * (size_t)p->height;
+  float *sums = calloc(texels * (size_t)(1 + rs->basis_count), sizeof(float));
+  cr_assert(sums);
+  const bb__sweep_dir a = {rs, s, sums, along}, o = {rs, t, sums, opposite};
+  bb_error err;
+  cr_assert_eq(bb__sweep_lines(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &a,
+                               t >= 0 ? &o : NULL, bias, 2, long_line, &err),
+               BB_OK, "%s", err.message);
+  free(sums);
+}
+
+/* The three ways to a slice's horizon agree bit for bit: line sweeps (whole
+ * periodic lines, lines cut in chunks whose far texels are marched, clamped
+ * lines), the max-mip march and the brute-force DDA, on odd and non-square
+ * sizes, with and without bias, for 16 and 20 slices. */
+Test(trace, sweeps_march_and_brute_force_find_the_same_horizons) {
+  const int sizes[][2] = {{1, 1}, {5, 3}, {17, 17}, {40, 23}, {64, 64}};
+  rng_state = 4242;
+  long compared = 0, positive = 0;
+  for (int a = 0; a < 2; a++)
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++)
+      for (int kind = 0; kind < 3; kind++) {
+        bb_image z = random_field(sizes[si][0], sizes[si][1], 3.0f + 20.0f * (float)kind, kind);
+        bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
+        bb_rayset rs = rayset_of(si % 2 ? 20 : 16);
+        const double bias = kind == 1 ? 0.0 : 0.55;
+        const long long_line = si % 2 ? 0 : 7; /* cut periodic lines into 7-step chunks */
+        const size_t texels = (size_t)z.width * (size_t)z.height;
+        float *along = malloc(texels * sizeof(float)), *opposite = malloc(texels * sizeof(float));
+        for (int s = 0; s < rs.slice_count; s++) {
+          int t = -1; /* its opposite, swept along with it */
+          for (int u = 0; u < rs.slice_count; u++)
+            if (rs.slice_step[2 * u] == -rs.slice_step[2 * s] &&
+                rs.slice_step[2 * u + 1] == -rs.slice_step[2 * s + 1])
+              t = u;
+          sweep_horizons(p, &rs, s, t, bias, long_line, along, opposite);
+          const int steps[2][2] = {{rs.slice_step[2 * s], rs.slice_step[2 * s + 1]},
+                                   {-rs.slice_step[2 * s], -rs.slice_step[2 * s + 1]}};
+          for (int side = 0; side < (t >= 0 ? 2 : 1); side++)
+            for (size_t i = 0; i < texels; i += 1 + texels / 700) {
+              const int x = (int)(i % (size_t)z.width), y = (int)(i / (size_t)z.width);
+              const float swept = side ? opposite[i] : along[i];
+              const float marched = bb__slice_horizon(p, x, y, bias, steps[side][0], steps[side][1]);
+              const float brute = bb__slice_horizon_brute(p, x, y, bias, steps[side][0], steps[side][1]);
+              cr_assert(swept == marched && marched == brute,
+                        "%dx%d %s kind %d, step (%d, %d), texel (%d, %d): sweep %.9g, march %.9g, "
+                        "brute force %.9g",
+                        z.width, z.height, a ? "clamp" : "periodic", kind, steps[side][0],
+                        steps[side][1], x, y, (double)swept, (double)marched, (double)brute);
+              compared++;
+              positive += swept > 0.0f;
+            }
+        }
+        free(along);
+        free(opposite);
+        bb_rayset_free(&rs);
+        bb_pyramid_free(p);
+        bb_image_free(&z);
+      }
+  cr_assert(positive > compared / 4 && positive < compared, "%ld positive of %ld", positive, compared);
+}
+
 Test(trace, flat_field_is_fully_visible) {
   bb_image z;
   cr_assert_eq(bb_image_alloc(&z, 9, 7, 1, NULL), BB_OK);
-  bb_image vis = trace_field(&z, BB_ADDRESS_PERIODIC, 0, 256);
-  cr_assert_eq(vis.channels, 4);
-  for (int i = 0; i < 9 * 7 * 4; i++) cr_assert_eq(vis.pixels[i], 1.0f);
-  bb_image_free(&vis);
+  for (int a = 0; a < 2; a++) {
+    bb_image vis = trace_field(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC, 0, 16);
+    cr_assert_eq(vis.channels, 4);
+    for (int i = 0; i < 9 * 7 * 4; i++) cr_assert_eq(vis.pixels[i], 1.0f);
+    bb_image_free(&vis);
+  }
   bb_image_free(&z);
 }
 
 Test(trace, bit_identical_for_any_thread_count) {
   rng_state = 77;
   bb_image z = random_field(45, 38, 16.0f, 2);
-  bb_image v1 = trace_field(&z, BB_ADDRESS_PERIODIC, 1, 100);
-  bb_image v2 = trace_field(&z, BB_ADDRESS_PERIODIC, 2, 100);
-  bb_image v3 = trace_field(&z, BB_ADDRESS_PERIODIC, 3, 100);
+  bb_image v1 = trace_field(&z, BB_ADDRESS_PERIODIC, 1, 10);
+  bb_image v2 = trace_field(&z, BB_ADDRESS_PERIODIC, 2, 10);
+  bb_image v3 = trace_field(&z, BB_ADDRESS_PERIODIC, 3, 10);
   size_t bytes = (size_t)45 * 38 * 4 * sizeof(float);
   cr_assert_eq(memcmp(v1.pixels, v2.pixels, bytes), 0);
   cr_assert_eq(memcmp(v1.pixels, v3.pixels, bytes), 0);
@@ -253,7 +346,7 @@ Test(trace, bit_identical_for_any_thread_count) {
   bb_image_free(&z);
 }
 
-/* The same ray set from every texel makes the trace a pure function of the
+/* The same slices from every texel make the trace a pure function of the
  * neighbourhood: shifting the periodic input shifts the output exactly. */
 Test(trace, periodic_shift_shifts_the_output_exactly) {
   rng_state = 99;
@@ -263,8 +356,8 @@ Test(trace, periodic_shift_shifts_the_output_exactly) {
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++)
       shifted.pixels[((y + sy) % h) * w + (x + sx) % w] = z.pixels[y * w + x];
-  bb_image a = trace_field(&z, BB_ADDRESS_PERIODIC, 0, 64);
-  bb_image b = trace_field(&shifted, BB_ADDRESS_PERIODIC, 0, 64);
+  bb_image a = trace_field(&z, BB_ADDRESS_PERIODIC, 0, 8);
+  bb_image b = trace_field(&shifted, BB_ADDRESS_PERIODIC, 0, 8);
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++)
       for (int c = 0; c < 4; c++)
@@ -276,12 +369,11 @@ Test(trace, periodic_shift_shifts_the_output_exactly) {
   bb_image_free(&z);
 }
 
-Test(trace, rejects_negative_bias) {
+Test(trace, rejects_negative_bias_and_a_region_outside) {
   bb_image z;
   cr_assert_eq(bb_image_alloc(&z, 4, 4, 1, NULL), BB_OK);
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
-  bb_rayset rs;
-  cr_assert_eq(bb_rayset_make(16, 1.0, BB_BASIS_HL2, &rs, NULL), BB_OK);
+  bb_rayset rs = rayset_of(4);
   bb_trace_options o;
   bb_trace_options_init(&o);
   o.bias_texels = -1.0;
@@ -289,48 +381,53 @@ Test(trace, rejects_negative_bias) {
   bb_error err;
   cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "bias") != NULL);
+  o.bias_texels = 0.55;
+  o.region = (bb_region){2, 1, 3, 2};
+  cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert(strstr(err.message, "region") != NULL, "%s", err.message);
   bb_rayset_free(&rs);
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
 
-/* The batch trace by line sweeps and through direction bands must give, bit
- * for bit, what the square-node march gives (which the tests above tie to
- * brute force), in both addressing modes, on odd and non-square sizes, with
- * ray sets of one batch of slices (144 rays: 12) and of two (400 rays: 20). */
-Test(trace, sweeps_and_bands_equal_square_march) {
-  const int sizes[][2] = {{1, 1}, {5, 3}, {17, 17}, {40, 23}, {64, 64}};
-  rng_state = 4242;
+/* The whole trace by line sweeps, the same by marches texel by texel, and
+ * a region of it by marches give the same bits, in both addressing modes. */
+Test(trace, sweeps_marches_and_regions_trace_the_same_bits) {
+  const int sizes[][2] = {{1, 1}, {5, 3}, {17, 17}, {40, 23}};
+  rng_state = 31337;
   for (int a = 0; a < 2; a++)
-    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++)
-      for (int kind = 0; kind < 3; kind++) {
-        bb_image z = random_field(sizes[si][0], sizes[si][1], 3.0f + 20.0f * (float)kind, kind);
-        bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
-        bb_rayset rs;
-        cr_assert_eq(bb_rayset_make(si % 2 ? 400 : 144, 1.0, BB_BASIS_HL2_Z, &rs, NULL), BB_OK);
-        bb_trace_options o;
-        bb_trace_options_init(&o);
-        o.bias_texels = kind == 1 ? 0.0 : 0.55;
-        bb_image sweeps, bands, square;
-        bb_error err;
-        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SWEEP, &sweeps, &err), BB_OK,
-                     "%s", err.message);
-        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_BANDS, &bands, &err), BB_OK,
-                     "%s", err.message);
-        cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SQUARE, &square, &err), BB_OK,
-                     "%s", err.message);
-        size_t n = (size_t)z.width * (size_t)z.height * 5;
-        for (size_t i = 0; i < n; i++) {
-          cr_assert_eq(bands.pixels[i], square.pixels[i], "bands: %dx%d %s kind %d: texel %zu channel %zu",
-                       z.width, z.height, a ? "clamp" : "periodic", kind, i / 5, i % 5);
-          cr_assert_eq(sweeps.pixels[i], square.pixels[i], "sweeps: %dx%d %s kind %d: texel %zu channel %zu",
-                       z.width, z.height, a ? "clamp" : "periodic", kind, i / 5, i % 5);
-        }
-        bb_image_free(&sweeps);
-        bb_image_free(&bands);
-        bb_image_free(&square);
-        bb_rayset_free(&rs);
-        bb_pyramid_free(p);
-        bb_image_free(&z);
-      }
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++) {
+      bb_image z = random_field(sizes[si][0], sizes[si][1], 24.0f, (int)si % 3);
+      bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
+      bb_rayset rs = rayset_of(si % 2 ? 7 : 16);
+      bb_trace_options o;
+      bb_trace_options_init(&o);
+      bb_image sweeps, marches, region;
+      bb_error err;
+      cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SWEEP, &sweeps, &err), BB_OK, "%s",
+                   err.message);
+      cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_MARCH, &marches, &err), BB_OK, "%s",
+                   err.message);
+      const size_t n = (size_t)z.width * (size_t)z.height * 4;
+      for (size_t i = 0; i < n; i++)
+        cr_assert_eq(sweeps.pixels[i], marches.pixels[i], "%dx%d %s: texel %zu channel %zu",
+                     z.width, z.height, a ? "clamp" : "periodic", i / 4, i % 4);
+      o.region = (bb_region){z.width / 3, z.height / 2, z.width - z.width / 3, z.height - z.height / 2};
+      double found = 0;
+      cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &region, &found, &err), BB_OK, "%s", err.message);
+      cr_assert_eq(region.width, o.region.width);
+      cr_assert_eq(found, (double)o.region.width * o.region.height * rs.slice_count);
+      for (int y = 0; y < region.height; y++)
+        for (int x = 0; x < region.width; x++)
+          cr_assert_eq(memcmp(bb_image_texel(&region, x, y),
+                              bb_image_texel(&sweeps, x + o.region.x0, y + o.region.y0),
+                              4 * sizeof(float)),
+                       0, "region texel (%d, %d)", x, y);
+      bb_image_free(&sweeps);
+      bb_image_free(&marches);
+      bb_image_free(&region);
+      bb_rayset_free(&rs);
+      bb_pyramid_free(p);
+      bb_image_free(&z);
+    }
 }

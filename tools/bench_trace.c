@@ -1,31 +1,26 @@
-/* bench_trace.c: times the batch trace, the per-ray max-mip march and the brute-force
- * twin on one map.
+/* bench_trace.c: times the batch trace (line sweeps), the per-texel
+ * max-mip horizon march and its brute-force twin on one map, and checks that
+ * they agree.
  *
- *   bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--peer-ao FILE]
- *   bench_trace --dump-dirs FILE RAYS
+ *   bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--slices A]
+ *               [--clamp]
  *
- * The first form prepares the map as a bake does (bb_height_load, the default
- * bilateral smoothing, times SCALE, max-mip pyramid, ray set of power 1 on the
- * HL2 basis), times bb_trace_occlusion on THREADS threads, then traces every
- * ray of the set from N deterministic texels (default 2000) one ray at a time,
- * once with bb_ray_occluded_brute and once with bb_ray_occluded, on one thread.
- * A timing under 10 s is repeated to three runs and the median is reported.
- * Prints one JSON line on stdout and a human summary on stderr; exits 1 when
- * the brute-force and max-mip answers disagree on any ray (a benchmark that
- * disagrees is measuring a bug), 2 on a bad command line.
- *
- * With --peer-ao FILE nothing is timed: the subset is traced once by the
- * max-mip march and the ao the Embree peer (valve-embree) would compute from
- * those answers, sum of unblocked d.z over sum of d.z, is compared with FILE,
- * the peer's ao of the same (filtered) map, ray set and bias. This separates
- * "the tracers disagree about a ray" from "the estimators weight rays
- * differently". Prints one JSON line; exits 0 whatever the differences.
- *
- * The second form writes the ray set's unit directions, one "x y z" per line,
- * so another tracer can be run on exactly the same rays.
+ * Prepares the map as a bake does (bb_height_load, the default bilateral
+ * smoothing, times SCALE, max-mip pyramid, round(sqrt(RAYS)) slices of power
+ * 1 on the HL2 basis, or A slices), times bb_trace_occlusion on THREADS
+ * threads, then finds every slice's horizon at N deterministic texels
+ * (default 2000) one at a time on one thread, once by the max-mip march and
+ * once by brute force, and traces each of those texels alone as a one-texel
+ * region (by marches) to compare with the whole trace. A timing under 10 s
+ * is repeated to three runs and the median is reported. Prints one JSON
+ * line on stdout and a human summary on stderr; exits 1 when the march and
+ * brute force disagree on any horizon or a region differs from the whole
+ * trace in any bit (a benchmark that disagrees is measuring a bug), 2 on a
+ * bad command line.
  */
 #include "bumpbake.h"
 #include "cli_json.h"
+#include "trace_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -38,32 +33,21 @@
 #define DEFAULT_SUBSET 2000
 #define REPEAT_UNDER_SECONDS 10.0 /* a timing shorter than this is taken 3 times */
 #define MAX_RUNS 3
-#define PEER_AO_TOLERANCE 1e-5 /* one flipped ray moves the peer's ao by >= ~1e-3 */
 
 typedef struct args {
   const char *map;
   double scale;
-  int rays, threads, subset;
+  int rays, slices, threads, subset;
   double bias;
-  const char *peer_ao; /* --peer-ao FILE, or NULL */
+  bb_addressing addressing;
 } args;
 
 /* Everything prepared once and shared by the timed sections. */
 typedef struct field {
-  bb_image height;   /* normalised h as loaded */
-  bb_image filtered; /* after the default bilateral smoothing */
-  bb_image z;        /* heights in texels: scale * filtered */
+  bb_image height, filtered, z;
   bb_pyramid *pyramid;
   bb_rayset rs;
-  double seconds_load, seconds_smooth, seconds_pyramid;
 } field;
-
-/* The per-ray pass over the subset: texel coordinates and one answer per ray. */
-typedef struct subset {
-  int count;
-  int *x, *y;
-  unsigned char *blocked; /* count * ray_count answers, texel-major */
-} subset;
 
 static double now_seconds(void) {
   struct timespec ts;
@@ -74,9 +58,8 @@ static double now_seconds(void) {
 static int usage(const char *reason) {
   fprintf(stderr,
           "bench_trace: %s\n"
-          "usage: bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--peer-ao "
-          "FILE]\n"
-          "       bench_trace --dump-dirs FILE RAYS\n",
+          "usage: bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--slices A] "
+          "[--clamp]\n",
           reason);
   return 2;
 }
@@ -87,47 +70,42 @@ static int parse_int(const char *s, int lo, int hi, int *out) {
   char *end;
   errno = 0;
   long v = strtol(s, &end, 10);
-  if (errno || end == s || *end || v < lo || v > hi)
-    return 1;
+  if (errno || end == s || *end || v < lo || v > hi) return 1;
   *out = (int)v;
   return 0;
 }
 
-static int parse_positive(const char *s, double *out) {
+static int parse_nonnegative(const char *s, double *out) {
   char *end;
   errno = 0;
   double v = strtod(s, &end);
-  if (errno || end == s || *end || !isfinite(v) || v < 0.0)
-    return 1;
+  if (errno || end == s || *end || !isfinite(v) || v < 0.0) return 1;
   *out = v;
   return 0;
 }
 
 /* Returns 0 and fills a, or a usage exit code. */
 static int parse_args(int argc, char **argv, args *a) {
-  if (argc < 5)
-    return usage("wrong number of arguments");
-  a->map = argv[1];
-  a->subset = DEFAULT_SUBSET;
-  a->bias = 0.55;
-  a->peer_ao = NULL;
-  if (parse_positive(argv[2], &a->scale) || !(a->scale > 0.0))
+  if (argc < 5) return usage("wrong number of arguments");
+  *a = (args){.map = argv[1], .subset = DEFAULT_SUBSET, .bias = 0.55};
+  if (parse_nonnegative(argv[2], &a->scale) || !(a->scale > 0.0))
     return usage("SCALE must be a number > 0");
-  if (parse_int(argv[3], 1, 65536, &a->rays))
-    return usage("RAYS must be 1..65536");
-  if (parse_int(argv[4], 1, 4096, &a->threads))
-    return usage("THREADS must be 1..4096");
-  for (int i = 5; i < argc; i += 2) {
-    if (i + 1 >= argc)
-      return usage("option without a value");
-    if (!strcmp(argv[i], "--subset")) {
-      if (parse_int(argv[i + 1], 0, 1 << 24, &a->subset))
-        return usage("--subset must be 0..16777216");
-    } else if (!strcmp(argv[i], "--bias")) {
-      if (parse_positive(argv[i + 1], &a->bias))
-        return usage("--bias must be >= 0");
-    } else if (!strcmp(argv[i], "--peer-ao")) {
-      a->peer_ao = argv[i + 1];
+  if (parse_int(argv[3], 1, 65536, &a->rays)) return usage("RAYS must be 1..65536");
+  if (parse_int(argv[4], 1, 4096, &a->threads)) return usage("THREADS must be 1..4096");
+  a->slices = bb_slices_for_rays(a->rays);
+  for (int i = 5; i < argc; i++) {
+    if (!strcmp(argv[i], "--clamp")) {
+      a->addressing = BB_ADDRESS_CLAMP;
+      continue;
+    }
+    if (i + 1 >= argc) return usage("option without a value");
+    const char *v = argv[++i];
+    if (!strcmp(argv[i - 1], "--subset")) {
+      if (parse_int(v, 0, 1 << 24, &a->subset)) return usage("--subset must be 0..16777216");
+    } else if (!strcmp(argv[i - 1], "--bias")) {
+      if (parse_nonnegative(v, &a->bias)) return usage("--bias must be >= 0");
+    } else if (!strcmp(argv[i - 1], "--slices")) {
+      if (parse_int(v, 1, BB_MAX_SLICES, &a->slices)) return usage("--slices must be 1..256");
     } else {
       return usage("unknown option");
     }
@@ -150,12 +128,10 @@ static double median_seconds(timed_fn f, void *ctx, int *runs) {
   double t[MAX_RUNS];
   t[0] = f(ctx);
   *runs = 1;
-  if (t[0] < 0.0 || t[0] >= REPEAT_UNDER_SECONDS)
-    return t[0];
+  if (t[0] < 0.0 || t[0] >= REPEAT_UNDER_SECONDS) return t[0];
   for (; *runs < MAX_RUNS; (*runs)++) {
     t[*runs] = f(ctx);
-    if (t[*runs] < 0.0)
-      return t[*runs];
+    if (t[*runs] < 0.0) return t[*runs];
   }
   qsort(t, MAX_RUNS, sizeof t[0], compare_doubles);
   return t[MAX_RUNS / 2];
@@ -163,32 +139,21 @@ static double median_seconds(timed_fn f, void *ctx, int *runs) {
 
 /* ----------------------------------------------------------- preparing */
 
-/* Load -> smooth -> scale -> pyramid -> ray set, as bb_bake does them. */
+/* Load -> smooth -> scale -> pyramid -> slices, as bb_bake does them. */
 static bb_status prepare(const args *a, field *f, bb_error *err) {
-  double t0 = now_seconds();
   bb_status st = bb_height_load(a->map, BB_CHANNEL_AUTO, &f->height, err);
-  double t1 = now_seconds();
-  f->seconds_load = t1 - t0;
-  if (st != BB_OK)
-    return st;
+  if (st != BB_OK) return st;
   bb_smooth_options so;
   bb_smooth_options_init(&so);
+  so.addressing = a->addressing;
   st = bb_smooth_bilateral(&f->height, &f->height, &so, &f->filtered, err);
-  double t2 = now_seconds();
-  f->seconds_smooth = t2 - t1;
-  if (st == BB_OK)
-    st = bb_image_alloc(&f->z, f->filtered.width, f->filtered.height, 1, err);
-  if (st != BB_OK)
-    return st;
-  /* float times float, exactly as the bake scales its heights */
-  const float scale = (float)a->scale;
+  if (st == BB_OK) st = bb_image_alloc(&f->z, f->filtered.width, f->filtered.height, 1, err);
+  if (st != BB_OK) return st;
+  const float scale = (float)a->scale; /* float times float, exactly as the bake scales */
   const size_t n = (size_t)f->z.width * (size_t)f->z.height;
-  for (size_t i = 0; i < n; i++)
-    f->z.pixels[i] = scale * f->filtered.pixels[i];
-  st = bb_pyramid_build(&f->z, BB_ADDRESS_PERIODIC, &f->pyramid, err);
-  if (st == BB_OK)
-    st = bb_rayset_make(a->rays, 1.0, BB_BASIS_HL2, &f->rs, err);
-  f->seconds_pyramid = now_seconds() - t2;
+  for (size_t i = 0; i < n; i++) f->z.pixels[i] = scale * f->filtered.pixels[i];
+  st = bb_pyramid_build(&f->z, a->addressing, &f->pyramid, err);
+  if (st == BB_OK) st = bb_rayset_make(a->slices, 1.0, BB_BASIS_HL2, &f->rs, err);
   return st;
 }
 
@@ -206,7 +171,7 @@ typedef struct trace_run {
   const field *f;
   bb_trace_options options;
   bb_image vis; /* the last run's result */
-  double rays_traced;
+  double horizons;
   bb_error err;
 } trace_run;
 
@@ -214,8 +179,8 @@ static double run_trace(void *ctx) {
   trace_run *r = ctx;
   bb_image_free(&r->vis);
   double t0 = now_seconds();
-  bb_status st = bb_trace_occlusion(r->f->pyramid, &r->f->rs, &r->options, &r->vis,
-                                    &r->rays_traced, &r->err);
+  bb_status st =
+      bb_trace_occlusion(r->f->pyramid, &r->f->rs, &r->options, &r->vis, &r->horizons, &r->err);
   double t = now_seconds() - t0;
   return st == BB_OK ? t : -1.0;
 }
@@ -225,13 +190,18 @@ static double run_trace(void *ctx) {
 /* Texels spread evenly and deterministically over the map: the 2D R2
  * low-discrepancy sequence (additive recurrence on the plastic number), which
  * covers the map without the rows or columns a regular stride would favour. */
-static int subset_make(subset *s, int count, int width, int height, int rays) {
+typedef struct subset {
+  int count;
+  int *x, *y;
+  float *horizon; /* count * slices */
+} subset;
+
+static int subset_make(subset *s, int count, int width, int height, int slices) {
   s->count = count;
   s->x = malloc((size_t)(count ? count : 1) * sizeof(int));
   s->y = malloc((size_t)(count ? count : 1) * sizeof(int));
-  s->blocked = malloc((size_t)(count ? count : 1) * (size_t)rays);
-  if (!s->x || !s->y || !s->blocked)
-    return 1;
+  s->horizon = malloc((size_t)(count ? count : 1) * (size_t)slices * sizeof(float));
+  if (!s->x || !s->y || !s->horizon) return 1;
   const double g = 1.32471795724474602596, a1 = 1.0 / g, a2 = 1.0 / (g * g);
   for (int i = 0; i < count; i++) {
     double u = fmod(0.5 + a1 * (i + 1), 1.0), v = fmod(0.5 + a2 * (i + 1), 1.0);
@@ -244,78 +214,61 @@ static int subset_make(subset *s, int count, int width, int height, int rays) {
 static void subset_free(subset *s) {
   free(s->x);
   free(s->y);
-  free(s->blocked);
+  free(s->horizon);
 }
 
-typedef int (*occluded_fn)(const bb_pyramid *p, const bb_ray *ray);
+typedef float (*horizon_fn)(const bb_pyramid *p, int x, int y, double bias, int a, int b);
 
 typedef struct subset_run {
   const field *f;
   subset *s;
   double bias;
-  occluded_fn occluded;
+  horizon_fn horizon;
 } subset_run;
 
-/* Every ray of the set from every subset texel, one call per ray. */
+/* Every slice's horizon at every subset texel, one call each. */
 static double run_subset(void *ctx) {
   subset_run *r = ctx;
   const bb_rayset *rs = &r->f->rs;
   double t0 = now_seconds();
-  for (int i = 0; i < r->s->count; i++) {
-    bb_ray ray;
-    ray.origin[0] = r->s->x[i];
-    ray.origin[1] = r->s->y[i];
-    ray.origin[2] = (double)*bb_image_texel(&r->f->z, r->s->x[i], r->s->y[i]) + r->bias;
-    unsigned char *out = r->s->blocked + (size_t)i * (size_t)rs->ray_count;
-    for (int k = 0; k < rs->ray_count; k++) {
-      memcpy(ray.direction, rs->direction + 3 * (size_t)k, sizeof ray.direction);
-      out[k] = (unsigned char)r->occluded(r->f->pyramid, &ray);
-    }
-  }
+  for (int i = 0; i < r->s->count; i++)
+    for (int k = 0; k < rs->slice_count; k++)
+      r->s->horizon[(size_t)i * (size_t)rs->slice_count + (size_t)k] =
+          r->horizon(r->f->pyramid, r->s->x[i], r->s->y[i], r->bias, rs->slice_step[2 * k],
+                     rs->slice_step[2 * k + 1]);
   return now_seconds() - t0;
 }
 
-/* Rays answered differently by the two passes. */
-static long count_disagreements(const subset *a, const subset *b, int rays) {
+static long count_disagreements(const subset *a, const subset *b, int slices) {
   long n = 0;
-  for (size_t i = 0; i < (size_t)a->count * (size_t)rays; i++)
-    n += a->blocked[i] != b->blocked[i];
+  for (size_t i = 0; i < (size_t)a->count * (size_t)slices; i++) n += a->horizon[i] != b->horizon[i];
   return n;
 }
 
-static long count_blocked(const subset *s, int rays) {
+/* Subset texels whose one-texel region trace differs in any bit from the
+ * whole trace's. */
+static long region_mismatches(const field *f, const subset *s, const bb_trace_options *o,
+                              const bb_image *whole) {
   long n = 0;
-  for (size_t i = 0; i < (size_t)s->count * (size_t)rays; i++)
-    n += s->blocked[i];
-  return n;
-}
-
-/* Largest |ao| difference at the subset texels between the batch trace and
- * the ao rebuilt from the per-ray answers (information: both should agree to
- * float rounding unless a ray grazes a breakpoint). */
-static double ao_max_difference(const subset *s, const bb_rayset *rs,
-                                const bb_image *vis) {
-  double worst = 0.0;
+  bb_trace_options one = *o;
+  one.threads = 1;
   for (int i = 0; i < s->count; i++) {
-    const unsigned char *b = s->blocked + (size_t)i * (size_t)rs->ray_count;
-    double sum = 0.0;
-    for (int k = 0; k < rs->ray_count; k++)
-      if (!b[k])
-        sum += rs->weight_ao[k];
-    double ao = rs->total_ao > 0.0 ? sum / rs->total_ao : 1.0;
-    double d = fabs(ao - (double)*bb_image_texel(vis, s->x[i], s->y[i]));
-    if (d > worst)
-      worst = d;
+    one.region = (bb_region){s->x[i], s->y[i], 1, 1};
+    bb_image vis = {0};
+    if (bb_trace_occlusion(f->pyramid, &f->rs, &one, &vis, NULL, NULL) != BB_OK) return -1;
+    n += memcmp(vis.pixels, bb_image_texel(whole, s->x[i], s->y[i]),
+                (size_t)vis.channels * sizeof(float)) != 0;
+    bb_image_free(&vis);
   }
-  return worst;
+  return n;
 }
 
 /* ------------------------------------------------------------- output */
 
 typedef struct results {
-  double trace_s, brute_s, maxmip_s, ao_diff;
-  int trace_runs, brute_runs, maxmip_runs;
-  long subset_rays, blocked, disagreements;
+  double trace_s, brute_s, march_s;
+  int trace_runs, brute_runs, march_runs;
+  long subset_horizons, positive, disagreements, mismatches;
   long maxrss_kib;
 } results;
 
@@ -323,172 +276,94 @@ static double per_second(double work, double seconds) {
   return seconds > 0.0 ? work / seconds : 0.0;
 }
 
-static void print_json(const args *a, const field *f, const trace_run *t,
-                       const results *r) {
-  const double subset_rays = (double)r->subset_rays;
-  const double trace_rate = per_second(t->rays_traced, r->trace_s);
-  const double brute_rate = per_second(subset_rays, r->brute_s);
+static void print_json(const args *a, const field *f, const trace_run *t, const results *r) {
   printf("{\"map\":");
   cli_json_quoted(stdout, a->map);
-  printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"threads\":%d,"
-         "\"bias\":%g,",
-         f->z.width, f->z.height, a->scale, a->rays, a->threads, a->bias);
-  printf("\"load_s\":%.6f,\"smooth_s\":%.6f,\"pyramid_s\":%.6f,", f->seconds_load,
-         f->seconds_smooth, f->seconds_pyramid);
-  printf(
-      "\"trace_s\":%.6f,\"trace_runs\":%d,\"trace_rays\":%.0f,\"trace_rays_per_s\":%.6g,",
-      r->trace_s, r->trace_runs, t->rays_traced, trace_rate);
-  printf("\"subset_texels\":%d,\"subset_rays\":%ld,\"subset_threads\":1,", a->subset,
-         r->subset_rays);
-  printf("\"brute_s\":%.6f,\"brute_runs\":%d,\"brute_rays_per_s\":%.6g,", r->brute_s,
-         r->brute_runs, brute_rate);
-  printf("\"maxmip_s\":%.6f,\"maxmip_runs\":%d,\"maxmip_rays_per_s\":%.6g,", r->maxmip_s,
-         r->maxmip_runs, per_second(subset_rays, r->maxmip_s));
-  printf("\"trace_over_brute\":%.6g,\"blocked_fraction\":%.6g,\"disagreements\":%ld,",
-         brute_rate > 0.0 ? trace_rate / brute_rate : 0.0,
-         r->subset_rays ? (double)r->blocked / subset_rays : 0.0, r->disagreements);
-  printf("\"trace_ao_max_diff\":%.3g,\"maxrss_kib\":%ld}\n", r->ao_diff, r->maxrss_kib);
+  printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"slices\":%d,\"threads\":%d,"
+         "\"addressing\":\"%s\",\"bias\":%g,\"rayset\":",
+         f->z.width, f->z.height, a->scale, a->rays, f->rs.slice_count, a->threads,
+         a->addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a->bias);
+  cli_json_quoted(stdout, f->rs.id);
+  printf(",\"trace_s\":%.6f,\"trace_runs\":%d,\"horizons\":%.0f,\"horizons_per_s\":%.6g,"
+         "\"subset_texels\":%d,\"subset_horizons\":%ld,\"positive_fraction\":%.6g,"
+         "\"march_s\":%.6f,\"march_runs\":%d,\"march_horizons_per_s\":%.6g,"
+         "\"brute_s\":%.6f,\"brute_runs\":%d,\"brute_horizons_per_s\":%.6g,"
+         "\"trace_over_brute\":%.6g,\"disagreements\":%ld,\"region_mismatches\":%ld,"
+         "\"maxrss_kib\":%ld}\n",
+         r->trace_s, r->trace_runs, t->horizons, per_second(t->horizons, r->trace_s), a->subset,
+         r->subset_horizons,
+         r->subset_horizons ? (double)r->positive / (double)r->subset_horizons : 0.0, r->march_s,
+         r->march_runs, per_second((double)r->subset_horizons, r->march_s), r->brute_s,
+         r->brute_runs, per_second((double)r->subset_horizons, r->brute_s),
+         per_second(t->horizons, r->trace_s) /
+             (r->brute_s > 0 ? (double)r->subset_horizons / r->brute_s : 1.0),
+         r->disagreements, r->mismatches, r->maxrss_kib);
 }
 
-static void print_human(const args *a, const field *f, const trace_run *t,
-                        const results *r) {
+static void print_human(const field *f, const trace_run *t, const results *r) {
   fprintf(stderr,
-          "bench_trace: %s %dx%d scale %g, %d rays, %d thread(s): trace %.3f s (median "
-          "of %d) "
-          "= %.1f Mrays/s",
-          a->map, f->z.width, f->z.height, a->scale, a->rays, a->threads, r->trace_s,
-          r->trace_runs, per_second(t->rays_traced, r->trace_s) / 1e6);
-  if (r->subset_rays)
-    fprintf(stderr,
-            "; subset %d texels: brute %.2f Mrays/s, per-ray max-mip %.2f Mrays/s, "
-            "%.1f%% blocked, %ld disagreements",
-            a->subset, per_second((double)r->subset_rays, r->brute_s) / 1e6,
-            per_second((double)r->subset_rays, r->maxmip_s) / 1e6,
-            100.0 * (double)r->blocked / (double)r->subset_rays, r->disagreements);
-  fprintf(stderr, "; peak RSS %.1f MiB\n", (double)r->maxrss_kib / 1024.0);
+          "bench_trace: %dx%d, %d slices: trace %.3f s (median of %d), %.1f M horizons/s; "
+          "march %.3f M/s, brute force %.3f M/s over %ld horizons; %ld disagreements, %ld "
+          "region mismatches\n",
+          f->z.width, f->z.height, f->rs.slice_count, r->trace_s, r->trace_runs,
+          per_second(t->horizons, r->trace_s) / 1e6,
+          per_second((double)r->subset_horizons, r->march_s) / 1e6,
+          per_second((double)r->subset_horizons, r->brute_s) / 1e6, r->subset_horizons,
+          r->disagreements, r->mismatches);
 }
 
-/* ------------------------------------------------- agreement with the peer */
+/* ---------------------------------------------------------------- main */
 
-/* The peer's ao at subset texel i from our answers: unblocked d.z / all d.z. */
-static double peer_style_ao(const subset *s, const bb_rayset *rs, int i) {
-  const unsigned char *b = s->blocked + (size_t)i * (size_t)rs->ray_count;
-  double open = 0.0, all = 0.0;
-  for (int k = 0; k < rs->ray_count; k++) {
-    const double dz = rs->direction[3 * (size_t)k + 2];
-    all += dz;
-    if (!b[k])
-      open += dz;
-  }
-  return all > 0.0 ? open / all : 1.0;
-}
-
-/* Traces the subset once and compares the peer-style ao with the peer's file. */
-static int peer_agreement(const args *a, const field *f) {
-  bb_image peer = {0};
-  bb_error err = {{0}};
-  if (bb_image_read(a->peer_ao, &peer, NULL, &err) != BB_OK) {
-    fprintf(stderr, "bench_trace: %s\n", err.message);
-    return 1;
-  }
-  int rc = 0;
-  subset s = {0};
-  if (peer.width != f->z.width || peer.height != f->z.height || peer.channels != 1) {
-    fprintf(stderr, "bench_trace: %s is %dx%d with %d channel(s), the map %dx%d\n",
-            a->peer_ao, peer.width, peer.height, peer.channels, f->z.width, f->z.height);
-    rc = 1;
-  } else if (subset_make(&s, a->subset, f->z.width, f->z.height, f->rs.ray_count)) {
-    fprintf(stderr, "bench_trace: out of memory for the subset\n");
-    rc = 1;
-  } else {
-    subset_run run = {f, &s, a->bias, bb_ray_occluded};
-    run_subset(&run);
-    double worst = 0.0, sum = 0.0;
-    int over = 0;
-    for (int i = 0; i < s.count; i++) {
-      double d = fabs(peer_style_ao(&s, &f->rs, i) -
-                      (double)*bb_image_texel(&peer, s.x[i], s.y[i]));
-      sum += d;
-      if (d > worst)
-        worst = d;
-      over += d > PEER_AO_TOLERANCE;
-    }
-    printf("{\"peer_ao\":");
-    cli_json_quoted(stdout, a->peer_ao);
-    printf(",\"subset_texels\":%d,\"mean_abs\":%.3g,\"max_abs\":%.3g,\"tolerance\":%g,"
-           "\"texels_over\":%d}\n",
-           s.count, s.count ? sum / s.count : 0.0, worst, PEER_AO_TOLERANCE, over);
-    fprintf(
-        stderr,
-        "bench_trace: peer-style ao from bumpbake's per-ray answers vs %s at %d texels: "
-        "max |d| %.3g, %d texel(s) over %g\n",
-        a->peer_ao, s.count, worst, over, PEER_AO_TOLERANCE);
-  }
-  subset_free(&s);
-  bb_image_free(&peer);
-  return rc;
-}
-
-/* ------------------------------------------------------------ the runs */
-
-/* Brute force and per-ray max-mip over the subset; fills r. Returns 0 or 1. */
-static int bench_subset(const args *a, const field *f, const bb_image *vis, results *r) {
-  subset brute = {0}, maxmip = {0};
-  int fail = subset_make(&brute, a->subset, f->z.width, f->z.height, f->rs.ray_count) ||
-             subset_make(&maxmip, a->subset, f->z.width, f->z.height, f->rs.ray_count);
-  if (fail) {
-    fprintf(stderr, "bench_trace: out of memory for the subset\n");
-  } else {
-    subset_run rb = {f, &brute, a->bias, bb_ray_occluded_brute};
-    subset_run rm = {f, &maxmip, a->bias, bb_ray_occluded};
+static int bench_subset(const args *a, const field *f, const trace_run *t, results *r) {
+  subset march = {0}, brute = {0};
+  const int slices = f->rs.slice_count;
+  int fail = subset_make(&march, a->subset, f->z.width, f->z.height, slices) ||
+             subset_make(&brute, a->subset, f->z.width, f->z.height, slices);
+  if (!fail) {
+    subset_run rm = {f, &march, a->bias, bb__slice_horizon};
+    subset_run rb = {f, &brute, a->bias, bb__slice_horizon_brute};
+    r->march_s = median_seconds(run_subset, &rm, &r->march_runs);
     r->brute_s = median_seconds(run_subset, &rb, &r->brute_runs);
-    r->maxmip_s = median_seconds(run_subset, &rm, &r->maxmip_runs);
-    r->subset_rays = (long)a->subset * f->rs.ray_count;
-    r->blocked = count_blocked(&brute, f->rs.ray_count);
-    r->disagreements = count_disagreements(&brute, &maxmip, f->rs.ray_count);
-    r->ao_diff = ao_max_difference(&maxmip, &f->rs, vis);
+    r->subset_horizons = (long)a->subset * slices;
+    r->disagreements = count_disagreements(&march, &brute, slices);
+    for (long i = 0; i < r->subset_horizons; i++) r->positive += march.horizon[i] > 0.0f;
+    r->mismatches = region_mismatches(f, &march, &t->options, &t->vis);
+    fail = r->mismatches < 0;
   }
+  subset_free(&march);
   subset_free(&brute);
-  subset_free(&maxmip);
   return fail;
 }
 
 static int bench(const args *a) {
   field f = {0};
   bb_error err = {{0}};
-  int rc = 0;
   if (prepare(a, &f, &err) != BB_OK) {
     fprintf(stderr, "bench_trace: %s\n", err.message);
     field_free(&f);
     return 1;
   }
-  if (a->peer_ao) {
-    rc = peer_agreement(a, &f);
-    field_free(&f);
-    return rc;
-  }
   trace_run t = {.f = &f};
   bb_trace_options_init(&t.options);
-  t.options.bias_texels = a->bias;
   t.options.threads = a->threads;
+  t.options.bias_texels = a->bias;
   results r = {0};
   r.trace_s = median_seconds(run_trace, &t, &r.trace_runs);
+  int rc = 0;
   if (r.trace_s < 0.0) {
     fprintf(stderr, "bench_trace: %s\n", t.err.message);
     rc = 1;
-  }
-  if (!rc && a->subset > 0)
-    rc = bench_subset(a, &f, &t.vis, &r);
-  if (!rc) {
+  } else if (bench_subset(a, &f, &t, &r)) {
+    fprintf(stderr, "bench_trace: out of memory for the subset\n");
+    rc = 1;
+  } else {
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     r.maxrss_kib = ru.ru_maxrss;
     print_json(a, &f, &t, &r);
-    print_human(a, &f, &t, &r);
-    if (r.disagreements) {
-      fprintf(stderr,
-              "bench_trace: brute force and max-mip disagree on %ld of %ld rays\n",
-              r.disagreements, r.subset_rays);
+    print_human(&f, &t, &r);
+    if (r.disagreements || r.mismatches) {
+      fprintf(stderr, "bench_trace: the march, brute force and the sweeps disagree\n");
       rc = 1;
     }
   }
@@ -497,39 +372,7 @@ static int bench(const args *a) {
   return rc;
 }
 
-/* --dump-dirs FILE RAYS */
-static int dump_dirs(const char *path, const char *rays_text) {
-  int rays;
-  if (parse_int(rays_text, 1, 65536, &rays))
-    return usage("RAYS must be 1..65536");
-  bb_rayset rs;
-  bb_error err = {{0}};
-  if (bb_rayset_make(rays, 1.0, BB_BASIS_HL2, &rs, &err) != BB_OK) {
-    fprintf(stderr, "bench_trace: %s\n", err.message);
-    return 1;
-  }
-  FILE *fp = fopen(path, "w");
-  int rc = fp ? 0 : 1;
-  if (fp) {
-    fprintf(fp, "# bumpbake ray set %s: %d unit directions x y z\n", rs.id, rs.ray_count);
-    for (int k = 0; k < rs.ray_count; k++) {
-      const double *d = rs.direction + 3 * (size_t)k;
-      fprintf(fp, "%.17g %.17g %.17g\n", d[0], d[1], d[2]);
-    }
-    rc = fclose(fp) != 0;
-  }
-  if (rc)
-    fprintf(stderr, "bench_trace: cannot write %s: %s\n", path, strerror(errno));
-  bb_rayset_free(&rs);
-  return rc;
-}
-
 int main(int argc, char **argv) {
-  if (argc >= 2 && !strcmp(argv[1], "--dump-dirs")) {
-    if (argc != 4)
-      return usage("--dump-dirs takes FILE RAYS");
-    return dump_dirs(argv[2], argv[3]);
-  }
   args a;
   int rc = parse_args(argc, argv, &a);
   return rc ? rc : bench(&a);
