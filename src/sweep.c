@@ -497,7 +497,7 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
 
 /* Lines per work item: neighbouring lines write neighbouring texels, so a
  * bundle of them fills whole cache lines of the sums on one thread. */
-enum { BUNDLE = 8 };
+enum { BUNDLE = 64 };
 
 /* One line (or chunk) of the list, with buffers sized for the longest. */
 static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
