@@ -65,6 +65,13 @@ static const cli_option opt_out_filtered = {.id = CLI_OPT_OUT_FILTERED,
                                             .long_name = "filtered",
                                             .value_name = "FILE",
                                             .help = "write the smoothed height"};
+static const cli_option opt_slices = {
+    .id = CLI_OPT_SLICES,
+    .long_name = "slices",
+    .value_name = "A",
+    .default_text = "from --rays",
+    .range_text = "1..256",
+    .help = "azimuth slices, each integrated exactly above its horizon (overrides --rays)"};
 static const cli_option opt_json = {
     .id = CLI_OPT_JSON,
     .long_name = "json",
@@ -77,6 +84,7 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
 static const cli_option *const bake_options[] = {
     &cli_opt_scale,
     &cli_opt_rays,
+    &opt_slices,
     &cli_opt_filter_radius,
     &cli_opt_filter_threshold,
     &cli_opt_bias,
@@ -140,6 +148,9 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_QUIET:
     a->quiet = 1;
     return 0;
+  case CLI_OPT_SLICES:
+    return cli_parse_int(bake_command.name, "--slices", arg, 1, BB_MAX_SLICES,
+                         &a->settings.bake.slices);
   default:
     break;
   }

@@ -36,7 +36,7 @@ const cli_option cli_opt_rays = {.id = CLI_OPT_RAYS,
                                  .long_name = "rays",
                                  .value_name = "N",
                                  .range_text = "1..65536",
-                                 .help = "rays traced per texel"};
+                                 .help = "ray budget, as Valve's -r: round(sqrt(N)) azimuth slices"};
 const cli_option cli_opt_filter_radius = {
     .id = CLI_OPT_FILTER_RADIUS,
     .long_name = "filter-radius",

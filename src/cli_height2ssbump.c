@@ -14,7 +14,7 @@ static const cli_option opt_rays = {.id = CLI_OPT_RAYS,
                                     .short_name = 'r',
                                     .value_name = "N",
                                     .range_text = "1..65536",
-                                    .help = "rays traced per texel"};
+                                    .help = "ray budget: round(sqrt(N)) azimuth slices"};
 static const cli_option opt_radius = {
     .id = CLI_OPT_FILTER_RADIUS,
     .short_name = 'f',

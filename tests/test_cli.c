@@ -719,6 +719,27 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
   cli_result_free(&r);
 }
 
+/* --slices overrides --rays, is recorded in the JSON and the ray-set id,
+ * and is checked like any number. */
+Test(cli, bake_slices_option) {
+  const char *in = tmp("flat.png");
+  write_image(in, 8, 8, 1, mid_grey);
+  cli_result r = RUN("bake", in, "--scale", "4", "--rays", "16", "--slices", "7", "--ao",
+                     tmp("ao.png"), "--json");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "\"slices\":7,\"rayset\":\"bb-horizon-v1:a7:"), "%s", r.out);
+  cr_expect(strstr(r.out, "\"horizons\":448"), "8x8 texels x 7 slices: %s", r.out);
+  cli_result_free(&r);
+  const char *bad[] = {"0", "257", "3.5", "x"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    r = RUN("bake", in, "--scale", "4", "--slices", bad[i], "--ao", tmp("bad.png"));
+    cr_expect_eq(r.code, 2, "--slices %s: exit %d", bad[i], r.code);
+    cr_expect(strstr(r.err, "--slices"), "--slices %s: %s", bad[i], r.err);
+    cr_expect(!file_exists(tmp("bad.png")));
+    cli_result_free(&r);
+  }
+}
+
 /* ------------------------------------------------------------ height2ssbump */
 
 /* Mid-grey colour with a height of 0.25 in alpha: RGB and alpha differ, so
