@@ -1,26 +1,36 @@
 #!/usr/bin/env bash
-# bench.sh BIN: times bumpbake's trace and whole bake against brute force and the Embree peer, with accuracy.
+# bench.sh BIN: times bumpbake's trace and whole bake against brute force and the Embree
+# peer, measures accuracy against converged references, and large sizes.
 #
 #   tools/bench.sh build/bumpbake        (make bench runs it after make all)
 #
 # Sections: 1 trace benchmark (build/tools/bench_trace), 2 the peer
 # (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
-# 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy against the peer,
-# 6 start-up (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and
-# linked to libbumpbake.so), then a summary table. Everything it writes goes into build/bench/.
+# 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy
+# against converged references (the peer at 16384 rays, and bumpbake's own
+# dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps,
+# 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
+# (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
+# libbumpbake.so), then a summary table. Everything it writes goes into
+# build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
 # and the median is reported, otherwise it is run once; each figure says
 # which. bench_trace applies the same rule inside, to each part it times.
+# The peer's 16384-ray references take minutes; they are kept in
+# build/bench/accuracy/ and reused while newer than the peer and the map.
 #
 # Environment, for quick runs on small maps (defaults are the real bench):
 #   BENCH_ROCK=PATH        rock height map (fixtures/rock06_height.png)
+#   BENCH_LAVA=PATH        lava height map (lava01_height.png beside rock06)
 #   BENCH_NOISE_SIZE=N     side of the genheight noise map (1024)
-#   BENCH_SUBSET=N         texels of the brute-force subset (2000)
+#   BENCH_SUBSET=N         texels of the per-texel march / brute-force subset (2000)
 #   BENCH_PEER_DIR=DIR     valve-embree sources (../shared/peers/valve-embree)
+#   BENCH_LARGE=0          skip section 6 (4096 and 8192 texels square)
+#   BENCH_ACCURACY=0       skip section 5
 #
 # Exits 0 whatever the ratios and whether or not the peer could be built;
-# exits 1 when bumpbake itself fails or brute force and max-mip disagree.
+# exits 1 when bumpbake itself fails or its paths disagree on a horizon.
 set -euo pipefail
 
 bin=${1:?usage: tools/bench.sh path/to/bumpbake}
@@ -32,10 +42,11 @@ out=build/bench
 mkdir -p "$out"
 
 rays=256 bias=0.55 threads=2 repeat_under=10
+acc_size=256 acc_rock_scale=32 acc_noise_scale=16 acc_ref_rays=16384
 rock_scale=128 noise_scale=64
 noise_size=${BENCH_NOISE_SIZE:-1024}
 subset=${BENCH_SUBSET:-2000}
-target_trace=3 target_whole=10 target_brute=20
+target_trace=3 target_whole=20 target_brute=20
 failures=() # bumpbake-side failures: they make the bench exit 1
 peer_ok=0 peer_reason="not tried"
 start_all=$(date +%s.%N)
@@ -138,17 +149,19 @@ mib() { calc "$1 / 1024" '%.0f'; }
 
 # ------------------------------------------------------------------- inputs
 
-find_rock() {
-  local input=${BENCH_ROCK:-fixtures/rock06_height.png} alt
-  # the shared copy beside the checkout (or beside the worktrees), as demo.sh
+# find_fixture NAME [OVERRIDE]: fixtures/NAME, or the shared copy beside the
+# checkout (or beside the worktrees), as demo.sh.
+find_fixture() {
+  local input=${2:-fixtures/$1} alt
   for alt in ../shared/fixtures ../../shared/fixtures; do
-    [ -f "$input" ] || input=$alt/rock06_height.png
+    [ -f "$input" ] || input=$alt/$1
   done
-  [ -f "$input" ] || { echo "bench: rock06_height.png not found" >&2; exit 1; }
+  [ -f "$input" ] || { echo "bench: $1 not found" >&2; return 1; }
   printf '%s' "$input"
 }
 
-rock=$(find_rock)
+rock=$(find_fixture rock06_height.png "${BENCH_ROCK:-}") || exit 1
+lava=$(find_fixture lava01_height.png "${BENCH_LAVA:-}") || lava=""
 noise=$out/noise${noise_size}.png
 "$tools/genheight" noise "$noise_size" "$noise_size" "$noise"
 maps=(rock noise)
@@ -160,8 +173,8 @@ echo "commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown), $(date -
 echo "machine: $(nproc) cores, $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1)," \
   "load average $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "maps: rock = $rock (scale $rock_scale), noise = $noise (genheight noise, scale $noise_scale)"
-echo "rays $rays per texel, bias $bias; a figure is the median of 3 runs when a run takes" \
-  "under ${repeat_under} s, else 1 run"
+echo "rays $rays per texel ($(( $(printf '%.0f' "$(calc "sqrt($rays)" %.3f)") )) slices), bias $bias;" \
+  "a figure is the median of 3 runs when a run takes under ${repeat_under} s, else 1 run"
 
 # ---------------------------------------------------------- 1. trace bench
 
@@ -177,30 +190,34 @@ trace_bench() {
 # trace_row MAP THREADS: one line of the trace table.
 trace_row() {
   local j=$out/trace_${1}_t$2.json
-  printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %8s %6s\n' "$1" \
+  printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %9s %6s\n' "$1" \
     "$(json_num width "$j")" "$2" "$(calc "$(json_num trace_s "$j")")" \
-    "($(json_num trace_runs "$j"))" "$(calc "$(json_num trace_rays_per_s "$j") / 1e6" %.2f)" \
-    "$(calc "$(json_num brute_rays_per_s "$j") / 1e6" %.3f)" \
-    "$(calc "$(json_num maxmip_rays_per_s "$j") / 1e6" %.3f)" \
-    "$(calc "$(json_num trace_over_brute "$j")" %.1f)" \
-    "$(calc "$(json_num blocked_fraction "$j") * 100" %.1f)%" \
-    "$(json_num disagreements "$j")" "$(mib "$(json_num maxrss_kib "$j")")"
+    "($(json_num trace_runs "$j"))" "$(calc "$(json_num horizons_per_s "$j") / 1e6" %.2f)" \
+    "$(calc "$(json_num march_horizons_per_s "$j") / 1e6" %.3f)" \
+    "$(calc "$(json_num brute_horizons_per_s "$j") / 1e6" %.3f)" \
+    "$(calc "$(json_num trace_over_brute "$j")" %.0f)" \
+    "$(calc "$(json_num positive_fraction "$j") * 100" %.1f)%" \
+    "$(json_num disagreements "$j")/$(json_num region_mismatches "$j")" \
+    "$(mib "$(json_num maxrss_kib "$j")")"
 }
 
 section "1. Trace benchmark (build/tools/bench_trace)"
-echo "bb_trace_occlusion over every texel; then $subset texels x $rays rays one ray at a time" \
-  "on 1 thread, by brute force (bb_ray_occluded_brute) and by the max-mip march (bb_ray_occluded)."
+echo "bb_trace_occlusion (line sweeps) over every texel; then every slice's horizon at $subset texels"
+echo "one at a time on 1 thread, by the max-mip march and by brute force, and each of those texels"
+echo "traced alone as a one-texel region (marches), compared bit for bit with the whole trace."
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do trace_bench "$m" "$t"; done
 done
 echo
-printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %8s %6s\n' map size thr trace_s runs \
-  Mrays/s brute_M/s maxmip_M/s tr/brute blocked disagree MiB
+printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %9s %6s\n' map size thr trace_s runs \
+  Mhor/s march_M/s brute_M/s tr/brute horizon diff/reg MiB
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do trace_row "$m" "$t"; done
 done
-echo "(trace_s: median over 'runs' runs; Mrays/s = texels x rays / trace_s; tr/brute = trace" \
-  "rays/s over brute-force rays/s; MiB = peak RSS of the process)"
+echo "(trace_s: median over 'runs' runs; Mhor/s = texels x slices / trace_s; tr/brute = trace"
+echo "horizons/s over brute-force horizons/s; horizon = share of positive horizons; diff/reg ="
+echo "march vs brute-force disagreements / region texels differing from the whole trace, both 0"
+echo "when the paths agree; MiB = peak RSS of the process)"
 
 # ----------------------------------------------------------------- 2. peer
 
@@ -251,22 +268,22 @@ build_peer() {
   fi
 }
 
-# peer_run MAP: the peer on bumpbake's filtered MAP with bumpbake's rays.
+# peer_run MAP: the peer's whole run on bumpbake's filtered MAP, its own ray
+# set (Fibonacci, uniform in solid angle) of the same count.
 peer_run() {
   local m=$1
   measure "peer_$m" "$peer" "$out/${m}_filtered.exr" --scale "${map_scale[$m]}" --rays "$rays" \
-    --bias "$bias" --threads "$threads" --dirs "$out/dirs_$rays.txt" \
+    --bias "$bias" --threads "$threads" \
     --ao "$out/${m}_peer_ao.exr" --ssbump "$out/${m}_peer_ssbump.exr"
 }
 
-# Filtered heights for the peer. For rock the same bake also writes the float
-# ao and ssbump that section 5 compares with the peer's.
+# Filtered heights for the peer, which does not smooth.
 make_filtered() {
-  "$tools/bench_trace" --dump-dirs "$out/dirs_$rays.txt" "$rays" || return 1
-  "$bin" bake "$rock" --scale "$rock_scale" --rays "$rays" --bias "$bias" --threads "$threads" \
-    -q --filtered "$out/rock_filtered.exr" --ao "$out/rock_ao.exr" \
-    --ssbump "$out/rock_ssbump.exr" || return 1
-  "$bin" bake "$noise" --scale "$noise_scale" -q --filtered "$out/noise_filtered.exr"
+  local m
+  for m in "${maps[@]}"; do
+    "$bin" bake "${map_path[$m]}" --scale "${map_scale[$m]}" -q \
+      --filtered "$out/${m}_filtered.exr" || return 1
+  done
 }
 
 peer_row() {
@@ -286,7 +303,7 @@ if [ "$peer_ok" = 1 ]; then
 fi
 if [ "$peer_ok" = 1 ]; then
   echo "input: bumpbake's filtered height (bake --filtered, radius 10), since the peer does not"
-  echo "smooth; rays: bumpbake's ray set via --dirs $out/dirs_$rays.txt; $threads threads"
+  echo "smooth; $rays rays of its own set (uniform in solid angle); $threads threads"
   for m in "${maps[@]}"; do
     if ! peer_run "$m"; then
       peer_ok=0 peer_reason="the peer failed on ${m}_filtered.exr (see $out/peer_$m.1.err)"
@@ -371,9 +388,8 @@ fi
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do
     j=$out/trace_${m}_t$t.json
-    add_ratio "trace rays/s / brute-force rays/s, $m ($t thr)" \
-      "$(ratio "$(json_num trace_rays_per_s "$j")" "$(json_num brute_rays_per_s "$j")")" \
-      "$target_brute"
+    add_ratio "trace horizons/s / brute-force horizons/s, $m ($t thr)" \
+      "$(calc "$(json_num trace_over_brute "$j")" %.0f)" "$target_brute"
   done
 done
 printf '%-50s %8s   %-7s %s\n' ratio value target ""
@@ -383,64 +399,154 @@ echo "(brute force runs on 1 thread; the $threads-thread ratio includes the para
 
 # ------------------------------------------------------------- 5. accuracy
 
-# imgstats_rows KIND: per-channel rows of bumpbake's vs the peer's rock KIND,
-# the peer tracing its own ray set (see below).
-imgstats_rows() {
-  local kind=$1 j=$out/accuracy_$1.json c=0
-  if ! "$tools/imgstats" "$out/rock_$kind.exr" "$out/rock_peer_own_$kind.exr" >"$j" 2>/dev/null; then
-    echo "$kind: imgstats failed"
-    return
-  fi
-  # one {"mean_abs":..,"p99_abs":..,"max_abs":..} per channel
-  sed 's/.*"channels":\[//; s/\]}$//; s/},{/}\n{/g' "$j" | while IFS= read -r ch; do
-    printf '%s\n' "$ch" >"$out/accuracy_ch.json"
-    printf '%-7s %3d %10s %10s %10s\n' "$kind" "$c" \
-      "$(calc "$(json_num mean_abs "$out/accuracy_ch.json")" %.5f)" \
-      "$(calc "$(json_num p99_abs "$out/accuracy_ch.json")" %.5f)" \
-      "$(calc "$(json_num max_abs "$out/accuracy_ch.json")" %.5f)"
-    c=$((c + 1))
+acc=$out/accuracy
+acc_ok=0
+acc_rows=()
+
+# acc_maps: the 256 x 256 maps, as NAME:PATH:SCALE words.
+acc_maps() {
+  mkdir -p "$acc"
+  local words=() m src
+  for m in rock lava; do
+    src=$rock
+    [ "$m" = lava ] && src=$lava
+    [ -n "$src" ] || continue
+    [ -f "$acc/$m.png" ] && [ "$acc/$m.png" -nt "$src" ] ||
+      oiiotool "$src" --resize "${acc_size}x${acc_size}" -d uint16 -o "$acc/$m.png" ||
+      continue
+    words+=("$m:$acc/$m.png:$acc_rock_scale")
   done
+  "$tools/genheight" noise "$acc_size" "$acc_size" "$acc/noise.png" &&
+    words+=("noise:$acc/noise.png:$acc_noise_scale")
+  printf '%s\n' "${words[@]}"
 }
 
-section "5. Accuracy vs the peer: rock, scale $rock_scale, same filtered map and rays"
-# Each tool with its own ray set, so each estimator is the consistent one: the
-# peer's weights (d.z, max(0, B.d)) assume directions uniform in solid angle,
-# which its default Fibonacci set is and bumpbake's cosine slices are not.
-peer_own_ok=0
-if [ "$peer_ok" = 1 ] && "$peer" "$out/rock_filtered.exr" --scale "$rock_scale" --rays "$rays" \
-  --bias "$bias" --threads "$threads" --ao "$out/rock_peer_own_ao.exr" \
-  --ssbump "$out/rock_peer_own_ssbump.exr" >"$out/peer_own.out" 2>"$out/peer_own.err"; then
-  peer_own_ok=1
-fi
-if [ "$peer_own_ok" = 1 ]; then
-  own_trace=$(json_num trace_s "$out/peer_own.out")
-  echo "peer with its own ray set (uniform in solid angle, so more grazing rays): trace" \
-    "$(calc "$own_trace") s, build $(calc "$(json_num build_s "$out/peer_own.out")") s;" \
-    "its trace / bumpbake's (rock, $threads thr): $(ratio "$own_trace" "$(json_num trace_s "$out/trace_rock_t$threads.json")")"
-  printf '%-7s %3s %10s %10s %10s\n' image ch mean_abs p99_abs max_abs
-  imgstats_rows ao
-  imgstats_rows ssbump
-  echo "(bumpbake's float EXRs vs the peer's with its own $rays-ray Fibonacci set; |difference|"
-  echo "per channel over every texel: the two differ in ray set, and the peer's mesh stops one"
-  echo "tile out while bumpbake's rays wrap as far as they need)"
-  echo "Ray by ray, the peer's ao formula fed bumpbake's per-ray answers (bench_trace --peer-ao)"
-  echo "against the peer run on bumpbake's own directions (section 2):"
-  if "$tools/bench_trace" "$rock" "$rock_scale" "$rays" 1 --subset "$subset" --bias "$bias" \
-    --peer-ao "$out/rock_peer_ao.exr" >"$out/accuracy_rays.json" 2>/dev/null; then
-    a=$out/accuracy_rays.json
-    echo "  at $(json_num subset_texels "$a") texels: mean |d| $(json_num mean_abs "$a")," \
-      "max |d| $(json_num max_abs "$a"), $(json_num texels_over "$a") texel(s) over" \
-      "$(json_num tolerance "$a") (one ray flipped moves ao by ~1e-3)"
-  else
-    echo "  bench_trace --peer-ao failed"
-  fi
+# acc_stats RUN REFNAME AO SS REFAO REFSS: "|e| bias" of ao and each ssbump
+# channel, from imgstats, as 8 numbers.
+acc_stats() {
+  local a s
+  a=$("$tools/imgstats" "$1" "$3" 2>/dev/null) || return 1
+  s=$("$tools/imgstats" "$2" "$4" 2>/dev/null) || return 1
+  printf '%s\n%s\n' "$a" "$s" | sed 's/.*"channels":\[//; s/\]}$//; s/},{/}\n{/g' |
+    sed 's/.*"mean":\([^,]*\),"mean_abs":\([^,]*\),.*/\2 \1/' | tr '\n' ' '
+}
+
+# acc_row MAP RUN REF NUMBERS...: one line of the accuracy table
+acc_row() {
+  local m=$1 r=$2 ref=$3
+  shift 3
+  local line
+  line=$(printf '%-6s %-11s %-9s' "$m" "$r" "$ref")
+  while [ $# -ge 2 ]; do
+    line+=$(printf ' %8s %9s' "$(calc "$1" %.5f)" "$(calc "$2" %+.5f)")
+    shift 2
+  done
+  acc_rows+=("$line")
+  printf '%s\n' "$line"
+}
+
+section "5. Accuracy against converged references (256 x 256 maps)"
+if [ "${BENCH_ACCURACY:-1}" = 0 ]; then
+  echo "skipped (BENCH_ACCURACY=0)"
+elif ! command -v oiiotool >/dev/null; then
+  echo "skipped: oiiotool (openimageio-tools) is needed to downsample the maps"
 else
-  echo "peer: not available (${peer_reason:-its run with its own ray set failed})"
+  echo "rock06 and lava01 downsampled to ${acc_size} x ${acc_size} (oiiotool --resize) at scale" \
+    "$acc_rock_scale, genheight noise at scale $acc_noise_scale; no smoothing (--filter-radius 0)," \
+    "bias $bias, Valve's normal (--normal-filter valve) on both sides. References:"
+  echo "  peer16k = the peer (Valve's method on Embree) with $acc_ref_rays uniform rays per texel;"
+  echo "  dense   = build/tools/accuracy_ref: bb_ray_horizon in 2048 azimuths at every 4th texel"
+  echo "            of every 4th row, integrated in elevation in closed form."
+  echo "Each pair of columns is mean |error| and bias (signed mean of run - reference)."
+  printf '%-6s %-11s %-9s' map run reference
+  for c in ao ss0 ss1 ss2; do printf ' %8s %9s' "$c|e|" "bias"; done
+  echo
+  while IFS=: read -r m path scale; do
+    [ -n "$m" ] || continue
+    runs=()
+    for n in 64 256 1024; do
+      "$bin" bake "$path" --scale "$scale" --rays "$n" --filter-radius 0 --normal-filter valve \
+        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_bb$n.ao.exr" \
+        --ssbump "$acc/${m}_bb$n.ss.exr" || { fail "bumpbake bake $path --rays $n"; continue; }
+      runs+=("bb$n")
+    done
+    if [ "$peer_ok" = 1 ]; then
+      "$peer" "$path" --scale "$scale" --rays 256 --bias "$bias" --threads "$threads" \
+        --ao "$acc/${m}_peer256.ao.exr" --ssbump "$acc/${m}_peer256.ss.exr" >/dev/null 2>&1 &&
+        runs+=(peer256)
+      ref="$acc/${m}_peer16k"
+      if ! { [ -f "$ref.ss.exr" ] && [ "$ref.ss.exr" -nt "$peer" ] && [ "$ref.ss.exr" -nt "$path" ]; }; then
+        "$peer" "$path" --scale "$scale" --rays "$acc_ref_rays" --bias "$bias" --threads "$threads" \
+          --ao "$ref.ao.exr" --ssbump "$ref.ss.exr" >"$acc/${m}_peer16k.json" 2>&1 ||
+          rm -f "$ref.ao.exr" "$ref.ss.exr"
+      fi
+      if [ -f "$ref.ss.exr" ]; then
+        for r in "${runs[@]}"; do
+          nums=$(acc_stats "$acc/${m}_$r.ao.exr" "$acc/${m}_$r.ss.exr" "$ref.ao.exr" "$ref.ss.exr") &&
+            acc_row "$m" "$r" peer16k $nums
+        done
+      fi
+    fi
+    compare=()
+    for r in "${runs[@]}"; do compare+=("$r=$acc/${m}_$r.ao.exr,$acc/${m}_$r.ss.exr"); done
+    [ -f "$acc/${m}_peer16k.ss.exr" ] && compare+=("peer16k=$acc/${m}_peer16k.ao.exr,$acc/${m}_peer16k.ss.exr")
+    if "$tools/accuracy_ref" "$path" "$scale" --bias "$bias" "${compare[@]}" \
+      >"$acc/${m}_dense.json" 2>/dev/null; then
+      acc_ok=1
+      while IFS= read -r res; do
+        name=$(printf '%s' "$res" | sed 's/.*"name":"\([^"]*\)".*/\1/')
+        nums=$(printf '%s' "$res" | grep -o '"mean":[^,]*,"mean_abs":[^}]*' |
+          sed 's/"mean":\([^,]*\),"mean_abs":\(.*\)/\2 \1/' | tr '\n' ' ')
+        acc_row "$m" "$name" dense $nums
+      done < <(sed 's/.*"results":\[//; s/\]}$//; s/}\]},{/}]}\n{/g' "$acc/${m}_dense.json")
+    else
+      fail "accuracy_ref on $path"
+    fi
+  done < <(acc_maps)
 fi
 
-# ------------------------------------------------------------- 6. start-up
+# ---------------------------------------------------------- 6. large sizes
 
-section "6. Start-up: bumpbake --version, the CLI linked three ways"
+large_rows=()
+# large_run NAME INPUT: a whole bake (ssbump and ao as PNG) of INPUT, once
+large_run() {
+  measure "large_$1" "$bin" bake "$2" --scale "$rock_scale" --rays "$rays" --threads "$threads" \
+    --json -q --ssbump "$out/large_$1_ssbump.png" --ao "$out/large_$1_ao.png"
+}
+
+section "6. Large sizes: rock06 tiled, ssbump and ao, $threads threads"
+if [ "${BENCH_LARGE:-1}" = 0 ]; then
+  echo "skipped (BENCH_LARGE=0)"
+elif ! command -v oiiotool >/dev/null; then
+  echo "skipped: oiiotool (openimageio-tools) is needed to tile the map"
+else
+  echo "inputs: rock06 tiled n x n with oiiotool --mosaic into build/bench/ (kept, not committed)"
+  printf '%-6s %7s %9s %11s %9s %11s %8s\n' size texels trace_s "trace_ns/tx" wall_s "wall_ns/tx" MiB
+  for n in 1 4 8; do
+    size=$((1024 * n)) input=$rock
+    if [ "$n" != 1 ]; then
+      input=$out/rock_${n}x$n.png
+      if [ ! -f "$input" ] || [ "$input" -ot "$rock" ]; then
+        dups=()
+        for ((k = 1; k < n * n; k++)); do dups+=(--dup); done
+        oiiotool "$rock" "${dups[@]}" --mosaic "${n}x$n" -o "$input" || { echo "tiling failed"; continue; }
+      fi
+    fi
+    large_run "$size" "$input" || { fail "bumpbake bake of the ${size}^2 map"; continue; }
+    texels=$((size * size))
+    tr=$(med "large_$size" trace) wall=$(med "large_$size" @wall)
+    line=$(printf '%-6s %7s %9s %11s %9s %11s %8s' "$size" "$((texels / 1048576))M" "$(calc "$tr")" \
+      "$(calc "$tr * 1e9 / $texels" %.1f)" "$(calc "$wall")" "$(calc "$wall * 1e9 / $texels" %.1f)" \
+      "$(mib "$(med "large_$size" @rss)")")
+    large_rows+=("$line")
+    printf '%s\n' "$line"
+  done
+  echo "(ns/tx = nanoseconds per texel; MiB = peak RSS; each size $(runs_text large_1024) or 1 run)"
+fi
+
+# ------------------------------------------------------------- 7. start-up
+
+section "7. Start-up: bumpbake --version, the CLI linked three ways"
 echo "static: build/bumpbake as built (libbumpbake.a); early: the same with OpenImageIO's"
 echo "heaviest libraries named first (make EARLY_LINK=1); shared: linked to libbumpbake.so."
 startup_ok=0
@@ -466,14 +572,13 @@ summary_row figure value note
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do
     j=$out/trace_${m}_t$t.json
-    summary_row "bumpbake trace, $m, $t thr (Mrays/s)" \
-      "$(calc "$(json_num trace_rays_per_s "$j") / 1e6" %.2f)" \
-      "$(calc "$(json_num trace_s "$j")") s, runs $(json_num trace_runs "$j")"
+    summary_row "bumpbake trace, $m, $t thr (s)" "$(calc "$(json_num trace_s "$j")")" \
+      "$(calc "$(json_num horizons_per_s "$j") / 1e6" %.1f) M horizons/s, runs $(json_num trace_runs "$j")"
   done
   j=$out/trace_${m}_t1.json
-  summary_row "brute force, $m, 1 thr (Mrays/s)" \
-    "$(calc "$(json_num brute_rays_per_s "$j") / 1e6" %.3f)" \
-    "max-mip per ray $(calc "$(json_num maxmip_rays_per_s "$j") / 1e6" %.3f) Mrays/s, $(json_num disagreements "$j") disagreements"
+  summary_row "brute force, $m, 1 thr (M horizons/s)" \
+    "$(calc "$(json_num brute_horizons_per_s "$j") / 1e6" %.3f)" \
+    "march $(calc "$(json_num march_horizons_per_s "$j") / 1e6" %.3f) M/s, $(json_num disagreements "$j") disagreements"
   if [ "$peer_ok" = 1 ]; then
     summary_row "peer trace, $m, $threads thr (s)" "$(calc "$(med "peer_$m" trace_s)")" \
       "build $(calc "$(med "peer_$m" build_s)") s, $(runs_text "peer_$m")"
@@ -499,6 +604,18 @@ if [ "$startup_ok" = 1 ]; then
     summary_row "start-up, $variant (s)" "$(startup_field "$variant" 2)" \
       "x$(startup_field "$variant" 5) of static; $(startup_field "$variant" 6) M instructions"
   done
+fi
+if [ "${#acc_rows[@]}" -gt 0 ]; then
+  echo
+  printf '%-6s %-11s %-9s' map run reference
+  for c in ao ss0 ss1 ss2; do printf ' %8s %9s' "$c|e|" "bias"; done
+  echo
+  printf '%s\n' "${acc_rows[@]}"
+fi
+if [ "${#large_rows[@]}" -gt 0 ]; then
+  echo
+  printf '%-6s %7s %9s %11s %9s %11s %8s\n' size texels trace_s "trace_ns/tx" wall_s "wall_ns/tx" MiB
+  printf '%s\n' "${large_rows[@]}"
 fi
 echo
 printf '%-50s %8s   %-7s %s\n' ratio value target ""
