@@ -195,6 +195,28 @@ static inline int under_chord(const point *l, const point *t, double xu, double 
   return (t->z - l->z) * (xu - l->u) <= (xz - l->z) * (t->u - l->u);
 }
 
+/* The second pass of profile_fill, in place over its n points: returns how
+ * many stay. A point of step j lies in (j, j + 1]; j + 1 itself is a vertex
+ * (an origin) and may be the end of the step. */
+static int hull_filter(point *restrict pt, int n) {
+  int count = 0;
+  for (int q = 0; q < n; q++) {
+    const point x = pt[q];
+    const double vertex_u = (double)x.step; /* vertex j, the step's start */
+    while (count >= 2) {
+      const point *top = &pt[count - 1], *left = &pt[count - 2];
+      /* an interior point of this step, with its left from vertex j on; or
+       * vertex j itself, with its left from vertex j - 1 on */
+      const int allowed = top->u > vertex_u ? left->u >= vertex_u
+                                            : top->u == vertex_u && left->u >= vertex_u - 1.0;
+      if (!allowed || !under_chord(left, top, x.u, x.z)) break;
+      count--;
+    }
+    pt[count++] = x;
+  }
+  return count;
+}
+
 /* The points of steps first_step .. first_step + steps - 1 of the line whose
  * texel 0 is (x0, y0), without those that can never decide a horizon.
  *
@@ -202,12 +224,13 @@ static inline int under_chord(const point *l, const point *t, double xu, double 
  * long as no origin (a vertex) lies strictly between L and X but T itself:
  * from an origin outside [L, X] the farther of L, X on the side of T's
  * slope is at least as steep; from an origin at L (or X, looking back),
- * which sits at or above its vertex (bias >= 0), X (or L) is. So each step's
- * points (between vertices j and j + 1) are kept as the upper hull of the
- * step with its two vertices, and a vertex goes when it is under the chord
- * of its neighbours: a stack like the walks' hulls, whose pops never reach
- * across a vertex. About a third of the points stay on rough maps. The ends
- * are kept. */
+ * which sits at or above its vertex (bias >= 0), X (or L) is. Two passes
+ * drop such points: first every point under the chord of the points just
+ * before and after it (a convex kink; no branch, about half go), then, over
+ * what is left, a stack like the walks' hulls keeps each step (between
+ * vertices j and j + 1) as its upper hull, with a vertex going when it is
+ * under the chord of its neighbours: pops never reach across a vertex.
+ * About a third of the points stay on rough maps. The ends are kept. */
 static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   const bb_pyramid *p = job->p;
   const int tcount = job->point_count;
@@ -216,10 +239,12 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   double zs[4 * BB__MAX_LATTICE_STEP + 1];
   int bx = coordinate_at(p, (long)x0 + (long)pr->first_step * job->a, p->width);
   int by = coordinate_at(p, (long)y0 + (long)pr->first_step * job->b, p->height);
-  point *restrict out = pr->pt;
-  int count = 0;
   const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
   const int sa = periodic ? job->a % p->width : job->a, sb = periodic ? job->b % p->height : job->b;
+  point *restrict out = pr->pt;
+  int count = 0, seen = 0;
+  double ua = 0.0, za = 0.0; /* the kink window: a, then the pending point b */
+  point b = {0};
   for (int s = 0; s < pr->steps; s++, bx = step_along(p, bx, sa, p->width),
            by = step_along(p, by, sb, p->height)) {
     const int j = pr->first_step + s; /* texel of the line at the step's start */
@@ -241,29 +266,18 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
                                    field_z(p, bx + t->x2, by + t->y2), weight[k]);
       }
     }
-    /* Pops stay above `floor`, the index of vertex j (the last point of the
-     * step before; the profile's first point in its first step, an end that
-     * stays); vertex j itself may go while its left neighbour is from vertex
-     * j - 1 on, after which the floor is the point that took it. */
-    int floor = count > 0 ? count - 1 : 0;
-    int vertex_may_go = count >= 2 && out[count - 2].u >= (double)(j - 1);
+    /* first pass: b is kept when above the chord from a to the new point */
     const double ju = (double)j;
-    for (int k = 0; k < tcount; k++) {
-      const double xu = ju + frac[k], xz = zs[k];
-      while (count - 2 >= floor && under_chord(&out[count - 2], &out[count - 1], xu, xz)) count--;
-      if (vertex_may_go && count - 1 == floor && under_chord(&out[floor - 1], &out[floor], xu, xz)) {
-        count--;
-        floor = count;
-        vertex_may_go = 0;
-      }
-      out[count].u = xu;
-      out[count].z = xz;
-      out[count].step = j;
-      out[count].tp = k;
-      count++;
+    for (int k = 0; k < tcount; k++, seen++) {
+      const double u = ju + frac[k], z = zs[k];
+      out[count] = b;
+      count += seen == 1 || (seen > 1 && (b.z - za) * (u - ua) > (z - za) * (b.u - ua));
+      ua = b.u, za = b.z;
+      b = (point){u, z, j, k};
     }
   }
-  pr->count = count;
+  if (seen) out[count++] = b; /* the last point is an end */
+  pr->count = hull_filter(out, count);
 }
 
 /* ------------------------------------------------------------------ hulls */
