@@ -190,8 +190,10 @@ Test(cli_convert, ssbump2normal_of_an_unoccluded_bake) {
   const char *h = tmp("h.png"), *n = tmp("n.exr"), *s = tmp("s.exr");
   const char *ao = tmp("ao.exr"), *back = tmp("back.exr");
   write_height(h, 48, 32, 0.25);
-  cli_result r = RUN("bake", h, "--scale", "2", "--rays", "64", "--normal", n, "--ssbump",
-                     s, "--ao", ao, "-q");
+  /* exact horizons see any crest above the ray origin: a bias over the
+   * field's 1-texel relief leaves none */
+  cli_result r = RUN("bake", h, "--scale", "2", "--rays", "64", "--bias", "1.5", "--normal", n,
+                     "--ssbump", s, "--ao", ao, "-q");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   bb_image occlusion = harness_read(ao, NULL);
