@@ -248,7 +248,7 @@ def read(path):
         _lib.bb_image_info_free(info)
 
 
-def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, filter_radius=None,
+def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filter_radius=None,
          filter_threshold=None, bias=None, power=None, basis=None, normal_filter=None,
          normal_y=None, clamp=None, channel="auto", threads=None):
     """Bakes the maps named in outputs from a height array in one pass and
@@ -258,6 +258,10 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, filter_radius=Non
                         normal_y, clamp)
     if rays is not None:
         o.rays = _int_value("bake", "rays", rays)
+    if slices is not None:
+        o.slices = _int_value("bake", "slices", slices)
+        if o.slices == 0:
+            raise ArgumentError("bake: slices must be in 1..256 (got 0)", "bad argument")
     if bias is not None:
         o.trace.bias_texels = _cli_limit("bake", "bias", float(bias))
     if power is not None:
@@ -296,8 +300,10 @@ Parameters (as `bumpbake bake --help`; None keeps the library's default):
         value / max code.
     scale: texels of displacement per unit of height, > 0 (required).
     outputs (bake): names from {", ".join(OUTPUTS)}; default
-        {", ".join(DEFAULT_OUTPUTS)}. ssbump, ao and bent trace rays.
-    rays (bake): rays per texel, default {DEFAULTS["rays"]}, 1..65536.
+        {", ".join(DEFAULT_OUTPUTS)}. ssbump, ao and bent trace horizons.
+    rays (bake): ray budget, default {DEFAULTS["rays"]}, 1..65536: round(sqrt(rays))
+        azimuth slices, as Valve's tool counts rays.
+    slices (bake): azimuth slices, 1..256; overrides rays.
     filter_radius: bilateral smoothing radius in texels, default
         {DEFAULTS["filter_radius"]}, 0..4096, 0 = off.
     filter_threshold: smoothing range threshold, default

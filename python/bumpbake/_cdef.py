@@ -74,9 +74,14 @@ typedef enum bb_basis {
 
 typedef void (*bb_progress_fn)(void *user, long done, long total);
 
+typedef struct bb_region {
+  int x0, y0, width, height;
+} bb_region;
+
 typedef struct bb_trace_options {
   double bias_texels;
   int threads;
+  bb_region region;
   bb_progress_fn progress;
   void *progress_user;
 } bb_trace_options;
@@ -84,6 +89,7 @@ typedef struct bb_trace_options {
 typedef struct bb_bake_options {
   float height_scale;
   int rays;
+  int slices;
   bb_smooth_options smooth;
   bb_trace_options trace;
   double power;
@@ -102,7 +108,7 @@ typedef struct bb_bake_result {
   bb_image ao;
   bb_image bent;
   double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
-  double rays_traced;
+  double horizons_found;
   char rayset_id[64];
 } bb_bake_result;
 """

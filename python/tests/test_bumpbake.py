@@ -103,6 +103,17 @@ def test_same_bits_for_any_thread_count():
         np.testing.assert_array_equal(one[k], two[k])
 
 
+def test_slices_override_rays():
+    h = np.random.default_rng(3).random((24, 20), dtype=np.float32)
+    a = bumpbake.bake(h, 8, rays=49, outputs="ao")["ao"]  # round(sqrt(49)) = 7 slices
+    b = bumpbake.bake(h, 8, rays=1000, slices=7, outputs="ao")["ao"]
+    np.testing.assert_array_equal(a, b)
+    with pytest.raises(bumpbake.ArgumentError, match="slices must be in 1..256"):
+        bumpbake.bake(h, 8, slices=0, outputs="ao")
+    with pytest.raises(bumpbake.ArgumentError, match="slices must be in 1..256"):
+        bumpbake.bake(h, 8, slices=257, outputs="ao")
+
+
 def test_basis_hl2_z_adds_a_fourth_ssbump_channel():
     s = bumpbake.bake(np.zeros((8, 8)), 4, rays=16, basis="hl2+z", outputs="ssbump")["ssbump"]
     assert s.shape == (8, 8, 4)
