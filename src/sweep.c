@@ -190,47 +190,19 @@ static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
   return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step, n) : v + step;
 }
 
-/* Is t on or under the chord from l to (xu, xz) (l before t before x)? */
-static inline int under_chord(const point *l, const point *t, double xu, double xz) {
-  return (t->z - l->z) * (xu - l->u) <= (xz - l->z) * (t->u - l->u);
-}
-
-/* The second pass of profile_fill, in place over its n points: returns how
- * many stay. A point of step j lies in (j, j + 1]; j + 1 itself is a vertex
- * (an origin) and may be the end of the step. */
-static int hull_filter(point *restrict pt, int n) {
-  int count = 0;
-  for (int q = 0; q < n; q++) {
-    const point x = pt[q];
-    const double vertex_u = (double)x.step; /* vertex j, the step's start */
-    while (count >= 2) {
-      const point *top = &pt[count - 1], *left = &pt[count - 2];
-      /* an interior point of this step, with its left from vertex j on; or
-       * vertex j itself, with its left from vertex j - 1 on */
-      const int allowed = top->u > vertex_u ? left->u >= vertex_u
-                                            : top->u == vertex_u && left->u >= vertex_u - 1.0;
-      if (!allowed || !under_chord(left, top, x.u, x.z)) break;
-      count--;
-    }
-    pt[count++] = x;
-  }
-  return count;
-}
-
 /* The points of steps first_step .. first_step + steps - 1 of the line whose
  * texel 0 is (x0, y0), without those that can never decide a horizon.
  *
- * A point T on or under the chord of two points L < T < X never does, as
- * long as no origin (a vertex) lies strictly between L and X but T itself:
+ * A point T on or under the chord of its neighbours L < T < X never does:
  * from an origin outside [L, X] the farther of L, X on the side of T's
  * slope is at least as steep; from an origin at L (or X, looking back),
- * which sits at or above its vertex (bias >= 0), X (or L) is. Two passes
- * drop such points: first every point under the chord of the points just
- * before and after it (a convex kink; no branch, about half go), then, over
- * what is left, a stack like the walks' hulls keeps each step (between
- * vertices j and j + 1) as its upper hull, with a vertex going when it is
- * under the chord of its neighbours: pops never reach across a vertex.
- * About a third of the points stay on rough maps. The ends are kept. */
+ * which sits at or above its vertex (bias >= 0), X (or L) is. A run of such
+ * points lies under the chord of the points kept around it (the profile is
+ * convex along the run), so dropping them all at once is safe too. Half the
+ * points go on rough maps, without a branch. (Keeping only each step's
+ * upper hull drops a sixth more, but the stack that finds it branches on
+ * every point, unpredictably, and costs more than the walks save.) The ends
+ * are kept. */
 static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   const bb_pyramid *p = job->p;
   const int tcount = job->point_count;
@@ -266,7 +238,7 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
                                    field_z(p, bx + t->x2, by + t->y2), weight[k]);
       }
     }
-    /* first pass: b is kept when above the chord from a to the new point */
+    /* b is kept when above the chord from a to the new point */
     const double ju = (double)j;
     for (int k = 0; k < tcount; k++, seen++) {
       const double u = ju + frac[k], z = zs[k];
@@ -277,7 +249,7 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
     }
   }
   if (seen) out[count++] = b; /* the last point is an end */
-  pr->count = hull_filter(out, count);
+  pr->count = count;
 }
 
 /* ------------------------------------------------------------------ hulls */
