@@ -115,7 +115,14 @@ static const cli_command bake_command = {
     "bake",
     "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ...)",
     "Bakes the requested maps from HEIGHT in one pass; tracing runs only when\n"
-    "ssbump, ao or bent is asked for.",
+    "ssbump, ao or bent is asked for. Tracing finds each texel's exact horizon\n"
+    "in each azimuth slice and integrates the slice above it exactly; what is\n"
+    "left is azimuth sampling. Cost and mean |error| against converged truth\n"
+    "(rock06, 1024 x 1024 at scale 128, 2 busy cores; error on its 256 x 256 downsample):\n"
+    "  --rays 64    8 slices   trace ~1.0 s   ao 0.0015   ssbump 0.0030\n"
+    "  --rays 256  16 slices   trace ~1.8 s   ao 0.0004   ssbump 0.0010  (default)\n"
+    "  --rays 1024 32 slices   trace ~7.4 s   ao 0.0001   ssbump 0.0004\n"
+    "--clamp traces about twice as long; see the README, Performance and Accuracy.",
     bake_options,
     (int)(sizeof bake_options / sizeof bake_options[0]),
     cli_settings_init,
