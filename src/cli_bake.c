@@ -119,10 +119,12 @@ static const cli_command bake_command = {
     "in each azimuth slice and integrates the slice above it exactly; what is\n"
     "left is azimuth sampling. Cost and mean |error| against converged truth\n"
     "(rock06, 1024 x 1024 at scale 128, 2 busy cores; error on its 256 x 256 downsample):\n"
-    "  --rays 64    8 slices   trace ~1.0 s   ao 0.0015   ssbump 0.0030\n"
-    "  --rays 256  16 slices   trace ~1.8 s   ao 0.0004   ssbump 0.0010  (default)\n"
-    "  --rays 1024 32 slices   trace ~7.4 s   ao 0.0001   ssbump 0.0004\n"
-    "--clamp traces about twice as long; see the README, Performance and Accuracy.",
+    "  budget       slices   trace     ao      ssbump\n"
+    "  64 rays         8     ~1.0 s   0.0015   0.0030\n"
+    "  256 rays       16     ~1.8 s   0.0004   0.0010   (the default)\n"
+    "  1024 rays      32     ~7.4 s   0.0001   0.0004\n"
+    "With --clamp the trace takes about twice as long. See the README's\n"
+    "Performance and Accuracy.",
     bake_options,
     (int)(sizeof bake_options / sizeof bake_options[0]),
     cli_settings_init,
