@@ -38,6 +38,18 @@ static inline int bb__wrap_near(int i, int n) {
   return i;
 }
 
+/* Greatest common divisor of |a| and |b| (gcd(0, n) = |n|). */
+static inline long bb__gcd(long a, long b) {
+  a = a < 0 ? -a : a;
+  b = b < 0 ? -b : b;
+  while (b) {
+    const long r = a % b;
+    a = b;
+    b = r;
+  }
+  return a;
+}
+
 static inline int bb__clampi(int i, int lo, int hi) {
   return i < lo ? lo : (i > hi ? hi : i);
 }

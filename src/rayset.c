@@ -46,17 +46,6 @@ static bb_status allocate(bb_rayset *rs, bb_error *err) {
   return bb__fail(err, BB_ERR_MEMORY, "ray set: out of memory");
 }
 
-static int gcd(int a, int b) {
-  a = a < 0 ? -a : a;
-  b = b < 0 ? -b : b;
-  while (b) {
-    int r = a % b;
-    a = b;
-    b = r;
-  }
-  return a;
-}
-
 /* The smallest coprime lattice step (a, b) within tolerance of angle phi,
  * or failing that (never seen for up to 256 slices, whose steps stay under
  * 100) the closest with |a|, |b| <= BB__MAX_LATTICE_STEP. */
@@ -65,7 +54,7 @@ static void lattice_step(double phi, double tolerance, int step[2]) {
   for (int q = 1; q <= BB__MAX_LATTICE_STEP; q++)
     for (int a = -q; a <= q; a++)
       for (int b = -q; b <= q; b++) {
-        if ((abs(a) != q && abs(b) != q) || gcd(a, b) != 1) continue;
+        if ((abs(a) != q && abs(b) != q) || bb__gcd(a, b) != 1) continue;
         const double error = fabs(remainder(atan2(b, a) - phi, 2.0 * BB__PI));
         if (error < best) {
           best = error;

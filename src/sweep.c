@@ -573,17 +573,6 @@ static int clamped_lines(const bb_pyramid *p, int a, int b, items *it) {
   return 0;
 }
 
-static long gcd_long(long a, long b) {
-  a = a < 0 ? -a : a;
-  b = b < 0 ? -b : b;
-  while (b) {
-    const long r = a % b;
-    a = b;
-    b = r;
-  }
-  return a;
-}
-
 /* Periodic mode: every line of `period` steps once, whole, or cut into
  * chunks of chunk_len steps. y mod h, h = gcd(b, H), is the same all along a
  * line, and a line meets its row y0 < h every H / h steps, x moving on by
@@ -592,8 +581,8 @@ static long gcd_long(long a, long b) {
  * one after the other. */
 static int periodic_lines(const bb_pyramid *p, int a, int b, long period, int chunk_len,
                           items *it) {
-  const long W = p->width, H = p->height, h = gcd_long(b, H);
-  const long columns = gcd_long((H / h) * a, W);
+  const long W = p->width, H = p->height, h = bb__gcd(b, H);
+  const long columns = bb__gcd((H / h) * a, W);
   for (long y0 = 0; y0 < h; y0++)
     for (long x0 = 0; x0 < columns; x0++) {
       if (!chunk_len) {

@@ -538,20 +538,9 @@ double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_d
 
 /* ---- lattice slices ------------------------------------------------------ */
 
-static long gcd_long(long a, long b) {
-  a = a < 0 ? -a : a;
-  b = b < 0 ? -b : b;
-  while (b) {
-    const long r = a % b;
-    a = b;
-    b = r;
-  }
-  return a;
-}
-
 long bb__line_period(const bb_pyramid *p, int a, int b) {
-  const long px = p->width / gcd_long(a, p->width), py = p->height / gcd_long(b, p->height);
-  return px / gcd_long(px, py) * py;
+  const long px = p->width / bb__gcd(a, p->width), py = p->height / bb__gcd(b, p->height);
+  return px / bb__gcd(px, py) * py;
 }
 
 static inline int sign(long v) {
