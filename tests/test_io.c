@@ -2,6 +2,7 @@
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "hostile_tiff.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -11,7 +12,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 /* ------------------------------------------------------------- fixtures */
@@ -740,4 +745,282 @@ Test(io, supports_depth_follows_the_format_table) {
   cr_assert(bb_path_supports_depth("a.tiff", BB_DEPTH_FLOAT));
   cr_assert_not(bb_path_supports_depth("a.jpg", BB_DEPTH_DEFAULT));
   cr_assert_not(bb_path_supports_depth(NULL, BB_DEPTH_8));
+}
+
+/* ------------------------------------------------------ full disk (issue 10) */
+
+/* One output format and depth a writer must protect. */
+typedef struct format_case {
+  const char *name;
+  bb_depth depth;
+} format_case;
+
+static const format_case every_format[] = {
+    {"f8.png", BB_DEPTH_8},   {"f16.png", BB_DEPTH_16},    {"f8.tga", BB_DEPTH_8},
+    {"f8.tif", BB_DEPTH_8},   {"f16.tif", BB_DEPTH_16},    {"ff.tif", BB_DEPTH_FLOAT},
+    {"fh.exr", BB_DEPTH_HALF}, {"ff.exr", BB_DEPTH_FLOAT},
+};
+
+/* Runs bb_image_write in a child whose files may not grow past limit bytes
+ * (RLIMIT_FSIZE: the small filesystem a test can make without root), with
+ * SIGXFSZ ignored so that writes fail with EFBIG as on a full disk. Returns
+ * the status and copies the message into msg. Every write of a test that
+ * uses this must happen in such a child: a fork after OpenEXR has started
+ * its thread pool would leave the child waiting for threads it lacks. */
+static bb_status write_under_file_size_limit(const char *path, const bb_image *img,
+                                             bb_depth depth, rlim_t limit, char *msg,
+                                             size_t cap) {
+  int fds[2];
+  cr_assert_eq(pipe(fds), 0);
+  fflush(NULL);
+  pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    alarm(30); /* a stuck child must not outlive the test */
+    close(fds[0]);
+    signal(SIGXFSZ, SIG_IGN);
+    struct rlimit rl = {limit, limit};
+    if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(100);
+    bb_write_options o = options(depth, BB_RANGE_UNIT, "provenance text");
+    bb_error err = {{0}};
+    bb_status st = bb_image_write(path, img, &o, &err);
+    ssize_t n = write(fds[1], err.message, strlen(err.message));
+    (void)n;
+    _exit((int)st);
+  }
+  close(fds[1]);
+  ssize_t got = read(fds[0], msg, cap - 1);
+  msg[got > 0 ? got : 0] = '\0';
+  close(fds[0]);
+  int status = 0;
+  cr_assert_eq(waitpid(pid, &status, 0), pid);
+  cr_assert(WIFEXITED(status), "%s: the writer died of signal %d", path,
+            WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return (bb_status)WEXITSTATUS(status);
+}
+
+/* Every format and depth, cut off before its first byte, half way and one
+ * byte short: an I/O error naming the file and the system's reason, nothing
+ * at the final name and no temporary left. A 256 x 256 noise image spans
+ * several write buffers in every format. */
+Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
+  bb_image img = make_image(256, 256, 3, 0.0f, 1.0f, 40);
+  for (size_t i = 0; i < sizeof every_format / sizeof every_format[0]; i++) {
+    const format_case *fc = &every_format[i];
+    char full[600], path[600];
+    snprintf(full, sizeof full, "%s/full-%s", tmpdir, fc->name);
+    snprintf(path, sizeof path, "%s/%s", tmpdir, fc->name);
+    char msg[600];
+    cr_assert_eq(write_under_file_size_limit(full, &img, fc->depth, RLIM_INFINITY, msg,
+                                             sizeof msg),
+                 BB_OK, "%s", msg);
+    const long size = file_size(full);
+    const rlim_t limits[] = {0, (rlim_t)size / 2, (rlim_t)size - 1};
+    for (size_t k = 0; k < sizeof limits / sizeof limits[0]; k++) {
+      bb_status st =
+          write_under_file_size_limit(path, &img, fc->depth, limits[k], msg, sizeof msg);
+      cr_expect_eq(st, BB_ERR_IO, "%s, %ld of %ld bytes: status %d (%s)", fc->name,
+                   (long)limits[k], size, st, msg);
+      cr_expect(strstr(msg, path) && strstr(msg, "File too large"),
+                "%s, limit %ld: message '%s'", fc->name, (long)limits[k], msg);
+      cr_expect_not(file_exists(path), "%s, limit %ld: a file was left at the final name",
+                    fc->name, (long)limits[k]);
+      cr_expect_eq(count_entries(tmpdir, ".bb-tmp-"), 0, "%s, limit %ld: temporary left",
+                   fc->name, (long)limits[k]);
+    }
+    /* With room for every byte the same child succeeds: the limit, not the
+     * harness, made the writes above fail. */
+    cr_expect_eq(write_under_file_size_limit(path, &img, fc->depth, (rlim_t)size, msg,
+                                             sizeof msg),
+                 BB_OK, "%s with exactly %ld bytes allowed: %s", fc->name, size, msg);
+    cr_expect_eq(file_size(path), size, "%s", fc->name);
+  }
+  bb_image_free(&img);
+}
+
+/* A failed write must leave an existing file at the final name untouched. */
+Test(io, failed_write_keeps_the_previous_file) {
+  bb_image old_img = make_image(8, 8, 1, 0.0f, 1.0f, 41);
+  bb_image new_img = make_image(128, 128, 3, 0.0f, 1.0f, 42);
+  const char *path = tmp_path("keep.png");
+  bb_error err;
+  cr_assert_eq(bb_image_write(path, &old_img, NULL, &err), BB_OK, "%s", err.message);
+  long before = file_size(path);
+  char msg[600];
+  cr_assert_eq(write_under_file_size_limit(path, &new_img, BB_DEPTH_8, 1000, msg, sizeof msg),
+               BB_ERR_IO, "%s", msg);
+  cr_assert_eq(file_size(path), before);
+  bb_image back;
+  cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(back.width, 8);
+  bb_image_free(&back);
+  bb_image_free(&old_img);
+  bb_image_free(&new_img);
+}
+
+/* ------------------------------------------------------------ staged writes */
+
+Test(io, staged_write_appears_only_on_commit) {
+  bb_image img = make_image(16, 16, 3, 0.0f, 1.0f, 43);
+  const char *path = tmp_path("staged.exr");
+  bb_staged_file *f = NULL;
+  bb_error err;
+  cr_assert_eq(bb_image_write_staged(path, &img, NULL, &f, &err), BB_OK, "%s", err.message);
+  cr_assert_not_null(f);
+  cr_assert_str_eq(bb_staged_file_path(f), path);
+  cr_assert_not(file_exists(path), "nothing at the final name before the commit");
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 1, "the staged file waits");
+  cr_assert_eq(bb_staged_file_commit(f, &err), BB_OK, "%s", err.message);
+  cr_assert(file_exists(path));
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
+  bb_image back;
+  cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(memcmp(back.pixels, img.pixels, 16 * 16 * 3 * sizeof(float)), 0);
+  bb_image_free(&back);
+  bb_image_free(&img);
+}
+
+Test(io, staged_write_discard_leaves_nothing) {
+  bb_image img = make_image(16, 16, 1, 0.0f, 1.0f, 44);
+  bb_staged_file *f = NULL;
+  bb_error err;
+  cr_assert_eq(bb_image_write_staged(tmp_path("gone.png"), &img, NULL, &f, &err), BB_OK,
+               "%s", err.message);
+  bb_staged_file_discard(f);
+  bb_staged_file_discard(NULL);
+  cr_assert_eq(count_entries(tmpdir, ""), 2, "only . and .. are left");
+  /* A failed staging gives no handle. */
+  f = (bb_staged_file *)&err; /* any non-NULL value must be overwritten */
+  cr_assert_eq(bb_image_write_staged(tmp_path("x.jpg2"), &img, NULL, &f, &err),
+               BB_ERR_FORMAT);
+  cr_assert_null(f);
+  bb_image_free(&img);
+}
+
+/* What a SIGINT handler calls: the temporaries of writes in progress go, a
+ * file already in place stays. */
+Test(io, tempfiles_remove_takes_pending_temporaries_only) {
+  bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
+  bb_error err;
+  cr_assert_eq(bb_image_write(tmp_path("done.png"), &img, NULL, &err), BB_OK, "%s",
+               err.message);
+  bb_staged_file *a = NULL, *b = NULL;
+  cr_assert_eq(bb_image_write_staged(tmp_path("a.tif"), &img, NULL, &a, &err), BB_OK);
+  cr_assert_eq(bb_image_write_staged(tmp_path("b.exr"), &img, NULL, &b, &err), BB_OK);
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 2);
+  bb_tempfiles_remove();
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
+  cr_assert(file_exists(tmp_path("done.png")));
+  /* The handles are still freed normally; their commit now fails. */
+  cr_assert_eq(bb_staged_file_commit(a, &err), BB_ERR_IO);
+  bb_staged_file_discard(b);
+  cr_assert_not(file_exists(tmp_path("a.tif")));
+  bb_image_free(&img);
+}
+
+/* ------------------------------------------------ hostile headers (issue 10) */
+
+/* The 186-byte TIFF declaring 8192 x 8192 x 64 channels once took 16.5 GB
+ * and 47 s: refused from its header, before any allocation. The read runs
+ * in a child whose address space is capped (except under ASan, which
+ * reserves terabytes), so a regression fails here instead of taking the
+ * machine's memory. Returns the status; the message goes to msg. */
+static bb_status read_in_capped_child(const char *path, int header_only, char *msg,
+                                      size_t cap, double *seconds) {
+  int fds[2];
+  cr_assert_eq(pipe(fds), 0);
+  fflush(NULL);
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    alarm(30);
+    close(fds[0]);
+#ifndef __SANITIZE_ADDRESS__
+    struct rlimit rl = {(rlim_t)3 << 30, (rlim_t)3 << 30};
+    setrlimit(RLIMIT_AS, &rl);
+#endif
+    bb_image img;
+    bb_error err = {{0}};
+    int w, h, c;
+    bb_status st = header_only ? bb_image_read_info(path, &w, &h, &c, NULL, &err)
+                               : bb_image_read(path, &img, NULL, &err);
+    ssize_t n = write(fds[1], err.message, strlen(err.message));
+    (void)n;
+    _exit((int)st);
+  }
+  close(fds[1]);
+  ssize_t got = read(fds[0], msg, cap - 1);
+  msg[got > 0 ? got : 0] = '\0';
+  close(fds[0]);
+  int wstatus = 0;
+  cr_assert_eq(waitpid(pid, &wstatus, 0), pid);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  cr_assert(WIFEXITED(wstatus), "the reader died");
+  *seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+  return (bb_status)WEXITSTATUS(wstatus);
+}
+
+Test(io, hostile_tiff_header_is_refused_before_allocating) {
+  const char *path = tmp_path("hostile.tif");
+  cr_assert_eq(write_hostile_tiff(path, 8192, 8192, 64), 0);
+  cr_assert_eq(file_size(path), HOSTILE_TIFF_BYTES);
+  for (int header_only = 0; header_only < 2; header_only++) {
+    char msg[600];
+    double seconds;
+    bb_status st = read_in_capped_child(path, header_only, msg, sizeof msg, &seconds);
+    cr_expect_eq(st, BB_ERR_SIZE, "%s", msg);
+    cr_expect(strstr(msg, "hostile.tif") && strstr(msg, "1024 MiB"), "%s", msg);
+    cr_expect_null(strchr(msg, '\n'), "%s", msg);
+    cr_expect_lt(seconds, 5.0);
+  }
+}
+
+/* 8192 x 8192 x 4 is within the byte limit (exactly 1 GiB of floats), but its
+ * 52 bytes of data end in the first band: the read fails there instead of
+ * decoding, and touching, all 8192 rows. */
+Test(io, truncated_huge_tiff_fails_at_its_first_band) {
+  const char *path = tmp_path("h4.tif");
+  cr_assert_eq(write_hostile_tiff(path, 8192, 8192, 4), 0);
+  struct rusage before, after;
+  getrusage(RUSAGE_SELF, &before);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_ERR_FORMAT, "%s", err.message);
+  getrusage(RUSAGE_SELF, &after);
+  cr_assert(strstr(err.message, "truncated"), "%s", err.message);
+  cr_assert_lt(strlen(err.message), 300, "one reason, not one per row: %s", err.message);
+  cr_assert_lt(after.ru_maxrss - before.ru_maxrss, 256L * 1024,
+               "the read touched %ld KiB", after.ru_maxrss - before.ru_maxrss);
+  /* The header alone reads fine, whatever it declares. */
+  int w = 0, h = 0, c = 0;
+  bb_image_info info;
+  cr_assert_eq(bb_image_read_info(path, &w, &h, &c, &info, &err), BB_OK, "%s",
+               err.message);
+  cr_assert(w == 8192 && h == 8192 && c == 4);
+  cr_assert_str_eq(info.format_name, "tiff");
+  bb_image_info_free(&info);
+}
+
+Test(io, read_header_matches_the_full_read) {
+  bb_image img = make_image(13, 7, 4, 0.0f, 1.0f, 46);
+  bb_write_options o = options(BB_DEPTH_16, BB_RANGE_UNIT, "made by a test");
+  bb_error err;
+  cr_assert_eq(bb_image_write(tmp_path("hdr.png"), &img, &o, &err), BB_OK, "%s",
+               err.message);
+  int w, h, c;
+  bb_image_info hi, fi;
+  bb_image back;
+  cr_assert_eq(bb_image_read_info(tmp_path("hdr.png"), &w, &h, &c, &hi, &err), BB_OK);
+  cr_assert_eq(bb_image_read(tmp_path("hdr.png"), &back, &fi, &err), BB_OK);
+  cr_assert(w == back.width && h == back.height && c == back.channels);
+  cr_assert_eq(hi.alpha_channel, fi.alpha_channel);
+  cr_assert_eq(hi.bits_per_sample, 16);
+  cr_assert_str_eq(hi.description, "made by a test");
+  bb_image_info_free(&hi);
+  bb_image_info_free(&fi);
+  bb_image_free(&back);
+  bb_image_free(&img);
+  check_read_fails(tmp_path("absent.png"), BB_ERR_IO, "no such file");
 }
