@@ -1172,6 +1172,12 @@ int bb_path_supports_mips(const char *path);
 bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err);
 
+/* bb_image_write_mips up to, not including, the rename, as
+ * bb_image_write_staged: commit or discard *staged. */
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err);
+
 /* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
  * reads level 0. level_count (may be NULL) receives the file's number of
  * levels; a level past the last is BB_ERR_ARGUMENT. */

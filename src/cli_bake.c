@@ -193,7 +193,7 @@ static int check_outputs(bake_args *a, const char *input) {
       continue;
     any = 1;
     for (int j = 0; j < k; j++)
-      if (a->paths[j] && !strcmp(a->paths[j], a->paths[k]))
+      if (a->paths[j] && cli_same_file(a->paths[j], a->paths[k]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
                                output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
@@ -282,51 +282,50 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   fputc('\n', stdout);
 }
 
-/* Writes every requested output; stops at the first failure. */
-/* One output written on its own thread: encoding (zlib for PNG) is most of
- * a write, so the outputs of a bake are written side by side. Each task has
- * its own copy of the run, which cli_write_output updates. */
+/* One output staged on its own thread: encoding (zlib for PNG) is most of
+ * a write, so the outputs of a bake are encoded side by side. */
 typedef struct write_task {
-  const bake_args *args;
-  const bb_bake_result *result;
-  cli_run run;
-  int kind;
-  int rc;
+  const cli_run *run;
+  const bb_image *image;
+  bb_range range;
+  cli_staged_output *out;
 } write_task;
 
-static void *write_one(void *arg) {
+static void *stage_one(void *arg) {
   write_task *t = arg;
-  t->rc = cli_write_output(&t->run, output_kinds[t->kind].kind, t->args->paths[t->kind],
-                           result_image(t->result, t->kind), output_kinds[t->kind].range);
+  cli_stage_output(t->run, t->out, t->image, t->range);
   return NULL;
 }
 
+/* Writes every requested output, all or nothing: each is staged (complete
+ * and synced under a temporary name) and they are renamed into place only
+ * when every one succeeded, so a full disk leaves the previous files as they
+ * were. */
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r) {
+  cli_staged_output outs[OUTPUT_KIND_COUNT];
   write_task tasks[OUTPUT_KIND_COUNT];
   pthread_t threads[OUTPUT_KIND_COUNT];
-  int started[OUTPUT_KIND_COUNT] = {0};
+  int started[OUTPUT_KIND_COUNT] = {0}, kinds[OUTPUT_KIND_COUNT], n = 0;
   const double t0 = cli_now_seconds();
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k])
-      continue;
-    tasks[k] = (write_task){.args = a, .result = r, .run = *run, .kind = k, .rc = 0};
-    started[k] = pthread_create(&threads[k], NULL, write_one, &tasks[k]) == 0;
-    if (!started[k]) /* no thread to be had: write it here */
-      write_one(&tasks[k]);
-  }
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
-    if (started[k])
-      pthread_join(threads[k], NULL);
-  run->seconds_write += cli_now_seconds() - t0;
-  int rc = 0;
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k])
-      continue;
-    if (tasks[k].rc && !rc)
-      rc = tasks[k].rc;
-    else if (!tasks[k].rc && !a->json && !a->quiet)
-      printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
+    if (a->paths[k]) {
+      outs[n] = (cli_staged_output){.kind = output_kinds[k].kind, .path = a->paths[k]};
+      tasks[n] = (write_task){run, result_image(r, k), output_kinds[k].range, &outs[n]};
+      kinds[n++] = k;
+    }
+  for (int i = 0; i < n; i++) {
+    started[i] = pthread_create(&threads[i], NULL, stage_one, &tasks[i]) == 0;
+    if (!started[i]) /* no thread to be had: stage it here */
+      stage_one(&tasks[i]);
   }
+  for (int i = 0; i < n; i++)
+    if (started[i])
+      pthread_join(threads[i], NULL);
+  int rc = cli_commit_outputs(outs, n);
+  run->seconds_write += cli_now_seconds() - t0;
+  for (int i = 0; i < n && !rc; i++)
+    if (!a->json && !a->quiet)
+      printf("wrote %s %s\n", output_kinds[kinds[i]].kind, outs[i].path);
   return rc;
 }
 

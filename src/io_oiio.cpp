@@ -841,8 +841,11 @@ bb_status check_chain(const char *path, const bb_image *levels, int count, bb_er
   return BB_OK;
 }
 
+// Writes the chain to a finished (complete, synced) temporary for path:
+// staged is then committed or discarded by the caller.
 bb_status write_mips(const char *path, const bb_image *levels, int count,
-                     const bb_write_options *options, bb_error *err) {
+                     const bb_write_options *options, bb_staged_file *staged,
+                     bb_error *err) {
   bb_status st = check_chain(path, levels, count, err);
   if (st != BB_OK) return st;
   const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
@@ -857,14 +860,12 @@ bb_status write_mips(const char *path, const bb_image *levels, int count,
   st = resolve_depth(path, *f, o, levels[0].channels, &depth, err);
   if (st != BB_OK) return st;
 
-  bb_staged_file staged;
-  st = write_safely(
+  return write_safely(
       path,
       [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
         return encode_mips(name, proxy, levels, count, depth, o.range, o.description);
       },
-      &staged, err);
-  return st == BB_OK ? bb__safe_commit(&staged, err) : st;
+      staged, err);
 }
 
 bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
@@ -952,15 +953,33 @@ int bb_path_supports_mips(const char *path) {
 bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
-  try {
-    return write_mips(path, levels, count, options, err);
-  } catch (const std::bad_alloc &) {
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
-  } catch (const std::exception &e) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
-  } catch (...) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
+  bb_staged_file f;
+  std::memset(&f, 0, sizeof f);
+  f.fd = -1;
+  f.slot = -1;
+  return guarded_write(path, &f, err, [&] {
+    bb_status st = write_mips(path, levels, count, options, &f, err);
+    return st == BB_OK ? bb__safe_commit(&f, err) : st;
+  });
+}
+
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err) {
+  if (!staged)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: staged is NULL");
+  *staged = nullptr;
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: path is NULL");
+  bb_staged_file *f = bb__staged_new();
+  if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  bb_status st = guarded_write(
+      path, f, err, [&] { return write_mips(path, levels, count, options, f, err); });
+  if (st != BB_OK) {
+    std::free(f);
+    return st;
   }
+  *staged = f;
+  return BB_OK;
 }
 
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
