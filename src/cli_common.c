@@ -293,7 +293,10 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   shortopts[ns] = '\0';
 
   opterr = 0; /* our messages, in our format */
-  optind = 1;
+  /* 0, not 1: glibc then forgets all its state, including its pointer into
+   * the previous argv when that parse stopped inside a cluster such as
+   * "-nx" (a later parse read freed memory through it: found by fuzz_cli). */
+  optind = 0;
   for (;;) {
     int c = long_only
                 ? getopt_long_only(argc, argv, shortopts, longopts, NULL)
