@@ -597,7 +597,8 @@ char *bb_provenance_format(const bb_provenance *p);
 /* Writes into out (capacity cap) the keys whose values differ between two
  * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
  * when either text is NULL). Keys "command" and "output" are ignored. Returns
- * the number of differing keys. */
+ * the number of differing keys, or -1 when out of memory. Time is
+ * O(n log n) in the number of lines, whatever the texts hold. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
 /* What an image description holds, for readers of provenance. */
