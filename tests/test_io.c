@@ -753,29 +753,22 @@ static const format_case every_format[] = {
     {"fh.exr", BB_DEPTH_HALF}, {"ff.exr", BB_DEPTH_FLOAT},
 };
 
-/* Runs bb_image_write in a child whose files may not grow past limit bytes
- * (RLIMIT_FSIZE: the small filesystem a test can make without root), with
- * SIGXFSZ ignored so that writes fail with EFBIG as on a full disk. Returns
- * the status and copies the message into msg. Every write of a test that
- * uses this must happen in such a child: a fork after OpenEXR has started
- * its thread pool would leave the child waiting for threads it lacks. */
-static bb_status write_under_file_size_limit(const char *path, const bb_image *img,
-                                             bb_depth depth, rlim_t limit, char *msg,
-                                             size_t cap) {
+/* Runs fn(arg, err) in a forked child (which alarm() ends after 30 s if it
+ * hangs) and returns its status; the child's message goes to msg. Library
+ * calls that must run under resource limits go through here. */
+typedef bb_status (*child_fn)(const void *arg, bb_error *err);
+
+static bb_status run_in_child(child_fn fn, const void *arg, char *msg, size_t cap) {
   int fds[2];
   cr_assert_eq(pipe(fds), 0);
   fflush(NULL);
   pid_t pid = fork();
   cr_assert(pid >= 0);
   if (pid == 0) {
-    alarm(30); /* a stuck child must not outlive the test */
+    alarm(30);
     close(fds[0]);
-    signal(SIGXFSZ, SIG_IGN);
-    struct rlimit rl = {limit, limit};
-    if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(100);
-    bb_write_options o = options(depth, BB_RANGE_UNIT, "provenance text");
     bb_error err = {{0}};
-    bb_status st = bb_image_write(path, img, &o, &err);
+    bb_status st = fn(arg, &err);
     ssize_t n = write(fds[1], err.message, strlen(err.message));
     (void)n;
     _exit((int)st);
@@ -786,9 +779,38 @@ static bb_status write_under_file_size_limit(const char *path, const bb_image *i
   close(fds[0]);
   int status = 0;
   cr_assert_eq(waitpid(pid, &status, 0), pid);
-  cr_assert(WIFEXITED(status), "%s: the writer died of signal %d", path,
+  cr_assert(WIFEXITED(status), "the child died of signal %d",
             WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   return (bb_status)WEXITSTATUS(status);
+}
+
+typedef struct limited_write {
+  const char *path;
+  const bb_image *img;
+  bb_depth depth;
+  rlim_t limit;
+} limited_write;
+
+static bb_status write_with_limit(const void *arg, bb_error *err) {
+  const limited_write *w = arg;
+  signal(SIGXFSZ, SIG_IGN);
+  struct rlimit rl = {w->limit, w->limit};
+  if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(100);
+  bb_write_options o = options(w->depth, BB_RANGE_UNIT, "provenance text");
+  return bb_image_write(w->path, w->img, &o, err);
+}
+
+/* Runs bb_image_write in a child whose files may not grow past limit bytes
+ * (RLIMIT_FSIZE: the small filesystem a test can make without root), with
+ * SIGXFSZ ignored so that writes fail with EFBIG as on a full disk. Every
+ * write of a test that uses this must happen in such a child: a fork after
+ * OpenEXR has started its thread pool would leave the child waiting for
+ * threads it lacks. */
+static bb_status write_under_file_size_limit(const char *path, const bb_image *img,
+                                             bb_depth depth, rlim_t limit, char *msg,
+                                             size_t cap) {
+  limited_write w = {path, img, depth, limit};
+  return run_in_child(write_with_limit, &w, msg, cap);
 }
 
 /* Every format and depth, cut off before its first byte, half way and one
@@ -916,42 +938,22 @@ Test(io, tempfiles_remove_takes_pending_temporaries_only) {
  * and 47 s: refused from its header, before any allocation. The read runs
  * in a child whose address space is capped (except under ASan, which
  * reserves terabytes), so a regression fails here instead of taking the
- * machine's memory. Returns the status; the message goes to msg. */
-static bb_status read_in_capped_child(const char *path, int header_only, char *msg,
-                                      size_t cap, double *seconds) {
-  int fds[2];
-  cr_assert_eq(pipe(fds), 0);
-  fflush(NULL);
-  struct timespec t0, t1;
-  clock_gettime(CLOCK_MONOTONIC, &t0);
-  pid_t pid = fork();
-  cr_assert(pid >= 0);
-  if (pid == 0) {
-    alarm(30);
-    close(fds[0]);
+ * machine's memory. */
+typedef struct capped_read {
+  const char *path;
+  int header_only;
+} capped_read;
+
+static bb_status read_with_capped_memory(const void *arg, bb_error *err) {
+  const capped_read *r = arg;
 #ifndef __SANITIZE_ADDRESS__
-    struct rlimit rl = {(rlim_t)3 << 30, (rlim_t)3 << 30};
-    setrlimit(RLIMIT_AS, &rl);
+  struct rlimit rl = {(rlim_t)3 << 30, (rlim_t)3 << 30};
+  setrlimit(RLIMIT_AS, &rl);
 #endif
-    bb_image img;
-    bb_error err = {{0}};
-    int w, h, c;
-    bb_status st = header_only ? bb_image_read_info(path, &w, &h, &c, NULL, &err)
-                               : bb_image_read(path, &img, NULL, &err);
-    ssize_t n = write(fds[1], err.message, strlen(err.message));
-    (void)n;
-    _exit((int)st);
-  }
-  close(fds[1]);
-  ssize_t got = read(fds[0], msg, cap - 1);
-  msg[got > 0 ? got : 0] = '\0';
-  close(fds[0]);
-  int wstatus = 0;
-  cr_assert_eq(waitpid(pid, &wstatus, 0), pid);
-  clock_gettime(CLOCK_MONOTONIC, &t1);
-  cr_assert(WIFEXITED(wstatus), "the reader died");
-  *seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-  return (bb_status)WEXITSTATUS(wstatus);
+  bb_image img;
+  int w, h, c;
+  return r->header_only ? bb_image_read_info(r->path, &w, &h, &c, NULL, err)
+                        : bb_image_read(r->path, &img, NULL, err);
 }
 
 Test(io, hostile_tiff_header_is_refused_before_allocating) {
@@ -960,8 +962,12 @@ Test(io, hostile_tiff_header_is_refused_before_allocating) {
   cr_assert_eq(file_size(path), HOSTILE_TIFF_BYTES);
   for (int header_only = 0; header_only < 2; header_only++) {
     char msg[600];
-    double seconds;
-    bb_status st = read_in_capped_child(path, header_only, msg, sizeof msg, &seconds);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    capped_read r = {path, header_only};
+    bb_status st = run_in_child(read_with_capped_memory, &r, msg, sizeof msg);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     cr_expect_eq(st, BB_ERR_SIZE, "%s", msg);
     cr_expect(strstr(msg, "hostile.tif") && strstr(msg, "1024 MiB"), "%s", msg);
     cr_expect_null(strchr(msg, '\n'), "%s", msg);
