@@ -294,8 +294,8 @@ int rows_per_band(const ImageSpec &spec, int channels) {
 // Decodes channels [first, first + out->channels) into out, band by band.
 // A truncated file must fail, not come back as zeros: both the return value
 // and the error queue are checked, since some readers only record a warning.
-std::string read_bands(ImageInput &in, bool png, const ImageSpec &spec, int first,
-                       bb_image *out) {
+std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &spec,
+                       int first, bb_image *out) {
   const int band = rows_per_band(spec, out->channels);
   const size_t row_floats = (size_t)spec.width * (size_t)out->channels;
   for (int y = 0; y < spec.height; y += band) {
@@ -304,11 +304,11 @@ std::string read_bands(ImageInput &in, bool png, const ImageSpec &spec, int firs
     const int y0 = spec.y + y, y1 = spec.y + y + rows;
     OiioPngLeakScope png_leak(png);
     bool ok = spec.tile_width > 0
-                  ? in.read_tiles(0, 0, spec.x, spec.x + spec.width, y0, y1, spec.z,
+                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1, spec.z,
                                   spec.z + 1, first, first + out->channels, TypeDesc::FLOAT,
                                   dst)
-                  : in.read_scanlines(0, 0, y0, y1, spec.z, first, first + out->channels,
-                                      TypeDesc::FLOAT, dst);
+                  : in.read_scanlines(0, miplevel, y0, y1, spec.z, first,
+                                      first + out->channels, TypeDesc::FLOAT, dst);
     if (!ok || in.has_error()) {
       std::string why = in.geterror();
       return why.empty() ? std::string("read failed") : why;
@@ -339,7 +339,7 @@ bb_status read_channels(const char *path, int first, int count, bb_image *out,
   st = bb_image_alloc(out, spec.width, spec.height, count, &alloc_err);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
 
-  std::string why = read_bands(*in, opened.png, spec, first, out);
+  std::string why = read_bands(*in, opened.png, 0, spec, first, out);
   if (!why.empty()) {
     bb_image_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
@@ -502,6 +502,44 @@ bb_status write_safely(const char *path, const encoder_fn &encode, bb_staged_fil
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
   }
   return bb__safe_finish(f, err);
+}
+
+// Reads a finished file back; "" when it is whole, else why not.
+using verify_fn = std::function<std::string(const std::string &name)>;
+
+// write_safely for an encoder OpenImageIO cannot run through a proxy, which
+// gets proxy == nullptr and writes to the temporary by name: OpenImageIO
+// 2.4's TIFF writer re-opens its proxy in "w" mode for every directory it
+// appends, so through a proxy a file of several directories keeps only the
+// last. Its own writes are then not checked one by one, so the temporary is
+// fsynced (a full disk can show only there) and verify must read the whole
+// file back. Same contract as write_safely otherwise.
+bb_status write_safely_by_name(const char *path, const encoder_fn &encode,
+                               const verify_fn &verify, bb_staged_file *f, bb_error *err) {
+  bb_status st = bb__safe_open(f, path, err);
+  if (st != BB_OK) return st;
+  std::string why;
+  try {
+    why = encode(f->temp_path, nullptr);
+  } catch (...) {
+    bb__safe_discard(f);
+    throw;
+  }
+  if (why.empty()) {
+    st = bb__safe_finish(f, err);
+    if (st != BB_OK) return st;
+    try {
+      why = verify(f->temp_path);
+    } catch (...) {
+      bb__safe_discard(f);
+      throw;
+    }
+  }
+  if (!why.empty()) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  return BB_OK;
 }
 
 // Round-half-up quantisation of v (after the range mapping) to 0..max_code.
@@ -899,6 +937,9 @@ bb_status check_chain(const char *path, const bb_image *levels, int count, bb_er
 
 // Writes the chain to a finished (complete, synced) temporary for path:
 // staged is then committed or discarded by the caller.
+bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
+                   int *level_count, bb_error *err);
+
 bb_status write_mips(const char *path, const bb_image *levels, int count,
                      const bb_write_options *options, bb_staged_file *staged,
                      bb_error *err) {
@@ -916,24 +957,37 @@ bb_status write_mips(const char *path, const bb_image *levels, int count,
   st = resolve_depth(path, *f, o, levels[0].channels, &depth, err);
   if (st != BB_OK) return st;
 
-  return write_safely(
-      path,
-      [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
-        return encode_mips(name, proxy, levels, count, depth, o.range, o.description);
-      },
-      staged, err);
+  auto encode = [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
+    return encode_mips(name, proxy, levels, count, depth, o.range, o.description);
+  };
+  // A TIFF of several directories cannot go through a proxy (see
+  // write_safely_by_name); it is read back level by level instead.
+  if (ext == ".exr" || count == 1) return write_safely(path, encode, staged, err);
+  auto verify = [&](const std::string &name) -> std::string {
+    for (int k = 0; k < count; k++) {
+      bb_image level;
+      bb_error why;
+      int file_levels = 0;
+      if (read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK)
+        return std::string("read back: ") + why.message;
+      bool same = level.width == levels[k].width && level.height == levels[k].height &&
+                  file_levels == count;
+      bb_image_free(&level);
+      if (!same) return "read back: the file does not hold the levels written";
+    }
+    return std::string();
+  };
+  return write_safely_by_name(path, encode, verify, staged, err);
 }
 
+// Level `level` of a mip-mapped file, read with the same bounds and bands
+// as bb_image_read.
 bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
                    int *level_count, bb_error *err) {
-  bb_status st = check_readable(path, err);
-  if (st != BB_OK) return st;
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in)
-    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                    one_line(OIIO::geterror()).c_str());
+  bb_status st;
+  opened_input opened = open_input(path, &st, err);
+  if (!opened.in) return st;
+  ImageInput *in = opened.in.get();
   int levels = 0;
   while (in->seek_subimage(0, levels)) levels++;
   (void)in->geterror(); // the failed seek past the last level queued a message
@@ -949,12 +1003,11 @@ bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *in
   bb_error alloc_err;
   st = bb_image_alloc(out, spec.width, spec.height, spec.nchannels, &alloc_err);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
-  bool ok = in->read_image(0, level, 0, spec.nchannels, TypeDesc::FLOAT, out->pixels);
-  if (!ok || in->has_error()) {
-    std::string why = in->geterror();
+  std::string why = read_bands(*in, opened.png, level, spec, 0, out);
+  if (!why.empty()) {
     bb_image_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
-                    one_line(why).c_str());
+                    one_line(first_line(why)).c_str());
   }
   st = fill_info(*in, spec, info, path, err);
   if (st != BB_OK) bb_image_free(out);

@@ -173,7 +173,7 @@ static int create_temp(bb_staged_file *f) {
     int slot = register_temp(name);
     /* 0666 less the umask, as for any new file (mkstemp would make 0600,
      * and the rename keeps the mode). */
-    int fd = open(name, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    int fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
       f->fd = fd;
       f->slot = slot;

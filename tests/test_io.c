@@ -784,12 +784,65 @@ static bb_status run_in_child(child_fn fn, const void *arg, char *msg, size_t ca
   return (bb_status)WEXITSTATUS(status);
 }
 
+/* Which writer a limited write goes through. */
+typedef enum writer { WRITE_IMAGE, WRITE_MIPS, WRITE_GIF, WRITE_MESH } writer;
+
 typedef struct limited_write {
   const char *path;
   const bb_image *img;
   bb_depth depth;
   rlim_t limit;
+  writer kind;
 } limited_write;
+
+/* Three frames of img (3 channels) as an animated GIF. */
+static bb_status write_gif(const char *path, const bb_image *img, bb_error *err) {
+  bb_animation *a = NULL;
+  bb_status st = bb_animation_open(path, img->width, img->height, 10.0, &a, err);
+  for (int k = 0; k < 3 && st == BB_OK; k++) st = bb_animation_add_frame(a, img, err);
+  if (st != BB_OK) {
+    bb_animation_abort(a);
+    return st;
+  }
+  return bb_animation_close(a, err);
+}
+
+/* A grid mesh of img's size (two triangles per cell), heights from img. */
+static bb_status write_mesh(const char *path, const bb_image *img, bb_error *err) {
+  const int w = img->width, h = img->height;
+  bb_mesh m;
+  bb_status st = bb_mesh_alloc(&m, (size_t)w * (size_t)h, 2 * (size_t)(w - 1) * (size_t)(h - 1),
+                               0, err);
+  if (st != BB_OK) return st;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *p = m.positions + 3 * ((size_t)y * (size_t)w + (size_t)x);
+      p[0] = (float)x, p[1] = (float)y, p[2] = bb_image_texel(img, x, y)[0];
+    }
+  uint32_t *t = m.indices;
+  for (int y = 0; y + 1 < h; y++)
+    for (int x = 0; x + 1 < w; x++) {
+      uint32_t i = (uint32_t)(y * w + x);
+      const uint32_t quad[6] = {i, i + 1, i + (uint32_t)w, i + 1, i + 1 + (uint32_t)w,
+                                i + (uint32_t)w};
+      memcpy(t, quad, sizeof quad);
+      t += 6;
+    }
+  st = bb_mesh_write(path, &m, err);
+  bb_mesh_free(&m);
+  return st;
+}
+
+static bb_status write_mip_file(const char *path, const bb_image *img, bb_depth depth,
+                                bb_error *err) {
+  bb_image *levels = NULL;
+  int count = 0;
+  bb_status st = bb_mip_chain(img, BB_MIP_AVERAGE, &levels, &count, err);
+  bb_write_options o = options(depth, BB_RANGE_UNIT, "provenance text");
+  if (st == BB_OK) st = bb_image_write_mips(path, levels, count, &o, err);
+  bb_mip_chain_free(levels, count);
+  return st;
+}
 
 static bb_status write_with_limit(const void *arg, bb_error *err) {
   const limited_write *w = arg;
@@ -797,6 +850,12 @@ static bb_status write_with_limit(const void *arg, bb_error *err) {
   struct rlimit rl = {w->limit, w->limit};
   if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(100);
   bb_write_options o = options(w->depth, BB_RANGE_UNIT, "provenance text");
+  switch (w->kind) {
+  case WRITE_MIPS: return write_mip_file(w->path, w->img, w->depth, err);
+  case WRITE_GIF: return write_gif(w->path, w->img, err);
+  case WRITE_MESH: return write_mesh(w->path, w->img, err);
+  case WRITE_IMAGE: break;
+  }
   return bb_image_write(w->path, w->img, &o, err);
 }
 
@@ -809,7 +868,15 @@ static bb_status write_with_limit(const void *arg, bb_error *err) {
 static bb_status write_under_file_size_limit(const char *path, const bb_image *img,
                                              bb_depth depth, rlim_t limit, char *msg,
                                              size_t cap) {
-  limited_write w = {path, img, depth, limit};
+  limited_write w = {path, img, depth, limit, WRITE_IMAGE};
+  return run_in_child(write_with_limit, &w, msg, cap);
+}
+
+/* The same for the other writers: mip-mapped files, GIFs and meshes. */
+static bb_status write_kind_under_limit(writer kind, const char *path, const bb_image *img,
+                                        bb_depth depth, rlim_t limit, char *msg,
+                                        size_t cap) {
+  limited_write w = {path, img, depth, limit, kind};
   return run_in_child(write_with_limit, &w, msg, cap);
 }
 
@@ -848,6 +915,46 @@ Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
                                              sizeof msg),
                  BB_OK, "%s with exactly %ld bytes allowed: %s", fc->name, size, msg);
     cr_expect_eq(file_size(path), size, "%s", fc->name);
+  }
+  bb_image_free(&img);
+}
+
+/* The writers added since: mip-mapped TIFF (written by name and read back,
+ * see io_oiio.cpp) and EXR, the animated GIF and the mesh formats, cut off
+ * at nothing, half way and one byte short like every image format above. */
+Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
+  bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 47);
+  const struct {
+    writer kind;
+    const char *name;
+    bb_depth depth;
+  } cases[] = {
+      {WRITE_MIPS, "m8.tif", BB_DEPTH_8},    {WRITE_MIPS, "m16.tif", BB_DEPTH_16},
+      {WRITE_MIPS, "mf.tif", BB_DEPTH_FLOAT}, {WRITE_MIPS, "mh.exr", BB_DEPTH_HALF},
+      {WRITE_MIPS, "mf.exr", BB_DEPTH_FLOAT}, {WRITE_GIF, "a.gif", BB_DEPTH_8},
+      {WRITE_MESH, "g.obj", BB_DEPTH_DEFAULT}, {WRITE_MESH, "g.ply", BB_DEPTH_DEFAULT},
+      {WRITE_MESH, "g.stl", BB_DEPTH_DEFAULT}, {WRITE_MESH, "g.glb", BB_DEPTH_DEFAULT},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    char full[600], path[600], msg[600];
+    snprintf(full, sizeof full, "%s/full-%s", tmpdir, cases[i].name);
+    snprintf(path, sizeof path, "%s/%s", tmpdir, cases[i].name);
+    cr_assert_eq(write_kind_under_limit(cases[i].kind, full, &img, cases[i].depth,
+                                        RLIM_INFINITY, msg, sizeof msg),
+                 BB_OK, "%s: %s", cases[i].name, msg);
+    const long size = file_size(full);
+    const rlim_t limits[] = {0, (rlim_t)size / 2, (rlim_t)size - 1};
+    for (size_t k = 0; k < 3; k++) {
+      bb_status st = write_kind_under_limit(cases[i].kind, path, &img, cases[i].depth,
+                                            limits[k], msg, sizeof msg);
+      cr_expect_eq(st, BB_ERR_IO, "%s, %ld of %ld bytes: status %d (%s)", cases[i].name,
+                   (long)limits[k], size, st, msg);
+      cr_expect(strstr(msg, path) != NULL, "%s: message '%s'", cases[i].name, msg);
+      cr_expect_not(file_exists(path), "%s, limit %ld: a file was left at the final name",
+                    cases[i].name, (long)limits[k]);
+      cr_expect_eq(count_entries(tmpdir, ".bb-tmp-"), 0, "%s, limit %ld: temporary left",
+                   cases[i].name, (long)limits[k]);
+    }
   }
   bb_image_free(&img);
 }
