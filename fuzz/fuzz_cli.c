@@ -3,12 +3,14 @@
  * command; the rest is its arguments, separated by NUL bytes.
  *
  * Safety: the process works in an empty scratch directory and inputs
- * holding a '/' are skipped, so no argument can name a file outside it; no
- * image exists there, so every run stops at loading its input, before
- * anything is written. What is fuzzed is everything before that: getopt
+ * holding a '/' are skipped, so no argument can name a file outside it
+ * ("--base .." lets program read, never write, one level up); no image
+ * exists there, so nearly every run stops at loading its input, before
+ * anything is written (program's _flat needs none; it writes into the
+ * scratch directory). What is fuzzed is everything before that: getopt
  * tables, number parsing and ranges, prefix expansion, output-name checks,
- * compare's own parser. Properties: no crash, leak or undefined behaviour,
- * and only the documented exit codes. */
+ * compare's own parser, program's expression parser. Properties: no crash,
+ * leak or undefined behaviour, and only the documented exit codes. */
 #include "cli.h"
 #include "fuzz_common.h"
 
@@ -19,9 +21,18 @@ static const struct {
   command_fn run;
   int max_exit; /* compare follows idiff: up to 4 */
 } COMMANDS[] = {
-    {"normal", bb_cli_normal, 2},  {"bake", bb_cli_bake, 2},
-    {"height2ssbump", bb_cli_height2ssbump, 2}, {"compare", bb_cli_compare, 4},
+    {"normal", bb_cli_normal, 2},
+    {"bake", bb_cli_bake, 2},
+    {"height2ssbump", bb_cli_height2ssbump, 2},
+    {"compare", bb_cli_compare, 4},
     {"info", bb_cli_info, 2},
+    {"renderbumpflat", bb_cli_renderbumpflat, 2},
+    {"render", bb_cli_render, 2},
+    {"sheet", bb_cli_sheet, 2},
+    {"normal2ssbump", bb_cli_normal2ssbump, 2},
+    {"ssbump2normal", bb_cli_ssbump2normal, 2},
+    {"combine", bb_cli_combine, 2},
+    {"program", bb_cli_program, 2},
 };
 
 enum { MAX_ARGS = 48 };

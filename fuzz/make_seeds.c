@@ -173,6 +173,13 @@ static void cli_seeds(const char *out) {
       "\003a.png\0b.png\0--warn\0" "0.1\0--warnpercent\0" "5",
       "\004h.png",
       "\001--help",
+      "\005-size\0" "64\0" "32\0m.obj",
+      "\006h.png\0--scale\0" "8\0-o\0r.png\0--light\0" "45,30",
+      "\007h.png\0--scale\0" "8\0-o\0s.png",
+      "\010n.png\0-o\0s.tga\0--mips",
+      "\011s.png\0-o\0n.exr",
+      "\012a.png\0b.png\0-o\0c.png\0--mix\0" "0.5",
+      "\013addnormals(a.tga, heightmap(b.tga, 4))\0-o\0p.png",
   };
   static const size_t SIZES[] = {
       sizeof "\001h.png\0--scale\0" "64\0-o\0rock",
@@ -185,6 +192,13 @@ static void cli_seeds(const char *out) {
       sizeof "\003a.png\0b.png\0--warn\0" "0.1\0--warnpercent\0" "5",
       sizeof "\004h.png",
       sizeof "\001--help",
+      sizeof "\005-size\0" "64\0" "32\0m.obj",
+      sizeof "\006h.png\0--scale\0" "8\0-o\0r.png\0--light\0" "45,30",
+      sizeof "\007h.png\0--scale\0" "8\0-o\0s.png",
+      sizeof "\010n.png\0-o\0s.tga\0--mips",
+      sizeof "\011s.png\0-o\0n.exr",
+      sizeof "\012a.png\0b.png\0-o\0c.png\0--mix\0" "0.5",
+      sizeof "\013addnormals(a.tga, heightmap(b.tga, 4))\0-o\0p.png",
   };
   char dir[1024];
   make_dir(out, "cli", dir, sizeof dir);
