@@ -1181,6 +1181,18 @@ Test(cli, two_names_for_one_output_are_refused) {
     cli_result_free(&r);
   }
   cr_expect_not(file_exists(tmp("D/a.png")));
+  /* The slope map and its preview are outputs too. */
+  cli_result slope = RUN("bake", in, "--scale", "2", "--normal", tmp("D/s.png"), "--slope",
+                         tmp("L/s.png"));
+  cr_expect_eq(slope.code, 2, "%s", slope.err);
+  cr_expect(strstr(slope.err, "would both be written"), "%s", slope.err);
+  cli_result_free(&slope);
+  slope = RUN("bake", in, "--scale", "2", "--normal", tmp("D/s_lit.png"), "--slope",
+              tmp("D/s.png"), "--lit", "45,30");
+  cr_expect_eq(slope.code, 2, "%s", slope.err);
+  cr_expect(strstr(slope.err, "slope_lit"), "%s", slope.err);
+  cli_result_free(&slope);
+  cr_expect_not(file_exists(tmp("D/s.png")));
   /* Two different names in the same directory are fine. */
   cli_result r = RUN("bake", in, "--scale", "2", "--rays", "4", "--ao", tmp("D/a.png"),
                      "--normal", tmp("L/b.png"), "-q");
