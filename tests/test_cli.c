@@ -1041,11 +1041,12 @@ static const output_format every_output_format[] = {
     {"tif", "16"}, {"tif", "float"}, {"exr", "half"}, {"exr", "float"},
 };
 
-/* Item 1: a full disk (RLIMIT_FSIZE of a few bytes or one byte short of
- * the largest output) is exit 1, one line, and nothing changes on disk: the
- * previous normal map stays byte for byte, no ao appears, no temporary is
- * left. The CLI ignores SIGXFSZ itself, so the limit is a write error here
- * and not a kill. */
+/* Item 1: a full disk (RLIMIT_FSIZE of a few bytes, and for PNG and TGA,
+ * which once failed silently, one byte short of the largest output) is exit
+ * 1, one line, and nothing changes on disk: the previous normal map stays
+ * byte for byte, no ao appears, no temporary is left. The CLI ignores
+ * SIGXFSZ itself, so the limit is a write error here and not a kill.
+ * (test_io.c cuts every format and depth at three points.) */
 Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
   const char *in = tmp("noise.png");
   write_image(in, 64, 64, 1, noise);
@@ -1059,20 +1060,25 @@ Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
     const char *args[] = {"bake",   in,   "--scale",    "8",      "--rays", "8",
                           "--depth", f->depth, "--normal", tmp(normal), "--ao", tmp(ao),
                           "-q",     NULL};
-    /* The full size of the larger output, from a run with room. */
-    cli_result r = run_in(NULL, args);
-    cr_assert_eq(r.code, 0, "%s/%s: %s", f->ext, f->depth, r.err);
-    cli_result_free(&r);
-    struct stat st;
-    cr_assert_eq(stat(tmp(normal), &st), 0);
-    long biggest = (long)st.st_size;
-    cr_assert_eq(stat(tmp(ao), &st), 0);
-    biggest = (long)st.st_size > biggest ? (long)st.st_size : biggest;
-    cr_assert_eq(unlink(tmp(ao)), 0);
+    long limits[2] = {100, -1};
+    int cuts = 1;
+    if (!strcmp(f->depth, "8") && (!strcmp(f->ext, "png") || !strcmp(f->ext, "tga"))) {
+      /* The full size of the larger output, from a run with room. */
+      cli_result r = run_in(NULL, args);
+      cr_assert_eq(r.code, 0, "%s/%s: %s", f->ext, f->depth, r.err);
+      cli_result_free(&r);
+      struct stat st;
+      cr_assert_eq(stat(tmp(normal), &st), 0);
+      long biggest = (long)st.st_size;
+      cr_assert_eq(stat(tmp(ao), &st), 0);
+      biggest = (long)st.st_size > biggest ? (long)st.st_size : biggest;
+      cr_assert_eq(unlink(tmp(ao)), 0);
+      limits[cuts++] = biggest - 1;
+    }
     write_bytes(tmp(normal), "the previous map", 16);
 
-    const long limits[] = {100, biggest - 1};
-    for (size_t k = 0; k < 2; k++) {
+    for (int k = 0; k < cuts; k++) {
+      cli_result r;
       run_limits lim = {limits[k], -1};
       r = run_limited(NULL, &lim, args);
       cr_expect_eq(r.code, 1, "%s/%s under %ld bytes: exit %d, %s", f->ext, f->depth,
