@@ -59,7 +59,7 @@ static inline const char *fuzz_write_file(const char *name, const uint8_t *data,
 #define FUZZ_CHECK(cond)                                                                 \
   do {                                                                                   \
     if (!(cond)) {                                                                       \
-      fprintf(stderr, "fuzz: check failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__);   \
+      fprintf(stderr, "fuzz: check failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__);    \
       abort();                                                                           \
     }                                                                                    \
   } while (0)

@@ -3,9 +3,9 @@
  * Layout: width-1, height-1, channels-1 (low bits of 3 bytes), 2 floats of
  * thresholds, then A's samples and B's samples. Properties: no crash or
  * undefined behaviour, counts within the pixel count, max >= mean (to
- * rounding) when both are finite, and a diff image exactly as documented: |A - B| in double
- * rounded to float, 0 for equal values (equal infinities too), infinity
- * where either side is NaN. */
+ * rounding) when both are finite, and a diff image exactly as documented: |A - B| in
+ * double rounded to float, 0 for equal values (equal infinities too), infinity where
+ * either side is NaN. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
 
@@ -49,7 +49,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const double fail = take_float(&p, end), warn = take_float(&p, end);
   bb_image a, b, diff = {0};
   bb_error err;
-  if (bb_image_alloc(&a, w, h, c, &err) != BB_OK || bb_image_alloc(&b, bw, h, c, &err) != BB_OK)
+  if (bb_image_alloc(&a, w, h, c, &err) != BB_OK ||
+      bb_image_alloc(&b, bw, h, c, &err) != BB_OK)
     abort();
   fill(&a, &p, end);
   fill(&b, &p, end);
@@ -67,7 +68,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       FUZZ_CHECK(s.max_abs >= s.mean_abs * (1.0 - 1e-12));
     size_t n = (size_t)w * (size_t)h * (size_t)c;
     for (size_t i = 0; i < n; i++)
-      FUZZ_CHECK(same_bits(expected_difference(a.pixels[i], b.pixels[i]), diff.pixels[i]));
+      FUZZ_CHECK(
+          same_bits(expected_difference(a.pixels[i], b.pixels[i]), diff.pixels[i]));
   } else {
     FUZZ_CHECK(diff.pixels == NULL);
   }

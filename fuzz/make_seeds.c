@@ -113,7 +113,8 @@ static void compare_seeds(const char *out) {
     float thresholds[2] = {1e-6f, s == 2 ? 0.5f : 1.0f};
     memcpy(seed + 3, thresholds, sizeof thresholds);
     for (int i = 0; i < 2 * 48; i++) {
-      float v = (float)((i * 37 + s * 11) % 97) / 97.0f + (s == 1 && i == 60 ? 0.25f : 0.0f);
+      float v =
+          (float)((i * 37 + s * 11) % 97) / 97.0f + (s == 1 && i == 60 ? 0.25f : 0.0f);
       memcpy(seed + 11 + 4 * i, &v, sizeof v);
     }
     char name[32];
@@ -163,41 +164,79 @@ static void provenance_seeds(const char *fixtures, const char *out) {
 /* fuzz_cli's layout: the command's index, then NUL-separated arguments. */
 static void cli_seeds(const char *out) {
   static const char *const LINES[] = {
-      "\001h.png\0--scale\0" "64\0-o\0rock",
-      "\001h.png\0--scale\0" "64\0--ssbump\0s.exr\0--json\0--rays\0" "16",
-      "\001h.png\0--scale\0" "8\0--normal\0n.png\0--ao\0a.png\0--depth\0" "16\0--clamp",
-      "\000h.png\0-o\0n.png\0--scale\0" "64\0--normal-y\0up\0--channel\0luma",
-      "\002-r\0" "32\0-n\0-A\0h.tga\0" "4",
-      "\002-D\0-d\0-f\0" "3\0h.tga\0" "2",
-      "\003a.exr\0b.exr\0--fail\0" "1e-5\0--diff\0d.exr\0--json",
-      "\003a.png\0b.png\0--warn\0" "0.1\0--warnpercent\0" "5",
+      "\001h.png\0--scale\0"
+      "64\0-o\0rock",
+      "\001h.png\0--scale\0"
+      "64\0--ssbump\0s.exr\0--json\0--rays\0"
+      "16",
+      "\001h.png\0--scale\0"
+      "8\0--normal\0n.png\0--ao\0a.png\0--depth\0"
+      "16\0--clamp",
+      "\000h.png\0-o\0n.png\0--scale\0"
+      "64\0--normal-y\0up\0--channel\0luma",
+      "\002-r\0"
+      "32\0-n\0-A\0h.tga\0"
+      "4",
+      "\002-D\0-d\0-f\0"
+      "3\0h.tga\0"
+      "2",
+      "\003a.exr\0b.exr\0--fail\0"
+      "1e-5\0--diff\0d.exr\0--json",
+      "\003a.png\0b.png\0--warn\0"
+      "0.1\0--warnpercent\0"
+      "5",
       "\004h.png",
       "\001--help",
-      "\005-size\0" "64\0" "32\0m.obj",
-      "\006h.png\0--scale\0" "8\0-o\0r.png\0--light\0" "45,30",
-      "\007h.png\0--scale\0" "8\0-o\0s.png",
+      "\005-size\0"
+      "64\0"
+      "32\0m.obj",
+      "\006h.png\0--scale\0"
+      "8\0-o\0r.png\0--light\0"
+      "45,30",
+      "\007h.png\0--scale\0"
+      "8\0-o\0s.png",
       "\010n.png\0-o\0s.tga\0--mips",
       "\011s.png\0-o\0n.exr",
-      "\012a.png\0b.png\0-o\0c.png\0--mix\0" "0.5",
+      "\012a.png\0b.png\0-o\0c.png\0--mix\0"
+      "0.5",
       "\013addnormals(a.tga, heightmap(b.tga, 4))\0-o\0p.png",
   };
   static const size_t SIZES[] = {
-      sizeof "\001h.png\0--scale\0" "64\0-o\0rock",
-      sizeof "\001h.png\0--scale\0" "64\0--ssbump\0s.exr\0--json\0--rays\0" "16",
-      sizeof "\001h.png\0--scale\0" "8\0--normal\0n.png\0--ao\0a.png\0--depth\0" "16\0--clamp",
-      sizeof "\000h.png\0-o\0n.png\0--scale\0" "64\0--normal-y\0up\0--channel\0luma",
-      sizeof "\002-r\0" "32\0-n\0-A\0h.tga\0" "4",
-      sizeof "\002-D\0-d\0-f\0" "3\0h.tga\0" "2",
-      sizeof "\003a.exr\0b.exr\0--fail\0" "1e-5\0--diff\0d.exr\0--json",
-      sizeof "\003a.png\0b.png\0--warn\0" "0.1\0--warnpercent\0" "5",
+      sizeof "\001h.png\0--scale\0"
+             "64\0-o\0rock",
+      sizeof "\001h.png\0--scale\0"
+             "64\0--ssbump\0s.exr\0--json\0--rays\0"
+             "16",
+      sizeof "\001h.png\0--scale\0"
+             "8\0--normal\0n.png\0--ao\0a.png\0--depth\0"
+             "16\0--clamp",
+      sizeof "\000h.png\0-o\0n.png\0--scale\0"
+             "64\0--normal-y\0up\0--channel\0luma",
+      sizeof "\002-r\0"
+             "32\0-n\0-A\0h.tga\0"
+             "4",
+      sizeof "\002-D\0-d\0-f\0"
+             "3\0h.tga\0"
+             "2",
+      sizeof "\003a.exr\0b.exr\0--fail\0"
+             "1e-5\0--diff\0d.exr\0--json",
+      sizeof "\003a.png\0b.png\0--warn\0"
+             "0.1\0--warnpercent\0"
+             "5",
       sizeof "\004h.png",
       sizeof "\001--help",
-      sizeof "\005-size\0" "64\0" "32\0m.obj",
-      sizeof "\006h.png\0--scale\0" "8\0-o\0r.png\0--light\0" "45,30",
-      sizeof "\007h.png\0--scale\0" "8\0-o\0s.png",
+      sizeof "\005-size\0"
+             "64\0"
+             "32\0m.obj",
+      sizeof "\006h.png\0--scale\0"
+             "8\0-o\0r.png\0--light\0"
+             "45,30",
+      sizeof "\007h.png\0--scale\0"
+             "8\0-o\0s.png",
       sizeof "\010n.png\0-o\0s.tga\0--mips",
       sizeof "\011s.png\0-o\0n.exr",
-      sizeof "\012a.png\0b.png\0-o\0c.png\0--mix\0" "0.5",
+      sizeof "\012a.png\0b.png\0-o\0c.png\0--mix\0"
+             "0.5",
       sizeof "\013addnormals(a.tga, heightmap(b.tga, 4))\0-o\0p.png",
   };
   char dir[1024];

@@ -37,7 +37,8 @@ static char slot_path[TEMP_SLOTS][PATH_MAX];
  * is full (the file then loses only its signal-time cleanup). */
 static int register_temp(const char *path) {
   size_t n = strlen(path);
-  if (n >= PATH_MAX) return -1;
+  if (n >= PATH_MAX)
+    return -1;
   for (int i = 0; i < TEMP_SLOTS; i++) {
     int expected = SLOT_FREE;
     if (atomic_compare_exchange_strong(&slot_state[i], &expected, SLOT_FILLED)) {
@@ -50,7 +51,8 @@ static int register_temp(const char *path) {
 }
 
 static void unregister_temp(int slot) {
-  if (slot >= 0) atomic_store_explicit(&slot_state[slot], SLOT_FREE, memory_order_release);
+  if (slot >= 0)
+    atomic_store_explicit(&slot_state[slot], SLOT_FREE, memory_order_release);
 }
 
 void bb_tempfiles_remove(void) {
@@ -79,14 +81,16 @@ static char *temp_name(const char *path, uint64_t *seed) {
   size_t dir_len = (size_t)(base - path);
   size_t len = dir_len + sizeof ".bb-tmp-XXXXXX" + strlen(ext);
   char *name = malloc(len);
-  if (!name) return NULL;
+  if (!name)
+    return NULL;
   /* splitmix64: a fresh, well mixed value per call. */
   uint64_t z = (*seed += 0x9E3779B97F4A7C15ull);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
   char random[7];
-  for (int i = 0; i < 6; i++, z /= 62) random[i] = ALNUM[z % 62];
+  for (int i = 0; i < 6; i++, z /= 62)
+    random[i] = ALNUM[z % 62];
   random[6] = '\0';
   snprintf(name, len, "%.*s.bb-tmp-%s%s", (int)dir_len, path, random, ext);
   return name;
@@ -108,10 +112,12 @@ static int write_fully(int fd, const unsigned char *data, size_t size, int64_t o
   while (size > 0) {
     ssize_t n = pwrite(fd, data, size, (off_t)offset);
     if (n < 0) {
-      if (errno == EINTR) continue;
+      if (errno == EINTR)
+        continue;
       return errno;
     }
-    if (n == 0) return ENOSPC;
+    if (n == 0)
+      return ENOSPC;
     data += n;
     size -= (size_t)n;
     offset += n;
@@ -120,7 +126,8 @@ static int write_fully(int fd, const unsigned char *data, size_t size, int64_t o
 }
 
 static void note_error(bb_staged_file *f, int error) {
-  if (!f->error) f->error = error;
+  if (!f->error)
+    f->error = error;
 }
 
 static void flush_buffer(bb_staged_file *f) {
@@ -130,13 +137,16 @@ static void flush_buffer(bb_staged_file *f) {
 }
 
 static void grow_size(bb_staged_file *f, int64_t end) {
-  if (end > f->size) f->size = end;
+  if (end > f->size)
+    f->size = end;
 }
 
 /* Closes the descriptor once; the result of close(2) counts as a write. */
 static void close_fd(bb_staged_file *f) {
-  if (f->fd < 0) return;
-  if (close(f->fd) != 0 && errno != EINTR) note_error(f, errno);
+  if (f->fd < 0)
+    return;
+  if (close(f->fd) != 0 && errno != EINTR)
+    note_error(f, errno);
   f->fd = -1;
 }
 
@@ -146,7 +156,8 @@ static void release(bb_staged_file *f, int remove_temp) {
     close(f->fd);
     f->fd = -1;
   }
-  if (remove_temp && f->temp_path) unlink(f->temp_path);
+  if (remove_temp && f->temp_path)
+    unlink(f->temp_path);
   unregister_temp(f->slot);
   f->slot = -1;
   free(f->buffer);
@@ -154,7 +165,8 @@ static void release(bb_staged_file *f, int remove_temp) {
   free(f->path);
   f->buffer = NULL;
   f->temp_path = f->path = NULL;
-  if (f->lock_ready) pthread_mutex_destroy(&f->lock);
+  if (f->lock_ready)
+    pthread_mutex_destroy(&f->lock);
   f->lock_ready = 0;
 }
 
@@ -169,7 +181,8 @@ static int create_temp(bb_staged_file *f) {
   uint64_t seed = fresh_seed();
   for (int attempt = 0; attempt < 100; attempt++) {
     char *name = temp_name(f->path, &seed);
-    if (!name) return ENOMEM;
+    if (!name)
+      return ENOMEM;
     int slot = register_temp(name);
     /* 0666 less the umask, as for any new file (mkstemp would make 0600,
      * and the rename keeps the mode). */
@@ -183,7 +196,8 @@ static int create_temp(bb_staged_file *f) {
     int error = errno;
     unregister_temp(slot);
     free(name);
-    if (error != EEXIST) return error;
+    if (error != EEXIST)
+      return error;
   }
   return EEXIST;
 }
@@ -192,7 +206,8 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
   memset(f, 0, sizeof *f);
   f->fd = -1;
   f->slot = -1;
-  if (!path || !*path) return bb__fail(err, BB_ERR_ARGUMENT, "no output path");
+  if (!path || !*path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "no output path");
   f->path = malloc(strlen(path) + 1);
   f->buffer = malloc(BUFFER_BYTES);
   if (!f->path || !f->buffer) {
@@ -217,25 +232,32 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
 
 /* Buffered write at offset; the caller holds the lock. */
 static size_t write_at(bb_staged_file *f, const void *data, size_t size, int64_t offset) {
-  if (f->error || f->fd < 0) return 0;
-  if (size == 0) return 0;
+  if (f->error || f->fd < 0)
+    return 0;
+  if (size == 0)
+    return 0;
   if (offset < 0 || (uint64_t)offset > (uint64_t)INT64_MAX - size) {
     note_error(f, EINVAL);
     return 0;
   }
   /* The buffer holds bytes contiguous from buffer_pos; anything else (a
    * seek back, a big block) flushes it first. */
-  if (f->buffered && offset != f->buffer_pos + (int64_t)f->buffered) flush_buffer(f);
+  if (f->buffered && offset != f->buffer_pos + (int64_t)f->buffered)
+    flush_buffer(f);
   if (size >= BUFFER_BYTES) {
     flush_buffer(f);
-    if (!f->error) note_error(f, write_fully(f->fd, data, size, offset));
+    if (!f->error)
+      note_error(f, write_fully(f->fd, data, size, offset));
   } else {
-    if (f->buffered + size > BUFFER_BYTES) flush_buffer(f);
-    if (!f->buffered) f->buffer_pos = offset;
+    if (f->buffered + size > BUFFER_BYTES)
+      flush_buffer(f);
+    if (!f->buffered)
+      f->buffer_pos = offset;
     memcpy(f->buffer + f->buffered, data, size);
     f->buffered += size;
   }
-  if (f->error) return 0;
+  if (f->error)
+    return 0;
   grow_size(f, offset + (int64_t)size);
   return size;
 }
@@ -262,8 +284,10 @@ size_t bb__safe_pread(bb_staged_file *f, void *data, size_t size, int64_t offset
   while (!f->error && f->fd >= 0 && done < size && offset >= 0) {
     ssize_t n = pread(f->fd, (unsigned char *)data + done, size - done,
                       (off_t)(offset + (int64_t)done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n <= 0)
+      break;
     done += (size_t)n;
   }
   pthread_mutex_unlock(&f->lock);
@@ -279,7 +303,8 @@ size_t bb__safe_read(bb_staged_file *f, void *data, size_t size) {
 }
 
 int bb__safe_seek(bb_staged_file *f, int64_t offset) {
-  if (offset < 0) return -1;
+  if (offset < 0)
+    return -1;
   pthread_mutex_lock(&f->lock);
   f->pos = offset;
   pthread_mutex_unlock(&f->lock);
@@ -309,16 +334,19 @@ void bb__safe_fail(bb_staged_file *f, int error) {
 /* -------------------------------------------------------- finish, commit */
 
 bb_status bb__safe_finish(bb_staged_file *f, bb_error *err) {
-  if (f->fd < 0 && !f->error && f->temp_path) return BB_OK; /* finished before */
+  if (f->fd < 0 && !f->error && f->temp_path)
+    return BB_OK; /* finished before */
   if (!f->temp_path)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: nothing to finish", f->path ? f->path : "?");
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: nothing to finish",
+                    f->path ? f->path : "?");
   flush_buffer(f);
   /* A full disk may only show at fsync (delayed allocation) or close (NFS). */
-  if (!f->error && fsync(f->fd) != 0) note_error(f, errno);
+  if (!f->error && fsync(f->fd) != 0)
+    note_error(f, errno);
   close_fd(f);
   if (f->error) {
-    bb_status st = bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path,
-                            strerror(f->error));
+    bb_status st =
+        bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(f->error));
     release(f, 1);
     return st;
   }
@@ -344,7 +372,8 @@ static void sync_directory_of(const char *path) {
 
 bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
   bb_status st = bb__safe_finish(f, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   if (rename(f->temp_path, f->path) != 0) {
     st = bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(errno));
     release(f, 1);
@@ -356,7 +385,8 @@ bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
 }
 
 void bb__safe_discard(bb_staged_file *f) {
-  if (f) release(f, 1);
+  if (f)
+    release(f, 1);
 }
 
 /* ------------------------------------------------------ public handles */
@@ -375,14 +405,16 @@ const char *bb_staged_file_path(const bb_staged_file *staged) {
 }
 
 bb_status bb_staged_file_commit(bb_staged_file *staged, bb_error *err) {
-  if (!staged) return bb__fail(err, BB_ERR_ARGUMENT, "bb_staged_file_commit: NULL");
+  if (!staged)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_staged_file_commit: NULL");
   bb_status st = bb__safe_commit(staged, err);
   free(staged);
   return st;
 }
 
 void bb_staged_file_discard(bb_staged_file *staged) {
-  if (!staged) return;
+  if (!staged)
+    return;
   bb__safe_discard(staged);
   free(staged);
 }

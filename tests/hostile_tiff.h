@@ -17,7 +17,8 @@ static inline void hostile_put16(unsigned char *p, unsigned v) {
 }
 
 static inline void hostile_put32(unsigned char *p, uint32_t v) {
-  for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i));
+  for (int i = 0; i < 4; i++)
+    p[i] = (unsigned char)(v >> (8 * i));
 }
 
 /* Writes the TIFF to path (little-endian, one strip, 8-bit samples,
@@ -57,7 +58,8 @@ static inline int write_hostile_tiff(const char *path, uint32_t width, uint32_t 
   }
   /* next-IFD offset 0 at 130, then 52 zero bytes of "strip" up to 186 */
   FILE *f = fopen(path, "wb");
-  if (!f) return -1;
+  if (!f)
+    return -1;
   size_t written = fwrite(b, 1, sizeof b, f);
   return (fclose(f) == 0 && written == sizeof b) ? 0 : -1;
 }
