@@ -22,7 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   int width = 0, height = 0, channels = 0;
   bb_image_info info;
   bb_error err;
-  bb_status header = bb_image_read_header(path, &width, &height, &channels, &info, &err);
+  bb_status header = bb_image_read_info(path, &width, &height, &channels, &info, &err);
   bb_image_info_free(&info);
   /* Past 65536 texels decoding is legitimate and bounded (up to
    * BB_MAX_READ_BYTES, which the tests check) but slow: OpenImageIO's PNG

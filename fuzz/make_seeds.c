@@ -139,7 +139,7 @@ static void provenance_seeds(const char *fixtures, const char *out) {
     int w, h, c;
     bb_image_info info;
     bb_error err;
-    if (bb_image_read_header(path, &w, &h, &c, &info, &err) == BB_OK && info.description)
+    if (bb_image_read_info(path, &w, &h, &c, &info, &err) == BB_OK && info.description)
       texts[n++] = info.description; /* owned here from now on */
   }
   if (d)
