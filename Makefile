@@ -1,6 +1,7 @@
 # bumpbake: plain Makefile. `make` builds, `make test` builds and runs every
 # test, `make demo` bakes a fixture into out/, `make bench` measures,
-# `make install` installs (PREFIX=/usr/local, DESTDIR= for staging).
+# `make install` installs (PREFIX=/usr/local, DESTDIR= for staging),
+# `make fuzz` runs the libFuzzer targets of fuzz/.
 # `make DEBUG=1 ...` builds with assertions and ASan/UBSan into build/debug.
 
 DEBUG ?= 0
@@ -88,7 +89,11 @@ LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
 CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o)
 TEST_OBJ := $(TEST_C:%.c=$(BUILD)/%.o)
 TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
-ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ)
+# The fuzz targets' code, compiled into the test binary to replay the saved
+# regression inputs (tests/test_fuzz.c), with the CLI minus main().
+FUZZ_REPLAY_OBJ := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%.o,$(wildcard fuzz/fuzz_*.c))
+CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli_main.o,$(CLI_OBJ))
+ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
 SHLIB    := $(BUILD)/$(SHLIB_REAL)
 # The symbols libbumpbake.so exports: bb_* (the public API) and nothing else.
@@ -100,7 +105,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python bench goldens docs install uninstall clean format FORCE
+        check-python bench goldens docs install uninstall clean format FORCE \
+        fuzz fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
@@ -125,6 +131,19 @@ ensure-deps:
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
+
+# libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
+# fuzz` asks for them.
+FUZZ_DEB_PKGS := clang libclang-rt-14-dev
+fuzz-deps:
+	$(SUDO) apt-get update
+	DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y --no-install-recommends $(FUZZ_DEB_PKGS)
+
+# Linking an empty fuzzer proves clang, libFuzzer and the sanitizer runtimes.
+ensure-fuzz-deps: ensure-deps
+	@if command -v clang >/dev/null 2>&1 && printf 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { (void)d; (void)n; return 0; }\n' \
+	    | clang -x c -fsanitize=fuzzer,address,undefined -o /dev/null - >/dev/null 2>&1; then :; \
+	 else echo "bumpbake: installing clang and libFuzzer (make fuzz-deps)"; $(MAKE) --no-print-directory fuzz-deps; fi
 
 # ---- build ------------------------------------------------------------------
 # Objects and binaries also depend on a record of the flags they were made
@@ -184,8 +203,13 @@ TOOL_JSON := $(BUILD)/src/cli_json.o
 $(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(TOOL_JSON) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $< $(TOOL_JSON) $(LIB) $(LDLIBS)
 
-$(TESTBIN): $(TEST_OBJ) $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(LIB) $(CRIT_LIBS) $(LDLIBS)
+$(FUZZ_REPLAY_OBJ): $(BUILD)/fuzz/%.o: fuzz/%.c $(BUILD)/compile.flags
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(DEPFLAGS) -DLLVMFuzzerTestOneInput=bb_$* -c $< -o $@
+
+$(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) \
+	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths.
@@ -256,8 +280,56 @@ goldens: ensure-deps
 	@$(MAKE) --no-print-directory all
 	@./tools/goldens.sh $(BIN) regenerate
 
+# ---- fuzzing (libFuzzer, ASan + UBSan) ---------------------------------------
+# `make fuzz FUZZ_SECONDS=N` builds fuzz/fuzz_*.c with clang against a copy of
+# the library instrumented for coverage and runs each target N seconds,
+# seeded from fixtures/ (fuzz/make_seeds.c) and from the corpus earlier runs
+# left in build/fuzz/corpus, after replaying fuzz/regressions/. Crashes land
+# in build/fuzz/crashes/; each one found becomes a regression test of `make
+# test` (tests/test_fuzz.c).
+FUZZ_SECONDS ?= 60
+FUZZ_BUILD   := build/fuzz
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
+FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) -Iinclude -Isrc
+FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
+FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
+FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
+FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli_main.c,$(CLI_C)))
+# Per target: libFuzzer options beyond time and corpus.
+FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
+FUZZ_ARGS_fuzz_provenance := -max_len=65536
+
+# Objects are kept between runs (make would delete them as intermediates).
+.SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+
+$(FUZZ_BUILD)/src/%.o: src/%.c
+	@mkdir -p $(@D)
+	clang $(FUZZ_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
+
+$(FUZZ_BUILD)/src/%.o: src/%.cpp
+	@mkdir -p $(@D)
+	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -fsanitize=fuzzer-no-link \
+	  -c $< -o $@
+
+-include $(FUZZ_LIB_OBJ:.o=.d) $(FUZZ_CLI_OBJ:.o=.d)
+
+$(FUZZ_BUILD)/%: fuzz/%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+	@mkdir -p $(@D)
+	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< -x none $(FUZZ_CLI_OBJ) \
+	  $(FUZZ_LIB_OBJ) $(LDLIBS)
+
+$(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_LIB_OBJ)
+	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -o $@ $< -x none \
+	  $(FUZZ_LIB_OBJ) $(LDLIBS)
+
+fuzz: ensure-fuzz-deps
+	@$(MAKE) --no-print-directory $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds
+	@./fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) \
+	  $(foreach t,$(FUZZ_TARGETS),"$(notdir $(t)) $(FUZZ_ARGS_$(notdir $(t)))")
+
 format:
-	clang-format -i include/*.h src/*.c src/*.h src/*.cpp tests/*.c tools/*.c
+	clang-format -i include/*.h src/*.c src/*.h src/*.cpp tests/*.c tools/*.c fuzz/*.c
 
 clean:
 	rm -rf build out

@@ -41,6 +41,18 @@ extern "C" {
 #define BB_MAX_DIMENSION 65536
 #define BB_MAX_PIXELS (8192L * 8192L)
 
+/* Most bytes of samples a read may take (1 GiB, an 8192 x 8192 RGBA float
+ * image): both the file's own samples (texels x channels x bytes per
+ * sample, as its header declares them) and the floats decoded (texels x
+ * channels read x 4) must fit, checked before anything is allocated. The
+ * first read also lowers OpenImageIO's process-wide "limits:imagesize_MB"
+ * to 1024 and "limits:channels" to 64 when they are higher. */
+#define BB_MAX_READ_BYTES (1L << 30)
+
+/* Largest |height_scale x h| a bake accepts, in texels: scaled heights are
+ * floats and are differenced, so they keep a factor of 4 below FLT_MAX. */
+#define BB_MAX_HEIGHT_TEXELS 8.5e37
+
 typedef enum bb_status {
   BB_OK = 0,          /* success */
   BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
@@ -104,7 +116,8 @@ void bb_image_info_free(bb_image_info *info);
 /* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
  * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
  * Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not an image,
- * truncated, corrupt), BB_ERR_SIZE (zero or over the maximum). */
+ * truncated, corrupt), BB_ERR_SIZE (zero, over BB_MAX_PIXELS or over
+ * BB_MAX_READ_BYTES, refused before allocating). */
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 
@@ -112,8 +125,10 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * bb_image_info holds, without decoding a pixel (fast on any size; a
  * truncated pixel stream is not noticed). width, height, channels and info
  * may each be NULL. Errors as bb_image_read, except that the size limits
- * BB_MAX_DIMENSION and BB_MAX_PIXELS are not applied (the size is reported,
- * not allocated). */
+ * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied
+ * (the size is reported, not allocated; OpenImageIO's own limits, see
+ * BB_MAX_READ_BYTES, may still refuse a header declaring more than 1 GiB of
+ * samples). */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
@@ -145,12 +160,45 @@ typedef struct bb_write_options {
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
  * .tiff .exr). Integer formats clamp to the code range and round to nearest.
- * The file is written to a temporary file in the destination directory and
- * renamed into place, so a failure leaves no partial file. Errors:
- * BB_ERR_FORMAT (unknown extension, depth not supported by the format),
- * BB_ERR_IO (cannot write). */
+ * The file is written to a temporary file in the destination directory,
+ * every write checked, then flushed, fsynced and closed (checked) and only
+ * then renamed into place, so a failure (a full disk included) leaves no
+ * partial file and nothing at path. Errors: BB_ERR_FORMAT (unknown
+ * extension, depth not supported by the format), BB_ERR_IO (cannot write:
+ * the message gives the system's reason, e.g. "No space left on device"). */
 bb_status bb_image_write(const char *path, const bb_image *img,
                          const bb_write_options *options, bb_error *err);
+
+/* A file written in full (and fsynced) under a temporary name next to its
+ * destination, waiting to be renamed into place. A program writing several
+ * files stages them all and commits only when every one was written, so a
+ * failure changes nothing on disk (bumpbake bake does this). */
+typedef struct bb_staged_file bb_staged_file;
+
+/* bb_image_write up to, not including, the rename: on success *staged
+ * receives the handle; on failure it is NULL and nothing is left on disk.
+ * The handle must be passed to bb_staged_file_commit or _discard. */
+bb_status bb_image_write_staged(const char *path, const bb_image *img,
+                                const bb_write_options *options,
+                                bb_staged_file **staged, bb_error *err);
+
+/* Renames the staged file to its path and frees the handle (also when the
+ * rename fails, which removes the temporary). Errors: BB_ERR_IO. */
+bb_status bb_staged_file_commit(bb_staged_file *staged, bb_error *err);
+
+/* Removes the staged file's temporary and frees the handle; NULL is fine. */
+void bb_staged_file_discard(bb_staged_file *staged);
+
+/* The destination path of a staged file (owned by the handle). */
+const char *bb_staged_file_path(const bb_staged_file *staged);
+
+/* Removes every temporary file a write of this process has open right now
+ * (staged files included). Async-signal-safe: call it from a SIGINT or
+ * SIGTERM handler, then re-raise the signal with the default action, and an
+ * interrupted run leaves no temporary behind. Only files whose names this
+ * library created are removed. At most 64 temporaries are tracked at once;
+ * further ones are still removed on errors, but not by this function. */
+void bb_tempfiles_remove(void);
 
 /* True (1) when the extension of path names a format bb_image_write knows. */
 int bb_path_is_writable_format(const char *path);
@@ -549,7 +597,8 @@ char *bb_provenance_format(const bb_provenance *p);
 /* Writes into out (capacity cap) the keys whose values differ between two
  * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
  * when either text is NULL). Keys "command" and "output" are ignored. Returns
- * the number of differing keys. */
+ * the number of differing keys, or -1 when out of memory. Time is
+ * O(n log n) in the number of lines, whatever the texts hold. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
 /* What an image description holds, for readers of provenance. */
@@ -1123,6 +1172,12 @@ int bb_path_supports_mips(const char *path);
  * bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
 bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err);
+
+/* bb_image_write_mips up to, not including, the rename, as
+ * bb_image_write_staged: commit or discard *staged. */
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err);
 
 /* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
  * reads level 0. level_count (may be NULL) receives the file's number of

@@ -94,6 +94,8 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
   bb_status st = check_options(o, err);
+  /* Before any stage: an overflow of scale x height is named as such. */
+  if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
   if (st != BB_OK) return st;
   double t0 = bb__now_seconds();
   st = bb_smooth_bilateral(height, height, &o->smooth, &r->filtered, err);

@@ -185,6 +185,24 @@ static int expand_prefix(bake_args *a) {
   return 0;
 }
 
+/* The slope map and its preview must not name a file another output does. */
+static int check_slope_names(const bake_args *a) {
+  const char *slope[2] = {a->slope.path, a->slope.lit_path};
+  const char *slope_kind[2] = {"slope", "slope_lit"};
+  for (int s = 0; s < 2; s++) {
+    if (!slope[s])
+      continue;
+    for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+      if (a->paths[k] && cli_same_file(a->paths[k], slope[s]))
+        return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
+                               output_kinds[k].kind, slope_kind[s], slope[s]);
+  }
+  if (slope[0] && slope[1] && cli_same_file(slope[0], slope[1]))
+    return cli_usage_error(bake_command.name, "slope and slope_lit would both be written to %s",
+                           slope[1]);
+  return 0;
+}
+
 /* Every output is checked before the (possibly long) bake starts. */
 static int check_outputs(bake_args *a, const char *input) {
   int any = a->slope.path != NULL;
@@ -193,7 +211,7 @@ static int check_outputs(bake_args *a, const char *input) {
       continue;
     any = 1;
     for (int j = 0; j < k; j++)
-      if (a->paths[j] && !strcmp(a->paths[j], a->paths[k]))
+      if (a->paths[j] && cli_same_file(a->paths[j], a->paths[k]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
                                output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
@@ -207,7 +225,8 @@ static int check_outputs(bake_args *a, const char *input) {
         bake_command.name,
         "nothing to write: give -o PREFIX or at least one of --normal, "
         "--weights, --ssbump, --ao, --bent, --filtered, --slope");
-  return cli_slope_check(bake_command.name, &a->slope, input, a->settings.depth);
+  int rc = cli_slope_check(bake_command.name, &a->slope, input, a->settings.depth);
+  return rc ? rc : check_slope_names(a);
 }
 
 static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
@@ -282,52 +301,88 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   fputc('\n', stdout);
 }
 
-/* Writes every requested output; stops at the first failure. */
-/* One output written on its own thread: encoding (zlib for PNG) is most of
- * a write, so the outputs of a bake are written side by side. Each task has
- * its own copy of the run, which cli_write_output updates. */
+/* One output staged on its own thread: encoding (zlib for PNG) is most of
+ * a write, so the outputs of a bake are encoded side by side. */
 typedef struct write_task {
-  const bake_args *args;
-  const bb_bake_result *result;
-  cli_run run;
-  int kind;
-  int rc;
+  const cli_run *run;
+  const bb_image *image;
+  bb_range range;
+  cli_staged_output *out;
 } write_task;
 
-static void *write_one(void *arg) {
+static void *stage_one(void *arg) {
   write_task *t = arg;
-  t->rc = cli_write_output(&t->run, output_kinds[t->kind].kind, t->args->paths[t->kind],
-                           result_image(t->result, t->kind), output_kinds[t->kind].range);
+  cli_stage_output(t->run, t->out, t->image, t->range);
   return NULL;
 }
 
-static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r) {
-  write_task tasks[OUTPUT_KIND_COUNT];
-  pthread_t threads[OUTPUT_KIND_COUNT];
-  int started[OUTPUT_KIND_COUNT] = {0};
+/* The slope map and its preview (--slope, --lit), written with the others
+ * but with their own settings (cli_slope_settings). */
+typedef struct slope_outputs {
+  bb_image map, lit;
+  cli_settings map_settings, lit_settings;
+  cli_run map_run, lit_run;
+} slope_outputs;
+
+enum { MAX_OUTPUTS = OUTPUT_KIND_COUNT + 2 };
+
+/* Writes every requested output, all or nothing: each is staged (complete
+ * and synced under a temporary name) and they are renamed into place only
+ * when every one succeeded, so a full disk leaves the previous files as they
+ * were. */
+static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r,
+                         const slope_outputs *slope) {
+  cli_staged_output outs[MAX_OUTPUTS];
+  write_task tasks[MAX_OUTPUTS];
+  pthread_t threads[MAX_OUTPUTS];
+  int started[MAX_OUTPUTS] = {0}, n = 0;
   const double t0 = cli_now_seconds();
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k])
-      continue;
-    tasks[k] = (write_task){.args = a, .result = r, .run = *run, .kind = k, .rc = 0};
-    started[k] = pthread_create(&threads[k], NULL, write_one, &tasks[k]) == 0;
-    if (!started[k]) /* no thread to be had: write it here */
-      write_one(&tasks[k]);
-  }
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
-    if (started[k])
-      pthread_join(threads[k], NULL);
-  run->seconds_write += cli_now_seconds() - t0;
-  int rc = 0;
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!a->paths[k])
-      continue;
-    if (tasks[k].rc && !rc)
-      rc = tasks[k].rc;
-    else if (!tasks[k].rc && !a->json && !a->quiet)
-      printf("wrote %s %s\n", output_kinds[k].kind, a->paths[k]);
+    if (a->paths[k]) {
+      outs[n] = (cli_staged_output){.kind = output_kinds[k].kind, .path = a->paths[k]};
+      tasks[n] = (write_task){run, result_image(r, k), output_kinds[k].range, &outs[n]};
+      n++;
+    }
+  if (slope->map.pixels) {
+    outs[n] = (cli_staged_output){.kind = "slope", .path = a->slope.path};
+    tasks[n] = (write_task){&slope->map_run, &slope->map, BB_RANGE_UNIT, &outs[n]};
+    n++;
   }
+  if (slope->lit.pixels) {
+    outs[n] = (cli_staged_output){.kind = "slope_lit", .path = a->slope.lit_path};
+    tasks[n] = (write_task){&slope->lit_run, &slope->lit, BB_RANGE_UNIT, &outs[n]};
+    n++;
+  }
+  for (int i = 0; i < n; i++) {
+    started[i] = pthread_create(&threads[i], NULL, stage_one, &tasks[i]) == 0;
+    if (!started[i]) /* no thread to be had: stage it here */
+      stage_one(&tasks[i]);
+  }
+  for (int i = 0; i < n; i++)
+    if (started[i])
+      pthread_join(threads[i], NULL);
+  int rc = cli_commit_outputs(outs, n);
+  run->seconds_write += cli_now_seconds() - t0;
+  for (int i = 0; i < n && !rc; i++)
+    if (!a->json && !a->quiet)
+      printf("wrote %s %s\n", outs[i].kind, outs[i].path);
   return rc;
+}
+
+/* Makes the slope outputs when --slope asked for them; 0 or the exit code
+ * after printing the error. */
+static int make_slope(const bake_args *a, const cli_run *run, const bb_image *filtered,
+                      slope_outputs *s) {
+  memset(s, 0, sizeof *s);
+  if (!a->slope.path)
+    return 0;
+  cli_slope_settings(run->settings, 1, &s->map_settings);
+  cli_slope_settings(run->settings, 0, &s->lit_settings);
+  s->map_run = *run;
+  s->map_run.settings = &s->map_settings;
+  s->lit_run = *run;
+  s->lit_run.settings = &s->lit_settings;
+  return cli_slope_make(run, &a->slope, filtered, &s->map, &s->lit);
 }
 
 static int needs_trace(const bake_args *a) {
@@ -356,9 +411,12 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   if (!rc) {
     cli_run_set_input(run, input, &height, &a->settings);
     run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
-    rc = write_outputs(a, run, &result);
+    slope_outputs slope;
+    rc = make_slope(a, run, &result.filtered, &slope);
     if (!rc)
-      rc = cli_slope_write(run, &a->slope, &result.filtered, a->json || a->quiet);
+      rc = write_outputs(a, run, &result, &slope);
+    bb_image_free(&slope.map);
+    bb_image_free(&slope.lit);
     t.write = run->seconds_write;
   }
   if (!rc && a->json)

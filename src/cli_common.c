@@ -11,11 +11,11 @@
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -113,7 +113,7 @@ int cli_usage_error(const char *command, const char *fmt, ...) {
 
 void cli_file_error(const char *path, const char *reason) {
   /* Errors are one line, whatever a lower layer put in its message. */
-  char line[sizeof(((bb_error *)0)->message)];
+  char line[2 * sizeof(bb_error)];
   snprintf(line, sizeof line, "%s", reason && *reason ? reason : "unknown error");
   for (char *c = line; *c; c++)
     if (*c == '\n' || *c == '\r')
@@ -293,7 +293,10 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   shortopts[ns] = '\0';
 
   opterr = 0; /* our messages, in our format */
-  optind = 1;
+  /* 0, not 1: glibc then forgets all its state, including its pointer into
+   * the previous argv when that parse stopped inside a cluster such as
+   * "-nx" (a later parse read freed memory through it: found by fuzz_cli). */
+  optind = 0;
   for (;;) {
     int c = long_only
                 ? getopt_long_only(argc, argv, shortopts, longopts, NULL)
@@ -467,27 +470,56 @@ static const char *depth_name(bb_depth d) {
   return "default";
 }
 
-/* 1 when a and b name the same file: by realpath when both exist (so
- * "./h.png" and "h.png" match), else by spelling. */
-static int same_file(const char *a, const char *b) {
-  char *ra = realpath(a, NULL), *rb = realpath(b, NULL);
-  int same = (ra && rb) ? strcmp(ra, rb) == 0 : strcmp(a, b) == 0;
-  free(ra);
-  free(rb);
-  return same;
+/* The directory part of path ("." when none), into dir. */
+static void directory_part(const char *path, char *dir, size_t cap) {
+  const char *slash = strrchr(path, '/');
+  if (!slash)
+    snprintf(dir, cap, ".");
+  else if (slash == path)
+    snprintf(dir, cap, "/");
+  else
+    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
+/* The directory entry a write of path replaces: its directory's device and
+ * inode and its last component. Returns 0 when the directory exists. */
+typedef struct dir_entry {
+  dev_t dev;
+  ino_t ino;
+  const char *name;
+} dir_entry;
+
+static int entry_of(const char *path, dir_entry *e) {
+  char dir[PATH_MAX];
+  directory_part(path, dir, sizeof dir);
+  struct stat st;
+  if (stat(dir, &st) != 0)
+    return -1;
+  const char *slash = strrchr(path, '/');
+  e->dev = st.st_dev;
+  e->ino = st.st_ino;
+  e->name = slash ? slash + 1 : path;
+  return 0;
+}
+
+int cli_same_file(const char *a, const char *b) {
+  /* Two names of one existing file (symbolic or hard links, "./", ".."). */
+  struct stat sa, sb;
+  if (stat(a, &sa) == 0 && stat(b, &sb) == 0)
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  /* Files not made yet: the same name in the same directory, however the
+   * directory is spelled. */
+  dir_entry ea, eb;
+  if (entry_of(a, &ea) == 0 && entry_of(b, &eb) == 0)
+    return ea.dev == eb.dev && ea.ino == eb.ino && strcmp(ea.name, eb.name) == 0;
+  return strcmp(a, b) == 0;
 }
 
 /* 0 when the directory part of path exists and is a directory; else prints
  * why not and returns BB_EXIT_FAILURE. */
 static int check_output_directory(const char *path) {
-  const char *slash = strrchr(path, '/');
   char dir[PATH_MAX];
-  if (!slash)
-    snprintf(dir, sizeof dir, ".");
-  else if (slash == path)
-    snprintf(dir, sizeof dir, "/");
-  else
-    snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+  directory_part(path, dir, sizeof dir);
   struct stat st;
   if (stat(dir, &st) != 0) {
     char reason[PATH_MAX + 128];
@@ -517,7 +549,7 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
     return cli_usage_error(command, "%s: --depth %s is not available in .%s files",
                            output_path, depth_name(depth),
                            path_extension(output_path, ext, sizeof ext));
-  if (same_file(input_path, output_path)) {
+  if (cli_same_file(input_path, output_path)) {
     cli_file_error(output_path, "output would overwrite the input file");
     return BB_EXIT_FAILURE;
   }
@@ -541,18 +573,33 @@ int cli_check_mips(const char *command, const cli_settings *s, const char *outpu
   return cli_usage_error(command, "%s: --mips needs a .tif or .exr output", output_path);
 }
 
-bb_status cli_write_image(const char *path, const bb_image *img, const bb_write_options *wo,
-                          int mips, bb_error *err) {
-  if (!mips)
-    return bb_image_write(path, img, wo, err);
+/* img's mip chain (renormalised when wo->range is BB_RANGE_SIGNED) written
+ * as one file: at path, or staged into *staged when staged is not NULL. */
+static bb_status write_mip_file(const char *path, const bb_image *img,
+                                const bb_write_options *wo, bb_staged_file **staged,
+                                bb_error *err) {
   bb_image *levels = NULL;
   int count = 0;
   bb_mip_filter filter = wo->range == BB_RANGE_SIGNED ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
   bb_status st = bb_mip_chain(img, filter, &levels, &count, err);
   if (st == BB_OK)
-    st = bb_image_write_mips(path, levels, count, wo, err);
+    st = staged ? bb_image_write_mips_staged(path, levels, count, wo, staged, err)
+                : bb_image_write_mips(path, levels, count, wo, err);
   bb_mip_chain_free(levels, count);
   return st;
+}
+
+bb_status cli_write_image(const char *path, const bb_image *img, const bb_write_options *wo,
+                          int mips, bb_error *err) {
+  return mips ? write_mip_file(path, img, wo, NULL, err) : bb_image_write(path, img, wo, err);
+}
+
+/* cli_write_image staged (complete under a temporary name) into *staged. */
+static bb_status stage_image(const char *path, const bb_image *img, const bb_write_options *wo,
+                             int mips, bb_staged_file **staged, bb_error *err) {
+  *staged = NULL;
+  return mips ? write_mip_file(path, img, wo, staged, err)
+              : bb_image_write_staged(path, img, wo, staged, err);
 }
 
 static const char *file_name_of(const char *path) {
@@ -590,23 +637,101 @@ void cli_run_free(cli_run *run) {
   run->command_line = NULL;
 }
 
-int cli_write_output(cli_run *run, const char *kind, const char *path,
-                     const bb_image *img, bb_range range) {
+/* The write options of one output of run: its depth and range and a
+ * provenance description of kind (malloc'd into *description). */
+static bb_status output_options(const cli_run *run, const char *kind, bb_range range,
+                                bb_write_options *wo, char **description, bb_error *err) {
   bb_provenance p = {
       run->command_line,    file_name_of(run->input_path), run->input_hash, kind,
       &run->settings->bake, run->settings->channel,        run->rayset_id};
-  char *description = bb_provenance_format(&p);
-  if (!description) {
-    cli_file_error(path, "out of memory");
-    return BB_EXIT_FAILURE;
+  *description = bb_provenance_format(&p);
+  if (!*description) {
+    snprintf(err->message, sizeof err->message, "out of memory");
+    return BB_ERR_MEMORY;
   }
-  bb_write_options wo = {run->settings->depth, range, description};
+  *wo = (bb_write_options){run->settings->depth, range, *description};
+  return BB_OK;
+}
+
+int cli_write_output(cli_run *run, const char *kind, const char *path,
+                     const bb_image *img, bb_range range) {
+  bb_write_options wo;
+  char *description = NULL;
   bb_error err = {{0}};
+  bb_status st = output_options(run, kind, range, &wo, &description, &err);
   double t0 = cli_now_seconds();
-  bb_status st = cli_write_image(path, img, &wo, run->settings->mips, &err);
+  if (st == BB_OK)
+    st = cli_write_image(path, img, &wo, run->settings->mips, &err);
   run->seconds_write += cli_now_seconds() - t0;
   free(description);
   return cli_status_exit(path, st, &err);
+}
+
+void cli_stage_output(const cli_run *run, cli_staged_output *out, const bb_image *img,
+                      bb_range range) {
+  bb_write_options wo;
+  char *description = NULL;
+  out->file = NULL;
+  memset(&out->error, 0, sizeof out->error);
+  out->status = output_options(run, out->kind, range, &wo, &description, &out->error);
+  if (out->status == BB_OK)
+    out->status = stage_image(out->path, img, &wo, run->settings->mips, &out->file,
+                              &out->error);
+  free(description);
+}
+
+/* Appends to text (capacity cap) the outputs in place, or says that none
+ * is. */
+static void describe_written(const cli_staged_output *outs, int n, char *text, size_t cap) {
+  size_t len = strlen(text);
+  int any = 0;
+  for (int i = 0; i < n && len < cap; i++) {
+    if (!outs[i].written)
+      continue;
+    len += (size_t)snprintf(text + len, cap - len, "%s%s %s",
+                            any ? ", " : "; already written: ", outs[i].kind, outs[i].path);
+    any = 1;
+  }
+  if (!any && len < cap)
+    snprintf(text + len, cap - len, "; no output was written");
+}
+
+static void discard_all(cli_staged_output *outs, int n) {
+  for (int i = 0; i < n; i++) {
+    bb_staged_file_discard(outs[i].file);
+    outs[i].file = NULL;
+  }
+}
+
+int cli_commit_outputs(cli_staged_output *outs, int n) {
+  int failed = -1;
+  for (int i = 0; i < n; i++) {
+    outs[i].written = 0;
+    if (failed < 0 && outs[i].status != BB_OK)
+      failed = i;
+  }
+  /* All or nothing: one failure discards every staged file. Only a rename
+   * can still fail after this, which leaves the ones before it in place. */
+  for (int i = 0; i < n && failed < 0; i++) {
+    bb_staged_file *f = outs[i].file;
+    outs[i].file = NULL;
+    outs[i].status = bb_staged_file_commit(f, &outs[i].error);
+    if (outs[i].status == BB_OK)
+      outs[i].written = 1;
+    else
+      failed = i;
+  }
+  discard_all(outs, n);
+  if (failed < 0)
+    return 0;
+  char reason[2 * sizeof(bb_error)];
+  snprintf(reason, sizeof reason, "%s",
+           outs[failed].error.message[0] ? outs[failed].error.message
+                                         : bb_status_name(outs[failed].status));
+  if (n > 1)
+    describe_written(outs, n, reason, sizeof reason);
+  cli_file_error(outs[failed].path, reason);
+  return BB_EXIT_FAILURE;
 }
 
 /* libpng, inside OpenImageIO, prints its own "libpng error: ..." line on
@@ -665,6 +790,42 @@ double cli_now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---------------------------------------------------------------- signals */
+
+/* Removes the temporaries of the writes in progress, then dies of the same
+ * signal: SA_RESETHAND has restored the default action, and the signal,
+ * blocked while this runs, is delivered when it returns, so the exit status
+ * is what a shell expects of Ctrl-C or kill. Only async-signal-safe calls. */
+static void remove_temporaries_and_die(int sig) {
+  bb_tempfiles_remove();
+  raise(sig);
+}
+
+void cli_install_signal_handlers(void) {
+  /* Over RLIMIT_FSIZE a write then fails with EFBIG, reported and cleaned
+   * up like a full disk, instead of SIGXFSZ killing the process with its
+   * temporary left behind. */
+  struct sigaction ignore;
+  memset(&ignore, 0, sizeof ignore);
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, NULL);
+
+  static const int fatal[] = {SIGINT, SIGTERM, SIGHUP};
+  for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++) {
+    struct sigaction old, sa;
+    /* A signal ignored by whoever started us (nohup, a background job)
+     * stays ignored. */
+    if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+      continue;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = (int)SA_RESETHAND;
+    sigaction(fatal[i], &sa, NULL);
+  }
 }
 
 /* --------------------------------------------------------------- progress */

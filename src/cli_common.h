@@ -179,6 +179,12 @@ int cli_check_mips(const char *command, const cli_settings *s, const char *outpu
 bb_status cli_write_image(const char *path, const bb_image *img, const bb_write_options *wo,
                           int mips, bb_error *err);
 
+/* 1 when a and b name the same file: the same device and inode when both
+ * exist (symbolic and hard links, "./", "..": a write of one would replace
+ * or clobber the other), else the same name in the same directory (by the
+ * directory's device and inode), else the same spelling. */
+int cli_same_file(const char *a, const char *b);
+
 /* What every output of one run shares, for its provenance. */
 typedef struct cli_run {
   char *command_line; /* "bumpbake " + argv joined with spaces */
@@ -206,6 +212,37 @@ void cli_run_free(cli_run *run);
  * and returns BB_EXIT_FAILURE on failure, 0 on success. */
 int cli_write_output(cli_run *run, const char *kind, const char *path,
                      const bb_image *img, bb_range range);
+
+/* One output of a command that writes several: staged first (complete and
+ * synced under a temporary name), then put in place with the others by
+ * cli_commit_outputs, so that a failure changes nothing on disk. */
+typedef struct cli_staged_output {
+  const char *kind;     /* "normal", ... for provenance and messages */
+  const char *path;     /* destination */
+  bb_staged_file *file; /* the staged file, NULL when staging failed */
+  bb_status status;     /* of staging, then of the commit */
+  bb_error error;       /* why status is not BB_OK */
+  int written;          /* set by cli_commit_outputs once in place */
+} cli_staged_output;
+
+/* Stages img for out->path like cli_write_output, without printing: the
+ * result goes to out->status, out->error and out->file. Thread-safe for
+ * distinct outputs (it does not touch run). */
+void cli_stage_output(const cli_run *run, cli_staged_output *out, const bb_image *img,
+                      bb_range range);
+
+/* All or nothing: when every one of the n outputs was staged, renames them
+ * into place in order and returns 0; otherwise removes every staged file.
+ * A failure prints one line, "bumpbake: PATH: reason; no output was written"
+ * (or "; already written: KIND PATH, ..." when a rename failed after
+ * others), and returns BB_EXIT_FAILURE. */
+int cli_commit_outputs(cli_staged_output *outs, int n);
+
+/* Installs the CLI's signal handling, first thing in main: SIGINT, SIGTERM
+ * and SIGHUP remove the temporaries of writes in progress
+ * (bb_tempfiles_remove) and end the process by the same signal; SIGXFSZ is
+ * ignored, so a write over RLIMIT_FSIZE is an ordinary write error. */
+void cli_install_signal_handlers(void);
 
 /* Loads the height of path by the settings' channel rule; prints the error
  * and returns BB_EXIT_FAILURE on failure. When the rule finds the height in

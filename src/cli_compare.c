@@ -387,10 +387,12 @@ static int compare_loaded(const compare_args *a, const bb_image *x, const bb_ima
   char prov_diff[4096] = "";
   int prov_count = 0;
   if (bb_provenance_classify(ix->description) == BB_PROVENANCE_INTACT &&
-      bb_provenance_classify(iy->description) == BB_PROVENANCE_INTACT)
+      bb_provenance_classify(iy->description) == BB_PROVENANCE_INTACT) {
     prov_count =
         bb_provenance_diff(ix->description, iy->description, prov_diff, sizeof prov_diff);
-  else
+    if (prov_count < 0)
+      fprintf(stderr, "bumpbake: out of memory comparing provenance; not compared\n");
+  } else
     note_damaged_provenance(a, ix, iy);
   bb_compare_verdict v = bb_compare_judge(&stats, &a->limits);
   if (a->quiet)

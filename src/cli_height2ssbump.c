@@ -125,6 +125,9 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
   rc = cli_check_output(h2s_command.name, a->input, a->output, a->settings.depth);
   if (!rc && a->dump_filtered)
     rc = cli_check_output(h2s_command.name, a->input, dump_path, a->settings.depth);
+  if (!rc && a->dump_filtered && cli_same_file(a->output, dump_path))
+    rc = cli_usage_error(h2s_command.name, "-D would write %s over the output %s",
+                         dump_path, a->output);
   return rc;
 }
 
@@ -201,12 +204,17 @@ static int h2s_run(cli_run *run, h2s_args *a) {
   if (!rc)
     rc = make_rgba(a, &img, &height, &result, &rgba);
   if (!rc) {
+    /* With -D, both files or neither (see cli_commit_outputs). */
     cli_run_set_input(run, a->input, &height, &a->settings);
     run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
-    rc = cli_write_output(run, output_kind(a), a->output, &rgba, BB_RANGE_UNIT);
+    cli_staged_output outs[2] = {{.kind = output_kind(a), .path = a->output},
+                                 {.kind = "filtered", .path = dump_path}};
+    int n = a->dump_filtered ? 2 : 1;
+    cli_stage_output(run, &outs[0], &rgba, BB_RANGE_UNIT);
+    if (n == 2)
+      cli_stage_output(run, &outs[1], &result.filtered, BB_RANGE_UNIT);
+    rc = cli_commit_outputs(outs, n);
   }
-  if (!rc && a->dump_filtered)
-    rc = cli_write_output(run, "filtered", dump_path, &result.filtered, BB_RANGE_UNIT);
   bb_image_free(&rgba);
   bb_bake_result_free(&result);
   bb_image_free(&height);

@@ -1,6 +1,7 @@
 /* cli_main.c: the bumpbake program: dispatches to a subcommand, answers
  * --help and --version. */
 #include "cli.h"
+#include "cli_common.h"
 
 #include "bumpbake.h"
 
@@ -43,6 +44,7 @@ static void print_usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
+  cli_install_signal_handlers();
   if (argc < 2) {
     print_usage(stderr);
     return BB_EXIT_USAGE;

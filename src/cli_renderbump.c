@@ -202,7 +202,7 @@ static int check_outputs(rbf_args *a) {
   }
   int rc = cli_check_output(rbf_command.name, a->model, a->output, BB_DEPTH_DEFAULT);
   if (!rc && a->height) {
-    if (!strcmp(a->height, a->output))
+    if (cli_same_file(a->height, a->output))
       return cli_usage_error(rbf_command.name, "--height and the normal map are both %s",
                              a->output);
     rc = cli_check_output(rbf_command.name, a->model, a->height, BB_DEPTH_DEFAULT);
@@ -250,19 +250,20 @@ static char *describe(const cli_run *run, const rbf_args *a, uint64_t model_hash
   return all;
 }
 
-static int write_image(const char *path, const bb_image *img, bb_depth depth, bb_range range,
-                       char *description, int quiet, const char *kind) {
+/* Stages img for out->path (complete under a temporary name) with its own
+ * provenance text, which it frees; cli_commit_outputs puts the normal map
+ * and the height in place together or neither. */
+static void stage_image(cli_staged_output *out, const bb_image *img, bb_depth depth,
+                        bb_range range, char *description) {
+  out->file = NULL;
   if (!description) {
-    cli_file_error(path, "out of memory");
-    return BB_EXIT_FAILURE;
+    out->status = BB_ERR_MEMORY;
+    snprintf(out->error.message, sizeof out->error.message, "out of memory");
+    return;
   }
   bb_write_options wo = {depth, range, description};
-  bb_error err = {{0}};
-  bb_status st = bb_image_write(path, img, &wo, &err);
+  out->status = bb_image_write_staged(out->path, img, &wo, &out->file, &out->error);
   free(description);
-  if (!st && !quiet)
-    printf("wrote %s %s\n", kind, path);
-  return cli_status_exit(path, st, &err);
 }
 
 /* Integer files hold 0.5 + 0.5 N and the coverage as it is, so RGB is
@@ -306,14 +307,20 @@ static int write_outputs(const cli_run *run, const rbf_args *a, const bb_mesh *m
     bb_image_flip_green(&r->normal);
   bb_range range;
   encode_for(a->output, &r->normal, &range);
-  int rc = write_image(a->output, &r->normal, BB_DEPTH_DEFAULT, range, normal_text, a->quiet,
-                       "normal");
-  if (rc || !a->height)
-    return rc;
-  bb_depth depth = bb_path_supports_depth(a->height, BB_DEPTH_16) ? BB_DEPTH_16 : BB_DEPTH_DEFAULT;
-  rc = write_image(a->height, &r->height, depth, BB_RANGE_UNIT,
-                   describe(run, a, hash, "height", r), a->quiet, "height");
-  if (!rc) {
+  cli_staged_output outs[2] = {{.kind = "normal", .path = a->output},
+                               {.kind = "height", .path = a->height}};
+  const int n = a->height ? 2 : 1;
+  stage_image(&outs[0], &r->normal, BB_DEPTH_DEFAULT, range, normal_text);
+  if (a->height) {
+    bb_depth depth =
+        bb_path_supports_depth(a->height, BB_DEPTH_16) ? BB_DEPTH_16 : BB_DEPTH_DEFAULT;
+    stage_image(&outs[1], &r->height, depth, BB_RANGE_UNIT,
+                describe(run, a, hash, "height", r));
+  }
+  int rc = cli_commit_outputs(outs, n);
+  for (int i = 0; i < n && !rc && !a->quiet; i++)
+    printf("wrote %s %s\n", outs[i].kind, outs[i].path);
+  if (!rc && a->height) {
     note_texel_aspect(a, r);
     /* The one number the height is useless without: printed even with -q. */
     printf("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)\n",

@@ -89,49 +89,35 @@ int cli_slope_check(const char *command, cli_slope_args *a, const char *input,
   return cli_check_output(command, input, a->lit_path, depth);
 }
 
-/* cli_write_output without mip levels (an average of slope bytes means
- * nothing, and the preview is a picture), the map itself at 8 bits whatever
- * --depth says: its bytes are the map. */
-static int write_flat(cli_run *run, const char *kind, const char *path,
-                      const bb_image *img, int eight_bit) {
-  cli_settings settings = *run->settings;
-  settings.mips = 0;
+void cli_slope_settings(const cli_settings *run_settings, int eight_bit,
+                        cli_settings *out) {
+  *out = *run_settings;
+  out->mips = 0;
   if (eight_bit)
-    settings.depth = BB_DEPTH_8;
-  cli_run copy = *run;
-  copy.settings = &settings;
-  int rc = cli_write_output(&copy, kind, path, img, BB_RANGE_UNIT);
-  run->seconds_write = copy.seconds_write;
-  return rc;
+    out->depth = BB_DEPTH_8;
 }
 
-int cli_slope_write(cli_run *run, const cli_slope_args *a, const bb_image *filtered,
-                    int quiet) {
+int cli_slope_make(const cli_run *run, const cli_slope_args *a, const bb_image *filtered,
+                   bb_image *slope, bb_image *lit) {
+  memset(slope, 0, sizeof *slope);
+  memset(lit, 0, sizeof *lit);
   if (!a->path)
     return 0;
   const bb_bake_options *o = &run->settings->bake;
-  bb_image slope = {0}, lit = {0};
   bb_error err = {{0}};
-  bb_status st =
-      bb_slope_map(filtered, o->height_scale, o->smooth.addressing, &slope, &err);
+  bb_status st = bb_slope_map(filtered, o->height_scale, o->smooth.addressing, slope, &err);
   int rc = cli_status_exit(a->path, st, &err);
-  if (!rc)
-    rc = write_flat(run, "slope", a->path, &slope, 1);
-  if (!rc && !quiet)
-    printf("wrote slope %s\n", a->path);
   if (!rc && a->lit) {
     double light[3];
     float table[256];
     bb_light_direction(a->azimuth, a->elevation, light);
     bb_slope_table(light, table);
-    rc = cli_status_exit(a->lit_path, bb_slope_light(&slope, table, &lit, &err), &err);
-    if (!rc)
-      rc = write_flat(run, "slope_lit", a->lit_path, &lit, 0);
-    if (!rc && !quiet)
-      printf("wrote slope_lit %s\n", a->lit_path);
+    rc = cli_status_exit(a->lit_path, bb_slope_light(slope, table, lit, &err), &err);
   }
-  bb_image_free(&lit);
-  bb_image_free(&slope);
+  if (rc) {
+    bb_image_free(slope);
+    bb_image_free(lit);
+  }
   return rc;
 }
 

@@ -27,10 +27,18 @@ int cli_slope_option(const char *command, cli_slope_args *a, const cli_option *o
 int cli_slope_check(const char *command, cli_slope_args *a, const char *input,
                     bb_depth depth);
 
-/* Writes the slope map of the smoothed height (and the preview) with the
- * run's provenance; prints "wrote ..." unless quiet. 0 or BB_EXIT_FAILURE. */
-int cli_slope_write(cli_run *run, const cli_slope_args *a, const bb_image *filtered,
-                    int quiet);
+/* Makes the slope map of the smoothed height into *slope and, with --lit,
+ * its preview into *lit (zeroed otherwise); nothing when --slope was not
+ * given. 0, or BB_EXIT_FAILURE after printing the error. bake writes them
+ * with its other outputs, all or none (cli_commit_outputs). */
+int cli_slope_make(const cli_run *run, const cli_slope_args *a, const bb_image *filtered,
+                   bb_image *slope, bb_image *lit);
+
+/* The settings the slope files are written with: no mip levels (an average
+ * of slope bytes means nothing, and the preview is a picture), and with
+ * eight_bit (the map itself) 8 bits whatever --depth says: its bytes are the
+ * map. */
+void cli_slope_settings(const cli_settings *run_settings, int eight_bit, cli_settings *out);
 
 void cli_slope_free(cli_slope_args *a);
 

@@ -8,24 +8,33 @@
 // (heights, ssbump, ao), so both directions ask for unassociated alpha.
 #include "internal.h"
 #include "maps_internal.h"
+#include "sanitizer_options.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <fcntl.h>
 #include <memory>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
+
+#ifdef BB_ASAN_BUILD
+#include <sanitizer/lsan_interface.h>
+#endif
 
 using OIIO::ImageInput;
 using OIIO::ImageOutput;
@@ -117,16 +126,138 @@ bb_status check_readable(const char *path, bb_error *err) {
   return BB_OK;
 }
 
-bb_status check_spec_size(const char *path, const ImageSpec &spec, bb_error *err) {
+constexpr long MiB = 1L << 20;
+
+// OpenImageIO's own guards against headers that declare absurd sizes: some
+// readers check them in open(), before bumpbake sees the header. They are
+// process-wide, so they are only ever lowered, never raised.
+void lower_oiio_limits() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    int mb = 0, channels = 0;
+    const int our_mb = (int)(BB_MAX_READ_BYTES / MiB);
+    if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
+      OIIO::attribute("limits:imagesize_MB", our_mb);
+    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
+      OIIO::attribute("limits:channels", 64);
+  });
+}
+
+// OIIO's refusal under its limits spans two lines and tells the reader to
+// raise an OIIO attribute, which a bumpbake user cannot: keep the first line.
+bool is_limit_refusal(const std::string &why) {
+  return why.find("limits:imagesize_MB") != std::string::npos ||
+         why.find("limits:channels") != std::string::npos;
+}
+
+std::string first_line(const std::string &s) {
+  return s.substr(0, s.find('\n'));
+}
+
+// In sanitizer builds, allocations made while OpenImageIO's PNG reader
+// opens or decodes a file (in this thread) are not leaks to LeakSanitizer:
+// its one known leak is not ours (see sanitizer_options.h). Whether the
+// file is a PNG is asked of OpenImageIO's PNG reader (its signature check),
+// since OpenImageIO picks readers by content too. Release builds skip all
+// of this.
+class OiioPngLeakScope {
+public:
+  explicit OiioPngLeakScope(bool png) : active_(png) {
+#ifdef BB_ASAN_BUILD
+    if (active_) __lsan_disable();
+#endif
+  }
+  ~OiioPngLeakScope() {
+#ifdef BB_ASAN_BUILD
+    if (active_) __lsan_enable();
+#endif
+  }
+  OiioPngLeakScope(const OiioPngLeakScope &) = delete;
+  OiioPngLeakScope &operator=(const OiioPngLeakScope &) = delete;
+
+  static bool applies_to(const char *path) {
+#ifdef BB_ASAN_BUILD
+    auto png = ImageInput::create("png");
+    return png && png->valid_file(path);
+#else
+    (void)path;
+    return false;
+#endif
+  }
+
+private:
+  bool active_;
+};
+
+// An opened input and whether it is read by OpenImageIO's PNG reader.
+struct opened_input {
+  std::unique_ptr<ImageInput> in;
+  bool png = false;
+};
+
+opened_input open_input(const char *path, bb_status *st, bb_error *err) {
+  opened_input opened;
+  *st = check_readable(path, err);
+  if (*st != BB_OK) return opened;
+  lower_oiio_limits();
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  opened.png = OiioPngLeakScope::applies_to(path);
+  {
+    OiioPngLeakScope png_leak(opened.png);
+    opened.in = ImageInput::open(path, &config);
+  }
+  if (!opened.in) {
+    std::string why = OIIO::geterror();
+    if (is_limit_refusal(why))
+      *st = bb__fail(err, BB_ERR_SIZE,
+                     "%s: too large to read: %s (bumpbake reads at most %ld MiB of samples)",
+                     path, first_line(why).c_str(), BB_MAX_READ_BYTES / MiB);
+    else
+      *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                     one_line(why).c_str());
+  }
+  return opened;
+}
+
+bb_status check_spec_shape(const char *path, const ImageSpec &spec, bb_error *err) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     return bb__fail(err, BB_ERR_SIZE, "%s: zero or negative image size %dx%d, %d channels",
                     path, spec.width, spec.height, spec.nchannels);
   if (spec.depth > 1)
     return bb__fail(err, BB_ERR_FORMAT, "%s: volume images (depth %d) are not supported",
                     path, spec.depth);
+  if (spec.deep)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: deep images are not supported", path);
+  return BB_OK;
+}
+
+// Everything a read would allocate, checked against the header before any
+// allocation: the texel count, the channel count, the bytes of the file's
+// own samples (some readers decode the whole image natively first) and the
+// bytes of the floats handed back.
+bb_status check_spec_size(const char *path, const ImageSpec &spec, int channels_read,
+                          bb_error *err) {
+  bb_status st = check_spec_shape(path, spec, err);
+  if (st != BB_OK) return st;
   if (spec.nchannels > 64)
     return bb__fail(err, BB_ERR_FORMAT, "%s: %d channels (at most 64 are supported)", path,
                     spec.nchannels);
+  const double texels = (double)spec.width * (double)spec.height;
+  if (spec.width > BB_MAX_DIMENSION || spec.height > BB_MAX_DIMENSION ||
+      texels > (double)BB_MAX_PIXELS)
+    return bb__fail(err, BB_ERR_SIZE,
+                    "%s: image %dx%d is over the maximum (%d per side, %ld texels)", path,
+                    spec.width, spec.height, BB_MAX_DIMENSION, (long)BB_MAX_PIXELS);
+  const double file_bytes = (double)spec.image_bytes(true);
+  const double float_bytes = texels * channels_read * (double)sizeof(float);
+  const double bytes = file_bytes > float_bytes ? file_bytes : float_bytes;
+  if (bytes > (double)BB_MAX_READ_BYTES)
+    return bb__fail(err, BB_ERR_SIZE,
+                    "%s: %dx%d with %d channels of %s needs %.0f MiB, over the limit of "
+                    "%ld MiB",
+                    path, spec.width, spec.height, spec.nchannels,
+                    spec.format.c_str(), bytes / (double)MiB, BB_MAX_READ_BYTES / MiB);
   return BB_OK;
 }
 
@@ -150,32 +281,70 @@ bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *
   return BB_OK;
 }
 
-bb_status read_image(const char *path, bb_image *out, bb_image_info *info, bb_error *err) {
-  bb_status st = check_readable(path, err);
-  if (st != BB_OK) return st;
+// Rows decoded per call: whole tile rows for tiled files, else about 4 MiB
+// of floats. Reading in bands lets a file whose data stops early (a header
+// promising 8192 rows over 52 bytes) fail at its first band instead of
+// decoding, and touching, the whole image.
+int rows_per_band(const ImageSpec &spec, int channels) {
+  if (spec.tile_width > 0 && spec.tile_height > 0) return spec.tile_height;
+  long row_bytes = (long)spec.width * channels * (long)sizeof(float);
+  long rows = (4 * MiB) / (row_bytes > 0 ? row_bytes : 1);
+  return rows < 1 ? 1 : (rows > spec.height ? spec.height : (int)rows);
+}
 
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in)
-    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                    one_line(OIIO::geterror()).c_str());
+// Decodes channels [first, first + out->channels) into out, band by band.
+// A truncated file must fail, not come back as zeros: both the return value
+// and the error queue are checked, since some readers only record a warning.
+std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &spec,
+                       int first, bb_image *out) {
+  const int band = rows_per_band(spec, out->channels);
+  const size_t row_floats = (size_t)spec.width * (size_t)out->channels;
+  for (int y = 0; y < spec.height; y += band) {
+    const int rows = spec.height - y < band ? spec.height - y : band;
+    float *dst = out->pixels + (size_t)y * row_floats;
+    const int y0 = spec.y + y, y1 = spec.y + y + rows;
+    OiioPngLeakScope png_leak(png);
+    bool ok = spec.tile_width > 0
+                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1, spec.z,
+                                  spec.z + 1, first, first + out->channels, TypeDesc::FLOAT,
+                                  dst)
+                  : in.read_scanlines(0, miplevel, y0, y1, spec.z, first,
+                                      first + out->channels, TypeDesc::FLOAT, dst);
+    if (!ok || in.has_error()) {
+      std::string why = in.geterror();
+      return why.empty() ? std::string("read failed") : why;
+    }
+  }
+  return std::string();
+}
+
+// Reads channels [first, first + count) (count < 0: all of them).
+bb_status read_channels(const char *path, int first, int count, bb_image *out,
+                        bb_image_info *info, bb_error *err) {
+  bb_status st;
+  opened_input opened = open_input(path, &st, err);
+  if (!opened.in) return st;
+  ImageInput *in = opened.in.get();
   const ImageSpec spec = in->spec();
-  st = check_spec_size(path, spec, err);
+  if (count < 0) {
+    first = 0;
+    count = spec.nchannels;
+  }
+  st = check_spec_size(path, spec, count, err);
   if (st != BB_OK) return st;
+  if (first < 0 || count < 1 || first + count > spec.nchannels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: channels %d..%d asked of a %d-channel image",
+                    path, first, first + count - 1, spec.nchannels);
 
   bb_error alloc_err;
-  st = bb_image_alloc(out, spec.width, spec.height, spec.nchannels, &alloc_err);
+  st = bb_image_alloc(out, spec.width, spec.height, count, &alloc_err);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
 
-  // A truncated file must fail, not come back as zeros: check both the return
-  // value and the error queue, since some readers only record a warning.
-  bool ok = in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, out->pixels);
-  if (!ok || in->has_error()) {
-    std::string why = in->geterror();
+  std::string why = read_bands(*in, opened.png, 0, spec, first, out);
+  if (!why.empty()) {
     bb_image_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
-                    one_line(why).c_str());
+                    one_line(first_line(why)).c_str());
   }
   st = fill_info(*in, spec, info, path, err);
   if (st != BB_OK) {
@@ -185,25 +354,41 @@ bb_status read_image(const char *path, bb_image *out, bb_image_info *info, bb_er
   return st;
 }
 
-// Opens path and reads its header only: no pixel is decoded, so a file of
-// any size costs only its header (and a truncated file is not noticed).
 bb_status read_header(const char *path, int *width, int *height, int *channels,
                       bb_image_info *info, bb_error *err) {
-  bb_status st = check_readable(path, err);
-  if (st != BB_OK) return st;
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in)
-    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                    one_line(OIIO::geterror()).c_str());
-  const ImageSpec spec = in->spec();
-  st = check_spec_size(path, spec, err);
+  bb_status st;
+  opened_input opened = open_input(path, &st, err);
+  if (!opened.in) return st;
+  ImageInput *in = opened.in.get();
+  const ImageSpec &spec = in->spec();
+  st = check_spec_shape(path, spec, err);
   if (st != BB_OK) return st;
   if (width) *width = spec.width;
   if (height) *height = spec.height;
   if (channels) *channels = spec.nchannels;
   return fill_info(*in, spec, info, path, err);
+}
+
+// Runs a read, turning exceptions into statuses and cleaning up after any
+// failure: the firewall every extern "C" read goes through.
+template <typename Fn>
+bb_status guarded_read(const char *path, bb_image *out, bb_image_info *info, bb_error *err,
+                       Fn &&read) {
+  bb_status st;
+  try {
+    st = read();
+  } catch (const std::bad_alloc &) {
+    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
+  } catch (const std::exception &e) {
+    st = bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    st = bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+  if (st != BB_OK) {
+    bb_image_free(out);
+    bb_image_info_free(info);
+  }
+  return st;
 }
 
 // ------------------------------------------------------------------ writing
@@ -253,41 +438,109 @@ const format_rule *find_format(const std::string &ext) {
   return nullptr;
 }
 
-std::string directory_of(const char *path) {
-  const char *slash = std::strrchr(path, '/');
-  if (!slash) return ".";
-  if (slash == path) return "/";
-  return std::string(path, (size_t)(slash - path));
+// ------------------------------------------------------- the safe write path
+
+// An OpenImageIO output proxy over a bb_staged_file: every byte an encoder
+// produces goes through bumpbake's checked, buffered writes (internal.h),
+// whatever the encoder itself does with a failed write.
+class SafeProxy final : public OIIO::Filesystem::IOProxy {
+public:
+  SafeProxy(bb_staged_file *file, const std::string &name)
+      : IOProxy(name, Write), file_(file) {}
+  const char *proxytype() const override { return "bumpbake-safe"; }
+  void close() override {} // bb__safe_finish closes, checked
+  int64_t tell() override { return bb__safe_tell(file_); }
+  bool seek(int64_t offset) override { return bb__safe_seek(file_, offset) == 0; }
+  size_t read(void *buf, size_t size) override { return bb__safe_read(file_, buf, size); }
+  size_t write(const void *buf, size_t size) override {
+    return bb__safe_write(file_, buf, size);
+  }
+  size_t pread(void *buf, size_t size, int64_t offset) override {
+    return bb__safe_pread(file_, buf, size, offset);
+  }
+  size_t pwrite(const void *buf, size_t size, int64_t offset) override {
+    return bb__safe_pwrite(file_, buf, size, offset);
+  }
+  size_t size() const override { return (size_t)bb__safe_size(file_); }
+  void flush() const override {} // bb__safe_finish flushes and fsyncs
+
+private:
+  bb_staged_file *file_;
+};
+
+// What an encoder does: create an ImageOutput for name (its extension picks
+// the format) that writes through proxy (ImageOutput::create(name, proxy)),
+// open, write and close it, and return "" or OpenImageIO's reason.
+using encoder_fn =
+    std::function<std::string(const std::string &name, OIIO::Filesystem::IOProxy *proxy)>;
+
+// THE way an OpenImageIO writer puts a file on disk; every writer in this
+// file (and any new one: mip-mapped, multi-image...) calls it. It opens a
+// bb_staged_file for path, runs encode through a SafeProxy, and then either
+// finishes the file (flushed, fsynced, closed: complete under its temporary
+// name, for the caller to bb__safe_commit or bb__safe_discard) or removes
+// it and returns BB_ERR_IO. A failed write is reported with the system's
+// reason ("No space left on device") even when the encoder claimed success.
+bb_status write_safely(const char *path, const encoder_fn &encode, bb_staged_file *f,
+                       bb_error *err) {
+  bb_status st = bb__safe_open(f, path, err);
+  if (st != BB_OK) return st;
+  std::string why;
+  try {
+    SafeProxy proxy(f, f->temp_path);
+    why = encode(f->temp_path, &proxy);
+    // An encoder that ignored the proxy would have written past the checks.
+    if (why.empty() && bb__safe_size(f) == 0)
+      why = "internal error: the encoder did not write through the checked output";
+  } catch (...) {
+    bb__safe_discard(f);
+    throw;
+  }
+  // The encoder is done, so no other thread touches f. When a write failed,
+  // finish reports the system's reason, which says more than the codec's.
+  if (!why.empty() && !f->error) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  return bb__safe_finish(f, err);
 }
 
-// Creates an empty temporary file "DIR/.bb-tmp-XXXXXX.ext" with mode 0666 less
-// the umask (mkstemps would make it 0600, and the rename keeps the mode).
-// Returns its name, or "" with errno set.
-std::string create_temp_file(const std::string &dir, const std::string &ext) {
-  static const char ALNUM[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
-  static std::uint64_t counter = 0;
-  struct timespec ts;
-  clock_gettime(CLOCK_REALTIME, &ts);
-  std::uint64_t seed = (std::uint64_t)ts.tv_nsec ^ ((std::uint64_t)ts.tv_sec << 30) ^
-                       ((std::uint64_t)getpid() << 16);
-  for (int attempt = 0; attempt < 100; attempt++) {
-    // splitmix64 step: a fresh, well mixed value per attempt and per call.
-    std::uint64_t z = (seed += 0x9E3779B97F4A7C15ull + __atomic_fetch_add(&counter, 1, __ATOMIC_RELAXED));
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    std::string name = dir + "/.bb-tmp-";
-    for (int i = 0; i < 6; i++, z /= 62) name += ALNUM[z % 62];
-    name += ext;
-    int fd = open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      close(fd);
-      return name;
-    }
-    if (errno != EEXIST) return std::string();
+// Reads a finished file back; "" when it is whole, else why not.
+using verify_fn = std::function<std::string(const std::string &name)>;
+
+// write_safely for an encoder OpenImageIO cannot run through a proxy, which
+// gets proxy == nullptr and writes to the temporary by name: OpenImageIO
+// 2.4's TIFF writer re-opens its proxy in "w" mode for every directory it
+// appends, so through a proxy a file of several directories keeps only the
+// last. Its own writes are then not checked one by one, so the temporary is
+// fsynced (a full disk can show only there) and verify must read the whole
+// file back. Same contract as write_safely otherwise.
+bb_status write_safely_by_name(const char *path, const encoder_fn &encode,
+                               const verify_fn &verify, bb_staged_file *f, bb_error *err) {
+  bb_status st = bb__safe_open(f, path, err);
+  if (st != BB_OK) return st;
+  std::string why;
+  try {
+    why = encode(f->temp_path, nullptr);
+  } catch (...) {
+    bb__safe_discard(f);
+    throw;
   }
-  errno = EEXIST;
-  return std::string();
+  if (why.empty()) {
+    st = bb__safe_finish(f, err);
+    if (st != BB_OK) return st;
+    try {
+      why = verify(f->temp_path);
+    } catch (...) {
+      bb__safe_discard(f);
+      throw;
+    }
+  }
+  if (!why.empty()) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
+  }
+  return BB_OK;
 }
 
 // Round-half-up quantisation of v (after the range mapping) to 0..max_code.
@@ -318,10 +571,11 @@ std::vector<T> quantise_image(const bb_image *img, bb_range range) {
   return codes;
 }
 
-// Writes img to file_name (a temporary name whose extension picks the format).
-// Returns "" on success, else OIIO's reason.
-std::string write_with_oiio(const std::string &file_name, const bb_image *img, bb_depth depth,
-                            bb_range range, const char *description) {
+// Encodes img into file_name (a temporary name whose extension picks the
+// format) through proxy. Returns "" on success, else OIIO's reason.
+std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy *proxy,
+                         const bb_image *img, bb_depth depth, bb_range range,
+                         const char *description) {
   TypeDesc file_type = depth == BB_DEPTH_8      ? TypeDesc::UINT8
                        : depth == BB_DEPTH_16   ? TypeDesc::UINT16
                        : depth == BB_DEPTH_HALF ? TypeDesc::HALF
@@ -334,8 +588,11 @@ std::string write_with_oiio(const std::string &file_name, const bb_image *img, b
                    description_to_store(extension_of(file_name.c_str()) == ".tga", description));
   if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
 
-  auto out = ImageOutput::create(file_name);
+  auto out = ImageOutput::create(file_name, proxy);
   if (!out) return one_line(OIIO::geterror());
+  if (!out->supports("ioproxy"))
+    return std::string("internal error: the ") + out->format_name() +
+           " writer cannot write through a checked output";
   if (std::strcmp(out->format_name(), "png") == 0) {
     // Bakes are iterated on far more often than shipped, so PNG favours speed.
     // libpng's default tries all five row filters on every row and keeps one
@@ -412,43 +669,57 @@ bb_status resolve_depth(const char *path, const format_rule &f, const bb_write_o
   return BB_OK;
 }
 
-bb_status write_image(const char *path, const bb_image *img, const bb_write_options *options,
-                      bb_error *err) {
+// Everything bb_image_write checks before writing a byte; *depth receives
+// the depth to write.
+bb_status check_write(const char *path, const bb_image *img, const bb_write_options &o,
+                      bb_depth *depth, bb_error *err) {
   bb_status st = check_image_arg(path, img, err);
   if (st != BB_OK) return st;
-  const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
-  const bb_write_options &o = options ? *options : defaults;
-
   st = check_options(path, o, err);
   if (st != BB_OK) return st;
-
   std::string ext = extension_of(path);
   const format_rule *f = find_format(ext);
   if (!f)
     return bb__fail(err, BB_ERR_FORMAT,
                     "%s: unknown output format '%s' (use .png, .tga, .tif, .tiff or .exr)", path,
                     ext.c_str());
-  bb_depth depth;
-  st = resolve_depth(path, *f, o, img->channels, &depth, err);
-  if (st != BB_OK) return st;
+  return resolve_depth(path, *f, o, img->channels, depth, err);
+}
 
-  std::string tmp = create_temp_file(directory_of(path), ext);
-  if (tmp.empty())
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
-  std::string why;
+// Writes img to a finished (complete, synced) temporary for path: f is then
+// committed or discarded by the caller.
+bb_status write_image_staged(const char *path, const bb_image *img,
+                             const bb_write_options *options, bb_staged_file *f,
+                             bb_error *err) {
+  const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
+  const bb_write_options &o = options ? *options : defaults;
+  bb_depth depth;
+  bb_status st = check_write(path, img, o, &depth, err);
+  if (st != BB_OK) return st;
+  return write_safely(
+      path,
+      [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
+        return encode_image(name, proxy, img, depth, o.range, o.description);
+      },
+      f, err);
+}
+
+// The firewall of every extern "C" write: exceptions become statuses, and
+// whatever was staged is removed.
+template <typename Fn>
+bb_status guarded_write(const char *path, bb_staged_file *f, bb_error *err, Fn &&write) {
   try {
-    why = write_with_oiio(tmp, img, depth, o.range, o.description);
+    return write();
+  } catch (const std::bad_alloc &) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
+  } catch (const std::exception &e) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
   } catch (...) {
-    unlink(tmp.c_str());
-    throw;
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
   }
-  if (why.empty() && std::rename(tmp.c_str(), path) != 0)
-    why = std::strerror(errno);
-  if (!why.empty()) {
-    unlink(tmp.c_str());
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
-  }
-  return BB_OK;
 }
 
 // --------------------------------------------------------------------- text
@@ -489,10 +760,13 @@ bb_status count_frames(const char *path, int *frames, bb_error *err) {
 
 } // namespace
 
-// The GIF being written: OIIO's writer holds the temporary file open; the
+// The GIF being written: OIIO's writer writes the frames through a
+// SafeProxy into a staged temporary (the safe write path of internal.h); the
 // final name appears only once bb_animation_close has checked the file.
 struct bb_animation {
-  std::string path, tmp;
+  std::string path;
+  bb_staged_file file; // the temporary; discarded unless committed
+  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy; // outlives out
   std::unique_ptr<ImageOutput> out;
   ImageSpec spec;
   int frames = 0;
@@ -500,13 +774,16 @@ struct bb_animation {
 
 namespace {
 
-void animation_destroy(bb_animation *a, bool remove_tmp) {
+// Closes and frees a; a temporary still staged is removed (after a commit
+// there is none).
+void animation_destroy(bb_animation *a) {
   if (!a) return;
   try {
     if (a->out) a->out->close();
   } catch (...) {
   }
-  if (remove_tmp && !a->tmp.empty()) unlink(a->tmp.c_str());
+  a->out.reset();
+  bb__safe_discard(&a->file);
   delete a;
 }
 
@@ -519,15 +796,19 @@ bb_status animation_open(const char *path, int width, int height, double fps,
   if (!(fps >= 1.0 && fps <= 100.0))
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: frames per second must be in 1..100 (got %g)",
                     path, fps);
-  std::unique_ptr<bb_animation> a(new bb_animation);
+  bb_animation *a = new bb_animation;
   a->path = path;
-  a->tmp = create_temp_file(directory_of(path), ".gif");
-  if (a->tmp.empty())
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
-  a->out = ImageOutput::create(a->tmp);
-  if (!a->out) {
-    std::string why = one_line(OIIO::geterror());
-    unlink(a->tmp.c_str());
+  st = bb__safe_open(&a->file, path, err);
+  if (st != BB_OK) {
+    delete a; // nothing was staged
+    return st;
+  }
+  a->proxy.reset(new SafeProxy(&a->file, a->file.temp_path));
+  a->out = ImageOutput::create(a->file.temp_path, a->proxy.get());
+  if (!a->out || !a->out->supports("ioproxy")) {
+    std::string why = a->out ? std::string("the GIF writer cannot write through a checked output")
+                             : one_line(OIIO::geterror());
+    animation_destroy(a);
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
   }
   a->spec = ImageSpec(width, height, 3, TypeDesc::UINT8);
@@ -535,7 +816,7 @@ bb_status animation_open(const char *path, int width, int height, double fps,
   int per_second[2] = {100, (int)std::lround(100.0 / fps)};
   a->spec.attribute("FramesPerSecond", OIIO::TypeRational, per_second);
   a->spec.attribute("gif:LoopCount", 0); // loop forever
-  *out = a.release();
+  *out = a;
   return BB_OK;
 }
 
@@ -547,31 +828,33 @@ bb_status animation_add(bb_animation *a, const bb_image *frame, bb_error *err) {
                     a->spec.width, a->spec.height);
   ImageOutput::OpenMode mode = a->frames == 0 ? ImageOutput::Create : ImageOutput::AppendSubimage;
   std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(frame, BB_RANGE_UNIT);
-  if (!a->out->open(a->tmp, a->spec, mode) || !a->out->write_image(TypeDesc::UINT8, codes.data()))
+  if (!a->out->open(a->file.temp_path, a->spec, mode) ||
+      !a->out->write_image(TypeDesc::UINT8, codes.data()))
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path,
                     one_line(a->out->geterror()).c_str());
   a->frames++;
   return BB_OK;
 }
 
-// OIIO 2.4's GIF writer does not report a failed fwrite, so the finished
-// temporary file is read back: a short file has fewer frames or none.
+// OIIO 2.4's GIF writer does not report a failed fwrite; the checked output
+// does (bb__safe_finish), and the finished temporary is read back as well:
+// a short file has fewer frames or none.
 bb_status animation_close(bb_animation *a, bb_error *err) {
   const char *path = a->path.c_str();
   if (a->frames == 0) return bb__fail(err, BB_ERR_ARGUMENT, "%s: no frames to write", path);
   bool closed = a->out->close();
   std::string why = a->out->geterror();
   a->out.reset();
-  if (!closed) return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(why).c_str());
+  if (!closed && !a->file.error)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(why).c_str());
+  bb_status st = bb__safe_finish(&a->file, err);
+  if (st != BB_OK) return st;
   int frames = 0;
   bb_error read_err;
-  if (count_frames(a->tmp.c_str(), &frames, &read_err) != BB_OK || frames != a->frames)
+  if (count_frames(a->file.temp_path, &frames, &read_err) != BB_OK || frames != a->frames)
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: the file holds %d of %d frames", path,
                     frames, a->frames);
-  if (std::rename(a->tmp.c_str(), path) != 0)
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
-  a->tmp.clear(); // renamed: nothing to remove
-  return BB_OK;
+  return bb__safe_commit(&a->file, err);
 }
 
 // ------------------------------------------------------------ mip chains
@@ -582,6 +865,30 @@ constexpr int MIP_TILE = 64;
 
 bool format_holds_mips(const std::string &ext) {
   return ext == ".tif" || ext == ".tiff" || ext == ".exr";
+}
+
+// Writes one level tile by tile, each from a full MIP_TILE x MIP_TILE buffer
+// whose part past the image edge is zero. OpenImageIO 2.4's write_image
+// leaves that part of edge tiles uninitialised (valgrind: uninitialised
+// bytes reach deflate), so mip-mapped TIFFs came out different on every run
+// (171557 to 198825 bytes for one 96 x 64 chain) and could carry stray
+// memory. samples: the level's width x height x channels values of type.
+template <typename T>
+bool write_padded_tiles(ImageOutput &out, const bb_image &img, TypeDesc type,
+                        const T *samples) {
+  const size_t channels = (size_t)img.channels, tile = (size_t)MIP_TILE;
+  std::vector<T> buffer(tile * tile * channels);
+  for (int y0 = 0; y0 < img.height; y0 += MIP_TILE)
+    for (int x0 = 0; x0 < img.width; x0 += MIP_TILE) {
+      std::fill(buffer.begin(), buffer.end(), T(0));
+      const int rows = std::min(MIP_TILE, img.height - y0), cols = std::min(MIP_TILE, img.width - x0);
+      for (int r = 0; r < rows; r++)
+        std::memcpy(&buffer[(size_t)r * tile * channels],
+                    samples + ((size_t)(y0 + r) * (size_t)img.width + (size_t)x0) * channels,
+                    (size_t)cols * channels * sizeof(T));
+      if (!out.write_tile(x0, y0, 0, type, buffer.data())) return false;
+    }
+  return true;
 }
 
 // Encodes the chain into file_name (a temporary name whose extension picks
@@ -619,12 +926,12 @@ std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy 
     bool ok;
     if (depth == BB_DEPTH_8) {
       std::vector<std::uint8_t> codes = quantise_image<std::uint8_t>(img, range);
-      ok = out->write_image(TypeDesc::UINT8, codes.data());
+      ok = write_padded_tiles(*out, *img, TypeDesc::UINT8, codes.data());
     } else if (depth == BB_DEPTH_16) {
       std::vector<std::uint16_t> codes = quantise_image<std::uint16_t>(img, range);
-      ok = out->write_image(TypeDesc::UINT16, codes.data());
+      ok = write_padded_tiles(*out, *img, TypeDesc::UINT16, codes.data());
     } else {
-      ok = out->write_image(TypeDesc::FLOAT, img->pixels);
+      ok = write_padded_tiles(*out, *img, TypeDesc::FLOAT, img->pixels);
     }
     if (!ok) return one_line(out->geterror());
   }
@@ -653,8 +960,14 @@ bb_status check_chain(const char *path, const bb_image *levels, int count, bb_er
   return BB_OK;
 }
 
+// Writes the chain to a finished (complete, synced) temporary for path:
+// staged is then committed or discarded by the caller.
+bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
+                   int *level_count, bb_error *err);
+
 bb_status write_mips(const char *path, const bb_image *levels, int count,
-                     const bb_write_options *options, bb_error *err) {
+                     const bb_write_options *options, bb_staged_file *staged,
+                     bb_error *err) {
   bb_status st = check_chain(path, levels, count, err);
   if (st != BB_OK) return st;
   const bb_write_options defaults = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, nullptr};
@@ -669,34 +982,37 @@ bb_status write_mips(const char *path, const bb_image *levels, int count,
   st = resolve_depth(path, *f, o, levels[0].channels, &depth, err);
   if (st != BB_OK) return st;
 
-  std::string tmp = create_temp_file(directory_of(path), ext);
-  if (tmp.empty())
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, std::strerror(errno));
-  std::string why;
-  try {
-    why = encode_mips(tmp, nullptr, levels, count, depth, o.range, o.description);
-  } catch (...) {
-    unlink(tmp.c_str());
-    throw;
-  }
-  if (why.empty() && std::rename(tmp.c_str(), path) != 0) why = std::strerror(errno);
-  if (!why.empty()) {
-    unlink(tmp.c_str());
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
-  }
-  return BB_OK;
+  auto encode = [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
+    return encode_mips(name, proxy, levels, count, depth, o.range, o.description);
+  };
+  // A TIFF of several directories cannot go through a proxy (see
+  // write_safely_by_name); it is read back level by level instead.
+  if (ext == ".exr" || count == 1) return write_safely(path, encode, staged, err);
+  auto verify = [&](const std::string &name) -> std::string {
+    for (int k = 0; k < count; k++) {
+      bb_image level;
+      bb_error why;
+      int file_levels = 0;
+      if (read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK)
+        return std::string("read back: ") + why.message;
+      bool same = level.width == levels[k].width && level.height == levels[k].height &&
+                  file_levels == count;
+      bb_image_free(&level);
+      if (!same) return "read back: the file does not hold the levels written";
+    }
+    return std::string();
+  };
+  return write_safely_by_name(path, encode, verify, staged, err);
 }
 
+// Level `level` of a mip-mapped file, read with the same bounds and bands
+// as bb_image_read.
 bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
                    int *level_count, bb_error *err) {
-  bb_status st = check_readable(path, err);
-  if (st != BB_OK) return st;
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in)
-    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                    one_line(OIIO::geterror()).c_str());
+  bb_status st;
+  opened_input opened = open_input(path, &st, err);
+  if (!opened.in) return st;
+  ImageInput *in = opened.in.get();
   int levels = 0;
   while (in->seek_subimage(0, levels)) levels++;
   (void)in->geterror(); // the failed seek past the last level queued a message
@@ -707,17 +1023,16 @@ bb_status read_mip(const char *path, int level, bb_image *out, bb_image_info *in
   if (!in->seek_subimage(0, level))
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(in->geterror()).c_str());
   const ImageSpec spec = in->spec();
-  st = check_spec_size(path, spec, err);
+  st = check_spec_size(path, spec, spec.nchannels, err);
   if (st != BB_OK) return st;
   bb_error alloc_err;
   st = bb_image_alloc(out, spec.width, spec.height, spec.nchannels, &alloc_err);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
-  bool ok = in->read_image(0, level, 0, spec.nchannels, TypeDesc::FLOAT, out->pixels);
-  if (!ok || in->has_error()) {
-    std::string why = in->geterror();
+  std::string why = read_bands(*in, opened.png, level, spec, 0, out);
+  if (!why.empty()) {
     bb_image_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt or truncated image: %s", path,
-                    one_line(why).c_str());
+                    one_line(first_line(why)).c_str());
   }
   st = fill_info(*in, spec, info, path, err);
   if (st != BB_OK) bb_image_free(out);
@@ -772,15 +1087,33 @@ int bb_path_supports_mips(const char *path) {
 bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
-  try {
-    return write_mips(path, levels, count, options, err);
-  } catch (const std::bad_alloc &) {
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
-  } catch (const std::exception &e) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
-  } catch (...) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
+  bb_staged_file f;
+  std::memset(&f, 0, sizeof f);
+  f.fd = -1;
+  f.slot = -1;
+  return guarded_write(path, &f, err, [&] {
+    bb_status st = write_mips(path, levels, count, options, &f, err);
+    return st == BB_OK ? bb__safe_commit(&f, err) : st;
+  });
+}
+
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err) {
+  if (!staged)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: staged is NULL");
+  *staged = nullptr;
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: path is NULL");
+  bb_staged_file *f = bb__staged_new();
+  if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  bb_status st = guarded_write(
+      path, f, err, [&] { return write_mips(path, levels, count, options, f, err); });
+  if (st != BB_OK) {
+    std::free(f);
+    return st;
   }
+  *staged = f;
+  return BB_OK;
 }
 
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
@@ -821,55 +1154,63 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info, bb
   std::memset(out, 0, sizeof *out);
   clear_info(info);
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read: path is NULL");
-  try {
-    return read_image(path, out, info, err);
-  } catch (const std::bad_alloc &) {
-    bb_image_free(out);
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
-  } catch (const std::exception &e) {
-    bb_image_free(out);
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
-  } catch (...) {
-    bb_image_free(out);
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
-  }
+  return guarded_read(path, out, info, err,
+                      [&] { return read_channels(path, 0, -1, out, info, err); });
+}
+
+bb_status bb__image_read_channels(const char *path, int first_channel, int channel_count,
+                                  bb_image *out, bb_image_info *info, bb_error *err) {
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_channels: out is NULL");
+  std::memset(out, 0, sizeof *out);
+  clear_info(info);
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_channels: path is NULL");
+  if (channel_count < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: no channel to read", path);
+  return guarded_read(path, out, info, err, [&] {
+    return read_channels(path, first_channel, channel_count, out, info, err);
+  });
 }
 
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err) {
   clear_info(info);
+  if (width) *width = 0;
+  if (height) *height = 0;
+  if (channels) *channels = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_info: path is NULL");
-  try {
-    bb_status st = read_header(path, width, height, channels, info, err);
-    if (st != BB_OK) bb_image_info_free(info);
-    return st;
-  } catch (const std::bad_alloc &) {
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
-  } catch (const std::exception &e) {
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
-  } catch (...) {
-    bb_image_info_free(info);
-    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
-  }
+  return guarded_read(path, nullptr, info, err,
+                      [&] { return read_header(path, width, height, channels, info, err); });
 }
 
 bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_options *options,
                          bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write: path is NULL");
-  try {
-    return write_image(path, img, options, err);
-  } catch (const std::bad_alloc &) {
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while writing", path);
-  } catch (const std::exception &e) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, one_line(e.what()).c_str());
-  } catch (...) {
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", path);
+  bb_staged_file f;
+  std::memset(&f, 0, sizeof f);
+  f.fd = -1;
+  f.slot = -1;
+  return guarded_write(path, &f, err, [&] {
+    bb_status st = write_image_staged(path, img, options, &f, err);
+    return st == BB_OK ? bb__safe_commit(&f, err) : st;
+  });
+}
+
+bb_status bb_image_write_staged(const char *path, const bb_image *img,
+                                const bb_write_options *options, bb_staged_file **staged,
+                                bb_error *err) {
+  if (!staged) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: staged is NULL");
+  *staged = nullptr;
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: path is NULL");
+  bb_staged_file *f = bb__staged_new();
+  if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  bb_status st = guarded_write(path, f, err,
+                               [&] { return write_image_staged(path, img, options, f, err); });
+  if (st != BB_OK) {
+    std::free(f);
+    return st;
   }
+  *staged = f;
+  return BB_OK;
 }
 
 int bb_path_supports_depth(const char *path, bb_depth depth) {
@@ -969,11 +1310,11 @@ bb_status bb_animation_close(bb_animation *a, bb_error *err) {
   } catch (...) {
     st = bb__fail(err, BB_ERR_IO, "%s: cannot write: unknown error", a->path.c_str());
   }
-  animation_destroy(a, true);
+  animation_destroy(a);
   return st;
 }
 
-void bb_animation_abort(bb_animation *a) { animation_destroy(a, true); }
+void bb_animation_abort(bb_animation *a) { animation_destroy(a); }
 
 bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err) {
   if (!path || !frames) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_frame_count: NULL argument");

@@ -13,7 +13,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -265,60 +264,14 @@ std::unique_ptr<aiScene> mesh_to_scene(const bb_mesh *m) {
   return scene;
 }
 
-// Creates an empty "DIR/.bb-tmp-PID-N.ext" beside path with mode 0666 less
-// the umask (the rename keeps the mode). The pid and a counter make names
-// unique between threads and processes; a stale file of an earlier process
-// with the same pid only costs a retry. Returns its descriptor, or -1 with
-// errno set.
-int create_temp_file(const char *path, const char *ext, std::string *name) {
-  static std::atomic<unsigned> counter{0};
-  const char *slash = std::strrchr(path, '/');
-  std::string dir = !slash ? std::string(".")
-                    : slash == path ? std::string("/")
-                                    : std::string(path, (size_t)(slash - path));
-  for (int attempt = 0; attempt < 100; attempt++) {
-    char leaf[96];
-    std::snprintf(leaf, sizeof leaf, "/.bb-tmp-%ld-%u%s", (long)getpid(), counter++, ext);
-    std::string candidate = dir + leaf;
-    int fd = open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      *name = candidate;
-      return fd;
-    }
-    if (errno != EEXIST) return -1;
-  }
-  errno = EEXIST;
-  return -1;
-}
-
-// Writes size bytes to fd; 0 or an errno.
-int write_all(int fd, const void *data, size_t size) {
-  const char *p = static_cast<const char *>(data);
-  while (size > 0) {
-    ssize_t n = write(fd, p, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return n < 0 ? errno : EIO;
-    p += n;
-    size -= (size_t)n;
-  }
-  return 0;
-}
-
-// Publishes blob at path through a temporary file and a rename, so a
-// failure leaves no partial file. Returns "" or the reason.
-std::string write_blob_atomically(const char *path, const export_format &f,
-                                  const aiExportDataBlob *blob) {
-  std::string tmp;
-  int fd = create_temp_file(path, f.ext, &tmp);
-  if (fd < 0) return std::strerror(errno);
-  int e = write_all(fd, blob->data, blob->size);
-  if (close(fd) != 0 && e == 0) e = errno;
-  if (e == 0 && std::rename(tmp.c_str(), path) != 0) e = errno;
-  if (e != 0) {
-    unlink(tmp.c_str());
-    return std::strerror(e);
-  }
-  return std::string();
+// Publishes blob at path through the safe write path of internal.h
+// (checked writes, fsync, rename; nothing at path on any failure).
+bb_status write_blob_safely(const char *path, const aiExportDataBlob *blob, bb_error *err) {
+  bb_staged_file f;
+  bb_status st = bb__safe_open(&f, path, err);
+  if (st != BB_OK) return st;
+  bb__safe_write(&f, blob->data, blob->size);
+  return bb__safe_commit(&f, err);
 }
 
 bb_status check_mesh(const char *path, const bb_mesh *m, bb_error *err) {
@@ -348,9 +301,7 @@ bb_status write_mesh(const char *path, const bb_mesh *m, bb_error *err) {
   if (!blob)
     return bb__fail(err, BB_ERR_IO, "%s: cannot export: %s", path,
                     one_line(exporter.GetErrorString()).c_str());
-  std::string why = write_blob_atomically(path, *f, blob);
-  if (!why.empty()) return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, why.c_str());
-  return BB_OK;
+  return write_blob_safely(path, blob, err);
 }
 
 } // namespace

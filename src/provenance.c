@@ -186,18 +186,6 @@ static int next_entry(const char **cursor, entry *e) {
   return 1;
 }
 
-/* The first entry of text whose key is key; 0 when there is none. */
-static int find_entry(const char *text_, const char *key, size_t key_length, entry *out) {
-  entry e;
-  const char *cursor = text_;
-  while (next_entry(&cursor, &e))
-    if (e.key_length == key_length && memcmp(e.key, key, key_length) == 0) {
-      *out = e;
-      return 1;
-    }
-  return 0;
-}
-
 static int is_ignored_key(const entry *e) {
   /* The command line names temporary paths and "output" the map kind; both
    * differ between a golden and a re-bake without any pixel changing. */
@@ -240,41 +228,113 @@ static int same_value(const entry *a, const entry *b) {
          memcmp(a->value, b->value, a->value_length) == 0;
 }
 
+/* A text's entries that count (a key, not ignored), first occurrence of
+ * each key only, sorted by key for binary search; `order` keeps the line
+ * order for the report. Sorting makes a diff O(n log n): the scan it
+ * replaces searched the whole text for every line, and a crafted 300 KB
+ * description (32000 lines) held `bumpbake compare` for 100 s. */
+typedef struct keyed_entry {
+  entry e;
+  size_t order;
+} keyed_entry;
+
+typedef struct entry_index {
+  keyed_entry *entries;
+  size_t count;
+} entry_index;
+
+static int compare_keys(const entry *x, const entry *y) {
+  size_t n = x->key_length < y->key_length ? x->key_length : y->key_length;
+  int c = memcmp(x->key, y->key, n);
+  if (c)
+    return c;
+  return (x->key_length > y->key_length) - (x->key_length < y->key_length);
+}
+
+static int by_key_then_order(const void *p, const void *q) {
+  const keyed_entry *x = p, *y = q;
+  int c = compare_keys(&x->e, &y->e);
+  return c ? c : (x->order > y->order) - (x->order < y->order);
+}
+
+static int by_order(const void *p, const void *q) {
+  const keyed_entry *x = p, *y = q;
+  return (x->order > y->order) - (x->order < y->order);
+}
+
+/* Returns 0, or -1 when out of memory. */
+static int index_entries(const char *text_, entry_index *index) {
+  size_t lines = 1;
+  for (const char *c = text_; *c; c++)
+    lines += *c == '\n';
+  index->count = 0;
+  index->entries = malloc(lines * sizeof *index->entries);
+  if (!index->entries)
+    return -1;
+  entry e;
+  const char *cursor = text_;
+  for (size_t order = 0; next_entry(&cursor, &e); order++)
+    if (e.key_length && !is_ignored_key(&e))
+      index->entries[index->count++] = (keyed_entry){e, order};
+  qsort(index->entries, index->count, sizeof *index->entries, by_key_then_order);
+  /* A repeated key: only its first occurrence counts. */
+  size_t kept = 0;
+  for (size_t i = 0; i < index->count; i++)
+    if (kept == 0 || compare_keys(&index->entries[kept - 1].e, &index->entries[i].e) != 0)
+      index->entries[kept++] = index->entries[i];
+  index->count = kept;
+  return 0;
+}
+
+static const entry *lookup(const entry_index *index, const entry *key) {
+  size_t lo = 0, hi = index->count;
+  while (lo < hi) {
+    size_t mid = lo + (hi - lo) / 2;
+    int c = compare_keys(&index->entries[mid].e, key);
+    if (c == 0)
+      return &index->entries[mid].e;
+    if (c < 0)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return NULL;
+}
+
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   size_t used = 0;
   if (out && cap)
     out[0] = '\0';
   if (!a || !b)
     return 0;
+  entry_index ia = {0}, ib = {0};
+  if (index_entries(a, &ia) != 0 || index_entries(b, &ib) != 0) {
+    free(ia.entries);
+    free(ib.entries);
+    return -1;
+  }
   int differing = 0;
-  entry e, other;
-  const char *cursor = a;
   /* Keys of a, in a's order: changed or missing from b. */
-  while (next_entry(&cursor, &e)) {
-    if (!e.key_length || is_ignored_key(&e))
+  qsort(ia.entries, ia.count, sizeof *ia.entries, by_order);
+  for (size_t i = 0; i < ia.count; i++) {
+    const entry *e = &ia.entries[i].e, *other = lookup(&ib, e);
+    if (other && same_value(e, other))
       continue;
-    entry first;
-    if (find_entry(a, e.key, e.key_length, &first) && first.value != e.value)
-      continue; /* a repeated key: only its first occurrence counts */
-    int in_b = find_entry(b, e.key, e.key_length, &other);
-    if (in_b && same_value(&e, &other))
-      continue;
-    report(out, cap, &used, &e, &e, in_b ? &other : NULL);
+    report(out, cap, &used, e, e, other);
     differing++;
   }
-  /* Keys only b has. */
-  cursor = b;
-  while (next_entry(&cursor, &e)) {
-    if (!e.key_length || is_ignored_key(&e))
+  /* Keys only b has, in b's order (a sorted by key again for the lookup). */
+  qsort(ia.entries, ia.count, sizeof *ia.entries, by_key_then_order);
+  qsort(ib.entries, ib.count, sizeof *ib.entries, by_order);
+  for (size_t i = 0; i < ib.count; i++) {
+    const entry *e = &ib.entries[i].e;
+    if (lookup(&ia, e))
       continue;
-    entry first;
-    if (find_entry(b, e.key, e.key_length, &first) && first.value != e.value)
-      continue;
-    if (find_entry(a, e.key, e.key_length, &other))
-      continue;
-    report(out, cap, &used, &e, NULL, &e);
+    report(out, cap, &used, e, NULL, e);
     differing++;
   }
+  free(ia.entries);
+  free(ib.entries);
   return differing;
 }
 

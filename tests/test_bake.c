@@ -312,3 +312,27 @@ Test(bake, rejects_bad_options) {
   cr_assert(strstr(err.message, "slices") != NULL, "%s", err.message);
   bb_image_free(&h);
 }
+
+/* Finite heights whose product with the scale leaves the float range are
+ * refused before any stage, and the message names the product, not a later
+ * stage's symptom (it once read "pyramid: non-finite height"). */
+Test(bake, scale_times_height_overflow_is_named) {
+  bb_image h = field(4, 4);
+  *bb_image_texel(&h, 2, 1) = 3.0e38f;
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 2.0f;
+  o.rays = 4;
+  bb_bake_result r;
+  bb_error err;
+  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_VALUE);
+  cr_assert(strstr(err.message, "height scale 2") && strstr(err.message, "(2, 1)") &&
+                strstr(err.message, "3e+38"),
+            "%s", err.message);
+  cr_assert_null(r.normal.pixels);
+  /* At the limit itself the bake runs. */
+  *bb_image_texel(&h, 2, 1) = (float)(BB_MAX_HEIGHT_TEXELS / 4.0);
+  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  bb_bake_result_free(&r);
+  bb_image_free(&h);
+}

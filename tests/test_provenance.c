@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <time.h>
 
 /* FNV-1a 64 over a byte string, written from the published definition
  * (offset basis 14695981039346656037, prime 1099511628211), so the test
@@ -376,4 +377,39 @@ Test(provenance, survives_a_tga_file_as_whole_lines) {
   unlink(path);
   rmdir(dir);
   free(text);
+}
+
+/* Repeated keys count once (their first value), in either text. */
+Test(provenance, diff_counts_the_first_of_repeated_keys) {
+  char out[256];
+  cr_assert_eq(bb_provenance_diff("k=1\nk=2\nz=0\n", "z=0\nk=1\nk=3\n", out, sizeof out), 0);
+  cr_assert_eq(bb_provenance_diff("k=2\nk=1\n", "k=1\nk=2\n", out, sizeof out), 1);
+  cr_assert_str_eq(out, "k: 2 -> 1\n");
+}
+
+/* A description is whatever a file holds: 100000 lines (1.2 MB) on each
+ * side must be compared in well under a second. The line-by-line scan this
+ * replaced took 100 s for 32000 lines and hours for 100000. */
+static char *many_keys(long lines, long changed_every) {
+  char *text = malloc((size_t)lines * 24 + 1);
+  cr_assert_not_null(text);
+  size_t len = 0;
+  for (long i = 0; i < lines; i++)
+    len += (size_t)sprintf(text + len, "key%ld=%ld\n", i,
+                           changed_every && i % changed_every == 0 ? -i : i);
+  return text;
+}
+
+Test(provenance, diff_of_huge_texts_is_fast, .timeout = 30) {
+  char *a = many_keys(100000, 0), *b = many_keys(100000, 1000);
+  char out[64];
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  int n = bb_provenance_diff(a, b, out, sizeof out);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+  cr_assert_eq(n, 99, "key0 is 0 either way; every 1000th other key differs");
+  cr_assert_lt(seconds, 2.0, "%.2f s", seconds);
+  free(a);
+  free(b);
 }
