@@ -145,6 +145,10 @@ typedef struct bb_write_options {
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
  * .tiff .exr). Integer formats clamp to the code range and round to nearest.
+ * Channels are R, G, B, A for up to 4; an image of more (a basis map with
+ * more than 4 directions) has them named B0, B1, ... instead, zero-padded
+ * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
+ * name, and none is alpha.
  * The file is written to a temporary file in the destination directory and
  * renamed into place, so a failure leaves no partial file. Errors:
  * BB_ERR_FORMAT (unknown extension, depth not supported by the format),
@@ -159,6 +163,12 @@ int bb_path_is_writable_format(const char *path);
  * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
  * bad combination before a long bake rather than after it. */
 int bb_path_supports_depth(const char *path, bb_depth depth);
+
+/* Most channels bb_image_write can store in the format path's extension
+ * names: 4 for .png and .tga, 64 for .tif, .tiff and .exr; 0 for an unknown
+ * extension. So a caller can refuse a basis with more directions than the
+ * file can hold before the bake. */
+int bb_path_max_channels(const char *path);
 
 /* ----------------------------------------------------------- height input */
 
