@@ -18,7 +18,8 @@
  *   integer files store value * max code, float files store the value.
  * - Half-Life 2 basis: B0 = (sqrt(2/3), 0, 1/sqrt(3)),
  *   B1 = (-1/sqrt(6), 1/sqrt(2), 1/sqrt(3)), B2 = (-1/sqrt(6), -1/sqrt(2),
- *   1/sqrt(3)); optional B3 = (0, 0, 1).
+ *   1/sqrt(3)); optional B3 = (0, 0, 1). Bakes may use other bases
+ *   (bb_basis: "dirs:N", vectors of the caller's): one channel per direction.
  * - Errors: fallible calls return bb_status and, when err is not NULL, write
  *   a one-line message into it. There is no global error state.
  * - Ownership: a function that fills a bb_image allocates its pixels; the
@@ -160,6 +161,10 @@ typedef struct bb_write_options {
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
  * .tiff .exr). Integer formats clamp to the code range and round to nearest.
+ * Channels are R, G, B, A for up to 4; an image of more (a basis map with
+ * more than 4 directions) has them named B0, B1, ... instead, zero-padded
+ * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
+ * name, and none is alpha.
  * The file is written to a temporary file in the destination directory,
  * every write checked, then flushed, fsynced and closed (checked) and only
  * then renamed into place, so a failure (a full disk included) leaves no
@@ -207,6 +212,12 @@ int bb_path_is_writable_format(const char *path);
  * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
  * bad combination before a long bake rather than after it. */
 int bb_path_supports_depth(const char *path, bb_depth depth);
+
+/* Most channels bb_image_write can store in the format path's extension
+ * names: 4 for .png and .tga, 64 for .tif, .tiff and .exr; 0 for an unknown
+ * extension. So a caller can refuse a basis with more directions than the
+ * file can hold before the bake. */
+int bb_path_max_channels(const char *path);
 
 /* ----------------------------------------------------------- height input */
 
@@ -343,22 +354,79 @@ double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distanc
 /* The same answer by the brute-force twin (every cell, no pyramid). */
 double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance);
 
-/* -------------------------------------------------------------- ray set */
+/* ------------------------------------------------------------------ basis */
 
-#define BB_MAX_BASIS 4
-#define BB_MAX_SLICES 256
+/* Most directions a basis may have: each costs one channel of ssbump,
+ * weights and the trace's sums (memory) and one table per slice (time). */
+#define BB_MAX_BASIS 16
 
-/* Basis the occlusion is projected on. */
-typedef enum bb_basis {
-  BB_BASIS_HL2 = 0,   /* B0, B1, B2 */
-  BB_BASIS_HL2_Z      /* B0, B1, B2 and B3 = (0, 0, 1) */
+/* The directions occlusion is projected on: one channel of ssbump and
+ * weights per direction, in this order. A plain struct; copy it freely. */
+typedef struct bb_basis {
+  int count;                       /* directions, 3..BB_MAX_BASIS */
+  double vector[BB_MAX_BASIS][3];  /* unit B_c in the tangent frame (+Y down),
+                                      z >= 0; entries past count are zero */
+  char name[32];                   /* "hl2", "hl2+z", "dirs:N" or
+                                      "vectors:" + 16 hex digits (a hash of
+                                      the vectors); recorded in provenance */
 } bb_basis;
 
-int bb_basis_parse(const char *name, bb_basis *out); /* "hl2", "hl2+z" */
-const char *bb_basis_name(bb_basis b);
-int bb_basis_count(bb_basis b);
-/* Unit vector of basis direction index (0..3) into v. */
+/* The default basis, "hl2": Half-Life 2's B0, B1, B2 (header top). */
+void bb_basis_init(bb_basis *b);
+
+/* Unit vector of Half-Life 2's direction index 0..3 into v (3 is the
+ * optional B3 = (0, 0, 1) of "hl2+z"); an index outside gives zeros. */
 void bb_basis_vector(int index, double v[3]);
+
+/* "dirs:N": N directions (3..BB_MAX_BASIS) evenly spread in azimuth at
+ * Half-Life 2's elevation asin(1/sqrt(3)) (35.26 degrees):
+ *   B_c = (sqrt(2/3) cos(phi_c), sqrt(2/3) sin(phi_c), 1/sqrt(3)),
+ *   phi_c = 360 c / N degrees,
+ * in the +Y-down frame: B_0 lights from the right (+x) and phi grows from
+ * +x towards +y (the bottom of the image), clockwise on screen, the way
+ * Half-Life 2's B1 and B2 lie at 120 and 240 degrees. So "dirs:3" is "hl2"
+ * bit for bit (a direction of N's that is one of Half-Life 2's takes its
+ * constants: "dirs:6" holds B0, B1, B2 in channels 0, 2, 4), and a quarter
+ * turn is exact ((0, +-sqrt(2/3)) for N a multiple of 4). BB_ERR_ARGUMENT
+ * for N outside 3..BB_MAX_BASIS; out is untouched then. */
+bb_status bb_basis_dirs(int count, bb_basis *out, bb_error *err);
+
+/* A named basis: "hl2", "hl2+z" or "dirs:N" (bb_basis_dirs), exactly as
+ * written. BB_ERR_ARGUMENT with a message saying what is accepted for any
+ * other text; out is untouched then. */
+bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
+
+/* A basis of count (3..BB_MAX_BASIS) vectors of the caller's, each scaled
+ * to unit length; named "vectors:" + the FNV-1a hash of the unit vectors'
+ * bits. Rejects (BB_ERR_ARGUMENT, naming the vector's index from 0) a NaN
+ * or infinite component, a zero vector and one pointing below the surface
+ * (z < 0 after scaling). out is untouched on failure. */
+bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
+                                bb_error *err);
+
+/* Parses a basis file's text: one direction "x y z" per line (numbers as
+ * strtod reads them, separated by blanks or commas), '#' starts a comment
+ * that runs to the end of the line, blank lines are skipped; then as
+ * bb_basis_from_vectors. source names the text in messages, which read
+ * "SOURCE:LINE: reason" (BB_ERR_FORMAT for a line that is not three
+ * numbers, BB_ERR_ARGUMENT for a vector or a count the basis refuses). */
+bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out,
+                             bb_error *err);
+
+/* Reads a basis file (format: bb_basis_read_text) of at most 64 KiB.
+ * Errors: BB_ERR_IO (missing, unreadable, a directory), BB_ERR_SIZE (over
+ * 64 KiB), and those of bb_basis_read_text, each naming path. */
+bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
+
+/* 1 when b holds Half-Life 2's B0, B1, B2 in channels 0..2 bit for bit
+ * ("hl2", "dirs:3", and "hl2+z", whose B3 is a fourth channel), which the
+ * consumers of 3-channel basis maps (render, ssbump2normal, Valve's
+ * files) assume; else 0. */
+int bb_basis_is_hl2(const bb_basis *b);
+
+/* -------------------------------------------------------------- ray set */
+
+#define BB_MAX_SLICES 256
 
 /* Azimuth slices a budget of `rays` rays per texel stands for, as Valve's
  * tool counts rays: round(sqrt(rays)), at least 1 (so -r 250 and 256 both
@@ -379,9 +447,9 @@ int bb_slices_for_rays(int rays);
  * so an unobstructed texel gets exactly 1. */
 typedef struct bb_rayset {
   int slice_count;           /* A, 1..BB_MAX_SLICES */
-  int basis_count;           /* lobes: 3 (hl2) or 4 (hl2+z) */
+  int basis_count;           /* lobes: the basis' count, 3..BB_MAX_BASIS */
   double power;              /* P >= 1 of the lobes */
-  double basis[BB_MAX_BASIS][3]; /* unit lobe directions B_c */
+  double basis[BB_MAX_BASIS][3]; /* unit lobe directions B_c (the basis' vectors) */
   int *slice_step;           /* 2 per slice: the lattice step (a, b), coprime */
   double *slice_dir;         /* 2 per slice: unit (dx, dy) along (a, b) */
   double *sector;            /* 2 per slice: first and last azimuth, radians */
@@ -392,8 +460,11 @@ typedef struct bb_rayset {
 } bb_rayset;
 
 /* Builds the slices and their integration tables: slices in
- * 1..BB_MAX_SLICES, power >= 1. Allocates; free with bb_rayset_free. */
-bb_status bb_rayset_make(int slices, double power, bb_basis basis, bb_rayset *out,
+ * 1..BB_MAX_SLICES, power >= 1, one lobe per direction of basis (NULL:
+ * "hl2"; copied). The tables cost slices x basis->count x 8 KiB and their
+ * build time grows with the same product. Allocates; free with
+ * bb_rayset_free. */
+bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset *out,
                          bb_error *err);
 void bb_rayset_free(bb_rayset *rs);
 
@@ -436,19 +507,31 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
 
 /* ----------------------------------------------------------------- derive */
 
-/* weights w_c = sat(N.B_c)^2 / sum_k sat(N.B_k)^2 (3 channels). */
-bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *err);
+/* The maps of CONVENTIONS "Derived maps", for any basis: channel c belongs
+ * to basis->vector[c]. basis NULL means Half-Life 2's B0, B1, B2, and for
+ * ssbump and bent also hl2+z when the input has a fourth basis channel. */
 
-/* ssbump s_c = max(0, N.B_c) * vis_c, for the basis_count channels of vis
- * after ao (vis as bb_trace_occlusion makes it). */
+/* weights w_c = sat(N.B_c)^2 / sum_k sat(N.B_k)^2 over the basis' count
+ * directions (Valve's normal2ssbump for "hl2"); a normal facing away from
+ * every direction gets 1 / count in each. normals: 3 channels; out
+ * (allocated): count channels. */
+bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
+                            bb_error *err);
+
+/* ssbump s_c = max(0, N.B_c) * vis_c, for the channels of vis after ao
+ * (vis as bb_trace_occlusion makes it: 1 + basis->count channels; with
+ * basis NULL, 4 or 5). out (allocated): count channels. */
 bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
-                           bb_image *out, bb_error *err);
+                           const bb_basis *basis, bb_image *out, bb_error *err);
 
 /* ao as a 1-channel image (channel 0 of vis). */
 bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err);
 
-/* Bent normal normalize(sum_c s_c B_c) (3 channels; +Y down). */
-bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err);
+/* Bent normal normalize(sum_c s_c B_c) over the basis' channels of ssbump
+ * (basis->count of them; with basis NULL, 3 or 4); (0, 0, 1) where every
+ * s_c is 0. out (allocated): 3 channels, +Y down. */
+bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
+                         bb_error *err);
 
 /* ------------------------------------------------------------------- bake */
 
@@ -460,7 +543,8 @@ typedef struct bb_bake_options {
   bb_smooth_options smooth;   /* filter radius/threshold/addressing */
   bb_trace_options trace;     /* bias, threads, progress */
   double power;               /* P >= 1, default 1 */
-  bb_basis basis;             /* default BB_BASIS_HL2 */
+  bb_basis basis;             /* default "hl2" (bb_basis_init); weights and
+                                 ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
   int want_trace;             /* 0: only normals/weights/filtered are made */
@@ -472,14 +556,15 @@ void bb_bake_options_init(bb_bake_options *o);
 typedef struct bb_bake_result {
   bb_image filtered;   /* smoothed h, 1 channel */
   bb_image normal;     /* 3 channels */
-  bb_image weights;    /* 3 channels */
-  bb_image vis;        /* 1 + basis channels: ao, vis_c (when traced) */
-  bb_image ssbump;     /* basis channels (when traced) */
+  bb_image weights;    /* basis count channels */
+  bb_image vis;        /* 1 + basis count channels: ao, vis_c (when traced) */
+  bb_image ssbump;     /* basis count channels (when traced) */
   bb_image ao;         /* 1 channel (when traced) */
   bb_image bent;       /* 3 channels (when traced) */
   double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
   double horizons_found;   /* texels x slices */
   char rayset_id[64];
+  bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
 } bb_bake_result;
 
 /* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
@@ -505,7 +590,9 @@ void bb_valve_options_init(bb_valve_options *o);
  * result->filtered or result->ao. Every channel of out is then a unit value
  * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
  * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
- * want_trace) or has too few channels; BB_ERR_SIZE when sizes differ. */
+ * want_trace) or has too few channels, or when the ssbump is of a basis
+ * other than Half-Life 2's (result->basis, when set, or more than 4
+ * channels); BB_ERR_SIZE when sizes differ. */
 bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
                         bb_image *out, bb_error *err);
 
@@ -591,7 +678,9 @@ typedef struct bb_provenance {
 /* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
  * output, scale, rays, rayset, filter_radius, filter_threshold, bias, power,
  * basis, normal_filter, normal_y, addressing, channel), malloc'd; the caller
- * frees it. Returns NULL when out of memory. */
+ * frees it. A basis of the caller's vectors ("vectors:HASH") adds
+ * basis_vectors after basis: "x y z" per direction, joined by "; ".
+ * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
 
 /* Writes into out (capacity cap) the keys whose values differ between two
@@ -614,6 +703,12 @@ typedef enum bb_provenance_class {
  * "bumpbake_version=" line; intact when each non-empty line is key=value
  * with a key of lower-case letters, digits and '_'. */
 bb_provenance_class bb_provenance_classify(const char *description);
+
+/* The value of key in a provenance text (its first "key=value" line) into
+ * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
+ * there, 0 when it is not or description is NULL (out is then ""). So a
+ * reader can ask which basis a map was baked with ("basis"). */
+int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
 
 const char *bb_channel_name(bb_channel c);
 
@@ -784,6 +879,7 @@ typedef enum bb_ssbump_kind {
  * f(s) = s for BB_SSBUMP_LINEAR and sqrt(max(0, s)) for BB_SSBUMP_SQUARED (the
  * square root undoes normal2ssbump's square, so both kinds give back N
  * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
+ * A map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
  * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
                               bb_image *normals, bb_error *err);
@@ -829,7 +925,8 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
  * under one 16-bit code) leaves the base texel unchanged bit for bit.
  * ssbump, weights, ao: out_c = base_c * detail_c / flat_c on the kind's
  * channels (visibilities multiply; a flat detail is the identity, on either
- * side); further base channels (Valve's alpha) are copied.
+ * side); further base channels (Valve's alpha) are copied, so an ssbump or
+ * weights map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
  * normal: DOOM 3's addnormals: n = base (z rebuilt as sqrt(1 - x^2 - y^2)
  * when |n| < 1), n.xy += detail.xy - flat.xy, out = normalize(n).
  * Allocates out with base's channels. */
@@ -986,7 +1083,9 @@ void bb_light_direction(double azimuth_degrees, double elevation_degrees, double
 /* The maps a render reads; all of the same width and height. Pointers not
  * needed by the mode may be NULL. Images may have more channels than used:
  * channels past the first 3 (1 for ao) are ignored (a height2ssbump TGA
- * keeps the height in alpha). */
+ * keeps the height in alpha), except that the ssbump holds Half-Life 2's
+ * basis: one of more than 4 channels (a bake with another basis) is
+ * refused. */
 typedef struct bb_render_maps {
   const bb_image *normal; /* unit N, >= 3 channels, +Y down */
   const bb_image *ssbump; /* s_c, >= 3 channels */
@@ -1110,7 +1209,8 @@ void bb_sheet_options_init(bb_sheet_options *o);
 /* A contact sheet of one bake: height and filtered height (grey, stretched
  * over the height's range), normal, weights, ssbump, ao, bent normal, and
  * the ssbump lit by o->lit; labelled as bb_panels_compose does. height is
- * the bake's input; r a traced bake with normal_y_up = 0. */
+ * the bake's input; r a traced bake with normal_y_up = 0 and Half-Life 2's
+ * basis (another is BB_ERR_ARGUMENT). */
 bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
                         const bb_sheet_options *o, bb_image *out, int *labels_drawn,
                         bb_error *err);

@@ -14,7 +14,7 @@ void bb_bake_options_init(bb_bake_options *o) {
   bb_smooth_options_init(&o->smooth);
   bb_trace_options_init(&o->trace);
   o->power = 1.0;
-  o->basis = BB_BASIS_HL2;
+  bb_basis_init(&o->basis);
   o->normal_filter = BB_NORMAL_VERTEX;
   o->want_trace = 1;
 }
@@ -44,7 +44,7 @@ static bb_status check_options(const bb_bake_options *o, bb_error *err) {
   if (!(o->trace.bias_texels >= 0.0) || !isfinite(o->trace.bias_texels))
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: bias must be >= 0 (got %g)",
                     o->trace.bias_texels);
-  return BB_OK;
+  return bb__basis_check(&o->basis, "bake", err);
 }
 
 /* Heights in texels, the field the tracer sees. */
@@ -68,7 +68,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, bb_bake_result *r,
   if (st == BB_OK) st = bb_pyramid_build(&z, o->smooth.addressing, &pyramid, err);
   bb_image_free(&z);
   const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
-  if (st == BB_OK) st = bb_rayset_make(slices, o->power, o->basis, &rays, err);
+  if (st == BB_OK) st = bb_rayset_make(slices, o->power, &o->basis, &rays, err);
   double t1 = bb__now_seconds();
   r->seconds_pyramid = t1 - t0;
   if (st == BB_OK) {
@@ -81,9 +81,9 @@ static bb_status trace_and_derive(const bb_bake_options *o, bb_bake_result *r,
   r->seconds_trace = t2 - t1;
   bb_rayset_free(&rays);
   bb_pyramid_free(pyramid);
-  if (st == BB_OK) st = bb_derive_ssbump(&r->normal, &r->vis, &r->ssbump, err);
+  if (st == BB_OK) st = bb_derive_ssbump(&r->normal, &r->vis, &o->basis, &r->ssbump, err);
   if (st == BB_OK) st = bb_derive_ao(&r->vis, &r->ao, err);
-  if (st == BB_OK) st = bb_derive_bent(&r->ssbump, &r->bent, err);
+  if (st == BB_OK) st = bb_derive_bent(&r->ssbump, &o->basis, &r->bent, err);
   r->seconds_derive += bb__now_seconds() - t2;
   return st;
 }
@@ -97,6 +97,7 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
   /* Before any stage: an overflow of scale x height is named as such. */
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
   if (st != BB_OK) return st;
+  r->basis = o->basis;
   double t0 = bb__now_seconds();
   st = bb_smooth_bilateral(height, height, &o->smooth, &r->filtered, err);
   double t1 = bb__now_seconds();
@@ -104,7 +105,7 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
   if (st == BB_OK)
     st = bb_normals_compute(&r->filtered, o->height_scale, o->normal_filter,
                             o->smooth.addressing, &r->normal, err);
-  if (st == BB_OK) st = bb_derive_weights(&r->normal, &r->weights, err);
+  if (st == BB_OK) st = bb_derive_weights(&r->normal, &o->basis, &r->weights, err);
   r->seconds_derive = bb__now_seconds() - t1;
   if (st == BB_OK && o->want_trace) st = trace_and_derive(o, r, err);
   if (st == BB_OK && o->normal_y_up) {

@@ -14,16 +14,17 @@ typedef struct output_kind {
   bb_range range;       /* how integer files encode it */
   int needs_trace;      /* made only when bb_bake traces */
   int from_prefix;      /* written by -o PREFIX (as PREFIX_kind.png) */
+  int per_direction;    /* one channel per basis direction (else a fixed count) */
   size_t result_offset; /* where bb_bake_result holds it */
 } output_kind;
 
 static const output_kind output_kinds[] = {
-    {"normal", BB_RANGE_SIGNED, 0, 1, offsetof(bb_bake_result, normal)},
-    {"weights", BB_RANGE_UNIT, 0, 0, offsetof(bb_bake_result, weights)},
-    {"ssbump", BB_RANGE_UNIT, 1, 1, offsetof(bb_bake_result, ssbump)},
-    {"ao", BB_RANGE_UNIT, 1, 1, offsetof(bb_bake_result, ao)},
-    {"bent", BB_RANGE_SIGNED, 1, 0, offsetof(bb_bake_result, bent)},
-    {"filtered", BB_RANGE_UNIT, 0, 0, offsetof(bb_bake_result, filtered)},
+    {"normal", BB_RANGE_SIGNED, 0, 1, 0, offsetof(bb_bake_result, normal)},
+    {"weights", BB_RANGE_UNIT, 0, 0, 1, offsetof(bb_bake_result, weights)},
+    {"ssbump", BB_RANGE_UNIT, 1, 1, 1, offsetof(bb_bake_result, ssbump)},
+    {"ao", BB_RANGE_UNIT, 1, 1, 0, offsetof(bb_bake_result, ao)},
+    {"bent", BB_RANGE_SIGNED, 1, 0, 0, offsetof(bb_bake_result, bent)},
+    {"filtered", BB_RANGE_UNIT, 0, 0, 0, offsetof(bb_bake_result, filtered)},
 };
 
 enum { OUTPUT_KIND_COUNT = sizeof output_kinds / sizeof output_kinds[0] };
@@ -203,6 +204,22 @@ static int check_slope_names(const bake_args *a) {
   return 0;
 }
 
+/* A map with a channel per basis direction needs a format with room for
+ * them: PNG and TGA hold 4, so "hl2+z" still fits RGBA. Refused before the
+ * bake, not after it. */
+static int check_channels(const bake_args *a, int k) {
+  const bb_basis *basis = &a->settings.bake.basis;
+  const int room = bb_path_max_channels(a->paths[k]);
+  if (!output_kinds[k].per_direction || basis->count <= room)
+    return 0;
+  const char *dot = strrchr(a->paths[k], '.');
+  return cli_usage_error(bake_command.name,
+                         "%s: --basis %s gives %s %d channels and %s files hold at most %d "
+                         "(write it as .exr or .tif)",
+                         a->paths[k], basis->name, output_kinds[k].kind, basis->count,
+                         dot ? dot : "such", room);
+}
+
 /* Every output is checked before the (possibly long) bake starts. */
 static int check_outputs(bake_args *a, const char *input) {
   int any = a->slope.path != NULL;
@@ -217,6 +234,8 @@ static int check_outputs(bake_args *a, const char *input) {
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
     if (!rc)
       rc = cli_check_mips(bake_command.name, &a->settings, a->paths[k]);
+    if (!rc)
+      rc = check_channels(a, k);
     if (rc)
       return rc;
   }
@@ -268,7 +287,7 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
   cli_json_number(&j, "bias", b->trace.bias_texels);
   cli_json_number(&j, "power", b->power);
-  cli_json_string(&j, "basis", bb_basis_name(b->basis));
+  cli_json_string(&j, "basis", b->basis.name);
   cli_json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
   cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
   cli_json_string(&j, "addressing",

@@ -133,6 +133,10 @@ static void map_input_free(map_input *m) {
 
 static int load_map(const combine_args *a, const char *path, map_input *m) {
   int rc = cli_maps_read(path, &m->file, &m->info);
+  /* --detail scales Half-Life 2's three channels; a blend is linear in
+   * every channel, so it takes maps of any basis (of the same count). */
+  if (!rc && a->detail && (a->kind == BB_MAP_SSBUMP || a->kind == BB_MAP_WEIGHTS))
+    rc = cli_check_hl2_map(path, &m->file, &m->info);
   if (rc || a->kind != BB_MAP_NORMAL)
     return rc;
   /* Not renormalised: a texel the operators copy must keep its code. */

@@ -60,10 +60,13 @@ const cli_option cli_opt_power = {.id = CLI_OPT_POWER,
                                   .value_name = "P",
                                   .range_text = ">= 1",
                                   .help = "exponent of the basis lobes max(0, w.B)^P"};
-const cli_option cli_opt_basis = {.id = CLI_OPT_BASIS,
-                                  .long_name = "basis",
-                                  .value_name = "hl2|hl2+z",
-                                  .help = "directions occlusion is projected on"};
+const cli_option cli_opt_basis = {
+    .id = CLI_OPT_BASIS,
+    .long_name = "basis",
+    .value_name = "hl2|hl2+z|dirs:N|FILE",
+    .range_text = "N 3..16",
+    .help = "directions occlusion is projected on, one channel each: Half-Life 2's, "
+            "N evenly spread, or a file of x y z lines (README \"Bases\")"};
 const cli_option cli_opt_normal_filter = {
     .id = CLI_OPT_NORMAL_FILTER,
     .long_name = "normal-filter",
@@ -209,7 +212,7 @@ static const char *settings_default_text(int id, const cli_settings *d, char *bu
     snprintf(buf, cap, "%.5g", b->power);
     break;
   case CLI_OPT_BASIS:
-    snprintf(buf, cap, "%s", bb_basis_name(b->basis));
+    snprintf(buf, cap, "%s", b->basis.name);
     break;
   case CLI_OPT_NORMAL_FILTER:
     snprintf(buf, cap, "%s", bb_normal_filter_name(b->normal_filter));
@@ -383,6 +386,27 @@ static int bad_choice(const char *command, const cli_option *opt, const char *ar
                          arg);
 }
 
+/* --basis: a name ("hl2", "hl2+z", "dirs:N"; names win over a file of the
+ * same name, which ./NAME reaches) or else a basis file. A word that is
+ * neither is a usage error; a file that is there but wrong is the file's
+ * error (exit 1, "bumpbake: FILE:LINE: reason"). */
+static int apply_basis(const char *command, const char *arg, bb_basis *out) {
+  bb_error err = {{0}};
+  if (!strcmp(arg, "hl2") || !strcmp(arg, "hl2+z") || !strncmp(arg, "dirs:", 5)) {
+    if (bb_basis_parse(arg, out, &err) == BB_OK)
+      return 0;
+    return cli_usage_error(command, "--basis dirs:N needs a whole N in 3..%d (got '%s')",
+                           BB_MAX_BASIS, arg);
+  }
+  struct stat st;
+  if (stat(arg, &st) != 0)
+    return cli_usage_error(command,
+                           "--basis must be hl2, hl2+z, dirs:N (N in 3..%d) or a file of "
+                           "directions (got '%s': %s)",
+                           BB_MAX_BASIS, arg, strerror(errno));
+  return cli_status_exit(arg, bb_basis_load(arg, out, &err), &err);
+}
+
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
                        const char *arg) {
   bb_bake_options *b = &s->bake;
@@ -415,7 +439,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_THREADS:
     return cli_parse_int(command, name, arg, 0, 4096, &b->trace.threads);
   case CLI_OPT_BASIS:
-    return bb_basis_parse(arg, &b->basis) ? bad_choice(command, opt, arg) : 0;
+    return apply_basis(command, arg, &b->basis);
   case CLI_OPT_NORMAL_FILTER:
     return bb_normal_filter_parse(arg, &b->normal_filter) ? bad_choice(command, opt, arg)
                                                           : 0;
@@ -777,6 +801,24 @@ int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
     bb_image_free(&img);
   }
   return cli_status_exit(path, st, &err);
+}
+
+int cli_check_hl2_map(const char *path, const bb_image *img, const bb_image_info *info) {
+  char basis[64], reason[256];
+  bb_provenance_value(info ? info->description : NULL, "basis", basis, sizeof basis);
+  if (basis[0] && strcmp(basis, "hl2") && strcmp(basis, "hl2+z") && strcmp(basis, "dirs:3"))
+    snprintf(reason, sizeof reason,
+             "baked with --basis %s; this reads Half-Life 2's basis (bake with --basis hl2)",
+             basis);
+  else if (img->channels > 4)
+    snprintf(reason, sizeof reason,
+             "%d channels, one per direction of a basis other than Half-Life 2's; this "
+             "reads Half-Life 2's 3 (bake with --basis hl2)",
+             img->channels);
+  else
+    return 0;
+  cli_file_error(path, reason);
+  return BB_EXIT_FAILURE;
 }
 
 int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options *o,

@@ -249,6 +249,13 @@ void cli_install_signal_handlers(void);
  * alpha (constant colour, varying alpha) it says so on stderr. */
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height);
 
+/* Readers of basis maps (render, ssbump2normal, combine --detail) take
+ * channels 0..2 as Half-Life 2's B0, B1, B2. 0 when the file at path (img,
+ * its info) can be one: at most 4 channels, and a provenance basis, if any,
+ * of hl2, hl2+z or dirs:3; else prints "bumpbake: PATH: reason" and
+ * returns BB_EXIT_FAILURE. */
+int cli_check_hl2_map(const char *path, const bb_image *img, const bb_image_info *info);
+
 /* Runs bb_bake; prints the error (naming path) and returns BB_EXIT_FAILURE on
  * failure. */
 int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options *o,

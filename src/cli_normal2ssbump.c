@@ -129,7 +129,7 @@ static int n2s_run(const cli_run *run, n2s_args *a, const char *input) {
     bb_error err = {{0}};
     bb_status st = bb_normal_map_decode(&values, info.is_float, &o, &normals, &err);
     if (st == BB_OK)
-      st = bb_derive_weights(&normals, &weights, &err);
+      st = bb_derive_weights(&normals, NULL, &weights, &err);
     rc = cli_status_exit(input, st, &err);
   }
   if (!rc)

@@ -362,7 +362,12 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
   if (st != BB_OK)
     return cli_status_exit(path, st, &err);
   int is_float = info.is_float;
+  int rc = kind == MAP_SSBUMP ? cli_check_hl2_map(path, &raw, &info) : 0;
   bb_image_info_free(&info);
+  if (rc) {
+    bb_image_free(&raw);
+    return rc;
+  }
   char reason[256];
   if (raw.channels < map_kinds[kind].channels) {
     snprintf(reason, sizeof reason, "%d channel%s; %s %s map needs %d (%s)", raw.channels,

@@ -83,6 +83,8 @@ static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
   bb_image ssbump = {0}, normals = {0};
   bb_image_info info = {0};
   int rc = cli_maps_read(input, &ssbump, &info);
+  if (!rc)
+    rc = cli_check_hl2_map(input, &ssbump, &info);
   if (!rc) {
     bb_error err = {{0}};
     rc = cli_status_exit(input, bb_ssbump_to_normal(&ssbump, a->kind, &normals, &err),

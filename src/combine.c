@@ -180,6 +180,12 @@ static bb_status check_detail(const bb_image *base, const bb_image *detail,
     st = bb__check_channels(detail, need, "detail", err);
   if (st == BB_OK)
     st = bb__check_same_size(base, "the base", detail, "the detail", err);
+  /* Only the kind's 3 channels are scaled and the rest copied, which would
+   * leave a basis of more directions half overlaid. */
+  if (st == BB_OK && need == 3 && kind != BB_MAP_NORMAL)
+    st = bb__check_hl2_map(base, NULL, "detail: the base", err);
+  if (st == BB_OK && need == 3 && kind != BB_MAP_NORMAL)
+    st = bb__check_hl2_map(detail, NULL, "detail: the detail", err);
   if (st == BB_OK)
     st = bb__check_finite(base, base->channels, "base", err);
   if (st == BB_OK)

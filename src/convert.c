@@ -54,6 +54,8 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
     return bb__fail(err, BB_ERR_ARGUMENT, "ssbump to normal: unknown kind %d", (int)kind);
   bb_status st = bb__check_channels(ssbump, 3, "ssbump", err);
   if (st == BB_OK)
+    st = bb__check_hl2_map(ssbump, NULL, "ssbump", err);
+  if (st == BB_OK)
     st = bb__check_finite(ssbump, 3, "ssbump", err);
   /* The three basis channels alone: bb_derive_bent would read a fourth
    * (Valve's alpha height) as the weight of B3. */
@@ -70,7 +72,7 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
         s = sqrtf(s > 0.0f ? s : 0.0f);
       weights.pixels[3 * i + (size_t)c] = s;
     }
-  st = bb_derive_bent(&weights, normals, err);
+  st = bb_derive_bent(&weights, NULL, normals, err);
   bb_image_free(&weights);
   return st;
 }

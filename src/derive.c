@@ -1,64 +1,9 @@
-/* derive.c: the Half-Life 2 basis and the maps derived per texel from normals and
- * visibility. */
+/* derive.c: the maps derived per texel from normals and visibility, for any
+ * basis (basis.c). */
 #include "internal.h"
 
 #include <math.h>
 #include <string.h>
-
-int bb_basis_parse(const char *name, bb_basis *out) {
-  if (!name || !out)
-    return -1;
-  if (strcmp(name, "hl2") == 0) {
-    *out = BB_BASIS_HL2;
-    return 0;
-  }
-  if (strcmp(name, "hl2+z") == 0) {
-    *out = BB_BASIS_HL2_Z;
-    return 0;
-  }
-  return -1;
-}
-
-const char *bb_basis_name(bb_basis b) {
-  switch (b) {
-  case BB_BASIS_HL2:
-    return "hl2";
-  case BB_BASIS_HL2_Z:
-    return "hl2+z";
-  }
-  return "unknown";
-}
-
-/* 3 or 4; 0 for a value that is not a bb_basis. */
-int bb_basis_count(bb_basis b) {
-  switch (b) {
-  case BB_BASIS_HL2:
-    return 3;
-  case BB_BASIS_HL2_Z:
-    return 4;
-  }
-  return 0;
-}
-
-/* CONVENTIONS "Half-Life 2 basis", +Y down; index 3 is the optional (0, 0, 1).
- * An index outside 0..3 gives the zero vector. */
-void bb_basis_vector(int index, double v[3]) {
-  assert(index >= 0 && index < BB_MAX_BASIS);
-  if (index < 0 || index >= BB_MAX_BASIS) {
-    v[0] = v[1] = v[2] = 0.0;
-    return;
-  }
-  const double side = sqrt(2.0 / 3.0), back = 1.0 / sqrt(6.0), across = 1.0 / sqrt(2.0),
-               up = 1.0 / sqrt(3.0);
-  const double basis[BB_MAX_BASIS][3] = {
-      {side, 0.0, up},      /* B0: light from the right */
-      {-back, across, up},  /* B1: from the bottom-left */
-      {-back, -across, up}, /* B2: from the top-left */
-      {0.0, 0.0, 1.0},      /* B3: light from straight above */
-  };
-  for (int k = 0; k < 3; k++)
-    v[k] = basis[index][k];
-}
 
 static double dot3(const float n[3], const double b[3]) {
   return (double)n[0] * b[0] + (double)n[1] * b[1] + (double)n[2] * b[2];
@@ -104,13 +49,37 @@ typedef struct derive_job {
 } derive_job;
 
 static void job_init(derive_job *job, const bb_image *in, const bb_image *vis,
-                     bb_image *out, int count) {
+                     bb_image *out, const bb_basis *basis) {
   job->in = in;
   job->vis = vis;
   job->out = out;
-  job->count = count;
-  for (int c = 0; c < count; c++)
-    bb_basis_vector(c, job->basis[c]);
+  job->count = basis ? basis->count : 0;
+  for (int c = 0; c < job->count; c++)
+    for (int k = 0; k < 3; k++)
+      job->basis[c][k] = basis->vector[c][k];
+}
+
+/* The basis a map of `channels` basis channels is derived with: basis
+ * itself, whose count must match, or for NULL Half-Life 2's (hl2+z for a
+ * fourth channel). */
+static bb_status resolve_basis(const bb_basis *basis, int channels, const char *what,
+                               bb_basis *out, bb_error *err) {
+  if (basis) {
+    bb_status st = bb__basis_check(basis, "derive", err);
+    if (st != BB_OK)
+      return st;
+    if (channels >= 0 && channels != basis->count)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "derive: %s has %d basis channels but the basis %s has %d directions",
+                      what, channels, basis->name, basis->count);
+    *out = *basis;
+    return BB_OK;
+  }
+  if (channels >= 0 && channels != 3 && channels != 4)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "derive: %s has %d basis channels; without a basis, 3 (hl2) or 4 (hl2+z)",
+                    what, channels);
+  return bb_basis_parse(channels == 4 ? "hl2+z" : "hl2", out, err);
 }
 
 /* Runs fn over the rows of job->out; frees job->out if that fails. */
@@ -132,28 +101,34 @@ static void weights_row(void *user, int y) {
   const size_t first = row_start(normals, y), end = first + (size_t)normals->width;
   for (size_t i = first; i < end; i++) {
     const float *n = normals->pixels + 3 * i;
-    double w[3], sum = 0.0;
-    for (int c = 0; c < 3; c++) {
+    const int count = job->count;
+    double w[BB_MAX_BASIS], sum = 0.0;
+    for (int c = 0; c < count; c++) {
       double s = saturate(dot3(n, job->basis[c]));
       w[c] = s * s;
       sum += w[c];
     }
-    /* A normal facing away from all three directions has no preferred one. */
-    for (int c = 0; c < 3; c++)
-      job->out->pixels[3 * i + (size_t)c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / 3.0);
+    /* A normal facing away from every direction has no preferred one. */
+    float *out = job->out->pixels + (size_t)count * i;
+    for (int c = 0; c < count; c++)
+      out[c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / count);
   }
 }
 
-bb_status bb_derive_weights(const bb_image *normals, bb_image *out, bb_error *err) {
+bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
+                            bb_error *err) {
   bb_status st;
+  bb_basis b;
   if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, -1, "weights", &b, err)) != BB_OK)
     return st;
   if ((st = check_output(out, normals, NULL, err)) != BB_OK)
     return st;
-  if ((st = bb_image_alloc(out, normals->width, normals->height, 3, err)) != BB_OK)
+  if ((st = bb_image_alloc(out, normals->width, normals->height, b.count, err)) != BB_OK)
     return st;
   derive_job job;
-  job_init(&job, normals, NULL, out, 3);
+  job_init(&job, normals, NULL, out, &b);
   return run_rows(&job, weights_row, err);
 }
 
@@ -171,12 +146,15 @@ static void ssbump_row(void *user, int y) {
   }
 }
 
-bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis, bb_image *out,
-                           bb_error *err) {
+bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
+                           const bb_basis *basis, bb_image *out, bb_error *err) {
   bb_status st;
+  bb_basis b;
   if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
     return st;
   if ((st = check_image(vis, "visibility", 4, 1 + BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, vis->channels - 1, "visibility", &b, err)) != BB_OK)
     return st;
   if (vis->width != normals->width || vis->height != normals->height)
     return bb__fail(err, BB_ERR_ARGUMENT,
@@ -184,11 +162,10 @@ bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis, bb_imag
                     vis->height, normals->width, normals->height);
   if ((st = check_output(out, normals, vis, err)) != BB_OK)
     return st;
-  const int count = vis->channels - 1;
-  if ((st = bb_image_alloc(out, vis->width, vis->height, count, err)) != BB_OK)
+  if ((st = bb_image_alloc(out, vis->width, vis->height, b.count, err)) != BB_OK)
     return st;
   derive_job job;
-  job_init(&job, normals, vis, out, count);
+  job_init(&job, normals, vis, out, &b);
   return run_rows(&job, ssbump_row, err);
 }
 
@@ -209,7 +186,7 @@ bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
   if ((st = bb_image_alloc(out, vis->width, vis->height, 1, err)) != BB_OK)
     return st;
   derive_job job;
-  job_init(&job, NULL, vis, out, 0);
+  job_init(&job, NULL, vis, out, NULL);
   return run_rows(&job, ao_row, err);
 }
 
@@ -236,15 +213,19 @@ static void bent_row(void *user, int y) {
   }
 }
 
-bb_status bb_derive_bent(const bb_image *ssbump, bb_image *out, bb_error *err) {
+bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
+                         bb_error *err) {
   bb_status st;
+  bb_basis b;
   if ((st = check_image(ssbump, "ssbump", 3, BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, ssbump->channels, "ssbump", &b, err)) != BB_OK)
     return st;
   if ((st = check_output(out, ssbump, NULL, err)) != BB_OK)
     return st;
   if ((st = bb_image_alloc(out, ssbump->width, ssbump->height, 3, err)) != BB_OK)
     return st;
   derive_job job;
-  job_init(&job, ssbump, NULL, out, ssbump->channels);
+  job_init(&job, ssbump, NULL, out, &b);
   return run_rows(&job, bent_row, err);
 }

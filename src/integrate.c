@@ -289,6 +289,16 @@ static double fill_channel(const rules *r, double lo, double hi, const double b[
   return value;
 }
 
+void bb__slice_blocked_more(const double *coef, double f, int lobes, double *blocked) {
+  for (int c = 4; c < lobes; c++) blocked[1 + c] = BB__HERMITE(coef, f, c);
+}
+
+void bb__slice_accumulate_more(const bb__slice_integral *si, float horizon, float *sums) {
+  double blocked[1 + BB_MAX_BASIS];
+  bb__slice_blocked(si, (double)horizon, blocked);
+  for (int c = 0; c <= si->lobes; c++) sums[c] += (float)blocked[c];
+}
+
 void bb__slice_table_build(double lo, double hi, const double (*basis)[3], int basis_count,
                            double power, double *table, double *share) {
   rules r;

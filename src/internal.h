@@ -81,6 +81,19 @@ uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
 /* bb__fnv1a_u32 over the bits of n floats. */
 uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n);
 
+/* BB_OK when b has 3..BB_MAX_BASIS unit vectors with z >= 0 (a basis
+ * filled by hand is checked before it is used), else BB_ERR_ARGUMENT with a
+ * message starting "who: ". */
+bb_status bb__basis_check(const bb_basis *b, const char *who, bb_error *err);
+
+/* Consumers of basis maps (render, ssbump2normal, combine's detail,
+ * Valve's files) read channels 0..2 as Half-Life 2's B0, B1, B2 and leave a
+ * fourth alone (Valve's alpha, hl2+z's B3). BB_OK when img (named what)
+ * has at most 4 channels, else BB_ERR_ARGUMENT saying so; with a basis
+ * (may be NULL: not known) also when it is not Half-Life 2's. */
+bb_status bb__check_hl2_map(const bb_image *img, const bb_basis *basis, const char *what,
+                            bb_error *err);
+
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);
 

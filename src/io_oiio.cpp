@@ -543,6 +543,20 @@ bb_status write_safely_by_name(const char *path, const encoder_fn &encode,
   return BB_OK;
 }
 
+// Names the channels of an image with more than RGBA holds (a basis map of
+// more than 4 directions) B0, B1, ... instead of OpenImageIO's R, G, B, A,
+// channel4, ...: zero-padded to one width, since OpenEXR keeps channels
+// sorted by name and reads them back in that order, and none is alpha.
+void name_basis_channels(ImageSpec &spec) {
+  if (spec.nchannels <= 4) return;
+  const int width = (int)std::to_string(spec.nchannels - 1).size();
+  for (int c = 0; c < spec.nchannels; c++) {
+    std::string digits = std::to_string(c);
+    spec.channelnames[(size_t)c] = "B" + std::string((size_t)width - digits.size(), '0') + digits;
+  }
+  spec.alpha_channel = -1;
+}
+
 // Round-half-up quantisation of v (after the range mapping) to 0..max_code.
 // NaN becomes 0 so that it cannot reach an undefined float-to-int cast.
 // u * max_code + 0.5 lies in [0.5, max_code + 0.5], so truncation is the
@@ -581,6 +595,7 @@ std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy
                        : depth == BB_DEPTH_HALF ? TypeDesc::HALF
                                                 : TypeDesc::FLOAT;
   ImageSpec spec(img->width, img->height, img->channels, file_type);
+  name_basis_channels(spec);
   spec.attribute("oiio:UnassociatedAlpha", 1);
   spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
   if (description)
@@ -914,6 +929,7 @@ std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy 
   for (int k = 0; k < count; k++) {
     const bb_image *img = &levels[k];
     ImageSpec spec(img->width, img->height, img->channels, file_type);
+    name_basis_channels(spec);
     spec.tile_width = MIP_TILE;
     spec.tile_height = MIP_TILE;
     spec.attribute("textureformat", "Plain Texture");
@@ -1218,6 +1234,16 @@ int bb_path_supports_depth(const char *path, bb_depth depth) {
   try {
     const format_rule *f = find_format(extension_of(path));
     return f && (depth == BB_DEPTH_DEFAULT || (f->allowed & bit(depth)) != 0);
+  } catch (...) {
+    return 0;
+  }
+}
+
+int bb_path_max_channels(const char *path) {
+  if (!path) return 0;
+  try {
+    const format_rule *f = find_format(extension_of(path));
+    return f ? f->max_channels : 0;
   } catch (...) {
     return 0;
   }

@@ -98,12 +98,36 @@ static void put_float(text *t, const char *key, float value) {
 
 /* Doubles print in the shortest of %.15g / %.17g that reads back exactly, so
  * 0.55 stays "0.55" instead of "0.55000000000000004". */
+static void format_double(char *buf, size_t cap, double value) {
+  snprintf(buf, cap, "%.15g", value);
+  if (strtod(buf, NULL) != value)
+    snprintf(buf, cap, "%.17g", value);
+}
+
 static void put_double(text *t, const char *key, double value) {
   char buf[64];
-  snprintf(buf, sizeof buf, "%.15g", value);
-  if (strtod(buf, NULL) != value)
-    snprintf(buf, sizeof buf, "%.17g", value);
+  format_double(buf, sizeof buf, value);
   put(t, key, buf);
+}
+
+/* The basis by name; a caller's vectors (named by their hash) are also
+ * written out, "x y z" per direction joined by "; " (a basis file's lines),
+ * so the file records what to bake it again with. */
+static void put_basis(text *t, const bb_basis *b) {
+  put(t, "basis", b->name);
+  if (strncmp(b->name, "vectors:", 8) != 0 || b->count < 1 || b->count > BB_MAX_BASIS)
+    return;
+  char line[BB_MAX_BASIS * 3 * 26 + 1];
+  size_t used = 0;
+  line[0] = '\0';
+  for (int c = 0; c < b->count; c++)
+    for (int k = 0; k < 3; k++) {
+      char number[32];
+      format_double(number, sizeof number, b->vector[c][k]);
+      used += (size_t)snprintf(line + used, sizeof line - used, "%s%s",
+                               k ? " " : (c ? "; " : ""), number);
+    }
+  put(t, "basis_vectors", line);
 }
 
 static void put_int(text *t, const char *key, long value) {
@@ -122,7 +146,7 @@ static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
   put_float(t, "filter_threshold", o->smooth.threshold);
   put_double(t, "bias", o->trace.bias_texels);
   put_double(t, "power", o->power);
-  put(t, "basis", bb_basis_name(o->basis));
+  put_basis(t, &o->basis);
   put(t, "normal_filter", bb_normal_filter_name(o->normal_filter));
   put(t, "normal_y", o->normal_y_up ? "up" : "down");
   put(t, "addressing", o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
@@ -183,6 +207,29 @@ static int next_entry(const char **cursor, entry *e) {
       e->value_length--;
   }
   *cursor = *end ? end + 1 : end;
+  return 1;
+}
+
+/* The first entry of text whose key is key; 0 when there is none. */
+static int find_entry(const char *text_, const char *key, size_t key_length, entry *out) {
+  entry e;
+  const char *cursor = text_;
+  while (next_entry(&cursor, &e))
+    if (e.key_length == key_length && memcmp(e.key, key, key_length) == 0) {
+      *out = e;
+      return 1;
+    }
+  return 0;
+}
+
+int bb_provenance_value(const char *description, const char *key, char *out, size_t cap) {
+  if (out && cap)
+    out[0] = '\0';
+  entry e;
+  if (!description || !key || !find_entry(description, key, strlen(key), &e))
+    return 0;
+  if (out && cap)
+    snprintf(out, cap, "%.*s", (int)e.value_length, e.value);
   return 1;
 }
 

@@ -105,7 +105,7 @@ static void build_slice_table(void *user, int s) {
                         job->share + (size_t)s * (size_t)rs->basis_count);
 }
 
-bb_status bb_rayset_make(int slices, double power, bb_basis basis, bb_rayset *out,
+bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset *out,
                          bb_error *err) {
   memset(out, 0, sizeof *out);
   if (slices < 1 || slices > BB_MAX_SLICES)
@@ -113,13 +113,18 @@ bb_status bb_rayset_make(int slices, double power, bb_basis basis, bb_rayset *ou
                     BB_MAX_SLICES, slices);
   if (!(power >= 1.0) || !isfinite(power))
     return bb__fail(err, BB_ERR_ARGUMENT, "ray set: power must be >= 1 (got %g)", power);
-  if (bb_basis_count(basis) < 3)
-    return bb__fail(err, BB_ERR_ARGUMENT, "ray set: unknown basis");
+  bb_basis hl2;
+  if (!basis) {
+    bb_basis_init(&hl2);
+    basis = &hl2;
+  }
+  bb_status st = bb__basis_check(basis, "ray set", err);
+  if (st != BB_OK) return st;
   out->slice_count = slices;
-  out->basis_count = bb_basis_count(basis);
+  out->basis_count = basis->count;
   out->power = power;
-  for (int c = 0; c < out->basis_count; c++) bb_basis_vector(c, out->basis[c]);
-  bb_status st = allocate(out, err);
+  memcpy(out->basis, basis->vector, sizeof out->basis);
+  st = allocate(out, err);
   if (st != BB_OK) return st;
   const double spacing = 2.0 * BB__PI / slices;
   for (int s = 0; s < slices; s++)
@@ -142,8 +147,12 @@ bb_status bb_rayset_make(int slices, double power, bb_basis basis, bb_rayset *ou
     bb_rayset_free(out);
     return st;
   }
-  snprintf(out->id, sizeof out->id, "bb-horizon-v1:a%d:p%g:%s", slices, power,
-           bb_basis_name(basis));
+  /* At most 57 characters (256 slices, power 1.23457e+06, a vectors: name);
+   * the larger buffer only keeps the compiler from counting wider. */
+  char id[160];
+  snprintf(id, sizeof id, "bb-horizon-v1:a%d:p%g:%.*s", slices, power,
+           (int)sizeof basis->name, basis->name);
+  snprintf(out->id, sizeof out->id, "%.63s", id);
   return BB_OK;
 }
 

@@ -332,6 +332,8 @@ static bb_status check_maps(const bb_render_maps *m, unsigned needs,
     if (!list[i].needed)
       continue;
     bb_status st = check_map(list[i].img, list[i].what, list[i].channels, first, err);
+    if (st == BB_OK && list[i].img == m->ssbump)
+      st = bb__check_hl2_map(m->ssbump, NULL, "render: the ssbump map", err);
     if (st != BB_OK)
       return st;
     if (!first)

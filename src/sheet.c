@@ -44,7 +44,9 @@ static bb_status check_bake(const bb_image *height, const bb_bake_result *r,
   if (r->normal.width != height->width || r->normal.height != height->height)
     return bb__fail(err, BB_ERR_ARGUMENT, "sheet: the bake is %dx%d, the height %dx%d",
                     r->normal.width, r->normal.height, height->width, height->height);
-  return BB_OK;
+  /* Its weights, ssbump and lit panel show Half-Life 2's three directions. */
+  return bb__check_hl2_map(&r->ssbump, r->basis.count ? &r->basis : NULL, "sheet: the bake",
+                           err);
 }
 
 enum { SHEET_PANELS = 8 };

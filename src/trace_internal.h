@@ -55,11 +55,24 @@ static inline bb__slice_integral bb__slice_integral_of(const bb_rayset *rs, int 
   return si;
 }
 
+/* Lobes past the fourth (bases of more than 4 directions), out of line so
+ * the inner loops of 3 and 4 lobes keep their values in registers:
+ * blocked[1 + c] for c = 4..lobes-1 from a table interval's coefficients
+ * coef at fraction f; and bb__slice_accumulate for any count. */
+void bb__slice_blocked_more(const double *coef, double f, int lobes, double *blocked);
+void bb__slice_accumulate_more(const bb__slice_integral *si, float horizon, float *sums);
+
+/* One lobe's cubic piece at fraction f of its interval. */
+#define BB__HERMITE(coef, f, c)                                                                  \
+  ((coef)[4 * (c)] +                                                                             \
+   (f) * ((coef)[4 * (c) + 1] + (f) * ((coef)[4 * (c) + 2] + (f) * (coef)[4 * (c) + 3])))
+
 /* What the slice loses to a horizon of tangent t >= 0 (the float the
- * tracer found, as a double): blocked[0] for ao, blocked[1 + c] per lobe.
- * One inline function for every path, so the same horizon gives the same
- * bits; lobes is 3 or 4, unrolled. */
-static inline void bb__slice_blocked(const bb__slice_integral *si, double t, double *blocked) {
+ * tracer found, as a double): blocked[0] for ao, blocked[1 + c] per lobe,
+ * for up to the first 4 lobes; *coef and *f receive the interval's
+ * coefficients and fraction for bb__slice_blocked_more. */
+static inline void bb__slice_blocked4(const bb__slice_integral *si, double t, double *blocked,
+                                      const double **coef_out, double *f_out) {
   /* one division for both t^2 / (1 + t^2) and q = t / (1 + t) */
   const double tt = t * t, one_t = 1.0 + t, one_tt = 1.0 + tt;
   const double inverse = 1.0 / (one_t * one_tt);
@@ -69,12 +82,23 @@ static inline void bb__slice_blocked(const bb__slice_integral *si, double t, dou
   if (k > BB__TABLE_INTERVALS - 1) k = BB__TABLE_INTERVALS - 1;
   const double f = x - (double)k;
   const double *coef = si->table + (size_t)k * (size_t)si->lobes * 4;
-#define BB__HERMITE(c) (coef[4 * (c)] + f * (coef[4 * (c) + 1] + f * (coef[4 * (c) + 2] + f * coef[4 * (c) + 3])))
-  blocked[1] = BB__HERMITE(0);
-  blocked[2] = BB__HERMITE(1);
-  blocked[3] = BB__HERMITE(2);
-  if (si->lobes > 3) blocked[4] = BB__HERMITE(3);
-#undef BB__HERMITE
+  blocked[1] = BB__HERMITE(coef, f, 0);
+  blocked[2] = BB__HERMITE(coef, f, 1);
+  blocked[3] = BB__HERMITE(coef, f, 2);
+  if (si->lobes > 3) blocked[4] = BB__HERMITE(coef, f, 3);
+  *coef_out = coef;
+  *f_out = f;
+}
+
+/* What the slice loses to a horizon of tangent t >= 0: blocked[0] for ao,
+ * blocked[1 + c] per lobe (1 + lobes values). One inline function for
+ * every path, so the same horizon gives the same bits; lobes is
+ * 3..BB_MAX_BASIS, the first 4 unrolled. */
+static inline void bb__slice_blocked(const bb__slice_integral *si, double t, double *blocked) {
+  const double *coef;
+  double f;
+  bb__slice_blocked4(si, t, blocked, &coef, &f);
+  if (si->lobes > 4) bb__slice_blocked_more(coef, f, si->lobes, blocked);
 }
 
 /* Adds the slice's loss at a horizon to a texel's float sums (1 + lobes
@@ -82,8 +106,14 @@ static inline void bb__slice_blocked(const bb__slice_integral *si, double t, dou
  * nothing, and adding zeros would change no bit, so it adds nothing. */
 static inline void bb__slice_accumulate(const bb__slice_integral *si, float horizon, float *sums) {
   if (!(horizon > 0.0f)) return;
-  double blocked[1 + BB_MAX_BASIS];
-  bb__slice_blocked(si, (double)horizon, blocked);
+  if (si->lobes > 4) {
+    bb__slice_accumulate_more(si, horizon, sums);
+    return;
+  }
+  double blocked[1 + 4];
+  const double *coef;
+  double f;
+  bb__slice_blocked4(si, (double)horizon, blocked, &coef, &f);
   sums[0] += (float)blocked[0];
   sums[1] += (float)blocked[1];
   sums[2] += (float)blocked[2];

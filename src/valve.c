@@ -37,6 +37,9 @@ bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
   const bb_image *rgb = o->normal_map ? &result->normal : &result->ssbump;
   const bb_image *alpha = o->ao_in_alpha ? &result->ao : &result->filtered;
   bb_status st = check_part(rgb, o->normal_map ? "normal map" : "ssbump", 3, err);
+  if (st == BB_OK && !o->normal_map) /* a hand-made result has a zeroed basis */
+    st = bb__check_hl2_map(rgb, result->basis.count ? &result->basis : NULL,
+                           "valve pack: the ssbump", err);
   if (st == BB_OK)
     st = check_part(alpha, o->ao_in_alpha ? "ao" : "filtered height", 1, err);
   if (st != BB_OK)

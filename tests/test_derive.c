@@ -1,4 +1,5 @@
-/* test_derive.c: the Half-Life 2 basis and the weights, ssbump, ao and bent maps. */
+/* test_derive.c: the Half-Life 2 basis vectors and the weights, ssbump, ao and bent maps
+ * (other bases: test_basis.c). */
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -24,21 +25,6 @@ static void set_normal(bb_image *n, int i, double x, double y, double z) {
 
 static double dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-Test(derive, basis_names_and_counts) {
-  bb_basis b = BB_BASIS_HL2;
-  cr_assert_eq(bb_basis_parse("hl2+z", &b), 0);
-  cr_assert_eq(b, BB_BASIS_HL2_Z);
-  cr_assert_eq(bb_basis_parse("hl2", &b), 0);
-  cr_assert_eq(b, BB_BASIS_HL2);
-  cr_assert_neq(bb_basis_parse("hl3", &b), 0);
-  cr_assert_neq(bb_basis_parse("HL2", &b), 0);
-  cr_assert_eq(b, BB_BASIS_HL2, "a failed parse must not write");
-  cr_assert_str_eq(bb_basis_name(BB_BASIS_HL2), "hl2");
-  cr_assert_str_eq(bb_basis_name(BB_BASIS_HL2_Z), "hl2+z");
-  cr_assert_eq(bb_basis_count(BB_BASIS_HL2), 3);
-  cr_assert_eq(bb_basis_count(BB_BASIS_HL2_Z), 4);
 }
 
 /* The vectors of CONVENTIONS, unit length, the first three 120 degrees apart
@@ -67,10 +53,10 @@ Test(derive, flat_unoccluded_texel) {
   bb_image n = {0}, vis = {0}, w = {0}, s = {0}, ao = {0}, bent = {0};
   make_uniform(&n, 4, 3, up);
   make_uniform(&vis, 4, 4, all_visible);
-  cr_assert_eq(bb_derive_weights(&n, &w, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &s, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
   cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
-  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
   cr_assert_eq(s.channels, 3);
   cr_assert_eq(ao.channels, 1);
   for (int i = 0; i < 4; i++) {
@@ -93,10 +79,10 @@ Test(derive, flat_with_z_channel) {
   bb_image n = {0}, vis = {0}, s = {0}, bent = {0};
   make_uniform(&n, 1, 3, up);
   make_uniform(&vis, 1, 5, vis5);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &s, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
   cr_assert_eq(s.channels, 4);
   cr_assert_float_eq(s.pixels[3], 0.75f, 1e-7f);
-  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
   cr_assert_float_eq(bent.pixels[2], 1.0f, 1e-7f);
   bb_image_free(&n), bb_image_free(&vis), bb_image_free(&s), bb_image_free(&bent);
 }
@@ -109,7 +95,7 @@ Test(derive, normal_along_a_basis_vector_takes_all_weight) {
     bb_basis_vector(c, b);
     set_normal(&n, c, b[0], b[1], b[2]);
   }
-  cr_assert_eq(bb_derive_weights(&n, &w, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
   for (int i = 0; i < 3; i++)
     for (int c = 0; c < 3; c++)
       cr_assert_float_eq(w.pixels[3 * i + c], i == c ? 1.0f : 0.0f, 1e-6f,
@@ -127,7 +113,7 @@ Test(derive, weights_between_and_beyond) {
   cr_assert_eq(bb_image_alloc(&n, 2, 1, 3, NULL), BB_OK);
   set_normal(&n, 0, b0[0] + b1[0], b0[1] + b1[1], b0[2] + b1[2]);
   set_normal(&n, 1, 0.0, 0.0, -1.0);
-  cr_assert_eq(bb_derive_weights(&n, &w, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
   cr_assert_float_eq(w.pixels[0], 0.5f, 1e-6f);
   cr_assert_float_eq(w.pixels[1], 0.5f, 1e-6f);
   cr_assert_float_eq(w.pixels[2], 0.0f, 1e-6f);
@@ -143,7 +129,7 @@ Test(derive, ssbump_is_zero_where_the_normal_faces_away) {
   make_uniform(&n, 1, 3, zero);
   set_normal(&n, 0, 1.0, 0.0, 0.2);
   make_uniform(&vis, 1, 4, vis4);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &s, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
   double b0[3];
   bb_basis_vector(0, b0);
   double n0[3] = {n.pixels[0], n.pixels[1], n.pixels[2]};
@@ -159,7 +145,7 @@ Test(derive, bent_of_a_single_light_follows_its_basis_vector) {
   cr_assert_eq(bb_image_alloc(&s, 4, 1, 4, NULL), BB_OK);
   for (int c = 0; c < 4; c++)
     s.pixels[4 * c + c] = 0.4f;
-  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
   for (int c = 0; c < 4; c++) {
     double b[3];
     bb_basis_vector(c, b);
@@ -173,7 +159,7 @@ Test(derive, bent_of_a_dark_texel_is_straight_up) {
   const float dark[3] = {0.0f, 0.0f, 0.0f};
   bb_image s = {0}, bent = {0};
   make_uniform(&s, 2, 3, dark);
-  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
   for (int i = 0; i < 2; i++)
     cr_assert(bent.pixels[3 * i] == 0.0f && bent.pixels[3 * i + 1] == 0.0f &&
               bent.pixels[3 * i + 2] == 1.0f);
@@ -220,10 +206,10 @@ static void check_maps_against_formulas(int count) {
       vis.pixels[(1 + count) * i + c] = (float)next_random(&state);
   }
   n.pixels[3 * 100] = NAN;
-  cr_assert_eq(bb_derive_weights(&n, &wt, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &s, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &wt, NULL), BB_OK);
+  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
   cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
-  cr_assert_eq(bb_derive_bent(&s, &bent, NULL), BB_OK);
+  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
   double b[4][3];
   for (int c = 0; c < count; c++)
     bb_basis_vector(c, b[c]);
@@ -272,14 +258,14 @@ Test(derive, rejects_mismatched_inputs) {
   cr_assert_eq(bb_image_alloc(&vis, 4, 4, 4, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&vis2, 4, 4, 2, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&s2, 4, 4, 2, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ssbump(&n_small, &vis, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_derive_ssbump(&n_small, &vis, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "4x3") != NULL, "%s", err.message);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis2, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_derive_ssbump(&vis, &vis, &out, &err), BB_ERR_ARGUMENT,
+  cr_assert_eq(bb_derive_ssbump(&n, &vis2, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_derive_ssbump(&vis, &vis, NULL, &out, &err), BB_ERR_ARGUMENT,
                "normals need 3 channels");
-  cr_assert_eq(bb_derive_weights(&vis, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_derive_weights(&n, &n, &err), BB_ERR_ARGUMENT, "output aliases input");
-  cr_assert_eq(bb_derive_bent(&s2, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_derive_weights(&vis, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &n, &err), BB_ERR_ARGUMENT, "output aliases input");
+  cr_assert_eq(bb_derive_bent(&s2, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb_derive_ao(NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_null(out.pixels);
   cr_assert_not_null(n.pixels);

@@ -176,7 +176,9 @@ Test(integrate, rayset_sectors_and_totals) {
   for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
     bb_rayset rs;
     bb_error err;
-    cr_assert_eq(bb_rayset_make(counts[i], 1.0, BB_BASIS_HL2_Z, &rs, &err), BB_OK, "%s", err.message);
+    bb_basis hl2z;
+    cr_assert_eq(bb_basis_parse("hl2+z", &hl2z, NULL), BB_OK);
+    cr_assert_eq(bb_rayset_make(counts[i], 1.0, &hl2z, &rs, &err), BB_OK, "%s", err.message);
     double width = 0.0;
     for (int s = 0; s < rs.slice_count; s++) {
       const double lo = rs.sector[2 * s], hi = rs.sector[2 * s + 1];
@@ -200,10 +202,10 @@ Test(integrate, rayset_sectors_and_totals) {
 Test(integrate, rayset_rejects_bad_arguments) {
   bb_rayset rs;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(0, 1.0, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(BB_MAX_SLICES + 1, 1.0, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(16, 0.5, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(16, NAN, BB_BASIS_HL2, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_rayset_make(0, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_rayset_make(BB_MAX_SLICES + 1, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_rayset_make(16, 0.5, NULL, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_rayset_make(16, NAN, NULL, &rs, &err), BB_ERR_ARGUMENT);
 }
 
 Test(integrate, slices_for_rays_follow_valves_count) {

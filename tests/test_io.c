@@ -219,6 +219,36 @@ Test(io, round_trip_exr_half) {
   bb_image_free(&img);
 }
 
+/* A basis map of more than 4 directions: every channel comes back in its
+ * place (OpenEXR sorts channels by name, so B0..B15 unpadded would read
+ * back as B0, B1, B10, ...), none of them as alpha, at every depth. */
+Test(io, round_trip_basis_maps_of_many_channels) {
+  const int counts[] = {5, 6, 11, 16};
+  for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+    bb_image img = make_image(5, 4, counts[i], 0.0f, 1.0f, 40 + (uint32_t)i);
+    check_round_trip("many.exr", &img, BB_DEPTH_FLOAT, 0.0, "openexr", 1, 32);
+    check_round_trip("many_half.exr", &img, BB_DEPTH_HALF, 1.0 / 2048.0, "openexr", 1, 16);
+    check_round_trip("many.tif", &img, BB_DEPTH_8, HALF_STEP_8, "tiff", 0, 8);
+    check_round_trip("many16.tif", &img, BB_DEPTH_16, HALF_STEP_16, "tiff", 0, 16);
+    check_round_trip("manyf.tif", &img, BB_DEPTH_FLOAT, 0.0, "tiff", 1, 32);
+    const char *names[] = {"many.exr", "many.tif"};
+    for (int k = 0; k < 2; k++) {
+      bb_image_info info;
+      cr_assert_eq(bb_image_read_info(tmp_path(names[k]), NULL, NULL, NULL, &info, NULL), BB_OK);
+      cr_expect_eq(info.alpha_channel, -1, "%s, %d channels: channel %d read as alpha",
+                   names[k], counts[i], info.alpha_channel);
+      bb_image_info_free(&info);
+    }
+    bb_image_free(&img);
+  }
+  cr_assert_eq(bb_path_max_channels("a.png"), 4);
+  cr_assert_eq(bb_path_max_channels("a.TGA"), 4);
+  cr_assert_eq(bb_path_max_channels("a.tif"), 64);
+  cr_assert_eq(bb_path_max_channels("a.exr"), 64);
+  cr_assert_eq(bb_path_max_channels("a.jpg"), 0);
+  cr_assert_eq(bb_path_max_channels(NULL), 0);
+}
+
 /* ------------------------------------------------------------ encoding */
 
 /* Writes a 1-row image of the given values and reads back the codes. */

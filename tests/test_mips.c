@@ -162,8 +162,8 @@ Test(mips, mip_of_an_ssbump_lights_like_the_mean_of_the_lit_texels) {
   bb_image n = noise_normals(16, 16, 5), w;
   levels = chain(&n, BB_MIP_RENORMALIZE, &count);
   bb_image w1;
-  cr_assert_eq(bb_derive_weights(&n, &w, NULL), BB_OK);
-  cr_assert_eq(bb_derive_weights(&levels[1], &w1, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb_derive_weights(&levels[1], NULL, &w1, NULL), BB_OK);
   double worst = 0.0;
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 8; x++) {

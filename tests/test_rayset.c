@@ -17,7 +17,7 @@ Test(rayset, slices_follow_lattice_steps_near_uniform_azimuths) {
   const int counts[] = {1, 2, 3, 7, 16, 32, 64, 100, 256};
   for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
     bb_rayset rs;
-    cr_assert_eq(bb_rayset_make(counts[i], 1.0, BB_BASIS_HL2, &rs, NULL), BB_OK);
+    cr_assert_eq(bb_rayset_make(counts[i], 1.0, NULL, &rs, NULL), BB_OK);
     const double spacing = 2 * PI / rs.slice_count;
     for (int s = 0; s < rs.slice_count; s++) {
       const int a = rs.slice_step[2 * s], b = rs.slice_step[2 * s + 1];
@@ -41,7 +41,9 @@ Test(rayset, slices_follow_lattice_steps_near_uniform_azimuths) {
 
 Test(rayset, id_names_the_scheme_and_its_parameters) {
   bb_rayset rs;
-  cr_assert_eq(bb_rayset_make(16, 2.0, BB_BASIS_HL2_Z, &rs, NULL), BB_OK);
+  bb_basis hl2z;
+  cr_assert_eq(bb_basis_parse("hl2+z", &hl2z, NULL), BB_OK);
+  cr_assert_eq(bb_rayset_make(16, 2.0, &hl2z, &rs, NULL), BB_OK);
   cr_assert_str_eq(rs.id, "bb-horizon-v1:a16:p2:hl2+z");
   cr_assert_eq(rs.basis_count, 4);
   cr_assert_eq(rs.power, 2.0);
@@ -52,7 +54,7 @@ Test(rayset, id_names_the_scheme_and_its_parameters) {
  * vertical wall, and more loss for a higher horizon. */
 Test(rayset, blocked_rises_with_the_horizon) {
   bb_rayset rs;
-  cr_assert_eq(bb_rayset_make(16, 1.0, BB_BASIS_HL2, &rs, NULL), BB_OK);
+  cr_assert_eq(bb_rayset_make(16, 1.0, NULL, &rs, NULL), BB_OK);
   double last[4] = {0};
   for (double t = -1.0; t < 1e4; t = t < 0 ? 0.001 : t * 2) {
     double blocked[4];

@@ -236,7 +236,7 @@ Test(trace, vertical_ray_is_never_blocked) {
 static bb_rayset rayset_of(int slices) {
   bb_rayset rs;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(slices, 1.0, BB_BASIS_HL2, &rs, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_rayset_make(slices, 1.0, NULL, &rs, &err), BB_OK, "%s", err.message);
   return rs;
 }
 

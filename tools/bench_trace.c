@@ -153,7 +153,7 @@ static bb_status prepare(const args *a, field *f, bb_error *err) {
   const size_t n = (size_t)f->z.width * (size_t)f->z.height;
   for (size_t i = 0; i < n; i++) f->z.pixels[i] = scale * f->filtered.pixels[i];
   st = bb_pyramid_build(&f->z, a->addressing, &f->pyramid, err);
-  if (st == BB_OK) st = bb_rayset_make(a->slices, 1.0, BB_BASIS_HL2, &f->rs, err);
+  if (st == BB_OK) st = bb_rayset_make(a->slices, 1.0, NULL, &f->rs, err);
   return st;
 }
 

@@ -81,7 +81,7 @@ def _library_defaults():
         "filter_threshold": o.smooth.threshold,
         "bias": o.trace.bias_texels,
         "power": o.power,
-        "basis": _ffi.string(_lib.bb_basis_name(o.basis)).decode(),
+        "basis": _ffi.string(o.basis.name).decode(),
         "normal_filter": _ffi.string(_lib.bb_normal_filter_name(o.normal_filter)).decode(),
         "normal_y": "up" if o.normal_y_up else "down",
         "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP,
@@ -152,6 +152,45 @@ def _common_options(command, scale, filter_radius, filter_threshold, normal_filt
     if clamp is not None:
         o.smooth.addressing = _lib.BB_ADDRESS_CLAMP if clamp else _lib.BB_ADDRESS_PERIODIC
     return o
+
+
+# The named bases; any other text is a basis file (as for `bumpbake bake --basis`).
+_BASIS_NAMES = ("hl2", "hl2+z")
+
+
+def _basis(command, spec):
+    """A bb_basis from "hl2", "hl2+z", "dirs:N", a basis file's path, or an
+    (N, 3) array of directions (each scaled to unit length by the library)."""
+    out = _ffi.new("bb_basis *")
+    err = _ffi.new("bb_error *")
+    if isinstance(spec, str) and (spec in _BASIS_NAMES or spec.startswith("dirs:")):
+        st = _lib.bb_basis_parse(spec.encode(), out, err)
+    elif isinstance(spec, (str, bytes, os.PathLike)):
+        path = os.fsencode(spec)
+        if not os.path.exists(path):
+            raise ArgumentError(
+                f"{command}: basis must be hl2, hl2+z, dirs:N or a file of directions "
+                f"(got {spec!r}: no such file)", "bad argument")
+        st = _lib.bb_basis_load(path, out, err)
+    else:
+        v = np.asarray(spec, dtype=np.float64)
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise ArgumentError(f"{command}: basis vectors must be an (N, 3) array "
+                                f"(got shape {v.shape})", "bad argument")
+        v = np.ascontiguousarray(v)
+        st = _lib.bb_basis_from_vectors(_ffi.cast("const double (*)[3]", _ffi.from_buffer(v)),
+                                        v.shape[0], out, err)
+    if st != _lib.BB_OK:
+        _raise_status(st, err)
+    return out
+
+
+def basis(spec):
+    """The unit directions of a basis, float64 (N, 3), in the order of the
+    ssbump and weights channels a bake with basis=spec makes (spec as for
+    bake())."""
+    b = _basis("basis", spec)
+    return np.array([[b.vector[c][k] for k in range(3)] for c in range(b.count)])
 
 
 def _output_kinds(outputs):
@@ -269,7 +308,7 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filt
     if threads is not None:
         o.trace.threads = _cli_limit("bake", "threads", _int_value("bake", "threads", threads))
     if basis is not None:
-        o.basis = _choice("bake", "basis", ("bb_basis_parse", "bb_basis"), basis, "hl2|hl2+z")
+        o.basis = _basis("bake", basis)[0]
     o.want_trace = any(k in TRACED_OUTPUTS for k in kinds)
     result = _run_bake(height, channel, o, "bake")
     try:
@@ -310,8 +349,10 @@ Parameters (as `bumpbake bake --help`; None keeps the library's default):
         {DEFAULTS["filter_threshold"]:.7g}, > 0.
     bias (bake): ray origin lift in texels, default {DEFAULTS["bias"]:g}, 0..1e6.
     power (bake): exponent of the basis lobes, default {DEFAULTS["power"]:g}, 1..1e6.
-    basis (bake): "hl2" or "hl2+z" (4 ssbump channels); default
-        "{DEFAULTS["basis"]}".
+    basis (bake): the directions of ssbump and weights, one channel each:
+        "hl2" (default), "hl2+z" (adds (0, 0, 1)), "dirs:N" (N in 3..16
+        evenly spread in azimuth at Half-Life 2's elevation), a basis file
+        (lines "x y z", # comments) or an (N, 3) array of directions.
     normal_filter: "vertex" (centred on the texel's vertex), "valve"
         (Valve's), "central" or "sobel"; default "{DEFAULTS["normal_filter"]}".
     normal_y: "down" (Source, DirectX) or "up" (OpenGL); default

@@ -67,9 +67,10 @@ typedef enum bb_normal_filter {
   BB_NORMAL_VERTEX
 } bb_normal_filter;
 
-typedef enum bb_basis {
-  BB_BASIS_HL2 = 0,
-  BB_BASIS_HL2_Z
+typedef struct bb_basis {
+  int count;
+  double vector[16][3];
+  char name[32];
 } bb_basis;
 
 typedef void (*bb_progress_fn)(void *user, long done, long total);
@@ -110,6 +111,7 @@ typedef struct bb_bake_result {
   double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
   double horizons_found;
   char rayset_id[64];
+  bb_basis basis;
 } bb_bake_result;
 """
 
@@ -126,8 +128,11 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_error *err);
 int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
 const char *bb_normal_filter_name(bb_normal_filter f);
-int bb_basis_parse(const char *name, bb_basis *out);
-const char *bb_basis_name(bb_basis b);
+void bb_basis_init(bb_basis *b);
+bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
+bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
+                                bb_error *err);
+bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);

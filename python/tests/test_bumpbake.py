@@ -120,6 +120,39 @@ def test_basis_hl2_z_adds_a_fourth_ssbump_channel():
     np.testing.assert_allclose(s[..., 3], 1.0, atol=1e-6)  # N.B3 = 1 on a flat field
 
 
+def test_dirs_basis_has_a_channel_per_direction():
+    h = np.random.default_rng(5).random((16, 12), dtype=np.float32)
+    maps = bumpbake.bake(h, 6, slices=8, basis="dirs:6", outputs=("ssbump", "weights"))
+    assert maps["ssbump"].shape == (16, 12, 6)
+    assert maps["weights"].shape == (16, 12, 6)
+    np.testing.assert_allclose(maps["weights"].sum(axis=2), 1.0, atol=1e-6)
+    flat = bumpbake.bake(np.zeros((8, 8)), 4, slices=8, basis="dirs:6", outputs="ssbump")
+    np.testing.assert_allclose(flat["ssbump"], 1 / np.sqrt(3), atol=1e-7)
+    # dirs:3 is Half-Life 2's basis, bit for bit.
+    a = bumpbake.bake(h, 6, slices=8, basis="dirs:3", outputs="ssbump")["ssbump"]
+    b = bumpbake.bake(h, 6, slices=8, outputs="ssbump")["ssbump"]
+    np.testing.assert_array_equal(a, b)
+
+
+def test_basis_from_an_array_a_file_and_a_name_agree(tmp_path):
+    v = bumpbake.basis("dirs:5")
+    assert v.shape == (5, 3)
+    np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, atol=1e-15)
+    path = tmp_path / "five.txt"
+    path.write_text("# five directions\n" + "".join(
+        f"{x!r} {y!r} {z!r}\n" for x, y, z in (2 * v).tolist()))
+    np.testing.assert_array_equal(bumpbake.basis(path), bumpbake.basis(v))
+    np.testing.assert_allclose(bumpbake.basis(path), v, atol=1e-15)
+    h = np.random.default_rng(6).random((10, 10), dtype=np.float32)
+    from_file = bumpbake.bake(h, 5, slices=6, basis=str(path), outputs="ssbump")["ssbump"]
+    from_array = bumpbake.bake(h, 5, slices=6, basis=2 * v, outputs="ssbump")["ssbump"]
+    np.testing.assert_array_equal(from_file, from_array)
+    bad = tmp_path / "bad.txt"
+    bad.write_text("0 0 1\n1 0 1\n0 1\n")
+    with pytest.raises(bumpbake.Error, match=r"bad.txt:3: 2 numbers; a direction is 3"):
+        bumpbake.basis(bad)
+
+
 @pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
 def test_same_bits_as_the_command_line(tmp_path):
     """Defaults, reading and every output as `bumpbake bake` makes them."""
@@ -151,7 +184,10 @@ def test_same_bits_as_the_command_line(tmp_path):
     ({"filter_radius": 4097}, "bake: filter_radius must be in 0..4096 (got 4097)"),
     ({"threads": -1}, "bake: threads must be in 0..4096 (got -1)"),
     ({"rays": 2**40}, "bake: rays 1099511627776 is out of range"),
-    ({"basis": "hl3"}, "bake: basis must be one of hl2|hl2+z (got 'hl3')"),
+    ({"basis": "hl3"}, "bake: basis must be hl2, hl2+z, dirs:N or a file of directions"),
+    ({"basis": "dirs:2"}, "basis: dirs:N needs a count N in 3..16 (got 'dirs:2')"),
+    ({"basis": [[0, 0, 1], [1, 0, 0], [0, 0, 0]]}, "basis: vector 2: the zero vector"),
+    ({"basis": np.zeros((3, 2))}, "bake: basis vectors must be an (N, 3) array"),
     ({"normal_filter": "box"}, "bake: normal_filter must be one of vertex|valve|central|sobel"),
     ({"normal_y": "left"}, "bake: normal_y must be one of down|up (got 'left')"),
     ({"channel": "z"}, "bake: channel must be one of auto|r|g|b|a|luma|mean (got 'z')"),
