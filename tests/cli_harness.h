@@ -11,14 +11,19 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/time.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 typedef struct cli_result {
-  int code;  /* exit code, or 128 + signal when it crashed */
-  char *out; /* all of stdout, NUL-terminated */
-  char *err; /* all of stderr */
+  int code;         /* exit code, or 128 + signal when it crashed */
+  char *out;        /* all of stdout, NUL-terminated */
+  char *err;        /* all of stderr */
+  long max_rss_kib; /* the child's peak resident memory */
+  double seconds;   /* wall-clock time of the run */
 } cli_result;
 
 static inline void cli_result_free(cli_result *r) {
@@ -40,7 +45,8 @@ static inline char *harness_slurp(FILE *f) {
   return buf;
 }
 
-/* Absolute path of the binary (BB_BIN, default build/bumpbake). */
+/* Absolute path of the binary (BB_BIN, default build/bumpbake), so runs
+ * with another cwd find it too. */
 static inline const char *harness_binary(void) {
   static char path[4096];
   if (!path[0]) {
@@ -51,17 +57,36 @@ static inline const char *harness_binary(void) {
   return path;
 }
 
-/* Runs bumpbake with args (NULL-terminated, without argv[0]) in directory
- * cwd (NULL = ours); no shell. */
-static inline cli_result harness_run_in(const char *cwd, const char *const *args) {
+/* Resource limits for a run; a negative value leaves that limit alone. */
+typedef struct run_limits {
+  long file_size_bytes;     /* RLIMIT_FSIZE: a small filesystem without root */
+  long address_space_bytes; /* RLIMIT_AS: a safety net for memory tests */
+} run_limits;
+
+static const run_limits harness_no_limits = {-1, -1};
+
+static inline void harness_set_limit(int resource, long value) {
+  if (value < 0)
+    return;
+  struct rlimit rl = {(rlim_t)value, (rlim_t)value};
+  if (setrlimit(resource, &rl) != 0)
+    _exit(125);
+}
+
+/* Forks and execs bumpbake with args (NULL-terminated, without argv[0]) in
+ * cwd (NULL = ours) under lim, stdout and stderr to out and err: no shell,
+ * so nothing is reinterpreted. Returns the pid. */
+static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
+                                  const char *const *args, FILE *out, FILE *err) {
   const char *argv[64] = {"bumpbake"};
   for (int i = 0; args[i]; i++) {
     cr_assert_lt(i, 62, "too many arguments");
     argv[i + 1] = args[i];
   }
+  /* Resolved here, not in the child: the child may chdir first, and a
+   * failed assertion there would report from a process Criterion does not
+   * know. */
   const char *binary = harness_binary();
-  FILE *out = tmpfile(), *err = tmpfile();
-  cr_assert(out && err);
   fflush(NULL);
   pid_t pid = fork();
   cr_assert(pid >= 0);
@@ -70,18 +95,43 @@ static inline cli_result harness_run_in(const char *cwd, const char *const *args
     dup2(fileno(err), STDERR_FILENO);
     if (cwd && chdir(cwd) != 0)
       _exit(126);
+    harness_set_limit(RLIMIT_FSIZE, lim->file_size_bytes);
+    harness_set_limit(RLIMIT_AS, lim->address_space_bytes);
     execv(binary, (char *const *)argv);
     _exit(127);
   }
+  return pid;
+}
+
+static inline double harness_seconds_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Runs bumpbake with args in cwd (NULL = ours) under lim and waits for it. */
+static inline cli_result harness_run_limited(const char *cwd, const run_limits *lim,
+                                             const char *const *args) {
+  FILE *out = tmpfile(), *err = tmpfile();
+  cr_assert(out && err);
+  double t0 = harness_seconds_now();
+  pid_t pid = harness_spawn(cwd, lim, args, out, err);
   int status = 0;
-  cr_assert(waitpid(pid, &status, 0) == pid);
+  struct rusage usage;
+  cr_assert(wait4(pid, &status, 0, &usage) == pid);
   cli_result r;
+  r.seconds = harness_seconds_now() - t0;
+  r.max_rss_kib = usage.ru_maxrss;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.out = harness_slurp(out);
   r.err = harness_slurp(err);
   fclose(out);
   fclose(err);
   return r;
+}
+
+static inline cli_result harness_run_in(const char *cwd, const char *const *args) {
+  return harness_run_limited(cwd, &harness_no_limits, args);
 }
 
 static inline cli_result harness_run(const char *const *args) {

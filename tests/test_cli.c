@@ -24,174 +24,7 @@
 #include <time.h>
 #include <unistd.h>
 
-/* ------------------------------------------------------- running the CLI */
-
-typedef struct cli_result {
-  int code;  /* exit code, or 128 + signal when it crashed */
-  char *out; /* all of stdout, NUL-terminated */
-  char *err; /* all of stderr */
-  long max_rss_kib; /* the child's peak resident memory */
-  double seconds;   /* wall-clock time of the run */
-} cli_result;
-
-static void cli_result_free(cli_result *r) {
-  free(r->out);
-  free(r->err);
-  memset(r, 0, sizeof *r);
-}
-
-static char *slurp_stream(FILE *f) {
-  fflush(f);
-  long n = ftell(f);
-  cr_assert(n >= 0);
-  char *buf = malloc((size_t)n + 1);
-  cr_assert_not_null(buf);
-  rewind(f);
-  size_t got = fread(buf, 1, (size_t)n, f);
-  buf[got] = '\0';
-  return buf;
-}
-
-/* Absolute path of the binary, so runs with another cwd find it too. */
-static const char *cli_binary(void) {
-  static char path[4096];
-  if (!path[0]) {
-    const char *bin = getenv("BB_BIN");
-    if (!bin || !*bin)
-      bin = "build/bumpbake";
-    cr_assert(realpath(bin, path) != NULL, "BB_BIN %s not found", bin);
-  }
-  return path;
-}
-
-/* Resource limits for a run; a negative value leaves that limit alone. */
-typedef struct run_limits {
-  long file_size_bytes;     /* RLIMIT_FSIZE: a small filesystem without root */
-  long address_space_bytes; /* RLIMIT_AS: a safety net for memory tests */
-} run_limits;
-
-static const run_limits no_limits = {-1, -1};
-
-static void set_limit(int resource, long value) {
-  if (value < 0)
-    return;
-  struct rlimit rl = {(rlim_t)value, (rlim_t)value};
-  if (setrlimit(resource, &rl) != 0)
-    _exit(125);
-}
-
-/* Forks and execs bumpbake with args (NULL-terminated, without argv[0]) in
- * cwd (NULL = ours) under lim, stdout and stderr to out and err: no shell,
- * so nothing is reinterpreted. Returns the pid. */
-static pid_t spawn_cli(const char *cwd, const run_limits *lim, const char *const *args,
-                       FILE *out, FILE *err) {
-  const char *argv[64] = {"bumpbake"};
-  for (int i = 0; args[i]; i++) {
-    cr_assert_lt(i, 62, "too many arguments");
-    argv[i + 1] = args[i];
-  }
-  /* Resolved here, not in the child: the child may chdir first, and a
-   * failed assertion there would report from a process Criterion does not
-   * know. */
-  const char *binary = cli_binary();
-  fflush(NULL);
-  pid_t pid = fork();
-  cr_assert(pid >= 0);
-  if (pid == 0) {
-    dup2(fileno(out), STDOUT_FILENO);
-    dup2(fileno(err), STDERR_FILENO);
-    if (cwd && chdir(cwd) != 0)
-      _exit(126);
-    set_limit(RLIMIT_FSIZE, lim->file_size_bytes);
-    set_limit(RLIMIT_AS, lim->address_space_bytes);
-    execv(binary, (char *const *)argv);
-    _exit(127);
-  }
-  return pid;
-}
-
-static double seconds_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static cli_result run_limited(const char *cwd, const run_limits *lim,
-                              const char *const *args) {
-  FILE *out = tmpfile(), *err = tmpfile();
-  cr_assert(out && err);
-  double t0 = seconds_now();
-  pid_t pid = spawn_cli(cwd, lim, args, out, err);
-  int status = 0;
-  struct rusage usage;
-  cr_assert(wait4(pid, &status, 0, &usage) == pid);
-  cli_result r;
-  r.seconds = seconds_now() - t0;
-  r.max_rss_kib = usage.ru_maxrss;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  fseek(out, 0, SEEK_END);
-  fseek(err, 0, SEEK_END);
-  r.out = slurp_stream(out);
-  r.err = slurp_stream(err);
-  fclose(out);
-  fclose(err);
-  return r;
-}
-
-static cli_result run_in(const char *cwd, const char *const *args) {
-  return run_limited(cwd, &no_limits, args);
-}
-
-#define RUN(...) run_in(NULL, (const char *const[]){__VA_ARGS__, NULL})
-#define RUN_IN(cwd, ...) run_in(cwd, (const char *const[]){__VA_ARGS__, NULL})
-
-static int count_lines(const char *s) {
-  int n = 0;
-  for (; *s; s++)
-    n += *s == '\n';
-  return n;
-}
-
-/* ------------------------------------------------- temporary directory */
-
-static char tmpdir[64];
-/* Paths made by tmp(), freed when the test ends. */
-static char *tmp_paths[256];
-static int tmp_path_count;
-
-static int remove_entry(const char *path, const struct stat *st, int flag,
-                        struct FTW *ftw) {
-  (void)st, (void)flag, (void)ftw;
-  return remove(path);
-}
-
-static void make_tmpdir(void) {
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/bb_cli_XXXXXX");
-  cr_assert_not_null(mkdtemp(tmpdir));
-}
-
-static void remove_tmpdir(void) {
-  if (tmpdir[0])
-    nftw(tmpdir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-  tmpdir[0] = '\0';
-  while (tmp_path_count > 0)
-    free(tmp_paths[--tmp_path_count]);
-}
-
-/* Path of name inside the temporary directory, valid until the test ends. */
-static const char *tmp(const char *name) {
-  cr_assert_lt(tmp_path_count, 256);
-  size_t len = strlen(tmpdir) + strlen(name) + 2;
-  char *path = malloc(len);
-  cr_assert_not_null(path);
-  snprintf(path, len, "%s/%s", tmpdir, name);
-  return tmp_paths[tmp_path_count++] = path;
-}
-
-static int file_exists(const char *path) {
-  struct stat st;
-  return stat(path, &st) == 0;
-}
+#include "cli_harness.h"
 
 /* The whole content of a file (malloc'd), its size in *size. */
 static unsigned char *read_bytes(const char *path, size_t *size) {
@@ -276,14 +109,7 @@ static void expect_uniform8(const char *path, int channels, const int *codes, in
   bb_image_free(&img);
 }
 
-static void setup(void) {
-  make_tmpdir();
-}
-static void teardown(void) {
-  remove_tmpdir();
-}
-
-TestSuite(cli, .init = setup, .fini = teardown, .timeout = 120);
+TestSuite(cli, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
 
 /* ---------------------------------------------------------- help, version */
 
@@ -363,11 +189,11 @@ Test(cli, usage_errors_exit_2_with_a_message) {
   size_t before_size;
   unsigned char *before = read_bytes(in, &before_size);
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    cli_result r = run_in(NULL, cases[i].args);
+    cli_result r = harness_run_in(NULL, cases[i].args);
     cr_expect_eq(r.code, 2, "case %zu (%s %s ...): exit %d, stderr: %s", i,
                  cases[i].args[0], cases[i].args[1] ? cases[i].args[1] : "", r.code,
                  r.err);
-    cr_expect_eq(count_lines(r.err), 1, "case %zu: stderr should be one line: %s", i,
+    cr_expect_eq(harness_lines(r.err), 1, "case %zu: stderr should be one line: %s", i,
                  r.err);
     cr_expect(strncmp(r.err, "bumpbake", 8) == 0, "case %zu: %s", i, r.err);
     cr_expect(strstr(r.err, cases[i].message_part), "case %zu: message '%s' lacks '%s'",
@@ -394,9 +220,9 @@ static void expect_failure(const char *const *args, const char *named_file,
                            const char *output, const char *input) {
   size_t before_size = 0, after_size = 0;
   unsigned char *before = file_exists(input) ? read_bytes(input, &before_size) : NULL;
-  cli_result r = run_in(NULL, args);
+  cli_result r = harness_run_in(NULL, args);
   cr_expect_eq(r.code, 1, "%s: exit %d, stderr: %s", named_file, r.code, r.err);
-  cr_expect_eq(count_lines(r.err), 1, "stderr should be one line: '%s'", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "stderr should be one line: '%s'", r.err);
   cr_expect(strncmp(r.err, "bumpbake: ", 10) == 0, "%s", r.err);
   cr_expect(strstr(r.err, named_file), "message '%s' should name %s", r.err, named_file);
   cr_expect(!file_exists(output) || !strcmp(output, input), "%s was written", output);
@@ -446,7 +272,7 @@ Test(cli, output_equal_to_input) {
                  in, in);
   /* The same file under another spelling is caught too (realpath). */
   char other[300];
-  snprintf(other, sizeof other, "%s/./h.png", tmpdir);
+  snprintf(other, sizeof other, "%s/./h.png", harness_dir);
   expect_failure((const char *[]){"bake", in, "--scale", "2", "--ao", other, NULL},
                  "h.png", in, in);
 }
@@ -524,7 +350,7 @@ Test(cli, height_in_alpha_is_found_and_said) {
   write_image(in, 16, 16, 4, white_with_height_in_alpha);
   cli_result r = RUN("normal", in, "-o", out, "--scale", "20", "--clamp");
   cr_assert_eq(r.code, 0, "%s", r.err);
-  cr_expect_eq(count_lines(r.err), 1, "one note: %s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "one note: %s", r.err);
   cr_expect(strstr(r.err, "valve.tga: note: ") && strstr(r.err, "using alpha as the height"),
             "%s", r.err);
   cli_result_free(&r);
@@ -552,7 +378,7 @@ Test(cli, bake_of_flat_map) {
   cli_result r =
       RUN("bake", in, "--scale", "8", "--rays", "64", "--ssbump", ss, "--ao", ao);
   cr_assert_eq(r.code, 0, "%s", r.err);
-  cr_expect_eq(count_lines(r.out), 2, "one line per output: %s", r.out);
+  cr_expect_eq(harness_lines(r.out), 2, "one line per output: %s", r.out);
   cr_expect(strstr(r.out, ss) && strstr(r.out, ao), "%s", r.out);
   cli_result_free(&r);
   int s = (int)lrint(255.0 / sqrt(3.0)); /* 147 */
@@ -743,7 +569,7 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
   cli_result r = RUN("bake", in, "--scale", "4", "--rays", "16", "--ao", tmp("ao.png"),
                      "--normal", tmp("n.tga"), "--json");
   cr_assert_eq(r.code, 0, "%s", r.err);
-  cr_expect_eq(count_lines(r.out), 1, "%s", r.out);
+  cr_expect_eq(harness_lines(r.out), 1, "%s", r.out);
   const char *end = json_value(r.out);
   cr_assert_not_null(end, "not JSON: %s", r.out);
   cr_expect_str_eq(json_ws(end), "", "trailing text after the JSON value: %s", r.out);
@@ -799,7 +625,7 @@ static float grey_with_low_alpha(int x, int y, int c) {
 }
 
 static void run_ok_in(const char *cwd, const char *const *args) {
-  cli_result r = run_in(cwd, args);
+  cli_result r = harness_run_in(cwd, args);
   cr_assert_eq(r.code, 0, "%s: exit %d, stderr: %s", args[0], r.code, r.err);
   cli_result_free(&r);
 }
@@ -838,7 +664,7 @@ Test(cli, height2ssbump_flags) {
 
 Test(cli, height2ssbump_dump_writes_filtered_in_cwd) {
   write_image(tmp("wall.tga"), 16, 16, 4, grey_with_low_alpha);
-  run_ok_in(tmpdir,
+  run_ok_in(harness_dir,
             (const char *[]){"height2ssbump", "-D", "-r", "16", "wall.tga", "4", NULL});
   cr_expect(file_exists(tmp("wall-ssbump.tga")));
   bb_image f = read_image(tmp("filtered.tga"), NULL);
@@ -851,7 +677,7 @@ Test(cli, height2ssbump_without_alpha_uses_mean_and_says_so) {
   write_image(in, 16, 16, 3, mid_grey);
   cli_result r = RUN("height2ssbump", "-r", "16", in, "4");
   cr_assert_eq(r.code, 0, "%s", r.err);
-  cr_expect_eq(count_lines(r.err), 1, "one note on stderr: %s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "one note on stderr: %s", r.err);
   cr_expect(strstr(r.err, "alpha"), "%s", r.err);
   cli_result_free(&r);
   int s = (int)lrint(255.0 / sqrt(3.0));
@@ -914,7 +740,7 @@ Test(cli, renderbumpflat_height_and_its_scale_agree_with_normal) {
   cr_assert_eq(r.code, 0, "%s", r.err);
   /* texel centres 0.5 .. 7.5: heights 0.1875 .. 2.8125, a range of 2.625 */
   cr_expect(strstr(r.out, "height scale 2.625 "), "%s", r.out);
-  cr_expect_eq(count_lines(r.out), 1, "-q: only the scale: %s", r.out);
+  cr_expect_eq(harness_lines(r.out), 1, "-q: only the scale: %s", r.out);
   cli_result_free(&r);
   bb_image_info info;
   bb_image h = read_image(height, &info);
@@ -963,7 +789,7 @@ Test(cli, renderbumpflat_bad_models_fail_with_one_line) {
       write_bytes(model, cases[i].content, cases[i].size);
     cli_result r = RUN("renderbumpflat", model, "--height", tmp("h.png"));
     cr_expect_eq(r.code, 1, "%s: exit %d, stderr: %s", cases[i].name, r.code, r.err);
-    cr_expect_eq(count_lines(r.err), 1, "%s: %s", cases[i].name, r.err);
+    cr_expect_eq(harness_lines(r.err), 1, "%s: %s", cases[i].name, r.err);
     cr_expect(strncmp(r.err, "bumpbake: ", 10) == 0 && strstr(r.err, cases[i].name) &&
                   strstr(r.err, cases[i].reason),
               "%s: '%s' should name the file and say '%s'", cases[i].name, r.err,
@@ -998,9 +824,9 @@ Test(cli, renderbumpflat_usage_errors_exit_2) {
       {{"renderbumpflat"}, "MODEL"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    cli_result r = run_in(NULL, cases[i].args);
+    cli_result r = harness_run_in(NULL, cases[i].args);
     cr_expect_eq(r.code, 2, "case %zu: exit %d, stderr: %s", i, r.code, r.err);
-    cr_expect_eq(count_lines(r.err), 1, "case %zu: %s", i, r.err);
+    cr_expect_eq(harness_lines(r.err), 1, "case %zu: %s", i, r.err);
     cr_expect(strstr(r.err, cases[i].message_part), "case %zu: '%s' lacks '%s'", i, r.err,
               cases[i].message_part);
     cr_expect_str_empty(r.out, "case %zu", i);
@@ -1064,7 +890,7 @@ Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
     int cuts = 1;
     if (!strcmp(f->depth, "8") && (!strcmp(f->ext, "png") || !strcmp(f->ext, "tga"))) {
       /* The full size of the larger output, from a run with room. */
-      cli_result r = run_in(NULL, args);
+      cli_result r = harness_run_in(NULL, args);
       cr_assert_eq(r.code, 0, "%s/%s: %s", f->ext, f->depth, r.err);
       cli_result_free(&r);
       struct stat st;
@@ -1080,10 +906,10 @@ Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
     for (int k = 0; k < cuts; k++) {
       cli_result r;
       run_limits lim = {limits[k], -1};
-      r = run_limited(NULL, &lim, args);
+      r = harness_run_limited(NULL, &lim, args);
       cr_expect_eq(r.code, 1, "%s/%s under %ld bytes: exit %d, %s", f->ext, f->depth,
                    limits[k], r.code, r.err);
-      cr_expect_eq(count_lines(r.err), 1, "%s", r.err);
+      cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
       cr_expect(strstr(r.err, "cannot write: File too large") &&
                     strstr(r.err, "no output was written"),
                 "%s/%s: %s", f->ext, f->depth, r.err);
@@ -1121,7 +947,7 @@ enum { BOUNDED_RSS_KIB = 400 * 1024 };
 #endif
 
 static cli_result run_bounded(const char *const *args) {
-  cli_result r = run_limited(NULL, &memory_safety_net, args);
+  cli_result r = harness_run_limited(NULL, &memory_safety_net, args);
   cr_expect_lt(r.max_rss_kib, BOUNDED_RSS_KIB, "%s %s took %ld MiB", args[0], args[1],
                r.max_rss_kib / 1024);
   cr_expect_lt(r.seconds, 10.0, "%s %s took %.1f s", args[0], args[1], r.seconds);
@@ -1147,7 +973,7 @@ Test(cli, hostile_headers_cost_bounded_time_and_memory) {
   for (int i = 0; i < 2; i++) {
     r = run_bounded(bakes[i]);
     cr_expect_eq(r.code, 1, "%s: %s", bakes[i][0], r.err);
-    cr_expect_eq(count_lines(r.err), 1, "%s", r.err);
+    cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
     cr_expect(strstr(r.err, "h64.tif") && strstr(r.err, "1024 MiB"), "%s", r.err);
     cli_result_free(&r);
   }
@@ -1156,7 +982,7 @@ Test(cli, hostile_headers_cost_bounded_time_and_memory) {
   r = run_bounded((const char *[]){"bake", h4, "--scale", "2", "--normal", tmp("n.png"),
                                    NULL});
   cr_expect_eq(r.code, 1, "%s", r.err);
-  cr_expect_eq(count_lines(r.err), 1, "%s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
   cr_expect(strstr(r.err, "truncated"), "%s", r.err);
   cr_expect_lt(strlen(r.err), 400, "one reason, not one per row: %s", r.err);
   cli_result_free(&r);
@@ -1172,7 +998,7 @@ Test(cli, two_names_for_one_output_are_refused) {
   write_bytes(tmp("D/old.png"), "x", 1);
   cr_assert_eq(link(tmp("D/old.png"), tmp("D/hard.png")), 0);
   char dot[300];
-  snprintf(dot, sizeof dot, "%s/D/./a.png", tmpdir);
+  snprintf(dot, sizeof dot, "%s/D/./a.png", harness_dir);
   const char *pairs[][2] = {
       {tmp("D/a.png"), dot},                   /* "./" */
       {tmp("D/a.png"), tmp("L/a.png")},        /* a symlinked directory */
@@ -1183,7 +1009,7 @@ Test(cli, two_names_for_one_output_are_refused) {
                        "--normal", pairs[i][1]);
     cr_expect_eq(r.code, 2, "case %d: exit %d, %s", i, r.code, r.err);
     cr_expect(strstr(r.err, "would both be written"), "case %d: %s", i, r.err);
-    cr_expect_eq(count_lines(r.err), 1, "%s", r.err);
+    cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
     cli_result_free(&r);
   }
   cr_expect_not(file_exists(tmp("D/a.png")));
@@ -1231,18 +1057,18 @@ static void interrupt_mid_write(int sig) {
                         "--weights", finals[2], "--depth", "float", "-q", NULL};
   for (int attempt = 0; attempt < 5; attempt++) {
     FILE *out = tmpfile(), *err = tmpfile();
-    pid_t pid = spawn_cli(NULL, &no_limits, args, out, err);
+    pid_t pid = harness_spawn(NULL, &harness_no_limits, args, out, err);
     int caught = 0, status = 0;
-    double deadline = seconds_now() + 60;
-    while (!caught && seconds_now() < deadline && waitpid(pid, &status, WNOHANG) == 0) {
-      if (!mid_write(tmpdir, finals)) {
+    double deadline = harness_seconds_now() + 60;
+    while (!caught && harness_seconds_now() < deadline && waitpid(pid, &status, WNOHANG) == 0) {
+      if (!mid_write(harness_dir, finals)) {
         usleep(500);
         continue;
       }
       kill(pid, SIGSTOP);
       cr_assert_eq(waitpid(pid, &status, WUNTRACED), pid);
       cr_assert(WIFSTOPPED(status));
-      caught = mid_write(tmpdir, finals);
+      caught = mid_write(harness_dir, finals);
       if (caught)
         kill(pid, sig);
       kill(pid, SIGCONT);
@@ -1260,7 +1086,7 @@ static void interrupt_mid_write(int sig) {
     }
     cr_expect(WIFSIGNALED(status) && WTERMSIG(status) == sig,
               "the CLI should die of signal %d (status %#x)", sig, status);
-    cr_expect_eq(count_entries(tmpdir, ".bb-tmp-"), 0,
+    cr_expect_eq(count_entries(harness_dir, ".bb-tmp-"), 0,
                  "signal %d left temporary files behind", sig);
     return;
   }

@@ -3,6 +3,7 @@
  * before the bake for formats that cannot hold them, basis files' errors,
  * provenance, and the readers of Half-Life 2 maps refusing other bases. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

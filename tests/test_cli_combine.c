@@ -1,6 +1,7 @@
 /* test_cli_combine.c: `bumpbake combine` through files: identities bit for
  * bit at every file depth, the blend and detail formulas, and errors. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

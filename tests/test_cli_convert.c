@@ -2,6 +2,7 @@
  * as a user runs them: Valve's default name, round trips through files
  * against `bake`'s own maps, decoding of 8/16-bit and float maps, errors. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

@@ -1,6 +1,7 @@
 /* test_cli_mips.c: `--mips` on the commands' outputs: mip-mapped TIFF and
  * EXR files with every level, normals renormalised, and refusals. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

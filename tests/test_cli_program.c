@@ -1,6 +1,7 @@
 /* test_cli_program.c: `bumpbake program` and bake's `--slope`/`--lit` run
  * as programs: outputs, exit codes, one-line errors, no file left behind. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

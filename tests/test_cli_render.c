@@ -2,6 +2,7 @@
  * outputs and their provenance, maps read back, orbits, threads, and bad
  * inputs (one line, no file). */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath, setenv */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"
