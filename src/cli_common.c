@@ -41,7 +41,7 @@ const cli_option cli_opt_filter_radius = {
     .id = CLI_OPT_FILTER_RADIUS,
     .long_name = "filter-radius",
     .value_name = "R",
-    .range_text = ">= 0 (integer)",
+    .range_text = "0..4096",
     .help = "bilateral smoothing radius in texels, 0 = off"};
 const cli_option cli_opt_filter_threshold = {
     .id = CLI_OPT_FILTER_THRESHOLD,
@@ -53,12 +53,12 @@ const cli_option cli_opt_bias = {
     .id = CLI_OPT_BIAS,
     .long_name = "bias",
     .value_name = "B",
-    .range_text = ">= 0",
+    .range_text = "0..1e6",
     .help = "ray origin lift above the vertex in texels (0.55 = Valve's offset)"};
 const cli_option cli_opt_power = {.id = CLI_OPT_POWER,
                                   .long_name = "power",
                                   .value_name = "P",
-                                  .range_text = ">= 1",
+                                  .range_text = "1..1e6",
                                   .help = "exponent of the basis lobes max(0, w.B)^P"};
 const cli_option cli_opt_basis = {
     .id = CLI_OPT_BASIS,
@@ -81,7 +81,7 @@ const cli_option cli_opt_threads = {.id = CLI_OPT_THREADS,
                                     .long_name = "threads",
                                     .value_name = "N",
                                     .range_text = "0..4096",
-                                    .help = "worker threads, 0 = all cores"};
+                                    .help = "worker threads of every stage, 0 = all cores"};
 const cli_option cli_opt_clamp = {.id = CLI_OPT_CLAMP,
                                   .long_name = "clamp",
                                   .default_text = "periodic",
@@ -161,6 +161,8 @@ int cli_parse_int(const char *command, const char *option, const char *text, lon
   if (end == text || *end != '\0')
     return cli_usage_error(command, "%s needs an integer (got '%s')", option, text);
   if (errno == ERANGE || v < min || v > max) {
+    if (min == INT_MIN && max == INT_MAX) /* the caller checks the range itself */
+      return cli_usage_error(command, "%s is out of range (got %s)", option, text);
     if (max == INT_MAX)
       return cli_usage_error(command, "%s must be >= %ld (got %s)", option, min, text);
     return cli_usage_error(command, "%s must be in %ld..%ld (got %s)", option, min, max,
@@ -407,6 +409,25 @@ static int apply_basis(const char *command, const char *arg, bb_basis *out) {
   return cli_status_exit(arg, bb_basis_load(arg, out, &err), &err);
 }
 
+/* The ranges of --filter-radius, --bias, --power and --threads are the
+ * library's (bb_bake_options_check), not the CLI's: the option is parsed
+ * as a number, then the settings so far are checked by the library, and
+ * its message becomes the usage error ("bumpbake bake: --threads: threads
+ * must be in 0..4096 (got 5000)"). --scale may come later, so a valid
+ * stand-in takes its place. */
+static int check_with_library(const char *command, const char *name, const cli_settings *s) {
+  bb_bake_options o = s->bake;
+  if (!s->scale_given)
+    o.height_scale = 1.0f;
+  bb_error err = {{0}};
+  if (bb_bake_options_check(&o, &err) == BB_OK)
+    return 0;
+  const char *why = err.message;
+  if (strncmp(why, "bake: ", 6) == 0)
+    why += 6;
+  return cli_usage_error(command, "%s: %s", name, why);
+}
+
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
                        const char *arg) {
   bb_bake_options *b = &s->bake;
@@ -425,19 +446,22 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_RAYS:
     return cli_parse_int(command, name, arg, 1, 65536, &b->rays);
   case CLI_OPT_FILTER_RADIUS:
-    /* Beyond a few hundred texels the window covers any texture anyway. */
-    return cli_parse_int(command, name, arg, 0, 4096, &b->smooth.radius_texels);
+    rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->smooth.radius_texels);
+    return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_FILTER_THRESHOLD:
     rc = cli_parse_double(command, name, arg, 0.0, 1, (double)FLT_MAX, &d);
     if (!rc)
       b->smooth.threshold = (float)d;
     return rc;
   case CLI_OPT_BIAS:
-    return cli_parse_double(command, name, arg, 0.0, 0, 1.0e6, &b->trace.bias_texels);
+    rc = cli_parse_double(command, name, arg, -DBL_MAX, 0, DBL_MAX, &b->trace.bias_texels);
+    return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_POWER:
-    return cli_parse_double(command, name, arg, 1.0, 0, 1.0e6, &b->power);
+    rc = cli_parse_double(command, name, arg, -DBL_MAX, 0, DBL_MAX, &b->power);
+    return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_THREADS:
-    return cli_parse_int(command, name, arg, 0, 4096, &b->trace.threads);
+    rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->trace.threads);
+    return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_BASIS:
     return apply_basis(command, arg, &b->basis);
   case CLI_OPT_NORMAL_FILTER:
@@ -874,12 +898,13 @@ void cli_install_signal_handlers(void) {
 
 enum { PROGRESS_BAR_WIDTH = 20 };
 
-static void progress_draw(void *user, long done, long total) {
+/* Never cancels: Ctrl-C ends the process (cli_install_signal_handlers). */
+static int progress_draw(void *user, long done, long total) {
   cli_progress *p = user;
   double now = cli_now_seconds(), elapsed = now - p->start_seconds;
   /* Short bakes stay silent; long ones redraw ten times a second at most. */
   if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1)
-    return;
+    return 0;
   p->last_draw_seconds = now;
   double frac = done <= 0 ? 0.0 : (double)done / (double)total;
   if (frac > 1.0)
@@ -895,6 +920,7 @@ static void progress_draw(void *user, long done, long total) {
   fputs("\033[K", stderr); /* erase what a longer previous line left */
   fflush(stderr);
   p->shown = 1;
+  return 0;
 }
 
 void cli_progress_attach(cli_progress *p, const char *label, int quiet,

@@ -36,7 +36,7 @@ static bb_bake_options sample_options(void) {
   bb_basis_init(&o.basis);
   o.normal_filter = BB_NORMAL_VALVE;
   o.normal_y_up = 0;
-  o.want_trace = 1;
+  o.outputs = BB_OUTPUTS_ALL;
   return o;
 }
 
