@@ -879,7 +879,8 @@ typedef struct bb_renderbump_options {
                          the image, in model units along right and up */
   int tile;           /* 1: geometry outside the rectangle wraps around into
                          it (the sculpt tiles with the rectangle as period) */
-  int threads;        /* 0 = all cores; the result is the same for any count */
+  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
+                         same for any count */
 } bb_renderbump_options;
 
 void bb_renderbump_options_init(bb_renderbump_options *o);
@@ -1197,7 +1198,8 @@ typedef struct bb_render_options {
   int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
   int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
                                    texels; crop_width 0 = no crop */
-  int threads;                  /* 0 = all cores; results are identical */
+  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
+                                   are identical */
 } bb_render_options;
 
 void bb_render_options_init(bb_render_options *o);
