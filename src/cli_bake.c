@@ -263,8 +263,11 @@ typedef struct bake_timing {
   double load, write;
 } bake_timing;
 
+/* Parameters are those used: the channel the rule took and the threads
+ * that ran, not "auto" and 0. */
 static void print_json(const bake_args *a, const char *input, const bb_image *height,
-                       const bb_bake_result *r, const bake_timing *t) {
+                       const cli_height_source *source, const bb_bake_result *r,
+                       const bake_timing *t) {
   const bb_bake_options *b = &a->settings.bake;
   cli_json j = {stdout, 0};
   cli_json_open(&j, NULL, '{');
@@ -286,8 +289,8 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
   cli_json_string(&j, "addressing",
                   b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
-  cli_json_string(&j, "channel", bb_channel_name(a->settings.channel));
-  cli_json_number(&j, "threads", b->trace.threads);
+  cli_json_string(&j, "channel", cli_height_channel_name(source));
+  cli_json_number(&j, "threads", r->threads);
   cli_json_close(&j, '}');
 
   cli_json_open(&j, "seconds", '{');
@@ -344,7 +347,7 @@ enum { MAX_OUTPUTS = OUTPUT_KIND_COUNT + 2 };
  * when every one succeeded, so a full disk leaves the previous files as they
  * were. */
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r,
-                         const slope_outputs *slope) {
+                         const slope_outputs *slope, const cli_run *filtered_run) {
   cli_staged_output outs[MAX_OUTPUTS];
   write_task tasks[MAX_OUTPUTS];
   pthread_t threads[MAX_OUTPUTS];
@@ -353,8 +356,9 @@ static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result 
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     if (a->paths[k]) {
       outs[n] = (cli_staged_output){.kind = kind_info(k)->name, .path = a->paths[k]};
-      tasks[n] = (write_task){run, bb_bake_result_image(r, (bb_output_kind)k),
-                              kind_info(k)->range, &outs[n]};
+      tasks[n] = (write_task){k == BB_OUTPUT_FILTERED ? filtered_run : run,
+                              bb_bake_result_image(r, (bb_output_kind)k), kind_info(k)->range,
+                              &outs[n]};
       n++;
     }
   if (slope->map.pixels) {
@@ -411,6 +415,21 @@ static unsigned asked_outputs(const bake_args *a) {
 }
 
 
+/* write_outputs, with the filtered height at the input's depth unless
+ * --depth says otherwise (a 16-bit height stays 16-bit where the format
+ * can hold it). */
+static int write_outputs_keeping_depth(const bake_args *a, cli_run *run,
+                                       const bb_bake_result *r, const slope_outputs *slope,
+                                       const cli_height_source *source) {
+  cli_settings filtered_settings = *run->settings;
+  const char *path = a->paths[BB_OUTPUT_FILTERED];
+  if (path && filtered_settings.depth == BB_DEPTH_DEFAULT)
+    filtered_settings.depth = cli_depth_like_input(source, path);
+  cli_run filtered_run = *run;
+  filtered_run.settings = &filtered_settings;
+  return write_outputs(a, run, r, slope, &filtered_run);
+}
+
 static int bake_run(cli_run *run, bake_args *a, const char *input) {
   bb_image height = {0};
   bb_bake_result result;
@@ -419,7 +438,8 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   a->settings.bake.outputs = asked_outputs(a);
 
   double t0 = cli_now_seconds();
-  int rc = cli_load_height(input, &a->settings, &height);
+  cli_height_source source;
+  int rc = cli_load_height_source(input, &a->settings, &height, &source);
   t.load = cli_now_seconds() - t0;
   if (!rc) {
     cli_progress progress;
@@ -433,13 +453,13 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
     slope_outputs slope;
     rc = make_slope(a, run, &result.filtered, &slope);
     if (!rc)
-      rc = write_outputs(a, run, &result, &slope);
+      rc = write_outputs_keeping_depth(a, run, &result, &slope, &source);
     bb_image_free(&slope.map);
     bb_image_free(&slope.lit);
     t.write = run->seconds_write;
   }
   if (!rc && a->json)
-    print_json(a, input, &height, &result, &t);
+    print_json(a, input, &height, &source, &result, &t);
   bb_bake_result_free(&result);
   bb_image_free(&height);
   return rc;

@@ -590,7 +590,7 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
   char ext[16];
   if (!bb_path_is_writable_format(output_path))
     return cli_usage_error(
-        command, "%s: unknown output format '.%s' (use .png, .tga, .tif or .exr)",
+        command, "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff or .exr)",
         output_path, path_extension(output_path, ext, sizeof ext));
   /* Checked before baking, so a bad combination fails before a long bake. */
   if (!bb_path_supports_depth(output_path, depth))
@@ -808,6 +808,11 @@ bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, b
 }
 
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
+  return cli_load_height_source(path, s, height, NULL);
+}
+
+int cli_load_height_source(const char *path, const cli_settings *s, bb_image *height,
+                           cli_height_source *source) {
   bb_image img = {0};
   bb_image_info info;
   bb_error err = {{0}};
@@ -815,6 +820,11 @@ int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
   if (st == BB_OK) {
     /* The rule's own choice, so a height found in alpha is said once. */
     bb_channel used = bb_height_channel(&img, info.alpha_channel, s->channel);
+    if (source) {
+      const int alpha = info.alpha_channel >= 0 || img.channels == 2 || img.channels == 4;
+      *source = (cli_height_source){used, img.channels - alpha < 3, info.bits_per_sample,
+                                    info.is_float};
+    }
     if (s->channel == BB_CHANNEL_AUTO && used == BB_CHANNEL_A)
       fprintf(stderr,
               "bumpbake: %s: note: the colour is constant and alpha is not; using "
@@ -825,6 +835,32 @@ int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
     bb_image_free(&img);
   }
   return cli_status_exit(path, st, &err);
+}
+
+const char *cli_height_channel_name(const cli_height_source *source) {
+  /* The mean of one colour channel is that channel. */
+  if (source->grey && (source->channel == BB_CHANNEL_MEAN || source->channel == BB_CHANNEL_LUMA))
+    return "grey";
+  return bb_channel_name(source->channel);
+}
+
+bb_depth cli_depth_like_input(const cli_height_source *source, const char *path) {
+  /* The closest the format holds, from the input's own depth downwards. */
+  static const bb_depth float_order[] = {BB_DEPTH_FLOAT, BB_DEPTH_HALF, BB_DEPTH_16};
+  static const bb_depth half_order[] = {BB_DEPTH_HALF, BB_DEPTH_FLOAT, BB_DEPTH_16};
+  static const bb_depth int16_order[] = {BB_DEPTH_16, BB_DEPTH_FLOAT};
+  const bb_depth *order = NULL;
+  size_t n = 0;
+  if (source->is_float && source->bits_per_sample <= 16)
+    order = half_order, n = 3;
+  else if (source->is_float)
+    order = float_order, n = 3;
+  else if (source->bits_per_sample > 8)
+    order = int16_order, n = 2;
+  for (size_t i = 0; i < n; i++)
+    if (bb_path_supports_depth(path, order[i]))
+      return order[i];
+  return BB_DEPTH_DEFAULT;
 }
 
 int cli_check_hl2_map(const char *path, const bb_image *img, const bb_image_info *info) {

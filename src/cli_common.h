@@ -249,6 +249,28 @@ void cli_install_signal_handlers(void);
  * alpha (constant colour, varying alpha) it says so on stderr. */
 int cli_load_height(const char *path, const cli_settings *s, bb_image *height);
 
+/* What cli_load_height_source found out about the height's file. */
+typedef struct cli_height_source {
+  bb_channel channel;  /* the channel rule's choice (never BB_CHANNEL_AUTO) */
+  int grey;            /* 1: one colour channel (grey, or grey + alpha) */
+  int bits_per_sample; /* of the file: 8, 16, 32 */
+  int is_float;        /* 1: float or half samples */
+} cli_height_source;
+
+/* cli_load_height, also filling *source (may be NULL). */
+int cli_load_height_source(const char *path, const cli_settings *s, bb_image *height,
+                           cli_height_source *source);
+
+/* The name of the channel the height came from, for --json: "grey" for a
+ * grey image (whose mean is its grey), else bb_channel_name's. */
+const char *cli_height_channel_name(const cli_height_source *source);
+
+/* The depth nearest the input's that path's format holds, for outputs that
+ * are the height itself (--filtered): 16 bits for a 16-bit input, float or
+ * half for a float or half input; BB_DEPTH_DEFAULT for an 8-bit input or
+ * when the format holds nothing deeper (TGA). */
+bb_depth cli_depth_like_input(const cli_height_source *source, const char *path);
+
 /* Readers of basis maps (render, ssbump2normal, combine --detail) take
  * channels 0..2 as Half-Life 2's B0, B1, B2. 0 when the file at path (img,
  * its info) can be one: at most 4 channels, and a provenance basis, if any,
