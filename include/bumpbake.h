@@ -35,7 +35,7 @@
 extern "C" {
 #endif
 
-#define BB_VERSION_STRING "0.1.0"
+#define BB_VERSION_STRING "0.2.0"
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (8192 x 8192), checked before allocating. */
