@@ -35,7 +35,7 @@
 extern "C" {
 #endif
 
-#define BB_VERSION_STRING "0.1.0"
+#define BB_VERSION_STRING "0.2.0"
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (8192 x 8192), checked before allocating. */
@@ -61,7 +61,8 @@ typedef enum bb_status {
   BB_ERR_FORMAT,      /* corrupt, truncated or unsupported image; unknown extension */
   BB_ERR_SIZE,        /* zero width or height, or over the documented maximum */
   BB_ERR_VALUE,       /* NaN or infinite value where a finite one is needed */
-  BB_ERR_MEMORY       /* an allocation failed */
+  BB_ERR_MEMORY,      /* an allocation failed */
+  BB_ERR_CANCELLED    /* a progress callback asked to stop; nothing was made */
 } bb_status;
 
 /* Caller-owned error message, filled where the error is detected. */
@@ -475,8 +476,10 @@ void bb_rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, doubl
 
 /* ------------------------------------------------------------------ trace */
 
-/* Progress callback: done out of total work units; return nonzero to go on. */
-typedef void (*bb_progress_fn)(void *user, long done, long total);
+/* Progress callback: done out of total work units. Return 0 to go on,
+ * nonzero to cancel: the call it reports on then stops as soon as the work
+ * in flight ends and returns BB_ERR_CANCELLED, making nothing. */
+typedef int (*bb_progress_fn)(void *user, long done, long total);
 
 /* A rectangle of texels, x0..x0+width-1 by y0..y0+height-1. */
 typedef struct bb_region {
@@ -488,7 +491,9 @@ typedef struct bb_trace_options {
   int threads;          /* 0 = all cores */
   bb_region region;     /* width 0 (default): every texel, by line sweeps;
                            else only these texels, by max-mip marches */
-  bb_progress_fn progress; /* may be NULL; called from one thread */
+  bb_progress_fn progress; /* may be NULL; called from one thread as the
+                              work goes (per slice, or every 50 ms); a
+                              nonzero return cancels */
   void *progress_user;
 } bb_trace_options;
 
@@ -500,7 +505,8 @@ void bb_trace_options_init(bb_trace_options *o);
  * must lie inside it). Sweeps and marches find the same horizons, so a
  * region's texels are bit-identical to the same texels of a whole trace,
  * and the result is bit-identical for any thread count. horizons_found (may
- * be NULL) receives texels * slices. */
+ * be NULL) receives texels * slices. BB_ERR_CANCELLED when o->progress
+ * returned nonzero (vis is then left unallocated). */
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *horizons_found, bb_error *err);
@@ -535,22 +541,91 @@ bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image
 
 /* ------------------------------------------------------------------- bake */
 
+/* The maps a bake can make, in the order of this enum everywhere (the
+ * command line's options, JSON, Python's bumpbake.OUTPUTS). New kinds are
+ * appended. */
+typedef enum bb_output_kind {
+  BB_OUTPUT_NORMAL = 0, /* unit N, 3 channels */
+  BB_OUTPUT_WEIGHTS,    /* w_c, one channel per basis direction */
+  BB_OUTPUT_SSBUMP,     /* s_c, one channel per basis direction (traced) */
+  BB_OUTPUT_AO,         /* ao, 1 channel (traced) */
+  BB_OUTPUT_BENT,       /* bent normal, 3 channels (traced) */
+  BB_OUTPUT_FILTERED,   /* the smoothed height h, 1 channel */
+  BB_OUTPUT_KIND_COUNT  /* number of kinds, not a kind */
+} bb_output_kind;
+
+/* Bit of a kind in bb_bake_options.outputs. */
+#define BB_OUTPUT_BIT(kind) (1u << (unsigned)(kind))
+/* Every kind (the default of bb_bake_options.outputs). */
+#define BB_OUTPUTS_ALL ((1u << (unsigned)BB_OUTPUT_KIND_COUNT) - 1u)
+/* The kinds that need the tracer: ssbump, ao and bent. */
+#define BB_OUTPUTS_TRACED \
+  (BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_AO) | BB_OUTPUT_BIT(BB_OUTPUT_BENT))
+
+/* What one output kind is, so a client can list, name and store the maps
+ * without a table of its own. Static data; never freed. */
+typedef struct bb_output_kind_info {
+  const char *name;        /* "normal", "weights", "ssbump", "ao", "bent",
+                              "filtered": names in provenance, files, JSON */
+  const char *description; /* one line for help texts */
+  int channels;            /* channels of the image; 0 = one per basis
+                              direction (bb_basis.count) */
+  bb_range range;          /* values: BB_RANGE_SIGNED in [-1, 1] (normal,
+                              bent), else BB_RANGE_UNIT in [0, 1] (the
+                              filtered height of a float input may leave it) */
+  int needs_trace;         /* 1: made only by tracing (ssbump, ao, bent) */
+} bb_output_kind_info;
+
+/* The description of kind, or NULL for a value outside
+ * 0..BB_OUTPUT_KIND_COUNT-1. */
+const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
+
+/* The kind named name (as bb_output_kind_info.name); returns 0 on success,
+ * -1 for an unknown name (out untouched). */
+int bb_output_kind_parse(const char *name, bb_output_kind *out);
+
+/* Most threads a bake, render or renderbump accepts (0 = all cores). */
+#define BB_MAX_THREADS 4096
+/* Largest smoothing radius a bake accepts, in texels: beyond a few hundred
+ * the window covers any texture anyway. (bb_smooth_bilateral alone takes
+ * more.) */
+#define BB_MAX_FILTER_RADIUS 4096
+/* Largest ray origin lift (texels) and lobe power a bake accepts. */
+#define BB_MAX_BIAS_TEXELS 1.0e6
+#define BB_MAX_POWER 1.0e6
+
 typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
-  int rays;                   /* ray budget, default 256: round(sqrt(rays)) slices */
+  int rays;                   /* ray budget, 1..65536, default 256:
+                                 round(sqrt(rays)) slices */
   int slices;                 /* azimuth slices, 1..BB_MAX_SLICES; 0 (default):
                                  from rays */
-  bb_smooth_options smooth;   /* filter radius/threshold/addressing */
-  bb_trace_options trace;     /* bias, threads, progress */
-  double power;               /* P >= 1, default 1 */
+  bb_smooth_options smooth;   /* filter radius 0..BB_MAX_FILTER_RADIUS,
+                                 threshold > 0, addressing */
+  bb_trace_options trace;     /* bias 0..BB_MAX_BIAS_TEXELS; threads
+                                 0..BB_MAX_THREADS, used by EVERY stage of the
+                                 bake (smooth, normals, pyramid, trace,
+                                 derive); progress, which may cancel */
+  double power;               /* P in 1..BB_MAX_POWER, default 1 */
   bb_basis basis;             /* default "hl2" (bb_basis_init); weights and
                                  ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
-  int want_trace;             /* 0: only normals/weights/filtered are made */
+  unsigned outputs;           /* the maps to make: BB_OUTPUT_BIT(kind)s,
+                                 default BB_OUTPUTS_ALL, not 0. Nothing else
+                                 is computed: no trace without a traced kind
+                                 (then rays and slices are not checked); a map
+                                 another needs is made and freed (bent needs
+                                 ssbump, both need the normal) */
 } bb_bake_options;
 
 void bb_bake_options_init(bb_bake_options *o);
+
+/* Checks every field of o as bb_bake does before it starts (ranges in the
+ * field comments): BB_OK, or BB_ERR_ARGUMENT with a message such as "bake:
+ * filter radius must be in 0..4096 (got 5000)". So a caller can refuse bad
+ * options before loading anything. */
+bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 
 /* Everything one bake makes. Images not made are zeroed (pixels NULL). */
 typedef struct bb_bake_result {
@@ -563,14 +638,26 @@ typedef struct bb_bake_result {
   bb_image bent;       /* 3 channels (when traced) */
   double seconds_smooth, seconds_pyramid, seconds_trace, seconds_derive;
   double horizons_found;   /* texels x slices */
-  char rayset_id[64];
+  char rayset_id[64];      /* empty when nothing was traced */
   bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
+  int threads;             /* worker threads the stages ran on (o->trace.threads,
+                              or the core count for 0) */
 } bb_bake_result;
 
 /* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
- * field (normalised h). Fills result; free it with bb_bake_result_free. */
+ * field (normalised h), making the maps o->outputs asks for and nothing
+ * else (vis is made whenever a traced kind is asked). Results are
+ * bit-identical for any o->trace.threads. Fills result; free it with
+ * bb_bake_result_free. Errors: those of bb_bake_options_check, BB_ERR_VALUE
+ * (NaN heights, scale x height overflowing), BB_ERR_MEMORY, and
+ * BB_ERR_CANCELLED when o->trace.progress returned nonzero: then nothing is
+ * returned (result is zeroed). */
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
+
+/* The image of kind in r (NULL for an unknown kind); its pixels are NULL
+ * when the bake did not make it. Owned by r. */
+const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 
 void bb_bake_result_free(bb_bake_result *r);
 
@@ -590,7 +677,7 @@ void bb_valve_options_init(bb_valve_options *o);
  * result->filtered or result->ao. Every channel of out is then a unit value
  * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
  * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
- * want_trace) or has too few channels, or when the ssbump is of a basis
+ * the traced outputs) or has too few channels, or when the ssbump is of a basis
  * other than Half-Life 2's (result->basis, when set, or more than 4
  * channels); BB_ERR_SIZE when sizes differ. */
 bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
@@ -792,7 +879,8 @@ typedef struct bb_renderbump_options {
                          the image, in model units along right and up */
   int tile;           /* 1: geometry outside the rectangle wraps around into
                          it (the sculpt tiles with the rectangle as period) */
-  int threads;        /* 0 = all cores; the result is the same for any count */
+  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
+                         same for any count */
 } bb_renderbump_options;
 
 void bb_renderbump_options_init(bb_renderbump_options *o);
@@ -1110,7 +1198,8 @@ typedef struct bb_render_options {
   int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
   int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
                                    texels; crop_width 0 = no crop */
-  int threads;                  /* 0 = all cores; results are identical */
+  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
+                                   are identical */
 } bb_render_options;
 
 void bb_render_options_init(bb_render_options *o);

@@ -8,30 +8,19 @@
 #include <pthread.h>
 #include <string.h>
 
-/* The maps bake can write, in CLI_OPT_OUT_* order. */
-typedef struct output_kind {
-  const char *kind;     /* name in provenance, messages and JSON */
-  bb_range range;       /* how integer files encode it */
-  int needs_trace;      /* made only when bb_bake traces */
-  int from_prefix;      /* written by -o PREFIX (as PREFIX_kind.png) */
-  int per_direction;    /* one channel per basis direction (else a fixed count) */
-  size_t result_offset; /* where bb_bake_result holds it */
-} output_kind;
+/* The maps are the library's (bb_output_kind_get); CLI_OPT_OUT_* follow
+ * its order. */
+enum { OUTPUT_KIND_COUNT = BB_OUTPUT_KIND_COUNT };
+_Static_assert(CLI_OPT_OUT_FILTERED - CLI_OPT_OUT_NORMAL + 1 == BB_OUTPUT_KIND_COUNT,
+               "one --KIND option per output kind, in bb_output_kind order");
 
-static const output_kind output_kinds[] = {
-    {"normal", BB_RANGE_SIGNED, 0, 1, 0, offsetof(bb_bake_result, normal)},
-    {"weights", BB_RANGE_UNIT, 0, 0, 1, offsetof(bb_bake_result, weights)},
-    {"ssbump", BB_RANGE_UNIT, 1, 1, 1, offsetof(bb_bake_result, ssbump)},
-    {"ao", BB_RANGE_UNIT, 1, 1, 0, offsetof(bb_bake_result, ao)},
-    {"bent", BB_RANGE_SIGNED, 1, 0, 0, offsetof(bb_bake_result, bent)},
-    {"filtered", BB_RANGE_UNIT, 0, 0, 0, offsetof(bb_bake_result, filtered)},
-};
+/* What -o PREFIX writes (as PREFIX_kind.png): Valve's trio. */
+static const unsigned prefix_kinds = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) |
+                                     BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) |
+                                     BB_OUTPUT_BIT(BB_OUTPUT_AO);
 
-enum { OUTPUT_KIND_COUNT = sizeof output_kinds / sizeof output_kinds[0] };
-
-static const bb_image *result_image(const bb_bake_result *r, int kind) {
-  return (const bb_image *)(const void *)((const char *)r +
-                                          output_kinds[kind].result_offset);
+static const bb_output_kind_info *kind_info(int kind) {
+  return bb_output_kind_get((bb_output_kind)kind);
 }
 
 static const cli_option opt_prefix = {
@@ -172,15 +161,16 @@ static int expand_prefix(bake_args *a) {
   if (!a->prefix)
     return 0;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++) {
-    if (!output_kinds[k].from_prefix || a->paths[k])
+    if (!(prefix_kinds & BB_OUTPUT_BIT(k)) || a->paths[k])
       continue;
-    size_t len = strlen(a->prefix) + strlen(output_kinds[k].kind) + sizeof "_.png";
+    const char *name = kind_info(k)->name;
+    size_t len = strlen(a->prefix) + strlen(name) + sizeof "_.png";
     a->prefix_paths[k] = malloc(len);
     if (!a->prefix_paths[k]) {
       cli_file_error(a->prefix, "out of memory");
       return BB_EXIT_FAILURE;
     }
-    snprintf(a->prefix_paths[k], len, "%s_%s.png", a->prefix, output_kinds[k].kind);
+    snprintf(a->prefix_paths[k], len, "%s_%s.png", a->prefix, name);
     a->paths[k] = a->prefix_paths[k];
   }
   return 0;
@@ -196,7 +186,7 @@ static int check_slope_names(const bake_args *a) {
     for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
       if (a->paths[k] && cli_same_file(a->paths[k], slope[s]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
-                               output_kinds[k].kind, slope_kind[s], slope[s]);
+                               kind_info(k)->name, slope_kind[s], slope[s]);
   }
   if (slope[0] && slope[1] && cli_same_file(slope[0], slope[1]))
     return cli_usage_error(bake_command.name, "slope and slope_lit would both be written to %s",
@@ -210,13 +200,13 @@ static int check_slope_names(const bake_args *a) {
 static int check_channels(const bake_args *a, int k) {
   const bb_basis *basis = &a->settings.bake.basis;
   const int room = bb_path_max_channels(a->paths[k]);
-  if (!output_kinds[k].per_direction || basis->count <= room)
+  if (kind_info(k)->channels != 0 || basis->count <= room) /* 0: one per direction */
     return 0;
   const char *dot = strrchr(a->paths[k], '.');
   return cli_usage_error(bake_command.name,
                          "%s: --basis %s gives %s %d channels and %s files hold at most %d "
                          "(write it as .exr or .tif)",
-                         a->paths[k], basis->name, output_kinds[k].kind, basis->count,
+                         a->paths[k], basis->name, kind_info(k)->name, basis->count,
                          dot ? dot : "such", room);
 }
 
@@ -230,7 +220,7 @@ static int check_outputs(bake_args *a, const char *input) {
     for (int j = 0; j < k; j++)
       if (a->paths[j] && cli_same_file(a->paths[j], a->paths[k]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
-                               output_kinds[j].kind, output_kinds[k].kind, a->paths[k]);
+                               kind_info(j)->name, kind_info(k)->name, a->paths[k]);
     int rc = cli_check_output(bake_command.name, input, a->paths[k], a->settings.depth);
     if (!rc)
       rc = cli_check_mips(bake_command.name, &a->settings, a->paths[k]);
@@ -264,13 +254,20 @@ static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
   return rc ? rc : check_outputs(a, *input);
 }
 
+static int traced(const bake_args *a) {
+  return (a->settings.bake.outputs & BB_OUTPUTS_TRACED) != 0;
+}
+
 /* Timings the CLI measures around the library's own. */
 typedef struct bake_timing {
   double load, write;
 } bake_timing;
 
+/* Parameters are those used: the channel the rule took and the threads
+ * that ran, not "auto" and 0. */
 static void print_json(const bake_args *a, const char *input, const bb_image *height,
-                       const bb_bake_result *r, const bake_timing *t) {
+                       const cli_height_source *source, const bb_bake_result *r,
+                       const bake_timing *t) {
   const bb_bake_options *b = &a->settings.bake;
   cli_json j = {stdout, 0};
   cli_json_open(&j, NULL, '{');
@@ -282,7 +279,7 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_number(&j, "scale", (double)b->height_scale);
   cli_json_number(&j, "rays", b->rays);
   cli_json_number(&j, "slices", b->slices ? b->slices : bb_slices_for_rays(b->rays));
-  cli_json_string(&j, "rayset", b->want_trace ? r->rayset_id : NULL);
+  cli_json_string(&j, "rayset", traced(a) ? r->rayset_id : NULL);
   cli_json_number(&j, "filter_radius", b->smooth.radius_texels);
   cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
   cli_json_number(&j, "bias", b->trace.bias_texels);
@@ -292,8 +289,8 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
   cli_json_string(&j, "addressing",
                   b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
-  cli_json_string(&j, "channel", bb_channel_name(a->settings.channel));
-  cli_json_number(&j, "threads", b->trace.threads);
+  cli_json_string(&j, "channel", cli_height_channel_name(source));
+  cli_json_number(&j, "threads", r->threads);
   cli_json_close(&j, '}');
 
   cli_json_open(&j, "seconds", '{');
@@ -311,7 +308,7 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
     if (!a->paths[k])
       continue;
     cli_json_open(&j, NULL, '{');
-    cli_json_string(&j, "kind", output_kinds[k].kind);
+    cli_json_string(&j, "kind", kind_info(k)->name);
     cli_json_string(&j, "path", a->paths[k]);
     cli_json_close(&j, '}');
   }
@@ -350,7 +347,7 @@ enum { MAX_OUTPUTS = OUTPUT_KIND_COUNT + 2 };
  * when every one succeeded, so a full disk leaves the previous files as they
  * were. */
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r,
-                         const slope_outputs *slope) {
+                         const slope_outputs *slope, const cli_run *filtered_run) {
   cli_staged_output outs[MAX_OUTPUTS];
   write_task tasks[MAX_OUTPUTS];
   pthread_t threads[MAX_OUTPUTS];
@@ -358,8 +355,10 @@ static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result 
   const double t0 = cli_now_seconds();
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     if (a->paths[k]) {
-      outs[n] = (cli_staged_output){.kind = output_kinds[k].kind, .path = a->paths[k]};
-      tasks[n] = (write_task){run, result_image(r, k), output_kinds[k].range, &outs[n]};
+      outs[n] = (cli_staged_output){.kind = kind_info(k)->name, .path = a->paths[k]};
+      tasks[n] = (write_task){k == BB_OUTPUT_FILTERED ? filtered_run : run,
+                              bb_bake_result_image(r, (bb_output_kind)k), kind_info(k)->range,
+                              &outs[n]};
       n++;
     }
   if (slope->map.pixels) {
@@ -404,11 +403,31 @@ static int make_slope(const bake_args *a, const cli_run *run, const bb_image *fi
   return cli_slope_make(run, &a->slope, filtered, &s->map, &s->lit);
 }
 
-static int needs_trace(const bake_args *a) {
+/* The maps to bake: those with a path, and the filtered height for --slope. */
+static unsigned asked_outputs(const bake_args *a) {
+  unsigned mask = 0;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
-    if (a->paths[k] && output_kinds[k].needs_trace)
-      return 1;
-  return 0;
+    if (a->paths[k])
+      mask |= BB_OUTPUT_BIT(k);
+  if (a->slope.path)
+    mask |= BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  return mask;
+}
+
+
+/* write_outputs, with the filtered height at the input's depth unless
+ * --depth says otherwise (a 16-bit height stays 16-bit where the format
+ * can hold it). */
+static int write_outputs_keeping_depth(const bake_args *a, cli_run *run,
+                                       const bb_bake_result *r, const slope_outputs *slope,
+                                       const cli_height_source *source) {
+  cli_settings filtered_settings = *run->settings;
+  const char *path = a->paths[BB_OUTPUT_FILTERED];
+  if (path && filtered_settings.depth == BB_DEPTH_DEFAULT)
+    filtered_settings.depth = cli_depth_like_input(source, path);
+  cli_run filtered_run = *run;
+  filtered_run.settings = &filtered_settings;
+  return write_outputs(a, run, r, slope, &filtered_run);
 }
 
 static int bake_run(cli_run *run, bake_args *a, const char *input) {
@@ -416,10 +435,11 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   bake_timing t = {0, 0};
-  a->settings.bake.want_trace = needs_trace(a);
+  a->settings.bake.outputs = asked_outputs(a);
 
   double t0 = cli_now_seconds();
-  int rc = cli_load_height(input, &a->settings, &height);
+  cli_height_source source;
+  int rc = cli_load_height_source(input, &a->settings, &height, &source);
   t.load = cli_now_seconds() - t0;
   if (!rc) {
     cli_progress progress;
@@ -429,17 +449,17 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   }
   if (!rc) {
     cli_run_set_input(run, input, &height, &a->settings);
-    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    run->rayset_id = traced(a) ? result.rayset_id : NULL;
     slope_outputs slope;
     rc = make_slope(a, run, &result.filtered, &slope);
     if (!rc)
-      rc = write_outputs(a, run, &result, &slope);
+      rc = write_outputs_keeping_depth(a, run, &result, &slope, &source);
     bb_image_free(&slope.map);
     bb_image_free(&slope.lit);
     t.write = run->seconds_write;
   }
   if (!rc && a->json)
-    print_json(a, input, &height, &result, &t);
+    print_json(a, input, &height, &source, &result, &t);
   bb_bake_result_free(&result);
   bb_image_free(&height);
   return rc;

@@ -191,8 +191,12 @@ static int h2s_run(cli_run *run, h2s_args *a) {
   bb_image img = {0}, height = {0}, rgba = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
-  /* Only the -n map with the height in alpha needs no rays. */
-  a->settings.bake.want_trace = !a->normal_map || a->ao_in_alpha;
+  /* What Valve's RGBA layout takes, and -D's filtered height: only the -n
+   * map with the height in alpha needs no rays. */
+  a->settings.bake.outputs =
+      BB_OUTPUT_BIT(a->normal_map ? BB_OUTPUT_NORMAL : BB_OUTPUT_SSBUMP) |
+      BB_OUTPUT_BIT(a->ao_in_alpha ? BB_OUTPUT_AO : BB_OUTPUT_FILTERED) |
+      (a->dump_filtered ? BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) : 0u);
 
   int rc = load_input(a, &img, &height);
   if (!rc) {
@@ -206,7 +210,7 @@ static int h2s_run(cli_run *run, h2s_args *a) {
   if (!rc) {
     /* With -D, both files or neither (see cli_commit_outputs). */
     cli_run_set_input(run, a->input, &height, &a->settings);
-    run->rayset_id = a->settings.bake.want_trace ? result.rayset_id : NULL;
+    run->rayset_id = (a->settings.bake.outputs & BB_OUTPUTS_TRACED) ? result.rayset_id : NULL;
     cli_staged_output outs[2] = {{.kind = output_kind(a), .path = a->output},
                                  {.kind = "filtered", .path = dump_path}};
     int n = a->dump_filtered ? 2 : 1;

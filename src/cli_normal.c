@@ -24,6 +24,7 @@ static const cli_option *const normal_options[] = {
     &cli_opt_filter_threshold,
     &cli_opt_normal_filter,
     &cli_opt_normal_y,
+    &cli_opt_threads,
     &cli_opt_clamp,
     &cli_opt_channel,
     &cli_opt_depth,
@@ -106,7 +107,7 @@ int bb_cli_normal(int argc, char **argv) {
   normal_args a;
   memset(&a, 0, sizeof a);
   cli_settings_init(&a.settings);
-  a.settings.bake.want_trace = 0; /* a normal map needs no rays */
+  a.settings.bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL); /* no rays, nothing else */
   const char *input = NULL;
   int rc = normal_parse(argc, argv, &a, &input);
   if (rc < 0)

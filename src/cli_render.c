@@ -453,8 +453,12 @@ static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
     rc = check_view(a, &in->height);
   if (rc)
     return rc;
-  a->settings.bake.want_trace =
-      (needed_maps(a) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
+  /* The normal always (every mode lights with it), the filtered height for
+   * the slope map, and the traced maps when the view needs one. */
+  const int traced = (needed_maps(a) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
+  a->settings.bake.outputs =
+      BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
+      (traced ? BB_OUTPUTS_TRACED : 0u);
   cli_progress progress;
   cli_progress_attach(&progress, "render", a->quiet, &a->settings.bake.trace);
   rc = cli_run_bake(a->height_path, &in->height, &a->settings.bake, &in->bake);
@@ -462,7 +466,7 @@ static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
   if (rc)
     return rc;
   cli_run_set_input(run, a->height_path, &in->height, &a->settings);
-  run->rayset_id = a->settings.bake.want_trace ? in->bake.rayset_id : NULL;
+  run->rayset_id = traced ? in->bake.rayset_id : NULL;
   bb_bake_result *r = &in->bake;
   in->view = (bb_render_maps){&r->normal, r->ssbump.pixels ? &r->ssbump : NULL,
                               r->ao.pixels ? &r->ao : NULL,

@@ -82,9 +82,10 @@ static bb_status resolve_basis(const bb_basis *basis, int channels, const char *
   return bb_basis_parse(channels == 4 ? "hl2+z" : "hl2", out, err);
 }
 
-/* Runs fn over the rows of job->out; frees job->out if that fails. */
-static bb_status run_rows(derive_job *job, bb__work_fn fn, bb_error *err) {
-  bb_status st = bb__parallel_for(job->out->height, 0, fn, job, NULL, NULL, err);
+/* Runs fn over the rows of job->out on `threads` threads (0 = all cores);
+ * frees job->out if that fails. */
+static bb_status run_rows(derive_job *job, bb__work_fn fn, int threads, bb_error *err) {
+  bb_status st = bb__parallel_for(job->out->height, threads, fn, job, NULL, NULL, err);
   if (st != BB_OK)
     bb_image_free(job->out);
   return st;
@@ -117,6 +118,11 @@ static void weights_row(void *user, int y) {
 
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
                             bb_error *err) {
+  return bb__derive_weights(normals, basis, 0, out, err);
+}
+
+bb_status bb__derive_weights(const bb_image *normals, const bb_basis *basis, int threads,
+                             bb_image *out, bb_error *err) {
   bb_status st;
   bb_basis b;
   if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
@@ -129,7 +135,7 @@ bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_i
     return st;
   derive_job job;
   job_init(&job, normals, NULL, out, &b);
-  return run_rows(&job, weights_row, err);
+  return run_rows(&job, weights_row, threads, err);
 }
 
 static void ssbump_row(void *user, int y) {
@@ -148,6 +154,11 @@ static void ssbump_row(void *user, int y) {
 
 bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
                            const bb_basis *basis, bb_image *out, bb_error *err) {
+  return bb__derive_ssbump(normals, vis, basis, 0, out, err);
+}
+
+bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
+                            const bb_basis *basis, int threads, bb_image *out, bb_error *err) {
   bb_status st;
   bb_basis b;
   if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
@@ -166,7 +177,7 @@ bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
     return st;
   derive_job job;
   job_init(&job, normals, vis, out, &b);
-  return run_rows(&job, ssbump_row, err);
+  return run_rows(&job, ssbump_row, threads, err);
 }
 
 static void ao_row(void *user, int y) {
@@ -178,6 +189,10 @@ static void ao_row(void *user, int y) {
 }
 
 bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
+  return bb__derive_ao(vis, 0, out, err);
+}
+
+bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_error *err) {
   bb_status st;
   if ((st = check_image(vis, "visibility", 1, 64, err)) != BB_OK)
     return st;
@@ -187,7 +202,7 @@ bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
     return st;
   derive_job job;
   job_init(&job, NULL, vis, out, NULL);
-  return run_rows(&job, ao_row, err);
+  return run_rows(&job, ao_row, threads, err);
 }
 
 static void bent_row(void *user, int y) {
@@ -215,6 +230,11 @@ static void bent_row(void *user, int y) {
 
 bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
                          bb_error *err) {
+  return bb__derive_bent(ssbump, basis, 0, out, err);
+}
+
+bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
+                          bb_image *out, bb_error *err) {
   bb_status st;
   bb_basis b;
   if ((st = check_image(ssbump, "ssbump", 3, BB_MAX_BASIS, err)) != BB_OK)
@@ -227,5 +247,5 @@ bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image
     return st;
   derive_job job;
   job_init(&job, ssbump, NULL, out, &b);
-  return run_rows(&job, bent_row, err);
+  return run_rows(&job, bent_row, threads, err);
 }

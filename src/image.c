@@ -14,6 +14,7 @@ const char *bb_status_name(bb_status status) {
   case BB_ERR_SIZE: return "bad image size";
   case BB_ERR_VALUE: return "bad value";
   case BB_ERR_MEMORY: return "out of memory";
+  case BB_ERR_CANCELLED: return "cancelled";
   }
   return "unknown status";
 }

@@ -67,11 +67,35 @@ int bb__thread_count(int threads);
 /* Runs fn(user, item) for item = 0 .. items-1 on `threads` threads; items
  * are handed out in order from a shared counter. Each item's result must
  * depend only on the item, which keeps outputs identical for any thread
- * count. progress (may be NULL) is called from the calling thread. */
+ * count. progress (may be NULL) is called from the calling thread; when it
+ * returns nonzero no further item starts and BB_ERR_CANCELLED is returned
+ * (the items already running finish first). */
 typedef void (*bb__work_fn)(void *user, int item);
 bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
                            bb_progress_fn progress, void *progress_user,
                            bb_error *err);
+
+/* The stages of a bake with the bake's thread count (0 = all cores); the
+ * public functions of the same name without "bb__" call them with 0.
+ * Every stage splits its work into items whose results do not depend on
+ * the split, so any thread count gives the same bits. */
+bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
+                               const bb_smooth_options *o, int threads, bb_image *out,
+                               bb_error *err);
+bb_status bb__normals_compute(const bb_image *height, float height_scale,
+                              bb_normal_filter filter, bb_addressing addressing, int threads,
+                              bb_image *out, bb_error *err);
+bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing addressing,
+                            int threads, bb_pyramid **out, bb_error *err);
+bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int threads,
+                          bb_rayset *out, bb_error *err);
+bb_status bb__derive_weights(const bb_image *normals, const bb_basis *basis, int threads,
+                             bb_image *out, bb_error *err);
+bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
+                            const bb_basis *basis, int threads, bb_image *out, bb_error *err);
+bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_error *err);
+bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
+                          bb_image *out, bb_error *err);
 
 /* 64-bit FNV-1a: the hash of an empty input, and one step over the four
  * bytes of v, little-endian whatever the host (so hashes recorded on one

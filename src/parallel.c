@@ -51,7 +51,7 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
   }
   pthread_t tids[256];
   if (n > 256) n = 256;
-  int started = 0;
+  int started = 0, cancelled = 0;
   for (; started < n; started++)
     if (pthread_create(&tids[started], NULL, worker, &q) != 0) break;
   if (started == 0) {
@@ -59,13 +59,18 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
   } else if (progress) {
     /* Poll from the calling thread so the callback never runs concurrently. */
     while (atomic_load(&q.done) < items) {
-      progress(progress_user, atomic_load(&q.done), items);
+      if (progress(progress_user, atomic_load(&q.done), items)) {
+        cancelled = 1;
+        atomic_store(&q.next, items); /* no new items; those running finish */
+        break;
+      }
       struct timespec ts = {0, 50 * 1000 * 1000};
       nanosleep(&ts, NULL);
     }
   }
   for (int i = 0; i < started; i++) pthread_join(tids[i], NULL);
-  if (progress) progress(progress_user, items, items);
-  (void)err;
+  if (!cancelled && progress) cancelled = progress(progress_user, items, items) != 0;
+  if (cancelled)
+    return bb__fail(err, BB_ERR_CANCELLED, "cancelled by the progress callback");
   return BB_OK;
 }

@@ -98,13 +98,14 @@ static void level_columns(void *user, int j) { /* row_max -> node row j */
         addressed_max(job->row_max + i, (size_t)lw, p->height, j * span, span, p->addressing);
 }
 
-static bb_status build_levels(bb_pyramid *p, float *row_max, bb_error *err) {
+static bb_status build_levels(bb_pyramid *p, float *row_max, int threads, bb_error *err) {
   build_job job = {p, 0, row_max};
-  bb_status st = bb__parallel_for(p->height, 0, build_cells_row, &job, NULL, NULL, err);
+  bb_status st = bb__parallel_for(p->height, threads, build_cells_row, &job, NULL, NULL, err);
   for (job.k = 1; st == BB_OK && job.k < p->levels; job.k++) {
-    st = bb__parallel_for(p->height, 0, level_rows, &job, NULL, NULL, err);
+    st = bb__parallel_for(p->height, threads, level_rows, &job, NULL, NULL, err);
     if (st == BB_OK)
-      st = bb__parallel_for(p->level_height[job.k], 0, level_columns, &job, NULL, NULL, err);
+      st = bb__parallel_for(p->level_height[job.k], threads, level_columns, &job, NULL, NULL,
+                            err);
   }
   return st;
 }
@@ -136,6 +137,11 @@ static bb_status check_heights(const bb_image *z, bb_error *err) {
 
 bb_status bb_pyramid_build(const bb_image *height_texels, bb_addressing addressing,
                            bb_pyramid **out, bb_error *err) {
+  return bb__pyramid_build(height_texels, addressing, 0, out, err);
+}
+
+bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing addressing,
+                            int threads, bb_pyramid **out, bb_error *err) {
   *out = NULL;
   bb_status st = check_heights(height_texels, err);
   if (st != BB_OK) return st;
@@ -164,7 +170,7 @@ bb_status bb_pyramid_build(const bb_image *height_texels, bb_addressing addressi
     return bb__fail(err, BB_ERR_MEMORY, "pyramid: out of memory for %dx%d", w, h);
   }
   memcpy(p->z, height_texels->pixels, n * sizeof(float));
-  st = build_levels(p, row_max, err);
+  st = build_levels(p, row_max, threads, err);
   free(row_max);
   if (st != BB_OK) {
     bb_pyramid_free(p);

@@ -107,6 +107,11 @@ static void build_slice_table(void *user, int s) {
 
 bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset *out,
                          bb_error *err) {
+  return bb__rayset_make(slices, power, basis, 0, out, err);
+}
+
+bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int threads,
+                          bb_rayset *out, bb_error *err) {
   memset(out, 0, sizeof *out);
   if (slices < 1 || slices > BB_MAX_SLICES)
     return bb__fail(err, BB_ERR_ARGUMENT, "ray set: slices must be in 1..%d (got %d)",
@@ -135,7 +140,7 @@ bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_ray
     bb_rayset_free(out);
     return bb__fail(err, BB_ERR_MEMORY, "ray set: out of memory");
   }
-  st = bb__parallel_for(slices, 0, build_slice_table, &job, NULL, NULL, err);
+  st = bb__parallel_for(slices, threads, build_slice_table, &job, NULL, NULL, err);
   /* The totals, summed in slice order whatever the threads did. */
   for (int s = 0; s < slices; s++) {
     out->total[0] += out->half_width[s];

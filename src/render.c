@@ -294,6 +294,9 @@ static bb_status check_options(const bb_render_options *o, bb_error *err) {
   if (o->crop_width < 0 || (o->crop_width > 0 && o->crop_height <= 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: crop size must be > 0 (got %dx%d)",
                     o->crop_width, o->crop_height);
+  if (o->threads < 0 || o->threads > BB_MAX_THREADS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "render: threads must be in 0..%d (got %d)",
+                    BB_MAX_THREADS, o->threads);
   return check_lights(o, err);
 }
 

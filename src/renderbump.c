@@ -76,8 +76,9 @@ static bb_status check_options(const bb_renderbump_options *o, bb_error *err) {
                     o->samples);
   if ((int)o->axis < 0 || (int)o->axis > BB_AXIS_NEG_X)
     return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: unknown axis %d", (int)o->axis);
-  if (o->threads < 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: negative thread count");
+  if (o->threads < 0 || o->threads > BB_MAX_THREADS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: threads must be in 0..%d (got %d)",
+                    BB_MAX_THREADS, o->threads);
   if (o->rect_given) {
     for (int k = 0; k < 4; k++)
       if (!isfinite(o->rect[k]))

@@ -685,7 +685,9 @@ static bb_status trace_sweeps(trace_job *job, bb_error *err) {
     st = bb__sweep_lines(job->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
                          pair ? &opposite : NULL, job->o->bias_texels, job->o->threads, 0, err);
     k += pair ? 2 : 1;
-    if (job->o->progress) job->o->progress(job->o->progress_user, k, rs->slice_count);
+    if (st == BB_OK && job->o->progress &&
+        job->o->progress(job->o->progress_user, k, rs->slice_count))
+      st = bb__fail(err, BB_ERR_CANCELLED, "trace: cancelled by the progress callback");
   }
   if (st == BB_OK)
     st = bb__parallel_for(job->region.height, job->o->threads, finish_row, job, NULL, NULL, err);

@@ -271,26 +271,205 @@ Test(bake, periodic_shift_shifts_every_output) {
   }
 }
 
-Test(bake, bit_identical_for_one_two_and_three_threads) {
+static size_t image_bytes(const bb_image *img) {
+  return (size_t)img->width * (size_t)img->height * (size_t)img->channels * sizeof(float);
+}
+
+/* Every stage (smooth, normals, weights, pyramid, ray set, trace, derive)
+ * runs on the bake's threads; its work items do not depend on the split, so
+ * any count gives the same bits, on an odd size with more rows than
+ * threads and fewer (7 threads, 31 rows of 4-row normal bands). */
+Test(bake, bit_identical_for_any_thread_count) {
   bb_image h = field(50, 31);
   noise_field(&h, 3);
-  bb_bake_result r[3];
-  for (int t = 0; t < 3; t++) {
+  const int counts[] = {1, 2, 3, 7, 64};
+  enum { RUNS = sizeof counts / sizeof counts[0] };
+  bb_bake_result r[RUNS];
+  for (int t = 0; t < RUNS; t++) {
     bb_bake_options o;
     bb_bake_options_init(&o);
     o.height_scale = 8.0f;
     o.slices = 10;
-    o.trace.threads = t + 1;
+    o.smooth.radius_texels = 4;
+    o.smooth.threshold = 0.3f;
+    o.trace.threads = counts[t];
     r[t] = bake(&h, &o);
+    cr_assert_eq(r[t].threads, counts[t], "the result says how many threads ran");
   }
-  for (int t = 1; t < 3; t++)
+  for (int t = 1; t < RUNS; t++)
     for (int i = 0; i < 6; i++) {
       const bb_image *a = outputs(&r[0], i), *b = outputs(&r[t], i);
-      size_t bytes = (size_t)a->width * (size_t)a->height * (size_t)a->channels * sizeof(float);
-      cr_assert_eq(memcmp(a->pixels, b->pixels, bytes), 0, "output %d, %d threads", i, t + 1);
+      cr_assert_eq(memcmp(a->pixels, b->pixels, image_bytes(a)), 0, "output %d, %d threads", i,
+                   counts[t]);
     }
-  for (int t = 0; t < 3; t++) bb_bake_result_free(&r[t]);
+  for (int t = 0; t < RUNS; t++) bb_bake_result_free(&r[t]);
   bb_image_free(&h);
+}
+
+/* A bake makes only the maps it is asked for (vis too when it traces), and
+ * each is the same bits as in a bake of every map. */
+Test(bake, output_mask_makes_only_what_was_asked) {
+  bb_image h = field(24, 17);
+  noise_field(&h, 5);
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 6.0f;
+  o.slices = 6;
+  o.normal_y_up = 1; /* the flip applies to what is kept, once */
+  bb_bake_result all = bake(&h, &o);
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    o.outputs = BB_OUTPUT_BIT(k);
+    bb_bake_result one = bake(&h, &o);
+    const int traced = bb_output_kind_get((bb_output_kind)k)->needs_trace;
+    for (int j = 0; j < BB_OUTPUT_KIND_COUNT; j++) {
+      const bb_image *img = bb_bake_result_image(&one, (bb_output_kind)j);
+      if (j != k) {
+        cr_assert_null(img->pixels, "asked %d, made %d", k, j);
+        continue;
+      }
+      const bb_image *ref = bb_bake_result_image(&all, (bb_output_kind)j);
+      cr_assert_eq(img->channels, ref->channels);
+      cr_assert_eq(memcmp(img->pixels, ref->pixels, image_bytes(ref)), 0, "kind %d", k);
+    }
+    cr_assert_eq(one.vis.pixels != NULL, traced, "vis only with a trace (kind %d)", k);
+    cr_assert_eq(one.rayset_id[0] != '\0', traced, "ray set only with a trace (kind %d)", k);
+    bb_bake_result_free(&one);
+  }
+  /* Without a traced map, the trace's options are not even checked. */
+  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  o.rays = 0;
+  bb_bake_result r = bake(&h, &o);
+  cr_assert_not_null(r.normal.pixels);
+  cr_assert_not_null(r.filtered.pixels);
+  bb_bake_result_free(&r);
+  bb_bake_result_free(&all);
+  bb_image_free(&h);
+}
+
+/* Progress callbacks that cancel after `after` calls (never when < 0). */
+typedef struct cancel_state {
+  int calls, after;
+  long last_done, last_total;
+} cancel_state;
+
+static int cancel_after(void *user, long done, long total) {
+  cancel_state *c = user;
+  c->last_done = done;
+  c->last_total = total;
+  return c->after >= 0 && ++c->calls > c->after;
+}
+
+Test(bake, progress_callback_cancels_and_nothing_is_returned) {
+  bb_image h = field(40, 30);
+  noise_field(&h, 9);
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 8.0f;
+  o.slices = 16;
+  /* Going on: every slice reported, the bake whole. */
+  cancel_state go = {0, -1, 0, 0};
+  o.trace.progress = cancel_after;
+  o.trace.progress_user = &go;
+  bb_bake_result r = bake(&h, &o);
+  cr_assert_eq(go.last_done, 16);
+  cr_assert_eq(go.last_total, 16);
+  bb_bake_result_free(&r);
+  /* Cancelled at the first report, and at the last one. */
+  for (int after = 0; after < 2; after++) {
+    cancel_state stop = {0, after == 0 ? 0 : 7, 0, 0};
+    o.trace.progress_user = &stop;
+    bb_error err;
+    memset(&r, 0xff, sizeof r); /* every field must be cleared */
+    cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_CANCELLED);
+    cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
+    cr_assert_str_eq(bb_status_name(BB_ERR_CANCELLED), "cancelled");
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      cr_assert_null(bb_bake_result_image(&r, (bb_output_kind)k)->pixels, "kind %d", k);
+    cr_assert_null(r.vis.pixels);
+    bb_bake_result_free(&r);
+  }
+  bb_image_free(&h);
+}
+
+/* A region is traced by marches on the thread pool, which polls the
+ * callback; cancelling there stops the workers and returns no image. */
+Test(bake, progress_callback_cancels_a_region_trace) {
+  bb_image h = field(64, 64);
+  noise_field(&h, 4);
+  for (int i = 0; i < 64 * 64; i++) h.pixels[i] *= 20.0f;
+  bb_pyramid *p = NULL;
+  bb_rayset rs;
+  cr_assert_eq(bb_pyramid_build(&h, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  cr_assert_eq(bb_rayset_make(64, 1.0, NULL, &rs, NULL), BB_OK);
+  bb_trace_options t;
+  bb_trace_options_init(&t);
+  t.region = (bb_region){0, 0, 64, 64};
+  t.threads = 2;
+  cancel_state stop = {0, 0, 0, 0};
+  t.progress = cancel_after;
+  t.progress_user = &stop;
+  bb_image vis;
+  bb_error err;
+  cr_assert_eq(bb_trace_occlusion(p, &rs, &t, &vis, NULL, &err), BB_ERR_CANCELLED);
+  cr_assert(strstr(err.message, "cancelled"), "%s", err.message);
+  cr_assert_null(vis.pixels);
+  cr_assert_geq(stop.calls, 1);
+  bb_rayset_free(&rs);
+  bb_pyramid_free(p);
+  bb_image_free(&h);
+}
+
+/* The ranges the command line used to check alone are the library's. */
+Test(bake, options_check_holds_every_limit) {
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 4.0f;
+  bb_error err;
+  cr_assert_eq(bb_bake_options_check(&o, &err), BB_OK, "%s", err.message);
+  static const struct {
+    int field; /* 0 radius, 1 threads, 2 bias, 3 power, 4 outputs */
+    double ok, bad;
+    const char *message;
+  } cases[] = {
+      {0, 4096, 4097, "bake: filter radius must be in 0..4096 (got 4097)"},
+      {0, 0, -1, "bake: filter radius must be in 0..4096 (got -1)"},
+      {1, 4096, 4097, "bake: threads must be in 0..4096 (got 4097)"},
+      {1, 0, -1, "bake: threads must be in 0..4096 (got -1)"},
+      {2, 1e6, 2e6, "bake: bias must be <= 1e+06 (got 2e+06)"},
+      {2, 0, -1, "bake: bias must be >= 0 (got -1)"},
+      {3, 1e6, 1.5e6, "bake: power must be <= 1e+06 (got 1.5e+06)"},
+      {3, 1, 0.5, "bake: power must be >= 1 (got 0.5)"},
+      {4, BB_OUTPUTS_ALL, 0, "bake: outputs must be a non-empty set"},
+      {4, 1, BB_OUTPUTS_ALL + 1, "bake: outputs must be a non-empty set"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    for (int bad = 0; bad < 2; bad++) {
+      bb_bake_options c = o;
+      const double v = bad ? cases[i].bad : cases[i].ok;
+      switch (cases[i].field) {
+      case 0: c.smooth.radius_texels = (int)v; break;
+      case 1: c.trace.threads = (int)v; break;
+      case 2: c.trace.bias_texels = v; break;
+      case 3: c.power = v; break;
+      default: c.outputs = (unsigned)v; break;
+      }
+      memset(&err, 0, sizeof err);
+      bb_status st = bb_bake_options_check(&c, &err);
+      if (!bad) {
+        cr_assert_eq(st, BB_OK, "case %zu: %s", i, err.message);
+        continue;
+      }
+      cr_assert_eq(st, BB_ERR_ARGUMENT, "case %zu", i);
+      cr_assert(strncmp(err.message, cases[i].message, strlen(cases[i].message)) == 0,
+                "case %zu: %s", i, err.message);
+      /* bb_bake refuses them the same way, before any work. */
+      bb_image h = field(4, 4);
+      bb_bake_result r;
+      bb_error err2;
+      cr_assert_eq(bb_bake(&h, &c, &r, &err2), BB_ERR_ARGUMENT);
+      cr_assert_str_eq(err2.message, err.message);
+      bb_image_free(&h);
+    }
 }
 
 Test(bake, rejects_bad_options) {

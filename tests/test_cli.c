@@ -176,9 +176,23 @@ Test(cli, usage_errors_exit_2_with_a_message) {
       {{"bake", in, "--scale", "1", "--rays", "65537", "-o", tmp("p")}, "--rays"},
       {{"bake", in, "--scale", "1", "--bias", "-0.1", "-o", tmp("p")}, "--bias"},
       {{"bake", in, "--scale", "1", "--power", "0.5", "-o", tmp("p")}, "--power"},
+      /* Ranges the library checks (bb_bake_options_check), said in its words. */
+      {{"bake", in, "--scale", "1", "--threads", "4097", "-o", tmp("p")},
+       "--threads: threads must be in 0..4096 (got 4097)"},
+      {{"normal", in, "-o", out, "--threads", "-1", "--scale", "1"},
+       "bumpbake normal: --threads: threads must be in 0..4096 (got -1)"},
+      {{"bake", in, "--scale", "1", "--filter-radius", "4097", "-o", tmp("p")},
+       "--filter-radius: filter radius must be in 0..4096 (got 4097)"},
+      {{"bake", in, "--scale", "1", "--bias", "2e6", "-o", tmp("p")},
+       "--bias: bias must be <= 1e+06 (got 2e+06)"},
+      {{"bake", in, "--scale", "1", "--power", "1e7", "-o", tmp("p")},
+       "--power: power must be <= 1e+06 (got 1e+07)"},
+      {{"bake", in, "--scale", "1", "--threads", "99999999999", "-o", tmp("p")},
+       "--threads is out of range"},
       {{"bake", in, "--scale", "1", "--basis", "hl3", "-o", tmp("p")}, "--basis"},
       {{"bake", in, "--scale", "1"}, "nothing to write"},
-      {{"bake", in, "--scale", "1", "--ao", tmp("ao.jpg2")}, "ao.jpg2"},
+      {{"bake", in, "--scale", "1", "--ao", tmp("ao.jpg2")},
+       "unknown output format '.jpg2' (use .png, .tga, .tif, .tiff or .exr)"},
       {{"bake", in, "--scale", "1", "--ao", tmp("ao.exr"), "--depth", "16"}, "--depth"},
       {{"bake", "--scale", "1", "-o", tmp("p")}, "HEIGHT"},
       {{"height2ssbump", in}, "BUMPSCALE"},
@@ -592,6 +606,87 @@ Test(cli, bake_json_is_one_line_with_the_keys) {
             "%s", r.out);
   cr_expect(strstr(r.out, "\"horizons\":256"), "8x8 texels x 4 slices (16 rays): %s", r.out);
   cli_result_free(&r);
+}
+
+static float alpha_ramp(int x, int y, int c) {
+  (void)y;
+  return c < 3 ? 0.25f : (float)x / 8.0f;
+}
+
+/* --json reports the channel and the threads the bake used, not the
+ * requests (auto, 0). */
+Test(cli, bake_json_reports_the_channel_and_threads_used) {
+  const char *grey = tmp("grey.png"), *rgba = tmp("rgba.png"), *rgb = tmp("rgb.png");
+  write_image(grey, 8, 8, 1, mid_grey);
+  write_image(rgba, 8, 8, 4, alpha_ramp);
+  write_image(rgb, 8, 8, 3, mid_grey);
+  const struct {
+    const char *input, *threads, *json;
+  } cases[] = {
+      {grey, "3", "\"channel\":\"grey\",\"threads\":3"},
+      {rgba, "1", "\"channel\":\"a\",\"threads\":1"},
+      {rgb, "2", "\"channel\":\"mean\",\"threads\":2"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    cli_result r = RUN("bake", cases[i].input, "--scale", "4", "--normal", tmp("n.png"),
+                       "--threads", cases[i].threads, "--json");
+    cr_assert_eq(r.code, 0, "%s", r.err);
+    cr_expect(strstr(r.out, cases[i].json), "case %zu lacks %s: %s", i, cases[i].json, r.out);
+    cli_result_free(&r);
+  }
+  /* --threads 0: the core count, which is at least 1. */
+  cli_result r = RUN("bake", grey, "--scale", "4", "--normal", tmp("n.png"), "--json");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  const char *t = strstr(r.out, "\"threads\":");
+  cr_assert_not_null(t, "%s", r.out);
+  cr_expect_gt(atoi(t + strlen("\"threads\":")), 0, "%s", r.out);
+  cli_result_free(&r);
+}
+
+/* --filtered writes the height at the input's depth where the format holds
+ * it, unless --depth says otherwise; TGA holds 8 bits only. */
+Test(cli, filtered_keeps_the_input_depth) {
+  const char *in = tmp("h16.png");
+  bb_image h;
+  cr_assert_eq(bb_image_alloc(&h, 16, 16, 1, NULL), BB_OK);
+  for (int i = 0; i < 256; i++)
+    h.pixels[i] = (float)(i * 97 % 256) / 255.0f + 1.0f / 65535.0f * (float)(i % 7);
+  bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL};
+  cr_assert_eq(bb_image_write(in, &h, &wo, NULL), BB_OK);
+  bb_image_free(&h);
+  const struct {
+    const char *out, *depth;
+    int bits, is_float;
+  } cases[] = {
+      {"f.png", NULL, 16, 0}, {"f8.png", "8", 8, 0}, {"f.tif", NULL, 16, 0},
+      {"f.tga", NULL, 8, 0},  {"f.exr", NULL, 32, 1},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    const char *out = tmp(cases[i].out);
+    cli_result r = cases[i].depth
+                       ? RUN("bake", in, "--scale", "4", "--filtered", out, "--depth",
+                             cases[i].depth, "-q")
+                       : RUN("bake", in, "--scale", "4", "--filtered", out, "-q");
+    cr_assert_eq(r.code, 0, "%s", r.err);
+    cli_result_free(&r);
+    bb_image_info info;
+    bb_image img = read_image(out, &info);
+    cr_expect_eq(info.bits_per_sample, cases[i].bits, "%s", cases[i].out);
+    cr_expect_eq(info.is_float, cases[i].is_float, "%s", cases[i].out);
+    bb_image_info_free(&info);
+    bb_image_free(&img);
+  }
+  /* An 8-bit input stays 8-bit. */
+  const char *in8 = tmp("h8.png");
+  write_image(in8, 8, 8, 1, mid_grey);
+  cli_result r = RUN("bake", in8, "--scale", "4", "--filtered", tmp("g.png"), "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  bb_image_info info;
+  bb_image img = read_image(tmp("g.png"), &info);
+  cr_expect_eq(info.bits_per_sample, 8);
+  bb_image_info_free(&info);
+  bb_image_free(&img);
 }
 
 /* --slices overrides --rays, is recorded in the JSON and the ray-set id,

@@ -470,6 +470,12 @@ Test(render, bad_arguments_are_refused) {
   o.specular_exponent = -1;
   cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.specular_exponent = 0;
+  o.threads = BB_MAX_THREADS + 1;
+  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_str_eq(err.message, "render: threads must be in 0..4096 (got 4097)");
+  o.threads = -1;
+  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  o.threads = 0;
   o.mode = (bb_render_mode)9;
   cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.mode = BB_RENDER_NORMAL;

@@ -27,25 +27,25 @@ from . import _library
 
 _ffi, _lib, library_path = _library.load()
 
-# The maps bake() can make, as `bumpbake bake` names them.
-OUTPUTS = ("normal", "weights", "ssbump", "ao", "bent", "filtered")
+
+def _output_kind_table():
+    """{name: bb_output_kind} in the library's order (bb_output_kind_get)."""
+    table = {}
+    for k in range(_lib.BB_OUTPUT_KIND_COUNT):
+        info = _lib.bb_output_kind_get(k)
+        table[_ffi.string(info.name).decode()] = (k, bool(info.needs_trace))
+    return table
+
+
+_KINDS = _output_kind_table()
+# The maps bake() can make, as the library (and `bumpbake bake`) names them.
+OUTPUTS = tuple(_KINDS)
 # Those that need the tracer (the others take no rays).
-TRACED_OUTPUTS = ("ssbump", "ao", "bent")
+TRACED_OUTPUTS = tuple(k for k, (_, traced) in _KINDS.items() if traced)
 # What `bumpbake bake -o PREFIX` writes.
 DEFAULT_OUTPUTS = ("normal", "ssbump", "ao")
 
 _INT_MIN, _INT_MAX = -(2**31), 2**31 - 1
-
-# Limits the command line enforces and bb_bake does not check yet: the
-# library takes filter radii up to 65536, any bias >= 0 and power >= 1, and
-# any thread count (<= 0 meaning all cores). Everything else is checked by
-# the library itself. (Part 2 of issue 11 moves these into the library.)
-_CLI_ONLY_LIMITS = {
-    "filter_radius": (0, 4096),
-    "bias": (0.0, 1e6),
-    "power": (1.0, 1e6),
-    "threads": (0, 4096),
-}
 
 
 class Error(Exception):
@@ -106,20 +106,6 @@ def _int_value(command, name, value):
     return value
 
 
-def _cli_limit(command, name, value):
-    """The command line's limits the library lacks (see _CLI_ONLY_LIMITS).
-    Integer ranges are checked whole; for bias and power the library checks
-    the lower bound itself."""
-    low, high = _CLI_ONLY_LIMITS[name]
-    if isinstance(value, int) and not low <= value <= high:
-        raise ArgumentError(f"{command}: {name} must be in {low}..{high} (got {value})",
-                            "bad argument")
-    if value > high:
-        raise ArgumentError(f"{command}: {name} must be <= {high:g} (got {value:g})",
-                            "bad argument")
-    return value
-
-
 def _choice(command, name, parse, text, words):
     """Parses an enum option with the library's own parser."""
     out = _ffi.new(f"{parse[1]} *")
@@ -136,8 +122,7 @@ def _common_options(command, scale, filter_radius, filter_threshold, normal_filt
     _lib.bb_bake_options_init(o)
     o.height_scale = float(scale)
     if filter_radius is not None:
-        o.smooth.radius_texels = _cli_limit(
-            command, "filter_radius", _int_value(command, "filter_radius", filter_radius))
+        o.smooth.radius_texels = _int_value(command, "filter_radius", filter_radius)
     if filter_threshold is not None:
         o.smooth.threshold = float(filter_threshold)
     if normal_filter is not None:
@@ -255,9 +240,12 @@ def _array(img):
 
 
 def _run_bake(height, channel, options, command):
+    err = _ffi.new("bb_error *")
+    st = _lib.bb_bake_options_check(options, err)  # bad options before a bad height
+    if st != _lib.BB_OK:
+        _raise_status(st, err)
     field = _height_field(command, height, channel)
     result = _ffi.new("bb_bake_result *")
-    err = _ffi.new("bb_error *")
     try:
         st = _lib.bb_bake(field, options, result, err)  # cffi releases the GIL here
         if st != _lib.BB_OK:
@@ -302,17 +290,17 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filt
         if o.slices == 0:
             raise ArgumentError("bake: slices must be in 1..256 (got 0)", "bad argument")
     if bias is not None:
-        o.trace.bias_texels = _cli_limit("bake", "bias", float(bias))
+        o.trace.bias_texels = float(bias)
     if power is not None:
-        o.power = _cli_limit("bake", "power", float(power))
+        o.power = float(power)
     if threads is not None:
-        o.trace.threads = _cli_limit("bake", "threads", _int_value("bake", "threads", threads))
+        o.trace.threads = _int_value("bake", "threads", threads)
     if basis is not None:
         o.basis = _basis("bake", basis)[0]
-    o.want_trace = any(k in TRACED_OUTPUTS for k in kinds)
+    o.outputs = sum(1 << _KINDS[k][0] for k in kinds)  # only these are computed
     result = _run_bake(height, channel, o, "bake")
     try:
-        return {k: _array(getattr(result, k)) for k in kinds}
+        return {k: _array(_lib.bb_bake_result_image(result, _KINDS[k][0])) for k in kinds}
     finally:
         _lib.bb_bake_result_free(result)
 
@@ -323,7 +311,7 @@ def normal(height, scale, *, filter_radius=None, filter_threshold=None,
     as `bumpbake normal` makes them (nothing is traced)."""
     o = _common_options("normal", scale, filter_radius, filter_threshold, normal_filter,
                         normal_y, clamp)
-    o.want_trace = 0
+    o.outputs = 1 << _lib.BB_OUTPUT_NORMAL
     result = _run_bake(height, channel, o, "normal")
     try:
         return _array(result.normal)

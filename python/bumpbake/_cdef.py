@@ -17,7 +17,8 @@ typedef enum bb_status {
   BB_ERR_FORMAT,
   BB_ERR_SIZE,
   BB_ERR_VALUE,
-  BB_ERR_MEMORY
+  BB_ERR_MEMORY,
+  BB_ERR_CANCELLED
 } bb_status;
 
 typedef struct bb_error {
@@ -43,6 +44,11 @@ typedef enum bb_addressing {
   BB_ADDRESS_PERIODIC = 0,
   BB_ADDRESS_CLAMP
 } bb_addressing;
+
+typedef enum bb_range {
+  BB_RANGE_UNIT = 0,
+  BB_RANGE_SIGNED
+} bb_range;
 
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0,
@@ -73,7 +79,7 @@ typedef struct bb_basis {
   char name[32];
 } bb_basis;
 
-typedef void (*bb_progress_fn)(void *user, long done, long total);
+typedef int (*bb_progress_fn)(void *user, long done, long total);
 
 typedef struct bb_region {
   int x0, y0, width, height;
@@ -87,6 +93,24 @@ typedef struct bb_trace_options {
   void *progress_user;
 } bb_trace_options;
 
+typedef enum bb_output_kind {
+  BB_OUTPUT_NORMAL = 0,
+  BB_OUTPUT_WEIGHTS,
+  BB_OUTPUT_SSBUMP,
+  BB_OUTPUT_AO,
+  BB_OUTPUT_BENT,
+  BB_OUTPUT_FILTERED,
+  BB_OUTPUT_KIND_COUNT
+} bb_output_kind;
+
+typedef struct bb_output_kind_info {
+  const char *name;
+  const char *description;
+  int channels;
+  bb_range range;
+  int needs_trace;
+} bb_output_kind_info;
+
 typedef struct bb_bake_options {
   float height_scale;
   int rays;
@@ -97,7 +121,7 @@ typedef struct bb_bake_options {
   bb_basis basis;
   bb_normal_filter normal_filter;
   int normal_y_up;
-  int want_trace;
+  unsigned outputs;
 } bb_bake_options;
 
 typedef struct bb_bake_result {
@@ -112,6 +136,7 @@ typedef struct bb_bake_result {
   double horizons_found;
   char rayset_id[64];
   bb_basis basis;
+  int threads;
 } bb_bake_result;
 """
 
@@ -133,9 +158,12 @@ bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
 bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
                                 bb_error *err);
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
+const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
 void bb_bake_options_init(bb_bake_options *o);
+bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
+const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
 """
 

@@ -1,0 +1,26 @@
+/* cli_progress.h: the progress bar of long bakes (cli_progress.c). */
+#ifndef BB_CLI_PROGRESS_H
+#define BB_CLI_PROGRESS_H
+
+#include "bumpbake.h"
+
+/* --------------------------------------------------------------- progress */
+
+/* A one-line progress bar on stderr: "bake [#####.....] 42% ETA 1.3s". It
+ * appears only once the work has run for about a second, so short bakes
+ * print nothing, and only when stderr is a terminal. */
+typedef struct cli_progress {
+  const char *label;
+  double start_seconds;
+  double last_draw_seconds;
+  int shown; /* a line is on screen and must be cleared */
+} cli_progress;
+
+/* Sets up p and, when stderr is a terminal and not quiet, points the trace
+ * options' progress callback at it. */
+void cli_progress_attach(cli_progress *p, const char *label, int quiet,
+                         bb_trace_options *trace);
+/* Clears the bar's line if one was drawn. */
+void cli_progress_finish(cli_progress *p);
+
+#endif /* BB_CLI_PROGRESS_H */
