@@ -110,8 +110,8 @@ static const cli_option *const bake_options[] = {
 
 static const cli_command bake_command = {
     "bake",
-    "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ...)\n"
-    "       bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST] [OPTIONS]",
+    "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ... | "
+    "--out-dir DIR)",
     "Bakes the requested maps from HEIGHT in one pass; tracing runs only when\n"
     "ssbump, ao or bent is asked for. Tracing finds each texel's exact horizon\n"
     "in each azimuth slice and integrates the slice above it exactly; what is\n"
@@ -122,7 +122,13 @@ static const cli_command bake_command = {
     "  256 rays       16     ~1.8 s   0.0004   0.0010   (the default)\n"
     "  1024 rays      32     ~7.4 s   0.0001   0.0004\n"
     "With --clamp the trace takes about twice as long. See the README's\n"
-    "Performance and Accuracy.",
+    "Performance and Accuracy.\n"
+    "\n"
+    "Batches: bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST]\n"
+    "bakes every HEIGHT (a directory: the images in it, sorted, not below it)\n"
+    "in one process into DIR/--name, and skips an input whose outputs are\n"
+    "up to date: their provenance names the same input bytes, parameters\n"
+    "and bumpbake version (--force bakes anyway).",
     bake_options,
     (int)(sizeof bake_options / sizeof bake_options[0]),
     cli_settings_init,
