@@ -341,3 +341,45 @@ Test(cli_batch, make_runs_bakes_from_depfiles) {
   cr_expect_eq(s.channels, 5, "baked with the new 5-direction basis");
   bb_image_free(&s);
 }
+
+/* ninja reads the depfile too (deps = gcc), with both outputs of a bake
+ * as targets; restat sees an up-to-date bake leave its outputs alone. */
+Test(cli_batch, ninja_runs_bakes_from_depfiles) {
+  if (system("ninja --version >/dev/null 2>&1") != 0)
+    cr_skip_test("no ninja");
+  height_file(tmp("rock.png"), 1);
+  write_text(tmp("lights.txt"), "1 0 1\n0 1 1\n-1 0 1\n0 -1 1\n");
+  make_dir(tmp("out"));
+  char ninja[8192];
+  snprintf(ninja, sizeof ninja,
+           "rule bake\n"
+           "  command = %s bake $in --scale 6 --slices 4 --filter-radius 2 --basis lights.txt "
+           "--out-dir out --maps ssbump,ao --name '{stem}_{kind}.exr' --depfile $depfile -q\n"
+           "  depfile = out/$stem.d\n"
+           "  deps = gcc\n"
+           "  restat = 1\n"
+           "build out/rock_ssbump.exr out/rock_ao.exr: bake rock.png\n"
+           "  stem = rock\n",
+           harness_binary());
+  write_text(tmp("build.ninja"), ninja);
+  char command[512], deps[512];
+  snprintf(command, sizeof command, "ninja -C %s >%s 2>&1", harness_dir, tmp("ninja.log"));
+  snprintf(deps, sizeof deps, "ninja -C %s -t deps >%s 2>&1", harness_dir, tmp("deps.log"));
+  cr_assert_eq(system(command), 0, "ninja: %s", read_text(tmp("ninja.log")));
+  cr_assert_eq(system(deps), 0);
+  char *text = read_text(tmp("deps.log"));
+  cr_expect(strstr(text, "out/rock_ao.exr: #deps 2"), "%s", text);
+  cr_expect(strstr(text, "    lights.txt\n"), "%s", text);
+  free(text);
+  /* A new basis file re-bakes; a second ninja has nothing to do. */
+  long long before = mtime_of(tmp("out/rock_ssbump.exr"));
+  struct timespec pause = {0, 20 * 1000 * 1000};
+  nanosleep(&pause, NULL);
+  write_text(tmp("lights.txt"), "1 0 1\n0 1 1\n-1 0 1\n0 -1 1\n0 0 1\n");
+  cr_assert_eq(system(command), 0, "ninja: %s", read_text(tmp("ninja.log")));
+  cr_expect_gt(mtime_of(tmp("out/rock_ssbump.exr")), before);
+  cr_assert_eq(system(command), 0);
+  text = read_text(tmp("ninja.log"));
+  cr_expect(strstr(text, "no work to do"), "%s", text);
+  free(text);
+}
