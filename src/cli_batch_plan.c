@@ -40,14 +40,30 @@ static int choose_kinds(const cli_batch_client *c, const char *maps, int *chosen
 
 /* ---------------------------------------------------------------- inputs */
 
-/* The inputs gathered so far, with the identity of each existing file so
- * one named twice is kept once. */
+/* Which file a path names, when it exists. */
+typedef struct file_id {
+  int exists;
+  dev_t dev;
+  ino_t ino;
+} file_id;
+
+static file_id file_id_of(const char *path) {
+  struct stat st;
+  if (stat(path, &st) != 0)
+    return (file_id){0, 0, 0};
+  return (file_id){1, st.st_dev, st.st_ino};
+}
+
+static int same_file_id(file_id a, file_id b) {
+  return a.exists && b.exists && a.dev == b.dev && a.ino == b.ino;
+}
+
+/* The inputs gathered so far, with the identity of each, so a file named
+ * twice is kept once. */
 typedef struct input_list {
   cli_batch_plan *plan;
   int capacity;
-  dev_t *dev;
-  ino_t *ino;
-  int *exists;
+  file_id *ids;
 } input_list;
 
 static int grow(input_list *l) {
@@ -55,16 +71,10 @@ static int grow(input_list *l) {
   cli_batch_item *items = realloc(l->plan->items, (size_t)cap * sizeof *items);
   if (items)
     l->plan->items = items;
-  dev_t *dev = realloc(l->dev, (size_t)cap * sizeof *dev);
-  if (dev)
-    l->dev = dev;
-  ino_t *ino = realloc(l->ino, (size_t)cap * sizeof *ino);
-  if (ino)
-    l->ino = ino;
-  int *exists = realloc(l->exists, (size_t)cap * sizeof *exists);
-  if (exists)
-    l->exists = exists;
-  if (!items || !dev || !ino || !exists)
+  file_id *ids = realloc(l->ids, (size_t)cap * sizeof *ids);
+  if (ids)
+    l->ids = ids;
+  if (!items || !ids)
     return -1;
   l->capacity = cap;
   return 0;
@@ -73,10 +83,9 @@ static int grow(input_list *l) {
 /* Adds path (copied) unless the same file is there already. 0 or -1 when
  * out of memory. */
 static int add_input(input_list *l, const char *path) {
-  struct stat st;
-  int exists = stat(path, &st) == 0;
-  for (int i = 0; exists && i < l->plan->count; i++)
-    if (l->exists[i] && l->dev[i] == st.st_dev && l->ino[i] == st.st_ino)
+  file_id id = file_id_of(path);
+  for (int i = 0; i < l->plan->count; i++)
+    if (same_file_id(l->ids[i], id))
       return 0;
   if (l->plan->count == l->capacity && grow(l) != 0)
     return -1;
@@ -85,10 +94,7 @@ static int add_input(input_list *l, const char *path) {
   item->input = strdup(path);
   if (!item->input)
     return -1;
-  l->exists[l->plan->count] = exists;
-  l->dev[l->plan->count] = exists ? st.st_dev : 0;
-  l->ino[l->plan->count] = exists ? st.st_ino : 0;
-  l->plan->count++;
+  l->ids[l->plan->count++] = id;
   return 0;
 }
 
@@ -164,19 +170,26 @@ static int read_directory(const char *dir, char ***names) {
   return count;
 }
 
-/* Adds the regular image files of dir that are not baked maps. */
+/* Adds dir/name when it is a regular file and not a baked map. */
+static int add_directory_entry(const cli_batch_client *c, input_list *l, const char *dir,
+                               const char *name) {
+  char *path = join_path(dir, name);
+  struct stat st;
+  int failed = !path;
+  if (path && stat(path, &st) == 0 && S_ISREG(st.st_mode) && !is_baked_map(c, path))
+    failed = add_input(l, path) != 0;
+  if (failed)
+    cli_file_error(path ? path : dir, "out of memory");
+  free(path);
+  return failed ? BB_EXIT_FAILURE : 0;
+}
+
 static int add_directory(const cli_batch_client *c, input_list *l, const char *dir) {
   char **names;
   int count = read_directory(dir, &names), rc = count < 0 ? BB_EXIT_FAILURE : 0;
   for (int i = 0; i < count; i++) {
-    char *path = rc ? NULL : join_path(dir, names[i]);
-    struct stat st;
-    if (!rc && !path)
-      rc = BB_EXIT_FAILURE, cli_file_error(dir, "out of memory");
-    else if (!rc && stat(path, &st) == 0 && S_ISREG(st.st_mode) && !is_baked_map(c, path) &&
-             add_input(l, path) != 0)
-      rc = BB_EXIT_FAILURE, cli_file_error(path, "out of memory");
-    free(path);
+    if (!rc)
+      rc = add_directory_entry(c, l, dir, names[i]);
     free(names[i]);
   }
   free(names);
@@ -185,18 +198,18 @@ static int add_directory(const cli_batch_client *c, input_list *l, const char *d
 
 static int gather_inputs(const cli_batch_client *c, char *const *inputs, int input_count,
                          cli_batch_plan *plan) {
-  input_list l = {plan, 0, NULL, NULL, NULL};
+  input_list l = {plan, 0, NULL};
   int rc = 0;
   for (int i = 0; i < input_count && !rc; i++) {
     struct stat st;
-    if (stat(inputs[i], &st) == 0 && S_ISDIR(st.st_mode))
+    if (stat(inputs[i], &st) == 0 && S_ISDIR(st.st_mode)) {
       rc = add_directory(c, &l, inputs[i]);
-    else if (add_input(&l, inputs[i]) != 0) /* a missing file fails at its bake */
-      rc = BB_EXIT_FAILURE, cli_file_error(inputs[i], "out of memory");
+    } else if (add_input(&l, inputs[i]) != 0) { /* a missing file fails at its bake */
+      cli_file_error(inputs[i], "out of memory");
+      rc = BB_EXIT_FAILURE;
+    }
   }
-  free(l.dev);
-  free(l.ino);
-  free(l.exists);
+  free(l.ids);
   if (!rc && plan->count == 0)
     rc = cli_usage_error(c->command, "nothing to bake: %s%s holds no image file", inputs[0],
                          input_count > 1 ? " (and the others)" : "");
@@ -316,21 +329,18 @@ static int check_clashes(const cli_batch_client *c, const cli_batch_plan *plan,
  * name): baking would overwrite a height another bake of the batch reads. */
 static int check_outputs_on_inputs(const cli_batch_client *c, const cli_batch_plan *plan,
                                    const planned_output *outs, int n) {
-  struct stat *in = malloc((size_t)plan->count * sizeof *in);
+  file_id *in = malloc((size_t)plan->count * sizeof *in);
   if (!in) {
     cli_file_error(plan->items[0].input, "out of memory");
     return BB_EXIT_FAILURE;
   }
   for (int j = 0; j < plan->count; j++)
-    if (stat(plan->items[j].input, &in[j]) != 0)
-      in[j].st_nlink = 0; /* missing: no output can be it */
+    in[j] = file_id_of(plan->items[j].input);
   int rc = 0;
   for (int i = 0; i < n && !rc; i++) {
-    struct stat so;
-    if (stat(outs[i].path, &so) != 0)
-      continue;
-    for (int j = 0; j < plan->count && !rc; j++)
-      if (in[j].st_nlink && in[j].st_dev == so.st_dev && in[j].st_ino == so.st_ino)
+    file_id out = file_id_of(outs[i].path);
+    for (int j = 0; j < plan->count && out.exists && !rc; j++)
+      if (same_file_id(in[j], out))
         rc = cli_usage_error(c->command, "%s: %s of %s would overwrite the input %s",
                              outs[i].path, c->kinds[outs[i].kind].name,
                              plan->items[outs[i].item].input, plan->items[j].input);
