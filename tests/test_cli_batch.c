@@ -3,6 +3,7 @@
  * re-bakes, --force, depfiles (read by a real make), clashes refused before
  * any bake, and the single bake unchanged. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"

@@ -2,6 +2,7 @@
  * an output is current only when its provenance, depth and mip levels are
  * what writing it now would give. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"
