@@ -482,6 +482,10 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   bake_timing t = {0, 0};
   a->settings.bake.outputs = asked_outputs(a);
 
+  /* The bytes hashed before they are decoded: provenance must never pair
+   * a newer file's hash with an older file's pixels. */
+  if (!run->input_file_hash && bb_file_hash(input, &run->input_file_hash, NULL) != BB_OK)
+    run->input_file_hash = 0;
   double t0 = cli_now_seconds();
   cli_height_source source;
   int rc = cli_load_height_source(input, &a->settings, &height, &source);
