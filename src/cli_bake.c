@@ -460,16 +460,24 @@ static unsigned asked_outputs(const bake_args *a) {
 }
 
 
-/* write_outputs, with the filtered height at the input's depth unless
- * --depth says otherwise (a 16-bit height stays 16-bit where the format
- * can hold it). */
+/* The depth of kind's file at path: --depth, but the filtered height keeps
+ * the input's depth unless --depth says otherwise (a 16-bit height stays
+ * 16-bit where the format can hold it). */
+static bb_depth output_depth(const cli_settings *s, const cli_height_source *source, int kind,
+                             const char *path) {
+  if (kind == BB_OUTPUT_FILTERED && s->depth == BB_DEPTH_DEFAULT)
+    return cli_depth_like_input(source, path);
+  return s->depth;
+}
+
+/* write_outputs, with the filtered height at output_depth. */
 static int write_outputs_keeping_depth(const bake_args *a, cli_run *run,
                                        const bb_bake_result *r, const slope_outputs *slope,
                                        const cli_height_source *source) {
   cli_settings filtered_settings = *run->settings;
   const char *path = a->paths[BB_OUTPUT_FILTERED];
-  if (path && filtered_settings.depth == BB_DEPTH_DEFAULT)
-    filtered_settings.depth = cli_depth_like_input(source, path);
+  if (path)
+    filtered_settings.depth = output_depth(run->settings, source, BB_OUTPUT_FILTERED, path);
   cli_run filtered_run = *run;
   filtered_run.settings = &filtered_settings;
   return write_outputs(a, run, r, slope, &filtered_run);
@@ -553,13 +561,27 @@ static int batch_bake(void *ctx, cli_run *run, const char *input, const char *co
   return bake_run(run, a, input);
 }
 
+/* output_depth for a batch's up-to-date check, from the input's header
+ * (the bake itself takes it from the decoded file). */
+static bb_depth batch_depth(void *ctx, const char *input, int kind, const char *path) {
+  const bake_args *a = ctx;
+  if (kind != BB_OUTPUT_FILTERED || a->settings.depth != BB_DEPTH_DEFAULT)
+    return a->settings.depth;
+  bb_image_info info;
+  int saved = cli_mute_stderr();
+  bb_status st = bb_image_read_info(input, NULL, NULL, NULL, &info, NULL);
+  cli_unmute_stderr(saved);
+  if (st != BB_OK)
+    return a->settings.depth; /* the bake will say what is wrong */
+  cli_height_source source = {.bits_per_sample = info.bits_per_sample,
+                              .is_float = info.is_float};
+  bb_image_info_free(&info);
+  return output_depth(&a->settings, &source, kind, path);
+}
+
 static int run_batch(cli_run *run, bake_args *a, int argc, char **argv, int first) {
-  cli_batch_kind kinds[OUTPUT_KIND_COUNT];
-  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
-    kinds[k] = (cli_batch_kind){kind_info(k)->name, kind_info(k)->needs_trace,
-                                (prefix_kinds & BB_OUTPUT_BIT(k)) != 0};
-  cli_batch_client client = {bake_command.name, kinds, OUTPUT_KIND_COUNT, &a->settings,
-                             a->json, a->quiet, a, batch_check, batch_bake};
+  cli_batch_client client = {bake_command.name, prefix_kinds, &a->settings, a->json, a->quiet,
+                             a, batch_check, batch_depth, batch_bake};
   return cli_batch_run(&client, &a->batch, run, argc, argv, first);
 }
 

@@ -103,13 +103,12 @@ int cli_batch_write_depfile(const cli_batch_args *b, const cli_settings *s, cons
 typedef enum outcome { NOT_RUN = 0, BAKED, CURRENT, FAILED } outcome;
 
 /* The outputs of an item as a compact list (the paths' non-NULL entries). */
-static int outputs_of(const cli_batch_client *c, const cli_batch_item *item,
-                      const char **out, const char **kinds) {
+static int outputs_of(const cli_batch_item *item, const char **out, const char **kinds) {
   int n = 0;
-  for (int k = 0; k < c->kind_count; k++)
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
     if (item->paths[k]) {
       if (kinds)
-        kinds[n] = c->kinds[k].name;
+        kinds[n] = cli_batch_kind_name(k);
       out[n++] = item->paths[k];
     }
   return n;
@@ -121,19 +120,20 @@ static int item_is_current(const cli_batch_client *c, const cli_batch_item *item
   bb_bake_options o = c->settings->bake;
   /* The client's kinds are the library's, in bb_output_kind order. */
   o.outputs = 0;
-  for (int k = 0; k < c->kind_count; k++)
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
     if (item->paths[k])
       o.outputs |= BB_OUTPUT_BIT(k);
   char rayset[64];
   bb_bake_rayset_id(&o, rayset, sizeof rayset);
-  for (int k = 0; k < c->kind_count; k++) {
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
     if (!item->paths[k])
       continue;
-    bb_provenance want = {NULL, NULL, 0, c->kinds[k].name, &o, c->settings->channel,
+    bb_provenance want = {NULL, NULL, 0, cli_batch_kind_name(k), &o, c->settings->channel,
                           rayset[0] ? rayset : NULL, file_hash};
     bb_output_state state;
-    if (bb_output_check(item->paths[k], &want, c->settings->depth, c->settings->mips,
-                        &state, NULL, 0, NULL) != BB_OK ||
+    bb_depth depth = c->depth(c->ctx, item->input, k, item->paths[k]);
+    if (bb_output_check(item->paths[k], &want, depth, c->settings->mips, &state, NULL, 0,
+                        NULL) != BB_OK ||
         state != BB_OUTPUT_CURRENT)
       return 0;
   }
@@ -160,7 +160,7 @@ static char *command_line_for(const char *input, char **argv, int first) {
 static void print_line(const cli_batch_client *c, const cli_batch_item *item, outcome o,
                        int code) {
   const char *paths[CLI_BATCH_MAX_KINDS], *kinds[CLI_BATCH_MAX_KINDS];
-  int n = outputs_of(c, item, paths, kinds);
+  int n = outputs_of(item, paths, kinds);
   if (!c->json) {
     for (int i = 0; i < n && o == CURRENT && !c->quiet; i++)
       printf("up to date %s %s\n", kinds[i], paths[i]);
@@ -227,7 +227,7 @@ static int write_batch_depfile(const cli_batch_client *c, const cli_batch_args *
     for (int i = 0; i < plan->count; i++) {
       if (outcomes[i] != BAKED && outcomes[i] != CURRENT)
         continue;
-      int count = outputs_of(c, &plan->items[i], targets[n], NULL);
+      int count = outputs_of(&plan->items[i], targets[n], NULL);
       rules[n] = (cli_dep_rule){targets[n], count, prereq[n],
                                 prerequisites_of(b, c->settings, plan->items[i].input,
                                                  prereq[n])};

@@ -36,27 +36,29 @@ int cli_batch_option(cli_batch_args *b, const cli_option *opt, const char *arg);
  * 0 or BB_EXIT_USAGE after printing. */
 int cli_batch_check_single(const char *command, const cli_batch_args *b);
 
-/* One map a batch can write. */
-typedef struct cli_batch_kind {
-  const char *name; /* "normal", ...: --maps and the template's {kind} */
-  int needs_trace;  /* made only when the bake traces */
-  int by_default;   /* written when --maps is not given (as -o PREFIX) */
-} cli_batch_kind;
+/* The maps a batch writes are the library's output kinds
+ * (bb_output_kind_get): --maps and the template's {kind} use their names. */
+enum { CLI_BATCH_MAX_KINDS = BB_OUTPUT_KIND_COUNT };
 
-enum { CLI_BATCH_MAX_KINDS = 16 };
+/* The name of kind (a bb_output_kind). */
+static inline const char *cli_batch_kind_name(int kind) {
+  return bb_output_kind_get((bb_output_kind)kind)->name;
+}
 
 /* What the batch needs of the command that bakes one input. paths has
- * kind_count entries, NULL for a kind not written. */
+ * BB_OUTPUT_KIND_COUNT entries, by bb_output_kind, NULL for a kind not
+ * written. */
 typedef struct cli_batch_client {
-  const char *command; /* "bake", for messages */
-  const cli_batch_kind *kinds;
-  int kind_count;
+  const char *command;   /* "bake", for messages */
+  unsigned default_maps; /* BB_OUTPUT_BIT(kind)s written without --maps */
   const cli_settings *settings; /* as parsed; the provenance of the outputs */
   int json, quiet;
   void *ctx;
   /* Checks one input's outputs as the single bake would, before any bake:
    * 0 or the exit code after printing the error. */
   int (*check)(void *ctx, const char *input, const char *const *paths);
+  /* The depth kind is written with at path when input is baked. */
+  bb_depth (*depth)(void *ctx, const char *input, int kind, const char *path);
   /* Bakes one input into paths (printing "wrote ..." or its JSON line with
    * the given status): 0 or the exit code after printing the error. */
   int (*bake)(void *ctx, cli_run *run, const char *input, const char *const *paths);

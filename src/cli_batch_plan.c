@@ -14,26 +14,26 @@
  * client's defaults. 0 or BB_EXIT_USAGE. */
 static int choose_kinds(const cli_batch_client *c, const char *maps, int *chosen) {
   int any = 0;
-  for (int k = 0; k < c->kind_count; k++)
-    chosen[k] = maps ? 0 : c->kinds[k].by_default;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    chosen[k] = maps ? 0 : (c->default_maps & BB_OUTPUT_BIT(k)) != 0;
   for (const char *s = maps; s && *s;) {
     size_t n = strcspn(s, ",");
     int found = -1;
-    for (int k = 0; k < c->kind_count; k++)
-      if (strlen(c->kinds[k].name) == n && strncmp(c->kinds[k].name, s, n) == 0)
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      if (strlen(cli_batch_kind_name(k)) == n && strncmp(cli_batch_kind_name(k), s, n) == 0)
         found = k;
     if (found < 0) {
       char names[256] = "";
-      for (int k = 0; k < c->kind_count; k++)
+      for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
         snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? ", " : "",
-                 c->kinds[k].name);
+                 cli_batch_kind_name(k));
       return cli_usage_error(c->command, "--maps: unknown map '%.*s' (one of %s)", (int)n, s,
                              names);
     }
     chosen[found] = 1;
     s += n + (s[n] == ',');
   }
-  for (int k = 0; k < c->kind_count; k++)
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
     any |= chosen[k];
   return any ? 0 : cli_usage_error(c->command, "--maps: no map named");
 }
@@ -100,7 +100,7 @@ static int add_input(input_list *l, const char *path) {
 
 /* 1 when the file's provenance says this command wrote it as one of its
  * maps: reading it back as a height would bake a map of a map. */
-static int is_baked_map(const cli_batch_client *c, const char *path) {
+static int is_baked_map(const char *path) {
   bb_image_info info;
   int saved = cli_mute_stderr();
   bb_status st = bb_image_read_info(path, NULL, NULL, NULL, &info, NULL);
@@ -111,8 +111,8 @@ static int is_baked_map(const cli_batch_client *c, const char *path) {
   int baked = 0;
   if (bb_provenance_classify(info.description) != BB_PROVENANCE_NONE &&
       bb_provenance_value(info.description, "output", kind, sizeof kind))
-    for (int k = 0; k < c->kind_count; k++)
-      baked |= strcmp(kind, c->kinds[k].name) == 0;
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      baked |= strcmp(kind, cli_batch_kind_name(k)) == 0;
   bb_image_info_free(&info);
   return baked;
 }
@@ -171,12 +171,11 @@ static int read_directory(const char *dir, char ***names) {
 }
 
 /* Adds dir/name when it is a regular file and not a baked map. */
-static int add_directory_entry(const cli_batch_client *c, input_list *l, const char *dir,
-                               const char *name) {
+static int add_directory_entry(input_list *l, const char *dir, const char *name) {
   char *path = join_path(dir, name);
   struct stat st;
   int failed = !path;
-  if (path && stat(path, &st) == 0 && S_ISREG(st.st_mode) && !is_baked_map(c, path))
+  if (path && stat(path, &st) == 0 && S_ISREG(st.st_mode) && !is_baked_map(path))
     failed = add_input(l, path) != 0;
   if (failed)
     cli_file_error(path ? path : dir, "out of memory");
@@ -184,12 +183,12 @@ static int add_directory_entry(const cli_batch_client *c, input_list *l, const c
   return failed ? BB_EXIT_FAILURE : 0;
 }
 
-static int add_directory(const cli_batch_client *c, input_list *l, const char *dir) {
+static int add_directory(input_list *l, const char *dir) {
   char **names;
   int count = read_directory(dir, &names), rc = count < 0 ? BB_EXIT_FAILURE : 0;
   for (int i = 0; i < count; i++) {
     if (!rc)
-      rc = add_directory_entry(c, l, dir, names[i]);
+      rc = add_directory_entry(l, dir, names[i]);
     free(names[i]);
   }
   free(names);
@@ -203,7 +202,7 @@ static int gather_inputs(const cli_batch_client *c, char *const *inputs, int inp
   for (int i = 0; i < input_count && !rc; i++) {
     struct stat st;
     if (stat(inputs[i], &st) == 0 && S_ISDIR(st.st_mode)) {
-      rc = add_directory(c, &l, inputs[i]);
+      rc = add_directory(&l, inputs[i]);
     } else if (add_input(&l, inputs[i]) != 0) { /* a missing file fails at its bake */
       cli_file_error(inputs[i], "out of memory");
       rc = BB_EXIT_FAILURE;
@@ -278,10 +277,10 @@ static int name_outputs(const cli_batch_client *c, const cli_batch_args *b, cons
   char stem[1024], ext[64], name[4096];
   split_name(item->input, stem, sizeof stem, ext, sizeof ext);
   const char *tmpl = b->name_template ? b->name_template : CLI_BATCH_DEFAULT_NAME;
-  for (int k = 0; k < c->kind_count; k++) {
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
     if (!chosen[k])
       continue;
-    const char *fields[3] = {stem, c->kinds[k].name, ext};
+    const char *fields[3] = {stem, cli_batch_kind_name(k), ext};
     int rc = expand_name(c->command, tmpl, fields, name, sizeof name);
     if (rc)
       return rc;
@@ -317,8 +316,8 @@ static int check_clashes(const cli_batch_client *c, const cli_batch_plan *plan,
     const planned_output *a = &outs[i - 1], *o = &outs[i];
     if (a->item == o->item)
       return cli_usage_error(c->command, "%s: %s and %s would both be written to %s",
-                             plan->items[a->item].input, c->kinds[a->kind].name,
-                             c->kinds[o->kind].name, o->path);
+                             plan->items[a->item].input, cli_batch_kind_name(a->kind),
+                             cli_batch_kind_name(o->kind), o->path);
     return cli_usage_error(c->command, "%s and %s would both be written to %s",
                            plan->items[a->item].input, plan->items[o->item].input, o->path);
   }
@@ -342,7 +341,7 @@ static int check_outputs_on_inputs(const cli_batch_client *c, const cli_batch_pl
     for (int j = 0; j < plan->count && out.exists && !rc; j++)
       if (same_file_id(in[j], out))
         rc = cli_usage_error(c->command, "%s: %s of %s would overwrite the input %s",
-                             outs[i].path, c->kinds[outs[i].kind].name,
+                             outs[i].path, cli_batch_kind_name(outs[i].kind),
                              plan->items[outs[i].item].input, plan->items[j].input);
   }
   free(in);
@@ -351,13 +350,13 @@ static int check_outputs_on_inputs(const cli_batch_client *c, const cli_batch_pl
 
 static int check_paths(const cli_batch_client *c, const cli_batch_plan *plan) {
   int n = 0;
-  planned_output *outs = malloc((size_t)plan->count * (size_t)c->kind_count * sizeof *outs);
+  planned_output *outs = malloc((size_t)plan->count * (size_t)BB_OUTPUT_KIND_COUNT * sizeof *outs);
   if (!outs) {
     cli_file_error(plan->items[0].input, "out of memory");
     return BB_EXIT_FAILURE;
   }
   for (int i = 0; i < plan->count; i++)
-    for (int k = 0; k < c->kind_count; k++)
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       if (plan->items[i].paths[k])
         outs[n++] = (planned_output){plan->items[i].paths[k], i, k};
   int rc = check_outputs_on_inputs(c, plan, outs, n);
