@@ -854,7 +854,7 @@ typedef enum bb_output_state {
  * (nonzero): without it nothing is CURRENT. A file that cannot be read is
  * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
  * may be NULL) receives why it is not CURRENT, one line ("no such file",
- * "scale: 8 -> 16", "bumpbake_version: 0.0.9 -> 0.1.0", "16-bit samples;
+ * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
  * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
  * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
  * BB_ERR_MEMORY. */
