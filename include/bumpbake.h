@@ -206,6 +206,12 @@ const char *bb_staged_file_path(const bb_staged_file *staged);
  * further ones are still removed on errors, but not by this function. */
 void bb_tempfiles_remove(void);
 
+/* True (1) when the extension of path (any case) is one OpenImageIO has a
+ * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
+ * caller can pick the images out of a directory without opening each file.
+ * It says nothing of the file's contents. */
+int bb_path_is_readable_format(const char *path);
+
 /* True (1) when the extension of path names a format bb_image_write knows. */
 int bb_path_is_writable_format(const char *path);
 
@@ -760,11 +766,14 @@ typedef struct bb_provenance {
   const bb_bake_options *options;
   bb_channel channel;         /* height channel rule used */
   const char *rayset_id;      /* bb_rayset.id, or NULL when nothing was traced */
+  uint64_t input_file_hash;   /* bb_file_hash of the input file's bytes, or 0:
+                                 unknown (the key is then left out) */
 } bb_provenance;
 
 /* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
- * output, scale, rays, rayset, filter_radius, filter_threshold, bias, power,
- * basis, normal_filter, normal_y, addressing, channel), malloc'd; the caller
+ * input_file_hash when known, output, scale, rays, rayset, filter_radius,
+ * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
+ * channel), malloc'd; the caller
  * frees it. A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
  * Returns NULL when out of memory. */
@@ -798,6 +807,60 @@ bb_provenance_class bb_provenance_classify(const char *description);
 int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
 
 const char *bb_channel_name(bb_channel c);
+
+/* ------------------------------------------------------------ incremental */
+
+/* What a build tool needs to skip a bake whose outputs are already what it
+ * would write: a hash of the input file, recorded in every output's
+ * provenance (input_file_hash), and a check of an existing output that reads
+ * only its header. */
+
+/* 64-bit FNV-1a hash of the bytes of the file at path, read in blocks (any
+ * size, constant memory), into *hash. It is what provenance records as
+ * input_file_hash, so a later run can tell an input is unchanged without
+ * decoding it. Errors: BB_ERR_IO (missing, unreadable, not a regular file),
+ * with the system's reason. */
+bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
+
+/* The rayset id bb_bake records in result->rayset_id for options o (slices
+ * from o->slices, or from o->rays; power; basis), computed without building
+ * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
+ * any id). "" when o->outputs asks for no traced kind: nothing is traced
+ * then, and provenance says rayset=none. */
+void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
+
+/* Whether an existing output is what writing it now would make. */
+typedef enum bb_output_state {
+  BB_OUTPUT_CURRENT = 0, /* made from the same input bytes, with the same
+                            parameters and bumpbake version, depth and mips */
+  BB_OUTPUT_MISSING,     /* no file at the path */
+  BB_OUTPUT_STALE        /* a file, but made otherwise, or not known to be
+                            current (no or damaged provenance, unreadable) */
+} bb_output_state;
+
+/* Decides from the header of the file at path alone (bb_image_read_info;
+ * no pixel is decoded) whether it is what writing the output described by
+ * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
+ * 1), would make now. CURRENT when its provenance is bumpbake's, intact
+ * (bb_provenance_classify), and holds every key bb_provenance_format(expected)
+ * writes with the same value, and no key that text lacks, except "command"
+ * and "input" (the command line and the input's name, which do not change a
+ * pixel) and "input_hash" (the decoded height's hash, implied by
+ * input_file_hash and channel): so the bumpbake version, the input file's
+ * bytes, the output kind and every parameter that affects pixels must
+ * match; and when its samples have the depth `depth` gives in path's format
+ * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
+ * level exactly when mip_mapped. expected->input_file_hash must be set
+ * (nonzero): without it nothing is CURRENT. A file that cannot be read is
+ * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
+ * may be NULL) receives why it is not CURRENT, one line ("no such file",
+ * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
+ * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
+ * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
+ * BB_ERR_MEMORY. */
+bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
+                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
+                          bb_error *err);
 
 /* ----------------------------------------------------------------- meshes */
 

@@ -1,5 +1,6 @@
 /* cli_bake.c: `bumpbake bake`, every map from one height map in one pass
  * (one bb_bake call, so ssbump, ao and bent share a single trace). */
+#include "cli_batch.h"
 #include "cli_common.h"
 #include "cli_slope.h"
 
@@ -96,6 +97,12 @@ static const cli_option *const bake_options[] = {
     &cli_opt_slope,
     &cli_opt_slope_lit,
     &opt_prefix,
+    &cli_opt_out_dir,
+    &cli_opt_maps,
+    &cli_opt_name,
+    &cli_opt_keep_going,
+    &cli_opt_force,
+    &cli_opt_depfile,
     &opt_json,
     &opt_quiet,
     &cli_opt_help,
@@ -103,7 +110,8 @@ static const cli_option *const bake_options[] = {
 
 static const cli_command bake_command = {
     "bake",
-    "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ...)",
+    "HEIGHT --scale S [OPTIONS] (-o PREFIX | --normal FILE | --ssbump FILE | ... | "
+    "--out-dir DIR)",
     "Bakes the requested maps from HEIGHT in one pass; tracing runs only when\n"
     "ssbump, ao or bent is asked for. Tracing finds each texel's exact horizon\n"
     "in each azimuth slice and integrates the slice above it exactly; what is\n"
@@ -114,7 +122,13 @@ static const cli_command bake_command = {
     "  256 rays       16     ~1.8 s   0.0004   0.0010   (the default)\n"
     "  1024 rays      32     ~7.4 s   0.0001   0.0004\n"
     "With --clamp the trace takes about twice as long. See the README's\n"
-    "Performance and Accuracy.",
+    "Performance and Accuracy.\n"
+    "\n"
+    "Batches: bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST]\n"
+    "bakes every HEIGHT (a directory: the images in it, sorted, not below it)\n"
+    "in one process into DIR/--name, and skips an input whose outputs are\n"
+    "up to date: their provenance names the same input bytes, parameters\n"
+    "and bumpbake version (--force bakes anyway).",
     bake_options,
     (int)(sizeof bake_options / sizeof bake_options[0]),
     cli_settings_init,
@@ -127,6 +141,8 @@ typedef struct bake_args {
   const char *prefix;
   int json, quiet;
   cli_slope_args slope; /* --slope FILE, --lit AZ,EL */
+  cli_batch_args batch; /* --out-dir, --maps, --name, ..., --depfile */
+  const char *json_status; /* a batch's "status" field of the JSON line */
 } bake_args;
 
 static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -137,6 +153,10 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   }
   if (cli_slope_owns(opt))
     return cli_slope_option(bake_command.name, &a->slope, opt, arg);
+  if (cli_batch_owns(opt))
+    return cli_batch_option(&a->batch, opt, arg);
+  if (opt->id == CLI_OPT_BASIS)
+    a->batch.basis_arg = arg; /* a basis file is a dependency of the bake */
   switch (opt->id) {
   case CLI_OPT_OUTPUT:
     a->prefix = arg;
@@ -238,20 +258,43 @@ static int check_outputs(bake_args *a, const char *input) {
   return rc ? rc : check_slope_names(a);
 }
 
-static int bake_parse(int argc, char **argv, bake_args *a, const char **input) {
-  int first = 0;
-  int rc = cli_parse_options(&bake_command, argc, argv, bake_option, a, &first);
+/* A batch names its outputs itself (--maps, --name). */
+static int check_batch_args(const bake_args *a) {
+  int named = a->prefix || a->slope.path;
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    named |= a->paths[k] != NULL;
+  if (!named)
+    return 0;
+  return cli_usage_error(bake_command.name, "--out-dir names the outputs: choose the maps "
+                                            "with --maps, not -o, --MAP FILE or --slope");
+}
+
+static int check_positionals(const bake_args *a, int argc, char **argv, int first) {
+  if (argc - first > 1 && !a->batch.out_dir)
+    return cli_usage_error(bake_command.name, "several HEIGHT files need --out-dir DIR");
+  return cli_expect_positionals(&bake_command, argc, argv, first,
+                                a->batch.out_dir && argc - first > 1 ? argc - first : 1,
+                                "HEIGHT");
+}
+
+/* Parses and checks the command line; *first receives the index of the
+ * first HEIGHT. */
+static int bake_parse(int argc, char **argv, bake_args *a, int *first) {
+  int rc = cli_parse_options(&bake_command, argc, argv, bake_option, a, first);
+  if (!rc && !a->batch.out_dir)
+    rc = cli_batch_check_single(bake_command.name, &a->batch);
   if (!rc)
-    rc = cli_expect_positionals(&bake_command, argc, argv, first, 1, "HEIGHT");
+    rc = check_positionals(a, argc, argv, *first);
   if (rc)
     return rc;
-  *input = argv[first];
   if (!a->settings.scale_given)
     return cli_usage_error(
         bake_command.name,
         "--scale is required (texels of displacement per unit of height)");
+  if (a->batch.out_dir)
+    return check_batch_args(a);
   rc = expand_prefix(a);
-  return rc ? rc : check_outputs(a, *input);
+  return rc ? rc : check_outputs(a, argv[*first]);
 }
 
 static int traced(const bake_args *a) {
@@ -272,6 +315,8 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json j = {stdout, 0};
   cli_json_open(&j, NULL, '{');
   cli_json_string(&j, "input", input);
+  if (a->json_status)
+    cli_json_string(&j, "status", a->json_status);
   cli_json_number(&j, "width", height->width);
   cli_json_number(&j, "height", height->height);
 
@@ -415,16 +460,24 @@ static unsigned asked_outputs(const bake_args *a) {
 }
 
 
-/* write_outputs, with the filtered height at the input's depth unless
- * --depth says otherwise (a 16-bit height stays 16-bit where the format
- * can hold it). */
+/* The depth of kind's file at path: --depth, but the filtered height keeps
+ * the input's depth unless --depth says otherwise (a 16-bit height stays
+ * 16-bit where the format can hold it). */
+static bb_depth output_depth(const cli_settings *s, const cli_height_source *source, int kind,
+                             const char *path) {
+  if (kind == BB_OUTPUT_FILTERED && s->depth == BB_DEPTH_DEFAULT)
+    return cli_depth_like_input(source, path);
+  return s->depth;
+}
+
+/* write_outputs, with the filtered height at output_depth. */
 static int write_outputs_keeping_depth(const bake_args *a, cli_run *run,
                                        const bb_bake_result *r, const slope_outputs *slope,
                                        const cli_height_source *source) {
   cli_settings filtered_settings = *run->settings;
   const char *path = a->paths[BB_OUTPUT_FILTERED];
-  if (path && filtered_settings.depth == BB_DEPTH_DEFAULT)
-    filtered_settings.depth = cli_depth_like_input(source, path);
+  if (path)
+    filtered_settings.depth = output_depth(run->settings, source, BB_OUTPUT_FILTERED, path);
   cli_run filtered_run = *run;
   filtered_run.settings = &filtered_settings;
   return write_outputs(a, run, r, slope, &filtered_run);
@@ -437,6 +490,10 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   bake_timing t = {0, 0};
   a->settings.bake.outputs = asked_outputs(a);
 
+  /* The bytes hashed before they are decoded: provenance must never pair
+   * a newer file's hash with an older file's pixels. */
+  if (!run->input_file_hash && bb_file_hash(input, &run->input_file_hash, NULL) != BB_OK)
+    run->input_file_hash = 0;
   double t0 = cli_now_seconds();
   cli_height_source source;
   int rc = cli_load_height_source(input, &a->settings, &height, &source);
@@ -465,6 +522,69 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   return rc;
 }
 
+/* --depfile of a single bake: every file it wrote depends on the input. */
+static int write_depfile(const bake_args *a, const char *input) {
+  const char *outputs[MAX_OUTPUTS];
+  int n = 0;
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    if (a->paths[k])
+      outputs[n++] = a->paths[k];
+  if (a->slope.path)
+    outputs[n++] = a->slope.path;
+  if (a->slope.lit_path)
+    outputs[n++] = a->slope.lit_path;
+  return cli_batch_write_depfile(&a->batch, &a->settings, input, outputs, n);
+}
+
+static int bake_single(cli_run *run, bake_args *a, const char *input) {
+  int rc = bake_run(run, a, input);
+  return rc == 0 && a->batch.depfile ? write_depfile(a, input) : rc;
+}
+
+/* ---------------------------------------------------------------- batches */
+
+static void set_batch_paths(bake_args *a, const char *const *paths) {
+  for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
+    a->paths[k] = paths[k];
+}
+
+static int batch_check(void *ctx, const char *input, const char *const *paths) {
+  bake_args *a = ctx;
+  set_batch_paths(a, paths);
+  return check_outputs(a, input);
+}
+
+static int batch_bake(void *ctx, cli_run *run, const char *input, const char *const *paths) {
+  bake_args *a = ctx;
+  set_batch_paths(a, paths);
+  a->json_status = "baked";
+  return bake_run(run, a, input);
+}
+
+/* output_depth for a batch's up-to-date check, from the input's header
+ * (the bake itself takes it from the decoded file). */
+static bb_depth batch_depth(void *ctx, const char *input, int kind, const char *path) {
+  const bake_args *a = ctx;
+  if (kind != BB_OUTPUT_FILTERED || a->settings.depth != BB_DEPTH_DEFAULT)
+    return a->settings.depth;
+  bb_image_info info;
+  int saved = cli_mute_stderr();
+  bb_status st = bb_image_read_info(input, NULL, NULL, NULL, &info, NULL);
+  cli_unmute_stderr(saved);
+  if (st != BB_OK)
+    return a->settings.depth; /* the bake will say what is wrong */
+  cli_height_source source = {.bits_per_sample = info.bits_per_sample,
+                              .is_float = info.is_float};
+  bb_image_info_free(&info);
+  return output_depth(&a->settings, &source, kind, path);
+}
+
+static int run_batch(cli_run *run, bake_args *a, int argc, char **argv, int first) {
+  cli_batch_client client = {bake_command.name, prefix_kinds, &a->settings, a->json, a->quiet,
+                             a, batch_check, batch_depth, batch_bake};
+  return cli_batch_run(&client, &a->batch, run, argc, argv, first);
+}
+
 int bb_cli_bake(int argc, char **argv) {
   cli_run run;
   if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
@@ -472,12 +592,14 @@ int bb_cli_bake(int argc, char **argv) {
   bake_args a;
   memset(&a, 0, sizeof a);
   cli_settings_init(&a.settings);
-  const char *input = NULL;
-  int rc = bake_parse(argc, argv, &a, &input);
+  int first = 0;
+  int rc = bake_parse(argc, argv, &a, &first);
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0 && a.batch.out_dir)
+    rc = run_batch(&run, &a, argc, argv, first);
   else if (rc == 0)
-    rc = bake_run(&run, &a, input);
+    rc = bake_single(&run, &a, argv[first]);
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     free(a.prefix_paths[k]);
   cli_slope_free(&a.slope);

@@ -41,7 +41,7 @@ int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *i
                    bb_range range, bb_depth depth, int mips) {
   bb_provenance p = {
       run->command_line, input_name, input ? bb_image_hash(input) : 0, kind, NULL,
-      BB_CHANNEL_AUTO,   NULL};
+      BB_CHANNEL_AUTO,   NULL, run->input_file_hash};
   char *description = bb_provenance_format(&p);
   if (!description) {
     cli_file_error(path, "out of memory");

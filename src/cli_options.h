@@ -40,7 +40,14 @@ typedef enum cli_opt_id {
   CLI_OPT_VALVE_AO_ALPHA, /* -A */
   CLI_OPT_VALVE_DUMP,     /* -D */
   CLI_OPT_VALVE_DETAIL,   /* -d */
-  CLI_OPT_MIPS            /* --mips */
+  CLI_OPT_MIPS,           /* --mips */
+  /* bake's batches (cli_batch.h) */
+  CLI_OPT_OUT_DIR,
+  CLI_OPT_NAME,
+  CLI_OPT_MAPS,
+  CLI_OPT_KEEP_GOING,
+  CLI_OPT_FORCE,
+  CLI_OPT_DEPFILE
 } cli_opt_id;
 
 /* One row of a subcommand's option table: getopt_long's struct option and

@@ -198,6 +198,8 @@ void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *hei
                        const cli_settings *settings) {
   run->input_path = input_path;
   run->input_hash = bb_image_hash(height);
+  if (!run->input_file_hash && bb_file_hash(input_path, &run->input_file_hash, NULL) != BB_OK)
+    run->input_file_hash = 0; /* provenance then leaves the key out */
   run->settings = settings;
 }
 
@@ -212,7 +214,8 @@ static bb_status output_options(const cli_run *run, const char *kind, bb_range r
                                 bb_write_options *wo, char **description, bb_error *err) {
   bb_provenance p = {
       run->command_line,    file_name_of(run->input_path), run->input_hash, kind,
-      &run->settings->bake, run->settings->channel,        run->rayset_id};
+      &run->settings->bake, run->settings->channel,        run->rayset_id,
+      run->input_file_hash};
   *description = bb_provenance_format(&p);
   if (!*description) {
     snprintf(err->message, sizeof err->message, "out of memory");

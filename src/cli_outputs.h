@@ -43,6 +43,7 @@ typedef struct cli_run {
   char *command_line; /* "bumpbake " + argv joined with spaces */
   const char *input_path;
   uint64_t input_hash; /* bb_image_hash of the decoded height */
+  uint64_t input_file_hash; /* bb_file_hash of the input file; 0 = not yet */
   const cli_settings *settings;
   const char *rayset_id; /* NULL when nothing was traced */
   double seconds_write;  /* summed over cli_write_output calls */
@@ -54,7 +55,9 @@ typedef struct cli_run {
  * memory, after printing why. */
 int cli_run_init(cli_run *run, int argc, char **argv);
 /* Records the input once it is loaded: its path, the hash of its decoded
- * height and the settings the outputs are made with. */
+ * height and the settings the outputs are made with; and the hash of the
+ * input file's bytes, unless the caller set input_file_hash before loading
+ * (bake does, to record the bytes it then decoded). */
 void cli_run_set_input(cli_run *run, const char *input_path, const bb_image *height,
                        const cli_settings *settings);
 void cli_run_free(cli_run *run);

@@ -156,7 +156,8 @@ static char *describe(const cli_run *run, const bb_bake_options *bake, const cha
                      kind,
                      bake,
                      run->settings ? run->settings->channel : BB_CHANNEL_AUTO,
-                     run->rayset_id};
+                     run->rayset_id,
+                     run->input_file_hash};
   char *base = bb_provenance_format(&p);
   if (!base || !extra)
     return base;

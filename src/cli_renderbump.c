@@ -234,7 +234,7 @@ static char *describe(const cli_run *run, const rbf_args *a, uint64_t model_hash
                       const char *kind, const bb_renderbump_result *r) {
   const char *slash = strrchr(a->model, '/');
   bb_provenance p = {run->command_line, slash ? slash + 1 : a->model, model_hash, kind,
-                     NULL, BB_CHANNEL_AUTO, NULL};
+                     NULL, BB_CHANNEL_AUTO, NULL, 0};
   char *common = bb_provenance_format(&p), *own = bb_renderbump_describe(&a->render, r);
   char *all = NULL;
   if (common && own) {

@@ -140,6 +140,26 @@ bb_status bb__text_draw(bb_image *img, int center_x, int baseline_y, const char 
  * rows * (row_chars + 1) bytes. Returns how many lines did not fit. */
 int bb__provenance_pack(const char *description, int rows, int row_chars, char *out);
 
+/* 1 when two provenance texts differ in a key not in `ignored` (a
+ * NULL-terminated list): a key of want missing from have or holding
+ * another value there, or a key have holds and want lacks (first
+ * occurrences count). reason (capacity cap, may be NULL) receives the first
+ * such key as "key: have-value -> want-value" ("(none)" for a missing one).
+ * 0 when they agree. */
+int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
+                            char *reason, size_t cap);
+
+/* The id bb_rayset_make gives a rayset of these parameters, into out
+ * (capacity cap), without building it. */
+void bb__rayset_id(int slices, double power, const bb_basis *basis, char *out, size_t cap);
+
+/* Image headers for bb_output_check (io_oiio.cpp): the depth bb_image_write
+ * stores for `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1
+ * for an unknown extension; and the number of mip levels of subimage 0 of
+ * the file at path, from its headers. */
+int bb__path_resolved_depth(const char *path, bb_depth depth);
+bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
+
 /* ------------------------------------------------- safe file writing
  * Every writer (src/safe_file.c; OpenImageIO writers reach it through
  * write_safely() in src/io_oiio.cpp) puts bytes on disk this way, so that

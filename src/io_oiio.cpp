@@ -1249,6 +1249,65 @@ int bb_path_max_channels(const char *path) {
   }
 }
 
+int bb__path_resolved_depth(const char *path, bb_depth depth) {
+  if (!path) return -1;
+  try {
+    const format_rule *f = find_format(extension_of(path));
+    if (!f) return -1;
+    return depth == BB_DEPTH_DEFAULT ? f->default_depth : depth;
+  } catch (...) {
+    return -1;
+  }
+}
+
+// Headers only: each level's spec, never its pixels.
+bb_status bb__image_level_count(const char *path, int *levels, bb_error *err) {
+  *levels = 0;
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_level_count: path is NULL");
+  try {
+    bb_status st;
+    opened_input opened = open_input(path, &st, err);
+    if (!opened.in) return st;
+    while (opened.in->seek_subimage(0, *levels)) ++*levels;
+    (void)opened.in->geterror(); // the failed seek past the last level queued a message
+    return BB_OK;
+  } catch (const std::bad_alloc &) {
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
+  } catch (const std::exception &e) {
+    return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
+  } catch (...) {
+    return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
+  }
+}
+
+int bb_path_is_readable_format(const char *path) {
+  if (!path) return 0;
+  try {
+    std::string ext = extension_of(path);
+    if (ext.size() < 2) return 0;
+    ext.erase(0, 1);
+    // "tiff:tif,tiff;png:png;...": a format, then its extensions.
+    const std::string list = OIIO::get_string_attribute("extension_list");
+    size_t pos = 0;
+    while (pos < list.size()) {
+      size_t end = list.find(';', pos);
+      if (end == std::string::npos) end = list.size();
+      size_t colon = list.find(':', pos);
+      size_t at = colon != std::string::npos && colon < end ? colon + 1 : pos;
+      while (at < end) {
+        size_t comma = list.find(',', at);
+        if (comma == std::string::npos || comma > end) comma = end;
+        if (list.compare(at, comma - at, ext) == 0) return 1;
+        at = comma + 1;
+      }
+      pos = end + 1;
+    }
+    return 0;
+  } catch (...) {
+    return 0;
+  }
+}
+
 int bb_path_is_writable_format(const char *path) {
   if (!path) return 0;
   try {

@@ -163,6 +163,10 @@ char *bb_provenance_format(const bb_provenance *p) {
   put(&t, "command", p->command);
   put(&t, "input", p->input_name);
   put(&t, "input_hash", hash);
+  if (p->input_file_hash) {
+    snprintf(hash, sizeof hash, "%016" PRIx64, p->input_file_hash);
+    put(&t, "input_file_hash", hash);
+  }
   put(&t, "output", p->output_kind);
   /* The key order is fixed so two texts line up when read side by side. */
   if (p->options)
@@ -385,6 +389,47 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   return differing;
 }
 
+/* ------------------------------------------------------------ mismatch */
+
+static int is_listed(const entry *e, const char *const *keys) {
+  for (; keys && *keys; keys++)
+    if (e->key_length == strlen(*keys) && memcmp(e->key, *keys, e->key_length) == 0)
+      return 1;
+  return 0;
+}
+
+/* The first key of `from` (not ignored) that `other` does not hold with
+ * the same value, reported as "key: have -> want"; 0 when there is none.
+ * Linear in the size of each text times the lines of the other, and `want`
+ * is the short text bb_provenance_format made. */
+static int first_missing(const char *from, const char *other, int from_is_have,
+                         const char *const *ignored, char *reason, size_t cap) {
+  entry e, o;
+  for (const char *cursor = from; next_entry(&cursor, &e);) {
+    if (!e.key_length || is_listed(&e, ignored))
+      continue;
+    int found = find_entry(other, e.key, e.key_length, &o);
+    if (found && same_value(&e, &o))
+      continue;
+    size_t used = 0;
+    const entry *have = from_is_have ? &e : (found ? &o : NULL);
+    const entry *want = from_is_have ? (found ? &o : NULL) : &e;
+    report(reason, cap, &used, &e, have, want);
+    if (reason && cap && used && reason[used - 1] == '\n')
+      reason[used - 1] = '\0';
+    return 1;
+  }
+  return 0;
+}
+
+int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
+                            char *reason, size_t cap) {
+  if (reason && cap)
+    reason[0] = '\0';
+  return first_missing(want, have, 0, ignored, reason, cap) ||
+         first_missing(have, want, 1, ignored, reason, cap);
+}
+
 /* ---------------------------------------------------------------- classify */
 
 static int is_key_char(char ch) {
@@ -427,7 +472,8 @@ bb_provenance_class bb_provenance_classify(const char *description) {
  * names the file, and the long command line last. NULL marks where the
  * other keys go; lines of one rank keep their text order. */
 static const char *const PACK_ORDER[] = {
-    "bumpbake_version", "input_hash", "scale", "rays",   "rayset",        "filter_radius",
+    "bumpbake_version", "input_hash", "input_file_hash", "scale", "rays", "rayset",
+    "filter_radius",
     "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
     "addressing",       "channel",    NULL,    "output", "input",         "command"};
 enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };

@@ -152,13 +152,17 @@ bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int t
     bb_rayset_free(out);
     return st;
   }
+  bb__rayset_id(slices, power, basis, out->id, sizeof out->id);
+  return BB_OK;
+}
+
+void bb__rayset_id(int slices, double power, const bb_basis *basis, char *out, size_t cap) {
   /* At most 57 characters (256 slices, power 1.23457e+06, a vectors: name);
    * the larger buffer only keeps the compiler from counting wider. */
   char id[160];
   snprintf(id, sizeof id, "bb-horizon-v1:a%d:p%g:%.*s", slices, power,
            (int)sizeof basis->name, basis->name);
-  snprintf(out->id, sizeof out->id, "%.63s", id);
-  return BB_OK;
+  snprintf(out, cap, "%.63s", id);
 }
 
 void bb_rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked) {

@@ -11,7 +11,8 @@
 # dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps,
 # 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
 # (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
-# libbumpbake.so), then a summary table. Everything it writes goes into
+# libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
+# one process against one process each), then a summary table. Everything it writes goes into
 # build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -563,6 +564,18 @@ fi
 # startup_field NAME COLUMN: a column of bench_startup's row for NAME.
 startup_field() { awk -v n="$1" -v c="$2" '$1 == n { print $c }' "$out/startup.txt"; }
 
+# ------------------------------------------------------------- 8. batches
+
+section "8. Batches: 20 bakes of 256 x 256 in one process against one process each"
+batch_ok=0
+if tools/bench_batch.sh -n 20 -r 3 "$bin" | tee "$out/batch.txt"; then
+  batch_ok=1
+else
+  fail "tools/bench_batch.sh failed"
+fi
+# batch_field LABEL_START COLUMN: a column (counted from the end) of bench_batch's row.
+batch_field() { awk -v l="$1" -v c="$2" 'index($0, l) == 1 { print $(NF - c) }' "$out/batch.txt"; }
+
 # -------------------------------------------------------------- summary
 
 summary_row() { printf '%-46s %14s  %s\n' "$1" "$2" "${3:-}"; }
@@ -604,6 +617,13 @@ if [ "$startup_ok" = 1 ]; then
     summary_row "start-up, $variant (s)" "$(startup_field "$variant" 2)" \
       "x$(startup_field "$variant" 5) of static; $(startup_field "$variant" 6) M instructions"
   done
+fi
+if [ "$batch_ok" = 1 ]; then
+  summary_row "bake per 256^2 file, one process each (s)" "$(batch_field "one process per file" 1)"
+  summary_row "bake per 256^2 file, in one batch (s)" "$(batch_field "one batch process" 1)" \
+    "x$(batch_field "one batch process" 0) of one process each"
+  summary_row "batch per file, all up to date (s)" "$(batch_field "batch, all up to date" 1)" \
+    "x$(batch_field "batch, all up to date" 0)"
 fi
 if [ "${#acc_rows[@]}" -gt 0 ]; then
   echo

@@ -275,6 +275,20 @@ def read(path):
         _lib.bb_image_info_free(info)
 
 
+def file_hash(path):
+    """The 64-bit FNV-1a hash of a file's bytes, as an int: what every map
+    bumpbake writes records of its input as input_file_hash (16 hex
+    digits), so a pipeline can tell which input a map was baked from, and
+    whether it changed since, without decoding it. Raises Error with the
+    library's message when the file cannot be read."""
+    value = _ffi.new("uint64_t *")
+    err = _ffi.new("bb_error *")
+    st = _lib.bb_file_hash(os.fsencode(path), value, err)
+    if st != _lib.BB_OK:
+        _raise_status(st, err)
+    return int(value[0])
+
+
 def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filter_radius=None,
          filter_threshold=None, bias=None, power=None, basis=None, normal_filter=None,
          normal_y=None, clamp=None, channel="auto", threads=None):

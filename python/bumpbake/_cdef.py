@@ -165,6 +165,7 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
+bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
 """
 
 CDEF = TYPES + FUNCTIONS

@@ -306,3 +306,18 @@ def test_a_missing_library_fails_import_with_a_hint(tmp_path):
     assert out.returncode != 0
     assert "ImportError: bumpbake: cannot load" in out.stderr
     assert "nowhere.so (missing)" in out.stderr
+
+
+@pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
+def test_file_hash_is_what_the_command_line_records(tmp_path):
+    src = os.path.join(FIXTURES, "rock06_128.png")
+    out = tmp_path / "n.png"
+    subprocess.run([BIN, "bake", src, "--scale", "8", "--normal", str(out), "-q"], check=True)
+    info = subprocess.run([BIN, "info", str(out)], check=True, capture_output=True,
+                          text=True).stdout
+    recorded = re.search(r"input_file_hash=([0-9a-f]{16})", info).group(1)
+    assert f"{bumpbake.file_hash(src):016x}" == recorded
+    (tmp_path / "a").write_bytes(b"a")
+    assert bumpbake.file_hash(tmp_path / "a") == 0xaf63dc4c8601ec8c  # FNV-1a 64 of "a"
+    with pytest.raises(bumpbake.Error, match="cannot read"):
+        bumpbake.file_hash(tmp_path / "missing.png")

@@ -1,0 +1,96 @@
+/* cli_depfile.c: Make/Ninja depfiles ("outputs: inputs"), so make -j and
+ * ninja (depfile = ..., deps = gcc) learn what a bake reads. */
+#include "cli_batch.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Writes name escaped as GCC's depfiles escape it; -1 on a write error. */
+static int put_name(FILE *f, const char *name) {
+  for (const char *s = name; *s; s++) {
+    int ok;
+    if (*s == ' ' || *s == '#')
+      ok = fputc('\\', f) != EOF && fputc(*s, f) != EOF;
+    else if (*s == '$')
+      ok = fputs("$$", f) != EOF;
+    else
+      ok = fputc(*s, f) != EOF;
+    if (!ok)
+      return -1;
+  }
+  return 0;
+}
+
+static int put_names(FILE *f, const char *const *names, int count) {
+  for (int i = 0; i < count; i++)
+    if (fputc(' ', f) == EOF || put_name(f, names[i]) != 0)
+      return -1;
+  return 0;
+}
+
+static int put_rule(FILE *f, const cli_dep_rule *r) {
+  if (r->target_count < 1)
+    return 0;
+  /* The first target without the leading space of put_names. */
+  if (put_name(f, r->targets[0]) != 0 || put_names(f, r->targets + 1, r->target_count - 1) ||
+      fputc(':', f) == EOF || put_names(f, r->prerequisites, r->prerequisite_count) ||
+      fputc('\n', f) == EOF)
+    return -1;
+  return 0;
+}
+
+static const char *unwritable_name(const cli_dep_rule *rules, int count) {
+  for (int i = 0; i < count; i++) {
+    for (int t = 0; t < rules[i].target_count; t++)
+      if (strchr(rules[i].targets[t], '\n'))
+        return rules[i].targets[t];
+    for (int p = 0; p < rules[i].prerequisite_count; p++)
+      if (strchr(rules[i].prerequisites[p], '\n'))
+        return rules[i].prerequisites[p];
+  }
+  return NULL;
+}
+
+/* Writes the rules to the open temporary and closes it, every step
+ * checked; returns 0 or the errno of the failure. */
+static int write_and_close(FILE *f, const cli_dep_rule *rules, int count) {
+  int failed = 0;
+  for (int i = 0; i < count && !failed; i++)
+    failed = put_rule(f, &rules[i]) != 0;
+  if (!failed)
+    failed = fflush(f) != 0 || fsync(fileno(f)) != 0;
+  int saved = failed ? (errno ? errno : EIO) : 0;
+  if (fclose(f) != 0 && !saved)
+    saved = errno ? errno : EIO;
+  return saved;
+}
+
+int cli_depfile_write(const char *path, const cli_dep_rule *rules, int count) {
+  const char *bad = unwritable_name(rules, count);
+  if (bad) {
+    cli_file_error(path, "a file name holds a newline, which a depfile cannot say");
+    return BB_EXIT_FAILURE;
+  }
+  size_t len = strlen(path) + 32;
+  char *temp = malloc(len);
+  if (!temp) {
+    cli_file_error(path, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  snprintf(temp, len, "%s.tmp-%ld", path, (long)getpid());
+  FILE *f = fopen(temp, "w");
+  int error = f ? write_and_close(f, rules, count) : errno;
+  if (!error && rename(temp, path) != 0)
+    error = errno;
+  if (error) {
+    if (f)
+      unlink(temp);
+    char reason[256];
+    snprintf(reason, sizeof reason, "cannot write the depfile: %s", strerror(error));
+    cli_file_error(path, reason);
+  }
+  free(temp);
+  return error ? BB_EXIT_FAILURE : 0;
+}
