@@ -117,10 +117,11 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # through OpenImageIO's FreeType text; without a font they are left out).
 PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
-# check their exit codes agree (skipped without it).
+# check their exit codes agree; ninja-build: a test has ninja read a bake's
+# --depfile. Both tests skip without them, so ensure-deps installs them.
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools
+            openimageio-tools ninja-build
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -129,6 +130,7 @@ deps:
 ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
+	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
 	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
