@@ -183,6 +183,15 @@ static inline const char *tmp(const char *name) {
   return harness_paths[harness_path_count++] = path;
 }
 
+/* Writes size bytes to path (a new file); the test fails if it cannot. */
+static inline void write_bytes(const char *path, const void *data, size_t size) {
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f, "cannot create %s", path);
+  if (size)
+    cr_assert_eq(fwrite(data, 1, size, f), size);
+  cr_assert_eq(fclose(f), 0);
+}
+
 static inline int file_exists(const char *path) {
   struct stat st;
   return stat(path, &st) == 0;

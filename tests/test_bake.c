@@ -7,21 +7,9 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bake_harness.h"
 
 static const double PI = 3.14159265358979323846;
-
-static bb_image field(int w, int h) {
-  bb_image img;
-  cr_assert_eq(bb_image_alloc(&img, w, h, 1, NULL), BB_OK);
-  return img;
-}
-
-static bb_bake_result bake(const bb_image *h, const bb_bake_options *o) {
-  bb_bake_result r;
-  bb_error err;
-  cr_assert_eq(bb_bake(h, o, &r, &err), BB_OK, "%s", err.message);
-  return r;
-}
 
 static bb_bake_options sharp_options(float scale, int rays) {
   bb_bake_options o;
@@ -38,12 +26,12 @@ static const float *at(const bb_image *img, int x, int y) {
 }
 
 Test(bake, flat_map_is_neutral_everywhere) {
-  bb_image h = field(13, 9);
+  bb_image h = harness_field(13, 9, 0.0f);
   for (int i = 0; i < 13 * 9; i++) h.pixels[i] = 0.5f;
   bb_bake_options o;
   bb_bake_options_init(&o);
   o.height_scale = 32.0f;
-  bb_bake_result r = bake(&h, &o);
+  bb_bake_result r = harness_bake(&h, &o);
   for (int y = 0; y < 9; y++)
     for (int x = 0; x < 13; x++) {
       const float *n = at(&r.normal, x, y), *w = at(&r.weights, x, y), *s = at(&r.ssbump, x, y);
@@ -139,7 +127,7 @@ static double trench_horizon(const void *ctx, double phi) {
 Test(bake, trench_floor_matches_the_exact_integrals) {
   const trench tr = {8, 12, 8}; /* walls at 45 and 34 degrees */
   const int w = (int)(tr.left + tr.right) + 1, h = 7, x0 = (int)tr.left, y0 = 3;
-  bb_image height = field(w, h);
+  bb_image height = harness_field(w, h, 0.0f);
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++) height.pixels[y * w + x] = (x == 0 || x == w - 1) ? 1.0f : 0.0f;
   double ao, vis[3];
@@ -150,7 +138,7 @@ Test(bake, trench_floor_matches_the_exact_integrals) {
   for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
     bb_bake_options o = sharp_options((float)tr.wall, budgets[i].rays);
     o.smooth.addressing = BB_ADDRESS_CLAMP;
-    bb_bake_result r = bake(&height, &o);
+    bb_bake_result r = harness_bake(&height, &o);
     expect_answer(&r, x0, y0, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "trench, 256 rays" : "trench, 1024 rays");
     bb_bake_result_free(&r);
   }
@@ -168,7 +156,7 @@ Test(bake, slope_matches_the_exact_integrals) {
   const int w = 61, h = 9, x0 = 30, y0 = 4;
   const float scale = 30.0f; /* z = scale * x / (w - 1): slope 0.5 */
   const double s = (double)scale / (w - 1);
-  bb_image height = field(w, h);
+  bb_image height = harness_field(w, h, 0.0f);
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++) height.pixels[y * w + x] = (float)x / (float)(w - 1);
   double ao, vis[3];
@@ -177,7 +165,7 @@ Test(bake, slope_matches_the_exact_integrals) {
   for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
     bb_bake_options o = sharp_options(scale, budgets[i].rays);
     o.smooth.addressing = BB_ADDRESS_CLAMP;
-    bb_bake_result r = bake(&height, &o);
+    bb_bake_result r = harness_bake(&height, &o);
     expect_answer(&r, x0, y0, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "slope, 256 rays" : "slope, 1024 rays");
     bb_bake_result_free(&r);
   }
@@ -203,7 +191,7 @@ static double pit_horizon(const void *ctx, double phi) {
 Test(bake, cylindrical_pit_centre_matches_the_exact_integrals) {
   const int size = 128, c = 64;
   const double radius = 40.0, depth = 40.0;
-  bb_image h = field(size, size), z = field(size, size);
+  bb_image h = harness_field(size, size, 0.0f), z = harness_field(size, size, 0.0f);
   for (int y = 0; y < size; y++)
     for (int x = 0; x < size; x++) {
       h.pixels[y * size + x] = hypot(x - c, y - c) < radius ? 0.0f : 1.0f;
@@ -218,7 +206,7 @@ Test(bake, cylindrical_pit_centre_matches_the_exact_integrals) {
   cr_assert_float_eq(ao, round_rim, 0.02, "stair-stepped %g, round %g", ao, round_rim);
   for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
     bb_bake_options o = sharp_options((float)depth, budgets[i].rays);
-    bb_bake_result r = bake(&h, &o);
+    bb_bake_result r = harness_bake(&h, &o);
     expect_answer(&r, c, c, ao, vis, budgets[i].tolerance, budgets[i].rays == 256 ? "pit, 256 rays" : "pit, 1024 rays");
     bb_bake_result_free(&r);
   }
@@ -245,7 +233,7 @@ Test(bake, periodic_shift_shifts_every_output) {
   const int w = 37, h = 23, sx = 11, sy = 5;
   const int radii[] = {0, 10};
   for (int ri = 0; ri < 2; ri++) {
-    bb_image a = field(w, h), b = field(w, h);
+    bb_image a = harness_field(w, h, 0.0f), b = harness_field(w, h, 0.0f);
     noise_field(&a, 7);
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) b.pixels[((y + sy) % h) * w + (x + sx) % w] = a.pixels[y * w + x];
@@ -255,7 +243,7 @@ Test(bake, periodic_shift_shifts_every_output) {
     o.slices = 8;
     o.smooth.radius_texels = radii[ri];
     o.smooth.threshold = 0.2f;
-    bb_bake_result ra = bake(&a, &o), rb = bake(&b, &o);
+    bb_bake_result ra = harness_bake(&a, &o), rb = harness_bake(&b, &o);
     for (int i = 0; i < 6; i++) {
       const bb_image *ia = outputs(&ra, i), *ib = outputs(&rb, i);
       for (int y = 0; y < h; y++)
@@ -280,7 +268,7 @@ static size_t image_bytes(const bb_image *img) {
  * any count gives the same bits, on an odd size with more rows than
  * threads and fewer (7 threads, 31 rows of 4-row normal bands). */
 Test(bake, bit_identical_for_any_thread_count) {
-  bb_image h = field(50, 31);
+  bb_image h = harness_field(50, 31, 0.0f);
   noise_field(&h, 3);
   const int counts[] = {1, 2, 3, 7, 64};
   enum { RUNS = sizeof counts / sizeof counts[0] };
@@ -293,7 +281,7 @@ Test(bake, bit_identical_for_any_thread_count) {
     o.smooth.radius_texels = 4;
     o.smooth.threshold = 0.3f;
     o.trace.threads = counts[t];
-    r[t] = bake(&h, &o);
+    r[t] = harness_bake(&h, &o);
     cr_assert_eq(r[t].threads, counts[t], "the result says how many threads ran");
   }
   for (int t = 1; t < RUNS; t++)
@@ -309,17 +297,17 @@ Test(bake, bit_identical_for_any_thread_count) {
 /* A bake makes only the maps it is asked for (vis too when it traces), and
  * each is the same bits as in a bake of every map. */
 Test(bake, output_mask_makes_only_what_was_asked) {
-  bb_image h = field(24, 17);
+  bb_image h = harness_field(24, 17, 0.0f);
   noise_field(&h, 5);
   bb_bake_options o;
   bb_bake_options_init(&o);
   o.height_scale = 6.0f;
   o.slices = 6;
   o.normal_y_up = 1; /* the flip applies to what is kept, once */
-  bb_bake_result all = bake(&h, &o);
+  bb_bake_result all = harness_bake(&h, &o);
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
     o.outputs = BB_OUTPUT_BIT(k);
-    bb_bake_result one = bake(&h, &o);
+    bb_bake_result one = harness_bake(&h, &o);
     const int traced = bb_output_kind_get((bb_output_kind)k)->needs_trace;
     for (int j = 0; j < BB_OUTPUT_KIND_COUNT; j++) {
       const bb_image *img = bb_bake_result_image(&one, (bb_output_kind)j);
@@ -338,7 +326,7 @@ Test(bake, output_mask_makes_only_what_was_asked) {
   /* Without a traced map, the trace's options are not even checked. */
   o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
   o.rays = 0;
-  bb_bake_result r = bake(&h, &o);
+  bb_bake_result r = harness_bake(&h, &o);
   cr_assert_not_null(r.normal.pixels);
   cr_assert_not_null(r.filtered.pixels);
   bb_bake_result_free(&r);
@@ -360,7 +348,7 @@ static int cancel_after(void *user, long done, long total) {
 }
 
 Test(bake, progress_callback_cancels_and_nothing_is_returned) {
-  bb_image h = field(40, 30);
+  bb_image h = harness_field(40, 30, 0.0f);
   noise_field(&h, 9);
   bb_bake_options o;
   bb_bake_options_init(&o);
@@ -370,7 +358,7 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
   cancel_state go = {0, -1, 0, 0};
   o.trace.progress = cancel_after;
   o.trace.progress_user = &go;
-  bb_bake_result r = bake(&h, &o);
+  bb_bake_result r = harness_bake(&h, &o);
   cr_assert_eq(go.last_done, 16);
   cr_assert_eq(go.last_total, 16);
   bb_bake_result_free(&r);
@@ -394,7 +382,7 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
 /* A region is traced by marches on the thread pool, which polls the
  * callback; cancelling there stops the workers and returns no image. */
 Test(bake, progress_callback_cancels_a_region_trace) {
-  bb_image h = field(64, 64);
+  bb_image h = harness_field(64, 64, 0.0f);
   noise_field(&h, 4);
   for (int i = 0; i < 64 * 64; i++) h.pixels[i] *= 20.0f;
   bb_pyramid *p = NULL;
@@ -463,7 +451,7 @@ Test(bake, options_check_holds_every_limit) {
       cr_assert(strncmp(err.message, cases[i].message, strlen(cases[i].message)) == 0,
                 "case %zu: %s", i, err.message);
       /* bb_bake refuses them the same way, before any work. */
-      bb_image h = field(4, 4);
+      bb_image h = harness_field(4, 4, 0.0f);
       bb_bake_result r;
       bb_error err2;
       cr_assert_eq(bb_bake(&h, &c, &r, &err2), BB_ERR_ARGUMENT);
@@ -473,7 +461,7 @@ Test(bake, options_check_holds_every_limit) {
 }
 
 Test(bake, rejects_bad_options) {
-  bb_image h = field(4, 4);
+  bb_image h = harness_field(4, 4, 0.0f);
   bb_bake_options o;
   bb_bake_options_init(&o);
   bb_bake_result r;
@@ -496,7 +484,7 @@ Test(bake, rejects_bad_options) {
  * refused before any stage, and the message names the product, not a later
  * stage's symptom (it once read "pyramid: non-finite height"). */
 Test(bake, scale_times_height_overflow_is_named) {
-  bb_image h = field(4, 4);
+  bb_image h = harness_field(4, 4, 0.0f);
   *bb_image_texel(&h, 2, 1) = 3.0e38f;
   bb_bake_options o;
   bb_bake_options_init(&o);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "bake_harness.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -296,20 +297,6 @@ Test(basis, each_lobes_total_is_its_closed_form) {
     }
 }
 
-static bb_image field(int w, int h, float value) {
-  bb_image img;
-  cr_assert_eq(bb_image_alloc(&img, w, h, 1, NULL), BB_OK);
-  for (int i = 0; i < w * h; i++) img.pixels[i] = value;
-  return img;
-}
-
-static bb_bake_result bake(const bb_image *h, const bb_bake_options *o) {
-  bb_bake_result r;
-  bb_error err;
-  cr_assert_eq(bb_bake(h, o, &r, &err), BB_OK, "%s", err.message);
-  return r;
-}
-
 static bb_bake_options options(const bb_basis *basis, float scale, int slices) {
   bb_bake_options o;
   bb_bake_options_init(&o);
@@ -325,11 +312,11 @@ Test(basis, a_flat_field_gives_vis_1_and_the_lobes_height) {
   const double v[4][3] = {{1, 0, 0}, {0.3, -0.2, 0.9}, {-1, 1, 0.2}, {0, 0, 1}};
   bb_basis bases[3] = {named("dirs:6"), named("dirs:16")};
   cr_assert_eq(bb_basis_from_vectors(v, 4, &bases[2], NULL), BB_OK);
-  bb_image h = field(9, 7, 0.25f);
+  bb_image h = harness_field(9, 7, 0.25f);
   for (int k = 0; k < 3; k++) {
     const bb_basis *b = &bases[k];
     bb_bake_options o = options(b, 16.0f, 8);
-    bb_bake_result r = bake(&h, &o);
+    bb_bake_result r = harness_bake(&h, &o);
     cr_assert_str_eq(r.basis.name, b->name);
     cr_assert_eq(r.vis.channels, 1 + b->count);
     cr_assert_eq(r.ssbump.channels, b->count);
@@ -357,7 +344,7 @@ Test(basis, a_flat_field_gives_vis_1_and_the_lobes_height) {
 /* With every direction of Half-Life 2's, dirs:3 is hl2 and dirs:6's even
  * channels are hl2's, bit for bit, through trace and derive. */
 Test(basis, shared_directions_bake_to_the_same_bits) {
-  bb_image h = field(23, 17, 0.0f);
+  bb_image h = harness_field(23, 17, 0.0f);
   unsigned seed = 7;
   for (int i = 0; i < 23 * 17; i++) {
     seed = seed * 1103515245u + 12345u;
@@ -365,15 +352,15 @@ Test(basis, shared_directions_bake_to_the_same_bits) {
   }
   const bb_basis hl2 = named("hl2"), d3 = named("dirs:3"), d6 = named("dirs:6");
   bb_bake_options o = options(&hl2, 6.0f, 16);
-  bb_bake_result a = bake(&h, &o);
+  bb_bake_result a = harness_bake(&h, &o);
   o.basis = d3;
-  bb_bake_result b = bake(&h, &o);
+  bb_bake_result b = harness_bake(&h, &o);
   cr_assert(memcmp(a.vis.pixels, b.vis.pixels, 23 * 17 * 4 * sizeof(float)) == 0);
   cr_assert(memcmp(a.ssbump.pixels, b.ssbump.pixels, 23 * 17 * 3 * sizeof(float)) == 0);
   cr_assert(memcmp(a.weights.pixels, b.weights.pixels, 23 * 17 * 3 * sizeof(float)) == 0);
   cr_assert(memcmp(a.bent.pixels, b.bent.pixels, 23 * 17 * 3 * sizeof(float)) == 0);
   o.basis = d6;
-  bb_bake_result c = bake(&h, &o);
+  bb_bake_result c = harness_bake(&h, &o);
   for (int i = 0; i < 23 * 17; i++) {
     cr_assert_eq(c.vis.pixels[7 * i], a.vis.pixels[4 * i], "ao");
     for (int k = 0; k < 3; k++) {
@@ -390,19 +377,19 @@ Test(basis, shared_directions_bake_to_the_same_bits) {
 /* Any basis: the same bits on 1 and 3 threads, and a region traced by
  * marches equals the same texels of the whole trace by sweeps. */
 Test(basis, more_directions_stay_deterministic_on_every_path) {
-  bb_image h = field(21, 18, 0.0f);
+  bb_image h = harness_field(21, 18, 0.0f);
   for (int y = 0; y < 18; y++)
     for (int x = 0; x < 21; x++) h.pixels[y * 21 + x] = (float)(sin(x * 0.9) * cos(y * 1.3));
   const bb_basis d7 = named("dirs:7");
   bb_bake_options o = options(&d7, 3.0f, 12);
   o.trace.threads = 1;
-  bb_bake_result one = bake(&h, &o);
+  bb_bake_result one = harness_bake(&h, &o);
   o.trace.threads = 3;
-  bb_bake_result three = bake(&h, &o);
+  bb_bake_result three = harness_bake(&h, &o);
   const size_t n = 21 * 18 * 8;
   cr_assert(memcmp(one.vis.pixels, three.vis.pixels, n * sizeof(float)) == 0);
 
-  bb_image z = field(21, 18, 0.0f);
+  bb_image z = harness_field(21, 18, 0.0f);
   for (int i = 0; i < 21 * 18; i++) z.pixels[i] = 3.0f * one.filtered.pixels[i];
   bb_pyramid *p;
   bb_rayset rs;
@@ -459,7 +446,7 @@ static double wall_vis(const double b[3], double side, double height_over_distan
  * integral at 32 slices. */
 static void expect_one_wall(const char *basis_name, int wall_below, int facing, int away) {
   const int size = 48, wall = 30, texel = 20; /* H / d = 8 / 10 */
-  bb_image h = field(size, size, 0.0f);
+  bb_image h = harness_field(size, size, 0.0f);
   for (int y = 0; y < size; y++)
     for (int x = 0; x < size; x++)
       h.pixels[y * size + x] = (wall_below ? y : x) >= wall ? 1.0f : 0.0f;
@@ -468,7 +455,7 @@ static void expect_one_wall(const char *basis_name, int wall_below, int facing, 
   o.smooth.radius_texels = 0;
   o.smooth.addressing = BB_ADDRESS_CLAMP;
   o.trace.bias_texels = 0.0;
-  bb_bake_result r = bake(&h, &o);
+  bb_bake_result r = harness_bake(&h, &o);
   const float *vis = bb_image_texel(&r.vis, wall_below ? size / 2 : texel,
                                     wall_below ? texel : size / 2);
   const double side = wall_below ? PI / 2 : 0.0;
@@ -541,7 +528,7 @@ Test(basis, derive_takes_the_basis_or_defaults_to_hl2) {
 
 /* A hand-filled basis is checked by the bake before anything runs. */
 Test(basis, bake_refuses_a_broken_basis) {
-  bb_image h = field(4, 4, 0.0f);
+  bb_image h = harness_field(4, 4, 0.0f);
   bb_basis b = named("dirs:4");
   b.count = 2;
   bb_bake_options o = options(&b, 1.0f, 4);
@@ -574,12 +561,12 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   bb_image_free(&s6);
 
   /* A 3-direction basis that is not Half-Life 2's: caught by the result's basis. */
-  bb_image h = field(6, 6, 0.0f);
+  bb_image h = harness_field(6, 6, 0.0f);
   const double v[3][3] = {{1, 0, 1}, {0, 1, 1}, {-1, -1, 1}};
   bb_basis mine;
   cr_assert_eq(bb_basis_from_vectors(v, 3, &mine, NULL), BB_OK);
   bb_bake_options o = options(&mine, 1.0f, 4);
-  bb_bake_result r = bake(&h, &o);
+  bb_bake_result r = harness_bake(&h, &o);
   bb_valve_options vo;
   bb_valve_options_init(&vo);
   cr_assert_eq(bb_valve_pack(&r, &vo, &out, &err), BB_ERR_ARGUMENT);

@@ -40,14 +40,6 @@ static unsigned char *read_bytes(const char *path, size_t *size) {
   return buf;
 }
 
-static void write_bytes(const char *path, const void *data, size_t size) {
-  FILE *f = fopen(path, "wb");
-  cr_assert_not_null(f);
-  if (size)
-    cr_assert_eq(fwrite(data, 1, size, f), size);
-  fclose(f);
-}
-
 /* ------------------------------------------------------- input images */
 
 /* Writes a channels-deep image whose every texel is value(x, y, c). */

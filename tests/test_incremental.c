@@ -11,13 +11,6 @@
 
 TestSuite(incremental, .init = harness_setup, .fini = harness_teardown, .timeout = 30);
 
-static void write_bytes(const char *path, const char *bytes, size_t n) {
-  FILE *f = fopen(path, "wb");
-  cr_assert_not_null(f);
-  cr_assert_eq(fwrite(bytes, 1, n, f), n);
-  cr_assert_eq(fclose(f), 0);
-}
-
 /* FNV-1a 64's published values: "" and "a", and a file larger than the
  * 64 KiB block agrees with a one-shot hash of its bytes. */
 Test(incremental, file_hash_is_fnv1a_of_the_bytes) {
