@@ -1181,9 +1181,9 @@ bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image
  * with Source's weights w_c = dp_c / sum_k dp_k, dp_c = sat(N.B_c)^2 (the
  * weights map). Output = A * (static + dynamic) + specular (A by
  * bb_albedo_mode; 1 without an albedo), where the
- * Blinn-Phong specular of exponent k sums, over every light (d, K) in use
- * (the dynamic light, and the three B_c with colours L_c when the
- * lightmaps are on), K * max(0, Ns.h)^k with h = normalize(d + (0, 0, 1)),
+ * Blinn-Phong specular of exponent k and strength ks sums, over every
+ * light (d, K) in use (the dynamic light, and the three B_c with colours L_c
+ * when the lightmaps are on), ks * K * max(0, Ns.h)^k with h = normalize(d + (0, 0, 1)),
  * counted only where Ns.d > 0; Ns is Nb for ssbump, N otherwise. A flat,
  * unoccluded texel under an overhead light gives 1 in every mode, the
  * value of N.L. */
@@ -1256,6 +1256,8 @@ typedef struct bb_render_options {
   float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
                                    three basis directions in three colours */
   double specular_exponent;     /* k > 0, or 0 = no specular (default 0) */
+  double specular_strength;     /* ks, 0..1000: the highlight's scale, a
+                                   material's specular intensity (default 1) */
   bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
                                    default BB_ALBEDO_MULTIPLY */
   int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
@@ -1276,7 +1278,8 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
                     bb_error *err);
 
 /* "key=value" lines of every option of o that affects pixels (render_mode,
- * light, light_color, lightmap, specular, albedo_mode, tile, crop), for
+ * light, light_color, lightmap, specular, specular_strength, albedo_mode,
+ * tile, crop), for
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 

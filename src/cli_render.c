@@ -113,6 +113,7 @@ static const cli_option *const render_options[] = {
     &cli_render_opt_light_color,
     &cli_render_opt_lightmap,
     &cli_render_opt_specular,
+    &cli_render_opt_specular_strength,
     &opt_albedo,
     &opt_albedo_mode,
     &opt_compare,

@@ -42,6 +42,14 @@ const cli_option cli_render_opt_specular = {
     .default_text = "0 (off)",
     .range_text = "0..100000",
     .help = "Blinn-Phong highlight from the bent normal (ssbump) or N, viewer overhead"};
+const cli_option cli_render_opt_specular_strength = {
+    .id = CLI_RENDER_OPT_SPECULAR_STRENGTH,
+    .long_name = "specular-strength",
+    .value_name = "KS",
+    .default_text = "1",
+    .range_text = "0..1000",
+    .help = "scale of the highlight (a material's specular intensity; 1 = the light's "
+            "colour, which saturates readily at low light)"};
 const cli_option cli_render_opt_output = {.id = CLI_RENDER_OPT_OUTPUT,
                                           .long_name = "output",
                                           .short_name = 'o',
@@ -137,6 +145,9 @@ int cli_render_apply_lighting(const char *command, bb_render_options *o, int *li
   case CLI_RENDER_OPT_SPECULAR:
     return cli_parse_double(command, "--specular", arg, 0.0, 0, 100000.0,
                             &o->specular_exponent);
+  case CLI_RENDER_OPT_SPECULAR_STRENGTH:
+    return cli_parse_double(command, "--specular-strength", arg, 0.0, 0, 1000.0,
+                            &o->specular_strength);
   default:
     return -1;
   }

@@ -14,6 +14,7 @@ enum {
   CLI_RENDER_OPT_LIGHT_COLOR,
   CLI_RENDER_OPT_LIGHTMAP,
   CLI_RENDER_OPT_SPECULAR,
+  CLI_RENDER_OPT_SPECULAR_STRENGTH,
   CLI_RENDER_OPT_ALBEDO,
   CLI_RENDER_OPT_ALBEDO_MODE,
   CLI_RENDER_OPT_TILE,
@@ -33,6 +34,7 @@ enum {
 /* Rows of the lighting options, shared by both commands' tables. */
 extern const cli_option cli_render_opt_mode, cli_render_opt_light,
     cli_render_opt_light_color, cli_render_opt_lightmap, cli_render_opt_specular,
+    cli_render_opt_specular_strength,
     cli_render_opt_output, cli_render_opt_quiet;
 
 /* Applies a lighting option (mode, light, light colour, lightmap, specular)

@@ -28,6 +28,7 @@ static const cli_option *const sheet_options[] = {
     &cli_render_opt_light_color,
     &cli_render_opt_lightmap,
     &cli_render_opt_specular,
+    &cli_render_opt_specular_strength,
     &opt_panel_size,
     &cli_render_opt_output,
     &cli_opt_depth,

@@ -245,6 +245,7 @@ void bb_render_options_init(bb_render_options *o) {
     o->light_color[k] = 1.0f;
     o->lightmap[k][k] = 1.0f; /* L_0 red, L_1 green, L_2 blue */
   }
+  o->specular_strength = 1.0;
   o->tile_x = o->tile_y = 1;
 }
 
@@ -276,6 +277,10 @@ static bb_status check_lights(const bb_render_options *o, bb_error *err) {
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "render: specular exponent must be >= 0 (got %g)",
                     o->specular_exponent);
+  if (!(o->specular_strength >= 0.0 && o->specular_strength <= 1000.0))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: specular strength must be in 0..1000 (got %g)",
+                    o->specular_strength);
   return BB_OK;
 }
 
@@ -399,14 +404,14 @@ static const float *texel_of(const bb_image *img, size_t i) {
 
 /* Blinn-Phong over the job's lights, for the unit normal n. */
 static void add_specular(const render_job *job, const double n[3], double rgb[3]) {
-  const double k = job->o->specular_exponent;
+  const double k = job->o->specular_exponent, strength = job->o->specular_strength;
   for (int i = 0; i < job->light_count; i++) {
     if (!(dot3d(n, job->light_dir[i]) > 0.0))
       continue; /* the light is behind the surface the highlight is on */
     double n_dot_h = dot3d(n, job->light_half[i]);
     if (!(n_dot_h > 0.0))
       continue;
-    double spec = pow(n_dot_h, k);
+    double spec = strength * pow(n_dot_h, k);
     for (int c = 0; c < 3; c++)
       rgb[c] += (double)job->light_color[i][c] * spec;
   }
@@ -578,8 +583,9 @@ char *bb_render_options_describe(const bb_render_options *o) {
   } else {
     t = append(t, &n, "lightmap=none\n");
   }
-  t = append(t, &n, "specular=%.9g\nalbedo_mode=%s\ntile=%dx%d\n", o->specular_exponent,
-             bb_albedo_mode_name(o->albedo_mode), o->tile_x, o->tile_y);
+  t = append(t, &n, "specular=%.9g\nspecular_strength=%.9g\nalbedo_mode=%s\ntile=%dx%d\n",
+             o->specular_exponent, o->specular_strength, bb_albedo_mode_name(o->albedo_mode),
+             o->tile_x, o->tile_y);
   if (o->crop_width > 0)
     t = append(t, &n, "crop=%d,%d,%d,%d\n", o->crop_x, o->crop_y, o->crop_width,
                o->crop_height);

@@ -227,14 +227,21 @@ Test(render, flat_specular_is_blinn_phong) {
   bb_render_maps m = sc.maps;
   const double rad = 3.14159265358979323846 / 180.0;
   for (int mode = 0; mode < 2; mode++) {
-    bb_render_options o;
-    options(&o, mode ? BB_RENDER_NORMAL : BB_RENDER_SSBUMP, 300, 30);
-    o.specular_exponent = 8.0;
-    bb_image img = render(&m, &o);
-    double v = 0.5 + pow(cos(30.0 * rad), 8.0);
-    double rgb[3] = {v, v, v};
-    assert_uniform(&img, rgb, 1e-5, "specular");
-    bb_image_free(&img);
+    /* --specular-strength scales the highlight only: 1 (the default),
+     * 0.25 and 0 (no highlight at all). */
+    const double strengths[] = {1.0, 0.25, 0.0};
+    for (int k = 0; k < 3; k++) {
+      bb_render_options o;
+      options(&o, mode ? BB_RENDER_NORMAL : BB_RENDER_SSBUMP, 300, 30);
+      o.specular_exponent = 8.0;
+      if (k > 0)
+        o.specular_strength = strengths[k];
+      bb_image img = render(&m, &o);
+      double v = 0.5 + strengths[k] * pow(cos(30.0 * rad), 8.0);
+      double rgb[3] = {v, v, v};
+      assert_uniform(&img, rgb, 1e-5, "specular");
+      bb_image_free(&img);
+    }
   }
   bb_render_options o;
   options(&o, BB_RENDER_SSBUMP, 0, 0);
@@ -470,6 +477,13 @@ Test(render, bad_arguments_are_refused) {
   o.specular_exponent = -1;
   cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.specular_exponent = 0;
+  const double bad_strengths[] = {-0.5, 1000.5, NAN};
+  for (int k = 0; k < 3; k++) {
+    o.specular_strength = bad_strengths[k];
+    cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+    cr_assert(strstr(err.message, "specular strength must be in 0..1000"), "%s", err.message);
+  }
+  o.specular_strength = 1;
   o.threads = BB_MAX_THREADS + 1;
   cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "render: threads must be in 0..4096 (got 4097)");
@@ -498,7 +512,7 @@ Test(render, describe_names_every_option) {
   cr_assert_not_null(text);
   cr_assert_str_eq(
       text, "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
-            "lightmap=none\nspecular=0\nalbedo_mode=multiply\ntile=1x1\ncrop=none\n");
+            "lightmap=none\nspecular=0\nspecular_strength=1\nalbedo_mode=multiply\ntile=1x1\ncrop=none\n");
   free(text);
   o.dynamic_light = 0;
   o.static_light = 1;

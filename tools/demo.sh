@@ -56,6 +56,6 @@ printf 'demo: done in %d.%03d s; look at out/rivet_panel_local.tga and out/rivet
 # sheet of every map (this one bakes again).
 "$bin" render --normal out/rock06_normal.png --ssbump out/rock06_ssbump.png \
   --ao out/rock06_ao.png --bent out/rock06_bent.png \
-  --compare --light 0,20 --crop 256,512,512,512 -o out/rock06_compare.png
+  --compare --light 0,20 --specular-strength 0.35 --crop 256,512,512,512 -o out/rock06_compare.png
 "$bin" sheet "$input" --scale 64 -o out/rock06_sheet.png
 echo "demo: look at out/rock06_compare.png and out/rock06_sheet.png"
