@@ -6,7 +6,6 @@
 
 #include <stddef.h>
 #include <stdlib.h>
-#include <pthread.h>
 #include <string.h>
 
 /* The maps are the library's (bb_output_kind_get); CLI_OPT_OUT_* follow
@@ -362,21 +361,6 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   fputc('\n', stdout);
 }
 
-/* One output staged on its own thread: encoding (zlib for PNG) is most of
- * a write, so the outputs of a bake are encoded side by side. */
-typedef struct write_task {
-  const cli_run *run;
-  const bb_image *image;
-  bb_range range;
-  cli_staged_output *out;
-} write_task;
-
-static void *stage_one(void *arg) {
-  write_task *t = arg;
-  cli_stage_output(t->run, t->out, t->image, t->range);
-  return NULL;
-}
-
 /* The slope map and its preview (--slope, --lit), written with the others
  * but with their own settings (cli_slope_settings). */
 typedef struct slope_outputs {
@@ -394,36 +378,30 @@ enum { MAX_OUTPUTS = OUTPUT_KIND_COUNT + 2 };
 static int write_outputs(const bake_args *a, cli_run *run, const bb_bake_result *r,
                          const slope_outputs *slope, const cli_run *filtered_run) {
   cli_staged_output outs[MAX_OUTPUTS];
-  write_task tasks[MAX_OUTPUTS];
-  pthread_t threads[MAX_OUTPUTS];
-  int started[MAX_OUTPUTS] = {0}, n = 0;
+  cli_stage_task tasks[MAX_OUTPUTS];
+  int n = 0;
   const double t0 = cli_now_seconds();
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     if (a->paths[k]) {
       outs[n] = (cli_staged_output){.kind = kind_info(k)->name, .path = a->paths[k]};
-      tasks[n] = (write_task){k == BB_OUTPUT_FILTERED ? filtered_run : run,
-                              bb_bake_result_image(r, (bb_output_kind)k), kind_info(k)->range,
-                              &outs[n]};
+      tasks[n] = (cli_stage_task){k == BB_OUTPUT_FILTERED ? filtered_run : run,
+                                  bb_bake_result_image(r, (bb_output_kind)k),
+                                  kind_info(k)->range, &outs[n]};
       n++;
     }
   if (slope->map.pixels) {
     outs[n] = (cli_staged_output){.kind = "slope", .path = a->slope.path};
-    tasks[n] = (write_task){&slope->map_run, &slope->map, BB_RANGE_UNIT, &outs[n]};
+    tasks[n] = (cli_stage_task){&slope->map_run, &slope->map, BB_RANGE_UNIT, &outs[n]};
     n++;
   }
   if (slope->lit.pixels) {
     outs[n] = (cli_staged_output){.kind = "slope_lit", .path = a->slope.lit_path};
-    tasks[n] = (write_task){&slope->lit_run, &slope->lit, BB_RANGE_UNIT, &outs[n]};
+    tasks[n] = (cli_stage_task){&slope->lit_run, &slope->lit, BB_RANGE_UNIT, &outs[n]};
     n++;
   }
-  for (int i = 0; i < n; i++) {
-    started[i] = pthread_create(&threads[i], NULL, stage_one, &tasks[i]) == 0;
-    if (!started[i]) /* no thread to be had: stage it here */
-      stage_one(&tasks[i]);
-  }
-  for (int i = 0; i < n; i++)
-    if (started[i])
-      pthread_join(threads[i], NULL);
+  /* --threads bounds this stage as every other (r->threads is the count
+   * the bake resolved: all cores for 0). */
+  cli_stage_outputs(tasks, n, r->threads);
   int rc = cli_commit_outputs(outs, n);
   run->seconds_write += cli_now_seconds() - t0;
   for (int i = 0; i < n && !rc; i++)

@@ -213,10 +213,10 @@ static int h2s_run(cli_run *run, h2s_args *a) {
     run->rayset_id = (a->settings.bake.outputs & BB_OUTPUTS_TRACED) ? result.rayset_id : NULL;
     cli_staged_output outs[2] = {{.kind = output_kind(a), .path = a->output},
                                  {.kind = "filtered", .path = dump_path}};
+    const cli_stage_task tasks[2] = {{run, &rgba, BB_RANGE_UNIT, &outs[0]},
+                                     {run, &result.filtered, BB_RANGE_UNIT, &outs[1]}};
     int n = a->dump_filtered ? 2 : 1;
-    cli_stage_output(run, &outs[0], &rgba, BB_RANGE_UNIT);
-    if (n == 2)
-      cli_stage_output(run, &outs[1], &result.filtered, BB_RANGE_UNIT);
+    cli_stage_outputs(tasks, n, result.threads);
     rc = cli_commit_outputs(outs, n);
   }
   bb_image_free(&rgba);

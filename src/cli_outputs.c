@@ -4,6 +4,8 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -250,6 +252,41 @@ void cli_stage_output(const cli_run *run, cli_staged_output *out, const bb_image
     out->status = stage_image(out->path, img, &wo, run->settings->mips, &out->file,
                               &out->error);
   free(description);
+}
+
+/* The tasks of one cli_stage_outputs call, handed out in order. */
+typedef struct stage_queue {
+  const cli_stage_task *tasks;
+  int n;
+  atomic_int next;
+} stage_queue;
+
+static void *stage_worker(void *arg) {
+  stage_queue *q = arg;
+  for (int i; (i = atomic_fetch_add(&q->next, 1)) < q->n;) {
+    const cli_stage_task *t = &q->tasks[i];
+    cli_stage_output(t->run, t->out, t->image, t->range);
+  }
+  return NULL;
+}
+
+enum { MAX_STAGE_HELPERS = 15 };
+
+void cli_stage_outputs(const cli_stage_task *tasks, int n, int threads) {
+  stage_queue q = {.tasks = tasks, .n = n};
+  atomic_init(&q.next, 0);
+  int helpers = (threads <= 0 || threads > n ? n : threads) - 1;
+  if (helpers > MAX_STAGE_HELPERS)
+    helpers = MAX_STAGE_HELPERS;
+  pthread_t tids[MAX_STAGE_HELPERS];
+  int started = 0;
+  while (started < helpers && pthread_create(&tids[started], NULL, stage_worker, &q) == 0)
+    started++;
+  /* The calling thread works too, so a helper that could not start only
+   * makes the stage slower. */
+  stage_worker(&q);
+  for (int i = 0; i < started; i++)
+    pthread_join(tids[i], NULL);
 }
 
 /* Appends to text (capacity cap) the outputs in place, or says that none

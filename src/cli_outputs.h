@@ -87,6 +87,21 @@ typedef struct cli_staged_output {
 void cli_stage_output(const cli_run *run, cli_staged_output *out, const bb_image *img,
                       bb_range range);
 
+/* One output to stage: cli_stage_output(run, out, image, range). */
+typedef struct cli_stage_task {
+  const cli_run *run;
+  const bb_image *image;
+  bb_range range;
+  cli_staged_output *out;
+} cli_stage_task;
+
+/* Stages every task with cli_stage_output, several at once: encoding (zlib
+ * for PNG, TIFF and EXR) is most of a write, so outputs are encoded side by
+ * side on at most `threads` threads (the caller's included; 0 = one per
+ * task). Returns when all n are staged; the results are in each task's out,
+ * whatever order they finished in. */
+void cli_stage_outputs(const cli_stage_task *tasks, int n, int threads);
+
 /* All or nothing: when every one of the n outputs was staged, renames them
  * into place in order and returns 0; otherwise removes every staged file.
  * A failure prints one line, "bumpbake: PATH: reason; no output was written"

@@ -11,6 +11,7 @@
 #include <ctype.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1011,6 +1012,62 @@ Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
       cr_expect_eq(count_entries(tmp(name), ".bb-tmp-"), 0, "%s/%s: temporary left",
                    f->ext, f->depth);
     }
+  }
+}
+
+/* Six outputs staged side by side (issue 9), of which the 3rd (ssbump) and
+ * the 5th (bent) are EXR files several times larger than the PNGs around
+ * them: under a file-size limit between the two, both fail while the others
+ * stage. Whatever the thread count and whichever failure comes first in
+ * time, the one reported is the first in output order, alone on one line,
+ * and nothing is left: no output, no temporary. */
+Test(cli, failed_third_of_six_outputs_leaves_nothing, .timeout = 60) {
+  const char *in = tmp("noise6.png");
+  write_image(in, 64, 64, 1, noise);
+  cr_assert_eq(mkdir(tmp("six"), 0700), 0);
+  static const char *const names[6] = {"six/n.png", "six/w.png", "six/s.exr",
+                                       "six/a.png", "six/b.exr", "six/f.png"};
+  char paths[6][600];
+  for (int i = 0; i < 6; i++)
+    snprintf(paths[i], sizeof paths[i], "%s", tmp(names[i]));
+  for (int threads = 1; threads <= 6; threads += 5) {
+    char t[8];
+    snprintf(t, sizeof t, "%d", threads);
+    const char *args[] = {"bake",      in,       "--scale",  "8",      "--rays",
+                          "8",         "--threads", t,        "-q",     "--normal",
+                          paths[0],    "--weights", paths[1], "--ssbump", paths[2],
+                          "--ao",      paths[3], "--bent",   paths[4], "--filtered",
+                          paths[5],    NULL};
+    /* Sizes from a run with room: the limit lies between the PNGs and the EXRs. */
+    cli_result r = harness_run_in(NULL, args);
+    cr_assert_eq(r.code, 0, "%s", r.err);
+    cli_result_free(&r);
+    long png_max = 0, exr_min = LONG_MAX;
+    for (int i = 0; i < 6; i++) {
+      struct stat st;
+      cr_assert_eq(stat(paths[i], &st), 0, "%s", paths[i]);
+      int exr = i == 2 || i == 4;
+      if (exr && (long)st.st_size < exr_min)
+        exr_min = (long)st.st_size;
+      if (!exr && (long)st.st_size > png_max)
+        png_max = (long)st.st_size;
+      cr_assert_eq(unlink(paths[i]), 0);
+    }
+    cr_assert_gt(exr_min, 2 * png_max, "EXR %ld bytes, PNG up to %ld", exr_min, png_max);
+
+    run_limits lim = {(png_max + exr_min) / 2, -1};
+    r = harness_run_limited(NULL, &lim, args);
+    cr_expect_eq(r.code, 1, "threads %d: exit %d, %s", threads, r.code, r.err);
+    cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
+    char expected[700];
+    snprintf(expected, sizeof expected,
+             "bumpbake: %s: cannot write: File too large; no output was written\n", paths[2]);
+    cr_expect_str_eq(r.err, expected, "threads %d", threads);
+    cli_result_free(&r);
+    for (int i = 0; i < 6; i++)
+      cr_expect_not(file_exists(paths[i]), "threads %d: %s was written", threads, paths[i]);
+    cr_expect_eq(count_entries(tmp("six"), ".bb-tmp-"), 0, "threads %d: temporary left",
+                 threads);
   }
 }
 
