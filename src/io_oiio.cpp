@@ -587,6 +587,16 @@ std::vector<T> quantise_image(const bb_image *img, bb_range range) {
 
 // Encodes img into file_name (a temporary name whose extension picks the
 // format) through proxy. Returns "" on success, else OIIO's reason.
+// What every file bumpbake writes carries besides its pixels. DateTime is
+// set empty, which makes OpenImageIO leave the write time out of TIFF and
+// EXR headers: the same input and options then give the same bytes, which
+// is what a golden or a build cache compares.
+void set_common_attributes(ImageSpec &spec) {
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
+  spec.attribute("DateTime", "");
+}
+
 std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy *proxy,
                          const bb_image *img, bb_depth depth, bb_range range,
                          const char *description) {
@@ -596,8 +606,7 @@ std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy
                                                 : TypeDesc::FLOAT;
   ImageSpec spec(img->width, img->height, img->channels, file_type);
   name_basis_channels(spec);
-  spec.attribute("oiio:UnassociatedAlpha", 1);
-  spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
+  set_common_attributes(spec);
   if (description)
     spec.attribute("ImageDescription",
                    description_to_store(extension_of(file_name.c_str()) == ".tga", description));
@@ -933,8 +942,7 @@ std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy 
     spec.tile_width = MIP_TILE;
     spec.tile_height = MIP_TILE;
     spec.attribute("textureformat", "Plain Texture");
-    spec.attribute("oiio:UnassociatedAlpha", 1);
-    spec.attribute("Software", "bumpbake " BB_VERSION_STRING);
+    set_common_attributes(spec);
     if (description) spec.attribute("ImageDescription", description);
     spec.attribute("compression", "zip");
     if (!out->open(file_name, spec, k == 0 ? ImageOutput::Create : append))
