@@ -149,13 +149,39 @@ static inline int imin(int a, int b) {
 
 /* ------------------------------------------------------------- profiles */
 
-/* A point of a profile: where it is (u, in steps from the line's texel 0),
- * its height, and for the exact slope the step it belongs to and its
- * template point. */
-typedef struct point {
-  double u, z;
-  int step, tp;
-} point;
+/* Points of a profile or a hull, one array per field: where each is (u, in
+ * steps from the line's texel 0, or mirrored), its height, and for the
+ * exact slope its key: the step it belongs to and its template point,
+ * step * KEY_STEP + tp (a shift of the step by d adds d * KEY_STEP). */
+typedef struct points {
+  double *u, *z;
+  int64_t *key;
+} points;
+
+static int points_alloc(points *p, size_t count) {
+  p->u = malloc(count * sizeof(double));
+  p->z = malloc(count * sizeof(double));
+  p->key = malloc(count * sizeof(int64_t));
+  return p->u && p->z && p->key;
+}
+
+static void points_free(points *p) {
+  free(p->u);
+  free(p->z);
+  free(p->key);
+}
+
+#define KEY_STEP 1024 /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
+
+static inline int64_t key_of(int step, int tp) {
+  return (int64_t)step * KEY_STEP + tp;
+}
+static inline int key_step(int64_t key) { /* floors: tp >= 0 */
+  return (int)(key >> 10);
+}
+static inline int key_tp(int64_t key) {
+  return (int)(key & (KEY_STEP - 1));
+}
 
 /* The points of a line (or chunk) that can matter, by rising u: step
  * first_step + s covers u in (first_step + s, first_step + s + 1]. Origins
@@ -163,9 +189,13 @@ typedef struct point {
 typedef struct profile {
   int first_step, steps, len;
   int count;
-  point *pt;
+  points pt;
   double *vz;
   size_t *texel;
+  float *found[2]; /* each texel's horizon along (a, b) and along (-a, -b) */
+  /* the points of a block of steps, for the kink filter */
+  double *block_u, *block_z;
+  double *block_rise; /* kept when > 0 */
 } profile;
 
 /* Height of vertex (x, y) through the addressing; periodic coordinates lie
@@ -190,6 +220,28 @@ static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
   return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step, n) : v + step;
 }
 
+/* The heights of the points of the step from texel (bx, by), in template
+ * order. Away from the edges no vertex wraps or clamps, and each is a fixed
+ * offset. */
+static inline void step_heights(const sweep_job *job, int bx, int by, double *zs) {
+  const bb_pyramid *p = job->p;
+  const int tcount = job->point_count;
+  if (bx >= job->reach_x && bx < p->width - job->reach_x && by >= job->reach_y &&
+      by < p->height - job->reach_y) {
+    const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
+    const long *const off1 = job->offset1, *const off2 = job->offset2;
+    const double *const weight = job->weight;
+    for (int k = 0; k < tcount; k++)
+      zs[k] = bb__lattice_height(here[off1[k]], here[off2[k]], weight[k]);
+  } else {
+    for (int k = 0; k < tcount; k++) {
+      const template_point *t = &job->points[k];
+      zs[k] = bb__lattice_height(field_z(p, bx + t->x1, by + t->y1),
+                                 field_z(p, bx + t->x2, by + t->y2), job->weight[k]);
+    }
+  }
+}
+
 /* The points of steps first_step .. first_step + steps - 1 of the line whose
  * texel 0 is (x0, y0), without those that can never decide a horizon.
  *
@@ -199,96 +251,126 @@ static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
  * which sits at or above its vertex (bias >= 0), X (or L) is. A run of such
  * points lies under the chord of the points kept around it (the profile is
  * convex along the run), so dropping them all at once is safe too. Half the
- * points go on rough maps, without a branch. (Keeping only each step's
+ * points go on rough maps, without a branch: each point is stored, and the
+ * count moves on past it only when it is kept. (Keeping only each step's
  * upper hull drops a sixth more, but the stack that finds it branches on
  * every point, unpredictably, and costs more than the walks save.) The ends
  * are kept. */
+/* Steps whose points are made before the kink filter runs over them: their
+ * heights and u first, then the chord test of every point at once (a loop
+ * the compiler vectorises), then the kept points, copied out in order. */
+enum { BLOCK_STEPS = 32 };
+
+static inline void put_point(const points *pts, int i, double u, double z, int64_t key) {
+  pts->u[i] = u, pts->z[i] = z, pts->key[i] = key;
+}
+
+/* Copies the points of steps s0 .. s1-1 of the block out of the block
+ * arrays (the step s0 starts at index base) and moves the count on past
+ * those kept; the block's last point is left for the next block. */
+static inline int keep_points(const sweep_job *job, const profile *pr, int s0, int s1, int base,
+                              int count) {
+  const int tcount = job->point_count;
+  const double *restrict u = pr->block_u, *restrict z = pr->block_z;
+  const double *restrict rise = pr->block_rise;
+  double *restrict out_u = pr->pt.u, *restrict out_z = pr->pt.z;
+  int64_t *restrict out_key = pr->pt.key;
+  for (int s = s0; s < s1; s++, base += tcount) {
+    const int64_t key = key_of(pr->first_step + s, 0);
+    const int last = s == s1 - 1 ? tcount - 1 : tcount;
+    for (int k = 0; k < last; k++) {
+      out_u[count] = u[base + k];
+      out_z[count] = z[base + k];
+      out_key[count] = key + k;
+      count += rise[base + k] > 0.0;
+    }
+  }
+  return count;
+}
+
 static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   const bb_pyramid *p = job->p;
   const int tcount = job->point_count;
-  const long *const off1 = job->offset1, *const off2 = job->offset2;
-  const double *const frac = job->frac, *const weight = job->weight;
-  double zs[4 * BB__MAX_LATTICE_STEP + 1];
+  const double *const frac = job->frac;
   int bx = coordinate_at(p, (long)x0 + (long)pr->first_step * job->a, p->width);
   int by = coordinate_at(p, (long)y0 + (long)pr->first_step * job->b, p->height);
   const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
   const int sa = periodic ? job->a % p->width : job->a, sb = periodic ? job->b % p->height : job->b;
-  point *restrict out = pr->pt;
-  int count = 0, seen = 0;
-  double ua = 0.0, za = 0.0; /* the kink window: a, then the pending point b */
-  point b = {0};
-  for (int s = 0; s < pr->steps; s++, bx = step_along(p, bx, sa, p->width),
-           by = step_along(p, by, sb, p->height)) {
-    const int j = pr->first_step + s; /* texel of the line at the step's start */
-    if (j >= 0 && j < pr->len) {
-      pr->vz[j] = field_z(p, bx, by);
-      pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
-    }
-    /* The heights of the step's points. Away from the edges no vertex wraps
-     * or clamps, and each is a fixed offset. */
-    if (bx >= job->reach_x && bx < p->width - job->reach_x && by >= job->reach_y &&
-        by < p->height - job->reach_y) {
-      const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
-      for (int k = 0; k < tcount; k++)
-        zs[k] = bb__lattice_height(here[off1[k]], here[off2[k]], weight[k]);
-    } else {
-      for (int k = 0; k < tcount; k++) {
-        const template_point *t = &job->points[k];
-        zs[k] = bb__lattice_height(field_z(p, bx + t->x1, by + t->y1),
-                                   field_z(p, bx + t->x2, by + t->y2), weight[k]);
+  double *restrict u = pr->block_u, *restrict z = pr->block_z;
+  double *restrict rise = pr->block_rise;
+  int count = 0;
+  int n = 0; /* points in the block arrays: two carried over (after the first block), then the block's */
+  for (int s0 = 0; s0 < pr->steps; s0 += BLOCK_STEPS) {
+    const int s1 = imin(s0 + BLOCK_STEPS, pr->steps), base = n;
+    for (int s = s0; s < s1; s++, bx = step_along(p, bx, sa, p->width),
+             by = step_along(p, by, sb, p->height)) {
+      const int j = pr->first_step + s; /* texel of the line at the step's start */
+      if (j >= 0 && j < pr->len) {
+        pr->vz[j] = field_z(p, bx, by);
+        pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
       }
+      step_heights(job, bx, by, z + n);
+      const double ju = (double)j;
+      for (int k = 0; k < tcount; k++) u[n + k] = ju + frac[k];
+      n += tcount;
     }
-    /* b is kept when above the chord from a to the new point */
-    const double ju = (double)j;
-    for (int k = 0; k < tcount; k++, seen++) {
-      const double u = ju + frac[k], z = zs[k];
-      out[count] = b;
-      count += seen == 1 || (seen > 1 && (b.z - za) * (u - ua) > (z - za) * (b.u - ua));
-      ua = b.u, za = b.z;
-      b = (point){u, z, j, k};
+    /* point i is kept when above the chord of its neighbours: when l > r,
+     * which is when l - r > 0 (a difference of doubles is 0 only when they
+     * are equal, and keeps its sign), a form the compiler vectorises */
+    for (int i = 1; i < n - 1; i++)
+      rise[i] = (z[i] - z[i - 1]) * (u[i + 1] - u[i - 1]) - (z[i + 1] - z[i - 1]) * (u[i] - u[i - 1]);
+    if (s0 == 0) {
+      rise[0] = 1.0; /* the first point is an end */
+    } else { /* the previous block's last point, carried at index 1 */
+      put_point(&pr->pt, count, u[1], z[1], key_of(pr->first_step + s0 - 1, tcount - 1));
+      count += rise[1] > 0.0;
+    }
+    count = keep_points(job, pr, s0, s1, base, count);
+    if (s1 < pr->steps) { /* the last two go on to the next block */
+      u[0] = u[n - 2], z[0] = z[n - 2];
+      u[1] = u[n - 1], z[1] = z[n - 1];
+      n = 2;
     }
   }
-  if (seen) out[count++] = b; /* the last point is an end */
+  /* the last point is an end */
+  put_point(&pr->pt, count++, u[n - 1], z[n - 1], key_of(pr->first_step + pr->steps - 1, tcount - 1));
   pr->count = count;
 }
 
 /* ------------------------------------------------------------------ hulls */
 
-/* Upper hull of the points ahead, nearest last (u may be mirrored). */
-typedef struct hull {
-  point *v;
-  int size;
-} hull;
+/* The hull: upper hull of the points ahead, nearest last (u may be
+ * mirrored), in a points triple; its size is passed around. */
 
 /* Pushes a point nearer than all others, dropping those now under the hull;
  * then, if nothing ahead is higher than it, keeps it alone: from any origin
  * behind it is then either steeper than everything ahead (positive slope,
  * shorter distance) or everything is below the origin (horizon 0). */
-static inline void hull_push(hull *h, point q) {
-  point *restrict v = h->v;
-  int size = h->size;
+static inline int hull_push(const points *h, int size, double qu, double qz, int64_t key) {
+  double *restrict hu = h->u, *restrict hz = h->z;
   while (size >= 2) {
-    const point *a = &v[size - 1], *b = &v[size - 2];
-    /* a is on or under the segment from the new point to b */
-    if ((a->z - q.z) * (b->u - q.u) <= (b->z - q.z) * (a->u - q.u)) size--;
-    else break;
+    /* a = size - 1 is on or under the segment from the new point to b = size - 2 */
+    if ((hz[size - 1] - qz) * (hu[size - 2] - qu) <= (hz[size - 2] - qz) * (hu[size - 1] - qu))
+      size--;
+    else
+      break;
   }
-  if (size >= 1 && v[size - 1].z <= q.z) size = 0;
-  v[size++] = q;
-  h->size = size;
+  if (size >= 1 && hz[size - 1] <= qz) size = 0;
+  hu[size] = qu, hz[size] = qz, h->key[size] = key;
+  return size + 1;
 }
 
 /* Index of the hull vertex of largest slope from (u0, z0), behind every
  * point: slopes to hull vertices rise, then fall, going away from the
  * origin. The tangent is mostly at the nearest vertex or the next, so a walk
  * from the near end beats a binary search. */
-static inline int hull_tangent(const hull *h, double u0, double z0) {
-  const point *v = h->v;
-  int i = h->size - 1;
+static inline int hull_tangent(const points *h, int size, double u0, double z0) {
+  const double *restrict hu = h->u, *restrict hz = h->z;
+  int i = size - 1;
   if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
-  double du = v[i].u - u0, dz = v[i].z - z0;
+  double du = hu[i] - u0, dz = hz[i] - z0;
   while (i > 0) {
-    const double du_far = v[i - 1].u - u0, dz_far = v[i - 1].z - z0;
+    const double du_far = hu[i - 1] - u0, dz_far = hz[i - 1] - z0;
     /* is the farther vertex steeper? (denominators are positive) */
     if (!(dz_far * du > dz * du_far)) break;
     du = du_far;
@@ -300,27 +382,18 @@ static inline int hull_tangent(const hull *h, double u0, double z0) {
 
 /* The canonical slope per step from origin texel j (height oz) to hull
  * vertex i, ahead of the origin (forward) or behind it. */
-static inline double slope_to(const sweep_job *job, const hull *h, int i, int j, double oz,
+static inline double slope_to(const sweep_job *job, const points *h, int i, int j, double oz,
                               int forward) {
   if (i < 0) return 0.0;
-  const point *v = &h->v[i];
-  const template_point *t = &job->points[v->tp];
-  const long n = forward ? (long)(v->step - j) * t->m + t->i : (long)(j - v->step) * t->m - t->i;
-  return (v->z - oz) / bb__lattice_distance(n, t->inverse_m);
+  const int step = key_step(h->key[i]);
+  const template_point *t = &job->points[key_tp(h->key[i])];
+  const long n = forward ? (long)(step - j) * t->m + t->i : (long)(j - step) * t->m - t->i;
+  return (h->z[i] - oz) / bb__lattice_distance(n, t->inverse_m);
 }
 
-/* A texel's horizon along side k: stored for the tests when asked, and
- * integrated into its sums. */
-static inline void emit_horizon(const sweep_job *job, int k, size_t texel, float h) {
-  const bb__sweep_dir *dir = job->side[k].dir;
-  if (dir->horizon) dir->horizon[texel] = h;
-  bb__slice_accumulate(&job->side[k].integral, h, dir->sums + texel * (size_t)job->channels);
-}
-
-/* The same from the best slope per step. */
-static inline void emit(const sweep_job *job, int k, size_t texel, double slope) {
-  emit_horizon(job, k, texel,
-               bb__lattice_horizon(slope > 0.0 ? slope : 0.0, job->side[k].inverse_length));
+/* The horizon in texels from the best slope per step. */
+static inline float horizon_of(const sweep_job *job, int k, double slope) {
+  return bb__lattice_horizon(slope > 0.0 ? slope : 0.0, job->side[k].inverse_length);
 }
 
 /* ---------------------------------------------------------- line sweeps */
@@ -333,29 +406,29 @@ static int vouched(const sweep_job *job, double slope, double oz, double distanc
 }
 
 /* Origin j of a line (texel j mod L, -L <= j < 2 L) asks the hull for its
- * horizon. In a chunk, a texel the profile cannot vouch for (the points
- * beyond it lie at least `beyond` steps away) is marched instead, which
- * finds the same bits. */
-static inline void query(const sweep_job *job, const profile *pr, const hull *h, int j,
-                         int forward) {
+ * horizon, kept in found[k] until the line's walks are done. In a chunk, a
+ * texel the profile cannot vouch for (the points beyond it lie at least
+ * `beyond` steps away) is marched instead, which finds the same bits. */
+static inline __attribute__((always_inline)) void query(const sweep_job *job, const profile *pr,
+                                                       const points *h, int size, int j,
+                                                       int forward) {
   const int L = pr->len;
   const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
   const double oz = pr->vz[texel_j] + job->bias;
   const int k = forward ? 0 : 1;
   const double u0 = forward ? (double)j : -(double)j;
-  const double slope = slope_to(job, h, hull_tangent(h, u0, oz), j, oz, forward);
-  const size_t texel = pr->texel[texel_j];
+  const double slope = slope_to(job, h, hull_tangent(h, size, u0, oz), j, oz, forward);
+  float found = horizon_of(job, k, slope);
   if (job->kind == LINE_CHUNK) {
     const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
                                   : (double)(j - pr->first_step);
     if (!vouched(job, slope, oz, beyond)) {
+      const size_t texel = pr->texel[texel_j];
       const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
-      emit_horizon(job, k, texel,
-                   bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b));
-      return;
+      found = bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
     }
   }
-  emit(job, k, texel, slope);
+  pr->found[k][texel_j] = found;
 }
 
 /* A stretch of profile points, pt[from] to pt[to] inclusive (either way
@@ -367,53 +440,55 @@ typedef struct stretch {
 /* Along (a, b): the points of the stretches by falling u; origins j from
  * j_high down to j_low, each asking once every point beyond it is on the
  * hull. */
-static void walk_ahead(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
-                       int stretches, int j_high, int j_low) {
-  int j = j_high;
-  h->size = 0;
+static void walk_ahead(const sweep_job *job, const profile *pr, const points *h,
+                       const stretch *st, int stretches, int j_high, int j_low) {
+  int j = j_high, size = 0;
+  const double *restrict pu = pr->pt.u, *restrict pz = pr->pt.z;
+  const int64_t *restrict pkey = pr->pt.key;
   for (int r = 0; r < stretches; r++) {
     const double du = (double)st[r].shift;
-    const int ds = st[r].shift;
+    const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
     for (int q = st[r].from; q >= st[r].to; q--) {
-      point v = pr->pt[q];
-      v.u += du, v.step += ds;
-      for (; (double)j >= v.u; j--) {
+      const double u = pu[q] + du;
+      for (; (double)j >= u; j--) {
         if (j < j_low) return;
-        query(job, pr, h, j, 1);
+        query(job, pr, h, size, j, 1);
       }
-      hull_push(h, v);
+      size = hull_push(h, size, u, pz[q], pkey[q] + dkey);
     }
   }
-  for (; j >= j_low; j--) query(job, pr, h, j, 1);
+  for (; j >= j_low; j--) query(job, pr, h, size, j, 1);
 }
 
 /* Along (-a, -b): the points of the stretches by rising u, on mirrored u so
  * the hull code is the same; origins j from j_low up to j_high. */
-static void walk_behind(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
-                        int stretches, int j_low, int j_high) {
-  int j = j_low;
-  h->size = 0;
+static void walk_behind(const sweep_job *job, const profile *pr, const points *h,
+                        const stretch *st, int stretches, int j_low, int j_high) {
+  int j = j_low, size = 0;
+  const double *restrict pu = pr->pt.u, *restrict pz = pr->pt.z;
+  const int64_t *restrict pkey = pr->pt.key;
   for (int r = 0; r < stretches; r++) {
     const double du = (double)st[r].shift;
-    const int ds = st[r].shift;
+    const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
     for (int q = st[r].from; q <= st[r].to; q++) {
-      point v = pr->pt[q];
-      v.u = -(v.u + du), v.step += ds;
-      for (; (double)j <= -v.u; j++) {
+      const double u = pu[q] + du;
+      for (; (double)j <= u; j++) {
         if (j > j_high) return;
-        query(job, pr, h, j, 0);
+        query(job, pr, h, size, j, 0);
       }
-      hull_push(h, v);
+      size = hull_push(h, size, -u, pz[q], pkey[q] + dkey);
     }
   }
-  for (; j <= j_high; j++) query(job, pr, h, j, 0);
+  for (; j <= j_high; j++) query(job, pr, h, size, j, 0);
 }
 
 /* The first point of the highest height in a profile. */
 static int highest_point(const profile *pr) {
   int best = 0;
+  const double *restrict z = pr->pt.z;
+  double best_z = z[0];
   for (int q = 1; q < pr->count; q++)
-    if (pr->pt[q].z > pr->pt[best].z) best = q;
+    if (z[q] > best_z) best = q, best_z = z[q];
   return best;
 }
 
@@ -422,9 +497,9 @@ static int highest_point(const profile *pr) {
  * backwards, for origins from just below it down to u*, so each sees
  * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
  * origins from just above it up to u*, so each sees [u* - L, j). */
-static void walk_round(const sweep_job *job, const profile *pr, hull *h) {
+static void walk_round(const sweep_job *job, const profile *pr, const points *h) {
   const int top = highest_point(pr), n = pr->count, L = pr->len;
-  const double u_top = pr->pt[top].u;
+  const double u_top = pr->pt.u[top];
   if (job->side[0].dir) {
     const stretch st[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
     const int first = (int)ceil(u_top);
@@ -438,10 +513,40 @@ static void walk_round(const sweep_job *job, const profile *pr, hull *h) {
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
-static void walk_line(const sweep_job *job, const profile *pr, hull *h) {
+static void walk_line(const sweep_job *job, const profile *pr, const points *h) {
   const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
   if (job->side[0].dir) walk_ahead(job, pr, h, &down, 1, pr->len - 1, 0);
   if (job->side[1].dir) walk_behind(job, pr, h, &up, 1, 0, pr->len - 1);
+}
+
+/* What the line's texels lose to the horizons found, added to their sums:
+ * along (a, b) first, then along (-a, -b), as the slices' order wants. The
+ * walks only find horizons; integrating them here, in a loop of its own,
+ * lets the divisions and table reads of neighbouring texels overlap. */
+static void integrate_line(const sweep_job *job, const profile *pr) {
+  const int channels = job->channels;
+  for (int k = 0; k < 2; k++) {
+    const bb__sweep_dir *dir = job->side[k].dir;
+    if (!dir || !dir->horizon) continue;
+    for (int j = 0; j < pr->len; j++) dir->horizon[pr->texel[j]] = pr->found[k][j];
+  }
+  if (job->side[0].dir && job->side[1].dir) {
+    const bb__slice_integral *along = &job->side[0].integral, *opposite = &job->side[1].integral;
+    float *sums = job->side[0].dir->sums;
+    for (int j = 0; j < pr->len; j++) {
+      float *texel_sums = sums + pr->texel[j] * (size_t)channels;
+      bb__slice_accumulate(along, pr->found[0][j], texel_sums);
+      bb__slice_accumulate(opposite, pr->found[1][j], texel_sums);
+    }
+    return;
+  }
+  for (int k = 0; k < 2; k++) {
+    const bb__sweep_dir *dir = job->side[k].dir;
+    if (!dir) continue;
+    for (int j = 0; j < pr->len; j++)
+      bb__slice_accumulate(&job->side[k].integral, pr->found[k][j],
+                           dir->sums + pr->texel[j] * (size_t)channels);
+  }
 }
 
 /* ------------------------------------------------------------ work items */
@@ -486,7 +591,7 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
 enum { BUNDLE = 64 };
 
 /* One line (or chunk) of the list, with buffers sized for the longest. */
-static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
+static void sweep_one(sweep_job *job, int item, profile *pr, const points *h) {
   int before, after;
   item_extent(job, item, &before, &after);
   pr->len = job->item_len[item];
@@ -497,6 +602,7 @@ static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
     walk_round(job, pr, h);
   else
     walk_line(job, pr, h);
+  integrate_line(job, pr);
 }
 
 static void sweep_bundle(void *user, int bundle) {
@@ -509,22 +615,33 @@ static void sweep_bundle(void *user, int bundle) {
     steps = imax(steps, before + job->item_len[item] + after);
     len = imax(len, job->item_len[item]);
   }
-  const size_t points = (size_t)steps * (size_t)job->point_count + 1;
+  const size_t count = (size_t)steps * (size_t)job->point_count + 1;
+  const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
   profile pr = {0};
-  hull h = {0};
-  pr.pt = malloc(points * sizeof(point));
+  points h = {0};
+  pr.block_u = malloc(block * sizeof(double));
+  pr.block_z = malloc(block * sizeof(double));
+  pr.block_rise = malloc(block * sizeof(double));
   pr.vz = malloc((size_t)len * sizeof(double));
   pr.texel = malloc((size_t)len * sizeof(size_t));
-  h.v = malloc(points * sizeof(point));
-  if (pr.pt && pr.vz && pr.texel && h.v) {
+  pr.found[0] = malloc((size_t)len * sizeof(float));
+  pr.found[1] = malloc((size_t)len * sizeof(float));
+  const int have_points = points_alloc(&pr.pt, count) && points_alloc(&h, count);
+  if (have_points && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
+      pr.found[0] && pr.found[1]) {
     for (int item = first; item < last; item++) sweep_one(job, item, &pr, &h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
-  free(pr.pt);
+  points_free(&pr.pt);
+  points_free(&h);
+  free(pr.block_u);
+  free(pr.block_z);
+  free(pr.block_rise);
   free(pr.vz);
   free(pr.texel);
-  free(h.v);
+  free(pr.found[0]);
+  free(pr.found[1]);
 }
 
 /* A growable list of work items. */
