@@ -149,27 +149,15 @@ static inline int imin(int a, int b) {
 
 /* ------------------------------------------------------------- profiles */
 
-/* Points of a profile or a hull, one array per field: where each is (u, in
- * steps from the line's texel 0, or mirrored), its height, and for the
- * exact slope its key: the step it belongs to and its template point,
- * step * KEY_STEP + tp (a shift of the step by d adds d * KEY_STEP). */
-typedef struct points {
-  double *u, *z;
-  int64_t *key;
-} points;
-
-static int points_alloc(points *p, size_t count) {
-  p->u = malloc(count * sizeof(double));
-  p->z = malloc(count * sizeof(double));
-  p->key = malloc(count * sizeof(int64_t));
-  return p->u && p->z && p->key;
-}
-
-static void points_free(points *p) {
-  free(p->u);
-  free(p->z);
-  free(p->key);
-}
+/* A point of a profile or a hull: where it is (u, in steps from the line's
+ * texel 0, or mirrored), its height, and for the exact slope its key: the
+ * step it belongs to and its template point, step * KEY_STEP + tp (a shift
+ * of the step by d adds d * KEY_STEP). Fields are stored one by one: a copy
+ * of the whole struct costs shuffles between registers. */
+typedef struct point {
+  double u, z;
+  int64_t key;
+} point;
 
 #define KEY_STEP 1024 /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
 
@@ -189,7 +177,7 @@ static inline int key_tp(int64_t key) {
 typedef struct profile {
   int first_step, steps, len;
   int count;
-  points pt;
+  point *pt;
   double *vz;
   size_t *texel;
   float *found[2]; /* each texel's horizon along (a, b) and along (-a, -b) */
@@ -261,8 +249,8 @@ static inline void step_heights(const sweep_job *job, int bx, int by, double *zs
  * the compiler vectorises), then the kept points, copied out in order. */
 enum { BLOCK_STEPS = 32 };
 
-static inline void put_point(const points *pts, int i, double u, double z, int64_t key) {
-  pts->u[i] = u, pts->z[i] = z, pts->key[i] = key;
+static inline void put_point(point *pt, double u, double z, int64_t key) {
+  pt->u = u, pt->z = z, pt->key = key;
 }
 
 /* Copies the points of steps s0 .. s1-1 of the block out of the block
@@ -273,15 +261,12 @@ static inline int keep_points(const sweep_job *job, const profile *pr, int s0, i
   const int tcount = job->point_count;
   const double *restrict u = pr->block_u, *restrict z = pr->block_z;
   const double *restrict rise = pr->block_rise;
-  double *restrict out_u = pr->pt.u, *restrict out_z = pr->pt.z;
-  int64_t *restrict out_key = pr->pt.key;
+  point *restrict out = pr->pt;
   for (int s = s0; s < s1; s++, base += tcount) {
     const int64_t key = key_of(pr->first_step + s, 0);
     const int last = s == s1 - 1 ? tcount - 1 : tcount;
     for (int k = 0; k < last; k++) {
-      out_u[count] = u[base + k];
-      out_z[count] = z[base + k];
-      out_key[count] = key + k;
+      put_point(&out[count], u[base + k], z[base + k], key + k);
       count += rise[base + k] > 0.0;
     }
   }
@@ -322,7 +307,7 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
     if (s0 == 0) {
       rise[0] = 1.0; /* the first point is an end */
     } else { /* the previous block's last point, carried at index 1 */
-      put_point(&pr->pt, count, u[1], z[1], key_of(pr->first_step + s0 - 1, tcount - 1));
+      put_point(&pr->pt[count], u[1], z[1], key_of(pr->first_step + s0 - 1, tcount - 1));
       count += rise[1] > 0.0;
     }
     count = keep_points(job, pr, s0, s1, base, count);
@@ -333,30 +318,31 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
     }
   }
   /* the last point is an end */
-  put_point(&pr->pt, count++, u[n - 1], z[n - 1], key_of(pr->first_step + pr->steps - 1, tcount - 1));
+  put_point(&pr->pt[count++], u[n - 1], z[n - 1],
+            key_of(pr->first_step + pr->steps - 1, tcount - 1));
   pr->count = count;
 }
 
 /* ------------------------------------------------------------------ hulls */
 
 /* The hull: upper hull of the points ahead, nearest last (u may be
- * mirrored), in a points triple; its size is passed around. */
+ * mirrored), an array of points; its size is passed around. */
 
 /* Pushes a point nearer than all others, dropping those now under the hull;
  * then, if nothing ahead is higher than it, keeps it alone: from any origin
  * behind it is then either steeper than everything ahead (positive slope,
  * shorter distance) or everything is below the origin (horizon 0). */
-static inline int hull_push(const points *h, int size, double qu, double qz, int64_t key) {
-  double *restrict hu = h->u, *restrict hz = h->z;
+static inline int hull_push(point *restrict v, int size, double qu, double qz, int64_t key) {
   while (size >= 2) {
-    /* a = size - 1 is on or under the segment from the new point to b = size - 2 */
-    if ((hz[size - 1] - qz) * (hu[size - 2] - qu) <= (hz[size - 2] - qz) * (hu[size - 1] - qu))
+    const point *a = &v[size - 1], *b = &v[size - 2];
+    /* a is on or under the segment from the new point to b */
+    if ((a->z - qz) * (b->u - qu) <= (b->z - qz) * (a->u - qu))
       size--;
     else
       break;
   }
-  if (size >= 1 && hz[size - 1] <= qz) size = 0;
-  hu[size] = qu, hz[size] = qz, h->key[size] = key;
+  if (size >= 1 && v[size - 1].z <= qz) size = 0;
+  put_point(&v[size], qu, qz, key);
   return size + 1;
 }
 
@@ -364,13 +350,12 @@ static inline int hull_push(const points *h, int size, double qu, double qz, int
  * point: slopes to hull vertices rise, then fall, going away from the
  * origin. The tangent is mostly at the nearest vertex or the next, so a walk
  * from the near end beats a binary search. */
-static inline int hull_tangent(const points *h, int size, double u0, double z0) {
-  const double *restrict hu = h->u, *restrict hz = h->z;
+static inline int hull_tangent(const point *v, int size, double u0, double z0) {
   int i = size - 1;
   if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
-  double du = hu[i] - u0, dz = hz[i] - z0;
+  double du = v[i].u - u0, dz = v[i].z - z0;
   while (i > 0) {
-    const double du_far = hu[i - 1] - u0, dz_far = hz[i - 1] - z0;
+    const double du_far = v[i - 1].u - u0, dz_far = v[i - 1].z - z0;
     /* is the farther vertex steeper? (denominators are positive) */
     if (!(dz_far * du > dz * du_far)) break;
     du = du_far;
@@ -382,13 +367,13 @@ static inline int hull_tangent(const points *h, int size, double u0, double z0) 
 
 /* The canonical slope per step from origin texel j (height oz) to hull
  * vertex i, ahead of the origin (forward) or behind it. */
-static inline double slope_to(const sweep_job *job, const points *h, int i, int j, double oz,
+static inline double slope_to(const sweep_job *job, const point *v, int i, int j, double oz,
                               int forward) {
   if (i < 0) return 0.0;
-  const int step = key_step(h->key[i]);
-  const template_point *t = &job->points[key_tp(h->key[i])];
+  const int step = key_step(v[i].key);
+  const template_point *t = &job->points[key_tp(v[i].key)];
   const long n = forward ? (long)(step - j) * t->m + t->i : (long)(j - step) * t->m - t->i;
-  return (h->z[i] - oz) / bb__lattice_distance(n, t->inverse_m);
+  return (v[i].z - oz) / bb__lattice_distance(n, t->inverse_m);
 }
 
 /* The horizon in texels from the best slope per step. */
@@ -410,7 +395,7 @@ static int vouched(const sweep_job *job, double slope, double oz, double distanc
  * texel the profile cannot vouch for (the points beyond it lie at least
  * `beyond` steps away) is marched instead, which finds the same bits. */
 static inline __attribute__((always_inline)) void query(const sweep_job *job, const profile *pr,
-                                                       const points *h, int size, int j,
+                                                       const point *h, int size, int j,
                                                        int forward) {
   const int L = pr->len;
   const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
@@ -440,21 +425,20 @@ typedef struct stretch {
 /* Along (a, b): the points of the stretches by falling u; origins j from
  * j_high down to j_low, each asking once every point beyond it is on the
  * hull. */
-static void walk_ahead(const sweep_job *job, const profile *pr, const points *h,
+static void walk_ahead(const sweep_job *job, const profile *pr, point *restrict h,
                        const stretch *st, int stretches, int j_high, int j_low) {
   int j = j_high, size = 0;
-  const double *restrict pu = pr->pt.u, *restrict pz = pr->pt.z;
-  const int64_t *restrict pkey = pr->pt.key;
+  const point *restrict pt = pr->pt;
   for (int r = 0; r < stretches; r++) {
     const double du = (double)st[r].shift;
     const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
     for (int q = st[r].from; q >= st[r].to; q--) {
-      const double u = pu[q] + du;
+      const double u = pt[q].u + du;
       for (; (double)j >= u; j--) {
         if (j < j_low) return;
         query(job, pr, h, size, j, 1);
       }
-      size = hull_push(h, size, u, pz[q], pkey[q] + dkey);
+      size = hull_push(h, size, u, pt[q].z, pt[q].key + dkey);
     }
   }
   for (; j >= j_low; j--) query(job, pr, h, size, j, 1);
@@ -462,21 +446,20 @@ static void walk_ahead(const sweep_job *job, const profile *pr, const points *h,
 
 /* Along (-a, -b): the points of the stretches by rising u, on mirrored u so
  * the hull code is the same; origins j from j_low up to j_high. */
-static void walk_behind(const sweep_job *job, const profile *pr, const points *h,
+static void walk_behind(const sweep_job *job, const profile *pr, point *restrict h,
                         const stretch *st, int stretches, int j_low, int j_high) {
   int j = j_low, size = 0;
-  const double *restrict pu = pr->pt.u, *restrict pz = pr->pt.z;
-  const int64_t *restrict pkey = pr->pt.key;
+  const point *restrict pt = pr->pt;
   for (int r = 0; r < stretches; r++) {
     const double du = (double)st[r].shift;
     const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
     for (int q = st[r].from; q <= st[r].to; q++) {
-      const double u = pu[q] + du;
+      const double u = pt[q].u + du;
       for (; (double)j <= u; j++) {
         if (j > j_high) return;
         query(job, pr, h, size, j, 0);
       }
-      size = hull_push(h, size, -u, pz[q], pkey[q] + dkey);
+      size = hull_push(h, size, -u, pt[q].z, pt[q].key + dkey);
     }
   }
   for (; j <= j_high; j++) query(job, pr, h, size, j, 0);
@@ -485,10 +468,10 @@ static void walk_behind(const sweep_job *job, const profile *pr, const points *h
 /* The first point of the highest height in a profile. */
 static int highest_point(const profile *pr) {
   int best = 0;
-  const double *restrict z = pr->pt.z;
-  double best_z = z[0];
+  const point *pt = pr->pt;
+  double best_z = pt[0].z;
   for (int q = 1; q < pr->count; q++)
-    if (z[q] > best_z) best = q, best_z = z[q];
+    if (pt[q].z > best_z) best = q, best_z = pt[q].z;
   return best;
 }
 
@@ -497,9 +480,9 @@ static int highest_point(const profile *pr) {
  * backwards, for origins from just below it down to u*, so each sees
  * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
  * origins from just above it up to u*, so each sees [u* - L, j). */
-static void walk_round(const sweep_job *job, const profile *pr, const points *h) {
+static void walk_round(const sweep_job *job, const profile *pr, point *h) {
   const int top = highest_point(pr), n = pr->count, L = pr->len;
-  const double u_top = pr->pt.u[top];
+  const double u_top = pr->pt[top].u;
   if (job->side[0].dir) {
     const stretch st[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
     const int first = (int)ceil(u_top);
@@ -513,7 +496,7 @@ static void walk_round(const sweep_job *job, const profile *pr, const points *h)
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
-static void walk_line(const sweep_job *job, const profile *pr, const points *h) {
+static void walk_line(const sweep_job *job, const profile *pr, point *h) {
   const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
   if (job->side[0].dir) walk_ahead(job, pr, h, &down, 1, pr->len - 1, 0);
   if (job->side[1].dir) walk_behind(job, pr, h, &up, 1, 0, pr->len - 1);
@@ -591,7 +574,7 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
 enum { BUNDLE = 64 };
 
 /* One line (or chunk) of the list, with buffers sized for the longest. */
-static void sweep_one(sweep_job *job, int item, profile *pr, const points *h) {
+static void sweep_one(sweep_job *job, int item, profile *pr, point *h) {
   int before, after;
   item_extent(job, item, &before, &after);
   pr->len = job->item_len[item];
@@ -618,7 +601,7 @@ static void sweep_bundle(void *user, int bundle) {
   const size_t count = (size_t)steps * (size_t)job->point_count + 1;
   const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
   profile pr = {0};
-  points h = {0};
+  point *h = malloc(count * sizeof(point));
   pr.block_u = malloc(block * sizeof(double));
   pr.block_z = malloc(block * sizeof(double));
   pr.block_rise = malloc(block * sizeof(double));
@@ -626,15 +609,15 @@ static void sweep_bundle(void *user, int bundle) {
   pr.texel = malloc((size_t)len * sizeof(size_t));
   pr.found[0] = malloc((size_t)len * sizeof(float));
   pr.found[1] = malloc((size_t)len * sizeof(float));
-  const int have_points = points_alloc(&pr.pt, count) && points_alloc(&h, count);
-  if (have_points && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
+  pr.pt = malloc(count * sizeof(point));
+  if (pr.pt && h && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
       pr.found[0] && pr.found[1]) {
-    for (int item = first; item < last; item++) sweep_one(job, item, &pr, &h);
+    for (int item = first; item < last; item++) sweep_one(job, item, &pr, h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
-  points_free(&pr.pt);
-  points_free(&h);
+  free(pr.pt);
+  free(h);
   free(pr.block_u);
   free(pr.block_z);
   free(pr.block_rise);
