@@ -346,22 +346,34 @@ static inline int hull_push(point *restrict v, int size, double qu, double qz, i
   return size + 1;
 }
 
+/* Is hull vertex far steeper from the origin than the vertex at (du, dz)
+ * from it? (denominators are positive) */
+static inline int steeper(const point *far, double du, double dz, double u0, double z0) {
+  return (far->z - z0) * du > dz * (far->u - u0);
+}
+
 /* Index of the hull vertex of largest slope from (u0, z0), behind every
  * point: slopes to hull vertices rise, then fall, going away from the
- * origin. The tangent is mostly at the nearest vertex or the next, so a walk
- * from the near end beats a binary search. */
+ * origin, so a walk from the near end finds it, mostly within three steps.
+ * The nearest vertex (a fraction of a step ahead, below an origin lifted by
+ * the bias) is seldom the tangent, but whether the walk goes one or two
+ * steps further is a toss-up: those two tests are made together and
+ * combined without a branch, which the processor would mispredict half the
+ * time. The tests and where the walk stops are those of a plain walk. */
 static inline int hull_tangent(const point *v, int size, double u0, double z0) {
   int i = size - 1;
   if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
   double du = v[i].u - u0, dz = v[i].z - z0;
-  while (i > 0) {
-    const double du_far = v[i - 1].u - u0, dz_far = v[i - 1].z - z0;
-    /* is the farther vertex steeper? (denominators are positive) */
-    if (!(dz_far * du > dz * du_far)) break;
-    du = du_far;
-    dz = dz_far;
-    i--;
+  if (i == 0 || !steeper(&v[i - 1], du, dz, u0, z0)) return i;
+  i--, du = v[i].u - u0, dz = v[i].z - z0;
+  if (i >= 2) {
+    const double du1 = v[i - 1].u - u0, dz1 = v[i - 1].z - z0;
+    const int one = steeper(&v[i - 1], du, dz, u0, z0);
+    const int two = one & steeper(&v[i - 2], du1, dz1, u0, z0);
+    if (!two) return i - one;
+    i -= 2, du = v[i].u - u0, dz = v[i].z - z0;
   }
+  while (i > 0 && steeper(&v[i - 1], du, dz, u0, z0)) i--, du = v[i].u - u0, dz = v[i].z - z0;
   return i;
 }
 
