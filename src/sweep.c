@@ -257,8 +257,8 @@ static inline void put_point(point *pt, double u, double z, int64_t key) {
 /* Copies the points of steps s0 .. s1-1 of the block out of the block
  * arrays (the step s0 starts at index base) and moves the count on past
  * those kept; the block's last point is left for the next block. */
-static inline int keep_points(const sweep_job *job, const profile *pr, int s0, int s1, int base,
-                              int count) {
+static inline int keep_points(const sweep_job *job, const profile *pr, int s0, int s1,
+                              int base, int count) {
   const int tcount = job->point_count;
   const double *restrict u = pr->block_u, *restrict z = pr->block_z;
   const double *restrict rise = pr->block_rise;
@@ -299,7 +299,8 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   double *restrict u = pr->block_u, *restrict z = pr->block_z;
   double *restrict rise = pr->block_rise;
   int count = 0, top = 0;
-  int n = 0; /* points in the block arrays: two carried over (after the first block), then the block's */
+  int n = 0; /* points in the block arrays: two carried over (after the first
+              * block), then the block's */
   for (int s0 = 0; s0 < pr->steps; s0 += BLOCK_STEPS) {
     const int s1 = imin(s0 + BLOCK_STEPS, pr->steps), base = n;
     for (int s = s0; s < s1; s++, bx = step_along(p, bx, sa, p->width),
@@ -318,7 +319,8 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
      * which is when l - r > 0 (a difference of doubles is 0 only when they
      * are equal, and keeps its sign), a form the compiler vectorises */
     for (int i = 1; i < n - 1; i++)
-      rise[i] = (z[i] - z[i - 1]) * (u[i + 1] - u[i - 1]) - (z[i + 1] - z[i - 1]) * (u[i] - u[i - 1]);
+      rise[i] = (z[i] - z[i - 1]) * (u[i + 1] - u[i - 1]) -
+                (z[i + 1] - z[i - 1]) * (u[i] - u[i - 1]);
     if (s0 == 0) rise[0] = 1.0; /* the first point is an end */
     const int first_kept = count;
     if (s0 > 0) { /* the previous block's last point, carried at index 1 */
@@ -359,7 +361,8 @@ static inline int under(const point *a, const point *b, double qu, double qz) {
  * 11%; three or more 3%): the first two tests are made together and
  * combined without a branch, which would be mispredicted a third of the
  * time; the vertices dropped are those of a plain loop. */
-static inline int hull_push(point *restrict v, int size, double qu, double qz, int64_t key) {
+static inline int hull_push(point *restrict v, int size, double qu, double qz,
+                            int64_t key) {
   int more = 1; /* may more vertices go? */
   if (size >= 3) {
     const int one = under(&v[size - 1], &v[size - 2], qu, qz);
@@ -400,7 +403,8 @@ static inline int hull_tangent(const point *v, int size, double u0, double z0) {
     if (!two) return i - one;
     i -= 2, du = v[i].u - u0, dz = v[i].z - z0;
   }
-  while (i > 0 && steeper(&v[i - 1], du, dz, u0, z0)) i--, du = v[i].u - u0, dz = v[i].z - z0;
+  while (i > 0 && steeper(&v[i - 1], du, dz, u0, z0))
+    i--, du = v[i].u - u0, dz = v[i].z - z0;
   return i;
 }
 
