@@ -465,47 +465,121 @@ typedef struct stretch {
   int from, to, shift;
 } stretch;
 
-/* Along (a, b): the points of the stretches by falling u; origins j from
- * j_high down to j_low, each asking once every point beyond it is on the
- * hull. */
-static void walk_ahead(const sweep_job *job, const profile *pr, point *restrict h,
-                       const stretch *st, int stretches, int j_high, int j_low) {
-  int j = j_high, size = 0;
-  const point *restrict pt = pr->pt;
-  for (int r = 0; r < stretches; r++) {
-    const double du = (double)st[r].shift;
-    const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
-    for (int q = st[r].from; q >= st[r].to; q--) {
-      const double u = pt[q].u + du;
-      for (; (double)j >= u; j--) {
-        if (j < j_low) return;
-        query(job, pr, h, size, j, 1);
-      }
-      size = hull_push(h, size, u, pt[q].z, pt[q].key + dkey);
-    }
-  }
-  for (; j >= j_low; j--) query(job, pr, h, size, j, 1);
+/* One walk along a line, with its own hull. Along (a, b) (forward) it
+ * pushes the points of its stretches by falling u, and its origins j, from
+ * j_first down to j_last, each ask the hull once every point beyond them is
+ * on it. Along (-a, -b) it takes the points by rising u, on mirrored u so the
+ * hull code is the same, and the origins rising. */
+typedef struct walk {
+  point *h;
+  int size;
+  stretch *st;
+  int stretches, r; /* the stretch under way */
+  int q, left;      /* its next point, and the points left in it */
+  double du;        /* its shift */
+  int64_t dkey;
+  int j, j_last; /* the next origin, and the last */
+} walk;
+
+/* Is point q of stretch s still wanted: is an origin left to ask once it is
+ * on the hull? Past the first that is not, none is (u falls along a forward
+ * walk, rises along the other). */
+static inline int walk_wants(const profile *pr, const walk *w, const stretch *s, int q,
+                             int forward) {
+  const double u = pr->pt[q].u + (double)s->shift;
+  return forward ? !((double)(w->j_last - 1) >= u) : !((double)(w->j_last + 1) <= u);
 }
 
-/* Along (-a, -b): the points of the stretches by rising u, on mirrored u so
- * the hull code is the same; origins j from j_low up to j_high. */
-static void walk_behind(const sweep_job *job, const profile *pr, point *restrict h,
-                        const stretch *st, int stretches, int j_low, int j_high) {
-  int j = j_low, size = 0;
-  const point *restrict pt = pr->pt;
-  for (int r = 0; r < stretches; r++) {
-    const double du = (double)st[r].shift;
-    const int64_t dkey = (int64_t)st[r].shift * KEY_STEP;
-    for (int q = st[r].from; q <= st[r].to; q++) {
-      const double u = pt[q].u + du;
-      for (; (double)j <= u; j++) {
-        if (j > j_high) return;
-        query(job, pr, h, size, j, 0);
-      }
-      size = hull_push(h, size, -u, pt[q].z, pt[q].key + dkey);
+/* Cuts the stretches at the first point no origin wants (found by halving),
+ * so that the walk's loops need not look for the end of the origins. */
+static void walk_clip(const profile *pr, walk *w, int forward) {
+  const int dq = forward ? -1 : 1;
+  for (int r = 0; r < w->stretches; r++) {
+    stretch *s = &w->st[r];
+    const int n = (s->to - s->from) * dq + 1;
+    if (n <= 0 || walk_wants(pr, w, s, s->to, forward)) continue;
+    int lo = 0, hi = n - 1; /* the first unwanted is in (lo - 1, hi] */
+    while (lo < hi) {
+      const int mid = lo + (hi - lo) / 2;
+      if (walk_wants(pr, w, s, s->from + mid * dq, forward))
+        lo = mid + 1;
+      else
+        hi = mid;
     }
+    s->to = s->from + (lo - 1) * dq; /* before `from` when none is wanted */
+    w->stretches = r + 1;
+    return;
   }
-  for (; j <= j_high; j++) query(job, pr, h, size, j, 0);
+}
+
+static walk walk_start(const profile *pr, point *h, stretch *st, int stretches, int j_first,
+                       int j_last, int forward) {
+  walk w = {.h = h, .st = st, .stretches = stretches, .j = j_first, .j_last = j_last};
+  walk_clip(pr, &w, forward);
+  return w;
+}
+
+/* Moves the walk on to the first stretch from r on that holds points; 0
+ * when there is none. */
+static inline int walk_enter(walk *w, int forward) {
+  const int dq = forward ? -1 : 1;
+  for (; w->r < w->stretches; w->r++) {
+    const stretch *s = &w->st[w->r];
+    w->left = (s->to - s->from) * dq + 1;
+    if (w->left <= 0) continue;
+    w->q = s->from;
+    w->du = (double)s->shift, w->dkey = (int64_t)s->shift * KEY_STEP;
+    return 1;
+  }
+  return 0;
+}
+
+/* The walk's next point: the origins before it ask the hull, then it is
+ * pushed. */
+static inline __attribute__((always_inline)) void walk_next(const sweep_job *job,
+                                                           const profile *pr, walk *w,
+                                                           int forward) {
+  const point *next = pr->pt + w->q;
+  const double u = next->u + w->du;
+  if (forward)
+    for (; (double)w->j >= u; w->j--) query(job, pr, w->h, w->size, w->j, 1);
+  else
+    for (; (double)w->j <= u; w->j++) query(job, pr, w->h, w->size, w->j, 0);
+  w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, next->key + w->dkey);
+  w->q += forward ? -1 : 1;
+}
+
+/* Every point of the walk, then the origins left once all are on the hull. */
+static inline void walk_rest(const sweep_job *job, const profile *pr, walk *w, int more,
+                             int forward) {
+  for (; more; w->r++, more = walk_enter(w, forward))
+    for (; w->left > 0; w->left--) walk_next(job, pr, w, forward);
+  if (forward)
+    for (; w->j >= w->j_last; w->j--) query(job, pr, w->h, w->size, w->j, 1);
+  else
+    for (; w->j <= w->j_last; w->j++) query(job, pr, w->h, w->size, w->j, 0);
+}
+
+/* Both walks of a line (NULL: that side is not wanted), one point of each
+ * in turn. Each push waits on what the push before it stored in the same
+ * hull; the two hulls are independent, so the processor overlaps the two
+ * chains. The walks write different horizons (found[0], found[1]), so the
+ * results are those of one walk after the other. */
+static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind) {
+  walk a = ahead ? *ahead : (walk){0}, b = behind ? *behind : (walk){0};
+  int more_a = ahead && walk_enter(&a, 1), more_b = behind && walk_enter(&b, 0);
+  while (more_a && more_b) {
+    const int n = imin(a.left, b.left);
+    for (int i = 0; i < n; i++) {
+      walk_next(job, pr, &a, 1);
+      walk_next(job, pr, &b, 0);
+    }
+    a.left -= n, b.left -= n;
+    if (!a.left) a.r++, more_a = walk_enter(&a, 1);
+    if (!b.left) b.r++, more_b = walk_enter(&b, 0);
+  }
+  if (ahead) walk_rest(job, pr, &a, more_a, 1);
+  if (behind) walk_rest(job, pr, &b, more_b, 0);
 }
 
 /* Once round a periodic line of L steps (points in u (0, L]), from its
@@ -513,26 +587,23 @@ static void walk_behind(const sweep_job *job, const profile *pr, point *restrict
  * backwards, for origins from just below it down to u*, so each sees
  * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
  * origins from just above it up to u*, so each sees [u* - L, j). */
-static void walk_round(const sweep_job *job, const profile *pr, point *h) {
+static void walk_round(const sweep_job *job, const profile *pr, point *h[2]) {
   const int top = pr->top, n = pr->count, L = pr->len;
   const double u_top = pr->pt[top].u;
-  if (job->side[0].dir) {
-    const stretch st[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
-    const int first = (int)ceil(u_top);
-    walk_ahead(job, pr, h, st, 2, first + L - 1, first);
-  }
-  if (job->side[1].dir) {
-    const stretch st[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
-    const int last = (int)floor(u_top);
-    walk_behind(job, pr, h, st, 2, last - L + 1, last);
-  }
+  stretch down[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
+  stretch up[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
+  const int first = (int)ceil(u_top), last = (int)floor(u_top);
+  walk ahead = walk_start(pr, h[0], down, 2, first + L - 1, first, 1);
+  walk behind = walk_start(pr, h[1], up, 2, last - L + 1, last, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
-static void walk_line(const sweep_job *job, const profile *pr, point *h) {
-  const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
-  if (job->side[0].dir) walk_ahead(job, pr, h, &down, 1, pr->len - 1, 0);
-  if (job->side[1].dir) walk_behind(job, pr, h, &up, 1, 0, pr->len - 1);
+static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
+  stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
+  walk ahead = walk_start(pr, h[0], &down, 1, pr->len - 1, 0, 1);
+  walk behind = walk_start(pr, h[1], &up, 1, 0, pr->len - 1, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
 }
 
 /* What the line's texels lose to the horizons found, added to their sums:
@@ -607,7 +678,7 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
 enum { BUNDLE = 64 };
 
 /* One line (or chunk) of the list, with buffers sized for the longest. */
-static void sweep_one(sweep_job *job, int item, profile *pr, point *h) {
+static void sweep_one(sweep_job *job, int item, profile *pr, point *h[2]) {
   int before, after;
   item_extent(job, item, &before, &after);
   pr->len = job->item_len[item];
@@ -634,7 +705,7 @@ static void sweep_bundle(void *user, int bundle) {
   const size_t count = (size_t)steps * (size_t)job->point_count + 1;
   const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
   profile pr = {0};
-  point *h = malloc(count * sizeof(point));
+  point *h[2] = {malloc(count * sizeof(point)), malloc(count * sizeof(point))}; /* a hull per walk */
   pr.block_u = malloc(block * sizeof(double));
   pr.block_z = malloc(block * sizeof(double));
   pr.block_rise = malloc(block * sizeof(double));
@@ -643,14 +714,15 @@ static void sweep_bundle(void *user, int bundle) {
   pr.found[0] = malloc((size_t)len * sizeof(float));
   pr.found[1] = malloc((size_t)len * sizeof(float));
   pr.pt = malloc(count * sizeof(point));
-  if (pr.pt && h && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
+  if (pr.pt && h[0] && h[1] && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
       pr.found[0] && pr.found[1]) {
     for (int item = first; item < last; item++) sweep_one(job, item, &pr, h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
   free(pr.pt);
-  free(h);
+  free(h[0]);
+  free(h[1]);
   free(pr.block_u);
   free(pr.block_z);
   free(pr.block_rise);
