@@ -149,13 +149,27 @@ static inline int imin(int a, int b) {
 
 /* ------------------------------------------------------------- profiles */
 
-/* A point of a profile: where it is (u, in steps from the line's texel 0),
- * its height, and for the exact slope the step it belongs to and its
- * template point. */
+/* A point of a profile or a hull: where it is (u, in steps from the line's
+ * texel 0, or mirrored), its height, and for the exact slope its key: the
+ * step it belongs to and its template point, step * KEY_STEP + tp (a shift
+ * of the step by d adds d * KEY_STEP). Fields are stored one by one: a copy
+ * of the whole struct costs shuffles between registers. */
 typedef struct point {
   double u, z;
-  int step, tp;
+  int64_t key;
 } point;
+
+#define KEY_STEP 1024 /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
+
+static inline int64_t key_of(int step, int tp) {
+  return (int64_t)step * KEY_STEP + tp;
+}
+static inline int key_step(int64_t key) { /* floors: tp >= 0 */
+  return (int)(key >> 10);
+}
+static inline int key_tp(int64_t key) {
+  return (int)(key & (KEY_STEP - 1));
+}
 
 /* The points of a line (or chunk) that can matter, by rising u: step
  * first_step + s covers u in (first_step + s, first_step + s + 1]. Origins
@@ -163,9 +177,14 @@ typedef struct point {
 typedef struct profile {
   int first_step, steps, len;
   int count;
+  int top; /* the first point of the greatest height */
   point *pt;
   double *vz;
   size_t *texel;
+  float *found[2]; /* each texel's horizon along (a, b) and along (-a, -b) */
+  /* the points of a block of steps, for the kink filter */
+  double *block_u, *block_z;
+  double *block_rise; /* kept when > 0 */
 } profile;
 
 /* Height of vertex (x, y) through the addressing; periodic coordinates lie
@@ -190,6 +209,28 @@ static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
   return p->addressing == BB_ADDRESS_PERIODIC ? bb__wrap_near(v + step, n) : v + step;
 }
 
+/* The heights of the points of the step from texel (bx, by), in template
+ * order. Away from the edges no vertex wraps or clamps, and each is a fixed
+ * offset. */
+static inline void step_heights(const sweep_job *job, int bx, int by, double *zs) {
+  const bb_pyramid *p = job->p;
+  const int tcount = job->point_count;
+  if (bx >= job->reach_x && bx < p->width - job->reach_x && by >= job->reach_y &&
+      by < p->height - job->reach_y) {
+    const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
+    const long *const off1 = job->offset1, *const off2 = job->offset2;
+    const double *const weight = job->weight;
+    for (int k = 0; k < tcount; k++)
+      zs[k] = bb__lattice_height(here[off1[k]], here[off2[k]], weight[k]);
+  } else {
+    for (int k = 0; k < tcount; k++) {
+      const template_point *t = &job->points[k];
+      zs[k] = bb__lattice_height(field_z(p, bx + t->x1, by + t->y1),
+                                 field_z(p, bx + t->x2, by + t->y2), job->weight[k]);
+    }
+  }
+}
+
 /* The points of steps first_step .. first_step + steps - 1 of the line whose
  * texel 0 is (x0, y0), without those that can never decide a horizon.
  *
@@ -199,128 +240,188 @@ static inline int step_along(const bb_pyramid *p, int v, int step, int n) {
  * which sits at or above its vertex (bias >= 0), X (or L) is. A run of such
  * points lies under the chord of the points kept around it (the profile is
  * convex along the run), so dropping them all at once is safe too. Half the
- * points go on rough maps, without a branch. (Keeping only each step's
+ * points go on rough maps, without a branch: each point is stored, and the
+ * count moves on past it only when it is kept. (Keeping only each step's
  * upper hull drops a sixth more, but the stack that finds it branches on
  * every point, unpredictably, and costs more than the walks save.) The ends
  * are kept. */
+/* Steps whose points are made before the kink filter runs over them: their
+ * heights and u first, then the chord test of every point at once (a loop
+ * the compiler vectorises), then the kept points, copied out in order. */
+enum { BLOCK_STEPS = 32 };
+
+static inline void put_point(point *pt, double u, double z, int64_t key) {
+  pt->u = u, pt->z = z, pt->key = key;
+}
+
+/* Copies the points of steps s0 .. s1-1 of the block out of the block
+ * arrays (the step s0 starts at index base) and moves the count on past
+ * those kept; the block's last point is left for the next block. */
+static inline int keep_points(const sweep_job *job, const profile *pr, int s0, int s1,
+                              int base, int count) {
+  const int tcount = job->point_count;
+  const double *restrict u = pr->block_u, *restrict z = pr->block_z;
+  const double *restrict rise = pr->block_rise;
+  point *restrict out = pr->pt;
+  for (int s = s0; s < s1; s++, base += tcount) {
+    const int64_t key = key_of(pr->first_step + s, 0);
+    const int last = s == s1 - 1 ? tcount - 1 : tcount;
+    for (int k = 0; k < last; k++) {
+      put_point(&out[count], u[base + k], z[base + k], key + k);
+      count += rise[base + k] > 0.0;
+    }
+  }
+  return count;
+}
+
+/* The first point of the greatest height among pt[0 .. to-1], given best,
+ * that of pt[0 .. from-1] (0 when from is 0). Run on each block's points
+ * while they are in the cache. */
+static int highest_point(const point *pt, int from, int to, int best) {
+  if (from == 0) {
+    if (to == 0) return 0;
+    best = 0, from = 1;
+  }
+  double best_z = pt[best].z;
+  for (int q = from; q < to; q++)
+    if (pt[q].z > best_z) best = q, best_z = pt[q].z;
+  return best;
+}
+
 static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
   const bb_pyramid *p = job->p;
   const int tcount = job->point_count;
-  const long *const off1 = job->offset1, *const off2 = job->offset2;
-  const double *const frac = job->frac, *const weight = job->weight;
-  double zs[4 * BB__MAX_LATTICE_STEP + 1];
+  const double *const frac = job->frac;
   int bx = coordinate_at(p, (long)x0 + (long)pr->first_step * job->a, p->width);
   int by = coordinate_at(p, (long)y0 + (long)pr->first_step * job->b, p->height);
   const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
   const int sa = periodic ? job->a % p->width : job->a, sb = periodic ? job->b % p->height : job->b;
-  point *restrict out = pr->pt;
-  int count = 0, seen = 0;
-  double ua = 0.0, za = 0.0; /* the kink window: a, then the pending point b */
-  point b = {0};
-  for (int s = 0; s < pr->steps; s++, bx = step_along(p, bx, sa, p->width),
-           by = step_along(p, by, sb, p->height)) {
-    const int j = pr->first_step + s; /* texel of the line at the step's start */
-    if (j >= 0 && j < pr->len) {
-      pr->vz[j] = field_z(p, bx, by);
-      pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
-    }
-    /* The heights of the step's points. Away from the edges no vertex wraps
-     * or clamps, and each is a fixed offset. */
-    if (bx >= job->reach_x && bx < p->width - job->reach_x && by >= job->reach_y &&
-        by < p->height - job->reach_y) {
-      const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
-      for (int k = 0; k < tcount; k++)
-        zs[k] = bb__lattice_height(here[off1[k]], here[off2[k]], weight[k]);
-    } else {
-      for (int k = 0; k < tcount; k++) {
-        const template_point *t = &job->points[k];
-        zs[k] = bb__lattice_height(field_z(p, bx + t->x1, by + t->y1),
-                                   field_z(p, bx + t->x2, by + t->y2), weight[k]);
+  double *restrict u = pr->block_u, *restrict z = pr->block_z;
+  double *restrict rise = pr->block_rise;
+  int count = 0, top = 0;
+  int n = 0; /* points in the block arrays: two carried over (after the first
+              * block), then the block's */
+  for (int s0 = 0; s0 < pr->steps; s0 += BLOCK_STEPS) {
+    const int s1 = imin(s0 + BLOCK_STEPS, pr->steps), base = n;
+    for (int s = s0; s < s1; s++, bx = step_along(p, bx, sa, p->width),
+             by = step_along(p, by, sb, p->height)) {
+      const int j = pr->first_step + s; /* texel of the line at the step's start */
+      if (j >= 0 && j < pr->len) {
+        pr->vz[j] = field_z(p, bx, by);
+        pr->texel[j] = (size_t)by * (size_t)p->width + (size_t)bx;
       }
+      step_heights(job, bx, by, z + n);
+      const double ju = (double)j;
+      for (int k = 0; k < tcount; k++) u[n + k] = ju + frac[k];
+      n += tcount;
     }
-    /* b is kept when above the chord from a to the new point */
-    const double ju = (double)j;
-    for (int k = 0; k < tcount; k++, seen++) {
-      const double u = ju + frac[k], z = zs[k];
-      out[count] = b;
-      count += seen == 1 || (seen > 1 && (b.z - za) * (u - ua) > (z - za) * (b.u - ua));
-      ua = b.u, za = b.z;
-      b = (point){u, z, j, k};
+    /* point i is kept when above the chord of its neighbours: when l > r,
+     * which is when l - r > 0 (a difference of doubles is 0 only when they
+     * are equal, and keeps its sign), a form the compiler vectorises */
+    for (int i = 1; i < n - 1; i++)
+      rise[i] = (z[i] - z[i - 1]) * (u[i + 1] - u[i - 1]) -
+                (z[i + 1] - z[i - 1]) * (u[i] - u[i - 1]);
+    if (s0 == 0) rise[0] = 1.0; /* the first point is an end */
+    const int first_kept = count;
+    if (s0 > 0) { /* the previous block's last point, carried at index 1 */
+      put_point(&pr->pt[count], u[1], z[1], key_of(pr->first_step + s0 - 1, tcount - 1));
+      count += rise[1] > 0.0;
+    }
+    count = keep_points(job, pr, s0, s1, base, count);
+    top = highest_point(pr->pt, first_kept, count, top);
+    if (s1 < pr->steps) { /* the last two go on to the next block */
+      u[0] = u[n - 2], z[0] = z[n - 2];
+      u[1] = u[n - 1], z[1] = z[n - 1];
+      n = 2;
     }
   }
-  if (seen) out[count++] = b; /* the last point is an end */
+  /* the last point is an end */
+  put_point(&pr->pt[count++], u[n - 1], z[n - 1],
+            key_of(pr->first_step + pr->steps - 1, tcount - 1));
+  pr->top = highest_point(pr->pt, count - 1, count, top);
   pr->count = count;
 }
 
 /* ------------------------------------------------------------------ hulls */
 
-/* Upper hull of the points ahead, nearest last (u may be mirrored). */
-typedef struct hull {
-  point *v;
-  int size;
-} hull;
+/* The hull: upper hull of the points ahead, nearest last (u may be
+ * mirrored), an array of points; its size is passed around. */
 
 /* Pushes a point nearer than all others, dropping those now under the hull;
  * then, if nothing ahead is higher than it, keeps it alone: from any origin
  * behind it is then either steeper than everything ahead (positive slope,
  * shorter distance) or everything is below the origin (horizon 0). */
-static inline void hull_push(hull *h, point q) {
-  point *restrict v = h->v;
-  int size = h->size;
-  while (size >= 2) {
-    const point *a = &v[size - 1], *b = &v[size - 2];
-    /* a is on or under the segment from the new point to b */
-    if ((a->z - q.z) * (b->u - q.u) <= (b->z - q.z) * (a->u - q.u)) size--;
-    else break;
+/* Is hull vertex a on or under the segment from the new point (qu, qz) to
+ * the vertex b beyond it? */
+static inline int under(const point *a, const point *b, double qu, double qz) {
+  return (a->z - qz) * (b->u - qu) <= (b->z - qz) * (a->u - qu);
+}
+
+/* A push mostly drops one vertex, sometimes none or two (rock06: 68%, 18%,
+ * 11%; three or more 3%): the first two tests are made together and
+ * combined without a branch, which would be mispredicted a third of the
+ * time; the vertices dropped are those of a plain loop. */
+static inline int hull_push(point *restrict v, int size, double qu, double qz,
+                            int64_t key) {
+  int more = 1; /* may more vertices go? */
+  if (size >= 3) {
+    const int one = under(&v[size - 1], &v[size - 2], qu, qz);
+    const int two = one & under(&v[size - 2], &v[size - 3], qu, qz);
+    size -= one + two;
+    more = two;
   }
-  if (size >= 1 && v[size - 1].z <= q.z) size = 0;
-  v[size++] = q;
-  h->size = size;
+  while (more && size >= 2 && under(&v[size - 1], &v[size - 2], qu, qz)) size--;
+  if (size >= 1 && v[size - 1].z <= qz) size = 0;
+  put_point(&v[size], qu, qz, key);
+  return size + 1;
+}
+
+/* Is hull vertex far steeper from the origin than the vertex at (du, dz)
+ * from it? (denominators are positive) */
+static inline int steeper(const point *far, double du, double dz, double u0, double z0) {
+  return (far->z - z0) * du > dz * (far->u - u0);
 }
 
 /* Index of the hull vertex of largest slope from (u0, z0), behind every
  * point: slopes to hull vertices rise, then fall, going away from the
- * origin. The tangent is mostly at the nearest vertex or the next, so a walk
- * from the near end beats a binary search. */
-static inline int hull_tangent(const hull *h, double u0, double z0) {
-  const point *v = h->v;
-  int i = h->size - 1;
+ * origin, so a walk from the near end finds it, mostly within three steps.
+ * The nearest vertex (a fraction of a step ahead, below an origin lifted by
+ * the bias) is seldom the tangent, but whether the walk goes one or two
+ * steps further is a toss-up: those two tests are made together and
+ * combined without a branch, which the processor would mispredict half the
+ * time. The tests and where the walk stops are those of a plain walk. */
+static inline int hull_tangent(const point *v, int size, double u0, double z0) {
+  int i = size - 1;
   if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
   double du = v[i].u - u0, dz = v[i].z - z0;
-  while (i > 0) {
-    const double du_far = v[i - 1].u - u0, dz_far = v[i - 1].z - z0;
-    /* is the farther vertex steeper? (denominators are positive) */
-    if (!(dz_far * du > dz * du_far)) break;
-    du = du_far;
-    dz = dz_far;
-    i--;
+  if (i == 0 || !steeper(&v[i - 1], du, dz, u0, z0)) return i;
+  i--, du = v[i].u - u0, dz = v[i].z - z0;
+  if (i >= 2) {
+    const double du1 = v[i - 1].u - u0, dz1 = v[i - 1].z - z0;
+    const int one = steeper(&v[i - 1], du, dz, u0, z0);
+    const int two = one & steeper(&v[i - 2], du1, dz1, u0, z0);
+    if (!two) return i - one;
+    i -= 2, du = v[i].u - u0, dz = v[i].z - z0;
   }
+  while (i > 0 && steeper(&v[i - 1], du, dz, u0, z0))
+    i--, du = v[i].u - u0, dz = v[i].z - z0;
   return i;
 }
 
 /* The canonical slope per step from origin texel j (height oz) to hull
  * vertex i, ahead of the origin (forward) or behind it. */
-static inline double slope_to(const sweep_job *job, const hull *h, int i, int j, double oz,
+static inline double slope_to(const sweep_job *job, const point *v, int i, int j, double oz,
                               int forward) {
   if (i < 0) return 0.0;
-  const point *v = &h->v[i];
-  const template_point *t = &job->points[v->tp];
-  const long n = forward ? (long)(v->step - j) * t->m + t->i : (long)(j - v->step) * t->m - t->i;
-  return (v->z - oz) / bb__lattice_distance(n, t->inverse_m);
+  const int step = key_step(v[i].key);
+  const template_point *t = &job->points[key_tp(v[i].key)];
+  const long n = forward ? (long)(step - j) * t->m + t->i : (long)(j - step) * t->m - t->i;
+  return (v[i].z - oz) / bb__lattice_distance(n, t->inverse_m);
 }
 
-/* A texel's horizon along side k: stored for the tests when asked, and
- * integrated into its sums. */
-static inline void emit_horizon(const sweep_job *job, int k, size_t texel, float h) {
-  const bb__sweep_dir *dir = job->side[k].dir;
-  if (dir->horizon) dir->horizon[texel] = h;
-  bb__slice_accumulate(&job->side[k].integral, h, dir->sums + texel * (size_t)job->channels);
-}
-
-/* The same from the best slope per step. */
-static inline void emit(const sweep_job *job, int k, size_t texel, double slope) {
-  emit_horizon(job, k, texel,
-               bb__lattice_horizon(slope > 0.0 ? slope : 0.0, job->side[k].inverse_length));
+/* The horizon in texels from the best slope per step. */
+static inline float horizon_of(const sweep_job *job, int k, double slope) {
+  return bb__lattice_horizon(slope > 0.0 ? slope : 0.0, job->side[k].inverse_length);
 }
 
 /* ---------------------------------------------------------- line sweeps */
@@ -333,29 +434,29 @@ static int vouched(const sweep_job *job, double slope, double oz, double distanc
 }
 
 /* Origin j of a line (texel j mod L, -L <= j < 2 L) asks the hull for its
- * horizon. In a chunk, a texel the profile cannot vouch for (the points
- * beyond it lie at least `beyond` steps away) is marched instead, which
- * finds the same bits. */
-static inline void query(const sweep_job *job, const profile *pr, const hull *h, int j,
-                         int forward) {
+ * horizon, kept in found[k] until the line's walks are done. In a chunk, a
+ * texel the profile cannot vouch for (the points beyond it lie at least
+ * `beyond` steps away) is marched instead, which finds the same bits. */
+static inline __attribute__((always_inline)) void query(const sweep_job *job, const profile *pr,
+                                                       const point *h, int size, int j,
+                                                       int forward) {
   const int L = pr->len;
   const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
   const double oz = pr->vz[texel_j] + job->bias;
   const int k = forward ? 0 : 1;
   const double u0 = forward ? (double)j : -(double)j;
-  const double slope = slope_to(job, h, hull_tangent(h, u0, oz), j, oz, forward);
-  const size_t texel = pr->texel[texel_j];
+  const double slope = slope_to(job, h, hull_tangent(h, size, u0, oz), j, oz, forward);
+  float found = horizon_of(job, k, slope);
   if (job->kind == LINE_CHUNK) {
     const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
                                   : (double)(j - pr->first_step);
     if (!vouched(job, slope, oz, beyond)) {
+      const size_t texel = pr->texel[texel_j];
       const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
-      emit_horizon(job, k, texel,
-                   bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b));
-      return;
+      found = bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
     }
   }
-  emit(job, k, texel, slope);
+  pr->found[k][texel_j] = found;
 }
 
 /* A stretch of profile points, pt[from] to pt[to] inclusive (either way
@@ -364,57 +465,121 @@ typedef struct stretch {
   int from, to, shift;
 } stretch;
 
-/* Along (a, b): the points of the stretches by falling u; origins j from
- * j_high down to j_low, each asking once every point beyond it is on the
- * hull. */
-static void walk_ahead(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
-                       int stretches, int j_high, int j_low) {
-  int j = j_high;
-  h->size = 0;
-  for (int r = 0; r < stretches; r++) {
-    const double du = (double)st[r].shift;
-    const int ds = st[r].shift;
-    for (int q = st[r].from; q >= st[r].to; q--) {
-      point v = pr->pt[q];
-      v.u += du, v.step += ds;
-      for (; (double)j >= v.u; j--) {
-        if (j < j_low) return;
-        query(job, pr, h, j, 1);
-      }
-      hull_push(h, v);
-    }
-  }
-  for (; j >= j_low; j--) query(job, pr, h, j, 1);
+/* One walk along a line, with its own hull. Along (a, b) (forward) it
+ * pushes the points of its stretches by falling u, and its origins j, from
+ * j_first down to j_last, each ask the hull once every point beyond them is
+ * on it. Along (-a, -b) it takes the points by rising u, on mirrored u so the
+ * hull code is the same, and the origins rising. */
+typedef struct walk {
+  point *h;
+  int size;
+  stretch *st;
+  int stretches, r; /* the stretch under way */
+  int q, left;      /* its next point, and the points left in it */
+  double du;        /* its shift */
+  int64_t dkey;
+  int j, j_last; /* the next origin, and the last */
+} walk;
+
+/* Is point q of stretch s still wanted: is an origin left to ask once it is
+ * on the hull? Past the first that is not, none is (u falls along a forward
+ * walk, rises along the other). */
+static inline int walk_wants(const profile *pr, const walk *w, const stretch *s, int q,
+                             int forward) {
+  const double u = pr->pt[q].u + (double)s->shift;
+  return forward ? !((double)(w->j_last - 1) >= u) : !((double)(w->j_last + 1) <= u);
 }
 
-/* Along (-a, -b): the points of the stretches by rising u, on mirrored u so
- * the hull code is the same; origins j from j_low up to j_high. */
-static void walk_behind(const sweep_job *job, const profile *pr, hull *h, const stretch *st,
-                        int stretches, int j_low, int j_high) {
-  int j = j_low;
-  h->size = 0;
-  for (int r = 0; r < stretches; r++) {
-    const double du = (double)st[r].shift;
-    const int ds = st[r].shift;
-    for (int q = st[r].from; q <= st[r].to; q++) {
-      point v = pr->pt[q];
-      v.u = -(v.u + du), v.step += ds;
-      for (; (double)j <= -v.u; j++) {
-        if (j > j_high) return;
-        query(job, pr, h, j, 0);
-      }
-      hull_push(h, v);
+/* Cuts the stretches at the first point no origin wants (found by halving),
+ * so that the walk's loops need not look for the end of the origins. */
+static void walk_clip(const profile *pr, walk *w, int forward) {
+  const int dq = forward ? -1 : 1;
+  for (int r = 0; r < w->stretches; r++) {
+    stretch *s = &w->st[r];
+    const int n = (s->to - s->from) * dq + 1;
+    if (n <= 0 || walk_wants(pr, w, s, s->to, forward)) continue;
+    int lo = 0, hi = n - 1; /* the first unwanted is in (lo - 1, hi] */
+    while (lo < hi) {
+      const int mid = lo + (hi - lo) / 2;
+      if (walk_wants(pr, w, s, s->from + mid * dq, forward))
+        lo = mid + 1;
+      else
+        hi = mid;
     }
+    s->to = s->from + (lo - 1) * dq; /* before `from` when none is wanted */
+    w->stretches = r + 1;
+    return;
   }
-  for (; j <= j_high; j++) query(job, pr, h, j, 0);
 }
 
-/* The first point of the highest height in a profile. */
-static int highest_point(const profile *pr) {
-  int best = 0;
-  for (int q = 1; q < pr->count; q++)
-    if (pr->pt[q].z > pr->pt[best].z) best = q;
-  return best;
+static walk walk_start(const profile *pr, point *h, stretch *st, int stretches, int j_first,
+                       int j_last, int forward) {
+  walk w = {.h = h, .st = st, .stretches = stretches, .j = j_first, .j_last = j_last};
+  walk_clip(pr, &w, forward);
+  return w;
+}
+
+/* Moves the walk on to the first stretch from r on that holds points; 0
+ * when there is none. */
+static inline int walk_enter(walk *w, int forward) {
+  const int dq = forward ? -1 : 1;
+  for (; w->r < w->stretches; w->r++) {
+    const stretch *s = &w->st[w->r];
+    w->left = (s->to - s->from) * dq + 1;
+    if (w->left <= 0) continue;
+    w->q = s->from;
+    w->du = (double)s->shift, w->dkey = (int64_t)s->shift * KEY_STEP;
+    return 1;
+  }
+  return 0;
+}
+
+/* The walk's next point: the origins before it ask the hull, then it is
+ * pushed. */
+static inline __attribute__((always_inline)) void walk_next(const sweep_job *job,
+                                                           const profile *pr, walk *w,
+                                                           int forward) {
+  const point *next = pr->pt + w->q;
+  const double u = next->u + w->du;
+  if (forward)
+    for (; (double)w->j >= u; w->j--) query(job, pr, w->h, w->size, w->j, 1);
+  else
+    for (; (double)w->j <= u; w->j++) query(job, pr, w->h, w->size, w->j, 0);
+  w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, next->key + w->dkey);
+  w->q += forward ? -1 : 1;
+}
+
+/* Every point of the walk, then the origins left once all are on the hull. */
+static inline void walk_rest(const sweep_job *job, const profile *pr, walk *w, int more,
+                             int forward) {
+  for (; more; w->r++, more = walk_enter(w, forward))
+    for (; w->left > 0; w->left--) walk_next(job, pr, w, forward);
+  if (forward)
+    for (; w->j >= w->j_last; w->j--) query(job, pr, w->h, w->size, w->j, 1);
+  else
+    for (; w->j <= w->j_last; w->j++) query(job, pr, w->h, w->size, w->j, 0);
+}
+
+/* Both walks of a line (NULL: that side is not wanted), one point of each
+ * in turn. Each push waits on what the push before it stored in the same
+ * hull; the two hulls are independent, so the processor overlaps the two
+ * chains. The walks write different horizons (found[0], found[1]), so the
+ * results are those of one walk after the other. */
+static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind) {
+  walk a = ahead ? *ahead : (walk){0}, b = behind ? *behind : (walk){0};
+  int more_a = ahead && walk_enter(&a, 1), more_b = behind && walk_enter(&b, 0);
+  while (more_a && more_b) {
+    const int n = imin(a.left, b.left);
+    for (int i = 0; i < n; i++) {
+      walk_next(job, pr, &a, 1);
+      walk_next(job, pr, &b, 0);
+    }
+    a.left -= n, b.left -= n;
+    if (!a.left) a.r++, more_a = walk_enter(&a, 1);
+    if (!b.left) b.r++, more_b = walk_enter(&b, 0);
+  }
+  if (ahead) walk_rest(job, pr, &a, more_a, 1);
+  if (behind) walk_rest(job, pr, &b, more_b, 0);
 }
 
 /* Once round a periodic line of L steps (points in u (0, L]), from its
@@ -422,26 +587,53 @@ static int highest_point(const profile *pr) {
  * backwards, for origins from just below it down to u*, so each sees
  * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
  * origins from just above it up to u*, so each sees [u* - L, j). */
-static void walk_round(const sweep_job *job, const profile *pr, hull *h) {
-  const int top = highest_point(pr), n = pr->count, L = pr->len;
+static void walk_round(const sweep_job *job, const profile *pr, point *h[2]) {
+  const int top = pr->top, n = pr->count, L = pr->len;
   const double u_top = pr->pt[top].u;
-  if (job->side[0].dir) {
-    const stretch st[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
-    const int first = (int)ceil(u_top);
-    walk_ahead(job, pr, h, st, 2, first + L - 1, first);
-  }
-  if (job->side[1].dir) {
-    const stretch st[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
-    const int last = (int)floor(u_top);
-    walk_behind(job, pr, h, st, 2, last - L + 1, last);
-  }
+  stretch down[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
+  stretch up[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
+  const int first = (int)ceil(u_top), last = (int)floor(u_top);
+  walk ahead = walk_start(pr, h[0], down, 2, first + L - 1, first, 1);
+  walk behind = walk_start(pr, h[1], up, 2, last - L + 1, last, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
-static void walk_line(const sweep_job *job, const profile *pr, hull *h) {
-  const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
-  if (job->side[0].dir) walk_ahead(job, pr, h, &down, 1, pr->len - 1, 0);
-  if (job->side[1].dir) walk_behind(job, pr, h, &up, 1, 0, pr->len - 1);
+static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
+  stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
+  walk ahead = walk_start(pr, h[0], &down, 1, pr->len - 1, 0, 1);
+  walk behind = walk_start(pr, h[1], &up, 1, 0, pr->len - 1, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
+}
+
+/* What the line's texels lose to the horizons found, added to their sums:
+ * along (a, b) first, then along (-a, -b), as the slices' order wants. The
+ * walks only find horizons; integrating them here, in a loop of its own,
+ * lets the divisions and table reads of neighbouring texels overlap. */
+static void integrate_line(const sweep_job *job, const profile *pr) {
+  const int channels = job->channels;
+  for (int k = 0; k < 2; k++) {
+    const bb__sweep_dir *dir = job->side[k].dir;
+    if (!dir || !dir->horizon) continue;
+    for (int j = 0; j < pr->len; j++) dir->horizon[pr->texel[j]] = pr->found[k][j];
+  }
+  if (job->side[0].dir && job->side[1].dir) {
+    const bb__slice_integral *along = &job->side[0].integral, *opposite = &job->side[1].integral;
+    float *sums = job->side[0].dir->sums;
+    for (int j = 0; j < pr->len; j++) {
+      float *texel_sums = sums + pr->texel[j] * (size_t)channels;
+      bb__slice_accumulate(along, pr->found[0][j], texel_sums);
+      bb__slice_accumulate(opposite, pr->found[1][j], texel_sums);
+    }
+    return;
+  }
+  for (int k = 0; k < 2; k++) {
+    const bb__sweep_dir *dir = job->side[k].dir;
+    if (!dir) continue;
+    for (int j = 0; j < pr->len; j++)
+      bb__slice_accumulate(&job->side[k].integral, pr->found[k][j],
+                           dir->sums + pr->texel[j] * (size_t)channels);
+  }
 }
 
 /* ------------------------------------------------------------ work items */
@@ -486,7 +678,7 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
 enum { BUNDLE = 64 };
 
 /* One line (or chunk) of the list, with buffers sized for the longest. */
-static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
+static void sweep_one(sweep_job *job, int item, profile *pr, point *h[2]) {
   int before, after;
   item_extent(job, item, &before, &after);
   pr->len = job->item_len[item];
@@ -497,6 +689,7 @@ static void sweep_one(sweep_job *job, int item, profile *pr, hull *h) {
     walk_round(job, pr, h);
   else
     walk_line(job, pr, h);
+  integrate_line(job, pr);
 }
 
 static void sweep_bundle(void *user, int bundle) {
@@ -509,22 +702,34 @@ static void sweep_bundle(void *user, int bundle) {
     steps = imax(steps, before + job->item_len[item] + after);
     len = imax(len, job->item_len[item]);
   }
-  const size_t points = (size_t)steps * (size_t)job->point_count + 1;
+  const size_t count = (size_t)steps * (size_t)job->point_count + 1;
+  const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
   profile pr = {0};
-  hull h = {0};
-  pr.pt = malloc(points * sizeof(point));
+  point *h[2] = {malloc(count * sizeof(point)), malloc(count * sizeof(point))}; /* a hull per walk */
+  pr.block_u = malloc(block * sizeof(double));
+  pr.block_z = malloc(block * sizeof(double));
+  pr.block_rise = malloc(block * sizeof(double));
   pr.vz = malloc((size_t)len * sizeof(double));
   pr.texel = malloc((size_t)len * sizeof(size_t));
-  h.v = malloc(points * sizeof(point));
-  if (pr.pt && pr.vz && pr.texel && h.v) {
-    for (int item = first; item < last; item++) sweep_one(job, item, &pr, &h);
+  pr.found[0] = malloc((size_t)len * sizeof(float));
+  pr.found[1] = malloc((size_t)len * sizeof(float));
+  pr.pt = malloc(count * sizeof(point));
+  if (pr.pt && h[0] && h[1] && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
+      pr.found[0] && pr.found[1]) {
+    for (int item = first; item < last; item++) sweep_one(job, item, &pr, h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
   free(pr.pt);
+  free(h[0]);
+  free(h[1]);
+  free(pr.block_u);
+  free(pr.block_z);
+  free(pr.block_rise);
   free(pr.vz);
   free(pr.texel);
-  free(h.v);
+  free(pr.found[0]);
+  free(pr.found[1]);
 }
 
 /* A growable list of work items. */
