@@ -8,6 +8,7 @@
 
 #include <dirent.h>
 #include <ftw.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,6 +96,13 @@ static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
     dup2(fileno(err), STDERR_FILENO);
     if (cwd && chdir(cwd) != 0)
       _exit(126);
+    /* The CLI keeps a signal ignored when it was ignored at its start (as
+     * under nohup); a test runner started in the background by a
+     * non-interactive shell ignores SIGINT, so give the child the defaults
+     * an interactive user's program gets. */
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    signal(SIGHUP, SIG_DFL);
     harness_set_limit(RLIMIT_FSIZE, lim->file_size_bytes);
     harness_set_limit(RLIMIT_AS, lim->address_space_bytes);
     execv(binary, (char *const *)argv);
