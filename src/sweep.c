@@ -90,6 +90,8 @@ typedef struct sweep_job {
   double frac[4 * BB__MAX_LATTICE_STEP + 1], weight[4 * BB__MAX_LATTICE_STEP + 1];
   int min_dx, max_dx, min_dy, max_dy; /* template vertex offsets */
   atomic_int out_of_memory;
+  struct scratch *scratch; /* a slot per thread (sweep_bundle) */
+  int scratch_count;
 } sweep_job;
 
 static int cmp_frac(const void *pa, const void *pb) {
@@ -692,6 +694,68 @@ static void sweep_one(sweep_job *job, int item, profile *pr, point *h[2]) {
   integrate_line(job, pr);
 }
 
+/* A worker's buffers, kept from one bundle to the next and grown when a
+ * bundle needs more: allocated per bundle, they went back to the system at
+ * each free and faulted in again at the next bundle. At most one bundle per
+ * thread runs at a time, so a slot per thread always has one free. */
+typedef struct scratch {
+  atomic_flag busy;
+  size_t points, len; /* what pt, h[] and the per-texel arrays hold */
+  point *pt, *h[2];   /* the profile, a hull per walk */
+  double *block_u, *block_z, *block_rise;
+  double *vz;
+  size_t *texel;
+  float *found[2];
+} scratch;
+
+static void scratch_release(scratch *sc) {
+  free(sc->pt);
+  free(sc->h[0]);
+  free(sc->h[1]);
+  free(sc->block_u);
+  free(sc->block_z);
+  free(sc->block_rise);
+  free(sc->vz);
+  free(sc->texel);
+  free(sc->found[0]);
+  free(sc->found[1]);
+}
+
+/* Room for `points` profile points and `len` texels; 0 when out of memory. */
+static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, size_t len) {
+  if (!sc->block_u) {
+    const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
+    sc->block_u = malloc(block * sizeof(double));
+    sc->block_z = malloc(block * sizeof(double));
+    sc->block_rise = malloc(block * sizeof(double));
+    if (!sc->block_u || !sc->block_z || !sc->block_rise) return 0;
+  }
+  if (points > sc->points) {
+    free(sc->pt), free(sc->h[0]), free(sc->h[1]);
+    sc->pt = malloc(points * sizeof(point));
+    sc->h[0] = malloc(points * sizeof(point));
+    sc->h[1] = malloc(points * sizeof(point));
+    sc->points = sc->pt && sc->h[0] && sc->h[1] ? points : 0;
+    if (!sc->points) return 0;
+  }
+  if (len > sc->len) {
+    free(sc->vz), free(sc->texel), free(sc->found[0]), free(sc->found[1]);
+    sc->vz = malloc(len * sizeof(double));
+    sc->texel = malloc(len * sizeof(size_t));
+    sc->found[0] = malloc(len * sizeof(float));
+    sc->found[1] = malloc(len * sizeof(float));
+    sc->len = sc->vz && sc->texel && sc->found[0] && sc->found[1] ? len : 0;
+    if (!sc->len) return 0;
+  }
+  return 1;
+}
+
+static scratch *scratch_take(sweep_job *job) {
+  for (;;)
+    for (int i = 0; i < job->scratch_count; i++)
+      if (!atomic_flag_test_and_set(&job->scratch[i].busy)) return &job->scratch[i];
+}
+
 static void sweep_bundle(void *user, int bundle) {
   sweep_job *job = user;
   const int first = bundle * BUNDLE, last = imin(first + BUNDLE, job->item_count);
@@ -702,34 +766,16 @@ static void sweep_bundle(void *user, int bundle) {
     steps = imax(steps, before + job->item_len[item] + after);
     len = imax(len, job->item_len[item]);
   }
-  const size_t count = (size_t)steps * (size_t)job->point_count + 1;
-  const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
-  profile pr = {0};
-  point *h[2] = {malloc(count * sizeof(point)), malloc(count * sizeof(point))}; /* a hull per walk */
-  pr.block_u = malloc(block * sizeof(double));
-  pr.block_z = malloc(block * sizeof(double));
-  pr.block_rise = malloc(block * sizeof(double));
-  pr.vz = malloc((size_t)len * sizeof(double));
-  pr.texel = malloc((size_t)len * sizeof(size_t));
-  pr.found[0] = malloc((size_t)len * sizeof(float));
-  pr.found[1] = malloc((size_t)len * sizeof(float));
-  pr.pt = malloc(count * sizeof(point));
-  if (pr.pt && h[0] && h[1] && pr.block_u && pr.block_z && pr.block_rise && pr.vz && pr.texel &&
-      pr.found[0] && pr.found[1]) {
-    for (int item = first; item < last; item++) sweep_one(job, item, &pr, h);
+  scratch *sc = scratch_take(job);
+  if (scratch_reserve(sc, job, (size_t)steps * (size_t)job->point_count + 1, (size_t)len)) {
+    profile pr = {.pt = sc->pt, .vz = sc->vz, .texel = sc->texel,
+                  .found = {sc->found[0], sc->found[1]}, .block_u = sc->block_u,
+                  .block_z = sc->block_z, .block_rise = sc->block_rise};
+    for (int item = first; item < last; item++) sweep_one(job, item, &pr, sc->h);
   } else {
     atomic_store(&job->out_of_memory, 1);
   }
-  free(pr.pt);
-  free(h[0]);
-  free(h[1]);
-  free(pr.block_u);
-  free(pr.block_z);
-  free(pr.block_rise);
-  free(pr.vz);
-  free(pr.texel);
-  free(pr.found[0]);
-  free(pr.found[1]);
+  atomic_flag_clear(&sc->busy);
 }
 
 /* A growable list of work items. */
@@ -870,8 +916,16 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
     job.item_y = it.y;
     job.item_len = it.len;
     job.item_count = it.count;
-    st = bb__parallel_for((it.count + BUNDLE - 1) / BUNDLE, threads, sweep_bundle, &job, NULL,
-                          NULL, err);
+    const int bundles = (it.count + BUNDLE - 1) / BUNDLE;
+    job.scratch_count = imin(imin(bb__thread_count(threads), bundles), 256);
+    job.scratch = calloc((size_t)imax(job.scratch_count, 1), sizeof(scratch));
+    if (!job.scratch) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+    if (st == BB_OK) {
+      for (int i = 0; i < job.scratch_count; i++) atomic_flag_clear(&job.scratch[i].busy);
+      st = bb__parallel_for(bundles, threads, sweep_bundle, &job, NULL, NULL, err);
+      for (int i = 0; i < job.scratch_count; i++) scratch_release(&job.scratch[i]);
+    }
+    free(job.scratch);
     if (st == BB_OK && atomic_load(&job.out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
   }

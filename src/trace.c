@@ -672,6 +672,17 @@ static void march_row(void *user, int row) {
   }
 }
 
+/* The sums start at zero, written row by row on every thread before any
+ * slice adds to them. calloc's pages are mapped on first touch, and a
+ * slice's first touch is a read (sums[c] += ...): each page then faulted
+ * twice, the second time a copy-on-write that interrupts every other thread
+ * of the bake to flush its TLB. */
+static void zero_row(void *user, int y) {
+  const trace_job *job = user;
+  const size_t n = (size_t)job->region.width * (size_t)job->channels;
+  memset(job->vis + (size_t)y * n, 0, n * sizeof(float));
+}
+
 /* Sweep path: slices in the summing order, a slice and its opposite per
  * sweep when they pair up. */
 static bb_status trace_sweeps(trace_job *job, bb_error *err) {
@@ -725,6 +736,9 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
     st = bb_image_alloc(vis, job.region.width, job.region.height, job.channels, err);
   if (st == BB_OK) {
     job.vis = vis->pixels;
+    st = bb__parallel_for(job.region.height, o->threads, zero_row, &job, NULL, NULL, err);
+  }
+  if (st == BB_OK) {
     st = path == BB__TRACE_MARCH
              ? bb__parallel_for(job.region.height, o->threads, march_row, &job, o->progress,
                                 o->progress_user, err)
