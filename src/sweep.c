@@ -903,13 +903,19 @@ static void job_template(sweep_job *job, template_point *pts) {
  * points of a block from its first step: template point k of a step (the
  * last is the next texel) may take the chord from k - 2 to k + 1 when
  * 1 <= k <= count - 2 (k - 2 = -1 is the step's start vertex), and the one
- * from k - 1 to k + 2 when k <= count - 3. 0 when out of memory. */
+ * from k - 1 to k + 2 when k <= count - 3. Kept as arrays, not worked out
+ * from i in the loop, so that the loop stays a plain vectorisable one.
+ * 0 when out of memory (nothing is left allocated). */
 static int job_chords(sweep_job *job) {
   const int count = job->point_count;
   const size_t block_points = (size_t)BLOCK_STEPS * (size_t)count;
   job->open_a = malloc(block_points * sizeof(double));
   job->open_b = malloc(block_points * sizeof(double));
-  if (!job->open_a || !job->open_b) return 0;
+  if (!job->open_a || !job->open_b) {
+    free(job->open_a);
+    free(job->open_b);
+    return 0;
+  }
   for (size_t q = 0; q < block_points; q++) {
     const int k = (int)(q % (size_t)count);
     job->open_a[q] = k >= 1 && k <= count - 2 ? 0.0 : INFINITY;
@@ -941,11 +947,8 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
   job.channels = 1 + (along ? along : opposite)->rs->basis_count;
   atomic_init(&job.out_of_memory, 0);
   job_template(&job, pts);
-  if (!job_chords(&job)) {
-    free(job.open_a);
-    free(job.open_b);
+  if (!job_chords(&job))
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
-  }
   items it = {0};
   int failed;
   if (p->addressing == BB_ADDRESS_CLAMP) {
