@@ -185,6 +185,11 @@ typedef struct profile {
   double *vz;
   size_t *texel;
   float *found[2]; /* each texel's horizon along (a, b) and along (-a, -b) */
+  /* what each texel's walk found: the tangent vertex's height and its key
+   * relative to the origin's step, turned into horizons after the walks
+   * (horizons_of_line) */
+  double *tangent_z[2];
+  int64_t *tangent_key[2];
   /* the points of a block of steps, for the kink filter */
   double *block_u, *block_z;
   double *block_rise; /* kept when > 0 */
@@ -434,15 +439,15 @@ static inline int hull_tangent(const point *v, int size, double u0, double z0) {
   return i;
 }
 
-/* The canonical slope per step from origin texel j (height oz) to hull
- * vertex i, ahead of the origin (forward) or behind it. */
-static inline double slope_to(const sweep_job *job, const point *v, int i, int j, double oz,
-                              int forward) {
-  if (i < 0) return 0.0;
-  const int step = key_step(v[i].key);
-  const template_point *t = &job->points[key_tp(v[i].key)];
-  const long n = forward ? (long)(step - j) * t->m + t->i : (long)(j - step) * t->m - t->i;
-  return (v[i].z - oz) / bb__lattice_distance(n, t->inverse_m);
+/* The canonical slope per step from an origin of height oz to the point of
+ * height z and key `key`, relative to the origin's step: ahead of the origin
+ * (forward) or behind it. */
+static inline double tangent_slope(const sweep_job *job, double z, int64_t key, double oz,
+                                   int forward) {
+  const int step = key_step(key);
+  const template_point *t = &job->points[key_tp(key)];
+  const long n = forward ? (long)step * t->m + t->i : (long)(-step) * t->m - t->i;
+  return (z - oz) / bb__lattice_distance(n, t->inverse_m);
 }
 
 /* The horizon in texels from the best slope per step. */
@@ -460,9 +465,10 @@ static int vouched(const sweep_job *job, double slope, double oz, double distanc
 }
 
 /* Origin j of a line (texel j mod L, -L <= j < 2 L) asks the hull for its
- * horizon, kept in found[k] until the line's walks are done. In a chunk, a
- * texel the profile cannot vouch for (the points beyond it lie at least
- * `beyond` steps away) is marched instead, which finds the same bits. */
+ * tangent vertex, kept until the line's walks are done: its slope is worked
+ * out after them (horizons_of_line). The walks' loops then carry only the
+ * hull, with fewer values live across them, and the divisions of
+ * neighbouring texels overlap in a loop of their own. */
 static inline __attribute__((always_inline)) void query(const sweep_job *job, const profile *pr,
                                                        const point *h, int size, int j,
                                                        int forward) {
@@ -471,18 +477,38 @@ static inline __attribute__((always_inline)) void query(const sweep_job *job, co
   const double oz = pr->vz[texel_j] + job->bias;
   const int k = forward ? 0 : 1;
   const double u0 = forward ? (double)j : -(double)j;
-  const double slope = slope_to(job, h, hull_tangent(h, size, u0, oz), j, oz, forward);
-  float found = horizon_of(job, k, slope);
-  if (job->kind == LINE_CHUNK) {
+  const int i = hull_tangent(h, size, u0, oz);
+  if (i >= 0) {
+    pr->tangent_z[k][texel_j] = h[i].z;
+    pr->tangent_key[k][texel_j] = h[i].key - (int64_t)j * KEY_STEP;
+  } else { /* nothing there: a point at -infinity one step away, horizon 0 */
+    pr->tangent_z[k][texel_j] = -INFINITY;
+    pr->tangent_key[k][texel_j] = key_of(forward ? 0 : -2, job->point_count - 1);
+  }
+}
+
+/* The horizons of a line's texels along side k, from the tangents its walk
+ * found. In a chunk, a texel the profile cannot vouch for (the points beyond
+ * it lie at least `beyond` steps away) is marched instead, which finds the
+ * same bits. */
+static void horizons_of_line(const sweep_job *job, const profile *pr, int k) {
+  const int forward = k == 0;
+  const double *restrict tz = pr->tangent_z[k];
+  const int64_t *restrict tkey = pr->tangent_key[k];
+  float *restrict found = pr->found[k];
+  for (int j = 0; j < pr->len; j++)
+    found[j] = horizon_of(job, k, tangent_slope(job, tz[j], tkey[j], pr->vz[j] + job->bias, forward));
+  if (job->kind != LINE_CHUNK) return;
+  for (int j = 0; j < pr->len; j++) {
+    const double oz = pr->vz[j] + job->bias;
     const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
                                   : (double)(j - pr->first_step);
-    if (!vouched(job, slope, oz, beyond)) {
-      const size_t texel = pr->texel[texel_j];
+    if (!vouched(job, tangent_slope(job, tz[j], tkey[j], oz, forward), oz, beyond)) {
+      const size_t texel = pr->texel[j];
       const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
-      found = bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
+      found[j] = bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
     }
   }
-  pr->found[k][texel_j] = found;
 }
 
 /* A stretch of profile points, pt[from] to pt[to] inclusive (either way
@@ -632,12 +658,15 @@ static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
   walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
 }
 
-/* What the line's texels lose to the horizons found, added to their sums:
- * along (a, b) first, then along (-a, -b), as the slices' order wants. The
- * walks only find horizons; integrating them here, in a loop of its own,
- * lets the divisions and table reads of neighbouring texels overlap. */
+/* The line's horizons from its tangents, and what its texels lose to them,
+ * added to their sums: along (a, b) first, then along (-a, -b), as the
+ * slices' order wants. The walks only find tangents; integrating here, in
+ * loops of their own, lets the divisions and table reads of neighbouring
+ * texels overlap. */
 static void integrate_line(const sweep_job *job, const profile *pr) {
   const int channels = job->channels;
+  for (int k = 0; k < 2; k++)
+    if (job->side[k].dir) horizons_of_line(job, pr, k);
   for (int k = 0; k < 2; k++) {
     const bb__sweep_dir *dir = job->side[k].dir;
     if (!dir || !dir->horizon) continue;
@@ -730,6 +759,8 @@ typedef struct scratch {
   double *vz;
   size_t *texel;
   float *found[2];
+  double *tangent_z[2];
+  int64_t *tangent_key[2];
 } scratch;
 
 static void scratch_release(scratch *sc) {
@@ -743,6 +774,7 @@ static void scratch_release(scratch *sc) {
   free(sc->texel);
   free(sc->found[0]);
   free(sc->found[1]);
+  for (int k = 0; k < 2; k++) free(sc->tangent_z[k]), free(sc->tangent_key[k]);
 }
 
 /* Room for `points` profile points and `len` texels; 0 when out of memory. */
@@ -768,7 +800,14 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
     sc->texel = malloc(len * sizeof(size_t));
     sc->found[0] = malloc(len * sizeof(float));
     sc->found[1] = malloc(len * sizeof(float));
-    sc->len = sc->vz && sc->texel && sc->found[0] && sc->found[1] ? len : 0;
+    int tangents = 1;
+    for (int k = 0; k < 2; k++) {
+      free(sc->tangent_z[k]), free(sc->tangent_key[k]);
+      sc->tangent_z[k] = malloc(len * sizeof(double));
+      sc->tangent_key[k] = malloc(len * sizeof(int64_t));
+      tangents = tangents && sc->tangent_z[k] && sc->tangent_key[k];
+    }
+    sc->len = sc->vz && sc->texel && sc->found[0] && sc->found[1] && tangents ? len : 0;
     if (!sc->len) return 0;
   }
   return 1;
@@ -793,7 +832,9 @@ static void sweep_bundle(void *user, int bundle) {
   scratch *sc = scratch_take(job);
   if (scratch_reserve(sc, job, (size_t)steps * (size_t)job->point_count + 1, (size_t)len)) {
     profile pr = {.pt = sc->pt, .vz = sc->vz, .texel = sc->texel,
-                  .found = {sc->found[0], sc->found[1]}, .block_u = sc->block_u,
+                  .found = {sc->found[0], sc->found[1]},
+                  .tangent_z = {sc->tangent_z[0], sc->tangent_z[1]},
+                  .tangent_key = {sc->tangent_key[0], sc->tangent_key[1]}, .block_u = sc->block_u,
                   .block_z = sc->block_z, .block_rise = sc->block_rise};
     for (int item = first; item < last; item++) sweep_one(job, item, &pr, sc->h);
   } else {
