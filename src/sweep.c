@@ -255,7 +255,10 @@ static inline void step_heights(const sweep_job *job, int bx, int by, double *zs
  * Two wider chords, i-2..i+1 and i-1..i+2, are tested the same way where
  * both their ends lie in T's own step (its start vertex included): no
  * origin lies strictly between them, so the argument holds, and they drop a
- * fifth of the points the first test keeps. The ends are kept. */
+ * fifth of the points the first test keeps. So does the chord of the whole
+ * step, from its start vertex to its end vertex: it drops a sixth of what is
+ * left (rock06: 39% of the breakpoints kept before it, 32% after). The ends
+ * are kept. */
 /* Steps whose points are made before the kink filter runs over them: their
  * heights and u first, then the chord test of every point at once (a loop
  * the compiler vectorises), then the kept points, copied out in order. */
@@ -351,6 +354,16 @@ static void profile_fill(const sweep_job *job, int x0, int y0, profile *pr) {
                             (z[i + 2] - z[i - 1]) * (u[i] - u[i - 1]) + job->open_b[i - base];
       const double wide = wide_a < wide_b ? wide_a : wide_b;
       rise[i] = wide < rise[i] ? wide : rise[i];
+    }
+    /* the chord from each step's start vertex to its end vertex */
+    for (int s = 0; s < s1 - s0; s++) {
+      const int st = base + s * tcount - 1, e = st + tcount;
+      if (st < 0) continue;
+      const double zs = z[st], ze = z[e], us = u[st], span = u[e] - u[st];
+      for (int k = st + 1; k < e; k++) {
+        const double full = (z[k] - zs) * span - (ze - zs) * (u[k] - us);
+        rise[k] = full < rise[k] ? full : rise[k];
+      }
     }
     if (s0 == 0) rise[0] = 1.0; /* the first point is an end */
     const int first_kept = count;
