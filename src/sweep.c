@@ -509,14 +509,14 @@ static void horizons_of_line(const sweep_job *job, const profile *pr, int k) {
   const double *restrict tz = pr->tangent_z[k];
   const int64_t *restrict tkey = pr->tangent_key[k];
   float *restrict found = pr->found[k];
-  for (int j = 0; j < pr->len; j++)
-    found[j] = horizon_of(job, k, tangent_slope(job, tz[j], tkey[j], pr->vz[j] + job->bias, forward));
-  if (job->kind != LINE_CHUNK) return;
   for (int j = 0; j < pr->len; j++) {
     const double oz = pr->vz[j] + job->bias;
+    const double slope = tangent_slope(job, tz[j], tkey[j], oz, forward);
+    found[j] = horizon_of(job, k, slope);
+    if (job->kind != LINE_CHUNK) continue;
     const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
                                   : (double)(j - pr->first_step);
-    if (!vouched(job, tangent_slope(job, tz[j], tkey[j], oz, forward), oz, beyond)) {
+    if (!vouched(job, slope, oz, beyond)) {
       const size_t texel = pr->texel[j];
       const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
       found[j] = bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
