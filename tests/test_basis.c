@@ -37,7 +37,7 @@ Test(basis, names_parse_and_anything_else_is_refused) {
   cr_assert_str_eq(b.name, "hl2+z");
   cr_assert(b.vector[3][0] == 0.0 && b.vector[3][1] == 0.0 && b.vector[3][2] == 1.0);
   for (int n = 3; n <= BB_MAX_BASIS; n++) {
-    char name[16];
+    char name[32]; /* room for any int, so -Wformat-truncation stays quiet */
     snprintf(name, sizeof name, "dirs:%d", n);
     b = named(name);
     cr_assert_eq(b.count, n);
@@ -61,7 +61,7 @@ Test(basis, names_parse_and_anything_else_is_refused) {
 Test(basis, dirs_spreads_directions_evenly_at_hl2s_elevation) {
   const double side = sqrt(2.0 / 3.0), up = 1.0 / sqrt(3.0);
   for (int n = 3; n <= BB_MAX_BASIS; n++) {
-    char name[16];
+    char name[32];
     snprintf(name, sizeof name, "dirs:%d", n);
     const bb_basis b = named(name);
     for (int c = 0; c < n; c++) {

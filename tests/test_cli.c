@@ -1031,7 +1031,7 @@ Test(cli, failed_third_of_six_outputs_leaves_nothing, .timeout = 60) {
   for (int i = 0; i < 6; i++)
     snprintf(paths[i], sizeof paths[i], "%s", tmp(names[i]));
   for (int threads = 1; threads <= 6; threads += 5) {
-    char t[8];
+    char t[16];
     snprintf(t, sizeof t, "%d", threads);
     const char *args[] = {"bake",      in,       "--scale",  "8",      "--rays",
                           "8",         "--threads", t,        "-q",     "--normal",
