@@ -500,9 +500,8 @@ static int bake_run(cli_run *run, bake_args *a, const char *input) {
   return rc;
 }
 
-/* --depfile of a single bake: every file it wrote depends on the input. */
-static int write_depfile(const bake_args *a, const char *input) {
-  const char *outputs[MAX_OUTPUTS];
+/* The files a single bake writes; their count. */
+static int single_outputs(const bake_args *a, const char **outputs) {
   int n = 0;
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     if (a->paths[k])
@@ -511,12 +510,22 @@ static int write_depfile(const bake_args *a, const char *input) {
     outputs[n++] = a->slope.path;
   if (a->slope.lit_path)
     outputs[n++] = a->slope.lit_path;
-  return cli_batch_write_depfile(&a->batch, &a->settings, input, outputs, n);
+  return n;
 }
 
+/* --depfile of a single bake: every file it wrote depends on the input.
+ * Checked before the bake, so it cannot replace the input or an output. */
 static int bake_single(cli_run *run, bake_args *a, const char *input) {
-  int rc = bake_run(run, a, input);
-  return rc == 0 && a->batch.depfile ? write_depfile(a, input) : rc;
+  const char *outputs[MAX_OUTPUTS];
+  const int n = single_outputs(a, outputs);
+  int rc = a->batch.depfile ? cli_batch_check_depfile(bake_command.name, &a->batch,
+                                                      &a->settings, input, outputs, n)
+                            : 0;
+  if (!rc)
+    rc = bake_run(run, a, input);
+  return rc == 0 && a->batch.depfile
+             ? cli_batch_write_depfile(&a->batch, &a->settings, input, outputs, n)
+             : rc;
 }
 
 /* ---------------------------------------------------------------- batches */

@@ -91,6 +91,14 @@ static int prerequisites_of(const cli_batch_args *b, const cli_settings *s, cons
   return 1 + extra_prerequisites(b, s, prereq + 1);
 }
 
+int cli_batch_check_depfile(const char *command, const cli_batch_args *b,
+                            const cli_settings *s, const char *input,
+                            const char *const *outputs, int output_count) {
+  const char *prereq[2];
+  cli_dep_rule rule = {outputs, output_count, prereq, prerequisites_of(b, s, input, prereq)};
+  return cli_depfile_check(command, b->depfile, &rule, 1);
+}
+
 int cli_batch_write_depfile(const cli_batch_args *b, const cli_settings *s, const char *input,
                             const char *const *outputs, int output_count) {
   const char *prereq[2];
@@ -216,30 +224,69 @@ static outcome run_item(const cli_batch_client *c, const cli_batch_args *b, cli_
   return code ? FAILED : BAKED;
 }
 
+/* A batch's depfile rules, in arrays of their own. */
+typedef struct batch_rules {
+  const char *(*targets)[CLI_BATCH_MAX_KINDS];
+  const char *(*prereq)[2];
+  cli_dep_rule *rules;
+  int count;
+} batch_rules;
+
+static void batch_rules_free(batch_rules *r) {
+  free(r->targets);
+  free(r->prereq);
+  free(r->rules);
+}
+
+/* A rule per input baked or up to date (every input when outcomes is
+ * NULL: the plan before it runs); 0, or -1 when out of memory. */
+static int batch_rules_make(const cli_batch_client *c, const cli_batch_args *b,
+                            const cli_batch_plan *plan, const outcome *outcomes,
+                            batch_rules *r) {
+  r->targets = malloc((size_t)plan->count * sizeof *r->targets);
+  r->prereq = malloc((size_t)plan->count * sizeof *r->prereq);
+  r->rules = malloc((size_t)plan->count * sizeof *r->rules);
+  r->count = 0;
+  if (!r->targets || !r->prereq || !r->rules) {
+    batch_rules_free(r);
+    return -1;
+  }
+  for (int i = 0; i < plan->count; i++) {
+    if (outcomes && outcomes[i] != BAKED && outcomes[i] != CURRENT)
+      continue;
+    const int n = r->count++;
+    int count = outputs_of(&plan->items[i], r->targets[n], NULL);
+    r->rules[n] = (cli_dep_rule){r->targets[n], count, r->prereq[n],
+                                 prerequisites_of(b, c->settings, plan->items[i].input,
+                                                  r->prereq[n])};
+  }
+  return 0;
+}
+
 /* The depfile of a batch: a rule per input baked or up to date. */
 static int write_batch_depfile(const cli_batch_client *c, const cli_batch_args *b,
                                const cli_batch_plan *plan, const outcome *outcomes) {
-  const char *(*targets)[CLI_BATCH_MAX_KINDS] = malloc((size_t)plan->count * sizeof *targets);
-  const char *(*prereq)[2] = malloc((size_t)plan->count * sizeof *prereq);
-  cli_dep_rule *rules = malloc((size_t)plan->count * sizeof *rules);
-  int n = 0, rc = BB_EXIT_FAILURE;
-  if (targets && prereq && rules) {
-    for (int i = 0; i < plan->count; i++) {
-      if (outcomes[i] != BAKED && outcomes[i] != CURRENT)
-        continue;
-      int count = outputs_of(&plan->items[i], targets[n], NULL);
-      rules[n] = (cli_dep_rule){targets[n], count, prereq[n],
-                                prerequisites_of(b, c->settings, plan->items[i].input,
-                                                 prereq[n])};
-      n++;
-    }
-    rc = cli_depfile_write(b->depfile, rules, n);
-  } else {
+  batch_rules r;
+  if (batch_rules_make(c, b, plan, outcomes, &r) != 0) {
     cli_file_error(b->depfile, "out of memory");
+    return BB_EXIT_FAILURE;
   }
-  free(targets);
-  free(prereq);
-  free(rules);
+  int rc = cli_depfile_write(b->depfile, r.rules, r.count);
+  batch_rules_free(&r);
+  return rc;
+}
+
+/* The depfile's path against every input and output of the plan, before
+ * the first bake. */
+static int check_batch_depfile(const cli_batch_client *c, const cli_batch_args *b,
+                               const cli_batch_plan *plan) {
+  batch_rules r;
+  if (batch_rules_make(c, b, plan, NULL, &r) != 0) {
+    cli_file_error(b->depfile, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  int rc = cli_depfile_check(c->command, b->depfile, r.rules, r.count);
+  batch_rules_free(&r);
   return rc;
 }
 
@@ -282,6 +329,8 @@ int cli_batch_run(const cli_batch_client *c, const cli_batch_args *b, cli_run *r
   int rc = cli_batch_plan_make(c, b, argv + first, argc - first, &plan);
   if (!rc)
     rc = check_plan(c, &plan);
+  if (!rc && b->depfile)
+    rc = check_batch_depfile(c, b, &plan);
   outcome *outcomes = rc ? NULL : calloc((unsigned)plan.count, sizeof *outcomes);
   if (!rc && !outcomes) {
     cli_file_error(plan.items[0].input, "out of memory");

@@ -73,6 +73,13 @@ typedef struct cli_batch_client {
 int cli_batch_run(const cli_batch_client *c, const cli_batch_args *b, cli_run *run, int argc,
                   char **argv, int first);
 
+/* Checks b->depfile for one bake before it runs (cli_depfile_check with
+ * the rule cli_batch_write_depfile will write): 0, or the exit code after
+ * printing. */
+int cli_batch_check_depfile(const char *command, const cli_batch_args *b,
+                            const cli_settings *s, const char *input,
+                            const char *const *outputs, int output_count);
+
 /* Writes b->depfile for one bake ("out1 out2: input [basis file]"), the
  * rule a batch writes for each of its inputs; s are the bake's settings.
  * 0 or BB_EXIT_FAILURE after printing. */
@@ -86,6 +93,13 @@ typedef struct cli_dep_rule {
   const char *const *prerequisites;
   int prerequisite_count;
 } cli_dep_rule;
+
+/* Checks path, a depfile to write with rules, before any bake: not a
+ * prerequisite of a rule (BB_EXIT_FAILURE: it would replace a file the
+ * bake reads), not a target (BB_EXIT_USAGE), not a directory, and in a
+ * directory that exists. 0, or the exit code after printing. */
+int cli_depfile_check(const char *command, const char *path, const cli_dep_rule *rules,
+                      int count);
 
 /* Writes a Make/Ninja depfile ("t1 t2: p1 p2" per rule; spaces and '#'
  * escaped with '\', '$' as "$$", as GCC's -MD writes them) to path,

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* Writes name escaped as GCC's depfiles escape it; -1 on a write error. */
@@ -51,6 +52,29 @@ static const char *unwritable_name(const cli_dep_rule *rules, int count) {
         return rules[i].prerequisites[p];
   }
   return NULL;
+}
+
+int cli_depfile_check(const char *command, const char *path, const cli_dep_rule *rules,
+                      int count) {
+  /* A file the bake reads would be replaced by text (the input, as any
+   * output over the input, is a failure); one it writes would be
+   * clobbered by the other, which is a usage error as for two outputs. */
+  for (int i = 0; i < count; i++) {
+    for (int p = 0; p < rules[i].prerequisite_count; p++)
+      if (cli_same_file(rules[i].prerequisites[p], path)) {
+        cli_file_error(path, "the depfile would overwrite a file the bake reads");
+        return BB_EXIT_FAILURE;
+      }
+    for (int t = 0; t < rules[i].target_count; t++)
+      if (cli_same_file(rules[i].targets[t], path))
+        return cli_usage_error(command, "--depfile %s is also an output of the bake", path);
+  }
+  struct stat st;
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+    cli_file_error(path, "cannot write the depfile: is a directory");
+    return BB_EXIT_FAILURE;
+  }
+  return cli_check_output_directory(path);
 }
 
 /* Writes the rules to the open temporary and closes it, every step

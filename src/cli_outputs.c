@@ -86,9 +86,7 @@ int cli_same_file(const char *a, const char *b) {
   return strcmp(a, b) == 0;
 }
 
-/* 0 when the directory part of path exists and is a directory; else prints
- * why not and returns BB_EXIT_FAILURE. */
-static int check_output_directory(const char *path) {
+int cli_check_output_directory(const char *path) {
   char dir[PATH_MAX];
   directory_part(path, dir, sizeof dir);
   struct stat st;
@@ -124,7 +122,7 @@ int cli_check_output(const char *command, const char *input_path, const char *ou
     cli_file_error(output_path, "output would overwrite the input file");
     return BB_EXIT_FAILURE;
   }
-  return check_output_directory(output_path);
+  return cli_check_output_directory(output_path);
 }
 
 char *cli_path_with_suffix(const char *path, const char *suffix) {

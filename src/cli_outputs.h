@@ -17,6 +17,10 @@
 int cli_check_output(const char *command, const char *input_path, const char *output_path,
                      bb_depth depth);
 
+/* 0 when the directory part of path exists and is a directory; else prints
+ * "bumpbake: PATH: cannot write: ..." and returns BB_EXIT_FAILURE. */
+int cli_check_output_directory(const char *path);
+
 /* path without the extension of its last component, plus suffix
  * ("rock.png", "-ssbump.tga" -> "rock-ssbump.tga"), malloc'd; NULL when
  * out of memory. */

@@ -301,6 +301,41 @@ Test(cli_batch, depfiles) {
   free(text);
 }
 
+/* A depfile on a file the bake reads (exit 1, as any output on its input)
+ * or writes (exit 2, as two outputs on one name), or where it cannot be
+ * written, is refused before the bake: no file is written or replaced. */
+Test(cli_batch, depfile_on_an_input_or_an_output_is_refused) {
+  make_dir(tmp("out"));
+  height_file(tmp("a.png"), 1);
+  write_text(tmp("lights.txt"), "1 0 1\n0 1 1\n-1 0 1\n");
+  const long long height_time = mtime_of(tmp("a.png"));
+  const long long basis_time = mtime_of(tmp("lights.txt"));
+  static const struct {
+    const char *args[16];
+    int code;
+    const char *part;
+  } cases[] = {
+      {{"bake", "a.png", FAST, "--ao", "ao.png", "--depfile", "a.png"}, 1, "a.png: "},
+      {{"bake", "a.png", FAST, "--ao", "ao.png", "--depfile", "./a.png"}, 1, "read"},
+      {{"bake", "a.png", FAST, "--basis", "lights.txt", "--ao", "ao.png", "--depfile",
+        "lights.txt"},
+       1, "lights.txt: "},
+      {{"bake", "a.png", FAST, "--ao", "ao.png", "--depfile", "ao.png"}, 2, "ao.png"},
+      {{"bake", "a.png", FAST, "-o", "out/p", "--depfile", "out/p_normal.png"}, 2,
+       "out/p_normal.png"},
+      {{"bake", "a.png", FAST, "--ao", "ao.png", "--depfile", "nodir/a.d"}, 1, "nodir"},
+      {{"bake", "a.png", FAST, "--ao", "ao.png", "--depfile", "out"}, 1, "directory"},
+      {{"bake", "a.png", FAST, "--out-dir", "out", "--depfile", "a.png"}, 1, "a.png: "},
+      {{"bake", "a.png", FAST, "--out-dir", "out", "--depfile", "out/a_ao.png"}, 2,
+       "out/a_ao.png"},
+      {{"bake", "a.png", FAST, "--out-dir", "out", "--depfile", "nodir/a.d"}, 1, "nodir"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    harness_expect_refusal(harness_dir, cases[i].args, cases[i].code, cases[i].part, i);
+  cr_expect_eq(mtime_of(tmp("a.png")), height_time, "the input was rewritten");
+  cr_expect_eq(mtime_of(tmp("lights.txt")), basis_time, "the basis file was rewritten");
+}
+
 /* make schedules bakes with the depfile: a changed basis file re-bakes,
  * which the Makefile's own rule does not say. */
 Test(cli_batch, make_runs_bakes_from_depfiles) {
