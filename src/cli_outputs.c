@@ -109,10 +109,16 @@ int cli_check_output_directory(const char *path) {
 int cli_check_output(const char *command, const char *input_path, const char *output_path,
                      bb_depth depth) {
   char ext[16];
-  if (!bb_path_is_writable_format(output_path))
+  if (!bb_path_is_writable_format(output_path)) {
+    if (!path_extension(output_path, ext, sizeof ext)[0])
+      return cli_usage_error(command,
+                             "%s: no extension to choose the format by (use .png, .tga, "
+                             ".tif, .tiff or .exr)",
+                             output_path);
     return cli_usage_error(
         command, "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff or .exr)",
-        output_path, path_extension(output_path, ext, sizeof ext));
+        output_path, ext);
+  }
   /* Checked before baking, so a bad combination fails before a long bake. */
   if (!bb_path_supports_depth(output_path, depth))
     return cli_usage_error(command, "%s: --depth %s is not available in .%s files",

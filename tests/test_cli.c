@@ -186,6 +186,9 @@ Test(cli, usage_errors_exit_2_with_a_message) {
       {{"bake", in, "--scale", "1"}, "nothing to write"},
       {{"bake", in, "--scale", "1", "--ao", tmp("ao.jpg2")},
        "unknown output format '.jpg2' (use .png, .tga, .tif, .tiff or .exr)"},
+      /* No extension at all is said so, not shown as an extension '.'. */
+      {{"bake", in, "--scale", "1", "--ao", tmp("ao")},
+       "ao: no extension to choose the format by (use .png, .tga, .tif, .tiff or .exr)"},
       {{"bake", in, "--scale", "1", "--ao", tmp("ao.exr"), "--depth", "16"}, "--depth"},
       {{"bake", "--scale", "1", "-o", tmp("p")}, "HEIGHT"},
       {{"height2ssbump", in}, "BUMPSCALE"},
