@@ -19,7 +19,7 @@ static const cli_option opt_radius = {
     .id = CLI_OPT_FILTER_RADIUS,
     .short_name = 'f',
     .value_name = "R",
-    .range_text = ">= 0 (integer)",
+    .range_text = "0..4096",
     .help = "bilateral smoothing radius in texels, 0 = off"};
 static const cli_option opt_normal = {
     .id = CLI_OPT_VALVE_NORMAL,
@@ -139,14 +139,12 @@ static bb_channel valve_height_channel(const char *path, const bb_image *img,
     return BB_CHANNEL_A;
   if (img->channels >= 3) {
     fprintf(stderr,
-            "bumpbake height2ssbump: %s has no alpha channel; using the mean of "
-            "R, G, B as the height\n",
+            "bumpbake: %s: note: no alpha channel; using the mean of R, G, B as the "
+            "height\n",
             path);
     return BB_CHANNEL_MEAN;
   }
-  fprintf(stderr,
-          "bumpbake height2ssbump: %s has no alpha channel; using its grey "
-          "channel as the height\n",
+  fprintf(stderr, "bumpbake: %s: note: no alpha channel; using its grey channel as the height\n",
           path);
   return BB_CHANNEL_AUTO;
 }
