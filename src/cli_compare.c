@@ -341,9 +341,9 @@ static int read_image(const char *path, bb_image *img, bb_image_info *info) {
 
 static int report_size_mismatch(const compare_args *a, const bb_image *x,
                                 const bb_image *y) {
-  fprintf(stderr, "bumpbake: %s: %d x %d, %d channels, but %s is %d x %d, %d channels\n",
-          a->path_b, y->width, y->height, y->channels, a->path_a, x->width, x->height,
-          x->channels);
+  fprintf(stderr, "bumpbake: %s: %d x %d, %d channel%s, but %s is %d x %d, %d channel%s\n",
+          a->path_b, y->width, y->height, y->channels, y->channels == 1 ? "" : "s",
+          a->path_a, x->width, x->height, x->channels, x->channels == 1 ? "" : "s");
   if (a->json && !a->quiet) {
     cli_json j = {stdout, 0};
     cli_json_open(&j, NULL, '{');

@@ -572,6 +572,9 @@ Test(cli, info_and_compare_json_parse) {
   r = RUN("compare", "--json", a, rgb);
   cr_expect_eq(r.code, 3, "%s", r.err);
   cr_expect_eq(expect_json_lines(r.out), 1, "%s", r.out);
+  /* One line, in words: "1 channel", not "1 channels". */
+  cr_expect(strstr(r.err, "8 x 8, 3 channels, but") && strstr(r.err, "8 x 8, 1 channel\n"),
+            "%s", r.err);
   cli_result_free(&r);
 }
 
