@@ -225,7 +225,8 @@ static int check_channels(const bake_args *a, int k) {
   return cli_usage_error(bake_command.name,
                          "%s: --basis %s gives %s %d channels and %s files hold at most %d "
                          "(write it as .exr or .tif)",
-                         a->paths[k], basis->name, kind_info(k)->name, basis->count,
+                         a->paths[k], a->batch.basis_arg ? a->batch.basis_arg : basis->name,
+                         kind_info(k)->name, basis->count,
                          dot ? dot : "such", room);
 }
 

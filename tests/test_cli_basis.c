@@ -101,6 +101,14 @@ Test(cli_basis, formats_without_room_are_refused_before_the_bake) {
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     harness_expect_refusal(NULL, cases[i].args, 2, cases[i].part, i);
+  /* a basis file is named as the user gave it, not by its hash */
+  const char *five = tmp("five.txt");
+  write_text(five, "1 0 1\n0 1 1\n-1 0 1\n0 -1 1\n0 0 1\n");
+  char want[512];
+  snprintf(want, sizeof want, "--basis %s gives ssbump 5 channels", five);
+  const char *file_case[] = {"bake", in, "--scale", "4", "--basis", five, "--ssbump", tmp("f.png"),
+                             NULL};
+  harness_expect_refusal(NULL, file_case, 2, want, 99);
   cli_result r = RUN("bake", in, "--scale", "4", "--basis", "hl2+z", "--ssbump", tmp("z.png"),
                      "--weights", tmp("zw.tga"), "-q");
   expect_ok(&r, "hl2+z in RGBA");
