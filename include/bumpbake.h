@@ -198,6 +198,14 @@ void bb_staged_file_discard(bb_staged_file *staged);
 /* The destination path of a staged file (owned by the handle). */
 const char *bb_staged_file_path(const bb_staged_file *staged);
 
+/* Writes size bytes of data to path (a text file: a depfile, a list) the way
+ * images are written: through a temporary in path's directory, flushed,
+ * synced and renamed into place, so path is either untouched or whole. The
+ * temporary is removed on failure, and by bb_tempfiles_remove on a signal.
+ * Errors: BB_ERR_ARGUMENT (no path, or NULL data with a size),
+ * BB_ERR_MEMORY, BB_ERR_IO ("PATH: cannot write: reason"). */
+bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err);
+
 /* Removes every temporary file a write of this process has open right now
  * (staged files included). Async-signal-safe: call it from a SIGINT or
  * SIGTERM handler, then re-raise the signal with the default action, and an

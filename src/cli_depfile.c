@@ -77,44 +77,41 @@ int cli_depfile_check(const char *command, const char *path, const cli_dep_rule 
   return cli_check_output_directory(path);
 }
 
-/* Writes the rules to the open temporary and closes it, every step
- * checked; returns 0 or the errno of the failure. */
-static int write_and_close(FILE *f, const cli_dep_rule *rules, int count) {
+/* The rules as depfile text, in a buffer the caller frees; NULL when out
+ * of memory. */
+static char *depfile_text(const cli_dep_rule *rules, int count, size_t *size) {
+  char *text = NULL;
+  FILE *f = open_memstream(&text, size);
+  if (!f)
+    return NULL;
   int failed = 0;
   for (int i = 0; i < count && !failed; i++)
     failed = put_rule(f, &rules[i]) != 0;
-  if (!failed)
-    failed = fflush(f) != 0 || fsync(fileno(f)) != 0;
-  int saved = failed ? (errno ? errno : EIO) : 0;
-  if (fclose(f) != 0 && !saved)
-    saved = errno ? errno : EIO;
-  return saved;
+  if (fclose(f) != 0)
+    failed = 1;
+  if (failed) {
+    free(text);
+    return NULL;
+  }
+  return text;
 }
 
+/* Composed in memory, then written by the library as images are (a
+ * temporary renamed into place, removed on a signal). */
 int cli_depfile_write(const char *path, const cli_dep_rule *rules, int count) {
   const char *bad = unwritable_name(rules, count);
   if (bad) {
     cli_file_error(path, "a file name holds a newline, which a depfile cannot say");
     return BB_EXIT_FAILURE;
   }
-  size_t len = strlen(path) + 32;
-  char *temp = malloc(len);
-  if (!temp) {
+  size_t size = 0;
+  char *text = depfile_text(rules, count, &size);
+  if (!text) {
     cli_file_error(path, "out of memory");
     return BB_EXIT_FAILURE;
   }
-  snprintf(temp, len, "%s.tmp-%ld", path, (long)getpid());
-  FILE *f = fopen(temp, "w");
-  int error = f ? write_and_close(f, rules, count) : errno;
-  if (!error && rename(temp, path) != 0)
-    error = errno;
-  if (error) {
-    if (f)
-      unlink(temp);
-    char reason[256];
-    snprintf(reason, sizeof reason, "cannot write the depfile: %s", strerror(error));
-    cli_file_error(path, reason);
-  }
-  free(temp);
-  return error ? BB_EXIT_FAILURE : 0;
+  bb_error err;
+  bb_status st = bb_file_write(path, text, size, &err);
+  free(text);
+  return st == BB_OK ? 0 : cli_status_exit(path, st, &err);
 }

@@ -418,3 +418,14 @@ void bb_staged_file_discard(bb_staged_file *staged) {
   bb__safe_discard(staged);
   free(staged);
 }
+
+bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err) {
+  if (!data && size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_file_write: no data");
+  bb_staged_file f;
+  bb_status st = bb__safe_open(&f, path, err);
+  if (st != BB_OK)
+    return st;
+  bb__safe_write(&f, data, size); /* an error is kept, and reported by the commit */
+  return bb__safe_commit(&f, err);
+}

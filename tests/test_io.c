@@ -591,6 +591,36 @@ Test(io, overwrite_replaces_content_with_umask_mode) {
   bb_image_free(&b);
 }
 
+/* bb_file_write: the bytes, whole, replacing what was there; nothing left
+ * behind and the destination untouched when it cannot be written. */
+Test(io, file_write_replaces_whole_and_fails_cleanly) {
+  const char *path = tmp_path("deps.d");
+  bb_error err;
+  cr_assert_eq(bb_file_write(path, "old rule\n", 9, &err), BB_OK, "%s", err.message);
+  const char text[] = "a.png b.png: in.png\n";
+  cr_assert_eq(bb_file_write(path, text, sizeof text - 1, &err), BB_OK, "%s", err.message);
+  char back[64] = {0};
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f);
+  size_t n = fread(back, 1, sizeof back - 1, f);
+  fclose(f);
+  cr_assert_eq(n, sizeof text - 1);
+  cr_assert_str_eq(back, text);
+  cr_assert_eq(bb_file_write(path, "", 0, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(file_size(path), 0, "an empty write leaves an empty file");
+
+  cr_assert_eq(mkdir(tmp_path("taken.d"), 0700), 0);
+  cr_assert_eq(bb_file_write(tmp_path("taken.d"), text, 4, &err), BB_ERR_IO);
+  cr_assert_not_null(strstr(err.message, "cannot write"), "%s", err.message);
+  struct stat st;
+  cr_assert_eq(stat(tmp_path("taken.d"), &st), 0);
+  cr_assert(S_ISDIR(st.st_mode), "the destination was replaced");
+  cr_assert_eq(bb_file_write(tmp_path("nodir/x.d"), text, 4, &err), BB_ERR_IO);
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
+  cr_assert_eq(bb_file_write(path, NULL, 4, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_file_write(NULL, text, 4, &err), BB_ERR_ARGUMENT);
+}
+
 /* --------------------------------------------------------- read errors */
 
 static void check_read_fails(const char *path, bb_status want, const char *needle) {
