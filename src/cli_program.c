@@ -3,6 +3,7 @@
 #include "cli_maps.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const cli_option opt_output = {.id = CLI_OPT_OUTPUT,
@@ -67,24 +68,29 @@ static bb_status quiet_loader(void *user, const char *path, bb_image *img,
   return cli_read_image(path, img, info, err);
 }
 
-/* The output must not replace any image the program reads. */
+/* The output must not replace any image the program reads: every one of
+ * them, however many the program names. */
 static int check_output_against_images(const program_args *a, const bb_program *program) {
-  enum { MAX_NAMES = 64 };
-  const char *names[MAX_NAMES];
-  size_t count = bb_program_images(program, names, MAX_NAMES);
+  size_t count = bb_program_images(program, NULL, 0);
   if (count == 0) /* _flat alone: there is no input to protect */
     return cli_check_output(program_command.name, "", a->output, a->settings.depth);
-  for (size_t i = 0; i < count && i < MAX_NAMES; i++) {
+  const char **names = malloc(count * sizeof *names);
+  if (!names) {
+    cli_file_error(a->output, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  bb_program_images(program, names, count);
+  int rc = 0;
+  for (size_t i = 0; i < count && !rc; i++) {
     char path[4096];
     if (a->base_dir && *a->base_dir && names[i][0] != '/')
       snprintf(path, sizeof path, "%s/%s", a->base_dir, names[i]);
     else
       snprintf(path, sizeof path, "%s", names[i]);
-    int rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
-    if (rc)
-      return rc;
+    rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
   }
-  return 0;
+  free(names);
+  return rc;
 }
 
 /* Parses the command line and the program: a syntax error is a usage error. */

@@ -95,6 +95,29 @@ Test(cli_program, errors) {
     harness_expect_refusal(harness_dir, cases[i].args, cases[i].code, cases[i].part, i);
 }
 
+/* The output was checked against the first 64 image names only: a longer
+ * program naming its own output after those replaced that input. */
+Test(cli_program, output_checked_against_every_image_past_64) {
+  write_heights(tmp("h.png"));
+  write_heights(tmp("out.png"));
+  /* add(add(...add(h.png, h.png)..., h.png), out.png): 64 calls deep (the
+   * limit), 65 names, out.png last. */
+  char program[2048] = "";
+  for (int i = 0; i < 64; i++)
+    strcat(program, "add(");
+  strcat(program, "h.png");
+  for (int i = 0; i < 63; i++)
+    strcat(program, ", h.png)");
+  strcat(program, ", out.png)");
+  bb_image before = harness_read(tmp("out.png"), NULL);
+  const char *args[] = {"program", program, "-o", "out.png", NULL};
+  harness_expect_refusal(harness_dir, args, 1, "overwrite the input", 0);
+  bb_image after = harness_read(tmp("out.png"), NULL);
+  cr_expect(harness_same_pixels(&before, &after), "out.png was replaced");
+  bb_image_free(&after);
+  bb_image_free(&before);
+}
+
 /* ----------------------------------------------------------- bake --slope */
 
 Test(cli_program, bake_slope_bytes_and_lit_preview) {
