@@ -75,10 +75,14 @@ static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
   const bb_program_options *o = ev->o;
   char path[4096];
   const char *base = o->base_dir;
-  if (base && *base && n->name[0] != '/')
-    snprintf(path, sizeof path, "%s/%s", base, n->name);
-  else
-    snprintf(path, sizeof path, "%s", n->name);
+  int len = base && *base && n->name[0] != '/'
+                ? snprintf(path, sizeof path, "%s/%s", base, n->name)
+                : snprintf(path, sizeof path, "%s", n->name);
+  /* A cut path would name another file (even an existing one). */
+  if (len < 0 || (size_t)len >= sizeof path)
+    return bb__fail(ev->err, BB_ERR_ARGUMENT,
+                    "%.64s: path too long (%d bytes, at most %zu)", n->name, len,
+                    sizeof path - 1);
   bb_image raw = {0};
   bb_image_info info;
   memset(&info, 0, sizeof info);

@@ -342,6 +342,38 @@ Test(program, nesting_is_bounded) {
   cr_assert(strstr(err.message, "at most 64"), "%s", err.message);
 }
 
+/* A base directory and name past 4095 bytes were cut to fit a fixed buffer,
+ * and the cut path was read: here an image that exists, h.png, read for the
+ * h.png.missing the program names. */
+Test(program, a_path_too_long_is_an_error_not_cut) {
+  static char base[4096], cut[4096];
+  memset(base, 0, sizeof base);
+  strcpy(base, "base");
+  while (strlen(base) + strlen("/h.png") < 4095)
+    strcat(base, strlen(base) + strlen("/./h.png") <= 4095 ? "/." : "x");
+  strcat(strcpy(cut, base), "/h.png");
+  cr_assert_eq(strlen(cut), 4095);
+  library lib = {0};
+  float one[1] = {0.5f};
+  add_image(&lib, cut, 1, 1, 1, one);
+  bb_program *p = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_program_parse("invertColor(h.png.missing)", &p, &err), BB_OK);
+  bb_program_options o;
+  bb_program_options_init(&o);
+  o.loader = load_from;
+  o.loader_user = &lib;
+  o.base_dir = base;
+  bb_image out;
+  int is_normal;
+  cr_assert_eq(bb_program_run(p, &o, &out, &is_normal, &err), BB_ERR_ARGUMENT, "read %s",
+               lib.last_path);
+  cr_assert(strstr(err.message, "h.png.missing: path too long"), "%s", err.message);
+  cr_assert_null(out.pixels);
+  bb_program_free(p);
+  free_library(&lib);
+}
+
 Test(program, names_quotes_base_directory_and_missing_files) {
   library lib = {0};
   float one[1] = {0.5f};
