@@ -42,20 +42,28 @@ static int put_rule(FILE *f, const cli_dep_rule *r) {
   return 0;
 }
 
-static const char *unwritable_name(const cli_dep_rule *rules, int count) {
+/* A name with a newline cannot be written in a depfile; 0, or the exit code
+ * after printing. */
+static int refuse_unwritable_names(const char *path, const cli_dep_rule *rules, int count) {
   for (int i = 0; i < count; i++) {
+    int bad = 0;
     for (int t = 0; t < rules[i].target_count; t++)
-      if (strchr(rules[i].targets[t], '\n'))
-        return rules[i].targets[t];
+      bad |= strchr(rules[i].targets[t], '\n') != NULL;
     for (int p = 0; p < rules[i].prerequisite_count; p++)
-      if (strchr(rules[i].prerequisites[p], '\n'))
-        return rules[i].prerequisites[p];
+      bad |= strchr(rules[i].prerequisites[p], '\n') != NULL;
+    if (bad) {
+      cli_file_error(path, "a file name holds a newline, which a depfile cannot say");
+      return BB_EXIT_FAILURE;
+    }
   }
-  return NULL;
+  return 0;
 }
 
 int cli_depfile_check(const char *command, const char *path, const cli_dep_rule *rules,
                       int count) {
+  int rc = refuse_unwritable_names(path, rules, count);
+  if (rc)
+    return rc;
   /* A file the bake reads would be replaced by text (the input, as any
    * output over the input, is a failure); one it writes would be
    * clobbered by the other, which is a usage error as for two outputs. */
@@ -99,11 +107,9 @@ static char *depfile_text(const cli_dep_rule *rules, int count, size_t *size) {
 /* Composed in memory, then written by the library as images are (a
  * temporary renamed into place, removed on a signal). */
 int cli_depfile_write(const char *path, const cli_dep_rule *rules, int count) {
-  const char *bad = unwritable_name(rules, count);
-  if (bad) {
-    cli_file_error(path, "a file name holds a newline, which a depfile cannot say");
-    return BB_EXIT_FAILURE;
-  }
+  int rc = refuse_unwritable_names(path, rules, count);
+  if (rc)
+    return rc;
   size_t size = 0;
   char *text = depfile_text(rules, count, &size);
   if (!text) {

@@ -302,8 +302,8 @@ Test(cli_batch, depfiles) {
 }
 
 /* A depfile on a file the bake reads (exit 1, as any output on its input)
- * or writes (exit 2, as two outputs on one name), or where it cannot be
- * written, is refused before the bake: no file is written or replaced. */
+ * or writes (exit 2, as two outputs on one name), where it cannot be
+ * written, or naming a file it cannot say, is refused before the bake: no file is written or replaced. */
 Test(cli_batch, depfile_on_an_input_or_an_output_is_refused) {
   make_dir(tmp("out"));
   height_file(tmp("a.png"), 1);
@@ -329,6 +329,8 @@ Test(cli_batch, depfile_on_an_input_or_an_output_is_refused) {
       {{"bake", "a.png", FAST, "--out-dir", "out", "--depfile", "out/a_ao.png"}, 2,
        "out/a_ao.png"},
       {{"bake", "a.png", FAST, "--out-dir", "out", "--depfile", "nodir/a.d"}, 1, "nodir"},
+      /* a name a depfile cannot hold is found before the bake writes it */
+      {{"bake", "a.png", FAST, "--ao", "a\no.png", "--depfile", "a.d"}, 1, "newline"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     harness_expect_refusal(harness_dir, cases[i].args, cases[i].code, cases[i].part, i);
