@@ -1117,6 +1117,13 @@ void bb_program_free(bb_program *program);
  * id's timestamps, and to keep an output from replacing an input. */
 size_t bb_program_images(const bb_program *program, const char **names, size_t cap);
 
+/* The file a program's image name is read from: name as written when it is
+ * absolute or base_dir is NULL or empty, else base_dir/name (base_dir as in
+ * bb_program_options). Writes it into out (cap bytes, terminated) and
+ * returns its length, as snprintf does: a length >= cap means it did not
+ * fit, and bb_program_run refuses such a name rather than read a cut path. */
+int bb_program_image_path(const char *base_dir, const char *name, char *out, size_t cap);
+
 /* Reads the image a program names: fills img (any channel count) and info
  * (may be NULL) as bb_image_read does. */
 typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,

@@ -2,11 +2,9 @@
  * ninja (depfile = ..., deps = gcc) learn what a bake reads. */
 #include "cli_batch.h"
 
-#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 /* Writes name escaped as GCC's depfiles escape it; -1 on a write error. */
 static int put_name(FILE *f, const char *name) {

@@ -83,11 +83,11 @@ static int check_output_against_images(const program_args *a, const bb_program *
   int rc = 0;
   for (size_t i = 0; i < count && !rc; i++) {
     char path[4096];
-    if (a->base_dir && *a->base_dir && names[i][0] != '/')
-      snprintf(path, sizeof path, "%s/%s", a->base_dir, names[i]);
-    else
-      snprintf(path, sizeof path, "%s", names[i]);
-    rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
+    /* a name too long to resolve is refused when the program runs, before
+     * anything is written; a cut path is no input to compare with */
+    const int len = bb_program_image_path(a->base_dir, names[i], path, sizeof path);
+    if (len >= 0 && (size_t)len < sizeof path)
+      rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
   }
   free(names);
   return rc;

@@ -71,13 +71,18 @@ static bb_status to_rgba(const bb_image *in, int alpha_channel, bb_image *out,
   return BB_OK;
 }
 
+int bb_program_image_path(const char *base_dir, const char *name, char *out, size_t cap) {
+  if (!name)
+    name = "";
+  if (base_dir && *base_dir && name[0] != '/')
+    return snprintf(out, cap, "%s/%s", base_dir, name);
+  return snprintf(out, cap, "%s", name);
+}
+
 static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
   const bb_program_options *o = ev->o;
   char path[4096];
-  const char *base = o->base_dir;
-  int len = base && *base && n->name[0] != '/'
-                ? snprintf(path, sizeof path, "%s/%s", base, n->name)
-                : snprintf(path, sizeof path, "%s", n->name);
+  int len = bb_program_image_path(o->base_dir, n->name, path, sizeof path);
   /* A cut path would name another file (even an existing one). */
   if (len < 0 || (size_t)len >= sizeof path)
     return bb__fail(ev->err, BB_ERR_ARGUMENT,

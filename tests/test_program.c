@@ -403,3 +403,19 @@ Test(program, names_quotes_base_directory_and_missing_files) {
   bb_program_free(p);
   free_library(&lib);
 }
+
+/* Where an image name is read from: base_dir joins relative names only;
+ * the length is snprintf's, so a cut path can be told from a whole one. */
+Test(program, image_path_joins_base_dir_for_relative_names) {
+  char out[32];
+  cr_assert_eq(bb_program_image_path("maps", "a.tga", out, sizeof out), 10);
+  cr_assert_str_eq(out, "maps/a.tga");
+  cr_assert_eq(bb_program_image_path("maps", "/abs/a.tga", out, sizeof out), 10);
+  cr_assert_str_eq(out, "/abs/a.tga");
+  cr_assert_eq(bb_program_image_path("", "a.tga", out, sizeof out), 5);
+  cr_assert_str_eq(out, "a.tga");
+  cr_assert_eq(bb_program_image_path(NULL, "a.tga", out, sizeof out), 5);
+  char small[8];
+  cr_assert_eq(bb_program_image_path("maps", "a.tga", small, sizeof small), 10,
+               "the whole length, past cap");
+}
