@@ -19,8 +19,16 @@ WARN    := -Wall -Wextra -Wshadow -Wconversion -Wstrict-prototypes -Wmissing-pro
 # -MMD -MP: every compile also writes OBJ.d listing the headers it read, so
 # touching a header recompiles exactly what includes it (included below).
 DEPFLAGS:= -MMD -MP
-CFLAGS  += -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(OPT) $(WARN) -Iinclude -Isrc
-CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow -Iinclude -Isrc
+# Include paths by family: the library sees its private headers (-Isrc:
+# "core/internal.h", "trace/sweep.h"...); the CLI sees the public header and
+# its own folder only, so the build proves it uses nothing but bumpbake.h;
+# tests and tools also see tests/ and src/ (internals they check, the CLI's
+# JSON writer).
+CFLAGS  += -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(OPT) $(WARN)
+CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow
+LIB_INCLUDES  := -Iinclude -Isrc
+CLI_INCLUDES  := -Iinclude -Isrc/cli
+TEST_INCLUDES := -Iinclude -Isrc -Itests
 # Library objects go into libbumpbake.so as well as libbumpbake.a, so they
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
@@ -79,10 +87,12 @@ CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
 comma := ,
 
 # ---- sources and products ----------------------------------------------------
-LIB_C    := $(filter-out src/cli%.c,$(wildcard src/*.c))
-LIB_CXX  := $(wildcard src/*.cpp)
-CLI_C    := $(wildcard src/cli*.c)
-TEST_C   := $(wildcard tests/test_*.c)
+# The library's families, in the order data flows (README "Layout").
+FAMILIES := core io bake trace maps render mesh job
+LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
+LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
+CLI_C    := $(wildcard src/cli/*.c)
+TEST_C   := $(wildcard tests/*/test_*.c)
 TOOL_C   := $(wildcard tools/*.c)
 
 LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
@@ -92,7 +102,7 @@ TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
 # The fuzz targets' code, compiled into the test binary to replay the saved
 # regression inputs (tests/test_fuzz.c), with the CLI minus main().
 FUZZ_REPLAY_OBJ := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%.o,$(wildcard fuzz/fuzz_*.c))
-CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli_main.o,$(CLI_OBJ))
+CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o,$(CLI_OBJ))
 ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
 SHLIB    := $(BUILD)/$(SHLIB_REAL)
@@ -161,7 +171,9 @@ $(BUILD)/link.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS)
+$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES)
+$(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
+$(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
 $(BUILD)/%.o: %.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)
@@ -200,14 +212,14 @@ $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
 
-# The tools print JSON with the CLI's one writer (src/cli_json.c).
-TOOL_JSON := $(BUILD)/src/cli_json.o
+# The tools print JSON with the CLI's one writer (src/cli/json.c).
+TOOL_JSON := $(BUILD)/src/cli/json.o
 $(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(TOOL_JSON) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $< $(TOOL_JSON) $(LIB) $(LDLIBS)
 
 $(FUZZ_REPLAY_OBJ): $(BUILD)/fuzz/%.o: fuzz/%.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(DEPFLAGS) -DLLVMFuzzerTestOneInput=bb_$* -c $< -o $@
+	$(CC) $(CFLAGS) $(TEST_INCLUDES) $(DEPFLAGS) -DLLVMFuzzerTestOneInput=bb_$* -c $< -o $@
 
 $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) \
@@ -297,11 +309,11 @@ FUZZ_SECONDS ?= 60
 FUZZ_BUILD   := build/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
-FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) -Iinclude -Isrc
+FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) $(TEST_INCLUDES) -Isrc/cli
 FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
 FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
 FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
-FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli_main.c,$(CLI_C)))
+FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(CLI_C)))
 # Per target: libFuzzer options beyond time and corpus.
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536
@@ -335,7 +347,7 @@ fuzz: ensure-fuzz-deps
 	  $(foreach t,$(FUZZ_TARGETS),"$(notdir $(t)) $(FUZZ_ARGS_$(notdir $(t)))")
 
 format:
-	clang-format -i include/*.h src/*.c src/*.h src/*.cpp tests/*.c tools/*.c fuzz/*.c
+	clang-format -i include/*.h src/*/*.c src/*/*.h src/*/*.cpp tests/*.h tests/*/*.c tools/*.c fuzz/*.c
 
 clean:
 	rm -rf build out

@@ -11,7 +11,7 @@
  * tables, number parsing and ranges, prefix expansion, output-name checks,
  * compare's own parser, program's expression parser. Properties: no crash,
  * leak or undefined behaviour, and only the documented exit codes. */
-#include "cli.h"
+#include "cli/cli.h"
 #include "fuzz_common.h"
 
 typedef int (*command_fn)(int argc, char **argv);

@@ -22,8 +22,8 @@
  * command line.
  */
 #include "bumpbake.h"
-#include "internal.h"
-#include "cli_json.h"
+#include "core/internal.h"
+#include "cli/json.h"
 
 #include <errno.h>
 #include <math.h>

@@ -19,8 +19,8 @@
  * bad command line.
  */
 #include "bumpbake.h"
-#include "cli_json.h"
-#include "trace_internal.h"
+#include "cli/json.h"
+#include "trace/trace_internal.h"
 
 #include <errno.h>
 #include <math.h>

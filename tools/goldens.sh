@@ -2,7 +2,7 @@
 # goldens.sh: regenerate or check the golden bakes listed in fixtures/goldens/cases.txt.
 #
 #   tools/goldens.sh BIN regenerate   bake every case into fixtures/goldens/
-#   tools/goldens.sh BIN check        run the golden test (tests/test_goldens.c),
+#   tools/goldens.sh BIN check        run the golden test (tests/job/test_goldens.c),
 #                                     which re-bakes and compares with tolerances
 #
 # Regenerate only on purpose (`make goldens`): a changed golden is a changed

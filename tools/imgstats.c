@@ -14,7 +14,7 @@
  * command line.
  */
 #include "bumpbake.h"
-#include "cli_json.h"
+#include "cli/json.h"
 
 #include <math.h>
 #include <stdio.h>

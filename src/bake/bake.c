@@ -1,0 +1,190 @@
+/* bake.c: the pipeline smooth -> normals -> pyramid -> trace -> derive over
+ * one height field, with the time of each stage. No file I/O here. */
+#include "core/internal.h"
+#include "trace/trace_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+void bb_bake_options_init(bb_bake_options *o) {
+  memset(o, 0, sizeof *o);
+  o->height_scale = 0.0f; /* must be set: there is no meaningful default */
+  o->rays = 256;
+  bb_smooth_options_init(&o->smooth);
+  bb_trace_options_init(&o->trace);
+  o->power = 1.0;
+  bb_basis_init(&o->basis);
+  o->normal_filter = BB_NORMAL_VERTEX;
+  o->outputs = BB_OUTPUTS_ALL;
+}
+
+void bb_bake_result_free(bb_bake_result *r) {
+  bb_image_free(&r->filtered);
+  bb_image_free(&r->normal);
+  bb_image_free(&r->weights);
+  bb_image_free(&r->vis);
+  bb_image_free(&r->ssbump);
+  bb_image_free(&r->ao);
+  bb_image_free(&r->bent);
+  memset(r, 0, sizeof *r);
+}
+
+static int wants(const bb_bake_options *o, unsigned bits) {
+  return (o->outputs & bits) != 0;
+}
+
+/* The options' ranges that need a trace: they mean nothing without one. */
+static bb_status check_trace_options(const bb_bake_options *o, bb_error *err) {
+  if (!o->slices && (o->rays < 1 || o->rays > 65536))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: rays must be in 1..65536 (got %d)", o->rays);
+  if (o->slices < 0 || o->slices > BB_MAX_SLICES)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: slices must be in 1..%d (got %d)",
+                    BB_MAX_SLICES, o->slices);
+  return BB_OK;
+}
+
+/* A double option in [min, max]; NaN fails the lower bound. */
+static bb_status check_range(double v, double min, double max, const char *what,
+                             bb_error *err) {
+  if (!(v >= min))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: %s must be >= %g (got %g)", what, min, v);
+  if (!(v <= max))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: %s must be <= %g (got %g)", what, max, v);
+  return BB_OK;
+}
+
+bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
+  if (!o)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing options");
+  if (!(o->height_scale > 0.0f) || !isfinite(o->height_scale))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: height scale must be > 0 (got %g)",
+                    (double)o->height_scale);
+  if (o->outputs == 0 || (o->outputs & ~BB_OUTPUTS_ALL) != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "bake: outputs must be a non-empty set of BB_OUTPUT_BIT(kind) (got 0x%x)",
+                    o->outputs);
+  bb_status st = wants(o, BB_OUTPUTS_TRACED) ? check_trace_options(o, err) : BB_OK;
+  if (st != BB_OK)
+    return st;
+  if (o->smooth.radius_texels < 0 || o->smooth.radius_texels > BB_MAX_FILTER_RADIUS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: filter radius must be in 0..%d (got %d)",
+                    BB_MAX_FILTER_RADIUS, o->smooth.radius_texels);
+  if (!(o->smooth.threshold > 0.0f) || !isfinite(o->smooth.threshold))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: filter threshold must be > 0 (got %g)",
+                    (double)o->smooth.threshold);
+  if (o->smooth.addressing != BB_ADDRESS_PERIODIC && o->smooth.addressing != BB_ADDRESS_CLAMP)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown addressing mode %d",
+                    (int)o->smooth.addressing);
+  if ((st = check_range(o->power, 1.0, BB_MAX_POWER, "power", err)) != BB_OK ||
+      (st = check_range(o->trace.bias_texels, 0.0, BB_MAX_BIAS_TEXELS, "bias", err)) != BB_OK)
+    return st;
+  if (o->trace.threads < 0 || o->trace.threads > BB_MAX_THREADS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: threads must be in 0..%d (got %d)",
+                    BB_MAX_THREADS, o->trace.threads);
+  if (strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
+                    (int)o->normal_filter);
+  return bb__basis_check(&o->basis, "bake", err);
+}
+
+/* Heights in texels, the field the tracer sees. */
+static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
+                                bb_error *err) {
+  bb_status st = bb_image_alloc(out, h->width, h->height, 1, err);
+  if (st != BB_OK) return st;
+  size_t n = (size_t)h->width * (size_t)h->height;
+  for (size_t i = 0; i < n; i++) out->pixels[i] = scale * h->pixels[i];
+  return BB_OK;
+}
+
+/* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent. */
+static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake_result *r,
+                                  bb_error *err) {
+  double t0 = bb__now_seconds();
+  bb_image z = {0};
+  bb_pyramid *pyramid = NULL;
+  bb_rayset rays = {0};
+  bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
+  if (st == BB_OK) st = bb__pyramid_build(&z, o->smooth.addressing, threads, &pyramid, err);
+  bb_image_free(&z);
+  const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
+  if (st == BB_OK) st = bb__rayset_make(slices, o->power, &o->basis, threads, &rays, err);
+  double t1 = bb__now_seconds();
+  r->seconds_pyramid = t1 - t0;
+  if (st == BB_OK) {
+    snprintf(r->rayset_id, sizeof r->rayset_id, "%s", rays.id);
+    bb_trace_options whole = o->trace;
+    whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
+    whole.threads = threads;
+    st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+  }
+  double t2 = bb__now_seconds();
+  r->seconds_trace = t2 - t1;
+  bb_rayset_free(&rays);
+  bb_pyramid_free(pyramid);
+  const unsigned ssbump_or_bent =
+      BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);
+  if (st == BB_OK && wants(o, ssbump_or_bent))
+    st = bb__derive_ssbump(&r->normal, &r->vis, &o->basis, threads, &r->ssbump, err);
+  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_AO)))
+    st = bb__derive_ao(&r->vis, threads, &r->ao, err);
+  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_BENT)))
+    st = bb__derive_bent(&r->ssbump, &o->basis, threads, &r->bent, err);
+  r->seconds_derive += bb__now_seconds() - t2;
+  return st;
+}
+
+/* smooth -> normals -> weights, as far as the asked maps need them. */
+static bb_status smooth_and_normals(const bb_image *height, const bb_bake_options *o,
+                                    int threads, bb_bake_result *r, bb_error *err) {
+  double t0 = bb__now_seconds();
+  bb_status st = bb__smooth_bilateral(height, height, &o->smooth, threads, &r->filtered, err);
+  double t1 = bb__now_seconds();
+  r->seconds_smooth = t1 - t0;
+  const unsigned need_normal = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) |
+                               BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS) | BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) |
+                               BB_OUTPUT_BIT(BB_OUTPUT_BENT);
+  if (st == BB_OK && wants(o, need_normal))
+    st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
+                             o->smooth.addressing, threads, &r->normal, err);
+  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)))
+    st = bb__derive_weights(&r->normal, &o->basis, threads, &r->weights, err);
+  r->seconds_derive = bb__now_seconds() - t1;
+  return st;
+}
+
+/* Frees what was made only because another map needed it. */
+static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
+  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED))) bb_image_free(&r->filtered);
+  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_free(&r->normal);
+  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP))) bb_image_free(&r->ssbump);
+}
+
+bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
+                  bb_error *err) {
+  memset(r, 0, sizeof *r);
+  if (!height || !height->pixels || height->channels != 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
+  bb_status st = bb_bake_options_check(o, err);
+  /* Before any stage: an overflow of scale x height is named as such. */
+  if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
+  if (st != BB_OK) return st;
+  r->basis = o->basis;
+  const int threads = bb__thread_count(o->trace.threads);
+  st = smooth_and_normals(height, o, threads, r, err);
+  if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED)) st = trace_and_derive(o, threads, r, err);
+  if (st == BB_OK && o->normal_y_up) {
+    if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);
+    if (r->bent.pixels) bb_image_flip_green(&r->bent);
+  }
+  if (st == BB_ERR_CANCELLED)
+    bb__fail(err, st, "bake: cancelled by the progress callback");
+  if (st != BB_OK) {
+    bb_bake_result_free(r);
+    return st;
+  }
+  drop_unasked(o, r);
+  r->threads = threads;
+  return BB_OK;
+}

@@ -1,0 +1,251 @@
+/* derive.c: the maps derived per texel from normals and visibility, for any
+ * basis (basis.c). */
+#include "core/internal.h"
+
+#include <math.h>
+#include <string.h>
+
+static double dot3(const float n[3], const double b[3]) {
+  return (double)n[0] * b[0] + (double)n[1] * b[1] + (double)n[2] * b[2];
+}
+
+static double saturate(double v) {
+  return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+}
+
+static bb_status check_image(const bb_image *img, const char *what, int min_channels,
+                             int max_channels, bb_error *err) {
+  if (!img || !img->pixels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: missing %s image", what);
+  if (img->channels < min_channels || img->channels > max_channels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: %s has %d channels, not %d..%d", what,
+                    img->channels, min_channels, max_channels);
+  return BB_OK;
+}
+
+static bb_status check_output(const bb_image *out, const bb_image *a, const bb_image *b,
+                              bb_error *err) {
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: missing output image");
+  if (out == a || out == b)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: the output must be a separate image");
+  return BB_OK;
+}
+
+/* max(0, v) with the value glibc's fmax(0.0, v) returns, which the maps have
+ * always used: v < 0 and NaN (a NaN normal) give +0, and -0 stays -0. Inline
+ * because fmax is a library call per texel. */
+static double max0(double v) {
+  return v >= 0.0 ? v : 0.0;
+}
+
+/* The inputs, output and basis of one derive call; each parallel work item is
+ * one row, and each texel depends only on its own inputs. */
+typedef struct derive_job {
+  const bb_image *in, *vis;
+  bb_image *out;
+  int count; /* basis vectors used */
+  double basis[BB_MAX_BASIS][3];
+} derive_job;
+
+static void job_init(derive_job *job, const bb_image *in, const bb_image *vis,
+                     bb_image *out, const bb_basis *basis) {
+  job->in = in;
+  job->vis = vis;
+  job->out = out;
+  job->count = basis ? basis->count : 0;
+  for (int c = 0; c < job->count; c++)
+    for (int k = 0; k < 3; k++)
+      job->basis[c][k] = basis->vector[c][k];
+}
+
+/* The basis a map of `channels` basis channels is derived with: basis
+ * itself, whose count must match, or for NULL Half-Life 2's (hl2+z for a
+ * fourth channel). */
+static bb_status resolve_basis(const bb_basis *basis, int channels, const char *what,
+                               bb_basis *out, bb_error *err) {
+  if (basis) {
+    bb_status st = bb__basis_check(basis, "derive", err);
+    if (st != BB_OK)
+      return st;
+    if (channels >= 0 && channels != basis->count)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "derive: %s has %d basis channels but the basis %s has %d directions",
+                      what, channels, basis->name, basis->count);
+    *out = *basis;
+    return BB_OK;
+  }
+  if (channels >= 0 && channels != 3 && channels != 4)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "derive: %s has %d basis channels; without a basis, 3 (hl2) or 4 (hl2+z)",
+                    what, channels);
+  return bb_basis_parse(channels == 4 ? "hl2+z" : "hl2", out, err);
+}
+
+/* Runs fn over the rows of job->out on `threads` threads (0 = all cores);
+ * frees job->out if that fails. */
+static bb_status run_rows(derive_job *job, bb__work_fn fn, int threads, bb_error *err) {
+  bb_status st = bb__parallel_for(job->out->height, threads, fn, job, NULL, NULL, err);
+  if (st != BB_OK)
+    bb_image_free(job->out);
+  return st;
+}
+
+/* Flat index of the first texel of row y. */
+static size_t row_start(const bb_image *img, int y) {
+  return (size_t)y * (size_t)img->width;
+}
+
+static void weights_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *normals = job->in;
+  const size_t first = row_start(normals, y), end = first + (size_t)normals->width;
+  for (size_t i = first; i < end; i++) {
+    const float *n = normals->pixels + 3 * i;
+    const int count = job->count;
+    double w[BB_MAX_BASIS], sum = 0.0;
+    for (int c = 0; c < count; c++) {
+      double s = saturate(dot3(n, job->basis[c]));
+      w[c] = s * s;
+      sum += w[c];
+    }
+    /* A normal facing away from every direction has no preferred one. */
+    float *out = job->out->pixels + (size_t)count * i;
+    for (int c = 0; c < count; c++)
+      out[c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / count);
+  }
+}
+
+bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
+                            bb_error *err) {
+  return bb__derive_weights(normals, basis, 0, out, err);
+}
+
+bb_status bb__derive_weights(const bb_image *normals, const bb_basis *basis, int threads,
+                             bb_image *out, bb_error *err) {
+  bb_status st;
+  bb_basis b;
+  if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, -1, "weights", &b, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, normals, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, normals->width, normals->height, b.count, err)) != BB_OK)
+    return st;
+  derive_job job;
+  job_init(&job, normals, NULL, out, &b);
+  return run_rows(&job, weights_row, threads, err);
+}
+
+static void ssbump_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *vis = job->vis;
+  const int count = job->count;
+  const size_t first = row_start(vis, y), end = first + (size_t)vis->width;
+  for (size_t i = first; i < end; i++) {
+    const float *n = job->in->pixels + 3 * i;
+    const float *v = vis->pixels + (size_t)vis->channels * i + 1; /* skip ao */
+    float *s = job->out->pixels + (size_t)count * i;
+    for (int c = 0; c < count; c++)
+      s[c] = (float)(max0(dot3(n, job->basis[c])) * (double)v[c]);
+  }
+}
+
+bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
+                           const bb_basis *basis, bb_image *out, bb_error *err) {
+  return bb__derive_ssbump(normals, vis, basis, 0, out, err);
+}
+
+bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
+                            const bb_basis *basis, int threads, bb_image *out, bb_error *err) {
+  bb_status st;
+  bb_basis b;
+  if ((st = check_image(normals, "normal", 3, 3, err)) != BB_OK)
+    return st;
+  if ((st = check_image(vis, "visibility", 4, 1 + BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, vis->channels - 1, "visibility", &b, err)) != BB_OK)
+    return st;
+  if (vis->width != normals->width || vis->height != normals->height)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "derive: visibility is %dx%d but normals are %dx%d", vis->width,
+                    vis->height, normals->width, normals->height);
+  if ((st = check_output(out, normals, vis, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, vis->width, vis->height, b.count, err)) != BB_OK)
+    return st;
+  derive_job job;
+  job_init(&job, normals, vis, out, &b);
+  return run_rows(&job, ssbump_row, threads, err);
+}
+
+static void ao_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *vis = job->vis;
+  const size_t first = row_start(vis, y), end = first + (size_t)vis->width;
+  for (size_t i = first; i < end; i++)
+    job->out->pixels[i] = vis->pixels[(size_t)vis->channels * i];
+}
+
+bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
+  return bb__derive_ao(vis, 0, out, err);
+}
+
+bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_error *err) {
+  bb_status st;
+  if ((st = check_image(vis, "visibility", 1, 64, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, vis, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, vis->width, vis->height, 1, err)) != BB_OK)
+    return st;
+  derive_job job;
+  job_init(&job, NULL, vis, out, NULL);
+  return run_rows(&job, ao_row, threads, err);
+}
+
+static void bent_row(void *user, int y) {
+  const derive_job *job = user;
+  const bb_image *ssbump = job->in;
+  const int count = job->count;
+  const size_t first = row_start(ssbump, y), end = first + (size_t)ssbump->width;
+  for (size_t i = first; i < end; i++) {
+    const float *s = ssbump->pixels + (size_t)count * i;
+    double b[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < count; c++)
+      for (int k = 0; k < 3; k++)
+        b[k] += (double)s[c] * job->basis[c][k];
+    double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    float *o = job->out->pixels + 3 * i;
+    /* Fully shadowed: no light direction to bend towards, so report straight up. */
+    if (!(len > 0.0)) {
+      o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
+      continue;
+    }
+    for (int k = 0; k < 3; k++)
+      o[k] = (float)(b[k] / len);
+  }
+}
+
+bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
+                         bb_error *err) {
+  return bb__derive_bent(ssbump, basis, 0, out, err);
+}
+
+bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
+                          bb_image *out, bb_error *err) {
+  bb_status st;
+  bb_basis b;
+  if ((st = check_image(ssbump, "ssbump", 3, BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, ssbump->channels, "ssbump", &b, err)) != BB_OK)
+    return st;
+  if ((st = check_output(out, ssbump, NULL, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, ssbump->width, ssbump->height, 3, err)) != BB_OK)
+    return st;
+  derive_job job;
+  job_init(&job, ssbump, NULL, out, &b);
+  return run_rows(&job, bent_row, threads, err);
+}

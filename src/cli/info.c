@@ -1,0 +1,193 @@
+/* cli_info.c: `bumpbake info`, what image files are (size, channels, format,
+ * sample type, alpha) and the provenance bumpbake stored in them. Reads
+ * headers only: no pixel is decoded. */
+#include "cli.h"
+#include "common.h"
+
+#include "bumpbake.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const cli_option opt_json = {
+    .id = CLI_OPT_JSON,
+    .long_name = "json",
+    .default_text = "off",
+    .help = "print one JSON object per file, one per line (JSON Lines)"};
+
+static const cli_option *const info_options[] = {&opt_json, &cli_opt_help};
+
+static const cli_command info_command = {
+    "info",
+    "FILE... [--json]",
+    "Prints each image's size, channels, format, sample type and alpha channel,\n"
+    "and the provenance bumpbake stored in it, from the file's header alone (no\n"
+    "pixel is decoded). A file that cannot be read is reported and skipped; the\n"
+    "exit code is then 1.",
+    info_options,
+    (int)(sizeof info_options / sizeof info_options[0]),
+    NULL, /* no baking settings */
+};
+
+typedef struct info_args {
+  int json;
+} info_args;
+
+static int info_option(void *ctx, const cli_option *opt, const char *arg) {
+  (void)arg;
+  info_args *a = ctx;
+  if (opt->id == CLI_OPT_JSON) {
+    a->json = 1;
+    return 0;
+  }
+  return cli_usage_error(info_command.name, "internal error: option %d has no handler",
+                         opt->id);
+}
+
+/* What one file is, as read from its header. */
+typedef struct file_info {
+  int width, height, channels;
+  bb_image_info info;
+  bb_provenance_class provenance;
+} file_info;
+
+static const char *provenance_class_name(bb_provenance_class c) {
+  switch (c) {
+  case BB_PROVENANCE_INTACT:
+    return "intact";
+  case BB_PROVENANCE_DAMAGED:
+    return "damaged";
+  case BB_PROVENANCE_NONE:
+    break;
+  }
+  return "none";
+}
+
+/* ------------------------------------------------------------------ text */
+
+static void print_text(const char *path, const file_info *f) {
+  const bb_image_info *i = &f->info;
+  printf("%s: %d x %d, %d channel%s, %s, %d-bit %s\n", path, f->width, f->height,
+         f->channels, f->channels == 1 ? "" : "s", i->format_name, i->bits_per_sample,
+         i->is_float ? "float" : "integer");
+  if (i->alpha_channel >= 0)
+    printf("alpha channel: %d\n", i->alpha_channel);
+  if (f->provenance == BB_PROVENANCE_NONE) {
+    printf("no bumpbake provenance\n");
+    if (i->description && *i->description)
+      printf("description: %s\n", i->description);
+    return;
+  }
+  printf("%s:\n%s",
+         f->provenance == BB_PROVENANCE_DAMAGED
+             ? "provenance (cut or re-wrapped by the file format)"
+             : "provenance",
+         i->description);
+  size_t n = strlen(i->description);
+  if (n && i->description[n - 1] != '\n')
+    printf("\n");
+}
+
+/* ------------------------------------------------------------------ JSON */
+
+/* The key=value lines of intact provenance as a JSON object of strings
+ * (values are kept as written: exact, and the same for every key). */
+static void json_provenance(cli_json *j, const char *text) {
+  cli_json_open(j, "provenance", '{');
+  for (const char *line = text; *line;) {
+    size_t n = strcspn(line, "\n");
+    const char *eq = memchr(line, '=', n);
+    if (eq) {
+      char key[128], value[1024];
+      size_t k = (size_t)(eq - line), v = n - k - 1;
+      if (v && eq[v] == '\r')
+        v--;
+      snprintf(key, sizeof key, "%.*s", (int)k, line);
+      snprintf(value, sizeof value, "%.*s", (int)v, eq + 1);
+      cli_json_string(j, key, value);
+    }
+    line += n + (line[n] == '\n');
+  }
+  cli_json_close(j, '}');
+}
+
+static void print_json(const char *path, const file_info *f) {
+  const bb_image_info *i = &f->info;
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "path", path);
+  cli_json_int(&j, "width", f->width);
+  cli_json_int(&j, "height", f->height);
+  cli_json_int(&j, "channels", f->channels);
+  cli_json_string(&j, "format", i->format_name);
+  cli_json_int(&j, "bits_per_sample", i->bits_per_sample);
+  cli_json_bool(&j, "float", i->is_float);
+  cli_json_int(&j, "alpha_channel", i->alpha_channel);
+  cli_json_string(&j, "provenance_state", provenance_class_name(f->provenance));
+  if (f->provenance == BB_PROVENANCE_INTACT)
+    json_provenance(&j, i->description);
+  else
+    cli_json_string(&j, "provenance", NULL);
+  cli_json_string(&j, "description", i->description);
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
+}
+
+/* A file that cannot be read: its one-line error on stderr, and with --json
+ * a line saying so, so a pipeline sees one line per file. */
+static void report_error(const info_args *a, const char *path, const bb_error *err) {
+  cli_file_error(path, err->message);
+  if (!a->json)
+    return;
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "path", path);
+  cli_json_string(&j, "error", err->message);
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
+}
+
+/* Reports one file; returns 0 or BB_EXIT_FAILURE. */
+static int info_file(const info_args *a, const char *path, int index) {
+  file_info f;
+  memset(&f, 0, sizeof f);
+  bb_error err = {{0}};
+  int muted = cli_mute_stderr();
+  bb_status st =
+      bb_image_read_info(path, &f.width, &f.height, &f.channels, &f.info, &err);
+  cli_unmute_stderr(muted);
+  if (st != BB_OK) {
+    report_error(a, path, &err);
+    return BB_EXIT_FAILURE;
+  }
+  f.provenance = bb_provenance_classify(f.info.description);
+  if (a->json) {
+    print_json(path, &f);
+  } else {
+    if (index > 0)
+      putchar('\n'); /* a blank line between files */
+    print_text(path, &f);
+  }
+  bb_image_info_free(&f.info);
+  return 0;
+}
+
+int bb_cli_info(int argc, char **argv) {
+  info_args a = {0};
+  int first = 0;
+  int rc = cli_parse_options(&info_command, argc, argv, info_option, &a, &first);
+  if (rc < 0)
+    return BB_EXIT_OK; /* --help */
+  if (rc)
+    return rc;
+  if (first >= argc)
+    return cli_usage_error(info_command.name, "missing FILE (usage: bumpbake info %s)",
+                           info_command.synopsis);
+  rc = BB_EXIT_OK;
+  for (int i = first; i < argc; i++) {
+    if (info_file(&a, argv[i], i - first))
+      rc = BB_EXIT_FAILURE;
+    fflush(stdout); /* keep stdout and stderr lines in order */
+  }
+  return rc;
+}

@@ -1,0 +1,82 @@
+/* cli_json.c: the one JSON writer of the command line and the tools (see
+ * cli_json.h). */
+#include "json.h"
+
+#include <math.h>
+
+void cli_json_quoted(FILE *f, const char *s) {
+  if (!s) {
+    fputs("null", f);
+    return;
+  }
+  fputc('"', f);
+  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+    switch (*c) {
+    case '"':
+    case '\\':
+      fputc('\\', f);
+      fputc(*c, f);
+      break;
+    case '\n':
+      fputs("\\n", f);
+      break;
+    case '\r':
+      fputs("\\r", f);
+      break;
+    case '\t':
+      fputs("\\t", f);
+      break;
+    default:
+      if (*c < 0x20)
+        fprintf(f, "\\u%04x", *c);
+      else
+        fputc(*c, f);
+    }
+  }
+  fputc('"', f);
+}
+
+/* The separator and "key": that precede every value. */
+static void json_begin_value(cli_json *j, const char *key) {
+  if (j->need_comma)
+    fputc(',', j->f);
+  if (key) {
+    cli_json_quoted(j->f, key);
+    fputc(':', j->f);
+  }
+  j->need_comma = 1;
+}
+
+void cli_json_open(cli_json *j, const char *key, char open) {
+  json_begin_value(j, key);
+  fputc(open, j->f);
+  j->need_comma = 0;
+}
+
+void cli_json_close(cli_json *j, char close) {
+  fputc(close, j->f);
+  j->need_comma = 1;
+}
+
+void cli_json_string(cli_json *j, const char *key, const char *value) {
+  json_begin_value(j, key);
+  cli_json_quoted(j->f, value);
+}
+
+void cli_json_number(cli_json *j, const char *key, double value) {
+  json_begin_value(j, key);
+  if (isfinite(value))
+    fprintf(j->f, "%.9g", value);
+  else
+    fputs("null", j->f);
+}
+
+void cli_json_int(cli_json *j, const char *key, long long value) {
+  json_begin_value(j, key);
+  fprintf(j->f, "%lld", value);
+}
+
+void cli_json_bool(cli_json *j, const char *key, int value) {
+  json_begin_value(j, key);
+  fputs(value ? "true" : "false", j->f);
+}

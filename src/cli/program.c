@@ -1,0 +1,157 @@
+/* cli_program.c: `bumpbake program`, a DOOM 3 image program (the text of a
+ * material's bumpmap or diffusemap stage) evaluated outside the engine. */
+#include "maps.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const cli_option opt_output = {.id = CLI_OPT_OUTPUT,
+                                      .long_name = "output",
+                                      .short_name = 'o',
+                                      .value_name = "OUT",
+                                      .help =
+                                          "image to write (.png .tga .tif .exr); a "
+                                          "normal map as bumpbake writes them; required"};
+static const cli_option opt_base = {
+    .id = CLI_OPT_MAP_BASE_DIR,
+    .long_name = "base",
+    .value_name = "DIR",
+    .default_text = "the current directory",
+    .help = "directory image names are relative to (a game's base/, say)"};
+static const cli_option opt_depth = {.id = CLI_OPT_DEPTH,
+                                     .long_name = "depth",
+                                     .value_name = "8|16|half|float",
+                                     .default_text = "8 (png/tga/tif) or float (exr)",
+                                     .help = "sample depth of the output"};
+
+static const cli_option *const program_options[] = {&opt_output, &opt_base, &opt_depth,
+                                                    &cli_opt_mips, &cli_opt_help};
+
+static const cli_command program_command = {
+    "program",
+    "EXPR -o OUT [OPTIONS]",
+    "Evaluates a DOOM 3 image program, e.g. 'addnormals(a_local.tga, heightmap(a_h.tga, "
+    "4))',\n"
+    "with id Tech 4's formulas (README \"program\"): heightmap(img, scale),\n"
+    "addnormals(a, b), smoothnormals(a), add(a, b), scale(a, r, g, b, a),\n"
+    "invertAlpha(a), invertColor(a), makeIntensity(a), makeAlpha(a), _flat.\n"
+    "A program that makes a normal map is written as bumpbake writes normals\n"
+    "(0.5 + 0.5 N; N in EXR), any other as RGBA.",
+    program_options,
+    (int)(sizeof program_options / sizeof program_options[0]),
+    cli_settings_init,
+};
+
+typedef struct program_args {
+  cli_settings settings;
+  const char *output, *base_dir;
+} program_args;
+
+static int program_option(void *ctx, const cli_option *opt, const char *arg) {
+  program_args *a = ctx;
+  if (opt->id == CLI_OPT_OUTPUT) {
+    a->output = arg;
+    return 0;
+  }
+  if (opt->id == CLI_OPT_MAP_BASE_DIR) {
+    a->base_dir = arg;
+    return 0;
+  }
+  return cli_settings_apply(program_command.name, &a->settings, opt, arg);
+}
+
+/* bb_image_read with libpng's own messages muted, as for every command. */
+static bb_status quiet_loader(void *user, const char *path, bb_image *img,
+                              bb_image_info *info, bb_error *err) {
+  (void)user;
+  return cli_read_image(path, img, info, err);
+}
+
+/* The output must not replace any image the program reads: every one of
+ * them, however many the program names. */
+static int check_output_against_images(const program_args *a, const bb_program *program) {
+  size_t count = bb_program_images(program, NULL, 0);
+  if (count == 0) /* _flat alone: there is no input to protect */
+    return cli_check_output(program_command.name, "", a->output, a->settings.depth);
+  const char **names = malloc(count * sizeof *names);
+  if (!names) {
+    cli_file_error(a->output, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  bb_program_images(program, names, count);
+  int rc = 0;
+  for (size_t i = 0; i < count && !rc; i++) {
+    char path[4096];
+    /* a name too long to resolve is refused when the program runs, before
+     * anything is written; a cut path is no input to compare with */
+    const int len = bb_program_image_path(a->base_dir, names[i], path, sizeof path);
+    if (len >= 0 && (size_t)len < sizeof path)
+      rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
+  }
+  free(names);
+  return rc;
+}
+
+/* Parses the command line and the program: a syntax error is a usage error. */
+static int program_parse(int argc, char **argv, program_args *a, const char **text,
+                         bb_program **program) {
+  int first = 0;
+  int rc = cli_parse_options(&program_command, argc, argv, program_option, a, &first);
+  if (!rc)
+    rc = cli_expect_positionals(&program_command, argc, argv, first, 1, "EXPR");
+  if (rc)
+    return rc;
+  *text = argv[first];
+  if (!a->output)
+    return cli_usage_error(program_command.name, "-o OUT is required");
+  bb_error err = {{0}};
+  if (bb_program_parse(*text, program, &err) != BB_OK)
+    return cli_usage_error(program_command.name, "%s", err.message);
+  rc = check_output_against_images(a, *program);
+  return rc ? rc : cli_check_mips(program_command.name, &a->settings, a->output);
+}
+
+static int program_run(const cli_run *run, const program_args *a, const char *text,
+                       const bb_program *program) {
+  bb_program_options o;
+  bb_program_options_init(&o);
+  o.base_dir = a->base_dir;
+  o.loader = quiet_loader;
+  bb_image out = {0};
+  int is_normal = 0;
+  bb_error err = {{0}};
+  bb_status st = bb_program_run(program, &o, &out, &is_normal, &err);
+  if (st != BB_OK) {
+    /* The message names the image file or the function at fault. */
+    fprintf(stderr, "bumpbake: %s\n", err.message[0] ? err.message : bb_status_name(st));
+    return BB_EXIT_FAILURE;
+  }
+  const char *kind = is_normal ? "normal" : "colour";
+  int rc = cli_maps_write(run, text, NULL, kind, a->output, &out,
+                          is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth,
+                          a->settings.mips);
+  if (!rc)
+    printf("wrote %s %s\n", kind, a->output);
+  bb_image_free(&out);
+  return rc;
+}
+
+int bb_cli_program(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+    return BB_EXIT_FAILURE;
+  program_args a;
+  memset(&a, 0, sizeof a);
+  cli_settings_init(&a.settings);
+  bb_program *program = NULL;
+  const char *text = NULL;
+  int rc = program_parse(argc, argv, &a, &text, &program);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = program_run(&run, &a, text, program);
+  bb_program_free(program);
+  cli_run_free(&run);
+  return rc;
+}

@@ -1,0 +1,53 @@
+/* cli_progress.c: the progress bar of long bakes on a terminal. */
+#include "common.h"
+
+#include <string.h>
+#include <unistd.h>
+
+/* --------------------------------------------------------------- progress */
+
+enum { PROGRESS_BAR_WIDTH = 20 };
+
+/* Never cancels: Ctrl-C ends the process (cli_install_signal_handlers). */
+static int progress_draw(void *user, long done, long total) {
+  cli_progress *p = user;
+  double now = cli_now_seconds(), elapsed = now - p->start_seconds;
+  /* Short bakes stay silent; long ones redraw ten times a second at most. */
+  if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1)
+    return 0;
+  p->last_draw_seconds = now;
+  double frac = done <= 0 ? 0.0 : (double)done / (double)total;
+  if (frac > 1.0)
+    frac = 1.0;
+  int filled = (int)(frac * PROGRESS_BAR_WIDTH); /* full only when done */
+  char bar[PROGRESS_BAR_WIDTH + 1];
+  for (int i = 0; i < PROGRESS_BAR_WIDTH; i++)
+    bar[i] = i < filled ? '#' : '.';
+  bar[PROGRESS_BAR_WIDTH] = '\0';
+  fprintf(stderr, "\r%s [%s] %3d%%", p->label, bar, (int)(frac * 100.0));
+  if (frac > 0.0)
+    fprintf(stderr, " ETA %.1fs", elapsed * (1.0 - frac) / frac);
+  fputs("\033[K", stderr); /* erase what a longer previous line left */
+  fflush(stderr);
+  p->shown = 1;
+  return 0;
+}
+
+void cli_progress_attach(cli_progress *p, const char *label, int quiet,
+                         bb_trace_options *trace) {
+  memset(p, 0, sizeof *p);
+  p->label = label;
+  p->start_seconds = cli_now_seconds();
+  if (quiet || !isatty(STDERR_FILENO))
+    return;
+  trace->progress = progress_draw;
+  trace->progress_user = p;
+}
+
+void cli_progress_finish(cli_progress *p) {
+  if (!p->shown)
+    return;
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+  p->shown = 0;
+}

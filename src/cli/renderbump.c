@@ -1,0 +1,368 @@
+/* cli_renderbump.c: `bumpbake renderbumpflat`, DOOM 3's RenderBumpFlat: a
+ * flat sculpt (a model file) to its normal map, and optionally its height
+ * with the scale that `bumpbake bake` needs to make ssbump and ao from it. */
+#include "common.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Option ids of this command only (the shared ones are in cli_common.h). */
+enum {
+  OPT_SIZE = 1000, /* -size W H, taken out of argv before getopt */
+  OPT_RECT,        /* --rect L B R T, likewise */
+  OPT_HEIGHT,
+  OPT_AXIS,
+  OPT_SAMPLES,
+  OPT_FACE_NORMALS,
+  OPT_TILE,
+  OPT_QUIET
+};
+
+static const cli_option opt_size = {
+    .id = OPT_SIZE,
+    .long_name = "size",
+    .value_name = "W H",
+    .default_text = "256 256",
+    .range_text = "1..65536 each, W*H <= 8192*8192",
+    .help = "output size in texels (DOOM 3's -size W H; one dash or two)"};
+static const cli_option opt_output = {
+    .id = CLI_OPT_OUTPUT,
+    .long_name = "output",
+    .short_name = 'o',
+    .value_name = "OUT",
+    .default_text = "MODEL_local.tga beside MODEL",
+    .help = "normal map, RGB = N, A = coverage (.tga .png .tif .exr)"};
+static const cli_option opt_height = {
+    .id = OPT_HEIGHT,
+    .long_name = "height",
+    .value_name = "FILE",
+    .help = "also write the height, 0..1 (16-bit png/tif, float exr), and print its scale"};
+static const cli_option opt_axis = {
+    .id = OPT_AXIS,
+    .long_name = "axis",
+    .value_name = "-y|+y|+z|-z|+x|-x",
+    .default_text = "-y (DOOM 3)",
+    .help = "the side the sculpt's front faces (+z: Blender's top view)"};
+static const cli_option opt_samples = {
+    .id = OPT_SAMPLES,
+    .long_name = "samples",
+    .value_name = "N",
+    .default_text = "4 (16 samples per texel)",
+    .range_text = "1..16",
+    .help = "N x N samples per texel"};
+static const cli_option opt_face_normals = {
+    .id = OPT_FACE_NORMALS,
+    .long_name = "face-normals",
+    .default_text = "off",
+    .help = "triangles' plane normals even where the model has vertex normals"};
+static const cli_option opt_rect = {
+    .id = OPT_RECT,
+    .long_name = "rect",
+    .value_name = "L B R T",
+    .default_text = "the model's bounding rectangle",
+    .help = "rectangle in model units along the image's right and up axes"};
+static const cli_option opt_tile = {
+    .id = OPT_TILE,
+    .long_name = "tile",
+    .default_text = "off",
+    .help = "wrap geometry outside --rect into it (the sculpt tiles; needs --rect)"};
+static const cli_option opt_quiet = {.id = OPT_QUIET,
+                                     .long_name = "quiet",
+                                     .short_name = 'q',
+                                     .help = "print only errors, notes and the height scale"};
+
+static const cli_option *const rbf_options[] = {
+    &opt_size,  &opt_output,   &opt_height,       &opt_axis,         &opt_samples,
+    &opt_face_normals, &opt_rect, &opt_tile, &cli_opt_normal_y, &cli_opt_threads,
+    &opt_quiet, &cli_opt_help,
+};
+
+static const cli_command rbf_command = {
+    "renderbumpflat",
+    "[-size W H] MODEL [OPTIONS]",
+    "DOOM 3's RenderBumpFlat: projects MODEL (any format Assimp reads) onto its\n"
+    "bounding rectangle and writes the front-most surface's normals, 16x\n"
+    "oversampled, with alpha = coverage.",
+    rbf_options,
+    (int)(sizeof rbf_options / sizeof rbf_options[0]),
+    cli_settings_init,
+};
+
+typedef struct rbf_args {
+  bb_renderbump_options render;
+  cli_settings settings; /* --normal-y and --threads, through the shared rows */
+  const char *model, *output, *height;
+  char *default_output; /* malloc'd MODEL_local.tga */
+  int quiet;
+} rbf_args;
+
+/* ------------------------------------------------------------- parsing */
+
+static int rbf_option(void *ctx, const cli_option *opt, const char *arg) {
+  rbf_args *a = ctx;
+  switch (opt->id) {
+  case CLI_OPT_OUTPUT:
+    a->output = arg;
+    return 0;
+  case OPT_HEIGHT:
+    a->height = arg;
+    return 0;
+  case OPT_AXIS:
+    if (bb_axis_parse(arg, &a->render.axis))
+      return cli_usage_error(rbf_command.name, "--axis must be one of %s (got '%s')",
+                             opt->value_name, arg);
+    return 0;
+  case OPT_SAMPLES:
+    return cli_parse_int(rbf_command.name, "--samples", arg, 1, 16, &a->render.samples);
+  case OPT_FACE_NORMALS:
+    a->render.face_normals = 1;
+    return 0;
+  case OPT_TILE:
+    a->render.tile = 1;
+    return 0;
+  case OPT_QUIET:
+    a->quiet = 1;
+    return 0;
+  case OPT_SIZE: /* only an abbreviation ("--si") reaches getopt */
+  case OPT_RECT:
+    return cli_usage_error(rbf_command.name, "--%s takes %s values: --%s %s",
+                           opt->long_name, opt->id == OPT_SIZE ? "two" : "four",
+                           opt->long_name, opt->value_name);
+  default:
+    return cli_settings_apply(rbf_command.name, &a->settings, opt, arg);
+  }
+}
+
+static int parse_size(rbf_args *a, char **values) {
+  int rc = cli_parse_int(rbf_command.name, "-size W", values[0], 1, BB_MAX_DIMENSION,
+                         &a->render.width);
+  if (!rc)
+    rc = cli_parse_int(rbf_command.name, "-size H", values[1], 1, BB_MAX_DIMENSION,
+                       &a->render.height);
+  if (!rc && (long long)a->render.width * a->render.height > BB_MAX_PIXELS)
+    rc = cli_usage_error(rbf_command.name, "-size %d %d is over %ld texels",
+                         a->render.width, a->render.height, (long)BB_MAX_PIXELS);
+  return rc;
+}
+
+static int parse_rect(rbf_args *a, char **values) {
+  static const char *const names[4] = {"--rect L", "--rect B", "--rect R", "--rect T"};
+  for (int k = 0; k < 4; k++) {
+    int rc = cli_parse_double(rbf_command.name, names[k], values[k], -HUGE_VAL, 0, HUGE_VAL,
+                              &a->render.rect[k]);
+    if (rc)
+      return rc;
+  }
+  if (!(a->render.rect[2] > a->render.rect[0]) || !(a->render.rect[3] > a->render.rect[1]))
+    return cli_usage_error(rbf_command.name, "--rect needs L < R and B < T");
+  a->render.rect_given = 1;
+  return 0;
+}
+
+/* DOOM 3 writes "-size W H": options with several values, which getopt
+ * cannot take. They are parsed here and removed from argv (before "--");
+ * *argc shrinks accordingly. */
+static int take_multi_value_options(rbf_args *a, int *argc, char **argv) {
+  int kept = 1;
+  for (int i = 1; i < *argc; i++) {
+    const char *s = argv[i];
+    int is_size = !strcmp(s, "-size") || !strcmp(s, "--size");
+    int is_rect = !strcmp(s, "-rect") || !strcmp(s, "--rect");
+    if (!strcmp(s, "--")) {
+      while (i < *argc)
+        argv[kept++] = argv[i++];
+      break;
+    }
+    if (!is_size && !is_rect) {
+      argv[kept++] = argv[i];
+      continue;
+    }
+    int values = is_size ? 2 : 4;
+    if (i + values >= *argc)
+      return cli_usage_error(rbf_command.name, "%s needs %d values: %s", s, values,
+                             is_size ? "-size W H" : "--rect L B R T");
+    int rc = is_size ? parse_size(a, argv + i + 1) : parse_rect(a, argv + i + 1);
+    if (rc)
+      return rc;
+    i += values;
+  }
+  *argc = kept;
+  return 0;
+}
+
+static int check_outputs(rbf_args *a) {
+  if (!a->output) {
+    a->default_output = cli_path_with_suffix(a->model, "_local.tga");
+    if (!a->default_output) {
+      cli_file_error(a->model, "out of memory");
+      return BB_EXIT_FAILURE;
+    }
+    a->output = a->default_output;
+  }
+  int rc = cli_check_output(rbf_command.name, a->model, a->output, BB_DEPTH_DEFAULT);
+  if (!rc && a->height) {
+    if (cli_same_file(a->height, a->output))
+      return cli_usage_error(rbf_command.name, "--height and the normal map are both %s",
+                             a->output);
+    rc = cli_check_output(rbf_command.name, a->model, a->height, BB_DEPTH_DEFAULT);
+  }
+  return rc;
+}
+
+static int rbf_parse(int argc, char **argv, rbf_args *a) {
+  int rc = take_multi_value_options(a, &argc, argv);
+  int first = 0;
+  if (!rc)
+    rc = cli_parse_options(&rbf_command, argc, argv, rbf_option, a, &first);
+  if (!rc)
+    rc = cli_expect_positionals(&rbf_command, argc, argv, first, 1, "MODEL");
+  if (rc)
+    return rc;
+  a->model = argv[first];
+  if (a->render.tile && !a->render.rect_given)
+    return cli_usage_error(rbf_command.name,
+                           "--tile needs --rect L B R T: the tile the sculpt repeats with");
+  a->render.threads = a->settings.bake.trace.threads;
+  return check_outputs(a);
+}
+
+/* ------------------------------------------------------------- running */
+
+/* Provenance of one output: the common lines, then the render's. */
+static char *describe(const cli_run *run, const rbf_args *a, uint64_t model_hash,
+                      const char *kind, const bb_renderbump_result *r) {
+  const char *slash = strrchr(a->model, '/');
+  bb_provenance p = {run->command_line, slash ? slash + 1 : a->model, model_hash, kind,
+                     NULL, BB_CHANNEL_AUTO, NULL, 0};
+  char *common = bb_provenance_format(&p), *own = bb_renderbump_describe(&a->render, r);
+  char *all = NULL;
+  if (common && own) {
+    char line[32];
+    snprintf(line, sizeof line, "normal_y=%s\n", a->settings.bake.normal_y_up ? "up" : "down");
+    size_t len = strlen(common) + strlen(own) + strlen(line) + 1;
+    all = malloc(len);
+    if (all)
+      snprintf(all, len, "%s%s%s", common, own, line);
+  }
+  free(common);
+  free(own);
+  return all;
+}
+
+/* Stages img for out->path (complete under a temporary name) with its own
+ * provenance text, which it frees; cli_commit_outputs puts the normal map
+ * and the height in place together or neither. */
+static void stage_image(cli_staged_output *out, const bb_image *img, bb_depth depth,
+                        bb_range range, char *description) {
+  out->file = NULL;
+  if (!description) {
+    out->status = BB_ERR_MEMORY;
+    snprintf(out->error.message, sizeof out->error.message, "out of memory");
+    return;
+  }
+  bb_write_options wo = {depth, range, description};
+  out->status = bb_image_write_staged(out->path, img, &wo, &out->file, &out->error);
+  free(description);
+}
+
+/* Integer files hold 0.5 + 0.5 N and the coverage as it is, so RGB is
+ * encoded here (BB_RANGE_SIGNED would encode alpha too); files that only
+ * hold floats (EXR) store N raw, as every bumpbake normal map. */
+static void encode_for(const char *path, bb_image *normal, bb_range *range) {
+  *range = BB_RANGE_SIGNED; /* float files store every channel raw */
+  if (!bb_path_supports_depth(path, BB_DEPTH_8))
+    return;
+  size_t texels = (size_t)normal->width * (size_t)normal->height;
+  for (size_t i = 0; i < texels; i++)
+    for (int c = 0; c < 3; c++)
+      normal->pixels[4 * i + (size_t)c] = 0.5f + 0.5f * normal->pixels[4 * i + (size_t)c];
+  *range = BB_RANGE_UNIT;
+}
+
+static void print_summary(const rbf_args *a, const bb_mesh *mesh, const bb_renderbump_result *r) {
+  printf("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
+         "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each\n",
+         a->model, mesh->triangle_count, r->used_vertex_normals ? "vertex" : "face",
+         bb_axis_name(a->render.axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
+         a->render.width, a->render.height, a->render.samples * a->render.samples);
+}
+
+/* The height's scale matters only with square texels; say so otherwise. */
+static void note_texel_aspect(const rbf_args *a, const bb_renderbump_result *r) {
+  if (!a->height || fabs(r->texel_aspect - 1.0) <= 0.01)
+    return;
+  fprintf(stderr,
+          "bumpbake renderbumpflat: note: texels are %.4g times as wide as high; the "
+          "height's scale uses their geometric mean (square texels need W / H = %.4g "
+          "in -size)\n",
+          r->texel_aspect, (r->rect[2] - r->rect[0]) / (r->rect[3] - r->rect[1]));
+}
+
+static int write_outputs(const cli_run *run, const rbf_args *a, const bb_mesh *mesh,
+                         bb_renderbump_result *r) {
+  uint64_t hash = bb_mesh_hash(mesh);
+  char *normal_text = describe(run, a, hash, "normal+coverage", r);
+  if (a->settings.bake.normal_y_up)
+    bb_image_flip_green(&r->normal);
+  bb_range range;
+  encode_for(a->output, &r->normal, &range);
+  cli_staged_output outs[2] = {{.kind = "normal", .path = a->output},
+                               {.kind = "height", .path = a->height}};
+  const int n = a->height ? 2 : 1;
+  stage_image(&outs[0], &r->normal, BB_DEPTH_DEFAULT, range, normal_text);
+  if (a->height) {
+    bb_depth depth =
+        bb_path_supports_depth(a->height, BB_DEPTH_16) ? BB_DEPTH_16 : BB_DEPTH_DEFAULT;
+    stage_image(&outs[1], &r->height, depth, BB_RANGE_UNIT,
+                describe(run, a, hash, "height", r));
+  }
+  int rc = cli_commit_outputs(outs, n);
+  for (int i = 0; i < n && !rc && !a->quiet; i++)
+    printf("wrote %s %s\n", outs[i].kind, outs[i].path);
+  if (!rc && a->height) {
+    note_texel_aspect(a, r);
+    /* The one number the height is useless without: printed even with -q. */
+    printf("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)\n",
+           r->height_scale, a->height, r->height_scale);
+  }
+  return rc;
+}
+
+static int rbf_run(cli_run *run, rbf_args *a) {
+  bb_mesh mesh;
+  bb_renderbump_result result;
+  memset(&mesh, 0, sizeof mesh);
+  memset(&result, 0, sizeof result);
+  bb_error err = {{0}};
+  bb_status st = bb_mesh_load(a->model, &mesh, &err);
+  if (st == BB_OK)
+    st = bb_renderbump_flat(&mesh, &a->render, &result, &err);
+  int rc = cli_status_exit(a->model, st, &err);
+  if (!rc) {
+    if (!a->quiet)
+      print_summary(a, &mesh, &result);
+    rc = write_outputs(run, a, &mesh, &result);
+  }
+  bb_renderbump_result_free(&result);
+  bb_mesh_free(&mesh);
+  return rc;
+}
+
+int bb_cli_renderbumpflat(int argc, char **argv) {
+  cli_run run;
+  if (cli_run_init(&run, argc, argv)) /* before argv is rearranged */
+    return BB_EXIT_FAILURE;
+  rbf_args a;
+  memset(&a, 0, sizeof a);
+  bb_renderbump_options_init(&a.render);
+  cli_settings_init(&a.settings);
+  int rc = rbf_parse(argc, argv, &a);
+  if (rc < 0)
+    rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0)
+    rc = rbf_run(&run, &a);
+  free(a.default_output);
+  cli_run_free(&run);
+  return rc;
+}

@@ -1,0 +1,76 @@
+/* parallel.c: a tiny thread pool for the per-row loops of smooth and trace. */
+#include "core/internal.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <time.h>
+#include <unistd.h>
+
+double bb__now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int bb__thread_count(int threads) {
+  if (threads > 0) return threads;
+  long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n > 0 ? (int)n : 1;
+}
+
+typedef struct work_queue {
+  bb__work_fn fn;
+  void *user;
+  int items;
+  atomic_int next;
+  atomic_long done;
+} work_queue;
+
+static void *worker(void *arg) {
+  work_queue *q = arg;
+  for (;;) {
+    int item = atomic_fetch_add(&q->next, 1);
+    if (item >= q->items) break;
+    q->fn(q->user, item);
+    atomic_fetch_add(&q->done, 1);
+  }
+  return NULL;
+}
+
+bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
+                           bb_progress_fn progress, void *progress_user,
+                           bb_error *err) {
+  work_queue q = {.fn = fn, .user = user, .items = items};
+  atomic_init(&q.next, 0);
+  atomic_init(&q.done, 0);
+  int n = bb__thread_count(threads);
+  if (n > items) n = items > 0 ? items : 1;
+  if (n == 1 && !progress) {
+    worker(&q);
+    return BB_OK;
+  }
+  pthread_t tids[256];
+  if (n > 256) n = 256;
+  int started = 0, cancelled = 0;
+  for (; started < n; started++)
+    if (pthread_create(&tids[started], NULL, worker, &q) != 0) break;
+  if (started == 0) {
+    worker(&q); /* no thread could start: do the work here */
+  } else if (progress) {
+    /* Poll from the calling thread so the callback never runs concurrently. */
+    while (atomic_load(&q.done) < items) {
+      if (progress(progress_user, atomic_load(&q.done), items)) {
+        cancelled = 1;
+        atomic_store(&q.next, items); /* no new items; those running finish */
+        break;
+      }
+      struct timespec ts = {0, 50 * 1000 * 1000};
+      nanosleep(&ts, NULL);
+    }
+  }
+  for (int i = 0; i < started; i++) pthread_join(tids[i], NULL);
+  if (!cancelled && progress) cancelled = progress(progress_user, items, items) != 0;
+  if (cancelled)
+    return bb__fail(err, BB_ERR_CANCELLED, "cancelled by the progress callback");
+  return BB_OK;
+}

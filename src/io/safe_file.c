@@ -1,0 +1,431 @@
+/* safe_file.c: the one way bumpbake puts bytes on disk (see internal.h).
+ *
+ * A file is written to a temporary ".bb-tmp-XXXXXX.EXT" in its destination
+ * directory (same filesystem, so the final rename is atomic), through a
+ * buffer whose every write(2) is checked and retried on short counts. The
+ * first error is kept; later writes do nothing. Finishing flushes, fsyncs
+ * and closes (checked) the file; committing renames it into place. Any
+ * failure removes the temporary, so the final name never holds a partial
+ * file, and a full disk is an error, never a silent truncation.
+ *
+ * Temporaries being written are listed in a fixed table that a signal
+ * handler can walk (bb_tempfiles_remove): only lock-free atomics and
+ * unlink(2) are used there, both async-signal-safe. */
+#include "core/internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* ------------------------------------------------- temporary-file registry */
+
+/* Slots of temporaries that exist right now. A slot is FREE, being FILLED
+ * by its owner, or LIVE (its path is complete and may be unlinked). */
+enum { TEMP_SLOTS = 64 };
+enum { SLOT_FREE = 0, SLOT_FILLED, SLOT_LIVE };
+static atomic_int slot_state[TEMP_SLOTS];
+static char slot_path[TEMP_SLOTS][PATH_MAX];
+
+/* Lists path for bb_tempfiles_remove; returns its slot, or -1 when the table
+ * is full (the file then loses only its signal-time cleanup). */
+static int register_temp(const char *path) {
+  size_t n = strlen(path);
+  if (n >= PATH_MAX)
+    return -1;
+  for (int i = 0; i < TEMP_SLOTS; i++) {
+    int expected = SLOT_FREE;
+    if (atomic_compare_exchange_strong(&slot_state[i], &expected, SLOT_FILLED)) {
+      memcpy(slot_path[i], path, n + 1);
+      atomic_store_explicit(&slot_state[i], SLOT_LIVE, memory_order_release);
+      return i;
+    }
+  }
+  return -1;
+}
+
+static void unregister_temp(int slot) {
+  if (slot >= 0)
+    atomic_store_explicit(&slot_state[slot], SLOT_FREE, memory_order_release);
+}
+
+void bb_tempfiles_remove(void) {
+  int saved_errno = errno; /* a handler must leave errno as it found it */
+  for (int i = 0; i < TEMP_SLOTS; i++)
+    if (atomic_load_explicit(&slot_state[i], memory_order_acquire) == SLOT_LIVE)
+      unlink(slot_path[i]);
+  errno = saved_errno;
+}
+
+/* ------------------------------------------------------------ file names */
+
+static const char *base_name(const char *path) {
+  const char *slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
+}
+
+/* "DIR/.bb-tmp-" + 6 random characters + the extension of path (so a
+ * writer that picks its format by name sees the right one), malloc'd. */
+static char *temp_name(const char *path, uint64_t *seed) {
+  static const char ALNUM[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+  const char *base = base_name(path);
+  const char *dot = strrchr(base, '.');
+  const char *ext = dot ? dot : "";
+  size_t dir_len = (size_t)(base - path);
+  size_t len = dir_len + sizeof ".bb-tmp-XXXXXX" + strlen(ext);
+  char *name = malloc(len);
+  if (!name)
+    return NULL;
+  /* splitmix64: a fresh, well mixed value per call. */
+  uint64_t z = (*seed += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  char random[7];
+  for (int i = 0; i < 6; i++, z /= 62)
+    random[i] = ALNUM[z % 62];
+  random[6] = '\0';
+  snprintf(name, len, "%.*s.bb-tmp-%s%s", (int)dir_len, path, random, ext);
+  return name;
+}
+
+static uint64_t fresh_seed(void) {
+  static atomic_uint_fast64_t calls;
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return (uint64_t)ts.tv_nsec ^ ((uint64_t)ts.tv_sec << 30) ^ ((uint64_t)getpid() << 16) ^
+         (atomic_fetch_add(&calls, 1) * 0xD1B54A32D192ED03ull);
+}
+
+/* ------------------------------------------------------------ low level */
+
+/* Writes all of data at offset, retrying short counts and EINTR. Returns 0,
+ * or the errno of the failure (ENOSPC for a write that made no progress). */
+static int write_fully(int fd, const unsigned char *data, size_t size, int64_t offset) {
+  while (size > 0) {
+    ssize_t n = pwrite(fd, data, size, (off_t)offset);
+    if (n < 0) {
+      if (errno == EINTR)
+        continue;
+      return errno;
+    }
+    if (n == 0)
+      return ENOSPC;
+    data += n;
+    size -= (size_t)n;
+    offset += n;
+  }
+  return 0;
+}
+
+static void note_error(bb_staged_file *f, int error) {
+  if (!f->error)
+    f->error = error;
+}
+
+static void flush_buffer(bb_staged_file *f) {
+  if (f->buffered && !f->error)
+    note_error(f, write_fully(f->fd, f->buffer, f->buffered, f->buffer_pos));
+  f->buffered = 0;
+}
+
+static void grow_size(bb_staged_file *f, int64_t end) {
+  if (end > f->size)
+    f->size = end;
+}
+
+/* Closes the descriptor once; the result of close(2) counts as a write. */
+static void close_fd(bb_staged_file *f) {
+  if (f->fd < 0)
+    return;
+  if (close(f->fd) != 0 && errno != EINTR)
+    note_error(f, errno);
+  f->fd = -1;
+}
+
+/* Removes the temporary, forgets it and frees everything f owns. */
+static void release(bb_staged_file *f, int remove_temp) {
+  if (f->fd >= 0) {
+    close(f->fd);
+    f->fd = -1;
+  }
+  if (remove_temp && f->temp_path)
+    unlink(f->temp_path);
+  unregister_temp(f->slot);
+  f->slot = -1;
+  free(f->buffer);
+  free(f->temp_path);
+  free(f->path);
+  f->buffer = NULL;
+  f->temp_path = f->path = NULL;
+  if (f->lock_ready)
+    pthread_mutex_destroy(&f->lock);
+  f->lock_ready = 0;
+}
+
+/* ----------------------------------------------------------------- open */
+
+enum { BUFFER_BYTES = 1 << 16 };
+
+/* Creates the temporary with O_EXCL. Its name is registered before the
+ * file exists, so no instant passes in which a signal could leave it
+ * behind; a name that already exists is unregistered and another tried. */
+static int create_temp(bb_staged_file *f) {
+  uint64_t seed = fresh_seed();
+  for (int attempt = 0; attempt < 100; attempt++) {
+    char *name = temp_name(f->path, &seed);
+    if (!name)
+      return ENOMEM;
+    int slot = register_temp(name);
+    /* 0666 less the umask, as for any new file (mkstemp would make 0600,
+     * and the rename keeps the mode). */
+    int fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      f->fd = fd;
+      f->slot = slot;
+      f->temp_path = name;
+      return 0;
+    }
+    int error = errno;
+    unregister_temp(slot);
+    free(name);
+    if (error != EEXIST)
+      return error;
+  }
+  return EEXIST;
+}
+
+bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
+  memset(f, 0, sizeof *f);
+  f->fd = -1;
+  f->slot = -1;
+  if (!path || !*path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "no output path");
+  f->path = malloc(strlen(path) + 1);
+  f->buffer = malloc(BUFFER_BYTES);
+  if (!f->path || !f->buffer) {
+    release(f, 0);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  }
+  strcpy(f->path, path);
+  if (pthread_mutex_init(&f->lock, NULL) != 0) {
+    release(f, 0);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: cannot create a lock", path);
+  }
+  f->lock_ready = 1;
+  int error = create_temp(f);
+  if (error) {
+    release(f, 0);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, strerror(error));
+  }
+  return BB_OK;
+}
+
+/* ------------------------------------------------------- reads and writes */
+
+/* Buffered write at offset; the caller holds the lock. */
+static size_t write_at(bb_staged_file *f, const void *data, size_t size, int64_t offset) {
+  if (f->error || f->fd < 0)
+    return 0;
+  if (size == 0)
+    return 0;
+  if (offset < 0 || (uint64_t)offset > (uint64_t)INT64_MAX - size) {
+    note_error(f, EINVAL);
+    return 0;
+  }
+  /* The buffer holds bytes contiguous from buffer_pos; anything else (a
+   * seek back, a big block) flushes it first. */
+  if (f->buffered && offset != f->buffer_pos + (int64_t)f->buffered)
+    flush_buffer(f);
+  if (size >= BUFFER_BYTES) {
+    flush_buffer(f);
+    if (!f->error)
+      note_error(f, write_fully(f->fd, data, size, offset));
+  } else {
+    if (f->buffered + size > BUFFER_BYTES)
+      flush_buffer(f);
+    if (!f->buffered)
+      f->buffer_pos = offset;
+    memcpy(f->buffer + f->buffered, data, size);
+    f->buffered += size;
+  }
+  if (f->error)
+    return 0;
+  grow_size(f, offset + (int64_t)size);
+  return size;
+}
+
+size_t bb__safe_write(bb_staged_file *f, const void *data, size_t size) {
+  pthread_mutex_lock(&f->lock);
+  size_t n = write_at(f, data, size, f->pos);
+  f->pos += (int64_t)n;
+  pthread_mutex_unlock(&f->lock);
+  return n;
+}
+
+size_t bb__safe_pwrite(bb_staged_file *f, const void *data, size_t size, int64_t offset) {
+  pthread_mutex_lock(&f->lock);
+  size_t n = write_at(f, data, size, offset);
+  pthread_mutex_unlock(&f->lock);
+  return n;
+}
+
+size_t bb__safe_pread(bb_staged_file *f, void *data, size_t size, int64_t offset) {
+  pthread_mutex_lock(&f->lock);
+  flush_buffer(f); /* what was written must be what is read back */
+  size_t done = 0;
+  while (!f->error && f->fd >= 0 && done < size && offset >= 0) {
+    ssize_t n = pread(f->fd, (unsigned char *)data + done, size - done,
+                      (off_t)(offset + (int64_t)done));
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n <= 0)
+      break;
+    done += (size_t)n;
+  }
+  pthread_mutex_unlock(&f->lock);
+  return done;
+}
+
+size_t bb__safe_read(bb_staged_file *f, void *data, size_t size) {
+  size_t n = bb__safe_pread(f, data, size, bb__safe_tell(f));
+  pthread_mutex_lock(&f->lock);
+  f->pos += (int64_t)n;
+  pthread_mutex_unlock(&f->lock);
+  return n;
+}
+
+int bb__safe_seek(bb_staged_file *f, int64_t offset) {
+  if (offset < 0)
+    return -1;
+  pthread_mutex_lock(&f->lock);
+  f->pos = offset;
+  pthread_mutex_unlock(&f->lock);
+  return 0;
+}
+
+int64_t bb__safe_tell(bb_staged_file *f) {
+  pthread_mutex_lock(&f->lock);
+  int64_t pos = f->pos;
+  pthread_mutex_unlock(&f->lock);
+  return pos;
+}
+
+int64_t bb__safe_size(bb_staged_file *f) {
+  pthread_mutex_lock(&f->lock);
+  int64_t size = f->size;
+  pthread_mutex_unlock(&f->lock);
+  return size;
+}
+
+void bb__safe_fail(bb_staged_file *f, int error) {
+  pthread_mutex_lock(&f->lock);
+  note_error(f, error ? error : EIO);
+  pthread_mutex_unlock(&f->lock);
+}
+
+/* -------------------------------------------------------- finish, commit */
+
+bb_status bb__safe_finish(bb_staged_file *f, bb_error *err) {
+  if (f->fd < 0 && !f->error && f->temp_path)
+    return BB_OK; /* finished before */
+  if (!f->temp_path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: nothing to finish",
+                    f->path ? f->path : "?");
+  flush_buffer(f);
+  /* A full disk may only show at fsync (delayed allocation) or close (NFS). */
+  if (!f->error && fsync(f->fd) != 0)
+    note_error(f, errno);
+  close_fd(f);
+  if (f->error) {
+    bb_status st =
+        bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(f->error));
+    release(f, 1);
+    return st;
+  }
+  return BB_OK;
+}
+
+/* Makes the rename itself durable. It has already happened and cannot be
+ * undone, so a directory that refuses fsync (some filesystems do) is not an
+ * error of the write. */
+static void sync_directory_of(const char *path) {
+  const char *base = base_name(path);
+  char dir[PATH_MAX];
+  if (base == path)
+    snprintf(dir, sizeof dir, ".");
+  else
+    snprintf(dir, sizeof dir, "%.*s", (int)(base - path), path);
+  int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0) {
+    (void)fsync(fd);
+    close(fd);
+  }
+}
+
+bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
+  bb_status st = bb__safe_finish(f, err);
+  if (st != BB_OK)
+    return st;
+  if (rename(f->temp_path, f->path) != 0) {
+    st = bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(errno));
+    release(f, 1);
+    return st;
+  }
+  sync_directory_of(f->path);
+  release(f, 0);
+  return BB_OK;
+}
+
+void bb__safe_discard(bb_staged_file *f) {
+  if (f)
+    release(f, 1);
+}
+
+/* ------------------------------------------------------ public handles */
+
+bb_staged_file *bb__staged_new(void) {
+  bb_staged_file *f = calloc(1, sizeof *f);
+  if (f) {
+    f->fd = -1;
+    f->slot = -1;
+  }
+  return f;
+}
+
+const char *bb_staged_file_path(const bb_staged_file *staged) {
+  return staged ? staged->path : NULL;
+}
+
+bb_status bb_staged_file_commit(bb_staged_file *staged, bb_error *err) {
+  if (!staged)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_staged_file_commit: NULL");
+  bb_status st = bb__safe_commit(staged, err);
+  free(staged);
+  return st;
+}
+
+void bb_staged_file_discard(bb_staged_file *staged) {
+  if (!staged)
+    return;
+  bb__safe_discard(staged);
+  free(staged);
+}
+
+bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err) {
+  if (!data && size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_file_write: no data");
+  bb_staged_file f;
+  bb_status st = bb__safe_open(&f, path, err);
+  if (st != BB_OK)
+    return st;
+  bb__safe_write(&f, data, size); /* an error is kept, and reported by the commit */
+  return bb__safe_commit(&f, err);
+}

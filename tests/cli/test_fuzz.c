@@ -1,0 +1,124 @@
+/* test_fuzz.c: every input that once made a libFuzzer target fail
+ * (fuzz/regressions/NAME/, see `make fuzz`) replayed through the target's
+ * own code, compiled into this binary with LLVMFuzzerTestOneInput renamed
+ * bb_fuzz_NAME. A target signals a failure by crashing (a failed property
+ * aborts), which fails the test. Inputs of one target run in name order in
+ * one process, since some failures need the state an earlier input left. */
+#define _XOPEN_SOURCE 700 /* realpath */
+
+#include "bumpbake.h"
+#include "cli/cli.h"
+
+#include <criterion/criterion.h>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+int bb_fuzz_cli(const uint8_t *data, size_t size);
+int bb_fuzz_compare(const uint8_t *data, size_t size);
+int bb_fuzz_load(const uint8_t *data, size_t size);
+int bb_fuzz_provenance(const uint8_t *data, size_t size);
+
+typedef int (*fuzz_target)(const uint8_t *data, size_t size);
+
+typedef struct input {
+  char name[256];
+  uint8_t *data;
+  size_t size;
+} input;
+
+static int by_name(const void *a, const void *b) {
+  return strcmp(((const input *)a)->name, ((const input *)b)->name);
+}
+
+/* Reads every file of fuzz/regressions/NAME (before any target runs: the
+ * CLI target changes directory) and returns how many, sorted by name. */
+static int read_inputs(const char *name, input *inputs, int cap) {
+  char dir[PATH_MAX];
+  snprintf(dir, sizeof dir, "fuzz/regressions/%s", name);
+  DIR *d = opendir(dir);
+  cr_assert_not_null(d, "%s is missing (tests run from the project root)", dir);
+  int n = 0;
+  for (struct dirent *e; (e = readdir(d)) != NULL;) {
+    if (e->d_name[0] == '.')
+      continue;
+    cr_assert_lt(n, cap);
+    input *in = &inputs[n++];
+    snprintf(in->name, sizeof in->name, "%s", e->d_name);
+    char path[PATH_MAX + 256];
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    FILE *f = fopen(path, "rb");
+    cr_assert_not_null(f, "%s", path);
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    rewind(f);
+    in->data = malloc((size_t)size + 1);
+    in->size = fread(in->data, 1, (size_t)size, f);
+    fclose(f);
+  }
+  closedir(d);
+  qsort(inputs, (size_t)n, sizeof inputs[0], by_name);
+  return n;
+}
+
+/* The targets print what the CLI prints; the test output stays quiet. */
+static void mute_output(void) {
+  int null_fd = open("/dev/null", O_WRONLY);
+  cr_assert(null_fd >= 0);
+  fflush(NULL);
+  dup2(null_fd, STDOUT_FILENO);
+  dup2(null_fd, STDERR_FILENO);
+  close(null_fd);
+}
+
+static void replay(const char *name, fuzz_target target, int expected_at_least) {
+  input inputs[64];
+  int n = read_inputs(name, inputs, 64);
+  cr_assert_geq(n, expected_at_least, "fuzz/regressions/%s lost inputs", name);
+  mute_output();
+  for (int i = 0; i < n; i++) {
+    target(inputs[i].data, inputs[i].size);
+    free(inputs[i].data);
+  }
+}
+
+TestSuite(fuzz, .timeout = 60);
+
+/* getopt kept a pointer into the previous argv (freed by then) when a parse
+ * stopped inside a cluster ("-xr5": unknown -x, "r5" pending); the next
+ * parse read it: a heap use-after-free under ASan. */
+Test(fuzz, cli_regressions) {
+  replay("cli", bb_fuzz_cli, 2);
+}
+
+/* A PNG cut inside its header: OpenImageIO 2.4 leaks an error string while
+ * opening it (LeakSanitizer's report failed the target). */
+Test(fuzz, load_regressions) {
+  replay("load", bb_fuzz_load, 1);
+}
+
+/* Nine differences near 1e27: their mean, sum / 9 in double, came out one
+ * ulp above their maximum. Rounding, not a fault of compare; the target's
+ * check now allows it, and this input keeps the check honest. */
+Test(fuzz, compare_regressions) {
+  replay("compare", bb_fuzz_compare, 1);
+}
+
+/* The same getopt fault without a sanitizer: the second, valid command line
+ * took "-r 5" from the first one's leftovers and then found one argument
+ * too many (exit 2) instead of reporting its missing file (exit 1). */
+Test(fuzz, a_parse_forgets_the_previous_one) {
+  char first[] = "-xr5", rays[] = "-r", count[] = "32", file[] = "absent.tga",
+       scale[] = "2", name[] = "height2ssbump";
+  char *stops_inside_a_cluster[] = {name, first, file, scale, NULL};
+  char *valid[] = {name, rays, count, file, scale, NULL};
+  mute_output();
+  cr_assert_eq(bb_cli_height2ssbump(4, stops_inside_a_cluster), 2);
+  cr_assert_eq(bb_cli_height2ssbump(5, valid), 1);
+}
