@@ -115,7 +115,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python bench goldens docs install uninstall clean format FORCE \
+        check-python check-circles bench goldens docs install uninstall clean format FORCE \
         fuzz fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
@@ -259,9 +259,14 @@ test: ensure-deps
 	@$(MAKE) --no-print-directory -j$(NPROC) all $(TESTBIN)
 	@$(MAKE) --no-print-directory check
 
-# Everything `make test` runs: the Criterion suite, the install check and
-# the Python tests.
-check: check-unit check-install check-python
+# Everything `make test` runs: the Criterion suite, the install check, the
+# Python tests and the check that no two files need each other.
+check: check-unit check-install check-python check-circles
+
+# Object files that use each other's symbols in a circle fail the build's
+# checks (tools/check_circles.py): one of them has two jobs.
+check-circles: $(LIB_OBJ) $(CLI_OBJ)
+	@./tools/check_circles.py $(LIB_OBJ) $(CLI_OBJ)
 
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.

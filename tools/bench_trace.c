@@ -20,7 +20,7 @@
  */
 #include "bumpbake.h"
 #include "cli/json.h"
-#include "trace/trace_internal.h"
+#include "trace/march.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,8 +1,10 @@
 /* bake.c: the pipeline smooth -> normals -> pyramid -> trace -> derive over
  * one height field, with the time of each stage. No file I/O here. */
-#include "core/internal.h"
-#include "trace/trace_internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "trace/pyramid.h"
+#include "trace/rayset.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

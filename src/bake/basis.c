@@ -3,8 +3,9 @@
  * or a text file). A basis is a plain value; everything downstream (the
  * integration tables, derive, the writers) reads its count and vectors.
  */
-#include "core/internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>

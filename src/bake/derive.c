@@ -1,7 +1,8 @@
 /* derive.c: the maps derived per texel from normals and visibility, for any
  * basis (basis.c). */
-#include "core/internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
 #include <math.h>
 #include <string.h>
 

@@ -4,8 +4,9 @@
  * addressing mode and sums it in a fixed order, so a periodic shift of the
  * input shifts the output bit for bit and the thread count does not matter.
  */
-#include "core/internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
 #include <math.h>
 #include <string.h>
 

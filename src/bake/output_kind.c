@@ -1,6 +1,7 @@
 /* output_kind.c: the maps a bake can make, described once for every client
  * (the command line's options and JSON, Python's outputs=). */
-#include "core/internal.h"
+#include "bumpbake.h"
+
 
 #include <stddef.h>
 #include <string.h>

@@ -6,8 +6,9 @@
  * result does not depend on the thread count, and a periodic shift of the
  * input shifts the output bit for bit.
  */
-#include "core/internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>

@@ -1,7 +1,33 @@
 /* height_channel.c: what BB_CHANNEL_AUTO means for one image (CONVENTIONS.md
  * "Height input", with Valve's height-in-alpha convention detected): the
  * mean of the colour, unless the colour is constant and alpha is not. */
-#include "core/internal.h"
+#include "bumpbake.h"
+
+
+#include <strings.h>
+
+static const char *const CHANNEL_NAMES[] = {
+    [BB_CHANNEL_AUTO] = "auto", [BB_CHANNEL_R] = "r",       [BB_CHANNEL_G] = "g",
+    [BB_CHANNEL_B] = "b",       [BB_CHANNEL_A] = "a",       [BB_CHANNEL_LUMA] = "luma",
+    [BB_CHANNEL_MEAN] = "mean",
+};
+#define CHANNEL_COUNT ((int)(sizeof CHANNEL_NAMES / sizeof CHANNEL_NAMES[0]))
+
+int bb_channel_parse(const char *name, bb_channel *out) {
+  if (!name || !out) return -1;
+  for (int c = 0; c < CHANNEL_COUNT; c++) {
+    if (strcasecmp(name, CHANNEL_NAMES[c]) == 0) {
+      *out = (bb_channel)c;
+      return 0;
+    }
+  }
+  return -1;
+}
+
+const char *bb_channel_name(bb_channel c) {
+  if ((int)c < 0 || (int)c >= CHANNEL_COUNT) return "unknown";
+  return CHANNEL_NAMES[c];
+}
 
 /* Index of the alpha channel: the file's, else the last channel of a grey +
  * alpha or RGBA image (TGA does not always flag its alpha); -1 if none. */

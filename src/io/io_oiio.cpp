@@ -7,7 +7,10 @@
 // Alpha is never premultiplied or divided out: bumpbake's channels are data
 // (heights, ssbump, ao), so both directions ask for unassociated alpha.
 #include "core/internal.h"
-#include "maps/maps_internal.h"
+#include "io/oiio.h"
+#include "io/provenance.h"
+#include "io/safe_file.h"
+#include "io/text.h"
 #include "core/sanitizer_options.h"
 
 #include <OpenImageIO/filesystem.h>

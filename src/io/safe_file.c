@@ -11,8 +11,9 @@
  * Temporaries being written are listed in a fixed table that a signal
  * handler can walk (bb_tempfiles_remove): only lock-free atomics and
  * unlink(2) are used there, both async-signal-safe. */
-#include "core/internal.h"
 
+#include "core/internal.h"
+#include "io/safe_file.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>

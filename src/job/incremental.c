@@ -8,8 +8,11 @@
  * will not open) counts as stale: a needless re-bake costs time, a wrong
  * skip leaves a wrong map.
  */
-#include "core/internal.h"
 
+#include "core/internal.h"
+#include "io/oiio.h"
+#include "io/provenance.h"
+#include "trace/rayset.h"
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>

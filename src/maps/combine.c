@@ -5,8 +5,10 @@
  * factor of exactly 0 (or 1) copies a (or b); a detail texel equal to the
  * detail's flat texel (within FLAT_TOLERANCE) copies the base texel. Every other texel is computed
  * in double from its own inputs only. */
-#include "maps/maps_internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 #include <strings.h>

@@ -1,7 +1,9 @@
 /* convert.c: normal maps decoded from file values (normal2ssbump's input)
  * and basis maps turned back into normals (ssbump2normal). */
-#include "maps/maps_internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 

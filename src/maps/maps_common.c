@@ -1,6 +1,7 @@
 /* maps_common.c: checks and vector helpers the map conversions share. */
-#include "maps/maps_internal.h"
 
+#include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 
 bb_status bb__check_channels(const bb_image *img, int min_channels, const char *what,

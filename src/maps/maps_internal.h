@@ -3,7 +3,8 @@
 #ifndef BB_MAPS_INTERNAL_H
 #define BB_MAPS_INTERNAL_H
 
-#include "core/internal.h"
+#include "bumpbake.h"
+
 
 #ifdef __cplusplus
 extern "C" {
@@ -31,10 +32,6 @@ void bb__normalize3(double v[3]);
  * out = normalize(n). */
 void bb__add_normals(const double base[3], double dx, double dy, double out[3]);
 
-/* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
- * (io_oiio.cpp, the only file that sees OpenImageIO). Allocates out. */
-bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
-                               bb_error *err);
 
 #ifdef __cplusplus
 }

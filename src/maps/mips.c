@@ -1,7 +1,9 @@
 /* mips.c: mip chains: each level box-filtered from the one above by
  * OpenImageIO (bb__image_resize_box), normal maps renormalised per level. */
-#include "maps/maps_internal.h"
 
+#include "core/internal.h"
+#include "io/oiio.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

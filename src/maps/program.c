@@ -7,8 +7,10 @@
  * R_HeightmapToNormalMap encodes with 127 + 128). Where id relies on power of
  * two sizes (x & (width - 1)), this code wraps with a modulo, which is the
  * same for those sizes and tiles any other size too. */
-#include "maps/program_internal.h"
 
+#include "core/internal.h"
+#include "maps/maps_internal.h"
+#include "maps/program_internal.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -3,7 +3,8 @@
 #ifndef BB_PROGRAM_INTERNAL_H
 #define BB_PROGRAM_INTERNAL_H
 
-#include "maps/maps_internal.h"
+#include "bumpbake.h"
+
 
 /* Deepest nesting the parser accepts, so a hostile program cannot exhaust
  * the stack of either the parser or the evaluator. */

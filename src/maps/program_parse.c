@@ -9,8 +9,9 @@
  * other characters up to white space, so paths such as
  * textures/base_wall/a_h.tga need no quotes. Function names are matched
  * case-insensitively, like id's token.Icmp. */
-#include "maps/program_internal.h"
 
+#include "core/internal.h"
+#include "maps/program_internal.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

@@ -1,7 +1,8 @@
 /* slope.c: flipcode's 1999 slope map (one byte of slopes per texel) and
  * the 16 x 16 table that lights it (README "Slope map"). */
-#include "maps/maps_internal.h"
 
+#include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 

@@ -1,8 +1,9 @@
 /* valve.c: the RGBA files of Valve's height2ssbump (CONVENTIONS.md "Valve
  * compatibility"): RGB = ssbump or the encoded normal map, A = the filtered
  * height or ao, and the detail variant's colour factor. */
-#include "core/internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
 #include <math.h>
 #include <string.h>
 

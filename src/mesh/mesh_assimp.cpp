@@ -3,8 +3,9 @@
 // A firewall like io_oiio.cpp: every extern "C" function catches every
 // exception and returns a bb_status with a one-line message. The rest of
 // bumpbake sees only bb_mesh.
-#include "core/internal.h"
 
+#include "core/internal.h"
+#include "io/safe_file.h"
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Exporter.hpp>
 #include <assimp/IOStream.hpp>

@@ -8,8 +8,10 @@
  * else (albedo, colours, specular, tiling) is shared, so a new mode is one
  * function and one row of `modes` below.
  */
-#include "maps/maps_internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

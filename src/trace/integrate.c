@@ -32,7 +32,7 @@
  * slice loses exactly nothing.
  */
 #include "core/internal.h"
-#include "trace/trace_internal.h"
+#include "trace/integrate.h"
 
 #include <math.h>
 #include <stdlib.h>

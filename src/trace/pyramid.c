@@ -14,7 +14,7 @@
  * the march needs. The last level has a single node, the global maximum.
  */
 #include "core/internal.h"
-#include "trace/trace_internal.h"
+#include "trace/pyramid.h"
 
 #include <float.h>
 #include <stdlib.h>

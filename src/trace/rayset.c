@@ -10,9 +10,11 @@
  * horizons (sweep.c). Slice s stands for the azimuth sector halfway to its
  * neighbours; integrate.c turns a horizon into what the sector loses.
  */
-#include "core/internal.h"
-#include "trace/trace_internal.h"
 
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "trace/integrate.h"
+#include "trace/rayset.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

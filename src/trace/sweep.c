@@ -13,7 +13,7 @@
  * walking the line backwards, each point is pushed onto a hull stack once,
  * and each texel asks the stack for its tangent by a short walk from its
  * near end. The tangent's slope is then computed from integers exactly as
- * the march computes it (trace_internal.h), and what the slice loses to it
+ * the march computes it (march.h), and what the slice loses to it
  * is added to the texel's sums: no per-slice buffer is kept.
  *
  * The opposite direction (-a, -b) runs along the same lines through the same
@@ -37,9 +37,13 @@
  * Lines (and chunks) are independent, so they run on all threads; each
  * texel is written by one of them per slice, in the slices' fixed order.
  */
-#include "core/internal.h"
-#include "trace/trace_internal.h"
 
+#include "core/internal.h"
+#include "trace/integrate.h"
+#include "trace/march.h"
+#include "trace/pyramid.h"
+#include "trace/rayset.h"
+#include "trace/sweep.h"
 #include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>

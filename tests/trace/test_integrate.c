@@ -6,7 +6,7 @@
 #include <math.h>
 
 #include "bumpbake.h"
-#include "trace/trace_internal.h"
+#include "trace/integrate.h"
 
 static const double PI = 3.14159265358979323846;
 

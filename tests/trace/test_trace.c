@@ -8,7 +8,10 @@
 #include <string.h>
 
 #include "bumpbake.h"
-#include "trace/trace_internal.h"
+#include "trace/march.h"
+#include "trace/pyramid.h"
+#include "trace/sweep.h"
+#include "trace/trace.h"
 
 /* xorshift64*: a small deterministic generator for the property tests. */
 static uint64_t rng_state;

@@ -5,8 +5,9 @@
  * line is "key=value\n", keys are always present in the same order, and
  * numbers print so that parsing them gives back the same value.
  */
-#include "core/internal.h"
 
+#include "core/internal.h"
+#include "io/provenance.h"
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>

@@ -1,4 +1,5 @@
 /* test_provenance.c: image hash, provenance text and its key-by-key diff. */
+#include "io/provenance.h"
 #include "bumpbake.h"
 #include "core/internal.h" /* bb__provenance_pack */
 

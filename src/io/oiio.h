@@ -1,0 +1,37 @@
+/* oiio.h: what the library asks of OpenImageIO beyond the
+ * public reads and writes: file headers, bounded channel reads, resizing
+ * (io_oiio.cpp). */
+#ifndef BB_IO_OIIO_H
+#define BB_IO_OIIO_H
+
+#include "bumpbake.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Image headers for bb_output_check (io_oiio.cpp): the depth bb_image_write
+ * stores for `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1
+ * for an unknown extension; and the number of mip levels of subimage 0 of
+ * the file at path, from its headers. */
+int bb__path_resolved_depth(const char *path, bb_depth depth);
+bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
+
+
+/* Reads channels [first_channel, first_channel + channel_count) of path as
+ * float (the bounds of bb_image_read apply: the bytes of the whole file's
+ * samples and of what is read). info may be NULL. Messages name the file. */
+bb_status bb__image_read_channels(const char *path, int first_channel, int channel_count,
+                                  bb_image *out, bb_image_info *info, bb_error *err);
+
+
+/* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
+ * (io_oiio.cpp, the only file that sees OpenImageIO). Allocates out. */
+bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
+                               bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_IO_OIIO_H */

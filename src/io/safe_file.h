@@ -1,0 +1,80 @@
+/* safe_file.h: every file the library writes goes to disk this
+ * way (safe_file.c), so that no failure leaves a partial file at its name. */
+#ifndef BB_IO_SAFE_FILE_H
+#define BB_IO_SAFE_FILE_H
+
+#include "bumpbake.h"
+
+#include <pthread.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Every writer (safe_file.c; OpenImageIO's writers reach it through
+ * write_safely() in io_oiio.cpp) puts bytes on disk this way, so that no
+ * failure leaves a partial file at the final name:
+ *
+ *   bb_staged_file f;
+ *   if (bb__safe_open(&f, path, err) != BB_OK) return ...;  temp created
+ *   bb__safe_write(&f, bytes, n); ...          checked; errors are kept
+ *   return bb__safe_commit(&f, err);           or bb__safe_discard(&f)
+ *
+ * - The bytes go to "DIR/.bb-tmp-XXXXXX.EXT" next to path (same
+ *   filesystem, so the rename is atomic), registered for
+ *   bb_tempfiles_remove() (signal handlers) while it exists.
+ * - Writes are buffered; every write(2) is checked and retried on short
+ *   counts. The first failure (ENOSPC, EFBIG under RLIMIT_FSIZE, EIO...) is
+ *   kept and later writes return 0, so a codec that ignores a failed write
+ *   cannot hide it: bb__safe_finish reports it.
+ * - bb__safe_finish flushes, fsyncs and closes (checked) the temporary;
+ *   bb__safe_commit finishes and renames it to path. Both remove the
+ *   temporary on failure and return BB_ERR_IO with "PATH: cannot write:
+ *   REASON". After finish alone the complete file waits under its temporary
+ *   name (that is what bb_staged_file is): commit or discard it later.
+ * - A bb_staged_file may be used from several threads (each call locks). */
+struct bb_staged_file {
+  pthread_mutex_t lock;
+  int lock_ready;
+  int fd;               /* -1 once closed */
+  int error;            /* first errno seen, 0 when none */
+  int slot;             /* registry slot for bb_tempfiles_remove, or -1 */
+  int64_t pos;          /* position of the next bb__safe_write / read */
+  int64_t size;         /* bytes in the file (highest byte written + 1) */
+  unsigned char *buffer;
+  size_t buffered;      /* bytes waiting in buffer */
+  int64_t buffer_pos;   /* file offset of buffer[0] */
+  char *path;           /* final name, malloc'd */
+  char *temp_path;      /* temporary name, malloc'd */
+};
+
+/* Creates the temporary for path (f is the caller's; nothing to free on
+ * failure). Errors: BB_ERR_IO (directory missing or not writable). */
+bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err);
+/* Writes at the current position / at offset; returns size, or 0 once any
+ * write has failed. */
+size_t bb__safe_write(bb_staged_file *f, const void *data, size_t size);
+size_t bb__safe_pwrite(bb_staged_file *f, const void *data, size_t size, int64_t offset);
+/* Reads back what was written (some encoders patch headers). */
+size_t bb__safe_read(bb_staged_file *f, void *data, size_t size);
+size_t bb__safe_pread(bb_staged_file *f, void *data, size_t size, int64_t offset);
+int bb__safe_seek(bb_staged_file *f, int64_t offset); /* 0, or -1 if offset < 0 */
+int64_t bb__safe_tell(bb_staged_file *f);
+int64_t bb__safe_size(bb_staged_file *f);
+/* Marks the file failed (an encoder's own error): finish will refuse it. */
+void bb__safe_fail(bb_staged_file *f, int error);
+bb_status bb__safe_finish(bb_staged_file *f, bb_error *err);
+bb_status bb__safe_commit(bb_staged_file *f, bb_error *err);
+/* Removes the temporary; safe after a failed open, finish or commit. */
+void bb__safe_discard(bb_staged_file *f);
+/* A zeroed heap bb_staged_file for the public handle API (NULL when out of
+ * memory). */
+bb_staged_file *bb__staged_new(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_IO_SAFE_FILE_H */
