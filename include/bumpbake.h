@@ -24,6 +24,21 @@
  *   a one-line message into it. There is no global error state.
  * - Ownership: a function that fills a bb_image allocates its pixels; the
  *   caller frees them with bb_image_free().
+ * - Parsers of names ("vertex", "luma", "-y"...) return BB_OK, or
+ *   BB_ERR_ARGUMENT with a message listing the names accepted.
+ * docs/conventions.md gives the frame, units and formulas in full.
+ *
+ * The header reads in the order data flows, one family after another:
+ *   core     status, errors, images, limits
+ *   io       reading and writing image files, the height input
+ *   bake     smoothing, normals, bases, the tracer, derived maps, bb_bake
+ *   maps     Valve's files, conversions, combining, programs, slope maps,
+ *            mip chains, comparing images
+ *   render   lighting the maps, pictures, contact sheets, animations
+ *   mesh     models and DOOM 3's flat render bump
+ *   job      the whole job on files: provenance, output paths, writing all
+ *            or nothing, bakes of files and batches, depfiles, up-to-date
+ *            checks
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -34,6 +49,11 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+
+/* =====================================================================
+ * core: status, errors, limits, images
+ * ===================================================================== */
 
 #define BB_VERSION_STRING "0.2.0"
 
@@ -54,6 +74,28 @@ extern "C" {
  * floats and are differenced, so they keep a factor of 4 below FLT_MAX. */
 #define BB_MAX_HEIGHT_TEXELS 8.5e37
 
+/* Most threads a bake, render or renderbump accepts (0 = all cores). */
+#define BB_MAX_THREADS 4096
+/* Largest smoothing radius a bake accepts, in texels: beyond a few hundred
+ * the window covers any texture anyway. (bb_smooth_bilateral alone takes
+ * more.) */
+#define BB_MAX_FILTER_RADIUS 4096
+/* Largest ray origin lift (texels) and lobe power a bake accepts. */
+#define BB_MAX_BIAS_TEXELS 1.0e6
+#define BB_MAX_POWER 1.0e6
+
+/* Most rays a bake's budget may name (bb_bake_options.rays), and most
+ * azimuth slices: round(sqrt(65536)) = 256. */
+#define BB_MAX_RAYS 65536
+#define BB_MAX_SLICES 256
+
+/* Most directions a basis may have: each costs one channel of ssbump,
+ * weights and the trace's sums (memory) and one table per slice (time). */
+#define BB_MAX_BASIS 16
+
+/* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
+#define BB_MAX_MESH_ELEMENTS (1UL << 27)
+
 typedef enum bb_status {
   BB_OK = 0,          /* success */
   BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
@@ -72,8 +114,6 @@ typedef struct bb_error {
 
 /* Short name of a status ("ok", "bad argument", ...); never NULL. */
 const char *bb_status_name(bb_status status);
-
-/* ------------------------------------------------------------------ images */
 
 typedef struct bb_image {
   int width;      /* texels */
@@ -95,13 +135,34 @@ void bb_image_free(bb_image *img);
 /* Pointer to texel (x, y), channel 0. No bounds check beyond debug asserts. */
 float *bb_image_texel(const bb_image *img, int x, int y);
 
+/* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
+void bb_image_flip_green(bb_image *img);
+
+/* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
+uint64_t bb_image_hash(const bb_image *img);
+
 /* Addressing of texels outside the image. */
 typedef enum bb_addressing {
   BB_ADDRESS_PERIODIC = 0, /* the texture tiles: h(x + W, y) = h(x, y) */
   BB_ADDRESS_CLAMP         /* border texels extend outwards */
 } bb_addressing;
 
-/* -------------------------------------------------------------- image I/O */
+/* Progress callback: done out of total work units. Return 0 to go on,
+ * nonzero to cancel: the call it reports on then stops as soon as the work
+ * in flight ends and returns BB_ERR_CANCELLED, making nothing. */
+typedef int (*bb_progress_fn)(void *user, long done, long total);
+
+/* A rectangle of texels, x0..x0+width-1 by y0..y0+height-1. */
+typedef struct bb_region {
+  int x0, y0, width, height;
+} bb_region;
+
+/* =====================================================================
+ * io: image files in and out, the height input
+ * Every read and write of an image file goes through OpenImageIO.
+ * ===================================================================== */
+
+/* ------------------------------------------------------ reading images */
 
 /* What a file held, beyond its pixels. */
 typedef struct bb_image_info {
@@ -133,6 +194,17 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * samples). */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
+
+/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
+ * reads level 0. level_count (may be NULL) receives the file's number of
+ * levels; a level past the last is BB_ERR_ARGUMENT. */
+bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
+                            bb_image_info *info, int *level_count, bb_error *err);
+
+/* Number of subimages (frames) in an image file. */
+bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
+
+/* ------------------------------------------------------ writing images */
 
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
  * float32 for exr. */
@@ -234,7 +306,24 @@ int bb_path_supports_depth(const char *path, bb_depth depth);
  * file can hold before the bake. */
 int bb_path_max_channels(const char *path);
 
-/* ----------------------------------------------------------- height input */
+/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr). */
+int bb_path_supports_mips(const char *path);
+
+/* Writes a mip chain (levels[0] the largest, each the halved size of the one
+ * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
+ * OpenEXR file, every level encoded as bb_image_write encodes an image, and
+ * written to a temporary name and renamed as it does. Errors as
+ * bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
+bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
+                              const bb_write_options *options, bb_error *err);
+
+/* bb_image_write_mips up to, not including, the rename, as
+ * bb_image_write_staged: commit or discard *staged. */
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err);
+
+/* -------------------------------------------------------- height input */
 
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
@@ -249,8 +338,10 @@ typedef enum bb_channel {
   BB_CHANNEL_MEAN      /* (R + G + B) / 3, computed in double */
 } bb_channel;
 
-/* Parses "r", "g", "b", "a", "luma", "mean", "auto"; returns 0 on success. */
-int bb_channel_parse(const char *name, bb_channel *out);
+/* Parses "r", "g", "b", "a", "luma", "mean", "auto" (any case). */
+bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
+/* The name bb_channel_parse accepts; "unknown" for other values. */
+const char *bb_channel_name(bb_channel c);
 
 /* The channel the rule takes from img when asked for `channel`: channel
  * itself, except BB_CHANNEL_AUTO, which gives BB_CHANNEL_A when img has an
@@ -274,7 +365,11 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
 bb_status bb_height_load(const char *path, bb_channel channel,
                          bb_image *height, bb_error *err);
 
-/* -------------------------------------------------------------- smoothing */
+/* =====================================================================
+ * bake: smooth -> normals -> pyramid -> trace -> derive
+ * ===================================================================== */
+
+/* ----------------------------------------------------------- smoothing */
 
 typedef struct bb_smooth_options {
   int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
@@ -284,14 +379,14 @@ typedef struct bb_smooth_options {
 
 void bb_smooth_options_init(bb_smooth_options *o);
 
-/* Valve's tileable bilateral filter (CONVENTIONS.md "Smoothing") of every
+/* Valve's tileable bilateral filter (docs/conventions.md "Smoothing") of every
  * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
  * with in's size and channels. */
 bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
                               const bb_smooth_options *o, bb_image *out,
                               bb_error *err);
 
-/* ---------------------------------------------------------------- normals */
+/* ------------------------------------------------------------- normals */
 
 typedef enum bb_normal_filter {
   BB_NORMAL_VALVE = 0, /* Valve's: mean of the 18 triangle normals of the 9 cells
@@ -305,8 +400,8 @@ typedef enum bb_normal_filter {
                           vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
 
-/* Parses "vertex", "valve", "central", "sobel"; returns 0 on success. */
-int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
+/* Parses "vertex", "valve", "central", "sobel". */
+bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb_normal_filter_name(bb_normal_filter f);
 
 /* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
@@ -315,65 +410,26 @@ bb_status bb_normals_compute(const bb_image *height, float height_scale,
                              bb_normal_filter filter, bb_addressing addressing,
                              bb_image *out, bb_error *err);
 
-/* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
-void bb_image_flip_green(bb_image *img);
+typedef struct bb_normal_decode_options {
+  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
+  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
+} bb_normal_decode_options;
 
-/* ---------------------------------------------------------------- pyramid */
+/* Defaults: +Y down, normalize on. */
+void bb_normal_decode_options_init(bb_normal_decode_options *o);
 
-/* Max-mip pyramid over the surface z = height_texels(x, y): opaque, built
- * once per bake, read-only afterwards and safe to share between threads. */
-typedef struct bb_pyramid bb_pyramid;
+/* The normals a normal-map file holds, from the values bb_image_read
+ * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
+ * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
+ * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
+ * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
+ * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
+ * texel. Allocates normals: 3 channels, same size. */
+bb_status bb_normal_map_decode(const bb_image *values, int is_float,
+                               const bb_normal_decode_options *o, bb_image *normals,
+                               bb_error *err);
 
-/* Builds the pyramid of a 1-channel field of heights in texels (already
- * multiplied by the height scale). The field is copied. */
-bb_status bb_pyramid_build(const bb_image *height_texels,
-                           bb_addressing addressing, bb_pyramid **out,
-                           bb_error *err);
-
-void bb_pyramid_free(bb_pyramid *p);
-
-/* Number of levels (level 0 = one node per cell, the last = one root node). */
-int bb_pyramid_levels(const bb_pyramid *p);
-
-/* Max over the surface of node (x, y) of a level: testing aid. */
-float bb_pyramid_node_max(const bb_pyramid *p, int level, int x, int y);
-
-/* ----------------------------------------------------------------- tracer */
-
-/* A ray in texel space: origin and direction (need not be unit; z > 0). */
-typedef struct bb_ray {
-  double origin[3];
-  double direction[3];
-} bb_ray;
-
-/* 1 when the ray meets the surface at a distance > 0, else 0. Rays have no
- * maximum length: periodic rays wrap as often as needed. Max-mip march. */
-int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
-
-/* The same answer by the brute-force twin: a 2D DDA through every cell with
- * the same exact cell test and no pyramid. Slow; for tests and benchmarks. */
-int bb_ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray);
-
-/* The horizon of the ray's vertical half-plane: the largest slope
- * (surface - origin z) / d, in texels of rise per texel of horizontal
- * distance, over every breakpoint of the surface (cell edge or diagonal
- * crossing) at 0 < d <= max_distance along the ray's horizontal direction
- * (its z is ignored), or 0 when none is positive: a direction is open
- * exactly when its tangent of elevation exceeds it. max_distance is in
- * texels, > 0; it may be INFINITY in clamp mode (past the border the surface
- * turns flat), not in periodic mode, where a ray that never rises above its
- * origin would wrap for ever. Returns -1 for a bad max_distance or a
- * vertical direction. Max-mip march. */
-double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance);
-
-/* The same answer by the brute-force twin (every cell, no pyramid). */
-double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance);
-
-/* ------------------------------------------------------------------ basis */
-
-/* Most directions a basis may have: each costs one channel of ssbump,
- * weights and the trace's sums (memory) and one table per slice (time). */
-#define BB_MAX_BASIS 16
+/* --------------------------------------------------------------- basis */
 
 /* The directions occlusion is projected on: one channel of ssbump and
  * weights per direction, in this order. A plain struct; copy it freely. */
@@ -439,66 +495,87 @@ bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
  * files) assume; else 0. */
 int bb_basis_is_hl2(const bb_basis *b);
 
-/* -------------------------------------------------------------- ray set */
+/* ------------------------------------------------------------- pyramid */
 
-#define BB_MAX_SLICES 256
+/* Max-mip pyramid over the surface z = height_texels(x, y): opaque, built
+ * once per bake, read-only afterwards and safe to share between threads. */
+typedef struct bb_pyramid bb_pyramid;
+
+/* Builds the pyramid of a 1-channel field of heights in texels (already
+ * multiplied by the height scale). The field is copied. */
+bb_status bb_pyramid_build(const bb_image *height_texels,
+                           bb_addressing addressing, bb_pyramid **out,
+                           bb_error *err);
+
+void bb_pyramid_free(bb_pyramid *p);
+
+/* -------------------------------------------------------------- tracer */
+
+/* A ray in texel space: origin and direction (need not be unit; z > 0). */
+typedef struct bb_ray {
+  double origin[3];
+  double direction[3];
+} bb_ray;
+
+/* 1 when the ray meets the surface at a distance > 0, else 0. Rays have no
+ * maximum length: periodic rays wrap as often as needed. Max-mip march. */
+int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
+
+/* The horizon of the ray's vertical half-plane: the largest slope
+ * (surface - origin z) / d, in texels of rise per texel of horizontal
+ * distance, over every breakpoint of the surface (cell edge or diagonal
+ * crossing) at 0 < d <= max_distance along the ray's horizontal direction
+ * (its z is ignored), or 0 when none is positive: a direction is open
+ * exactly when its tangent of elevation exceeds it. max_distance is in
+ * texels, > 0; it may be INFINITY in clamp mode (past the border the surface
+ * turns flat), not in periodic mode, where a ray that never rises above its
+ * origin would wrap for ever. Returns -1 for a bad max_distance or a
+ * vertical direction. Max-mip march. */
+double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance);
+
+/* ------------------------------------------------------------- ray set */
 
 /* Azimuth slices a budget of `rays` rays per texel stands for, as Valve's
  * tool counts rays: round(sqrt(rays)), at least 1 (so -r 250 and 256 both
  * give 16). */
 int bb_slices_for_rays(int rays);
 
-/* The directions the bake integrates over, and how. ("Ray set" is the
- * historical name: nothing is sampled in elevation.) Slice s follows the
- * integer lattice step (a, b) nearest to the azimuth 2 pi (s + 1/2) / A and
- * stands for the azimuth sector [sector[2s], sector[2s+1]] halfway to its
- * neighbours. A texel's horizon along the step's direction (tangent t, found
- * exactly by the tracer) blocks, over the whole sector, the elevations
- * below atan(max(t, 0)); what that takes from each integral of CONVENTIONS
- * (ao: w.z; vis_c: max(0, w.B_c)^P) is exact: closed form for ao, tables in
- * t built here for the lobes (error under 1e-9 of the sector's share). Then
- *   ao    = 1 - sum_s blocked_ao,s(t_s) / total[0]
- *   vis_c = 1 - sum_s blocked_c,s(t_s) / total[1 + c]
+/* The directions the bake integrates over, and how; opaque, built by
+ * bb_rayset_make, read-only afterwards and safe to share between threads.
+ * ("Ray set" is the historical name: nothing is sampled in elevation.)
+ * Slice s follows the integer lattice step (a, b) nearest to the azimuth
+ * 2 pi (s + 1/2) / A and stands for the azimuth sector halfway to its
+ * neighbours. A texel's horizon along the step's direction (tangent t,
+ * found exactly by the tracer) blocks, over the whole sector, the
+ * elevations below atan(max(t, 0)); what that takes from each integral of
+ * docs/conventions.md (ao: w.z; vis_c: max(0, w.B_c)^P) is exact: closed
+ * form for ao, tables in t built here for the lobes (error under 1e-9 of
+ * the sector's share). Then
+ *   ao    = 1 - sum_s blocked_ao,s(t_s) / total_ao
+ *   vis_c = 1 - sum_s blocked_c,s(t_s) / total_c
  * so an unobstructed texel gets exactly 1. */
-typedef struct bb_rayset {
-  int slice_count;           /* A, 1..BB_MAX_SLICES */
-  int basis_count;           /* lobes: the basis' count, 3..BB_MAX_BASIS */
-  double power;              /* P >= 1 of the lobes */
-  double basis[BB_MAX_BASIS][3]; /* unit lobe directions B_c (the basis' vectors) */
-  int *slice_step;           /* 2 per slice: the lattice step (a, b), coprime */
-  double *slice_dir;         /* 2 per slice: unit (dx, dy) along (a, b) */
-  double *sector;            /* 2 per slice: first and last azimuth, radians */
-  double *half_width;        /* per slice: (last - first) / 2 */
-  double *table;             /* per slice, the lobes' tables (layout internal) */
-  double total[1 + BB_MAX_BASIS]; /* the whole integrals: pi for ao, then each lobe's */
-  char id[64];               /* names the scheme and its parameters, for provenance */
-} bb_rayset;
+typedef struct bb_rayset bb_rayset;
 
 /* Builds the slices and their integration tables: slices in
  * 1..BB_MAX_SLICES, power >= 1, one lobe per direction of basis (NULL:
  * "hl2"; copied). The tables cost slices x basis->count x 8 KiB and their
- * build time grows with the same product. Allocates; free with
- * bb_rayset_free. */
-bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset *out,
+ * build time grows with the same product. On success *out receives the
+ * ray set; free it with bb_rayset_free. */
+bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset **out,
                          bb_error *err);
+
+/* Frees a ray set; NULL is fine. */
 void bb_rayset_free(bb_rayset *rs);
 
-/* What slice `slice` loses to a horizon of tangent tan_horizon (rise per
- * horizontal texel; <= 0 loses nothing) from each integral: blocked[0] for
- * ao, blocked[1 + c] for lobe c (1 + basis_count values). */
-void bb_rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked);
+/* Its azimuth slices (A) and lobes (the basis' direction count). */
+int bb_rayset_slice_count(const bb_rayset *rs);
+int bb_rayset_lobe_count(const bb_rayset *rs);
 
-/* ------------------------------------------------------------------ trace */
+/* The id that names the scheme and its parameters in provenance ("rayset"
+ * key); owned by rs. */
+const char *bb_rayset_id(const bb_rayset *rs);
 
-/* Progress callback: done out of total work units. Return 0 to go on,
- * nonzero to cancel: the call it reports on then stops as soon as the work
- * in flight ends and returns BB_ERR_CANCELLED, making nothing. */
-typedef int (*bb_progress_fn)(void *user, long done, long total);
-
-/* A rectangle of texels, x0..x0+width-1 by y0..y0+height-1. */
-typedef struct bb_region {
-  int x0, y0, width, height;
-} bb_region;
+/* --------------------------------------------------------------- trace */
 
 typedef struct bb_trace_options {
   double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
@@ -514,7 +591,7 @@ typedef struct bb_trace_options {
 void bb_trace_options_init(bb_trace_options *o);
 
 /* Finds every texel's horizon in each slice of rs and integrates it (see
- * bb_rayset). Allocates vis with 1 + rs->basis_count channels: ao, vis_0,
+ * bb_rayset). Allocates vis with 1 + bb_rayset_lobe_count(rs) channels: ao, vis_0,
  * vis_1, ... in [0, 1], over the whole pyramid or over o->region (which
  * must lie inside it). Sweeps and marches find the same horizons, so a
  * region's texels are bit-identical to the same texels of a whole trace,
@@ -525,9 +602,9 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *horizons_found, bb_error *err);
 
-/* ----------------------------------------------------------------- derive */
+/* -------------------------------------------------------------- derive */
 
-/* The maps of CONVENTIONS "Derived maps", for any basis: channel c belongs
+/* The maps of docs/conventions.md "Derived maps", for any basis: channel c belongs
  * to basis->vector[c]. basis NULL means Half-Life 2's B0, B1, B2, and for
  * ssbump and bent also hl2+z when the input has a fourth basis channel. */
 
@@ -553,7 +630,7 @@ bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err);
 bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
                          bb_error *err);
 
-/* ------------------------------------------------------------------- bake */
+/* ---------------------------------------------------------------- bake */
 
 /* The maps a bake can make, in the order of this enum everywhere (the
  * command line's options, JSON, Python's bumpbake.OUTPUTS). New kinds are
@@ -596,22 +673,13 @@ const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
 
 /* The kind named name (as bb_output_kind_info.name); returns 0 on success,
  * -1 for an unknown name (out untouched). */
-int bb_output_kind_parse(const char *name, bb_output_kind *out);
+bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err);
 
-/* Most threads a bake, render or renderbump accepts (0 = all cores). */
-#define BB_MAX_THREADS 4096
-/* Largest smoothing radius a bake accepts, in texels: beyond a few hundred
- * the window covers any texture anyway. (bb_smooth_bilateral alone takes
- * more.) */
-#define BB_MAX_FILTER_RADIUS 4096
-/* Largest ray origin lift (texels) and lobe power a bake accepts. */
-#define BB_MAX_BIAS_TEXELS 1.0e6
-#define BB_MAX_POWER 1.0e6
 
 typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
-  int rays;                   /* ray budget, 1..65536, default 256:
-                                 round(sqrt(rays)) slices */
+  int rays;                   /* ray budget, 1..BB_MAX_RAYS, default 256:
+                                 round(sqrt(rays)) slices (bb_bake_slices) */
   int slices;                 /* azimuth slices, 1..BB_MAX_SLICES; 0 (default):
                                  from rays */
   bb_smooth_options smooth;   /* filter radius 0..BB_MAX_FILTER_RADIUS,
@@ -634,6 +702,11 @@ typedef struct bb_bake_options {
 } bb_bake_options;
 
 void bb_bake_options_init(bb_bake_options *o);
+
+/* The azimuth slices o traces with: o->slices when set, else
+ * bb_slices_for_rays(o->rays). The one rule; provenance, JSON and the
+ * up-to-date check all report it. */
+int bb_bake_slices(const bb_bake_options *o);
 
 /* Checks every field of o as bb_bake does before it starts (ranges in the
  * field comments): BB_OK, or BB_ERR_ARGUMENT with a message such as "bake:
@@ -675,7 +748,13 @@ const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kin
 
 void bb_bake_result_free(bb_bake_result *r);
 
-/* ----------------------------------------------------- Valve's RGBA files */
+/* =====================================================================
+ * maps: Valve's files, converting, combining, programs, mips, compare
+ * Every function here works on decoded values: normals as N in [-1, 1]
+ * (+Y down), ssbump, weights and ao in [0, 1], colours in [0, 1].
+ * ===================================================================== */
+
+/* -------------------------------------------------- Valve's RGBA files */
 
 /* What goes into the RGBA file Valve's height2ssbump writes. */
 typedef struct bb_valve_options {
@@ -709,322 +788,7 @@ bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
 bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
                           const bb_smooth_options *smooth, bb_error *err);
 
-/* ---------------------------------------------------------------- compare */
-
-typedef struct bb_compare_stats {
-  double mean_abs, rms, max_abs;
-  int worst_x, worst_y, worst_channel;
-  long pixels;
-  long over_fail, over_warn;  /* pixels with any channel over the threshold */
-} bb_compare_stats;
-
-/* Channel-by-channel comparison of two images of equal size and channels
- * (BB_ERR_SIZE otherwise). A pixel counts as over a threshold when any of
- * its channels differs by more than it. diff (may be NULL) receives |a - b|. */
-bb_status bb_compare_images(const bb_image *a, const bb_image *b,
-                            double fail_threshold, double warn_threshold,
-                            bb_compare_stats *stats, bb_image *diff,
-                            bb_error *err);
-
-/* The tolerances of a comparison, as OpenImageIO's idiff takes them (its
- * -fail, -failpercent, -hardfail, -allowfailures, -warn, -warnpercent,
- * -hardwarn). Differences are absolute, in the images' float units. */
-typedef struct bb_compare_limits {
-  double fail;          /* a pixel fails when a channel differs by more; 1e-6 */
-  double fail_percent;  /* failing pixels allowed, % of all, 0..100; 0 */
-  double hard_fail;     /* any difference above this fails; infinity */
-  long allow_failures;  /* up to this many failing pixels pass, by any
-                           amount (hard_fail included); 0 */
-  double warn;          /* a pixel warns when a channel differs by more; 1e-6 */
-  double warn_percent;  /* warning pixels allowed, % of all, 0..100; 0 */
-  double hard_warn;     /* any difference above this warns; infinity */
-} bb_compare_limits;
-
-/* Sets idiff's defaults (in the field comments above). */
-void bb_compare_limits_init(bb_compare_limits *limits);
-
-/* A comparison's outcome; the values are idiff's exit codes. */
-typedef enum bb_compare_verdict {
-  BB_COMPARE_PASS = 0,
-  BB_COMPARE_WARN = 1,
-  BB_COMPARE_FAIL = 2
-} bb_compare_verdict;
-
-/* idiff's rule (OpenImageIO 2.4), for stats made by bb_compare_images with
- * thresholds limits->fail and limits->warn: PASS when at most
- * allow_failures pixels fail; else FAIL when more than fail_percent % of
- * the pixels fail or max_abs > hard_fail; else WARN when more than
- * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
- * warnings are only reported once some pixel fails: with no failing pixel
- * the verdict is PASS. */
-bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
-                                    const bb_compare_limits *limits);
-
-/* ------------------------------------------------------------- provenance */
-
-/* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
-uint64_t bb_image_hash(const bb_image *img);
-
-/* How an output was made. Every field that affects pixels is here. */
-typedef struct bb_provenance {
-  const char *command;        /* the command line, or NULL */
-  const char *input_name;     /* input file name (no directory), or NULL */
-  uint64_t input_hash;        /* bb_image_hash of the decoded input pixels */
-  const char *output_kind;    /* "normal", "ssbump", "ao", ... */
-  const bb_bake_options *options;
-  bb_channel channel;         /* height channel rule used */
-  const char *rayset_id;      /* bb_rayset.id, or NULL when nothing was traced */
-  uint64_t input_file_hash;   /* bb_file_hash of the input file's bytes, or 0:
-                                 unknown (the key is then left out) */
-} bb_provenance;
-
-/* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
- * input_file_hash when known, output, scale, rays, rayset, filter_radius,
- * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
- * channel), malloc'd; the caller
- * frees it. A basis of the caller's vectors ("vectors:HASH") adds
- * basis_vectors after basis: "x y z" per direction, joined by "; ".
- * Returns NULL when out of memory. */
-char *bb_provenance_format(const bb_provenance *p);
-
-/* Writes into out (capacity cap) the keys whose values differ between two
- * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
- * when either text is NULL). Keys "command" and "output" are ignored. Returns
- * the number of differing keys, or -1 when out of memory. Time is
- * O(n log n) in the number of lines, whatever the texts hold. */
-int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
-
-/* What an image description holds, for readers of provenance. */
-typedef enum bb_provenance_class {
-  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
-  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
-  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
-                             re-wrapped (by a format or another tool), so a
-                             key-by-key diff would mislead */
-} bb_provenance_class;
-
-/* Classifies a description (NULL is NONE): bumpbake's when it has a
- * "bumpbake_version=" line; intact when each non-empty line is key=value
- * with a key of lower-case letters, digits and '_'. */
-bb_provenance_class bb_provenance_classify(const char *description);
-
-/* The value of key in a provenance text (its first "key=value" line) into
- * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
- * there, 0 when it is not or description is NULL (out is then ""). So a
- * reader can ask which basis a map was baked with ("basis"). */
-int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
-
-const char *bb_channel_name(bb_channel c);
-
-/* ------------------------------------------------------------ incremental */
-
-/* What a build tool needs to skip a bake whose outputs are already what it
- * would write: a hash of the input file, recorded in every output's
- * provenance (input_file_hash), and a check of an existing output that reads
- * only its header. */
-
-/* 64-bit FNV-1a hash of the bytes of the file at path, read in blocks (any
- * size, constant memory), into *hash. It is what provenance records as
- * input_file_hash, so a later run can tell an input is unchanged without
- * decoding it. Errors: BB_ERR_IO (missing, unreadable, not a regular file),
- * with the system's reason. */
-bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
-
-/* The rayset id bb_bake records in result->rayset_id for options o (slices
- * from o->slices, or from o->rays; power; basis), computed without building
- * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
- * any id). "" when o->outputs asks for no traced kind: nothing is traced
- * then, and provenance says rayset=none. */
-void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
-
-/* Whether an existing output is what writing it now would make. */
-typedef enum bb_output_state {
-  BB_OUTPUT_CURRENT = 0, /* made from the same input bytes, with the same
-                            parameters and bumpbake version, depth and mips */
-  BB_OUTPUT_MISSING,     /* no file at the path */
-  BB_OUTPUT_STALE        /* a file, but made otherwise, or not known to be
-                            current (no or damaged provenance, unreadable) */
-} bb_output_state;
-
-/* Decides from the header of the file at path alone (bb_image_read_info;
- * no pixel is decoded) whether it is what writing the output described by
- * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
- * 1), would make now. CURRENT when its provenance is bumpbake's, intact
- * (bb_provenance_classify), and holds every key bb_provenance_format(expected)
- * writes with the same value, and no key that text lacks, except "command"
- * and "input" (the command line and the input's name, which do not change a
- * pixel) and "input_hash" (the decoded height's hash, implied by
- * input_file_hash and channel): so the bumpbake version, the input file's
- * bytes, the output kind and every parameter that affects pixels must
- * match; and when its samples have the depth `depth` gives in path's format
- * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
- * level exactly when mip_mapped. expected->input_file_hash must be set
- * (nonzero): without it nothing is CURRENT. A file that cannot be read is
- * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
- * may be NULL) receives why it is not CURRENT, one line ("no such file",
- * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
- * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
- * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
- * BB_ERR_MEMORY. */
-bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
-                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
-                          bb_error *err);
-
-/* ----------------------------------------------------------------- meshes */
-
-/* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
-#define BB_MAX_MESH_ELEMENTS (1UL << 27)
-
-/* A triangle mesh in model units. bb_mesh_load fills one from a file: every
- * mesh of the file merged, node transforms applied, polygons triangulated,
- * points and lines dropped. */
-typedef struct bb_mesh {
-  size_t vertex_count;
-  size_t triangle_count;
-  float *positions;  /* 3 floats per vertex: x, y, z in model units */
-  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
-                        a vertex whose normal is zero or not finite has none */
-  uint32_t *indices; /* 3 per triangle, each < vertex_count */
-} bb_mesh;
-
-/* Allocates a zeroed mesh of the given counts (normals only when
- * with_normals). Rejects counts of 0 vertices or over BB_MAX_MESH_ELEMENTS
- * (BB_ERR_SIZE) and failed allocations (BB_ERR_MEMORY), leaving m zeroed. */
-bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
-                        int with_normals, bb_error *err);
-
-/* Frees the arrays and zeroes the struct; safe on a zeroed struct. */
-void bb_mesh_free(bb_mesh *m);
-
-/* 64-bit FNV-1a hash of the counts, positions, normals and indices, for
- * provenance (the input_hash of outputs baked from a mesh). */
-uint64_t bb_mesh_hash(const bb_mesh *m);
-
-/* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
- * anything Assimp imports), merged as described at bb_mesh. Normals are kept
- * when any part of the model has them (vertices of parts without are zero).
- * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
- * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
- * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
-bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
-
-/* Writes m through Assimp's exporters; the format comes from the extension:
- * .obj (without a material file), .ply (binary little-endian), .stl
- * (binary), .glb. Normals are written when m has them. The file is written
- * to a temporary name in the destination directory and renamed into place.
- * Errors: BB_ERR_FORMAT (unknown extension), BB_ERR_ARGUMENT (an index out
- * of range), BB_ERR_IO (cannot write). */
-bb_status bb_mesh_write(const char *path, const bb_mesh *m, bb_error *err);
-
-/* ------------------------------------------------------ flat render bump */
-
-/* The direction a flat sculpt's front side faces, towards the viewer of an
- * orthographic projection. Each names a right-handed frame (right, up, out):
- * image columns run along right, rows run down -up, and out is the height. */
-typedef enum bb_axis {
-  BB_AXIS_NEG_Y = 0, /* DOOM 3's RenderBumpFlat (and Blender's front view):
-                        right +X, up +Z, out -Y */
-  BB_AXIS_POS_Y,     /* right -X, up +Z, out +Y (Blender's back view) */
-  BB_AXIS_POS_Z,     /* right +X, up +Y, out +Z (Blender's top view) */
-  BB_AXIS_NEG_Z,     /* right +X, up -Y, out -Z (Blender's bottom view) */
-  BB_AXIS_POS_X,     /* right +Y, up +Z, out +X (Blender's right view) */
-  BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
-} bb_axis;
-
-/* Parses "-y", "+y", "+z", "-z", "+x", "-x" ("y" means "+y"); 0 on success. */
-int bb_axis_parse(const char *name, bb_axis *out);
-/* "-y", "+z", ...; "unknown" for a value outside the enum. */
-const char *bb_axis_name(bb_axis a);
-/* The model-space unit vectors right, up and out of axis a. */
-void bb_axis_frame(bb_axis a, double right[3], double up[3], double out[3]);
-
-typedef struct bb_renderbump_options {
-  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
-  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
-                         a regular grid; default 4 (DOOM 3's 16x) */
-  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
-  int face_normals;   /* 1: every triangle's own plane normal, even when the
-                         mesh has vertex normals; default 0 */
-  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
-  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
-                         the image, in model units along right and up */
-  int tile;           /* 1: geometry outside the rectangle wraps around into
-                         it (the sculpt tiles with the rectangle as period) */
-  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
-                         same for any count */
-} bb_renderbump_options;
-
-void bb_renderbump_options_init(bb_renderbump_options *o);
-
-/* What a flat render bump makes. */
-typedef struct bb_renderbump_result {
-  bb_image normal;   /* 4 channels: unit N in the tangent frame (x right, y
-                        DOWN, z out) and alpha = covered fraction of the
-                        texel's samples; N = (0, 0, 1) where alpha is 0 */
-  bb_image height;   /* 1 channel: h in [0, 1], the texel's mean height of the
-                        front-most surface over its covered samples, 0 where
-                        alpha is 0 */
-  double rect[4];    /* the rectangle used: left, bottom, right, top */
-  double depth_min, depth_max; /* model units along out that h = 0 and 1 are */
-  double texel_size; /* model units per texel: sqrt(texel width * height) */
-  double texel_aspect; /* texel width / texel height (1 = square texels) */
-  double height_scale; /* texels of height per unit of h, (depth_max -
-                          depth_min) / texel_size: bb_bake's height_scale
-                          for this height; 0 when the surface is flat */
-  int used_vertex_normals; /* 1 when some texel used interpolated normals */
-  size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
-} bb_renderbump_result;
-
-/* DOOM 3's RenderBumpFlat on the CPU: projects mesh orthographically along
- * o->axis onto the rectangle, keeps the front-most surface at each sample
- * (no culling: the side facing the viewer is taken), and averages the
- * samples of each texel into result (allocated; free with
- * bb_renderbump_result_free). Bit-identical for any thread count. Errors:
- * BB_ERR_ARGUMENT (bad options, an index out of range, a degenerate
- * rectangle, nothing facing the viewer), BB_ERR_VALUE (a NaN or infinite
- * coordinate), BB_ERR_SIZE (size over the maximum, or the model covering
- * the image too many times over with tile), BB_ERR_MEMORY. */
-bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
-                             bb_renderbump_result *result, bb_error *err);
-
-void bb_renderbump_result_free(bb_renderbump_result *r);
-
-/* The "key=value" provenance lines of a render (axis, size, samples,
- * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
- * bb_provenance_format's lines; NULL when out of memory. */
-char *bb_renderbump_describe(const bb_renderbump_options *o,
-                             const bb_renderbump_result *r);
-
-/* =================================================================
- * Converting, combining and programming maps (README "Converting and
- * combining maps"): normal2ssbump, ssbump2normal, combine, DOOM 3's image
- * programs and flipcode's slope map. Every function here works on decoded
- * values: normals as N in [-1, 1] (+Y down), ssbump, weights and ao in
- * [0, 1], colours in [0, 1].
- * ================================================================= */
-
-/* ------------------------------------------------- normal map decoding */
-
-typedef struct bb_normal_decode_options {
-  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
-  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
-} bb_normal_decode_options;
-
-/* Defaults: +Y down, normalize on. */
-void bb_normal_decode_options_init(bb_normal_decode_options *o);
-
-/* The normals a normal-map file holds, from the values bb_image_read
- * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
- * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
- * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
- * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
- * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
- * texel. Allocates normals: 3 channels, same size. */
-bb_status bb_normal_map_decode(const bb_image *values, int is_float,
-                               const bb_normal_decode_options *o, bb_image *normals,
-                               bb_error *err);
-
-/* ------------------------------------------------------ ssbump to normal */
+/* ---------------------------------------------------- ssbump to normal */
 
 /* What a three-channel basis map holds. */
 typedef enum bb_ssbump_kind {
@@ -1054,8 +818,8 @@ typedef enum bb_map_kind {
   BB_MAP_NORMAL      /* decoded unit normals, 3 channels */
 } bb_map_kind;
 
-/* Parses "ssbump", "weights", "ao", "normal"; returns 0 on success. */
-int bb_map_kind_parse(const char *name, bb_map_kind *out);
+/* Parses "ssbump", "weights", "ao", "normal" (any case). */
+bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
 const char *bb_map_kind_name(bb_map_kind kind);
 
 /* Channels the kind's operators act on: 3, or 1 for ao. */
@@ -1093,7 +857,7 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err);
 
-/* ---------------------------------------------------- DOOM 3 programs */
+/* ----------------------------------------------------- DOOM 3 programs */
 
 /* A parsed DOOM 3 image program, such as "addnormals(a_local.tga,
  * heightmap(a_h.tga, 4))": opaque, made by bb_program_parse. */
@@ -1150,7 +914,7 @@ void bb_program_options_init(bb_program_options *o);
 bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
                          bb_image *out, int *is_normal_map, bb_error *err);
 
-/* --------------------------------------------------- flipcode slope map */
+/* -------------------------------------------------- flipcode slope map */
 
 /* Packs slopes dx, dy (each clamped to -7..7) into flipcode's byte: dx in
  * the low nibble, dy in the high nibble, each as a 4-bit two's complement
@@ -1181,7 +945,83 @@ void bb_slope_table(const double light[3], float table[256]);
 bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image *out,
                          bb_error *err);
 
-/* ----------------------------------------------------------------- render */
+/* ---------------------------------------------------------- mip chains */
+
+/* How a mip level is made from the one above it. */
+typedef enum bb_mip_filter {
+  BB_MIP_AVERAGE = 0,  /* box average of every channel: ssbump, weights, ao, heights
+                          (linear in light, so averages light as the paper says) */
+  BB_MIP_RENORMALIZE   /* box average, then channels 0..2 rescaled to unit length
+                          (normal maps; a zero average becomes (0, 0, 1)) */
+} bb_mip_filter;
+
+/* The mip chain of img, down to 1 x 1: level 0 is a copy of img, level k + 1
+ * is level k box-filtered by OpenImageIO's ImageBufAlgo::resize to
+ * max(1, w / 2) x max(1, h / 2) (for even sides exactly the mean of 2 x 2
+ * texels; an odd side's box covers the 3 texels under each output texel),
+ * then renormalised for BB_MIP_RENORMALIZE. *levels is malloc'd with *count
+ * images (1 + floor(log2(max(w, h)))); free it with bb_mip_chain_free. */
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err);
+
+void bb_mip_chain_free(bb_image *levels, int count);
+
+/* ------------------------------------------------------------- compare */
+
+typedef struct bb_compare_stats {
+  double mean_abs, rms, max_abs;
+  int worst_x, worst_y, worst_channel;
+  long pixels;
+  long over_fail, over_warn;  /* pixels with any channel over the threshold */
+} bb_compare_stats;
+
+/* Channel-by-channel comparison of two images of equal size and channels
+ * (BB_ERR_SIZE otherwise). A pixel counts as over a threshold when any of
+ * its channels differs by more than it. diff (may be NULL) receives |a - b|. */
+bb_status bb_compare_images(const bb_image *a, const bb_image *b,
+                            double fail_threshold, double warn_threshold,
+                            bb_compare_stats *stats, bb_image *diff,
+                            bb_error *err);
+
+/* The tolerances of a comparison, as OpenImageIO's idiff takes them (its
+ * -fail, -failpercent, -hardfail, -allowfailures, -warn, -warnpercent,
+ * -hardwarn). Differences are absolute, in the images' float units. */
+typedef struct bb_compare_limits {
+  double fail;          /* a pixel fails when a channel differs by more; 1e-6 */
+  double fail_percent;  /* failing pixels allowed, % of all, 0..100; 0 */
+  double hard_fail;     /* any difference above this fails; infinity */
+  long allow_failures;  /* up to this many failing pixels pass, by any
+                           amount (hard_fail included); 0 */
+  double warn;          /* a pixel warns when a channel differs by more; 1e-6 */
+  double warn_percent;  /* warning pixels allowed, % of all, 0..100; 0 */
+  double hard_warn;     /* any difference above this warns; infinity */
+} bb_compare_limits;
+
+/* Sets idiff's defaults (in the field comments above). */
+void bb_compare_limits_init(bb_compare_limits *limits);
+
+/* A comparison's outcome; the values are idiff's exit codes. */
+typedef enum bb_compare_verdict {
+  BB_COMPARE_PASS = 0,
+  BB_COMPARE_WARN = 1,
+  BB_COMPARE_FAIL = 2
+} bb_compare_verdict;
+
+/* idiff's rule (OpenImageIO 2.4), for stats made by bb_compare_images with
+ * thresholds limits->fail and limits->warn: PASS when at most
+ * allow_failures pixels fail; else FAIL when more than fail_percent % of
+ * the pixels fail or max_abs > hard_fail; else WARN when more than
+ * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
+ * warnings are only reported once some pixel fails: with no failing pixel
+ * the verdict is PASS. */
+bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
+                                    const bb_compare_limits *limits);
+
+/* =====================================================================
+ * render: lighting the maps, pictures, sheets, animations
+ * ===================================================================== */
+
+/* ------------------------------------------------------------ lighting */
 
 /* Lighting the baked maps as the paper's "Rendering" section (and Source's
  * shaders) do, per texel, in the tangent frame above (+Y down, viewer
@@ -1213,8 +1053,8 @@ typedef enum bb_albedo_mode {
                              detail of mid-grey input (0.5 each) gives 1 */
 } bb_albedo_mode;
 
-/* Parses "multiply", "mod2x", "ssbump"; returns 0 on success. */
-int bb_albedo_mode_parse(const char *name, bb_albedo_mode *out);
+/* Parses "multiply", "mod2x", "ssbump". */
+bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err);
 const char *bb_albedo_mode_name(bb_albedo_mode mode);
 
 /* What one render shows. New modes are appended. */
@@ -1226,8 +1066,8 @@ typedef enum bb_render_mode {
                            table (bb_slope_table; needs slope) */
 } bb_render_mode;
 
-/* Parses "ssbump", "normal", "ao", "slope"; returns 0 on success. */
-int bb_render_mode_parse(const char *name, bb_render_mode *out);
+/* Parses "ssbump", "normal", "ao", "slope". */
+bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err);
 
 /* The maps a mode reads, as BB_RENDER_NEEDS_* bits (0 for an unknown mode). */
 #define BB_RENDER_NEEDS_NORMAL 1u
@@ -1298,15 +1138,7 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 
-/* Decodes a normal map as read by bb_image_read: integer files
- * (is_float = 0) hold 0.5 + 0.5 N, so N = 2 v - 1; float files hold N.
- * green_up = 1 flips y (an OpenGL-style map). Each N is renormalised (8-bit
- * codes are not unit length); a zero vector becomes (0, 0, 1). out gets 3
- * channels; img needs >= 3. */
-bb_status bb_normals_decode(const bb_image *img, int is_float, int green_up, bb_image *out,
-                            bb_error *err);
-
-/* ----------------------------------------------------------------- panels */
+/* ---------------------------------------------------- image operations */
 
 /* Repeats in nx x ny times (nx, ny >= 1) into out. */
 bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out, bb_error *err);
@@ -1326,6 +1158,8 @@ bb_status bb_image_resample(const bb_image *in, int width, int height, bb_image 
  * three channels. Values are clamped to [0, 1]. */
 bb_status bb_image_to_display(const bb_image *map, bb_range range, float low, float high,
                               bb_image *rgb, bb_error *err);
+
+/* -------------------------------------------------------------- panels */
 
 /* One picture of a panel grid and the label written under it (may be NULL). */
 typedef struct bb_panel {
@@ -1367,7 +1201,7 @@ bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options 
 /* The exponent bb_render_compare uses when o->specular_exponent is 0. */
 #define BB_COMPARE_SPECULAR_EXPONENT 64.0
 
-/* ------------------------------------------------------------------ sheet */
+/* --------------------------------------------------------------- sheet */
 
 typedef struct bb_sheet_options {
   bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
@@ -1385,7 +1219,7 @@ bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
                         const bb_sheet_options *o, bb_image *out, int *labels_drawn,
                         bb_error *err);
 
-/* -------------------------------------------------------------- animation */
+/* ----------------------------------------------------------- animation */
 
 /* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
  * channel, a palette per frame). Frames go to a temporary file in the
@@ -1409,51 +1243,240 @@ bb_status bb_animation_close(bb_animation *a, bb_error *err);
 /* Removes the temporary file and frees a; safe on NULL. */
 void bb_animation_abort(bb_animation *a);
 
-/* Number of subimages (frames) in an image file. */
-bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
-/* ------------------------------------------------------------ mip chains */
+/* =====================================================================
+ * mesh: models and DOOM 3's flat render bump
+ * ===================================================================== */
 
-/* How a mip level is made from the one above it. */
-typedef enum bb_mip_filter {
-  BB_MIP_AVERAGE = 0,  /* box average of every channel: ssbump, weights, ao, heights
-                          (linear in light, so averages light as the paper says) */
-  BB_MIP_RENORMALIZE   /* box average, then channels 0..2 rescaled to unit length
-                          (normal maps; a zero average becomes (0, 0, 1)) */
-} bb_mip_filter;
+/* -------------------------------------------------------------- meshes */
 
-/* The mip chain of img, down to 1 x 1: level 0 is a copy of img, level k + 1
- * is level k box-filtered by OpenImageIO's ImageBufAlgo::resize to
- * max(1, w / 2) x max(1, h / 2) (for even sides exactly the mean of 2 x 2
- * texels; an odd side's box covers the 3 texels under each output texel),
- * then renormalised for BB_MIP_RENORMALIZE. *levels is malloc'd with *count
- * images (1 + floor(log2(max(w, h)))); free it with bb_mip_chain_free. */
-bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
-                       int *count, bb_error *err);
+/* A triangle mesh in model units. bb_mesh_load fills one from a file: every
+ * mesh of the file merged, node transforms applied, polygons triangulated,
+ * points and lines dropped. */
+typedef struct bb_mesh {
+  size_t vertex_count;
+  size_t triangle_count;
+  float *positions;  /* 3 floats per vertex: x, y, z in model units */
+  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
+                        a vertex whose normal is zero or not finite has none */
+  uint32_t *indices; /* 3 per triangle, each < vertex_count */
+} bb_mesh;
 
-void bb_mip_chain_free(bb_image *levels, int count);
+/* Allocates a zeroed mesh of the given counts (normals only when
+ * with_normals). Rejects counts of 0 vertices or over BB_MAX_MESH_ELEMENTS
+ * (BB_ERR_SIZE) and failed allocations (BB_ERR_MEMORY), leaving m zeroed. */
+bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
+                        int with_normals, bb_error *err);
 
-/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr). */
-int bb_path_supports_mips(const char *path);
+/* Frees the arrays and zeroes the struct; safe on a zeroed struct. */
+void bb_mesh_free(bb_mesh *m);
 
-/* Writes a mip chain (levels[0] the largest, each the halved size of the one
- * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
- * OpenEXR file, every level encoded as bb_image_write encodes an image, and
- * written to a temporary name and renamed as it does. Errors as
- * bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
-bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
-                              const bb_write_options *options, bb_error *err);
+/* 64-bit FNV-1a hash of the counts, positions, normals and indices, for
+ * provenance (the input_hash of outputs baked from a mesh). */
+uint64_t bb_mesh_hash(const bb_mesh *m);
 
-/* bb_image_write_mips up to, not including, the rename, as
- * bb_image_write_staged: commit or discard *staged. */
-bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
-                                     const bb_write_options *options,
-                                     bb_staged_file **staged, bb_error *err);
+/* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
+ * anything Assimp imports), merged as described at bb_mesh. Normals are kept
+ * when any part of the model has them (vertices of parts without are zero).
+ * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
+ * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
+ * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
+bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
 
-/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
- * reads level 0. level_count (may be NULL) receives the file's number of
- * levels; a level past the last is BB_ERR_ARGUMENT. */
-bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
-                            bb_image_info *info, int *level_count, bb_error *err);
+/* Writes m through Assimp's exporters; the format comes from the extension:
+ * .obj (without a material file), .ply (binary little-endian), .stl
+ * (binary), .glb. Normals are written when m has them. The file is written
+ * to a temporary name in the destination directory and renamed into place.
+ * Errors: BB_ERR_FORMAT (unknown extension), BB_ERR_ARGUMENT (an index out
+ * of range), BB_ERR_IO (cannot write). */
+bb_status bb_mesh_write(const char *path, const bb_mesh *m, bb_error *err);
+
+/* ---------------------------------------------------- flat render bump */
+
+/* The direction a flat sculpt's front side faces, towards the viewer of an
+ * orthographic projection. Each names a right-handed frame (right, up, out):
+ * image columns run along right, rows run down -up, and out is the height. */
+typedef enum bb_axis {
+  BB_AXIS_NEG_Y = 0, /* DOOM 3's RenderBumpFlat (and Blender's front view):
+                        right +X, up +Z, out -Y */
+  BB_AXIS_POS_Y,     /* right -X, up +Z, out +Y (Blender's back view) */
+  BB_AXIS_POS_Z,     /* right +X, up +Y, out +Z (Blender's top view) */
+  BB_AXIS_NEG_Z,     /* right +X, up -Y, out -Z (Blender's bottom view) */
+  BB_AXIS_POS_X,     /* right +Y, up +Z, out +X (Blender's right view) */
+  BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
+} bb_axis;
+
+/* Parses "-y", "+y", "+z", "-z", "+x", "-x" ("y" means "+y"). */
+bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err);
+/* "-y", "+z", ...; "unknown" for a value outside the enum. */
+const char *bb_axis_name(bb_axis a);
+/* The model-space unit vectors right, up and out of axis a. */
+void bb_axis_frame(bb_axis a, double right[3], double up[3], double out[3]);
+
+typedef struct bb_renderbump_options {
+  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
+  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
+                         a regular grid; default 4 (DOOM 3's 16x) */
+  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
+  int face_normals;   /* 1: every triangle's own plane normal, even when the
+                         mesh has vertex normals; default 0 */
+  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
+  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
+                         the image, in model units along right and up */
+  int tile;           /* 1: geometry outside the rectangle wraps around into
+                         it (the sculpt tiles with the rectangle as period) */
+  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
+                         same for any count */
+} bb_renderbump_options;
+
+void bb_renderbump_options_init(bb_renderbump_options *o);
+
+/* What a flat render bump makes. */
+typedef struct bb_renderbump_result {
+  bb_image normal;   /* 4 channels: unit N in the tangent frame (x right, y
+                        DOWN, z out) and alpha = covered fraction of the
+                        texel's samples; N = (0, 0, 1) where alpha is 0 */
+  bb_image height;   /* 1 channel: h in [0, 1], the texel's mean height of the
+                        front-most surface over its covered samples, 0 where
+                        alpha is 0 */
+  double rect[4];    /* the rectangle used: left, bottom, right, top */
+  double depth_min, depth_max; /* model units along out that h = 0 and 1 are */
+  double texel_size; /* model units per texel: sqrt(texel width * height) */
+  double texel_aspect; /* texel width / texel height (1 = square texels) */
+  double height_scale; /* texels of height per unit of h, (depth_max -
+                          depth_min) / texel_size: bb_bake's height_scale
+                          for this height; 0 when the surface is flat */
+  int used_vertex_normals; /* 1 when some texel used interpolated normals */
+  size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
+} bb_renderbump_result;
+
+/* DOOM 3's RenderBumpFlat on the CPU: projects mesh orthographically along
+ * o->axis onto the rectangle, keeps the front-most surface at each sample
+ * (no culling: the side facing the viewer is taken), and averages the
+ * samples of each texel into result (allocated; free with
+ * bb_renderbump_result_free). Bit-identical for any thread count. Errors:
+ * BB_ERR_ARGUMENT (bad options, an index out of range, a degenerate
+ * rectangle, nothing facing the viewer), BB_ERR_VALUE (a NaN or infinite
+ * coordinate), BB_ERR_SIZE (size over the maximum, or the model covering
+ * the image too many times over with tile), BB_ERR_MEMORY. */
+bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
+                             bb_renderbump_result *result, bb_error *err);
+
+void bb_renderbump_result_free(bb_renderbump_result *r);
+
+/* The "key=value" provenance lines of a render (axis, size, samples,
+ * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
+ * bb_provenance_format's lines; NULL when out of memory. */
+char *bb_renderbump_describe(const bb_renderbump_options *o,
+                             const bb_renderbump_result *r);
+
+/* =====================================================================
+ * job: the whole job on files
+ * ===================================================================== */
+
+/* ---------------------------------------------------------- provenance */
+
+/* How an output was made. Every field that affects pixels is here. */
+typedef struct bb_provenance {
+  const char *command;        /* the command line, or NULL */
+  const char *input_name;     /* input file name (no directory), or NULL */
+  uint64_t input_hash;        /* bb_image_hash of the decoded input pixels */
+  const char *output_kind;    /* "normal", "ssbump", "ao", ... */
+  const bb_bake_options *options;
+  bb_channel channel;         /* height channel rule used */
+  const char *rayset_id;      /* bb_rayset_id, or NULL when nothing was traced */
+  uint64_t input_file_hash;   /* bb_file_hash of the input file's bytes, or 0:
+                                 unknown (the key is then left out) */
+} bb_provenance;
+
+/* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
+ * input_file_hash when known, output, scale, rays, rayset, filter_radius,
+ * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
+ * channel), malloc'd; the caller
+ * frees it. A basis of the caller's vectors ("vectors:HASH") adds
+ * basis_vectors after basis: "x y z" per direction, joined by "; ".
+ * Returns NULL when out of memory. */
+char *bb_provenance_format(const bb_provenance *p);
+
+/* Writes into out (capacity cap) the keys whose values differ between two
+ * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
+ * when either text is NULL). Keys "command" and "output" are ignored. Returns
+ * the number of differing keys, or -1 when out of memory. Time is
+ * O(n log n) in the number of lines, whatever the texts hold. */
+int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
+
+/* What an image description holds, for readers of provenance. */
+typedef enum bb_provenance_class {
+  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
+  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
+  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
+                             re-wrapped (by a format or another tool), so a
+                             key-by-key diff would mislead */
+} bb_provenance_class;
+
+/* Classifies a description (NULL is NONE): bumpbake's when it has a
+ * "bumpbake_version=" line; intact when each non-empty line is key=value
+ * with a key of lower-case letters, digits and '_'. */
+bb_provenance_class bb_provenance_classify(const char *description);
+
+/* The value of key in a provenance text (its first "key=value" line) into
+ * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
+ * there, 0 when it is not or description is NULL (out is then ""). So a
+ * reader can ask which basis a map was baked with ("basis"). */
+int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
+
+/* --------------------------------------------------- up-to-date checks */
+
+/* What a build tool needs to skip a bake whose outputs are already what it
+ * would write: a hash of the input file, recorded in every output's
+ * provenance (input_file_hash), and a check of an existing output that reads
+ * only its header. */
+
+/* 64-bit FNV-1a hash of the bytes of the file at path, read in blocks (any
+ * size, constant memory), into *hash. It is what provenance records as
+ * input_file_hash, so a later run can tell an input is unchanged without
+ * decoding it. Errors: BB_ERR_IO (missing, unreadable, not a regular file),
+ * with the system's reason. */
+bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
+
+/* The rayset id bb_bake records in result->rayset_id for options o (slices
+ * from o->slices, or from o->rays; power; basis), computed without building
+ * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
+ * any id). "" when o->outputs asks for no traced kind: nothing is traced
+ * then, and provenance says rayset=none. */
+void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
+
+/* Whether an existing output is what writing it now would make. */
+typedef enum bb_output_state {
+  BB_OUTPUT_CURRENT = 0, /* made from the same input bytes, with the same
+                            parameters and bumpbake version, depth and mips */
+  BB_OUTPUT_MISSING,     /* no file at the path */
+  BB_OUTPUT_STALE        /* a file, but made otherwise, or not known to be
+                            current (no or damaged provenance, unreadable) */
+} bb_output_state;
+
+/* Decides from the header of the file at path alone (bb_image_read_info;
+ * no pixel is decoded) whether it is what writing the output described by
+ * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
+ * 1), would make now. CURRENT when its provenance is bumpbake's, intact
+ * (bb_provenance_classify), and holds every key bb_provenance_format(expected)
+ * writes with the same value, and no key that text lacks, except "command"
+ * and "input" (the command line and the input's name, which do not change a
+ * pixel) and "input_hash" (the decoded height's hash, implied by
+ * input_file_hash and channel): so the bumpbake version, the input file's
+ * bytes, the output kind and every parameter that affects pixels must
+ * match; and when its samples have the depth `depth` gives in path's format
+ * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
+ * level exactly when mip_mapped. expected->input_file_hash must be set
+ * (nonzero): without it nothing is CURRENT. A file that cannot be read is
+ * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
+ * may be NULL) receives why it is not CURRENT, one line ("no such file",
+ * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
+ * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
+ * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
+ * BB_ERR_MEMORY. */
+bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
+                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
+                          bb_error *err);
 
 #ifdef __cplusplus
 }

@@ -21,6 +21,7 @@
 #include "bumpbake.h"
 #include "cli/json.h"
 #include "trace/march.h"
+#include "trace/rayset.h"
 
 #include <errno.h>
 #include <math.h>
@@ -46,7 +47,7 @@ typedef struct args {
 typedef struct field {
   bb_image height, filtered, z;
   bb_pyramid *pyramid;
-  bb_rayset rs;
+  bb_rayset *rs;
 } field;
 
 static double now_seconds(void) {
@@ -162,7 +163,7 @@ static void field_free(field *f) {
   bb_image_free(&f->filtered);
   bb_image_free(&f->z);
   bb_pyramid_free(f->pyramid);
-  bb_rayset_free(&f->rs);
+  bb_rayset_free(f->rs);
 }
 
 /* --------------------------------------------------------- batch trace */
@@ -180,7 +181,7 @@ static double run_trace(void *ctx) {
   bb_image_free(&r->vis);
   double t0 = now_seconds();
   bb_status st =
-      bb_trace_occlusion(r->f->pyramid, &r->f->rs, &r->options, &r->vis, &r->horizons, &r->err);
+      bb_trace_occlusion(r->f->pyramid, r->f->rs, &r->options, &r->vis, &r->horizons, &r->err);
   double t = now_seconds() - t0;
   return st == BB_OK ? t : -1.0;
 }
@@ -229,7 +230,7 @@ typedef struct subset_run {
 /* Every slice's horizon at every subset texel, one call each. */
 static double run_subset(void *ctx) {
   subset_run *r = ctx;
-  const bb_rayset *rs = &r->f->rs;
+  const bb_rayset *rs = r->f->rs;
   double t0 = now_seconds();
   for (int i = 0; i < r->s->count; i++)
     for (int k = 0; k < rs->slice_count; k++)
@@ -255,7 +256,7 @@ static long region_mismatches(const field *f, const subset *s, const bb_trace_op
   for (int i = 0; i < s->count; i++) {
     one.region = (bb_region){s->x[i], s->y[i], 1, 1};
     bb_image vis = {0};
-    if (bb_trace_occlusion(f->pyramid, &f->rs, &one, &vis, NULL, NULL) != BB_OK) return -1;
+    if (bb_trace_occlusion(f->pyramid, f->rs, &one, &vis, NULL, NULL) != BB_OK) return -1;
     n += memcmp(vis.pixels, bb_image_texel(whole, s->x[i], s->y[i]),
                 (size_t)vis.channels * sizeof(float)) != 0;
     bb_image_free(&vis);
@@ -281,9 +282,9 @@ static void print_json(const args *a, const field *f, const trace_run *t, const 
   cli_json_quoted(stdout, a->map);
   printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"slices\":%d,\"threads\":%d,"
          "\"addressing\":\"%s\",\"bias\":%g,\"rayset\":",
-         f->z.width, f->z.height, a->scale, a->rays, f->rs.slice_count, a->threads,
+         f->z.width, f->z.height, a->scale, a->rays, f->rs->slice_count, a->threads,
          a->addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a->bias);
-  cli_json_quoted(stdout, f->rs.id);
+  cli_json_quoted(stdout, f->rs->id);
   printf(",\"trace_s\":%.6f,\"trace_runs\":%d,\"horizons\":%.0f,\"horizons_per_s\":%.6g,"
          "\"subset_texels\":%d,\"subset_horizons\":%ld,\"positive_fraction\":%.6g,"
          "\"march_s\":%.6f,\"march_runs\":%d,\"march_horizons_per_s\":%.6g,"
@@ -305,7 +306,7 @@ static void print_human(const field *f, const trace_run *t, const results *r) {
           "bench_trace: %dx%d, %d slices: trace %.3f s (median of %d), %.1f M horizons/s; "
           "march %.3f M/s, brute force %.3f M/s over %ld horizons; %ld disagreements, %ld "
           "region mismatches\n",
-          f->z.width, f->z.height, f->rs.slice_count, r->trace_s, r->trace_runs,
+          f->z.width, f->z.height, f->rs->slice_count, r->trace_s, r->trace_runs,
           per_second(t->horizons, r->trace_s) / 1e6,
           per_second((double)r->subset_horizons, r->march_s) / 1e6,
           per_second((double)r->subset_horizons, r->brute_s) / 1e6, r->subset_horizons,
@@ -316,7 +317,7 @@ static void print_human(const field *f, const trace_run *t, const results *r) {
 
 static int bench_subset(const args *a, const field *f, const trace_run *t, results *r) {
   subset march = {0}, brute = {0};
-  const int slices = f->rs.slice_count;
+  const int slices = f->rs->slice_count;
   int fail = subset_make(&march, a->subset, f->z.width, f->z.height, slices) ||
              subset_make(&brute, a->subset, f->z.width, f->z.height, slices);
   if (!fail) {

@@ -109,7 +109,7 @@ def _int_value(command, name, value):
 def _choice(command, name, parse, text, words):
     """Parses an enum option with the library's own parser."""
     out = _ffi.new(f"{parse[1]} *")
-    if not isinstance(text, str) or getattr(_lib, parse[0])(text.encode(), out) != 0:
+    if not isinstance(text, str) or getattr(_lib, parse[0])(text.encode(), out, _ffi.NULL) != 0:
         raise ArgumentError(f"{command}: {name} must be one of {words} (got {text!r})",
                             "bad argument")
     return out[0]

@@ -147,11 +147,11 @@ void bb_image_free(bb_image *img);
 void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
-int bb_channel_parse(const char *name, bb_channel *out);
+bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-int bb_normal_filter_parse(const char *name, bb_normal_filter *out);
+bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb_normal_filter_name(bb_normal_filter f);
 void bb_basis_init(bb_basis *b);
 bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);

@@ -32,14 +32,19 @@ void bb_bake_result_free(bb_bake_result *r) {
   memset(r, 0, sizeof *r);
 }
 
+int bb_bake_slices(const bb_bake_options *o) {
+  return o->slices ? o->slices : bb_slices_for_rays(o->rays);
+}
+
 static int wants(const bb_bake_options *o, unsigned bits) {
   return (o->outputs & bits) != 0;
 }
 
 /* The options' ranges that need a trace: they mean nothing without one. */
 static bb_status check_trace_options(const bb_bake_options *o, bb_error *err) {
-  if (!o->slices && (o->rays < 1 || o->rays > 65536))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: rays must be in 1..65536 (got %d)", o->rays);
+  if (!o->slices && (o->rays < 1 || o->rays > BB_MAX_RAYS))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: rays must be in 1..%d (got %d)", BB_MAX_RAYS,
+                    o->rays);
   if (o->slices < 0 || o->slices > BB_MAX_SLICES)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: slices must be in 1..%d (got %d)",
                     BB_MAX_SLICES, o->slices);
@@ -110,8 +115,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
   bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
   if (st == BB_OK) st = bb__pyramid_build(&z, o->smooth.addressing, threads, &pyramid, err);
   bb_image_free(&z);
-  const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
-  if (st == BB_OK) st = bb__rayset_make(slices, o->power, &o->basis, threads, &rays, err);
+  if (st == BB_OK) st = bb__rayset_make(bb_bake_slices(o), o->power, &o->basis, threads, &rays, err);
   double t1 = bb__now_seconds();
   r->seconds_pyramid = t1 - t0;
   if (st == BB_OK) {
@@ -123,7 +127,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
-  bb_rayset_free(&rays);
+  bb__rayset_release(&rays);
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
       BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);

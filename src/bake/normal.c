@@ -10,22 +10,16 @@
 #include <math.h>
 #include <string.h>
 
-int bb_normal_filter_parse(const char *name, bb_normal_filter *out) {
-  static const struct {
-    const char *name;
-    bb_normal_filter filter;
-  } names[] = {{"vertex", BB_NORMAL_VERTEX},
-               {"valve", BB_NORMAL_VALVE},
-               {"central", BB_NORMAL_CENTRAL},
-               {"sobel", BB_NORMAL_SOBEL}};
-  if (!name || !out)
-    return -1;
-  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-    if (strcmp(name, names[i].name) == 0) {
-      *out = names[i].filter;
-      return 0;
-    }
-  return -1;
+bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err) {
+  /* In the order of --help (the default first), then mapped to the enum. */
+  static const char *const names[] = {"vertex", "valve", "central", "sobel"};
+  static const bb_normal_filter filters[] = {BB_NORMAL_VERTEX, BB_NORMAL_VALVE,
+                                             BB_NORMAL_CENTRAL, BB_NORMAL_SOBEL};
+  int i;
+  bb_status st = bb__parse_name("normal filter", name, names, 4, 0, &i, err);
+  if (st == BB_OK)
+    *out = filters[i];
+  return st;
 }
 
 const char *bb_normal_filter_name(bb_normal_filter f) {

@@ -1,6 +1,6 @@
 /* output_kind.c: the maps a bake can make, described once for every client
  * (the command line's options and JSON, Python's outputs=). */
-#include "bumpbake.h"
+#include "core/internal.h"
 
 
 #include <stddef.h>
@@ -31,13 +31,15 @@ const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind) {
   return &kinds[kind].info;
 }
 
-int bb_output_kind_parse(const char *name, bb_output_kind *out) {
-  for (int k = 0; name && k < BB_OUTPUT_KIND_COUNT; k++)
-    if (strcmp(name, kinds[k].info.name) == 0) {
-      *out = (bb_output_kind)k;
-      return 0;
-    }
-  return -1;
+bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err) {
+  const char *names[BB_OUTPUT_KIND_COUNT];
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    names[k] = kinds[k].info.name;
+  int k;
+  bb_status st = bb__parse_name("map", name, names, BB_OUTPUT_KIND_COUNT, 0, &k, err);
+  if (st == BB_OK)
+    *out = (bb_output_kind)k;
+  return st;
 }
 
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind) {

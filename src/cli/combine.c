@@ -83,7 +83,7 @@ static int combine_option(void *ctx, const cli_option *opt, const char *arg) {
     a->mix_given = 1;
     return cli_parse_double(combine_command.name, "--mix", arg, 0.0, 0, 1.0, &a->mix);
   case CLI_OPT_MAP_KIND:
-    if (bb_map_kind_parse(arg, &a->kind))
+    if (bb_map_kind_parse(arg, &a->kind, NULL))
       return cli_usage_error(combine_command.name,
                              "--kind must be one of ssbump|weights|ao|normal (got '%s')",
                              arg);

@@ -425,7 +425,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_BASIS:
     return apply_basis(command, arg, &b->basis);
   case CLI_OPT_NORMAL_FILTER:
-    return bb_normal_filter_parse(arg, &b->normal_filter) ? bad_choice(command, opt, arg)
+    return bb_normal_filter_parse(arg, &b->normal_filter, NULL) ? bad_choice(command, opt, arg)
                                                           : 0;
   case CLI_OPT_NORMAL_Y:
     if (strcmp(arg, "down") && strcmp(arg, "up"))
@@ -433,7 +433,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
     b->normal_y_up = strcmp(arg, "up") == 0;
     return 0;
   case CLI_OPT_CHANNEL:
-    return bb_channel_parse(arg, &s->channel) ? bad_choice(command, opt, arg) : 0;
+    return bb_channel_parse(arg, &s->channel, NULL) ? bad_choice(command, opt, arg) : 0;
   case CLI_OPT_DEPTH:
     return parse_depth(arg, &s->depth) ? bad_choice(command, opt, arg) : 0;
   case CLI_OPT_CLAMP:

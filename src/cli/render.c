@@ -188,7 +188,7 @@ static int render_option(void *ctx, const cli_option *opt, const char *arg) {
     a->albedo_path = arg;
     return 0;
   case CLI_RENDER_OPT_ALBEDO_MODE:
-    if (bb_albedo_mode_parse(arg, &a->render.albedo_mode))
+    if (bb_albedo_mode_parse(arg, &a->render.albedo_mode, NULL))
       return cli_usage_error(cmd, "--albedo-mode must be one of %s (got '%s')",
                              opt->value_name, arg);
     return 0;
@@ -387,7 +387,10 @@ static int read_map(const char *path, int kind, int green_up, const bb_image **s
     return BB_EXIT_FAILURE;
   }
   if (map_kinds[kind].is_vector) {
-    st = bb_normals_decode(&raw, is_float, green_up, out, &err);
+    bb_normal_decode_options decode;
+    bb_normal_decode_options_init(&decode);
+    decode.normal_y_up = green_up;
+    st = bb_normal_map_decode(&raw, is_float, &decode, out, &err);
     bb_image_free(&raw);
     if (st != BB_OK)
       return cli_status_exit(path, st, &err);

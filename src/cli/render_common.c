@@ -125,7 +125,7 @@ int cli_render_apply_lighting(const char *command, bb_render_options *o, int *li
   int rc;
   switch (opt->id) {
   case CLI_RENDER_OPT_MODE:
-    if (bb_render_mode_parse(arg, &o->mode))
+    if (bb_render_mode_parse(arg, &o->mode, NULL))
       return cli_usage_error(command, "--mode must be one of %s (got '%s')",
                              opt->value_name, arg);
     return 0;

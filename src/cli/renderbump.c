@@ -109,7 +109,7 @@ static int rbf_option(void *ctx, const cli_option *opt, const char *arg) {
     a->height = arg;
     return 0;
   case OPT_AXIS:
-    if (bb_axis_parse(arg, &a->render.axis))
+    if (bb_axis_parse(arg, &a->render.axis, NULL))
       return cli_usage_error(rbf_command.name, "--axis must be one of %s (got '%s')",
                              opt->value_name, arg);
     return 0;

@@ -23,6 +23,13 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 #endif
     ;
 
+/* Finds name among names[0..count-1] (NULL entries skipped), comparing
+ * with or without case, into *index: BB_OK, or BB_ERR_ARGUMENT with "WHAT
+ * must be one of a, b, c (got 'x')". Every enum parser of the library uses
+ * it. */
+bb_status bb__parse_name(const char *what, const char *name, const char *const *names,
+                         int count, int ignore_case, int *index, bb_error *err);
+
 #define BB__PI 3.14159265358979323846
 
 /* Non-negative remainder: the periodic index of i in [0, n). */

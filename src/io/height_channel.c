@@ -1,7 +1,7 @@
 /* height_channel.c: what BB_CHANNEL_AUTO means for one image (CONVENTIONS.md
  * "Height input", with Valve's height-in-alpha convention detected): the
  * mean of the colour, unless the colour is constant and alpha is not. */
-#include "bumpbake.h"
+#include "core/internal.h"
 
 
 #include <strings.h>
@@ -13,15 +13,11 @@ static const char *const CHANNEL_NAMES[] = {
 };
 #define CHANNEL_COUNT ((int)(sizeof CHANNEL_NAMES / sizeof CHANNEL_NAMES[0]))
 
-int bb_channel_parse(const char *name, bb_channel *out) {
-  if (!name || !out) return -1;
-  for (int c = 0; c < CHANNEL_COUNT; c++) {
-    if (strcasecmp(name, CHANNEL_NAMES[c]) == 0) {
-      *out = (bb_channel)c;
-      return 0;
-    }
-  }
-  return -1;
+bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err) {
+  int i;
+  bb_status st = bb__parse_name("channel", name, CHANNEL_NAMES, CHANNEL_COUNT, 1, &i, err);
+  if (st == BB_OK) *out = (bb_channel)i;
+  return st;
 }
 
 const char *bb_channel_name(bb_channel c) {

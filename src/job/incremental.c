@@ -73,8 +73,7 @@ void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
   out[0] = '\0';
   if (!o || !(o->outputs & BB_OUTPUTS_TRACED))
     return;
-  int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
-  bb__rayset_id(slices, o->power, &o->basis, out, cap);
+  bb__rayset_id(bb_bake_slices(o), o->power, &o->basis, out, cap);
 }
 
 static const char *resolved_depth_name(int depth) {

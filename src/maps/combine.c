@@ -21,15 +21,12 @@ static const char *const KIND_NAMES[] = {
 };
 #define KIND_COUNT ((int)(sizeof KIND_NAMES / sizeof KIND_NAMES[0]))
 
-int bb_map_kind_parse(const char *name, bb_map_kind *out) {
-  if (!name || !out)
-    return -1;
-  for (int k = 0; k < KIND_COUNT; k++)
-    if (strcasecmp(name, KIND_NAMES[k]) == 0) {
-      *out = (bb_map_kind)k;
-      return 0;
-    }
-  return -1;
+bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
+  int k;
+  bb_status st = bb__parse_name("map kind", name, KIND_NAMES, KIND_COUNT, 1, &k, err);
+  if (st == BB_OK)
+    *out = (bb_map_kind)k;
+  return st;
 }
 
 const char *bb_map_kind_name(bb_map_kind kind) {

@@ -69,22 +69,20 @@ static const struct {
 
 enum { AXIS_COUNT = sizeof axes / sizeof axes[0] };
 
-int bb_axis_parse(const char *name, bb_axis *out) {
-  if (!name || !out)
-    return -1;
-  char full[3] = {'+', 0, 0};
-  if (strlen(name) == 1) /* "y" is "+y" */
-    full[1] = name[0];
-  else if (strlen(name) == 2)
-    memcpy(full, name, 2);
-  else
-    return -1;
+bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err) {
+  const char *names[AXIS_COUNT];
   for (int i = 0; i < AXIS_COUNT; i++)
-    if (strcmp(full, axes[i].name) == 0) {
-      *out = (bb_axis)i;
-      return 0;
-    }
-  return -1;
+    names[i] = axes[i].name;
+  char full[3] = {'+', 0, 0};
+  if (name && strlen(name) == 1) /* "y" is "+y" */
+    full[1] = name[0];
+  int i;
+  bb_status st = bb__parse_name("axis", full[1] ? full : name, names, AXIS_COUNT, 0, &i, NULL);
+  if (st != BB_OK) /* again for the message, naming what was given */
+    st = bb__parse_name("axis", name, names, AXIS_COUNT, 0, &i, err);
+  if (st == BB_OK)
+    *out = (bb_axis)i;
+  return st;
 }
 
 const char *bb_axis_name(bb_axis a) {

@@ -164,15 +164,15 @@ static const mode_info *find_mode(bb_render_mode mode) {
   return NULL;
 }
 
-int bb_render_mode_parse(const char *name, bb_render_mode *out) {
-  if (!name || !out)
-    return -1;
+bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err) {
+  const char *names[MODE_COUNT];
   for (int i = 0; i < MODE_COUNT; i++)
-    if (strcmp(name, modes[i].name) == 0) {
-      *out = modes[i].mode;
-      return 0;
-    }
-  return -1;
+    names[i] = modes[i].name;
+  int i;
+  bb_status st = bb__parse_name("render mode", name, names, MODE_COUNT, 0, &i, err);
+  if (st == BB_OK)
+    *out = modes[i].mode;
+  return st;
 }
 
 unsigned bb_render_mode_needs(bb_render_mode mode) {
@@ -189,15 +189,12 @@ const char *bb_render_mode_name(bb_render_mode mode) {
 
 static const char *const albedo_mode_names[] = {"multiply", "mod2x", "ssbump"};
 
-int bb_albedo_mode_parse(const char *name, bb_albedo_mode *out) {
-  if (!name || !out)
-    return -1;
-  for (int i = 0; i < 3; i++)
-    if (strcmp(name, albedo_mode_names[i]) == 0) {
-      *out = (bb_albedo_mode)i;
-      return 0;
-    }
-  return -1;
+bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err) {
+  int i;
+  bb_status st = bb__parse_name("albedo mode", name, albedo_mode_names, 3, 0, &i, err);
+  if (st == BB_OK)
+    *out = (bb_albedo_mode)i;
+  return st;
 }
 
 const char *bb_albedo_mode_name(bb_albedo_mode mode) {
@@ -596,36 +593,3 @@ char *bb_render_options_describe(const bb_render_options *o) {
   return t;
 }
 
-/* --------------------------------------------------------- normal maps */
-
-bb_status bb_normals_decode(const bb_image *img, int is_float, int green_up,
-                            bb_image *out, bb_error *err) {
-  if (!out)
-    return bb__fail(err, BB_ERR_ARGUMENT, "normals: out is NULL");
-  memset(out, 0, sizeof *out);
-  if (!img || !img->pixels)
-    return bb__fail(err, BB_ERR_ARGUMENT, "normals: missing image");
-  if (img->channels < 3)
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "normals: a normal map needs 3 channels, not %d", img->channels);
-  bb_status st = bb_image_alloc(out, img->width, img->height, 3, err);
-  if (st != BB_OK)
-    return st;
-  const size_t count = (size_t)img->width * (size_t)img->height;
-  for (size_t i = 0; i < count; i++) {
-    const float *v = img->pixels + i * (size_t)img->channels;
-    double n[3];
-    for (int k = 0; k < 3; k++)
-      n[k] = is_float ? (double)v[k] : 2.0 * (double)v[k] - 1.0;
-    if (green_up)
-      n[1] = -n[1];
-    double len = sqrt(dot3d(n, n));
-    if (!(len > 0.0) || !isfinite(len)) {
-      n[0] = n[1] = 0.0;
-      n[2] = len = 1.0;
-    }
-    for (int k = 0; k < 3; k++)
-      out->pixels[3 * i + (size_t)k] = (float)(n[k] / len);
-  }
-  return BB_OK;
-}

@@ -4,7 +4,7 @@
 #ifndef BB_TRACE_INTEGRATE_H
 #define BB_TRACE_INTEGRATE_H
 
-#include "bumpbake.h"
+#include "trace/rayset.h"
 
 #include <stddef.h>
 

@@ -28,6 +28,7 @@
  * breakpoint's slope does not depend on the path that reached it, so the
  * march, the brute-force DDA and the sweeps find bit-identical horizons.
  */
+#include "trace/testing.h"
 #include "core/internal.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"
@@ -516,7 +517,7 @@ int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray) {
   return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded(p, &r, tan_el) : 0;
 }
 
-int bb_ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray) {
+int bb__ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray) {
   bb__march_ray r;
   double tan_el;
   return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded_brute(p, &r, tan_el) : 0;
@@ -535,7 +536,7 @@ double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distanc
   return ray_horizon(p, ray, max_distance, 0);
 }
 
-double bb_ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
+double bb__ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
   return ray_horizon(p, ray, max_distance, 1);
 }
 

@@ -13,6 +13,7 @@
  * always a conservative bound for the unwrapped cells under it, which is all
  * the march needs. The last level has a single node, the global maximum.
  */
+#include "trace/testing.h"
 #include "core/internal.h"
 #include "trace/pyramid.h"
 
@@ -20,11 +21,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-int bb_pyramid_levels(const bb_pyramid *p) {
+int bb__pyramid_levels(const bb_pyramid *p) {
   return p->levels;
 }
 
-float bb_pyramid_node_max(const bb_pyramid *p, int level, int x, int y) {
+float bb__pyramid_node_max(const bb_pyramid *p, int level, int x, int y) {
   assert(level >= 0 && level < p->levels);
   assert(x >= 0 && x < p->level_width[level] && y >= 0 && y < p->level_height[level]);
   return p->level_max[level][(size_t)y * (size_t)p->level_width[level] + (size_t)x];

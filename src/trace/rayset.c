@@ -12,6 +12,7 @@
  */
 
 #include "bake/bake_internal.h"
+#include "trace/testing.h"
 #include "core/internal.h"
 #include "trace/integrate.h"
 #include "trace/rayset.h"
@@ -25,7 +26,7 @@ int bb_slices_for_rays(int rays) {
   return slices < 1 ? 1 : (slices > BB_MAX_SLICES ? BB_MAX_SLICES : (int)slices);
 }
 
-void bb_rayset_free(bb_rayset *rs) {
+void bb__rayset_release(bb_rayset *rs) {
   if (!rs) return;
   free(rs->slice_step);
   free(rs->slice_dir);
@@ -33,6 +34,23 @@ void bb_rayset_free(bb_rayset *rs) {
   free(rs->half_width);
   free(rs->table);
   memset(rs, 0, sizeof *rs);
+}
+
+void bb_rayset_free(bb_rayset *rs) {
+  bb__rayset_release(rs);
+  free(rs);
+}
+
+int bb_rayset_slice_count(const bb_rayset *rs) {
+  return rs ? rs->slice_count : 0;
+}
+
+int bb_rayset_lobe_count(const bb_rayset *rs) {
+  return rs ? rs->basis_count : 0;
+}
+
+const char *bb_rayset_id(const bb_rayset *rs) {
+  return rs ? rs->id : "";
 }
 
 static bb_status allocate(bb_rayset *rs, bb_error *err) {
@@ -44,7 +62,7 @@ static bb_status allocate(bb_rayset *rs, bb_error *err) {
   rs->table = malloc(a * BB__TABLE_INTERVALS * (size_t)rs->basis_count * 4 * sizeof(double));
   if (rs->slice_step && rs->slice_dir && rs->sector && rs->half_width && rs->table)
     return BB_OK;
-  bb_rayset_free(rs);
+  bb__rayset_release(rs);
   return bb__fail(err, BB_ERR_MEMORY, "ray set: out of memory");
 }
 
@@ -107,9 +125,21 @@ static void build_slice_table(void *user, int s) {
                         job->share + (size_t)s * (size_t)rs->basis_count);
 }
 
-bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset *out,
+bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset **out,
                          bb_error *err) {
-  return bb__rayset_make(slices, power, basis, 0, out, err);
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "ray set: out is NULL");
+  *out = NULL;
+  bb_rayset *rs = malloc(sizeof *rs);
+  if (!rs)
+    return bb__fail(err, BB_ERR_MEMORY, "ray set: out of memory");
+  bb_status st = bb__rayset_make(slices, power, basis, 0, rs, err);
+  if (st != BB_OK) {
+    free(rs);
+    return st;
+  }
+  *out = rs;
+  return BB_OK;
 }
 
 bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int threads,
@@ -139,7 +169,7 @@ bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int t
   for (int s = 0; s < slices; s++) place_slice(out, s);
   table_job job = {out, malloc((size_t)slices * (size_t)out->basis_count * sizeof(double))};
   if (!job.share) {
-    bb_rayset_free(out);
+    bb__rayset_release(out);
     return bb__fail(err, BB_ERR_MEMORY, "ray set: out of memory");
   }
   st = bb__parallel_for(slices, threads, build_slice_table, &job, NULL, NULL, err);
@@ -151,7 +181,7 @@ bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int t
   }
   free(job.share);
   if (st != BB_OK) {
-    bb_rayset_free(out);
+    bb__rayset_release(out);
     return st;
   }
   bb__rayset_id(slices, power, basis, out->id, sizeof out->id);
@@ -167,7 +197,7 @@ void bb__rayset_id(int slices, double power, const bb_basis *basis, char *out, s
   snprintf(out, cap, "%.63s", id);
 }
 
-void bb_rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked) {
+void bb__rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked) {
   const bb__slice_integral si = bb__slice_integral_of(rs, slice);
   double t = tan_horizon > 0.0 ? tan_horizon : 0.0;
   if (t > 1e100) t = 1e100; /* keeps t^2 (1 + t) (1 + t^2) finite; the tables end at q = 1 */

@@ -11,10 +11,29 @@
 #define BB__MAX_LATTICE_STEP 128
 
 
-/* bb_rayset_make with the bake's thread count (the tables are built in
- * parallel; the same bits for any count). */
+/* The ray set's layout (bumpbake.h describes what it stands for). */
+struct bb_rayset {
+  int slice_count;           /* A, 1..BB_MAX_SLICES */
+  int basis_count;           /* lobes: the basis' count, 3..BB_MAX_BASIS */
+  double power;              /* P >= 1 of the lobes */
+  double basis[BB_MAX_BASIS][3]; /* unit lobe directions B_c (the basis' vectors) */
+  int *slice_step;           /* 2 per slice: the lattice step (a, b), coprime */
+  double *slice_dir;         /* 2 per slice: unit (dx, dy) along (a, b) */
+  double *sector;            /* 2 per slice: first and last azimuth, radians */
+  double *half_width;        /* per slice: (last - first) / 2 */
+  double *table;             /* per slice, the lobes' tables (integrate.c's layout) */
+  double total[1 + BB_MAX_BASIS]; /* the whole integrals: pi for ao, then each lobe's */
+  char id[64];               /* names the scheme and its parameters, for provenance */
+};
+
+/* bb_rayset_make into a struct of the caller's (a bake keeps it on its
+ * stack), with the bake's thread count (the tables are built in parallel;
+ * the same bits for any count). Release it with bb__rayset_release. */
 bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int threads,
                           bb_rayset *out, bb_error *err);
+
+/* Frees what bb__rayset_make allocated in rs and zeroes it. */
+void bb__rayset_release(bb_rayset *rs);
 
 /* The id bb_rayset_make gives a rayset of these parameters, into out
  * (capacity cap), without building it. */

@@ -6,7 +6,7 @@
 #include "trace/march.h"
 #include "trace/pyramid.h"
 #include "trace/sweep.h"
-#include "trace/trace.h"
+#include "trace/testing.h"
 
 #include <stdlib.h>
 #include <string.h>

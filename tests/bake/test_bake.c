@@ -1,6 +1,8 @@
 /* test_bake.c: the whole bake (smooth -> normals -> trace -> derive) against
  * answers known on paper or by numerical integration of CONVENTIONS'
  * integrals, and its invariances. */
+#include "trace/rayset.h"
+#include "trace/testing.h"
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -185,7 +187,7 @@ typedef struct pit {
 static double pit_horizon(const void *ctx, double phi) {
   const pit *pt = ctx;
   const bb_ray r = {{pt->x, pt->y, 0.0}, {cos(phi), sin(phi), 0.0}};
-  return bb_ray_horizon_brute(pt->p, &r, 100.0);
+  return bb__ray_horizon_brute(pt->p, &r, 100.0);
 }
 
 Test(bake, cylindrical_pit_centre_matches_the_exact_integrals) {
@@ -388,7 +390,7 @@ Test(bake, progress_callback_cancels_a_region_trace) {
   bb_pyramid *p = NULL;
   bb_rayset rs;
   cr_assert_eq(bb_pyramid_build(&h, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
-  cr_assert_eq(bb_rayset_make(64, 1.0, NULL, &rs, NULL), BB_OK);
+  cr_assert_eq(bb__rayset_make(64, 1.0, NULL, 0, &rs, NULL), BB_OK);
   bb_trace_options t;
   bb_trace_options_init(&t);
   t.region = (bb_region){0, 0, 64, 64};
@@ -402,7 +404,7 @@ Test(bake, progress_callback_cancels_a_region_trace) {
   cr_assert(strstr(err.message, "cancelled"), "%s", err.message);
   cr_assert_null(vis.pixels);
   cr_assert_geq(stop.calls, 1);
-  bb_rayset_free(&rs);
+  bb__rayset_release(&rs);
   bb_pyramid_free(p);
   bb_image_free(&h);
 }

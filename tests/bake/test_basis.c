@@ -1,6 +1,7 @@
 /* test_basis.c: bases (named, dirs:N, a caller's vectors, basis files) and
  * what every stage that reads one makes of it: the lobes' totals, the
  * trace's channels, derive and the whole bake. */
+#include "trace/rayset.h"
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -284,7 +285,7 @@ Test(basis, each_lobes_total_is_its_closed_form) {
     for (size_t i = 0; i < sizeof slices / sizeof slices[0]; i++) {
       bb_rayset rs;
       bb_error err;
-      cr_assert_eq(bb_rayset_make(slices[i], 1.0, &bases[k], &rs, &err), BB_OK, "%s",
+      cr_assert_eq(bb__rayset_make(slices[i], 1.0, &bases[k], 0, &rs, &err), BB_OK, "%s",
                    err.message);
       cr_assert_eq(rs.basis_count, bases[k].count);
       cr_assert(strstr(rs.id, bases[k].name), "%s", rs.id);
@@ -293,7 +294,7 @@ Test(basis, each_lobes_total_is_its_closed_form) {
         cr_assert_float_eq(rs.total[1 + c], exact, 1e-9, "%s, %d slices, lobe %d: %.12f vs %.12f",
                            bases[k].name, slices[i], c, rs.total[1 + c], exact);
       }
-      bb_rayset_free(&rs);
+      bb__rayset_release(&rs);
     }
 }
 
@@ -394,7 +395,7 @@ Test(basis, more_directions_stay_deterministic_on_every_path) {
   bb_pyramid *p;
   bb_rayset rs;
   cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
-  cr_assert_eq(bb_rayset_make(12, 1.0, &d7, &rs, NULL), BB_OK);
+  cr_assert_eq(bb__rayset_make(12, 1.0, &d7, 0, &rs, NULL), BB_OK);
   bb_trace_options t;
   bb_trace_options_init(&t);
   t.region = (bb_region){5, 4, 9, 7};
@@ -406,7 +407,7 @@ Test(basis, more_directions_stay_deterministic_on_every_path) {
                        8 * sizeof(float)) == 0,
                 "texel (%d, %d)", 5 + x, 4 + y);
   bb_image_free(&region);
-  bb_rayset_free(&rs);
+  bb__rayset_release(&rs);
   bb_pyramid_free(p);
   bb_image_free(&z);
   bb_bake_result_free(&one);

@@ -31,7 +31,7 @@ static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addre
 Test(normal, filter_names_round_trip) {
   for (size_t i = 0; i < FILTER_COUNT; i++) {
     bb_normal_filter parsed = (bb_normal_filter)-1;
-    cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed),
+    cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed, NULL),
                  0);
     cr_assert_eq(parsed, all_filters[i]);
   }
@@ -40,8 +40,8 @@ Test(normal, filter_names_round_trip) {
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_CENTRAL), "central");
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_SOBEL), "sobel");
   bb_normal_filter f = BB_NORMAL_SOBEL;
-  cr_assert_neq(bb_normal_filter_parse("Valve", &f), 0);
-  cr_assert_neq(bb_normal_filter_parse("", &f), 0);
+  cr_assert_neq(bb_normal_filter_parse("Valve", &f, NULL), 0);
+  cr_assert_neq(bb_normal_filter_parse("", &f, NULL), 0);
   cr_assert_eq(f, BB_NORMAL_SOBEL, "a failed parse must not write");
 }
 

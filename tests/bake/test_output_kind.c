@@ -22,7 +22,7 @@ Test(output_kind, table_lists_every_kind_in_enum_order) {
     if (info->needs_trace)
       traced |= BB_OUTPUT_BIT(k);
     bb_output_kind parsed = BB_OUTPUT_KIND_COUNT;
-    cr_assert_eq(bb_output_kind_parse(names[k], &parsed), 0);
+    cr_assert_eq(bb_output_kind_parse(names[k], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, k);
   }
   cr_assert_eq(traced, BB_OUTPUTS_TRACED);
@@ -33,9 +33,9 @@ Test(output_kind, unknown_kinds_are_refused) {
   cr_assert_null(bb_output_kind_get(BB_OUTPUT_KIND_COUNT));
   cr_assert_null(bb_output_kind_get((bb_output_kind)-1));
   bb_output_kind k = BB_OUTPUT_AO;
-  cr_assert_eq(bb_output_kind_parse("shadow", &k), -1);
-  cr_assert_eq(bb_output_kind_parse("Normal", &k), -1);
-  cr_assert_eq(bb_output_kind_parse(NULL, &k), -1);
+  cr_assert_eq(bb_output_kind_parse("shadow", &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_output_kind_parse("Normal", &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_output_kind_parse(NULL, &k, NULL), BB_ERR_ARGUMENT);
   cr_assert_eq(k, BB_OUTPUT_AO, "untouched on failure");
 }
 

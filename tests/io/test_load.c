@@ -97,7 +97,7 @@ Test(load, parse_every_name_and_back) {
                                BB_CHANNEL_A, BB_CHANNEL_LUMA, BB_CHANNEL_MEAN};
   for (int i = 0; i < 7; i++) {
     bb_channel c = (bb_channel)99;
-    cr_assert_eq(bb_channel_parse(names[i], &c), 0, "%s", names[i]);
+    cr_assert_eq(bb_channel_parse(names[i], &c, NULL), 0, "%s", names[i]);
     cr_assert_eq(c, values[i]);
     cr_assert_str_eq(bb_channel_name(values[i]), names[i]);
   }
@@ -105,13 +105,13 @@ Test(load, parse_every_name_and_back) {
 
 Test(load, parse_ignores_case_and_rejects_others) {
   bb_channel c = BB_CHANNEL_AUTO;
-  cr_assert_eq(bb_channel_parse("LUMA", &c), 0);
+  cr_assert_eq(bb_channel_parse("LUMA", &c, NULL), 0);
   cr_assert_eq(c, BB_CHANNEL_LUMA);
   c = BB_CHANNEL_R;
-  cr_assert_neq(bb_channel_parse("alpha", &c), 0);
-  cr_assert_neq(bb_channel_parse("", &c), 0);
-  cr_assert_neq(bb_channel_parse(NULL, &c), 0);
-  cr_assert_neq(bb_channel_parse("r ", &c), 0);
+  cr_assert_neq(bb_channel_parse("alpha", &c, NULL), 0);
+  cr_assert_neq(bb_channel_parse("", &c, NULL), 0);
+  cr_assert_neq(bb_channel_parse(NULL, &c, NULL), 0);
+  cr_assert_neq(bb_channel_parse("r ", &c, NULL), 0);
   cr_assert_eq(c, BB_CHANNEL_R, "a failed parse changed the output");
   cr_assert_str_eq(bb_channel_name((bb_channel)42), "unknown");
 }

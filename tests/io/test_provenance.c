@@ -194,7 +194,7 @@ Test(provenance, channel_line_parses_back_to_the_rule) {
     char *text = bb_provenance_format(&p);
     char buf[64];
     bb_channel parsed;
-    cr_assert_eq(bb_channel_parse(value_of(text, "channel", buf, sizeof buf), &parsed), 0,
+    cr_assert_eq(bb_channel_parse(value_of(text, "channel", buf, sizeof buf), &parsed, NULL), 0,
                  "channel=%s", buf);
     cr_assert_eq((int)parsed, c);
     free(text);

@@ -45,11 +45,11 @@ static int same_bits(const bb_image *a, const bb_image *b) {
 
 Test(combine, kind_names) {
   bb_map_kind k = BB_MAP_AO;
-  cr_assert_eq(bb_map_kind_parse("normal", &k), 0);
+  cr_assert_eq(bb_map_kind_parse("normal", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_NORMAL);
-  cr_assert_eq(bb_map_kind_parse("Weights", &k), 0);
+  cr_assert_eq(bb_map_kind_parse("Weights", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_WEIGHTS);
-  cr_assert_neq(bb_map_kind_parse("height", &k), 0);
+  cr_assert_neq(bb_map_kind_parse("height", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_WEIGHTS, "a failed parse must not write");
   cr_assert_str_eq(bb_map_kind_name(BB_MAP_SSBUMP), "ssbump");
   cr_assert_eq(bb_map_kind_channels(BB_MAP_AO), 1);

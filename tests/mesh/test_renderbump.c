@@ -450,7 +450,7 @@ Test(renderbump, axis_names_and_frames) {
   static const char *const names[] = {"-y", "+y", "+z", "-z", "+x", "-x"};
   for (int a = 0; a < 6; a++) {
     bb_axis parsed;
-    cr_assert_eq(bb_axis_parse(names[a], &parsed), 0);
+    cr_assert_eq(bb_axis_parse(names[a], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, a);
     cr_assert_str_eq(bb_axis_name((bb_axis)a), names[a]);
     double r[3], u[3], o[3];
@@ -462,11 +462,11 @@ Test(renderbump, axis_names_and_frames) {
       cr_assert_eq(c[k], o[k], "%s", names[a]);
   }
   bb_axis parsed = BB_AXIS_NEG_X;
-  cr_assert_eq(bb_axis_parse("z", &parsed), 0);
+  cr_assert_eq(bb_axis_parse("z", &parsed, NULL), 0);
   cr_assert_eq(parsed, BB_AXIS_POS_Z);
-  cr_assert_neq(bb_axis_parse("up", &parsed), 0);
-  cr_assert_neq(bb_axis_parse("", &parsed), 0);
-  cr_assert_neq(bb_axis_parse("*z", &parsed), 0);
+  cr_assert_neq(bb_axis_parse("up", &parsed, NULL), 0);
+  cr_assert_neq(bb_axis_parse("", &parsed, NULL), 0);
+  cr_assert_neq(bb_axis_parse("*z", &parsed, NULL), 0);
   cr_assert_eq(parsed, BB_AXIS_POS_Z, "a failed parse must not write");
 }
 

@@ -106,11 +106,11 @@ static void options(bb_render_options *o, bb_render_mode mode, double az, double
 
 Test(render, mode_names_and_needs) {
   bb_render_mode m = BB_RENDER_NORMAL;
-  cr_assert_eq(bb_render_mode_parse("ssbump", &m), 0);
+  cr_assert_eq(bb_render_mode_parse("ssbump", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_SSBUMP);
-  cr_assert_eq(bb_render_mode_parse("ao", &m), 0);
+  cr_assert_eq(bb_render_mode_parse("ao", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_NORMAL_AO);
-  cr_assert_neq(bb_render_mode_parse("phong", &m), 0);
+  cr_assert_neq(bb_render_mode_parse("phong", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_NORMAL_AO, "a failed parse must not write");
   cr_assert_str_eq(bb_render_mode_name(BB_RENDER_NORMAL), "normal");
   cr_assert_str_eq(bb_render_mode_name((bb_render_mode)77), "unknown");
@@ -118,13 +118,13 @@ Test(render, mode_names_and_needs) {
   cr_assert_eq(bb_render_mode_needs(BB_RENDER_NORMAL_AO),
                BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_AO);
   cr_assert_eq(bb_render_mode_needs((bb_render_mode)77), 0u);
-  cr_assert_eq(bb_render_mode_parse("slope", &m), 0);
+  cr_assert_eq(bb_render_mode_parse("slope", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_SLOPE);
   cr_assert_eq(bb_render_mode_needs(BB_RENDER_SLOPE), BB_RENDER_NEEDS_SLOPE);
   bb_albedo_mode a = BB_ALBEDO_MULTIPLY;
-  cr_assert_eq(bb_albedo_mode_parse("ssbump", &a), 0);
+  cr_assert_eq(bb_albedo_mode_parse("ssbump", &a, NULL), 0);
   cr_assert_eq(a, BB_ALBEDO_SSBUMP);
-  cr_assert_neq(bb_albedo_mode_parse("mod4x", &a), 0);
+  cr_assert_neq(bb_albedo_mode_parse("mod4x", &a, NULL), 0);
   cr_assert_str_eq(bb_albedo_mode_name(BB_ALBEDO_MOD2X), "mod2x");
 }
 
@@ -525,6 +525,14 @@ Test(render, describe_names_every_option) {
 
 /* ---------------------------------------------------------- normal maps */
 
+/* Decodes as render reads a normal map: renormalised, green_up flips y. */
+static bb_status decode(const bb_image *img, int is_float, int green_up, bb_image *n) {
+  bb_normal_decode_options o;
+  bb_normal_decode_options_init(&o);
+  o.normal_y_up = green_up;
+  return bb_normal_map_decode(img, is_float, &o, n, NULL);
+}
+
 Test(render, normals_decode) {
   bb_image img, n;
   cr_assert_eq(bb_image_alloc(&img, 3, 1, 4, NULL), BB_OK);
@@ -532,7 +540,7 @@ Test(render, normals_decode) {
                        1.0f, 0.5f, 0.5f, 0.0f,  /* +x */
                        0.5f, 0.5f, 0.5f, 1.0f}; /* zero vector */
   memcpy(img.pixels, v, sizeof v);
-  cr_assert_eq(bb_normals_decode(&img, 0, 0, &n, NULL), BB_OK);
+  cr_assert_eq(decode(&img, 0, 0, &n), BB_OK);
   cr_assert_eq(n.channels, 3);
   cr_assert(n.pixels[0] == 0.0f && n.pixels[1] == 0.0f && n.pixels[2] == 1.0f);
   cr_assert(n.pixels[3] == 1.0f && n.pixels[4] == 0.0f && n.pixels[5] == 0.0f);
@@ -541,7 +549,7 @@ Test(render, normals_decode) {
   /* Float files hold N; green up flips y; lengths are renormalised. */
   const float f[12] = {0.0f, 0.6f, 0.8f, 0, 0.0f, 0.0f, 2.0f, 0, 3.0f, 0.0f, 4.0f, 0};
   memcpy(img.pixels, f, sizeof f);
-  cr_assert_eq(bb_normals_decode(&img, 1, 1, &n, NULL), BB_OK);
+  cr_assert_eq(decode(&img, 1, 1, &n), BB_OK);
   cr_assert_float_eq(n.pixels[1], -0.6f, 1e-7);
   cr_assert_float_eq(n.pixels[2], 0.8f, 1e-7);
   cr_assert_float_eq(n.pixels[5], 1.0f, 1e-7);
@@ -550,7 +558,7 @@ Test(render, normals_decode) {
   bb_image_free(&img);
   bb_image two;
   cr_assert_eq(bb_image_alloc(&two, 2, 2, 2, NULL), BB_OK);
-  cr_assert_eq(bb_normals_decode(&two, 0, 0, &n, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(decode(&two, 0, 0, &n), BB_ERR_ARGUMENT);
   bb_image_free(&two);
 }
 

@@ -1,6 +1,7 @@
 /* test_integrate.c: the sector integrals and their tables against an
  * independent quadrature (elevation inside, in closed form where it has one;
  * azimuth outside, adaptive Simpson), and the ray set's totals. */
+#include "trace/rayset.h"
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -178,7 +179,7 @@ Test(integrate, rayset_sectors_and_totals) {
     bb_error err;
     bb_basis hl2z;
     cr_assert_eq(bb_basis_parse("hl2+z", &hl2z, NULL), BB_OK);
-    cr_assert_eq(bb_rayset_make(counts[i], 1.0, &hl2z, &rs, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__rayset_make(counts[i], 1.0, &hl2z, 0, &rs, &err), BB_OK, "%s", err.message);
     double width = 0.0;
     for (int s = 0; s < rs.slice_count; s++) {
       const double lo = rs.sector[2 * s], hi = rs.sector[2 * s + 1];
@@ -195,17 +196,17 @@ Test(integrate, rayset_sectors_and_totals) {
       const double whole = reference(0.0, 2 * PI, b, 1.0, 0.0);
       cr_assert_float_eq(rs.total[1 + c], whole, 1e-9, "%d slices, lobe %d", counts[i], c);
     }
-    bb_rayset_free(&rs);
+    bb__rayset_release(&rs);
   }
 }
 
 Test(integrate, rayset_rejects_bad_arguments) {
   bb_rayset rs;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(0, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(BB_MAX_SLICES + 1, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(16, 0.5, NULL, &rs, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_rayset_make(16, NAN, NULL, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__rayset_make(0, 1.0, NULL, 0, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__rayset_make(BB_MAX_SLICES + 1, 1.0, NULL, 0, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__rayset_make(16, 0.5, NULL, 0, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__rayset_make(16, NAN, NULL, 0, &rs, &err), BB_ERR_ARGUMENT);
 }
 
 Test(integrate, slices_for_rays_follow_valves_count) {

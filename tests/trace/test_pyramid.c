@@ -1,5 +1,6 @@
 /* test_pyramid.c: every node bounds exactly the cells it covers, for odd,
  * non-square sizes and both addressing modes. */
+#include "trace/testing.h"
 #include <criterion/criterion.h>
 
 #include <float.h>
@@ -38,14 +39,14 @@ Test(pyramid, nodes_equal_max_of_covered_cells) {
       for (int i = 0; i < z.width * z.height; i++) z.pixels[i] = (float)(rand() % 1000) / 10.0f;
       bb_pyramid *p = NULL;
       cr_assert_eq(bb_pyramid_build(&z, modes[m], &p, NULL), BB_OK);
-      int levels = bb_pyramid_levels(p);
+      int levels = bb__pyramid_levels(p);
       cr_assert_eq(1 << (levels - 1) >= z.width && 1 << (levels - 1) >= z.height, 1);
       for (int k = 0; k < levels; k++) {
         int span = 1 << k;
         int lw = (z.width + span - 1) / span, lh = (z.height + span - 1) / span;
         for (int j = 0; j < lh; j++)
           for (int i = 0; i < lw; i++)
-            cr_assert_eq(bb_pyramid_node_max(p, k, i, j),
+            cr_assert_eq(bb__pyramid_node_max(p, k, i, j),
                          covered_max(&z, i * span, j * span, span, modes[m]),
                          "%dx%d mode %d level %d node (%d, %d)", z.width, z.height, m, k, i, j);
       }

@@ -1,5 +1,6 @@
 /* test_trace.c: the max-mip march against its brute-force twin, hand-made
  * rays with known answers, and the batch trace's invariances. */
+#include "trace/rayset.h"
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -11,7 +12,7 @@
 #include "trace/march.h"
 #include "trace/pyramid.h"
 #include "trace/sweep.h"
-#include "trace/trace.h"
+#include "trace/testing.h"
 
 /* xorshift64*: a small deterministic generator for the property tests. */
 static uint64_t rng_state;
@@ -80,7 +81,7 @@ Test(trace, maxmip_equals_brute_force_on_random_rays) {
           bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
           for (int i = 0; i < 1100; i++, rays++) {
             bb_ray r = random_ray(&z);
-            int fast = bb_ray_occluded(p, &r), slow = bb_ray_occluded_brute(p, &r);
+            int fast = bb_ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
             cr_assert_eq(fast, slow,
                          "%dx%d scale %g %s kind %d: origin (%.17g, %.17g, %.17g) dir (%.17g, "
                          "%.17g, %.17g): max-mip %d, brute force %d",
@@ -113,7 +114,7 @@ Test(trace, horizon_march_equals_brute_force_on_random_rays) {
         for (int i = 0; i < 400; i++, rays++) {
           bb_ray r = random_ray(&z);
           const double far = a && i % 2 ? INFINITY : reach * rnd();
-          const double fast = bb_ray_horizon(p, &r, far), slow = bb_ray_horizon_brute(p, &r, far);
+          const double fast = bb_ray_horizon(p, &r, far), slow = bb__ray_horizon_brute(p, &r, far);
           cr_assert(fast == slow, "%dx%d %s kind %d ray %d: max-mip %.17g, brute force %.17g",
                     z.width, z.height, a ? "clamp" : "periodic", kind, i, fast, slow);
           cr_assert_geq(fast, 0.0);
@@ -164,8 +165,8 @@ Test(trace, ray_just_over_and_just_under_a_peak) {
   bb_ray under = ray_to(10, 8, 0.5, 1, 0, 0.95 - 1e-6);
   cr_assert_eq(bb_ray_occluded(p, &over), 0);
   cr_assert_eq(bb_ray_occluded(p, &under), 1);
-  cr_assert_eq(bb_ray_occluded_brute(p, &over), 0);
-  cr_assert_eq(bb_ray_occluded_brute(p, &under), 1);
+  cr_assert_eq(bb__ray_occluded_brute(p, &over), 0);
+  cr_assert_eq(bb__ray_occluded_brute(p, &under), 1);
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
@@ -196,7 +197,7 @@ Test(trace, ray_wraps_several_times_before_it_is_blocked) {
    * (7, 9)) only after passing x = 9.0 -> it starts at x = 10.2, drifting
    * backwards: 10.2 - 0.0625 k enters (7, 9) at k >= 20 tiles. */
   bb_ray r = ray_to(10.2, 0.0, 1.0, -0.0625 / 16.0, 1.0, 0.05);
-  int fast = bb_ray_occluded(p, &r), slow = bb_ray_occluded_brute(p, &r);
+  int fast = bb_ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
   cr_assert_eq(fast, 1, "the spike (100 high) must block a ray that is ~17 high there");
   cr_assert_eq(slow, 1);
   /* The same ray in clamp mode never meets the spike. */
@@ -239,7 +240,7 @@ Test(trace, vertical_ray_is_never_blocked) {
 static bb_rayset rayset_of(int slices) {
   bb_rayset rs;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(slices, 1.0, NULL, &rs, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__rayset_make(slices, 1.0, NULL, 0, &rs, &err), BB_OK, "%s", err.message);
   return rs;
 }
 
@@ -252,7 +253,7 @@ static bb_image trace_field(const bb_image *z, bb_addressing a, int threads, int
   bb_image vis;
   bb_error err;
   cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_OK, "%s", err.message);
-  bb_rayset_free(&rs);
+  bb__rayset_release(&rs);
   bb_pyramid_free(p);
   return vis;
 }
@@ -315,7 +316,7 @@ Test(trace, sweeps_march_and_brute_force_find_the_same_horizons) {
         }
         free(along);
         free(opposite);
-        bb_rayset_free(&rs);
+        bb__rayset_release(&rs);
         bb_pyramid_free(p);
         bb_image_free(&z);
       }
@@ -388,7 +389,7 @@ Test(trace, rejects_negative_bias_and_a_region_outside) {
   o.region = (bb_region){2, 1, 3, 2};
   cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "region") != NULL, "%s", err.message);
-  bb_rayset_free(&rs);
+  bb__rayset_release(&rs);
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
@@ -429,7 +430,7 @@ Test(trace, sweeps_marches_and_regions_trace_the_same_bits) {
       bb_image_free(&sweeps);
       bb_image_free(&marches);
       bb_image_free(&region);
-      bb_rayset_free(&rs);
+      bb__rayset_release(&rs);
       bb_pyramid_free(p);
       bb_image_free(&z);
     }
