@@ -8,7 +8,7 @@
  * reads it, no smoothing, heights times SCALE, periodic), the horizon is
  * found in N azimuths (default 2048, spread evenly) by bb_ray_horizon, the
  * exact horizon of the triangle mesh along any direction out to D texels
- * (default 8 times the longer side), and CONVENTIONS' integrals are taken
+ * (default 8 times the longer side), and docs/conventions.md's integrals are taken
  * per azimuth in closed form (power 1): ao from cos^2 of the horizon's
  * elevation, vis_c from the lobe max(0, w.B_c) above it. ssbump uses
  * Valve's normal (bb_normals_compute, BB_NORMAL_VALVE). This shares with the

@@ -53,7 +53,7 @@ def test_normals_of_a_bump_lean_away_from_its_top():
     assert n[c + 3, c, 1] > 0.3 and n[c - 3, c, 1] < -0.3  # y is down: lower flank leans +y
     np.testing.assert_allclose(np.linalg.norm(n, axis=2), 1.0, atol=1e-5)
     # The default estimator is centred on the vertex: the top comes out
-    # level. Valve's is centred half a texel off it (CONVENTIONS.md).
+    # level. Valve's is centred half a texel off it (docs/conventions.md).
     np.testing.assert_array_equal(n[c, c], [0, 0, 1])
     valve = bumpbake.normal(h, scale=8, normal_filter="valve")
     assert valve[c, c, 0] > 0.1 and valve[c, c, 1] > 0.1

@@ -18,7 +18,7 @@
  * generous comments, and a bound on what a wrong path can make it read. */
 #define BASIS_FILE_MAX_BYTES (64 * 1024)
 
-/* CONVENTIONS "Half-Life 2 basis", +Y down; index 3 is hl2+z's (0, 0, 1).
+/* docs/conventions.md "Bases", +Y down; index 3 is hl2+z's (0, 0, 1).
  * cos(elevation) = sqrt(2/3) and sin(elevation) = 1/sqrt(3) are written the
  * same way in dirs_vector, so shared directions have the same bits. */
 void bb_basis_vector(int index, double v[3]) {

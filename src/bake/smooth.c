@@ -1,4 +1,4 @@
-/* smooth.c: Valve's tileable bilateral filter of a height field (CONVENTIONS
+/* smooth.c: Valve's tileable bilateral filter of a height field (docs/conventions.md
  * "Smoothing").
  *
  * Invariant: every output texel is the sum over the same cut kernel, taken in

@@ -1,4 +1,4 @@
-/* height_channel.c: what BB_CHANNEL_AUTO means for one image (CONVENTIONS.md
+/* height_channel.c: what BB_CHANNEL_AUTO means for one image (docs/conventions.md
  * "Height input", with Valve's height-in-alpha convention detected): the
  * mean of the colour, unless the colour is constant and alpha is not. */
 #include "core/internal.h"

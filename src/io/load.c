@@ -1,4 +1,4 @@
-/* load.c: the height channel rule (CONVENTIONS.md "Height input"): which channel becomes h. */
+/* load.c: the height channel rule (docs/conventions.md "Height input"): which channel becomes h. */
 
 #include "bake/bake_internal.h"
 #include "core/internal.h"

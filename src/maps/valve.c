@@ -1,4 +1,4 @@
-/* valve.c: the RGBA files of Valve's height2ssbump (CONVENTIONS.md "Valve
+/* valve.c: the RGBA files of Valve's height2ssbump (docs/conventions.md "Valve
  * compatibility"): RGB = ssbump or the encoded normal map, A = the filtered
  * height or ao, and the detail variant's colour factor. */
 

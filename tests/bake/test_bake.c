@@ -1,5 +1,5 @@
 /* test_bake.c: the whole bake (smooth -> normals -> trace -> derive) against
- * answers known on paper or by numerical integration of CONVENTIONS'
+ * answers known on paper or by numerical integration of docs/conventions.md's
  * integrals, and its invariances. */
 #include "trace/rayset.h"
 #include "trace/testing.h"
@@ -50,7 +50,7 @@ Test(bake, flat_map_is_neutral_everywhere) {
   bb_image_free(&h);
 }
 
-/* ---- known answers: CONVENTIONS' integrals for a horizon t(phi) ---------
+/* ---- known answers: docs/conventions.md's integrals for a horizon t(phi) ---------
 
  * With the horizon's tangent t(phi) known in every azimuth, ao and vis_c
  * are integrals over phi of closed forms in elevation: for ao,

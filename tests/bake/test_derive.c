@@ -27,7 +27,7 @@ static double dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* The vectors of CONVENTIONS, unit length, the first three 120 degrees apart
+/* The vectors of docs/conventions.md, unit length, the first three 120 degrees apart
  * around z at the same elevation, and oriented in the +Y-down frame. */
 Test(derive, basis_vectors) {
   double b[4][3];

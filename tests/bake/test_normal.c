@@ -241,7 +241,7 @@ Test(normal, periodic_shift_is_exact) {
   bb_image_free(&shifted);
 }
 
-/* The estimators as direct per-texel sums (the form of CONVENTIONS), kept here
+/* The estimators as direct per-texel sums (the form of docs/conventions.md), kept here
  * to check the library's per-cell form bit for bit. */
 static double ref_z(const bb_image *h, double scale, int x, int y, bb_addressing a) {
   int ax, ay;

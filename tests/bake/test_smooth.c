@@ -34,7 +34,7 @@ static int address(int i, int n, bb_addressing a) {
   return i < 0 ? 0 : (i >= n ? n - 1 : i);
 }
 
-/* CONVENTIONS "Smoothing" summed directly over the uncut (2R+1)^2 window. */
+/* docs/conventions.md "Smoothing" summed directly over the uncut (2R+1)^2 window. */
 static double brute_force(const bb_image *in, const bb_image *guide, int x, int y, int c,
                           int radius, double threshold, bb_addressing a) {
   double centre = bb_image_texel(guide, x, y)[0];
