@@ -6,6 +6,7 @@
 //
 // Alpha is never premultiplied or divided out: bumpbake's channels are data
 // (heights, ssbump, ao), so both directions ask for unassociated alpha.
+#include "core/input_file.h"
 #include "core/internal.h"
 #include "io/oiio.h"
 #include "io/provenance.h"
@@ -114,20 +115,10 @@ void clear_info(bb_image_info *info) {
 
 // Distinguishes "missing" and "unreadable" from "not an image" before OIIO
 // sees the file, since OIIO reports all three as a failed open.
-bb_status check_readable(const char *path, bb_error *err) {
-  struct stat st;
-  if (stat(path, &st) != 0) {
-    if (errno == ENOENT || errno == ENOTDIR)
-      return bb__fail(err, BB_ERR_IO, "%s: no such file", path);
-    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(errno));
-  }
-  if (S_ISDIR(st.st_mode)) return bb__fail(err, BB_ERR_IO, "%s: is a directory", path);
-  int fd = open(path, O_RDONLY);
-  if (fd < 0)
-    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(errno));
-  close(fd);
-  return BB_OK;
-}
+// Missing files, directories, FIFOs and devices are refused before
+// OpenImageIO opens the name (it would block on a FIFO and spin on
+// /dev/zero).
+bb_status check_readable(const char *path, bb_error *err) { return bb__input_check(path, err); }
 
 constexpr long MiB = 1L << 20;
 
