@@ -57,7 +57,7 @@ static void check_round_trip(const char *a, const char *b) {
   o1.height_scale = 2.0f;
   o2 = o1;
   o2.height_scale = 3.0f;
-  bb_provenance p = {a, b, 0x1234, a, &o1, BB_CHANNEL_AUTO, b, 0x5678};
+  bb_provenance p = {a, b, 0x1234, a, &o1, BB_CHANNEL_AUTO, b, 0x5678, NULL};
   char *t1 = bb_provenance_format(&p);
   p.options = &o2;
   char *t2 = bb_provenance_format(&p);

@@ -282,7 +282,7 @@ bb_status bb_file_write(const char *path, const void *data, size_t size, bb_erro
  * (staged files included). Async-signal-safe: call it from a SIGINT or
  * SIGTERM handler, then re-raise the signal with the default action, and an
  * interrupted run leaves no temporary behind. Only files whose names this
- * library created are removed. At most 64 temporaries are tracked at once;
+ * library created are removed. At most 4096 temporaries are tracked at once;
  * further ones are still removed on errors, but not by this function. */
 void bb_tempfiles_remove(void);
 
@@ -327,30 +327,34 @@ bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, i
 
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
-  BB_CHANNEL_AUTO = 0, /* 1 ch: it; grey+alpha: grey; 3+ ch: mean of R, G, B;
-                          but alpha when the colour is constant and alpha
-                          varies (see bb_height_channel) */
+  BB_CHANNEL_AUTO = 0, /* the grey, or the mean of R, G, B; alpha where the
+                          image shows Valve's convention (bb_height_channel) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
   BB_CHANNEL_A,
   BB_CHANNEL_LUMA,     /* Rec. 709: 0.2126 R + 0.7152 G + 0.0722 B */
-  BB_CHANNEL_MEAN      /* (R + G + B) / 3, computed in double */
+  BB_CHANNEL_MEAN,     /* (R + G + B) / 3, computed in double */
+  BB_CHANNEL_VALVE     /* Valve's height2ssbump: alpha when the image has
+                          one, else the grey or the mean of R, G, B */
 } bb_channel;
 
-/* Parses "r", "g", "b", "a", "luma", "mean", "auto" (any case). */
+/* Parses "r", "g", "b", "a", "luma", "mean", "auto", "valve" (any case). */
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 /* The name bb_channel_parse accepts; "unknown" for other values. */
 const char *bb_channel_name(bb_channel c);
 
 /* The channel the rule takes from img when asked for `channel`: channel
- * itself, except BB_CHANNEL_AUTO, which gives BB_CHANNEL_A when img has an
- * alpha channel (alpha_channel, or the last of 2 or 4 channels), its colour
- * channels (grey, or R, G and B) are each the same at every texel and alpha
- * is not: Valve's convention, the height in alpha, which the mean of a
- * constant colour would bake flat. Otherwise AUTO gives BB_CHANNEL_MEAN
- * (for a grey image, the grey). A caller can say which was used; reads img
- * once at most (it stops at the first texel whose colour differs). */
+ * itself, except for two rules. BB_CHANNEL_AUTO reads img once and gives
+ * BB_CHANNEL_A when img has an alpha channel (alpha_channel, or the last of
+ * 2 or 4 channels) that varies while the colour (grey, or R, G and B) is the
+ * same at every texel, or when the colour is a colour (R, G and B not all
+ * equal) and alpha takes three values or more (a height, not a cutout
+ * mask): Valve's convention, the height in alpha. Otherwise it gives
+ * BB_CHANNEL_MEAN (for a grey image, the grey). BB_CHANNEL_VALVE gives
+ * BB_CHANNEL_A whenever there is an alpha channel, else BB_CHANNEL_MEAN for
+ * colour and BB_CHANNEL_AUTO (the grey) for grey. bb_height_file_read says
+ * which was taken whenever the image left a choice. */
 bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 
 /* Extracts a 1-channel height field from a decoded image by the channel rule.
@@ -488,6 +492,24 @@ bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out
  * Errors: BB_ERR_IO (missing, unreadable, a directory), BB_ERR_SIZE (over
  * 64 KiB), and those of bb_basis_read_text, each naming path. */
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
+
+/* Readers of basis maps (render, ssbump2normal, combine --detail) take
+ * channels 0..2 as Half-Life 2's B0, B1, B2. BB_OK when a map file (its
+ * decoded img and its description, the provenance text, may be NULL) can
+ * be one: at most 4 channels, and a provenance basis, if any, that is
+ * Half-Life 2's (hl2, hl2+z, dirs:3: bb_basis_is_hl2); else
+ * BB_ERR_ARGUMENT saying which ("baked with --basis dirs:6; this reads
+ * Half-Life 2's basis (bake with --basis hl2)"). */
+bb_status bb_basis_map_check(const bb_image *img, const char *description, bb_error *err);
+
+/* A basis as the command line names it: "hl2", "hl2+z" or "dirs:N" (a name
+ * wins over a file of the same name, which ./NAME reaches), else the path
+ * of a basis file (bb_basis_load). BB_ERR_ARGUMENT for a word that is
+ * neither ("basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of
+ * directions (got 'x': No such file or directory)") or a dirs:N out of
+ * range; a file's own errors otherwise. *from_file (may be NULL) receives 1
+ * when spec named a file. out is untouched on failure. */
+bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
 
 /* 1 when b holds Half-Life 2's B0, B1, B2 in channels 0..2 bit for bit
  * ("hl2", "dirs:3", and "hl2+z", whose B3 is a fourth channel), which the
@@ -1138,6 +1160,54 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 
+/* ------------------------------------------------------ rendering files */
+
+/* The maps a render can read from files instead of baking a height. */
+typedef enum bb_render_map {
+  BB_RENDER_MAP_NORMAL = 0, /* a normal map, >= 3 channels, decoded to unit N */
+  BB_RENDER_MAP_SSBUMP,     /* >= 3 channels, Half-Life 2's basis */
+  BB_RENDER_MAP_AO,         /* channel 0 */
+  BB_RENDER_MAP_BENT,       /* a bent normal, decoded as a normal map */
+  BB_RENDER_MAP_SLOPE,      /* flipcode's slope bytes / 255 in channel 0 */
+  BB_RENDER_MAP_COUNT       /* number of kinds, not a kind */
+} bb_render_map;
+
+/* "normal", "ssbump", "ao", "bent", "slope" (the command line's options and
+ * provenance's map_KIND keys); "unknown" for other values. */
+const char *bb_render_map_name(bb_render_map kind);
+
+/* Reads a map file for a render and checks it for its kind: channels
+ * enough, Half-Life 2's basis for an ssbump (bb_basis_map_check), and the
+ * size of like when like is not NULL; normal and bent maps are decoded to
+ * unit N (bb_normal_map_decode; normal_y_up 1: OpenGL-style files).
+ * *hash (may be NULL) receives bb_image_hash of what the file decoded to.
+ * Errors name the file: those of bb_image_read, BB_ERR_ARGUMENT for a map
+ * that is not what its kind needs. */
+bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_up,
+                             const bb_image *like, bb_image *out, uint64_t *hash,
+                             bb_error *err);
+
+/* What a render lit, for its provenance. */
+typedef struct bb_render_sources {
+  const char *height;   /* the height file baked for it, or NULL: maps read */
+  const char *maps[BB_RENDER_MAP_COUNT]; /* the map files read, NULL when not */
+  int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
+  const char *albedo;   /* the albedo file, or NULL */
+  uint64_t albedo_hash; /* bb_image_hash of the albedo read */
+  int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
+} bb_render_sources;
+
+/* The "key=value" lines a render adds to bb_provenance_format's (as its
+ * extra): render_from (height or maps), map_normal_y, map_KIND (file
+ * names), albedo and albedo_hash, then bb_render_options_describe's, then
+ * frame=F/N for an orbit's frame. malloc'd; NULL when out of memory. */
+char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o);
+
+/* The file of frame `frame` of an orbit of `frames` written to output:
+ * OUT_007.png for OUT.png (four digits past 1000 frames). malloc'd; NULL
+ * when out of memory. */
+char *bb_render_frame_path(const char *output, int frame, int frames);
+
 /* ---------------------------------------------------- image operations */
 
 /* Repeats in nx x ny times (nx, ny >= 1) into out. */
@@ -1363,6 +1433,19 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
 
 void bb_renderbump_result_free(bb_renderbump_result *r);
 
+/* Writes a flat render bump's files together or neither (bb_outputs_write):
+ * the normal map at normal_path (RGB = N as bumpbake stores normal maps:
+ * 0.5 + 0.5 N in integer files, N in float ones; alpha = the coverage as it
+ * is; green flipped for normal_y_up) and, when height_path is not NULL,
+ * the height (16-bit where the format holds it). Each records provenance:
+ * command, the model's file name and bb_mesh_hash (model_hash), its kind
+ * ("normal+coverage", "height"), bb_renderbump_describe's keys and
+ * normal_y. Errors as bb_outputs_write's. */
+bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
+                              int normal_y_up, const char *model, uint64_t model_hash,
+                              const char *command, const char *normal_path,
+                              const char *height_path, bb_error *err);
+
 /* The "key=value" provenance lines of a render (axis, size, samples,
  * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
  * bb_provenance_format's lines; NULL when out of memory. */
@@ -1386,6 +1469,8 @@ typedef struct bb_provenance {
   const char *rayset_id;      /* bb_rayset_id, or NULL when nothing was traced */
   uint64_t input_file_hash;   /* bb_file_hash of the input file's bytes, or 0:
                                  unknown (the key is then left out) */
+  const char *extra;          /* "key=value" lines appended as they are (a
+                                 render's or a render bump's own keys), or NULL */
 } bb_provenance;
 
 /* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
@@ -1423,6 +1508,329 @@ bb_provenance_class bb_provenance_classify(const char *description);
  * there, 0 when it is not or description is NULL (out is then ""). So a
  * reader can ask which basis a map was baked with ("basis"). */
 int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
+
+/* ------------------------------------------------------------------ notes */
+
+/* A remark about an input that is not an error: which channel became the
+ * height, a lossy or shallow input. path names the file (may be NULL);
+ * text is one line without it. Called on the thread that reads the file. */
+typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
+
+/* ----------------------------------------------------------- output paths */
+
+/* One file a command will write, as checked before any work is done. */
+typedef struct bb_output_spec {
+  const char *path;
+  const char *kind;  /* what it holds, in messages: "normal", "render", "depfile" */
+  int channels;      /* the image's channels; 0: not known yet, not checked */
+  bb_depth depth;    /* as asked; BB_DEPTH_DEFAULT: the format's */
+  int mips;          /* 1: a mip-mapped file */
+  int text;          /* 1: a text file (a depfile): no image format rules */
+} bb_output_spec;
+
+/* Checks every output before any work, so a bad name costs no baking time:
+ * BB_ERR_ARGUMENT (usage: an extension bb_image_write does not know, a
+ * depth, mip chain or channel count the format cannot hold, two outputs on
+ * one file under any spelling: "KIND and KIND would both be written to
+ * PATH"); BB_ERR_IO (an output that is one of the reads[0..read_count-1]
+ * under any spelling, hard or symbolic link: "PATH: output would overwrite
+ * the input file"; a directory that does not exist or is not one; an
+ * output that is a directory). Messages start with the path. */
+bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
+                           const char *const *reads, int read_count, bb_error *err);
+
+/* 1 when a and b name the same file: the same device and inode when both
+ * exist (symbolic and hard links, "./", ".."), else the same name in the
+ * same directory (by the directory's device and inode), else the same
+ * spelling. */
+int bb_same_file(const char *a, const char *b);
+
+/* path without the extension of its last component, plus suffix ("rock.png",
+ * "-ssbump.tga" -> "rock-ssbump.tga"), malloc'd; NULL when out of memory. */
+char *bb_path_with_suffix(const char *path, const char *suffix);
+
+/* Creates directory path and its missing parents (mode 0777 less the
+ * umask), as mkdir -p. An existing directory is fine. Errors: BB_ERR_IO
+ * ("PATH: cannot create directory: REASON"; a part that is a file). */
+bb_status bb_directory_create(const char *path, bb_error *err);
+
+/* ------------------------------------------------------- writing outputs */
+
+/* One file of a set written all or nothing: an image (with its provenance)
+ * or, with image NULL, text bytes (a depfile). */
+typedef struct bb_output_file {
+  const char *path;
+  const char *kind;          /* for messages: "normal", "ssbump+height" ... */
+  const bb_image *image;     /* the pixels, or NULL for text */
+  bb_range range;            /* how image's values map to codes */
+  bb_depth depth;            /* BB_DEPTH_DEFAULT: the format's */
+  int mips;                  /* 1: the mip chain (bb_mip_chain: renormalised
+                                for BB_RANGE_SIGNED, averaged otherwise) */
+  const char *description;   /* provenance text stored in the file, or NULL */
+  const void *text;          /* the bytes of a text file (image NULL) */
+  size_t text_size;
+} bb_output_file;
+
+/* Writes count files all or nothing: each is encoded and synced under a
+ * temporary name in its directory (up to `threads` at once, 0 = one per
+ * file), and only when every one succeeded are they renamed into place, in
+ * order, with the process's ending by a signal deferred until the last
+ * rename (bb_signal_cleanup): an interrupted or failed write leaves every
+ * destination as it was, or, should a rename itself fail (the destination
+ * became a directory), says which were replaced. Errors (BB_ERR_IO,
+ * BB_ERR_FORMAT, BB_ERR_MEMORY) read "PATH: reason; no output was written"
+ * for sets of more than one, or "...; already written: KIND PATH, ...". */
+bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
+
+/* Renames count staged files (bb_image_write_staged, ...) into place in
+ * order, as bb_outputs_write does with its set: the process's ending by a
+ * signal waits for the last rename (bb_signal_cleanup). Every handle is
+ * freed, committed or discarded: when a rename fails, the files after it
+ * are discarded and the message says which were already replaced ("PATH:
+ * reason; already written: KIND PATH, ..." with kinds[i], which may be
+ * NULL). For sets too large to hold in memory at once, such as an
+ * orbit's frames: stage each, then commit them together. */
+bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
+                                 bb_error *err);
+
+/* For a SIGINT, SIGTERM or SIGHUP handler (async-signal-safe): removes the
+ * temporaries of the writes in flight and ends the process by signal_number
+ * with its default action; but while bb_outputs_write is renaming a set
+ * into place, on any thread, the ending waits until the set is complete, so
+ * a signal leaves all of a set old or all new. The handler should be
+ * installed without SA_RESETHAND: this resets the action itself. */
+void bb_signal_cleanup(int signal_number);
+
+/* ----------------------------------------------------------- height files */
+
+/* What bb_height_file_read found out about a height file. */
+typedef struct bb_height_source {
+  bb_channel channel;     /* the channel rule's choice (never AUTO or VALVE) */
+  int grey;               /* 1: one colour channel (grey, or grey + alpha) */
+  int channels;           /* channels of the file */
+  int bits_per_sample;    /* of the file: 8, 16, 32 */
+  int is_float;           /* 1: float or half samples */
+  char format_name[32];   /* OpenImageIO's: "png", "openexr", ... */
+  uint64_t file_hash;     /* bb_file_hash of the bytes that were decoded */
+  uint64_t height_hash;   /* bb_image_hash of the height */
+} bb_height_source;
+
+/* Reads the height of the file at path by the channel rule (bb_channel,
+ * bb_height_channel): the file's bytes are hashed first, then decoded, so
+ * provenance never pairs a newer file's hash with older pixels. note (may
+ * be NULL) hears which channel the rule took when it was not the obvious
+ * one, and warnings about the input (lossy JPEG blocks, 8-bit codes that
+ * terrace at the scale asked). height_scale (0: not known) is the bake's,
+ * for the terracing note. source may be NULL. Errors as bb_image_read and
+ * bb_height_from_image, each naming path. */
+bb_status bb_height_file_read(const char *path, bb_channel channel, float height_scale,
+                              bb_note_fn note, void *note_user, bb_image *height,
+                              bb_height_source *source, bb_error *err);
+
+/* The name of the channel a height came from: "grey" for a grey image
+ * (whose mean is its grey), else bb_channel_name's. */
+const char *bb_height_source_channel(const bb_height_source *source);
+
+/* The depth nearest an input's (bits_per_sample, is_float) that path's
+ * format holds, for outputs that are the height itself: 16 bits for a
+ * 16-bit input, float or half for a float or half input; BB_DEPTH_DEFAULT
+ * for an 8-bit input or when the format holds nothing deeper (TGA). */
+bb_depth bb_depth_like_input(int bits_per_sample, int is_float, const char *path);
+
+/* --------------------------------------------------------- comparing files */
+
+/* What comparing two image files found (bb_compare_files). */
+typedef struct bb_compare_report {
+  int same_shape;             /* 0: sizes or channel counts differ; nothing
+                                 else was compared (idiff's exit 3) */
+  int width, height, channels;       /* of A */
+  int b_width, b_height, b_channels; /* of B */
+  bb_compare_stats stats;     /* per pixel, as bb_compare_images */
+  bb_compare_verdict verdict; /* idiff's rule (bb_compare_judge); FAIL when
+                                 the shapes differ */
+  bb_provenance_class provenance_a, provenance_b;
+  int provenance_differences; /* keys that differ, or -1 when not compared
+                                 (either side not intact provenance) */
+  char *provenance_diff;      /* "key: A-value -> B-value" lines
+                                 (bb_provenance_diff), malloc'd, or NULL */
+  int diff_written;           /* 1 when diff_path was written */
+  bb_error diff_error;        /* why it was not, when asked */
+} bb_compare_report;
+
+/* Compares the image files a and b channel by channel under limits (NULL:
+ * idiff's defaults), as OpenImageIO's idiff does, and their provenance key
+ * by key. With diff_path (may be NULL; check it first with
+ * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
+ * the largest finite difference is white (NaN and infinite ones clip to
+ * 1). A diff that cannot be written does not change the verdict: the
+ * report says so. Errors: those of bb_image_read for either file (the
+ * message names it), BB_ERR_MEMORY. Free the report with
+ * bb_compare_report_free. */
+bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
+                           const char *diff_path, bb_compare_report *report, bb_error *err);
+
+void bb_compare_report_free(bb_compare_report *report);
+
+/* -------------------------------------------------------------- bake jobs */
+
+/* What `bumpbake bake` does, as one plan and its run: inputs (height files,
+ * or directories of them), the maps to write and where, checked before any
+ * bake; inputs whose outputs are up to date skipped; each input baked once
+ * (every traced map from one trace) and its maps written all or nothing
+ * with provenance; a Make/Ninja depfile. A batch names its outputs from
+ * out_dir and a template; a single input may name each output instead. */
+
+/* Most files one input's bake writes: the maps, the slope map and its lit
+ * preview. */
+#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 2)
+/* A batch's file names: the input's stem, the map's name, the input's
+ * extension ("{{" and "}}" are braces). */
+#define BB_JOB_DEFAULT_NAME "{stem}_{kind}.png"
+/* The maps a batch writes unless told: Valve's trio. */
+#define BB_JOB_DEFAULT_MAPS \
+  (BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_AO))
+
+typedef struct bb_job_options {
+  bb_bake_options bake;      /* every bake parameter; .outputs is set from
+                                the maps asked */
+  bb_channel channel;        /* the height channel rule (default AUTO) */
+  bb_depth depth;            /* every map's depth; BB_DEPTH_DEFAULT: the
+                                format's, and the filtered height keeps the
+                                input's (bb_depth_like_input) */
+  int mips;                  /* 1: mip-mapped files (.tif, .tiff, .exr) */
+  const char *basis_file;    /* the file bake.basis came from, or NULL: a
+                                prerequisite in the depfile */
+  /* One input, outputs named one by one (out_dir NULL): */
+  const char *paths[BB_OUTPUT_KIND_COUNT]; /* by bb_output_kind; NULL = not written */
+  const char *prefix;        /* also PREFIX_KIND.png for each of
+                                BB_JOB_DEFAULT_MAPS not named in paths, or NULL */
+  const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
+  int slope_lit;             /* 1: also slope_path with "_lit" before its
+                                extension, the map lit through its table */
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction */
+  /* A batch (out_dir set): */
+  const char *out_dir;       /* outputs go to out_dir/name; created when missing */
+  const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"
+                                makes subfolders, created as needed; a name
+                                must stay inside out_dir */
+  unsigned maps;             /* BB_OUTPUT_BIT(kind)s; 0: BB_JOB_DEFAULT_MAPS */
+  int force;                 /* 1: bake inputs whose outputs are up to date too */
+  int keep_going;            /* 1: go on after an input fails (bb_job_run) */
+  const char *depfile;       /* a Make/Ninja depfile to write, or NULL */
+  /* Provenance: the "command" key. */
+  const char *command;       /* one input: the whole command line as typed */
+  const char *command_options; /* a batch: what follows "bumpbake bake INPUT"
+                                in each output's command; NULL for both: the
+                                options written out by bb_job_command_text */
+  bb_note_fn note;           /* notes about inputs (may be NULL) */
+  void *note_user;
+} bb_job_options;
+
+/* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
+ * no outputs. */
+void bb_job_options_init(bb_job_options *o);
+
+/* A planned job: opaque. */
+typedef struct bb_job bb_job;
+
+/* What became of one input. */
+typedef enum bb_job_outcome {
+  BB_JOB_PENDING = 0, /* planned, not run yet */
+  BB_JOB_BAKED,       /* baked and written */
+  BB_JOB_CURRENT,     /* skipped: every output was up to date */
+  BB_JOB_FAILED,      /* see status and error; nothing of it was written */
+  BB_JOB_NOT_RUN      /* not run: an earlier input failed (keep_going 0) */
+} bb_job_outcome;
+
+/* One file of a report: its kind ("normal", ..., "slope", "slope_lit") and path. */
+typedef struct bb_job_file {
+  const char *kind;
+  const char *path;
+} bb_job_file;
+
+/* One input's part of a job: what it will write, and once run, what
+ * happened. Owned by the job. */
+typedef struct bb_job_report {
+  const char *input;          /* the path as planned (a directory's file: DIR/NAME) */
+  int output_count;
+  bb_job_file outputs[BB_JOB_MAX_OUTPUTS]; /* in bb_output_kind order, then slope */
+  bb_job_outcome outcome;
+  bb_status status;           /* BB_OK unless FAILED */
+  bb_error error;             /* why it FAILED ("PATH: reason") */
+  char reason[256];           /* why an output is not current ("scale: 8 -> 16",
+                                 "no such file"), or "" */
+  /* Once baked: */
+  int width, height;
+  bb_height_source source;    /* the channel used, the input's depth, its hashes */
+  int threads;                /* threads the stages ran on */
+  int slices;                 /* azimuth slices traced, 0 when nothing was */
+  char rayset_id[64];         /* "" when nothing was traced */
+  double horizons;            /* texels x slices */
+  double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
+      seconds_derive, seconds_write;
+} bb_job_report;
+
+/* Plans a job over inputs[0..input_count-1]: files, and directories, which
+ * give the image files in them (not below), sorted by name, leaving out
+ * names starting with '.' and files whose provenance says bumpbake baked
+ * them as maps (so a directory can be its own out_dir); a file named twice
+ * counts once. Every option and every output path is checked here, before
+ * any bake (bb_outputs_check for each input's outputs against every input;
+ * clashes across the whole batch; the depfile against every input and
+ * output); out_dir and the template's subfolders are created. Errors:
+ * BB_ERR_ARGUMENT (a usage error: bad option, template or map name, a
+ * clash, no output), BB_ERR_IO (an output over an input, a directory that
+ * cannot be made or read), BB_ERR_MEMORY. On success *out receives the
+ * job; free it with bb_job_free. */
+bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                      bb_job **out, bb_error *err);
+
+void bb_job_free(bb_job *job);
+
+/* Inputs in the plan, and input i's report (0 <= i < count). */
+int bb_job_count(const bb_job *job);
+const bb_job_report *bb_job_report_get(const bb_job *job, int i);
+
+/* Whether every output of input i is what baking it now would write
+ * (bb_output_check of each, from the files' headers; no pixel is decoded):
+ * *current is 1 or 0, and the report's reason says why not. The input's
+ * bytes are hashed. Errors: BB_ERR_IO (the input cannot be read). */
+bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
+
+/* Runs input i: skips it (BB_JOB_CURRENT) when its outputs are up to date
+ * and the job is not forced, else reads, bakes and writes its maps all or
+ * nothing (BB_JOB_BAKED), filling its report. progress (may be NULL)
+ * follows the bake and may cancel it. Returns the report's status; a
+ * failure is the input's alone (the job goes on). Thread-compatible: one
+ * job, one thread at a time. */
+bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
+
+/* Called after each input of bb_job_run with its report. */
+typedef void (*bb_job_report_fn)(void *user, const bb_job_report *report);
+
+/* Runs every input in order (stopping at the first failure unless
+ * keep_going: the rest are BB_JOB_NOT_RUN), calling each after each, then
+ * writes the depfile (a rule per input baked or up to date). Returns BB_OK
+ * when no input failed and the depfile was written, else the first
+ * failure's status with err naming it. */
+bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
+                     bb_job_report_fn each, void *user, bb_error *err);
+
+/* The depfile of the inputs run so far that were baked or up to date
+ * ("out1 out2: input [basis file]" per input; names escaped as GCC's
+ * depfiles are, for make and ninja alike), written all or nothing.
+ * bb_job_run calls it; a caller running items one by one calls it at the
+ * end. BB_OK when the job has no depfile. */
+bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
+
+/* The command line of options o, as the provenance of a job without
+ * command or command_options records it: "bumpbake bake INPUT" and then
+ * every option that differs from its default, in the order of `bumpbake
+ * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
+ * --maps normal,ao --name T). A CLI invocation typed this way records the
+ * same text, so the same job through the CLI and through Python writes the
+ * same bytes. malloc'd; NULL when out of memory. */
+char *bb_job_command_text(const bb_job_options *o, const char *input);
 
 /* --------------------------------------------------- up-to-date checks */
 

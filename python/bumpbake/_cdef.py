@@ -57,7 +57,8 @@ typedef enum bb_channel {
   BB_CHANNEL_B,
   BB_CHANNEL_A,
   BB_CHANNEL_LUMA,
-  BB_CHANNEL_MEAN
+  BB_CHANNEL_MEAN,
+  BB_CHANNEL_VALVE
 } bb_channel;
 
 typedef struct bb_smooth_options {

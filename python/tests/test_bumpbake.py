@@ -90,7 +90,9 @@ def test_rgba_heights_follow_the_channel_rule():
     np.testing.assert_array_equal(bumpbake.normal(rgba, 8), bumpbake.normal(h, 8))
     # ... while the mean of R, G, B, asked for, is flat
     np.testing.assert_array_equal(bumpbake.normal(rgba, 8, channel="mean")[..., 2], 1.0)
-    rgba[5, 7, 1] = 0.25  # a colour that varies is a height: auto takes its mean
+    rgba[5, 7, 1] = 0.25  # a colour with a graded alpha: still Valve's convention
+    np.testing.assert_array_equal(bumpbake.normal(rgba, 8), bumpbake.normal(h, 8))
+    rgba[5, 7, :3] = 0.25  # a grey that varies is a height: auto takes it
     assert bumpbake.normal(rgba, 8)[..., 2].min() < 1.0
     assert not np.array_equal(bumpbake.normal(rgba, 8), bumpbake.normal(h, 8))
 

@@ -322,3 +322,42 @@ int bb_basis_is_hl2(const bb_basis *b) {
   }
   return 1;
 }
+
+bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err) {
+  if (from_file)
+    *from_file = 0;
+  if (!spec || !out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "basis: no basis named");
+  if (!strcmp(spec, "hl2") || !strcmp(spec, "hl2+z") || !strncmp(spec, "dirs:", 5)) {
+    if (bb_basis_parse(spec, out, NULL) == BB_OK)
+      return BB_OK;
+    return bb__fail(err, BB_ERR_ARGUMENT, "basis dirs:N needs a whole N in 3..%d (got '%s')",
+                    BB_MAX_BASIS, spec);
+  }
+  struct stat st;
+  if (stat(spec, &st) != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "basis must be hl2, hl2+z, dirs:N (N in 3..%d) or a file of directions "
+                    "(got '%s': %s)",
+                    BB_MAX_BASIS, spec, strerror(errno));
+  if (from_file)
+    *from_file = 1;
+  return bb_basis_load(spec, out, err);
+}
+
+bb_status bb_basis_map_check(const bb_image *img, const char *description, bb_error *err) {
+  char name[64];
+  bb_basis basis;
+  if (bb_provenance_value(description, "basis", name, sizeof name) && name[0] &&
+      (bb_basis_parse(name, &basis, NULL) != BB_OK || !bb_basis_is_hl2(&basis)))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "baked with --basis %s; this reads Half-Life 2's basis (bake with --basis "
+                    "hl2)",
+                    name);
+  if (img && img->channels > 4)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%d channels, one per direction of a basis other than Half-Life 2's; this "
+                    "reads Half-Life 2's 3 (bake with --basis hl2)",
+                    img->channels);
+  return BB_OK;
+}

@@ -1,5 +1,7 @@
 /* cli_combine.c: `bumpbake combine`, blending two maps by a mask or a
  * constant, or overlaying a detail map (README "combine"). */
+#include "cli.h"
+#include "common.h"
 #include "maps.h"
 
 #include <float.h>
@@ -109,13 +111,12 @@ static int combine_parse(int argc, char **argv, combine_args *a, const char **in
     return cli_usage_error(combine_command.name,
                            "give exactly one of --mix T, --mask FILE "
                            "and --detail");
-  rc = cli_check_output(combine_command.name, in[0], a->output, a->settings.depth);
-  if (!rc)
-    rc = cli_check_output(combine_command.name, in[1], a->output, a->settings.depth);
-  if (!rc && a->mask)
-    rc = cli_check_output(combine_command.name, a->mask, a->output, a->settings.depth);
-  if (!rc)
-    rc = cli_check_mips(combine_command.name, &a->settings, a->output);
+  /* The output must not replace A, B or the mask. */
+  const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
+  const char *reads[3] = {in[0], in[1], a->mask};
+  bb_error err = {{0}};
+  bb_status st = bb_outputs_check(&spec, 1, reads, a->mask ? 3 : 2, &err);
+  rc = st == BB_OK ? 0 : cli_library_error(combine_command.name, st, &err);
   return rc;
 }
 
@@ -136,7 +137,7 @@ static int load_map(const combine_args *a, const char *path, map_input *m) {
   /* --detail scales Half-Life 2's three channels; a blend is linear in
    * every channel, so it takes maps of any basis (of the same count). */
   if (!rc && a->detail && (a->kind == BB_MAP_SSBUMP || a->kind == BB_MAP_WEIGHTS))
-    rc = cli_check_hl2_map(path, &m->file, &m->info);
+    rc = cli_maps_check_hl2(path, &m->file, &m->info);
   if (rc || a->kind != BB_MAP_NORMAL)
     return rc;
   /* Not renormalised: a texel the operators copy must keep its code. */

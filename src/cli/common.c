@@ -1,39 +1,93 @@
-/* cli_common.c: what the bumpbake subcommands share besides options
- * (cli_options.c), outputs (cli_outputs.c), progress (cli_progress.c) and
- * JSON (cli_json.c): error messages, reading inputs, signals. */
+/* common.c: the messages, lines, command line and signal handling every
+ * subcommand shares. */
 #include "common.h"
+#include "cli.h"
 
-#include <fcntl.h>
 #include <signal.h>
 #include <stdarg.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
+
+/* ---------------------------------------------------------------- escapes */
+
+/* The length of the UTF-8 sequence at s that is safe to print: 0 when its
+ * bytes are not a well-formed sequence or encode a C1 control. */
+static size_t printable_sequence(const unsigned char *s) {
+  if (s[0] < 0x80)
+    return s[0] >= 0x20 && s[0] != 0x7f;
+  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
+  if (s[0] > 0xf4)
+    n = 0;
+  for (size_t i = 1; i < n; i++)
+    if ((s[i] & 0xc0) != 0x80)
+      return 0;
+  if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
+    return 0; /* U+0080..U+009F: C1 controls (0x9b is CSI to some terminals) */
+  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
+    return 0; /* overlong, or a surrogate */
+  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
+    return 0;
+  return n;
+}
+
+const char *cli_escape(const char *s, char *out, size_t cap) {
+  size_t used = 0;
+  if (!cap)
+    return out;
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p;) {
+    size_t n = printable_sequence(p);
+    if (n == 0) {
+      if (used + 4 >= cap)
+        break;
+      used += (size_t)snprintf(out + used, cap - used, "\\x%02x", *p);
+      p++;
+      continue;
+    }
+    if (used + n >= cap)
+      break;
+    memcpy(out + used, p, n);
+    used += n;
+    p += n;
+  }
+  out[used] = '\0';
+  return out;
+}
+
+/* Prints the formatted text escaped, with prefix and a newline, on f. */
+static void vprint_line(FILE *f, const char *prefix, const char *fmt, va_list ap) {
+  char text[4096], safe[4 * sizeof text];
+  vsnprintf(text, sizeof text, fmt, ap);
+  fprintf(f, "%s%s\n", prefix, cli_escape(text, safe, sizeof safe));
+}
 
 /* ----------------------------------------------------------------- errors */
 
 int cli_usage_error(const char *command, const char *fmt, ...) {
+  char prefix[64];
+  snprintf(prefix, sizeof prefix, "bumpbake %s: ", command);
   va_list ap;
   va_start(ap, fmt);
-  fprintf(stderr, "bumpbake %s: ", command);
-  vfprintf(stderr, fmt, ap);
-  fputc('\n', stderr);
+  vprint_line(stderr, prefix, fmt, ap);
   va_end(ap);
   return BB_EXIT_USAGE;
 }
 
+void cli_error_line(const char *message) {
+  char safe[4 * sizeof(bb_error)];
+  fprintf(stderr, "bumpbake: %s\n",
+          cli_escape(message && *message ? message : "unknown error", safe, sizeof safe));
+}
+
 void cli_file_error(const char *path, const char *reason) {
-  /* Errors are one line, whatever a lower layer put in its message. */
-  char line[2 * sizeof(bb_error)];
-  snprintf(line, sizeof line, "%s", reason && *reason ? reason : "unknown error");
-  for (char *c = line; *c; c++)
-    if (*c == '\n' || *c == '\r')
-      *c = ' ';
+  const char *why = reason && *reason ? reason : "unknown error";
   size_t n = strlen(path);
-  if (strncmp(line, path, n) == 0 && line[n] == ':')
-    fprintf(stderr, "bumpbake: %s\n", line);
+  char line[8192];
+  if (strncmp(why, path, n) == 0 && why[n] == ':')
+    snprintf(line, sizeof line, "%s", why);
   else
-    fprintf(stderr, "bumpbake: %s: %s\n", path, line);
+    snprintf(line, sizeof line, "%s: %s", path, why);
+  cli_error_line(line);
 }
 
 int cli_status_exit(const char *path, bb_status status, const bb_error *err) {
@@ -43,110 +97,50 @@ int cli_status_exit(const char *path, bb_status status, const bb_error *err) {
   return BB_EXIT_FAILURE;
 }
 
-/* libpng, inside OpenImageIO, prints its own "libpng error: ..." line on
- * stderr for a corrupt PNG before OpenImageIO returns the error we report.
- * The CLI mutes stderr while decoding so every error stays one line; the
- * library leaves the process's file descriptors alone. */
-int cli_mute_stderr(void) {
-  fflush(stderr);
-  int saved = dup(STDERR_FILENO), null_fd = open("/dev/null", O_WRONLY);
-  if (saved >= 0 && null_fd >= 0) dup2(null_fd, STDERR_FILENO);
-  if (null_fd >= 0) close(null_fd);
-  return saved;
-}
-
-void cli_unmute_stderr(int saved) {
-  if (saved < 0) return;
-  dup2(saved, STDERR_FILENO);
-  close(saved);
-}
-
-bb_status cli_read_image(const char *path, bb_image *img, bb_image_info *info, bb_error *err) {
-  int saved = cli_mute_stderr();
-  bb_status st = bb_image_read(path, img, info, err);
-  cli_unmute_stderr(saved);
-  return st;
-}
-
-int cli_load_height(const char *path, const cli_settings *s, bb_image *height) {
-  return cli_load_height_source(path, s, height, NULL);
-}
-
-int cli_load_height_source(const char *path, const cli_settings *s, bb_image *height,
-                           cli_height_source *source) {
-  bb_image img = {0};
-  bb_image_info info;
-  bb_error err = {{0}};
-  bb_status st = cli_read_image(path, &img, &info, &err);
-  if (st == BB_OK) {
-    /* The rule's own choice, so a height found in alpha is said once. */
-    bb_channel used = bb_height_channel(&img, info.alpha_channel, s->channel);
-    if (source) {
-      const int alpha = info.alpha_channel >= 0 || img.channels == 2 || img.channels == 4;
-      *source = (cli_height_source){used, img.channels - alpha < 3, info.bits_per_sample,
-                                    info.is_float};
-    }
-    if (s->channel == BB_CHANNEL_AUTO && used == BB_CHANNEL_A)
-      fprintf(stderr,
-              "bumpbake: %s: note: the colour is constant and alpha is not; using "
-              "alpha as the height (Valve's convention; --channel chooses)\n",
-              path);
-    st = bb_height_from_image(&img, info.alpha_channel, used, height, &err);
-    bb_image_info_free(&info);
-    bb_image_free(&img);
-  }
-  return cli_status_exit(path, st, &err);
-}
-
-const char *cli_height_channel_name(const cli_height_source *source) {
-  /* The mean of one colour channel is that channel. */
-  if (source->grey && (source->channel == BB_CHANNEL_MEAN || source->channel == BB_CHANNEL_LUMA))
-    return "grey";
-  return bb_channel_name(source->channel);
-}
-
-bb_depth cli_depth_like_input(const cli_height_source *source, const char *path) {
-  /* The closest the format holds, from the input's own depth downwards. */
-  static const bb_depth float_order[] = {BB_DEPTH_FLOAT, BB_DEPTH_HALF, BB_DEPTH_16};
-  static const bb_depth half_order[] = {BB_DEPTH_HALF, BB_DEPTH_FLOAT, BB_DEPTH_16};
-  static const bb_depth int16_order[] = {BB_DEPTH_16, BB_DEPTH_FLOAT};
-  const bb_depth *order = NULL;
-  size_t n = 0;
-  if (source->is_float && source->bits_per_sample <= 16)
-    order = half_order, n = 3;
-  else if (source->is_float)
-    order = float_order, n = 3;
-  else if (source->bits_per_sample > 8)
-    order = int16_order, n = 2;
-  for (size_t i = 0; i < n; i++)
-    if (bb_path_supports_depth(path, order[i]))
-      return order[i];
-  return BB_DEPTH_DEFAULT;
-}
-
-int cli_check_hl2_map(const char *path, const bb_image *img, const bb_image_info *info) {
-  char basis[64], reason[256];
-  bb_provenance_value(info ? info->description : NULL, "basis", basis, sizeof basis);
-  if (basis[0] && strcmp(basis, "hl2") && strcmp(basis, "hl2+z") && strcmp(basis, "dirs:3"))
-    snprintf(reason, sizeof reason,
-             "baked with --basis %s; this reads Half-Life 2's basis (bake with --basis hl2)",
-             basis);
-  else if (img->channels > 4)
-    snprintf(reason, sizeof reason,
-             "%d channels, one per direction of a basis other than Half-Life 2's; this "
-             "reads Half-Life 2's 3 (bake with --basis hl2)",
-             img->channels);
-  else
-    return 0;
-  cli_file_error(path, reason);
+int cli_library_error(const char *command, bb_status status, const bb_error *err) {
+  const char *why = err->message[0] ? err->message : bb_status_name(status);
+  if (status == BB_ERR_ARGUMENT)
+    return cli_usage_error(command, "%s", why);
+  cli_error_line(why);
   return BB_EXIT_FAILURE;
 }
 
-int cli_run_bake(const char *path, const bb_image *height, const bb_bake_options *o,
-                 bb_bake_result *result) {
-  bb_error err = {{0}};
-  bb_status st = bb_bake(height, o, result, &err);
-  return cli_status_exit(path, st, &err);
+/* ------------------------------------------------------------------ lines */
+
+void cli_printf_line(const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vprint_line(stdout, "", fmt, ap);
+  va_end(ap);
+}
+
+void cli_note(void *user, const char *path, const char *text) {
+  (void)user;
+  char line[2048], safe[4 * sizeof line];
+  if (path)
+    snprintf(line, sizeof line, "%s: note: %s", path, text);
+  else
+    snprintf(line, sizeof line, "note: %s", text);
+  fprintf(stderr, "bumpbake: %s\n", cli_escape(line, safe, sizeof safe));
+}
+
+/* --------------------------------------------------------- command line */
+
+char *cli_command_line(int argc, char **argv) {
+  size_t len = strlen("bumpbake") + 1;
+  for (int i = 0; i < argc; i++)
+    len += strlen(argv[i]) + 1;
+  char *line = malloc(len);
+  if (!line) {
+    fprintf(stderr, "bumpbake: out of memory\n");
+    return NULL;
+  }
+  strcpy(line, "bumpbake");
+  for (int i = 0; i < argc; i++) {
+    strcat(line, " ");
+    strcat(line, argv[i]);
+  }
+  return line;
 }
 
 double cli_now_seconds(void) {
@@ -157,13 +151,10 @@ double cli_now_seconds(void) {
 
 /* ---------------------------------------------------------------- signals */
 
-/* Removes the temporaries of the writes in progress, then dies of the same
- * signal: SA_RESETHAND has restored the default action, and the signal,
- * blocked while this runs, is delivered when it returns, so the exit status
- * is what a shell expects of Ctrl-C or kill. Only async-signal-safe calls. */
-static void remove_temporaries_and_die(int sig) {
-  bb_tempfiles_remove();
-  raise(sig);
+/* The library removes the temporaries and ends us by the same signal, once
+ * no set of outputs is half renamed (bb_signal_cleanup). */
+static void on_fatal_signal(int sig) {
+  bb_signal_cleanup(sig);
 }
 
 void cli_install_signal_handlers(void) {
@@ -184,9 +175,8 @@ void cli_install_signal_handlers(void) {
     if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
       continue;
     memset(&sa, 0, sizeof sa);
-    sa.sa_handler = remove_temporaries_and_die;
+    sa.sa_handler = on_fatal_signal;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = (int)SA_RESETHAND;
     sigaction(fatal[i], &sa, NULL);
   }
 }

@@ -11,6 +11,8 @@
  */
 #include "cli.h"
 #include "common.h"
+#include "json.h"
+#include "options.h"
 
 #include "bumpbake.h"
 
@@ -19,6 +21,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <stdlib.h>
 #include <strings.h>
 
 enum { COMPARE_DIFFERENT_SIZE = 3, COMPARE_CANNOT_READ = 4, COMPARE_USAGE = 4 };
@@ -187,47 +190,14 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
   /* The diff is checked before the (possibly long) reads, and must not
    * overwrite either input. */
   if (a->diff_path) {
-    rc =
-        cli_check_output(compare_command.name, a->path_a, a->diff_path, BB_DEPTH_DEFAULT);
-    if (!rc)
-      rc = cli_check_output(compare_command.name, a->path_b, a->diff_path,
-                            BB_DEPTH_DEFAULT);
+    const bb_output_spec diff = {a->diff_path, "diff", 0, BB_DEPTH_DEFAULT, 0, 0};
+    const char *reads[2] = {a->path_a, a->path_b};
+    bb_error err = {{0}};
+    bb_status st = bb_outputs_check(&diff, 1, reads, 2, &err);
+    if (st != BB_OK)
+      rc = cli_library_error(compare_command.name, st, &err);
   }
   return rc;
-}
-
-/* ----------------------------------------------------------------- files */
-
-static int has_extension(const char *path, const char *ext) {
-  size_t n = strlen(path), m = strlen(ext);
-  return n >= m && strcasecmp(path + n - m, ext) == 0;
-}
-
-/* Writes |A-B|. EXR keeps the raw differences; integer formats would round
- * typical golden differences (1e-5) to 0, so the image is scaled to make the
- * largest finite difference white and NaN/infinite differences clip to 1. */
-static int write_diff_image(const char *path, bb_image *diff, double max_finite) {
-  bb_write_options wo = {0};
-  wo.range = BB_RANGE_UNIT;
-  if (has_extension(path, ".exr")) {
-    wo.depth = BB_DEPTH_FLOAT;
-  } else if (max_finite > 0) {
-    size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
-    for (size_t i = 0; i < n; i++)
-      diff->pixels[i] =
-          isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite) : 1.0f;
-  }
-  bb_error err = {{0}};
-  return cli_status_exit(path, bb_image_write(path, diff, &wo, &err), &err);
-}
-
-static double max_finite_value(const bb_image *img) {
-  size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
-  double m = 0;
-  for (size_t i = 0; i < n; i++)
-    if (isfinite(img->pixels[i]) && img->pixels[i] > m)
-      m = img->pixels[i];
-  return m;
 }
 
 /* --------------------------------------------------------------- reports */
@@ -248,12 +218,11 @@ static double percent_of(long count, long total) {
   return total > 0 ? 100.0 * (double)count / (double)total : 0.0;
 }
 
-static void print_text_report(const compare_args *a, const bb_image *img,
-                              const bb_compare_stats *s, const char *prov_diff,
-                              int prov_count, bb_compare_verdict v) {
+static void print_text_report(const compare_args *a, const bb_compare_report *r) {
   const bb_compare_limits *l = &a->limits;
-  printf("compare %s %s: %d x %d, %d channel%s\n", a->path_a, a->path_b, img->width,
-         img->height, img->channels, img->channels == 1 ? "" : "s");
+  const bb_compare_stats *s = &r->stats;
+  cli_printf_line("compare %s %s: %d x %d, %d channel%s", a->path_a, a->path_b, r->width,
+                  r->height, r->channels, r->channels == 1 ? "" : "s");
   printf("  mean abs error %.6g\n", s->mean_abs);
   printf("  RMS error      %.6g\n", s->rms);
   printf("  max abs error  %.6g", s->max_abs);
@@ -272,9 +241,15 @@ static void print_text_report(const compare_args *a, const bb_image *img,
   if (isfinite(l->hard_warn))
     printf("; hard warn %g", l->hard_warn);
   printf(")\n");
-  if (prov_count > 0)
-    printf("provenance differs:\n%s", prov_diff);
-  printf("%s\n", verdict_name(v));
+  if (r->provenance_differences > 0) {
+    printf("provenance differs:\n");
+    for (const char *line = r->provenance_diff; line && *line;) {
+      size_t n = strcspn(line, "\n");
+      cli_printf_line("%.*s", (int)n, line);
+      line += n + (line[n] == '\n');
+    }
+  }
+  printf("%s\n", verdict_name(r->verdict));
 }
 
 /* The provenance differences, one string per "key: a -> b" line. */
@@ -283,9 +258,9 @@ static void json_provenance(cli_json *j, const char *prov_diff) {
   for (const char *line = prov_diff; line && *line;) {
     const char *end = strchr(line, '\n');
     size_t n = end ? (size_t)(end - line) : strlen(line);
-    char buf[600];
-    snprintf(buf, sizeof buf, "%.*s", (int)(n < sizeof buf ? n : sizeof buf - 1), line);
-    cli_json_string(j, NULL, buf);
+    char *one = strndup(line, n);
+    cli_json_string(j, NULL, one ? one : "");
+    free(one);
     line = end ? end + 1 : line + n;
   }
   cli_json_close(j, ']');
@@ -296,16 +271,15 @@ static void json_paths(cli_json *j, const compare_args *a) {
   cli_json_string(j, "b", a->path_b);
 }
 
-static void print_json_report(const compare_args *a, const bb_image *img,
-                              const bb_compare_stats *s, const char *prov_diff,
-                              bb_compare_verdict v) {
+static void print_json_report(const compare_args *a, const bb_compare_report *r) {
   const bb_compare_limits *l = &a->limits;
+  const bb_compare_stats *s = &r->stats;
   cli_json j = {stdout, 0};
   cli_json_open(&j, NULL, '{');
   json_paths(&j, a);
-  cli_json_int(&j, "width", img->width);
-  cli_json_int(&j, "height", img->height);
-  cli_json_int(&j, "channels", img->channels);
+  cli_json_int(&j, "width", r->width);
+  cli_json_int(&j, "height", r->height);
+  cli_json_int(&j, "channels", r->channels);
   cli_json_int(&j, "pixels", s->pixels);
   cli_json_number(&j, "mean_abs", s->mean_abs);
   cli_json_number(&j, "rms", s->rms);
@@ -325,25 +299,21 @@ static void print_json_report(const compare_args *a, const bb_image *img,
   cli_json_number(&j, "warnpercent", l->warn_percent);
   cli_json_number(&j, "hardwarn", l->hard_warn);
   cli_json_int(&j, "over_warn", s->over_warn);
-  json_provenance(&j, prov_diff);
-  cli_json_string(&j, "result", verdict_name(v));
-  cli_json_int(&j, "exit", (int)v);
+  json_provenance(&j, r->provenance_differences > 0 ? r->provenance_diff : "");
+  cli_json_string(&j, "result", verdict_name(r->verdict));
+  cli_json_int(&j, "exit", (int)r->verdict);
   cli_json_close(&j, '}');
   fputc('\n', stdout);
 }
 
 /* ------------------------------------------------------------- decisions */
 
-static int read_image(const char *path, bb_image *img, bb_image_info *info) {
-  bb_error err = {{0}};
-  return cli_status_exit(path, cli_read_image(path, img, info, &err), &err);
-}
-
-static int report_size_mismatch(const compare_args *a, const bb_image *x,
-                                const bb_image *y) {
-  fprintf(stderr, "bumpbake: %s: %d x %d, %d channel%s, but %s is %d x %d, %d channel%s\n",
-          a->path_b, y->width, y->height, y->channels, y->channels == 1 ? "" : "s",
-          a->path_a, x->width, x->height, x->channels, x->channels == 1 ? "" : "s");
+static int report_size_mismatch(const compare_args *a, const bb_compare_report *r) {
+  char line[1024];
+  snprintf(line, sizeof line, "%s: %d x %d, %d channel%s, but %s is %d x %d, %d channel%s",
+           a->path_b, r->b_width, r->b_height, r->b_channels, r->b_channels == 1 ? "" : "s",
+           a->path_a, r->width, r->height, r->channels, r->channels == 1 ? "" : "s");
+  cli_error_line(line);
   if (a->json && !a->quiet) {
     cli_json j = {stdout, 0};
     cli_json_open(&j, NULL, '{');
@@ -358,55 +328,13 @@ static int report_size_mismatch(const compare_args *a, const bb_image *x,
 
 /* Says why provenance was not compared when a file has a damaged copy; on
  * stderr, so --json output stays one line. */
-static void note_damaged_provenance(const compare_args *a, const bb_image_info *ix,
-                                    const bb_image_info *iy) {
+static void note_damaged_provenance(const compare_args *a, const bb_compare_report *r) {
   const char *paths[2] = {a->path_a, a->path_b};
-  const bb_image_info *infos[2] = {ix, iy};
+  const bb_provenance_class classes[2] = {r->provenance_a, r->provenance_b};
   for (int i = 0; i < 2; i++)
-    if (bb_provenance_classify(infos[i]->description) == BB_PROVENANCE_DAMAGED)
-      fprintf(stderr,
-              "bumpbake: %s: provenance is cut or re-wrapped by the file format; "
-              "not compared\n",
-              paths[i]);
-}
-
-/* Compares two decoded images and reports; returns the exit code. */
-static int compare_loaded(const compare_args *a, const bb_image *x, const bb_image *y,
-                          const bb_image_info *ix, const bb_image_info *iy) {
-  if (x->width != y->width || x->height != y->height || x->channels != y->channels)
-    return report_size_mismatch(a, x, y);
-  bb_compare_stats stats;
-  bb_image diff = {0};
-  bb_error err = {{0}};
-  bb_status st = bb_compare_images(x, y, a->limits.fail, a->limits.warn, &stats,
-                                   a->diff_path ? &diff : NULL, &err);
-  if (st != BB_OK) {
-    cli_file_error(a->path_b, err.message);
-    return st == BB_ERR_SIZE ? COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
-  }
-  char prov_diff[4096] = "";
-  int prov_count = 0;
-  if (bb_provenance_classify(ix->description) == BB_PROVENANCE_INTACT &&
-      bb_provenance_classify(iy->description) == BB_PROVENANCE_INTACT) {
-    prov_count =
-        bb_provenance_diff(ix->description, iy->description, prov_diff, sizeof prov_diff);
-    if (prov_count < 0)
-      fprintf(stderr, "bumpbake: out of memory comparing provenance; not compared\n");
-  } else
-    note_damaged_provenance(a, ix, iy);
-  bb_compare_verdict v = bb_compare_judge(&stats, &a->limits);
-  if (a->quiet)
-    ; /* the exit code is the answer */
-  else if (a->json)
-    print_json_report(a, x, &stats, prov_diff, v);
-  else
-    print_text_report(a, x, &stats, prov_diff, prov_count, v);
-  /* A diff that cannot be written is reported but does not change the
-   * verdict: the comparison itself was made. */
-  if (a->diff_path)
-    write_diff_image(a->diff_path, &diff, max_finite_value(&diff));
-  bb_image_free(&diff);
-  return (int)v;
+    if (classes[i] == BB_PROVENANCE_DAMAGED)
+      cli_file_error(paths[i],
+                     "provenance is cut or re-wrapped by the file format; not compared");
 }
 
 int bb_cli_compare(int argc, char **argv) {
@@ -416,16 +344,31 @@ int bb_cli_compare(int argc, char **argv) {
     return BB_EXIT_OK; /* --help */
   if (parsed > 0)
     return COMPARE_USAGE;
-
-  bb_image x = {0}, y = {0};
-  bb_image_info ix = {0}, iy = {0};
-  int code = COMPARE_CANNOT_READ;
-  if (read_image(a.path_a, &x, &ix) == 0 && read_image(a.path_b, &y, &iy) == 0)
-    code = compare_loaded(&a, &x, &y, &ix, &iy);
-  bb_image_free(&x);
-  bb_image_free(&y);
-  bb_image_info_free(&ix);
-  bb_image_info_free(&iy);
+  bb_compare_report r;
+  bb_error err = {{0}};
+  bb_status st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);
+  if (st != BB_OK) {
+    cli_error_line(err.message[0] ? err.message : bb_status_name(st));
+    return st == BB_ERR_SIZE ? COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
+  }
+  int code;
+  if (!r.same_shape) {
+    code = report_size_mismatch(&a, &r);
+  } else {
+    note_damaged_provenance(&a, &r);
+    if (a.quiet)
+      ; /* the exit code is the answer */
+    else if (a.json)
+      print_json_report(&a, &r);
+    else
+      print_text_report(&a, &r);
+    /* A diff that cannot be written is reported but does not change the
+     * verdict: the comparison itself was made. */
+    if (a.diff_path && !r.diff_written)
+      cli_file_error(a.diff_path, r.diff_error.message);
+    code = (int)r.verdict;
+  }
+  bb_compare_report_free(&r);
   fflush(stdout);
   return code;
 }

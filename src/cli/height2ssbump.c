@@ -1,7 +1,10 @@
 /* cli_height2ssbump.c: `bumpbake height2ssbump`, a drop-in for Valve's tool
  * of that name (docs/conventions.md "Valve compatibility"): same flags, same
  * defaults, same output files (FILE-ssbump.tga or FILE-bump.tga, RGBA). */
+#include "cli.h"
 #include "common.h"
+#include "options.h"
+#include "progress.h"
 
 #include <float.h>
 #include <stdlib.h>
@@ -117,50 +120,19 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
     return cli_usage_error(h2s_command.name,
                            "-d makes a detail ssbump; it cannot be used with -n");
 
-  a->output = cli_path_with_suffix(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
+  a->output = bb_path_with_suffix(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
   if (!a->output) {
     cli_file_error(a->input, "out of memory");
     return BB_EXIT_FAILURE;
   }
-  rc = cli_check_output(h2s_command.name, a->input, a->output, a->settings.depth);
-  if (!rc && a->dump_filtered)
-    rc = cli_check_output(h2s_command.name, a->input, dump_path, a->settings.depth);
-  if (!rc && a->dump_filtered && cli_same_file(a->output, dump_path))
-    rc = cli_usage_error(h2s_command.name, "-D would write %s over the output %s",
-                         dump_path, a->output);
-  return rc;
-}
-
-/* Valve's channel rule: alpha when there is one, else (not Valve: it would
- * fail) the mean of R, G, B, which we say on stderr so nobody is surprised. */
-static bb_channel valve_height_channel(const char *path, const bb_image *img,
-                                       const bb_image_info *info) {
-  if (info->alpha_channel >= 0)
-    return BB_CHANNEL_A;
-  if (img->channels >= 3) {
-    fprintf(stderr,
-            "bumpbake: %s: note: no alpha channel; using the mean of R, G, B as the "
-            "height\n",
-            path);
-    return BB_CHANNEL_MEAN;
-  }
-  fprintf(stderr, "bumpbake: %s: note: no alpha channel; using its grey channel as the height\n",
-          path);
-  return BB_CHANNEL_AUTO;
-}
-
-/* Reads FILE once: its pixels (for -d) and the height by Valve's rule. */
-static int load_input(h2s_args *a, bb_image *img, bb_image *height) {
-  bb_image_info info;
-  memset(&info, 0, sizeof info);
+  if (a->dump_filtered && bb_same_file(a->output, dump_path))
+    return cli_usage_error(h2s_command.name, "-D would write %s over the output %s",
+                           dump_path, a->output);
+  const bb_output_spec outputs[2] = {{a->output, "output", 4, a->settings.depth, 0, 0},
+                                     {dump_path, "filtered", 1, a->settings.depth, 0, 0}};
   bb_error err = {{0}};
-  bb_status st = cli_read_image(a->input, img, &info, &err);
-  if (st == BB_OK) {
-    a->settings.channel = valve_height_channel(a->input, img, &info);
-    st = bb_height_from_image(img, info.alpha_channel, a->settings.channel, height, &err);
-  }
-  bb_image_info_free(&info);
-  return cli_status_exit(a->input, st, &err);
+  bb_status st = bb_outputs_check(outputs, a->dump_filtered ? 2 : 1, &a->input, 1, &err);
+  return st == BB_OK ? 0 : cli_library_error(h2s_command.name, st, &err);
 }
 
 static const char *output_kind(const h2s_args *a) {
@@ -171,22 +143,65 @@ static const char *output_kind(const h2s_args *a) {
   return a->ao_in_alpha ? "ssbump+ao" : "ssbump+height";
 }
 
-/* Makes the RGBA image to write from the bake (and for -d the input). */
-static int make_rgba(const h2s_args *a, const bb_image *img, const bb_image *height,
-                     const bb_bake_result *r, bb_image *rgba) {
+/* Makes the RGBA image to write from the bake (and for -d the input's
+ * colour, read again: the height reader keeps only the height). */
+static int make_rgba(const h2s_args *a, const bb_image *height, const bb_bake_result *r,
+                     bb_image *rgba) {
   bb_valve_options vo;
   bb_valve_options_init(&vo);
   vo.normal_map = a->normal_map;
   vo.ao_in_alpha = a->ao_in_alpha;
   bb_error err = {{0}};
   bb_status st = bb_valve_pack(r, &vo, rgba, &err);
-  if (st == BB_OK && a->detail)
-    st = bb_valve_detail(rgba, img, height, &a->settings.bake.smooth, &err);
+  if (st == BB_OK && a->detail) {
+    bb_image colour = {0};
+    st = bb_image_read(a->input, &colour, NULL, &err);
+    if (st == BB_OK)
+      st = bb_valve_detail(rgba, &colour, height, &a->settings.bake.smooth, &err);
+    bb_image_free(&colour);
+  }
   return cli_status_exit(a->input, st, &err);
 }
 
-static int h2s_run(cli_run *run, h2s_args *a) {
-  bb_image img = {0}, height = {0}, rgba = {0};
+/* Valve's RGBA file (and -D's filtered height), written together with the
+ * library's provenance under Valve's kind names. */
+static int write_outputs(const h2s_args *a, const char *command_line,
+                         const bb_height_source *source, const bb_bake_result *r,
+                         const bb_image *rgba) {
+  const int traced = (a->settings.bake.outputs & BB_OUTPUTS_TRACED) != 0;
+  const char *slash = strrchr(a->input, '/');
+  bb_provenance p = {command_line,     slash ? slash + 1 : a->input,
+                     source->height_hash, output_kind(a),
+                     &a->settings.bake, source->channel,
+                     traced ? r->rayset_id : NULL, source->file_hash,
+                     NULL};
+  char *texts[2] = {bb_provenance_format(&p), NULL};
+  p.output_kind = "filtered";
+  texts[1] = bb_provenance_format(&p);
+  int rc = 0;
+  bb_error err = {{0}};
+  if (!texts[0] || !texts[1]) {
+    cli_file_error(a->output, "out of memory");
+    rc = BB_EXIT_FAILURE;
+  } else {
+    /* With -D, both files or neither. */
+    const bb_output_file files[2] = {{a->output, output_kind(a), rgba, BB_RANGE_UNIT,
+                                      a->settings.depth, 0, texts[0], NULL, 0},
+                                     {dump_path, "filtered", &r->filtered, BB_RANGE_UNIT,
+                                      a->settings.depth, 0, texts[1], NULL, 0}};
+    bb_status st = bb_outputs_write(files, a->dump_filtered ? 2 : 1, r->threads, &err);
+    if (st != BB_OK) {
+      cli_error_line(err.message);
+      rc = BB_EXIT_FAILURE;
+    }
+  }
+  free(texts[0]);
+  free(texts[1]);
+  return rc;
+}
+
+static int h2s_run(const char *command_line, h2s_args *a) {
+  bb_image height = {0}, rgba = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   /* What Valve's RGBA layout takes, and -D's filtered height: only the -n
@@ -195,38 +210,32 @@ static int h2s_run(cli_run *run, h2s_args *a) {
       BB_OUTPUT_BIT(a->normal_map ? BB_OUTPUT_NORMAL : BB_OUTPUT_SSBUMP) |
       BB_OUTPUT_BIT(a->ao_in_alpha ? BB_OUTPUT_AO : BB_OUTPUT_FILTERED) |
       (a->dump_filtered ? BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) : 0u);
-
-  int rc = load_input(a, &img, &height);
+  bb_height_source source;
+  bb_error err = {{0}};
+  /* Valve's channel rule: alpha when there is one, else (Valve's tool would
+   * fail) the grey or the mean of R, G, B, which a note says. */
+  bb_status st = bb_height_file_read(a->input, BB_CHANNEL_VALVE, 0.0f, cli_note, NULL, &height,
+                                     &source, &err);
+  int rc = cli_status_exit(a->input, st, &err);
   if (!rc) {
     cli_progress progress;
     cli_progress_attach(&progress, "height2ssbump", 0, &a->settings.bake.trace);
-    rc = cli_run_bake(a->input, &height, &a->settings.bake, &result);
+    rc = cli_status_exit(a->input, bb_bake(&height, &a->settings.bake, &result, &err), &err);
     cli_progress_finish(&progress);
   }
   if (!rc)
-    rc = make_rgba(a, &img, &height, &result, &rgba);
-  if (!rc) {
-    /* With -D, both files or neither (see cli_commit_outputs). */
-    cli_run_set_input(run, a->input, &height, &a->settings);
-    run->rayset_id = (a->settings.bake.outputs & BB_OUTPUTS_TRACED) ? result.rayset_id : NULL;
-    cli_staged_output outs[2] = {{.kind = output_kind(a), .path = a->output},
-                                 {.kind = "filtered", .path = dump_path}};
-    const cli_stage_task tasks[2] = {{run, &rgba, BB_RANGE_UNIT, &outs[0]},
-                                     {run, &result.filtered, BB_RANGE_UNIT, &outs[1]}};
-    int n = a->dump_filtered ? 2 : 1;
-    cli_stage_outputs(tasks, n, result.threads);
-    rc = cli_commit_outputs(outs, n);
-  }
+    rc = make_rgba(a, &height, &result, &rgba);
+  if (!rc)
+    rc = write_outputs(a, command_line, &source, &result, &rgba);
   bb_image_free(&rgba);
   bb_bake_result_free(&result);
   bb_image_free(&height);
-  bb_image_free(&img);
   return rc;
 }
 
 int bb_cli_height2ssbump(int argc, char **argv) {
-  cli_run run;
-  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+  char *command_line = cli_command_line(argc, argv); /* before getopt permutes argv */
+  if (!command_line)
     return BB_EXIT_FAILURE;
   h2s_args a;
   memset(&a, 0, sizeof a);
@@ -235,8 +244,8 @@ int bb_cli_height2ssbump(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = h2s_run(&run, &a);
+    rc = h2s_run(command_line, &a);
   free(a.output);
-  cli_run_free(&run);
+  free(command_line);
   return rc;
 }

@@ -3,6 +3,9 @@
  * headers only: no pixel is decoded. */
 #include "cli.h"
 #include "common.h"
+#include "json.h"
+#include "options.h"
+#include "read.h"
 
 #include "bumpbake.h"
 

@@ -1,7 +1,10 @@
-/* cli_normal.c: `bumpbake normal`, a normal map from a height map (no
- * tracing). */
+/* normal.c: `bumpbake normal`, a normal map from a height map (no tracing):
+ * a bake job of one map. */
+#include "cli.h"
 #include "common.h"
+#include "options.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 static const cli_option opt_output = {
@@ -78,31 +81,40 @@ static int normal_parse(int argc, char **argv, normal_args *a, const char **inpu
     return cli_usage_error(
         normal_command.name,
         "--scale is required (texels of displacement per unit of height)");
-  int rc2 = cli_check_output(normal_command.name, *input, a->output, a->settings.depth);
-  return rc2 ? rc2 : cli_check_mips(normal_command.name, &a->settings, a->output);
+  return 0;
 }
 
-static int normal_run(cli_run *run, normal_args *a, const char *input) {
-  bb_image height = {0};
-  bb_bake_result result;
-  memset(&result, 0, sizeof result);
-  int rc = cli_load_height(input, &a->settings, &height);
-  if (!rc)
-    rc = cli_run_bake(input, &height, &a->settings.bake, &result);
-  if (!rc) {
-    cli_run_set_input(run, input, &height, &a->settings);
-    rc = cli_write_output(run, "normal", a->output, &result.normal, BB_RANGE_SIGNED);
+/* A bake of the normal map alone (nothing is traced), through the job. */
+static int normal_run(normal_args *a, const char *command_line, const char *input) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake = a->settings.bake;
+  o.channel = a->settings.channel;
+  o.depth = a->settings.depth;
+  o.mips = a->settings.mips;
+  o.paths[BB_OUTPUT_NORMAL] = a->output;
+  o.force = 1;
+  o.command = command_line;
+  o.note = cli_note;
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  bb_status st = bb_job_plan(&input, 1, &o, &job, &err);
+  if (st != BB_OK)
+    return cli_library_error(normal_command.name, st, &err);
+  int rc = BB_EXIT_OK;
+  if (bb_job_run_item(job, 0, NULL, NULL) != BB_OK) {
+    cli_error_line(bb_job_report_get(job, 0)->error.message);
+    rc = BB_EXIT_FAILURE;
+  } else if (!a->quiet) { /* as bake says it */
+    cli_printf_line("wrote normal %s", a->output);
   }
-  if (!rc && !a->quiet) /* as bake says it */
-    printf("wrote normal %s\n", a->output);
-  bb_bake_result_free(&result);
-  bb_image_free(&height);
+  bb_job_free(job);
   return rc;
 }
 
 int bb_cli_normal(int argc, char **argv) {
-  cli_run run;
-  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+  char *command_line = cli_command_line(argc, argv); /* before getopt permutes argv */
+  if (!command_line)
     return BB_EXIT_FAILURE;
   normal_args a;
   memset(&a, 0, sizeof a);
@@ -113,7 +125,7 @@ int bb_cli_normal(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = normal_run(&run, &a, input);
-  cli_run_free(&run);
+    rc = normal_run(&a, command_line, input);
+  free(command_line);
   return rc;
 }

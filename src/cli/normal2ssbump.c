@@ -1,6 +1,8 @@
 /* cli_normal2ssbump.c: `bumpbake normal2ssbump`, Valve's SDK tool of that
  * name: a normal map to unshadowed basis weights, written by default where
  * Valve's tool writes them (NAME_ssbump.tga). */
+#include "cli.h"
+#include "common.h"
 #include "maps.h"
 
 #include <stdlib.h>
@@ -92,8 +94,7 @@ static int n2s_parse(int argc, char **argv, n2s_args *a, const char **input) {
     }
     a->output = a->default_output;
   }
-  int rc2 = cli_check_output(n2s_command.name, *input, a->output, a->settings.depth);
-  return rc2 ? rc2 : cli_check_mips(n2s_command.name, &a->settings, a->output);
+  return cli_maps_check_output(n2s_command.name, *input, a->output, &a->settings);
 }
 
 /* Appends the input's alpha (channel 3 of RGBA) to the weights, as Valve's

@@ -2,6 +2,7 @@
  * parsing, the option parser and --help built from a command's table, and
  * the shared bake settings (whose ranges the library checks). */
 #include "common.h"
+#include "options.h"
 
 #include <errno.h>
 #include <float.h>
@@ -348,25 +349,19 @@ static int bad_choice(const char *command, const cli_option *opt, const char *ar
                          arg);
 }
 
-/* --basis: a name ("hl2", "hl2+z", "dirs:N"; names win over a file of the
- * same name, which ./NAME reaches) or else a basis file. A word that is
- * neither is a usage error; a file that is there but wrong is the file's
- * error (exit 1, "bumpbake: FILE:LINE: reason"). */
-static int apply_basis(const char *command, const char *arg, bb_basis *out) {
+/* --basis: the library's rule (bb_basis_resolve): a name, else a basis
+ * file. A word that is neither is a usage error; a file that is there but
+ * wrong is the file's error (exit 1, "bumpbake: FILE:LINE: reason"). */
+static int apply_basis(const char *command, const char *arg, cli_settings *s) {
   bb_error err = {{0}};
-  if (!strcmp(arg, "hl2") || !strcmp(arg, "hl2+z") || !strncmp(arg, "dirs:", 5)) {
-    if (bb_basis_parse(arg, out, &err) == BB_OK)
-      return 0;
-    return cli_usage_error(command, "--basis dirs:N needs a whole N in 3..%d (got '%s')",
-                           BB_MAX_BASIS, arg);
-  }
-  struct stat st;
-  if (stat(arg, &st) != 0)
-    return cli_usage_error(command,
-                           "--basis must be hl2, hl2+z, dirs:N (N in 3..%d) or a file of "
-                           "directions (got '%s': %s)",
-                           BB_MAX_BASIS, arg, strerror(errno));
-  return cli_status_exit(arg, bb_basis_load(arg, out, &err), &err);
+  int from_file = 0;
+  bb_status st = bb_basis_resolve(arg, &s->bake.basis, &from_file, &err);
+  if (st == BB_ERR_ARGUMENT && !from_file)
+    return cli_usage_error(command, "--%s", err.message);
+  if (st != BB_OK)
+    return cli_status_exit(arg, st, &err);
+  s->basis_file = from_file ? arg : NULL;
+  return 0;
 }
 
 /* The ranges of --filter-radius, --bias, --power and --threads are the
@@ -388,6 +383,14 @@ static int check_with_library(const char *command, const char *name, const cli_s
   return cli_usage_error(command, "%s: %s", name, why);
 }
 
+int cli_settings_apply_slices(const char *command, cli_settings *s, const char *arg) {
+  int rc = cli_parse_int(command, "--slices", arg, INT_MIN, INT_MAX, &s->bake.slices);
+  if (!rc && s->bake.slices == 0) /* 0 means "from --rays" to the library */
+    return cli_usage_error(command, "--slices: slices must be in 1..%d (got 0)",
+                           BB_MAX_SLICES);
+  return rc ? rc : check_with_library(command, "--slices", s);
+}
+
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
                        const char *arg) {
   bb_bake_options *b = &s->bake;
@@ -404,7 +407,8 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
     }
     return rc;
   case CLI_OPT_RAYS:
-    return cli_parse_int(command, name, arg, 1, 65536, &b->rays);
+    rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->rays);
+    return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_FILTER_RADIUS:
     rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->smooth.radius_texels);
     return rc ? rc : check_with_library(command, name, s);
@@ -423,7 +427,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
     rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->trace.threads);
     return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_BASIS:
-    return apply_basis(command, arg, &b->basis);
+    return apply_basis(command, arg, s);
   case CLI_OPT_NORMAL_FILTER:
     return bb_normal_filter_parse(arg, &b->normal_filter, NULL) ? bad_choice(command, opt, arg)
                                                           : 0;

@@ -1,4 +1,4 @@
-/* cli_options.h: option tables, their parsing with range checks and --help,
+/* options.h: option tables, their parsing with range checks and --help,
  * and the bake settings the baking commands share (cli_options.c). */
 #ifndef BB_CLI_OPTIONS_H
 #define BB_CLI_OPTIONS_H
@@ -41,13 +41,15 @@ typedef enum cli_opt_id {
   CLI_OPT_VALVE_DUMP,     /* -D */
   CLI_OPT_VALVE_DETAIL,   /* -d */
   CLI_OPT_MIPS,           /* --mips */
-  /* bake's batches (cli_batch.h) */
+  /* bake's batches */
   CLI_OPT_OUT_DIR,
   CLI_OPT_NAME,
   CLI_OPT_MAPS,
   CLI_OPT_KEEP_GOING,
   CLI_OPT_FORCE,
-  CLI_OPT_DEPFILE
+  CLI_OPT_DEPFILE,
+  CLI_OPT_SLOPE,     /* bake --slope FILE */
+  CLI_OPT_SLOPE_LIT  /* bake --lit AZ,EL */
 } cli_opt_id;
 
 /* One row of a subcommand's option table: getopt_long's struct option and
@@ -120,6 +122,7 @@ struct cli_settings {
   bb_depth depth;
   int scale_given;
   int mips; /* --mips: outputs are mip-mapped TIFF or EXR files */
+  const char *basis_file; /* --basis FILE (a file, not a name), or NULL */
 };
 
 /* Library defaults, plus the CLI's own (channel auto, default depth). */
@@ -132,6 +135,9 @@ void cli_settings_init(cli_settings *s);
  * usage error (also for an option it does not know: an internal error). */
 int cli_settings_apply(const char *command, cli_settings *s, const cli_option *opt,
                        const char *arg);
+
+/* --slices A: an integer, its range the library's. */
+int cli_settings_apply_slices(const char *command, cli_settings *s, const char *arg);
 
 /* Option-table rows of the shared settings, to build subcommand tables from
  * (the help text of each lives here once). */

@@ -1,6 +1,9 @@
 /* cli_program.c: `bumpbake program`, a DOOM 3 image program (the text of a
  * material's bumpmap or diffusemap stage) evaluated outside the engine. */
+#include "cli.h"
+#include "common.h"
 #include "maps.h"
+#include "read.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -69,27 +72,35 @@ static bb_status quiet_loader(void *user, const char *path, bb_image *img,
 }
 
 /* The output must not replace any image the program reads: every one of
- * them, however many the program names. */
+ * them, however many the program names (bb_outputs_check against all). */
 static int check_output_against_images(const program_args *a, const bb_program *program) {
   size_t count = bb_program_images(program, NULL, 0);
-  if (count == 0) /* _flat alone: there is no input to protect */
-    return cli_check_output(program_command.name, "", a->output, a->settings.depth);
-  const char **names = malloc(count * sizeof *names);
-  if (!names) {
-    cli_file_error(a->output, "out of memory");
-    return BB_EXIT_FAILURE;
-  }
-  bb_program_images(program, names, count);
+  const char **names = malloc((count ? count : 1) * sizeof *names);
+  char (*paths)[4096] = malloc((count ? count : 1) * sizeof *paths);
+  const char **reads = malloc((count ? count : 1) * sizeof *reads);
   int rc = 0;
-  for (size_t i = 0; i < count && !rc; i++) {
-    char path[4096];
-    /* a name too long to resolve is refused when the program runs, before
-     * anything is written; a cut path is no input to compare with */
-    const int len = bb_program_image_path(a->base_dir, names[i], path, sizeof path);
-    if (len >= 0 && (size_t)len < sizeof path)
-      rc = cli_check_output(program_command.name, path, a->output, a->settings.depth);
+  if (!names || !paths || !reads) {
+    cli_file_error(a->output, "out of memory");
+    rc = BB_EXIT_FAILURE;
+  }
+  int n = 0;
+  if (!rc) {
+    bb_program_images(program, names, count);
+    for (size_t i = 0; i < count; i++) {
+      /* a name too long to resolve is refused when the program runs, before
+       * anything is written; a cut path is no input to compare with */
+      const int len = bb_program_image_path(a->base_dir, names[i], paths[n], sizeof paths[n]);
+      if (len >= 0 && (size_t)len < sizeof paths[n])
+        reads[n] = paths[n], n++;
+    }
+    const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
+    bb_error err = {{0}};
+    bb_status st = bb_outputs_check(&spec, 1, reads, n, &err);
+    rc = st == BB_OK ? 0 : cli_library_error(program_command.name, st, &err);
   }
   free(names);
+  free(paths);
+  free(reads);
   return rc;
 }
 
@@ -108,8 +119,7 @@ static int program_parse(int argc, char **argv, program_args *a, const char **te
   bb_error err = {{0}};
   if (bb_program_parse(*text, program, &err) != BB_OK)
     return cli_usage_error(program_command.name, "%s", err.message);
-  rc = check_output_against_images(a, *program);
-  return rc ? rc : cli_check_mips(program_command.name, &a->settings, a->output);
+  return check_output_against_images(a, *program);
 }
 
 static int program_run(const cli_run *run, const program_args *a, const char *text,

@@ -1,5 +1,6 @@
-/* cli_progress.c: the progress bar of long bakes on a terminal. */
+/* progress.c: the progress bar of long bakes on a terminal. */
 #include "common.h"
+#include "progress.h"
 
 #include <string.h>
 #include <unistd.h>
@@ -33,14 +34,21 @@ static int progress_draw(void *user, long done, long total) {
   return 0;
 }
 
-void cli_progress_attach(cli_progress *p, const char *label, int quiet,
-                         bb_trace_options *trace) {
+void cli_progress_start(cli_progress *p, const char *label, int quiet) {
   memset(p, 0, sizeof *p);
   p->label = label;
   p->start_seconds = cli_now_seconds();
-  if (quiet || !isatty(STDERR_FILENO))
-    return;
-  trace->progress = progress_draw;
+  p->active = !quiet && isatty(STDERR_FILENO);
+}
+
+bb_progress_fn cli_progress_fn(const cli_progress *p) {
+  return p->active ? progress_draw : NULL;
+}
+
+void cli_progress_attach(cli_progress *p, const char *label, int quiet,
+                         bb_trace_options *trace) {
+  cli_progress_start(p, label, quiet);
+  trace->progress = cli_progress_fn(p);
   trace->progress_user = p;
 }
 

@@ -1,4 +1,4 @@
-/* cli_progress.h: the progress bar of long bakes (cli_progress.c). */
+/* progress.h: the progress bar of long bakes (cli_progress.c). */
 #ifndef BB_CLI_PROGRESS_H
 #define BB_CLI_PROGRESS_H
 
@@ -13,11 +13,17 @@ typedef struct cli_progress {
   const char *label;
   double start_seconds;
   double last_draw_seconds;
-  int shown; /* a line is on screen and must be cleared */
+  int shown;  /* a line is on screen and must be cleared */
+  int active; /* stderr is a terminal and the command is not quiet */
 } cli_progress;
 
-/* Sets up p and, when stderr is a terminal and not quiet, points the trace
- * options' progress callback at it. */
+/* Sets up p; the bar is drawn only when stderr is a terminal and not quiet. */
+void cli_progress_start(cli_progress *p, const char *label, int quiet);
+/* The callback for the library's progress argument (p as its user), or
+ * NULL when no bar is drawn. */
+bb_progress_fn cli_progress_fn(const cli_progress *p);
+
+/* cli_progress_start, pointing the trace options' progress callback at p. */
 void cli_progress_attach(cli_progress *p, const char *label, int quiet,
                          bb_trace_options *trace);
 /* Clears the bar's line if one was drawn. */

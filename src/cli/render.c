@@ -1,8 +1,11 @@
-/* cli_render.c: `bumpbake render`, the maps lit as Source lights them, from a
+/* render.c: `bumpbake render`, the maps lit as Source lights them, from a
  * height map (baked on the fly) or from maps already baked; one picture, the
  * paper's four-panel comparison, or an orbit of the light. */
-#define _XOPEN_SOURCE 700 /* realpath */
-
+#include "cli.h"
+#include "common.h"
+#include "options.h"
+#include "progress.h"
+#include "read.h"
 #include "render_common.h"
 
 #include <limits.h>
@@ -10,22 +13,10 @@
 #include <string.h>
 #include <strings.h>
 
-/* The baked maps render can read instead of a height, in this order. */
-enum { MAP_NORMAL, MAP_SSBUMP, MAP_AO, MAP_BENT, MAP_SLOPE, MAP_COUNT };
-
-static const struct {
-  const char *name; /* option name and provenance key */
-  unsigned need;    /* BB_RENDER_NEEDS_* bit, 0 for optional maps */
-  int channels;     /* at least */
-  int is_vector;    /* decoded as a normal map */
-  const char *channels_why;
-} map_kinds[MAP_COUNT] = {
-    {"normal", BB_RENDER_NEEDS_NORMAL, 3, 1, "X, Y, Z"},
-    {"ssbump", BB_RENDER_NEEDS_SSBUMP, 3, 0, "R, G, B = the basis B0, B1, B2"},
-    {"ao", BB_RENDER_NEEDS_AO, 1, 0, "grey"},
-    {"bent", 0, 3, 1, "X, Y, Z"},
-    {"slope", BB_RENDER_NEEDS_SLOPE, 1, 0, "flipcode's slope byte, as bake --slope writes"},
-};
+/* The maps each mode needs, by the library's kinds of render map. */
+static const unsigned map_need[BB_RENDER_MAP_COUNT] = {
+    BB_RENDER_NEEDS_NORMAL, BB_RENDER_NEEDS_SSBUMP, BB_RENDER_NEEDS_AO, 0,
+    BB_RENDER_NEEDS_SLOPE};
 
 static const cli_option opt_in_normal = {
     .id = CLI_RENDER_OPT_IN_NORMAL,
@@ -142,7 +133,7 @@ typedef struct render_args {
   cli_settings settings;
   bb_render_options render;
   int light_given;
-  const char *map_paths[MAP_COUNT];
+  const char *map_paths[BB_RENDER_MAP_COUNT];
   const char *height_path, *albedo_path, *output;
   int compare, orbit, quiet;
   int green_up; /* --normal-y up: the input normal and bent files */
@@ -230,7 +221,7 @@ static int has_extension(const char *path, const char *ext) {
 static int check_inputs(const render_args *a) {
   const char *cmd = render_command.name;
   int any_map = 0;
-  for (int m = 0; m < MAP_COUNT; m++)
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
     any_map |= a->map_paths[m] != NULL;
   if (a->height_path && any_map)
     return cli_usage_error(cmd,
@@ -245,52 +236,79 @@ static int check_inputs(const render_args *a) {
   if (!any_map)
     return cli_usage_error(cmd, "missing HEIGHT or baked maps (usage: bumpbake %s %s)",
                            cmd, render_command.synopsis);
-  for (int m = 0; m < MAP_COUNT; m++)
-    if ((needed_maps(a) & map_kinds[m].need) && !a->map_paths[m])
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+    if ((needed_maps(a) & map_need[m]) && !a->map_paths[m])
       return cli_usage_error(cmd, "%s needs --%s FILE (or a HEIGHT to bake)",
                              a->compare ? "--compare"
                                         : bb_render_mode_name(a->render.mode),
-                             map_kinds[m].name);
+                             bb_render_map_name((bb_render_map)m));
   return 0;
 }
 
-/* 1 when a and b are the same existing file. */
-static int same_existing_file(const char *a, const char *b) {
-  char ra[PATH_MAX], rb[PATH_MAX];
-  return realpath(a, ra) && realpath(b, rb) && strcmp(ra, rb) == 0;
+/* The files the picture will be: one, an orbit's frames, or one GIF. */
+static int output_specs(const render_args *a, bb_output_spec **specs, char ***frames, int *n) {
+  *n = a->orbit && !has_extension(a->output, ".gif") ? a->orbit : 1;
+  *specs = calloc((size_t)*n, sizeof **specs);
+  *frames = calloc((size_t)*n, sizeof **frames);
+  if (!*specs || !*frames) {
+    cli_file_error(a->output, "out of memory");
+    return BB_EXIT_FAILURE;
+  }
+  for (int f = 0; f < *n; f++) {
+    const char *path = a->output;
+    if (*n > 1 || (a->orbit && !has_extension(a->output, ".gif"))) {
+      if (!((*frames)[f] = bb_render_frame_path(a->output, f, a->orbit))) {
+        cli_file_error(a->output, "out of memory");
+        return BB_EXIT_FAILURE;
+      }
+      path = (*frames)[f];
+    }
+    /* A GIF is written by the animation writer, not bb_image_write: its
+     * name is checked as a file, its format here. */
+    (*specs)[f] = (bb_output_spec){path, a->compare ? "comparison" : "render", 0,
+                                   a->settings.depth, 0, has_extension(path, ".gif")};
+  }
+  return 0;
 }
 
+/* Checks the output before any work: against every file the render reads
+ * (the height or the maps, and the albedo), and every frame of an orbit. */
 static int check_output(const render_args *a) {
   const char *cmd = render_command.name;
-  const char *input = a->height_path;
-  for (int m = 0; m < MAP_COUNT && !input; m++)
-    input = a->map_paths[m];
   if (!a->output)
     return cli_usage_error(cmd, "-o OUT is required");
   if (a->orbit && !a->render.dynamic_light)
     return cli_usage_error(cmd, "--orbit circles the dynamic light: give --light");
-  if (!has_extension(a->output, ".gif"))
-    return cli_check_output(cmd, input, a->output, a->settings.depth);
-  if (!a->orbit)
-    return cli_usage_error(cmd, "%s: GIF is for --orbit animations; use .png or .exr",
-                           a->output);
-  if (a->settings.depth != BB_DEPTH_DEFAULT && a->settings.depth != BB_DEPTH_8)
-    return cli_usage_error(cmd, "%s: GIF files are 8-bit", a->output);
-  /* The directory check of cli_check_output, on a .png twin of the name. */
-  size_t len = strlen(a->output);
-  char twin[PATH_MAX];
-  if (len >= sizeof twin)
-    return cli_usage_error(cmd, "%s: path too long", a->output);
-  memcpy(twin, a->output, len - 4);
-  strcpy(twin + len - 4, ".png");
-  for (int m = 0; m < MAP_COUNT + 1; m++) {
-    const char *in = m < MAP_COUNT ? a->map_paths[m] : a->height_path;
-    if (in && same_existing_file(in, a->output)) {
-      cli_file_error(a->output, "output would overwrite the input file");
-      return BB_EXIT_FAILURE;
-    }
+  if (has_extension(a->output, ".gif")) {
+    if (!a->orbit)
+      return cli_usage_error(cmd, "%s: GIF is for --orbit animations; use .png or .exr",
+                             a->output);
+    if (a->settings.depth != BB_DEPTH_DEFAULT && a->settings.depth != BB_DEPTH_8)
+      return cli_usage_error(cmd, "%s: GIF files are 8-bit", a->output);
   }
-  return cli_check_output(cmd, input, twin, BB_DEPTH_DEFAULT);
+  const char *reads[BB_RENDER_MAP_COUNT + 2];
+  int n_reads = 0;
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+    if (a->map_paths[m])
+      reads[n_reads++] = a->map_paths[m];
+  if (a->height_path)
+    reads[n_reads++] = a->height_path;
+  if (a->albedo_path)
+    reads[n_reads++] = a->albedo_path;
+  bb_output_spec *specs = NULL;
+  char **frames = NULL;
+  int n = 0;
+  int rc = output_specs(a, &specs, &frames, &n);
+  if (!rc) {
+    bb_error err = {{0}};
+    bb_status st = bb_outputs_check(specs, n, reads, n_reads, &err);
+    rc = st == BB_OK ? 0 : cli_library_error(cmd, st, &err);
+  }
+  for (int f = 0; frames && f < n; f++)
+    free(frames[f]);
+  free(frames);
+  free(specs);
+  return rc;
 }
 
 static int render_parse(int argc, char **argv, render_args *a) {
@@ -317,89 +335,24 @@ static int render_parse(int argc, char **argv, render_args *a) {
 /* Everything a picture is made from, and what the provenance says of it. */
 typedef struct render_inputs {
   bb_image height;
+  bb_height_source source; /* the height's, when one was baked */
   bb_bake_result bake;
-  bb_image maps[MAP_COUNT]; /* read from files */
+  bb_image maps[BB_RENDER_MAP_COUNT]; /* read from files */
   bb_image albedo;
   bb_image slope;      /* made from the bake's filtered height for --mode slope */
   bb_render_maps view; /* pointers into the above */
-  char *extra;         /* provenance lines about the inputs, malloc'd */
+  bb_render_sources sources;
+  const char *input;   /* the file the provenance's input keys describe */
+  uint64_t input_hash;
 } render_inputs;
 
 static void inputs_free(render_inputs *in) {
   bb_image_free(&in->height);
   bb_bake_result_free(&in->bake);
-  for (int m = 0; m < MAP_COUNT; m++)
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
     bb_image_free(&in->maps[m]);
   bb_image_free(&in->albedo);
   bb_image_free(&in->slope);
-  free(in->extra);
-}
-
-/* Appends "key=value\n" to in->extra; 0, or BB_EXIT_FAILURE when out of memory. */
-static int add_line(render_inputs *in, const char *key, const char *value) {
-  size_t old = in->extra ? strlen(in->extra) : 0, add = strlen(key) + strlen(value) + 2;
-  char *grown = realloc(in->extra, old + add + 1);
-  if (!grown) {
-    fprintf(stderr, "bumpbake: out of memory\n");
-    return BB_EXIT_FAILURE;
-  }
-  snprintf(grown + old, add + 1, "%s=%s\n", key, value);
-  in->extra = grown;
-  return 0;
-}
-
-static const char *file_name_of(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
-/* Reads one map file and decodes it; the size must match *size when set. */
-static int read_map(const char *path, int kind, int green_up, const bb_image **size,
-                    bb_image *out) {
-  bb_image raw = {0};
-  bb_image_info info;
-  bb_error err = {{0}};
-  bb_status st = cli_read_image(path, &raw, &info, &err);
-  if (st != BB_OK)
-    return cli_status_exit(path, st, &err);
-  int is_float = info.is_float;
-  int rc = kind == MAP_SSBUMP ? cli_check_hl2_map(path, &raw, &info) : 0;
-  bb_image_info_free(&info);
-  if (rc) {
-    bb_image_free(&raw);
-    return rc;
-  }
-  char reason[256];
-  if (raw.channels < map_kinds[kind].channels) {
-    snprintf(reason, sizeof reason, "%d channel%s; %s %s map needs %d (%s)", raw.channels,
-             raw.channels == 1 ? "" : "s",
-             (kind == MAP_AO || kind == MAP_SSBUMP) ? "an" : "a", map_kinds[kind].name,
-             map_kinds[kind].channels, map_kinds[kind].channels_why);
-  } else if (*size && (raw.width != (*size)->width || raw.height != (*size)->height)) {
-    snprintf(reason, sizeof reason, "%dx%d, but the other maps are %dx%d", raw.width,
-             raw.height, (*size)->width, (*size)->height);
-  } else {
-    reason[0] = '\0';
-  }
-  if (reason[0]) {
-    bb_image_free(&raw);
-    cli_file_error(path, reason);
-    return BB_EXIT_FAILURE;
-  }
-  if (map_kinds[kind].is_vector) {
-    bb_normal_decode_options decode;
-    bb_normal_decode_options_init(&decode);
-    decode.normal_y_up = green_up;
-    st = bb_normal_map_decode(&raw, is_float, &decode, out, &err);
-    bb_image_free(&raw);
-    if (st != BB_OK)
-      return cli_status_exit(path, st, &err);
-  } else {
-    *out = raw;
-  }
-  if (!*size)
-    *size = out;
-  return 0;
 }
 
 /* A crop must fit the tiled picture: checked once the size is known, before
@@ -420,39 +373,43 @@ static int check_view(const render_args *a, const bb_image *size) {
   return 0;
 }
 
-static int load_maps(const render_args *a, cli_run *run, render_inputs *in) {
+static int load_maps(const render_args *a, render_inputs *in) {
   const bb_image *size = NULL;
-  int rc = add_line(in, "render_from", "maps");
-  if (!rc && (a->map_paths[MAP_NORMAL] || a->map_paths[MAP_BENT]))
-    rc = add_line(in, "map_normal_y", a->green_up ? "up" : "down");
-  for (int m = 0; m < MAP_COUNT && !rc; m++) {
+  in->sources.maps_normal_y_up = a->green_up;
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++) {
     if (!a->map_paths[m])
       continue;
-    rc = read_map(a->map_paths[m], m, a->green_up, &size, &in->maps[m]);
-    if (!rc) {
-      char key[32];
-      snprintf(key, sizeof key, "map_%s", map_kinds[m].name);
-      rc = add_line(in, key, file_name_of(a->map_paths[m]));
+    bb_error err = {{0}};
+    uint64_t hash = 0;
+    bb_status st = bb_render_map_read(a->map_paths[m], (bb_render_map)m, a->green_up, size,
+                                      &in->maps[m], &hash, &err);
+    if (st != BB_OK)
+      return cli_status_exit(a->map_paths[m], st, &err);
+    in->sources.maps[m] = a->map_paths[m];
+    if (!in->input) {
+      in->input = a->map_paths[m];
+      in->input_hash = hash;
     }
-    if (!rc && !run->input_path) {
-      run->input_path = a->map_paths[m];
-      run->input_hash = bb_image_hash(&in->maps[m]);
-    }
+    if (!size)
+      size = &in->maps[m];
   }
-  if (!rc)
-    rc = check_view(a, size);
+  int rc = check_view(a, size);
   if (rc)
     return rc;
-  in->view.normal = in->maps[MAP_NORMAL].pixels ? &in->maps[MAP_NORMAL] : NULL;
-  in->view.ssbump = in->maps[MAP_SSBUMP].pixels ? &in->maps[MAP_SSBUMP] : NULL;
-  in->view.ao = in->maps[MAP_AO].pixels ? &in->maps[MAP_AO] : NULL;
-  in->view.bent = in->maps[MAP_BENT].pixels ? &in->maps[MAP_BENT] : NULL;
-  in->view.slope = in->maps[MAP_SLOPE].pixels ? &in->maps[MAP_SLOPE] : NULL;
+  in->view.normal = in->maps[BB_RENDER_MAP_NORMAL].pixels ? &in->maps[BB_RENDER_MAP_NORMAL] : NULL;
+  in->view.ssbump = in->maps[BB_RENDER_MAP_SSBUMP].pixels ? &in->maps[BB_RENDER_MAP_SSBUMP] : NULL;
+  in->view.ao = in->maps[BB_RENDER_MAP_AO].pixels ? &in->maps[BB_RENDER_MAP_AO] : NULL;
+  in->view.bent = in->maps[BB_RENDER_MAP_BENT].pixels ? &in->maps[BB_RENDER_MAP_BENT] : NULL;
+  in->view.slope = in->maps[BB_RENDER_MAP_SLOPE].pixels ? &in->maps[BB_RENDER_MAP_SLOPE] : NULL;
   return 0;
 }
 
-static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
-  int rc = cli_load_height(a->height_path, &a->settings, &in->height);
+static int bake_height(render_args *a, render_inputs *in) {
+  bb_error err = {{0}};
+  bb_status st = bb_height_file_read(a->height_path, a->settings.channel,
+                                     a->settings.bake.height_scale, cli_note, NULL, &in->height,
+                                     &in->source, &err);
+  int rc = cli_status_exit(a->height_path, st, &err);
   if (!rc)
     rc = check_view(a, &in->height);
   if (rc)
@@ -465,26 +422,26 @@ static int bake_height(render_args *a, cli_run *run, render_inputs *in) {
       (traced ? BB_OUTPUTS_TRACED : 0u);
   cli_progress progress;
   cli_progress_attach(&progress, "render", a->quiet, &a->settings.bake.trace);
-  rc = cli_run_bake(a->height_path, &in->height, &a->settings.bake, &in->bake);
+  st = bb_bake(&in->height, &a->settings.bake, &in->bake, &err);
   cli_progress_finish(&progress);
-  if (rc)
-    return rc;
-  cli_run_set_input(run, a->height_path, &in->height, &a->settings);
-  run->rayset_id = traced ? in->bake.rayset_id : NULL;
+  if (st != BB_OK)
+    return cli_status_exit(a->height_path, st, &err);
+  in->input = a->height_path;
+  in->input_hash = in->source.height_hash;
+  in->sources.height = a->height_path;
   bb_bake_result *r = &in->bake;
   in->view = (bb_render_maps){&r->normal, r->ssbump.pixels ? &r->ssbump : NULL,
                               r->ao.pixels ? &r->ao : NULL,
                               r->bent.pixels ? &r->bent : NULL, NULL, NULL};
   if (needed_maps(a) & BB_RENDER_NEEDS_SLOPE) {
     /* The slope map bake --slope would write, from the same filtered height. */
-    bb_error err = {{0}};
-    bb_status st = bb_slope_map(&r->filtered, a->settings.bake.height_scale,
-                                a->settings.bake.smooth.addressing, &in->slope, &err);
+    st = bb_slope_map(&r->filtered, a->settings.bake.height_scale,
+                      a->settings.bake.smooth.addressing, &in->slope, &err);
     if (st != BB_OK)
       return cli_status_exit(a->height_path, st, &err);
     in->view.slope = &in->slope;
   }
-  return add_line(in, "render_from", "height");
+  return 0;
 }
 
 static int load_albedo(const render_args *a, render_inputs *in) {
@@ -503,10 +460,9 @@ static int load_albedo(const render_args *a, render_inputs *in) {
     return BB_EXIT_FAILURE;
   }
   in->view.albedo = &in->albedo;
-  char hash[32];
-  snprintf(hash, sizeof hash, "%016llx", (unsigned long long)bb_image_hash(&in->albedo));
-  int rc = add_line(in, "albedo", file_name_of(a->albedo_path));
-  return rc ? rc : add_line(in, "albedo_hash", hash);
+  in->sources.albedo = a->albedo_path;
+  in->sources.albedo_hash = bb_image_hash(&in->albedo);
+  return 0;
 }
 
 /* -------------------------------------------------------------- pictures */
@@ -535,94 +491,99 @@ static int make_picture(const render_args *a, const render_inputs *in, double az
   return cli_status_exit(a->output, st, &err);
 }
 
-/* Provenance lines of one picture: the inputs', then the options'. */
-static char *picture_lines(const render_args *a, const render_inputs *in, double azimuth,
-                           int frame) {
+/* The provenance of one picture: the input's keys, the bake's when a
+ * height was baked, then the render's (bb_render_provenance). */
+static char *describe(const render_args *a, const char *command_line, const render_inputs *in,
+                      double azimuth, int frame) {
   bb_render_options o = a->render;
   o.light_azimuth = azimuth;
-  char *opts = bb_render_options_describe(&o);
-  if (!opts)
+  bb_render_sources sources = in->sources;
+  sources.frame = frame;
+  sources.frames = a->orbit;
+  char *extra = bb_render_provenance(&sources, &o);
+  if (!extra)
     return NULL;
-  char head[64] = "";
-  if (a->orbit)
-    snprintf(head, sizeof head, "frame=%d/%d\n", frame, a->orbit);
-  size_t len = strlen(in->extra) + strlen(opts) + strlen(head) + 1;
-  char *all = malloc(len);
-  if (all)
-    snprintf(all, len, "%s%s%s", in->extra, opts, head);
-  free(opts);
-  return all;
-}
-
-static int write_picture(const render_args *a, const cli_run *run,
-                         const render_inputs *in, double azimuth, int frame,
-                         const char *path, const bb_image *img) {
-  char *extra = picture_lines(a, in, azimuth, frame);
-  if (!extra) {
-    cli_file_error(path, "out of memory");
-    return BB_EXIT_FAILURE;
-  }
-  const bb_bake_options *bake = a->height_path ? &a->settings.bake : NULL;
-  int rc = cli_render_write(run, bake, extra, a->compare ? "render-compare" : "render",
-                            path, img, a->settings.depth);
+  const char *slash = strrchr(in->input, '/');
+  const int baked = a->height_path != NULL;
+  const int traced = baked && (a->settings.bake.outputs & BB_OUTPUTS_TRACED);
+  bb_provenance p = {command_line,
+                     slash ? slash + 1 : in->input,
+                     in->input_hash,
+                     a->compare ? "render-compare" : "render",
+                     baked ? &a->settings.bake : NULL,
+                     baked ? a->settings.channel : BB_CHANNEL_AUTO,
+                     traced ? in->bake.rayset_id : NULL,
+                     baked ? in->source.file_hash : 0,
+                     extra};
+  char *text = bb_provenance_format(&p);
   free(extra);
-  return rc;
+  return text;
 }
 
-/* OUT_007.png for frame 7 of OUT.png; four digits past 1000 frames (--orbit
- * stops at 3600). */
-static char *frame_path(const char *output, int frame, int frames) {
-  const char *slash = strrchr(output, '/');
-  const char *dot = strrchr(slash ? slash + 1 : output, '.');
-  size_t stem = dot ? (size_t)(dot - output) : strlen(output);
-  size_t len = strlen(output) + 8;
-  char *path = malloc(len);
-  if (path)
-    snprintf(path, len, frames > 1000 ? "%.*s_%04d%s" : "%.*s_%03d%s", (int)stem, output,
-             frame % 10000, dot ? dot : "");
-  return path;
+/* Encodes one picture under a temporary name; the caller commits it. */
+static int stage_picture(const render_args *a, const char *command_line,
+                         const render_inputs *in, double azimuth, int frame, const char *path,
+                         int *labels, bb_staged_file **staged) {
+  bb_image picture = {0};
+  int rc = make_picture(a, in, azimuth, &picture, labels);
+  char *text = rc ? NULL : describe(a, command_line, in, azimuth, frame);
+  if (!rc && !text) {
+    cli_file_error(path, "out of memory");
+    rc = BB_EXIT_FAILURE;
+  }
+  if (!rc) {
+    const bb_write_options wo = {a->settings.depth, BB_RANGE_UNIT, text};
+    bb_error err = {{0}};
+    rc = cli_status_exit(path, bb_image_write_staged(path, &picture, &wo, staged, &err), &err);
+  }
+  free(text);
+  bb_image_free(&picture);
+  return rc;
 }
 
 static double frame_azimuth(const render_args *a, int frame) {
   return a->render.light_azimuth + 360.0 * frame / (a->orbit ? a->orbit : 1);
 }
 
-static int write_single(const render_args *a, const cli_run *run, const render_inputs *in,
-                        int *labels) {
-  bb_image picture = {0};
-  int rc = make_picture(a, in, a->render.light_azimuth, &picture, labels);
-  if (!rc)
-    rc = write_picture(a, run, in, a->render.light_azimuth, 0, a->output, &picture);
-  bb_image_free(&picture);
-  if (!rc && !a->quiet)
-    printf("wrote %s %s\n", a->compare ? "comparison" : "render", a->output);
-  return rc;
-}
-
-static int write_frames(const render_args *a, const cli_run *run, const render_inputs *in,
-                        int *labels) {
-  int rc = 0;
-  char *first = NULL, *last = NULL;
-  for (int f = 0; f < a->orbit && !rc; f++) {
-    bb_image picture = {0};
-    char *path = frame_path(a->output, f, a->orbit);
-    rc = path ? make_picture(a, in, frame_azimuth(a, f), &picture, labels)
-              : BB_EXIT_FAILURE;
-    if (!rc)
-      rc = write_picture(a, run, in, frame_azimuth(a, f), f, path, &picture);
-    bb_image_free(&picture);
-    if (f == 0)
-      first = path;
-    else {
-      free(last);
-      last = path;
+/* The picture, or every frame of an orbit, staged one by one (a frame in
+ * memory at a time) and then put in place together: an orbit interrupted
+ * or failed leaves the old frames, all of them. */
+static int write_pictures(const render_args *a, const char *command_line,
+                          const render_inputs *in, int *labels) {
+  const int n = a->orbit ? a->orbit : 1;
+  bb_staged_file **staged = calloc((size_t)n, sizeof *staged);
+  char **paths = calloc((size_t)n, sizeof *paths);
+  const char **kinds = calloc((size_t)n, sizeof *kinds);
+  int rc = staged && paths && kinds ? 0 : BB_EXIT_FAILURE;
+  if (rc)
+    cli_file_error(a->output, "out of memory");
+  for (int f = 0; f < n && !rc; f++) {
+    paths[f] = a->orbit ? bb_render_frame_path(a->output, f, a->orbit) : strdup(a->output);
+    kinds[f] = a->compare ? "comparison" : "render";
+    rc = paths[f] ? stage_picture(a, command_line, in, frame_azimuth(a, f), f, paths[f],
+                                  labels, &staged[f])
+                  : BB_EXIT_FAILURE;
+  }
+  if (!rc) {
+    bb_error err = {{0}};
+    bb_status st = bb_staged_files_commit(staged, kinds, n, &err);
+    if (st != BB_OK) {
+      cli_error_line(err.message);
+      rc = BB_EXIT_FAILURE;
     }
   }
-  if (!rc && !a->quiet)
-    printf("wrote %d frames %s%s%s\n", a->orbit, first, last ? " .. " : "",
-           last ? last : "");
-  free(first);
-  free(last);
+  for (int f = 0; staged && f < n; f++)
+    bb_staged_file_discard(staged[f]);
+  if (!rc && !a->quiet && !a->orbit)
+    cli_printf_line("wrote %s %s", a->compare ? "comparison" : "render", a->output);
+  else if (!rc && !a->quiet)
+    cli_printf_line("wrote %d frames %s%s%s", a->orbit, paths[0], n > 1 ? " .. " : "",
+                    n > 1 ? paths[n - 1] : "");
+  for (int f = 0; paths && f < n; f++)
+    free(paths[f]);
+  free(paths);
+  free(kinds);
+  free(staged);
   return rc;
 }
 
@@ -648,23 +609,21 @@ static int write_gif(const render_args *a, const render_inputs *in, int *labels)
   }
   rc = cli_status_exit(a->output, bb_animation_close(anim, &err), &err);
   if (!rc && !a->quiet)
-    printf("wrote orbit %s (%d frames)\n", a->output, a->orbit);
+    cli_printf_line("wrote orbit %s (%d frames)", a->output, a->orbit);
   return rc;
 }
 
-static int render_run(cli_run *run, render_args *a) {
+static int render_run(const char *command_line, render_args *a) {
   render_inputs in;
   memset(&in, 0, sizeof in);
-  int rc = a->height_path ? bake_height(a, run, &in) : load_maps(a, run, &in);
+  int rc = a->height_path ? bake_height(a, &in) : load_maps(a, &in);
   if (!rc)
     rc = load_albedo(a, &in);
   int labels = 1;
-  if (!rc && !a->orbit)
-    rc = write_single(a, run, &in, &labels);
-  else if (!rc && has_extension(a->output, ".gif"))
+  if (!rc && a->orbit && has_extension(a->output, ".gif"))
     rc = write_gif(a, &in, &labels);
   else if (!rc)
-    rc = write_frames(a, run, &in, &labels);
+    rc = write_pictures(a, command_line, &in, &labels);
   if (!rc && !labels)
     cli_render_no_font_note(render_command.name);
   inputs_free(&in);
@@ -672,8 +631,8 @@ static int render_run(cli_run *run, render_args *a) {
 }
 
 int bb_cli_render(int argc, char **argv) {
-  cli_run run;
-  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+  char *command_line = cli_command_line(argc, argv); /* before getopt permutes argv */
+  if (!command_line)
     return BB_EXIT_FAILURE;
   render_args a;
   memset(&a, 0, sizeof a);
@@ -683,7 +642,7 @@ int bb_cli_render(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = render_run(&run, &a);
-  cli_run_free(&run);
+    rc = render_run(command_line, &a);
+  free(command_line);
   return rc;
 }

@@ -1,5 +1,5 @@
-/* cli_render_common.c: the lighting options and the provenance writer that
- * `render` and `sheet` share. */
+/* render_common.c: the lighting options that `render` and `sheet` share. */
+#include "common.h"
 #include "render_common.h"
 
 #include <math.h>
@@ -151,50 +151,6 @@ int cli_render_apply_lighting(const char *command, bb_render_options *o, int *li
   default:
     return -1;
   }
-}
-
-static const char *file_name_of(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
-/* bb_provenance_format's lines followed by extra's, malloc'd. */
-static char *describe(const cli_run *run, const bb_bake_options *bake, const char *extra,
-                      const char *kind) {
-  bb_provenance p = {run->command_line,
-                     run->input_path ? file_name_of(run->input_path) : NULL,
-                     run->input_hash,
-                     kind,
-                     bake,
-                     run->settings ? run->settings->channel : BB_CHANNEL_AUTO,
-                     run->rayset_id,
-                     run->input_file_hash};
-  char *base = bb_provenance_format(&p);
-  if (!base || !extra)
-    return base;
-  size_t a = strlen(base), b = strlen(extra);
-  char *all = realloc(base, a + b + 1);
-  if (!all) {
-    free(base);
-    return NULL;
-  }
-  memcpy(all + a, extra, b + 1);
-  return all;
-}
-
-int cli_render_write(const cli_run *run, const bb_bake_options *bake, const char *extra,
-                     const char *kind, const char *path, const bb_image *img,
-                     bb_depth depth) {
-  char *description = describe(run, bake, extra, kind);
-  if (!description) {
-    cli_file_error(path, "out of memory");
-    return BB_EXIT_FAILURE;
-  }
-  bb_write_options wo = {depth, BB_RANGE_UNIT, description};
-  bb_error err = {{0}};
-  bb_status st = bb_image_write(path, img, &wo, &err);
-  free(description);
-  return cli_status_exit(path, st, &err);
 }
 
 void cli_render_no_font_note(const char *command) {

@@ -1,11 +1,12 @@
-/* cli_render_common.h: what `render` and `sheet` share: the lighting
- * options (--light, --light-color, --lightmap, --specular, --mode), writing
- * a picture with its provenance, and the note printed when labels could not
- * be drawn. Nothing here is part of the library. */
+/* render_common.h: what `render` and `sheet` share: the lighting options
+ * (--light, --light-color, --lightmap, --specular, --mode) and the note
+ * printed when labels could not be drawn. Nothing here is part of the
+ * library. */
 #ifndef BB_CLI_RENDER_COMMON_H
 #define BB_CLI_RENDER_COMMON_H
 
-#include "common.h"
+#include "bumpbake.h"
+#include "options.h"
 
 /* Option ids of render and sheet, after cli_common's (which stay below 1000). */
 enum {
@@ -44,13 +45,6 @@ extern const cli_option cli_render_opt_mode, cli_render_opt_light,
  * given (in either order): *light_given tracks that. */
 int cli_render_apply_lighting(const char *command, bb_render_options *o, int *light_given,
                               const cli_option *opt, const char *arg);
-
-/* Writes img to path with provenance: the run's command line and input,
- * the bake options when bake is not NULL, then the lines of extra (may be
- * NULL). Prints the error and returns BB_EXIT_FAILURE on failure. */
-int cli_render_write(const cli_run *run, const bb_bake_options *bake, const char *extra,
-                     const char *kind, const char *path, const bb_image *img,
-                     bb_depth depth);
 
 /* The note for a picture whose labels could not be drawn. */
 void cli_render_no_font_note(const char *command);

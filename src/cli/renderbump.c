@@ -1,13 +1,15 @@
-/* cli_renderbump.c: `bumpbake renderbumpflat`, DOOM 3's RenderBumpFlat: a
+/* renderbump.c: `bumpbake renderbumpflat`, DOOM 3's RenderBumpFlat: a
  * flat sculpt (a model file) to its normal map, and optionally its height
  * with the scale that `bumpbake bake` needs to make ssbump and ao from it. */
+#include "cli.h"
 #include "common.h"
+#include "options.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Option ids of this command only (the shared ones are in cli_common.h). */
+/* Option ids of this command only (the shared ones are in options.h). */
 enum {
   OPT_SIZE = 1000, /* -size W H, taken out of argv before getopt */
   OPT_RECT,        /* --rect L B R T, likewise */
@@ -193,21 +195,21 @@ static int take_multi_value_options(rbf_args *a, int *argc, char **argv) {
 
 static int check_outputs(rbf_args *a) {
   if (!a->output) {
-    a->default_output = cli_path_with_suffix(a->model, "_local.tga");
+    a->default_output = bb_path_with_suffix(a->model, "_local.tga");
     if (!a->default_output) {
       cli_file_error(a->model, "out of memory");
       return BB_EXIT_FAILURE;
     }
     a->output = a->default_output;
   }
-  int rc = cli_check_output(rbf_command.name, a->model, a->output, BB_DEPTH_DEFAULT);
-  if (!rc && a->height) {
-    if (cli_same_file(a->height, a->output))
-      return cli_usage_error(rbf_command.name, "--height and the normal map are both %s",
-                             a->output);
-    rc = cli_check_output(rbf_command.name, a->model, a->height, BB_DEPTH_DEFAULT);
-  }
-  return rc;
+  if (a->height && bb_same_file(a->height, a->output))
+    return cli_usage_error(rbf_command.name, "--height and the normal map are both %s",
+                           a->output);
+  const bb_output_spec specs[2] = {{a->output, "normal", 4, BB_DEPTH_DEFAULT, 0, 0},
+                                   {a->height, "height", 1, BB_DEPTH_DEFAULT, 0, 0}};
+  bb_error err = {{0}};
+  bb_status st = bb_outputs_check(specs, a->height ? 2 : 1, &a->model, 1, &err);
+  return st == BB_OK ? 0 : cli_library_error(rbf_command.name, st, &err);
 }
 
 static int rbf_parse(int argc, char **argv, rbf_args *a) {
@@ -229,60 +231,9 @@ static int rbf_parse(int argc, char **argv, rbf_args *a) {
 
 /* ------------------------------------------------------------- running */
 
-/* Provenance of one output: the common lines, then the render's. */
-static char *describe(const cli_run *run, const rbf_args *a, uint64_t model_hash,
-                      const char *kind, const bb_renderbump_result *r) {
-  const char *slash = strrchr(a->model, '/');
-  bb_provenance p = {run->command_line, slash ? slash + 1 : a->model, model_hash, kind,
-                     NULL, BB_CHANNEL_AUTO, NULL, 0};
-  char *common = bb_provenance_format(&p), *own = bb_renderbump_describe(&a->render, r);
-  char *all = NULL;
-  if (common && own) {
-    char line[32];
-    snprintf(line, sizeof line, "normal_y=%s\n", a->settings.bake.normal_y_up ? "up" : "down");
-    size_t len = strlen(common) + strlen(own) + strlen(line) + 1;
-    all = malloc(len);
-    if (all)
-      snprintf(all, len, "%s%s%s", common, own, line);
-  }
-  free(common);
-  free(own);
-  return all;
-}
-
-/* Stages img for out->path (complete under a temporary name) with its own
- * provenance text, which it frees; cli_commit_outputs puts the normal map
- * and the height in place together or neither. */
-static void stage_image(cli_staged_output *out, const bb_image *img, bb_depth depth,
-                        bb_range range, char *description) {
-  out->file = NULL;
-  if (!description) {
-    out->status = BB_ERR_MEMORY;
-    snprintf(out->error.message, sizeof out->error.message, "out of memory");
-    return;
-  }
-  bb_write_options wo = {depth, range, description};
-  out->status = bb_image_write_staged(out->path, img, &wo, &out->file, &out->error);
-  free(description);
-}
-
-/* Integer files hold 0.5 + 0.5 N and the coverage as it is, so RGB is
- * encoded here (BB_RANGE_SIGNED would encode alpha too); files that only
- * hold floats (EXR) store N raw, as every bumpbake normal map. */
-static void encode_for(const char *path, bb_image *normal, bb_range *range) {
-  *range = BB_RANGE_SIGNED; /* float files store every channel raw */
-  if (!bb_path_supports_depth(path, BB_DEPTH_8))
-    return;
-  size_t texels = (size_t)normal->width * (size_t)normal->height;
-  for (size_t i = 0; i < texels; i++)
-    for (int c = 0; c < 3; c++)
-      normal->pixels[4 * i + (size_t)c] = 0.5f + 0.5f * normal->pixels[4 * i + (size_t)c];
-  *range = BB_RANGE_UNIT;
-}
-
 static void print_summary(const rbf_args *a, const bb_mesh *mesh, const bb_renderbump_result *r) {
-  printf("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
-         "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each\n",
+  cli_printf_line("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
+         "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each",
          a->model, mesh->triangle_count, r->used_vertex_normals ? "vertex" : "face",
          bb_axis_name(a->render.axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
          a->render.width, a->render.height, a->render.samples * a->render.samples);
@@ -299,37 +250,31 @@ static void note_texel_aspect(const rbf_args *a, const bb_renderbump_result *r) 
           r->texel_aspect, (r->rect[2] - r->rect[0]) / (r->rect[3] - r->rect[1]));
 }
 
-static int write_outputs(const cli_run *run, const rbf_args *a, const bb_mesh *mesh,
-                         bb_renderbump_result *r) {
-  uint64_t hash = bb_mesh_hash(mesh);
-  char *normal_text = describe(run, a, hash, "normal+coverage", r);
-  if (a->settings.bake.normal_y_up)
-    bb_image_flip_green(&r->normal);
-  bb_range range;
-  encode_for(a->output, &r->normal, &range);
-  cli_staged_output outs[2] = {{.kind = "normal", .path = a->output},
-                               {.kind = "height", .path = a->height}};
-  const int n = a->height ? 2 : 1;
-  stage_image(&outs[0], &r->normal, BB_DEPTH_DEFAULT, range, normal_text);
-  if (a->height) {
-    bb_depth depth =
-        bb_path_supports_depth(a->height, BB_DEPTH_16) ? BB_DEPTH_16 : BB_DEPTH_DEFAULT;
-    stage_image(&outs[1], &r->height, depth, BB_RANGE_UNIT,
-                describe(run, a, hash, "height", r));
+static int write_outputs(const char *command_line, const rbf_args *a, const bb_mesh *mesh,
+                         const bb_renderbump_result *r) {
+  bb_error err = {{0}};
+  bb_status st = bb_renderbump_write(r, &a->render, a->settings.bake.normal_y_up, a->model,
+                                     bb_mesh_hash(mesh), command_line, a->output, a->height,
+                                     &err);
+  if (st != BB_OK) {
+    cli_error_line(err.message);
+    return BB_EXIT_FAILURE;
   }
-  int rc = cli_commit_outputs(outs, n);
-  for (int i = 0; i < n && !rc && !a->quiet; i++)
-    printf("wrote %s %s\n", outs[i].kind, outs[i].path);
-  if (!rc && a->height) {
+  if (!a->quiet) {
+    cli_printf_line("wrote normal %s", a->output);
+    if (a->height)
+      cli_printf_line("wrote height %s", a->height);
+  }
+  if (a->height) {
     note_texel_aspect(a, r);
     /* The one number the height is useless without: printed even with -q. */
-    printf("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)\n",
-           r->height_scale, a->height, r->height_scale);
+    cli_printf_line("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)",
+                    r->height_scale, a->height, r->height_scale);
   }
-  return rc;
+  return 0;
 }
 
-static int rbf_run(cli_run *run, rbf_args *a) {
+static int rbf_run(const char *command_line, rbf_args *a) {
   bb_mesh mesh;
   bb_renderbump_result result;
   memset(&mesh, 0, sizeof mesh);
@@ -342,7 +287,7 @@ static int rbf_run(cli_run *run, rbf_args *a) {
   if (!rc) {
     if (!a->quiet)
       print_summary(a, &mesh, &result);
-    rc = write_outputs(run, a, &mesh, &result);
+    rc = write_outputs(command_line, a, &mesh, &result);
   }
   bb_renderbump_result_free(&result);
   bb_mesh_free(&mesh);
@@ -350,8 +295,8 @@ static int rbf_run(cli_run *run, rbf_args *a) {
 }
 
 int bb_cli_renderbumpflat(int argc, char **argv) {
-  cli_run run;
-  if (cli_run_init(&run, argc, argv)) /* before argv is rearranged */
+  char *command_line = cli_command_line(argc, argv); /* before argv is rearranged */
+  if (!command_line)
     return BB_EXIT_FAILURE;
   rbf_args a;
   memset(&a, 0, sizeof a);
@@ -361,8 +306,8 @@ int bb_cli_renderbumpflat(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = rbf_run(&run, &a);
+    rc = rbf_run(command_line, &a);
   free(a.default_output);
-  cli_run_free(&run);
+  free(command_line);
   return rc;
 }

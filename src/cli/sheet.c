@@ -1,5 +1,9 @@
-/* cli_sheet.c: `bumpbake sheet`, one labelled contact sheet of every map of
- * a bake and one lit render. */
+/* sheet.c: `bumpbake sheet`, one labelled contact sheet of every map of a
+ * bake and one lit render. */
+#include "cli.h"
+#include "common.h"
+#include "options.h"
+#include "progress.h"
 #include "render_common.h"
 
 #include <stdlib.h>
@@ -95,42 +99,62 @@ static int sheet_parse(int argc, char **argv, sheet_args *a, const char **input)
                            "--mode slope is render's (bumpbake render HEIGHT --mode slope); "
                            "the sheet lights the ssbump, normal or ao");
   a->sheet.lit.threads = a->settings.bake.trace.threads;
-  return cli_check_output(sheet_command.name, *input, a->output, a->settings.depth);
+  const bb_output_spec spec = {a->output, "sheet", 0, a->settings.depth, 0, 0};
+  bb_error err = {{0}};
+  bb_status st = bb_outputs_check(&spec, 1, input, 1, &err);
+  return st == BB_OK ? 0 : cli_library_error(sheet_command.name, st, &err);
 }
 
-static int sheet_run(cli_run *run, sheet_args *a, const char *input) {
+/* The sheet's provenance: the height's and the bake's keys, then the lit
+ * panel's options. */
+static char *describe(const sheet_args *a, const char *command_line, const char *input,
+                      const bb_height_source *source, const bb_bake_result *result) {
+  char *extra = bb_render_options_describe(&a->sheet.lit);
+  if (!extra)
+    return NULL;
+  const char *slash = strrchr(input, '/');
+  bb_provenance p = {command_line, slash ? slash + 1 : input, source->height_hash, "sheet",
+                     &a->settings.bake, a->settings.channel, result->rayset_id,
+                     source->file_hash, extra};
+  char *text = bb_provenance_format(&p);
+  free(extra);
+  return text;
+}
+
+static int sheet_run(const char *command_line, sheet_args *a, const char *input) {
   bb_image height = {0}, sheet = {0};
   bb_bake_result result;
   memset(&result, 0, sizeof result);
-  int rc = cli_load_height(input, &a->settings, &height);
+  bb_height_source source;
+  bb_error err = {{0}};
+  bb_status st = bb_height_file_read(input, a->settings.channel, a->settings.bake.height_scale,
+                                     cli_note, NULL, &height, &source, &err);
+  int rc = cli_status_exit(input, st, &err);
   if (!rc) {
     cli_progress progress;
     cli_progress_attach(&progress, "sheet", a->quiet, &a->settings.bake.trace);
-    rc = cli_run_bake(input, &height, &a->settings.bake, &result);
+    rc = cli_status_exit(input, bb_bake(&height, &a->settings.bake, &result, &err), &err);
     cli_progress_finish(&progress);
   }
   int labels = 1;
-  if (!rc) {
-    bb_error err = {{0}};
+  if (!rc)
     rc = cli_status_exit(
-        a->output, bb_sheet_make(&height, &result, &a->sheet, &sheet, &labels, &err),
-        &err);
+        a->output, bb_sheet_make(&height, &result, &a->sheet, &sheet, &labels, &err), &err);
+  char *text = rc ? NULL : describe(a, command_line, input, &source, &result);
+  if (!rc && !text) {
+    cli_file_error(a->output, "out of memory");
+    rc = BB_EXIT_FAILURE;
   }
   if (!rc) {
-    cli_run_set_input(run, input, &height, &a->settings);
-    run->rayset_id = result.rayset_id;
-    char *extra = bb_render_options_describe(&a->sheet.lit);
-    rc = extra ? cli_render_write(run, &a->settings.bake, extra, "sheet", a->output,
-                                  &sheet, a->settings.depth)
-               : BB_EXIT_FAILURE;
-    if (!extra)
-      cli_file_error(a->output, "out of memory");
-    free(extra);
+    const bb_output_file file = {a->output, "sheet", &sheet, BB_RANGE_UNIT, a->settings.depth,
+                                 0, text, NULL, 0};
+    rc = cli_status_exit(a->output, bb_outputs_write(&file, 1, 1, &err), &err);
   }
+  free(text);
   if (!rc && !labels)
     cli_render_no_font_note(sheet_command.name);
   if (!rc && !a->quiet)
-    printf("wrote sheet %s\n", a->output);
+    cli_printf_line("wrote sheet %s", a->output);
   bb_image_free(&sheet);
   bb_bake_result_free(&result);
   bb_image_free(&height);
@@ -138,8 +162,8 @@ static int sheet_run(cli_run *run, sheet_args *a, const char *input) {
 }
 
 int bb_cli_sheet(int argc, char **argv) {
-  cli_run run;
-  if (cli_run_init(&run, argc, argv)) /* before getopt permutes argv */
+  char *command_line = cli_command_line(argc, argv); /* before getopt permutes argv */
+  if (!command_line)
     return BB_EXIT_FAILURE;
   sheet_args a;
   memset(&a, 0, sizeof a);
@@ -150,7 +174,7 @@ int bb_cli_sheet(int argc, char **argv) {
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
   else if (rc == 0)
-    rc = sheet_run(&run, &a, input);
-  cli_run_free(&run);
+    rc = sheet_run(command_line, &a, input);
+  free(command_line);
   return rc;
 }

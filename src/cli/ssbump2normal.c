@@ -1,5 +1,7 @@
 /* cli_ssbump2normal.c: `bumpbake ssbump2normal`, the normal an ssbump (or
  * normal2ssbump's weights) stands for: the paper's normalize(sum s_c B_c). */
+#include "cli.h"
+#include "common.h"
 #include "maps.h"
 
 #include <string.h>
@@ -75,8 +77,7 @@ static int s2n_parse(int argc, char **argv, s2n_args *a, const char **input) {
   *input = argv[first];
   if (!a->output)
     return cli_usage_error(s2n_command.name, "-o OUT is required");
-  int rc2 = cli_check_output(s2n_command.name, *input, a->output, a->settings.depth);
-  return rc2 ? rc2 : cli_check_mips(s2n_command.name, &a->settings, a->output);
+  return cli_maps_check_output(s2n_command.name, *input, a->output, &a->settings);
 }
 
 static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
@@ -84,7 +85,7 @@ static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
   bb_image_info info = {0};
   int rc = cli_maps_read(input, &ssbump, &info);
   if (!rc)
-    rc = cli_check_hl2_map(input, &ssbump, &info);
+    rc = cli_maps_check_hl2(input, &ssbump, &info);
   if (!rc) {
     bb_error err = {{0}};
     rc = cli_status_exit(input, bb_ssbump_to_normal(&ssbump, a->kind, &normals, &err),

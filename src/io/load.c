@@ -38,6 +38,7 @@ static bb_status resolve_pick(int channels, int alpha_channel, bb_channel channe
   p->index = 0;
   switch (channel) {
   case BB_CHANNEL_AUTO:
+  case BB_CHANNEL_VALVE: /* resolved by bb_height_channel before this */
   case BB_CHANNEL_MEAN:
     if (colour) p->kind = PICK_MEAN;
     return BB_OK;

@@ -176,6 +176,13 @@ char *bb_provenance_format(const bb_provenance *p) {
   if (p->options)
     put_smoothing_and_tracing(&t, p->options);
   put(&t, "channel", bb_channel_name(p->channel));
+  if (p->extra) {
+    /* Lines of the caller's, each ended by a newline. */
+    size_t n = strlen(p->extra);
+    text_append(&t, p->extra, n);
+    if (n && p->extra[n - 1] != '\n')
+      text_append(&t, "\n", 1);
+  }
 
   if (t.failed) {
     free(t.data);

@@ -29,7 +29,9 @@
 
 /* Slots of temporaries that exist right now. A slot is FREE, being FILLED
  * by its owner, or LIVE (its path is complete and may be unlinked). */
-enum { TEMP_SLOTS = 64 };
+/* Enough for every frame of the longest orbit (3600) staged at once; the
+ * table is zero pages until used. */
+enum { TEMP_SLOTS = 4096 };
 enum { SLOT_FREE = 0, SLOT_FILLED, SLOT_LIVE };
 static atomic_int slot_state[TEMP_SLOTS];
 static char slot_path[TEMP_SLOTS][PATH_MAX];

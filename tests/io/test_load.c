@@ -63,6 +63,20 @@ static float expected(const bb_image *img, int x, int y, bb_channel ch) {
   return t[0];
 }
 
+/* The rule asked for ch gives the heights of channel as (AUTO resolves). */
+static void check_rule_as(const bb_image *img, int alpha_channel, bb_channel ch, bb_channel as) {
+  bb_image h;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_height_from_image(img, alpha_channel, ch, &h, &err), BB_OK, "%s",
+               err.message);
+  for (int y = 0; y < img->height; y++)
+    for (int x = 0; x < img->width; x++)
+      cr_assert_eq(*bb_image_texel(&h, x, y), expected(img, x, y, as),
+                   "%d channels, '%s' as '%s', texel (%d, %d)", img->channels,
+                   bb_channel_name(ch), bb_channel_name(as), x, y);
+  bb_image_free(&h);
+}
+
 static void check_rule(const bb_image *img, int alpha_channel, bb_channel ch) {
   bb_image h;
   bb_error err = {{0}};
@@ -174,11 +188,31 @@ Test(load, luma_uses_rec709_weights) {
   bb_image_free(&img);
 }
 
-Test(load, rgba_image_ignores_alpha_unless_asked) {
+/* Valve's convention where the image shows it: a colour (R, G, B differ)
+ * with a graded alpha bakes the alpha; the mean is there when asked. */
+Test(load, rgba_colour_with_graded_alpha_takes_alpha) {
   bb_image img = make_image(3, 3, 4);
-  check_rule(&img, 3, BB_CHANNEL_AUTO);
+  check_rule_as(&img, 3, BB_CHANNEL_AUTO, BB_CHANNEL_A);
+  check_rule_as(&img, -1, BB_CHANNEL_AUTO, BB_CHANNEL_A); /* an unflagged 4th is alpha */
+  check_rule(&img, 3, BB_CHANNEL_MEAN);
   check_rule(&img, 3, BB_CHANNEL_A);
-  check_rule(&img, -1, BB_CHANNEL_A); /* an unflagged 4th channel is alpha */
+  bb_image_free(&img);
+}
+
+/* A cutout mask (alpha at its extremes but for an edge) is no height: the
+ * colour's mean stays the height. */
+Test(load, rgba_colour_with_a_mask_keeps_the_colour) {
+  bb_image img = make_image(4, 4, 4);
+  for (int i = 0; i < 16; i++)
+    img.pixels[4 * i + 3] = i < 9 ? 1.0f : i < 15 ? 0.0f : 0.5f;
+  check_rule_as(&img, 3, BB_CHANNEL_AUTO, BB_CHANNEL_MEAN);
+  /* A grey image with a graded alpha keeps its grey as well. */
+  for (int i = 0; i < 16; i++) {
+    float *t = img.pixels + 4 * i;
+    t[1] = t[2] = t[0];
+    t[3] = 0.1f + 0.05f * (float)i;
+  }
+  cr_assert_eq(bb_height_channel(&img, 3, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   bb_image_free(&img);
 }
 
@@ -237,9 +271,9 @@ Test(load, auto_takes_alpha_when_only_alpha_varies) {
 
 Test(load, auto_keeps_the_colour_otherwise) {
   bb_image img = height_in_alpha(4, 3, 4);
-  /* The last texel's green differs: the colour is a height after all. */
+  /* The last texel's green differs: a colour, and alpha a graded height. */
   bb_image_texel(&img, 3, 2)[1] = 0.5f;
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
   /* A constant alpha too: nothing varies, nothing to prefer. */
   bb_image_texel(&img, 3, 2)[1] = 0.75f;
   for (int i = 0; i < 12; i++)
@@ -345,7 +379,7 @@ Test(load, files_with_one_to_four_channels) {
   check_load("rgb.png", &rgb, BB_CHANNEL_AUTO, STEP_8);
   check_load("rgb.png", &rgb, BB_CHANNEL_LUMA, STEP_8);
   check_load("rgb.png", &rgb, BB_CHANNEL_B, STEP_8);
-  check_load("rgba.tga", &rgba, BB_CHANNEL_AUTO, STEP_8);
+  check_load("rgba.tga", &rgba, BB_CHANNEL_MEAN, STEP_8);
   check_load("rgba.tga", &rgba, BB_CHANNEL_A, STEP_8);
   check_load("rgb.exr", &rgb, BB_CHANNEL_AUTO, 0.0);
   check_load("rgb.exr", &rgb, BB_CHANNEL_G, 0.0);

@@ -81,7 +81,7 @@ static void fixture_init(fixture *f) {
   f->options.height_scale = 8.0f;
   f->p = (bb_provenance){"bumpbake bake a.png --scale 8", "a.png", 0x1234, "normal",
                          &f->options, BB_CHANNEL_AUTO, "bb-horizon-v1:a16:p1:hl2",
-                         0xfeedULL};
+                         0xfeedULL, NULL};
 }
 
 /* An image written with the given description. */

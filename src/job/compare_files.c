@@ -1,0 +1,100 @@
+/* compare_files.c: two image files compared as OpenImageIO's idiff compares
+ * them, their provenance key by key, and the image of their differences. */
+#include "core/internal.h"
+#include "job/job_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Writes |A-B|. EXR keeps the raw differences; integer formats would round
+ * typical golden differences (1e-5) to 0, so the image is scaled to make the
+ * largest finite difference white and NaN/infinite differences clip to 1. */
+static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
+  char ext[16];
+  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
+  const size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
+  if (strcmp(bb__extension(path, ext, sizeof ext), "exr") == 0) {
+    wo.depth = BB_DEPTH_FLOAT;
+  } else {
+    double max_finite = 0;
+    for (size_t i = 0; i < n; i++)
+      if (isfinite(diff->pixels[i]) && diff->pixels[i] > max_finite)
+        max_finite = diff->pixels[i];
+    if (max_finite > 0)
+      for (size_t i = 0; i < n; i++)
+        diff->pixels[i] =
+            isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite) : 1.0f;
+  }
+  return bb_image_write(path, diff, &wo, err);
+}
+
+static void compare_provenance(const bb_image_info *ia, const bb_image_info *ib,
+                               bb_compare_report *r) {
+  r->provenance_a = bb_provenance_classify(ia->description);
+  r->provenance_b = bb_provenance_classify(ib->description);
+  r->provenance_differences = -1;
+  if (r->provenance_a != BB_PROVENANCE_INTACT || r->provenance_b != BB_PROVENANCE_INTACT)
+    return;
+  /* Room for every line of both texts, so no difference is cut off. */
+  const size_t cap = strlen(ia->description) + strlen(ib->description) + 1024;
+  r->provenance_diff = malloc(cap);
+  if (!r->provenance_diff)
+    return;
+  r->provenance_differences =
+      bb_provenance_diff(ia->description, ib->description, r->provenance_diff, cap);
+  if (r->provenance_differences < 0) {
+    free(r->provenance_diff);
+    r->provenance_diff = NULL;
+  }
+}
+
+bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
+                           const char *diff_path, bb_compare_report *report, bb_error *err) {
+  if (!a || !b || !report)
+    return bb__fail(err, BB_ERR_ARGUMENT, "compare: bad arguments");
+  memset(report, 0, sizeof *report);
+  report->provenance_differences = -1;
+  bb_compare_limits defaults;
+  bb_compare_limits_init(&defaults);
+  if (!limits)
+    limits = &defaults;
+  bb_image x = {0}, y = {0};
+  bb_image_info ix = {0}, iy = {0};
+  bb_status st = bb_image_read(a, &x, &ix, err);
+  if (st == BB_OK)
+    st = bb_image_read(b, &y, &iy, err);
+  if (st == BB_OK) {
+    report->width = x.width, report->height = x.height, report->channels = x.channels;
+    report->b_width = y.width, report->b_height = y.height, report->b_channels = y.channels;
+    report->same_shape =
+        x.width == y.width && x.height == y.height && x.channels == y.channels;
+    report->verdict = BB_COMPARE_FAIL;
+  }
+  bb_image diff = {0};
+  if (st == BB_OK && report->same_shape) {
+    st = bb_compare_images(&x, &y, limits->fail, limits->warn, &report->stats,
+                           diff_path ? &diff : NULL, err);
+    if (st == BB_OK) {
+      compare_provenance(&ix, &iy, report);
+      report->verdict = bb_compare_judge(&report->stats, limits);
+      if (diff_path)
+        report->diff_written = write_diff(diff_path, &diff, &report->diff_error) == BB_OK;
+    }
+  }
+  bb_image_free(&diff);
+  bb_image_free(&x);
+  bb_image_free(&y);
+  bb_image_info_free(&ix);
+  bb_image_info_free(&iy);
+  if (st != BB_OK)
+    bb_compare_report_free(report);
+  return st;
+}
+
+void bb_compare_report_free(bb_compare_report *report) {
+  if (!report)
+    return;
+  free(report->provenance_diff);
+  report->provenance_diff = NULL;
+}

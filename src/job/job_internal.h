@@ -1,0 +1,70 @@
+/* job_internal.h: what the job family's files share (not public): path
+ * parts, depfile rules, and the planned job itself. */
+#ifndef BB_JOB_INTERNAL_H
+#define BB_JOB_INTERNAL_H
+
+#include "bumpbake.h"
+
+#include <stddef.h>
+
+/* ------------------------------------------------------------ path parts */
+
+/* The last component of path (after the last '/'). */
+const char *bb__file_name(const char *path);
+
+/* The directory part of path ("." when none) into dir (capacity cap). */
+void bb__directory_part(const char *path, char *dir, size_t cap);
+
+/* The lower-case extension of path's last component, without the dot ("" when
+ * none), into buf (capacity cap); returns buf. */
+const char *bb__extension(const char *path, char *buf, size_t cap);
+
+/* BB_OK when path's directory exists and is a directory and path itself is
+ * not a directory; else BB_ERR_IO "PATH: cannot write: ...". */
+bb_status bb__check_output_directory(const char *path, bb_error *err);
+
+/* --------------------------------------------------------------- depfiles */
+
+/* One rule of a depfile: every target depends on every prerequisite. */
+typedef struct bb__dep_rule {
+  const char *const *targets;
+  int target_count;
+  const char *const *prerequisites;
+  int prerequisite_count;
+} bb__dep_rule;
+
+/* BB_ERR_IO naming the first file name of the rules that a depfile
+ * cannot hold (depfile.c says which characters), else BB_OK. */
+bb_status bb__depfile_check_names(const char *depfile, const bb__dep_rule *rules, int count,
+                                  bb_error *err);
+
+/* The rules as depfile text (malloc'd, *size bytes), NULL when out of memory. */
+char *bb__depfile_text(const bb__dep_rule *rules, int count, size_t *size);
+
+/* ------------------------------------------------------------------- jobs */
+
+/* One input of a job and its outputs (paths malloc'd for a batch, the
+ * options' own for a single input). */
+typedef struct bb__job_item {
+  char *input;
+  char *paths[BB_OUTPUT_KIND_COUNT]; /* NULL = kind not written */
+  char *slope_lit_path;              /* single input with slope_lit */
+  uint64_t file_hash;                /* the bytes checked for currency, 0 = not yet */
+  bb_job_report report;
+} bb__job_item;
+
+struct bb_job {
+  bb_job_options options;   /* as given; options.bake.outputs = the kinds asked */
+  char *basis_file;         /* copies of the options' strings */
+  char *out_dir, *name_template, *depfile, *command, *command_options;
+  char *slope_path;
+  bb__job_item *items;
+  int count;
+  int batch;                /* 1: out_dir names the outputs */
+  char prerequisite_basis;  /* 1: basis_file is a prerequisite (a vectors basis) */
+};
+
+/* The provenance "command" of item i (malloc'd, NULL when out of memory). */
+char *bb__job_command_of(const bb_job *job, const bb__job_item *item);
+
+#endif /* BB_JOB_INTERNAL_H */

@@ -1,0 +1,236 @@
+/* paths.c: the output paths of a command, checked before any work: formats,
+ * depths, channels, clashes, inputs overwritten under any spelling, and
+ * directories. */
+#include "core/internal.h"
+#include "job/job_internal.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdlib.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* ------------------------------------------------------------ path parts */
+
+const char *bb__file_name(const char *path) {
+  const char *slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
+}
+
+void bb__directory_part(const char *path, char *dir, size_t cap) {
+  const char *slash = strrchr(path, '/');
+  if (!slash)
+    snprintf(dir, cap, ".");
+  else if (slash == path)
+    snprintf(dir, cap, "/");
+  else
+    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
+const char *bb__extension(const char *path, char *buf, size_t cap) {
+  const char *dot = strrchr(bb__file_name(path), '.');
+  size_t n = 0;
+  if (dot)
+    for (const char *c = dot + 1; *c && n + 1 < cap; c++)
+      buf[n++] = (char)((*c >= 'A' && *c <= 'Z') ? *c - 'A' + 'a' : *c);
+  buf[n] = '\0';
+  return buf;
+}
+
+char *bb_path_with_suffix(const char *path, const char *suffix) {
+  if (!path || !suffix)
+    return NULL;
+  const char *dot = strrchr(bb__file_name(path), '.');
+  size_t stem = dot ? (size_t)(dot - path) : strlen(path);
+  size_t len = stem + strlen(suffix) + 1;
+  char *out = malloc(len);
+  if (out)
+    snprintf(out, len, "%.*s%s", (int)stem, path, suffix);
+  return out;
+}
+
+/* ------------------------------------------------------------ same file */
+
+/* Which file a path names, worked out once: the file itself when it
+ * exists, and the directory entry a write of it replaces (its directory's
+ * device and inode and its last component) when the directory exists. */
+typedef struct file_identity {
+  int exists;
+  dev_t dev;
+  ino_t ino;
+  int dir_exists;
+  dev_t dir_dev;
+  ino_t dir_ino;
+  const char *name;
+  const char *path;
+} file_identity;
+
+static file_identity identify(const char *path) {
+  file_identity id = {0};
+  id.path = path;
+  struct stat st;
+  if (stat(path, &st) == 0) {
+    id.exists = 1;
+    id.dev = st.st_dev;
+    id.ino = st.st_ino;
+  }
+  char dir[PATH_MAX];
+  bb__directory_part(path, dir, sizeof dir);
+  if (stat(dir, &st) == 0) {
+    id.dir_exists = 1;
+    id.dir_dev = st.st_dev;
+    id.dir_ino = st.st_ino;
+  }
+  id.name = bb__file_name(path);
+  return id;
+}
+
+static int same_identity(const file_identity *a, const file_identity *b) {
+  /* Two names of one existing file (symbolic or hard links, "./", ".."). */
+  if (a->exists && b->exists)
+    return a->dev == b->dev && a->ino == b->ino;
+  /* Files not made yet: the same name in the same directory, however the
+   * directory is spelled. */
+  if (a->dir_exists && b->dir_exists)
+    return a->dir_dev == b->dir_dev && a->dir_ino == b->dir_ino && strcmp(a->name, b->name) == 0;
+  return strcmp(a->path, b->path) == 0;
+}
+
+int bb_same_file(const char *a, const char *b) {
+  if (!a || !b)
+    return 0;
+  const file_identity ia = identify(a), ib = identify(b);
+  return same_identity(&ia, &ib);
+}
+
+/* ----------------------------------------------------------- directories */
+
+bb_status bb_directory_create(const char *path, bb_error *err) {
+  if (!path || !*path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "no directory name given");
+  char buf[PATH_MAX];
+  if (strlen(path) >= sizeof buf)
+    return bb__fail(err, BB_ERR_IO, "%.64s...: cannot create directory: name too long", path);
+  snprintf(buf, sizeof buf, "%s", path);
+  /* Each prefix ending before a '/', then the whole: mkdir -p. */
+  for (char *p = buf + 1;; p++) {
+    const int end = *p == '\0';
+    if (*p != '/' && !end)
+      continue;
+    *p = '\0';
+    struct stat st;
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+      return bb__fail(err, BB_ERR_IO, "%s: cannot create directory: %s", buf,
+                      strerror(errno));
+    if (stat(buf, &st) != 0 || !S_ISDIR(st.st_mode))
+      return bb__fail(err, BB_ERR_IO, "%s: cannot create directory: a file of that name exists",
+                      buf);
+    if (end)
+      break;
+    *p = '/';
+    while (p[1] == '/')
+      p++;
+  }
+  return BB_OK;
+}
+
+bb_status bb__check_output_directory(const char *path, bb_error *err) {
+  char dir[PATH_MAX];
+  bb__directory_part(path, dir, sizeof dir);
+  struct stat st;
+  if (stat(dir, &st) != 0)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: directory %s: %s", path, dir,
+                    strerror(errno));
+  if (!S_ISDIR(st.st_mode))
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s is not a directory", path, dir);
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: is a directory", path);
+  return BB_OK;
+}
+
+/* ---------------------------------------------------------------- checks */
+
+static const char *depth_name(bb_depth d) {
+  switch (d) {
+  case BB_DEPTH_8: return "8";
+  case BB_DEPTH_16: return "16";
+  case BB_DEPTH_HALF: return "half";
+  case BB_DEPTH_FLOAT: return "float";
+  case BB_DEPTH_DEFAULT: break;
+  }
+  return "default";
+}
+
+/* The format rules of one image output: its extension and depth, or (late
+ * is 1) its mip chain and channels, checked after its paths as they always
+ * were, so the first message of several stays the same. */
+static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) {
+  char ext[16];
+  if (late) {
+    if (o->mips && !bb_path_supports_mips(o->path))
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s: --mips needs a .tif or .exr output", o->path);
+    const int room = bb_path_max_channels(o->path);
+    if (o->channels > room)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: %s has %d channels and .%s files hold at most %d (write it as "
+                      ".exr or .tif)",
+                      o->path, o->kind ? o->kind : "the image", o->channels,
+                      bb__extension(o->path, ext, sizeof ext), room);
+    return BB_OK;
+  }
+  if (!bb_path_is_writable_format(o->path)) {
+    if (!bb__extension(o->path, ext, sizeof ext)[0])
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: no extension to choose the format by (use .png, .tga, .tif, "
+                      ".tiff or .exr)",
+                      o->path);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff or .exr)",
+                    o->path, ext);
+  }
+  if (!bb_path_supports_depth(o->path, o->depth))
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in .%s files",
+                    o->path, depth_name(o->depth), bb__extension(o->path, ext, sizeof ext));
+  return BB_OK;
+}
+
+bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
+                           const char *const *reads, int read_count, bb_error *err) {
+  if (count < 0 || (count > 0 && !outputs) || read_count < 0 || (read_count > 0 && !reads))
+    return bb__fail(err, BB_ERR_ARGUMENT, "outputs check: bad arguments");
+  /* Each name is looked up once; the comparisons are then in memory, so
+   * the thousands of frames of an orbit check in a moment. */
+  file_identity *ids = malloc(((size_t)count + (size_t)read_count + 1) * sizeof *ids);
+  if (!ids)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  file_identity *in = ids + count;
+  for (int r = 0; r < read_count; r++)
+    if (reads[r])
+      in[r] = identify(reads[r]);
+  bb_status st = BB_OK;
+  for (int k = 0; k < count && st == BB_OK; k++) {
+    const bb_output_spec *o = &outputs[k];
+    if (!o->path || !*o->path) {
+      st = bb__fail(err, BB_ERR_ARGUMENT, "%s: no file name given", o->kind ? o->kind : "output");
+      break;
+    }
+    ids[k] = identify(o->path);
+    for (int j = 0; j < k && st == BB_OK; j++)
+      if (same_identity(&ids[j], &ids[k]))
+        st = bb__fail(err, BB_ERR_ARGUMENT, "%s and %s would both be written to %s",
+                      outputs[j].kind ? outputs[j].kind : "an output",
+                      o->kind ? o->kind : "another", o->path);
+    if (st == BB_OK && !o->text)
+      st = check_format(o, 0, err);
+    for (int r = 0; r < read_count && st == BB_OK; r++)
+      if (reads[r] && same_identity(&in[r], &ids[k]))
+        st = bb__fail(err, BB_ERR_IO, "%s: output would overwrite the input file", o->path);
+    if (st == BB_OK)
+      st = bb__check_output_directory(o->path, err);
+    if (st == BB_OK && !o->text)
+      st = check_format(o, 1, err);
+  }
+  free(ids);
+  return st;
+}

@@ -1,0 +1,671 @@
+/* plan.c: a bake job decided before any bake: its options checked, its
+ * inputs gathered (directories expanded), each input's output paths named
+ * (one by one, or from out_dir and a template) and checked against each
+ * other, against every input and against the depfile, so a clash or a bad
+ * name costs no baking time. */
+#include "core/internal.h"
+#include "job/job_internal.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char *kind_name(int kind) {
+  return bb_output_kind_get((bb_output_kind)kind)->name;
+}
+
+static char *copy(const char *s) {
+  return s ? strdup(s) : NULL;
+}
+
+void bb_job_options_init(bb_job_options *o) {
+  memset(o, 0, sizeof *o);
+  bb_bake_options_init(&o->bake);
+  o->channel = BB_CHANNEL_AUTO;
+  o->depth = BB_DEPTH_DEFAULT;
+}
+
+/* ----------------------------------------------------------------- inputs */
+
+/* Which file a path names, when it exists. */
+typedef struct file_id {
+  int exists;
+  dev_t dev;
+  ino_t ino;
+} file_id;
+
+static file_id file_id_of(const char *path) {
+  struct stat st;
+  if (stat(path, &st) != 0)
+    return (file_id){0, 0, 0};
+  return (file_id){1, st.st_dev, st.st_ino};
+}
+
+static int same_file_id(file_id a, file_id b) {
+  return a.exists && b.exists && a.dev == b.dev && a.ino == b.ino;
+}
+
+/* The inputs gathered so far, with the identity of each, so a file named
+ * twice is kept once. */
+typedef struct input_list {
+  bb_job *job;
+  int capacity;
+  file_id *ids;
+} input_list;
+
+static bb_status add_input(input_list *l, const char *path, bb_error *err) {
+  file_id id = file_id_of(path);
+  for (int i = 0; i < l->job->count; i++)
+    if (same_file_id(l->ids[i], id))
+      return BB_OK;
+  if (l->job->count == l->capacity) {
+    int cap = l->capacity ? 2 * l->capacity : 16;
+    bb__job_item *items = realloc(l->job->items, (size_t)cap * sizeof *items);
+    if (items)
+      l->job->items = items;
+    file_id *ids = realloc(l->ids, (size_t)cap * sizeof *ids);
+    if (ids)
+      l->ids = ids;
+    if (!items || !ids)
+      return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+    l->capacity = cap;
+  }
+  bb__job_item *item = &l->job->items[l->job->count];
+  memset(item, 0, sizeof *item);
+  if (!(item->input = strdup(path)))
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  l->ids[l->job->count++] = id;
+  return BB_OK;
+}
+
+/* 1 when the file's provenance says bumpbake wrote it as one of the maps:
+ * reading it back as a height would bake a map of a map. */
+static int is_baked_map(const char *path) {
+  bb_image_info info;
+  if (bb_image_read_info(path, NULL, NULL, NULL, &info, NULL) != BB_OK)
+    return 0; /* not ours to judge: its bake will say what is wrong */
+  char kind[64];
+  int baked = 0;
+  if (bb_provenance_classify(info.description) != BB_PROVENANCE_NONE &&
+      bb_provenance_value(info.description, "output", kind, sizeof kind))
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      baked |= strcmp(kind, kind_name(k)) == 0;
+  bb_image_info_free(&info);
+  return baked;
+}
+
+static int by_name(const void *a, const void *b) {
+  return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static char *join_path(const char *dir, const char *name) {
+  size_t n = strlen(dir);
+  while (n > 1 && dir[n - 1] == '/')
+    n--;
+  size_t len = n + 1 + strlen(name) + 1;
+  char *path = malloc(len);
+  if (path)
+    snprintf(path, len, "%.*s/%s", (int)n, dir, name);
+  return path;
+}
+
+static void free_names(char **names, int count) {
+  for (int i = 0; i < count; i++)
+    free(names[i]);
+  free(names);
+}
+
+/* The names in dir that may be heights, sorted (malloc'd array of malloc'd
+ * names in *names); the count. */
+static bb_status read_directory(const char *dir, char ***names, int *count, bb_error *err) {
+  *names = NULL;
+  *count = 0;
+  DIR *d = opendir(dir);
+  if (!d)
+    return bb__fail(err, BB_ERR_IO, "%s: %s", dir, strerror(errno));
+  int capacity = 0, failed = 0;
+  for (struct dirent *e; !failed && (e = readdir(d));) {
+    if (e->d_name[0] == '.' || !bb_path_is_readable_format(e->d_name))
+      continue;
+    if (*count == capacity) {
+      capacity = capacity ? 2 * capacity : 32;
+      char **grown = realloc(*names, (size_t)capacity * sizeof *grown);
+      failed = !grown;
+      if (grown)
+        *names = grown;
+    }
+    if (!failed && !((*names)[*count] = strdup(e->d_name)))
+      failed = 1;
+    *count += !failed;
+  }
+  closedir(d);
+  if (failed) {
+    free_names(*names, *count);
+    *names = NULL;
+    *count = 0;
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", dir);
+  }
+  if (*count)
+    qsort(*names, (size_t)*count, sizeof **names, by_name);
+  return BB_OK;
+}
+
+/* Adds the regular files of dir that are not maps bumpbake baked. */
+static bb_status add_directory(input_list *l, const char *dir, bb_error *err) {
+  char **names;
+  int count;
+  bb_status st = read_directory(dir, &names, &count, err);
+  for (int i = 0; i < count && st == BB_OK; i++) {
+    char *path = join_path(dir, names[i]);
+    struct stat s;
+    if (!path)
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", dir);
+    else if (stat(path, &s) == 0 && S_ISREG(s.st_mode) && !is_baked_map(path))
+      st = add_input(l, path, err);
+    free(path);
+  }
+  free_names(names, count);
+  return st;
+}
+
+static bb_status gather_inputs(bb_job *job, const char *const *inputs, int input_count,
+                               bb_error *err) {
+  input_list l = {job, 0, NULL};
+  bb_status st = BB_OK;
+  for (int i = 0; i < input_count && st == BB_OK; i++) {
+    struct stat s;
+    if (!inputs[i] || !*inputs[i])
+      st = bb__fail(err, BB_ERR_ARGUMENT, "an input name is empty");
+    else if (job->batch && stat(inputs[i], &s) == 0 && S_ISDIR(s.st_mode))
+      st = add_directory(&l, inputs[i], err);
+    else /* a missing file fails at its bake */
+      st = add_input(&l, inputs[i], err);
+  }
+  free(l.ids);
+  if (st == BB_OK && job->count == 0)
+    st = bb__fail(err, BB_ERR_ARGUMENT, "nothing to bake: %s%s holds no image file", inputs[0],
+                  input_count > 1 ? " (and the others)" : "");
+  return st;
+}
+
+/* ------------------------------------------------------------------ names */
+
+/* The file name of input (no directory) split into stem and extension
+ * (after the last dot; "" when none). */
+static void split_name(const char *input, char *stem, size_t stem_cap, char *ext,
+                       size_t ext_cap) {
+  const char *base = bb__file_name(input);
+  const char *dot = strrchr(base, '.');
+  if (dot == base) /* ".hidden": all stem */
+    dot = NULL;
+  size_t n = dot ? (size_t)(dot - base) : strlen(base);
+  snprintf(stem, stem_cap, "%.*s", (int)n, base);
+  snprintf(ext, ext_cap, "%s", dot ? dot + 1 : "");
+}
+
+/* BB_OK when name, made from a template, stays inside the output
+ * directory: relative, and no part of it empty, "." or "..". */
+static bb_status check_inside(const char *tmpl, const char *input, const char *name,
+                              bb_error *err) {
+  if (name[0] == '/')
+    return bb__fail(err, BB_ERR_ARGUMENT, "name template %s: '%s' is an absolute path", tmpl,
+                    name);
+  for (const char *part = name; *part;) {
+    size_t n = strcspn(part, "/");
+    if (n == 0 || (n == 1 && part[0] == '.') || (n == 2 && part[0] == '.' && part[1] == '.'))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "name template %s: %s of %s would leave the output directory "
+                      "(a part of the name is empty, '.' or '..')",
+                      tmpl, name, input);
+    part += n + (part[n] == '/');
+  }
+  return BB_OK;
+}
+
+/* Expands the template's fields {stem}, {kind} and {ext} ("{{" and "}}" are
+ * braces) into out (capacity cap). */
+static bb_status expand_name(const char *tmpl, const char *const fields[3], char *out,
+                             size_t cap, bb_error *err) {
+  static const char *const names[3] = {"stem", "kind", "ext"};
+  size_t used = 0;
+  for (const char *s = tmpl; *s;) {
+    const char *piece = s;
+    size_t n = 1;
+    if ((s[0] == '{' && s[1] == '{') || (s[0] == '}' && s[1] == '}')) {
+      s += 2;
+    } else if (*s == '{') {
+      size_t len = strcspn(s + 1, "}");
+      if (s[1 + len] != '}')
+        return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: '{' without '}'", tmpl);
+      int f = 0;
+      while (f < 3 && !(strlen(names[f]) == len && strncmp(names[f], s + 1, len) == 0))
+        f++;
+      if (f == 3)
+        return bb__fail(err, BB_ERR_ARGUMENT,
+                        "--name %s: unknown field {%.*s} (use {stem}, {kind}, {ext})", tmpl,
+                        (int)len, s + 1);
+      piece = fields[f];
+      n = strlen(piece);
+      s += len + 2;
+    } else if (*s == '}') {
+      return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: '}' without '{' (write }} for a brace)",
+                      tmpl);
+    } else {
+      s++;
+    }
+    if (used + n >= cap)
+      return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: the name is too long", tmpl);
+    memcpy(out + used, piece, n);
+    used += n;
+  }
+  out[used] = '\0';
+  if (used == 0 || out[used - 1] == '/')
+    return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: gives no file name", tmpl);
+  return BB_OK;
+}
+
+static bb_status name_outputs(bb_job *job, bb__job_item *item, bb_error *err) {
+  char stem[1024], ext[64], name[4096];
+  split_name(item->input, stem, sizeof stem, ext, sizeof ext);
+  const char *tmpl = job->name_template ? job->name_template : BB_JOB_DEFAULT_NAME;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    if (!(job->options.bake.outputs & BB_OUTPUT_BIT(k)))
+      continue;
+    const char *fields[3] = {stem, kind_name(k), ext};
+    bb_status st = expand_name(tmpl, fields, name, sizeof name, err);
+    if (st == BB_OK)
+      st = check_inside(tmpl, item->input, name, err);
+    if (st != BB_OK)
+      return st;
+    if (!(item->paths[k] = join_path(job->out_dir, name)))
+      return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  }
+  return BB_OK;
+}
+
+/* A literal "../" (or an absolute path) in the template leaves out_dir for
+ * every input alike: refused once, before any input is named. */
+static bb_status check_template(const char *tmpl, bb_error *err) {
+  if (!tmpl)
+    return BB_OK;
+  if (tmpl[0] == '/')
+    return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: names are relative to the output directory",
+                    tmpl);
+  for (const char *part = tmpl; *part;) {
+    size_t n = strcspn(part, "/");
+    if ((n == 1 && part[0] == '.') || (n == 2 && part[0] == '.' && part[1] == '.'))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--name %s: '%.*s' would leave the output directory",
+                      tmpl, (int)n, part);
+    part += n + (part[n] == '/');
+  }
+  return BB_OK;
+}
+
+/* ---------------------------------------------------------------- clashes */
+
+typedef struct planned_output {
+  const char *path;
+  int item, kind;
+} planned_output;
+
+static int by_path(const void *a, const void *b) {
+  const planned_output *x = a, *y = b;
+  int c = strcmp(x->path, y->path);
+  return c ? c : (x->item > y->item) - (x->item < y->item);
+}
+
+/* Two outputs of a batch on one path, found by sorting the paths (all are
+ * made the same way under one directory, so equal files have equal
+ * spellings), and outputs that are one of the inputs. */
+static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
+  planned_output *outs = malloc((size_t)job->count * BB_OUTPUT_KIND_COUNT * sizeof *outs);
+  file_id *in = malloc((size_t)job->count * sizeof *in);
+  bb_status st = BB_OK;
+  if (!outs || !in)
+    st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  int n = 0;
+  for (int i = 0; i < job->count && st == BB_OK; i++) {
+    in[i] = file_id_of(job->items[i].input);
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      if (job->items[i].paths[k])
+        outs[n++] = (planned_output){job->items[i].paths[k], i, k};
+  }
+  for (int i = 0; i < n && st == BB_OK; i++) {
+    file_id out = file_id_of(outs[i].path);
+    for (int j = 0; j < job->count && out.exists && st == BB_OK; j++)
+      if (same_file_id(in[j], out))
+        st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %s of %s would overwrite the input %s",
+                      outs[i].path, kind_name(outs[i].kind), job->items[outs[i].item].input,
+                      job->items[j].input);
+  }
+  if (st == BB_OK && n > 1) {
+    qsort(outs, (size_t)n, sizeof *outs, by_path);
+    for (int i = 1; i < n && st == BB_OK; i++) {
+      if (strcmp(outs[i - 1].path, outs[i].path) != 0)
+        continue;
+      const planned_output *a = &outs[i - 1], *o = &outs[i];
+      if (a->item == o->item)
+        st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %s and %s would both be written to %s",
+                      job->items[a->item].input, kind_name(a->kind), kind_name(o->kind),
+                      o->path);
+      else
+        st = bb__fail(err, BB_ERR_ARGUMENT, "%s and %s would both be written to %s",
+                      job->items[a->item].input, job->items[o->item].input, o->path);
+    }
+  }
+  free(outs);
+  free(in);
+  return st;
+}
+
+/* ---------------------------------------------------------- output checks */
+
+/* A map with a channel per basis direction needs room for them: PNG and TGA
+ * hold 4, so "hl2+z" still fits RGBA. */
+static bb_status check_channels(const bb_job *job, const char *path, int kind, bb_error *err) {
+  const bb_basis *basis = &job->options.bake.basis;
+  const int room = bb_path_max_channels(path);
+  if (bb_output_kind_get((bb_output_kind)kind)->channels != 0 || basis->count <= room)
+    return BB_OK;
+  char ext[16];
+  return bb__fail(err, BB_ERR_ARGUMENT,
+                  "%s: --basis %s gives %s %d channels and .%s files hold at most %d (write it "
+                  "as .exr or .tif)",
+                  path, job->basis_file ? job->basis_file : basis->name, kind_name(kind),
+                  basis->count, bb__extension(path, ext, sizeof ext), room);
+}
+
+/* One input's outputs as a single bake checks them. */
+static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
+                                    bb_error *err) {
+  bb_output_spec specs[BB_JOB_MAX_OUTPUTS];
+  int kinds[BB_JOB_MAX_OUTPUTS];
+  int n = 0;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    if (item->paths[k]) {
+      kinds[n] = k;
+      specs[n++] = (bb_output_spec){item->paths[k], kind_name(k), 0, job->options.depth,
+                                    job->options.mips, 0};
+    }
+  const int maps = n;
+  if (job->slope_path) {
+    /* The slope map is its bytes: 8-bit, no mips; its preview a picture. */
+    if (!bb_path_supports_depth(job->slope_path, BB_DEPTH_8))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: the slope map is one byte per texel: use .png, .tga or .tif",
+                      job->slope_path);
+    kinds[n] = -1;
+    specs[n++] = (bb_output_spec){job->slope_path, "slope", 1, BB_DEPTH_8, 0, 0};
+    if (item->slope_lit_path) {
+      kinds[n] = -1;
+      specs[n++] = (bb_output_spec){item->slope_lit_path, "slope_lit", 1, job->options.depth, 0, 0};
+    }
+  }
+  const char *reads[2] = {item->input, job->prerequisite_basis ? job->basis_file : NULL};
+  bb_status st = bb_outputs_check(specs, n, reads, 2, err);
+  for (int i = 0; i < maps && st == BB_OK; i++)
+    st = check_channels(job, specs[i].path, kinds[i], err);
+  return st;
+}
+
+/* ---------------------------------------------------------------- depfile */
+
+/* The depfile against every input and output of the plan: not a file the
+ * bake reads, not one it writes, every name one a depfile can hold, its
+ * directory writable. */
+static bb_status check_depfile(const bb_job *job, bb_error *err) {
+  const char *path = job->depfile;
+  for (int i = 0; i < job->count; i++) {
+    const bb__job_item *item = &job->items[i];
+    const char *prereq[2] = {item->input, job->prerequisite_basis ? job->basis_file : NULL};
+    const char *targets[BB_JOB_MAX_OUTPUTS];
+    int t = 0;
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      if (item->paths[k])
+        targets[t++] = item->paths[k];
+    if (job->slope_path)
+      targets[t++] = job->slope_path;
+    if (item->slope_lit_path)
+      targets[t++] = item->slope_lit_path;
+    bb__dep_rule rule = {targets, t, prereq, prereq[1] ? 2 : 1};
+    bb_status st = bb__depfile_check_names(path, &rule, 1, err);
+    if (st != BB_OK)
+      return st;
+    for (int p = 0; p < rule.prerequisite_count; p++)
+      if (bb_same_file(prereq[p], path))
+        return bb__fail(err, BB_ERR_IO, "%s: the depfile would overwrite a file the bake reads",
+                        path);
+    for (int k = 0; k < t; k++)
+      if (bb_same_file(targets[k], path))
+        return bb__fail(err, BB_ERR_ARGUMENT, "--depfile %s is also an output of the bake",
+                        path);
+  }
+  bb__dep_rule none = {NULL, 0, NULL, 0};
+  const char *self[1] = {path};
+  none.targets = self;
+  none.target_count = 1;
+  bb_status st = bb__depfile_check_names(path, &none, 1, err);
+  if (st == BB_OK)
+    st = bb__check_output_directory(path, err);
+  if (st == BB_OK) {
+    char dir[PATH_MAX];
+    bb__directory_part(path, dir, sizeof dir);
+    if (access(dir, W_OK) != 0)
+      st = bb__fail(err, BB_ERR_IO, "%s: cannot write the depfile: directory %s: %s", path,
+                    dir, strerror(errno));
+  }
+  return st;
+}
+
+/* ------------------------------------------------------------------- plan */
+
+/* The kinds asked: the named paths (and the filtered height the slope map
+ * is made from), or a batch's maps. */
+static unsigned asked_kinds(const bb_job_options *o) {
+  if (o->out_dir)
+    return o->maps ? o->maps : BB_JOB_DEFAULT_MAPS;
+  unsigned mask = o->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    if (o->paths[k])
+      mask |= BB_OUTPUT_BIT(k);
+  if (o->slope_path)
+    mask |= BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  return mask;
+}
+
+static bb_status check_options(const bb_job_options *o, int input_count, bb_error *err) {
+  if (input_count < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "no input given");
+  if (o->out_dir) {
+    int named = o->slope_path != NULL || o->prefix != NULL;
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      named |= o->paths[k] != NULL;
+    if (named)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--out-dir names the outputs: choose the maps with --maps, not -o, "
+                      "--MAP FILE or --slope");
+    if (o->maps & ~BB_OUTPUTS_ALL)
+      return bb__fail(err, BB_ERR_ARGUMENT, "maps: unknown map bits 0x%x", o->maps);
+  } else {
+    if (input_count > 1)
+      return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
+    if (o->slope_lit && !o->slope_path)
+      return bb__fail(err, BB_ERR_ARGUMENT, "--lit previews the slope map: give --slope FILE too");
+    if (!asked_kinds(o))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "nothing to write: give -o PREFIX or at least one of --normal, "
+                      "--weights, --ssbump, --ao, --bent, --filtered, --slope");
+  }
+  if (strcmp(bb_channel_name(o->channel), "unknown") == 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "unknown height channel %d", (int)o->channel);
+  if ((int)o->depth < BB_DEPTH_DEFAULT || o->depth > BB_DEPTH_FLOAT)
+    return bb__fail(err, BB_ERR_ARGUMENT, "unknown depth %d", (int)o->depth);
+  bb_bake_options bake = o->bake;
+  bake.outputs = asked_kinds(o);
+  return bb_bake_options_check(&bake, err);
+}
+
+/* The options' strings, copied: a job outlives its caller's buffers. */
+static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *err) {
+  job->options = *o;
+  job->options.bake.outputs = asked_kinds(o);
+  job->batch = o->out_dir != NULL;
+  job->basis_file = copy(o->basis_file);
+  job->out_dir = copy(o->out_dir);
+  job->name_template = copy(o->name_template);
+  job->depfile = copy(o->depfile);
+  job->command = copy(o->command);
+  job->command_options = copy(o->command_options);
+  job->slope_path = copy(o->slope_path);
+  if ((o->basis_file && !job->basis_file) || (o->out_dir && !job->out_dir) ||
+      (o->name_template && !job->name_template) || (o->depfile && !job->depfile) ||
+      (o->command && !job->command) || (o->command_options && !job->command_options) ||
+      (o->slope_path && !job->slope_path))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  /* The options keep no pointer of the caller's. */
+  memset(job->options.paths, 0, sizeof job->options.paths);
+  job->options.basis_file = job->basis_file;
+  job->options.out_dir = job->out_dir;
+  job->options.name_template = job->name_template;
+  job->options.depfile = job->depfile;
+  job->options.command = job->command;
+  job->options.command_options = job->command_options;
+  job->options.slope_path = job->slope_path;
+  job->options.prefix = NULL; /* expanded into the item's paths */
+  /* A basis file is a prerequisite only when it made the basis. */
+  job->prerequisite_basis =
+      job->basis_file && strncmp(o->bake.basis.name, "vectors:", 8) == 0;
+  return BB_OK;
+}
+
+/* A single input's outputs, as named, and PREFIX_KIND.png for Valve's trio
+ * where a prefix is given. */
+static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err) {
+  bb__job_item *item = &job->items[0];
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    if (o->paths[k]) {
+      if (!(item->paths[k] = strdup(o->paths[k])))
+        return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    } else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_OUTPUT_BIT(k))) {
+      const size_t len = strlen(o->prefix) + strlen(kind_name(k)) + sizeof "_.png";
+      if (!(item->paths[k] = malloc(len)))
+        return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+      snprintf(item->paths[k], len, "%s_%s.png", o->prefix, kind_name(k));
+    }
+  }
+  if (o->slope_path && o->slope_lit) {
+    /* The preview is the map's name with "_lit" before its extension. */
+    const char *dot = strrchr(bb__file_name(o->slope_path), '.');
+    const size_t stem = dot ? (size_t)(dot - o->slope_path) : strlen(o->slope_path);
+    const size_t len = strlen(o->slope_path) + sizeof "_lit";
+    if (!(item->slope_lit_path = malloc(len)))
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    snprintf(item->slope_lit_path, len, "%.*s_lit%s", (int)stem, o->slope_path, dot ? dot : "");
+  }
+  return BB_OK;
+}
+
+/* Creates out_dir and every directory the outputs' names need. */
+static bb_status create_directories(const bb_job *job, bb_error *err) {
+  bb_status st = bb_directory_create(job->out_dir, err);
+  for (int i = 0; i < job->count && st == BB_OK; i++)
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
+      const char *path = job->items[i].paths[k];
+      if (!path)
+        continue;
+      char dir[PATH_MAX];
+      bb__directory_part(path, dir, sizeof dir);
+      struct stat s;
+      if (stat(dir, &s) != 0 || !S_ISDIR(s.st_mode))
+        st = bb_directory_create(dir, err);
+    }
+  return st;
+}
+
+static void init_reports(bb_job *job) {
+  for (int i = 0; i < job->count; i++) {
+    bb__job_item *item = &job->items[i];
+    bb_job_report *r = &item->report;
+    memset(r, 0, sizeof *r);
+    r->input = item->input;
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      if (item->paths[k])
+        r->outputs[r->output_count++] = (bb_job_file){kind_name(k), item->paths[k]};
+    if (job->slope_path)
+      r->outputs[r->output_count++] = (bb_job_file){"slope", job->slope_path};
+    if (item->slope_lit_path)
+      r->outputs[r->output_count++] = (bb_job_file){"slope_lit", item->slope_lit_path};
+  }
+}
+
+bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                      bb_job **out, bb_error *err) {
+  if (!out || !o || (input_count > 0 && !inputs))
+    return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
+  *out = NULL;
+  bb_status st = check_options(o, input_count, err);
+  if (st != BB_OK)
+    return st;
+  bb_job *job = calloc(1, sizeof *job);
+  if (!job)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  st = copy_options(job, o, err);
+  if (st == BB_OK && job->batch)
+    st = check_template(job->name_template, err);
+  if (st == BB_OK)
+    st = gather_inputs(job, inputs, input_count, err);
+  if (st == BB_OK && !job->batch)
+    st = name_single(job, o, err);
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK && !job->batch; k++)
+    job->options.paths[k] = job->items[0].paths[k]; /* the job's copies */
+  for (int i = 0; i < job->count && st == BB_OK && job->batch; i++)
+    st = name_outputs(job, &job->items[i], err);
+  if (st == BB_OK && job->batch)
+    st = check_batch_paths(job, err);
+  if (st == BB_OK && job->batch)
+    st = create_directories(job, err);
+  for (int i = 0; i < job->count && st == BB_OK; i++)
+    st = check_item_outputs(job, &job->items[i], err);
+  if (st == BB_OK && job->depfile)
+    st = check_depfile(job, err);
+  if (st != BB_OK) {
+    bb_job_free(job);
+    return st;
+  }
+  init_reports(job);
+  *out = job;
+  return BB_OK;
+}
+
+void bb_job_free(bb_job *job) {
+  if (!job)
+    return;
+  for (int i = 0; i < job->count; i++) {
+    free(job->items[i].input);
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+      free(job->items[i].paths[k]);
+    free(job->items[i].slope_lit_path);
+  }
+  free(job->items);
+  free(job->basis_file);
+  free(job->out_dir);
+  free(job->name_template);
+  free(job->depfile);
+  free(job->command);
+  free(job->command_options);
+  free(job->slope_path);
+  free(job);
+}
+
+int bb_job_count(const bb_job *job) {
+  return job ? job->count : 0;
+}
+
+const bb_job_report *bb_job_report_get(const bb_job *job, int i) {
+  return job && i >= 0 && i < job->count ? &job->items[i].report : NULL;
+}

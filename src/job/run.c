@@ -1,0 +1,344 @@
+/* run.c: a planned bake job run input by input: inputs whose outputs are
+ * up to date skipped, the others read, baked once and written all or
+ * nothing with their provenance, and the depfile of what was made. */
+#include "core/internal.h"
+#include "job/job_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const bb_output_kind_info *kind_info(int kind) {
+  return bb_output_kind_get((bb_output_kind)kind);
+}
+
+/* The depth kind is written with: the job's, but the filtered height keeps
+ * the input's depth where the format holds it unless a depth was asked. */
+static bb_depth output_depth(const bb_job *job, int kind, const char *path, int bits,
+                             int is_float) {
+  if (kind == BB_OUTPUT_FILTERED && job->options.depth == BB_DEPTH_DEFAULT)
+    return bb_depth_like_input(bits, is_float, path);
+  return job->options.depth;
+}
+
+/* ----------------------------------------------------------- up to date */
+
+static bb_status fail_item(bb_job_report *r, bb_status st, const bb_error *e) {
+  r->outcome = BB_JOB_FAILED;
+  r->status = st;
+  if (e && e != &r->error)
+    r->error = *e;
+  return st;
+}
+
+/* 1 when every map of item is what baking it now would write, judged from
+ * the files' headers; reason says why not. */
+static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, size_t cap) {
+  if (job->slope_path) { /* the slope files are not judged: baked every time */
+    snprintf(reason, cap, "a slope map is asked");
+    return 0;
+  }
+  bb_bake_options o = job->options.bake;
+  char rayset[64];
+  bb_bake_rayset_id(&o, rayset, sizeof rayset);
+  bb_image_info info;
+  int bits = 8, is_float = 0;
+  if (bb_image_read_info(item->input, NULL, NULL, NULL, &info, NULL) == BB_OK) {
+    bits = info.bits_per_sample;
+    is_float = info.is_float;
+    bb_image_info_free(&info);
+  }
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    if (!item->paths[k])
+      continue;
+    bb_provenance want = {NULL, NULL, 0, kind_info(k)->name, &o, job->options.channel,
+                          rayset[0] ? rayset : NULL, item->file_hash, NULL};
+    bb_output_state state;
+    const bb_depth depth = output_depth(job, k, item->paths[k], bits, is_float);
+    char why[200] = "";
+    if (bb_output_check(item->paths[k], &want, depth, job->options.mips, &state, why,
+                        sizeof why, NULL) != BB_OK) {
+      snprintf(reason, cap, "%s: cannot be checked", item->paths[k]);
+      return 0;
+    }
+    if (state != BB_OUTPUT_CURRENT) {
+      snprintf(reason, cap, "%s: %s", item->paths[k], why);
+      return 0;
+    }
+  }
+  reason[0] = '\0';
+  return 1;
+}
+
+bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) {
+  if (!job || i < 0 || i >= job->count || !current)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job check: bad arguments");
+  bb__job_item *item = &job->items[i];
+  *current = 0;
+  bb_status st = bb_file_hash(item->input, &item->file_hash, err);
+  if (st != BB_OK)
+    return st;
+  *current = item_is_current(job, item, item->report.reason, sizeof item->report.reason);
+  return BB_OK;
+}
+
+/* ------------------------------------------------------------------ bake */
+
+/* Everything one input's bake makes, and the provenance texts of its files. */
+typedef struct baked {
+  bb_image height;
+  bb_bake_result result;
+  bb_image slope, slope_lit;
+  char *descriptions[BB_JOB_MAX_OUTPUTS];
+  char *depfile_text;
+} baked;
+
+static void baked_free(baked *b) {
+  bb_image_free(&b->height);
+  bb_bake_result_free(&b->result);
+  bb_image_free(&b->slope);
+  bb_image_free(&b->slope_lit);
+  for (int i = 0; i < BB_JOB_MAX_OUTPUTS; i++)
+    free(b->descriptions[i]);
+  free(b->depfile_text);
+}
+
+/* flipcode's slope map of the filtered height and its lit preview. */
+static bb_status make_slope(const bb_job *job, const bb__job_item *item, baked *b,
+                            bb_error *err) {
+  const bb_bake_options *o = &job->options.bake;
+  bb_status st = bb_slope_map(&b->result.filtered, o->height_scale, o->smooth.addressing,
+                              &b->slope, err);
+  if (st == BB_OK && item->slope_lit_path) {
+    double light[3];
+    float table[256];
+    bb_light_direction(job->options.slope_lit_azimuth, job->options.slope_lit_elevation, light);
+    bb_slope_table(light, table);
+    st = bb_slope_light(&b->slope, table, &b->slope_lit, err);
+  }
+  return st;
+}
+
+/* The provenance text of one output of item. */
+static char *describe(const bb_job *job, const char *command, const baked *b,
+                      const bb_job_report *r, const char *kind) {
+  const int traced = (job->options.bake.outputs & BB_OUTPUTS_TRACED) != 0;
+  bb_provenance p = {command,
+                     bb__file_name(r->input),
+                     r->source.height_hash,
+                     kind,
+                     &job->options.bake,
+                     job->options.channel,
+                     traced ? b->result.rayset_id : NULL,
+                     r->source.file_hash,
+                     NULL};
+  return bb_provenance_format(&p);
+}
+
+/* The depfile rule of one input: its outputs depend on it (and on the basis
+ * file that made the basis). */
+static bb__dep_rule rule_of(const bb_job *job, const bb__job_item *item, const char **targets,
+                            const char **prereq) {
+  int t = 0;
+  for (int k = 0; k < item->report.output_count; k++)
+    targets[t++] = item->report.outputs[k].path;
+  prereq[0] = item->input;
+  prereq[1] = job->prerequisite_basis ? job->basis_file : NULL;
+  return (bb__dep_rule){targets, t, prereq, prereq[1] ? 2 : 1};
+}
+
+/* The files of one input: its maps, the slope files, and a single input's
+ * depfile, written together. */
+static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error *err) {
+  bb_job_report *r = &item->report;
+  char *command = bb__job_command_of(job, item);
+  if (!command)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  bb_output_file files[BB_JOB_MAX_OUTPUTS + 1];
+  int n = 0;
+  bb_status st = BB_OK;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
+    if (!item->paths[k])
+      continue;
+    b->descriptions[n] = describe(job, command, b, r, kind_info(k)->name);
+    files[n] = (bb_output_file){item->paths[k],
+                                kind_info(k)->name,
+                                bb_bake_result_image(&b->result, (bb_output_kind)k),
+                                kind_info(k)->range,
+                                output_depth(job, k, item->paths[k], r->source.bits_per_sample,
+                                             r->source.is_float),
+                                job->options.mips,
+                                b->descriptions[n],
+                                NULL,
+                                0};
+    if (!b->descriptions[n++])
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  }
+  /* The slope map is its bytes (8-bit, no mip levels: an average of slope
+   * bytes means nothing); its preview is a picture at the job's depth. */
+  if (st == BB_OK && b->slope.pixels) {
+    b->descriptions[n] = describe(job, command, b, r, "slope");
+    files[n] = (bb_output_file){job->slope_path, "slope", &b->slope, BB_RANGE_UNIT,
+                                BB_DEPTH_8, 0, b->descriptions[n], NULL, 0};
+    if (!b->descriptions[n++])
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  }
+  if (st == BB_OK && b->slope_lit.pixels) {
+    b->descriptions[n] = describe(job, command, b, r, "slope_lit");
+    files[n] = (bb_output_file){item->slope_lit_path, "slope_lit", &b->slope_lit,
+                                BB_RANGE_UNIT, job->options.depth, 0, b->descriptions[n],
+                                NULL, 0};
+    if (!b->descriptions[n++])
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  }
+  free(command);
+  if (st == BB_OK && job->depfile && !job->batch) {
+    /* One input's depfile goes in with its maps: all of them or none. */
+    const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[2];
+    bb__dep_rule rule = rule_of(job, item, targets, prereq);
+    size_t size = 0;
+    if (!(b->depfile_text = bb__depfile_text(&rule, 1, &size)))
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
+    else
+      files[n++] = (bb_output_file){job->depfile, "depfile", NULL, BB_RANGE_UNIT,
+                                    BB_DEPTH_DEFAULT, 0, NULL, b->depfile_text, size};
+  }
+  const double t0 = bb__now_seconds();
+  if (st == BB_OK)
+    st = bb_outputs_write(files, n, b->result.threads, err);
+  r->seconds_write = bb__now_seconds() - t0;
+  return st;
+}
+
+static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progress,
+                           void *progress_user, bb_error *err) {
+  bb_job_report *r = &item->report;
+  baked b;
+  memset(&b, 0, sizeof b);
+  const double t0 = bb__now_seconds();
+  bb_status st = bb_height_file_read(item->input, job->options.channel,
+                                     job->options.bake.height_scale, job->options.note,
+                                     job->options.note_user, &b.height, &r->source, err);
+  r->seconds_load = bb__now_seconds() - t0;
+  if (st == BB_OK) {
+    bb_bake_options o = job->options.bake;
+    o.trace.progress = progress;
+    o.trace.progress_user = progress_user;
+    bb_error bake_err = {{0}};
+    st = bb_bake(&b.height, &o, &b.result, &bake_err);
+    if (st != BB_OK)
+      bb__fail(err, st, "%s: %s", item->input, bake_err.message);
+  }
+  if (st == BB_OK && job->slope_path)
+    st = make_slope(job, item, &b, err);
+  if (st == BB_OK) {
+    const bb_bake_result *res = &b.result;
+    r->width = b.height.width;
+    r->height = b.height.height;
+    r->threads = res->threads;
+    r->slices = res->rayset_id[0] ? bb_bake_slices(&job->options.bake) : 0;
+    snprintf(r->rayset_id, sizeof r->rayset_id, "%s", res->rayset_id);
+    r->horizons = res->horizons_found;
+    r->seconds_smooth = res->seconds_smooth;
+    r->seconds_pyramid = res->seconds_pyramid;
+    r->seconds_trace = res->seconds_trace;
+    r->seconds_derive = res->seconds_derive;
+    st = write_item(job, item, &b, err);
+  }
+  baked_free(&b);
+  return st;
+}
+
+bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user) {
+  if (!job || i < 0 || i >= job->count)
+    return BB_ERR_ARGUMENT;
+  bb__job_item *item = &job->items[i];
+  bb_job_report *r = &item->report;
+  r->outcome = BB_JOB_PENDING;
+  r->status = BB_OK;
+  memset(&r->error, 0, sizeof r->error);
+  if (!job->options.force) {
+    int current = 0;
+    bb_status st = bb_job_check_current(job, i, &current, &r->error);
+    if (st != BB_OK)
+      return fail_item(r, st, NULL);
+    if (current) {
+      r->outcome = BB_JOB_CURRENT;
+      return BB_OK;
+    }
+  }
+  bb_status st = bake_item(job, item, progress, progress_user, &r->error);
+  if (st != BB_OK)
+    return fail_item(r, st, NULL);
+  r->outcome = BB_JOB_BAKED;
+  return BB_OK;
+}
+
+/* --------------------------------------------------------------- depfile */
+
+bb_status bb_job_write_depfile(bb_job *job, bb_error *err) {
+  if (!job)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job depfile: no job");
+  /* A single input's depfile was written with its maps. */
+  if (!job->depfile || !job->batch)
+    return BB_OK;
+  const char *(*targets)[BB_JOB_MAX_OUTPUTS] = malloc((size_t)job->count * sizeof *targets);
+  const char *(*prereq)[2] = malloc((size_t)job->count * sizeof *prereq);
+  bb__dep_rule *rules = malloc((size_t)job->count * sizeof *rules);
+  bb_status st = BB_OK;
+  int n = 0, baked_inputs = 0;
+  if (!targets || !prereq || !rules)
+    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
+  for (int i = 0; i < job->count && st == BB_OK; i++) {
+    const bb_job_outcome o = job->items[i].report.outcome;
+    baked_inputs += o == BB_JOB_BAKED;
+    if (o == BB_JOB_BAKED || o == BB_JOB_CURRENT) {
+      rules[n] = rule_of(job, &job->items[i], targets[n], prereq[n]);
+      n++;
+    }
+  }
+  size_t size = 0;
+  char *text = st == BB_OK ? bb__depfile_text(rules, n, &size) : NULL;
+  if (st == BB_OK && !text)
+    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
+  if (st == BB_OK) {
+    bb_error local = {{0}};
+    st = bb_file_write(job->depfile, text, size, &local);
+    if (st != BB_OK)
+      bb__fail(err, st, "%s; the maps of %d input%s baked were written", local.message, baked_inputs,
+               baked_inputs == 1 ? "" : "s");
+  }
+  free(text);
+  free(targets);
+  free(prereq);
+  free(rules);
+  return st;
+}
+
+/* ------------------------------------------------------------------ runs */
+
+bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
+                     bb_job_report_fn each, void *user, bb_error *err) {
+  if (!job)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job run: no job");
+  bb_status first = BB_OK;
+  int stopped = 0;
+  for (int i = 0; i < job->count; i++) {
+    bb_job_report *r = &job->items[i].report;
+    if (stopped) {
+      r->outcome = BB_JOB_NOT_RUN;
+    } else {
+      bb_status st = bb_job_run_item(job, i, progress, progress_user);
+      if (st != BB_OK && first == BB_OK) {
+        first = st;
+        if (err)
+          *err = r->error;
+      }
+      stopped = st != BB_OK && !job->options.keep_going;
+    }
+    if (each)
+      each(user, r);
+  }
+  bb_status st = bb_job_write_depfile(job, first == BB_OK ? err : NULL);
+  return first != BB_OK ? first : st;
+}

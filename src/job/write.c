@@ -1,0 +1,211 @@
+/* write.c: a command's outputs written all or nothing. Every file is
+ * encoded and synced under a temporary name first (several at once: zlib
+ * is most of a write), and the set is renamed into place only when all of
+ * them are complete; a signal that arrives during the renames waits for
+ * the last one, so an interrupted command leaves the set all old or all
+ * new. */
+#include "core/internal.h"
+#include "io/safe_file.h"
+#include "job/job_internal.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------- signals */
+
+/* Sets being renamed into place right now, on any thread, and a signal
+ * that arrived meanwhile. The handler stores the signal first and then
+ * looks at the count; the committer lowers the count first and then looks
+ * at the signal (both sequentially consistent), so one of the two always
+ * sees the other and the process ends exactly once the last set is whole. */
+static atomic_int commits_in_flight;
+static atomic_int pending_signal;
+
+static void die_of(int signal_number) {
+  bb_tempfiles_remove();
+  struct sigaction dfl;
+  memset(&dfl, 0, sizeof dfl);
+  dfl.sa_handler = SIG_DFL;
+  sigemptyset(&dfl.sa_mask);
+  sigaction(signal_number, &dfl, NULL);
+  /* In a handler the signal is blocked until it returns, and is then
+   * delivered with its default action; elsewhere it ends us here. */
+  raise(signal_number);
+}
+
+void bb_signal_cleanup(int signal_number) {
+  const int saved_errno = errno;
+  atomic_store(&pending_signal, signal_number);
+  if (atomic_load(&commits_in_flight) == 0)
+    die_of(signal_number);
+  errno = saved_errno;
+}
+
+static void commit_begin(void) {
+  atomic_fetch_add(&commits_in_flight, 1);
+}
+
+static void commit_end(void) {
+  atomic_fetch_sub(&commits_in_flight, 1);
+  const int sig = atomic_load(&pending_signal);
+  if (sig && atomic_load(&commits_in_flight) == 0)
+    die_of(sig);
+}
+
+/* --------------------------------------------------------------- staging */
+
+/* One file of the set as it goes: staged, then put in place. */
+typedef struct staged {
+  const bb_output_file *file;
+  bb_staged_file *handle; /* NULL when staging failed */
+  bb_status status;
+  bb_error error;
+} staged;
+
+/* Text bytes under a temporary name, synced: the staged twin of bb_file_write. */
+static bb_status stage_text(const bb_output_file *o, bb_staged_file **out, bb_error *err) {
+  *out = NULL;
+  if (!o->text && o->text_size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: no text to write", o->path);
+  bb_staged_file *f = bb__staged_new();
+  if (!f)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->path);
+  bb_status st = bb__safe_open(f, o->path, err);
+  if (st == BB_OK) {
+    bb__safe_write(f, o->text, o->text_size); /* an error is kept and reported next */
+    st = bb__safe_finish(f, err);
+  }
+  if (st != BB_OK) {
+    bb__safe_discard(f);
+    free(f);
+    return st;
+  }
+  *out = f;
+  return BB_OK;
+}
+
+/* An image's mip chain, renormalised for normal maps, as one staged file. */
+static bb_status stage_mips(const bb_output_file *o, const bb_write_options *wo,
+                            bb_staged_file **out, bb_error *err) {
+  bb_image *levels = NULL;
+  int count = 0;
+  const bb_mip_filter filter = o->range == BB_RANGE_SIGNED ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
+  bb_status st = bb_mip_chain(o->image, filter, &levels, &count, err);
+  if (st == BB_OK)
+    st = bb_image_write_mips_staged(o->path, levels, count, wo, out, err);
+  bb_mip_chain_free(levels, count);
+  return st;
+}
+
+static void stage_one(void *user, int item) {
+  staged *s = (staged *)user + item;
+  const bb_output_file *o = s->file;
+  s->handle = NULL;
+  memset(&s->error, 0, sizeof s->error);
+  if (!o->image) {
+    s->status = stage_text(o, &s->handle, &s->error);
+    return;
+  }
+  const bb_write_options wo = {o->depth, o->range, o->description};
+  s->status = o->mips ? stage_mips(o, &wo, &s->handle, &s->error)
+                      : bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
+}
+
+/* --------------------------------------------------------------- commits */
+
+bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
+                                 bb_error *err) {
+  if (count < 0 || (count > 0 && !files))
+    return bb__fail(err, BB_ERR_ARGUMENT, "staged files commit: bad arguments");
+  /* The paths of the ones renamed, for the message should a later one fail. */
+  char **done = calloc((size_t)(count ? count : 1), sizeof *done);
+  int failed = -1;
+  bb_error why = {{0}};
+  commit_begin();
+  for (int i = 0; i < count && failed < 0; i++) {
+    char *path = done ? strdup(bb_staged_file_path(files[i])) : NULL;
+    bb_status st = bb_staged_file_commit(files[i], &why);
+    files[i] = NULL;
+    if (st != BB_OK)
+      failed = i, free(path);
+    else if (done)
+      done[i] = path;
+  }
+  commit_end();
+  bb_status st = BB_OK;
+  if (failed >= 0) {
+    for (int i = failed + 1; i < count; i++) {
+      bb_staged_file_discard(files[i]);
+      files[i] = NULL;
+    }
+    char reason[2 * sizeof(bb_error)];
+    snprintf(reason, sizeof reason, "%s", why.message[0] ? why.message : "cannot rename");
+    size_t len = strlen(reason);
+    for (int i = 0; i < failed && len < sizeof reason; i++)
+      len += (size_t)snprintf(reason + len, sizeof reason - len, "%s%s %s",
+                              i ? ", " : "; already written: ",
+                              kinds && kinds[i] ? kinds[i] : "file",
+                              done && done[i] ? done[i] : "?");
+    if (failed == 0 && count > 1 && len < sizeof reason)
+      snprintf(reason + len, sizeof reason - len, "; no output was written");
+    st = bb__fail(err, BB_ERR_IO, "%s", reason);
+  }
+  for (int i = 0; done && i < count; i++)
+    free(done[i]);
+  free(done);
+  return st;
+}
+
+bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err) {
+  if (count < 0 || (count > 0 && !files))
+    return bb__fail(err, BB_ERR_ARGUMENT, "outputs write: bad arguments");
+  if (count == 0)
+    return BB_OK;
+  staged *set = calloc((size_t)count, sizeof *set);
+  if (!set)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", files[0].path);
+  for (int i = 0; i < count; i++)
+    set[i].file = &files[i];
+  /* Encoding runs side by side, at most one thread per file. */
+  int workers = threads <= 0 || threads > count ? count : threads;
+  bb_status st = bb__parallel_for(count, workers, stage_one, set, NULL, NULL, err);
+  int failed = -1;
+  for (int i = 0; i < count && failed < 0 && st == BB_OK; i++)
+    if (set[i].status != BB_OK)
+      failed = i;
+  if (st == BB_OK && failed < 0) {
+    bb_staged_file **handles = malloc((size_t)count * sizeof *handles);
+    const char **kinds = malloc((size_t)count * sizeof *kinds);
+    if (!handles || !kinds) {
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", files[0].path);
+    } else {
+      for (int i = 0; i < count; i++) {
+        handles[i] = set[i].handle;
+        kinds[i] = files[i].kind;
+        set[i].handle = NULL;
+      }
+      st = bb_staged_files_commit(handles, kinds, count, err);
+    }
+    free(handles);
+    free(kinds);
+    failed = -1; /* the commit's message is the whole story */
+  }
+  for (int i = 0; i < count; i++)
+    bb_staged_file_discard(set[i].handle);
+  if (st == BB_OK && failed >= 0) {
+    char reason[2 * sizeof(bb_error)];
+    snprintf(reason, sizeof reason, "%s",
+             set[failed].error.message[0] ? set[failed].error.message
+                                           : bb_status_name(set[failed].status));
+    if (count > 1 && strlen(reason) < sizeof reason)
+      snprintf(reason + strlen(reason), sizeof reason - strlen(reason),
+               "; no output was written");
+    st = bb__fail(err, set[failed].status, "%s", reason);
+  }
+  free(set);
+  return st;
+}
