@@ -152,6 +152,11 @@ typedef enum bb_addressing {
  * in flight ends and returns BB_ERR_CANCELLED, making nothing. */
 typedef int (*bb_progress_fn)(void *user, long done, long total);
 
+/* A remark about an input that is not an error: which channel became the
+ * height, a lossy or shallow input. path names the file (may be NULL);
+ * text is one line without it. Called on the thread that reads the file. */
+typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
+
 /* A rectangle of texels, x0..x0+width-1 by y0..y0+height-1. */
 typedef struct bb_region {
   int x0, y0, width, height;
@@ -916,7 +921,12 @@ typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img
                                      bb_image_info *info, bb_error *err);
 
 typedef struct bb_program_options {
-  const char *base_dir;   /* image names are relative to it; NULL or "" = as given */
+  const char *base_dir;   /* image names are relative to it; NULL or "" = the
+                             current directory */
+  int allow_outside_base; /* 0 (default): an image name must stay inside the
+                             base directory, resolved (no absolute path, no
+                             "..", no symbolic link out: BB_ERR_ARGUMENT);
+                             1: any file may be read */
   bb_image_loader loader; /* NULL = bb_image_read */
   void *loader_user;
 } bb_program_options;
@@ -1396,6 +1406,10 @@ typedef struct bb_renderbump_options {
                          it (the sculpt tiles with the rectangle as period) */
   int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
                          same for any count */
+  bb_note_fn note;    /* told when the texels come out not square, with the
+                         size or rectangle that keeps them square (may be
+                         NULL) */
+  void *note_user;
 } bb_renderbump_options;
 
 void bb_renderbump_options_init(bb_renderbump_options *o);
@@ -1508,13 +1522,6 @@ bb_provenance_class bb_provenance_classify(const char *description);
  * there, 0 when it is not or description is NULL (out is then ""). So a
  * reader can ask which basis a map was baked with ("basis"). */
 int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
-
-/* ------------------------------------------------------------------ notes */
-
-/* A remark about an input that is not an error: which channel became the
- * height, a lossy or shallow input. path names the file (may be NULL);
- * text is one line without it. Called on the thread that reads the file. */
-typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
 
 /* ----------------------------------------------------------- output paths */
 

@@ -203,7 +203,7 @@ static int combine_run(const cli_run *run, combine_args *a, const char *const *i
         &out, normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, depth, a->settings.mips);
   }
   if (!rc)
-    printf("wrote %s %s\n", bb_map_kind_name(a->kind), a->output);
+    cli_printf_line("wrote %s %s", bb_map_kind_name(a->kind), a->output);
   bb_image_free(&out);
   bb_image_free(&mask);
   map_input_free(&m[0]);

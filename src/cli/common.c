@@ -2,6 +2,7 @@
  * subcommand shares. */
 #include "common.h"
 #include "cli.h"
+#include "json.h"
 
 #include <signal.h>
 #include <stdarg.h>
@@ -11,22 +12,14 @@
 
 /* ---------------------------------------------------------------- escapes */
 
-/* The length of the UTF-8 sequence at s that is safe to print: 0 when its
- * bytes are not a well-formed sequence or encode a C1 control. */
+/* The length of the UTF-8 sequence at s that is safe to print: 0 for a
+ * control character (C0, DEL, C1: 0x9b is CSI to some terminals) or bytes
+ * that are not UTF-8. */
 static size_t printable_sequence(const unsigned char *s) {
   if (s[0] < 0x80)
     return s[0] >= 0x20 && s[0] != 0x7f;
-  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
-  if (s[0] > 0xf4)
-    n = 0;
-  for (size_t i = 1; i < n; i++)
-    if ((s[i] & 0xc0) != 0x80)
-      return 0;
+  const size_t n = cli_utf8_sequence(s);
   if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
-    return 0; /* U+0080..U+009F: C1 controls (0x9b is CSI to some terminals) */
-  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
-    return 0; /* overlong, or a surrogate */
-  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
     return 0;
   return n;
 }

@@ -10,6 +10,7 @@
 #include "bumpbake.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const cli_option opt_json = {
@@ -68,27 +69,33 @@ static const char *provenance_class_name(bb_provenance_class c) {
 
 /* ------------------------------------------------------------------ text */
 
+/* A file's text, line by line, control characters escaped: the first line
+ * after first_prefix. */
+static void print_lines(const char *first_prefix, const char *text) {
+  for (int first = 1; *text; first = 0) {
+    size_t n = strcspn(text, "\n");
+    cli_printf_line("%s%.*s", first ? first_prefix : "", (int)n, text);
+    text += n + (text[n] == '\n');
+  }
+}
+
 static void print_text(const char *path, const file_info *f) {
   const bb_image_info *i = &f->info;
-  printf("%s: %d x %d, %d channel%s, %s, %d-bit %s\n", path, f->width, f->height,
-         f->channels, f->channels == 1 ? "" : "s", i->format_name, i->bits_per_sample,
-         i->is_float ? "float" : "integer");
+  cli_printf_line("%s: %d x %d, %d channel%s, %s, %d-bit %s", path, f->width, f->height,
+                  f->channels, f->channels == 1 ? "" : "s", i->format_name,
+                  i->bits_per_sample, i->is_float ? "float" : "integer");
   if (i->alpha_channel >= 0)
     printf("alpha channel: %d\n", i->alpha_channel);
   if (f->provenance == BB_PROVENANCE_NONE) {
     printf("no bumpbake provenance\n");
     if (i->description && *i->description)
-      printf("description: %s\n", i->description);
+      print_lines("description: ", i->description);
     return;
   }
-  printf("%s:\n%s",
-         f->provenance == BB_PROVENANCE_DAMAGED
-             ? "provenance (cut or re-wrapped by the file format)"
-             : "provenance",
-         i->description);
-  size_t n = strlen(i->description);
-  if (n && i->description[n - 1] != '\n')
-    printf("\n");
+  printf("%s:\n", f->provenance == BB_PROVENANCE_DAMAGED
+                      ? "provenance (cut or re-wrapped by the file format)"
+                      : "provenance");
+  print_lines("", i->description);
 }
 
 /* ------------------------------------------------------------------ JSON */
@@ -101,13 +108,15 @@ static void json_provenance(cli_json *j, const char *text) {
     size_t n = strcspn(line, "\n");
     const char *eq = memchr(line, '=', n);
     if (eq) {
-      char key[128], value[1024];
       size_t k = (size_t)(eq - line), v = n - k - 1;
       if (v && eq[v] == '\r')
         v--;
-      snprintf(key, sizeof key, "%.*s", (int)k, line);
-      snprintf(value, sizeof value, "%.*s", (int)v, eq + 1);
-      cli_json_string(j, key, value);
+      /* Whole keys and values, however long: JSON is not cut. */
+      char *key = strndup(line, k), *value = strndup(eq + 1, v);
+      if (key && value)
+        cli_json_string(j, key, value);
+      free(key);
+      free(value);
     }
     line += n + (line[n] == '\n');
   }

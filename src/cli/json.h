@@ -1,13 +1,21 @@
-/* cli_json.h: the one JSON writer of bumpbake's command line and tools:
+/* json.h: the one JSON writer of bumpbake's command line and tools:
  * one-line objects for --json output, with strings escaped in one place. */
 #ifndef BB_CLI_JSON_H
 #define BB_CLI_JSON_H
 
+#include <stddef.h>
 #include <stdio.h>
 
-/* Writes s to f as a quoted JSON string: '"' and '\' escaped, newline,
- * carriage return and tab as \n, \r, \t, other control bytes as \u00XX.
- * Bytes from 0x80 up pass through (UTF-8 stays UTF-8). NULL writes null. */
+/* The length of the well-formed UTF-8 sequence at s (1 to 4), or 0 when
+ * its bytes are not one (or s is at its end). */
+size_t cli_utf8_sequence(const unsigned char *s);
+
+/* Writes s to f as a quoted JSON string, always valid UTF-8 and never cut:
+ * '"' and '\' escaped, newline, carriage return and tab as \n, \r, \t,
+ * other control characters (C0, DEL, C1) as \u00XX; UTF-8 passes through;
+ * a byte that is not part of UTF-8 (a file name in another encoding)
+ * becomes the lone surrogate \udcXX, which Python's json and
+ * os.fsencode() turn back into the same byte. NULL writes null. */
 void cli_json_quoted(FILE *f, const char *s);
 
 /* A one-line JSON writer: fields are separated by commas automatically.

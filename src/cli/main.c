@@ -61,7 +61,9 @@ int main(int argc, char **argv) {
   for (int i = 0; i < SUBCOMMAND_COUNT; i++)
     if (!strcmp(name, subcommands[i].name))
       return subcommands[i].run(argc - 1, argv + 1);
-  fprintf(stderr, "bumpbake: unknown %s '%s' (see bumpbake --help)\n",
-          name[0] == '-' ? "option" : "command", name);
+  char line[512];
+  snprintf(line, sizeof line, "unknown %s '%s' (see bumpbake --help)",
+           name[0] == '-' ? "option" : "command", name);
+  cli_error_line(line);
   return BB_EXIT_USAGE;
 }

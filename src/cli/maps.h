@@ -15,7 +15,8 @@ enum cli_maps_opt_id {
   CLI_OPT_MAP_MIX,         /* --mix T */
   CLI_OPT_MAP_MASK,        /* --mask FILE */
   CLI_OPT_MAP_DETAIL,      /* --detail */
-  CLI_OPT_MAP_BASE_DIR     /* --base DIR */
+  CLI_OPT_MAP_BASE_DIR,    /* --base DIR */
+  CLI_OPT_MAP_ALLOW_OUTSIDE /* --allow-outside-base */
 };
 
 /* --depth for commands whose default follows their input. */

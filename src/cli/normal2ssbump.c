@@ -141,7 +141,7 @@ static int n2s_run(const cli_run *run, n2s_args *a, const char *input) {
                         &weights, BB_RANGE_UNIT, depth, a->settings.mips);
   }
   if (!rc)
-    printf("wrote weights %s\n", a->output);
+    cli_printf_line("wrote weights %s", a->output);
   bb_image_free(&weights);
   bb_image_free(&normals);
   bb_image_free(&values);

@@ -28,8 +28,14 @@ static const cli_option opt_depth = {.id = CLI_OPT_DEPTH,
                                      .default_text = "8 (png/tga/tif) or float (exr)",
                                      .help = "sample depth of the output"};
 
-static const cli_option *const program_options[] = {&opt_output, &opt_base, &opt_depth,
-                                                    &cli_opt_mips, &cli_opt_help};
+static const cli_option opt_allow_outside = {
+    .id = CLI_OPT_MAP_ALLOW_OUTSIDE,
+    .long_name = "allow-outside-base",
+    .default_text = "off",
+    .help = "read images outside --base too (absolute paths, .., links out)"};
+
+static const cli_option *const program_options[] = {
+    &opt_output, &opt_base, &opt_allow_outside, &opt_depth, &cli_opt_mips, &cli_opt_help};
 
 static const cli_command program_command = {
     "program",
@@ -49,6 +55,7 @@ static const cli_command program_command = {
 typedef struct program_args {
   cli_settings settings;
   const char *output, *base_dir;
+  int allow_outside_base;
 } program_args;
 
 static int program_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -59,6 +66,10 @@ static int program_option(void *ctx, const cli_option *opt, const char *arg) {
   }
   if (opt->id == CLI_OPT_MAP_BASE_DIR) {
     a->base_dir = arg;
+    return 0;
+  }
+  if (opt->id == CLI_OPT_MAP_ALLOW_OUTSIDE) {
+    a->allow_outside_base = 1;
     return 0;
   }
   return cli_settings_apply(program_command.name, &a->settings, opt, arg);
@@ -127,6 +138,7 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   bb_program_options o;
   bb_program_options_init(&o);
   o.base_dir = a->base_dir;
+  o.allow_outside_base = a->allow_outside_base;
   o.loader = quiet_loader;
   bb_image out = {0};
   int is_normal = 0;
@@ -134,7 +146,7 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   bb_status st = bb_program_run(program, &o, &out, &is_normal, &err);
   if (st != BB_OK) {
     /* The message names the image file or the function at fault. */
-    fprintf(stderr, "bumpbake: %s\n", err.message[0] ? err.message : bb_status_name(st));
+    cli_error_line(err.message[0] ? err.message : bb_status_name(st));
     return BB_EXIT_FAILURE;
   }
   const char *kind = is_normal ? "normal" : "colour";
@@ -142,7 +154,7 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
                           is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth,
                           a->settings.mips);
   if (!rc)
-    printf("wrote %s %s\n", kind, a->output);
+    cli_printf_line("wrote %s %s", kind, a->output);
   bb_image_free(&out);
   return rc;
 }

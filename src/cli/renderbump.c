@@ -226,6 +226,7 @@ static int rbf_parse(int argc, char **argv, rbf_args *a) {
     return cli_usage_error(rbf_command.name,
                            "--tile needs --rect L B R T: the tile the sculpt repeats with");
   a->render.threads = a->settings.bake.trace.threads;
+  a->render.note = cli_note;
   return check_outputs(a);
 }
 
@@ -237,17 +238,6 @@ static void print_summary(const rbf_args *a, const bb_mesh *mesh, const bb_rende
          a->model, mesh->triangle_count, r->used_vertex_normals ? "vertex" : "face",
          bb_axis_name(a->render.axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
          a->render.width, a->render.height, a->render.samples * a->render.samples);
-}
-
-/* The height's scale matters only with square texels; say so otherwise. */
-static void note_texel_aspect(const rbf_args *a, const bb_renderbump_result *r) {
-  if (!a->height || fabs(r->texel_aspect - 1.0) <= 0.01)
-    return;
-  fprintf(stderr,
-          "bumpbake renderbumpflat: note: texels are %.4g times as wide as high; the "
-          "height's scale uses their geometric mean (square texels need W / H = %.4g "
-          "in -size)\n",
-          r->texel_aspect, (r->rect[2] - r->rect[0]) / (r->rect[3] - r->rect[1]));
 }
 
 static int write_outputs(const char *command_line, const rbf_args *a, const bb_mesh *mesh,
@@ -265,12 +255,14 @@ static int write_outputs(const char *command_line, const rbf_args *a, const bb_m
     if (a->height)
       cli_printf_line("wrote height %s", a->height);
   }
-  if (a->height) {
-    note_texel_aspect(a, r);
+  if (a->height && r->height_scale > 0.0)
     /* The one number the height is useless without: printed even with -q. */
     cli_printf_line("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)",
                     r->height_scale, a->height, r->height_scale);
-  }
+  else if (a->height)
+    cli_printf_line("height scale 0: the model is flat along %s, so its height is 0 "
+                    "everywhere and a bake of it would trace nothing",
+                    bb_axis_name(a->render.axis));
   return 0;
 }
 

@@ -99,7 +99,7 @@ static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
                         &normals, BB_RANGE_SIGNED, depth, a->settings.mips);
   }
   if (!rc)
-    printf("wrote normal %s\n", a->output);
+    cli_printf_line("wrote normal %s", a->output);
   bb_image_free(&normals);
   bb_image_free(&ssbump);
   bb_image_info_free(&info);

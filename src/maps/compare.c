@@ -5,10 +5,12 @@
 #include <string.h>
 
 /* Difference of one channel value. Equal values (including equal infinities,
- * whose subtraction would give NaN) differ by 0; a NaN on either side is the
- * worst possible difference, so a NaN can never hide under a threshold. */
+ * whose subtraction would give NaN) and two NaNs differ by 0, so an image
+ * compares equal to itself as idiff finds it; a NaN against a number is the
+ * worst possible difference, so a NaN can never hide under a threshold
+ * (idiff's comparisons, false for NaN, let it pass). */
 static double channel_difference(float a, float b) {
-  if (a == b)
+  if (a == b || (isnan(a) && isnan(b)))
     return 0.0;
   if (isnan(a) || isnan(b))
     return INFINITY;

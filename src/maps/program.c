@@ -8,9 +8,12 @@
  * two sizes (x & (width - 1)), this code wraps with a modulo, which is the
  * same for those sizes and tiles any other size too. */
 
+#define _XOPEN_SOURCE 700 /* realpath */
+
 #include "core/internal.h"
 #include "maps/maps_internal.h"
 #include "maps/program_internal.h"
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -81,6 +84,30 @@ int bb_program_image_path(const char *base_dir, const char *name, char *out, siz
   return snprintf(out, cap, "%s", name);
 }
 
+/* A program's images are untrusted text (a material from a mod): unless
+ * allowed, an image must resolve to a file inside the base directory. A
+ * name that resolves to nothing is left to the read, which says so. */
+static bb_status check_inside_base(const bb_program_options *o, const char *name,
+                                   const char *path, bb_error *err) {
+  if (o->allow_outside_base)
+    return BB_OK;
+  if (name[0] == '/')
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%.200s: an absolute path; image names are relative to the base directory",
+                    name);
+  char base[PATH_MAX], file[PATH_MAX];
+  if (!realpath(o->base_dir && *o->base_dir ? o->base_dir : ".", base) || !realpath(path, file))
+    return BB_OK;
+  const size_t n = strlen(base);
+  const int inside =
+      strncmp(file, base, n) == 0 && (file[n] == '/' || (n == 1 && base[0] == '/'));
+  if (!inside)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%.200s: resolves to %.200s, outside the base directory %.200s", name, file,
+                    base);
+  return BB_OK;
+}
+
 static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
   const bb_program_options *o = ev->o;
   char path[4096];
@@ -90,6 +117,9 @@ static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
     return bb__fail(ev->err, BB_ERR_ARGUMENT,
                     "%.64s: path too long (%d bytes, at most %zu)", n->name, len,
                     sizeof path - 1);
+  bb_status inside = check_inside_base(o, n->name, path, ev->err);
+  if (inside != BB_OK)
+    return inside;
   bb_image raw = {0};
   bb_image_info info;
   memset(&info, 0, sizeof info);

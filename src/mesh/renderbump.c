@@ -11,6 +11,7 @@
  * same for any thread count.
  */
 #include "core/internal.h"
+#include "mesh/renderbump_notes.h"
 #include "mesh/rasterize.h"
 
 #include <math.h>
@@ -569,6 +570,8 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
   free(job.bins);
   if (st != BB_OK)
     bb_renderbump_result_free(result);
+  else
+    bb__renderbump_notes(o, result);
   return st;
 }
 

@@ -79,6 +79,19 @@ Test(compare, nan_is_an_infinite_difference) {
   bb_image_free(&diff);
 }
 
+/* An image with NaN compared with itself passes, as idiff finds it. */
+Test(compare, nan_against_nan_does_not_differ) {
+  float x[4] = {0, NAN, 1, NAN};
+  bb_image a = wrap(x, 2, 2, 1);
+  bb_compare_stats s;
+  cr_assert_eq(bb_compare_images(&a, &a, 0.0, 0.0, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(s.max_abs, 0.0);
+  cr_assert_eq(s.over_fail, 0);
+  bb_compare_limits l;
+  bb_compare_limits_init(&l);
+  cr_assert_eq(bb_compare_judge(&s, &l), BB_COMPARE_PASS);
+}
+
 Test(compare, equal_infinities_do_not_differ) {
   float x[2] = {INFINITY, -INFINITY};
   bb_image a = wrap(x, 1, 1, 2);

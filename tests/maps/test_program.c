@@ -396,10 +396,18 @@ Test(program, names_quotes_base_directory_and_missing_files) {
   bb_program_free(p);
 
   /* The default loader reads files; a missing one is named. */
-  cr_assert_eq(bb_program_parse("heightmap(/nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
+  cr_assert_eq(bb_program_parse("heightmap(nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
   cr_assert_eq(bb_program_run(p, NULL, &out, &is_normal, &err), BB_ERR_IO);
-  cr_assert(strstr(err.message, "/nonexistent/h_bmp.tga"), "%s", err.message);
+  cr_assert(strstr(err.message, "nonexistent/h_bmp.tga"), "%s", err.message);
   cr_assert_null(out.pixels);
+  bb_program_free(p);
+  /* An absolute name is refused unless allowed; allowed, it is read. */
+  cr_assert_eq(bb_program_parse("heightmap(/nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
+  cr_assert_eq(bb_program_run(p, NULL, &out, &is_normal, &err), BB_ERR_ARGUMENT);
+  cr_assert(strstr(err.message, "absolute"), "%s", err.message);
+  bb_program_options_init(&o);
+  o.allow_outside_base = 1;
+  cr_assert_eq(bb_program_run(p, &o, &out, &is_normal, &err), BB_ERR_IO);
   bb_program_free(p);
   free_library(&lib);
 }

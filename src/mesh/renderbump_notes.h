@@ -1,0 +1,12 @@
+/* renderbump_notes.h: the notes a flat render bump owes its caller
+ * (renderbump_files.c). */
+#ifndef BB_MESH_RENDERBUMP_NOTES_H
+#define BB_MESH_RENDERBUMP_NOTES_H
+
+#include "bumpbake.h"
+
+/* Tells o->note (when set) that r's texels are not square, with the size
+ * and the rectangle that would make them so. */
+void bb__renderbump_notes(const bb_renderbump_options *o, const bb_renderbump_result *r);
+
+#endif /* BB_MESH_RENDERBUMP_NOTES_H */
