@@ -33,14 +33,18 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp
+PKGS    := OpenImageIO criterion assimp libsquish Imath
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 # Assimp reads and writes meshes (src/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) -lm -pthread
+# libsquish compresses BC1..BC5 blocks (src/io/squish.cpp only). Imath's
+# half.h (C, header only) converts floats to half for VTF and DDS.
+SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
+SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -129,7 +133,8 @@ PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
-DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
+DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
+            pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
@@ -162,7 +167,7 @@ ensure-fuzz-deps: ensure-deps
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) | $(LIB_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -181,7 +186,7 @@ $(BUILD)/%.o: %.c $(BUILD)/compile.flags
 
 $(BUILD)/src/%.o: src/%.cpp $(BUILD)/compile.flags
 	@mkdir -p $(@D)
-	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -c $< -o $@
+	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) -c $< -o $@
 
 -include $(ALL_OBJ:.o=.d)
 
@@ -332,7 +337,7 @@ $(FUZZ_BUILD)/src/%.o: src/%.c
 
 $(FUZZ_BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
-	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -fsanitize=fuzzer-no-link \
+	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) -fsanitize=fuzzer-no-link \
 	  -c $< -o $@
 
 -include $(FUZZ_LIB_OBJ:.o=.d) $(FUZZ_CLI_OBJ:.o=.d)

@@ -30,7 +30,8 @@
  *
  * The header reads in the order data flows, one family after another:
  *   core     status, errors, images, limits
- *   io       reading and writing image files, the height input
+ *   io       reading and writing image files, engine textures (VTF, DDS)
+ *            and Source materials, the height input
  *   bake     smoothing, normals, bases, the tracer, derived maps, bb_bake
  *   maps     Valve's files, conversions, combining, programs, slope maps,
  *            mip chains, comparing images
@@ -163,8 +164,9 @@ typedef struct bb_region {
 } bb_region;
 
 /* =====================================================================
- * io: image files in and out, the height input
- * Every read and write of an image file goes through OpenImageIO.
+ * io: image files in and out, engine textures, the height input
+ * Every read and write of an image file goes through OpenImageIO, except
+ * the engine textures (VTF, DDS), which OpenImageIO does not write.
  * ===================================================================== */
 
 /* ------------------------------------------------------ reading images */
@@ -327,6 +329,194 @@ bb_status bb_image_write_mips(const char *path, const bb_image *levels, int coun
 bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
                                      const bb_write_options *options,
                                      bb_staged_file **staged, bb_error *err);
+
+/* ------------------------------- engine textures: Source VTF and DDS */
+
+/* A texture an engine loads as it is: Valve's VTF (Source) or DirectX's DDS
+ * (Unreal, Unity, Godot, id Tech and most others), with its mip chain and
+ * block compression (BC1..BC5, by Debian's libsquish). OpenImageIO reads DDS
+ * but writes neither, so bumpbake writes both containers itself.
+ *
+ * Every format stores what the engine samples: values in [0, 1] as they
+ * are and normal maps as 0.5 + 0.5 N, the float formats included (a shader
+ * unpacks 2 t - 1 whatever the format; this differs from bb_image_write's
+ * float files, which store N). Integer and block formats clamp to [0, 1]
+ * and round to 8 bits first. Channels: 1 is grey (v, v, v), 2 are R and G,
+ * 3 are R, G, B; alpha is 1 unless the image has a fourth channel. */
+
+/* Pixel format of an engine texture. Names for bb_texture_format_parse in
+ * quotes. */
+typedef enum bb_texture_format {
+  BB_TEXTURE_FORMAT_DEFAULT = 0, /* VTF: DXT1 (DXT5 for 4 channels), as Valve ships
+                                    ssbump and normal maps. DDS: BC5 for a normal map,
+                                    BC4 for 1 channel, BC5 for 2, BC1 for 3, BC3 for 4 */
+  BB_TEXTURE_FORMAT_BC1,     /* "bc1" or "dxt1": R, G, B, 4 bits a texel; VTF, DDS */
+  BB_TEXTURE_FORMAT_BC3,     /* "bc3" or "dxt5": R, G, B, A, 8 bits a texel; VTF, DDS */
+  BB_TEXTURE_FORMAT_BC4,     /* "bc4": one channel (ao, height), 4 bits; DDS */
+  BB_TEXTURE_FORMAT_BC5,     /* "bc5": two channels, 8 bits: a normal map's x and y,
+                                z left to the shader (sqrt(1 - x^2 - y^2)); DDS */
+  BB_TEXTURE_FORMAT_BGR8,    /* "bgr888": 24 bits; VTF */
+  BB_TEXTURE_FORMAT_BGRA8,   /* "bgra8888": 32 bits; VTF */
+  BB_TEXTURE_FORMAT_RGBA8,   /* "rgba8": 32 bits; DDS */
+  BB_TEXTURE_FORMAT_RGBA16F, /* "rgba16f" or "rgba16161616f": half floats; VTF, DDS */
+  BB_TEXTURE_FORMAT_RGBA32F  /* "rgba32f": floats; DDS */
+} bb_texture_format;
+
+/* Parses a format name above (any case); "default" is BB_TEXTURE_FORMAT_DEFAULT. */
+bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
+/* The first name of format ("bc1", ...), "default", or "unknown". */
+const char *bb_texture_format_name(bb_texture_format format);
+
+/* What the image is: it picks the mip rule, the VTF flags and the value range. */
+typedef enum bb_texture_map {
+  BB_TEXTURE_MAP_PLAIN = 0, /* ao, heights, weights...: values in [0, 1], mips
+                               averaged, no VTF flag */
+  BB_TEXTURE_MAP_NORMAL,    /* unit vectors in [-1, 1] (normal, bent normal): mips
+                               renormalised, VTF flag NORMAL, DDS default BC5 */
+  BB_TEXTURE_MAP_SSBUMP     /* a self-shadowed bump map, values in [0, 1]: mips
+                               averaged, VTF flag SSBUMP (which also makes Source's
+                               shaders use the ssbump blend) */
+} bb_texture_map;
+
+/* VTF header flags (Valve's TEXTUREFLAGS_*) the writer sets, for
+ * bb_texture_options.vtf_flags and bb_vtf_info.flags. */
+#define BB_VTF_FLAG_EIGHTBITALPHA 0x00002000u /* set when a 4-channel image keeps alpha */
+#define BB_VTF_FLAG_NORMAL 0x00000080u
+#define BB_VTF_FLAG_NOMIP 0x00000100u         /* set, with NOLOD, without mips */
+#define BB_VTF_FLAG_NOLOD 0x00000200u
+#define BB_VTF_FLAG_ENVMAP 0x00004000u        /* a cube map: refused (one face is written) */
+#define BB_VTF_FLAG_SSBUMP 0x08000000u
+
+typedef struct bb_texture_options {
+  bb_texture_format format;  /* BB_TEXTURE_FORMAT_DEFAULT: see above */
+  bb_texture_map map;        /* what the image is */
+  int mips;                  /* 1: the full chain down to 1 x 1, by bb_mip_chain
+                                (BB_MIP_RENORMALIZE for normal maps, BB_MIP_AVERAGE
+                                otherwise); 0: the image alone */
+  int fast;                  /* 1: the codec's range fit, about 40 times faster than
+                                its cluster fit (0) and 1-2 dB lower PSNR on BC1/BC3;
+                                BC4 and BC5 are the same either way */
+  int threads;               /* block compression threads, 0 = all cores; the bytes
+                                are the same for any count */
+  int vtf_version;           /* VTF minor version: 2 (7.2, the default, read by every
+                                Source branch) to 5; 3 and up hold provenance */
+  uint32_t vtf_flags;        /* VTF flags added to the map's (BB_VTF_FLAG_* or any
+                                other TEXTUREFLAGS_* bit; ENVMAP is refused) */
+  const char *description;   /* provenance text ("key=value" lines) or NULL. VTF 7.3
+                                and up store it as a "KVD" (key-value data) resource,
+                                "bumpbake" { "key" "value" ... }; VTF 7.2 and DDS have
+                                no room for it and leave it out */
+} bb_texture_options;
+
+/* Defaults: format DEFAULT, map PLAIN, mips 1, fast 0, threads 0, VTF 7.2, no
+ * extra flag, no description. */
+void bb_texture_options_init(bb_texture_options *options);
+
+/* True (1) when path's extension (any case) is .vtf or .dds, the containers
+ * bb_texture_write writes. */
+int bb_path_is_texture_format(const char *path);
+
+/* Checks, before any work, that a width x height image of `channels`
+ * channels can go to path (.vtf or .dds) with options, so a caller can
+ * refuse a bad request before a long bake. BB_ERR_ARGUMENT with the reason
+ * for: another extension; a format the container does not have (VTF: bc1,
+ * bc3, bgr888, bgra8888, rgba16f; DDS: bc1, bc3, bc4, bc5, rgba8, rgba16f,
+ * rgba32f); a format that cannot hold the channels (bc1 and bgr888 take at
+ * most 3, the others 4; bc4 exactly 1; bc5 2, or a normal map's 3); a
+ * normal map of fewer than 3 channels; a VTF side that is not a power of
+ * two or over 32768 (Source); a block format (bc*) whose width or height is
+ * not a multiple of 4; a VTF version outside 2..5 or the ENVMAP flag; an
+ * unknown format or map. */
+bb_status bb_texture_check(const char *path, int width, int height, int channels,
+                           const bb_texture_options *options, bb_error *err);
+
+/* Writes img to path as a VTF or DDS texture (by extension), after
+ * bb_texture_check; options may be NULL (the defaults). The mip chain is
+ * made here (options->mips).
+ *
+ * VTF (Valve's layout: VTFLib's VTFFormat.h and the Valve Developer
+ * Community's "Valve Texture Format" page): an 80-byte header (7.3 and up:
+ * followed by a resource dictionary of 8-byte entries), reflectivity the
+ * mean of (code / 255)^2.2 per channel over the 8-bit top level (as vtex and
+ * VTFLib compute it), bump scale 1, one frame, depth 1, the low-resolution
+ * image as DXT1 at the first mip size of at most 16 x 16, then every level,
+ * smallest first. Flags: the map's, BB_VTF_FLAG_NOMIP | NOLOD without mips,
+ * EIGHTBITALPHA for a 4-channel image in a format with alpha, and
+ * options->vtf_flags.
+ *
+ * DDS: "DDS " and the 124-byte header, levels largest first. BC1 and BC3
+ * carry FourCC DXT1 and DXT5; BC4 and BC5 ATI1 and ATI2 (the oldest codes,
+ * which every DDS reader knows, OpenImageIO's included); a BC5 normal map
+ * also carries the DDPF_NORMAL flag (0x80000000, NVIDIA's), which tells
+ * readers that know it (OpenImageIO) to rebuild z. RGBA8 is a 32-bit RGB +
+ * alpha pixel format with masks; RGBA16F and RGBA32F need, and get, the
+ * DX10 header (DXGI_FORMAT_R16G16B16A16_FLOAT and _R32G32B32A32_FLOAT).
+ * OpenImageIO 2.4 reads every DDS written here except those two float ones.
+ *
+ * The file is written as bb_image_write writes, through a temporary renamed
+ * into place. Errors: as bb_texture_check; BB_ERR_VALUE (NaN or infinite
+ * texels); BB_ERR_MEMORY; BB_ERR_IO. */
+bb_status bb_texture_write(const char *path, const bb_image *img,
+                           const bb_texture_options *options, bb_error *err);
+
+/* bb_texture_write up to, not including, the rename, as
+ * bb_image_write_staged: commit or discard *staged. */
+bb_status bb_texture_write_staged(const char *path, const bb_image *img,
+                                  const bb_texture_options *options,
+                                  bb_staged_file **staged, bb_error *err);
+
+/* What a VTF file's header says (bb_vtf_read_info). */
+typedef struct bb_vtf_info {
+  int version_major, version_minor; /* 7 and 0..5 */
+  int header_size;          /* bytes, resource dictionary included */
+  int width, height, depth; /* of the top level, in texels */
+  int frames, first_frame;
+  uint32_t flags;           /* TEXTUREFLAGS_* (BB_VTF_FLAG_*) */
+  float reflectivity[3];
+  float bump_scale;
+  int format;               /* Valve's IMAGE_FORMAT_* code (13 = DXT1, 15 = DXT5,
+                               3 = BGR888, 12 = BGRA8888, 24 = RGBA16161616F...) */
+  char format_name[24];     /* "DXT1", "BGR888", ..., or "unknown" */
+  int mip_count;
+  int low_res_format;       /* IMAGE_FORMAT_* of the low-resolution image, -1 none */
+  int low_res_width, low_res_height;
+  int resource_count;       /* 7.3 and up; 0 before */
+  long data_size;           /* bytes of image data the header declares (every level) */
+  char *description;        /* provenance from a "KVD" resource written by
+                               bumpbake ("key=value" lines), malloc'd, or NULL */
+} bb_vtf_info;
+
+/* Reads the header (and resource dictionary) of the VTF file at path, an
+ * untrusted file: every size and offset is checked against the file's
+ * length. Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not a
+ * VTF, a version other than 7.0..7.5, a header, resource or image data
+ * that runs past the end of the file). Free with bb_vtf_info_free. */
+bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
+
+/* Frees info->description and clears it; safe on a zeroed struct. */
+void bb_vtf_info_free(bb_vtf_info *info);
+
+/* ------------------------------------------------- Source materials */
+
+typedef struct bb_vmt_options {
+  const char *materials_dir; /* the game's materials folder; the material's
+                                texture paths are relative to it */
+  const char *bumpmap;       /* path of the bump map's .vtf, inside materials_dir */
+  const char *basetexture;   /* path of the colour .vtf, inside materials_dir, or NULL */
+  int ssbump;                /* 1: the bump map is a self-shadowed bump map ($ssbump 1) */
+} bb_vmt_options;
+
+/* Writes a Source material (.vmt) to path: LightmappedGeneric with
+ * "$basetexture" (when given), "$bumpmap" and "$ssbump" "1" (when ssbump),
+ * each texture named by its path relative to materials_dir, with '/' and
+ * without ".vtf", as Source looks textures up. Paths are compared as
+ * written, made absolute against the working directory, "." and ".."
+ * resolved, symbolic links not followed (the textures need not exist yet).
+ * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path,
+ * materials_dir or bumpmap; a texture that is not a .vtf or lies outside
+ * materials_dir; a '"' or control character in a path, which a material
+ * cannot quote); BB_ERR_MEMORY; BB_ERR_IO. */
+bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 
 /* -------------------------------------------------------- height input */
 

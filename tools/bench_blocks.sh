@@ -1,0 +1,101 @@
+#!/bin/sh
+# bench_blocks.sh: what block compression costs the engine textures, and how
+# long writing them takes.
+#
+#   tools/bench_blocks.sh [BIN] [OUTDIR]     (after `make all`)
+#
+# BIN is bumpbake (default build/bumpbake); OUTDIR keeps every file made
+# (default: a temporary directory, removed at the end). Bakes
+# fixtures/rock06_height.png at scale 64 (1024 x 1024: normal, ssbump, ao as
+# float EXR, the uncompressed reference), writes each map in each block
+# format with build/tools/texture_quality, reads it back (DDS through
+# OpenImageIO, VTF through the tests' own decoder) and prints PSNR and the
+# worst error in 8-bit codes against the float map (normal maps compared as
+# 0.5 + 0.5 N; 8-bit rounding alone gives ~58.9 dB and 0.5). For normal maps
+# also the mean and worst angle between decoded and true normals. Then the
+# same with NVIDIA Texture Tools' nvcompress (Debian's libnvtt-bin, if
+# installed) on the 8-bit PNG of each map, and the time to write a
+# 2048 x 2048 ssbump as VTF DXT1 with mips against writing it as PNG.
+set -eu
+
+BIN=${1:-build/bumpbake}
+TQ=$(dirname "$BIN")/tools/texture_quality
+[ -x "$BIN" ] && [ -x "$TQ" ] || { echo "bench_blocks: build first (make all): $BIN, $TQ" >&2; exit 2; }
+if [ $# -ge 2 ]; then OUT=$2; mkdir -p "$OUT"; KEEP=1; else OUT=$(mktemp -d); KEEP=0; fi
+trap '[ "$KEEP" = 1 ] || rm -rf "$OUT"' EXIT
+FIX=${BB_FIXTURES:-fixtures}
+
+"$BIN" bake "$FIX/rock06_height.png" --scale 64 --normal "$OUT/normal.exr" \
+  --ssbump "$OUT/ssbump.exr" --ao "$OUT/ao.exr" -q
+
+row() { # CODEC MAP FORMAT FILE COMPARE-ARGS...
+  codec=$1 map=$2 format=$3 file=$4
+  shift 4
+  printf '%-12s %-7s %-13s %s\n' "$codec" "$map" "$format" "$("$TQ" compare "$OUT/$map.exr" "$file" "$@")"
+}
+
+# write MAP FORMAT EXT [OPTIONS]: our file, and its row.
+ours() {
+  map=$1 format=$2 ext=$3
+  shift 3
+  kind=plain
+  [ "$map" = normal ] && kind=normal
+  [ "$map" = ssbump ] && kind=ssbump
+  file=$OUT/${map}_$format$(printf '%s' "$*" | tr -d ' -').$ext
+  seconds=$("$TQ" write "$OUT/$map.exr" "$file" --map "$kind" --format "$format" "$@")
+  channels=
+  [ "$format" = bc5 ] && channels="--channels 2"
+  # shellcheck disable=SC2086
+  row "squish$(printf '%s' "$*" | sed 's/--fast/-fast/')" "$map" "$ext $format" "$file" --map "$kind" $channels
+  echo "$seconds" >"$file.seconds"
+}
+
+echo "== quality: rock06 1024 x 1024, scale 64, every level written (level 0 compared)"
+printf '%-12s %-7s %-13s %s\n' codec map file "result (codes of 255)"
+ours normal bc1 dds
+ours normal bc1 dds --fast
+ours normal bc3 dds
+ours normal bc5 dds
+ours normal rgba8 dds
+ours normal bc1 vtf
+ours ssbump bc1 dds
+ours ssbump bc1 dds --fast
+ours ssbump bc3 dds
+ours ssbump bc1 vtf
+ours ssbump bgr888 vtf
+ours ao bc4 dds
+ours ao bc1 dds
+ours ao bc1 vtf
+
+if command -v nvcompress >/dev/null 2>&1; then
+  echo "== the same through NVIDIA Texture Tools 2.0.8 (nvcompress -nomips, 8-bit PNG in)"
+  "$TQ" write "$OUT/normal.exr" "$OUT/normal8.png" --map normal >/dev/null
+  "$TQ" write "$OUT/ssbump.exr" "$OUT/ssbump8.png" >/dev/null
+  "$TQ" write "$OUT/ao.exr" "$OUT/ao8.png" >/dev/null
+  for job in "normal bc1" "normal bc3" "normal bc5" "ssbump bc1" "ssbump bc3" "ao bc4" "ao bc1"; do
+    set -- $job
+    nvcompress -nomips -"$2" "$OUT/${1}8.png" "$OUT/${1}_nvtt_$2.dds" >/dev/null 2>&1
+    kind=plain
+    [ "$1" = normal ] && kind=normal
+    channels=
+    [ "$2" = bc5 ] && channels="--channels 2"
+    # shellcheck disable=SC2086
+    row nvtt "$1" "dds $2" "$OUT/${1}_nvtt_$2.dds" --map "$kind" $channels
+  done
+else
+  echo "== nvcompress not found (apt-get install libnvtt-bin for the NVIDIA Texture Tools rows)"
+fi
+
+echo "== time: a 2048 x 2048 ssbump (rock06 resized, scale 128), median of 3 writes, in-process"
+oiiotool "$FIX/rock06_height.png" --resize 2048x2048 -d uint16 -o "$OUT/h2048.png"
+"$BIN" bake "$OUT/h2048.png" --scale 128 --ssbump "$OUT/ss2048.exr" -q
+median() { sort -n | sed -n 2p; }
+for target in "png" "vtf" "vtf --fast" "dds"; do
+  set -- $target
+  ext=$1
+  shift
+  t=$(for i in 1 2 3; do "$TQ" write "$OUT/ss2048.exr" "$OUT/ss2048.$ext" --map ssbump "$@"; done | median)
+  printf '%-26s %s s  %s bytes\n' "$ext ${*:-}" "$t" "$(wc -c <"$OUT/ss2048.$ext")"
+done
+echo "(png: 8-bit through OpenImageIO; vtf: DXT1 + 12 mip levels + low-res; dds: BC1 + mips;"
+echo " threads: all $(nproc) cores)"
