@@ -1,5 +1,5 @@
 /* renderbump_notes.h: the notes a flat render bump owes its caller
- * (renderbump_files.c). */
+ * (renderbump_notes.c). */
 #ifndef BB_MESH_RENDERBUMP_NOTES_H
 #define BB_MESH_RENDERBUMP_NOTES_H
 
