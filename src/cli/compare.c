@@ -366,6 +366,8 @@ int bb_cli_compare(int argc, char **argv) {
      * verdict: the comparison itself was made. */
     if (a.diff_path && !r.diff_written)
       cli_file_error(a.diff_path, r.diff_error.message);
+    else if (a.diff_path && !a.quiet && !a.json)
+      cli_printf_line("wrote diff %s", a.diff_path);
     code = (int)r.verdict;
   }
   bb_compare_report_free(&r);

@@ -45,9 +45,14 @@ static const cli_option opt_detail = {
     .default_text = "off",
     .help = "detail variant: RGB times (R+G+B)/sqrt(3) of the filtered input colour"};
 
+static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
+                                     .short_name = 'q',
+                                     .default_text = "off",
+                                     .help = "no list of files written"};
+
 static const cli_option *const h2s_options[] = {
     &opt_rays, &opt_normal, &opt_ao_alpha, &opt_radius,
-    &opt_dump, &opt_detail, &cli_opt_help,
+    &opt_dump, &opt_detail, &opt_quiet,  &cli_opt_help,
 };
 
 static void h2s_settings_init(cli_settings *s) {
@@ -71,7 +76,7 @@ static const cli_command h2s_command = {
 
 typedef struct h2s_args {
   cli_settings settings;
-  int normal_map, ao_in_alpha, dump_filtered, detail;
+  int normal_map, ao_in_alpha, dump_filtered, detail, quiet;
   const char *input;
   char *output; /* malloc'd FILE-ssbump.tga or FILE-bump.tga */
 } h2s_args;
@@ -93,6 +98,9 @@ static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_VALVE_DETAIL:
     a->detail = 1;
     return 0;
+  case CLI_OPT_QUIET:
+    a->quiet = 1;
+    return 0;
   default:
     break;
   }
@@ -103,7 +111,8 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
   int first = 0;
   int rc = cli_parse_options(&h2s_command, argc, argv, h2s_option, a, &first);
   if (!rc)
-    rc = cli_expect_positionals(&h2s_command, argc, argv, first, 2, "FILE BUMPSCALE");
+    rc = cli_expect_positionals(&h2s_command, argc, argv, first, 2,
+                                argc - first == 1 ? "BUMPSCALE" : "FILE BUMPSCALE");
   if (rc)
     return rc;
   a->input = argv[first];
@@ -194,6 +203,8 @@ static int write_outputs(const h2s_args *a, const char *command_line,
       cli_error_line(err.message);
       rc = BB_EXIT_FAILURE;
     }
+    for (int i = 0; !rc && !a->quiet && i < (a->dump_filtered ? 2 : 1); i++)
+      cli_printf_line("wrote %s %s", files[i].kind, files[i].path);
   }
   free(texts[0]);
   free(texts[1]);

@@ -2,6 +2,7 @@
  * a bake job of one map. */
 #include "cli.h"
 #include "common.h"
+#include "job_json.h"
 #include "options.h"
 
 #include <stdlib.h>
@@ -20,6 +21,11 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .default_text = "off",
                                      .help = "no \"wrote ...\" line"};
 
+static const cli_option opt_json = {.id = CLI_OPT_JSON,
+                                    .long_name = "json",
+                                    .default_text = "off",
+                                    .help = "print one JSON line describing the bake on stdout"};
+
 static const cli_option *const normal_options[] = {
     &opt_output,
     &cli_opt_scale,
@@ -32,6 +38,7 @@ static const cli_option *const normal_options[] = {
     &cli_opt_channel,
     &cli_opt_depth,
     &cli_opt_mips,
+    &opt_json,
     &opt_quiet,
     &cli_opt_help,
 };
@@ -49,7 +56,7 @@ static const cli_command normal_command = {
 typedef struct normal_args {
   cli_settings settings;
   const char *output;
-  int quiet;
+  int json, quiet;
 } normal_args;
 
 static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -60,6 +67,10 @@ static int normal_option(void *ctx, const cli_option *opt, const char *arg) {
   }
   if (opt->id == CLI_OPT_QUIET) {
     a->quiet = 1;
+    return 0;
+  }
+  if (opt->id == CLI_OPT_JSON) {
+    a->json = 1;
     return 0;
   }
   return cli_settings_apply(normal_command.name, &a->settings, opt, arg);
@@ -105,6 +116,8 @@ static int normal_run(normal_args *a, const char *command_line, const char *inpu
   if (bb_job_run_item(job, 0, NULL, NULL) != BB_OK) {
     cli_error_line(bb_job_report_get(job, 0)->error.message);
     rc = BB_EXIT_FAILURE;
+  } else if (a->json) {
+    cli_job_json(&o.bake, bb_job_report_get(job, 0), NULL);
   } else if (!a->quiet) { /* as bake says it */
     cli_printf_line("wrote normal %s", a->output);
   }

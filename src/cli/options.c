@@ -231,6 +231,89 @@ static void print_help(const cli_command *cmd) {
   }
 }
 
+/* Edit distance of a and b (each at most 63 characters), for "did you
+ * mean". */
+static size_t edit_distance(const char *a, size_t na, const char *b) {
+  size_t nb = strlen(b), row[64];
+  if (na > 63 || nb > 63)
+    return 99;
+  for (size_t j = 0; j <= nb; j++)
+    row[j] = j;
+  for (size_t i = 1; i <= na; i++) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= nb; j++) {
+      size_t above = row[j];
+      size_t best = diagonal + (a[i - 1] != b[j - 1]);
+      if (above + 1 < best)
+        best = above + 1;
+      if (row[j - 1] + 1 < best)
+        best = row[j - 1] + 1;
+      row[j] = best;
+      diagonal = above;
+    }
+  }
+  return row[nb];
+}
+
+/* Every long option word must name an option in full: getopt_long would
+ * take "--ray" for --rays silently. An unknown word gets the nearest
+ * name; a prefix of several names lists them. The words after "--" and the
+ * values of options that take one are not options. */
+static int check_long_words(const cli_command *cmd, int argc, char **argv, int long_only) {
+  for (int i = 1; i < argc; i++) {
+    const char *w = argv[i];
+    if (!strcmp(w, "--"))
+      return 0;
+    const int dashes = w[0] == '-' && w[1] == '-' ? 2 : (long_only && w[0] == '-' && w[1] && w[2]) ? 1 : 0;
+    if (!dashes)
+      continue;
+    const char *name = w + dashes;
+    const size_t n = strcspn(name, "=");
+    const cli_option *exact = NULL;
+    char candidates[256] = "";
+    int prefix_of = 0;
+    for (int k = 0; k < cmd->option_count; k++) {
+      const cli_option *o = cmd->options[k];
+      if (!o->long_name)
+        continue;
+      if (strlen(o->long_name) == n && !strncmp(o->long_name, name, n))
+        exact = o;
+      else if (strncmp(o->long_name, name, n) == 0) {
+        prefix_of++;
+        snprintf(candidates + strlen(candidates), sizeof candidates - strlen(candidates),
+                 "%s--%s", candidates[0] ? ", " : "", o->long_name);
+      }
+    }
+    if (exact) {
+      if (exact->value_name && !name[n])
+        i++; /* its value */
+      continue;
+    }
+    if (dashes == 1) /* a cluster of short options ("-nA") is getopt's */
+      continue;
+    if (prefix_of > 1)
+      return cli_usage_error(cmd->name, "option '--%.*s' is ambiguous: %s", (int)n, name,
+                             candidates);
+    if (prefix_of == 1)
+      return cli_usage_error(cmd->name, "unknown option '--%.*s' (did you mean %s?)", (int)n,
+                             name, candidates);
+    const cli_option *near = NULL;
+    size_t best = 3;
+    for (int k = 0; k < cmd->option_count; k++) {
+      const cli_option *o = cmd->options[k];
+      size_t d = o->long_name ? edit_distance(name, n, o->long_name) : 99;
+      if (d < best)
+        best = d, near = o;
+    }
+    if (near)
+      return cli_usage_error(cmd->name, "unknown option '--%.*s' (did you mean --%s?)",
+                             (int)n, name, near->long_name);
+    return cli_usage_error(cmd->name, "unknown option '--%.*s' (see --help)", (int)n, name);
+  }
+  return 0;
+}
+
 int cli_parse_options(const cli_command *cmd, int argc, char **argv,
                       cli_option_fn on_option, void *ctx, int *first_positional) {
   enum { MAX_OPTIONS = 48 };
@@ -258,6 +341,9 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
   longopts[nl] = (struct option){NULL, 0, NULL, 0};
   shortopts[ns] = '\0';
 
+  int rc = check_long_words(cmd, argc, argv, long_only);
+  if (rc)
+    return rc;
   opterr = 0; /* our messages, in our format */
   /* 0, not 1: glibc then forgets all its state, including its pointer into
    * the previous argv when that parse stopped inside a cluster such as
@@ -294,7 +380,7 @@ int cli_parse_options(const cli_command *cmd, int argc, char **argv,
       print_help(cmd);
       return -1;
     }
-    int rc = on_option(ctx, o, optarg);
+    rc = on_option(ctx, o, optarg);
     if (rc)
       return rc;
   }

@@ -11,9 +11,11 @@
 #include <string.h>
 
 /* One code of an integer height file is 1 / max code of h, so S / max code
- * texels of displacement. Past a quarter of a texel the steps between
- * codes show as terraces in the normals, through the default smoothing. */
-#define TERRACE_STEP_TEXELS 0.25
+ * texels of displacement. Past about an eighth of a texel the steps between
+ * codes show as rings in the normals of a smooth slope, through the default
+ * smoothing (an 8-bit dome: faint at scale 32, plain at 64, strong at 128;
+ * none at 16). */
+#define TERRACE_STEP_TEXELS 0.12
 
 static void say(bb_note_fn note, void *user, const char *path, const char *text) {
   if (note && text)

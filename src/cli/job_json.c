@@ -1,0 +1,60 @@
+/* job_json.c: the JSON line of one baked input, as bake and normal print it
+ * with --json. */
+#include "job_json.h"
+#include "json.h"
+
+#include <string.h>
+
+/* Parameters are those used: the channel the rule took and the threads
+ * that ran, not "auto" and 0. */
+void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {
+  const int traced = r->rayset_id[0] != '\0';
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "input", r->input);
+  if (status)
+    cli_json_string(&j, "status", status);
+  cli_json_number(&j, "width", r->width);
+  cli_json_number(&j, "height", r->height);
+
+  cli_json_open(&j, "parameters", '{');
+  cli_json_number(&j, "scale", (double)b->height_scale);
+  cli_json_number(&j, "rays", b->rays);
+  cli_json_number(&j, "slices", bb_bake_slices(b));
+  cli_json_string(&j, "rayset", traced ? r->rayset_id : NULL);
+  cli_json_number(&j, "filter_radius", b->smooth.radius_texels);
+  cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
+  cli_json_number(&j, "bias", b->trace.bias_texels);
+  cli_json_number(&j, "power", b->power);
+  cli_json_string(&j, "basis", b->basis.name);
+  cli_json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
+  cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
+  cli_json_string(&j, "addressing",
+                  b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+  cli_json_string(&j, "channel", bb_height_source_channel(&r->source));
+  cli_json_number(&j, "threads", r->threads);
+  cli_json_close(&j, '}');
+
+  cli_json_open(&j, "seconds", '{');
+  cli_json_number(&j, "load", r->seconds_load);
+  cli_json_number(&j, "smooth", r->seconds_smooth);
+  cli_json_number(&j, "pyramid", r->seconds_pyramid);
+  cli_json_number(&j, "trace", r->seconds_trace);
+  cli_json_number(&j, "derive", r->seconds_derive);
+  cli_json_number(&j, "write", r->seconds_write);
+  cli_json_close(&j, '}');
+
+  cli_json_number(&j, "horizons", r->horizons);
+  cli_json_open(&j, "outputs", '[');
+  for (int i = 0; i < r->output_count; i++) {
+    if (!strncmp(r->outputs[i].kind, "slope", 5))
+      continue; /* the maps of the bake only */
+    cli_json_open(&j, NULL, '{');
+    cli_json_string(&j, "kind", r->outputs[i].kind);
+    cli_json_string(&j, "path", r->outputs[i].path);
+    cli_json_close(&j, '}');
+  }
+  cli_json_close(&j, ']');
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
+}

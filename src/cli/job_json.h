@@ -1,0 +1,13 @@
+/* job_json.h: the JSON line of one baked input (job_json.c). */
+#ifndef BB_CLI_JOB_JSON_H
+#define BB_CLI_JOB_JSON_H
+
+#include "bumpbake.h"
+
+/* Prints r (an input the library baked with options b) as one JSON line on
+ * stdout: input, status (when not NULL), size, the parameters used (the
+ * channel the rule took, the threads that ran), seconds per stage,
+ * horizons and the maps written. */
+void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status);
+
+#endif /* BB_CLI_JOB_JSON_H */
