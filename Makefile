@@ -276,7 +276,7 @@ check-circles: $(LIB_OBJ) $(CLI_OBJ)
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.
 check-unit: $(BIN) $(TESTBIN) $(TOOLS)
-	BB_BIN=$(BIN) BB_FIXTURES=fixtures ./$(TESTBIN) --jobs 2
+	@BB_BIN=$(BIN) BB_FIXTURES=fixtures ./tools/run_tests.sh ./$(TESTBIN)
 
 # Installs into a temporary prefix, builds tests/install_client.c with
 # pkg-config and runs it; checks the exported symbols and the man page.
