@@ -91,7 +91,7 @@ CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
 comma := ,
 
 # ---- sources and products ----------------------------------------------------
-# The library's families, in the order data flows (README "Layout").
+# The library's families, in the order data flows (README.md, "Layout").
 FAMILIES := core io bake trace maps render mesh job
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))

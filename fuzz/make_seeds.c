@@ -4,7 +4,7 @@
  * OUT_DIR/load: every small fixture PNG as it is, and each converted to TGA,
  * TIFF and EXR (with fuzz_load's leading byte); OUT_DIR/compare: pairs of
  * small images; OUT_DIR/provenance: the provenance texts of the golden
- * EXRs, in pairs; OUT_DIR/cli: the command lines of the README. */
+ * EXRs, in pairs; OUT_DIR/cli: the command lines of the docs' examples. */
 #include "bumpbake.h"
 
 #include <dirent.h>

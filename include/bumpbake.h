@@ -1123,7 +1123,7 @@ typedef struct bb_program_options {
 
 void bb_program_options_init(bb_program_options *o);
 
-/* Evaluates a program as id Tech 4 does (README "program" gives each
+/* Evaluates a program as id Tech 4 does (docs/commands/program.md gives each
  * formula), in float rather than bytes. Inside, every image is RGBA in
  * [0, 1] standing for id's bytes / 255 (files are read as value / max code,
  * clamped; grey gives R = G = B, no alpha gives A = 1), and normal-map

@@ -1,5 +1,5 @@
 /* cli_combine.c: `bumpbake combine`, blending two maps by a mask or a
- * constant, or overlaying a detail map (README "combine"). */
+ * constant, or overlaying a detail map (docs/commands/combine.md). */
 #include "cli.h"
 #include "common.h"
 #include "maps.h"

@@ -1,5 +1,5 @@
 /* combine.c: blending two maps and overlaying a detail map, for ssbumps,
- * weights, ao and normal maps (README "combine" defines the operators).
+ * weights, ao and normal maps (docs/commands/combine.md defines the operators).
  *
  * Invariant: an identity input gives the base back bit for bit. A blend
  * factor of exactly 0 (or 1) copies a (or b); a detail texel equal to the
