@@ -119,7 +119,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles bench goldens docs install uninstall clean format FORCE \
+        check-python check-circles check-docs bench goldens docs docs-reference install \
+        uninstall clean format FORCE \
         fuzz fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
@@ -265,8 +266,17 @@ test: ensure-deps
 	@$(MAKE) --no-print-directory check
 
 # Everything `make test` runs: the Criterion suite, the install check, the
-# Python tests and the check that no two files need each other.
-check: check-unit check-install check-python check-circles
+# Python tests, the check that no two files need each other and the check
+# that the command reference and the man page say what --help says.
+check: check-unit check-install check-python check-circles check-docs
+
+# docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
+# each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
+# them, `make check-docs` fails, naming the command, when they differ.
+docs-reference: $(BIN)
+	$(PYTHON) tools/gen_docs.py $(BIN)
+check-docs: $(BIN)
+	@$(PYTHON) tools/gen_docs.py --check $(BIN)
 
 # Object files that use each other's symbols in a circle fail the build's
 # checks (tools/check_circles.py): one of them has two jobs.
