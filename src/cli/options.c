@@ -223,11 +223,11 @@ static void print_help(const cli_command *cmd) {
                     : cmd->init_settings
                         ? settings_default_text(o->id, &defaults, dflt, sizeof dflt)
                         : NULL;
-    /* Flags wider than their column go on a line of their own, so the
-     * column still says where the description starts (tools/gen_docs.py
-     * reads it). */
-    if (strlen(flags) > 36)
-      printf("  %s\n  %-36s %s", flags, "", o->help);
+    /* At least two spaces end the flags, also when they fill or overflow
+     * their column: tools/gen_docs.py splits the line there, and an option
+     * and its default stay on one line for whoever greps them. */
+    if (strlen(flags) >= 36)
+      printf("  %s  %s", flags, o->help);
     else
       printf("  %-36s %s", flags, o->help);
     if (d)
