@@ -36,8 +36,6 @@ MAN = os.path.join(ROOT, "docs", "bumpbake.1")
 BEGIN_OPTIONS = "<!-- generated: options -->"
 BEGIN_COMMANDS = "<!-- generated: commands -->"
 END = "<!-- end generated -->"
-# --help prints each option as "  FLAGS" padded to this column, then its text.
-HELP_COLUMN = 39
 
 
 class DocsError(Exception):
@@ -104,21 +102,14 @@ def parse_command(name, text):
         start = lines.index("options:") + 1
     except ValueError:
         raise DocsError("bumpbake %s --help has no 'options:' line" % name)
-    options, i = [], start
-    while i < len(lines):
-        line = lines[i]
-        if not line.startswith("  -"):
+    options = []
+    for line in lines[start:]:
+        # "  FLAGS  TEXT": the flags never hold two spaces in a row, and --help
+        # ends them with at least two (padding them to a column when they fit).
+        m = re.match(r"^  (-\S+(?: \S+)*)  +(\S.*)$", line)
+        if not m:
             raise DocsError("bumpbake %s --help: cannot read the line '%s'" % (name, line))
-        if len(line) > HELP_COLUMN and line[HELP_COLUMN - 1] == " " and line[2:HELP_COLUMN - 1].strip():
-            flags, text = line[2:HELP_COLUMN - 1].strip(), line[HELP_COLUMN:]
-        else:  # flags wider than their column: the text is on the next line
-            flags = line.strip()
-            i += 1
-            if i >= len(lines) or not lines[i].startswith(" " * HELP_COLUMN):
-                raise DocsError("bumpbake %s --help: no description under '%s'" % (name, flags))
-            text = lines[i][HELP_COLUMN:]
-        options.append(Option(flags, text.strip()))
-        i += 1
+        options.append(Option(m.group(1), m.group(2).strip()))
     return usage, options
 
 
