@@ -223,6 +223,12 @@ typedef enum bb_depth {
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
 
+/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
+bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
+/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+ * for values outside the enum. */
+const char *bb_depth_name(bb_depth depth);
+
 /* How float values map to integer codes. */
 typedef enum bb_range {
   BB_RANGE_UNIT = 0, /* [0, 1] stored as value * max code (ssbump, ao, height) */
@@ -1867,6 +1873,17 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
                            const char *diff_path, bb_compare_report *report, bb_error *err);
 
 void bb_compare_report_free(bb_compare_report *report);
+
+/* idiff's exit code for a report, which `bumpbake compare` exits with: the
+ * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
+ * the sizes or channel counts differ. (An unreadable file is no report:
+ * idiff and `bumpbake compare` exit 4.) */
+#define BB_COMPARE_DIFFERENT_SIZE 3
+int bb_compare_report_exit_code(const bb_compare_report *report);
+
+/* idiff's word for a report's outcome, as `bumpbake compare` prints it:
+ * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
+const char *bb_compare_report_result(const bb_compare_report *report);
 
 /* -------------------------------------------------------------- bake jobs */
 

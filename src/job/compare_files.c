@@ -98,3 +98,24 @@ void bb_compare_report_free(bb_compare_report *report) {
   free(report->provenance_diff);
   report->provenance_diff = NULL;
 }
+
+int bb_compare_report_exit_code(const bb_compare_report *report) {
+  if (!report)
+    return BB_COMPARE_FAIL;
+  if (!report->same_shape)
+    return BB_COMPARE_DIFFERENT_SIZE;
+  return (int)report->verdict;
+}
+
+const char *bb_compare_report_result(const bb_compare_report *report) {
+  if (!report)
+    return "FAILURE";
+  if (!report->same_shape)
+    return "DIFFERENT SIZE";
+  switch (report->verdict) {
+  case BB_COMPARE_PASS: return "PASS";
+  case BB_COMPARE_WARN: return "WARNING";
+  case BB_COMPARE_FAIL: return "FAILURE";
+  }
+  return "FAILURE";
+}
