@@ -1921,7 +1921,8 @@ typedef struct bb_job_options {
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
   int slope_lit;             /* 1: also slope_path with "_lit" before its
                                 extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction */
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction;
+                                azimuth finite, elevation 0..90 */
   /* A batch (out_dir set): */
   const char *out_dir;       /* outputs go to out_dir/name; created when missing */
   const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"
