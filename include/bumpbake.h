@@ -1228,6 +1228,13 @@ typedef struct bb_compare_limits {
 /* Sets idiff's defaults (in the field comments above). */
 void bb_compare_limits_init(bb_compare_limits *limits);
 
+/* BB_OK when every limit is in its range: fail, hard_fail, warn and
+ * hard_warn >= 0 (infinity allowed), the percentages in 0..100,
+ * allow_failures >= 0; else BB_ERR_ARGUMENT naming the limit by idiff's
+ * option ("compare: failpercent must be in 0..100 (got 150)"). NaN is
+ * refused. */
+bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
+
 /* A comparison's outcome; the values are idiff's exit codes. */
 typedef enum bb_compare_verdict {
   BB_COMPARE_PASS = 0,
@@ -1861,7 +1868,8 @@ typedef struct bb_compare_report {
 } bb_compare_report;
 
 /* Compares the image files a and b channel by channel under limits (NULL:
- * idiff's defaults), as OpenImageIO's idiff does, and their provenance key
+ * idiff's defaults; checked by bb_compare_limits_check before any read),
+ * as OpenImageIO's idiff does, and their provenance key
  * by key. With diff_path (may be NULL; check it first with
  * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
  * the largest finite difference is white (NaN and infinite ones clip to

@@ -59,6 +59,9 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
   bb_compare_limits_init(&defaults);
   if (!limits)
     limits = &defaults;
+  bb_status checked = bb_compare_limits_check(limits, err);
+  if (checked != BB_OK)
+    return checked;
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
   bb_status st = bb_image_read(a, &x, &ix, err);
