@@ -307,7 +307,7 @@ def test_a_missing_library_fails_import_with_a_hint(tmp_path):
                          capture_output=True, text=True)
     assert out.returncode != 0
     assert "ImportError: bumpbake: cannot load" in out.stderr
-    assert "nowhere.so (missing)" in out.stderr
+    assert "nowhere.so (no such file)" in out.stderr
 
 
 @pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
@@ -323,3 +323,29 @@ def test_file_hash_is_what_the_command_line_records(tmp_path):
     assert bumpbake.file_hash(tmp_path / "a") == 0xaf63dc4c8601ec8c  # FNV-1a 64 of "a"
     with pytest.raises(bumpbake.Error, match="cannot read"):
         bumpbake.file_hash(tmp_path / "missing.png")
+
+
+def test_an_installed_package_loads_the_recorded_library_or_says_what_to_do(tmp_path):
+    """`make install` records the library's path in bumpbake/_install.py;
+    with that file gone, the error names only the paths tried and the
+    remedy (tools/check_install.sh checks a real install)."""
+    site = tmp_path / "dist-packages"
+    (site / "bumpbake").mkdir(parents=True)
+    for name in os.listdir(os.path.dirname(bumpbake.__file__)):
+        if name.endswith(".py"):
+            with open(os.path.join(os.path.dirname(bumpbake.__file__), name), "rb") as f:
+                (site / "bumpbake" / name).write_bytes(f.read())
+    gone = tmp_path / "lib" / bumpbake._library.SONAME
+    (site / "bumpbake" / "_install.py").write_text(f"LIBRARY = {str(gone)!r}\n")
+    env = {"PATH": os.environ.get("PATH", "/usr/bin:/bin"), "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-c", "import bumpbake"], env=env, cwd="/",
+                         capture_output=True, text=True)
+    assert out.returncode != 0
+    message = out.stderr.strip().splitlines()[-1]
+    assert message.startswith(f"ImportError: bumpbake: cannot load {bumpbake._library.SONAME}: "
+                              "the library this package was installed with is gone: run "
+                              "`make install` again")
+    tried = message.split("Tried: ")[1]
+    assert tried.startswith(f"{gone} (no such file); {bumpbake._library.SONAME} by the dynamic "
+                            "loader's search")
+    assert "build" not in tried and "pkg-config" not in tried
