@@ -6,6 +6,7 @@ import json
 import os
 import pickle
 import shutil
+import signal
 
 import numpy as np
 import pytest
@@ -217,3 +218,24 @@ def test_a_job_planned_here_runs_elsewhere(tmp_path, fixtures):
     assert len(rules) == 4 and rules[0].endswith(os.path.join("heights", "bricks_128x64.png"))
     with pytest.raises(IndexError):
         job.run(4)
+
+
+def test_ctrl_c_during_a_trace_cancels_it_cleanly(tmp_path, fixtures):
+    """A real SIGINT (Python's own handler raises KeyboardInterrupt at the
+    next bytecode, here inside the progress callback on the calling
+    thread): the bake stops, nothing is written, and KeyboardInterrupt
+    reaches the caller."""
+    src = os.path.join(fixtures, "noise_96x80.png")
+    seen = []
+
+    def ctrl_c(done, total):
+        seen.append(done)
+        if len(seen) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(10000):  # bytecodes, where the handler runs
+                pass
+
+    with pytest.raises(KeyboardInterrupt):
+        bumpbake.bake_file(src, {"ao": tmp_path / "ao.png"}, scale=8, rays=1024, progress=ctrl_c)
+    assert len(seen) == 1, "stopped at the first slice"
+    assert not list(tmp_path.iterdir())
