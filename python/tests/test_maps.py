@@ -177,6 +177,15 @@ def test_flat_maps_under_an_overhead_light_render_white():
     both = bumpbake.render(**flat, mode="normal", lightmap="basis", light=(0, 90))
     np.testing.assert_allclose(both, 1 + 1 / 3, atol=1e-6)
     assert bumpbake.render(**flat, compare=True).shape[2] == 3
+    # An albedo multiplies the diffuse light; mod2x's neutral is 0.5.
+    grey = np.full((8, 8), 0.5, np.float32)
+    lit = bumpbake.render(**flat, light=(0, 90), albedo=grey)
+    np.testing.assert_allclose(lit, 0.5, atol=1e-6)
+    lit = bumpbake.render(**flat, light=(0, 90), albedo=grey, albedo_mode="mod2x")
+    np.testing.assert_allclose(lit, 1, atol=1e-6)
+    rgb = np.broadcast_to(np.float32([1, 0.5, 0.25]), (8, 8, 3))
+    np.testing.assert_allclose(bumpbake.render(**flat, light=(0, 90), albedo=rgb)[3, 4],
+                               [1, 0.5, 0.25], atol=1e-6)
     with pytest.raises(bumpbake.ArgumentError, match="elevation must be in 0..90"):
         bumpbake.render(**flat, light=(0, 95))
     with pytest.raises(bumpbake.ArgumentError, match="slope map is missing"):
