@@ -42,6 +42,8 @@ typedef enum bb_addressing {
 
 typedef int (*bb_progress_fn)(void *user, long done, long total);
 
+typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
+
 typedef struct bb_region {
   int x0, y0, width, height;
 } bb_region;
@@ -175,6 +177,7 @@ typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img
 
 typedef struct bb_program_options {
   const char *base_dir;
+  int allow_outside_base;
   bb_image_loader loader;
   void *loader_user;
 } bb_program_options;
@@ -293,6 +296,8 @@ typedef struct bb_renderbump_options {
   double rect[4];
   int tile;
   int threads;
+  bb_note_fn note;
+  void *note_user;
 } bb_renderbump_options;
 
 typedef struct bb_renderbump_result {
@@ -312,8 +317,6 @@ typedef enum bb_provenance_class {
   BB_PROVENANCE_INTACT,
   BB_PROVENANCE_DAMAGED
 } bb_provenance_class;
-
-typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
 
 typedef struct bb_output_spec {
   const char *path;
@@ -447,6 +450,8 @@ bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis 
                                 bb_error *err);
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
 bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
+bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
+                            bb_error *err);
 const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
 bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
@@ -456,8 +461,6 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
-bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
-                            bb_error *err);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
                               bb_image *normals, bb_error *err);
 bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);

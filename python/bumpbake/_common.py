@@ -8,6 +8,7 @@ read.
 """
 
 import os
+import warnings
 
 import numpy as np
 
@@ -37,6 +38,28 @@ class NoteWarning(UserWarning):
     """A remark of the library about an input that is not an error: which
     channel became the height, a lossy JPEG, 8-bit codes that terrace at
     the scale asked. `bumpbake bake` prints the same lines on stderr."""
+
+
+# ------------------------------------------------------------------ notes
+
+def _note_text(path, text):
+    return f"{path}: {text}" if path else text
+
+
+def _dispatch_notes(notes, policy, stacklevel):
+    if policy == "ignore":
+        return
+    for line in notes:
+        if policy == "warn":
+            warnings.warn(line, NoteWarning, stacklevel=stacklevel + 1)
+        else:
+            policy(line)
+
+
+def _check_notes(notes):
+    if notes not in ("warn", "ignore") and not callable(notes):
+        raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {notes!r})")
+    return notes
 
 
 def _status_name(status):

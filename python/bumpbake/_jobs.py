@@ -4,11 +4,10 @@ the same files, provenance, up-to-date decisions and depfiles."""
 import dataclasses
 import os
 import typing
-import warnings
 
 from ._bake import BAKE_PARAMETERS, OUTPUTS, _bake_options, _channel, _kinds_mask
-from ._common import (NoteWarning, _argument_error, _check, _depth, _exception, _ffi, _lib,
-                      _message, _path, _status_name, _text)
+from ._common import (_argument_error, _check, _check_notes, _depth, _dispatch_notes,
+                      _exception, _ffi, _lib, _message, _note_text, _path, _status_name, _text)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -59,26 +58,6 @@ def _report(r, status=None):
         out.rayset = _text(r.rayset_id) or None
         out.seconds = {k: getattr(r, "seconds_" + k) for k in _SECONDS}
     return out
-
-
-def _note_text(path, text):
-    return f"{path}: {text}" if path else text
-
-
-def _dispatch_notes(notes, policy, stacklevel):
-    if policy == "ignore":
-        return
-    for line in notes:
-        if policy == "warn":
-            warnings.warn(line, NoteWarning, stacklevel=stacklevel + 1)
-        else:
-            policy(line)
-
-
-def _check_notes(notes):
-    if notes not in ("warn", "ignore") and not callable(notes):
-        raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {notes!r})")
-    return notes
 
 
 class BakeJob:

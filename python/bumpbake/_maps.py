@@ -122,10 +122,12 @@ def combine(a, b, mix=None, mask=None, detail=False, kind="ssbump", detail_depth
     return _take(out)
 
 
-def program(text, base=None):
+def program(text, base=None, allow_outside_base=False):
     """Evaluates a DOOM 3 image program ("addnormals(a_local.tga,
     heightmap(a_h.tga, 4))") as `bumpbake program` does: image names are
-    files, relative to base (a directory; None: as given). Returns (array,
+    files, relative to base (a directory; None: the current one), and must
+    stay inside it (no absolute path, "..", or symbolic link out) unless
+    allow_outside_base. Returns (array,
     is_normal_map): the decoded normals N, float32 (H, W, 3), +Y down, when
     the program makes a normal map (heightmap, addnormals, smoothnormals or
     _flat in it), else RGBA colour, float32 (H, W, 4) in [0, 1]. A syntax
@@ -141,6 +143,7 @@ def program(text, base=None):
     _lib.bb_program_options_init(o)
     base_dir = _ffi.new("char[]", _path(base, "base")) if base is not None else _ffi.NULL
     o.base_dir = base_dir
+    o.allow_outside_base = int(bool(allow_outside_base))
     out = _ffi.new("bb_image *")
     is_normal = _ffi.new("int *")
     _check(_lib.bb_program_run(prog, o, out, is_normal, err), err)

@@ -7,8 +7,8 @@ import os
 import numpy as np
 
 from ._bake import BAKE_PARAMETERS, _bake_options, _height_field, _normal_y_up
-from ._common import (_Image, _argument_error, _array, _check, _ffi, _int, _lib, _parse, _path,
-                      _take)
+from ._common import (_Image, _argument_error, _array, _check, _check_notes, _dispatch_notes,
+                      _ffi, _int, _lib, _note_text, _parse, _path, _take, _text)
 
 # The default light of bb_render_options_init: on, at this azimuth and
 # elevation (degrees).
@@ -203,11 +203,12 @@ class RenderBump:
     triangles: int           # of the model
     vertices: int
     model_hash: int          # bb_mesh_hash, recorded in provenance as model_hash
+    notes: list              # the library's notes ("texels are ... times as wide")
 
 
 def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=False,
                    rect=None, tile=False, threads=0, *, output=None, height_output=None,
-                   normal_y="down"):
+                   normal_y="down", notes="warn"):
     """DOOM 3's RenderBumpFlat of a model file (anything Assimp reads) as
     `bumpbake renderbumpflat` makes it: the model projected orthographically
     along axis ("-y" DOOM 3's, "+y", "+z", "-z", "+x", "-x") onto rect
@@ -218,7 +219,9 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
     (needs rect). Returns a RenderBump (arrays +Y down). With output (and
     height_output) the files are also written all or nothing, with
     provenance, as the command line writes them (normal_y="up" flips their
-    green)."""
+    green). The library's note when the texels come out not square (with the
+    size or rect that keeps them square) goes to notes ("warn": a
+    NoteWarning, "ignore", or a callable) and to the result's notes."""
     o = _ffi.new("bb_renderbump_options *")
     _lib.bb_renderbump_options_init(o)
     try:
@@ -241,6 +244,11 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
                               "with")
     o.tile = int(bool(tile))
     o.threads = _int("renderbumpflat", "threads", threads)
+    _check_notes(notes)
+    heard = []
+    note = _ffi.callback("bb_note_fn",
+                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
+    o.note = note
     green_up = _normal_y_up("renderbumpflat", normal_y)
     path = _path(model, "model")
     err = _ffi.new("bb_error *")
@@ -263,6 +271,7 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
     try:
         _check(_lib.bb_mesh_load(path, mesh, err), err)
         _check(_lib.bb_renderbump_flat(mesh, o, result, err), err)
+        _dispatch_notes(heard, notes, stacklevel=2)
         model_hash = _lib.bb_mesh_hash(mesh)
         if output is not None:
             _check(_lib.bb_renderbump_write(result, o, int(green_up), path, model_hash,
@@ -275,7 +284,7 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
             height_scale=result.height_scale,
             used_vertex_normals=bool(result.used_vertex_normals),
             triangles_drawn=int(result.triangles_drawn), triangles=int(mesh.triangle_count),
-            vertices=int(mesh.vertex_count), model_hash=int(model_hash))
+            vertices=int(mesh.vertex_count), model_hash=int(model_hash), notes=heard)
     finally:
         _lib.bb_renderbump_result_free(result)
         _lib.bb_mesh_free(mesh)

@@ -106,6 +106,12 @@ def test_program_evaluates_id_tech_4(tmp_path):
     with pytest.raises(bumpbake.Error, match="nothing.png") as e:
         bumpbake.program("makeIntensity(nothing.png)", base=tmp_path)
     assert not isinstance(e.value, bumpbake.ArgumentError)
+    (tmp_path / "sub").mkdir()
+    with pytest.raises(bumpbake.ArgumentError, match="c.png"):
+        bumpbake.program("invertColor(../c.png)", base=tmp_path / "sub")
+    outside, _ = bumpbake.program("invertColor(../c.png)", base=tmp_path / "sub",
+                                  allow_outside_base=True)
+    np.testing.assert_array_equal(outside, c)
 
 
 # ---------------------------------------------------------------- mips
@@ -152,8 +158,10 @@ def test_render_sheet_and_renderbumpflat_are_the_clis(tmp_path, fixtures, cli):
     sheet = bumpbake.sheet(bumpbake.read(height), 8, rays=64, mode="ao")
     np.testing.assert_array_equal(sheet, bumpbake.read(tmp_path / "sheet.exr"))
 
-    rb = bumpbake.renderbumpflat(model, size=(64, 32), output=tmp_path / "py.png",
-                                 height_output=tmp_path / "py_h.png")
+    with pytest.warns(bumpbake.NoteWarning, match="texels are 0.6456 times as wide as high"):
+        rb = bumpbake.renderbumpflat(model, size=(64, 32), output=tmp_path / "py.png",
+                                     height_output=tmp_path / "py_h.png")
+    assert len(rb.notes) == 1 and "size 64 50" in rb.notes[0]
     for ours, theirs in (("py.png", "rbf.png"), ("py_h.png", "rbf_h.png")):
         c = bumpbake.compare(tmp_path / ours, tmp_path / theirs, fail=0)
         assert c.passed and c.max_abs == 0 and c.provenance_diff == [], ours
@@ -202,3 +210,5 @@ def test_renderbumpflat_refusals(fixtures, tmp_path):
         bumpbake.renderbumpflat(model, axis="w")
     with pytest.raises(bumpbake.Error, match="nothing.obj"):
         bumpbake.renderbumpflat(tmp_path / "nothing.obj")
+    square = bumpbake.renderbumpflat(model, size=(64, 50), notes="ignore")
+    assert square.notes == [] and abs(square.texel_aspect - 1) < 0.01
