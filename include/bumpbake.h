@@ -223,6 +223,12 @@ typedef enum bb_depth {
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
 
+/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
+bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
+/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+ * for values outside the enum. */
+const char *bb_depth_name(bb_depth depth);
+
 /* How float values map to integer codes. */
 typedef enum bb_range {
   BB_RANGE_UNIT = 0, /* [0, 1] stored as value * max code (ssbump, ao, height) */
@@ -1222,6 +1228,13 @@ typedef struct bb_compare_limits {
 /* Sets idiff's defaults (in the field comments above). */
 void bb_compare_limits_init(bb_compare_limits *limits);
 
+/* BB_OK when every limit is in its range: fail, hard_fail, warn and
+ * hard_warn >= 0 (infinity allowed), the percentages in 0..100,
+ * allow_failures >= 0; else BB_ERR_ARGUMENT naming the limit by idiff's
+ * option ("compare: failpercent must be in 0..100 (got 150)"). NaN is
+ * refused. */
+bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
+
 /* A comparison's outcome; the values are idiff's exit codes. */
 typedef enum bb_compare_verdict {
   BB_COMPARE_PASS = 0,
@@ -1855,7 +1868,8 @@ typedef struct bb_compare_report {
 } bb_compare_report;
 
 /* Compares the image files a and b channel by channel under limits (NULL:
- * idiff's defaults), as OpenImageIO's idiff does, and their provenance key
+ * idiff's defaults; checked by bb_compare_limits_check before any read),
+ * as OpenImageIO's idiff does, and their provenance key
  * by key. With diff_path (may be NULL; check it first with
  * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
  * the largest finite difference is white (NaN and infinite ones clip to
@@ -1867,6 +1881,17 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
                            const char *diff_path, bb_compare_report *report, bb_error *err);
 
 void bb_compare_report_free(bb_compare_report *report);
+
+/* idiff's exit code for a report, which `bumpbake compare` exits with: the
+ * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
+ * the sizes or channel counts differ. (An unreadable file is no report:
+ * idiff and `bumpbake compare` exit 4.) */
+#define BB_COMPARE_DIFFERENT_SIZE 3
+int bb_compare_report_exit_code(const bb_compare_report *report);
+
+/* idiff's word for a report's outcome, as `bumpbake compare` prints it:
+ * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
+const char *bb_compare_report_result(const bb_compare_report *report);
 
 /* -------------------------------------------------------------- bake jobs */
 
@@ -1904,7 +1929,8 @@ typedef struct bb_job_options {
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
   int slope_lit;             /* 1: also slope_path with "_lit" before its
                                 extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction */
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction;
+                                azimuth finite, elevation 0..90 */
   /* A batch (out_dir set): */
   const char *out_dir;       /* outputs go to out_dir/name; created when missing */
   const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"
