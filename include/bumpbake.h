@@ -96,6 +96,14 @@ extern "C" {
 /* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
 
+/* Most rasterising a flat render bump may do: the samples its triangles
+ * reach (each triangle's samples, bounded by its area and by the part of
+ * its box inside the image, plus one per sample row it spans) at most 256
+ * times the image's samples plus 256 per triangle drawn. A sculpt covers
+ * its image a few times over; a pile of triangles drawn over one another
+ * thousands of times is refused (BB_ERR_SIZE) before anything is drawn. */
+#define BB_MAX_RENDERBUMP_LAYERS 256
+
 typedef enum bb_status {
   BB_OK = 0,          /* success */
   BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
