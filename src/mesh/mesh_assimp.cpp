@@ -346,7 +346,8 @@ double mesh_triangles(const aiMesh *m) {
 // places a copy of a mesh for every node that uses it, so a small file can
 // name a great many. Walked with a stack of our own, not by recursion: the
 // node tree is as deep as the importer made it. False when it is over the
-// limits (or holds more nodes than memory could, a cycle).
+// limits (or holds more nodes than memory could: a cycle). Counting costs
+// one visit per node; nothing is built.
 bool instanced_size_ok(const aiScene *scene, double *triangles, double *vertices) {
   std::vector<double> per_mesh(scene->mNumMeshes);
   for (unsigned i = 0; i < scene->mNumMeshes; i++) per_mesh[i] = mesh_triangles(scene->mMeshes[i]);
@@ -364,12 +365,10 @@ bool instanced_size_ok(const aiScene *scene, double *triangles, double *vertices
       *triangles += per_mesh[m];
       *vertices += scene->mMeshes[m]->mNumVertices;
     }
-    if (*triangles > (double)BB_MAX_MODEL_TRIANGLES ||
-        *vertices > 3.0 * (double)BB_MAX_MODEL_TRIANGLES)
-      return false;
     for (unsigned c = 0; c < node->mNumChildren; c++) stack.push_back(node->mChildren[c]);
   }
-  return true;
+  return *triangles <= (double)BB_MAX_MODEL_TRIANGLES &&
+         *vertices <= 3.0 * (double)BB_MAX_MODEL_TRIANGLES;
 }
 
 // Counts of what the merged mesh will hold.
