@@ -12,6 +12,7 @@
 
 #include <fcntl.h>
 #include <limits.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -416,4 +417,50 @@ Test(mesh_hostile, the_importer_memory_is_capped) {
   cr_expect_eq(st, BB_ERR_MEMORY, "%d: %s", st, err.message);
   cr_expect(strstr(err.message, "out of memory") || strstr(err.message, "killed"), "%s",
             err.message);
+}
+
+/* Loads from several threads at once: each child may hold, for a moment,
+ * the pipes of the others' children; every load still gets its own mesh. */
+typedef struct loader {
+  const char *path;
+  uint64_t hash[6];
+  bb_status status[6];
+} loader;
+
+static void *load_six(void *user) {
+  loader *l = user;
+  for (int i = 0; i < 6; i++) {
+    bb_mesh m;
+    bb_error err;
+    l->status[i] = bb_mesh_load(l->path, &m, &err);
+    l->hash[i] = l->status[i] == BB_OK ? bb_mesh_hash(&m) : 0;
+    if (l->status[i] == BB_OK)
+      bb_mesh_free(&m);
+  }
+  return NULL;
+}
+
+Test(mesh_hostile, loads_on_several_threads_at_once_each_get_their_mesh) {
+  const char *fixtures = getenv("BB_FIXTURES");
+  char path[PATH_MAX];
+  snprintf(path, sizeof path, "%s/rivet_panel.obj", fixtures ? fixtures : "fixtures");
+  bb_mesh m;
+  bb_error err = {{0}};
+  cr_assert_eq(bb__mesh_import(path, &m, NULL, 0, &err), BB_OK, "%s", err.message);
+  uint64_t expected = bb_mesh_hash(&m);
+  bb_mesh_free(&m);
+  enum { THREADS = 4 };
+  pthread_t threads[THREADS];
+  loader loaders[THREADS];
+  for (int t = 0; t < THREADS; t++) {
+    loaders[t].path = path;
+    cr_assert_eq(pthread_create(&threads[t], NULL, load_six, &loaders[t]), 0);
+  }
+  for (int t = 0; t < THREADS; t++) {
+    pthread_join(threads[t], NULL);
+    for (int i = 0; i < 6; i++) {
+      cr_expect_eq(loaders[t].status[i], BB_OK, "thread %d, load %d", t, i);
+      cr_expect_eq(loaders[t].hash[i], expected, "thread %d, load %d", t, i);
+    }
+  }
 }
