@@ -40,12 +40,16 @@ typedef struct bb__import_limits {
                           reserve terabytes of address space) */
   long stack_bytes;    /* stack of the thread the import runs on */
   int cpu_seconds;     /* CPU time, after which the child is killed */
-  int wall_seconds;    /* wall-clock time, after which the child is killed
-                          (a child stuck without using CPU) */
+  int wall_seconds;    /* wall-clock time, after which the child is killed */
+  int stall_seconds;   /* time without using CPU or answering, after which a
+                          child is taken for stuck, killed and made once more
+                          (a lock another thread of the caller's held at the
+                          fork stays held in the child); 0: never */
 } bb__import_limits;
 
 /* The limits bb_mesh_load uses: BB_MAX_IMPORT_MEMORY, BB__IMPORT_STACK_BYTES,
- * BB_MAX_IMPORT_SECONDS of CPU and four times that of wall-clock time. */
+ * BB_MAX_IMPORT_SECONDS of CPU, four times that of wall-clock time, and
+ * 10 s of standing still. */
 void bb__import_limits_default(bb__import_limits *lim);
 
 /* bb__mesh_import in a child process within lim, the mesh returned through

@@ -39,6 +39,7 @@ void bb__import_limits_default(bb__import_limits *lim) {
   lim->stack_bytes = BB__IMPORT_STACK_BYTES;
   lim->cpu_seconds = BB_MAX_IMPORT_SECONDS;
   lim->wall_seconds = 4 * BB_MAX_IMPORT_SECONDS;
+  lim->stall_seconds = 10;
 }
 
 /* ------------------------------------------------------------ the wire */
@@ -207,7 +208,49 @@ typedef struct child {
   int status;  /* waitpid's, valid when exited and known */
   int known;
   int timed_out;
+  int stall_seconds;    /* 0: not watched */
+  long cpu_ticks;       /* the child's CPU time when last looked at */
+  double moved;         /* when it last used CPU or sent bytes */
+  int stalled;
 } child;
+
+/* CPU time the process has used, in clock ticks, or -1 (no /proc). */
+static long cpu_ticks_of(pid_t pid) {
+  char path[64], text[512];
+  snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
+    return -1;
+  ssize_t n = read(fd, text, sizeof text - 1);
+  close(fd);
+  if (n <= 0)
+    return -1;
+  text[n] = '\0';
+  /* after "pid (comm) ": state is field 3, utime 14 and stime 15 */
+  const char *p = strrchr(text, ')');
+  unsigned long utime, stime;
+  if (!p || sscanf(p + 1, " %*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &utime,
+                   &stime) != 2)
+    return -1;
+  return (long)(utime + stime);
+}
+
+/* Whether the child has stood still (no CPU, no bytes) for stall_seconds:
+ * stuck on a lock it inherited locked, not working. */
+static int child_stalled(child *c) {
+  if (c->stall_seconds <= 0)
+    return 0;
+  long ticks = cpu_ticks_of(c->pid);
+  double now = bb__now_seconds();
+  if (ticks < 0)
+    return 0; /* cannot tell: only the deadline applies */
+  if (ticks != c->cpu_ticks) {
+    c->cpu_ticks = ticks;
+    c->moved = now;
+    return 0;
+  }
+  return now - c->moved > c->stall_seconds;
+}
 
 static int child_gone(child *c) {
   if (c->exited)
@@ -229,6 +272,7 @@ static int read_exact(child *c, void *buf, size_t n) {
     ssize_t got = read(c->fd, p, n);
     if (got > 0) {
       p += got, n -= (size_t)got;
+      c->moved = bb__now_seconds();
       continue;
     }
     if (got == 0)
@@ -250,8 +294,10 @@ static int read_exact(child *c, void *buf, size_t n) {
     int ready = poll(&pfd, 1, left > 0.1 ? 100 : (int)(left * 1000.0) + 1);
     if (ready == 0 && was_gone)
       return -1;
-    if (ready == 0)
-      child_gone(c);
+    if (ready == 0 && !child_gone(c) && child_stalled(c)) {
+      c->stalled = 1;
+      return -1;
+    }
   }
   return 0;
 }
@@ -322,6 +368,9 @@ static bb_status child_failure(const child *c, const char *path, const bb__impor
   if (c->timed_out)
     return bb__fail(err, BB_ERR_SIZE, "%s: the importer took more than %d s; stopped", path,
                     lim->wall_seconds);
+  if (c->stalled)
+    return bb__fail(err, BB_ERR_IO, "%s: the importer stood still for %d s, twice; stopped",
+                    path, lim->stall_seconds);
   if (c->known && WIFSIGNALED(c->status)) {
     int sig = WTERMSIG(c->status);
     if (sig == SIGXCPU)
@@ -384,6 +433,49 @@ static bb_status receive(child *c, const char *path, const bb__import_limits *li
   return st;
 }
 
+/* One child: forked, answered (or not), reaped. */
+static bb_status one_child(const char *path, const bb__import_limits *lim, double deadline,
+                           bb_mesh *out, char *note, size_t cap, int *answered, int *stalled,
+                           bb_error *err) {
+  *answered = *stalled = 0;
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot start the importer: %s", path, strerror(errno));
+  fcntl(fds[0], F_SETPIPE_SZ, 1 << 20); /* fewer wake-ups for a large mesh */
+  pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    child_main(path, lim, fds[1]); /* does not return */
+  }
+  int fork_errno = errno;
+  close(fds[1]);
+  if (pid < 0) {
+    close(fds[0]);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: cannot start the importer: %s", path,
+                    strerror(fork_errno));
+  }
+  child c;
+  memset(&c, 0, sizeof c);
+  c.fd = fds[0];
+  c.pid = pid;
+  c.deadline = deadline;
+  c.stall_seconds = lim->stall_seconds;
+  c.cpu_ticks = -1;
+  c.moved = bb__now_seconds();
+  fcntl(c.fd, F_SETFL, fcntl(c.fd, F_GETFL) | O_NONBLOCK);
+  bb_status st = receive(&c, path, lim, out, note, cap, answered, err);
+  finish(&c, !*answered);
+  close(c.fd);
+  /* A whole answer from a child that then died is no answer. */
+  if (*answered && c.known && !(WIFEXITED(c.status) && WEXITSTATUS(c.status) == 0)) {
+    bb_mesh_free(out);
+    *answered = 0;
+    st = child_failure(&c, path, lim, err);
+  }
+  *stalled = c.stalled;
+  return st;
+}
+
 bb_status bb__mesh_load_isolated(const char *path, const bb__import_limits *lim, bb_mesh *out,
                                  char *note, size_t cap, int *clean, bb_error *err) {
   if (clean)
@@ -401,33 +493,15 @@ bb_status bb__mesh_load_isolated(const char *path, const bb__import_limits *lim,
   bb_status st = bb__mesh_check_model(path, &size, err);
   if (st != BB_OK)
     return st;
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0)
-    return bb__fail(err, BB_ERR_IO, "%s: cannot start the importer: %s", path, strerror(errno));
-  fcntl(fds[0], F_SETPIPE_SZ, 1 << 20); /* fewer wake-ups for a large mesh */
-  pid_t pid = fork();
-  if (pid == 0) {
-    close(fds[0]);
-    child_main(path, lim, fds[1]); /* does not return */
-  }
-  int fork_errno = errno;
-  close(fds[1]);
-  if (pid < 0) {
-    close(fds[0]);
-    return bb__fail(err, BB_ERR_MEMORY, "%s: cannot start the importer: %s", path,
-                    strerror(fork_errno));
-  }
-  child c = {fds[0], pid, bb__now_seconds() + lim->wall_seconds, 0, 0, 0, 0};
-  fcntl(c.fd, F_SETFL, fcntl(c.fd, F_GETFL) | O_NONBLOCK);
-  int answered = 0;
-  st = receive(&c, path, lim, out, note, cap, &answered, err);
-  finish(&c, !answered);
-  close(c.fd);
-  /* A whole answer from a child that then died is no answer. */
-  if (answered && c.known && !(WIFEXITED(c.status) && WEXITSTATUS(c.status) == 0)) {
-    bb_mesh_free(out);
-    answered = 0;
-    st = child_failure(&c, path, lim, err);
+  /* A child that stands still is made once more: what holds it is a lock
+   * that another thread of the caller's held at the moment of the fork
+   * (sanitizer runtimes' allocators do not release theirs), not the model. */
+  const double deadline = bb__now_seconds() + lim->wall_seconds;
+  int answered = 0, stalled = 0;
+  for (int attempt = 0; attempt < 2; attempt++) {
+    st = one_child(path, lim, deadline, out, note, cap, &answered, &stalled, err);
+    if (!stalled)
+      break;
   }
   if (clean)
     *clean = answered;
