@@ -342,6 +342,7 @@ FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(C
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536
 FUZZ_ARGS_fuzz_program    := -dict=fuzz/program.dict
+FUZZ_ARGS_fuzz_mesh       := -dict=fuzz/mesh.dict -max_len=16384
 
 # Objects are kept between runs (make would delete them as intermediates).
 .SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)

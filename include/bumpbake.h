@@ -97,6 +97,35 @@ extern "C" {
 /* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
 
+/* What reading one model (bb_mesh_load) may take. Model files are untrusted,
+ * and Assimp's importers build their own structures before bumpbake sees a
+ * triangle, so the import runs in a child process held to these limits:
+ * - BB_MAX_MODEL_BYTES: the model file and every file it refers to (a glTF's
+ *   buffers, an OBJ's .mtl), 256 MiB together, checked before each is read;
+ * - BB_MAX_MODEL_TRIANGLES: triangles after polygons are split and every
+ *   instance of a mesh is placed (8 Mi), and at most three times as many
+ *   vertices, checked on the importer's scene before it is post-processed
+ *   or copied;
+ * - BB_MAX_IMPORT_MEMORY: memory the importer may take beyond the process's
+ *   own (4 GiB; Assimp takes 8 to 27 times an OBJ's size: 600 MiB for a
+ *   1 M-triangle grid with normals, 76 MB; 2 GiB for 10 M triangles of
+ *   "f 1 2 3", 80 MB);
+ * - BB_MAX_IMPORT_SECONDS: CPU seconds of the import (120; four times as
+ *   many of wall-clock time).
+ * A model over one of them is refused with BB_ERR_SIZE or BB_ERR_MEMORY. */
+#define BB_MAX_MODEL_BYTES (256L << 20)
+#define BB_MAX_MODEL_TRIANGLES (1L << 23)
+#define BB_MAX_IMPORT_MEMORY (4L << 30)
+#define BB_MAX_IMPORT_SECONDS 120
+
+/* Most rasterising a flat render bump may do: the samples its triangles
+ * reach (each triangle's samples, bounded by its area and by the part of
+ * its box inside the image, plus one per sample row it spans) at most 256
+ * times the image's samples plus 256 per triangle drawn. A sculpt covers
+ * its image a few times over; a pile of triangles drawn over one another
+ * thousands of times is refused (BB_ERR_SIZE) before anything is drawn. */
+#define BB_MAX_RENDERBUMP_LAYERS 256
+
 typedef enum bb_status {
   BB_OK = 0,          /* success */
   BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
@@ -1560,10 +1589,33 @@ uint64_t bb_mesh_hash(const bb_mesh *m);
 /* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
  * anything Assimp imports), merged as described at bb_mesh. Normals are kept
  * when any part of the model has them (vertices of parts without are zero).
- * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
- * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
- * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
+ *
+ * Model files are untrusted. A model may read only regular files inside its
+ * own directory (after following links and ".."; a glTF's buffers, an OBJ's
+ * .mtl; embedded data: URIs need no file): naming a file outside it, or a
+ * FIFO, device, directory or unreadable file, fails the load. A file it
+ * names that does not exist is done without when the format can be (an
+ * OBJ's .mtl; a glTF's missing buffer fails), and bb_mesh_load_noted says
+ * so. The import runs in a child process (fork) held to BB_MAX_MODEL_BYTES,
+ * BB_MAX_MODEL_TRIANGLES, BB_MAX_IMPORT_MEMORY and BB_MAX_IMPORT_SECONDS,
+ * on a stack of its own: a model that crashes Assimp (nodes nested 20,000
+ * deep) fails the load, not the caller. The child never returns into the
+ * caller's code (it ends with _exit) and takes no signal handler of the
+ * caller's; a caller that reaps every child from a SIGCHLD handler only
+ * loses the check of the child's exit status.
+ *
+ * Errors: BB_ERR_IO (missing, a directory, a FIFO or device, unreadable, or
+ * a file the model names refused as above), BB_ERR_FORMAT (not a model
+ * Assimp reads, corrupt, no triangles, the importer crashed), BB_ERR_VALUE
+ * (a coordinate is NaN or infinite), BB_ERR_SIZE (over a limit above),
+ * BB_ERR_MEMORY (over BB_MAX_IMPORT_MEMORY, or no memory here). */
 bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
+
+/* bb_mesh_load, also saying what the load did without: on success note (cap
+ * bytes; NULL or cap 0 for none) holds "" or one line such as "read without
+ * bricks.mtl (no such file)"; on failure "". */
+bb_status bb_mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
+                             bb_error *err);
 
 /* Writes m through Assimp's exporters; the format comes from the extension:
  * .obj (without a material file), .ply (binary little-endian), .stl
