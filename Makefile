@@ -68,6 +68,12 @@ LIBDIR     ?= $(PREFIX)/lib
 INCLUDEDIR ?= $(PREFIX)/include
 MANDIR     ?= $(PREFIX)/share/man
 PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+# The Python package goes where Debian's python3 looks for a prefix's
+# packages: PREFIX/lib/python3/dist-packages (on its path for /usr; other
+# prefixes need PYTHONPATH), except /usr/local, whose directory Debian names
+# by the interpreter's version (/usr/local/lib/python3.11/dist-packages).
+PYTHON_VERSION := $(shell /usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)
+PYTHONDIR  ?= $(if $(and $(filter /usr/local,$(PREFIX)),$(PYTHON_VERSION)),$(PREFIX)/lib/python$(PYTHON_VERSION)/dist-packages,$(PREFIX)/lib/python3/dist-packages)
 # Refreshes the loader's cache after a real (DESTDIR-less) install as root;
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
@@ -232,7 +238,9 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
-# bumpbake.pc is made from bumpbake.pc.in with the install's own paths.
+# bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
+# Python package gets bumpbake/_install.py, the path of the library it loads
+# (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
 install: $(BIN) lib
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
 	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
@@ -245,6 +253,11 @@ install: $(BIN) lib
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake
+	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
+	  $(DESTDIR)$(PYTHONDIR)/bumpbake/
+	printf '%s\n' '# Written by make install: the library this installed package loads.' \
+	  'LIBRARY = "$(LIBDIR)/$(SONAME)"' >$(DESTDIR)$(PYTHONDIR)/bumpbake/_install.py
 	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ]; then $(LDCONFIG) || true; fi
 
 uninstall:
@@ -252,6 +265,7 @@ uninstall:
 	  $(DESTDIR)$(LIBDIR)/$(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so \
 	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(DESTDIR)$(INCLUDEDIR)/bumpbake.h \
 	  $(DESTDIR)$(MANDIR)/man1/bumpbake.1 $(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 
 # ---- the README's commands ---------------------------------------------------
 demo: ensure-deps
@@ -337,6 +351,8 @@ FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(C
 # Per target: libFuzzer options beyond time and corpus.
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536
+FUZZ_ARGS_fuzz_program    := -dict=fuzz/program.dict
+FUZZ_ARGS_fuzz_mesh       := -dict=fuzz/mesh.dict -max_len=16384
 
 # Objects are kept between runs (make would delete them as intermediates).
 .SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)

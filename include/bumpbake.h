@@ -97,6 +97,35 @@ extern "C" {
 /* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
 
+/* What reading one model (bb_mesh_load) may take. Model files are untrusted,
+ * and Assimp's importers build their own structures before bumpbake sees a
+ * triangle, so the import runs in a child process held to these limits:
+ * - BB_MAX_MODEL_BYTES: the model file and every file it refers to (a glTF's
+ *   buffers, an OBJ's .mtl), 256 MiB together, checked before each is read;
+ * - BB_MAX_MODEL_TRIANGLES: triangles after polygons are split and every
+ *   instance of a mesh is placed (8 Mi), and at most three times as many
+ *   vertices, checked on the importer's scene before it is post-processed
+ *   or copied;
+ * - BB_MAX_IMPORT_MEMORY: memory the importer may take beyond the process's
+ *   own (4 GiB; Assimp takes 8 to 27 times an OBJ's size: 600 MiB for a
+ *   1 M-triangle grid with normals, 76 MB; 2 GiB for 10 M triangles of
+ *   "f 1 2 3", 80 MB);
+ * - BB_MAX_IMPORT_SECONDS: CPU seconds of the import (120; four times as
+ *   many of wall-clock time).
+ * A model over one of them is refused with BB_ERR_SIZE or BB_ERR_MEMORY. */
+#define BB_MAX_MODEL_BYTES (256L << 20)
+#define BB_MAX_MODEL_TRIANGLES (1L << 23)
+#define BB_MAX_IMPORT_MEMORY (4L << 30)
+#define BB_MAX_IMPORT_SECONDS 120
+
+/* Most rasterising a flat render bump may do: the samples its triangles
+ * reach (each triangle's samples, bounded by its area and by the part of
+ * its box inside the image, plus one per sample row it spans) at most 256
+ * times the image's samples plus 256 per triangle drawn. A sculpt covers
+ * its image a few times over; a pile of triangles drawn over one another
+ * thousands of times is refused (BB_ERR_SIZE) before anything is drawn. */
+#define BB_MAX_RENDERBUMP_LAYERS 256
+
 typedef enum bb_status {
   BB_OK = 0,          /* success */
   BB_ERR_ARGUMENT,    /* a parameter is out of range or inconsistent */
@@ -222,6 +251,12 @@ typedef enum bb_depth {
   BB_DEPTH_HALF,  /* exr */
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
+
+/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
+bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
+/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+ * for values outside the enum. */
+const char *bb_depth_name(bb_depth depth);
 
 /* How float values map to integer codes. */
 typedef enum bb_range {
@@ -1222,6 +1257,13 @@ typedef struct bb_compare_limits {
 /* Sets idiff's defaults (in the field comments above). */
 void bb_compare_limits_init(bb_compare_limits *limits);
 
+/* BB_OK when every limit is in its range: fail, hard_fail, warn and
+ * hard_warn >= 0 (infinity allowed), the percentages in 0..100,
+ * allow_failures >= 0; else BB_ERR_ARGUMENT naming the limit by idiff's
+ * option ("compare: failpercent must be in 0..100 (got 150)"). NaN is
+ * refused. */
+bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
+
 /* A comparison's outcome; the values are idiff's exit codes. */
 typedef enum bb_compare_verdict {
   BB_COMPARE_PASS = 0,
@@ -1547,10 +1589,33 @@ uint64_t bb_mesh_hash(const bb_mesh *m);
 /* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
  * anything Assimp imports), merged as described at bb_mesh. Normals are kept
  * when any part of the model has them (vertices of parts without are zero).
- * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
- * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
- * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
+ *
+ * Model files are untrusted. A model may read only regular files inside its
+ * own directory (after following links and ".."; a glTF's buffers, an OBJ's
+ * .mtl; embedded data: URIs need no file): naming a file outside it, or a
+ * FIFO, device, directory or unreadable file, fails the load. A file it
+ * names that does not exist is done without when the format can be (an
+ * OBJ's .mtl; a glTF's missing buffer fails), and bb_mesh_load_noted says
+ * so. The import runs in a child process (fork) held to BB_MAX_MODEL_BYTES,
+ * BB_MAX_MODEL_TRIANGLES, BB_MAX_IMPORT_MEMORY and BB_MAX_IMPORT_SECONDS,
+ * on a stack of its own: a model that crashes Assimp (nodes nested 20,000
+ * deep) fails the load, not the caller. The child never returns into the
+ * caller's code (it ends with _exit) and takes no signal handler of the
+ * caller's; a caller that reaps every child from a SIGCHLD handler only
+ * loses the check of the child's exit status.
+ *
+ * Errors: BB_ERR_IO (missing, a directory, a FIFO or device, unreadable, or
+ * a file the model names refused as above), BB_ERR_FORMAT (not a model
+ * Assimp reads, corrupt, no triangles, the importer crashed), BB_ERR_VALUE
+ * (a coordinate is NaN or infinite), BB_ERR_SIZE (over a limit above),
+ * BB_ERR_MEMORY (over BB_MAX_IMPORT_MEMORY, or no memory here). */
 bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
+
+/* bb_mesh_load, also saying what the load did without: on success note (cap
+ * bytes; NULL or cap 0 for none) holds "" or one line such as "read without
+ * bricks.mtl (no such file)"; on failure "". */
+bb_status bb_mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
+                             bb_error *err);
 
 /* Writes m through Assimp's exporters; the format comes from the extension:
  * .obj (without a material file), .ply (binary little-endian), .stl
@@ -1855,7 +1920,8 @@ typedef struct bb_compare_report {
 } bb_compare_report;
 
 /* Compares the image files a and b channel by channel under limits (NULL:
- * idiff's defaults), as OpenImageIO's idiff does, and their provenance key
+ * idiff's defaults; checked by bb_compare_limits_check before any read),
+ * as OpenImageIO's idiff does, and their provenance key
  * by key. With diff_path (may be NULL; check it first with
  * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
  * the largest finite difference is white (NaN and infinite ones clip to
@@ -1867,6 +1933,17 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
                            const char *diff_path, bb_compare_report *report, bb_error *err);
 
 void bb_compare_report_free(bb_compare_report *report);
+
+/* idiff's exit code for a report, which `bumpbake compare` exits with: the
+ * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
+ * the sizes or channel counts differ. (An unreadable file is no report:
+ * idiff and `bumpbake compare` exit 4.) */
+#define BB_COMPARE_DIFFERENT_SIZE 3
+int bb_compare_report_exit_code(const bb_compare_report *report);
+
+/* idiff's word for a report's outcome, as `bumpbake compare` prints it:
+ * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
+const char *bb_compare_report_result(const bb_compare_report *report);
 
 /* -------------------------------------------------------------- bake jobs */
 
@@ -1904,7 +1981,8 @@ typedef struct bb_job_options {
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
   int slope_lit;             /* 1: also slope_path with "_lit" before its
                                 extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction */
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction;
+                                azimuth finite, elevation 0..90 */
   /* A batch (out_dir set): */
   const char *out_dir;       /* outputs go to out_dir/name; created when missing */
   const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"

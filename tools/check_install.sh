@@ -9,16 +9,22 @@
 #   3. checks libbumpbake.so exports exactly the functions of bumpbake.h;
 #   4. checks the man page renders without warnings and names every command
 #      and option the installed bumpbake's --help lists;
-#   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths.
+#   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths;
+#   6. the installed Python package imports and bakes with PYTHONPATH set to
+#      its dist-packages and nothing else (no BUMPBAKE_LIBRARY, no
+#      PKG_CONFIG_PATH): it loads the installed library by itself.
 #
-# Environment: MAKE (make), DEBUG (0), BUILD (build), CC (cc). A DEBUG=1
-# library is sanitized, so the clients are built with the sanitizers too.
+# Environment: MAKE (make), DEBUG (0), BUILD (build), CC (cc), PYTHON
+# (/usr/bin/python3). A DEBUG=1 library is sanitized, so the clients are
+# built with the sanitizers too, and Python runs with their runtimes
+# preloaded.
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
 make=${MAKE:-make}
 debug=${DEBUG:-0}
 cc=${CC:-cc}
+python=${PYTHON:-/usr/bin/python3}
 client_flags=(-std=c11 -Wall -Wextra -Werror)
 [ "$debug" = 1 ] && client_flags+=("-fsanitize=address,undefined")
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
@@ -136,6 +142,42 @@ if [ -f "$stage/usr/lib/pkgconfig/bumpbake.pc" ] && [ -e "$stage/usr/bin/bumpbak
   pass "staged install (DESTDIR, PREFIX=/usr) lands under DESTDIR with /usr paths"
 else
   fail "staged install: files or bumpbake.pc's prefix not as expected"
+fi
+# The package's record names where the library will be, not the stage.
+staged_record=$stage/usr/lib/python3/dist-packages/bumpbake/_install.py
+if grep -qx "LIBRARY = \"/usr/lib/$soname\"" "$staged_record" 2>/dev/null; then
+  pass "staged install: the Python package in /usr/lib/python3/dist-packages loads /usr/lib/$soname"
+else
+  fail "staged install: $staged_record does not name /usr/lib/$soname"
+fi
+
+# ------------------------------------------------------ 6. Python package
+site=$prefix/lib/python3/dist-packages
+if [ ! -f "$site/bumpbake/__init__.py" ]; then
+  fail "make install did not install the Python package into $site"
+elif ! "$python" -c 'import cffi, numpy' 2>/dev/null; then
+  echo "check_install: $python lacks cffi or numpy; the Python package not checked"
+else
+  preload=()
+  if [ "$debug" = 1 ]; then
+    preload=("LD_PRELOAD=$("$cc" -print-file-name=libasan.so) $("$cc" -print-file-name=libubsan.so)"
+      ASAN_OPTIONS=detect_leaks=0)
+  fi
+  # From /, with nothing set but PYTHONPATH (and PATH for the interpreter).
+  if out=$(cd / && env -i PATH=/usr/bin:/bin PYTHONPATH="$site" "${preload[@]}" "$python" -c '
+import os, sys
+import numpy as np
+import bumpbake
+assert os.path.realpath(bumpbake.library_path) == os.path.realpath(sys.argv[1]), bumpbake.library_path
+maps = bumpbake.bake(np.zeros((8, 8), np.float32), 4, outputs=("normal", "ao"), rays=16)
+assert (maps["normal"][..., 2] == 1).all() and (maps["ao"] == 1).all()
+print("ok", bumpbake.library_path)
+' "$prefix/lib/$soname" 2>&1) && [ "${out%% *}" = ok ]; then
+    pass "python3 -c 'import bumpbake' with PYTHONPATH=$site alone: bakes, loads ${out#ok }"
+  else
+    echo "$out" >&2
+    fail "the installed Python package does not import or bake with PYTHONPATH alone"
+  fi
 fi
 
 if [ "$failures" -gt 0 ]; then

@@ -1,11 +1,14 @@
 """The part of include/bumpbake.h the Python package calls, for cffi.
 
-Kept to what read(), bake() and normal() need. The structs must match the header
-field for field, since cffi's ABI mode lays them out from these
-declarations: tests/test_cdef.py compiles a C program against the real
+Every type and function the package uses, and nothing else. The structs must
+match the header field for field, since cffi's ABI mode lays them out from
+these declarations: tests/test_cdef.py compiles a C program against the real
 header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
-update. Copy declarations from the header as they are (comments dropped).
+update. Declarations are the header's as they are, in its order, comments
+dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
+BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 8), which cffi needs; the test
+checks those numbers too.
 """
 
 # Types, in header order.
@@ -32,6 +35,19 @@ typedef struct bb_image {
   float *pixels;
 } bb_image;
 
+typedef enum bb_addressing {
+  BB_ADDRESS_PERIODIC = 0,
+  BB_ADDRESS_CLAMP
+} bb_addressing;
+
+typedef int (*bb_progress_fn)(void *user, long done, long total);
+
+typedef void (*bb_note_fn)(void *user, const char *path, const char *text);
+
+typedef struct bb_region {
+  int x0, y0, width, height;
+} bb_region;
+
 typedef struct bb_image_info {
   int alpha_channel;
   int is_float;
@@ -40,10 +56,13 @@ typedef struct bb_image_info {
   char *description;
 } bb_image_info;
 
-typedef enum bb_addressing {
-  BB_ADDRESS_PERIODIC = 0,
-  BB_ADDRESS_CLAMP
-} bb_addressing;
+typedef enum bb_depth {
+  BB_DEPTH_DEFAULT = 0,
+  BB_DEPTH_8,
+  BB_DEPTH_16,
+  BB_DEPTH_HALF,
+  BB_DEPTH_FLOAT
+} bb_depth;
 
 typedef enum bb_range {
   BB_RANGE_UNIT = 0,
@@ -74,17 +93,16 @@ typedef enum bb_normal_filter {
   BB_NORMAL_VERTEX
 } bb_normal_filter;
 
+typedef struct bb_normal_decode_options {
+  int normal_y_up;
+  int normalize;
+} bb_normal_decode_options;
+
 typedef struct bb_basis {
   int count;
   double vector[16][3];
   char name[32];
 } bb_basis;
-
-typedef int (*bb_progress_fn)(void *user, long done, long total);
-
-typedef struct bb_region {
-  int x0, y0, width, height;
-} bb_region;
 
 typedef struct bb_trace_options {
   double bias_texels;
@@ -139,34 +157,397 @@ typedef struct bb_bake_result {
   bb_basis basis;
   int threads;
 } bb_bake_result;
+
+typedef enum bb_ssbump_kind {
+  BB_SSBUMP_LINEAR = 0,
+  BB_SSBUMP_SQUARED
+} bb_ssbump_kind;
+
+typedef enum bb_map_kind {
+  BB_MAP_SSBUMP = 0,
+  BB_MAP_WEIGHTS,
+  BB_MAP_AO,
+  BB_MAP_NORMAL
+} bb_map_kind;
+
+typedef struct bb_program bb_program;
+
+typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
+                                     bb_image_info *info, bb_error *err);
+
+typedef struct bb_program_options {
+  const char *base_dir;
+  int allow_outside_base;
+  bb_image_loader loader;
+  void *loader_user;
+} bb_program_options;
+
+typedef enum bb_mip_filter {
+  BB_MIP_AVERAGE = 0,
+  BB_MIP_RENORMALIZE
+} bb_mip_filter;
+
+typedef struct bb_compare_stats {
+  double mean_abs, rms, max_abs;
+  int worst_x, worst_y, worst_channel;
+  long pixels;
+  long over_fail, over_warn;
+} bb_compare_stats;
+
+typedef struct bb_compare_limits {
+  double fail;
+  double fail_percent;
+  double hard_fail;
+  long allow_failures;
+  double warn;
+  double warn_percent;
+  double hard_warn;
+} bb_compare_limits;
+
+typedef enum bb_compare_verdict {
+  BB_COMPARE_PASS = 0,
+  BB_COMPARE_WARN = 1,
+  BB_COMPARE_FAIL = 2
+} bb_compare_verdict;
+
+typedef enum bb_albedo_mode {
+  BB_ALBEDO_MULTIPLY = 0,
+  BB_ALBEDO_MOD2X,
+  BB_ALBEDO_SSBUMP
+} bb_albedo_mode;
+
+typedef enum bb_render_mode {
+  BB_RENDER_SSBUMP = 0,
+  BB_RENDER_NORMAL,
+  BB_RENDER_NORMAL_AO,
+  BB_RENDER_SLOPE
+} bb_render_mode;
+
+typedef struct bb_render_maps {
+  const bb_image *normal;
+  const bb_image *ssbump;
+  const bb_image *ao;
+  const bb_image *bent;
+  const bb_image *albedo;
+  const bb_image *slope;
+} bb_render_maps;
+
+typedef struct bb_render_options {
+  bb_render_mode mode;
+  int dynamic_light;
+  double light_azimuth;
+  double light_elevation;
+  float light_color[3];
+  int static_light;
+  float lightmap[3][3];
+  double specular_exponent;
+  double specular_strength;
+  bb_albedo_mode albedo_mode;
+  int tile_x, tile_y;
+  int crop_x, crop_y, crop_width, crop_height;
+  int threads;
+} bb_render_options;
+
+typedef enum bb_render_map {
+  BB_RENDER_MAP_NORMAL = 0,
+  BB_RENDER_MAP_SSBUMP,
+  BB_RENDER_MAP_AO,
+  BB_RENDER_MAP_BENT,
+  BB_RENDER_MAP_SLOPE,
+  BB_RENDER_MAP_COUNT
+} bb_render_map;
+
+typedef struct bb_panel_layout {
+  int columns;
+  int panel_width;
+  int gap;
+  int font_size;
+  const char *font;
+} bb_panel_layout;
+
+typedef struct bb_sheet_options {
+  bb_panel_layout layout;
+  bb_render_options lit;
+} bb_sheet_options;
+
+typedef struct bb_mesh {
+  size_t vertex_count;
+  size_t triangle_count;
+  float *positions;
+  float *normals;
+  uint32_t *indices;
+} bb_mesh;
+
+typedef enum bb_axis {
+  BB_AXIS_NEG_Y = 0,
+  BB_AXIS_POS_Y,
+  BB_AXIS_POS_Z,
+  BB_AXIS_NEG_Z,
+  BB_AXIS_POS_X,
+  BB_AXIS_NEG_X
+} bb_axis;
+
+typedef struct bb_renderbump_options {
+  int width, height;
+  int samples;
+  bb_axis axis;
+  int face_normals;
+  int rect_given;
+  double rect[4];
+  int tile;
+  int threads;
+  bb_note_fn note;
+  void *note_user;
+} bb_renderbump_options;
+
+typedef struct bb_renderbump_result {
+  bb_image normal;
+  bb_image height;
+  double rect[4];
+  double depth_min, depth_max;
+  double texel_size;
+  double texel_aspect;
+  double height_scale;
+  int used_vertex_normals;
+  size_t triangles_drawn;
+} bb_renderbump_result;
+
+typedef enum bb_provenance_class {
+  BB_PROVENANCE_NONE = 0,
+  BB_PROVENANCE_INTACT,
+  BB_PROVENANCE_DAMAGED
+} bb_provenance_class;
+
+typedef struct bb_output_spec {
+  const char *path;
+  const char *kind;
+  int channels;
+  bb_depth depth;
+  int mips;
+  int text;
+} bb_output_spec;
+
+typedef struct bb_output_file {
+  const char *path;
+  const char *kind;
+  const bb_image *image;
+  bb_range range;
+  bb_depth depth;
+  int mips;
+  const char *description;
+  const void *text;
+  size_t text_size;
+} bb_output_file;
+
+typedef struct bb_height_source {
+  bb_channel channel;
+  int grey;
+  int channels;
+  int bits_per_sample;
+  int is_float;
+  char format_name[32];
+  uint64_t file_hash;
+  uint64_t height_hash;
+} bb_height_source;
+
+typedef struct bb_compare_report {
+  int same_shape;
+  int width, height, channels;
+  int b_width, b_height, b_channels;
+  bb_compare_stats stats;
+  bb_compare_verdict verdict;
+  bb_provenance_class provenance_a, provenance_b;
+  int provenance_differences;
+  char *provenance_diff;
+  int diff_written;
+  bb_error diff_error;
+} bb_compare_report;
+
+typedef struct bb_job_options {
+  bb_bake_options bake;
+  bb_channel channel;
+  bb_depth depth;
+  int mips;
+  const char *basis_file;
+  const char *paths[6];
+  const char *prefix;
+  const char *slope_path;
+  int slope_lit;
+  double slope_lit_azimuth, slope_lit_elevation;
+  const char *out_dir;
+  const char *name_template;
+  unsigned maps;
+  int force;
+  int keep_going;
+  const char *depfile;
+  const char *command;
+  const char *command_options;
+  bb_note_fn note;
+  void *note_user;
+} bb_job_options;
+
+typedef struct bb_job bb_job;
+
+typedef enum bb_job_outcome {
+  BB_JOB_PENDING = 0,
+  BB_JOB_BAKED,
+  BB_JOB_CURRENT,
+  BB_JOB_FAILED,
+  BB_JOB_NOT_RUN
+} bb_job_outcome;
+
+typedef struct bb_job_file {
+  const char *kind;
+  const char *path;
+} bb_job_file;
+
+typedef struct bb_job_report {
+  const char *input;
+  int output_count;
+  bb_job_file outputs[8];
+  bb_job_outcome outcome;
+  bb_status status;
+  bb_error error;
+  char reason[256];
+  int width, height;
+  bb_height_source source;
+  int threads;
+  int slices;
+  char rayset_id[64];
+  double horizons;
+  double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
+      seconds_derive, seconds_write;
+} bb_job_report;
 """
 
-# Functions, as declared in the header.
+# Functions, in header order.
 FUNCTIONS = """
 const char *bb_status_name(bb_status status);
+bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
+                         bb_error *err);
 void bb_image_free(bb_image *img);
 void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
+bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
+                             bb_image_info *info, bb_error *err);
+bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
+const char *bb_depth_name(bb_depth depth);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
+const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
 bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb_normal_filter_name(bb_normal_filter f);
+void bb_normal_decode_options_init(bb_normal_decode_options *o);
+bb_status bb_normal_map_decode(const bb_image *values, int is_float,
+                               const bb_normal_decode_options *o, bb_image *normals,
+                               bb_error *err);
 void bb_basis_init(bb_basis *b);
 bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
 bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
                                 bb_error *err);
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
+bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
+bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
+                            bb_error *err);
 const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
+bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
+int bb_bake_slices(const bb_bake_options *o);
 bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
+bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
+                              bb_image *normals, bb_error *err);
+bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
+void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
+                       float texel[3]);
+bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
+                           float mix, bb_map_kind kind, bb_image *out, bb_error *err);
+bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
+                            bb_map_kind kind, const float *flat, bb_image *out,
+                            bb_error *err);
+bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
+void bb_program_free(bb_program *program);
+void bb_program_options_init(bb_program_options *o);
+bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
+                         bb_image *out, int *is_normal_map, bb_error *err);
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err);
+void bb_mip_chain_free(bb_image *levels, int count);
+void bb_compare_limits_init(bb_compare_limits *limits);
+bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
+bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err);
+bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err);
+void bb_render_options_init(bb_render_options *o);
+bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
+                    bb_error *err);
+bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_up,
+                             const bb_image *like, bb_image *out, uint64_t *hash,
+                             bb_error *err);
+void bb_panel_layout_init(bb_panel_layout *l);
+bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
+                            const bb_panel_layout *l, bb_image *out, int *labels_drawn,
+                            bb_error *err);
+void bb_sheet_options_init(bb_sheet_options *o);
+bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
+                        const bb_sheet_options *o, bb_image *out, int *labels_drawn,
+                        bb_error *err);
+void bb_mesh_free(bb_mesh *m);
+uint64_t bb_mesh_hash(const bb_mesh *m);
+bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
+bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err);
+const char *bb_axis_name(bb_axis a);
+void bb_renderbump_options_init(bb_renderbump_options *o);
+bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
+                             bb_renderbump_result *result, bb_error *err);
+void bb_renderbump_result_free(bb_renderbump_result *r);
+bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
+                              int normal_y_up, const char *model, uint64_t model_hash,
+                              const char *command, const char *normal_path,
+                              const char *height_path, bb_error *err);
+bb_provenance_class bb_provenance_classify(const char *description);
+bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
+                           const char *const *reads, int read_count, bb_error *err);
+bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
+const char *bb_height_source_channel(const bb_height_source *source);
+bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
+                           const char *diff_path, bb_compare_report *report, bb_error *err);
+void bb_compare_report_free(bb_compare_report *report);
+int bb_compare_report_exit_code(const bb_compare_report *report);
+const char *bb_compare_report_result(const bb_compare_report *report);
+void bb_job_options_init(bb_job_options *o);
+bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                      bb_job **out, bb_error *err);
+void bb_job_free(bb_job *job);
+int bb_job_count(const bb_job *job);
+const bb_job_report *bb_job_report_get(const bb_job *job, int i);
+bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
+bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
+bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
+char *bb_job_command_text(const bb_job_options *o, const char *input);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
 """
 
-CDEF = TYPES + FUNCTIONS
+# Constants of the header (#define), by value: cffi reads only literals.
+CONSTANTS = """
+#define BB_MAX_THREADS 4096
+#define BB_MAX_RAYS 65536
+#define BB_MAX_SLICES 256
+#define BB_MAX_BASIS 16
+#define BB_COMPARE_DIFFERENT_SIZE 3
+#define BB_JOB_MAX_OUTPUTS 8
+#define BB_JOB_DEFAULT_MAPS 13
+"""
+
+# From the C library: the strings the library returns malloc'd
+# (bb_job_command_text) are freed with it.
+LIBC = """
+void free(void *ptr);
+"""
+
+CDEF = CONSTANTS + TYPES + FUNCTIONS + LIBC

@@ -187,13 +187,14 @@ def test_same_bits_as_the_command_line(tmp_path):
     ({"threads": -1}, "bake: threads must be in 0..4096 (got -1)"),
     ({"threads": 4097}, "bake: threads must be in 0..4096 (got 4097)"),
     ({"rays": 2**40}, "bake: rays 1099511627776 is out of range"),
-    ({"basis": "hl3"}, "bake: basis must be hl2, hl2+z, dirs:N or a file of directions"),
-    ({"basis": "dirs:2"}, "basis: dirs:N needs a count N in 3..16 (got 'dirs:2')"),
+    ({"basis": "hl3"}, "basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of directions "
+                        "(got 'hl3': No such file or directory)"),
+    ({"basis": "dirs:2"}, "basis dirs:N needs a whole N in 3..16 (got 'dirs:2')"),
     ({"basis": [[0, 0, 1], [1, 0, 0], [0, 0, 0]]}, "basis: vector 2: the zero vector"),
-    ({"basis": np.zeros((3, 2))}, "bake: basis vectors must be an (N, 3) array"),
-    ({"normal_filter": "box"}, "bake: normal_filter must be one of vertex|valve|central|sobel"),
+    ({"basis": np.zeros((3, 2))}, "basis vectors must be an (N, 3) array"),
+    ({"normal_filter": "box"}, "normal filter must be one of vertex, valve, central, sobel"),
     ({"normal_y": "left"}, "bake: normal_y must be one of down|up (got 'left')"),
-    ({"channel": "z"}, "bake: channel must be one of auto|r|g|b|a|luma|mean (got 'z')"),
+    ({"channel": "z"}, "channel must be one of auto, r, g, b, a, luma, mean, valve (got 'z')"),
     ({"channel": "a"}, "channel 'a' asked of an image with no alpha (1 channels)"),
     ({"outputs": ("normal", "shadow")}, "bake: unknown output 'shadow'"),
     ({"outputs": ()}, "bake: nothing to make: outputs is empty"),
@@ -307,7 +308,7 @@ def test_a_missing_library_fails_import_with_a_hint(tmp_path):
                          capture_output=True, text=True)
     assert out.returncode != 0
     assert "ImportError: bumpbake: cannot load" in out.stderr
-    assert "nowhere.so (missing)" in out.stderr
+    assert "nowhere.so (no such file)" in out.stderr
 
 
 @pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
@@ -323,3 +324,29 @@ def test_file_hash_is_what_the_command_line_records(tmp_path):
     assert bumpbake.file_hash(tmp_path / "a") == 0xaf63dc4c8601ec8c  # FNV-1a 64 of "a"
     with pytest.raises(bumpbake.Error, match="cannot read"):
         bumpbake.file_hash(tmp_path / "missing.png")
+
+
+def test_an_installed_package_loads_the_recorded_library_or_says_what_to_do(tmp_path):
+    """`make install` records the library's path in bumpbake/_install.py;
+    with that file gone, the error names only the paths tried and the
+    remedy (tools/check_install.sh checks a real install)."""
+    site = tmp_path / "dist-packages"
+    (site / "bumpbake").mkdir(parents=True)
+    for name in os.listdir(os.path.dirname(bumpbake.__file__)):
+        if name.endswith(".py"):
+            with open(os.path.join(os.path.dirname(bumpbake.__file__), name), "rb") as f:
+                (site / "bumpbake" / name).write_bytes(f.read())
+    gone = tmp_path / "lib" / bumpbake._library.SONAME
+    (site / "bumpbake" / "_install.py").write_text(f"LIBRARY = {str(gone)!r}\n")
+    env = {"PATH": os.environ.get("PATH", "/usr/bin:/bin"), "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-c", "import bumpbake"], env=env, cwd="/",
+                         capture_output=True, text=True)
+    assert out.returncode != 0
+    message = out.stderr.strip().splitlines()[-1]
+    assert message.startswith(f"ImportError: bumpbake: cannot load {bumpbake._library.SONAME}: "
+                              "the library this package was installed with is gone: run "
+                              "`make install` again")
+    tried = message.split("Tried: ")[1]
+    assert tried.startswith(f"{gone} (no such file); {bumpbake._library.SONAME} by the dynamic "
+                            "loader's search")
+    assert "build" not in tried and "pkg-config" not in tried

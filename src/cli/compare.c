@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <strings.h>
 
-enum { COMPARE_DIFFERENT_SIZE = 3, COMPARE_CANNOT_READ = 4, COMPARE_USAGE = 4 };
+enum { COMPARE_CANNOT_READ = 4, COMPARE_USAGE = 4 };
 
 /* Option ids of compare alone, above the shared cli_opt_id values (only
  * unique within one command's table). */
@@ -202,18 +202,6 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
 
 /* --------------------------------------------------------------- reports */
 
-static const char *verdict_name(bb_compare_verdict v) {
-  switch (v) {
-  case BB_COMPARE_PASS:
-    return "PASS";
-  case BB_COMPARE_WARN:
-    return "WARNING";
-  case BB_COMPARE_FAIL:
-    return "FAILURE";
-  }
-  return "ERROR";
-}
-
 static double percent_of(long count, long total) {
   return total > 0 ? 100.0 * (double)count / (double)total : 0.0;
 }
@@ -249,7 +237,7 @@ static void print_text_report(const compare_args *a, const bb_compare_report *r)
       line += n + (line[n] == '\n');
     }
   }
-  printf("%s\n", verdict_name(r->verdict));
+  printf("%s\n", bb_compare_report_result(r));
 }
 
 /* The provenance differences, one string per "key: a -> b" line. */
@@ -300,8 +288,8 @@ static void print_json_report(const compare_args *a, const bb_compare_report *r)
   cli_json_number(&j, "hardwarn", l->hard_warn);
   cli_json_int(&j, "over_warn", s->over_warn);
   json_provenance(&j, r->provenance_differences > 0 ? r->provenance_diff : "");
-  cli_json_string(&j, "result", verdict_name(r->verdict));
-  cli_json_int(&j, "exit", (int)r->verdict);
+  cli_json_string(&j, "result", bb_compare_report_result(r));
+  cli_json_int(&j, "exit", bb_compare_report_exit_code(r));
   cli_json_close(&j, '}');
   fputc('\n', stdout);
 }
@@ -318,12 +306,12 @@ static int report_size_mismatch(const compare_args *a, const bb_compare_report *
     cli_json j = {stdout, 0};
     cli_json_open(&j, NULL, '{');
     json_paths(&j, a);
-    cli_json_string(&j, "result", "DIFFERENT SIZE");
-    cli_json_int(&j, "exit", COMPARE_DIFFERENT_SIZE);
+    cli_json_string(&j, "result", bb_compare_report_result(r));
+    cli_json_int(&j, "exit", bb_compare_report_exit_code(r));
     cli_json_close(&j, '}');
     fputc('\n', stdout);
   }
-  return COMPARE_DIFFERENT_SIZE;
+  return bb_compare_report_exit_code(r);
 }
 
 /* Says why provenance was not compared when a file has a damaged copy; on
@@ -349,7 +337,7 @@ int bb_cli_compare(int argc, char **argv) {
   bb_status st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);
   if (st != BB_OK) {
     cli_error_line(err.message[0] ? err.message : bb_status_name(st));
-    return st == BB_ERR_SIZE ? COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
+    return st == BB_ERR_SIZE ? BB_COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
   }
   int code;
   if (!r.same_shape) {
@@ -368,7 +356,7 @@ int bb_cli_compare(int argc, char **argv) {
       cli_file_error(a.diff_path, r.diff_error.message);
     else if (a.diff_path && !a.quiet && !a.json)
       cli_printf_line("wrote diff %s", a.diff_path);
-    code = (int)r.verdict;
+    code = bb_compare_report_exit_code(&r);
   }
   bb_compare_report_free(&r);
   fflush(stdout);

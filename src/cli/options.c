@@ -417,22 +417,6 @@ void cli_settings_init(cli_settings *s) {
   s->scale_given = 0;
 }
 
-static int parse_depth(const char *text, bb_depth *out) {
-  static const struct {
-    const char *name;
-    bb_depth depth;
-  } depths[] = {{"8", BB_DEPTH_8},
-                {"16", BB_DEPTH_16},
-                {"half", BB_DEPTH_HALF},
-                {"float", BB_DEPTH_FLOAT}};
-  for (size_t i = 0; i < sizeof depths / sizeof depths[0]; i++)
-    if (strcmp(text, depths[i].name) == 0) {
-      *out = depths[i].depth;
-      return 0;
-    }
-  return -1;
-}
-
 /* Applies a choice-valued option ("--basis hl2"); a usage error names the
  * accepted words, which the row's value_name lists. */
 static int bad_choice(const char *command, const cli_option *opt, const char *arg) {
@@ -532,7 +516,7 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
   case CLI_OPT_CHANNEL:
     return bb_channel_parse(arg, &s->channel, NULL) ? bad_choice(command, opt, arg) : 0;
   case CLI_OPT_DEPTH:
-    return parse_depth(arg, &s->depth) ? bad_choice(command, opt, arg) : 0;
+    return bb_depth_parse(arg, &s->depth, NULL) ? bad_choice(command, opt, arg) : 0;
   case CLI_OPT_CLAMP:
     b->smooth.addressing = BB_ADDRESS_CLAMP;
     return 0;

@@ -1,5 +1,5 @@
 /* height_channel.h: the channel rule with the note it owes the user
- * (height_channel.c). */
+ * (height_channel.c), and the height loader that applies it (load.c). */
 #ifndef BB_IO_HEIGHT_CHANNEL_H
 #define BB_IO_HEIGHT_CHANNEL_H
 
@@ -10,5 +10,18 @@
  * rule), or NULL. The text is static. */
 bb_channel bb__height_channel_noted(const bb_image *img, int alpha_channel, bb_channel channel,
                                     const char **note);
+
+/* What bb__height_load found out about the file. */
+typedef struct bb__height_loaded {
+  bb_channel channel;     /* the rule's choice */
+  const char *note;       /* what to tell the user of that choice, or NULL */
+  int channels, bits_per_sample, is_float;
+  char format_name[32];
+} bb__height_loaded;
+
+/* bb_height_load, telling which channel it took and why (load.c): the
+ * header decides where it can, and only the channels needed are decoded. */
+bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
+                          bb__height_loaded *loaded, bb_error *err);
 
 #endif /* BB_IO_HEIGHT_CHANNEL_H */

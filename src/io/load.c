@@ -2,6 +2,7 @@
 
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "io/height_channel.h"
 #include "io/oiio.h"
 #include <math.h>
 #include <stdio.h>
@@ -114,13 +115,28 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel, bb_channe
   return st;
 }
 
+/* 1 when R = G = B at every texel of a 3-channel image. */
+static int is_grey(const bb_image *rgb) {
+  const size_t n = (size_t)rgb->width * (size_t)rgb->height;
+  for (size_t i = 0; i < n; i++) {
+    const float *t = rgb->pixels + 3 * i;
+    if (t[0] != t[1] || t[1] != t[2])
+      return 0;
+  }
+  return 1;
+}
+
 /* The height of a file whose pick was resolved from its header: only the
  * channels the pick needs are decoded (one, or R, G, B for a mean or luma),
- * so a file with many channels costs no more than a grey one. */
-static bb_status load_picked(const char *path, pick p, bb_image *height, bb_error *err) {
+ * so a file with many channels costs no more than a grey one. *grey
+ * receives whether decoded R, G, B were all equal (1 when one channel was
+ * read). */
+static bb_status load_picked(const char *path, pick p, bb_image *height, int *grey,
+                             bb_error *err) {
   const int first = p.kind == PICK_ONE ? p.index : 0;
   const int count = p.kind == PICK_ONE ? 1 : 3;
   bb_image part;
+  *grey = 1;
   bb_status st = bb__image_read_channels(path, first, count, &part, NULL, err);
   if (st != BB_OK) return st;
   bb_error local;
@@ -131,6 +147,7 @@ static bb_status load_picked(const char *path, pick p, bb_image *height, bb_erro
       return BB_OK;
     }
   } else {
+    *grey = is_grey(&part);
     bb_channel rule = p.kind == PICK_LUMA ? BB_CHANNEL_LUMA : BB_CHANNEL_MEAN;
     st = bb_height_from_image(&part, -1, rule, height, &local);
   }
@@ -142,41 +159,71 @@ static bb_status load_picked(const char *path, pick p, bb_image *height, bb_erro
 /* The height of the whole decoded image: for the cases where the rule
  * looks at the pixels (bb_height_channel). */
 static bb_status load_whole(const char *path, bb_channel channel, bb_image *height,
-                            bb_error *err) {
+                            bb__height_loaded *loaded, bb_error *err) {
   bb_image img;
   bb_image_info info;
   /* bb_image_read's messages already name the file. */
   bb_status st = bb_image_read(path, &img, &info, err);
   if (st != BB_OK) return st;
+  loaded->channel = bb__height_channel_noted(&img, info.alpha_channel, channel, &loaded->note);
   bb_error local;
-  st = bb_height_from_image(&img, info.alpha_channel, channel, height, &local);
+  st = bb_height_from_image(&img, info.alpha_channel, loaded->channel, height, &local);
   if (st != BB_OK) bb__fail(err, st, "%s: %s", path, local.message);
   bb_image_free(&img);
   bb_image_info_free(&info);
   return st;
 }
 
-bb_status bb_height_load(const char *path, bb_channel channel, bb_image *height,
-                         bb_error *err) {
+bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
+                          bb__height_loaded *loaded, bb_error *err) {
   if (!height) return bb__fail(err, BB_ERR_ARGUMENT, "bb_height_load: height is NULL");
   memset(height, 0, sizeof *height);
+  memset(loaded, 0, sizeof *loaded);
   int channels = 0;
   bb_image_info info;
   /* The header says which channels the rule needs; the I/O layer's
    * messages already name the file. */
   bb_status st = bb_image_read_info(path, NULL, NULL, &channels, &info, err);
   if (st != BB_OK) return st;
-  int alpha_channel = info.alpha_channel;
+  const int alpha_channel = info.alpha_channel;
+  loaded->channels = channels;
+  loaded->bits_per_sample = info.bits_per_sample;
+  loaded->is_float = info.is_float;
+  snprintf(loaded->format_name, sizeof loaded->format_name, "%s", info.format_name);
   bb_image_info_free(&info);
-  /* Auto on an image with alpha looks at the pixels (the height is in alpha
-   * when the colour is constant): that case decodes every channel. */
-  if (channel == BB_CHANNEL_AUTO && alpha_index(channels, alpha_channel) >= 0)
-    return load_whole(path, channel, height, err);
+  const int alpha = alpha_index(channels, alpha_channel);
+  /* Auto on an image with alpha looks at the pixels (is the height in
+   * alpha?): that case decodes every channel. */
+  if (channel == BB_CHANNEL_AUTO && alpha >= 0)
+    return load_whole(path, channel, height, loaded, err);
+  /* Valve's rule and auto without alpha are decided by the header. */
+  loaded->channel = channel;
+  if (channel == BB_CHANNEL_VALVE && alpha >= 0)
+    loaded->channel = BB_CHANNEL_A;
+  else if (channel == BB_CHANNEL_VALVE) {
+    loaded->channel = channels >= 3 ? BB_CHANNEL_MEAN : BB_CHANNEL_AUTO;
+    loaded->note = channels >= 3 ? "no alpha channel; using the mean of R, G, B as the height"
+                                 : "no alpha channel; using its grey channel as the height";
+  }
   pick p;
   bb_error local;
-  st = resolve_pick(channels, alpha_channel, channel, &p, &local);
+  st = resolve_pick(channels, alpha_channel, loaded->channel, &p, &local);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, local.message);
-  return load_picked(path, p, height, err);
+  int grey = 1;
+  st = load_picked(path, p, height, &grey, err);
+  if (st == BB_OK && channel == BB_CHANNEL_AUTO) {
+    loaded->channel = BB_CHANNEL_MEAN;
+    if (!grey)
+      loaded->note = "R, G and B differ (a colour image); using their mean as the height (a "
+                     "channel option chooses another)";
+  }
+  return st;
+}
+
+bb_status bb_height_load(const char *path, bb_channel channel, bb_image *height,
+                         bb_error *err) {
+  bb__height_loaded loaded;
+  return bb__height_load(path, channel, height, &loaded, err);
 }
 
 bb_status bb__check_scaled_height(const bb_image *height, float height_scale,

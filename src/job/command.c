@@ -82,17 +82,6 @@ static void add_int(text *t, const char *name, long v) {
   add_option(t, name, buf);
 }
 
-static const char *depth_word(bb_depth d) {
-  switch (d) {
-  case BB_DEPTH_8: return "8";
-  case BB_DEPTH_16: return "16";
-  case BB_DEPTH_HALF: return "half";
-  case BB_DEPTH_FLOAT: return "float";
-  case BB_DEPTH_DEFAULT: break;
-  }
-  return NULL;
-}
-
 /* The bake's settings that differ from bb_job_options_init's, in the order
  * of `bumpbake bake --help`. */
 static void add_settings(text *t, const bb_job_options *o) {
@@ -124,8 +113,8 @@ static void add_settings(text *t, const bb_job_options *o) {
     add_option(t, "--clamp", NULL);
   if (o->channel != d.channel)
     add_option(t, "--channel", bb_channel_name(o->channel));
-  if (depth_word(o->depth))
-    add_option(t, "--depth", depth_word(o->depth));
+  if (o->depth != BB_DEPTH_DEFAULT)
+    add_option(t, "--depth", bb_depth_name(o->depth));
   if (o->mips)
     add_option(t, "--mips", NULL);
 }

@@ -59,6 +59,9 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
   bb_compare_limits_init(&defaults);
   if (!limits)
     limits = &defaults;
+  bb_status checked = bb_compare_limits_check(limits, err);
+  if (checked != BB_OK)
+    return checked;
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
   bb_status st = bb_image_read(a, &x, &ix, err);
@@ -97,4 +100,25 @@ void bb_compare_report_free(bb_compare_report *report) {
     return;
   free(report->provenance_diff);
   report->provenance_diff = NULL;
+}
+
+int bb_compare_report_exit_code(const bb_compare_report *report) {
+  if (!report)
+    return BB_COMPARE_FAIL;
+  if (!report->same_shape)
+    return BB_COMPARE_DIFFERENT_SIZE;
+  return (int)report->verdict;
+}
+
+const char *bb_compare_report_result(const bb_compare_report *report) {
+  if (!report)
+    return "FAILURE";
+  if (!report->same_shape)
+    return "DIFFERENT SIZE";
+  switch (report->verdict) {
+  case BB_COMPARE_PASS: return "PASS";
+  case BB_COMPARE_WARN: return "WARNING";
+  case BB_COMPARE_FAIL: return "FAILURE";
+  }
+  return "FAILURE";
 }

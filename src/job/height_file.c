@@ -23,7 +23,7 @@ static void say(bb_note_fn note, void *user, const char *path, const char *text)
 }
 
 /* Notes about what the file itself will cost the maps. */
-static void note_input(const bb_image_info *info, float height_scale, bb_note_fn note,
+static void note_input(const bb__height_loaded *info, float height_scale, bb_note_fn note,
                        void *user, const char *path) {
   if (strcmp(info->format_name, "jpeg") == 0)
     say(note, user, path,
@@ -62,32 +62,20 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
     st = bb_file_hash(path, &source->file_hash, err);
   if (st != BB_OK)
     return st;
-  bb_image img = {0};
-  bb_image_info info;
-  st = bb_image_read(path, &img, &info, err);
+  bb__height_loaded loaded;
+  st = bb__height_load(path, channel, height, &loaded, err);
   if (st != BB_OK)
     return st;
-  const char *channel_note = NULL;
-  const bb_channel used = bb__height_channel_noted(&img, info.alpha_channel, channel,
-                                                   &channel_note);
-  const int alpha = info.alpha_channel >= 0 || img.channels == 2 || img.channels == 4;
-  source->channel = used;
-  source->grey = img.channels - alpha < 3;
-  source->channels = img.channels;
-  source->bits_per_sample = info.bits_per_sample;
-  source->is_float = info.is_float;
-  snprintf(source->format_name, sizeof source->format_name, "%s", info.format_name);
-  say(note, note_user, path, channel_note);
-  note_input(&info, height_scale, note, note_user, path);
-  bb_error local_err = {{0}};
-  st = bb_height_from_image(&img, info.alpha_channel, used, height, &local_err);
-  if (st != BB_OK)
-    bb__fail(err, st, "%s: %s", path, local_err.message);
-  else
-    source->height_hash = bb_image_hash(height);
-  bb_image_info_free(&info);
-  bb_image_free(&img);
-  return st;
+  source->channel = loaded.channel;
+  source->channels = loaded.channels;
+  source->grey = loaded.channels - (loaded.channels == 2 || loaded.channels == 4) < 3;
+  source->bits_per_sample = loaded.bits_per_sample;
+  source->is_float = loaded.is_float;
+  snprintf(source->format_name, sizeof source->format_name, "%s", loaded.format_name);
+  source->height_hash = bb_image_hash(height);
+  say(note, note_user, path, loaded.note);
+  note_input(&loaded, height_scale, note, note_user, path);
+  return BB_OK;
 }
 
 const char *bb_height_source_channel(const bb_height_source *source) {

@@ -9,6 +9,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -496,6 +497,14 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
       return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
     if (o->slope_lit && !o->slope_path)
       return bb__fail(err, BB_ERR_ARGUMENT, "--lit previews the slope map: give --slope FILE too");
+    /* bb_light_direction takes any angle; above 90 degrees the light would
+     * come from under the surface. */
+    if (o->slope_lit && !isfinite(o->slope_lit_azimuth))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--lit azimuth must be finite (got %g)",
+                      o->slope_lit_azimuth);
+    if (o->slope_lit && !(o->slope_lit_elevation >= 0.0 && o->slope_lit_elevation <= 90.0))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--lit elevation must be in 0..90 (got %g)",
+                      o->slope_lit_elevation);
     if (!asked_kinds(o))
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "nothing to write: give -o PREFIX or at least one of --normal, "

@@ -109,6 +109,25 @@ void bb_compare_limits_init(bb_compare_limits *limits) {
   limits->hard_warn = INFINITY;
 }
 
+bb_status bb_compare_limits_check(const bb_compare_limits *l, bb_error *err) {
+  if (!l)
+    return bb__fail(err, BB_ERR_ARGUMENT, "compare: no limits");
+  const struct {
+    const char *name;
+    double value, high;
+  } checks[] = {{"fail", l->fail, INFINITY},          {"failpercent", l->fail_percent, 100.0},
+                {"hardfail", l->hard_fail, INFINITY}, {"warn", l->warn, INFINITY},
+                {"warnpercent", l->warn_percent, 100.0}, {"hardwarn", l->hard_warn, INFINITY}};
+  for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
+    if (!(checks[i].value >= 0.0 && checks[i].value <= checks[i].high))
+      return bb__fail(err, BB_ERR_ARGUMENT, "compare: %s must be %s (got %g)", checks[i].name,
+                      isinf(checks[i].high) ? ">= 0" : "in 0..100", checks[i].value);
+  if (l->allow_failures < 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "compare: allowfailures must be >= 0 (got %ld)",
+                    l->allow_failures);
+  return BB_OK;
+}
+
 bb_compare_verdict bb_compare_judge(const bb_compare_stats *s,
                                     const bb_compare_limits *l) {
   /* The order is idiff's: allowed failures pass before anything else is

@@ -1272,3 +1272,24 @@ Test(io, leak_suppressions_name_criterion_only) {
   cr_expect_str_eq(__lsan_default_suppressions(), "leak:libcriterion.so\n");
   cr_expect_null(strstr(__lsan_default_suppressions(), "std::"));
 }
+
+/* The words of --depth, one way: each parses to its depth and back. */
+Test(io, depth_names_round_trip_and_others_are_refused) {
+  const char *names[] = {"8", "16", "half", "float"};
+  const bb_depth depths[] = {BB_DEPTH_8, BB_DEPTH_16, BB_DEPTH_HALF, BB_DEPTH_FLOAT};
+  for (int i = 0; i < 4; i++) {
+    bb_depth d = BB_DEPTH_DEFAULT;
+    cr_assert_eq(bb_depth_parse(names[i], &d, NULL), BB_OK, "%s", names[i]);
+    cr_expect_eq(d, depths[i], "%s", names[i]);
+    cr_expect_str_eq(bb_depth_name(d), names[i]);
+  }
+  cr_expect_str_eq(bb_depth_name(BB_DEPTH_DEFAULT), "default");
+  cr_expect_str_eq(bb_depth_name((bb_depth)99), "unknown");
+  bb_depth d = BB_DEPTH_16;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_depth_parse("32", &d, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "depth must be one of 8, 16, half, float (got '32')");
+  cr_expect_eq(d, BB_DEPTH_16, "left untouched");
+  cr_expect_eq(bb_depth_parse("default", &d, NULL), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_depth_parse("HALF", &d, NULL), BB_ERR_ARGUMENT, "exact case");
+}

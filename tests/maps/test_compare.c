@@ -661,3 +661,82 @@ Test(compare_cli, tga_provenance_is_compared_key_by_key) {
   cr_assert_not_null(strstr(out, "\ninput: h1.png -> h2.png\n"), "%s", out);
   cr_assert_null(strstr(out, "cut or re-wrapped"), "%s", out);
 }
+
+/* ------------------------------------------------ a report's words and code */
+
+/* bb_compare_files on files, its report in idiff's words and exit code: the
+ * one rule `bumpbake compare` and Python's bumpbake.compare both print. */
+Test(compare_cli, report_result_and_exit_code_are_idiffs) {
+  const char *a = ramp_with("ra.exr", 0, 0), *same = ramp_with("rs.exr", 0, 0);
+  const char *off = ramp_with("ro.exr", 3, 0.25f);
+  float wide[32] = {0};
+  const char *other = write_image("rw.exr", 8, 4, 1, wide, NULL);
+  struct {
+    const char *b;
+    long allow;
+    double fail_percent;
+    const char *result;
+    int code;
+  } cases[] = {
+      {same, 0, 0, "PASS", 0},
+      {off, 0, 0, "FAILURE", 2},
+      {off, 0, 50, "WARNING", 1}, /* 3 of 16 fail, within 50 %: warned */
+      {off, 3, 0, "PASS", 0},     /* allowed failures pass by any amount */
+      {other, 0, 0, "DIFFERENT SIZE", 3},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    bb_compare_limits l;
+    bb_compare_limits_init(&l);
+    l.allow_failures = cases[i].allow;
+    l.fail_percent = cases[i].fail_percent;
+    bb_compare_report r;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_compare_files(a, cases[i].b, &l, NULL, &r, &err), BB_OK, "%s",
+                 err.message);
+    cr_expect_str_eq(bb_compare_report_result(&r), cases[i].result, "case %zu", i);
+    cr_expect_eq(bb_compare_report_exit_code(&r), cases[i].code, "case %zu", i);
+    bb_compare_report_free(&r);
+  }
+  cr_assert_eq(BB_COMPARE_DIFFERENT_SIZE, 3, "idiff's exit code for a size mismatch");
+}
+
+/* Limits out of range are refused by the library, naming idiff's option,
+ * so every caller (the CLI parses its own ranges; Python does not) gets
+ * the same answer; bb_compare_files checks them before reading. */
+Test(compare_cli, limits_out_of_range_are_refused) {
+  bb_compare_limits l;
+  bb_compare_limits_init(&l);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_compare_limits_check(&l, &err), BB_OK, "idiff's defaults");
+  l.hard_fail = l.hard_warn = INFINITY;
+  l.fail_percent = l.warn_percent = 100.0;
+  cr_expect_eq(bb_compare_limits_check(&l, &err), BB_OK, "the ends of the ranges");
+  const struct {
+    int field;
+    double value;
+    const char *message;
+  } bad[] = {{0, -1e-6, "compare: fail must be >= 0 (got -1e-06)"},
+             {1, 150.0, "compare: failpercent must be in 0..100 (got 150)"},
+             {2, NAN, "compare: hardfail must be >= 0 (got nan)"},
+             {3, -1.0, "compare: warn must be >= 0 (got -1)"},
+             {4, -0.5, "compare: warnpercent must be in 0..100 (got -0.5)"},
+             {5, -INFINITY, "compare: hardwarn must be >= 0 (got -inf)"}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    bb_compare_limits_init(&l);
+    double *fields[] = {&l.fail, &l.fail_percent, &l.hard_fail,
+                        &l.warn, &l.warn_percent, &l.hard_warn};
+    *fields[bad[i].field] = bad[i].value;
+    cr_expect_eq(bb_compare_limits_check(&l, &err), BB_ERR_ARGUMENT, "case %zu", i);
+    cr_expect_str_eq(err.message, bad[i].message);
+  }
+  bb_compare_limits_init(&l);
+  l.allow_failures = -1;
+  cr_expect_eq(bb_compare_limits_check(&l, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
+  /* Before any read: the files need not exist. */
+  bb_compare_report r;
+  cr_expect_eq(bb_compare_files(tmp_file("none1.png"), tmp_file("none2.png"), &l, NULL, &r,
+                                &err),
+               BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
+}

@@ -1,0 +1,185 @@
+"""What every part of the package shares: the loaded library, its errors,
+and numpy arrays to and from bb_image.
+
+Arrays follow the library's conventions (include/bumpbake.h): row 0 is the
+top row; (H, W) for one channel, (H, W, C) for more; float arrays are used
+as they are and unsigned integer arrays as value / max code, as files are
+read.
+"""
+
+import os
+import warnings
+
+import numpy as np
+
+from . import _library
+
+_ffi, _lib, library_path = _library.load()
+
+_INT_MIN, _INT_MAX = -(2**31), 2**31 - 1
+
+
+class Error(Exception):
+    """A libbumpbake call failed. str(e) is the library's message; e.status
+    is the bb_status name ("bad argument", "i/o error", ...)."""
+
+    def __init__(self, message, status):
+        super().__init__(message)
+        self.status = status
+
+
+class ArgumentError(Error, ValueError):
+    """The library refused a parameter (BB_ERR_ARGUMENT) or, for functions
+    on arrays, the array itself (a NaN or infinite value, an empty or
+    oversized array)."""
+
+
+class NoteWarning(UserWarning):
+    """A remark of the library about an input that is not an error: which
+    channel became the height, a lossy JPEG, 8-bit codes that terrace at
+    the scale asked. `bumpbake bake` prints the same lines on stderr."""
+
+
+# ------------------------------------------------------------------ notes
+
+def _note_text(path, text):
+    return f"{path}: {text}" if path else text
+
+
+def _dispatch_notes(notes, policy, stacklevel):
+    if policy == "ignore":
+        return
+    for line in notes:
+        if policy == "warn":
+            warnings.warn(line, NoteWarning, stacklevel=stacklevel + 1)
+        else:
+            policy(line)
+
+
+def _check_notes(notes):
+    if notes not in ("warn", "ignore") and not callable(notes):
+        raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {notes!r})")
+    return notes
+
+
+def _status_name(status):
+    return _ffi.string(_lib.bb_status_name(status)).decode()
+
+
+def _message(err, status):
+    return _ffi.string(err.message).decode("utf-8", "replace") or _status_name(status)
+
+
+def _exception(status, message, arrays=False):
+    """The exception for a library status: ArgumentError for a bad argument
+    (and, for calls on arrays, a bad value or size), Error otherwise."""
+    argument = (_lib.BB_ERR_ARGUMENT,)
+    if arrays:
+        argument += (_lib.BB_ERR_VALUE, _lib.BB_ERR_SIZE)
+    cls = ArgumentError if status in argument else Error
+    return cls(message, _status_name(status))
+
+
+def _check(status, err, arrays=False):
+    """Raises the library's error when status is not BB_OK."""
+    if status != _lib.BB_OK:
+        raise _exception(status, _message(err, status), arrays)
+
+
+def _argument_error(message):
+    return ArgumentError(message, "bad argument")
+
+
+def _text(value):
+    """A C string of the library's, as str (None for NULL)."""
+    if value == _ffi.NULL:
+        return None
+    return _ffi.string(value).decode("utf-8", "surrogateescape")
+
+
+def _path(value, what="path"):
+    """A path (str, bytes or os.PathLike) as the bytes the library opens."""
+    if not isinstance(value, (str, bytes, os.PathLike)):
+        raise TypeError(f"{what} must be a path (got {value!r})")
+    return os.fsencode(value)
+
+
+def _int(command, name, value):
+    try:
+        value = int(value.__index__())
+    except AttributeError:
+        raise TypeError(f"{command}: {name} must be an integer (got {value!r})") from None
+    if not _INT_MIN <= value <= _INT_MAX:
+        raise _argument_error(f"{command}: {name} {value} is out of range")
+    return value
+
+
+def _parse(parser, ctype, text, what):
+    """An enum value by the library's own parser; its message when refused."""
+    if not isinstance(text, str):
+        raise TypeError(f"{what} must be a str (got {text!r})")
+    out = _ffi.new(f"{ctype} *")
+    err = _ffi.new("bb_error *")
+    _check(getattr(_lib, parser)(text.encode(), out, err), err)
+    return out[0]
+
+
+def _depth(depth):
+    """bb_depth from None (the default), 8, 16, "8", "16", "half", "float"."""
+    if depth is None:
+        return _lib.BB_DEPTH_DEFAULT
+    if isinstance(depth, int) and not isinstance(depth, bool):
+        depth = str(depth)
+    return _parse("bb_depth_parse", "bb_depth", depth, "depth")
+
+
+# ---------------------------------------------------------------- arrays
+
+class _Image:
+    """A bb_image over a numpy array's float32 pixels (a copy when the array
+    is not already contiguous float32); keeps the array alive."""
+
+    def __init__(self, what, array, channels=None):
+        a = np.asarray(array)
+        if a.ndim == 2:
+            a = a[:, :, np.newaxis]
+        elif a.ndim != 3:
+            raise _argument_error(
+                f"{what} must be an (H, W) or (H, W, C) array (got shape {a.shape})")
+        if a.dtype.kind == "u":  # value / max code, as integer files are read
+            a = a.astype(np.float32) / np.float32(np.iinfo(a.dtype).max)
+        elif a.dtype.kind != "f":
+            raise TypeError(f"{what} must be a float or unsigned integer array (got {a.dtype})")
+        if channels is not None and a.shape[2] not in channels:
+            raise _argument_error(f"{what} must have {' or '.join(map(str, channels))} "
+                                  f"channels (got shape {a.shape[:2] + (a.shape[2],)})")
+        self.array = np.ascontiguousarray(a, dtype=np.float32)
+        rows, cols, chans = self.array.shape
+        self.image = _ffi.new("bb_image *")
+        self.image.width, self.image.height, self.image.channels = cols, rows, chans
+        self._buffer = _ffi.from_buffer("float[]", self.array) if self.array.size else _ffi.NULL
+        self.image.pixels = self._buffer
+
+    @property
+    def alpha(self):
+        """The alpha channel's index as OpenImageIO reports files: the last
+        of grey + alpha and RGBA, else -1."""
+        return {2: 1, 4: 3}.get(self.image.channels, -1)
+
+
+def _array(img, squeeze=True):
+    """A float32 copy of a bb_image: (H, W) for one channel (squeeze), else
+    (H, W, C)."""
+    n = img.width * img.height * img.channels
+    a = np.frombuffer(_ffi.buffer(img.pixels, n * 4), dtype=np.float32).copy()
+    one = squeeze and img.channels == 1
+    return a.reshape((img.height, img.width) + (() if one else (img.channels,)))
+
+
+def _take(img, squeeze=True):
+    """_array(img), then the library's pixels freed."""
+    try:
+        return _array(img, squeeze)
+    finally:
+        _lib.bb_image_free(img)
+

@@ -1,0 +1,170 @@
+"""Maps on arrays: decoding normal maps, Valve's conversions, combining,
+DOOM 3 image programs and mip chains, each one call of the library."""
+
+from ._bake import _basis, _normal_y_up
+from ._common import (_Image, _argument_error, _array, _check, _depth, _ffi, _lib, _parse,
+                      _path, _take)
+from ._files import _signed
+
+
+def decode_normals(values, is_float=False, normal_y="down", normalize=True):
+    """The unit normals N a normal-map file holds, from the values
+    bumpbake.read returns for it (bb_normal_map_decode): integer files hold
+    0.5 + 0.5 N, so N = 2 v - 1 (code 127.5 of 255 is 0; 128 reads as
+    +1/255); float files (is_float=True) hold N itself. normal_y="up": the
+    map's green is +Y up (OpenGL) and is negated to the library's +Y down.
+    normalize: each texel scaled to unit length ((0, 0, 0) becomes
+    (0, 0, 1)). values: (H, W, C), C >= 3 (channels past 3 are ignored).
+    Returns float32 (H, W, 3)."""
+    src = _Image("decode_normals: values", values)
+    o = _ffi.new("bb_normal_decode_options *")
+    _lib.bb_normal_decode_options_init(o)
+    o.normal_y_up = _normal_y_up("decode_normals", normal_y)
+    o.normalize = int(bool(normalize))
+    out = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_normal_map_decode(src.image, int(bool(is_float)), o, out, err), err,
+           arrays=True)
+    return _take(out)
+
+
+def normal2ssbump(normals, basis="hl2"):
+    """Valve's normal2ssbump: the basis weights w_c = sat(N.B_c)^2 /
+    sum_k sat(N.B_k)^2 of unit normals (H, W, 3), +Y down (decode a file
+    with decode_normals), one channel per direction of basis (bake()'s
+    basis argument). A normal facing away from every direction gets 1 /
+    count in each. Returns float32 (H, W, count)."""
+    src = _Image("normal2ssbump: normals", normals, channels=(3,))
+    b, _ = _basis(basis)
+    out = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_derive_weights(src.image, b, out, err), err, arrays=True)
+    return _take(out)
+
+
+_SSBUMP_KINDS = {"ssbump": "BB_SSBUMP_LINEAR", "weights": "BB_SSBUMP_SQUARED"}
+
+
+def ssbump2normal(ssbump, kind="ssbump"):
+    """The normal of a Half-Life 2 basis map: N = normalize(sum_c f(s_c)
+    B_c) over channels 0..2 (a fourth, Valve's alpha, is ignored), f(s) = s
+    for kind "ssbump" (bake's ssbump, height2ssbump) and sqrt(s) for
+    "weights" (normal2ssbump's, whose square it undoes). A texel of no
+    weight gives (0, 0, 1). More than 4 channels (another basis) is refused.
+    Returns float32 (H, W, 3), +Y down."""
+    if kind not in _SSBUMP_KINDS:
+        raise _argument_error(f"ssbump2normal: kind must be one of ssbump|weights (got {kind!r})")
+    src = _Image("ssbump2normal: ssbump", ssbump)
+    out = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_ssbump_to_normal(src.image, getattr(_lib, _SSBUMP_KINDS[kind]), out, err),
+           err, arrays=True)
+    return _take(out)
+
+
+def _mask_field(mask):
+    """A blend mask as the command line reads one: a 2-D array as it is, else
+    its grey (or the mean of R, G, B) by the height channel rule."""
+    src = _Image("combine: mask", mask)
+    if src.image.channels == 1:
+        return src, None
+    field = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_height_from_image(src.image, src.alpha, _lib.BB_CHANNEL_AUTO, field, err),
+           err, arrays=True)
+    return None, field
+
+
+def combine(a, b, mix=None, mask=None, detail=False, kind="ssbump", detail_depth=None):
+    """Combines two maps of the same size, as `bumpbake combine` does;
+    exactly one of mix, mask and detail.
+
+    mix=T or mask (an (H, W) array, or an image whose grey / mean of R, G,
+    B is taken; clamped to 0..1): (1 - T) a + T b, linear for "ssbump",
+    "weights" and "ao" (every channel), renormalised for "normal" (decoded
+    normals, as decode_normals makes them; the command line decodes with
+    normalize=False, so a texel the blend copies keeps its code).
+    detail=True overlays b on a: a * b / flat for ssbump, weights and ao,
+    DOOM 3's addnormals for normals; flat is the kind's flat, unoccluded
+    texel, exact (detail_depth None) or as a file of detail_depth (8, 16,
+    "half", "float") stores it (bb_map_flat_texel: 147/255 in an 8-bit
+    ssbump), so a flat detail read from such a file leaves a unchanged bit
+    for bit. Returns float32 with a's channels (3 for normals)."""
+    given = (mix is not None) + (mask is not None) + bool(detail)
+    if given != 1:
+        raise _argument_error("combine: give exactly one of mix, mask and detail")
+    k = _parse("bb_map_kind_parse", "bb_map_kind", kind, "kind")
+    ia, ib = _Image("combine: a", a), _Image("combine: b", b)
+    out = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    if detail:
+        flat = _ffi.NULL
+        if detail_depth is not None:
+            d = _depth(detail_depth)
+            bits = {_lib.BB_DEPTH_8: 8, _lib.BB_DEPTH_16: 16, _lib.BB_DEPTH_HALF: 16,
+                    _lib.BB_DEPTH_FLOAT: 32}[d]
+            is_float = d in (_lib.BB_DEPTH_HALF, _lib.BB_DEPTH_FLOAT)
+            flat = _ffi.new("float[3]")
+            _lib.bb_map_flat_texel(k, bits, int(is_float), flat)
+        st = _lib.bb_combine_detail(ia.image, ib.image, k, flat, out, err)
+    else:
+        keep, field = (None, None)
+        m = _ffi.NULL
+        if mask is not None:
+            keep, field = _mask_field(mask)
+            m = keep.image if keep is not None else field
+        try:
+            st = _lib.bb_combine_blend(ia.image, ib.image, m, float(mix or 0.0), k, out, err)
+        finally:
+            if field is not None:
+                _lib.bb_image_free(field)
+    _check(st, err, arrays=True)
+    return _take(out)
+
+
+def program(text, base=None, allow_outside_base=False):
+    """Evaluates a DOOM 3 image program ("addnormals(a_local.tga,
+    heightmap(a_h.tga, 4))") as `bumpbake program` does: image names are
+    files, relative to base (a directory; None: the current one), and must
+    stay inside it (no absolute path, "..", or symbolic link out) unless
+    allow_outside_base. Returns (array,
+    is_normal_map): the decoded normals N, float32 (H, W, 3), +Y down, when
+    the program makes a normal map (heightmap, addnormals, smoothnormals or
+    _flat in it), else RGBA colour, float32 (H, W, 4) in [0, 1]. A syntax
+    error is ArgumentError giving the column; a file that cannot be read,
+    Error naming it."""
+    if not isinstance(text, str):
+        raise TypeError(f"program: text must be a str (got {text!r})")
+    err = _ffi.new("bb_error *")
+    prog = _ffi.new("bb_program **")
+    _check(_lib.bb_program_parse(text.encode(), prog, err), err)
+    prog = _ffi.gc(prog[0], _lib.bb_program_free)
+    o = _ffi.new("bb_program_options *")
+    _lib.bb_program_options_init(o)
+    base_dir = _ffi.new("char[]", _path(base, "base")) if base is not None else _ffi.NULL
+    o.base_dir = base_dir
+    o.allow_outside_base = int(bool(allow_outside_base))
+    out = _ffi.new("bb_image *")
+    is_normal = _ffi.new("int *")
+    _check(_lib.bb_program_run(prog, o, out, is_normal, err), err)
+    return _take(out, squeeze=False), bool(is_normal[0])
+
+
+def mips(array, kind="colour"):
+    """The mip chain of an array down to 1 x 1, as written with mips=True
+    (bb_mip_chain): level 0 a copy, each next level the box filter of the
+    one before to half its size (OpenImageIO's resize; odd sides cover 3
+    texels), renormalised for kind "normal" and "bent" (a zero average
+    becomes (0, 0, 1)), averaged for every other kind (write()'s kinds).
+    Returns a list of float32 arrays, largest first."""
+    signed = _signed("mips", kind)
+    src = _Image("mips: array", array)
+    levels = _ffi.new("bb_image **")
+    count = _ffi.new("int *")
+    err = _ffi.new("bb_error *")
+    flt = _lib.BB_MIP_RENORMALIZE if signed else _lib.BB_MIP_AVERAGE
+    _check(_lib.bb_mip_chain(src.image, flt, levels, count, err), err, arrays=True)
+    try:
+        return [_array(levels[0][i]) for i in range(count[0])]
+    finally:
+        _lib.bb_mip_chain_free(levels[0], count[0])

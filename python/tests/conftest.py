@@ -1,0 +1,39 @@
+"""What the package's tests share: where the fixtures and the command line
+are (BB_BIN, set by `make check-python`), and a way to run it."""
+
+import os
+import subprocess
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FIXTURES = os.path.join(ROOT, "fixtures")
+BIN = os.environ.get("BB_BIN") or os.path.join(ROOT, "build", "bumpbake")
+
+
+@pytest.fixture
+def fixtures():
+    return FIXTURES
+
+
+@pytest.fixture
+def cli():
+    """cli(*args, cwd=None, check=True) runs `bumpbake ARGS` and returns the
+    CompletedProcess (text). cli.start(*args, cwd=None) starts it and
+    returns the Popen, to run several at once. Skips without the binary."""
+    if not os.access(BIN, os.X_OK):
+        pytest.skip(f"{BIN} not built")
+
+    def run(*args, cwd=None, check=True):
+        out = subprocess.run([BIN, *map(str, args)], cwd=cwd, capture_output=True, text=True)
+        if check and out.returncode != 0:
+            raise AssertionError(f"bumpbake {' '.join(map(str, args))}: exit {out.returncode}\n"
+                                 f"{out.stderr}")
+        return out
+
+    def start(*args, cwd=None):
+        return subprocess.Popen([BIN, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+
+    run.start = start
+    return run
