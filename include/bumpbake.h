@@ -11,7 +11,8 @@
  *   Geometry is in texels: texel (x, y) is the vertex (x, y, height_scale*h).
  * - Surface model: two triangles per cell, (x,y)-(x+1,y)-(x,y+1) and
  *   (x+1,y)-(x+1,y+1)-(x,y+1), split along the (x+1,y)-(x,y+1) diagonal
- *   (Valve's mesh). Addressing is periodic (the texture tiles) unless
+ *   (the Embree peer's mesh; Valve's splits along the other diagonal, see
+ *   docs/conventions.md). Addressing is periodic (the texture tiles) unless
  *   BB_ADDRESS_CLAMP extends the border texels.
  * - Normals are unit vectors in [-1, 1]; integer files store 0.5 + 0.5*N,
  *   float files store N. Visibility, ssbump, weights and ao are in [0, 1];

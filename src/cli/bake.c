@@ -92,6 +92,7 @@ static const cli_option opt_depfile = {
 static const cli_option opt_json = {
     .id = CLI_OPT_JSON,
     .long_name = "json",
+    .default_text = "off",
     .help = "print one JSON line describing the bake on stdout"};
 static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .long_name = "quiet",
