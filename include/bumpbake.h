@@ -699,7 +699,32 @@ typedef struct bb_bake_options {
                                  (then rays and slices are not checked); a map
                                  another needs is made and freed (bent needs
                                  ssbump, both need the normal) */
+  double bounce_albedo;       /* rho in [0, 1]: inter-reflection. ao, ssbump
+                                 and bent then include the light the
+                                 surrounding height field reflects,
+                                 Lambertian with albedo rho (times
+                                 bounce_albedo_map), normalised as without it
+                                 (docs/conventions.md "Inter-reflection"; the
+                                 weights hold no visibility and do not change).
+                                 Default 0: none, and the bake is bit for bit
+                                 the one without these fields. Costs about 3
+                                 traces per bounce, and 72 (1 + basis count)
+                                 bytes per texel */
+  const bb_image *bounce_albedo_map; /* NULL (default), or an image of the
+                                 height's size whose grey (1 channel: it; 2:
+                                 the first; 3 or more: Rec. 709 luma of R, G,
+                                 B), clamped to [0, 1], multiplies rho at each
+                                 vertex, linear over each triangle. Not owned;
+                                 ignored while bounce_albedo is 0 */
+  int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
+                                 times; 0 (default): until one more bounce
+                                 would change what the surface reflects by
+                                 under 1e-5 of the sky's radiance (at most
+                                 BB_MAX_BOUNCES) */
 } bb_bake_options;
+
+/* Most bounces a bake's inter-reflection follows. */
+#define BB_MAX_BOUNCES 64
 
 void bb_bake_options_init(bb_bake_options *o);
 
@@ -729,6 +754,8 @@ typedef struct bb_bake_result {
   bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
   int threads;             /* worker threads the stages ran on (o->trace.threads,
                               or the core count for 0) */
+  int bounces;             /* bounces of inter-reflection followed (0: none) */
+  double seconds_bounce;   /* the inter-reflection's part, after seconds_trace */
 } bb_bake_result;
 
 /* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height

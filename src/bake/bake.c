@@ -3,6 +3,7 @@
 
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "trace/bounce.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include <math.h>
@@ -89,6 +90,13 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
   if (o->trace.threads < 0 || o->trace.threads > BB_MAX_THREADS)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: threads must be in 0..%d (got %d)",
                     BB_MAX_THREADS, o->trace.threads);
+  if ((st = check_range(o->bounce_albedo, 0.0, 1.0, "bounce albedo", err)) != BB_OK)
+    return st;
+  if (o->bounces < 0 || o->bounces > BB_MAX_BOUNCES)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: bounces must be in 0..%d (got %d)",
+                    BB_MAX_BOUNCES, o->bounces);
+  if (o->bounce_albedo_map && (!o->bounce_albedo_map->pixels || o->bounce_albedo_map->channels < 1))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the bounce albedo map has no pixels");
   if (strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
                     (int)o->normal_filter);
@@ -103,6 +111,58 @@ static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
   size_t n = (size_t)h->width * (size_t)h->height;
   for (size_t i = 0; i < n; i++) out->pixels[i] = scale * h->pixels[i];
   return BB_OK;
+}
+
+/* The grey of the bounce albedo map per vertex, clamped to [0, 1]: 1
+ * channel as it is, 2 (grey and alpha) the grey, 3 or more Rec. 709 luma. */
+static bb_status albedo_grey(const bb_image *map, int width, int height, bb_image *out,
+                             bb_error *err) {
+  if (map->width != width || map->height != height)
+    return bb__fail(err, BB_ERR_SIZE, "bake: the bounce albedo map is %dx%d, the height %dx%d",
+                    map->width, map->height, width, height);
+  bb_status st = bb_image_alloc(out, width, height, 1, err);
+  if (st != BB_OK) return st;
+  const size_t n = (size_t)width * (size_t)height, c = (size_t)map->channels;
+  for (size_t i = 0; i < n; i++) {
+    const float *p = map->pixels + i * c;
+    const double v = c >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : (double)p[0];
+    if (!isfinite(v)) {
+      bb_image_free(out);
+      return bb__fail(err, BB_ERR_VALUE, "bake: the bounce albedo map is not finite at (%zu, %zu)",
+                      i % (size_t)width, i / (size_t)width);
+    }
+    out->pixels[i] = (float)(v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v));
+  }
+  return BB_OK;
+}
+
+/* Inter-reflection, added to r->vis (bounce.c). */
+static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
+                        const bb_rayset *rays, int threads, bb_bake_result *r, bb_error *err) {
+  bb_image grey = {0};
+  bb_status st = BB_OK;
+  if (o->bounce_albedo_map)
+    st = albedo_grey(o->bounce_albedo_map, r->vis.width, r->vis.height, &grey, err);
+  bb__bounce_options bo;
+  bb__bounce_options_init(&bo);
+  bo.rho = o->bounce_albedo;
+  bo.albedo = grey.pixels ? &grey : NULL;
+  bo.bounces = o->bounces;
+  bo.bias = o->trace.bias_texels;
+  bo.threads = threads;
+  bo.progress = o->trace.progress;
+  bo.progress_user = o->trace.progress_user;
+  if (st == BB_OK) st = bb__bounce_add(pyramid, rays, &bo, &r->vis, &r->bounces, err);
+  bb_image_free(&grey);
+  return st;
+}
+
+/* Inter-reflection can make a lobe brighter than its open sky, but a
+ * channel of the ssbump holds at most 1. */
+static void ssbump_cap(bb_image *ssbump) {
+  const size_t n = (size_t)ssbump->width * (size_t)ssbump->height * (size_t)ssbump->channels;
+  for (size_t i = 0; i < n; i++)
+    if (ssbump->pixels[i] > 1.0f) ssbump->pixels[i] = 1.0f;
 }
 
 /* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent. */
@@ -127,12 +187,19 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
+  if (st == BB_OK && o->bounce_albedo > 0.0) {
+    st = bounce(o, pyramid, &rays, threads, r, err);
+    const double t3 = bb__now_seconds();
+    r->seconds_bounce = t3 - t2;
+    t2 = t3;
+  }
   bb__rayset_release(&rays);
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
       BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);
   if (st == BB_OK && wants(o, ssbump_or_bent))
     st = bb__derive_ssbump(&r->normal, &r->vis, &o->basis, threads, &r->ssbump, err);
+  if (st == BB_OK && r->ssbump.pixels && o->bounce_albedo > 0.0) ssbump_cap(&r->ssbump);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_AO)))
     st = bb__derive_ao(&r->vis, threads, &r->ao, err);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_BENT)))
