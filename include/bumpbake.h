@@ -718,9 +718,18 @@ typedef struct bb_bake_options {
                                  ignored while bounce_albedo is 0 */
   int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
                                  times; 0 (default): until one more bounce
-                                 would change what the surface reflects by
-                                 under 1e-5 of the sky's radiance (at most
-                                 BB_MAX_BOUNCES) */
+                                 would move what any triangle reflects by
+                                 under 1e-2 of the sky's radiance, the rest
+                                 of the series then added as geometric (at
+                                 most BB_MAX_BOUNCES bounces) */
+  const bb_image *brightness; /* NULL (default), or a brightness map of the
+                                 height's size: ssbump and weights are
+                                 multiplied by its grey, the paper's
+                                 "brightness modulation factor in the normal
+                                 map", as bb_combine_brightness does (a
+                                 texel that would exceed 1 is scaled down,
+                                 its channels' ratios kept); ao and bent do
+                                 not change. Not owned */
 } bb_bake_options;
 
 /* Most bounces a bake's inter-reflection follows. */
@@ -883,6 +892,29 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err);
+
+/* Multiplies a map by a grey brightness map of the same size: the paper's
+ * "brightness modulation factor in the normal map, for free", which lets a
+ * low-resolution colour map and a high-resolution ssbump share the work.
+ * The engine multiplies the stored weights by its lightmaps, so scaling the
+ * weights scales the light. b is the brightness map's grey at the texel (1
+ * channel: it; 2: the first; 3 or more: Rec. 709 luma of R, G, B; a
+ * negative grey counts as 0).
+ *   ssbump, weights: channels 0..2 times b. A channel holds at most 1: where
+ *     the largest of the three would exceed it, the texel is scaled so that
+ *     the largest is 1 instead, which keeps the channels' ratios (the
+ *     direction the engine derives from them, the paper's bent normal): what
+ *     clips is the brightness, never the direction. A flat, unoccluded
+ *     ssbump texel (1/sqrt(3)) takes brightness up to sqrt(3) unclipped.
+ *     Further channels (Valve's alpha) are copied; a map of more than 4
+ *     channels (another basis) is BB_ERR_ARGUMENT.
+ *   ao: times b, at most 1.
+ *   normal: BB_ERR_ARGUMENT: a unit normal has no room for a brightness.
+ * A brightness of 1 gives the map back bit for bit. Allocates out with the
+ * map's channels. Errors: BB_ERR_ARGUMENT, BB_ERR_SIZE (another size),
+ * BB_ERR_VALUE (a NaN or infinite value in either map). */
+bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err);
 
 /* ----------------------------------------------------- DOOM 3 programs */
 

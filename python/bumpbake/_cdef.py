@@ -125,6 +125,7 @@ typedef struct bb_bake_options {
   double bounce_albedo;
   const bb_image *bounce_albedo_map;
   int bounces;
+  const bb_image *brightness;
 } bb_bake_options;
 
 typedef struct bb_bake_result {

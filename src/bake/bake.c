@@ -97,6 +97,8 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
                     BB_MAX_BOUNCES, o->bounces);
   if (o->bounce_albedo_map && (!o->bounce_albedo_map->pixels || o->bounce_albedo_map->channels < 1))
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: the bounce albedo map has no pixels");
+  if (o->brightness && (!o->brightness->pixels || o->brightness->channels < 1))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the brightness map has no pixels");
   if (strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
                     (int)o->normal_filter);
@@ -113,26 +115,13 @@ static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
   return BB_OK;
 }
 
-/* The grey of the bounce albedo map per vertex, clamped to [0, 1]: 1
- * channel as it is, 2 (grey and alpha) the grey, 3 or more Rec. 709 luma. */
+/* The grey of the bounce albedo map per vertex, clamped to [0, 1]. */
 static bb_status albedo_grey(const bb_image *map, int width, int height, bb_image *out,
                              bb_error *err) {
-  if (map->width != width || map->height != height)
-    return bb__fail(err, BB_ERR_SIZE, "bake: the bounce albedo map is %dx%d, the height %dx%d",
-                    map->width, map->height, width, height);
-  bb_status st = bb_image_alloc(out, width, height, 1, err);
+  bb_status st = bb__image_grey(map, width, height, "bake: the bounce albedo map", out, err);
   if (st != BB_OK) return st;
-  const size_t n = (size_t)width * (size_t)height, c = (size_t)map->channels;
-  for (size_t i = 0; i < n; i++) {
-    const float *p = map->pixels + i * c;
-    const double v = c >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : (double)p[0];
-    if (!isfinite(v)) {
-      bb_image_free(out);
-      return bb__fail(err, BB_ERR_VALUE, "bake: the bounce albedo map is not finite at (%zu, %zu)",
-                      i % (size_t)width, i / (size_t)width);
-    }
-    out->pixels[i] = (float)(v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v));
-  }
+  const size_t n = (size_t)width * (size_t)height;
+  for (size_t i = 0; i < n; i++) out->pixels[i] = fminf(fmaxf(out->pixels[i], 0.0f), 1.0f);
   return BB_OK;
 }
 
@@ -227,6 +216,24 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
   return st;
 }
 
+/* The brightness map on ssbump and weights, every basis channel (bent was
+ * derived before, from the ssbump's own directions). */
+static bb_status brightness(const bb_bake_options *o, int threads, bb_bake_result *r,
+                            bb_error *err) {
+  bb_image *maps[2] = {wants(o, BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP)) ? &r->ssbump : NULL,
+                       wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)) ? &r->weights : NULL};
+  for (int i = 0; i < 2; i++) {
+    if (!maps[i] || !maps[i]->pixels) continue;
+    bb_image scaled;
+    bb_status st = bb__derive_brightness(maps[i], maps[i]->channels, o->brightness, "bake",
+                                         threads, &scaled, err);
+    if (st != BB_OK) return st;
+    bb_image_free(maps[i]);
+    *maps[i] = scaled;
+  }
+  return BB_OK;
+}
+
 /* Frees what was made only because another map needed it. */
 static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
   if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED))) bb_image_free(&r->filtered);
@@ -240,13 +247,21 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
   bb_status st = bb_bake_options_check(o, err);
-  /* Before any stage: an overflow of scale x height is named as such. */
+  /* Before any stage: an overflow of scale x height is named as such, a
+   * map of another size as such. */
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
+  const bb_image *sized[2] = {o->bounce_albedo > 0.0 ? o->bounce_albedo_map : NULL, o->brightness};
+  const char *sized_name[2] = {"bounce albedo map", "brightness map"};
+  for (int i = 0; st == BB_OK && i < 2; i++)
+    if (sized[i] && (sized[i]->width != height->width || sized[i]->height != height->height))
+      st = bb__fail(err, BB_ERR_SIZE, "bake: the %s is %dx%d, the height %dx%d", sized_name[i],
+                    sized[i]->width, sized[i]->height, height->width, height->height);
   if (st != BB_OK) return st;
   r->basis = o->basis;
   const int threads = bb__thread_count(o->trace.threads);
   st = smooth_and_normals(height, o, threads, r, err);
   if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED)) st = trace_and_derive(o, threads, r, err);
+  if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
     if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);
     if (r->bent.pixels) bb_image_flip_green(&r->bent);
