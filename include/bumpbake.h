@@ -1453,6 +1453,10 @@ typedef struct bb_provenance {
  * channel), malloc'd; the caller
  * frees it. A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
+ * Options in use add, after addressing: bounce (rho) and bounces when
+ * bounce_albedo > 0, with bounce_albedo_map (bb_image_hash of the map, 16
+ * hex digits) when it has one; brightness (the brightness map's
+ * bb_image_hash) when there is one.
  * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
 

@@ -158,3 +158,33 @@ Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
   bb_bake_result_free(&plain), bb_bake_result_free(&lit);
   bb_image_free(&h), bb_image_free(&b);
 }
+
+Test(brightness, provenance_names_the_maps_it_was_made_with) {
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 4.0f;
+  bb_provenance p = {.output_kind = "ssbump", .options = &o};
+  char *text = bb_provenance_format(&p), value[64];
+  cr_assert_not_null(text);
+  cr_expect_eq(bb_provenance_value(text, "brightness", value, sizeof value), 0);
+  cr_expect_eq(bb_provenance_value(text, "bounce", value, sizeof value), 0);
+  free(text);
+  bb_image b = harness_field(3, 3, 0.5f), albedo = harness_field(3, 3, 0.25f);
+  o.brightness = &b;
+  o.bounce_albedo = 0.4;
+  o.bounce_albedo_map = &albedo;
+  text = bb_provenance_format(&p);
+  char want[32];
+  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb_image_hash(&b));
+  cr_expect_eq(bb_provenance_value(text, "brightness", value, sizeof value), 1);
+  cr_expect_str_eq(value, want);
+  cr_expect_eq(bb_provenance_value(text, "bounce", value, sizeof value), 1);
+  cr_expect_str_eq(value, "0.4");
+  cr_expect_eq(bb_provenance_value(text, "bounces", value, sizeof value), 1);
+  cr_expect_str_eq(value, "0");
+  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb_image_hash(&albedo));
+  cr_expect_eq(bb_provenance_value(text, "bounce_albedo_map", value, sizeof value), 1);
+  cr_expect_str_eq(value, want);
+  free(text);
+  bb_image_free(&b), bb_image_free(&albedo);
+}
