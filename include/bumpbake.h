@@ -1179,21 +1179,49 @@ typedef struct bb_render_options {
                                    texels; crop_width 0 = no crop */
   int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
                                    are identical */
+  int view;                     /* 1: an orthographic camera at view_azimuth,
+                                   view_elevation looks at the surface (the
+                                   texture tiling on for ever); 0 (default):
+                                   straight down, texel for pixel */
+  double view_azimuth;          /* degrees, as the light's (default 270: from the
+                                   bottom of the image, which then recedes up
+                                   the picture) */
+  double view_elevation;        /* degrees, 1..90 (default 30) */
+  int relief;                   /* 1: parallax occlusion mapping of
+                                   relief_height as shaders/ssbump_relief.glsl
+                                   does it: each pixel's view ray is followed
+                                   into the relief and the maps are read where
+                                   it meets it; needs view */
+  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
+                                   the bake's filtered height. Not owned */
+  double relief_depth;          /* texels of relief per unit of h, > 0: the
+                                   bake's height_scale (default 0: must be set
+                                   with relief) */
 } bb_render_options;
 
 void bb_render_options_init(bb_render_options *o);
 
 /* Renders maps by o into out (allocated: 3 channels, linear values, 1 =
  * white, not clamped), then tiles and crops it as o says. Bit-identical for
- * any thread count. Errors: BB_ERR_ARGUMENT (missing map for the mode, too
- * few channels, maps of different sizes, option out of range: the message
- * says which), BB_ERR_SIZE, BB_ERR_MEMORY. */
+ * any thread count. With o->view the picture is the same size (the maps'
+ * times the tiles, then cropped), seen by the camera: pixel (i, j) shows
+ * the point of the surface's top plane
+ *   C + (i - W'/2) R + (j - H'/2) / sin(el) D,   W' x H' the picture,
+ * C its middle, D = (cos az, -sin az) the horizontal way to the viewer and
+ * R = (D_y, -D_x) (texels; the maps tile), or with o->relief where the
+ * view ray from there meets o->relief_height (README "render"), and the maps are
+ * read there bilinearly (texel (x, y) at point (x, y), tiling); the
+ * specular highlight takes the view direction V instead of (0, 0, 1). View
+ * 270, 90 without relief is the plain render. Errors: BB_ERR_ARGUMENT
+ * (missing map for the mode, too few channels, maps of different sizes,
+ * option out of range: the message says which), BB_ERR_SIZE,
+ * BB_ERR_MEMORY. */
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err);
 
 /* "key=value" lines of every option of o that affects pixels (render_mode,
  * light, light_color, lightmap, specular, specular_strength, albedo_mode,
- * tile, crop), for
+ * tile, crop; view and relief when used), for
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 
