@@ -4,7 +4,7 @@
  *   bounce_bake MAP SCALE PREFIX [--rays N] [--rho R] [--bounces N]
  *               [--bias B] [--filter-radius R] [--normal-filter NAME]
  *               [--clamp] [--threads T]
- *               [--exact N] [--surface-exact N] [--far N] [--lift L]
+ *               [--exact N] [--surface-exact N] [--far N] [--surface-far N] [--lift L]
  *               [--tolerance T] [--surface-slices N]
  *
  * Writes PREFIX.ao.exr and PREFIX.ss.exr. Without the settings of the last
@@ -12,7 +12,8 @@
  * what `bumpbake bake --bounce R` makes); with any of them, the same
  * stages run one by one (smooth, normals, pyramid, trace, bb__bounce_add
  * with those settings, derive), so the bench can show what, say, the
- * horizon-point approximation (--exact 0 --surface-exact 0 --far 0) costs.
+ * horizon-point approximation (--exact 0 --surface-exact 0 --far 0
+ * --surface-far 0) costs.
  * Defaults: 256 rays, rho 0.5, bounces 0, bias 0.55, filter radius 0 (no
  * smoothing, as README "Accuracy"), Valve's normal. Prints one JSON line
  * (seconds of the trace and of the bounce, bounces followed) on stdout;
@@ -33,7 +34,8 @@ static int usage(const char *reason) {
           "bounce_bake: %s\n"
           "usage: bounce_bake MAP SCALE PREFIX [--rays N] [--rho R] [--bounces N] [--bias B]\n"
           "                   [--filter-radius R] [--normal-filter NAME] [--clamp] [--threads T]\n"
-          "                   [--exact N] [--surface-exact N] [--far N] [--lift L]\n"
+          "                   [--exact N] [--surface-exact N] [--far N] [--surface-far N]\n"
+          "                   [--lift L]\n"
           "                   [--tolerance T] [--surface-slices N]\n",
           reason);
   return 2;
@@ -91,6 +93,7 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--exact")) a->bounce.exact_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-exact")) a->bounce.surface_exact_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--far")) a->bounce.far_steps = (int)v, a->inner = 1;
+    else if (!strcmp(o, "--surface-far")) a->bounce.surface_far_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--lift")) a->bounce.lift = v, a->inner = 1;
     else if (!strcmp(o, "--tolerance")) a->bounce.tolerance = v, a->inner = 1;
     else if (!strcmp(o, "--surface-slices")) a->bounce.surface_slices = (int)v, a->inner = 1;

@@ -1033,7 +1033,7 @@ static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err)
   ctx->rs = rs;
   ctx->mode = mode;
   ctx->exact_steps = mode == PASS_TEXEL ? d->o->exact_steps : d->o->surface_exact_steps;
-  ctx->far_steps = d->o->far_steps;
+  ctx->far_steps = mode == PASS_TEXEL ? d->o->far_steps : d->o->surface_far_steps;
   bb_status st = bb__parallel_for(ctx->p->height, d->o->threads, zero_row, d, NULL, NULL, err);
   for (int k = 0; st == BB_OK && k < rs->slice_count;) {
     const int s = order[k];
@@ -1194,6 +1194,7 @@ void bb__bounce_options_init(bb__bounce_options *o) {
   o->exact_steps = 4;
   o->surface_exact_steps = 1;
   o->far_steps = 1024;
+  o->surface_far_steps = 16;
 }
 
 bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bounce_options *o,

@@ -19,6 +19,7 @@ typedef struct bb__bounce_options {
                              surface below each horizon counts, in the
                              texels' gather */
   int surface_exact_steps; /* the same in the corners' gathers */
+  int surface_far_steps;  /* far_steps of the corners' gathers */
   int far_steps;          /* how far the line's texels count after that
                              (the surface between two taken as straight);
                              past it the horizon's own point stands for the
@@ -33,8 +34,9 @@ typedef struct bb__bounce_options {
 } bb__bounce_options;
 
 /* The defaults a bake uses (rho, albedo and bias left at 0/NULL): bounces
- * 0 with tolerance 1e-2, lift 0.25, exact steps 4 and 1, far steps 1024,
- * surface slices 0. docs/conventions.md "Inter-reflection" says why. */
+ * 0 with tolerance 1e-2, lift 0.25, exact steps 4 (texels) and 1
+ * (corners), far steps 1024 (texels) and 16 (corners: the light of later
+ * bounces, where the surface further off weighs little), surface slices 0. docs/conventions.md "Inter-reflection" says why. */
 void bb__bounce_options_init(bb__bounce_options *o);
 
 /* Adds to vis (1 + lobes channels, as bb_trace_occlusion made it for the
