@@ -71,6 +71,33 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .short_name = 'q',
                                      .help = "no progress bar, no list of files written"};
 
+static const cli_option opt_bounce = {
+    .id = CLI_OPT_BOUNCE,
+    .long_name = "bounce",
+    .value_name = "RHO",
+    .default_text = "0 (none; 1 with --bounce-albedo)",
+    .range_text = "0..1",
+    .help = "inter-reflection: ao, ssbump and bent include the light the relief "
+            "reflects, albedo RHO (README \"Inter-reflection\")"};
+static const cli_option opt_bounces = {
+    .id = CLI_OPT_BOUNCES,
+    .long_name = "bounces",
+    .value_name = "N",
+    .default_text = "0 (until converged)",
+    .range_text = "0..64",
+    .help = "bounces of reflected light to follow"};
+static const cli_option opt_bounce_albedo = {
+    .id = CLI_OPT_BOUNCE_ALBEDO,
+    .long_name = "bounce-albedo",
+    .value_name = "FILE",
+    .help = "albedo map (grey; RGB: luma) of the height's size, times RHO"};
+static const cli_option opt_brightness = {
+    .id = CLI_OPT_BRIGHTNESS,
+    .long_name = "brightness",
+    .value_name = "FILE",
+    .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights "
+            "(a texel over 1 is scaled down whole)"};
+
 static const cli_option *const bake_options[] = {
     &cli_opt_scale,
     &cli_opt_rays,
@@ -87,6 +114,10 @@ static const cli_option *const bake_options[] = {
     &cli_opt_channel,
     &cli_opt_depth,
     &cli_opt_mips,
+    &opt_bounce,
+    &opt_bounces,
+    &opt_bounce_albedo,
+    &opt_brightness,
     &opt_out_normal,
     &opt_out_weights,
     &opt_out_ssbump,
@@ -142,6 +173,9 @@ typedef struct bake_args {
   cli_slope_args slope; /* --slope FILE, --lit AZ,EL */
   cli_batch_args batch; /* --out-dir, --maps, --name, ..., --depfile */
   const char *json_status; /* a batch's "status" field of the JSON line */
+  const char *bounce_albedo_path, *brightness_path;
+  int bounce_given;
+  bb_image bounce_albedo_map, brightness_map;
 } bake_args;
 
 static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -169,6 +203,19 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_SLICES:
     return cli_parse_int(bake_command.name, "--slices", arg, 1, BB_MAX_SLICES,
                          &a->settings.bake.slices);
+  case CLI_OPT_BOUNCE:
+    a->bounce_given = 1;
+    return cli_parse_double(bake_command.name, "--bounce", arg, 0.0, 0, 1.0,
+                            &a->settings.bake.bounce_albedo);
+  case CLI_OPT_BOUNCES:
+    return cli_parse_int(bake_command.name, "--bounces", arg, 0, BB_MAX_BOUNCES,
+                         &a->settings.bake.bounces);
+  case CLI_OPT_BOUNCE_ALBEDO:
+    a->bounce_albedo_path = arg;
+    return 0;
+  case CLI_OPT_BRIGHTNESS:
+    a->brightness_path = arg;
+    return 0;
   default:
     break;
   }
@@ -237,6 +284,11 @@ static int check_outputs(bake_args *a, const char *input) {
     if (!a->paths[k])
       continue;
     any = 1;
+    const char *maps[2] = {a->bounce_albedo_path, a->brightness_path};
+    for (int m = 0; m < 2; m++)
+      if (maps[m] && cli_same_file(maps[m], a->paths[k]))
+        return cli_usage_error(bake_command.name, "%s would overwrite the input %s",
+                               kind_info(k)->name, maps[m]);
     for (int j = 0; j < k; j++)
       if (a->paths[j] && cli_same_file(a->paths[j], a->paths[k]))
         return cli_usage_error(bake_command.name, "%s and %s would both be written to %s",
@@ -277,10 +329,36 @@ static int check_positionals(const bake_args *a, int argc, char **argv, int firs
                                 "HEIGHT");
 }
 
+/* --bounce-albedo and --brightness: read once, for every HEIGHT (the
+ * library checks their size against each). --bounce-albedo alone bounces
+ * with the map as it is (RHO 1). */
+static int load_bake_maps(bake_args *a) {
+  const char *paths[2] = {a->bounce_albedo_path, a->brightness_path};
+  bb_image *maps[2] = {&a->bounce_albedo_map, &a->brightness_map};
+  for (int m = 0; m < 2; m++) {
+    if (!paths[m])
+      continue;
+    bb_error err = {{0}};
+    bb_status st = cli_read_image(paths[m], maps[m], NULL, &err);
+    if (st != BB_OK)
+      return cli_status_exit(paths[m], st, &err);
+  }
+  if (a->bounce_albedo_path) {
+    a->settings.bake.bounce_albedo_map = &a->bounce_albedo_map;
+    if (!a->bounce_given)
+      a->settings.bake.bounce_albedo = 1.0;
+  }
+  if (a->brightness_path)
+    a->settings.bake.brightness = &a->brightness_map;
+  return 0;
+}
+
 /* Parses and checks the command line; *first receives the index of the
  * first HEIGHT. */
 static int bake_parse(int argc, char **argv, bake_args *a, int *first) {
   int rc = cli_parse_options(&bake_command, argc, argv, bake_option, a, first);
+  if (!rc)
+    rc = load_bake_maps(a);
   if (!rc && !a->batch.out_dir)
     rc = cli_batch_check_single(bake_command.name, &a->batch);
   if (!rc)
@@ -336,6 +414,10 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
                   b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
   cli_json_string(&j, "channel", cli_height_channel_name(source));
   cli_json_number(&j, "threads", r->threads);
+  if (b->bounce_albedo > 0.0) {
+    cli_json_number(&j, "bounce", b->bounce_albedo);
+    cli_json_number(&j, "bounces", r->bounces);
+  }
   cli_json_close(&j, '}');
 
   cli_json_open(&j, "seconds", '{');
@@ -343,6 +425,8 @@ static void print_json(const bake_args *a, const char *input, const bb_image *he
   cli_json_number(&j, "smooth", r->seconds_smooth);
   cli_json_number(&j, "pyramid", r->seconds_pyramid);
   cli_json_number(&j, "trace", r->seconds_trace);
+  if (b->bounce_albedo > 0.0)
+    cli_json_number(&j, "bounce", r->seconds_bounce);
   cli_json_number(&j, "derive", r->seconds_derive);
   cli_json_number(&j, "write", t->write);
   cli_json_close(&j, '}');
@@ -591,6 +675,8 @@ int bb_cli_bake(int argc, char **argv) {
   for (int k = 0; k < OUTPUT_KIND_COUNT; k++)
     free(a.prefix_paths[k]);
   cli_slope_free(&a.slope);
+  bb_image_free(&a.bounce_albedo_map);
+  bb_image_free(&a.brightness_map);
   cli_run_free(&run);
   return rc;
 }

@@ -15,7 +15,8 @@ enum cli_maps_opt_id {
   CLI_OPT_MAP_DETAIL,      /* --detail */
   CLI_OPT_MAP_BASE_DIR,    /* --base DIR */
   CLI_OPT_SLOPE,           /* bake --slope FILE */
-  CLI_OPT_SLOPE_LIT        /* bake --lit AZ,EL */
+  CLI_OPT_SLOPE_LIT,       /* bake --lit AZ,EL */
+  CLI_OPT_MAP_BRIGHTNESS   /* combine --brightness FILE */
 };
 
 /* --depth for commands whose default follows their input. */
