@@ -141,6 +141,10 @@ typedef struct bb_bake_options {
   bb_normal_filter normal_filter;
   int normal_y_up;
   unsigned outputs;
+  double bounce_albedo;
+  const bb_image *bounce_albedo_map;
+  int bounces;
+  const bb_image *brightness;
 } bb_bake_options;
 
 typedef struct bb_bake_result {
@@ -156,6 +160,8 @@ typedef struct bb_bake_result {
   char rayset_id[64];
   bb_basis basis;
   int threads;
+  int bounces;
+  double seconds_bounce;
 } bb_bake_result;
 
 typedef enum bb_ssbump_kind {

@@ -58,11 +58,21 @@ struct bb_job {
   char *basis_file;         /* copies of the options' strings */
   char *out_dir, *name_template, *depfile, *command, *command_options;
   char *slope_path;
+  char *bounce_albedo_file, *brightness_file;
+  bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
   bb__job_item *items;
   int count;
   int batch;                /* 1: out_dir names the outputs */
   char prerequisite_basis;  /* 1: basis_file is a prerequisite (a vectors basis) */
 };
+
+/* Most files one input's bake reads: the input, the basis file, the bounce
+ * albedo map and the brightness map. */
+#define BB__JOB_MAX_READS 4
+
+/* The files item's bake reads, its depfile prerequisites, into out
+ * (BB__JOB_MAX_READS entries); the count. */
+int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out);
 
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);
