@@ -14,7 +14,7 @@ extern "C" {
 #endif
 
 /* Every writer (safe_file.c; OpenImageIO's writers reach it through
- * write_safely() in io_oiio.cpp) puts bytes on disk this way, so that no
+ * bb::write_staged() in oiio_write.cpp) puts bytes on disk this way, so that no
  * failure leaves a partial file at the final name:
  *
  *   bb_staged_file f;

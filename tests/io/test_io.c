@@ -1,4 +1,4 @@
-/* test_io.c: image file reading and writing (src/io_oiio.cpp) against real files. */
+/* test_io.c: image file reading and writing (src/io/) against real files. */
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
@@ -980,7 +980,7 @@ Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
 }
 
 /* The writers added since: mip-mapped TIFF (written by name and read back,
- * see io_oiio.cpp) and EXR, the animated GIF and the mesh formats, cut off
+ * see src/io/oiio_mips.cpp) and EXR, the animated GIF and the mesh formats, cut off
  * at nothing, half way and one byte short like every image format above. */
 Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
   bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 47);
