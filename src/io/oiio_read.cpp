@@ -13,14 +13,17 @@
 #include "io/oiio_guard.h"
 #include "io/read_limits.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <unistd.h>
 
 #ifdef BB_ASAN_BUILD
 #include <sanitizer/lsan_interface.h>
@@ -91,26 +94,71 @@ private:
   bool active_;
 };
 
-// An opened input and whether it is read by OpenImageIO's PNG reader.
+// The file a read checked (bb__input_open: a regular file, opened without
+// blocking), as the IOProxy OpenImageIO's readers read through, so the file
+// checked is the file read. It is an IOFile over that descriptor (the
+// JPEG reader takes no other kind of proxy) that keeps the file's name for
+// messages and closes the descriptor itself, once, when it goes.
+class CheckedInput final : public OIIO::Filesystem::IOFile {
+public:
+  CheckedInput(FILE *file, const char *path) : IOFile(file, Read), file_(file) {
+    m_filename = path;
+  }
+  ~CheckedInput() override { std::fclose(file_); }
+  void close() override {} // readers never own it; the destructor closes
+  CheckedInput(const CheckedInput &) = delete;
+  CheckedInput &operator=(const CheckedInput &) = delete;
+
+private:
+  FILE *file_;
+};
+
+// Opens path as a CheckedInput: a missing file, a directory, a FIFO or a
+// device is refused before any reader sees it (one would block on a FIFO
+// and spin on /dev/zero).
+std::unique_ptr<CheckedInput> open_checked(const char *path, bb_status *st, bb_error *err) {
+  int fd;
+  *st = bb__input_open(path, &fd, err);
+  if (*st != BB_OK) return nullptr;
+  FILE *file = fdopen(fd, "rb");
+  if (!file) {
+    int e = errno;
+    close(fd);
+    *st = bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, std::strerror(e));
+    return nullptr;
+  }
+  std::unique_ptr<FILE, int (*)(FILE *)> until_owned(file, std::fclose);
+  std::unique_ptr<CheckedInput> checked(new CheckedInput(file, path));
+  until_owned.release(); // the CheckedInput closes it now
+  return checked;
+}
+
+// An opened input, the checked file it reads (which must outlive it), and
+// whether it is read by OpenImageIO's PNG reader.
 struct opened_input {
-  std::unique_ptr<ImageInput> in;
+  std::unique_ptr<CheckedInput> file;
+  std::unique_ptr<ImageInput> in; // declared after file: destroyed before it
   bool png = false;
 };
 
-// Opens path for reading: missing files, directories, FIFOs and devices
-// are refused before OpenImageIO opens the name (it would block on a FIFO
-// and spin on /dev/zero), and OpenImageIO's refusals become one line.
+// Opens path for reading through its checked descriptor (readers that
+// cannot read through a proxy open the name, checked a moment before), and
+// makes OpenImageIO's refusals one line.
 opened_input open_input(const char *path, bb_status *st, bb_error *err) {
   opened_input opened;
-  *st = bb__input_check(path, err);
-  if (*st != BB_OK) return opened;
+  opened.file = open_checked(path, st, err);
+  if (!opened.file) return opened;
   lower_oiio_limits();
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
   opened.png = OiioPngLeakScope::applies_to(path);
   {
     OiioPngLeakScope png_leak(opened.png);
-    opened.in = ImageInput::open(path, &config);
+    // create(do_open = true), not open(): open() with a config first asks
+    // the extension's reader whether the file is its own by opening the
+    // name (valid_file), then reads the name; create hands every reader
+    // the proxy.
+    opened.in = ImageInput::create(path, true, &config, opened.file.get());
   }
   if (!opened.in) {
     std::string why = OIIO::geterror();
@@ -276,15 +324,12 @@ bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err) {
 
 bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
-    bb_status st = bb__input_check(path, err);
-    if (st != BB_OK) return st;
-    auto in = ImageInput::open(path);
-    if (!in)
-      return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                      bb::one_line(OIIO::geterror()).c_str());
+    bb_status st;
+    opened_input opened = open_input(path, &st, err);
+    if (!opened.in) return st;
     int n = 0;
-    while (n < 1000000 && in->seek_subimage(n, 0)) n++;
-    (void)in->geterror(); // seeking past the last subimage records an error
+    while (n < 1000000 && opened.in->seek_subimage(n, 0)) n++;
+    (void)opened.in->geterror(); // seeking past the last subimage records an error
     *frames = n;
     return BB_OK;
   });
