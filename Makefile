@@ -33,14 +33,18 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp
+PKGS    := OpenImageIO criterion assimp libpng
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
+# libpng: src/io/png_messages.c wraps the error handlers OpenImageIO gives
+# it, so its own "libpng error:" line never reaches stderr.
+PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
+PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 # Assimp reads and writes meshes (src/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) -lm -pthread
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(PNG_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -129,7 +133,7 @@ PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
-DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev pkg-config g++ make \
+DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libpng-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
@@ -162,7 +166,7 @@ ensure-fuzz-deps: ensure-deps
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -171,7 +175,7 @@ $(BUILD)/link.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES)
+$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 

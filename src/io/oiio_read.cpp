@@ -11,6 +11,7 @@
 #include "io/description.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
+#include "io/png_messages.h"
 #include "io/read_limits.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -149,6 +150,7 @@ opened_input open_input(const char *path, bb_status *st, bb_error *err) {
   opened.file = open_checked(path, st, err);
   if (!opened.file) return opened;
   lower_oiio_limits();
+  (void)bb__png_messages_wrapped(); // links the wrapper of libpng's messages
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
   opened.png = OiioPngLeakScope::applies_to(path);

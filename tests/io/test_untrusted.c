@@ -7,6 +7,7 @@
 #include "bumpbake.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -160,4 +161,97 @@ Test(untrusted, a_device_is_refused_by_every_reader) {
   const char *link = tmp_path("zero.png");
   cr_assert_eq(symlink("/dev/zero", link), 0, "symlink: %s", strerror(errno));
   expect_refused_at_once(link, "is a device, not a regular file");
+}
+
+/* ------------------------------------------- third-party messages (issue 21) */
+
+/* What the calls of fn wrote on file descriptor 2 (then restored), as a
+ * malloc'd string: the library must print nothing there, whoever asks. */
+static char *stderr_during(void (*fn)(const char *path), const char *path) {
+  const char *capture = tmp_path("stderr.txt");
+  fflush(stderr);
+  int saved = dup(STDERR_FILENO);
+  int fd = open(capture, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  cr_assert(saved >= 0 && fd >= 0);
+  dup2(fd, STDERR_FILENO);
+  close(fd);
+  fn(path);
+  fflush(stderr);
+  dup2(saved, STDERR_FILENO);
+  close(saved);
+  FILE *f = fopen(capture, "rb");
+  cr_assert_not_null(f);
+  char *text = calloc(1, 4096);
+  size_t n = fread(text, 1, 4095, f);
+  text[n] = '\0';
+  fclose(f);
+  return text;
+}
+
+/* Every read of a damaged file fails with the library's own one-line
+ * message, and nothing else is said. */
+static void read_damaged(const char *path) {
+  bb_error err;
+  bb_image img, h;
+  int w, ht, c;
+  bb_status st = bb_image_read(path, &img, NULL, &err);
+  cr_expect_neq(st, BB_OK, "%s read", path);
+  cr_expect(strstr(err.message, path) != NULL, "%s", err.message);
+  bb_image_free(&img);
+  (void)bb_image_read_info(path, &w, &ht, &c, NULL, &err);
+  st = bb_height_load(path, BB_CHANNEL_AUTO, &h, &err);
+  cr_expect_neq(st, BB_OK, "%s height", path);
+  bb_image_free(&h);
+}
+
+static void write_bytes(const char *path, const unsigned char *bytes, size_t n) {
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f);
+  cr_assert_eq(fwrite(bytes, 1, n, f), n);
+  cr_assert_eq(fclose(f), 0);
+}
+
+/* A PNG of noise (poorly compressible, so the pixel data spans most of the
+ * file), its bytes returned (malloc'd) with their count. */
+static unsigned char *noise_png(size_t *size) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 96, 64, 3, NULL), BB_OK);
+  uint32_t s = 7;
+  for (size_t i = 0; i < 96u * 64u * 3u; i++) {
+    s = s * 1664525u + 1013904223u;
+    img.pixels[i] = (float)(s >> 8) / 16777216.0f;
+  }
+  bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL};
+  cr_assert_eq(bb_image_write(tmp_path("noise.png"), &img, &o, NULL), BB_OK);
+  bb_image_free(&img);
+  FILE *f = fopen(tmp_path("noise.png"), "rb");
+  cr_assert_not_null(f);
+  unsigned char *bytes = malloc(1 << 20);
+  *size = fread(bytes, 1, 1 << 20, f);
+  fclose(f);
+  cr_assert_gt(*size, 20000);
+  return bytes;
+}
+
+/* libpng printed "libpng error: IDAT: Read error: hit end of file" (a
+ * truncated file) or "libpng error: IDAT: CRC error" (a damaged one) on
+ * stderr, before OpenImageIO returned the error the library reports; the
+ * CLI hid it by muting stderr, a Python caller saw it. */
+Test(untrusted, a_damaged_png_prints_nothing_on_stderr) {
+  size_t n;
+  unsigned char *png = noise_png(&n);
+  const char *cut = tmp_path("cut.png"), *crc = tmp_path("crc.png"), *header = tmp_path("ihdr.png");
+  write_bytes(cut, png, n / 2);
+  png[n / 2] ^= 0x55; /* inside the pixel data: the chunk's CRC no longer matches */
+  write_bytes(crc, png, n);
+  png[n / 2] ^= 0x55;
+  png[20] ^= 0x01; /* inside IHDR (the width): its CRC no longer matches */
+  write_bytes(header, png, n);
+  free(png);
+  const char *files[] = {cut, crc, header};
+  for (size_t i = 0; i < 3; i++) {
+    char *said = stderr_during(read_damaged, files[i]);
+    cr_expect_str_empty(said, "%s: stderr got '%s'", files[i], said);
+    free(said);
+  }
 }

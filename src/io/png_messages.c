@@ -1,0 +1,100 @@
+/* png_messages.c: libpng's own "libpng error: ..." line, kept off stderr.
+ *
+ * Where the line comes from: libpng's png_error() calls the error handler
+ * its user set with png_set_error_fn() and, if that handler returns, its
+ * own png_default_error(), which prints "libpng error: MESSAGE" on stderr
+ * and then longjmps (libpng 1.6.39 pngerror.c). OpenImageIO's PNG handlers
+ * (rderr_handler, wrerr_handler in png_pvt.h, the same in 2.4 and in its
+ * newest sources) record the message and return, so every corrupt or
+ * truncated PNG printed that line before OpenImageIO reported the error we
+ * report. OpenImageIO offers no attribute for it and does not let its user
+ * reach the png_struct, and libpng has no switch for the print.
+ *
+ * So the library defines png_set_error_fn itself (exported: the one
+ * non-bb_ symbol of libbumpbake.so). OpenImageIO's call reaches it first,
+ * since the program, or libbumpbake.so ahead of its own dependencies, comes
+ * before libpng in the dynamic linker's search order; it passes the call on
+ * to libpng's (dlsym RTLD_NEXT) with the handler wrapped, and the wrapper
+ * does what libpng does after a handler returns, png_longjmp(), minus the
+ * print. A handler that does not return (libpng's contract) behaves as
+ * before; NULL (libpng's default, which prints) is left alone. This holds
+ * for every libpng user of the process, OpenImageIO's writers included.
+ * It does not take effect when OpenImageIO was loaded and bound to libpng
+ * before libbumpbake (a program that dlopen()s OpenImageIO first, then
+ * bumpbake); the process's file descriptors are never touched. */
+#define _GNU_SOURCE /* RTLD_NEXT */
+
+#include <dlfcn.h>
+#include <png.h>
+#include <stdatomic.h>
+#include <stddef.h>
+
+#include "io/png_messages.h"
+
+/* Distinct handlers seen: OpenImageIO has two (read and write); each gets
+ * its own wrapper, since libpng passes the wrapper nothing to tell them
+ * apart. Past the table's end handlers are passed on unwrapped. */
+enum { SLOTS = 8 };
+static _Atomic(png_error_ptr) handlers[SLOTS];
+
+static void PNGCBAPI call_then_jump(int slot, png_structp png, png_const_charp message) {
+  png_error_ptr handler = atomic_load(&handlers[slot]);
+  handler(png, message);
+  png_longjmp(png, 1);
+}
+
+#define WRAPPER(k)                                                                    \
+  static void PNGCBAPI quiet_##k(png_structp png, png_const_charp message) {          \
+    call_then_jump(k, png, message);                                                  \
+  }
+WRAPPER(0)
+WRAPPER(1)
+WRAPPER(2)
+WRAPPER(3)
+WRAPPER(4)
+WRAPPER(5)
+WRAPPER(6)
+WRAPPER(7)
+static const png_error_ptr WRAPPERS[SLOTS] = {quiet_0, quiet_1, quiet_2, quiet_3,
+                                              quiet_4, quiet_5, quiet_6, quiet_7};
+
+/* The wrapper of handler, or handler itself when the table is full (or it
+ * is one of ours already). */
+static png_error_ptr wrapped(png_error_ptr handler) {
+  for (int k = 0; k < SLOTS; k++)
+    if (handler == WRAPPERS[k]) return handler;
+  for (int k = 0; k < SLOTS; k++) {
+    png_error_ptr seen = atomic_load(&handlers[k]);
+    if (seen == handler) return WRAPPERS[k];
+    if (!seen) {
+      png_error_ptr expected = NULL;
+      if (atomic_compare_exchange_strong(&handlers[k], &expected, handler) ||
+          expected == handler)
+        return WRAPPERS[k];
+    }
+  }
+  return handler;
+}
+
+typedef void(PNGAPI *set_error_fn_t)(png_structrp, png_voidp, png_error_ptr, png_error_ptr);
+
+void PNGAPI png_set_error_fn(png_structrp png, png_voidp error_ptr, png_error_ptr error_fn,
+                             png_error_ptr warning_fn) {
+  static _Atomic(set_error_fn_t) libpngs;
+  set_error_fn_t real = atomic_load(&libpngs);
+  if (!real) {
+    /* The ISO C cast of a data pointer to a function pointer, as POSIX allows. */
+    void *found = dlsym(RTLD_NEXT, "png_set_error_fn");
+    *(void **)&real = found;
+    if (!real) return; /* no libpng after us: nothing calls this */
+    atomic_store(&libpngs, real);
+  }
+  real(png, error_ptr, error_fn ? wrapped(error_fn) : NULL, warning_fn);
+}
+
+
+
+/* Something a read refers to: a program linking libbumpbake.a gets this
+ * file only for a symbol one of its objects asks for (OpenImageIO's call
+ * to png_set_error_fn comes from a shared library and pulls nothing). */
+int bb__png_messages_wrapped(void) { return atomic_load(&handlers[0]) != NULL; }
