@@ -33,18 +33,23 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp libpng
+PKGS    := OpenImageIO criterion assimp libpng libjpeg OpenEXR
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 # libpng: src/io/png_messages.c wraps the error handlers OpenImageIO gives
 # it, so its own "libpng error:" line never reaches stderr.
 PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
 PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
+# libjpeg and OpenEXRCore read headers before OpenImageIO's readers do
+# (src/io/header_probe.c), to refuse what they would allocate in open().
+PROBE_CFLAGS := $(shell pkg-config --cflags libjpeg OpenEXR 2>/dev/null)
+PROBE_LIBS   := $(shell pkg-config --libs libjpeg 2>/dev/null) \
+                $(filter -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 # Assimp reads and writes meshes (src/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(PNG_LIBS) -lm -pthread
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -133,7 +138,8 @@ PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
-DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libpng-dev pkg-config g++ make \
+DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libpng-dev libjpeg-dev \
+            libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
@@ -166,7 +172,7 @@ ensure-fuzz-deps: ensure-deps
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -175,7 +181,7 @@ $(BUILD)/link.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS)
+$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 

@@ -9,6 +9,7 @@
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
 #include "io/description.h"
+#include "io/header_probe.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
 #include "io/png_messages.h"
@@ -116,11 +117,21 @@ private:
 
 // Opens path as a CheckedInput: a missing file, a directory, a FIFO or a
 // device is refused before any reader sees it (one would block on a FIFO
-// and spin on /dev/zero).
-std::unique_ptr<CheckedInput> open_checked(const char *path, bb_status *st, bb_error *err) {
+// and spin on /dev/zero), and so is a header that would make its reader
+// allocate more than the limits in open() (header_probe.h), or, when
+// `reading` pixels, declare more than a read accepts.
+std::unique_ptr<CheckedInput> open_checked(const char *path, bool reading, bb_status *st,
+                                           bb_error *err) {
   int fd;
   *st = bb__input_open(path, &fd, err);
   if (*st != BB_OK) return nullptr;
+  bb__probe probe;
+  *st = bb__probe_header(fd, path, &probe, err);
+  if (*st == BB_OK) *st = bb__read_check_probe(path, &probe, reading ? 1 : 0, err);
+  if (*st != BB_OK) {
+    close(fd);
+    return nullptr;
+  }
   FILE *file = fdopen(fd, "rb");
   if (!file) {
     int e = errno;
@@ -142,12 +153,12 @@ struct opened_input {
   bool png = false;
 };
 
-// Opens path for reading through its checked descriptor (readers that
-// cannot read through a proxy open the name, checked a moment before), and
-// makes OpenImageIO's refusals one line.
-opened_input open_input(const char *path, bb_status *st, bb_error *err) {
+// Opens path through its checked descriptor (readers that cannot read
+// through a proxy open the name, checked a moment before), for `reading`
+// pixels or only headers, and makes OpenImageIO's refusals one line.
+opened_input open_input(const char *path, bool reading, bb_status *st, bb_error *err) {
   opened_input opened;
-  opened.file = open_checked(path, st, err);
+  opened.file = open_checked(path, reading, st, err);
   if (!opened.file) return opened;
   lower_oiio_limits();
   (void)bb__png_messages_wrapped(); // links the wrapper of libpng's messages
@@ -251,7 +262,7 @@ int count_levels(ImageInput &in) {
 bb_status read_image(const char *path, int first, int count, int level, bb_image *out,
                      bb_image_info *info, int *level_count, bb_error *err) {
   bb_status st;
-  opened_input opened = open_input(path, &st, err);
+  opened_input opened = open_input(path, true, &st, err);
   if (!opened.in) return st;
   ImageInput *in = opened.in.get();
   if (level_count || level != 0) {
@@ -301,7 +312,7 @@ bb_status bb__oiio_read_header(const char *path, int *width, int *height, int *c
                                bb_image_info *info, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
-    opened_input opened = open_input(path, &st, err);
+    opened_input opened = open_input(path, false, &st, err);
     if (!opened.in) return st;
     const ImageSpec &spec = opened.in->spec();
     const bb__image_header h = header_of(spec);
@@ -317,7 +328,7 @@ bb_status bb__oiio_read_header(const char *path, int *width, int *height, int *c
 bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
-    opened_input opened = open_input(path, &st, err);
+    opened_input opened = open_input(path, false, &st, err);
     if (!opened.in) return st;
     *levels = count_levels(*opened.in);
     return BB_OK;
@@ -327,7 +338,7 @@ bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err) {
 bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
-    opened_input opened = open_input(path, &st, err);
+    opened_input opened = open_input(path, false, &st, err);
     if (!opened.in) return st;
     int n = 0;
     while (n < 1000000 && opened.in->seek_subimage(n, 0)) n++;

@@ -30,6 +30,20 @@ bb_status bb__read_check_shape(const char *path, const bb__image_header *h, bb_e
 bb_status bb__read_check_size(const char *path, const bb__image_header *h, int channels_read,
                               bb_error *err);
 
+/* Most bytes one decode unit (a tile, or a block of scanlines) may take as
+ * floats of every channel: a reader allocates it whole however small the
+ * image (a 1 x 1 TIFF declaring 16384 x 16384 tiles took 8.5 GB). */
+#define BB__MAX_CHUNK_BYTES (64L << 20)
+
+/* What a header makes a reader allocate in open() (header_probe.h), checked
+ * before the reader sees the file: the open itself within BB_MAX_READ_BYTES,
+ * an OpenEXR chunk within BB__MAX_CHUNK_BYTES and its chunk tables within
+ * the file, and when `reading` pixels, the declared size within the limits
+ * of bb__read_check_size. */
+struct bb__probe;
+bb_status bb__read_check_probe(const char *path, const struct bb__probe *probe, int reading,
+                               bb_error *err);
+
 /* Rows decoded per call: whole tile rows for tiled files, else about 4 MiB
  * of floats. Reading in bands lets a file whose data stops early (a header
  * promising 8192 rows over 52 bytes) fail at its first band instead of

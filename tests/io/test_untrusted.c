@@ -2,9 +2,12 @@
  * files are untrusted"): FIFOs and devices under an input's name. Each
  * call runs in a child with an alarm, so a regression that blocks fails
  * here instead of hanging the suite. */
+#define _DEFAULT_SOURCE /* wait4 (child_call.h) */
+
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "child_call.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -39,53 +42,6 @@ static const char *tmp_path(const char *name) {
   char *p = buf[next++ % 4];
   snprintf(p, 512, "%s/%s", tmpdir, name);
   return p;
-}
-
-/* ----------------------------------------------------------- the harness */
-
-typedef bb_status (*call_fn)(const char *path, bb_error *err);
-
-typedef struct outcome {
-  bb_status status;
-  int signal;     /* the child's killing signal, or 0 */
-  double seconds; /* wall-clock time of the call */
-  char message[600];
-} outcome;
-
-/* Runs fn(path) in a child killed after `alarm_seconds`, and reports its
- * status, message and time. */
-static outcome run_call(call_fn fn, const char *path, unsigned alarm_seconds) {
-  outcome o;
-  memset(&o, 0, sizeof o);
-  int fds[2];
-  cr_assert_eq(pipe(fds), 0);
-  fflush(NULL);
-  struct timespec t0, t1;
-  clock_gettime(CLOCK_MONOTONIC, &t0);
-  pid_t pid = fork();
-  cr_assert(pid >= 0);
-  if (pid == 0) {
-    close(fds[0]);
-    alarm(alarm_seconds);
-    bb_error err = {{0}};
-    bb_status st = fn(path, &err);
-    ssize_t n = write(fds[1], err.message, strlen(err.message));
-    (void)n;
-    _exit((int)st);
-  }
-  close(fds[1]);
-  ssize_t got = read(fds[0], o.message, sizeof o.message - 1);
-  o.message[got > 0 ? got : 0] = '\0';
-  close(fds[0]);
-  int status = 0;
-  cr_assert_eq(waitpid(pid, &status, 0), pid);
-  clock_gettime(CLOCK_MONOTONIC, &t1);
-  o.seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-  if (WIFSIGNALED(status))
-    o.signal = WTERMSIG(status);
-  else
-    o.status = (bb_status)WEXITSTATUS(status);
-  return o;
 }
 
 /* --------------------------------------------- every reader of the library */
@@ -127,7 +83,7 @@ static bb_status call_file_hash(const char *path, bb_error *err) {
 
 static const struct {
   const char *name;
-  call_fn fn;
+  child_call_fn fn;
 } READERS[] = {
     {"bb_image_read", call_read},       {"bb_image_read_info", call_read_info},
     {"bb_image_read_mip", call_read_mip}, {"bb_image_frame_count", call_frame_count},
@@ -139,7 +95,7 @@ static const struct {
  * block in open() for ever, /dev/zero to be read without end). */
 static void expect_refused_at_once(const char *path, const char *what) {
   for (size_t i = 0; i < sizeof READERS / sizeof READERS[0]; i++) {
-    outcome o = run_call(READERS[i].fn, path, 10);
+    child_outcome o = child_call(READERS[i].fn, path, 10, 0);
     cr_expect_eq(o.signal, 0, "%s(%s): killed by signal %d after %.1f s (it blocked)",
                  READERS[i].name, path, o.signal, o.seconds);
     if (o.signal) continue;
