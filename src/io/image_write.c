@@ -10,14 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A stack bb_staged_file that bb__safe_discard may be called on before it
- * was opened. */
-static void clear_staged(bb_staged_file *f) {
-  memset(f, 0, sizeof *f);
-  f->fd = -1;
-  f->slot = -1;
-}
-
 static bb_status write_image(const char *path, const bb_image *img,
                              const bb_write_options *options, bb_staged_file *f,
                              bb_error *err) {
@@ -46,7 +38,7 @@ bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_o
                          bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write: path is NULL");
   bb_staged_file f;
-  clear_staged(&f);
+  bb__safe_init(&f);
   bb_status st = write_image(path, img, options, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
@@ -72,7 +64,7 @@ bb_status bb_image_write_mips(const char *path, const bb_image *levels, int coun
                               const bb_write_options *options, bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
   bb_staged_file f;
-  clear_staged(&f);
+  bb__safe_init(&f);
   bb_status st = write_mips(path, levels, count, options, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }

@@ -125,20 +125,24 @@ std::string verify_chain(const std::string &name, const bb_image *levels, int co
 }
 
 // bb::write_staged for a TIFF of several directories, which OpenImageIO
-// cannot write through a proxy: OpenImageIO 2.4's TIFF writer re-opens its
-// proxy in "w" mode for every directory it appends, so through a proxy a
-// file of several directories keeps only the last. The encoder gets proxy
-// == nullptr and writes to the temporary by name; its own writes are then
-// not checked one by one, so the temporary is fsynced (a full disk can
-// show only there) and read back whole.
+// cannot write through a proxy: OpenImageIO 2.4's TIFF writer appends a
+// directory by opening its output again in "a" mode, and its proxy
+// callbacks cannot read (writer_readproc returns 0), so through a proxy a
+// file of several directories keeps only the last. The encoder therefore
+// opens a name, and reopens it for every level: the name is in a private
+// directory reached through its descriptor (bb__safe_open_private), never
+// one in the destination's directory, where a link planted between two
+// opens was written through (issue 22, #8). Its writes are not checked one
+// by one, so the file is fsynced (a full disk can show only there) and
+// read back whole.
 bb_status write_staged_by_name(const char *path, const bb::encoder_fn &encode,
                                const bb_image *levels, int count, bb_staged_file *f,
                                bb_error *err) {
-  bb_status st = bb__safe_open(f, path, err);
+  bb_status st = bb__safe_open_private(f, path, err);
   if (st != BB_OK) return st;
   std::string why = encode(f->temp_path, nullptr);
   if (why.empty()) {
-    st = bb__safe_finish(f, err);
+    st = bb__safe_adopt(f, err);
     if (st != BB_OK) return st;
     why = verify_chain(f->temp_path, levels, count);
   }

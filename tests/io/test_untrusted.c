@@ -10,12 +10,16 @@
 #include "child_call.h"
 
 #include <errno.h>
+#include <poll.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/inotify.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -210,4 +214,126 @@ Test(untrusted, a_damaged_png_prints_nothing_on_stderr) {
     cr_expect_str_empty(said, "%s: stderr got '%s'", files[i], said);
     free(said);
   }
+}
+
+/* ------------------------------------------ links planted in temporaries */
+
+/* What another user who may write in the destination's directory does
+ * (issue 22, #8): watch it, and the moment a temporary of bumpbake's
+ * appears, replace a file by a link to `target`, and move a directory away
+ * and put a link to `decoy` (a directory of theirs, holding links to
+ * target under any name bumpbake might open) in its place. They cannot
+ * enter bumpbake's private directory (mode 0700, another user's), so the
+ * watcher does not either. */
+typedef struct planter {
+  const char *dir, *target, *decoy;
+  atomic_int stop;
+  int files, dirs; /* replaced */
+} planter;
+
+static void *plant_links(void *arg) {
+  planter *p = arg;
+  int in = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  cr_assert(in >= 0);
+  cr_assert(inotify_add_watch(in, p->dir, IN_CREATE) >= 0);
+  char buf[8192] __attribute__((aligned(__alignof__(struct inotify_event))));
+  int moved = 0;
+  while (!atomic_load(&p->stop)) {
+    struct pollfd pfd = {in, POLLIN, 0};
+    if (poll(&pfd, 1, 5) <= 0) continue;
+    ssize_t n = read(in, buf, sizeof buf);
+    for (char *at = buf; n > 0 && at < buf + n;) {
+      const struct inotify_event *ev = (const struct inotify_event *)at;
+      at += sizeof *ev + ev->len;
+      if (!ev->len || strncmp(ev->name, ".bb-tmp-", 8) != 0) continue;
+      char path[700], away[700];
+      snprintf(path, sizeof path, "%s/%s", p->dir, ev->name);
+      struct stat st;
+      if (lstat(path, &st) != 0 || S_ISLNK(st.st_mode)) continue; /* gone, or its own link */
+      if (S_ISDIR(st.st_mode)) {
+        snprintf(away, sizeof away, "%s/moved-%d", p->dir, moved++);
+        if (rename(path, away) == 0 && symlink(p->decoy, path) == 0) p->dirs++;
+      } else if (unlink(path) == 0 && symlink(p->target, path) == 0) {
+        p->files++;
+      }
+    }
+  }
+  close(in);
+  return NULL;
+}
+
+static void write_text(const char *path, const char *text) {
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(text, f);
+  cr_assert_eq(fclose(f), 0);
+}
+
+/* A mip-mapped TIFF is written by OpenImageIO opening a name, once per
+ * level: that name was the O_EXCL temporary in the destination's directory,
+ * and a link planted there between two opens was written through (9 of 9
+ * trials). Now it is a name in a private directory reached through its
+ * descriptor: whatever the watcher does, the target keeps its bytes, and
+ * the file is written whole (or, had the watcher won the race for the
+ * directory itself, refused cleanly). */
+Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
+  const char *out_dir = tmp_path("shared"), *decoy = tmp_path("decoy");
+  char target[600];
+  snprintf(target, sizeof target, "%s", tmp_path("precious.txt"));
+  cr_assert_eq(mkdir(out_dir, 0777), 0);
+  cr_assert_eq(mkdir(decoy, 0777), 0);
+  write_text(target, "precious\n");
+  const char *leaves[] = {"staged.tif", "staged.TIF", "out.tif"};
+  for (size_t i = 0; i < 3; i++) {
+    char link[700];
+    snprintf(link, sizeof link, "%s/%s", decoy, leaves[i]);
+    cr_assert_eq(symlink(target, link), 0);
+  }
+  bb_image img, *levels = NULL;
+  int count_made = 0;
+  cr_assert_eq(bb_image_alloc(&img, 256, 128, 3, NULL), BB_OK);
+  for (size_t i = 0; i < 256u * 128u * 3u; i++) img.pixels[i] = (float)(i % 97) / 97.0f;
+  bb_error err;
+  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count_made, &err), BB_OK, "%s",
+               err.message);
+  cr_assert_eq(count_made, 9);
+
+  planter p = {out_dir, target, decoy, 0, 0, 0};
+  pthread_t watcher;
+  cr_assert_eq(pthread_create(&watcher, NULL, plant_links, &p), 0);
+  usleep(20000); /* the watch is in place */
+  char out[700];
+  snprintf(out, sizeof out, "%s/out.tif", out_dir);
+  int written = 0;
+  for (int trial = 0; trial < 5; trial++) {
+    unlink(out);
+    bb_status st = bb_image_write_mips(out, levels, count_made, NULL, &err);
+    if (st == BB_OK) {
+      written++;
+      int count = 0;
+      bb_image back;
+      cr_assert_eq(bb_image_read_mip(out, 3, &back, NULL, &count, &err), BB_OK, "%s",
+                   err.message);
+      cr_expect(count == 9 && back.width == 32 && back.height == 16);
+      bb_image_free(&back);
+    } else {
+      cr_expect_eq(st, BB_ERR_IO, "%s", err.message);
+    }
+  }
+  atomic_store(&p.stop, 1);
+  pthread_join(watcher, NULL);
+  FILE *f = fopen(target, "r");
+  char text[64] = {0};
+  cr_assert_not_null(f);
+  size_t n = fread(text, 1, sizeof text - 1, f);
+  fclose(f);
+  cr_expect(n == 9 && strcmp(text, "precious\n") == 0,
+            "the target was written through (%zu bytes; %d files, %d directories replaced)", n,
+            p.files, p.dirs);
+  cr_expect_gt(written, 0, "no trial wrote the file: %s", err.message);
+  cr_expect_gt(p.files + p.dirs, 0, "the watcher never acted");
+  cr_log_info("%d of 5 written; the watcher replaced %d files and %d directories", written,
+              p.files, p.dirs);
+  bb_mip_chain_free(levels, count_made);
+  bb_image_free(&img);
 }
