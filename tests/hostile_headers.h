@@ -93,6 +93,21 @@ static inline int write_exr_with_huge_attribute(const char *path, uint32_t decla
   return hostile_write(path, b, sizeof b);
 }
 
+/* An OpenEXR file whose first attribute has no type name and declares
+ * `declared` bytes (the load fuzzer's first find): OpenEXR's C++ reader
+ * takes it for an opaque attribute and allocates the declared size;
+ * OpenEXRCore reports it and skips it. */
+static inline int write_exr_with_untyped_attribute(const char *path, uint32_t declared) {
+  unsigned char b[86];
+  size_t n = 0;
+  const unsigned char magic[] = {0x76, 0x2F, 0x31, 0x01, 2, 0, 0, 0};
+  memcpy(b, magic, sizeof magic), n += sizeof magic;
+  memcpy(b + n, "junk\0\0", 6), n += 6; /* name "junk", type "" */
+  hostile_put32(b + n, declared), n += 4;
+  memset(b + n, 'x', sizeof b - n);
+  return hostile_write(path, b, sizeof b);
+}
+
 /* A GIF whose logical screen and one image are width x height, with a
  * two-colour table and an LZW stream that ends at once (35 bytes):
  * OpenImageIO allocates a canvas of width x height x 4 bytes to open it. */

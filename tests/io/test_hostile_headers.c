@@ -102,9 +102,19 @@ Test(hostile_headers, an_exr_attribute_larger_than_its_file_is_refused) {
   expect_every_read_refuses(path, BB_ERR_FORMAT, "'comment'");
 }
 
+Test(hostile_headers, an_exr_attribute_of_no_type_is_refused) {
+  const char *path = tmp("u.exr");
+  cr_assert_eq(write_exr_with_untyped_attribute(path, 0x6E697274u), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "attribute type for attribute 'junk'");
+}
+
 Test(hostile_headers, a_gif_screen_too_large_to_open_says_so) {
   const char *path = tmp("g.gif");
   cr_assert_eq(write_gif_screen(path, 65535, 65535), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a GIF of 65535x65535 needs 16384 MiB to open");
+  /* giflib reads any version after "GIF" (the fuzzer's "GIF\x939a"). */
+  FILE *f = fopen(path, "r+b");
+  cr_assert(f && fseek(f, 3, SEEK_SET) == 0 && fwrite("\x93" "9a", 1, 3, f) == 3 && fclose(f) == 0);
   expect_every_read_refuses(path, BB_ERR_SIZE, "a GIF of 65535x65535 needs 16384 MiB to open");
   /* A screen within what may be opened, but not read: the read refuses it
    * before OpenImageIO allocates and decodes 1 GiB. */
@@ -112,6 +122,42 @@ Test(hostile_headers, a_gif_screen_too_large_to_open_says_so) {
   cr_assert_eq(write_gif_screen(mid, 16384, 16384), 0);
   expect_refusal(read_pixels, "bb_image_read", mid, BB_ERR_SIZE,
                  "image 16384x16384 is over the maximum");
+}
+
+/* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
+ * extension index, then the file), read under an address space of 1.2 GiB:
+ * each allocated well past it before (1.6 to 1.8 GB at once) and now is
+ * refused from its header, saying why. */
+Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
+  static const struct {
+    const char *input, *ext, *reason;
+  } finds[] = {
+      {"exr-attribute-with-no-type", ".exr", "attribute type for attribute 'Softwar?'"},
+      {"exr-attribute-name-with-a-newline", ".exr", "attribute type for attribute '?'"},
+      {"exr-header-two-parsers-read-differently", ".exr", "'compression' attribute not found"},
+      {"gif-of-another-version-with-a-huge-screen", ".gif", "a GIF of 14616x29285 needs 1633 MiB"},
+  };
+  for (size_t i = 0; i < sizeof finds / sizeof finds[0]; i++) {
+    char from[256];
+    snprintf(from, sizeof from, "fuzz/regressions/load/%s", finds[i].input);
+    FILE *f = fopen(from, "rb");
+    cr_assert_not_null(f, "%s (tests run from the project root)", from);
+    unsigned char bytes[4096];
+    size_t n = fread(bytes, 1, sizeof bytes, f);
+    fclose(f);
+    cr_assert_gt(n, 1);
+    char name[64];
+    snprintf(name, sizeof name, "find%zu%s", i, finds[i].ext);
+    const char *path = tmp(name);
+    write_bytes(path, bytes + 1, n - 1);
+    child_outcome o = child_call(read_info, path, 30, 1228L << 20);
+    cr_expect_eq(o.signal, 0, "%s: signal %d", finds[i].input, o.signal);
+    cr_expect(o.status == BB_ERR_FORMAT || o.status == BB_ERR_SIZE, "%s: %s",
+              finds[i].input, o.message);
+    cr_expect(strstr(o.message, finds[i].reason), "%s: '%s' lacks '%s'", finds[i].input,
+              o.message, finds[i].reason);
+    cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", finds[i].input, o.message);
+  }
 }
 
 /* ---------------------------------------------------------- the CLI */
