@@ -1,7 +1,7 @@
 # bumpbake: plain Makefile. `make` builds, `make test` builds and runs every
 # test, `make demo` bakes a fixture into out/, `make bench` measures,
 # `make install` installs (PREFIX=/usr/local, DESTDIR= for staging),
-# `make fuzz` runs the libFuzzer targets of fuzz/.
+# `make fuzz` runs the libFuzzer targets of fuzz/ (`make fuzz-long` for longer).
 # `make DEBUG=1 ...` builds with assertions and ASan/UBSan into build/debug.
 
 DEBUG ?= 0
@@ -125,7 +125,7 @@ BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-circles bench goldens docs install uninstall clean format FORCE \
-        fuzz fuzz-deps ensure-fuzz-deps
+        fuzz fuzz-long fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
@@ -316,11 +316,21 @@ goldens: ensure-deps
 # ---- fuzzing (libFuzzer, ASan + UBSan) ---------------------------------------
 # `make fuzz FUZZ_SECONDS=N` builds fuzz/fuzz_*.c with clang against a copy of
 # the library instrumented for coverage and runs each target N seconds,
-# seeded from fixtures/ (fuzz/make_seeds.c) and from the corpus earlier runs
-# left in build/fuzz/corpus, after replaying fuzz/regressions/. Crashes land
-# in build/fuzz/crashes/; each one found becomes a regression test of `make
-# test` (tests/test_fuzz.c).
+# seeded by fuzz/make_seeds.c (the fixtures, and a small valid file of every
+# image format OpenImageIO writes here) and from the corpus earlier runs left
+# in build/fuzz/corpus, after replaying fuzz/regressions/. A crash, a leak, a
+# failed property, an input slower than FUZZ_TIMEOUT seconds, one allocation
+# over FUZZ_MALLOC_MB or a process over FUZZ_RSS_MB fails the run
+# (fuzz/run.sh); the input lands in build/fuzz/crashes/, and each one found
+# becomes a regression input under fuzz/regressions/NAME/, replayed by `make
+# test` (tests/cli/test_fuzz.c) and by every `make fuzz`.
+# CI runs `make fuzz FUZZ_SECONDS=15`; `make fuzz-long` runs each target
+# FUZZ_LONG_SECONDS (1800) seconds, for a machine left to it.
 FUZZ_SECONDS ?= 60
+FUZZ_LONG_SECONDS ?= 1800
+FUZZ_TIMEOUT   ?= 10
+FUZZ_MALLOC_MB ?= 1100
+FUZZ_RSS_MB    ?= 2560
 FUZZ_BUILD   := build/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
@@ -338,12 +348,12 @@ FUZZ_ARGS_fuzz_provenance := -max_len=65536
 
 $(FUZZ_BUILD)/src/%.o: src/%.c
 	@mkdir -p $(@D)
-	clang $(FUZZ_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
+	clang $(FUZZ_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
 
 $(FUZZ_BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
-	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -fsanitize=fuzzer-no-link \
-	  -c $< -o $@
+	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(PNG_CFLAGS) \
+	  $(PROBE_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
 
 -include $(FUZZ_LIB_OBJ:.o=.d) $(FUZZ_CLI_OBJ:.o=.d)
 
@@ -352,14 +362,22 @@ $(FUZZ_BUILD)/%: fuzz/%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< -x none $(FUZZ_CLI_OBJ) \
 	  $(FUZZ_LIB_OBJ) $(LDLIBS)
 
-$(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_LIB_OBJ)
+$(FUZZ_BUILD)/seed_formats.o: fuzz/seed_formats.cpp
+	@mkdir -p $(@D)
+	clang++ $(FUZZ_CXXFLAGS) $(OIIO_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -o $@ $< -x none \
-	  $(FUZZ_LIB_OBJ) $(LDLIBS)
+	  $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ) $(LDLIBS)
 
 fuzz: ensure-fuzz-deps
 	@$(MAKE) --no-print-directory $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds
-	@./fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) \
+	@FUZZ_TIMEOUT=$(FUZZ_TIMEOUT) FUZZ_MALLOC_MB=$(FUZZ_MALLOC_MB) FUZZ_RSS_MB=$(FUZZ_RSS_MB) \
+	  ./fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) \
 	  $(foreach t,$(FUZZ_TARGETS),"$(notdir $(t)) $(FUZZ_ARGS_$(notdir $(t)))")
+
+fuzz-long:
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_LONG_SECONDS)
 
 format:
 	clang-format -i include/*.h src/*/*.c src/*/*.h src/*/*.cpp tests/*.h tests/*/*.c tools/*.c fuzz/*.c
