@@ -36,8 +36,8 @@ LIB_CFLAGS := -fPIC -fno-semantic-interposition
 PKGS    := OpenImageIO criterion assimp libpng libjpeg OpenEXR
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
-# libpng: src/io/png_messages.c wraps the error handlers OpenImageIO gives
-# it, so its own "libpng error:" line never reaches stderr.
+# libpng: src/io/png_hooks.c sets quiet error handlers and bounded
+# allocations on the libpng structs OpenImageIO makes.
 PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
 PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
 # libjpeg and OpenEXRCore read headers before OpenImageIO's readers do

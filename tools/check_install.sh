@@ -91,8 +91,8 @@ fi
 
 # ------------------------------------------------------ 3. exported symbols
 # (typedef lines left out: "typedef bb_status (*name)(...)" is no function.)
-# Besides them, png_set_error_fn (src/io/png_messages.c: it keeps libpng's
-# own error line off stderr, so it must be found before libpng's).
+# Besides them, png_set_error_fn (src/io/png_hooks.c: it sets up the
+# libpng structs OpenImageIO makes, so it must be found before libpng's).
 { grep -v '^[[:space:]]*typedef' "$prefix/include/bumpbake.h" |
     grep -o '\bbb_[a-z0-9_]*[[:space:]]*(' | tr -d '( '
   echo png_set_error_fn; } | sort -u >"$tmp/header.sym"

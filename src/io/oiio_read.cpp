@@ -12,7 +12,7 @@
 #include "io/header_probe.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
-#include "io/png_messages.h"
+#include "io/png_hooks.h"
 #include "io/read_limits.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -161,7 +161,7 @@ opened_input open_input(const char *path, bool reading, bb_status *st, bb_error 
   opened.file = open_checked(path, reading, st, err);
   if (!opened.file) return opened;
   lower_oiio_limits();
-  (void)bb__png_messages_wrapped(); // links the wrapper of libpng's messages
+  (void)bb__png_hooks_set(); // links the hooks on libpng (png_hooks.c)
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
   opened.png = OiioPngLeakScope::applies_to(path);

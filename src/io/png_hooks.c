@@ -1,35 +1,45 @@
-/* png_messages.c: libpng's own "libpng error: ..." line, kept off stderr.
+/* png_hooks.c: what the library sets on every png_struct OpenImageIO makes:
+ * error handlers that do not print, and allocations bounded.
  *
- * Where the line comes from: libpng's png_error() calls the error handler
- * its user set with png_set_error_fn() and, if that handler returns, its
- * own png_default_error(), which prints "libpng error: MESSAGE" on stderr
- * and then longjmps (libpng 1.6.39 pngerror.c). OpenImageIO's PNG handlers
+ * Why: libpng's png_error() calls the error handler its user set with
+ * png_set_error_fn() and, if that handler returns, its own
+ * png_default_error(), which prints "libpng error: MESSAGE" on stderr and
+ * then longjmps (libpng 1.6.39 pngerror.c). OpenImageIO's PNG handlers
  * (rderr_handler, wrerr_handler in png_pvt.h, the same in 2.4 and in its
  * newest sources) record the message and return, so every corrupt or
  * truncated PNG printed that line before OpenImageIO reported the error we
- * report. OpenImageIO offers no attribute for it and does not let its user
- * reach the png_struct, and libpng has no switch for the print.
+ * report. And libpng checks a chunk's length against its 8 MB chunk limit
+ * with a benign error, which on read is a warning: a 211-byte PNG whose
+ * tEXt chunk declared 1.7 GB was allocated and zeroed whole (5 s, 1.8 GB)
+ * in OpenImageIO's open(). OpenImageIO offers no attribute for either and
+ * never shows its png_struct; libpng's user may set both on the struct.
  *
- * So the library defines png_set_error_fn itself (exported: the one
+ * How: the library defines png_set_error_fn itself (exported: the one
  * non-bb_ symbol of libbumpbake.so). OpenImageIO's call reaches it first,
  * since the program, or libbumpbake.so ahead of its own dependencies, comes
- * before libpng in the dynamic linker's search order; it passes the call on
- * to libpng's (dlsym RTLD_NEXT) with the handler wrapped, and the wrapper
- * does what libpng does after a handler returns, png_longjmp(), minus the
- * print. A handler that does not return (libpng's contract) behaves as
- * before; NULL (libpng's default, which prints) is left alone. This holds
- * for every libpng user of the process, OpenImageIO's writers included.
- * It does not take effect when OpenImageIO was loaded and bound to libpng
- * before libbumpbake (a program that dlopen()s OpenImageIO first, then
- * bumpbake); the process's file descriptors are never touched. */
+ * before libpng in the dynamic linker's search order, right after it
+ * created the struct. It passes the call on to libpng's (dlsym RTLD_NEXT)
+ * and, for structs whose call comes from OpenImageIO (dladdr of the return
+ * address), wraps the handler so that after it returns the wrapper does what
+ * libpng does, png_longjmp(), minus the print, and sets allocation
+ * functions (png_set_mem_fn; the C heap, as libpng's own) that refuse any
+ * single allocation over BB__MAX_CHUNK_BYTES: libpng then skips an
+ * ancillary chunk it cannot hold ("insufficient memory to read chunk") and
+ * fails on anything else. Other libpng users of the process are left
+ * alone. It does not take effect when OpenImageIO was loaded and bound to
+ * libpng before libbumpbake (a program that dlopen()s OpenImageIO first,
+ * then bumpbake); the process's file descriptors are never touched. */
 #define _GNU_SOURCE /* RTLD_NEXT */
 
 #include <dlfcn.h>
 #include <png.h>
 #include <stdatomic.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "io/png_messages.h"
+#include "io/png_hooks.h"
+#include "io/read_limits.h"
 
 /* Distinct handlers seen: OpenImageIO has two (read and write); each gets
  * its own wrapper, since libpng passes the wrapper nothing to tell them
@@ -76,6 +86,26 @@ static png_error_ptr wrapped(png_error_ptr handler) {
   return handler;
 }
 
+/* libpng's allocations on OpenImageIO's structs: the C heap, as libpng's
+ * defaults are (so what was allocated before is freed alike), but never
+ * one block over the bound. */
+static png_voidp PNGCBAPI bounded_malloc(png_structp png, png_alloc_size_t size) {
+  (void)png;
+  return size <= (png_alloc_size_t)BB__MAX_CHUNK_BYTES ? malloc((size_t)size) : NULL;
+}
+
+static void PNGCBAPI heap_free(png_structp png, png_voidp block) {
+  (void)png;
+  free(block);
+}
+
+/* 1 when the code at address belongs to OpenImageIO's library. */
+static int in_openimageio(const void *address) {
+  Dl_info info;
+  return dladdr(address, &info) != 0 && info.dli_fname &&
+         strstr(info.dli_fname, "libOpenImageIO") != NULL;
+}
+
 typedef void(PNGAPI *set_error_fn_t)(png_structrp, png_voidp, png_error_ptr, png_error_ptr);
 
 void PNGAPI png_set_error_fn(png_structrp png, png_voidp error_ptr, png_error_ptr error_fn,
@@ -89,7 +119,12 @@ void PNGAPI png_set_error_fn(png_structrp png, png_voidp error_ptr, png_error_pt
     if (!real) return; /* no libpng after us: nothing calls this */
     atomic_store(&libpngs, real);
   }
+  if (!png || !in_openimageio(__builtin_return_address(0))) {
+    real(png, error_ptr, error_fn, warning_fn);
+    return;
+  }
   real(png, error_ptr, error_fn ? wrapped(error_fn) : NULL, warning_fn);
+  png_set_mem_fn(png, NULL, bounded_malloc, heap_free);
 }
 
 
@@ -97,4 +132,4 @@ void PNGAPI png_set_error_fn(png_structrp png, png_voidp error_ptr, png_error_pt
 /* Something a read refers to: a program linking libbumpbake.a gets this
  * file only for a symbol one of its objects asks for (OpenImageIO's call
  * to png_set_error_fn comes from a shared library and pulls nothing). */
-int bb__png_messages_wrapped(void) { return atomic_load(&handlers[0]) != NULL; }
+int bb__png_hooks_set(void) { return atomic_load(&handlers[0]) != NULL; }
