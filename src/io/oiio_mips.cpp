@@ -114,8 +114,12 @@ std::string verify_chain(const std::string &name, const bb_image *levels, int co
     bb_image level;
     bb_error why;
     int file_levels = 0;
-    if (bb_image_read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK)
-      return std::string("read back: ") + why.message;
+    if (bb_image_read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK) {
+      // The reason, without the temporary's name the read gave it.
+      std::string reason = why.message;
+      if (reason.compare(0, name.size() + 2, name + ": ") == 0) reason.erase(0, name.size() + 2);
+      return "read back: " + reason;
+    }
     bool same = level.width == levels[k].width && level.height == levels[k].height &&
                 file_levels == count;
     bb_image_free(&level);
