@@ -66,8 +66,10 @@ extern "C" {
  * image): both the file's own samples (texels x channels x bytes per
  * sample, as its header declares them) and the floats decoded (texels x
  * channels read x 4) must fit, checked before anything is allocated. The
- * first read also lowers OpenImageIO's process-wide "limits:imagesize_MB"
- * to 1024 and "limits:channels" to 64 when they are higher. */
+ * first read or write also lowers OpenImageIO's process-wide
+ * "limits:imagesize_MB" to 1024 and "limits:channels" to 64 when they are
+ * higher, and sets its "exr_threads" to -1 (OpenEXR without its own thread
+ * pool, which crashed when started short of memory). */
 #define BB_MAX_READ_BYTES (1L << 30)
 
 /* Largest |height_scale x h| a bake accepts, in texels: scaled heights are

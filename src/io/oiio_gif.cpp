@@ -4,6 +4,7 @@
 #include "core/internal.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
+#include "io/oiio_setup.h"
 #include "io/oiio_proxy.h"
 #include "io/quantise.h"
 
@@ -118,6 +119,7 @@ extern "C" {
 bb_status bb__oiio_gif_open(const char *path, int width, int height, double frames_per_second,
                             bb_animation **out, bb_error *err) {
   return bb::guard(err, path, bb::WRITING, [&] {
+    bb::oiio_setup();
     return animation_open(path, width, height, frames_per_second, out, err);
   });
 }

@@ -7,6 +7,7 @@
 #include "io/formats.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
+#include "io/oiio_setup.h"
 #include "io/oiio_proxy.h"
 #include "io/quantise.h"
 
@@ -180,6 +181,7 @@ bb_status bb__oiio_write_mips(const char *path, const bb_image *levels, int coun
                               bb_depth depth, bb_range range, const char *description,
                               bb_staged_file *f, bb_error *err) {
   return bb::guard(err, path, bb::WRITING, [&] {
+    bb::oiio_setup();
     auto encode = [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
       return encode_mips(name, proxy, levels, count, depth, range, description);
     };

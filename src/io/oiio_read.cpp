@@ -12,6 +12,7 @@
 #include "io/header_probe.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
+#include "io/oiio_setup.h"
 #include "io/png_hooks.h"
 #include "io/read_limits.h"
 
@@ -38,21 +39,6 @@ using OIIO::TypeDesc;
 namespace {
 
 constexpr long MiB = 1L << 20;
-
-// OpenImageIO's own guards against headers that declare absurd sizes: some
-// readers check them in open(), before bumpbake sees the header. They are
-// process-wide, so they are only ever lowered, never raised.
-void lower_oiio_limits() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    int mb = 0, channels = 0;
-    const int our_mb = (int)(BB_MAX_READ_BYTES / MiB);
-    if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
-      OIIO::attribute("limits:imagesize_MB", our_mb);
-    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
-      OIIO::attribute("limits:channels", 64);
-  });
-}
 
 // OIIO's refusal under its limits spans two lines and tells the reader to
 // raise an OIIO attribute, which a bumpbake user cannot: keep the first line.
@@ -160,7 +146,7 @@ opened_input open_input(const char *path, bool reading, bb_status *st, bb_error 
   opened_input opened;
   opened.file = open_checked(path, reading, st, err);
   if (!opened.file) return opened;
-  lower_oiio_limits();
+  bb::oiio_setup();
   (void)bb__png_hooks_set(); // links the hooks on libpng (png_hooks.c)
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
@@ -298,6 +284,24 @@ bb_status read_image(const char *path, int first, int count, int level, bb_image
 }
 
 } // namespace
+
+namespace bb {
+
+void oiio_setup() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    int mb = 0, channels = 0, exr_threads = 0;
+    const int our_mb = (int)(BB_MAX_READ_BYTES / MiB);
+    if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
+      OIIO::attribute("limits:imagesize_MB", our_mb);
+    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
+      OIIO::attribute("limits:channels", 64);
+    if (!OIIO::getattribute("exr_threads", exr_threads) || exr_threads != -1)
+      OIIO::attribute("exr_threads", -1);
+  });
+}
+
+} // namespace bb
 
 extern "C" {
 

@@ -7,6 +7,7 @@
 #include "io/formats.h"
 #include "io/oiio_calls.h"
 #include "io/oiio_guard.h"
+#include "io/oiio_setup.h"
 #include "io/oiio_proxy.h"
 #include "io/quantise.h"
 
@@ -149,6 +150,7 @@ extern "C" bb_status bb__oiio_write_image(const char *path, const bb_image *img,
                                           bb_range range, const char *description,
                                           bb_staged_file *f, bb_error *err) {
   return bb::guard(err, path, bb::WRITING, [&] {
+    bb::oiio_setup();
     return bb::write_staged(
         path,
         [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
