@@ -14,13 +14,14 @@
  * in OpenImageIO's open(). OpenImageIO offers no attribute for either and
  * never shows its png_struct; libpng's user may set both on the struct.
  *
- * How: the library defines png_set_error_fn itself (exported: the one
- * non-bb_ symbol of libbumpbake.so). OpenImageIO's call reaches it first,
- * since the program, or libbumpbake.so ahead of its own dependencies, comes
- * before libpng in the dynamic linker's search order, right after it
- * created the struct. It passes the call on to libpng's (dlsym RTLD_NEXT)
- * and, for structs whose call comes from OpenImageIO (dladdr of the return
- * address), wraps the handler so that after it returns the wrapper does what
+ * How: the library defines png_set_error_fn (OpenImageIO's PNG reader
+ * calls it right after creating its struct) and png_create_write_struct
+ * (its writer passes its handlers there) itself: exported, the two non-bb_
+ * symbols of libbumpbake.so. OpenImageIO's calls reach them first, since
+ * the program, or libbumpbake.so ahead of its own dependencies, comes
+ * before libpng in the dynamic linker's search order. They pass the call on
+ * to libpng's (dlsym RTLD_NEXT) and, for calls from OpenImageIO (dladdr of
+ * the return address), wrap the handler so that after it returns the wrapper does what
  * libpng does, png_longjmp(), minus the print, and sets allocation
  * functions (png_set_mem_fn; the C heap, as libpng's own) that refuse any
  * single allocation over BB__MAX_CHUNK_BYTES: libpng then skips an
@@ -125,6 +126,28 @@ void PNGAPI png_set_error_fn(png_structrp png, png_voidp error_ptr, png_error_pt
   }
   real(png, error_ptr, error_fn ? wrapped(error_fn) : NULL, warning_fn);
   png_set_mem_fn(png, NULL, bounded_malloc, heap_free);
+}
+
+/* OpenImageIO's PNG writer hands its handlers to png_create_write_struct
+ * and never calls png_set_error_fn: the same hooks, at creation. */
+typedef png_structp(PNGAPI *create_write_t)(png_const_charp, png_voidp, png_error_ptr,
+                                            png_error_ptr);
+
+png_structp PNGAPI png_create_write_struct(png_const_charp version, png_voidp error_ptr,
+                                           png_error_ptr error_fn, png_error_ptr warning_fn) {
+  static _Atomic(create_write_t) libpngs;
+  create_write_t real = atomic_load(&libpngs);
+  if (!real) {
+    void *found = dlsym(RTLD_NEXT, "png_create_write_struct");
+    *(void **)&real = found;
+    if (!real) return NULL; /* no libpng after us: nothing calls this */
+    atomic_store(&libpngs, real);
+  }
+  if (!in_openimageio(__builtin_return_address(0)))
+    return real(version, error_ptr, error_fn, warning_fn);
+  png_structp png = real(version, error_ptr, error_fn ? wrapped(error_fn) : NULL, warning_fn);
+  if (png) png_set_mem_fn(png, NULL, bounded_malloc, heap_free);
+  return png;
 }
 
 

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/inotify.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -335,5 +336,66 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
   cr_log_info("%d of 5 written; the watcher replaced %d files and %d directories", written,
               p.files, p.dirs);
   bb_mip_chain_free(levels, count_made);
+  bb_image_free(&img);
+}
+
+/* Short of memory, a PNG write fails somewhere inside OpenImageIO's writer:
+ * then libpng's own "libpng error: No IDATs written into file" reached
+ * stderr (36 of 80 bakes under `ulimit -v` 534..546 MB), since OpenImageIO
+ * gives its writer's handlers to png_create_write_struct. Each write here
+ * runs in a child whose data (RLIMIT_DATA: address space would count
+ * reserved arenas) may grow by a margin, the margins spanning the write's
+ * needs, with stderr on a file. */
+static size_t data_bytes(void) {
+  FILE *f = fopen("/proc/self/status", "r");
+  char line[256];
+  size_t kib = 0;
+  while (f && fgets(line, sizeof line, f))
+    if (sscanf(line, "VmData: %zu kB", &kib) == 1) break;
+  if (f) fclose(f);
+  return kib * 1024;
+}
+
+Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
+#ifdef CHILD_CALL_ASAN
+  cr_skip_test("ASan's allocator does not fail like malloc under RLIMIT_DATA");
+#endif
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 2048, 2048, 4, NULL), BB_OK);
+  for (size_t i = 0; i < 2048u * 2048u * 4u; i++)
+    img.pixels[i] = (float)((i * 2654435761u) >> 8 & 255) / 255.0f;
+  const char *capture = tmp_path("stderr.txt");
+  int failed = 0, written = 0;
+  for (int margin_mib = 0; margin_mib <= 40; margin_mib += 1) {
+    fflush(NULL);
+    pid_t pid = fork();
+    cr_assert(pid >= 0);
+    if (pid == 0) {
+      int fd = open(capture, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+      dup2(fd, STDERR_FILENO);
+      alarm(30);
+      struct rlimit rl;
+      rl.rlim_cur = rl.rlim_max = data_bytes() + ((size_t)margin_mib << 20);
+      setrlimit(RLIMIT_DATA, &rl);
+      bb_error err = {{0}};
+      bb_status st = bb_image_write(tmp_path("short.png"), &img, NULL, &err);
+      if (st != BB_OK && (!err.message[0] || strchr(err.message, '\n'))) _exit(3);
+      _exit(st == BB_OK ? 0 : 1);
+    }
+    int status = 0;
+    cr_assert_eq(waitpid(pid, &status, 0), pid);
+    cr_assert(WIFEXITED(status), "margin %d MiB: killed by signal %d", margin_mib,
+              WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    cr_expect_neq(WEXITSTATUS(status), 3, "margin %d MiB: a bad message", margin_mib);
+    if (WEXITSTATUS(status) == 0) written++; else failed++;
+    FILE *f = fopen(capture, "r");
+    char said[512] = {0};
+    size_t n = f ? fread(said, 1, sizeof said - 1, f) : 0;
+    if (f) fclose(f);
+    cr_expect_eq(n, 0, "margin %d MiB: stderr got '%s'", margin_mib, said);
+  }
+  cr_log_info("%d writes failed short of memory, %d succeeded", failed, written);
+  cr_expect_gt(failed, 0, "no margin was short of memory");
+  cr_expect_gt(written, 0, "no margin was enough");
   bb_image_free(&img);
 }
