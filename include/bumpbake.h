@@ -68,8 +68,10 @@ extern "C" {
  * image): both the file's own samples (texels x channels x bytes per
  * sample, as its header declares them) and the floats decoded (texels x
  * channels read x 4) must fit, checked before anything is allocated. The
- * first read also lowers OpenImageIO's process-wide "limits:imagesize_MB"
- * to 1024 and "limits:channels" to 64 when they are higher. */
+ * first read or write also lowers OpenImageIO's process-wide
+ * "limits:imagesize_MB" to 1024 and "limits:channels" to 64 when they are
+ * higher, and sets its "exr_threads" to -1 (OpenEXR without its own thread
+ * pool, which crashed when started short of memory). */
 #define BB_MAX_READ_BYTES (1L << 30)
 
 /* Largest |height_scale x h| a bake accepts, in texels: scaled heights are
@@ -215,9 +217,13 @@ void bb_image_info_free(bb_image_info *info);
 
 /* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
  * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
- * Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not an image,
- * truncated, corrupt), BB_ERR_SIZE (zero, over BB_MAX_PIXELS or over
- * BB_MAX_READ_BYTES, refused before allocating). */
+ * The file must be a regular one (a FIFO, a device or a directory is
+ * refused at once) and is read through the descriptor that was checked.
+ * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
+ * BB_ERR_FORMAT (not an image, truncated, corrupt), BB_ERR_SIZE (zero,
+ * over BB_MAX_PIXELS or over BB_MAX_READ_BYTES, or tiles of more than 64
+ * MiB as floats, or a header whose reader would allocate more than
+ * BB_MAX_READ_BYTES to open it: all refused before allocating). */
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 
@@ -225,10 +231,13 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * bb_image_info holds, without decoding a pixel (fast on any size; a
  * truncated pixel stream is not noticed). width, height, channels and info
  * may each be NULL. Errors as bb_image_read, except that the size limits
- * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied
- * (the size is reported, not allocated; OpenImageIO's own limits, see
- * BB_MAX_READ_BYTES, may still refuse a header declaring more than 1 GiB of
- * samples). */
+ * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied to
+ * the image (its size is reported, not allocated). Some readers allocate
+ * from the header to open a file at all (a progressive JPEG's whole
+ * coefficients, a GIF's canvas, an OpenEXR's chunk buffers): that is
+ * refused past BB_MAX_READ_BYTES (64 MiB for one OpenEXR chunk) with
+ * BB_ERR_SIZE, and OpenImageIO's own limits, see BB_MAX_READ_BYTES, may
+ * refuse a header declaring more than 1 GiB of samples. */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
