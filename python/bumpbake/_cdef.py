@@ -252,6 +252,12 @@ typedef struct bb_render_options {
   int tile_x, tile_y;
   int crop_x, crop_y, crop_width, crop_height;
   int threads;
+  int view;
+  double view_azimuth;
+  double view_elevation;
+  int relief;
+  const bb_image *relief_height;
+  double relief_depth;
 } bb_render_options;
 
 typedef enum bb_render_map {
@@ -375,6 +381,8 @@ typedef struct bb_job_options {
   bb_depth depth;
   int mips;
   const char *basis_file;
+  const char *bounce_albedo_file;
+  const char *brightness_file;
   const char *paths[6];
   const char *prefix;
   const char *slope_path;
