@@ -5,7 +5,6 @@
 #include "common.h"
 #include "json.h"
 #include "options.h"
-#include "read.h"
 
 #include "bumpbake.h"
 
@@ -164,10 +163,8 @@ static int info_file(const info_args *a, const char *path, int index) {
   file_info f;
   memset(&f, 0, sizeof f);
   bb_error err = {{0}};
-  int muted = cli_mute_stderr();
   bb_status st =
       bb_image_read_info(path, &f.width, &f.height, &f.channels, &f.info, &err);
-  cli_unmute_stderr(muted);
   if (st != BB_OK) {
     report_error(a, path, &err);
     return BB_EXIT_FAILURE;

@@ -3,7 +3,6 @@
 #include "maps.h"
 #include "cli.h"
 #include "common.h"
-#include "read.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -36,7 +35,7 @@ int cli_maps_check_output(const char *command, const char *input, const char *ou
 
 int cli_maps_read(const char *path, bb_image *img, bb_image_info *info) {
   bb_error err = {{0}};
-  bb_status st = cli_read_image(path, img, info, &err);
+  bb_status st = bb_image_read(path, img, info, &err);
   return cli_status_exit(path, st, &err);
 }
 

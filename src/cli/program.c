@@ -3,7 +3,6 @@
 #include "cli.h"
 #include "common.h"
 #include "maps.h"
-#include "read.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -75,13 +74,6 @@ static int program_option(void *ctx, const cli_option *opt, const char *arg) {
   return cli_settings_apply(program_command.name, &a->settings, opt, arg);
 }
 
-/* bb_image_read with libpng's own messages muted, as for every command. */
-static bb_status quiet_loader(void *user, const char *path, bb_image *img,
-                              bb_image_info *info, bb_error *err) {
-  (void)user;
-  return cli_read_image(path, img, info, err);
-}
-
 /* The output must not replace any image the program reads: every one of
  * them, however many the program names (bb_outputs_check against all). */
 static int check_output_against_images(const program_args *a, const bb_program *program) {
@@ -139,7 +131,6 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   bb_program_options_init(&o);
   o.base_dir = a->base_dir;
   o.allow_outside_base = a->allow_outside_base;
-  o.loader = quiet_loader;
   bb_image out = {0};
   int is_normal = 0;
   bb_error err = {{0}};

@@ -5,7 +5,6 @@
 #include "common.h"
 #include "options.h"
 #include "progress.h"
-#include "read.h"
 #include "render_common.h"
 
 #include <limits.h>
@@ -487,7 +486,7 @@ static int load_albedo(const render_args *a, render_inputs *in) {
   if (!a->albedo_path)
     return 0;
   bb_error err = {{0}};
-  bb_status st = cli_read_image(a->albedo_path, &in->albedo, NULL, &err);
+  bb_status st = bb_image_read(a->albedo_path, &in->albedo, NULL, &err);
   if (st != BB_OK)
     return cli_status_exit(a->albedo_path, st, &err);
   const bb_image *size = in->view.normal ? in->view.normal : in->view.ssbump;
