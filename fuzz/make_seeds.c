@@ -172,7 +172,7 @@ static void load_seeds(const char *fixtures, const char *out) {
       unsigned char k;
     } depths[] = {{".png", BB_DEPTH_16, 0}, {".tif", BB_DEPTH_16, 2}, {".exr", BB_DEPTH_HALF, 3}};
     for (size_t i = 0; i < sizeof depths / sizeof depths[0]; i++) {
-      bb_write_options o = {depths[i].depth, BB_RANGE_UNIT, "seed"};
+      bb_write_options o = {depths[i].depth, BB_RANGE_UNIT, "seed", NULL};
       char name[64];
       snprintf(tmp, sizeof tmp, "%s/seed%s", out, depths[i].ext);
       snprintf(name, sizeof name, "depth%d%s", c, depths[i].ext);
@@ -451,6 +451,63 @@ static void mesh_seeds(const char *fixtures, const char *out) {
   write_seed(dir, "quad.dae", &dae_lead, 1, SEED_DAE, sizeof SEED_DAE - 1);
 }
 
+/* Text seeds, one file per string: fuzz_basis's basis files and
+ * fuzz_program's image programs (the images it names are the target's). */
+static void text_seeds(const char *out, const char *name, const char *const *texts,
+                       size_t n) {
+  char dir[1024];
+  make_dir(out, name, dir, sizeof dir);
+  for (size_t i = 0; i < n; i++) {
+    char file[32];
+    snprintf(file, sizeof file, "seed%zu", i);
+    write_seed(dir, file, texts[i], strlen(texts[i]), NULL, 0);
+  }
+}
+
+static void basis_seeds(const char *out) {
+  static const char *const texts[] = {
+      "# Half-Life 2's basis\n0.816497 0 0.57735\n-0.408248 0.707107 0.57735\n"
+      "-0.408248 -0.707107 0.57735\n",
+      "1 0 1\n0 1 1\n-1 0 1\n0 -1 1\n",
+      "1, 0, 0.5\n0, 1, 0.5 # comma separated\n-1, -1, 0.5\n",
+      "0 0 1\n0 0 1\n1 0 0\n",
+      "1e308 0 1\nnan 0 1\n0 inf 1\n"};
+  text_seeds(out, "basis", texts, sizeof texts / sizeof texts[0]);
+}
+
+static void program_seeds(const char *out) {
+  static const char *const texts[] = {
+      "heightmap(a.png, 4)",
+      "addnormals(heightmap(a.png, 2), heightmap(d.tif, 8))",
+      "smoothnormals(heightmap(c.exr, 1))",
+      "add(b.tga, scale(c.exr, 0.5, 0.5, 0.5, 1))",
+      "invertColor(makeIntensity(e.png))",
+      "makeAlpha(invertAlpha(b.tga))",
+      "addnormals(_flat, heightmap(e.png, 3))",
+      "heightmap(../outside.png, 4)"};
+  text_seeds(out, "program", texts, sizeof texts / sizeof texts[0]);
+}
+
+/* fuzz_print: a leading byte (how many of the last bytes name the file),
+ * then a description: bumpbake's own provenance, another tool's, and one
+ * with an escape sequence, a bidi override and a C1 control in it. */
+static void print_seeds(const char *out) {
+  static const char *const texts[] = {
+      "\x04" "bumpbake 0.2.0\nkind: ssbump\ncommand: bumpbake bake h.png --scale 4\n"
+      "input: h.png sha256:00\nbasis: hl2\n_name",
+      "\x00" "Created with GIMP",
+      "\x03" "kind: normal\ncommand: \x1b]0;title\x07 \xe2\x80\xae evil \xc2\x9b 31m\nred"};
+  char dir[1024];
+  make_dir(out, "print", dir, sizeof dir);
+  for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+    char file[32];
+    snprintf(file, sizeof file, "seed%zu", i);
+    /* The second seed's leading byte is a NUL: strlen would stop at it. */
+    size_t n = i == 1 ? 1 + strlen(texts[i] + 1) : strlen(texts[i]);
+    write_seed(dir, file, texts[i], n, NULL, 0);
+  }
+}
+
 int main(int argc, char **argv) {
 
   if (argc != 3) {
@@ -466,5 +523,8 @@ int main(int argc, char **argv) {
   provenance_seeds(argv[1], argv[2]);
   cli_seeds(argv[2]);
   mesh_seeds(argv[1], argv[2]);
+  basis_seeds(argv[2]);
+  program_seeds(argv[2]);
+  print_seeds(argv[2]);
   return 0;
 }
