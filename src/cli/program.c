@@ -34,7 +34,8 @@ static const cli_option opt_allow_outside = {
     .help = "read images outside --base too (absolute paths, .., links out)"};
 
 static const cli_option *const program_options[] = {
-    &opt_output, &opt_base, &opt_allow_outside, &opt_depth, &cli_opt_mips, &cli_opt_help};
+    &opt_output, &opt_base, &opt_allow_outside, &opt_depth, &cli_opt_mips, CLI_TEXTURE_OPTIONS,
+    &cli_opt_help};
 
 static const cli_command program_command = {
     "program",
@@ -96,7 +97,8 @@ static int check_output_against_images(const program_args *a, const bb_program *
       if (len >= 0 && (size_t)len < sizeof paths[n])
         reads[n] = paths[n], n++;
     }
-    const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
+    const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0,
+                                 0, 0, BB_RANGE_UNIT, &a->settings.texture};
     bb_error err = {{0}};
     bb_status st = bb_outputs_check(&spec, 1, reads, n, &err);
     rc = st == BB_OK ? 0 : cli_library_error(program_command.name, st, &err);
@@ -143,7 +145,7 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   const char *kind = is_normal ? "normal" : "colour";
   int rc = cli_maps_write(run, text, NULL, kind, a->output, &out,
                           is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth,
-                          a->settings.mips);
+                          a->settings.mips, &a->settings.texture);
   if (!rc)
     cli_printf_line("wrote %s %s", kind, a->output);
   bb_image_free(&out);

@@ -1,9 +1,11 @@
-/* formats.c: the formats bumpbake writes (.png .tga .tif .tiff .exr), the
- * depths and channel counts each holds, and the checks of a write before
- * any encoder runs. No OpenImageIO here: these are bumpbake's rules. */
+/* formats.c: the formats bumpbake writes (.png .tga .tif .tiff .exr, and
+ * the engine textures .vtf .dds), the depths and channel counts each
+ * holds, and the checks of a write before any encoder runs. No OpenImageIO
+ * here: these are bumpbake's rules. */
 #include "io/formats.h"
 #include "core/internal.h"
 #include "io/oiio.h"
+#include "io/texture.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -66,20 +68,29 @@ static const format_rule *find_format(const char *path) {
   return NULL;
 }
 
-int bb_path_is_writable_format(const char *path) { return find_format(path) != NULL; }
+/* The engine textures (texture.c) choose their samples by texture format,
+ * hold 4 channels and carry their own mip chain. */
+static int is_texture(const char *path) { return bb_path_is_texture_format(path); }
+
+int bb_path_is_writable_format(const char *path) {
+  return find_format(path) != NULL || is_texture(path);
+}
 
 int bb_path_supports_depth(const char *path, bb_depth depth) {
+  if (is_texture(path)) return depth == BB_DEPTH_DEFAULT;
   const format_rule *f = find_format(path);
   return f && (depth == BB_DEPTH_DEFAULT ||
                ((unsigned)depth < 32 && (f->allowed & BIT((unsigned)depth)) != 0));
 }
 
 int bb_path_max_channels(const char *path) {
+  if (is_texture(path)) return 4;
   const format_rule *f = find_format(path);
   return f ? f->max_channels : 0;
 }
 
 int bb__path_holds_mips(const char *path) {
+  if (is_texture(path)) return 1;
   const format_rule *f = find_format(path);
   return f && f->holds_mips;
 }
@@ -120,7 +131,32 @@ static bb_status resolve_depth(const char *path, const format_rule *f, const bb_
   return BB_OK;
 }
 
-static const bb_write_options DEFAULT_OPTIONS = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
+static const bb_write_options DEFAULT_OPTIONS = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
+
+void bb__texture_options_of(const bb_write_options *options, bb_texture_options *out) {
+  const bb_write_options *o = options ? options : &DEFAULT_OPTIONS;
+  if (o->texture) {
+    *out = *o->texture;
+  } else {
+    bb_texture_options_init(out);
+    out->map = o->range == BB_RANGE_SIGNED ? BB_TEXTURE_MAP_NORMAL : BB_TEXTURE_MAP_PLAIN;
+  }
+  if (o->description) out->description = o->description;
+}
+
+/* A texture's checks: no sample depth to choose, then bb_texture_check's. */
+static bb_status texture_check(const char *path, const bb_image *top,
+                               const bb_write_options *o, bb_error *err) {
+  char ext[16];
+  if (o->depth != BB_DEPTH_DEFAULT)
+    return bb__fail(err, BB_ERR_FORMAT,
+                    "%s: %s samples cannot be chosen for %s files: their texture format "
+                    "sets them",
+                    path, depth_name(o->depth), (bb__extension_of(path, ext, sizeof ext), ext));
+  bb_texture_options t;
+  bb__texture_options_of(o, &t);
+  return bb_texture_check(path, top->width, top->height, top->channels, &t, err);
+}
 
 bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_options *options,
                           bb_depth *depth, bb_error *err) {
@@ -129,13 +165,16 @@ bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_
   if (st != BB_OK) return st;
   st = check_options(path, o, err);
   if (st != BB_OK) return st;
+  *depth = BB_DEPTH_DEFAULT;
+  if (is_texture(path)) return texture_check(path, img, o, err);
   const format_rule *f = find_format(path);
   if (!f) {
     char ext[sizeof err->message];
     bb__extension_of(path, ext, sizeof ext);
     return bb__fail(err, BB_ERR_FORMAT,
-                    "%s: unknown output format '%s' (use .png, .tga, .tif, .tiff or .exr)", path,
-                    ext);
+                    "%s: unknown output format '%s' (use .png, .tga, .tif, .tiff, .exr, .vtf "
+                    "or .dds)",
+                    path, ext);
   }
   return resolve_depth(path, f, o, img->channels, depth, err);
 }
@@ -168,9 +207,12 @@ bb_status bb__write_mips_check(const char *path, const bb_image *levels, int cou
   if (st != BB_OK) return st;
   st = check_options(path, o, err);
   if (st != BB_OK) return st;
+  *depth = BB_DEPTH_DEFAULT;
+  if (is_texture(path)) return texture_check(path, &levels[0], o, err);
   const format_rule *f = find_format(path);
   if (!f || !f->holds_mips)
-    return bb__fail(err, BB_ERR_FORMAT, "%s: mip maps need a .tif, .tiff or .exr file", path);
+    return bb__fail(err, BB_ERR_FORMAT,
+                    "%s: mip maps need a .tif, .tiff, .exr, .vtf or .dds file", path);
   return resolve_depth(path, f, o, levels[0].channels, depth, err);
 }
 

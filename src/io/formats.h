@@ -19,7 +19,7 @@ void bb__extension_of(const char *path, char *out, size_t cap);
 /* 1 when the extension of path (any case) is ext ("exr", without the dot). */
 int bb__path_has_extension(const char *path, const char *ext);
 
-/* 1 when path's format can hold a mip chain (.tif, .tiff, .exr). */
+/* 1 when path's format can hold a mip chain (.tif, .tiff, .exr, .vtf, .dds). */
 int bb__path_holds_mips(const char *path);
 
 /* Everything bb_image_write checks before encoding: the image (not empty),
@@ -34,6 +34,11 @@ bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_
 bb_status bb__write_mips_check(const char *path, const bb_image *levels, int count,
                                const bb_write_options *options, bb_depth *depth,
                                bb_error *err);
+
+/* The texture options a write of a .vtf or .dds uses: options->texture's
+ * (or the defaults, with the map NORMAL for BB_RANGE_SIGNED), with
+ * options->description when it has one. */
+void bb__texture_options_of(const bb_write_options *options, bb_texture_options *out);
 
 /* The name of channel c of an image of `count` channels: NULL when count <=
  * 4 (OpenImageIO's R, G, B, A stay), else "B" and c zero-padded to the

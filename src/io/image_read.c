@@ -6,9 +6,45 @@
 #include "io/formats.h"
 #include "io/oiio.h"
 #include "io/oiio_calls.h"
+#include "io/texture.h"
+#include "io/vtf.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* OpenImageIO has no VTF reader: its header is read here (vtf.c), and its
+ * pixels are not read at all. */
+static bb_status refuse_vtf_pixels(const char *path, bb_error *err) {
+  return bb__fail(err, BB_ERR_FORMAT,
+                  "%s: VTF textures are written, not read, by bumpbake (info reads their "
+                  "header; compare the image they were made from)",
+                  path);
+}
+
+/* A VTF's header as bb_image_read_info reports an image's. */
+static bb_status read_vtf_info(const char *path, int *width, int *height, int *channels,
+                               bb_image_info *info, bb_error *err) {
+  bb_vtf_info v;
+  bb_status st = bb_vtf_read_info(path, &v, err);
+  if (st != BB_OK) return st;
+  const int alpha = v.format == BB__VTF_DXT5 || v.format == BB__VTF_BGRA8888 ||
+                    v.format == BB__VTF_RGBA16161616F ||
+                    (v.flags & BB_VTF_FLAG_EIGHTBITALPHA) != 0;
+  if (width) *width = v.width;
+  if (height) *height = v.height;
+  if (channels) *channels = alpha ? 4 : 3;
+  if (info) {
+    info->alpha_channel = alpha ? 3 : -1;
+    info->is_float = v.format == BB__VTF_RGBA16161616F;
+    info->bits_per_sample = info->is_float ? 16 : 8;
+    snprintf(info->format_name, sizeof info->format_name, "vtf");
+    info->description = v.description;
+    v.description = NULL;
+  }
+  bb_vtf_info_free(&v);
+  return BB_OK;
+}
 
 static void clear_info(bb_image_info *info) {
   if (!info) return;
@@ -36,6 +72,7 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info, bb
   memset(out, 0, sizeof *out);
   clear_info(info);
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read: path is NULL");
+  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
   return finish_read(bb__oiio_read(path, 0, -1, 0, out, info, NULL, err), out, info);
 }
 
@@ -46,6 +83,7 @@ bb_status bb__image_read_channels(const char *path, int first_channel, int chann
   clear_info(info);
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_channels: path is NULL");
   if (channel_count < 1) return bb__fail(err, BB_ERR_ARGUMENT, "%s: no channel to read", path);
+  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
   return finish_read(bb__oiio_read(path, first_channel, channel_count, 0, out, info, NULL, err),
                      out, info);
 }
@@ -57,6 +95,7 @@ bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image
   clear_info(info);
   if (level_count) *level_count = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: path is NULL");
+  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
   int levels = 0; /* counted whatever the caller asks: a level past the last is an error */
   bb_status st = bb__oiio_read(path, 0, -1, level, out, info, &levels, err);
   if (level_count) *level_count = levels;
@@ -70,6 +109,8 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
   if (height) *height = 0;
   if (channels) *channels = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_info: path is NULL");
+  if (bb__texture_container(path) == BB__CONTAINER_VTF)
+    return read_vtf_info(path, width, height, channels, info, err);
   bb_status st = bb__oiio_read_header(path, width, height, channels, info, err);
   if (st != BB_OK) bb_image_info_free(info);
   return st;

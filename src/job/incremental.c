@@ -189,8 +189,10 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
   if (bb_image_read_info(path, NULL, NULL, NULL, &info, &why) != BB_OK) {
     say(reason, cap, "%s", why.message);
   } else {
+    /* A texture's layout (format, mips, VTF flags) is in its provenance. */
     if (provenance_matches(&info, want, reason, cap) &&
-        layout_matches(path, &info, depth, mip_mapped, reason, cap))
+        (bb_path_is_texture_format(path) ||
+         layout_matches(path, &info, depth, mip_mapped, reason, cap)))
       *state = BB_OUTPUT_CURRENT;
     bb_image_info_free(&info);
   }

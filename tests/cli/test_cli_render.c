@@ -232,7 +232,7 @@ Test(cli_render, usage_errors) {
 Test(cli_render, tiles_over_the_maximum) {
   bb_image h;
   cr_assert_eq(bb_image_alloc(&h, 1025, 1025, 1, NULL), BB_OK);
-  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL};
+  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   cli_result r =

@@ -119,7 +119,7 @@ static bb_image make_image(int w, int h, int c, float lo, float hi, uint32_t see
 }
 
 static bb_write_options options(bb_depth depth, bb_range range, const char *description) {
-  bb_write_options o = {depth, range, description};
+  bb_write_options o = {depth, range, description, NULL};
   return o;
 }
 

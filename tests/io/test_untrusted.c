@@ -182,7 +182,7 @@ static unsigned char *noise_png(size_t *size) {
     s = s * 1664525u + 1013904223u;
     img.pixels[i] = (float)(s >> 8) / 16777216.0f;
   }
-  bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL};
+  bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(tmp_path("noise.png"), &img, &o, NULL), BB_OK);
   bb_image_free(&img);
   FILE *f = fopen(tmp_path("noise.png"), "rb");

@@ -88,7 +88,7 @@ static void fixture_init(fixture *f) {
 static void write_output(const char *path, const char *description, bb_depth depth) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 3, NULL), BB_OK);
-  bb_write_options wo = {depth, BB_RANGE_SIGNED, description};
+  bb_write_options wo = {depth, BB_RANGE_SIGNED, description, NULL};
   bb_error err;
   cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
