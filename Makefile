@@ -130,8 +130,9 @@ LIB_MAP  := src/libbumpbake.map
 BIN      := $(BUILD)/bumpbake
 TESTBIN  := $(BUILD)/bb_tests
 TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
-# The CLI linked other ways, for `make bench`'s start-up comparison only.
-BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
+# The CLI linked other ways, for `make bench`'s start-up comparison, and the
+# Criterion suite, whose trench test section 10 (tools/bench_bounce.sh) reads.
+BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-circles check-docs bench goldens docs docs-reference install \

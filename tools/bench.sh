@@ -12,8 +12,12 @@
 # 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
 # (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
 # libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
-# one process against one process each), then a summary table. Everything it writes goes into
-# build/bench/.
+# one process against one process each), 9 engine textures (tools/bench_blocks.sh:
+# block compression's PSNR and worst error per format and map, libsquish
+# against nvcompress, and the time of a 2048 x 2048 VTF DXT1 with mips against
+# PNG), 10 inter-reflection (tools/bench_bounce.sh: bake --bounce against a
+# path tracer and exact radiosity, and its cost), then a summary table.
+# Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
 # and the median is reported, otherwise it is run once; each figure says
@@ -29,6 +33,12 @@
 #   BENCH_PEER_DIR=DIR     valve-embree sources (../shared/peers/valve-embree)
 #   BENCH_LARGE=0          skip section 6 (4096 and 8192 texels square)
 #   BENCH_ACCURACY=0       skip section 5
+#   BENCH_BLOCKS=0         skip section 9
+#   BENCH_BOUNCE=0         skip section 10 (its path-traced references take
+#                          many minutes the first time; BOUNCE_* as in
+#                          tools/bench_bounce.sh)
+#   BENCH_SECTIONS="9 10"  run only the sections listed (default: every one);
+#                          the summary then has only their figures
 #
 # Exits 0 whatever the ratios and whether or not the peer could be built;
 # exits 1 when bumpbake itself fails or its paths disagree on a horizon.
@@ -50,11 +60,15 @@ subset=${BENCH_SUBSET:-2000}
 target_trace=3 target_whole=20 target_brute=20
 failures=() # bumpbake-side failures: they make the bench exit 1
 peer_ok=0 peer_reason="not tried"
+bake_ok=0 clamp_ok=0 startup_ok=0 batch_ok=0 blocks_ok=0 bounce_ok=0
+ratio_rows=() acc_rows=() large_rows=()
 start_all=$(date +%s.%N)
 
 # ------------------------------------------------------------------ helpers
 
 section() { printf '\n== %s ==\n' "$*"; }
+# want N: section N is to run (BENCH_SECTIONS lists it, or is unset).
+want() { [ -z "${BENCH_SECTIONS:-}" ] || [[ " $BENCH_SECTIONS " == *" $1 "* ]]; }
 now() { date +%s.%N; }
 fail() { failures+=("$*"); echo "bench: FAILED: $*" >&2; }
 
@@ -176,6 +190,7 @@ echo "machine: $(nproc) cores, $(sed -n 's/^model name[[:space:]]*: //p' /proc/c
 echo "maps: rock = $rock (scale $rock_scale), noise = $noise (genheight noise, scale $noise_scale)"
 echo "rays $rays per texel ($(( $(printf '%.0f' "$(calc "sqrt($rays)" %.3f)") )) slices), bias $bias;" \
   "a figure is the median of 3 runs when a run takes under ${repeat_under} s, else 1 run"
+[ -z "${BENCH_SECTIONS:-}" ] || echo "sections: $BENCH_SECTIONS (BENCH_SECTIONS)"
 
 # ---------------------------------------------------------- 1. trace bench
 
@@ -202,6 +217,7 @@ trace_row() {
     "$(mib "$(json_num maxrss_kib "$j")")"
 }
 
+if want 1; then
 section "1. Trace benchmark (build/tools/bench_trace)"
 echo "bb_trace_occlusion (line sweeps) over every texel; then every slice's horizon at $subset texels"
 echo "one at a time on 1 thread, by the max-mip march and by brute force, and each of those texels"
@@ -219,6 +235,7 @@ echo "(trace_s: median over 'runs' runs; Mhor/s = texels x slices / trace_s; tr/
 echo "horizons/s over brute-force horizons/s; horizon = share of positive horizons; diff/reg ="
 echo "march vs brute-force disagreements / region texels differing from the whole trace, both 0"
 echo "when the paths agree; MiB = peak RSS of the process)"
+fi # section 1
 
 # ----------------------------------------------------------------- 2. peer
 
@@ -294,6 +311,7 @@ peer_row() {
     "$(mib "$(med "$n" @rss)")" "$(runs_text "$n")"
 }
 
+if want 2; then
 section "2. Peer: valve-embree (Valve's method on Intel Embree 3)"
 build_peer
 if [ "$peer_ok" = 1 ]; then
@@ -319,9 +337,13 @@ if [ "$peer_ok" = 1 ]; then
 else
   echo "peer: not available ($peer_reason)"
 fi
+else
+  peer_reason="section 2 not run (BENCH_SECTIONS)"
+fi # section 2
 
 # ------------------------------------------------------------ 3. full bake
 
+if want 3; then
 section "3. Full bake: bumpbake bake rock, every output, $threads threads"
 # full_cmd ARRAY PREFIX [options]: sets ARRAY to the whole bake of rock, every
 # output under PREFIX
@@ -368,11 +390,12 @@ if [ "$bake_ok" = 1 ]; then
     echo "peer: not available ($peer_reason)"
   fi
 fi
+fi # section 3
 
 # --------------------------------------------------------------- 4. ratios
 
+if want 4; then
 section "4. Ratios (information only; the bench passes whatever they are)"
-ratio_rows=()
 # add_ratio NAME VALUE TARGET
 add_ratio() { ratio_rows+=("$(printf '%-50s %8s   >= %-4s %s' "$1" "$2" "$3" "$(verdict "$2" "$3")")"); }
 for m in "${maps[@]}"; do
@@ -397,12 +420,12 @@ printf '%-50s %8s   %-7s %s\n' ratio value target ""
 printf '%s\n' "${ratio_rows[@]}"
 [ "$peer_ok" = 1 ] || echo "peer: not available ($peer_reason); its ratios are left out"
 echo "(brute force runs on 1 thread; the $threads-thread ratio includes the parallel speed-up)"
+fi # section 4
 
 # ------------------------------------------------------------- 5. accuracy
 
 acc=$out/accuracy
 acc_ok=0
-acc_rows=()
 
 # acc_maps: the 256 x 256 maps, as NAME:PATH:SCALE words.
 acc_maps() {
@@ -446,8 +469,10 @@ acc_row() {
   printf '%s\n' "$line"
 }
 
-section "5. Accuracy against converged references (256 x 256 maps)"
-if [ "${BENCH_ACCURACY:-1}" = 0 ]; then
+want 5 && section "5. Accuracy against converged references (256 x 256 maps)"
+if ! want 5; then
+  :
+elif [ "${BENCH_ACCURACY:-1}" = 0 ]; then
   echo "skipped (BENCH_ACCURACY=0)"
 elif ! command -v oiiotool >/dev/null; then
   echo "skipped: oiiotool (openimageio-tools) is needed to downsample the maps"
@@ -508,15 +533,16 @@ fi
 
 # ---------------------------------------------------------- 6. large sizes
 
-large_rows=()
 # large_run NAME INPUT: a whole bake (ssbump and ao as PNG) of INPUT, once
 large_run() {
   measure "large_$1" "$bin" bake "$2" --scale "$rock_scale" --rays "$rays" --threads "$threads" \
     --json -q --ssbump "$out/large_$1_ssbump.png" --ao "$out/large_$1_ao.png"
 }
 
-section "6. Large sizes: rock06 tiled, ssbump and ao, $threads threads"
-if [ "${BENCH_LARGE:-1}" = 0 ]; then
+want 6 && section "6. Large sizes: rock06 tiled, ssbump and ao, $threads threads"
+if ! want 6; then
+  :
+elif [ "${BENCH_LARGE:-1}" = 0 ]; then
   echo "skipped (BENCH_LARGE=0)"
 elif ! command -v oiiotool >/dev/null; then
   echo "skipped: oiiotool (openimageio-tools) is needed to tile the map"
@@ -547,6 +573,7 @@ fi
 
 # ------------------------------------------------------------- 7. start-up
 
+if want 7; then
 section "7. Start-up: bumpbake --version, the CLI linked three ways"
 echo "static: build/bumpbake as built (libbumpbake.a); early: the same with OpenImageIO's"
 echo "heaviest libraries named first (make EARLY_LINK=1); shared: linked to libbumpbake.so."
@@ -563,11 +590,12 @@ else
 fi
 # startup_field NAME COLUMN: a column of bench_startup's row for NAME.
 startup_field() { awk -v n="$1" -v c="$2" '$1 == n { print $c }' "$out/startup.txt"; }
+fi # section 7
 
 # ------------------------------------------------------------- 8. batches
 
+if want 8; then
 section "8. Batches: 20 bakes of 256 x 256 in one process against one process each"
-batch_ok=0
 if tools/bench_batch.sh -n 20 -r 3 "$bin" | tee "$out/batch.txt"; then
   batch_ok=1
 else
@@ -575,6 +603,51 @@ else
 fi
 # batch_field LABEL_START COLUMN: a column (counted from the end) of bench_batch's row.
 batch_field() { awk -v l="$1" -v c="$2" 'index($0, l) == 1 { print $(NF - c) }' "$out/batch.txt"; }
+fi # section 8
+
+# ------------------------------------------------------ 9. engine textures
+
+# NVIDIA Texture Tools' nvcompress, the peer of section 9: one attempt at
+# installing it, as install_embree.
+install_nvtt() {
+  local sudo=()
+  if [ "$(id -u)" != 0 ]; then
+    command -v sudo >/dev/null || return 1
+    if [ -t 0 ]; then sudo=(sudo); else sudo=(sudo -n); fi
+  fi
+  echo "blocks: nvcompress missing; trying apt-get install -y libnvtt-bin"
+  ${sudo[@]+"${sudo[@]}"} env DEBIAN_FRONTEND=noninteractive apt-get install -y libnvtt-bin \
+    >"$out/nvtt_install.log" 2>&1
+}
+
+if want 9; then
+  section "9. Engine textures: block compression's quality and time (tools/bench_blocks.sh)"
+  if [ "${BENCH_BLOCKS:-1}" != 0 ] && ! command -v nvcompress >/dev/null; then
+    install_nvtt || echo "blocks: apt-get install libnvtt-bin failed (see $out/nvtt_install.log)"
+  fi
+  if [ "${BENCH_BLOCKS:-1}" = 0 ]; then
+    echo "skipped (BENCH_BLOCKS=0)"
+  elif tools/bench_blocks.sh "$bin" "$out/blocks" | tee "$out/blocks.txt"; then
+    blocks_ok=1
+  else
+    fail "tools/bench_blocks.sh failed"
+  fi
+fi
+# blocks_field PATTERN COLUMN: a column of the first line of bench_blocks' output matching PATTERN.
+blocks_field() { awk -v p="$1" -v c="$2" '$0 ~ p { print $c; exit }' "$out/blocks.txt"; }
+
+# ------------------------------------------------------ 10. inter-reflection
+
+if want 10; then
+  section "10. Inter-reflection: bake --bounce against a path tracer (tools/bench_bounce.sh)"
+  if [ "${BENCH_BOUNCE:-1}" = 0 ]; then
+    echo "skipped (BENCH_BOUNCE=0)"
+  elif tools/bench_bounce.sh "$bin" | tee "$out/bounce.txt"; then
+    bounce_ok=1
+  else
+    fail "tools/bench_bounce.sh failed"
+  fi
+fi
 
 # -------------------------------------------------------------- summary
 
@@ -583,6 +656,7 @@ summary_row() { printf '%-46s %14s  %s\n' "$1" "$2" "${3:-}"; }
 section "Summary"
 summary_row figure value note
 for m in "${maps[@]}"; do
+  want 1 || continue
   for t in 1 "$threads"; do
     j=$out/trace_${m}_t$t.json
     summary_row "bumpbake trace, $m, $t thr (s)" "$(calc "$(json_num trace_s "$j")")" \
@@ -608,7 +682,7 @@ fi
 if [ "$peer_ok" = 1 ]; then
   summary_row "peer whole run, rock (s)" "$(calc "$(med peer_rock @wall)")" \
     "$(runs_text peer_rock), peak $(mib "$(med peer_rock @rss)") MiB"
-else
+elif want 2; then
   summary_row "peer" "not available" "$peer_reason"
 fi
 if [ "$startup_ok" = 1 ]; then
@@ -625,6 +699,22 @@ if [ "$batch_ok" = 1 ]; then
   summary_row "batch per file, all up to date (s)" "$(batch_field "batch, all up to date" 1)" \
     "x$(batch_field "batch, all up to date" 0)"
 fi
+if [ "$blocks_ok" = 1 ]; then
+  summary_row "ssbump VTF DXT1, rock06 1024 (PSNR dB)" \
+    "$(blocks_field '^squish +ssbump +vtf bc1' 6)" \
+    "worst $(blocks_field '^squish +ssbump +vtf bc1' 8) codes of 255"
+  summary_row "normal DDS BC5, rock06 1024 (PSNR dB)" \
+    "$(blocks_field '^squish +normal +dds bc5' 6)" \
+    "mean angle $(blocks_field '^squish +normal +dds bc5' 10) deg"
+  summary_row "2048^2 ssbump: VTF DXT1 + mips (s)" "$(blocks_field '^vtf +[0-9]' 2)" \
+    "PNG $(blocks_field '^png ' 2) s; range fit $(blocks_field '^vtf --fast' 3) s"
+fi
+if [ "$bounce_ok" = 1 ]; then
+  # "  trench, converged: added A, exact E (+D)"
+  summary_row "bounce: light added on the trench floor" \
+    "$(awk '/trench, converged:/ { sub(",", "", $4); print $4; exit }' "$out/bounce.txt")" \
+    "exact $(awk '/trench, converged:/ { print $6; exit }' "$out/bounce.txt"); accuracy in section 10"
+fi
 if [ "${#acc_rows[@]}" -gt 0 ]; then
   echo
   printf '%-6s %-11s %-9s' map run reference
@@ -637,9 +727,11 @@ if [ "${#large_rows[@]}" -gt 0 ]; then
   printf '%-6s %7s %9s %11s %9s %11s %8s\n' size texels trace_s "trace_ns/tx" wall_s "wall_ns/tx" MiB
   printf '%s\n' "${large_rows[@]}"
 fi
-echo
-printf '%-50s %8s   %-7s %s\n' ratio value target ""
-printf '%s\n' "${ratio_rows[@]}"
+if [ "${#ratio_rows[@]}" -gt 0 ]; then
+  echo
+  printf '%-50s %8s   %-7s %s\n' ratio value target ""
+  printf '%s\n' "${ratio_rows[@]}"
+fi
 echo "bench took $(calc "$(now) - $start_all" %.0f) s; outputs in $out/"
 
 if [ "${#failures[@]}" -gt 0 ]; then

@@ -14,8 +14,10 @@
 # 0.5 + 0.5 N; 8-bit rounding alone gives ~58.9 dB and 0.5). For normal maps
 # also the mean and worst angle between decoded and true normals. Then the
 # same with NVIDIA Texture Tools' nvcompress (Debian's libnvtt-bin, if
-# installed) on the 8-bit PNG of each map, and the time to write a
-# 2048 x 2048 ssbump as VTF DXT1 with mips against writing it as PNG.
+# installed) on the 8-bit PNG of each map (its BC1 output differs from run
+# to run: one run each, so its rows move in the last digits), and the time
+# to write a 2048 x 2048 ssbump as VTF DXT1 with mips against writing it as
+# PNG, and nvcompress's time for the same DDS BC1 with mips.
 set -eu
 
 BIN=${1:-build/bumpbake}
@@ -72,9 +74,14 @@ if command -v nvcompress >/dev/null 2>&1; then
   "$TQ" write "$OUT/normal.exr" "$OUT/normal8.png" --map normal >/dev/null
   "$TQ" write "$OUT/ssbump.exr" "$OUT/ssbump8.png" >/dev/null
   "$TQ" write "$OUT/ao.exr" "$OUT/ao8.png" >/dev/null
+  # nvtt 2.0.8's BC4 encodes the alpha channel (a grey PNG's is 255
+  # everywhere): give it ao in every channel, alpha included.
+  oiiotool "$OUT/ao8.png" --ch 0,0,0,0 --chnames R,G,B,A -o "$OUT/ao8rgba.png"
   for job in "normal bc1" "normal bc3" "normal bc5" "ssbump bc1" "ssbump bc3" "ao bc4" "ao bc1"; do
     set -- $job
-    nvcompress -nomips -"$2" "$OUT/${1}8.png" "$OUT/${1}_nvtt_$2.dds" >/dev/null 2>&1
+    in=$OUT/${1}8.png
+    [ "$2" = bc4 ] && in=$OUT/ao8rgba.png
+    nvcompress -nomips -"$2" "$in" "$OUT/${1}_nvtt_$2.dds" >/dev/null 2>&1
     kind=plain
     [ "$1" = normal ] && kind=normal
     channels=
@@ -97,5 +104,17 @@ for target in "png" "vtf" "vtf --fast" "dds"; do
   t=$(for i in 1 2 3; do "$TQ" write "$OUT/ss2048.exr" "$OUT/ss2048.$ext" --map ssbump "$@"; done | median)
   printf '%-26s %s s  %s bytes\n' "$ext ${*:-}" "$t" "$(wc -c <"$OUT/ss2048.$ext")"
 done
+if command -v nvcompress >/dev/null 2>&1; then
+  "$TQ" write "$OUT/ss2048.exr" "$OUT/ss2048_8.png" >/dev/null
+  for target in "" "-fast"; do
+    t=$(for i in 1 2 3; do
+      s=$(date +%s.%N)
+      nvcompress $target -bc1 "$OUT/ss2048_8.png" "$OUT/ss2048_nvtt.dds" >/dev/null 2>&1
+      awk -v a="$(date +%s.%N)" -v b="$s" 'BEGIN { printf "%.3f\n", a - b }'
+    done | median)
+    printf '%-26s %s s  %s bytes\n' "dds nvcompress ${target:-}" "$t" "$(wc -c <"$OUT/ss2048_nvtt.dds")"
+  done
+fi
 echo "(png: 8-bit through OpenImageIO; vtf: DXT1 + 12 mip levels + low-res; dds: BC1 + mips;"
-echo " threads: all $(nproc) cores)"
+echo " threads: all $(nproc) cores; nvcompress: the whole process, from the 8-bit PNG, its own"
+echo " threads)"

@@ -7,8 +7,8 @@ header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
 update. Declarations are the header's as they are, in its order, comments
 dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
-BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 9), which cffi needs; the test
-checks those numbers too.
+BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 9; the VTF flags in decimal), which
+cffi needs; the test checks those numbers too.
 """
 
 # Types, in header order.
@@ -98,6 +98,31 @@ typedef struct bb_texture_options {
   uint32_t vtf_flags;
   const char *description;
 } bb_texture_options;
+
+typedef struct bb_vtf_info {
+  int version_major, version_minor;
+  int header_size;
+  int width, height, depth;
+  int frames, first_frame;
+  uint32_t flags;
+  float reflectivity[3];
+  float bump_scale;
+  int format;
+  char format_name[24];
+  int mip_count;
+  int low_res_format;
+  int low_res_width, low_res_height;
+  int resource_count;
+  long data_size;
+  char *description;
+} bb_vtf_info;
+
+typedef struct bb_vmt_options {
+  const char *materials_dir;
+  const char *bumpmap;
+  const char *basetexture;
+  int ssbump;
+} bb_vmt_options;
 
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0,
@@ -485,6 +510,14 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
                              bb_image_info *info, bb_error *err);
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const char *bb_depth_name(bb_depth depth);
+bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
+const char *bb_texture_format_name(bb_texture_format format);
+void bb_texture_options_init(bb_texture_options *options);
+int bb_path_is_texture_format(const char *path);
+bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
+void bb_vtf_info_free(bb_vtf_info *info);
+const char *bb_vtf_flag_name(int bit);
+bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
@@ -594,6 +627,12 @@ CONSTANTS = """
 #define BB_COMPARE_DIFFERENT_SIZE 3
 #define BB_JOB_MAX_OUTPUTS 9
 #define BB_JOB_DEFAULT_MAPS 13
+#define BB_VTF_FLAG_EIGHTBITALPHA 8192
+#define BB_VTF_FLAG_NORMAL 128
+#define BB_VTF_FLAG_NOMIP 256
+#define BB_VTF_FLAG_NOLOD 512
+#define BB_VTF_FLAG_ENVMAP 16384
+#define BB_VTF_FLAG_SSBUMP 134217728
 """
 
 # From the C library: the strings the library returns malloc'd

@@ -133,6 +133,64 @@ def _depth(depth):
     return _parse("bb_depth_parse", "bb_depth", depth, "depth")
 
 
+# -------------------------------------------------------- engine textures
+
+# The texture settings of write(), bake_file(), bake_files() and BakeJob,
+# named as the command line's options.
+TEXTURE_PARAMETERS = ("texture_format", "vtf_version", "vtf_flags", "nomip",
+                      "fast_compression")
+
+
+def _vtf_version(command, value):
+    """The VTF minor version of 3, "7.3", "3" or 7.3, as --vtf-version
+    reads it; the library refuses one it does not write."""
+    if isinstance(value, float):
+        value = repr(value)
+    if isinstance(value, str):
+        minor = value[2:] if value.startswith("7.") else value
+        if not minor.isdigit():
+            raise _argument_error(f"{command}: vtf_version must be 7.2, 7.3, 7.4 or 7.5 "
+                                  f"(got {value!r})")
+        value = int(minor)
+    return _int(command, "vtf_version", value)
+
+
+def _vtf_flags(command, value):
+    """TEXTUREFLAGS_* bits: an int, or text as --vtf-flags takes it ("0x4")."""
+    if isinstance(value, str):
+        try:
+            value = int(value, 0)
+        except ValueError:
+            raise _argument_error(f"{command}: vtf_flags needs a 32-bit number, e.g. 0x4 "
+                                  f"(got {value!r})") from None
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise TypeError(f"{command}: vtf_flags must be an int (got {value!r})")
+    if not 0 <= value <= 0xFFFFFFFF:
+        raise _argument_error(f"{command}: vtf_flags needs a 32-bit number, e.g. 0x4 "
+                              f"(got {value:#x})")
+    return value
+
+
+def _texture_options(command, texture_format=None, vtf_version=None, vtf_flags=None,
+                     nomip=False, fast_compression=False, out=None):
+    """A bb_texture_options of the CLI-named settings (None: the library's
+    default), filled into out (a bb_texture_options cdata) or a new one.
+    Names are parsed by the library; the rest is checked where it is used
+    (bb_texture_check), with its message."""
+    o = out if out is not None else _ffi.new("bb_texture_options *")
+    _lib.bb_texture_options_init(o)
+    if texture_format is not None:
+        o.format = _parse("bb_texture_format_parse", "bb_texture_format", texture_format,
+                          "texture_format")
+    if vtf_version is not None:
+        o.vtf_version = _vtf_version(command, vtf_version)
+    if vtf_flags is not None:
+        o.vtf_flags = _vtf_flags(command, vtf_flags)
+    o.mips = 0 if nomip else 1
+    o.fast = 1 if fast_compression else 0
+    return o
+
+
 # ---------------------------------------------------------------- arrays
 
 class _Image:

@@ -8,7 +8,7 @@ import typing
 
 from ._bake import _KINDS
 from ._common import (_Image, _argument_error, _array, _check, _depth, _ffi, _int, _lib,
-                      _path, _text)
+                      _path, _text, _texture_options)
 
 
 def read(path):
@@ -73,26 +73,76 @@ class ImageInfo:
     provenance: typing.Optional[dict]  # {key: value} when intact, else None
     description: typing.Optional[str]  # the stored text (provenance or another
                                        # tool's ImageDescription), or None
+    vtf: typing.Optional["VtfInfo"] = None  # a .vtf's header, else None
+
+
+@dataclasses.dataclass
+class VtfInfo:
+    """What a Source texture's (.vtf) header says (bb_vtf_read_info), as
+    `bumpbake info` prints it."""
+    version: str            # "7.2" ... "7.5"
+    header_size: int        # bytes, the resource dictionary included
+    width: int
+    height: int
+    depth: int
+    frames: int
+    first_frame: int
+    flags: int              # TEXTUREFLAGS_* bits
+    flag_names: list        # Valve's names of the bits set: ["SSBUMP"], ...
+    reflectivity: tuple     # (r, g, b)
+    bump_scale: float
+    format: int             # Valve's IMAGE_FORMAT_* code (13 = DXT1, 15 = DXT5, ...)
+    format_name: str        # "DXT1", "BGR888", ...
+    mip_count: int
+    low_res_format: int     # IMAGE_FORMAT_* of the low-resolution image, -1: none
+    low_res_width: int
+    low_res_height: int
+    resource_count: int     # 7.3 and up; 0 before
+    data_size: int          # bytes of image data the header declares
+
+
+def _vtf_info(path):
+    v = _ffi.new("bb_vtf_info *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_vtf_read_info(path, v, err), err)
+    try:
+        names = [_text(_lib.bb_vtf_flag_name(bit)) for bit in range(32)
+                 if v.flags >> bit & 1 and _lib.bb_vtf_flag_name(bit) != _ffi.NULL]
+        return VtfInfo(
+            version=f"{v.version_major}.{v.version_minor}", header_size=v.header_size,
+            width=v.width, height=v.height, depth=v.depth, frames=v.frames,
+            first_frame=v.first_frame, flags=v.flags, flag_names=names,
+            reflectivity=tuple(v.reflectivity), bump_scale=v.bump_scale, format=v.format,
+            format_name=_text(v.format_name), mip_count=v.mip_count,
+            low_res_format=v.low_res_format, low_res_width=v.low_res_width,
+            low_res_height=v.low_res_height, resource_count=v.resource_count,
+            data_size=v.data_size)
+    finally:
+        _lib.bb_vtf_info_free(v)
 
 
 def info(path):
     """What an image file is, from its header alone (no pixel is decoded),
-    as `bumpbake info` reports it: an ImageInfo. Raises Error with the
-    library's message when the file cannot be read."""
+    as `bumpbake info` reports it: an ImageInfo; for a Source texture
+    (.vtf) also its header's version, format, flags and mips (.vtf, a
+    VtfInfo). Raises Error with the library's message when the file cannot
+    be read."""
     w, h, c = (_ffi.new("int *") for _ in range(3))
     i = _ffi.new("bb_image_info *")
     err = _ffi.new("bb_error *")
-    _check(_lib.bb_image_read_info(_path(path), w, h, c, i, err), err)
+    p = _path(path)
+    _check(_lib.bb_image_read_info(p, w, h, c, i, err), err)
     try:
         description = _text(i.description)
         klass = _PROVENANCE_CLASSES[_lib.bb_provenance_classify(i.description)]
+        fmt = _text(i.format_name)
         return ImageInfo(
-            path=os.fsdecode(_path(path)),
-            width=w[0], height=h[0], channels=c[0], format=_text(i.format_name),
+            path=os.fsdecode(p),
+            width=w[0], height=h[0], channels=c[0], format=fmt,
             bits_per_sample=i.bits_per_sample, is_float=bool(i.is_float),
             alpha_channel=i.alpha_channel, provenance_class=klass,
             provenance=_provenance_dict(description) if klass == "intact" else None,
-            description=description)
+            description=description, vtf=_vtf_info(p) if fmt == "vtf" else None)
     finally:
         _lib.bb_image_info_free(i)
 
@@ -114,11 +164,13 @@ def _signed(command, kind):
                           f"{', '.join(tuple(_KINDS) + _UNIT_KINDS)} (got {kind!r})")
 
 
-def write(path, array, *, kind="colour", depth=None, mips=False, description=None):
+def write(path, array, *, kind="colour", depth=None, mips=False, description=None,
+          texture_format=None, vtf_version=None, vtf_flags=None, nomip=False,
+          fast_compression=False):
     """Writes an array to path with the library's writer, as `bumpbake bake`
     writes its maps: the format from the extension (.png .tga .tif .tiff
-    .exr), written to a temporary file and renamed into place (nothing is
-    left at path on failure).
+    .exr, and the engine textures .vtf and .dds), written to a temporary
+    file and renamed into place (nothing is left at path on failure).
 
     kind says how values become integer codes: "normal" and "bent" arrays
     are signed unit vectors stored as 0.5 + 0.5 N (N itself in float files);
@@ -129,24 +181,59 @@ def write(path, array, *, kind="colour", depth=None, mips=False, description=Non
     "float". mips: a mip chain (tif and exr only), renormalised for normal
     and bent, averaged otherwise. description: text stored in the file's
     ImageDescription (bumpbake's provenance, or anything), or None.
+
+    .vtf (Source) and .dds files are engine textures, with the command
+    line's settings: texture_format (None: VTF DXT1, DXT5 with alpha; DDS
+    BC5 for "normal" and "bent", BC4 for one channel, BC1 for three;
+    "dxt1", "dxt5", "bgr888", "bgra8888", "rgba16f" in a VTF, "bc1", "bc3",
+    "bc4", "bc5", "rgba8", "rgba16f", "rgba32f" in a DDS), vtf_version (7.2
+    by default; 7.3 to 7.5 as 3, "7.3" or 7.3: these keep description),
+    vtf_flags (TEXTUREFLAGS_* bits added to the kind's own: SSBUMP for
+    "ssbump" and "weights", NORMAL for "normal" and "bent"), nomip (no mip
+    chain; a texture has the full one by default, whatever mips says),
+    fast_compression (the block codec's range fit). depth must be None.
     Raises ArgumentError for a format that cannot hold the depth, mips or
-    channels, Error when the file cannot be written."""
+    channels, a texture size or format its container cannot take (a VTF
+    side not a power of two, a block format's side not a multiple of 4),
+    Error when the file cannot be written."""
     signed = _signed("write", kind)
     src = _Image("write: array", array)
     d = _depth(depth)
+    texture = _texture_options("write", texture_format, vtf_version, vtf_flags, nomip,
+                               fast_compression)
+    rng = _lib.BB_RANGE_SIGNED if signed else _lib.BB_RANGE_UNIT
     p = _path(path)
     err = _ffi.new("bb_error *")
     c_path, c_kind = _ffi.new("char[]", p), _ffi.new("char[]", kind.encode())
     c_text = _ffi.new("char[]", description.encode()) if description is not None else _ffi.NULL
     spec = _ffi.new("bb_output_spec *", {"path": c_path, "kind": c_kind,
                                          "channels": src.image.channels, "depth": d,
-                                         "mips": int(bool(mips))})
+                                         "mips": int(bool(mips)), "width": src.image.width,
+                                         "height": src.image.height, "range": rng,
+                                         "texture": texture})
     _check(_lib.bb_outputs_check(spec, 1, _ffi.NULL, 0, err), err)
     f = _ffi.new("bb_output_file *", {
-        "path": c_path, "kind": c_kind, "image": src.image,
-        "range": _lib.BB_RANGE_SIGNED if signed else _lib.BB_RANGE_UNIT,
-        "depth": d, "mips": int(bool(mips)), "description": c_text})
+        "path": c_path, "kind": c_kind, "image": src.image, "range": rng,
+        "depth": d, "mips": int(bool(mips)), "description": c_text, "texture": texture})
     _check(_lib.bb_outputs_write(f, 1, 1, err), err)
+
+
+def write_vmt(path, bumpmap, *, materials=None, basetexture=None, ssbump=True):
+    """Writes a Source material (.vmt) as `bumpbake bake --vmt` does:
+    LightmappedGeneric with "$bumpmap" (and "$ssbump" "1" when ssbump), and
+    "$basetexture" when given, each texture (a .vtf path; it need not exist
+    yet) named relative to materials, the game's materials folder (None:
+    the nearest folder named "materials" above bumpmap), without ".vtf".
+    Written all or nothing. Raises ArgumentError (a texture that is not a
+    .vtf or lies outside materials, no materials folder), Error when it
+    cannot be written."""
+    strings = [_ffi.new("char[]", _path(v, what)) if v is not None else _ffi.NULL
+               for v, what in ((path, "path"), (materials, "materials"),
+                               (bumpmap, "bumpmap"), (basetexture, "basetexture"))]
+    o = _ffi.new("bb_vmt_options *", {"materials_dir": strings[1], "bumpmap": strings[2],
+                                      "basetexture": strings[3], "ssbump": int(bool(ssbump))})
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_vmt_write(strings[0], o, err), err)
 
 
 # --------------------------------------------------------------- compare

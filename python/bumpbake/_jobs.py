@@ -7,7 +7,8 @@ import typing
 
 from ._bake import BAKE_PARAMETERS, OUTPUTS, _bake_options, _channel, _kinds_mask
 from ._common import (_argument_error, _check, _check_notes, _depth, _dispatch_notes,
-                      _exception, _ffi, _lib, _message, _note_text, _path, _status_name, _text)
+                      _exception, _ffi, _lib, _message, _note_text, _path, _status_name, _text,
+                      _texture_options)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -69,8 +70,8 @@ class BakeJob:
             report = job.run(i)     # up to date: skipped; else baked and written
         job.write_depfile()
 
-    Arguments are bake_files()'s, and bake_file()'s outputs, prefix, slope
-    and lit. `reports` lists one BakeReport per input, in order (a
+    Arguments are bake_files()'s, and bake_file()'s outputs, prefix, slope,
+    lit, vmt, materials and basetexture. `reports` lists one BakeReport per input, in order (a
     directory's images sorted by name). run(i) is what bake_files() does
     for one input; items of one job run one at a time (a job is not
     thread-safe), on the calling thread, without the GIL.
@@ -85,6 +86,8 @@ class BakeJob:
     def __init__(self, inputs, out_dir=None, *, maps=None, name=None, outputs=None,
                  prefix=None, slope=None, lit=None, force=False, keep_going=False,
                  depfile=None, depth=None, mips=False, channel="auto", scale=None,
+                 texture_format=None, vtf_version=None, vtf_flags=None, nomip=False,
+                 fast_compression=False, vmt=None, materials=None, basetexture=None,
                  notes="warn", **options):
         for key in options:
             if key not in BAKE_PARAMETERS:
@@ -92,7 +95,10 @@ class BakeJob:
         self._args = dict(out_dir=out_dir, maps=maps, name=name, outputs=outputs, prefix=prefix,
                           slope=slope, lit=lit, force=force, keep_going=keep_going,
                           depfile=depfile, depth=depth, mips=mips, channel=channel,
-                          scale=scale, notes=notes, **options)
+                          scale=scale, texture_format=texture_format,
+                          vtf_version=vtf_version, vtf_flags=vtf_flags, nomip=nomip,
+                          fast_compression=fast_compression, vmt=vmt, materials=materials,
+                          basetexture=basetexture, notes=notes, **options)
         self._notes_policy = _check_notes(notes)
         if isinstance(inputs, (str, bytes, os.PathLike)):
             inputs = [inputs]
@@ -120,6 +126,12 @@ class BakeJob:
         o.keep_going = int(bool(a["keep_going"]))
         if a["depfile"] is not None:
             o.depfile = c(_path(a["depfile"], "depfile"))
+        _texture_options("bake", a["texture_format"], a["vtf_version"], a["vtf_flags"],
+                         a["nomip"], a["fast_compression"], out=_ffi.addressof(o, "texture"))
+        for field, key in (("vmt", "vmt"), ("vmt_materials", "materials"),
+                           ("vmt_basetexture", "basetexture")):
+            if a[key] is not None:
+                setattr(o, field, c(_path(a[key], key)))
         if a["out_dir"] is not None:
             if a["outputs"] or a["prefix"] is not None or a["slope"] is not None:
                 raise _argument_error("bake: out_dir names the outputs: choose them with maps, "
@@ -333,7 +345,11 @@ def bake_files(inputs, out_dir, *, maps=None, name=None, force=False, keep_going
     keep_going: go on after an input fails (default: stop; the rest are
     "not run"). depfile: a Make/Ninja depfile to write. Options: scale
     (required) and bake()'s parameters, channel, depth (None, 8, 16, "half",
-    "float") and mips.
+    "float") and mips, and the settings of .vtf and .dds outputs, as write()
+    takes them (texture_format, vtf_version, vtf_flags, nomip,
+    fast_compression), each map's flags and default format following its
+    kind. A VTF 7.2 or DDS output holds no provenance, so it is never up
+    to date: it is baked again every time (VTF 7.3 and up hold it).
 
     check (default True): when an input failed, raise its error once the
     run is over (ArgumentError for a bad argument, Error otherwise), with
@@ -364,8 +380,11 @@ def bake_file(input, outputs=None, *, prefix=None, slope=None, lit=None, depfile
     slope: flipcode's slope map (8-bit .png .tga .tif) and lit=(azimuth,
     elevation) its lit preview, written as SLOPE_lit.EXT. force (default
     True, as the command line's single bake): bake even when every output
-    is up to date. Other arguments as bake_files()'s. Every file is written
-    all or nothing, with provenance.
+    is up to date. vmt: also a Source material (.vmt) naming the ssbump
+    .vtf (with $ssbump 1), else the normal map's .vtf, relative to
+    materials (None: the folder named "materials" above it), with
+    basetexture (a .vtf) as $basetexture when given. Other arguments as
+    bake_files()'s. Every file is written all or nothing, with provenance.
     """
     job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
                   depfile=depfile, force=force, notes=notes, **options)

@@ -6,9 +6,10 @@
 //
 // Why libsquish 1.15 and not NVIDIA Texture Tools 2.0.8 (both Debian 12, both
 // MIT): on rock06's 1024 x 1024 maps (tools/bench_blocks.sh) squish's cluster
-// fit is 4.4 dB better on BC1 normal and 4.7 dB on BC1 ssbump, and 28 dB on
-// BC4 ao; nvtt 2.0.8 turns some opaque texels of BC1 blocks into black
-// (3-colour mode's fourth entry: errors of 255 codes); and nvtt takes only
+// fit is 4.3 dB better on BC1 normal and 4.1 to 4.7 dB on BC1 ssbump (BC4, BC5
+// are a tie); nvtt 2.0.8 turns some opaque texels of BC1 blocks into black
+// (3-colour mode's fourth entry: errors of 255 codes), and its BC1 output
+// differs from run to run on the same input; and nvtt takes only
 // 8-bit input through its own pipeline with its own mip maps, where the
 // project has its own (bb_mip_chain). nvtt also carries a private copy of
 // squish whose symbols clash with libsquish's: the two cannot share a process

@@ -82,3 +82,30 @@ Test(job, command_text_spells_the_options_as_typed) {
                          "--mips --out-dir out --name {kind}/{stem}.tif");
   free(text);
 }
+
+/* The engine textures' settings and the material come last, as in --help,
+ * spelled as the CLI reads them back; threads are not recorded. */
+Test(job, command_text_spells_the_texture_options) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 64.0f;
+  o.paths[BB_OUTPUT_SSBUMP] = "m/rock-ssbump.vtf";
+  o.texture.threads = 1;
+  char *text = bb_job_command_text(&o, "h.png");
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
+  free(text);
+  o.texture.format = BB_TEXTURE_FORMAT_BC3;
+  o.texture.vtf_version = 3;
+  o.texture.vtf_flags = 0x4;
+  o.texture.mips = 0;
+  o.texture.fast = 1;
+  o.vmt = "m/rock.vmt";
+  o.vmt_materials = "m";
+  o.vmt_basetexture = "m/rock.vtf";
+  text = bb_job_command_text(&o, "h.png");
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
+                         "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
+                         "--fast-compression --vmt m/rock.vmt --materials m "
+                         "--basetexture m/rock.vtf");
+  free(text);
+}
