@@ -825,6 +825,52 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *horizons_found, bb_error *err);
 
+/* A trace split over processes or machines (Python's bumpbake.dask bakes
+ * big maps so): each finds the horizons of some of the slices
+ * (bb_trace_horizons), and one adds them up (bb_trace_accumulate) in the
+ * order every trace adds them (bb_trace_slice_order) and turns the sums into
+ * visibilities (bb_trace_finish). The result is bb_trace_occlusion's, bit
+ * for bit: the same horizons, the same losses, added in the same order. */
+
+/* The order in which every trace adds its slices' losses to a texel's sums:
+ * order[k] is the slice added k-th (k is its rank), for k = 0 ..
+ * bb_rayset_slice_count(rs) - 1; each slice is followed by its opposite
+ * (lattice step (-a, -b)) when the set has one. Errors: BB_ERR_ARGUMENT,
+ * BB_ERR_MEMORY. */
+bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err);
+
+/* The horizon of every texel in count distinct slices of rs, found by the
+ * line sweeps bb_trace_occlusion runs: horizons[k] (allocated here: 1
+ * channel, the pyramid's size) holds slice slices[k]'s horizons, tangents of
+ * elevation >= 0 (rise per texel of horizontal distance; 0 where nothing
+ * rises above the origin), the floats the whole trace adds up. A slice and
+ * its opposite asked together share one sweep, as they do in the whole
+ * trace. o->region must be empty (the whole pyramid); o->bias_texels,
+ * o->threads and o->progress (once per sweep) as for bb_trace_occlusion.
+ * Memory: 4 bytes per texel per slice, plus a line's profile per thread.
+ * Errors: BB_ERR_ARGUMENT (a slice out of range or asked twice, a region),
+ * BB_ERR_MEMORY, BB_ERR_CANCELLED; then no image is left allocated. */
+bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
+                            const bb_trace_options *o, const int *slices, int count,
+                            bb_image *horizons, bb_error *err);
+
+/* Adds what slice order[rank] (bb_trace_slice_order) loses at each texel's
+ * horizon (horizon: that slice's image from bb_trace_horizons) to sums:
+ * 1 + bb_rayset_lobe_count(rs) channels (ao first, then each lobe), the
+ * horizons' size, all zeros before rank 0 (bb_image_alloc makes them so).
+ * Called for ranks 0, 1, ..., slice count - 1 in turn, each once, it adds
+ * what bb_trace_occlusion adds in the order it adds it, so the sums are the
+ * same bits; the caller keeps to that order. threads: 0 = all cores (the
+ * same bits for any). Errors: BB_ERR_ARGUMENT (rank out of range, sizes or
+ * channels that do not match). */
+bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
+                              bb_image *sums, int threads, bb_error *err);
+
+/* Turns sums, once every rank is added, into visibilities in place: ao,
+ * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as bb_trace_occlusion
+ * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
+bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
+
 /* -------------------------------------------------------------- derive */
 
 /* The maps of docs/conventions.md "Derived maps", for any basis: channel c belongs
