@@ -800,7 +800,21 @@ const char *bb_rayset_id(const bb_rayset *rs);
 
 /* --------------------------------------------------------------- trace */
 
-typedef struct bb_trace_options {
+typedef struct bb_trace_options bb_trace_options;
+
+/* A trace of the caller's, which bb_bake calls in place of
+ * bb_trace_occlusion (bb_trace_options.trace): for the pyramid and ray set
+ * the bake built, it fills vis exactly as bb_trace_occlusion(p, rs, o, vis)
+ * would: allocated (bb_image_alloc), the pyramid's size, 1 +
+ * bb_rayset_lobe_count(rs) channels. A trace split over machines does this
+ * with bb_trace_horizons, bb_trace_accumulate and bb_trace_finish, so the
+ * bake's maps are a single bake's bits. Returns BB_OK, or an error with err
+ * filled (vis then left unallocated). Called on the thread that called
+ * bb_bake. */
+typedef bb_status (*bb_trace_fn)(void *user, const bb_pyramid *p, const bb_rayset *rs,
+                                 const bb_trace_options *o, bb_image *vis, bb_error *err);
+
+struct bb_trace_options {
   double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
   int threads;          /* 0 = all cores */
   bb_region region;     /* width 0 (default): every texel, by line sweeps;
@@ -809,7 +823,12 @@ typedef struct bb_trace_options {
                               work goes (per slice, or every 50 ms); a
                               nonzero return cancels */
   void *progress_user;
-} bb_trace_options;
+  bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
+                           bb_trace_occlusion; else bb_bake calls
+                           trace(trace_user, ...) in its place (bb_trace_fn).
+                           bb_trace_occlusion itself ignores it */
+  void *trace_user;
+};
 
 void bb_trace_options_init(bb_trace_options *o);
 
@@ -1010,6 +1029,17 @@ typedef struct bb_bake_result {
  * returned (result is zeroed). */
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
+
+/* What bb_bake traces, built alone for a trace split over processes: the
+ * max-mip pyramid of the smoothed height scaled to texels, and the ray set
+ * of o's slices, power and basis, built by bb_bake's own stages (the same
+ * bits), so the horizons found from them (bb_trace_horizons) are those of
+ * bb_bake's trace of height with o. Checks o and the height as bb_bake does;
+ * o->outputs must ask for a traced kind. On success *pyramid and *rays
+ * receive them (free with bb_pyramid_free and bb_rayset_free). Memory:
+ * about 13 bytes per texel while building, 5.4 once built. */
+bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
+                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */

@@ -105,6 +105,28 @@ static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
   return BB_OK;
 }
 
+/* The trace of the caller's (bb_trace_options.trace) in place of
+ * bb_trace_occlusion; what it makes is checked to be what that would make. */
+static bb_status caller_trace(const bb_pyramid *p, const bb_rayset *rs, const bb_trace_options *o,
+                              bb_image *vis, double *horizons_found, bb_error *err) {
+  memset(vis, 0, sizeof *vis);
+  bb_error local = {{0}};
+  bb_status st = o->trace(o->trace_user, p, rs, o, vis, &local);
+  if (st != BB_OK) {
+    bb_image_free(vis);
+    return bb__fail(err, st, "%s", local.message[0] ? local.message : "trace: failed");
+  }
+  if (!vis->pixels || vis->width != p->width || vis->height != p->height ||
+      vis->channels != 1 + rs->basis_count) {
+    bb_image_free(vis);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "trace: the caller's trace made no %dx%d image of %d channels", p->width,
+                    p->height, 1 + rs->basis_count);
+  }
+  *horizons_found = (double)p->width * (double)p->height * (double)rs->slice_count;
+  return BB_OK;
+}
+
 /* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent. */
 static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake_result *r,
                                   bb_error *err) {
@@ -123,7 +145,9 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
     bb_trace_options whole = o->trace;
     whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
     whole.threads = threads;
-    st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+    st = o->trace.trace ? caller_trace(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err)
+                        : bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found,
+                                             err);
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
