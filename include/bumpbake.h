@@ -299,6 +299,18 @@ bb_status bb_file_write(const char *path, const void *data, size_t size, bb_erro
  * further ones are still removed on errors, but not by this function. */
 void bb_tempfiles_remove(void);
 
+/* Removes from directory dir (not below it) the temporaries
+ * ".bb-tmp-XXXXXX.EXT" whose writer is gone: a writer holds an advisory
+ * lock (flock) on its temporary from its creation until it is renamed into
+ * place or removed, and the kernel drops it when the process dies, so one
+ * that no process holds is what a process killed outright (SIGKILL, an
+ * out-of-memory kill, a lost machine) left behind. Temporaries being
+ * written, by this process or any other, on this machine or another sharing
+ * the directory (NFS v4 carries flock), are left alone. *removed (may be
+ * NULL) receives how many were removed. Errors: BB_ERR_ARGUMENT (no dir),
+ * BB_ERR_IO (dir cannot be read, an orphan cannot be removed). */
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
+
 /* True (1) when the extension of path (any case) is one OpenImageIO has a
  * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
  * caller can pick the images out of a directory without opening each file.

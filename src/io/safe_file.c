@@ -21,6 +21,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -161,6 +163,9 @@ static void release(bb_staged_file *f, int remove_temp) {
   }
   if (remove_temp && f->temp_path)
     unlink(f->temp_path);
+  if (f->locked) /* after the rename or unlink: a sweep never sees it unlocked */
+    close(f->lock_fd);
+  f->locked = 0;
   unregister_temp(f->slot);
   f->slot = -1;
   free(f->buffer);
@@ -177,9 +182,28 @@ static void release(bb_staged_file *f, int remove_temp) {
 
 enum { BUFFER_BYTES = 1 << 16 };
 
-/* Creates the temporary with O_EXCL. Its name is registered before the
- * file exists, so no instant passes in which a signal could leave it
- * behind; a name that already exists is unregistered and another tried. */
+/* Locks the temporary just created as fd under name, for
+ * bb_tempfiles_sweep: 0 when this process now holds the lock on the file
+ * that name names, EEXIST when a sweep got to it first (it removes what it
+ * locks: try another name), or another errno. The lock goes with a dup of
+ * fd, which stays open until the temporary is renamed or removed. */
+static int lock_temp(int fd, const char *name, int *lock_fd) {
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0)
+    return errno == EWOULDBLOCK ? EEXIST : (errno == ENOLCK || errno == EINVAL ? ENOLCK : errno);
+  struct stat ours, named;
+  if (fstat(fd, &ours) != 0 || stat(name, &named) != 0 || ours.st_dev != named.st_dev ||
+      ours.st_ino != named.st_ino)
+    return EEXIST; /* swept between the open and the lock */
+  *lock_fd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  return *lock_fd >= 0 ? 0 : errno;
+}
+
+/* Creates the temporary with O_EXCL and locks it. Its name is registered
+ * before the file exists, so no instant passes in which a signal could
+ * leave it behind; a name that already exists is unregistered and another
+ * tried. A filesystem without locks (ENOLCK) still gets its temporary,
+ * unlocked: a sweep there may take it for an orphan, which only a sweep run
+ * while it is written can do. */
 static int create_temp(bb_staged_file *f) {
   uint64_t seed = fresh_seed();
   for (int attempt = 0; attempt < 100; attempt++) {
@@ -190,13 +214,19 @@ static int create_temp(bb_staged_file *f) {
     /* 0666 less the umask, as for any new file (mkstemp would make 0600,
      * and the rename keeps the mode). */
     int fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
+    int error = fd >= 0 ? lock_temp(fd, name, &f->lock_fd) : errno;
+    if (error == ENOLCK)
+      error = 0;
+    else if (!error)
+      f->locked = 1;
+    if (!error) {
       f->fd = fd;
       f->slot = slot;
       f->temp_path = name;
       return 0;
     }
-    int error = errno;
+    if (fd >= 0)
+      close(fd); /* a sweep's: not ours to remove */
     unregister_temp(slot);
     free(name);
     if (error != EEXIST)
@@ -390,6 +420,72 @@ bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
 void bb__safe_discard(bb_staged_file *f) {
   if (f)
     release(f, 1);
+}
+
+/* ------------------------------------------------------- orphans */
+
+/* ".bb-tmp-" and six characters of temp_name's alphabet, then anything (the
+ * extension). */
+static int is_temp_name(const char *name) {
+  if (strncmp(name, ".bb-tmp-", 8) != 0)
+    return 0;
+  for (int i = 8; i < 14; i++) {
+    const char c = name[i];
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9')))
+      return 0;
+  }
+  return name[14] == '\0' || name[14] == '.';
+}
+
+/* Removes dir/name when it is a temporary nobody holds: 1 removed, 0 left
+ * (held, gone, not a regular file), -1 failed (errno). */
+static int sweep_one(const char *dir, const char *name) {
+  char path[PATH_MAX];
+  if (snprintf(path, sizeof path, "%s/%s", dir, name) >= (int)sizeof path)
+    return 0;
+  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    return errno == ENOENT || errno == ELOOP ? 0 : -1;
+  int removed = 0;
+  struct stat held, named;
+  if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &held) == 0 && S_ISREG(held.st_mode) &&
+      lstat(path, &named) == 0 && held.st_dev == named.st_dev && held.st_ino == named.st_ino) {
+    /* Locked by us, it is still the file at that name: its writer is gone. */
+    if (unlink(path) == 0)
+      removed = 1;
+    else if (errno != ENOENT)
+      removed = -1;
+  }
+  const int saved = errno;
+  close(fd); /* drops the lock */
+  errno = saved;
+  return removed;
+}
+
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err) {
+  if (removed)
+    *removed = 0;
+  if (!dir || !*dir)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_tempfiles_sweep: no directory");
+  DIR *d = opendir(dir);
+  if (!d)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read the directory: %s", dir, strerror(errno));
+  bb_status st = BB_OK;
+  int count = 0;
+  for (struct dirent *e; (e = readdir(d)) != NULL;) {
+    if (!is_temp_name(e->d_name))
+      continue;
+    const int r = sweep_one(dir, e->d_name);
+    if (r > 0)
+      count++;
+    else if (r < 0 && st == BB_OK)
+      st = bb__fail(err, BB_ERR_IO, "%s/%s: cannot remove a left-over temporary: %s", dir,
+                    e->d_name, strerror(errno));
+  }
+  closedir(d);
+  if (removed)
+    *removed = count;
+  return st;
 }
 
 /* ------------------------------------------------------ public handles */
