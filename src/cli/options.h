@@ -49,7 +49,8 @@ typedef enum cli_opt_id {
   CLI_OPT_FORCE,
   CLI_OPT_DEPFILE,
   CLI_OPT_SLOPE,     /* bake --slope FILE */
-  CLI_OPT_SLOPE_LIT  /* bake --lit AZ,EL */
+  CLI_OPT_SLOPE_LIT, /* bake --lit AZ,EL */
+  CLI_OPT_SCHEDULER  /* bake --scheduler ADDRESS: on a Dask cluster */
 } cli_opt_id;
 
 /* One row of a subcommand's option table: getopt_long's struct option and
