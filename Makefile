@@ -139,10 +139,12 @@ PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
+# python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
+# a Dask cluster (its tests run a LocalCluster).
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools ninja-build
+            openimageio-tools ninja-build python3-distributed python3-dask
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -152,7 +154,7 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
@@ -252,9 +254,10 @@ install: $(BIN) lib
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
-	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake
+	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake $(DESTDIR)$(PYTHONDIR)/bumpbake/dask
 	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
 	  $(DESTDIR)$(PYTHONDIR)/bumpbake/
+	install -m 644 $(wildcard python/bumpbake/dask/*.py) $(DESTDIR)$(PYTHONDIR)/bumpbake/dask/
 	printf '%s\n' '# Written by make install: the library this installed package loads.' \
 	  'LIBRARY = "$(LIBDIR)/$(SONAME)"' >$(DESTDIR)$(PYTHONDIR)/bumpbake/_install.py
 	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ]; then $(LDCONFIG) || true; fi

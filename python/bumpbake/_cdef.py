@@ -442,9 +442,9 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
-bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const char *bb_depth_name(bb_depth depth);
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
