@@ -59,17 +59,25 @@ extern "C" {
 #define BB_VERSION_STRING "0.2.0"
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
- * most BB_MAX_PIXELS texels in all (8192 x 8192), checked before allocating. */
+ * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
+ * allocating. What a machine can bake is less: reads and bakes estimate
+ * their memory from the sizes first and refuse, naming the estimate and
+ * what is available, what will not fit (bb_memory_available,
+ * bb_bake_memory_estimate). */
 #define BB_MAX_DIMENSION 65536
-#define BB_MAX_PIXELS (8192L * 8192L)
+#define BB_MAX_PIXELS (32768L * 32768L)
 
-/* Most bytes of samples a read may take (1 GiB, an 8192 x 8192 RGBA float
- * image): both the file's own samples (texels x channels x bytes per
- * sample, as its header declares them) and the floats decoded (texels x
- * channels read x 4) must fit, checked before anything is allocated. The
- * first read also lowers OpenImageIO's process-wide "limits:imagesize_MB"
- * to 1024 and "limits:channels" to 64 when they are higher. */
+/* Most bytes of samples a read may take: BB_MAX_READ_BYTES_PER_TEXEL a
+ * texel (an RGBA float image), and BB_MAX_READ_BYTES (1 GiB) whatever the
+ * size (so 1 GiB up to 8192 x 8192, 4 GiB at 16384 x 16384): both the
+ * file's own samples (texels x channels x bytes per sample, as its header
+ * declares them) and the floats decoded (texels x channels read x 4) must
+ * fit, checked before anything is allocated, and then what is available
+ * (bb_memory_available) must hold them. The first read also lowers
+ * OpenImageIO's process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16
+ * bytes (16384) and "limits:channels" to 64 when they are higher. */
 #define BB_MAX_READ_BYTES (1L << 30)
+#define BB_MAX_READ_BYTES_PER_TEXEL 16
 
 /* Largest |height_scale x h| a bake accepts, in texels: scaled heights are
  * floats and are differenced, so they keep a factor of 4 below FLT_MAX. */
@@ -122,6 +130,17 @@ typedef struct bb_image {
   int channels;   /* interleaved floats per texel */
   float *pixels;  /* width*height*channels floats, row 0 at the top */
 } bb_image;
+
+/* What this process may still allocate, in bytes: the smaller of what the
+ * system has available (MemAvailable of /proc/meminfo, else its free pages)
+ * and, under an RLIMIT_AS (ulimit -v), the room left below it (the limit
+ * less the address space mapped now). *source (may be NULL) receives which
+ * ("MemAvailable", "sysconf free pages", "RLIMIT_AS"). Bakes and reads
+ * check their estimate against it before allocating, so one too large is
+ * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
+ * the process; several processes started at once each see the same
+ * figure. Errors: BB_ERR_IO (neither can be read). */
+bb_status bb_memory_available(uint64_t *bytes, const char **source, bb_error *err);
 
 /* Allocates a zeroed image. Rejects sizes <= 0, over BB_MAX_DIMENSION or
  * BB_MAX_PIXELS, and channel counts outside 1..64 (overflow-checked).
@@ -197,7 +216,7 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * may each be NULL. Errors as bb_image_read, except that the size limits
  * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied
  * (the size is reported, not allocated; OpenImageIO's own limits, see
- * BB_MAX_READ_BYTES, may still refuse a header declaring more than 1 GiB of
+ * BB_MAX_READ_BYTES, may still refuse a header declaring more than 16 GiB of
  * samples). */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
@@ -1052,6 +1071,15 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
  * about 13 bytes per texel while building, 5.4 once built. */
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
+
+/* The most bytes bb_bake allocates at one time for a width x height field
+ * with options o (its outputs, basis, slices and threads), not counting the
+ * height itself: an upper bound worked out from the sizes alone, following
+ * the bake's stages. bb_bake refuses (BB_ERR_MEMORY, naming both figures) a
+ * bake whose estimate is over bb_memory_available before it allocates
+ * anything. About 32 bytes a texel for ssbump and ao, 36 with the normal
+ * map, 64 for every output. 0 for a bad size or NULL options. */
+uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o);
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */

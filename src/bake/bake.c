@@ -230,6 +230,16 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
   return st;
 }
 
+/* Before anything is allocated: refuses a bake the machine cannot hold
+ * (bb__bake_memory against bb_memory_available), with the figures. */
+static bb_status check_memory(const bb_image *height, const bb_bake_options *o, unsigned flags,
+                              bb_error *err) {
+  char what[64];
+  snprintf(what, sizeof what, "bake: %d x %d", height->width, height->height);
+  return bb__memory_check(bb__bake_memory(height->width, height->height, o, flags, 0.0, NULL),
+                          what, err);
+}
+
 static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
                              bb_bake_result *r, bb_error *err) {
   memset(r, 0, sizeof *r);
@@ -238,6 +248,7 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   bb_status st = bb_bake_options_check(o, err);
   /* Before any stage: an overflow of scale x height is named as such. */
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
+  if (st == BB_OK) st = check_memory(height, o, flags, err);
   if (st != BB_OK) return st;
   r->basis = o->basis;
   const int threads = bb__thread_count(o->trace.threads);

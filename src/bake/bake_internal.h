@@ -46,6 +46,15 @@ enum { BB__BAKE_DROP_VIS = 1, BB__BAKE_TAKE_HEIGHT = 2 };
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
                    bb_bake_result *r, bb_error *err);
 
+/* The most bytes bb__bake with flags allocates at one time for a width x
+ * height bake with options o (memory.c follows its stages), counting
+ * `held` bytes the caller holds as the bake starts (its height, freed
+ * after smoothing with BB__BAKE_TAKE_HEIGHT); *kept (may be NULL) receives
+ * what is left allocated once it returns (the maps it made). An upper
+ * bound, from the sizes alone. */
+double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned flags,
+                       double held, double *kept);
+
 /* BB_OK when b has 3..BB_MAX_BASIS unit vectors with z >= 0 (a basis
  * filled by hand is checked before it is used), else BB_ERR_ARGUMENT with a
  * message starting "who: ". */

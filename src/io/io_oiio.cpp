@@ -129,7 +129,7 @@ void lower_oiio_limits() {
   static std::once_flag once;
   std::call_once(once, [] {
     int mb = 0, channels = 0;
-    const int our_mb = (int)(BB_MAX_READ_BYTES / MiB);
+    const int our_mb = (int)((double)BB_MAX_PIXELS * BB_MAX_READ_BYTES_PER_TEXEL / MiB);
     if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
       OIIO::attribute("limits:imagesize_MB", our_mb);
     if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
@@ -246,13 +246,18 @@ bb_status check_spec_size(const char *path, const ImageSpec &spec, int channels_
   const double file_bytes = (double)spec.image_bytes(true);
   const double float_bytes = texels * channels_read * (double)sizeof(float);
   const double bytes = file_bytes > float_bytes ? file_bytes : float_bytes;
-  if (bytes > (double)BB_MAX_READ_BYTES)
+  const double limit = std::max((double)BB_MAX_READ_BYTES, texels * BB_MAX_READ_BYTES_PER_TEXEL);
+  if (bytes > limit)
     return bb__fail(err, BB_ERR_SIZE,
                     "%s: %dx%d with %d channels of %s needs %.0f MiB, over the limit of "
-                    "%ld MiB",
+                    "%.0f MiB",
                     path, spec.width, spec.height, spec.nchannels,
-                    spec.format.c_str(), bytes / (double)MiB, BB_MAX_READ_BYTES / MiB);
-  return BB_OK;
+                    spec.format.c_str(), bytes / (double)MiB, limit / (double)MiB);
+  // The floats, and at most the file's own samples decoded beside them.
+  char what[600];
+  snprintf(what, sizeof what, "%s: reading %dx%d with %d channels of %s", path, spec.width,
+           spec.height, spec.nchannels, spec.format.c_str());
+  return bb__memory_check(float_bytes + file_bytes, what, err);
 }
 
 bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *info,

@@ -217,9 +217,11 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
   baked b;
   memset(&b, 0, sizeof b);
   const double t0 = bb__now_seconds();
-  bb_status st = bb_height_file_read(item->input, job->options.channel,
-                                     job->options.bake.height_scale, job->options.note,
-                                     job->options.note_user, &b.height, &r->source, err);
+  bb_status st = bb__job_memory_check(job, item, err);
+  if (st == BB_OK)
+    st = bb_height_file_read(item->input, job->options.channel,
+                             job->options.bake.height_scale, job->options.note,
+                             job->options.note_user, &b.height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
   const int height_width = b.height.width, height_height = b.height.height;
   if (st == BB_OK) {
