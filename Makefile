@@ -97,7 +97,7 @@ CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
 comma := ,
 
 # ---- sources and products ----------------------------------------------------
-# The library's families, in the order data flows (README "Layout").
+# The library's families, in the order data flows (README.md, "Layout").
 FAMILIES := core io bake trace maps render mesh job
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
@@ -125,7 +125,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles bench goldens docs install uninstall clean format FORCE \
+        check-python check-circles check-docs bench goldens docs docs-reference install \
+        uninstall clean format FORCE \
         fuzz fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
@@ -282,8 +283,17 @@ test: ensure-deps
 	@$(MAKE) --no-print-directory check
 
 # Everything `make test` runs: the Criterion suite, the install check, the
-# Python tests and the check that no two files need each other.
-check: check-unit check-install check-python check-circles
+# Python tests, the check that no two files need each other and the check
+# that the command reference and the man page say what --help says.
+check: check-unit check-install check-python check-circles check-docs
+
+# docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
+# each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
+# them, `make check-docs` fails, naming the command, when they differ.
+docs-reference: $(BIN)
+	$(PYTHON) tools/gen_docs.py $(BIN)
+check-docs: $(BIN)
+	@$(PYTHON) tools/gen_docs.py --check $(BIN)
 
 # Object files that use each other's symbols in a circle fail the build's
 # checks (tools/check_circles.py): one of them has two jobs.
@@ -345,6 +355,7 @@ FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(C
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536
 FUZZ_ARGS_fuzz_program    := -dict=fuzz/program.dict
+FUZZ_ARGS_fuzz_mesh       := -dict=fuzz/mesh.dict -max_len=16384
 
 # Objects are kept between runs (make would delete them as intermediates).
 .SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)

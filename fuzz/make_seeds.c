@@ -4,7 +4,8 @@
  * OUT_DIR/load: every small fixture PNG as it is, and each converted to TGA,
  * TIFF and EXR (with fuzz_load's leading byte); OUT_DIR/compare: pairs of
  * small images; OUT_DIR/provenance: the provenance texts of the golden
- * EXRs, in pairs; OUT_DIR/cli: the command lines of the README. */
+ * EXRs, in pairs; OUT_DIR/cli: the command lines of the docs' examples;
+ * OUT_DIR/mesh: small models of each format fuzz_mesh reads. */
 #include "bumpbake.h"
 
 #include <dirent.h>
@@ -248,7 +249,99 @@ static void cli_seeds(const char *out) {
   }
 }
 
+/* fuzz_mesh's leading byte: the format (obj, gltf, dae, glb) in the low two
+ * bits, the render's axis and tiling above. Seeds: the first triangles of
+ * the rivet panel fixture, written as OBJ and binary glTF by the library's
+ * own exporter, and a glTF (a node hierarchy, normals, 16-bit indices in a
+ * data: URI) and a Collada file of one quad, as text. */
+static const char SEED_GLTF[] =
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"chi"
+    "ldren\":[1],\"translation\":[0,0.5,0]},{\"mesh\":0,\"scale\":[1,1,2]}],\"meshes\":[{\""
+    "primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],\"buffer"
+    "s\":[{\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAA"
+    "AAAAAAACAPwAAAAAAAIA/AAAAAAAAAAAAAIA/AAAAAAAAgL8AAAAAAAAAAAAAgL8AAAAAAAAAAAA"
+    "AgL8AAAAAAAAAAAAAgL8AAAAAAAABAAIAAAACAAMA\",\"byteLength\":108}],\"bufferViews\":"
+    "[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"by"
+    "teLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12}],\"accessors\":[{\"b"
+    "ufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"min\":[0,0,0],\"max"
+    "\":[1,0,1]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},{\"b"
+    "ufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}";
+
+static const char SEED_DAE[] =
+    "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+    "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"
+    "<asset><unit name=\"meter\" meter=\"1\"/><up_axis>Z_UP</up_axis></asset>\n"
+    "<library_geometries><geometry id=\"q\"><mesh>\n"
+    "<source id=\"q-p\"><float_array id=\"q-a\" count=\"12\">0 0 0 1 0 0 1 0 1 0 0 1"
+    "</float_array>\n"
+    "<technique_common><accessor source=\"#q-a\" count=\"4\" stride=\"3\">"
+    "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
+    "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"
+    "<vertices id=\"q-v\"><input semantic=\"POSITION\" source=\"#q-p\"/></vertices>\n"
+    "<polylist count=\"1\"><input semantic=\"VERTEX\" source=\"#q-v\" offset=\"0\"/>"
+    "<vcount>4</vcount><p>0 1 2 3</p></polylist>\n"
+    "</mesh></geometry></library_geometries>\n"
+    "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\">"
+    "<matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</matrix>"
+    "<instance_geometry url=\"#q\"/></node></visual_scene></library_visual_scenes>\n"
+    "<scene><instance_visual_scene url=\"#s\"/></scene>\n"
+    "</COLLADA>\n";
+
+/* Writes the first `triangles` of m (their vertices renumbered) to path. */
+static void write_part(const bb_mesh *m, size_t triangles, const char *path) {
+  bb_mesh part;
+  bb_error err;
+  size_t n = triangles < m->triangle_count ? triangles : m->triangle_count;
+  if (bb_mesh_alloc(&part, 3 * n, n, m->normals != NULL, &err) != BB_OK) {
+    fprintf(stderr, "make_seeds: %s\n", err.message);
+    exit(1);
+  }
+  for (size_t i = 0; i < 3 * n; i++) {
+    memcpy(part.positions + 3 * i, m->positions + 3 * (size_t)m->indices[i], 3 * sizeof(float));
+    if (m->normals)
+      memcpy(part.normals + 3 * i, m->normals + 3 * (size_t)m->indices[i], 3 * sizeof(float));
+    part.indices[i] = (uint32_t)i;
+  }
+  if (bb_mesh_write(path, &part, &err) != BB_OK) {
+    fprintf(stderr, "make_seeds: %s\n", err.message);
+    exit(1);
+  }
+  bb_mesh_free(&part);
+}
+
+static void mesh_seeds(const char *fixtures, const char *out) {
+  char dir[1024], model[1024], tmp[1100];
+  make_dir(out, "mesh", dir, sizeof dir);
+  snprintf(model, sizeof model, "%s/rivet_panel.obj", fixtures);
+  bb_mesh panel;
+  bb_error err;
+  if (bb_mesh_load(model, &panel, &err) != BB_OK) {
+    fprintf(stderr, "make_seeds: %s\n", err.message);
+    exit(1);
+  }
+  static const char *const KINDS[] = {"part.obj", "part.glb"};
+  static const unsigned char LEAD[] = {0x00, 0x83};
+  for (int k = 0; k < 2; k++) {
+    snprintf(tmp, sizeof tmp, "%s/.%s", dir, KINDS[k]);
+    write_part(&panel, 60, tmp);
+    size_t size;
+    unsigned char *bytes = read_all(tmp, &size);
+    if (!bytes || remove(tmp) != 0) {
+      fprintf(stderr, "make_seeds: %s: cannot read back\n", tmp);
+      exit(1);
+    }
+    write_seed(dir, KINDS[k], &LEAD[k], 1, bytes, size);
+    free(bytes);
+  }
+  bb_mesh_free(&panel);
+  const unsigned char gltf_lead = 0x01, tiled_gltf_lead = 0x89, dae_lead = 0x02;
+  write_seed(dir, "quad.gltf", &gltf_lead, 1, SEED_GLTF, sizeof SEED_GLTF - 1);
+  write_seed(dir, "tiled.gltf", &tiled_gltf_lead, 1, SEED_GLTF, sizeof SEED_GLTF - 1);
+  write_seed(dir, "quad.dae", &dae_lead, 1, SEED_DAE, sizeof SEED_DAE - 1);
+}
+
 int main(int argc, char **argv) {
+
   if (argc != 3) {
     fprintf(stderr, "usage: make_seeds FIXTURES_DIR OUT_DIR\n");
     return 2;
@@ -261,5 +354,6 @@ int main(int argc, char **argv) {
   compare_seeds(argv[2]);
   provenance_seeds(argv[1], argv[2]);
   cli_seeds(argv[2]);
+  mesh_seeds(argv[1], argv[2]);
   return 0;
 }

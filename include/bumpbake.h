@@ -11,7 +11,8 @@
  *   Geometry is in texels: texel (x, y) is the vertex (x, y, height_scale*h).
  * - Surface model: two triangles per cell, (x,y)-(x+1,y)-(x,y+1) and
  *   (x+1,y)-(x+1,y+1)-(x,y+1), split along the (x+1,y)-(x,y+1) diagonal
- *   (Valve's mesh). Addressing is periodic (the texture tiles) unless
+ *   (the Embree peer's mesh; Valve's splits along the other diagonal, see
+ *   docs/conventions.md). Addressing is periodic (the texture tiles) unless
  *   BB_ADDRESS_CLAMP extends the border texels.
  * - Normals are unit vectors in [-1, 1]; integer files store 0.5 + 0.5*N,
  *   float files store N. Visibility, ssbump, weights and ao are in [0, 1];
@@ -104,6 +105,35 @@ extern "C" {
 
 /* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
+
+/* What reading one model (bb_mesh_load) may take. Model files are untrusted,
+ * and Assimp's importers build their own structures before bumpbake sees a
+ * triangle, so the import runs in a child process held to these limits:
+ * - BB_MAX_MODEL_BYTES: the model file and every file it refers to (a glTF's
+ *   buffers, an OBJ's .mtl), 256 MiB together, checked before each is read;
+ * - BB_MAX_MODEL_TRIANGLES: triangles after polygons are split and every
+ *   instance of a mesh is placed (8 Mi), and at most three times as many
+ *   vertices, checked on the importer's scene before it is post-processed
+ *   or copied;
+ * - BB_MAX_IMPORT_MEMORY: memory the importer may take beyond the process's
+ *   own (4 GiB; Assimp takes 8 to 27 times an OBJ's size: 600 MiB for a
+ *   1 M-triangle grid with normals, 76 MB; 2 GiB for 10 M triangles of
+ *   "f 1 2 3", 80 MB);
+ * - BB_MAX_IMPORT_SECONDS: CPU seconds of the import (120; four times as
+ *   many of wall-clock time).
+ * A model over one of them is refused with BB_ERR_SIZE or BB_ERR_MEMORY. */
+#define BB_MAX_MODEL_BYTES (256L << 20)
+#define BB_MAX_MODEL_TRIANGLES (1L << 23)
+#define BB_MAX_IMPORT_MEMORY (4L << 30)
+#define BB_MAX_IMPORT_SECONDS 120
+
+/* Most rasterising a flat render bump may do: the samples its triangles
+ * reach (each triangle's samples, bounded by its area and by the part of
+ * its box inside the image, plus one per sample row it spans) at most 256
+ * times the image's samples plus 256 per triangle drawn. A sculpt covers
+ * its image a few times over; a pile of triangles drawn over one another
+ * thousands of times is refused (BB_ERR_SIZE) before anything is drawn. */
+#define BB_MAX_RENDERBUMP_LAYERS 256
 
 typedef enum bb_status {
   BB_OK = 0,          /* success */
@@ -1018,7 +1048,41 @@ typedef struct bb_bake_options {
                                  (then rays and slices are not checked); a map
                                  another needs is made and freed (bent needs
                                  ssbump, both need the normal) */
+  double bounce_albedo;       /* rho in [0, 1]: inter-reflection. ao, ssbump
+                                 and bent then include the light the
+                                 surrounding height field reflects,
+                                 Lambertian with albedo rho (times
+                                 bounce_albedo_map), normalised as without it
+                                 (docs/conventions.md "Inter-reflection"; the
+                                 weights hold no visibility and do not change).
+                                 Default 0: none, and the bake is bit for bit
+                                 the one without these fields. Costs about 3
+                                 traces per bounce, and 72 (1 + basis count)
+                                 bytes per texel */
+  const bb_image *bounce_albedo_map; /* NULL (default), or an image of the
+                                 height's size whose grey (1 channel: it; 2:
+                                 the first; 3 or more: Rec. 709 luma of R, G,
+                                 B), clamped to [0, 1], multiplies rho at each
+                                 vertex, linear over each triangle. Not owned;
+                                 ignored while bounce_albedo is 0 */
+  int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
+                                 times; 0 (default): until one more bounce
+                                 would move what any triangle reflects by
+                                 under 1e-2 of the sky's radiance, the rest
+                                 of the series then added as geometric (at
+                                 most BB_MAX_BOUNCES bounces) */
+  const bb_image *brightness; /* NULL (default), or a brightness map of the
+                                 height's size: ssbump and weights are
+                                 multiplied by its grey, the paper's
+                                 "brightness modulation factor in the normal
+                                 map", as bb_combine_brightness does (a
+                                 texel that would exceed 1 is scaled down,
+                                 its channels' ratios kept); ao and bent do
+                                 not change. Not owned */
 } bb_bake_options;
+
+/* Most bounces a bake's inter-reflection follows. */
+#define BB_MAX_BOUNCES 64
 
 void bb_bake_options_init(bb_bake_options *o);
 
@@ -1048,6 +1112,8 @@ typedef struct bb_bake_result {
   bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
   int threads;             /* worker threads the stages ran on (o->trace.threads,
                               or the core count for 0) */
+  int bounces;             /* bounces of inter-reflection followed (0: none) */
+  double seconds_bounce;   /* the inter-reflection's part, after seconds_trace */
 } bb_bake_result;
 
 /* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
@@ -1196,6 +1262,29 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err);
 
+/* Multiplies a map by a grey brightness map of the same size: the paper's
+ * "brightness modulation factor in the normal map, for free", which lets a
+ * low-resolution colour map and a high-resolution ssbump share the work.
+ * The engine multiplies the stored weights by its lightmaps, so scaling the
+ * weights scales the light. b is the brightness map's grey at the texel (1
+ * channel: it; 2: the first; 3 or more: Rec. 709 luma of R, G, B; a
+ * negative grey counts as 0).
+ *   ssbump, weights: channels 0..2 times b. A channel holds at most 1: where
+ *     the largest of the three would exceed it, the texel is scaled so that
+ *     the largest is 1 instead, which keeps the channels' ratios (the
+ *     direction the engine derives from them, the paper's bent normal): what
+ *     clips is the brightness, never the direction. A flat, unoccluded
+ *     ssbump texel (1/sqrt(3)) takes brightness up to sqrt(3) unclipped.
+ *     Further channels (Valve's alpha) are copied; a map of more than 4
+ *     channels (another basis) is BB_ERR_ARGUMENT.
+ *   ao: times b, at most 1.
+ *   normal: BB_ERR_ARGUMENT: a unit normal has no room for a brightness.
+ * A brightness of 1 gives the map back bit for bit. Allocates out with the
+ * map's channels. Errors: BB_ERR_ARGUMENT, BB_ERR_SIZE (another size),
+ * BB_ERR_VALUE (a NaN or infinite value in either map). */
+bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err);
+
 /* ----------------------------------------------------- DOOM 3 programs */
 
 /* A parsed DOOM 3 image program, such as "addnormals(a_local.tga,
@@ -1245,7 +1334,7 @@ typedef struct bb_program_options {
 
 void bb_program_options_init(bb_program_options *o);
 
-/* Evaluates a program as id Tech 4 does (README "program" gives each
+/* Evaluates a program as id Tech 4 does (docs/commands/program.md gives each
  * formula), in float rather than bytes. Inside, every image is RGBA in
  * [0, 1] standing for id's bytes / 255 (files are read as value / max code,
  * clamped; grey gives R = G = B, no alpha gives A = 1), and normal-map
@@ -1471,21 +1560,49 @@ typedef struct bb_render_options {
                                    texels; crop_width 0 = no crop */
   int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
                                    are identical */
+  int view;                     /* 1: an orthographic camera at view_azimuth,
+                                   view_elevation looks at the surface (the
+                                   texture tiling on for ever); 0 (default):
+                                   straight down, texel for pixel */
+  double view_azimuth;          /* degrees, as the light's (default 270: from the
+                                   bottom of the image, which then recedes up
+                                   the picture) */
+  double view_elevation;        /* degrees, 1..90 (default 30) */
+  int relief;                   /* 1: parallax occlusion mapping of
+                                   relief_height as shaders/ssbump_relief.glsl
+                                   does it: each pixel's view ray is followed
+                                   into the relief and the maps are read where
+                                   it meets it; needs view */
+  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
+                                   the bake's filtered height. Not owned */
+  double relief_depth;          /* texels of relief per unit of h, > 0: the
+                                   bake's height_scale (default 0: must be set
+                                   with relief) */
 } bb_render_options;
 
 void bb_render_options_init(bb_render_options *o);
 
 /* Renders maps by o into out (allocated: 3 channels, linear values, 1 =
  * white, not clamped), then tiles and crops it as o says. Bit-identical for
- * any thread count. Errors: BB_ERR_ARGUMENT (missing map for the mode, too
- * few channels, maps of different sizes, option out of range: the message
- * says which), BB_ERR_SIZE, BB_ERR_MEMORY. */
+ * any thread count. With o->view the picture is the same size (the maps'
+ * times the tiles, then cropped), seen by the camera: pixel (i, j) shows
+ * the point of the surface's top plane
+ *   C + (i - W'/2) R + (j - H'/2) / sin(el) D,   W' x H' the picture,
+ * C its middle, D = (cos az, -sin az) the horizontal way to the viewer and
+ * R = (D_y, -D_x) (texels; the maps tile), or with o->relief where the
+ * view ray from there meets o->relief_height (README "render"), and the maps are
+ * read there bilinearly (texel (x, y) at point (x, y), tiling); the
+ * specular highlight takes the view direction V instead of (0, 0, 1). View
+ * 270, 90 without relief is the plain render. Errors: BB_ERR_ARGUMENT
+ * (missing map for the mode, too few channels, maps of different sizes,
+ * option out of range: the message says which), BB_ERR_SIZE,
+ * BB_ERR_MEMORY. */
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err);
 
 /* "key=value" lines of every option of o that affects pixels (render_mode,
  * light, light_color, lightmap, specular, specular_strength, albedo_mode,
- * tile, crop), for
+ * tile, crop; view and relief when used), for
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb_render_options_describe(const bb_render_options *o);
 
@@ -1676,10 +1793,33 @@ uint64_t bb_mesh_hash(const bb_mesh *m);
 /* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
  * anything Assimp imports), merged as described at bb_mesh. Normals are kept
  * when any part of the model has them (vertices of parts without are zero).
- * Errors: BB_ERR_IO (missing, a directory, unreadable), BB_ERR_FORMAT (not a
- * model Assimp reads, corrupt, no triangles), BB_ERR_VALUE (a coordinate is
- * NaN or infinite), BB_ERR_SIZE (over BB_MAX_MESH_ELEMENTS). */
+ *
+ * Model files are untrusted. A model may read only regular files inside its
+ * own directory (after following links and ".."; a glTF's buffers, an OBJ's
+ * .mtl; embedded data: URIs need no file): naming a file outside it, or a
+ * FIFO, device, directory or unreadable file, fails the load. A file it
+ * names that does not exist is done without when the format can be (an
+ * OBJ's .mtl; a glTF's missing buffer fails), and bb_mesh_load_noted says
+ * so. The import runs in a child process (fork) held to BB_MAX_MODEL_BYTES,
+ * BB_MAX_MODEL_TRIANGLES, BB_MAX_IMPORT_MEMORY and BB_MAX_IMPORT_SECONDS,
+ * on a stack of its own: a model that crashes Assimp (nodes nested 20,000
+ * deep) fails the load, not the caller. The child never returns into the
+ * caller's code (it ends with _exit) and takes no signal handler of the
+ * caller's; a caller that reaps every child from a SIGCHLD handler only
+ * loses the check of the child's exit status.
+ *
+ * Errors: BB_ERR_IO (missing, a directory, a FIFO or device, unreadable, or
+ * a file the model names refused as above), BB_ERR_FORMAT (not a model
+ * Assimp reads, corrupt, no triangles, the importer crashed), BB_ERR_VALUE
+ * (a coordinate is NaN or infinite), BB_ERR_SIZE (over a limit above),
+ * BB_ERR_MEMORY (over BB_MAX_IMPORT_MEMORY, or no memory here). */
 bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
+
+/* bb_mesh_load, also saying what the load did without: on success note (cap
+ * bytes; NULL or cap 0 for none) holds "" or one line such as "read without
+ * bricks.mtl (no such file)"; on failure "". */
+bb_status bb_mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
+                             bb_error *err);
 
 /* Writes m through Assimp's exporters; the format comes from the extension:
  * .obj (without a material file), .ply (binary little-endian), .stl
@@ -1812,6 +1952,10 @@ typedef struct bb_provenance {
  * channel), malloc'd; the caller
  * frees it. A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
+ * Options in use add, after addressing: bounce (rho) and bounces when
+ * bounce_albedo > 0, with bounce_albedo_map (bb_image_hash of the map, 16
+ * hex digits) when it has one; brightness (the brightness map's
+ * bb_image_hash) when there is one.
  * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
 
@@ -2038,6 +2182,12 @@ typedef struct bb_job_options {
   int mips;                  /* 1: mip-mapped files (.tif, .tiff, .exr) */
   const char *basis_file;    /* the file bake.basis came from, or NULL: a
                                 prerequisite in the depfile */
+  const char *bounce_albedo_file; /* an albedo map for inter-reflection
+                                (bake.bounce_albedo_map), read once by the plan;
+                                with bake.bounce_albedo 0 it bounces with the
+                                map as it is (rho 1). NULL: none */
+  const char *brightness_file; /* a brightness map (bake.brightness), read once
+                                by the plan, or NULL */
   /* One input, outputs named one by one (out_dir NULL): */
   const char *paths[BB_OUTPUT_KIND_COUNT]; /* by bb_output_kind; NULL = not written */
   const char *prefix;        /* also PREFIX_KIND.png for each of

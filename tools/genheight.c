@@ -1,6 +1,6 @@
 /* genheight.c: writes deterministic synthetic height maps that tile, for fixtures.
  *
- *   genheight noise|bricks|pit WIDTH HEIGHT OUT [--seed K]
+ *   genheight noise|bricks|pit|cones WIDTH HEIGHT OUT [--seed K]
  *
  * Every map is a periodic function of the texel position with period
  * (WIDTH, HEIGHT) exactly, for any size (non-power-of-two, non-square), so
@@ -137,6 +137,27 @@ static double pit_height(int x, int y, int width, int height, uint32_t seed) {
   return dx * dx + dy * dy <= r * r ? 0.0 : 1.0;
 }
 
+/* ----------------------------------------------------------------- cones */
+
+/* Flat 0 with three small, sharp cones of height 1 (radius 1.5 to 3 texels)
+ * at fixed fractions of the size, distances taken periodically so the map
+ * tiles: where a bake's few azimuth slices show as wedges around each cone
+ * (docs/accuracy.md, "Azimuth wedges"). */
+static double cones_height(int x, int y, int width, int height, uint32_t seed) {
+  (void)seed;
+  static const double cones[3][3] = {{0.31, 0.31, 2.0}, {0.70, 0.55, 1.5}, {0.47, 0.78, 3.0}};
+  double h = 0.0;
+  for (int i = 0; i < 3; i++) {
+    double dx = fabs(x - floor(cones[i][0] * width + 0.5));
+    double dy = fabs(y - floor(cones[i][1] * height + 0.5));
+    dx = fmin(dx, width - dx);
+    dy = fmin(dy, height - dy);
+    const double v = 1.0 - sqrt(dx * dx + dy * dy) / cones[i][2];
+    h = v > h ? v : h;
+  }
+  return h;
+}
+
 /* ------------------------------------------------------------------ main */
 
 typedef double (*height_fn)(int x, int y, int width, int height, uint32_t seed);
@@ -148,6 +169,8 @@ static height_fn generator_named(const char *kind) {
     return bricks_height;
   if (strcmp(kind, "pit") == 0)
     return pit_height;
+  if (strcmp(kind, "cones") == 0)
+    return cones_height;
   return NULL;
 }
 
@@ -189,7 +212,7 @@ static int wants_16_bits(const char *path) {
 static int usage(const char *reason) {
   fprintf(stderr,
           "genheight: %s\n"
-          "usage: genheight noise|bricks|pit WIDTH HEIGHT OUT [--seed K]\n",
+          "usage: genheight noise|bricks|pit|cones WIDTH HEIGHT OUT [--seed K]\n",
           reason);
   return 2;
 }
@@ -199,7 +222,7 @@ int main(int argc, char **argv) {
     return usage("wrong number of arguments");
   height_fn fn = generator_named(argv[1]);
   if (!fn)
-    return usage("unknown kind (noise, bricks, pit)");
+    return usage("unknown kind (noise, bricks, pit, cones)");
   int width, height;
   if (parse_side(argv[2], &width) || parse_side(argv[3], &height))
     return usage("WIDTH and HEIGHT must be 1..4096");

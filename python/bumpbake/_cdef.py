@@ -152,6 +152,10 @@ typedef struct bb_bake_options {
   bb_normal_filter normal_filter;
   int normal_y_up;
   unsigned outputs;
+  double bounce_albedo;
+  const bb_image *bounce_albedo_map;
+  int bounces;
+  const bb_image *brightness;
 } bb_bake_options;
 
 typedef struct bb_bake_result {
@@ -167,6 +171,8 @@ typedef struct bb_bake_result {
   char rayset_id[64];
   bb_basis basis;
   int threads;
+  int bounces;
+  double seconds_bounce;
 } bb_bake_result;
 
 typedef enum bb_ssbump_kind {
@@ -257,6 +263,12 @@ typedef struct bb_render_options {
   int tile_x, tile_y;
   int crop_x, crop_y, crop_width, crop_height;
   int threads;
+  int view;
+  double view_azimuth;
+  double view_elevation;
+  int relief;
+  const bb_image *relief_height;
+  double relief_depth;
 } bb_render_options;
 
 typedef enum bb_render_map {
@@ -380,6 +392,8 @@ typedef struct bb_job_options {
   bb_depth depth;
   int mips;
   const char *basis_file;
+  const char *bounce_albedo_file;
+  const char *brightness_file;
   const char *paths[6];
   const char *prefix;
   const char *slope_path;

@@ -3,6 +3,7 @@
 
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "trace/bounce.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include <math.h>
@@ -89,6 +90,15 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
   if (o->trace.threads < 0 || o->trace.threads > BB_MAX_THREADS)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: threads must be in 0..%d (got %d)",
                     BB_MAX_THREADS, o->trace.threads);
+  if ((st = check_range(o->bounce_albedo, 0.0, 1.0, "bounce albedo", err)) != BB_OK)
+    return st;
+  if (o->bounces < 0 || o->bounces > BB_MAX_BOUNCES)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: bounces must be in 0..%d (got %d)",
+                    BB_MAX_BOUNCES, o->bounces);
+  if (o->bounce_albedo_map && (!o->bounce_albedo_map->pixels || o->bounce_albedo_map->channels < 1))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the bounce albedo map has no pixels");
+  if (o->brightness && (!o->brightness->pixels || o->brightness->channels < 1))
+    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the brightness map has no pixels");
   if (strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
                     (int)o->normal_filter);
@@ -127,6 +137,45 @@ static bb_status caller_trace(const bb_pyramid *p, const bb_rayset *rs, const bb
   return BB_OK;
 }
 
+/* The grey of the bounce albedo map per vertex, clamped to [0, 1]. */
+static bb_status albedo_grey(const bb_image *map, int width, int height, bb_image *out,
+                             bb_error *err) {
+  bb_status st = bb__image_grey(map, width, height, "bake: the bounce albedo map", out, err);
+  if (st != BB_OK) return st;
+  const size_t n = (size_t)width * (size_t)height;
+  for (size_t i = 0; i < n; i++) out->pixels[i] = fminf(fmaxf(out->pixels[i], 0.0f), 1.0f);
+  return BB_OK;
+}
+
+/* Inter-reflection, added to r->vis (bounce.c). */
+static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
+                        const bb_rayset *rays, int threads, bb_bake_result *r, bb_error *err) {
+  bb_image grey = {0};
+  bb_status st = BB_OK;
+  if (o->bounce_albedo_map)
+    st = albedo_grey(o->bounce_albedo_map, r->vis.width, r->vis.height, &grey, err);
+  bb__bounce_options bo;
+  bb__bounce_options_init(&bo);
+  bo.rho = o->bounce_albedo;
+  bo.albedo = grey.pixels ? &grey : NULL;
+  bo.bounces = o->bounces;
+  bo.bias = o->trace.bias_texels;
+  bo.threads = threads;
+  bo.progress = o->trace.progress;
+  bo.progress_user = o->trace.progress_user;
+  if (st == BB_OK) st = bb__bounce_add(pyramid, rays, &bo, &r->vis, &r->bounces, err);
+  bb_image_free(&grey);
+  return st;
+}
+
+/* Inter-reflection can make a lobe brighter than its open sky, but a
+ * channel of the ssbump holds at most 1. */
+static void ssbump_cap(bb_image *ssbump) {
+  const size_t n = (size_t)ssbump->width * (size_t)ssbump->height * (size_t)ssbump->channels;
+  for (size_t i = 0; i < n; i++)
+    if (ssbump->pixels[i] > 1.0f) ssbump->pixels[i] = 1.0f;
+}
+
 /* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent.
  * What is done with goes as soon as it is: the pyramid after the trace, vis
  * (unless keep_vis) once ssbump and ao are made, the smoothed height once
@@ -155,6 +204,12 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
+  if (st == BB_OK && o->bounce_albedo > 0.0) {
+    st = bounce(o, pyramid, &rays, threads, r, err);
+    const double t3 = bb__now_seconds();
+    r->seconds_bounce = t3 - t2;
+    t2 = t3;
+  }
   bb__rayset_release(&rays);
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
@@ -166,6 +221,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
              : bb__derive_ssbump_from_height(&r->filtered, o->height_scale, o->normal_filter,
                                              o->smooth.addressing, &r->vis, &o->basis, threads,
                                              &r->ssbump, err);
+  if (st == BB_OK && r->ssbump.pixels && o->bounce_albedo > 0.0) ssbump_cap(&r->ssbump);
   if (!normal_later && !wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
     bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_AO)))
@@ -207,6 +263,24 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
   return st;
 }
 
+/* The brightness map on ssbump and weights, every basis channel (bent was
+ * derived before, from the ssbump's own directions). */
+static bb_status brightness(const bb_bake_options *o, int threads, bb_bake_result *r,
+                            bb_error *err) {
+  bb_image *maps[2] = {wants(o, BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP)) ? &r->ssbump : NULL,
+                       wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)) ? &r->weights : NULL};
+  for (int i = 0; i < 2; i++) {
+    if (!maps[i] || !maps[i]->pixels) continue;
+    bb_image scaled;
+    bb_status st = bb__derive_brightness(maps[i], maps[i]->channels, o->brightness, "bake",
+                                         threads, &scaled, err);
+    if (st != BB_OK) return st;
+    bb_image_free(maps[i]);
+    *maps[i] = scaled;
+  }
+  return BB_OK;
+}
+
 /* Frees what was made only because another map needed it. */
 static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
   if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED))) bb_image_free(&r->filtered);
@@ -246,8 +320,15 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
   bb_status st = bb_bake_options_check(o, err);
-  /* Before any stage: an overflow of scale x height is named as such. */
+  /* Before any stage: an overflow of scale x height is named as such, a
+   * map of another size as such. */
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
+  const bb_image *sized[2] = {o->bounce_albedo > 0.0 ? o->bounce_albedo_map : NULL, o->brightness};
+  const char *sized_name[2] = {"bounce albedo map", "brightness map"};
+  for (int i = 0; st == BB_OK && i < 2; i++)
+    if (sized[i] && (sized[i]->width != height->width || sized[i]->height != height->height))
+      st = bb__fail(err, BB_ERR_SIZE, "bake: the %s is %dx%d, the height %dx%d", sized_name[i],
+                    sized[i]->width, sized[i]->height, height->width, height->height);
   if (st == BB_OK) st = check_memory(height, o, flags, err);
   if (st != BB_OK) return st;
   r->basis = o->basis;
@@ -255,6 +336,7 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   st = smooth_and_normals(height, o, threads, (flags & BB__BAKE_TAKE_HEIGHT) != 0, r, err);
   if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED))
     st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), r, err);
+  if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
     if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);
     if (r->bent.pixels) bb_image_flip_green(&r->bent);

@@ -55,6 +55,21 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
 double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned flags,
                        double held, double *kept);
 
+/* The grey of img (1 channel: it; 2: the first; 3 or more: Rec. 709 luma
+ * of R, G, B) into out (allocated, 1 channel), which must be width x
+ * height: BB_ERR_SIZE otherwise, BB_ERR_VALUE at a NaN or infinite grey,
+ * messages starting with `what`. Not clamped. */
+bb_status bb__image_grey(const bb_image *img, int width, int height, const char *what,
+                         bb_image *out, bb_error *err);
+
+/* The first `scaled` channels of map times the grey of brightness
+ * (bb__image_grey; negative taken as 0), the others copied; where the
+ * largest scaled channel would exceed 1, the texel's scaled channels are
+ * divided by it (their ratios kept). out is allocated; messages start
+ * with "who: ". */
+bb_status bb__derive_brightness(const bb_image *map, int scaled, const bb_image *brightness,
+                                const char *who, int threads, bb_image *out, bb_error *err);
+
 /* BB_OK when b has 3..BB_MAX_BASIS unit vectors with z >= 0 (a basis
  * filled by hand is checked before it is used), else BB_ERR_ARGUMENT with a
  * message starting "who: ". */

@@ -5,6 +5,7 @@
 #include "core/internal.h"
 #include <math.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -325,4 +326,75 @@ bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int thr
   derive_job job;
   job_init(&job, ssbump, NULL, out, &b);
   return run_rows(&job, bent_row, threads, err);
+}
+
+/* ---------------------------------------------------------------- grey */
+
+bb_status bb__image_grey(const bb_image *img, int width, int height, const char *what,
+                         bb_image *out, bb_error *err) {
+  memset(out, 0, sizeof *out);
+  if (!img || !img->pixels || img->channels < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s has no pixels", what);
+  if (img->width != width || img->height != height)
+    return bb__fail(err, BB_ERR_SIZE, "%s is %dx%d, not %dx%d", what, img->width, img->height,
+                    width, height);
+  bb_status st = bb_image_alloc(out, width, height, 1, err);
+  if (st != BB_OK) return st;
+  const size_t n = (size_t)width * (size_t)height, c = (size_t)img->channels;
+  for (size_t i = 0; i < n; i++) {
+    const float *p = img->pixels + i * c;
+    const double v = c >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : (double)p[0];
+    if (!isfinite(v)) {
+      bb_image_free(out);
+      return bb__fail(err, BB_ERR_VALUE, "%s is not finite at (%zu, %zu)", what,
+                      i % (size_t)width, i / (size_t)width);
+    }
+    out->pixels[i] = (float)v;
+  }
+  return BB_OK;
+}
+
+/* ---------------------------------------------------------- brightness */
+
+typedef struct brightness_job {
+  const bb_image *map, *grey;
+  bb_image *out;
+  int scaled;   /* channels multiplied */
+  int cap_one;  /* 1: a scaled channel holds at most 1, the texel scaled down to keep ratios */
+} brightness_job;
+
+static void brightness_row(void *user, int y) {
+  const brightness_job *job = user;
+  const int channels = job->map->channels, scaled = job->scaled;
+  const size_t first = row_start(job->map, y), end = first + (size_t)job->map->width;
+  for (size_t i = first; i < end; i++) {
+    const float *in = job->map->pixels + i * (size_t)channels;
+    float *out = job->out->pixels + i * (size_t)channels;
+    memcpy(out, in, (size_t)channels * sizeof(float));
+    double b = (double)job->grey->pixels[i];
+    if (!(b > 0.0)) b = 0.0;
+    double largest = 0.0;
+    for (int c = 0; c < scaled; c++) largest = fmax(largest, (double)in[c] * b);
+    if (job->cap_one && largest > 1.0) b /= largest;
+    for (int c = 0; c < scaled; c++) out[c] = (float)((double)in[c] * b);
+  }
+}
+
+bb_status bb__derive_brightness(const bb_image *map, int scaled, const bb_image *brightness,
+                                const char *who, int threads, bb_image *out, bb_error *err) {
+  bb_status st = check_image(map, "map", 1, 64, err);
+  if (st != BB_OK) return st;
+  if ((st = check_output(out, map, brightness, err)) != BB_OK) return st;
+  bb_image grey;
+  char what[96];
+  snprintf(what, sizeof what, "%s: the brightness map", who);
+  if ((st = bb__image_grey(brightness, map->width, map->height, what, &grey, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, map->width, map->height, map->channels, err)) == BB_OK) {
+    brightness_job job = {map, &grey, out, scaled < map->channels ? scaled : map->channels, 1};
+    st = bb__parallel_for(map->height, threads, brightness_row, &job, NULL, NULL, err);
+    if (st != BB_OK) bb_image_free(out);
+  }
+  bb_image_free(&grey);
+  return st;
 }

@@ -67,7 +67,7 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     take(&l, lobes * texel);
   if (traced) {
     const double levels = pyramid_levels(width, height);
-    const int slices = bb_bake_slices(o);
+    const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
     take(&l, texel);                   /* heights in texels */
     take(&l, texel + levels + texel);  /* the pyramid's copy, its levels, a row pass */
     give(&l, texel);                   /* the row pass */
@@ -77,6 +77,12 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     take(&l, vis);
     take(&l, threads * sweep_scratch(width, height));
     give(&l, threads * sweep_scratch(width, height));
+    if (o->bounce_albedo > 0.0) { /* bounce.c: three sums per triangle corner, the albedo's grey */
+      const double bounce = 3.0 * 6.0 * (1 + lobes) * texel + texel +
+                            threads * sweep_scratch(width, height) * 2.0;
+      take(&l, bounce);
+      give(&l, bounce);
+    }
     give(&l, texel + levels + (double)slices * lobes * 8192.0 + 65536.0);
     const int normal_later = wants(o, normal) && !normal_now;
     double ssbump_alive = 0.0;
@@ -107,6 +113,8 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     give(&l, filtered_alive);
   if (!wants(o, normal))
     give(&l, normals);
+  if (o->brightness) /* ssbump and weights each scaled into a copy */
+    take(&l, lobes * texel), give(&l, lobes * texel);
   if (kept)
     *kept = l.alive;
   return l.peak;

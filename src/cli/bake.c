@@ -93,6 +93,7 @@ static const cli_option opt_depfile = {
 static const cli_option opt_json = {
     .id = CLI_OPT_JSON,
     .long_name = "json",
+    .default_text = "off",
     .help = "print one JSON line describing the bake on stdout"};
 static const cli_option opt_scheduler = {
     .id = CLI_OPT_SCHEDULER,
@@ -105,11 +106,39 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .short_name = 'q',
                                      .help = "no progress bar, no list of files written"};
 
+static const cli_option opt_bounce = {
+    .id = CLI_OPT_BOUNCE,
+    .long_name = "bounce",
+    .value_name = "RHO",
+    .default_text = "0 (none; 1 with --bounce-albedo)",
+    .range_text = "0..1",
+    .help = "inter-reflection: ao, ssbump and bent include the light the relief "
+            "reflects, albedo RHO (docs/commands/bake.md)"};
+static const cli_option opt_bounces = {
+    .id = CLI_OPT_BOUNCES,
+    .long_name = "bounces",
+    .value_name = "N",
+    .default_text = "0 (until converged)",
+    .range_text = "0..64",
+    .help = "bounces of reflected light to follow"};
+static const cli_option opt_bounce_albedo = {
+    .id = CLI_OPT_BOUNCE_ALBEDO,
+    .long_name = "bounce-albedo",
+    .value_name = "FILE",
+    .help = "albedo map (grey; RGB: luma) of the height's size, times RHO"};
+static const cli_option opt_brightness = {
+    .id = CLI_OPT_BRIGHTNESS,
+    .long_name = "brightness",
+    .value_name = "FILE",
+    .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights "
+            "(a texel over 1 is scaled down whole)"};
+
 static const cli_option *const bake_options[] = {
     &cli_opt_scale,    &cli_opt_rays,      &opt_slices,       &cli_opt_filter_radius,
     &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,
     &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,
-    &cli_opt_channel,  &cli_opt_depth,     &cli_opt_mips,     &opt_out_normal,
+    &cli_opt_channel,  &cli_opt_depth,     &cli_opt_mips,     &opt_bounce,
+    &opt_bounces,      &opt_bounce_albedo, &opt_brightness,   &opt_out_normal,
     &opt_out_weights,  &opt_out_ssbump,    &opt_out_ao,       &opt_out_bent,
     &opt_out_filtered, &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
     &opt_out_dir,      &opt_maps,          &opt_name,         &opt_keep_going,
@@ -130,8 +159,8 @@ static const cli_command bake_command = {
     "  64 rays         8     ~0.4 s   0.0015   0.0030\n"
     "  256 rays       16     ~0.7 s   0.0004   0.0010   (the default)\n"
     "  1024 rays      32     ~2.6 s   0.0001   0.0004\n"
-    "With --clamp the trace takes 2.3 to 3.4 times as long. See the README's\n"
-    "Performance and Accuracy.\n"
+    "With --clamp the trace takes 2.3 to 3.4 times as long. See\n"
+    "docs/performance.md and docs/accuracy.md.\n"
     "\n"
     "Batches: bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST]\n"
     "bakes every HEIGHT (a directory: the images in it, sorted, not below it)\n"
@@ -172,6 +201,14 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_QUIET: a->quiet = 1; return 0;
   case CLI_OPT_SCHEDULER: a->scheduler = arg; return 0;
   case CLI_OPT_SLICES: return cli_settings_apply_slices(bake_command.name, &a->settings, arg);
+  case CLI_OPT_BOUNCE:
+    return cli_parse_double(bake_command.name, "--bounce", arg, 0.0, 0, 1.0,
+                            &a->settings.bake.bounce_albedo);
+  case CLI_OPT_BOUNCES:
+    return cli_parse_int(bake_command.name, "--bounces", arg, 0, BB_MAX_BOUNCES,
+                         &a->settings.bake.bounces);
+  case CLI_OPT_BOUNCE_ALBEDO: a->job.bounce_albedo_file = arg; return 0;
+  case CLI_OPT_BRIGHTNESS: a->job.brightness_file = arg; return 0;
   default: break;
   }
   return cli_settings_apply(bake_command.name, &a->settings, opt, arg);

@@ -1,5 +1,5 @@
 /* cli_combine.c: `bumpbake combine`, blending two maps by a mask or a
- * constant, or overlaying a detail map (README "combine"). */
+ * constant, or overlaying a detail map (docs/commands/combine.md). */
 #include "cli.h"
 #include "common.h"
 #include "maps.h"
@@ -34,6 +34,12 @@ static const cli_option opt_detail = {
     .long_name = "detail",
     .help = "overlay B on A as detail (ssbump/weights/ao: A * B / flat; normal: "
             "DOOM 3's addnormals)"};
+static const cli_option opt_brightness = {
+    .id = CLI_OPT_MAP_BRIGHTNESS,
+    .long_name = "brightness",
+    .value_name = "FILE",
+    .help = "multiply A by FILE's grey (RGB: luma), the paper's brightness stored in the "
+            "ssbump; a texel over 1 is scaled down whole (no B)"};
 static const cli_option opt_normal_y = {
     .id = CLI_OPT_NORMAL_Y,
     .long_name = "normal-y",
@@ -43,19 +49,22 @@ static const cli_option opt_normal_y = {
 
 static const cli_option *const combine_options[] = {
     &opt_output,         &opt_mix,      &opt_mask,
-    &opt_detail,         &opt_kind,     &opt_normal_y,
+    &opt_detail,         &opt_brightness, &opt_kind, &opt_normal_y,
     &cli_maps_opt_depth, &cli_opt_mips, &cli_opt_help};
 
 static const cli_command combine_command = {
     "combine",
-    "A B -o OUT (--mix T | --mask FILE | --detail) [OPTIONS]",
+    "A B -o OUT (--mix T | --mask FILE | --detail) [OPTIONS] | A --brightness FILE -o OUT",
     "Combines two maps of the same size. --mix and --mask blend them,\n"
     "(1 - T) A + T B, linear for ssbump, weights and ao (they are linear in light),\n"
     "renormalised for normal maps. --detail overlays B on A: A * B / flat for\n"
     "ssbump, weights and ao (flat = B's flat, unoccluded value as its file holds\n"
     "it: 147 in an 8-bit ssbump), DOOM 3's addnormals for normal maps. A flat B,\n"
     "T = 0 or a black mask leaves A unchanged bit for bit. Channels past the\n"
-    "kind's (an alpha) blend like the rest, or with --detail are A's.",
+    "kind's (an alpha) blend like the rest, or with --detail are A's.\n"
+    "--brightness multiplies one map by a grey brightness map (ssbump, weights: a\n"
+    "texel whose largest channel would pass 1 is scaled so it is 1, its ratios kept;\n"
+    "ao: clipped at 1).",
     combine_options,
     (int)(sizeof combine_options / sizeof combine_options[0]),
     cli_settings_init,
@@ -63,7 +72,7 @@ static const cli_command combine_command = {
 
 typedef struct combine_args {
   cli_settings settings;
-  const char *output, *mask;
+  const char *output, *mask, *brightness;
   bb_map_kind kind;
   double mix;
   int mix_given, detail;
@@ -80,6 +89,9 @@ static int combine_option(void *ctx, const cli_option *opt, const char *arg) {
     return 0;
   case CLI_OPT_MAP_DETAIL:
     a->detail = 1;
+    return 0;
+  case CLI_OPT_MAP_BRIGHTNESS:
+    a->brightness = arg;
     return 0;
   case CLI_OPT_MAP_MIX:
     a->mix_given = 1;
@@ -99,19 +111,20 @@ static int combine_parse(int argc, char **argv, combine_args *a, const char **in
   int first = 0;
   int rc = cli_parse_options(&combine_command, argc, argv, combine_option, a, &first);
   if (!rc)
-    rc = cli_expect_positionals(&combine_command, argc, argv, first, 2, "A B");
+    rc = cli_expect_positionals(&combine_command, argc, argv, first, a->brightness ? 1 : 2,
+                                a->brightness ? "A" : "A B");
   if (rc)
     return rc;
   in[0] = argv[first];
-  in[1] = argv[first + 1];
+  in[1] = a->brightness ? a->brightness : argv[first + 1];
   if (!a->output)
     return cli_usage_error(combine_command.name, "-o OUT is required");
-  int modes = a->mix_given + (a->mask != NULL) + a->detail;
+  int modes = a->mix_given + (a->mask != NULL) + a->detail + (a->brightness != NULL);
   if (modes != 1)
     return cli_usage_error(combine_command.name,
-                           "give exactly one of --mix T, --mask FILE "
-                           "and --detail");
-  /* The output must not replace A, B or the mask. */
+                           "give exactly one of --mix T, --mask FILE, --detail "
+                           "and --brightness FILE");
+  /* The output must not replace A, B (or the brightness map) or the mask. */
   const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
   const char *reads[3] = {in[0], in[1], a->mask};
   bb_error err = {{0}};
@@ -172,7 +185,9 @@ static int combine_maps(const combine_args *a, const char *const *in, const map_
                         const bb_image *mask, bb_image *out) {
   bb_error err = {{0}};
   bb_status st;
-  if (a->detail) {
+  if (a->brightness) {
+    st = bb_combine_brightness(values_of(&m[0]), &m[1].file, a->kind, out, &err);
+  } else if (a->detail) {
     float flat[3];
     bb_map_flat_texel(a->kind, m[1].info.bits_per_sample, m[1].info.is_float, flat);
     st = bb_combine_detail(values_of(&m[0]), values_of(&m[1]), a->kind, flat, out, &err);
@@ -187,7 +202,9 @@ static int combine_run(const cli_run *run, combine_args *a, const char *const *i
   map_input m[2] = {{{0}, {0}, {0}}, {{0}, {0}, {0}}};
   bb_image mask = {0}, out = {0};
   int rc = load_map(a, in[0], &m[0]);
-  if (!rc)
+  if (!rc && a->brightness) /* a grey to multiply by, whatever the kind */
+    rc = cli_maps_read(in[1], &m[1].file, &m[1].info);
+  else if (!rc)
     rc = load_map(a, in[1], &m[1]);
   if (!rc && a->mask)
     rc = load_mask(a->mask, &mask);

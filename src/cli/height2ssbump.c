@@ -225,7 +225,8 @@ static int h2s_run(const char *command_line, h2s_args *a) {
   bb_error err = {{0}};
   /* Valve's channel rule: alpha when there is one, else (Valve's tool would
    * fail) the grey or the mean of R, G, B, which a note says. */
-  bb_status st = bb_height_file_read(a->input, BB_CHANNEL_VALVE, 0.0f, cli_note, NULL, &height,
+  bb_status st = bb_height_file_read(a->input, BB_CHANNEL_VALVE, a->settings.bake.height_scale,
+                                     cli_note, NULL, &height,
                                      &source, &err);
   int rc = cli_status_exit(a->input, st, &err);
   if (!rc) {

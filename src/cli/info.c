@@ -177,7 +177,7 @@ static int info_file(const info_args *a, const char *path, int index) {
     print_json(path, &f);
   } else {
     if (index > 0)
-      putchar('\n'); /* a blank line between files */
+      putchar('\n'); /* a blank line between the files described */
     print_text(path, &f);
   }
   bb_image_info_free(&f.info);
@@ -196,9 +196,12 @@ int bb_cli_info(int argc, char **argv) {
     return cli_usage_error(info_command.name, "missing FILE (usage: bumpbake info %s)",
                            info_command.synopsis);
   rc = BB_EXIT_OK;
+  int described = 0; /* files described so far, for the blank line between */
   for (int i = first; i < argc; i++) {
-    if (info_file(&a, argv[i], i - first))
+    if (info_file(&a, argv[i], described))
       rc = BB_EXIT_FAILURE;
+    else
+      described++;
     fflush(stdout); /* keep stdout and stderr lines in order */
   }
   return rc;

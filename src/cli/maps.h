@@ -16,7 +16,8 @@ enum cli_maps_opt_id {
   CLI_OPT_MAP_MASK,        /* --mask FILE */
   CLI_OPT_MAP_DETAIL,      /* --detail */
   CLI_OPT_MAP_BASE_DIR,    /* --base DIR */
-  CLI_OPT_MAP_ALLOW_OUTSIDE /* --allow-outside-base */
+  CLI_OPT_MAP_ALLOW_OUTSIDE, /* --allow-outside-base */
+  CLI_OPT_MAP_BRIGHTNESS     /* combine --brightness FILE */
 };
 
 /* --depth for commands whose default follows their input. */

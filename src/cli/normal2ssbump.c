@@ -33,7 +33,8 @@ static const cli_command n2s_command = {
     "normal map (no self-shadowing; bake --ssbump traces that). NORMAL's codes\n"
     "decode as N = 2 code / max - 1 (127.5 of 255 is 0), float files as N; an\n"
     "alpha channel is copied. Without -o, writes NAME_ssbump.tga next to NORMAL,\n"
-    "NAME being NORMAL up to \"_normal\", else up to its extension (Valve's rule).",
+    "NAME being NORMAL's file name up to its first \"_normal\" (any case), else up\n"
+    "to its first '.' (Valve's rule: wall.v2.png gives wall_ssbump.tga).",
     n2s_options,
     (int)(sizeof n2s_options / sizeof n2s_options[0]),
     cli_settings_init,

@@ -60,7 +60,7 @@ const cli_option cli_opt_basis = {
     .value_name = "hl2|hl2+z|dirs:N|FILE",
     .range_text = "N 3..16",
     .help = "directions occlusion is projected on, one channel each: Half-Life 2's, "
-            "N evenly spread, or a file of x y z lines (README \"Bases\")"};
+            "N evenly spread, or a file of x y z lines (docs/commands/bake.md, \"Bases\")"};
 const cli_option cli_opt_normal_filter = {
     .id = CLI_OPT_NORMAL_FILTER,
     .long_name = "normal-filter",
@@ -84,7 +84,8 @@ const cli_option cli_opt_channel = {
     .id = CLI_OPT_CHANNEL,
     .long_name = "channel",
     .value_name = "r|g|b|a|luma|mean",
-    .help = "height channel (auto: grey, or mean of R, G, B)"};
+    .help = "height channel (auto: the grey; alpha where it holds the height, as Valve's "
+            "tools keep it; else the mean of R, G, B; a note says which)"};
 const cli_option cli_opt_mips = {
     .id = CLI_OPT_MIPS,
     .long_name = "mips",
@@ -222,7 +223,13 @@ static void print_help(const cli_command *cmd) {
                     : cmd->init_settings
                         ? settings_default_text(o->id, &defaults, dflt, sizeof dflt)
                         : NULL;
-    printf("  %-36s %s", flags, o->help);
+    /* At least two spaces end the flags, also when they fill or overflow
+     * their column: tools/gen_docs.py splits the line there, and an option
+     * and its default stay on one line for whoever greps them. */
+    if (strlen(flags) >= 36)
+      printf("  %s  %s", flags, o->help);
+    else
+      printf("  %-36s %s", flags, o->help);
     if (d)
       printf("; default %s", d);
     if (o->range_text)

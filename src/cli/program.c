@@ -42,7 +42,7 @@ static const cli_command program_command = {
     "EXPR -o OUT [OPTIONS]",
     "Evaluates a DOOM 3 image program, e.g. 'addnormals(a_local.tga, heightmap(a_h.tga, "
     "4))',\n"
-    "with id Tech 4's formulas (README \"program\"): heightmap(img, scale),\n"
+    "with id Tech 4's formulas (docs/commands/program.md): heightmap(img, scale),\n"
     "addnormals(a, b), smoothnormals(a), add(a, b), scale(a, r, g, b, a),\n"
     "invertAlpha(a), invertColor(a), makeIntensity(a), makeAlpha(a), _flat.\n"
     "A program that makes a normal map is written as bumpbake writes normals\n"

@@ -9,6 +9,7 @@
 #include "render_common.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -82,6 +83,21 @@ static const cli_option opt_orbit = {
     .help = "N frames of the light circling at its elevation: OUT.gif animates at 10 "
             "frames/s, OUT.png/.exr writes OUT_000.png, ..."};
 
+static const cli_option opt_view = {
+    .id = CLI_RENDER_OPT_VIEW,
+    .long_name = "view",
+    .value_name = "AZ,EL",
+    .default_text = "overhead",
+    .range_text = "EL 1..90",
+    .help = "a camera at azimuth AZ (as --light's) and elevation EL degrees, the "
+            "surface tiling (270,30: from the bottom, receding up)"};
+static const cli_option opt_relief = {
+    .id = CLI_RENDER_OPT_RELIEF,
+    .long_name = "relief",
+    .default_text = "off",
+    .help = "with --view and a HEIGHT: parallax occlusion mapping of the height, the "
+            "maps read where each view ray meets it (shaders/ssbump_relief.glsl)"};
+
 static const cli_option *const render_options[] = {
     &cli_opt_scale,
     &cli_opt_rays,
@@ -111,6 +127,8 @@ static const cli_option *const render_options[] = {
     &opt_tile,
     &opt_crop,
     &opt_orbit,
+    &opt_view,
+    &opt_relief,
     &cli_render_opt_output,
     &cli_opt_depth,
     &cli_render_opt_quiet,
@@ -194,6 +212,20 @@ static int render_option(void *ctx, const cli_option *opt, const char *arg) {
     return parse_crop(a, arg);
   case CLI_RENDER_OPT_ORBIT:
     return cli_parse_int(cmd, "--orbit", arg, 1, 3600, &a->orbit);
+  case CLI_RENDER_OPT_VIEW: {
+    char *end = NULL;
+    const double az = strtod(arg, &end);
+    const double el = end && *end == ',' ? strtod(end + 1, &end) : NAN;
+    if (!end || *end != '\0' || !isfinite(az) || !(el >= 1.0 && el <= 90.0))
+      return cli_usage_error(cmd, "--view needs AZ,EL: an azimuth and an elevation in "
+                                  "1..90 degrees (got '%s')",
+                             arg);
+    a->render.view = 1, a->render.view_azimuth = az, a->render.view_elevation = el;
+    return 0;
+  }
+  case CLI_RENDER_OPT_RELIEF:
+    a->render.relief = 1;
+    return 0;
   case CLI_RENDER_OPT_OUTPUT:
     a->output = arg;
     return 0;
@@ -227,6 +259,11 @@ static int check_inputs(const render_args *a) {
     return cli_usage_error(cmd,
                            "give a HEIGHT to bake or baked maps (--normal, --ssbump, "
                            "--ao, --bent, --slope), not both");
+  if (a->render.relief && !a->render.view)
+    return cli_usage_error(cmd, "--relief needs --view AZ,EL (from straight above a relief "
+                                "shows nothing)");
+  if (a->render.relief && !a->height_path)
+    return cli_usage_error(cmd, "--relief reads the height: give a HEIGHT (and --scale)");
   if (a->height_path) {
     if (!a->settings.scale_given)
       return cli_usage_error(cmd, "--scale is required with a HEIGHT (texels of "
@@ -430,6 +467,8 @@ static int bake_height(render_args *a, render_inputs *in) {
   in->input_hash = in->source.height_hash;
   in->sources.height = a->height_path;
   bb_bake_result *r = &in->bake;
+  a->render.relief_height = &r->filtered; /* --relief: the height as baked */
+  a->render.relief_depth = (double)a->settings.bake.height_scale;
   in->view = (bb_render_maps){&r->normal, r->ssbump.pixels ? &r->ssbump : NULL,
                               r->ao.pixels ? &r->ao : NULL,
                               r->bent.pixels ? &r->bent : NULL, NULL, NULL};

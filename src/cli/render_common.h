@@ -29,7 +29,9 @@ enum {
   CLI_RENDER_OPT_IN_SLOPE, /* the IN_ ids stay consecutive: they index map paths */
   CLI_RENDER_OPT_PANEL_SIZE,
   CLI_RENDER_OPT_OUTPUT,
-  CLI_RENDER_OPT_QUIET
+  CLI_RENDER_OPT_QUIET,
+  CLI_RENDER_OPT_VIEW,
+  CLI_RENDER_OPT_RELIEF
 };
 
 /* Rows of the lighting options, shared by both commands' tables. */

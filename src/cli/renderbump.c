@@ -272,7 +272,10 @@ static int rbf_run(const char *command_line, rbf_args *a) {
   memset(&mesh, 0, sizeof mesh);
   memset(&result, 0, sizeof result);
   bb_error err = {{0}};
-  bb_status st = bb_mesh_load(a->model, &mesh, &err);
+  char note[512];
+  bb_status st = bb_mesh_load_noted(a->model, &mesh, note, sizeof note, &err);
+  if (st == BB_OK && note[0]) /* a missing .mtl and the like */
+    fprintf(stderr, "bumpbake: %s: note: %s\n", a->model, note);
   if (st == BB_OK)
     st = bb_renderbump_flat(&mesh, &a->render, &result, &err);
   int rc = cli_status_exit(a->model, st, &err);

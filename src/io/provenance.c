@@ -151,6 +151,22 @@ static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
   put(t, "normal_filter", bb_normal_filter_name(o->normal_filter));
   put(t, "normal_y", o->normal_y_up ? "up" : "down");
   put(t, "addressing", o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+  /* Inter-reflection and brightness only when used, so the provenance of
+   * a bake without them (and its up-to-date check) stays as it was. Maps
+   * are named by bb_image_hash of their pixels as given. */
+  char hash[32];
+  if (o->bounce_albedo > 0.0) {
+    put_double(t, "bounce", o->bounce_albedo);
+    put_int(t, "bounces", o->bounces);
+    if (o->bounce_albedo_map) {
+      snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->bounce_albedo_map));
+      put(t, "bounce_albedo_map", hash);
+    }
+  }
+  if (o->brightness) {
+    snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->brightness));
+    put(t, "brightness", hash);
+  }
 }
 
 char *bb_provenance_format(const bb_provenance *p) {
@@ -483,7 +499,8 @@ static const char *const PACK_ORDER[] = {
     "bumpbake_version", "input_hash", "input_file_hash", "scale", "rays", "rayset",
     "filter_radius",
     "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
-    "addressing",       "channel",    NULL,    "output", "input",         "command"};
+    "addressing",       "bounce",     "bounces", "bounce_albedo_map", "brightness",
+    "channel",          NULL,         "output", "input",         "command"};
 enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
 
 /* Rank of a line's key in PACK_ORDER (the NULL entry's for other keys). */

@@ -117,6 +117,15 @@ static void add_settings(text *t, const bb_job_options *o) {
     add_option(t, "--depth", bb_depth_name(o->depth));
   if (o->mips)
     add_option(t, "--mips", NULL);
+  if (b->bounce_albedo != db->bounce_albedo &&
+      !(o->bounce_albedo_file && b->bounce_albedo == 1.0))
+    add_double(t, "--bounce", b->bounce_albedo);
+  if (b->bounces != db->bounces)
+    add_int(t, "--bounces", b->bounces);
+  if (o->bounce_albedo_file)
+    add_option(t, "--bounce-albedo", o->bounce_albedo_file);
+  if (o->brightness_file)
+    add_option(t, "--brightness", o->brightness_file);
 }
 
 /* The outputs: one by one, or a batch's directory, maps and names. */

@@ -58,6 +58,8 @@ struct bb_job {
   char *basis_file;         /* copies of the options' strings */
   char *out_dir, *name_template, *depfile, *command, *command_options;
   char *slope_path;
+  char *bounce_albedo_file, *brightness_file;
+  bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
   bb__job_item *items;
   int count;
   int batch;                /* 1: out_dir names the outputs */
@@ -74,6 +76,14 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
  * writing it would take more memory than is available (memory.c), naming
  * both figures; BB_OK otherwise, or when its header cannot be read. */
 bb_status bb__job_memory_check(const bb_job *job, const bb__job_item *item, bb_error *err);
+
+/* Most files one input's bake reads: the input, the basis file, the bounce
+ * albedo map and the brightness map. */
+#define BB__JOB_MAX_READS 4
+
+/* The files item's bake reads, its depfile prerequisites, into out
+ * (BB__JOB_MAX_READS entries); the count. */
+int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out);
 
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);

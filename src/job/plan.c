@@ -407,8 +407,8 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
       specs[n++] = (bb_output_spec){item->slope_lit_path, "slope_lit", 1, job->options.depth, 0, 0};
     }
   }
-  const char *reads[2] = {item->input, job->prerequisite_basis ? job->basis_file : NULL};
-  bb_status st = bb_outputs_check(specs, n, reads, 2, err);
+  const char *reads[BB__JOB_MAX_READS];
+  bb_status st = bb_outputs_check(specs, n, reads, bb__job_reads(job, item, reads), err);
   for (int i = 0; i < maps && st == BB_OK; i++)
     st = check_channels(job, specs[i].path, kinds[i], err);
   return st;
@@ -423,7 +423,8 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
   const char *path = job->depfile;
   for (int i = 0; i < job->count; i++) {
     const bb__job_item *item = &job->items[i];
-    const char *prereq[2] = {item->input, job->prerequisite_basis ? job->basis_file : NULL};
+    const char *prereq[BB__JOB_MAX_READS];
+    const int n_prereq = bb__job_reads(job, item, prereq);
     const char *targets[BB_JOB_MAX_OUTPUTS];
     int t = 0;
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
@@ -433,7 +434,7 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
       targets[t++] = job->slope_path;
     if (item->slope_lit_path)
       targets[t++] = item->slope_lit_path;
-    bb__dep_rule rule = {targets, t, prereq, prereq[1] ? 2 : 1};
+    bb__dep_rule rule = {targets, t, prereq, n_prereq};
     bb_status st = bb__depfile_check_names(path, &rule, 1, err);
     if (st != BB_OK)
       return st;
@@ -531,6 +532,11 @@ static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *er
   job->command = copy(o->command);
   job->command_options = copy(o->command_options);
   job->slope_path = copy(o->slope_path);
+  job->bounce_albedo_file = copy(o->bounce_albedo_file);
+  job->brightness_file = copy(o->brightness_file);
+  if ((o->bounce_albedo_file && !job->bounce_albedo_file) ||
+      (o->brightness_file && !job->brightness_file))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   if ((o->basis_file && !job->basis_file) || (o->out_dir && !job->out_dir) ||
       (o->name_template && !job->name_template) || (o->depfile && !job->depfile) ||
       (o->command && !job->command) || (o->command_options && !job->command_options) ||
@@ -546,10 +552,29 @@ static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *er
   job->options.command_options = job->command_options;
   job->options.slope_path = job->slope_path;
   job->options.prefix = NULL; /* expanded into the item's paths */
+  job->options.bounce_albedo_file = job->bounce_albedo_file;
+  job->options.brightness_file = job->brightness_file;
   /* A basis file is a prerequisite only when it made the basis. */
   job->prerequisite_basis =
       job->basis_file && strncmp(o->bake.basis.name, "vectors:", 8) == 0;
   return BB_OK;
+}
+
+/* The maps the bake multiplies by, read once for every input (the bake
+ * checks their size against each). */
+static bb_status read_bake_maps(bb_job *job, bb_error *err) {
+  bb_status st = BB_OK;
+  if (job->bounce_albedo_file) {
+    st = bb_image_read(job->bounce_albedo_file, &job->bounce_albedo_map, NULL, err);
+    job->options.bake.bounce_albedo_map = st == BB_OK ? &job->bounce_albedo_map : NULL;
+    if (st == BB_OK && job->options.bake.bounce_albedo == 0.0)
+      job->options.bake.bounce_albedo = 1.0;
+  }
+  if (st == BB_OK && job->brightness_file) {
+    st = bb_image_read(job->brightness_file, &job->brightness_map, NULL, err);
+    job->options.bake.brightness = st == BB_OK ? &job->brightness_map : NULL;
+  }
+  return st;
 }
 
 /* A single input's outputs, as named, and PREFIX_KIND.png for Valve's trio
@@ -624,6 +649,8 @@ bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_o
   if (!job)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   st = copy_options(job, o, err);
+  if (st == BB_OK)
+    st = read_bake_maps(job, err);
   if (st == BB_OK && job->batch)
     st = check_template(job->name_template, err);
   if (st == BB_OK)
@@ -668,7 +695,23 @@ void bb_job_free(bb_job *job) {
   free(job->command);
   free(job->command_options);
   free(job->slope_path);
+  free(job->bounce_albedo_file);
+  free(job->brightness_file);
+  bb_image_free(&job->bounce_albedo_map);
+  bb_image_free(&job->brightness_map);
   free(job);
+}
+
+int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out) {
+  int n = 0;
+  out[n++] = item->input;
+  if (job->prerequisite_basis)
+    out[n++] = job->basis_file;
+  if (job->bounce_albedo_file)
+    out[n++] = job->bounce_albedo_file;
+  if (job->brightness_file)
+    out[n++] = job->brightness_file;
+  return n;
 }
 
 int bb_job_count(const bb_job *job) {

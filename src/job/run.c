@@ -143,9 +143,7 @@ static bb__dep_rule rule_of(const bb_job *job, const bb__job_item *item, const c
   int t = 0;
   for (int k = 0; k < item->report.output_count; k++)
     targets[t++] = item->report.outputs[k].path;
-  prereq[0] = item->input;
-  prereq[1] = job->prerequisite_basis ? job->basis_file : NULL;
-  return (bb__dep_rule){targets, t, prereq, prereq[1] ? 2 : 1};
+  return (bb__dep_rule){targets, t, prereq, bb__job_reads(job, item, prereq)};
 }
 
 /* The files of one input: its maps, the slope files, and a single input's
@@ -195,7 +193,7 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   free(command);
   if (st == BB_OK && job->depfile && !job->batch) {
     /* One input's depfile goes in with its maps: all of them or none. */
-    const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[2];
+    const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
     bb__dep_rule rule = rule_of(job, item, targets, prereq);
     size_t size = 0;
     if (!(b->depfile_text = bb__depfile_text(&rule, 1, &size)))
@@ -290,7 +288,7 @@ bb_status bb_job_write_depfile(bb_job *job, bb_error *err) {
   if (!job->depfile || !job->batch)
     return BB_OK;
   const char *(*targets)[BB_JOB_MAX_OUTPUTS] = malloc((size_t)job->count * sizeof *targets);
-  const char *(*prereq)[2] = malloc((size_t)job->count * sizeof *prereq);
+  const char *(*prereq)[BB__JOB_MAX_READS] = malloc((size_t)job->count * sizeof *prereq);
   bb__dep_rule *rules = malloc((size_t)job->count * sizeof *rules);
   bb_status st = BB_OK;
   int n = 0, baked_inputs = 0;

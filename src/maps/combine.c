@@ -1,5 +1,5 @@
 /* combine.c: blending two maps and overlaying a detail map, for ssbumps,
- * weights, ao and normal maps (README "combine" defines the operators).
+ * weights, ao and normal maps (docs/commands/combine.md defines the operators).
  *
  * Invariant: an identity input gives the base back bit for bit. A blend
  * factor of exactly 0 (or 1) copies a (or b); a detail texel equal to the
@@ -249,4 +249,28 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
       detail_linear_texel(tb, td, flat, need, channels, to);
   }
   return BB_OK;
+}
+
+/* --------------------------------------------------------- brightness */
+
+bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err) {
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "brightness: out is NULL");
+  memset(out, 0, sizeof *out);
+  if (kind == BB_MAP_NORMAL)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "brightness: a normal map has no room for a brightness (unit vectors); "
+                    "give it to the ssbump or the weights");
+  if (strcmp(bb_map_kind_name(kind), "unknown") == 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "brightness: unknown map kind %d", (int)kind);
+  const int need = bb_map_kind_channels(kind);
+  bb_status st = bb__check_channels(map, need, "brightness: the map", err);
+  if (st == BB_OK && need == 3) st = bb__check_hl2_map(map, NULL, "brightness: the map", err);
+  if (st == BB_OK) st = bb__check_finite(map, map->channels, "brightness: the map", err);
+  if (st == BB_OK && (!brightness || !brightness->pixels))
+    st = bb__fail(err, BB_ERR_ARGUMENT, "brightness: missing brightness map");
+  if (st == BB_OK)
+    st = bb__derive_brightness(map, need, brightness, "brightness", 0, out, err);
+  return st;
 }

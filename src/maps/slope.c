@@ -1,5 +1,5 @@
 /* slope.c: flipcode's 1999 slope map (one byte of slopes per texel) and
- * the 16 x 16 table that lights it (README "Slope map"). */
+ * the 16 x 16 table that lights it (docs/commands/bake.md, "Slope map"). */
 
 #include "core/internal.h"
 #include "maps/maps_internal.h"

@@ -72,6 +72,45 @@ static void sample_span(double lo, double hi, int n, int count, int *first, int 
   *last = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
 }
 
+/* Edge k's value at sample column i of a row whose own term is row: the
+ * one expression every inside test uses. fl(a u + row) never decreases in
+ * u when a > 0 and never increases when a < 0 (rounding is monotone), so
+ * the columns where it is >= 0 are one run reaching an end of the row. */
+static inline double edge_at(double a, double row, int i, int n) {
+  const double u = (i + 0.5) / n;
+  return a * u + row;
+}
+
+/* Narrows [*lo, *hi] to the columns where edge (a, row) is >= 0: from the
+ * crossing's estimate, then stepped until the very test the drawing loop
+ * makes agrees, so the run is exact and costs O(1), not a scan of the row. */
+static void clip_to_edge(double a, double row, int n, int *lo, int *hi) {
+  if (*lo > *hi)
+    return;
+  if (a == 0.0) { /* the edge runs along the row: all or nothing */
+    if (!(row >= 0.0))
+      *hi = *lo - 1;
+    return;
+  }
+  /* The column whose centre is nearest the crossing u = -row / a, kept
+   * within the run as a double before it becomes an int. */
+  double x = (-row / a) * n - 0.5;
+  int c = !(x >= *lo) ? *lo : (!(x <= *hi) ? *hi : (int)x);
+  if (a > 0.0) { /* inside from the crossing rightwards: find the first inside column */
+    while (c > *lo && edge_at(a, row, c - 1, n) >= 0.0)
+      c--;
+    while (c <= *hi && !(edge_at(a, row, c, n) >= 0.0))
+      c++;
+    *lo = c;
+  } else { /* inside leftwards: find the last inside column */
+    while (c < *hi && edge_at(a, row, c + 1, n) >= 0.0)
+      c++;
+    while (c >= *lo && !(edge_at(a, row, c, n) >= 0.0))
+      c--;
+    *hi = c;
+  }
+}
+
 void bb__band_draw(bb__sample_band *band, const bb__raster_setup *s, int32_t id) {
   const int n = band->per_texel;
   int i0, i1, j0, j1;
@@ -83,11 +122,17 @@ void bb__band_draw(bb__sample_band *band, const bb__raster_setup *s, int32_t id)
     const double v = (j + 0.5) / n;
     const double row0 = s->b[0] * v + s->c[0], row1 = s->b[1] * v + s->c[1],
                  row2 = s->b[2] * v + s->c[2];
+    /* Only the columns the triangle covers in this row are visited: its
+     * cost is what it draws plus a few tests per row, not its box. */
+    int lo = i0, hi = i1;
+    clip_to_edge(s->a[0], row0, n, &lo, &hi);
+    clip_to_edge(s->a[1], row1, n, &lo, &hi);
+    clip_to_edge(s->a[2], row2, n, &lo, &hi);
     double *depth = band->depth + (long)(j - band->first_row) * band->columns;
     int32_t *winner = band->winner + (long)(j - band->first_row) * band->columns;
-    for (int i = i0; i <= i1; i++) {
-      const double u = (i + 0.5) / n;
-      const double e0 = s->a[0] * u + row0, e1 = s->a[1] * u + row1, e2 = s->a[2] * u + row2;
+    for (int i = lo; i <= hi; i++) {
+      const double e0 = edge_at(s->a[0], row0, i, n), e1 = edge_at(s->a[1], row1, i, n),
+                   e2 = edge_at(s->a[2], row2, i, n);
       if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0)
         continue;
       const double d = (e0 * s->d[0] + e1 * s->d[1] + e2 * s->d[2]) * s->inv_area;

@@ -60,6 +60,8 @@ typedef struct rb_job {
   int band_rows, bands;
   size_t *bin_start;      /* bands + 1 */
   bin_entry *bins;
+  double reach;           /* estimated samples the copies reach (see reach_of) */
+  double copies;          /* triangle copies drawn */
   bb_renderbump_result *r;
   atomic_int out_of_memory;
 } rb_job;
@@ -229,6 +231,43 @@ static void band_range(const rb_job *job, double lo, double hi, int *first, int 
   *last = l >= job->bands ? job->bands - 1 : (int)l;
 }
 
+/* Sample rows or columns whose centres (k + 0.5) / n lie in [lo, hi],
+ * within 0 .. count * n - 1 (count texels). */
+static double samples_within(double lo, double hi, int n, int count) {
+  double first = fmax(ceil(lo * n - 0.5), 0.0);
+  double last = fmin(floor(hi * n - 0.5), (double)count * n - 1.0);
+  return last >= first ? last - first + 1.0 : 0.0;
+}
+
+/* Twice the area (texels^2) and the perimeter (texels) of triangle t in
+ * image space. */
+static void triangle_measure(const rb_job *job, size_t t, double *area2, double *perimeter) {
+  const uint32_t *idx = job->mesh->indices + 3 * t;
+  const double *p[3];
+  for (int k = 0; k < 3; k++)
+    p[k] = job->uvd + 3 * (size_t)idx[k];
+  *area2 = fabs((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
+                (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]));
+  *perimeter = 0.0;
+  for (int k = 0; k < 3; k++) {
+    const double *a = p[k], *b = p[(k + 1) % 3];
+    *perimeter += hypot(b[0] - a[0], b[1] - a[1]);
+  }
+}
+
+/* What drawing one copy (its box shifted into place) costs at most, in
+ * samples: one per sample row it spans (the run of each row is found in a
+ * few tests), plus the samples it covers: no more than the part of its box
+ * inside the image, nor than a convex shape of its area and perimeter can
+ * hold (area + perimeter / 2 + 1, in samples). */
+static double reach_of(const rb_job *job, const double box[4], double area2, double perimeter) {
+  const int n = job->o->samples;
+  const double rows = samples_within(box[1], box[3], n, job->o->height);
+  const double columns = samples_within(box[0], box[2], n, job->o->width);
+  const double shape = 0.5 * area2 * n * n + 0.5 * perimeter * n + 1.0;
+  return rows + fmin(rows * columns, shape);
+}
+
 /* One pass over every triangle copy and the bands it reaches, in mesh
  * order: counts entries per band into count[] (fill 0), or writes them at
  * cursor[] (fill 1). Returns the total, or -1 past BIN_LIMIT or the tile
@@ -236,9 +275,12 @@ static void band_range(const rb_job *job, double lo, double hi, int *first, int 
 static long bin_pass(rb_job *job, int fill, size_t *count_or_cursor) {
   const int W = job->o->width, H = job->o->height;
   long total = 0;
+  job->reach = job->copies = 0.0;
   for (size_t t = 0; t < job->mesh->triangle_count; t++) {
-    double box[4];
+    double box[4], area2 = 0.0, perimeter = 0.0;
     triangle_box(job, t, box);
+    if (!fill)
+      triangle_measure(job, t, &area2, &perimeter);
     long ku0 = 0, ku1 = 0, kv0 = 0, kv1 = 0;
     if (job->o->tile) {
       if (!period_range(box[0], box[2], W, &ku0, &ku1) ||
@@ -251,7 +293,13 @@ static long bin_pass(rb_job *job, int fill, size_t *count_or_cursor) {
     for (long kv = kv0; kv <= kv1; kv++) {
       int b0, b1;
       band_range(job, box[1] + (double)kv * H, box[3] + (double)kv * H, &b0, &b1);
-      for (long ku = ku0; ku <= ku1; ku++)
+      for (long ku = ku0; ku <= ku1; ku++) {
+        if (!fill) {
+          const double shifted[4] = {box[0] + (double)ku * W, box[1] + (double)kv * H,
+                                     box[2] + (double)ku * W, box[3] + (double)kv * H};
+          job->reach += reach_of(job, shifted, area2, perimeter);
+          job->copies += 1.0;
+        }
         for (int b = b0; b <= b1; b++) {
           if (++total > BIN_LIMIT)
             return -1;
@@ -261,6 +309,7 @@ static long bin_pass(rb_job *job, int fill, size_t *count_or_cursor) {
           else
             count_or_cursor[b]++;
         }
+      }
     }
   }
   return total;
@@ -280,6 +329,17 @@ static bb_status bin_triangles(rb_job *job, bb_error *err) {
                     "renderbump: the model covers the image too many times over (more than "
                     "%ld triangle-bands, or tiles over %ld periods away)",
                     BIN_LIMIT, TILE_REACH_LIMIT);
+  }
+  /* The work bound, before anything is drawn or allocated for drawing. */
+  const double samples = (double)job->o->width * job->o->height * job->o->samples *
+                         job->o->samples;
+  if (job->reach > (double)BB_MAX_RENDERBUMP_LAYERS * (samples + job->copies)) {
+    free(cursor);
+    return bb__fail(err, BB_ERR_SIZE,
+                    "renderbump: the model's %.0f triangles reach about %.3g samples, %.0f "
+                    "times the image's %.0f: over the %d layers a render may draw",
+                    job->copies, job->reach, job->reach / samples, samples,
+                    BB_MAX_RENDERBUMP_LAYERS);
   }
   for (int b = 0; b < job->bands; b++) {
     job->bin_start[b + 1] = job->bin_start[b] + cursor[b];

@@ -246,6 +246,8 @@ void bb_render_options_init(bb_render_options *o) {
   }
   o->specular_strength = 1.0;
   o->tile_x = o->tile_y = 1;
+  o->view_azimuth = 270.0; /* from the bottom: the surface recedes up the picture */
+  o->view_elevation = 30.0;
 }
 
 static int finite_non_negative(const float v[3]) {
@@ -301,6 +303,19 @@ static bb_status check_options(const bb_render_options *o, bb_error *err) {
   if (o->threads < 0 || o->threads > BB_MAX_THREADS)
     return bb__fail(err, BB_ERR_ARGUMENT, "render: threads must be in 0..%d (got %d)",
                     BB_MAX_THREADS, o->threads);
+  if (o->view && !isfinite(o->view_azimuth))
+    return bb__fail(err, BB_ERR_ARGUMENT, "render: view azimuth must be finite");
+  if (o->view && !(o->view_elevation >= 1.0 && o->view_elevation <= 90.0))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: view elevation must be in 1..90 degrees (got %g)",
+                    o->view_elevation);
+  if (o->relief && !o->view)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: relief needs a view (seen from straight above it shows nothing)");
+  if (o->relief && !(o->relief_depth > 0.0 && o->relief_depth <= BB_MAX_HEIGHT_TEXELS))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "render: relief depth must be > 0 texels: the bake's scale (got %g)",
+                    o->relief_depth);
   return check_lights(o, err);
 }
 
@@ -363,6 +378,10 @@ typedef struct render_job {
   double light_half[4][3]; /* normalize(d + view) */
   float light_color[4][3];
   bb_image *out;
+  /* o->view: V towards the viewer, the screen's right R and the way to the
+   * viewer D on the plane (2D), 1 / sin(elevation), the picture's size */
+  double view[3], right[2], toward[2], stretch;
+  int width, height;
 } render_job;
 
 static void add_specular_light(render_job *job, const double dir[3],
@@ -370,7 +389,7 @@ static void add_specular_light(render_job *job, const double dir[3],
   int i = job->light_count++;
   for (int k = 0; k < 3; k++) {
     job->light_dir[i][k] = dir[k];
-    job->light_half[i][k] = dir[k] + (k == 2 ? 1.0 : 0.0); /* viewer overhead */
+    job->light_half[i][k] = dir[k] + job->view[k];
     job->light_color[i][k] = color[k];
   }
   bb__normalize3(job->light_half[i]);
@@ -383,6 +402,20 @@ static void job_init(render_job *job, const bb_render_maps *maps,
   job->o = o;
   job->mode = find_mode(o->mode);
   job->out = out;
+  job->view[2] = 1.0; /* overhead */
+  if (o->view) {
+    bb_light_direction(o->view_azimuth, o->view_elevation, job->view);
+    double horizontal = hypot(job->view[0], job->view[1]);
+    if (horizontal > 0.0) {
+      job->toward[0] = job->view[0] / horizontal, job->toward[1] = job->view[1] / horizontal;
+    } else { /* straight down: the azimuth still turns the picture */
+      double d[3];
+      bb_light_direction(o->view_azimuth, 0.0, d);
+      job->toward[0] = d[0], job->toward[1] = d[1];
+    }
+    job->right[0] = job->toward[1], job->right[1] = -job->toward[0];
+    job->stretch = 1.0 / job->view[2];
+  }
   for (int c = 0; c < 3; c++)
     bb_basis_vector(c, job->setup.basis[c]);
   if (o->dynamic_light) {
@@ -419,13 +452,12 @@ static void add_specular(const render_job *job, const double n[3], double rgb[3]
 /* The albedo factor of texel i by the albedo mode (Source's TextureCombine:
  * mod2x is 2 A per channel; an ssbump detail used as an albedo is the grey
  * dot(A, 2/3)). */
-static void albedo_of(const render_job *job, size_t i, double a[3]) {
+static void albedo_from(const render_job *job, const float *v, double a[3]) {
   const bb_image *albedo = job->maps->albedo;
   if (!albedo) {
     a[0] = a[1] = a[2] = 1.0;
     return;
   }
-  const float *v = texel_of(albedo, i);
   for (int c = 0; c < 3; c++)
     a[c] = (double)(albedo->channels >= 3 ? v[c] : v[0]);
   switch (job->o->albedo_mode) {
@@ -441,18 +473,11 @@ static void albedo_of(const render_job *job, size_t i, double a[3]) {
   }
 }
 
-static void shade_texel(const render_job *job, size_t i, float *out) {
-  const bb_render_maps *m = job->maps;
-  const unsigned needs = job->mode->needs;
-  texel_maps t = {
-      (needs & NEEDS_NORMAL) ? texel_of(m->normal, i) : NULL,
-      (needs & NEEDS_SSBUMP) ? texel_of(m->ssbump, i) : NULL,
-      (needs & NEEDS_AO) ? texel_of(m->ao, i) : NULL,
-      (needs & NEEDS_SSBUMP) ? texel_of(m->bent, i) : NULL,
-      (needs & NEEDS_SLOPE) ? texel_of(m->slope, i) : NULL,
-  };
+/* One point's maps (t) and albedo (its values, or NULL) lit into out. */
+static void shade_point(const render_job *job, const texel_maps *t, const float *albedo_texel,
+                        float *out) {
   shade_terms terms;
-  job->mode->shade(&job->setup, &t, &terms);
+  job->mode->shade(&job->setup, t, &terms);
 
   const bb_render_options *o = job->o;
   double diffuse[3] = {0.0, 0.0, 0.0}, albedo[3], rgb[3] = {0.0, 0.0, 0.0};
@@ -463,13 +488,131 @@ static void shade_texel(const render_job *job, size_t i, float *out) {
     if (o->dynamic_light)
       diffuse[k] += terms.dynamic * (double)o->light_color[k];
   }
-  albedo_of(job, i, albedo);
+  albedo_from(job, albedo_texel, albedo);
   for (int k = 0; k < 3; k++)
     rgb[k] = albedo[k] * diffuse[k];
   if (o->specular_exponent > 0.0)
     add_specular(job, terms.specular_normal, rgb);
   for (int k = 0; k < 3; k++)
     out[k] = (float)rgb[k];
+}
+
+static void shade_texel(const render_job *job, size_t i, float *out) {
+  const bb_render_maps *m = job->maps;
+  const unsigned needs = job->mode->needs;
+  texel_maps t = {
+      (needs & NEEDS_NORMAL) ? texel_of(m->normal, i) : NULL,
+      (needs & NEEDS_SSBUMP) ? texel_of(m->ssbump, i) : NULL,
+      (needs & NEEDS_AO) ? texel_of(m->ao, i) : NULL,
+      (needs & NEEDS_SSBUMP) ? texel_of(m->bent, i) : NULL,
+      (needs & NEEDS_SLOPE) ? texel_of(m->slope, i) : NULL,
+  };
+  shade_point(job, &t, texel_of(m->albedo, i), out);
+}
+
+/* ------------------------------------------------------ view and relief */
+
+/* Bilinear read of the first `channels` channels of img at point (x, y):
+ * texel (i, j) sits at (i, j) and the map tiles (GL_LINEAR, GL_REPEAT). */
+static void sample(const bb_image *img, double x, double y, int channels, float *out) {
+  const double fx0 = floor(x), fy0 = floor(y), fx = x - fx0, fy = y - fy0;
+  const int x0 = bb__wrap((int)fmod(fx0, (double)img->width), img->width);
+  const int y0 = bb__wrap((int)fmod(fy0, (double)img->height), img->height);
+  const int x1 = x0 + 1 < img->width ? x0 + 1 : 0, y1 = y0 + 1 < img->height ? y0 + 1 : 0;
+  const float *a = bb_image_texel(img, x0, y0), *b = bb_image_texel(img, x1, y0);
+  const float *c = bb_image_texel(img, x0, y1), *d = bb_image_texel(img, x1, y1);
+  for (int k = 0; k < channels; k++)
+    out[k] = (float)((1.0 - fy) * ((1.0 - fx) * a[k] + fx * b[k]) +
+                     fy * ((1.0 - fx) * c[k] + fx * d[k]));
+}
+
+/* The relief's height, in texels, at point (x, y). */
+static double relief_z(const bb_image *height, double depth, double x, double y) {
+  float h;
+  sample(height, x, y, 1, &h);
+  return depth * (double)h;
+}
+
+/* Parallax occlusion mapping, shaders/ssbump_relief.glsl's relief_hit: the
+ * view ray enters the relief's top plane (z = depth) at p and runs down
+ * along -V; layers a horizontal half texel apart at most (at least 1, at
+ * most BB__RELIEF_LAYERS) are tested until the ray is under the surface,
+ * and the crossing is taken on the line between the last two (the
+ * secant). Returns the point met. */
+#define BB__RELIEF_LAYERS 1024
+static void relief_hit(const bb_image *height, double depth, const double v[3], double px,
+                       double py, double hit[2]) {
+  const double reach = depth * hypot(v[0], v[1]) / v[2];
+  double layers = ceil(2.0 * reach);
+  layers = layers < 1.0 ? 1.0 : (layers > BB__RELIEF_LAYERS ? BB__RELIEF_LAYERS : layers);
+  const double dz = depth / layers, dx = -v[0] / v[2] * dz, dy = -v[1] / v[2] * dz;
+  double z = depth, above = z - relief_z(height, depth, px, py);
+  hit[0] = px, hit[1] = py;
+  if (!(above > 0.0)) return;
+  for (int i = 0; i < (int)layers; i++) {
+    const double nx = hit[0] + dx, ny = hit[1] + dy, nz = z - dz;
+    const double below = nz - relief_z(height, depth, nx, ny);
+    if (!(below > 0.0)) {
+      const double t = above / (above - below);
+      hit[0] += t * dx, hit[1] += t * dy;
+      return;
+    }
+    hit[0] = nx, hit[1] = ny, z = nz, above = below;
+  }
+}
+
+static void normalize3f(float *v) {
+  const double len = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+  if (len > 0.0)
+    for (int k = 0; k < 3; k++) v[k] = (float)(v[k] / len);
+}
+
+static void view_pixel(const render_job *job, int i, int j, float *out) {
+  const bb_render_maps *m = job->maps;
+  const bb_render_options *o = job->o;
+  const double si = (double)i - 0.5 * job->width, sj = ((double)j - 0.5 * job->height) * job->stretch;
+  double p[2] = {0.5 * job->width + si * job->right[0] + sj * job->toward[0],
+                 0.5 * job->height + si * job->right[1] + sj * job->toward[1]};
+  if (o->relief) {
+    double hit[2];
+    relief_hit(o->relief_height, o->relief_depth, job->view, p[0], p[1], hit);
+    p[0] = hit[0], p[1] = hit[1];
+  }
+  const unsigned needs = job->mode->needs;
+  float normal[3], ssbump[3], ao[1], bent[3], slope[1], albedo[3];
+  texel_maps t = {NULL, NULL, NULL, NULL, NULL};
+  if (needs & NEEDS_NORMAL) {
+    sample(m->normal, p[0], p[1], 3, normal);
+    normalize3f(normal);
+    t.normal = normal;
+  }
+  if (needs & NEEDS_SSBUMP) {
+    sample(m->ssbump, p[0], p[1], 3, ssbump);
+    t.ssbump = ssbump;
+    if (m->bent) {
+      sample(m->bent, p[0], p[1], 3, bent);
+      normalize3f(bent);
+      t.bent = bent;
+    }
+  }
+  if (needs & NEEDS_AO) {
+    sample(m->ao, p[0], p[1], 1, ao);
+    t.ao = ao;
+  }
+  if (needs & NEEDS_SLOPE) { /* a byte code, not a quantity: the nearest texel */
+    const int x = bb__wrap((int)fmod(floor(p[0] + 0.5), (double)m->slope->width), m->slope->width);
+    const int y = bb__wrap((int)fmod(floor(p[1] + 0.5), (double)m->slope->height), m->slope->height);
+    slope[0] = bb_image_texel(m->slope, x, y)[0];
+    t.slope = slope;
+  }
+  if (m->albedo) sample(m->albedo, p[0], p[1], m->albedo->channels >= 3 ? 3 : 1, albedo);
+  shade_point(job, &t, m->albedo ? albedo : NULL, out);
+}
+
+static void view_row(void *user, int y) {
+  const render_job *job = user;
+  for (int x = 0; x < job->width; x++)
+    view_pixel(job, x, y, job->out->pixels + 3 * ((size_t)y * (size_t)job->width + (size_t)x));
 }
 
 static void render_row(void *user, int y) {
@@ -514,16 +657,38 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
     return st;
   const bb_image *size = NULL;
   st = check_maps(maps, find_mode(o->mode)->needs, &size, err);
-  if (st != BB_OK)
-    return st;
-  st = bb_image_alloc(out, size->width, size->height, 3, err);
+  if (st == BB_OK && o->relief)
+    st = check_map(o->relief_height, "relief height", 1, size, err);
   if (st != BB_OK)
     return st;
   render_job job;
-  job_init(&job, maps, o, out);
-  st = bb__parallel_for(out->height, o->threads, render_row, &job, NULL, NULL, err);
-  if (st == BB_OK)
-    st = apply_view(o, out, err);
+  if (!o->view) {
+    st = bb_image_alloc(out, size->width, size->height, 3, err);
+    if (st != BB_OK)
+      return st;
+    job_init(&job, maps, o, out);
+    st = bb__parallel_for(out->height, o->threads, render_row, &job, NULL, NULL, err);
+    if (st == BB_OK)
+      st = apply_view(o, out, err);
+  } else {
+    /* the picture of the tiled maps' size, seen by the camera, then cropped */
+    const long w = (long)size->width * o->tile_x, h = (long)size->height * o->tile_y;
+    if (w > BB_MAX_DIMENSION || h > BB_MAX_DIMENSION || w * h > BB_MAX_PIXELS)
+      return bb__fail(err, BB_ERR_SIZE, "render: a view of %ldx%ld is over the maximum", w, h);
+    st = bb_image_alloc(out, (int)w, (int)h, 3, err);
+    if (st != BB_OK)
+      return st;
+    job_init(&job, maps, o, out);
+    job.width = (int)w, job.height = (int)h;
+    st = bb__parallel_for(out->height, o->threads, view_row, &job, NULL, NULL, err);
+    if (st == BB_OK && o->crop_width > 0) {
+      bb_image cropped;
+      st = bb_image_crop(out, o->crop_x, o->crop_y, o->crop_width, o->crop_height, &cropped, err);
+      bb_image_free(out);
+      if (st == BB_OK)
+        *out = cropped;
+    }
+  }
   if (st != BB_OK)
     bb_image_free(out);
   return st;
@@ -590,6 +755,10 @@ char *bb_render_options_describe(const bb_render_options *o) {
                o->crop_height);
   else
     t = append(t, &n, "crop=none\n");
+  if (o->view)
+    t = append(t, &n, "view=%.9g,%.9g\n", o->view_azimuth, o->view_elevation);
+  if (o->relief)
+    t = append(t, &n, "relief=%.9g\n", o->relief_depth);
   return t;
 }
 

@@ -54,16 +54,8 @@ enum { CHUNK_STEPS = 4096 };
 /* Periodic lines of more points than this are swept in chunks. */
 #define LONG_LINE_POINTS (1L << 20)
 
-/* A breakpoint of one step, relative to the step's first texel: the surface
- * there is bb__lattice_height(z(v1), z(v2), w), w = r / m, at n / m steps
- * from an origin k whole steps behind the step, n = k m + i. */
-typedef struct template_point {
-  double frac;     /* i / m, in (0, 1]: for ordering and hull geometry */
-  int m, i;        /* m = 1, i = 1: the next texel, a vertex */
-  double inverse_m, w; /* bb__lattice_inverse(m), bb__lattice_weight(r, m) (0: the vertex) */
-  int x1, y1, x2, y2;
-  long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
-} template_point;
+/* A breakpoint of one step (sweep.h). */
+typedef bb__template_point template_point;
 
 /* One direction of a sweep with its slice's step. */
 typedef struct sweep_side {
@@ -95,6 +87,8 @@ typedef struct sweep_job {
   int min_dx, max_dx, min_dy, max_dy; /* template vertex offsets */
   atomic_int out_of_memory;
   double *open_a, *open_b; /* where the wider chords apply (job_chords) */
+  bb__line_hook hook;      /* NULL: the sums; else called per line */
+  void *hook_ctx;
   struct scratch *scratch; /* a slot per thread (sweep_bundle) */
   int scratch_count;
 } sweep_job;
@@ -166,7 +160,7 @@ typedef struct point {
   int64_t key;
 } point;
 
-#define KEY_STEP 1024 /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
+#define KEY_STEP BB__KEY_STEP /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
 
 static inline int64_t key_of(int step, int tp) {
   return (int64_t)step * KEY_STEP + tp;
@@ -680,10 +674,21 @@ static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
  * slices' order wants. The walks only find tangents; integrating here, in
  * loops of their own, lets the divisions and table reads of neighbouring
  * texels overlap. */
-static void integrate_line(const sweep_job *job, const profile *pr) {
+static void integrate_line(const sweep_job *job, const profile *pr, int x0, int y0) {
   const int channels = job->channels;
   for (int k = 0; k < 2; k++)
     if (job->side[k].dir) horizons_of_line(job, pr, k);
+  if (job->hook) {
+    const bb__line_view line = {
+        .p = job->p, .a = job->a, .b = job->b, .points = job->points,
+        .point_count = job->point_count, .round = job->kind == LINE_ROUND, .x0 = x0, .y0 = y0,
+        .first_step = pr->first_step, .steps = pr->steps, .len = pr->len, .texel = pr->texel,
+        .vz = pr->vz, .bias = job->bias, .dir = {job->side[0].dir, job->side[1].dir},
+        .found = {job->side[0].dir ? pr->found[0] : NULL, job->side[1].dir ? pr->found[1] : NULL},
+        .tangent_key = {pr->tangent_key[0], pr->tangent_key[1]}};
+    job->hook(job->hook_ctx, &line);
+    return;
+  }
   for (int k = 0; k < 2; k++) {
     const bb__sweep_dir *dir = job->side[k].dir;
     if (!dir || !dir->horizon) continue;
@@ -762,7 +767,7 @@ static void sweep_one(sweep_job *job, int item, profile *pr, point *h[2]) {
     walk_round(job, pr, h);
   else
     walk_line(job, pr, h);
-  integrate_line(job, pr);
+  integrate_line(job, pr, job->item_x[item], job->item_y[item]);
 }
 
 /* A worker's buffers, kept from one bundle to the next and grown when a
@@ -983,8 +988,8 @@ static int job_chords(sweep_job *job) {
   return 1;
 }
 
-static bb_status check_dir(const bb__sweep_dir *dir, bb_error *err) {
-  if (dir && (!dir->rs || (!dir->sums && !dir->horizon) || dir->slice < 0 ||
+static bb_status check_dir(const bb__sweep_dir *dir, int hooked, bb_error *err) {
+  if (dir && (!dir->rs || (!dir->sums && !dir->horizon && !hooked) || dir->slice < 0 ||
               dir->slice >= dir->rs->slice_count))
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "trace: a sweep direction needs a slice, and sums or horizons");
@@ -994,13 +999,21 @@ static bb_status check_dir(const bb__sweep_dir *dir, bb_error *err) {
 bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
                           const bb__sweep_dir *opposite, double bias, int threads,
                           long long_line, bb_error *err) {
+  return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL, NULL,
+                                err);
+}
+
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 long long_line, bb__line_hook hook, void *hook_ctx,
+                                 bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
-  bb_status st = check_dir(along, err);
-  if (st == BB_OK) st = check_dir(opposite, err);
+  bb_status st = check_dir(along, hook != NULL, err);
+  if (st == BB_OK) st = check_dir(opposite, hook != NULL, err);
   if (st != BB_OK || (!along && !opposite)) return st;
-  sweep_job job = {.p = p, .a = a, .b = b, .bias = bias};
+  sweep_job job = {.p = p, .a = a, .b = b, .bias = bias, .hook = hook, .hook_ctx = hook_ctx};
   job.side[0] = (sweep_side){along, a, b, bb__step_inverse(a, b), {0}};
   job.side[1] = (sweep_side){opposite, -a, -b, bb__step_inverse(a, b), {0}};
   if (along) job.side[0].integral = bb__slice_integral_of(along->rs, along->slice);

@@ -5,6 +5,9 @@
 
 #include "bumpbake.h"
 
+#include <stddef.h>
+#include <stdint.h>
+
 
 /* One direction of a line sweep: slice s of rs, whose loss at each texel is
  * added to sums (1 + basis_count floats per texel); horizon (may be NULL)
@@ -26,5 +29,66 @@ typedef struct bb__sweep_dir {
 bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
                           const bb__sweep_dir *opposite, double bias, int threads,
                           long long_line, bb_error *err);
+
+/* ------------------------------------------------ lines for other passes */
+
+/* A breakpoint of one step, relative to the step's first texel: the surface
+ * there is bb__lattice_height(z(x1, y1), z(x2, y2), w), w = r / m, at n / m
+ * steps from an origin k whole steps behind the step, n = k m + i. */
+typedef struct bb__template_point {
+  double frac;     /* i / m, in (0, 1]: for ordering and hull geometry */
+  int m, i;        /* m = 1, i = 1: the next texel, a vertex */
+  double inverse_m, w; /* bb__lattice_inverse(m), bb__lattice_weight(r, m) (0: the vertex) */
+  int x1, y1, x2, y2;
+  long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
+} bb__template_point;
+
+/* A tangent key: the step of a point relative to the origin's step, times
+ * BB__KEY_STEP, plus its template point. */
+#define BB__KEY_STEP 1024
+static inline int bb__key_step(int64_t key) { /* floors: the point index is >= 0 */
+  return (int)(key >> 10);
+}
+static inline int bb__key_point(int64_t key) {
+  return (int)(key & (BB__KEY_STEP - 1));
+}
+
+/* One line of a sweep once its horizons are found, for a pass that does
+ * more with them than the trace's sums (bounce.c). Texel j of the line is
+ * at (x0 + j a, y0 + j b) (periodic coordinates wrap; clamped ones are the
+ * image's own, and the steps before and after the line lie outside it);
+ * step s runs from texel s to texel s + 1 through the template's points.
+ * For each side k (0: along (a, b), 1: along (-a, -b); found[k] NULL when
+ * not wanted), texel j's horizon (texels of rise per texel) and its
+ * tangent point's key, relative to the texel's step. A round line is a
+ * periodic line closed after len steps: its point at step s + len is that
+ * at step s. */
+typedef struct bb__line_view {
+  const bb_pyramid *p;
+  int a, b;
+  const bb__template_point *points;
+  int point_count;
+  int round;
+  int x0, y0;
+  int first_step, steps; /* the steps profiled: first_step .. first_step + steps - 1 */
+  int len;
+  const size_t *texel;   /* image index of texel j */
+  const double *vz;      /* height of texel j */
+  double bias;
+  const bb__sweep_dir *dir[2];
+  const float *found[2];
+  const int64_t *tangent_key[2];
+} bb__line_view;
+
+/* Called once per line, from the sweep's worker threads, instead of adding
+ * the slices' losses to the sums. */
+typedef void (*bb__line_hook)(void *ctx, const bb__line_view *line);
+
+/* bb__sweep_lines with a hook for every line in place of the sums (the
+ * directions' sums may then be NULL). */
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 long long_line, bb__line_hook hook, void *hook_ctx,
+                                 bb_error *err);
 
 #endif /* BB_TRACE_SWEEP_H */

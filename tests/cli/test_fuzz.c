@@ -23,6 +23,7 @@
 int bb_fuzz_cli(const uint8_t *data, size_t size);
 int bb_fuzz_compare(const uint8_t *data, size_t size);
 int bb_fuzz_load(const uint8_t *data, size_t size);
+int bb_fuzz_mesh(const uint8_t *data, size_t size);
 int bb_fuzz_provenance(const uint8_t *data, size_t size);
 
 typedef int (*fuzz_target)(const uint8_t *data, size_t size);
@@ -101,6 +102,14 @@ Test(fuzz, cli_regressions) {
  * opening it (LeakSanitizer's report failed the target). */
 Test(fuzz, load_regressions) {
   replay("load", bb_fuzz_load, 1);
+}
+
+/* Models that read outside their directory or crashed Assimp: an OBJ whose
+ * mtllib is its own directory (Assimp lost the stream it opened on it:
+ * LeakSanitizer), a glTF buffer up and out of it, Collada nodes nested
+ * 3,000 deep. */
+Test(fuzz, mesh_regressions) {
+  replay("mesh", bb_fuzz_mesh, 3);
 }
 
 /* Nine differences near 1e27: their mean, sum / 9 in double, came out one

@@ -94,7 +94,7 @@ static void normalize(double v[3]) {
     v[k] /= len;
 }
 
-/* README's heightmap formula, written out from the README. */
+/* docs/commands/program.md's heightmap formula, written out from the page. */
 static void doom3_heightmap(int x, int y, double scale, double n[3]) {
   const double s = scale / 256.0;
   int x1 = (x + 1) % 4, y1 = (y + 1) % 4;

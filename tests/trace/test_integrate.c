@@ -121,7 +121,7 @@ Test(integrate, tables_match_an_independent_quadrature) {
 
 /* Between its nodes the table is a cubic: its largest error, against the
  * library's own quadrature at the middle of every third interval, stays
- * under 1e-7 of the sector's share (the README says so; measured 2.5e-8 for
+ * under 1e-7 of the sector's share (docs/how-it-works.md says so; measured 2.5e-8 for
  * quarter-turn sectors, 1.4e-9 for 16 and 32 slices). */
 Test(integrate, interpolation_error_is_under_1e_7_of_the_share) {
   double basis[3][3];

@@ -1,0 +1,527 @@
+/* test_bounce.c: the bake's inter-reflection (bounce_albedo) against the
+ * exact 2D radiosity of a trench, the closed form of a plane, the path
+ * tracer tools/bounce_ref, and its invariances. */
+#include <criterion/criterion.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bumpbake.h"
+#include "bake_harness.h"
+
+static const double PI = 3.14159265358979323846;
+
+static bb_bake_options options(float scale, int rays, double rho) {
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = scale;
+  o.rays = rays;
+  o.smooth.radius_texels = 0;
+  o.bounce_albedo = rho;
+  return o;
+}
+
+static const float *at(const bb_image *img, int x, int y) {
+  return bb_image_texel(img, x, y);
+}
+
+static int same_image(const bb_image *a, const bb_image *b) {
+  if (!a->pixels || !b->pixels) return !a->pixels && !b->pixels;
+  return a->width == b->width && a->height == b->height && a->channels == b->channels &&
+         memcmp(a->pixels, b->pixels,
+                (size_t)a->width * (size_t)a->height * (size_t)a->channels * sizeof(float)) == 0;
+}
+
+static void expect_same_bake(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    cr_expect(same_image(bb_bake_result_image(a, (bb_output_kind)k),
+                         bb_bake_result_image(b, (bb_output_kind)k)),
+              "%s: %s differs", what, bb_output_kind_get((bb_output_kind)k)->name);
+  cr_expect(same_image(&a->vis, &b->vis), "%s: vis differs", what);
+}
+
+static bb_image load_fixture(const char *name) {
+  const char *dir = getenv("BB_FIXTURES");
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s", dir && *dir ? dir : "fixtures", name);
+  bb_image h;
+  bb_error err;
+  cr_assert_eq(bb_height_load(path, BB_CHANNEL_AUTO, &h, &err), BB_OK, "%s", err.message);
+  return h;
+}
+
+/* ---- rho = 0 is the bake without the option, bit for bit ---------------- */
+
+Test(bounce, rho_zero_is_the_bake_without_it) {
+  static const char *const maps[] = {"noise_96x80.png", "pit_65x65.png", "bricks_128x64.png",
+                                     "rock06_128.png"};
+  bb_image grey = harness_field(4, 4, 0.5f); /* a map that must not be looked at */
+  for (size_t m = 0; m < sizeof maps / sizeof maps[0]; m++) {
+    bb_image h = load_fixture(maps[m]);
+    for (int threads = 1; threads <= 3; threads++) {
+      bb_bake_options plain;
+      bb_bake_options_init(&plain);
+      plain.height_scale = 8.0f;
+      plain.trace.threads = threads;
+      bb_bake_options zero = plain;
+      zero.bounce_albedo = 0.0;
+      zero.bounces = 7;
+      zero.bounce_albedo_map = &grey;
+      bb_bake_result a = harness_bake(&h, &plain), b = harness_bake(&h, &zero);
+      char what[128];
+      snprintf(what, sizeof what, "%s, %d threads", maps[m], threads);
+      expect_same_bake(&a, &b, what);
+      cr_expect_eq(b.bounces, 0);
+      bb_bake_result_free(&a);
+      bb_bake_result_free(&b);
+    }
+    bb_image_free(&h);
+  }
+  bb_image_free(&grey);
+}
+
+/* ---- what bouncing light may and may not do ------------------------------- */
+
+Test(bounce, never_darker_and_ao_never_above_one) {
+  bb_image h = load_fixture("rock06_128.png");
+  bb_bake_options o = options(16.0f, 256, 0.0);
+  bb_bake_result base = harness_bake(&h, &o);
+  const double rhos[] = {0.6, 1.0};
+  for (size_t i = 0; i < 2; i++) {
+    o.bounce_albedo = rhos[i];
+    bb_bake_result r = harness_bake(&h, &o);
+    double added = 0.0;
+    for (int y = 0; y < h.height; y++)
+      for (int x = 0; x < h.width; x++) {
+        const float ao = at(&r.ao, x, y)[0], ao0 = at(&base.ao, x, y)[0];
+        cr_assert(ao >= ao0 && ao <= 1.0f, "rho %g, (%d, %d): ao %g, without %g", rhos[i], x, y,
+                  (double)ao, (double)ao0);
+        added += ao - ao0;
+        for (int c = 0; c < 3; c++) {
+          const float s = at(&r.ssbump, x, y)[c], s0 = at(&base.ssbump, x, y)[c];
+          cr_assert(s >= s0 && s <= 1.0f, "rho %g, (%d, %d): ssbump %d %g, without %g", rhos[i],
+                    x, y, c, (double)s, (double)s0);
+          cr_assert(at(&r.vis, x, y)[1 + c] >= at(&base.vis, x, y)[1 + c]);
+        }
+        const float *b = at(&r.bent, x, y);
+        cr_assert_float_eq(b[0] * b[0] + b[1] * b[1] + b[2] * b[2], 1.0, 1e-5);
+      }
+    cr_expect_gt(added / (h.width * h.height), 0.005 * rhos[i], "rho %g adds %g on average",
+                 rhos[i], added / (h.width * h.height));
+    cr_expect(same_image(&r.weights, &base.weights), "the weights hold no visibility");
+    cr_expect_eq(r.bounces > 1, 1, "bounces 0 follows more than one bounce (%d)", r.bounces);
+    bb_bake_result_free(&r);
+  }
+  bb_bake_result_free(&base);
+  bb_image_free(&h);
+}
+
+Test(bounce, flat_stays_exactly_one) {
+  bb_image h = harness_field(24, 20, 0.5f);
+  bb_bake_options o = options(32.0f, 256, 0.0);
+  bb_bake_result base = harness_bake(&h, &o);
+  o.bounce_albedo = 1.0;
+  bb_bake_result r = harness_bake(&h, &o);
+  for (int y = 0; y < 20; y++)
+    for (int x = 0; x < 24; x++) cr_assert_eq(at(&r.ao, x, y)[0], 1.0f);
+  expect_same_bake(&base, &r, "a flat map at rho 1");
+  bb_bake_result_free(&base);
+  bb_bake_result_free(&r);
+  bb_image_free(&h);
+}
+
+Test(bounce, any_thread_count_and_periodic_shift_give_the_same_bits) {
+  bb_image h = load_fixture("noise_96x80.png");
+  const int W = h.width, H = h.height, sx = 37, sy = 11;
+  bb_image shifted = harness_field(W, H, 0.0f);
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) *bb_image_texel(&shifted, (x + sx) % W, (y + sy) % H) = at(&h, x, y)[0];
+  bb_bake_options o = options(8.0f, 256, 0.5);
+  o.trace.threads = 1;
+  bb_bake_result one = harness_bake(&h, &o);
+  for (int threads = 2; threads <= 5; threads += 3) {
+    o.trace.threads = threads;
+    bb_bake_result r = harness_bake(&h, &o);
+    char what[64];
+    snprintf(what, sizeof what, "%d threads against 1", threads);
+    expect_same_bake(&one, &r, what);
+    bb_bake_result_free(&r);
+  }
+  o.trace.threads = 2;
+  bb_bake_result s = harness_bake(&shifted, &o);
+  cr_expect_eq(s.bounces, one.bounces);
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    const bb_image *a = bb_bake_result_image(&one, (bb_output_kind)k);
+    const bb_image *b = bb_bake_result_image(&s, (bb_output_kind)k);
+    int differ = 0;
+    for (int y = 0; y < H; y++)
+      for (int x = 0; x < W; x++)
+        differ += memcmp(at(a, x, y), at(b, (x + sx) % W, (y + sy) % H),
+                         (size_t)a->channels * sizeof(float)) != 0;
+    cr_expect_eq(differ, 0, "%s: %d texels differ after a periodic shift",
+                 bb_output_kind_get((bb_output_kind)k)->name, differ);
+  }
+  bb_bake_result_free(&one);
+  bb_bake_result_free(&s);
+  bb_image_free(&shifted);
+  bb_image_free(&h);
+}
+
+Test(bounce, options_are_checked) {
+  bb_image h = harness_field(8, 8, 0.5f);
+  const double bad_rho[] = {-0.1, 1.5, NAN};
+  for (size_t i = 0; i < 3; i++) {
+    bb_bake_options o = options(4.0f, 16, bad_rho[i]);
+    bb_error err;
+    cr_expect_eq(bb_bake_options_check(&o, &err), BB_ERR_ARGUMENT, "rho %g", bad_rho[i]);
+  }
+  bb_bake_options o = options(4.0f, 16, 0.5);
+  o.bounces = BB_MAX_BOUNCES + 1;
+  bb_error err;
+  cr_expect_eq(bb_bake_options_check(&o, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "bounces") != NULL, "%s", err.message);
+  /* an albedo map of another size is named as such */
+  bb_image small = harness_field(4, 4, 1.0f);
+  o.bounces = 0;
+  o.bounce_albedo_map = &small;
+  bb_bake_result r;
+  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_SIZE);
+  cr_expect(strstr(err.message, "albedo") != NULL, "%s", err.message);
+  small.pixels[5] = NAN;
+  bb_image nan_map = harness_field(8, 8, 1.0f);
+  nan_map.pixels[9] = NAN;
+  o.bounce_albedo_map = &nan_map;
+  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_VALUE);
+  bb_image_free(&nan_map);
+  bb_image_free(&small);
+  bb_image_free(&h);
+}
+
+/* An albedo map of 0 where half the surface is bounces nothing from there:
+ * a black floor around a white wall, against the same all white. */
+Test(bounce, the_albedo_map_scales_rho_per_vertex) {
+  const int W = 40, H = 8;
+  bb_image h = harness_field(W, H, 0.0f);
+  for (int y = 0; y < H; y++)
+    for (int x = 18; x < 22; x++) *bb_image_texel(&h, x, y) = 1.0f;
+  bb_bake_options o = options(6.0f, 256, 0.8);
+  o.smooth.addressing = BB_ADDRESS_CLAMP;
+  bb_bake_result white = harness_bake(&h, &o);
+  bb_image black = harness_field(W, H, 1.0f);
+  for (int i = 0; i < W * H; i++) black.pixels[i] = 0.0f;
+  o.bounce_albedo_map = &black;
+  bb_bake_result none = harness_bake(&h, &o);
+  o.bounce_albedo = 0.0;
+  o.bounce_albedo_map = NULL;
+  bb_bake_result base = harness_bake(&h, &o);
+  /* the floor beside the wall: lit by the wall with a white map only */
+  const double from_wall = at(&white.ao, 16, 4)[0] - at(&base.ao, 16, 4)[0];
+  cr_expect_gt(from_wall, 0.01, "the white wall adds %g", from_wall);
+  cr_expect_eq(at(&none.ao, 16, 4)[0], at(&base.ao, 16, 4)[0], "a black surface adds nothing");
+  bb_bake_result_free(&white);
+  bb_bake_result_free(&none);
+  bb_bake_result_free(&base);
+  bb_image_free(&black);
+  bb_image_free(&h);
+}
+
+/* ---- a plane: one bounce in closed form ------------------------------------
+
+ * A plane of slope s along +x, z = s x (clamp mode; the texel in the middle,
+ * bias 0). Every point of it sees the sky above the plane and above the
+ * horizon, nothing of itself: its irradiance is E_k = integral over those
+ * directions of sky_k(w) n.w, the same everywhere, and a texel's blocked
+ * directions (below the plane, uphill) all meet it. One bounce gives
+ *   ao'    = ao + (1 - ao) rho (1 + cos a) / 2,  tan a = s
+ *   vis_c' = vis_c + Omega rho E_c / pi / T_c,
+ * Omega = integral over cos(phi) > 0 of sin(atan(s cos phi)) dphi the
+ * blocked solid angle. E_c and T_c by a midpoint rule here. One bounce,
+ * since the plane sees nothing of itself (its ends, far off, would). */
+static double lobe_sky(const double b[3], const double w[3]) {
+  const double v = b[0] * w[0] + b[1] * w[1] + b[2] * w[2];
+  return v > 0.0 ? v : 0.0;
+}
+
+Test(bounce, a_plane_reflects_its_closed_form) {
+  const int w = 61, h = 9, x0 = 30, y0 = 4;
+  const float scale = 30.0f; /* slope 0.5 */
+  const double s = (double)scale / (w - 1), rho = 0.5;
+  bb_image height = harness_field(w, h, 0.0f);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) *bb_image_texel(&height, x, y) = (float)x / (float)(w - 1);
+  bb_bake_options o = options(scale, 256, 0.0);
+  o.smooth.addressing = BB_ADDRESS_CLAMP;
+  o.trace.bias_texels = 0.0;
+  bb_bake_result base = harness_bake(&height, &o);
+  o.bounce_albedo = rho;
+  o.bounces = 1;
+  bb_bake_result r = harness_bake(&height, &o);
+  const double len = sqrt(1.0 + s * s), n[3] = {-s / len, 0.0, 1.0 / len};
+  const double ao0 = at(&base.ao, x0, y0)[0];
+  const double want_ao = ao0 + (1.0 - ao0) * rho * (1.0 + 1.0 / len) / 2.0;
+  cr_log_info("plane: ao %+.5f", at(&r.ao, x0, y0)[0] - want_ao);
+  cr_expect(fabs(at(&r.ao, x0, y0)[0] - want_ao) <= 0.002, "ao %.5f, closed form %.5f",
+            (double)at(&r.ao, x0, y0)[0], want_ao);
+  const int ne = 1000, na = 2000;
+  double omega = 0.0;
+  for (int j = 0; j < na; j++) {
+    const double phi = 2.0 * PI * (j + 0.5) / na;
+    if (cos(phi) > 0.0) omega += sin(atan(s * cos(phi))) * 2.0 * PI / na;
+  }
+  for (int c = 0; c < 3; c++) {
+    double b[3], e = 0.0, total = 0.0;
+    bb_basis_vector(c, b);
+    for (int i = 0; i < ne; i++) {
+      const double el = 0.5 * PI * (i + 0.5) / ne;
+      for (int j = 0; j < na; j++) {
+        const double phi = 2.0 * PI * (j + 0.5) / na;
+        const double wv[3] = {cos(el) * cos(phi), cos(el) * sin(phi), sin(el)};
+        const double dw = cos(el) * (0.5 * PI / ne) * (2.0 * PI / na);
+        const double nw = n[0] * wv[0] + n[1] * wv[1] + n[2] * wv[2];
+        total += lobe_sky(b, wv) * dw;
+        if (nw > 0.0) e += lobe_sky(b, wv) * nw * dw;
+      }
+    }
+    const float *nn = at(&r.normal, x0, y0);
+    const double ndotb = nn[0] * b[0] + nn[1] * b[1] + nn[2] * b[2];
+    const double vis0 = at(&base.ssbump, x0, y0)[c] / ndotb, vis = at(&r.ssbump, x0, y0)[c] / ndotb;
+    const double want = vis0 + omega * rho * e / PI / total;
+    cr_log_info("plane: vis_%d %+.5f", c, vis - want);
+    cr_expect(fabs(vis - want) <= 0.0015, "vis_%d %.5f, closed form %.5f", c, vis, want);
+  }
+  bb_bake_result_free(&base);
+  bb_bake_result_free(&r);
+  bb_image_free(&height);
+}
+
+/* ---- the trench: exact 2D radiosity ---------------------------------------
+
+ * A trench constant along y (clamp mode): a floor at 0 from x = 1 to
+ * x = W - 2 between walls that rise over one cell to H, the plateau beyond
+ * (the border extruded). The surface is its cross-section extruded, so the
+ * light it reflects is a 2D problem: the cavity (two walls and the floor)
+ * is convex, every strip of it sees every other whole, and the view factor
+ * between two infinitely long strips is Hottel's crossed strings,
+ *   F_ij = (|a_i b_j| + |b_i a_j| - |a_i a_j| - |b_i b_j|) / (2 L_i);
+ * what a strip does not see of the cavity is sky (the opening). With the
+ * sky's radiance 1, each strip's radiance J_i solves
+ *   J_i = rho (F_i,sky + sum_j F_ij J_j),
+ * one bounce being J = rho F_sky. The texel's origin P (the floor's centre
+ * line, bias above it) sees a strip above it by the view factor of a
+ * horizontal element to an infinite strip, (sin p_b - sin p_a) / 2 (p the
+ * angle of each end from the vertical): ao' - ao = sum over the strips of
+ * that times J_i, the part of a strip under P's horizontal cut off. */
+typedef struct strip {
+  double ax, az, bx, bz;
+} strip;
+
+static double distance2d(double x0, double z0, double x1, double z1) {
+  return hypot(x1 - x0, z1 - z0);
+}
+
+static int trench_strips(double H, int W, int per_wall, int per_floor, strip *s, int *segment) {
+  int n = 0;
+  const double wall[2][4] = {{0.0, H, 1.0, 0.0}, {W - 2.0, 0.0, W - 1.0, H}};
+  for (int part = 0; part < 3; part++) {
+    double x0, z0, x1, z1;
+    if (part == 1) x0 = 1.0, z0 = 0.0, x1 = W - 2.0, z1 = 0.0;
+    else {
+      const double *g = wall[part / 2];
+      x0 = g[0], z0 = g[1], x1 = g[2], z1 = g[3];
+    }
+    const int count = part == 1 ? per_floor : per_wall;
+    for (int i = 0; i < count; i++) {
+      const double t0 = (double)i / count, t1 = (double)(i + 1) / count;
+      s[n] = (strip){x0 + (x1 - x0) * t0, z0 + (z1 - z0) * t0, x0 + (x1 - x0) * t1,
+                     z0 + (z1 - z0) * t1};
+      segment[n++] = part;
+    }
+  }
+  return n;
+}
+
+/* The light the bounces add to ao at (xc, bias) over a floor at 0, for
+ * `bounces` bounces (0: to convergence); *direct (may be NULL) receives
+ * ao without them, the view factor of P to the opening. */
+static double trench_added(double H, int W, double bias, double rho, int bounces, double *direct) {
+  enum { PER_WALL = 200, PER_FLOOR = 900, N = 2 * PER_WALL + PER_FLOOR };
+  static strip s[N];
+  static int segment[N];
+  const int n = trench_strips(H, W, PER_WALL, PER_FLOOR, s, segment);
+  double *F = malloc((size_t)n * (size_t)n * sizeof(double));
+  double *sky = malloc((size_t)n * sizeof(double)), *J = calloc((size_t)n, sizeof(double));
+  double *next = malloc((size_t)n * sizeof(double)), *len = malloc((size_t)n * sizeof(double));
+  cr_assert(F && sky && J && next && len);
+  for (int i = 0; i < n; i++) len[i] = distance2d(s[i].ax, s[i].az, s[i].bx, s[i].bz);
+  for (int i = 0; i < n; i++) {
+    double seen = 0.0;
+    for (int j = 0; j < n; j++) {
+      double f = 0.0;
+      if (segment[i] != segment[j]) /* strips of one straight side see nothing of each other */
+        f = fabs(distance2d(s[i].ax, s[i].az, s[j].bx, s[j].bz) +
+                 distance2d(s[i].bx, s[i].bz, s[j].ax, s[j].az) -
+                 distance2d(s[i].ax, s[i].az, s[j].ax, s[j].az) -
+                 distance2d(s[i].bx, s[i].bz, s[j].bx, s[j].bz)) / (2.0 * len[i]);
+      F[(size_t)i * (size_t)n + (size_t)j] = f;
+      seen += f;
+    }
+    cr_assert(seen <= 1.0 + 1e-9, "strip %d sees %g of the cavity", i, seen);
+    sky[i] = 1.0 - seen;
+  }
+  for (int i = 0; i < n; i += 97) /* reciprocity, L_i F_ij = L_j F_ji */
+    for (int j = 0; j < n; j += 89)
+      cr_assert_float_eq(len[i] * F[(size_t)i * (size_t)n + (size_t)j],
+                         len[j] * F[(size_t)j * (size_t)n + (size_t)i], 1e-12);
+  for (int it = 0; bounces ? it < bounces : it < 2000; it++) {
+    double change = 0.0;
+    for (int i = 0; i < n; i++) {
+      double e = sky[i];
+      for (int j = 0; j < n; j++) e += F[(size_t)i * (size_t)n + (size_t)j] * J[j];
+      next[i] = rho * e;
+      change = fmax(change, fabs(next[i] - J[i]));
+    }
+    memcpy(J, next, (size_t)n * sizeof(double));
+    if (!bounces && change < 1e-14) break;
+  }
+  const double px = (W - 1) / 2.0;
+  double added = 0.0;
+  for (int i = 0; i < n; i++) {
+    double ax = s[i].ax, az = s[i].az, bx = s[i].bx, bz = s[i].bz;
+    if (fmax(az, bz) <= bias) continue;
+    if (az < bias) ax += (bx - ax) * (bias - az) / (bz - az), az = bias;
+    if (bz < bias) bx += (ax - bx) * (bias - bz) / (az - bz), bz = bias;
+    const double sa = (ax - px) / distance2d(px, bias, ax, az);
+    const double sb = (bx - px) / distance2d(px, bias, bx, bz);
+    added += fabs(sb - sa) / 2.0 * J[i];
+  }
+  if (direct) { /* the opening, from the top of one wall to the other */
+    const double sa = (0.0 - px) / distance2d(px, bias, 0.0, H);
+    const double sb = (W - 1.0 - px) / distance2d(px, bias, W - 1.0, H);
+    *direct = (sb - sa) / 2.0;
+  }
+  free(F), free(sky), free(J), free(next), free(len);
+  return added;
+}
+
+Test(bounce, trench_matches_the_exact_2d_radiosity) {
+  const int W = 21, H = 8; /* floor 19 texels wide between walls 8 high */
+  const double rho = 0.5, bias = 0.55;
+  bb_image height = harness_field(W, H, 0.0f);
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) *bb_image_texel(&height, x, y) = (x == 0 || x == W - 1) ? 1.0f : 0.0f;
+  bb_bake_options o = options((float)H, 1024, 0.0);
+  o.smooth.addressing = BB_ADDRESS_CLAMP;
+  bb_bake_result base = harness_bake(&height, &o);
+  const int xc = (W - 1) / 2, yc = H / 2;
+  double direct;
+  const double one = trench_added(H, W, bias, rho, 1, &direct);
+  const double two = trench_added(H, W, bias, rho, 2, NULL), all = trench_added(H, W, bias, rho, 0, NULL);
+  cr_expect(0.0 < one && one < two && two < all, "bounces only add: %g %g %g", one, two, all);
+  /* the geometry: without bounces, the bake's own known accuracy */
+  cr_expect(fabs(at(&base.ao, xc, yc)[0] - direct) <= 0.0015, "ao %.5f, the opening's view %.5f",
+            (double)at(&base.ao, xc, yc)[0], direct);
+  const int counts[] = {1, 0};
+  const double exact[] = {one, all};
+  for (size_t i = 0; i < 2; i++) {
+    o.bounce_albedo = rho;
+    o.bounces = counts[i];
+    bb_bake_result r = harness_bake(&height, &o);
+    const double added = at(&r.ao, xc, yc)[0] - at(&base.ao, xc, yc)[0];
+    cr_log_info("trench, %s: added %.5f, exact %.5f (%+.5f)", counts[i] ? "1 bounce" : "converged",
+                added, exact[i], added - exact[i]);
+    cr_expect(fabs(added - exact[i]) <= 0.002, "%s: the bounce adds %.5f to ao, exactly %.5f",
+              counts[i] ? "1 bounce" : "to convergence", added, exact[i]);
+    bb_bake_result_free(&r);
+  }
+  bb_bake_result_free(&base);
+  bb_image_free(&height);
+}
+
+/* ---- against the path tracer (tools/bounce_ref), loosely -------------------
+
+ * The tight comparison is tools/bench_bounce.sh's; here a small map and
+ * 4096 paths per texel (standard error about 0.001) must agree within
+ * 0.004 (mean |error|) and 0.0025 (bias) in ao and every ssbump channel. */
+static void tool_path(const char *tool, char *out, size_t cap) {
+  const char *bin = getenv("BB_BIN");
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s", bin && *bin ? bin : "build/bumpbake");
+  char *slash = strrchr(dir, '/');
+  if (slash) slash[1] = '\0';
+  else dir[0] = '\0';
+  snprintf(out, cap, "%stools/%s", dir, tool);
+}
+
+static int run_capture(char *const argv[], char *out, size_t cap) {
+  int pipefd[2];
+  cr_assert_eq(pipe(pipefd), 0);
+  const pid_t pid = fork();
+  cr_assert_neq(pid, -1);
+  if (pid == 0) {
+    dup2(pipefd[1], 1);
+    const int quiet = open("/dev/null", O_WRONLY);
+    if (quiet >= 0) dup2(quiet, 2);
+    close(pipefd[0]);
+    execv(argv[0], argv);
+    _exit(127);
+  }
+  close(pipefd[1]);
+  size_t got = 0;
+  ssize_t n;
+  while (got + 1 < cap && (n = read(pipefd[0], out + got, cap - 1 - got)) > 0) got += (size_t)n;
+  out[got] = '\0';
+  close(pipefd[0]);
+  int status;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 120) {
+  char dir[] = "/tmp/bb-bounce-XXXXXX", ref[1100], ao[1100], ss[1100], pair[2300], tool[1100];
+  cr_assert_not_null(mkdtemp(dir));
+  const char *dirfix = getenv("BB_FIXTURES");
+  char map[1100];
+  snprintf(map, sizeof map, "%s/noise_96x80.png", dirfix && *dirfix ? dirfix : "fixtures");
+  snprintf(ref, sizeof ref, "%s/ref.exr", dir);
+  snprintf(ao, sizeof ao, "%s/ao.exr", dir);
+  snprintf(ss, sizeof ss, "%s/ss.exr", dir);
+  tool_path("bounce_ref", tool, sizeof tool);
+  char out[8192];
+  char *trace[] = {tool, "trace", map, "8", "-o", ref, "--rho", "0.6", "--paths", "4096",
+                   "--stride", "8", NULL};
+  cr_assert_eq(run_capture(trace, out, sizeof out), 0, "%s failed: %s", tool, out);
+  bb_image h;
+  bb_error err;
+  cr_assert_eq(bb_height_load(map, BB_CHANNEL_AUTO, &h, &err), BB_OK, "%s", err.message);
+  bb_bake_options o = options(8.0f, 256, 0.6);
+  o.normal_filter = BB_NORMAL_VALVE;
+  bb_bake_result r = harness_bake(&h, &o);
+  const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL};
+  cr_assert_eq(bb_image_write(ao, &r.ao, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_image_write(ss, &r.ssbump, &wo, &err), BB_OK, "%s", err.message);
+  snprintf(pair, sizeof pair, "bake=%s,%s", ao, ss);
+  char *compare[] = {tool, "compare", ref, map, "8", pair, NULL};
+  cr_assert_eq(run_capture(compare, out, sizeof out), 0, "compare failed: %s", out);
+  /* {"reference":..,"results":[{"name":"bake","channels":[{"mean":..,"mean_abs":..},...]}]} */
+  const char *p = strstr(out, "\"channels\":[");
+  cr_assert_not_null(p, "%s", out);
+  for (int c = 0; c < 4; c++) {
+    double mean, mean_abs;
+    p = strstr(p, "{\"mean\":");
+    cr_assert_not_null(p, "%s", out);
+    cr_assert_eq(sscanf(p, "{\"mean\":%lf,\"mean_abs\":%lf", &mean, &mean_abs), 2, "%s", p);
+    cr_log_info("against the path tracer, channel %d: mean |error| %.5f, bias %+.5f", c, mean_abs,
+                mean);
+    cr_expect(mean_abs <= 0.004 && fabs(mean) <= 0.0025,
+              "channel %d (0 ao, then ssbump): mean |error| %.5f, bias %+.5f", c, mean_abs, mean);
+    p++;
+  }
+  bb_bake_result_free(&r);
+  bb_image_free(&h);
+  unlink(ref), unlink(ao), unlink(ss), rmdir(dir);
+}
