@@ -70,13 +70,17 @@ static void assert_same(const bb_image *a, const bb_image *b, const char *what) 
 }
 
 Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
+  /* the last with inter-reflection, which the bake adds to the vis the
+   * hook made (bounce.c, on the bake's own pyramid) */
   const struct {
     int w, h, slices;
     bb_addressing a;
     const char *basis;
-  } cases[] = {{45, 38, 8, BB_ADDRESS_PERIODIC, "hl2"},
-               {45, 38, 16, BB_ADDRESS_CLAMP, "dirs:6"},
-               {31, 50, 5, BB_ADDRESS_PERIODIC, "hl2+z"}};
+    double bounce;
+  } cases[] = {{45, 38, 8, BB_ADDRESS_PERIODIC, "hl2", 0.0},
+               {45, 38, 16, BB_ADDRESS_CLAMP, "dirs:6", 0.0},
+               {31, 50, 5, BB_ADDRESS_PERIODIC, "hl2+z", 0.0},
+               {40, 36, 8, BB_ADDRESS_PERIODIC, "hl2", 0.6}};
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     bb_image height = bumps(cases[c].w, cases[c].h);
     bb_bake_options o;
@@ -84,6 +88,7 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     o.height_scale = 9.0f;
     o.slices = cases[c].slices;
     o.smooth.addressing = cases[c].a;
+    o.bounce_albedo = cases[c].bounce;
     cr_assert_eq(bb_basis_parse(cases[c].basis, &o.basis, NULL), BB_OK);
     bb_bake_result plain, split;
     bb_error err;
@@ -94,6 +99,7 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     with_hook.trace.trace_user = &u;
     cr_assert_eq(bb_bake(&height, &with_hook, &split, &err), BB_OK, "%s", err.message);
     cr_assert_eq(u.calls, 1);
+    cr_assert_eq(plain.bounces > 0, cases[c].bounce > 0.0, "bounces %d", plain.bounces);
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       assert_same(bb_bake_result_image(&plain, (bb_output_kind)k),
                   bb_bake_result_image(&split, (bb_output_kind)k),

@@ -38,6 +38,8 @@ _VALUED = ("scale", "rays", "slices", "filter-radius", "filter-threshold", "bias
            "weights", "ssbump", "ao", "bent", "filtered", "slope", "lit", "output", "out-dir",
            "maps", "name", "depfile", "scheduler")
 _FLAGS = ("clamp", "mips", "keep-going", "force", "json", "quiet", "help")
+# bumpbake bake's options that the Python package does not take yet.
+_NOT_ON_A_CLUSTER = ("bounce", "bounces", "bounce-albedo", "brightness")
 _SHORT = {"o": "output", "q": "quiet", "h": "help"}
 
 
@@ -47,7 +49,7 @@ class Usage(Exception):
 
 def _long(name):
     """The option an unambiguous prefix names, as getopt_long finds it."""
-    every = _VALUED + _FLAGS
+    every = _VALUED + _FLAGS + _NOT_ON_A_CLUSTER
     if name in every:
         return name
     found = [o for o in every if o.startswith(name)]
@@ -73,6 +75,9 @@ def parse(args):
         if word.startswith("--"):
             name, eq, value = word[2:].partition("=")
             name = _long(name)
+            if name in _NOT_ON_A_CLUSTER:
+                raise Usage(f"--{name} is not available with --scheduler yet: bake on one "
+                            "machine for inter-reflection and brightness maps")
             typed = [word]
             if name in _VALUED:
                 if not eq:
