@@ -12,6 +12,7 @@ once per worker process and bake, and finds its slices' horizons
 (bb_trace_horizons). The driver's own worker uses the driver's pyramid.
 """
 
+import collections
 import os
 import threading
 import time
@@ -44,15 +45,27 @@ class _Entry:
 
 # What this worker process holds for each bake it helps: the pyramid and
 # ray set, built once (by the first of its tasks) and shared by the others,
-# read-only, until the driver drops them.
+# read-only, until the driver drops them. The driver's own worker borrows
+# the driver's (_lend), which the bake frees once the loan ends (_take_back).
 _inputs = {}
 _building = set()
 _inputs_changed = threading.Condition()
+# Bakes whose inputs were dropped here, the newest last: a horizon task that
+# starts after its bake ended (cancelled, but begun before the cancel
+# arrived) must not build a pyramid nobody would free.
+_ended = collections.OrderedDict()
+_ENDED_KEPT = 1024
+
+
+class _Ended(Exception):
+    status = "cancelled"
 
 
 def _acquire(key, build):
     with _inputs_changed:
         while True:
+            if key in _ended:
+                raise _Ended(f"bake {key} is over")
             entry = _inputs.get(key)
             if entry is not None:
                 entry.users += 1
@@ -69,10 +82,14 @@ def _acquire(key, build):
             _inputs_changed.notify_all()
         raise
     with _inputs_changed:
-        entry = _inputs[key] = _Entry(pyramid, rays, owned=True)
-        entry.users = 1
         _building.discard(key)
         _inputs_changed.notify_all()
+        if key in _ended:  # dropped while it was built
+            _lib.bb_pyramid_free(pyramid)
+            _lib.bb_rayset_free(rays)
+            raise _Ended(f"bake {key} is over")
+        entry = _inputs[key] = _Entry(pyramid, rays, owned=True)
+        entry.users = 1
     return entry
 
 
@@ -86,10 +103,15 @@ def _release(entry):
 
 def _drop(key):
     """Frees this worker's inputs of a bake once no task uses them (run on
-    every worker by the driver at the end)."""
+    every worker by the driver at the end); no task of the bake starts here
+    after it. The driver's loan is left to _take_back."""
     with _inputs_changed:
-        entry = _inputs.pop(key, None)
+        _ended[key] = True
+        while len(_ended) > _ENDED_KEPT:
+            _ended.popitem(last=False)
+        entry = _inputs.get(key)
         if entry is not None and entry.owned:
+            del _inputs[key]
             entry.dropped = True
             if entry.users == 0:
                 entry.free()
@@ -98,17 +120,18 @@ def _drop(key):
 
 def _lend(key, pyramid, rays):
     with _inputs_changed:
-        _inputs[key] = _Entry(pyramid, rays, owned=False)
+        entry = _inputs[key] = _Entry(pyramid, rays, owned=False)
+    return entry
 
 
-def _take_back(key):
-    """Ends the loan of the driver's pyramid: waits until no task uses it."""
+def _take_back(key, entry):
+    """Ends the loan of the driver's pyramid (entry): waits until no task
+    uses it, since the bake frees it next."""
     with _inputs_changed:
-        entry = _inputs.get(key)
-        if entry is not None and not entry.owned:
+        if _inputs.get(key) is entry:
             del _inputs[key]
-            while entry.users:
-                _inputs_changed.wait()
+        while entry.users:
+            _inputs_changed.wait()
 
 
 def _bake_options_of(task):
@@ -213,7 +236,7 @@ class _SplitTrace:
         # go together: bb_trace_horizons sweeps them once.
         groups = [list(range(k, min(k + 2, n))) for k in range(0, n, 2)]
         me = distributed.get_worker().address
-        _lend(task["key"], pyramid, rays)
+        loan = _lend(task["key"], pyramid, rays)
         moved = received = 0
         ran = {}
         try:
@@ -248,7 +271,7 @@ class _SplitTrace:
                     client.cancel([f for f in futures if not f.done()])
                     client.run(_drop, task["key"])
         finally:
-            _take_back(task["key"])
+            _take_back(task["key"], loan)
         self.stats = {"slices": n, "tasks": len(groups), "slices_by_worker": ran,
                       "bytes_received": received, "bytes_moved": moved,
                       "driver": me, "seconds_trace": time.monotonic() - t0}
@@ -298,7 +321,7 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     added up on the driver in the single machine's fixed order. So: the
     driver holds what a single bake holds but for the trace's pyramid
     (docs/cluster.md has the bytes per texel), each other worker the
-    smoothed height's pyramid (about 5.4 bytes a texel) and the horizons of
+    smoothed height's pyramid (about 9.3 bytes a texel) and the horizons of
     the slices it is working on (4 bytes a texel a slice); what moves is
     4 bytes a texel for every slice traced away from the driver, and the
     input file, read by every worker from shared storage.
