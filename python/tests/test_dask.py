@@ -6,6 +6,7 @@ changes nothing of the result."""
 
 import os
 import signal
+import time
 
 import numpy as np
 import pytest
@@ -243,3 +244,32 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     bad = cli("bake", "heights/h01.png", "heights/h02.png", "--scale", "16", "--scheduler",
               address, "-o", "x", check=False)
     assert bad.returncode == 2 and "several HEIGHT files need --out-dir DIR" in bad.stderr
+
+
+def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, client, cli):
+    """Ctrl-C on `bake MAP -o PREFIX --scheduler ADDRESS` while the slices
+    are out: a running task cannot be killed, so the driver is told (a
+    distributed.Variable) and stops at its next group of slices; no output
+    is written and nothing of the bake goes on running on the workers."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1, side=640)  # 648 x 640, 32 tasks of two slices: a few seconds
+    bake = cli.start("bake", "h00.png", "--scale", "16", "--slices", "64", "-o", "m",
+                     "--scheduler", client.scheduler.address)
+
+    def running():  # keys of bumpbake's tasks running on the workers, seceded ones too
+        return [k for keys in client.run(lambda dask_worker: list(
+            dask_worker.active_threads.values())).values() for k in keys
+            if "bumpbake-" in str(k)]
+
+    deadline = time.monotonic() + 60
+    while not any("bumpbake-horizons" in str(k) for k in running()):
+        assert bake.poll() is None, bake.communicate()
+        assert time.monotonic() < deadline, "the slices never went out"
+        time.sleep(0.02)
+    bake.send_signal(signal.SIGINT)
+    _, err = bake.communicate(timeout=60)
+    assert bake.returncode == 130, err
+    while running():
+        assert time.monotonic() < deadline, f"still running: {running()}"
+        time.sleep(0.05)
+    assert sorted(os.listdir(".")) == ["h00.png"], "an output was written"

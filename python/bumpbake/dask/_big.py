@@ -266,6 +266,9 @@ class _SplitTrace:
                                 options.progress_user, g[-1] + 1, n):
                             raise _exception(_lib.BB_ERR_CANCELLED,
                                              "trace: cancelled by the progress callback")
+                        if distributed.Variable(task["stop"], client=client).get():
+                            raise _exception(_lib.BB_ERR_CANCELLED,
+                                             "trace: cancelled by the client")
                     _check(_lib.bb_trace_finish(rays, vis, self.own_threads, err), err)
                 finally:
                     client.cancel([f for f in futures if not f.done()])
@@ -356,13 +359,23 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
             "scale": args["scale"], "channel": args["channel"], "options": task_options,
             "horizon_threads": int(horizon_threads)}
+    # Set when the client gives up (Ctrl-C): the driver stops at the next
+    # group of slices, writing nothing (a running task cannot be killed).
+    task["stop"] = f"bumpbake-big-stop-{task['key']}"
+    stop = distributed.Variable(task["stop"], client=client)
+    stop.set(0)
     future = client.submit(_drive, directory, planned, args, task, pure=False,
                            key=f"bumpbake-big-{task['key']}")
     try:
         report, stats = future.result()
     except BaseException:
-        client.cancel([future])
+        try:
+            stop.set(1)  # left set: the driver may still be reading it
+            client.cancel([future])
+        except Exception:  # noqa: BLE001 (the scheduler lost: the first error is the one)
+            pass
         raise
+    stop.delete()
     report.cluster = stats
     sweep_temporaries({os.path.dirname(p) or "." for p in report.outputs.values()})
     _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
