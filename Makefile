@@ -1,7 +1,7 @@
 # bumpbake: plain Makefile. `make` builds, `make test` builds and runs every
 # test, `make demo` bakes a fixture into out/, `make bench` measures,
 # `make install` installs (PREFIX=/usr/local, DESTDIR= for staging),
-# `make fuzz` runs the libFuzzer targets of fuzz/.
+# `make fuzz` runs the libFuzzer targets of fuzz/ (`make fuzz-long` for longer).
 # `make DEBUG=1 ...` builds with assertions and ASan/UBSan into build/debug.
 
 DEBUG ?= 0
@@ -33,9 +33,18 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp libsquish Imath
+PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
+# libpng: src/io/png_hooks.c sets quiet error handlers and bounded
+# allocations on the libpng structs OpenImageIO makes.
+PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
+PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
+# libjpeg and OpenEXRCore read headers before OpenImageIO's readers do
+# (src/io/header_probe.c), to refuse what they would allocate in open().
+PROBE_CFLAGS := $(shell pkg-config --cflags libjpeg OpenEXR 2>/dev/null)
+PROBE_LIBS   := $(shell pkg-config --libs libjpeg 2>/dev/null) \
+                $(filter -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 # Assimp reads and writes meshes (src/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
@@ -44,7 +53,7 @@ ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) -lm -pthread
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -127,7 +136,7 @@ BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-circles check-docs bench goldens docs docs-reference install \
         uninstall clean format FORCE \
-        fuzz fuzz-deps ensure-fuzz-deps
+        fuzz fuzz-long fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
@@ -143,7 +152,7 @@ PYTHON   := /usr/bin/python3
 # python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
 # a Dask cluster (its tests run a LocalCluster).
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
-            pkg-config g++ make \
+            libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build python3-distributed python3-dask
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
@@ -176,7 +185,7 @@ ensure-fuzz-deps: ensure-deps
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) | $(LIB_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -185,7 +194,7 @@ $(BUILD)/link.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES)
+$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
@@ -338,11 +347,21 @@ goldens: ensure-deps
 # ---- fuzzing (libFuzzer, ASan + UBSan) ---------------------------------------
 # `make fuzz FUZZ_SECONDS=N` builds fuzz/fuzz_*.c with clang against a copy of
 # the library instrumented for coverage and runs each target N seconds,
-# seeded from fixtures/ (fuzz/make_seeds.c) and from the corpus earlier runs
-# left in build/fuzz/corpus, after replaying fuzz/regressions/. Crashes land
-# in build/fuzz/crashes/; each one found becomes a regression test of `make
-# test` (tests/test_fuzz.c).
+# seeded by fuzz/make_seeds.c (the fixtures, and a small valid file of every
+# image format OpenImageIO writes here) and from the corpus earlier runs left
+# in build/fuzz/corpus, after replaying fuzz/regressions/. A crash, a leak, a
+# failed property, an input slower than FUZZ_TIMEOUT seconds, one allocation
+# over FUZZ_MALLOC_MB or a process over FUZZ_RSS_MB fails the run
+# (fuzz/run.sh); the input lands in build/fuzz/crashes/, and each one found
+# becomes a regression input under fuzz/regressions/NAME/, replayed by `make
+# test` (tests/cli/test_fuzz.c) and by every `make fuzz`.
+# CI runs `make fuzz FUZZ_SECONDS=15`; `make fuzz-long` runs each target
+# FUZZ_LONG_SECONDS (1800) seconds, for a machine left to it.
 FUZZ_SECONDS ?= 60
+FUZZ_LONG_SECONDS ?= 1800
+FUZZ_TIMEOUT   ?= 10
+FUZZ_MALLOC_MB ?= 1100
+FUZZ_RSS_MB    ?= 2560
 FUZZ_BUILD   := build/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
@@ -362,12 +381,12 @@ FUZZ_ARGS_fuzz_mesh       := -dict=fuzz/mesh.dict -max_len=16384
 
 $(FUZZ_BUILD)/src/%.o: src/%.c
 	@mkdir -p $(@D)
-	clang $(FUZZ_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
+	clang $(FUZZ_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
 
 $(FUZZ_BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
-	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) -fsanitize=fuzzer-no-link \
-	  -c $< -o $@
+	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) \
+	  $(PNG_CFLAGS) $(PROBE_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
 
 -include $(FUZZ_LIB_OBJ:.o=.d) $(FUZZ_CLI_OBJ:.o=.d)
 
@@ -376,14 +395,22 @@ $(FUZZ_BUILD)/%: fuzz/%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< -x none $(FUZZ_CLI_OBJ) \
 	  $(FUZZ_LIB_OBJ) $(LDLIBS)
 
-$(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_LIB_OBJ)
+$(FUZZ_BUILD)/seed_formats.o: fuzz/seed_formats.cpp
+	@mkdir -p $(@D)
+	clang++ $(FUZZ_CXXFLAGS) $(OIIO_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -o $@ $< -x none \
-	  $(FUZZ_LIB_OBJ) $(LDLIBS)
+	  $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ) $(LDLIBS)
 
 fuzz: ensure-fuzz-deps
 	@$(MAKE) --no-print-directory $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds
-	@./fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) \
+	@FUZZ_TIMEOUT=$(FUZZ_TIMEOUT) FUZZ_MALLOC_MB=$(FUZZ_MALLOC_MB) FUZZ_RSS_MB=$(FUZZ_RSS_MB) \
+	  ./fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) \
 	  $(foreach t,$(FUZZ_TARGETS),"$(notdir $(t)) $(FUZZ_ARGS_$(notdir $(t)))")
+
+fuzz-long:
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_LONG_SECONDS)
 
 format:
 	clang-format -i include/*.h src/*/*.c src/*/*.h src/*/*.cpp tests/*.h tests/*/*.c tools/*.c fuzz/*.c

@@ -4,8 +4,8 @@
  * thresholds, then A's samples and B's samples. Properties: no crash or
  * undefined behaviour, counts within the pixel count, max >= mean (to
  * rounding) when both are finite, and a diff image exactly as documented: |A - B| in
- * double rounded to float, 0 for equal values (equal infinities too), infinity where
- * either side is NaN. */
+ * double rounded to float, 0 for equal values (equal infinities, and NaN on both
+ * sides, too), infinity where one side is NaN. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
 
@@ -21,7 +21,7 @@ static float take_float(const uint8_t **p, const uint8_t *end) {
 }
 
 static float expected_difference(float a, float b) {
-  if (a == b)
+  if (a == b || (isnan(a) && isnan(b)))
     return 0.0f;
   if (isnan(a) || isnan(b))
     return INFINITY;

@@ -1,22 +1,29 @@
-/* fuzz_load.c: image bytes -> bb_height_load, the path every command's
- * input takes (OpenImageIO's header, bumpbake's size checks, the channel
- * rule, banded decoding). The first byte picks the file extension (the
- * format OpenImageIO tries first) and the height channel rule; the rest is
- * the file. Properties: no crash, no leak, and a success is a finite
- * 1-channel height of the size the header declares. */
+/* fuzz_load.c: image bytes -> every read of the library, the path every
+ * command's input takes (the checked descriptor, the header probes,
+ * OpenImageIO's readers, bumpbake's size checks, the channel rule, banded
+ * decoding, frames). The first byte's low 4 bits pick the file extension
+ * (the format OpenImageIO tries first; every other reader then gets its
+ * turn by content), its high bits the height channel rule; the rest is the
+ * file. Properties: no crash, no leak, no unit slower than `make fuzz`'s
+ * -timeout or allocating past its -malloc_limit_mb, every failure one line,
+ * and a success a finite 1-channel height of the size the header declares. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
 
 #include <math.h>
 
-static const char *const EXTENSIONS[] = {"in.png", "in.tga", "in.tif", "in.exr"};
+/* Every format the seed corpus holds a valid file of (make_seeds.c), PSD
+ * and DDS read-only. */
+static const char *const EXTENSIONS[16] = {
+    "in.png", "in.tga", "in.tif", "in.exr", "in.jpg", "in.bmp", "in.pnm", "in.gif",
+    "in.hdr", "in.dpx", "in.jp2", "in.webp", "in.sgi", "in.ico", "in.psd", "in.dds"};
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size < 1)
     return 0;
-  const char *name = EXTENSIONS[data[0] & 3];
-  const bb_channel channel = (bb_channel)((data[0] >> 2) % 7);
+  const char *name = EXTENSIONS[data[0] & 15];
+  const bb_channel channel = (bb_channel)((data[0] >> 4) % 7);
   const char *path = fuzz_write_file(name, data + 1, size - 1);
 
   int width = 0, height = 0, channels = 0;
@@ -24,18 +31,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   bb_error err;
   bb_status header = bb_image_read_info(path, &width, &height, &channels, &info, &err);
   bb_image_info_free(&info);
+  if (header != BB_OK) {
+    FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);
+    return 0;
+  }
   /* Past 65536 texels decoding is legitimate and bounded (up to
-   * BB_MAX_READ_BYTES, which the tests check) but slow: OpenImageIO's PNG
-   * reader zero-fills the whole declared image first. Such inputs would
+   * BB_MAX_READ_BYTES, which the tests check) but slow: such inputs would
    * drown the search in page faults, so only their header is fuzzed. */
-  if (header == BB_OK && (long)width * height > (1L << 16))
+  if ((long)width * height > (1L << 16))
     return 0;
 
   bb_image h;
   bb_status st = bb_height_load(path, channel, &h, &err);
   FUZZ_CHECK((st == BB_OK) == (h.pixels != NULL));
   if (st == BB_OK) {
-    FUZZ_CHECK(header == BB_OK);
     FUZZ_CHECK(h.channels == 1 && h.width == width && h.height == height);
     size_t n = (size_t)h.width * (size_t)h.height;
     for (size_t i = 0; i < n; i++)
@@ -44,5 +53,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);
   }
   bb_image_free(&h);
+
+  /* Frames and mip levels: further subimages and levels, each opened. */
+  int frames = 0, levels = 0;
+  if (bb_image_frame_count(path, &frames, &err) == BB_OK) {
+    FUZZ_CHECK(frames >= 1);
+  } else {
+    FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);
+  }
+  bb_image level;
+  st = bb_image_read_mip(path, 1, &level, NULL, &levels, &err);
+  FUZZ_CHECK((st == BB_OK) == (level.pixels != NULL));
+  FUZZ_CHECK(st != BB_OK || levels >= 2);
+  bb_image_free(&level);
   return 0;
 }

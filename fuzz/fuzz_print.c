@@ -91,7 +91,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   bb_image img;
   if (bb_image_alloc(&img, 2, 2, 1, NULL) != BB_OK)
     abort();
-  const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, text};
+  const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, text, NULL};
   if (bb_image_write(path, &img, &wo, NULL) == BB_OK) {
     char *info[] = {"info", path, NULL};
     char *printed = captured(bb_cli_info, 2, info);

@@ -36,7 +36,7 @@ static void write_images(void) {
       img.pixels[i] = (float)((i * 37 + f * 11) % 64) / 63.0f;
     char path[256];
     snprintf(path, sizeof path, "%s/%s", fuzz_scratch_dir(), files[f].name);
-    const bb_write_options wo = {files[f].depth, BB_RANGE_UNIT, NULL};
+    const bb_write_options wo = {files[f].depth, BB_RANGE_UNIT, NULL, NULL};
     if (bb_image_write(path, &img, &wo, NULL) != BB_OK)
       abort();
     bb_image_free(&img);

@@ -1,8 +1,11 @@
 /* make_seeds.c: writes the seed corpora of the fuzz targets from the
- * project's own fixtures, so no binary seed is committed:
+ * project's own fixtures and small patterns, so no binary seed is committed:
  *   make_seeds FIXTURES_DIR OUT_DIR
- * OUT_DIR/load: every small fixture PNG as it is, and each converted to TGA,
- * TIFF and EXR (with fuzz_load's leading byte); OUT_DIR/compare: pairs of
+ * OUT_DIR/load: every small fixture PNG as it is and as TGA, TIFF and EXR,
+ * and a small valid file of every other format OpenImageIO writes here
+ * (JPEG, progressive JPEG, BMP, PNM, GIF, HDR, DPX, JPEG 2000, WebP, SGI,
+ * ICO; through seed_formats.cpp), 16-bit, half and mip-mapped files and a
+ * GIF of three frames, each after fuzz_load's leading byte; OUT_DIR/compare: pairs of
  * small images; OUT_DIR/provenance: the provenance texts of the golden
  * EXRs, in pairs; OUT_DIR/cli: the command lines of the docs' examples;
  * OUT_DIR/mesh: small models of each format fuzz_mesh reads. */
@@ -52,16 +55,56 @@ static void make_dir(const char *out, const char *name, char *dir, size_t cap) {
   }
 }
 
-/* fuzz_load's leading byte: extension index (png, tga, tif, exr) in the low
- * two bits, channel rule above. */
+/* fuzz_load's leading byte: extension index in the low 4 bits (its
+ * EXTENSIONS), channel rule 0 (auto) above. */
+static const char *const LOAD_EXT[16] = {".png", ".tga", ".tif", ".exr", ".jpg", ".bmp",
+                                         ".pnm", ".gif", ".hdr", ".dpx", ".jp2", ".webp",
+                                         ".sgi", ".ico", ".psd", ".dds"};
+
+/* OpenImageIO's writer of the formats bumpbake does not write (seed_formats.cpp). */
+int seed_write(const char *path, const float *pixels, int width, int height, int channels,
+               const char *flag);
+
+/* Saves the file at tmp as a load seed of extension index k, then removes
+ * it; returns 1 when it was small enough to be a seed. */
+static int keep_seed(const char *dir, const char *name, const char *tmp, unsigned char k) {
+  size_t size;
+  unsigned char *bytes = read_all(tmp, &size);
+  unlink(tmp);
+  if (!bytes)
+    return 0;
+  write_seed(dir, name, &k, 1, bytes, size);
+  free(bytes);
+  return 1;
+}
+
+/* A small image of c channels: a ramp, a ring and a checker, so each
+ * channel differs and compressors have something to do. */
+static bb_image pattern(int w, int h, int c) {
+  bb_image img;
+  if (bb_image_alloc(&img, w, h, c, NULL) != BB_OK)
+    exit(1);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      for (int ch = 0; ch < c; ch++) {
+        float v = ch % 3 == 0   ? (float)x / (float)(w - 1)
+                  : ch % 3 == 1 ? (float)((x - w / 2) * (x - w / 2) + (y - h / 2) * (y - h / 2)) /
+                                      (float)(w * w / 4 + h * h / 4)
+                                : (float)((x / 4 + y / 4) % 2);
+        img.pixels[((size_t)y * (size_t)w + (size_t)x) * (size_t)c + (size_t)ch] =
+            ch == 3 ? 1.0f - v * 0.5f : v;
+      }
+  return img;
+}
+
 static void load_seeds(const char *fixtures, const char *out) {
-  static const char *const EXT[] = {".png", ".tga", ".tif", ".exr"};
   char dir[1024], tmp[1024];
   make_dir(out, "load", dir, sizeof dir);
   DIR *d = opendir(fixtures);
   if (!d)
     exit(1);
-  int n = 0;
+  int n = 0, written = 0;
+  /* The small fixtures as they are, and as bumpbake writes TGA, TIFF and EXR. */
   for (struct dirent *e; (e = readdir(d)) != NULL;) {
     size_t len = strlen(e->d_name);
     if (len < 5 || strcmp(e->d_name + len - 4, ".png") != 0)
@@ -80,27 +123,95 @@ static void load_seeds(const char *fixtures, const char *out) {
     }
     for (unsigned char k = 0; k < 4; k++) {
       char name[300];
-      snprintf(name, sizeof name, "%s%s", e->d_name, EXT[k]);
+      snprintf(name, sizeof name, "%s%s", e->d_name, LOAD_EXT[k]);
       if (k == 0) {
         write_seed(dir, name, &k, 1, bytes, size);
+        written++;
         continue;
       }
-      snprintf(tmp, sizeof tmp, "%s/seed%s", out, EXT[k]);
-      size_t converted_size;
-      unsigned char *converted = NULL;
+      snprintf(tmp, sizeof tmp, "%s/seed%s", out, LOAD_EXT[k]);
       if (bb_image_write(tmp, &img, NULL, &err) == BB_OK)
-        converted = read_all(tmp, &converted_size);
-      unlink(tmp);
-      if (converted)
-        write_seed(dir, name, &k, 1, converted, converted_size);
-      free(converted);
+        written += keep_seed(dir, name, tmp, k);
     }
     bb_image_free(&img);
     free(bytes);
     n++;
   }
   closedir(d);
-  printf("make_seeds: %d fixtures x 4 formats for load\n", n);
+
+  /* Every other format OpenImageIO writes here, from small patterns of 1, 3
+   * and 4 channels (a format refusing one is skipped), and the variants a
+   * reader takes another path for. */
+  for (int c = 1; c <= 4; c++) {
+    if (c == 2)
+      continue;
+    bb_image img = pattern(24, 16, c);
+    /* OpenJPEG's default of 6 resolutions needs 32 texels a side. */
+    bb_image large = pattern(64, 40, c);
+    for (unsigned char k = 4; k < 16; k++) {
+      const bb_image *src = strcmp(LOAD_EXT[k], ".jp2") == 0 ? &large : &img;
+      char name[64];
+      snprintf(tmp, sizeof tmp, "%s/seed%s", out, LOAD_EXT[k]);
+      snprintf(name, sizeof name, "pattern%d%s", c, LOAD_EXT[k]);
+      if (seed_write(tmp, src->pixels, src->width, src->height, c, NULL) == 0)
+        written += keep_seed(dir, name, tmp, k);
+      else
+        unlink(tmp);
+    }
+    bb_image_free(&large);
+    snprintf(tmp, sizeof tmp, "%s/seed.jpg", out);
+    if (seed_write(tmp, img.pixels, img.width, img.height, c, "jpeg:progressive") == 0) {
+      char name[64];
+      snprintf(name, sizeof name, "progressive%d.jpg", c);
+      written += keep_seed(dir, name, tmp, 4);
+    }
+    /* 16-bit PNG and TIFF, half EXR, and mip-mapped TIFF and EXR. */
+    const struct {
+      const char *ext;
+      bb_depth depth;
+      unsigned char k;
+    } depths[] = {{".png", BB_DEPTH_16, 0}, {".tif", BB_DEPTH_16, 2}, {".exr", BB_DEPTH_HALF, 3}};
+    for (size_t i = 0; i < sizeof depths / sizeof depths[0]; i++) {
+      bb_write_options o = {depths[i].depth, BB_RANGE_UNIT, "seed", NULL};
+      char name[64];
+      snprintf(tmp, sizeof tmp, "%s/seed%s", out, depths[i].ext);
+      snprintf(name, sizeof name, "depth%d%s", c, depths[i].ext);
+      if (bb_image_write(tmp, &img, &o, NULL) == BB_OK)
+        written += keep_seed(dir, name, tmp, depths[i].k);
+    }
+    bb_image *levels = NULL;
+    int count = 0;
+    if (bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count, NULL) == BB_OK) {
+      for (unsigned char k = 2; k <= 3; k++) {
+        char name[64];
+        snprintf(tmp, sizeof tmp, "%s/seed%s", out, LOAD_EXT[k]);
+        snprintf(name, sizeof name, "mips%d%s", c, LOAD_EXT[k]);
+        if (bb_image_write_mips(tmp, levels, count, NULL, NULL) == BB_OK)
+          written += keep_seed(dir, name, tmp, k);
+      }
+      bb_mip_chain_free(levels, count);
+    }
+    bb_image_free(&img);
+  }
+  /* A GIF of three frames. */
+  bb_image frame = pattern(16, 12, 3);
+  bb_animation *a = NULL;
+  snprintf(tmp, sizeof tmp, "%s/seed.gif", out);
+  if (bb_animation_open(tmp, 16, 12, 10.0, &a, NULL) == BB_OK) {
+    int ok = 1;
+    for (int f = 0; f < 3 && ok; f++) {
+      for (size_t i = 0; i < 16u * 12u * 3u; i++)
+        frame.pixels[i] = 1.0f - frame.pixels[i];
+      ok = bb_animation_add_frame(a, &frame, NULL) == BB_OK;
+    }
+    if (ok && bb_animation_close(a, NULL) == BB_OK)
+      written += keep_seed(dir, "frames.gif", tmp, 7);
+    else if (!ok)
+      bb_animation_abort(a);
+  }
+  bb_image_free(&frame);
+  printf("make_seeds: %d load seeds (%d fixtures, and every format OpenImageIO writes)\n",
+         written, n);
 }
 
 /* fuzz_compare's layout: w-1, h-1, c-1, fail, warn, then the floats. */
@@ -340,6 +451,63 @@ static void mesh_seeds(const char *fixtures, const char *out) {
   write_seed(dir, "quad.dae", &dae_lead, 1, SEED_DAE, sizeof SEED_DAE - 1);
 }
 
+/* Text seeds, one file per string: fuzz_basis's basis files and
+ * fuzz_program's image programs (the images it names are the target's). */
+static void text_seeds(const char *out, const char *name, const char *const *texts,
+                       size_t n) {
+  char dir[1024];
+  make_dir(out, name, dir, sizeof dir);
+  for (size_t i = 0; i < n; i++) {
+    char file[32];
+    snprintf(file, sizeof file, "seed%zu", i);
+    write_seed(dir, file, texts[i], strlen(texts[i]), NULL, 0);
+  }
+}
+
+static void basis_seeds(const char *out) {
+  static const char *const texts[] = {
+      "# Half-Life 2's basis\n0.816497 0 0.57735\n-0.408248 0.707107 0.57735\n"
+      "-0.408248 -0.707107 0.57735\n",
+      "1 0 1\n0 1 1\n-1 0 1\n0 -1 1\n",
+      "1, 0, 0.5\n0, 1, 0.5 # comma separated\n-1, -1, 0.5\n",
+      "0 0 1\n0 0 1\n1 0 0\n",
+      "1e308 0 1\nnan 0 1\n0 inf 1\n"};
+  text_seeds(out, "basis", texts, sizeof texts / sizeof texts[0]);
+}
+
+static void program_seeds(const char *out) {
+  static const char *const texts[] = {
+      "heightmap(a.png, 4)",
+      "addnormals(heightmap(a.png, 2), heightmap(d.tif, 8))",
+      "smoothnormals(heightmap(c.exr, 1))",
+      "add(b.tga, scale(c.exr, 0.5, 0.5, 0.5, 1))",
+      "invertColor(makeIntensity(e.png))",
+      "makeAlpha(invertAlpha(b.tga))",
+      "addnormals(_flat, heightmap(e.png, 3))",
+      "heightmap(../outside.png, 4)"};
+  text_seeds(out, "program", texts, sizeof texts / sizeof texts[0]);
+}
+
+/* fuzz_print: a leading byte (how many of the last bytes name the file),
+ * then a description: bumpbake's own provenance, another tool's, and one
+ * with an escape sequence, a bidi override and a C1 control in it. */
+static void print_seeds(const char *out) {
+  static const char *const texts[] = {
+      "\x04" "bumpbake 0.2.0\nkind: ssbump\ncommand: bumpbake bake h.png --scale 4\n"
+      "input: h.png sha256:00\nbasis: hl2\n_name",
+      "\x00" "Created with GIMP",
+      "\x03" "kind: normal\ncommand: \x1b]0;title\x07 \xe2\x80\xae evil \xc2\x9b 31m\nred"};
+  char dir[1024];
+  make_dir(out, "print", dir, sizeof dir);
+  for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+    char file[32];
+    snprintf(file, sizeof file, "seed%zu", i);
+    /* The second seed's leading byte is a NUL: strlen would stop at it. */
+    size_t n = i == 1 ? 1 + strlen(texts[i] + 1) : strlen(texts[i]);
+    write_seed(dir, file, texts[i], n, NULL, 0);
+  }
+}
+
 int main(int argc, char **argv) {
 
   if (argc != 3) {
@@ -355,5 +523,8 @@ int main(int argc, char **argv) {
   provenance_seeds(argv[1], argv[2]);
   cli_seeds(argv[2]);
   mesh_seeds(argv[1], argv[2]);
+  basis_seeds(argv[2]);
+  program_seeds(argv[2]);
+  print_seeds(argv[2]);
   return 0;
 }

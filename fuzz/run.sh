@@ -3,12 +3,23 @@
 #   fuzz/run.sh BUILD_DIR SECONDS "fuzz_NAME [libFuzzer options]" ...
 # For each target: replays the saved crash inputs of fuzz/regressions/NAME,
 # then fuzzes SECONDS seconds from build/fuzz/corpus/NAME (kept between runs)
-# and the seeds make_seeds wrote from fixtures/, and prints executions and
-# time per target. Exits 1 when a target crashed, leaked or hung; the input
-# is saved in BUILD_DIR/crashes/.
+# and the seeds make_seeds wrote, and prints executions and time per
+# target. Exits 1 when a target crashed, leaked, failed a property, took
+# longer than FUZZ_TIMEOUT seconds on one input, allocated more than
+# FUZZ_MALLOC_MB at once or grew past FUZZ_RSS_MB; the input is saved in
+# BUILD_DIR/crashes/ (crash-, leak-, timeout- or oom-HASH).
+#
+# The limits (environment, `make fuzz` passes them on):
+#   FUZZ_TIMEOUT   (10)   seconds one input may take (ASan and UBSan on)
+#   FUZZ_MALLOC_MB (1100) one allocation: a read's documented bound is
+#                         BB_MAX_READ_BYTES (1024 MiB), so more is a bug
+#   FUZZ_RSS_MB    (2560) the process: that bound touched, with the
+#                         sanitizers' own overhead
 set -uo pipefail
 build=$1 seconds=$2
 shift 2
+limits=(-timeout="${FUZZ_TIMEOUT:-10}" -malloc_limit_mb="${FUZZ_MALLOC_MB:-1100}"
+        -rss_limit_mb="${FUZZ_RSS_MB:-2560}")
 cd "$(dirname "$0")/.."
 # Absolute paths: a target may chdir (fuzz_cli works in a scratch directory).
 build=$(realpath "$build")
@@ -26,17 +37,16 @@ for spec in "$@"; do
   # Inputs that once crashed must stay fixed.
   regressions=("$PWD"/fuzz/regressions/"$name"/*)
   if [ -e "${regressions[0]}" ]; then
-    if ! "$build/$target" $options -close_fd_mask=3 "${regressions[@]}" >"$log" 2>&1; then
+    if ! "$build/$target" $options "${limits[@]}" -close_fd_mask=3 "${regressions[@]}" \
+      >"$log" 2>&1; then
       echo "fuzz: $target: a saved regression input fails again (see $log)"
       failed=1
       continue
     fi
   fi
   start=$(date +%s.%N)
-  # -rss_limit_mb: every read is bounded by 1 GiB of samples, plus the
-  # sanitizers' own overhead; -timeout: no input may take this long.
   "$build/$target" $options -max_total_time="$seconds" -close_fd_mask=3 \
-    -rss_limit_mb=3072 -timeout=30 -print_final_stats=1 \
+    "${limits[@]}" -print_final_stats=1 \
     -artifact_prefix="$build/crashes/$name-" "$corpus" "$build/seeds/$name" >"$log" 2>&1
   status=$?
   elapsed=$(echo "$(date +%s.%N) - $start" | bc)

@@ -74,9 +74,13 @@ extern "C" {
  * file's own samples (texels x channels x bytes per sample, as its header
  * declares them) and the floats decoded (texels x channels read x 4) must
  * fit, checked before anything is allocated, and then what is available
- * (bb_memory_available) must hold them. The first read also lowers
- * OpenImageIO's process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16
- * bytes (16384) and "limits:channels" to 64 when they are higher. */
+ * (bb_memory_available) must hold them. What a reader allocates to open a
+ * file at all (see bb_image_read_info) stays within BB_MAX_READ_BYTES
+ * whatever the size. The first read or write also lowers OpenImageIO's
+ * process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16 bytes (16384)
+ * and "limits:channels" to 64 when they are higher, and sets its
+ * "exr_threads" to -1 (OpenEXR without its own thread pool, which crashed
+ * when started short of memory). */
 #define BB_MAX_READ_BYTES (1L << 30)
 #define BB_MAX_READ_BYTES_PER_TEXEL 16
 
@@ -234,9 +238,13 @@ void bb_image_info_free(bb_image_info *info);
 
 /* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
  * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
- * Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not an image,
- * truncated, corrupt), BB_ERR_SIZE (zero, over BB_MAX_PIXELS or over
- * BB_MAX_READ_BYTES, refused before allocating). */
+ * The file must be a regular one (a FIFO, a device or a directory is
+ * refused at once) and is read through the descriptor that was checked.
+ * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
+ * BB_ERR_FORMAT (not an image, truncated, corrupt), BB_ERR_SIZE (zero,
+ * over BB_MAX_PIXELS or over BB_MAX_READ_BYTES, or tiles of more than 64
+ * MiB as floats, or a header whose reader would allocate more than
+ * BB_MAX_READ_BYTES to open it: all refused before allocating). */
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
 
@@ -244,10 +252,13 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * bb_image_info holds, without decoding a pixel (fast on any size; a
  * truncated pixel stream is not noticed). width, height, channels and info
  * may each be NULL. Errors as bb_image_read, except that the size limits
- * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied
- * (the size is reported, not allocated; OpenImageIO's own limits, see
- * BB_MAX_READ_BYTES, may still refuse a header declaring more than 16 GiB of
- * samples). */
+ * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied to
+ * the image (its size is reported, not allocated). Some readers allocate
+ * from the header to open a file at all (a progressive JPEG's whole
+ * coefficients, a GIF's canvas, an OpenEXR's chunk buffers): that is
+ * refused past BB_MAX_READ_BYTES (64 MiB for one OpenEXR chunk) with
+ * BB_ERR_SIZE, and OpenImageIO's own limits, see BB_MAX_READ_BYTES, may
+ * refuse a header declaring more than 16 GiB of samples. */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
@@ -292,10 +303,18 @@ typedef struct bb_write_options {
                               is fitted with whole key=value lines, keys that
                               affect pixels first, and what does not fit is
                               left out (see bb_provenance_classify) */
+  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
+                              chain, flags (see "engine textures"); NULL: the
+                              defaults, the map NORMAL for BB_RANGE_SIGNED and
+                              PLAIN otherwise. description overrides its own */
 } bb_write_options;
 
 /* Writes img to path; the format comes from the extension (.png .tga .tif
- * .tiff .exr). Integer formats clamp to the code range and round to nearest.
+ * .tiff .exr, and the engine textures .vtf and .dds, written by
+ * bb_texture_write with options->texture: depth must then be
+ * BB_DEPTH_DEFAULT, the texture format sets it; with a description, the
+ * texture's settings are added to it as bb_texture_provenance's lines).
+ * Integer formats clamp to the code range and round to nearest.
  * Channels are R, G, B, A for up to 4; an image of more (a basis map with
  * more than 4 directions) has them named B0, B1, ... instead, zero-padded
  * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
@@ -349,13 +368,15 @@ bb_status bb_file_write(const char *path, const void *data, size_t size, bb_erro
 void bb_tempfiles_remove(void);
 
 /* Removes from directory dir (not below it) the temporaries
- * ".bb-tmp-XXXXXX.EXT" whose writer is gone: a writer holds an advisory
- * lock (flock) on its temporary from its creation until it is renamed into
- * place or removed, and the kernel drops it when the process dies, so one
- * that no process holds is what a process killed outright (SIGKILL, an
- * out-of-memory kill, a lost machine) left behind. Temporaries being
- * written, by this process or any other, on this machine or another sharing
- * the directory (NFS v4 carries flock), are left alone. *removed (may be
+ * ".bb-tmp-XXXXXX.EXT" whose writer is gone, and the private directories
+ * ".bb-tmp-XXXXXX" some encoders write in with what they hold: a writer
+ * holds an advisory lock (flock) on its temporary from its creation until
+ * it is renamed into place or removed, and the kernel drops it when the
+ * process dies, so one that no process holds is what a process killed
+ * outright (SIGKILL, an out-of-memory kill, a lost machine) left behind.
+ * Temporaries being written, by this process or any other, on this machine
+ * or another sharing the directory (NFS v4 carries flock), are left alone,
+ * and so is a private directory holding anything but its staged file. *removed (may be
  * NULL) receives how many were removed. Errors: BB_ERR_ARGUMENT (no dir),
  * BB_ERR_IO (dir cannot be read, an orphan cannot be removed). */
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
@@ -366,7 +387,8 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
  * It says nothing of the file's contents. */
 int bb_path_is_readable_format(const char *path);
 
-/* True (1) when the extension of path names a format bb_image_write knows. */
+/* True (1) when the extension of path names a format bb_image_write knows
+ * (.vtf and .dds included). */
 int bb_path_is_writable_format(const char *path);
 
 /* True (1) when bb_image_write can store depth in the format path's extension
@@ -375,19 +397,21 @@ int bb_path_is_writable_format(const char *path);
 int bb_path_supports_depth(const char *path, bb_depth depth);
 
 /* Most channels bb_image_write can store in the format path's extension
- * names: 4 for .png and .tga, 64 for .tif, .tiff and .exr; 0 for an unknown
+ * names: 4 for .png, .tga, .vtf and .dds, 64 for .tif, .tiff and .exr; 0 for an unknown
  * extension. So a caller can refuse a basis with more directions than the
  * file can hold before the bake. */
 int bb_path_max_channels(const char *path);
 
-/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr). */
+/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr; .vtf
+ * and .dds, which have one unless bb_texture_options.mips is 0). */
 int bb_path_supports_mips(const char *path);
 
 /* Writes a mip chain (levels[0] the largest, each the halved size of the one
  * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
  * OpenEXR file, every level encoded as bb_image_write encodes an image, and
- * written to a temporary name and renamed as it does. Errors as
- * bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
+ * written to a temporary name and renamed as it does; or as a .vtf or .dds
+ * texture holding these levels (options->texture's mips is then ignored).
+ * Errors as bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
 bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err);
 
@@ -532,6 +556,23 @@ bb_status bb_texture_write_staged(const char *path, const bb_image *img,
                                   const bb_texture_options *options,
                                   bb_staged_file **staged, bb_error *err);
 
+/* Sets options->map for a file of an output kind: SSBUMP for the kinds
+ * "ssbump", "ssbump+...", "detail-ssbump..." and "weights" (normal2ssbump's,
+ * an ssbump without shadows, which Source loads the same way); NORMAL for
+ * an image of BB_RANGE_SIGNED (normal and bent normal maps); PLAIN for the
+ * rest, with BB_VTF_FLAG_NORMAL added for a normal map already packed into
+ * [0, 1] (the kinds "normal+...", height2ssbump -n's). bb_outputs_write
+ * applies it to every .vtf and .dds it writes, bb_outputs_check to every
+ * one it checks. */
+void bb_texture_options_for(bb_texture_options *options, const char *kind, bb_range range);
+
+/* The "key=value" lines bb_image_write adds to a texture's provenance, so
+ * an up-to-date check sees a changed texture setting: texture (vtf or
+ * dds), texture_format, texture_mips, texture_fit (cluster or range), and
+ * for VTF vtf_version and vtf_flags (hex). options may be NULL (the
+ * defaults). malloc'd; NULL for another extension or out of memory. */
+char *bb_texture_provenance(const char *path, const bb_texture_options *options);
+
 /* What a VTF file's header says (bb_vtf_read_info). */
 typedef struct bb_vtf_info {
   int version_major, version_minor; /* 7 and 0..5 */
@@ -563,11 +604,18 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 /* Frees info->description and clears it; safe on a zeroed struct. */
 void bb_vtf_info_free(bb_vtf_info *info);
 
+/* Valve's name of the TEXTUREFLAGS_* bit `bit` (0..31) as Source SDK 2013
+ * spells it without the prefix ("CLAMPS", "NORMAL", "SSBUMP"), or NULL for
+ * an unused bit or one out of range. */
+const char *bb_vtf_flag_name(int bit);
+
 /* ------------------------------------------------- Source materials */
 
 typedef struct bb_vmt_options {
   const char *materials_dir; /* the game's materials folder; the material's
-                                texture paths are relative to it */
+                                texture paths are relative to it. NULL: the
+                                nearest folder named "materials" (any case)
+                                above the bump map, as in a game's tree */
   const char *bumpmap;       /* path of the bump map's .vtf, inside materials_dir */
   const char *basetexture;   /* path of the colour .vtf, inside materials_dir, or NULL */
   int ssbump;                /* 1: the bump map is a self-shadowed bump map ($ssbump 1) */
@@ -579,11 +627,18 @@ typedef struct bb_vmt_options {
  * without ".vtf", as Source looks textures up. Paths are compared as
  * written, made absolute against the working directory, "." and ".."
  * resolved, symbolic links not followed (the textures need not exist yet).
- * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path,
- * materials_dir or bumpmap; a texture that is not a .vtf or lies outside
- * materials_dir; a '"' or control character in a path, which a material
- * cannot quote); BB_ERR_MEMORY; BB_ERR_IO. */
+ * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path or
+ * bumpmap; no materials_dir and no "materials" folder above the bump map;
+ * a texture that is not a .vtf or lies outside materials_dir; a '"' or
+ * control character in a path, which a material cannot quote);
+ * BB_ERR_MEMORY; BB_ERR_IO. */
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
+
+/* The text bb_vmt_write writes, malloc'd into *text (*size bytes), for a
+ * caller that writes it with other files (bb_outputs_write). Errors as
+ * bb_vmt_write's, without BB_ERR_IO. */
+bb_status bb_vmt_text(const char *path, const bb_vmt_options *options, char **text,
+                      size_t *size, bb_error *err);
 
 /* -------------------------------------------------------- height input */
 
@@ -1996,11 +2051,18 @@ typedef struct bb_output_spec {
   bb_depth depth;    /* as asked; BB_DEPTH_DEFAULT: the format's */
   int mips;          /* 1: a mip-mapped file */
   int text;          /* 1: a text file (a depfile): no image format rules */
+  /* .vtf and .dds outputs, when the size is known (width 0: not checked
+   * here, only when written): */
+  int width, height; /* the image's size in texels */
+  bb_range range;    /* as bb_output_file's: with kind, picks the map */
+  const bb_texture_options *texture; /* NULL: the defaults */
 } bb_output_spec;
 
 /* Checks every output before any work, so a bad name costs no baking time:
  * BB_ERR_ARGUMENT (usage: an extension bb_image_write does not know, a
- * depth, mip chain or channel count the format cannot hold, two outputs on
+ * depth, mip chain or channel count the format cannot hold, a .vtf or .dds
+ * of a size or channels its format cannot take (bb_texture_check, with the
+ * map bb_texture_options_for(opts, kind, range)), two outputs on
  * one file under any spelling: "KIND and KIND would both be written to
  * PATH"); BB_ERR_IO (an output that is one of the reads[0..read_count-1]
  * under any spelling, hard or symbolic link: "PATH: output would overwrite
@@ -2039,6 +2101,10 @@ typedef struct bb_output_file {
   const char *description;   /* provenance text stored in the file, or NULL */
   const void *text;          /* the bytes of a text file (image NULL) */
   size_t text_size;
+  const bb_texture_options *texture; /* a .vtf or .dds file's settings (NULL:
+                                the defaults); its map is set from kind and
+                                range (bb_texture_options_for), its mip chain by
+                                its own mips, not the file's */
 } bb_output_file;
 
 /* Writes count files all or nothing: each is encoded and synced under a
@@ -2163,8 +2229,8 @@ const char *bb_compare_report_result(const bb_compare_report *report);
  * out_dir and a template; a single input may name each output instead. */
 
 /* Most files one input's bake writes: the maps, the slope map and its lit
- * preview. */
-#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 2)
+ * preview, and a Source material. */
+#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 3)
 /* A batch's file names: the input's stem, the map's name, the input's
  * extension ("{{" and "}}" are braces). */
 #define BB_JOB_DEFAULT_NAME "{stem}_{kind}.png"
@@ -2213,10 +2279,23 @@ typedef struct bb_job_options {
                                 options written out by bb_job_command_text */
   bb_note_fn note;           /* notes about inputs (may be NULL) */
   void *note_user;
+  /* Engine textures and a Source material: */
+  bb_texture_options texture; /* the settings of every .vtf and .dds output
+                                (format, mips, VTF version and flags); each
+                                one's map follows its kind
+                                (bb_texture_options_for); threads 0: the bake's. Sizes and channels are
+                                checked against the input's header when planned */
+  const char *vmt;           /* one input: a Source material (.vmt) written with
+                                the maps, its $bumpmap the ssbump .vtf (with
+                                $ssbump 1), else the normal map's .vtf; NULL: none */
+  const char *vmt_materials; /* the game's materials folder the material's paths
+                                are relative to; NULL: the nearest folder named
+                                "materials" above the bump map (bb_vmt_options) */
+  const char *vmt_basetexture; /* the colour .vtf the material names, or NULL */
 } bb_job_options;
 
 /* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
- * no outputs. */
+ * the texture defaults (bb_texture_options_init), no outputs. */
 void bb_job_options_init(bb_job_options *o);
 
 /* A planned job: opaque. */

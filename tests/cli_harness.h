@@ -251,7 +251,7 @@ static inline void harness_expect_refusal(const char *cwd, const char *const *ar
 /* Writes img with bb_image_write; the test fails if it cannot. */
 static inline void harness_write(const char *path, const bb_image *img, bb_depth depth,
                                  bb_range range) {
-  bb_write_options o = {depth, range, NULL};
+  bb_write_options o = {depth, range, NULL, NULL};
   bb_error err;
   cr_assert_eq(bb_image_write(path, img, &o, &err), BB_OK, "%s", err.message);
 }

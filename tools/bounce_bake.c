@@ -157,7 +157,7 @@ int main(int argc, char **argv) {
   bb_status st = bb_height_load(a.map, BB_CHANNEL_AUTO, &height, &err);
   if (st == BB_OK) st = a.inner ? staged_bake(&a, &height, &r, &err) : bb_bake(&height, &a.bake, &r, &err);
   char path[4200];
-  const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL};
+  const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
   if (st == BB_OK) {
     snprintf(path, sizeof path, "%s.ao.exr", a.prefix);
     st = bb_image_write(path, &r.ao, &wo, &err);

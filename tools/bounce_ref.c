@@ -632,7 +632,7 @@ static int run_trace(int argc, char **argv) {
            s.w, s.h, a.scale, a.stride, a.rho, a.albedo_path ? a.albedo_path : "none", a.bounces,
            a.paths, a.bias, a.power, a.basis.name,
            a.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a.seed);
-  bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, description};
+  bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, description, NULL};
   if (st == BB_OK && a.out) st = bb_image_write(a.out, &out, &wo, &err);
   if (st == BB_OK && a.texels) { /* one line per texel: value and standard error */
     for (int t = 0; t < a.texels; t++) {

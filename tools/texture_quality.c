@@ -159,7 +159,7 @@ static int cmd_write(int argc, char **argv) {
     st = bb_texture_write(argv[1], &img, &o, &err);
   } else {
     bb_write_options w = {BB_DEPTH_DEFAULT,
-                          o.map == BB_TEXTURE_MAP_NORMAL ? BB_RANGE_SIGNED : BB_RANGE_UNIT, NULL};
+                          o.map == BB_TEXTURE_MAP_NORMAL ? BB_RANGE_SIGNED : BB_RANGE_UNIT, NULL, NULL};
     st = bb_image_write(argv[1], &img, &w, &err);
   }
   const double seconds = now() - t0;
@@ -186,7 +186,7 @@ static int cmd_decode(int argc, char **argv) {
   for (size_t i = 0; i < (size_t)img.width * (size_t)img.height; i++)
     for (int k = 0; k < c; k++)
       rgb.pixels[i * (size_t)c + (size_t)k] = img.pixels[i * (size_t)img.channels + (size_t)k];
-  bb_write_options w = {BB_DEPTH_8, BB_RANGE_UNIT, NULL};
+  bb_write_options w = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
   bb_status st = bb_image_write(argv[1], &rgb, &w, &err);
   bb_image_free(&img);
   bb_image_free(&rgb);

@@ -7,7 +7,7 @@ header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
 update. Declarations are the header's as they are, in its order, comments
 dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
-BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 8), which cffi needs; the test
+BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 9), which cffi needs; the test
 checks those numbers too.
 """
 
@@ -68,6 +68,36 @@ typedef enum bb_range {
   BB_RANGE_UNIT = 0,
   BB_RANGE_SIGNED
 } bb_range;
+
+typedef enum bb_texture_format {
+  BB_TEXTURE_FORMAT_DEFAULT = 0,
+  BB_TEXTURE_FORMAT_BC1,
+  BB_TEXTURE_FORMAT_BC3,
+  BB_TEXTURE_FORMAT_BC4,
+  BB_TEXTURE_FORMAT_BC5,
+  BB_TEXTURE_FORMAT_BGR8,
+  BB_TEXTURE_FORMAT_BGRA8,
+  BB_TEXTURE_FORMAT_RGBA8,
+  BB_TEXTURE_FORMAT_RGBA16F,
+  BB_TEXTURE_FORMAT_RGBA32F
+} bb_texture_format;
+
+typedef enum bb_texture_map {
+  BB_TEXTURE_MAP_PLAIN = 0,
+  BB_TEXTURE_MAP_NORMAL,
+  BB_TEXTURE_MAP_SSBUMP
+} bb_texture_map;
+
+typedef struct bb_texture_options {
+  bb_texture_format format;
+  bb_texture_map map;
+  int mips;
+  int fast;
+  int threads;
+  int vtf_version;
+  uint32_t vtf_flags;
+  const char *description;
+} bb_texture_options;
 
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0,
@@ -348,6 +378,9 @@ typedef struct bb_output_spec {
   bb_depth depth;
   int mips;
   int text;
+  int width, height;
+  bb_range range;
+  const bb_texture_options *texture;
 } bb_output_spec;
 
 typedef struct bb_output_file {
@@ -360,6 +393,7 @@ typedef struct bb_output_file {
   const char *description;
   const void *text;
   size_t text_size;
+  const bb_texture_options *texture;
 } bb_output_file;
 
 typedef struct bb_height_source {
@@ -409,6 +443,10 @@ typedef struct bb_job_options {
   const char *command_options;
   bb_note_fn note;
   void *note_user;
+  bb_texture_options texture;
+  const char *vmt;
+  const char *vmt_materials;
+  const char *vmt_basetexture;
 } bb_job_options;
 
 typedef struct bb_job bb_job;
@@ -429,7 +467,7 @@ typedef struct bb_job_file {
 typedef struct bb_job_report {
   const char *input;
   int output_count;
-  bb_job_file outputs[8];
+  bb_job_file outputs[9];
   bb_job_outcome outcome;
   bb_status status;
   bb_error error;
@@ -583,7 +621,7 @@ CONSTANTS = """
 #define BB_MAX_SLICES 256
 #define BB_MAX_BASIS 16
 #define BB_COMPARE_DIFFERENT_SIZE 3
-#define BB_JOB_MAX_OUTPUTS 8
+#define BB_JOB_MAX_OUTPUTS 9
 #define BB_JOB_DEFAULT_MAPS 13
 """
 

@@ -5,6 +5,7 @@
  */
 
 #include "bake/bake_internal.h"
+#include "core/input_file.h"
 #include "core/internal.h"
 #include <errno.h>
 #include <inttypes.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* Largest basis file bb_basis_load reads: 16 lines of vectors and room for
  * generous comments, and a bound on what a wrong path can make it read. */
@@ -249,12 +251,15 @@ bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out
 
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "basis: no path");
-  FILE *f = fopen(path, "rb");
-  if (!f) return bb__fail(err, BB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-  struct stat info;
-  if (fstat(fileno(f), &info) == 0 && S_ISDIR(info.st_mode)) {
-    fclose(f);
-    return bb__fail(err, BB_ERR_IO, "%s: is a directory", path);
+  /* A FIFO, a device or a directory is refused before it is read. */
+  int fd;
+  bb_status opened = bb__input_open(path, &fd, err);
+  if (opened != BB_OK) return opened;
+  FILE *f = fdopen(fd, "rb");
+  if (!f) {
+    int e = errno;
+    close(fd);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(e));
   }
   char *text = malloc(BASIS_FILE_MAX_BYTES + 1);
   if (!text) {

@@ -143,6 +143,7 @@ static const cli_option *const bake_options[] = {
     &opt_out_filtered, &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
     &opt_out_dir,      &opt_maps,          &opt_name,         &opt_keep_going,
     &opt_force,        &opt_depfile,       &opt_json,         &opt_quiet,
+    CLI_TEXTURE_OPTIONS, &cli_opt_vmt,     &cli_opt_materials, &cli_opt_basetexture,
     &opt_scheduler,    &cli_opt_help,
 };
 
@@ -209,6 +210,9 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
                          &a->settings.bake.bounces);
   case CLI_OPT_BOUNCE_ALBEDO: a->job.bounce_albedo_file = arg; return 0;
   case CLI_OPT_BRIGHTNESS: a->job.brightness_file = arg; return 0;
+  case CLI_OPT_VMT: a->job.vmt = arg; return 0;
+  case CLI_OPT_MATERIALS: a->job.vmt_materials = arg; return 0;
+  case CLI_OPT_BASETEXTURE: a->job.vmt_basetexture = arg; return 0;
   default: break;
   }
   return cli_settings_apply(bake_command.name, &a->settings, opt, arg);
@@ -273,6 +277,7 @@ static int bake_parse(int argc, char **argv, bake_args *a, int *first) {
   a->job.channel = a->settings.channel;
   a->job.depth = a->settings.depth;
   a->job.mips = a->settings.mips;
+  a->job.texture = a->settings.texture;
   a->job.basis_file = a->settings.basis_file;
   a->job.slope_path = a->slope.path;
   a->job.slope_lit = a->slope.lit;

@@ -50,7 +50,7 @@ static const cli_option opt_normal_y = {
 static const cli_option *const combine_options[] = {
     &opt_output,         &opt_mix,      &opt_mask,
     &opt_detail,         &opt_brightness, &opt_kind, &opt_normal_y,
-    &cli_maps_opt_depth, &cli_opt_mips, &cli_opt_help};
+    &cli_maps_opt_depth, &cli_opt_mips, CLI_TEXTURE_OPTIONS, &cli_opt_help};
 
 static const cli_command combine_command = {
     "combine",
@@ -125,7 +125,8 @@ static int combine_parse(int argc, char **argv, combine_args *a, const char **in
                            "give exactly one of --mix T, --mask FILE, --detail "
                            "and --brightness FILE");
   /* The output must not replace A, B (or the brightness map) or the mask. */
-  const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
+  const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0,
+                               0, 0, BB_RANGE_UNIT, &a->settings.texture};
   const char *reads[3] = {in[0], in[1], a->mask};
   bb_error err = {{0}};
   bb_status st = bb_outputs_check(&spec, 1, reads, a->mask ? 3 : 2, &err);
@@ -217,7 +218,8 @@ static int combine_run(const cli_run *run, combine_args *a, const char *const *i
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &m[0].info, a->output);
     rc = cli_maps_write(
         run, cli_maps_file_name(in[0]), &m[0].file, bb_map_kind_name(a->kind), a->output,
-        &out, normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, depth, a->settings.mips);
+        &out, normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, depth, a->settings.mips,
+        &a->settings.texture);
   }
   if (!rc)
     cli_printf_line("wrote %s %s", bb_map_kind_name(a->kind), a->output);

@@ -190,7 +190,8 @@ static int parse_compare_args(int argc, char **argv, compare_args *a) {
   /* The diff is checked before the (possibly long) reads, and must not
    * overwrite either input. */
   if (a->diff_path) {
-    const bb_output_spec diff = {a->diff_path, "diff", 0, BB_DEPTH_DEFAULT, 0, 0};
+    const bb_output_spec diff = {a->diff_path, "diff", 0, BB_DEPTH_DEFAULT, 0, 0, 0, 0,
+                                 BB_RANGE_UNIT, NULL};
     const char *reads[2] = {a->path_a, a->path_b};
     bb_error err = {{0}};
     bb_status st = bb_outputs_check(&diff, 1, reads, 2, &err);

@@ -50,9 +50,19 @@ static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .default_text = "off",
                                      .help = "no list of files written"};
 
+static const cli_option opt_output = {
+    .id = CLI_OPT_OUTPUT,
+    .short_name = 'o',
+    .long_name = "output",
+    .value_name = "FILE",
+    .default_text = "FILE-ssbump.tga (-n: FILE-bump.tga)",
+    .help = "write FILE instead, in its extension's format (.vtf: a Source texture)"};
+
 static const cli_option *const h2s_options[] = {
-    &opt_rays, &opt_normal, &opt_ao_alpha, &opt_radius,
-    &opt_dump, &opt_detail, &opt_quiet,  &cli_opt_help,
+    &opt_rays,   &opt_normal,        &opt_ao_alpha,         &opt_radius,
+    &opt_dump,   &opt_detail,        &opt_quiet,            &opt_output,
+    CLI_TEXTURE_OPTIONS,             &cli_opt_vmt,          &cli_opt_materials,
+    &cli_opt_basetexture,            &cli_opt_help,
 };
 
 static void h2s_settings_init(cli_settings *s) {
@@ -60,7 +70,9 @@ static void h2s_settings_init(cli_settings *s) {
   s->bake.rays = VALVE_RAYS;
   s->bake.smooth.radius_texels = VALVE_FILTER_RADIUS;
   s->bake.normal_filter = BB_NORMAL_VALVE; /* parity with Valve's tool */
-  s->depth = BB_DEPTH_8; /* Valve writes 8-bit RGBA TGA */
+  /* Valve writes 8-bit RGBA TGA: the format's default depth, which leaves
+   * a texture (.vtf) to its texture format. */
+  s->depth = BB_DEPTH_DEFAULT;
 }
 
 static const cli_command h2s_command = {
@@ -68,7 +80,9 @@ static const cli_command h2s_command = {
     "[-r N] [-n] [-A] [-f R] [-D] [-d] FILE BUMPSCALE",
     "Valve-compatible: bakes FILE-ssbump.tga (RGB = ssbump, A = filtered height)\n"
     "next to FILE. The height is FILE's alpha channel, or the mean of R, G, B when\n"
-    "it has none. BUMPSCALE (> 0) is the height scale in texels.",
+    "it has none. BUMPSCALE (> 0) is the height scale in texels. -o names another\n"
+    "file; with -o NAME-ssbump.vtf --vmt NAME.vmt it goes straight into a Source\n"
+    "game's materials (docs/textures.md).",
     h2s_options,
     (int)(sizeof h2s_options / sizeof h2s_options[0]),
     h2s_settings_init,
@@ -78,7 +92,11 @@ typedef struct h2s_args {
   cli_settings settings;
   int normal_map, ao_in_alpha, dump_filtered, detail, quiet;
   const char *input;
-  char *output; /* malloc'd FILE-ssbump.tga or FILE-bump.tga */
+  const char *output_given;               /* -o FILE, or NULL */
+  char *output; /* malloc'd: -o's, or FILE-ssbump.tga or FILE-bump.tga */
+  const char *vmt, *materials, *basetexture; /* --vmt and its paths */
+  char *vmt_text;                         /* the material's bytes */
+  size_t vmt_size;
 } h2s_args;
 
 static const char dump_path[] = "filtered.tga";
@@ -101,10 +119,30 @@ static int h2s_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_QUIET:
     a->quiet = 1;
     return 0;
+  case CLI_OPT_OUTPUT:
+    a->output_given = arg;
+    return 0;
+  case CLI_OPT_VMT:
+    a->vmt = arg;
+    return 0;
+  case CLI_OPT_MATERIALS:
+    a->materials = arg;
+    return 0;
+  case CLI_OPT_BASETEXTURE:
+    a->basetexture = arg;
+    return 0;
   default:
     break;
   }
   return cli_settings_apply(h2s_command.name, &a->settings, opt, arg);
+}
+
+static const char *output_kind(const h2s_args *a) {
+  if (a->normal_map)
+    return a->ao_in_alpha ? "normal+ao" : "normal+height";
+  if (a->detail)
+    return a->ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
+  return a->ao_in_alpha ? "ssbump+ao" : "ssbump+height";
 }
 
 static int h2s_parse(int argc, char **argv, h2s_args *a) {
@@ -129,7 +167,9 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
     return cli_usage_error(h2s_command.name,
                            "-d makes a detail ssbump; it cannot be used with -n");
 
-  a->output = bb_path_with_suffix(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
+  a->output = a->output_given
+                  ? strdup(a->output_given)
+                  : bb_path_with_suffix(a->input, a->normal_map ? "-bump.tga" : "-ssbump.tga");
   if (!a->output) {
     cli_file_error(a->input, "out of memory");
     return BB_EXIT_FAILURE;
@@ -137,19 +177,31 @@ static int h2s_parse(int argc, char **argv, h2s_args *a) {
   if (a->dump_filtered && bb_same_file(a->output, dump_path))
     return cli_usage_error(h2s_command.name, "-D would write %s over the output %s",
                            dump_path, a->output);
-  const bb_output_spec outputs[2] = {{a->output, "output", 4, a->settings.depth, 0, 0},
-                                     {dump_path, "filtered", 1, a->settings.depth, 0, 0}};
+  if ((a->materials || a->basetexture) && !a->vmt)
+    return cli_usage_error(h2s_command.name,
+                           "--materials and --basetexture name a material's paths: give "
+                           "--vmt FILE");
   bb_error err = {{0}};
-  bb_status st = bb_outputs_check(outputs, a->dump_filtered ? 2 : 1, &a->input, 1, &err);
+  if (a->vmt) {
+    const bb_vmt_options v = {a->materials, a->output, a->basetexture, !a->normal_map};
+    bb_status st = bb_vmt_text(a->vmt, &v, &a->vmt_text, &a->vmt_size, &err);
+    if (st != BB_OK)
+      return cli_library_error(h2s_command.name, st, &err);
+  }
+  /* The input's size, so a texture the size cannot make is refused now. */
+  int width = 0, height = 0;
+  if (bb_image_read_info(a->input, &width, &height, NULL, NULL, NULL) != BB_OK)
+    width = height = 0; /* the bake says why */
+  bb_output_spec outputs[3] = {
+      {a->output, output_kind(a), 4, a->settings.depth, 0, 0, width, height, BB_RANGE_UNIT,
+       &a->settings.texture},
+      {dump_path, "filtered", 1, a->settings.depth, 0, 0, 0, 0, BB_RANGE_UNIT, NULL},
+      {a->vmt, "material", 0, BB_DEPTH_DEFAULT, 0, 1, 0, 0, BB_RANGE_UNIT, NULL}};
+  int n = a->dump_filtered ? 2 : 1;
+  if (a->vmt)
+    outputs[n++] = outputs[2];
+  bb_status st = bb_outputs_check(outputs, n, &a->input, 1, &err);
   return st == BB_OK ? 0 : cli_library_error(h2s_command.name, st, &err);
-}
-
-static const char *output_kind(const h2s_args *a) {
-  if (a->normal_map)
-    return a->ao_in_alpha ? "normal+ao" : "normal+height";
-  if (a->detail)
-    return a->ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
-  return a->ao_in_alpha ? "ssbump+ao" : "ssbump+height";
 }
 
 /* Makes the RGBA image to write from the bake (and for -d the input's
@@ -193,17 +245,22 @@ static int write_outputs(const h2s_args *a, const char *command_line,
     cli_file_error(a->output, "out of memory");
     rc = BB_EXIT_FAILURE;
   } else {
-    /* With -D, both files or neither. */
-    const bb_output_file files[2] = {{a->output, output_kind(a), rgba, BB_RANGE_UNIT,
-                                      a->settings.depth, 0, texts[0], NULL, 0},
-                                     {dump_path, "filtered", &r->filtered, BB_RANGE_UNIT,
-                                      a->settings.depth, 0, texts[1], NULL, 0}};
-    bb_status st = bb_outputs_write(files, a->dump_filtered ? 2 : 1, r->threads, &err);
+    /* With -D and --vmt, every file or none. */
+    bb_output_file files[3] = {{a->output, output_kind(a), rgba, BB_RANGE_UNIT,
+                                a->settings.depth, 0, texts[0], NULL, 0, &a->settings.texture},
+                               {dump_path, "filtered", &r->filtered, BB_RANGE_UNIT,
+                                a->settings.depth, 0, texts[1], NULL, 0, NULL},
+                               {a->vmt, "material", NULL, BB_RANGE_UNIT, BB_DEPTH_DEFAULT, 0,
+                                NULL, a->vmt_text, a->vmt_size, NULL}};
+    int n = a->dump_filtered ? 2 : 1;
+    if (a->vmt)
+      files[n++] = files[2];
+    bb_status st = bb_outputs_write(files, n, r->threads, &err);
     if (st != BB_OK) {
       cli_error_line(err.message);
       rc = BB_EXIT_FAILURE;
     }
-    for (int i = 0; !rc && !a->quiet && i < (a->dump_filtered ? 2 : 1); i++)
+    for (int i = 0; !rc && !a->quiet && i < n; i++)
       cli_printf_line("wrote %s %s", files[i].kind, files[i].path);
   }
   free(texts[0]);
@@ -258,6 +315,7 @@ int bb_cli_height2ssbump(int argc, char **argv) {
   else if (rc == 0)
     rc = h2s_run(command_line, &a);
   free(a.output);
+  free(a.vmt_text);
   free(command_line);
   return rc;
 }

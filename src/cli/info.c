@@ -5,7 +5,6 @@
 #include "common.h"
 #include "json.h"
 #include "options.h"
-#include "read.h"
 
 #include "bumpbake.h"
 
@@ -26,8 +25,9 @@ static const cli_command info_command = {
     "FILE... [--json]",
     "Prints each image's size, channels, format, sample type and alpha channel,\n"
     "and the provenance bumpbake stored in it, from the file's header alone (no\n"
-    "pixel is decoded). A file that cannot be read is reported and skipped; the\n"
-    "exit code is then 1.",
+    "pixel is decoded); for a Source texture (.vtf) also its version, format,\n"
+    "flags and mip levels. A file that cannot be read is reported and skipped;\n"
+    "the exit code is then 1.",
     info_options,
     (int)(sizeof info_options / sizeof info_options[0]),
     NULL, /* no baking settings */
@@ -53,7 +53,23 @@ typedef struct file_info {
   int width, height, channels;
   bb_image_info info;
   bb_provenance_class provenance;
+  int is_vtf;
+  bb_vtf_info vtf; /* when is_vtf */
 } file_info;
+
+/* The names of the flags set, "SSBUMP NORMAL" (unnamed bits as hex). */
+static void flag_names(uint32_t flags, char *out, size_t cap) {
+  size_t n = 0;
+  out[0] = '\0';
+  for (int bit = 0; bit < 32 && n < cap; bit++) {
+    if (!(flags & (1u << bit)))
+      continue;
+    const char *name = bb_vtf_flag_name(bit);
+    int w = name ? snprintf(out + n, cap - n, "%s%s", n ? " " : "", name)
+                 : snprintf(out + n, cap - n, "%s0x%08x", n ? " " : "", 1u << bit);
+    n += w > 0 ? (size_t)w : 0;
+  }
+}
 
 static const char *provenance_class_name(bb_provenance_class c) {
   switch (c) {
@@ -86,6 +102,19 @@ static void print_text(const char *path, const file_info *f) {
                   i->bits_per_sample, i->is_float ? "float" : "integer");
   if (i->alpha_channel >= 0)
     printf("alpha channel: %d\n", i->alpha_channel);
+  if (f->is_vtf) {
+    const bb_vtf_info *v = &f->vtf;
+    char names[512];
+    flag_names(v->flags, names, sizeof names);
+    printf("vtf: version %d.%d, %s, %d mip level%s, flags 0x%08x (%s)\n", v->version_major,
+           v->version_minor, v->format_name, v->mip_count, v->mip_count == 1 ? "" : "s",
+           (unsigned)v->flags, names[0] ? names : "none");
+    printf("vtf: low-resolution image %d x %d, reflectivity %.4f %.4f %.4f, bump scale %g, "
+           "%d frame%s\n",
+           v->low_res_width, v->low_res_height, (double)v->reflectivity[0],
+           (double)v->reflectivity[1], (double)v->reflectivity[2], (double)v->bump_scale,
+           v->frames, v->frames == 1 ? "" : "s");
+  }
   if (f->provenance == BB_PROVENANCE_NONE) {
     printf("no bumpbake provenance\n");
     if (i->description && *i->description)
@@ -135,6 +164,26 @@ static void print_json(const char *path, const file_info *f) {
   cli_json_int(&j, "bits_per_sample", i->bits_per_sample);
   cli_json_bool(&j, "float", i->is_float);
   cli_json_int(&j, "alpha_channel", i->alpha_channel);
+  if (f->is_vtf) {
+    const bb_vtf_info *v = &f->vtf;
+    char text[512];
+    cli_json_open(&j, "vtf", '{');
+    snprintf(text, sizeof text, "%d.%d", v->version_major, v->version_minor);
+    cli_json_string(&j, "version", text);
+    cli_json_string(&j, "format", v->format_name);
+    cli_json_int(&j, "format_code", v->format);
+    cli_json_int(&j, "mip_count", v->mip_count);
+    cli_json_int(&j, "flags", (long)v->flags);
+    cli_json_open(&j, "flag_names", '[');
+    for (int bit = 0; bit < 32; bit++)
+      if ((v->flags & (1u << bit)) && bb_vtf_flag_name(bit))
+        cli_json_string(&j, NULL, bb_vtf_flag_name(bit));
+    cli_json_close(&j, ']');
+    cli_json_int(&j, "low_res_width", v->low_res_width);
+    cli_json_int(&j, "low_res_height", v->low_res_height);
+    cli_json_int(&j, "frames", v->frames);
+    cli_json_close(&j, '}');
+  }
   cli_json_string(&j, "provenance_state", provenance_class_name(f->provenance));
   if (f->provenance == BB_PROVENANCE_INTACT)
     json_provenance(&j, i->description);
@@ -164,15 +213,15 @@ static int info_file(const info_args *a, const char *path, int index) {
   file_info f;
   memset(&f, 0, sizeof f);
   bb_error err = {{0}};
-  int muted = cli_mute_stderr();
   bb_status st =
       bb_image_read_info(path, &f.width, &f.height, &f.channels, &f.info, &err);
-  cli_unmute_stderr(muted);
   if (st != BB_OK) {
     report_error(a, path, &err);
     return BB_EXIT_FAILURE;
   }
   f.provenance = bb_provenance_classify(f.info.description);
+  if (strcmp(f.info.format_name, "vtf") == 0 && bb_vtf_read_info(path, &f.vtf, &err) == BB_OK)
+    f.is_vtf = 1;
   if (a->json) {
     print_json(path, &f);
   } else {
@@ -181,6 +230,7 @@ static int info_file(const info_args *a, const char *path, int index) {
     print_text(path, &f);
   }
   bb_image_info_free(&f.info);
+  bb_vtf_info_free(&f.vtf);
   return 0;
 }
 

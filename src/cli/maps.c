@@ -3,7 +3,6 @@
 #include "maps.h"
 #include "cli.h"
 #include "common.h"
-#include "read.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +27,8 @@ void cli_run_free(cli_run *run) {
 
 int cli_maps_check_output(const char *command, const char *input, const char *output,
                           const cli_settings *s) {
-  const bb_output_spec spec = {output, "output", 0, s->depth, s->mips, 0};
+  const bb_output_spec spec = {output, "output", 0, s->depth, s->mips, 0, 0, 0, BB_RANGE_UNIT,
+                               &s->texture};
   bb_error err = {{0}};
   bb_status st = bb_outputs_check(&spec, 1, &input, input && *input ? 1 : 0, &err);
   return st == BB_OK ? 0 : cli_library_error(command, st, &err);
@@ -36,7 +36,7 @@ int cli_maps_check_output(const char *command, const char *input, const char *ou
 
 int cli_maps_read(const char *path, bb_image *img, bb_image_info *info) {
   bb_error err = {{0}};
-  bb_status st = cli_read_image(path, img, info, &err);
+  bb_status st = bb_image_read(path, img, info, &err);
   return cli_status_exit(path, st, &err);
 }
 
@@ -60,7 +60,8 @@ const char *cli_maps_file_name(const char *path) {
 
 int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *input,
                    const char *kind, const char *path, const bb_image *img,
-                   bb_range range, bb_depth depth, int mips) {
+                   bb_range range, bb_depth depth, int mips,
+                   const bb_texture_options *texture) {
   bb_provenance p = {run->command_line,
                      input_name,
                      input ? bb_image_hash(input) : 0,
@@ -75,7 +76,8 @@ int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *i
     cli_file_error(path, "out of memory");
     return BB_EXIT_FAILURE;
   }
-  const bb_output_file file = {path, kind, img, range, depth, mips, description, NULL, 0};
+  const bb_output_file file = {path, kind, img, range, depth, mips, description, NULL, 0,
+                               texture};
   bb_error err = {{0}};
   bb_status st = bb_outputs_write(&file, 1, 1, &err);
   free(description);

@@ -58,10 +58,12 @@ const char *cli_maps_file_name(const char *path);
 /* Writes img with provenance (command line, input name and the hash of the
  * decoded input, kind; no bake parameters: the command line holds every
  * option). input_name (a file name, or a program's text) and input may be
- * NULL. mips: the mip chain (bb_outputs_write). Prints the error and
- * returns BB_EXIT_FAILURE on failure. */
+ * NULL. mips: the mip chain (bb_outputs_write); texture: a .vtf or .dds
+ * output's settings. Prints the error and returns BB_EXIT_FAILURE on
+ * failure. */
 int cli_maps_write(const cli_run *run, const char *input_name, const bb_image *input,
                    const char *kind, const char *path, const bb_image *img,
-                   bb_range range, bb_depth depth, int mips);
+                   bb_range range, bb_depth depth, int mips,
+                   const bb_texture_options *texture);
 
 #endif /* BB_CLI_MAPS_H */

@@ -38,6 +38,7 @@ static const cli_option *const normal_options[] = {
     &cli_opt_channel,
     &cli_opt_depth,
     &cli_opt_mips,
+    CLI_TEXTURE_OPTIONS,
     &opt_json,
     &opt_quiet,
     &cli_opt_help,
@@ -103,6 +104,7 @@ static int normal_run(normal_args *a, const char *command_line, const char *inpu
   o.channel = a->settings.channel;
   o.depth = a->settings.depth;
   o.mips = a->settings.mips;
+  o.texture = a->settings.texture;
   o.paths[BB_OUTPUT_NORMAL] = a->output;
   o.force = 1;
   o.command = command_line;

@@ -24,7 +24,8 @@ static const cli_option opt_normal_y = {
     .help = "green axis of NORMAL: down = Source/DirectX, up = OpenGL"};
 
 static const cli_option *const n2s_options[] = {
-    &opt_output, &opt_normal_y, &cli_maps_opt_depth, &cli_opt_mips, &cli_opt_help};
+    &opt_output, &opt_normal_y, &cli_maps_opt_depth, &cli_opt_mips, CLI_TEXTURE_OPTIONS,
+    &cli_opt_help};
 
 static const cli_command n2s_command = {
     "normal2ssbump",
@@ -139,7 +140,8 @@ static int n2s_run(const cli_run *run, n2s_args *a, const char *input) {
   if (!rc) {
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &info, a->output);
     rc = cli_maps_write(run, cli_maps_file_name(input), &values, "weights", a->output,
-                        &weights, BB_RANGE_UNIT, depth, a->settings.mips);
+                        &weights, BB_RANGE_UNIT, depth, a->settings.mips,
+                        &a->settings.texture);
   }
   if (!rc)
     cli_printf_line("wrote weights %s", a->output);

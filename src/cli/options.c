@@ -96,6 +96,56 @@ const cli_option cli_opt_depth = {
     .long_name = "depth",
     .value_name = "8|16|half|float",
     .help = "sample depth (default: 8 for png/tga/tif, float for exr)"};
+const cli_option cli_opt_texture_format = {
+    .id = CLI_OPT_TEXTURE_FORMAT,
+    .long_name = "texture-format",
+    .value_name = "NAME",
+    .default_text = "default",
+    .range_text = "dxt1 dxt5 bgr888 bgra8888 rgba16f (vtf); bc1 bc3 bc4 bc5 rgba8 rgba16f "
+                  "rgba32f (dds)",
+    .help = ".vtf/.dds format; default: VTF DXT1 (DXT5 with alpha); DDS BC5 normals, BC4 "
+            "grey, BC1 colour (docs/textures.md)"};
+const cli_option cli_opt_vtf_version = {
+    .id = CLI_OPT_VTF_VERSION,
+    .long_name = "vtf-version",
+    .value_name = "7.N",
+    .default_text = "7.2",
+    .range_text = "7.2..7.5",
+    .help = "VTF version: 7.2 loads in every Source branch; 7.3 and up keep provenance"};
+const cli_option cli_opt_vtf_flags = {
+    .id = CLI_OPT_VTF_FLAGS,
+    .long_name = "vtf-flags",
+    .value_name = "HEX",
+    .default_text = "0",
+    .help = "TEXTUREFLAGS_* bits added to the map's own (SSBUMP, NORMAL), e.g. 0x4 = "
+            "CLAMPS"};
+const cli_option cli_opt_nomip = {
+    .id = CLI_OPT_NOMIP,
+    .long_name = "nomip",
+    .default_text = "off",
+    .help = "write .vtf/.dds without their mip chain (vtex's nomip)"};
+const cli_option cli_opt_vmt = {
+    .id = CLI_OPT_VMT,
+    .long_name = "vmt",
+    .value_name = "FILE",
+    .help = "also write a Source material (LightmappedGeneric) naming the .vtf bump map"};
+const cli_option cli_opt_materials = {
+    .id = CLI_OPT_MATERIALS,
+    .long_name = "materials",
+    .value_name = "DIR",
+    .default_text = "the folder named materials above the bump map",
+    .help = "the game's materials folder the material's paths are relative to"};
+const cli_option cli_opt_basetexture = {
+    .id = CLI_OPT_BASETEXTURE,
+    .long_name = "basetexture",
+    .value_name = "FILE",
+    .help = "the colour .vtf the material names as $basetexture"};
+const cli_option cli_opt_fast_compression = {
+    .id = CLI_OPT_FAST_COMPRESSION,
+    .long_name = "fast-compression",
+    .default_text = "off",
+    .help = "block-compress with libsquish's range fit: far faster, ~1-2 dB lower PSNR on "
+            "DXT1/DXT5"};
 
 /* ---------------------------------------------------------------- numbers */
 
@@ -414,6 +464,7 @@ void cli_settings_init(cli_settings *s) {
   bb_bake_options_init(&s->bake);
   s->channel = BB_CHANNEL_AUTO;
   s->depth = BB_DEPTH_DEFAULT;
+  bb_texture_options_init(&s->texture);
   s->scale_given = 0;
 }
 
@@ -502,6 +553,8 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
     return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_THREADS:
     rc = cli_parse_int(command, name, arg, INT_MIN, INT_MAX, &b->trace.threads);
+    if (!rc)
+      s->texture.threads = b->trace.threads; /* block compression too */
     return rc ? rc : check_with_library(command, name, s);
   case CLI_OPT_BASIS:
     return apply_basis(command, arg, s);
@@ -522,6 +575,38 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
     return 0;
   case CLI_OPT_MIPS:
     s->mips = 1;
+    return 0;
+  case CLI_OPT_TEXTURE_FORMAT: {
+    bb_error err = {{0}};
+    return bb_texture_format_parse(arg, &s->texture.format, &err) == BB_OK
+               ? 0
+               : cli_usage_error(command, "%s: %s", name, err.message);
+  }
+  case CLI_OPT_VTF_VERSION: {
+    /* "7.3" as Valve writes it, or the minor number alone. */
+    const char *minor = strncmp(arg, "7.", 2) == 0 ? arg + 2 : arg;
+    char *end = NULL;
+    long v = strtol(minor, &end, 10);
+    if (end == minor || *end || v < 2 || v > 5)
+      return cli_usage_error(command, "%s must be 7.2, 7.3, 7.4 or 7.5 (got '%s')", name, arg);
+    s->texture.vtf_version = (int)v;
+    return 0;
+  }
+  case CLI_OPT_VTF_FLAGS: {
+    char *end = NULL;
+    errno = 0;
+    unsigned long v = strtoul(arg, &end, 0);
+    if (end == arg || *end || errno || v > 0xffffffffUL || arg[0] == '-')
+      return cli_usage_error(command, "%s needs a 32-bit number, e.g. 0x4 (got '%s')", name,
+                             arg);
+    s->texture.vtf_flags = (uint32_t)v;
+    return 0;
+  }
+  case CLI_OPT_NOMIP:
+    s->texture.mips = 0;
+    return 0;
+  case CLI_OPT_FAST_COMPRESSION:
+    s->texture.fast = 1;
     return 0;
   default: /* a table row whose subcommand forgot to handle it */
     return cli_usage_error(command, "internal error: option %s has no handler", name);

@@ -55,7 +55,16 @@ typedef enum cli_opt_id {
   CLI_OPT_BOUNCE,
   CLI_OPT_BOUNCES,
   CLI_OPT_BOUNCE_ALBEDO,
-  CLI_OPT_BRIGHTNESS
+  CLI_OPT_BRIGHTNESS,
+  /* engine textures (.vtf, .dds) and Source materials */
+  CLI_OPT_TEXTURE_FORMAT,
+  CLI_OPT_VTF_VERSION,
+  CLI_OPT_VTF_FLAGS,
+  CLI_OPT_NOMIP,
+  CLI_OPT_FAST_COMPRESSION,
+  CLI_OPT_VMT,
+  CLI_OPT_MATERIALS,
+  CLI_OPT_BASETEXTURE
 } cli_opt_id;
 
 /* One row of a subcommand's option table: getopt_long's struct option and
@@ -129,6 +138,7 @@ struct cli_settings {
   int scale_given;
   int mips; /* --mips: outputs are mip-mapped TIFF or EXR files */
   const char *basis_file; /* --basis FILE (a file, not a name), or NULL */
+  bb_texture_options texture; /* .vtf and .dds outputs (--texture-format...) */
 };
 
 /* Library defaults, plus the CLI's own (channel auto, default depth). */
@@ -151,5 +161,15 @@ extern const cli_option cli_opt_scale, cli_opt_rays, cli_opt_filter_radius,
     cli_opt_filter_threshold, cli_opt_bias, cli_opt_power, cli_opt_basis,
     cli_opt_normal_filter, cli_opt_normal_y, cli_opt_threads, cli_opt_clamp,
     cli_opt_channel, cli_opt_depth, cli_opt_help, cli_opt_mips;
+
+/* The rows of the engine texture settings (cli_settings.texture), for the
+ * tables of every command that writes maps. */
+extern const cli_option cli_opt_texture_format, cli_opt_vtf_version, cli_opt_vtf_flags,
+    cli_opt_nomip, cli_opt_fast_compression;
+/* A Source material's rows (bake, height2ssbump). */
+extern const cli_option cli_opt_vmt, cli_opt_materials, cli_opt_basetexture;
+#define CLI_TEXTURE_OPTIONS                                                              \
+  &cli_opt_texture_format, &cli_opt_vtf_version, &cli_opt_vtf_flags, &cli_opt_nomip,     \
+      &cli_opt_fast_compression
 
 #endif /* BB_CLI_OPTIONS_H */

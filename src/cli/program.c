@@ -3,7 +3,6 @@
 #include "cli.h"
 #include "common.h"
 #include "maps.h"
-#include "read.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,7 +34,8 @@ static const cli_option opt_allow_outside = {
     .help = "read images outside --base too (absolute paths, .., links out)"};
 
 static const cli_option *const program_options[] = {
-    &opt_output, &opt_base, &opt_allow_outside, &opt_depth, &cli_opt_mips, &cli_opt_help};
+    &opt_output, &opt_base, &opt_allow_outside, &opt_depth, &cli_opt_mips, CLI_TEXTURE_OPTIONS,
+    &cli_opt_help};
 
 static const cli_command program_command = {
     "program",
@@ -75,13 +75,6 @@ static int program_option(void *ctx, const cli_option *opt, const char *arg) {
   return cli_settings_apply(program_command.name, &a->settings, opt, arg);
 }
 
-/* bb_image_read with libpng's own messages muted, as for every command. */
-static bb_status quiet_loader(void *user, const char *path, bb_image *img,
-                              bb_image_info *info, bb_error *err) {
-  (void)user;
-  return cli_read_image(path, img, info, err);
-}
-
 /* The output must not replace any image the program reads: every one of
  * them, however many the program names (bb_outputs_check against all). */
 static int check_output_against_images(const program_args *a, const bb_program *program) {
@@ -104,7 +97,8 @@ static int check_output_against_images(const program_args *a, const bb_program *
       if (len >= 0 && (size_t)len < sizeof paths[n])
         reads[n] = paths[n], n++;
     }
-    const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0};
+    const bb_output_spec spec = {a->output, "output", 0, a->settings.depth, a->settings.mips, 0,
+                                 0, 0, BB_RANGE_UNIT, &a->settings.texture};
     bb_error err = {{0}};
     bb_status st = bb_outputs_check(&spec, 1, reads, n, &err);
     rc = st == BB_OK ? 0 : cli_library_error(program_command.name, st, &err);
@@ -139,7 +133,6 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   bb_program_options_init(&o);
   o.base_dir = a->base_dir;
   o.allow_outside_base = a->allow_outside_base;
-  o.loader = quiet_loader;
   bb_image out = {0};
   int is_normal = 0;
   bb_error err = {{0}};
@@ -152,7 +145,7 @@ static int program_run(const cli_run *run, const program_args *a, const char *te
   const char *kind = is_normal ? "normal" : "colour";
   int rc = cli_maps_write(run, text, NULL, kind, a->output, &out,
                           is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, a->settings.depth,
-                          a->settings.mips);
+                          a->settings.mips, &a->settings.texture);
   if (!rc)
     cli_printf_line("wrote %s %s", kind, a->output);
   bb_image_free(&out);

@@ -5,7 +5,6 @@
 #include "common.h"
 #include "options.h"
 #include "progress.h"
-#include "read.h"
 #include "render_common.h"
 
 #include <limits.h>
@@ -303,7 +302,8 @@ static int output_specs(const render_args *a, bb_output_spec **specs, char ***fr
     /* A GIF is written by the animation writer, not bb_image_write: its
      * name is checked as a file, its format here. */
     (*specs)[f] = (bb_output_spec){path, a->compare ? "comparison" : "render", 0,
-                                   a->settings.depth, 0, has_extension(path, ".gif")};
+                                   a->settings.depth, 0, has_extension(path, ".gif"),
+                                   0, 0, BB_RANGE_UNIT, NULL};
   }
   return 0;
 }
@@ -487,7 +487,7 @@ static int load_albedo(const render_args *a, render_inputs *in) {
   if (!a->albedo_path)
     return 0;
   bb_error err = {{0}};
-  bb_status st = cli_read_image(a->albedo_path, &in->albedo, NULL, &err);
+  bb_status st = bb_image_read(a->albedo_path, &in->albedo, NULL, &err);
   if (st != BB_OK)
     return cli_status_exit(a->albedo_path, st, &err);
   const bb_image *size = in->view.normal ? in->view.normal : in->view.ssbump;
@@ -571,7 +571,7 @@ static int stage_picture(const render_args *a, const char *command_line,
     rc = BB_EXIT_FAILURE;
   }
   if (!rc) {
-    const bb_write_options wo = {a->settings.depth, BB_RANGE_UNIT, text};
+    const bb_write_options wo = {a->settings.depth, BB_RANGE_UNIT, text, NULL};
     bb_error err = {{0}};
     rc = cli_status_exit(path, bb_image_write_staged(path, &picture, &wo, staged, &err), &err);
   }

@@ -205,8 +205,9 @@ static int check_outputs(rbf_args *a) {
   if (a->height && bb_same_file(a->height, a->output))
     return cli_usage_error(rbf_command.name, "--height and the normal map are both %s",
                            a->output);
-  const bb_output_spec specs[2] = {{a->output, "normal", 4, BB_DEPTH_DEFAULT, 0, 0},
-                                   {a->height, "height", 1, BB_DEPTH_DEFAULT, 0, 0}};
+  const bb_output_spec specs[2] = {
+      {a->output, "normal", 4, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_SIGNED, NULL},
+      {a->height, "height", 1, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_UNIT, NULL}};
   bb_error err = {{0}};
   bb_status st = bb_outputs_check(specs, a->height ? 2 : 1, &a->model, 1, &err);
   return st == BB_OK ? 0 : cli_library_error(rbf_command.name, st, &err);

@@ -99,7 +99,8 @@ static int sheet_parse(int argc, char **argv, sheet_args *a, const char **input)
                            "--mode slope is render's (bumpbake render HEIGHT --mode slope); "
                            "the sheet lights the ssbump, normal or ao");
   a->sheet.lit.threads = a->settings.bake.trace.threads;
-  const bb_output_spec spec = {a->output, "sheet", 0, a->settings.depth, 0, 0};
+  const bb_output_spec spec = {a->output, "sheet", 0, a->settings.depth, 0, 0, 0, 0,
+                               BB_RANGE_UNIT, NULL};
   bb_error err = {{0}};
   bb_status st = bb_outputs_check(&spec, 1, input, 1, &err);
   return st == BB_OK ? 0 : cli_library_error(sheet_command.name, st, &err);
@@ -147,7 +148,7 @@ static int sheet_run(const char *command_line, sheet_args *a, const char *input)
   }
   if (!rc) {
     const bb_output_file file = {a->output, "sheet", &sheet, BB_RANGE_UNIT, a->settings.depth,
-                                 0, text, NULL, 0};
+                                 0, text, NULL, 0, NULL};
     rc = cli_status_exit(a->output, bb_outputs_write(&file, 1, 1, &err), &err);
   }
   free(text);

@@ -28,7 +28,8 @@ static const cli_option opt_normal_y = {
 
 static const cli_option *const s2n_options[] = {&opt_output,   &opt_kind,
                                                 &opt_normal_y, &cli_maps_opt_depth,
-                                                &cli_opt_mips, &cli_opt_help};
+                                                &cli_opt_mips, CLI_TEXTURE_OPTIONS,
+                                                &cli_opt_help};
 
 static const cli_command s2n_command = {
     "ssbump2normal",
@@ -96,7 +97,8 @@ static int s2n_run(const cli_run *run, s2n_args *a, const char *input) {
       bb_image_flip_green(&normals);
     bb_depth depth = cli_maps_output_depth(a->settings.depth, &info, a->output);
     rc = cli_maps_write(run, cli_maps_file_name(input), &ssbump, "normal", a->output,
-                        &normals, BB_RANGE_SIGNED, depth, a->settings.mips);
+                        &normals, BB_RANGE_SIGNED, depth, a->settings.mips,
+                        &a->settings.texture);
   }
   if (!rc)
     cli_printf_line("wrote normal %s", a->output);

@@ -57,16 +57,13 @@ static void put_u32(unsigned char *p, uint32_t v) {
     p[k] = (unsigned char)((v >> (8 * k)) & 0xff);
 }
 
-bb_status bb__dds_encode(bb_staged_file *f, const bb_image *img,
+bb_status bb__dds_encode(bb_staged_file *f, const bb_image *chain, int levels,
                          const bb_texture_options *o, bb_texture_format format,
                          bb_error *err) {
   const char *path = f->path;
-  bb_image *chain = NULL;
-  int count = 0;
-  bb_status st = bb__texture_chain(img, o->map, &chain, &count, err);
-  if (st != BB_OK)
-    return st;
-  const int levels = o->mips ? count : 1;
+  const bb_image *img = &chain[0];
+  bb_status st = BB_OK;
+  const int mips = o->mips != 0;
   const int block = format == BB_TEXTURE_FORMAT_BC1 || format == BB_TEXTURE_FORMAT_BC3 ||
                     format == BB_TEXTURE_FORMAT_BC4 || format == BB_TEXTURE_FORMAT_BC5;
   const int dx10 = format == BB_TEXTURE_FORMAT_RGBA16F || format == BB_TEXTURE_FORMAT_RGBA32F;
@@ -78,14 +75,14 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *img,
   put_u32(h + 4, 124);
   uint32_t flags = DDSD_CAPS | DDSD_HEIGHT | DDSD_WIDTH | DDSD_PIXELFORMAT;
   flags |= block ? DDSD_LINEARSIZE : DDSD_PITCH;
-  if (o->mips)
+  if (mips)
     flags |= DDSD_MIPMAPCOUNT;
   put_u32(h + 8, flags);
   put_u32(h + 12, (uint32_t)img->height);
   put_u32(h + 16, (uint32_t)img->width);
   /* Block formats: bytes of the top level; others: bytes of a row. */
   put_u32(h + 20, block ? (uint32_t)top_bytes : (uint32_t)(top_bytes / (size_t)img->height));
-  put_u32(h + 28, o->mips ? (uint32_t)levels : 0);
+  put_u32(h + 28, mips ? (uint32_t)levels : 0);
   put_u32(h + 76, 32);
   uint32_t pf_flags = DDPF_FOURCC;
   switch (format) {
@@ -115,12 +112,11 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *img,
     put_u32(h + 140, 1); /* array size */
     break;
   default:
-    bb_mip_chain_free(chain, count);
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: DDS has no format %s", path,
                     bb_texture_format_name(format));
   }
   put_u32(h + 80, pf_flags);
-  put_u32(h + 108, DDSCAPS_TEXTURE | (o->mips && levels > 1 ? DDSCAPS_COMPLEX | DDSCAPS_MIPMAP : 0));
+  put_u32(h + 108, DDSCAPS_TEXTURE | (mips ? DDSCAPS_COMPLEX | DDSCAPS_MIPMAP : 0));
 
   unsigned char *buffer = malloc(top_bytes);
   if (!buffer)
@@ -135,6 +131,5 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *img,
   }
   /* Write errors are kept by f and reported when the caller finishes it. */
   free(buffer);
-  bb_mip_chain_free(chain, count);
   return st;
 }

@@ -1,6 +1,6 @@
-/* oiio.h: what the library asks of OpenImageIO beyond the
- * public reads and writes: file headers, bounded channel reads, resizing
- * (io_oiio.cpp). */
+/* oiio.h: what the rest of the library asks of the io family beyond the
+ * public reads and writes: file headers, bounded channel reads, resizing.
+ * (The family reaches OpenImageIO only in its oiio_*.cpp files.) */
 #ifndef BB_IO_OIIO_H
 #define BB_IO_OIIO_H
 
@@ -10,23 +10,24 @@
 extern "C" {
 #endif
 
-/* Image headers for bb_output_check (io_oiio.cpp): the depth bb_image_write
- * stores for `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1
- * for an unknown extension; and the number of mip levels of subimage 0 of
- * the file at path, from its headers. */
+/* Image headers for bb_output_check: the depth bb_image_write stores for
+ * `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1 for an
+ * unknown extension (formats.c); and the number of mip levels of subimage 0
+ * of the file at path, from its headers (image_read.c). */
 int bb__path_resolved_depth(const char *path, bb_depth depth);
 bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
 
 
 /* Reads channels [first_channel, first_channel + channel_count) of path as
  * float (the bounds of bb_image_read apply: the bytes of the whole file's
- * samples and of what is read). info may be NULL. Messages name the file. */
+ * samples and of what is read). info may be NULL. Messages name the file.
+ * (image_read.c) */
 bb_status bb__image_read_channels(const char *path, int first_channel, int channel_count,
                                   bb_image *out, bb_image_info *info, bb_error *err);
 
 
 /* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
- * (io_oiio.cpp, the only file that sees OpenImageIO). Allocates out. */
+ * (oiio_mips.cpp). Allocates out. */
 bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
                                bb_error *err);
 

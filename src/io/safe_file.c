@@ -37,10 +37,12 @@ enum { TEMP_SLOTS = 4096 };
 enum { SLOT_FREE = 0, SLOT_FILLED, SLOT_LIVE };
 static atomic_int slot_state[TEMP_SLOTS];
 static char slot_path[TEMP_SLOTS][PATH_MAX];
+static int slot_is_dir[TEMP_SLOTS]; /* a private directory (bb__safe_open_private) */
 
-/* Lists path for bb_tempfiles_remove; returns its slot, or -1 when the table
- * is full (the file then loses only its signal-time cleanup). */
-static int register_temp(const char *path) {
+/* Lists path (a file, or a directory when is_dir) for bb_tempfiles_remove;
+ * returns its slot, or -1 when the table is full (it then loses only its
+ * signal-time cleanup). */
+static int register_path(const char *path, int is_dir) {
   size_t n = strlen(path);
   if (n >= PATH_MAX)
     return -1;
@@ -48,6 +50,7 @@ static int register_temp(const char *path) {
     int expected = SLOT_FREE;
     if (atomic_compare_exchange_strong(&slot_state[i], &expected, SLOT_FILLED)) {
       memcpy(slot_path[i], path, n + 1);
+      slot_is_dir[i] = is_dir;
       atomic_store_explicit(&slot_state[i], SLOT_LIVE, memory_order_release);
       return i;
     }
@@ -60,11 +63,16 @@ static void unregister_temp(int slot) {
     atomic_store_explicit(&slot_state[slot], SLOT_FREE, memory_order_release);
 }
 
+static int register_temp(const char *path) { return register_path(path, 0); }
+
 void bb_tempfiles_remove(void) {
   int saved_errno = errno; /* a handler must leave errno as it found it */
-  for (int i = 0; i < TEMP_SLOTS; i++)
-    if (atomic_load_explicit(&slot_state[i], memory_order_acquire) == SLOT_LIVE)
-      unlink(slot_path[i]);
+  /* Files first, then the private directories they emptied. */
+  for (int pass = 0; pass < 2; pass++)
+    for (int i = 0; i < TEMP_SLOTS; i++)
+      if (atomic_load_explicit(&slot_state[i], memory_order_acquire) == SLOT_LIVE &&
+          slot_is_dir[i] == pass)
+        (void)(pass ? rmdir(slot_path[i]) : unlink(slot_path[i]));
   errno = saved_errno;
 }
 
@@ -75,14 +83,19 @@ static const char *base_name(const char *path) {
   return slash ? slash + 1 : path;
 }
 
-/* "DIR/.bb-tmp-" + 6 random characters + the extension of path (so a
- * writer that picks its format by name sees the right one), malloc'd. */
-static char *temp_name(const char *path, uint64_t *seed) {
+/* The extension of path's last component, with its dot, or "". */
+static const char *extension_of(const char *path) {
+  const char *dot = strrchr(base_name(path), '.');
+  return dot ? dot : "";
+}
+
+/* "DIR/.bb-tmp-" + 6 random characters + ext (the extension of path, so a
+ * writer that picks its format by name sees the right one; "" for a
+ * directory), malloc'd. */
+static char *temp_name(const char *path, const char *ext, uint64_t *seed) {
   static const char ALNUM[] =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
   const char *base = base_name(path);
-  const char *dot = strrchr(base, '.');
-  const char *ext = dot ? dot : "";
   size_t dir_len = (size_t)(base - path);
   size_t len = dir_len + sizeof ".bb-tmp-XXXXXX" + strlen(ext);
   char *name = malloc(len);
@@ -155,24 +168,39 @@ static void close_fd(bb_staged_file *f) {
   f->fd = -1;
 }
 
-/* Removes the temporary, forgets it and frees everything f owns. */
+/* Removes the temporary (and its private directory), forgets them and
+ * frees everything f owns. */
 static void release(bb_staged_file *f, int remove_temp) {
   if (f->fd >= 0) {
     close(f->fd);
     f->fd = -1;
   }
-  if (remove_temp && f->temp_path)
+  if (f->dir_fd >= 0) {
+    if (remove_temp && f->leaf) unlinkat(f->dir_fd, f->leaf, 0);
+  } else if (remove_temp && f->temp_path) {
     unlink(f->temp_path);
-  if (f->locked) /* after the rename or unlink: a sweep never sees it unlocked */
-    close(f->lock_fd);
+  }
+  if (f->temp_dir) rmdir(f->temp_dir); /* empty once its file is gone or renamed */
+  /* The locks go last, after the rename, unlink or rmdir: a sweep never
+   * sees a temporary of ours unlocked. */
+  if (f->dir_fd >= 0) {
+    close(f->dir_fd);
+    f->dir_fd = -1;
+  }
+  if (f->locked) close(f->lock_fd);
   f->locked = 0;
   unregister_temp(f->slot);
-  f->slot = -1;
+  unregister_temp(f->file_slot);
+  unregister_temp(f->dir_slot);
+  f->slot = f->file_slot = f->dir_slot = -1;
   free(f->buffer);
   free(f->temp_path);
   free(f->path);
+  free(f->temp_dir);
+  free(f->registered_file);
   f->buffer = NULL;
-  f->temp_path = f->path = NULL;
+  f->temp_path = f->path = f->temp_dir = f->registered_file = NULL;
+  f->leaf = NULL;
   if (f->lock_ready)
     pthread_mutex_destroy(&f->lock);
   f->lock_ready = 0;
@@ -186,7 +214,8 @@ enum { BUFFER_BYTES = 1 << 16 };
  * bb_tempfiles_sweep: 0 when this process now holds the lock on the file
  * that name names, EEXIST when a sweep got to it first (it removes what it
  * locks: try another name), or another errno. The lock goes with a dup of
- * fd, which stays open until the temporary is renamed or removed. */
+ * fd into *lock_fd, which stays open until the temporary is renamed or
+ * removed; with lock_fd NULL, with fd itself. */
 static int lock_temp(int fd, const char *name, int *lock_fd) {
   if (flock(fd, LOCK_EX | LOCK_NB) != 0)
     return errno == EWOULDBLOCK ? EEXIST : (errno == ENOLCK || errno == EINVAL ? ENOLCK : errno);
@@ -194,6 +223,7 @@ static int lock_temp(int fd, const char *name, int *lock_fd) {
   if (fstat(fd, &ours) != 0 || stat(name, &named) != 0 || ours.st_dev != named.st_dev ||
       ours.st_ino != named.st_ino)
     return EEXIST; /* swept between the open and the lock */
+  if (!lock_fd) return 0; /* the lock goes with fd itself */
   *lock_fd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
   return *lock_fd >= 0 ? 0 : errno;
 }
@@ -207,7 +237,7 @@ static int lock_temp(int fd, const char *name, int *lock_fd) {
 static int create_temp(bb_staged_file *f) {
   uint64_t seed = fresh_seed();
   for (int attempt = 0; attempt < 100; attempt++) {
-    char *name = temp_name(f->path, &seed);
+    char *name = temp_name(f->path, extension_of(f->path), &seed);
     if (!name)
       return ENOMEM;
     int slot = register_temp(name);
@@ -235,10 +265,14 @@ static int create_temp(bb_staged_file *f) {
   return EEXIST;
 }
 
-bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
+void bb__safe_init(bb_staged_file *f) {
   memset(f, 0, sizeof *f);
-  f->fd = -1;
-  f->slot = -1;
+  f->fd = f->dir_fd = -1;
+  f->slot = f->file_slot = f->dir_slot = -1;
+}
+
+bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
+  bb__safe_init(f);
   if (!path || !*path)
     return bb__fail(err, BB_ERR_ARGUMENT, "no output path");
   f->path = malloc(strlen(path) + 1);
@@ -257,6 +291,106 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
   if (error) {
     release(f, 0);
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, strerror(error));
+  }
+  return BB_OK;
+}
+
+/* Creates the private directory with mkdir (which never follows a link and
+ * fails on any existing name), registered before it exists, opens it
+ * without following a link and locks it as create_temp locks a file:
+ * f->dir_fd, f->temp_dir and f->dir_slot. A directory a sweep removed or
+ * locked first (it removes what it locks) is given up for another name. */
+static int create_private_dir(bb_staged_file *f) {
+  uint64_t seed = fresh_seed();
+  for (int attempt = 0; attempt < 100; attempt++) {
+    char *name = temp_name(f->path, "", &seed);
+    if (!name) return ENOMEM;
+    int slot = register_path(name, 1);
+    int error = mkdir(name, 0700) == 0 ? 0 : errno;
+    int fd = -1;
+    if (!error) {
+      /* Swapped for a link or another's directory in between: refused. */
+      fd = open(name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+      struct stat st;
+      if (fd < 0)
+        error = errno == ENOENT ? EEXIST : errno;
+      else if (fstat(fd, &st) != 0 || st.st_uid != geteuid() || (st.st_mode & 077) != 0)
+        error = EPERM;
+      else if ((error = lock_temp(fd, name, NULL)) == ENOLCK)
+        error = 0; /* no locks here: unlocked, as create_temp's files */
+    }
+    if (!error) {
+      f->temp_dir = name;
+      f->dir_slot = slot;
+      f->dir_fd = fd;
+      return 0;
+    }
+    if (fd >= 0) close(fd);
+    unregister_temp(slot);
+    free(name);
+    if (error != EEXIST) return error;
+  }
+  return EEXIST;
+}
+
+bb_status bb__safe_open_private(bb_staged_file *f, const char *path, bb_error *err) {
+  bb__safe_init(f);
+  if (!path || !*path) return bb__fail(err, BB_ERR_ARGUMENT, "no output path");
+  f->path = malloc(strlen(path) + 1);
+  if (!f->path) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  strcpy(f->path, path);
+  int error = create_private_dir(f);
+  if (!error) {
+    const char *ext = extension_of(path);
+    char through_fd[64];
+    snprintf(through_fd, sizeof through_fd, "/proc/self/fd/%d", f->dir_fd);
+    struct stat st;
+    /* The name through the descriptor reaches this directory whatever
+     * happens to its path; without /proc the path has to do. */
+    const char *dir = stat(through_fd, &st) == 0 && S_ISDIR(st.st_mode) ? through_fd : f->temp_dir;
+    size_t dir_len = strlen(dir), reg_len = strlen(f->temp_dir), leaf_len = strlen("/staged") + strlen(ext);
+    f->temp_path = malloc(dir_len + leaf_len + 1);
+    f->registered_file = malloc(reg_len + leaf_len + 1);
+    if (!f->temp_path || !f->registered_file) {
+      error = ENOMEM;
+    } else {
+      sprintf(f->temp_path, "%s/staged%s", dir, ext);
+      sprintf(f->registered_file, "%s/staged%s", f->temp_dir, ext);
+      f->leaf = f->temp_path + dir_len + 1;
+      f->file_slot = register_temp(f->registered_file);
+    }
+  }
+  if (error) {
+    release(f, 1);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, strerror(error));
+  }
+  if (pthread_mutex_init(&f->lock, NULL) != 0) {
+    release(f, 1);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: cannot create a lock", path);
+  }
+  f->lock_ready = 1;
+  return BB_OK;
+}
+
+bb_status bb__safe_adopt(bb_staged_file *f, bb_error *err) {
+  int error = 0;
+  int fd = openat(f->dir_fd, f->leaf, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0)
+    error = errno;
+  else if (fstat(fd, &st) != 0)
+    error = errno;
+  else if (!S_ISREG(st.st_mode))
+    error = EINVAL;
+  /* A full disk may only show at fsync (delayed allocation) or close (NFS). */
+  else if (fsync(fd) != 0)
+    error = errno;
+  if (fd >= 0 && close(fd) != 0 && !error && errno != EINTR) error = errno;
+  if (error) {
+    bb_status status =
+        bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(error));
+    release(f, 1);
+    return status;
   }
   return BB_OK;
 }
@@ -407,7 +541,8 @@ bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
   bb_status st = bb__safe_finish(f, err);
   if (st != BB_OK)
     return st;
-  if (rename(f->temp_path, f->path) != 0) {
+  if (f->dir_fd >= 0 ? renameat(f->dir_fd, f->leaf, AT_FDCWD, f->path) != 0
+                     : rename(f->temp_path, f->path) != 0) {
     st = bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(errno));
     release(f, 1);
     return st;
@@ -437,8 +572,23 @@ static int is_temp_name(const char *name) {
   return name[14] == '\0' || name[14] == '.';
 }
 
-/* Removes dir/name when it is a temporary nobody holds: 1 removed, 0 left
- * (held, gone, not a regular file), -1 failed (errno). */
+/* Empties a private directory (bb__safe_open_private) whose writer is gone,
+ * open as fd: its staged file, whatever the encoder named "staged*". */
+static void empty_private_dir(int fd) {
+  const int listing = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  DIR *d = listing >= 0 ? fdopendir(listing) : NULL;
+  if (!d) {
+    if (listing >= 0) close(listing);
+    return;
+  }
+  for (struct dirent *e; (e = readdir(d)) != NULL;)
+    if (strncmp(e->d_name, "staged", 6) == 0) unlinkat(fd, e->d_name, 0);
+  closedir(d);
+}
+
+/* Removes dir/name when it is a temporary nobody holds (a file, or a
+ * private directory and its staged file): 1 removed, 0 left (held, gone,
+ * neither, or a directory holding something else), -1 failed (errno). */
 static int sweep_one(const char *dir, const char *name) {
   char path[PATH_MAX];
   if (snprintf(path, sizeof path, "%s/%s", dir, name) >= (int)sizeof path)
@@ -448,13 +598,21 @@ static int sweep_one(const char *dir, const char *name) {
     return errno == ENOENT || errno == ELOOP ? 0 : -1;
   int removed = 0;
   struct stat held, named;
-  if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &held) == 0 && S_ISREG(held.st_mode) &&
+  if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &held) == 0 &&
       lstat(path, &named) == 0 && held.st_dev == named.st_dev && held.st_ino == named.st_ino) {
     /* Locked by us, it is still the file at that name: its writer is gone. */
-    if (unlink(path) == 0)
-      removed = 1;
-    else if (errno != ENOENT)
-      removed = -1;
+    if (S_ISREG(held.st_mode)) {
+      if (unlink(path) == 0)
+        removed = 1;
+      else if (errno != ENOENT)
+        removed = -1;
+    } else if (S_ISDIR(held.st_mode) && name[14] == '\0' && held.st_uid == geteuid()) {
+      empty_private_dir(fd);
+      if (rmdir(path) == 0)
+        removed = 1;
+      else if (errno != ENOENT && errno != ENOTEMPTY && errno != EEXIST)
+        removed = -1;
+    }
   }
   const int saved = errno;
   close(fd); /* drops the lock */
@@ -491,11 +649,8 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err) {
 /* ------------------------------------------------------ public handles */
 
 bb_staged_file *bb__staged_new(void) {
-  bb_staged_file *f = calloc(1, sizeof *f);
-  if (f) {
-    f->fd = -1;
-    f->slot = -1;
-  }
+  bb_staged_file *f = malloc(sizeof *f);
+  if (f) bb__safe_init(f);
   return f;
 }
 

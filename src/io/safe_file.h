@@ -14,7 +14,7 @@ extern "C" {
 #endif
 
 /* Every writer (safe_file.c; OpenImageIO's writers reach it through
- * write_safely() in io_oiio.cpp) puts bytes on disk this way, so that no
+ * bb::write_staged() in oiio_write.cpp) puts bytes on disk this way, so that no
  * failure leaves a partial file at the final name:
  *
  *   bb_staged_file f;
@@ -55,11 +55,40 @@ struct bb_staged_file {
   int locked;           /* 1: lock_fd holds the temporary's flock */
   int lock_fd;          /* a dup of fd, open until the temporary is renamed
                            or removed, so its lock outlives fd's close */
+  /* A file staged by name in a private directory (bb__safe_open_private):
+   * the directory's path, its open descriptor, the file's name in it and
+   * the registry slots of both; NULL and -1 otherwise. */
+  char *temp_dir;
+  int dir_fd;
+  const char *leaf; /* points into temp_path */
+  char *registered_file; /* the file's path through temp_dir, for the registry */
+  int dir_slot, file_slot;
 };
+
+/* A bb_staged_file that bb__safe_discard may be called on before any open. */
+void bb__safe_init(bb_staged_file *f);
 
 /* Creates the temporary for path (f is the caller's; nothing to free on
  * failure). Errors: BB_ERR_IO (directory missing or not writable). */
 bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err);
+
+/* For an encoder that can only open its output by name (OpenImageIO's
+ * TIFF writer appending directories): creates, next to path, a private
+ * directory "DIR/.bb-tmp-XXXXXX" (mode 0700, so no other user can put a
+ * link in it, and held open, so renaming it away changes nothing) and sets
+ * f->temp_path to the name the encoder must write: LEAF in that directory
+ * reached through its descriptor ("/proc/self/fd/N/LEAF"; the directory's
+ * path where /proc is not mounted), LEAF being "staged" and path's
+ * extension. Nothing exists at that name yet. Both are registered for
+ * bb_tempfiles_remove. Then bb__safe_adopt, then commit or discard as for
+ * bb__safe_open. Errors: BB_ERR_IO. */
+bb_status bb__safe_open_private(bb_staged_file *f, const char *path, bb_error *err);
+
+/* Makes the file the encoder wrote at f->temp_path the staged file: opened
+ * without following a link, checked to be a regular file, fsynced and
+ * closed (checked), as bb__safe_finish does. On failure the temporary and
+ * its directory are removed and BB_ERR_IO says why. */
+bb_status bb__safe_adopt(bb_staged_file *f, bb_error *err);
 /* Writes at the current position / at offset; returns size, or 0 once any
  * write has failed. */
 size_t bb__safe_write(bb_staged_file *f, const void *data, size_t size);

@@ -1,5 +1,5 @@
 /* text.h: labels drawn through OpenImageIO's FreeType text
- * (io_oiio.cpp), for the panels of pictures. */
+ * (oiio_text.cpp), for the panels of pictures. */
 #ifndef BB_IO_TEXT_H
 #define BB_IO_TEXT_H
 
@@ -9,7 +9,7 @@
 extern "C" {
 #endif
 
-/* Text through OpenImageIO (io_oiio.cpp). font is a font file or a name
+/* Text through OpenImageIO (oiio_text.cpp). font is a font file or a name
  * OpenImageIO searches for (its font path and /usr/share/fonts). */
 /* 1 when OpenImageIO can draw text with font. */
 int bb__font_usable(const char *font);

@@ -244,12 +244,6 @@ bb_status bb_texture_check(const char *path, int width, int height, int channels
 
 /* ------------------------------------------------------------- encoding */
 
-bb_status bb__texture_chain(const bb_image *img, bb_texture_map map, bb_image **levels,
-                            int *count, bb_error *err) {
-  return bb_mip_chain(img, map == BB_TEXTURE_MAP_NORMAL ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE,
-                      levels, count, err);
-}
-
 void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]) {
   const float *t = img->pixels + i * (size_t)img->channels;
   switch (img->channels) {
@@ -350,4 +344,45 @@ bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
     p += f->texel_bytes;
   }
   return BB_OK;
+}
+
+/* ----------------------------------------------------- maps, provenance */
+
+/* 1 when kind is name or starts with name and '+' ("ssbump+height"). */
+static int kind_is(const char *kind, const char *name) {
+  const size_t n = strlen(name);
+  return strncmp(kind, name, n) == 0 && (kind[n] == '\0' || kind[n] == '+');
+}
+
+void bb_texture_options_for(bb_texture_options *o, const char *kind, bb_range range) {
+  if (!o)
+    return;
+  const char *k = kind ? kind : "";
+  if (kind_is(k, "ssbump") || kind_is(k, "detail-ssbump") || kind_is(k, "weights")) {
+    o->map = BB_TEXTURE_MAP_SSBUMP;
+  } else if (range == BB_RANGE_SIGNED) {
+    o->map = BB_TEXTURE_MAP_NORMAL;
+  } else {
+    o->map = BB_TEXTURE_MAP_PLAIN;
+    if (strncmp(k, "normal+", 7) == 0) /* packed already: flagged, not re-packed */
+      o->vtf_flags |= BB_VTF_FLAG_NORMAL;
+  }
+}
+
+char *bb_texture_provenance(const char *path, const bb_texture_options *options) {
+  const bb__container c = bb__texture_container(path);
+  if (c == BB__CONTAINER_NONE)
+    return NULL;
+  bb_texture_options defaults;
+  bb_texture_options_init(&defaults);
+  const bb_texture_options *o = options ? options : &defaults;
+  char text[256];
+  int n = snprintf(text, sizeof text,
+                   "texture=%s\ntexture_format=%s\ntexture_mips=%d\ntexture_fit=%s",
+                   c == BB__CONTAINER_VTF ? "vtf" : "dds", bb_texture_format_name(o->format),
+                   o->mips ? 1 : 0, o->fast ? "range" : "cluster");
+  if (c == BB__CONTAINER_VTF && n > 0 && (size_t)n < sizeof text)
+    snprintf(text + n, sizeof text - (size_t)n, "\nvtf_version=7.%d\nvtf_flags=0x%08x",
+             o->vtf_version, (unsigned)o->vtf_flags);
+  return strdup(text);
 }

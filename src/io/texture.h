@@ -27,16 +27,19 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
                               const bb_texture_options *options, bb_texture_format *format,
                               bb_error *err);
 
+/* Encodes levels[0] (given 0: its chain is made here by the map's rule and
+ * written when options->mips) or the caller's chain levels[0..count-1]
+ * (given 1: checked, written as it is) into f, opened here and finished on
+ * success, discarded on failure. f must be bb__safe_init'ed. */
+bb_status bb__texture_stage(const char *path, const bb_image *levels, int count, int given,
+                            const bb_texture_options *options, struct bb_staged_file *f,
+                            bb_error *err);
+
 /* Bytes of a width x height level in format. */
 size_t bb__texture_level_bytes(bb_texture_format format, int width, int height);
 
 /* 1 when format stores an alpha channel. */
 int bb__texture_format_has_alpha(bb_texture_format format);
-
-/* The levels to write: bb_mip_chain of img by the map's rule (it also
- * rejects NaN and infinite texels). */
-bb_status bb__texture_chain(const bb_image *img, bb_texture_map map, bb_image **levels,
-                            int *count, bb_error *err);
 
 /* Texel i of img as the engine samples it (see bumpbake.h): R, G, B, A,
  * normal maps mapped to 0.5 + 0.5 v; not clamped. */

@@ -93,29 +93,80 @@ static bb_status texture_name(const char *materials, const char *texture, const 
   return BB_OK;
 }
 
-bb_status bb_vmt_write(const char *path, const bb_vmt_options *o, bb_error *err) {
+/* The nearest folder named "materials" (any case) above the bump map, into
+ * out: where a game's tree keeps its materials. 0 when found. */
+static int find_materials(const char *bumpmap, char *out, size_t cap) {
+  char file[PATH_MAX];
+  if (absolute_path(bumpmap, file, sizeof file) != 0)
+    return -1;
+  char *slash = strrchr(file, '/');
+  while (slash && slash != file) {
+    *slash = '\0';
+    const char *name = strrchr(file, '/');
+    name = name ? name + 1 : file;
+    if (strcasecmp(name, "materials") == 0) {
+      if (strlen(file) + 1 > cap)
+        return -1;
+      memcpy(out, file, strlen(file) + 1);
+      return 0;
+    }
+    slash = strrchr(file, '/');
+  }
+  return -1;
+}
+
+bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, size_t *size,
+                      bb_error *err) {
+  if (text)
+    *text = NULL;
+  if (size)
+    *size = 0;
   if (!path || !*path)
     return bb__fail(err, BB_ERR_ARGUMENT, "material: no path");
-  if (!o || !o->materials_dir || !*o->materials_dir)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: a material needs the materials folder", path);
-  if (!o->bumpmap || !*o->bumpmap)
+  if (!text || !size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: bb_vmt_text: NULL argument", path);
+  if (!o || !o->bumpmap || !*o->bumpmap)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: a material needs its bump map's .vtf", path);
+  char found[PATH_MAX];
+  const char *materials = o->materials_dir;
+  if (!materials || !*materials) {
+    if (find_materials(o->bumpmap, found, sizeof found) != 0)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: no folder named \"materials\" above %s: name the game's materials "
+                      "folder",
+                      path, o->bumpmap);
+    materials = found;
+  }
   char bump[PATH_MAX], base[PATH_MAX];
-  bb_status st = texture_name(o->materials_dir, o->bumpmap, "bump map", bump, sizeof bump, err);
+  bb_status st = texture_name(materials, o->bumpmap, "bump map", bump, sizeof bump, err);
   if (st == BB_OK && o->basetexture)
-    st = texture_name(o->materials_dir, o->basetexture, "base texture", base, sizeof base,
-                      err);
+    st = texture_name(materials, o->basetexture, "base texture", base, sizeof base, err);
   if (st != BB_OK)
     return st;
-  char text[3 * PATH_MAX + 256];
-  int n = snprintf(text, sizeof text, "// Source material written by bumpbake %s\n"
-                                      "\"LightmappedGeneric\"\n{\n",
+  const size_t cap = 3 * PATH_MAX + 256;
+  char *out = malloc(cap);
+  if (!out)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  int n = snprintf(out, cap, "// Source material written by bumpbake %s\n"
+                             "\"LightmappedGeneric\"\n{\n",
                    BB_VERSION_STRING);
   if (o->basetexture)
-    n += snprintf(text + n, sizeof text - (size_t)n, "\t\"$basetexture\" \"%s\"\n", base);
-  n += snprintf(text + n, sizeof text - (size_t)n, "\t\"$bumpmap\" \"%s\"\n", bump);
+    n += snprintf(out + n, cap - (size_t)n, "\t\"$basetexture\" \"%s\"\n", base);
+  n += snprintf(out + n, cap - (size_t)n, "\t\"$bumpmap\" \"%s\"\n", bump);
   if (o->ssbump)
-    n += snprintf(text + n, sizeof text - (size_t)n, "\t\"$ssbump\" \"1\"\n");
-  n += snprintf(text + n, sizeof text - (size_t)n, "}\n");
-  return bb_file_write(path, text, (size_t)n, err);
+    n += snprintf(out + n, cap - (size_t)n, "\t\"$ssbump\" \"1\"\n");
+  n += snprintf(out + n, cap - (size_t)n, "}\n");
+  *text = out;
+  *size = (size_t)n;
+  return BB_OK;
+}
+
+bb_status bb_vmt_write(const char *path, const bb_vmt_options *o, bb_error *err) {
+  char *text = NULL;
+  size_t size = 0;
+  bb_status st = bb_vmt_text(path, o, &text, &size, err);
+  if (st == BB_OK)
+    st = bb_file_write(path, text, size, err);
+  free(text);
+  return st;
 }

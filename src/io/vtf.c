@@ -145,23 +145,15 @@ static char *kvd_text(const char *description, size_t *size) {
   return out;
 }
 
-bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
-                         const bb_texture_options *o, bb_texture_format format,
-                         bb_error *err) {
+bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *chain, int levels,
+                         const bb_image *low, const bb_texture_options *o,
+                         bb_texture_format format, bb_error *err) {
   const char *path = f->path;
-  bb_image *chain = NULL;
-  int count = 0;
-  bb_status st = bb__texture_chain(img, o->map, &chain, &count, err);
-  if (st != BB_OK)
-    return st;
-  const int levels = o->mips ? count : 1;
-
-  /* The low-resolution image: the first level of at most 16 x 16. */
-  int low = 0;
-  while (low + 1 < count && (chain[low].width > 16 || chain[low].height > 16))
-    low++;
-  const size_t low_bytes =
-      bb__texture_level_bytes(BB_TEXTURE_FORMAT_BC1, chain[low].width, chain[low].height);
+  const bb_image *img = &chain[0];
+  bb_status st = BB_OK;
+  if (!low)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: no low-resolution level", path);
+  const size_t low_bytes = bb__texture_level_bytes(BB_TEXTURE_FORMAT_BC1, low->width, low->height);
 
   uint32_t flags = o->vtf_flags;
   if (o->map == BB_TEXTURE_MAP_NORMAL)
@@ -180,17 +172,14 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
   char *kvd = NULL;
   size_t kvd_bytes = 0;
   const int resources = o->vtf_version >= 3 ? (o->description ? 3 : 2) : 0;
-  if (resources == 3 && !(kvd = kvd_text(o->description, &kvd_bytes))) {
-    bb_mip_chain_free(chain, count);
+  if (resources == 3 && !(kvd = kvd_text(o->description, &kvd_bytes)))
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  }
   const uint32_t header_size = (uint32_t)(HEADER_BYTES + RESOURCE_BYTES * resources);
   const uint64_t low_at = header_size;
   const uint64_t kvd_at = low_at + low_bytes;
   const uint64_t image_at = kvd_at + (kvd ? 4 + kvd_bytes : 0);
   if (image_at + data_bytes > UINT32_MAX) {
     free(kvd);
-    bb_mip_chain_free(chain, count);
     return bb__fail(err, BB_ERR_SIZE, "%s: %llu bytes do not fit a VTF's 32-bit offsets",
                     path, (unsigned long long)(image_at + data_bytes));
   }
@@ -214,8 +203,8 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
   put_u32(header + 52, (uint32_t)vtf_code(format));
   header[56] = (unsigned char)levels;
   put_u32(header + 57, BB__VTF_DXT1);
-  header[61] = (unsigned char)chain[low].width;
-  header[62] = (unsigned char)chain[low].height;
+  header[61] = (unsigned char)low->width;
+  header[62] = (unsigned char)low->height;
   put_u16(header + 63, 1); /* depth */
   if (resources) {
     put_u32(header + 68, (uint32_t)resources);
@@ -239,8 +228,8 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   if (st == BB_OK) {
     bb__safe_write(f, header, header_size);
-    st = bb__texture_encode(&chain[low], o->map, BB_TEXTURE_FORMAT_BC1, o->fast, o->threads,
-                            buffer, err);
+    st = bb__texture_encode(low, o->map, BB_TEXTURE_FORMAT_BC1, o->fast, o->threads, buffer,
+                            err);
   }
   if (st == BB_OK) {
     bb__safe_write(f, buffer, low_bytes);
@@ -260,7 +249,6 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
   /* Write errors are kept by f and reported when the caller finishes it. */
   free(buffer);
   free(kvd);
-  bb_mip_chain_free(chain, count);
   return st;
 }
 
@@ -565,4 +553,17 @@ done:
   if (st != BB_OK)
     bb_vtf_info_free(info);
   return st;
+}
+
+const char *bb_vtf_flag_name(int bit) {
+  /* Source SDK 2013, public/vtf/vtf.h, CompiledVtfFlags. */
+  static const char *const names[32] = {
+      "POINTSAMPLE", "TRILINEAR",   "CLAMPS",      "CLAMPT",         "ANISOTROPIC",
+      "HINT_DXT5",   "SRGB",        "NORMAL",      "NOMIP",          "NOLOD",
+      "ALL_MIPS",    "PROCEDURAL",  "ONEBITALPHA", "EIGHTBITALPHA",  "ENVMAP",
+      "RENDERTARGET", "DEPTHRENDERTARGET", "NODEBUGOVERRIDE", "SINGLECOPY", "PRE_SRGB",
+      NULL,          NULL,          NULL,          "NODEPTHBUFFER",  NULL,
+      "CLAMPU",      "VERTEXTEXTURE", "SSBUMP",    NULL,             "BORDER",
+      NULL,          NULL};
+  return bit >= 0 && bit < 32 ? names[bit] : NULL;
 }

@@ -21,9 +21,12 @@ enum {
 /* Writes img as a VTF file into f (open, unfinished: the caller finishes or
  * discards it), in format (resolved by bb__texture_resolve, which has
  * accepted the request). */
-bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *img,
-                         const bb_texture_options *options, bb_texture_format format,
-                         bb_error *err);
+/* Writes the header, the low-resolution image (low, at most 16 x 16, as
+ * DXT1), the provenance resource and levels[0..count-1], smallest first,
+ * into f (open). */
+bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
+                         const bb_image *low, const bb_texture_options *options,
+                         bb_texture_format format, bb_error *err);
 
 #ifdef __cplusplus
 }

@@ -12,7 +12,7 @@
  * largest finite difference white and NaN/infinite differences clip to 1. */
 static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
   char ext[16];
-  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
+  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
   const size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
   if (strcmp(bb__extension(path, ext, sizeof ext), "exr") == 0) {
     wo.depth = BB_DEPTH_FLOAT;

@@ -9,6 +9,7 @@
  * skip leaves a wrong map.
  */
 
+#include "core/input_file.h"
 #include "core/internal.h"
 #include "io/oiio.h"
 #include "io/provenance.h"
@@ -19,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* ------------------------------------------------------------------ hash */
 
@@ -37,15 +39,21 @@ bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err) {
   if (!path || !hash)
     return bb__fail(err, BB_ERR_ARGUMENT, "bb_file_hash: NULL argument");
   *hash = 0;
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
-  /* fopen succeeds on a directory; its read would fail with EISDIR, but a
-   * FIFO would block: only regular files are hashed. */
-  struct stat st;
-  if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-    fclose(f);
-    return bb__fail(err, BB_ERR_IO, "%s: cannot read: not a regular file", path);
+  /* Only regular files are hashed: a FIFO would block, a device never end. */
+  int fd;
+  bb_error why;
+  if (bb__input_open(path, &fd, &why) != BB_OK) {
+    size_t n = strlen(path);
+    const char *reason = strncmp(why.message, path, n) == 0 && !strncmp(why.message + n, ": ", 2)
+                             ? why.message + n + 2
+                             : why.message;
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, reason);
+  }
+  FILE *f = fdopen(fd, "rb");
+  if (!f) {
+    int e = errno;
+    close(fd);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(e));
   }
   unsigned char *block = malloc(HASH_BLOCK_BYTES);
   if (!block) {
@@ -181,8 +189,10 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
   if (bb_image_read_info(path, NULL, NULL, NULL, &info, &why) != BB_OK) {
     say(reason, cap, "%s", why.message);
   } else {
+    /* A texture's layout (format, mips, VTF flags) is in its provenance. */
     if (provenance_matches(&info, want, reason, cap) &&
-        layout_matches(path, &info, depth, mip_mapped, reason, cap))
+        (bb_path_is_texture_format(path) ||
+         layout_matches(path, &info, depth, mip_mapped, reason, cap)))
       *state = BB_OUTPUT_CURRENT;
     bb_image_info_free(&info);
   }

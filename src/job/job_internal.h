@@ -59,6 +59,9 @@ struct bb_job {
   char *out_dir, *name_template, *depfile, *command, *command_options;
   char *slope_path;
   char *bounce_albedo_file, *brightness_file;
+  char *vmt, *vmt_materials, *vmt_basetexture;
+  char *vmt_text;           /* the material's bytes, made by the plan */
+  size_t vmt_size;
   bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
   bb__job_item *items;
   int count;

@@ -4,6 +4,7 @@
  * machine has left, so a map too large is refused with the figures. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "io/texture.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>
@@ -16,6 +17,20 @@ static double sample_bytes(bb_depth depth, const char *path) {
   case BB_DEPTH_FLOAT: return 4.0;
   default: return bb_path_max_channels(path) == 4 ? 1.0 : 4.0; /* png/tga 8-bit; exr float */
   }
+}
+
+/* An engine texture's encoder (io/texture_write.c): the map's mip chain in
+ * float, made whether it is written or not, and one buffer of the top
+ * level in the file's format. */
+static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,
+                            int w, int h, int channels) {
+  bb_texture_options t = job->options.texture;
+  bb_texture_options_for(&t, kind->name, kind->range);
+  bb_texture_format format;
+  const double top = bb__texture_resolve(path, w, h, channels, &t, &format, NULL) == BB_OK
+                         ? (double)bb__texture_level_bytes(format, w, h)
+                         : 16.0 * w * h; /* refused by the write: the widest format */
+  return (double)w * (double)h * channels * 4.0 * 4.0 / 3.0 + top;
 }
 
 double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
@@ -36,8 +51,13 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
     if (!item->paths[k])
       continue;
-    const int c = bb_output_kind_get((bb_output_kind)k)->channels;
-    const double samples = t * (c ? c : o->basis.count);
+    const bb_output_kind_info *kind = bb_output_kind_get((bb_output_kind)k);
+    const int c = kind->channels ? kind->channels : o->basis.count;
+    const double samples = t * c;
+    if (bb_path_is_texture_format(item->paths[k])) {
+      encode += texture_bytes(job, item->paths[k], kind, w, h, c);
+      continue;
+    }
     const double mips = job->options.mips ? 4.0 / 3.0 : 1.0;
     encode += samples * mips * sample_bytes(job->options.depth, item->paths[k]) +
               (job->options.mips ? samples * mips * 4.0 : 0.0);

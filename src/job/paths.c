@@ -177,21 +177,32 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
                       ".exr or .tif)",
                       o->path, o->kind ? o->kind : "the image", o->channels,
                       bb__extension(o->path, ext, sizeof ext), room);
+    if (bb_path_is_texture_format(o->path) && o->width > 0 && o->channels > 0) {
+      bb_texture_options t;
+      if (o->texture)
+        t = *o->texture;
+      else
+        bb_texture_options_init(&t);
+      bb_texture_options_for(&t, o->kind, o->range);
+      return bb_texture_check(o->path, o->width, o->height, o->channels, &t, err);
+    }
     return BB_OK;
   }
   if (!bb_path_is_writable_format(o->path)) {
     if (!bb__extension(o->path, ext, sizeof ext)[0])
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: no extension to choose the format by (use .png, .tga, .tif, "
-                      ".tiff or .exr)",
+                      ".tiff, .exr, .vtf or .dds)",
                       o->path);
     return bb__fail(err, BB_ERR_ARGUMENT,
-                    "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff or .exr)",
+                    "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff, .exr, .vtf "
+                    "or .dds)",
                     o->path, ext);
   }
   if (!bb_path_supports_depth(o->path, o->depth))
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in .%s files",
-                    o->path, depth_name(o->depth), bb__extension(o->path, ext, sizeof ext));
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in .%s files%s",
+                    o->path, depth_name(o->depth), bb__extension(o->path, ext, sizeof ext),
+                    bb_path_is_texture_format(o->path) ? " (their texture format sets it)" : "");
   return BB_OK;
 }
 

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -29,6 +30,7 @@ void bb_job_options_init(bb_job_options *o) {
   bb_bake_options_init(&o->bake);
   o->channel = BB_CHANNEL_AUTO;
   o->depth = BB_DEPTH_DEFAULT;
+  bb_texture_options_init(&o->texture);
 }
 
 /* ----------------------------------------------------------------- inputs */
@@ -381,17 +383,49 @@ static bb_status check_channels(const bb_job *job, const char *path, int kind, b
                   basis->count, bb__extension(path, ext, sizeof ext), room);
 }
 
+/* The channels a map of kind has (one per basis direction for weights
+ * and ssbump). */
+static int kind_channels(const bb_job *job, int kind) {
+  const int c = bb_output_kind_get((bb_output_kind)kind)->channels;
+  return c ? c : job->options.bake.basis.count;
+}
+
+/* The input's size from its header, when an output is a .vtf or .dds
+ * (whose sizes are checked before the bake); 0 x 0 when there is none or
+ * the header cannot be read (the bake then says why). */
+static void texture_input_size(const bb__job_item *item, int *width, int *height) {
+  *width = *height = 0;
+  int textures = 0;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    textures |= item->paths[k] && bb_path_is_texture_format(item->paths[k]);
+  if (textures && bb_image_read_info(item->input, width, height, NULL, NULL, NULL) != BB_OK)
+    *width = *height = 0;
+}
+
 /* One input's outputs as a single bake checks them. */
 static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
                                     bb_error *err) {
   bb_output_spec specs[BB_JOB_MAX_OUTPUTS];
   int kinds[BB_JOB_MAX_OUTPUTS];
-  int n = 0;
+  int n = 0, width, height;
+  texture_input_size(item, &width, &height);
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
     if (item->paths[k]) {
       kinds[n] = k;
-      specs[n++] = (bb_output_spec){item->paths[k], kind_name(k), 0, job->options.depth,
-                                    job->options.mips, 0};
+      specs[n++] = (bb_output_spec){item->paths[k],
+                                    kind_name(k),
+                                    /* the basis message below is the clearer one
+                                       for other formats */
+                                    bb_path_is_texture_format(item->paths[k])
+                                        ? kind_channels(job, k)
+                                        : 0,
+                                    job->options.depth,
+                                    job->options.mips,
+                                    0,
+                                    width,
+                                    height,
+                                    bb_output_kind_get((bb_output_kind)k)->range,
+                                    &job->options.texture};
     }
   const int maps = n;
   if (job->slope_path) {
@@ -401,11 +435,18 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
                       "%s: the slope map is one byte per texel: use .png, .tga or .tif",
                       job->slope_path);
     kinds[n] = -1;
-    specs[n++] = (bb_output_spec){job->slope_path, "slope", 1, BB_DEPTH_8, 0, 0};
+    specs[n++] = (bb_output_spec){job->slope_path, "slope", 1, BB_DEPTH_8, 0, 0, 0, 0,
+                                  BB_RANGE_UNIT, NULL};
     if (item->slope_lit_path) {
       kinds[n] = -1;
-      specs[n++] = (bb_output_spec){item->slope_lit_path, "slope_lit", 1, job->options.depth, 0, 0};
+      specs[n++] = (bb_output_spec){item->slope_lit_path, "slope_lit", 1, job->options.depth,
+                                    0, 0, 0, 0, BB_RANGE_UNIT, NULL};
     }
+  }
+  if (job->vmt) {
+    kinds[n] = -1;
+    specs[n++] = (bb_output_spec){job->vmt, "material", 0, BB_DEPTH_DEFAULT, 0, 1, 0, 0,
+                                  BB_RANGE_UNIT, NULL};
   }
   const char *reads[BB__JOB_MAX_READS];
   bb_status st = bb_outputs_check(specs, n, reads, bb__job_reads(job, item, reads), err);
@@ -434,6 +475,8 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
       targets[t++] = job->slope_path;
     if (item->slope_lit_path)
       targets[t++] = item->slope_lit_path;
+    if (job->vmt)
+      targets[t++] = job->vmt;
     bb__dep_rule rule = {targets, t, prereq, n_prereq};
     bb_status st = bb__depfile_check_names(path, &rule, 1, err);
     if (st != BB_OK)
@@ -493,6 +536,9 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
                       "--MAP FILE or --slope");
     if (o->maps & ~BB_OUTPUTS_ALL)
       return bb__fail(err, BB_ERR_ARGUMENT, "maps: unknown map bits 0x%x", o->maps);
+    if (o->vmt)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--vmt writes one material: bake one input with --ssbump FILE.vtf");
   } else {
     if (input_count > 1)
       return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
@@ -511,6 +557,9 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
                       "nothing to write: give -o PREFIX or at least one of --normal, "
                       "--weights, --ssbump, --ao, --bent, --filtered, --slope");
   }
+  if ((o->vmt_materials || o->vmt_basetexture) && !o->vmt)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--materials and --basetexture name a material's paths: give --vmt FILE");
   if (strcmp(bb_channel_name(o->channel), "unknown") == 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "unknown height channel %d", (int)o->channel);
   if ((int)o->depth < BB_DEPTH_DEFAULT || o->depth > BB_DEPTH_FLOAT)
@@ -534,6 +583,18 @@ static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *er
   job->slope_path = copy(o->slope_path);
   job->bounce_albedo_file = copy(o->bounce_albedo_file);
   job->brightness_file = copy(o->brightness_file);
+  job->vmt = copy(o->vmt);
+  job->vmt_materials = copy(o->vmt_materials);
+  job->vmt_basetexture = copy(o->vmt_basetexture);
+  if ((o->vmt && !job->vmt) || (o->vmt_materials && !job->vmt_materials) ||
+      (o->vmt_basetexture && !job->vmt_basetexture))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  job->options.vmt = job->vmt;
+  job->options.vmt_materials = job->vmt_materials;
+  job->options.vmt_basetexture = job->vmt_basetexture;
+  job->options.texture.description = NULL; /* each file's own provenance */
+  if (job->options.texture.threads == 0)
+    job->options.texture.threads = o->bake.trace.threads;
   if ((o->bounce_albedo_file && !job->bounce_albedo_file) ||
       (o->brightness_file && !job->brightness_file))
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
@@ -604,6 +665,34 @@ static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err
   return BB_OK;
 }
 
+static int is_vtf(const char *path) {
+  char ext[8];
+  return strcmp(bb__extension(path, ext, sizeof ext), "vtf") == 0;
+}
+
+/* The material of a single input: its bump map is the ssbump .vtf, else
+ * the normal map's .vtf; its text is made now, so a path it cannot name
+ * costs no baking time. */
+static bb_status plan_material(bb_job *job, bb_error *err) {
+  if (!job->vmt)
+    return BB_OK;
+  const size_t len = strlen(job->vmt);
+  if (len < 4 || strcasecmp(job->vmt + len - 4, ".vmt") != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--vmt %s: a Source material's name ends in .vmt",
+                    job->vmt);
+  const bb__job_item *item = &job->items[0];
+  const char *ssbump = item->paths[BB_OUTPUT_SSBUMP], *normal = item->paths[BB_OUTPUT_NORMAL];
+  const int is_ssbump = ssbump && is_vtf(ssbump);
+  const char *bump = is_ssbump ? ssbump : normal && is_vtf(normal) ? normal : NULL;
+  if (!bump)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--vmt %s: a material needs a .vtf bump map: write --ssbump (or --normal) "
+                    "as a .vtf file",
+                    job->vmt);
+  const bb_vmt_options v = {job->vmt_materials, bump, job->vmt_basetexture, is_ssbump};
+  return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
+}
+
 /* Creates out_dir and every directory the outputs' names need. */
 static bb_status create_directories(const bb_job *job, bb_error *err) {
   bb_status st = bb_directory_create(job->out_dir, err);
@@ -634,6 +723,8 @@ static void init_reports(bb_job *job) {
       r->outputs[r->output_count++] = (bb_job_file){"slope", job->slope_path};
     if (item->slope_lit_path)
       r->outputs[r->output_count++] = (bb_job_file){"slope_lit", item->slope_lit_path};
+    if (job->vmt)
+      r->outputs[r->output_count++] = (bb_job_file){"material", job->vmt};
   }
 }
 
@@ -659,6 +750,8 @@ bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_o
     st = name_single(job, o, err);
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK && !job->batch; k++)
     job->options.paths[k] = job->items[0].paths[k]; /* the job's copies */
+  if (st == BB_OK && !job->batch)
+    st = plan_material(job, err);
   for (int i = 0; i < job->count && st == BB_OK && job->batch; i++)
     st = name_outputs(job, &job->items[i], err);
   if (st == BB_OK && job->batch)
@@ -697,6 +790,10 @@ void bb_job_free(bb_job *job) {
   free(job->slope_path);
   free(job->bounce_albedo_file);
   free(job->brightness_file);
+  free(job->vmt);
+  free(job->vmt_materials);
+  free(job->vmt_basetexture);
+  free(job->vmt_text);
   bb_image_free(&job->bounce_albedo_map);
   bb_image_free(&job->brightness_map);
   free(job);

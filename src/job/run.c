@@ -2,12 +2,14 @@
  * up to date skipped, the others read, baked once and written all or
  * nothing with their provenance, and the depfile of what was made. */
 #include "bake/bake_internal.h"
+#include "core/input_file.h"
 #include "core/internal.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const bb_output_kind_info *kind_info(int kind) {
   return bb_output_kind_get((bb_output_kind)kind);
@@ -32,6 +34,24 @@ static bb_status fail_item(bb_job_report *r, bb_status st, const bb_error *e) {
   return st;
 }
 
+/* 1 when the material file holds the bytes the plan made for it. */
+static int material_is_current(const bb_job *job) {
+  int fd;
+  if (bb__input_open(job->vmt, &fd, NULL) != BB_OK) /* a FIFO is not waited on */
+    return 0;
+  FILE *f = fdopen(fd, "rb");
+  if (!f) {
+    close(fd);
+    return 0;
+  }
+  char *have = malloc(job->vmt_size + 1);
+  const size_t n = have ? fread(have, 1, job->vmt_size + 1, f) : 0;
+  const int same = have && n == job->vmt_size && memcmp(have, job->vmt_text, n) == 0;
+  free(have);
+  fclose(f);
+  return same;
+}
+
 /* 1 when every map of item is what baking it now would write, judged from
  * the files' headers; reason says why not. */
 static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, size_t cap) {
@@ -52,13 +72,17 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
     if (!item->paths[k])
       continue;
+    /* A texture's settings are part of its provenance (bb_image_write adds them). */
+    char *texture = bb_texture_provenance(item->paths[k], &job->options.texture);
     bb_provenance want = {NULL, NULL, 0, kind_info(k)->name, &o, job->options.channel,
-                          rayset[0] ? rayset : NULL, item->file_hash, NULL};
+                          rayset[0] ? rayset : NULL, item->file_hash, texture};
     bb_output_state state;
     const bb_depth depth = output_depth(job, k, item->paths[k], bits, is_float);
     char why[200] = "";
-    if (bb_output_check(item->paths[k], &want, depth, job->options.mips, &state, why,
-                        sizeof why, NULL) != BB_OK) {
+    const bb_status checked = bb_output_check(item->paths[k], &want, depth, job->options.mips,
+                                              &state, why, sizeof why, NULL);
+    free(texture);
+    if (checked != BB_OK) {
       snprintf(reason, cap, "%s: cannot be checked", item->paths[k]);
       return 0;
     }
@@ -66,6 +90,10 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
       snprintf(reason, cap, "%s: %s", item->paths[k], why);
       return 0;
     }
+  }
+  if (job->vmt && !material_is_current(job)) {
+    snprintf(reason, cap, "%s: not the material this bake writes", job->vmt);
+    return 0;
   }
   reason[0] = '\0';
   return 1;
@@ -153,7 +181,7 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   char *command = bb__job_command_of(job, item);
   if (!command)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
-  bb_output_file files[BB_JOB_MAX_OUTPUTS + 1];
+  bb_output_file files[BB_JOB_MAX_OUTPUTS + 1]; /* the maps, slope files, material, depfile */
   int n = 0;
   bb_status st = BB_OK;
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
@@ -169,7 +197,8 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
                                 job->options.mips,
                                 b->descriptions[n],
                                 NULL,
-                                0};
+                                0,
+                                &job->options.texture};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
@@ -178,7 +207,7 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   if (st == BB_OK && b->slope.pixels) {
     b->descriptions[n] = describe(job, command, b, r, "slope");
     files[n] = (bb_output_file){job->slope_path, "slope", &b->slope, BB_RANGE_UNIT,
-                                BB_DEPTH_8, 0, b->descriptions[n], NULL, 0};
+                                BB_DEPTH_8, 0, b->descriptions[n], NULL, 0, NULL};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
@@ -186,11 +215,14 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
     b->descriptions[n] = describe(job, command, b, r, "slope_lit");
     files[n] = (bb_output_file){item->slope_lit_path, "slope_lit", &b->slope_lit,
                                 BB_RANGE_UNIT, job->options.depth, 0, b->descriptions[n],
-                                NULL, 0};
+                                NULL, 0, NULL};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
   free(command);
+  if (st == BB_OK && job->vmt)
+    files[n++] = (bb_output_file){job->vmt, "material", NULL, BB_RANGE_UNIT, BB_DEPTH_DEFAULT,
+                                  0, NULL, job->vmt_text, job->vmt_size, NULL};
   if (st == BB_OK && job->depfile && !job->batch) {
     /* One input's depfile goes in with its maps: all of them or none. */
     const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
@@ -200,7 +232,7 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
     else
       files[n++] = (bb_output_file){job->depfile, "depfile", NULL, BB_RANGE_UNIT,
-                                    BB_DEPTH_DEFAULT, 0, NULL, b->depfile_text, size};
+                                    BB_DEPTH_DEFAULT, 0, NULL, b->depfile_text, size, NULL};
   }
   const double t0 = bb__now_seconds();
   if (st == BB_OK)

@@ -110,7 +110,19 @@ static void stage_one(void *user, int item) {
     s->status = stage_text(o, &s->handle, &s->error);
     return;
   }
-  const bb_write_options wo = {o->depth, o->range, o->description};
+  if (bb_path_is_texture_format(o->path)) {
+    /* A texture makes its own chain (its mips option), as the map its kind is. */
+    bb_texture_options t;
+    if (o->texture)
+      t = *o->texture;
+    else
+      bb_texture_options_init(&t);
+    bb_texture_options_for(&t, o->kind, o->range);
+    const bb_write_options wo = {o->depth, o->range, o->description, &t};
+    s->status = bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
+    return;
+  }
+  const bb_write_options wo = {o->depth, o->range, o->description, NULL};
   s->status = o->mips ? stage_mips(o, &wo, &s->handle, &s->error)
                       : bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
 }

@@ -68,8 +68,9 @@ bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump
         height_path && bb_path_supports_depth(height_path, BB_DEPTH_16) ? BB_DEPTH_16
                                                                          : BB_DEPTH_DEFAULT;
     const bb_output_file files[2] = {
-        {normal_path, "normal", &normal, range, BB_DEPTH_DEFAULT, 0, texts[0], NULL, 0},
-        {height_path, "height", &r->height, BB_RANGE_UNIT, height_depth, 0, texts[1], NULL, 0}};
+        {normal_path, "normal", &normal, range, BB_DEPTH_DEFAULT, 0, texts[0], NULL, 0, NULL},
+        {height_path, "height", &r->height, BB_RANGE_UNIT, height_depth, 0, texts[1], NULL, 0,
+         NULL}};
     st = bb_outputs_write(files, height_path ? 2 : 1, 2, err);
   }
   free(texts[0]);

@@ -178,26 +178,6 @@ typedef struct rules {
   double theta_x[THETA_NODES], theta_w[THETA_NODES];
 } rules;
 
-static void gauss_legendre(int n, double *x, double *w) {
-  for (int i = 0; i < n; i++) {
-    double z = cos(BB__PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
-    for (int iteration = 0; iteration < 100; iteration++) {
-      double p0 = 1.0, p1 = 0.0;
-      for (int k = 1; k <= n; k++) {
-        const double p2 = p1;
-        p1 = p0;
-        p0 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p2) / k;
-      }
-      dp = n * (z * p0 - p1) / (z * z - 1.0);
-      const double step = p0 / dp;
-      z -= step;
-      if (fabs(step) < 1e-16) break;
-    }
-    x[i] = z;
-    w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-  }
-}
-
 typedef struct lobe_ring {
   const rules *r;
   double rho, beta, bz, power; /* B's horizontal length and azimuth, B_z, P */
@@ -348,8 +328,8 @@ static bb_status vtables_build(const bb_rayset *rs, int threads, vtables *t, bb_
   t->total = malloc((size_t)rs->slice_count * 3 * (size_t)t->channels * sizeof(double));
   if (!t->coef || !t->total) return bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
   rules r;
-  gauss_legendre(RING_NODES, r.ring_x, r.ring_w);
-  gauss_legendre(THETA_NODES, r.theta_x, r.theta_w);
+  bb__gauss_legendre(RING_NODES, r.ring_x, r.ring_w);
+  bb__gauss_legendre(THETA_NODES, r.theta_x, r.theta_w);
   table_job job = {rs, t, &r};
   bb_status st = bb__parallel_for(rs->slice_count, threads, build_slice, &job, NULL, NULL, err);
   for (int s = 0; s < rs->slice_count; s++) /* in slice order, whatever the threads did */

@@ -48,8 +48,7 @@
  * most MAX_DEPTH times: smooth pieces (every piece at power 1) never are. */
 enum { GL_LOW = 7, GL_HIGH = 14, MAX_DEPTH = 12 };
 
-/* Nodes x and weights w of the n-point rule on [-1, 1] (Newton on P_n). */
-static void gauss_legendre(int n, double *x, double *w) {
+void bb__gauss_legendre(int n, double *x, double *w) {
   for (int i = 0; i < n; i++) {
     double z = cos(BB__PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
     for (int iteration = 0; iteration < 100; iteration++) {
@@ -74,8 +73,8 @@ typedef struct rules {
 } rules;
 
 static void rules_init(rules *r) {
-  gauss_legendre(GL_LOW, r->xl, r->wl);
-  gauss_legendre(GL_HIGH, r->xh, r->wh);
+  bb__gauss_legendre(GL_LOW, r->xl, r->wl);
+  bb__gauss_legendre(GL_HIGH, r->xh, r->wh);
 }
 
 typedef double (*integrand_fn)(const void *ctx, double x);

@@ -24,6 +24,10 @@ double bb__lobe_blocked_exact(double lo, double hi, const double b[3], double po
                               double tan_horizon);
 double bb__ao_blocked(double lo, double hi, double tan_horizon);
 
+/* Nodes x[0..n-1] and weights w[0..n-1] of the n-point Gauss-Legendre rule
+ * on [-1, 1] (Newton on P_n, to 1e-16). */
+void bb__gauss_legendre(int n, double *x, double *w);
+
 /* One slice's integration, gathered for the inner loops. */
 typedef struct bb__slice_integral {
   const double *table; /* the slice's table (layout in integrate.c) */

@@ -240,7 +240,7 @@ Test(basis, files_load_and_bad_files_are_refused) {
   char missing[300];
   snprintf(missing, sizeof missing, "%s/missing.txt", dir);
   cr_assert_eq(bb_basis_load(missing, &b, &err), BB_ERR_IO);
-  cr_assert(strstr(err.message, missing) && strstr(err.message, "No such file"), "%s",
+  cr_assert(strstr(err.message, missing) && strstr(err.message, "no such file"), "%s",
             err.message);
 
   const char nul[] = "0 0 1\n1 0 1\0\n0 1 1\n";

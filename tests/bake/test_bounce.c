@@ -501,7 +501,7 @@ Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 120) {
   bb_bake_options o = options(8.0f, 256, 0.6);
   o.normal_filter = BB_NORMAL_VALVE;
   bb_bake_result r = harness_bake(&h, &o);
-  const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL};
+  const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(ao, &r.ao, &wo, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_image_write(ss, &r.ssbump, &wo, &err), BB_OK, "%s", err.message);
   snprintf(pair, sizeof pair, "bake=%s,%s", ao, ss);

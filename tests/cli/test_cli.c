@@ -54,7 +54,7 @@ static void write_image(const char *path, int w, int h, int channels, texel_fn v
     for (int x = 0; x < w; x++)
       for (int c = 0; c < channels; c++)
         bb_image_texel(&img, x, y)[c] = value(x, y, c);
-  bb_write_options o = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL};
+  bb_write_options o = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
 }
@@ -187,10 +187,10 @@ Test(cli, usage_errors_exit_2_with_a_message) {
       {{"bake", in, "--scale", "1", "--basis", "hl3", "-o", tmp("p")}, "--basis"},
       {{"bake", in, "--scale", "1"}, "nothing to write"},
       {{"bake", in, "--scale", "1", "--ao", tmp("ao.jpg2")},
-       "unknown output format '.jpg2' (use .png, .tga, .tif, .tiff or .exr)"},
+       "unknown output format '.jpg2' (use .png, .tga, .tif, .tiff, .exr, .vtf or .dds)"},
       /* No extension at all is said so, not shown as an extension '.'. */
       {{"bake", in, "--scale", "1", "--ao", tmp("ao")},
-       "ao: no extension to choose the format by (use .png, .tga, .tif, .tiff or .exr)"},
+       "ao: no extension to choose the format by (use .png, .tga, .tif, .tiff, .exr, .vtf or .dds)"},
       {{"bake", in, "--scale", "1", "--ao", tmp("ao.exr"), "--depth", "16"}, "--depth"},
       {{"bake", "--scale", "1", "-o", tmp("p")}, "HEIGHT"},
       {{"height2ssbump", in}, "BUMPSCALE"},
@@ -652,7 +652,7 @@ Test(cli, filtered_keeps_the_input_depth) {
   cr_assert_eq(bb_image_alloc(&h, 16, 16, 1, NULL), BB_OK);
   for (int i = 0; i < 256; i++)
     h.pixels[i] = (float)(i * 97 % 256) / 255.0f + 1.0f / 65535.0f * (float)(i % 7);
-  bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL};
+  bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(in, &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   const struct {

@@ -26,7 +26,7 @@ static void write_height(const char *path, int side) {
     img.pixels[i] = (float)(0.5 + 0.3 * sin(x * 0.05) * cos(y * 0.04) +
                             0.2 * (double)(s >> 11) / 9007199254740992.0);
   }
-  bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL};
+  bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(path, &img, &wo, NULL), BB_OK);
   bb_image_free(&img);
 }

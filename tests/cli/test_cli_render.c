@@ -227,12 +227,12 @@ Test(cli_render, usage_errors) {
   expect_no_new_files(0);
 }
 
-/* Checked once the size is known, before the bake: 8 x 1025 squared is over
- * the 8192 x 8192 maximum. */
+/* Checked once the size is known, before the bake: 8 x 4097 squared is over
+ * the 32768 x 32768 maximum. */
 Test(cli_render, tiles_over_the_maximum) {
   bb_image h;
   cr_assert_eq(bb_image_alloc(&h, 4097, 4097, 1, NULL), BB_OK);
-  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL};
+  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   cli_result r =

@@ -241,7 +241,7 @@ Test(hostile, printed_text_never_drives_the_terminal) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
-                               "bumpbake_version=x\ncommand=\x1b]0;pwned\x07\x1b[31mred\xff\n"};
+                               "bumpbake_version=x\ncommand=\x1b]0;pwned\x07\x1b[31mred\xff\n", NULL};
   cr_assert_eq(bb_image_write(tmp("e.png"), &img, &wo, NULL), BB_OK);
   const char *name = "bad\x1b[2J\xff.png";
   cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);

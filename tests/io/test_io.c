@@ -1,4 +1,4 @@
-/* test_io.c: image file reading and writing (src/io_oiio.cpp) against real files. */
+/* test_io.c: image file reading and writing (src/io/) against real files. */
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
@@ -119,7 +119,7 @@ static bb_image make_image(int w, int h, int c, float lo, float hi, uint32_t see
 }
 
 static bb_write_options options(bb_depth depth, bb_range range, const char *description) {
-  bb_write_options o = {depth, range, description};
+  bb_write_options o = {depth, range, description, NULL};
   return o;
 }
 
@@ -980,7 +980,7 @@ Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
 }
 
 /* The writers added since: mip-mapped TIFF (written by name and read back,
- * see io_oiio.cpp) and EXR, the animated GIF and the mesh formats, cut off
+ * see src/io/oiio_mips.cpp) and EXR, the animated GIF and the mesh formats, cut off
  * at nothing, half way and one byte short like every image format above. */
 Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
   bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 47);
@@ -1158,17 +1158,26 @@ Test(io, tempfiles_remove_takes_pending_temporaries_only) {
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("done.png"), &img, NULL, &err), BB_OK, "%s",
                err.message);
-  bb_staged_file *a = NULL, *b = NULL;
+  bb_staged_file *a = NULL, *b = NULL, *m = NULL;
   cr_assert_eq(bb_image_write_staged(tmp_path("a.tif"), &img, NULL, &a, &err), BB_OK);
   cr_assert_eq(bb_image_write_staged(tmp_path("b.exr"), &img, NULL, &b, &err), BB_OK);
-  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 2);
+  /* A mip-mapped TIFF waits in a private directory of its own. */
+  bb_image *chain = NULL;
+  int levels = 0;
+  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &levels, &err), BB_OK);
+  cr_assert_eq(bb_image_write_mips_staged(tmp_path("m.tif"), chain, levels, NULL, &m, &err),
+               BB_OK, "%s", err.message);
+  cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 3);
   bb_tempfiles_remove();
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   cr_assert(file_exists(tmp_path("done.png")));
   /* The handles are still freed normally; their commit now fails. */
   cr_assert_eq(bb_staged_file_commit(a, &err), BB_ERR_IO);
+  cr_assert_eq(bb_staged_file_commit(m, &err), BB_ERR_IO);
   bb_staged_file_discard(b);
   cr_assert_not(file_exists(tmp_path("a.tif")));
+  cr_assert_not(file_exists(tmp_path("m.tif")));
+  bb_mip_chain_free(chain, levels);
   bb_image_free(&img);
 }
 

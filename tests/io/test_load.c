@@ -344,7 +344,7 @@ Test(load, empty_image_is_refused) {
 /* ------------------------------------------------------- rule on files */
 
 static void write_file(const char *name, const bb_image *img, bb_depth depth) {
-  bb_write_options o = {depth, BB_RANGE_UNIT, NULL};
+  bb_write_options o = {depth, BB_RANGE_UNIT, NULL, NULL};
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path(name), img, &o, &err), BB_OK, "%s", err.message);
 }

@@ -338,7 +338,7 @@ Test(provenance, survives_a_tga_file_as_whole_lines) {
   snprintf(path, sizeof path, "%s/p.tga", dir);
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 4, NULL), BB_OK);
-  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, text};
+  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, text, NULL};
   bb_error err = {{0}};
   cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image back = {0};

@@ -28,7 +28,12 @@ static void remove_dir(void) {
     if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
     char path[512];
     snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-    unlink(path);
+    if (unlink(path) != 0) { /* a private directory and its staged file */
+      char inner[600];
+      snprintf(inner, sizeof inner, "%s/staged.tif", path);
+      unlink(inner);
+      rmdir(path);
+    }
   }
   closedir(d);
   rmdir(dir);
@@ -61,6 +66,34 @@ static void killed_writer(const char *path) {
     bb_image img = small();
     bb_staged_file *f = NULL;
     if (bb_image_write_staged(path, &img, NULL, &f, NULL) != BB_OK) _exit(3);
+    raise(SIGKILL);
+    _exit(4);
+  }
+  int status = 0;
+  cr_assert_eq(waitpid(pid, &status, 0), pid);
+  cr_assert(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL, "status %d", status);
+}
+
+/* A mip-mapped TIFF staged through a private directory (OpenImageIO's
+ * TIFF writer opens its file by name): *f, to commit or discard. */
+static bb_status stage_tiff_mips(const char *path, bb_staged_file **f) {
+  bb_image img = small(), *levels = NULL;
+  int count = 0;
+  bb_status st = bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count, NULL);
+  if (st == BB_OK) st = bb_image_write_mips_staged(path, levels, count, NULL, f, NULL);
+  bb_mip_chain_free(levels, count);
+  bb_image_free(&img);
+  return st;
+}
+
+/* A child that stages a mip-mapped TIFF and dies by SIGKILL: its private
+ * directory, with the file in it, stays behind. */
+static void killed_private_writer(const char *path) {
+  const pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    bb_staged_file *f = NULL;
+    if (stage_tiff_mips(path, &f) != BB_OK) _exit(3);
     raise(SIGKILL);
     _exit(4);
   }
@@ -147,4 +180,34 @@ Test(sweep, refuses_a_missing_directory) {
             err.message);
   cr_assert_eq(removed, 0);
   cr_assert_eq(bb_tempfiles_sweep(NULL, NULL, &err), BB_ERR_ARGUMENT);
+}
+
+Test(sweep, removes_the_private_directories_killed_writers_left, .init = make_dir,
+     .fini = remove_dir) {
+  char path[512], live[512], inner[600];
+  snprintf(path, sizeof path, "%s/killed.tif", dir);
+  killed_private_writer(path);
+  cr_assert_eq(temporaries(), 1, "the killed writer left its private directory");
+  DIR *d = opendir(dir);
+  cr_assert_not_null(d);
+  for (struct dirent *e; (e = readdir(d));)
+    if (strncmp(e->d_name, ".bb-tmp-", 8) == 0) {
+      snprintf(inner, sizeof inner, "%s/%s/staged.tif", dir, e->d_name);
+      cr_assert_eq(access(inner, F_OK), 0, "with the file in it: %s", inner);
+    }
+  closedir(d);
+  /* one being written here stays */
+  snprintf(live, sizeof live, "%s/live.tif", dir);
+  bb_staged_file *mine = NULL;
+  cr_assert_eq(stage_tiff_mips(live, &mine), BB_OK);
+  cr_assert_eq(temporaries(), 2);
+
+  int removed = -1;
+  bb_error err;
+  cr_assert_eq(bb_tempfiles_sweep(dir, &removed, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(removed, 1);
+  cr_assert_eq(temporaries(), 1, "the live writer's directory stays");
+  cr_assert_eq(bb_staged_file_commit(mine, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(temporaries(), 0);
+  cr_assert_eq(access(live, F_OK), 0);
 }

@@ -208,7 +208,7 @@ Test(mips, files_hold_every_level) {
   for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
     const char *path = temp_path(files[f].ext);
     cr_assert(bb_path_supports_mips(path));
-    bb_write_options o = {files[f].depth, BB_RANGE_UNIT, "test=1\n"};
+    bb_write_options o = {files[f].depth, BB_RANGE_UNIT, "test=1\n", NULL};
     bb_error err;
     cr_assert_eq(bb_image_write_mips(path, levels, count, &o, &err), BB_OK, "%s",
                  err.message);

@@ -1,0 +1,130 @@
+/* hostile_headers.h: small files whose headers declare what their readers
+ * would allocate before any size check of bumpbake's (issue 22, #5), made
+ * here so no binary is committed. Each writer returns 0 on success.
+ * Little-endian helpers come from hostile_tiff.h. */
+#ifndef BB_TESTS_HOSTILE_HEADERS_H
+#define BB_TESTS_HOSTILE_HEADERS_H
+
+#include "hostile_tiff.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+static inline int hostile_write(const char *path, const unsigned char *bytes, size_t n) {
+  FILE *f = fopen(path, "wb");
+  if (!f) return -1;
+  size_t written = fwrite(bytes, 1, n, f);
+  return (fclose(f) == 0 && written == n) ? 0 : -1;
+}
+
+/* A progressive JPEG (SOF2) of one component declaring width x height: a
+ * quantisation table, a one-code Huffman table and a DC scan of 8 zero
+ * bytes (126 bytes). libjpeg buffers a progressive image whole, 2 bytes a
+ * texel: 8 GiB for 65500 x 65500. */
+static inline int write_progressive_jpeg(const char *path, unsigned width, unsigned height) {
+  unsigned char b[160];
+  size_t n = 0;
+  b[n++] = 0xFF, b[n++] = 0xD8;                        /* SOI */
+  b[n++] = 0xFF, b[n++] = 0xDB, b[n++] = 0, b[n++] = 67; /* DQT */
+  b[n++] = 0;
+  for (int i = 0; i < 64; i++) b[n++] = 1;
+  b[n++] = 0xFF, b[n++] = 0xC2, b[n++] = 0, b[n++] = 11; /* SOF2: progressive */
+  b[n++] = 8;
+  b[n++] = (unsigned char)(height >> 8), b[n++] = (unsigned char)height;
+  b[n++] = (unsigned char)(width >> 8), b[n++] = (unsigned char)width;
+  b[n++] = 1, b[n++] = 1, b[n++] = 0x11, b[n++] = 0;   /* one component, 1x1 sampling */
+  b[n++] = 0xFF, b[n++] = 0xC4, b[n++] = 0, b[n++] = 20; /* DHT: DC table 0, one code */
+  b[n++] = 0x00, b[n++] = 1;
+  for (int i = 1; i < 16; i++) b[n++] = 0;
+  b[n++] = 0;
+  b[n++] = 0xFF, b[n++] = 0xDA, b[n++] = 0, b[n++] = 8;  /* SOS: the DC scan */
+  b[n++] = 1, b[n++] = 1, b[n++] = 0x00, b[n++] = 0, b[n++] = 0, b[n++] = 0;
+  for (int i = 0; i < 8; i++) b[n++] = 0;
+  b[n++] = 0xFF, b[n++] = 0xD9;                        /* EOI */
+  return hostile_write(path, b, n);
+}
+
+/* A tiled TIFF of width x height, one 8-bit channel, declaring tiles of
+ * tile_w x tile_h (16 bytes of data follow): libtiff and OpenImageIO
+ * decode a whole tile at a time, however small the image. */
+static inline int write_tiled_tiff(const char *path, uint32_t width, uint32_t height,
+                                   uint32_t tile_w, uint32_t tile_h) {
+  const struct {
+    unsigned tag, type;
+    uint32_t value;
+  } entries[] = {
+      {256, 4, width},  {257, 4, height}, {258, 3, 8},      {259, 3, 1},
+      {262, 3, 1},      {277, 3, 1},      {284, 3, 1},      {322, 4, tile_w},
+      {323, 4, tile_h}, {324, 4, 0},      {325, 4, 16},
+  };
+  enum { N = sizeof entries / sizeof entries[0] };
+  unsigned char b[8 + 2 + 12 * N + 4 + 16];
+  memset(b, 0, sizeof b);
+  memcpy(b, "II*\0", 4);
+  hostile_put32(b + 4, 8);
+  hostile_put16(b + 8, N);
+  const uint32_t data = 8 + 2 + 12 * N + 4;
+  for (unsigned i = 0; i < N; i++) {
+    unsigned char *e = b + 10 + 12 * i;
+    uint32_t value = entries[i].tag == 324 ? data : entries[i].value; /* TileOffsets */
+    hostile_put16(e, entries[i].tag);
+    hostile_put16(e + 2, entries[i].type);
+    hostile_put32(e + 4, 1);
+    if (entries[i].type == 3)
+      hostile_put16(e + 8, (unsigned)value);
+    else
+      hostile_put32(e + 8, value);
+  }
+  return hostile_write(path, b, sizeof b);
+}
+
+/* An OpenEXR file whose first attribute, a string "comment", declares
+ * `declared` bytes and holds 64 (91 bytes): OpenEXR's C++ reader
+ * allocates the declared size before it reads a byte of it. */
+static inline int write_exr_with_huge_attribute(const char *path, uint32_t declared) {
+  unsigned char b[91];
+  size_t n = 0;
+  const unsigned char magic[] = {0x76, 0x2F, 0x31, 0x01, 2, 0, 0, 0};
+  memcpy(b, magic, sizeof magic), n += sizeof magic;
+  memcpy(b + n, "comment\0string\0", 15), n += 15;
+  hostile_put32(b + n, declared), n += 4;
+  memset(b + n, 'x', sizeof b - n);
+  return hostile_write(path, b, sizeof b);
+}
+
+/* An OpenEXR file whose first attribute has no type name and declares
+ * `declared` bytes (the load fuzzer's first find): OpenEXR's C++ reader
+ * takes it for an opaque attribute and allocates the declared size;
+ * OpenEXRCore reports it and skips it. */
+static inline int write_exr_with_untyped_attribute(const char *path, uint32_t declared) {
+  unsigned char b[86];
+  size_t n = 0;
+  const unsigned char magic[] = {0x76, 0x2F, 0x31, 0x01, 2, 0, 0, 0};
+  memcpy(b, magic, sizeof magic), n += sizeof magic;
+  memcpy(b + n, "junk\0\0", 6), n += 6; /* name "junk", type "" */
+  hostile_put32(b + n, declared), n += 4;
+  memset(b + n, 'x', sizeof b - n);
+  return hostile_write(path, b, sizeof b);
+}
+
+/* A GIF whose logical screen and one image are width x height, with a
+ * two-colour table and an LZW stream that ends at once (35 bytes):
+ * OpenImageIO allocates a canvas of width x height x 4 bytes to open it. */
+static inline int write_gif_screen(const char *path, unsigned width, unsigned height) {
+  unsigned char b[35];
+  size_t n = 0;
+  memcpy(b, "GIF89a", 6), n = 6;
+  hostile_put16(b + n, width), hostile_put16(b + n + 2, height), n += 4;
+  b[n++] = 0x80, b[n++] = 0, b[n++] = 0;          /* global table of 2 colours */
+  b[n++] = 0, b[n++] = 0, b[n++] = 0, b[n++] = 0xFF, b[n++] = 0xFF, b[n++] = 0xFF;
+  b[n++] = 0x2C;                                  /* image descriptor */
+  hostile_put16(b + n, 0), hostile_put16(b + n + 2, 0), n += 4;
+  hostile_put16(b + n, width), hostile_put16(b + n + 2, height), n += 4;
+  b[n++] = 0;
+  b[n++] = 2, b[n++] = 2, b[n++] = 0x44, b[n++] = 0x01, b[n++] = 0; /* LZW data */
+  b[n++] = 0x3B;                                  /* trailer */
+  return hostile_write(path, b, n);
+}
+
+#endif /* BB_TESTS_HOSTILE_HEADERS_H */
