@@ -2395,9 +2395,10 @@ bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
  * command or command_options records it: "bumpbake bake INPUT" and then
  * every option that differs from its default, in the order of `bumpbake
  * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
- * --maps normal,ao --name T). A CLI invocation typed this way records the
- * same text, so the same job through the CLI and through Python writes the
- * same bytes. malloc'd; NULL when out of memory. */
+ * --maps normal,ao --name T --texture-format dxt5 --vmt FILE). A CLI
+ * invocation typed this way records the same text, so the same job through
+ * the CLI and through Python writes the same bytes. malloc'd; NULL when out
+ * of memory. */
 char *bb_job_command_text(const bb_job_options *o, const char *input);
 
 /* --------------------------------------------------- up-to-date checks */

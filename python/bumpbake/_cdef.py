@@ -497,6 +497,8 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const char *bb_depth_name(bb_depth depth);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
+bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
+const char *bb_texture_format_name(bb_texture_format format);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,

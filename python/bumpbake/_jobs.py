@@ -43,6 +43,36 @@ class BakeReport:
         return self.status in ("baked", "up to date")
 
 
+def _texture_options(o, a, c):
+    """The .vtf/.dds settings and the Source material of BakeJob's
+    arguments a into bb_job_options o (c keeps a C string alive)."""
+    t = o.texture
+    if a["texture_format"] is not None:
+        f = _ffi.new("bb_texture_format *")
+        err = _ffi.new("bb_error *")
+        if _lib.bb_texture_format_parse(str(a["texture_format"]).encode(), f, err) != _lib.BB_OK:
+            raise _argument_error(f"bake: texture_format: {_text(err.message)}")
+        t.format = f[0]
+    version = a["vtf_version"]
+    if version is not None:
+        text = str(version)
+        minor = text[2:] if text.startswith("7.") else text
+        if not minor.isdigit() or not 2 <= int(minor) <= 5:
+            raise _argument_error(f"bake: vtf_version must be 7.2, 7.3, 7.4 or 7.5 (or 2 to 5; "
+                                  f"got {version!r})")
+        t.vtf_version = int(minor)
+    flags = a["vtf_flags"]
+    if flags is not None:
+        if isinstance(flags, bool) or not isinstance(flags, int) or not 0 <= flags <= 0xFFFFFFFF:
+            raise _argument_error(f"bake: vtf_flags must be a 32-bit integer (got {flags!r})")
+        t.vtf_flags = flags
+    t.mips = 0 if a["nomip"] else 1
+    t.fast = 1 if a["fast_compression"] else 0
+    for key in ("vmt", "vmt_materials", "vmt_basetexture"):
+        if a[key] is not None:
+            setattr(o, key, c(_path(a[key], key)))
+
+
 def _report(r, status=None):
     out = BakeReport(input=_text(r.input), status=status or _OUTCOMES[r.outcome],
                      outputs={_text(r.outputs[k].kind): _text(r.outputs[k].path)
@@ -86,7 +116,9 @@ class BakeJob:
     def __init__(self, inputs, out_dir=None, *, maps=None, name=None, outputs=None,
                  prefix=None, slope=None, lit=None, force=False, keep_going=False,
                  depfile=None, depth=None, mips=False, channel="auto", scale=None,
-                 notes="warn", command=None, command_options=None, _trace=None, **options):
+                 notes="warn", command=None, command_options=None, texture_format=None,
+                 vtf_version=None, vtf_flags=None, nomip=False, fast_compression=False,
+                 vmt=None, vmt_materials=None, vmt_basetexture=None, _trace=None, **options):
         for key in options:
             if key not in BAKE_PARAMETERS:
                 raise TypeError(f"bake: unexpected keyword argument {key!r}")
@@ -94,7 +126,11 @@ class BakeJob:
                           slope=slope, lit=lit, force=force, keep_going=keep_going,
                           depfile=depfile, depth=depth, mips=mips, channel=channel,
                           scale=scale, notes=notes, command=command,
-                          command_options=command_options, **options)
+                          command_options=command_options, texture_format=texture_format,
+                          vtf_version=vtf_version, vtf_flags=vtf_flags, nomip=nomip,
+                          fast_compression=fast_compression, vmt=vmt,
+                          vmt_materials=vmt_materials, vmt_basetexture=vmt_basetexture,
+                          **options)
         self._notes_policy = _check_notes(notes)
         self._trace = _trace  # a bb_trace_fn callback, kept alive with the job
         if isinstance(inputs, (str, bytes, os.PathLike)):
@@ -123,6 +159,7 @@ class BakeJob:
                     raise TypeError(f"bake: {key} must be a str (got {a[key]!r})")
                 setattr(o, key, c(a[key]))
         o.basis_file = c(basis_file)
+        _texture_options(o, a, c)
         o.channel = _channel(a["channel"])
         o.depth = _depth(a["depth"])
         o.mips = int(bool(a["mips"]))

@@ -5,6 +5,8 @@ process's bake bit for bit; a worker killed in the middle of a batch
 changes nothing of the result."""
 
 import os
+import re
+import shutil
 import signal
 import time
 
@@ -34,12 +36,13 @@ def client():
         yield c
 
 
-def heights(directory, count, side=40):
-    """count small, different height files (16-bit PNG): smooth bumps with
-    noise, so every map shadows."""
+def heights(directory, count, side=40, width=None):
+    """count small, different height files (16-bit PNG) of side rows and
+    width columns (side + 8 by default): smooth bumps with noise, so every
+    map shadows."""
     os.makedirs(directory, exist_ok=True)
     rng = np.random.default_rng(20240611)
-    y, x = np.mgrid[0:side, 0:side + 8].astype(np.float64)
+    y, x = np.mgrid[0:side, 0:width or side + 8].astype(np.float64)
     for i in range(count):
         h = 0.5 + 0.3 * np.sin(x * (0.2 + 0.01 * i)) * np.cos(y * 0.17) + 0.2 * rng.random(x.shape)
         bumpbake.write(os.path.join(directory, f"h{i:02d}.png"), h.astype(np.float32),
@@ -244,6 +247,12 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     bad = cli("bake", "heights/h01.png", "heights/h02.png", "--scale", "16", "--scheduler",
               address, "-o", "x", check=False)
     assert bad.returncode == 2 and "several HEIGHT files need --out-dir DIR" in bad.stderr
+    # what the cluster does not bake is refused, saying so, before anything
+    refused = cli("bake", "heights/h01.png", "--scale", "16", "--bounce", "0.5", "-o", "b/m",
+                  "--scheduler", address, check=False)
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1
+    assert "--bounce is not available with --scheduler" in refused.stderr
+    assert not os.path.exists("b")
 
 
 def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, client, cli):
@@ -273,3 +282,60 @@ def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, cl
         assert time.monotonic() < deadline, f"still running: {running()}"
         time.sleep(0.05)
     assert sorted(os.listdir(".")) == ["h00.png"], "an output was written"
+
+
+def test_the_cli_knows_every_option_of_the_c_program(cli):
+    """--scheduler re-reads the C program's arguments in Python, with
+    getopt's prefixes: the two must know the same options to read a
+    prefix the same way."""
+    from bumpbake.dask import _cli
+    help_text = cli("bake", "--help").stdout
+    c_options = set(re.findall(r"^\s+(?:-\w, )?--([a-z-]+)", help_text, re.M))
+    assert c_options == set(_cli._VALUED + _cli._FLAGS + _cli._NOT_ON_A_CLUSTER)
+
+
+def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, client, cli):
+    """.vtf and .dds outputs with their settings and a Source material,
+    through `bake --scheduler` (a batch and a split single map) and
+    through bake_files: the bytes of the same command on one machine."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 4, side=32, width=64)  # Source textures: powers of two
+    address = client.scheduler.address
+    batch = ["bake", "heights", "--scale", "16", "--slices", "8", "--out-dir", "out", "--maps",
+             "normal,ssbump", "--name", "{stem}_{kind}.vtf", "--vtf-version", "7.3",
+             "--texture-format", "dxt5", "--vtf-flags", "0x4"]
+    out = cli(*batch, "--scheduler", address)
+    assert "wrote ssbump out/h02_ssbump.vtf" in out.stdout
+    os.rename("out", "out_dask")
+    cli(*batch)
+    ours, theirs = files_of("out_dask"), files_of("out")
+    assert sorted(ours) == sorted(theirs) and len(ours) == 8
+    assert not [n for n in ours if ours[n] != theirs[n]], "not the CLI batch's bytes"
+    assert b"bumpbake" in ours["h02_ssbump.vtf"], "7.3 keeps the provenance"
+
+    # the Python API, typed as command_text spells it
+    shutil.rmtree("out")
+    options = dict(scale=SCALE, slices=8, maps=("normal", "ssbump"), name="{stem}_{kind}.vtf",
+                   vtf_version="7.3", texture_format="dxt5", vtf_flags=4, nomip=True)
+    bumpbake.dask.bake_files("heights", "out", client=client, **options)
+    command = bumpbake.BakeJob("heights", "out", **options).command_text(0)
+    # the format by its first name (bc3 is dxt5), as bb_texture_format_name spells it
+    assert command.endswith("--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip")
+    os.rename("out", "out_api")
+    cli("bake", "heights", *command.split()[3:])
+    assert files_of("out_api") == files_of("out")
+
+    # one map split over the workers: a .vtf, a .dds and the material
+    os.makedirs("materials/rock")
+    single = ["bake", "heights/h01.png", "--scale", "16", "--slices", "8", "--ssbump",
+              "materials/rock/m_ssbump.vtf", "--normal", "materials/rock/m_normal.dds",
+              "--vtf-version", "7.4", "--vmt", "materials/rock/m.vmt"]
+    out = cli(*single, "--scheduler", address)
+    assert "wrote material materials/rock/m.vmt" in out.stdout
+    split = files_of("materials")
+    assert sorted(split) == ["rock/m.vmt", "rock/m_normal.dds", "rock/m_ssbump.vtf"]
+    assert b'"$bumpmap" "rock/m_ssbump"' in split["rock/m.vmt"]
+    shutil.rmtree("materials")
+    os.makedirs("materials/rock")
+    cli(*single)
+    assert files_of("materials") == split

@@ -162,6 +162,36 @@ static void add_outputs(text *t, const bb_job_options *o) {
     add_option(t, "--name", o->name_template);
 }
 
+/* The engine textures' settings and the material, as --help lists them
+ * after the outputs. */
+static void add_texture(text *t, const bb_job_options *o) {
+  bb_texture_options d;
+  bb_texture_options_init(&d);
+  const bb_texture_options *x = &o->texture;
+  if (x->format != d.format)
+    add_option(t, "--texture-format", bb_texture_format_name(x->format));
+  if (x->vtf_version != d.vtf_version) {
+    char v[24];
+    snprintf(v, sizeof v, "7.%d", x->vtf_version);
+    add_option(t, "--vtf-version", v);
+  }
+  if (x->vtf_flags != d.vtf_flags) {
+    char v[24];
+    snprintf(v, sizeof v, "0x%x", (unsigned)x->vtf_flags);
+    add_option(t, "--vtf-flags", v);
+  }
+  if (!x->mips && d.mips)
+    add_option(t, "--nomip", NULL);
+  if (x->fast && !d.fast)
+    add_option(t, "--fast-compression", NULL);
+  if (o->vmt)
+    add_option(t, "--vmt", o->vmt);
+  if (o->vmt_materials)
+    add_option(t, "--materials", o->vmt_materials);
+  if (o->vmt_basetexture)
+    add_option(t, "--basetexture", o->vmt_basetexture);
+}
+
 char *bb_job_command_text(const bb_job_options *o, const char *input) {
   if (!o || !input)
     return NULL;
@@ -170,6 +200,7 @@ char *bb_job_command_text(const bb_job_options *o, const char *input) {
   add(&t, input);
   add_settings(&t, o);
   add_outputs(&t, o);
+  add_texture(&t, o);
   if (t.failed) {
     free(t.data);
     return NULL;

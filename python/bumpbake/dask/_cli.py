@@ -36,8 +36,10 @@ machine's bake). docs/cluster.md says how to start a cluster.
 _VALUED = ("scale", "rays", "slices", "filter-radius", "filter-threshold", "bias", "power",
            "basis", "normal-filter", "normal-y", "threads", "channel", "depth", "normal",
            "weights", "ssbump", "ao", "bent", "filtered", "slope", "lit", "output", "out-dir",
-           "maps", "name", "depfile", "scheduler")
-_FLAGS = ("clamp", "mips", "keep-going", "force", "json", "quiet", "help")
+           "maps", "name", "depfile", "texture-format", "vtf-version", "vtf-flags", "vmt",
+           "materials", "basetexture", "scheduler")
+_FLAGS = ("clamp", "mips", "keep-going", "force", "json", "quiet", "nomip", "fast-compression",
+          "help")
 # bumpbake bake's options that the Python package does not take yet.
 _NOT_ON_A_CLUSTER = ("bounce", "bounces", "bounce-albedo", "brightness")
 _SHORT = {"o": "output", "q": "quiet", "h": "help"}
@@ -161,8 +163,20 @@ def _bake_arguments(options):
                 raise Usage(f"--lit: '{value}' is not AZ,EL in degrees") from None
         elif name == "maps":
             kw["maps"] = tuple(value.split(","))
-        elif name in ("keep-going", "force"):
+        elif name in ("keep-going", "force", "nomip", "fast-compression"):
             kw[key] = True
+        elif name in ("texture-format", "vtf-version", "vmt"):
+            kw[key] = value
+        elif name in ("materials", "basetexture"):
+            kw["vmt_" + key] = value
+        elif name == "vtf-flags":
+            try:  # as C's strtoul(value, NULL, 0) reads it: 0x hex, 0 octal, else decimal
+                v = value.lower()
+                kw["vtf_flags"] = int(v, 16 if v.startswith("0x") else 8 if v.startswith("0")
+                                      and len(v) > 1 else 10)
+            except ValueError:
+                raise Usage(f"--vtf-flags needs a 32-bit number, e.g. 0x4 (got '{value}')") \
+                    from None
     return kw, outputs
 
 
