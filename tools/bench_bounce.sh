@@ -6,7 +6,7 @@
 #   tools/bench_bounce.sh build/bumpbake     (after make all build/bb_tests)
 #
 # Sections:
-# 1. Accuracy (README "Accuracy"): rock06 and lava01 downsampled to 256 x 256
+# 1. Accuracy (docs/accuracy.md "Inter-reflection"): rock06 and lava01 downsampled to 256 x 256
 #    (oiiotool --resize, as tools/bench.sh section 5) at scale 32 and
 #    genheight noise at scale 16, no smoothing, Valve's normal, bias 0.55,
 #    256 rays; rho 0.3 and 0.6, bounces to convergence (the default). The

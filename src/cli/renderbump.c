@@ -213,6 +213,12 @@ static int check_outputs(rbf_args *a) {
   return st == BB_OK ? 0 : cli_library_error(rbf_command.name, st, &err);
 }
 
+/* The library's notes on a render name no file (it sees a mesh, not a path);
+ * note_user carries the model's, so they read like every other note. */
+static void rbf_note(void *model, const char *path, const char *text) {
+  cli_note(NULL, path ? path : (const char *)model, text);
+}
+
 static int rbf_parse(int argc, char **argv, rbf_args *a) {
   int rc = take_multi_value_options(a, &argc, argv);
   int first = 0;
@@ -227,7 +233,8 @@ static int rbf_parse(int argc, char **argv, rbf_args *a) {
     return cli_usage_error(rbf_command.name,
                            "--tile needs --rect L B R T: the tile the sculpt repeats with");
   a->render.threads = a->settings.bake.trace.threads;
-  a->render.note = cli_note;
+  a->render.note = rbf_note;
+  a->render.note_user = (void *)a->model;
   return check_outputs(a);
 }
 
@@ -276,7 +283,7 @@ static int rbf_run(const char *command_line, rbf_args *a) {
   char note[512];
   bb_status st = bb_mesh_load_noted(a->model, &mesh, note, sizeof note, &err);
   if (st == BB_OK && note[0]) /* a missing .mtl and the like */
-    fprintf(stderr, "bumpbake: %s: note: %s\n", a->model, note);
+    cli_note(NULL, a->model, note);
   if (st == BB_OK)
     st = bb_renderbump_flat(&mesh, &a->render, &result, &err);
   int rc = cli_status_exit(a->model, st, &err);

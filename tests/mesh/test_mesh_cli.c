@@ -92,3 +92,24 @@ Test(mesh_cli, renderbumpflat_refuses_a_million_stacked_triangles_quickly) {
       harness_dir, (const char *const[]){"renderbumpflat", "f.obj", "--size", "64", "64", NULL},
       1, "over the 256 layers a render may draw", 0);
 }
+
+/* A model twice as wide as high on square images: its texels come out
+ * twice as wide as high, and a user is told so, with the size or rectangle
+ * that keeps them square, even without --height and with -q; the note
+ * names the model like every other note. A size of the model's shape gives
+ * no note. */
+Test(mesh_cli, renderbumpflat_names_the_model_in_its_note_on_stretched_texels) {
+  write_text(tmp("wide.obj"), "v 0 0 0\nv 2 0 0\nv 2 0 1\nv 0 0 1\nf 1 2 3 4\n");
+  cli_result r = RUN_IN(harness_dir, "renderbumpflat", "wide.obj", "-size", "8", "8", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
+  cr_expect(strstr(r.err, "bumpbake: wide.obj: note: texels are 2 times as wide as high (a 2 x 1 "
+                          "rectangle on 8 x 8 texels)"),
+            "%s", r.err);
+  cr_expect(strstr(r.err, "size 16 8, or rect 0 0 2 2, keeps them square"), "%s", r.err);
+  cli_result_free(&r);
+  r = RUN_IN(harness_dir, "renderbumpflat", "wide.obj", "-size", "16", "8", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+}
