@@ -134,7 +134,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles check-docs bench goldens docs docs-reference install \
+        check-python check-circles check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
@@ -334,6 +334,15 @@ check-python: $(BIN) lib
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# bumpbake on a Dask cluster of this machine (2 worker processes) against
+# one process, with cmp of their files (tools/bench_cluster.sh, for
+# docs/cluster.md); BENCH_CLUSTER picks sizes and sections, e.g.
+# BENCH_CLUSTER="-n 60 -r 2 batch big". Every section by default: a long
+# run (about 3 GB of work files in build/bench/cluster), never in `make test`.
+bench-cluster: ensure-deps
+	@$(MAKE) --no-print-directory all
+	@PYTHON=$(PYTHON) ./tools/bench_cluster.sh $(BENCH_CLUSTER) $(BIN)
 
 # The README's pictures (docs/*.png, committed); never part of `make test`.
 docs: ensure-deps
