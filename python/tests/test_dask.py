@@ -8,6 +8,7 @@ import os
 import re
 import shutil
 import signal
+import threading
 import time
 
 import numpy as np
@@ -129,6 +130,41 @@ def test_a_failure_stops_the_batch_unless_keep_going(tmp_path, monkeypatch, clie
                                        scale=SCALE, keep_going=True, check=False)
     assert [r.status == "failed" for r in reports] == [i == 5 for i in range(12)]
     assert all(r.ok for i, r in enumerate(reports) if i != 5)
+
+
+def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch, client):
+    """A failed batch's exception keeps its frame; the chunks' futures must
+    not live on in it: Dask runs a held future's task again when the worker
+    holding its result is lost, and such a chunk, its batch's stop variable
+    deleted, waited for it for ever (a later batch hung behind it). A chunk
+    run after its batch is over does nothing."""
+    from bumpbake.dask import _batch, _shared
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 6)
+    with open("heights/h02.png", "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n not really")
+    with pytest.raises(bumpbake.Error) as e:
+        bumpbake.dask.bake_files("heights", "out", client=client, maps="normal", scale=SCALE,
+                                 chunk_size=1)
+    assert e.value.__traceback__ is not None
+
+    def chunks(dask_scheduler):
+        return [k for k in dask_scheduler.tasks if str(k).startswith("bumpbake-chunk-")]
+
+    deadline = time.monotonic() + 10
+    while client.run_on_scheduler(chunks):
+        assert time.monotonic() < deadline, client.run_on_scheduler(chunks)
+        time.sleep(0.05)
+
+    monkeypatch.setattr(_shared, "_VARIABLE_WAIT", 0.2)
+    args = dict(bumpbake.BakeJob("heights", "out", maps="normal", scale=SCALE)._args,
+                keep_going=True, depfile=None)
+    done = []
+    run = threading.Thread(target=lambda: done.append(_batch._bake_chunk(
+        os.getcwd(), ["heights/h00.png"], [0], args, _batch._Stop("bumpbake-stop-gone"), True)))
+    run.start()
+    run.join(timeout=20)
+    assert done == [[(0, None)]], "a chunk of a batch that is over waits or bakes"
 
 
 CASES = [  # (addressing, slices, basis): each at a size that is no power of two

@@ -11,7 +11,7 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
-from ._shared import client_directory, client_of, worker_threads
+from ._shared import client_directory, client_of, variable_value, worker_threads
 
 # Inputs per chunk: enough chunks that the last ones end together (the
 # scheduler hands a chunk to whichever worker thread is free), few enough
@@ -38,15 +38,20 @@ class _Stop:
 
     def __init__(self, name):
         self.name = name
+        self.over = False  # the batch ended: this chunk is a re-run nobody waits for
 
     def reached(self, index):
-        return index > distributed.Variable(self.name).get()
+        if self.over:
+            return True
+        stop = variable_value(self.name, None)
+        self.over = stop is None
+        return self.over or index > stop
 
     def lower(self, index):
         with distributed.Lock(self.name + "-lock"):
-            variable = distributed.Variable(self.name)
-            if index < variable.get():
-                variable.set(index)
+            stop = variable_value(self.name, None)
+            if stop is not None and index < stop:
+                distributed.Variable(self.name).set(index)
 
 
 def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
@@ -177,6 +182,12 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         client.cancel(list(futures))
         raise
     finally:
+        # Released now, not when the frame goes (an exception's traceback
+        # keeps it): a future still held makes Dask run its chunk again
+        # when a worker holding its result is lost.
+        for f in futures:
+            f.release()
+        futures.clear()
         if stop is not None:
             distributed.Variable(stop.name, client=client).delete()
     for i in range(count):

@@ -25,7 +25,8 @@ from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _k
 from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
-from ._shared import client_directory, client_of, this_worker_threads, worker_threads
+from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
+                      worker_threads)
 
 # -------------------------------------------------- a worker's trace inputs
 
@@ -266,12 +267,14 @@ class _SplitTrace:
                                 options.progress_user, g[-1] + 1, n):
                             raise _exception(_lib.BB_ERR_CANCELLED,
                                              "trace: cancelled by the progress callback")
-                        if distributed.Variable(task["stop"], client=client).get():
+                        if variable_value(task["stop"], 1, client=client):
                             raise _exception(_lib.BB_ERR_CANCELLED,
                                              "trace: cancelled by the client")
                     _check(_lib.bb_trace_finish(rays, vis, self.own_threads, err), err)
                 finally:
                     client.cancel([f for f in futures if not f.done()])
+                    for f in futures:  # none left for Dask to run again
+                        f.release()
                     client.run(_drop, task["key"])
         finally:
             _take_back(task["key"], loan)
@@ -375,6 +378,10 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
         except Exception:  # noqa: BLE001 (the scheduler lost: the first error is the one)
             pass
         raise
+    finally:
+        # Released at once: a future still held (by an exception's
+        # traceback) makes Dask bake again when the driver's worker is lost.
+        future.release()
     stop.delete()
     report.cluster = stats
     sweep_temporaries({os.path.dirname(p) or "." for p in report.outputs.values()})

@@ -1,6 +1,7 @@
 """What bumpbake's Dask tasks share: the client to use, the client's
 directory on the workers, and thread counts."""
 
+import asyncio
 import contextlib
 import os
 import threading
@@ -82,3 +83,20 @@ def this_worker_threads(default=1):
         return max(1, int(distributed.get_worker().state.nthreads))
     except ValueError:
         return default
+
+
+# How long a task waits for a bake's distributed.Variable that is not there:
+# one that exists answers at once, so only a variable deleted when its bake
+# ended waits this long.
+_VARIABLE_WAIT = 5
+
+
+def variable_value(name, gone, client=None):
+    """The value of the distributed.Variable name, or gone when it no longer
+    exists: its bake is over, and the task reading it (run again by Dask
+    after a worker was lost, for a future somebody still held) must do
+    nothing. Variable.get without a timeout would wait for ever."""
+    try:
+        return distributed.Variable(name, client=client).get(timeout=_VARIABLE_WAIT)
+    except (TimeoutError, asyncio.TimeoutError):
+        return gone
