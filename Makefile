@@ -135,7 +135,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles check-docs bench goldens docs docs-reference install \
+        check-python check-circles check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps
 all: $(BIN) lib $(TOOLS)
@@ -150,10 +150,12 @@ PYTHON   := /usr/bin/python3
 # openimageio-tools: idiff, which a test runs beside `bumpbake compare` to
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
+# python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
+# a Dask cluster (its tests run a LocalCluster).
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools ninja-build
+            openimageio-tools ninja-build python3-distributed python3-dask
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -163,7 +165,7 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest' >/dev/null 2>&1; then :; \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed' >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
@@ -263,9 +265,10 @@ install: $(BIN) lib
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
-	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake
+	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake $(DESTDIR)$(PYTHONDIR)/bumpbake/dask
 	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
 	  $(DESTDIR)$(PYTHONDIR)/bumpbake/
+	install -m 644 $(wildcard python/bumpbake/dask/*.py) $(DESTDIR)$(PYTHONDIR)/bumpbake/dask/
 	printf '%s\n' '# Written by make install: the library this installed package loads.' \
 	  'LIBRARY = "$(LIBDIR)/$(SONAME)"' >$(DESTDIR)$(PYTHONDIR)/bumpbake/_install.py
 	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ]; then $(LDCONFIG) || true; fi
@@ -332,6 +335,15 @@ check-python: $(BIN) lib
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# bumpbake on a Dask cluster of this machine (2 worker processes) against
+# one process, with cmp of their files (tools/bench_cluster.sh, for
+# docs/cluster.md); BENCH_CLUSTER picks sizes and sections, e.g.
+# BENCH_CLUSTER="-n 60 -r 2 batch big". Every section by default: a long
+# run (about 3 GB of work files in build/bench/cluster), never in `make test`.
+bench-cluster: ensure-deps
+	@$(MAKE) --no-print-directory all
+	@PYTHON=$(PYTHON) ./tools/bench_cluster.sh $(BENCH_CLUSTER) $(BIN)
 
 # The README's pictures (docs/*.png, committed); never part of `make test`.
 docs: ensure-deps

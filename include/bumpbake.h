@@ -60,19 +60,29 @@ extern "C" {
 #define BB_VERSION_STRING "0.2.0"
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
- * most BB_MAX_PIXELS texels in all (8192 x 8192), checked before allocating. */
+ * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
+ * allocating. What a machine can bake is less: reads and bakes estimate
+ * their memory from the sizes first and refuse, naming the estimate and
+ * what is available, what will not fit (bb_memory_available,
+ * bb_bake_memory_estimate). */
 #define BB_MAX_DIMENSION 65536
-#define BB_MAX_PIXELS (8192L * 8192L)
+#define BB_MAX_PIXELS (32768L * 32768L)
 
-/* Most bytes of samples a read may take (1 GiB, an 8192 x 8192 RGBA float
- * image): both the file's own samples (texels x channels x bytes per
- * sample, as its header declares them) and the floats decoded (texels x
- * channels read x 4) must fit, checked before anything is allocated. The
- * first read or write also lowers OpenImageIO's process-wide
- * "limits:imagesize_MB" to 1024 and "limits:channels" to 64 when they are
- * higher, and sets its "exr_threads" to -1 (OpenEXR without its own thread
- * pool, which crashed when started short of memory). */
+/* Most bytes of samples a read may take: BB_MAX_READ_BYTES_PER_TEXEL a
+ * texel (an RGBA float image), and BB_MAX_READ_BYTES (1 GiB) whatever the
+ * size (so 1 GiB up to 8192 x 8192, 4 GiB at 16384 x 16384): both the
+ * file's own samples (texels x channels x bytes per sample, as its header
+ * declares them) and the floats decoded (texels x channels read x 4) must
+ * fit, checked before anything is allocated, and then what is available
+ * (bb_memory_available) must hold them. What a reader allocates to open a
+ * file at all (see bb_image_read_info) stays within BB_MAX_READ_BYTES
+ * whatever the size. The first read or write also lowers OpenImageIO's
+ * process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16 bytes (16384)
+ * and "limits:channels" to 64 when they are higher, and sets its
+ * "exr_threads" to -1 (OpenEXR without its own thread pool, which crashed
+ * when started short of memory). */
 #define BB_MAX_READ_BYTES (1L << 30)
+#define BB_MAX_READ_BYTES_PER_TEXEL 16
 
 /* Largest |height_scale x h| a bake accepts, in texels: scaled heights are
  * floats and are differenced, so they keep a factor of 4 below FLT_MAX. */
@@ -154,6 +164,17 @@ typedef struct bb_image {
   int channels;   /* interleaved floats per texel */
   float *pixels;  /* width*height*channels floats, row 0 at the top */
 } bb_image;
+
+/* What this process may still allocate, in bytes: the smaller of what the
+ * system has available (MemAvailable of /proc/meminfo, else its free pages)
+ * and, under an RLIMIT_AS (ulimit -v), the room left below it (the limit
+ * less the address space mapped now). *source (may be NULL) receives which
+ * ("MemAvailable", "sysconf free pages", "RLIMIT_AS"). Bakes and reads
+ * check their estimate against it before allocating, so one too large is
+ * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
+ * the process; several processes started at once each see the same
+ * figure. Errors: BB_ERR_IO (neither can be read). */
+bb_status bb_memory_available(uint64_t *bytes, const char **source, bb_error *err);
 
 /* Allocates a zeroed image. Rejects sizes <= 0, over BB_MAX_DIMENSION or
  * BB_MAX_PIXELS, and channel counts outside 1..64 (overflow-checked).
@@ -237,7 +258,7 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
  * coefficients, a GIF's canvas, an OpenEXR's chunk buffers): that is
  * refused past BB_MAX_READ_BYTES (64 MiB for one OpenEXR chunk) with
  * BB_ERR_SIZE, and OpenImageIO's own limits, see BB_MAX_READ_BYTES, may
- * refuse a header declaring more than 1 GiB of samples. */
+ * refuse a header declaring more than 16 GiB of samples. */
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
@@ -345,6 +366,20 @@ bb_status bb_file_write(const char *path, const void *data, size_t size, bb_erro
  * library created are removed. At most 4096 temporaries are tracked at once;
  * further ones are still removed on errors, but not by this function. */
 void bb_tempfiles_remove(void);
+
+/* Removes from directory dir (not below it) the temporaries
+ * ".bb-tmp-XXXXXX.EXT" whose writer is gone, and the private directories
+ * ".bb-tmp-XXXXXX" some encoders write in with what they hold: a writer
+ * holds an advisory lock (flock) on its temporary from its creation until
+ * it is renamed into place or removed, and the kernel drops it when the
+ * process dies, so one that no process holds is what a process killed
+ * outright (SIGKILL, an out-of-memory kill, a lost machine) left behind.
+ * Temporaries being written, by this process or any other, on this machine
+ * or another sharing the directory (NFS v4 carries flock), are left alone,
+ * and so is a private directory holding anything but its staged file. *removed (may be
+ * NULL) receives how many were removed. Errors: BB_ERR_ARGUMENT (no dir),
+ * BB_ERR_IO (dir cannot be read, an orphan cannot be removed). */
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 
 /* True (1) when the extension of path (any case) is one OpenImageIO has a
  * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
@@ -881,7 +916,21 @@ const char *bb_rayset_id(const bb_rayset *rs);
 
 /* --------------------------------------------------------------- trace */
 
-typedef struct bb_trace_options {
+typedef struct bb_trace_options bb_trace_options;
+
+/* A trace of the caller's, which bb_bake calls in place of
+ * bb_trace_occlusion (bb_trace_options.trace): for the pyramid and ray set
+ * the bake built, it fills vis exactly as bb_trace_occlusion(p, rs, o, vis)
+ * would: allocated (bb_image_alloc), the pyramid's size, 1 +
+ * bb_rayset_lobe_count(rs) channels. A trace split over machines does this
+ * with bb_trace_horizons, bb_trace_accumulate and bb_trace_finish, so the
+ * bake's maps are a single bake's bits. Returns BB_OK, or an error with err
+ * filled (vis then left unallocated). Called on the thread that called
+ * bb_bake. */
+typedef bb_status (*bb_trace_fn)(void *user, const bb_pyramid *p, const bb_rayset *rs,
+                                 const bb_trace_options *o, bb_image *vis, bb_error *err);
+
+struct bb_trace_options {
   double bias_texels;   /* origin lift above the vertex, >= 0 (default 0.55) */
   int threads;          /* 0 = all cores */
   bb_region region;     /* width 0 (default): every texel, by line sweeps;
@@ -890,7 +939,12 @@ typedef struct bb_trace_options {
                               work goes (per slice, or every 50 ms); a
                               nonzero return cancels */
   void *progress_user;
-} bb_trace_options;
+  bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
+                           bb_trace_occlusion; else bb_bake calls
+                           trace(trace_user, ...) in its place (bb_trace_fn).
+                           bb_trace_occlusion itself ignores it */
+  void *trace_user;
+};
 
 void bb_trace_options_init(bb_trace_options *o);
 
@@ -905,6 +959,52 @@ void bb_trace_options_init(bb_trace_options *o);
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *horizons_found, bb_error *err);
+
+/* A trace split over processes or machines (Python's bumpbake.dask bakes
+ * big maps so): each finds the horizons of some of the slices
+ * (bb_trace_horizons), and one adds them up (bb_trace_accumulate) in the
+ * order every trace adds them (bb_trace_slice_order) and turns the sums into
+ * visibilities (bb_trace_finish). The result is bb_trace_occlusion's, bit
+ * for bit: the same horizons, the same losses, added in the same order. */
+
+/* The order in which every trace adds its slices' losses to a texel's sums:
+ * order[k] is the slice added k-th (k is its rank), for k = 0 ..
+ * bb_rayset_slice_count(rs) - 1; each slice is followed by its opposite
+ * (lattice step (-a, -b)) when the set has one. Errors: BB_ERR_ARGUMENT,
+ * BB_ERR_MEMORY. */
+bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err);
+
+/* The horizon of every texel in count distinct slices of rs, found by the
+ * line sweeps bb_trace_occlusion runs: horizons[k] (allocated here: 1
+ * channel, the pyramid's size) holds slice slices[k]'s horizons, tangents of
+ * elevation >= 0 (rise per texel of horizontal distance; 0 where nothing
+ * rises above the origin), the floats the whole trace adds up. A slice and
+ * its opposite asked together share one sweep, as they do in the whole
+ * trace. o->region must be empty (the whole pyramid); o->bias_texels,
+ * o->threads and o->progress (once per sweep) as for bb_trace_occlusion.
+ * Memory: 4 bytes per texel per slice, plus a line's profile per thread.
+ * Errors: BB_ERR_ARGUMENT (a slice out of range or asked twice, a region),
+ * BB_ERR_MEMORY, BB_ERR_CANCELLED; then no image is left allocated. */
+bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
+                            const bb_trace_options *o, const int *slices, int count,
+                            bb_image *horizons, bb_error *err);
+
+/* Adds what slice order[rank] (bb_trace_slice_order) loses at each texel's
+ * horizon (horizon: that slice's image from bb_trace_horizons) to sums:
+ * 1 + bb_rayset_lobe_count(rs) channels (ao first, then each lobe), the
+ * horizons' size, all zeros before rank 0 (bb_image_alloc makes them so).
+ * Called for ranks 0, 1, ..., slice count - 1 in turn, each once, it adds
+ * what bb_trace_occlusion adds in the order it adds it, so the sums are the
+ * same bits; the caller keeps to that order. threads: 0 = all cores (the
+ * same bits for any). Errors: BB_ERR_ARGUMENT (rank out of range, sizes or
+ * channels that do not match). */
+bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
+                              bb_image *sums, int threads, bb_error *err);
+
+/* Turns sums, once every rank is added, into visibilities in place: ao,
+ * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as bb_trace_occlusion
+ * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
+bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 
 /* -------------------------------------------------------------- derive */
 
@@ -1081,6 +1181,26 @@ typedef struct bb_bake_result {
  * returned (result is zeroed). */
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
+
+/* What bb_bake traces, built alone for a trace split over processes: the
+ * max-mip pyramid of the smoothed height scaled to texels, and the ray set
+ * of o's slices, power and basis, built by bb_bake's own stages (the same
+ * bits), so the horizons found from them (bb_trace_horizons) are those of
+ * bb_bake's trace of height with o. Checks o and the height as bb_bake does;
+ * o->outputs must ask for a traced kind. On success *pyramid and *rays
+ * receive them (free with bb_pyramid_free and bb_rayset_free). Memory:
+ * about 13 bytes per texel while building, 5.4 once built. */
+bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
+                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
+
+/* The most bytes bb_bake allocates at one time for a width x height field
+ * with options o (its outputs, basis, slices and threads), not counting the
+ * height itself: an upper bound worked out from the sizes alone, following
+ * the bake's stages. bb_bake refuses (BB_ERR_MEMORY, naming both figures) a
+ * bake whose estimate is over bb_memory_available before it allocates
+ * anything. About 32 bytes a texel for ssbump and ao, 36 with the normal
+ * map, 64 for every output. 0 for a bad size or NULL options. */
+uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o);
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */

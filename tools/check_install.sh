@@ -181,6 +181,18 @@ print("ok", bumpbake.library_path)
     echo "$out" >&2
     fail "the installed Python package does not import or bake with PYTHONPATH alone"
   fi
+  # bumpbake.dask, a subpackage, is installed too (it needs python3-distributed)
+  if [ ! -f "$site/bumpbake/dask/__init__.py" ]; then
+    fail "make install did not install bumpbake.dask into $site"
+  elif "$python" -c 'import distributed' 2>/dev/null; then
+    if out=$(cd / && env -i PATH=/usr/bin:/bin PYTHONPATH="$site" "${preload[@]}" "$python" \
+        -m bumpbake.dask --help 2>&1) && [ -n "$out" ]; then
+      pass "python3 -m bumpbake.dask --help with PYTHONPATH=$site alone"
+    else
+      echo "$out" >&2
+      fail "the installed bumpbake.dask does not run with PYTHONPATH alone"
+    fi
+  fi
 fi
 
 if [ "$failures" -gt 0 ]; then

@@ -159,13 +159,24 @@ typedef struct bb_basis {
   char name[32];
 } bb_basis;
 
-typedef struct bb_trace_options {
+typedef struct bb_pyramid bb_pyramid;
+
+typedef struct bb_rayset bb_rayset;
+
+typedef struct bb_trace_options bb_trace_options;
+
+typedef bb_status (*bb_trace_fn)(void *user, const bb_pyramid *p, const bb_rayset *rs,
+                                 const bb_trace_options *o, bb_image *vis, bb_error *err);
+
+struct bb_trace_options {
   double bias_texels;
   int threads;
   bb_region region;
   bb_progress_fn progress;
   void *progress_user;
-} bb_trace_options;
+  bb_trace_fn trace;
+  void *trace_user;
+};
 
 typedef enum bb_output_kind {
   BB_OUTPUT_NORMAL = 0,
@@ -518,6 +529,7 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 void bb_vtf_info_free(bb_vtf_info *info);
 const char *bb_vtf_flag_name(int bit);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
@@ -535,6 +547,18 @@ bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis 
                                 bb_error *err);
 bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
 bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
+void bb_pyramid_free(bb_pyramid *p);
+void bb_rayset_free(bb_rayset *rs);
+int bb_rayset_slice_count(const bb_rayset *rs);
+int bb_rayset_lobe_count(const bb_rayset *rs);
+const char *bb_rayset_id(const bb_rayset *rs);
+bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err);
+bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
+                            const bb_trace_options *o, const int *slices, int count,
+                            bb_image *horizons, bb_error *err);
+bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
+                              bb_image *sums, int threads, bb_error *err);
+bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
                             bb_error *err);
 const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
@@ -544,6 +568,8 @@ int bb_bake_slices(const bb_bake_options *o);
 bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
+bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
+                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
@@ -599,6 +625,9 @@ bb_provenance_class bb_provenance_classify(const char *description);
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
+bb_status bb_height_file_read(const char *path, bb_channel channel, float height_scale,
+                              bb_note_fn note, void *note_user, bb_image *height,
+                              bb_height_source *source, bb_error *err);
 const char *bb_height_source_channel(const bb_height_source *source);
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err);

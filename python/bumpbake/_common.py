@@ -152,7 +152,11 @@ def _vtf_version(command, value):
             raise _argument_error(f"{command}: vtf_version must be 7.2, 7.3, 7.4 or 7.5 "
                                   f"(got {value!r})")
         value = int(minor)
-    return _int(command, "vtf_version", value)
+    value = _int(command, "vtf_version", value)
+    if not 2 <= value <= 5:  # as --vtf-version refuses it, whatever the outputs
+        raise _argument_error(f"{command}: vtf_version must be 7.2, 7.3, 7.4 or 7.5 "
+                              f"(got 7.{value})")
+    return value
 
 
 def _vtf_flags(command, value):

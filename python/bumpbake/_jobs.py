@@ -35,6 +35,7 @@ class BakeReport:
     horizons: typing.Optional[float] = None  # texels x slices
     seconds: dict = dataclasses.field(default_factory=dict)  # load, smooth, ..., write
     notes: list = dataclasses.field(default_factory=list)    # "PATH: text" lines
+    cluster: typing.Optional[dict] = None  # bumpbake.dask.bake_big: where the trace ran
     _code: int = dataclasses.field(default=0, repr=False, compare=False)  # bb_status
 
     @property
@@ -86,20 +87,22 @@ class BakeJob:
     def __init__(self, inputs, out_dir=None, *, maps=None, name=None, outputs=None,
                  prefix=None, slope=None, lit=None, force=False, keep_going=False,
                  depfile=None, depth=None, mips=False, channel="auto", scale=None,
-                 texture_format=None, vtf_version=None, vtf_flags=None, nomip=False,
-                 fast_compression=False, vmt=None, materials=None, basetexture=None,
-                 notes="warn", **options):
+                 notes="warn", command=None, command_options=None, texture_format=None,
+                 vtf_version=None, vtf_flags=None, nomip=False, fast_compression=False,
+                 vmt=None, materials=None, basetexture=None, _trace=None, **options):
         for key in options:
             if key not in BAKE_PARAMETERS:
                 raise TypeError(f"bake: unexpected keyword argument {key!r}")
         self._args = dict(out_dir=out_dir, maps=maps, name=name, outputs=outputs, prefix=prefix,
                           slope=slope, lit=lit, force=force, keep_going=keep_going,
                           depfile=depfile, depth=depth, mips=mips, channel=channel,
-                          scale=scale, texture_format=texture_format,
+                          scale=scale, notes=notes, command=command,
+                          command_options=command_options, texture_format=texture_format,
                           vtf_version=vtf_version, vtf_flags=vtf_flags, nomip=nomip,
                           fast_compression=fast_compression, vmt=vmt, materials=materials,
-                          basetexture=basetexture, notes=notes, **options)
+                          basetexture=basetexture, **options)
         self._notes_policy = _check_notes(notes)
+        self._trace = _trace  # a bb_trace_fn callback, kept alive with the job
         if isinstance(inputs, (str, bytes, os.PathLike)):
             inputs = [inputs]
         self._plan([_path(p, "input") for p in inputs], self._args, options)
@@ -118,6 +121,13 @@ class BakeJob:
 
         bake, basis_file = _bake_options("bake", a["scale"], **options)
         o.bake = bake[0]
+        if self._trace is not None:
+            o.bake.trace.trace = self._trace
+        for key in ("command", "command_options"):
+            if a[key] is not None:
+                if not isinstance(a[key], str):
+                    raise TypeError(f"bake: {key} must be a str (got {a[key]!r})")
+                setattr(o, key, c(a[key]))
         o.basis_file = c(basis_file)
         o.channel = _channel(a["channel"])
         o.depth = _depth(a["depth"])

@@ -96,10 +96,14 @@ def _header_text():
 
 
 def _header_body(kind, name):
-    """What is between the braces of `typedef KIND NAME { ... } NAME;` in
-    bumpbake.h, without comments."""
+    """What is between the braces of `typedef KIND NAME { ... } NAME;` (or of
+    `KIND NAME { ... };` after a `typedef KIND NAME NAME;` that a function
+    type before it needs) in bumpbake.h, without comments."""
     text = _header_text()
-    return re.search(r"typedef %s %s \{(.*?)\} %s;" % (kind, name, name), text, re.S).group(1)
+    found = (re.search(r"typedef %s %s \{(.*?)\} %s;" % (kind, name, name), text, re.S)
+             or re.search(r"\n%s %s \{(.*?)\};" % (kind, name), text, re.S))
+    assert found, f"{kind} {name} is not in bumpbake.h"
+    return found.group(1)
 
 
 def _header_struct_fields(name):

@@ -140,6 +140,12 @@ def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):
     ({"depth": 12}, bumpbake.ArgumentError, "depth must be one of 8, 16, half, float"),
     ({"rays": 0}, bumpbake.ArgumentError, "bake: rays must be in 1..65536 (got 0)"),
     ({"mips": True}, bumpbake.ArgumentError, "--mips needs a .tif or .exr output"),
+    ({"texture_format": "dxt7"}, bumpbake.ArgumentError, "texture format must be one of"),
+    ({"vtf_version": "7.9"}, bumpbake.ArgumentError, "vtf_version must be 7.2, 7.3, 7.4 or 7.5"),
+    ({"vtf_flags": -1}, bumpbake.ArgumentError, "vtf_flags needs a 32-bit number"),
+    ({"vmt": "m.vmt"}, bumpbake.ArgumentError, "--vmt writes one material"),
+    ({"name": "{stem}_{kind}.vtf"}, bumpbake.ArgumentError,
+     "Source textures need a power of two on each side"),
 ])
 def test_bad_jobs_are_refused_before_any_bake(tmp_path, fixtures, kwargs, error, message):
     with pytest.raises(error) as e:

@@ -115,6 +115,28 @@ static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
   return BB_OK;
 }
 
+/* The trace of the caller's (bb_trace_options.trace) in place of
+ * bb_trace_occlusion; what it makes is checked to be what that would make. */
+static bb_status caller_trace(const bb_pyramid *p, const bb_rayset *rs, const bb_trace_options *o,
+                              bb_image *vis, double *horizons_found, bb_error *err) {
+  memset(vis, 0, sizeof *vis);
+  bb_error local = {{0}};
+  bb_status st = o->trace(o->trace_user, p, rs, o, vis, &local);
+  if (st != BB_OK) {
+    bb_image_free(vis);
+    return bb__fail(err, st, "%s", local.message[0] ? local.message : "trace: failed");
+  }
+  if (!vis->pixels || vis->width != p->width || vis->height != p->height ||
+      vis->channels != 1 + rs->basis_count) {
+    bb_image_free(vis);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "trace: the caller's trace made no %dx%d image of %d channels", p->width,
+                    p->height, 1 + rs->basis_count);
+  }
+  *horizons_found = (double)p->width * (double)p->height * (double)rs->slice_count;
+  return BB_OK;
+}
+
 /* The grey of the bounce albedo map per vertex, clamped to [0, 1]. */
 static bb_status albedo_grey(const bb_image *map, int width, int height, bb_image *out,
                              bb_error *err) {
@@ -154,9 +176,13 @@ static void ssbump_cap(bb_image *ssbump) {
     if (ssbump->pixels[i] > 1.0f) ssbump->pixels[i] = 1.0f;
 }
 
-/* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent. */
-static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake_result *r,
-                                  bb_error *err) {
+/* pyramid -> trace -> ssbump, ao, bent: the asked ones, and ssbump for bent.
+ * What is done with goes as soon as it is: the pyramid after the trace, vis
+ * (unless keep_vis) once ssbump and ao are made, the smoothed height once
+ * nothing needs it; the normal map is made after the trace, when vis is
+ * gone, and ssbump without one takes its normals a band at a time. */
+static bb_status trace_and_derive(const bb_bake_options *o, int threads, int keep_vis,
+                                  bb_bake_result *r, bb_error *err) {
   double t0 = bb__now_seconds();
   bb_image z = {0};
   bb_pyramid *pyramid = NULL;
@@ -172,7 +198,9 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
     bb_trace_options whole = o->trace;
     whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
     whole.threads = threads;
-    st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+    st = o->trace.trace ? caller_trace(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err)
+                        : bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found,
+                                             err);
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
@@ -186,28 +214,47 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, bb_bake
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
       BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);
+  const int normal_later = wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL)) && !r->normal.pixels;
   if (st == BB_OK && wants(o, ssbump_or_bent))
-    st = bb__derive_ssbump(&r->normal, &r->vis, &o->basis, threads, &r->ssbump, err);
+    st = r->normal.pixels
+             ? bb__derive_ssbump(&r->normal, &r->vis, &o->basis, threads, &r->ssbump, err)
+             : bb__derive_ssbump_from_height(&r->filtered, o->height_scale, o->normal_filter,
+                                             o->smooth.addressing, &r->vis, &o->basis, threads,
+                                             &r->ssbump, err);
   if (st == BB_OK && r->ssbump.pixels && o->bounce_albedo > 0.0) ssbump_cap(&r->ssbump);
+  if (!normal_later && !wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
+    bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_AO)))
     st = bb__derive_ao(&r->vis, threads, &r->ao, err);
+  if (!keep_vis)
+    bb_image_free(&r->vis);
+  if (st == BB_OK && normal_later)
+    st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
+                             o->smooth.addressing, threads, &r->normal, err);
+  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
+    bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_BENT)))
     st = bb__derive_bent(&r->ssbump, &o->basis, threads, &r->bent, err);
   r->seconds_derive += bb__now_seconds() - t2;
   return st;
 }
 
-/* smooth -> normals -> weights, as far as the asked maps need them. */
+/* smooth -> normals -> weights, as far as the asked maps need them: the
+ * normal map waits for the trace (trace_and_derive) unless weights need it
+ * now or nothing is traced. */
 static bb_status smooth_and_normals(const bb_image *height, const bb_bake_options *o,
-                                    int threads, bb_bake_result *r, bb_error *err) {
+                                    int threads, int take_height, bb_bake_result *r,
+                                    bb_error *err) {
   double t0 = bb__now_seconds();
   bb_status st = bb__smooth_bilateral(height, height, &o->smooth, threads, &r->filtered, err);
+  if (take_height) /* smoothed: the bake reads only its own maps from now on */
+    bb_image_free((bb_image *)height);
   double t1 = bb__now_seconds();
   r->seconds_smooth = t1 - t0;
-  const unsigned need_normal = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) |
-                               BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS) | BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) |
-                               BB_OUTPUT_BIT(BB_OUTPUT_BENT);
-  if (st == BB_OK && wants(o, need_normal))
+  const int normal_now = wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)) ||
+                         (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL)) &&
+                          !wants(o, BB_OUTPUTS_TRACED));
+  if (st == BB_OK && normal_now)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
                              o->smooth.addressing, threads, &r->normal, err);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)))
@@ -243,6 +290,32 @@ static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
 
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
                   bb_error *err) {
+  return bb__bake((bb_image *)height, o, 0, r, err); /* no flag: height is only read */
+}
+
+static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
+                             bb_bake_result *r, bb_error *err);
+
+bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
+                   bb_bake_result *r, bb_error *err) {
+  bb_status st = bake_stages(height, o, flags, r, err);
+  if (flags & BB__BAKE_TAKE_HEIGHT)
+    bb_image_free(height);
+  return st;
+}
+
+/* Before anything is allocated: refuses a bake the machine cannot hold
+ * (bb__bake_memory against bb_memory_available), with the figures. */
+static bb_status check_memory(const bb_image *height, const bb_bake_options *o, unsigned flags,
+                              bb_error *err) {
+  char what[64];
+  snprintf(what, sizeof what, "bake: %d x %d", height->width, height->height);
+  return bb__memory_check(bb__bake_memory(height->width, height->height, o, flags, 0.0, NULL),
+                          what, err);
+}
+
+static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
+                             bb_bake_result *r, bb_error *err) {
   memset(r, 0, sizeof *r);
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
@@ -256,11 +329,13 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
     if (sized[i] && (sized[i]->width != height->width || sized[i]->height != height->height))
       st = bb__fail(err, BB_ERR_SIZE, "bake: the %s is %dx%d, the height %dx%d", sized_name[i],
                     sized[i]->width, sized[i]->height, height->width, height->height);
+  if (st == BB_OK) st = check_memory(height, o, flags, err);
   if (st != BB_OK) return st;
   r->basis = o->basis;
   const int threads = bb__thread_count(o->trace.threads);
-  st = smooth_and_normals(height, o, threads, r, err);
-  if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED)) st = trace_and_derive(o, threads, r, err);
+  st = smooth_and_normals(height, o, threads, (flags & BB__BAKE_TAKE_HEIGHT) != 0, r, err);
+  if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED))
+    st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), r, err);
   if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
     if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);

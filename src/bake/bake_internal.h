@@ -15,6 +15,19 @@ bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
 bb_status bb__normals_compute(const bb_image *height, float height_scale,
                               bb_normal_filter filter, bb_addressing addressing, int threads,
                               bb_image *out, bb_error *err);
+/* Rows y0 .. y1-1 of bb__normals_compute's normals of height (finite
+ * heights; the same bits), into rows: (y1 - y0) x width x 3 floats. For a
+ * stage that needs the normals a band at a time, without the whole image. */
+void bb__normals_rows(const bb_image *height, float height_scale, bb_normal_filter filter,
+                      bb_addressing addressing, int y0, int y1, float *rows);
+/* bb__derive_ssbump with the normals of the smoothed height computed band
+ * by band (bb__normals_rows with the bake's scale, filter and addressing)
+ * instead of read from a normal image: the same bits, 12 bytes a texel
+ * fewer when the bake writes no normal map. */
+bb_status bb__derive_ssbump_from_height(const bb_image *filtered, float height_scale,
+                                        bb_normal_filter filter, bb_addressing addressing,
+                                        const bb_image *vis, const bb_basis *basis, int threads,
+                                        bb_image *out, bb_error *err);
 bb_status bb__derive_weights(const bb_image *normals, const bb_basis *basis, int threads,
                              bb_image *out, bb_error *err);
 bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
@@ -23,6 +36,24 @@ bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_erro
 bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
                           bb_image *out, bb_error *err);
 
+
+/* bb_bake for a caller that only writes the maps (the job), which lets go
+ * of what it will not use as soon as the bake is done with it:
+ * BB__BAKE_DROP_VIS: r->vis goes once ssbump and ao are made (4 bytes a
+ * texel per lobe and one); BB__BAKE_TAKE_HEIGHT: the bake frees height's
+ * pixels once it is smoothed (4 bytes a texel), on success or failure. */
+enum { BB__BAKE_DROP_VIS = 1, BB__BAKE_TAKE_HEIGHT = 2 };
+bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
+                   bb_bake_result *r, bb_error *err);
+
+/* The most bytes bb__bake with flags allocates at one time for a width x
+ * height bake with options o (memory.c follows its stages), counting
+ * `held` bytes the caller holds as the bake starts (its height, freed
+ * after smoothing with BB__BAKE_TAKE_HEIGHT); *kept (may be NULL) receives
+ * what is left allocated once it returns (the maps it made). An upper
+ * bound, from the sizes alone. */
+double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned flags,
+                       double held, double *kept);
 
 /* The grey of img (1 channel: it; 2: the first; 3 or more: Rec. 709 luma
  * of R, G, B) into out (allocated, 1 channel), which must be width x

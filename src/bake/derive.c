@@ -4,7 +4,9 @@
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static double dot3(const float n[3], const double b[3]) {
@@ -180,6 +182,80 @@ bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
   derive_job job;
   job_init(&job, normals, vis, out, &b);
   return run_rows(&job, ssbump_row, threads, err);
+}
+
+/* ssbump of one texel row from its normals (3 floats a texel). */
+static void ssbump_of_row(const derive_job *job, const float *normals, int y) {
+  const bb_image *vis = job->vis;
+  const int count = job->count;
+  const size_t first = row_start(vis, y);
+  for (int x = 0; x < vis->width; x++) {
+    const float *n = normals + 3 * (size_t)x;
+    const float *v = vis->pixels + (size_t)vis->channels * (first + (size_t)x) + 1;
+    float *s = job->out->pixels + (size_t)count * (first + (size_t)x);
+    for (int c = 0; c < count; c++)
+      s[c] = (float)(max0(dot3(n, job->basis[c])) * (double)v[c]);
+  }
+}
+
+/* Rows of texels the fused derive computes normals for at a time. */
+enum { NORMAL_BAND_ROWS = 16 };
+
+typedef struct fused_job {
+  derive_job derive;
+  const bb_image *filtered;
+  float scale;
+  bb_normal_filter filter;
+  bb_addressing addressing;
+  atomic_int out_of_memory;
+} fused_job;
+
+static void fused_band(void *user, int band) {
+  fused_job *job = user;
+  const int width = job->filtered->width, rows = job->filtered->height;
+  const int y0 = band * NORMAL_BAND_ROWS;
+  const int y1 = y0 + NORMAL_BAND_ROWS < rows ? y0 + NORMAL_BAND_ROWS : rows;
+  float *normals = malloc((size_t)(y1 - y0) * (size_t)width * 3 * sizeof(float));
+  if (!normals) {
+    atomic_store(&job->out_of_memory, 1);
+    return;
+  }
+  bb__normals_rows(job->filtered, job->scale, job->filter, job->addressing, y0, y1, normals);
+  for (int y = y0; y < y1; y++)
+    ssbump_of_row(&job->derive, normals + 3 * (size_t)(y - y0) * (size_t)width, y);
+  free(normals);
+}
+
+bb_status bb__derive_ssbump_from_height(const bb_image *filtered, float height_scale,
+                                        bb_normal_filter filter, bb_addressing addressing,
+                                        const bb_image *vis, const bb_basis *basis, int threads,
+                                        bb_image *out, bb_error *err) {
+  bb_status st;
+  bb_basis b;
+  if ((st = check_image(filtered, "height", 1, 1, err)) != BB_OK)
+    return st;
+  if ((st = check_image(vis, "visibility", 4, 1 + BB_MAX_BASIS, err)) != BB_OK)
+    return st;
+  if ((st = resolve_basis(basis, vis->channels - 1, "visibility", &b, err)) != BB_OK)
+    return st;
+  if (vis->width != filtered->width || vis->height != filtered->height)
+    return bb__fail(err, BB_ERR_ARGUMENT, "derive: visibility is %dx%d but the height is %dx%d",
+                    vis->width, vis->height, filtered->width, filtered->height);
+  if ((st = check_output(out, filtered, vis, err)) != BB_OK)
+    return st;
+  if ((st = bb_image_alloc(out, vis->width, vis->height, b.count, err)) != BB_OK)
+    return st;
+  fused_job job = {.filtered = filtered, .scale = height_scale, .filter = filter,
+                   .addressing = addressing};
+  job_init(&job.derive, NULL, vis, out, &b);
+  atomic_init(&job.out_of_memory, 0);
+  const int bands = (vis->height + NORMAL_BAND_ROWS - 1) / NORMAL_BAND_ROWS;
+  st = bb__parallel_for(bands, threads, fused_band, &job, NULL, NULL, err);
+  if (st == BB_OK && atomic_load(&job.out_of_memory))
+    st = bb__fail(err, BB_ERR_MEMORY, "derive: out of memory for a band of normals");
+  if (st != BB_OK)
+    bb_image_free(out);
+  return st;
 }
 
 static void ao_row(void *user, int y) {

@@ -41,7 +41,8 @@ typedef struct normal_job {
   double scale;
   bb_normal_filter filter;
   bb_addressing addressing;
-  bb_image *out;
+  bb_image *out; /* rows row0 .. row0 + out->height - 1 of the normals */
+  int row0;
 } normal_job;
 
 /* Texel rows per parallel work item: the cell rows above and below a band are
@@ -96,7 +97,7 @@ static void cell_row(const normal_job *job, int y0, int first, int count,
 /* Writes n / |n| at (x, y). n.z > 0 in every estimator, so |n| is never 0. */
 static void write_unit(const normal_job *job, int x, int y, const double n[3]) {
   double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  float *p = job->out->pixels + 3 * ((size_t)y * (size_t)job->out->width + (size_t)x);
+  float *p = job->out->pixels + 3 * ((size_t)(y - job->row0) * (size_t)job->out->width + (size_t)x);
   for (int c = 0; c < 3; c++)
     p[c] = (float)(n[c] / len);
 }
@@ -213,12 +214,28 @@ static void normal_sobel(const normal_job *job, int x, int y, double n[3]) {
   n[2] = 1.0;
 }
 
+static void normal_rows(const normal_job *job, int y_start, int y_end);
+
 /* One work item: texel rows band*BAND_ROWS .. +BAND_ROWS-1. */
 static void normal_band(void *user, int band) {
   const normal_job *job = user;
   const int y_start = band * BAND_ROWS;
   const int y_end = y_start + BAND_ROWS < job->height->height ? y_start + BAND_ROWS
                                                               : job->height->height;
+  normal_rows(job, y_start, y_end);
+}
+
+void bb__normals_rows(const bb_image *height, float height_scale, bb_normal_filter filter,
+                      bb_addressing addressing, int y0, int y1, float *rows) {
+  bb_image band = {height->width, y1 - y0, 3, rows};
+  const normal_job job = {height, (double)height_scale, filter, addressing, &band, y0};
+  normal_rows(&job, y0, y1);
+}
+
+/* Rows y_start .. y_end - 1 of the normals, each texel as every band
+ * computes it (each estimator's per-texel sum does not depend on where a
+ * band starts). */
+static void normal_rows(const normal_job *job, int y_start, int y_end) {
   if (job->filter == BB_NORMAL_VALVE) {
     valve_band(job, y_start, y_end);
     return;
@@ -279,7 +296,7 @@ bb_status bb__normals_compute(const bb_image *height, float height_scale,
   st = bb_image_alloc(out, height->width, height->height, 3, err);
   if (st != BB_OK)
     return st;
-  normal_job job = {height, (double)height_scale, filter, addressing, out};
+  normal_job job = {height, (double)height_scale, filter, addressing, out, 0};
   const int bands = height->height / BAND_ROWS + (height->height % BAND_ROWS != 0);
   st = bb__parallel_for(bands, threads, normal_band, &job, NULL, NULL, err);
   if (st != BB_OK)

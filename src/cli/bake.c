@@ -3,6 +3,7 @@
  * job planned, run and reported by the library (bb_job_*); this file keeps
  * the words. */
 #include "cli.h"
+#include "cluster.h"
 #include "common.h"
 #include "job_json.h"
 #include "json.h"
@@ -94,6 +95,12 @@ static const cli_option opt_json = {
     .long_name = "json",
     .default_text = "off",
     .help = "print one JSON line describing the bake on stdout"};
+static const cli_option opt_scheduler = {
+    .id = CLI_OPT_SCHEDULER,
+    .long_name = "scheduler",
+    .value_name = "ADDRESS",
+    .help = "bake on the Dask cluster of this scheduler (tcp://host:8786): a batch's inputs "
+            "on its workers, a single map's trace split over them (docs/cluster.md)"};
 static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
                                      .long_name = "quiet",
                                      .short_name = 'q',
@@ -137,7 +144,7 @@ static const cli_option *const bake_options[] = {
     &opt_out_dir,      &opt_maps,          &opt_name,         &opt_keep_going,
     &opt_force,        &opt_depfile,       &opt_json,         &opt_quiet,
     CLI_TEXTURE_OPTIONS, &cli_opt_vmt,     &cli_opt_materials, &cli_opt_basetexture,
-    &cli_opt_help,
+    &opt_scheduler,    &cli_opt_help,
 };
 
 static const cli_command bake_command = {
@@ -172,6 +179,7 @@ typedef struct bake_args {
   cli_slope_args slope; /* --slope FILE, --lit AZ,EL */
   const char *maps;     /* --maps LIST as given */
   int json, quiet;
+  const char *scheduler; /* --scheduler ADDRESS, or NULL */
 } bake_args;
 
 static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
@@ -192,6 +200,7 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_DEPFILE: a->job.depfile = arg; return 0;
   case CLI_OPT_JSON: a->json = 1; return 0;
   case CLI_OPT_QUIET: a->quiet = 1; return 0;
+  case CLI_OPT_SCHEDULER: a->scheduler = arg; return 0;
   case CLI_OPT_SLICES: return cli_settings_apply_slices(bake_command.name, &a->settings, arg);
   case CLI_OPT_BOUNCE:
     return cli_parse_double(bake_command.name, "--bounce", arg, 0.0, 0, 1.0,
@@ -417,11 +426,21 @@ int bb_cli_bake(int argc, char **argv) {
   cli_settings_init(&a.settings);
   bb_job_options_init(&a.job);
   int first = 0;
+  /* the arguments as typed, for --scheduler (getopt permutes argv) */
+  char **typed = malloc(((size_t)argc + 1) * sizeof *typed);
+  if (!typed) {
+    free(command_line);
+    return BB_EXIT_FAILURE;
+  }
+  memcpy(typed, argv, (size_t)argc * sizeof *typed);
   int rc = bake_parse(argc, argv, &a, &first);
   if (rc < 0)
     rc = BB_EXIT_OK; /* --help */
+  else if (rc == 0 && a.scheduler)
+    rc = cli_cluster_exec(argc, typed); /* returns only on failure */
   else if (rc == 0)
     rc = bake_run(&a, command_line, argv, argc, first);
+  free(typed);
   free(command_line);
   return rc;
 }

@@ -50,6 +50,7 @@ typedef enum cli_opt_id {
   CLI_OPT_DEPFILE,
   CLI_OPT_SLOPE,     /* bake --slope FILE */
   CLI_OPT_SLOPE_LIT, /* bake --lit AZ,EL */
+  CLI_OPT_SCHEDULER, /* bake --scheduler ADDRESS: on a Dask cluster */
   /* bake's inter-reflection and brightness */
   CLI_OPT_BOUNCE,
   CLI_OPT_BOUNCES,

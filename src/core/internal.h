@@ -89,6 +89,11 @@ uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
 /* bb__fnv1a_u32 over the bits of n floats. */
 uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n);
 
+/* BB_OK when need bytes fit in what bb_memory_available says is left, else
+ * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
+ * (MemAvailable)". BB_OK when nothing can be known. */
+bb_status bb__memory_check(double need, const char *what, bb_error *err);
+
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);
 

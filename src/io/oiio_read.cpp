@@ -40,6 +40,12 @@ namespace {
 
 constexpr long MiB = 1L << 20;
 
+// OpenImageIO's own guard on an image's samples: the most any read may
+// take, BB_MAX_READ_BYTES_PER_TEXEL bytes for each of BB_MAX_PIXELS texels.
+constexpr double oiio_imagesize_limit() {
+  return (double)BB_MAX_PIXELS * BB_MAX_READ_BYTES_PER_TEXEL;
+}
+
 // OIIO's refusal under its limits spans two lines and tells the reader to
 // raise an OIIO attribute, which a bumpbake user cannot: keep the first line.
 bool is_limit_refusal(const std::string &why) {
@@ -163,8 +169,8 @@ opened_input open_input(const char *path, bool reading, bb_status *st, bb_error 
     std::string why = OIIO::geterror();
     if (is_limit_refusal(why))
       *st = bb__fail(err, BB_ERR_SIZE,
-                     "%s: too large to read: %s (bumpbake reads at most %ld MiB of samples)",
-                     path, bb::first_line(why).c_str(), BB_MAX_READ_BYTES / MiB);
+                     "%s: too large to read: %s (bumpbake reads at most %.0f MiB of samples)",
+                     path, bb::first_line(why).c_str(), oiio_imagesize_limit() / (double)MiB);
     else
       *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
                      bb::one_line(why).c_str());
@@ -291,7 +297,7 @@ void oiio_setup() {
   static std::once_flag once;
   std::call_once(once, [] {
     int mb = 0, channels = 0, exr_threads = 0;
-    const int our_mb = (int)(BB_MAX_READ_BYTES / MiB);
+    const int our_mb = (int)(oiio_imagesize_limit() / MiB);
     if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
       OIIO::attribute("limits:imagesize_MB", our_mb);
     if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)

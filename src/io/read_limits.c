@@ -1,9 +1,12 @@
 /* read_limits.c: the bounds every image read applies, from the header, before
  * it allocates: the public limits (BB_MAX_DIMENSION, BB_MAX_PIXELS,
- * BB_MAX_READ_BYTES, 64 channels) and how a read is cut into bands. */
+ * BB_MAX_READ_BYTES and its bytes a texel, 64 channels), the memory left,
+ * and how a read is cut into bands. */
 #include "io/read_limits.h"
 #include "core/internal.h"
 #include "io/header_probe.h"
+
+#include <stdio.h>
 
 #define MiB (1L << 20)
 
@@ -47,8 +50,18 @@ bb_status bb__read_check_probe(const char *path, const bb__probe *p, int reading
                     "%s: too large to read: %s blocks of %.0f MiB each (bumpbake decodes at "
                     "most %ld MiB at once)",
                     path, p->format, p->chunk_bytes / (double)MiB, BB__MAX_CHUNK_BYTES / MiB);
-  if (reading && p->width > 0 && p->height > 0) return check_texels(path, p->width, p->height, err);
-  return BB_OK;
+  if (reading && p->width > 0 && p->height > 0) {
+    const bb_status st = check_texels(path, p->width, p->height, err);
+    if (st != BB_OK) return st;
+  }
+  /* What the open allocates, and a read's floats of one channel at least
+   * beside it, must fit in what this process may still allocate: a size
+   * within the limits can still be more than the machine has. */
+  const double texels = (double)(p->width > 0 ? p->width : 0) * (double)(p->height > 0 ? p->height : 0);
+  char what[600];
+  snprintf(what, sizeof what, "%s: %s a %s of %dx%d", path, reading ? "reading" : "opening",
+           p->format, p->width, p->height);
+  return bb__memory_check(p->open_bytes + (reading ? texels * 4.0 : 0.0), what, err);
 }
 
 bb_status bb__read_check_size(const char *path, const bb__image_header *h, int channels_read,
@@ -74,13 +87,20 @@ bb_status bb__read_check_size(const char *path, const bb__image_header *h, int c
   }
   const double float_bytes = texels * channels_read * (double)sizeof(float);
   const double bytes = h->file_bytes > float_bytes ? h->file_bytes : float_bytes;
-  if (bytes > (double)BB_MAX_READ_BYTES)
+  const double per_texel = texels * BB_MAX_READ_BYTES_PER_TEXEL;
+  const double limit = per_texel > (double)BB_MAX_READ_BYTES ? per_texel : (double)BB_MAX_READ_BYTES;
+  if (bytes > limit)
     return bb__fail(err, BB_ERR_SIZE,
                     "%s: %dx%d with %d channels of %s needs %.0f MiB, over the limit of "
-                    "%ld MiB",
+                    "%.0f MiB",
                     path, h->width, h->height, h->channels, h->format, bytes / (double)MiB,
-                    BB_MAX_READ_BYTES / MiB);
-  return BB_OK;
+                    limit / (double)MiB);
+  /* The floats, and at most the file's own samples decoded beside them,
+   * must fit in what this process may still allocate. */
+  char what[600];
+  snprintf(what, sizeof what, "%s: reading %dx%d with %d channels of %s", path, h->width,
+           h->height, h->channels, h->format);
+  return bb__memory_check(float_bytes + h->file_bytes, what, err);
 }
 
 int bb__read_band_rows(const bb__image_header *h, int channels) {

@@ -21,6 +21,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -174,13 +176,19 @@ static void release(bb_staged_file *f, int remove_temp) {
     f->fd = -1;
   }
   if (f->dir_fd >= 0) {
-    if (remove_temp) unlinkat(f->dir_fd, f->leaf, 0);
-    close(f->dir_fd);
-    f->dir_fd = -1;
+    if (remove_temp && f->leaf) unlinkat(f->dir_fd, f->leaf, 0);
   } else if (remove_temp && f->temp_path) {
     unlink(f->temp_path);
   }
   if (f->temp_dir) rmdir(f->temp_dir); /* empty once its file is gone or renamed */
+  /* The locks go last, after the rename, unlink or rmdir: a sweep never
+   * sees a temporary of ours unlocked. */
+  if (f->dir_fd >= 0) {
+    close(f->dir_fd);
+    f->dir_fd = -1;
+  }
+  if (f->locked) close(f->lock_fd);
+  f->locked = 0;
   unregister_temp(f->slot);
   unregister_temp(f->file_slot);
   unregister_temp(f->dir_slot);
@@ -202,9 +210,30 @@ static void release(bb_staged_file *f, int remove_temp) {
 
 enum { BUFFER_BYTES = 1 << 16 };
 
-/* Creates the temporary with O_EXCL. Its name is registered before the
- * file exists, so no instant passes in which a signal could leave it
- * behind; a name that already exists is unregistered and another tried. */
+/* Locks the temporary just created as fd under name, for
+ * bb_tempfiles_sweep: 0 when this process now holds the lock on the file
+ * that name names, EEXIST when a sweep got to it first (it removes what it
+ * locks: try another name), or another errno. The lock goes with a dup of
+ * fd into *lock_fd, which stays open until the temporary is renamed or
+ * removed; with lock_fd NULL, with fd itself. */
+static int lock_temp(int fd, const char *name, int *lock_fd) {
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0)
+    return errno == EWOULDBLOCK ? EEXIST : (errno == ENOLCK || errno == EINVAL ? ENOLCK : errno);
+  struct stat ours, named;
+  if (fstat(fd, &ours) != 0 || stat(name, &named) != 0 || ours.st_dev != named.st_dev ||
+      ours.st_ino != named.st_ino)
+    return EEXIST; /* swept between the open and the lock */
+  if (!lock_fd) return 0; /* the lock goes with fd itself */
+  *lock_fd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  return *lock_fd >= 0 ? 0 : errno;
+}
+
+/* Creates the temporary with O_EXCL and locks it. Its name is registered
+ * before the file exists, so no instant passes in which a signal could
+ * leave it behind; a name that already exists is unregistered and another
+ * tried. A filesystem without locks (ENOLCK) still gets its temporary,
+ * unlocked: a sweep there may take it for an orphan, which only a sweep run
+ * while it is written can do. */
 static int create_temp(bb_staged_file *f) {
   uint64_t seed = fresh_seed();
   for (int attempt = 0; attempt < 100; attempt++) {
@@ -215,13 +244,19 @@ static int create_temp(bb_staged_file *f) {
     /* 0666 less the umask, as for any new file (mkstemp would make 0600,
      * and the rename keeps the mode). */
     int fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
+    int error = fd >= 0 ? lock_temp(fd, name, &f->lock_fd) : errno;
+    if (error == ENOLCK)
+      error = 0;
+    else if (!error)
+      f->locked = 1;
+    if (!error) {
       f->fd = fd;
       f->slot = slot;
       f->temp_path = name;
       return 0;
     }
-    int error = errno;
+    if (fd >= 0)
+      close(fd); /* a sweep's: not ours to remove */
     unregister_temp(slot);
     free(name);
     if (error != EEXIST)
@@ -261,29 +296,36 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
 }
 
 /* Creates the private directory with mkdir (which never follows a link and
- * fails on any existing name), registered before it exists, and opens it
- * without following a link: *dir_fd, f->temp_dir and f->dir_slot. */
+ * fails on any existing name), registered before it exists, opens it
+ * without following a link and locks it as create_temp locks a file:
+ * f->dir_fd, f->temp_dir and f->dir_slot. A directory a sweep removed or
+ * locked first (it removes what it locks) is given up for another name. */
 static int create_private_dir(bb_staged_file *f) {
   uint64_t seed = fresh_seed();
   for (int attempt = 0; attempt < 100; attempt++) {
     char *name = temp_name(f->path, "", &seed);
     if (!name) return ENOMEM;
     int slot = register_path(name, 1);
-    if (mkdir(name, 0700) == 0) {
+    int error = mkdir(name, 0700) == 0 ? 0 : errno;
+    int fd = -1;
+    if (!error) {
+      /* Swapped for a link or another's directory in between: refused. */
+      fd = open(name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+      struct stat st;
+      if (fd < 0)
+        error = errno == ENOENT ? EEXIST : errno;
+      else if (fstat(fd, &st) != 0 || st.st_uid != geteuid() || (st.st_mode & 077) != 0)
+        error = EPERM;
+      else if ((error = lock_temp(fd, name, NULL)) == ENOLCK)
+        error = 0; /* no locks here: unlocked, as create_temp's files */
+    }
+    if (!error) {
       f->temp_dir = name;
       f->dir_slot = slot;
-      /* Swapped for a link or another's directory in between: refused. */
-      int fd = open(name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-      struct stat st;
-      if (fd < 0) return errno;
-      if (fstat(fd, &st) != 0 || st.st_uid != geteuid() || (st.st_mode & 077) != 0) {
-        close(fd);
-        return EPERM;
-      }
       f->dir_fd = fd;
       return 0;
     }
-    int error = errno;
+    if (fd >= 0) close(fd);
     unregister_temp(slot);
     free(name);
     if (error != EEXIST) return error;
@@ -513,6 +555,95 @@ bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
 void bb__safe_discard(bb_staged_file *f) {
   if (f)
     release(f, 1);
+}
+
+/* ------------------------------------------------------- orphans */
+
+/* ".bb-tmp-" and six characters of temp_name's alphabet, then anything (the
+ * extension). */
+static int is_temp_name(const char *name) {
+  if (strncmp(name, ".bb-tmp-", 8) != 0)
+    return 0;
+  for (int i = 8; i < 14; i++) {
+    const char c = name[i];
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9')))
+      return 0;
+  }
+  return name[14] == '\0' || name[14] == '.';
+}
+
+/* Empties a private directory (bb__safe_open_private) whose writer is gone,
+ * open as fd: its staged file, whatever the encoder named "staged*". */
+static void empty_private_dir(int fd) {
+  const int listing = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  DIR *d = listing >= 0 ? fdopendir(listing) : NULL;
+  if (!d) {
+    if (listing >= 0) close(listing);
+    return;
+  }
+  for (struct dirent *e; (e = readdir(d)) != NULL;)
+    if (strncmp(e->d_name, "staged", 6) == 0) unlinkat(fd, e->d_name, 0);
+  closedir(d);
+}
+
+/* Removes dir/name when it is a temporary nobody holds (a file, or a
+ * private directory and its staged file): 1 removed, 0 left (held, gone,
+ * neither, or a directory holding something else), -1 failed (errno). */
+static int sweep_one(const char *dir, const char *name) {
+  char path[PATH_MAX];
+  if (snprintf(path, sizeof path, "%s/%s", dir, name) >= (int)sizeof path)
+    return 0;
+  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    return errno == ENOENT || errno == ELOOP ? 0 : -1;
+  int removed = 0;
+  struct stat held, named;
+  if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &held) == 0 &&
+      lstat(path, &named) == 0 && held.st_dev == named.st_dev && held.st_ino == named.st_ino) {
+    /* Locked by us, it is still the file at that name: its writer is gone. */
+    if (S_ISREG(held.st_mode)) {
+      if (unlink(path) == 0)
+        removed = 1;
+      else if (errno != ENOENT)
+        removed = -1;
+    } else if (S_ISDIR(held.st_mode) && name[14] == '\0' && held.st_uid == geteuid()) {
+      empty_private_dir(fd);
+      if (rmdir(path) == 0)
+        removed = 1;
+      else if (errno != ENOENT && errno != ENOTEMPTY && errno != EEXIST)
+        removed = -1;
+    }
+  }
+  const int saved = errno;
+  close(fd); /* drops the lock */
+  errno = saved;
+  return removed;
+}
+
+bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err) {
+  if (removed)
+    *removed = 0;
+  if (!dir || !*dir)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_tempfiles_sweep: no directory");
+  DIR *d = opendir(dir);
+  if (!d)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot read the directory: %s", dir, strerror(errno));
+  bb_status st = BB_OK;
+  int count = 0;
+  for (struct dirent *e; (e = readdir(d)) != NULL;) {
+    if (!is_temp_name(e->d_name))
+      continue;
+    const int r = sweep_one(dir, e->d_name);
+    if (r > 0)
+      count++;
+    else if (r < 0 && st == BB_OK)
+      st = bb__fail(err, BB_ERR_IO, "%s/%s: cannot remove a left-over temporary: %s", dir,
+                    e->d_name, strerror(errno));
+  }
+  closedir(d);
+  if (removed)
+    *removed = count;
+  return st;
 }
 
 /* ------------------------------------------------------ public handles */

@@ -34,7 +34,11 @@ extern "C" {
  *   temporary on failure and return BB_ERR_IO with "PATH: cannot write:
  *   REASON". After finish alone the complete file waits under its temporary
  *   name (that is what bb_staged_file is): commit or discard it later.
- * - A bb_staged_file may be used from several threads (each call locks). */
+ * - A bb_staged_file may be used from several threads (each call locks).
+ * - The temporary is flock'ed from its creation until it is renamed or
+ *   removed, so bb_tempfiles_sweep can tell one being written (here, or by
+ *   another process or machine sharing the directory) from one a killed
+ *   process left behind. */
 struct bb_staged_file {
   pthread_mutex_t lock;
   int lock_ready;
@@ -48,6 +52,9 @@ struct bb_staged_file {
   int64_t buffer_pos;   /* file offset of buffer[0] */
   char *path;           /* final name, malloc'd */
   char *temp_path;      /* temporary name, malloc'd */
+  int locked;           /* 1: lock_fd holds the temporary's flock */
+  int lock_fd;          /* a dup of fd, open until the temporary is renamed
+                           or removed, so its lock outlives fd's close */
   /* A file staged by name in a private directory (bb__safe_open_private):
    * the directory's path, its open descriptor, the file's name in it and
    * the registry slots of both; NULL and -1 otherwise. */

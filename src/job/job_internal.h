@@ -69,6 +69,17 @@ struct bb_job {
   char prerequisite_basis;  /* 1: basis_file is a prerequisite (a vectors basis) */
 };
 
+/* The most bytes reading, baking and writing item's input of w x h texels
+ * and `channels` channels takes at one time (memory.c): an upper bound,
+ * with 5% and 32 MiB to spare. */
+double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
+                      int channels);
+
+/* Before item's input is read: BB_ERR_MEMORY when reading, baking and
+ * writing it would take more memory than is available (memory.c), naming
+ * both figures; BB_OK otherwise, or when its header cannot be read. */
+bb_status bb__job_memory_check(const bb_job *job, const bb__job_item *item, bb_error *err);
+
 /* Most files one input's bake reads: the input, the basis file, the bounce
  * albedo map and the brightness map. */
 #define BB__JOB_MAX_READS 4

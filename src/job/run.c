@@ -1,6 +1,7 @@
 /* run.c: a planned bake job run input by input: inputs whose outputs are
  * up to date skipped, the others read, baked once and written all or
  * nothing with their provenance, and the depfile of what was made. */
+#include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
 #include "job/job_internal.h"
@@ -246,16 +247,22 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
   baked b;
   memset(&b, 0, sizeof b);
   const double t0 = bb__now_seconds();
-  bb_status st = bb_height_file_read(item->input, job->options.channel,
-                                     job->options.bake.height_scale, job->options.note,
-                                     job->options.note_user, &b.height, &r->source, err);
+  bb_status st = bb__job_memory_check(job, item, err);
+  if (st == BB_OK)
+    st = bb_height_file_read(item->input, job->options.channel,
+                             job->options.bake.height_scale, job->options.note,
+                             job->options.note_user, &b.height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
+  const int height_width = b.height.width, height_height = b.height.height;
   if (st == BB_OK) {
     bb_bake_options o = job->options.bake;
     o.trace.progress = progress;
     o.trace.progress_user = progress_user;
     bb_error bake_err = {{0}};
-    st = bb_bake(&b.height, &o, &b.result, &bake_err);
+    /* only the maps are written: the bake lets the height and vis go as
+     * soon as it is done with them */
+    st = bb__bake(&b.height, &o, BB__BAKE_DROP_VIS | BB__BAKE_TAKE_HEIGHT, &b.result,
+                  &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
@@ -263,8 +270,8 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
     st = make_slope(job, item, &b, err);
   if (st == BB_OK) {
     const bb_bake_result *res = &b.result;
-    r->width = b.height.width;
-    r->height = b.height.height;
+    r->width = height_width;
+    r->height = height_height;
     r->threads = res->threads;
     r->slices = res->rayset_id[0] ? bb_bake_slices(&job->options.bake) : 0;
     snprintf(r->rayset_id, sizeof r->rayset_id, "%s", res->rayset_id);

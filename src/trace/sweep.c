@@ -694,7 +694,8 @@ static void integrate_line(const sweep_job *job, const profile *pr, int x0, int 
     if (!dir || !dir->horizon) continue;
     for (int j = 0; j < pr->len; j++) dir->horizon[pr->texel[j]] = pr->found[k][j];
   }
-  if (job->side[0].dir && job->side[1].dir) {
+  if (job->side[0].dir && job->side[1].dir && job->side[0].dir->sums &&
+      job->side[1].dir->sums) {
     const bb__slice_integral *along = &job->side[0].integral, *opposite = &job->side[1].integral;
     float *sums = job->side[0].dir->sums;
     for (int j = 0; j < pr->len; j++) {
@@ -706,7 +707,7 @@ static void integrate_line(const sweep_job *job, const profile *pr, int x0, int 
   }
   for (int k = 0; k < 2; k++) {
     const bb__sweep_dir *dir = job->side[k].dir;
-    if (!dir) continue;
+    if (!dir || !dir->sums) continue; /* horizons only */
     for (int j = 0; j < pr->len; j++)
       bb__slice_accumulate(&job->side[k].integral, pr->found[k][j],
                            dir->sums + pr->texel[j] * (size_t)channels);
@@ -988,9 +989,10 @@ static int job_chords(sweep_job *job) {
 }
 
 static bb_status check_dir(const bb__sweep_dir *dir, int hooked, bb_error *err) {
-  if (dir && (!dir->rs || (!dir->sums && !hooked) || dir->slice < 0 ||
+  if (dir && (!dir->rs || (!dir->sums && !dir->horizon && !hooked) || dir->slice < 0 ||
               dir->slice >= dir->rs->slice_count))
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a sweep direction needs a slice and sums");
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "trace: a sweep direction needs a slice, and sums or horizons");
   return BB_OK;
 }
 

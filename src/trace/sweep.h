@@ -11,7 +11,9 @@
 
 /* One direction of a line sweep: slice s of rs, whose loss at each texel is
  * added to sums (1 + basis_count floats per texel); horizon (may be NULL)
- * receives each texel's horizon, for tests. */
+ * receives each texel's horizon (tests, and bb_trace_horizons, which gives
+ * sums NULL: horizons only, nothing added). One of the two is needed; when
+ * both directions of a sweep add, they add to the same sums. */
 typedef struct bb__sweep_dir {
   const bb_rayset *rs;
   int slice;

@@ -180,3 +180,118 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
     *horizons_found = (double)vis->width * (double)vis->height * (double)rs->slice_count;
   return st;
 }
+
+/* ------------------------------------------------------------ split trace */
+
+/* A trace split over processes: horizons found by any of them, added up by
+ * one in the order every path adds them (order_slices), so the sums are the
+ * bits bb_trace_occlusion makes. */
+
+bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err) {
+  if (!rs || !order || rs->slice_count < 1 || rs->slice_count > BB_MAX_SLICES)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing ray set or order");
+  if (order_slices(rs, order) != 0) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  return BB_OK;
+}
+
+bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs, const bb_trace_options *o,
+                            const int *slices, int count, bb_image *horizons, bb_error *err) {
+  if (!horizons || count < 0 || (count > 0 && !slices))
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing slices or horizons");
+  for (int k = 0; k < count; k++) memset(&horizons[k], 0, sizeof horizons[k]);
+  bb_status st = check_trace(p, rs, o, err);
+  if (st != BB_OK) return st;
+  if (o->region.width != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: horizons are found for the whole image, "
+                                          "not a region");
+  int order[BB_MAX_SLICES];
+  if (order_slices(rs, order) != 0) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  for (int k = 0; k < count; k++) {
+    if (slices[k] < 0 || slices[k] >= rs->slice_count)
+      return bb__fail(err, BB_ERR_ARGUMENT, "trace: slice %d is not one of the ray set's 0..%d",
+                      slices[k], rs->slice_count - 1);
+    for (int j = 0; j < k; j++)
+      if (slices[j] == slices[k])
+        return bb__fail(err, BB_ERR_ARGUMENT, "trace: slice %d asked twice", slices[k]);
+  }
+  for (int k = 0; k < count && st == BB_OK; k++)
+    st = bb_image_alloc(&horizons[k], p->width, p->height, 1, err);
+  /* The sweeps of trace_sweeps, walking the summing order: a slice and its
+   * opposite share one, the earlier along; a sweep runs for either or both
+   * of its directions when asked, so each horizon is found exactly as the
+   * whole trace finds it. */
+  int sweeps = 0;
+  for (int k = 0; k < rs->slice_count; k += 1 + (k + 1 < rs->slice_count &&
+                                                    opposite_steps(rs, order[k], order[k + 1])))
+    sweeps++;
+  int sweep = 0;
+  for (int k = 0; st == BB_OK && k < rs->slice_count; sweep++) {
+    const int s = order[k];
+    const int pair = k + 1 < rs->slice_count && opposite_steps(rs, s, order[k + 1]);
+    const int t = pair ? order[k + 1] : -1;
+    bb_image *hs = NULL, *ht = NULL;
+    for (int j = 0; j < count; j++) {
+      if (slices[j] == s) hs = &horizons[j];
+      if (slices[j] == t) ht = &horizons[j];
+    }
+    const bb__sweep_dir along = {rs, s, NULL, hs ? hs->pixels : NULL};
+    const bb__sweep_dir opposite = {rs, pair ? t : 0, NULL, ht ? ht->pixels : NULL};
+    if (hs || ht)
+      st = bb__sweep_lines(p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
+                           hs ? &along : NULL, ht ? &opposite : NULL, o->bias_texels,
+                           o->threads, 0, err);
+    k += pair ? 2 : 1;
+    if (st == BB_OK && (hs || ht) && o->progress &&
+        o->progress(o->progress_user, sweep + 1, sweeps))
+      st = bb__fail(err, BB_ERR_CANCELLED, "trace: cancelled by the progress callback");
+  }
+  if (st != BB_OK)
+    for (int k = 0; k < count; k++) bb_image_free(&horizons[k]);
+  return st;
+}
+
+/* One row of a slice's losses added to the sums (accumulate_row). */
+typedef struct accumulate_job {
+  bb__slice_integral integral;
+  const float *horizon;
+  float *sums;
+  int width, channels;
+} accumulate_job;
+
+static void accumulate_row(void *user, int y) {
+  const accumulate_job *job = user;
+  const size_t first = (size_t)y * (size_t)job->width;
+  for (size_t i = first; i < first + (size_t)job->width; i++)
+    bb__slice_accumulate(&job->integral, job->horizon[i], job->sums + i * (size_t)job->channels);
+}
+
+bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
+                              bb_image *sums, int threads, bb_error *err) {
+  if (!rs || !horizon || !sums || !horizon->pixels || !sums->pixels || !rs->table)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: missing ray set, horizons or sums");
+  if (rank < 0 || rank >= rs->slice_count)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: rank %d is not one of the ray set's 0..%d",
+                    rank, rs->slice_count - 1);
+  if (horizon->channels != 1 || sums->channels != 1 + rs->basis_count ||
+      horizon->width != sums->width || horizon->height != sums->height)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "trace: horizons %dx%d (%d channels) and sums %dx%d (%d channels) do not "
+                    "match: sums need 1 + %d lobes channels of the horizons' size",
+                    horizon->width, horizon->height, horizon->channels, sums->width,
+                    sums->height, sums->channels, rs->basis_count);
+  int order[BB_MAX_SLICES];
+  if (order_slices(rs, order) != 0) return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory");
+  const accumulate_job job = {bb__slice_integral_of(rs, order[rank]), horizon->pixels,
+                              sums->pixels, sums->width, sums->channels};
+  return bb__parallel_for(sums->height, threads, accumulate_row, (void *)&job, NULL, NULL, err);
+}
+
+bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err) {
+  if (!rs || !sums || !sums->pixels || sums->channels != 1 + rs->basis_count)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: sums need 1 + %d lobes channels",
+                    rs ? rs->basis_count : 0);
+  trace_job job = {.rs = rs, .channels = sums->channels};
+  job.region = (bb_region){0, 0, sums->width, sums->height};
+  job.vis = sums->pixels;
+  return bb__parallel_for(sums->height, threads, finish_row, &job, NULL, NULL, err);
+}

@@ -1120,18 +1120,19 @@ Test(cli, hostile_headers_cost_bounded_time_and_memory) {
   cr_expect(strstr(r.out, "8192 x 8192, 4 channels, tiff"), "%s", r.out);
   cli_result_free(&r);
 
-  /* 8192 x 8192 x 64 x 1 byte is 4 GiB of samples: refused from the header. */
-  const char *const bakes[][8] = {
-      {"bake", h64, "--scale", "2", "--normal", tmp("n.png"), NULL},
-      {"info", h64, NULL},
-  };
-  for (int i = 0; i < 2; i++) {
-    r = run_bounded(bakes[i]);
-    cr_expect_eq(r.code, 1, "%s: %s", bakes[i][0], r.err);
-    cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
-    cr_expect(strstr(r.err, "h64.tif") && strstr(r.err, "1024 MiB"), "%s", r.err);
-    cli_result_free(&r);
-  }
+  /* 8192 x 8192 x 64 x 1 byte is 4 GiB of samples, 64 bytes a texel (an
+   * image of RGBA floats is 16): a bake refuses it from the header; info
+   * describes the header. */
+  r = run_bounded((const char *[]){"bake", h64, "--scale", "2", "--normal", tmp("n.png"),
+                                   NULL});
+  cr_expect_eq(r.code, 1, "%s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
+  cr_expect(strstr(r.err, "h64.tif") && strstr(r.err, "1024 MiB"), "%s", r.err);
+  cli_result_free(&r);
+  r = run_bounded((const char *[]){"info", h64, NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "8192 x 8192, 64 channels, tiff"), "%s", r.out);
+  cli_result_free(&r);
 
   /* 4 channels fit the limit; the data ends in the first band. */
   r = run_bounded((const char *[]){"bake", h4, "--scale", "2", "--normal", tmp("n.png"),

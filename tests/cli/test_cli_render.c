@@ -227,17 +227,17 @@ Test(cli_render, usage_errors) {
   expect_no_new_files(0);
 }
 
-/* Checked once the size is known, before the bake: 8 x 1025 squared is over
- * the 8192 x 8192 maximum. */
+/* Checked once the size is known, before the bake: 8 x 4097 squared is over
+ * the 32768 x 32768 maximum. */
 Test(cli_render, tiles_over_the_maximum) {
   bb_image h;
-  cr_assert_eq(bb_image_alloc(&h, 1025, 1025, 1, NULL), BB_OK);
+  cr_assert_eq(bb_image_alloc(&h, 4097, 4097, 1, NULL), BB_OK);
   bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
   cr_assert_eq(bb_image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   cli_result r =
       RUN("render", tmp("big.png"), "--scale", "8", "--tile", "8", "-o", tmp("o.png"));
-  expect_one_line_error(&r, 2, "8200x8200 picture, over the maximum");
+  expect_one_line_error(&r, 2, "32776x32776 picture, over the maximum");
   cli_result_free(&r);
   expect_no_new_files(1);
 }

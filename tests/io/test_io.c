@@ -752,7 +752,7 @@ Test(io, huge_png_dimension_is_a_size_error) {
 
 Test(io, png_with_too_many_pixels_is_a_size_error) {
   /* Each side is allowed; the product is over BB_MAX_PIXELS. */
-  write_png_header(tmp_path("wide.png"), 65536, 1025);
+  write_png_header(tmp_path("wide.png"), 65536, 16385);
   check_read_fails(tmp_path("wide.png"), BB_ERR_SIZE, "over the maximum");
 }
 
@@ -1184,7 +1184,9 @@ Test(io, tempfiles_remove_takes_pending_temporaries_only) {
 /* ------------------------------------------------ hostile headers (issue 10) */
 
 /* The 186-byte TIFF declaring 8192 x 8192 x 64 channels once took 16.5 GB
- * and 47 s: refused from its header, before any allocation. The read runs
+ * and 47 s: its read is refused from its header (64 bytes a texel, over the
+ * 16 of an RGBA float image), before any allocation; its header alone is
+ * described, at once. The read runs
  * in a child whose address space is capped (except under ASan, which
  * reserves terabytes), so a regression fails here instead of taking the
  * machine's memory. */
@@ -1217,8 +1219,12 @@ Test(io, hostile_tiff_header_is_refused_before_allocating) {
     bb_status st = run_in_child(read_with_capped_memory, &r, msg, sizeof msg);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-    cr_expect_eq(st, BB_ERR_SIZE, "%s", msg);
-    cr_expect(strstr(msg, "hostile.tif") && strstr(msg, "1024 MiB"), "%s", msg);
+    if (header_only) {
+      cr_expect_eq(st, BB_OK, "%s", msg);
+    } else {
+      cr_expect_eq(st, BB_ERR_SIZE, "%s", msg);
+      cr_expect(strstr(msg, "hostile.tif") && strstr(msg, "1024 MiB"), "%s", msg);
+    }
     cr_expect_null(strchr(msg, '\n'), "%s", msg);
     cr_expect_lt(seconds, 5.0);
   }

@@ -1,0 +1,24 @@
+"""bumpbake on a Dask cluster (Debian's python3-distributed): batches and
+big maps spread over many machines, the bytes one machine writes.
+
+    from distributed import Client
+    import bumpbake.dask
+    client = Client("tcp://scheduler:8786")
+    reports = bumpbake.dask.bake_files("heights/", "maps/", client=client, scale=64)
+    report = bumpbake.dask.bake_big("terrain_16k.png", prefix="maps/terrain", client=client,
+                                    scale=64)
+
+bake_files: a batch planned on the client, its stale inputs baked on the
+workers in chunks. bake_big: one map whose trace (the sweeps of its
+slices) is split over the workers and added up in the single machine's
+order, so its files are a single bake's bit for bit. Workers open the
+client's paths (shared storage). `python3 -m bumpbake.dask bake ...` is
+the same from the command line (what `bumpbake bake --scheduler ADDRESS`
+runs). docs/cluster.md says how to start a cluster and what each worker
+holds.
+"""
+
+from ._batch import bake_files
+from ._big import bake_big
+
+__all__ = ["bake_big", "bake_files"]

@@ -1,0 +1,215 @@
+"""bake_files on a Dask cluster: a batch planned once on the client, its
+stale inputs baked on the workers in chunks, the same files as the CLI's
+batch."""
+
+import math
+import os
+import uuid
+
+import distributed
+
+from .. import _common
+from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
+from .._jobs import BakeJob, _raise_failures
+from ._shared import client_directory, client_of, variable_value, worker_threads
+
+# Inputs per chunk: enough chunks that the last ones end together (the
+# scheduler hands a chunk to whichever worker thread is free), few enough
+# that a task's cost (a few milliseconds: scheduling, a plan of the chunk)
+# stays small against its bakes.
+_CHUNKS_PER_THREAD = 20
+_MAX_CHUNK = 32
+
+# The stop variable's value when nothing failed: past every index.
+_NO_STOP = 2**62
+
+
+def chunk_size_for(pending, threads):
+    """Inputs per chunk for `pending` inputs on `threads` worker threads."""
+    return max(1, min(_MAX_CHUNK, math.ceil(pending / (_CHUNKS_PER_THREAD * threads))))
+
+
+class _Stop:
+    """Where a batch without keep_going stops: the index of its first failed
+    input, kept by the scheduler (a distributed.Variable, lowered under a
+    distributed.Lock) so every worker sees it before starting an input.
+    Inputs after it that have not started are not run; those before it
+    still run, as in the CLI's batch, which would have baked them first."""
+
+    def __init__(self, name):
+        self.name = name
+        self.over = False  # the batch ended: this chunk is a re-run nobody waits for
+
+    def reached(self, index):
+        if self.over:
+            return True
+        stop = variable_value(self.name, None)
+        self.over = stop is None
+        return self.over or index > stop
+
+    def lower(self, index):
+        with distributed.Lock(self.name + "-lock"):
+            stop = variable_value(self.name, None)
+            if stop is not None and index < stop:
+                distributed.Variable(self.name).set(index)
+
+
+def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
+    """On a worker: bakes inputs (indices in the batch) of one chunk with
+    the batch's arguments; returns [(index, BakeReport or None: not run)].
+    stop (a _Stop or None) says which inputs no longer start; a failure
+    lowers it when stop_on_failure. Each input is checked again (a chunk
+    run a second time, after its worker died, skips what the first run
+    finished) and written all or nothing, as bb_job_run_item does."""
+    out = []
+    with client_directory(directory):
+        job = BakeJob(inputs, args["out_dir"], notes="ignore",
+                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        for k, index in enumerate(indices):
+            if stop is not None and stop.reached(index):
+                out.append((index, None))
+                continue
+            report = job.run(k)
+            if report.status == "failed" and stop_on_failure:
+                stop.lower(index)
+            out.append((index, report))
+    return out
+
+
+def _output_directories(reports):
+    return sorted({os.path.dirname(p) or "." for r in reports for p in r.outputs.values()})
+
+
+def sweep_temporaries(directories):
+    """Removes what killed writers left in directories (bb_tempfiles_sweep);
+    the number removed."""
+    removed = 0
+    for d in directories:
+        n = _ffi.new("int *")
+        err = _ffi.new("bb_error *")
+        if os.path.isdir(d):
+            _check(_lib.bb_tempfiles_sweep(_path(d), n, err), err)
+            removed += n[0]
+    return removed
+
+
+def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=False,
+               keep_going=False, depfile=None, check=True, progress=None, notes="warn",
+               chunk_size=None, command_options=None, **options):
+    """Bakes height files and directories of them into out_dir on a Dask
+    cluster, as `bumpbake bake INPUT... --out-dir OUT_DIR` does on one
+    machine, and returns one BakeReport per input, in input order.
+
+    The batch is planned here, on the client (bumpbake.BakeJob: every
+    option and path checked, every name clash across the whole batch
+    refused before anything is baked, out_dir made); inputs whose outputs
+    are up to date are skipped here (their bytes hashed, the outputs'
+    headers read); the rest go to the workers in chunks, so many that every
+    worker thread stays busy to the end. Workers open the client's paths,
+    relative ones in the client's current directory: they must see the
+    same files at the same paths (shared storage). The files are the CLI
+    batch's byte for byte when the CLI is typed as BakeJob.command_text
+    spells the options (or give command_options, what follows `bumpbake
+    bake INPUT` in each file's provenance, as the CLI's --scheduler does).
+
+    A chunk whose worker dies is run again by Dask: what the first run
+    finished is then up to date, the rest is baked, and once the batch is
+    over the temporaries killed writers left in the output directories are
+    removed (bb_tempfiles_sweep). A re-run of the batch bakes nothing.
+
+    keep_going: go on after an input fails. Without it (the default, the
+    CLI's) the batch stops at its first failure: no input after the first
+    failed one (in input order) starts once the failure is known, and they
+    are reported "not run"; inputs before it still run, as the CLI would
+    have baked them first; inputs already being baked on other workers when
+    it failed finish (each is written whole) and are reported as they
+    ended. So more inputs may be baked than by the CLI, never fewer.
+
+    client: a distributed.Client (default: the current one). chunk_size:
+    inputs per task (default: about 20 chunks per worker thread, at most
+    32 inputs). progress(done, total), called here as inputs finish, may
+    return True to stop: no input starts after that, the rest are "not
+    run". Other arguments as bumpbake.bake_files; threads (default 1: one
+    per task, each worker thread runs a task) is the library's threads per
+    bake and changes no byte. check: raise the first failure once the
+    batch is over (its e.reports holds every report).
+    """
+    client = client_of(client)
+    directory = os.getcwd()
+    job = BakeJob(inputs, out_dir, maps=maps, name=name, force=force, keep_going=keep_going,
+                  depfile=depfile, notes=notes, command_options=command_options, **options)
+    count = len(job)
+    reports = [None] * count
+    pending = []
+    for i in range(count):
+        if not force and job.check_current(i):
+            reports[i] = job.report(i)
+            reports[i].status = "up to date"
+        else:
+            pending.append(i)
+    args = dict(job._args, depfile=None, keep_going=True)
+    args.setdefault("threads", 1)
+    if args["threads"] is None:
+        args["threads"] = 1
+    inputs_planned = job.inputs
+    size = chunk_size or chunk_size_for(len(pending), worker_threads(client))
+    if not isinstance(size, int) or size < 1:
+        raise _argument_error(f"bumpbake.dask: chunk_size must be a positive integer "
+                              f"(got {chunk_size!r})")
+    token = uuid.uuid4().hex
+    stop = None
+    if not keep_going or progress is not None:
+        stop = _Stop(f"bumpbake-stop-{token}")
+        distributed.Variable(stop.name, client=client).set(_NO_STOP)
+    chunks = [pending[c:c + size] for c in range(0, len(pending), size)]
+    futures = {}
+    try:
+        for n, chunk in enumerate(chunks):
+            f = client.submit(_bake_chunk, directory, [inputs_planned[i] for i in chunk], chunk,
+                              args, stop, not keep_going,
+                              key=f"bumpbake-chunk-{token}-{n}", pure=False)
+            futures[f] = chunk
+        done = count - len(pending)
+        for f in distributed.as_completed(list(futures)):
+            for index, report in f.result():
+                reports[index] = report
+                done += 1
+            if progress is not None and progress(done, count):
+                distributed.Variable(stop.name, client=client).set(-1)
+    except BaseException:
+        if stop is not None:
+            distributed.Variable(stop.name, client=client).set(-1)
+        client.cancel(list(futures))
+        raise
+    finally:
+        # Released now, not when the frame goes (an exception's traceback
+        # keeps it): a future still held makes Dask run its chunk again
+        # when a worker holding its result is lost.
+        for f in futures:
+            f.release()
+        futures.clear()
+        if stop is not None:
+            distributed.Variable(stop.name, client=client).delete()
+    for i in range(count):
+        if reports[i] is None:
+            reports[i] = job.report(i)
+            reports[i].status = "not run"
+    sweep_temporaries(_output_directories(reports))
+    depfile_error = None
+    if depfile is not None:
+        # The client's job learns what the workers made: each baked input is
+        # now up to date (its bytes hashed, its outputs' headers read).
+        for i in range(count):
+            if reports[i].ok:
+                job.run(i)
+        try:
+            job.write_depfile()
+        except _common.Error as e:
+            depfile_error = e
+    for r in reports:
+        _dispatch_notes(r.notes, job._notes_policy, stacklevel=2)
+    if check:
+        _raise_failures(reports, depfile_error)
+    elif depfile_error:
+        raise depfile_error
+    return reports

@@ -1,0 +1,401 @@
+"""bake_big: one map whose trace is split over the workers of a Dask
+cluster, bit for bit the single machine's bake.
+
+One task, the driver, runs the bake itself on a worker (a BakeJob: read,
+smooth, normals, derive, write with provenance, all or nothing); its trace
+is a hook (bb_trace_options.trace) that sends the slices to horizon tasks,
+two slices each (a slice and its opposite share their sweeps), and adds
+what comes back in the order the single machine adds it
+(bb_trace_accumulate by rank), as each group arrives. A horizon task builds
+what the bake traces (bb_bake_trace_input: read, smooth, scale, pyramid)
+once per worker process and bake, and finds its slices' horizons
+(bb_trace_horizons). The driver's own worker uses the driver's pyramid.
+"""
+
+import collections
+import os
+import threading
+import time
+import uuid
+
+import distributed
+import numpy as np
+
+from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _kinds_mask
+from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _text
+from .._jobs import BakeJob, _raise_failures
+from ._batch import sweep_temporaries
+from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
+                      worker_threads)
+
+# -------------------------------------------------- a worker's trace inputs
+
+
+class _Entry:
+    def __init__(self, pyramid, rays, owned):
+        self.pyramid, self.rays, self.owned = pyramid, rays, owned
+        self.users = 0
+        self.dropped = False
+
+    def free(self):
+        if self.owned:
+            _lib.bb_pyramid_free(self.pyramid)
+            _lib.bb_rayset_free(self.rays)
+        self.pyramid = self.rays = None
+
+
+# What this worker process holds for each bake it helps: the pyramid and
+# ray set, built once (by the first of its tasks) and shared by the others,
+# read-only, until the driver drops them. The driver's own worker borrows
+# the driver's (_lend), which the bake frees once the loan ends (_take_back).
+_inputs = {}
+_building = set()
+_inputs_changed = threading.Condition()
+# Bakes whose inputs were dropped here, the newest last: a horizon task that
+# starts after its bake ended (cancelled, but begun before the cancel
+# arrived) must not build a pyramid nobody would free.
+_ended = collections.OrderedDict()
+_ENDED_KEPT = 1024
+
+
+class _Ended(Exception):
+    status = "cancelled"
+
+
+def _acquire(key, build):
+    with _inputs_changed:
+        while True:
+            if key in _ended:
+                raise _Ended(f"bake {key} is over")
+            entry = _inputs.get(key)
+            if entry is not None:
+                entry.users += 1
+                return entry
+            if key not in _building:
+                _building.add(key)
+                break
+            _inputs_changed.wait()
+    try:
+        pyramid, rays = build()
+    except BaseException:
+        with _inputs_changed:
+            _building.discard(key)
+            _inputs_changed.notify_all()
+        raise
+    with _inputs_changed:
+        _building.discard(key)
+        _inputs_changed.notify_all()
+        if key in _ended:  # dropped while it was built
+            _lib.bb_pyramid_free(pyramid)
+            _lib.bb_rayset_free(rays)
+            raise _Ended(f"bake {key} is over")
+        entry = _inputs[key] = _Entry(pyramid, rays, owned=True)
+        entry.users = 1
+    return entry
+
+
+def _release(entry):
+    with _inputs_changed:
+        entry.users -= 1
+        if entry.dropped and entry.users == 0:
+            entry.free()
+        _inputs_changed.notify_all()
+
+
+def _drop(key):
+    """Frees this worker's inputs of a bake once no task uses them (run on
+    every worker by the driver at the end); no task of the bake starts here
+    after it. The driver's loan is left to _take_back."""
+    with _inputs_changed:
+        _ended[key] = True
+        while len(_ended) > _ENDED_KEPT:
+            _ended.popitem(last=False)
+        entry = _inputs.get(key)
+        if entry is not None and entry.owned:
+            del _inputs[key]
+            entry.dropped = True
+            if entry.users == 0:
+                entry.free()
+    return entry is not None
+
+
+def _lend(key, pyramid, rays):
+    with _inputs_changed:
+        entry = _inputs[key] = _Entry(pyramid, rays, owned=False)
+    return entry
+
+
+def _take_back(key, entry):
+    """Ends the loan of the driver's pyramid (entry): waits until no task
+    uses it, since the bake frees it next."""
+    with _inputs_changed:
+        if _inputs.get(key) is entry:
+            del _inputs[key]
+        while entry.users:
+            _inputs_changed.wait()
+
+
+def _bake_options_of(task):
+    options = {k: v for k, v in task["options"].items()}
+    o, _ = _bake_options("bake", task["scale"], **options)
+    o.outputs = _kinds_mask("bake", TRACED_OUTPUTS)[1]
+    return o
+
+
+def _build(task, threads):
+    """The trace's input of task's bake on this worker: the height read as
+    the driver read it (the same bytes: their hash is checked), smoothed,
+    scaled, its pyramid, and the ray set."""
+    err = _ffi.new("bb_error *")
+    height = _ffi.new("bb_image *")
+    source = _ffi.new("bb_height_source *")
+    _check(_lib.bb_height_file_read(os.fsencode(task["path"]), _channel(task["channel"]),
+                                    float(task["scale"]), _ffi.NULL, _ffi.NULL, height,
+                                    source, err), err)
+    try:
+        if source.file_hash != task["file_hash"]:
+            raise Error(f"{task['path']}: the file changed while it was baked (a worker read "
+                        "other bytes than the bake's)", "i/o error")
+        o = _bake_options_of(task)
+        o.trace.threads = threads
+        pyramid = _ffi.new("bb_pyramid **")
+        rays = _ffi.new("bb_rayset **")
+        _check(_lib.bb_bake_trace_input(height, o, pyramid, rays, err), err)
+    finally:
+        _lib.bb_image_free(height)
+    if _text(_lib.bb_rayset_id(rays[0])) != task["rayset"]:
+        _lib.bb_pyramid_free(pyramid[0])
+        _lib.bb_rayset_free(rays[0])
+        raise Error(f"{task['path']}: a worker's ray set is not the bake's "
+                    "(another bumpbake version?)", "bad argument")
+    return pyramid[0], rays[0]
+
+
+def _owned_array(img):
+    """A numpy view of a bb_image's pixels that frees them when it goes."""
+    n = img.width * img.height * img.channels
+    pixels = _ffi.gc(_ffi.cast("float *", img.pixels), _lib.free)
+    img.pixels = _ffi.NULL
+    return np.frombuffer(_ffi.buffer(pixels, 4 * n), dtype=np.float32).reshape(
+        img.height, img.width)
+
+
+def _horizons(task, slices, threads):
+    """On a worker: the horizons of slices ({slice: float32 (H, W)}) of
+    task's bake, found by the sweeps the single machine runs."""
+    entry = _acquire(task["key"], lambda: _build(task, threads))
+    try:
+        o = _ffi.new("bb_trace_options *")
+        o[0] = _bake_options_of(task).trace
+        o.threads = threads
+        c_slices = _ffi.new("int[]", slices)
+        images = _ffi.new("bb_image[]", len(slices))
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_trace_horizons(entry.pyramid, entry.rays, o, c_slices, len(slices),
+                                      images, err), err)
+        return {s: _owned_array(images[k]) for k, s in enumerate(slices)}
+    finally:
+        _release(entry)
+
+
+# ------------------------------------------------------------- the driver
+
+
+class _SplitTrace:
+    """The bake's trace hook on the driver (bb_trace_fn): horizon tasks
+    for every slice, added up here by rank as they arrive."""
+
+    def __init__(self, task, lib_threads, own_threads):
+        self.task = task
+        self.lib_threads = lib_threads
+        self.own_threads = own_threads
+        self.job = None
+        self.raised = None
+        self.stats = {}
+
+    def __call__(self, user, pyramid, rays, options, vis, err):
+        # Nothing may raise through C: the exception is kept for the driver
+        # and the bake fails with its message.
+        try:
+            return self._trace(pyramid, rays, options, vis, err)
+        except BaseException as e:  # noqa: B902 (KeyboardInterrupt included)
+            self.raised = e
+            message = f"trace on the cluster: {e}".encode("utf-8", "replace")[:500]
+            _ffi.memmove(err.message, message + b"\0", len(message) + 1)
+            return _lib.BB_ERR_CANCELLED if getattr(e, "status", None) == "cancelled" \
+                else _STATUS.get(getattr(e, "status", None), _lib.BB_ERR_IO)
+
+    def _trace(self, pyramid, rays, options, vis, err):
+        t0 = time.monotonic()
+        n = _lib.bb_rayset_slice_count(rays)
+        lobes = _lib.bb_rayset_lobe_count(rays)
+        order = _ffi.new("int[]", n)
+        _check(_lib.bb_trace_slice_order(rays, order, err), err)
+        task = dict(self.task, rayset=_text(_lib.bb_rayset_id(rays)),
+                    file_hash=self.job._raw(0).source.file_hash)
+        # A slice and the next in the order (its opposite, when it has one)
+        # go together: bb_trace_horizons sweeps them once.
+        groups = [list(range(k, min(k + 2, n))) for k in range(0, n, 2)]
+        me = distributed.get_worker().address
+        loan = _lend(task["key"], pyramid, rays)
+        moved = received = 0
+        ran = {}
+        try:
+            with distributed.worker_client() as client:
+                futures = [client.submit(_horizons, task, [order[r] for r in g], self.lib_threads,
+                                         key=f"bumpbake-horizons-{task['key']}-{k}", pure=False)
+                           for k, g in enumerate(groups)]
+                try:
+                    for k, (g, future) in enumerate(zip(groups, futures)):
+                        got = future.result()
+                        holders = client.who_has([future]).get(future.key, ())
+                        for worker in holders or ("?",):
+                            ran[worker] = ran.get(worker, 0) + len(g)
+                            break
+                        size = sum(a.nbytes for a in got.values())
+                        received += size
+                        if me not in holders:
+                            moved += size
+                        if k == 0:
+                            h, w = got[order[0]].shape
+                            _check(_lib.bb_image_alloc(vis, w, h, 1 + lobes, err), err)
+                        for r in g:
+                            self._accumulate(rays, r, got[order[r]], vis, err)
+                        del got
+                        future.release()
+                        if options.progress != _ffi.NULL and options.progress(
+                                options.progress_user, g[-1] + 1, n):
+                            raise _exception(_lib.BB_ERR_CANCELLED,
+                                             "trace: cancelled by the progress callback")
+                        if variable_value(task["stop"], 1, client=client):
+                            raise _exception(_lib.BB_ERR_CANCELLED,
+                                             "trace: cancelled by the client")
+                    _check(_lib.bb_trace_finish(rays, vis, self.own_threads, err), err)
+                finally:
+                    client.cancel([f for f in futures if not f.done()])
+                    for f in futures:  # none left for Dask to run again
+                        f.release()
+                    client.run(_drop, task["key"])
+        finally:
+            _take_back(task["key"], loan)
+        self.stats = {"slices": n, "tasks": len(groups), "slices_by_worker": ran,
+                      "bytes_received": received, "bytes_moved": moved,
+                      "driver": me, "seconds_trace": time.monotonic() - t0}
+        return _lib.BB_OK
+
+    def _accumulate(self, rays, rank, horizon, vis, err):
+        img = _ffi.new("bb_image *")
+        img.width, img.height, img.channels = horizon.shape[1], horizon.shape[0], 1
+        keep = _ffi.from_buffer("float[]", np.ascontiguousarray(horizon, dtype=np.float32))
+        img.pixels = keep
+        _check(_lib.bb_trace_accumulate(rays, rank, img, vis, self.own_threads, err), err)
+
+
+def _drive(directory, input, args, task):
+    """On a worker: the bake of input with its trace split over the
+    cluster; returns (BakeReport, what the split did)."""
+    with client_directory(directory):
+        own = this_worker_threads()
+        args = dict(args)
+        if args.get("threads") is None:
+            args["threads"] = own
+        lib_threads = task.pop("horizon_threads")
+        hook = _SplitTrace(task, lib_threads, args["threads"] or own)
+        callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
+        job = BakeJob(input, None, notes="ignore", _trace=callback,
+                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        hook.job = job
+        report = job.run(0)
+        if hook.raised is not None and not isinstance(hook.raised, Error):
+            raise hook.raised  # the cluster's (a lost worker, a cancel), not the bake's
+        return report, hook.stats
+
+
+def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=None,
+             depfile=None, force=True, check=True, notes="warn", command=None,
+             horizon_threads=None, **options):
+    """Bakes one height file into the files named, as bumpbake.bake_file
+    (and `bumpbake bake INPUT --normal FILE ...`) does, with its trace
+    split over the workers of a Dask cluster; returns its BakeReport. The
+    files are a single machine's bake's, bit for bit.
+
+    The job is planned (every path checked) here, on the client. The bake
+    then runs on one worker, the driver: it reads, smooths and writes as
+    one machine does; its trace goes out as tasks of two slices each (A/2
+    tasks for A slices), which every worker runs on the map's pyramid,
+    built once per worker process, and the horizons they send back are
+    added up on the driver in the single machine's fixed order. So: the
+    driver holds what a single bake holds but for the trace's pyramid
+    (docs/cluster.md has the bytes per texel), each other worker the
+    smoothed height's pyramid (about 9.3 bytes a texel) and the horizons of
+    the slices it is working on (4 bytes a texel a slice); what moves is
+    4 bytes a texel for every slice traced away from the driver, and the
+    input file, read by every worker from shared storage.
+
+    The report's `cluster` says where the slices ran and what moved:
+    {"slices", "tasks", "slices_by_worker", "bytes_received",
+    "bytes_moved", "driver", "seconds_trace"}. horizon_threads: the
+    library's threads in each horizon task (default: the cluster's threads
+    over the tasks, at least 1). Other arguments as bumpbake.bake_file's
+    (force defaults to True, as there: bake even when up to date).
+    """
+    client = client_of(client)
+    directory = os.getcwd()
+    job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
+                  depfile=depfile, force=force, notes=notes, command=command, **options)
+    if not force and job.check_current(0):
+        report = job.report(0)
+        report.status = "up to date"
+        return report
+    args = dict(job._args, force=True)
+    planned = job.inputs[0]
+    basis = options.get("basis")
+    task_options = {k: v for k, v in options.items()
+                    if k in BAKE_PARAMETERS and k != "threads"}
+    if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
+            os.fsdecode(basis) not in ("hl2", "hl2+z") and not os.fsdecode(basis).startswith(
+                "dirs:"):
+        task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
+    tasks = max(1, (_lib_slices(task_options) + 1) // 2)
+    if horizon_threads is None:
+        horizon_threads = max(1, worker_threads(client) // tasks)
+    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
+            "scale": args["scale"], "channel": args["channel"], "options": task_options,
+            "horizon_threads": int(horizon_threads)}
+    # Set when the client gives up (Ctrl-C): the driver stops at the next
+    # group of slices, writing nothing (a running task cannot be killed).
+    task["stop"] = f"bumpbake-big-stop-{task['key']}"
+    stop = distributed.Variable(task["stop"], client=client)
+    stop.set(0)
+    future = client.submit(_drive, directory, planned, args, task, pure=False,
+                           key=f"bumpbake-big-{task['key']}")
+    try:
+        report, stats = future.result()
+    except BaseException:
+        try:
+            stop.set(1)  # left set: the driver may still be reading it
+            client.cancel([future])
+        except Exception:  # noqa: BLE001 (the scheduler lost: the first error is the one)
+            pass
+        raise
+    finally:
+        # Released at once: a future still held (by an exception's
+        # traceback) makes Dask bake again when the driver's worker is lost.
+        future.release()
+    stop.delete()
+    report.cluster = stats
+    sweep_temporaries({os.path.dirname(p) or "." for p in report.outputs.values()})
+    _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
+    if check:
+        _raise_failures([report], None)
+    return report
+
+
+def _lib_slices(options):
+    o, _ = _bake_options("bake", 1.0, **{k: v for k, v in options.items()
+                                         if k in ("rays", "slices")})
+    return _lib.bb_bake_slices(o)
+
+
+# bb_status by name ("i/o error", ...), for an exception's .status.
+_STATUS = {_text(_lib.bb_status_name(code)): code for code in range(_lib.BB_ERR_CANCELLED + 1)}

@@ -1,0 +1,377 @@
+"""bumpbake.dask on a LocalCluster of 2 worker processes: a batch is the
+CLI batch byte for byte and a re-run bakes nothing; a clash is refused
+before anything is baked; one map split over the workers is the single
+process's bake bit for bit; a worker killed in the middle of a batch
+changes nothing of the result."""
+
+import os
+import re
+import shutil
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import bumpbake
+
+distributed = pytest.importorskip(
+    "distributed", reason="python3-distributed is not installed (make deps installs it)")
+import bumpbake.dask  # noqa: E402
+
+SCALE = 16
+
+
+@pytest.fixture(scope="module")
+def client():
+    """Two worker processes of one thread each, started the way a user
+    would (processes, nannies that restart a worker that dies)."""
+    try:
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=40)
+    except Exception as e:  # pragma: no cover: what this machine cannot do
+        pytest.skip(f"dask cannot start a LocalCluster here: {e!r}")
+    with cluster, distributed.Client(cluster) as c:
+        c.wait_for_workers(2, timeout=60)
+        yield c
+
+
+def heights(directory, count, side=40, width=None):
+    """count small, different height files (16-bit PNG) of side rows and
+    width columns (side + 8 by default): smooth bumps with noise, so every
+    map shadows."""
+    os.makedirs(directory, exist_ok=True)
+    rng = np.random.default_rng(20240611)
+    y, x = np.mgrid[0:side, 0:width or side + 8].astype(np.float64)
+    for i in range(count):
+        h = 0.5 + 0.3 * np.sin(x * (0.2 + 0.01 * i)) * np.cos(y * 0.17) + 0.2 * rng.random(x.shape)
+        bumpbake.write(os.path.join(directory, f"h{i:02d}.png"), h.astype(np.float32),
+                       kind="height", depth=16)
+
+
+def files_of(directory):
+    out = {}
+    for base, _, names in os.walk(directory):
+        for n in names:
+            with open(os.path.join(base, n), "rb") as f:
+                out[os.path.relpath(os.path.join(base, n), directory)] = f.read()
+    return out
+
+
+def test_a_batch_is_the_cli_batch_and_a_rerun_bakes_nothing(tmp_path, monkeypatch, client,
+                                                            cli):
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 40)
+    maps = ("normal", "ssbump", "ao")
+    reports = bumpbake.dask.bake_files("heights", "out", client=client, maps=maps, scale=SCALE,
+                                       rays=64, chunk_size=3, depfile="dask.d")
+    assert [r.status for r in reports] == ["baked"] * 40
+    assert [os.path.basename(r.input) for r in reports] == [f"h{i:02d}.png" for i in range(40)]
+    assert reports[7].outputs == {k: f"out/h07_{k}.png" for k in maps}
+    # the chunks ran on both workers: a worker's horizons count, each
+    assert {r.slices for r in reports} == {8} and all(r.threads == 1 for r in reports)
+    os.rename("out", "out_dask")
+
+    job = bumpbake.BakeJob("heights", "out", maps=maps, scale=SCALE, rays=64)
+    options = job.command_text(0).split()[3:]
+    assert options == ["--scale", "16", "--rays", "64", "--out-dir", "out"]
+    cli("bake", "heights", *options)  # as typed: -q, --depfile would be recorded too
+    ours, theirs = files_of("out_dask"), files_of("out")
+    assert len(ours) == 120 and sorted(ours) == sorted(theirs)
+    assert not [n for n in ours if ours[n] != theirs[n]], "not byte-identical to the CLI batch"
+    cli("bake", "heights", *options, "--depfile", "cli.d")  # up to date: the depfile alone
+    assert files_of("out") == theirs
+    with open("dask.d", "rb") as a, open("cli.d", "rb") as b:
+        assert a.read() == b.read()
+
+    # A re-run, by the cluster or by the CLI, bakes nothing.
+    again = bumpbake.dask.bake_files("heights", "out", client=client, maps=maps, scale=SCALE,
+                                     rays=64, chunk_size=3)
+    assert {r.status for r in again} == {"up to date"}
+    assert files_of("out") == theirs
+    # one input changed: that one alone is baked again
+    heights("changed", 1)
+    os.replace("changed/h00.png", "heights/h13.png")
+    again = bumpbake.dask.bake_files("heights", "out", client=client, maps=maps, scale=SCALE,
+                                     rays=64)
+    assert [i for i, r in enumerate(again) if r.status == "baked"] == [13]
+    assert not [p for p in os.listdir("out") if p.startswith(".bb-tmp-")]
+
+
+def test_a_clash_across_chunks_is_refused_before_any_bake(tmp_path, monkeypatch, client):
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 40)
+    # heights/a.png and more/a.png both give out/a_ao.png: the first input
+    # and the last, a chunk apart and more
+    os.replace("heights/h00.png", "heights/a.png")
+    os.makedirs("more")
+    os.replace("heights/h39.png", "more/a.png")
+    with pytest.raises(bumpbake.ArgumentError, match="would both be written to out/a_ao.png"):
+        bumpbake.dask.bake_files(["heights", "more"], "out", client=client, maps="ao",
+                                 scale=SCALE, chunk_size=1)
+    assert not os.path.exists("out") or not os.listdir("out"), "nothing is baked"
+
+
+def test_a_failure_stops_the_batch_unless_keep_going(tmp_path, monkeypatch, client):
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 12)
+    with open("heights/h05.png", "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n not really")
+    with pytest.raises(bumpbake.Error, match="h05.png") as e:
+        bumpbake.dask.bake_files("heights", "out", client=client, maps="normal", scale=SCALE,
+                                 chunk_size=1)
+    statuses = [r.status for r in e.value.reports]
+    assert statuses[5] == "failed" and e.value.reports[5].error_status == "bad image format"
+    assert statuses[:5] == ["baked"] * 5, "inputs before the failure run, as in the CLI"
+    assert "not run" in statuses[6:], "the batch stopped"
+    assert set(statuses[6:]) <= {"baked", "not run"}
+    reports = bumpbake.dask.bake_files("heights", "out", client=client, maps="normal",
+                                       scale=SCALE, keep_going=True, check=False)
+    assert [r.status == "failed" for r in reports] == [i == 5 for i in range(12)]
+    assert all(r.ok for i, r in enumerate(reports) if i != 5)
+
+
+def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch, client):
+    """A failed batch's exception keeps its frame; the chunks' futures must
+    not live on in it: Dask runs a held future's task again when the worker
+    holding its result is lost, and such a chunk, its batch's stop variable
+    deleted, waited for it for ever (a later batch hung behind it). A chunk
+    run after its batch is over does nothing."""
+    from bumpbake.dask import _batch, _shared
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 6)
+    with open("heights/h02.png", "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n not really")
+    with pytest.raises(bumpbake.Error) as e:
+        bumpbake.dask.bake_files("heights", "out", client=client, maps="normal", scale=SCALE,
+                                 chunk_size=1)
+    assert e.value.__traceback__ is not None
+
+    def chunks(dask_scheduler):
+        return [k for k in dask_scheduler.tasks if str(k).startswith("bumpbake-chunk-")]
+
+    deadline = time.monotonic() + 10
+    while client.run_on_scheduler(chunks):
+        assert time.monotonic() < deadline, client.run_on_scheduler(chunks)
+        time.sleep(0.05)
+
+    monkeypatch.setattr(_shared, "_VARIABLE_WAIT", 0.2)
+    args = dict(bumpbake.BakeJob("heights", "out", maps="normal", scale=SCALE)._args,
+                keep_going=True, depfile=None)
+    done = []
+    run = threading.Thread(target=lambda: done.append(_batch._bake_chunk(
+        os.getcwd(), ["heights/h00.png"], [0], args, _batch._Stop("bumpbake-stop-gone"), True)))
+    run.start()
+    run.join(timeout=20)
+    assert done == [[(0, None)]], "a chunk of a batch that is over waits or bakes"
+
+
+CASES = [  # (addressing, slices, basis): each at a size that is no power of two
+    ("periodic", 8, "hl2"),
+    ("clamp", 16, "dirs:6"),
+    ("periodic", 16, "dirs:6"),
+    ("clamp", 8, "hl2"),
+]
+
+
+@pytest.mark.parametrize("addressing, slices, basis", CASES)
+def test_one_map_split_over_the_workers_is_the_single_bake(tmp_path, monkeypatch, client,
+                                                           addressing, slices, basis):
+    monkeypatch.chdir(tmp_path)
+    heights("in", 1, side=61)  # 69 x 61
+    os.replace("in/h00.png", "in/map.png")
+    outputs = {k: f"map_{k}.exr" for k in bumpbake.OUTPUTS}
+    options = dict(scale=SCALE, slices=slices, basis=basis, clamp=addressing == "clamp")
+    os.makedirs("single")
+    os.makedirs("split")
+    os.symlink("../in", "single/in")
+    os.symlink("../in", "split/in")
+    monkeypatch.chdir(tmp_path / "split")
+    report = bumpbake.dask.bake_big("in/map.png", outputs, client=client, **options)
+    assert report.status == "baked" and report.slices == slices
+    c = report.cluster
+    assert c["slices"] == slices and c["tasks"] == slices // 2
+    assert sum(c["slices_by_worker"].values()) == slices
+    assert c["bytes_received"] == slices * 69 * 61 * 4
+    monkeypatch.chdir(tmp_path / "single")
+    single = bumpbake.bake_file("in/map.png", outputs, **options)
+    assert single.status == "baked"
+    a, b = files_of(tmp_path / "single"), files_of(tmp_path / "split")
+    assert sorted(a) == sorted(b) and len(a) == len(bumpbake.OUTPUTS)  # in/ is a link
+    assert not [n for n in a if a[n] != b[n]], "the split bake's bits differ"
+    # the pixels are not flat: a test that can fail
+    ao = bumpbake.read("map_ao.exr")
+    assert ao.min() < 0.9 and ao.max() == 1.0
+
+
+def test_split_bake_is_the_cli_bake(tmp_path, monkeypatch, client, cli):
+    """The CLI typed as command_text spells it writes the same bytes."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1, side=50)
+    report = bumpbake.dask.bake_big("h00.png", {"ssbump": "s.png", "ao": "a.png"},
+                                    client=client, scale=SCALE, slices=8, clamp=True)
+    split = files_of(".")
+    command = bumpbake.BakeJob("h00.png", outputs={"ssbump": "s.png", "ao": "a.png"},
+                               scale=SCALE, slices=8, clamp=True).command_text(0)
+    assert command == "bumpbake bake h00.png --scale 16 --slices 8 --clamp --ssbump s.png --ao a.png"
+    cli(*command.split()[1:])
+    assert files_of(".") == split and report.status == "baked"
+
+
+def test_a_worker_killed_in_the_middle_of_a_batch(tmp_path, monkeypatch, client, cli):
+    """SIGKILL to a worker busy with a chunk: Dask runs the chunk again on
+    a worker that is left (the nanny restarts the killed one); the batch
+    completes with the CLI's bytes and leaves no temporary behind."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 40, side=120)
+    killed = []
+
+    def kill_a_busy_worker(done, total):
+        # twice: once early, once when the restarted worker is busy again;
+        # six maps an input, so a kill often lands in a write
+        if len(killed) >= 2 or done < 6 + 14 * len(killed):
+            return False
+        pids = client.run(os.getpid)
+        for address, tasks in client.processing().items():
+            if tasks and address in pids:
+                os.kill(pids[address], signal.SIGKILL)
+                killed.append(address)
+                break
+        return False
+
+    reports = bumpbake.dask.bake_files("heights", "out", client=client, maps=bumpbake.OUTPUTS,
+                                       scale=SCALE, rays=16, chunk_size=2,
+                                       progress=kill_a_busy_worker)
+    assert killed, "no worker was busy to be killed"
+    assert all(r.ok for r in reports) and len(reports) == 40
+    assert not [p for p in os.listdir("out") if p.startswith(".bb-tmp-")]
+    os.rename("out", "out_dask")
+    cli("bake", "heights", "--scale", "16", "--rays", "16", "--out-dir", "out", "--maps",
+        ",".join(bumpbake.OUTPUTS))
+    assert files_of("out_dask") == files_of("out")
+    client.wait_for_workers(2, timeout=60)  # the nanny brought it back
+
+
+def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, client, cli):
+    """`bumpbake bake ... --scheduler ADDRESS` (the C program execs
+    `python3 -m bumpbake.dask` with the same arguments): a batch and a
+    single map, each the bytes of the same command without --scheduler."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 6)
+    address = client.scheduler.address
+    batch = ["bake", "heights", "--scale", "16", "--rays", "16", "--out-dir", "out", "--maps",
+             "normal,ao"]
+    out = cli(*batch[:2], "--scheduler", address, *batch[2:])
+    assert out.stdout.splitlines()[-1] == "bake: 6 files: 6 baked, 0 up to date, 0 failed"
+    assert "wrote ao out/h03_ao.png" in out.stdout
+    os.rename("out", "out_dask")
+    cli(*batch)
+    assert files_of("out_dask") == files_of("out")
+    again = cli(*batch, "--scheduler=" + address, "--json")
+    assert again.stdout.splitlines()[-1] == (
+        '{"summary":{"files":6,"baked":0,"up_to_date":6,"failed":0,"not_run":0}}')
+
+    single = ["bake", "heights/h01.png", "--scale", "16", "--slices", "8", "-o", "one/m"]
+    os.makedirs("one")
+    cli(*single[:2], "--scheduler", address, *single[2:])
+    split = files_of("one")
+    assert sorted(split) == ["m_ao.png", "m_normal.png", "m_ssbump.png"]
+    cli(*single)
+    assert files_of("one") == split
+    # usage errors are the C program's, before Python starts
+    bad = cli("bake", "heights/h01.png", "heights/h02.png", "--scale", "16", "--scheduler",
+              address, "-o", "x", check=False)
+    assert bad.returncode == 2 and "several HEIGHT files need --out-dir DIR" in bad.stderr
+    # what the cluster does not bake is refused, saying so, before anything
+    refused = cli("bake", "heights/h01.png", "--scale", "16", "--bounce", "0.5", "-o", "b/m",
+                  "--scheduler", address, check=False)
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1
+    assert "--bounce is not available with --scheduler" in refused.stderr
+    assert not os.path.exists("b")
+
+
+def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, client, cli):
+    """Ctrl-C on `bake MAP -o PREFIX --scheduler ADDRESS` while the slices
+    are out: a running task cannot be killed, so the driver is told (a
+    distributed.Variable) and stops at its next group of slices; no output
+    is written and nothing of the bake goes on running on the workers."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1, side=640)  # 648 x 640, 32 tasks of two slices: a few seconds
+    bake = cli.start("bake", "h00.png", "--scale", "16", "--slices", "64", "-o", "m",
+                     "--scheduler", client.scheduler.address)
+
+    def running():  # keys of bumpbake's tasks running on the workers, seceded ones too
+        return [k for keys in client.run(lambda dask_worker: list(
+            dask_worker.active_threads.values())).values() for k in keys
+            if "bumpbake-" in str(k)]
+
+    deadline = time.monotonic() + 60
+    while not any("bumpbake-horizons" in str(k) for k in running()):
+        assert bake.poll() is None, bake.communicate()
+        assert time.monotonic() < deadline, "the slices never went out"
+        time.sleep(0.02)
+    bake.send_signal(signal.SIGINT)
+    _, err = bake.communicate(timeout=60)
+    assert bake.returncode == 130, err
+    while running():
+        assert time.monotonic() < deadline, f"still running: {running()}"
+        time.sleep(0.05)
+    assert sorted(os.listdir(".")) == ["h00.png"], "an output was written"
+
+
+def test_the_cli_knows_every_option_of_the_c_program(cli):
+    """--scheduler re-reads the C program's arguments in Python, with
+    getopt's prefixes: the two must know the same options to read a
+    prefix the same way."""
+    from bumpbake.dask import _cli
+    help_text = cli("bake", "--help").stdout
+    c_options = set(re.findall(r"^\s+(?:-\w, )?--([a-z-]+)", help_text, re.M))
+    assert c_options == set(_cli._VALUED + _cli._FLAGS + _cli._NOT_ON_A_CLUSTER)
+
+
+def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, client, cli):
+    """.vtf and .dds outputs with their settings and a Source material,
+    through `bake --scheduler` (a batch and a split single map) and
+    through bake_files: the bytes of the same command on one machine."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 4, side=32, width=64)  # Source textures: powers of two
+    address = client.scheduler.address
+    batch = ["bake", "heights", "--scale", "16", "--slices", "8", "--out-dir", "out", "--maps",
+             "normal,ssbump", "--name", "{stem}_{kind}.vtf", "--vtf-version", "7.3",
+             "--texture-format", "dxt5", "--vtf-flags", "0x4"]
+    out = cli(*batch, "--scheduler", address)
+    assert "wrote ssbump out/h02_ssbump.vtf" in out.stdout
+    os.rename("out", "out_dask")
+    cli(*batch)
+    ours, theirs = files_of("out_dask"), files_of("out")
+    assert sorted(ours) == sorted(theirs) and len(ours) == 8
+    assert not [n for n in ours if ours[n] != theirs[n]], "not the CLI batch's bytes"
+    assert b"bumpbake" in ours["h02_ssbump.vtf"], "7.3 keeps the provenance"
+
+    # the Python API, typed as command_text spells it
+    shutil.rmtree("out")
+    options = dict(scale=SCALE, slices=8, maps=("normal", "ssbump"), name="{stem}_{kind}.vtf",
+                   vtf_version="7.3", texture_format="dxt5", vtf_flags=4, nomip=True)
+    bumpbake.dask.bake_files("heights", "out", client=client, **options)
+    command = bumpbake.BakeJob("heights", "out", **options).command_text(0)
+    # the format by its first name (bc3 is dxt5), as bb_texture_format_name spells it
+    assert command.endswith("--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip")
+    os.rename("out", "out_api")
+    cli("bake", "heights", *command.split()[3:])
+    assert files_of("out_api") == files_of("out")
+
+    # one map split over the workers: a .vtf, a .dds and the material
+    os.makedirs("materials/rock")
+    single = ["bake", "heights/h01.png", "--scale", "16", "--slices", "8", "--ssbump",
+              "materials/rock/m_ssbump.vtf", "--normal", "materials/rock/m_normal.dds",
+              "--vtf-version", "7.4", "--vmt", "materials/rock/m.vmt"]
+    out = cli(*single, "--scheduler", address)
+    assert "wrote material materials/rock/m.vmt" in out.stdout
+    split = files_of("materials")
+    assert sorted(split) == ["rock/m.vmt", "rock/m_normal.dds", "rock/m_ssbump.vtf"]
+    assert b'"$bumpmap" "rock/m_ssbump"' in split["rock/m.vmt"]
+    shutil.rmtree("materials")
+    os.makedirs("materials/rock")
+    cli(*single)
+    assert files_of("materials") == split
