@@ -955,27 +955,6 @@ static void line_hook(void *user, const bb__line_view *line) {
 
 /* ------------------------------------------------------------ the driver */
 
-/* The trace's order of the slices: each followed by its opposite. */
-static int order_slices(const bb_rayset *rs, int *order) {
-  unsigned char *placed = calloc((size_t)rs->slice_count, 1);
-  if (!placed) return -1;
-  int n = 0;
-  for (int s = 0; s < rs->slice_count; s++) {
-    if (placed[s]) continue;
-    placed[s] = 1;
-    order[n++] = s;
-    for (int t = s + 1; t < rs->slice_count; t++)
-      if (!placed[t] && rs->slice_step[2 * s] == -rs->slice_step[2 * t] &&
-          rs->slice_step[2 * s + 1] == -rs->slice_step[2 * t + 1]) {
-        placed[t] = 1;
-        order[n++] = t;
-        break;
-      }
-  }
-  free(placed);
-  return 0;
-}
-
 /* A move in fixed point (2^-40 of the sky's radiance), summed exactly: the
  * sum, and so the tail, does not depend on the order of the texels, which
  * a periodic shift of the map changes. */
@@ -1204,7 +1183,7 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   ctx->slots = calloc((size_t)ctx->slot_count, sizeof(scratch));
   bb_status st = BB_OK;
   if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_change || !d.row_sum || !ctx->slots ||
-      order_slices(rs, order) != 0)
+      bb_trace_slice_order(rs, order, NULL) != BB_OK)
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)", corners / (size_t)channels);
   d.order = order;
   d.fine = rs;
@@ -1215,7 +1194,8 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
     memcpy(basis.vector, rs->basis, sizeof basis.vector);
     st = bb__rayset_make(surface_slices, rs->power, &basis, o->threads, &d.coarse, err);
     d.coarse_order = st == BB_OK ? malloc((size_t)surface_slices * sizeof(int)) : NULL;
-    if (st == BB_OK && (!d.coarse_order || order_slices(&d.coarse, d.coarse_order) != 0))
+    if (st == BB_OK && (!d.coarse_order ||
+                        bb_trace_slice_order(&d.coarse, d.coarse_order, NULL) != BB_OK))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
   }
   for (int i = 0; st == BB_OK && i < ctx->slot_count; i++) atomic_flag_clear(&ctx->slots[i].busy);
