@@ -264,6 +264,13 @@ fifo_case e "render F --scale 8" .png render @ --scale 8 -o o.png
 fifo_case g "render --ssbump h.png --albedo F" .png render --ssbump h.png --albedo @ -o o.png
 fifo_case h "bake h.png --basis F" .txt bake h.png "${bake_fast[@]}" --basis @ --ssbump o.png
 fifo_case i "renderbumpflat F.obj" .obj renderbumpflat @
+# The other commands that read an image, through the same checks.
+fifo_case k "normal F --scale 8" .png normal @ --scale 8 -o o.png
+fifo_case l "combine F h.png --mix 0.5" .png combine @ h.png --mix 0.5 -o o.png
+fifo_case m "height2ssbump F 8" .png height2ssbump @ 8
+fifo_case n "normal2ssbump F" .png normal2ssbump @ -o o.png
+fifo_case o "ssbump2normal F" .png ssbump2normal @ -o o.png
+fifo_case p "sheet F --scale 8" .png sheet @ --scale 8 --rays 16 -o o.png
 for kind in f z; do
   begin "4j$kind" "renderbumpflat m.obj, mtllib $([ $kind = f ] && echo FIFO || echo 'link to /dev/zero')"
   mkfifo f.mtl && ln -s /dev/zero z.mtl
@@ -559,6 +566,10 @@ mkdir in out && cp h.png "in/$esc_name"
 run "$BIN" bake in "${bake_fast[@]}" --out-dir out --maps normal
 WANT=ok ALLOW='^out' finish
 print_case 13i "program's error naming an image with escapes" fail program $'invertColor(bad\e[31m.png)' -o o.png
+begin 13j "renderbumpflat: 'wrote' line of a model named with ESC [2J"
+cp "$ROOT/fixtures/rivet_panel.obj" $'m\e[2J.obj'
+run "$BIN" renderbumpflat $'m\e[2J.obj' --size 32 32
+WANT=ok LINES=1 ALLOW='_local\.tga$' finish
 
 # --------------------------------------------------------- 14. --json
 
