@@ -137,7 +137,7 @@ BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TES
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-circles check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
-        fuzz fuzz-long fuzz-deps ensure-fuzz-deps
+        fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
 lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
 
@@ -151,11 +151,13 @@ PYTHON   := /usr/bin/python3
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
 # python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
-# a Dask cluster (its tests run a LocalCluster).
+# a Dask cluster (its tests run a LocalCluster). strace: a test (and make
+# hostile) delivers a signal in the middle of a commit; time: make hostile's
+# peak memory (GNU time's %M).
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools ninja-build python3-distributed python3-dask
+            openimageio-tools ninja-build python3-distributed python3-dask strace time
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -353,6 +355,14 @@ docs: ensure-deps
 goldens: ensure-deps
 	@$(MAKE) --no-print-directory all
 	@./tools/goldens.sh $(BIN) regenerate
+
+# `make hostile` reruns the reproductions of hostile files (models reading
+# outside their directory, FIFOs, huge headers, outputs over inputs, links at
+# temporaries, signals in a commit, depfile names, escapes, JSON, address
+# space) against the binary, a line per case, in about a minute and a half
+# (tools/hostile_repro.sh; not part of make test).
+hostile: $(BIN)
+	@./tools/hostile_repro.sh $(BIN)
 
 # ---- fuzzing (libFuzzer, ASan + UBSan) ---------------------------------------
 # `make fuzz FUZZ_SECONDS=N` builds fuzz/fuzz_*.c with clang against a copy of

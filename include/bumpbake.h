@@ -363,8 +363,12 @@ bb_status bb_file_write(const char *path, const void *data, size_t size, bb_erro
  * (staged files included). Async-signal-safe: call it from a SIGINT or
  * SIGTERM handler, then re-raise the signal with the default action, and an
  * interrupted run leaves no temporary behind. Only files whose names this
- * library created are removed. At most 4096 temporaries are tracked at once;
- * further ones are still removed on errors, but not by this function. */
+ * library created are removed. A temporary being made on another thread at
+ * that moment is waited for (those threads hold SIGINT, SIGTERM and SIGHUP
+ * off while they make one), and from then on the process is taken to be
+ * ending: a write that starts makes no temporary and fails (BB_ERR_IO). At
+ * most 4096 temporaries are tracked at once; further ones are still removed
+ * on errors, but not by this function. */
 void bb_tempfiles_remove(void);
 
 /* Removes from directory dir (not below it) the temporaries

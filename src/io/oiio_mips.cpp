@@ -145,7 +145,23 @@ bb_status write_staged_by_name(const char *path, const bb::encoder_fn &encode,
                                bb_error *err) {
   bb_status st = bb__safe_open_private(f, path, err);
   if (st != BB_OK) return st;
+  // The encoder makes the file: a signal's cleanup waits for it (ended
+  // however encode ends, an exception included).
+  struct creation {
+    sigset_t held;
+    bool begun;
+    ~creation() {
+      if (begun) bb__safe_creation_end(&held);
+    }
+  } making;
+  making.begun = bb__safe_creation_begin(&making.held) == 0;
+  if (!making.begun) {
+    bb__safe_discard(f);
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: the process is ending", path);
+  }
   std::string why = encode(f->temp_path, nullptr);
+  bb__safe_creation_end(&making.held);
+  making.begun = false;
   if (why.empty()) {
     st = bb__safe_adopt(f, err);
     if (st != BB_OK) return st;

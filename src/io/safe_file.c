@@ -9,14 +9,15 @@
  * file, and a full disk is an error, never a silent truncation.
  *
  * Temporaries being written are listed in a fixed table that a signal
- * handler can walk (bb_tempfiles_remove): only lock-free atomics and
- * unlink(2) are used there, both async-signal-safe. */
+ * handler can walk (bb_tempfiles_remove): only lock-free atomics, unlink(2),
+ * rmdir(2) and clock_gettime(2) are used there, all async-signal-safe. */
 
 #include "core/internal.h"
 #include "io/safe_file.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,8 +66,52 @@ static void unregister_temp(int slot) {
 
 static int register_temp(const char *path) { return register_path(path, 0); }
 
+/* A name is registered before its file exists, so the handler's walk never
+ * misses a file; but a walk that unlinks the name while another thread's
+ * open(2) is making it would miss the file that open then leaves (seen as a
+ * temporary left after SIGTERM under load). So every name is made into a
+ * file inside a creation: the thread holds SIGINT, SIGTERM and SIGHUP off,
+ * so the handler never runs on it there, and counts itself in `creating`;
+ * bb_tempfiles_remove first says the process is ending (`closing`), after
+ * which no creation starts, then waits for those in flight, then walks.
+ * (Each side stores before it loads, sequentially consistent: one of the
+ * two always sees the other.) */
+static atomic_int creating;
+static atomic_int closing;
+
+int bb__safe_creation_begin(sigset_t *held) {
+  sigset_t fatal;
+  sigemptyset(&fatal);
+  sigaddset(&fatal, SIGINT);
+  sigaddset(&fatal, SIGTERM);
+  sigaddset(&fatal, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &fatal, held);
+  atomic_fetch_add(&creating, 1);
+  if (atomic_load(&closing)) {
+    bb__safe_creation_end(held);
+    return EINTR;
+  }
+  return 0;
+}
+
+void bb__safe_creation_end(const sigset_t *held) {
+  atomic_fetch_sub(&creating, 1);
+  pthread_sigmask(SIG_SETMASK, held, NULL);
+}
+
 void bb_tempfiles_remove(void) {
   int saved_errno = errno; /* a handler must leave errno as it found it */
+  atomic_store(&closing, 1);
+  /* A creation is an open(2), a mkdir(2) or a mip chain's encoding. The
+   * bound only matters to a handler of another signal run on a creating
+   * thread, which would otherwise wait for itself. */
+  struct timespec start, now;
+  clock_gettime(CLOCK_MONOTONIC, &start);
+  while (atomic_load(&creating) > 0) {
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (now.tv_sec - start.tv_sec > 10)
+      break;
+  }
   /* Files first, then the private directories they emptied. */
   for (int pass = 0; pass < 2; pass++)
     for (int i = 0; i < TEMP_SLOTS; i++)
@@ -240,6 +285,11 @@ static int create_temp(bb_staged_file *f) {
     char *name = temp_name(f->path, extension_of(f->path), &seed);
     if (!name)
       return ENOMEM;
+    sigset_t held;
+    if (bb__safe_creation_begin(&held) != 0) {
+      free(name);
+      return EINTR;
+    }
     int slot = register_temp(name);
     /* 0666 less the umask, as for any new file (mkstemp would make 0600,
      * and the rename keeps the mode). */
@@ -249,15 +299,18 @@ static int create_temp(bb_staged_file *f) {
       error = 0;
     else if (!error)
       f->locked = 1;
+    if (error) {
+      if (fd >= 0)
+        close(fd); /* a sweep's: not ours to remove */
+      unregister_temp(slot);
+    }
+    bb__safe_creation_end(&held);
     if (!error) {
       f->fd = fd;
       f->slot = slot;
       f->temp_path = name;
       return 0;
     }
-    if (fd >= 0)
-      close(fd); /* a sweep's: not ours to remove */
-    unregister_temp(slot);
     free(name);
     if (error != EEXIST)
       return error;
@@ -305,6 +358,11 @@ static int create_private_dir(bb_staged_file *f) {
   for (int attempt = 0; attempt < 100; attempt++) {
     char *name = temp_name(f->path, "", &seed);
     if (!name) return ENOMEM;
+    sigset_t held;
+    if (bb__safe_creation_begin(&held) != 0) {
+      free(name);
+      return EINTR;
+    }
     int slot = register_path(name, 1);
     int error = mkdir(name, 0700) == 0 ? 0 : errno;
     int fd = -1;
@@ -319,14 +377,17 @@ static int create_private_dir(bb_staged_file *f) {
       else if ((error = lock_temp(fd, name, NULL)) == ENOLCK)
         error = 0; /* no locks here: unlocked, as create_temp's files */
     }
+    if (error) {
+      if (fd >= 0) close(fd);
+      unregister_temp(slot);
+    }
+    bb__safe_creation_end(&held);
     if (!error) {
       f->temp_dir = name;
       f->dir_slot = slot;
       f->dir_fd = fd;
       return 0;
     }
-    if (fd >= 0) close(fd);
-    unregister_temp(slot);
     free(name);
     if (error != EEXIST) return error;
   }

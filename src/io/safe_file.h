@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 
 #include <pthread.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -64,6 +65,16 @@ struct bb_staged_file {
   char *registered_file; /* the file's path through temp_dir, for the registry */
   int dir_slot, file_slot;
 };
+
+/* A creation: between begin and end the calling thread holds SIGINT,
+ * SIGTERM and SIGHUP off, and bb_tempfiles_remove (a signal's cleanup)
+ * waits for it before it removes the registered temporaries, so a file
+ * being made while the handler runs is not left behind. Every temporary
+ * is made inside one; so is an encoder's file made by name in a private
+ * directory. begin returns 0, or EINTR once the process is ending (then
+ * make nothing, and do not call end). */
+int bb__safe_creation_begin(sigset_t *held);
+void bb__safe_creation_end(const sigset_t *held);
 
 /* A bb_staged_file that bb__safe_discard may be called on before any open. */
 void bb__safe_init(bb_staged_file *f);

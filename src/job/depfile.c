@@ -3,13 +3,14 @@
  *
  * Names are escaped as GCC's -MD writes them, which both tools read: a space
  * as "\ " (a backslash run before a space doubled, so "a\ b" is "a\\\ b"),
- * '#' as "\#", '$' as "$$", and the wildcards '*' and '[' with a backslash
- * (make would glob them; ninja 1.11 reads "\*" and "\[" back). A few
- * characters neither tool can hold in a name are refused before the bake:
- * control characters (newline and tab end a name for ninja), ':' and ';'
- * (rule and recipe separators), '=' (make reads an assignment), '%'
- * (make's pattern), '?' (make's wildcard, which no escape stops in both),
- * and '|' (make's order-only separator). */
+ * '#' as "\#", '$' as "$$". A few characters neither tool can hold in a
+ * name are refused before the bake: control characters (newline and tab end
+ * a name for ninja), ':' and ';' (rule and recipe separators), '=' (make
+ * reads an assignment), '%' (make's pattern), '|' (make's order-only
+ * separator), and make's wildcards '?', '*' and '[': make globs them bare
+ * (it reads "a[bc].png" as ab.png where that exists), and ninja 1.11 keeps
+ * the backslash of "\*" and "\[" in the name it reads, so no spelling reads
+ * back right in both. */
 #include "core/internal.h"
 #include "job/job_internal.h"
 
@@ -38,6 +39,8 @@ static int unsayable(const char *name, const char **why) {
     case '=': *why = "'=' (make reads a variable assignment)"; return *s;
     case '%': *why = "'%' (make's pattern character)"; return *s;
     case '?': *why = "'?' (make's wildcard)"; return *s;
+    case '*': *why = "'*' (make's wildcard)"; return *s;
+    case '[': *why = "'[' (make's wildcard)"; return *s;
     case '|': *why = "'|' (make's order-only separator)"; return *s;
     default: break;
     }
@@ -72,7 +75,7 @@ static int put_name(FILE *f, const char *name) {
       for (size_t k = 0; k < run * (before_space ? 2 : 1) && ok; k++)
         ok = fputc('\\', f) != EOF;
       s += run - 1;
-    } else if (*s == ' ' || *s == '#' || *s == '*' || *s == '[') {
+    } else if (*s == ' ' || *s == '#') {
       ok = fputc('\\', f) != EOF && fputc(*s, f) != EOF;
     } else if (*s == '$') {
       ok = fputs("$$", f) != EOF;

@@ -1181,6 +1181,30 @@ Test(io, tempfiles_remove_takes_pending_temporaries_only) {
   bb_image_free(&img);
 }
 
+/* Once a signal's cleanup has run the process is ending: a write that
+ * starts then makes no temporary the cleanup could not see (one made by
+ * another thread just as the handler walked the list was left behind by a
+ * SIGTERM under load). */
+Test(io, no_temporary_is_made_once_the_cleanup_has_run) {
+  bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
+  bb_error err;
+  bb_tempfiles_remove();
+  cr_expect_eq(bb_image_write(tmp_path("late.png"), &img, NULL, &err), BB_ERR_IO);
+  bb_staged_file *staged = NULL;
+  cr_expect_eq(bb_image_write_staged(tmp_path("late.exr"), &img, NULL, &staged, &err),
+               BB_ERR_IO);
+  bb_image *chain = NULL;
+  int levels = 0;
+  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &levels, &err), BB_OK);
+  cr_expect_eq(bb_image_write_mips(tmp_path("late.tif"), chain, levels, NULL, &err), BB_ERR_IO);
+  cr_expect_eq(bb_file_write(tmp_path("late.d"), "x: y\n", 5, &err), BB_ERR_IO);
+  cr_expect_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
+  cr_expect_not(file_exists(tmp_path("late.png")));
+  cr_expect_not(file_exists(tmp_path("late.tif")));
+  bb_mip_chain_free(chain, levels);
+  bb_image_free(&img);
+}
+
 /* ------------------------------------------------ hostile headers (issue 10) */
 
 /* The 186-byte TIFF declaring 8192 x 8192 x 64 channels once took 16.5 GB

@@ -302,6 +302,16 @@ Test(compare_cli, identical_files_pass_with_exit_0) {
   cr_assert_not_null(strstr(out, "PASS"), "%s", out);
 }
 
+/* `compare` of an EXR holding NaN with itself: it failed (exit 2) where
+ * idiff passes. */
+Test(compare_cli, an_image_with_nan_passes_against_itself) {
+  const float values[4] = {0.25f, NAN, 1.0f, NAN};
+  const char *a = write_image("nan.exr", 2, 2, 1, values, NULL);
+  char out[4096];
+  cr_assert_eq(run(out, sizeof out, "compare %s %s", a, a), 0, "%s", out);
+  cr_assert_not_null(strstr(out, "PASS"), "%s", out);
+}
+
 Test(compare_cli, allowed_failures_warn_with_exit_1) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 3, 0.01f);
   char out[4096];

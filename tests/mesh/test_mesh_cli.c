@@ -113,3 +113,15 @@ Test(mesh_cli, renderbumpflat_names_the_model_in_its_note_on_stretched_texels) {
   cr_expect_str_empty(r.err);
   cli_result_free(&r);
 }
+
+/* A flat model's height is 0 everywhere: renderbumpflat suggested `bake
+ * --scale 0`, which bake refuses; it says the model is flat instead. */
+Test(mesh_cli, a_flat_model_suggests_no_scale_bake_refuses) {
+  write_text(tmp("flat.obj"), "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3\nf 1 3 4\n");
+  cli_result r = RUN_IN(harness_dir, "renderbumpflat", "flat.obj", "--size", "16", "16",
+                        "--height", "fh.png", "-o", "fn.tga");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_null(strstr(r.out, "--scale 0"), "%s", r.out);
+  cr_expect(strstr(r.out, "the model is flat"), "%s", r.out);
+  cli_result_free(&r);
+}
