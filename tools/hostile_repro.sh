@@ -642,7 +642,9 @@ sweep_case() { # ID DESC ARGS...
       early=$((early + 1))
     elif [ -z "$sig" ] && [ "$rc" = 0 ]; then
       ok=$((ok + 1))
-    elif [ -z "$sig" ] && [ "$rc" = 1 ] && [ "$n" = 1 ] && grep -q 'out of memory' "$ERRF" &&
+    # An allocation that failed, or the bake's memory estimate refused first.
+    elif [ -z "$sig" ] && [ "$rc" = 1 ] && [ "$n" = 1 ] &&
+      grep -q -e 'out of memory' -e ' of memory; .* is available' "$ERRF" &&
       [ -z "$(ls -A out)" ]; then
       oom=$((oom + 1))
     elif [ -z "$sig" ] && [ "$rc" = 1 ] && [ "$n" = 1 ] && [ -z "$(ls -A out)" ]; then
