@@ -16,7 +16,11 @@
 # block compression's PSNR and worst error per format and map, libsquish
 # against nvcompress, and the time of a 2048 x 2048 VTF DXT1 with mips against
 # PNG), 10 inter-reflection (tools/bench_bounce.sh: bake --bounce against a
-# path tracer and exact radiosity, and its cost), then a summary table.
+# path tracer and exact radiosity, and its cost), 11 a Dask cluster of this
+# machine (tools/bench_cluster.sh batch big: 200 maps of 512 x 512 as a CLI
+# batch, two half batches and bumpbake.dask.bake_files; one 8192 x 8192 map
+# in one process and split over 2 workers; `make bench-cluster` runs it
+# alone, with 16384 x 16384 too), then a summary table.
 # Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -37,6 +41,8 @@
 #   BENCH_BOUNCE=0         skip section 10 (its path-traced references take
 #                          many minutes the first time; BOUNCE_* as in
 #                          tools/bench_bounce.sh)
+#   BENCH_CLUSTER=0        skip section 11 (about 15 minutes and 3 GB of
+#                          files in build/bench/cluster)
 #   BENCH_SECTIONS="9 10"  run only the sections listed (default: every one);
 #                          the summary then has only their figures
 #
@@ -646,6 +652,15 @@ if want 10; then
     bounce_ok=1
   else
     fail "tools/bench_bounce.sh failed"
+  fi
+fi
+
+if want 11; then
+  section "11. A Dask cluster of this machine (tools/bench_cluster.sh batch big)"
+  if [ "${BENCH_CLUSTER:-1}" = 0 ]; then
+    echo "skipped (BENCH_CLUSTER=0)"
+  elif ! tools/bench_cluster.sh batch big "$bin" | tee "$out/cluster.txt"; then
+    fail "tools/bench_cluster.sh failed"
   fi
 fi
 
