@@ -88,6 +88,12 @@ bb_status bb__job_memory_check(const bb_job *job, const bb__job_item *item, bb_e
  * (BB__JOB_MAX_READS entries); the count. */
 int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out);
 
+/* The settings a .vtf or .dds output of kind and range is written with:
+ * given's (NULL: the defaults), the map set by bb_texture_options_for
+ * (paths.c). */
+bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
+                                      bb_range range);
+
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);
 

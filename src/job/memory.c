@@ -24,8 +24,7 @@ static double sample_bytes(bb_depth depth, const char *path) {
  * level in the file's format. */
 static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,
                             int w, int h, int channels) {
-  bb_texture_options t = job->options.texture;
-  bb_texture_options_for(&t, kind->name, kind->range);
+  const bb_texture_options t = bb__job_texture_of(&job->options.texture, kind->name, kind->range);
   bb_texture_format format;
   const double top = bb__texture_resolve(path, w, h, channels, &t, &format, NULL) == BB_OK
                          ? (double)bb__texture_level_bytes(format, w, h)

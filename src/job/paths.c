@@ -165,6 +165,17 @@ static const char *depth_name(bb_depth d) {
 /* The format rules of one image output: its extension and depth, or (late
  * is 1) its mip chain and channels, checked after its paths as they always
  * were, so the first message of several stays the same. */
+bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
+                                      bb_range range) {
+  bb_texture_options t;
+  if (given)
+    t = *given;
+  else
+    bb_texture_options_init(&t);
+  bb_texture_options_for(&t, kind, range);
+  return t;
+}
+
 static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) {
   char ext[16];
   if (late) {
@@ -178,12 +189,7 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
                       o->path, o->kind ? o->kind : "the image", o->channels,
                       bb__extension(o->path, ext, sizeof ext), room);
     if (bb_path_is_texture_format(o->path) && o->width > 0 && o->channels > 0) {
-      bb_texture_options t;
-      if (o->texture)
-        t = *o->texture;
-      else
-        bb_texture_options_init(&t);
-      bb_texture_options_for(&t, o->kind, o->range);
+      const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
       return bb_texture_check(o->path, o->width, o->height, o->channels, &t, err);
     }
     return BB_OK;

@@ -112,12 +112,7 @@ static void stage_one(void *user, int item) {
   }
   if (bb_path_is_texture_format(o->path)) {
     /* A texture makes its own chain (its mips option), as the map its kind is. */
-    bb_texture_options t;
-    if (o->texture)
-      t = *o->texture;
-    else
-      bb_texture_options_init(&t);
-    bb_texture_options_for(&t, o->kind, o->range);
+    const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
     const bb_write_options wo = {o->depth, o->range, o->description, &t};
     s->status = bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
     return;
