@@ -8,6 +8,7 @@
 #include "bumpbake.h"
 #include "cli/cli.h"
 #include "fuzz_common.h"
+#include "printed_text.h"
 
 #include <fcntl.h>
 
@@ -45,26 +46,6 @@ static char *captured(int (*fn)(int, char **), int argc, char **argv) {
   text[n] = '\0';
   fclose(f);
   return text;
-}
-
-static int has_control(const char *s) {
-  for (const unsigned char *c = (const unsigned char *)s; *c; c++)
-    if ((*c < 0x20 && *c != '\n') || *c == 0x7f || (c[0] == 0xc2 && c[1] >= 0x80 && c[1] < 0xa0))
-      return 1;
-  return 0;
-}
-
-static int valid_utf8(const char *s) {
-  for (const unsigned char *c = (const unsigned char *)s; *c;) {
-    int n = *c < 0x80 ? 1 : (*c & 0xe0) == 0xc0 ? 2 : (*c & 0xf0) == 0xe0 ? 3 : (*c & 0xf8) == 0xf0 ? 4 : 0;
-    if (!n || (n == 2 && *c < 0xc2))
-      return 0;
-    for (int i = 1; i < n; i++)
-      if ((c[i] & 0xc0) != 0x80)
-        return 0;
-    c += n;
-  }
-  return 1;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

@@ -10,6 +10,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "printed_text.h"
 
 #include <math.h>
 
@@ -383,29 +384,6 @@ Test(hostile, program_images_stay_inside_the_base) {
 }
 
 /* ---------------------------------------------------- what it prints */
-
-/* 1 when s holds a byte that drives a terminal: C0 controls but newline,
- * DEL, or a C1 control (UTF-8 0xc2 0x80..0x9f). */
-static int has_control(const char *s) {
-  for (const unsigned char *c = (const unsigned char *)s; *c; c++)
-    if ((*c < 0x20 && *c != '\n') || *c == 0x7f || (c[0] == 0xc2 && c[1] >= 0x80 && c[1] < 0xa0))
-      return 1;
-  return 0;
-}
-
-/* 1 when s is valid UTF-8. */
-static int valid_utf8(const char *s) {
-  for (const unsigned char *c = (const unsigned char *)s; *c;) {
-    int n = *c < 0x80 ? 1 : (*c & 0xe0) == 0xc0 ? 2 : (*c & 0xf0) == 0xe0 ? 3 : (*c & 0xf8) == 0xf0 ? 4 : 0;
-    if (!n || (n == 2 && *c < 0xc2))
-      return 0;
-    for (int i = 1; i < n; i++)
-      if ((c[i] & 0xc0) != 0x80)
-        return 0;
-    c += n;
-  }
-  return 1;
-}
 
 /* A description holding an escape sequence and a byte that is not UTF-8,
  * and a file name with both: info, compare and errors print them escaped,
