@@ -461,6 +461,12 @@ typedef enum bb_texture_format {
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
 /* The first name of format ("bc1", ...), "default", or "unknown". */
 const char *bb_texture_format_name(bb_texture_format format);
+/* Parses a VTF version as --vtf-version takes it: "7.2" to "7.5", or the
+ * minor number alone ("2" to "5"); *minor receives 2..5. */
+bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
+/* Parses VTF flags as --vtf-flags takes them: a 32-bit number, decimal,
+ * 0x hexadecimal or 0 octal (strtoul's base 0), no sign. */
+bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 
 /* What the image is: it picks the mip rule, the VTF flags and the value range. */
 typedef enum bb_texture_map {

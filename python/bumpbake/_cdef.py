@@ -523,6 +523,8 @@ bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const char *bb_depth_name(bb_depth depth);
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
 const char *bb_texture_format_name(bb_texture_format format);
+bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
+bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 void bb_texture_options_init(bb_texture_options *options);
 int bb_path_is_texture_format(const char *path);
 bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);

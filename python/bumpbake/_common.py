@@ -141,38 +141,36 @@ TEXTURE_PARAMETERS = ("texture_format", "vtf_version", "vtf_flags", "nomip",
                       "fast_compression")
 
 
+def _vtf_text(command, name, value):
+    """value as text for the library's parsers: str as given, an int in
+    decimal, a float as Python spells it (7.3); else TypeError."""
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise TypeError(f"{command}: {name} must be a str or a number (got {value!r})")
+    return value if isinstance(value, str) else repr(value)
+
+
 def _vtf_version(command, value):
     """The VTF minor version of 3, "7.3", "3" or 7.3, as --vtf-version
-    reads it; the library refuses one it does not write."""
-    if isinstance(value, float):
-        value = repr(value)
-    if isinstance(value, str):
-        minor = value[2:] if value.startswith("7.") else value
-        if not minor.isdigit():
-            raise _argument_error(f"{command}: vtf_version must be 7.2, 7.3, 7.4 or 7.5 "
-                                  f"(got {value!r})")
-        value = int(minor)
-    value = _int(command, "vtf_version", value)
-    if not 2 <= value <= 5:  # as --vtf-version refuses it, whatever the outputs
-        raise _argument_error(f"{command}: vtf_version must be 7.2, 7.3, 7.4 or 7.5 "
-                              f"(got 7.{value})")
-    return value
+    reads it (bb_vtf_version_parse)."""
+    out = _ffi.new("int *")
+    err = _ffi.new("bb_error *")
+    if _lib.bb_vtf_version_parse(_vtf_text(command, "vtf_version", value).encode(), out,
+                                 err) != _lib.BB_OK:
+        raise _argument_error(f"{command}: vtf_version: {_text(err.message)}")
+    return out[0]
 
 
 def _vtf_flags(command, value):
-    """TEXTUREFLAGS_* bits: an int, or text as --vtf-flags takes it ("0x4")."""
-    if isinstance(value, str):
-        try:
-            value = int(value, 0)
-        except ValueError:
-            raise _argument_error(f"{command}: vtf_flags needs a 32-bit number, e.g. 0x4 "
-                                  f"(got {value!r})") from None
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise TypeError(f"{command}: vtf_flags must be an int (got {value!r})")
-    if not 0 <= value <= 0xFFFFFFFF:
-        raise _argument_error(f"{command}: vtf_flags needs a 32-bit number, e.g. 0x4 "
-                              f"(got {value:#x})")
-    return value
+    """TEXTUREFLAGS_* bits: an int, or text as --vtf-flags takes it ("0x4")
+    (bb_vtf_flags_parse)."""
+    if isinstance(value, float):
+        raise TypeError(f"{command}: vtf_flags must be an int or a str (got {value!r})")
+    out = _ffi.new("uint32_t *")
+    err = _ffi.new("bb_error *")
+    if _lib.bb_vtf_flags_parse(_vtf_text(command, "vtf_flags", value).encode(), out,
+                               err) != _lib.BB_OK:
+        raise _argument_error(f"{command}: vtf_flags: {_text(err.message)}")
+    return out[0]
 
 
 def _texture_options(command, texture_format=None, vtf_version=None, vtf_flags=None,

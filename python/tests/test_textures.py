@@ -228,9 +228,9 @@ def test_what_a_texture_cannot_hold_is_refused_before_any_work(tmp_path, fixture
     refused("format bc4 holds 1 channel, and the normal map has 3", bumpbake.write,
             tmp_path / "o.dds", rock["normal"], kind="normal", texture_format="bc4")
     refused("texture format", bumpbake.write, tmp_path / "o.dds", odd, texture_format="bc7")
-    refused(r"vtf_version must be 7.2, 7.3, 7.4 or 7.5 \(got 7.9\)", bumpbake.write,
+    refused(r"vtf_version: VTF version must be 7.2, 7.3, 7.4 or 7.5 \(got '7.9'\)", bumpbake.write,
             tmp_path / "o.vtf", rock["ao"], vtf_version="7.9")
-    refused("vtf_version must be 7.2, 7.3, 7.4 or 7.5", bumpbake.write, tmp_path / "o.vtf",
+    refused("VTF version must be 7.2, 7.3, 7.4 or 7.5", bumpbake.write, tmp_path / "o.vtf",
             rock["ao"], vtf_version="seven")
     refused("ENVMAP flag", bumpbake.write, tmp_path / "o.vtf", rock["ao"], vtf_flags=0x4000)
     refused("32-bit number", bumpbake.write, tmp_path / "o.vtf", rock["ao"],

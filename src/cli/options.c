@@ -583,24 +583,16 @@ int cli_settings_apply(const char *command, cli_settings *s, const cli_option *o
                : cli_usage_error(command, "%s: %s", name, err.message);
   }
   case CLI_OPT_VTF_VERSION: {
-    /* "7.3" as Valve writes it, or the minor number alone. */
-    const char *minor = strncmp(arg, "7.", 2) == 0 ? arg + 2 : arg;
-    char *end = NULL;
-    long v = strtol(minor, &end, 10);
-    if (end == minor || *end || v < 2 || v > 5)
-      return cli_usage_error(command, "%s must be 7.2, 7.3, 7.4 or 7.5 (got '%s')", name, arg);
-    s->texture.vtf_version = (int)v;
-    return 0;
+    bb_error err = {{0}};
+    return bb_vtf_version_parse(arg, &s->texture.vtf_version, &err) == BB_OK
+               ? 0
+               : cli_usage_error(command, "%s: %s", name, err.message);
   }
   case CLI_OPT_VTF_FLAGS: {
-    char *end = NULL;
-    errno = 0;
-    unsigned long v = strtoul(arg, &end, 0);
-    if (end == arg || *end || errno || v > 0xffffffffUL || arg[0] == '-')
-      return cli_usage_error(command, "%s needs a 32-bit number, e.g. 0x4 (got '%s')", name,
-                             arg);
-    s->texture.vtf_flags = (uint32_t)v;
-    return 0;
+    bb_error err = {{0}};
+    return bb_vtf_flags_parse(arg, &s->texture.vtf_flags, &err) == BB_OK
+               ? 0
+               : cli_usage_error(command, "%s: %s", name, err.message);
   }
   case CLI_OPT_NOMIP:
     s->texture.mips = 0;

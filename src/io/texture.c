@@ -10,6 +10,7 @@
 #define IMATH_HALF_NO_LOOKUP_TABLE
 #include <Imath/half.h>
 
+#include <errno.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,6 +71,33 @@ bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_e
   if (st == BB_OK && out)
     *out = format_names[k].format;
   return st;
+}
+
+bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err) {
+  /* "7.3" as Valve writes it, or the minor number alone. */
+  const char *m = text && strncmp(text, "7.", 2) == 0 ? text + 2 : text;
+  char *end = NULL;
+  /* A digit first: strtol would also take spaces and a sign. */
+  const int digits = m && m[0] >= '0' && m[0] <= '9';
+  const long v = digits ? strtol(m, &end, 10) : 0;
+  if (!digits || *end || v < 2 || v > 5)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "VTF version must be 7.2, 7.3, 7.4 or 7.5 (got '%.64s')", text ? text : "");
+  if (minor) *minor = (int)v;
+  return BB_OK;
+}
+
+bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err) {
+  char *end = NULL;
+  errno = 0;
+  /* A digit first: strtoul would also take spaces and a sign. */
+  const int digits = text && text[0] >= '0' && text[0] <= '9';
+  const unsigned long v = digits ? strtoul(text, &end, 0) : 0;
+  if (!digits || *end || errno || v > 0xffffffffUL)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "VTF flags must be a 32-bit number, e.g. 0x4 (got '%.64s')", text ? text : "");
+  if (flags) *flags = (uint32_t)v;
+  return BB_OK;
 }
 
 const char *bb_texture_format_name(bb_texture_format format) {

@@ -165,16 +165,9 @@ def _bake_arguments(options):
             kw["maps"] = tuple(value.split(","))
         elif name in ("keep-going", "force", "nomip", "fast-compression"):
             kw[key] = True
-        elif name in ("texture-format", "vtf-version", "vmt", "materials", "basetexture"):
-            kw[key] = value
-        elif name == "vtf-flags":
-            try:  # as C's strtoul(value, NULL, 0) reads it: 0x hex, 0 octal, else decimal
-                v = value.lower()
-                kw["vtf_flags"] = int(v, 16 if v.startswith("0x") else 8 if v.startswith("0")
-                                      and len(v) > 1 else 10)
-            except ValueError:
-                raise Usage(f"--vtf-flags needs a 32-bit number, e.g. 0x4 (got '{value}')") \
-                    from None
+        elif name in ("texture-format", "vtf-version", "vtf-flags", "vmt", "materials",
+                      "basetexture"):
+            kw[key] = value  # parsed by the library, as the C CLI parses them
     return kw, outputs
 
 
