@@ -51,10 +51,13 @@
  * the light its corners gather from the surface, over half the slices (the
  * light of later bounces is smooth); last, what each texel's origin
  * (lifted by the bake's bias) gathers, added to its visibility. With
- * bounces 0 the bounces stop when no corner's light moves by more than the
- * tolerance, and the rest of the series, close to geometric, is added as
- * the last move times lambda / (1 - lambda), lambda the ratio of the last
- * two moves summed over every corner.
+ * bounces N that is N - 1 surface passes from the first bounce. With
+ * bounces 0 (converged) the corners start from an estimate of all their
+ * light (estimate_ratio), one surface pass gathers from it, and the rest
+ * of the series, close to geometric, is added as the last move times
+ * lambda / (1 - lambda), lambda the ratio of the last two moves summed
+ * over every corner. Progress counts every pass's slices, weighted by
+ * what they cost (slice_work).
  */
 #include "core/internal.h"
 #include "trace/bounce.h"
@@ -973,9 +976,9 @@ typedef struct driver {
   float *direct;   /* E of every corner from the sky (FACES x channels per vertex) */
   float *radiance; /* what every corner reflects now */
   const float *albedo;
-  double *row_change;
   exact_sum *row_sum;
   double tail; /* the last move's multiple added as the series' rest (0: none) */
+  long work, work_done; /* bb__bounce_work, and what the passes so far did */
 } driver;
 
 static void zero_row(void *user, int y) {
@@ -984,16 +987,39 @@ static void zero_row(void *user, int y) {
   memset(d->ctx.sums + (size_t)y * n, 0, n * sizeof(float));
 }
 
+/* What one slice of each pass costs, in a trace's slices (instructions,
+ * rock06 256 x 256 at scale 32, callgrind): the progress's weights. */
+static int slice_work(pass_mode mode) {
+  return mode == PASS_DIRECT ? 3 : mode == PASS_SURFACE ? 16 : 10;
+}
+
+static int surface_passes(const bb__bounce_options *o) {
+  if (o->bounces > 0) return o->bounces - 1;
+  return o->estimate_passes > 1 ? o->estimate_passes : 1;
+}
+
+static int coarse_slices(const bb_rayset *rs, const bb__bounce_options *o) {
+  const int n = o->surface_slices;
+  if (n > 0) return n < rs->slice_count ? n : rs->slice_count;
+  return rs->slice_count / 2 >= 4 ? rs->slice_count / 2 : rs->slice_count;
+}
+
+long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o) {
+  return (long)rs->slice_count * (slice_work(PASS_DIRECT) + slice_work(PASS_TEXEL)) +
+         (long)surface_passes(o) * coarse_slices(rs, o) * slice_work(PASS_SURFACE);
+}
+
 static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err) {
   bounce_ctx *ctx = &d->ctx;
   const int coarse = mode == PASS_SURFACE && d->coarse.slice_count;
   const bb_rayset *rs = coarse ? &d->coarse : d->fine;
   const int *order = coarse ? d->coarse_order : d->order;
+  const bb__bounce_options *o = d->o;
   ctx->rs = rs;
   ctx->mode = mode;
-  ctx->exact_steps = mode == PASS_TEXEL ? d->o->exact_steps : d->o->surface_exact_steps;
-  ctx->far_steps = mode == PASS_TEXEL ? d->o->far_steps : d->o->surface_far_steps;
-  bb_status st = bb__parallel_for(ctx->p->height, d->o->threads, zero_row, d, NULL, NULL, err);
+  ctx->exact_steps = mode == PASS_TEXEL ? o->exact_steps : o->surface_exact_steps;
+  ctx->far_steps = mode == PASS_TEXEL ? o->far_steps : o->surface_far_steps;
+  bb_status st = bb__parallel_for(ctx->p->height, o->threads, zero_row, d, NULL, NULL, err);
   for (int k = 0; st == BB_OK && k < rs->slice_count;) {
     const int s = order[k];
     const int pair = k + 1 < rs->slice_count &&
@@ -1002,16 +1028,36 @@ static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err)
     const bb__sweep_dir along = {rs, s, NULL, NULL};
     const bb__sweep_dir opposite = {rs, pair ? order[k + 1] : 0, NULL, NULL};
     st = bb__sweep_lines_hooked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
-                                pair ? &opposite : NULL, bias, d->o->threads, 0, line_hook, ctx,
+                                pair ? &opposite : NULL, bias, o->threads, 0, line_hook, ctx,
                                 err);
     k += pair ? 2 : 1;
     if (st == BB_OK && atomic_load(&ctx->out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");
-    if (st == BB_OK && d->o->progress &&
-        d->o->progress(d->o->progress_user, k, rs->slice_count))
+    /* monotone over the whole: what the passes before this one did, and
+     * this one's slices so far */
+    const long done = o->progress_before + d->work_done + (long)k * slice_work(mode);
+    const long total = o->progress_before + d->work + o->progress_after;
+    if (st == BB_OK && o->progress && o->progress(o->progress_user, done, total))
       st = bb__fail(err, BB_ERR_CANCELLED, "bounce: cancelled by the progress callback");
   }
+  d->work_done += (long)rs->slice_count * slice_work(mode);
   return st;
+}
+
+/* Bounces 0 starts from an estimate of each corner's converged light: as
+ * though every surface it sees were as bright as itself, the light it
+ * reflects is its first bounce times 1 / (1 - lambda), lambda = rho beta,
+ * beta the part of its hemisphere (cosine-weighted) that the surface
+ * blocks, 1 - E_ao / pi (held under 0.9). One surface pass from there
+ * brings the texels within what 4 or 5 passes from the first bounce did
+ * (docs/accuracy.md "Inter-reflection"). Lobes take the ao channel's
+ * ratio: the surfaces seen are lit by the same lobe. */
+static double estimate_ratio(const driver *d, double rho, size_t v, int f) {
+  const double e_ao = (double)d->direct[(v * FACES + (size_t)f) * (size_t)d->ctx.channels];
+  double beta = 1.0 - e_ao / BB__PI;
+  beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
+  const double lambda = rho * beta;
+  return lambda < 0.9 ? lambda : 0.9;
 }
 
 /* After the direct pass: each corner's E from the sky, and its radiance. */
@@ -1033,7 +1079,9 @@ static void direct_row(void *user, int y) {
         const double e = n[f][0] * all[0] + n[f][1] * all[1] + n[f][2] * all[2] - (double)ctx->sums[i];
         d->direct[i] = (float)(e > 0.0 ? e : 0.0);
         if (out != SIZE_MAX) {
-          d->radiance[out + (size_t)k] = (float)(rho / BB__PI * (double)d->direct[i]);
+          /* the first bounce, or (bounces 0) the corner's estimate of all */
+          const double gain = d->o->bounces ? 1.0 : 1.0 / (1.0 - estimate_ratio(d, rho, v, f));
+          d->radiance[out + (size_t)k] = (float)(rho / BB__PI * (double)d->direct[i] * gain);
           sum += fixed((double)d->radiance[out + (size_t)k]);
         }
       }
@@ -1042,9 +1090,9 @@ static void direct_row(void *user, int y) {
   d->row_sum[y] = sum;
 }
 
-/* After a surface pass: how far each corner's radiance would move (the
- * largest and the sum, per row); then the move, and with it, when the
- * bounces stop here, the rest of the series estimated as geometric. */
+/* After a surface pass: how far each corner's radiance would move, summed
+ * per row; then the move, and with it, when the bounces stop here, the
+ * rest of the series estimated as geometric. */
 static double corner_radiance(const driver *d, size_t v, size_t i) {
   const double rho = d->o->rho * (d->albedo ? (double)d->albedo[v] : 1.0);
   const double e = (double)d->direct[i] + (double)d->ctx.sums[i];
@@ -1055,7 +1103,6 @@ static void change_row(void *user, int y) {
   driver *d = user;
   const int channels = d->ctx.channels;
   const size_t W = (size_t)d->ctx.p->width;
-  double largest = 0.0;
   exact_sum sum = 0;
   for (size_t x = 0; x < W; x++) {
     const size_t v = (size_t)y * W + x;
@@ -1064,14 +1111,11 @@ static void change_row(void *user, int y) {
       if (out == SIZE_MAX) continue;
       for (int k = 0; k < channels; k++) {
         const size_t i = (v * FACES + (size_t)f) * (size_t)channels + (size_t)k;
-        const double moved =
-            fabs((double)(float)corner_radiance(d, v, i) - (double)d->radiance[out + (size_t)k]);
-        largest = moved > largest ? moved : largest;
-        sum += fixed(moved);
+        sum += fixed(fabs((double)(float)corner_radiance(d, v, i) -
+                          (double)d->radiance[out + (size_t)k]));
       }
     }
   }
-  d->row_change[y] = largest;
   d->row_sum[y] = sum;
 }
 
@@ -1148,7 +1192,7 @@ static void finish_row(void *user, int y) {
 
 void bb__bounce_options_init(bb__bounce_options *o) {
   memset(o, 0, sizeof *o);
-  o->tolerance = 1e-2;
+  o->estimate_passes = 1;
   o->lift = 0.25;
   o->exact_steps = 4;
   o->surface_exact_steps = 1;
@@ -1177,18 +1221,17 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   ctx->sums = malloc(corners * sizeof(float));
   d.direct = malloc(corners * sizeof(float));
   d.radiance = malloc(corners * sizeof(float));
-  d.row_change = malloc((size_t)p->height * sizeof(double));
   d.row_sum = malloc((size_t)p->height * sizeof *d.row_sum);
   ctx->slot_count = threads < 256 ? threads : 256;
   ctx->slots = calloc((size_t)ctx->slot_count, sizeof(scratch));
   bb_status st = BB_OK;
-  if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_change || !d.row_sum || !ctx->slots ||
+  if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
       bb_trace_slice_order(rs, order, NULL) != BB_OK)
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)", corners / (size_t)channels);
   d.order = order;
   d.fine = rs;
-  int surface_slices = o->surface_slices;
-  if (surface_slices <= 0) surface_slices = rs->slice_count / 2 >= 4 ? rs->slice_count / 2 : rs->slice_count;
+  const int surface_slices = coarse_slices(rs, o);
+  d.work = bb__bounce_work(rs, o);
   if (st == BB_OK && surface_slices < rs->slice_count) {
     bb_basis basis = {.count = rs->basis_count, .name = "bounce"};
     memcpy(basis.vector, rs->basis, sizeof basis.vector);
@@ -1204,27 +1247,24 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, direct_row, &d, NULL, NULL, err);
   if (st == BB_OK) corner_fixup(&d);
   ctx->radiance = d.radiance;
-  /* The bounces: each adds what the corners gather of the last one. With
-   * bounces 0 they stop once no corner moves by more than the tolerance;
-   * the terms left are then about the last one times lambda / (1 - lambda),
-   * lambda the ratio of the last two moves summed over every corner (the
-   * series of bounces is close to geometric), and that is added. */
+  /* The bounces: each pass adds what the corners gather of the last one.
+   * bounces N: N - 1 passes from the first bounce. bounces 0: the passes
+   * from the estimate; the terms left are then about the last move times
+   * lambda / (1 - lambda), lambda the ratio of the last two moves summed
+   * over every corner (the series of bounces is close to geometric), and
+   * that is added. */
   int done = 1;
   exact_sum last_sum = 0;
   for (int y = 0; st == BB_OK && y < p->height; y++) last_sum += d.row_sum[y];
-  while (st == BB_OK && (o->bounces == 0 ? done < BB_MAX_BOUNCES : done < o->bounces)) {
+  const int passes = surface_passes(o);
+  for (int pass = 0; st == BB_OK && pass < passes; pass++) {
     st = run_pass(&d, PASS_SURFACE, o->lift, err);
     if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, change_row, &d, NULL, NULL, err);
     if (st != BB_OK) break;
-    double change = 0.0;
     exact_sum sum = 0;
-    for (int y = 0; y < p->height; y++) {
-      change = d.row_change[y] > change ? d.row_change[y] : change;
-      sum += d.row_sum[y];
-    }
-    const int stop = o->bounces == 0 && change <= o->tolerance;
+    for (int y = 0; y < p->height; y++) sum += d.row_sum[y];
     d.tail = 0.0;
-    if (stop && last_sum > 0) {
+    if (o->bounces == 0 && pass == passes - 1 && last_sum > 0) {
       double lambda = (double)sum / (double)last_sum;
       lambda = lambda < 0.9 ? lambda : 0.9;
       d.tail = lambda / (1.0 - lambda);
@@ -1233,7 +1273,6 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
     st = bb__parallel_for(p->height, o->threads, update_row, &d, NULL, NULL, err);
     if (st == BB_OK) corner_fixup(&d);
     done++;
-    if (stop) break;
   }
   if (st == BB_OK) st = run_pass(&d, PASS_TEXEL, o->bias, err);
   if (st == BB_OK) {
@@ -1252,7 +1291,6 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   free(ctx->sums);
   free(d.direct);
   free(d.radiance);
-  free(d.row_change);
   free(d.row_sum);
   bb__rayset_release(&d.coarse);
   free(d.coarse_order);

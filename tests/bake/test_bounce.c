@@ -85,6 +85,50 @@ Test(bounce, rho_zero_is_the_bake_without_it) {
   bb_image_free(&grey);
 }
 
+/* ---- progress: once from 0 to the whole over the trace and every pass ---- */
+
+typedef struct progress_log {
+  long done[256], total[256];
+  int calls;
+} progress_log;
+
+static int log_progress(void *user, long done, long total) {
+  progress_log *l = user;
+  if (l->calls < 256) l->done[l->calls] = done, l->total[l->calls] = total;
+  l->calls++;
+  return 0;
+}
+
+Test(bounce, progress_is_monotone_over_the_whole_bake) {
+  bb_image h = load_fixture("noise_96x80.png");
+  const int counts[] = {0, 3};
+  for (size_t c = 0; c < 2; c++) {
+    bb_bake_options o = options(8.0f, 256, 0.5);
+    o.bounces = counts[c];
+    progress_log l = {{0}, {0}, 0};
+    o.trace.progress = log_progress;
+    o.trace.progress_user = &l;
+    bb_bake_result r = harness_bake(&h, &o);
+    cr_assert(l.calls > 16 && l.calls <= 256, "bounces %d: %d calls", counts[c], l.calls);
+    for (int i = 0; i < l.calls; i++) {
+      cr_assert_eq(l.total[i], l.total[0], "bounces %d: the whole changes at call %d (%ld, then %ld)",
+                   counts[c], i, l.total[0], l.total[i]);
+      cr_assert(l.done[i] >= 0 && l.done[i] <= l.total[i], "bounces %d: call %d: %ld of %ld",
+                counts[c], i, l.done[i], l.total[i]);
+      if (i)
+        cr_assert(l.done[i] >= l.done[i - 1], "bounces %d: back from %ld to %ld at call %d",
+                  counts[c], l.done[i - 1], l.done[i], i);
+    }
+    cr_expect_eq(l.done[l.calls - 1], l.total[0], "bounces %d: ends at %ld of %ld", counts[c],
+                 l.done[l.calls - 1], l.total[0]);
+    /* the trace is its first part, not the whole: 16 slices of a much larger total */
+    cr_expect_lt(l.done[7] * 4, l.total[0], "bounces %d: the trace's sweeps weigh %ld of %ld",
+                 counts[c], l.done[7], l.total[0]);
+    bb_bake_result_free(&r);
+  }
+  bb_image_free(&h);
+}
+
 /* ---- what bouncing light may and may not do ------------------------------- */
 
 Test(bounce, never_darker_and_ao_never_above_one) {
