@@ -145,22 +145,22 @@ static inline double height_at(const bb_pyramid *p, long x, long y) {
   return (double)p->z[vertex_at(p, x, y)];
 }
 
-/* Unit normal of half `upper` of cell (cx, cy). */
-static void face_normal(const bb_pyramid *p, long cx, long cy, int upper, double n[3]) {
-  const double z00 = height_at(p, cx, cy), z10 = height_at(p, cx + 1, cy);
-  const double z01 = height_at(p, cx, cy + 1), z11 = height_at(p, cx + 1, cy + 1);
-  if (upper)
-    n[0] = z01 - z11, n[1] = z10 - z11;
-  else
-    n[0] = z00 - z10, n[1] = z00 - z01;
-  const double len = sqrt(n[0] * n[0] + n[1] * n[1] + 1.0);
-  n[0] /= len, n[1] /= len, n[2] = 1.0 / len;
-}
-
-/* The normals of the 6 triangles around vertex (x, y). */
+/* The normals of the 6 triangles around vertex (x, y): face_normal's
+ * arithmetic, each of the 7 heights around it read once. */
 static void vertex_faces(const bb_pyramid *p, long x, long y, double n[FACES][3]) {
-  for (int f = 0; f < FACES; f++)
-    face_normal(p, x + slot_dx[f], y + slot_dy[f], slot_upper[f], n[f]);
+  double z[3][3]; /* z[1 + dy][1 + dx]; (-1, -1) and (+1, +1) are no triangle's corner */
+  for (int j = -1; j <= 1; j++)
+    for (int i = -1; i <= 1; i++)
+      if (i != j || i == 0) z[1 + j][1 + i] = height_at(p, x + i, y + j);
+  for (int f = 0; f < FACES; f++) {
+    const int cx = 1 + slot_dx[f], cy = 1 + slot_dy[f]; /* the cell's (0, 0) in z */
+    if (slot_upper[f])
+      n[f][0] = z[cy + 1][cx] - z[cy + 1][cx + 1], n[f][1] = z[cy][cx + 1] - z[cy + 1][cx + 1];
+    else
+      n[f][0] = z[cy][cx] - z[cy][cx + 1], n[f][1] = z[cy][cx] - z[cy + 1][cx];
+    const double len = sqrt(n[f][0] * n[f][0] + n[f][1] * n[f][1] + 1.0);
+    n[f][0] /= len, n[f][1] /= len, n[f][2] = 1.0 / len;
+  }
 }
 
 /* ------------------------------------------------ vector sector tables */
@@ -501,6 +501,7 @@ static void band_add(gather *g, double ta, double tb, double theta_a, double the
     double th_a = theta_a, s2 = s2a, sc = sca;
     if (g->plane[f] > ta) {
       if (!(tb > g->plane[f])) continue;
+      if (isnan(g->plane_theta[f])) g->plane_theta[f] = atan(g->plane[f]); /* when first met */
       th_a = g->plane_theta[f], s2 = g->plane_sin2[f], sc = g->plane_sincos[f];
     }
     const double cos2 = 0.5 * (theta_b - th_a) + 0.5 * (scb - sc);
@@ -538,9 +539,11 @@ static void band_pieces(gather *g, const segment *seg, double sa, double sb) {
    * wide band and the radiance changes along the segment: only then is
    * the band cut (a tall wall seen from its foot, not a short segment). */
   double change = 0.0;
-  for (int k = 0; k < channels; k++)
-    change = fmax(change, fabs((double)seg->far[k] - (double)seg->near[k]));
-  const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : fmin(fabs(ta), fabs(tb));
+  for (int k = 0; k < channels; k++) {
+    const double c = fabs((double)seg->far[k] - (double)seg->near[k]);
+    change = c > change ? c : change;
+  }
+  const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : (fabs(ta) < fabs(tb) ? fabs(ta) : fabs(tb));
   if (fabs(at_b - at_a) * change > 0.01 && (tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND) {
     theta_a = theta_of(g, ta), theta_b = atan(tb); /* the bound above is not the width */
     pieces = (int)ceil((theta_b - theta_a) / WIDE_BAND);
@@ -886,7 +889,7 @@ static void gather_corners(gather *g, const bb_pyramid *p, long x, long y, doubl
     g->horizontal[f] = n[f][0] * g->cx + n[f][1] * g->cy;
     g->vertical[f] = n[f][2] * g->half_width;
     g->plane[f] = plane;
-    g->plane_theta[f] = atan(plane);
+    g->plane_theta[f] = NAN; /* band_add takes its atan when a band crosses the plane */
     g->plane_sin2[f] = sin2(plane);
     g->plane_sincos[f] = sincos_of(plane);
     g->plane_low = f == 0 || plane < g->plane_low ? plane : g->plane_low;
