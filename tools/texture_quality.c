@@ -21,7 +21,7 @@
  *       A angle_max_deg B z_max_codes Z]".
  */
 #include "bumpbake.h"
-#include "io/texture_oracle.h"
+#include "texture/texture_oracle.h"
 
 #include <math.h>
 #include <stdio.h>

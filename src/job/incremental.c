@@ -11,8 +11,8 @@
 
 #include "core/input_file.h"
 #include "core/internal.h"
-#include "io/oiio.h"
-#include "io/provenance.h"
+#include "image/oiio.h"
+#include "files/provenance.h"
 #include "trace/rayset.h"
 #include <errno.h>
 #include <stdarg.h>

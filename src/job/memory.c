@@ -4,7 +4,7 @@
  * machine has left, so a map too large is refused with the figures. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
-#include "io/texture.h"
+#include "texture/texture.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>

@@ -5,7 +5,7 @@
  * the last one, so an interrupted command leaves the set all old or all
  * new. */
 #include "core/internal.h"
-#include "io/safe_file.h"
+#include "files/safe_file.h"
 #include "job/job_internal.h"
 
 #include <errno.h>

@@ -2,7 +2,7 @@
  * OpenImageIO (bb__image_resize_box), normal maps renormalised per level. */
 
 #include "core/internal.h"
-#include "io/oiio.h"
+#include "image/oiio.h"
 #include "maps/maps_internal.h"
 #include <math.h>
 #include <stdlib.h>

@@ -8,7 +8,7 @@
 #include "core/input_file.h"
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
-#include "io/safe_file.h"
+#include "files/safe_file.h"
 #include "mesh/mesh_import.h"
 #include <assimp/Exporter.hpp>
 #include <assimp/IOStream.hpp>

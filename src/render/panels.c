@@ -2,7 +2,7 @@
  * OpenImageIO (io/oiio_text.cpp); the grid is drawn here. */
 
 #include "core/internal.h"
-#include "io/text.h"
+#include "render/text.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
