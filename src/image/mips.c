@@ -3,7 +3,6 @@
 
 #include "core/internal.h"
 #include "image/oiio.h"
-#include "maps/maps_internal.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
