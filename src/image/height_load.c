@@ -1,6 +1,6 @@
-/* load.c: the height channel rule (docs/conventions.md "Height input"): which channel becomes h. */
+/* height_load.c: heights from images and files by the channel rule
+ * (docs/conventions.md "Height input"): which channel becomes h. */
 
-#include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "image/height_channel.h"
 #include "image/oiio.h"
@@ -224,20 +224,4 @@ bb_status bb_height_load(const char *path, bb_channel channel, bb_image *height,
                          bb_error *err) {
   bb__height_loaded loaded;
   return bb__height_load(path, channel, height, &loaded, err);
-}
-
-bb_status bb__check_scaled_height(const bb_image *height, float height_scale,
-                                  bb_error *err) {
-  for (int y = 0; y < height->height; y++)
-    for (int x = 0; x < height->width; x++) {
-      double h = (double)*bb_image_texel(height, x, y);
-      double z = (double)height_scale * h;
-      if (!(fabs(z) <= BB_MAX_HEIGHT_TEXELS))
-        return bb__fail(err, BB_ERR_VALUE,
-                        "height scale %g times the height %g at texel (%d, %d) is %g "
-                        "texels, over the limit of %g (scaled heights must stay well "
-                        "inside the float range)",
-                        (double)height_scale, h, x, y, z, BB_MAX_HEIGHT_TEXELS);
-    }
-  return BB_OK;
 }

@@ -4,7 +4,7 @@
  * integration tables, derive, the writers) reads its count and vectors.
  */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/input_file.h"
 #include "core/internal.h"
 #include <errno.h>
