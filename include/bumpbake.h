@@ -63,8 +63,7 @@ extern "C" {
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
  * allocating. What a machine can bake is less: reads and bakes estimate
  * their memory from the sizes first and refuse, naming the estimate and
- * what is available, what will not fit (bb_memory_available,
- * bb_bake_memory_estimate). */
+ * what is available, what will not fit (bb_memory_available). */
 #define BB_MAX_DIMENSION 65536
 #define BB_MAX_PIXELS (32768L * 32768L)
 
@@ -560,12 +559,6 @@ bb_status bb_texture_check(const char *path, int width, int height, int channels
 bb_status bb_texture_write(const char *path, const bb_image *img,
                            const bb_texture_options *options, bb_error *err);
 
-/* bb_texture_write up to, not including, the rename, as
- * bb_image_write_staged: commit or discard *staged. */
-bb_status bb_texture_write_staged(const char *path, const bb_image *img,
-                                  const bb_texture_options *options,
-                                  bb_staged_file **staged, bb_error *err);
-
 /* Sets options->map for a file of an output kind: SSBUMP for the kinds
  * "ssbump", "ssbump+...", "detail-ssbump..." and "weights" (normal2ssbump's,
  * an ssbump without shadows, which Source loads the same way); NORMAL for
@@ -691,10 +684,6 @@ bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel 
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-
-/* bb_image_read followed by bb_height_from_image; messages name the file. */
-bb_status bb_height_load(const char *path, bb_channel channel,
-                         bb_image *height, bb_error *err);
 
 /* =====================================================================
  * bake: smooth -> normals -> pyramid -> trace -> derive
@@ -857,30 +846,6 @@ bb_status bb_pyramid_build(const bb_image *height_texels,
                            bb_error *err);
 
 void bb_pyramid_free(bb_pyramid *p);
-
-/* -------------------------------------------------------------- tracer */
-
-/* A ray in texel space: origin and direction (need not be unit; z > 0). */
-typedef struct bb_ray {
-  double origin[3];
-  double direction[3];
-} bb_ray;
-
-/* 1 when the ray meets the surface at a distance > 0, else 0. Rays have no
- * maximum length: periodic rays wrap as often as needed. Max-mip march. */
-int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
-
-/* The horizon of the ray's vertical half-plane: the largest slope
- * (surface - origin z) / d, in texels of rise per texel of horizontal
- * distance, over every breakpoint of the surface (cell edge or diagonal
- * crossing) at 0 < d <= max_distance along the ray's horizontal direction
- * (its z is ignored), or 0 when none is positive: a direction is open
- * exactly when its tangent of elevation exceeds it. max_distance is in
- * texels, > 0; it may be INFINITY in clamp mode (past the border the surface
- * turns flat), not in periodic mode, where a ray that never rises above its
- * origin would wrap for ever. Returns -1 for a bad max_distance or a
- * vertical direction. Max-mip march. */
-double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance);
 
 /* ------------------------------------------------------------- ray set */
 
@@ -1202,15 +1167,6 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
  * about 13 bytes per texel while building, 5.4 once built. */
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
-
-/* The most bytes bb_bake allocates at one time for a width x height field
- * with options o (its outputs, basis, slices and threads), not counting the
- * height itself: an upper bound worked out from the sizes alone, following
- * the bake's stages. bb_bake refuses (BB_ERR_MEMORY, naming both figures) a
- * bake whose estimate is over bb_memory_available before it allocates
- * anything. About 32 bytes a texel for ssbump and ao, 36 with the normal
- * map, 64 for every output. 0 for a bad size or NULL options. */
-uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o);
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */

@@ -553,12 +553,6 @@ int64_t bb__safe_size(bb_staged_file *f) {
   return size;
 }
 
-void bb__safe_fail(bb_staged_file *f, int error) {
-  pthread_mutex_lock(&f->lock);
-  note_error(f, error ? error : EIO);
-  pthread_mutex_unlock(&f->lock);
-}
-
 /* -------------------------------------------------------- finish, commit */
 
 bb_status bb__safe_finish(bb_staged_file *f, bb_error *err) {

@@ -110,8 +110,6 @@ size_t bb__safe_pread(bb_staged_file *f, void *data, size_t size, int64_t offset
 int bb__safe_seek(bb_staged_file *f, int64_t offset); /* 0, or -1 if offset < 0 */
 int64_t bb__safe_tell(bb_staged_file *f);
 int64_t bb__safe_size(bb_staged_file *f);
-/* Marks the file failed (an encoder's own error): finish will refuse it. */
-void bb__safe_fail(bb_staged_file *f, int error);
 bb_status bb__safe_finish(bb_staged_file *f, bb_error *err);
 bb_status bb__safe_commit(bb_staged_file *f, bb_error *err);
 /* Removes the temporary; safe after a failed open, finish or commit. */

@@ -19,8 +19,10 @@ typedef struct bb__height_loaded {
   char format_name[32];
 } bb__height_loaded;
 
-/* bb_height_load, telling which channel it took and why (load.c): the
- * header decides where it can, and only the channels needed are decoded. */
+/* The height of the image file at path by the channel rule, telling which
+ * channel it took and why (height_load.c): the header decides where it
+ * can, and only the channels needed are decoded. Messages name the file.
+ * bb_height_file_read's loader; tests call it alone. */
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err);
 

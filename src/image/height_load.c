@@ -176,7 +176,7 @@ static bb_status load_whole(const char *path, bb_channel channel, bb_image *heig
 
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err) {
-  if (!height) return bb__fail(err, BB_ERR_ARGUMENT, "bb_height_load: height is NULL");
+  if (!height) return bb__fail(err, BB_ERR_ARGUMENT, "height load: height is NULL");
   memset(height, 0, sizeof *height);
   memset(loaded, 0, sizeof *loaded);
   int channels = 0;
@@ -218,10 +218,4 @@ bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height
                      "channel option chooses another)";
   }
   return st;
-}
-
-bb_status bb_height_load(const char *path, bb_channel channel, bb_image *height,
-                         bb_error *err) {
-  bb__height_loaded loaded;
-  return bb__height_load(path, channel, height, &loaded, err);
 }

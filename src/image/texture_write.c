@@ -114,21 +114,3 @@ bb_status bb_texture_write(const char *path, const bb_image *img,
   bb_status st = bb__texture_stage(path, img, 1, 0, options, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
-
-bb_status bb_texture_write_staged(const char *path, const bb_image *img,
-                                  const bb_texture_options *options,
-                                  bb_staged_file **staged, bb_error *err) {
-  if (!staged)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_texture_write_staged: staged is NULL");
-  *staged = NULL;
-  bb_staged_file *f = bb__staged_new();
-  if (!f)
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path ? path : "texture");
-  bb_status st = bb__texture_stage(path, img, 1, 0, options, f, err);
-  if (st != BB_OK) {
-    free(f);
-    return st;
-  }
-  *staged = f;
-  return BB_OK;
-}

@@ -2,6 +2,7 @@
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "image/height_channel.h"
 
 #include <errno.h>
 #include <math.h>
@@ -354,7 +355,7 @@ static void write_file(const char *name, const bb_image *img, bb_depth depth) {
 static void check_load(const char *name, const bb_image *img, bb_channel ch, double tol) {
   bb_image h;
   bb_error err = {{0}};
-  cr_assert_eq(bb_height_load(tmp_path(name), ch, &h, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__height_load(tmp_path(name), ch, &h, &(bb__height_loaded){0}, &err), BB_OK, "%s", err.message);
   cr_assert_eq(h.channels, 1);
   for (int y = 0; y < img->height; y++)
     for (int x = 0; x < img->width; x++)
@@ -388,7 +389,7 @@ Test(load, files_with_one_to_four_channels) {
   write_file("rgba.tga", &valve, BB_DEPTH_DEFAULT);
   check_load("rgba.tga", &valve, BB_CHANNEL_A, STEP_8);
   bb_image h;
-  cr_assert_eq(bb_height_load(tmp_path("rgba.tga"), BB_CHANNEL_AUTO, &h, NULL), BB_OK);
+  cr_assert_eq(bb__height_load(tmp_path("rgba.tga"), BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, NULL), BB_OK);
   cr_assert_float_eq(*bb_image_texel(&h, 5, 4), 0.54, STEP_8, "alpha at (5, 4)");
   bb_image_free(&h);
   bb_image_free(&valve);
@@ -403,11 +404,11 @@ Test(load, file_errors_name_the_file) {
   write_file("g.png", &g, BB_DEPTH_DEFAULT);
   bb_image h;
   bb_error err;
-  cr_assert_eq(bb_height_load(tmp_path("g.png"), BB_CHANNEL_G, &h, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__height_load(tmp_path("g.png"), BB_CHANNEL_G, &h, &(bb__height_loaded){0}, &err), BB_ERR_ARGUMENT);
   cr_assert_null(h.pixels);
   cr_assert_eq(strncmp(err.message, tmp_path("g.png"), strlen(tmp_path("g.png"))), 0, "%s",
                err.message);
-  cr_assert_eq(bb_height_load(tmp_path("missing.png"), BB_CHANNEL_AUTO, &h, &err), BB_ERR_IO);
+  cr_assert_eq(bb__height_load(tmp_path("missing.png"), BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, &err), BB_ERR_IO);
   cr_assert_not_null(strstr(err.message, "missing.png: no such file"), "%s", err.message);
   bb_image_free(&g);
 }
@@ -418,13 +419,13 @@ static void check_bad_float_file(const char *name, float bad, const char *word) 
   write_file(name, &img, BB_DEPTH_FLOAT);
   bb_image h;
   bb_error err;
-  cr_assert_eq(bb_height_load(tmp_path(name), BB_CHANNEL_AUTO, &h, &err), BB_ERR_VALUE);
+  cr_assert_eq(bb__height_load(tmp_path(name), BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, &err), BB_ERR_VALUE);
   cr_assert_null(h.pixels);
   cr_assert_not_null(strstr(err.message, name), "%s", err.message);
   cr_assert_not_null(strstr(err.message, "(4, 3)"), "%s", err.message);
   cr_assert_not_null(strstr(err.message, word), "%s", err.message);
   /* Red is finite there, so asking for it loads. */
-  cr_assert_eq(bb_height_load(tmp_path(name), BB_CHANNEL_R, &h, &err), BB_OK, "%s",
+  cr_assert_eq(bb__height_load(tmp_path(name), BB_CHANNEL_R, &h, &(bb__height_loaded){0}, &err), BB_OK, "%s",
                err.message);
   bb_image_free(&h);
   bb_image_free(&img);

@@ -12,6 +12,7 @@
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "image/height_channel.h"
 #include "child_call.h"
 #include "cli_harness.h"
 #include "hostile_headers.h"
@@ -37,7 +38,7 @@ static bb_status read_pixels(const char *path, bb_error *err) {
 
 static bb_status load_height(const char *path, bb_error *err) {
   bb_image h;
-  bb_status st = bb_height_load(path, BB_CHANNEL_AUTO, &h, err);
+  bb_status st = bb__height_load(path, BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, err);
   bb_image_free(&h);
   return st;
 }
@@ -63,7 +64,7 @@ static void expect_refusal(child_call_fn fn, const char *what, const char *path,
 static void expect_every_read_refuses(const char *path, bb_status want, const char *part) {
   expect_refusal(read_info, "bb_image_read_info", path, want, part);
   expect_refusal(read_pixels, "bb_image_read", path, want, part);
-  expect_refusal(load_height, "bb_height_load", path, want, part);
+  expect_refusal(load_height, "bb__height_load", path, want, part);
 }
 
 Test(hostile_headers, a_progressive_jpeg_is_refused_from_its_header) {
@@ -93,7 +94,7 @@ Test(hostile_headers, huge_tiles_are_refused_before_decoding) {
   cr_expect(w == 1 && h == 1 && c == 1);
   const char *part = "tiles of 16384x16384 with 1 channel need 1024 MiB each";
   expect_refusal(read_pixels, "bb_image_read", path, BB_ERR_SIZE, part);
-  expect_refusal(load_height, "bb_height_load", path, BB_ERR_SIZE, part);
+  expect_refusal(load_height, "bb__height_load", path, BB_ERR_SIZE, part);
 }
 
 Test(hostile_headers, an_exr_attribute_larger_than_its_file_is_refused) {

@@ -7,6 +7,7 @@
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "image/height_channel.h"
 #include "child_call.h"
 
 #include <errno.h>
@@ -160,7 +161,7 @@ static void read_damaged(const char *path) {
   cr_expect(strstr(err.message, path) != NULL, "%s", err.message);
   bb_image_free(&img);
   (void)bb_image_read_info(path, &w, &ht, &c, NULL, &err);
-  st = bb_height_load(path, BB_CHANNEL_AUTO, &h, &err);
+  st = bb__height_load(path, BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, &err);
   cr_expect_neq(st, BB_OK, "%s height", path);
   bb_image_free(&h);
 }
