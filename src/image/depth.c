@@ -1,6 +1,7 @@
 /* depth.c: the names of sample depths, as the command line's --depth, the
- * provenance's command and Python spell them. */
+ * provenance's command and Python spell them, and as messages say them. */
 #include "core/internal.h"
+#include "image/oiio.h"
 
 #include <stddef.h>
 
@@ -14,6 +15,17 @@ bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err) {
   if (st == BB_OK)
     *out = (bb_depth)i;
   return st;
+}
+
+const char *bb__depth_words(int depth) {
+  switch (depth) {
+  case BB_DEPTH_DEFAULT: return "default";
+  case BB_DEPTH_8: return "8-bit";
+  case BB_DEPTH_16: return "16-bit";
+  case BB_DEPTH_HALF: return "half float";
+  case BB_DEPTH_FLOAT: return "float";
+  }
+  return "unknown";
 }
 
 const char *bb_depth_name(bb_depth depth) {

@@ -30,17 +30,6 @@ static const format_rule FORMATS[] = {
     {".exr", BB_DEPTH_FLOAT, BIT(BB_DEPTH_HALF) | BIT(BB_DEPTH_FLOAT), 64, 1},
 };
 
-static const char *depth_name(bb_depth d) {
-  switch (d) {
-  case BB_DEPTH_DEFAULT: return "default";
-  case BB_DEPTH_8: return "8-bit";
-  case BB_DEPTH_16: return "16-bit";
-  case BB_DEPTH_HALF: return "half float";
-  case BB_DEPTH_FLOAT: return "float";
-  }
-  return "unknown";
-}
-
 /* The dot of the last component's extension, or NULL. */
 static const char *extension_start(const char *path) {
   const char *slash = strrchr(path, '/');
@@ -124,7 +113,7 @@ static bb_status resolve_depth(const char *path, const format_rule *f, const bb_
   *depth = o->depth == BB_DEPTH_DEFAULT ? f->default_depth : o->depth;
   if (!(f->allowed & BIT(*depth)))
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s samples are not supported by %s files", path,
-                    depth_name(*depth), f->ext);
+                    bb__depth_words(*depth), f->ext);
   if (channels > f->max_channels)
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s files hold at most %d channels, not %d", path,
                     f->ext, f->max_channels, channels);
@@ -152,7 +141,7 @@ static bb_status texture_check(const char *path, const bb_image *top,
     return bb__fail(err, BB_ERR_FORMAT,
                     "%s: %s samples cannot be chosen for %s files: their texture format "
                     "sets them",
-                    path, depth_name(o->depth), (bb__extension_of(path, ext, sizeof ext), ext));
+                    path, bb__depth_words(o->depth), (bb__extension_of(path, ext, sizeof ext), ext));
   bb_texture_options t;
   bb__texture_options_of(o, &t);
   return bb_texture_check(path, top->width, top->height, top->channels, &t, err);

@@ -30,6 +30,10 @@ static void renormalize(bb_image *img) {
   }
 }
 
+bb_mip_filter bb__mip_filter(int normal_map) {
+  return normal_map ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
+}
+
 void bb_mip_chain_free(bb_image *levels, int count) {
   if (!levels)
     return;

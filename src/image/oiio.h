@@ -15,6 +15,11 @@ extern "C" {
  * unknown extension (formats.c); and the number of mip levels of subimage 0
  * of the file at path, from its headers (image_read.c). */
 int bb__path_resolved_depth(const char *path, bb_depth depth);
+
+/* A depth as messages say it: "8-bit", "16-bit", "half float", "float",
+ * "default", or "unknown" for anything else (depth.c; bb_depth_name is
+ * the word --depth takes). */
+const char *bb__depth_words(int depth);
 bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
 
 
@@ -25,6 +30,10 @@ bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
 bb_status bb__image_read_channels(const char *path, int first_channel, int channel_count,
                                   bb_image *out, bb_image_info *info, bb_error *err);
 
+
+/* The filter of a map's mip chain (mips.c): a normal map's levels
+ * renormalised, any other's averaged. */
+bb_mip_filter bb__mip_filter(int normal_map);
 
 /* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
  * (oiio_mips.cpp). Allocates out. */

@@ -4,6 +4,7 @@
  * file the library writes. */
 
 #include "core/internal.h"
+#include "image/oiio.h"
 #include "texture/dds.h"
 #include "files/safe_file.h"
 #include "texture/texture.h"
@@ -18,8 +19,7 @@
  * rejects NaN and infinite texels). */
 static bb_status texture_chain(const bb_image *img, bb_texture_map map, bb_image **levels,
                                int *count, bb_error *err) {
-  return bb_mip_chain(img, map == BB_TEXTURE_MAP_NORMAL ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE,
-                      levels, count, err);
+  return bb_mip_chain(img, bb__mip_filter(map == BB_TEXTURE_MAP_NORMAL), levels, count, err);
 }
 
 /* A caller's chain must be one bb_mip_chain could have made (each level
