@@ -36,20 +36,20 @@ LIB_CFLAGS := -fPIC -fno-semantic-interposition
 PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
-# libpng: src/io/png_hooks.c sets quiet error handlers and bounded
+# libpng: src/image/png_hooks.c sets quiet error handlers and bounded
 # allocations on the libpng structs OpenImageIO makes.
 PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
 PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
 # libjpeg and OpenEXRCore read headers before OpenImageIO's readers do
-# (src/io/header_probe.c), to refuse what they would allocate in open().
+# (src/image/header_probe.c), to refuse what they would allocate in open().
 PROBE_CFLAGS := $(shell pkg-config --cflags libjpeg OpenEXR 2>/dev/null)
 PROBE_LIBS   := $(shell pkg-config --libs libjpeg 2>/dev/null) \
                 $(filter -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
-# Assimp reads and writes meshes (src/mesh_assimp.cpp only).
+# Assimp reads and writes meshes (src/mesh/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-# libsquish compresses BC1..BC5 blocks (src/io/squish.cpp only). Imath's
+# libsquish compresses BC1..BC5 blocks (src/texture/squish.cpp only). Imath's
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)

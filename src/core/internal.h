@@ -1,6 +1,6 @@
 /* internal.h: what every family of the library shares (not public): error
  * messages, periodic addressing, threads, hashing and the clock. Each family
- * keeps its own private headers beside its files (io/oiio.h, trace/march.h...). */
+ * keeps its own private headers beside its files (image/oiio.h, trace/march.h...). */
 #ifndef BB_INTERNAL_H
 #define BB_INTERNAL_H
 

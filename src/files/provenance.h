@@ -1,7 +1,7 @@
 /* provenance.h: what the file writers and the up-to-date check
  * need of provenance texts beyond the public calls (provenance.c). */
-#ifndef BB_IO_PROVENANCE_H
-#define BB_IO_PROVENANCE_H
+#ifndef BB_FILES_PROVENANCE_H
+#define BB_FILES_PROVENANCE_H
 
 #include "bumpbake.h"
 
@@ -32,4 +32,4 @@ int bb__provenance_mismatch(const char *have, const char *want, const char *cons
 }
 #endif
 
-#endif /* BB_IO_PROVENANCE_H */
+#endif /* BB_FILES_PROVENANCE_H */

@@ -1,7 +1,7 @@
 /* safe_file.h: every file the library writes goes to disk this
  * way (safe_file.c), so that no failure leaves a partial file at its name. */
-#ifndef BB_IO_SAFE_FILE_H
-#define BB_IO_SAFE_FILE_H
+#ifndef BB_FILES_SAFE_FILE_H
+#define BB_FILES_SAFE_FILE_H
 
 #include "bumpbake.h"
 
@@ -122,4 +122,4 @@ bb_staged_file *bb__staged_new(void);
 }
 #endif
 
-#endif /* BB_IO_SAFE_FILE_H */
+#endif /* BB_FILES_SAFE_FILE_H */

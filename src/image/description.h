@@ -1,7 +1,7 @@
 /* description.h: how an ImageDescription (provenance) is fitted to a file
  * format and read back from it (description.c). */
-#ifndef BB_IO_DESCRIPTION_H
-#define BB_IO_DESCRIPTION_H
+#ifndef BB_IMAGE_DESCRIPTION_H
+#define BB_IMAGE_DESCRIPTION_H
 
 #include "bumpbake.h"
 
@@ -23,4 +23,4 @@ void bb__description_as_read(const char *format_name, char *description);
 }
 #endif
 
-#endif /* BB_IO_DESCRIPTION_H */
+#endif /* BB_IMAGE_DESCRIPTION_H */

@@ -1,8 +1,8 @@
 /* formats.h: the formats bumpbake writes and what each can hold (depths,
  * channels, mip levels), and the checks a write makes before OpenImageIO
  * sees a byte (formats.c). */
-#ifndef BB_IO_FORMATS_H
-#define BB_IO_FORMATS_H
+#ifndef BB_IMAGE_FORMATS_H
+#define BB_IMAGE_FORMATS_H
 
 #include "bumpbake.h"
 
@@ -50,4 +50,4 @@ const char *bb__basis_channel_name(int c, int count, char out[8]);
 }
 #endif
 
-#endif /* BB_IO_FORMATS_H */
+#endif /* BB_IMAGE_FORMATS_H */

@@ -1,8 +1,8 @@
 /* header_probe.h: what opening a file will make OpenImageIO's reader
  * allocate, learnt from the file's header before that reader sees it
  * (header_probe.c). */
-#ifndef BB_IO_HEADER_PROBE_H
-#define BB_IO_HEADER_PROBE_H
+#ifndef BB_IMAGE_HEADER_PROBE_H
+#define BB_IMAGE_HEADER_PROBE_H
 
 #include "bumpbake.h"
 
@@ -36,4 +36,4 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *probe, bb_error 
 }
 #endif
 
-#endif /* BB_IO_HEADER_PROBE_H */
+#endif /* BB_IMAGE_HEADER_PROBE_H */

@@ -1,7 +1,7 @@
 /* height_channel.h: the channel rule with the note it owes the user
- * (height_channel.c), and the height loader that applies it (load.c). */
-#ifndef BB_IO_HEIGHT_CHANNEL_H
-#define BB_IO_HEIGHT_CHANNEL_H
+ * (height_channel.c), and the height loader that applies it (height_load.c). */
+#ifndef BB_IMAGE_HEIGHT_CHANNEL_H
+#define BB_IMAGE_HEIGHT_CHANNEL_H
 
 #include "bumpbake.h"
 
@@ -26,4 +26,4 @@ typedef struct bb__height_loaded {
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err);
 
-#endif /* BB_IO_HEIGHT_CHANNEL_H */
+#endif /* BB_IMAGE_HEIGHT_CHANNEL_H */

@@ -1,5 +1,5 @@
 /* image_read.c: the public image reads (bumpbake.h "reading images") and
- * bb__image_read_channels / bb__image_level_count (io/oiio.h): arguments
+ * bb__image_read_channels / bb__image_level_count (image/oiio.h): arguments
  * checked, outputs cleared, OpenImageIO called (oiio_read.cpp), and
  * whatever a failed read made freed. */
 #include "core/internal.h"

@@ -1,8 +1,8 @@
-/* oiio.h: what the rest of the library asks of the io family beyond the
+/* oiio.h: what the rest of the library asks of the image family beyond the
  * public reads and writes: file headers, bounded channel reads, resizing.
  * (The family reaches OpenImageIO only in its oiio_*.cpp files.) */
-#ifndef BB_IO_OIIO_H
-#define BB_IO_OIIO_H
+#ifndef BB_IMAGE_OIIO_H
+#define BB_IMAGE_OIIO_H
 
 #include "bumpbake.h"
 
@@ -44,4 +44,4 @@ bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_ima
 }
 #endif
 
-#endif /* BB_IO_OIIO_H */
+#endif /* BB_IMAGE_OIIO_H */

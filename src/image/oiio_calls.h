@@ -1,10 +1,10 @@
-/* oiio_calls.h: the OpenImageIO calls of the io family, by job, as C
+/* oiio_calls.h: the OpenImageIO calls of the image family, by job, as C
  * functions for the family's C files (image_read.c, image_write.c,
  * animation.c). Each is defined in an oiio_*.cpp file and runs behind the
  * one exception guard (oiio_guard.h): none throws. The rules around them
  * (formats, limits, descriptions, codes) are C and live elsewhere. */
-#ifndef BB_IO_OIIO_CALLS_H
-#define BB_IO_OIIO_CALLS_H
+#ifndef BB_IMAGE_OIIO_CALLS_H
+#define BB_IMAGE_OIIO_CALLS_H
 
 #include "bumpbake.h"
 
@@ -66,4 +66,4 @@ void bb__oiio_gif_abort(bb_animation *a);
 }
 #endif
 
-#endif /* BB_IO_OIIO_CALLS_H */
+#endif /* BB_IMAGE_OIIO_CALLS_H */

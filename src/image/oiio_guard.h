@@ -1,4 +1,4 @@
-// oiio_guard.h: the one exception guard of the io family's C++ files
+// oiio_guard.h: the one exception guard of the OpenImageIO C++ files
 // (oiio_*.cpp), the only files that call OpenImageIO.
 //
 // OpenImageIO and the C++ runtime may throw (std::bad_alloc, a length_error
@@ -8,8 +8,8 @@
 // one-line message naming the file, and nothing else in them catches.
 // (As Embree's RTC_CATCH_BEGIN / RTC_CATCH_END: one catch site, one
 // classification, bb::exception_status.)
-#ifndef BB_IO_OIIO_GUARD_H
-#define BB_IO_OIIO_GUARD_H
+#ifndef BB_IMAGE_OIIO_GUARD_H
+#define BB_IMAGE_OIIO_GUARD_H
 
 #include "bumpbake.h"
 
@@ -65,4 +65,4 @@ std::string first_line(const std::string &s);
 
 } // namespace bb
 
-#endif // BB_IO_OIIO_GUARD_H
+#endif // BB_IMAGE_OIIO_GUARD_H

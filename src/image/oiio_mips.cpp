@@ -1,5 +1,5 @@
 // oiio_mips.cpp: the OpenImageIO calls of mip chains: the box filter that
-// makes each level (bb__image_resize_box, for maps/mips.c) and the tiled,
+// makes each level (bb__image_resize_box, for mips.c) and the tiled,
 // mip-mapped TIFF or OpenEXR file that holds them. The chain's checks are
 // C (formats.c); the public writes are image_write.c.
 #include "core/internal.h"
@@ -137,7 +137,7 @@ std::string verify_chain(const std::string &name, const bb_image *levels, int co
 // opens a name, and reopens it for every level: the name is in a private
 // directory reached through its descriptor (bb__safe_open_private), never
 // one in the destination's directory, where a link planted between two
-// opens was written through (issue 22, #8). Its writes are not checked one
+// opens would be written through. Its writes are not checked one
 // by one, so the file is fsynced (a full disk can show only there) and
 // read back whole.
 bb_status write_staged_by_name(const char *path, const bb::encoder_fn &encode,

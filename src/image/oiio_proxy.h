@@ -1,8 +1,8 @@
-// oiio_proxy.h: the OpenImageIO IOProxy every writer of the io family's
+// oiio_proxy.h: the OpenImageIO IOProxy every writer of the image family's
 // C++ files encodes through, and the staged write around it
 // (oiio_write.cpp).
-#ifndef BB_IO_OIIO_PROXY_H
-#define BB_IO_OIIO_PROXY_H
+#ifndef BB_IMAGE_OIIO_PROXY_H
+#define BB_IMAGE_OIIO_PROXY_H
 
 #include "bumpbake.h"
 #include "files/safe_file.h"
@@ -69,4 +69,4 @@ void set_common_attributes(OIIO::ImageSpec &spec);
 
 } // namespace bb
 
-#endif // BB_IO_OIIO_PROXY_H
+#endif // BB_IMAGE_OIIO_PROXY_H

@@ -1,7 +1,7 @@
 // oiio_setup.h: the process-wide OpenImageIO settings every image read and
 // write of the library applies first (defined in oiio_read.cpp).
-#ifndef BB_IO_OIIO_SETUP_H
-#define BB_IO_OIIO_SETUP_H
+#ifndef BB_IMAGE_OIIO_SETUP_H
+#define BB_IMAGE_OIIO_SETUP_H
 
 namespace bb {
 
@@ -21,4 +21,4 @@ void oiio_setup();
 
 } // namespace bb
 
-#endif // BB_IO_OIIO_SETUP_H
+#endif // BB_IMAGE_OIIO_SETUP_H

@@ -1,7 +1,7 @@
 /* png_hooks.h: what the library sets on OpenImageIO's libpng structs:
  * quiet errors, bounded allocations (png_hooks.c). */
-#ifndef BB_IO_PNG_HOOKS_H
-#define BB_IO_PNG_HOOKS_H
+#ifndef BB_IMAGE_PNG_HOOKS_H
+#define BB_IMAGE_PNG_HOOKS_H
 
 #ifdef __cplusplus
 extern "C" {
@@ -16,4 +16,4 @@ int bb__png_hooks_set(void);
 }
 #endif
 
-#endif /* BB_IO_PNG_HOOKS_H */
+#endif /* BB_IMAGE_PNG_HOOKS_H */

@@ -1,7 +1,7 @@
 /* quantise.h: float samples to the integer codes of 8- and 16-bit files
  * (quantise.c). */
-#ifndef BB_IO_QUANTISE_H
-#define BB_IO_QUANTISE_H
+#ifndef BB_IMAGE_QUANTISE_H
+#define BB_IMAGE_QUANTISE_H
 
 #include "bumpbake.h"
 
@@ -22,4 +22,4 @@ uint16_t *bb__quantise_16(const bb_image *img, bb_range range);
 }
 #endif
 
-#endif /* BB_IO_QUANTISE_H */
+#endif /* BB_IMAGE_QUANTISE_H */

@@ -1,7 +1,7 @@
 /* read_limits.h: what a read may cost, decided from an image's header
  * before anything is allocated (read_limits.c). */
-#ifndef BB_IO_READ_LIMITS_H
-#define BB_IO_READ_LIMITS_H
+#ifndef BB_IMAGE_READ_LIMITS_H
+#define BB_IMAGE_READ_LIMITS_H
 
 #include "bumpbake.h"
 
@@ -54,4 +54,4 @@ int bb__read_band_rows(const bb__image_header *h, int channels);
 }
 #endif
 
-#endif /* BB_IO_READ_LIMITS_H */
+#endif /* BB_IMAGE_READ_LIMITS_H */

@@ -1,5 +1,5 @@
 /* panels.c: pictures side by side in a labelled grid. Text goes through
- * OpenImageIO (io/oiio_text.cpp); the grid is drawn here. */
+ * OpenImageIO (oiio_text.cpp); the grid is drawn here. */
 
 #include "core/internal.h"
 #include "render/text.h"

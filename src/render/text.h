@@ -1,7 +1,7 @@
 /* text.h: labels drawn through OpenImageIO's FreeType text
  * (oiio_text.cpp), for the panels of pictures. */
-#ifndef BB_IO_TEXT_H
-#define BB_IO_TEXT_H
+#ifndef BB_RENDER_TEXT_H
+#define BB_RENDER_TEXT_H
 
 #include "bumpbake.h"
 
@@ -24,4 +24,4 @@ bb_status bb__text_draw(bb_image *img, int center_x, int baseline_y, const char 
 }
 #endif
 
-#endif /* BB_IO_TEXT_H */
+#endif /* BB_RENDER_TEXT_H */

@@ -1,7 +1,7 @@
 /* blocks.h: 4 x 4 block compression (BC1, BC3, BC4, BC5) of RGBA images,
  * the one door to the block codec (squish.cpp, over Debian's libsquish). */
-#ifndef BB_IO_BLOCKS_H
-#define BB_IO_BLOCKS_H
+#ifndef BB_TEXTURE_BLOCKS_H
+#define BB_TEXTURE_BLOCKS_H
 
 #include "bumpbake.h"
 
@@ -45,4 +45,4 @@ bb_status bb__blocks_compress(const float *rgba, int width, int height,
 }
 #endif
 
-#endif /* BB_IO_BLOCKS_H */
+#endif /* BB_TEXTURE_BLOCKS_H */

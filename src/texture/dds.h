@@ -1,6 +1,6 @@
 /* dds.h: DirectX's DDS texture container, written (dds.c). */
-#ifndef BB_IO_DDS_H
-#define BB_IO_DDS_H
+#ifndef BB_TEXTURE_DDS_H
+#define BB_TEXTURE_DDS_H
 
 #include "bumpbake.h"
 #include "files/safe_file.h"
@@ -21,4 +21,4 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *levels, int count,
 }
 #endif
 
-#endif /* BB_IO_DDS_H */
+#endif /* BB_TEXTURE_DDS_H */

@@ -1,8 +1,8 @@
 /* texture.h: what the VTF and DDS writers share (texture.c): the table of
  * formats, the checks of a request against a container, the mip chain and
  * the encoding of one level into a format's bytes. */
-#ifndef BB_IO_TEXTURE_H
-#define BB_IO_TEXTURE_H
+#ifndef BB_TEXTURE_TEXTURE_H
+#define BB_TEXTURE_TEXTURE_H
 
 #include "bumpbake.h"
 
@@ -56,4 +56,4 @@ bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
 }
 #endif
 
-#endif /* BB_IO_TEXTURE_H */
+#endif /* BB_TEXTURE_TEXTURE_H */

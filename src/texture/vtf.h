@@ -1,6 +1,6 @@
 /* vtf.h: Valve's texture container, written and its header read (vtf.c). */
-#ifndef BB_IO_VTF_H
-#define BB_IO_VTF_H
+#ifndef BB_TEXTURE_VTF_H
+#define BB_TEXTURE_VTF_H
 
 #include "bumpbake.h"
 #include "files/safe_file.h"
@@ -32,4 +32,4 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
 }
 #endif
 
-#endif /* BB_IO_VTF_H */
+#endif /* BB_TEXTURE_VTF_H */

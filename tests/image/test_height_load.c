@@ -1,4 +1,4 @@
-/* test_load.c: the height channel rule (src/load.c), on buffers and on files. */
+/* test_height_load.c: the height channel rule (src/image/height_load.c), on buffers and on files. */
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
@@ -51,7 +51,7 @@ static bb_image make_image(int w, int h, int channels) {
   return img;
 }
 
-/* Height of (x, y) by the rule, computed here independently of load.c. */
+/* Height of (x, y) by the rule, computed here independently of height_load.c. */
 static float expected(const bb_image *img, int x, int y, bb_channel ch) {
   const float *t = bb_image_texel(img, x, y);
   if (ch == BB_CHANNEL_LUMA && img->channels >= 3)

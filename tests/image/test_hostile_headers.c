@@ -1,5 +1,5 @@
 /* test_hostile_headers.c: headers that declare what their readers would
- * allocate in open(), before any size check (issue 22, #5): a 126-byte
+ * allocate in open(), before any size check: a 126-byte
  * progressive JPEG of 65500 x 65500 (8.5 GB and 21 s for `info`), a 1 x 1
  * TIFF of 16384 x 16384 tiles (8.5 GB for `bake`), a 91-byte EXR with a
  * 2 GB string attribute (2.2 GB for `info`), GIFs of 65535 x 65535

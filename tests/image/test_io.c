@@ -1,4 +1,4 @@
-/* test_io.c: image file reading and writing (src/io/) against real files. */
+/* test_io.c: image file reading and writing (src/image/) against real files. */
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
@@ -799,7 +799,7 @@ Test(io, supports_depth_follows_the_format_table) {
   cr_assert_not(bb_path_supports_depth(NULL, BB_DEPTH_8));
 }
 
-/* ------------------------------------------------------ full disk (issue 10) */
+/* ----------------------------------------------------------------- full disk */
 
 /* One output format and depth a writer must protect. */
 typedef struct format_case {
@@ -980,7 +980,7 @@ Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
 }
 
 /* The writers added since: mip-mapped TIFF (written by name and read back,
- * see src/io/oiio_mips.cpp) and EXR, the animated GIF and the mesh formats, cut off
+ * see src/image/oiio_mips.cpp) and EXR, the animated GIF and the mesh formats, cut off
  * at nothing, half way and one byte short like every image format above. */
 Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
   bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 47);
@@ -1205,7 +1205,7 @@ Test(io, no_temporary_is_made_once_the_cleanup_has_run) {
   bb_image_free(&img);
 }
 
-/* ------------------------------------------------ hostile headers (issue 10) */
+/* ----------------------------------------------------------- hostile headers */
 
 /* The 186-byte TIFF declaring 8192 x 8192 x 64 channels once took 16.5 GB
  * and 47 s: its read is refused from its header (64 bytes a texel, over the
@@ -1302,7 +1302,7 @@ Test(io, read_header_matches_the_full_read) {
   check_read_fails(tmp_path("absent.png"), BB_ERR_IO, "no such file");
 }
 
-/* ------------------------------------------------- sanitizer hygiene (issue 10) */
+/* --------------------------------------------------------- sanitizer hygiene */
 
 /* The only leak suppression names Criterion's runner: a pattern on a
  * libstdc++ symbol (it was std::string::_M_assign) would hide every leaked

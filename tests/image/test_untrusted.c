@@ -125,7 +125,7 @@ Test(untrusted, a_device_is_refused_by_every_reader) {
   expect_refused_at_once(link, "is a device, not a regular file");
 }
 
-/* ------------------------------------------- third-party messages (issue 21) */
+/* ------------------------------------------------------ third-party messages */
 
 /* What the calls of fn wrote on file descriptor 2 (then restored), as a
  * malloc'd string: the library must print nothing there, whoever asks. */
@@ -220,8 +220,8 @@ Test(untrusted, a_damaged_png_prints_nothing_on_stderr) {
 
 /* ------------------------------------------ links planted in temporaries */
 
-/* What another user who may write in the destination's directory does
- * (issue 22, #8): watch it, and the moment a temporary of bumpbake's
+/* What another user who may write in the destination's directory does:
+ * watch it, and the moment a temporary of bumpbake's
  * appears, replace a file by a link to `target`, and move a directory away
  * and put a link to `decoy` (a directory of theirs, holding links to
  * target under any name bumpbake might open) in its place. They cannot

@@ -1,5 +1,5 @@
 /* texture_oracle.h: the tests' own reading of VTF and DDS files, written
- * from the formats' specifications and independent of src/io/: a BC1..BC5
+ * from the formats' specifications and independent of src/texture/: a BC1..BC5
  * block decoder and the offsets of a VTF's levels. A test oracle (and the
  * quality tool's VTF decoder), not product code.
  *
