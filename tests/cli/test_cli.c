@@ -971,7 +971,7 @@ static const output_format every_output_format[] = {
  * 1, one line, and nothing changes on disk: the previous normal map stays
  * byte for byte, no ao appears, no temporary is left. The CLI ignores
  * SIGXFSZ itself, so the limit is a write error here and not a kill.
- * (test_io.c cuts every format and depth at three points.) */
+ * (test_image_files.c cuts every format and depth at three points.) */
 Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
   const char *in = tmp("noise.png");
   write_image(in, 64, 64, 1, noise);

@@ -1,4 +1,4 @@
-/* test_io.c: image file reading and writing (src/image/) against real files. */
+/* test_image_files.c: image file reading and writing (src/image/) against real files. */
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
@@ -52,7 +52,7 @@ static void make_tmpdir(void) {
 
 static void remove_tmpdir(void) { remove_tree(tmpdir); }
 
-TestSuite(io, .init = make_tmpdir, .fini = remove_tmpdir);
+TestSuite(image_files, .init = make_tmpdir, .fini = remove_tmpdir);
 
 /* Criterion's runner leaks one 48-byte block when it exits after parallel
  * jobs: the only suppression (OpenImageIO's known PNG leak is handled where
@@ -159,13 +159,13 @@ static void check_round_trip(const char *name, const bb_image *img, bb_depth dep
 
 /* ---------------------------------------------------------- round trips */
 
-Test(io, round_trip_png8) {
+Test(image_files, round_trip_png8) {
   bb_image img = make_image(7, 5, 3, 0.0f, 1.0f, 1);
   check_round_trip("a.png", &img, BB_DEPTH_DEFAULT, HALF_STEP_8, "png", 0, 8);
   bb_image_free(&img);
 }
 
-Test(io, round_trip_png16) {
+Test(image_files, round_trip_png16) {
   bb_image img = make_image(7, 5, 3, 0.0f, 1.0f, 2);
   check_round_trip("a.png", &img, BB_DEPTH_16, HALF_STEP_16, "png", 0, 16);
   bb_image_free(&img);
@@ -173,7 +173,7 @@ Test(io, round_trip_png16) {
 
 /* Big enough for many deflate blocks and rows, with flat runs beside noise:
  * the PNG and TIFF encoders' speed settings must stay lossless. */
-Test(io, round_trip_large_png_and_tif_with_runs) {
+Test(image_files, round_trip_large_png_and_tif_with_runs) {
   bb_image img = make_image(517, 301, 3, 0.0f, 1.0f, 11);
   for (int y = 0; y < img.height; y += 2)
     for (int x = 0; x < img.width / 2; x++)
@@ -186,33 +186,33 @@ Test(io, round_trip_large_png_and_tif_with_runs) {
   bb_image_free(&img);
 }
 
-Test(io, round_trip_tga) {
+Test(image_files, round_trip_tga) {
   bb_image img = make_image(6, 4, 4, 0.0f, 1.0f, 3);
   check_round_trip("a.tga", &img, BB_DEPTH_DEFAULT, HALF_STEP_8, "targa", 0, 8);
   bb_image_free(&img);
 }
 
-Test(io, round_trip_tif8_and_tiff16) {
+Test(image_files, round_trip_tif8_and_tiff16) {
   bb_image img = make_image(5, 6, 1, 0.0f, 1.0f, 4);
   check_round_trip("a.tif", &img, BB_DEPTH_8, HALF_STEP_8, "tiff", 0, 8);
   check_round_trip("b.tiff", &img, BB_DEPTH_16, HALF_STEP_16, "tiff", 0, 16);
   bb_image_free(&img);
 }
 
-Test(io, round_trip_tif_float_is_exact) {
+Test(image_files, round_trip_tif_float_is_exact) {
   bb_image img = make_image(5, 3, 3, -4.0f, 4.0f, 5);
   check_round_trip("a.tif", &img, BB_DEPTH_FLOAT, 0.0, "tiff", 1, 32);
   bb_image_free(&img);
 }
 
-Test(io, round_trip_exr_float_is_exact) {
+Test(image_files, round_trip_exr_float_is_exact) {
   bb_image img = make_image(9, 4, 4, -3.0f, 7.0f, 6);
   img.pixels[0] = 1e-30f; /* a tiny value a lossy path would flush */
   check_round_trip("a.exr", &img, BB_DEPTH_DEFAULT, 0.0, "openexr", 1, 32);
   bb_image_free(&img);
 }
 
-Test(io, round_trip_exr_half) {
+Test(image_files, round_trip_exr_half) {
   /* In [0.5, 1) half has 10 fraction bits: error at most 2^-12 after rounding. */
   bb_image img = make_image(8, 8, 2, 0.5f, 1.0f, 7);
   check_round_trip("a.exr", &img, BB_DEPTH_HALF, 1.0 / 4096.0 + 1e-7, "openexr", 1, 16);
@@ -222,7 +222,7 @@ Test(io, round_trip_exr_half) {
 /* A basis map of more than 4 directions: every channel comes back in its
  * place (OpenEXR sorts channels by name, so B0..B15 unpadded would read
  * back as B0, B1, B10, ...), none of them as alpha, at every depth. */
-Test(io, round_trip_basis_maps_of_many_channels) {
+Test(image_files, round_trip_basis_maps_of_many_channels) {
   const int counts[] = {5, 6, 11, 16};
   for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
     bb_image img = make_image(5, 4, counts[i], 0.0f, 1.0f, 40 + (uint32_t)i);
@@ -274,7 +274,7 @@ static void write_and_read_codes(const char *name, const float *values, int coun
   bb_image_free(&img);
 }
 
-Test(io, unit_range_rounds_half_up_and_clamps) {
+Test(image_files, unit_range_rounds_half_up_and_clamps) {
   /* 0.5 * 255 = 127.5 and 0.25 * 255 = 63.75 are exact in float and double. */
   const float v[] = {0.0f, 1.0f, 0.5f, 0.25f, -0.2f, 1.7f, NAN, 3.0f / 255.0f};
   const long want[] = {0, 255, 128, 64, 0, 255, 0, 3};
@@ -283,7 +283,7 @@ Test(io, unit_range_rounds_half_up_and_clamps) {
   for (int i = 0; i < 8; i++) cr_assert_eq(got[i], want[i], "value %d: %ld != %ld", i, got[i], want[i]);
 }
 
-Test(io, unit_range_16_bit_rounds_half_up) {
+Test(image_files, unit_range_16_bit_rounds_half_up) {
   const float v[] = {0.5f, 0.25f, 1.0f, 0.0f};
   const long want[] = {32768, 16384, 65535, 0}; /* 32767.5 -> 32768, 16383.75 -> 16384 */
   long got[4];
@@ -291,7 +291,7 @@ Test(io, unit_range_16_bit_rounds_half_up) {
   for (int i = 0; i < 4; i++) cr_assert_eq(got[i], want[i], "value %d: %ld != %ld", i, got[i], want[i]);
 }
 
-Test(io, signed_range_maps_minus_one_to_one_onto_codes) {
+Test(image_files, signed_range_maps_minus_one_to_one_onto_codes) {
   const float v[] = {-1.0f, 0.0f, 1.0f, -0.5f, 0.5f, 2.0f, -3.0f};
   /* 0.5+0.5v: 0, 0.5 (127.5 -> 128), 1, 0.25 (63.75 -> 64), 0.75 (191.25 -> 191), clamped */
   const long want[] = {0, 128, 255, 64, 191, 255, 0};
@@ -300,7 +300,7 @@ Test(io, signed_range_maps_minus_one_to_one_onto_codes) {
   for (int i = 0; i < 7; i++) cr_assert_eq(got[i], want[i], "value %d: %ld != %ld", i, got[i], want[i]);
 }
 
-Test(io, signed_range_16_bit_tif) {
+Test(image_files, signed_range_16_bit_tif) {
   const float v[] = {0.0f, -1.0f, 1.0f};
   const long want[] = {32768, 0, 65535};
   long got[3];
@@ -345,17 +345,17 @@ static void check_codes_match_naive(const char *name, bb_depth depth, bb_range r
   free(v);
 }
 
-Test(io, codes_match_the_naive_formula_8_bit) {
+Test(image_files, codes_match_the_naive_formula_8_bit) {
   check_codes_match_naive("n8u.png", BB_DEPTH_8, BB_RANGE_UNIT, 255.0);
   check_codes_match_naive("n8s.tga", BB_DEPTH_8, BB_RANGE_SIGNED, 255.0);
 }
 
-Test(io, codes_match_the_naive_formula_16_bit) {
+Test(image_files, codes_match_the_naive_formula_16_bit) {
   check_codes_match_naive("n16u.png", BB_DEPTH_16, BB_RANGE_UNIT, 65535.0);
   check_codes_match_naive("n16s.tif", BB_DEPTH_16, BB_RANGE_SIGNED, 65535.0);
 }
 
-Test(io, float_formats_store_signed_values_raw) {
+Test(image_files, float_formats_store_signed_values_raw) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 3, 1, 1, NULL), BB_OK);
   img.pixels[0] = -1.0f;
@@ -390,9 +390,9 @@ static void check_alpha_kept(const char *name) {
   bb_image_free(&img);
 }
 
-Test(io, alpha_is_not_premultiplied_png) { check_alpha_kept("alpha.png"); }
-Test(io, alpha_is_not_premultiplied_tga) { check_alpha_kept("alpha.tga"); }
-Test(io, alpha_is_not_premultiplied_tif) { check_alpha_kept("alpha.tif"); }
+Test(image_files, alpha_is_not_premultiplied_png) { check_alpha_kept("alpha.png"); }
+Test(image_files, alpha_is_not_premultiplied_tga) { check_alpha_kept("alpha.tga"); }
+Test(image_files, alpha_is_not_premultiplied_tif) { check_alpha_kept("alpha.tif"); }
 
 /* --------------------------------------------------------- description */
 
@@ -413,13 +413,13 @@ static void check_description(const char *name) {
   bb_image_free(&img);
 }
 
-Test(io, description_round_trips_png) { check_description("d.png"); }
-Test(io, description_round_trips_tif) { check_description("d.tif"); }
-Test(io, description_round_trips_exr) { check_description("d.exr"); }
+Test(image_files, description_round_trips_png) { check_description("d.png"); }
+Test(image_files, description_round_trips_tif) { check_description("d.tif"); }
+Test(image_files, description_round_trips_exr) { check_description("d.exr"); }
 /* OIIO 2.4 keeps it in the TGA 2.0 extension area's comment field. */
-Test(io, description_round_trips_tga) { check_description("d.tga"); }
+Test(image_files, description_round_trips_tga) { check_description("d.tga"); }
 
-Test(io, no_description_reads_as_null) {
+Test(image_files, no_description_reads_as_null) {
   bb_image img = make_image(3, 2, 1, 0.0f, 1.0f, 9);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("n.png"), &img, NULL, &err), BB_OK, "%s", err.message);
@@ -434,7 +434,7 @@ Test(io, no_description_reads_as_null) {
 
 /* -------------------------------------------------------- write errors */
 
-Test(io, unknown_extension_is_a_format_error) {
+Test(image_files, unknown_extension_is_a_format_error) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 10);
   bb_error err;
   const char *path = tmp_path("out.xyz");
@@ -446,7 +446,7 @@ Test(io, unknown_extension_is_a_format_error) {
   bb_image_free(&img);
 }
 
-Test(io, writable_format_by_extension_ignores_case) {
+Test(image_files, writable_format_by_extension_ignores_case) {
   cr_assert(bb_path_is_writable_format("a.png"));
   cr_assert(bb_path_is_writable_format("dir.d/A.PNG"));
   cr_assert(bb_path_is_writable_format("x.TiFf"));
@@ -458,7 +458,7 @@ Test(io, writable_format_by_extension_ignores_case) {
   cr_assert_not(bb_path_is_writable_format(NULL));
 }
 
-Test(io, upper_case_extension_writes_that_format) {
+Test(image_files, upper_case_extension_writes_that_format) {
   bb_image img = make_image(2, 2, 3, 0.0f, 1.0f, 11);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("UP.TIF"), &img, NULL, &err), BB_OK, "%s", err.message);
@@ -480,7 +480,7 @@ static void check_depth_refused(const char *name, bb_depth depth) {
   bb_image_free(&img);
 }
 
-Test(io, unsupported_depths_are_refused) {
+Test(image_files, unsupported_depths_are_refused) {
   check_depth_refused("h.png", BB_DEPTH_HALF);
   check_depth_refused("f.png", BB_DEPTH_FLOAT);
   check_depth_refused("s.tga", BB_DEPTH_16);
@@ -491,7 +491,7 @@ Test(io, unsupported_depths_are_refused) {
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
 }
 
-Test(io, unknown_enum_values_are_argument_errors) {
+Test(image_files, unknown_enum_values_are_argument_errors) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 12);
   bb_write_options o = options((bb_depth)42, BB_RANGE_UNIT, NULL);
   bb_error err;
@@ -503,7 +503,7 @@ Test(io, unknown_enum_values_are_argument_errors) {
   bb_image_free(&img);
 }
 
-Test(io, too_many_channels_for_png_is_a_format_error) {
+Test(image_files, too_many_channels_for_png_is_a_format_error) {
   bb_image img = make_image(2, 2, 5, 0.0f, 1.0f, 13);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("five.png"), &img, NULL, &err), BB_ERR_FORMAT);
@@ -513,7 +513,7 @@ Test(io, too_many_channels_for_png_is_a_format_error) {
   bb_image_free(&img);
 }
 
-Test(io, empty_image_is_an_argument_error) {
+Test(image_files, empty_image_is_an_argument_error) {
   bb_image img = {0, 0, 0, NULL};
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("e.png"), &img, NULL, &err), BB_ERR_ARGUMENT);
@@ -521,7 +521,7 @@ Test(io, empty_image_is_an_argument_error) {
   cr_assert_not(file_exists(tmp_path("e.png")));
 }
 
-Test(io, unwritable_directory_is_an_io_error) {
+Test(image_files, unwritable_directory_is_an_io_error) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 14);
   char path[600];
   if (geteuid() == 0) {
@@ -540,7 +540,7 @@ Test(io, unwritable_directory_is_an_io_error) {
   bb_image_free(&img);
 }
 
-Test(io, missing_directory_is_an_io_error) {
+Test(image_files, missing_directory_is_an_io_error) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 15);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("nodir/out.exr"), &img, NULL, &err), BB_ERR_IO);
@@ -550,7 +550,7 @@ Test(io, missing_directory_is_an_io_error) {
 
 /* The rename fails when the destination is a directory: the temporary file
  * was fully written by then and must be removed. */
-Test(io, failed_rename_leaves_no_temporary_file) {
+Test(image_files, failed_rename_leaves_no_temporary_file) {
   bb_image img = make_image(4, 4, 3, 0.0f, 1.0f, 16);
   cr_assert_eq(mkdir(tmp_path("taken.png"), 0700), 0);
   bb_error err;
@@ -563,7 +563,7 @@ Test(io, failed_rename_leaves_no_temporary_file) {
   bb_image_free(&img);
 }
 
-Test(io, successful_write_leaves_no_temporary_file) {
+Test(image_files, successful_write_leaves_no_temporary_file) {
   bb_image img = make_image(4, 4, 3, 0.0f, 1.0f, 17);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("ok.exr"), &img, NULL, &err), BB_OK, "%s", err.message);
@@ -572,7 +572,7 @@ Test(io, successful_write_leaves_no_temporary_file) {
   bb_image_free(&img);
 }
 
-Test(io, overwrite_replaces_content_with_umask_mode) {
+Test(image_files, overwrite_replaces_content_with_umask_mode) {
   umask(022);
   bb_image a = make_image(4, 4, 1, 0.0f, 1.0f, 18);
   bb_image b = make_image(3, 5, 1, 0.0f, 1.0f, 19);
@@ -593,7 +593,7 @@ Test(io, overwrite_replaces_content_with_umask_mode) {
 
 /* bb_file_write: the bytes, whole, replacing what was there; nothing left
  * behind and the destination untouched when it cannot be written. */
-Test(io, file_write_replaces_whole_and_fails_cleanly) {
+Test(image_files, file_write_replaces_whole_and_fails_cleanly) {
   const char *path = tmp_path("deps.d");
   bb_error err;
   cr_assert_eq(bb_file_write(path, "old rule\n", 9, &err), BB_OK, "%s", err.message);
@@ -638,13 +638,13 @@ static void check_read_fails(const char *path, bb_status want, const char *needl
   cr_assert_null(strchr(err.message, '\n'), "multi-line message: %s", err.message);
 }
 
-Test(io, missing_file_is_an_io_error) {
+Test(image_files, missing_file_is_an_io_error) {
   check_read_fails(tmp_path("nothere.png"), BB_ERR_IO, "no such file");
 }
 
-Test(io, directory_is_an_io_error) { check_read_fails(tmpdir, BB_ERR_IO, NULL); }
+Test(image_files, directory_is_an_io_error) { check_read_fails(tmpdir, BB_ERR_IO, NULL); }
 
-Test(io, unreadable_file_is_an_io_error) {
+Test(image_files, unreadable_file_is_an_io_error) {
   if (geteuid() == 0) {
     remove_tmpdir(); /* a skipped test does not run .fini */
     cr_skip_test("root reads files whatever their mode");
@@ -656,7 +656,7 @@ Test(io, unreadable_file_is_an_io_error) {
   bb_image_free(&img);
 }
 
-Test(io, random_bytes_are_a_format_error) {
+Test(image_files, random_bytes_are_a_format_error) {
   unsigned char bytes[1000];
   uint32_t s = 12345;
   for (size_t i = 0; i < sizeof bytes; i++) {
@@ -667,7 +667,7 @@ Test(io, random_bytes_are_a_format_error) {
   check_read_fails(tmp_path("random.png"), BB_ERR_FORMAT, NULL);
 }
 
-Test(io, zero_byte_file_is_a_format_error) {
+Test(image_files, zero_byte_file_is_a_format_error) {
   write_bytes(tmp_path("empty.exr"), "", 0);
   check_read_fails(tmp_path("empty.exr"), BB_ERR_FORMAT, NULL);
 }
@@ -699,11 +699,11 @@ static void check_truncation_detected(const char *name, double keep) {
   bb_image_free(&img);
 }
 
-Test(io, truncated_png_is_a_format_error) { check_truncation_detected("cut.png", 0.5); }
-Test(io, truncated_png_tail_is_a_format_error) { check_truncation_detected("cut2.png", 0.97); }
-Test(io, truncated_exr_is_a_format_error) { check_truncation_detected("cut.exr", 0.8); }
-Test(io, truncated_tif_is_a_format_error) { check_truncation_detected("cut.tif", 0.6); }
-Test(io, truncated_tga_is_a_format_error) { check_truncation_detected("cut.tga", 0.5); }
+Test(image_files, truncated_png_is_a_format_error) { check_truncation_detected("cut.png", 0.5); }
+Test(image_files, truncated_png_tail_is_a_format_error) { check_truncation_detected("cut2.png", 0.97); }
+Test(image_files, truncated_exr_is_a_format_error) { check_truncation_detected("cut.exr", 0.8); }
+Test(image_files, truncated_tif_is_a_format_error) { check_truncation_detected("cut.tif", 0.6); }
+Test(image_files, truncated_tga_is_a_format_error) { check_truncation_detected("cut.tga", 0.5); }
 
 /* --------------------------------------------------------- size limits */
 
@@ -745,18 +745,18 @@ static void write_png_header(const char *path, uint32_t width, uint32_t height) 
   write_bytes(path, f, sizeof f);
 }
 
-Test(io, huge_png_dimension_is_a_size_error) {
+Test(image_files, huge_png_dimension_is_a_size_error) {
   write_png_header(tmp_path("huge.png"), 100000, 100000);
   check_read_fails(tmp_path("huge.png"), BB_ERR_SIZE, "over the maximum");
 }
 
-Test(io, png_with_too_many_pixels_is_a_size_error) {
+Test(image_files, png_with_too_many_pixels_is_a_size_error) {
   /* Each side is allowed; the product is over BB_MAX_PIXELS. */
   write_png_header(tmp_path("wide.png"), 65536, 16385);
   check_read_fails(tmp_path("wide.png"), BB_ERR_SIZE, "over the maximum");
 }
 
-Test(io, huge_tga_is_a_size_error) {
+Test(image_files, huge_tga_is_a_size_error) {
   /* Uncompressed true-colour TGA header, 65535 x 65535 x 24 bits, no pixels. */
   unsigned char h[18] = {0, 0, 2};
   h[12] = 0xFF;
@@ -769,13 +769,13 @@ Test(io, huge_tga_is_a_size_error) {
   check_read_fails(tmp_path("huge.tga"), BB_ERR_SIZE, NULL);
 }
 
-Test(io, zero_size_image_is_a_size_error) {
+Test(image_files, zero_size_image_is_a_size_error) {
   /* OIIO opens a PGM header that declares 0 x 0. */
   write_bytes(tmp_path("zero.pgm"), "P5\n0 0\n255\n", 11);
   check_read_fails(tmp_path("zero.pgm"), BB_ERR_SIZE, NULL);
 }
 
-Test(io, read_info_of_grey_alpha_png) {
+Test(image_files, read_info_of_grey_alpha_png) {
   bb_image img = make_image(3, 3, 2, 0.0f, 1.0f, 22);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("ga.png"), &img, NULL, &err), BB_OK, "%s", err.message);
@@ -788,7 +788,7 @@ Test(io, read_info_of_grey_alpha_png) {
   bb_image_free(&img);
 }
 
-Test(io, supports_depth_follows_the_format_table) {
+Test(image_files, supports_depth_follows_the_format_table) {
   cr_assert(bb_path_supports_depth("a.png", BB_DEPTH_16));
   cr_assert(bb_path_supports_depth("a.PNG", BB_DEPTH_DEFAULT));
   cr_assert_not(bb_path_supports_depth("a.tga", BB_DEPTH_16));
@@ -944,7 +944,7 @@ static bb_status write_kind_under_limit(writer kind, const char *path, const bb_
  * byte short: an I/O error naming the file and the system's reason, nothing
  * at the final name and no temporary left. A 256 x 256 noise image spans
  * several write buffers in every format. */
-Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
+Test(image_files, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
   bb_image img = make_image(256, 256, 3, 0.0f, 1.0f, 40);
   for (size_t i = 0; i < sizeof every_format / sizeof every_format[0]; i++) {
     const format_case *fc = &every_format[i];
@@ -982,7 +982,7 @@ Test(io, every_format_fails_cleanly_on_a_full_disk, .timeout = 60) {
 /* The writers added since: mip-mapped TIFF (written by name and read back,
  * see src/image/oiio_mips.cpp) and EXR, the animated GIF and the mesh formats, cut off
  * at nothing, half way and one byte short like every image format above. */
-Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
+Test(image_files, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
   bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 47);
   const struct {
     writer kind;
@@ -1022,7 +1022,7 @@ Test(io, every_other_writer_fails_cleanly_on_a_full_disk, .timeout = 90) {
 /* Mip-mapped files are bit-identical from run to run: the padding of edge
  * tiles was uninitialised memory, so TIFF chains differed in bytes and size
  * (which also made the size - 1 cut above pass now and then). */
-Test(io, mip_files_are_the_same_bytes_every_time) {
+Test(image_files, mip_files_are_the_same_bytes_every_time) {
   bb_image img = make_image(96, 64, 3, 0.0f, 1.0f, 48);
   bb_image *levels = NULL;
   int count = 0;
@@ -1067,7 +1067,7 @@ static unsigned char *slurp_file(const char *path, size_t *size) {
 /* TIFF and EXR carry a DateTime that OpenImageIO fills with the write time
  * unless told otherwise: two writes in different seconds must still be the
  * same bytes (goldens and build caches compare files). */
-Test(io, files_written_seconds_apart_are_the_same_bytes) {
+Test(image_files, files_written_seconds_apart_are_the_same_bytes) {
   bb_image img = make_image(24, 16, 3, 0.0f, 1.0f, 49);
   const char *exts[] = {"tif", "exr"};
   for (int f = 0; f < 2; f++) {
@@ -1093,7 +1093,7 @@ Test(io, files_written_seconds_apart_are_the_same_bytes) {
 }
 
 /* A failed write must leave an existing file at the final name untouched. */
-Test(io, failed_write_keeps_the_previous_file) {
+Test(image_files, failed_write_keeps_the_previous_file) {
   bb_image old_img = make_image(8, 8, 1, 0.0f, 1.0f, 41);
   bb_image new_img = make_image(128, 128, 3, 0.0f, 1.0f, 42);
   const char *path = tmp_path("keep.png");
@@ -1114,7 +1114,7 @@ Test(io, failed_write_keeps_the_previous_file) {
 
 /* ------------------------------------------------------------ staged writes */
 
-Test(io, staged_write_appears_only_on_commit) {
+Test(image_files, staged_write_appears_only_on_commit) {
   bb_image img = make_image(16, 16, 3, 0.0f, 1.0f, 43);
   const char *path = tmp_path("staged.exr");
   bb_staged_file *f = NULL;
@@ -1134,7 +1134,7 @@ Test(io, staged_write_appears_only_on_commit) {
   bb_image_free(&img);
 }
 
-Test(io, staged_write_discard_leaves_nothing) {
+Test(image_files, staged_write_discard_leaves_nothing) {
   bb_image img = make_image(16, 16, 1, 0.0f, 1.0f, 44);
   bb_staged_file *f = NULL;
   bb_error err;
@@ -1153,7 +1153,7 @@ Test(io, staged_write_discard_leaves_nothing) {
 
 /* What a SIGINT handler calls: the temporaries of writes in progress go, a
  * file already in place stays. */
-Test(io, tempfiles_remove_takes_pending_temporaries_only) {
+Test(image_files, tempfiles_remove_takes_pending_temporaries_only) {
   bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
   bb_error err;
   cr_assert_eq(bb_image_write(tmp_path("done.png"), &img, NULL, &err), BB_OK, "%s",
@@ -1185,7 +1185,7 @@ Test(io, tempfiles_remove_takes_pending_temporaries_only) {
  * starts then makes no temporary the cleanup could not see (one made by
  * another thread just as the handler walked the list was left behind by a
  * SIGTERM under load). */
-Test(io, no_temporary_is_made_once_the_cleanup_has_run) {
+Test(image_files, no_temporary_is_made_once_the_cleanup_has_run) {
   bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
   bb_error err;
   bb_tempfiles_remove();
@@ -1231,7 +1231,7 @@ static bb_status read_with_capped_memory(const void *arg, bb_error *err) {
                         : bb_image_read(r->path, &img, NULL, err);
 }
 
-Test(io, hostile_tiff_header_is_refused_before_allocating) {
+Test(image_files, hostile_tiff_header_is_refused_before_allocating) {
   const char *path = tmp_path("hostile.tif");
   cr_assert_eq(write_hostile_tiff(path, 8192, 8192, 64), 0);
   cr_assert_eq(file_size(path), HOSTILE_TIFF_BYTES);
@@ -1257,7 +1257,7 @@ Test(io, hostile_tiff_header_is_refused_before_allocating) {
 /* 8192 x 8192 x 4 is within the byte limit (exactly 1 GiB of floats), but its
  * 52 bytes of data end in the first band: the read fails there instead of
  * decoding, and touching, all 8192 rows. */
-Test(io, truncated_huge_tiff_fails_at_its_first_band) {
+Test(image_files, truncated_huge_tiff_fails_at_its_first_band) {
   const char *path = tmp_path("h4.tif");
   cr_assert_eq(write_hostile_tiff(path, 8192, 8192, 4), 0);
   struct rusage before, after;
@@ -1280,7 +1280,7 @@ Test(io, truncated_huge_tiff_fails_at_its_first_band) {
   bb_image_info_free(&info);
 }
 
-Test(io, read_header_matches_the_full_read) {
+Test(image_files, read_header_matches_the_full_read) {
   bb_image img = make_image(13, 7, 4, 0.0f, 1.0f, 46);
   bb_write_options o = options(BB_DEPTH_16, BB_RANGE_UNIT, "made by a test");
   bb_error err;
@@ -1307,13 +1307,13 @@ Test(io, read_header_matches_the_full_read) {
 /* The only leak suppression names Criterion's runner: a pattern on a
  * libstdc++ symbol (it was std::string::_M_assign) would hide every leaked
  * string, bumpbake's included. */
-Test(io, leak_suppressions_name_criterion_only) {
+Test(image_files, leak_suppressions_name_criterion_only) {
   cr_expect_str_eq(__lsan_default_suppressions(), "leak:libcriterion.so\n");
   cr_expect_null(strstr(__lsan_default_suppressions(), "std::"));
 }
 
 /* The words of --depth, one way: each parses to its depth and back. */
-Test(io, depth_names_round_trip_and_others_are_refused) {
+Test(image_files, depth_names_round_trip_and_others_are_refused) {
   const char *names[] = {"8", "16", "half", "float"};
   const bb_depth depths[] = {BB_DEPTH_8, BB_DEPTH_16, BB_DEPTH_HALF, BB_DEPTH_FLOAT};
   for (int i = 0; i < 4; i++) {
