@@ -1191,11 +1191,11 @@ typedef struct bb_bake_options {
                                  vertex, linear over each triangle. Not owned;
                                  ignored while bounce_albedo is 0 */
   int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
-                                 times; 0 (default): until one more bounce
-                                 would move what any triangle reflects by
-                                 under 1e-2 of the sky's radiance, the rest
-                                 of the series then added as geometric (at
-                                 most BB_MAX_BOUNCES bounces) */
+                                 times; 0 (default): converged (each
+                                 triangle's light estimated from what it
+                                 blocks, one bounce gathered from that
+                                 estimate, the rest of the series then
+                                 added as geometric) */
   const bb_image *brightness; /* NULL (default), or a brightness map of the
                                  height's size: ssbump and weights are
                                  multiplied by its grey, the paper's
@@ -1237,7 +1237,8 @@ typedef struct bb_bake_result {
   bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
   int threads;             /* worker threads the stages ran on (o->trace.threads,
                               or the core count for 0) */
-  int bounces;             /* bounces of inter-reflection followed (0: none) */
+  int bounces;             /* passes of inter-reflection gathered: bounces,
+                              or 2 when converged (0: none) */
   double seconds_bounce;   /* the inter-reflection's part, after seconds_trace */
 } bb_bake_result;
 

@@ -729,6 +729,10 @@ if [ "$bounce_ok" = 1 ]; then
   summary_row "bounce: light added on the trench floor" \
     "$(awk '/trench, converged:/ { sub(",", "", $4); print $4; exit }' "$out/bounce.txt")" \
     "exact $(awk '/trench, converged:/ { print $6; exit }' "$out/bounce.txt"); accuracy in section 10"
+  # "rock06 512 (scale 64)   1.00s   2.00s   2.0x   2"
+  summary_row "bounce: --bounce 0.5 over a bake, rock06 512" \
+    "$(awk '/^rock06 512 / { print $7; exit }' "$out/bounce.txt")" \
+    "rivet panel 512: $(awk '/^rivet panel 512 / { print $8; exit }' "$out/bounce.txt"); goal under 3x"
 fi
 if [ "${#acc_rows[@]}" -gt 0 ]; then
   echo

@@ -314,10 +314,12 @@ typedef struct printer {
   const bake_args *a;
   int batch;
   int counts[5]; /* by bb_job_outcome */
+  cli_progress *progress; /* its bar is cleared before anything is printed */
 } printer;
 
 static void print_report(void *user, const bb_job_report *r) {
   printer *p = user;
+  cli_progress_finish(p->progress);
   p->counts[r->outcome]++;
   if (r->outcome == BB_JOB_FAILED)
     cli_error_line(r->error.message[0] ? r->error.message : bb_status_name(r->status));
@@ -398,8 +400,8 @@ static int bake_run(bake_args *a, const char *command_line, char **argv, int arg
   free(options);
   if (st != BB_OK)
     return cli_library_error(bake_command.name, st, &err);
-  printer p = {a, a->job.out_dir != NULL, {0}};
   cli_progress progress;
+  printer p = {a, a->job.out_dir != NULL, {0}, &progress};
   cli_progress_start(&progress, "bake", a->quiet);
   st = bb_job_run(job, cli_progress_fn(&progress), &progress, print_report, &p, &err);
   cli_progress_finish(&progress);
