@@ -696,57 +696,26 @@ typedef struct stretch {
 
 /* One walk along a line, with its own hull. Along (a, b) (forward) it
  * pushes the points of its stretches by falling u, and its origins j, from
- * j_first down to j_last, each ask the hull once every point beyond them is
- * on it. Along (-a, -b) it takes the points by rising u, on mirrored u so the
- * hull code is the same, and the origins rising. */
+ * the first down, each ask the hull once every point beyond them is on it.
+ * Along (-a, -b) it takes the points by rising u, on mirrored u so the hull
+ * code is the same, and the origins rising. The walk is driven by its
+ * origins: each pushes the points beyond it not yet pushed, then asks, so
+ * the points no origin wants are never pushed. Whether a point lies beyond
+ * origin j is read from its key: along (a, b) its u > j exactly when its
+ * step is j or later, along (-a, -b) its u < j exactly when it comes before
+ * the vertex at the end of step j - 1 (u is j + its template fraction,
+ * which never rounds to a whole number but at the vertex). */
 typedef struct walk {
   point *h;
   int size;
-  stretch *st;
-  int stretches, r; /* the stretch under way */
-  int q, left;      /* its next point, and the points left in it */
-  double du;        /* its shift */
+  const point *pt;     /* the profile */
+  const stretch *st;
+  int stretches, r;    /* the stretch under way */
+  const point *q, *end; /* its next point, and the point past its last */
+  double du;           /* its shift */
   int64_t dkey;
-  int j, j_last; /* the next origin, and the last */
+  int j; /* the next origin */
 } walk;
-
-/* Is point q of stretch s still wanted: is an origin left to ask once it is
- * on the hull? Past the first that is not, none is (u falls along a forward
- * walk, rises along the other). */
-static inline int walk_wants(const profile *pr, const walk *w, const stretch *s, int q,
-                             int forward) {
-  const double u = pr->pt[q].u + (double)s->shift;
-  return forward ? !((double)(w->j_last - 1) >= u) : !((double)(w->j_last + 1) <= u);
-}
-
-/* Cuts the stretches at the first point no origin wants (found by halving),
- * so that the walk's loops need not look for the end of the origins. */
-static void walk_clip(const profile *pr, walk *w, int forward) {
-  const int dq = forward ? -1 : 1;
-  for (int r = 0; r < w->stretches; r++) {
-    stretch *s = &w->st[r];
-    const int n = (s->to - s->from) * dq + 1;
-    if (n <= 0 || walk_wants(pr, w, s, s->to, forward)) continue;
-    int lo = 0, hi = n - 1; /* the first unwanted is in (lo - 1, hi] */
-    while (lo < hi) {
-      const int mid = lo + (hi - lo) / 2;
-      if (walk_wants(pr, w, s, s->from + mid * dq, forward))
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
-    s->to = s->from + (lo - 1) * dq; /* before `from` when none is wanted */
-    w->stretches = r + 1;
-    return;
-  }
-}
-
-static walk walk_start(const profile *pr, point *h, stretch *st, int stretches, int j_first,
-                       int j_last, int forward) {
-  walk w = {.h = h, .st = st, .stretches = stretches, .j = j_first, .j_last = j_last};
-  walk_clip(pr, &w, forward);
-  return w;
-}
 
 /* Moves the walk on to the first stretch from r on that holds points; 0
  * when there is none. */
@@ -754,61 +723,63 @@ static inline int walk_enter(walk *w, int forward) {
   const int dq = forward ? -1 : 1;
   for (; w->r < w->stretches; w->r++) {
     const stretch *s = &w->st[w->r];
-    w->left = (s->to - s->from) * dq + 1;
-    if (w->left <= 0) continue;
-    w->q = s->from;
+    if ((s->to - s->from) * dq < 0) continue;
+    w->q = w->pt + s->from;
+    w->end = w->pt + s->to + dq;
     w->du = (double)s->shift, w->dkey = (int64_t)s->shift * KEY_STEP;
     return 1;
   }
+  w->q = w->end = NULL;
   return 0;
 }
 
-/* The walk's next point: the origins before it ask the hull, then it is
- * pushed. */
+static walk walk_start(const profile *pr, point *h, const stretch *st, int stretches,
+                       int j_first, int forward) {
+  walk w = {.h = h, .pt = pr->pt, .st = st, .stretches = stretches, .j = j_first};
+  walk_enter(&w, forward);
+  return w;
+}
+
+/* The walk's next origin: the points beyond it are pushed, then it asks the
+ * hull for its tangent. */
 static inline __attribute__((always_inline)) void walk_next(const sweep_job *job,
                                                            const profile *pr, walk *w,
                                                            int forward) {
-  const point *next = pr->pt + w->q;
-  const double u = next->u + w->du;
-  if (forward)
-    for (; (double)w->j >= u; w->j--) query(job, pr, w->h, w->size, w->j, 1);
-  else
-    for (; (double)w->j <= u; w->j++) query(job, pr, w->h, w->size, w->j, 0);
-  w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, next->key + w->dkey);
-  w->q += forward ? -1 : 1;
+  const int64_t beyond = forward ? (int64_t)w->j * KEY_STEP
+                                 : key_of(w->j - 1, job->point_count - 1);
+  for (;;) {
+    if (w->q == w->end) {
+      w->r++;
+      if (!walk_enter(w, forward)) break;
+    }
+    const point *next = w->q;
+    const int64_t key = next->key + w->dkey;
+    if (forward ? key < beyond : key >= beyond) break;
+    const double u = next->u + w->du;
+    w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, key);
+    w->q += forward ? -1 : 1;
+  }
+  query(job, pr, w->h, w->size, w->j, forward);
+  w->j += forward ? -1 : 1;
 }
 
-/* Every point of the walk, then the origins left once all are on the hull. */
-static inline void walk_rest(const sweep_job *job, const profile *pr, walk *w, int more,
-                             int forward) {
-  for (; more; w->r++, more = walk_enter(w, forward))
-    for (; w->left > 0; w->left--) walk_next(job, pr, w, forward);
-  if (forward)
-    for (; w->j >= w->j_last; w->j--) query(job, pr, w->h, w->size, w->j, 1);
-  else
-    for (; w->j <= w->j_last; w->j++) query(job, pr, w->h, w->size, w->j, 0);
-}
-
-/* Both walks of a line (NULL: that side is not wanted), one point of each
- * in turn. Each push waits on what the push before it stored in the same
- * hull; the two hulls are independent, so the processor overlaps the two
- * chains. The walks write different horizons (found[0], found[1]), so the
- * results are those of one walk after the other. */
-static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind) {
+/* Both walks of a line (NULL: that side is not wanted), `origins` each,
+ * one origin of each in turn. Each push waits on what the push before it
+ * stored in the same hull; the two hulls are independent, so the processor
+ * overlaps the two chains. The walks write different horizons (found[0],
+ * found[1]), so the results are those of one walk after the other. */
+static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind,
+                      int origins) {
   walk a = ahead ? *ahead : (walk){0}, b = behind ? *behind : (walk){0};
-  int more_a = ahead && walk_enter(&a, 1), more_b = behind && walk_enter(&b, 0);
-  while (more_a && more_b) {
-    const int n = imin(a.left, b.left);
-    for (int i = 0; i < n; i++) {
+  if (ahead && behind)
+    for (int i = 0; i < origins; i++) {
       walk_next(job, pr, &a, 1);
       walk_next(job, pr, &b, 0);
     }
-    a.left -= n, b.left -= n;
-    if (!a.left) a.r++, more_a = walk_enter(&a, 1);
-    if (!b.left) b.r++, more_b = walk_enter(&b, 0);
-  }
-  if (ahead) walk_rest(job, pr, &a, more_a, 1);
-  if (behind) walk_rest(job, pr, &b, more_b, 0);
+  else if (ahead)
+    for (int i = 0; i < origins; i++) walk_next(job, pr, &a, 1);
+  else if (behind)
+    for (int i = 0; i < origins; i++) walk_next(job, pr, &b, 0);
 }
 
 /* Once round a periodic line of L steps (points in u (0, L]), from its
@@ -819,20 +790,21 @@ static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk
 static void walk_round(const sweep_job *job, const profile *pr, point *h[2]) {
   const int top = pr->top, n = pr->count, L = pr->len;
   const double u_top = pr->pt[top].u;
-  stretch down[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
-  stretch up[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
+  const stretch down[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
+  const stretch up[2] = {{top, n - 1, -L}, {0, top - 1, 0}};
   const int first = (int)ceil(u_top), last = (int)floor(u_top);
-  walk ahead = walk_start(pr, h[0], down, 2, first + L - 1, first, 1);
-  walk behind = walk_start(pr, h[1], up, 2, last - L + 1, last, 0);
-  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
+  walk ahead = walk_start(pr, h[0], down, 2, first + L - 1, 1);
+  walk behind = walk_start(pr, h[1], up, 2, last - L + 1, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL, L);
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
 static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
-  stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
-  walk ahead = walk_start(pr, h[0], &down, 1, pr->len - 1, 0, 1);
-  walk behind = walk_start(pr, h[1], &up, 1, 0, pr->len - 1, 0);
-  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL);
+  const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
+  walk ahead = walk_start(pr, h[0], &down, 1, pr->len - 1, 1);
+  walk behind = walk_start(pr, h[1], &up, 1, 0, 0);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL,
+            pr->len);
 }
 
 /* The line's horizons from its tangents, and what its texels lose to them,
