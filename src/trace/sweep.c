@@ -89,6 +89,7 @@ typedef struct sweep_job {
   double *open_a, *open_b; /* where the wider chords apply (job_chords) */
   bb__line_hook hook;      /* NULL: the sums; else called per line */
   void *hook_ctx;
+  bb__channels4 *table4; /* both sides' tables by channels (integrate.h), when 3 lobes */
   struct scratch *scratch; /* a slot per thread (sweep_bundle) */
   int scratch_count;
 } sweep_job;
@@ -812,6 +813,7 @@ static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
  * slices' order wants. The walks only find tangents; integrating here, in
  * loops of their own, lets the divisions and table reads of neighbouring
  * texels overlap. */
+PROFILE_CLONES
 static void integrate_line(const sweep_job *job, const profile *pr, int x0, int y0) {
   const int channels = job->channels;
   for (int k = 0; k < 2; k++)
@@ -836,6 +838,15 @@ static void integrate_line(const sweep_job *job, const profile *pr, int x0, int 
       job->side[1].dir->sums) {
     const bb__slice_integral *along = &job->side[0].integral, *opposite = &job->side[1].integral;
     float *sums = job->side[0].dir->sums;
+    if (job->table4) {
+      const bb__channels4 *t_along = job->table4, *t_opposite = job->table4 + 4 * BB__TABLE_INTERVALS;
+      for (int j = 0; j < pr->len; j++) {
+        float *texel_sums = sums + pr->texel[j] * 4;
+        bb__slice_accumulate4(along, t_along, pr->found[0][j], texel_sums);
+        bb__slice_accumulate4(opposite, t_opposite, pr->found[1][j], texel_sums);
+      }
+      return;
+    }
     for (int j = 0; j < pr->len; j++) {
       float *texel_sums = sums + pr->texel[j] * (size_t)channels;
       bb__slice_accumulate(along, pr->found[0][j], texel_sums);
@@ -1218,6 +1229,13 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sw
   job_template(&job, pts);
   if (!job_chords(&job))
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  if (along && opposite && along->sums && opposite->sums && job.channels == 4 && !hook) {
+    job.table4 = aligned_alloc(sizeof(bb__channels4), 8 * BB__TABLE_INTERVALS * sizeof(bb__channels4));
+    if (job.table4) {
+      bb__slice_table4(&job.side[0].integral, job.table4);
+      bb__slice_table4(&job.side[1].integral, job.table4 + 4 * BB__TABLE_INTERVALS);
+    } /* else the lobes one by one */
+  }
   items it = {0};
   int failed;
   if (p->addressing == BB_ADDRESS_CLAMP) {
@@ -1252,5 +1270,6 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sw
   items_free(&it);
   free(job.open_a);
   free(job.open_b);
+  free(job.table4);
   return st;
 }
