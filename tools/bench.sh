@@ -500,18 +500,15 @@ else
   while IFS=: read -r m path scale; do
     [ -n "$m" ] || continue
     runs=()
-    for n in 64 256 1024; do
-      "$bin" bake "$path" --scale "$scale" --rays "$n" --filter-radius 0 --normal-filter valve \
-        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_bb$n.ao.exr" \
-        --ssbump "$acc/${m}_bb$n.ss.exr" || { fail "bumpbake bake $path --rays $n"; continue; }
-      runs+=("bb$n")
-    done
-    # the slice counts between (8 and 16 slices are 64 and 256 rays above)
-    for a in 6 10 12; do
-      "$bin" bake "$path" --scale "$scale" --slices "$a" --filter-radius 0 --normal-filter valve \
-        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_bb_s$a.ao.exr" \
-        --ssbump "$acc/${m}_bb_s$a.ss.exr" || { fail "bumpbake bake $path --slices $a"; continue; }
-      runs+=("bb_s$a")
+    # rays 64, 256, 1024 (8, 16, 32 slices) and the slice counts between
+    for setting in rays:64 rays:256 rays:1024 slices:6 slices:10 slices:12; do
+      option=${setting%%:*} n=${setting#*:}
+      r=bb$n
+      [ "$option" = slices ] && r=bb_s$n
+      "$bin" bake "$path" --scale "$scale" "--$option" "$n" --filter-radius 0 --normal-filter valve \
+        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_$r.ao.exr" \
+        --ssbump "$acc/${m}_$r.ss.exr" || { fail "bumpbake bake $path --$option $n"; continue; }
+      runs+=("$r")
     done
     if [ "$peer_ok" = 1 ]; then
       "$peer" "$path" --scale "$scale" --rays 256 --bias "$bias" --threads "$threads" \
