@@ -1,0 +1,85 @@
+/* texture_read.h: engine textures read as images: the containers OpenImageIO
+ * 2.4 cannot read (Valve's VTF; DDS with a DX10 header) laid out by their
+ * own readers (vtf_read.c, dds_read.c), their texels decoded (texels.c,
+ * blocks through libsquish) and handed back as bb_image_read does
+ * (texture_read.c), within the limits of read_limits.h. */
+#ifndef BB_IO_TEXTURE_READ_H
+#define BB_IO_TEXTURE_READ_H
+
+#include "bumpbake.h"
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* How a format stores its texels. */
+typedef enum bb__texel_kind {
+  BB__TEXELS_BLOCKS,  /* 4 x 4 blocks (block: a bb__block_format) */
+  BB__TEXELS_UNORM8,  /* `samples` bytes a texel, v / 255 */
+  BB__TEXELS_UNORM16, /* `samples` little-endian u16 a texel, v / 65535 */
+  BB__TEXELS_HALF,    /* `samples` binary16 a texel */
+  BB__TEXELS_FLOAT,   /* `samples` binary32 a texel */
+  BB__TEXELS_PACKED16 /* one little-endian u16 a texel, channel c in bits
+                         [shift[c], shift[c] + bits[c]), v / (2^bits - 1) */
+} bb__texel_kind;
+
+typedef struct bb__texel_format {
+  const char *name;          /* "DXT1", "BGR888", "R16G16B16A16_FLOAT"... */
+  bb__texel_kind kind;
+  int block;                 /* BLOCKS: the bb__block_format */
+  int samples;               /* samples stored a texel (UNORM8..FLOAT) */
+  int channels;              /* channels handed back, 1 to 4 */
+  signed char source[4];     /* channel c: sample source[c] (BLOCKS: of the
+                                decoded R, G, B, A; PACKED16: bit shift) */
+  unsigned char bits[4];     /* PACKED16: bits of channel c */
+} bb__texel_format;
+
+/* Bytes a width x height level of f takes in the file. */
+uint64_t bb__texels_bytes(const bb__texel_format *f, int width, int height);
+
+/* Bytes decoding a width x height level allocates beside its floats. */
+uint64_t bb__texels_scratch_bytes(const bb__texel_format *f, int width, int height);
+
+/* Decodes a width x height level (bb__texels_bytes of data) into out:
+ * channels [first, first + count) of f's, as floats, row-major. */
+bb_status bb__texels_decode(const bb__texel_format *f, const unsigned char *data, int width,
+                            int height, int first, int count, float *out, bb_error *err);
+
+enum { BB__TEXTURE_MAX_LEVELS = 17 }; /* 65536 texels a side: 17 levels */
+
+/* Where a texture's levels are, as its container's reader found them:
+ * every offset and size checked against the file's length. */
+typedef struct bb__texture_layout {
+  const char *container;     /* "vtf" or "dds" */
+  bb__texel_format format;
+  int width, height;         /* level 0 */
+  int levels;                /* 1 to BB__TEXTURE_MAX_LEVELS */
+  uint64_t offset[BB__TEXTURE_MAX_LEVELS]; /* level k's first byte (frame 0, face 0) */
+  int alpha_channel;         /* -1 for none */
+  int bits_per_sample, is_float;
+  char *description;         /* provenance (VTF 7.3+ KVD), malloc'd, or NULL */
+} bb__texture_layout;
+
+/* The layout of the VTF (vtf_read.c) or DX10 DDS (dds_read.c) open at fd.
+ * On failure nothing is left allocated. */
+bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
+bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
+
+/* 1 when path is read by the readers above rather than OpenImageIO: a .vtf
+ * name or a file starting with "VTF\0", or a DDS with a DX10 header. */
+int bb__texture_read_applies(const char *path);
+
+/* bb_image_read_mip's read (channels [first, first + count), count < 0: all)
+ * of a texture bb__texture_read_applies to, and its header alone. */
+bb_status bb__texture_read(const char *path, int first, int count, int level, bb_image *out,
+                           bb_image_info *info, int *level_count, bb_error *err);
+bb_status bb__texture_read_header(const char *path, int *width, int *height, int *channels,
+                                  bb_image_info *info, int *level_count, bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_IO_TEXTURE_READ_H */
