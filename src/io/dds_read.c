@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 enum { DDS_HEADER_BYTES = 148, DDSD_MIPMAPCOUNT = 0x20000, TEXTURE2D = 3 };
 
@@ -51,19 +50,6 @@ static uint32_t u32_at(const unsigned char *p) {
   return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
-static int read_at(int fd, void *buf, size_t n, off_t offset) {
-  size_t done = 0;
-  while (done < n) {
-    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, offset + (off_t)done);
-    if (got < 0 && errno == EINTR)
-      continue;
-    if (got <= 0)
-      return -1;
-    done += (size_t)got;
-  }
-  return 0;
-}
-
 bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err) {
   memset(layout, 0, sizeof *layout);
   layout->alpha_channel = -1;
@@ -72,7 +58,7 @@ bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, b
   if (fstat(fd, &sb) != 0)
     return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
   const uint64_t file_size = (uint64_t)sb.st_size;
-  if (file_size < DDS_HEADER_BYTES || read_at(fd, h, sizeof h, 0) != 0 ||
+  if (file_size < DDS_HEADER_BYTES || bb__read_at(fd, h, sizeof h, 0) != sizeof h ||
       memcmp(h, "DDS ", 4) != 0 || memcmp(h + 84, "DX10", 4) != 0)
     return bb__fail(err, BB_ERR_FORMAT, "%s: not a DDS file with a DX10 header", path);
   const uint32_t height = u32_at(h + 12), width = u32_at(h + 16), depth = u32_at(h + 24);

@@ -19,10 +19,10 @@
 
 enum { MAGIC_BYTES = 88 };
 
-static size_t read_at(int fd, void *buf, size_t n, off_t offset) {
+size_t bb__read_at(int fd, void *buf, size_t n, uint64_t offset) {
   size_t done = 0;
   while (done < n) {
-    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, offset + (off_t)done);
+    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, (off_t)(offset + done));
     if (got < 0 && errno == EINTR)
       continue;
     if (got <= 0)
@@ -52,7 +52,7 @@ int bb__texture_read_applies(const char *path) {
   unsigned char m[MAGIC_BYTES];
   size_t n = 0;
   if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode))
-    n = read_at(fd, m, sizeof m, 0);
+    n = bb__read_at(fd, m, sizeof m, 0);
   close(fd);
   return is_vtf(m, n) || is_dx10_dds(m, n);
 }
@@ -60,10 +60,23 @@ int bb__texture_read_applies(const char *path) {
 /* The layout of the texture open at fd, by its first bytes. */
 static bb_status layout_of(int fd, const char *path, bb__texture_layout *layout, bb_error *err) {
   unsigned char m[MAGIC_BYTES];
-  const size_t n = read_at(fd, m, sizeof m, 0);
+  const size_t n = bb__read_at(fd, m, sizeof m, 0);
   if (n >= 4 && !memcmp(m, "DDS ", 4))
     return bb__dds_layout(fd, path, layout, err);
   return bb__vtf_layout(fd, path, layout, err); /* says "not a VTF file" when it is not one */
+}
+
+/* Opens path (checked: a regular file) and lays it out; on success the
+ * caller closes *fd and frees layout->description. */
+static bb_status open_layout(const char *path, int *fd, bb__texture_layout *layout,
+                             bb_error *err) {
+  bb_status st = bb__input_open(path, fd, err);
+  if (st != BB_OK)
+    return st;
+  st = layout_of(*fd, path, layout, err);
+  if (st != BB_OK)
+    close(*fd);
+  return st;
 }
 
 static void fill_info(bb__texture_layout *layout, bb_image_info *info) {
@@ -85,14 +98,11 @@ static int level_side(int side, int level) { return side >> level > 0 ? side >> 
 bb_status bb__texture_read_header(const char *path, int *width, int *height, int *channels,
                                   bb_image_info *info, int *level_count, bb_error *err) {
   int fd;
-  bb_status st = bb__input_open(path, &fd, err);
-  if (st != BB_OK)
-    return st;
   bb__texture_layout layout;
-  st = layout_of(fd, path, &layout, err);
-  close(fd);
+  bb_status st = open_layout(path, &fd, &layout, err);
   if (st != BB_OK)
     return st;
+  close(fd);
   if (width) *width = layout.width;
   if (height) *height = layout.height;
   if (channels) *channels = layout.format.channels;
@@ -131,7 +141,7 @@ static bb_status read_level(int fd, const char *path, bb__texture_layout *layout
   unsigned char *data = malloc((size_t)bytes);
   if (!data)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  if (read_at(fd, data, (size_t)bytes, (off_t)layout->offset[level]) != (size_t)bytes) {
+  if (bb__read_at(fd, data, (size_t)bytes, layout->offset[level]) != (size_t)bytes) {
     free(data);
     return bb__fail(err, BB_ERR_FORMAT, "%s: truncated %s: level %d cannot be read", path,
                     layout->container, level);
@@ -153,15 +163,10 @@ static bb_status read_level(int fd, const char *path, bb__texture_layout *layout
 bb_status bb__texture_read(const char *path, int first, int count, int level, bb_image *out,
                            bb_image_info *info, int *level_count, bb_error *err) {
   int fd;
-  bb_status st = bb__input_open(path, &fd, err);
+  bb__texture_layout layout;
+  bb_status st = open_layout(path, &fd, &layout, err);
   if (st != BB_OK)
     return st;
-  bb__texture_layout layout;
-  st = layout_of(fd, path, &layout, err);
-  if (st != BB_OK) {
-    close(fd);
-    return st;
-  }
   if (level_count) *level_count = layout.levels;
   if (level < 0 || level >= layout.levels)
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s: no mip level %d (the file has %d)", path, level,
