@@ -419,3 +419,31 @@ Test(texture_read, hostile_dx10_dds_headers) {
   free(v);
   free(f);
 }
+
+Test(texture_read, legacy_dds_mip_count_past_its_size) {
+  /* OpenImageIO's DDS reader walks every level before the one it seeks:
+   * a 16 x 16 file declaring 65029 levels took minutes to count (the
+   * fuzzer's find). The header probe refuses it first. */
+  bb_image img = pattern(16, 16, 3);
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.format = BB_TEXTURE_FORMAT_BC1;
+  const char *path = in_dir("mips.dds");
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  bb_image_free(&img);
+  size_t size;
+  unsigned char *f = slurp(path, &size);
+  int levels = 0;
+  bb_image level;
+  cr_assert_eq(bb_image_read_mip(path, 4, &level, NULL, &levels, &err), BB_OK, "%s",
+               err.message);
+  cr_assert(levels == 5 && level.width == 1 && level.height == 1);
+  bb_image_free(&level);
+  put_u32(f + 28, 65029);
+  spill(path, f, size);
+  expect_refused(path, "65029 mip levels");
+  cr_assert_eq(bb_image_read_info(path, NULL, NULL, NULL, NULL, &err), BB_ERR_FORMAT);
+  cr_assert_not_null(strstr(err.message, "65029 mip levels"), "%s", err.message);
+  free(f);
+}
