@@ -6,6 +6,7 @@
  * DX10_TEXELS, are read here. The layout is Microsoft's (dds.c cites it):
  * "DDS ", a 124-byte header, the 20-byte DX10 header at 128, then every
  * level of array element 0, largest first. */
+#include "core/input_file.h"
 #include "core/internal.h"
 #include "io/blocks.h"
 #include "io/texture_read.h"
@@ -58,7 +59,7 @@ bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, b
   if (fstat(fd, &sb) != 0)
     return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
   const uint64_t file_size = (uint64_t)sb.st_size;
-  if (file_size < DDS_HEADER_BYTES || bb__read_at(fd, h, sizeof h, 0) != sizeof h ||
+  if (file_size < DDS_HEADER_BYTES || bb__input_read_at(fd, h, sizeof h, 0) != sizeof h ||
       memcmp(h, "DDS ", 4) != 0 || memcmp(h + 84, "DX10", 4) != 0)
     return bb__fail(err, BB_ERR_FORMAT, "%s: not a DDS file with a DX10 header", path);
   const uint32_t height = u32_at(h + 12), width = u32_at(h + 16), depth = u32_at(h + 24);

@@ -9,7 +9,6 @@
 #include "io/formats.h"
 #include "io/read_limits.h"
 
-#include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,19 +17,6 @@
 #include <unistd.h>
 
 enum { MAGIC_BYTES = 88 };
-
-size_t bb__read_at(int fd, void *buf, size_t n, uint64_t offset) {
-  size_t done = 0;
-  while (done < n) {
-    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, (off_t)(offset + done));
-    if (got < 0 && errno == EINTR)
-      continue;
-    if (got <= 0)
-      break;
-    done += (size_t)got;
-  }
-  return done;
-}
 
 static int is_vtf(const unsigned char *m, size_t n) { return n >= 4 && !memcmp(m, "VTF\0", 4); }
 
@@ -52,7 +38,7 @@ int bb__texture_read_applies(const char *path) {
   unsigned char m[MAGIC_BYTES];
   size_t n = 0;
   if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode))
-    n = bb__read_at(fd, m, sizeof m, 0);
+    n = bb__input_read_at(fd, m, sizeof m, 0);
   close(fd);
   return is_vtf(m, n) || is_dx10_dds(m, n);
 }
@@ -60,7 +46,7 @@ int bb__texture_read_applies(const char *path) {
 /* The layout of the texture open at fd, by its first bytes. */
 static bb_status layout_of(int fd, const char *path, bb__texture_layout *layout, bb_error *err) {
   unsigned char m[MAGIC_BYTES];
-  const size_t n = bb__read_at(fd, m, sizeof m, 0);
+  const size_t n = bb__input_read_at(fd, m, sizeof m, 0);
   if (n >= 4 && !memcmp(m, "DDS ", 4))
     return bb__dds_layout(fd, path, layout, err);
   return bb__vtf_layout(fd, path, layout, err); /* says "not a VTF file" when it is not one */
@@ -141,7 +127,7 @@ static bb_status read_level(int fd, const char *path, bb__texture_layout *layout
   unsigned char *data = malloc((size_t)bytes);
   if (!data)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  if (bb__read_at(fd, data, (size_t)bytes, layout->offset[level]) != (size_t)bytes) {
+  if (bb__input_read_at(fd, data, (size_t)bytes, layout->offset[level]) != (size_t)bytes) {
     free(data);
     return bb__fail(err, BB_ERR_FORMAT, "%s: truncated %s: level %d cannot be read", path,
                     layout->container, level);

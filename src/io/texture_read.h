@@ -8,7 +8,6 @@
 
 #include "bumpbake.h"
 
-#include <stddef.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -67,10 +66,6 @@ typedef struct bb__texture_layout {
  * On failure nothing is left allocated. */
 bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
 bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
-
-/* pread of n bytes at offset, through EINTR and short reads: the bytes
- * read (fewer at the end of the file or on an error). */
-size_t bb__read_at(int fd, void *buf, size_t n, uint64_t offset);
 
 /* 1 when path is read by the readers above rather than OpenImageIO: a .vtf
  * name or a file starting with "VTF\0", or a DDS with a DX10 header. */
