@@ -447,3 +447,71 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   cr_assert_not_null(strstr(err.message, "65029 mip levels"), "%s", err.message);
   free(f);
 }
+
+/* A hand-made VTF of 8 x 8 BGR888 texels, 4 levels, `frames` frames, as
+ * Valve's layout has it (levels smallest first, each holding every frame),
+ * version 7.minor; 7.3+ with an inline CRC resource ahead of the image, as
+ * vtex writes one. Texel i of frame f at level k holds B = 10 k + f, G =
+ * i, R = 200. *size receives the file's size; malloc'd. */
+static unsigned char *layered_vtf(int minor, int frames, size_t *size) {
+  const int levels = 4;
+  size_t data = 0;
+  for (int k = 0; k < levels; k++)
+    data += (size_t)(8 >> k) * (size_t)(8 >> k) * 3 * (size_t)frames;
+  const size_t header = minor >= 3 ? 80 + 2 * 8 : 80;
+  unsigned char *f = calloc(1, header + data);
+  memcpy(f, "VTF", 4);
+  put_u32(f + 4, 7);
+  put_u32(f + 8, (uint32_t)minor);
+  put_u32(f + 12, (uint32_t)header);
+  f[16] = 8, f[18] = 8;
+  f[24] = (unsigned char)frames;
+  put_u32(f + 52, 3); /* BGR888 */
+  f[56] = (unsigned char)levels;
+  put_u32(f + 57, 0xffffffffu); /* no low-resolution image */
+  f[63] = 1;
+  if (minor >= 3) {
+    put_u32(f + 68, 2);
+    memcpy(f + 80, "CRC\x02", 4); /* inline: its value is the data field */
+    put_u32(f + 84, 0x12345678u);
+    put_u32(f + 88, 0x30);
+    put_u32(f + 92, (uint32_t)header);
+  }
+  unsigned char *p = f + header;
+  for (int k = levels - 1; k >= 0; k--)
+    for (int fr = 0; fr < frames; fr++)
+      for (int i = 0; i < (8 >> k) * (8 >> k); i++, p += 3)
+        p[0] = (unsigned char)(10 * k + fr), p[1] = (unsigned char)i, p[2] = 200;
+  *size = header + data;
+  return f;
+}
+
+Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
+  const char *path = in_dir("frames.vtf");
+  for (int minor = 2; minor <= 5; minor += 3)
+    for (int frames = 1; frames <= 3; frames += 2) {
+      size_t size;
+      unsigned char *f = layered_vtf(minor, frames, &size);
+      spill(path, f, size);
+      for (int k = 0; k < 4; k++) {
+        bb_image img;
+        int levels = 0;
+        bb_error err = {{0}};
+        cr_assert_eq(bb_image_read_mip(path, k, &img, NULL, &levels, &err), BB_OK,
+                     "7.%d, %d frames, level %d: %s", minor, frames, k, err.message);
+        cr_assert(levels == 4 && img.width == 8 >> k && img.channels == 3);
+        for (int i = 0; i < img.width * img.height; i++) {
+          cr_assert_float_eq(img.pixels[3 * i + 0], 200.0f / 255.0f, 1e-7f);
+          cr_assert_float_eq(img.pixels[3 * i + 1], (float)i / 255.0f, 1e-7f);
+          cr_assert_float_eq(img.pixels[3 * i + 2], (float)(10 * k) / 255.0f, 1e-7f,
+                             "7.%d, %d frames, level %d texel %d: not frame 0's", minor,
+                             frames, k, i);
+        }
+        bb_image_free(&img);
+      }
+      /* The last frame of the top level cut short: refused. */
+      spill(path, f, size - 1);
+      expect_refused(path, "truncated last frame");
+      free(f);
+    }
+}
