@@ -243,10 +243,11 @@ void bb_image_info_free(bb_image_info *info);
  * with "VTF\0": versions 7.0 to 7.5, frame 0 and face 0 of a flat texture;
  * DXT1/3/5, ATI1N/2N, the 8-, 16- and 32-bit texel formats; alpha when the
  * flags EIGHTBITALPHA or ONEBITALPHA say the texture has one; format_name
- * "vtf", description the provenance of a 7.3+ KVD resource) and DDS with a
- * DX10 header (RGBA16F, RGBA32F, BC1 to BC5, 8-bit RGBA and one-channel
- * formats; format_name "dds"); blocks are decoded by libsquish. info may
- * be NULL.
+ * "vtf", description the provenance of a 7.3+ KVD resource) and DDS (a
+ * file starting with "DDS ", read by bumpbake too, as OpenImageIO 2.4's
+ * reader crashes on hostile headers: DXT1 to DXT5, BC4, BC5, masked RGB,
+ * luminance and alpha, and with a DX10 header RGBA16F, RGBA32F and more;
+ * format_name "dds"); blocks are decoded by libsquish. info may be NULL.
  * The file must be a regular one (a FIFO, a device or a directory is
  * refused at once) and is read through the descriptor that was checked.
  * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
@@ -277,8 +278,8 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
                             bb_image_info *info, int *level_count, bb_error *err);
 
-/* Number of subimages (frames) in an image file (1 for a VTF or DX10 DDS:
- * the frame read). */
+/* Number of subimages (frames) in an image file (1 for a VTF or DDS: the
+ * frame read). */
 bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
 
 /* ------------------------------------------------------ writing images */

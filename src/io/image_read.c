@@ -1,8 +1,8 @@
 /* image_read.c: the public image reads (bumpbake.h "reading images") and
  * bb__image_read_channels / bb__image_level_count (io/oiio.h): arguments
  * checked, outputs cleared, OpenImageIO called (oiio_read.cpp) or, for the
- * textures it cannot read (VTF, DX10 DDS), texture_read.c, and whatever a
- * failed read made freed. */
+ * engine textures (VTF, which it cannot read, and DDS, which it cannot read
+ * safely), texture_read.c, and whatever a failed read made freed. */
 #include "core/internal.h"
 #include "io/formats.h"
 #include "io/oiio.h"

@@ -1,8 +1,8 @@
 /* texels.c: a texture level's stored texels decoded into floats: 4 x 4
  * blocks through the block codec (blocks.h, libsquish), 8- and 16-bit
  * normalised samples as v / 255 and v / 65535 (as OpenImageIO reads 8- and
- * 16-bit files), half floats through Imath's C conversion, packed 16-bit
- * texels (5:6:5, 5:5:5:1, 4:4:4:4) channel by channel. */
+ * 16-bit files), half floats through Imath's C conversion, packed texels
+ * (DDS's bit masks; 5:6:5, 5:5:5:1, 4:4:4:4) channel by channel. */
 #include "io/texture_read.h"
 #include "core/internal.h"
 #include "io/blocks.h"
@@ -12,6 +12,7 @@
 #define IMATH_HALF_NO_LOOKUP_TABLE
 #include <Imath/half.h>
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,7 +25,7 @@ uint64_t bb__texels_bytes(const bb__texel_format *f, int width, int height) {
   case BB__TEXELS_UNORM16:
   case BB__TEXELS_HALF: return w * h * 2 * (uint64_t)f->samples;
   case BB__TEXELS_FLOAT: return w * h * 4 * (uint64_t)f->samples;
-  case BB__TEXELS_PACKED16: return w * h * 2;
+  case BB__TEXELS_PACKED: return w * h * (uint64_t)f->samples;
   }
   return 0;
 }
@@ -52,9 +53,17 @@ static float sample(const bb__texel_format *f, const unsigned char *p, int s) {
   case BB__TEXELS_HALF: return imath_half_to_float((imath_half_bits_t)u16_at(p + 2 * s));
   case BB__TEXELS_FLOAT: return f32_at(p + 4 * s);
   case BB__TEXELS_BLOCKS:
-  case BB__TEXELS_PACKED16: break;
+  case BB__TEXELS_PACKED: break;
   }
   return 0.0f;
+}
+
+/* z of the unit normal whose x and y a BC5 texel holds, as 0.5 + 0.5 z
+ * (what OpenImageIO's DDS reader gave for NVIDIA's DDPF_NORMAL). */
+static float rebuilt_z(const unsigned char *rgba) {
+  const double x = rgba[0] / 127.5 - 1.0, y = rgba[1] / 127.5 - 1.0;
+  const double zz = 1.0 - x * x - y * y;
+  return (float)(0.5 + 0.5 * (zz > 0.0 ? sqrt(zz) : 0.0));
 }
 
 bb_status bb__texels_decode(const bb__texel_format *f, const unsigned char *data, int width,
@@ -72,17 +81,23 @@ bb_status bb__texels_decode(const bb__texel_format *f, const unsigned char *data
     if (st == BB_OK)
       for (size_t i = 0; i < n; i++)
         for (int c = 0; c < count; c++)
-          out[i * (size_t)count + (size_t)c] = (float)rgba[4 * i + (size_t)f->source[first + c]] / 255.0f;
+          out[i * (size_t)count + (size_t)c] =
+              f->rebuild_z && first + c == 2
+                  ? rebuilt_z(rgba + 4 * i)
+                  : (float)rgba[4 * i + (size_t)f->source[first + c]] / 255.0f;
     free(rgba);
     return st;
   }
-  if (f->kind == BB__TEXELS_PACKED16) {
+  if (f->kind == BB__TEXELS_PACKED) {
     for (size_t i = 0; i < n; i++) {
-      const unsigned v = u16_at(data + 2 * i);
+      uint32_t v = 0;
+      for (int b = 0; b < f->samples; b++)
+        v |= (uint32_t)data[i * (size_t)f->samples + (size_t)b] << (8 * b);
       for (int c = 0; c < count; c++) {
-        const unsigned bits = f->bits[first + c], max = (1u << bits) - 1u;
+        const unsigned bits = f->bits[first + c];
+        const uint64_t max = (1ull << bits) - 1u;
         out[i * (size_t)count + (size_t)c] =
-            (float)((v >> f->source[first + c]) & max) / (float)max;
+            (float)((double)(((uint64_t)v >> f->source[first + c]) & max) / (double)max);
       }
     }
     return BB_OK;

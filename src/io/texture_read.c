@@ -1,5 +1,4 @@
-/* texture_read.c: VTF files, and DDS files with a DX10 header, read as
- * images: the container's reader lays the levels out (vtf_read.c,
+/* texture_read.c: VTF and DDS files read as images: the container's reader lays the levels out (vtf_read.c,
  * dds_read.c), the limits of read_limits.h are checked against the level's
  * size before anything is allocated, its bytes are read through the
  * descriptor the read checked, and texels.c decodes them. */
@@ -20,9 +19,7 @@ enum { MAGIC_BYTES = 88 };
 
 static int is_vtf(const unsigned char *m, size_t n) { return n >= 4 && !memcmp(m, "VTF\0", 4); }
 
-static int is_dx10_dds(const unsigned char *m, size_t n) {
-  return n >= MAGIC_BYTES && !memcmp(m, "DDS ", 4) && !memcmp(m + 84, "DX10", 4);
-}
+static int is_dds(const unsigned char *m, size_t n) { return n >= 4 && !memcmp(m, "DDS ", 4); }
 
 int bb__texture_read_applies(const char *path) {
   if (!path)
@@ -40,7 +37,7 @@ int bb__texture_read_applies(const char *path) {
   if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode))
     n = bb__input_read_at(fd, m, sizeof m, 0);
   close(fd);
-  return is_vtf(m, n) || is_dx10_dds(m, n);
+  return is_vtf(m, n) || is_dds(m, n);
 }
 
 /* The layout of the texture open at fd, by its first bytes. */

@@ -1,6 +1,7 @@
-/* texture_read.h: engine textures read as images: the containers OpenImageIO
- * 2.4 cannot read (Valve's VTF; DDS with a DX10 header) laid out by their
- * own readers (vtf_read.c, dds_read.c), their texels decoded (texels.c,
+/* texture_read.h: engine textures read as images: Valve's VTF (OpenImageIO
+ * has no reader) and DDS (OpenImageIO 2.4.7's reader crashes or hangs on
+ * hostile headers: see dds_read.c) laid out by their own readers
+ * (vtf_read.c, dds_read.c), their texels decoded (texels.c,
  * blocks through libsquish) and handed back as bb_image_read does
  * (texture_read.c), within the limits of read_limits.h. */
 #ifndef BB_IO_TEXTURE_READ_H
@@ -21,19 +22,25 @@ typedef enum bb__texel_kind {
   BB__TEXELS_UNORM16, /* `samples` little-endian u16 a texel, v / 65535 */
   BB__TEXELS_HALF,    /* `samples` binary16 a texel */
   BB__TEXELS_FLOAT,   /* `samples` binary32 a texel */
-  BB__TEXELS_PACKED16 /* one little-endian u16 a texel, channel c in bits
-                         [shift[c], shift[c] + bits[c]), v / (2^bits - 1) */
+  BB__TEXELS_PACKED   /* one little-endian word of `samples` bytes (1 to 4)
+                         a texel, channel c in bits [source[c], source[c] +
+                         bits[c]), v / (2^bits - 1) (DDS's masks, VTF's
+                         565, 5551, 4444) */
 } bb__texel_kind;
 
 typedef struct bb__texel_format {
   const char *name;          /* "DXT1", "BGR888", "R16G16B16A16_FLOAT"... */
   bb__texel_kind kind;
   int block;                 /* BLOCKS: the bb__block_format */
-  int samples;               /* samples stored a texel (UNORM8..FLOAT) */
+  int samples;               /* samples stored a texel (UNORM8..FLOAT; PACKED:
+                                bytes of its word) */
   int channels;              /* channels handed back, 1 to 4 */
   signed char source[4];     /* channel c: sample source[c] (BLOCKS: of the
-                                decoded R, G, B, A; PACKED16: bit shift) */
-  unsigned char bits[4];     /* PACKED16: bits of channel c */
+                                decoded R, G, B, A; PACKED: bit shift) */
+  unsigned char bits[4];     /* PACKED: bits of channel c */
+  int rebuild_z;             /* BLOCKS, 3 channels from BC5's two: channel 2
+                                is z = sqrt(1 - x^2 - y^2) of the normal
+                                (x, y) = 2 (R, G) - 1, stored as 0.5 + 0.5 z */
 } bb__texel_format;
 
 /* Bytes a width x height level of f takes in the file. */
@@ -62,13 +69,13 @@ typedef struct bb__texture_layout {
   char *description;         /* provenance (VTF 7.3+ KVD), malloc'd, or NULL */
 } bb__texture_layout;
 
-/* The layout of the VTF (vtf_read.c) or DX10 DDS (dds_read.c) open at fd.
+/* The layout of the VTF (vtf_read.c) or DDS (dds_read.c) open at fd.
  * On failure nothing is left allocated. */
 bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
 bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, bb_error *err);
 
 /* 1 when path is read by the readers above rather than OpenImageIO: a .vtf
- * name or a file starting with "VTF\0", or a DDS with a DX10 header. */
+ * name or a file starting with "VTF\0" or "DDS ". */
 int bb__texture_read_applies(const char *path);
 
 /* bb_image_read_mip's read (channels [first, first + count), count < 0: all)

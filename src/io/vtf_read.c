@@ -21,9 +21,9 @@
 #define ONEBITALPHA 0x00001000u
 
 #define T(name, kind, block, samples, channels, s0, s1, s2, s3)                                \
-  { name, kind, block, samples, channels, {s0, s1, s2, s3}, {0, 0, 0, 0} }
+  { name, kind, block, samples, channels, {s0, s1, s2, s3}, {0, 0, 0, 0}, 0 }
 #define P(name, channels, s0, b0, s1, b1, s2, b2, s3, b3)                                      \
-  { name, BB__TEXELS_PACKED16, 0, 1, channels, {s0, s1, s2, s3}, {b0, b1, b2, b3} }
+  { name, BB__TEXELS_PACKED, 0, 2, channels, {s0, s1, s2, s3}, {b0, b1, b2, b3}, 0 }
 
 /* Valve's IMAGE_FORMAT_* codes (Source SDK 2013, public/bitmap/imageformat.h),
  * as read; channels with alpha when the flags allow it (4), else one less.

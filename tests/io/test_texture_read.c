@@ -1,5 +1,6 @@
-/* test_texture_read.c: VTF files, and DDS files with a DX10 header, read
- * back through bb_image_read and friends.
+/* test_texture_read.c: VTF and DDS files read back through bb_image_read
+ * and friends (bumpbake's own readers; tests/io/test_dds.c checks the DDS
+ * bumpbake writes).
  *
  * - Every format and version bumpbake writes, with and without mips: each
  *   level read (bb_image_read_mip) against the tests' own decoding of the
@@ -423,7 +424,7 @@ Test(texture_read, hostile_dx10_dds_headers) {
 Test(texture_read, legacy_dds_mip_count_past_its_size) {
   /* OpenImageIO's DDS reader walks every level before the one it seeks:
    * a 16 x 16 file declaring 65029 levels took minutes to count (the
-   * fuzzer's find). The header probe refuses it first. */
+   * fuzzer's find). bumpbake's own DDS reader refuses it in one line. */
   bb_image img = pattern(16, 16, 3);
   bb_texture_options o;
   bb_texture_options_init(&o);
@@ -514,4 +515,103 @@ Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
       expect_refused(path, "truncated last frame");
       free(f);
     }
+}
+
+/* A legacy DDS header (no DX10) of w x h, one level, pixel format flags,
+ * FourCC or bit count and masks, then `data` bytes of a pattern. */
+static unsigned char *legacy_dds(uint32_t w, uint32_t h, uint32_t pf_flags, const char *fourcc,
+                                 uint32_t bits, const uint32_t masks[4], size_t data,
+                                 size_t *size) {
+  unsigned char *f = calloc(1, 128 + data);
+  memcpy(f, "DDS ", 4);
+  put_u32(f + 4, 124);
+  put_u32(f + 8, 0x1007);
+  put_u32(f + 12, h);
+  put_u32(f + 16, w);
+  put_u32(f + 76, 32);
+  put_u32(f + 80, pf_flags);
+  if (fourcc)
+    memcpy(f + 84, fourcc, 4);
+  put_u32(f + 88, bits);
+  for (int c = 0; c < 4; c++)
+    put_u32(f + 92 + 4 * c, masks ? masks[c] : 0);
+  put_u32(f + 108, 0x1000);
+  for (size_t i = 0; i < data; i++)
+    f[128 + i] = (unsigned char)(i * 37 + 11);
+  *size = 128 + data;
+  return f;
+}
+
+Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
+  /* OpenImageIO 2.4.7 divided by zero on DXT2 and DXT4 (the fuzzer's find)
+   * and looped for ever on a zero mask: bumpbake's reader takes DXT2/DXT4
+   * as DXT3/DXT5 (premultiplied colour, read as stored) and refuses masks
+   * it cannot use, in one line. */
+  const char *path = in_dir("legacy.dds");
+  size_t size;
+  for (int k = 0; k < 2; k++) {
+    unsigned char *f = legacy_dds(16, 16, 0x4, k ? "DXT4" : "DXT2", 0, NULL, 16 * 16, &size);
+    spill(path, f, size);
+    bb_image img;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+    cr_assert(img.width == 16 && img.channels == 4);
+    bb_image_free(&img);
+    free(f);
+  }
+  const uint32_t zero[4] = {0, 0, 0, 0}, gap[4] = {0xf0f, 0xf0, 0xf000, 0},
+                 rgb565[4] = {0xf800, 0x7e0, 0x1f, 0}, la[4] = {0xff, 0, 0, 0xff00};
+  struct {
+    const char *what;
+    uint32_t flags, bits;
+    const uint32_t *masks;
+    int ok, channels;
+  } cases[] = {
+      {"RGB, zero masks", 0x40, 32, zero, 0, 0},
+      {"RGB, a mask with a gap", 0x40, 16, gap, 0, 0},
+      {"RGB, 7 bits", 0x40, 7, rgb565, 0, 0},
+      {"RGB, 0 bits", 0x40, 0, rgb565, 0, 0},
+      {"no format at all", 0, 0, zero, 0, 0},
+      {"RGB 565", 0x40, 16, rgb565, 1, 3},
+      {"luminance and alpha", 0x20001, 16, la, 1, 2},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    unsigned char *f =
+        legacy_dds(16, 16, cases[k].flags, NULL, cases[k].bits, cases[k].masks, 16 * 16 * 4, &size);
+    spill(path, f, size);
+    if (cases[k].ok) {
+      bb_image img;
+      bb_error err = {{0}};
+      cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s: %s", cases[k].what,
+                   err.message);
+      cr_assert_eq(img.channels, cases[k].channels, "%s", cases[k].what);
+      /* 565: the first texel's bytes 11, 48 as R 5, G 6, B 5 bits. */
+      if (cases[k].bits == 16 && cases[k].channels == 3) {
+        const unsigned v = 11u | 48u << 8;
+        cr_assert_float_eq(img.pixels[0], (float)((v >> 11) & 31) / 31.0f, 1e-6f);
+        cr_assert_float_eq(img.pixels[1], (float)((v >> 5) & 63) / 63.0f, 1e-6f);
+        cr_assert_float_eq(img.pixels[2], (float)(v & 31) / 31.0f, 1e-6f);
+      }
+      bb_image_free(&img);
+    } else {
+      expect_refused(path, cases[k].what);
+    }
+    free(f);
+  }
+  unsigned char *f = legacy_dds(16, 16, 0x4, "BC7X", 0, NULL, 256, &size);
+  spill(path, f, size);
+  expect_refused(path, "unknown FourCC");
+  free(f);
+  /* A DDS under another name is still read by bumpbake's reader. */
+  f = legacy_dds(16, 16, 0x4, "DXT1", 0, NULL, 128, &size);
+  path = in_dir("really_a_dds.png");
+  spill(path, f, size);
+  bb_image img;
+  bb_image_info info;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_image_read(path, &img, &info, &err), BB_OK, "%s", err.message);
+  cr_assert_str_eq(info.format_name, "dds");
+  bb_image_free(&img);
+  bb_image_info_free(&info);
+  free(f);
 }
