@@ -241,7 +241,7 @@ static double json_number(const char *json, const char *key) {
 
 Test(cli_textures, vtf_round_trip_within_block_error) {
   /* rock06 at 128 x 128, scale 32: rough for its size, so a 4 x 4 block
-   * spans several features (the worst case of tests/io/test_dds.c's
+   * spans several features (the worst case of tests/texture/test_dds.c's
    * goldens). Measured with libsquish 1.15's cluster fit, max / rms in
    * 8-bit codes against the 8-bit PNG: ssbump DXT1 and DXT5 109 / 13.2,
    * normal DXT1 68 / 8.2; BGR888 exact; RGBA16161616F the PNG's rounding
