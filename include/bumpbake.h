@@ -518,7 +518,8 @@ typedef struct bb_image_info {
   int alpha_channel;    /* index of the alpha channel, or -1 */
   int is_float;         /* 1 when the file stores float or half samples */
   int bits_per_sample;  /* 8, 16, 32 (float or int), ... */
-  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ... */
+  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ...;
+                           "vtf", "dds" for bumpbake's own texture reader */
   char *description;    /* bumpbake provenance or ImageDescription, malloc'd, or NULL */
 } bb_image_info;
 
@@ -526,7 +527,16 @@ typedef struct bb_image_info {
 void bb_image_info_free(bb_image_info *info);
 
 /* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
- * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
+ * (integer formats scaled to [0, 1] as value / max code), and of the engine
+ * textures it does not read: Valve's VTF (a .vtf name, or a file starting
+ * with "VTF\0": versions 7.0 to 7.5, frame 0 and face 0 of a flat texture;
+ * DXT1/3/5, ATI1N/2N, the 8-, 16- and 32-bit texel formats; alpha when the
+ * flags EIGHTBITALPHA or ONEBITALPHA say the texture has one; format_name
+ * "vtf", description the provenance of a 7.3+ KVD resource) and DDS (a
+ * file starting with "DDS ", read by bumpbake too, as OpenImageIO 2.4's
+ * reader crashes on hostile headers: DXT1 to DXT5, BC4, BC5, masked RGB,
+ * luminance and alpha, and with a DX10 header RGBA16F, RGBA32F and more;
+ * format_name "dds"); blocks are decoded by libsquish. info may be NULL.
  * The file must be a regular one (a FIFO, a device or a directory is
  * refused at once) and is read through the descriptor that was checked.
  * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
@@ -557,7 +567,8 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
                             bb_image_info *info, int *level_count, bb_error *err);
 
-/* Number of subimages (frames) in an image file. */
+/* Number of subimages (frames) in an image file (1 for a VTF or DDS: the
+ * frame read). */
 bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
 
 /* ------------------------------------------------------ writing images */

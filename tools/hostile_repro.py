@@ -120,6 +120,23 @@ def gif_screen(path, w, h):
     write(path, b)
 
 
+def vtf_header(path, w, h, fmt, mips):
+    """A VTF 7.2 header alone (80 bytes, no low-resolution image) declaring
+    w x h texels of Valve's format code fmt in `mips` levels."""
+    b = b"VTF\x00" + struct.pack("<III", 7, 2, 80) + struct.pack("<HHIHH", int(w), int(h), 0, 1, 0)
+    b += b"\x00" * 4 + struct.pack("<fff", 0.5, 0.5, 0.5) + b"\x00" * 4 + struct.pack("<f", 1.0)
+    b += struct.pack("<IBIBBH", int(fmt), int(mips), 0xFFFFFFFF, 0, 0, 1)
+    write(path, b + b"\x00" * (80 - len(b)))
+
+
+def dds_mips(path, mips):
+    """A 16 x 16 DXT1 DDS (legacy header) declaring `mips` mip levels, with
+    the top level's blocks."""
+    b = b"DDS " + struct.pack("<7I", 124, 0x000A1007, 16, 16, 128, 0, int(mips)) + b"\x00" * 44
+    b += struct.pack("<II4s5I", 32, 4, b"DXT1", 0, 0, 0, 0, 0) + struct.pack("<5I", 0x401008, 0, 0, 0, 0)
+    write(path, b + b"\x00" * 128)
+
+
 def png_chunk(kind, data):
     return struct.pack(">I", len(data)) + kind + data + struct.pack(
         ">I", zlib.crc32(kind + data) & 0xffffffff)
@@ -157,7 +174,7 @@ MAKERS = {
     "deep_dae": deep_dae, "deep_json": deep_json, "faces_obj": faces_obj,
     "flat_obj": flat_obj, "progressive_jpeg": progressive_jpeg, "tiled_tiff": tiled_tiff,
     "exr_attribute": exr_attribute, "gif_screen": gif_screen, "png_desc": png_desc,
-    "nan_tiff": nan_tiff,
+    "nan_tiff": nan_tiff, "vtf_header": vtf_header, "dds_mips": dds_mips,
 }
 
 

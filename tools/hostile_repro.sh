@@ -311,6 +311,8 @@ hdr_case 5a "a 126-byte progressive JPEG of 65500x65500" p.jpg progressive_jpeg 
 hdr_case 5b "a 1x1 TIFF of 16384x16384 tiles" t.tif tiled_tiff t.tif 1 1 16384 16384
 hdr_case 5c "a 91-byte EXR with a 2 GB string attribute" a.exr exr_attribute a.exr 2147483632
 hdr_case 5d "a 35-byte GIF of 65535x65535" g.gif gif_screen g.gif 65535 65535
+hdr_case 5e "an 80-byte VTF of 65535x65535 RGBA32323232F" v.vtf vtf_header v.vtf 65535 65535 29 1
+hdr_case 5f "a 16x16 DDS declaring 65029 mip levels" d.dds dds_mips d.dds 65029
 
 # -------------------------------------------- 6. outputs over what is read
 

@@ -117,7 +117,7 @@ Test(fuzz, cli_regressions) {
  * crashes are checked here, the allocations by `make fuzz`, which replays
  * them under its limits, and by tests/image/test_hostile_headers.c. */
 Test(fuzz, load_regressions) {
-  replay("load", bb_fuzz_load, 6);
+  replay("load", bb_fuzz_load, 8);
 }
 
 /* Models that read outside their directory or crashed Assimp: an OBJ whose
