@@ -33,7 +33,7 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR
+PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR libmicrohttpd
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 # libpng: src/io/png_hooks.c sets quiet error handlers and bounded
@@ -53,6 +53,10 @@ ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
+# libmicrohttpd: the HTTP server of `bumpbake serve` (src/cli/serve/ only,
+# linked into the CLI, not the library).
+MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
+MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
 LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
@@ -110,7 +114,12 @@ comma := ,
 FAMILIES := core io bake trace maps render mesh job
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
-CLI_C    := $(wildcard src/cli/*.c)
+CLI_C    := $(wildcard src/cli/*.c) $(wildcard src/cli/serve/*.c)
+# `bumpbake serve` (src/cli/serve.c, src/cli/serve/): the CLI's only HTTP
+# server, left out of the test binary and the fuzz targets.
+SERVE_C  := src/cli/serve.c $(wildcard src/cli/serve/*.c)
+# The page it serves, embedded into serve_page.o at build time.
+SERVE_ASSETS := $(wildcard share/serve/*) shaders/ssbump_relief.glsl
 TEST_C   := $(wildcard tests/*/test_*.c)
 TOOL_C   := $(wildcard tools/*.c)
 
@@ -121,7 +130,7 @@ TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
 # The fuzz targets' code, compiled into the test binary to replay the saved
 # regression inputs (tests/test_fuzz.c), with the CLI minus main().
 FUZZ_REPLAY_OBJ := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%.o,$(wildcard fuzz/fuzz_*.c))
-CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o,$(CLI_OBJ))
+CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o $(SERVE_C:%.c=$(BUILD)/%.o),$(CLI_OBJ))
 ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
 SHLIB    := $(BUILD)/$(SHLIB_REAL)
@@ -157,7 +166,8 @@ PYTHON   := /usr/bin/python3
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools ninja-build python3-distributed python3-dask strace time
+            openimageio-tools ninja-build python3-distributed python3-dask strace time \
+            libmicrohttpd-dev chromium chromium-driver python3-selenium
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -199,6 +209,8 @@ $(BUILD)/link.flags: FORCE
 
 $(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
+$(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(CLI_INCLUDES) $(MHD_CFLAGS)
+$(BUILD)/src/cli/serve/serve_page.o: $(SERVE_ASSETS)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
 $(BUILD)/%.o: %.c $(BUILD)/compile.flags
@@ -229,14 +241,14 @@ $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
 # (`make bench` measures both) and the installed binary finds no library at
 # run time but OpenImageIO's.
 $(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
 $(BUILD)/bench/bumpbake-early: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS) $(MHD_LIBS)
 $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
 
 # The tools print JSON with the CLI's one writer (src/cli/json.c).
 TOOL_JSON := $(BUILD)/src/cli/json.o
@@ -389,7 +401,7 @@ FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) $(TEST_I
 FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
 FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
 FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
-FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(CLI_C)))
+FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c $(SERVE_C),$(CLI_C)))
 # Per target: libFuzzer options beyond time and corpus.
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536
