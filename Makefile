@@ -144,7 +144,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles check-docs bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-circles check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -177,7 +177,8 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed' >/dev/null 2>&1; then :; \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium' >/dev/null 2>&1 \
+	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
@@ -309,7 +310,7 @@ test: ensure-deps
 # Everything `make test` runs: the Criterion suite, the install check, the
 # Python tests, the check that no two files need each other and the check
 # that the command reference and the man page say what --help says.
-check: check-unit check-install check-python check-circles check-docs
+check: check-unit check-install check-python check-serve check-circles check-docs
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -345,6 +346,16 @@ check-python: $(BIN) lib
 	cd python && BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) BB_BIN=$(abspath $(BIN)) \
 	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
 	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
+
+# `bumpbake serve` in headless Chromium (tests/serve/): the page draws, relights,
+# re-bakes on a save by rename and on a control, keeps the last maps after a
+# broken save, writes what `bumpbake bake` writes. Skipped, saying why,
+# without chromium, chromium-driver or python3-selenium. Screenshots:
+# build/serve-test/.
+check-serve: $(BIN)
+	@echo "serve: the page in headless Chromium (tests/serve)"
+	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
+	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
 
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)

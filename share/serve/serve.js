@@ -139,11 +139,25 @@ async function loadMaps(id) {
     if (!heightTexture) heightTexture = makeTexture(4);
     upload(4, gl.R8, gl.RED, w, h, height);
     maps = { id: ids[0], width: w, height: h };
+    fitCanvas();
     draw();
   } finally {
     loading = 0;
   }
   if (state && state.bake && state.bake.id > maps.id) loadMaps(state.bake.id);
+}
+
+// The picture keeps the maps' shape, its longer side 640 pixels.
+function fitCanvas() {
+  const tall = maps.height > maps.width;
+  const w = tall ? Math.round(640 * maps.width / maps.height) : 640;
+  const h = tall ? 640 : Math.round(640 * maps.height / maps.width);
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+    canvas.style.width = w + "px";
+    canvas.style.height = h + "px";
+  }
 }
 
 function requestDraw() {
