@@ -114,37 +114,66 @@ function upload(unit, internal, format, w, h, bytes) {
   gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, gl.UNSIGNED_BYTE, bytes);
 }
 
-// Fetches every texture of the last good bake; they must all be of one bake.
-async function loadMaps(id) {
-  loading = id;
-  try {
-    const replies = await Promise.all(TEXTURES.map((name) => fetch("map/" + name)));
-    for (const r of replies)
-      if (!r.ok) throw new Error("map: " + r.status + " " + (await r.text()));
-    const ids = replies.map((r) => Number(r.headers.get("X-Bake-Id")));
-    const w = Number(replies[0].headers.get("X-Width"));
-    const h = Number(replies[0].headers.get("X-Height"));
-    const data = await Promise.all(replies.map((r) => r.arrayBuffer()));
-    if (ids.some((x) => x !== ids[0])) {  // a bake landed in between: again
-      loading = 0;
-      return loadMaps(Math.max(...ids));
+// The textures each mode reads (serve.frag.glsl); the height texture is
+// made from normal_height's alpha.
+function texturesOf(mode) {
+  return { 0: ["ssbump_ao"], 3: ["ssbump_ao"], 6: ["ssbump_ao"], 4: ["bent"], 5: ["weights"] }[mode]
+         || ["ssbump_ao", "normal_height"];
+}
+
+// Fetches names of the last good bake; they must all be of one bake (id,
+// or any when id is 0). Returns {id, w, h, data} or null when a newer bake
+// landed in between.
+async function fetchMaps(names, id) {
+  const replies = await Promise.all(names.map((name) => fetch("map/" + name)));
+  for (const r of replies)
+    if (!r.ok) throw new Error("map: " + r.status + " " + (await r.text()));
+  const ids = replies.map((r) => Number(r.headers.get("X-Bake-Id")));
+  const data = await Promise.all(replies.map((r) => r.arrayBuffer()));
+  if (ids.some((x) => x !== ids[0]) || (id && ids[0] !== id)) return null;
+  return { id: ids[0], w: Number(replies[0].headers.get("X-Width")),
+           h: Number(replies[0].headers.get("X-Height")), data: data };
+}
+
+function uploadMaps(names, got) {
+  names.forEach((name, i) => {
+    const unit = TEXTURES.indexOf(name);
+    if (!textures[name]) textures[name] = makeTexture(unit);
+    upload(unit, gl.RGBA8, gl.RGBA, got.w, got.h, new Uint8Array(got.data[i]));
+    if (name === "normal_height") {
+      // the relief reads the height's first channel (ssbump_relief.glsl's relief_h)
+      const nh = new Uint8Array(got.data[i]), n = got.w * got.h, height = new Uint8Array(n);
+      for (let k = 0; k < n; k++) height[k] = nh[4 * k + 3];
+      if (!heightTexture) heightTexture = makeTexture(4);
+      upload(4, gl.R8, gl.RED, got.w, got.h, height);
     }
-    TEXTURES.forEach((name, unit) => {
-      if (!textures[name]) textures[name] = makeTexture(unit);
-      upload(unit, gl.RGBA8, gl.RGBA, w, h, new Uint8Array(data[unit]));
-    });
-    // the relief reads the height's first channel (ssbump_relief.glsl's relief_h)
-    const nh = new Uint8Array(data[1]), height = new Uint8Array(w * h);
-    for (let i = 0; i < w * h; i++) height[i] = nh[4 * i + 3];
-    if (!heightTexture) heightTexture = makeTexture(4);
-    upload(4, gl.R8, gl.RED, w, h, height);
-    maps = { id: ids[0], width: w, height: h };
-    fitCanvas();
-    draw();
+  });
+}
+
+// A new bake: first the textures the picture shown needs, drawn at once,
+// then the others (so a save shows as soon as its ssbump has arrived).
+async function loadMaps() {
+  loading = 1;
+  try {
+    for (;;) {
+      const first = texturesOf(Number($("mode").value));
+      const got = await fetchMaps(first, 0);
+      if (!got) continue;  // a bake landed in between: again
+      const rest = TEXTURES.filter((t) => !first.includes(t));
+      uploadMaps(first, got);
+      maps = { id: got.id, width: got.w, height: got.h };
+      fitCanvas();
+      draw();
+      const others = await fetchMaps(rest, got.id);
+      if (others) uploadMaps(rest, others);
+      else continue;  // newer maps already: load them whole
+      draw();
+      break;
+    }
   } finally {
     loading = 0;
   }
-  if (state && state.bake && state.bake.id > maps.id) loadMaps(state.bake.id);
+  if (state && state.bake && state.bake.id > maps.id) loadMaps();
 }
 
 // The picture keeps the maps' shape, its longer side 640 pixels.
@@ -233,7 +262,7 @@ function showState(s) {
     $("provenance").textContent = b.provenance;
     if (b.basis_count !== 3) fail("the maps are in a basis of " + b.basis_count +
                                   " directions: the page lights Half-Life 2's 3");
-    if ((!maps || b.id > maps.id) && !loading) loadMaps(b.id).catch((e) => fail(String(e)));
+    if ((!maps || b.id > maps.id) && !loading) loadMaps().catch((e) => fail(String(e)));
   }
   requestDraw();
 }
