@@ -7,7 +7,9 @@
 #include "options.h"
 #include "serve/serve.h"
 
+#include <arpa/inet.h>
 #include <limits.h>
+#include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,7 +51,13 @@ static int serve_option(void *ctx, const cli_option *opt, const char *arg) {
   serve_args *a = ctx;
   switch (opt->id) {
   case SERVE_OPT_PORT: return cli_parse_int("serve", "--port", arg, 0, 65535, &a->port);
-  case SERVE_OPT_ADDRESS: a->address = arg; return 0;
+  case SERVE_OPT_ADDRESS: {
+    unsigned char any[sizeof(struct in6_addr)];
+    if (inet_pton(AF_INET, arg, any) != 1 && inet_pton(AF_INET6, arg, any) != 1)
+      return cli_usage_error("serve", "--address: '%s' is not an IPv4 or IPv6 address", arg);
+    a->address = arg;
+    return 0;
+  }
   case CLI_OPT_QUIET: a->quiet = 1; return 0;
   default: break;
   }
@@ -153,12 +161,17 @@ int bb_cli_serve(int argc, char **argv) {
     if (also[i])
       s.watched[s.watched_count++] = also[i];
 
+  /* A height that cannot be read at all is a mistake on the command line,
+   * not a save to wait for (a broken save later keeps the page going). */
+  bb_error err = {{0}};
+  bb_status st = bb_image_read_info(height, NULL, NULL, NULL, NULL, &err);
+  if (st != BB_OK)
+    return cli_status_exit(height, st, &err);
   /* The options and files checked once by the library before serving. */
   bb_job_options o;
   serve_job_options(&s, &o);
   bb_job *job = NULL;
-  bb_error err = {{0}};
-  bb_status st = bb_job_plan(&height, 1, &o, &job, &err);
+  st = bb_job_plan(&height, 1, &o, &job, &err);
   bb_job_free(job);
   if (st != BB_OK)
     return cli_library_error("serve", st, &err);

@@ -4,6 +4,7 @@
  * runs, nothing written), then publishes the maps as the page's textures.
  * A newer request cancels the bake in flight through the progress
  * callback; a failure keeps the last good maps and shows why. */
+#include "common.h"
 #include "serve.h"
 
 #include <math.h>
@@ -189,8 +190,11 @@ static void bake_once(serve_state *s, long wanted) {
     /* the last good maps stay on the page, with why the new ones are not */
     snprintf(s->error, sizeof s->error, "%s",
              err.message[0] ? err.message : bb_status_name(st));
-    if (!s->quiet)
-      fprintf(stderr, "serve: %s (the last good maps stay on the page)\n", s->error);
+    if (!s->quiet) {
+      char line[1200];
+      snprintf(line, sizeof line, "%s (the last good maps stay on the page)", s->error);
+      cli_error_line(line); /* control characters escaped */
+    }
   }
   s->version++;
   pthread_cond_broadcast(&s->changed);
