@@ -60,7 +60,8 @@ def main():
     served = os.path.join(work, "height.png")
     variant = os.path.join(work, "variant.png")
     subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
-                    "--base", os.path.dirname(os.path.abspath(a.height)), "-o", variant],
+                    "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
+                    "-o", variant],
                    check=True, stdout=subprocess.DEVNULL)
     with open(a.height, "rb") as f:
         original = f.read()
@@ -97,10 +98,10 @@ def main():
             t_render = run([binary, "render", "--ssbump", prefix + "_ssbump.png", "-o",
                             os.path.join(work, "cold_render.png"), "--quiet"])
             cold.append((t_bake, t_render))
-            print("save %2d: %.3f s to pixels; the bake inside serve %.3f s (trace %.3f s); "
-                  "cold bake %.3f s + render %.3f s"
-                  % (i + 1, latencies[-1], bake["seconds"], bake["seconds_trace"], t_bake,
-                     t_render))
+            print("save %2d: %.3f s to pixels; the bake inside serve %.3f s (trace %.3f s, "
+                  "textures %.3f s); cold bake %.3f s + render %.3f s"
+                  % (i + 1, latencies[-1], bake["seconds"], bake["seconds_trace"],
+                     bake["seconds_textures"], t_bake, t_render))
     finally:
         sb.stop_browser(driver)
         server.close()

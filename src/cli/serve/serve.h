@@ -30,6 +30,7 @@ typedef struct serve_bake {
   int width, height;
   unsigned char *tex[SERVE_TEX_COUNT];
   double seconds;          /* from the start of the bake to its textures */
+  double seconds_textures; /* the page's textures made from the maps */
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */

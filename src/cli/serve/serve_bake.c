@@ -160,7 +160,9 @@ static void bake_once(serve_state *s, long wanted) {
   }
   if (st == BB_OK) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
+    const double t1 = now_seconds();
     if ((b = make_textures(&result, rep->width, rep->height))) {
+      b->seconds_textures = now_seconds() - t1;
       b->report = *rep;
       b->report.input = NULL;
       b->command = bb_job_command_text(&o, input);

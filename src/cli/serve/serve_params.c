@@ -39,6 +39,7 @@ static void add_bake(cli_json *j, const serve_bake *b) {
   cli_json_number(j, "seconds_pyramid", r->seconds_pyramid);
   cli_json_number(j, "seconds_trace", r->seconds_trace);
   cli_json_number(j, "seconds_derive", r->seconds_derive);
+  cli_json_number(j, "seconds_textures", b->seconds_textures);
   cli_json_int(j, "threads", r->threads);
   cli_json_int(j, "slices", r->slices);
   cli_json_bool(j, "normal_y_up", b->normal_y_up);
