@@ -393,7 +393,8 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
   sv.daemon = MHD_start_daemon(flags, (uint16_t)o->port, NULL, NULL, handle, &sv,
                                MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
                                MHD_OPTION_CONNECTION_LIMIT, (unsigned)64,
-                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)0, MHD_OPTION_END);
+                               /* an idle connection goes after 60 s; events send every 15 s */
+                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)60, MHD_OPTION_END);
   if (!sv.daemon) {
     snprintf(url, cap, "cannot listen on %s port %d: %s", address, o->port,
              errno ? strerror(errno) : "libmicrohttpd refused");
