@@ -134,14 +134,17 @@ static const cli_option opt_brightness = {
     .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights "
             "(a texel over 1 is scaled down whole)"};
 
+/* The bake's parameters and its outputs one by one: bake's and serve's. */
+#define BAKE_PARAMETER_ROWS                                                              \
+  &cli_opt_scale, &cli_opt_rays, &opt_slices, &cli_opt_filter_radius,                    \
+      &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,          \
+      &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,       \
+      &cli_opt_channel, &cli_opt_depth, &cli_opt_mips, &opt_bounce, &opt_bounces,        \
+      &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights,            \
+      &opt_out_ssbump, &opt_out_ao, &opt_out_bent, &opt_out_filtered
+
 static const cli_option *const bake_options[] = {
-    &cli_opt_scale,    &cli_opt_rays,      &opt_slices,       &cli_opt_filter_radius,
-    &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,
-    &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,
-    &cli_opt_channel,  &cli_opt_depth,     &cli_opt_mips,     &opt_bounce,
-    &opt_bounces,      &opt_bounce_albedo, &opt_brightness,   &opt_out_normal,
-    &opt_out_weights,  &opt_out_ssbump,    &opt_out_ao,       &opt_out_bent,
-    &opt_out_filtered, &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
+    BAKE_PARAMETER_ROWS,  &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
     &opt_out_dir,      &opt_maps,          &opt_name,         &opt_keep_going,
     &opt_force,        &opt_depfile,       &opt_json,         &opt_quiet,
     CLI_TEXTURE_OPTIONS, &cli_opt_vmt,     &cli_opt_materials, &cli_opt_basetexture,
@@ -213,13 +216,7 @@ void cli_bake_settings_to_job(const cli_settings *s, bb_job_options *job) {
 }
 
 const cli_option *const cli_bake_parameter_rows[] = {
-    &cli_opt_scale,    &cli_opt_rays,      &opt_slices,       &cli_opt_filter_radius,
-    &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,
-    &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,
-    &cli_opt_channel,  &cli_opt_depth,     &cli_opt_mips,     &opt_bounce,
-    &opt_bounces,      &opt_bounce_albedo, &opt_brightness,   &opt_out_normal,
-    &opt_out_weights,  &opt_out_ssbump,    &opt_out_ao,       &opt_out_bent,
-    &opt_out_filtered, &opt_prefix,        CLI_TEXTURE_OPTIONS,
+    BAKE_PARAMETER_ROWS, &opt_prefix, CLI_TEXTURE_OPTIONS,
 };
 const int cli_bake_parameter_row_count =
     (int)(sizeof cli_bake_parameter_rows / sizeof cli_bake_parameter_rows[0]);

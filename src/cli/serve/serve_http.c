@@ -7,6 +7,7 @@
  * those that change something must carry an X-Bumpbake header (which a
  * page of another origin cannot send without asking first); with
  * --address, every path also starts with a random token. */
+#include "job_json.h"
 #include "json.h"
 #include "serve.h"
 
@@ -260,7 +261,8 @@ static enum MHD_Result apply_params(server *sv, struct MHD_Connection *c) {
 }
 
 /* POST write: the maps written through the job, as the `bumpbake bake`
- * line the page shows would write them. */
+ * line the page shows would write them; the reply is the line `bake
+ * --json` prints. */
 static enum MHD_Result write_maps(server *sv, struct MHD_Connection *c) {
   bb_job_options o;
   pthread_mutex_lock(&sv->s->lock);
@@ -280,26 +282,13 @@ static enum MHD_Result write_maps(server *sv, struct MHD_Connection *c) {
     return send_error(c, 422,
                       err.message[0] ? err.message : bb_status_name(st));
   }
+  /* what `bumpbake bake --json` prints of it */
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
   if (f) {
-    const bb_job_report *r = bb_job_report_get(job, 0);
-    char *command = bb_job_command_text(&o, input);
-    cli_json j = {f, 0};
-    cli_json_open(&j, NULL, '{');
-    cli_json_string(&j, "command", command);
-    cli_json_open(&j, "outputs", '[');
-    for (int i = 0; i < r->output_count; i++) {
-      cli_json_open(&j, NULL, '{');
-      cli_json_string(&j, "kind", r->outputs[i].kind);
-      cli_json_string(&j, "path", r->outputs[i].path);
-      cli_json_close(&j, '}');
-    }
-    cli_json_close(&j, ']');
-    cli_json_close(&j, '}');
+    cli_job_json_to(f, &o.bake, bb_job_report_get(job, 0), "written");
     fclose(f);
-    free(command);
   }
   bb_job_free(job);
   return send_json(c, MHD_HTTP_OK, text);
