@@ -39,9 +39,9 @@ void main() {
     vec2 uv = (p + 0.5) / uSize;
     vec3 rgb;
     if (uMode == 8) {
-        // render's view_pixel: the picture of the tiled maps seen by the camera
-        vec2 q = screen * extent;
-        float si = q.x - 0.5 * extent.x, sj = (q.y - 0.5 * extent.y) * uStretch;
+        // render's view_pixel: the picture of the tiled maps seen by the
+        // camera, its pixel (i, j) at the point p = (i, j)
+        float si = p.x - 0.5 * extent.x, sj = (p.y - 0.5 * extent.y) * uStretch;
         vec2 point = 0.5 * extent + si * uRight + sj * uToward;
         rgb = ssbump_relief_shade(uHeight, uSsbumpAo, uSize, point, uView, uDepth, uLight,
                                   vec3(1.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(1.0),
