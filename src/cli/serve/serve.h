@@ -17,20 +17,23 @@
 enum {
   SERVE_TEX_SSBUMP_AO,     /* ssbump s_0..s_2 in RGB, ao in A */
   SERVE_TEX_NORMAL_HEIGHT, /* the normal (N + 1) / 2 in RGB, the smoothed height in A */
-  SERVE_TEX_BENT_WEIGHTS,  /* the bent normal (Nb + 1) / 2 in RGB, A 255 */
+  SERVE_TEX_BENT,          /* the bent normal (Nb + 1) / 2 in RGB, A 255 */
   SERVE_TEX_WEIGHTS,       /* the basis weights w_0..w_2 in RGB, A 255 */
   SERVE_TEX_COUNT
 };
 
-/* One finished bake: never changed once published, freed with its last
+/* One finished bake: published at once, its textures made when first
+ * asked (the picture shown asks for one first), freed with its last
  * reference (a response may still be sending it when a newer one lands). */
 typedef struct serve_bake {
   int refs; /* under serve_state.lock */
   long id;
   int width, height;
-  unsigned char *tex[SERVE_TEX_COUNT];
-  double seconds;          /* from the start of the bake to its textures */
-  double seconds_textures; /* the page's textures made from the maps */
+  pthread_mutex_t tex_lock;            /* makes tex[] and frees maps */
+  unsigned char *tex[SERVE_TEX_COUNT]; /* NULL until asked */
+  bb_bake_result maps;                 /* the bake's maps, until every texture is made */
+  double seconds;          /* from the start of the bake to its maps */
+  double seconds_textures; /* making the textures asked so far */
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */
@@ -73,6 +76,9 @@ void *serve_bake_thread(void *state);
 void serve_request_bake(serve_state *s);
 /* Drops one reference; the caller holds the lock. */
 void serve_bake_release(serve_bake *b);
+/* Texture t of b (4 x width x height bytes), made on first use; NULL when
+ * out of memory. Any thread, with a reference held. */
+const unsigned char *serve_bake_texture(serve_bake *b, int t);
 /* The job options a bake or a write uses now (the caller holds the lock). */
 void serve_job_options(const serve_state *s, bb_job_options *o);
 

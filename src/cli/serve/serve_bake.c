@@ -1,7 +1,8 @@
 /* serve_bake.c: `bumpbake serve`'s bake thread: whenever a save or a
  * control asks, plans the job of the current options and bakes its input
  * through it (bb_job_bake_item: the very read and bake `bumpbake bake`
- * runs, nothing written), then publishes the maps as the page's textures.
+ * runs, nothing written), then publishes the maps, which become the
+ * page's 8-bit textures as the page asks for them.
  * A newer request cancels the bake in flight through the progress
  * callback; a failure keeps the last good maps and shows why. */
 #include "common.h"
@@ -29,6 +30,8 @@ void serve_bake_release(serve_bake *b) {
     return;
   for (int t = 0; t < SERVE_TEX_COUNT; t++)
     free(b->tex[t]);
+  bb_bake_result_free(&b->maps);
+  pthread_mutex_destroy(&b->tex_lock);
   free(b->provenance);
   free(b->command);
   free(b);
@@ -95,25 +98,29 @@ static void fill(unsigned char *tex, size_t n, const bb_image *img, int is_vecto
   }
 }
 
-static serve_bake *make_textures(const bb_bake_result *r, int w, int h) {
-  serve_bake *b = calloc(1, sizeof *b);
-  if (!b)
-    return NULL;
-  b->refs = 1;
-  b->width = w;
-  b->height = h;
-  const size_t n = (size_t)w * (size_t)h;
-  for (int t = 0; t < SERVE_TEX_COUNT; t++)
-    if (!(b->tex[t] = malloc(4 * n))) {
-      serve_bake_release(b);
-      return NULL;
+const unsigned char *serve_bake_texture(serve_bake *b, int t) {
+  pthread_mutex_lock(&b->tex_lock);
+  if (!b->tex[t]) {
+    const double t0 = now_seconds();
+    const size_t n = (size_t)b->width * (size_t)b->height;
+    const bb_bake_result *r = &b->maps;
+    if ((b->tex[t] = malloc(4 * n))) {
+      switch (t) {
+      case SERVE_TEX_SSBUMP_AO: fill(b->tex[t], n, &r->ssbump, 0, &r->ao); break;
+      case SERVE_TEX_NORMAL_HEIGHT: fill(b->tex[t], n, &r->normal, 1, &r->filtered); break;
+      case SERVE_TEX_BENT: fill(b->tex[t], n, &r->bent, 1, NULL); break;
+      default: fill(b->tex[t], n, &r->weights, 0, NULL); break;
+      }
     }
-  fill(b->tex[SERVE_TEX_SSBUMP_AO], n, &r->ssbump, 0, &r->ao);
-  fill(b->tex[SERVE_TEX_NORMAL_HEIGHT], n, &r->normal, 1, &r->filtered);
-  fill(b->tex[SERVE_TEX_BENT_WEIGHTS], n, &r->bent, 1, NULL);
-  fill(b->tex[SERVE_TEX_WEIGHTS], n, &r->weights, 0, NULL);
-  b->basis_count = r->basis.count;
-  return b;
+    int all = 1;
+    for (int k = 0; k < SERVE_TEX_COUNT; k++)
+      all &= b->tex[k] != NULL;
+    if (all) /* the floats are not needed any more */
+      bb_bake_result_free(&b->maps);
+    b->seconds_textures += now_seconds() - t0;
+  }
+  pthread_mutex_unlock(&b->tex_lock);
+  return b->tex[t];
 }
 
 /* The ssbump's provenance as the job records it in the file it writes. */
@@ -160,9 +167,14 @@ static void bake_once(serve_state *s, long wanted) {
   }
   if (st == BB_OK) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
-    const double t1 = now_seconds();
-    if ((b = make_textures(&result, rep->width, rep->height))) {
-      b->seconds_textures = now_seconds() - t1;
+    if ((b = calloc(1, sizeof *b))) {
+      b->refs = 1;
+      b->width = rep->width;
+      b->height = rep->height;
+      pthread_mutex_init(&b->tex_lock, NULL);
+      b->maps = result; /* kept for the textures */
+      memset(&result, 0, sizeof result);
+      b->basis_count = b->maps.basis.count;
       b->report = *rep;
       b->report.input = NULL;
       b->command = bb_job_command_text(&o, input);
@@ -171,7 +183,7 @@ static void bake_once(serve_state *s, long wanted) {
       b->seconds = now_seconds() - t0;
     } else {
       st = BB_ERR_MEMORY;
-      snprintf(err.message, sizeof err.message, "out of memory for the page's textures");
+      snprintf(err.message, sizeof err.message, "out of memory");
     }
   }
   bb_bake_result_free(&result);

@@ -122,7 +122,11 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c, const 
     free(r);
     return send_text(c, MHD_HTTP_SERVICE_UNAVAILABLE, "no bake yet");
   }
-  r->data = r->bake->tex[t];
+  r->data = serve_bake_texture(r->bake, t); /* made on first use */
+  if (!r->data) {
+    texture_free(r);
+    return send_text(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "out of memory");
+  }
   const uint64_t size = 4 * (uint64_t)r->bake->width * (uint64_t)r->bake->height;
   char id[32], w[16], h[16];
   snprintf(id, sizeof id, "%ld", r->bake->id);

@@ -27,7 +27,7 @@ static void add_params(cli_json *j, const serve_state *s) {
   cli_json_close(j, '}');
 }
 
-static void add_bake(cli_json *j, const serve_bake *b) {
+static void add_bake(cli_json *j, serve_bake *b) {
   cli_json_open(j, "bake", '{');
   cli_json_int(j, "id", b->id);
   cli_json_int(j, "width", b->width);
@@ -39,7 +39,10 @@ static void add_bake(cli_json *j, const serve_bake *b) {
   cli_json_number(j, "seconds_pyramid", r->seconds_pyramid);
   cli_json_number(j, "seconds_trace", r->seconds_trace);
   cli_json_number(j, "seconds_derive", r->seconds_derive);
-  cli_json_number(j, "seconds_textures", b->seconds_textures);
+  pthread_mutex_lock(&b->tex_lock);
+  const double textures = b->seconds_textures;
+  pthread_mutex_unlock(&b->tex_lock);
+  cli_json_number(j, "seconds_textures", textures);
   cli_json_int(j, "threads", r->threads);
   cli_json_int(j, "slices", r->slices);
   cli_json_bool(j, "normal_y_up", b->normal_y_up);
