@@ -164,3 +164,33 @@ def test_a_newer_control_cancels_the_bake_in_flight(tmp_path):
     # serve said nothing of the cancelled bake but the bake that was shown
     err = s.proc.stderr.read()
     assert err.count("serve: bake") == 1, err
+
+
+def test_the_brightness_map_switches_on_and_off(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "b.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"),
+                  ["--scale", "8", "--rays", "16", "--brightness", str(tmp_path / "b.png"),
+                   "--quiet"])
+    try:
+        st = wait_bake(s, 0, "the first bake")
+        assert st["params"]["brightness"] and "--brightness" in st["command"]
+        assert "--brightness" in st["bake"]["command"]
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=off")
+        assert status == 200
+        st = wait_bake(s, st["bake"]["id"], "the bake without it")
+        assert not st["params"]["brightness"] and "--brightness" not in st["bake"]["command"]
+        # a save of the brightness map bakes again too (it is watched)
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=on")
+        st = wait_bake(s, st["bake"]["id"], "the bake with it")
+        with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+            sb.save_by_rename(f.read(), str(tmp_path / "b.png"))
+        wait_bake(s, st["bake"]["id"], "the bake after the brightness map's save")
+    finally:
+        s.close()
+    s = sb.Server(BIN, str(tmp_path / "h.png"), ["--scale", "8", "--rays", "16", "--quiet"])
+    try:
+        status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=on")
+        assert status == 400 and "no --brightness FILE" in json.loads(body)["error"]
+    finally:
+        s.close()
