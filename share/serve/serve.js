@@ -17,6 +17,7 @@ let maps = null;          // {id, width, height} of the textures loaded
 let state = null;         // the server's last state
 let loading = 0;          // the bake id being fetched, 0 when none
 let drawPending = false;
+const bakeScale = {};      // each bake's --scale by id: the depth of its relief
 
 function fail(message) {
   $("error").textContent = message;
@@ -216,7 +217,7 @@ function draw() {
   gl.uniform2f(uniforms.uToward, toward[0], toward[1]);
   gl.uniform2f(uniforms.uRight, toward[1], -toward[0]);
   gl.uniform1f(uniforms.uStretch, 1 / view[2]);
-  gl.uniform1f(uniforms.uDepth, state ? state.params.scale : 1);
+  gl.uniform1f(uniforms.uDepth, bakeScale[maps.id] || (state ? state.params.scale : 1));
   gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
   gl.finish();
   document.body.dataset.drawnBake = String(maps.id);
@@ -255,6 +256,7 @@ function showState(s) {
   $("p-brightness").checked = s.params.brightness;
   if (s.bake) {
     const b = s.bake;
+    bakeScale[b.id] = b.scale;
     $("times").textContent = `${b.width} x ${b.height}, ${b.slices} slices, ${b.threads} threads: ` +
       `${b.seconds.toFixed(3)} s (load ${b.seconds_load.toFixed(3)}, smooth ${b.seconds_smooth.toFixed(3)}, ` +
       `pyramid ${b.seconds_pyramid.toFixed(3)}, trace ${b.seconds_trace.toFixed(3)}, ` +

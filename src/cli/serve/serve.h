@@ -38,6 +38,7 @@ typedef struct serve_bake {
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */
   int normal_y_up, basis_count;
+  double scale;            /* the bake's --scale: the relief's depth */
 } serve_bake;
 
 /* The watched files: the height and the maps the options read. */

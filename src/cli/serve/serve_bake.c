@@ -180,6 +180,7 @@ static void bake_once(serve_state *s, long wanted) {
       b->command = bb_job_command_text(&o, input);
       b->provenance = provenance_of(&o, rep, &result, b->command, input);
       b->normal_y_up = o.bake.normal_y_up;
+      b->scale = (double)o.bake.height_scale;
       b->seconds = now_seconds() - t0;
     } else {
       st = BB_ERR_MEMORY;

@@ -45,6 +45,7 @@ static void add_bake(cli_json *j, serve_bake *b) {
   cli_json_number(j, "seconds_textures", textures);
   cli_json_int(j, "threads", r->threads);
   cli_json_int(j, "slices", r->slices);
+  cli_json_number(j, "scale", b->scale);
   cli_json_bool(j, "normal_y_up", b->normal_y_up);
   cli_json_int(j, "basis_count", b->basis_count);
   cli_json_string(j, "command", b->command);
