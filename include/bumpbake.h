@@ -2377,6 +2377,18 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
  * job, one thread at a time. */
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 
+/* Reads and bakes input i exactly as bb_job_run_item does, but writes
+ * nothing and keeps the maps: the job's kinds and those in `also`
+ * (BB_OUTPUT_BITs; the maps of the job's kinds are the bits
+ * bb_job_run_item would write) go to *result, to be freed with
+ * bb_bake_result_free. Fills the report's figures (size, source, threads,
+ * slices, seconds) and leaves its outcome alone; for a live view of an
+ * input that changes (bumpbake serve). progress (may be NULL) may cancel:
+ * BB_ERR_CANCELLED, nothing kept. err names the input. Thread-compatible
+ * as bb_job_run_item. */
+bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
+                           void *progress_user, bb_bake_result *result, bb_error *err);
+
 /* Called after each input of bb_job_run with its report. */
 typedef void (*bb_job_report_fn)(void *user, const bb_job_report *report);
 

@@ -21,7 +21,9 @@
 # machine (tools/bench_cluster.sh batch big: 200 maps of 512 x 512 as a CLI
 # batch, two half batches and bumpbake.dask.bake_files; one 8192 x 8192 map
 # in one process and split over 2 workers; `make bench-cluster` runs it
-# alone, with 16384 x 16384 too), then a summary table.
+# alone, with 16384 x 16384 too), 12 `bumpbake serve`'s save-to-pixels
+# latency in headless Chromium against the cold bake + render pair
+# (tools/bench_serve.py), then a summary table.
 # Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -44,6 +46,7 @@
 #                          tools/bench_bounce.sh)
 #   BENCH_CLUSTER=0        skip section 11 (about 15 minutes and 3 GB of
 #                          files in build/bench/cluster)
+#   BENCH_SERVE=0          skip section 12
 #   BENCH_SECTIONS="9 10"  run only the sections listed (default: every one);
 #                          the summary then has only their figures
 #
@@ -669,6 +672,15 @@ if want 11; then
     echo "skipped (BENCH_CLUSTER=0)"
   elif ! tools/bench_cluster.sh batch big "$bin" | tee "$out/cluster.txt"; then
     fail "tools/bench_cluster.sh failed"
+  fi
+fi
+
+if want 12; then
+  section "12. bumpbake serve: save-to-pixels in headless Chromium (tools/bench_serve.py)"
+  if [ "${BENCH_SERVE:-1}" = 0 ]; then
+    echo "skipped (BENCH_SERVE=0)"
+  elif ! /usr/bin/python3 tools/bench_serve.py "$bin" | tee "$out/serve.txt"; then
+    fail "tools/bench_serve.py failed"
   fi
 fi
 

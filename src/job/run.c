@@ -241,35 +241,37 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   return st;
 }
 
-static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progress,
-                           void *progress_user, bb_error *err) {
+/* Reads item's input and bakes it (the job's outputs and the kinds in also),
+ * filling its report's figures; writes nothing. */
+static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
+                               bb_progress_fn progress, void *progress_user, baked *b,
+                               bb_error *err) {
   bb_job_report *r = &item->report;
-  baked b;
-  memset(&b, 0, sizeof b);
   const double t0 = bb__now_seconds();
   bb_status st = bb__job_memory_check(job, item, err);
   if (st == BB_OK)
     st = bb_height_file_read(item->input, job->options.channel,
                              job->options.bake.height_scale, job->options.note,
-                             job->options.note_user, &b.height, &r->source, err);
+                             job->options.note_user, &b->height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
-  const int height_width = b.height.width, height_height = b.height.height;
+  const int height_width = b->height.width, height_height = b->height.height;
   if (st == BB_OK) {
     bb_bake_options o = job->options.bake;
+    o.outputs |= also;
     o.trace.progress = progress;
     o.trace.progress_user = progress_user;
     bb_error bake_err = {{0}};
-    /* only the maps are written: the bake lets the height and vis go as
-     * soon as it is done with them */
-    st = bb__bake(&b.height, &o, BB__BAKE_DROP_VIS | BB__BAKE_TAKE_HEIGHT, &b.result,
+    /* only the maps are kept: the bake lets the height and vis go as soon
+     * as it is done with them */
+    st = bb__bake(&b->height, &o, BB__BAKE_DROP_VIS | BB__BAKE_TAKE_HEIGHT, &b->result,
                   &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
   if (st == BB_OK && job->slope_path)
-    st = make_slope(job, item, &b, err);
+    st = make_slope(job, item, b, err);
   if (st == BB_OK) {
-    const bb_bake_result *res = &b.result;
+    const bb_bake_result *res = &b->result;
     r->width = height_width;
     r->height = height_height;
     r->threads = res->threads;
@@ -280,7 +282,35 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
     r->seconds_pyramid = res->seconds_pyramid;
     r->seconds_trace = res->seconds_trace;
     r->seconds_derive = res->seconds_derive;
+  }
+  return st;
+}
+
+static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progress,
+                           void *progress_user, bb_error *err) {
+  baked b;
+  memset(&b, 0, sizeof b);
+  bb_status st = read_and_bake(job, item, 0u, progress, progress_user, &b, err);
+  if (st == BB_OK)
     st = write_item(job, item, &b, err);
+  baked_free(&b);
+  return st;
+}
+
+bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
+                           void *progress_user, bb_bake_result *result, bb_error *err) {
+  if (result)
+    memset(result, 0, sizeof *result);
+  if (!job || i < 0 || i >= job->count || !result)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job bake: bad arguments");
+  if (also & ~(unsigned)BB_OUTPUTS_ALL)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job bake: unknown map bits 0x%x", also);
+  baked b;
+  memset(&b, 0, sizeof b);
+  bb_status st = read_and_bake(job, &job->items[i], also, progress, progress_user, &b, err);
+  if (st == BB_OK) {
+    *result = b.result; /* the maps change hands */
+    memset(&b.result, 0, sizeof b.result);
   }
   baked_free(&b);
   return st;
