@@ -20,7 +20,8 @@ void bb__directory_part(const char *path, char *dir, size_t cap);
 const char *bb__extension(const char *path, char *buf, size_t cap);
 
 /* BB_OK when path's directory exists and is a directory and path itself is
- * not a directory; else BB_ERR_IO "PATH: cannot write: ...". */
+ * nothing yet or a regular file (bb__safe_check_target); else BB_ERR_IO
+ * "PATH: cannot write: ...". */
 bb_status bb__check_output_directory(const char *path, bb_error *err);
 
 /* --------------------------------------------------------------- depfiles */

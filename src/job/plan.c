@@ -4,6 +4,7 @@
  * other, against every input and against the depfile, so a clash or a bad
  * name costs no baking time. */
 #include "core/internal.h"
+#include "io/safe_file.h"
 #include "job/job_internal.h"
 
 #include <dirent.h>
@@ -495,6 +496,13 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
   none.targets = self;
   none.target_count = 1;
   bb_status st = bb__depfile_check_names(path, &none, 1, err);
+  if (st == BB_OK && bb__safe_is_stream(path)) {
+    /* /dev/stdout on a pipe or terminal, a FIFO, /dev/null: written
+     * through (run.c), not replaced. */
+    if (access(path, W_OK) != 0)
+      st = bb__fail(err, BB_ERR_IO, "%s: cannot write the depfile: %s", path, strerror(errno));
+    return st;
+  }
   if (st == BB_OK)
     st = bb__check_output_directory(path, err);
   if (st == BB_OK) {

@@ -4,6 +4,7 @@
 #include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
+#include "io/safe_file.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>
@@ -174,8 +175,35 @@ static bb__dep_rule rule_of(const bb_job *job, const bb__job_item *item, const c
   return (bb__dep_rule){targets, t, prereq, bb__job_reads(job, item, prereq)};
 }
 
+/* The depfile's text written: replacing a file whole, or through a stream
+ * (bb__safe_is_stream: /dev/stdout, a FIFO) as it is; on failure the
+ * message ends with what was written before. */
+static bb_status write_depfile_text(const char *path, const char *text, size_t size,
+                                    const char *written, bb_error *err) {
+  bb_error local = {{0}};
+  bb_status st = bb__safe_is_stream(path) ? bb__safe_write_through(path, text, size, &local)
+                                          : bb_file_write(path, text, size, &local);
+  if (st != BB_OK)
+    bb__fail(err, st, "%s; %s", local.message, written);
+  return st;
+}
+
+/* A single input's depfile on its own, after its maps. */
+static bb_status write_depfile(const bb_job *job, const bb__job_item *item, const char *written,
+                               bb_error *err) {
+  const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
+  bb__dep_rule rule = rule_of(job, item, targets, prereq);
+  size_t size = 0;
+  char *text = bb__depfile_text(&rule, 1, &size);
+  bb_status st = text ? write_depfile_text(job->depfile, text, size, written, err)
+                      : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
+  free(text);
+  return st;
+}
+
 /* The files of one input: its maps, the slope files, and a single input's
- * depfile, written together. */
+ * depfile, written together (a depfile written through a stream comes
+ * after them). */
 static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error *err) {
   bb_job_report *r = &item->report;
   char *command = bb__job_command_of(job, item);
@@ -223,7 +251,8 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   if (st == BB_OK && job->vmt)
     files[n++] = (bb_output_file){job->vmt, "material", NULL, BB_RANGE_UNIT, BB_DEPTH_DEFAULT,
                                   0, NULL, job->vmt_text, job->vmt_size, NULL};
-  if (st == BB_OK && job->depfile && !job->batch) {
+  const int depfile_stream = job->depfile && !job->batch && bb__safe_is_stream(job->depfile);
+  if (st == BB_OK && job->depfile && !job->batch && !depfile_stream) {
     /* One input's depfile goes in with its maps: all of them or none. */
     const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
     bb__dep_rule rule = rule_of(job, item, targets, prereq);
@@ -237,6 +266,8 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   const double t0 = bb__now_seconds();
   if (st == BB_OK)
     st = bb_outputs_write(files, n, b->result.threads, err);
+  if (st == BB_OK && depfile_stream)
+    st = write_depfile(job, item, "the maps were written", err);
   r->seconds_write = bb__now_seconds() - t0;
   return st;
 }
@@ -339,11 +370,10 @@ bb_status bb_job_write_depfile(bb_job *job, bb_error *err) {
   if (st == BB_OK && !text)
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
   if (st == BB_OK) {
-    bb_error local = {{0}};
-    st = bb_file_write(job->depfile, text, size, &local);
-    if (st != BB_OK)
-      bb__fail(err, st, "%s; the maps of %d input%s baked were written", local.message, baked_inputs,
-               baked_inputs == 1 ? "" : "s");
+    char written[64];
+    snprintf(written, sizeof written, "the maps of %d input%s baked were written", baked_inputs,
+             baked_inputs == 1 ? "" : "s");
+    st = write_depfile_text(job->depfile, text, size, written, err);
   }
   free(text);
   free(targets);

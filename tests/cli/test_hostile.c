@@ -12,7 +12,9 @@
 #include "cli_harness.h"
 #include "printed_text.h"
 
+#include <fcntl.h>
 #include <math.h>
+#include <sys/sysmacros.h>
 
 TestSuite(hostile, .init = harness_setup, .fini = harness_teardown, .timeout = 60);
 
@@ -90,6 +92,106 @@ Test(hostile, fifos_and_devices_are_refused_by_every_command) {
                 runs[i].name);
     }
   }
+}
+
+/* What stands at a name, as lstat sees it: 'f' FIFO, 'l' link, 'r' regular. */
+static char kind_at(const char *path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return '-';
+  return S_ISFIFO(st.st_mode) ? 'f' : S_ISLNK(st.st_mode) ? 'l' : S_ISREG(st.st_mode) ? 'r' : '?';
+}
+
+/* An output that exists and is not a regular file (a FIFO, a device, a
+ * link to one, /dev/stdout) was renamed over: as root /dev/full became a
+ * 13-byte file. Every command refuses it now, in one line, and leaves it
+ * as it was; a batch whose output name is a FIFO too, and --vmt. */
+Test(hostile, outputs_that_are_not_regular_files_are_never_replaced) {
+  height_file(tmp("h.png"));
+  cr_assert_eq(mkfifo(tmp("fifo.png"), 0644), 0);
+  cr_assert_eq(symlink("/dev/null", tmp("null.png")), 0);
+  cr_assert_eq(symlink("/dev/null", tmp("null.vmt")), 0);
+  cr_assert_eq(mkdir(tmp("materials"), 0755), 0);
+  cr_assert_eq(mkdir(tmp("out"), 0755), 0);
+  cr_assert_eq(mkfifo(tmp("out/h_normal.png"), 0644), 0);
+  const struct {
+    const char *args[16];
+    const char *name, *part;
+  } runs[] = {
+      {{"bake", "h.png", FAST, "--normal", "fifo.png"}, "fifo.png", "is a FIFO"},
+      {{"bake", "h.png", FAST, "--ssbump", "null.png"}, "null.png", "symbolic link (to a character device)"},
+      {{"bake", "h.png", FAST, "--ssbump", "materials/s.vtf", "--vmt", "null.vmt"}, "null.vmt", "symbolic link"},
+      {{"bake", "h.png", FAST, "--out-dir", "out", "--maps", "normal"}, "out/h_normal.png", "is a FIFO"},
+      {{"normal", "h.png", "--scale", "4", "-o", "fifo.png"}, "fifo.png", "is a FIFO"},
+      {{"render", "h.png", "--scale", "6", "--rays", "16", "-o", "null.png"}, "null.png", "symbolic link"},
+  };
+  for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+    char what[64];
+    snprintf(what, sizeof what, "%s %s", runs[i].args[0], runs[i].name);
+    cli_result r = harness_run_in(harness_dir, runs[i].args);
+    harness_expect_error(&r, 1, runs[i].part, what);
+    cr_expect(strstr(r.err, runs[i].name), "%s: %s", what, r.err);
+    cli_result_free(&r);
+  }
+  cr_expect_eq(kind_at(tmp("fifo.png")), 'f');
+  cr_expect_eq(kind_at(tmp("out/h_normal.png")), 'f');
+  cr_expect_eq(kind_at(tmp("null.png")), 'l');
+  cr_expect_eq(kind_at(tmp("null.vmt")), 'l');
+  cr_expect(!file_exists(tmp("materials/s.vtf")), "the texture of a refused material was written");
+  /* The library's own writers refuse them too. */
+  bb_error err;
+  cr_expect_eq(bb_file_write(tmp("fifo.png"), "x", 1, &err), BB_ERR_IO);
+  cr_expect(strstr(err.message, "is a FIFO"), "%s", err.message);
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
+  bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
+  cr_expect_eq(bb_image_write(tmp("null.png"), &img, &wo, &err), BB_ERR_IO);
+  bb_image_free(&img);
+  cr_expect_eq(kind_at(tmp("fifo.png")), 'f');
+  cr_expect_eq(kind_at(tmp("null.png")), 'l');
+  cr_expect_eq(files_starting_with(".bb-tmp"), 0);
+  /* As root, a device node in the test's directory (what /dev/full was). */
+  if (geteuid() == 0 && mknod(tmp("full.png"), S_IFCHR | 0666, makedev(1, 7)) == 0) {
+    cli_result r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "full.png");
+    harness_expect_error(&r, 1, "is a character device", "a device node");
+    cli_result_free(&r);
+    struct stat st;
+    cr_expect(lstat(tmp("full.png"), &st) == 0 && S_ISCHR(st.st_mode), "the device was replaced");
+  }
+}
+
+/* A depfile is text a build tool reads: through a FIFO or a character
+ * device (/dev/stdout on a pipe, /dev/null) it is written through, not
+ * replaced; a full device is an error after the maps; a FIFO nobody reads
+ * is an error, not a wait. */
+Test(hostile, a_depfile_is_written_through_a_stream) {
+  height_file(tmp("h.png"));
+  cr_assert_eq(symlink("/dev/null", tmp("null.d")), 0);
+  cr_assert_eq(symlink("/dev/full", tmp("full.d")), 0);
+  cr_assert_eq(mkfifo(tmp("fifo.d"), 0644), 0);
+  cli_result r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n.png", "--depfile", "null.d");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  cr_expect_eq(kind_at(tmp("null.d")), 'l');
+  cr_expect(file_exists(tmp("n.png")));
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n2.png", "--depfile", "full.d");
+  harness_expect_error(&r, 1, "No space left on device; the maps were written", "/dev/full");
+  cli_result_free(&r);
+  cr_expect_eq(kind_at(tmp("full.d")), 'l');
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n3.png", "--depfile", "fifo.d");
+  harness_expect_error(&r, 1, "no process reads the FIFO", "a FIFO without a reader");
+  cli_result_free(&r);
+  /* With a reader (open before the bake, read after it: the rule fits in
+   * the pipe's buffer), the rule arrives through the FIFO. */
+  const int reader = open(tmp("fifo.d"), O_RDONLY | O_NONBLOCK);
+  cr_assert_geq(reader, 0);
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n4.png", "--depfile", "fifo.d");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  char line[256] = "";
+  const ssize_t got = read(reader, line, sizeof line - 1);
+  close(reader);
+  cr_expect_str_eq(line, "n4.png: h.png\n", "read %zd bytes", got);
+  cr_expect_eq(kind_at(tmp("fifo.d")), 'f');
 }
 
 /* --------------------------------------------- outputs over what is read */
