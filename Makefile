@@ -83,6 +83,13 @@ PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
 # by the interpreter's version (/usr/local/lib/python3.11/dist-packages).
 PYTHON_VERSION := $(shell /usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)
 PYTHONDIR  ?= $(if $(and $(filter /usr/local,$(PREFIX)),$(PYTHON_VERSION)),$(PREFIX)/lib/python$(PYTHON_VERSION)/dist-packages,$(PREFIX)/lib/python3/dist-packages)
+# bumpbake.pc: an rpath for a LIBDIR the dynamic loader does not search by
+# itself (Debian's: /lib, /usr/lib, /usr/local/lib and their multiarch
+# folders), and the static link's libraries (LDLIBS, Libs.private).
+MULTIARCH  := $(shell $(CC) -dumpmachine 2>/dev/null)
+LOADER_DIRS:= /lib /usr/lib /usr/local/lib $(addsuffix /$(MULTIARCH),/lib /usr/lib /usr/local/lib)
+PC_RPATH    = $(if $(filter $(patsubst %/,%,$(LIBDIR)),$(LOADER_DIRS)),, -Wl$(comma)-rpath$(comma)$${libdir})
+PC_LIBS_PRIVATE = $(LDLIBS) -lstdc++
 # Refreshes the loader's cache after a real (DESTDIR-less) install as root;
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
@@ -266,7 +273,8 @@ install: $(BIN) lib
 	install -m 644 include/bumpbake.h $(DESTDIR)$(INCLUDEDIR)/bumpbake.h
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
-	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	  -e 's|@VERSION@|$(VERSION)|; s|@RPATH@|$(PC_RPATH)|; s|@LIBS_PRIVATE@|$(PC_LIBS_PRIVATE)|' \
+	  bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake $(DESTDIR)$(PYTHONDIR)/bumpbake/dask
 	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
 	  $(DESTDIR)$(PYTHONDIR)/bumpbake/

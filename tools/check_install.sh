@@ -4,8 +4,10 @@
 #
 #   1. installs into a temporary prefix and checks the files and symlinks;
 #   2. builds tests/install_client.c with `pkg-config --cflags --libs
-#      bumpbake` (shared) and with `pkg-config --static --libs` against
-#      libbumpbake.a, runs both and checks they print "ok";
+#      bumpbake` (shared; nothing else: the prefix's rpath must come from
+#      bumpbake.pc, and --cflags must be the include directory alone) and
+#      with `pkg-config --static --libs` against libbumpbake.a, runs both
+#      and checks they print "ok";
 #   3. checks libbumpbake.so exports exactly the functions of bumpbake.h;
 #   4. checks the man page renders without warnings and names every command
 #      and option the installed bumpbake's --help lists;
@@ -62,15 +64,21 @@ libs=$(pkg-config --libs bumpbake)
 libdir=$(pkg-config --variable=libdir bumpbake)
 [ "$(pkg-config --modversion bumpbake)" = "${version#bumpbake }" ] ||
   fail "bumpbake.pc's version $(pkg-config --modversion bumpbake) is not ${version#bumpbake }"
-# The client itself uses libm (exp, sqrt); pkg-config's output is split on purpose.
+# bumpbake.h needs no other header: --cflags is the include directory alone
+# (Requires.private once added Debian's libsquish.pc's stray -I/include).
+[ "$(echo $cflags)" = "-I$prefix/include" ] || # (echo: pkg-config ends with a space)
+  fail "pkg-config --cflags bumpbake is '$cflags', not -I$prefix/include"
+# The client itself uses libm (exp, sqrt); pkg-config's output is split on
+# purpose. Nothing but pkg-config's flags: the temporary prefix is not one
+# the loader searches, so the client runs only if Libs carries its rpath.
 # shellcheck disable=SC2086
 "$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client" $libs \
-  -Wl,-rpath,"$libdir" -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
+  -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
 if [ -x "$tmp/client" ]; then
   # (ldd's output is kept first: grep -q quitting early would fail the pipe)
-  loaded=$(ldd "$tmp/client")
+  loaded=$(env -u LD_LIBRARY_PATH ldd "$tmp/client")
   grep -q "$soname => $libdir/" <<<"$loaded" || fail "the client does not load $libdir/$soname"
-  "$tmp/client" >"$tmp/client.out" 2>&1 || true
+  env -u LD_LIBRARY_PATH "$tmp/client" >"$tmp/client.out" 2>&1 || true
   if [ "$(tail -n1 "$tmp/client.out")" = ok ]; then
     pass "client built with pkg-config --cflags --libs bumpbake: ok"
   else
@@ -143,6 +151,8 @@ stage=$tmp/stage
 if [ -f "$stage/usr/lib/pkgconfig/bumpbake.pc" ] && [ -e "$stage/usr/bin/bumpbake" ] &&
   grep -qx 'prefix=/usr' "$stage/usr/lib/pkgconfig/bumpbake.pc"; then
   pass "staged install (DESTDIR, PREFIX=/usr) lands under DESTDIR with /usr paths"
+  ! grep -q '^Libs:.*rpath' "$stage/usr/lib/pkgconfig/bumpbake.pc" ||
+    fail "bumpbake.pc for PREFIX=/usr adds an rpath (the loader searches /usr/lib)"
 else
   fail "staged install: files or bumpbake.pc's prefix not as expected"
 fi
