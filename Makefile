@@ -259,13 +259,28 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
+# The installed program: the CLI with src/cli/installed_dirs.c compiled
+# again with the install's PYTHONDIR, where `bumpbake bake --scheduler`
+# finds the Python package (src/cli/cluster.c); build/bumpbake finds its
+# source tree instead. Relinked when PYTHONDIR changes.
+INSTALL_BIN := $(BUILD)/install/bumpbake
+$(BUILD)/install/dirs.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(PYTHONDIR)' | cmp -s - $@ || echo '$(PYTHONDIR)' >$@
+$(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dirs.flags \
+                                   $(BUILD)/compile.flags
+	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
+$(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
+                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS)
+
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
 # (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
-install: $(BIN) lib
+install: $(INSTALL_BIN) lib
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
 	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
-	install -m 755 $(BIN) $(DESTDIR)$(BINDIR)/bumpbake
+	install -m 755 $(INSTALL_BIN) $(DESTDIR)$(BINDIR)/bumpbake
 	install -m 755 $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL)
 	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so

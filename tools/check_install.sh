@@ -14,7 +14,9 @@
 #   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths;
 #   6. the installed Python package imports and bakes with PYTHONPATH set to
 #      its dist-packages and nothing else (no BUMPBAKE_LIBRARY, no
-#      PKG_CONFIG_PATH): it loads the installed library by itself.
+#      PKG_CONFIG_PATH): it loads the installed library by itself; the
+#      installed program's `bake --scheduler` finds it with no PYTHONPATH,
+#      and imports nothing from the working directory.
 #
 # Environment: MAKE (make), DEBUG (0), BUILD (build), CC (cc), PYTHON
 # (/usr/bin/python3). A DEBUG=1 library is sanitized, so the clients are
@@ -201,6 +203,23 @@ print("ok", bumpbake.library_path)
     else
       echo "$out" >&2
       fail "the installed bumpbake.dask does not run with PYTHONPATH alone"
+    fi
+    # `bumpbake bake --scheduler` from the installed program: its Python
+    # finds the package where make install put it (recorded in the
+    # program), with no PYTHONPATH, and imports nothing from the directory
+    # it bakes in (a bumpbake/ there would run).
+    hostile=$tmp/hostile
+    mkdir -p "$hostile/bumpbake"
+    cp fixtures/rock06_128.png "$hostile/h.png"
+    printf 'open(%s, "w").write("ran")\n' "'$hostile/RAN'" >"$hostile/bumpbake/__init__.py"
+    out=$(cd "$hostile" && env -i PATH=/usr/bin:/bin "${preload[@]}" "$prefix/bin/bumpbake" \
+      bake h.png --scale 8 --normal n.png --scheduler not-an-address 2>&1) || true
+    if [ -e "$hostile/RAN" ]; then
+      fail "bumpbake bake --scheduler imported bumpbake/ from the working directory"
+    elif grep -q "cannot import bumpbake.dask" <<<"$out"; then
+      fail "the installed bumpbake bake --scheduler does not find its package: $out"
+    else
+      pass "installed bumpbake bake --scheduler: finds the package in $site, nothing from the working directory"
     fi
   fi
 fi

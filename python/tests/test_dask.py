@@ -291,6 +291,31 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     assert not os.path.exists("b")
 
 
+def test_the_cli_with_a_scheduler_imports_nothing_from_the_working_directory(
+        tmp_path, monkeypatch, client, cli):
+    """`python3 -m bumpbake.dask` put the working directory first on
+    sys.path: a numpy.py, distributed/ or bumpbake/ in the directory being
+    baked ran (a stub exiting 0 gave exit 0 and nothing written). Python now
+    runs isolated, with the package's own directory on its path alone; an
+    empty PYTHONPATH entry (the current directory, to Python) changes
+    nothing."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1)
+    stub = f"open({str(tmp_path / 'RAN')!r}, 'a').write(__name__ + '\\n')\nraise SystemExit(0)\n"
+    for name in ("numpy.py", "distributed/__init__.py", "bumpbake/__init__.py",
+                 "bumpbake/dask/__init__.py", "runpy.py"):
+        os.makedirs(os.path.dirname(name) or ".", exist_ok=True)
+        with open(name, "w") as f:
+            f.write(stub)
+    monkeypatch.setenv("PYTHONPATH", ":")
+    monkeypatch.setenv("BUMPBAKE_PYTHONPATH", "::")
+    out = cli("bake", "h00.png", "--scale", "16", "--slices", "4", "--normal", "n.png",
+              "--scheduler", client.scheduler.address, check=False)
+    assert not os.path.exists("RAN"), open("RAN").read()
+    assert out.returncode == 0, out.stderr
+    assert os.path.exists("n.png")
+
+
 def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, client, cli):
     """Ctrl-C on `bake MAP -o PREFIX --scheduler ADDRESS` while the slices
     are out: a running task cannot be killed, so the driver is told (a
