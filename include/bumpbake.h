@@ -638,7 +638,9 @@ typedef struct bb_vmt_options {
  * written, made absolute against the working directory, "." and ".."
  * resolved, symbolic links not followed (the textures need not exist yet).
  * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path or
- * bumpmap; no materials_dir and no "materials" folder above the bump map;
+ * bumpmap; a path not ending in ".vmt" (any case), or naming the same file
+ * as the bump map or base texture (a hard link), which would be
+ * overwritten; no materials_dir and no "materials" folder above the bump map;
  * a texture that is not a .vtf or lies outside materials_dir; a '"' or
  * control character in a path, which a material cannot quote);
  * BB_ERR_MEMORY; BB_ERR_IO. */

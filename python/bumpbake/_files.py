@@ -224,8 +224,9 @@ def write_vmt(path, bumpmap, *, materials=None, basetexture=None, ssbump=True):
     "$basetexture" when given, each texture (a .vtf path; it need not exist
     yet) named relative to materials, the game's materials folder (None:
     the nearest folder named "materials" above bumpmap), without ".vtf".
-    Written all or nothing. Raises ArgumentError (a texture that is not a
-    .vtf or lies outside materials, no materials folder), Error when it
+    Written all or nothing. Raises ArgumentError (a path not ending in
+    .vmt, or another name of a texture it names; a texture that is not a
+    .vtf or lies outside materials; no materials folder), Error when it
     cannot be written."""
     strings = [_ffi.new("char[]", _path(v, what)) if v is not None else _ffi.NULL
                for v, what in ((path, "path"), (materials, "materials"),

@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -684,10 +683,6 @@ static int is_vtf(const char *path) {
 static bb_status plan_material(bb_job *job, bb_error *err) {
   if (!job->vmt)
     return BB_OK;
-  const size_t len = strlen(job->vmt);
-  if (len < 4 || strcasecmp(job->vmt + len - 4, ".vmt") != 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "--vmt %s: a Source material's name ends in .vmt",
-                    job->vmt);
   const bb__job_item *item = &job->items[0];
   const char *ssbump = item->paths[BB_OUTPUT_SSBUMP], *normal = item->paths[BB_OUTPUT_NORMAL];
   const int is_ssbump = ssbump && is_vtf(ssbump);
@@ -697,6 +692,7 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
                     "--vmt %s: a material needs a .vtf bump map: write --ssbump (or --normal) "
                     "as a .vtf file",
                     job->vmt);
+  /* bb_vmt_text checks the material's own name (.vmt, no texture's). */
   const bb_vmt_options v = {job->vmt_materials, bump, job->vmt_basetexture, is_ssbump};
   return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bumpbake.h"
@@ -555,6 +556,42 @@ Test(vtf, material) {
   bb_vmt_options none = {materials, NULL, NULL, 1};
   cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &none, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(access(in_dir("x.vmt"), F_OK), -1);
+  remove_dir();
+}
+
+/* bb_vmt_write (what Python's write_vmt calls) turned the texture it names
+ * into a 103-byte material, and overwrote a PNG: a material's name ends in
+ * .vmt and is no other name of a texture it names, as for bake --vmt. */
+Test(vtf, a_material_never_overwrites_a_texture_or_another_file) {
+  make_dir();
+  char materials[160], bump[200], alias[200];
+  snprintf(materials, sizeof materials, "%s/materials", dir);
+  cr_assert_eq(mkdir(materials, 0755), 0);
+  snprintf(bump, sizeof bump, "%s/materials/s.vtf", dir);
+  snprintf(alias, sizeof alias, "%s/materials/s.vmt", dir);
+  spill(bump, (const unsigned char *)"VTF\0 texture", 12);
+  spill(in_dir("x.png"), (const unsigned char *)"png bytes", 9);
+  bb_vmt_options o = {NULL, bump, NULL, 1};
+  bb_error err = {{0}};
+  cr_expect_eq(bb_vmt_write(bump, &o, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "ends in .vmt"), "%s", err.message);
+  cr_expect_eq(bb_vmt_write(in_dir("x.png"), &o, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_vmt_write(in_dir("x.VMT.png"), &o, &err), BB_ERR_ARGUMENT);
+  /* s.vmt a hard link of the texture: the same file under a .vmt name. */
+  cr_assert_eq(link(bump, alias), 0);
+  cr_expect_eq(bb_vmt_write(alias, &o, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "would overwrite the texture"), "%s", err.message);
+  bb_vmt_options base = {NULL, in_dir("materials/t.vtf"), bump, 1};
+  cr_expect_eq(bb_vmt_write(alias, &base, &err), BB_ERR_ARGUMENT);
+  size_t size;
+  unsigned char *bytes = slurp(bump, &size);
+  cr_expect(size == 12 && memcmp(bytes, "VTF\0 texture", 12) == 0, "the texture was changed");
+  free(bytes);
+  bytes = slurp(in_dir("x.png"), &size);
+  cr_expect(size == 9 && memcmp(bytes, "png bytes", 9) == 0, "the PNG was changed");
+  free(bytes);
+  /* Upper case is a .vmt too. */
+  cr_expect_eq(bb_vmt_write(in_dir("materials/M.VMT"), &o, &err), BB_OK, "%s", err.message);
   remove_dir();
 }
 
