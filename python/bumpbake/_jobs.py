@@ -6,9 +6,9 @@ import os
 import typing
 
 from ._bake import BAKE_PARAMETERS, OUTPUTS, _bake_options, _channel, _kinds_mask
-from ._common import (_argument_error, _check, _check_notes, _depth, _dispatch_notes,
-                      _exception, _ffi, _lib, _message, _note_text, _path, _status_name, _text,
-                      _texture_options)
+from ._common import (_argument_error, _c_bytes, _c_text, _check, _check_notes, _depth,
+                      _dispatch_notes, _exception, _ffi, _lib, _message, _note_text, _path,
+                      _status_name, _text, _texture_options)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -115,7 +115,8 @@ class BakeJob:
         def c(value):
             if value is None:
                 return _ffi.NULL
-            s = _ffi.new("char[]", value if isinstance(value, bytes) else value.encode())
+            s = _ffi.new("char[]", _c_bytes(value, "a path") if isinstance(value, bytes)
+                         else _c_text(value, "text"))
             keep.append(s)
             return s
 
