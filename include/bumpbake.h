@@ -2380,7 +2380,10 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 /* Runs input i: skips it (BB_JOB_CURRENT) when its outputs are up to date
  * and the job is not forced, else reads, bakes and writes its maps all or
  * nothing (BB_JOB_BAKED), filling its report. progress (may be NULL)
- * follows the bake and may cancel it. Returns the report's status; a
+ * follows the bake and may cancel it; it is also called once with done 0
+ * and total 0 when the input has been read and its notes given, before the
+ * bake: a nonzero return there (a note the caller takes as an error)
+ * cancels with nothing baked or written. Returns the report's status; a
  * failure is the input's alone (the job goes on). Thread-compatible: one
  * job, one thread at a time. */
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);

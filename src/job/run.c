@@ -284,6 +284,11 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
                              job->options.bake.height_scale, job->options.note,
                              job->options.note_user, &b.height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
+  /* The input's notes have been given: a caller that takes one as an
+   * error cancels here, before anything is baked or written (progress
+   * (0, 0): a checkpoint, no work done yet). */
+  if (st == BB_OK && progress && progress(progress_user, 0, 0))
+    st = bb__fail(err, BB_ERR_CANCELLED, "%s: cancelled by the progress callback", item->input);
   const int height_width = b.height.width, height_height = b.height.height;
   if (st == BB_OK) {
     bb_bake_options o = job->options.bake;
