@@ -165,11 +165,16 @@ typedef struct bb_image {
   float *pixels;  /* width*height*channels floats, row 0 at the top */
 } bb_image;
 
-/* What this process may still allocate, in bytes: the smaller of what the
- * system has available (MemAvailable of /proc/meminfo, else its free pages)
- * and, under an RLIMIT_AS (ulimit -v), the room left below it (the limit
- * less the address space mapped now). *source (may be NULL) receives which
- * ("MemAvailable", "sysconf free pages", "RLIMIT_AS"). Bakes and reads
+/* What this process may still allocate, in bytes: the smallest of what
+ * the system has available (MemAvailable of /proc/meminfo, else its free
+ * pages); under a container's or service's memory limit, the room left
+ * below the limit of every cgroup from the process's own up to the top
+ * (cgroup v2's memory.max, v1's memory.limit_in_bytes; the limit less the
+ * group's usage, its reclaimable page cache not counted); and, under an
+ * RLIMIT_AS (ulimit -v), the room left below it (the limit less the
+ * address space mapped now). *source (may be NULL) receives which
+ * ("MemAvailable", "sysconf free pages", "cgroup memory.max", "cgroup
+ * memory.limit_in_bytes", "RLIMIT_AS"). Bakes and reads
  * check their estimate against it before allocating, so one too large is
  * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
  * the process; several processes started at once each see the same

@@ -89,6 +89,14 @@ uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
 /* bb__fnv1a_u32 over the bits of n floats. */
 uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n);
 
+/* bb_memory_available, reading /proc and the cgroup files below root
+ * ("" for the system's own; a test points it at a made-up tree:
+ * ROOT/proc/meminfo, ROOT/proc/self/cgroup, ROOT/proc/self/mountinfo and
+ * the cgroup directories at ROOT + the mount points it names). RLIMIT_AS
+ * is this process's. */
+bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char **source,
+                                  bb_error *err);
+
 /* BB_OK when need bytes fit in what bb_memory_available says is left, else
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */
