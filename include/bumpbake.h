@@ -1672,6 +1672,22 @@ void bb_render_options_init(bb_render_options *o);
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err);
 
+/* The picture a render of maps of width x height makes by o (with compare,
+ * bb_render_compare's four-panel grid), worked out from the sizes alone,
+ * before anything is read or allocated: *picture_width x *picture_height
+ * (the maps' size times o's tiles, then o's crop; may be NULL) and *bytes
+ * (may be NULL), the most memory the render takes beyond its maps: the
+ * picture as rendered, tiled and cropped (3 floats a texel), and the copy
+ * the encoder of output at depth makes of it (output NULL: none, the
+ * picture alone). bb_render
+ * refuses (BB_ERR_MEMORY) a picture whose estimate is over
+ * bb_memory_available before it allocates it. Errors: BB_ERR_SIZE (the
+ * tiled picture over BB_MAX_DIMENSION a side or BB_MAX_PIXELS in all),
+ * BB_ERR_ARGUMENT (a crop not inside it), each message saying so. */
+bb_status bb_render_estimate(int width, int height, const bb_render_options *o, int compare,
+                             const char *output, bb_depth depth, int *picture_width,
+                             int *picture_height, double *bytes, bb_error *err);
+
 /* "key=value" lines of every option of o that affects pixels (render_mode,
  * light, light_color, lightmap, specular, specular_strength, albedo_mode,
  * tile, crop; view and relief when used), for
@@ -1720,6 +1736,22 @@ typedef struct bb_render_sources {
  * names), albedo and albedo_hash, then bb_render_options_describe's, then
  * frame=F/N for an orbit's frame. malloc'd; NULL when out of memory. */
 char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o);
+
+/* A render of files checked from their headers before any pixel is read,
+ * as bakes are: the maps (files->maps) or the height baked first
+ * (files->height, with bake, its outputs set) and the albedo
+ * (files->albedo, may be NULL); the maps share one size (*width x *height,
+ * may be NULL, set as soon as the first header is read); the picture fits
+ * (bb_render_estimate, with output and depth); and reading them as
+ * floats (the bake, for a height: bb_bake_memory_estimate), with the
+ * picture, fits in bb_memory_available. A file whose header is over the
+ * read's limits is left to the read to refuse. Errors: those of
+ * bb_image_read_info and bb_render_estimate, BB_ERR_ARGUMENT (maps of two
+ * sizes, naming the file), BB_ERR_MEMORY ("OUTPUT: a 32768 x 32768 render
+ * needs about 16.3 GiB of memory; 5.4 GiB is available (RLIMIT_AS)"). */
+bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_options *bake,
+                                const bb_render_options *o, int compare, const char *output,
+                                bb_depth depth, int *width, int *height, bb_error *err);
 
 /* The file of frame `frame` of an orbit of `frames` written to output:
  * OUT_007.png for OUT.png (four digits past 1000 frames). malloc'd; NULL
