@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "hostile_headers.h"
 
 #include <math.h>
 
@@ -242,60 +243,21 @@ Test(cli_render, tiles_over_the_maximum) {
   expect_no_new_files(1);
 }
 
-/* Appends a PNG chunk (length, type, data, CRC-32 of type and data). */
-static size_t png_chunk(unsigned char *out, const char *type, const unsigned char *data,
-                        unsigned length) {
-  const unsigned char len[4] = {(unsigned char)(length >> 24), (unsigned char)(length >> 16),
-                                (unsigned char)(length >> 8), (unsigned char)length};
-  memcpy(out, len, 4);
-  memcpy(out + 4, type, 4);
-  if (length)
-    memcpy(out + 8, data, length);
-  unsigned long crc = 0xffffffffUL;
-  for (unsigned i = 4; i < 8 + length; i++) {
-    crc ^= out[i];
-    for (int k = 0; k < 8; k++)
-      crc = (crc >> 1) ^ (0xedb88320UL & (0UL - (crc & 1)));
-  }
-  crc ^= 0xffffffffUL;
-  for (unsigned i = 0; i < 4; i++)
-    out[8 + length + i] = (unsigned char)(crc >> (24 - 8 * i));
-  return 12 + length;
-}
-
-/* A PNG of width x height, RGB 8-bit, whose image data is empty: its
- * header reads, its pixels do not. What the picture checks need (they read
- * headers only), and proof that they ran before any pixel was read. */
-static void png_header_only(const char *path, unsigned width, unsigned height) {
-  unsigned char png[128] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  unsigned char ihdr[13] = {0};
-  for (int i = 0; i < 4; i++) {
-    ihdr[i] = (unsigned char)(width >> (24 - 8 * i));
-    ihdr[4 + i] = (unsigned char)(height >> (24 - 8 * i));
-  }
-  ihdr[8] = 8, ihdr[9] = 2; /* 8-bit RGB */
-  size_t n = 8;
-  n += png_chunk(png + n, "IHDR", ihdr, sizeof ihdr);
-  n += png_chunk(png + n, "IDAT", NULL, 0);
-  n += png_chunk(png + n, "IEND", NULL, 0);
-  write_bytes(path, png, n);
-}
-
 /* render --normal n4096.png --tile 8 ran 62 s at 16 GB peak, and an 8192
  * map tiled 8 times was refused "over the maximum" only after 8 s and 1.7
  * GB: the picture is now worked out from the headers, before any pixel is
- * read (bb_render_files_check), as bakes are. The 8192 map here is a
- * header without pixels: reading them would fail, so only the check
- * before the read can give this answer. */
+ * read (bb_render_files_check), as bakes are. The maps here are headers
+ * without pixels (write_png_header): reading them would fail, so only the
+ * check before the read can give these answers. */
 Test(cli_render, a_picture_too_large_is_refused_before_any_pixel_is_read) {
-  png_header_only(tmp("n8192.png"), 8192, 8192);
+  cr_assert_eq(write_png_header(tmp("n8192.png"), 8192, 8192), 0);
   cli_result r = RUN("render", "--normal", tmp("n8192.png"), "--mode", "normal", "--tile", "8",
                      "-o", tmp("o.png"));
   expect_one_line_error(&r, 2, "65536x65536 picture, over the maximum");
   cli_result_free(&r);
   /* 2048 x 2048 tiled 8 times fits the limits (16384 x 16384), not the
    * memory left under a 1.2 GB address space: refused with the figures. */
-  png_header_only(tmp("n2048.png"), 2048, 2048);
+  cr_assert_eq(write_png_header(tmp("n2048.png"), 2048, 2048), 0);
   const run_limits lim = {-1,
 #ifdef __SANITIZE_ADDRESS__
                           -1
