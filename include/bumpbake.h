@@ -158,6 +158,21 @@ typedef struct bb_error {
 /* Short name of a status ("ok", "bad argument", ...); never NULL. */
 const char *bb_status_name(bb_status status);
 
+/* Text from a file (a file name, a description, a VTF's KVD, a message
+ * holding them) made safe to show a person: s is written into out
+ * (capacity cap, always terminated, cut short when full) with every byte of
+ * what could drive a terminal or reorder what it shows escaped as \xNN:
+ * the C0 controls, DEL, the C1 controls U+0080..U+009F, the bidirectional
+ * controls (U+061C, U+200E, U+200F, U+202A..U+202E, U+2066..U+2069, with
+ * which "a\u202egnp.exe" shows as "aexe.png") and bytes that are not UTF-8.
+ * Returns out. The command line prints every line through it. */
+const char *bb_text_printable(const char *s, char *out, size_t cap);
+
+/* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
+ * the end of the string or bytes that are not UTF-8 (overlong forms,
+ * surrogates and code points past U+10FFFF included). */
+size_t bb_utf8_sequence(const char *s);
+
 typedef struct bb_image {
   int width;      /* texels */
   int height;     /* texels */

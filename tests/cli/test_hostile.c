@@ -519,6 +519,51 @@ Test(hostile, printed_text_never_drives_the_terminal) {
   cli_result_free(&r);
 }
 
+/* Bidirectional controls from a file (U+202E in a VTF's KVD, U+2066 in a
+ * PNG's description, U+200E in a file name) were printed raw, while C0
+ * and C1 were escaped: they reorder what a terminal shows. They are
+ * escaped by the same rule (bb_text_printable), byte by byte. */
+Test(hostile, bidirectional_controls_from_a_file_are_escaped) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 4, 4, 3, NULL), BB_OK);
+  bb_texture_options t;
+  bb_texture_options_init(&t);
+  t.vtf_version = 3;
+  t.format = BB_TEXTURE_FORMAT_BGR8;
+  t.description = "bumpbake_version=x\ncommand=a\xe2\x80\xaegnp.exe\n";
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(tmp("k.vtf"), &img, &t, &err), BB_OK, "%s", err.message);
+  const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
+                               "a\xe2\x81\xa6" "b\xe2\x81\xa9 \xd8\x9c \xe2\x80\x8f\xe2\x80\xaa", NULL};
+  const char *name = "n\xe2\x80\x8e.png";
+  cr_assert_eq(bb_image_write(tmp("d.png"), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);
+  bb_image_free(&img);
+  const char *runs[][4] = {{"info", tmp("k.vtf"), NULL},
+                           {"info", tmp("d.png"), NULL},
+                           {"info", tmp(name), NULL},
+                           {"info", tmp("gone\xe2\x80\xae.png"), NULL}};
+  const char *shown[] = {"a\\xe2\\x80\\xaegnp.exe", "a\\xe2\\x81\\xa6b", "n\\xe2\\x80\\x8e.png",
+                         "gone\\xe2\\x80\\xae.png"};
+  for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+    cli_result r = harness_run(runs[i]);
+    cr_expect(!has_control(r.out) && !has_control(r.err), "info %zu printed a control: %s%s", i,
+              r.out, r.err);
+    cr_expect(strstr(r.out, shown[i]) || strstr(r.err, shown[i]), "info %zu lacks %s: %s%s", i,
+              shown[i], r.out, r.err);
+    cli_result_free(&r);
+  }
+  /* The rule itself: what it escapes, and what it leaves (accents, CJK). */
+  char out[256];
+  cr_expect_str_eq(bb_text_printable("\xd8\x9c|\xe2\x80\x8f|\xe2\x80\xaa|\xe2\x81\xa9|\x1b|\xc2\x9b|\xff",
+                                     out, sizeof out),
+                   "\\xd8\\x9c|\\xe2\\x80\\x8f|\\xe2\\x80\\xaa|\\xe2\\x81\\xa9|\\x1b|\\xc2\\x9b|\\xff");
+  cr_expect_str_eq(bb_text_printable("h\xc3\xa9ight \xe9\xab\x98\xe3\x81\x95 \xe2\x80\x94 \xe2\x80\xaf",
+                                     out, sizeof out),
+                   "h\xc3\xa9ight \xe9\xab\x98\xe3\x81\x95 \xe2\x80\x94 \xe2\x80\xaf");
+  cr_expect_str_eq(bb_text_printable("ab\xe2\x80\xae", out, 8), "ab", "a control cut short");
+}
+
 /* The other text a file brings: a basis file's line and a program's text
  * in error messages, and a batch's "wrote" lines of a name holding an
  * escape sequence (all printed raw before). */

@@ -490,6 +490,34 @@ Test(vtf, read_info_refuses_broken_files) {
   cr_assert_eq(bb_vtf_read_info(in_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
   cr_assert_null(info.description);
+  /* The low-resolution resource's offset past the end (the image data
+   * still ends where the file does): the message says which part, and no
+   * more than the truth ("needs 3636 bytes, the file has 3636" it was). */
+  unsigned char *moved = malloc(size);
+  memcpy(moved, good, size);
+  cr_assert_eq(oracle_u32(moved + 80), 0x01, "the low-res entry comes first");
+  const uint32_t past = (uint32_t)size + 100;
+  for (int i = 0; i < 4; i++)
+    moved[84 + i] = (unsigned char)(past >> (8 * i));
+  spill(in_dir("l.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
+  char want[160];
+  snprintf(want, sizeof want, "low-resolution image (128 bytes at offset %u) ends past the end "
+           "of the file (%zu bytes)", past, size);
+  cr_expect_not_null(strstr(err.message, want), "%s", err.message);
+  /* The image resource's offset past the end. */
+  memcpy(moved, good, size);
+  for (int i = 0; i < 4; i++)
+    moved[92 + i] = (unsigned char)(past >> (8 * i));
+  spill(in_dir("i.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
+  size_t data = 0; /* DXT1, 32 x 32 down to 1 x 1 */
+  for (int side = 32; side >= 1; side /= 2)
+    data += (size_t)((side + 3) / 4) * (size_t)((side + 3) / 4) * 8;
+  snprintf(want, sizeof want, "image data (%zu bytes at offset %u) ends past the end of the "
+           "file (%zu bytes)", data, past, size);
+  cr_expect_not_null(strstr(err.message, want), "%s", err.message);
+  free(moved);
   /* Not a VTF; a version from the future; a resource count past the header. */
   spill(in_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
   cr_assert_eq(bb_vtf_read_info(in_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
