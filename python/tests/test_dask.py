@@ -151,7 +151,7 @@ def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch
     def chunks(dask_scheduler):
         return [k for k in dask_scheduler.tasks if str(k).startswith("bumpbake-chunk-")]
 
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 120  # a hang guard, not a bound on time
     while client.run_on_scheduler(chunks):
         assert time.monotonic() < deadline, client.run_on_scheduler(chunks)
         time.sleep(0.05)
@@ -163,7 +163,7 @@ def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch
     run = threading.Thread(target=lambda: done.append(_batch._bake_chunk(
         os.getcwd(), ["heights/h00.png"], [0], args, _batch._Stop("bumpbake-stop-gone"), True)))
     run.start()
-    run.join(timeout=20)
+    run.join(timeout=120)  # a hang guard
     assert done == [[(0, None)]], "a chunk of a batch that is over waits or bakes"
 
 
@@ -331,13 +331,13 @@ def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, cl
             dask_worker.active_threads.values())).values() for k in keys
             if "bumpbake-" in str(k)]
 
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 180  # a hang guard, not a bound on time
     while not any("bumpbake-horizons" in str(k) for k in running()):
         assert bake.poll() is None, bake.communicate()
         assert time.monotonic() < deadline, "the slices never went out"
         time.sleep(0.02)
     bake.send_signal(signal.SIGINT)
-    _, err = bake.communicate(timeout=60)
+    _, err = bake.communicate(timeout=180)
     assert bake.returncode == 130, err
     while running():
         assert time.monotonic() < deadline, f"still running: {running()}"

@@ -7,9 +7,12 @@
 #include "io/safe_file.h"
 #include "job/job_internal.h"
 
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static const bb_output_kind_info *kind_info(int kind) {
@@ -98,6 +101,40 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
   }
   reason[0] = '\0';
   return 1;
+}
+
+/* An input found up to date whose outputs are older than a file it reads
+ * (a touched input, a basis file rewritten with the same directions):
+ * make compares times, not contents, so it would run the bake again on
+ * every make. The outputs' times are set to now (or to the newest read's,
+ * should its clock run ahead), so the target is newer than its
+ * prerequisites; outputs already newer are left alone. Best effort: an
+ * output whose time cannot be set is left as it is. */
+static void keep_outputs_newer(const bb_job *job, const bb__job_item *item) {
+  const char *reads[BB__JOB_MAX_READS];
+  const int n = bb__job_reads(job, item, reads);
+  struct timespec newest = {0, 0};
+  struct stat st;
+  for (int r = 0; r < n; r++)
+    if (reads[r] && stat(reads[r], &st) == 0 &&
+        (st.st_mtim.tv_sec > newest.tv_sec ||
+         (st.st_mtim.tv_sec == newest.tv_sec && st.st_mtim.tv_nsec > newest.tv_nsec)))
+      newest = st.st_mtim;
+  struct timespec now;
+  clock_gettime(CLOCK_REALTIME, &now);
+  const int ahead = newest.tv_sec > now.tv_sec ||
+                    (newest.tv_sec == now.tv_sec && newest.tv_nsec > now.tv_nsec);
+  const struct timespec when[2] = {ahead ? newest : now, ahead ? newest : now};
+  const bb_job_report *r = &item->report;
+  for (int k = 0; k < r->output_count; k++) {
+    const char *path = r->outputs[k].path;
+    if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode))
+      continue;
+    if (st.st_mtim.tv_sec > newest.tv_sec ||
+        (st.st_mtim.tv_sec == newest.tv_sec && st.st_mtim.tv_nsec > newest.tv_nsec))
+      continue;
+    (void)utimensat(AT_FDCWD, path, when, AT_SYMLINK_NOFOLLOW);
+  }
 }
 
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) {
@@ -336,6 +373,7 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
     if (st != BB_OK)
       return fail_item(r, st, NULL);
     if (current) {
+      keep_outputs_newer(job, item);
       r->outcome = BB_JOB_CURRENT;
       return BB_OK;
     }

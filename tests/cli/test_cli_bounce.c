@@ -10,7 +10,7 @@
 
 #include <math.h>
 
-TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 #define FAST "--scale", "6", "--slices", "8", "--filter-radius", "2"
 

@@ -294,7 +294,7 @@ static void cli_setup(void) {
     ramp[i] = (float)i / 16.0f;
 }
 
-TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 30);
+TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 300);
 
 Test(compare_cli, identical_files_pass_with_exit_0) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 0, 0);
