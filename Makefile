@@ -382,8 +382,10 @@ goldens: ensure-deps
 # `make hostile` reruns the reproductions of hostile files (models reading
 # outside their directory, FIFOs, huge headers, outputs over inputs, links at
 # temporaries, signals in a commit, depfile names, escapes, JSON, address
-# space) against the binary, a line per case, in about a minute and a half
-# (tools/hostile_repro.sh; not part of make test).
+# space; code from the working directory, outputs that are not regular
+# files, a memory cgroup, renders too large) against the binary, a line per
+# case, in about two minutes (tools/hostile_repro.sh; not part of make test:
+# its bounds are wall-clock).
 hostile: $(BIN)
 	@./tools/hostile_repro.sh $(BIN)
 
