@@ -375,6 +375,8 @@ const char *bb_staged_file_path(const bb_staged_file *staged);
  * images are written: through a temporary in path's directory, flushed,
  * synced and renamed into place, so path is either untouched or whole. The
  * temporary is removed on failure, and by bb_tempfiles_remove on a signal.
+ * A path that exists and is not a regular file (a device, a FIFO, a
+ * symbolic link, /dev/stdout) is refused, never renamed over.
  * Errors: BB_ERR_ARGUMENT (no path, or NULL data with a size),
  * BB_ERR_MEMORY, BB_ERR_IO ("PATH: cannot write: reason"). */
 bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err);
@@ -2131,7 +2133,12 @@ typedef struct bb_output_spec {
  * PATH"); BB_ERR_IO (an output that is one of the reads[0..read_count-1]
  * under any spelling, hard or symbolic link: "PATH: output would overwrite
  * the input file"; a directory that does not exist or is not one; an
- * output that is a directory). Messages start with the path. */
+ * output that exists and is not a regular file: a directory, a device, a
+ * FIFO, a socket or a symbolic link, which the rename that puts an output
+ * in place would replace: "PATH: cannot write: is a FIFO, not a regular
+ * file"). Messages start with the path. Every write (bb_file_write,
+ * bb_image_write and the staged writes) refuses such a name too, at its
+ * start and again just before its rename. */
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 
