@@ -23,6 +23,8 @@ while read -r suite n; do in_suite[$suite]=$n; done < <("$bin" --list 2>&1 |
   sed -n 's/^\([a-z0-9_]*\): \([0-9]*\) tests\{0,1\}$/\1 \2/p')
 for dir in tests/*/; do
   family=$(basename "$dir")
+  # Folders without Criterion files (tests/tools: the checks' own tests) are not the suite's.
+  compgen -G "${dir}test_*.c" >/dev/null || continue
   # The suites a family's files define: Test(SUITE, ...) and TestSuite(SUITE, ...).
   suites=$(sed -n 's/^Test\(Suite\)\{0,1\}(\([a-z0-9_]*\).*/\2/p' "$dir"test_*.c | sort -u | paste -sd'|')
   [ -n "$suites" ] || continue

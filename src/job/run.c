@@ -4,7 +4,7 @@
 #include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
-#include "io/safe_file.h"
+#include "files/safe_file.h"
 #include "job/job_internal.h"
 
 #include <fcntl.h>

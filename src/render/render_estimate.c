@@ -4,8 +4,9 @@
  * the peak checked against what is available, as bakes are. A 59 KB normal
  * map of 4096 x 4096 tiled 8 times is a 32768 x 32768 picture of 12 GiB
  * before it is encoded. */
+#include "bake/bake_internal.h"
 #include "core/internal.h"
-#include "io/formats.h"
+#include "image/formats.h"
 
 #include <stdio.h>
 
@@ -127,9 +128,10 @@ bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_op
       /* a height baked first: its read (the channels its rule needs, then
        * the height), then the bake, whose result the picture is lit from */
       const double read = ((channels < 4 ? channels : 4) + 1) * 4.0 * texels;
-      const double baked = bake ? (double)bb_bake_memory_estimate(fw, fh, bake) : 0.0;
+      double maps = 0.0;
+      const double baked = bake ? bb__bake_memory(fw, fh, bake, 0, 4.0 * texels, &maps) : 0.0;
       peak = read > baked ? read : baked;
-      keeps = baked;
+      keeps = 4.0 * texels + maps; /* the height, and the maps the picture is lit from */
     } else {
       map_bytes(texels, channels, m == BB_RENDER_MAP_NORMAL || m == BB_RENDER_MAP_BENT, &peak,
                 &keeps);
