@@ -87,6 +87,13 @@ PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
 # by the interpreter's version (/usr/local/lib/python3.11/dist-packages).
 PYTHON_VERSION := $(shell /usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)
 PYTHONDIR  ?= $(if $(and $(filter /usr/local,$(PREFIX)),$(PYTHON_VERSION)),$(PREFIX)/lib/python$(PYTHON_VERSION)/dist-packages,$(PREFIX)/lib/python3/dist-packages)
+# bumpbake.pc: an rpath for a LIBDIR the dynamic loader does not search by
+# itself (Debian's: /lib, /usr/lib, /usr/local/lib and their multiarch
+# folders), and the static link's libraries (LDLIBS, Libs.private).
+MULTIARCH  := $(shell $(CC) -dumpmachine 2>/dev/null)
+LOADER_DIRS:= /lib /usr/lib /usr/local/lib $(addsuffix /$(MULTIARCH),/lib /usr/lib /usr/local/lib)
+PC_RPATH    = $(if $(filter $(patsubst %/,%,$(LIBDIR)),$(LOADER_DIRS)),, -Wl$(comma)-rpath$(comma)$${libdir})
+PC_LIBS_PRIVATE = $(LDLIBS) -lstdc++
 # Refreshes the loader's cache after a real (DESTDIR-less) install as root;
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
@@ -266,13 +273,28 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
+# The installed program: the CLI with src/cli/installed_dirs.c compiled
+# again with the install's PYTHONDIR, where `bumpbake bake --scheduler`
+# finds the Python package (src/cli/cluster.c); build/bumpbake finds its
+# source tree instead. Relinked when PYTHONDIR changes.
+INSTALL_BIN := $(BUILD)/install/bumpbake
+$(BUILD)/install/dirs.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(PYTHONDIR)' | cmp -s - $@ || echo '$(PYTHONDIR)' >$@
+$(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dirs.flags \
+                                   $(BUILD)/compile.flags
+	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
+$(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
+                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS)
+
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
 # (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
-install: $(BIN) lib
+install: $(INSTALL_BIN) lib
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
 	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
-	install -m 755 $(BIN) $(DESTDIR)$(BINDIR)/bumpbake
+	install -m 755 $(INSTALL_BIN) $(DESTDIR)$(BINDIR)/bumpbake
 	install -m 755 $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL)
 	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so
@@ -280,7 +302,8 @@ install: $(BIN) lib
 	install -m 644 include/bumpbake.h $(DESTDIR)$(INCLUDEDIR)/bumpbake.h
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
-	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	  -e 's|@VERSION@|$(VERSION)|; s|@RPATH@|$(PC_RPATH)|; s|@LIBS_PRIVATE@|$(PC_LIBS_PRIVATE)|' \
+	  bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake $(DESTDIR)$(PYTHONDIR)/bumpbake/dask
 	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
 	  $(DESTDIR)$(PYTHONDIR)/bumpbake/
@@ -392,8 +415,10 @@ goldens: ensure-deps
 # `make hostile` reruns the reproductions of hostile files (models reading
 # outside their directory, FIFOs, huge headers, outputs over inputs, links at
 # temporaries, signals in a commit, depfile names, escapes, JSON, address
-# space) against the binary, a line per case, in about a minute and a half
-# (tools/hostile_repro.sh; not part of make test).
+# space; code from the working directory, outputs that are not regular
+# files, a memory cgroup, renders too large) against the binary, a line per
+# case, in about two minutes (tools/hostile_repro.sh; not part of make test:
+# its bounds are wall-clock).
 hostile: $(BIN)
 	@./tools/hostile_repro.sh $(BIN)
 

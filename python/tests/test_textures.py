@@ -291,3 +291,22 @@ def test_write_vmt(tmp_path):
     assert '"$bumpmap" "wall_normal"' in path.read_text() and "$ssbump" not in path.read_text()
     with pytest.raises(bumpbake.ArgumentError, match="vtf"):
         bumpbake.write_vmt(path, path.parent / "wall.png")
+
+
+def test_write_vmt_refuses_what_bake_vmt_refuses(tmp_path):
+    """write_vmt("s.vtf", "s.vtf") turned the texture into a 103-byte
+    material, and write_vmt("x.png", ...) overwrote the PNG: as `bake
+    --vmt`, a material's name ends in .vmt and is no texture it names."""
+    stone = tmp_path / "materials/stone"
+    stone.mkdir(parents=True)
+    texture, png = stone / "s.vtf", stone / "x.png"
+    texture.write_bytes(b"VTF\0 a texture")
+    png.write_bytes(b"a png")
+    for path in (texture, png, stone / "s.vtf.txt"):
+        with pytest.raises(bumpbake.ArgumentError, match="ends in .vmt"):
+            bumpbake.write_vmt(path, texture)
+    os.link(texture, stone / "s.vmt")
+    with pytest.raises(bumpbake.ArgumentError, match="would overwrite the texture"):
+        bumpbake.write_vmt(stone / "s.vmt", texture)
+    assert texture.read_bytes() == b"VTF\0 a texture" and png.read_bytes() == b"a png"
+    assert sorted(os.listdir(stone)) == ["s.vmt", "s.vtf", "x.png"]

@@ -510,10 +510,23 @@ bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
     st = bb__fail(err, BB_ERR_FORMAT, "%s: unknown VTF image format %d", path, info->format);
     goto done;
   }
-  if ((has_low && low_at + low_bytes > file_size) || image_at + data > file_size) {
+  /* Each part said where it lies: the low-resolution image and the image
+   * data are checked apart (a low-resolution resource past the end once
+   * gave "needs 3636 bytes, the file has 3636"). */
+  if (has_low && low_at + low_bytes > file_size) {
     st = bb__fail(err, BB_ERR_FORMAT,
-                  "%s: truncated VTF: its data needs %llu bytes, the file has %llu", path,
-                  (unsigned long long)(image_at + data), (unsigned long long)file_size);
+                  "%s: truncated VTF: its low-resolution image (%llu bytes at offset %llu) "
+                  "ends past the end of the file (%llu bytes)",
+                  path, (unsigned long long)low_bytes, (unsigned long long)low_at,
+                  (unsigned long long)file_size);
+    goto done;
+  }
+  if (image_at + data > file_size) {
+    st = bb__fail(err, BB_ERR_FORMAT,
+                  "%s: truncated VTF: its image data (%llu bytes at offset %llu) ends past "
+                  "the end of the file (%llu bytes)",
+                  path, (unsigned long long)data, (unsigned long long)image_at,
+                  (unsigned long long)file_size);
     goto done;
   }
 

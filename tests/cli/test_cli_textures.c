@@ -13,7 +13,7 @@
 
 #include <math.h>
 
-TestSuite(cli_textures, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(cli_textures, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 /* A 64 x 64 height with relief: bumps that shadow each other. */
 static void relief(const char *path, int width, int height) {

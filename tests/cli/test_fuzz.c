@@ -89,7 +89,7 @@ static void replay(const char *name, fuzz_target target, int expected_at_least) 
   }
 }
 
-TestSuite(fuzz, .timeout = 60);
+TestSuite(fuzz, .timeout = 300);
 
 /* getopt kept a pointer into the previous argv (freed by then) when a parse
  * stopped inside a cluster ("-xr5": unknown -x, "r5" pending); the next

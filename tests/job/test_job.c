@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-TestSuite(job, .init = harness_setup, .fini = harness_teardown, .timeout = 30);
+TestSuite(job, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 /* A small height file in the test's directory. */
 static const char *height_file(void) {
