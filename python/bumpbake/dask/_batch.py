@@ -11,6 +11,7 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
+from ._connect import ClusterLost, completed, settle
 from ._shared import client_directory, client_of, variable_value, worker_threads
 
 # Inputs per chunk: enough chunks that the last ones end together (the
@@ -157,12 +158,16 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         raise _argument_error(f"bumpbake.dask: chunk_size must be a positive integer "
                               f"(got {chunk_size!r})")
     token = uuid.uuid4().hex
-    stop = None
-    if not keep_going or progress is not None:
-        stop = _Stop(f"bumpbake-stop-{token}")
-        distributed.Variable(stop.name, client=client).set(_NO_STOP)
+    # Always there: a client that gives up (Ctrl-C, an exception) stops
+    # every chunk before its next input, keep_going or not.
+    stop = _Stop(f"bumpbake-stop-{token}")
+    distributed.Variable(stop.name, client=client).set(_NO_STOP)
     chunks = [pending[c:c + size] for c in range(0, len(pending), size)]
     futures = {}
+
+    def stop_all():
+        distributed.Variable(stop.name, client=client).set(-1)
+
     try:
         for n, chunk in enumerate(chunks):
             f = client.submit(_bake_chunk, directory, [inputs_planned[i] for i in chunk], chunk,
@@ -170,16 +175,21 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
                               key=f"bumpbake-chunk-{token}-{n}", pure=False)
             futures[f] = chunk
         done = count - len(pending)
-        for f in distributed.as_completed(list(futures)):
+        for f in completed(client, list(futures)):
             for index, report in f.result():
                 reports[index] = report
                 done += 1
             if progress is not None and progress(done, count):
-                distributed.Variable(stop.name, client=client).set(-1)
-    except BaseException:
-        if stop is not None:
-            distributed.Variable(stop.name, client=client).set(-1)
-        client.cancel(list(futures))
+                stop_all()
+    except BaseException as e:
+        # Nothing that has not started starts: the queued chunks are
+        # cancelled, the running ones stop before their next input (a
+        # running input is finished, whole: a task cannot be killed).
+        settle(client, stop_all)
+        settle(client, lambda: client.cancel(list(futures)))
+        if isinstance(e, ClusterLost):
+            # what the workers it lost were writing
+            sweep_temporaries(_output_directories(job.report(i) for i in range(count)))
         raise
     finally:
         # Released now, not when the frame goes (an exception's traceback
@@ -188,8 +198,7 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         for f in futures:
             f.release()
         futures.clear()
-        if stop is not None:
-            distributed.Variable(stop.name, client=client).delete()
+        settle(client, lambda: distributed.Variable(stop.name, client=client).delete())
     for i in range(count):
         if reports[i] is None:
             reports[i] = job.report(i)
