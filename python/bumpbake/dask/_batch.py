@@ -4,6 +4,7 @@ batch."""
 
 import math
 import os
+import time
 import uuid
 
 import distributed
@@ -37,9 +38,26 @@ class _Stop:
     Inputs after it that have not started are not run; those before it
     still run, as in the CLI's batch, which would have baked them first."""
 
+    # Seconds between two looks at the variable during one input's bake.
+    LOOK_EVERY = 0.5
+
     def __init__(self, name):
         self.name = name
         self.over = False  # the batch ended: this chunk is a re-run nobody waits for
+        self._next_look = 0.0
+
+    def abandoned(self, done=None, total=None):
+        """During an input's bake (its progress callback): whether the
+        client gave up (Ctrl-C, its own error: the variable is -1, or gone),
+        looked at every LOOK_EVERY seconds. The bake is then cancelled and
+        writes nothing: an input that failed stops only later inputs."""
+        now = time.monotonic()
+        if self.over or now < self._next_look:
+            return self.over
+        self._next_look = now + self.LOOK_EVERY
+        stop = variable_value(self.name, None)
+        self.over = stop is None or stop < 0
+        return self.over
 
     def reached(self, index):
         if self.over:
@@ -70,7 +88,7 @@ def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
             if stop is not None and stop.reached(index):
                 out.append((index, None))
                 continue
-            report = job.run(k)
+            report = job.run(k, progress=stop.abandoned if stop is not None else None)
             if report.status == "failed" and stop_on_failure:
                 stop.lower(index)
             out.append((index, report))
