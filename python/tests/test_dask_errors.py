@@ -39,9 +39,11 @@ class Cluster:
     """dask-scheduler and one dask-worker (one thread, no nanny: killed, it
     stays dead) as subprocesses on 127.0.0.1."""
 
-    def __init__(self, directory):
+    def __init__(self, directory, package=True):
         self.address = f"tcp://127.0.0.1:{_free_port()}"
         env = dict(os.environ, PYTHONPATH=PYTHON_DIR)
+        if not package:  # a worker that cannot import bumpbake
+            del env["PYTHONPATH"]
         quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
                      cwd=directory)
         self.scheduler = subprocess.Popen(
@@ -138,6 +140,21 @@ def test_a_python_without_distributed_or_numpy_names_the_package(tmp_path):
             env=dict(os.environ, PYTHONPATH=PYTHON_DIR))
         assert out.returncode == 1
         assert package in out.stderr.splitlines()[-1], out.stderr
+
+
+def test_a_worker_without_the_package_is_one_line(tmp_path, monkeypatch, cli):
+    monkeypatch.chdir(tmp_path)
+    heights("in", 2, side=16)
+    os.makedirs("empty")
+    cluster = Cluster(tmp_path / "empty", package=False)
+    try:
+        for how in (["in", "--out-dir", "out"], ["in/h00.png", "-o", "out/m"]):
+            out = cli("bake", *how, "--scale", "16", "--scheduler", cluster.address,
+                      check=False)
+            assert out.returncode == 1
+            assert "a Dask worker cannot import bumpbake: install" in _one_line(out.stderr)
+    finally:
+        cluster.close()
 
 
 # ------------------------------------------------------- a cluster lost

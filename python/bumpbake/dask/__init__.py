@@ -27,5 +27,6 @@ except ImportError as e:
 
 from ._batch import bake_files
 from ._big import bake_big
+from ._connect import ClusterLost
 
-__all__ = ["bake_big", "bake_files"]
+__all__ = ["ClusterLost", "bake_big", "bake_files"]
