@@ -817,6 +817,102 @@ if scale=$(grep -ao 'scale [0-9.e+-]*' "$OUTF" "$ERRF" | head -n 1 | awk '{ prin
 fi
 report
 
+# ---------------------------------------------- issue 32: the cluster path
+
+# 32.6: a malformed --scheduler gave a 27-44-line traceback and exit 1; it is
+# a usage error (one line, exit 2) found before connecting. A refused
+# connection took Dask's 30 s; it is one line at once.
+if "$PY" -c 'import distributed' 2>/dev/null; then
+  ids=(a b c d e f)
+  n=0
+  for address in garbage "" "tcp://[::1" inproc://x tcp://127.0.0.1:8786/path tcp://127.0.0.1:99999; do
+    begin "32.6${ids[n]}" "bake --scheduler '$address'"
+    n=$((n + 1))
+    run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "$address"
+    WANT_RC=2 TMAX=15 MSG="--scheduler" finish
+  done
+  begin 32.6g "bake --scheduler ADDRESS where nothing listens"
+  port=$("$PY" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "tcp://127.0.0.1:$port"
+  TMAX=15 MSG="connection refused" finish
+else
+  skip 32.6 "bake --scheduler: malformed and refused addresses" "no python3-distributed"
+fi
+
+# 32.7, 32.8: a scheduler and one worker (no nanny) on 127.0.0.1, killed or
+# left alone while a batch of 60 maps runs: the scheduler killed gave a
+# 62-127-line traceback after 35 s, the only worker killed a hang, Ctrl-C
+# exit 130 but the workers went on writing. Each is one line, files whole,
+# no temporary, and after Ctrl-C nothing is written once the client is gone.
+cluster_start() {
+  port=$("$PY" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  ADDRESS=tcp://127.0.0.1:$port
+  (cd "$C" && exec "$PY" -m distributed.cli.dask_scheduler --host 127.0.0.1 --port "$port" \
+    --no-dashboard) >"$LOG/$ID.scheduler" 2>&1 &
+  SCHED=$!
+  (cd "$C" && PYTHONPATH=$ROOT/python exec "$PY" -m distributed.cli.dask_worker "$ADDRESS" \
+    --nthreads 1 --no-nanny --memory-limit 0 --no-dashboard --local-directory "$W/dask-$ID") \
+    >"$LOG/$ID.worker" 2>&1 &
+  WORKER=$!
+  "$PY" -c 'import sys, distributed
+with distributed.Client(sys.argv[1], timeout=120) as c: c.wait_for_workers(1, timeout=120)' \
+    "$ADDRESS" >/dev/null 2>&1
+}
+cluster_stop() { kill "$SCHED" "$WORKER" 2>/dev/null; wait "$SCHED" "$WORKER" 2>/dev/null; }
+# after_files N SIGNAL PID: sends SIGNAL to PID once out/ holds N files.
+after_files() {
+  (for _ in $(seq 1200); do
+    [ "$(ls out 2>/dev/null | wc -l)" -ge "$1" ] && { kill -s "$2" "$3"; exit; }
+    sleep 0.1
+  done) &
+}
+whole() { # every output read back, no temporary
+  [ -n "$(find out -name '.bb-tmp*' 2>/dev/null)" ] && bad "a temporary was left"
+  for f in out/*.png; do
+    [ -e "$f" ] && ! "$BIN" info "$f" >/dev/null 2>&1 && bad "$f is not whole"
+  done
+}
+if "$PY" -c 'import distributed' 2>/dev/null; then
+  begin 32.7a "bake DIR --scheduler: the scheduler killed mid-batch"
+  mkdir in && for i in $(seq -w 1 60); do cp h.png "in/h$i.png"; done
+  cluster_start
+  after_files 3 KILL "$SCHED"
+  TLIM=120 run "$BIN" bake in --scale 8 --out-dir out -q --scheduler "$ADDRESS"
+  cluster_stop
+  whole
+  TMAX=60 MSG="the Dask cluster was lost" ALLOW='^out/' finish
+
+  begin 32.7b "bake DIR --scheduler: the only worker killed mid-batch"
+  mkdir in && for i in $(seq -w 1 60); do cp h.png "in/h$i.png"; done
+  cluster_start
+  after_files 3 KILL "$WORKER"
+  TLIM=120 run "$BIN" bake in --scale 8 --out-dir out -q --scheduler "$ADDRESS"
+  cluster_stop
+  whole
+  TMAX=60 MSG="no worker left" ALLOW='^out/' finish
+
+  begin 32.8a "bake DIR --scheduler: Ctrl-C, then nothing more is written"
+  mkdir in && for i in $(seq -w 1 60); do cp h.png "in/h$i.png"; done
+  cluster_start
+  # SIGINT as a terminal sends it: a background job of a script ignores
+  # SIGINT, so a small Python parent starts the bake with it restored.
+  TLIM=120 run "$PY" -c 'import os, signal, subprocess, sys, time
+bake = subprocess.Popen(sys.argv[1:], preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+while bake.poll() is None and len(os.listdir("out") if os.path.isdir("out") else ()) < 3:
+    time.sleep(0.05)
+bake.send_signal(signal.SIGINT)
+rc = bake.wait()
+sys.exit(128 - rc if rc < 0 else rc)' "$BIN" bake in --scale 8 --out-dir out -q --keep-going --scheduler "$ADDRESS"
+  at_exit=$(ls out | wc -l)
+  sleep 10
+  [ "$(ls out | wc -l)" = "$at_exit" ] || bad "$at_exit files at exit, $(ls out | wc -l) 10 s later"
+  cluster_stop
+  whole
+  SIGOK=1 WANT_RC=130 FAIL_LINES="0 1" TMAX=60 ALLOW='^out/' finish
+else
+  skip 32.7 "bake --scheduler: a cluster lost, Ctrl-C" "no python3-distributed"
+fi
+
 [ ${#not_clean_ids[@]} -gt 0 ] && echo "not clean: ${not_clean_ids[*]}"
 echo "$tried cases tried, $clean clean$([ $skipped -gt 0 ] && echo ", $skipped skipped")"
 [ $clean = $tried ] && [ $skipped = 0 ]

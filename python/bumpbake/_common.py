@@ -10,7 +10,11 @@ read.
 import os
 import warnings
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError as e:  # one line naming what to install, not a bare ImportError
+    raise ModuleNotFoundError(f"bumpbake needs numpy ({e}): install Debian's python3-numpy",
+                              name=e.name) from None
 
 from . import _library
 
