@@ -53,7 +53,9 @@ ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
+# OpenEXR's IlmThread: bumpbake's provider for its pool (src/io/exr_pool.cpp).
+EXR_POOL_LIBS := $(filter -lIlmThread%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) $(EXR_POOL_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
