@@ -16,9 +16,9 @@
  * is that floor.
  */
 #include "bumpbake.h"
-#include "io/formats.h"
-#include "io/oiio_calls.h"
-#include "io/safe_file.h"
+#include "image/formats.h"
+#include "image/oiio_calls.h"
+#include "files/safe_file.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -119,9 +119,3 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     *kept = l.alive;
   return l.peak;
 }
-
-uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o) {
-  if (!o || width <= 0 || height <= 0)
-    return 0;
-  return (uint64_t)bb__bake_memory(width, height, o, 0, 0.0, NULL);
-}

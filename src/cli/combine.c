@@ -1,4 +1,4 @@
-/* cli_combine.c: `bumpbake combine`, blending two maps by a mask or a
+/* combine.c: `bumpbake combine`, blending two maps by a mask or a
  * constant, or overlaying a detail map (docs/commands/combine.md). */
 #include "cli.h"
 #include "common.h"

@@ -1,4 +1,4 @@
-/* cli_height2ssbump.c: `bumpbake height2ssbump`, a drop-in for Valve's tool
+/* height2ssbump.c: `bumpbake height2ssbump`, a drop-in for Valve's tool
  * of that name (docs/conventions.md "Valve compatibility"): same flags, same
  * defaults, same output files (FILE-ssbump.tga or FILE-bump.tga, RGBA). */
 #include "cli.h"

@@ -1,4 +1,4 @@
-/* cli_main.c: the bumpbake program: dispatches to a subcommand, answers
+/* main.c: the bumpbake program: dispatches to a subcommand, answers
  * --help and --version. */
 #include "cli.h"
 #include "common.h"

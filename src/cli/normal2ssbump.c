@@ -1,4 +1,4 @@
-/* cli_normal2ssbump.c: `bumpbake normal2ssbump`, Valve's SDK tool of that
+/* normal2ssbump.c: `bumpbake normal2ssbump`, Valve's SDK tool of that
  * name: a normal map to unshadowed basis weights, written by default where
  * Valve's tool writes them (NAME_ssbump.tga). */
 #include "cli.h"

@@ -1,4 +1,4 @@
-/* cli_options.c: the option rows every baking command shares, strict number
+/* options.c: the option rows every baking command shares, strict number
  * parsing, the option parser and --help built from a command's table, and
  * the shared bake settings (whose ranges the library checks). */
 #include "common.h"

@@ -1,4 +1,4 @@
-/* cli_program.c: `bumpbake program`, a DOOM 3 image program (the text of a
+/* program.c: `bumpbake program`, a DOOM 3 image program (the text of a
  * material's bumpmap or diffusemap stage) evaluated outside the engine. */
 #include "cli.h"
 #include "common.h"

@@ -1,4 +1,4 @@
-/* cli_ssbump2normal.c: `bumpbake ssbump2normal`, the normal an ssbump (or
+/* ssbump2normal.c: `bumpbake ssbump2normal`, the normal an ssbump (or
  * normal2ssbump's weights) stands for: the paper's normalize(sum s_c B_c). */
 #include "cli.h"
 #include "common.h"

@@ -10,39 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A growing string; any failed step leaves failed set. */
-typedef struct text {
-  char *data;
-  size_t length, capacity;
-  int failed;
-} text;
-
-static void add(text *t, const char *s) {
-  const size_t n = strlen(s);
-  if (t->failed)
-    return;
-  if (t->length + n + 1 > t->capacity) {
-    size_t cap = t->capacity ? 2 * t->capacity : 128;
-    while (cap < t->length + n + 1)
-      cap *= 2;
-    char *grown = realloc(t->data, cap);
-    if (!grown) {
-      t->failed = 1;
-      return;
-    }
-    t->data = grown;
-    t->capacity = cap;
-  }
-  memcpy(t->data + t->length, s, n + 1);
-  t->length += n;
-}
-
-static void add_option(text *t, const char *name, const char *value) {
-  add(t, " ");
-  add(t, name);
+static void add_option(bb__text *t, const char *name, const char *value) {
+  bb__text_add(t, " ");
+  bb__text_add(t, name);
   if (value) {
-    add(t, " ");
-    add(t, value);
+    bb__text_add(t, " ");
+    bb__text_add(t, value);
   }
 }
 
@@ -64,19 +37,19 @@ static void double_text(double v, char *buf, size_t cap) {
   }
 }
 
-static void add_float(text *t, const char *name, float v) {
+static void add_float(bb__text *t, const char *name, float v) {
   char buf[32];
   float_text(v, buf, sizeof buf);
   add_option(t, name, buf);
 }
 
-static void add_double(text *t, const char *name, double v) {
+static void add_double(bb__text *t, const char *name, double v) {
   char buf[40];
   double_text(v, buf, sizeof buf);
   add_option(t, name, buf);
 }
 
-static void add_int(text *t, const char *name, long v) {
+static void add_int(bb__text *t, const char *name, long v) {
   char buf[24];
   snprintf(buf, sizeof buf, "%ld", v);
   add_option(t, name, buf);
@@ -84,7 +57,7 @@ static void add_int(text *t, const char *name, long v) {
 
 /* The bake's settings that differ from bb_job_options_init's, in the order
  * of `bumpbake bake --help`. */
-static void add_settings(text *t, const bb_job_options *o) {
+static void add_settings(bb__text *t, const bb_job_options *o) {
   bb_job_options d;
   bb_job_options_init(&d);
   const bb_bake_options *b = &o->bake, *db = &d.bake;
@@ -129,7 +102,7 @@ static void add_settings(text *t, const bb_job_options *o) {
 }
 
 /* The outputs: one by one, or a batch's directory, maps and names. */
-static void add_outputs(text *t, const bb_job_options *o) {
+static void add_outputs(bb__text *t, const bb_job_options *o) {
   if (!o->out_dir) {
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       if (o->paths[k]) {
@@ -164,7 +137,7 @@ static void add_outputs(text *t, const bb_job_options *o) {
 
 /* The engine textures' settings and the Source material, last in --help.
  * threads is left out: the bytes are the same for any count. */
-static void add_texture(text *t, const bb_job_options *o) {
+static void add_texture(bb__text *t, const bb_job_options *o) {
   bb_texture_options d;
   bb_texture_options_init(&d);
   const bb_texture_options *x = &o->texture;
@@ -195,9 +168,9 @@ static void add_texture(text *t, const bb_job_options *o) {
 char *bb_job_command_text(const bb_job_options *o, const char *input) {
   if (!o || !input)
     return NULL;
-  text t = {0};
-  add(&t, "bumpbake bake ");
-  add(&t, input);
+  bb__text t = {0};
+  bb__text_add(&t, "bumpbake bake ");
+  bb__text_add(&t, input);
   add_settings(&t, o);
   add_outputs(&t, o);
   add_texture(&t, o);
@@ -214,12 +187,12 @@ char *bb__job_command_of(const bb_job *job, const bb__job_item *item) {
   if (!job->command_options)
     return bb_job_command_text(&job->options, item->input);
   /* "bumpbake bake INPUT OPTIONS", as a batch run by hand records it. */
-  text t = {0};
-  add(&t, "bumpbake bake ");
-  add(&t, item->input);
+  bb__text t = {0};
+  bb__text_add(&t, "bumpbake bake ");
+  bb__text_add(&t, item->input);
   if (job->command_options[0]) {
-    add(&t, " ");
-    add(&t, job->command_options);
+    bb__text_add(&t, " ");
+    bb__text_add(&t, job->command_options);
   }
   if (t.failed) {
     free(t.data);

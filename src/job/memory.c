@@ -4,7 +4,7 @@
  * machine has left, so a map too large is refused with the figures. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
-#include "io/texture.h"
+#include "texture/texture.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>
@@ -19,10 +19,10 @@ static double sample_bytes(bb_depth depth, const char *path) {
   }
 }
 
-/* An engine texture's encoder (io/texture_write.c): the map's mip chain in
+/* An engine texture's encoder (image/texture_write.c): the map's mip chain in
  * float, made whether it is written or not, and every level in the file's
  * format (4/3 of the top level's bytes), twice for colour blocks (range
- * fit's candidates beside cluster fit's, io/blocks.h). */
+ * fit's candidates beside cluster fit's, texture/blocks.h). */
 static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,
                             int w, int h, int channels) {
   const bb_texture_options t = bb__job_texture_of(&job->options.texture, kind->name, kind->range);

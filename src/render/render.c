@@ -9,9 +9,8 @@
  * function and one row of `modes` below.
  */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
-#include "maps/maps_internal.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

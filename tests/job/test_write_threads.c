@@ -1,7 +1,7 @@
 /* test_write_threads.c: a set of outputs written by bb_outputs_write is the
  * same bytes on 1, 2 and 3 threads, whatever encodes each file on more than
  * one (an engine texture's blocks, an OpenEXR file's chunks on
- * io/exr_pool.h's workers, several PNGs side by side); and OpenEXR files
+ * image/exr_pool.h's workers, several PNGs side by side); and OpenEXR files
  * carry the compression chosen for their depth (PIZ for half, none for
  * float: docs/performance.md), with the pixels the image had. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
