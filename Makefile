@@ -57,7 +57,9 @@ SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
 # linked into the CLI, not the library).
 MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
 MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
+# OpenEXR's IlmThread: bumpbake's provider for its pool (src/image/exr_pool.cpp).
+EXR_POOL_LIBS := $(filter -lIlmThread%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) $(EXR_POOL_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif

@@ -82,8 +82,13 @@ extern "C" {
  * whatever the size. The first read or write also lowers OpenImageIO's
  * process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16 bytes (16384)
  * and "limits:channels" to 64 when they are higher, and sets its
- * "exr_threads" to -1 (OpenEXR without its own thread pool, which crashed
- * when started short of memory). */
+ * "exr_threads" to -1 (OpenImageIO leaves OpenEXR's thread pool alone: its
+ * own crashed when started short of memory). The first OpenEXR write
+ * installs bumpbake's provider for OpenEXR's global pool, unless the
+ * process set that pool up first: it compresses the chunks of the EXR files
+ * bumpbake writes on the write's threads (bb_outputs_write's, all cores for
+ * bb_image_write), and leaves every other read and write of OpenEXR on its
+ * own thread. */
 #define BB_MAX_READ_BYTES (1L << 30)
 #define BB_MAX_READ_BYTES_PER_TEXEL 16
 

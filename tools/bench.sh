@@ -740,9 +740,16 @@ if [ "$blocks_ok" = 1 ]; then
     "worst $(blocks_field '^squish +ssbump +vtf bc1' 8) codes of 255"
   summary_row "normal DDS BC5, rock06 1024 (PSNR dB)" \
     "$(blocks_field '^squish +normal +dds bc5' 6)" \
-    "mean angle $(blocks_field '^squish +normal +dds bc5' 10) deg"
-  summary_row "2048^2 ssbump: VTF DXT1 + mips (s)" "$(blocks_field '^vtf +[0-9]' 2)" \
-    "PNG $(blocks_field '^png ' 2) s; range fit $(blocks_field '^vtf --fast' 3) s"
+    "mean angle $(blocks_field '^squish +normal +dds bc5' 12) deg"
+  for size in 1024 2048; do
+    summary_row "${size}^2 ssbump: VTF DXT1 + mips, $threads thr (s)" \
+      "$(blocks_field "^$size +vtf --threads 2 " 5)" \
+      "DDS BC1 $(blocks_field "^$size +dds --threads 2 " 5) s; PNG $(blocks_field "^$size +png " 3) s; range fit $(blocks_field "^$size +vtf --fast" 6) s"
+  done
+  for f in png exr-float exr-half vtf dds; do
+    summary_row "bake's write stage, $f (x the stages)" "$(blocks_field "^$f: " 6)" \
+      "write $(blocks_field "^$f: " 3) s, trace $(blocks_field "^$f: " 2) s"
+  done
 fi
 if [ "$bounce_ok" = 1 ]; then
   # "  trench, converged: added A, exact E (+D)"

@@ -15,9 +15,12 @@
 # also the mean and worst angle between decoded and true normals. Then the
 # same with NVIDIA Texture Tools' nvcompress (Debian's libnvtt-bin, if
 # installed) on the 8-bit PNG of each map (its BC1 output differs from run
-# to run: one run each, so its rows move in the last digits), and the time
-# to write a 2048 x 2048 ssbump as VTF DXT1 with mips against writing it as
-# PNG, and nvcompress's time for the same DDS BC1 with mips.
+# to run: one run each, so its rows move in the last digits). Then the
+# time block compression takes: a 1024 and a 2048 ssbump written as VTF DXT1
+# and DDS BC1 with their mips (2 threads, and 1 for 1024) against writing
+# them as PNG, and nvcompress's time for the same DDS BC1 with mips; and the
+# write stage of a bake (PNG, float and half EXR, VTF, DDS) against its
+# trace, from bake --json's stages.
 set -eu
 
 BIN=${1:-build/bumpbake}
@@ -93,16 +96,26 @@ else
   echo "== nvcompress not found (apt-get install libnvtt-bin for the NVIDIA Texture Tools rows)"
 fi
 
-echo "== time: a 2048 x 2048 ssbump (rock06 resized, scale 128), median of 3 writes, in-process"
+echo "== time: block compression of a 1024 and a 2048 ssbump (rock06, resized for 2048; scale 128),"
+echo "   written in-process by texture_quality write, median of 3"
+median() { sort -n | sed -n 2p; }
+"$BIN" bake "$FIX/rock06_height.png" --scale 128 --ssbump "$OUT/ss1024.exr" -q
 oiiotool "$FIX/rock06_height.png" --resize 2048x2048 -d uint16 -o "$OUT/h2048.png"
 "$BIN" bake "$OUT/h2048.png" --scale 128 --ssbump "$OUT/ss2048.exr" -q
-median() { sort -n | sed -n 2p; }
-for target in "png" "vtf" "vtf --fast" "dds"; do
-  set -- $target
-  ext=$1
-  shift
-  t=$(for i in 1 2 3; do "$TQ" write "$OUT/ss2048.exr" "$OUT/ss2048.$ext" --map ssbump "$@"; done | median)
-  printf '%-26s %s s  %s bytes\n' "$ext ${*:-}" "$t" "$(wc -c <"$OUT/ss2048.$ext")"
+printf '%-6s %-24s %9s %12s\n' size file seconds bytes
+for size in 1024 2048; do
+  for target in "png" "vtf --threads 2" "vtf --threads 1" "vtf --fast --threads 2" \
+    "dds --threads 2" "dds --threads 1"; do
+    set -- $target
+    ext=$1
+    shift
+    # one thread at 2048 takes half a minute a run: 1024 shows the speed-up
+    case "$size $*" in "2048 "*"--threads 1") continue ;; esac
+    t=$(for i in 1 2 3; do
+      "$TQ" write "$OUT/ss$size.exr" "$OUT/ss$size.$ext" --map ssbump "$@"
+    done | median)
+    printf '%-6s %-24s %9s %12s\n' "$size" "$ext ${*:-}" "$t" "$(wc -c <"$OUT/ss$size.$ext")"
+  done
 done
 if command -v nvcompress >/dev/null 2>&1; then
   "$TQ" write "$OUT/ss2048.exr" "$OUT/ss2048_8.png" >/dev/null
@@ -112,9 +125,48 @@ if command -v nvcompress >/dev/null 2>&1; then
       nvcompress $target -bc1 "$OUT/ss2048_8.png" "$OUT/ss2048_nvtt.dds" >/dev/null 2>&1
       awk -v a="$(date +%s.%N)" -v b="$s" 'BEGIN { printf "%.3f\n", a - b }'
     done | median)
-    printf '%-26s %s s  %s bytes\n' "dds nvcompress ${target:-}" "$t" "$(wc -c <"$OUT/ss2048_nvtt.dds")"
+    printf '%-6s %-24s %9s %12s\n' 2048 "dds nvcompress ${target:-}" "$t" \
+      "$(wc -c <"$OUT/ss2048_nvtt.dds")"
   done
 fi
-echo "(png: 8-bit through OpenImageIO; vtf: DXT1 + 12 mip levels + low-res; dds: BC1 + mips;"
-echo " threads: all $(nproc) cores; nvcompress: the whole process, from the 8-bit PNG, its own"
-echo " threads)"
+echo "(png: 8-bit through OpenImageIO; vtf: DXT1 + all mip levels + low-res; dds: BC1 + mips;"
+echo " --fast: range fit alone; nvcompress: the whole process, from the 8-bit PNG, its own threads)"
+
+echo "== the write stage of a bake against its trace: rock06 1024 x 1024, scale 128, 256 rays,"
+echo "   2 threads (bake --json's stages), median of 3"
+# json_num KEY FILE: a number of the bake's JSON line.
+json_num() { sed -n "s/.*\"$1\":\([0-9][0-9.eE+-]*\).*/\1/p" "$2" | head -n1; }
+printf '%-10s %8s %8s %8s %12s %12s  %s\n' outputs trace_s write_s stages_s write/trace write/stages \
+  options
+for job in "png -o:w" "exr-float --ao:a.exr --ssbump:s.exr" \
+  "exr-half --ao:a.exr --ssbump:s.exr --depth half" "vtf --ssbump:s.vtf" "dds --ssbump:s.dds" \
+  "vtf-fast --ssbump:s.vtf --fast-compression"; do
+  set -- $job
+  label=$1
+  shift
+  args=
+  for a in "$@"; do
+    case $a in
+    *:*) args="$args ${a%%:*} $OUT/bake_${a#*:}" ;;
+    *) args="$args $a" ;;
+    esac
+  done
+  for i in 1 2 3; do
+    # shellcheck disable=SC2086
+    "$BIN" bake "$FIX/rock06_height.png" --scale 128 --rays 256 --threads 2 --json -q $args \
+      >"$OUT/stage_$label.$i.json"
+  done
+  med() { for i in 1 2 3; do json_num "$1" "$OUT/stage_$label.$i.json"; done | median; }
+  stages=$(for i in 1 2 3; do
+    f=$OUT/stage_$label.$i.json
+    awk -v a="$(json_num load "$f")" -v b="$(json_num smooth "$f")" -v c="$(json_num pyramid "$f")" \
+      -v d="$(json_num trace "$f")" -v e="$(json_num derive "$f")" -v g="$(json_num write "$f")" \
+      'BEGIN { printf "%.3f\n", a + b + c + d + e + g }'
+  done | median)
+  trace=$(med trace) write=$(med write)
+  printf '%-10s %8.3f %8.3f %8.3f %12s %12s  %s\n' "$label:" "$trace" "$write" "$stages" \
+    "$(awk -v a="$write" -v b="$trace" 'BEGIN { printf "%.3f", a / b }')" \
+    "$(awk -v a="$write" -v b="$stages" 'BEGIN { printf "%.3f", a / b }')" "$(echo "$@" | tr ':' ' ')"
+done
+echo "(png -o: normal, ssbump and ao as 8-bit PNG; exr: float, or half with --depth half;"
+echo " stages_s: the sum of the bake's stages, load to write; the goal is write/stages under 0.10)"

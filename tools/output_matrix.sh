@@ -78,6 +78,21 @@ run rock_16 bake $rock --scale 64 --depth 16 --normal out/rock_16_normal.png --a
 run rock_mips bake $rock --scale 64 --mips --normal out/rock_mips_normal.tif --ssbump out/rock_mips_ssbump.exr
 run rock_half bake $rock --scale 64 --depth half --ao out/rock_half_ao.exr --rays 64 --normal-y up \
   --bent out/rock_half_bent.exr
+# Engine textures: VTF and DDS in each block format and fit, 1 and 2 threads,
+# a thin strip (its levels down to 1 x 1 are rows of half blocks) and a
+# Source material.
+for t in 1 2; do
+  run tex_vtf$t bake $rock --scale 64 --threads $t --ssbump out/tex_vtf${t}_ssbump.vtf \
+    --normal out/tex_vtf${t}_normal.vtf --vtf-version 7.3 --vmt out/tex_vtf$t.vmt --materials out
+  run tex_dds$t bake $rock --scale 64 --threads $t --ssbump out/tex_dds${t}_ssbump.dds \
+    --normal out/tex_dds${t}_normal.dds --ao out/tex_dds${t}_ao.dds
+done
+run tex_fast bake $rock --scale 64 --ssbump out/tex_fast_ssbump.vtf --normal out/tex_fast_normal.dds \
+  --texture-format bc1 --fast-compression
+run tex_bc3 height2ssbump -A in/rock06_128.png 16 -o out/tex_h2s.vtf
+oiiotool $rock --cut 1024x16+0+0 --resize 4096x16 -o in/strip.png
+run tex_strip bake in/strip.png --scale 64 --ssbump out/tex_strip_ssbump.vtf \
+  --bent out/tex_strip_bent.dds --texture-format bc1
 run rock_slope bake in/rock06_128.png --scale 16 --slope out/rock_slope.png --lit 135,45
 run normal normal in/rock06_128.png --scale 16 -o out/normal.png --normal-filter valve
 run normal_up normal in/noise_96x80.png --scale 8 -o out/normal_up.tga --normal-y up

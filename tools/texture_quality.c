@@ -11,14 +11,16 @@
  *       level K of IN to an 8-bit PNG, to look at: a .vtf through the tests'
  *       own decoder (tests/texture/texture_oracle.h: DXT1, DXT5, BGR888,
  *       BGRA8888), anything else (.dds) through OpenImageIO.
- *   texture_quality compare REF DECODED [--map ...] [--channels N]
+ *   texture_quality compare REF DECODED [--map ...] [--channels N] [--level K]
  *       DECODED (.vtf as above, else OpenImageIO: a DDS, a PNG) against REF,
- *       the float map (normal maps as N, compared as 0.5 + 0.5 N): PSNR and
- *       max error in 8-bit code units over the first N channels (default:
- *       REF's, or 3 for a grey REF against colour); for normal maps also
- *       the angle between the decoded (renormalised) and true normals, and
- *       the error of z alone. One line: "psnr_db P max_codes M [angle_mean_deg
- *       A angle_max_deg B z_max_codes Z]".
+ *       the float map (normal maps as N, compared as 0.5 + 0.5 N): PSNR,
+ *       max and mean error in 8-bit code units over the first N channels
+ *       (default: REF's, or 3 for a grey REF against colour); for normal
+ *       maps also the angle between the decoded (renormalised) and true
+ *       normals, and the error of z alone. --level K compares DECODED's mip
+ *       level K with level K of REF's chain (bb_mip_chain, normals
+ *       renormalised). One line: "psnr_db P max_codes M mean_codes E
+ *       [angle_mean_deg A angle_max_deg B z_max_codes Z]".
  */
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
@@ -195,15 +197,17 @@ static int cmd_decode(int argc, char **argv) {
 
 static int cmd_compare(int argc, char **argv) {
   if (argc < 2)
-    return fail("compare REF DECODED [--map M] [--channels N]", NULL);
+    return fail("compare REF DECODED [--map M] [--channels N] [--level K]", NULL);
   bb_texture_map map = BB_TEXTURE_MAP_PLAIN;
-  int channels = 0;
+  int channels = 0, level = 0;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (strcmp(argv[i], "--map") == 0) {
       if (parse_map(argv[i + 1], &map) != 0)
         return fail("--map plain|normal|ssbump", NULL);
     } else if (strcmp(argv[i], "--channels") == 0) {
       channels = atoi(argv[i + 1]);
+    } else if (strcmp(argv[i], "--level") == 0) {
+      level = atoi(argv[i + 1]);
     } else {
       return fail(argv[i], NULL);
     }
@@ -212,7 +216,20 @@ static int cmd_compare(int argc, char **argv) {
   bb_error err;
   if (bb_image_read(argv[0], &ref, NULL, &err) != BB_OK)
     return fail(argv[0], &err);
-  if (read_any(argv[1], 0, &dec) != 0)
+  if (level > 0) {
+    bb_image *chain = NULL;
+    int count = 0;
+    if (bb_mip_chain(&ref, map == BB_TEXTURE_MAP_NORMAL ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE,
+                     &chain, &count, &err) != BB_OK)
+      return fail(argv[0], &err);
+    if (level >= count)
+      return fail("--level past the chain's last level", NULL);
+    bb_image_free(&ref);
+    ref = chain[level];
+    chain[level] = (bb_image){0};
+    bb_mip_chain_free(chain, count);
+  }
+  if (read_any(argv[1], level, &dec) != 0)
     return 1;
   if (ref.width != dec.width || ref.height != dec.height)
     return fail("sizes differ", NULL);
@@ -221,7 +238,7 @@ static int cmd_compare(int argc, char **argv) {
   if (channels > dec.channels)
     channels = dec.channels;
   const int normal = map == BB_TEXTURE_MAP_NORMAL;
-  double se = 0, max = 0, angle_sum = 0, angle_max = 0, z_max = 0;
+  double se = 0, sum = 0, max = 0, angle_sum = 0, angle_max = 0, z_max = 0;
   size_t n = (size_t)ref.width * (size_t)ref.height, samples = 0;
   for (size_t i = 0; i < n; i++) {
     const float *r = ref.pixels + i * (size_t)ref.channels;
@@ -233,6 +250,7 @@ static int cmd_compare(int argc, char **argv) {
       want = want < 0 ? 0 : want > 1 ? 1 : want;
       const double e = fabs((double)d[k] - want) * 255.0;
       se += e * e;
+      sum += e;
       max = e > max ? e : max;
       samples++;
     }
@@ -254,8 +272,8 @@ static int cmd_compare(int argc, char **argv) {
     }
   }
   const double mse = se / (double)samples;
-  printf("psnr_db %.2f max_codes %.1f", mse > 0 ? 10.0 * log10(255.0 * 255.0 / mse) : 99.0,
-         max);
+  printf("psnr_db %.2f max_codes %.1f mean_codes %.3f",
+         mse > 0 ? 10.0 * log10(255.0 * 255.0 / mse) : 99.0, max, sum / (double)samples);
   if (normal && dec.channels >= 3)
     printf(" angle_mean_deg %.3f angle_max_deg %.2f z_max_codes %.1f", angle_sum / (double)n,
            angle_max, z_max);

@@ -95,6 +95,10 @@ int bb__path_holds_mips(const char *path) {
 
 int bb_path_supports_mips(const char *path) { return bb__path_holds_mips(path); }
 
+const char *bb__exr_compression(bb_depth depth) {
+  return depth == BB_DEPTH_HALF ? "piz" : "none";
+}
+
 int bb__path_resolved_depth(const char *path, bb_depth depth) {
   const format_rule *f = find_format(path);
   if (!f) return -1;

@@ -5,6 +5,7 @@
  * for the caller, or removed on any failure. */
 #include "core/internal.h"
 #include "image/formats.h"
+#include "image/image_write.h"
 #include "image/oiio_calls.h"
 #include "files/safe_file.h"
 #include "texture/texture.h"
@@ -42,20 +43,20 @@ static bb_status write_texture(const char *path, const bb_image *levels, int cou
 }
 
 static bb_status write_image(const char *path, const bb_image *img,
-                             const bb_write_options *options, bb_staged_file *f,
+                             const bb_write_options *options, int threads, bb_staged_file *f,
                              bb_error *err) {
   bb_depth depth;
   bb_status st = bb__write_check(path, img, options, &depth, err);
   if (st != BB_OK) return st;
   if (bb_path_is_texture_format(path)) return write_texture(path, img, 1, 0, options, f, err);
   st = bb__oiio_write_image(path, img, depth, options ? options->range : BB_RANGE_UNIT,
-                            options ? options->description : NULL, f, err);
+                            options ? options->description : NULL, threads, NULL, f, err);
   if (st != BB_OK) bb__safe_discard(f);
   return st;
 }
 
 static bb_status write_mips(const char *path, const bb_image *levels, int count,
-                            const bb_write_options *options, bb_staged_file *f,
+                            const bb_write_options *options, int threads, bb_staged_file *f,
                             bb_error *err) {
   bb_depth depth;
   bb_status st = bb__write_mips_check(path, levels, count, options, &depth, err);
@@ -63,7 +64,7 @@ static bb_status write_mips(const char *path, const bb_image *levels, int count,
   if (bb_path_is_texture_format(path))
     return write_texture(path, levels, count, 1, options, f, err);
   st = bb__oiio_write_mips(path, levels, count, depth, options ? options->range : BB_RANGE_UNIT,
-                           options ? options->description : NULL, f, err);
+                           options ? options->description : NULL, threads, f, err);
   if (st != BB_OK) bb__safe_discard(f);
   return st;
 }
@@ -73,19 +74,25 @@ bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_o
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write: path is NULL");
   bb_staged_file f;
   bb__safe_init(&f);
-  bb_status st = write_image(path, img, options, &f, err);
+  bb_status st = write_image(path, img, options, 0, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
 
 bb_status bb_image_write_staged(const char *path, const bb_image *img,
                                 const bb_write_options *options, bb_staged_file **staged,
                                 bb_error *err) {
+  return bb__image_write_staged(path, img, options, 0, staged, err);
+}
+
+bb_status bb__image_write_staged(const char *path, const bb_image *img,
+                                 const bb_write_options *options, int threads,
+                                 bb_staged_file **staged, bb_error *err) {
   if (!staged) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: staged is NULL");
   *staged = NULL;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: path is NULL");
   bb_staged_file *f = bb__staged_new();
   if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  bb_status st = write_image(path, img, options, f, err);
+  bb_status st = write_image(path, img, options, threads, f, err);
   if (st != BB_OK) {
     free(f);
     return st;
@@ -99,20 +106,26 @@ bb_status bb_image_write_mips(const char *path, const bb_image *levels, int coun
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
   bb_staged_file f;
   bb__safe_init(&f);
-  bb_status st = write_mips(path, levels, count, options, &f, err);
+  bb_status st = write_mips(path, levels, count, options, 0, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
 
 bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
                                      const bb_write_options *options,
                                      bb_staged_file **staged, bb_error *err) {
+  return bb__image_write_mips_staged(path, levels, count, options, 0, staged, err);
+}
+
+bb_status bb__image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                      const bb_write_options *options, int threads,
+                                      bb_staged_file **staged, bb_error *err) {
   if (!staged)
     return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: staged is NULL");
   *staged = NULL;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: path is NULL");
   bb_staged_file *f = bb__staged_new();
   if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  bb_status st = write_mips(path, levels, count, options, f, err);
+  bb_status st = write_mips(path, levels, count, options, threads, f, err);
   if (st != BB_OK) {
     free(f);
     return st;

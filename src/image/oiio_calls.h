@@ -38,18 +38,21 @@ char *bb__oiio_extension_list(void);
 
 /* Encodes img at depth (resolved, checked by bb__write_check) into a
  * finished temporary for path (f: see safe_file.h), for the caller to
- * commit or discard. */
+ * commit or discard; an OpenEXR file's chunks are compressed on up to
+ * `threads` threads (0 = all cores; exr_pool.h), with exr_compression
+ * (OpenImageIO's name: "piz", "zip:1"...) or, when NULL, the library's
+ * rule (bb__exr_compression); tools/exr_compression.c measures the others. */
 bb_status bb__oiio_write_image(const char *path, const bb_image *img, bb_depth depth,
-                               bb_range range, const char *description, bb_staged_file *f,
-                               bb_error *err);
+                               bb_range range, const char *description, int threads,
+                               const char *exr_compression, bb_staged_file *f, bb_error *err);
 
 /* ----------------------------------------------- mip chains (oiio_mips.cpp) */
 
 /* Encodes the chain (checked by bb__write_mips_check) as one tiled,
- * mip-mapped file into a finished temporary for path. */
+ * mip-mapped file into a finished temporary for path (threads as above). */
 bb_status bb__oiio_write_mips(const char *path, const bb_image *levels, int count,
                               bb_depth depth, bb_range range, const char *description,
-                              bb_staged_file *f, bb_error *err);
+                              int threads, bb_staged_file *f, bb_error *err);
 
 /* ------------------------------------------------ animations (oiio_gif.cpp) */
 

@@ -4,6 +4,7 @@
 // C (formats.c); the public writes are image_write.c.
 #include "core/internal.h"
 #include "image/oiio.h"
+#include "image/exr_pool.h"
 #include "image/formats.h"
 #include "image/oiio_calls.h"
 #include "image/oiio_guard.h"
@@ -18,6 +19,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <new>
 #include <vector>
 
@@ -73,7 +75,11 @@ template <typename T> bool write_level_codes(ImageOutput &out, const bb_image &i
 // level. proxy may be null. Returns "" or OpenImageIO's reason.
 std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy *proxy,
                         const bb_image *levels, int count, bb_depth depth, bb_range range,
-                        const char *description) {
+                        const char *description, int threads) {
+  // OpenEXR compresses tiles from the first open() to close(), and out is
+  // destroyed before this scope ends.
+  std::optional<bb::ExrWriteThreads> exr_threads;
+  if (bb__path_has_extension(file_name.c_str(), "exr")) exr_threads.emplace(threads);
   auto out = ImageOutput::create(file_name, proxy);
   if (!out) return bb::one_line(OIIO::geterror());
   // OpenEXR stores MIP levels; OpenImageIO's TIFF writer does not, but it
@@ -92,7 +98,9 @@ std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy 
     spec.attribute("textureformat", "Plain Texture");
     bb::set_common_attributes(spec);
     if (description) spec.attribute("ImageDescription", description);
-    spec.attribute("compression", "zip");
+    spec.attribute("compression", std::strcmp(out->format_name(), "openexr") == 0
+                                      ? bb__exr_compression(depth)
+                                      : "zip");
     if (!out->open(file_name, spec, k == 0 ? ImageOutput::Create : append))
       return bb::one_line(out->geterror());
     bool ok;
@@ -195,11 +203,11 @@ extern "C" {
 
 bb_status bb__oiio_write_mips(const char *path, const bb_image *levels, int count,
                               bb_depth depth, bb_range range, const char *description,
-                              bb_staged_file *f, bb_error *err) {
+                              int threads, bb_staged_file *f, bb_error *err) {
   return bb::guard(err, path, bb::WRITING, [&] {
     bb::oiio_setup();
     auto encode = [&](const std::string &name, OIIO::Filesystem::IOProxy *proxy) {
-      return encode_mips(name, proxy, levels, count, depth, range, description);
+      return encode_mips(name, proxy, levels, count, depth, range, description, threads);
     };
     if (bb__path_has_extension(path, "exr") || count == 1)
       return bb::write_staged(path, encode, f, err);

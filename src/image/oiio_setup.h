@@ -9,14 +9,13 @@ namespace bb {
 // - OpenImageIO's own guards against headers that declare absurd sizes,
 //   which some readers check in open(), before bumpbake sees the header:
 //   "limits:imagesize_MB" to BB_MAX_READ_BYTES, "limits:channels" to 64.
-// - "exr_threads" to -1: OpenEXR without its own thread pool. OpenEXR 3.1's
-//   IlmThread pool, started under memory pressure (a thread it could not
-//   create), later posted to a semaphore it had freed: SIGSEGV in 28 of 80
-//   bakes writing an EXR under `ulimit -v` 534..546 MB, none without the
-//   pool. Without it OpenEXR's readers also keep one chunk buffer, not two
-//   per thread. bumpbake writes its files in parallel itself; rock06's four
-//   EXR maps took as long to write either way (0.68 s and 0.69 s, 5 runs
-//   each, alternated).
+// - "exr_threads" to -1: OpenImageIO never sizes OpenEXR's thread pool.
+//   OpenEXR 3.1's own pool, started under memory pressure (a thread it
+//   could not create), later posted to a semaphore it had freed: SIGSEGV in
+//   28 of 80 bakes writing an EXR under `ulimit -v` 534..546 MB, none
+//   without the pool. EXR writes compress their chunks on bumpbake's own
+//   provider for that pool instead (exr_pool.h), and readers keep OpenEXR's
+//   one chunk buffer, not two per thread.
 void oiio_setup();
 
 } // namespace bb

@@ -20,8 +20,9 @@ static double sample_bytes(bb_depth depth, const char *path) {
 }
 
 /* An engine texture's encoder (image/texture_write.c): the map's mip chain in
- * float, made whether it is written or not, and one buffer of the top
- * level in the file's format. */
+ * float, made whether it is written or not, and every level in the file's
+ * format (4/3 of the top level's bytes), twice for colour blocks (range
+ * fit's candidates beside cluster fit's, texture/blocks.h). */
 static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,
                             int w, int h, int channels) {
   const bb_texture_options t = bb__job_texture_of(&job->options.texture, kind->name, kind->range);
@@ -29,7 +30,7 @@ static double texture_bytes(const bb_job *job, const char *path, const bb_output
   const double top = bb__texture_resolve(path, w, h, channels, &t, &format, NULL) == BB_OK
                          ? (double)bb__texture_level_bytes(format, w, h)
                          : 16.0 * w * h; /* refused by the write: the widest format */
-  return (double)w * (double)h * channels * 4.0 * 4.0 / 3.0 + top;
+  return (double)w * (double)h * channels * 4.0 * 4.0 / 3.0 + 2.0 * top * 4.0 / 3.0;
 }
 
 double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,

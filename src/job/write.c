@@ -6,6 +6,7 @@
  * new. */
 #include "core/internal.h"
 #include "files/safe_file.h"
+#include "image/image_write.h"
 #include "image/oiio.h"
 #include "job/job_internal.h"
 
@@ -62,6 +63,8 @@ static void commit_end(void) {
 /* One file of the set as it goes: staged, then put in place. */
 typedef struct staged {
   const bb_output_file *file;
+  int threads;            /* the set's: an OpenEXR file's chunks are
+                             compressed on these (image/image_write.h) */
   bb_staged_file *handle; /* NULL when staging failed */
   bb_status status;
   bb_error error;
@@ -90,14 +93,14 @@ static bb_status stage_text(const bb_output_file *o, bb_staged_file **out, bb_er
 }
 
 /* An image's mip chain, renormalised for normal maps, as one staged file. */
-static bb_status stage_mips(const bb_output_file *o, const bb_write_options *wo,
+static bb_status stage_mips(const bb_output_file *o, const bb_write_options *wo, int threads,
                             bb_staged_file **out, bb_error *err) {
   bb_image *levels = NULL;
   int count = 0;
   bb_status st =
       bb_mip_chain(o->image, bb__mip_filter(o->range == BB_RANGE_SIGNED), &levels, &count, err);
   if (st == BB_OK)
-    st = bb_image_write_mips_staged(o->path, levels, count, wo, out, err);
+    st = bb__image_write_mips_staged(o->path, levels, count, wo, threads, out, err);
   bb_mip_chain_free(levels, count);
   return st;
 }
@@ -119,8 +122,9 @@ static void stage_one(void *user, int item) {
     return;
   }
   const bb_write_options wo = {o->depth, o->range, o->description, NULL};
-  s->status = o->mips ? stage_mips(o, &wo, &s->handle, &s->error)
-                      : bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
+  s->status = o->mips ? stage_mips(o, &wo, s->threads, &s->handle, &s->error)
+                      : bb__image_write_staged(o->path, o->image, &wo, s->threads, &s->handle,
+                                               &s->error);
 }
 
 /* --------------------------------------------------------------- commits */
@@ -177,8 +181,10 @@ bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, 
   if (!set)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", files[0].path);
   for (int i = 0; i < count; i++)
-    set[i].file = &files[i];
-  /* Encoding runs side by side, at most one thread per file. */
+    set[i].file = &files[i], set[i].threads = threads;
+  /* Files are encoded side by side, at most one thread per file; within a
+   * file, an engine texture's blocks and an OpenEXR file's chunks are
+   * compressed on `threads` more (the bytes are the same on any count). */
   int workers = threads <= 0 || threads > count ? count : threads;
   bb_status st = bb__parallel_for(count, workers, stage_one, set, NULL, NULL, err);
   int failed = -1;

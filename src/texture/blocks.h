@@ -19,27 +19,64 @@ typedef enum bb__block_format {
   BB__BLOCK_BC2      /* DXT3: BC1 colour + 4-bit explicit alpha, 16 bytes (decoded only) */
 } bb__block_format;
 
+/* How colour blocks (BC1, BC3's colour) are fitted; BC4 and BC5 have one way. */
+typedef enum bb__block_fit {
+  BB__FIT_BEST = 0, /* cluster fit, or range fit where a level gains (below) */
+  BB__FIT_RANGE,    /* range fit alone: --fast-compression */
+  BB__FIT_CLUSTER   /* cluster fit alone: for tests and measurements */
+} bb__block_fit;
+
 /* Bytes of one 4 x 4 block of format: 8 or 16. */
 size_t bb__block_bytes(bb__block_format format);
 
 /* Bytes of a width x height image in format: ceil(w/4) x ceil(h/4) blocks. */
 size_t bb__blocks_size(bb__block_format format, int width, int height);
 
-/* Compresses width x height texels of rgba (4 floats per texel, row-major,
- * values in [0, 1]; outside is clamped, NaN counts as 0) into out, which
- * holds bb__blocks_size bytes: blocks row by row, as DDS and VTF store
- * them. Each value is first rounded to 8 bits (round half up), as the codec
+/* Writes the texels x0..x0+w-1, y0..y0+h-1 (w, h at most 4, all inside the
+ * image) of source as RGBA floats in [0, 1] into rgba[4 * (4 * y + x) + c],
+ * y and x counted from y0 and x0. Called from any of the worker threads. */
+typedef void (*bb__block_texels_fn)(const void *source, int x0, int y0, int w, int h,
+                                    float rgba[64]);
+
+/* One image to compress: its size, where its texels come from, and out,
+ * which holds bb__blocks_size bytes: blocks row by row, as DDS and VTF
+ * store them. */
+typedef struct bb__block_image {
+  int width, height;
+  bb__block_texels_fn texels;
+  const void *source;
+  unsigned char *out;
+} bb__block_image;
+
+/* Compresses every image of images[0..count-1] (a texture's mip levels,
+ * largest first) in one job on `threads` threads (0 = all cores): the rows
+ * of blocks of all the images are handed out in turn, so small levels fill
+ * the threads as the large one ends. Each value is first rounded to 8 bits
+ * (round half up; outside [0, 1] clamped, NaN counts as 0), as the codec
  * works on bytes. BC1 takes R, G, B; BC3 R, G, B, A; BC4 R; BC5 R and G.
  * Sides need not be multiples of 4: the texels past an edge are left out
- * of the fit (a mip level of 2 x 2 is one block). fast selects the codec's
- * range fit (about 40 times faster, about 1.7 dB lower PSNR on colour
- * blocks) instead of its cluster fit; BC4 and BC5 blocks are the same
- * either way. Blocks are compressed on `threads` threads (0 = all cores);
- * each block depends only on its texels, so out is the same for any count.
- * Errors: BB_ERR_ARGUMENT (bad format or size), BB_ERR_MEMORY, and any
- * exception of the codec, turned into a message. */
+ * of the fit (a mip level of 2 x 2 is one block).
+ *
+ * BB__FIT_BEST fits each image's colour blocks (BC1, BC3's colour) by the
+ * codec's cluster fit and by its range fit, and keeps the range fit's
+ * blocks for an image where their squared error (8-bit codes, R, G, B, the
+ * codec's own decoder, against the rounded texels) is under 90% of cluster
+ * fit's: never worse than cluster fit alone on a level, and a gain under
+ * any decoder's rounding (squish.cpp says why per level and 10%).
+ * BB__FIT_RANGE takes the range fit alone (about 30 times faster, about
+ * 1.8 dB lower PSNR). BC4 and BC5 blocks are the same whatever the fit.
+ *
+ * Each block depends only on its texels, so the bytes are the same for any
+ * thread count. Errors: BB_ERR_ARGUMENT (bad format or size),
+ * BB_ERR_MEMORY, and any exception of the codec, turned into a message. */
+bb_status bb__blocks_compress_images(const bb__block_image *images, int count,
+                                     bb__block_format format, bb__block_fit fit, int threads,
+                                     bb_error *err);
+
+/* bb__blocks_compress_images of one image given as width x height texels
+ * of rgba (4 floats per texel, row-major) into out. */
 bb_status bb__blocks_compress(const float *rgba, int width, int height,
-                              bb__block_format format, int fast, int threads,
+                              bb__block_format format, bb__block_fit fit, int threads,
                               unsigned char *out, bb_error *err);
 
 /* Decodes width x height texels from blocks (bb__blocks_size bytes of

@@ -118,18 +118,26 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *chain, int levels,
   put_u32(h + 80, pf_flags);
   put_u32(h + 108, DDSCAPS_TEXTURE | (mips ? DDSCAPS_COMPLEX | DDSCAPS_MIPMAP : 0));
 
-  unsigned char *buffer = malloc(top_bytes);
-  if (!buffer)
+  /* Every level, largest first as the file holds them, compressed in one job. */
+  size_t data_bytes = 0;
+  for (int k = 0; k < levels; k++)
+    data_bytes += bb__texture_level_bytes(format, chain[k].width, chain[k].height);
+  unsigned char *data = malloc(data_bytes ? data_bytes : 1);
+  unsigned char **at = malloc((size_t)levels * sizeof *at);
+  if (!data || !at)
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  for (size_t offset = 0, k = 0; st == BB_OK && k < (size_t)levels; k++) {
+    at[k] = data + offset;
+    offset += bb__texture_level_bytes(format, chain[k].width, chain[k].height);
+  }
   if (st == BB_OK)
+    st = bb__texture_encode_levels(chain, levels, o->map, format, o->fast, o->threads, at, err);
+  if (st == BB_OK) {
     bb__safe_write(f, h, dx10 ? 148 : 128);
-  for (int k = 0; k < levels && st == BB_OK; k++) {
-    st = bb__texture_encode(&chain[k], o->map, format, o->fast, o->threads, buffer, err);
-    if (st == BB_OK)
-      bb__safe_write(f, buffer,
-                     bb__texture_level_bytes(format, chain[k].width, chain[k].height));
+    bb__safe_write(f, data, data_bytes);
   }
   /* Write errors are kept by f and reported when the caller finishes it. */
-  free(buffer);
+  free(at);
+  free(data);
   return st;
 }

@@ -304,43 +304,24 @@ static void put_f32(unsigned char *p, float v) {
     p[k] = (unsigned char)((u >> (8 * k)) & 0xff);
 }
 
-/* Rows of texels expanded to RGBA floats at once for the block codec: 64
- * rows (16 rows of blocks) keep the buffer at width x 1 KiB. */
-enum { BAND_ROWS = 64 };
+/* The block codec's view of a level: its texels as the engine samples them. */
+typedef struct level_source {
+  const bb_image *level;
+  bb_texture_map map;
+} level_source;
 
-static bb_status encode_blocks(const bb_image *level, bb_texture_map map,
-                               bb__block_format block, int fast, int threads,
-                               unsigned char *out, bb_error *err) {
-  const int w = level->width, h = level->height;
-  const int rows = h < BAND_ROWS ? h : BAND_ROWS;
-  float *band = malloc((size_t)w * (size_t)rows * 4 * sizeof(float));
-  if (!band)
-    return bb__fail(err, BB_ERR_MEMORY, "texture: out of memory (%d x %d level)", w, h);
-  bb_status st = BB_OK;
-  for (int y0 = 0; y0 < h && st == BB_OK; y0 += BAND_ROWS) {
-    const int n = h - y0 < BAND_ROWS ? h - y0 : BAND_ROWS;
-    for (int y = 0; y < n; y++)
-      for (int x = 0; x < w; x++)
-        bb__texture_texel(level, map, (size_t)(y0 + y) * (size_t)w + (size_t)x,
-                          band + ((size_t)y * (size_t)w + (size_t)x) * 4);
-    /* y0 is a multiple of 4, so the band starts a row of blocks, after the
-     * blocks of the y0 rows above it (none for y0 = 0). */
-    unsigned char *dst = out + bb__blocks_size(block, w, y0);
-    st = bb__blocks_compress(band, w, n, block, fast, threads, dst, err);
-  }
-  free(band);
-  return st;
+static void level_texels(const void *source, int x0, int y0, int w, int h, float rgba[64]) {
+  const level_source *s = source;
+  const size_t width = (size_t)s->level->width;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      bb__texture_texel(s->level, s->map, (size_t)(y0 + y) * width + (size_t)(x0 + x),
+                        rgba + 4 * (4 * y + x));
 }
 
-bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
-                             bb_texture_format format, int fast, int threads,
-                             unsigned char *out, bb_error *err) {
-  const format_info *f = info_of(format);
-  if (!f || format == BB_TEXTURE_FORMAT_DEFAULT || !level || !level->pixels || !out)
-    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad level or format");
-  if (f->block)
-    return encode_blocks(level, map, (bb__block_format)(f->block - 1), fast, threads, out,
-                         err);
+/* One level in a texel format, texel by texel. */
+static void encode_texels(const bb_image *level, bb_texture_map map, bb_texture_format format,
+                          int texel_bytes, unsigned char *out) {
   const size_t n = (size_t)level->width * (size_t)level->height;
   unsigned char *p = out;
   for (size_t i = 0; i < n; i++) {
@@ -361,17 +342,54 @@ bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
       for (int c = 0; c < 4; c++)
         put_u16(p + 2 * c, imath_float_to_half(t[c]));
       break;
-    case BB_TEXTURE_FORMAT_RGBA32F:
+    default: /* BB_TEXTURE_FORMAT_RGBA32F */
       for (int c = 0; c < 4; c++)
         put_f32(p + 4 * c, t[c]);
       break;
-    default:
-      return bb__fail(err, BB_ERR_ARGUMENT, "texture: format %s is not a texel format",
-                      f->name);
     }
-    p += f->texel_bytes;
+    p += texel_bytes;
   }
-  return BB_OK;
+}
+
+bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_texture_map map,
+                                    bb_texture_format format, int fast, int threads,
+                                    unsigned char *const *out, bb_error *err) {
+  const format_info *f = info_of(format);
+  if (!f || format == BB_TEXTURE_FORMAT_DEFAULT || count < 1 || !levels || !out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad levels or format");
+  for (int k = 0; k < count; k++)
+    if (!levels[k].pixels || !out[k])
+      return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad level %d", k);
+  if (!f->block) {
+    for (int k = 0; k < count; k++)
+      encode_texels(&levels[k], map, format, f->texel_bytes, out[k]);
+    return BB_OK;
+  }
+  level_source *sources = malloc((size_t)count * sizeof *sources);
+  bb__block_image *images = malloc((size_t)count * sizeof *images);
+  bb_status st = BB_OK;
+  if (!sources || !images) {
+    st = bb__fail(err, BB_ERR_MEMORY, "texture: out of memory");
+  } else {
+    for (int k = 0; k < count; k++) {
+      sources[k] = (level_source){&levels[k], map};
+      images[k] = (bb__block_image){levels[k].width, levels[k].height, level_texels,
+                                    &sources[k], out[k]};
+    }
+    st = bb__blocks_compress_images(images, count, (bb__block_format)(f->block - 1),
+                                    fast ? BB__FIT_RANGE : BB__FIT_BEST, threads, err);
+  }
+  free(images);
+  free(sources);
+  return st;
+}
+
+bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
+                             bb_texture_format format, int fast, int threads,
+                             unsigned char *out, bb_error *err) {
+  if (!level)
+    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad level or format");
+  return bb__texture_encode_levels(level, 1, map, format, fast, threads, &out, err);
 }
 
 /* ----------------------------------------------------- maps, provenance */

@@ -45,9 +45,16 @@ int bb__texture_format_has_alpha(bb_texture_format format);
  * normal maps mapped to 0.5 + 0.5 v; not clamped. */
 void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]);
 
-/* Encodes one level into format's bytes (bb__texture_level_bytes of them)
- * at out, little-endian; block formats on `threads` threads (fast: the
- * codec's fast fit). */
+/* Encodes levels[0..count-1] into out[k], bb__texture_level_bytes(format,
+ * levels[k]) bytes each, little-endian. Block formats compress all the
+ * levels in one job on `threads` threads (0 = all cores), the same bytes on
+ * any count; fast: the codec's range fit alone, else BB__FIT_BEST (blocks.h). Pass the largest
+ * level first: its rows are handed out first, the small levels' fill in. */
+bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_texture_map map,
+                                    bb_texture_format format, int fast, int threads,
+                                    unsigned char *const *out, bb_error *err);
+
+/* bb__texture_encode_levels of one level. */
 bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
                              bb_texture_format format, int fast, int threads,
                              unsigned char *out, bb_error *err);

@@ -220,35 +220,38 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *chain, int levels,
     }
   }
 
-  /* One buffer for the largest level written (level 0) serves them all. */
-  size_t buffer_bytes = bb__texture_level_bytes(format, chain[0].width, chain[0].height);
-  if (buffer_bytes < low_bytes)
-    buffer_bytes = low_bytes;
-  unsigned char *buffer = malloc(buffer_bytes);
-  if (!buffer)
+  /* The low-resolution image, then the levels, smallest first, as the
+   * file holds them; the levels are compressed in one job, largest first. */
+  unsigned char *low_blocks = malloc(low_bytes);
+  unsigned char *data = malloc(data_bytes ? (size_t)data_bytes : 1);
+  unsigned char **at = malloc((size_t)levels * sizeof *at);
+  if (!low_blocks || !data || !at)
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   if (st == BB_OK) {
-    bb__safe_write(f, header, header_size);
-    st = bb__texture_encode(low, o->map, BB_TEXTURE_FORMAT_BC1, o->fast, o->threads, buffer,
-                            err);
+    size_t offset = (size_t)data_bytes;
+    for (int k = 0; k < levels; k++) {
+      offset -= bb__texture_level_bytes(format, chain[k].width, chain[k].height);
+      at[k] = data + offset;
+    }
+    st = bb__texture_encode(low, o->map, BB_TEXTURE_FORMAT_BC1, o->fast, 1, low_blocks, err);
   }
+  if (st == BB_OK)
+    st = bb__texture_encode_levels(chain, levels, o->map, format, o->fast, o->threads, at, err);
   if (st == BB_OK) {
-    bb__safe_write(f, buffer, low_bytes);
+    bb__safe_write(f, header, header_size);
+    bb__safe_write(f, low_blocks, low_bytes);
     if (kvd) {
       unsigned char size[4];
       put_u32(size, (uint32_t)kvd_bytes);
       bb__safe_write(f, size, 4);
       bb__safe_write(f, kvd, kvd_bytes);
     }
-  }
-  for (int k = levels - 1; k >= 0 && st == BB_OK; k--) {
-    st = bb__texture_encode(&chain[k], o->map, format, o->fast, o->threads, buffer, err);
-    if (st == BB_OK)
-      bb__safe_write(f, buffer, bb__texture_level_bytes(format, chain[k].width,
-                                                        chain[k].height));
+    bb__safe_write(f, data, (size_t)data_bytes);
   }
   /* Write errors are kept by f and reported when the caller finishes it. */
-  free(buffer);
+  free(at);
+  free(data);
+  free(low_blocks);
   free(kvd);
   return st;
 }
