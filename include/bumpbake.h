@@ -61,7 +61,7 @@ extern "C" {
  * core: status, errors, limits, images
  * ===================================================================== */
 
-#define BB_VERSION_STRING "0.3.0"
+#define BB_VERSION_STRING "0.4.0"
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
