@@ -693,12 +693,12 @@ if "$PY" -c 'import distributed' 2>/dev/null; then
   for address in garbage "" "tcp://[::1" inproc://x tcp://127.0.0.1:8786/path tcp://127.0.0.1:99999; do
     begin "32.6${ids[n]}" "bake --scheduler '$address'"
     n=$((n + 1))
-    run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "$address"
+    TLIM=120 run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "$address"
     WANT_RC=2 TMAX=15 MSG="--scheduler" finish
   done
   begin 32.6g "bake --scheduler ADDRESS where nothing listens"
   port=$("$PY" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-  run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "tcp://127.0.0.1:$port"
+  TLIM=120 run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "tcp://127.0.0.1:$port"
   TMAX=15 MSG="connection refused" finish
 else
   skip 32.6 "bake --scheduler: malformed and refused addresses" "no python3-distributed"
