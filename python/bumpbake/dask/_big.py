@@ -22,7 +22,7 @@ import distributed
 import numpy as np
 
 from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _kinds_mask
-from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _text
+from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
 from ._connect import ClusterLost, completed, settle
@@ -150,7 +150,7 @@ def _build(task, threads):
     err = _ffi.new("bb_error *")
     height = _ffi.new("bb_image *")
     source = _ffi.new("bb_height_source *")
-    _check(_lib.bb_height_file_read(os.fsencode(task["path"]), _channel(task["channel"]),
+    _check(_lib.bb_height_file_read(_path(task["path"]), _channel(task["channel"]),
                                     float(task["scale"]), _ffi.NULL, _ffi.NULL, height,
                                     source, err), err)
     try:
