@@ -80,9 +80,10 @@ def _one_line(err):
 
 # ------------------------------------------------------------ the address
 
-BAD_ADDRESSES = ["garbage", "", "tcp://[::1", "inproc://x", "tcp://127.0.0.1:8786/path",
-                 "tcp://127.0.0.1:99999", "tcp://127.0.0.1:0", "tcp://::1:8786",
-                 "tcp://host:port", "http://127.0.0.1:8786", "tcp://a b:1"]
+BAD_ADDRESSES = ["garbage", "", "tcp://[::1", "inproc://x", "tcp://127.0.0.1:8786/path"]
+MORE_BAD = ["tcp://127.0.0.1:99999", "tcp://127.0.0.1:0", "tcp://::1:8786", "tcp://host:port",
+            "http://127.0.0.1:8786", "tcp://a b:1", "tcp://[nohost]:1", "tcp://h:1\x1b[2J",
+            "tcp://user@h:1"]
 
 
 @pytest.mark.parametrize("address", BAD_ADDRESSES)
@@ -95,6 +96,13 @@ def test_a_malformed_scheduler_is_a_usage_error_in_one_line(tmp_path, monkeypatc
     assert out.returncode == 2, out.stderr
     assert _one_line(out.stderr).startswith("bumpbake bake: --scheduler")
     assert sorted(os.listdir(".")) == ["h00.png"]
+
+
+def test_more_malformed_addresses_are_one_line():
+    for address in MORE_BAD:
+        with pytest.raises(bumpbake.ArgumentError, match="^--scheduler") as e:
+            _connect.scheduler_address(address)
+        assert str(e.value).isprintable(), str(e.value)
 
 
 def test_good_addresses_are_taken():
@@ -148,11 +156,10 @@ def test_a_worker_without_the_package_is_one_line(tmp_path, monkeypatch, cli):
     os.makedirs("empty")
     cluster = Cluster(tmp_path / "empty", package=False)
     try:
-        for how in (["in", "--out-dir", "out"], ["in/h00.png", "-o", "out/m"]):
-            out = cli("bake", *how, "--scale", "16", "--scheduler", cluster.address,
-                      check=False)
-            assert out.returncode == 1
-            assert "a Dask worker cannot import bumpbake: install" in _one_line(out.stderr)
+        out = cli("bake", "in", "--out-dir", "out", "--scale", "16", "--scheduler",
+                  cluster.address, check=False)
+        assert out.returncode == 1
+        assert "a Dask worker cannot import bumpbake: install" in _one_line(out.stderr)
     finally:
         cluster.close()
 
