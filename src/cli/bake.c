@@ -2,6 +2,7 @@
  * batch of them (--out-dir): the options parsed into a bb_job_options, the
  * job planned, run and reported by the library (bb_job_*); this file keeps
  * the words. */
+#include "bake_options.h"
 #include "cli.h"
 #include "cluster.h"
 #include "common.h"
@@ -133,14 +134,17 @@ static const cli_option opt_brightness = {
     .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights "
             "(a texel over 1 is scaled down whole)"};
 
+/* The bake's parameters and its outputs one by one: bake's and serve's. */
+#define BAKE_PARAMETER_ROWS                                                              \
+  &cli_opt_scale, &cli_opt_rays, &opt_slices, &cli_opt_filter_radius,                    \
+      &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,          \
+      &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,       \
+      &cli_opt_channel, &cli_opt_depth, &cli_opt_mips, &opt_bounce, &opt_bounces,        \
+      &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights,            \
+      &opt_out_ssbump, &opt_out_ao, &opt_out_bent, &opt_out_filtered
+
 static const cli_option *const bake_options[] = {
-    &cli_opt_scale,    &cli_opt_rays,      &opt_slices,       &cli_opt_filter_radius,
-    &cli_opt_filter_threshold, &cli_opt_bias, &cli_opt_power, &cli_opt_basis,
-    &cli_opt_normal_filter, &cli_opt_normal_y, &cli_opt_threads, &cli_opt_clamp,
-    &cli_opt_channel,  &cli_opt_depth,     &cli_opt_mips,     &opt_bounce,
-    &opt_bounces,      &opt_bounce_albedo, &opt_brightness,   &opt_out_normal,
-    &opt_out_weights,  &opt_out_ssbump,    &opt_out_ao,       &opt_out_bent,
-    &opt_out_filtered, &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
+    BAKE_PARAMETER_ROWS,  &cli_opt_slope,     &cli_opt_slope_lit, &opt_prefix,
     &opt_out_dir,      &opt_maps,          &opt_name,         &opt_keep_going,
     &opt_force,        &opt_depfile,       &opt_json,         &opt_quiet,
     CLI_TEXTURE_OPTIONS, &cli_opt_vmt,     &cli_opt_materials, &cli_opt_basetexture,
@@ -182,16 +186,46 @@ typedef struct bake_args {
   const char *scheduler; /* --scheduler ADDRESS, or NULL */
 } bake_args;
 
-static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
-  bake_args *a = ctx;
+int cli_bake_parameter(const char *command, cli_settings *s, bb_job_options *job,
+                       const cli_option *opt, const char *arg) {
   if (opt->id >= CLI_OPT_OUT_NORMAL && opt->id <= CLI_OPT_OUT_FILTERED) {
-    a->job.paths[opt->id - CLI_OPT_OUT_NORMAL] = arg;
+    job->paths[opt->id - CLI_OPT_OUT_NORMAL] = arg;
     return 0;
   }
+  switch (opt->id) {
+  case CLI_OPT_OUTPUT: job->prefix = arg; return 0;
+  case CLI_OPT_SLICES: return cli_settings_apply_slices(command, s, arg);
+  case CLI_OPT_BOUNCE:
+    return cli_parse_double(command, "--bounce", arg, 0.0, 0, 1.0, &s->bake.bounce_albedo);
+  case CLI_OPT_BOUNCES:
+    return cli_parse_int(command, "--bounces", arg, 0, BB_MAX_BOUNCES, &s->bake.bounces);
+  case CLI_OPT_BOUNCE_ALBEDO: job->bounce_albedo_file = arg; return 0;
+  case CLI_OPT_BRIGHTNESS: job->brightness_file = arg; return 0;
+  default: break;
+  }
+  return cli_settings_apply(command, s, opt, arg);
+}
+
+void cli_bake_settings_to_job(const cli_settings *s, bb_job_options *job) {
+  job->bake = s->bake;
+  job->channel = s->channel;
+  job->depth = s->depth;
+  job->mips = s->mips;
+  job->texture = s->texture;
+  job->basis_file = s->basis_file;
+}
+
+const cli_option *const cli_bake_parameter_rows[] = {
+    BAKE_PARAMETER_ROWS, &opt_prefix, CLI_TEXTURE_OPTIONS,
+};
+const int cli_bake_parameter_row_count =
+    (int)(sizeof cli_bake_parameter_rows / sizeof cli_bake_parameter_rows[0]);
+
+static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
+  bake_args *a = ctx;
   if (cli_slope_owns(opt))
     return cli_slope_option(bake_command.name, &a->slope, opt, arg);
   switch (opt->id) {
-  case CLI_OPT_OUTPUT: a->job.prefix = arg; return 0;
   case CLI_OPT_OUT_DIR: a->job.out_dir = arg; return 0;
   case CLI_OPT_NAME: a->job.name_template = arg; return 0;
   case CLI_OPT_MAPS: a->maps = arg; return 0;
@@ -201,21 +235,12 @@ static int bake_option(void *ctx, const cli_option *opt, const char *arg) {
   case CLI_OPT_JSON: a->json = 1; return 0;
   case CLI_OPT_QUIET: a->quiet = 1; return 0;
   case CLI_OPT_SCHEDULER: a->scheduler = arg; return 0;
-  case CLI_OPT_SLICES: return cli_settings_apply_slices(bake_command.name, &a->settings, arg);
-  case CLI_OPT_BOUNCE:
-    return cli_parse_double(bake_command.name, "--bounce", arg, 0.0, 0, 1.0,
-                            &a->settings.bake.bounce_albedo);
-  case CLI_OPT_BOUNCES:
-    return cli_parse_int(bake_command.name, "--bounces", arg, 0, BB_MAX_BOUNCES,
-                         &a->settings.bake.bounces);
-  case CLI_OPT_BOUNCE_ALBEDO: a->job.bounce_albedo_file = arg; return 0;
-  case CLI_OPT_BRIGHTNESS: a->job.brightness_file = arg; return 0;
   case CLI_OPT_VMT: a->job.vmt = arg; return 0;
   case CLI_OPT_MATERIALS: a->job.vmt_materials = arg; return 0;
   case CLI_OPT_BASETEXTURE: a->job.vmt_basetexture = arg; return 0;
   default: break;
   }
-  return cli_settings_apply(bake_command.name, &a->settings, opt, arg);
+  return cli_bake_parameter(bake_command.name, &a->settings, &a->job, opt, arg);
 }
 
 /* --maps LIST: the library's map names, comma-separated. */
@@ -273,12 +298,7 @@ static int bake_parse(int argc, char **argv, bake_args *a, int *first) {
     rc = parse_maps(a->maps, &a->job.maps);
   if (rc)
     return rc;
-  a->job.bake = a->settings.bake;
-  a->job.channel = a->settings.channel;
-  a->job.depth = a->settings.depth;
-  a->job.mips = a->settings.mips;
-  a->job.texture = a->settings.texture;
-  a->job.basis_file = a->settings.basis_file;
+  cli_bake_settings_to_job(&a->settings, &a->job);
   a->job.slope_path = a->slope.path;
   a->job.slope_lit = a->slope.lit;
   a->job.slope_lit_azimuth = a->slope.azimuth;

@@ -20,5 +20,6 @@ int bb_cli_normal2ssbump(int argc, char **argv);
 int bb_cli_ssbump2normal(int argc, char **argv);
 int bb_cli_combine(int argc, char **argv);
 int bb_cli_program(int argc, char **argv);
+int bb_cli_serve(int argc, char **argv);
 
 #endif /* BB_CLI_H */

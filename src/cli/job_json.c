@@ -7,9 +7,10 @@
 
 /* Parameters are those used: the channel the rule took and the threads
  * that ran, not "auto" and 0. */
-void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {
+void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
+                     const char *status) {
   const int traced = r->rayset_id[0] != '\0';
-  cli_json j = {stdout, 0};
+  cli_json j = {f, 0};
   cli_json_open(&j, NULL, '{');
   cli_json_string(&j, "input", r->input);
   if (status)
@@ -56,5 +57,9 @@ void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *
   }
   cli_json_close(&j, ']');
   cli_json_close(&j, '}');
+}
+
+void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {
+  cli_job_json_to(stdout, b, r, status);
   fputc('\n', stdout);
 }

@@ -27,6 +27,7 @@ static const subcommand subcommands[] = {
     {"ssbump2normal", bb_cli_ssbump2normal, "the normal an ssbump (or weights) stands for"},
     {"combine", bb_cli_combine, "blend two maps, or overlay a detail map"},
     {"program", bb_cli_program, "evaluate a DOOM 3 image program (heightmap, addnormals...)"},
+    {"serve", bb_cli_serve, "bake live: re-bake on save, see the maps lit in the browser"},
 };
 
 enum { SUBCOMMAND_COUNT = sizeof subcommands / sizeof subcommands[0] };

@@ -392,22 +392,38 @@ static void inputs_free(render_inputs *in) {
   bb_image_free(&in->slope);
 }
 
-/* A crop must fit the tiled picture: checked once the size is known, before
- * any baking. */
-static int check_view(const render_args *a, const bb_image *size) {
-  const bb_render_options *o = &a->render;
-  long w = (long)size->width * o->tile_x, h = (long)size->height * o->tile_y;
-  if (w > BB_MAX_DIMENSION || h > BB_MAX_DIMENSION || w * h > BB_MAX_PIXELS)
-    return cli_usage_error(
-        render_command.name,
-        "--tile %d makes a %ldx%ld picture, over the maximum (%ld texels)", o->tile_x, w,
-        h, (long)BB_MAX_PIXELS);
-  if (o->crop_width > 0 &&
-      ((long)o->crop_x + o->crop_width > w || (long)o->crop_y + o->crop_height > h))
-    return cli_usage_error(render_command.name,
-                           "--crop %d,%d,%d,%d is not inside the %ldx%ld picture",
-                           o->crop_x, o->crop_y, o->crop_width, o->crop_height, w, h);
-  return 0;
+/* The maps a bake on the fly makes: the normal always (every mode lights
+ * with it), the filtered height for the slope map and --relief, and the
+ * traced maps when the view needs one. */
+static unsigned baked_outputs(const render_args *a) {
+  const int traced = (needed_maps(a) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
+  return BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
+         (traced ? BB_OUTPUTS_TRACED : 0u);
+}
+
+/* Before any pixel is read, from the files' headers (bb_render_files_check):
+ * the maps' size, the picture the options make of it, and the memory the
+ * whole render takes against what is left. A tile or crop this input
+ * cannot take is a usage error. */
+static int check_files(render_args *a) {
+  bb_render_sources files;
+  memset(&files, 0, sizeof files);
+  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+    files.maps[m] = a->map_paths[m];
+  files.height = a->height_path;
+  files.albedo = a->albedo_path;
+  a->settings.bake.outputs = baked_outputs(a);
+  int w = 0, h = 0;
+  bb_error err = {{0}}, why = {{0}};
+  bb_status st = bb_render_files_check(&files, &a->settings.bake, &a->render, a->compare,
+                                       a->output, a->settings.depth, &w, &h, &err);
+  if (st == BB_OK)
+    return 0;
+  if (w > 0 && bb_render_estimate(w, h, &a->render, a->compare, NULL, BB_DEPTH_DEFAULT, NULL,
+                                  NULL, NULL, &why) != BB_OK)
+    return cli_usage_error(render_command.name, "%s", why.message);
+  cli_error_line(err.message[0] ? err.message : bb_status_name(st));
+  return BB_EXIT_FAILURE;
 }
 
 static int load_maps(const render_args *a, render_inputs *in) {
@@ -430,9 +446,6 @@ static int load_maps(const render_args *a, render_inputs *in) {
     if (!size)
       size = &in->maps[m];
   }
-  int rc = check_view(a, size);
-  if (rc)
-    return rc;
   in->view.normal = in->maps[BB_RENDER_MAP_NORMAL].pixels ? &in->maps[BB_RENDER_MAP_NORMAL] : NULL;
   in->view.ssbump = in->maps[BB_RENDER_MAP_SSBUMP].pixels ? &in->maps[BB_RENDER_MAP_SSBUMP] : NULL;
   in->view.ao = in->maps[BB_RENDER_MAP_AO].pixels ? &in->maps[BB_RENDER_MAP_AO] : NULL;
@@ -447,16 +460,9 @@ static int bake_height(render_args *a, render_inputs *in) {
                                      a->settings.bake.height_scale, cli_note, NULL, &in->height,
                                      &in->source, &err);
   int rc = cli_status_exit(a->height_path, st, &err);
-  if (!rc)
-    rc = check_view(a, &in->height);
   if (rc)
     return rc;
-  /* The normal always (every mode lights with it), the filtered height for
-   * the slope map, and the traced maps when the view needs one. */
-  const int traced = (needed_maps(a) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
-  a->settings.bake.outputs =
-      BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
-      (traced ? BB_OUTPUTS_TRACED : 0u);
+  a->settings.bake.outputs = baked_outputs(a);
   cli_progress progress;
   cli_progress_attach(&progress, "render", a->quiet, &a->settings.bake.trace);
   st = bb_bake(&in->height, &a->settings.bake, &in->bake, &err);
@@ -655,7 +661,10 @@ static int write_gif(const render_args *a, const render_inputs *in, int *labels)
 static int render_run(const char *command_line, render_args *a) {
   render_inputs in;
   memset(&in, 0, sizeof in);
-  int rc = a->height_path ? bake_height(a, &in) : load_maps(a, &in);
+  int rc = check_files(a);
+  if (rc)
+    return rc;
+  rc = a->height_path ? bake_height(a, &in) : load_maps(a, &in);
   if (!rc)
     rc = load_albedo(a, &in);
   int labels = 1;

@@ -587,7 +587,7 @@ static int run_capture(char *const argv[], char *out, size_t cap) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 120) {
+Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 600) {
   char dir[] = "/tmp/bb-bounce-XXXXXX", ref[1100], ao[1100], ss[1100], pair[2300], tool[1100];
   cr_assert_not_null(mkdtemp(dir));
   const char *dirfix = getenv("BB_FIXTURES");

@@ -13,7 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 #define FAST "--scale", "6", "--slices", "8", "--filter-radius", "2"
 
