@@ -44,8 +44,8 @@ bb_status bb__write_mips_check(const char *path, const bb_image *levels, int cou
  * OpenImageIO names it: "piz" for half, "none" for float. Chosen by
  * measuring every map (docs/performance.md, "EXR compression"): on half
  * maps PIZ is the fastest compressor and the smallest file or within 5% of
- * it; float maps' mantissas leave the compressors 4 to 12% to take, for 50
- * to 70 times the time of writing them as they are. */
+ * it; float maps' mantissas leave the compressors 4 to 13% to take, for 12
+ * to 25 times the time of writing them as they are. */
 const char *bb__exr_compression(bb_depth depth);
 
 /* The texture options a write of a .vtf or .dds uses: options->texture's

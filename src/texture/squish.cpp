@@ -30,7 +30,7 @@
 // +0.10 dB per level on rock06 and a 4096 x 16 strip; two decoders' ratios
 // of the two fits' errors differed by up to 0.2 dB (4.7%), so a 10% margin
 // keeps the choice a gain under either. On every level of those maps cluster
-// fit wins by 1.4 to 3.5 dB, so their bytes are what cluster fit alone made
+// fit wins by 0.8 to 3.5 dB, so their bytes are what cluster fit alone made
 // (docs/textures.md). The range fit and the two decodes cost about 2% of the
 // cluster fit's instructions.
 
