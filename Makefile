@@ -107,7 +107,7 @@ comma := ,
 
 # ---- sources and products ----------------------------------------------------
 # The library's families, in the order data flows (README.md, "Layout").
-FAMILIES := core io bake trace maps render mesh job
+FAMILIES := core io bake trace maps render mesh job cmd
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
 CLI_C    := $(wildcard src/cli/*.c)

@@ -67,7 +67,7 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     take(&l, lobes * texel);
   if (traced) {
     const double levels = pyramid_levels(width, height);
-    const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
+    const int slices = o->slices; /* prepared: bb__bake_prepare */
     take(&l, texel);                   /* heights in texels */
     take(&l, texel + levels + texel);  /* the pyramid's copy, its levels, a row pass */
     give(&l, texel);                   /* the row pass */
@@ -121,7 +121,8 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
 }
 
 uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o) {
-  if (!o || width <= 0 || height <= 0)
+  bb_bake_options prepared;
+  if (!o || width <= 0 || height <= 0 || bb__bake_prepare(o, &prepared, NULL) != BB_OK)
     return 0;
-  return (uint64_t)bb__bake_memory(width, height, o, 0, 0.0, NULL);
+  return (uint64_t)bb__bake_memory(width, height, &prepared, 0, 0.0, NULL);
 }

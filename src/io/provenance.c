@@ -52,46 +52,19 @@ uint64_t bb_image_hash(const bb_image *img) {
 
 /* ---------------------------------------------------------------- format */
 
-/* A growable text buffer; `failed` sticks once an allocation fails. */
-typedef struct text {
-  char *data;
-  size_t length, capacity;
-  int failed;
-} text;
-
-static void text_append(text *t, const char *s, size_t n) {
-  if (t->failed)
-    return;
-  if (t->length + n + 1 > t->capacity) {
-    size_t cap = t->capacity ? t->capacity : 256;
-    while (t->length + n + 1 > cap)
-      cap *= 2;
-    char *grown = realloc(t->data, cap);
-    if (!grown) {
-      t->failed = 1;
-      return;
-    }
-    t->data = grown;
-    t->capacity = cap;
-  }
-  memcpy(t->data + t->length, s, n);
-  t->length += n;
-  t->data[t->length] = '\0';
-}
-
 /* Appends "key=value\n". A value with line breaks (a command line pasted
  * with newlines) would split the record, so they become spaces. */
-static void put(text *t, const char *key, const char *value) {
-  text_append(t, key, strlen(key));
-  text_append(t, "=", 1);
+static void put(bb__text *t, const char *key, const char *value) {
+  bb__text_addn(t, key, strlen(key));
+  bb__text_addn(t, "=", 1);
   for (const char *s = value ? value : ""; *s; s++) {
     char ch = (*s == '\n' || *s == '\r') ? ' ' : *s;
-    text_append(t, &ch, 1);
+    bb__text_addn(t, &ch, 1);
   }
-  text_append(t, "\n", 1);
+  bb__text_addn(t, "\n", 1);
 }
 
-static void put_float(text *t, const char *key, float value) {
+static void put_float(bb__text *t, const char *key, float value) {
   char buf[64];
   snprintf(buf, sizeof buf, "%.9g", (double)value); /* 9 digits: any float round-trips */
   put(t, key, buf);
@@ -105,7 +78,7 @@ static void format_double(char *buf, size_t cap, double value) {
     snprintf(buf, cap, "%.17g", value);
 }
 
-static void put_double(text *t, const char *key, double value) {
+static void put_double(bb__text *t, const char *key, double value) {
   char buf[64];
   format_double(buf, sizeof buf, value);
   put(t, key, buf);
@@ -114,7 +87,7 @@ static void put_double(text *t, const char *key, double value) {
 /* The basis by name; a caller's vectors (named by their hash) are also
  * written out, "x y z" per direction joined by "; " (a basis file's lines),
  * so the file records what to bake it again with. */
-static void put_basis(text *t, const bb_basis *b) {
+static void put_basis(bb__text *t, const bb_basis *b) {
   put(t, "basis", b->name);
   if (strncmp(b->name, "vectors:", 8) != 0 || b->count < 1 || b->count > BB_MAX_BASIS)
     return;
@@ -131,18 +104,18 @@ static void put_basis(text *t, const bb_basis *b) {
   put(t, "basis_vectors", line);
 }
 
-static void put_int(text *t, const char *key, long value) {
+static void put_int(bb__text *t, const char *key, long value) {
   char buf[32];
   snprintf(buf, sizeof buf, "%ld", value);
   put(t, key, buf);
 }
 
-static void put_scale_and_rays(text *t, const bb_bake_options *o) {
+static void put_scale_and_rays(bb__text *t, const bb_bake_options *o) {
   put_float(t, "scale", o->height_scale);
   put_int(t, "rays", o->rays);
 }
 
-static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
+static void put_smoothing_and_tracing(bb__text *t, const bb_bake_options *o) {
   put_int(t, "filter_radius", o->smooth.radius_texels);
   put_float(t, "filter_threshold", o->smooth.threshold);
   put_double(t, "bias", o->trace.bias_texels);
@@ -172,7 +145,7 @@ static void put_smoothing_and_tracing(text *t, const bb_bake_options *o) {
 char *bb_provenance_format(const bb_provenance *p) {
   if (!p)
     return NULL;
-  text t = {0};
+  bb__text t = {0};
   char hash[32];
   snprintf(hash, sizeof hash, "%016" PRIx64, p->input_hash);
 
@@ -195,16 +168,12 @@ char *bb_provenance_format(const bb_provenance *p) {
   if (p->extra) {
     /* Lines of the caller's, each ended by a newline. */
     size_t n = strlen(p->extra);
-    text_append(&t, p->extra, n);
+    bb__text_addn(&t, p->extra, n);
     if (n && p->extra[n - 1] != '\n')
-      text_append(&t, "\n", 1);
+      bb__text_addn(&t, "\n", 1);
   }
 
-  if (t.failed) {
-    free(t.data);
-    return NULL;
-  }
-  return t.data;
+  return bb__text_take(&t);
 }
 
 /* ------------------------------------------------------------------ diff */
@@ -337,8 +306,9 @@ static int by_order(const void *p, const void *q) {
   return (x->order > y->order) - (x->order < y->order);
 }
 
-/* Returns 0, or -1 when out of memory. */
-static int index_entries(const char *text_, entry_index *index) {
+/* Returns 0, or -1 when out of memory. with_ignored: "command" and "output"
+ * count too. */
+static int index_entries(const char *text_, entry_index *index, int with_ignored) {
   size_t lines = 1;
   for (const char *c = text_; *c; c++)
     lines += *c == '\n';
@@ -349,7 +319,7 @@ static int index_entries(const char *text_, entry_index *index) {
   entry e;
   const char *cursor = text_;
   for (size_t order = 0; next_entry(&cursor, &e); order++)
-    if (e.key_length && !is_ignored_key(&e))
+    if (e.key_length && (with_ignored || !is_ignored_key(&e)))
       index->entries[index->count++] = (keyed_entry){e, order};
   qsort(index->entries, index->count, sizeof *index->entries, by_key_then_order);
   /* A repeated key: only its first occurrence counts. */
@@ -383,7 +353,7 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   if (!a || !b)
     return 0;
   entry_index ia = {0}, ib = {0};
-  if (index_entries(a, &ia) != 0 || index_entries(b, &ib) != 0) {
+  if (index_entries(a, &ia, 0) != 0 || index_entries(b, &ib, 0) != 0) {
     free(ia.entries);
     free(ib.entries);
     return -1;
@@ -411,6 +381,23 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   free(ia.entries);
   free(ib.entries);
   return differing;
+}
+
+long bb_provenance_entries(const char *description, bb_provenance_entry *entries,
+                           size_t cap) {
+  if (!description)
+    return 0;
+  entry_index index = {0};
+  if (index_entries(description, &index, 1) != 0)
+    return -1;
+  qsort(index.entries, index.count, sizeof *index.entries, by_order);
+  for (size_t i = 0; i < index.count && i < cap && entries; i++) {
+    const entry *e = &index.entries[i].e;
+    entries[i] = (bb_provenance_entry){e->key, e->key_length, e->value, e->value_length};
+  }
+  const long count = (long)index.count;
+  free(index.entries);
+  return count;
 }
 
 /* ------------------------------------------------------------ mismatch */
@@ -466,6 +453,15 @@ static int is_entry_line(const char *line, size_t n) {
   while (k < n && is_key_char(line[k]))
     k++;
   return n == 0 || (k > 0 && k < n && line[k] == '=');
+}
+
+const char *bb_provenance_class_name(bb_provenance_class c) {
+  switch (c) {
+  case BB_PROVENANCE_NONE: return "none";
+  case BB_PROVENANCE_INTACT: return "intact";
+  case BB_PROVENANCE_DAMAGED: return "damaged";
+  }
+  return "unknown";
 }
 
 bb_provenance_class bb_provenance_classify(const char *description) {

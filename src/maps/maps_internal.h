@@ -4,11 +4,19 @@
 #define BB_MAPS_INTERNAL_H
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The ranges of bb_compare_limits' fields (compare.c): thresholds >= 0
+ * (infinity allowed), percentages 0..100, counts >= 0. */
+extern const bb__range bb__range_compare_threshold, bb__range_compare_percent,
+    bb__range_compare_count;
+/* A blend's factor, 0..1 (combine.c). */
+extern const bb__range bb__range_mix;
 
 /* BB_ERR_VALUE naming the first texel whose channels 0..channels-1 are not
  * finite; what names the image ("normal map", "detail"). */

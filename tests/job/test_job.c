@@ -1,5 +1,5 @@
 /* test_job.c: a bake job's plan (bb_job_plan) refusing bad options before
- * any bake, and the command its outputs record (bb_job_command_text). */
+ * any bake. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
@@ -59,53 +59,3 @@ Test(job, slope_lit_light_is_checked_when_planned) {
   }
 }
 
-/* The command recorded in provenance: bake's options that differ from
- * their defaults, in --help's order, spelled as typed. */
-Test(job, command_text_spells_the_options_as_typed) {
-  bb_job_options o;
-  bb_job_options_init(&o);
-  o.bake.height_scale = 16.0f;
-  o.out_dir = "out";
-  o.maps = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_AO);
-  char *text = bb_job_command_text(&o, "heights/a.png");
-  cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
-  free(text);
-  o.bake.height_scale = 0.1f;
-  o.bake.rays = 64;
-  o.depth = BB_DEPTH_16;
-  o.mips = 1;
-  o.channel = BB_CHANNEL_A;
-  o.maps = 0;
-  o.name_template = "{kind}/{stem}.tif";
-  text = bb_job_command_text(&o, "a.png");
-  cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name {kind}/{stem}.tif");
-  free(text);
-}
-
-/* The engine textures' settings and the material come last, as in --help,
- * spelled as the CLI reads them back; threads are not recorded. */
-Test(job, command_text_spells_the_texture_options) {
-  bb_job_options o;
-  bb_job_options_init(&o);
-  o.bake.height_scale = 64.0f;
-  o.paths[BB_OUTPUT_SSBUMP] = "m/rock-ssbump.vtf";
-  o.texture.threads = 1;
-  char *text = bb_job_command_text(&o, "h.png");
-  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
-  free(text);
-  o.texture.format = BB_TEXTURE_FORMAT_BC3;
-  o.texture.vtf_version = 3;
-  o.texture.vtf_flags = 0x4;
-  o.texture.mips = 0;
-  o.texture.fast = 1;
-  o.vmt = "m/rock.vmt";
-  o.vmt_materials = "m";
-  o.vmt_basetexture = "m/rock.vtf";
-  text = bb_job_command_text(&o, "h.png");
-  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
-                         "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
-                         "--fast-compression --vmt m/rock.vmt --materials m "
-                         "--basetexture m/rock.vtf");
-  free(text);
-}
