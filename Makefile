@@ -36,20 +36,20 @@ LIB_CFLAGS := -fPIC -fno-semantic-interposition
 PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
-# libpng: src/io/png_hooks.c sets quiet error handlers and bounded
+# libpng: src/image/png_hooks.c sets quiet error handlers and bounded
 # allocations on the libpng structs OpenImageIO makes.
 PNG_CFLAGS  := $(shell pkg-config --cflags libpng 2>/dev/null)
 PNG_LIBS    := $(shell pkg-config --libs libpng 2>/dev/null)
 # libjpeg and OpenEXRCore read headers before OpenImageIO's readers do
-# (src/io/header_probe.c), to refuse what they would allocate in open().
+# (src/image/header_probe.c), to refuse what they would allocate in open().
 PROBE_CFLAGS := $(shell pkg-config --cflags libjpeg OpenEXR 2>/dev/null)
 PROBE_LIBS   := $(shell pkg-config --libs libjpeg 2>/dev/null) \
                 $(filter -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
-# Assimp reads and writes meshes (src/mesh_assimp.cpp only).
+# Assimp reads and writes meshes (src/mesh/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-# libsquish compresses BC1..BC5 blocks (src/io/squish.cpp only). Imath's
+# libsquish compresses BC1..BC5 blocks (src/texture/squish.cpp only). Imath's
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
@@ -106,8 +106,9 @@ CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
 comma := ,
 
 # ---- sources and products ----------------------------------------------------
-# The library's families, in the order data flows (README.md, "Layout").
-FAMILIES := core io bake trace maps render mesh job cmd
+# The library's families, each using only the ones before it: the order of
+# docs/how-it-works.md ("Layers"), which `make check-layers` holds them to.
+FAMILIES := core files texture image trace bake maps render mesh job cmd
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
 CLI_C    := $(wildcard src/cli/*.c)
@@ -135,7 +136,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles check-docs bench bench-cluster goldens docs docs-reference install \
+        check-python check-circles check-layers check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -295,9 +296,10 @@ test: ensure-deps
 	@$(MAKE) --no-print-directory check
 
 # Everything `make test` runs: the Criterion suite, the install check, the
-# Python tests, the check that no two files need each other and the check
-# that the command reference and the man page say what --help says.
-check: check-unit check-install check-python check-circles check-docs
+# Python tests, the check that no two files need each other, the check that
+# no family reaches up to a later one and the check that the command
+# reference and the man page say what --help says.
+check: check-unit check-install check-python check-circles check-layers check-docs
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -311,6 +313,14 @@ check-docs: $(BIN)
 # checks (tools/check_circles.py): one of them has two jobs.
 check-circles: $(LIB_OBJ) $(CLI_OBJ)
 	@./tools/check_circles.py $(LIB_OBJ) $(CLI_OBJ)
+
+# Families that include or call a later family in the order of
+# docs/how-it-works.md ("Layers") fail (tools/check_layers.py); its test
+# (tests/tools/test_check_layers.py) shows it refuses an upward include,
+# a relative one and an upward call in a tree of its own.
+check-layers: $(LIB_OBJ) $(CLI_OBJ)
+	@$(PYTHON) tools/check_layers.py --families '$(FAMILIES)' $(LIB_OBJ) $(CLI_OBJ)
+	@$(PYTHON) tests/tools/test_check_layers.py
 
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.

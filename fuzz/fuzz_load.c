@@ -8,6 +8,7 @@
  * -timeout or allocating past its -malloc_limit_mb, every failure one line,
  * and a success a finite 1-channel height of the size the header declares. */
 #include "bumpbake.h"
+#include "image/height_channel.h"
 #include "fuzz_common.h"
 
 #include <math.h>
@@ -42,7 +43,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
 
   bb_image h;
-  bb_status st = bb_height_load(path, channel, &h, &err);
+  bb_status st = bb__height_load(path, channel, &h, &(bb__height_loaded){0}, &err);
   FUZZ_CHECK((st == BB_OK) == (h.pixels != NULL));
   if (st == BB_OK) {
     FUZZ_CHECK(h.channels == 1 && h.width == width && h.height == height);

@@ -29,14 +29,18 @@
  *   BB_ERR_ARGUMENT with a message listing the names accepted.
  * docs/conventions.md gives the frame, units and formulas in full.
  *
- * The header reads in the order data flows, one family after another:
+ * The header reads family by family, each using only the ones before it
+ * (the folders of src/, in the order of docs/how-it-works.md, "Layers"):
  *   core     status, errors, images, limits
- *   io       reading and writing image files, engine textures (VTF, DDS)
- *            and Source materials, the height input
- *   bake     smoothing, normals, bases, the tracer, derived maps, bb_bake
+ *   files    checked, all-or-nothing writes of files; provenance texts read
+ *   texture  engine textures (VTF, DDS) and Source materials
+ *   image    reading and writing image files, mip chains, animations, the
+ *            height input
+ *   trace    bases, the max-mip pyramid, ray sets, the tracer
+ *   bake     smoothing, normals, derived maps, bb_bake
  *   maps     Valve's files, conversions, combining, programs, slope maps,
- *            mip chains, comparing images
- *   render   lighting the maps, pictures, contact sheets, animations
+ *            comparing images
+ *   render   lighting the maps, pictures, contact sheets
  *   mesh     models and DOOM 3's flat render bump
  *   job      the whole job on files: provenance, output paths, writing all
  *            or nothing, bakes of files and batches, depfiles, up-to-date
@@ -65,8 +69,7 @@ extern "C" {
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
  * allocating. What a machine can bake is less: reads and bakes estimate
  * their memory from the sizes first and refuse, naming the estimate and
- * what is available, what will not fit (bb_memory_available,
- * bb_bake_memory_estimate). */
+ * what is available, what will not fit (bb_memory_available). */
 #define BB_MAX_DIMENSION 65536
 #define BB_MAX_PIXELS (32768L * 32768L)
 
@@ -218,130 +221,23 @@ typedef struct bb_region {
   int x0, y0, width, height;
 } bb_region;
 
-/* =====================================================================
- * io: image files in and out, engine textures, the height input
- * Every read and write of an image file goes through OpenImageIO, except
- * the engine textures (VTF, DDS), which OpenImageIO does not write.
- * ===================================================================== */
-
-/* ------------------------------------------------------ reading images */
-
-/* What a file held, beyond its pixels. */
-typedef struct bb_image_info {
-  int alpha_channel;    /* index of the alpha channel, or -1 */
-  int is_float;         /* 1 when the file stores float or half samples */
-  int bits_per_sample;  /* 8, 16, 32 (float or int), ... */
-  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ... */
-  char *description;    /* bumpbake provenance or ImageDescription, malloc'd, or NULL */
-} bb_image_info;
-
-/* Frees info->description and clears it. */
-void bb_image_info_free(bb_image_info *info);
-
-/* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
- * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
- * The file must be a regular one (a FIFO, a device or a directory is
- * refused at once) and is read through the descriptor that was checked.
- * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
- * BB_ERR_FORMAT (not an image, truncated, corrupt), BB_ERR_SIZE (zero,
- * over BB_MAX_PIXELS or over BB_MAX_READ_BYTES, or tiles of more than 64
- * MiB as floats, or a header whose reader would allocate more than
- * BB_MAX_READ_BYTES to open it: all refused before allocating). */
-bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
-                        bb_error *err);
-
-/* Reads only the header of path: its size, channel count and what
- * bb_image_info holds, without decoding a pixel (fast on any size; a
- * truncated pixel stream is not noticed). width, height, channels and info
- * may each be NULL. Errors as bb_image_read, except that the size limits
- * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied to
- * the image (its size is reported, not allocated). Some readers allocate
- * from the header to open a file at all (a progressive JPEG's whole
- * coefficients, a GIF's canvas, an OpenEXR's chunk buffers): that is
- * refused past BB_MAX_READ_BYTES (64 MiB for one OpenEXR chunk) with
- * BB_ERR_SIZE, and OpenImageIO's own limits, see BB_MAX_READ_BYTES, may
- * refuse a header declaring more than 16 GiB of samples. */
-bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
-                             bb_image_info *info, bb_error *err);
-
-/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
- * reads level 0. level_count (may be NULL) receives the file's number of
- * levels; a level past the last is BB_ERR_ARGUMENT. */
-bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
-                            bb_image_info *info, int *level_count, bb_error *err);
-
-/* Number of subimages (frames) in an image file. */
-bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
-
-/* ------------------------------------------------------ writing images */
-
-/* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
- * float32 for exr. */
-typedef enum bb_depth {
-  BB_DEPTH_DEFAULT = 0,
-  BB_DEPTH_8,     /* png, tga, tif */
-  BB_DEPTH_16,    /* png, tif */
-  BB_DEPTH_HALF,  /* exr */
-  BB_DEPTH_FLOAT  /* exr, tif */
-} bb_depth;
-
-/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
-/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
- * for values outside the enum. */
-const char *bb_depth_name(bb_depth depth);
-
 /* How float values map to integer codes. */
 typedef enum bb_range {
   BB_RANGE_UNIT = 0, /* [0, 1] stored as value * max code (ssbump, ao, height) */
   BB_RANGE_SIGNED    /* [-1, 1] stored as (0.5 + 0.5 * value) * max code (normals) */
 } bb_range;
 
-typedef struct bb_write_options {
-  bb_depth depth;
-  bb_range range;
-  const char *description; /* provenance text stored in the file, or NULL.
-                              TGA holds 4 rows of 80 characters: provenance
-                              is fitted with whole key=value lines, keys that
-                              affect pixels first, and what does not fit is
-                              left out (see bb_provenance_classify) */
-  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
-                              chain, flags (see "engine textures"); NULL: the
-                              defaults, the map NORMAL for BB_RANGE_SIGNED and
-                              PLAIN otherwise. description overrides its own */
-} bb_write_options;
+/* =====================================================================
+ * files: checked, all-or-nothing writes of files; provenance texts read
+ * ===================================================================== */
 
-/* Writes img to path; the format comes from the extension (.png .tga .tif
- * .tiff .exr, and the engine textures .vtf and .dds, written by
- * bb_texture_write with options->texture: depth must then be
- * BB_DEPTH_DEFAULT, the texture format sets it; with a description, the
- * texture's settings are added to it as bb_texture_provenance's lines).
- * Integer formats clamp to the code range and round to nearest.
- * Channels are R, G, B, A for up to 4; an image of more (a basis map with
- * more than 4 directions) has them named B0, B1, ... instead, zero-padded
- * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
- * name, and none is alpha.
- * The file is written to a temporary file in the destination directory,
- * every write checked, then flushed, fsynced and closed (checked) and only
- * then renamed into place, so a failure (a full disk included) leaves no
- * partial file and nothing at path. Errors: BB_ERR_FORMAT (unknown
- * extension, depth not supported by the format), BB_ERR_IO (cannot write:
- * the message gives the system's reason, e.g. "No space left on device"). */
-bb_status bb_image_write(const char *path, const bb_image *img,
-                         const bb_write_options *options, bb_error *err);
+/* ---------------------------------------------------------- safe files */
 
 /* A file written in full (and fsynced) under a temporary name next to its
  * destination, waiting to be renamed into place. A program writing several
  * files stages them all and commits only when every one was written, so a
  * failure changes nothing on disk (bumpbake bake does this). */
 typedef struct bb_staged_file bb_staged_file;
-
-/* bb_image_write up to, not including, the rename: on success *staged
- * receives the handle; on failure it is NULL and nothing is left on disk.
- * The handle must be passed to bb_staged_file_commit or _discard. */
-bb_status bb_image_write_staged(const char *path, const bb_image *img,
-                                const bb_write_options *options,
-                                bb_staged_file **staged, bb_error *err);
 
 /* Renames the staged file to its path and frees the handle (also when the
  * rename fails, which removes the temporary). Errors: BB_ERR_IO. */
@@ -387,45 +283,59 @@ void bb_tempfiles_remove(void);
  * BB_ERR_IO (dir cannot be read, an orphan cannot be removed). */
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 
-/* True (1) when the extension of path (any case) is one OpenImageIO has a
- * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
- * caller can pick the images out of a directory without opening each file.
- * It says nothing of the file's contents. */
-int bb_path_is_readable_format(const char *path);
+/* ---------------------------------------------------- provenance texts */
 
-/* True (1) when the extension of path names a format bb_image_write knows
- * (.vtf and .dds included). */
-int bb_path_is_writable_format(const char *path);
+/* Writes into out (capacity cap) the keys whose values differ between two
+ * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
+ * when either text is NULL). Keys "command" and "output" are ignored. Returns
+ * the number of differing keys, or -1 when out of memory. Time is
+ * O(n log n) in the number of lines, whatever the texts hold. */
+int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
-/* True (1) when bb_image_write can store depth in the format path's extension
- * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
- * bad combination before a long bake rather than after it. */
-int bb_path_supports_depth(const char *path, bb_depth depth);
+/* What an image description holds, for readers of provenance. */
+typedef enum bb_provenance_class {
+  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
+  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
+  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
+                             re-wrapped (by a format or another tool), so a
+                             key-by-key diff would mislead */
+} bb_provenance_class;
 
-/* Most channels bb_image_write can store in the format path's extension
- * names: 4 for .png, .tga, .vtf and .dds, 64 for .tif, .tiff and .exr; 0 for an unknown
- * extension. So a caller can refuse a basis with more directions than the
- * file can hold before the bake. */
-int bb_path_max_channels(const char *path);
+/* Classifies a description (NULL is NONE): bumpbake's when it has a
+ * "bumpbake_version=" line; intact when each non-empty line is key=value
+ * with a key of lower-case letters, digits and '_'. */
+bb_provenance_class bb_provenance_classify(const char *description);
 
-/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr; .vtf
- * and .dds, which have one unless bb_texture_options.mips is 0). */
-int bb_path_supports_mips(const char *path);
+/* One "key=value" line of a provenance text, as pointers into it (not
+ * terminated). */
+typedef struct bb_provenance_entry {
+  const char *key;
+  size_t key_length;
+  const char *value;
+  size_t value_length;
+} bb_provenance_entry;
 
-/* Writes a mip chain (levels[0] the largest, each the halved size of the one
- * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
- * OpenEXR file, every level encoded as bb_image_write encodes an image, and
- * written to a temporary name and renamed as it does; or as a .vtf or .dds
- * texture holding these levels (options->texture's mips is then ignored).
- * Errors as bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
-bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
-                              const bb_write_options *options, bb_error *err);
+/* The one reading of a provenance text, which every reader uses (the
+ * values and diffs below, the up-to-date check, `bumpbake info --json`,
+ * Python's bumpbake.info): a line ends at '\n', and a '\r' before it is
+ * dropped (a text re-saved on Windows); its key is what comes before its
+ * first '=', its value what follows; a line without '=' is skipped; a key
+ * seen before keeps its first value (its later lines are skipped). Fills
+ * entries with up to cap of them, in line order; returns how many there are
+ * (which may exceed cap), or -1 when out of memory. Time O(n log n) in the
+ * lines. */
+long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 
-/* bb_image_write_mips up to, not including, the rename, as
- * bb_image_write_staged: commit or discard *staged. */
-bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
-                                     const bb_write_options *options,
-                                     bb_staged_file **staged, bb_error *err);
+/* The value of key in a provenance text (its first "key=value" line) into
+ * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
+ * there, 0 when it is not or description is NULL (out is then ""). So a
+ * reader can ask which basis a map was baked with ("basis"). */
+int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
+
+/* =====================================================================
+ * texture: engine textures (VTF, DDS) and Source materials, which
+ * OpenImageIO does not write
+ * ===================================================================== */
 
 /* ------------------------------- engine textures: Source VTF and DDS */
 
@@ -533,41 +443,6 @@ int bb_path_is_texture_format(const char *path);
 bb_status bb_texture_check(const char *path, int width, int height, int channels,
                            const bb_texture_options *options, bb_error *err);
 
-/* Writes img to path as a VTF or DDS texture (by extension), after
- * bb_texture_check; options may be NULL (the defaults). The mip chain is
- * made here (options->mips).
- *
- * VTF (Valve's layout: VTFLib's VTFFormat.h and the Valve Developer
- * Community's "Valve Texture Format" page): an 80-byte header (7.3 and up:
- * followed by a resource dictionary of 8-byte entries), reflectivity the
- * mean of (code / 255)^2.2 per channel over the 8-bit top level (as vtex and
- * VTFLib compute it), bump scale 1, one frame, depth 1, the low-resolution
- * image as DXT1 at the first mip size of at most 16 x 16, then every level,
- * smallest first. Flags: the map's, BB_VTF_FLAG_NOMIP | NOLOD without mips,
- * EIGHTBITALPHA for a 4-channel image in a format with alpha, and
- * options->vtf_flags.
- *
- * DDS: "DDS " and the 124-byte header, levels largest first. BC1 and BC3
- * carry FourCC DXT1 and DXT5; BC4 and BC5 ATI1 and ATI2 (the oldest codes,
- * which every DDS reader knows, OpenImageIO's included); a BC5 normal map
- * also carries the DDPF_NORMAL flag (0x80000000, NVIDIA's), which tells
- * readers that know it (OpenImageIO) to rebuild z. RGBA8 is a 32-bit RGB +
- * alpha pixel format with masks; RGBA16F and RGBA32F need, and get, the
- * DX10 header (DXGI_FORMAT_R16G16B16A16_FLOAT and _R32G32B32A32_FLOAT).
- * OpenImageIO 2.4 reads every DDS written here except those two float ones.
- *
- * The file is written as bb_image_write writes, through a temporary renamed
- * into place. Errors: as bb_texture_check; BB_ERR_VALUE (NaN or infinite
- * texels); BB_ERR_MEMORY; BB_ERR_IO. */
-bb_status bb_texture_write(const char *path, const bb_image *img,
-                           const bb_texture_options *options, bb_error *err);
-
-/* bb_texture_write up to, not including, the rename, as
- * bb_image_write_staged: commit or discard *staged. */
-bb_status bb_texture_write_staged(const char *path, const bb_image *img,
-                                  const bb_texture_options *options,
-                                  bb_staged_file **staged, bb_error *err);
-
 /* Sets options->map for a file of an output kind: SSBUMP for the kinds
  * "ssbump", "ssbump+...", "detail-ssbump..." and "weights" (normal2ssbump's,
  * an ssbump without shadows, which Source loads the same way); NORMAL for
@@ -652,6 +527,235 @@ bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error
 bb_status bb_vmt_text(const char *path, const bb_vmt_options *options, char **text,
                       size_t *size, bb_error *err);
 
+/* =====================================================================
+ * image: image files in and out, mip chains, animations, the height input
+ * Every read and write of an image file goes through OpenImageIO, except
+ * the engine textures (VTF, DDS), which the texture family encodes.
+ * ===================================================================== */
+
+/* ------------------------------------------------------ reading images */
+
+/* What a file held, beyond its pixels. */
+typedef struct bb_image_info {
+  int alpha_channel;    /* index of the alpha channel, or -1 */
+  int is_float;         /* 1 when the file stores float or half samples */
+  int bits_per_sample;  /* 8, 16, 32 (float or int), ... */
+  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ... */
+  char *description;    /* bumpbake provenance or ImageDescription, malloc'd, or NULL */
+} bb_image_info;
+
+/* Frees info->description and clears it. */
+void bb_image_info_free(bb_image_info *info);
+
+/* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
+ * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
+ * The file must be a regular one (a FIFO, a device or a directory is
+ * refused at once) and is read through the descriptor that was checked.
+ * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
+ * BB_ERR_FORMAT (not an image, truncated, corrupt), BB_ERR_SIZE (zero,
+ * over BB_MAX_PIXELS or over BB_MAX_READ_BYTES, or tiles of more than 64
+ * MiB as floats, or a header whose reader would allocate more than
+ * BB_MAX_READ_BYTES to open it: all refused before allocating). */
+bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
+                        bb_error *err);
+
+/* Reads only the header of path: its size, channel count and what
+ * bb_image_info holds, without decoding a pixel (fast on any size; a
+ * truncated pixel stream is not noticed). width, height, channels and info
+ * may each be NULL. Errors as bb_image_read, except that the size limits
+ * BB_MAX_DIMENSION, BB_MAX_PIXELS and BB_MAX_READ_BYTES are not applied to
+ * the image (its size is reported, not allocated). Some readers allocate
+ * from the header to open a file at all (a progressive JPEG's whole
+ * coefficients, a GIF's canvas, an OpenEXR's chunk buffers): that is
+ * refused past BB_MAX_READ_BYTES (64 MiB for one OpenEXR chunk) with
+ * BB_ERR_SIZE, and OpenImageIO's own limits, see BB_MAX_READ_BYTES, may
+ * refuse a header declaring more than 16 GiB of samples. */
+bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
+                             bb_image_info *info, bb_error *err);
+
+/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
+ * reads level 0. level_count (may be NULL) receives the file's number of
+ * levels; a level past the last is BB_ERR_ARGUMENT. */
+bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
+                            bb_image_info *info, int *level_count, bb_error *err);
+
+/* Number of subimages (frames) in an image file. */
+bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
+
+/* ------------------------------------------------------ writing images */
+
+/* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
+ * float32 for exr. */
+typedef enum bb_depth {
+  BB_DEPTH_DEFAULT = 0,
+  BB_DEPTH_8,     /* png, tga, tif */
+  BB_DEPTH_16,    /* png, tif */
+  BB_DEPTH_HALF,  /* exr */
+  BB_DEPTH_FLOAT  /* exr, tif */
+} bb_depth;
+
+/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
+bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
+/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+ * for values outside the enum. */
+const char *bb_depth_name(bb_depth depth);
+
+typedef struct bb_write_options {
+  bb_depth depth;
+  bb_range range;
+  const char *description; /* provenance text stored in the file, or NULL.
+                              TGA holds 4 rows of 80 characters: provenance
+                              is fitted with whole key=value lines, keys that
+                              affect pixels first, and what does not fit is
+                              left out (see bb_provenance_classify) */
+  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
+                              chain, flags (see "engine textures"); NULL: the
+                              defaults, the map NORMAL for BB_RANGE_SIGNED and
+                              PLAIN otherwise. description overrides its own */
+} bb_write_options;
+
+/* Writes img to path; the format comes from the extension (.png .tga .tif
+ * .tiff .exr, and the engine textures .vtf and .dds, written by
+ * bb_texture_write with options->texture: depth must then be
+ * BB_DEPTH_DEFAULT, the texture format sets it; with a description, the
+ * texture's settings are added to it as bb_texture_provenance's lines).
+ * Integer formats clamp to the code range and round to nearest.
+ * Channels are R, G, B, A for up to 4; an image of more (a basis map with
+ * more than 4 directions) has them named B0, B1, ... instead, zero-padded
+ * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
+ * name, and none is alpha.
+ * The file is written to a temporary file in the destination directory,
+ * every write checked, then flushed, fsynced and closed (checked) and only
+ * then renamed into place, so a failure (a full disk included) leaves no
+ * partial file and nothing at path. Errors: BB_ERR_FORMAT (unknown
+ * extension, depth not supported by the format), BB_ERR_IO (cannot write:
+ * the message gives the system's reason, e.g. "No space left on device"). */
+bb_status bb_image_write(const char *path, const bb_image *img,
+                         const bb_write_options *options, bb_error *err);
+
+/* bb_image_write up to, not including, the rename: on success *staged
+ * receives the handle; on failure it is NULL and nothing is left on disk.
+ * The handle must be passed to bb_staged_file_commit or _discard. */
+bb_status bb_image_write_staged(const char *path, const bb_image *img,
+                                const bb_write_options *options,
+                                bb_staged_file **staged, bb_error *err);
+
+/* True (1) when the extension of path (any case) is one OpenImageIO has a
+ * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
+ * caller can pick the images out of a directory without opening each file.
+ * It says nothing of the file's contents. */
+int bb_path_is_readable_format(const char *path);
+
+/* True (1) when the extension of path names a format bb_image_write knows
+ * (.vtf and .dds included). */
+int bb_path_is_writable_format(const char *path);
+
+/* True (1) when bb_image_write can store depth in the format path's extension
+ * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
+ * bad combination before a long bake rather than after it. */
+int bb_path_supports_depth(const char *path, bb_depth depth);
+
+/* Most channels bb_image_write can store in the format path's extension
+ * names: 4 for .png, .tga, .vtf and .dds, 64 for .tif, .tiff and .exr; 0 for an unknown
+ * extension. So a caller can refuse a basis with more directions than the
+ * file can hold before the bake. */
+int bb_path_max_channels(const char *path);
+
+/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr; .vtf
+ * and .dds, which have one unless bb_texture_options.mips is 0). */
+int bb_path_supports_mips(const char *path);
+
+/* Writes a mip chain (levels[0] the largest, each the halved size of the one
+ * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
+ * OpenEXR file, every level encoded as bb_image_write encodes an image, and
+ * written to a temporary name and renamed as it does; or as a .vtf or .dds
+ * texture holding these levels (options->texture's mips is then ignored).
+ * Errors as bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
+bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
+                              const bb_write_options *options, bb_error *err);
+
+/* bb_image_write_mips up to, not including, the rename, as
+ * bb_image_write_staged: commit or discard *staged. */
+bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+                                     const bb_write_options *options,
+                                     bb_staged_file **staged, bb_error *err);
+
+/* ------------------------------------------------------- texture files */
+
+/* Writes img to path as a VTF or DDS texture (by extension), after
+ * bb_texture_check; options may be NULL (the defaults). The mip chain is
+ * made here (options->mips).
+ *
+ * VTF (Valve's layout: VTFLib's VTFFormat.h and the Valve Developer
+ * Community's "Valve Texture Format" page): an 80-byte header (7.3 and up:
+ * followed by a resource dictionary of 8-byte entries), reflectivity the
+ * mean of (code / 255)^2.2 per channel over the 8-bit top level (as vtex and
+ * VTFLib compute it), bump scale 1, one frame, depth 1, the low-resolution
+ * image as DXT1 at the first mip size of at most 16 x 16, then every level,
+ * smallest first. Flags: the map's, BB_VTF_FLAG_NOMIP | NOLOD without mips,
+ * EIGHTBITALPHA for a 4-channel image in a format with alpha, and
+ * options->vtf_flags.
+ *
+ * DDS: "DDS " and the 124-byte header, levels largest first. BC1 and BC3
+ * carry FourCC DXT1 and DXT5; BC4 and BC5 ATI1 and ATI2 (the oldest codes,
+ * which every DDS reader knows, OpenImageIO's included); a BC5 normal map
+ * also carries the DDPF_NORMAL flag (0x80000000, NVIDIA's), which tells
+ * readers that know it (OpenImageIO) to rebuild z. RGBA8 is a 32-bit RGB +
+ * alpha pixel format with masks; RGBA16F and RGBA32F need, and get, the
+ * DX10 header (DXGI_FORMAT_R16G16B16A16_FLOAT and _R32G32B32A32_FLOAT).
+ * OpenImageIO 2.4 reads every DDS written here except those two float ones.
+ *
+ * The file is written as bb_image_write writes, through a temporary renamed
+ * into place. Errors: as bb_texture_check; BB_ERR_VALUE (NaN or infinite
+ * texels); BB_ERR_MEMORY; BB_ERR_IO. */
+bb_status bb_texture_write(const char *path, const bb_image *img,
+                           const bb_texture_options *options, bb_error *err);
+
+/* ---------------------------------------------------------- mip chains */
+
+/* How a mip level is made from the one above it. */
+typedef enum bb_mip_filter {
+  BB_MIP_AVERAGE = 0,  /* box average of every channel: ssbump, weights, ao, heights
+                          (linear in light, so averages light as the paper says) */
+  BB_MIP_RENORMALIZE   /* box average, then channels 0..2 rescaled to unit length
+                          (normal maps; a zero average becomes (0, 0, 1)) */
+} bb_mip_filter;
+
+/* The mip chain of img, down to 1 x 1: level 0 is a copy of img, level k + 1
+ * is level k box-filtered by OpenImageIO's ImageBufAlgo::resize to
+ * max(1, w / 2) x max(1, h / 2) (for even sides exactly the mean of 2 x 2
+ * texels; an odd side's box covers the 3 texels under each output texel),
+ * then renormalised for BB_MIP_RENORMALIZE. *levels is malloc'd with *count
+ * images (1 + floor(log2(max(w, h)))); free it with bb_mip_chain_free. */
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err);
+
+void bb_mip_chain_free(bb_image *levels, int count);
+
+/* ----------------------------------------------------------- animation */
+
+/* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
+ * channel, a palette per frame). Frames go to a temporary file in the
+ * destination directory; bb_animation_close checks it and renames it into
+ * place, so a failure leaves no partial file. GIF stores no provenance. */
+typedef struct bb_animation bb_animation;
+
+/* Starts path (extension .gif) for frames of width x height, shown at
+ * frames_per_second (1..100). Errors: BB_ERR_FORMAT (not .gif), BB_ERR_IO. */
+bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
+                            bb_animation **out, bb_error *err);
+
+/* Appends a frame: 3 channels, the open size, values in [0, 1]. On failure
+ * the animation stays open; bb_animation_abort it. */
+bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err);
+
+/* Finishes the file, reads it back to check its frame count, renames it into
+ * place and frees a, also on failure (then no file is left). */
+bb_status bb_animation_close(bb_animation *a, bb_error *err);
+
+/* Removes the temporary file and frees a; safe on NULL. */
+void bb_animation_abort(bb_animation *a);
+
 /* -------------------------------------------------------- height input */
 
 /* Which channel of a colour image becomes the height. */
@@ -694,73 +798,9 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
 
-/* bb_image_read followed by bb_height_from_image; messages name the file. */
-bb_status bb_height_load(const char *path, bb_channel channel,
-                         bb_image *height, bb_error *err);
-
 /* =====================================================================
- * bake: smooth -> normals -> pyramid -> trace -> derive
+ * trace: bases, the pyramid, ray sets and the tracer
  * ===================================================================== */
-
-/* ----------------------------------------------------------- smoothing */
-
-typedef struct bb_smooth_options {
-  int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
-  float threshold;       /* T in normalised height units, > 0. Default 2/255 */
-  bb_addressing addressing;
-} bb_smooth_options;
-
-void bb_smooth_options_init(bb_smooth_options *o);
-
-/* Valve's tileable bilateral filter (docs/conventions.md "Smoothing") of every
- * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
- * with in's size and channels. */
-bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
-                              const bb_smooth_options *o, bb_image *out,
-                              bb_error *err);
-
-/* ------------------------------------------------------------- normals */
-
-typedef enum bb_normal_filter {
-  BB_NORMAL_VALVE = 0, /* Valve's: mean of the 18 triangle normals of the 9 cells
-                          x-1..x+1, y-1..y+1; centred on (x + 1/2, y + 1/2) */
-  BB_NORMAL_CENTRAL,   /* central differences */
-  BB_NORMAL_SOBEL,     /* 3x3 Sobel gradient */
-  BB_NORMAL_VERTEX     /* the default: centred on the vertex (x, y) the rays
-                          leave from; the triangle normals of the 16 cells
-                          x-2..x+1, y-2..y+1 weighted (1,2,2,1) x (1,2,2,1),
-                          i.e. Valve's sums at the 4 cell centres around the
-                          vertex added; a symmetric bump's peak gives (0,0,1) */
-} bb_normal_filter;
-
-/* Parses "vertex", "valve", "central", "sobel". */
-bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
-const char *bb_normal_filter_name(bb_normal_filter f);
-
-/* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
- * height: 1 channel; out: allocated, 3 channels. */
-bb_status bb_normals_compute(const bb_image *height, float height_scale,
-                             bb_normal_filter filter, bb_addressing addressing,
-                             bb_image *out, bb_error *err);
-
-typedef struct bb_normal_decode_options {
-  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
-  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
-} bb_normal_decode_options;
-
-/* Defaults: +Y down, normalize on. */
-void bb_normal_decode_options_init(bb_normal_decode_options *o);
-
-/* The normals a normal-map file holds, from the values bb_image_read
- * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
- * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
- * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
- * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
- * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
- * texel. Allocates normals: 3 channels, same size. */
-bb_status bb_normal_map_decode(const bb_image *values, int is_float,
-                               const bb_normal_decode_options *o, bb_image *normals,
-                               bb_error *err);
 
 /* --------------------------------------------------------------- basis */
 
@@ -859,30 +899,6 @@ bb_status bb_pyramid_build(const bb_image *height_texels,
                            bb_error *err);
 
 void bb_pyramid_free(bb_pyramid *p);
-
-/* -------------------------------------------------------------- tracer */
-
-/* A ray in texel space: origin and direction (need not be unit; z > 0). */
-typedef struct bb_ray {
-  double origin[3];
-  double direction[3];
-} bb_ray;
-
-/* 1 when the ray meets the surface at a distance > 0, else 0. Rays have no
- * maximum length: periodic rays wrap as often as needed. Max-mip march. */
-int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray);
-
-/* The horizon of the ray's vertical half-plane: the largest slope
- * (surface - origin z) / d, in texels of rise per texel of horizontal
- * distance, over every breakpoint of the surface (cell edge or diagonal
- * crossing) at 0 < d <= max_distance along the ray's horizontal direction
- * (its z is ignored), or 0 when none is positive: a direction is open
- * exactly when its tangent of elevation exceeds it. max_distance is in
- * texels, > 0; it may be INFINITY in clamp mode (past the border the surface
- * turns flat), not in periodic mode, where a ray that never rises above its
- * origin would wrap for ever. Returns -1 for a bad max_distance or a
- * vertical direction. Max-mip march. */
-double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance);
 
 /* ------------------------------------------------------------- ray set */
 
@@ -1017,6 +1033,70 @@ bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *hor
  * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as bb_trace_occlusion
  * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
+
+/* =====================================================================
+ * bake: smooth -> normals -> pyramid -> trace -> derive
+ * ===================================================================== */
+
+/* ----------------------------------------------------------- smoothing */
+
+typedef struct bb_smooth_options {
+  int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
+  float threshold;       /* T in normalised height units, > 0. Default 2/255 */
+  bb_addressing addressing;
+} bb_smooth_options;
+
+void bb_smooth_options_init(bb_smooth_options *o);
+
+/* Valve's tileable bilateral filter (docs/conventions.md "Smoothing") of every
+ * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
+ * with in's size and channels. */
+bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
+                              const bb_smooth_options *o, bb_image *out,
+                              bb_error *err);
+
+/* ------------------------------------------------------------- normals */
+
+typedef enum bb_normal_filter {
+  BB_NORMAL_VALVE = 0, /* Valve's: mean of the 18 triangle normals of the 9 cells
+                          x-1..x+1, y-1..y+1; centred on (x + 1/2, y + 1/2) */
+  BB_NORMAL_CENTRAL,   /* central differences */
+  BB_NORMAL_SOBEL,     /* 3x3 Sobel gradient */
+  BB_NORMAL_VERTEX     /* the default: centred on the vertex (x, y) the rays
+                          leave from; the triangle normals of the 16 cells
+                          x-2..x+1, y-2..y+1 weighted (1,2,2,1) x (1,2,2,1),
+                          i.e. Valve's sums at the 4 cell centres around the
+                          vertex added; a symmetric bump's peak gives (0,0,1) */
+} bb_normal_filter;
+
+/* Parses "vertex", "valve", "central", "sobel". */
+bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
+const char *bb_normal_filter_name(bb_normal_filter f);
+
+/* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
+ * height: 1 channel; out: allocated, 3 channels. */
+bb_status bb_normals_compute(const bb_image *height, float height_scale,
+                             bb_normal_filter filter, bb_addressing addressing,
+                             bb_image *out, bb_error *err);
+
+typedef struct bb_normal_decode_options {
+  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
+  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
+} bb_normal_decode_options;
+
+/* Defaults: +Y down, normalize on. */
+void bb_normal_decode_options_init(bb_normal_decode_options *o);
+
+/* The normals a normal-map file holds, from the values bb_image_read
+ * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
+ * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
+ * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
+ * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
+ * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
+ * texel. Allocates normals: 3 channels, same size. */
+bb_status bb_normal_map_decode(const bb_image *values, int is_float,
+                               const bb_normal_decode_options *o, bb_image *normals,
+                               bb_error *err);
 
 /* -------------------------------------------------------------- derive */
 
@@ -1206,15 +1286,6 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 
-/* The most bytes bb_bake allocates at one time for a width x height field
- * with options o (its outputs, basis, slices and threads), not counting the
- * height itself: an upper bound worked out from the sizes alone, following
- * the bake's stages. bb_bake refuses (BB_ERR_MEMORY, naming both figures) a
- * bake whose estimate is over bb_memory_available before it allocates
- * anything. About 32 bytes a texel for ssbump and ao, 36 with the normal
- * map, 64 for every output. 0 for a bad size or NULL options. */
-uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o);
-
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
@@ -1222,7 +1293,7 @@ const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kin
 void bb_bake_result_free(bb_bake_result *r);
 
 /* =====================================================================
- * maps: Valve's files, converting, combining, programs, mips, compare
+ * maps: Valve's files, converting, combining, programs, slope maps, compare
  * Every function here works on decoded values: normals as N in [-1, 1]
  * (+Y down), ssbump, weights and ao in [0, 1], colours in [0, 1].
  * ===================================================================== */
@@ -1446,27 +1517,6 @@ void bb_slope_table(const double light[3], float table[256]);
 bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image *out,
                          bb_error *err);
 
-/* ---------------------------------------------------------- mip chains */
-
-/* How a mip level is made from the one above it. */
-typedef enum bb_mip_filter {
-  BB_MIP_AVERAGE = 0,  /* box average of every channel: ssbump, weights, ao, heights
-                          (linear in light, so averages light as the paper says) */
-  BB_MIP_RENORMALIZE   /* box average, then channels 0..2 rescaled to unit length
-                          (normal maps; a zero average becomes (0, 0, 1)) */
-} bb_mip_filter;
-
-/* The mip chain of img, down to 1 x 1: level 0 is a copy of img, level k + 1
- * is level k box-filtered by OpenImageIO's ImageBufAlgo::resize to
- * max(1, w / 2) x max(1, h / 2) (for even sides exactly the mean of 2 x 2
- * texels; an odd side's box covers the 3 texels under each output texel),
- * then renormalised for BB_MIP_RENORMALIZE. *levels is malloc'd with *count
- * images (1 + floor(log2(max(w, h)))); free it with bb_mip_chain_free. */
-bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
-                       int *count, bb_error *err);
-
-void bb_mip_chain_free(bb_image *levels, int count);
-
 /* ------------------------------------------------------------- compare */
 
 typedef struct bb_compare_stats {
@@ -1526,7 +1576,7 @@ bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
                                     const bb_compare_limits *limits);
 
 /* =====================================================================
- * render: lighting the maps, pictures, sheets, animations
+ * render: lighting the maps, pictures, panels, sheets
  * ===================================================================== */
 
 /* ------------------------------------------------------------ lighting */
@@ -1808,30 +1858,6 @@ bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
                         const bb_sheet_options *o, bb_image *out, int *labels_drawn,
                         bb_error *err);
 
-/* ----------------------------------------------------------- animation */
-
-/* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
- * channel, a palette per frame). Frames go to a temporary file in the
- * destination directory; bb_animation_close checks it and renames it into
- * place, so a failure leaves no partial file. GIF stores no provenance. */
-typedef struct bb_animation bb_animation;
-
-/* Starts path (extension .gif) for frames of width x height, shown at
- * frames_per_second (1..100). Errors: BB_ERR_FORMAT (not .gif), BB_ERR_IO. */
-bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
-                            bb_animation **out, bb_error *err);
-
-/* Appends a frame: 3 channels, the open size, values in [0, 1]. On failure
- * the animation stays open; bb_animation_abort it. */
-bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err);
-
-/* Finishes the file, reads it back to check its frame count, renames it into
- * place and frees a, also on failure (then no file is left). */
-bb_status bb_animation_close(bb_animation *a, bb_error *err);
-
-/* Removes the temporary file and frees a; safe on NULL. */
-void bb_animation_abort(bb_animation *a);
-
 /* =====================================================================
  * mesh: models and DOOM 3's flat render bump
  * ===================================================================== */
@@ -1979,19 +2005,6 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
 
 void bb_renderbump_result_free(bb_renderbump_result *r);
 
-/* Writes a flat render bump's files together or neither (bb_outputs_write):
- * the normal map at normal_path (RGB = N as bumpbake stores normal maps:
- * 0.5 + 0.5 N in integer files, N in float ones; alpha = the coverage as it
- * is; green flipped for normal_y_up) and, when height_path is not NULL,
- * the height (16-bit where the format holds it). Each records provenance:
- * command, the model's file name and bb_mesh_hash (model_hash), its kind
- * ("normal+coverage", "height"), bb_renderbump_describe's keys and
- * normal_y. Errors as bb_outputs_write's. */
-bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
-                              int normal_y_up, const char *model, uint64_t model_hash,
-                              const char *command, const char *normal_path,
-                              const char *height_path, bb_error *err);
-
 /* The "key=value" provenance lines of a render (axis, size, samples,
  * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
  * bb_provenance_format's lines; NULL when out of memory. */
@@ -2002,7 +2015,7 @@ char *bb_renderbump_describe(const bb_renderbump_options *o,
  * job: the whole job on files
  * ===================================================================== */
 
-/* ---------------------------------------------------------- provenance */
+/* ------------------------------------------------ provenance of a bake */
 
 /* How an output was made. Every field that affects pixels is here. */
 typedef struct bb_provenance {
@@ -2031,53 +2044,6 @@ typedef struct bb_provenance {
  * bb_image_hash) when there is one.
  * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
-
-/* Writes into out (capacity cap) the keys whose values differ between two
- * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
- * when either text is NULL). Keys "command" and "output" are ignored. Returns
- * the number of differing keys, or -1 when out of memory. Time is
- * O(n log n) in the number of lines, whatever the texts hold. */
-int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
-
-/* What an image description holds, for readers of provenance. */
-typedef enum bb_provenance_class {
-  BB_PROVENANCE_NONE = 0, /* no text, or another tool's description */
-  BB_PROVENANCE_INTACT,   /* bumpbake provenance: every line "key=value" */
-  BB_PROVENANCE_DAMAGED   /* bumpbake provenance whose lines were cut or
-                             re-wrapped (by a format or another tool), so a
-                             key-by-key diff would mislead */
-} bb_provenance_class;
-
-/* Classifies a description (NULL is NONE): bumpbake's when it has a
- * "bumpbake_version=" line; intact when each non-empty line is key=value
- * with a key of lower-case letters, digits and '_'. */
-bb_provenance_class bb_provenance_classify(const char *description);
-
-/* One "key=value" line of a provenance text, as pointers into it (not
- * terminated). */
-typedef struct bb_provenance_entry {
-  const char *key;
-  size_t key_length;
-  const char *value;
-  size_t value_length;
-} bb_provenance_entry;
-
-/* The one reading of a provenance text, which every reader uses (the
- * values and diffs below, the up-to-date check, `bumpbake info --json`,
- * Python's bumpbake.info): a line ends at '\n', and a '\r' before it is
- * dropped (a text re-saved on Windows); its key is what comes before its
- * first '=', its value what follows; a line without '=' is skipped; a key
- * seen before keeps its first value (its later lines are skipped). Fills
- * entries with up to cap of them, in line order; returns how many there are
- * (which may exceed cap), or -1 when out of memory. Time O(n log n) in the
- * lines. */
-long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
-
-/* The value of key in a provenance text (its first "key=value" line) into
- * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
- * there, 0 when it is not or description is NULL (out is then ""). So a
- * reader can ask which basis a map was baked with ("basis"). */
-int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
 
 /* ----------------------------------------------------------- output paths */
 
@@ -2174,6 +2140,22 @@ bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kind
  * a signal leaves all of a set old or all new. The handler should be
  * installed without SA_RESETHAND: this resets the action itself. */
 void bb_signal_cleanup(int signal_number);
+
+/* --------------------------------------------------- render bump files */
+
+/* Writes a flat render bump's files together or neither (bb_outputs_write):
+ * the normal map at normal_path (RGB = N as bumpbake stores normal maps:
+ * 0.5 + 0.5 N in integer files, N in float ones; alpha = the coverage as it
+ * is; green flipped for normal_y_up) and, when height_path is not NULL,
+ * the height (16-bit where the format holds it). Each records provenance:
+ * command, the model's file name and bb_mesh_hash (model_hash), its kind
+ * ("normal+coverage", "height"), bb_renderbump_describe's keys and
+ * normal_y. Errors as bb_outputs_write's. */
+bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
+                              int normal_y_up, const char *model, uint64_t model_hash,
+                              const char *command, const char *normal_path,
+                              const char *height_path, bb_error *err);
+
 
 /* ----------------------------------------------------------- height files */
 

@@ -1,5 +1,5 @@
 /* hostile_headers.h: small files whose headers declare what their readers
- * would allocate before any size check of bumpbake's (issue 22, #5), made
+ * would allocate before any size check of bumpbake's, made
  * here so no binary is committed. Each writer returns 0 on success.
  * Little-endian helpers come from hostile_tiff.h. */
 #ifndef BB_TESTS_HOSTILE_HEADERS_H

@@ -1,7 +1,7 @@
 /* hostile_tiff.h: a 186-byte TIFF whose header declares an image far larger
  * than its data (8192 x 8192 x 64 channels over 52 bytes of strip): what a
  * reader must refuse, or fail on quickly, without allocating what the header
- * asks for. Shared by test_io.c and test_cli.c. */
+ * asks for. Shared by test_image_files.c and test_cli.c. */
 #ifndef BB_TESTS_HOSTILE_TIFF_H
 #define BB_TESTS_HOSTILE_TIFF_H
 

@@ -6,7 +6,7 @@
  *
  * At every K-th texel of every K-th row (default 4) of MAP (read as a bake
  * reads it, no smoothing, heights times SCALE, periodic), the horizon is
- * found in N azimuths (default 2048, spread evenly) by bb_ray_horizon, the
+ * found in N azimuths (default 2048, spread evenly) by bb__ray_horizon, the
  * exact horizon of the triangle mesh along any direction out to D texels
  * (default 8 times the longer side), and docs/conventions.md's integrals are taken
  * per azimuth in closed form (power 1): ao from cos^2 of the horizon's
@@ -24,6 +24,7 @@
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "cli/json.h"
+#include "trace/testing.h"
 
 #include <errno.h>
 #include <math.h>
@@ -121,13 +122,13 @@ static void reference_row(void *user, int row) {
   const int y = row * a->stride;
   for (int i = 0; i < j->columns; i++) {
     const int x = i * a->stride;
-    const bb_ray base = {{x, y, (double)*bb_image_texel(j->z, x, y) + a->bias}, {1, 0, 0}};
+    const bb__ray base = {{x, y, (double)*bb_image_texel(j->z, x, y) + a->bias}, {1, 0, 0}};
     double open_ao = 0.0, open[3] = {0}, all[3] = {0};
     for (int k = 0; k < a->azimuths; k++) {
       const double phi = 2.0 * BB__PI * (k + 0.5) / a->azimuths;
-      bb_ray r = base;
+      bb__ray r = base;
       r.direction[0] = cos(phi), r.direction[1] = sin(phi);
-      const double t = bb_ray_horizon(j->p, &r, a->reach);
+      const double t = bb__ray_horizon(j->p, &r, a->reach);
       open_ao += 1.0 / (1.0 + t * t);
       for (int c = 0; c < 3; c++) {
         open[c] += lobe_above(j->basis[c], phi, t);
@@ -219,7 +220,7 @@ int main(int argc, char **argv) {
   bb_image h = {0}, z = {0}, normal = {0};
   bb_pyramid *p = NULL;
   bb_error err = {{0}};
-  bb_status st = bb_height_load(a.map, BB_CHANNEL_AUTO, &h, &err);
+  bb_status st = bb_height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err);
   if (st == BB_OK) st = bb_image_alloc(&z, h.width, h.height, 1, &err);
   if (st == BB_OK) {
     const float scale = (float)a.scale; /* float times float, as the bake scales */

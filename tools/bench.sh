@@ -487,7 +487,7 @@ else
     "$acc_rock_scale, genheight noise at scale $acc_noise_scale; no smoothing (--filter-radius 0)," \
     "bias $bias, Valve's normal (--normal-filter valve) on both sides. References:"
   echo "  peer16k = the peer (Valve's method on Embree) with $acc_ref_rays uniform rays per texel;"
-  echo "  dense   = build/tools/accuracy_ref: bb_ray_horizon in 2048 azimuths at every 4th texel"
+  echo "  dense   = build/tools/accuracy_ref: bb__ray_horizon in 2048 azimuths at every 4th texel"
   echo "            of every 4th row, integrated in elevation in closed form."
   echo "Each pair of columns is mean |error| and bias (signed mean of run - reference)."
   printf '%-6s %-11s %-9s' map run reference

@@ -154,7 +154,7 @@ int main(int argc, char **argv) {
   bb_image height = {0};
   bb_bake_result r = {0};
   bb_error err = {{0}};
-  bb_status st = bb_height_load(a.map, BB_CHANNEL_AUTO, &height, &err);
+  bb_status st = bb_height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &height, NULL, &err);
   if (st == BB_OK) st = a.inner ? staged_bake(&a, &height, &r, &err) : bb_bake(&height, &a.bake, &r, &err);
   char path[4200];
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};

@@ -97,7 +97,7 @@ fi
 
 # ------------------------------------------------------ 3. exported symbols
 # (typedef lines left out: "typedef bb_status (*name)(...)" is no function.)
-# Besides them, png_set_error_fn and png_create_write_struct (src/io/
+# Besides them, png_set_error_fn and png_create_write_struct (src/image/
 # png_hooks.c: they set up the libpng structs OpenImageIO makes, so they
 # must be found before libpng's).
 { grep -v '^[[:space:]]*typedef' "$prefix/include/bumpbake.h" |

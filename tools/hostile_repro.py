@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """hostile_repro.py: the file makers and checks of tools/hostile_repro.sh.
 
-Writes issue 22's hostile files (models that name files outside their
+Writes the hostile files (models that name files outside their
 directory or nest too deep, headers that declare huge allocations, PNGs
 with hostile provenance, a float TIFF of NaN), snapshots a directory and
 compares snapshots, checks printed text for control characters and JSON

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# hostile_repro.sh BIN: reruns every reproduction of issue 22 (hostile files,
+# hostile_repro.sh BIN: reruns every reproduction of a hostile input (hostile files,
 # second round: its 15 numbered cases with their variants, and the minor
 # paragraph's compare of NaN and flat model) against the binary BIN, one
 # line per case: its id, what ran, and CLEAN or NOT CLEAN with the reasons.

@@ -10,6 +10,8 @@ start=$(date +%s.%N)
 failed=0 total=0
 for dir in tests/*/; do
   family=$(basename "$dir")
+  # Folders without Criterion files (tests/tools: the checks' own tests) are not the suite's.
+  compgen -G "${dir}test_*.c" >/dev/null || continue
   # The suites a family's files define: Test(SUITE, ...) and TestSuite(SUITE, ...).
   suites=$(sed -n 's/^Test\(Suite\)\{0,1\}(\([a-z0-9_]*\).*/\2/p' "$dir"test_*.c | sort -u | paste -sd'|')
   [ -n "$suites" ] || continue

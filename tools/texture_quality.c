@@ -9,7 +9,7 @@
  *       excluded).
  *   texture_quality decode IN OUT.png [--level K]
  *       level K of IN to an 8-bit PNG, to look at: a .vtf through the tests'
- *       own decoder (tests/io/texture_oracle.h: DXT1, DXT5, BGR888,
+ *       own decoder (tests/texture/texture_oracle.h: DXT1, DXT5, BGR888,
  *       BGRA8888), anything else (.dds) through OpenImageIO.
  *   texture_quality compare REF DECODED [--map ...] [--channels N]
  *       DECODED (.vtf as above, else OpenImageIO: a DDS, a PNG) against REF,
@@ -21,7 +21,7 @@
  *       A angle_max_deg B z_max_codes Z]".
  */
 #include "bumpbake.h"
-#include "io/texture_oracle.h"
+#include "texture/texture_oracle.h"
 
 #include <math.h>
 #include <stdio.h>

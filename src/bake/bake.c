@@ -2,6 +2,7 @@
  * one height field, with the time of each stage. No file I/O here. */
 
 #include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include "trace/bounce.h"
 #include "trace/pyramid.h"

@@ -2,6 +2,7 @@
  * basis (basis.c). */
 
 #include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include <math.h>
 #include <stdatomic.h>

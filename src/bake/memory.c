@@ -119,10 +119,3 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     *kept = l.alive;
   return l.peak;
 }
-
-uint64_t bb_bake_memory_estimate(int width, int height, const bb_bake_options *o) {
-  bb_bake_options prepared;
-  if (!o || width <= 0 || height <= 0 || bb__bake_prepare(o, &prepared, NULL) != BB_OK)
-    return 0;
-  return (uint64_t)bb__bake_memory(width, height, &prepared, 0, 0.0, NULL);
-}

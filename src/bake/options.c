@@ -4,6 +4,7 @@
  * azimuth slices. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "trace/basis.h"
 
 #include <float.h>
 #include <math.h>

@@ -1,4 +1,4 @@
-/* cli_compare.c: `bumpbake compare`, an idiff-style image diff for CI.
+/* compare.c: `bumpbake compare`, an idiff-style image diff for CI.
  *
  * Options and exit codes are OpenImageIO idiff's (2.4), so a CI script
  * written for idiff works unchanged: -fail, -failpercent, -hardfail,

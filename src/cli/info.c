@@ -1,4 +1,4 @@
-/* cli_info.c: `bumpbake info`, what image files are (size, channels, format,
+/* info.c: `bumpbake info`, what image files are (size, channels, format,
  * sample type, alpha) and the provenance bumpbake stored in them. Reads
  * headers only: no pixel is decoded. */
 #include "cli.h"

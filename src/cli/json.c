@@ -1,4 +1,4 @@
-/* cli_json.c: the one JSON writer of the command line and the tools (see
+/* json.c: the one JSON writer of the command line and the tools (see
  * cli_json.h). */
 #include "json.h"
 

@@ -1,6 +1,6 @@
 /* internal.h: what every family of the library shares (not public): error
  * messages, periodic addressing, threads, hashing and the clock. Each family
- * keeps its own private headers beside its files (io/oiio.h, trace/march.h...). */
+ * keeps its own private headers beside its files (image/oiio.h, trace/march.h...). */
 #ifndef BB_INTERNAL_H
 #define BB_INTERNAL_H
 
@@ -107,29 +107,49 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
 
 /* 64-bit FNV-1a: the hash of an empty input, and one step over the four
  * bytes of v, little-endian whatever the host (so hashes recorded on one
- * machine check on another). For bb_image_hash and bb_mesh_hash. */
+ * machine check on another). For bb_image_hash and bb_mesh_hash (hash.c). */
 #define BB__FNV64_OFFSET 0xcbf29ce484222325ULL
 uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
 /* bb__fnv1a_u32 over the bits of n floats. */
 uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n);
+
+/* A growable NUL-terminated text (data is NULL until the first append);
+ * `failed` sticks once an allocation fails, and the caller then frees data
+ * and refuses the result. Zero-initialise it: bb__text t = {0}. */
+typedef struct bb__text {
+  char *data;
+  size_t length, capacity;
+  int failed;
+} bb__text;
+/* Appends n bytes of s. */
+void bb__text_append(bb__text *t, const char *s, size_t n);
+/* Appends the string s. */
+void bb__text_add(bb__text *t, const char *s);
+
+/* Checks of images, with the same words in every family (image_checks.c). */
+/* BB_ERR_VALUE naming the first texel whose channels 0..channels-1 are not
+ * finite; what names the image ("normal map", "detail"). */
+bb_status bb__check_finite(const bb_image *img, int channels, const char *what,
+                           bb_error *err);
+
+/* BB_ERR_ARGUMENT unless a and b have the same width and height. */
+bb_status bb__check_same_size(const bb_image *a, const char *name_a, const bb_image *b,
+                              const char *name_b, bb_error *err);
+
+/* BB_ERR_ARGUMENT unless img is allocated with at least min_channels. */
+bb_status bb__check_channels(const bb_image *img, int min_channels, const char *what,
+                             bb_error *err);
+
+/* Scales v to unit length; a zero (or non-finite) length gives (0, 0, 1),
+ * the flat normal, since such a texel has no direction to keep (vector.c). */
+void bb__normalize3(double v[3]);
 
 /* BB_OK when need bytes fit in what bb_memory_available says is left, else
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */
 bb_status bb__memory_check(double need, const char *what, bb_error *err);
 
-/* ------------------------------------------------------------------- text */
-
-/* A growable string; once an allocation fails, failed sticks and every
- * later addition is dropped (bb__text_take then gives NULL). */
-typedef struct bb__text {
-  char *data;
-  size_t length, capacity;
-  int failed;
-} bb__text;
-
-void bb__text_add(bb__text *t, const char *s);
-void bb__text_addn(bb__text *t, const char *s, size_t n);
+/* (text.c, beside bb__text_append and bb__text_add) */
 void bb__text_printf(bb__text *t, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))

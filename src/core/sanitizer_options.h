@@ -9,7 +9,7 @@
  * recorded stack is only operator new and std::string::_M_assign, which
  * every leaked string shows; the slow unwinder that reaches OpenImageIO's
  * frame triples the run time of every debug CLI run (0.2 -> 0.7 s of CPU at
- * start-up alone). Instead src/io/oiio_read.cpp stops counting allocations as
+ * start-up alone). Instead src/image/oiio_read.cpp stops counting allocations as
  * leaks while, and only while, OpenImageIO's PNG reader decodes in that
  * thread. That covers the library, the CLI and the tests alike, and leaves
  * every other leak visible.

@@ -1,13 +1,14 @@
-/* text.c: the library's one growable text buffer (provenance, command
- * lines, lists in messages), and numbers spelled the shortest way that
- * reads back as the same value. */
+/* text.c: the library's one growable text (bb__text, core/internal.h), for
+ * provenance and the command lines it records, and numbers spelled the
+ * shortest way that reads back as the same value. */
+
 #include "core/internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-void bb__text_addn(bb__text *t, const char *s, size_t n) {
+void bb__text_append(bb__text *t, const char *s, size_t n) {
   if (t->failed)
     return;
   if (t->length + n + 1 > t->capacity) {
@@ -28,7 +29,7 @@ void bb__text_addn(bb__text *t, const char *s, size_t n) {
 }
 
 void bb__text_add(bb__text *t, const char *s) {
-  bb__text_addn(t, s ? s : "", strlen(s ? s : ""));
+  bb__text_append(t, s, strlen(s));
 }
 
 void bb__text_printf(bb__text *t, const char *fmt, ...) {
@@ -42,7 +43,7 @@ void bb__text_printf(bb__text *t, const char *fmt, ...) {
     return;
   }
   if ((size_t)n < sizeof small) {
-    bb__text_addn(t, small, (size_t)n);
+    bb__text_append(t, small, (size_t)n);
     return;
   }
   char *big = malloc((size_t)n + 1);
@@ -53,7 +54,7 @@ void bb__text_printf(bb__text *t, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(big, (size_t)n + 1, fmt, ap);
   va_end(ap);
-  bb__text_addn(t, big, (size_t)n);
+  bb__text_append(t, big, (size_t)n);
   free(big);
 }
 

@@ -3,7 +3,7 @@
  * and what the file's format or depth will cost the maps said too. */
 #include "core/input_file.h"
 #include "core/internal.h"
-#include "io/height_channel.h"
+#include "image/height_channel.h"
 #include "job/job_internal.h"
 
 #include <math.h>

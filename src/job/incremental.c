@@ -12,8 +12,8 @@
 #include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
-#include "io/oiio.h"
-#include "io/provenance.h"
+#include "image/oiio.h"
+#include "files/provenance.h"
 #include "trace/rayset.h"
 #include <errno.h>
 #include <stdarg.h>
@@ -86,16 +86,6 @@ void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
   bb__rayset_id(prepared.slices, o->power, &o->basis, out, cap);
 }
 
-static const char *resolved_depth_name(int depth) {
-  switch (depth) {
-  case BB_DEPTH_8: return "8-bit";
-  case BB_DEPTH_16: return "16-bit";
-  case BB_DEPTH_HALF: return "half float";
-  case BB_DEPTH_FLOAT: return "float";
-  default: return "unknown";
-  }
-}
-
 /* The depth a file's samples have, as bb_image_write would have asked for
  * it; -1 for anything it does not write. */
 static int depth_of(const bb_image_info *info) {
@@ -145,8 +135,8 @@ static int layout_matches(const char *path, const bb_image_info *info, bb_depth 
                           int mip_mapped, char *reason, size_t cap) {
   int want = bb__path_resolved_depth(path, depth), have = depth_of(info);
   if (want < 0 || have != want) {
-    say(reason, cap, "%s samples; %s asked", resolved_depth_name(have),
-        resolved_depth_name(want));
+    say(reason, cap, "%s samples; %s asked", bb__depth_words(have),
+        bb__depth_words(want));
     return 0;
   }
   int levels = 0;

@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 
 #include <stddef.h>
+#include <sys/types.h>
 
 /* ------------------------------------------------------------ path parts */
 
@@ -18,6 +19,27 @@ void bb__directory_part(const char *path, char *dir, size_t cap);
 /* The lower-case extension of path's last component, without the dot ("" when
  * none), into buf (capacity cap); returns buf. */
 const char *bb__extension(const char *path, char *buf, size_t cap);
+
+/* Which file a path names, worked out once (paths.c): the file itself when
+ * it exists, and the directory entry a write of it replaces (its
+ * directory's device and inode and its last component) when the directory
+ * exists. path and name point into the caller's string. */
+typedef struct bb__file_identity {
+  int exists;
+  dev_t dev;
+  ino_t ino;
+  int dir_exists;
+  dev_t dir_dev;
+  ino_t dir_ino;
+  const char *name;
+  const char *path;
+} bb__file_identity;
+bb__file_identity bb__file_identify(const char *path);
+
+/* 1 when a and b name one file: one existing file under two names (links,
+ * "./", ".."), or, for files not made yet, the same name in the same
+ * directory however it is spelled; else the same spelling. */
+int bb__same_file_identity(const bb__file_identity *a, const bb__file_identity *b);
 
 /* BB_OK when path's directory exists and is a directory and path itself is
  * not a directory; else BB_ERR_IO "PATH: cannot write: ...". */

@@ -4,7 +4,7 @@
  * machine has left, so a map too large is refused with the figures. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
-#include "io/texture.h"
+#include "texture/texture.h"
 #include "job/job_internal.h"
 
 #include <stdio.h>
@@ -19,7 +19,7 @@ static double sample_bytes(bb_depth depth, const char *path) {
   }
 }
 
-/* An engine texture's encoder (io/texture_write.c): the map's mip chain in
+/* An engine texture's encoder (image/texture_write.c): the map's mip chain in
  * float, made whether it is written or not, and one buffer of the top
  * level in the file's format. */
 static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,

@@ -52,22 +52,8 @@ char *bb_path_with_suffix(const char *path, const char *suffix) {
 
 /* ------------------------------------------------------------ same file */
 
-/* Which file a path names, worked out once: the file itself when it
- * exists, and the directory entry a write of it replaces (its directory's
- * device and inode and its last component) when the directory exists. */
-typedef struct file_identity {
-  int exists;
-  dev_t dev;
-  ino_t ino;
-  int dir_exists;
-  dev_t dir_dev;
-  ino_t dir_ino;
-  const char *name;
-  const char *path;
-} file_identity;
-
-static file_identity identify(const char *path) {
-  file_identity id = {0};
+bb__file_identity bb__file_identify(const char *path) {
+  bb__file_identity id = {0};
   id.path = path;
   struct stat st;
   if (stat(path, &st) == 0) {
@@ -86,7 +72,7 @@ static file_identity identify(const char *path) {
   return id;
 }
 
-static int same_identity(const file_identity *a, const file_identity *b) {
+int bb__same_file_identity(const bb__file_identity *a, const bb__file_identity *b) {
   /* Two names of one existing file (symbolic or hard links, "./", ".."). */
   if (a->exists && b->exists)
     return a->dev == b->dev && a->ino == b->ino;
@@ -100,8 +86,8 @@ static int same_identity(const file_identity *a, const file_identity *b) {
 int bb_same_file(const char *a, const char *b) {
   if (!a || !b)
     return 0;
-  const file_identity ia = identify(a), ib = identify(b);
-  return same_identity(&ia, &ib);
+  const bb__file_identity ia = bb__file_identify(a), ib = bb__file_identify(b);
+  return bb__same_file_identity(&ia, &ib);
 }
 
 /* ----------------------------------------------------------- directories */
@@ -151,17 +137,6 @@ bb_status bb__check_output_directory(const char *path, bb_error *err) {
 
 /* ---------------------------------------------------------------- checks */
 
-static const char *depth_name(bb_depth d) {
-  switch (d) {
-  case BB_DEPTH_8: return "8";
-  case BB_DEPTH_16: return "16";
-  case BB_DEPTH_HALF: return "half";
-  case BB_DEPTH_FLOAT: return "float";
-  case BB_DEPTH_DEFAULT: break;
-  }
-  return "default";
-}
-
 /* The format rules of one image output: its extension and depth, or (late
  * is 1) its mip chain and channels, checked after its paths as they always
  * were, so the first message of several stays the same. */
@@ -207,7 +182,7 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
   }
   if (!bb_path_supports_depth(o->path, o->depth))
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in .%s files%s",
-                    o->path, depth_name(o->depth), bb__extension(o->path, ext, sizeof ext),
+                    o->path, bb_depth_name(o->depth), bb__extension(o->path, ext, sizeof ext),
                     bb_path_is_texture_format(o->path) ? " (their texture format sets it)" : "");
   return BB_OK;
 }
@@ -218,13 +193,13 @@ bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
     return bb__fail(err, BB_ERR_ARGUMENT, "outputs check: bad arguments");
   /* Each name is looked up once; the comparisons are then in memory, so
    * the thousands of frames of an orbit check in a moment. */
-  file_identity *ids = malloc(((size_t)count + (size_t)read_count + 1) * sizeof *ids);
+  bb__file_identity *ids = malloc(((size_t)count + (size_t)read_count + 1) * sizeof *ids);
   if (!ids)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-  file_identity *in = ids + count;
+  bb__file_identity *in = ids + count;
   for (int r = 0; r < read_count; r++)
     if (reads[r])
-      in[r] = identify(reads[r]);
+      in[r] = bb__file_identify(reads[r]);
   bb_status st = BB_OK;
   for (int k = 0; k < count && st == BB_OK; k++) {
     const bb_output_spec *o = &outputs[k];
@@ -232,16 +207,16 @@ bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
       st = bb__fail(err, BB_ERR_ARGUMENT, "%s: no file name given", o->kind ? o->kind : "output");
       break;
     }
-    ids[k] = identify(o->path);
+    ids[k] = bb__file_identify(o->path);
     for (int j = 0; j < k && st == BB_OK; j++)
-      if (same_identity(&ids[j], &ids[k]))
+      if (bb__same_file_identity(&ids[j], &ids[k]))
         st = bb__fail(err, BB_ERR_ARGUMENT, "%s and %s would both be written to %s",
                       outputs[j].kind ? outputs[j].kind : "an output",
                       o->kind ? o->kind : "another", o->path);
     if (st == BB_OK && !o->text)
       st = check_format(o, 0, err);
     for (int r = 0; r < read_count && st == BB_OK; r++)
-      if (reads[r] && same_identity(&in[r], &ids[k]))
+      if (reads[r] && bb__same_file_identity(&in[r], &ids[k]))
         st = bb__fail(err, BB_ERR_IO, "%s: output would overwrite the input file", o->path);
     if (st == BB_OK)
       st = bb__check_output_directory(o->path, err);

@@ -37,22 +37,10 @@ void bb_job_options_init(bb_job_options *o) {
 
 /* ----------------------------------------------------------------- inputs */
 
-/* Which file a path names, when it exists. */
-typedef struct file_id {
-  int exists;
-  dev_t dev;
-  ino_t ino;
-} file_id;
-
-static file_id file_id_of(const char *path) {
-  struct stat st;
-  if (stat(path, &st) != 0)
-    return (file_id){0, 0, 0};
-  return (file_id){1, st.st_dev, st.st_ino};
-}
-
-static int same_file_id(file_id a, file_id b) {
-  return a.exists && b.exists && a.dev == b.dev && a.ino == b.ino;
+/* 1 when a and b are one existing file (an input named twice, an output
+ * over an input). */
+static int same_existing_file(const bb__file_identity *a, const bb__file_identity *b) {
+  return a->exists && b->exists && bb__same_file_identity(a, b);
 }
 
 /* The inputs gathered so far, with the identity of each, so a file named
@@ -60,20 +48,20 @@ static int same_file_id(file_id a, file_id b) {
 typedef struct input_list {
   bb_job *job;
   int capacity;
-  file_id *ids;
+  bb__file_identity *ids;
 } input_list;
 
 static bb_status add_input(input_list *l, const char *path, bb_error *err) {
-  file_id id = file_id_of(path);
+  const bb__file_identity id = bb__file_identify(path);
   for (int i = 0; i < l->job->count; i++)
-    if (same_file_id(l->ids[i], id))
+    if (same_existing_file(&l->ids[i], &id))
       return BB_OK;
   if (l->job->count == l->capacity) {
     int cap = l->capacity ? 2 * l->capacity : 16;
     bb__job_item *items = realloc(l->job->items, (size_t)cap * sizeof *items);
     if (items)
       l->job->items = items;
-    file_id *ids = realloc(l->ids, (size_t)cap * sizeof *ids);
+    bb__file_identity *ids = realloc(l->ids, (size_t)cap * sizeof *ids);
     if (ids)
       l->ids = ids;
     if (!items || !ids)
@@ -329,21 +317,21 @@ static int by_path(const void *a, const void *b) {
  * spellings), and outputs that are one of the inputs. */
 static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
   planned_output *outs = malloc((size_t)job->count * BB_OUTPUT_KIND_COUNT * sizeof *outs);
-  file_id *in = malloc((size_t)job->count * sizeof *in);
+  bb__file_identity *in = malloc((size_t)job->count * sizeof *in);
   bb_status st = BB_OK;
   if (!outs || !in)
     st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
   int n = 0;
   for (int i = 0; i < job->count && st == BB_OK; i++) {
-    in[i] = file_id_of(job->items[i].input);
+    in[i] = bb__file_identify(job->items[i].input);
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       if (job->items[i].paths[k])
         outs[n++] = (planned_output){job->items[i].paths[k], i, k};
   }
   for (int i = 0; i < n && st == BB_OK; i++) {
-    file_id out = file_id_of(outs[i].path);
+    const bb__file_identity out = bb__file_identify(outs[i].path);
     for (int j = 0; j < job->count && out.exists && st == BB_OK; j++)
-      if (same_file_id(in[j], out))
+      if (same_existing_file(&in[j], &out))
         st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %s of %s would overwrite the input %s",
                       outs[i].path, kind_name(outs[i].kind), job->items[outs[i].item].input,
                       job->items[j].input);

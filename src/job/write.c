@@ -5,7 +5,8 @@
  * the last one, so an interrupted command leaves the set all old or all
  * new. */
 #include "core/internal.h"
-#include "io/safe_file.h"
+#include "files/safe_file.h"
+#include "image/oiio.h"
 #include "job/job_internal.h"
 
 #include <errno.h>
@@ -93,8 +94,8 @@ static bb_status stage_mips(const bb_output_file *o, const bb_write_options *wo,
                             bb_staged_file **out, bb_error *err) {
   bb_image *levels = NULL;
   int count = 0;
-  const bb_mip_filter filter = o->range == BB_RANGE_SIGNED ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
-  bb_status st = bb_mip_chain(o->image, filter, &levels, &count, err);
+  bb_status st =
+      bb_mip_chain(o->image, bb__mip_filter(o->range == BB_RANGE_SIGNED), &levels, &count, err);
   if (st == BB_OK)
     st = bb_image_write_mips_staged(o->path, levels, count, wo, out, err);
   bb_mip_chain_free(levels, count);

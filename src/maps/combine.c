@@ -7,6 +7,7 @@
  * in double from its own inputs only. */
 
 #include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include "maps/maps_internal.h"
 #include <math.h>

@@ -1,9 +1,8 @@
 /* convert.c: normal maps decoded from file values (normal2ssbump's input)
  * and basis maps turned back into normals (ssbump2normal). */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
-#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 

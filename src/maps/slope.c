@@ -2,7 +2,6 @@
  * the 16 x 16 table that lights it (docs/commands/bake.md, "Slope map"). */
 
 #include "core/internal.h"
-#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 

@@ -2,7 +2,7 @@
  * compatibility"): RGB = ssbump or the encoded normal map, A = the filtered
  * height or ao, and the detail variant's colour factor. */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include <math.h>
 #include <string.h>

@@ -1,6 +1,6 @@
 // mesh_assimp.cpp: model files through Assimp, the only file that includes it.
 //
-// A firewall like io/oiio_guard.h: every extern "C" function catches every
+// A firewall like image/oiio_guard.h: every extern "C" function catches every
 // exception and returns a bb_status with a one-line message. The rest of
 // bumpbake sees only bb_mesh. Reading here is the import itself, confined
 // to the model's directory; mesh_load.c runs it in a child process.
@@ -8,7 +8,7 @@
 #include "core/input_file.h"
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
-#include "io/safe_file.h"
+#include "files/safe_file.h"
 #include "mesh/mesh_import.h"
 #include <assimp/Exporter.hpp>
 #include <assimp/IOStream.hpp>
@@ -168,7 +168,7 @@ struct io_state {
   }
 };
 
-std::string base_name(const std::string &path) {
+static std::string base_name(const std::string &path) {
   size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }

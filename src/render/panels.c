@@ -1,8 +1,8 @@
 /* panels.c: pictures side by side in a labelled grid. Text goes through
- * OpenImageIO (io/oiio_text.cpp); the grid is drawn here. */
+ * OpenImageIO (oiio_text.cpp); the grid is drawn here. */
 
 #include "core/internal.h"
-#include "io/text.h"
+#include "render/text.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

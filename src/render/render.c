@@ -9,10 +9,9 @@
  * function and one row of `modes` below.
  */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include "render/render_internal.h"
-#include "maps/maps_internal.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>

@@ -1,7 +1,7 @@
 /* sheet.c: one labelled contact sheet of every map of a bake and one lit
  * render, for a quick look or a code-review comment. */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "core/internal.h"
 #include <math.h>
 #include <stdio.h>

@@ -242,12 +242,6 @@ static double elevation_of_q(double q) {
   return atan2(q, 1.0 - q); /* atan(t), t = q / (1 - q); exactly pi/2 at q = 1 */
 }
 
-double bb__ao_blocked(double lo, double hi, double tan_horizon) {
-  if (!(tan_horizon > 0.0)) return 0.0;
-  const double tt = tan_horizon * tan_horizon;
-  return 0.5 * (hi - lo) * (tt / (1.0 + tt));
-}
-
 double bb__lobe_blocked_exact(double lo, double hi, const double b[3], double power,
                               double tan_horizon) {
   if (!(tan_horizon > 0.0)) return 0.0;

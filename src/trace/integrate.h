@@ -17,12 +17,11 @@
 void bb__slice_table_build(double lo, double hi, const double (*basis)[3], int basis_count,
                            double power, double *table, double *share);
 
-/* The integrals the tables interpolate, by adaptive quadrature (for tests):
+/* The integral the tables interpolate, by adaptive quadrature (for tests):
  * what the sector [lo, hi] loses to a horizon of tangent t, for the lobe
- * max(0, w.b)^power and for ao (w.z, in closed form). */
+ * max(0, w.b)^power. */
 double bb__lobe_blocked_exact(double lo, double hi, const double b[3], double power,
                               double tan_horizon);
-double bb__ao_blocked(double lo, double hi, double tan_horizon);
 
 /* Nodes x[0..n-1] and weights w[0..n-1] of the n-point Gauss-Legendre rule
  * on [-1, 1] (Newton on P_n, to 1e-16). */

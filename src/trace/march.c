@@ -1,6 +1,6 @@
 /* march.c: horizons over the height field, marched through the max-mip
- * pyramid (no triangle database): of any ray (bb_ray_horizon,
- * bb_ray_occluded) and of a bake's lattice slices, which the sweeps fall
+ * pyramid (no triangle database): of any ray (bb__ray_horizon,
+ * bb__ray_occluded) and of a bake's lattice slices, which the sweeps fall
  * back to where a chunk of a long line cannot vouch for a texel.
  *
  * Exact horizons. Over a cell the surface is two planar triangles, so along
@@ -19,8 +19,8 @@
  * max is below that line), past its maximum distance (a periodic lattice
  * line is new for one period only), or where a clamped surface turns flat.
  *
- * Two ways to compute a breakpoint. For any ray (bb_ray_horizon and
- * bb_ray_occluded) from its line's index, the origin and the direction. For
+ * Two ways to compute a breakpoint. For any ray (bb__ray_horizon and
+ * bb__ray_occluded) from its line's index, the origin and the direction. For
  * a bake's slice, which follows an integer lattice step (a, b) from a
  * vertex, from integers only: the crossing index n and the family's count m
  * per step (distance n / m steps, interpolation weight r / m), exactly as
@@ -487,18 +487,9 @@ static double horizon(const bb_pyramid *p, const bb__march_ray *r, double max_di
   return w.best;
 }
 
-double bb__march_horizon(const bb_pyramid *p, const bb__march_ray *r, double max_distance) {
-  return horizon(p, r, max_distance, 0);
-}
-
-double bb__march_horizon_brute(const bb_pyramid *p, const bb__march_ray *r,
-                               double max_distance) {
-  return horizon(p, r, max_distance, 1);
-}
-
 /* Splits a 3D ray into the march's horizontal line and tangent. Returns 0 for
  * a vertical ray. */
-static int to_march_ray(const bb_ray *ray, bb__march_ray *r, double *tan_el) {
+static int to_march_ray(const bb__ray *ray, bb__march_ray *r, double *tan_el) {
   double h = hypot(ray->direction[0], ray->direction[1]);
   if (!(h > 0.0)) return 0;
   r->ox = ray->origin[0];
@@ -511,19 +502,19 @@ static int to_march_ray(const bb_ray *ray, bb__march_ray *r, double *tan_el) {
 }
 
 /* A vertical ray: nothing above the origin can block it. */
-int bb_ray_occluded(const bb_pyramid *p, const bb_ray *ray) {
+int bb__ray_occluded(const bb_pyramid *p, const bb__ray *ray) {
   bb__march_ray r;
   double tan_el;
   return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded(p, &r, tan_el) : 0;
 }
 
-int bb__ray_occluded_brute(const bb_pyramid *p, const bb_ray *ray) {
+int bb__ray_occluded_brute(const bb_pyramid *p, const bb__ray *ray) {
   bb__march_ray r;
   double tan_el;
   return to_march_ray(ray, &r, &tan_el) ? bb__march_occluded_brute(p, &r, tan_el) : 0;
 }
 
-static double ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance,
+static double ray_horizon(const bb_pyramid *p, const bb__ray *ray, double max_distance,
                           int brute) {
   bb__march_ray r;
   double tan_el;
@@ -532,11 +523,11 @@ static double ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_dis
   return horizon(p, &r, max_distance, brute);
 }
 
-double bb_ray_horizon(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
+double bb__ray_horizon(const bb_pyramid *p, const bb__ray *ray, double max_distance) {
   return ray_horizon(p, ray, max_distance, 0);
 }
 
-double bb__ray_horizon_brute(const bb_pyramid *p, const bb_ray *ray, double max_distance) {
+double bb__ray_horizon_brute(const bb_pyramid *p, const bb__ray *ray, double max_distance) {
   return ray_horizon(p, ray, max_distance, 1);
 }
 

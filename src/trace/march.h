@@ -21,12 +21,6 @@ typedef struct bb__march_ray {
 int bb__march_occluded(const bb_pyramid *p, const bb__march_ray *r, double tan_el);
 int bb__march_occluded_brute(const bb_pyramid *p, const bb__march_ray *r, double tan_el);
 
-/* The largest slope (surface - oz) / t over the breakpoints at 0 < t <=
- * max_distance, or 0 when none is positive. */
-double bb__march_horizon(const bb_pyramid *p, const bb__march_ray *r, double max_distance);
-double bb__march_horizon_brute(const bb_pyramid *p, const bb__march_ray *r,
-                               double max_distance);
-
 /* The horizon of lattice step (a, b) from vertex (x, y) lifted by bias, as
  * every path of the bake computes it: each breakpoint from integers (its
  * crossing index n and family count m: distance n / m steps, interpolation

@@ -11,7 +11,7 @@
  * neighbours; integrate.c turns a horizon into what the sector loses.
  */
 
-#include "bake/bake_internal.h"
+#include "trace/basis.h"
 #include "trace/testing.h"
 #include "core/internal.h"
 #include "trace/integrate.h"

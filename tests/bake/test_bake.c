@@ -186,7 +186,7 @@ typedef struct pit {
 
 static double pit_horizon(const void *ctx, double phi) {
   const pit *pt = ctx;
-  const bb_ray r = {{pt->x, pt->y, 0.0}, {cos(phi), sin(phi), 0.0}};
+  const bb__ray r = {{pt->x, pt->y, 0.0}, {cos(phi), sin(phi), 0.0}};
   return bb__ray_horizon_brute(pt->p, &r, 100.0);
 }
 

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "image/height_channel.h"
 #include "bake_harness.h"
 
 static const double PI = 3.14159265358979323846;
@@ -51,7 +52,7 @@ static bb_image load_fixture(const char *name) {
   snprintf(path, sizeof path, "%s/%s", dir && *dir ? dir : "fixtures", name);
   bb_image h;
   bb_error err;
-  cr_assert_eq(bb_height_load(path, BB_CHANNEL_AUTO, &h, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__height_load(path, BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, &err), BB_OK, "%s", err.message);
   return h;
 }
 
@@ -497,7 +498,7 @@ Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 120) {
   cr_assert_eq(run_capture(trace, out, sizeof out), 0, "%s failed: %s", tool, out);
   bb_image h;
   bb_error err;
-  cr_assert_eq(bb_height_load(map, BB_CHANNEL_AUTO, &h, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__height_load(map, BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, &err), BB_OK, "%s", err.message);
   bb_bake_options o = options(8.0f, 256, 0.6);
   o.normal_filter = BB_NORMAL_VALVE;
   bb_bake_result r = harness_bake(&h, &o);

@@ -935,7 +935,7 @@ Test(cli, renderbumpflat_usage_errors_exit_2) {
   }
 }
 
-/* ------------------------------------------------- hardening (issue 10) */
+/* ----------------------------------------------------------------- hardening */
 
 /* Deterministic noise in [0, 1): a bake of it has no flat, tiny outputs. */
 static float noise(int x, int y, int c) {
@@ -972,7 +972,7 @@ static const output_format every_output_format[] = {
  * 1, one line, and nothing changes on disk: the previous normal map stays
  * byte for byte, no ao appears, no temporary is left. The CLI ignores
  * SIGXFSZ itself, so the limit is a write error here and not a kill.
- * (test_io.c cuts every format and depth at three points.) */
+ * (test_image_files.c cuts every format and depth at three points.) */
 Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
   const char *in = tmp("noise.png");
   write_image(in, 64, 64, 1, noise);
@@ -1027,7 +1027,7 @@ Test(cli, full_disk_changes_nothing_for_every_format, .timeout = 180) {
   }
 }
 
-/* Six outputs staged side by side (issue 9), of which the 3rd (ssbump) and
+/* Six outputs staged side by side, of which the 3rd (ssbump) and
  * the 5th (bent) are EXR files several times larger than the PNGs around
  * them: under a file-size limit between the two, both fail while the others
  * stage. Whatever the thread count and whichever failure comes first in

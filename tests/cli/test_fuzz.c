@@ -115,7 +115,7 @@ Test(fuzz, cli_regressions) {
  * png_hooks.c bounds libpng's allocations on OpenImageIO's structs.
  * Replayed here without libFuzzer's memory limits: the messages and the
  * crashes are checked here, the allocations by `make fuzz`, which replays
- * them under its limits, and by tests/io/test_hostile_headers.c. */
+ * them under its limits, and by tests/image/test_hostile_headers.c. */
 Test(fuzz, load_regressions) {
   replay("load", bb_fuzz_load, 6);
 }

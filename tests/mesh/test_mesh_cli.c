@@ -1,5 +1,5 @@
 /* test_mesh_cli.c: `bumpbake renderbumpflat` on the hostile models of
- * issue 22, as a user runs them: one line, exit 1, nothing written, and a
+ * test_mesh_hostile.c, as a user runs them: one line, exit 1, nothing written, and a
  * note for what a model may do without. */
 #define _GNU_SOURCE /* wait4 (cli_harness.h), mkfifo */
 

@@ -1,4 +1,4 @@
-/* test_mesh_hostile.c: models as an attacker writes them (issue 22): files
+/* test_mesh_hostile.c: models as an attacker writes them: files
  * named outside the model's directory, FIFOs, devices, nesting that
  * overflows Assimp's stack, instancing and overdraw that multiply the
  * work, through bb_mesh_load (test_mesh_cli.c runs the CLI on them). */

@@ -49,8 +49,8 @@ static bb_pyramid *pyramid_of(const bb_image *z, bb_addressing a) {
 
 /* A random ray: from a vertex lifted by a random bias, or from anywhere
  * above the field; elevation from grazing (0.5 deg) to steep. */
-static bb_ray random_ray(const bb_image *z) {
-  bb_ray r;
+static bb__ray random_ray(const bb_image *z) {
+  bb__ray r;
   int vx = (int)(rnd() * z->width), vy = (int)(rnd() * z->height);
   if (rnd() < 0.7) {
     r.origin[0] = vx;
@@ -80,8 +80,8 @@ Test(trace, maxmip_equals_brute_force_on_random_rays) {
           bb_image z = random_field(sizes[si][0], sizes[si][1], scales[ci], kind);
           bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
           for (int i = 0; i < 1100; i++, rays++) {
-            bb_ray r = random_ray(&z);
-            int fast = bb_ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
+            bb__ray r = random_ray(&z);
+            int fast = bb__ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
             cr_assert_eq(fast, slow,
                          "%dx%d scale %g %s kind %d: origin (%.17g, %.17g, %.17g) dir (%.17g, "
                          "%.17g, %.17g): max-mip %d, brute force %d",
@@ -112,9 +112,9 @@ Test(trace, horizon_march_equals_brute_force_on_random_rays) {
         bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
         const double reach = 3.0 * (z.width + z.height);
         for (int i = 0; i < 400; i++, rays++) {
-          bb_ray r = random_ray(&z);
+          bb__ray r = random_ray(&z);
           const double far = a && i % 2 ? INFINITY : reach * rnd();
-          const double fast = bb_ray_horizon(p, &r, far), slow = bb__ray_horizon_brute(p, &r, far);
+          const double fast = bb__ray_horizon(p, &r, far), slow = bb__ray_horizon_brute(p, &r, far);
           cr_assert(fast == slow, "%dx%d %s kind %d ray %d: max-mip %.17g, brute force %.17g",
                     z.width, z.height, a ? "clamp" : "periodic", kind, i, fast, slow);
           cr_assert_geq(fast, 0.0);
@@ -122,7 +122,7 @@ Test(trace, horizon_march_equals_brute_force_on_random_rays) {
           if (far == INFINITY || (!a && far == reach)) {
             const double h = hypot(r.direction[0], r.direction[1]);
             r.direction[2] = fast * h * (1 + 1e-9) + 1e-12;
-            cr_assert_eq(bb_ray_occluded(p, &r), 0, "just above the horizon");
+            cr_assert_eq(bb__ray_occluded(p, &r), 0, "just above the horizon");
           }
         }
         bb_pyramid_free(p);
@@ -135,11 +135,11 @@ Test(trace, ray_horizon_rejects_what_it_cannot_answer) {
   bb_image z;
   cr_assert_eq(bb_image_alloc(&z, 8, 8, 1, NULL), BB_OK);
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
-  bb_ray r = {{1, 1, 0.5}, {1, 0, 0.1}};
-  cr_assert_eq(bb_ray_horizon(p, &r, INFINITY), -1.0, "periodic rays need a finite reach");
-  cr_assert_eq(bb_ray_horizon(p, &r, 0.0), -1.0);
+  bb__ray r = {{1, 1, 0.5}, {1, 0, 0.1}};
+  cr_assert_eq(bb__ray_horizon(p, &r, INFINITY), -1.0, "periodic rays need a finite reach");
+  cr_assert_eq(bb__ray_horizon(p, &r, 0.0), -1.0);
   r.direction[0] = 0.0;
-  cr_assert_eq(bb_ray_horizon(p, &r, 10.0), -1.0, "vertical");
+  cr_assert_eq(bb__ray_horizon(p, &r, 10.0), -1.0, "vertical");
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
@@ -151,8 +151,8 @@ static bb_image flat_with_peak(int w, int h, int px, int py, float peak) {
   return z;
 }
 
-static bb_ray ray_to(double ox, double oy, double oz, double dx, double dy, double dz) {
-  bb_ray r = {{ox, oy, oz}, {dx, dy, dz}};
+static bb__ray ray_to(double ox, double oy, double oz, double dx, double dy, double dz) {
+  bb__ray r = {{ox, oy, oz}, {dx, dy, dz}};
   return r;
 }
 
@@ -161,10 +161,10 @@ static bb_ray ray_to(double ox, double oy, double oz, double dx, double dy, doub
 Test(trace, ray_just_over_and_just_under_a_peak) {
   bb_image z = flat_with_peak(32, 16, 20, 8, 10.0f);
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
-  bb_ray over = ray_to(10, 8, 0.5, 1, 0, 0.95 + 1e-6);
-  bb_ray under = ray_to(10, 8, 0.5, 1, 0, 0.95 - 1e-6);
-  cr_assert_eq(bb_ray_occluded(p, &over), 0);
-  cr_assert_eq(bb_ray_occluded(p, &under), 1);
+  bb__ray over = ray_to(10, 8, 0.5, 1, 0, 0.95 + 1e-6);
+  bb__ray under = ray_to(10, 8, 0.5, 1, 0, 0.95 - 1e-6);
+  cr_assert_eq(bb__ray_occluded(p, &over), 0);
+  cr_assert_eq(bb__ray_occluded(p, &under), 1);
   cr_assert_eq(bb__ray_occluded_brute(p, &over), 0);
   cr_assert_eq(bb__ray_occluded_brute(p, &under), 1);
   bb_pyramid_free(p);
@@ -177,11 +177,11 @@ Test(trace, ray_crosses_the_wrap_seam) {
   bb_image z = flat_with_peak(32, 16, 4, 8, 12.0f);
   bb_pyramid *periodic = pyramid_of(&z, BB_ADDRESS_PERIODIC);
   bb_pyramid *clamp = pyramid_of(&z, BB_ADDRESS_CLAMP);
-  bb_ray r = ray_to(30, 8, 0.0, 1, 0, 1.9); /* slope 1.9 < 12 / 6 = 2 */
-  cr_assert_eq(bb_ray_occluded(periodic, &r), 1);
-  cr_assert_eq(bb_ray_occluded(clamp, &r), 0);
+  bb__ray r = ray_to(30, 8, 0.0, 1, 0, 1.9); /* slope 1.9 < 12 / 6 = 2 */
+  cr_assert_eq(bb__ray_occluded(periodic, &r), 1);
+  cr_assert_eq(bb__ray_occluded(clamp, &r), 0);
   r.direction[2] = 2.1;
-  cr_assert_eq(bb_ray_occluded(periodic, &r), 0);
+  cr_assert_eq(bb__ray_occluded(periodic, &r), 0);
   bb_pyramid_free(periodic);
   bb_pyramid_free(clamp);
   bb_image_free(&z);
@@ -196,13 +196,13 @@ Test(trace, ray_wraps_several_times_before_it_is_blocked) {
   /* x drifts by 1/16 texel per tile, so it reaches the spike's cells (x in
    * (7, 9)) only after passing x = 9.0 -> it starts at x = 10.2, drifting
    * backwards: 10.2 - 0.0625 k enters (7, 9) at k >= 20 tiles. */
-  bb_ray r = ray_to(10.2, 0.0, 1.0, -0.0625 / 16.0, 1.0, 0.05);
-  int fast = bb_ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
+  bb__ray r = ray_to(10.2, 0.0, 1.0, -0.0625 / 16.0, 1.0, 0.05);
+  int fast = bb__ray_occluded(p, &r), slow = bb__ray_occluded_brute(p, &r);
   cr_assert_eq(fast, 1, "the spike (100 high) must block a ray that is ~17 high there");
   cr_assert_eq(slow, 1);
   /* The same ray in clamp mode never meets the spike. */
   bb_pyramid *c = pyramid_of(&z, BB_ADDRESS_CLAMP);
-  cr_assert_eq(bb_ray_occluded(c, &r), 0);
+  cr_assert_eq(bb__ray_occluded(c, &r), 0);
   bb_pyramid_free(c);
   bb_pyramid_free(p);
   bb_image_free(&z);
@@ -215,13 +215,13 @@ Test(trace, tilted_plane_blocks_rays_below_it) {
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 40; x++) z.pixels[y * 40 + x] = 0.5f * (float)x;
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_CLAMP);
-  bb_ray r = ray_to(10, 4, 5.0, 1, 0, 0.49);
-  cr_assert_eq(bb_ray_occluded(p, &r), 1);
+  bb__ray r = ray_to(10, 4, 5.0, 1, 0, 0.49);
+  cr_assert_eq(bb__ray_occluded(p, &r), 1);
   r.direction[2] = 0.51; /* above the plane: past x = 39 the surface is flat */
-  cr_assert_eq(bb_ray_occluded(p, &r), 0);
+  cr_assert_eq(bb__ray_occluded(p, &r), 0);
   r.direction[0] = -1; /* downhill */
   r.direction[2] = 0.01;
-  cr_assert_eq(bb_ray_occluded(p, &r), 0);
+  cr_assert_eq(bb__ray_occluded(p, &r), 0);
   bb_pyramid_free(p);
   bb_image_free(&z);
 }
@@ -229,8 +229,8 @@ Test(trace, tilted_plane_blocks_rays_below_it) {
 Test(trace, vertical_ray_is_never_blocked) {
   bb_image z = flat_with_peak(8, 8, 2, 2, 5.0f);
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
-  bb_ray r = ray_to(2, 2, 5.0, 0, 0, 1);
-  cr_assert_eq(bb_ray_occluded(p, &r), 0);
+  bb__ray r = ray_to(2, 2, 5.0, 0, 0, 1);
+  cr_assert_eq(bb__ray_occluded(p, &r), 0);
   bb_pyramid_free(p);
   bb_image_free(&z);
 }

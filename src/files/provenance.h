@@ -1,0 +1,35 @@
+/* provenance.h: what the file writers and the up-to-date check
+ * need of provenance texts beyond the public calls (provenance.c). */
+#ifndef BB_FILES_PROVENANCE_H
+#define BB_FILES_PROVENANCE_H
+
+#include "bumpbake.h"
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Fits the "key=value" lines of a provenance text into `rows` rows of at
+ * most `row_chars` characters (TGA's comment field: 4 rows of 80), whole
+ * lines only: the keys that affect pixels first, then the others, each line
+ * in the first row it fits; lines joined by '\n' within a row. Row r is
+ * written NUL-terminated at out + r * (row_chars + 1), which must hold
+ * rows * (row_chars + 1) bytes. Returns how many lines did not fit. */
+int bb__provenance_pack(const char *description, int rows, int row_chars, char *out);
+
+/* 1 when two provenance texts differ in a key not in `ignored` (a
+ * NULL-terminated list): a key of want missing from have or holding
+ * another value there, or a key have holds and want lacks (first
+ * occurrences count). reason (capacity cap, may be NULL) receives the first
+ * such key as "key: have-value -> want-value" ("(none)" for a missing one).
+ * 0 when they agree. */
+int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
+                            char *reason, size_t cap);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_FILES_PROVENANCE_H */

@@ -1,0 +1,59 @@
+/* description.c: provenance in a TGA's comment field.
+ *
+ * TGA keeps ImageDescription in its extension area's comment field: 4 rows
+ * of 80 characters, each NUL-terminated (324 bytes). OpenImageIO 2.4 writes
+ * the text flat into those bytes and reads each 81-byte row back as one
+ * line, so a provenance text longer than a row came back cut inside values
+ * ("input=roc" / "k.tga"). Provenance is therefore fitted to the rows with
+ * whole key=value lines (bb__provenance_pack), each row padded to its 81
+ * bytes with newlines, and the blank lines the padding leaves are dropped
+ * when it is read. Other text is left to OpenImageIO. */
+#include "image/description.h"
+#include "image/formats.h"
+#include "files/provenance.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { TGA_COMMENT_ROWS = 4, TGA_COMMENT_CHARS = 80 };
+
+static char *copy_of(const char *s) {
+  size_t n = strlen(s) + 1;
+  char *c = malloc(n);
+  if (c) memcpy(c, s, n);
+  return c;
+}
+
+char *bb__description_to_store(const char *path, const char *description) {
+  /* A text that fits the first row comes back as it is. */
+  if (!bb__path_has_extension(path, "tga") || strlen(description) <= TGA_COMMENT_CHARS ||
+      bb_provenance_classify(description) == BB_PROVENANCE_NONE)
+    return copy_of(description);
+  char rows[TGA_COMMENT_ROWS][TGA_COMMENT_CHARS + 1];
+  bb__provenance_pack(description, TGA_COMMENT_ROWS, TGA_COMMENT_CHARS, &rows[0][0]);
+  char *flat = malloc(sizeof rows);
+  if (!flat) return NULL;
+  size_t n = 0;
+  for (int r = 0; r < TGA_COMMENT_ROWS && rows[r][0]; r++) {
+    /* pad the previous row to its 81 bytes */
+    size_t row_start = (size_t)r * (TGA_COMMENT_CHARS + 1);
+    while (n < row_start) flat[n++] = '\n';
+    size_t len = strlen(rows[r]);
+    memcpy(flat + n, rows[r], len);
+    n += len;
+  }
+  flat[n] = '\0';
+  return flat;
+}
+
+void bb__description_as_read(const char *format_name, char *desc) {
+  /* Padded rows always leave an empty line; a text stored as it was has none. */
+  if (strcmp(format_name, "targa") != 0 || !strstr(desc, "\n\n") ||
+      bb_provenance_classify(desc) == BB_PROVENANCE_NONE)
+    return;
+  size_t n = 0;
+  for (const char *c = desc; *c; c++)
+    if (*c != '\n' || (n > 0 && desc[n - 1] != '\n')) desc[n++] = *c;
+  while (n > 0 && desc[n - 1] == '\n') n--;
+  desc[n] = '\0';
+}

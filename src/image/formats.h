@@ -1,0 +1,53 @@
+/* formats.h: the formats bumpbake writes and what each can hold (depths,
+ * channels, mip levels), and the checks a write makes before OpenImageIO
+ * sees a byte (formats.c). */
+#ifndef BB_IMAGE_FORMATS_H
+#define BB_IMAGE_FORMATS_H
+
+#include "bumpbake.h"
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The extension of path's last component, lower-cased, with its dot
+ * ("" when it has none), into out (cap bytes, cut to fit). */
+void bb__extension_of(const char *path, char *out, size_t cap);
+
+/* 1 when the extension of path (any case) is ext ("exr", without the dot). */
+int bb__path_has_extension(const char *path, const char *ext);
+
+/* 1 when path's format can hold a mip chain (.tif, .tiff, .exr, .vtf, .dds). */
+int bb__path_holds_mips(const char *path);
+
+/* Everything bb_image_write checks before encoding: the image (not empty),
+ * the options (known enums), the format (known extension) and that it holds
+ * the depth and the channel count. *depth receives the depth to write. */
+bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_options *options,
+                          bb_depth *depth, bb_error *err);
+
+/* The same for a mip chain: every level half the one before (floored, at
+ * least 1) with the same channels, as bb_mip_chain makes them, and a
+ * format that holds mip levels. */
+bb_status bb__write_mips_check(const char *path, const bb_image *levels, int count,
+                               const bb_write_options *options, bb_depth *depth,
+                               bb_error *err);
+
+/* The texture options a write of a .vtf or .dds uses: options->texture's
+ * (or the defaults, with the map NORMAL for BB_RANGE_SIGNED), with
+ * options->description when it has one. */
+void bb__texture_options_of(const bb_write_options *options, bb_texture_options *out);
+
+/* The name of channel c of an image of `count` channels: NULL when count <=
+ * 4 (OpenImageIO's R, G, B, A stay), else "B" and c zero-padded to the
+ * width of count - 1 (B00..B15): OpenEXR keeps channels sorted by name and
+ * reads them back in that order. out holds at least 8 bytes. */
+const char *bb__basis_channel_name(int c, int count, char out[8]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_IMAGE_FORMATS_H */

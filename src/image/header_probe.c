@@ -1,0 +1,249 @@
+/* header_probe.c: a file's header read before OpenImageIO opens it, for
+ * the readers that allocate what a header declares inside open(), where no
+ * ImageSpec, limit or hook of OpenImageIO 2.4 can stop them:
+ *
+ * - JPEG: open() runs jpeg_start_decompress, which for a progressive (or
+ *   any multi-scan) file allocates and zeroes the coefficients of the whole
+ *   image, 128 bytes per 8 x 8 block and component, and then reads the
+ *   whole file: a 126-byte file declaring 65500 x 65500 took 8.5 GB and
+ *   21 s. libjpeg itself reads the header here (jpeg_read_header), so the
+ *   blocks counted are libjpeg's own.
+ * - GIF: open() allocates a canvas of width x height x 4 bytes for the
+ *   logical screen and decodes the first frame into it (65535 x 65535
+ *   overflowed an int inside OpenImageIO: "vector::_M_default_append").
+ *   The screen's size is two 16-bit numbers at offset 6 of every GIF, after
+ *   the 6-byte signature ("GIF87a", "GIF89a"; giflib checks "GIF" only):
+ *   a size read at a fixed place, not a parse.
+ * - OpenEXR: OpenEXR's C++ reader allocates each attribute's declared size
+ *   before reading it (a 91-byte file with a 2 GB string took 2.2 GB), the
+ *   chunk offset table (8 bytes a chunk) and two buffers per thread of the
+ *   largest chunk, all in open(). OpenEXRCore, OpenEXR's C library, reads
+ *   the header here, strictly: it refuses any attribute larger than the
+ *   file and any header it cannot read as a whole, and tells the chunk
+ *   count and the largest unpacked chunk.
+ *
+ * Every read goes through pread on the descriptor the read checked
+ * (core/input_file.h), so the file probed is the file read. */
+#include "image/header_probe.h"
+#include "core/internal.h"
+
+#include <errno.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <jpeglib.h>
+#include <openexr.h>
+
+/* pread of up to n bytes at offset; the bytes read (0 at the end or on an
+ * error). */
+static size_t read_at(int fd, void *buf, size_t n, off_t offset) {
+  size_t done = 0;
+  while (done < n) {
+    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, offset + (off_t)done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    done += (size_t)got;
+  }
+  return done;
+}
+
+/* -------------------------------------------------------------------- GIF */
+
+static void probe_gif(int fd, const unsigned char *magic, bb__probe *p) {
+  (void)fd;
+  /* giflib takes any version after "GIF" (it compares 3 bytes), so must this. */
+  if (memcmp(magic, "GIF", 3) != 0) return;
+  p->format = "GIF";
+  p->width = magic[6] | magic[7] << 8;
+  p->height = magic[8] | magic[9] << 8;
+  p->open_bytes = (double)p->width * (double)p->height * 4.0;
+}
+
+/* ------------------------------------------------------------------- JPEG */
+
+typedef struct fd_source {
+  struct jpeg_source_mgr pub;
+  int fd;
+  off_t offset;
+  JOCTET buffer[4096];
+} fd_source;
+
+static void source_init(j_decompress_ptr cinfo) { (void)cinfo; }
+
+static boolean source_fill(j_decompress_ptr cinfo) {
+  fd_source *src = (fd_source *)cinfo->src;
+  size_t n = read_at(src->fd, src->buffer, sizeof src->buffer, src->offset);
+  if (n == 0) { /* the file ends: an end-of-image marker, as libjpeg's own source does */
+    src->buffer[0] = 0xFF;
+    src->buffer[1] = JPEG_EOI;
+    n = 2;
+  } else {
+    src->offset += (off_t)n;
+  }
+  src->pub.next_input_byte = src->buffer;
+  src->pub.bytes_in_buffer = n;
+  return TRUE;
+}
+
+static void source_skip(j_decompress_ptr cinfo, long count) {
+  fd_source *src = (fd_source *)cinfo->src;
+  if (count <= 0) return;
+  if ((size_t)count <= src->pub.bytes_in_buffer) {
+    src->pub.next_input_byte += count;
+    src->pub.bytes_in_buffer -= (size_t)count;
+    return;
+  }
+  src->offset += (off_t)((size_t)count - src->pub.bytes_in_buffer);
+  src->pub.bytes_in_buffer = 0;
+}
+
+static void source_term(j_decompress_ptr cinfo) { (void)cinfo; }
+
+typedef struct quiet_errors {
+  struct jpeg_error_mgr pub;
+  jmp_buf escape;
+} quiet_errors;
+
+/* libjpeg's default handlers print on stderr and exit(). */
+static void jpeg_fail(j_common_ptr cinfo) { longjmp(((quiet_errors *)cinfo->err)->escape, 1); }
+static void jpeg_quiet(j_common_ptr cinfo, int level) { (void)cinfo, (void)level; }
+static void jpeg_no_output(j_common_ptr cinfo) { (void)cinfo; }
+
+static void probe_jpeg(int fd, bb__probe *p) {
+  struct jpeg_decompress_struct cinfo;
+  quiet_errors jerr;
+  fd_source src;
+  memset(&src, 0, sizeof src);
+  cinfo.err = jpeg_std_error(&jerr.pub);
+  jerr.pub.error_exit = jpeg_fail;
+  jerr.pub.emit_message = jpeg_quiet;
+  jerr.pub.output_message = jpeg_no_output;
+  if (setjmp(jerr.escape)) { /* a header libjpeg cannot read: the reader fails as well */
+    jpeg_destroy_decompress(&cinfo);
+    return;
+  }
+  jpeg_create_decompress(&cinfo);
+  src.fd = fd;
+  src.pub.init_source = source_init;
+  src.pub.fill_input_buffer = source_fill;
+  src.pub.skip_input_data = source_skip;
+  src.pub.resync_to_restart = jpeg_resync_to_restart;
+  src.pub.term_source = source_term;
+  cinfo.src = &src.pub;
+  if (jpeg_read_header(&cinfo, TRUE) == JPEG_HEADER_OK) {
+    p->format = "JPEG";
+    p->width = (int)cinfo.image_width;
+    p->height = (int)cinfo.image_height;
+    /* A multi-scan file is buffered whole as coefficients (jdcoefct.c):
+     * each component's blocks, rounded up to its sampling factors. */
+    if (jpeg_has_multiple_scans(&cinfo))
+      for (int c = 0; c < cinfo.num_components; c++) {
+        const jpeg_component_info *comp = &cinfo.comp_info[c];
+        double w = comp->width_in_blocks, h = comp->height_in_blocks;
+        if (comp->h_samp_factor > 0) w = comp->h_samp_factor * ((w + comp->h_samp_factor - 1) / comp->h_samp_factor);
+        if (comp->v_samp_factor > 0) h = comp->v_samp_factor * ((h + comp->v_samp_factor - 1) / comp->v_samp_factor);
+        p->open_bytes += w * h * (double)sizeof(JBLOCK);
+      }
+  }
+  jpeg_destroy_decompress(&cinfo);
+}
+
+/* ---------------------------------------------------------------- OpenEXR */
+
+typedef struct exr_stream {
+  int fd;
+  int64_t size;
+  char message[256];
+} exr_stream;
+
+static int64_t exr_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t size,
+                        uint64_t offset, exr_stream_error_func_ptr_t error) {
+  (void)ctxt, (void)error;
+  const exr_stream *s = user;
+  if (offset > (uint64_t)s->size) return 0;
+  return (int64_t)read_at(s->fd, buffer, size, (off_t)offset);
+}
+
+static int64_t exr_size(exr_const_context_t ctxt, void *user) {
+  (void)ctxt;
+  return ((const exr_stream *)user)->size;
+}
+
+/* OpenEXRCore's default handler prints on stderr: keep the first message,
+ * on one line (it quotes names from the file, control characters and all). */
+static void exr_message(exr_const_context_t ctxt, exr_result_t code, const char *msg) {
+  void *user = NULL;
+  if (exr_get_user_data(ctxt, &user) != EXR_ERR_SUCCESS || !user) return;
+  exr_stream *s = user;
+  if (s->message[0]) return;
+  snprintf(s->message, sizeof s->message, "%s", msg ? msg : exr_get_default_error_message(code));
+  for (char *c = s->message; *c; c++)
+    if ((unsigned char)*c < 0x20 || *c == 0x7F) *c = '?';
+}
+
+static bb_status probe_exr(int fd, const char *path, bb__probe *p, bb_error *err) {
+  exr_stream stream = {fd, (int64_t)p->file_bytes, {0}};
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.user_data = &stream;
+  init.read_fn = exr_read;
+  init.size_fn = exr_size;
+  init.error_handler_fn = exr_message;
+  /* Strict: the lenient parse skips what it cannot read and may then see
+   * other attributes than OpenEXR's C++ reader does (the fuzzer found one
+   * whose next "attribute" the C++ reader took as 1.6 GB). */
+  init.flags = EXR_CONTEXT_FLAG_STRICT_HEADER;
+  exr_context_t ctxt = NULL;
+  exr_result_t rv = exr_start_read(&ctxt, path, &init);
+  /* Any report refuses, even one OpenEXRCore would go on after. */
+  if (rv != EXR_ERR_SUCCESS || stream.message[0]) {
+    exr_finish(&ctxt);
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                    stream.message[0] ? stream.message : exr_get_default_error_message(rv));
+  }
+  p->format = "OpenEXR";
+  int parts = 0;
+  if (exr_get_count(ctxt, &parts) != EXR_ERR_SUCCESS) parts = 0;
+  for (int part = 0; part < parts; part++) {
+    if (part == 0) {
+      exr_attr_box2i_t dw;
+      if (exr_get_data_window(ctxt, 0, &dw) == EXR_ERR_SUCCESS) {
+        p->width = (int)((int64_t)dw.max.x - dw.min.x + 1);
+        p->height = (int)((int64_t)dw.max.y - dw.min.y + 1);
+      }
+    }
+    int32_t chunks = 0;
+    if (exr_get_chunk_count(ctxt, part, &chunks) == EXR_ERR_SUCCESS && chunks > 0)
+      p->table_bytes += 8.0 * chunks;
+    exr_storage_t storage;
+    uint64_t unpacked = 0;
+    if (exr_get_storage(ctxt, part, &storage) == EXR_ERR_SUCCESS &&
+        (storage == EXR_STORAGE_SCANLINE || storage == EXR_STORAGE_TILED) &&
+        exr_get_chunk_unpacked_size(ctxt, part, &unpacked) == EXR_ERR_SUCCESS &&
+        (double)unpacked > p->chunk_bytes)
+      p->chunk_bytes = (double)unpacked;
+  }
+  exr_finish(&ctxt);
+  return BB_OK;
+}
+
+/* ------------------------------------------------------------------ probe */
+
+bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err) {
+  memset(p, 0, sizeof *p);
+  struct stat st;
+  if (fstat(fd, &st) != 0) return BB_OK; /* the reader will say what is wrong */
+  p->file_bytes = (double)st.st_size;
+  unsigned char magic[10] = {0};
+  if (read_at(fd, magic, sizeof magic, 0) < 4) return BB_OK;
+  if (magic[0] == 0xFF && magic[1] == 0xD8 && magic[2] == 0xFF) {
+    probe_jpeg(fd, p);
+    return BB_OK;
+  }
+  if (magic[0] == 0x76 && magic[1] == 0x2F && magic[2] == 0x31 && magic[3] == 0x01)
+    return probe_exr(fd, path, p, err);
+  probe_gif(fd, magic, p);
+  return BB_OK;
+}

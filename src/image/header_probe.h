@@ -1,0 +1,39 @@
+/* header_probe.h: what opening a file will make OpenImageIO's reader
+ * allocate, learnt from the file's header before that reader sees it
+ * (header_probe.c). */
+#ifndef BB_IMAGE_HEADER_PROBE_H
+#define BB_IMAGE_HEADER_PROBE_H
+
+#include "bumpbake.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What a header declares that costs memory at open, for the formats whose
+ * readers allocate from the header inside open(), before any ImageSpec
+ * reaches bumpbake. format is NULL when no probe applies (another format,
+ * or a header the format's library cannot read: the reader then fails on
+ * its own, allocating nothing large). */
+typedef struct bb__probe {
+  const char *format;  /* "JPEG", "GIF", "OpenEXR" or NULL */
+  int width, height;   /* the declared image (subimage 0), 0 when unknown */
+  double open_bytes;   /* what the reader allocates in open() */
+  double chunk_bytes;  /* OpenEXR: the largest chunk (tile or scanline block) decoded */
+  double table_bytes;  /* OpenEXR: the chunk offset tables (8 bytes a chunk) */
+  double file_bytes;   /* the file's size */
+} bb__probe;
+
+/* Reads the header of the regular file open at fd (path names it in
+ * messages), through pread only, with the format's own Debian library
+ * (libjpeg's jpeg_read_header, OpenEXRCore's exr_start_read) or, for GIF,
+ * the screen size at its fixed offset. BB_ERR_FORMAT when OpenEXRCore
+ * refuses the header (an attribute larger than the file, say), which
+ * OpenImageIO's reader would first have allocated. */
+bb_status bb__probe_header(int fd, const char *path, bb__probe *probe, bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_IMAGE_HEADER_PROBE_H */

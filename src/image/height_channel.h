@@ -1,0 +1,29 @@
+/* height_channel.h: the channel rule with the note it owes the user
+ * (height_channel.c), and the height loader that applies it (height_load.c). */
+#ifndef BB_IMAGE_HEIGHT_CHANNEL_H
+#define BB_IMAGE_HEIGHT_CHANNEL_H
+
+#include "bumpbake.h"
+
+/* bb_height_channel, and in *note a line saying what it took when the image
+ * left a choice (a colour image, an alpha that varies, no alpha for Valve's
+ * rule), or NULL. The text is static. */
+bb_channel bb__height_channel_noted(const bb_image *img, int alpha_channel, bb_channel channel,
+                                    const char **note);
+
+/* What bb__height_load found out about the file. */
+typedef struct bb__height_loaded {
+  bb_channel channel;     /* the rule's choice */
+  const char *note;       /* what to tell the user of that choice, or NULL */
+  int channels, bits_per_sample, is_float;
+  char format_name[32];
+} bb__height_loaded;
+
+/* The height of the image file at path by the channel rule, telling which
+ * channel it took and why (height_load.c): the header decides where it
+ * can, and only the channels needed are decoded. Messages name the file.
+ * bb_height_file_read's loader; tests call it alone. */
+bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
+                          bb__height_loaded *loaded, bb_error *err);
+
+#endif /* BB_IMAGE_HEIGHT_CHANNEL_H */

@@ -1,0 +1,418 @@
+/* texture.c: what the VTF and DDS writers share: formats, checks, the mip
+ * chain and the encoding of a level (see texture.h). */
+
+#include "core/internal.h"
+#include "texture/blocks.h"
+#include "texture/texture.h"
+
+/* Imath's C half conversion (round to nearest even, as OpenEXR's), header
+ * only: no lookup table, so nothing to link. */
+#define IMATH_HALF_NO_LOOKUP_TABLE
+#include <Imath/half.h>
+
+#include <errno.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* ------------------------------------------------------------- formats */
+
+typedef struct format_info {
+  const char *name;  /* first name: bb_texture_format_name */
+  int block;         /* a bb__block_format + 1, or 0 for texel formats */
+  int texel_bytes;   /* texel formats: bytes a texel */
+  int max_channels;  /* channels of the image it holds (bc5: 2, or 3 of a normal map) */
+  int exact;         /* 1: exactly max_channels (bc4) */
+  int has_alpha;
+  int vtf, dds;      /* 1 when the container has it */
+} format_info;
+
+/* In bb_texture_format order, DEFAULT first. */
+static const format_info formats[] = {
+    {"default", 0, 0, 4, 0, 0, 1, 1},
+    {"bc1", 1 + BB__BLOCK_BC1, 0, 3, 0, 0, 1, 1},
+    {"bc3", 1 + BB__BLOCK_BC3, 0, 4, 0, 1, 1, 1},
+    {"bc4", 1 + BB__BLOCK_BC4, 0, 1, 1, 0, 0, 1},
+    {"bc5", 1 + BB__BLOCK_BC5, 0, 2, 0, 0, 0, 1},
+    {"bgr888", 0, 3, 3, 0, 0, 1, 0},
+    {"bgra8888", 0, 4, 4, 0, 1, 1, 0},
+    {"rgba8", 0, 4, 4, 0, 1, 0, 1},
+    {"rgba16f", 0, 8, 4, 0, 1, 1, 1},
+    {"rgba32f", 0, 16, 4, 0, 1, 0, 1},
+};
+enum { FORMAT_COUNT = (int)(sizeof formats / sizeof formats[0]) };
+
+/* Every name bb_texture_format_parse takes, and the format it names. */
+static const struct {
+  const char *name;
+  bb_texture_format format;
+} format_names[] = {
+    {"default", BB_TEXTURE_FORMAT_DEFAULT}, {"bc1", BB_TEXTURE_FORMAT_BC1},
+    {"dxt1", BB_TEXTURE_FORMAT_BC1},        {"bc3", BB_TEXTURE_FORMAT_BC3},
+    {"dxt5", BB_TEXTURE_FORMAT_BC3},        {"bc4", BB_TEXTURE_FORMAT_BC4},
+    {"bc5", BB_TEXTURE_FORMAT_BC5},         {"bgr888", BB_TEXTURE_FORMAT_BGR8},
+    {"bgra8888", BB_TEXTURE_FORMAT_BGRA8},  {"rgba8", BB_TEXTURE_FORMAT_RGBA8},
+    {"rgba16f", BB_TEXTURE_FORMAT_RGBA16F}, {"rgba16161616f", BB_TEXTURE_FORMAT_RGBA16F},
+    {"rgba32f", BB_TEXTURE_FORMAT_RGBA32F},
+};
+enum { NAME_COUNT = (int)(sizeof format_names / sizeof format_names[0]) };
+
+static const format_info *info_of(bb_texture_format format) {
+  return (int)format >= 0 && (int)format < FORMAT_COUNT ? &formats[format] : NULL;
+}
+
+bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err) {
+  const char *names[NAME_COUNT];
+  for (int k = 0; k < NAME_COUNT; k++)
+    names[k] = format_names[k].name;
+  int k;
+  bb_status st = bb__parse_name("texture format", name, names, NAME_COUNT, 1, &k, err);
+  if (st == BB_OK && out)
+    *out = format_names[k].format;
+  return st;
+}
+
+bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err) {
+  /* "7.3" as Valve writes it, or the minor number alone. */
+  const char *m = text && strncmp(text, "7.", 2) == 0 ? text + 2 : text;
+  char *end = NULL;
+  /* A digit first: strtol would also take spaces and a sign. */
+  const int digits = m && m[0] >= '0' && m[0] <= '9';
+  const long v = digits ? strtol(m, &end, 10) : 0;
+  if (!digits || *end || v < 2 || v > 5)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "VTF version must be 7.2, 7.3, 7.4 or 7.5 (got '%.64s')", text ? text : "");
+  if (minor) *minor = (int)v;
+  return BB_OK;
+}
+
+bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err) {
+  char *end = NULL;
+  errno = 0;
+  /* A digit first: strtoul would also take spaces and a sign. */
+  const int digits = text && text[0] >= '0' && text[0] <= '9';
+  const unsigned long v = digits ? strtoul(text, &end, 0) : 0;
+  if (!digits || *end || errno || v > 0xffffffffUL)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "VTF flags must be a 32-bit number, e.g. 0x4 (got '%.64s')", text ? text : "");
+  if (flags) *flags = (uint32_t)v;
+  return BB_OK;
+}
+
+const char *bb_texture_format_name(bb_texture_format format) {
+  const format_info *f = info_of(format);
+  return f ? f->name : "unknown";
+}
+
+int bb__texture_format_has_alpha(bb_texture_format format) {
+  const format_info *f = info_of(format);
+  return f ? f->has_alpha : 0;
+}
+
+size_t bb__texture_level_bytes(bb_texture_format format, int width, int height) {
+  const format_info *f = info_of(format);
+  if (!f || format == BB_TEXTURE_FORMAT_DEFAULT || width <= 0 || height <= 0)
+    return 0;
+  if (f->block)
+    return bb__blocks_size((bb__block_format)(f->block - 1), width, height);
+  return (size_t)width * (size_t)height * (size_t)f->texel_bytes;
+}
+
+void bb_texture_options_init(bb_texture_options *o) {
+  if (!o)
+    return;
+  memset(o, 0, sizeof *o);
+  o->format = BB_TEXTURE_FORMAT_DEFAULT;
+  o->map = BB_TEXTURE_MAP_PLAIN;
+  o->mips = 1;
+  o->vtf_version = 2;
+}
+
+/* ------------------------------------------------------------- checks */
+
+bb__container bb__texture_container(const char *path) {
+  const char *slash = path ? strrchr(path, '/') : NULL;
+  const char *dot = path ? strrchr(slash ? slash : path, '.') : NULL;
+  if (!dot)
+    return BB__CONTAINER_NONE;
+  if (strcasecmp(dot, ".vtf") == 0)
+    return BB__CONTAINER_VTF;
+  if (strcasecmp(dot, ".dds") == 0)
+    return BB__CONTAINER_DDS;
+  return BB__CONTAINER_NONE;
+}
+
+int bb_path_is_texture_format(const char *path) {
+  return bb__texture_container(path) != BB__CONTAINER_NONE;
+}
+
+static int is_power_of_two(int n) {
+  return n > 0 && (n & (n - 1)) == 0;
+}
+
+/* The power of two nearest n (ties up), for the message. */
+static int nearest_power_of_two(int n) {
+  int p = 1;
+  while (p < n && p < (1 << 30))
+    p <<= 1;
+  return p - n <= n - p / 2 ? p : p / 2;
+}
+
+/* The names of the container's formats, "bc1, bc3, ...", into buf. */
+static void container_formats(bb__container c, char *buf, size_t cap) {
+  buf[0] = '\0';
+  size_t used = 0;
+  for (int k = 1; k < FORMAT_COUNT; k++) {
+    if (!(c == BB__CONTAINER_VTF ? formats[k].vtf : formats[k].dds))
+      continue;
+    int n = snprintf(buf + used, cap - used, "%s%s", used ? ", " : "", formats[k].name);
+    if (n < 0 || (size_t)n >= cap - used)
+      break;
+    used += (size_t)n;
+  }
+}
+
+static bb_texture_format default_format(bb__container c, bb_texture_map map, int channels) {
+  if (c == BB__CONTAINER_VTF)
+    return channels == 4 ? BB_TEXTURE_FORMAT_BC3 : BB_TEXTURE_FORMAT_BC1;
+  if (map == BB_TEXTURE_MAP_NORMAL)
+    return BB_TEXTURE_FORMAT_BC5;
+  switch (channels) {
+  case 1: return BB_TEXTURE_FORMAT_BC4;
+  case 2: return BB_TEXTURE_FORMAT_BC5;
+  case 3: return BB_TEXTURE_FORMAT_BC1;
+  default: return BB_TEXTURE_FORMAT_BC3;
+  }
+}
+
+bb_status bb__texture_resolve(const char *path, int width, int height, int channels,
+                              const bb_texture_options *options, bb_texture_format *format,
+                              bb_error *err) {
+  bb_texture_options defaults;
+  bb_texture_options_init(&defaults);
+  const bb_texture_options *o = options ? options : &defaults;
+  if (!path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "texture: no path");
+  const bb__container c = bb__texture_container(path);
+  const char *kind = c == BB__CONTAINER_VTF ? "VTF" : "DDS";
+  if (c == BB__CONTAINER_NONE)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: not a texture file name (.vtf or .dds)", path);
+  if ((int)o->map < BB_TEXTURE_MAP_PLAIN || (int)o->map > BB_TEXTURE_MAP_SSBUMP)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown texture map kind %d", path, (int)o->map);
+  const format_info *f = info_of(o->format);
+  if (!f)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown texture format %d", path,
+                    (int)o->format);
+  if (!bb__range_holds(&bb__range_threads, o->threads)) {
+    char who[600];
+    snprintf(who, sizeof who, "%s: threads", path);
+    return bb__range_check(&bb__range_threads, o->threads, who, err);
+  }
+  if (c == BB__CONTAINER_VTF) {
+    if (o->vtf_version < 2 || o->vtf_version > 5)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: VTF version 7.%d is not written (7.2 to 7.5 are)", path,
+                      o->vtf_version);
+    if (o->vtf_flags & BB_VTF_FLAG_ENVMAP)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: the ENVMAP flag (0x%08x) makes a cube map, and one face is "
+                      "written",
+                      path, BB_VTF_FLAG_ENVMAP);
+  }
+  if (width <= 0 || height <= 0 || width > BB_MAX_DIMENSION || height > BB_MAX_DIMENSION)
+    return bb__fail(err, BB_ERR_SIZE, "%s: bad image size %d x %d", path, width, height);
+  if (channels < 1 || channels > 4)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: a %s texture holds at most 4 channels (the image has %d)", path,
+                    kind, channels);
+  if (o->map == BB_TEXTURE_MAP_NORMAL && channels < 3)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: a normal map needs 3 channels (the image has %d)", path, channels);
+  bb_texture_format fmt = o->format == BB_TEXTURE_FORMAT_DEFAULT
+                              ? default_format(c, o->map, channels)
+                              : o->format;
+  f = info_of(fmt);
+  if (!(c == BB__CONTAINER_VTF ? f->vtf : f->dds)) {
+    char names[128];
+    container_formats(c, names, sizeof names);
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: %s has no format %s (it has %s)", path, kind,
+                    f->name, names);
+  }
+  const int holds = fmt == BB_TEXTURE_FORMAT_BC5 && o->map == BB_TEXTURE_MAP_NORMAL
+                        ? 3
+                        : f->max_channels;
+  if (channels > holds || (f->exact && channels != holds))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: format %s holds %s%d channel%s, and the %s has %d", path, f->name,
+                    f->exact ? "" : "at most ", holds, holds == 1 ? "" : "s",
+                    o->map == BB_TEXTURE_MAP_NORMAL ? "normal map" : "image", channels);
+  if (c == BB__CONTAINER_VTF) {
+    if (!is_power_of_two(width) || !is_power_of_two(height))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s: %d x %d: Source textures need a power of two on each side "
+                      "(resize to %d x %d)",
+                      path, width, height, nearest_power_of_two(width),
+                      nearest_power_of_two(height));
+    if (width > 32768 || height > 32768)
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s: %d x %d: a VTF side is at most 32768",
+                      path, width, height);
+  }
+  if (f->block && (width % 4 != 0 || height % 4 != 0))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: %d x %d: block compression (%s) needs sides that are multiples of 4",
+                    path, width, height, f->name);
+  if (format)
+    *format = fmt;
+  return BB_OK;
+}
+
+bb_status bb_texture_check(const char *path, int width, int height, int channels,
+                           const bb_texture_options *options, bb_error *err) {
+  return bb__texture_resolve(path, width, height, channels, options, NULL, err);
+}
+
+/* ------------------------------------------------------------- encoding */
+
+void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]) {
+  const float *t = img->pixels + i * (size_t)img->channels;
+  switch (img->channels) {
+  case 1: rgba[0] = rgba[1] = rgba[2] = t[0]; rgba[3] = 1.0f; break;
+  case 2: rgba[0] = t[0]; rgba[1] = t[1]; rgba[2] = 0.0f; rgba[3] = 1.0f; break;
+  case 3: rgba[0] = t[0]; rgba[1] = t[1]; rgba[2] = t[2]; rgba[3] = 1.0f; break;
+  default: memcpy(rgba, t, 4 * sizeof(float)); break;
+  }
+  if (map == BB_TEXTURE_MAP_NORMAL)
+    for (int c = 0; c < 3; c++)
+      rgba[c] = 0.5f + 0.5f * rgba[c];
+}
+
+/* Round half up to 0..255, NaN to 0 (as 8-bit image files are written). */
+static unsigned char to_byte(float v) {
+  double u = v > 0.0f ? (double)v : 0.0;
+  u = u < 1.0 ? u : 1.0;
+  return (unsigned char)(u * 255.0 + 0.5);
+}
+
+static void put_u16(unsigned char *p, uint16_t v) {
+  p[0] = (unsigned char)(v & 0xff);
+  p[1] = (unsigned char)(v >> 8);
+}
+
+static void put_f32(unsigned char *p, float v) {
+  uint32_t u;
+  memcpy(&u, &v, sizeof u);
+  for (int k = 0; k < 4; k++)
+    p[k] = (unsigned char)((u >> (8 * k)) & 0xff);
+}
+
+/* Rows of texels expanded to RGBA floats at once for the block codec: 64
+ * rows (16 rows of blocks) keep the buffer at width x 1 KiB. */
+enum { BAND_ROWS = 64 };
+
+static bb_status encode_blocks(const bb_image *level, bb_texture_map map,
+                               bb__block_format block, int fast, int threads,
+                               unsigned char *out, bb_error *err) {
+  const int w = level->width, h = level->height;
+  const int rows = h < BAND_ROWS ? h : BAND_ROWS;
+  float *band = malloc((size_t)w * (size_t)rows * 4 * sizeof(float));
+  if (!band)
+    return bb__fail(err, BB_ERR_MEMORY, "texture: out of memory (%d x %d level)", w, h);
+  bb_status st = BB_OK;
+  for (int y0 = 0; y0 < h && st == BB_OK; y0 += BAND_ROWS) {
+    const int n = h - y0 < BAND_ROWS ? h - y0 : BAND_ROWS;
+    for (int y = 0; y < n; y++)
+      for (int x = 0; x < w; x++)
+        bb__texture_texel(level, map, (size_t)(y0 + y) * (size_t)w + (size_t)x,
+                          band + ((size_t)y * (size_t)w + (size_t)x) * 4);
+    /* y0 is a multiple of 4, so the band starts a row of blocks, after the
+     * blocks of the y0 rows above it (none for y0 = 0). */
+    unsigned char *dst = out + bb__blocks_size(block, w, y0);
+    st = bb__blocks_compress(band, w, n, block, fast, threads, dst, err);
+  }
+  free(band);
+  return st;
+}
+
+bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
+                             bb_texture_format format, int fast, int threads,
+                             unsigned char *out, bb_error *err) {
+  const format_info *f = info_of(format);
+  if (!f || format == BB_TEXTURE_FORMAT_DEFAULT || !level || !level->pixels || !out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad level or format");
+  if (f->block)
+    return encode_blocks(level, map, (bb__block_format)(f->block - 1), fast, threads, out,
+                         err);
+  const size_t n = (size_t)level->width * (size_t)level->height;
+  unsigned char *p = out;
+  for (size_t i = 0; i < n; i++) {
+    float t[4];
+    bb__texture_texel(level, map, i, t);
+    switch (format) {
+    case BB_TEXTURE_FORMAT_BGR8:
+      p[0] = to_byte(t[2]), p[1] = to_byte(t[1]), p[2] = to_byte(t[0]);
+      break;
+    case BB_TEXTURE_FORMAT_BGRA8:
+      p[0] = to_byte(t[2]), p[1] = to_byte(t[1]), p[2] = to_byte(t[0]), p[3] = to_byte(t[3]);
+      break;
+    case BB_TEXTURE_FORMAT_RGBA8:
+      for (int c = 0; c < 4; c++)
+        p[c] = to_byte(t[c]);
+      break;
+    case BB_TEXTURE_FORMAT_RGBA16F:
+      for (int c = 0; c < 4; c++)
+        put_u16(p + 2 * c, imath_float_to_half(t[c]));
+      break;
+    case BB_TEXTURE_FORMAT_RGBA32F:
+      for (int c = 0; c < 4; c++)
+        put_f32(p + 4 * c, t[c]);
+      break;
+    default:
+      return bb__fail(err, BB_ERR_ARGUMENT, "texture: format %s is not a texel format",
+                      f->name);
+    }
+    p += f->texel_bytes;
+  }
+  return BB_OK;
+}
+
+/* ----------------------------------------------------- maps, provenance */
+
+/* 1 when kind is name or starts with name and '+' ("ssbump+height"). */
+static int kind_is(const char *kind, const char *name) {
+  const size_t n = strlen(name);
+  return strncmp(kind, name, n) == 0 && (kind[n] == '\0' || kind[n] == '+');
+}
+
+void bb_texture_options_for(bb_texture_options *o, const char *kind, bb_range range) {
+  if (!o)
+    return;
+  const char *k = kind ? kind : "";
+  if (kind_is(k, "ssbump") || kind_is(k, "detail-ssbump") || kind_is(k, "weights")) {
+    o->map = BB_TEXTURE_MAP_SSBUMP;
+  } else if (range == BB_RANGE_SIGNED) {
+    o->map = BB_TEXTURE_MAP_NORMAL;
+  } else {
+    o->map = BB_TEXTURE_MAP_PLAIN;
+    if (strncmp(k, "normal+", 7) == 0) /* packed already: flagged, not re-packed */
+      o->vtf_flags |= BB_VTF_FLAG_NORMAL;
+  }
+}
+
+char *bb_texture_provenance(const char *path, const bb_texture_options *options) {
+  const bb__container c = bb__texture_container(path);
+  if (c == BB__CONTAINER_NONE)
+    return NULL;
+  bb_texture_options defaults;
+  bb_texture_options_init(&defaults);
+  const bb_texture_options *o = options ? options : &defaults;
+  char text[256];
+  int n = snprintf(text, sizeof text,
+                   "texture=%s\ntexture_format=%s\ntexture_mips=%d\ntexture_fit=%s",
+                   c == BB__CONTAINER_VTF ? "vtf" : "dds", bb_texture_format_name(o->format),
+                   o->mips ? 1 : 0, o->fast ? "range" : "cluster");
+  if (c == BB__CONTAINER_VTF && n > 0 && (size_t)n < sizeof text)
+    snprintf(text + n, sizeof text - (size_t)n, "\nvtf_version=7.%d\nvtf_flags=0x%08x",
+             o->vtf_version, (unsigned)o->vtf_flags);
+  return strdup(text);
+}

@@ -1,0 +1,59 @@
+/* texture.h: what the VTF and DDS writers share (texture.c): the table of
+ * formats, the checks of a request against a container, the mip chain and
+ * the encoding of one level into a format's bytes. */
+#ifndef BB_TEXTURE_TEXTURE_H
+#define BB_TEXTURE_TEXTURE_H
+
+#include "bumpbake.h"
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum bb__container {
+  BB__CONTAINER_NONE = 0,
+  BB__CONTAINER_VTF,
+  BB__CONTAINER_DDS
+} bb__container;
+
+/* The container path's extension names (any case). */
+bb__container bb__texture_container(const char *path);
+
+/* bb_texture_check's rules; on success *format is the format to write
+ * (BB_TEXTURE_FORMAT_DEFAULT resolved). Messages start with path. */
+bb_status bb__texture_resolve(const char *path, int width, int height, int channels,
+                              const bb_texture_options *options, bb_texture_format *format,
+                              bb_error *err);
+
+/* Encodes levels[0] (given 0: its chain is made here by the map's rule and
+ * written when options->mips) or the caller's chain levels[0..count-1]
+ * (given 1: checked, written as it is) into f, opened here and finished on
+ * success, discarded on failure. f must be bb__safe_init'ed. */
+bb_status bb__texture_stage(const char *path, const bb_image *levels, int count, int given,
+                            const bb_texture_options *options, struct bb_staged_file *f,
+                            bb_error *err);
+
+/* Bytes of a width x height level in format. */
+size_t bb__texture_level_bytes(bb_texture_format format, int width, int height);
+
+/* 1 when format stores an alpha channel. */
+int bb__texture_format_has_alpha(bb_texture_format format);
+
+/* Texel i of img as the engine samples it (see bumpbake.h): R, G, B, A,
+ * normal maps mapped to 0.5 + 0.5 v; not clamped. */
+void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]);
+
+/* Encodes one level into format's bytes (bb__texture_level_bytes of them)
+ * at out, little-endian; block formats on `threads` threads (fast: the
+ * codec's fast fit). */
+bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
+                             bb_texture_format format, int fast, int threads,
+                             unsigned char *out, bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_TEXTURE_TEXTURE_H */

@@ -1,0 +1,35 @@
+/* vtf.h: Valve's texture container, written and its header read (vtf.c). */
+#ifndef BB_TEXTURE_VTF_H
+#define BB_TEXTURE_VTF_H
+
+#include "bumpbake.h"
+#include "files/safe_file.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Valve's IMAGE_FORMAT_* codes the writer uses. */
+enum {
+  BB__VTF_BGR888 = 3,
+  BB__VTF_BGRA8888 = 12,
+  BB__VTF_DXT1 = 13,
+  BB__VTF_DXT5 = 15,
+  BB__VTF_RGBA16161616F = 24
+};
+
+/* Writes img as a VTF file into f (open, unfinished: the caller finishes or
+ * discards it), in format (resolved by bb__texture_resolve, which has
+ * accepted the request). */
+/* Writes the header, the low-resolution image (low, at most 16 x 16, as
+ * DXT1), the provenance resource and levels[0..count-1], smallest first,
+ * into f (open). */
+bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
+                         const bb_image *low, const bb_texture_options *options,
+                         bb_texture_format format, bb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BB_TEXTURE_VTF_H */

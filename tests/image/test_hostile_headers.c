@@ -1,0 +1,231 @@
+/* test_hostile_headers.c: headers that declare what their readers would
+ * allocate in open(), before any size check: a 126-byte
+ * progressive JPEG of 65500 x 65500 (8.5 GB and 21 s for `info`), a 1 x 1
+ * TIFF of 16384 x 16384 tiles (8.5 GB for `bake`), a 91-byte EXR with a
+ * 2 GB string attribute (2.2 GB for `info`), GIFs of 65535 x 65535
+ * ("vector::_M_default_append"). Each read says what is wrong in one line,
+ * at once, with bounded memory; the CLI does too under `ulimit -v
+ * 2000000`. */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath (cli_harness.h) */
+#define _DEFAULT_SOURCE    /* wait4 (child_call.h, cli_harness.h) */
+
+#include <criterion/criterion.h>
+
+#include "bumpbake.h"
+#include "image/height_channel.h"
+#include "child_call.h"
+#include "cli_harness.h"
+#include "hostile_headers.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+TestSuite(hostile_headers, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+
+/* ------------------------------------------------------- the library */
+
+static bb_status read_info(const char *path, bb_error *err) {
+  int w, h, c;
+  return bb_image_read_info(path, &w, &h, &c, NULL, err);
+}
+
+static bb_status read_pixels(const char *path, bb_error *err) {
+  bb_image img;
+  bb_status st = bb_image_read(path, &img, NULL, err);
+  bb_image_free(&img);
+  return st;
+}
+
+static bb_status load_height(const char *path, bb_error *err) {
+  bb_image h;
+  bb_status st = bb__height_load(path, BB_CHANNEL_AUTO, &h, &(bb__height_loaded){0}, err);
+  bb_image_free(&h);
+  return st;
+}
+
+/* A memory safety net for the child (the refusals need ~150 MB): a
+ * regression fails at the limit instead of taking the machine's memory. */
+static const long SAFETY_NET = 3L << 30;
+
+static void expect_refusal(child_call_fn fn, const char *what, const char *path,
+                           bb_status want, const char *part) {
+  child_outcome o = child_call(fn, path, 30, SAFETY_NET);
+  cr_expect_eq(o.signal, 0, "%s(%s): signal %d", what, path, o.signal);
+  cr_expect_eq(o.status, want, "%s(%s): status %s, '%s'", what, path, bb_status_name(o.status),
+               o.message);
+  cr_expect(strstr(o.message, path) && strstr(o.message, part), "%s: '%s' lacks '%s'", what,
+            o.message, part);
+  cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", what, o.message);
+  cr_expect_lt(o.seconds, 1.0, "%s(%s) took %.2f s", what, path, o.seconds);
+  cr_expect_lt(o.max_rss_kib, 400L * 1024, "%s(%s) took %ld MiB", what, path,
+               o.max_rss_kib / 1024);
+}
+
+static void expect_every_read_refuses(const char *path, bb_status want, const char *part) {
+  expect_refusal(read_info, "bb_image_read_info", path, want, part);
+  expect_refusal(read_pixels, "bb_image_read", path, want, part);
+  expect_refusal(load_height, "bb__height_load", path, want, part);
+}
+
+Test(hostile_headers, a_progressive_jpeg_is_refused_from_its_header) {
+  const char *path = tmp("p.jpg");
+  cr_assert_eq(write_progressive_jpeg(path, 65500, 65500), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a JPEG of 65500x65500 needs 8184 MiB to open");
+}
+
+/* The same file at 3000 x 2000 is a real one: it opens, and its pixels
+ * (the DC scan of zeros, then the end) read as a mid grey. */
+Test(hostile_headers, a_small_progressive_jpeg_still_reads) {
+  const char *path = tmp("small.jpg");
+  cr_assert_eq(write_progressive_jpeg(path, 3000, 2000), 0);
+  int w = 0, h = 0, c = 0;
+  bb_error err;
+  cr_assert_eq(bb_image_read_info(path, &w, &h, &c, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(w == 3000 && h == 2000 && c == 1);
+}
+
+Test(hostile_headers, huge_tiles_are_refused_before_decoding) {
+  const char *path = tmp("t.tif");
+  cr_assert_eq(write_tiled_tiff(path, 1, 1, 16384, 16384), 0);
+  /* The header alone is fine: it describes a 1 x 1 image. */
+  int w = 0, h = 0, c = 0;
+  bb_error err;
+  cr_assert_eq(bb_image_read_info(path, &w, &h, &c, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(w == 1 && h == 1 && c == 1);
+  const char *part = "tiles of 16384x16384 with 1 channel need 1024 MiB each";
+  expect_refusal(read_pixels, "bb_image_read", path, BB_ERR_SIZE, part);
+  expect_refusal(load_height, "bb__height_load", path, BB_ERR_SIZE, part);
+}
+
+Test(hostile_headers, an_exr_attribute_larger_than_its_file_is_refused) {
+  const char *path = tmp("a.exr");
+  cr_assert_eq(write_exr_with_huge_attribute(path, 0x7FFFFFF0u), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "'comment'");
+}
+
+Test(hostile_headers, an_exr_attribute_of_no_type_is_refused) {
+  const char *path = tmp("u.exr");
+  cr_assert_eq(write_exr_with_untyped_attribute(path, 0x6E697274u), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "attribute type for attribute 'junk'");
+}
+
+Test(hostile_headers, a_gif_screen_too_large_to_open_says_so) {
+  const char *path = tmp("g.gif");
+  cr_assert_eq(write_gif_screen(path, 65535, 65535), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a GIF of 65535x65535 needs 16384 MiB to open");
+  /* giflib reads any version after "GIF" (the fuzzer's "GIF\x939a"). */
+  FILE *f = fopen(path, "r+b");
+  cr_assert(f && fseek(f, 3, SEEK_SET) == 0 && fwrite("\x93" "9a", 1, 3, f) == 3 && fclose(f) == 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a GIF of 65535x65535 needs 16384 MiB to open");
+  /* A screen within what may be opened and read, on a machine that has
+   * the memory: where it has not (1.5 GB of address space here), the read
+   * refuses it from the header, before OpenImageIO allocates its 1 GiB
+   * canvas, naming what it needs. (AddressSanitizer builds run uncapped.) */
+#ifndef CHILD_CALL_ASAN
+  const char *mid = tmp("m.gif");
+  cr_assert_eq(write_gif_screen(mid, 16384, 16384), 0);
+  child_outcome o = child_call(read_pixels, mid, 30, 1536L << 20);
+  cr_expect_eq(o.signal, 0, "signal %d", o.signal);
+  cr_expect_eq(o.status, BB_ERR_MEMORY, "status %s, '%s'", bb_status_name(o.status), o.message);
+  cr_expect(strstr(o.message, mid) && strstr(o.message, "a GIF of 16384x16384 needs about") &&
+                strstr(o.message, "of memory"),
+            "'%s'", o.message);
+  cr_expect_lt(o.seconds, 1.0, "took %.2f s", o.seconds);
+  cr_expect_lt(o.max_rss_kib, 400L * 1024, "took %ld MiB", o.max_rss_kib / 1024);
+#endif
+}
+
+/* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
+ * extension index, then the file): each made OpenImageIO's reader allocate
+ * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
+ * and now is refused from its header, saying why, at once and in little
+ * memory. (libpng skips a chunk it cannot allocate: the PNG's read then
+ * ends at the end of the file, as before, but without the 1.8 GB.) */
+Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
+  static const struct {
+    const char *input, *ext, *reason;
+  } finds[] = {
+      {"exr-attribute-with-no-type", ".exr", "attribute type for attribute 'Softwar?'"},
+      {"exr-attribute-name-with-a-newline", ".exr", "attribute type for attribute '?'"},
+      {"exr-header-two-parsers-read-differently", ".exr", "'compression' attribute not found"},
+      {"gif-of-another-version-with-a-huge-screen", ".gif", "a GIF of 14616x29285 needs 1633 MiB"},
+      {"png-text-chunk-of-1.7-gb", ".png", "Read error: hit end of file"},
+  };
+  for (size_t i = 0; i < sizeof finds / sizeof finds[0]; i++) {
+    char from[256];
+    snprintf(from, sizeof from, "fuzz/regressions/load/%s", finds[i].input);
+    FILE *f = fopen(from, "rb");
+    cr_assert_not_null(f, "%s (tests run from the project root)", from);
+    unsigned char bytes[4096];
+    size_t n = fread(bytes, 1, sizeof bytes, f);
+    fclose(f);
+    cr_assert_gt(n, 1);
+    char name[64];
+    snprintf(name, sizeof name, "find%zu%s", i, finds[i].ext);
+    const char *path = tmp(name);
+    write_bytes(path, bytes + 1, n - 1);
+    child_outcome o = child_call(read_info, path, 30, SAFETY_NET);
+    cr_expect_eq(o.signal, 0, "%s: signal %d", finds[i].input, o.signal);
+    cr_expect(o.status == BB_ERR_FORMAT || o.status == BB_ERR_SIZE, "%s: %s",
+              finds[i].input, o.message);
+    cr_expect(strstr(o.message, finds[i].reason), "%s: '%s' lacks '%s'", finds[i].input,
+              o.message, finds[i].reason);
+    cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", finds[i].input, o.message);
+    cr_expect_lt(o.seconds, 1.0, "%s took %.2f s", finds[i].input, o.seconds);
+    cr_expect_lt(o.max_rss_kib, 400L * 1024, "%s took %ld MiB", finds[i].input,
+                 o.max_rss_kib / 1024);
+  }
+}
+
+/* ---------------------------------------------------------- the CLI */
+
+/* info and bake of each file under `ulimit -v 2000000` (KiB): exit 1, one
+ * line naming the file and the reason, well under a second of work (the
+ * bound is loose for a loaded machine; they take ~0.4 s, start-up). */
+Test(hostile_headers, info_and_bake_answer_at_once_in_2_gb) {
+  const char *jpg = tmp("p.jpg"), *tif = tmp("t.tif"), *exr = tmp("a.exr"), *gif = tmp("g.gif");
+  cr_assert_eq(write_progressive_jpeg(jpg, 65500, 65500), 0);
+  cr_assert_eq(write_tiled_tiff(tif, 1, 1, 16384, 16384), 0);
+  cr_assert_eq(write_exr_with_huge_attribute(exr, 0x7FFFFFF0u), 0);
+  cr_assert_eq(write_gif_screen(gif, 65535, 65535), 0);
+  const struct {
+    const char *path, *reason;
+    int info_ok; /* the tiled TIFF's header is a fine 1 x 1 image */
+  } files[] = {
+      {jpg, "needs 8184 MiB to open", 0},
+      {tif, "tiles of 16384x16384", 1},
+      {exr, "Attribute 'comment', type 'string': Invalid size", 0},
+      {gif, "needs 16384 MiB to open", 0},
+  };
+  /* ASan reserves terabytes of address space: no cap there, only the
+   * peak memory is bounded. */
+#ifdef CHILD_CALL_ASAN
+  const run_limits two_gb = {-1, -1};
+  const long rss_bound_kib = 768L * 1024;
+#else
+  const run_limits two_gb = {-1, 2000000L * 1024};
+  const long rss_bound_kib = 400L * 1024;
+#endif
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    const char *const info[] = {"info", files[i].path, NULL};
+    const char *const bake[] = {"bake", files[i].path, "--scale", "8", "--normal",
+                                tmp("n.png"), NULL};
+    for (int k = 0; k < 2; k++) {
+      const int is_info = k == 0;
+      cli_result r = harness_run_limited(NULL, &two_gb, is_info ? info : bake);
+      cr_expect_lt(r.seconds, 2.0, "%s %s took %.1f s", is_info ? "info" : "bake",
+                   files[i].path, r.seconds);
+      cr_expect_lt(r.max_rss_kib, rss_bound_kib, "%s %s took %ld MiB",
+                   is_info ? "info" : "bake", files[i].path, r.max_rss_kib / 1024);
+      if (is_info && files[i].info_ok) {
+        cr_expect_eq(r.code, 0, "%s", r.err);
+      } else {
+        cr_expect_eq(r.code, 1, "%s: %s", files[i].path, r.err);
+        cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
+        cr_expect(strstr(r.err, files[i].path) && strstr(r.err, files[i].reason), "%s", r.err);
+      }
+      cli_result_free(&r);
+    }
+  }
+  cr_expect_not(file_exists(tmp("n.png")));
+}

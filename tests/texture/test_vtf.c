@@ -1,0 +1,591 @@
+/* test_vtf.c: VTF files byte for byte against the published layout
+ * (VTFLib's VTFFormat.h, the Valve Developer Community's page): header
+ * fields, flags, format codes, mip count, low-resolution image, the size
+ * and place of every level smallest first; DXT1 blocks decoded by the
+ * test's own decoder; the header reader on good and hostile files; the
+ * Source material. */
+#define _XOPEN_SOURCE 700 /* mkdtemp */
+
+#include <criterion/criterion.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bumpbake.h"
+#include "texture/blocks.h"
+#include "texture/texture_oracle.h"
+
+static char dir[64];
+
+static void make_dir(void) {
+  snprintf(dir, sizeof dir, "/tmp/bb_vtf_XXXXXX");
+  cr_assert_not_null(mkdtemp(dir));
+}
+
+static void remove_dir(void) {
+  char cmd[128];
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+  cr_assert_eq(system(cmd), 0);
+}
+
+static const char *in_dir(const char *name) {
+  static char path[2][160];
+  static int k;
+  k ^= 1;
+  snprintf(path[k], sizeof path[k], "%s/%s", dir, name);
+  return path[k];
+}
+
+static unsigned char *slurp(const char *path, size_t *size) {
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "%s", path);
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  unsigned char *data = malloc((size_t)n + 1);
+  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
+  fclose(f);
+  *size = (size_t)n;
+  return data;
+}
+
+static void spill(const char *path, const unsigned char *data, size_t size) {
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f);
+  cr_assert_eq(fwrite(data, 1, size, f), size);
+  cr_assert_eq(fclose(f), 0);
+}
+
+/* A map of w x h in [0, 1]: waves, different in each channel (normal 0);
+ * a field of unit normals leaning with the waves (1); or waves whose
+ * colours lie on one line through RGB, which BC1 holds up to its 5:6:5
+ * steps (2). */
+static bb_image pattern(int w, int h, int channels, int normal) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, w, h, channels, NULL), BB_OK);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *t = img.pixels + ((size_t)y * (size_t)w + (size_t)x) * (size_t)channels;
+      const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+      if (normal == 2) {
+        const double a = 0.5 + 0.45 * sin(6.28 * (u + 2 * v));
+        for (int c = 0; c < channels; c++)
+          t[c] = (float)(c == 0 ? a : c == 1 ? 1.0 - a : 0.2 + 0.6 * a);
+      } else if (normal) {
+        double n[3] = {0.4 * sin(6.28 * u), 0.3 * cos(6.28 * 2 * v), 1.0};
+        const double len = sqrt(n[0] * n[0] + n[1] * n[1] + 1.0);
+        for (int c = 0; c < 3; c++)
+          t[c] = (float)(n[c] / len);
+      } else {
+        for (int c = 0; c < channels; c++)
+          t[c] = (float)(0.5 + 0.45 * sin(6.28 * (u * (c + 1) + v * (2 - c % 2))));
+      }
+    }
+  return img;
+}
+
+static float f32_at(const unsigned char *p) {
+  uint32_t u = oracle_u32(p);
+  float v;
+  memcpy(&v, &u, sizeof v);
+  return v;
+}
+
+/* vtex's reflectivity, computed here from the map as the writer should. */
+static void expected_reflectivity(const bb_image *img, double out[3]) {
+  out[0] = out[1] = out[2] = 0;
+  const size_t n = (size_t)img->width * (size_t)img->height;
+  for (size_t i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++) {
+      double v = img->pixels[i * (size_t)img->channels + (size_t)(img->channels == 1 ? 0 : c)];
+      v = v < 0 ? 0 : v > 1 ? 1 : v;
+      out[c] += pow(round(v * 255.0) / 255.0, 2.2) / (double)n;
+    }
+}
+
+Test(vtf, header_byte_for_byte_7_2) {
+  make_dir();
+  bb_image img = pattern(64, 32, 3, 0);
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.map = BB_TEXTURE_MAP_SSBUMP;
+  o.description = "bumpbake_version=x\nscale=64\n"; /* 7.2 has no room: left out */
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  size_t size;
+  unsigned char *f = slurp(in_dir("s.vtf"), &size);
+  cr_assert_eq(memcmp(f, "VTF\0", 4), 0, "magic");
+  cr_assert_eq(oracle_u32(f + 4), 7, "major version");
+  cr_assert_eq(oracle_u32(f + 8), 2, "minor version");
+  cr_assert_eq(oracle_u32(f + 12), 80, "header size");
+  cr_assert_eq(oracle_u16(f + 16), 64, "width");
+  cr_assert_eq(oracle_u16(f + 18), 32, "height");
+  cr_assert_eq(oracle_u32(f + 20), 0x08000000u, "flags: SSBUMP exactly, got 0x%08x",
+               oracle_u32(f + 20));
+  cr_assert_eq(oracle_u16(f + 24), 1, "frames");
+  cr_assert_eq(oracle_u16(f + 26), 0, "first frame");
+  cr_assert_eq(oracle_u32(f + 28), 0, "padding");
+  double refl[3];
+  expected_reflectivity(&img, refl);
+  for (int c = 0; c < 3; c++)
+    cr_assert_float_eq(f32_at(f + 32 + 4 * c), refl[c], 1e-6, "reflectivity %d: %g vs %g", c,
+                       (double)f32_at(f + 32 + 4 * c), refl[c]);
+  cr_assert_eq(oracle_u32(f + 44), 0, "padding");
+  cr_assert_eq(f32_at(f + 48), 1.0f, "bump scale");
+  cr_assert_eq(oracle_u32(f + 52), 13, "DXT1");
+  cr_assert_eq(f[56], 7, "mip count: 64 x 32 down to 1 x 1");
+  cr_assert_eq(oracle_u32(f + 57), 13, "low-res DXT1");
+  cr_assert_eq(f[61], 16, "low-res width");
+  cr_assert_eq(f[62], 8, "low-res height");
+  cr_assert_eq(oracle_u16(f + 63), 1, "depth");
+  for (int k = 65; k < 80; k++)
+    cr_assert_eq(f[k], 0, "byte %d of the padding", k);
+  /* Low-res 16 x 8 DXT1 (64 bytes) after the header, then levels smallest
+   * first: 1x1, 2x1, 4x2 (one block each), 8x4 (2), 16x8 (8), 32x16 (32),
+   * 64x32 (128 blocks). */
+  const size_t levels[] = {8, 8, 8, 16, 64, 256, 1024};
+  size_t at = 80 + 64;
+  for (int k = 0; k < 7; k++)
+    at += levels[k];
+  cr_assert_eq(size, at, "file of %zu bytes, layout says %zu", size, at);
+  int w, h;
+  cr_assert_eq(oracle_vtf_level_offset(f, size, 0, &w, &h), size - 1024);
+  cr_assert(w == 64 && h == 32);
+  cr_assert_eq(oracle_vtf_level_offset(f, size, 6, &w, &h), 80 + 64, "1 x 1 level first");
+  cr_assert(w == 1 && h == 1);
+
+  bb_vtf_info info;
+  cr_assert_eq(bb_vtf_read_info(in_dir("s.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert(info.version_major == 7 && info.version_minor == 2 && info.header_size == 80);
+  cr_assert(info.width == 64 && info.height == 32 && info.depth == 1 && info.frames == 1);
+  cr_assert_eq(info.flags, BB_VTF_FLAG_SSBUMP);
+  cr_assert_str_eq(info.format_name, "DXT1");
+  cr_assert(info.mip_count == 7 && info.low_res_format == 13 && info.low_res_width == 16 &&
+            info.low_res_height == 8);
+  cr_assert_eq(info.data_size, (long)(size - 144));
+  cr_assert_null(info.description, "7.2 holds no provenance");
+  bb_vtf_info_free(&info);
+  free(f);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+Test(vtf, resources_7_3_hold_the_provenance) {
+  make_dir();
+  bb_image img = pattern(32, 32, 3, 1);
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.map = BB_TEXTURE_MAP_NORMAL;
+  o.vtf_version = 3;
+  const char *provenance =
+      "bumpbake_version=0.2.0\ncommand=bumpbake bake \"a b.png\" --scale 64\nscale=64\n";
+  o.description = provenance;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(in_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  size_t size;
+  unsigned char *f = slurp(in_dir("n.vtf"), &size);
+  cr_assert_eq(oracle_u32(f + 8), 3);
+  cr_assert_eq(oracle_u32(f + 12), 80 + 3 * 8, "header size with 3 resources");
+  cr_assert_eq(oracle_u32(f + 20), 0x80u, "flags: NORMAL");
+  cr_assert_eq(oracle_u32(f + 68), 3, "resource count");
+  /* Sorted by id, as Source's binary search needs: low-res, image, KVD. */
+  cr_assert_eq(oracle_u32(f + 80), 0x01);
+  cr_assert_eq(oracle_u32(f + 88), 0x30);
+  cr_assert_eq(oracle_u32(f + 96), 'K' | 'V' << 8 | 'D' << 16);
+  const uint32_t low = oracle_u32(f + 84), image = oracle_u32(f + 92), kvd = oracle_u32(f + 100);
+  cr_assert_eq(low, 104, "low-res right after the dictionary");
+  cr_assert_eq(kvd, 104 + 128, "KVD after the 16 x 16 low-res image (16 blocks)");
+  const uint32_t kvd_size = oracle_u32(f + kvd);
+  cr_assert_eq(image, kvd + 4 + kvd_size, "image data last");
+  size_t data = 0;
+  for (int s = 32; s >= 1; s /= 2)
+    data += (size_t)((s + 3) / 4) * (size_t)((s + 3) / 4) * 8;
+  cr_assert_eq(size, image + data);
+  const char *text = (const char *)f + kvd + 4;
+  cr_assert_not_null(strstr(text, "\"bumpbake\"\n{\n"), "%s", text);
+  cr_assert_not_null(strstr(text, "\t\"command\" \"bumpbake bake \\\"a b.png\\\" --scale 64\"\n"),
+                     "%s", text);
+  bb_vtf_info info;
+  cr_assert_eq(bb_vtf_read_info(in_dir("n.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(info.resource_count, 3);
+  cr_assert_str_eq(info.description, provenance);
+  bb_vtf_info_free(&info);
+  free(f);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
+  /* Level k's bytes are what the codec makes of the mip chain's level k,
+   * and the test's own decoder finds the map in them within BC1's error. */
+  make_dir();
+  bb_image img = pattern(64, 64, 3, 2);
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.map = BB_TEXTURE_MAP_SSBUMP;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  size_t size;
+  unsigned char *f = slurp(in_dir("s.vtf"), &size);
+  bb_image *chain = NULL;
+  int count = 0;
+  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &count, NULL), BB_OK);
+  cr_assert_eq(f[56], count);
+  for (int k = 0; k < count; k++) {
+    int w, h;
+    const size_t at = oracle_vtf_level_offset(f, size, k, &w, &h);
+    cr_assert(at > 0 && w == chain[k].width && h == chain[k].height);
+    float *rgba = malloc((size_t)w * (size_t)h * 4 * sizeof(float));
+    for (int i = 0; i < w * h; i++) {
+      for (int c = 0; c < 3; c++)
+        rgba[4 * i + c] = chain[k].pixels[3 * i + c];
+      rgba[4 * i + 3] = 1.0f;
+    }
+    const size_t bytes = (size_t)((w + 3) / 4) * (size_t)((h + 3) / 4) * 8;
+    unsigned char *blocks = malloc(bytes);
+    cr_assert_eq(bb__blocks_compress(rgba, w, h, BB__BLOCK_BC1, 0, 1, blocks, NULL), BB_OK);
+    cr_assert_eq(memcmp(blocks, f + at, bytes), 0, "level %d: the codec's blocks", k);
+    unsigned char *dec = malloc((size_t)w * (size_t)h * 4);
+    oracle_decode(ORACLE_BC1, f + at, w, h, dec);
+    double worst = 0;
+    for (int i = 0; i < w * h; i++)
+      for (int c = 0; c < 3; c++) {
+        const double e = fabs(dec[4 * i + c] - 255.0 * rgba[4 * i + c]);
+        worst = e > worst ? e : worst;
+      }
+    /* Colours on one line: what is left is a block's 4 steps along it,
+     * up to a sixth of the wave's range over 4 texels; measured 16.3, 22.9,
+     * 21.7, 7.8, then 1.5 (5:6:5 rounding) from level 0 down. A decoder
+     * that swapped channels or read indices in another order would be off
+     * by 60 codes and more. */
+    cr_assert_leq(worst, 25.0, "level %d: %.1f codes off", k, worst);
+    free(dec);
+    free(blocks);
+    free(rgba);
+  }
+  bb_mip_chain_free(chain, count);
+  free(f);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+Test(vtf, flags_from_the_map_and_the_caller) {
+  make_dir();
+  bb_image rgb = pattern(16, 16, 3, 0), normal = pattern(16, 16, 3, 1),
+           rgba = pattern(16, 16, 4, 0);
+  const struct {
+    const bb_image *img;
+    bb_texture_map map;
+    bb_texture_format format;
+    int mips;
+    uint32_t extra, want;
+  } cases[] = {
+      {&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x08000000u},
+      {&normal, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x00000080u},
+      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0},
+      {&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 0, 0, 0x08000300u},
+      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0x0000000cu, 0x0000000cu},
+      {&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0x00002000u},
+      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0},
+  };
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.map = cases[c].map;
+    o.format = cases[c].format;
+    o.mips = cases[c].mips;
+    o.vtf_flags = cases[c].extra;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_texture_write(in_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
+                 err.message);
+    size_t size;
+    unsigned char *f = slurp(in_dir("f.vtf"), &size);
+    cr_assert_eq(oracle_u32(f + 20), cases[c].want, "case %zu: flags 0x%08x, want 0x%08x", c,
+                 oracle_u32(f + 20), cases[c].want);
+    cr_assert_eq(f[56], cases[c].mips ? 5 : 1, "case %zu: mip count", c);
+    free(f);
+  }
+  bb_image_free(&rgb);
+  bb_image_free(&normal);
+  bb_image_free(&rgba);
+  remove_dir();
+}
+
+/* binary16 to float, from IEEE 754 (not Imath's). */
+static float half_to_float(unsigned h) {
+  const int e = (h >> 10) & 31, m = h & 1023;
+  double v = e == 0 ? ldexp(m, -24) : ldexp(1024 + m, e - 25);
+  return (float)((h >> 15) ? -v : v);
+}
+
+Test(vtf, texel_formats) {
+  /* BGR888 and BGRA8888 in Valve's byte order; RGBA16161616F halves of
+   * what the engine samples (normals as 0.5 + 0.5 N); DXT5's code. */
+  make_dir();
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 4, 4, 4, NULL), BB_OK);
+  for (int i = 0; i < 16; i++) {
+    img.pixels[4 * i + 0] = 0.2f;
+    img.pixels[4 * i + 1] = 0.4f;
+    img.pixels[4 * i + 2] = 0.6f;
+    img.pixels[4 * i + 3] = 0.8f;
+  }
+  const struct {
+    bb_texture_format format;
+    int code;
+    size_t top;
+  } cases[] = {{BB_TEXTURE_FORMAT_BGRA8, 12, 64},
+               {BB_TEXTURE_FORMAT_RGBA16F, 24, 128},
+               {BB_TEXTURE_FORMAT_BC3, 15, 16}};
+  for (size_t c = 0; c < 3; c++) {
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.format = cases[c].format;
+    o.mips = 0;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_texture_write(in_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+    size_t size;
+    unsigned char *f = slurp(in_dir("t.vtf"), &size);
+    cr_assert_eq(oracle_u32(f + 52), (uint32_t)cases[c].code);
+    cr_assert_eq(size, 80 + 8 + cases[c].top, "header, 4 x 4 low-res DXT1, one level");
+    const unsigned char *t = f + 88;
+    if (cases[c].format == BB_TEXTURE_FORMAT_BGRA8)
+      cr_assert(t[0] == 153 && t[1] == 102 && t[2] == 51 && t[3] == 204, "B G R A: %d %d %d %d",
+                t[0], t[1], t[2], t[3]);
+    if (cases[c].format == BB_TEXTURE_FORMAT_RGBA16F)
+      for (int k = 0; k < 4; k++)
+        cr_assert_float_eq(half_to_float(oracle_u16(t + 2 * k)), 0.2f * (float)(k + 1), 2e-4);
+    free(f);
+  }
+  /* BGR888 of a normal map: 0.5 + 0.5 N in B, G, R order. */
+  bb_image n;
+  cr_assert_eq(bb_image_alloc(&n, 4, 4, 3, NULL), BB_OK);
+  for (int i = 0; i < 16; i++)
+    n.pixels[3 * i + 0] = 0.6f, n.pixels[3 * i + 1] = 0.0f, n.pixels[3 * i + 2] = 0.8f;
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.format = BB_TEXTURE_FORMAT_BGR8;
+  o.map = BB_TEXTURE_MAP_NORMAL;
+  o.mips = 0;
+  cr_assert_eq(bb_texture_write(in_dir("n.vtf"), &n, &o, NULL), BB_OK);
+  size_t size;
+  unsigned char *f = slurp(in_dir("n.vtf"), &size);
+  cr_assert_eq(oracle_u32(f + 52), 3);
+  /* B: 0.5f + 0.5f * 0.8f is 0.89999998f, 229.49999 codes, so 229; G: 0.5
+   * exactly, rounded half up to 128; R: 0.8, 204. */
+  cr_assert(f[88] == 229 && f[89] == 128 && f[90] == 204, "%d %d %d", f[88], f[89], f[90]);
+  free(f);
+  bb_image_free(&n);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+Test(vtf, same_bytes_for_any_thread_count) {
+  make_dir();
+  bb_image img = pattern(128, 64, 3, 0);
+  unsigned char *first = NULL;
+  size_t first_size = 0;
+  for (int threads = 1; threads <= 4; threads++) {
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.map = BB_TEXTURE_MAP_SSBUMP;
+    o.threads = threads;
+    cr_assert_eq(bb_texture_write(in_dir("d.vtf"), &img, &o, NULL), BB_OK);
+    size_t size;
+    unsigned char *f = slurp(in_dir("d.vtf"), &size);
+    if (!first) {
+      first = f, first_size = size;
+      continue;
+    }
+    cr_assert(size == first_size && memcmp(f, first, size) == 0, "threads %d differ", threads);
+    free(f);
+  }
+  free(first);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+static void expect_refused(const bb_image *img, bb_texture_map map, bb_texture_format format,
+                           int version, uint32_t flags, const char *words) {
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.map = map;
+  o.format = format;
+  o.vtf_version = version;
+  o.vtf_flags = flags;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(in_dir("bad.vtf"), img, &o, &err), BB_ERR_ARGUMENT, "%s",
+               err.message);
+  cr_assert_not_null(strstr(err.message, words), "'%s' lacks '%s'", err.message, words);
+  cr_assert_eq(bb_texture_check(in_dir("bad.vtf"), img->width, img->height, img->channels, &o,
+                                NULL),
+               BB_ERR_ARGUMENT);
+  cr_assert_eq(access(in_dir("bad.vtf"), F_OK), -1, "nothing written");
+}
+
+Test(vtf, usage_errors) {
+  make_dir();
+  bb_image odd = pattern(96, 80, 3, 0), tiny = pattern(2, 2, 3, 0),
+           rgba = pattern(16, 16, 4, 0), ao = pattern(16, 16, 1, 0),
+           rgb = pattern(16, 16, 3, 0);
+  expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
+                 "power of two on each side (resize to 128 x 64)");
+  expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BGR8, 2, 0, "power of two");
+  expect_refused(&tiny, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
+                 "multiples of 4");
+  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 2, 0,
+                 "format bc1 holds at most 3 channels");
+  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGR8, 2, 0,
+                 "format bgr888 holds at most 3 channels");
+  expect_refused(&ao, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 2, 0, "VTF has no format bc4");
+  expect_refused(&rgb, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 2, 0, "VTF has no format bc5");
+  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_RGBA32F, 2, 0,
+                 "VTF has no format rgba32f");
+  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 6, 0, "7.6");
+  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, "7.1");
+  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_ENVMAP,
+                 "ENVMAP");
+  /* 2 x 2 is fine uncompressed, and so is one channel in DXT1 (grey). */
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.format = BB_TEXTURE_FORMAT_BGR8;
+  cr_assert_eq(bb_texture_write(in_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
+  cr_assert_eq(bb_texture_write(in_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
+  bb_texture_format fmt;
+  cr_assert_eq(bb_texture_format_parse("DXT5", &fmt, NULL), BB_OK);
+  cr_assert_eq(fmt, BB_TEXTURE_FORMAT_BC3);
+  cr_assert_eq(bb_texture_format_parse("rgba16161616f", &fmt, NULL), BB_OK);
+  cr_assert_eq(fmt, BB_TEXTURE_FORMAT_RGBA16F);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_format_parse("dxt9", &fmt, &err), BB_ERR_ARGUMENT);
+  cr_assert_not_null(strstr(err.message, "bc1"), "%s", err.message);
+  cr_assert(bb_path_is_texture_format("a/B.VTF") && bb_path_is_texture_format("x.dds") &&
+            !bb_path_is_texture_format("x.vtf.png") && !bb_path_is_texture_format("vtf"));
+  bb_image_free(&odd);
+  bb_image_free(&tiny);
+  bb_image_free(&rgba);
+  bb_image_free(&ao);
+  bb_image_free(&rgb);
+  remove_dir();
+}
+
+Test(vtf, read_info_refuses_broken_files) {
+  make_dir();
+  bb_image img = pattern(32, 32, 3, 0);
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.vtf_version = 4;
+  o.description = "a=b\n";
+  cr_assert_eq(bb_texture_write(in_dir("g.vtf"), &img, &o, NULL), BB_OK);
+  size_t size;
+  unsigned char *good = slurp(in_dir("g.vtf"), &size);
+  bb_vtf_info info;
+  bb_error err = {{0}};
+  /* Truncated by one byte: the image data no longer fits. */
+  spill(in_dir("t.vtf"), good, size - 1);
+  cr_assert_eq(bb_vtf_read_info(in_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
+  cr_assert_null(info.description);
+  /* Not a VTF; a version from the future; a resource count past the header. */
+  spill(in_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
+  cr_assert_eq(bb_vtf_read_info(in_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
+  unsigned char *bad = malloc(size);
+  memcpy(bad, good, size);
+  bad[8] = 9;
+  spill(in_dir("v.vtf"), bad, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
+  memcpy(bad, good, size);
+  bad[68] = 200;
+  spill(in_dir("r.vtf"), bad, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb_vtf_read_info(in_dir("missing.vtf"), &info, &err), BB_ERR_IO);
+  /* Every byte of the header and dictionary set to each of 0, 1, 0x7f,
+   * 0xff in turn: OK or FORMAT, never a crash or an out-of-bounds read
+   * (the sanitized build checks). */
+  const unsigned char values[] = {0, 1, 0x7f, 0xff};
+  for (size_t at = 0; at < 112; at++)
+    for (int v = 0; v < 4; v++) {
+      memcpy(bad, good, size);
+      bad[at] = values[v];
+      spill(in_dir("m.vtf"), bad, size);
+      bb_status st = bb_vtf_read_info(in_dir("m.vtf"), &info, &err);
+      cr_assert(st == BB_OK || st == BB_ERR_FORMAT, "byte %zu = %d: %s", at, values[v],
+                err.message);
+      bb_vtf_info_free(&info);
+    }
+  free(bad);
+  free(good);
+  bb_image_free(&img);
+  remove_dir();
+}
+
+Test(vtf, material) {
+  make_dir();
+  char materials[160], bump[200], base[200], vmt[200];
+  snprintf(materials, sizeof materials, "%s/game/materials", dir);
+  snprintf(bump, sizeof bump, "%s/game/materials/./wood/wall020_height-ssbump.vtf", dir);
+  snprintf(base, sizeof base, "%s/game/materials/wood/../wood/wall020.vtf", dir);
+  snprintf(vmt, sizeof vmt, "%s/wall020.vmt", dir);
+  bb_vmt_options o = {materials, bump, base, 1};
+  bb_error err = {{0}};
+  cr_assert_eq(bb_vmt_write(vmt, &o, &err), BB_OK, "%s", err.message);
+  size_t size;
+  char *text = (char *)slurp(vmt, &size);
+  text[size] = '\0';
+  cr_assert_str_eq(text, "// Source material written by bumpbake " BB_VERSION_STRING "\n"
+                         "\"LightmappedGeneric\"\n{\n"
+                         "\t\"$basetexture\" \"wood/wall020\"\n"
+                         "\t\"$bumpmap\" \"wood/wall020_height-ssbump\"\n"
+                         "\t\"$ssbump\" \"1\"\n}\n");
+  free(text);
+  /* A bump map outside the materials, not a VTF, or unquotable: refused. */
+  char outside[200];
+  snprintf(outside, sizeof outside, "%s/game/textures/rock.vtf", dir);
+  bb_vmt_options bad = {materials, outside, NULL, 1};
+  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  cr_assert_not_null(strstr(err.message, "not inside the materials folder"), "%s", err.message);
+  snprintf(outside, sizeof outside, "%s/game/materials/rock.tga", dir);
+  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  cr_assert_not_null(strstr(err.message, "must be a .vtf"), "%s", err.message);
+  snprintf(outside, sizeof outside, "%s/game/materials/a\"b.vtf", dir);
+  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  bb_vmt_options none = {materials, NULL, NULL, 1};
+  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &none, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(access(in_dir("x.vmt"), F_OK), -1);
+  remove_dir();
+}
+
+/* --vtf-version and --vtf-flags as the library reads them for every client. */
+Test(vtf, version_and_flags_parse_as_the_options_take_them) {
+  bb_error err;
+  int minor = 0;
+  const char *good[] = {"7.2", "7.5", "3", "4"};
+  const int want[] = {2, 5, 3, 4};
+  for (int k = 0; k < 4; k++) {
+    cr_expect_eq(bb_vtf_version_parse(good[k], &minor, &err), BB_OK, "%s", good[k]);
+    cr_expect_eq(minor, want[k], "%s", good[k]);
+  }
+  const char *bad[] = {"7.9", "7.1", "8.2", "", "7.", "3x", "seven", " 3", "+3", NULL};
+  for (int k = 0; k < 10; k++) {
+    cr_expect_eq(bb_vtf_version_parse(bad[k], &minor, &err), BB_ERR_ARGUMENT, "%s",
+                 bad[k] ? bad[k] : "NULL");
+    cr_expect(strstr(err.message, "VTF version must be 7.2, 7.3, 7.4 or 7.5"), "%s", err.message);
+  }
+  uint32_t flags = 0;
+  cr_expect_eq(bb_vtf_flags_parse("0x08000000", &flags, &err), BB_OK);
+  cr_expect_eq(flags, BB_VTF_FLAG_SSBUMP);
+  cr_expect_eq(bb_vtf_flags_parse("12", &flags, &err), BB_OK);
+  cr_expect_eq(flags, 12u);
+  cr_expect_eq(bb_vtf_flags_parse("010", &flags, &err), BB_OK, "octal, as strtoul reads it");
+  cr_expect_eq(flags, 8u);
+  cr_expect_eq(bb_vtf_flags_parse("0xffffffff", &flags, &err), BB_OK);
+  const char *bad_flags[] = {"-1", " -1", "+4", "0x100000000", "4k", "", NULL};
+  for (int k = 0; k < 7; k++) {
+    cr_expect_eq(bb_vtf_flags_parse(bad_flags[k], &flags, &err), BB_ERR_ARGUMENT, "%s",
+                 bad_flags[k] ? bad_flags[k] : "NULL");
+    cr_expect(strstr(err.message, "VTF flags must be a 32-bit number"), "%s", err.message);
+  }
+}
