@@ -2295,8 +2295,9 @@ typedef struct bb_job_options {
   const char *command;       /* one input: the whole command line as typed */
   const char *command_options; /* what follows "bumpbake bake INPUT" in each
                                 output's command (a batch's, or a single input's
-                                when command is NULL); NULL for both: the command
-                                is left empty. bb_command_plan sets them */
+                                when command is NULL); NULL for both: the options
+                                written out by bb_job_command_text.
+                                bb_command_plan sets them */
   bb_note_fn note;           /* notes about inputs (may be NULL) */
   void *note_user;
   /* Engine textures and a Source material: */
@@ -2419,6 +2420,18 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
  * end. BB_OK when the job has no depfile. */
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 
+
+/* The command line of options o, as the provenance of a job without
+ * command or command_options records it: "bumpbake bake INPUT" and then
+ * every option that differs from its default, in the order of `bumpbake
+ * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
+ * --maps normal,ao --name T ... --texture-format bc3 --vtf-version 7.3
+ * --nomip --vmt FILE; the threads are left out). A CLI invocation typed
+ * this way records the same text, so the same job through the CLI and
+ * through Python writes the same bytes. (Python's jobs still plan with it;
+ * bb_command_text spells any command through the descriptions.) malloc'd;
+ * NULL when out of memory. */
+char *bb_job_command_text(const bb_job_options *o, const char *input);
 
 /* --------------------------------------------------- up-to-date checks */
 

@@ -7,7 +7,7 @@ header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
 update. Declarations are the header's as they are, in its order, comments
 dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
-BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 9; the VTF flags in decimal), which
+BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 10; the VTF flags in decimal), which
 cffi needs; the test checks those numbers too.
 """
 
@@ -507,7 +507,7 @@ typedef struct bb_job_file {
 typedef struct bb_job_report {
   const char *input;
   int output_count;
-  bb_job_file outputs[9];
+  bb_job_file outputs[10];
   bb_job_outcome outcome;
   bb_status status;
   bb_error error;
@@ -747,6 +747,7 @@ const bb_job_report *bb_job_report_get(const bb_job *job, int i);
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
+char *bb_job_command_text(const bb_job_options *o, const char *input);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
 int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);

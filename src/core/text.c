@@ -29,7 +29,8 @@ void bb__text_append(bb__text *t, const char *s, size_t n) {
 }
 
 void bb__text_add(bb__text *t, const char *s) {
-  bb__text_append(t, s, strlen(s));
+  if (s) /* a string not set adds nothing */
+    bb__text_append(t, s, strlen(s));
 }
 
 void bb__text_printf(bb__text *t, const char *fmt, ...) {

@@ -83,6 +83,8 @@ struct bb_job {
   char *bounce_albedo_file, *brightness_file;
   char *vmt, *vmt_materials, *vmt_basetexture;
   char *valve_path;         /* Valve's packed file (height2ssbump), or NULL */
+  int asked_slices;         /* options.bake.slices as given (0: from rays), before the
+                               plan resolved it: what the command text spells */
   char *vmt_text;           /* the material's bytes, made by the plan */
   size_t vmt_size;
   bb_image bounce_albedo_map, brightness_map; /* read once by the plan */

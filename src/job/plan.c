@@ -600,6 +600,7 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
 /* The options' strings, copied: a job outlives its caller's buffers. */
 static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *err) {
   job->options = *o;
+  job->asked_slices = o->bake.slices;
   job->options.bake.outputs = asked_kinds(o);
   job->batch = o->out_dir != NULL;
   job->basis_file = copy(o->basis_file);
