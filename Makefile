@@ -33,7 +33,7 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR
+PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR libmicrohttpd
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 # libpng: src/image/png_hooks.c sets quiet error handlers and bounded
@@ -53,6 +53,10 @@ ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # half.h (C, header only) converts floats to half for VTF and DDS.
 SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
 SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
+# libmicrohttpd: the HTTP server of `bumpbake serve` (src/cli/serve/ only,
+# linked into the CLI, not the library).
+MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
+MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
 LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
@@ -83,6 +87,13 @@ PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
 # by the interpreter's version (/usr/local/lib/python3.11/dist-packages).
 PYTHON_VERSION := $(shell /usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)
 PYTHONDIR  ?= $(if $(and $(filter /usr/local,$(PREFIX)),$(PYTHON_VERSION)),$(PREFIX)/lib/python$(PYTHON_VERSION)/dist-packages,$(PREFIX)/lib/python3/dist-packages)
+# bumpbake.pc: an rpath for a LIBDIR the dynamic loader does not search by
+# itself (Debian's: /lib, /usr/lib, /usr/local/lib and their multiarch
+# folders), and the static link's libraries (LDLIBS, Libs.private).
+MULTIARCH  := $(shell $(CC) -dumpmachine 2>/dev/null)
+LOADER_DIRS:= /lib /usr/lib /usr/local/lib $(addsuffix /$(MULTIARCH),/lib /usr/lib /usr/local/lib)
+PC_RPATH    = $(if $(filter $(patsubst %/,%,$(LIBDIR)),$(LOADER_DIRS)),, -Wl$(comma)-rpath$(comma)$${libdir})
+PC_LIBS_PRIVATE = $(LDLIBS) -lstdc++
 # Refreshes the loader's cache after a real (DESTDIR-less) install as root;
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
@@ -111,7 +122,12 @@ comma := ,
 FAMILIES := core files texture image trace bake maps render mesh job cmd
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
-CLI_C    := $(wildcard src/cli/*.c)
+CLI_C    := $(wildcard src/cli/*.c) $(wildcard src/cli/serve/*.c)
+# `bumpbake serve` (src/cli/serve.c, src/cli/serve/): the CLI's only HTTP
+# server, left out of the test binary and the fuzz targets.
+SERVE_C  := src/cli/serve.c $(wildcard src/cli/serve/*.c)
+# The page it serves, embedded into serve_page.o at build time.
+SERVE_ASSETS := $(wildcard share/serve/*) shaders/ssbump_relief.glsl
 TEST_C   := $(wildcard tests/*/test_*.c)
 TOOL_C   := $(wildcard tools/*.c)
 
@@ -122,7 +138,7 @@ TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
 # The fuzz targets' code, compiled into the test binary to replay the saved
 # regression inputs (tests/test_fuzz.c), with the CLI minus main().
 FUZZ_REPLAY_OBJ := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%.o,$(wildcard fuzz/fuzz_*.c))
-CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o,$(CLI_OBJ))
+CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o $(SERVE_C:%.c=$(BUILD)/%.o),$(CLI_OBJ))
 ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
 SHLIB    := $(BUILD)/$(SHLIB_REAL)
@@ -136,7 +152,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-circles check-layers check-docs bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-circles check-layers check-docs bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -158,7 +174,8 @@ PYTHON   := /usr/bin/python3
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
-            openimageio-tools ninja-build python3-distributed python3-dask strace time
+            openimageio-tools ninja-build python3-distributed python3-dask strace time \
+            libmicrohttpd-dev chromium chromium-driver python3-selenium
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -168,7 +185,8 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed' >/dev/null 2>&1; then :; \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium' >/dev/null 2>&1 \
+	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
@@ -200,6 +218,8 @@ $(BUILD)/link.flags: FORCE
 
 $(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
+$(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(CLI_INCLUDES) $(MHD_CFLAGS)
+$(BUILD)/src/cli/serve/serve_page.o: $(SERVE_ASSETS)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
 $(BUILD)/%.o: %.c $(BUILD)/compile.flags
@@ -230,14 +250,14 @@ $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
 # (`make bench` measures both) and the installed binary finds no library at
 # run time but OpenImageIO's.
 $(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
 $(BUILD)/bench/bumpbake-early: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS) $(MHD_LIBS)
 $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
 
 # The tools print JSON with the CLI's one writer (src/cli/json.c).
 TOOL_JSON := $(BUILD)/src/cli/json.o
@@ -253,13 +273,28 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
+# The installed program: the CLI with src/cli/installed_dirs.c compiled
+# again with the install's PYTHONDIR, where `bumpbake bake --scheduler`
+# finds the Python package (src/cli/cluster.c); build/bumpbake finds its
+# source tree instead. Relinked when PYTHONDIR changes.
+INSTALL_BIN := $(BUILD)/install/bumpbake
+$(BUILD)/install/dirs.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(PYTHONDIR)' | cmp -s - $@ || echo '$(PYTHONDIR)' >$@
+$(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dirs.flags \
+                                   $(BUILD)/compile.flags
+	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
+$(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
+                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS)
+
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
 # (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
-install: $(BIN) lib
+install: $(INSTALL_BIN) lib
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
 	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
-	install -m 755 $(BIN) $(DESTDIR)$(BINDIR)/bumpbake
+	install -m 755 $(INSTALL_BIN) $(DESTDIR)$(BINDIR)/bumpbake
 	install -m 755 $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL)
 	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so
@@ -267,7 +302,8 @@ install: $(BIN) lib
 	install -m 644 include/bumpbake.h $(DESTDIR)$(INCLUDEDIR)/bumpbake.h
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
-	  -e 's|@VERSION@|$(VERSION)|' bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
+	  -e 's|@VERSION@|$(VERSION)|; s|@RPATH@|$(PC_RPATH)|; s|@LIBS_PRIVATE@|$(PC_LIBS_PRIVATE)|' \
+	  bumpbake.pc.in >$(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 	install -d $(DESTDIR)$(PYTHONDIR)/bumpbake $(DESTDIR)$(PYTHONDIR)/bumpbake/dask
 	install -m 644 $(filter-out python/bumpbake/_install.py,$(wildcard python/bumpbake/*.py)) \
 	  $(DESTDIR)$(PYTHONDIR)/bumpbake/
@@ -296,10 +332,10 @@ test: ensure-deps
 	@$(MAKE) --no-print-directory check
 
 # Everything `make test` runs: the Criterion suite, the install check, the
-# Python tests, the check that no two files need each other, the check that
-# no family reaches up to a later one and the check that the command
-# reference and the man page say what --help says.
-check: check-unit check-install check-python check-circles check-layers check-docs
+# Python tests, serve's page in a browser, the check that no two files need
+# each other, the check that no family reaches up to a later one and the
+# check that the command reference and the man page say what --help says.
+check: check-unit check-install check-python check-serve check-circles check-layers check-docs
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -344,6 +380,16 @@ check-python: $(BIN) lib
 	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
 	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
 
+# `bumpbake serve` in headless Chromium (tests/serve/): the page draws, relights,
+# re-bakes on a save by rename and on a control, keeps the last maps after a
+# broken save, writes what `bumpbake bake` writes. Skipped, saying why,
+# without chromium, chromium-driver or python3-selenium. Screenshots:
+# build/serve-test/.
+check-serve: $(BIN)
+	@echo "serve: the page in headless Chromium (tests/serve)"
+	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
+	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
+
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
@@ -369,8 +415,10 @@ goldens: ensure-deps
 # `make hostile` reruns the reproductions of hostile files (models reading
 # outside their directory, FIFOs, huge headers, outputs over inputs, links at
 # temporaries, signals in a commit, depfile names, escapes, JSON, address
-# space) against the binary, a line per case, in about a minute and a half
-# (tools/hostile_repro.sh; not part of make test).
+# space; code from the working directory, outputs that are not regular
+# files, a memory cgroup, renders too large) against the binary, a line per
+# case, in about two minutes (tools/hostile_repro.sh; not part of make test:
+# its bounds are wall-clock).
 hostile: $(BIN)
 	@./tools/hostile_repro.sh $(BIN)
 
@@ -399,7 +447,7 @@ FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) $(TEST_I
 FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
 FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
 FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
-FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c,$(CLI_C)))
+FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c $(SERVE_C),$(CLI_C)))
 # Per target: libFuzzer options beyond time and corpus.
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
 FUZZ_ARGS_fuzz_provenance := -max_len=65536

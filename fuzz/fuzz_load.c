@@ -1,10 +1,11 @@
 /* fuzz_load.c: image bytes -> every read of the library, the path every
  * command's input takes (the checked descriptor, the header probes,
  * OpenImageIO's readers, bumpbake's size checks, the channel rule, banded
- * decoding, frames). The first byte's low 4 bits pick the file extension
- * (the format OpenImageIO tries first; every other reader then gets its
- * turn by content), its high bits the height channel rule; the rest is the
- * file. Properties: no crash, no leak, no unit slower than `make fuzz`'s
+ * decoding, frames; VTF and DX10 DDS files through bumpbake's own texture
+ * reader). The first byte's low 5 bits pick the file extension (modulo the
+ * 17 of EXTENSIONS: the format OpenImageIO tries first, every other reader
+ * then gets its turn by content; .vtf goes to the VTF reader), its top 3
+ * bits the height channel rule; the rest is the file. Properties: no crash, no leak, no unit slower than `make fuzz`'s
  * -timeout or allocating past its -malloc_limit_mb, every failure one line,
  * and a success a finite 1-channel height of the size the header declares. */
 #include "bumpbake.h"
@@ -14,17 +15,17 @@
 #include <math.h>
 
 /* Every format the seed corpus holds a valid file of (make_seeds.c), PSD
- * and DDS read-only. */
-static const char *const EXTENSIONS[16] = {
-    "in.png", "in.tga", "in.tif", "in.exr", "in.jpg", "in.bmp", "in.pnm", "in.gif",
-    "in.hdr", "in.dpx", "in.jp2", "in.webp", "in.sgi", "in.ico", "in.psd", "in.dds"};
+ * read-only. */
+static const char *const EXTENSIONS[17] = {
+    "in.png", "in.tga", "in.tif", "in.exr", "in.jpg", "in.bmp", "in.pnm", "in.gif", "in.hdr",
+    "in.dpx", "in.jp2", "in.webp", "in.sgi", "in.ico", "in.psd", "in.dds", "in.vtf"};
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size < 1)
     return 0;
-  const char *name = EXTENSIONS[data[0] & 15];
-  const bb_channel channel = (bb_channel)((data[0] >> 4) % 7);
+  const char *name = EXTENSIONS[(data[0] & 31) % 17];
+  const bb_channel channel = (bb_channel)((data[0] >> 5) % 7);
   const char *path = fuzz_write_file(name, data + 1, size - 1);
 
   int width = 0, height = 0, channels = 0;

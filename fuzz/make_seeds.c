@@ -4,8 +4,10 @@
  * OUT_DIR/load: every small fixture PNG as it is and as TGA, TIFF and EXR,
  * and a small valid file of every other format OpenImageIO writes here
  * (JPEG, progressive JPEG, BMP, PNM, GIF, HDR, DPX, JPEG 2000, WebP, SGI,
- * ICO; through seed_formats.cpp), 16-bit, half and mip-mapped files and a
- * GIF of three frames, each after fuzz_load's leading byte; OUT_DIR/compare: pairs of
+ * ICO; through seed_formats.cpp), 16-bit, half and mip-mapped files, a
+ * GIF of three frames, and the engine textures bumpbake writes (a VTF of
+ * every format, version 7.2 and 7.5, with and without mips; a DDS of every
+ * format), each after fuzz_load's leading byte; OUT_DIR/compare: pairs of
  * small images; OUT_DIR/provenance: the provenance texts of the golden
  * EXRs, in pairs; OUT_DIR/cli: the command lines of the docs' examples;
  * OUT_DIR/mesh: small models of each format fuzz_mesh reads. */
@@ -55,8 +57,8 @@ static void make_dir(const char *out, const char *name, char *dir, size_t cap) {
   }
 }
 
-/* fuzz_load's leading byte: extension index in the low 4 bits (its
- * EXTENSIONS), channel rule 0 (auto) above. */
+/* fuzz_load's leading byte: extension index in the low 5 bits (its
+ * EXTENSIONS; 15 .dds, 16 .vtf), channel rule 0 (auto) above. */
 static const char *const LOAD_EXT[16] = {".png", ".tga", ".tif", ".exr", ".jpg", ".bmp",
                                          ".pnm", ".gif", ".hdr", ".dpx", ".jp2", ".webp",
                                          ".sgi", ".ico", ".psd", ".dds"};
@@ -95,6 +97,54 @@ static bb_image pattern(int w, int h, int c) {
             ch == 3 ? 1.0f - v * 0.5f : v;
       }
   return img;
+}
+
+/* The engine textures: a VTF of every format bumpbake writes, in versions
+ * 7.2 and 7.5 (the resource dictionary), with and without mips; a DDS of
+ * every format (legacy header, and DX10 for the floats). 16 x 16, of 3 and
+ * 4 channels (a format refusing one is skipped). */
+static int texture_seeds(const char *dir, const char *out) {
+  static const bb_texture_format vtf[] = {BB_TEXTURE_FORMAT_BC1, BB_TEXTURE_FORMAT_BC3,
+                                          BB_TEXTURE_FORMAT_BGR8, BB_TEXTURE_FORMAT_BGRA8,
+                                          BB_TEXTURE_FORMAT_RGBA16F};
+  static const bb_texture_format dds[] = {
+      BB_TEXTURE_FORMAT_BC1,   BB_TEXTURE_FORMAT_BC3,     BB_TEXTURE_FORMAT_BC4,
+      BB_TEXTURE_FORMAT_BC5,   BB_TEXTURE_FORMAT_RGBA8,   BB_TEXTURE_FORMAT_RGBA16F,
+      BB_TEXTURE_FORMAT_RGBA32F};
+  char tmp[1024], name[64];
+  int written = 0;
+  for (int c = 1; c <= 4; c++) {
+    bb_image img = pattern(16, 16, c);
+    for (size_t f = 0; f < sizeof vtf / sizeof vtf[0]; f++)
+      for (int version = 2; version <= 5; version += 3)
+        for (int mips = 0; mips <= 1; mips++) {
+          bb_texture_options o;
+          bb_texture_options_init(&o);
+          o.format = vtf[f];
+          o.vtf_version = version;
+          o.mips = mips;
+          o.fast = 1;
+          o.description = "seed=1";
+          snprintf(tmp, sizeof tmp, "%s/seed.vtf", out);
+          snprintf(name, sizeof name, "texture%d_%s_7.%d%s.vtf", c,
+                   bb_texture_format_name(vtf[f]), version, mips ? "_mips" : "");
+          if (bb_texture_write(tmp, &img, &o, NULL) == BB_OK)
+            written += keep_seed(dir, name, tmp, 16);
+        }
+    for (size_t f = 0; f < sizeof dds / sizeof dds[0]; f++) {
+      bb_texture_options o;
+      bb_texture_options_init(&o);
+      o.format = dds[f];
+      o.map = dds[f] == BB_TEXTURE_FORMAT_BC5 ? BB_TEXTURE_MAP_NORMAL : BB_TEXTURE_MAP_PLAIN;
+      o.fast = 1;
+      snprintf(tmp, sizeof tmp, "%s/seed.dds", out);
+      snprintf(name, sizeof name, "texture%d_%s.dds", c, bb_texture_format_name(dds[f]));
+      if (bb_texture_write(tmp, &img, &o, NULL) == BB_OK)
+        written += keep_seed(dir, name, tmp, 15);
+    }
+    bb_image_free(&img);
+  }
+  return written;
 }
 
 static void load_seeds(const char *fixtures, const char *out) {
@@ -210,6 +260,7 @@ static void load_seeds(const char *fixtures, const char *out) {
       bb_animation_abort(a);
   }
   bb_image_free(&frame);
+  written += texture_seeds(dir, out);
   printf("make_seeds: %d load seeds (%d fixtures, and every format OpenImageIO writes)\n",
          written, n);
 }

@@ -163,6 +163,21 @@ typedef struct bb_error {
 /* Short name of a status ("ok", "bad argument", ...); never NULL. */
 const char *bb_status_name(bb_status status);
 
+/* Text from a file (a file name, a description, a VTF's KVD, a message
+ * holding them) made safe to show a person: s is written into out
+ * (capacity cap, always terminated, cut short when full) with every byte of
+ * what could drive a terminal or reorder what it shows escaped as \xNN:
+ * the C0 controls, DEL, the C1 controls U+0080..U+009F, the bidirectional
+ * controls (U+061C, U+200E, U+200F, U+202A..U+202E, U+2066..U+2069, with
+ * which "a\u202egnp.exe" shows as "aexe.png") and bytes that are not UTF-8.
+ * Returns out. The command line prints every line through it. */
+const char *bb_text_printable(const char *s, char *out, size_t cap);
+
+/* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
+ * the end of the string or bytes that are not UTF-8 (overlong forms,
+ * surrogates and code points past U+10FFFF included). */
+size_t bb_utf8_sequence(const char *s);
+
 typedef struct bb_image {
   int width;      /* texels */
   int height;     /* texels */
@@ -170,11 +185,16 @@ typedef struct bb_image {
   float *pixels;  /* width*height*channels floats, row 0 at the top */
 } bb_image;
 
-/* What this process may still allocate, in bytes: the smaller of what the
- * system has available (MemAvailable of /proc/meminfo, else its free pages)
- * and, under an RLIMIT_AS (ulimit -v), the room left below it (the limit
- * less the address space mapped now). *source (may be NULL) receives which
- * ("MemAvailable", "sysconf free pages", "RLIMIT_AS"). Bakes and reads
+/* What this process may still allocate, in bytes: the smallest of what
+ * the system has available (MemAvailable of /proc/meminfo, else its free
+ * pages); under a container's or service's memory limit, the room left
+ * below the limit of every cgroup from the process's own up to the top
+ * (cgroup v2's memory.max, v1's memory.limit_in_bytes; the limit less the
+ * group's usage, its reclaimable page cache not counted); and, under an
+ * RLIMIT_AS (ulimit -v), the room left below it (the limit less the
+ * address space mapped now). *source (may be NULL) receives which
+ * ("MemAvailable", "sysconf free pages", "cgroup memory.max", "cgroup
+ * memory.limit_in_bytes", "RLIMIT_AS"). Bakes and reads
  * check their estimate against it before allocating, so one too large is
  * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
  * the process; several processes started at once each see the same
@@ -253,6 +273,8 @@ const char *bb_staged_file_path(const bb_staged_file *staged);
  * images are written: through a temporary in path's directory, flushed,
  * synced and renamed into place, so path is either untouched or whole. The
  * temporary is removed on failure, and by bb_tempfiles_remove on a signal.
+ * A path that exists and is not a regular file (a device, a FIFO, a
+ * symbolic link, /dev/stdout) is refused, never renamed over.
  * Errors: BB_ERR_ARGUMENT (no path, or NULL data with a size),
  * BB_ERR_MEMORY, BB_ERR_IO ("PATH: cannot write: reason"). */
 bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err);
@@ -515,7 +537,9 @@ typedef struct bb_vmt_options {
  * written, made absolute against the working directory, "." and ".."
  * resolved, symbolic links not followed (the textures need not exist yet).
  * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path or
- * bumpmap; no materials_dir and no "materials" folder above the bump map;
+ * bumpmap; a path not ending in ".vmt" (any case), or naming the same file
+ * as the bump map or base texture (a hard link), which would be
+ * overwritten; no materials_dir and no "materials" folder above the bump map;
  * a texture that is not a .vtf or lies outside materials_dir; a '"' or
  * control character in a path, which a material cannot quote);
  * BB_ERR_MEMORY; BB_ERR_IO. */
@@ -540,7 +564,8 @@ typedef struct bb_image_info {
   int alpha_channel;    /* index of the alpha channel, or -1 */
   int is_float;         /* 1 when the file stores float or half samples */
   int bits_per_sample;  /* 8, 16, 32 (float or int), ... */
-  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ... */
+  char format_name[32]; /* OpenImageIO's format name: "png", "openexr", ...;
+                           "vtf", "dds" for bumpbake's own texture reader */
   char *description;    /* bumpbake provenance or ImageDescription, malloc'd, or NULL */
 } bb_image_info;
 
@@ -548,7 +573,16 @@ typedef struct bb_image_info {
 void bb_image_info_free(bb_image_info *info);
 
 /* Reads every channel of subimage 0 of any image OpenImageIO reads, as float
- * (integer formats scaled to [0, 1] as value / max code). info may be NULL.
+ * (integer formats scaled to [0, 1] as value / max code), and of the engine
+ * textures it does not read: Valve's VTF (a .vtf name, or a file starting
+ * with "VTF\0": versions 7.0 to 7.5, frame 0 and face 0 of a flat texture;
+ * DXT1/3/5, ATI1N/2N, the 8-, 16- and 32-bit texel formats; alpha when the
+ * flags EIGHTBITALPHA or ONEBITALPHA say the texture has one; format_name
+ * "vtf", description the provenance of a 7.3+ KVD resource) and DDS (a
+ * file starting with "DDS ", read by bumpbake too, as OpenImageIO 2.4's
+ * reader crashes on hostile headers: DXT1 to DXT5, BC4, BC5, masked RGB,
+ * luminance and alpha, and with a DX10 header RGBA16F, RGBA32F and more;
+ * format_name "dds"); blocks are decoded by libsquish. info may be NULL.
  * The file must be a regular one (a FIFO, a device or a directory is
  * refused at once) and is read through the descriptor that was checked.
  * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
@@ -579,7 +613,8 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
                             bb_image_info *info, int *level_count, bb_error *err);
 
-/* Number of subimages (frames) in an image file. */
+/* Number of subimages (frames) in an image file (1 for a VTF or DDS: the
+ * frame read). */
 bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
 
 /* ------------------------------------------------------ writing images */
@@ -1214,11 +1249,11 @@ typedef struct bb_bake_options {
                                  with bounce_albedo 0 it bounces with rho 1
                                  (the map's albedo as it is) */
   int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
-                                 times; 0 (default): until one more bounce
-                                 would move what any triangle reflects by
-                                 under 1e-2 of the sky's radiance, the rest
-                                 of the series then added as geometric (at
-                                 most BB_MAX_BOUNCES bounces) */
+                                 times; 0 (default): converged (each
+                                 triangle's light estimated from what it
+                                 blocks, one bounce gathered from that
+                                 estimate, the rest of the series then
+                                 added as geometric) */
   const bb_image *brightness; /* NULL (default), or a brightness map of the
                                  height's size: ssbump and weights are
                                  multiplied by its grey, the paper's
@@ -1260,7 +1295,8 @@ typedef struct bb_bake_result {
   bb_basis basis;          /* the basis of weights, ssbump and bent (the options') */
   int threads;             /* worker threads the stages ran on (o->trace.threads,
                               or the core count for 0) */
-  int bounces;             /* bounces of inter-reflection followed (0: none) */
+  int bounces;             /* passes of inter-reflection gathered: bounces,
+                              or 2 when converged (0: none) */
   double seconds_bounce;   /* the inter-reflection's part, after seconds_trace */
 } bb_bake_result;
 
@@ -1723,6 +1759,22 @@ void bb_render_options_init(bb_render_options *o);
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err);
 
+/* The picture a render of maps of width x height makes by o (with compare,
+ * bb_render_compare's four-panel grid), worked out from the sizes alone,
+ * before anything is read or allocated: *picture_width x *picture_height
+ * (the maps' size times o's tiles, then o's crop; may be NULL) and *bytes
+ * (may be NULL), the most memory the render takes beyond its maps: the
+ * picture as rendered, tiled and cropped (3 floats a texel), and the copy
+ * the encoder of output at depth makes of it (output NULL: none, the
+ * picture alone). bb_render
+ * refuses (BB_ERR_MEMORY) a picture whose estimate is over
+ * bb_memory_available before it allocates it. Errors: BB_ERR_SIZE (the
+ * tiled picture over BB_MAX_DIMENSION a side or BB_MAX_PIXELS in all),
+ * BB_ERR_ARGUMENT (a crop not inside it), each message saying so. */
+bb_status bb_render_estimate(int width, int height, const bb_render_options *o, int compare,
+                             const char *output, bb_depth depth, int *picture_width,
+                             int *picture_height, double *bytes, bb_error *err);
+
 /* "key=value" lines of every option of o that affects pixels (render_mode,
  * light, light_color, lightmap, specular, specular_strength, albedo_mode,
  * tile, crop; view and relief when used), for
@@ -1771,6 +1823,22 @@ typedef struct bb_render_sources {
  * names), albedo and albedo_hash, then bb_render_options_describe's, then
  * frame=F/N for an orbit's frame. malloc'd; NULL when out of memory. */
 char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o);
+
+/* A render of files checked from their headers before any pixel is read,
+ * as bakes are: the maps (files->maps) or the height baked first
+ * (files->height, with bake, its outputs set) and the albedo
+ * (files->albedo, may be NULL); the maps share one size (*width x *height,
+ * may be NULL, set as soon as the first header is read); the picture fits
+ * (bb_render_estimate, with output and depth); and reading them as
+ * floats (for a height, its read and the bake, as bb_bake estimates it),
+ * with the picture, fits in bb_memory_available. A file whose header is over the
+ * read's limits is left to the read to refuse. Errors: those of
+ * bb_image_read_info and bb_render_estimate, BB_ERR_ARGUMENT (maps of two
+ * sizes, naming the file), BB_ERR_MEMORY ("OUTPUT: a 32768 x 32768 render
+ * needs about 16.3 GiB of memory; 5.4 GiB is available (RLIMIT_AS)"). */
+bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_options *bake,
+                                const bb_render_options *o, int compare, const char *output,
+                                bb_depth depth, int *width, int *height, bb_error *err);
 
 /* The file of frame `frame` of an orbit of `frames` written to output:
  * OUT_007.png for OUT.png (four digits past 1000 frames). malloc'd; NULL
@@ -2071,7 +2139,12 @@ typedef struct bb_output_spec {
  * PATH"); BB_ERR_IO (an output that is one of the reads[0..read_count-1]
  * under any spelling, hard or symbolic link: "PATH: output would overwrite
  * the input file"; a directory that does not exist or is not one; an
- * output that is a directory). Messages start with the path. */
+ * output that exists and is not a regular file: a directory, a device, a
+ * FIFO, a socket or a symbolic link, which the rename that puts an output
+ * in place would replace: "PATH: cannot write: is a FIFO, not a regular
+ * file"). Messages start with the path. Every write (bb_file_write,
+ * bb_image_write and the staged writes) refuses such a name too, at its
+ * start and again just before its rename. */
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 
@@ -2397,10 +2470,25 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 /* Runs input i: skips it (BB_JOB_CURRENT) when its outputs are up to date
  * and the job is not forced, else reads, bakes and writes its maps all or
  * nothing (BB_JOB_BAKED), filling its report. progress (may be NULL)
- * follows the bake and may cancel it. Returns the report's status; a
+ * follows the bake and may cancel it; it is also called once with done 0
+ * and total 0 when the input has been read and its notes given, before the
+ * bake: a nonzero return there (a note the caller takes as an error)
+ * cancels with nothing baked or written. Returns the report's status; a
  * failure is the input's alone (the job goes on). Thread-compatible: one
  * job, one thread at a time. */
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
+
+/* Reads and bakes input i exactly as bb_job_run_item does, but writes
+ * nothing and keeps the maps: the job's kinds and those in `also`
+ * (BB_OUTPUT_BITs; the maps of the job's kinds are the bits
+ * bb_job_run_item would write) go to *result, to be freed with
+ * bb_bake_result_free. Fills the report's figures (size, source, threads,
+ * slices, seconds) and leaves its outcome alone; for a live view of an
+ * input that changes (bumpbake serve). progress (may be NULL) may cancel:
+ * BB_ERR_CANCELLED, nothing kept. err names the input. Thread-compatible
+ * as bb_job_run_item. */
+bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
+                           void *progress_user, bb_bake_result *result, bb_error *err);
 
 /* Called after each input of bb_job_run with its report. */
 typedef void (*bb_job_report_fn)(void *user, const bb_job_report *report);
@@ -2656,6 +2744,8 @@ typedef struct bb_command_options {
   int allow_outside_base;       /* program --allow-outside-base */
   int json, quiet;              /* how a command-line client prints */
   const char *scheduler;        /* bake --scheduler: a Dask scheduler's address */
+  int port;                     /* serve --port (0: any free one) */
+  const char *address;          /* serve --address: an IPv4 or IPv6 address, or NULL */
 } bb_command_options;
 
 /* ------------------------------------------------------------ commands */

@@ -23,7 +23,8 @@ typedef bb_status (*child_call_fn)(const char *path, bb_error *err);
 typedef struct child_outcome {
   bb_status status;
   int signal;       /* the child's killing signal, or 0 */
-  double seconds;   /* wall-clock time of the call */
+  double seconds;   /* wall-clock time of the call: to print, never to assert */
+  double cpu_seconds; /* the child's CPU time, user and system: to assert */
   long max_rss_kib; /* the child's peak resident memory */
   char message[600];
 } child_outcome;
@@ -77,6 +78,8 @@ static inline child_outcome child_call(child_call_fn fn, const char *path,
   clock_gettime(CLOCK_MONOTONIC, &t1);
   o.seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
   o.max_rss_kib = usage.ru_maxrss;
+  o.cpu_seconds = (double)usage.ru_utime.tv_sec + 1e-6 * (double)usage.ru_utime.tv_usec +
+                  (double)usage.ru_stime.tv_sec + 1e-6 * (double)usage.ru_stime.tv_usec;
   if (WIFSIGNALED(status))
     o.signal = WTERMSIG(status);
   else

@@ -24,7 +24,9 @@ typedef struct cli_result {
   char *out;        /* all of stdout, NUL-terminated */
   char *err;        /* all of stderr */
   long max_rss_kib; /* the child's peak resident memory */
-  double seconds;   /* wall-clock time of the run */
+  double seconds;   /* wall-clock time of the run: to print, never to assert
+                       (a busy machine stretches it; assert cpu_seconds) */
+  double cpu_seconds; /* the child's CPU time, user and system */
 } cli_result;
 
 static inline void cli_result_free(cli_result *r) {
@@ -111,6 +113,13 @@ static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
   return pid;
 }
 
+/* User plus system CPU time of a rusage: what a test may bound, as no
+ * load stretches it much (wall-clock time grows with every other job). */
+static inline double harness_cpu_seconds(const struct rusage *u) {
+  return (double)u->ru_utime.tv_sec + 1e-6 * (double)u->ru_utime.tv_usec +
+         (double)u->ru_stime.tv_sec + 1e-6 * (double)u->ru_stime.tv_usec;
+}
+
 static inline double harness_seconds_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -130,6 +139,7 @@ static inline cli_result harness_run_limited(const char *cwd, const run_limits *
   cli_result r;
   r.seconds = harness_seconds_now() - t0;
   r.max_rss_kib = usage.ru_maxrss;
+  r.cpu_seconds = harness_cpu_seconds(&usage);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.out = harness_slurp(out);
   r.err = harness_slurp(err);

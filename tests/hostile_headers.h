@@ -18,6 +18,62 @@ static inline int hostile_write(const char *path, const unsigned char *bytes, si
   return (fclose(f) == 0 && written == n) ? 0 : -1;
 }
 
+/* Appends a PNG chunk at out: length, type, data, CRC-32 of type and data.
+ * Returns its bytes. */
+static inline size_t hostile_png_chunk(unsigned char *out, const char *type,
+                                       const unsigned char *data, unsigned length) {
+  out[0] = (unsigned char)(length >> 24), out[1] = (unsigned char)(length >> 16);
+  out[2] = (unsigned char)(length >> 8), out[3] = (unsigned char)length;
+  memcpy(out + 4, type, 4);
+  if (length) memcpy(out + 8, data, length);
+  unsigned long crc = 0xffffffffUL;
+  for (unsigned i = 4; i < 8 + length; i++) {
+    crc ^= out[i];
+    for (int k = 0; k < 8; k++) crc = (crc >> 1) ^ (0xedb88320UL & (0UL - (crc & 1)));
+  }
+  crc ^= 0xffffffffUL;
+  for (unsigned i = 0; i < 4; i++) out[8 + length + i] = (unsigned char)(crc >> (24 - 8 * i));
+  return 12 + length;
+}
+
+/* A PNG of width x height, 8-bit RGB, whose image data is empty (57
+ * bytes): its header reads, its pixels do not. */
+static inline int write_png_header(const char *path, uint32_t width, uint32_t height) {
+  unsigned char b[128] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  unsigned char ihdr[13] = {0};
+  for (int i = 0; i < 4; i++) {
+    ihdr[i] = (unsigned char)(width >> (24 - 8 * i));
+    ihdr[4 + i] = (unsigned char)(height >> (24 - 8 * i));
+  }
+  ihdr[8] = 8, ihdr[9] = 2; /* 8-bit RGB */
+  size_t n = 8;
+  n += hostile_png_chunk(b + n, "IHDR", ihdr, sizeof ihdr);
+  n += hostile_png_chunk(b + n, "IDAT", NULL, 0);
+  n += hostile_png_chunk(b + n, "IEND", NULL, 0);
+  return hostile_write(path, b, n);
+}
+
+/* A DDS of width x height, 32-bit RGBA, with no data (128 bytes). */
+static inline int write_dds_header(const char *path, uint32_t width, uint32_t height) {
+  unsigned char b[128];
+  memset(b, 0, sizeof b);
+  memcpy(b, "DDS ", 4);
+  hostile_put32(b + 4, 124);        /* dwSize */
+  hostile_put32(b + 8, 0x100F);     /* CAPS | HEIGHT | WIDTH | PITCH | PIXELFORMAT */
+  hostile_put32(b + 12, height);
+  hostile_put32(b + 16, width);
+  hostile_put32(b + 20, width * 4); /* pitch */
+  hostile_put32(b + 76, 32);        /* the pixel format: its size, */
+  hostile_put32(b + 80, 0x41);      /* RGB | ALPHAPIXELS, */
+  hostile_put32(b + 88, 32);        /* 32 bits, and the masks */
+  hostile_put32(b + 92, 0x00FF0000);
+  hostile_put32(b + 96, 0x0000FF00);
+  hostile_put32(b + 100, 0x000000FF);
+  hostile_put32(b + 104, 0xFF000000);
+  hostile_put32(b + 108, 0x1000);   /* caps: a texture */
+  return hostile_write(path, b, sizeof b);
+}
+
 /* A progressive JPEG (SOF2) of one component declaring width x height: a
  * quantisation table, a one-code Huffman table and a DC scan of 8 zero
  * bytes (126 bytes). libjpeg buffers a progressive image whole, 2 bytes a

@@ -8,7 +8,8 @@
 # (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
 # 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy
 # against converged references (the peer at 16384 rays, and bumpbake's own
-# dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps,
+# dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps, at
+# 64, 256 and 1024 rays and at 6, 10 and 12 slices,
 # 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
 # (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
 # libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
@@ -20,7 +21,9 @@
 # machine (tools/bench_cluster.sh batch big: 200 maps of 512 x 512 as a CLI
 # batch, two half batches and bumpbake.dask.bake_files; one 8192 x 8192 map
 # in one process and split over 2 workers; `make bench-cluster` runs it
-# alone, with 16384 x 16384 too), then a summary table.
+# alone, with 16384 x 16384 too), 12 `bumpbake serve`'s save-to-pixels
+# latency in headless Chromium against the cold bake + render pair
+# (tools/bench_serve.py), then a summary table.
 # Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -43,6 +46,7 @@
 #                          tools/bench_bounce.sh)
 #   BENCH_CLUSTER=0        skip section 11 (about 15 minutes and 3 GB of
 #                          files in build/bench/cluster)
+#   BENCH_SERVE=0          skip section 12
 #   BENCH_SECTIONS="9 10"  run only the sections listed (default: every one);
 #                          the summary then has only their figures
 #
@@ -212,9 +216,10 @@ trace_bench() {
 # trace_row MAP THREADS: one line of the trace table.
 trace_row() {
   local j=$out/trace_${1}_t$2.json
-  printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %9s %6s\n' "$1" \
+  printf '%-6s %5s %4s %7s %-5s %9s %10s %9s %9s %8s %7s %9s %6s\n' "$1" \
     "$(json_num width "$j")" "$2" "$(calc "$(json_num trace_s "$j")")" \
     "($(json_num trace_runs "$j"))" "$(calc "$(json_num horizons_per_s "$j") / 1e6" %.2f)" \
+    "$(calc "$(json_num horizons_per_s "$j") / 1e6 / $2" %.2f)" \
     "$(calc "$(json_num march_horizons_per_s "$j") / 1e6" %.3f)" \
     "$(calc "$(json_num brute_horizons_per_s "$j") / 1e6" %.3f)" \
     "$(calc "$(json_num trace_over_brute "$j")" %.0f)" \
@@ -232,12 +237,13 @@ for m in "${maps[@]}"; do
   for t in 1 "$threads"; do trace_bench "$m" "$t"; done
 done
 echo
-printf '%-6s %5s %4s %7s %-5s %9s %9s %9s %8s %7s %9s %6s\n' map size thr trace_s runs \
-  Mhor/s march_M/s brute_M/s tr/brute horizon diff/reg MiB
+printf '%-6s %5s %4s %7s %-5s %9s %10s %9s %9s %8s %7s %9s %6s\n' map size thr trace_s runs \
+  Mhor/s Mhor/s/thr march_M/s brute_M/s tr/brute horizon diff/reg MiB
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do trace_row "$m" "$t"; done
 done
-echo "(trace_s: median over 'runs' runs; Mhor/s = texels x slices / trace_s; tr/brute = trace"
+echo "(trace_s: median over 'runs' runs; Mhor/s = texels x slices / trace_s, Mhor/s/thr the same"
+echo "per thread; tr/brute = trace"
 echo "horizons/s over brute-force horizons/s; horizon = share of positive horizons; diff/reg ="
 echo "march vs brute-force disagreements / region texels differing from the whole trace, both 0"
 echo "when the paths agree; MiB = peak RSS of the process)"
@@ -490,17 +496,22 @@ else
   echo "  dense   = build/tools/accuracy_ref: bb__ray_horizon in 2048 azimuths at every 4th texel"
   echo "            of every 4th row, integrated in elevation in closed form."
   echo "Each pair of columns is mean |error| and bias (signed mean of run - reference)."
+  echo "bbN = bumpbake at N rays (64, 256, 1024: 8, 16, 32 slices), bb_sA = bumpbake at A slices."
   printf '%-6s %-11s %-9s' map run reference
   for c in ao ss0 ss1 ss2; do printf ' %8s %9s' "$c|e|" "bias"; done
   echo
   while IFS=: read -r m path scale; do
     [ -n "$m" ] || continue
     runs=()
-    for n in 64 256 1024; do
-      "$bin" bake "$path" --scale "$scale" --rays "$n" --filter-radius 0 --normal-filter valve \
-        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_bb$n.ao.exr" \
-        --ssbump "$acc/${m}_bb$n.ss.exr" || { fail "bumpbake bake $path --rays $n"; continue; }
-      runs+=("bb$n")
+    # rays 64, 256, 1024 (8, 16, 32 slices) and the slice counts between
+    for setting in rays:64 rays:256 rays:1024 slices:6 slices:10 slices:12; do
+      option=${setting%%:*} n=${setting#*:}
+      r=bb$n
+      [ "$option" = slices ] && r=bb_s$n
+      "$bin" bake "$path" --scale "$scale" "--$option" "$n" --filter-radius 0 --normal-filter valve \
+        --bias "$bias" --threads "$threads" -q --ao "$acc/${m}_$r.ao.exr" \
+        --ssbump "$acc/${m}_$r.ss.exr" || { fail "bumpbake bake $path --$option $n"; continue; }
+      runs+=("$r")
     done
     if [ "$peer_ok" = 1 ]; then
       "$peer" "$path" --scale "$scale" --rays 256 --bias "$bias" --threads "$threads" \
@@ -664,6 +675,15 @@ if want 11; then
   fi
 fi
 
+if want 12; then
+  section "12. bumpbake serve: save-to-pixels in headless Chromium (tools/bench_serve.py)"
+  if [ "${BENCH_SERVE:-1}" = 0 ]; then
+    echo "skipped (BENCH_SERVE=0)"
+  elif ! /usr/bin/python3 tools/bench_serve.py "$bin" | tee "$out/serve.txt"; then
+    fail "tools/bench_serve.py failed"
+  fi
+fi
+
 # -------------------------------------------------------------- summary
 
 summary_row() { printf '%-46s %14s  %s\n' "$1" "$2" "${3:-}"; }
@@ -675,7 +695,7 @@ for m in "${maps[@]}"; do
   for t in 1 "$threads"; do
     j=$out/trace_${m}_t$t.json
     summary_row "bumpbake trace, $m, $t thr (s)" "$(calc "$(json_num trace_s "$j")")" \
-      "$(calc "$(json_num horizons_per_s "$j") / 1e6" %.1f) M horizons/s, runs $(json_num trace_runs "$j")"
+      "$(calc "$(json_num horizons_per_s "$j") / 1e6" %.1f) M horizons/s ($(calc "$(json_num horizons_per_s "$j") / 1e6 / $t" %.1f) a thread), runs $(json_num trace_runs "$j")"
   done
   j=$out/trace_${m}_t1.json
   summary_row "brute force, $m, 1 thr (M horizons/s)" \
@@ -729,6 +749,10 @@ if [ "$bounce_ok" = 1 ]; then
   summary_row "bounce: light added on the trench floor" \
     "$(awk '/trench, converged:/ { sub(",", "", $4); print $4; exit }' "$out/bounce.txt")" \
     "exact $(awk '/trench, converged:/ { print $6; exit }' "$out/bounce.txt"); accuracy in section 10"
+  # "rock06 512 (scale 64)   1.00s   2.00s   2.0x   2"
+  summary_row "bounce: --bounce 0.5 over a bake, rock06 512" \
+    "$(awk '/^rock06 512 / { print $7; exit }' "$out/bounce.txt")" \
+    "rivet panel 512: $(awk '/^rivet panel 512 / { print $8; exit }' "$out/bounce.txt"); goal under 3x"
 fi
 if [ "${#acc_rows[@]}" -gt 0 ]; then
   echo

@@ -23,10 +23,14 @@
 # 2. The trench (tests/bake/test_bounce.c): the light the bounce adds to ao
 #    on a trench's floor, against the exact 2D radiosity of its walls and
 #    floor (Hottel's crossed strings), rho 0.5, 1024 rays, one bounce and to
-#    convergence. Read from the test's own log (build/bb_tests).
-# 3. Time: the whole bake with and without --bounce 0.5 on the 256 x 256
-#    maps (medians of 3) and on rock06 1024 x 1024 at scale 128, 2 threads
-#    (BOUNCE_LARGE=0 skips the last).
+#    convergence; then the wall case, walls 8, 32 and 64 high. Read from the
+#    tests' own logs (build/bb_tests).
+# 3. Time: the whole bake with and without --bounce 0.5, and the ratio of
+#    the two (a bounce's cost over a bake's), 2 threads: the 256 x 256 maps
+#    (medians of 3); rock06 at 512 x 512 (scale 64) and the rivet panel's
+#    height (renderbumpflat of fixtures/rivet_panel.obj, tiled, at its own
+#    scale) at 256 and 512 (medians of 3); rock06 1024 x 1024 at scale 128
+#    (1 run; BOUNCE_LARGE=0 skips it).
 #
 # Environment: BOUNCE_PATHS (65536), BOUNCE_STRIDE (8), BOUNCE_LARGE (1).
 # Everything it writes goes into build/bench/bounce/. Exits 1 when a step
@@ -140,6 +144,11 @@ if [ -x "$tests" ]; then
     grep -o 'trench, [^:]*: added [0-9.]*, exact [0-9.]* ([+-][0-9.]*)' "$out/trench.log" |
       sed 's/^/  /'
     echo "  (floor 19 texels wide between walls 8 high, clamp mode, bias $bias; the test holds 0.002)"
+    BB_BIN="$bin" BB_FIXTURES=fixtures "$tests" --filter 'bounce/deep*' --verbose \
+      >"$out/wall.log" 2>&1 || fail "the wall case's test"
+    grep -o 'wall [0-9.]* high, x [0-9]*: added [^)]*)' "$out/wall.log" | sed 's/^/  /'
+    echo "  (the wall case: the same trench with walls 8, 32 and 64 high rising within one texel," \
+      "converged; x 10 the floor's centre, x 2 one texel from a wall's foot)"
   else
     sed 's/^/  | /' "$out/trench.log" | tail -n 5
     fail "the trench test"
@@ -149,7 +158,7 @@ else
 fi
 
 section "3. Time: the whole bake with and without --bounce 0.5 (2 threads)"
-printf '%-24s %10s %10s %10s %8s\n' map without with bounce bounces
+printf '%-24s %10s %10s %10s %8s\n' map without with ratio passes
 time_row() { # NAME PATH SCALE RUNS
   local name=$1 path=$2 scale=$3 runs=$4 i w=() b=() t0 n=0
   for ((i = 0; i < runs; i++)); do
@@ -173,10 +182,23 @@ while IFS=: read -r m path scale; do
   [ -n "$m" ] || continue
   time_row "$m 256 (scale $scale)" "$path" "$scale" 3 || fail "timing $m"
 done < <(maps)
+if rock=$(find_fixture rock06_height.png); then
+  [ -f "$out/rock512.png" ] && [ "$out/rock512.png" -nt "$rock" ] ||
+    oiiotool "$rock" --resize 512x512 -d uint16 -o "$out/rock512.png" || true
+  [ -f "$out/rock512.png" ] && { time_row "rock06 512 (scale 64)" "$out/rock512.png" 64 3 ||
+    fail "timing rock06 512"; }
+fi
+for n in 256 512; do
+  report=$("$bin" renderbumpflat -size "$n" "$n" fixtures/rivet_panel.obj --rect 0 0 1 1 --tile \
+    -o "$out/rivet$n.tga" --height "$out/rivet$n.png" 2>&1) || { fail "renderbumpflat $n"; continue; }
+  scale=$(printf '%s\n' "$report" | sed -n 's/^height scale \([^ ]*\) .*/\1/p')
+  time_row "rivet panel $n (scale $scale)" "$out/rivet$n.png" "$scale" 3 || fail "timing rivet $n"
+done
 if [ "${BOUNCE_LARGE:-1}" != 0 ]; then
   rock=$(find_fixture rock06_height.png) &&
     { time_row "rock06 1024 (scale 128)" "$rock" 128 1 || fail "timing rock06"; }
 fi
-echo "(the bake's defaults otherwise: smoothing radius 10, the vertex normal, 256 rays;" \
-  "medians of 3 runs on 256 x 256, 1 run on 1024 x 1024)"
+echo "(ratio: with over without, a bounce's cost over a bake's; passes: of the bounce, 2 when" \
+  "converged; the bake's defaults otherwise: smoothing radius 10, the vertex normal, 256 rays;" \
+  "medians of 3 runs, 1 run on 1024 x 1024)"
 exit "$status"

@@ -5,7 +5,7 @@
  *               [--bias B] [--filter-radius R] [--normal-filter NAME]
  *               [--clamp] [--threads T]
  *               [--exact N] [--surface-exact N] [--far N] [--surface-far N] [--lift L]
- *               [--tolerance T] [--surface-slices N]
+ *               [--estimate-passes N] [--surface-slices N]
  *
  * Writes PREFIX.ao.exr and PREFIX.ss.exr. Without the settings of the last
  * line it is bb_bake with bounce_albedo = R (the library's own defaults,
@@ -36,7 +36,7 @@ static int usage(const char *reason) {
           "                   [--filter-radius R] [--normal-filter NAME] [--clamp] [--threads T]\n"
           "                   [--exact N] [--surface-exact N] [--far N] [--surface-far N]\n"
           "                   [--lift L]\n"
-          "                   [--tolerance T] [--surface-slices N]\n",
+          "                   [--estimate-passes N] [--surface-slices N]\n",
           reason);
   return 2;
 }
@@ -95,7 +95,7 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--far")) a->bounce.far_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-far")) a->bounce.surface_far_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--lift")) a->bounce.lift = v, a->inner = 1;
-    else if (!strcmp(o, "--tolerance")) a->bounce.tolerance = v, a->inner = 1;
+    else if (!strcmp(o, "--estimate-passes")) a->bounce.estimate_passes = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-slices")) a->bounce.surface_slices = (int)v, a->inner = 1;
     else return usage("unknown option");
   }

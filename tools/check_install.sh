@@ -4,15 +4,19 @@
 #
 #   1. installs into a temporary prefix and checks the files and symlinks;
 #   2. builds tests/install_client.c with `pkg-config --cflags --libs
-#      bumpbake` (shared) and with `pkg-config --static --libs` against
-#      libbumpbake.a, runs both and checks they print "ok";
+#      bumpbake` (shared; nothing else: the prefix's rpath must come from
+#      bumpbake.pc, and --cflags must be the include directory alone) and
+#      with `pkg-config --static --libs` against libbumpbake.a, runs both
+#      and checks they print "ok";
 #   3. checks libbumpbake.so exports exactly the functions of bumpbake.h;
 #   4. checks the man page renders without warnings and names every command
 #      and option the installed bumpbake's --help lists;
 #   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths;
 #   6. the installed Python package imports and bakes with PYTHONPATH set to
 #      its dist-packages and nothing else (no BUMPBAKE_LIBRARY, no
-#      PKG_CONFIG_PATH): it loads the installed library by itself.
+#      PKG_CONFIG_PATH): it loads the installed library by itself; the
+#      installed program's `bake --scheduler` finds it with no PYTHONPATH,
+#      and imports nothing from the working directory.
 #
 # Environment: MAKE (make), DEBUG (0), BUILD (build), CC (cc), PYTHON
 # (/usr/bin/python3). A DEBUG=1 library is sanitized, so the clients are
@@ -62,15 +66,21 @@ libs=$(pkg-config --libs bumpbake)
 libdir=$(pkg-config --variable=libdir bumpbake)
 [ "$(pkg-config --modversion bumpbake)" = "${version#bumpbake }" ] ||
   fail "bumpbake.pc's version $(pkg-config --modversion bumpbake) is not ${version#bumpbake }"
-# The client itself uses libm (exp, sqrt); pkg-config's output is split on purpose.
+# bumpbake.h needs no other header: --cflags is the include directory alone
+# (Requires.private once added Debian's libsquish.pc's stray -I/include).
+[ "$(echo $cflags)" = "-I$prefix/include" ] || # (echo: pkg-config ends with a space)
+  fail "pkg-config --cflags bumpbake is '$cflags', not -I$prefix/include"
+# The client itself uses libm (exp, sqrt); pkg-config's output is split on
+# purpose. Nothing but pkg-config's flags: the temporary prefix is not one
+# the loader searches, so the client runs only if Libs carries its rpath.
 # shellcheck disable=SC2086
 "$cc" "${client_flags[@]}" $cflags tests/install_client.c -o "$tmp/client" $libs \
-  -Wl,-rpath,"$libdir" -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
+  -lm || fail "cc \$(pkg-config --cflags --libs bumpbake) failed"
 if [ -x "$tmp/client" ]; then
   # (ldd's output is kept first: grep -q quitting early would fail the pipe)
-  loaded=$(ldd "$tmp/client")
+  loaded=$(env -u LD_LIBRARY_PATH ldd "$tmp/client")
   grep -q "$soname => $libdir/" <<<"$loaded" || fail "the client does not load $libdir/$soname"
-  "$tmp/client" >"$tmp/client.out" 2>&1 || true
+  env -u LD_LIBRARY_PATH "$tmp/client" >"$tmp/client.out" 2>&1 || true
   if [ "$(tail -n1 "$tmp/client.out")" = ok ]; then
     pass "client built with pkg-config --cflags --libs bumpbake: ok"
   else
@@ -143,6 +153,8 @@ stage=$tmp/stage
 if [ -f "$stage/usr/lib/pkgconfig/bumpbake.pc" ] && [ -e "$stage/usr/bin/bumpbake" ] &&
   grep -qx 'prefix=/usr' "$stage/usr/lib/pkgconfig/bumpbake.pc"; then
   pass "staged install (DESTDIR, PREFIX=/usr) lands under DESTDIR with /usr paths"
+  ! grep -q '^Libs:.*rpath' "$stage/usr/lib/pkgconfig/bumpbake.pc" ||
+    fail "bumpbake.pc for PREFIX=/usr adds an rpath (the loader searches /usr/lib)"
 else
   fail "staged install: files or bumpbake.pc's prefix not as expected"
 fi
@@ -191,6 +203,23 @@ print("ok", bumpbake.library_path)
     else
       echo "$out" >&2
       fail "the installed bumpbake.dask does not run with PYTHONPATH alone"
+    fi
+    # `bumpbake bake --scheduler` from the installed program: its Python
+    # finds the package where make install put it (recorded in the
+    # program), with no PYTHONPATH, and imports nothing from the directory
+    # it bakes in (a bumpbake/ there would run).
+    hostile=$tmp/hostile
+    mkdir -p "$hostile/bumpbake"
+    cp fixtures/rock06_128.png "$hostile/h.png"
+    printf 'open(%s, "w").write("ran")\n' "'$hostile/RAN'" >"$hostile/bumpbake/__init__.py"
+    out=$(cd "$hostile" && env -i PATH=/usr/bin:/bin "${preload[@]}" "$prefix/bin/bumpbake" \
+      bake h.png --scale 8 --normal n.png --scheduler not-an-address 2>&1) || true
+    if [ -e "$hostile/RAN" ]; then
+      fail "bumpbake bake --scheduler imported bumpbake/ from the working directory"
+    elif grep -q "cannot import bumpbake.dask" <<<"$out"; then
+      fail "the installed bumpbake bake --scheduler does not find its package: $out"
+    else
+      pass "installed bumpbake bake --scheduler: finds the package in $site, nothing from the working directory"
     fi
   fi
 fi

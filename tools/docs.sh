@@ -2,7 +2,7 @@
 # docs.sh BIN: regenerates the pictures of README.md and docs/ (small PNGs,
 # kept in git): the contact sheet of the rock fixture, the paper's
 # four-panel comparison on a 128 x 128 window where self-shadowing shows,
-# and the azimuth wedges of docs/accuracy.md. Run by `make docs`, never by
+# the azimuth wedges of docs/accuracy.md and the page of `bumpbake serve`. Run by `make docs`, never by
 # `make test`.
 set -euo pipefail
 
@@ -41,4 +41,6 @@ for slices in 16 32; do
 done
 oiiotool "${panels[@]}" build/docs/wedges_stretched_16.png build/docs/wedges_stretched_32.png \
   --mosaic:pad=4 2x2 -d uint8 -o docs/azimuth_wedges.png
-ls -l docs/rock06_sheet.png docs/rock06_compare.png docs/azimuth_wedges.png
+# The page of `bumpbake serve` (docs/commands/serve.md), in headless Chromium.
+/usr/bin/python3 tools/serve_screenshot.py "$bin" docs/serve.png
+ls -l docs/rock06_sheet.png docs/rock06_compare.png docs/azimuth_wedges.png docs/serve.png

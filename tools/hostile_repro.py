@@ -120,6 +120,23 @@ def gif_screen(path, w, h):
     write(path, b)
 
 
+def vtf_header(path, w, h, fmt, mips):
+    """A VTF 7.2 header alone (80 bytes, no low-resolution image) declaring
+    w x h texels of Valve's format code fmt in `mips` levels."""
+    b = b"VTF\x00" + struct.pack("<III", 7, 2, 80) + struct.pack("<HHIHH", int(w), int(h), 0, 1, 0)
+    b += b"\x00" * 4 + struct.pack("<fff", 0.5, 0.5, 0.5) + b"\x00" * 4 + struct.pack("<f", 1.0)
+    b += struct.pack("<IBIBBH", int(fmt), int(mips), 0xFFFFFFFF, 0, 0, 1)
+    write(path, b + b"\x00" * (80 - len(b)))
+
+
+def dds_mips(path, mips):
+    """A 16 x 16 DXT1 DDS (legacy header) declaring `mips` mip levels, with
+    the top level's blocks."""
+    b = b"DDS " + struct.pack("<7I", 124, 0x000A1007, 16, 16, 128, 0, int(mips)) + b"\x00" * 44
+    b += struct.pack("<II4s5I", 32, 4, b"DXT1", 0, 0, 0, 0, 0) + struct.pack("<5I", 0x401008, 0, 0, 0, 0)
+    write(path, b + b"\x00" * 128)
+
+
 def png_chunk(kind, data):
     return struct.pack(">I", len(data)) + kind + data + struct.pack(
         ">I", zlib.crc32(kind + data) & 0xffffffff)
@@ -152,12 +169,26 @@ def nan_tiff(path):
     write(path, b + b"\x00" * 4 + pixels)
 
 
+def flat_png(path, width, height, channels="1", value="128"):
+    """A flat 8-bit PNG of width x height (1 grey or 3 RGB channels), every
+    sample value: a 4096 x 4096 one is 22 KB, an 8192 x 8192 RGB one 200 KB."""
+    w, h, c = int(width), int(height), int(channels)
+    row = b"\x00" + bytes([int(value)]) * (w * c)
+    z = zlib.compressobj(6)
+    data = b"".join(z.compress(row) for _ in range(h)) + z.flush()
+    colour = {1: 0, 3: 2}[c]
+    write(path, b"\x89PNG\r\n\x1a\n" +
+          png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0)) +
+          png_chunk(b"IDAT", data) + png_chunk(b"IEND", b""))
+
+
 MAKERS = {
     "gltf_uri": gltf_uri, "obj_mtllib": obj_mtllib, "deep_gltf": deep_gltf,
     "deep_dae": deep_dae, "deep_json": deep_json, "faces_obj": faces_obj,
     "flat_obj": flat_obj, "progressive_jpeg": progressive_jpeg, "tiled_tiff": tiled_tiff,
     "exr_attribute": exr_attribute, "gif_screen": gif_screen, "png_desc": png_desc,
-    "nan_tiff": nan_tiff,
+    "nan_tiff": nan_tiff, "vtf_header": vtf_header, "dds_mips": dds_mips,
+    "flat_png": flat_png,
 }
 
 
@@ -230,7 +261,10 @@ def snap_diff(top, path, allow):
 # ------------------------------------------------------------------ checks
 
 
-CONTROL = re.compile(rb"[\x00-\x08\x0b-\x1f\x7f]|\xc2[\x80-\x9f]")
+# C0 but tab and newline, DEL, C1, and the bidirectional controls (U+061C,
+# U+200E, U+200F, U+202A..U+202E, U+2066..U+2069)
+CONTROL = re.compile(rb"[\x00-\x08\x0b-\x1f\x7f]|\xc2[\x80-\x9f]|\xd8\x9c|"
+                     rb"\xe2\x80[\x8e\x8f\xaa-\xae]|\xe2\x81[\xa6-\xa9]")
 
 
 def control(paths):

@@ -6,7 +6,8 @@ import os
 
 import numpy as np
 
-from ._common import _argument_error, _array, _check, _ffi, _Image, _int, _lib, _parse, _text
+from ._common import (_argument_error, _array, _check, _ffi, _Image, _int, _lib, _parse, _path,
+                      _text)
 
 
 def _output_kind_table():
@@ -67,7 +68,7 @@ def _basis(spec):
     out = _ffi.new("bb_basis *")
     err = _ffi.new("bb_error *")
     if isinstance(spec, (str, bytes, os.PathLike)):
-        spelled = os.fsencode(spec)
+        spelled = _path(spec, "basis")
         from_file = _ffi.new("int *")
         _check(_lib.bb_basis_resolve(spelled, out, from_file, err), err)
         return out, spelled if from_file[0] else None

@@ -10,7 +10,11 @@ read.
 import os
 import warnings
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError as e:  # one line naming what to install, not a bare ImportError
+    raise ModuleNotFoundError(f"bumpbake needs numpy ({e}): install Debian's python3-numpy",
+                              name=e.name) from None
 
 from . import _library
 
@@ -97,11 +101,25 @@ def _text(value):
     return _ffi.string(value).decode("utf-8", "surrogateescape")
 
 
+def _c_bytes(value, what):
+    """value (bytes) for a C string: an embedded NUL, where C would end it
+    (a.png\\0.exr read as a.png), is ValueError, as os gives."""
+    if b"\0" in value:
+        raise ValueError(f"{what}: embedded null byte")
+    return value
+
+
+def _c_text(value, what):
+    """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes)."""
+    return _c_bytes(value.encode(), what)
+
+
 def _path(value, what="path"):
-    """A path (str, bytes or os.PathLike) as the bytes the library opens."""
+    """A path (str, bytes or os.PathLike) as the bytes the library opens;
+    ValueError for an embedded NUL."""
     if not isinstance(value, (str, bytes, os.PathLike)):
         raise TypeError(f"{what} must be a path (got {value!r})")
-    return os.fsencode(value)
+    return _c_bytes(os.fsencode(value), what)
 
 
 def _int(command, name, value):
@@ -120,7 +138,7 @@ def _parse(parser, ctype, text, what):
         raise TypeError(f"{what} must be a str (got {text!r})")
     out = _ffi.new(f"{ctype} *")
     err = _ffi.new("bb_error *")
-    _check(getattr(_lib, parser)(text.encode(), out, err), err)
+    _check(getattr(_lib, parser)(_c_text(text, what), out, err), err)
     return out[0]
 
 
@@ -154,7 +172,7 @@ def _vtf_version(command, value):
     reads it (bb_vtf_version_parse)."""
     out = _ffi.new("int *")
     err = _ffi.new("bb_error *")
-    if _lib.bb_vtf_version_parse(_vtf_text(command, "vtf_version", value).encode(), out,
+    if _lib.bb_vtf_version_parse(_c_text(_vtf_text(command, "vtf_version", value), "vtf_version"), out,
                                  err) != _lib.BB_OK:
         raise _argument_error(f"{command}: vtf_version: {_text(err.message)}")
     return out[0]
@@ -167,7 +185,7 @@ def _vtf_flags(command, value):
         raise TypeError(f"{command}: vtf_flags must be an int or a str (got {value!r})")
     out = _ffi.new("uint32_t *")
     err = _ffi.new("bb_error *")
-    if _lib.bb_vtf_flags_parse(_vtf_text(command, "vtf_flags", value).encode(), out,
+    if _lib.bb_vtf_flags_parse(_c_text(_vtf_text(command, "vtf_flags", value), "vtf_flags"), out,
                                err) != _lib.BB_OK:
         raise _argument_error(f"{command}: vtf_flags: {_text(err.message)}")
     return out[0]

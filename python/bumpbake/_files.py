@@ -7,8 +7,8 @@ import os
 import typing
 
 from ._bake import _KINDS
-from ._common import (_Image, _argument_error, _array, _check, _depth, _ffi, _int, _lib,
-                      _path, _text, _texture_options)
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi, _int,
+                      _lib, _path, _text, _texture_options)
 
 
 def read(path):
@@ -204,8 +204,9 @@ def write(path, array, *, kind="colour", depth=None, mips=False, description=Non
     rng = _lib.BB_RANGE_SIGNED if signed else _lib.BB_RANGE_UNIT
     p = _path(path)
     err = _ffi.new("bb_error *")
-    c_path, c_kind = _ffi.new("char[]", p), _ffi.new("char[]", kind.encode())
-    c_text = _ffi.new("char[]", description.encode()) if description is not None else _ffi.NULL
+    c_path, c_kind = _ffi.new("char[]", p), _ffi.new("char[]", _c_text(kind, "kind"))
+    c_text = (_ffi.new("char[]", _c_text(description, "description")) if description is not None
+              else _ffi.NULL)
     spec = _ffi.new("bb_output_spec *", {"path": c_path, "kind": c_kind,
                                          "channels": src.image.channels, "depth": d,
                                          "mips": int(bool(mips)), "width": src.image.width,
@@ -224,8 +225,9 @@ def write_vmt(path, bumpmap, *, materials=None, basetexture=None, ssbump=True):
     "$basetexture" when given, each texture (a .vtf path; it need not exist
     yet) named relative to materials, the game's materials folder (None:
     the nearest folder named "materials" above bumpmap), without ".vtf".
-    Written all or nothing. Raises ArgumentError (a texture that is not a
-    .vtf or lies outside materials, no materials folder), Error when it
+    Written all or nothing. Raises ArgumentError (a path not ending in
+    .vmt, or another name of a texture it names; a texture that is not a
+    .vtf or lies outside materials; no materials folder), Error when it
     cannot be written."""
     strings = [_ffi.new("char[]", _path(v, what)) if v is not None else _ffi.NULL
                for v, what in ((path, "path"), (materials, "materials"),

@@ -6,9 +6,9 @@ import os
 import typing
 
 from ._bake import BAKE_PARAMETERS, OUTPUTS, _bake_options, _channel, _kinds_mask
-from ._common import (_argument_error, _check, _check_notes, _depth, _dispatch_notes,
-                      _exception, _ffi, _lib, _message, _note_text, _path, _status_name, _text,
-                      _texture_options)
+from ._common import (_argument_error, _c_bytes, _c_text, _check, _check_notes, _depth,
+                      _dispatch_notes, _exception, _ffi, _lib, _message, _note_text, _path,
+                      _status_name, _text, _texture_options)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -115,7 +115,8 @@ class BakeJob:
         def c(value):
             if value is None:
                 return _ffi.NULL
-            s = _ffi.new("char[]", value if isinstance(value, bytes) else value.encode())
+            s = _ffi.new("char[]", _c_bytes(value, "a path") if isinstance(value, bytes)
+                         else _c_text(value, "text"))
             keep.append(s)
             return s
 
@@ -170,9 +171,15 @@ class BakeJob:
                     raise _argument_error(f"bake: lit must be (azimuth, elevation) in degrees "
                                           f"(got {a['lit']!r})") from None
                 o.slope_lit = 1
-        # Notes are kept during a call and handed out after it, on the
-        # caller's terms: a callback cannot raise through C.
+        # Notes are handed out as they come, on the caller's terms (a
+        # warning, a callable), and kept for the report. One the caller
+        # turns into an exception cannot raise through C: it is kept, the
+        # progress callback cancels the bake at its next call (the library
+        # makes one as soon as the input's notes are given, before baking),
+        # and it is raised once the library has stopped.
         self._pending = []
+        self._note_raised = []
+        self._note_stacklevel = None
         self._note = _ffi.callback("bb_note_fn", self._on_note)
         o.note = self._note
         self._options = o
@@ -187,7 +194,15 @@ class BakeJob:
         self._notes = [[] for _ in range(self._count)]
 
     def _on_note(self, user, path, text):
-        self._pending.append(_note_text(_text(path), _text(text)))
+        line = _note_text(_text(path), _text(text))
+        self._pending.append(line)
+        if self._note_stacklevel is None or self._note_raised:
+            return
+        try:
+            # (frames: _dispatch_notes, this callback, then _run's caller's)
+            _dispatch_notes([line], self._notes_policy, self._note_stacklevel + 1)
+        except BaseException as e:  # noqa: B036: raised again after the call
+            self._note_raised.append(e)
 
     # ------------------------------------------------------------ pickling
 
@@ -262,7 +277,9 @@ class BakeJob:
         raised = []
 
         def on_progress(user, done, total):
-            if progress is not None:
+            if self._note_raised:
+                return 1  # a note the caller made an error: nothing is written
+            if progress is not None and total > 0:  # (0, 0): the notes' checkpoint
                 return 1 if progress(done, total) else 0
             return 0
 
@@ -274,15 +291,19 @@ class BakeJob:
         # callback (it runs on the calling thread), which cancels the bake.
         cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
         self._pending = []
+        self._note_raised = []
+        self._note_stacklevel = stacklevel
         self._status[i] = None
         try:
             _lib.bb_job_run_item(self._job, i, cb, _ffi.NULL)  # without the GIL
         finally:
             notes, self._pending = self._pending, []
             self._notes[i] = notes
+            self._note_stacklevel = None
+        if self._note_raised:
+            raise self._note_raised[0]
         if raised:
             raise raised[0]
-        _dispatch_notes(notes, self._notes_policy, stacklevel)
         return self.report(i)
 
     def run_all(self, progress=None):

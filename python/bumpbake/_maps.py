@@ -2,8 +2,8 @@
 DOOM 3 image programs and mip chains, each one call of the library."""
 
 from ._bake import _basis, _normal_y_up
-from ._common import (_Image, _argument_error, _array, _check, _depth, _ffi, _lib, _parse,
-                      _path, _take)
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi, _lib,
+                      _parse, _path, _take)
 from ._files import _signed
 
 
@@ -137,7 +137,7 @@ def program(text, base=None, allow_outside_base=False):
         raise TypeError(f"program: text must be a str (got {text!r})")
     err = _ffi.new("bb_error *")
     prog = _ffi.new("bb_program **")
-    _check(_lib.bb_program_parse(text.encode(), prog, err), err)
+    _check(_lib.bb_program_parse(_c_text(text, "program"), prog, err), err)
     prog = _ffi.gc(prog[0], _lib.bb_program_free)
     o = _ffi.new("bb_program_options *")
     _lib.bb_program_options_init(o)

@@ -151,7 +151,7 @@ def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch
     def chunks(dask_scheduler):
         return [k for k in dask_scheduler.tasks if str(k).startswith("bumpbake-chunk-")]
 
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 120  # a hang guard, not a bound on time
     while client.run_on_scheduler(chunks):
         assert time.monotonic() < deadline, client.run_on_scheduler(chunks)
         time.sleep(0.05)
@@ -163,7 +163,7 @@ def test_a_batch_over_leaves_nothing_for_dask_to_run_again(tmp_path, monkeypatch
     run = threading.Thread(target=lambda: done.append(_batch._bake_chunk(
         os.getcwd(), ["heights/h00.png"], [0], args, _batch._Stop("bumpbake-stop-gone"), True)))
     run.start()
-    run.join(timeout=20)
+    run.join(timeout=120)  # a hang guard
     assert done == [[(0, None)]], "a chunk of a batch that is over waits or bakes"
 
 
@@ -291,6 +291,31 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     assert not os.path.exists("b")
 
 
+def test_the_cli_with_a_scheduler_imports_nothing_from_the_working_directory(
+        tmp_path, monkeypatch, client, cli):
+    """`python3 -m bumpbake.dask` put the working directory first on
+    sys.path: a numpy.py, distributed/ or bumpbake/ in the directory being
+    baked ran (a stub exiting 0 gave exit 0 and nothing written). Python now
+    runs isolated, with the package's own directory on its path alone; an
+    empty PYTHONPATH entry (the current directory, to Python) changes
+    nothing."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1)
+    stub = f"open({str(tmp_path / 'RAN')!r}, 'a').write(__name__ + '\\n')\nraise SystemExit(0)\n"
+    for name in ("numpy.py", "distributed/__init__.py", "bumpbake/__init__.py",
+                 "bumpbake/dask/__init__.py", "runpy.py"):
+        os.makedirs(os.path.dirname(name) or ".", exist_ok=True)
+        with open(name, "w") as f:
+            f.write(stub)
+    monkeypatch.setenv("PYTHONPATH", ":")
+    monkeypatch.setenv("BUMPBAKE_PYTHONPATH", "::")
+    out = cli("bake", "h00.png", "--scale", "16", "--slices", "4", "--normal", "n.png",
+              "--scheduler", client.scheduler.address, check=False)
+    assert not os.path.exists("RAN"), open("RAN").read()
+    assert out.returncode == 0, out.stderr
+    assert os.path.exists("n.png")
+
+
 def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, client, cli):
     """Ctrl-C on `bake MAP -o PREFIX --scheduler ADDRESS` while the slices
     are out: a running task cannot be killed, so the driver is told (a
@@ -306,13 +331,13 @@ def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, cl
             dask_worker.active_threads.values())).values() for k in keys
             if "bumpbake-" in str(k)]
 
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 180  # a hang guard, not a bound on time
     while not any("bumpbake-horizons" in str(k) for k in running()):
         assert bake.poll() is None, bake.communicate()
         assert time.monotonic() < deadline, "the slices never went out"
         time.sleep(0.02)
     bake.send_signal(signal.SIGINT)
-    _, err = bake.communicate(timeout=60)
+    _, err = bake.communicate(timeout=180)
     assert bake.returncode == 130, err
     while running():
         assert time.monotonic() < deadline, f"still running: {running()}"

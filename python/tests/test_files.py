@@ -130,3 +130,44 @@ def test_write_stores_codes_as_bake_does(tmp_path):
         bumpbake.write(tmp_path / "k.png", n, kind="normals")
     with pytest.raises(bumpbake.ArgumentError, match="depth must be one of"):
         bumpbake.write(tmp_path / "k.png", n, depth=32)
+
+
+def test_an_embedded_nul_in_a_path_is_a_value_error(tmp_path, monkeypatch):
+    """write("t.png\\0.exr", a) wrote t.png and read("h.png\\0junk") read
+    h.png: C ends a string at its NUL. Every path the package hands to C
+    (and every text: a program, a description) refuses one, as os does,
+    and nothing is written."""
+    monkeypatch.chdir(tmp_path)
+    bumpbake.write("h.png", RAMP, kind="height", depth=16)
+    os.makedirs("materials")
+    calls = {
+        "read": lambda: bumpbake.read("h.png\0junk"),
+        "read bytes": lambda: bumpbake.read(b"h.png\0junk"),
+        "info": lambda: bumpbake.info("h.png\0junk"),
+        "file_hash": lambda: bumpbake.file_hash("h.png\0junk"),
+        "write": lambda: bumpbake.write("t.png\0.exr", RAMP),
+        "write description": lambda: bumpbake.write("d.png", RAMP, description="a\0b"),
+        "write_vmt": lambda: bumpbake.write_vmt("materials/m.vmt\0.txt", "materials/s.vtf"),
+        "write_vmt bumpmap": lambda: bumpbake.write_vmt("materials/m.vmt",
+                                                        "materials/s.vtf\0x.vtf"),
+        "compare": lambda: bumpbake.compare("h.png", "h.png\0junk"),
+        "compare diff": lambda: bumpbake.compare("h.png", "h.png", diff="d.png\0.exr"),
+        "bake_file input": lambda: bumpbake.bake_file("h.png\0junk", {"normal": "n.png"},
+                                                      scale=8),
+        "bake_file output": lambda: bumpbake.bake_file("h.png", {"normal": "n.png\0.exr"},
+                                                       scale=8),
+        "bake_file depfile": lambda: bumpbake.bake_file("h.png", {"normal": "n.png"},
+                                                        depfile="d\0.d", scale=8),
+        "bake_files out_dir": lambda: bumpbake.bake_files(["h.png"], "out\0dir", scale=8),
+        "basis file": lambda: bumpbake.bake(RAMP, 8, basis="lights.txt\0junk"),
+        "program": lambda: bumpbake.program("invertColor(h.png\0junk)"),
+        "program base": lambda: bumpbake.program("invertColor(h.png)", base=".\0junk"),
+        "render": lambda: bumpbake.render(normal="h.png\0junk", mode="normal"),
+        "renderbumpflat": lambda: bumpbake.renderbumpflat("m.obj\0junk"),
+    }
+    for name, call in calls.items():
+        with pytest.raises(ValueError, match="embedded null byte"):
+            call()
+            pytest.fail(f"{name}: no ValueError")
+    assert sorted(os.listdir(".")) == ["h.png", "materials"]
+    assert os.listdir("materials") == []

@@ -190,6 +190,38 @@ def test_notes_warn_by_default_and_stay_in_the_report(tmp_path):
     assert len(report.notes) == 1
 
 
+def test_a_note_made_an_error_writes_nothing(tmp_path):
+    """With warnings.simplefilter("error", NoteWarning), or a notes callback
+    that raises, bake_file raised after its files were written. A note made
+    an error now stops the bake before anything is baked or written, as an
+    exception in a progress callback does, and is raised as it was."""
+    import warnings
+    src = tmp_path / "rgba.png"
+    colour_with_height_in_alpha(src)
+    outputs = {"normal": tmp_path / "n.png", "ao": tmp_path / "ao.png"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", bumpbake.NoteWarning)
+        with pytest.raises(bumpbake.NoteWarning, match="rgba.png: .*alpha"):
+            bumpbake.bake_file(src, outputs, scale=4, depfile=tmp_path / "d.d")
+
+    def refuse(line):
+        raise RuntimeError(f"no notes here: {line}")
+
+    with pytest.raises(RuntimeError, match="no notes here: .*rgba.png"):
+        bumpbake.bake_file(src, outputs, scale=4, notes=refuse)
+    job = bumpbake.BakeJob([src], tmp_path / "out", scale=4, notes=refuse)
+    with pytest.raises(RuntimeError):
+        job.run_all()
+    assert job.report(0).status == "failed" and "cancelled" in job.report(0).error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "rgba.png"]
+    assert not list((tmp_path / "out").iterdir())
+    # A progress callback is never shown the notes' checkpoint (0 of 0).
+    seen = []
+    bumpbake.bake_file(src, {"ao": tmp_path / "ao.png"}, scale=4, notes="ignore",
+                       progress=lambda done, total: seen.append(total))
+    assert seen and 0 not in seen
+
+
 def test_progress_may_cancel_and_an_exception_in_it_cancels(tmp_path, fixtures):
     src = os.path.join(fixtures, "noise_96x80.png")
     out = tmp_path / "ao.png"

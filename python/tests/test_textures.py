@@ -1,7 +1,8 @@
 """Engine textures from Python: write() and the bakes of files give .vtf
 and .dds files whose headers say what was asked (read back by info() and
-bb_vtf_read_info), whose DDS pixels OpenImageIO decodes within the block
-codec's error, the command line's bytes and up-to-date decisions, and the
+bb_vtf_read_info), whose pixels read() gives back within the block codec's
+error (DDS through OpenImageIO, VTF and float DDS through bumpbake's own
+reader), the command line's bytes and up-to-date decisions, and the
 library's refusals."""
 
 import os
@@ -139,6 +140,31 @@ def test_dds_read_back_through_openimageio(tmp_path, rock):
     assert np.abs(bumpbake.read(path)[..., 0] * 255 - codes).max() < 1e-3
 
 
+def test_vtf_and_float_dds_read_back(tmp_path, rock):
+    """read() takes what write() made: VTF of every format (bumpbake's own
+    reader, blocks decoded by libsquish), and the float DDS OpenImageIO
+    refuses; bounds as for DDS above."""
+    s = rock["ssbump"]
+    codes = np.floor(np.clip(s, 0, 1) * 255 + 0.5)
+    path = tmp_path / "s.vtf"
+    for fmt, version in (("bgr888", "7.2"), ("bgra8888", "7.5")):
+        bumpbake.write(path, s, kind="ssbump", texture_format=fmt, vtf_version=version)
+        back = bumpbake.read(path)
+        assert back.shape == (128, 128, 3)  # no alpha flag: no alpha channel
+        assert np.abs(back * 255 - codes).max() < 1e-3
+    bumpbake.write(path, s, kind="ssbump")  # DXT1: the DDS's BC1 blocks
+    psnr, worst = codes_error(bumpbake.read(path), s)
+    assert bumpbake.info(path).channels == 3
+    assert psnr > 25 and worst < 110  # 25.68 dB, 105.4 (OpenImageIO's BC1: 25.69, 105.4)
+    bumpbake.write(path, s, kind="ssbump", texture_format="rgba16f")
+    assert np.abs(bumpbake.read(path) - s).max() < 2 ** -11
+    path = tmp_path / "s.dds"
+    bumpbake.write(path, s, kind="ssbump", texture_format="rgba32f")
+    back = bumpbake.read(path)
+    assert back.shape == (128, 128, 4) and (back[..., 3] == 1).all()
+    assert (back[..., :3] == s.astype(np.float32)).all()
+
+
 # -------------------------------------------------- the command line's bytes
 
 def files_of(directory):
@@ -265,3 +291,22 @@ def test_write_vmt(tmp_path):
     assert '"$bumpmap" "wall_normal"' in path.read_text() and "$ssbump" not in path.read_text()
     with pytest.raises(bumpbake.ArgumentError, match="vtf"):
         bumpbake.write_vmt(path, path.parent / "wall.png")
+
+
+def test_write_vmt_refuses_what_bake_vmt_refuses(tmp_path):
+    """write_vmt("s.vtf", "s.vtf") turned the texture into a 103-byte
+    material, and write_vmt("x.png", ...) overwrote the PNG: as `bake
+    --vmt`, a material's name ends in .vmt and is no texture it names."""
+    stone = tmp_path / "materials/stone"
+    stone.mkdir(parents=True)
+    texture, png = stone / "s.vtf", stone / "x.png"
+    texture.write_bytes(b"VTF\0 a texture")
+    png.write_bytes(b"a png")
+    for path in (texture, png, stone / "s.vtf.txt"):
+        with pytest.raises(bumpbake.ArgumentError, match="ends in .vmt"):
+            bumpbake.write_vmt(path, texture)
+    os.link(texture, stone / "s.vmt")
+    with pytest.raises(bumpbake.ArgumentError, match="would overwrite the texture"):
+        bumpbake.write_vmt(stone / "s.vmt", texture)
+    assert texture.read_bytes() == b"VTF\0 a texture" and png.read_bytes() == b"a png"
+    assert sorted(os.listdir(stone)) == ["s.vmt", "s.vtf", "x.png"]

@@ -68,22 +68,45 @@ static bb_status albedo_grey(const bb_image *map, int width, int height, bb_imag
   return BB_OK;
 }
 
-/* Inter-reflection, added to r->vis (bounce.c). */
+/* The inter-reflection's options for a bake (its albedo map set apart). */
+static void bounce_options(const bb_bake_options *o, int threads, bb__bounce_options *bo) {
+  bb__bounce_options_init(bo);
+  bo->rho = o->bounce_albedo;
+  bo->bounces = o->bounces;
+  bo->bias = o->trace.bias_texels;
+  bo->threads = threads;
+  bo->progress = o->trace.progress;
+  bo->progress_user = o->trace.progress_user;
+}
+
+/* With inter-reflection, the trace's progress is the first part of the
+ * whole (its slices against the bounce's weighted passes), so the bar
+ * runs once from 0 to 100% over both. */
+typedef struct trace_progress {
+  bb_progress_fn progress;
+  void *user;
+  long span, total; /* the trace's part of the whole, and the whole */
+} trace_progress;
+
+static int trace_progress_of(void *user, long done, long total) {
+  const trace_progress *t = user;
+  const long part = total > 0 ? (long)((double)t->span * (double)done / (double)total) : 0;
+  return t->progress(t->user, part < t->span ? part : t->span, t->total);
+}
+
+/* Inter-reflection, added to r->vis (bounce.c); the trace did trace_work
+ * of the progress before it. */
 static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
-                        const bb_rayset *rays, int threads, bb_bake_result *r, bb_error *err) {
+                        const bb_rayset *rays, int threads, long trace_work, bb_bake_result *r,
+                        bb_error *err) {
   bb_image grey = {0};
   bb_status st = BB_OK;
   if (o->bounce_albedo_map)
     st = albedo_grey(o->bounce_albedo_map, r->vis.width, r->vis.height, &grey, err);
   bb__bounce_options bo;
-  bb__bounce_options_init(&bo);
-  bo.rho = o->bounce_albedo;
+  bounce_options(o, threads, &bo);
   bo.albedo = grey.pixels ? &grey : NULL;
-  bo.bounces = o->bounces;
-  bo.bias = o->trace.bias_texels;
-  bo.threads = threads;
-  bo.progress = o->trace.progress;
-  bo.progress_user = o->trace.progress_user;
+  bo.progress_before = trace_work;
   if (st == BB_OK) st = bb__bounce_add(pyramid, rays, &bo, &r->vis, &r->bounces, err);
   bb_image_free(&grey);
   return st;
@@ -108,6 +131,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   bb_image z = {0};
   bb_pyramid *pyramid = NULL;
   bb_rayset rays = {0};
+  trace_progress progress = {o->trace.progress, o->trace.progress_user, 0, 0};
   bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
   if (st == BB_OK) st = bb__pyramid_build(&z, o->smooth.addressing, threads, &pyramid, err);
   bb_image_free(&z);
@@ -119,6 +143,14 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     bb_trace_options whole = o->trace;
     whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
     whole.threads = threads;
+    if (o->bounce_albedo > 0.0 && o->trace.progress) {
+      bb__bounce_options bo;
+      bounce_options(o, threads, &bo);
+      progress.span = (long)rays.slice_count * BB__BOUNCE_TRACE_WORK;
+      progress.total = progress.span + bb__bounce_work(&rays, &bo);
+      whole.progress = trace_progress_of;
+      whole.progress_user = &progress;
+    }
     st = o->trace.trace ? caller_trace(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err)
                         : bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found,
                                              err);
@@ -126,7 +158,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
   if (st == BB_OK && o->bounce_albedo > 0.0) {
-    st = bounce(o, pyramid, &rays, threads, r, err);
+    st = bounce(o, pyramid, &rays, threads, progress.span, r, err);
     const double t3 = bb__now_seconds();
     r->seconds_bounce = t3 - t2;
     t2 = t3;

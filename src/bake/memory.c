@@ -23,13 +23,17 @@ static void give(ledger *l, double bytes) {
 /* A line sweep's buffers on one thread: the profile and two hulls of 24-byte
  * points for the longest line of a bundle, whose points a periodic line
  * caps near 2^20 (longer ones go in chunks) and a clamped line keeps near
- * a few per texel of its length; and 56 bytes per texel of the line. */
+ * a few per texel of its length; the profiles of the 3 periodic lines
+ * filled beside it (sweep.c's LANES, lines of up to 2^17 points); and 56
+ * bytes per texel of the line, 16 more for each line beside it. */
 static double sweep_scratch(int width, int height) {
   const double side = width > height ? width : height;
   double points = 64.0 * side; /* up to 4 steps past each end, 16 points a step */
   if (points > 1.2 * (1 << 20))
     points = 1.2 * (1 << 20);
-  return 3.0 * 24.0 * points + 56.0 * 4.0 * side + 256.0 * 1024.0;
+  const double beside = points < 131072.0 ? points : 131072.0;
+  return 3.0 * 24.0 * points + 3.0 * 24.0 * beside + (56.0 + 3.0 * 16.0) * 4.0 * side +
+         256.0 * 1024.0;
 }
 
 /* The pyramid's level maxima (level 0: one node per texel). */

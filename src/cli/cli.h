@@ -17,14 +17,20 @@ enum { BB_EXIT_OK = 0, BB_EXIT_FAILURE = 1, BB_EXIT_USAGE = 2 };
 int bb_cli_command(int argc, char **argv);
 
 /* One command about to run: checked by the library. */
-typedef struct cli_run {
+typedef struct cli_run cli_run;
+
+/* bb_cli_command with the run of run (serve's, which the test binary does
+ * not link), else the command's own. */
+int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r));
+
+struct cli_run {
   bb_command *command;
   const bb_command_options *options; /* bb_command_options_of(command) */
   const char *record;   /* the command line its outputs record: the words as typed,
                            less those of options that do not change the output */
   char **typed;         /* the arguments as typed (argv[0] the command's name) */
   int typed_count;
-} cli_run;
+};
 
 /* Each command's run: what it does with the library and what it prints;
  * returns the exit code. */
@@ -38,6 +44,7 @@ int cli_run_program(const cli_run *r);
 int cli_run_compare(const cli_run *r);
 int cli_run_info(const cli_run *r);
 int cli_run_renderbumpflat(const cli_run *r);
+int cli_run_serve(const cli_run *r); /* serve.c */
 
 /* `bumpbake --help` and `bumpbake COMMAND --help` (help.c), from the
  * descriptions. */

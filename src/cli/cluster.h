@@ -3,13 +3,21 @@
 #ifndef BB_CLI_CLUSTER_H
 #define BB_CLI_CLUSTER_H
 
-/* Replaces the process with `python3 -m bumpbake.dask bake ARGS...`, args
- * the bake command's arguments as typed (argv[0] = "bake"), so the same
- * options give the same files on the cluster. Python is $BUMPBAKE_PYTHON,
- * else /usr/bin/python3 (Debian's, with python3-distributed); when this
- * program runs from a source tree (build/bumpbake beside python/), that
- * tree's python/ goes first on PYTHONPATH. Returns only on failure, with
+/* Replaces the process with Python running bumpbake.dask's `bake ARGS...`,
+ * args the bake command's arguments as typed (argv[0] = "bake"), so the
+ * same options give the same files on the cluster. Python is
+ * $BUMPBAKE_PYTHON, else /usr/bin/python3 (Debian's, with
+ * python3-distributed), run isolated (-I): it imports nothing from the
+ * working directory, PYTHONPATH or the user's site directory. Its path gets
+ * the directories of $BUMPBAKE_PYTHONPATH (absolute ones; empty entries are
+ * skipped), then this source tree's python/ when this program runs from one
+ * (build/bumpbake beside python/), else the install's Python directory
+ * (cli_installed_python_dir). Returns only on failure, with
  * BB_EXIT_FAILURE after printing why. */
 int cli_cluster_exec(int argc, char **argv);
+
+/* Where `make install` put the Python package (its PYTHONDIR), compiled
+ * into the installed program (installed_dirs.c); "" in the build's own. */
+const char *cli_installed_python_dir(void);
 
 #endif /* BB_CLI_CLUSTER_H */

@@ -10,48 +10,11 @@
 #include <string.h>
 #include <time.h>
 
-/* ---------------------------------------------------------------- escapes */
-
-/* The length of the UTF-8 sequence at s that is safe to print: 0 for a
- * control character (C0, DEL, C1: 0x9b is CSI to some terminals) or bytes
- * that are not UTF-8. */
-static size_t printable_sequence(const unsigned char *s) {
-  if (s[0] < 0x80)
-    return s[0] >= 0x20 && s[0] != 0x7f;
-  const size_t n = cli_utf8_sequence(s);
-  if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
-    return 0;
-  return n;
-}
-
-const char *cli_escape(const char *s, char *out, size_t cap) {
-  size_t used = 0;
-  if (!cap)
-    return out;
-  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p;) {
-    size_t n = printable_sequence(p);
-    if (n == 0) {
-      if (used + 4 >= cap)
-        break;
-      used += (size_t)snprintf(out + used, cap - used, "\\x%02x", *p);
-      p++;
-      continue;
-    }
-    if (used + n >= cap)
-      break;
-    memcpy(out + used, p, n);
-    used += n;
-    p += n;
-  }
-  out[used] = '\0';
-  return out;
-}
-
 /* Prints the formatted text escaped, with prefix and a newline, on f. */
 static void vprint_line(FILE *f, const char *prefix, const char *fmt, va_list ap) {
   char text[4096], safe[4 * sizeof text];
   vsnprintf(text, sizeof text, fmt, ap);
-  fprintf(f, "%s%s\n", prefix, cli_escape(text, safe, sizeof safe));
+  fprintf(f, "%s%s\n", prefix, bb_text_printable(text, safe, sizeof safe));
 }
 
 /* ----------------------------------------------------------------- errors */
@@ -69,7 +32,7 @@ int cli_usage_error(const char *command, const char *fmt, ...) {
 void cli_error_line(const char *message) {
   char safe[4 * sizeof(bb_error)];
   fprintf(stderr, "bumpbake: %s\n",
-          cli_escape(message && *message ? message : "unknown error", safe, sizeof safe));
+          bb_text_printable(message && *message ? message : "unknown error", safe, sizeof safe));
 }
 
 void cli_file_error(const char *path, const char *reason) {
@@ -114,7 +77,7 @@ void cli_note(void *user, const char *path, const char *text) {
     snprintf(line, sizeof line, "%s: note: %s", path, text);
   else
     snprintf(line, sizeof line, "note: %s", text);
-  fprintf(stderr, "bumpbake: %s\n", cli_escape(line, safe, sizeof safe));
+  fprintf(stderr, "bumpbake: %s\n", bb_text_printable(line, safe, sizeof safe));
 }
 
 void cli_no_font_note(const char *command) {

@@ -54,10 +54,6 @@ void cli_note(void *user, const char *path, const char *text);
 /* The note for a picture whose labels could not be drawn (render, sheet). */
 void cli_no_font_note(const char *command);
 
-/* Writes s into out (capacity cap, always terminated) with every byte that
- * could drive a terminal escaped as \xNN: C0 controls, DEL, the C1 controls
- * U+0080..U+009F, and bytes that are not UTF-8. Returns out. */
-const char *cli_escape(const char *s, char *out, size_t cap);
 
 /* ------------------------------------------------- command line, signals */
 

@@ -166,7 +166,10 @@ int cli_run_compare(const cli_run *run) {
   bb_status st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);
   if (st != BB_OK) {
     cli_error_line(err.message[0] ? err.message : bb_status_name(st));
-    return st == BB_ERR_SIZE ? BB_COMPARE_DIFFERENT_SIZE : COMPARE_CANNOT_READ;
+    /* A file that cannot be read, a file over the size limits included,
+     * is idiff's 4; two readable files of different sizes are a report
+     * (same_shape 0, exit 3), never an error. */
+    return COMPARE_CANNOT_READ;
   }
   int code;
   if (!r.same_shape) {

@@ -22,9 +22,10 @@ static void outputs(cli_json *j, const bb_job_report *r, int maps_only) {
 
 /* Parameters are those used: the channel the rule took and the threads
  * that ran, not "auto" and 0. */
-void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {
+void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
+                     const char *status) {
   const int traced = r->rayset_id[0] != '\0';
-  cli_json j = {stdout, 0};
+  cli_json j = {f, 0};
   cli_json_open(&j, NULL, '{');
   cli_json_string(&j, "input", r->input);
   if (status)
@@ -61,7 +62,6 @@ void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *
   cli_json_number(&j, "horizons", r->horizons);
   outputs(&j, r, 1);
   cli_json_close(&j, '}');
-  fputc('\n', stdout);
 }
 
 void cli_job_json_short(const bb_job_report *r) {
@@ -73,5 +73,10 @@ void cli_job_json_short(const bb_job_report *r) {
     cli_json_int(&j, "exit_code", 1);
   outputs(&j, r, 0);
   cli_json_close(&j, '}');
+  fputc('\n', stdout);
+}
+
+void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {
+  cli_job_json_to(stdout, b, r, status);
   fputc('\n', stdout);
 }

@@ -2,23 +2,9 @@
  * cli_json.h). */
 #include "json.h"
 
-#include <math.h>
+#include "bumpbake.h"
 
-size_t cli_utf8_sequence(const unsigned char *s) {
-  if (s[0] < 0x80)
-    return s[0] ? 1 : 0;
-  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
-  if (s[0] > 0xf4)
-    n = 0;
-  for (size_t i = 1; i < n; i++)
-    if ((s[i] & 0xc0) != 0x80)
-      return 0;
-  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
-    return 0; /* overlong, or a surrogate */
-  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
-    return 0; /* overlong, or past U+10FFFF */
-  return n;
-}
+#include <math.h>
 
 void cli_json_quoted(FILE *f, const char *s) {
   if (!s) {
@@ -28,7 +14,7 @@ void cli_json_quoted(FILE *f, const char *s) {
   fputc('"', f);
   for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
     if (*c >= 0x80) {
-      const size_t n = cli_utf8_sequence(c);
+      const size_t n = bb_utf8_sequence((const char *)c);
       if (n == 0) /* not UTF-8: the byte as a lone surrogate, as Python's
                      surrogateescape reads it back */
         fprintf(f, "\\udc%02x", *c);

@@ -6,10 +6,6 @@
 #include <stddef.h>
 #include <stdio.h>
 
-/* The length of the well-formed UTF-8 sequence at s (1 to 4), or 0 when
- * its bytes are not one (or s is at its end). */
-size_t cli_utf8_sequence(const unsigned char *s);
-
 /* Writes s to f as a quoted JSON string, always valid UTF-8 and never cut:
  * '"' and '\' escaped, newline, carriage return and tab as \n, \r, \t,
  * other control characters (C0, DEL, C1) as \u00XX; UTF-8 passes through;

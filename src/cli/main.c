@@ -27,5 +27,7 @@ int main(int argc, char **argv) {
     cli_error_line(line);
     return BB_EXIT_USAGE;
   }
+  if (!strcmp(name, "serve")) /* its server is the program's alone */
+    return bb_cli_command_with(argc - 1, argv + 1, cli_run_serve);
   return bb_cli_command(argc - 1, argv + 1);
 }

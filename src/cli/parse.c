@@ -300,7 +300,7 @@ static char *recorded(const parse *p, int options_only) {
 
 /* -------------------------------------------------------------- the run */
 
-static int parse_and_run(parse *p) {
+static int parse_and_run(parse *p, int (*run)(const cli_run *r)) {
   int *map = malloc((size_t)p->argc * sizeof *map);
   char **kept = malloc(((size_t)p->argc + 1) * sizeof *kept);
   int n = 0, rc = map && kept ? 0 : BB_EXIT_FAILURE;
@@ -333,15 +333,21 @@ static int parse_and_run(parse *p) {
   }
   cli_run r = {p->command, bb_command_options_of(p->command), line, p->argv, p->argc};
   rc = BB_EXIT_FAILURE;
-  for (size_t i = 0; i < sizeof runners / sizeof runners[0]; i++)
+  for (size_t i = 0; !run && i < sizeof runners / sizeof runners[0]; i++)
     if (!strcmp(runners[i].name, p->info->name))
-      rc = runners[i].run(&r);
+      run = runners[i].run;
+  if (run)
+    rc = run(&r);
   free(line);
   free(options);
   return rc;
 }
 
 int bb_cli_command(int argc, char **argv) {
+  return bb_cli_command_with(argc, argv, NULL);
+}
+
+int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r)) {
   bb_command *command = NULL;
   bb_error err = {{0}};
   if (bb_command_new(argv[0], &command, &err) != BB_OK) {
@@ -364,7 +370,7 @@ int bb_cli_command(int argc, char **argv) {
   if (rc)
     cli_error_line("out of memory");
   else
-    rc = parse_and_run(&p);
+    rc = parse_and_run(&p, run);
   for (int i = 0; p.word && i < argc; i++)
     free(p.word[i]);
   free(p.word);

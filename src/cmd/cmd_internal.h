@@ -190,6 +190,6 @@ extern const bb__option bb__opt_scale, bb__opt_scale_optional, bb__opt_rays,
 extern const bb__command bb__command_bake, bb__command_normal, bb__command_height2ssbump,
     bb__command_compare, bb__command_info, bb__command_renderbumpflat, bb__command_render,
     bb__command_sheet, bb__command_normal2ssbump, bb__command_ssbump2normal,
-    bb__command_combine, bb__command_program;
+    bb__command_combine, bb__command_program, bb__command_serve;
 
 #endif /* BB_CMD_INTERNAL_H */

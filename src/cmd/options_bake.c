@@ -6,7 +6,9 @@
 #include "cmd/cmd_internal.h"
 #include "render/render_internal.h"
 
+#include <arpa/inet.h>
 #include <float.h>
+#include <netinet/in.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -706,3 +708,63 @@ const bb__command bb__command_height2ssbump = {
              .inputs = "FILE BUMPSCALE", .min_inputs = 2, .max_inputs = 2, .usage_exit = 2,
              .option_count = (int)(sizeof h2s_options / sizeof h2s_options[0]) - 1},
     .options = h2s_options, .init = h2s_init, .add_input = h2s_input, .job = h2s_job};
+
+/* --------------------------------------------------------------- serve */
+
+static const bb__range range_port = {"port", 0, 65535, 0, 1};
+
+/* --address: an IPv4 or IPv6 address (not a name to look up). */
+static bb_status set_address(bb_command *c, const bb__option *o, const char *text,
+                             double *values, int *count, bb_error *err) {
+  (void)values;
+  *count = 0;
+  unsigned char any[sizeof(struct in6_addr)];
+  if (inet_pton(AF_INET, text, any) != 1 && inet_pton(AF_INET6, text, any) != 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s: '%.64s' is not an IPv4 or IPv6 address",
+                    o->info.name, text);
+  return bb__set_generic(c, o, text, values, count, err);
+}
+
+static const bb__option opt_port = {
+    .info = {.name = "port", .value_name = "N", .type = BB_OPTION_INT, .count = 1, .values = 1,
+             .help = "the port to listen on, 0 = any free one (the URL printed says which)"},
+    .field = BB__FIELD_INT, .offset = AT(port), .range = &range_port};
+static const bb__option opt_address = {
+    .info = {.name = "address", .value_name = "A", .type = BB_OPTION_TEXT, .count = 1,
+             .values = 1, .default_text = "127.0.0.1",
+             .help = "listen on this IPv4 or IPv6 address instead: the URL then carries a "
+                     "random token every request needs"},
+    .field = BB__FIELD_STRING, .offset = AT(address), .set = set_address};
+static const bb__option opt_serve_quiet = ROW_QUIET('q', "print only the URL, not each bake");
+
+static const bb__option *const serve_options[] = {
+    &bb__opt_scale, &bb__opt_rays, &opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &opt_basis,
+    &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &opt_bounce, &opt_bounces,
+    &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
+    &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
+    &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
+    &bb__opt_fast_compression, &opt_port, &opt_address, &opt_serve_quiet, &bb__opt_help, NULL};
+
+static void serve_init(bb_command_options *o) {
+  o->port = 8077; /* the documented port serve listens on unless told */
+}
+
+const bb__command bb__command_serve = {
+    .info = {.name = "serve",
+             .summary = "bake live: re-bake on save, see the maps lit in the browser",
+             .synopsis = "HEIGHT --scale S [OPTIONS]",
+             .description =
+                 "Bakes HEIGHT, serves a page that shows its maps lit in the browser (the\n"
+                 "ssbump under a light you drag, normal-mapped, ao, bent normal, basis\n"
+                 "weights, relief; tiled to show seams) and re-bakes when HEIGHT, or a\n"
+                 "map the options read, is saved, or when a control on the page changes.\n"
+                 "Nothing is written until the page's \"write\" asks: then the maps are\n"
+                 "written as the `bumpbake bake` line the page shows would write them\n"
+                 "(PREFIX_normal.png, PREFIX_ssbump.png, PREFIX_ao.png by default, PREFIX\n"
+                 "being HEIGHT without its extension). Listens on 127.0.0.1 unless told;\n"
+                 "Ctrl-C stops. See docs/commands/serve.md.",
+             .inputs = "HEIGHT", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
+             .option_count = (int)(sizeof serve_options / sizeof serve_options[0]) - 1},
+    .options = serve_options, .init = serve_init};

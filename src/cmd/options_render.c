@@ -394,16 +394,31 @@ static bb_status render_check(bb_command *c, bb_error *err) {
       return bb__fail(err, BB_ERR_ARGUMENT, "%s needs --%s FILE (or a HEIGHT to bake)",
                       o->render_compare ? "--compare" : bb_render_mode_name(o->render.mode),
                       bb_render_map_name((bb_render_map)m));
-  /* the picture's size from the first file's header: a tile or crop it
-   * cannot take is refused before any work (an unreadable file is the
-   * run's to report) */
-  const char *first = height;
-  for (int m = 0; !first && m < BB_RENDER_MAP_COUNT; m++)
-    first = o->render_maps[m];
-  int width = 0, depth_rows = 0;
-  if (first && !c->in_memory &&
-      bb_image_read_info(first, &width, &depth_rows, NULL, NULL, NULL) == BB_OK) {
-    bb_status st = bb__render_view_check(&o->render, width, depth_rows, err);
+  /* before any pixel is read, from the files' headers: the maps' size, the
+   * picture the options make of it, the memory the render takes
+   * (bb_render_files_check); a tile or crop the input cannot take is a
+   * usage error, anything else the files' */
+  if (!c->in_memory) {
+    bb_render_sources files;
+    memset(&files, 0, sizeof files);
+    for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+      files.maps[m] = o->render_maps[m];
+    files.height = height;
+    files.albedo = o->albedo;
+    bb_bake_options bake = o->job.bake;
+    const int traced = (needed_maps(o) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
+    bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
+                   (traced ? BB_OUTPUTS_TRACED : 0u);
+    int w = 0, h = 0;
+    bb_error why = {{0}};
+    bb_status st = bb_render_files_check(&files, &bake, &o->render, o->render_compare, o->output,
+                                         o->job.depth, &w, &h, err);
+    if (st != BB_OK && w > 0 &&
+        bb_render_estimate(w, h, &o->render, o->render_compare, NULL, BB_DEPTH_DEFAULT, NULL,
+                           NULL, NULL, &why) != BB_OK)
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s", why.message);
+    if (st == BB_ERR_ARGUMENT)
+      return BB_ERR_FORMAT; /* the files' own fault (maps of two sizes): not a usage error */
     if (st != BB_OK)
       return st;
   }

@@ -58,6 +58,8 @@ static unsigned maps_asked(const bb_command *c) {
   const bb_job_options *j = &c->options.job;
   if (c->in_memory)
     return c->memory_maps;
+  if (!strcmp(c->def->info.name, "serve"))
+    return BB_OUTPUTS_ALL; /* its page shows every map */
   if (j->out_dir)
     return j->maps ? j->maps : BB_JOB_DEFAULT_MAPS;
   unsigned maps = j->prefix ? BB_JOB_DEFAULT_MAPS : 0u;

@@ -56,3 +56,14 @@ bb_status bb__input_check(const char *path, bb_error *err) {
   if (st == BB_OK) close(fd);
   return st;
 }
+
+size_t bb__input_read_at(int fd, void *buf, size_t n, uint64_t offset) {
+  size_t done = 0;
+  while (done < n) {
+    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, (off_t)(offset + done));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    done += (size_t)got;
+  }
+  return done;
+}

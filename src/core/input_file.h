@@ -5,6 +5,9 @@
 
 #include "bumpbake.h"
 
+#include <stddef.h>
+#include <stdint.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -20,6 +23,10 @@ bb_status bb__input_open(const char *path, int *fd, bb_error *err);
 /* bb__input_open and close: for readers that can only open by name (the
  * check then narrows, not closes, the window for a swap). */
 bb_status bb__input_check(const char *path, bb_error *err);
+
+/* pread of n bytes at offset of fd, through EINTR and short reads: the
+ * bytes read (fewer at the end of the file or on an error). */
+size_t bb__input_read_at(int fd, void *buf, size_t n, uint64_t offset);
 
 #ifdef __cplusplus
 }

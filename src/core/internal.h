@@ -144,6 +144,14 @@ bb_status bb__check_channels(const bb_image *img, int min_channels, const char *
  * the flat normal, since such a texel has no direction to keep (vector.c). */
 void bb__normalize3(double v[3]);
 
+/* bb_memory_available, reading /proc and the cgroup files below root
+ * ("" for the system's own; a test points it at a made-up tree:
+ * ROOT/proc/meminfo, ROOT/proc/self/cgroup, ROOT/proc/self/mountinfo and
+ * the cgroup directories at ROOT + the mount points it names). RLIMIT_AS
+ * is this process's. */
+bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char **source,
+                                  bb_error *err);
+
 /* BB_OK when need bytes fit in what bb_memory_available says is left, else
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */

@@ -167,6 +167,72 @@ static uint64_t fresh_seed(void) {
          (atomic_fetch_add(&calls, 1) * 0xD1B54A32D192ED03ull);
 }
 
+/* ---------------------------------------------------- what is at a name */
+
+static const char *kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISREG(mode)) return "a regular file";
+  return "a special file";
+}
+
+bb_status bb__safe_check_target(const char *path, bb_error *err) {
+  struct stat named, target;
+  if (!path || lstat(path, &named) != 0 || S_ISREG(named.st_mode))
+    return BB_OK; /* nothing there (or nothing to say yet): the write tells */
+  if (S_ISDIR(named.st_mode))
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: is a directory", path);
+  if (!S_ISLNK(named.st_mode))
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: is %s, not a regular file", path,
+                    kind_of(named.st_mode));
+  return bb__fail(err, BB_ERR_IO,
+                  "%s: cannot write: is a symbolic link (to %s), not a regular file; name "
+                  "the file itself",
+                  path, stat(path, &target) == 0 ? kind_of(target.st_mode) : "nothing");
+}
+
+int bb__safe_is_stream(const char *path) {
+  struct stat named, target;
+  return path && lstat(path, &named) == 0 && !S_ISREG(named.st_mode) &&
+         stat(path, &target) == 0 && (S_ISFIFO(target.st_mode) || S_ISCHR(target.st_mode));
+}
+
+bb_status bb__safe_write_through(const char *path, const void *data, size_t size,
+                                 bb_error *err) {
+  /* O_NONBLOCK: a FIFO without a reader fails (ENXIO) instead of waiting;
+   * cleared for the writes. */
+  int fd = open(path, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  int error = fd < 0 ? errno : 0;
+  struct stat st;
+  if (!error && fstat(fd, &st) != 0)
+    error = errno;
+  else if (!error && !S_ISFIFO(st.st_mode) && !S_ISCHR(st.st_mode))
+    error = EINVAL; /* swapped since it was checked */
+  int flags = error ? 0 : fcntl(fd, F_GETFL);
+  if (!error && (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0))
+    error = errno;
+  const unsigned char *bytes = data;
+  while (!error && size > 0) {
+    const ssize_t n = write(fd, bytes, size);
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n <= 0)
+      error = n < 0 ? errno : ENOSPC;
+    else
+      bytes += n, size -= (size_t)n;
+  }
+  if (fd >= 0 && close(fd) != 0 && !error && errno != EINTR)
+    error = errno;
+  if (error == ENXIO)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: no process reads the FIFO", path);
+  if (error)
+    return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", path, strerror(error));
+  return BB_OK;
+}
+
 /* ------------------------------------------------------------ low level */
 
 /* Writes all of data at offset, retrying short counts and EINTR. Returns 0,
@@ -335,6 +401,10 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err) {
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   }
   strcpy(f->path, path);
+  if (bb__safe_check_target(path, err) != BB_OK) {
+    release(f, 0);
+    return BB_ERR_IO;
+  }
   if (pthread_mutex_init(&f->lock, NULL) != 0) {
     release(f, 0);
     return bb__fail(err, BB_ERR_MEMORY, "%s: cannot create a lock", path);
@@ -400,6 +470,10 @@ bb_status bb__safe_open_private(bb_staged_file *f, const char *path, bb_error *e
   f->path = malloc(strlen(path) + 1);
   if (!f->path) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   strcpy(f->path, path);
+  if (bb__safe_check_target(path, err) != BB_OK) {
+    release(f, 0);
+    return BB_ERR_IO;
+  }
   int error = create_private_dir(f);
   if (!error) {
     const char *ext = extension_of(path);
@@ -596,6 +670,12 @@ bb_status bb__safe_commit(bb_staged_file *f, bb_error *err) {
   bb_status st = bb__safe_finish(f, err);
   if (st != BB_OK)
     return st;
+  /* Checked at open; again here, as what stands at the name may have
+   * changed while the file was encoded. */
+  if (bb__safe_check_target(f->path, err) != BB_OK) {
+    release(f, 1);
+    return BB_ERR_IO;
+  }
   if (f->dir_fd >= 0 ? renameat(f->dir_fd, f->leaf, AT_FDCWD, f->path) != 0
                      : rename(f->temp_path, f->path) != 0) {
     st = bb__fail(err, BB_ERR_IO, "%s: cannot write: %s", f->path, strerror(errno));

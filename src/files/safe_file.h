@@ -76,6 +76,28 @@ struct bb_staged_file {
 int bb__safe_creation_begin(sigset_t *held);
 void bb__safe_creation_end(const sigset_t *held);
 
+/* What stands at an output's name. A write puts a new file there by
+ * rename, which would replace, not write to, anything but a regular file:
+ * a device, a FIFO, a socket, a symbolic link (to anything: /dev/stdout is
+ * one) or a directory. BB_OK when nothing is there or a regular file is,
+ * else BB_ERR_IO "PATH: cannot write: is a FIFO, not a regular file" (a
+ * directory: "is a directory"). bb__safe_open, bb__safe_open_private and
+ * bb__safe_commit refuse such a name with it; the job checks every output
+ * with it before baking. */
+bb_status bb__safe_check_target(const char *path, bb_error *err);
+
+/* 1 when path exists, is not a regular file, and leads (through symbolic
+ * links) to a FIFO or a character device: a stream a depfile may be
+ * written through (/dev/stdout on a pipe or terminal, a FIFO, /dev/null). */
+int bb__safe_is_stream(const char *path);
+
+/* Writes data through such a stream (opened without creating, truncating
+ * or becoming a controlling terminal; a FIFO nobody reads is an error, not
+ * a wait), every write checked, closed checked. Errors: BB_ERR_IO "PATH:
+ * cannot write: REASON". */
+bb_status bb__safe_write_through(const char *path, const void *data, size_t size,
+                                 bb_error *err);
+
 /* A bb_staged_file that bb__safe_discard may be called on before any open. */
 void bb__safe_init(bb_staged_file *f);
 

@@ -78,6 +78,15 @@ int bb_path_max_channels(const char *path) {
   return f ? f->max_channels : 0;
 }
 
+double bb__encoded_sample_bytes(const char *path, bb_depth depth) {
+  const format_rule *f = find_format(path);
+  if (depth == BB_DEPTH_DEFAULT)
+    depth = f ? f->default_depth : BB_DEPTH_FLOAT;
+  if (is_texture(path))
+    return 4.0; /* a float mip chain before its blocks */
+  return depth == BB_DEPTH_8 ? 1.0 : depth == BB_DEPTH_FLOAT ? 4.0 : 2.0;
+}
+
 int bb__path_holds_mips(const char *path) {
   if (is_texture(path)) return 1;
   const format_rule *f = find_format(path);

@@ -19,6 +19,11 @@ void bb__extension_of(const char *path, char *out, size_t cap);
 /* 1 when the extension of path (any case) is ext ("exr", without the dot). */
 int bb__path_has_extension(const char *path, const char *ext);
 
+/* Bytes a sample of path's format takes at depth (BB_DEPTH_DEFAULT: the
+ * format's own) in the copy its encoder makes: 1, 2 or 4; 4 for an engine
+ * texture (its float mip chain) or an unknown format. */
+double bb__encoded_sample_bytes(const char *path, bb_depth depth);
+
 /* 1 when path's format can hold a mip chain (.tif, .tiff, .exr, .vtf, .dds). */
 int bb__path_holds_mips(const char *path);
 

@@ -22,6 +22,11 @@
  *   file and any header it cannot read as a whole, and tells the chunk
  *   count and the largest unpacked chunk.
  *
+ * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
+ *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
+ *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
+ *   this probe was swapped in after that look: it is refused.
+ *
  * Every read goes through pread on the descriptor the read checked
  * (core/input_file.h), so the file probed is the file read. */
 #include "image/header_probe.h"
@@ -244,6 +249,9 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
   }
   if (magic[0] == 0x76 && magic[1] == 0x2F && magic[2] == 0x31 && magic[3] == 0x01)
     return probe_exr(fd, path, p, err);
+  if (memcmp(magic, "DDS ", 4) == 0)
+    return bb__fail(err, BB_ERR_FORMAT, "%s: a DDS file swapped in while it was being opened",
+                    path);
   probe_gif(fd, magic, p);
   return BB_OK;
 }

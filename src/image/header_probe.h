@@ -29,7 +29,8 @@ typedef struct bb__probe {
  * (libjpeg's jpeg_read_header, OpenEXRCore's exr_start_read) or, for GIF,
  * the screen size at its fixed offset. BB_ERR_FORMAT when OpenEXRCore
  * refuses the header (an attribute larger than the file, say), which
- * OpenImageIO's reader would first have allocated. */
+ * OpenImageIO's reader would first have allocated, and for any DDS, which
+ * bumpbake reads itself (texture_read.h). */
 bb_status bb__probe_header(int fd, const char *path, bb__probe *probe, bb_error *err);
 
 #ifdef __cplusplus

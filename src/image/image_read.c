@@ -1,50 +1,17 @@
 /* image_read.c: the public image reads (bumpbake.h "reading images") and
  * bb__image_read_channels / bb__image_level_count (image/oiio.h): arguments
- * checked, outputs cleared, OpenImageIO called (oiio_read.cpp), and
- * whatever a failed read made freed. */
+ * checked, outputs cleared, OpenImageIO called (oiio_read.cpp) or, for the
+ * engine textures (VTF, which it cannot read, and DDS, which it cannot read
+ * safely), texture_read.c, and whatever a failed read made freed. */
 #include "core/internal.h"
 #include "image/formats.h"
 #include "image/oiio.h"
 #include "image/oiio_calls.h"
-#include "texture/texture.h"
-#include "texture/vtf.h"
+#include "image/texture_read.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* OpenImageIO has no VTF reader: its header is read here (vtf.c), and its
- * pixels are not read at all. */
-static bb_status refuse_vtf_pixels(const char *path, bb_error *err) {
-  return bb__fail(err, BB_ERR_FORMAT,
-                  "%s: VTF textures are written, not read, by bumpbake (info reads their "
-                  "header; compare the image they were made from)",
-                  path);
-}
-
-/* A VTF's header as bb_image_read_info reports an image's. */
-static bb_status read_vtf_info(const char *path, int *width, int *height, int *channels,
-                               bb_image_info *info, bb_error *err) {
-  bb_vtf_info v;
-  bb_status st = bb_vtf_read_info(path, &v, err);
-  if (st != BB_OK) return st;
-  const int alpha = v.format == BB__VTF_DXT5 || v.format == BB__VTF_BGRA8888 ||
-                    v.format == BB__VTF_RGBA16161616F ||
-                    (v.flags & BB_VTF_FLAG_EIGHTBITALPHA) != 0;
-  if (width) *width = v.width;
-  if (height) *height = v.height;
-  if (channels) *channels = alpha ? 4 : 3;
-  if (info) {
-    info->alpha_channel = alpha ? 3 : -1;
-    info->is_float = v.format == BB__VTF_RGBA16161616F;
-    info->bits_per_sample = info->is_float ? 16 : 8;
-    snprintf(info->format_name, sizeof info->format_name, "vtf");
-    info->description = v.description;
-    v.description = NULL;
-  }
-  bb_vtf_info_free(&v);
-  return BB_OK;
-}
 
 static void clear_info(bb_image_info *info) {
   if (!info) return;
@@ -72,7 +39,8 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info, bb
   memset(out, 0, sizeof *out);
   clear_info(info);
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read: path is NULL");
-  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
+  if (bb__texture_read_applies(path))
+    return finish_read(bb__texture_read(path, 0, -1, 0, out, info, NULL, err), out, info);
   return finish_read(bb__oiio_read(path, 0, -1, 0, out, info, NULL, err), out, info);
 }
 
@@ -83,7 +51,9 @@ bb_status bb__image_read_channels(const char *path, int first_channel, int chann
   clear_info(info);
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_channels: path is NULL");
   if (channel_count < 1) return bb__fail(err, BB_ERR_ARGUMENT, "%s: no channel to read", path);
-  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
+  if (bb__texture_read_applies(path))
+    return finish_read(
+        bb__texture_read(path, first_channel, channel_count, 0, out, info, NULL, err), out, info);
   return finish_read(bb__oiio_read(path, first_channel, channel_count, 0, out, info, NULL, err),
                      out, info);
 }
@@ -95,9 +65,10 @@ bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image
   clear_info(info);
   if (level_count) *level_count = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: path is NULL");
-  if (bb__texture_container(path) == BB__CONTAINER_VTF) return refuse_vtf_pixels(path, err);
   int levels = 0; /* counted whatever the caller asks: a level past the last is an error */
-  bb_status st = bb__oiio_read(path, 0, -1, level, out, info, &levels, err);
+  bb_status st = bb__texture_read_applies(path)
+                     ? bb__texture_read(path, 0, -1, level, out, info, &levels, err)
+                     : bb__oiio_read(path, 0, -1, level, out, info, &levels, err);
   if (level_count) *level_count = levels;
   return finish_read(st, out, info);
 }
@@ -109,9 +80,9 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
   if (height) *height = 0;
   if (channels) *channels = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_info: path is NULL");
-  if (bb__texture_container(path) == BB__CONTAINER_VTF)
-    return read_vtf_info(path, width, height, channels, info, err);
-  bb_status st = bb__oiio_read_header(path, width, height, channels, info, err);
+  bb_status st = bb__texture_read_applies(path)
+                     ? bb__texture_read_header(path, width, height, channels, info, NULL, err)
+                     : bb__oiio_read_header(path, width, height, channels, info, err);
   if (st != BB_OK) bb_image_info_free(info);
   return st;
 }
@@ -120,12 +91,19 @@ bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err) {
   if (!path || !frames)
     return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_frame_count: NULL argument");
   *frames = 0;
+  if (bb__texture_read_applies(path)) { /* frame 0 is what is read */
+    bb_status st = bb__texture_read_header(path, NULL, NULL, NULL, NULL, NULL, err);
+    if (st == BB_OK) *frames = 1;
+    return st;
+  }
   return bb__oiio_frame_count(path, frames, err);
 }
 
 bb_status bb__image_level_count(const char *path, int *levels, bb_error *err) {
   *levels = 0;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_level_count: path is NULL");
+  if (bb__texture_read_applies(path))
+    return bb__texture_read_header(path, NULL, NULL, NULL, NULL, levels, err);
   return bb__oiio_level_count(path, levels, err);
 }
 

@@ -42,7 +42,8 @@ bb__file_identity bb__file_identify(const char *path);
 int bb__same_file_identity(const bb__file_identity *a, const bb__file_identity *b);
 
 /* BB_OK when path's directory exists and is a directory and path itself is
- * not a directory; else BB_ERR_IO "PATH: cannot write: ...". */
+ * nothing yet or a regular file (bb__safe_check_target); else BB_ERR_IO
+ * "PATH: cannot write: ...". */
 bb_status bb__check_output_directory(const char *path, bb_error *err);
 
 /* --------------------------------------------------------------- depfiles */

@@ -2,6 +2,7 @@
  * depths, channels, clashes, inputs overwritten under any spelling, and
  * directories. */
 #include "core/internal.h"
+#include "files/safe_file.h"
 #include "job/job_internal.h"
 
 #include <errno.h>
@@ -130,9 +131,9 @@ bb_status bb__check_output_directory(const char *path, bb_error *err) {
                     strerror(errno));
   if (!S_ISDIR(st.st_mode))
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: %s is not a directory", path, dir);
-  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-    return bb__fail(err, BB_ERR_IO, "%s: cannot write: is a directory", path);
-  return BB_OK;
+  /* A directory, a device, a FIFO, a socket or a symbolic link would be
+   * replaced by the rename that puts the output in place. */
+  return bb__safe_check_target(path, err);
 }
 
 /* ---------------------------------------------------------------- checks */

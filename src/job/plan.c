@@ -5,6 +5,7 @@
  * name costs no baking time. */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "files/safe_file.h"
 #include "job/job_internal.h"
 #include "render/render_internal.h"
 
@@ -15,7 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -496,6 +496,13 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
   none.targets = self;
   none.target_count = 1;
   bb_status st = bb__depfile_check_names(path, &none, 1, err);
+  if (st == BB_OK && bb__safe_is_stream(path)) {
+    /* /dev/stdout on a pipe or terminal, a FIFO, /dev/null: written
+     * through (run.c), not replaced. */
+    if (access(path, W_OK) != 0)
+      st = bb__fail(err, BB_ERR_IO, "%s: cannot write the depfile: %s", path, strerror(errno));
+    return st;
+  }
   if (st == BB_OK)
     st = bb__check_output_directory(path, err);
   if (st == BB_OK) {
@@ -705,10 +712,6 @@ static int is_vtf(const char *path) {
 static bb_status plan_material(bb_job *job, bb_error *err) {
   if (!job->vmt)
     return BB_OK;
-  const size_t len = strlen(job->vmt);
-  if (len < 4 || strcasecmp(job->vmt + len - 4, ".vmt") != 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "--vmt %s: a Source material's name ends in .vmt",
-                    job->vmt);
   const bb__job_item *item = &job->items[0];
   const char *ssbump = item->paths[BB_OUTPUT_SSBUMP], *normal = item->paths[BB_OUTPUT_NORMAL];
   int is_ssbump = ssbump && is_vtf(ssbump);
@@ -722,6 +725,7 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
                     "--vmt %s: a material needs a .vtf bump map: write --ssbump (or --normal) "
                     "as a .vtf file",
                     job->vmt);
+  /* bb_vmt_text checks the material's own name (.vmt, no texture's). */
   const bb_vmt_options v = {job->vmt_materials, bump, job->vmt_basetexture, is_ssbump};
   return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }

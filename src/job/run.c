@@ -4,11 +4,15 @@
 #include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
+#include "files/safe_file.h"
 #include "job/job_internal.h"
 
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static const bb_output_kind_info *kind_info(int kind) {
@@ -97,6 +101,40 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
   }
   reason[0] = '\0';
   return 1;
+}
+
+/* An input found up to date whose outputs are older than a file it reads
+ * (a touched input, a basis file rewritten with the same directions):
+ * make compares times, not contents, so it would run the bake again on
+ * every make. The outputs' times are set to now (or to the newest read's,
+ * should its clock run ahead), so the target is newer than its
+ * prerequisites; outputs already newer are left alone. Best effort: an
+ * output whose time cannot be set is left as it is. */
+static void keep_outputs_newer(const bb_job *job, const bb__job_item *item) {
+  const char *reads[BB__JOB_MAX_READS];
+  const int n = bb__job_reads(job, item, reads);
+  struct timespec newest = {0, 0};
+  struct stat st;
+  for (int r = 0; r < n; r++)
+    if (reads[r] && stat(reads[r], &st) == 0 &&
+        (st.st_mtim.tv_sec > newest.tv_sec ||
+         (st.st_mtim.tv_sec == newest.tv_sec && st.st_mtim.tv_nsec > newest.tv_nsec)))
+      newest = st.st_mtim;
+  struct timespec now;
+  clock_gettime(CLOCK_REALTIME, &now);
+  const int ahead = newest.tv_sec > now.tv_sec ||
+                    (newest.tv_sec == now.tv_sec && newest.tv_nsec > now.tv_nsec);
+  const struct timespec when[2] = {ahead ? newest : now, ahead ? newest : now};
+  const bb_job_report *r = &item->report;
+  for (int k = 0; k < r->output_count; k++) {
+    const char *path = r->outputs[k].path;
+    if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode))
+      continue;
+    if (st.st_mtim.tv_sec > newest.tv_sec ||
+        (st.st_mtim.tv_sec == newest.tv_sec && st.st_mtim.tv_nsec > newest.tv_nsec))
+      continue;
+    (void)utimensat(AT_FDCWD, path, when, AT_SYMLINK_NOFOLLOW);
+  }
 }
 
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) {
@@ -204,8 +242,35 @@ static bb__dep_rule rule_of(const bb_job *job, const bb__job_item *item, const c
   return (bb__dep_rule){targets, t, prereq, bb__job_reads(job, item, prereq)};
 }
 
+/* The depfile's text written: replacing a file whole, or through a stream
+ * (bb__safe_is_stream: /dev/stdout, a FIFO) as it is; on failure the
+ * message ends with what was written before. */
+static bb_status write_depfile_text(const char *path, const char *text, size_t size,
+                                    const char *written, bb_error *err) {
+  bb_error local = {{0}};
+  bb_status st = bb__safe_is_stream(path) ? bb__safe_write_through(path, text, size, &local)
+                                          : bb_file_write(path, text, size, &local);
+  if (st != BB_OK)
+    bb__fail(err, st, "%s; %s", local.message, written);
+  return st;
+}
+
+/* A single input's depfile on its own, after its maps. */
+static bb_status write_depfile(const bb_job *job, const bb__job_item *item, const char *written,
+                               bb_error *err) {
+  const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
+  bb__dep_rule rule = rule_of(job, item, targets, prereq);
+  size_t size = 0;
+  char *text = bb__depfile_text(&rule, 1, &size);
+  bb_status st = text ? write_depfile_text(job->depfile, text, size, written, err)
+                      : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
+  free(text);
+  return st;
+}
+
 /* The files of one input: its maps, the slope files, and a single input's
- * depfile, written together. */
+ * depfile, written together (a depfile written through a stream comes
+ * after them). */
 static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error *err) {
   bb_job_report *r = &item->report;
   char *command = bb__job_command_of(job, item);
@@ -262,7 +327,8 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   if (st == BB_OK && job->vmt)
     files[n++] = (bb_output_file){job->vmt, "material", NULL, BB_RANGE_UNIT, BB_DEPTH_DEFAULT,
                                   0, NULL, job->vmt_text, job->vmt_size, NULL};
-  if (st == BB_OK && job->depfile && !job->batch) {
+  const int depfile_stream = job->depfile && !job->batch && bb__safe_is_stream(job->depfile);
+  if (st == BB_OK && job->depfile && !job->batch && !depfile_stream) {
     /* One input's depfile goes in with its maps: all of them or none. */
     const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
     bb__dep_rule rule = rule_of(job, item, targets, prereq);
@@ -276,52 +342,93 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   const double t0 = bb__now_seconds();
   if (st == BB_OK)
     st = bb_outputs_write(files, n, b->result.threads, err);
+  if (st == BB_OK && depfile_stream)
+    st = write_depfile(job, item, "the maps were written", err);
   r->seconds_write = bb__now_seconds() - t0;
   return st;
 }
 
-static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progress,
-                           void *progress_user, bb_error *err) {
+/* Reads item's input and bakes it (the job's outputs and the kinds in also),
+ * filling its report's figures; writes nothing. */
+static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
+                               bb_progress_fn progress, void *progress_user, baked *b,
+                               bb_error *err) {
   bb_job_report *r = &item->report;
-  baked b;
-  memset(&b, 0, sizeof b);
   const double t0 = bb__now_seconds();
   bb_status st = bb__job_memory_check(job, item, err);
   if (st == BB_OK)
     st = bb_height_file_read(item->input, job->options.channel,
                              job->options.bake.height_scale, job->options.note,
-                             job->options.note_user, &b.height, &r->source, err);
+                             job->options.note_user, &b->height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
-  const int height_width = b.height.width, height_height = b.height.height;
+  /* The input's notes have been given: a caller that takes one as an
+   * error cancels here, before anything is baked or written (progress
+   * (0, 0): a checkpoint, no work done yet). */
+  if (st == BB_OK && progress && progress(progress_user, 0, 0))
+    st = bb__fail(err, BB_ERR_CANCELLED, "%s: cancelled by the progress callback", item->input);
+  const int height_width = b->height.width, height_height = b->height.height;
+  int slices = job->options.bake.slices;
   if (st == BB_OK) {
     bb_bake_options o = job->options.bake;
+    o.outputs |= also;
+    bb__bake_resolve(&o); /* the kinds added may trace */
+    slices = o.slices;
     o.trace.progress = progress;
     o.trace.progress_user = progress_user;
     bb_error bake_err = {{0}};
-    /* only the maps are written: the bake lets the height and vis go as
-     * soon as it is done with them (Valve's detail reads the height again) */
-    const unsigned flags = BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
-    st = bb__bake(&b.height, &o, flags, &b.result, &bake_err);
+    /* only the maps are kept: the bake lets the height and vis go as soon
+     * as it is done with them (Valve's detail reads the height again) */
+    const unsigned flags =
+        BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
+    st = bb__bake(&b->height, &o, flags, &b->result, &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
   if (st == BB_OK && job->valve_path)
-    st = make_valve(job, item, &b, err);
+    st = make_valve(job, item, b, err);
   if (st == BB_OK && job->slope_path)
-    st = make_slope(job, item, &b, err);
+    st = make_slope(job, item, b, err);
   if (st == BB_OK) {
-    const bb_bake_result *res = &b.result;
+    const bb_bake_result *res = &b->result;
     r->width = height_width;
     r->height = height_height;
     r->threads = res->threads;
-    r->slices = res->rayset_id[0] ? job->options.bake.slices : 0; /* resolved by the plan */
+    r->slices = res->rayset_id[0] ? slices : 0; /* resolved by the plan */
     snprintf(r->rayset_id, sizeof r->rayset_id, "%s", res->rayset_id);
     r->horizons = res->horizons_found;
     r->seconds_smooth = res->seconds_smooth;
     r->seconds_pyramid = res->seconds_pyramid;
     r->seconds_trace = res->seconds_trace;
     r->seconds_derive = res->seconds_derive;
+  }
+  return st;
+}
+
+static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progress,
+                           void *progress_user, bb_error *err) {
+  baked b;
+  memset(&b, 0, sizeof b);
+  bb_status st = read_and_bake(job, item, 0u, progress, progress_user, &b, err);
+  if (st == BB_OK)
     st = write_item(job, item, &b, err);
+  baked_free(&b);
+  return st;
+}
+
+bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
+                           void *progress_user, bb_bake_result *result, bb_error *err) {
+  if (result)
+    memset(result, 0, sizeof *result);
+  if (!job || i < 0 || i >= job->count || !result)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job bake: bad arguments");
+  if (also & ~(unsigned)BB_OUTPUTS_ALL)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job bake: unknown map bits 0x%x", also);
+  baked b;
+  memset(&b, 0, sizeof b);
+  bb_status st = read_and_bake(job, &job->items[i], also, progress, progress_user, &b, err);
+  if (st == BB_OK) {
+    *result = b.result; /* the maps change hands */
+    memset(&b.result, 0, sizeof b.result);
   }
   baked_free(&b);
   return st;
@@ -341,6 +448,7 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
     if (st != BB_OK)
       return fail_item(r, st, NULL);
     if (current) {
+      keep_outputs_newer(job, item);
       r->outcome = BB_JOB_CURRENT;
       return BB_OK;
     }
@@ -380,11 +488,10 @@ bb_status bb_job_write_depfile(bb_job *job, bb_error *err) {
   if (st == BB_OK && !text)
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", job->depfile);
   if (st == BB_OK) {
-    bb_error local = {{0}};
-    st = bb_file_write(job->depfile, text, size, &local);
-    if (st != BB_OK)
-      bb__fail(err, st, "%s; the maps of %d input%s baked were written", local.message, baked_inputs,
-               baked_inputs == 1 ? "" : "s");
+    char written[64];
+    snprintf(written, sizeof written, "the maps of %d input%s baked were written", baked_inputs,
+             baked_inputs == 1 ? "" : "s");
+    st = write_depfile_text(job->depfile, text, size, written, err);
   }
   free(text);
   free(targets);

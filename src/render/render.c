@@ -662,6 +662,17 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
   st = check_maps(maps, find_mode(o->mode)->needs, &size, err);
   if (st == BB_OK && o->relief)
     st = check_map(o->relief_height, "relief height", 1, size, err);
+  /* The picture's size and memory, before it is allocated. */
+  double picture = 0.0;
+  int picture_width = 0, picture_height = 0;
+  if (st == BB_OK)
+    st = bb_render_estimate(size->width, size->height, o, 0, NULL, BB_DEPTH_DEFAULT,
+                            &picture_width, &picture_height, &picture, err);
+  if (st == BB_OK) {
+    char what[64];
+    snprintf(what, sizeof what, "render: a %d x %d picture", picture_width, picture_height);
+    st = bb__memory_check(picture, what, err);
+  }
   if (st != BB_OK)
     return st;
   render_job job;
@@ -676,8 +687,6 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
   } else {
     /* the picture of the tiled maps' size, seen by the camera, then cropped */
     const long w = (long)size->width * o->tile_x, h = (long)size->height * o->tile_y;
-    if (w > BB_MAX_DIMENSION || h > BB_MAX_DIMENSION || w * h > BB_MAX_PIXELS)
-      return bb__fail(err, BB_ERR_SIZE, "render: a view of %ldx%ld is over the maximum", w, h);
     st = bb_image_alloc(out, (int)w, (int)h, 3, err);
     if (st != BB_OK)
       return st;

@@ -15,7 +15,8 @@ typedef enum bb__block_format {
   BB__BLOCK_BC1 = 0, /* DXT1: R, G, B (5:6:5 end points, 2-bit indices), 8 bytes */
   BB__BLOCK_BC3,     /* DXT5: BC1 colour + BC4-style alpha, 16 bytes */
   BB__BLOCK_BC4,     /* one channel (R): 2 end points, 3-bit indices, 8 bytes */
-  BB__BLOCK_BC5      /* two channels (R, G): two BC4 blocks, 16 bytes */
+  BB__BLOCK_BC5,     /* two channels (R, G): two BC4 blocks, 16 bytes */
+  BB__BLOCK_BC2      /* DXT3: BC1 colour + 4-bit explicit alpha, 16 bytes (decoded only) */
 } bb__block_format;
 
 /* Bytes of one 4 x 4 block of format: 8 or 16. */
@@ -40,6 +41,15 @@ size_t bb__blocks_size(bb__block_format format, int width, int height);
 bb_status bb__blocks_compress(const float *rgba, int width, int height,
                               bb__block_format format, int fast, int threads,
                               unsigned char *out, bb_error *err);
+
+/* Decodes width x height texels from blocks (bb__blocks_size bytes of
+ * format, row by row) into rgba (4 bytes a texel, row-major) through the
+ * codec's decoder: BC1 (index 3 of a 3-colour block is black with alpha 0),
+ * BC2 and BC3 R, G, B, A; BC4 into R (G, B 0, A 255); BC5 into R and G (B
+ * 0, A 255). Texels of the blocks past an edge are dropped. Errors:
+ * BB_ERR_ARGUMENT (bad format or size) and any exception of the codec. */
+bb_status bb__blocks_decompress(const unsigned char *blocks, int width, int height,
+                                bb__block_format format, unsigned char *rgba, bb_error *err);
 
 #ifdef __cplusplus
 }

@@ -53,6 +53,7 @@ int squish_flags(bb__block_format format, int fast) {
   case BB__BLOCK_BC3: return squish::kDxt5 | fit;
   case BB__BLOCK_BC4: return squish::kBc4;
   case BB__BLOCK_BC5: return squish::kBc5;
+  case BB__BLOCK_BC2: return squish::kDxt3; // decoded only: bb__blocks_compress refuses it
   }
   return 0;
 }
@@ -142,5 +143,73 @@ extern "C" bb_status bb__blocks_compress(const float *rgba, int width, int heigh
     if (st == BB_OK && job.failed.load())
       st = bb__fail(err, BB_ERR_FORMAT, "block compression: the codec failed");
     return st;
+  });
+}
+
+// ------------------------------------------------------------- decoding
+//
+// The reading side (VTF and DDS inputs), apart from the compression above.
+// libsquish 1.15 decodes BC1, BC2 and BC3 blocks, but its Decompress takes a
+// BC4 or BC5 block as a BC1 colour block (FixFlags keeps the flag, but only
+// BC1/2/3 have a decoder). A BC4 block is, byte for byte, the alpha half of
+// a BC3 block (two 8-bit end points, 3-bit indices, the same two modes), so
+// a BC4 block is decoded as the alpha of a BC3 block made of it and an
+// empty colour block, by libsquish's own BC3 alpha decoder; BC5 is two BC4
+// blocks, R then G.
+
+namespace {
+
+// BC4 block b into channel c of 16 RGBA texels.
+void decode_bc4(const unsigned char *b, unsigned char *texels, int c) {
+  unsigned char bc3[16] = {0};
+  unsigned char decoded[16 * 4];
+  std::memcpy(bc3, b, 8);
+  squish::Decompress(decoded, bc3, squish::kDxt5);
+  for (int i = 0; i < 16; i++)
+    texels[4 * i + c] = decoded[4 * i + 3];
+}
+
+void decode_block(const unsigned char *b, bb__block_format format, unsigned char *texels) {
+  switch (format) {
+  case BB__BLOCK_BC1: squish::Decompress(texels, b, squish::kDxt1); return;
+  case BB__BLOCK_BC2: squish::Decompress(texels, b, squish::kDxt3); return;
+  case BB__BLOCK_BC3: squish::Decompress(texels, b, squish::kDxt5); return;
+  case BB__BLOCK_BC4:
+  case BB__BLOCK_BC5:
+    for (int i = 0; i < 16; i++) {
+      texels[4 * i + 0] = texels[4 * i + 1] = texels[4 * i + 2] = 0;
+      texels[4 * i + 3] = 255;
+    }
+    decode_bc4(b, texels, 0);
+    if (format == BB__BLOCK_BC5)
+      decode_bc4(b + 8, texels, 1);
+    return;
+  }
+}
+
+} // namespace
+
+extern "C" bb_status bb__blocks_decompress(const unsigned char *blocks, int width, int height,
+                                           bb__block_format format, unsigned char *rgba,
+                                           bb_error *err) {
+  if (format < BB__BLOCK_BC1 || format > BB__BLOCK_BC2)
+    return bb__fail(err, BB_ERR_ARGUMENT, "block decoding: unknown block format %d",
+                    (int)format);
+  if (!blocks || !rgba || width <= 0 || height <= 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "block decoding: no image (%d x %d)", width, height);
+  return guarded(err, [&]() -> bb_status {
+    const size_t block_bytes = bb__block_bytes(format);
+    const int blocks_wide = (width + 3) / 4;
+    unsigned char texels[16 * 4];
+    for (int by = 0; by < (height + 3) / 4; by++)
+      for (int bx = 0; bx < blocks_wide; bx++) {
+        decode_block(blocks + ((size_t)by * (size_t)blocks_wide + (size_t)bx) * block_bytes,
+                     format, texels);
+        for (int py = 0; py < 4 && by * 4 + py < height; py++)
+          for (int px = 0; px < 4 && bx * 4 + px < width; px++)
+            std::memcpy(rgba + ((size_t)(by * 4 + py) * (size_t)width + (size_t)(bx * 4 + px)) * 4,
+                        texels + (py * 4 + px) * 4, 4);
+      }
+    return BB_OK;
   });
 }

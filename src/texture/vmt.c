@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* path made absolute against the working directory, with "." and ".."
@@ -115,6 +116,26 @@ static int find_materials(const char *bumpmap, char *out, size_t cap) {
   return -1;
 }
 
+/* 1 when a and b both exist and are one file (hard links, a symbolic
+ * link to the other, a directory spelled two ways). */
+static int same_existing_file(const char *a, const char *b) {
+  struct stat sa, sb;
+  return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
+}
+
+/* The material's own name: a .vmt, and not a texture it names (a texture
+ * ends in .vtf, so only another name of the same file can be one). */
+static bb_status check_material_path(const char *path, const bb_vmt_options *o, bb_error *err) {
+  const size_t len = strlen(path);
+  if (len < 4 || strcasecmp(path + len - 4, ".vmt") != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: a Source material's name ends in .vmt", path);
+  if (same_existing_file(path, o->bumpmap) || same_existing_file(path, o->basetexture))
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the material would overwrite the texture %s",
+                    path, same_existing_file(path, o->bumpmap) ? o->bumpmap : o->basetexture);
+  return BB_OK;
+}
+
 bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, size_t *size,
                       bb_error *err) {
   if (text)
@@ -127,6 +148,9 @@ bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, si
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: bb_vmt_text: NULL argument", path);
   if (!o || !o->bumpmap || !*o->bumpmap)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: a material needs its bump map's .vtf", path);
+  bb_status checked = check_material_path(path, o, err);
+  if (checked != BB_OK)
+    return checked;
   char found[PATH_MAX];
   const char *materials = o->materials_dir;
   if (!materials || !*materials) {

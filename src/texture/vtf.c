@@ -1,5 +1,6 @@
 /* vtf.c: Valve Texture Format files: written (7.2 to 7.5, one frame, one
- * face) and their headers read for `info`.
+ * face) and their headers read, for `info` and for the pixel reader
+ * (vtf_read.c).
  *
  * The layout, from VTFLib's VTFFormat.h (Neil Jedrzejewski and Ryan Gregg,
  * github.com/NeilJed/VTFLib) and the Valve Developer Community's "Valve
@@ -387,16 +388,10 @@ static char *kvd_description(const char *text, size_t len) {
   return out;
 }
 
-bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
-  if (!info)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: info is NULL");
+bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
+                              uint64_t *image_offset, bb_error *err) {
   memset(info, 0, sizeof *info);
-  if (!path)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: path is NULL");
-  int fd;
-  bb_status st = bb__input_open(path, &fd, err);
-  if (st != BB_OK)
-    return st;
+  bb_status st = BB_OK;
   struct stat sb;
   unsigned char h[HEADER_BYTES + RESOURCE_BYTES * MAX_RESOURCES];
   memset(h, 0, sizeof h);
@@ -515,12 +510,28 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
     st = bb__fail(err, BB_ERR_FORMAT, "%s: unknown VTF image format %d", path, info->format);
     goto done;
   }
-  if ((has_low && low_at + low_bytes > file_size) || image_at + data > file_size) {
+  /* Each part said where it lies: the low-resolution image and the image
+   * data are checked apart (a low-resolution resource past the end once
+   * gave "needs 3636 bytes, the file has 3636"). */
+  if (has_low && low_at + low_bytes > file_size) {
     st = bb__fail(err, BB_ERR_FORMAT,
-                  "%s: truncated VTF: its data needs %llu bytes, the file has %llu", path,
-                  (unsigned long long)(image_at + data), (unsigned long long)file_size);
+                  "%s: truncated VTF: its low-resolution image (%llu bytes at offset %llu) "
+                  "ends past the end of the file (%llu bytes)",
+                  path, (unsigned long long)low_bytes, (unsigned long long)low_at,
+                  (unsigned long long)file_size);
     goto done;
   }
+  if (image_at + data > file_size) {
+    st = bb__fail(err, BB_ERR_FORMAT,
+                  "%s: truncated VTF: its image data (%llu bytes at offset %llu) ends past "
+                  "the end of the file (%llu bytes)",
+                  path, (unsigned long long)data, (unsigned long long)image_at,
+                  (unsigned long long)file_size);
+    goto done;
+  }
+
+  if (image_offset)
+    *image_offset = image_at;
 
   /* Provenance: a KVD chunk, { u32 size, text }, that bumpbake wrote. */
   if (kvd_at) {
@@ -549,9 +560,23 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
     free(text);
   }
 done:
-  close(fd);
   if (st != BB_OK)
     bb_vtf_info_free(info);
+  return st;
+}
+
+bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
+  if (!info)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: info is NULL");
+  memset(info, 0, sizeof *info);
+  if (!path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: path is NULL");
+  int fd;
+  bb_status st = bb__input_open(path, &fd, err);
+  if (st != BB_OK)
+    return st;
+  st = bb__vtf_read_header(fd, path, info, NULL, err);
+  close(fd);
   return st;
 }
 

@@ -1,9 +1,12 @@
-/* vtf.h: Valve's texture container, written and its header read (vtf.c). */
+/* vtf.h: Valve's texture container, written and its header read (vtf.c);
+ * its pixels are laid out by vtf_read.c (texture_layout.h). */
 #ifndef BB_TEXTURE_VTF_H
 #define BB_TEXTURE_VTF_H
 
 #include "bumpbake.h"
 #include "files/safe_file.h"
+
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +30,13 @@ enum {
 bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
                          const bb_image *low, const bb_texture_options *options,
                          bb_texture_format format, bb_error *err);
+
+/* bb_vtf_read_info on the file open at fd (path names it in messages; fd
+ * is left open): every size and offset checked against the file's length.
+ * *image_offset (may be NULL) receives where the image data starts (every
+ * level, smallest first). */
+bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
+                              uint64_t *image_offset, bb_error *err);
 
 #ifdef __cplusplus
 }

@@ -51,10 +51,13 @@
  * the light its corners gather from the surface, over half the slices (the
  * light of later bounces is smooth); last, what each texel's origin
  * (lifted by the bake's bias) gathers, added to its visibility. With
- * bounces 0 the bounces stop when no corner's light moves by more than the
- * tolerance, and the rest of the series, close to geometric, is added as
- * the last move times lambda / (1 - lambda), lambda the ratio of the last
- * two moves summed over every corner.
+ * bounces N that is N - 1 surface passes from the first bounce. With
+ * bounces 0 (converged) the corners start from an estimate of all their
+ * light (estimate_ratio), one surface pass gathers from it, and the rest
+ * of the series, close to geometric, is added as the last move times
+ * lambda / (1 - lambda), lambda the ratio of the last two moves summed
+ * over every corner. Progress counts every pass's slices, weighted by
+ * what they cost (slice_work).
  */
 #include "core/internal.h"
 #include "trace/bounce.h"
@@ -142,22 +145,22 @@ static inline double height_at(const bb_pyramid *p, long x, long y) {
   return (double)p->z[vertex_at(p, x, y)];
 }
 
-/* Unit normal of half `upper` of cell (cx, cy). */
-static void face_normal(const bb_pyramid *p, long cx, long cy, int upper, double n[3]) {
-  const double z00 = height_at(p, cx, cy), z10 = height_at(p, cx + 1, cy);
-  const double z01 = height_at(p, cx, cy + 1), z11 = height_at(p, cx + 1, cy + 1);
-  if (upper)
-    n[0] = z01 - z11, n[1] = z10 - z11;
-  else
-    n[0] = z00 - z10, n[1] = z00 - z01;
-  const double len = sqrt(n[0] * n[0] + n[1] * n[1] + 1.0);
-  n[0] /= len, n[1] /= len, n[2] = 1.0 / len;
-}
-
-/* The normals of the 6 triangles around vertex (x, y). */
+/* The normals of the 6 triangles around vertex (x, y): face_normal's
+ * arithmetic, each of the 7 heights around it read once. */
 static void vertex_faces(const bb_pyramid *p, long x, long y, double n[FACES][3]) {
-  for (int f = 0; f < FACES; f++)
-    face_normal(p, x + slot_dx[f], y + slot_dy[f], slot_upper[f], n[f]);
+  double z[3][3]; /* z[1 + dy][1 + dx]; (-1, -1) and (+1, +1) are no triangle's corner */
+  for (int j = -1; j <= 1; j++)
+    for (int i = -1; i <= 1; i++)
+      if (i != j || i == 0) z[1 + j][1 + i] = height_at(p, x + i, y + j);
+  for (int f = 0; f < FACES; f++) {
+    const int cx = 1 + slot_dx[f], cy = 1 + slot_dy[f]; /* the cell's (0, 0) in z */
+    if (slot_upper[f])
+      n[f][0] = z[cy + 1][cx] - z[cy + 1][cx + 1], n[f][1] = z[cy][cx + 1] - z[cy + 1][cx + 1];
+    else
+      n[f][0] = z[cy][cx] - z[cy][cx + 1], n[f][1] = z[cy][cx] - z[cy + 1][cx];
+    const double len = sqrt(n[f][0] * n[f][0] + n[f][1] * n[f][1] + 1.0);
+    n[f][0] /= len, n[f][1] /= len, n[f][2] = 1.0 / len;
+  }
 }
 
 /* ------------------------------------------------ vector sector tables */
@@ -498,6 +501,7 @@ static void band_add(gather *g, double ta, double tb, double theta_a, double the
     double th_a = theta_a, s2 = s2a, sc = sca;
     if (g->plane[f] > ta) {
       if (!(tb > g->plane[f])) continue;
+      if (isnan(g->plane_theta[f])) g->plane_theta[f] = atan(g->plane[f]); /* when first met */
       th_a = g->plane_theta[f], s2 = g->plane_sin2[f], sc = g->plane_sincos[f];
     }
     const double cos2 = 0.5 * (theta_b - th_a) + 0.5 * (scb - sc);
@@ -535,9 +539,11 @@ static void band_pieces(gather *g, const segment *seg, double sa, double sb) {
    * wide band and the radiance changes along the segment: only then is
    * the band cut (a tall wall seen from its foot, not a short segment). */
   double change = 0.0;
-  for (int k = 0; k < channels; k++)
-    change = fmax(change, fabs((double)seg->far[k] - (double)seg->near[k]));
-  const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : fmin(fabs(ta), fabs(tb));
+  for (int k = 0; k < channels; k++) {
+    const double c = fabs((double)seg->far[k] - (double)seg->near[k]);
+    change = c > change ? c : change;
+  }
+  const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : (fabs(ta) < fabs(tb) ? fabs(ta) : fabs(tb));
   if (fabs(at_b - at_a) * change > 0.01 && (tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND) {
     theta_a = theta_of(g, ta), theta_b = atan(tb); /* the bound above is not the width */
     pieces = (int)ceil((theta_b - theta_a) / WIDE_BAND);
@@ -883,7 +889,7 @@ static void gather_corners(gather *g, const bb_pyramid *p, long x, long y, doubl
     g->horizontal[f] = n[f][0] * g->cx + n[f][1] * g->cy;
     g->vertical[f] = n[f][2] * g->half_width;
     g->plane[f] = plane;
-    g->plane_theta[f] = atan(plane);
+    g->plane_theta[f] = NAN; /* band_add takes its atan when a band crosses the plane */
     g->plane_sin2[f] = sin2(plane);
     g->plane_sincos[f] = sincos_of(plane);
     g->plane_low = f == 0 || plane < g->plane_low ? plane : g->plane_low;
@@ -973,9 +979,9 @@ typedef struct driver {
   float *direct;   /* E of every corner from the sky (FACES x channels per vertex) */
   float *radiance; /* what every corner reflects now */
   const float *albedo;
-  double *row_change;
   exact_sum *row_sum;
   double tail; /* the last move's multiple added as the series' rest (0: none) */
+  long work, work_done; /* bb__bounce_work, and what the passes so far did */
 } driver;
 
 static void zero_row(void *user, int y) {
@@ -984,16 +990,39 @@ static void zero_row(void *user, int y) {
   memset(d->ctx.sums + (size_t)y * n, 0, n * sizeof(float));
 }
 
+/* What one slice of each pass costs, in a trace's slices (instructions,
+ * rock06 256 x 256 at scale 32, callgrind): the progress's weights. */
+static int slice_work(pass_mode mode) {
+  return mode == PASS_DIRECT ? 3 : mode == PASS_SURFACE ? 16 : 10;
+}
+
+static int surface_passes(const bb__bounce_options *o) {
+  if (o->bounces > 0) return o->bounces - 1;
+  return o->estimate_passes > 1 ? o->estimate_passes : 1;
+}
+
+static int coarse_slices(const bb_rayset *rs, const bb__bounce_options *o) {
+  const int n = o->surface_slices;
+  if (n > 0) return n < rs->slice_count ? n : rs->slice_count;
+  return rs->slice_count / 2 >= 4 ? rs->slice_count / 2 : rs->slice_count;
+}
+
+long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o) {
+  return (long)rs->slice_count * (slice_work(PASS_DIRECT) + slice_work(PASS_TEXEL)) +
+         (long)surface_passes(o) * coarse_slices(rs, o) * slice_work(PASS_SURFACE);
+}
+
 static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err) {
   bounce_ctx *ctx = &d->ctx;
   const int coarse = mode == PASS_SURFACE && d->coarse.slice_count;
   const bb_rayset *rs = coarse ? &d->coarse : d->fine;
   const int *order = coarse ? d->coarse_order : d->order;
+  const bb__bounce_options *o = d->o;
   ctx->rs = rs;
   ctx->mode = mode;
-  ctx->exact_steps = mode == PASS_TEXEL ? d->o->exact_steps : d->o->surface_exact_steps;
-  ctx->far_steps = mode == PASS_TEXEL ? d->o->far_steps : d->o->surface_far_steps;
-  bb_status st = bb__parallel_for(ctx->p->height, d->o->threads, zero_row, d, NULL, NULL, err);
+  ctx->exact_steps = mode == PASS_TEXEL ? o->exact_steps : o->surface_exact_steps;
+  ctx->far_steps = mode == PASS_TEXEL ? o->far_steps : o->surface_far_steps;
+  bb_status st = bb__parallel_for(ctx->p->height, o->threads, zero_row, d, NULL, NULL, err);
   for (int k = 0; st == BB_OK && k < rs->slice_count;) {
     const int s = order[k];
     const int pair = k + 1 < rs->slice_count &&
@@ -1002,16 +1031,36 @@ static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err)
     const bb__sweep_dir along = {rs, s, NULL, NULL};
     const bb__sweep_dir opposite = {rs, pair ? order[k + 1] : 0, NULL, NULL};
     st = bb__sweep_lines_hooked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
-                                pair ? &opposite : NULL, bias, d->o->threads, 0, line_hook, ctx,
+                                pair ? &opposite : NULL, bias, o->threads, 0, line_hook, ctx,
                                 err);
     k += pair ? 2 : 1;
     if (st == BB_OK && atomic_load(&ctx->out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");
-    if (st == BB_OK && d->o->progress &&
-        d->o->progress(d->o->progress_user, k, rs->slice_count))
+    /* monotone over the whole: what the passes before this one did, and
+     * this one's slices so far */
+    const long done = o->progress_before + d->work_done + (long)k * slice_work(mode);
+    const long total = o->progress_before + d->work + o->progress_after;
+    if (st == BB_OK && o->progress && o->progress(o->progress_user, done, total))
       st = bb__fail(err, BB_ERR_CANCELLED, "bounce: cancelled by the progress callback");
   }
+  d->work_done += (long)rs->slice_count * slice_work(mode);
   return st;
+}
+
+/* Bounces 0 starts from an estimate of each corner's converged light: as
+ * though every surface it sees were as bright as itself, the light it
+ * reflects is its first bounce times 1 / (1 - lambda), lambda = rho beta,
+ * beta the part of its hemisphere (cosine-weighted) that the surface
+ * blocks, 1 - E_ao / pi (held under 0.9). One surface pass from there
+ * brings the texels within what 4 or 5 passes from the first bounce did
+ * (docs/accuracy.md "Inter-reflection"). Lobes take the ao channel's
+ * ratio: the surfaces seen are lit by the same lobe. */
+static double estimate_ratio(const driver *d, double rho, size_t v, int f) {
+  const double e_ao = (double)d->direct[(v * FACES + (size_t)f) * (size_t)d->ctx.channels];
+  double beta = 1.0 - e_ao / BB__PI;
+  beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
+  const double lambda = rho * beta;
+  return lambda < 0.9 ? lambda : 0.9;
 }
 
 /* After the direct pass: each corner's E from the sky, and its radiance. */
@@ -1033,7 +1082,9 @@ static void direct_row(void *user, int y) {
         const double e = n[f][0] * all[0] + n[f][1] * all[1] + n[f][2] * all[2] - (double)ctx->sums[i];
         d->direct[i] = (float)(e > 0.0 ? e : 0.0);
         if (out != SIZE_MAX) {
-          d->radiance[out + (size_t)k] = (float)(rho / BB__PI * (double)d->direct[i]);
+          /* the first bounce, or (bounces 0) the corner's estimate of all */
+          const double gain = d->o->bounces ? 1.0 : 1.0 / (1.0 - estimate_ratio(d, rho, v, f));
+          d->radiance[out + (size_t)k] = (float)(rho / BB__PI * (double)d->direct[i] * gain);
           sum += fixed((double)d->radiance[out + (size_t)k]);
         }
       }
@@ -1042,9 +1093,9 @@ static void direct_row(void *user, int y) {
   d->row_sum[y] = sum;
 }
 
-/* After a surface pass: how far each corner's radiance would move (the
- * largest and the sum, per row); then the move, and with it, when the
- * bounces stop here, the rest of the series estimated as geometric. */
+/* After a surface pass: how far each corner's radiance would move, summed
+ * per row; then the move, and with it, when the bounces stop here, the
+ * rest of the series estimated as geometric. */
 static double corner_radiance(const driver *d, size_t v, size_t i) {
   const double rho = d->o->rho * (d->albedo ? (double)d->albedo[v] : 1.0);
   const double e = (double)d->direct[i] + (double)d->ctx.sums[i];
@@ -1055,7 +1106,6 @@ static void change_row(void *user, int y) {
   driver *d = user;
   const int channels = d->ctx.channels;
   const size_t W = (size_t)d->ctx.p->width;
-  double largest = 0.0;
   exact_sum sum = 0;
   for (size_t x = 0; x < W; x++) {
     const size_t v = (size_t)y * W + x;
@@ -1064,14 +1114,11 @@ static void change_row(void *user, int y) {
       if (out == SIZE_MAX) continue;
       for (int k = 0; k < channels; k++) {
         const size_t i = (v * FACES + (size_t)f) * (size_t)channels + (size_t)k;
-        const double moved =
-            fabs((double)(float)corner_radiance(d, v, i) - (double)d->radiance[out + (size_t)k]);
-        largest = moved > largest ? moved : largest;
-        sum += fixed(moved);
+        sum += fixed(fabs((double)(float)corner_radiance(d, v, i) -
+                          (double)d->radiance[out + (size_t)k]));
       }
     }
   }
-  d->row_change[y] = largest;
   d->row_sum[y] = sum;
 }
 
@@ -1148,7 +1195,7 @@ static void finish_row(void *user, int y) {
 
 void bb__bounce_options_init(bb__bounce_options *o) {
   memset(o, 0, sizeof *o);
-  o->tolerance = 1e-2;
+  o->estimate_passes = 1;
   o->lift = 0.25;
   o->exact_steps = 4;
   o->surface_exact_steps = 1;
@@ -1177,18 +1224,17 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   ctx->sums = malloc(corners * sizeof(float));
   d.direct = malloc(corners * sizeof(float));
   d.radiance = malloc(corners * sizeof(float));
-  d.row_change = malloc((size_t)p->height * sizeof(double));
   d.row_sum = malloc((size_t)p->height * sizeof *d.row_sum);
   ctx->slot_count = threads < 256 ? threads : 256;
   ctx->slots = calloc((size_t)ctx->slot_count, sizeof(scratch));
   bb_status st = BB_OK;
-  if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_change || !d.row_sum || !ctx->slots ||
+  if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
       bb_trace_slice_order(rs, order, NULL) != BB_OK)
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)", corners / (size_t)channels);
   d.order = order;
   d.fine = rs;
-  int surface_slices = o->surface_slices;
-  if (surface_slices <= 0) surface_slices = rs->slice_count / 2 >= 4 ? rs->slice_count / 2 : rs->slice_count;
+  const int surface_slices = coarse_slices(rs, o);
+  d.work = bb__bounce_work(rs, o);
   if (st == BB_OK && surface_slices < rs->slice_count) {
     bb_basis basis = {.count = rs->basis_count, .name = "bounce"};
     memcpy(basis.vector, rs->basis, sizeof basis.vector);
@@ -1204,27 +1250,24 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, direct_row, &d, NULL, NULL, err);
   if (st == BB_OK) corner_fixup(&d);
   ctx->radiance = d.radiance;
-  /* The bounces: each adds what the corners gather of the last one. With
-   * bounces 0 they stop once no corner moves by more than the tolerance;
-   * the terms left are then about the last one times lambda / (1 - lambda),
-   * lambda the ratio of the last two moves summed over every corner (the
-   * series of bounces is close to geometric), and that is added. */
+  /* The bounces: each pass adds what the corners gather of the last one.
+   * bounces N: N - 1 passes from the first bounce. bounces 0: the passes
+   * from the estimate; the terms left are then about the last move times
+   * lambda / (1 - lambda), lambda the ratio of the last two moves summed
+   * over every corner (the series of bounces is close to geometric), and
+   * that is added. */
   int done = 1;
   exact_sum last_sum = 0;
   for (int y = 0; st == BB_OK && y < p->height; y++) last_sum += d.row_sum[y];
-  while (st == BB_OK && (o->bounces == 0 ? done < BB_MAX_BOUNCES : done < o->bounces)) {
+  const int passes = surface_passes(o);
+  for (int pass = 0; st == BB_OK && pass < passes; pass++) {
     st = run_pass(&d, PASS_SURFACE, o->lift, err);
     if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, change_row, &d, NULL, NULL, err);
     if (st != BB_OK) break;
-    double change = 0.0;
     exact_sum sum = 0;
-    for (int y = 0; y < p->height; y++) {
-      change = d.row_change[y] > change ? d.row_change[y] : change;
-      sum += d.row_sum[y];
-    }
-    const int stop = o->bounces == 0 && change <= o->tolerance;
+    for (int y = 0; y < p->height; y++) sum += d.row_sum[y];
     d.tail = 0.0;
-    if (stop && last_sum > 0) {
+    if (o->bounces == 0 && pass == passes - 1 && last_sum > 0) {
       double lambda = (double)sum / (double)last_sum;
       lambda = lambda < 0.9 ? lambda : 0.9;
       d.tail = lambda / (1.0 - lambda);
@@ -1233,7 +1276,6 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
     st = bb__parallel_for(p->height, o->threads, update_row, &d, NULL, NULL, err);
     if (st == BB_OK) corner_fixup(&d);
     done++;
-    if (stop) break;
   }
   if (st == BB_OK) st = run_pass(&d, PASS_TEXEL, o->bias, err);
   if (st == BB_OK) {
@@ -1252,7 +1294,6 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
   free(ctx->sums);
   free(d.direct);
   free(d.radiance);
-  free(d.row_change);
   free(d.row_sum);
   bb__rayset_release(&d.coarse);
   free(d.coarse_order);

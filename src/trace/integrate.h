@@ -7,6 +7,7 @@
 #include "trace/rayset.h"
 
 #include <stddef.h>
+#include <string.h>
 
 /* Intervals of a slice's table in q = t / (1 + t) (integrate.c). */
 #define BB__TABLE_INTERVALS 256
@@ -105,6 +106,48 @@ static inline void bb__slice_accumulate(const bb__slice_integral *si, float hori
   sums[2] += (float)blocked[2];
   sums[3] += (float)blocked[3];
   if (si->lobes > 3) sums[4] += (float)blocked[4];
+}
+
+/* Three lobes (Half-Life 2's basis and any other of 3 vectors), the four
+ * channels of a texel's sums at once: a slice's table laid out again, per
+ * interval its 4 coefficients as vectors of the 4 channels (channel 0, ao,
+ * zero: ao is not a table), so one vector operation does the Hermite
+ * piece's step for every lobe, each lane exactly as BB__HERMITE does it
+ * (the same operations in the same order; ao's lane adds f * 0 = 0 to
+ * ao), and the four floats are added to the sums at once. The same bits
+ * as bb__slice_accumulate; rock06: a third of the integration's
+ * instructions. */
+typedef double bb__channels4 __attribute__((vector_size(4 * sizeof(double))));
+typedef float bb__channels4f __attribute__((vector_size(4 * sizeof(float))));
+
+/* out: BB__TABLE_INTERVALS * 4 vectors, from si's table (si->lobes == 3). */
+static inline void bb__slice_table4(const bb__slice_integral *si, bb__channels4 *out) {
+  for (int k = 0; k < BB__TABLE_INTERVALS; k++)
+    for (int e = 0; e < 4; e++) {
+      const double *coef = si->table + (size_t)k * 12;
+      out[k * 4 + e] = (bb__channels4){0.0, coef[e], coef[4 + e], coef[8 + e]};
+    }
+}
+
+static inline __attribute__((always_inline)) void bb__slice_accumulate4(
+    const bb__slice_integral *si, const bb__channels4 *table4, float horizon, float *sums) {
+  if (!(horizon > 0.0f)) return;
+  const double t = (double)horizon; /* as bb__slice_blocked4 */
+  const double tt = t * t, one_t = 1.0 + t, one_tt = 1.0 + tt;
+  const double inverse = 1.0 / (one_t * one_tt);
+  const double ao = si->half_width * (tt * one_t * inverse);
+  const double x = t * one_tt * inverse * BB__TABLE_INTERVALS;
+  int k = (int)x;
+  if (k > BB__TABLE_INTERVALS - 1) k = BB__TABLE_INTERVALS - 1;
+  const double f = x - (double)k;
+  const bb__channels4 *c = table4 + (size_t)k * 4;
+  bb__channels4 c0 = c[0];
+  c0[0] = ao;
+  const bb__channels4 blocked = c0 + f * (c[1] + f * (c[2] + f * c[3]));
+  bb__channels4f add = __builtin_convertvector(blocked, bb__channels4f), sum;
+  memcpy(&sum, sums, sizeof sum);
+  sum += add;
+  memcpy(sums, &sum, sizeof sum);
 }
 
 #endif /* BB_TRACE_INTEGRATE_H */

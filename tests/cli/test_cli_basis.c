@@ -10,7 +10,7 @@
 
 #include <math.h>
 
-TestSuite(cli_basis, .init = harness_setup, .fini = harness_teardown, .timeout = 60);
+TestSuite(cli_basis, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 /* A small height field with relief in every direction, as a float TIFF. */
 static const char *relief(void) {

@@ -8,10 +8,12 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 
+#include <fcntl.h>
 #include <math.h>
+#include <sys/stat.h>
 #include <time.h>
 
-TestSuite(cli_batch, .init = harness_setup, .fini = harness_teardown, .timeout = 60);
+TestSuite(cli_batch, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 /* A small height with relief, different for each seed. */
 static void height_file(const char *path, int seed) {
@@ -380,6 +382,31 @@ Test(cli_batch, make_runs_bakes_from_depfiles) {
   bb_image s = harness_read(tmp("out/b_ssbump.exr"), NULL);
   cr_expect_eq(s.channels, 5, "baked with the new 5-direction basis");
   bb_image_free(&s);
+
+  /* A touched, unchanged input: make runs the rule, the bake finds its
+   * output up to date and bakes nothing, but sets the output's time, so a
+   * second make has nothing to do (make compares times: it ran the rule
+   * on every make before). */
+  snprintf(command, sizeof command, "cp %s %s", tmp("out/a_ssbump.exr"), tmp("baked.exr"));
+  cr_assert_eq(system(command), 0);
+  nanosleep(&pause, NULL);
+  cr_assert_eq(utimensat(AT_FDCWD, tmp("a.png"), NULL, 0), 0);
+  cr_assert_gt(mtime_of(tmp("a.png")), mtime_of(tmp("out/a_ssbump.exr")));
+  snprintf(command, sizeof command, "make -C %s >%s 2>&1", harness_dir, tmp("make.log"));
+  cr_assert_eq(system(command), 0, "make: %s", read_text(tmp("make.log")));
+  char same[512];
+  snprintf(same, sizeof same, "cmp -s %s %s", tmp("out/a_ssbump.exr"), tmp("baked.exr"));
+  cr_expect_eq(system(same), 0, "the touched input was baked again");
+  cr_expect_geq(mtime_of(tmp("out/a_ssbump.exr")), mtime_of(tmp("a.png")));
+  char *log = read_text(tmp("make.log"));
+  cr_expect(strstr(log, "bake a.png"), "make ran the rule: %s", log);
+  free(log);
+  cr_assert_eq(system(command), 0, "make: %s", read_text(tmp("make.log")));
+  log = read_text(tmp("make.log"));
+  cr_expect(!strstr(log, "bake "), "the second make ran a bake: %s", log);
+  free(log);
+  snprintf(command, sizeof command, "make -q -C %s >/dev/null 2>&1", harness_dir);
+  cr_expect_eq(system(command), 0, "make -q: everything up to date after the touch");
 }
 
 /* ninja reads the depfile too (deps = gcc), with both outputs of a bake

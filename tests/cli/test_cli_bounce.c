@@ -9,8 +9,11 @@
 #include "cli_harness.h"
 
 #include <math.h>
+#include <pty.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(cli_bounce, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 #define FAST "--scale", "6", "--slices", "8", "--filter-radius", "2"
 
@@ -99,4 +102,54 @@ Test(cli_bounce, relief_view_renders) {
                 0, "relief changed nothing");
   bb_image_free(&r);
   bb_image_free(&f);
+}
+
+/* On a terminal the bar runs once from 0 to 100% over the trace and every
+ * pass of the bounce, and is cleared before the first "wrote" line (not
+ * after it). A bake long enough for the bar to show (it waits a second):
+ * 256 x 256 on one thread with --bounce. */
+Test(cli_bounce, the_bar_is_monotone_and_cleared_before_wrote) {
+  bb_image h;
+  cr_assert_eq(bb_image_alloc(&h, 256, 256, 1, NULL), BB_OK);
+  for (int i = 0; i < 256 * 256; i++)
+    h.pixels[i] = (float)(0.5 + 0.4 * sin(0.31 * (i % 256)) * cos(0.23 * (i / 256)));
+  harness_write(tmp("big.png"), &h, BB_DEPTH_16, BB_RANGE_UNIT);
+  bb_image_free(&h);
+  int master;
+  const pid_t pid = forkpty(&master, NULL, NULL, NULL);
+  cr_assert_neq(pid, -1, "forkpty");
+  if (pid == 0) {
+    execl(harness_binary(), "bumpbake", "bake", tmp("big.png"), "--scale", "24", "--bounce",
+          "0.5", "--threads", "1", "--ao", tmp("big_ao.png"), (char *)NULL);
+    _exit(127);
+  }
+  size_t cap = 1 << 20, got = 0;
+  char *out = malloc(cap);
+  cr_assert_not_null(out);
+  ssize_t n;
+  while (got + 1 < cap && (n = read(master, out + got, cap - 1 - got)) > 0) /* EIO at the end */
+    got += (size_t)n;
+  out[got] = '\0';
+  close(master);
+  int status;
+  waitpid(pid, &status, 0);
+  cr_assert(WIFEXITED(status) && WEXITSTATUS(status) == 0, "bake failed: %s", out);
+  const char *wrote = strstr(out, "wrote ao");
+  cr_assert_not_null(wrote, "no wrote line: %s", out);
+  int last = -1, bars = 0;
+  for (const char *c = strstr(out, "bake ["); c; c = strstr(c + 1, "bake [")) {
+    const char *close = strchr(c, ']');
+    cr_assert_not_null(close);
+    int percent;
+    cr_assert_eq(sscanf(close + 1, " %d%%", &percent), 1, "%s", c);
+    cr_expect_geq(percent, last, "the bar went back from %d%% to %d%%", last, percent);
+    cr_expect_lt(c, wrote, "a bar after the wrote line");
+    last = percent, bars++;
+  }
+  cr_assert_gt(bars, 0, "no bar was drawn (the bake took under a second?): %s", out);
+  const char *clear = "\r\033[K";
+  cr_expect(wrote - out >= (long)strlen(clear) &&
+                !strncmp(wrote - strlen(clear), clear, strlen(clear)),
+            "the bar is not cleared right before the wrote line");
+  free(out);
 }

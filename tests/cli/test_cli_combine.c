@@ -18,7 +18,7 @@ static void setup(void) {
 static void teardown(void) {
   harness_teardown();
 }
-TestSuite(cli_combine, .init = setup, .fini = teardown, .timeout = 60);
+TestSuite(cli_combine, .init = setup, .fini = teardown, .timeout = 300);
 
 static bb_image noise(int w, int h, int channels, unsigned seed) {
   bb_image img;

@@ -20,7 +20,7 @@ static void setup(void) {
 static void teardown(void) {
   harness_teardown();
 }
-TestSuite(cli_convert, .init = setup, .fini = teardown, .timeout = 60);
+TestSuite(cli_convert, .init = setup, .fini = teardown, .timeout = 300);
 
 /* A tiling height with slopes in every direction, steep enough in places
  * for some N.B_c < 0. */

@@ -10,7 +10,7 @@
 
 #include <math.h>
 
-TestSuite(cli_messages, .init = harness_setup, .fini = harness_teardown, .timeout = 60);
+TestSuite(cli_messages, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 static void dome(const char *path, int channels, bb_depth depth) {
   bb_image h;

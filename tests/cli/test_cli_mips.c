@@ -18,7 +18,7 @@ static void setup(void) {
 static void teardown(void) {
   harness_teardown();
 }
-TestSuite(cli_mips, .init = setup, .fini = teardown, .timeout = 60);
+TestSuite(cli_mips, .init = setup, .fini = teardown, .timeout = 300);
 
 static void write_height(const char *path) {
   bb_image img;

@@ -18,7 +18,7 @@ static void setup(void) {
 static void teardown(void) {
   harness_teardown();
 }
-TestSuite(cli_program, .init = setup, .fini = teardown, .timeout = 60);
+TestSuite(cli_program, .init = setup, .fini = teardown, .timeout = 300);
 
 /* 4 x 4 heights as 8-bit grey, in id's bytes. */
 static void write_heights(const char *path) {

@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "hostile_headers.h"
 
 #include <math.h>
 
@@ -240,6 +241,81 @@ Test(cli_render, tiles_over_the_maximum) {
   expect_one_line_error(&r, 2, "32776x32776 picture, over the maximum");
   cli_result_free(&r);
   expect_no_new_files(1);
+}
+
+/* render --normal n4096.png --tile 8 ran 62 s at 16 GB peak, and an 8192
+ * map tiled 8 times was refused "over the maximum" only after 8 s and 1.7
+ * GB: the picture is now worked out from the headers, before any pixel is
+ * read (bb_render_files_check), as bakes are. The maps here are headers
+ * without pixels (write_png_header): reading them would fail, so only the
+ * check before the read can give these answers. */
+Test(cli_render, a_picture_too_large_is_refused_before_any_pixel_is_read) {
+  cr_assert_eq(write_png_header(tmp("n8192.png"), 8192, 8192), 0);
+  cli_result r = RUN("render", "--normal", tmp("n8192.png"), "--mode", "normal", "--tile", "8",
+                     "-o", tmp("o.png"));
+  expect_one_line_error(&r, 2, "65536x65536 picture, over the maximum");
+  cli_result_free(&r);
+  /* 2048 x 2048 tiled 8 times fits the limits (16384 x 16384), not the
+   * memory left under a 1.2 GB address space: refused with the figures. */
+  cr_assert_eq(write_png_header(tmp("n2048.png"), 2048, 2048), 0);
+  const run_limits lim = {-1,
+#ifdef __SANITIZE_ADDRESS__
+                          -1
+#else
+                          1200L << 20
+#endif
+  };
+#ifdef __SANITIZE_ADDRESS__
+  cr_skip_test("ASan reserves terabytes of address space: no RLIMIT_AS here");
+#endif
+  r = harness_run_limited(NULL, &lim,
+                          (const char *[]){"render", "--normal", tmp("n2048.png"), "--mode",
+                                           "normal", "--tile", "8", "-o", tmp("o.png"), NULL});
+  expect_one_line_error(&r, 1, "a 16384 x 16384 render needs about");
+  cr_expect(strstr(r.err, "is available (RLIMIT_AS)"), "%s", r.err);
+  cli_result_free(&r);
+  expect_no_new_files(2);
+}
+
+/* The estimate itself: the picture's size, and its memory from the sizes
+ * alone (render, tiles, crop and the encoder's copy). */
+Test(cli_render, the_render_estimate) {
+  bb_render_options o;
+  bb_render_options_init(&o);
+  o.tile_x = o.tile_y = 8;
+  int w = 0, h = 0;
+  double bytes = 0.0;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_render_estimate(4096, 4096, &o, 0, "r.png", BB_DEPTH_DEFAULT, &w, &h, &bytes,
+                                  &err), BB_OK, "%s", err.message);
+  cr_expect(w == 32768 && h == 32768);
+  /* the tiled picture (12 bytes a texel) and its 8-bit RGB copy */
+  cr_expect_float_eq(bytes, 32768.0 * 32768.0 * 15.0, 1.0);
+  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, "r.exr", BB_DEPTH_DEFAULT, NULL, NULL,
+                                  &bytes, &err), BB_OK);
+  cr_expect_float_eq(bytes, 32768.0 * 32768.0 * 24.0, 1.0); /* float EXR */
+  o.crop_width = o.crop_height = 100;
+  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, &w, &h, &bytes,
+                                  &err), BB_OK);
+  cr_expect(w == 100 && h == 100);
+  cr_expect_float_eq(bytes, (4096.0 * 4096.0 + 32768.0 * 32768.0) * 12.0, 1.0);
+  o.crop_x = 32700;
+  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
+                                  &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "not inside the 32768x32768 picture"), "%s", err.message);
+  o.crop_width = 0;
+  cr_expect_eq(bb_render_estimate(4097, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
+                                  &err), BB_ERR_SIZE);
+  /* bb_render itself refuses a picture over what is left, before
+   * allocating it (here under no limit at all: more than the limits). */
+  bb_image map;
+  cr_assert_eq(bb_image_alloc(&map, 8192, 8192, 3, NULL), BB_OK);
+  const bb_render_maps maps = {&map, NULL, NULL, NULL, NULL, NULL};
+  o.mode = BB_RENDER_NORMAL;
+  bb_image out;
+  cr_expect_eq(bb_render(&maps, &o, &out, &err), BB_ERR_SIZE);
+  cr_expect(strstr(err.message, "over the maximum"), "%s", err.message);
+  bb_image_free(&map);
 }
 
 Test(cli_render, albedo_of_another_size) {

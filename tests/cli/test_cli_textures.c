@@ -3,7 +3,8 @@
  * NAME_normal.dds in one command; height2ssbump and normal2ssbump write
  * VTFs too; what a texture cannot hold is a usage error before the bake;
  * a batch of VTF 7.3 files is judged up to date from their provenance,
- * texture settings included; info reads a VTF's header. */
+ * texture settings included; info reads a VTF's header; every reader takes
+ * a VTF's pixels (bake -> .vtf -> compare, render, ssbump2normal). */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
@@ -12,7 +13,7 @@
 
 #include <math.h>
 
-TestSuite(cli_textures, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(cli_textures, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 /* A 64 x 64 height with relief: bumps that shadow each other. */
 static void relief(const char *path, int width, int height) {
@@ -213,8 +214,96 @@ Test(cli_textures, info_reads_a_vtf_header) {
   cr_expect(strstr(r.out, "\"flag_names\":[\"SSBUMP\"]") && strstr(r.out, "\"mip_count\":6"),
             "%s", r.out);
   cli_result_free(&r);
-  /* A VTF's pixels are not read: said plainly. */
+  /* Its pixels are read too: a file is the same as itself. */
   r = RUN("compare", tmp("s.vtf"), tmp("s.vtf"));
-  harness_expect_error(&r, 4, "VTF textures are written, not read", "compare");
+  cr_expect_eq(r.code, 0, "%s%s", r.out, r.err);
+  cli_result_free(&r);
+}
+
+/* A fixture of fixtures/ (BB_FIXTURES), as an absolute path. */
+static const char *fixture(const char *name) {
+  static char path[4096];
+  const char *dir = getenv("BB_FIXTURES");
+  char rel[4096];
+  snprintf(rel, sizeof rel, "%s/%s", dir && *dir ? dir : "fixtures", name);
+  cr_assert(realpath(rel, path) != NULL, "fixture %s not found", rel);
+  return path;
+}
+
+/* The number after "key": in compare's JSON line. */
+static double json_number(const char *json, const char *key) {
+  char pattern[64];
+  snprintf(pattern, sizeof pattern, "\"%s\":", key);
+  const char *at = strstr(json, pattern);
+  cr_assert_not_null(at, "%s in %s", key, json);
+  return strtod(at + strlen(pattern), NULL);
+}
+
+Test(cli_textures, vtf_round_trip_within_block_error) {
+  /* rock06 at 128 x 128, scale 32: rough for its size, so a 4 x 4 block
+   * spans several features (the worst case of tests/texture/test_dds.c's
+   * goldens). Measured with libsquish 1.15's cluster fit, max / rms in
+   * 8-bit codes against the 8-bit PNG: ssbump DXT1 and DXT5 109 / 13.2,
+   * normal DXT1 68 / 8.2; BGR888 exact; RGBA16161616F the PNG's rounding
+   * (0.5 code) and the half's (2^-11). The bounds sit ~10% above. */
+  const char *height = fixture("rock06_128.png");
+  cli_result r = RUN("bake", height, "--scale", "32", "--rays", "32", "--ssbump", tmp("s.png"),
+                     "--normal", tmp("n.png"));
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  static const struct {
+    const char *map, *format, *png;
+    double max, rms; /* codes */
+  } cases[] = {
+      {"--ssbump", "dxt1", "s.png", 120, 14.5}, {"--ssbump", "dxt5", "s.png", 120, 14.5},
+      {"--normal", "dxt1", "n.png", 75, 9.0},   {"--ssbump", "bgr888", "s.png", 1e-4, 1e-4},
+      {"--ssbump", "bgra8888", "s.png", 1e-4, 1e-4},
+      {"--ssbump", "rgba16f", "s.png", 0.5 + 255.0 / 2048.0, 0.5 + 255.0 / 2048.0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char name[64];
+    snprintf(name, sizeof name, "%s_%s.vtf", cases[k].map + 2, cases[k].format);
+    r = RUN("bake", height, "--scale", "32", "--rays", "32", cases[k].map, tmp(name),
+            "--texture-format", cases[k].format, "--vtf-version", k % 2 ? "7.2" : "7.5");
+    cr_assert_eq(r.code, 0, "%s", r.err);
+    cli_result_free(&r);
+    r = RUN("compare", "--json", tmp(name), tmp(cases[k].png));
+    cr_assert(r.code == 0 || r.code == 2, "%s: %s%s", name, r.out, r.err);
+    cr_expect_eq(json_number(r.out, "channels"), 3.0, "%s", r.out);
+    const double max = json_number(r.out, "max_abs") * 255.0,
+                 rms = json_number(r.out, "rms") * 255.0;
+    cr_expect_leq(max, cases[k].max, "%s: worst %.2f codes", name, max);
+    cr_expect_leq(rms, cases[k].rms, "%s: rms %.2f codes", name, rms);
+    cli_result_free(&r);
+  }
+
+  /* The readers take it as any image: render from the exact VTF draws the
+   * PNG's picture, bit for bit; from DXT1 a picture; ssbump2normal too. */
+  r = RUN("render", "--ssbump", tmp("ssbump_bgr888.vtf"), "-o", tmp("r_vtf.png"));
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("render", "--ssbump", tmp("s.png"), "-o", tmp("r_png.png"));
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("compare", "-q", tmp("r_vtf.png"), tmp("r_png.png"));
+  cr_expect_eq(r.code, 0, "the same ssbump, the same picture");
+  cli_result_free(&r);
+  r = RUN("render", "--ssbump", tmp("ssbump_dxt1.vtf"), "-o", tmp("r_dxt1.png"));
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("ssbump2normal", tmp("ssbump_dxt1.vtf"), "-o", tmp("n2.png"));
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("info", tmp("ssbump_dxt1.vtf"));
+  cr_expect(strstr(r.out, "vtf: version 7.5, DXT1, 8 mip levels, flags 0x08000000 (SSBUMP)"),
+            "%s", r.out);
+  cli_result_free(&r);
+  /* A broken one: one line naming it, exit 4. */
+  FILE *f = fopen(tmp("cut.vtf"), "wb");
+  cr_assert_not_null(f);
+  fwrite("VTF\0\7\0\0\0\2\0\0\0P\0\0\0", 1, 16, f);
+  fclose(f);
+  r = RUN("compare", tmp("cut.vtf"), tmp("s.png"));
+  harness_expect_error(&r, 4, "cut.vtf", "compare");
   cli_result_free(&r);
 }

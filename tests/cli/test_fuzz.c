@@ -89,7 +89,7 @@ static void replay(const char *name, fuzz_target target, int expected_at_least) 
   }
 }
 
-TestSuite(fuzz, .timeout = 60);
+TestSuite(fuzz, .timeout = 300);
 
 /* getopt kept a pointer into the previous argv (freed by then) when a parse
  * stopped inside a cluster ("-xr5": unknown -x, "r5" pending); the next
@@ -117,7 +117,7 @@ Test(fuzz, cli_regressions) {
  * crashes are checked here, the allocations by `make fuzz`, which replays
  * them under its limits, and by tests/image/test_hostile_headers.c. */
 Test(fuzz, load_regressions) {
-  replay("load", bb_fuzz_load, 6);
+  replay("load", bb_fuzz_load, 8);
 }
 
 /* Models that read outside their directory or crashed Assimp: an OBJ whose

@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-TestSuite(hostile_headers, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(hostile_headers, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 /* ------------------------------------------------------- the library */
 
@@ -56,7 +56,7 @@ static void expect_refusal(child_call_fn fn, const char *what, const char *path,
   cr_expect(strstr(o.message, path) && strstr(o.message, part), "%s: '%s' lacks '%s'", what,
             o.message, part);
   cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", what, o.message);
-  cr_expect_lt(o.seconds, 1.0, "%s(%s) took %.2f s", what, path, o.seconds);
+  cr_expect_lt(o.cpu_seconds, 1.0, "%s(%s) took %.2f s of CPU", what, path, o.cpu_seconds);
   cr_expect_lt(o.max_rss_kib, 400L * 1024, "%s(%s) took %ld MiB", what, path,
                o.max_rss_kib / 1024);
 }
@@ -130,7 +130,7 @@ Test(hostile_headers, a_gif_screen_too_large_to_open_says_so) {
   cr_expect(strstr(o.message, mid) && strstr(o.message, "a GIF of 16384x16384 needs about") &&
                 strstr(o.message, "of memory"),
             "'%s'", o.message);
-  cr_expect_lt(o.seconds, 1.0, "took %.2f s", o.seconds);
+  cr_expect_lt(o.cpu_seconds, 1.0, "took %.2f s of CPU", o.cpu_seconds);
   cr_expect_lt(o.max_rss_kib, 400L * 1024, "took %ld MiB", o.max_rss_kib / 1024);
 #endif
 }
@@ -171,7 +171,7 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
     cr_expect(strstr(o.message, finds[i].reason), "%s: '%s' lacks '%s'", finds[i].input,
               o.message, finds[i].reason);
     cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", finds[i].input, o.message);
-    cr_expect_lt(o.seconds, 1.0, "%s took %.2f s", finds[i].input, o.seconds);
+    cr_expect_lt(o.cpu_seconds, 1.0, "%s took %.2f s of CPU", finds[i].input, o.cpu_seconds);
     cr_expect_lt(o.max_rss_kib, 400L * 1024, "%s took %ld MiB", finds[i].input,
                  o.max_rss_kib / 1024);
   }
@@ -180,8 +180,10 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
 /* ---------------------------------------------------------- the CLI */
 
 /* info and bake of each file under `ulimit -v 2000000` (KiB): exit 1, one
- * line naming the file and the reason, well under a second of work (the
- * bound is loose for a loaded machine; they take ~0.4 s, start-up). */
+ * line naming the file and the reason, well under two seconds of CPU (they
+ * take ~0.4 s, start-up). Wall-clock time is not asserted: at load 7 to 10
+ * these runs took 2.6 s and failed make test (make hostile bounds the
+ * wall clock). */
 Test(hostile_headers, info_and_bake_answer_at_once_in_2_gb) {
   const char *jpg = tmp("p.jpg"), *tif = tmp("t.tif"), *exr = tmp("a.exr"), *gif = tmp("g.gif");
   cr_assert_eq(write_progressive_jpeg(jpg, 65500, 65500), 0);
@@ -213,8 +215,8 @@ Test(hostile_headers, info_and_bake_answer_at_once_in_2_gb) {
     for (int k = 0; k < 2; k++) {
       const int is_info = k == 0;
       cli_result r = harness_run_limited(NULL, &two_gb, is_info ? info : bake);
-      cr_expect_lt(r.seconds, 2.0, "%s %s took %.1f s", is_info ? "info" : "bake",
-                   files[i].path, r.seconds);
+      cr_expect_lt(r.cpu_seconds, 2.0, "%s %s took %.1f s of CPU", is_info ? "info" : "bake",
+                   files[i].path, r.cpu_seconds);
       cr_expect_lt(r.max_rss_kib, rss_bound_kib, "%s %s took %ld MiB",
                    is_info ? "info" : "bake", files[i].path, r.max_rss_kib / 1024);
       if (is_info && files[i].info_ok) {

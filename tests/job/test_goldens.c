@@ -238,7 +238,7 @@ ParameterizedTestParameters(goldens, rebake_matches_golden) {
   return cr_make_param_array(golden_case, cases, (size_t)n);
 }
 
-ParameterizedTest(golden_case *c, goldens, rebake_matches_golden, .timeout = 30) {
+ParameterizedTest(golden_case *c, goldens, rebake_matches_golden, .timeout = 300) {
   char dir[] = "/tmp/bb-golden-XXXXXX";
   cr_assert_not_null(mkdtemp(dir));
   char log[8192] = "";

@@ -9,7 +9,7 @@
 
 #include <stdio.h>
 
-TestSuite(incremental, .init = harness_setup, .fini = harness_teardown, .timeout = 30);
+TestSuite(incremental, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 /* FNV-1a 64's published values: "" and "a", and a file larger than the
  * 64 KiB block agrees with a one-shot hash of its bytes. */

@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-TestSuite(job, .init = harness_setup, .fini = harness_teardown, .timeout = 30);
+TestSuite(job, .init = harness_setup, .fini = harness_teardown, .timeout = 300);
 
 /* A small height file in the test's directory. */
 static const char *height_file(void) {
@@ -59,3 +59,117 @@ Test(job, slope_lit_light_is_checked_when_planned) {
   }
 }
 
+/* The command recorded in provenance: bake's options that differ from
+ * their defaults, in --help's order, spelled as typed. */
+Test(job, command_text_spells_the_options_as_typed) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 16.0f;
+  o.out_dir = "out";
+  o.maps = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_AO);
+  char *text = bb_job_command_text(&o, "heights/a.png");
+  cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
+  free(text);
+  o.bake.height_scale = 0.1f;
+  o.bake.rays = 64;
+  o.depth = BB_DEPTH_16;
+  o.mips = 1;
+  o.channel = BB_CHANNEL_A;
+  o.maps = 0;
+  o.name_template = "{kind}/{stem}.tif";
+  text = bb_job_command_text(&o, "a.png");
+  cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
+                         "--mips --out-dir out --name {kind}/{stem}.tif");
+  free(text);
+}
+
+/* The engine textures' settings and the material come last, as in --help,
+ * spelled as the CLI reads them back; threads are not recorded. */
+Test(job, command_text_spells_the_texture_options) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 64.0f;
+  o.paths[BB_OUTPUT_SSBUMP] = "m/rock-ssbump.vtf";
+  o.texture.threads = 1;
+  char *text = bb_job_command_text(&o, "h.png");
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
+  free(text);
+  o.texture.format = BB_TEXTURE_FORMAT_BC3;
+  o.texture.vtf_version = 3;
+  o.texture.vtf_flags = 0x4;
+  o.texture.mips = 0;
+  o.texture.fast = 1;
+  o.vmt = "m/rock.vmt";
+  o.vmt_materials = "m";
+  o.vmt_basetexture = "m/rock.vtf";
+  text = bb_job_command_text(&o, "h.png");
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
+                         "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
+                         "--fast-compression --vmt m/rock.vmt --materials m "
+                         "--basetexture m/rock.vtf");
+  free(text);
+}
+
+/* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
+ * would write, kept instead, with the kinds asked besides; nothing written. */
+Test(job, bake_item_keeps_the_maps_run_item_writes) {
+  const char *input = height_file();
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.bake.rays = 16;
+  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
+  o.paths[BB_OUTPUT_AO] = tmp("ao.exr");
+  o.force = 1;
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_bake_result kept;
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUT_BIT(BB_OUTPUT_BENT), NULL, NULL, &kept, &err),
+               BB_OK, "%s", err.message);
+  cr_expect_eq(access(tmp("s.exr"), F_OK), -1, "bake_item wrote a file");
+  cr_expect_not_null(kept.bent.pixels, "the kind asked besides");
+  cr_expect_null(kept.weights.pixels, "a kind not asked");
+  cr_expect_eq(bb_job_report_get(job, 0)->width, 8);
+  cr_assert_eq(bb_job_run_item(job, 0, NULL, NULL), BB_OK);
+  const struct {
+    const char *path;
+    const bb_image *img;
+  } maps[] = {{tmp("s.exr"), &kept.ssbump}, {tmp("ao.exr"), &kept.ao}};
+  for (int m = 0; m < 2; m++) {
+    bb_image written;
+    cr_assert_eq(bb_image_read(maps[m].path, &written, NULL, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(written.width * written.height * written.channels,
+                 maps[m].img->width * maps[m].img->height * maps[m].img->channels);
+    cr_expect_eq(memcmp(written.pixels, maps[m].img->pixels,
+                        sizeof(float) * (size_t)(written.width * written.height * written.channels)),
+                 0, "%s differs from the maps kept", maps[m].path);
+    bb_image_free(&written);
+  }
+  bb_bake_result_free(&kept);
+  bb_job_free(job);
+}
+
+static int cancel_at_once(void *user, long done, long total) {
+  (void)user, (void)done, (void)total;
+  return 1;
+}
+
+/* A cancelled bake keeps nothing and says so. */
+Test(job, bake_item_cancelled_keeps_nothing) {
+  const char *input = height_file();
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_bake_result kept;
+  cr_expect_eq(bb_job_bake_item(job, 0, 0u, cancel_at_once, NULL, &kept, &err),
+               BB_ERR_CANCELLED);
+  cr_expect_null(kept.ssbump.pixels);
+  cr_expect_eq(bb_job_bake_item(job, 0, 1u << 30, NULL, NULL, &kept, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_job_bake_item(job, 1, 0u, NULL, NULL, &kept, &err), BB_ERR_ARGUMENT);
+  bb_job_free(job);
+}

@@ -1,6 +1,7 @@
 /* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a
  * process. */
 #include "bumpbake.h"
+#include "hostile_headers.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
@@ -293,7 +294,7 @@ static void cli_setup(void) {
     ramp[i] = (float)i / 16.0f;
 }
 
-TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 30);
+TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 300);
 
 Test(compare_cli, identical_files_pass_with_exit_0) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 0, 0);
@@ -441,6 +442,26 @@ Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
     cr_assert(strncmp(out, "bumpbake compare: ", 18) == 0, "compare %s: %s", args, out);
     char *nl = strchr(out, '\n');
     cr_assert(nl && nl[1] == '\0', "one line for compare %s: %s", args, out);
+  }
+}
+
+/* A file over the size limit cannot be read: idiff's 4, as for any file
+ * that cannot be read, not 3 ("different size"), which bumpbake gave for
+ * a 65535 x 65535 PNG header, an oversize DDS, a TIFF of huge tiles and
+ * one of 65535 channels. */
+Test(compare_cli, a_file_over_the_size_limit_is_unreadable_exit_4) {
+  const char *a = ramp_with("a.exr", 0, 0);
+  cr_assert_eq(write_png_header(tmp_file("wide.png"), 65535, 65535), 0);
+  cr_assert_eq(write_dds_header(tmp_file("big.dds"), 65536, 65536), 0);
+  cr_assert_eq(write_tiled_tiff(tmp_file("tiles.tif"), 1, 1, 16384, 16384), 0);
+  cr_assert_eq(write_hostile_tiff(tmp_file("channels.tif"), 4, 4, 65535), 0);
+  const char *files[] = {"wide.png", "big.dds", "tiles.tif", "channels.tif"};
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    char out[4096];
+    const char *path = tmp_file(files[i]);
+    cr_expect_eq(run(out, sizeof out, "compare %s %s", i % 2 ? a : path, i % 2 ? path : a), 4,
+                 "%s: %s", files[i], out);
+    cr_expect(strstr(out, files[i]), "%s: %s", files[i], out);
   }
 }
 

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-TestSuite(mesh_cli, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(mesh_cli, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 static void write_text(const char *path, const char *text) {
   write_bytes(path, text, strlen(text));

@@ -21,7 +21,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-TestSuite(mesh_hostile, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
+TestSuite(mesh_hostile, .init = harness_setup, .fini = harness_teardown, .timeout = 600);
 
 /* ------------------------------------------------------------- making */
 
@@ -265,7 +265,7 @@ Test(mesh_hostile, a_side_file_that_is_not_a_regular_file_fails_and_a_missing_on
 /* The model itself as a FIFO or a device: refused at once, not opened
  * for blocking reads. */
 Test(mesh_hostile, a_model_that_is_a_fifo_or_a_device_is_refused_without_blocking,
-     .timeout = 20) {
+     .timeout = 300) {
   cr_assert_eq(mkfifo(tmp("fifo.obj"), 0644), 0);
   cr_assert_eq(symlink("/dev/zero", tmp("zero.obj")), 0);
   expect_refused(tmp("fifo.obj"), BB_ERR_IO, "is a FIFO, not a regular file");

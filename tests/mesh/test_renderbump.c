@@ -618,7 +618,7 @@ static bb_status load_status(const char *path, char *message, size_t cap) {
 }
 
 Test(renderbump_files, unreadable_empty_truncated_and_triangle_free_models_fail,
-     .timeout = 20) {
+     .timeout = 300) {
   char path[128], msg[512];
   bb_error err = {{0}};
   cr_assert_eq(load_status(tmp_path(path, sizeof path, "missing.obj"), msg, sizeof msg),

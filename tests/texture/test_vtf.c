@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bumpbake.h"
@@ -489,6 +490,34 @@ Test(vtf, read_info_refuses_broken_files) {
   cr_assert_eq(bb_vtf_read_info(in_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
   cr_assert_null(info.description);
+  /* The low-resolution resource's offset past the end (the image data
+   * still ends where the file does): the message says which part, and no
+   * more than the truth ("needs 3636 bytes, the file has 3636" it was). */
+  unsigned char *moved = malloc(size);
+  memcpy(moved, good, size);
+  cr_assert_eq(oracle_u32(moved + 80), 0x01, "the low-res entry comes first");
+  const uint32_t past = (uint32_t)size + 100;
+  for (int i = 0; i < 4; i++)
+    moved[84 + i] = (unsigned char)(past >> (8 * i));
+  spill(in_dir("l.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
+  char want[160];
+  snprintf(want, sizeof want, "low-resolution image (128 bytes at offset %u) ends past the end "
+           "of the file (%zu bytes)", past, size);
+  cr_expect_not_null(strstr(err.message, want), "%s", err.message);
+  /* The image resource's offset past the end. */
+  memcpy(moved, good, size);
+  for (int i = 0; i < 4; i++)
+    moved[92 + i] = (unsigned char)(past >> (8 * i));
+  spill(in_dir("i.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
+  size_t data = 0; /* DXT1, 32 x 32 down to 1 x 1 */
+  for (int side = 32; side >= 1; side /= 2)
+    data += (size_t)((side + 3) / 4) * (size_t)((side + 3) / 4) * 8;
+  snprintf(want, sizeof want, "image data (%zu bytes at offset %u) ends past the end of the "
+           "file (%zu bytes)", data, past, size);
+  cr_expect_not_null(strstr(err.message, want), "%s", err.message);
+  free(moved);
   /* Not a VTF; a version from the future; a resource count past the header. */
   spill(in_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
   cr_assert_eq(bb_vtf_read_info(in_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
@@ -555,6 +584,42 @@ Test(vtf, material) {
   bb_vmt_options none = {materials, NULL, NULL, 1};
   cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &none, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(access(in_dir("x.vmt"), F_OK), -1);
+  remove_dir();
+}
+
+/* bb_vmt_write (what Python's write_vmt calls) turned the texture it names
+ * into a 103-byte material, and overwrote a PNG: a material's name ends in
+ * .vmt and is no other name of a texture it names, as for bake --vmt. */
+Test(vtf, a_material_never_overwrites_a_texture_or_another_file) {
+  make_dir();
+  char materials[160], bump[200], alias[200];
+  snprintf(materials, sizeof materials, "%s/materials", dir);
+  cr_assert_eq(mkdir(materials, 0755), 0);
+  snprintf(bump, sizeof bump, "%s/materials/s.vtf", dir);
+  snprintf(alias, sizeof alias, "%s/materials/s.vmt", dir);
+  spill(bump, (const unsigned char *)"VTF\0 texture", 12);
+  spill(in_dir("x.png"), (const unsigned char *)"png bytes", 9);
+  bb_vmt_options o = {NULL, bump, NULL, 1};
+  bb_error err = {{0}};
+  cr_expect_eq(bb_vmt_write(bump, &o, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "ends in .vmt"), "%s", err.message);
+  cr_expect_eq(bb_vmt_write(in_dir("x.png"), &o, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_vmt_write(in_dir("x.VMT.png"), &o, &err), BB_ERR_ARGUMENT);
+  /* s.vmt a hard link of the texture: the same file under a .vmt name. */
+  cr_assert_eq(link(bump, alias), 0);
+  cr_expect_eq(bb_vmt_write(alias, &o, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "would overwrite the texture"), "%s", err.message);
+  bb_vmt_options base = {NULL, in_dir("materials/t.vtf"), bump, 1};
+  cr_expect_eq(bb_vmt_write(alias, &base, &err), BB_ERR_ARGUMENT);
+  size_t size;
+  unsigned char *bytes = slurp(bump, &size);
+  cr_expect(size == 12 && memcmp(bytes, "VTF\0 texture", 12) == 0, "the texture was changed");
+  free(bytes);
+  bytes = slurp(in_dir("x.png"), &size);
+  cr_expect(size == 9 && memcmp(bytes, "png bytes", 9) == 0, "the PNG was changed");
+  free(bytes);
+  /* Upper case is a .vmt too. */
+  cr_expect_eq(bb_vmt_write(in_dir("materials/M.VMT"), &o, &err), BB_OK, "%s", err.message);
   remove_dir();
 }
 

@@ -5,6 +5,7 @@
 #include <criterion/criterion.h>
 
 #include <math.h>
+#include <string.h>
 
 #include "bumpbake.h"
 #include "trace/integrate.h"
@@ -216,4 +217,29 @@ Test(integrate, slices_for_rays_follow_valves_count) {
   cr_assert_eq(bb_slices_for_rays(1024), 32);
   cr_assert_eq(bb_slices_for_rays(1), 1);
   cr_assert_eq(bb_slices_for_rays(65536), 256);
+}
+
+/* The four channels at once (three lobes, bb__slice_accumulate4, the
+ * sweeps' path) add exactly the bits the lobes one by one add (the
+ * march's path), over horizons from none to nearly vertical. */
+Test(integrate, four_channels_at_once_add_the_same_bits) {
+  double basis[3][3];
+  for (int c = 0; c < 3; c++) bb_basis_vector(c, basis[c]);
+  static double table[BB__TABLE_INTERVALS * 3 * 4];
+  static bb__channels4 table4[BB__TABLE_INTERVALS * 4];
+  double share[3];
+  bb__slice_table_build(0.7, 0.7 + 2 * PI / 16, (const double(*)[3])basis, 3, 1.0, table, share);
+  const bb__slice_integral si = {table, PI / 16, 3};
+  bb__slice_table4(&si, table4);
+  float one[5] = {0.25f, 0.5f, 0.0f, 1.0f, 0.0f}, four[5]; /* room for a 4th lobe's channel */
+  memcpy(four, one, sizeof four);
+  long compared = 0;
+  for (float h = -1.0f; h < 1e6f; h = h < 1e-3f ? h + 0.0137f : h * 1.013f) {
+    bb__slice_accumulate(&si, h, one);
+    bb__slice_accumulate4(&si, table4, h, four);
+    cr_assert(memcmp(one, four, 4 * sizeof(float)) == 0, "horizon %.9g: %.9g %.9g %.9g %.9g against %.9g %.9g %.9g %.9g",
+              (double)h, one[0], one[1], one[2], one[3], four[0], four[1], four[2], four[3]);
+    compared++;
+  }
+  cr_assert(compared > 1000, "%ld horizons", compared);
 }

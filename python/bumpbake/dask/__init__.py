@@ -18,7 +18,15 @@ runs). docs/cluster.md says how to start a cluster and what each worker
 holds.
 """
 
+try:
+    import distributed  # noqa: F401
+except ImportError as e:
+    raise ModuleNotFoundError(
+        f"bumpbake.dask needs Dask's distributed ({e}): install Debian's python3-distributed "
+        "and python3-dask (make deps)", name=e.name) from None
+
 from ._batch import bake_files
 from ._big import bake_big
+from ._connect import ClusterLost
 
-__all__ = ["bake_big", "bake_files"]
+__all__ = ["ClusterLost", "bake_big", "bake_files"]

@@ -4,6 +4,7 @@ batch."""
 
 import math
 import os
+import time
 import uuid
 
 import distributed
@@ -11,6 +12,7 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
+from ._connect import ClusterLost, completed, settle
 from ._shared import client_directory, client_of, variable_value, worker_threads
 
 # Inputs per chunk: enough chunks that the last ones end together (the
@@ -36,9 +38,26 @@ class _Stop:
     Inputs after it that have not started are not run; those before it
     still run, as in the CLI's batch, which would have baked them first."""
 
+    # Seconds between two looks at the variable during one input's bake.
+    LOOK_EVERY = 0.5
+
     def __init__(self, name):
         self.name = name
         self.over = False  # the batch ended: this chunk is a re-run nobody waits for
+        self._next_look = 0.0
+
+    def abandoned(self, done=None, total=None):
+        """During an input's bake (its progress callback): whether the
+        client gave up (Ctrl-C, its own error: the variable is -1, or gone),
+        looked at every LOOK_EVERY seconds. The bake is then cancelled and
+        writes nothing: an input that failed stops only later inputs."""
+        now = time.monotonic()
+        if self.over or now < self._next_look:
+            return self.over
+        self._next_look = now + self.LOOK_EVERY
+        stop = variable_value(self.name, None)
+        self.over = stop is None or stop < 0
+        return self.over
 
     def reached(self, index):
         if self.over:
@@ -69,7 +88,7 @@ def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
             if stop is not None and stop.reached(index):
                 out.append((index, None))
                 continue
-            report = job.run(k)
+            report = job.run(k, progress=stop.abandoned if stop is not None else None)
             if report.status == "failed" and stop_on_failure:
                 stop.lower(index)
             out.append((index, report))
@@ -157,12 +176,16 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         raise _argument_error(f"bumpbake.dask: chunk_size must be a positive integer "
                               f"(got {chunk_size!r})")
     token = uuid.uuid4().hex
-    stop = None
-    if not keep_going or progress is not None:
-        stop = _Stop(f"bumpbake-stop-{token}")
-        distributed.Variable(stop.name, client=client).set(_NO_STOP)
+    # Always there: a client that gives up (Ctrl-C, an exception) stops
+    # every chunk before its next input, keep_going or not.
+    stop = _Stop(f"bumpbake-stop-{token}")
+    distributed.Variable(stop.name, client=client).set(_NO_STOP)
     chunks = [pending[c:c + size] for c in range(0, len(pending), size)]
     futures = {}
+
+    def stop_all():
+        distributed.Variable(stop.name, client=client).set(-1)
+
     try:
         for n, chunk in enumerate(chunks):
             f = client.submit(_bake_chunk, directory, [inputs_planned[i] for i in chunk], chunk,
@@ -170,16 +193,21 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
                               key=f"bumpbake-chunk-{token}-{n}", pure=False)
             futures[f] = chunk
         done = count - len(pending)
-        for f in distributed.as_completed(list(futures)):
+        for f in completed(client, list(futures)):
             for index, report in f.result():
                 reports[index] = report
                 done += 1
             if progress is not None and progress(done, count):
-                distributed.Variable(stop.name, client=client).set(-1)
-    except BaseException:
-        if stop is not None:
-            distributed.Variable(stop.name, client=client).set(-1)
-        client.cancel(list(futures))
+                stop_all()
+    except BaseException as e:
+        # Nothing that has not started starts: the queued chunks are
+        # cancelled, the running ones stop before their next input (a
+        # running input is finished, whole: a task cannot be killed).
+        settle(client, stop_all)
+        settle(client, lambda: client.cancel(list(futures)))
+        if isinstance(e, ClusterLost):
+            # what the workers it lost were writing
+            sweep_temporaries(_output_directories(job.report(i) for i in range(count)))
         raise
     finally:
         # Released now, not when the frame goes (an exception's traceback
@@ -188,8 +216,7 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         for f in futures:
             f.release()
         futures.clear()
-        if stop is not None:
-            distributed.Variable(stop.name, client=client).delete()
+        settle(client, lambda: distributed.Variable(stop.name, client=client).delete())
     for i in range(count):
         if reports[i] is None:
             reports[i] = job.report(i)

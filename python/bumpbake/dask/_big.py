@@ -22,9 +22,10 @@ import distributed
 import numpy as np
 
 from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _kinds_mask
-from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _text
+from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
+from ._connect import ClusterLost, completed, settle
 from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
                       worker_threads)
 
@@ -149,7 +150,7 @@ def _build(task, threads):
     err = _ffi.new("bb_error *")
     height = _ffi.new("bb_image *")
     source = _ffi.new("bb_height_source *")
-    _check(_lib.bb_height_file_read(os.fsencode(task["path"]), _channel(task["channel"]),
+    _check(_lib.bb_height_file_read(_path(task["path"]), _channel(task["channel"]),
                                     float(task["scale"]), _ffi.NULL, _ffi.NULL, height,
                                     source, err), err)
     try:
@@ -370,13 +371,13 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     future = client.submit(_drive, directory, planned, args, task, pure=False,
                            key=f"bumpbake-big-{task['key']}")
     try:
-        report, stats = future.result()
-    except BaseException:
-        try:
-            stop.set(1)  # left set: the driver may still be reading it
-            client.cancel([future])
-        except Exception:  # noqa: BLE001 (the scheduler lost: the first error is the one)
-            pass
+        for done in completed(client, [future]):
+            report, stats = done.result()
+    except BaseException as e:
+        settle(client, lambda: stop.set(1))  # left set: the driver may still read it
+        settle(client, lambda: client.cancel([future]))
+        if isinstance(e, ClusterLost):  # what the lost driver was writing
+            sweep_temporaries({os.path.dirname(p) or "." for p in job.report(0).outputs.values()})
         raise
     finally:
         # Released at once: a future still held (by an exception's

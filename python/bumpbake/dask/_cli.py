@@ -233,15 +233,9 @@ def bake(args):
         raise Usage("missing HEIGHT")
     kw, outputs = _bake_arguments(options)
     as_json, quiet = "json" in names, "quiet" in names
-    import distributed
     from . import bake_big, bake_files
-    try:
-        client = distributed.Client(values["scheduler"], timeout="30s")
-    except (OSError, TimeoutError) as e:
-        print(f"bumpbake: cannot reach the Dask scheduler {values['scheduler']}: {e}",
-              file=sys.stderr)
-        return 1
-    with client:
+    from ._connect import connect
+    with connect(values["scheduler"], quiet=True) as client:
         if "out-dir" in values:
             if outputs or "prefix" in kw or "slope" in kw:
                 raise Usage("-o, --normal FILE ... and --slope are for a single bake; a batch "

@@ -1,0 +1,205 @@
+"""The connection to a Dask cluster and what happens when it goes: a
+scheduler address checked before any connection (a usage error in one
+line), a connection refused or unanswered reported within a bound, and
+results waited for under a watch that says, in one line, when the
+scheduler or every worker was lost, instead of a traceback or a wait for
+ever."""
+
+import ipaddress
+import logging
+import re
+import socket
+import time
+
+import distributed
+
+from .._common import Error, _argument_error
+
+# Seconds a connection to the scheduler may take (the TCP connection, then
+# Dask's handshake); also how long the client tries to reconnect to a
+# scheduler it lost before giving up.
+CONNECT_TIMEOUT = 10
+# Seconds a bake waits for a worker when the cluster has none left (a
+# nanny restarting a killed worker takes a few seconds).
+WORKERLESS_WAIT = 20
+# Seconds between looks at the cluster while waiting for results.
+_POLL = 0.5
+_WORKERS_EVERY = 2.0
+
+_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_HOSTNAME = re.compile(r"^(?=.{1,253}$)[A-Za-z0-9_](?:[A-Za-z0-9_.-]*[A-Za-z0-9_])?$")
+_EXAMPLE = "tcp://HOST:PORT, e.g. tcp://10.0.0.1:8786 (dask-scheduler prints it)"
+
+
+class ClusterLost(Error):
+    """The scheduler, or every worker, went away during a bake."""
+
+    def __init__(self, message):
+        super().__init__(message, "i/o error")
+
+
+def scheduler_address(text):
+    """(address, host, port) of a scheduler address as typed: PROTOCOL://HOST:PORT
+    or HOST:PORT (tcp), the host a name, an IPv4 address or [an IPv6 one].
+    ArgumentError, one line, for anything else (checked before connecting)."""
+    if not isinstance(text, str):
+        raise _argument_error(f"--scheduler: the address must be a string (got {text!r})")
+    shown = text.encode("unicode_escape").decode("ascii")
+    bad = f"--scheduler '{shown}':"
+    if not text.strip():
+        raise _argument_error(f"--scheduler: an empty address: give {_EXAMPLE}")
+    if not text.isprintable() or text != text.strip():
+        raise _argument_error(f"{bad} control characters or spaces in the address")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme.lower() == "inproc":
+        raise _argument_error(f"{bad} inproc:// addresses exist only inside one Python process; "
+                              f"give {_EXAMPLE}")
+    if scheme.lower() not in _SCHEMES:
+        raise _argument_error(f"{bad} unknown protocol '{scheme}' (one of "
+                              f"{', '.join(_SCHEMES)}); give {_EXAMPLE}")
+    if any(c in rest for c in "/?#@"):
+        raise _argument_error(f"{bad} an address has no path, query or user: give {_EXAMPLE}")
+    if rest.startswith("["):
+        end = rest.find("]")
+        if end < 0:
+            raise _argument_error(f"{bad} '[' without ']' around the IPv6 address")
+        host, after = rest[1:end], rest[end + 1:]
+        try:
+            ipaddress.IPv6Address(host)
+        except ValueError:
+            raise _argument_error(f"{bad} '{host}' is not an IPv6 address") from None
+        if not after.startswith(":"):
+            raise _argument_error(f"{bad} no port: give {_EXAMPLE}")
+        port = after[1:]
+    else:
+        host, colon, port = rest.rpartition(":")
+        if not colon:
+            raise _argument_error(f"{bad} no port: give {_EXAMPLE}")
+        if ":" in host:
+            raise _argument_error(f"{bad} an IPv6 address goes in brackets: "
+                                  f"{scheme}://[{host}]:{port}")
+        if not _HOSTNAME.match(host):
+            raise _argument_error(f"{bad} '{host}' is not a host name or address")
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise _argument_error(f"{bad} the port '{port}' is not a number from 1 to 65535")
+    return f"{scheme.lower()}://{rest}", host, int(port)
+
+
+def connect(text, timeout=None, quiet=False):
+    """A distributed.Client of the scheduler at text (checked first by
+    scheduler_address): a refused connection is reported at once, one that
+    is not answered after timeout seconds (CONNECT_TIMEOUT) then, as
+    bumpbake.Error, one line. quiet: no log lines of Dask's in this process
+    (a command line, which prints its own one-line errors)."""
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
+    address, host, port = scheduler_address(text)
+    cannot = f"cannot reach the Dask scheduler {address}"
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except socket.gaierror as e:
+        raise Error(f"{cannot}: unknown host '{host}' ({e.strerror})", "i/o error") from None
+    except ConnectionRefusedError:
+        raise Error(f"{cannot}: connection refused (no scheduler listens there: "
+                    "dask-scheduler prints its address)", "i/o error") from None
+    except (socket.timeout, TimeoutError):
+        raise Error(f"{cannot}: no answer within {timeout:g} s", "i/o error") from None
+    except OSError as e:
+        raise Error(f"{cannot}: {e.strerror or e}", "i/o error") from None
+    if quiet:  # Dask logs a lost scheduler with tracebacks
+        logging.disable(logging.CRITICAL)
+    try:
+        return distributed.Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as e:
+        raise Error(f"{cannot}: no Dask scheduler answered within {timeout:g} s "
+                    f"({str(e).splitlines()[0] if str(e) else type(e).__name__})",
+                    "i/o error") from None
+
+
+def alive(client):
+    """Whether client still talks to its scheduler."""
+    return client.status == "running"
+
+
+def completed(client, futures):
+    """Yields futures as they finish, watching the cluster meanwhile: raises
+    ClusterLost when the client lost its scheduler, or when no worker was
+    left for WORKERLESS_WAIT seconds; a task whose workers kept dying, or
+    that a worker cannot load (bumpbake not installed there), is one
+    bumpbake.Error too. A future that failed otherwise is yielded: its
+    result() raises the task's own error."""
+    pending = set(futures)
+    workerless_since = None
+    next_look = 0.0
+    while pending:
+        try:
+            # distributed.wait, with this client rather than the default one
+            done = client.sync(distributed.client._wait, list(pending), timeout=_POLL,
+                               return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            done = set()
+        except Exception:  # noqa: BLE001: the comm went away under the wait
+            if not alive(client):
+                raise _lost(client) from None
+            raise
+        for f in done:
+            pending.discard(f)
+            if f.status == "cancelled" or not alive(client):
+                raise _lost(client)
+            if f.status == "error":
+                _raise_cluster_error(f.exception())
+            yield f
+        if not alive(client):
+            raise _lost(client)
+        now = time.monotonic()
+        if pending and now >= next_look:
+            next_look = now + _WORKERS_EVERY
+            try:
+                workers = len(client.scheduler_info()["workers"])
+            except Exception:  # noqa: BLE001
+                if not alive(client):
+                    raise _lost(client) from None
+                raise
+            if workers:
+                workerless_since = None
+            elif workerless_since is None:
+                workerless_since = now
+            elif now - workerless_since >= WORKERLESS_WAIT:
+                raise ClusterLost(f"the Dask cluster was lost: no worker left on "
+                                  f"{client.scheduler.address} for {WORKERLESS_WAIT:g} s")
+
+
+def _lost(client):
+    address = getattr(client.scheduler, "address", None) or "(its address)"
+    return ClusterLost(f"the Dask cluster was lost: the connection to the scheduler "
+                       f"{address} closed")
+
+
+_MISSING = {"bumpbake": "bumpbake (make install on every worker, or PYTHONPATH=TREE/python "
+                        "in the workers' environment)",
+            "numpy": "numpy (Debian's python3-numpy)",
+            "cffi": "cffi (Debian's python3-cffi)"}
+
+
+def _raise_cluster_error(e):
+    if isinstance(e, distributed.KilledWorker):
+        raise ClusterLost(f"the Dask cluster lost the workers running a task several times "
+                          f"over (each died: {e})") from None
+    if isinstance(e, ImportError):
+        name = (e.name or "").split(".")[0]
+        if name in _MISSING:
+            raise Error(f"a Dask worker cannot import {name}: install {_MISSING[name]}",
+                        "i/o error") from None
+
+
+def settle(client, call):
+    """call() when the scheduler is still there (a cleanup), ignoring what
+    a scheduler lost meanwhile raises."""
+    if not alive(client):
+        return
+    try:
+        call()
+    except Exception:  # noqa: BLE001: the first error is the one reported
+        if alive(client):
+            raise

@@ -1,0 +1,244 @@
+"""bumpbake.dask when the cluster is not what it should be: a malformed
+--scheduler is a usage error (one line, exit 2) found before connecting; a
+refused connection is one line at once; a scheduler or the only worker lost
+in the middle of a batch is one line, within a bound, files whole and no
+temporaries; Ctrl-C on the client leaves the batch's later inputs
+untouched. A scheduler and a worker run as subprocesses (dask-scheduler,
+dask-worker without a nanny), as a user starts them, so they can be
+killed."""
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+import bumpbake
+
+distributed = pytest.importorskip(
+    "distributed", reason="python3-distributed is not installed (make deps installs it)")
+import bumpbake.dask  # noqa: E402
+from bumpbake.dask import _connect  # noqa: E402
+
+from test_dask import heights  # noqa: E402
+
+PYTHON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+START_TIMEOUT = 120  # seconds a scheduler or worker may take to start (a loaded machine)
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Cluster:
+    """dask-scheduler and one dask-worker (one thread, no nanny: killed, it
+    stays dead) as subprocesses on 127.0.0.1."""
+
+    def __init__(self, directory, package=True):
+        self.address = f"tcp://127.0.0.1:{_free_port()}"
+        env = dict(os.environ, PYTHONPATH=PYTHON_DIR)
+        if not package:  # a worker that cannot import bumpbake
+            del env["PYTHONPATH"]
+        quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
+                     cwd=directory)
+        self.scheduler = subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+             "--port", self.address.rsplit(":", 1)[1], "--no-dashboard"], **quiet)
+        self.worker = subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads",
+             "1", "--no-nanny", "--memory-limit", "0", "--no-dashboard"], **quiet)
+        self.client = distributed.Client(self.address, timeout=START_TIMEOUT,
+                                         set_as_default=False)
+        self.client.wait_for_workers(1, timeout=START_TIMEOUT)
+
+    def close(self):
+        self.client.close(timeout=10)
+        for p in (self.worker, self.scheduler):
+            if p.poll() is None:
+                p.kill()
+            p.wait()
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    c = Cluster(tmp_path)
+    try:
+        yield c
+    finally:
+        c.close()
+
+
+def _one_line(err):
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    return err
+
+
+# ------------------------------------------------------------ the address
+
+BAD_ADDRESSES = ["garbage", "", "tcp://[::1", "inproc://x", "tcp://127.0.0.1:8786/path",
+                 "tcp://127.0.0.1:99999", "tcp://127.0.0.1:0", "tcp://::1:8786",
+                 "tcp://host:port", "http://127.0.0.1:8786", "tcp://a b:1"]
+
+
+@pytest.mark.parametrize("address", BAD_ADDRESSES)
+def test_a_malformed_scheduler_is_a_usage_error_in_one_line(tmp_path, monkeypatch, cli,
+                                                            address):
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1, side=16)
+    out = cli("bake", "h00.png", "--scale", "16", "-o", "m", "--scheduler", address,
+              check=False)
+    assert out.returncode == 2, out.stderr
+    assert _one_line(out.stderr).startswith("bumpbake bake: --scheduler")
+    assert sorted(os.listdir(".")) == ["h00.png"]
+
+
+def test_good_addresses_are_taken():
+    for typed, port in (("tcp://10.0.0.1:8786", 8786), ("127.0.0.1:1", 1),
+                        ("tls://sched.example.org:8786", 8786), ("tcp://[::1]:65535", 65535),
+                        ("TCP://node-7:8786", 8786)):
+        address, _, got = _connect.scheduler_address(typed)
+        assert got == port and "://" in address
+
+
+def test_a_refused_connection_is_one_line_at_once(tmp_path, monkeypatch, cli):
+    """Nothing listens on the port: refused, said at once (it took Dask's
+    30 s connect timeout and a traceback)."""
+    monkeypatch.chdir(tmp_path)
+    heights(".", 1, side=16)
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    out = cli("bake", "h00.png", "--scale", "16", "-o", "m", "--scheduler", address,
+              check=False)
+    assert out.returncode == 1
+    assert "connection refused" in _one_line(out.stderr), out.stderr
+    assert sorted(os.listdir(".")) == ["h00.png"]
+
+
+def test_an_unanswered_connection_is_reported_within_the_timeout():
+    """A port that accepts and never speaks Dask (a listening socket that
+    is never served): the handshake's bound, not Dask's 30 s."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen(1)
+        address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
+        t0 = time.monotonic()
+        with pytest.raises(bumpbake.Error, match="cannot reach the Dask scheduler") as e:
+            _connect.connect(address, timeout=1)
+        assert time.monotonic() - t0 < 25, "Dask's own 30 s"
+        assert "\n" not in str(e.value)
+
+
+def test_a_python_without_distributed_or_numpy_names_the_package(tmp_path):
+    for hidden, package in (("distributed", "python3-distributed"), ("numpy", "python3-numpy")):
+        out = subprocess.run(
+            [sys.executable, "-c", f"import sys; sys.modules[{hidden!r}] = None\n"
+             "import bumpbake.dask"], capture_output=True, text=True, cwd=tmp_path,
+            env=dict(os.environ, PYTHONPATH=PYTHON_DIR))
+        assert out.returncode == 1
+        assert package in out.stderr.splitlines()[-1], out.stderr
+
+
+def test_a_worker_without_the_package_is_one_line(tmp_path, monkeypatch, cli):
+    monkeypatch.chdir(tmp_path)
+    heights("in", 2, side=16)
+    os.makedirs("empty")
+    cluster = Cluster(tmp_path / "empty", package=False)
+    try:
+        for how in (["in", "--out-dir", "out"], ["in/h00.png", "-o", "out/m"]):
+            out = cli("bake", *how, "--scale", "16", "--scheduler", cluster.address,
+                      check=False)
+            assert out.returncode == 1
+            assert "a Dask worker cannot import bumpbake: install" in _one_line(out.stderr)
+    finally:
+        cluster.close()
+
+
+# ------------------------------------------------------- a cluster lost
+
+def _whole(directory):
+    """Every output is whole (bumpbake reads it) and no temporary is left."""
+    names = os.listdir(directory) if os.path.isdir(directory) else []
+    assert not [n for n in names if n.startswith(".bb-tmp-")], names
+    for n in names:
+        bumpbake.read(os.path.join(directory, n))
+    return names
+
+
+def _wait_for_files(directory, count, process, deadline):
+    while len(os.listdir(directory) if os.path.isdir(directory) else ()) < count:
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "the batch did not start"
+        time.sleep(0.05)
+
+
+def test_the_scheduler_killed_in_a_batch_is_one_line(tmp_path, monkeypatch, cli, cluster):
+    monkeypatch.chdir(tmp_path)
+    heights("in", 40, side=96)
+    bake = cli.start("bake", "in", "--scale", "16", "--out-dir", "out", "--maps",
+                     "normal,ssbump,ao", "-q", "--scheduler", cluster.address)
+    _wait_for_files("out", 3, bake, time.monotonic() + START_TIMEOUT)
+    cluster.scheduler.kill()
+    t0 = time.monotonic()
+    _, err = bake.communicate(timeout=120)
+    lost_after = time.monotonic() - t0
+    assert bake.returncode == 1, err
+    assert "the Dask cluster was lost" in _one_line(err)
+    assert lost_after < 60, lost_after  # 35 s and a traceback before
+    cluster.worker.wait(timeout=120)  # its chunk ended: nothing more comes
+    assert len(_whole("out")) < 120
+
+
+def test_the_only_worker_killed_is_lost_within_a_bound(tmp_path, monkeypatch, cluster):
+    """It waited for ever for a worker; now WORKERLESS_WAIT seconds."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(_connect, "WORKERLESS_WAIT", 2)
+    heights("in", 30, side=96)
+    killed = []
+
+    def kill_the_worker(done, total):
+        if done >= 3 and not killed:
+            cluster.worker.kill()
+            killed.append(done)
+
+    t0 = time.monotonic()
+    with pytest.raises(_connect.ClusterLost, match="no worker left") as e:
+        bumpbake.dask.bake_files("in", "out", client=cluster.client, scale=16,
+                                 maps=("normal", "ao"), chunk_size=1, progress=kill_the_worker)
+    assert killed and "\n" not in str(e.value)
+    assert time.monotonic() - t0 < START_TIMEOUT
+    assert len(_whole("out")) < 60
+
+
+# ---------------------------------------------------------------- Ctrl-C
+
+def test_ctrl_c_on_the_client_leaves_later_inputs_untouched(tmp_path, monkeypatch, cli,
+                                                           cluster):
+    """SIGINT to `bake DIR --out-dir --scheduler --keep-going`: exit 130, and
+    nothing is written after it: the bake running on the worker is
+    cancelled (it looks at the batch's stop variable as it traces), the
+    chunks not started are cancelled. The running bake went on and wrote
+    after the client had gone."""
+    monkeypatch.chdir(tmp_path)
+    heights("in", 12, side=400)  # seconds an input on one loaded thread
+    bake = cli.start("bake", "in", "--scale", "16", "--slices", "32", "--out-dir", "out",
+                     "--maps", "ao", "-q", "--keep-going", "--scheduler", cluster.address)
+    _wait_for_files("out", 1, bake, time.monotonic() + START_TIMEOUT)
+    bake.send_signal(signal.SIGINT)
+    _, err = bake.communicate(timeout=60)
+    assert bake.returncode == 130, err
+    at_exit = sorted(os.listdir("out"))
+
+    def busy():
+        return [k for keys in cluster.client.run(lambda dask_worker: list(
+            dask_worker.active_threads.values())).values() for k in keys]
+
+    deadline = time.monotonic() + 60
+    while busy():
+        assert time.monotonic() < deadline, busy()
+        time.sleep(0.1)
+    assert sorted(_whole("out")) == at_exit, "written after the client had gone"
+    assert not any(cluster.client.processing().values()), "tasks left queued"

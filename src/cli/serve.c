@@ -1,0 +1,114 @@
+/* serve.c: `bumpbake serve`, a bake seen live: the height baked with
+ * bake's options, watched, re-baked on every save, and shown lit in the
+ * browser (src/cli/serve/). This file keeps the command line's words. */
+#include "cli.h"
+#include "common.h"
+#include "serve/serve.h"
+
+#include <arpa/inet.h>
+#include <limits.h>
+#include <netinet/in.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* The write action's files: as bake's -o PREFIX names them, spelled out
+ * one by one (--normal P_normal.png ...) so that the command line the page
+ * shows is the whole job; PREFIX defaults to HEIGHT without its extension. */
+static int name_outputs(bb_job_options *job, const char *height) {
+  char prefix[PATH_MAX];
+  if (job->prefix) {
+    snprintf(prefix, sizeof prefix, "%s", job->prefix);
+  } else {
+    snprintf(prefix, sizeof prefix, "%s", height);
+    char *dot = strrchr(prefix, '.'), *slash = strrchr(prefix, '/');
+    if (dot && (!slash || dot > slash + 1))
+      *dot = '\0';
+  }
+  int named = 0;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    named |= job->paths[k] != NULL;
+  if (named && !job->prefix)
+    return 0; /* the outputs the command line named, and only those */
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    if (!(BB_JOB_DEFAULT_MAPS & BB_OUTPUT_BIT(k)) || job->paths[k])
+      continue;
+    size_t n = strlen(prefix) + 32;
+    char *path = malloc(n); /* lives as long as the process */
+    if (!path)
+      return -1;
+    snprintf(path, n, "%s_%s.png", prefix, bb_output_kind_get((bb_output_kind)k)->name);
+    job->paths[k] = path;
+  }
+  job->prefix = NULL;
+  return 0;
+}
+
+int cli_run_serve(const cli_run *r) {
+  const bb_command_options *a = r->options;
+  const char *height = bb_command_input(r->command, 0);
+  bb_job_options named = a->job;
+  if (name_outputs(&named, height) != 0) {
+    cli_error_line("out of memory");
+    return BB_EXIT_FAILURE;
+  }
+
+  static serve_state s; /* the threads use it until the process ends */
+  pthread_mutex_init(&s.lock, NULL);
+  pthread_cond_init(&s.work, NULL);
+  pthread_cond_init(&s.changed, NULL);
+  s.height_path = height;
+  s.settings = a->job; /* the bake's parameters as parsed */
+  s.job = named;
+  s.brightness_file = a->job.brightness_file;
+  s.use_brightness = s.brightness_file != NULL;
+  s.quiet = a->quiet;
+  s.watched[s.watched_count++] = height;
+  const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
+                        a->job.basis_file};
+  for (size_t i = 0; i < sizeof also / sizeof also[0]; i++)
+    if (also[i])
+      s.watched[s.watched_count++] = also[i];
+
+  /* A height that cannot be read at all is a mistake on the command line,
+   * not a save to wait for (a broken save later keeps the page going). */
+  bb_error err = {{0}};
+  bb_status st = bb_image_read_info(height, NULL, NULL, NULL, NULL, &err);
+  if (st != BB_OK)
+    return cli_status_exit(height, st, &err);
+  /* The options and files checked once by the library before serving. */
+  bb_job_options o;
+  serve_job_options(&s, &o);
+  bb_job *job = NULL;
+  st = bb_job_plan(&height, 1, &o, &job, &err);
+  bb_job_free(job);
+  if (st != BB_OK)
+    return cli_library_error("serve", st, &err);
+
+  char message[512];
+  if (serve_watch_start(&s, message, sizeof message) != 0) {
+    cli_error_line(message);
+    return BB_EXIT_FAILURE;
+  }
+  pthread_t baker;
+  if (pthread_create(&baker, NULL, serve_bake_thread, &s) != 0) {
+    cli_error_line("serve: cannot start the bake thread");
+    return BB_EXIT_FAILURE;
+  }
+  pthread_mutex_lock(&s.lock);
+  serve_request_bake(&s);
+  pthread_mutex_unlock(&s.lock);
+  serve_http_options http = {a->address, a->port, a->address != NULL};
+  char url[256];
+  if (serve_http_start(&s, &http, url, sizeof url) != 0) {
+    char line[400];
+    snprintf(line, sizeof line, "serve: %s", url);
+    cli_error_line(line);
+    return BB_EXIT_FAILURE;
+  }
+  printf("serve: %s (Ctrl-C stops)\n", url);
+  fflush(stdout);
+  for (;;)
+    pause(); /* a signal ends the process (cli_install_signal_handlers) */
+}

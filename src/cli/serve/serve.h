@@ -1,0 +1,118 @@
+/* serve.h: what the parts of `bumpbake serve` share (src/cli/serve/): the
+ * state one bake thread, one watch thread and the HTTP server's connection
+ * threads read and change under one lock. The bakes go through the
+ * library's job (bb_job_bake_item, bb_job_run_item); nothing here is a
+ * bake rule. */
+#ifndef BB_CLI_SERVE_H
+#define BB_CLI_SERVE_H
+
+#include "bumpbake.h"
+#include "bumpbake.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+
+/* The textures the page draws, 8-bit RGBA each, W x H: */
+enum {
+  SERVE_TEX_SSBUMP_AO,     /* ssbump s_0..s_2 in RGB, ao in A */
+  SERVE_TEX_NORMAL_HEIGHT, /* the normal (N + 1) / 2 in RGB, the smoothed height in A */
+  SERVE_TEX_BENT,          /* the bent normal (Nb + 1) / 2 in RGB, A 255 */
+  SERVE_TEX_WEIGHTS,       /* the basis weights w_0..w_2 in RGB, A 255 */
+  SERVE_TEX_COUNT
+};
+
+/* One finished bake: published at once, its textures made when first
+ * asked (the picture shown asks for one first), freed with its last
+ * reference (a response may still be sending it when a newer one lands). */
+typedef struct serve_bake {
+  int refs; /* under serve_state.lock */
+  long id;
+  int width, height;
+  pthread_mutex_t tex_lock;            /* makes tex[] and frees maps */
+  unsigned char *tex[SERVE_TEX_COUNT]; /* NULL until asked */
+  bb_bake_result maps;                 /* the bake's maps, until every texture is made */
+  double seconds;          /* from the start of the bake to its maps */
+  double seconds_textures; /* making the textures asked so far */
+  bb_job_report report;    /* the job's figures (input pointer not kept) */
+  char *provenance;        /* the ssbump's provenance as the job writes it */
+  char *command;           /* the `bumpbake bake` line that writes these maps */
+  int normal_y_up, basis_count;
+  double scale;            /* the bake's --scale: the relief's depth */
+} serve_bake;
+
+/* The watched files: the height and the maps the options read. */
+enum { SERVE_MAX_WATCHED = 4 };
+
+typedef struct serve_state {
+  pthread_mutex_t lock;
+  pthread_cond_t work;    /* the bake thread waits for wanted != done */
+  pthread_cond_t changed; /* event streams wait for version to move */
+  long version;           /* bumped on every change a page shows */
+  /* what to bake: the command line's options, changed by the page's controls */
+  const char *height_path;
+  bb_job_options settings; /* the bake's parameters as the command line gave them */
+  bb_job_options job;     /* paths of a "write"; bake filled from settings */
+  const char *brightness_file; /* the command line's --brightness, or NULL */
+  int use_brightness;     /* the page's switch (1 when given) */
+  atomic_long wanted;     /* bumped by a save or a control: the bake in flight
+                             for an older value is cancelled */
+  long done;              /* the wanted value last baked (or failed) */
+  /* what is going on */
+  int baking;
+  double progress;        /* 0..1 of the bake in flight */
+  double last_progress_seconds;
+  char error[1024];       /* the last bake's failure, "" after a success */
+  serve_bake *current;    /* the last good bake, or NULL */
+  long next_id;
+  const char *watched[SERVE_MAX_WATCHED];
+  int watched_count;
+  int quiet;
+  int quit;
+} serve_state;
+
+/* serve_bake.c: the bake thread (runs until state->quit). */
+void *serve_bake_thread(void *state);
+/* Asks for a new bake (a save or a control changed); the caller holds the lock. */
+void serve_request_bake(serve_state *s);
+/* Drops one reference; the caller holds the lock. */
+void serve_bake_release(serve_bake *b);
+/* Texture t of b (4 x width x height bytes), made on first use; NULL when
+ * out of memory. Any thread, with a reference held. */
+const unsigned char *serve_bake_texture(serve_bake *b, int t);
+/* The job options a bake or a write uses now (the caller holds the lock). */
+void serve_job_options(const serve_state *s, bb_job_options *o);
+
+/* serve_watch.c: watches the directories of s->watched with inotify and
+ * asks for a bake when one of the files is saved (renamed over, or written
+ * and closed, or quiet for a moment after a write). Returns 0, or -1 with
+ * a message in err (capacity cap) when inotify cannot be set up. */
+int serve_watch_start(serve_state *s, char *err, size_t cap);
+
+/* serve_http.c: the server. */
+typedef struct serve_http_options {
+  const char *address; /* NULL: 127.0.0.1 */
+  int port;            /* 0: any free one */
+  int token;           /* 1: a random token in every path */
+} serve_http_options;
+/* Starts serving s; the URL of the page into url (capacity cap). Returns 0,
+ * or -1 with a message in url. */
+int serve_http_start(serve_state *s, const serve_http_options *o, char *url, size_t cap);
+
+/* serve_params.c: the state as one JSON object (malloc'd), as the page reads it. */
+char *serve_state_json(serve_state *s);
+/* serve_params.c: applies the page's control values (name=value pairs:
+ * scale, rays, slices, bias, bounce, bounces, brightness) to the state,
+ * all or none, after the library's checks; 0, or -1 with the library's
+ * words in err. The caller holds the lock. */
+int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
+                       int count, char *err, size_t cap);
+
+/* serve_page.c: the page's files, embedded at build time. */
+typedef struct serve_asset {
+  const char *name, *type;
+  const unsigned char *data;
+  size_t size;
+} serve_asset;
+const serve_asset *serve_asset_find(const char *name);
+
+#endif /* BB_CLI_SERVE_H */

@@ -1,0 +1,164 @@
+/* serve_params.c: the page's side of the options: the state it draws as
+ * JSON, and its controls (scale, rays, slices, bias, bounce, bounces,
+ * brightness) applied to the bake options after the library's own checks
+ * (bb_bake_options_check), whose words a refusal shows. */
+#include "json.h"
+#include "serve.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------- state */
+
+static void add_params(cli_json *j, const serve_state *s) {
+  const bb_bake_options *b = &s->settings.bake;
+  cli_json_open(j, "params", '{');
+  cli_json_number(j, "scale", (double)b->height_scale);
+  cli_json_int(j, "rays", b->rays);
+  cli_json_int(j, "slices", b->slices);
+  cli_json_int(j, "slices_traced", bb_bake_slices(b));
+  cli_json_number(j, "bias", b->trace.bias_texels);
+  cli_json_number(j, "bounce", b->bounce_albedo);
+  cli_json_int(j, "bounces", b->bounces);
+  cli_json_string(j, "brightness_file", s->brightness_file);
+  cli_json_bool(j, "brightness", s->use_brightness);
+  cli_json_close(j, '}');
+}
+
+static void add_bake(cli_json *j, serve_bake *b) {
+  cli_json_open(j, "bake", '{');
+  cli_json_int(j, "id", b->id);
+  cli_json_int(j, "width", b->width);
+  cli_json_int(j, "height", b->height);
+  cli_json_number(j, "seconds", b->seconds);
+  const bb_job_report *r = &b->report;
+  cli_json_number(j, "seconds_load", r->seconds_load);
+  cli_json_number(j, "seconds_smooth", r->seconds_smooth);
+  cli_json_number(j, "seconds_pyramid", r->seconds_pyramid);
+  cli_json_number(j, "seconds_trace", r->seconds_trace);
+  cli_json_number(j, "seconds_derive", r->seconds_derive);
+  pthread_mutex_lock(&b->tex_lock);
+  const double textures = b->seconds_textures;
+  pthread_mutex_unlock(&b->tex_lock);
+  cli_json_number(j, "seconds_textures", textures);
+  cli_json_int(j, "threads", r->threads);
+  cli_json_int(j, "slices", r->slices);
+  cli_json_number(j, "scale", b->scale);
+  cli_json_bool(j, "normal_y_up", b->normal_y_up);
+  cli_json_int(j, "basis_count", b->basis_count);
+  cli_json_string(j, "command", b->command);
+  cli_json_string(j, "provenance", b->provenance);
+  cli_json_close(j, '}');
+}
+
+char *serve_state_json(serve_state *s) {
+  char *text = NULL;
+  size_t size = 0;
+  FILE *f = open_memstream(&text, &size);
+  if (!f)
+    return NULL;
+  cli_json j = {f, 0};
+  pthread_mutex_lock(&s->lock);
+  bb_job_options o;
+  serve_job_options(s, &o);
+  char *command = bb_job_command_text(&o, s->height_path);
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "height", s->height_path);
+  cli_json_bool(&j, "baking", s->baking);
+  cli_json_number(&j, "progress", s->progress);
+  cli_json_string(&j, "error", s->error);
+  cli_json_string(&j, "command", command);
+  add_params(&j, s);
+  if (s->current)
+    add_bake(&j, s->current);
+  cli_json_close(&j, '}');
+  pthread_mutex_unlock(&s->lock);
+  free(command);
+  if (fclose(f) != 0) {
+    free(text);
+    return NULL;
+  }
+  return text;
+}
+
+/* --------------------------------------------------------------- controls */
+
+/* The whole text a finite number, else a refusal naming the control. */
+static int number(const char *name, const char *text, double *out, char *err, size_t cap) {
+  char *end = NULL;
+  double v = strtod(text, &end);
+  if (!text[0] || *end || !isfinite(v)) {
+    snprintf(err, cap, "%s: '%.40s' is not a number", name, text);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+static int integer(const char *name, const char *text, int *out, char *err, size_t cap) {
+  double v;
+  if (number(name, text, &v, err, cap) != 0)
+    return -1;
+  if (v != floor(v) || v < -2147483647.0 || v > 2147483647.0) {
+    snprintf(err, cap, "%s: '%.40s' is not a whole number", name, text);
+    return -1;
+  }
+  *out = (int)v;
+  return 0;
+}
+
+static int apply_one(serve_state *s, bb_bake_options *b, int *use_brightness, const char *name,
+                     const char *value, char *err, size_t cap) {
+  double v;
+  if (!strcmp(name, "scale")) {
+    if (number(name, value, &v, err, cap))
+      return -1;
+    b->height_scale = (float)v;
+    return 0;
+  }
+  if (!strcmp(name, "rays"))
+    return integer(name, value, &b->rays, err, cap);
+  if (!strcmp(name, "slices"))
+    return integer(name, value, &b->slices, err, cap);
+  if (!strcmp(name, "bias"))
+    return number(name, value, &b->trace.bias_texels, err, cap);
+  if (!strcmp(name, "bounce"))
+    return number(name, value, &b->bounce_albedo, err, cap);
+  if (!strcmp(name, "bounces"))
+    return integer(name, value, &b->bounces, err, cap);
+  if (!strcmp(name, "brightness")) {
+    if (!s->brightness_file) {
+      snprintf(err, cap, "brightness: no --brightness FILE was given to serve");
+      return -1;
+    }
+    if (strcmp(value, "on") && strcmp(value, "off")) {
+      snprintf(err, cap, "brightness: 'on' or 'off'");
+      return -1;
+    }
+    *use_brightness = !strcmp(value, "on");
+    return 0;
+  }
+  snprintf(err, cap, "unknown control '%.40s'", name);
+  return -1;
+}
+
+int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
+                       int count, char *err, size_t cap) {
+  bb_bake_options b = s->settings.bake;
+  int use_brightness = s->use_brightness;
+  for (int i = 0; i < count; i++)
+    if (apply_one(s, &b, &use_brightness, names[i], values[i], err, cap) != 0)
+      return -1;
+  bb_error e = {{0}};
+  if (bb_bake_options_check(&b, &e) != BB_OK) {
+    snprintf(err, cap, "%s", e.message);
+    return -1;
+  }
+  s->settings.bake = b;
+  s->use_brightness = use_brightness;
+  s->version++;
+  pthread_cond_broadcast(&s->changed);
+  return 0;
+}

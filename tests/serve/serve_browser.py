@@ -1,0 +1,96 @@
+"""What the browser test and tools/bench_serve.py share: `bumpbake serve`
+started on a free port, and Debian's Chromium, headless, driven by
+python3-selenium (WebGL on SwiftShader, no GPU, no network)."""
+
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+
+CHROMIUM = shutil.which("chromium")
+CHROMEDRIVER = shutil.which("chromedriver")
+
+
+def browser_missing():
+    """Why the browser tests cannot run here, or None."""
+    try:
+        import selenium  # noqa: F401
+    except ImportError:
+        return "python3-selenium is not installed (make deps)"
+    if not CHROMIUM or not CHROMEDRIVER:
+        return "chromium or chromium-driver is not installed (make deps)"
+    return None
+
+
+class Server:
+    """bumpbake serve HEIGHT ARGS... on 127.0.0.1, any free port."""
+
+    def __init__(self, binary, height, args):
+        self.proc = subprocess.Popen(
+            [binary, "serve", height, "--port", "0", *args],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        line = self.proc.stdout.readline()
+        m = re.search(r"(http://\S+)", line)
+        if not m:
+            self.proc.kill()
+            raise RuntimeError("serve printed no URL: %r %r" % (line, self.proc.stderr.read()))
+        self.url = m.group(1)
+
+    def close(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+
+
+def start_browser(width=1100, height=760):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    profile = tempfile.mkdtemp(prefix="bb-chromium-")
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                 "--no-first-run", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync",
+                 "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                 "--disable-dev-shm-usage", "--user-data-dir=" + profile,
+                 "--window-size=%d,%d" % (width, height)):
+        options.add_argument(flag)
+    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+    driver._bb_profile = profile
+    return driver
+
+
+def stop_browser(driver):
+    profile = getattr(driver, "_bb_profile", None)
+    driver.quit()
+    if profile:
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def drawn_bake(driver):
+    return int(driver.execute_script("return document.body.dataset.drawnBake || '0'"))
+
+
+def wait_for(predicate, timeout, what, interval=0.01):
+    """Polls until predicate() is true; generous timeouts, never a race."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(interval)
+    raise AssertionError("timed out after %g s waiting for %s" % (timeout, what))
+
+
+def save_by_rename(source_bytes, path):
+    """As Krita, GIMP or Photoshop save: a new file renamed over the old."""
+    tmp = os.path.join(os.path.dirname(path), ".~" + os.path.basename(path))
+    with open(tmp, "wb") as f:
+        f.write(source_bytes)
+    os.rename(tmp, path)

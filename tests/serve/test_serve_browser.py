@@ -1,0 +1,229 @@
+"""`bumpbake serve` in a real browser (Debian's Chromium, headless, driven
+by python3-selenium): the page loads and draws the ssbump, the light and a
+save by rename change the picture, a control re-bakes, a broken save shows
+its error and keeps the last maps, and "write" writes what `bumpbake bake`
+writes, byte for byte. Skipped, with the reason, without Chromium.
+Screenshots go to build/serve-test/ (BB_SERVE_SHOTS) to be looked at."""
+
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import urllib.request
+
+import pytest
+
+import serve_browser as sb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BIN = os.environ.get("BB_BIN", os.path.join(ROOT, "build", "bumpbake"))
+FIXTURES = os.path.join(ROOT, "fixtures")
+SHOTS = os.environ.get("BB_SERVE_SHOTS", os.path.join(ROOT, "build", "serve-test"))
+# Generous: a loaded machine (load 10 happens) must not fail the test.
+SLOW = 120
+
+missing = sb.browser_missing()
+pytestmark = pytest.mark.skipif(missing is not None, reason="browser test skipped: %s" % missing)
+
+
+@pytest.fixture(scope="module")
+def work(tmp_path_factory):
+    d = tmp_path_factory.mktemp("serve")
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), d / "height.png")
+    return d
+
+
+@pytest.fixture(scope="module")
+def server(work):
+    s = sb.Server(BIN, str(work / "height.png"), ["--scale", "32", "--quiet"])
+    yield s
+    s.close()
+
+
+@pytest.fixture(scope="module")
+def page(server):
+    driver = sb.start_browser()
+    driver.get(server.url)
+    yield driver
+    sb.stop_browser(driver)
+
+
+def stats(driver):
+    return driver.execute_script("return bbCanvasStats()")
+
+
+def state(server):
+    with urllib.request.urlopen(server.url + "state", timeout=30) as r:
+        return json.load(r)
+
+
+def shot(driver, name):
+    os.makedirs(SHOTS, exist_ok=True)
+    driver.save_screenshot(os.path.join(SHOTS, name + ".png"))
+
+
+def test_page_draws_the_ssbump(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    s = stats(page)
+    # rock06 lit from 135,45: neither black nor white, not one flat colour
+    assert 20 < s["mean"] < 235, s
+    assert page.find_element("id", "error").text == ""
+    assert "bumpbake bake" in page.find_element("id", "command").text
+    shot(page, "1-ssbump")
+
+
+def test_dragging_the_light_relights(page):
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    before = stats(page)
+    canvas = page.find_element("id", "canvas")
+    # from the right, low: drag to near the right edge of the picture
+    ActionChains(page).move_to_element_with_offset(canvas, 0, 0).click_and_hold() \
+        .move_by_offset(280, 10).release().perform()
+    sb.wait_for(lambda: stats(page)["hash"] != before["hash"], 30, "the picture to change")
+    assert page.find_element("id", "light-text").text != "135,45"
+    shot(page, "2-light-moved")
+
+
+def test_a_save_by_rename_rebakes(page, server, work):
+    old = sb.drawn_bake(page)
+    before = stats(page)
+    with open(os.path.join(FIXTURES, "bricks_128x64.png"), "rb") as f:
+        sb.save_by_rename(f.read(), str(work / "height.png"))
+    sb.wait_for(lambda: sb.drawn_bake(page) > old, SLOW, "the new height's bake drawn")
+    assert stats(page)["hash"] != before["hash"]
+    assert state(server)["bake"]["height"] == 64
+    shot(page, "3-resaved")
+
+
+def test_a_control_rebakes_and_a_refusal_shows_the_library_words(page, server):
+    old = sb.drawn_bake(page)
+    scale = page.find_element("id", "p-scale")
+    page.execute_script(
+        "arguments[0].value = '8'; arguments[0].dispatchEvent(new Event('change'))", scale)
+    sb.wait_for(lambda: sb.drawn_bake(page) > old, SLOW, "the re-bake at scale 8")
+    assert state(server)["params"]["scale"] == 8
+    assert "--scale 8 " in page.find_element("id", "command").text
+    bias = page.find_element("id", "p-bias")
+    page.execute_script(
+        "arguments[0].value = '-1'; arguments[0].dispatchEvent(new Event('change'))", bias)
+    sb.wait_for(lambda: page.find_element("id", "controls-error").text, 30, "the refusal")
+    assert "bias must be >= 0" in page.find_element("id", "controls-error").text
+    assert state(server)["params"]["bias"] == 0.55
+    shot(page, "4-control")
+
+
+def test_a_broken_save_keeps_the_last_maps(page, server, work):
+    old = sb.drawn_bake(page)
+    before = stats(page)
+    with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+        half = f.read()[:700]  # a save caught half written
+    sb.save_by_rename(half, str(work / "height.png"))
+    sb.wait_for(lambda: page.find_element("id", "error").text, SLOW, "the error shown")
+    assert "height.png" in page.find_element("id", "error").text
+    assert sb.drawn_bake(page) == old
+    assert stats(page)["hash"] == before["hash"]
+    assert state(server)["bake"]["id"] == old
+    shot(page, "5-broken-save")
+    # the next good save clears it
+    with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+        sb.save_by_rename(f.read(), str(work / "height.png"))
+    sb.wait_for(lambda: sb.drawn_bake(page) > old, SLOW, "the good save's bake drawn")
+    assert page.find_element("id", "error").text == ""
+
+
+def test_write_is_the_bake_commands_bytes(page, server, work):
+    page.find_element("id", "write").click()
+    sb.wait_for(lambda: page.find_element("id", "write-result").text
+                or page.find_element("id", "write-error").text, SLOW, "the write")
+    assert page.find_element("id", "write-error").text == ""
+    command = page.find_element("id", "command").text
+    words = shlex.split(command)
+    outputs = [words[i + 1] for i, w in enumerate(words) if w in ("--normal", "--ssbump", "--ao")]
+    assert len(outputs) == 3 and all(os.path.exists(p) for p in outputs)
+    written = {p: open(p, "rb").read() for p in outputs}
+    for p in outputs:
+        os.remove(p)
+    assert words[:2] == ["bumpbake", "bake"]
+    subprocess.run([BIN, *words[1:]], check=True, timeout=SLOW, stdout=subprocess.DEVNULL)
+    for p in outputs:
+        assert open(p, "rb").read() == written[p], p + " differs from bumpbake bake's"
+    shot(page, "6-written")
+
+
+# The page's picture of the written ssbump, drawn one pixel per texel, and
+# `bumpbake render --ssbump` of the same file: the same formulas (the page
+# runs shaders/ssbump_relief.glsl's ssbump_dynamic on the GPU).
+COMPARE_JS = """
+const [png, w, h, az, el, mode] = arguments;
+const done = arguments[arguments.length - 1];
+canvas.width = w; canvas.height = h;
+light.azimuth = az; light.elevation = el;
+document.getElementById('mode').value = String(mode);
+document.getElementById('tile').checked = false;
+draw();
+const mine = new Uint8Array(4 * w * h);
+gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, mine);
+const img = new Image();
+img.onload = () => {
+  const c = document.createElement('canvas');
+  c.width = w; c.height = h;
+  const g = c.getContext('2d');
+  g.drawImage(img, 0, 0);
+  const ref = g.getImageData(0, 0, w, h).data;
+  let worst = 0, sum = 0, over8 = 0;
+  for (let y = 0; y < h; y++)
+    for (let x = 0; x < w; x++)
+      for (let k = 0; k < 3; k++) {
+        const a = mine[4 * ((h - 1 - y) * w + x) + k], b = ref[4 * (y * w + x) + k];
+        worst = Math.max(worst, Math.abs(a - b));
+        sum += Math.abs(a - b);
+        over8 += Math.abs(a - b) > 8;
+      }
+  done({worst: worst, mean: sum / (3 * w * h), over8: over8 / (3 * w * h)});
+};
+img.src = 'data:image/png;base64,' + png;
+"""
+
+
+@pytest.mark.parametrize("mode,light", [(0, "0,20"), (1, "135,45"), (2, "250,30"), (8, "135,45")])
+def test_the_page_lights_as_render_does(page, server, work, mode, light):
+    import base64
+
+    ssbump = str(work / "height_ssbump.png")
+    normal = str(work / "height_normal.png")
+    assert os.path.exists(ssbump), "test_write_is_the_bake_commands_bytes writes it first"
+    out = str(work / "render.png")
+    ao = str(work / "height_ao.png")
+    maps = {0: ["--ssbump", ssbump], 1: ["--normal", normal, "--mode", "normal"],
+            2: ["--normal", normal, "--ao", ao, "--mode", "ao"],
+            # relief: render bakes the height itself (floats), the page has 8-bit maps
+            8: [str(work / "height.png"), "--scale", str(state(server)["params"]["scale"]),
+                "--view", "270,30", "--relief"]}[mode]
+    subprocess.run([BIN, "render", *maps, "--light", light, "-o", out], check=True,
+                   timeout=SLOW, stdout=subprocess.DEVNULL)
+    with open(out, "rb") as f:
+        png = base64.b64encode(f.read()).decode()
+    os.remove(out)
+    st = state(server)["bake"]
+    az, el = (float(v) for v in light.split(","))
+    page.set_script_timeout(60)
+    diff = page.execute_async_script(COMPARE_JS, png, st["width"], st["height"], az, el, mode)
+    print("page against render, mode %d light %s: %s" % (mode, light, diff))
+    if mode == 8:
+        # the page's maps are 8-bit, render's baked floats: the relief's
+        # hits move a little with the height's steps (1 level seen)
+        assert diff["worst"] <= 4 and diff["mean"] < 0.5, diff
+        return
+    # 8-bit maps on both sides; the GPU's float and the CPU's double may
+    # round a value either side of a step: one level at most
+    assert diff["worst"] <= 1, diff
+    assert diff["mean"] < 0.05, diff
+
+
+def test_nothing_is_written_unless_asked(work):
+    # only the height and what test_write asked for
+    names = sorted(os.listdir(work))
+    assert all(n == "height.png" or n.startswith("height_") for n in names), names
+    assert not any(n.startswith(".~") for n in names), names

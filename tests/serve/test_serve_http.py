@@ -1,0 +1,196 @@
+"""`bumpbake serve` without a browser: its command line, what its server
+refuses, and its watch of the height (a save by rename, a save in several
+writes, a broken save), through the state it publishes. Runs everywhere
+make test runs (no Chromium needed)."""
+
+import http.client
+import json
+import os
+import shutil
+import subprocess
+import time
+import urllib.parse
+
+import pytest
+
+import serve_browser as sb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BIN = os.environ.get("BB_BIN", os.path.join(ROOT, "build", "bumpbake"))
+FIXTURES = os.path.join(ROOT, "fixtures")
+SLOW = 120
+
+
+def request(url, method="GET", headers=None, path=""):
+    u = urllib.parse.urlsplit(url)
+    c = http.client.HTTPConnection(u.hostname, u.port, timeout=30)
+    c.request(method, u.path + path, headers=headers or {})
+    r = c.getresponse()
+    body = r.read()
+    c.close()
+    return r.status, body
+
+
+def state(server):
+    status, body = request(server.url, path="state")
+    assert status == 200
+    return json.loads(body)
+
+
+def wait_bake(server, after, what):
+    return sb.wait_for(lambda: (lambda s: s if s.get("bake", {}).get("id", 0) > after
+                                and not s["baking"] else None)(state(server)),
+                       SLOW, what, interval=0.02)
+
+
+@pytest.fixture
+def served(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"), ["--scale", "16", "--rays", "16", "--quiet"])
+    wait_bake(s, 0, "the first bake")
+    yield s, tmp_path
+    s.close()
+
+
+def run(*args):
+    return subprocess.run([BIN, "serve", *args], capture_output=True, text=True, timeout=60)
+
+
+def test_command_line_errors():
+    r = run(os.path.join(FIXTURES, "rock06_128.png"))
+    assert r.returncode == 2 and "--scale is required" in r.stderr
+    r = run("/nonexistent/h.png", "--scale", "4")
+    assert r.returncode == 1 and "/nonexistent/h.png" in r.stderr
+    r = run(os.path.join(FIXTURES, "rock06_128.png"), "--scale", "4", "--bias", "-1")
+    assert r.returncode == 2 and "bias" in r.stderr
+    r = run(os.path.join(FIXTURES, "rock06_128.png"), "--scale", "4", "--address", "nowhere")
+    assert r.returncode == 2 and "not an IPv4 or IPv6 address" in r.stderr
+    r = run(os.path.join(FIXTURES, "rock06_128.png"), "--scale", "4", "--port", "70000")
+    assert r.returncode == 2
+
+
+def test_the_port_taken_is_an_error(served):
+    s, _ = served
+    port = urllib.parse.urlsplit(s.url).port
+    r = run(os.path.join(FIXTURES, "rock06_128.png"), "--scale", "4", "--port", str(port))
+    assert r.returncode == 1 and "cannot listen" in r.stderr
+
+
+def test_the_server_refuses(served):
+    s, d = served
+    assert request(s.url)[0] == 200
+    assert request(s.url, path="../h.png")[0] == 404       # no request names a file
+    assert request(s.url, path="map/h.png")[0] == 404
+    assert request(s.url, path="map/ssbump_ao")[0] == 200
+    assert request(s.url, headers={"Host": "attacker.example:80"})[0] == 403  # rebinding
+    assert request(s.url, "POST", path="write")[0] == 403  # no X-Bumpbake header
+    assert request(s.url, "DELETE")[0] == 405
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=0")
+    assert status == 400 and "rays" in json.loads(body)["error"]
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?path=/etc/passwd")
+    assert status == 400 and "unknown control" in json.loads(body)["error"]
+    assert sorted(os.listdir(d)) == ["h.png"]  # nothing written unless asked
+
+
+def test_with_address_every_path_needs_the_token(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"),
+                  ["--scale", "8", "--rays", "16", "--address", "127.0.0.1", "--quiet"])
+    try:
+        u = urllib.parse.urlsplit(s.url)
+        token = u.path.strip("/")
+        assert len(token) == 32, s.url
+        assert request(s.url)[0] == 200
+        assert request("http://%s/" % u.netloc)[0] == 404
+        assert request("http://%s/state" % u.netloc)[0] == 404
+        assert request("http://%s/%s/state" % (u.netloc, "0" * 32))[0] == 404
+    finally:
+        s.close()
+
+
+def save_in_place_in_pieces(path, data, pause):
+    with open(path, "r+b") as f:  # as a program that writes over the file, in goes
+        f.truncate(0)
+        f.write(data[: len(data) // 2])
+        f.flush()
+        os.fsync(f.fileno())
+        time.sleep(pause)
+        f.write(data[len(data) // 2:])
+        f.flush()
+
+
+def test_saves_rebake(served):
+    s, d = served
+    first = state(s)["bake"]
+    with open(os.path.join(FIXTURES, "bricks_128x64.png"), "rb") as f:
+        bricks = f.read()
+    with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+        rock = f.read()
+    # by rename
+    sb.save_by_rename(bricks, str(d / "h.png"))
+    st = wait_bake(s, first["id"], "the renamed save's bake")
+    assert (st["bake"]["width"], st["bake"]["height"]) == (128, 64) and st["error"] == ""
+    # written in place in two goes, the file closed at the end: whatever was
+    # seen in between, the whole file is baked last and no error stays
+    save_in_place_in_pieces(str(d / "h.png"), rock, 0.05)
+    sb.wait_for(lambda: (lambda x: x["bake"]["height"] == 128 and not x["baking"]
+                         and x["error"] == "")(state(s)), SLOW, "the whole save baked")
+    # a broken save: the error shown, the last good maps kept
+    last = state(s)["bake"]["id"]
+    sb.save_by_rename(rock[:500], str(d / "h.png"))
+    st = sb.wait_for(lambda: (lambda x: x if x["error"] else None)(state(s)), SLOW, "the error")
+    assert "h.png" in st["error"] and st["bake"]["id"] == last
+    assert request(s.url, path="map/ssbump_ao")[0] == 200
+    # and the process is still there for the next save
+    sb.save_by_rename(rock, str(d / "h.png"))
+    st = wait_bake(s, last, "the next good save")
+    assert st["error"] == ""
+    assert s.proc.poll() is None
+
+
+def test_a_newer_control_cancels_the_bake_in_flight(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_height.png"), tmp_path / "h.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"), ["--scale", "64", "--rays", "4096"])
+    try:
+        sb.wait_for(lambda: state(s)["baking"], SLOW, "the first bake started")
+        # a second request while the slow first one runs
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=1")
+        assert status == 200
+        st = wait_bake(s, 0, "a bake at rays 1")
+        assert st["bake"]["id"] == 1, "the first, slow bake was cancelled, not shown"
+        assert st["params"]["rays"] == 1 and st["bake"]["slices"] == 1
+    finally:
+        s.close()
+    # serve said nothing of the cancelled bake but the bake that was shown
+    err = s.proc.stderr.read()
+    assert err.count("serve: bake") == 1, err
+
+
+def test_the_brightness_map_switches_on_and_off(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "b.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"),
+                  ["--scale", "8", "--rays", "16", "--brightness", str(tmp_path / "b.png"),
+                   "--quiet"])
+    try:
+        st = wait_bake(s, 0, "the first bake")
+        assert st["params"]["brightness"] and "--brightness" in st["command"]
+        assert "--brightness" in st["bake"]["command"]
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=off")
+        assert status == 200
+        st = wait_bake(s, st["bake"]["id"], "the bake without it")
+        assert not st["params"]["brightness"] and "--brightness" not in st["bake"]["command"]
+        # a save of the brightness map bakes again too (it is watched)
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=on")
+        st = wait_bake(s, st["bake"]["id"], "the bake with it")
+        with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+            sb.save_by_rename(f.read(), str(tmp_path / "b.png"))
+        wait_bake(s, st["bake"]["id"], "the bake after the brightness map's save")
+    finally:
+        s.close()
+    s = sb.Server(BIN, str(tmp_path / "h.png"), ["--scale", "8", "--rays", "16", "--quiet"])
+    try:
+        status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?brightness=on")
+        assert status == 400 and "no --brightness FILE" in json.loads(body)["error"]
+    finally:
+        s.close()
