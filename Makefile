@@ -121,7 +121,7 @@ comma := ,
 # ---- sources and products ----------------------------------------------------
 # The library's families, each using only the ones before it: the order of
 # docs/how-it-works.md ("Layers"), which `make check-layers` holds them to.
-FAMILIES := core files texture image trace bake maps render mesh job
+FAMILIES := core files texture image trace bake maps render mesh job cmd
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
 CLI_C    := $(wildcard src/cli/*.c) $(wildcard src/cli/serve/*.c)

@@ -75,15 +75,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, text, NULL};
   if (bb_image_write(path, &img, &wo, NULL) == BB_OK) {
     char *info[] = {"info", path, NULL};
-    char *printed = captured(bb_cli_info, 2, info);
+    char *printed = captured(bb_cli_command, 2, info);
     FUZZ_CHECK(!has_control(printed));
     free(printed);
     char *json[] = {"info", "--json", path, NULL};
-    printed = captured(bb_cli_info, 3, json);
+    printed = captured(bb_cli_command, 3, json);
     FUZZ_CHECK(valid_utf8(printed));
     free(printed);
     char *compare[] = {"compare", path, path, NULL};
-    printed = captured(bb_cli_compare, 3, compare);
+    printed = captured(bb_cli_command, 3, compare);
     FUZZ_CHECK(!has_control(printed));
     free(printed);
     unlink(path);

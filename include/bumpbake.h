@@ -45,6 +45,8 @@
  *   job      the whole job on files: provenance, output paths, writing all
  *            or nothing, bakes of files and batches, depfiles, up-to-date
  *            checks
+ *   commands every command and option described once, checked, and planned
+ *            through the job
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -330,6 +332,26 @@ typedef enum bb_provenance_class {
  * "bumpbake_version=" line; intact when each non-empty line is key=value
  * with a key of lower-case letters, digits and '_'. */
 bb_provenance_class bb_provenance_classify(const char *description);
+
+/* One "key=value" line of a provenance text, as pointers into it (not
+ * terminated). */
+typedef struct bb_provenance_entry {
+  const char *key;
+  size_t key_length;
+  const char *value;
+  size_t value_length;
+} bb_provenance_entry;
+
+/* The one reading of a provenance text, which every reader uses (the
+ * values and diffs below, the up-to-date check, `bumpbake info --json`,
+ * Python's bumpbake.info): a line ends at '\n', and a '\r' before it is
+ * dropped (a text re-saved on Windows); its key is what comes before its
+ * first '=', its value what follows; a line without '=' is skipped; a key
+ * seen before keeps its first value (its later lines are skipped). Fills
+ * entries with up to cap of them, in line order; returns how many there are
+ * (which may exceed cap), or -1 when out of memory. Time O(n log n) in the
+ * lines. */
+long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 
 /* The value of key in a provenance text (its first "key=value" line) into
  * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
@@ -1229,7 +1251,8 @@ typedef struct bb_bake_options {
                                  the first; 3 or more: Rec. 709 luma of R, G,
                                  B), clamped to [0, 1], multiplies rho at each
                                  vertex, linear over each triangle. Not owned;
-                                 ignored while bounce_albedo is 0 */
+                                 with bounce_albedo 0 it bounces with rho 1
+                                 (the map's albedo as it is) */
   int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
                                  times; 0 (default): converged (each
                                  triangle's light estimated from what it
@@ -1633,6 +1656,10 @@ typedef enum bb_albedo_mode {
 bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err);
 const char *bb_albedo_mode_name(bb_albedo_mode mode);
 
+/* Largest specular exponent a render takes: max(0, N.h)^k is a point far
+ * below one texel beyond it. */
+#define BB_MAX_SPECULAR_EXPONENT 100000.0
+
 /* What one render shows. New modes are appended. */
 typedef enum bb_render_mode {
   BB_RENDER_SSBUMP = 0, /* the self-shadowed bump map (needs ssbump) */
@@ -1686,12 +1713,13 @@ typedef struct bb_render_options {
   int static_light;             /* 1: the lightmaps are on (default 0) */
   float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
                                    three basis directions in three colours */
-  double specular_exponent;     /* k > 0, or 0 = no specular (default 0) */
+  double specular_exponent;     /* k in 0..BB_MAX_SPECULAR_EXPONENT, 0 = no specular
+                                   (default 0) */
   double specular_strength;     /* ks, 0..1000: the highlight's scale, a
                                    material's specular intensity (default 1) */
   bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
                                    default BB_ALBEDO_MULTIPLY */
-  int tile_x, tile_y;           /* repeat the render nx x ny (default 1, 1) */
+  int tile_x, tile_y;           /* repeat the render nx x ny, 1..64 (default 1, 1) */
   int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
                                    texels; crop_width 0 = no crop */
   int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
@@ -2298,9 +2326,9 @@ const char *bb_compare_report_result(const bb_compare_report *report);
  * with provenance; a Make/Ninja depfile. A batch names its outputs from
  * out_dir and a template; a single input may name each output instead. */
 
-/* Most files one input's bake writes: the maps, the slope map and its lit
- * preview, and a Source material. */
-#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 3)
+/* Most files one input's bake writes: Valve's packed file, the maps, the
+ * slope map and its lit preview, and a Source material. */
+#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 4)
 /* A batch's file names: the input's stem, the map's name, the input's
  * extension ("{{" and "}}" are braces). */
 #define BB_JOB_DEFAULT_NAME "{stem}_{kind}.png"
@@ -2319,9 +2347,8 @@ typedef struct bb_job_options {
   const char *basis_file;    /* the file bake.basis came from, or NULL: a
                                 prerequisite in the depfile */
   const char *bounce_albedo_file; /* an albedo map for inter-reflection
-                                (bake.bounce_albedo_map), read once by the plan;
-                                with bake.bounce_albedo 0 it bounces with the
-                                map as it is (rho 1). NULL: none */
+                                (bake.bounce_albedo_map), read once by the plan.
+                                NULL: none */
   const char *brightness_file; /* a brightness map (bake.brightness), read once
                                 by the plan, or NULL */
   /* One input, outputs named one by one (out_dir NULL): */
@@ -2344,9 +2371,11 @@ typedef struct bb_job_options {
   const char *depfile;       /* a Make/Ninja depfile to write, or NULL */
   /* Provenance: the "command" key. */
   const char *command;       /* one input: the whole command line as typed */
-  const char *command_options; /* a batch: what follows "bumpbake bake INPUT"
-                                in each output's command; NULL for both: the
-                                options written out by bb_job_command_text */
+  const char *command_options; /* what follows "bumpbake bake INPUT" in each
+                                output's command (a batch's, or a single input's
+                                when command is NULL); NULL for both: the options
+                                written out by bb_job_command_text.
+                                bb_command_plan sets them */
   bb_note_fn note;           /* notes about inputs (may be NULL) */
   void *note_user;
   /* Engine textures and a Source material: */
@@ -2362,6 +2391,14 @@ typedef struct bb_job_options {
                                 are relative to; NULL: the nearest folder named
                                 "materials" above the bump map (bb_vmt_options) */
   const char *vmt_basetexture; /* the colour .vtf the material names, or NULL */
+  /* Valve's height2ssbump file (one input, no out_dir): */
+  const char *valve_path;    /* the RGBA file bb_valve_pack makes of the bake (RGB
+                                ssbump or normal map, A filtered height or ao), written
+                                before the maps; NULL: none. Its provenance names the
+                                channel the height came from, as Valve's rule picks it */
+  bb_valve_options valve;    /* what goes into it */
+  int valve_detail;          /* 1: Valve's detail variant (bb_valve_detail of the
+                                input's colour); not with valve.normal_map */
 } bb_job_options;
 
 /* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
@@ -2476,6 +2513,7 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
  * end. BB_OK when the job has no depfile. */
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 
+
 /* The command line of options o, as the provenance of a job without
  * command or command_options records it: "bumpbake bake INPUT" and then
  * every option that differs from its default, in the order of `bumpbake
@@ -2483,7 +2521,9 @@ bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
  * --maps normal,ao --name T ... --texture-format bc3 --vtf-version 7.3
  * --nomip --vmt FILE; the threads are left out). A CLI invocation typed
  * this way records the same text, so the same job through the CLI and
- * through Python writes the same bytes. malloc'd; NULL when out of memory. */
+ * through Python writes the same bytes. (Python's jobs still plan with it;
+ * bb_command_text spells any command through the descriptions.) malloc'd;
+ * NULL when out of memory. */
 char *bb_job_command_text(const bb_job_options *o, const char *input);
 
 /* --------------------------------------------------- up-to-date checks */
@@ -2539,6 +2579,332 @@ typedef enum bb_output_state {
 bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
                           int mip_mapped, bb_output_state *state, char *reason, size_t cap,
                           bb_error *err);
+
+/* =====================================================================
+ * commands: every command of `bumpbake`, its options and their rules,
+ * described once
+ * ===================================================================== */
+
+/* Each command (bake, normal, height2ssbump, render, ...) and each of its
+ * options is described here once: name, short name, value, type, range,
+ * default, the mode it belongs to, whether it determines what is made,
+ * when it applies, and its help. The command line's parser, --help and
+ * "did you mean", the reference pages and the man page, Python's keyword
+ * arguments and the cluster's hand-over are drivers over these
+ * descriptions: a value is parsed and checked by the library's one
+ * function for its rule (bb_command_set), the rules between options by
+ * the library's (bb_command_check), and every client prints the library's
+ * words. A command's options land in one typed struct
+ * (bb_command_options); the commands that write files through the job
+ * are planned from it in one call (bb_command_plan). */
+
+/* What an option's value is. */
+typedef enum bb_option_type {
+  BB_OPTION_FLAG = 0, /* no value: given or not */
+  BB_OPTION_INT,      /* a decimal integer in the option's range */
+  BB_OPTION_NUMBER,   /* a finite number in the option's range */
+  BB_OPTION_WORD,     /* one of the words of bb_option_info.choices */
+  BB_OPTION_WORDS,    /* several of them, comma-separated ("normal,ao") */
+  BB_OPTION_NUMBERS,  /* bb_option_info.count numbers: comma-separated ("135,45"),
+                         or, with values > 1, as that many words ("-size 256 128") */
+  BB_OPTION_TEXT,     /* any text (a template, an address, a basis name or file) */
+  BB_OPTION_PATH      /* a file or directory, not empty */
+} bb_option_type;
+
+/* Which of a command's uses an option belongs to. */
+typedef enum bb_option_mode {
+  BB_MODE_ANY = 0,    /* every use */
+  BB_MODE_SINGLE,     /* one input, outputs named one by one */
+  BB_MODE_BATCH       /* a batch (bake --out-dir): refused without it */
+} bb_option_mode;
+
+/* bb_option_info.flags */
+#define BB_OPTION_RECORDED 0x1u    /* determines what the command makes (pixels, files):
+                                      kept in the provenance's command; the others
+                                      (-q, --json, --threads, --depfile...) are not */
+#define BB_OPTION_CLIENT 0x2u      /* how a command-line client prints (--help, --json,
+                                      -q): nothing for the library to do */
+#define BB_OPTION_SINGLE_DASH 0x4u /* also spelled with one dash (idiff's -fail,
+                                      DOOM 3's -size) */
+#define BB_OPTION_REQUIRED 0x8u    /* the command refuses to run without it */
+#define BB_OPTION_FILES 0x10u      /* about the files a run writes as a whole: their
+                                      names, format settings, a batch, a cluster;
+                                      not for images in memory (bb_command_set_in_memory) */
+
+typedef struct bb_option_info {
+  const char *name;        /* the long name without "--" ("filter-radius"); Python's
+                              keyword is it with '-' as '_' (filter_radius) */
+  char short_name;         /* 'o', or 0 */
+  const char *value_name;  /* "S", "AZ,EL", "W H"; NULL for a flag and for a word
+                              (bb_option_value_text shows its choices) */
+  bb_option_type type;
+  int count;               /* BB_OPTION_NUMBERS: how many numbers; else 1 */
+  int values;              /* words the value takes on a command line: 1 (2 for
+                              renderbumpflat's -size W H, 4 for --rect); 0 for a flag */
+  bb_option_mode mode;
+  unsigned flags;          /* BB_OPTION_* */
+  const char *help;        /* one line */
+  const char *default_text; /* the default as words, when it is not a value
+                              ("from --rays", "FILE-ssbump.tga (-n: FILE-bump.tga)");
+                              NULL: bb_option_default_text formats the value */
+  const char *range_text;  /* the range as words, when it is not a number range
+                              ("{stem} {kind} {ext}"); NULL: bb_option_range_text */
+  const char *applies;     /* what the option needs to do anything ("a .vtf or .dds
+                              output"), or NULL: it always does; bb_command_check
+                              refuses it given where it would do nothing */
+} bb_option_info;
+
+typedef struct bb_command_info {
+  const char *name;        /* "bake" */
+  const char *summary;     /* one line: what it does (bumpbake --help) */
+  const char *synopsis;    /* the usage after "bumpbake NAME " */
+  const char *description; /* a few lines for --help and the reference pages */
+  const char *inputs;      /* what its positional arguments are ("HEIGHT", "FILE
+                              BUMPSCALE", "A B"), for messages */
+  int min_inputs, max_inputs; /* how many (max -1: any number) */
+  int usage_exit;          /* the exit code of a usage error: 2, or 4 for compare
+                              (idiff's "could not compare") */
+  int option_count;
+} bb_command_info;
+
+/* The commands, in the order `bumpbake --help` lists them: index 0 ..
+ * bb_command_count() - 1; NULL outside. Static data. */
+int bb_command_count(void);
+const bb_command_info *bb_command_info_get(int index);
+/* The command named name, or NULL. */
+const bb_command_info *bb_command_info_find(const char *name);
+/* The command nearest to a mistyped name (at most 2 edits away, for "did
+ * you mean"), or NULL. */
+const bb_command_info *bb_command_info_nearest(const char *name);
+
+/* A command's options, in the order of its --help: 0 .. option_count - 1. */
+const bb_option_info *bb_command_option(const bb_command_info *command, int index);
+/* The option of command named name: its long name, or with '_' for '-'
+ * (Python's keyword); the first `length` characters of name (0: all). NULL
+ * when none. */
+const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
+                                     size_t length);
+/* The option whose short name is c, or NULL. */
+const bb_option_info *bb_option_find_short(const bb_command_info *command, char c);
+/* For "did you mean": the option of command whose name is nearest to the
+ * first length characters of name (at most 2 edits away, '_' read as '-'),
+ * or NULL. */
+const bb_option_info *bb_option_nearest(const bb_command_info *command, const char *name,
+                                        size_t length);
+/* The option's range as help prints it ("1..65536", "> 0", "0..1e6", its
+ * range_text, its choices), into out (capacity cap); "" when it has none. */
+void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
+/* The words a BB_OPTION_WORD or WORDS option takes, '|'-separated
+ * ("valve|central|sobel|vertex", the names of the library's enum), into out
+ * (capacity cap); "" for other types. */
+void bb_option_choices(const bb_option_info *option, char *out, size_t cap);
+/* How help shows the option's value: its value_name, else its choices
+ * ("down|up"); "" for a flag. */
+void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
+/* The option's numeric range: 1 and *min, *max (HUGE_VAL: none),
+ * *min_exclusive filled for BB_OPTION_INT, NUMBER and NUMBERS; 0 for others. */
+int bb_option_bounds(const bb_option_info *option, double *min, double *max,
+                     int *min_exclusive);
+/* The option's default for help into out (capacity cap): its default_text,
+ * else the value a new command of this kind holds, spelled as the option
+ * takes it ("256", "vertex", "periodic"); "" when it has none (a flag off,
+ * a path not given). */
+void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
+                            char *out, size_t cap);
+
+/* ------------------------------------------------------------- options */
+
+/* Every option of every command lands here, typed: the command's own
+ * structs (a bake's bb_job_options, a render's bb_render_options...) and
+ * what has no struct of its own yet. A command uses the fields its options
+ * name. Strings point into the bb_command, which owns them. */
+typedef struct bb_command_options {
+  bb_job_options job;           /* bake, normal, height2ssbump; the bake of render's
+                                   and sheet's HEIGHT; depth, mips and texture settings
+                                   of every command writing maps */
+  const char *output;           /* -o of the commands writing one named file (render,
+                                   sheet, combine, ...: the default filled in by
+                                   bb_command_check where the command has one) */
+  bb_render_options render;     /* render's picture; sheet's lit panel */
+  const char *render_maps[5];   /* render --normal, --ssbump, --ao, --bent, --slope
+                                   (by bb_render_map) */
+  const char *albedo;           /* render --albedo */
+  int render_compare;           /* render --compare */
+  int orbit;                    /* render --orbit: frames, 0: one picture */
+  int maps_normal_y_up;         /* --normal-y up of render, normal2ssbump, combine
+                                   (the maps read), ssbump2normal and renderbumpflat
+                                   (the map written) */
+  int panel_size;               /* sheet --panel-size */
+  bb_compare_limits limits;     /* compare */
+  const char *diff;             /* compare --diff */
+  bb_renderbump_options renderbump; /* renderbumpflat */
+  const char *height_output;    /* renderbumpflat --height */
+  bb_map_kind map_kind;         /* combine --kind */
+  bb_ssbump_kind ssbump_kind;   /* ssbump2normal --kind */
+  double mix;                   /* combine --mix */
+  const char *mask;             /* combine --mask */
+  int detail;                   /* combine --detail */
+  const char *brightness;       /* combine --brightness */
+  const char *base_dir;         /* program --base */
+  int allow_outside_base;       /* program --allow-outside-base */
+  int json, quiet;              /* how a command-line client prints */
+  const char *scheduler;        /* bake --scheduler: a Dask scheduler's address */
+  int port;                     /* serve --port (0: any free one) */
+  const char *address;          /* serve --address: an IPv4 or IPv6 address, or NULL */
+} bb_command_options;
+
+/* ------------------------------------------------------------ commands */
+
+/* One use of a command: its options and inputs as set, checked, then run.
+ * Opaque; not thread-safe. */
+typedef struct bb_command bb_command;
+
+/* A command named name with every option at its default. Errors:
+ * BB_ERR_ARGUMENT "unknown command 'x'" (with the nearest name when one is
+ * near), BB_ERR_MEMORY. Free with bb_command_free. */
+bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
+void bb_command_free(bb_command *command);
+const bb_command_info *bb_command_describe(const bb_command *command);
+
+/* Sets option name (as bb_option_find finds it) from text, through the
+ * option's parser, into the command's options: a flag takes text NULL (or
+ * "1"/"0": Python's True/False); an option of several values takes them
+ * separated by blanks ("256 128"). A value that does not parse is refused
+ * at once; its range, and the rules between options, by bb_command_check.
+ * Errors: BB_ERR_ARGUMENT with the message every client prints ("--rays
+ * needs an integer (got 'x')", "unknown option '--rayz' (did you mean
+ * --rays?)"). An option set again takes the new value. */
+bb_status bb_command_set(bb_command *command, const char *name, const char *text,
+                         bb_error *err);
+
+/* Adds a positional argument (an input file, or height2ssbump's
+ * BUMPSCALE) in order. Errors: BB_ERR_ARGUMENT (one too many, a
+ * BUMPSCALE that is no number), BB_ERR_MEMORY. */
+bb_status bb_command_add_input(bb_command *command, const char *text, bb_error *err);
+
+/* Checks everything that can be checked before any file is read: the
+ * inputs' count, the required options, every option's range, each option's
+ * mode and whether it applies, and the rules between options (one library
+ * function each); then fills in the default output names (FILE-ssbump.tga,
+ * NAME_ssbump.tga, MODEL_local.tga) and checks the outputs of the commands
+ * that do not run through a job against what they read. BB_OK, or
+ * BB_ERR_ARGUMENT with the usage error's message, BB_ERR_IO for an output
+ * that would replace an input. */
+bb_status bb_command_check(bb_command *command, bb_error *err);
+
+/* The command runs on images in memory (Python's bumpbake.bake(array),
+ * render(...) on arrays), not on files: its inputs are the caller's (not
+ * counted), options with BB_OPTION_FILES are refused and none is required,
+ * and maps (BB_OUTPUT_BIT(kind)s; 0 for a command that bakes no maps) are
+ * the maps asked, for the rules that look at them (--bounce needs a traced
+ * map). Call before bb_command_check. */
+void bb_command_set_in_memory(bb_command *command, unsigned maps);
+
+/* 1 when option name was set. */
+int bb_command_given(const bb_command *command, const char *name);
+/* The options as set (defaults elsewhere); owned by command. */
+const bb_command_options *bb_command_options_of(const bb_command *command);
+/* The inputs added, and how many. */
+int bb_command_input_count(const bb_command *command);
+const char *bb_command_input(const bb_command *command, int index);
+
+/* The command as text, through the descriptions: "bumpbake NAME INPUT...
+ * --option value ..." with every option given, in the order of its --help,
+ * spelled as it takes it; with BB_OPTION_RECORDED in flags only those that
+ * determine what is made (the provenance's command), else every one (the
+ * hand-over of a planned command to another process, which reads it back
+ * with bb_command_set). input not NULL: that input in place of the
+ * command's (a batch's provenance names each input). malloc'd; NULL when
+ * out of memory. */
+char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
+
+/* The command line the outputs record as their provenance's "command",
+ * when it is not the one bb_command_text spells: a command-line client
+ * gives the words as typed with those of options that are not
+ * BB_OPTION_RECORDED left out. line: the whole command ("bumpbake bake
+ * h.png --scale 8 --normal n.png"); options: the words of the options
+ * alone, which a batch's outputs record after "bumpbake bake INPUT".
+ * Either may be NULL. Errors: BB_ERR_MEMORY. */
+bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
+                                bb_error *err);
+
+/* What a caller hooks into a command's run; every field may be NULL. */
+typedef struct bb_command_hooks {
+  bb_note_fn note;      /* notes about the inputs */
+  void *note_user;
+  bb_progress_fn progress; /* follows the bake (bb_command_run), may cancel it */
+  void *progress_user;
+  bb_trace_fn trace;    /* a trace of the caller's in place of the bake's own
+                           (bb_trace_options.trace): a trace split over machines */
+  void *trace_user;
+} bb_command_hooks;
+
+/* Plans a checked command that writes through the job (bake, normal,
+ * height2ssbump): its options as a bb_job_options, planned by bb_job_plan
+ * (every output named and checked against every input, provenance,
+ * depths, staged all-or-nothing writes, up-to-date checks), without
+ * checking again what bb_command_check checked. A single input is baked
+ * even when its outputs are current, as the command line does (run it with
+ * bb_job_run_item after bb_job_check_current to skip it). Run it with
+ * bb_job_run; free it with bb_job_free. hooks may be NULL. Errors: those of
+ * bb_job_plan; BB_ERR_ARGUMENT for an unchecked command or one that has no
+ * job. */
+bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
+                          bb_error *err);
+
+/* 1 when the command writes through the job (bb_command_plan plans it). */
+int bb_command_has_job(const bb_command_info *command);
+
+/* What a command's run wrote. */
+typedef struct bb_command_result {
+  int file_count;
+  bb_job_file *files;    /* what was written, in order: kind ("normal", "render",
+                            "orbit"...) and path; owned by the result */
+  int frames;            /* render --orbit: the frames (files holds each frame, or
+                            the one GIF); 0 for one picture */
+  int labels_drawn;      /* 0 when a picture's labels could not be drawn (no font:
+                            render --compare, sheet); else 1 */
+} bb_command_result;
+
+/* Runs a checked command that writes files, as the command line runs it:
+ * those through the job (bake, normal, height2ssbump) are planned and run
+ * (stopping at the first failing input; bb_command_plan and bb_job_run for
+ * each input's report); render, sheet, normal2ssbump, ssbump2normal,
+ * combine and program read their inputs, make their picture or map and
+ * write it all or nothing with provenance (its command the record, else
+ * bb_command_text's). hooks may be NULL. Fills result (free it with
+ * bb_command_result_free) on success. Errors name the file: those of the
+ * reads, the bake and the writes; BB_ERR_ARGUMENT for an unchecked command
+ * or one that writes nothing (compare, info). */
+bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
+                         bb_command_result *result, bb_error *err);
+void bb_command_result_free(bb_command_result *result);
+
+/* Render's or sheet's picture of images in memory, with the options of a
+ * command checked for them (bb_command_set_in_memory): height, when not
+ * NULL, is a 1-channel height field (bb_height_from_image) baked as the
+ * command line bakes a HEIGHT (render: the maps its picture lights, its
+ * relief the filtered height); else render lights maps (decoded, as
+ * bb_render_map_read gives them; maps->albedo also with a height). out
+ * (allocated) receives render's picture (with the light as given: an
+ * orbit's first frame) or sheet's contact sheet; *labels_drawn (may be
+ * NULL) is 0 when the labels could not be drawn (no font). Errors as
+ * bb_bake's, bb_render's, bb_sheet_make's. */
+bb_status bb_command_picture(bb_command *command, const bb_image *height,
+                             const bb_render_maps *maps, const bb_command_hooks *hooks,
+                             bb_image *out, int *labels_drawn, bb_error *err);
+
+/* ------------------------------------------------- names of enums printed */
+
+/* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
+bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
+const char *bb_normal_y_name(int normal_y_up);
+/* "periodic" or "clamp"; "unknown" for other values. */
+const char *bb_addressing_name(bb_addressing addressing);
+/* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
+const char *bb_job_outcome_name(bb_job_outcome outcome);
+/* "none", "intact", "damaged"; "unknown" else. */
+const char *bb_provenance_class_name(bb_provenance_class c);
 
 #ifdef __cplusplus
 }

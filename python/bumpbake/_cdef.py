@@ -7,7 +7,7 @@ header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
 update. Declarations are the header's as they are, in its order, comments
 dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
-BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 9; the VTF flags in decimal), which
+BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 10; the VTF flags in decimal), which
 cffi needs; the test checks those numbers too.
 """
 
@@ -230,6 +230,11 @@ typedef struct bb_bake_result {
   double seconds_bounce;
 } bb_bake_result;
 
+typedef struct bb_valve_options {
+  int normal_map;
+  int ao_in_alpha;
+} bb_valve_options;
+
 typedef enum bb_ssbump_kind {
   BB_SSBUMP_LINEAR = 0,
   BB_SSBUMP_SQUARED
@@ -396,6 +401,13 @@ typedef enum bb_provenance_class {
   BB_PROVENANCE_DAMAGED
 } bb_provenance_class;
 
+typedef struct bb_provenance_entry {
+  const char *key;
+  size_t key_length;
+  const char *value;
+  size_t value_length;
+} bb_provenance_entry;
+
 typedef struct bb_output_spec {
   const char *path;
   const char *kind;
@@ -472,6 +484,9 @@ typedef struct bb_job_options {
   const char *vmt;
   const char *vmt_materials;
   const char *vmt_basetexture;
+  const char *valve_path;
+  bb_valve_options valve;
+  int valve_detail;
 } bb_job_options;
 
 typedef struct bb_job bb_job;
@@ -492,7 +507,7 @@ typedef struct bb_job_file {
 typedef struct bb_job_report {
   const char *input;
   int output_count;
-  bb_job_file outputs[9];
+  bb_job_file outputs[10];
   bb_job_outcome outcome;
   bb_status status;
   bb_error error;
@@ -506,6 +521,95 @@ typedef struct bb_job_report {
   double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
       seconds_derive, seconds_write;
 } bb_job_report;
+
+typedef enum bb_option_type {
+  BB_OPTION_FLAG = 0,
+  BB_OPTION_INT,
+  BB_OPTION_NUMBER,
+  BB_OPTION_WORD,
+  BB_OPTION_WORDS,
+  BB_OPTION_NUMBERS,
+  BB_OPTION_TEXT,
+  BB_OPTION_PATH
+} bb_option_type;
+
+typedef enum bb_option_mode {
+  BB_MODE_ANY = 0,
+  BB_MODE_SINGLE,
+  BB_MODE_BATCH
+} bb_option_mode;
+
+typedef struct bb_option_info {
+  const char *name;
+  char short_name;
+  const char *value_name;
+  bb_option_type type;
+  int count;
+  int values;
+  bb_option_mode mode;
+  unsigned flags;
+  const char *help;
+  const char *default_text;
+  const char *range_text;
+  const char *applies;
+} bb_option_info;
+
+typedef struct bb_command_info {
+  const char *name;
+  const char *summary;
+  const char *synopsis;
+  const char *description;
+  const char *inputs;
+  int min_inputs, max_inputs;
+  int usage_exit;
+  int option_count;
+} bb_command_info;
+
+typedef struct bb_command_options {
+  bb_job_options job;
+  const char *output;
+  bb_render_options render;
+  const char *render_maps[5];
+  const char *albedo;
+  int render_compare;
+  int orbit;
+  int maps_normal_y_up;
+  int panel_size;
+  bb_compare_limits limits;
+  const char *diff;
+  bb_renderbump_options renderbump;
+  const char *height_output;
+  bb_map_kind map_kind;
+  bb_ssbump_kind ssbump_kind;
+  double mix;
+  const char *mask;
+  int detail;
+  const char *brightness;
+  const char *base_dir;
+  int allow_outside_base;
+  int json, quiet;
+  const char *scheduler;
+  int port;
+  const char *address;
+} bb_command_options;
+
+typedef struct bb_command bb_command;
+
+typedef struct bb_command_hooks {
+  bb_note_fn note;
+  void *note_user;
+  bb_progress_fn progress;
+  void *progress_user;
+  bb_trace_fn trace;
+  void *trace_user;
+} bb_command_hooks;
+
+typedef struct bb_command_result {
+  int file_count;
+  bb_job_file *files;
+  int frames;
+  int labels_drawn;
+} bb_command_result;
 """
 
 # Functions, in header order.
@@ -647,6 +751,49 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 char *bb_job_command_text(const bb_job_options *o, const char *input);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
+int bb_command_count(void);
+const bb_command_info *bb_command_info_get(int index);
+const bb_command_info *bb_command_info_find(const char *name);
+const bb_command_info *bb_command_info_nearest(const char *name);
+const bb_option_info *bb_command_option(const bb_command_info *command, int index);
+const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
+                                     size_t length);
+const bb_option_info *bb_option_nearest(const bb_command_info *command, const char *name,
+                                        size_t length);
+void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
+void bb_option_choices(const bb_option_info *option, char *out, size_t cap);
+void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
+int bb_option_bounds(const bb_option_info *option, double *min, double *max,
+                     int *min_exclusive);
+void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
+                            char *out, size_t cap);
+bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
+void bb_command_free(bb_command *command);
+const bb_command_info *bb_command_describe(const bb_command *command);
+bb_status bb_command_set(bb_command *command, const char *name, const char *text,
+                         bb_error *err);
+bb_status bb_command_add_input(bb_command *command, const char *text, bb_error *err);
+bb_status bb_command_check(bb_command *command, bb_error *err);
+void bb_command_set_in_memory(bb_command *command, unsigned maps);
+int bb_command_given(const bb_command *command, const char *name);
+const bb_command_options *bb_command_options_of(const bb_command *command);
+int bb_command_input_count(const bb_command *command);
+const char *bb_command_input(const bb_command *command, int index);
+char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
+bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
+                                bb_error *err);
+bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
+                          bb_error *err);
+int bb_command_has_job(const bb_command_info *command);
+bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
+                         bb_command_result *result, bb_error *err);
+void bb_command_result_free(bb_command_result *result);
+bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
+const char *bb_normal_y_name(int normal_y_up);
+const char *bb_addressing_name(bb_addressing addressing);
+const char *bb_job_outcome_name(bb_job_outcome outcome);
+const char *bb_provenance_class_name(bb_provenance_class c);
+long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 """
 
 # Constants of the header (#define), by value: cffi reads only literals.
@@ -656,7 +803,7 @@ CONSTANTS = """
 #define BB_MAX_SLICES 256
 #define BB_MAX_BASIS 16
 #define BB_COMPARE_DIFFERENT_SIZE 3
-#define BB_JOB_MAX_OUTPUTS 9
+#define BB_JOB_MAX_OUTPUTS 10
 #define BB_JOB_DEFAULT_MAPS 13
 #define BB_VTF_FLAG_EIGHTBITALPHA 8192
 #define BB_VTF_FLAG_NORMAL 128
@@ -664,10 +811,15 @@ CONSTANTS = """
 #define BB_VTF_FLAG_NOLOD 512
 #define BB_VTF_FLAG_ENVMAP 16384
 #define BB_VTF_FLAG_SSBUMP 134217728
+#define BB_OPTION_RECORDED 1
+#define BB_OPTION_CLIENT 2
+#define BB_OPTION_SINGLE_DASH 4
+#define BB_OPTION_REQUIRED 8
+#define BB_OPTION_FILES 16
 """
 
 # From the C library: the strings the library returns malloc'd
-# (bb_job_command_text) are freed with it.
+# (bb_command_text) are freed with it.
 LIBC = """
 void free(void *ptr);
 """

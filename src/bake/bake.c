@@ -11,18 +11,6 @@
 #include <stdio.h>
 #include <string.h>
 
-void bb_bake_options_init(bb_bake_options *o) {
-  memset(o, 0, sizeof *o);
-  o->height_scale = 0.0f; /* must be set: there is no meaningful default */
-  o->rays = 256;
-  bb_smooth_options_init(&o->smooth);
-  bb_trace_options_init(&o->trace);
-  o->power = 1.0;
-  bb_basis_init(&o->basis);
-  o->normal_filter = BB_NORMAL_VERTEX;
-  o->outputs = BB_OUTPUTS_ALL;
-}
-
 void bb_bake_result_free(bb_bake_result *r) {
   bb_image_free(&r->filtered);
   bb_image_free(&r->normal);
@@ -34,76 +22,8 @@ void bb_bake_result_free(bb_bake_result *r) {
   memset(r, 0, sizeof *r);
 }
 
-int bb_bake_slices(const bb_bake_options *o) {
-  return o->slices ? o->slices : bb_slices_for_rays(o->rays);
-}
-
 static int wants(const bb_bake_options *o, unsigned bits) {
   return (o->outputs & bits) != 0;
-}
-
-/* The options' ranges that need a trace: they mean nothing without one. */
-static bb_status check_trace_options(const bb_bake_options *o, bb_error *err) {
-  if (!o->slices && (o->rays < 1 || o->rays > BB_MAX_RAYS))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: rays must be in 1..%d (got %d)", BB_MAX_RAYS,
-                    o->rays);
-  if (o->slices < 0 || o->slices > BB_MAX_SLICES)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: slices must be in 1..%d (got %d)",
-                    BB_MAX_SLICES, o->slices);
-  return BB_OK;
-}
-
-/* A double option in [min, max]; NaN fails the lower bound. */
-static bb_status check_range(double v, double min, double max, const char *what,
-                             bb_error *err) {
-  if (!(v >= min))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: %s must be >= %g (got %g)", what, min, v);
-  if (!(v <= max))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: %s must be <= %g (got %g)", what, max, v);
-  return BB_OK;
-}
-
-bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
-  if (!o)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing options");
-  if (!(o->height_scale > 0.0f) || !isfinite(o->height_scale))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: height scale must be > 0 (got %g)",
-                    (double)o->height_scale);
-  if (o->outputs == 0 || (o->outputs & ~BB_OUTPUTS_ALL) != 0)
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "bake: outputs must be a non-empty set of BB_OUTPUT_BIT(kind) (got 0x%x)",
-                    o->outputs);
-  bb_status st = wants(o, BB_OUTPUTS_TRACED) ? check_trace_options(o, err) : BB_OK;
-  if (st != BB_OK)
-    return st;
-  if (o->smooth.radius_texels < 0 || o->smooth.radius_texels > BB_MAX_FILTER_RADIUS)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: filter radius must be in 0..%d (got %d)",
-                    BB_MAX_FILTER_RADIUS, o->smooth.radius_texels);
-  if (!(o->smooth.threshold > 0.0f) || !isfinite(o->smooth.threshold))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: filter threshold must be > 0 (got %g)",
-                    (double)o->smooth.threshold);
-  if (o->smooth.addressing != BB_ADDRESS_PERIODIC && o->smooth.addressing != BB_ADDRESS_CLAMP)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown addressing mode %d",
-                    (int)o->smooth.addressing);
-  if ((st = check_range(o->power, 1.0, BB_MAX_POWER, "power", err)) != BB_OK ||
-      (st = check_range(o->trace.bias_texels, 0.0, BB_MAX_BIAS_TEXELS, "bias", err)) != BB_OK)
-    return st;
-  if (o->trace.threads < 0 || o->trace.threads > BB_MAX_THREADS)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: threads must be in 0..%d (got %d)",
-                    BB_MAX_THREADS, o->trace.threads);
-  if ((st = check_range(o->bounce_albedo, 0.0, 1.0, "bounce albedo", err)) != BB_OK)
-    return st;
-  if (o->bounces < 0 || o->bounces > BB_MAX_BOUNCES)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: bounces must be in 0..%d (got %d)",
-                    BB_MAX_BOUNCES, o->bounces);
-  if (o->bounce_albedo_map && (!o->bounce_albedo_map->pixels || o->bounce_albedo_map->channels < 1))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the bounce albedo map has no pixels");
-  if (o->brightness && (!o->brightness->pixels || o->brightness->channels < 1))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: the brightness map has no pixels");
-  if (strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
-                    (int)o->normal_filter);
-  return bb__basis_check(&o->basis, "bake", err);
 }
 
 /* Heights in texels, the field the tracer sees. */
@@ -215,7 +135,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
   if (st == BB_OK) st = bb__pyramid_build(&z, o->smooth.addressing, threads, &pyramid, err);
   bb_image_free(&z);
-  if (st == BB_OK) st = bb__rayset_make(bb_bake_slices(o), o->power, &o->basis, threads, &rays, err);
+  if (st == BB_OK) st = bb__rayset_make(o->slices, o->power, &o->basis, threads, &rays, err);
   double t1 = bb__now_seconds();
   r->seconds_pyramid = t1 - t0;
   if (st == BB_OK) {
@@ -323,7 +243,12 @@ static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
 
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
                   bb_error *err) {
-  return bb__bake((bb_image *)height, o, 0, r, err); /* no flag: height is only read */
+  bb_bake_options prepared;
+  if (r)
+    memset(r, 0, sizeof *r);
+  bb_status st = bb__bake_prepare(o, &prepared, err);
+  /* no flag: height is only read */
+  return st == BB_OK ? bb__bake((bb_image *)height, &prepared, 0, r, err) : st;
 }
 
 static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
@@ -352,7 +277,7 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   memset(r, 0, sizeof *r);
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
-  bb_status st = bb_bake_options_check(o, err);
+  bb_status st = BB_OK;
   /* Before any stage: an overflow of scale x height is named as such, a
    * map of another size as such. */
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);

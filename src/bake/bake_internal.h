@@ -4,6 +4,7 @@
 #define BB_BAKE_INTERNAL_H
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 /* The stages of a bake with the bake's thread count (0 = all cores); the
  * public functions of the same name without "bb__" call them with 0.
@@ -37,6 +38,23 @@ bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int thr
                           bb_image *out, bb_error *err);
 
 
+/* The ranges of bb_bake_options' fields, the one home of each (options.c);
+ * the options that set them (cmd/) check against these. */
+extern const bb__range bb__range_height_scale, bb__range_rays, bb__range_slices,
+    bb__range_filter_radius, bb__range_filter_threshold, bb__range_bias, bb__range_power,
+    bb__range_bounce_albedo, bb__range_bounces;
+
+/* The one check of a bake's options (bb_bake_options_check) and the one
+ * place its ray budget becomes azimuth slices: out is in with slices set
+ * (bb_bake_slices) when a traced map is asked. Every entry point taking
+ * bb_bake_options prepares them once; what runs after (bb__bake, the
+ * memory estimate, the ray set) reads out->slices and checks nothing. */
+bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err);
+/* bb__bake_prepare without the check, for options already checked (a
+ * command's, cmd/): the one place rays become slices (and a bounce albedo
+ * map without a rho bounces with rho 1). */
+void bb__bake_resolve(bb_bake_options *o);
+
 /* bb_bake for a caller that only writes the maps (the job), which lets go
  * of what it will not use as soon as the bake is done with it:
  * BB__BAKE_DROP_VIS: r->vis goes once ssbump and ao are made (4 bytes a
@@ -45,6 +63,7 @@ bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int thr
 enum { BB__BAKE_DROP_VIS = 1, BB__BAKE_TAKE_HEIGHT = 2 };
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
                    bb_bake_result *r, bb_error *err);
+/* (o prepared by bb__bake_prepare: it is not checked again.) */
 
 /* The most bytes bb__bake with flags allocates at one time for a width x
  * height bake with options o (memory.c follows its stages), counting

@@ -71,7 +71,7 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
     take(&l, lobes * texel);
   if (traced) {
     const double levels = pyramid_levels(width, height);
-    const int slices = o->slices ? o->slices : bb_slices_for_rays(o->rays);
+    const int slices = o->slices; /* prepared: bb__bake_prepare */
     take(&l, texel);                   /* heights in texels */
     take(&l, texel + levels + texel);  /* the pyramid's copy, its levels, a row pass */
     give(&l, texel);                   /* the row pass */

@@ -9,7 +9,7 @@
 
 #include <stdlib.h>
 
-bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
+bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *given,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err) {
   if (!pyramid || !rays)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing pyramid or ray set");
@@ -17,7 +17,9 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
   *rays = NULL;
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
-  bb_status st = bb_bake_options_check(o, err);
+  bb_bake_options prepared;
+  const bb_bake_options *o = &prepared;
+  bb_status st = bb__bake_prepare(given, &prepared, err);
   if (st == BB_OK && !(o->outputs & BB_OUTPUTS_TRACED))
     st = bb__fail(err, BB_ERR_ARGUMENT, "bake: the outputs asked need no trace");
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
@@ -38,7 +40,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
   bb_rayset *rs = NULL;
   if (st == BB_OK && !(rs = calloc(1, sizeof *rs)))
     st = bb__fail(err, BB_ERR_MEMORY, "bake: out of memory");
-  if (st == BB_OK) st = bb__rayset_make(bb_bake_slices(o), o->power, &o->basis, threads, rs, err);
+  if (st == BB_OK) st = bb__rayset_make(o->slices, o->power, &o->basis, threads, rs, err);
   if (st != BB_OK) {
     free(rs);
     bb_pyramid_free(*pyramid);

@@ -1,25 +1,54 @@
-/* cli.h: entry points of the bumpbake subcommands (the CLI is a client of
- * bumpbake.h; nothing here is part of the library). */
+/* cli.h: the bumpbake command line, a client of bumpbake.h: a generic
+ * driver over the library's descriptions of the commands (parse.c, help.c)
+ * and, per command, what it prints (nothing here is part of the library). */
 #ifndef BB_CLI_H
 #define BB_CLI_H
+
+#include "bumpbake.h"
+
+#include <stdio.h>
 
 /* Exit codes of every subcommand except compare (which follows idiff). */
 enum { BB_EXIT_OK = 0, BB_EXIT_FAILURE = 1, BB_EXIT_USAGE = 2 };
 
-/* Each takes the arguments after the program name, argv[0] being the
- * subcommand's name, and returns the process exit code. */
-int bb_cli_normal(int argc, char **argv);
-int bb_cli_bake(int argc, char **argv);
-int bb_cli_height2ssbump(int argc, char **argv);
-int bb_cli_compare(int argc, char **argv);
-int bb_cli_info(int argc, char **argv);
-int bb_cli_renderbumpflat(int argc, char **argv);
-int bb_cli_render(int argc, char **argv);
-int bb_cli_sheet(int argc, char **argv);
-int bb_cli_normal2ssbump(int argc, char **argv);
-int bb_cli_ssbump2normal(int argc, char **argv);
-int bb_cli_combine(int argc, char **argv);
-int bb_cli_program(int argc, char **argv);
-int bb_cli_serve(int argc, char **argv);
+/* Runs the command named argv[0] with the arguments after it: parsed
+ * against its description, checked by the library, then run and printed.
+ * Returns the process exit code. */
+int bb_cli_command(int argc, char **argv);
+
+/* One command about to run: checked by the library. */
+typedef struct cli_run cli_run;
+
+/* bb_cli_command with the run of run (serve's, which the test binary does
+ * not link), else the command's own. */
+int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r));
+
+struct cli_run {
+  bb_command *command;
+  const bb_command_options *options; /* bb_command_options_of(command) */
+  const char *record;   /* the command line its outputs record: the words as typed,
+                           less those of options that do not change the output */
+  char **typed;         /* the arguments as typed (argv[0] the command's name) */
+  int typed_count;
+};
+
+/* Each command's run: what it does with the library and what it prints;
+ * returns the exit code. */
+int cli_run_job(const cli_run *r); /* bake, normal, height2ssbump: through the job */
+int cli_run_render(const cli_run *r);
+int cli_run_sheet(const cli_run *r);
+int cli_run_normal2ssbump(const cli_run *r);
+int cli_run_ssbump2normal(const cli_run *r);
+int cli_run_combine(const cli_run *r);
+int cli_run_program(const cli_run *r);
+int cli_run_compare(const cli_run *r);
+int cli_run_info(const cli_run *r);
+int cli_run_renderbumpflat(const cli_run *r);
+int cli_run_serve(const cli_run *r); /* serve.c */
+
+/* `bumpbake --help` and `bumpbake COMMAND --help` (help.c), from the
+ * descriptions. */
+void cli_print_usage(FILE *f);
+void cli_print_help(const bb_command_info *command);
 
 #endif /* BB_CLI_H */

@@ -80,6 +80,13 @@ void cli_note(void *user, const char *path, const char *text) {
   fprintf(stderr, "bumpbake: %s\n", bb_text_printable(line, safe, sizeof safe));
 }
 
+void cli_no_font_note(const char *command) {
+  fprintf(stderr,
+          "bumpbake %s: no font found for the labels (install fonts-dejavu-core, or set "
+          "BUMPBAKE_FONT to a font file); drawn without labels\n",
+          command);
+}
+
 /* --------------------------------------------------------- command line */
 
 char *cli_command_line(int argc, char **argv) {

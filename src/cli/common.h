@@ -51,6 +51,9 @@ void cli_printf_line(const char *fmt, ...)
  * stderr. user is unused. */
 void cli_note(void *user, const char *path, const char *text);
 
+/* The note for a picture whose labels could not be drawn (render, sheet). */
+void cli_no_font_note(const char *command);
+
 
 /* ------------------------------------------------- command line, signals */
 

@@ -12,7 +12,6 @@
 #include "cli.h"
 #include "common.h"
 #include "json.h"
-#include "options.h"
 
 #include "bumpbake.h"
 
@@ -24,110 +23,7 @@
 #include <stdlib.h>
 #include <strings.h>
 
-enum { COMPARE_CANNOT_READ = 4, COMPARE_USAGE = 4 };
-
-/* Option ids of compare alone, above the shared cli_opt_id values (only
- * unique within one command's table). */
-enum {
-  OPT_FAIL = 0x1000,
-  OPT_FAIL_PERCENT,
-  OPT_HARD_FAIL,
-  OPT_ALLOW_FAILURES,
-  OPT_WARN,
-  OPT_WARN_PERCENT,
-  OPT_HARD_WARN,
-  OPT_DIFF
-};
-
-static const cli_option opt_fail = {
-    .id = OPT_FAIL,
-    .long_name = "fail",
-    .value_name = "T",
-    .default_text = "1e-06",
-    .range_text = ">= 0",
-    .help = "a pixel fails when a channel differs by more than T",
-    .single_dash = 1};
-static const cli_option opt_fail_percent = {
-    .id = OPT_FAIL_PERCENT,
-    .long_name = "failpercent",
-    .value_name = "P",
-    .default_text = "0",
-    .range_text = "0..100",
-    .help = "failing pixels allowed, in % of all (then a warning)",
-    .single_dash = 1};
-static const cli_option opt_hard_fail = {
-    .id = OPT_HARD_FAIL,
-    .long_name = "hardfail",
-    .value_name = "T",
-    .default_text = "inf",
-    .range_text = ">= 0",
-    .help = "fail when any difference exceeds T, even within -failpercent",
-    .single_dash = 1};
-static const cli_option opt_allow_failures = {
-    .id = OPT_ALLOW_FAILURES,
-    .long_name = "allowfailures",
-    .value_name = "N",
-    .default_text = "0",
-    .range_text = ">= 0 (integer)",
-    .help = "pass when at most N pixels fail, by any amount",
-    .single_dash = 1};
-static const cli_option opt_warn = {
-    .id = OPT_WARN,
-    .long_name = "warn",
-    .value_name = "T",
-    .default_text = "1e-06",
-    .range_text = ">= 0",
-    .help = "a pixel warns when a channel differs by more than T",
-    .single_dash = 1};
-static const cli_option opt_warn_percent = {.id = OPT_WARN_PERCENT,
-                                            .long_name = "warnpercent",
-                                            .value_name = "P",
-                                            .default_text = "0",
-                                            .range_text = "0..100",
-                                            .help = "warning pixels allowed, in % of all",
-                                            .single_dash = 1};
-static const cli_option opt_hard_warn = {.id = OPT_HARD_WARN,
-                                         .long_name = "hardwarn",
-                                         .value_name = "T",
-                                         .default_text = "inf",
-                                         .range_text = ">= 0",
-                                         .help = "warn when any difference exceeds T",
-                                         .single_dash = 1};
-static const cli_option opt_diff = {
-    .id = OPT_DIFF,
-    .long_name = "diff",
-    .value_name = "FILE",
-    .help = "write |A-B| (raw in .exr, scaled to a maximum of 1 otherwise)"};
-static const cli_option opt_json = {.id = CLI_OPT_JSON,
-                                    .long_name = "json",
-                                    .default_text = "off",
-                                    .help = "print the report as one JSON line"};
-static const cli_option opt_quiet = {.id = CLI_OPT_QUIET,
-                                     .long_name = "quiet",
-                                     .short_name = 'q',
-                                     .default_text = "off",
-                                     .help = "print no report; the exit code tells"};
-
-static const cli_option *const compare_options[] = {
-    &opt_fail, &opt_fail_percent, &opt_hard_fail, &opt_allow_failures,
-    &opt_warn, &opt_warn_percent, &opt_hard_warn, &opt_diff,
-    &opt_json, &opt_quiet,        &cli_opt_help,
-};
-
-static const cli_command compare_command = {
-    "compare",
-    "A B [OPTIONS]",
-    "Compares two images channel by channel, as OpenImageIO's idiff (whose\n"
-    "single-dash spellings are accepted), and lists differing provenance.\n"
-    "Verdict (idiff 2.4's): pass when at most -allowfailures pixels fail; else\n"
-    "fail when more than -failpercent % fail or any difference > -hardfail; else\n"
-    "warn when more than -warnpercent % warn or any difference > -hardwarn.\n"
-    "Exit: 0 pass, 1 warning, 2 failure, 3 different size or channels,\n"
-    "4 unreadable file or bad arguments.",
-    compare_options,
-    (int)(sizeof compare_options / sizeof compare_options[0]),
-    NULL, /* no baking settings */
-};
+enum { COMPARE_CANNOT_READ = 4 };
 
 typedef struct compare_args {
   const char *path_a, *path_b;
@@ -135,71 +31,6 @@ typedef struct compare_args {
   const char *diff_path;
   int json, quiet;
 } compare_args;
-
-/* ------------------------------------------------------------ arguments */
-
-static int compare_option(void *ctx, const cli_option *opt, const char *arg) {
-  compare_args *a = ctx;
-  bb_compare_limits *l = &a->limits;
-  const char *cmd = compare_command.name;
-  char name[64];
-  snprintf(name, sizeof name, "--%s", opt->long_name ? opt->long_name : "");
-  int n = 0, rc = 0;
-  switch (opt->id) {
-  case OPT_FAIL:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->fail);
-  case OPT_FAIL_PERCENT:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, 100.0, &l->fail_percent);
-  case OPT_HARD_FAIL:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->hard_fail);
-  case OPT_ALLOW_FAILURES:
-    rc = cli_parse_int(cmd, name, arg, 0, INT_MAX, &n);
-    l->allow_failures = n;
-    return rc;
-  case OPT_WARN:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->warn);
-  case OPT_WARN_PERCENT:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, 100.0, &l->warn_percent);
-  case OPT_HARD_WARN:
-    return cli_parse_double(cmd, name, arg, 0.0, 0, DBL_MAX, &l->hard_warn);
-  case OPT_DIFF:
-    a->diff_path = arg;
-    return 0;
-  case CLI_OPT_JSON:
-    a->json = 1;
-    return 0;
-  case CLI_OPT_QUIET:
-    a->quiet = 1;
-    return 0;
-  }
-  return cli_usage_error(cmd, "internal error: option %s has no handler", name);
-}
-
-/* 0, -1 for --help, or BB_EXIT_USAGE after a one-line usage error. */
-static int parse_compare_args(int argc, char **argv, compare_args *a) {
-  memset(a, 0, sizeof *a);
-  bb_compare_limits_init(&a->limits);
-  int first = 0;
-  int rc = cli_parse_options(&compare_command, argc, argv, compare_option, a, &first);
-  if (!rc)
-    rc = cli_expect_positionals(&compare_command, argc, argv, first, 2, "A B");
-  if (rc)
-    return rc;
-  a->path_a = argv[first];
-  a->path_b = argv[first + 1];
-  /* The diff is checked before the (possibly long) reads, and must not
-   * overwrite either input. */
-  if (a->diff_path) {
-    const bb_output_spec diff = {a->diff_path, "diff", 0, BB_DEPTH_DEFAULT, 0, 0, 0, 0,
-                                 BB_RANGE_UNIT, NULL};
-    const char *reads[2] = {a->path_a, a->path_b};
-    bb_error err = {{0}};
-    bb_status st = bb_outputs_check(&diff, 1, reads, 2, &err);
-    if (st != BB_OK)
-      rc = cli_library_error(compare_command.name, st, &err);
-  }
-  return rc;
-}
 
 /* --------------------------------------------------------------- reports */
 
@@ -326,13 +157,10 @@ static void note_damaged_provenance(const compare_args *a, const bb_compare_repo
                      "provenance is cut or re-wrapped by the file format; not compared");
 }
 
-int bb_cli_compare(int argc, char **argv) {
-  compare_args a;
-  int parsed = parse_compare_args(argc, argv, &a);
-  if (parsed < 0)
-    return BB_EXIT_OK; /* --help */
-  if (parsed > 0)
-    return COMPARE_USAGE;
+int cli_run_compare(const cli_run *run) {
+  const bb_command_options *o = run->options;
+  const compare_args a = {bb_command_input(run->command, 0), bb_command_input(run->command, 1),
+                          o->limits, o->diff, o->json, o->quiet};
   bb_compare_report r;
   bb_error err = {{0}};
   bb_status st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);

@@ -4,7 +4,6 @@
 #include "cli.h"
 #include "common.h"
 #include "json.h"
-#include "options.h"
 
 #include "bumpbake.h"
 
@@ -12,41 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const cli_option opt_json = {
-    .id = CLI_OPT_JSON,
-    .long_name = "json",
-    .default_text = "off",
-    .help = "print one JSON object per file, one per line (JSON Lines)"};
-
-static const cli_option *const info_options[] = {&opt_json, &cli_opt_help};
-
-static const cli_command info_command = {
-    "info",
-    "FILE... [--json]",
-    "Prints each image's size, channels, format, sample type and alpha channel,\n"
-    "and the provenance bumpbake stored in it, from the file's header alone (no\n"
-    "pixel is decoded); for a Source texture (.vtf) also its version, format,\n"
-    "flags and mip levels. A file that cannot be read is reported and skipped;\n"
-    "the exit code is then 1.",
-    info_options,
-    (int)(sizeof info_options / sizeof info_options[0]),
-    NULL, /* no baking settings */
-};
-
 typedef struct info_args {
   int json;
 } info_args;
-
-static int info_option(void *ctx, const cli_option *opt, const char *arg) {
-  (void)arg;
-  info_args *a = ctx;
-  if (opt->id == CLI_OPT_JSON) {
-    a->json = 1;
-    return 0;
-  }
-  return cli_usage_error(info_command.name, "internal error: option %d has no handler",
-                         opt->id);
-}
 
 /* What one file is, as read from its header. */
 typedef struct file_info {
@@ -69,18 +36,6 @@ static void flag_names(uint32_t flags, char *out, size_t cap) {
                  : snprintf(out + n, cap - n, "%s0x%08x", n ? " " : "", 1u << bit);
     n += w > 0 ? (size_t)w : 0;
   }
-}
-
-static const char *provenance_class_name(bb_provenance_class c) {
-  switch (c) {
-  case BB_PROVENANCE_INTACT:
-    return "intact";
-  case BB_PROVENANCE_DAMAGED:
-    return "damaged";
-  case BB_PROVENANCE_NONE:
-    break;
-  }
-  return "none";
 }
 
 /* ------------------------------------------------------------------ text */
@@ -129,26 +84,25 @@ static void print_text(const char *path, const file_info *f) {
 
 /* ------------------------------------------------------------------ JSON */
 
-/* The key=value lines of intact provenance as a JSON object of strings
- * (values are kept as written: exact, and the same for every key). */
+/* The key=value lines of intact provenance as a JSON object of strings, as
+ * the library reads them (bb_provenance_entries); values are kept as
+ * written: exact, and the same for every key. */
 static void json_provenance(cli_json *j, const char *text) {
   cli_json_open(j, "provenance", '{');
-  for (const char *line = text; *line;) {
-    size_t n = strcspn(line, "\n");
-    const char *eq = memchr(line, '=', n);
-    if (eq) {
-      size_t k = (size_t)(eq - line), v = n - k - 1;
-      if (v && eq[v] == '\r')
-        v--;
-      /* Whole keys and values, however long: JSON is not cut. */
-      char *key = strndup(line, k), *value = strndup(eq + 1, v);
-      if (key && value)
-        cli_json_string(j, key, value);
-      free(key);
-      free(value);
-    }
-    line += n + (line[n] == '\n');
+  const long count = bb_provenance_entries(text, NULL, 0);
+  bb_provenance_entry *entries = count > 0 ? malloc((size_t)count * sizeof *entries) : NULL;
+  if (entries)
+    bb_provenance_entries(text, entries, (size_t)count);
+  for (long i = 0; entries && i < count; i++) {
+    /* Whole keys and values, however long: JSON is not cut. */
+    char *key = strndup(entries[i].key, entries[i].key_length);
+    char *value = strndup(entries[i].value, entries[i].value_length);
+    if (key && value)
+      cli_json_string(j, key, value);
+    free(key);
+    free(value);
   }
+  free(entries);
   cli_json_close(j, '}');
 }
 
@@ -184,7 +138,7 @@ static void print_json(const char *path, const file_info *f) {
     cli_json_int(&j, "frames", v->frames);
     cli_json_close(&j, '}');
   }
-  cli_json_string(&j, "provenance_state", provenance_class_name(f->provenance));
+  cli_json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
   if (f->provenance == BB_PROVENANCE_INTACT)
     json_provenance(&j, i->description);
   else
@@ -234,21 +188,12 @@ static int info_file(const info_args *a, const char *path, int index) {
   return 0;
 }
 
-int bb_cli_info(int argc, char **argv) {
-  info_args a = {0};
-  int first = 0;
-  int rc = cli_parse_options(&info_command, argc, argv, info_option, &a, &first);
-  if (rc < 0)
-    return BB_EXIT_OK; /* --help */
-  if (rc)
-    return rc;
-  if (first >= argc)
-    return cli_usage_error(info_command.name, "missing FILE (usage: bumpbake info %s)",
-                           info_command.synopsis);
-  rc = BB_EXIT_OK;
+int cli_run_info(const cli_run *r) {
+  const info_args a = {r->options->json};
+  int rc = BB_EXIT_OK;
   int described = 0; /* files described so far, for the blank line between */
-  for (int i = first; i < argc; i++) {
-    if (info_file(&a, argv[i], described))
+  for (int i = 0; i < bb_command_input_count(r->command); i++) {
+    if (info_file(&a, bb_command_input(r->command, i), described))
       rc = BB_EXIT_FAILURE;
     else
       described++;

@@ -5,6 +5,21 @@
 
 #include <string.h>
 
+/* The "outputs" array of a report's files; the maps alone (not the slope
+ * files) when maps_only. */
+static void outputs(cli_json *j, const bb_job_report *r, int maps_only) {
+  cli_json_open(j, "outputs", '[');
+  for (int i = 0; i < r->output_count; i++) {
+    if (maps_only && !strncmp(r->outputs[i].kind, "slope", 5))
+      continue;
+    cli_json_open(j, NULL, '{');
+    cli_json_string(j, "kind", r->outputs[i].kind);
+    cli_json_string(j, "path", r->outputs[i].path);
+    cli_json_close(j, '}');
+  }
+  cli_json_close(j, ']');
+}
+
 /* Parameters are those used: the channel the rule took and the threads
  * that ran, not "auto" and 0. */
 void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
@@ -21,7 +36,7 @@ void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
   cli_json_open(&j, "parameters", '{');
   cli_json_number(&j, "scale", (double)b->height_scale);
   cli_json_number(&j, "rays", b->rays);
-  cli_json_number(&j, "slices", bb_bake_slices(b));
+  cli_json_number(&j, "slices", r->slices); /* 0: nothing was traced */
   cli_json_string(&j, "rayset", traced ? r->rayset_id : NULL);
   cli_json_number(&j, "filter_radius", b->smooth.radius_texels);
   cli_json_number(&j, "filter_threshold", (double)b->smooth.threshold);
@@ -29,9 +44,8 @@ void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
   cli_json_number(&j, "power", b->power);
   cli_json_string(&j, "basis", b->basis.name);
   cli_json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
-  cli_json_string(&j, "normal_y", b->normal_y_up ? "up" : "down");
-  cli_json_string(&j, "addressing",
-                  b->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+  cli_json_string(&j, "normal_y", bb_normal_y_name(b->normal_y_up));
+  cli_json_string(&j, "addressing", bb_addressing_name(b->smooth.addressing));
   cli_json_string(&j, "channel", bb_height_source_channel(&r->source));
   cli_json_number(&j, "threads", r->threads);
   cli_json_close(&j, '}');
@@ -46,17 +60,20 @@ void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
   cli_json_close(&j, '}');
 
   cli_json_number(&j, "horizons", r->horizons);
-  cli_json_open(&j, "outputs", '[');
-  for (int i = 0; i < r->output_count; i++) {
-    if (!strncmp(r->outputs[i].kind, "slope", 5))
-      continue; /* the maps of the bake only */
-    cli_json_open(&j, NULL, '{');
-    cli_json_string(&j, "kind", r->outputs[i].kind);
-    cli_json_string(&j, "path", r->outputs[i].path);
-    cli_json_close(&j, '}');
-  }
-  cli_json_close(&j, ']');
+  outputs(&j, r, 1);
   cli_json_close(&j, '}');
+}
+
+void cli_job_json_short(const bb_job_report *r) {
+  cli_json j = {stdout, 0};
+  cli_json_open(&j, NULL, '{');
+  cli_json_string(&j, "input", r->input);
+  cli_json_string(&j, "status", bb_job_outcome_name(r->outcome));
+  if (r->outcome == BB_JOB_FAILED)
+    cli_json_int(&j, "exit_code", 1);
+  outputs(&j, r, 0);
+  cli_json_close(&j, '}');
+  fputc('\n', stdout);
 }
 
 void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *status) {

@@ -15,4 +15,7 @@ void cli_job_json(const bb_bake_options *b, const bb_job_report *r, const char *
 void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
                      const char *status);
 
+/* A batch's line for an input that was not baked: up to date or failed. */
+void cli_job_json_short(const bb_job_report *r);
+
 #endif /* BB_CLI_JOB_JSON_H */

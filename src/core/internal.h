@@ -30,6 +30,28 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 bb_status bb__parse_name(const char *what, const char *name, const char *const *names,
                          int count, int ignore_case, int *index, bb_error *err);
 
+/* ----------------------------------------------------------------- ranges */
+
+/* The range of one parameter, written once where the parameter's struct
+ * is checked (bake/options.c, render/render.c, ...) and referred to by the
+ * option that sets it (cmd/), so a range has one home and one message. */
+typedef struct bb__range {
+  const char *what;   /* in messages of the struct's check: "filter radius" */
+  double min, max;    /* max HUGE_VAL: no upper bound */
+  int min_exclusive;  /* 1: > min */
+  int integer;        /* 1: whole numbers only */
+} bb__range;
+
+/* 1 when v is in r (NaN never is). */
+int bb__range_holds(const bb__range *r, double v);
+/* BB_OK, or BB_ERR_ARGUMENT "WHO must be in 1..65536 (got 0)" (or "> 0",
+ * ">= 0"); who NULL: r->what. */
+bb_status bb__range_check(const bb__range *r, double v, const char *who, bb_error *err);
+/* The range as help prints it: "1..65536", "> 0", "0..1e6". */
+void bb__range_text(const bb__range *r, char *out, size_t cap);
+/* v as messages print it: %g, with "1e6" for "1e+06". */
+void bb__number_text(double v, char *out, size_t cap);
+
 #define BB__PI 3.14159265358979323846
 
 /* Non-negative remainder: the periodic index of i in [0, n). */
@@ -69,6 +91,8 @@ static inline int bb__address(int i, int n, bb_addressing a) {
 
 /* Number of worker threads to use for a request of `threads` (0 = all cores). */
 int bb__thread_count(int threads);
+/* The threads any stage accepts: 0..BB_MAX_THREADS (parallel.c). */
+extern const bb__range bb__range_threads;
 
 /* Runs fn(user, item) for item = 0 .. items-1 on `threads` threads; items
  * are handed out in order from a shared counter. Each item's result must
@@ -132,6 +156,22 @@ bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char 
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */
 bb_status bb__memory_check(double need, const char *what, bb_error *err);
+
+/* (text.c, beside bb__text_append and bb__text_add) */
+void bb__text_printf(bb__text *t, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* The string (malloc'd, "" when empty), or NULL when an addition failed;
+ * t is emptied either way. */
+char *bb__text_take(bb__text *t);
+void bb__text_free(bb__text *t);
+
+/* The shortest decimal that reads back as the same float or double
+ * ("36.8083", not "36.8082962"), as a user would type it. */
+void bb__float_text(float v, char *buf, size_t cap);
+void bb__double_text(double v, char *buf, size_t cap);
 
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);

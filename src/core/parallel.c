@@ -12,6 +12,8 @@ double bb__now_seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+const bb__range bb__range_threads = {"threads", 0, BB_MAX_THREADS, 0, 1};
+
 int bb__thread_count(int threads) {
   if (threads > 0) return threads;
   long n = sysconf(_SC_NPROCESSORS_ONLN);

@@ -1,8 +1,10 @@
 /* text.c: the library's one growable text (bb__text, core/internal.h), for
- * provenance and the command lines it records. */
+ * provenance and the command lines it records, and numbers spelled the
+ * shortest way that reads back as the same value. */
 
 #include "core/internal.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,5 +29,65 @@ void bb__text_append(bb__text *t, const char *s, size_t n) {
 }
 
 void bb__text_add(bb__text *t, const char *s) {
-  bb__text_append(t, s, strlen(s));
+  if (s) /* a string not set adds nothing */
+    bb__text_append(t, s, strlen(s));
+}
+
+void bb__text_printf(bb__text *t, const char *fmt, ...) {
+  char small[256];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = vsnprintf(small, sizeof small, fmt, ap);
+  va_end(ap);
+  if (n < 0) {
+    t->failed = 1;
+    return;
+  }
+  if ((size_t)n < sizeof small) {
+    bb__text_append(t, small, (size_t)n);
+    return;
+  }
+  char *big = malloc((size_t)n + 1);
+  if (!big) {
+    t->failed = 1;
+    return;
+  }
+  va_start(ap, fmt);
+  vsnprintf(big, (size_t)n + 1, fmt, ap);
+  va_end(ap);
+  bb__text_append(t, big, (size_t)n);
+  free(big);
+}
+
+char *bb__text_take(bb__text *t) {
+  char *s = t->data;
+  if (t->failed) {
+    free(s);
+    s = NULL;
+  } else if (!s) {
+    s = calloc(1, 1);
+  }
+  memset(t, 0, sizeof *t);
+  return s;
+}
+
+void bb__text_free(bb__text *t) {
+  free(t->data);
+  memset(t, 0, sizeof *t);
+}
+
+void bb__float_text(float v, char *buf, size_t cap) {
+  for (int digits = 1; digits <= 9; digits++) {
+    snprintf(buf, cap, "%.*g", digits, (double)v);
+    if (strtof(buf, NULL) == v)
+      return;
+  }
+}
+
+void bb__double_text(double v, char *buf, size_t cap) {
+  for (int digits = 1; digits <= 17; digits++) {
+    snprintf(buf, cap, "%.*g", digits, v);
+    if (strtod(buf, NULL) == v)
+      return;
+  }
 }

@@ -140,8 +140,9 @@ static int by_order(const void *p, const void *q) {
   return (x->order > y->order) - (x->order < y->order);
 }
 
-/* Returns 0, or -1 when out of memory. */
-static int index_entries(const char *text_, entry_index *index) {
+/* Returns 0, or -1 when out of memory. with_ignored: "command" and "output"
+ * count too. */
+static int index_entries(const char *text_, entry_index *index, int with_ignored) {
   size_t lines = 1;
   for (const char *c = text_; *c; c++)
     lines += *c == '\n';
@@ -152,7 +153,7 @@ static int index_entries(const char *text_, entry_index *index) {
   entry e;
   const char *cursor = text_;
   for (size_t order = 0; next_entry(&cursor, &e); order++)
-    if (e.key_length && !is_ignored_key(&e))
+    if (e.key_length && (with_ignored || !is_ignored_key(&e)))
       index->entries[index->count++] = (keyed_entry){e, order};
   qsort(index->entries, index->count, sizeof *index->entries, by_key_then_order);
   /* A repeated key: only its first occurrence counts. */
@@ -186,7 +187,7 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   if (!a || !b)
     return 0;
   entry_index ia = {0}, ib = {0};
-  if (index_entries(a, &ia) != 0 || index_entries(b, &ib) != 0) {
+  if (index_entries(a, &ia, 0) != 0 || index_entries(b, &ib, 0) != 0) {
     free(ia.entries);
     free(ib.entries);
     return -1;
@@ -214,6 +215,23 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   free(ia.entries);
   free(ib.entries);
   return differing;
+}
+
+long bb_provenance_entries(const char *description, bb_provenance_entry *entries,
+                           size_t cap) {
+  if (!description)
+    return 0;
+  entry_index index = {0};
+  if (index_entries(description, &index, 1) != 0)
+    return -1;
+  qsort(index.entries, index.count, sizeof *index.entries, by_order);
+  for (size_t i = 0; i < index.count && i < cap && entries; i++) {
+    const entry *e = &index.entries[i].e;
+    entries[i] = (bb_provenance_entry){e->key, e->key_length, e->value, e->value_length};
+  }
+  const long count = (long)index.count;
+  free(index.entries);
+  return count;
 }
 
 /* ------------------------------------------------------------ mismatch */
@@ -269,6 +287,15 @@ static int is_entry_line(const char *line, size_t n) {
   while (k < n && is_key_char(line[k]))
     k++;
   return n == 0 || (k > 0 && k < n && line[k] == '=');
+}
+
+const char *bb_provenance_class_name(bb_provenance_class c) {
+  switch (c) {
+  case BB_PROVENANCE_NONE: return "none";
+  case BB_PROVENANCE_INTACT: return "intact";
+  case BB_PROVENANCE_DAMAGED: return "damaged";
+  }
+  return "unknown";
 }
 
 bb_provenance_class bb_provenance_classify(const char *description) {

@@ -184,8 +184,11 @@ char *bb_job_command_text(const bb_job_options *o, const char *input) {
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item) {
   if (job->command)
     return strdup(job->command);
-  if (!job->command_options)
-    return bb_job_command_text(&job->options, item->input);
+  if (!job->command_options) {
+    bb_job_options as_given = job->options; /* rays spelled as asked, not resolved */
+    as_given.bake.slices = job->asked_slices;
+    return bb_job_command_text(&as_given, item->input);
+  }
   /* "bumpbake bake INPUT OPTIONS", as a batch run by hand records it. */
   bb__text t = {0};
   bb__text_add(&t, "bumpbake bake ");

@@ -9,6 +9,7 @@
  * skip leaves a wrong map.
  */
 
+#include "bake/bake_internal.h"
 #include "core/input_file.h"
 #include "core/internal.h"
 #include "image/oiio.h"
@@ -79,9 +80,10 @@ void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
   if (!out || !cap)
     return;
   out[0] = '\0';
-  if (!o || !(o->outputs & BB_OUTPUTS_TRACED))
+  bb_bake_options prepared;
+  if (!o || !(o->outputs & BB_OUTPUTS_TRACED) || bb__bake_prepare(o, &prepared, NULL) != BB_OK)
     return;
-  bb__rayset_id(bb_bake_slices(o), o->power, &o->basis, out, cap);
+  bb__rayset_id(prepared.slices, o->power, &o->basis, out, cap);
 }
 
 /* The depth a file's samples have, as bb_image_write would have asked for

@@ -83,6 +83,9 @@ struct bb_job {
   char *slope_path;
   char *bounce_albedo_file, *brightness_file;
   char *vmt, *vmt_materials, *vmt_basetexture;
+  char *valve_path;         /* Valve's packed file (height2ssbump), or NULL */
+  int asked_slices;         /* options.bake.slices as given (0: from rays), before the
+                               plan resolved it: what the command text spells */
   char *vmt_text;           /* the material's bytes, made by the plan */
   size_t vmt_size;
   bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
@@ -116,6 +119,15 @@ int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out)
  * (paths.c). */
 bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
                                       bb_range range);
+
+/* The kind of Valve's packed file (bb_job_options.valve_path): "ssbump+height",
+ * "normal+ao", "detail-ssbump+height"... */
+const char *bb__job_valve_kind(const bb_job_options *o);
+
+/* bb_job_plan; options_checked 1: o's bake options were checked already
+ * (a command's, cmd/plan.c) and are only resolved (bb__bake_resolve). */
+bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                       int options_checked, bb_job **out, bb_error *err);
 
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);

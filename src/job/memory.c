@@ -64,6 +64,14 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
   }
   if (job->slope_path)
     kept += 2 * texel, encode += 2 * t;
+  if (job->valve_path) { /* Valve's RGBA file, and for -d the colour read again */
+    kept += 4 * texel;
+    encode += bb_path_is_texture_format(job->valve_path)
+                  ? 4.0 * 4.0 * t * 4.0 / 3.0 + 4.0 * t
+                  : 4.0 * t * sample_bytes(job->options.depth, job->valve_path);
+    if (job->options.valve_detail)
+      kept += (channels < 4 ? channels : 4) * texel + 4 * texel;
+  }
   const double write = kept + encode;
   const double need = read > bake ? read : bake;
   return (need > write ? need : write) * 1.05 + 32.0 * 1024 * 1024;

@@ -3,9 +3,11 @@
  * (one by one, or from out_dir and a template) and checked against each
  * other, against every input and against the depfile, so a clash or a bad
  * name costs no baking time. */
+#include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "files/safe_file.h"
 #include "job/job_internal.h"
+#include "render/render_internal.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -416,6 +418,15 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
                                     &job->options.texture};
     }
   const int maps = n;
+  if (job->valve_path) {
+    if (!width && bb_path_is_texture_format(job->valve_path) &&
+        bb_image_read_info(item->input, &width, &height, NULL, NULL, NULL) != BB_OK)
+      width = height = 0;
+    kinds[n] = -1;
+    specs[n++] = (bb_output_spec){job->valve_path, bb__job_valve_kind(&job->options), 4,
+                                  job->options.depth, 0, 0, width, height, BB_RANGE_UNIT,
+                                  &job->options.texture};
+  }
   if (job->slope_path) {
     /* The slope map is its bytes: 8-bit, no mips; its preview a picture. */
     if (!bb_path_supports_depth(job->slope_path, BB_DEPTH_8))
@@ -456,6 +467,8 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
     const int n_prereq = bb__job_reads(job, item, prereq);
     const char *targets[BB_JOB_MAX_OUTPUTS];
     int t = 0;
+    if (job->valve_path)
+      targets[t++] = job->valve_path;
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       if (item->paths[k])
         targets[t++] = item->paths[k];
@@ -505,7 +518,7 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
 /* ------------------------------------------------------------------- plan */
 
 /* The kinds asked: the named paths (and the filtered height the slope map
- * is made from), or a batch's maps. */
+ * is made from, what Valve's file packs), or a batch's maps. */
 static unsigned asked_kinds(const bb_job_options *o) {
   if (o->out_dir)
     return o->maps ? o->maps : BB_JOB_DEFAULT_MAPS;
@@ -515,14 +528,56 @@ static unsigned asked_kinds(const bb_job_options *o) {
       mask |= BB_OUTPUT_BIT(k);
   if (o->slope_path)
     mask |= BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  if (o->valve_path)
+    mask |= BB_OUTPUT_BIT(o->valve.normal_map ? BB_OUTPUT_NORMAL : BB_OUTPUT_SSBUMP) |
+            BB_OUTPUT_BIT(o->valve.ao_in_alpha ? BB_OUTPUT_AO : BB_OUTPUT_FILTERED);
   return mask;
+}
+
+const char *bb__job_valve_kind(const bb_job_options *o) {
+  if (o->valve.normal_map)
+    return o->valve.ao_in_alpha ? "normal+ao" : "normal+height";
+  if (o->valve_detail)
+    return o->valve.ao_in_alpha ? "detail-ssbump+ao" : "detail-ssbump+height";
+  return o->valve.ao_in_alpha ? "ssbump+ao" : "ssbump+height";
+}
+
+/* Options only a batch uses, refused without out_dir (force is not one: a
+ * single input may skip its bake when its outputs are current). */
+static bb_status check_single(const bb_job_options *o, int input_count, bb_error *err) {
+  if (input_count > 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
+  const char *batch_only = o->name_template ? "--name"
+                           : o->maps        ? "--maps"
+                           : o->keep_going  ? "--keep-going"
+                                            : NULL;
+  if (batch_only)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s is for batches: give --out-dir DIR", batch_only);
+  if (o->slope_lit && !o->slope_path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--lit previews the slope map: give --slope FILE too");
+  /* bb_light_direction takes any angle; above 90 degrees the light would
+   * come from under the surface. */
+  if (o->slope_lit && !isfinite(o->slope_lit_azimuth))
+    return bb__fail(err, BB_ERR_ARGUMENT, "--lit azimuth must be finite (got %g)",
+                    o->slope_lit_azimuth);
+  bb_status st = o->slope_lit ? bb__range_check(&bb__range_light_elevation,
+                                                o->slope_lit_elevation, "--lit elevation", err)
+                              : BB_OK;
+  if (st == BB_OK && o->valve_path && o->valve_detail && o->valve.normal_map)
+    st = bb__fail(err, BB_ERR_ARGUMENT, "-d makes a detail ssbump; it cannot be used with -n");
+  if (st == BB_OK && !asked_kinds(o))
+    st = bb__fail(err, BB_ERR_ARGUMENT,
+                  "nothing to write: give -o PREFIX or at least one of --normal, "
+                  "--weights, --ssbump, --ao, --bent, --filtered, --slope (or --out-dir DIR "
+                  "for a batch)");
+  return st;
 }
 
 static bb_status check_options(const bb_job_options *o, int input_count, bb_error *err) {
   if (input_count < 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "no input given");
   if (o->out_dir) {
-    int named = o->slope_path != NULL || o->prefix != NULL;
+    int named = o->slope_path != NULL || o->prefix != NULL || o->valve_path != NULL;
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       named |= o->paths[k] != NULL;
     if (named)
@@ -535,22 +590,9 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "--vmt writes one material: bake one input with --ssbump FILE.vtf");
   } else {
-    if (input_count > 1)
-      return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
-    if (o->slope_lit && !o->slope_path)
-      return bb__fail(err, BB_ERR_ARGUMENT, "--lit previews the slope map: give --slope FILE too");
-    /* bb_light_direction takes any angle; above 90 degrees the light would
-     * come from under the surface. */
-    if (o->slope_lit && !isfinite(o->slope_lit_azimuth))
-      return bb__fail(err, BB_ERR_ARGUMENT, "--lit azimuth must be finite (got %g)",
-                      o->slope_lit_azimuth);
-    if (o->slope_lit && !(o->slope_lit_elevation >= 0.0 && o->slope_lit_elevation <= 90.0))
-      return bb__fail(err, BB_ERR_ARGUMENT, "--lit elevation must be in 0..90 (got %g)",
-                      o->slope_lit_elevation);
-    if (!asked_kinds(o))
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "nothing to write: give -o PREFIX or at least one of --normal, "
-                      "--weights, --ssbump, --ao, --bent, --filtered, --slope");
+    bb_status st = check_single(o, input_count, err);
+    if (st != BB_OK)
+      return st;
   }
   if ((o->vmt_materials || o->vmt_basetexture) && !o->vmt)
     return bb__fail(err, BB_ERR_ARGUMENT,
@@ -559,14 +601,13 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
     return bb__fail(err, BB_ERR_ARGUMENT, "unknown height channel %d", (int)o->channel);
   if ((int)o->depth < BB_DEPTH_DEFAULT || o->depth > BB_DEPTH_FLOAT)
     return bb__fail(err, BB_ERR_ARGUMENT, "unknown depth %d", (int)o->depth);
-  bb_bake_options bake = o->bake;
-  bake.outputs = asked_kinds(o);
-  return bb_bake_options_check(&bake, err);
+  return BB_OK;
 }
 
 /* The options' strings, copied: a job outlives its caller's buffers. */
 static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *err) {
   job->options = *o;
+  job->asked_slices = o->bake.slices;
   job->options.bake.outputs = asked_kinds(o);
   job->batch = o->out_dir != NULL;
   job->basis_file = copy(o->basis_file);
@@ -581,7 +622,9 @@ static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *er
   job->vmt = copy(o->vmt);
   job->vmt_materials = copy(o->vmt_materials);
   job->vmt_basetexture = copy(o->vmt_basetexture);
-  if ((o->vmt && !job->vmt) || (o->vmt_materials && !job->vmt_materials) ||
+  job->valve_path = copy(o->valve_path);
+  job->options.valve_path = job->valve_path;
+  if ((o->valve_path && !job->valve_path) || (o->vmt && !job->vmt) || (o->vmt_materials && !job->vmt_materials) ||
       (o->vmt_basetexture && !job->vmt_basetexture))
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   job->options.vmt = job->vmt;
@@ -623,8 +666,6 @@ static bb_status read_bake_maps(bb_job *job, bb_error *err) {
   if (job->bounce_albedo_file) {
     st = bb_image_read(job->bounce_albedo_file, &job->bounce_albedo_map, NULL, err);
     job->options.bake.bounce_albedo_map = st == BB_OK ? &job->bounce_albedo_map : NULL;
-    if (st == BB_OK && job->options.bake.bounce_albedo == 0.0)
-      job->options.bake.bounce_albedo = 1.0;
   }
   if (st == BB_OK && job->brightness_file) {
     st = bb_image_read(job->brightness_file, &job->brightness_map, NULL, err);
@@ -673,8 +714,12 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
     return BB_OK;
   const bb__job_item *item = &job->items[0];
   const char *ssbump = item->paths[BB_OUTPUT_SSBUMP], *normal = item->paths[BB_OUTPUT_NORMAL];
-  const int is_ssbump = ssbump && is_vtf(ssbump);
+  int is_ssbump = ssbump && is_vtf(ssbump);
   const char *bump = is_ssbump ? ssbump : normal && is_vtf(normal) ? normal : NULL;
+  if (job->valve_path) { /* Valve's file is the bump map, whatever it is named */
+    bump = job->valve_path;
+    is_ssbump = !job->options.valve.normal_map;
+  }
   if (!bump)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "--vmt %s: a material needs a .vtf bump map: write --ssbump (or --normal) "
@@ -708,6 +753,9 @@ static void init_reports(bb_job *job) {
     bb_job_report *r = &item->report;
     memset(r, 0, sizeof *r);
     r->input = item->input;
+    if (job->valve_path)
+      r->outputs[r->output_count++] =
+          (bb_job_file){bb__job_valve_kind(&job->options), job->valve_path};
     for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
       if (item->paths[k])
         r->outputs[r->output_count++] = (bb_job_file){kind_name(k), item->paths[k]};
@@ -720,8 +768,8 @@ static void init_reports(bb_job *job) {
   }
 }
 
-bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                      bb_job **out, bb_error *err) {
+bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                       int options_checked, bb_job **out, bb_error *err) {
   if (!out || !o || (input_count > 0 && !inputs))
     return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
   *out = NULL;
@@ -732,8 +780,14 @@ bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_o
   if (!job)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   st = copy_options(job, o, err);
+  if (st == BB_OK && options_checked)
+    bb__bake_resolve(&job->options.bake);
+  else if (st == BB_OK)
+    st = bb__bake_prepare(&job->options.bake, &job->options.bake, err);
   if (st == BB_OK)
     st = read_bake_maps(job, err);
+  if (st == BB_OK)
+    bb__bake_resolve(&job->options.bake); /* a map's rho */
   if (st == BB_OK && job->batch)
     st = check_template(job->name_template, err);
   if (st == BB_OK)
@@ -763,6 +817,11 @@ bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_o
   return BB_OK;
 }
 
+bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+                      bb_job **out, bb_error *err) {
+  return bb__job_plan(inputs, input_count, o, 0, out, err);
+}
+
 void bb_job_free(bb_job *job) {
   if (!job)
     return;
@@ -786,6 +845,7 @@ void bb_job_free(bb_job *job) {
   free(job->vmt_materials);
   free(job->vmt_basetexture);
   free(job->vmt_text);
+  free(job->valve_path);
   bb_image_free(&job->bounce_albedo_map);
   bb_image_free(&job->brightness_map);
   free(job);

@@ -155,6 +155,7 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) 
 typedef struct baked {
   bb_image height;
   bb_bake_result result;
+  bb_image valve;    /* Valve's packed file (job->valve_path) */
   bb_image slope, slope_lit;
   char *descriptions[BB_JOB_MAX_OUTPUTS];
   char *depfile_text;
@@ -163,6 +164,7 @@ typedef struct baked {
 static void baked_free(baked *b) {
   bb_image_free(&b->height);
   bb_bake_result_free(&b->result);
+  bb_image_free(&b->valve);
   bb_image_free(&b->slope);
   bb_image_free(&b->slope_lit);
   for (int i = 0; i < BB_JOB_MAX_OUTPUTS; i++)
@@ -186,16 +188,44 @@ static bb_status make_slope(const bb_job *job, const bb__job_item *item, baked *
   return st;
 }
 
+/* The message of a failure about item's input, naming it once. */
+static bb_status fail_input(const bb__job_item *item, bb_status st, const bb_error *e,
+                            bb_error *err) {
+  const size_t n = strlen(item->input);
+  if (strncmp(e->message, item->input, n) == 0 && e->message[n] == ':')
+    return bb__fail(err, st, "%s", e->message);
+  return bb__fail(err, st, "%s: %s", item->input, e->message);
+}
+
+/* Valve's RGBA file of the bake (bb_valve_pack), and for its detail
+ * variant the input's colour read again (the height reader kept only the
+ * height) to scale it by (bb_valve_detail). */
+static bb_status make_valve(const bb_job *job, const bb__job_item *item, baked *b,
+                            bb_error *err) {
+  bb_error e = {{0}};
+  bb_status st = bb_valve_pack(&b->result, &job->options.valve, &b->valve, &e);
+  if (st == BB_OK && job->options.valve_detail) {
+    bb_image colour = {0};
+    st = bb_image_read(item->input, &colour, NULL, &e);
+    if (st == BB_OK)
+      st = bb_valve_detail(&b->valve, &colour, &b->height, &job->options.bake.smooth, &e);
+    bb_image_free(&colour);
+  }
+  return st == BB_OK ? BB_OK : fail_input(item, st, &e, err);
+}
+
 /* The provenance text of one output of item. */
 static char *describe(const bb_job *job, const char *command, const baked *b,
                       const bb_job_report *r, const char *kind) {
   const int traced = (job->options.bake.outputs & BB_OUTPUTS_TRACED) != 0;
+  /* Valve's file names the channel its rule took (alpha, or the grey) */
+  const bb_channel channel = job->valve_path ? r->source.channel : job->options.channel;
   bb_provenance p = {command,
                      bb__file_name(r->input),
                      r->source.height_hash,
                      kind,
                      &job->options.bake,
-                     job->options.channel,
+                     channel,
                      traced ? b->result.rayset_id : NULL,
                      r->source.file_hash,
                      NULL};
@@ -244,11 +274,20 @@ static bb_status write_depfile(const bb_job *job, const bb__job_item *item, cons
 static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error *err) {
   bb_job_report *r = &item->report;
   char *command = bb__job_command_of(job, item);
-  if (!command)
+  if (!command && (job->command || job->command_options))
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   bb_output_file files[BB_JOB_MAX_OUTPUTS + 1]; /* the maps, slope files, material, depfile */
   int n = 0;
   bb_status st = BB_OK;
+  if (job->valve_path) {
+    const char *kind = bb__job_valve_kind(&job->options);
+    b->descriptions[n] = describe(job, command, b, r, kind);
+    files[n] = (bb_output_file){job->valve_path, kind, &b->valve, BB_RANGE_UNIT,
+                                job->options.depth, 0, b->descriptions[n], NULL, 0,
+                                &job->options.texture};
+    if (!b->descriptions[n++])
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
+  }
   for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
     if (!item->paths[k])
       continue;
@@ -328,19 +367,25 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
   if (st == BB_OK && progress && progress(progress_user, 0, 0))
     st = bb__fail(err, BB_ERR_CANCELLED, "%s: cancelled by the progress callback", item->input);
   const int height_width = b->height.width, height_height = b->height.height;
+  int slices = job->options.bake.slices;
   if (st == BB_OK) {
     bb_bake_options o = job->options.bake;
     o.outputs |= also;
+    bb__bake_resolve(&o); /* the kinds added may trace */
+    slices = o.slices;
     o.trace.progress = progress;
     o.trace.progress_user = progress_user;
     bb_error bake_err = {{0}};
     /* only the maps are kept: the bake lets the height and vis go as soon
-     * as it is done with them */
-    st = bb__bake(&b->height, &o, BB__BAKE_DROP_VIS | BB__BAKE_TAKE_HEIGHT, &b->result,
-                  &bake_err);
+     * as it is done with them (Valve's detail reads the height again) */
+    const unsigned flags =
+        BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
+    st = bb__bake(&b->height, &o, flags, &b->result, &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
+  if (st == BB_OK && job->valve_path)
+    st = make_valve(job, item, b, err);
   if (st == BB_OK && job->slope_path)
     st = make_slope(job, item, b, err);
   if (st == BB_OK) {
@@ -348,7 +393,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     r->width = height_width;
     r->height = height_height;
     r->threads = res->threads;
-    r->slices = res->rayset_id[0] ? bb_bake_slices(&job->options.bake) : 0;
+    r->slices = res->rayset_id[0] ? slices : 0; /* resolved by the plan */
     snprintf(r->rayset_id, sizeof r->rayset_id, "%s", res->rayset_id);
     r->horizons = res->horizons_found;
     r->seconds_smooth = res->seconds_smooth;
@@ -481,4 +526,15 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
   }
   bb_status st = bb_job_write_depfile(job, first == BB_OK ? err : NULL);
   return first != BB_OK ? first : st;
+}
+
+const char *bb_job_outcome_name(bb_job_outcome outcome) {
+  switch (outcome) {
+  case BB_JOB_PENDING: return "pending";
+  case BB_JOB_BAKED: return "baked";
+  case BB_JOB_CURRENT: return "up to date";
+  case BB_JOB_FAILED: return "failed";
+  case BB_JOB_NOT_RUN: return "not run";
+  }
+  return "unknown";
 }

@@ -83,6 +83,9 @@ void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
   }
 }
 
+
+const bb__range bb__range_mix = {"blend factor", 0.0, 1.0, 0, 0};
+
 /* ------------------------------------------------------------------ blend */
 
 static bb_status check_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
@@ -104,9 +107,8 @@ static bb_status check_blend(const bb_image *a, const bb_image *b, const bb_imag
     if (st == BB_OK)
       st = bb__check_finite(mask, 1, "mask", err);
   }
-  if (st == BB_OK && !mask && !(mix >= 0.0f && mix <= 1.0f))
-    st = bb__fail(err, BB_ERR_ARGUMENT, "blend factor must be in 0..1 (got %g)",
-                  (double)mix);
+  if (st == BB_OK && !mask)
+    st = bb__range_check(&bb__range_mix, (double)mix, NULL, err);
   if (st == BB_OK)
     st = bb__check_finite(a, a->channels, "first map", err);
   if (st == BB_OK)

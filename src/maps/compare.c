@@ -1,5 +1,6 @@
 /* compare.c: channel-by-channel statistics of the difference of two images. */
 #include "core/internal.h"
+#include "maps/maps_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -109,23 +110,28 @@ void bb_compare_limits_init(bb_compare_limits *limits) {
   limits->hard_warn = INFINITY;
 }
 
+const bb__range bb__range_compare_threshold = {"threshold", 0.0, HUGE_VAL, 0, 0};
+const bb__range bb__range_compare_percent = {"percent", 0.0, 100.0, 0, 0};
+const bb__range bb__range_compare_count = {"count", 0.0, HUGE_VAL, 0, 1};
+
 bb_status bb_compare_limits_check(const bb_compare_limits *l, bb_error *err) {
   if (!l)
     return bb__fail(err, BB_ERR_ARGUMENT, "compare: no limits");
   const struct {
-    const char *name;
-    double value, high;
-  } checks[] = {{"fail", l->fail, INFINITY},          {"failpercent", l->fail_percent, 100.0},
-                {"hardfail", l->hard_fail, INFINITY}, {"warn", l->warn, INFINITY},
-                {"warnpercent", l->warn_percent, 100.0}, {"hardwarn", l->hard_warn, INFINITY}};
-  for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
-    if (!(checks[i].value >= 0.0 && checks[i].value <= checks[i].high))
-      return bb__fail(err, BB_ERR_ARGUMENT, "compare: %s must be %s (got %g)", checks[i].name,
-                      isinf(checks[i].high) ? ">= 0" : "in 0..100", checks[i].value);
-  if (l->allow_failures < 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "compare: allowfailures must be >= 0 (got %ld)",
-                    l->allow_failures);
-  return BB_OK;
+    const char *who;
+    double value;
+    const bb__range *range;
+  } checks[] = {{"compare: fail", l->fail, &bb__range_compare_threshold},
+                {"compare: failpercent", l->fail_percent, &bb__range_compare_percent},
+                {"compare: hardfail", l->hard_fail, &bb__range_compare_threshold},
+                {"compare: allowfailures", (double)l->allow_failures, &bb__range_compare_count},
+                {"compare: warn", l->warn, &bb__range_compare_threshold},
+                {"compare: warnpercent", l->warn_percent, &bb__range_compare_percent},
+                {"compare: hardwarn", l->hard_warn, &bb__range_compare_threshold}};
+  bb_status st = BB_OK;
+  for (size_t i = 0; i < sizeof checks / sizeof checks[0] && st == BB_OK; i++)
+    st = bb__range_check(checks[i].range, checks[i].value, checks[i].who, err);
+  return st;
 }
 
 bb_compare_verdict bb_compare_judge(const bb_compare_stats *s,

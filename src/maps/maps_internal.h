@@ -5,11 +5,19 @@
 #define BB_MAPS_INTERNAL_H
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The ranges of bb_compare_limits' fields (compare.c): thresholds >= 0
+ * (infinity allowed), percentages 0..100, counts >= 0. */
+extern const bb__range bb__range_compare_threshold, bb__range_compare_percent,
+    bb__range_compare_count;
+/* A blend's factor, 0..1 (combine.c). */
+extern const bb__range bb__range_mix;
 
 /* DOOM 3's addnormals on one texel: n = base, z rebuilt from x and y when
  * |n| < 1 (maps that fade to (0, 0, 0) at their edges), n.xy += (dx, dy),

@@ -11,6 +11,7 @@
  * same for any thread count.
  */
 #include "core/internal.h"
+#include "mesh/mesh_internal.h"
 #include "mesh/renderbump_notes.h"
 #include "mesh/rasterize.h"
 
@@ -68,20 +69,21 @@ typedef struct rb_job {
 
 /* ------------------------------------------------------------- checking */
 
+const bb__range bb__range_renderbump_samples = {"renderbump: samples per side", 1, 16, 0, 1};
+
 static bb_status check_options(const bb_renderbump_options *o, bb_error *err) {
   if (o->width < 1 || o->height < 1 || o->width > BB_MAX_DIMENSION ||
       o->height > BB_MAX_DIMENSION || (long long)o->width * o->height > BB_MAX_PIXELS)
     return bb__fail(err, BB_ERR_SIZE, "renderbump: size %d x %d is not in 1..%d per side "
                     "and %ld texels", o->width, o->height, BB_MAX_DIMENSION,
                     (long)BB_MAX_PIXELS);
-  if (o->samples < 1 || o->samples > 16)
-    return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: samples per side %d not in 1..16",
-                    o->samples);
+  if (!bb__range_holds(&bb__range_renderbump_samples, o->samples))
+    return bb__range_check(&bb__range_renderbump_samples, o->samples, NULL, err);
   if ((int)o->axis < 0 || (int)o->axis > BB_AXIS_NEG_X)
     return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: unknown axis %d", (int)o->axis);
-  if (o->threads < 0 || o->threads > BB_MAX_THREADS)
-    return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: threads must be in 0..%d (got %d)",
-                    BB_MAX_THREADS, o->threads);
+  bb_status st = bb__range_check(&bb__range_threads, o->threads, "renderbump: threads", err);
+  if (st != BB_OK)
+    return st;
   if (o->rect_given) {
     for (int k = 0; k < 4; k++)
       if (!isfinite(o->rect[k]))

@@ -11,6 +11,8 @@
 
 #include "trace/basis.h"
 #include "core/internal.h"
+#include "render/render_internal.h"
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -249,39 +251,43 @@ void bb_render_options_init(bb_render_options *o) {
   o->view_elevation = 30.0;
 }
 
-static int finite_non_negative(const float v[3]) {
-  for (int k = 0; k < 3; k++)
-    if (!isfinite(v[k]) || v[k] < 0.0f)
-      return 0;
-  return 1;
+const bb__range bb__range_light_elevation = {"light elevation", 0.0, 90.0, 0, 0};
+const bb__range bb__range_view_elevation = {"view elevation", 1.0, 90.0, 0, 0};
+const bb__range bb__range_colour = {"colour", 0.0, FLT_MAX, 0, 0};
+const bb__range bb__range_specular_exponent = {"specular exponent", 0.0,
+                                               BB_MAX_SPECULAR_EXPONENT, 0, 0};
+const bb__range bb__range_specular_strength = {"specular strength", 0.0, 1000.0, 0, 0};
+const bb__range bb__range_tile = {"tile", 1, 64, 0, 1};
+
+static bb_status in_range(const bb__range *r, double v, bb_error *err) {
+  char who[64] = "render: ";
+  strncat(who, r->what, sizeof who - strlen(who) - 1);
+  return bb__range_check(r, v, who, err);
+}
+
+static bb_status check_colour(const char *what, const float *c, bb_error *err) {
+  bb_status st = BB_OK;
+  for (int k = 0; k < 3 && st == BB_OK; k++)
+    st = bb__range_check(&bb__range_colour, (double)c[k], what, err);
+  return st;
 }
 
 static bb_status check_lights(const bb_render_options *o, bb_error *err) {
+  bb_status st = BB_OK;
   if (o->dynamic_light) {
     if (!isfinite(o->light_azimuth))
       return bb__fail(err, BB_ERR_ARGUMENT, "render: light azimuth must be finite");
-    if (!(o->light_elevation >= 0.0 && o->light_elevation <= 90.0))
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "render: light elevation must be in 0..90 degrees (got %g)",
-                      o->light_elevation);
-    if (!finite_non_negative(o->light_color))
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "render: light colour must be finite and >= 0");
+    st = in_range(&bb__range_light_elevation, o->light_elevation, err);
+    if (st == BB_OK)
+      st = check_colour("render: light colour", o->light_color, err);
   }
-  if (o->static_light)
-    for (int c = 0; c < 3; c++)
-      if (!finite_non_negative(o->lightmap[c]))
-        return bb__fail(err, BB_ERR_ARGUMENT,
-                        "render: lightmap colour %d must be finite and >= 0", c);
-  if (!(o->specular_exponent >= 0.0) || !isfinite(o->specular_exponent))
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "render: specular exponent must be >= 0 (got %g)",
-                    o->specular_exponent);
-  if (!(o->specular_strength >= 0.0 && o->specular_strength <= 1000.0))
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "render: specular strength must be in 0..1000 (got %g)",
-                    o->specular_strength);
-  return BB_OK;
+  for (int c = 0; c < 3 && o->static_light && st == BB_OK; c++)
+    st = check_colour("render: lightmap colour", o->lightmap[c], err);
+  if (st == BB_OK)
+    st = in_range(&bb__range_specular_exponent, o->specular_exponent, err);
+  if (st == BB_OK)
+    st = in_range(&bb__range_specular_strength, o->specular_strength, err);
+  return st;
 }
 
 static bb_status check_options(const bb_render_options *o, bb_error *err) {
@@ -292,22 +298,20 @@ static bb_status check_options(const bb_render_options *o, bb_error *err) {
   if ((int)o->albedo_mode < 0 || (int)o->albedo_mode > (int)BB_ALBEDO_SSBUMP)
     return bb__fail(err, BB_ERR_ARGUMENT, "render: unknown albedo mode %d",
                     (int)o->albedo_mode);
-  if (o->tile_x < 1 || o->tile_y < 1 || o->tile_x > 64 || o->tile_y > 64)
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "render: tile counts must be in 1..64 (got %dx%d)", o->tile_x,
-                    o->tile_y);
+  bb_status st = in_range(&bb__range_tile, o->tile_x, err);
+  if (st == BB_OK)
+    st = in_range(&bb__range_tile, o->tile_y, err);
+  if (st != BB_OK)
+    return st;
   if (o->crop_width < 0 || (o->crop_width > 0 && o->crop_height <= 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: crop size must be > 0 (got %dx%d)",
                     o->crop_width, o->crop_height);
-  if (o->threads < 0 || o->threads > BB_MAX_THREADS)
-    return bb__fail(err, BB_ERR_ARGUMENT, "render: threads must be in 0..%d (got %d)",
-                    BB_MAX_THREADS, o->threads);
+  if ((st = bb__range_check(&bb__range_threads, o->threads, "render: threads", err)) != BB_OK)
+    return st;
   if (o->view && !isfinite(o->view_azimuth))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: view azimuth must be finite");
-  if (o->view && !(o->view_elevation >= 1.0 && o->view_elevation <= 90.0))
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "render: view elevation must be in 1..90 degrees (got %g)",
-                    o->view_elevation);
+  if (o->view && (st = in_range(&bb__range_view_elevation, o->view_elevation, err)) != BB_OK)
+    return st;
   if (o->relief && !o->view)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "render: relief needs a view (seen from straight above it shows nothing)");

@@ -204,9 +204,11 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
   if (!f)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown texture format %d", path,
                     (int)o->format);
-  if (o->threads < 0 || o->threads > BB_MAX_THREADS)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: threads must be in 0..%d (got %d)", path,
-                    BB_MAX_THREADS, o->threads);
+  if (!bb__range_holds(&bb__range_threads, o->threads)) {
+    char who[600];
+    snprintf(who, sizeof who, "%s: threads", path);
+    return bb__range_check(&bb__range_threads, o->threads, who, err);
+  }
   if (c == BB__CONTAINER_VTF) {
     if (o->vtf_version < 2 || o->vtf_version > 5)
       return bb__fail(err, BB_ERR_ARGUMENT,

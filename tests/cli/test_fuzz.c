@@ -147,6 +147,6 @@ Test(fuzz, a_parse_forgets_the_previous_one) {
   char *stops_inside_a_cluster[] = {name, first, file, scale, NULL};
   char *valid[] = {name, rays, count, file, scale, NULL};
   mute_output();
-  cr_assert_eq(bb_cli_height2ssbump(4, stops_inside_a_cluster), 2);
-  cr_assert_eq(bb_cli_height2ssbump(5, valid), 1);
+  cr_assert_eq(bb_cli_command(4, stops_inside_a_cluster), 2);
+  cr_assert_eq(bb_cli_command(5, valid), 1);
 }

@@ -1,5 +1,5 @@
 /* test_job.c: a bake job's plan (bb_job_plan) refusing bad options before
- * any bake, and the command its outputs record (bb_job_command_text). */
+ * any bake. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 

@@ -746,7 +746,7 @@ Test(compare_cli, limits_out_of_range_are_refused) {
     int field;
     double value;
     const char *message;
-  } bad[] = {{0, -1e-6, "compare: fail must be >= 0 (got -1e-06)"},
+  } bad[] = {{0, -1e-6, "compare: fail must be >= 0 (got -1e-6)"},
              {1, 150.0, "compare: failpercent must be in 0..100 (got 150)"},
              {2, NAN, "compare: hardfail must be >= 0 (got nan)"},
              {3, -1.0, "compare: warn must be >= 0 (got -1)"},

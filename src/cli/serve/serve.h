@@ -7,8 +7,7 @@
 #define BB_CLI_SERVE_H
 
 #include "bumpbake.h"
-#include "bake_options.h"
-#include "options.h"
+#include "bumpbake.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -51,7 +50,7 @@ typedef struct serve_state {
   long version;           /* bumped on every change a page shows */
   /* what to bake: the command line's options, changed by the page's controls */
   const char *height_path;
-  cli_settings settings;
+  bb_job_options settings; /* the bake's parameters as the command line gave them */
   bb_job_options job;     /* paths of a "write"; bake filled from settings */
   const char *brightness_file; /* the command line's --brightness, or NULL */
   int use_brightness;     /* the page's switch (1 when given) */

@@ -39,7 +39,13 @@ void serve_bake_release(serve_bake *b) {
 
 void serve_job_options(const serve_state *s, bb_job_options *o) {
   *o = s->job;
-  cli_bake_settings_to_job(&s->settings, o);
+  /* the parameters, as bake takes them */
+  o->bake = s->settings.bake;
+  o->channel = s->settings.channel;
+  o->depth = s->settings.depth;
+  o->mips = s->settings.mips;
+  o->texture = s->settings.texture;
+  o->basis_file = s->settings.basis_file;
   o->brightness_file = s->use_brightness ? s->brightness_file : NULL;
   o->force = 1;       /* a single bake always bakes */
   o->command = NULL;  /* provenance: bb_job_command_text, the line the page shows */

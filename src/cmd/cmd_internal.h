@@ -1,0 +1,195 @@
+/* cmd_internal.h: what the commands family's files share (not public): an
+ * option's description with the functions of its rule, a command's with
+ * its rules, and a command in use. The family sits above job: it plans
+ * jobs and reads every family's ranges; nothing below includes it. */
+#ifndef BB_CMD_INTERNAL_H
+#define BB_CMD_INTERNAL_H
+
+#include "bumpbake.h"
+#include "core/internal.h"
+
+#include <stddef.h>
+
+typedef struct bb__option bb__option;
+
+/* Where a generic option's value goes in bb_command_options. */
+typedef enum bb__field {
+  BB__FIELD_NONE = 0, /* the option's set function writes it */
+  BB__FIELD_INT,      /* int (flags set 1) */
+  BB__FIELD_FLOAT,
+  BB__FIELD_DOUBLE,
+  BB__FIELD_STRING,   /* const char *, owned by the command */
+  BB__FIELD_ENUM      /* an enum, stored as int (enums of the API are int-sized) */
+} bb__field;
+
+/* The most numbers one option holds (--rect L B R T). */
+#define BB__MAX_NUMBERS 4
+
+/* Parses text into the option's field(s); the numbers to check against the
+ * option's range go to values, *count of them (bb_command_check checks
+ * them; the caller sets *count to the type's count first). */
+typedef bb_status (*bb__set_fn)(bb_command *c, const bb__option *o, const char *text,
+                                double *values, int *count, bb_error *err);
+/* Appends the option's value as it takes it, from the options. */
+typedef void (*bb__print_fn)(const bb_command *c, const bb__option *o, bb__text *t);
+/* 1 when the option does something in c as it stands. */
+typedef int (*bb__applies_fn)(const bb_command *c);
+/* An enum's name for value i ("unknown" or NULL past the last), and its
+ * parser (with the enum's aliases and case rules): 1 and *value, or 0. */
+typedef const char *(*bb__name_fn)(int i);
+typedef int (*bb__parse_fn)(const char *text, int *value);
+
+struct bb__option {
+  bb_option_info info;       /* first: a bb_option_info * is a bb__option * */
+  bb__field field;
+  size_t offset;             /* of the field in bb_command_options */
+  const bb__range *range;    /* INT, NUMBER(S): each number's range */
+  const char *range_of;      /* what of the value the range is of ("elevation"), or NULL */
+  bb__name_fn names;         /* WORD(S): the enum's names */
+  bb__parse_fn parse;        /* WORD(S): the enum's parser */
+  bb__set_fn set;            /* NULL: by type and field */
+  bb__print_fn print;        /* NULL: by type and field */
+  bb__applies_fn applies;    /* NULL: always applies */
+  const char *required_note; /* REQUIRED: what it is, after "is required" */
+  void (*range_words)(char *out, size_t cap); /* a range spelled from constants */
+};
+
+typedef struct bb__command bb__command;
+
+/* A command's run (run_*.c): reads, makes and writes, appending what it
+ * wrote to result (bb__result_add). */
+typedef bb_status (*bb__run_fn)(bb_command *c, const bb_command_hooks *hooks,
+                                bb_command_result *result, bb_error *err);
+
+struct bb__command {
+  bb_command_info info;               /* first, as bb__option's */
+  const bb__option *const *options;
+  void (*init)(bb_command_options *o);
+  /* positional i (from 0) of text; NULL: each is an input */
+  bb_status (*add_input)(bb_command *c, int i, const char *text, bb_error *err);
+  /* the command's own rules, after the generic checks */
+  bb_status (*check)(bb_command *c, bb_error *err);
+  /* its job's options (commands through the job); NULL: none */
+  bb_status (*job)(bb_command *c, bb_job_options *o, bb_error *err);
+  /* its run without a job (render, sheet, the map commands); NULL: none */
+  bb__run_fn run;
+};
+
+/* The most options one command has. */
+#define BB__MAX_OPTIONS 64
+
+struct bb_command {
+  const bb__command *def;
+  bb_command_options options;
+  unsigned char given[BB__MAX_OPTIONS];
+  double values[BB__MAX_OPTIONS][BB__MAX_NUMBERS]; /* the numbers each option set */
+  int value_count[BB__MAX_OPTIONS];
+  char **strings;                    /* owned copies the options point to */
+  int string_count, string_capacity;
+  char **inputs;
+  int input_count;
+  char *record_line, *record_options;
+  int checked;                       /* bb_command_check passed */
+  int in_memory;                     /* images in memory, not files */
+  unsigned memory_maps;              /* ... and the maps asked of them */
+};
+
+/* The commands' descriptions (commands.c), in bumpbake --help's order. */
+extern const bb__command *const bb__commands[];
+extern const int bb__command_total;
+
+/* 1 when the first length characters of name are option's name ('_'
+ * read as '-'). */
+int bb__names_option(const char *name, size_t length, const char *option);
+/* Index of the option named name in c's table, or -1. */
+int bb__option_find(const bb__command *c, const char *name);
+/* 1 when option name of c was set. */
+int bb__given(const bb_command *c, const char *name);
+
+/* A copy of text owned by c (NULL when out of memory). */
+char *bb__command_keep(bb_command *c, const char *text);
+
+/* "--name" (or "-x" for a short-only spelling), for messages. */
+void bb__option_spelling(const bb__option *o, char *out, size_t cap);
+
+/* The options given, " --name value" each, in the order of --help; only
+ * those that determine the output with BB_OPTION_RECORDED (text.c). */
+void bb__add_options(const bb_command *c, unsigned flags, bb__text *t);
+
+/* Runs (results.c): a file written, added to result; a failure about path
+ * (its message names path once). */
+bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
+                         bb_error *err);
+bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e);
+/* The command line the outputs of c record: its record, else
+ * bb_command_text's (malloc'd; NULL when out of memory). */
+char *bb__command_record(const bb_command *c);
+/* The runs of the commands without a job (run_render.c, run_maps.c). */
+bb_status bb__run_render(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                         bb_error *err);
+bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                        bb_error *err);
+bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
+                                bb_command_result *r, bb_error *err);
+bb_status bb__run_ssbump2normal(bb_command *c, const bb_command_hooks *hooks,
+                                bb_command_result *r, bb_error *err);
+bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                          bb_error *err);
+bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                          bb_error *err);
+
+/* A render's tile and crop for maps of width x height (options_render.c):
+ * BB_ERR_ARGUMENT when the tiled picture is over the maximum or the crop
+ * is not inside it. */
+bb_status bb__render_view_check(const bb_render_options *o, int width, int height,
+                                bb_error *err);
+
+/* Value parsers (values.c): one function per rule. */
+bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
+                          double *values, int *count, bb_error *err);
+void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t);
+/* count numbers of text (comma-separated, or blank-separated when the
+ * option takes several words) into v; BB_ERR_ARGUMENT naming the option. */
+bb_status bb__parse_numbers(const bb__option *o, const char *text, int count, int integers,
+                            double *v, bb_error *err);
+/* The words of a WORD(S) option, '|'-separated. */
+void bb__choices(const bb__option *o, char *out, size_t cap);
+
+/* Rules between options and the outputs they look at (rules.c). */
+int bb__applies_texture(const bb_command *c);
+int bb__applies_vtf(const bb_command *c);
+int bb__applies_traced(const bb_command *c);
+int bb__applies_bounces(const bb_command *c);
+int bb__applies_brightness(const bb_command *c);
+
+/* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
+#define BB__ENUM_WORDS(stem)                                                             \
+  const char *bb__name_##stem(int i);                                                    \
+  int bb__parse_##stem(const char *text, int *value);
+BB__ENUM_WORDS(normal_filter)
+BB__ENUM_WORDS(channel)
+BB__ENUM_WORDS(texture_format)
+BB__ENUM_WORDS(render_mode)
+BB__ENUM_WORDS(albedo_mode)
+BB__ENUM_WORDS(axis)
+BB__ENUM_WORDS(map_kind)
+BB__ENUM_WORDS(depth)
+BB__ENUM_WORDS(normal_y)
+BB__ENUM_WORDS(ssbump_kind)
+BB__ENUM_WORDS(output_kind)
+
+/* Rows several commands share (options_bake.c). */
+extern const bb__option bb__opt_scale, bb__opt_scale_optional, bb__opt_rays,
+    bb__opt_filter_radius, bb__opt_filter_threshold, bb__opt_bias, bb__opt_power,
+    bb__opt_normal_filter, bb__opt_normal_y, bb__opt_threads, bb__opt_clamp, bb__opt_channel,
+    bb__opt_depth, bb__opt_depth_like_input, bb__opt_depth_of_format, bb__opt_mips,
+    bb__opt_json, bb__opt_quiet, bb__opt_help, bb__opt_texture_format, bb__opt_vtf_version,
+    bb__opt_vtf_flags, bb__opt_nomip, bb__opt_fast_compression;
+
+/* The options' tables (options_*.c). */
+extern const bb__command bb__command_bake, bb__command_normal, bb__command_height2ssbump,
+    bb__command_compare, bb__command_info, bb__command_renderbumpflat, bb__command_render,
+    bb__command_sheet, bb__command_normal2ssbump, bb__command_ssbump2normal,
+    bb__command_combine, bb__command_program, bb__command_serve;
+
+#endif /* BB_CMD_INTERNAL_H */

@@ -1,0 +1,306 @@
+/* command.c: one use of a command: its options set through their parsers
+ * into one typed struct, its inputs, the checks that come before any file
+ * is read, the command spelled back as text, and its plan through the job.
+ *
+ * Invariant: every value in options came through the parser of the option
+ * that sets it; bb_command_check has checked each number against its
+ * parameter's one range and every rule between options, so a plan made
+ * from a checked command checks nothing again. */
+#include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const bb__command *find_command(const char *name) {
+  for (int i = 0; name && i < bb__command_total; i++)
+    if (!strcmp(bb__commands[i]->info.name, name))
+      return bb__commands[i];
+  return NULL;
+}
+
+bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no place for it");
+  *out = NULL;
+  const bb__command *def = find_command(name);
+  if (!def) {
+    const bb_command_info *near = bb_command_info_nearest(name ? name : "");
+    if (near)
+      return bb__fail(err, BB_ERR_ARGUMENT, "unknown command '%.64s' (did you mean %s?)",
+                      name ? name : "", near->name);
+    return bb__fail(err, BB_ERR_ARGUMENT, "unknown command '%.64s' (see bumpbake --help)",
+                    name ? name : "");
+  }
+  bb_command *c = calloc(1, sizeof *c);
+  if (!c)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  c->def = def;
+  bb_command_options *o = &c->options;
+  bb_job_options_init(&o->job);
+  bb_render_options_init(&o->render);
+  bb_compare_limits_init(&o->limits);
+  bb_renderbump_options_init(&o->renderbump);
+  o->map_kind = BB_MAP_SSBUMP;
+  o->ssbump_kind = BB_SSBUMP_LINEAR;
+  if (def->init)
+    def->init(o);
+  *out = c;
+  return BB_OK;
+}
+
+void bb_command_free(bb_command *c) {
+  if (!c)
+    return;
+  for (int i = 0; i < c->string_count; i++)
+    free(c->strings[i]);
+  free(c->strings);
+  for (int i = 0; i < c->input_count; i++)
+    free(c->inputs[i]);
+  free(c->inputs);
+  free(c->record_line);
+  free(c->record_options);
+  free(c);
+}
+
+const bb_command_info *bb_command_describe(const bb_command *c) {
+  return c ? &c->def->info : NULL;
+}
+
+void bb_command_set_in_memory(bb_command *c, unsigned maps) {
+  if (!c)
+    return;
+  c->in_memory = 1;
+  c->memory_maps = maps;
+  c->options.job.bake.outputs = maps ? maps : c->options.job.bake.outputs;
+  c->checked = 0;
+}
+
+int bb_command_given(const bb_command *c, const char *name) {
+  return c && name && bb__given(c, name);
+}
+
+const bb_command_options *bb_command_options_of(const bb_command *c) {
+  return c ? &c->options : NULL;
+}
+
+int bb_command_input_count(const bb_command *c) {
+  return c ? c->input_count : 0;
+}
+
+const char *bb_command_input(const bb_command *c, int i) {
+  return c && i >= 0 && i < c->input_count ? c->inputs[i] : NULL;
+}
+
+/* --------------------------------------------------------------- setting */
+
+bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_error *err) {
+  if (!c || !name)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
+  const int i = bb__option_find(c->def, name);
+  if (i < 0) {
+    const bb_option_info *near = bb_option_nearest(&c->def->info, name, 0);
+    if (near)
+      return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (did you mean --%s?)",
+                      name, near->name);
+    return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (see --help)", name);
+  }
+  const bb__option *o = c->def->options[i];
+  if (o->info.type != BB_OPTION_FLAG && !text)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
+  double values[BB__MAX_NUMBERS] = {0};
+  int count = o->info.type == BB_OPTION_NUMBERS ? o->info.count : 1;
+  bb_status st = o->set ? o->set(c, o, text, values, &count, err)
+                        : bb__set_generic(c, o, text, values, &count, err);
+  if (st != BB_OK)
+    return st;
+  c->given[i] = 1;
+  c->value_count[i] = count < BB__MAX_NUMBERS ? count : BB__MAX_NUMBERS;
+  memcpy(c->values[i], values, sizeof values);
+  c->checked = 0;
+  return BB_OK;
+}
+
+bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
+  if (!c || !text)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no input given");
+  if (c->def->add_input) {
+    bb_status st = c->def->add_input(c, c->input_count, text, err);
+    if (st != BB_OK)
+      return st;
+  }
+  char **grown = realloc(c->inputs, ((size_t)c->input_count + 1) * sizeof *grown);
+  if (!grown)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  c->inputs = grown;
+  if (!(c->inputs[c->input_count] = strdup(text)))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  c->input_count++;
+  c->checked = 0;
+  return BB_OK;
+}
+
+/* -------------------------------------------------------------- checking */
+
+/* The positional arguments' count: "missing HEIGHT (usage: ...)" names
+ * the ones missing. */
+static bb_status check_inputs(const bb_command *c, bb_error *err) {
+  const bb_command_info *info = &c->def->info;
+  if (c->input_count < info->min_inputs) {
+    const char *missing = info->inputs;
+    for (int k = 0; k < c->input_count && missing; k++) {
+      missing = strchr(missing, ' ');
+      missing = missing ? missing + 1 : NULL;
+    }
+    return bb__fail(err, BB_ERR_ARGUMENT, "missing %s (usage: bumpbake %s %s)",
+                    missing ? missing : info->inputs, info->name, info->synopsis);
+  }
+  if (info->max_inputs >= 0 && c->input_count > info->max_inputs)
+    return bb__fail(err, BB_ERR_ARGUMENT, "unexpected argument '%.128s' (expected only %s)",
+                    c->inputs[info->max_inputs], info->inputs);
+  return BB_OK;
+}
+
+static bb_status check_required(const bb_command *c, bb_error *err) {
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (c->in_memory && c->given[i] && (o->info.flags & BB_OPTION_FILES))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s is about files: not for images in memory",
+                      o->info.name);
+    if (!(o->info.flags & BB_OPTION_REQUIRED) || c->given[i] ||
+        (c->in_memory && (o->info.flags & BB_OPTION_FILES)))
+      continue;
+    if (o->info.short_name)
+      return bb__fail(err, BB_ERR_ARGUMENT, "-%c %s is required", o->info.short_name,
+                      o->info.value_name);
+    if (o->required_note)
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s is required (%s)", o->info.name,
+                      o->required_note);
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s is required", o->info.name);
+  }
+  return BB_OK;
+}
+
+/* Every number given against its parameter's one range: the only check of
+ * it on the way to the work. */
+static bb_status check_ranges(const bb_command *c, bb_error *err) {
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (!c->given[i] || !o->range)
+      continue;
+    char name[96];
+    bb__option_spelling(o, name, sizeof name);
+    if (o->range_of)
+      snprintf(name + strlen(name), sizeof name - strlen(name), " %s", o->range_of);
+    for (int k = 0; k < c->value_count[i]; k++) {
+      bb_status st = bb__range_check(o->range, c->values[i][k], name, err);
+      if (st != BB_OK)
+        return st;
+    }
+  }
+  return BB_OK;
+}
+
+/* An option of a batch given without one. */
+static bb_status check_modes(const bb_command *c, bb_error *err) {
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (c->given[i] && o->info.mode == BB_MODE_BATCH && !c->options.job.out_dir)
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s is for batches: give --out-dir DIR",
+                      o->info.name);
+  }
+  return BB_OK;
+}
+
+/* An option given where it would do nothing. */
+static bb_status check_applies(const bb_command *c, bb_error *err) {
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (c->given[i] && o->applies && !o->applies(c))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s does nothing without %s", o->info.name,
+                      o->info.applies);
+  }
+  return BB_OK;
+}
+
+bb_status bb_command_check(bb_command *c, bb_error *err) {
+  if (!c)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: none to check");
+  bb_status st = c->in_memory ? BB_OK : check_inputs(c, err);
+  if (st == BB_OK)
+    st = check_ranges(c, err);
+  if (st == BB_OK)
+    st = check_required(c, err);
+  if (st == BB_OK)
+    st = check_modes(c, err);
+  if (st == BB_OK)
+    st = check_applies(c, err);
+  if (st == BB_OK && c->def->check)
+    st = c->def->check(c, err);
+  c->checked = st == BB_OK;
+  return st;
+}
+
+bb_status bb_command_set_record(bb_command *c, const char *line, const char *options,
+                                bb_error *err) {
+  if (!c)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: none to record");
+  char *l = line ? strdup(line) : NULL, *o = options ? strdup(options) : NULL;
+  if ((line && !l) || (options && !o)) {
+    free(l);
+    free(o);
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  }
+  free(c->record_line);
+  free(c->record_options);
+  c->record_line = l;
+  c->record_options = o;
+  return BB_OK;
+}
+
+/* ------------------------------------------------------------------ plan */
+
+bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
+                          bb_error *err) {
+  if (!c || !job)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command plan: bad arguments");
+  *job = NULL;
+  if (!c->def->job)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s writes no job", c->def->info.name);
+  if (!c->checked)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the command is not checked (bb_command_check)",
+                    c->def->info.name);
+  bb_job_options o;
+  bb_status st = c->def->job(c, &o, err);
+  if (st != BB_OK)
+    return st;
+  /* the provenance's command: the line as typed less what does not change
+   * the output, else the options as the library spells them */
+  char *canonical = NULL;
+  o.command = o.out_dir ? NULL : c->record_line;
+  o.command_options = o.out_dir ? c->record_options : NULL;
+  if (!o.command && !o.command_options) {
+    bb__text t = {0};
+    if (o.out_dir) {
+      bb__add_options(c, BB_OPTION_RECORDED, &t);
+      canonical = bb__text_take(&t);
+      o.command_options = canonical && canonical[0] == ' ' ? canonical + 1 : canonical;
+    } else {
+      o.command = canonical = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+    }
+    if (!canonical)
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  }
+  if (hooks) {
+    o.note = hooks->note;
+    o.note_user = hooks->note_user;
+    o.bake.trace.trace = hooks->trace;
+    o.bake.trace.trace_user = hooks->trace_user;
+  }
+  /* height2ssbump's second positional is its scale, not an input */
+  const int inputs = o.valve_path ? 1 : c->input_count;
+  st = bb__job_plan((const char *const *)c->inputs, inputs, &o, 1, job, err);
+  free(canonical);
+  return st;
+}

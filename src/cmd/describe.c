@@ -1,0 +1,160 @@
+/* describe.c: the commands and their options as the public API shows them:
+ * lookups, and each option's range, choices and default spelled for help
+ * and the reference pages. */
+#include "cmd/cmd_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A public description is the first member of the library's. */
+static const bb__command *command_of(const bb_command_info *info) {
+  return (const bb__command *)(const void *)info;
+}
+
+static const bb__option *option_of(const bb_option_info *info) {
+  return (const bb__option *)(const void *)info;
+}
+
+static int option_total(const bb__command *c) {
+  int n = 0;
+  while (c->options[n])
+    n++;
+  return n;
+}
+
+int bb_command_count(void) {
+  return bb__command_total;
+}
+
+const bb_command_info *bb_command_info_get(int index) {
+  if (index < 0 || index >= bb__command_total)
+    return NULL;
+  /* option_count is known from the table's end */
+  return &bb__commands[index]->info;
+}
+
+const bb_command_info *bb_command_info_find(const char *name) {
+  for (int i = 0; name && i < bb__command_total; i++)
+    if (!strcmp(bb__commands[i]->info.name, name))
+      return &bb__commands[i]->info;
+  return NULL;
+}
+
+const bb_option_info *bb_command_option(const bb_command_info *command, int index) {
+  if (!command)
+    return NULL;
+  const bb__command *c = command_of(command);
+  return index >= 0 && index < option_total(c) ? &c->options[index]->info : NULL;
+}
+
+const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
+                                     size_t length) {
+  if (!command || !name)
+    return NULL;
+  const bb__command *c = command_of(command);
+  const size_t n = length ? length : strlen(name);
+  for (int i = 0; c->options[i]; i++)
+    if (bb__names_option(name, n, c->options[i]->info.name))
+      return &c->options[i]->info;
+  return NULL;
+}
+
+const bb_option_info *bb_option_find_short(const bb_command_info *command, char ch) {
+  if (!command || !ch)
+    return NULL;
+  const bb__command *c = command_of(command);
+  for (int i = 0; c->options[i]; i++)
+    if (c->options[i]->info.short_name == ch)
+      return &c->options[i]->info;
+  return NULL;
+}
+
+void bb_option_choices(const bb_option_info *option, char *out, size_t cap) {
+  if (!cap)
+    return;
+  out[0] = '\0';
+  if (option && (option->type == BB_OPTION_WORD || option->type == BB_OPTION_WORDS))
+    bb__choices(option_of(option), out, cap);
+}
+
+void bb_option_value_text(const bb_option_info *option, char *out, size_t cap) {
+  if (!cap)
+    return;
+  out[0] = '\0';
+  if (!option || option->type == BB_OPTION_FLAG)
+    return;
+  if (option->value_name)
+    snprintf(out, cap, "%s", option->value_name);
+  else
+    bb_option_choices(option, out, cap);
+}
+
+int bb_option_bounds(const bb_option_info *option, double *min, double *max,
+                     int *min_exclusive) {
+  const bb__option *o = option ? option_of(option) : NULL;
+  if (!o || !o->range)
+    return 0;
+  if (min)
+    *min = o->range->min;
+  if (max)
+    *max = o->range->max;
+  if (min_exclusive)
+    *min_exclusive = o->range->min_exclusive;
+  return 1;
+}
+
+void bb_option_range_text(const bb_option_info *option, char *out, size_t cap) {
+  if (!cap)
+    return;
+  out[0] = '\0';
+  if (!option)
+    return;
+  const bb__option *o = option_of(option);
+  if (option->range_text)
+    snprintf(out, cap, "%s", option->range_text);
+  else if (o->range_words)
+    o->range_words(out, cap);
+  else if (o->range)
+    bb__range_text(o->range, out, cap);
+  else if (option->type == BB_OPTION_WORDS)
+    bb__choices(o, out, cap);
+  for (char *bar = option->type == BB_OPTION_WORDS ? strchr(out, '|') : NULL; bar;
+       bar = strchr(bar, '|'))
+    *bar = ' ';
+}
+
+void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
+                            char *out, size_t cap) {
+  if (!cap)
+    return;
+  out[0] = '\0';
+  if (!command || !option)
+    return;
+  if (option->default_text) {
+    snprintf(out, cap, "%s", option->default_text);
+    return;
+  }
+  if (option->type == BB_OPTION_FLAG || option->type == BB_OPTION_PATH)
+    return;
+  const bb__option *o = option_of(option);
+  bb_command *c = NULL;
+  if (bb_command_new(command->name, &c, NULL) != BB_OK)
+    return;
+  bb__text t = {0};
+  if (o->print)
+    o->print(c, o, &t);
+  else
+    bb__print_generic(c, o, &t);
+  char *text = bb__text_take(&t);
+  /* a string not set is no default */
+  if (text)
+    snprintf(out, cap, "%s", text);
+  free(text);
+  bb_command_free(c);
+}
+
+int bb_command_has_job(const bb_command_info *command) {
+  return command && command_of(command)->job != NULL;
+}

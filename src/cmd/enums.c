@@ -1,0 +1,67 @@
+/* enums.c: the library's enums as the options' words: each parsed by its
+ * own parser (with its aliases) and named by its own _name function, so a
+ * word list is never typed twice. */
+#include "cmd/cmd_internal.h"
+
+#include <string.h>
+
+#define ENUM_WORDS(stem, type, parser, namer)                                           \
+  const char *bb__name_##stem(int i) { return namer((type)i); }                          \
+  int bb__parse_##stem(const char *text, int *value) {                                   \
+    type v;                                                                              \
+    if (parser(text, &v, NULL) != BB_OK)                                                 \
+      return 0;                                                                          \
+    *value = (int)v;                                                                     \
+    return 1;                                                                            \
+  }
+
+_Static_assert(sizeof(bb_normal_filter) == sizeof(int), "enums are stored as int");
+
+ENUM_WORDS(normal_filter, bb_normal_filter, bb_normal_filter_parse, bb_normal_filter_name)
+ENUM_WORDS(channel, bb_channel, bb_channel_parse, bb_channel_name)
+ENUM_WORDS(texture_format, bb_texture_format, bb_texture_format_parse, bb_texture_format_name)
+ENUM_WORDS(render_mode, bb_render_mode, bb_render_mode_parse, bb_render_mode_name)
+ENUM_WORDS(albedo_mode, bb_albedo_mode, bb_albedo_mode_parse, bb_albedo_mode_name)
+ENUM_WORDS(axis, bb_axis, bb_axis_parse, bb_axis_name)
+ENUM_WORDS(map_kind, bb_map_kind, bb_map_kind_parse, bb_map_kind_name)
+
+/* --depth: "default" is no word of its own */
+const char *bb__name_depth(int i) { return bb_depth_name((bb_depth)i); }
+int bb__parse_depth(const char *text, int *value) {
+  bb_depth d;
+  if (bb_depth_parse(text, &d, NULL) != BB_OK)
+    return 0;
+  *value = (int)d;
+  return 1;
+}
+
+const char *bb__name_normal_y(int i) { return i == 0 ? "down" : i == 1 ? "up" : NULL; }
+int bb__parse_normal_y(const char *text, int *value) {
+  return bb_normal_y_parse(text, value, NULL) == BB_OK;
+}
+
+/* ssbump2normal --kind: what a basis map holds */
+const char *bb__name_ssbump_kind(int i) {
+  return i == BB_SSBUMP_LINEAR ? "ssbump" : i == BB_SSBUMP_SQUARED ? "weights" : NULL;
+}
+int bb__parse_ssbump_kind(const char *text, int *value) {
+  for (int i = 0; i < 2; i++)
+    if (!strcmp(text, bb__name_ssbump_kind(i))) {
+      *value = i;
+      return 1;
+    }
+  return 0;
+}
+
+/* --maps: the bake's maps */
+const char *bb__name_output_kind(int i) {
+  const bb_output_kind_info *k = bb_output_kind_get((bb_output_kind)i);
+  return k ? k->name : NULL;
+}
+int bb__parse_output_kind(const char *text, int *value) {
+  bb_output_kind k;
+  if (bb_output_kind_parse(text, &k, NULL) != BB_OK)
+    return 0;
+  *value = (int)k;
+  return 1;
+}

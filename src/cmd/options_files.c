@@ -1,0 +1,282 @@
+/* options_files.c: the commands about files and models (compare, info,
+ * renderbumpflat), their options described once and their rules. */
+#include "cmd/cmd_internal.h"
+#include "maps/maps_internal.h"
+#include "mesh/mesh_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define AT(member) offsetof(bb_command_options, member)
+#define RECORDED BB_OPTION_RECORDED
+#define IDIFF (RECORDED | BB_OPTION_SINGLE_DASH)
+
+/* ------------------------------------------------------------- compare */
+
+static bb_status set_allow_failures(bb_command *c, const bb__option *o, const char *text,
+                                    double *values, int *count, bb_error *err) {
+  bb_status st = bb__set_generic(c, o, text, values, count, err);
+  if (st == BB_OK)
+    c->options.limits.allow_failures = (long)values[0];
+  return st;
+}
+
+static void print_allow_failures(const bb_command *c, const bb__option *o, bb__text *t) {
+  (void)o;
+  bb__text_printf(t, "%ld", c->options.limits.allow_failures);
+}
+
+#define ROW_LIMIT(name_, value_, member_, range_, help_)                                   \
+  {.info = {.name = (name_), .value_name = (value_), .type = BB_OPTION_NUMBER, .count = 1, \
+            .values = 1, .flags = IDIFF, .help = (help_)},                                 \
+   .field = BB__FIELD_DOUBLE, .offset = AT(limits.member_), .range = &(range_)}
+static const bb__option opt_fail =
+    ROW_LIMIT("fail", "T", fail, bb__range_compare_threshold,
+              "a pixel fails when a channel differs by more than T");
+static const bb__option opt_fail_percent =
+    ROW_LIMIT("failpercent", "P", fail_percent, bb__range_compare_percent,
+              "failing pixels allowed, in % of all (then a warning)");
+static const bb__option opt_hard_fail =
+    ROW_LIMIT("hardfail", "T", hard_fail, bb__range_compare_threshold,
+              "fail when any difference exceeds T, even within -failpercent");
+static const bb__option opt_allow_failures = {
+    .info = {.name = "allowfailures", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
+             .values = 1, .flags = IDIFF,
+             .help = "pass when at most N pixels fail, by any amount"},
+    .range = &bb__range_compare_count, .set = set_allow_failures, .print = print_allow_failures};
+static const bb__option opt_warn =
+    ROW_LIMIT("warn", "T", warn, bb__range_compare_threshold,
+              "a pixel warns when a channel differs by more than T");
+static const bb__option opt_warn_percent =
+    ROW_LIMIT("warnpercent", "P", warn_percent, bb__range_compare_percent,
+              "warning pixels allowed, in % of all");
+static const bb__option opt_hard_warn =
+    ROW_LIMIT("hardwarn", "T", hard_warn, bb__range_compare_threshold,
+              "warn when any difference exceeds T");
+static const bb__option opt_diff = {
+    .info = {.name = "diff", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = RECORDED | BB_OPTION_FILES,
+             .help = "write |A-B| (raw in .exr, scaled to a maximum of 1 otherwise)"},
+    .field = BB__FIELD_STRING, .offset = AT(diff)};
+static const bb__option opt_compare_json = {
+    .info = {.name = "json", .type = BB_OPTION_FLAG, .flags = BB_OPTION_CLIENT,
+             .default_text = "off", .help = "print the report as one JSON line"},
+    .field = BB__FIELD_INT, .offset = AT(json)};
+static const bb__option opt_compare_quiet = {
+    .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,
+             .flags = BB_OPTION_CLIENT, .default_text = "off",
+             .help = "print no report; the exit code tells"},
+    .field = BB__FIELD_INT, .offset = AT(quiet)};
+
+static const bb__option *const compare_options[] = {
+    &opt_fail, &opt_fail_percent, &opt_hard_fail, &opt_allow_failures, &opt_warn,
+    &opt_warn_percent, &opt_hard_warn, &opt_diff, &opt_compare_json, &opt_compare_quiet,
+    &bb__opt_help, NULL};
+
+static void compare_init(bb_command_options *o) {
+  bb_compare_limits_init(&o->limits);
+}
+
+/* The diff is checked before the (possibly long) reads, and must not
+ * overwrite either input. */
+static bb_status compare_check(bb_command *c, bb_error *err) {
+  if (!c->options.diff)
+    return BB_OK;
+  const bb_output_spec diff = {c->options.diff, "diff", 0, BB_DEPTH_DEFAULT, 0, 0, 0, 0,
+                               BB_RANGE_UNIT, NULL};
+  return bb_outputs_check(&diff, 1, (const char *const *)c->inputs, 2, err);
+}
+
+const bb__command bb__command_compare = {
+    .info = {.name = "compare",
+             .summary = "compare two images (statistics, provenance diff)",
+             .synopsis = "A B [OPTIONS]",
+             .description =
+                 "Compares two images channel by channel, as OpenImageIO's idiff (whose\n"
+                 "single-dash spellings are accepted), and lists differing provenance.\n"
+                 "Verdict (idiff 2.4's): pass when at most -allowfailures pixels fail; else\n"
+                 "fail when more than -failpercent % fail or any difference > -hardfail; else\n"
+                 "warn when more than -warnpercent % warn or any difference > -hardwarn.\n"
+                 "Exit: 0 pass, 1 warning, 2 failure, 3 different size or channels,\n"
+                 "4 unreadable file or bad arguments.",
+             .inputs = "A B", .min_inputs = 2, .max_inputs = 2, .usage_exit = 4,
+             .option_count = (int)(sizeof compare_options / sizeof compare_options[0]) - 1},
+    .options = compare_options, .init = compare_init, .check = compare_check};
+
+/* ---------------------------------------------------------------- info */
+
+static const bb__option opt_info_json = {
+    .info = {.name = "json", .type = BB_OPTION_FLAG, .flags = BB_OPTION_CLIENT,
+             .default_text = "off",
+             .help = "print one JSON object per file, one per line (JSON Lines)"},
+    .field = BB__FIELD_INT, .offset = AT(json)};
+
+static const bb__option *const info_options[] = {&opt_info_json, &bb__opt_help, NULL};
+
+const bb__command bb__command_info = {
+    .info = {.name = "info",
+             .summary = "print an image's size, format and provenance",
+             .synopsis = "FILE... [--json]",
+             .description =
+                 "Prints each image's size, channels, format, sample type and alpha channel,\n"
+                 "and the provenance bumpbake stored in it, from the file's header alone (no\n"
+                 "pixel is decoded); for a Source texture (.vtf) also its version, format,\n"
+                 "flags and mip levels. A file that cannot be read is reported and skipped;\n"
+                 "the exit code is then 1.",
+             .inputs = "FILE", .min_inputs = 1, .max_inputs = -1, .usage_exit = 2,
+             .option_count = (int)(sizeof info_options / sizeof info_options[0]) - 1},
+    .options = info_options};
+
+/* ------------------------------------------------------ renderbumpflat */
+
+static const bb__range range_side = {"a side", 1, BB_MAX_DIMENSION, 0, 1};
+
+/* -size W H: DOOM 3's, two words. */
+static bb_status set_size(bb_command *c, const bb__option *o, const char *text, double *values,
+                          int *count, bb_error *err) {
+  bb_status st = bb__parse_numbers(o, text, 2, 1, values, err);
+  *count = 2;
+  if (st == BB_OK && bb__range_holds(&range_side, values[0]) &&
+      bb__range_holds(&range_side, values[1]) && values[0] * values[1] > (double)BB_MAX_PIXELS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "-size %.0f %.0f is over %ld texels", values[0],
+                    values[1], (long)BB_MAX_PIXELS);
+  if (st == BB_OK) {
+    c->options.renderbump.width = (int)fmin(fmax(values[0], 0), BB_MAX_DIMENSION + 1.0);
+    c->options.renderbump.height = (int)fmin(fmax(values[1], 0), BB_MAX_DIMENSION + 1.0);
+  }
+  return st;
+}
+
+static void print_size(const bb_command *c, const bb__option *o, bb__text *t) {
+  (void)o;
+  bb__text_printf(t, "%d %d", c->options.renderbump.width, c->options.renderbump.height);
+}
+
+static void size_range(char *out, size_t cap) {
+  snprintf(out, cap, "1..%d each, W*H <= %ld", BB_MAX_DIMENSION, (long)BB_MAX_PIXELS);
+}
+
+/* --rect L B R T: four numbers, L < R and B < T. */
+static bb_status set_rect(bb_command *c, const bb__option *o, const char *text, double *values,
+                          int *count, bb_error *err) {
+  bb_status st = bb__parse_numbers(o, text, 4, 0, values, err);
+  *count = 0;
+  if (st == BB_OK && (!(values[2] > values[0]) || !(values[3] > values[1])))
+    return bb__fail(err, BB_ERR_ARGUMENT, "--rect needs L < R and B < T");
+  if (st == BB_OK) {
+    for (int k = 0; k < 4; k++)
+      c->options.renderbump.rect[k] = values[k];
+    c->options.renderbump.rect_given = 1;
+  }
+  return st;
+}
+
+static void print_rect(const bb_command *c, const bb__option *o, bb__text *t) {
+  (void)o;
+  for (int k = 0; k < 4; k++) {
+    char buf[40];
+    bb__double_text(c->options.renderbump.rect[k], buf, sizeof buf);
+    bb__text_printf(t, "%s%s", k ? " " : "", buf);
+  }
+}
+
+static const bb__option opt_size = {
+    .info = {.name = "size", .value_name = "W H", .type = BB_OPTION_NUMBERS, .count = 2,
+             .values = 2, .flags = RECORDED | BB_OPTION_SINGLE_DASH,
+             .help = "output size in texels (DOOM 3's -size W H; one dash or two)"},
+    .range = &range_side, .set = set_size, .print = print_size, .range_words = size_range};
+static const bb__option opt_rbf_output = {
+    .info = {.name = "output", .short_name = 'o', .value_name = "OUT", .type = BB_OPTION_PATH,
+             .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_FILES,
+             .default_text = "MODEL_local.tga beside MODEL",
+             .help = "normal map, RGB = N, A = coverage (.tga .png .tif .exr)"},
+    .field = BB__FIELD_STRING, .offset = AT(output)};
+static const bb__option opt_height = {
+    .info = {.name = "height", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = RECORDED | BB_OPTION_FILES,
+             .help = "also write the height, 0..1 (16-bit png/tif, float exr), and print its "
+                     "scale"},
+    .field = BB__FIELD_STRING, .offset = AT(height_output)};
+static const bb__option opt_axis = {
+    .info = {.name = "axis", .type = BB_OPTION_WORD, .count = 1, .values = 1, .flags = RECORDED,
+             .default_text = "-y (DOOM 3)",
+             .help = "the side the sculpt's front faces (+z: Blender's top view)"},
+    .field = BB__FIELD_ENUM, .offset = AT(renderbump.axis), .names = bb__name_axis,
+    .parse = bb__parse_axis};
+static const bb__option opt_samples = {
+    .info = {.name = "samples", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
+             .values = 1, .flags = RECORDED, .default_text = "4 (16 samples per texel)",
+             .help = "N x N samples per texel"},
+    .field = BB__FIELD_INT, .offset = AT(renderbump.samples),
+    .range = &bb__range_renderbump_samples};
+static const bb__option opt_face_normals = {
+    .info = {.name = "face-normals", .type = BB_OPTION_FLAG, .flags = RECORDED,
+             .default_text = "off",
+             .help = "triangles' plane normals even where the model has vertex normals"},
+    .field = BB__FIELD_INT, .offset = AT(renderbump.face_normals)};
+static const bb__option opt_rect = {
+    .info = {.name = "rect", .value_name = "L B R T", .type = BB_OPTION_NUMBERS, .count = 4,
+             .values = 4, .flags = RECORDED | BB_OPTION_SINGLE_DASH,
+             .default_text = "the model's bounding rectangle",
+             .help = "rectangle in model units along the image's right and up axes"},
+    .set = set_rect, .print = print_rect};
+static const bb__option opt_rbf_tile = {
+    .info = {.name = "tile", .type = BB_OPTION_FLAG, .flags = RECORDED, .default_text = "off",
+             .help = "wrap geometry outside --rect into it (the sculpt tiles; needs --rect)"},
+    .field = BB__FIELD_INT, .offset = AT(renderbump.tile)};
+static const bb__option opt_rbf_normal_y = {
+    .info = {.name = "normal-y", .type = BB_OPTION_WORD, .count = 1, .values = 1,
+             .flags = RECORDED,
+             .help = "green axis: down = Source/DirectX, up = OpenGL (flips green)"},
+    .field = BB__FIELD_INT, .offset = AT(maps_normal_y_up), .names = bb__name_normal_y,
+    .parse = bb__parse_normal_y};
+static const bb__option opt_rbf_quiet = {
+    .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,
+             .flags = BB_OPTION_CLIENT, .help = "print only errors, notes and the height scale"},
+    .field = BB__FIELD_INT, .offset = AT(quiet)};
+
+static const bb__option *const rbf_options[] = {
+    &opt_size, &opt_rbf_output, &opt_height, &opt_axis, &opt_samples, &opt_face_normals,
+    &opt_rect, &opt_rbf_tile, &opt_rbf_normal_y, &bb__opt_threads, &opt_rbf_quiet,
+    &bb__opt_help, NULL};
+
+static void rbf_init(bb_command_options *o) {
+  bb_renderbump_options_init(&o->renderbump);
+}
+
+/* --tile needs --rect; the normal map's default name; the outputs apart and
+ * not over the model. */
+static bb_status rbf_check(bb_command *c, bb_error *err) {
+  bb_command_options *o = &c->options;
+  if (o->renderbump.tile && !o->renderbump.rect_given)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--tile needs --rect L B R T: the tile the sculpt repeats with");
+  if (!o->output) {
+    char *name = bb_path_with_suffix(c->inputs[0], "_local.tga");
+    o->output = name ? bb__command_keep(c, name) : NULL;
+    free(name);
+    if (!o->output)
+      return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);
+  }
+  if (o->height_output && bb_same_file(o->height_output, o->output))
+    return bb__fail(err, BB_ERR_ARGUMENT, "--height and the normal map are both %s", o->output);
+  const bb_output_spec specs[2] = {
+      {o->output, "normal", 4, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_SIGNED, NULL},
+      {o->height_output, "height", 1, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_UNIT, NULL}};
+  return bb_outputs_check(specs, o->height_output ? 2 : 1, (const char *const *)c->inputs, 1,
+                          err);
+}
+
+const bb__command bb__command_renderbumpflat = {
+    .info = {.name = "renderbumpflat",
+             .summary = "DOOM 3's RenderBumpFlat: a flat sculpt's normal map and height",
+             .synopsis = "[-size W H] MODEL [OPTIONS]",
+             .description =
+                 "DOOM 3's RenderBumpFlat: projects MODEL (any format Assimp reads) onto its\n"
+                 "bounding rectangle and writes the front-most surface's normals, 16x\n"
+                 "oversampled, with alpha = coverage.",
+             .inputs = "MODEL", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
+             .option_count = (int)(sizeof rbf_options / sizeof rbf_options[0]) - 1},
+    .options = rbf_options, .init = rbf_init, .check = rbf_check};

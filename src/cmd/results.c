@@ -1,0 +1,42 @@
+/* results.c: what a run wrote (bb_command_result), and a failure about a
+ * file named once. */
+#include "cmd/cmd_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e) {
+  const char *why = e && e->message[0] ? e->message : bb_status_name(st);
+  const size_t n = strlen(path);
+  if (strncmp(why, path, n) == 0 && why[n] == ':')
+    return bb__fail(err, st, "%s", why);
+  return bb__fail(err, st, "%s: %s", path, why);
+}
+
+bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
+                         bb_error *err) {
+  bb_job_file *grown = realloc(r->files, ((size_t)r->file_count + 1) * sizeof *grown);
+  if (!grown)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  r->files = grown;
+  char *k = strdup(kind), *p = strdup(path);
+  if (!k || !p) {
+    free(k);
+    free(p);
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  }
+  r->files[r->file_count++] = (bb_job_file){k, p};
+  return BB_OK;
+}
+
+void bb_command_result_free(bb_command_result *r) {
+  if (!r)
+    return;
+  for (int i = 0; i < r->file_count; i++) {
+    free((char *)r->files[i].kind);
+    free((char *)r->files[i].path);
+  }
+  free(r->files);
+  memset(r, 0, sizeof *r);
+}
+

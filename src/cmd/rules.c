@@ -1,0 +1,83 @@
+/* rules.c: when an option does anything (the "applies when" of its
+ * description): engine texture settings with an engine texture written,
+ * inter-reflection with a traced map, and so on. bb_command_check refuses
+ * an option given where its rule says it would do nothing, as --depth 16
+ * with a .vtf is refused. */
+#include "cmd/cmd_internal.h"
+
+#include <string.h>
+#include <strings.h>
+
+static int has_extension(const char *path, const char *ext) {
+  if (!path)
+    return 0;
+  const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash + 1 : path, '.');
+  return dot && strcasecmp(dot + 1, ext) == 0;
+}
+
+/* The files c writes whose formats are known before it runs (a batch's
+ * name template stands for all of its files); the count. */
+static int outputs(const bb_command *c, const char **out) {
+  const bb_command_options *o = &c->options;
+  int n = 0;
+  if (o->job.out_dir) {
+    out[n++] = o->job.name_template ? o->job.name_template : BB_JOB_DEFAULT_NAME;
+    return n;
+  }
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    if (o->job.paths[k])
+      out[n++] = o->job.paths[k];
+  if (o->job.slope_path)
+    out[n++] = o->job.slope_path;
+  if (o->job.valve_path)
+    out[n++] = o->job.valve_path;
+  if (o->output)
+    out[n++] = o->output;
+  return n;
+}
+
+static int any_output(const bb_command *c, const char *ext, const char *also) {
+  const char *paths[BB_OUTPUT_KIND_COUNT + 4];
+  const int n = outputs(c, paths);
+  for (int i = 0; i < n; i++)
+    if (has_extension(paths[i], ext) || (also && has_extension(paths[i], also)))
+      return 1;
+  return 0;
+}
+
+int bb__applies_texture(const bb_command *c) {
+  return any_output(c, "vtf", "dds");
+}
+
+int bb__applies_vtf(const bb_command *c) {
+  return any_output(c, "vtf", NULL);
+}
+
+/* The bake's maps c asks for. */
+static unsigned maps_asked(const bb_command *c) {
+  const bb_job_options *j = &c->options.job;
+  if (c->in_memory)
+    return c->memory_maps;
+  if (!strcmp(c->def->info.name, "serve"))
+    return BB_OUTPUTS_ALL; /* its page shows every map */
+  if (j->out_dir)
+    return j->maps ? j->maps : BB_JOB_DEFAULT_MAPS;
+  unsigned maps = j->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    if (j->paths[k])
+      maps |= BB_OUTPUT_BIT(k);
+  return maps;
+}
+
+int bb__applies_traced(const bb_command *c) {
+  return (maps_asked(c) & BB_OUTPUTS_TRACED) != 0;
+}
+
+int bb__applies_bounces(const bb_command *c) {
+  return c->options.job.bake.bounce_albedo > 0.0 || c->options.job.bounce_albedo_file;
+}
+
+int bb__applies_brightness(const bb_command *c) {
+  return (maps_asked(c) &
+          (BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS))) != 0;
+}

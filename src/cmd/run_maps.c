@@ -1,0 +1,273 @@
+/* run_maps.c: the runs of the commands that turn maps into maps
+ * (normal2ssbump, ssbump2normal, combine, program), as the command line
+ * runs them: read, convert, write with provenance (the command line, the
+ * input's name and the hash of its decoded pixels, the kind; no bake
+ * parameters: the command holds every option). (These commands have no
+ * job yet.) */
+#include "cmd/cmd_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static bb_status read_map(const char *path, bb_image *img, bb_image_info *info, bb_error *err) {
+  bb_error e = {{0}};
+  bb_status st = bb_image_read(path, img, info, &e);
+  return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
+}
+
+/* A map read as Half-Life 2's basis (bb_basis_map_check). */
+static bb_status check_hl2(const char *path, const bb_image *img, const bb_image_info *info,
+                           bb_error *err) {
+  bb_error e = {{0}};
+  bb_status st = bb_basis_map_check(img, info ? info->description : NULL, &e);
+  return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
+}
+
+/* The depth to write with: the one asked, else the input's where the
+ * format holds it (bb_depth_like_input). */
+static bb_depth output_depth(bb_depth asked, const bb_image_info *input, const char *path) {
+  if (asked != BB_DEPTH_DEFAULT || !input)
+    return asked;
+  return bb_depth_like_input(input->bits_per_sample, input->is_float, path);
+}
+
+static const char *file_name(const char *path) {
+  const char *slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
+}
+
+/* Writes img with provenance; input_name (a file name, or a program's
+ * text) and input may be NULL. */
+static bb_status write_map(const bb_command *c, const char *input_name, const bb_image *input,
+                           const char *kind, const bb_image *img, bb_range range, bb_depth depth,
+                           bb_command_result *r, bb_error *err) {
+  const bb_command_options *o = &c->options;
+  char *record = bb__command_record(c);
+  bb_provenance p = {record, input_name, input ? bb_image_hash(input) : 0, kind, NULL,
+                     BB_CHANNEL_AUTO, NULL, 0, NULL};
+  char *description = record ? bb_provenance_format(&p) : NULL;
+  bb_status st = BB_OK;
+  if (!description) {
+    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->output);
+  } else {
+    const bb_output_file file = {o->output, kind, img, range, depth, o->job.mips, description,
+                                 NULL, 0, &o->job.texture};
+    bb_error e = {{0}};
+    if ((st = bb_outputs_write(&file, 1, 1, &e)) != BB_OK)
+      bb__fail_at(err, st, o->output, &e);
+  }
+  free(description);
+  free(record);
+  return st == BB_OK ? bb__result_add(r, kind, o->output, err) : st;
+}
+
+/* -------------------------------------------------------- normal2ssbump */
+
+/* Appends the input's alpha (channel 3 of RGBA) to the weights, as Valve's
+ * tool rewrites only R, G and B. */
+static bb_status with_alpha(const bb_image *input, const bb_image_info *info,
+                            bb_image *weights, bb_error *err) {
+  const int alpha =
+      info->alpha_channel >= 3 ? info->alpha_channel : (input->channels >= 4 ? 3 : -1);
+  if (alpha < 0)
+    return BB_OK;
+  bb_image rgba;
+  bb_status st = bb_image_alloc(&rgba, weights->width, weights->height, 4, err);
+  if (st != BB_OK)
+    return st;
+  const size_t n = (size_t)weights->width * (size_t)weights->height;
+  for (size_t i = 0; i < n; i++) {
+    memcpy(rgba.pixels + 4 * i, weights->pixels + 3 * i, 3 * sizeof(float));
+    rgba.pixels[4 * i + 3] = input->pixels[i * (size_t)input->channels + (size_t)alpha];
+  }
+  bb_image_free(weights);
+  *weights = rgba;
+  return BB_OK;
+}
+
+bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
+                                bb_command_result *r, bb_error *err) {
+  (void)hooks;
+  const bb_command_options *o = &c->options;
+  const char *input = c->inputs[0];
+  bb_image values = {0}, normals = {0}, weights = {0};
+  bb_image_info info = {0};
+  bb_status st = read_map(input, &values, &info, err);
+  if (st == BB_OK) {
+    bb_normal_decode_options d;
+    bb_normal_decode_options_init(&d);
+    d.normal_y_up = o->maps_normal_y_up;
+    bb_error e = {{0}};
+    st = bb_normal_map_decode(&values, info.is_float, &d, &normals, &e);
+    if (st == BB_OK)
+      st = bb_derive_weights(&normals, NULL, &weights, &e);
+    if (st == BB_OK)
+      st = with_alpha(&values, &info, &weights, &e);
+    if (st != BB_OK)
+      bb__fail_at(err, st, input, &e);
+  }
+  if (st == BB_OK)
+    st = write_map(c, file_name(input), &values, "weights", &weights, BB_RANGE_UNIT,
+                   output_depth(o->job.depth, &info, o->output), r, err);
+  bb_image_free(&weights);
+  bb_image_free(&normals);
+  bb_image_free(&values);
+  bb_image_info_free(&info);
+  return st;
+}
+
+/* -------------------------------------------------------- ssbump2normal */
+
+bb_status bb__run_ssbump2normal(bb_command *c, const bb_command_hooks *hooks,
+                                bb_command_result *r, bb_error *err) {
+  (void)hooks;
+  const bb_command_options *o = &c->options;
+  const char *input = c->inputs[0];
+  bb_image ssbump = {0}, normals = {0};
+  bb_image_info info = {0};
+  bb_status st = read_map(input, &ssbump, &info, err);
+  if (st == BB_OK)
+    st = check_hl2(input, &ssbump, &info, err);
+  if (st == BB_OK) {
+    bb_error e = {{0}};
+    if ((st = bb_ssbump_to_normal(&ssbump, o->ssbump_kind, &normals, &e)) != BB_OK)
+      bb__fail_at(err, st, input, &e);
+  }
+  if (st == BB_OK) {
+    if (o->maps_normal_y_up)
+      bb_image_flip_green(&normals);
+    st = write_map(c, file_name(input), &ssbump, "normal", &normals, BB_RANGE_SIGNED,
+                   output_depth(o->job.depth, &info, o->output), r, err);
+  }
+  bb_image_free(&normals);
+  bb_image_free(&ssbump);
+  bb_image_info_free(&info);
+  return st;
+}
+
+/* -------------------------------------------------------------- combine */
+
+/* A map as read, and the values the library combines (normals decoded). */
+typedef struct map_input {
+  bb_image file, values;
+  bb_image_info info;
+} map_input;
+
+static void map_input_free(map_input *m) {
+  bb_image_free(&m->file);
+  bb_image_free(&m->values);
+  bb_image_info_free(&m->info);
+}
+
+static bb_status load_map(const bb_command_options *a, const char *path, map_input *m,
+                          bb_error *err) {
+  bb_status st = read_map(path, &m->file, &m->info, err);
+  /* --detail scales Half-Life 2's three channels; a blend is linear in
+   * every channel, so it takes maps of any basis (of the same count). */
+  if (st == BB_OK && a->detail && (a->map_kind == BB_MAP_SSBUMP || a->map_kind == BB_MAP_WEIGHTS))
+    st = check_hl2(path, &m->file, &m->info, err);
+  if (st != BB_OK || a->map_kind != BB_MAP_NORMAL)
+    return st;
+  /* Not renormalised: a texel the operators copy must keep its code. */
+  bb_normal_decode_options o;
+  bb_normal_decode_options_init(&o);
+  o.normal_y_up = a->maps_normal_y_up;
+  o.normalize = 0;
+  bb_error e = {{0}};
+  st = bb_normal_map_decode(&m->file, m->info.is_float, &o, &m->values, &e);
+  return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
+}
+
+static const bb_image *values_of(const map_input *m) {
+  return m->values.pixels ? &m->values : &m->file;
+}
+
+static bb_status load_mask(const char *path, bb_image *mask, bb_error *err) {
+  map_input m = {{0}, {0}, {0}};
+  bb_status st = read_map(path, &m.file, &m.info, err);
+  if (st == BB_OK) {
+    bb_error e = {{0}};
+    st = bb_height_from_image(&m.file, m.info.alpha_channel, BB_CHANNEL_AUTO, mask, &e);
+    if (st != BB_OK)
+      bb__fail_at(err, st, path, &e);
+  }
+  map_input_free(&m);
+  return st;
+}
+
+/* Runs the library; errors about two images name the first input. */
+static bb_status combine_maps(const bb_command_options *a, const char *first,
+                              const map_input *m, const bb_image *mask, bb_image *out,
+                              bb_error *err) {
+  bb_error e = {{0}};
+  bb_status st;
+  if (a->brightness) {
+    st = bb_combine_brightness(values_of(&m[0]), &m[1].file, a->map_kind, out, &e);
+  } else if (a->detail) {
+    float flat[3];
+    bb_map_flat_texel(a->map_kind, m[1].info.bits_per_sample, m[1].info.is_float, flat);
+    st = bb_combine_detail(values_of(&m[0]), values_of(&m[1]), a->map_kind, flat, out, &e);
+  } else {
+    st = bb_combine_blend(values_of(&m[0]), values_of(&m[1]), mask->pixels ? mask : NULL,
+                          (float)a->mix, a->map_kind, out, &e);
+  }
+  return st == BB_OK ? BB_OK : bb__fail_at(err, st, first, &e);
+}
+
+bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                          bb_error *err) {
+  (void)hooks;
+  const bb_command_options *a = &c->options;
+  const char *in[2] = {c->inputs[0], a->brightness ? a->brightness : c->inputs[1]};
+  map_input m[2] = {{{0}, {0}, {0}}, {{0}, {0}, {0}}};
+  bb_image mask = {0}, out = {0};
+  bb_status st = load_map(a, in[0], &m[0], err);
+  if (st == BB_OK && a->brightness) /* a grey to multiply by, whatever the kind */
+    st = read_map(in[1], &m[1].file, &m[1].info, err);
+  else if (st == BB_OK)
+    st = load_map(a, in[1], &m[1], err);
+  if (st == BB_OK && a->mask)
+    st = load_mask(a->mask, &mask, err);
+  if (st == BB_OK)
+    st = combine_maps(a, in[0], m, &mask, &out, err);
+  if (st == BB_OK) {
+    const int normal = a->map_kind == BB_MAP_NORMAL;
+    if (normal && a->maps_normal_y_up)
+      bb_image_flip_green(&out); /* back to the inputs' convention */
+    st = write_map(c, file_name(in[0]), &m[0].file, bb_map_kind_name(a->map_kind), &out,
+                   normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT,
+                   output_depth(a->job.depth, &m[0].info, a->output), r, err);
+  }
+  bb_image_free(&out);
+  bb_image_free(&mask);
+  map_input_free(&m[0]);
+  map_input_free(&m[1]);
+  return st;
+}
+
+/* -------------------------------------------------------------- program */
+
+bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                          bb_error *err) {
+  (void)hooks;
+  const bb_command_options *o = &c->options;
+  const char *text = c->inputs[0];
+  bb_program *program = NULL;
+  bb_status st = bb_program_parse(text, &program, err);
+  if (st != BB_OK)
+    return st;
+  bb_program_options po;
+  bb_program_options_init(&po);
+  po.base_dir = o->base_dir;
+  po.allow_outside_base = o->allow_outside_base;
+  bb_image out = {0};
+  int is_normal = 0;
+  /* the message names the image file or the function at fault */
+  st = bb_program_run(program, &po, &out, &is_normal, err);
+  bb_program_free(program);
+  if (st == BB_OK)
+    st = write_map(c, text, NULL, is_normal ? "normal" : "colour", &out,
+                   is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, o->job.depth, r, err);
+  bb_image_free(&out);
+  return st;
+}

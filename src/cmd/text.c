@@ -1,0 +1,47 @@
+/* text.c: a command spelled back as text through the descriptions: the
+ * provenance's command (the options that determine the output) and the
+ * hand-over of a command to another process (every option). */
+#include "cmd/cmd_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* " --name value" of every option given, in the order of --help; only
+ * those that determine what is made when recorded. */
+void bb__add_options(const bb_command *c, unsigned flags, bb__text *t) {
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (!c->given[i] || (o->info.flags & BB_OPTION_CLIENT) ||
+        ((flags & BB_OPTION_RECORDED) && !(o->info.flags & BB_OPTION_RECORDED)))
+      continue;
+    bb__text_printf(t, " --%s", o->info.name);
+    if (o->info.type == BB_OPTION_FLAG)
+      continue;
+    bb__text_add(t, " ");
+    if (o->print)
+      o->print(c, o, t);
+    else
+      bb__print_generic(c, o, t);
+  }
+}
+
+char *bb_command_text(const bb_command *c, const char *input, unsigned flags) {
+  if (!c)
+    return NULL;
+  bb__text t = {0};
+  bb__text_printf(&t, "bumpbake %s", c->def->info.name);
+  for (int i = 0; i < c->input_count; i++)
+    bb__text_printf(&t, " %s", i == 0 && input ? input : c->inputs[i]);
+  if (!c->input_count && input)
+    bb__text_printf(&t, " %s", input);
+  bb__add_options(c, flags, &t);
+  return bb__text_take(&t);
+}
+
+
+char *bb__command_record(const bb_command *c) {
+  if (c->record_line)
+    return strdup(c->record_line);
+  return bb_command_text(c, NULL, BB_OPTION_RECORDED);
+}
+

@@ -1,0 +1,241 @@
+/* values.c: an option's value from text, by its type: the one function of
+ * each rule (an integer, a number, one of an enum's words, a list of
+ * numbers, a path), whose words every client prints; and the value spelled
+ * back as the option takes it, for the provenance's command and for
+ * handing a command to another process. Ranges are checked by
+ * bb_command_check, against each parameter's one range. Also what every
+ * file of the family needs of a command: its strings kept, its options
+ * found by name. */
+#include "cmd/cmd_internal.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+char *bb__command_keep(bb_command *c, const char *text) {
+  if (c->string_count == c->string_capacity) {
+    const int cap = c->string_capacity ? 2 * c->string_capacity : 16;
+    char **grown = realloc(c->strings, (size_t)cap * sizeof *grown);
+    if (!grown)
+      return NULL;
+    c->strings = grown;
+    c->string_capacity = cap;
+  }
+  char *copy = strdup(text);
+  if (copy)
+    c->strings[c->string_count++] = copy;
+  return copy;
+}
+
+int bb__given(const bb_command *c, const char *name) {
+  const int i = bb__option_find(c->def, name);
+  return i >= 0 && c->given[i];
+}
+
+/* name (its first length characters) is the option's long name, '_' read
+ * as '-'. */
+int bb__names_option(const char *name, size_t length, const char *option) {
+  if (strlen(option) != length)
+    return 0;
+  for (size_t i = 0; i < length; i++)
+    if ((name[i] == '_' ? '-' : name[i]) != option[i])
+      return 0;
+  return 1;
+}
+
+int bb__option_find(const bb__command *c, const char *name) {
+  for (int i = 0; name && c->options[i]; i++)
+    if (bb__names_option(name, strlen(name), c->options[i]->info.name))
+      return i;
+  return -1;
+}
+
+void bb__option_spelling(const bb__option *o, char *out, size_t cap) {
+  snprintf(out, cap, "--%s", o->info.name);
+}
+
+void bb__choices(const bb__option *o, char *out, size_t cap) {
+  size_t used = 0;
+  out[0] = '\0';
+  for (int i = 0; o->names && i < 64; i++) {
+    const char *name = o->names(i);
+    if (!name || !strcmp(name, "unknown"))
+      break;
+    if (!strcmp(name, "default")) /* the enum's "not asked", no word of its own */
+      continue;
+    int n = snprintf(out + used, cap - used, "%s%s", used ? "|" : "", name);
+    if (n < 0 || (size_t)n >= cap - used)
+      break;
+    used += (size_t)n;
+  }
+}
+
+static void *field_of(bb_command *c, const bb__option *o) {
+  return (char *)&c->options + o->offset;
+}
+
+static const void *field_of_const(const bb_command *c, const bb__option *o) {
+  return (const char *)&c->options + o->offset;
+}
+
+/* The integer of text: the whole text, decimal. */
+static bb_status parse_integer(const bb__option *o, const char *text, double *v, bb_error *err) {
+  char name[80];
+  bb__option_spelling(o, name, sizeof name);
+  char *end = NULL;
+  errno = 0;
+  const long long x = strtoll(text, &end, 10);
+  if (end == text || *end != '\0')
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s needs an integer (got '%.64s')", name, text);
+  *v = errno == ERANGE ? (x < 0 ? -HUGE_VAL : HUGE_VAL) : (double)x;
+  /* what an int cannot hold is out of any range an option has */
+  if (*v < INT_MIN || *v > INT_MAX)
+    return o->range ? bb__range_check(o->range, *v, name, err)
+                    : bb__fail(err, BB_ERR_ARGUMENT, "%s is out of range (got %.64s)", name,
+                               text);
+  return BB_OK;
+}
+
+/* A finite number: the whole text as strtod reads it (a denormal such as
+ * 5e-324 is a number; 1e999 is not finite). */
+static bb_status parse_number(const bb__option *o, const char *text, double *v, bb_error *err) {
+  char name[80];
+  bb__option_spelling(o, name, sizeof name);
+  char *end = NULL;
+  const double x = strtod(text, &end);
+  if (end == text || *end != '\0' || !isfinite(x))
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s needs a number (got '%.64s')", name, text);
+  *v = x;
+  return BB_OK;
+}
+
+bb_status bb__parse_numbers(const bb__option *o, const char *text, int count, int integers,
+                            double *v, bb_error *err) {
+  char name[80];
+  bb__option_spelling(o, name, sizeof name);
+  const char *p = text;
+  const int words = o->info.values > 1;
+  for (int i = 0; i < count; i++) {
+    char *end = NULL;
+    while (words && *p == ' ')
+      p++;
+    v[i] = integers ? (double)strtol(p, &end, 10) : strtod(p, &end);
+    const int last = i + 1 == count;
+    const char sep = words ? ' ' : ',';
+    if (end == p || !isfinite(v[i]) || (last ? *end != '\0' : *end != sep)) {
+      if (words)
+        return bb__fail(err, BB_ERR_ARGUMENT, "%s needs %d %s: %s %s (got '%.64s')", name,
+                        count, integers ? "integers" : "numbers", name, o->info.value_name,
+                        text);
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s needs %s: %d comma-separated %s (got '%.64s')",
+                      name, o->info.value_name, count, integers ? "integers" : "numbers",
+                      text);
+    }
+    p = end + 1;
+  }
+  return BB_OK;
+}
+
+static bb_status parse_word(const bb__option *o, const char *text, int *value, bb_error *err) {
+  if (o->parse(text, value))
+    return BB_OK;
+  char name[80], choices[256];
+  bb__option_spelling(o, name, sizeof name);
+  bb__choices(o, choices, sizeof choices);
+  for (char *bar = strchr(choices, '|'); bar; bar = strchr(bar, '|'))
+    *bar = ',';
+  /* ", " between the words, as every enum parser of the library lists them */
+  char listed[320] = "";
+  for (const char *w = choices; *w;) {
+    const size_t n = strcspn(w, ",");
+    snprintf(listed + strlen(listed), sizeof listed - strlen(listed), "%s%.*s",
+             listed[0] ? ", " : "", (int)n, w);
+    w += n + (w[n] == ',');
+  }
+  return bb__fail(err, BB_ERR_ARGUMENT, "%s must be one of %s (got '%.64s')", name, listed,
+                  text);
+}
+
+bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
+                          double *values, int *count, bb_error *err) {
+  char name[80];
+  bb__option_spelling(o, name, sizeof name);
+  void *field = field_of(c, o);
+  bb_status st = BB_OK;
+  *count = o->info.type == BB_OPTION_INT || o->info.type == BB_OPTION_NUMBER;
+  switch (o->info.type) {
+  case BB_OPTION_FLAG:
+    if (text && *text && strcmp(text, "1") != 0)
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s takes no value", name);
+    if (o->field == BB__FIELD_INT)
+      *(int *)field = 1;
+    return BB_OK;
+  case BB_OPTION_INT:
+    st = parse_integer(o, text, &values[0], err);
+    if (st == BB_OK && o->field == BB__FIELD_INT)
+      *(int *)field = (int)values[0];
+    return st;
+  case BB_OPTION_NUMBER:
+    st = parse_number(o, text, &values[0], err);
+    if (st == BB_OK && o->field == BB__FIELD_FLOAT)
+      *(float *)field = (float)values[0];
+    else if (st == BB_OK && o->field == BB__FIELD_DOUBLE)
+      *(double *)field = values[0];
+    return st;
+  case BB_OPTION_WORD: {
+    int v = 0;
+    st = parse_word(o, text, &v, err);
+    if (st == BB_OK && (o->field == BB__FIELD_ENUM || o->field == BB__FIELD_INT))
+      *(int *)field = v;
+    return st;
+  }
+  case BB_OPTION_PATH:
+  case BB_OPTION_TEXT: {
+    if (o->info.type == BB_OPTION_PATH && !*text)
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s needs a path (got '')", name);
+    if (o->field != BB__FIELD_STRING)
+      return bb__fail(err, BB_ERR_ARGUMENT, "%s: no field to set", name);
+    char *kept = bb__command_keep(c, text);
+    if (!kept)
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    *(const char **)field = kept;
+    return BB_OK;
+  }
+  case BB_OPTION_WORDS:
+  case BB_OPTION_NUMBERS:
+    break;
+  }
+  return bb__fail(err, BB_ERR_ARGUMENT, "%s: no parser", name);
+}
+
+void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
+  const void *field = field_of_const(c, o);
+  char buf[48];
+  switch (o->field) {
+  case BB__FIELD_INT:
+    if (o->info.type == BB_OPTION_WORD)
+      bb__text_add(t, o->names(*(const int *)field));
+    else if (o->info.type != BB_OPTION_FLAG)
+      bb__text_printf(t, "%d", *(const int *)field);
+    return;
+  case BB__FIELD_FLOAT:
+    bb__float_text(*(const float *)field, buf, sizeof buf);
+    bb__text_add(t, buf);
+    return;
+  case BB__FIELD_DOUBLE:
+    bb__double_text(*(const double *)field, buf, sizeof buf);
+    bb__text_add(t, buf);
+    return;
+  case BB__FIELD_STRING:
+    bb__text_add(t, *(const char *const *)field);
+    return;
+  case BB__FIELD_ENUM:
+    bb__text_add(t, o->names(*(const int *)field));
+    return;
+  case BB__FIELD_NONE:
+    return;
+  }
+}

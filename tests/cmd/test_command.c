@@ -1,0 +1,251 @@
+/* test_command.c: the commands described once (bb_command_*): options set
+ * through their parsers, their ranges checked against the library's one
+ * range each, the rules between options, the command spelled back as text
+ * (what provenance records, and a hand-over that reads back the same). */
+#include "bumpbake.h"
+
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static bb_command *command(const char *name, const char *const *words) {
+  bb_command *c = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_new(name, &c, &err), BB_OK, "%s", err.message);
+  for (int i = 0; words && words[i]; i++) {
+    if (words[i][0] != '-') {
+      cr_assert_eq(bb_command_add_input(c, words[i], &err), BB_OK, "%s", err.message);
+      continue;
+    }
+    const bb_option_info *o = bb_option_find(bb_command_describe(c), words[i] + 2, 0);
+    cr_assert_not_null(o, "%s", words[i]);
+    const char *value = o->type == BB_OPTION_FLAG ? NULL : words[++i];
+    cr_assert_eq(bb_command_set(c, o->name, value, &err), BB_OK, "%s: %s", words[i],
+                 err.message);
+  }
+  return c;
+}
+
+/* A refusal by set or check, and its words. */
+static void refused(const char *name, const char *const *words, const char *message) {
+  bb_command *c = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_new(name, &c, &err), BB_OK);
+  bb_status st = BB_OK;
+  for (int i = 0; words[i] && st == BB_OK; i++) {
+    if (words[i][0] != '-') {
+      st = bb_command_add_input(c, words[i], &err);
+      continue;
+    }
+    const bb_option_info *o = bb_option_find(bb_command_describe(c), words[i] + 2, 0);
+    const char *value = o && o->type != BB_OPTION_FLAG ? words[++i] : NULL;
+    st = bb_command_set(c, words[i - (value ? 1 : 0)] + 2, value, &err);
+  }
+  if (st == BB_OK)
+    st = bb_command_check(c, &err);
+  cr_expect_eq(st, BB_ERR_ARGUMENT, "%s: refused: %s", message, err.message);
+  cr_expect_str_eq(err.message, message);
+  bb_command_free(c);
+}
+
+/* What provenance records: the options that change the output, in the
+ * order of --help, spelled as typed; -q, --json, --threads, --depfile and
+ * a batch's --force are left out, since they change no byte. */
+Test(cmd, recorded_text_spells_what_changes_the_output) {
+  const char *words[] = {"heights/a.png", "--scale", "16", "--out-dir", "out", "--maps",
+                         "normal,ao", "--threads", "2", "--json", "--quiet", "--force",
+                         "--depfile", "d.d", NULL};
+  bb_command *c = command("bake", words);
+  cr_assert_eq(bb_command_check(c, NULL), BB_OK);
+  char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
+  free(text);
+  text = bb_command_text(c, "b.png", 0); /* every option but the client's own */
+  cr_expect_str_eq(text, "bumpbake bake b.png --scale 16 --threads 2 --out-dir out --maps "
+                         "normal,ao --force --depfile d.d");
+  free(text);
+  bb_command_free(c);
+
+  const char *more[] = {"a.png", "--scale", "0.1", "--rays", "64", "--channel", "a",
+                        "--depth", "16", "--mips", "--out-dir", "out", "--name",
+                        "{kind}/{stem}.tif", NULL};
+  c = command("bake", more);
+  text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
+                         "--mips --out-dir out --name {kind}/{stem}.tif");
+  free(text);
+  bb_command_free(c);
+}
+
+/* The engine textures' settings and the material come last, as in --help,
+ * spelled as the parser reads them back. */
+Test(cmd, recorded_text_spells_the_texture_options) {
+  const char *words[] = {"h.png", "--scale", "64", "--ssbump", "m/rock-ssbump.vtf",
+                         "--texture-format", "dxt5", "--vtf-version", "3", "--vtf-flags",
+                         "4", "--nomip", "--fast-compression", "--vmt", "m/rock.vmt",
+                         "--materials", "m", "--basetexture", "m/rock.vtf", NULL};
+  bb_command *c = command("bake", words);
+  cr_assert_eq(bb_command_check(c, NULL), BB_OK);
+  char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
+                         "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
+                         "--fast-compression --vmt m/rock.vmt --materials m "
+                         "--basetexture m/rock.vtf");
+  free(text);
+  bb_command_free(c);
+}
+
+/* A command's text reads back into the same command (the hand-over of a
+ * planned command to another process). */
+Test(cmd, text_reads_back_the_same) {
+  const char *words[] = {"h.png", "--scale", "36.8083", "--rays", "100", "--bias", "0.3",
+                         "--power", "2.5", "--basis", "dirs:6", "--normal-filter", "sobel",
+                         "--normal-y", "up", "--clamp", "--channel", "luma", "--bounce",
+                         "0.25", "--bounces", "3", "--ssbump", "s.exr", "--slope", "sl.png",
+                         "--lit", "135,45.5", "--threads", "3", NULL};
+  bb_command *c = command("bake", words);
+  cr_assert_eq(bb_command_check(c, NULL), BB_OK);
+  char *text = bb_command_text(c, NULL, 0);
+  /* split the text back into words (no word here holds a blank) */
+  char *copy = strdup(text), *argv[64];
+  int n = 0;
+  for (char *w = strtok(copy, " "); w && n < 63; w = strtok(NULL, " "))
+    argv[n++] = w;
+  argv[n] = NULL;
+  cr_assert(n > 3 && !strcmp(argv[0], "bumpbake") && !strcmp(argv[1], "bake"));
+  bb_command *back = command("bake", (const char *const *)argv + 2);
+  char *again = bb_command_text(back, NULL, 0);
+  cr_expect_str_eq(again, text);
+  const bb_command_options *a = bb_command_options_of(c), *b = bb_command_options_of(back);
+  cr_expect_eq(a->job.bake.height_scale, b->job.bake.height_scale);
+  cr_expect_eq(a->job.slope_lit_elevation, b->job.slope_lit_elevation);
+  cr_expect_eq(a->job.bake.basis.count, 6);
+  free(again);
+  free(text);
+  free(copy);
+  bb_command_free(back);
+  bb_command_free(c);
+}
+
+/* Each option's range is its parameter's one range: the help spells it
+ * from the library's constants, the check refuses outside it in the same
+ * words for every client. */
+Test(cmd, ranges_are_the_library_constants) {
+  const bb_command_info *bake = bb_command_info_find("bake");
+  char text[160];
+  char expect[64];
+  bb_option_range_text(bb_option_find(bake, "rays", 0), text, sizeof text);
+  snprintf(expect, sizeof expect, "1..%d", BB_MAX_RAYS);
+  cr_expect_str_eq(text, expect);
+  bb_option_range_text(bb_option_find(bake, "bounces", 0), text, sizeof text);
+  snprintf(expect, sizeof expect, "0..%d", BB_MAX_BOUNCES);
+  cr_expect_str_eq(text, expect);
+  double min, max;
+  int exclusive;
+  cr_assert(bb_option_bounds(bb_option_find(bake, "filter_radius", 0), &min, &max, &exclusive));
+  cr_expect(min == 0 && max == BB_MAX_FILTER_RADIUS && !exclusive);
+  cr_assert(bb_option_bounds(bb_option_find(bake, "scale", 0), &min, &max, &exclusive));
+  cr_expect(min == 0 && exclusive);
+  const bb_command_info *render = bb_command_info_find("render");
+  bb_option_range_text(bb_option_find(render, "specular", 0), text, sizeof text);
+  cr_expect_str_eq(text, "0..100000");
+
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--rays", "0", NULL},
+          "--rays must be in 1..65536 (got 0)");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--slices", "0", NULL},
+          "--slices must be in 1..256 (got 0)");
+  refused("bake", (const char *[]){"h.png", "--scale", "-1", NULL},
+          "--scale must be > 0 (got -1)");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--bounce", "1.5", "--ao",
+                                   "a.png", NULL},
+          "--bounce must be in 0..1 (got 1.5)");
+  refused("render", (const char *[]){"--ssbump", "s.png", "--output", "x.png", "--specular",
+                                     "1e6", NULL},
+          "--specular must be in 0..100000 (got 1e6)");
+  refused("render", (const char *[]){"--ssbump", "s.png", "--output", "x.png", "--light",
+                                     "0,95", NULL},
+          "--light elevation must be in 0..90 (got 95)");
+  /* a denormal is a number (5e-324 was "needs a number") */
+  const char *tiny[] = {"h.png", "--scale", "1", "--bounce", "5e-324", "--ao", "a.png", NULL};
+  bb_command *c = command("bake", tiny);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  bb_command_free(c);
+}
+
+/* An option given where it does nothing is refused, naming what it needs. */
+Test(cmd, options_that_do_nothing_are_refused) {
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--normal", "n.png",
+                                   "--texture-format", "bc3", NULL},
+          "--texture-format does nothing without a .vtf or .dds output");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--normal", "n.dds",
+                                   "--vtf-version", "7.3", NULL},
+          "--vtf-version does nothing without a .vtf output");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--normal", "n.png", "--nomip",
+                                   NULL},
+          "--nomip does nothing without a .vtf or .dds output");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--bounces", "2",
+                                   NULL},
+          "--bounces does nothing without --bounce RHO or --bounce-albedo FILE");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--normal", "n.png", "--bounce",
+                                   "0.5", NULL},
+          "--bounce does nothing without a traced map (--ssbump, --ao, --bent)");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--brightness",
+                                   "b.png", NULL},
+          "--brightness does nothing without an ssbump or weights map");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--materials", "",
+                                   NULL},
+          "--materials needs a path (got '')");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--force", NULL},
+          "--force is for batches: give --out-dir DIR");
+  /* a batch's name template stands for its outputs */
+  const char *batch[] = {"h.png", "--scale", "1", "--out-dir", "o", "--name",
+                         "{stem}_{kind}.vtf", "--texture-format", "bc3", NULL};
+  bb_command *c = command("bake", batch);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  bb_command_free(c);
+}
+
+/* Names: an unknown option or command gets the nearest, Python's spelling
+ * (filter_radius) finds the option, the enums' own names are the words. */
+Test(cmd, names_and_did_you_mean) {
+  bb_command *c = NULL;
+  bb_error err = {{0}};
+  cr_expect_eq(bb_command_new("bkae", &c, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "unknown command 'bkae' (did you mean bake?)");
+  cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+  cr_expect_eq(bb_command_set(c, "filter_radus", "3", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "unknown option '--filter_radus' (did you mean --filter-radius?)");
+  cr_expect_eq(bb_command_set(c, "filter_radius", "3", &err), BB_OK);
+  cr_expect_eq(bb_command_options_of(c)->job.bake.smooth.radius_texels, 3);
+  cr_expect_eq(bb_command_set(c, "normal-filter", "fancy", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message,
+                   "--normal-filter must be one of valve, central, sobel, vertex (got 'fancy')");
+  bb_command_free(c);
+  char words[128];
+  bb_option_choices(bb_option_find(bb_command_info_find("bake"), "normal-y", 0), words,
+                    sizeof words);
+  cr_expect_str_eq(words, "down|up");
+}
+
+/* height2ssbump through the job: Valve's file named next to FILE, its
+ * BUMPSCALE the scale, the second positional no input. */
+Test(cmd, height2ssbump_plans_a_job) {
+  bb_command *c = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_new("height2ssbump", &c, &err), BB_OK);
+  cr_assert_eq(bb_command_add_input(c, "dir/rock.png", &err), BB_OK);
+  cr_expect_eq(bb_command_add_input(c, "zero", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "BUMPSCALE needs a number (got 'zero')");
+  cr_expect_eq(bb_command_add_input(c, "0", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "BUMPSCALE must be > 0 (got 0)");
+  cr_assert_eq(bb_command_add_input(c, "16", &err), BB_OK);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  const bb_command_options *o = bb_command_options_of(c);
+  cr_expect_eq(o->job.bake.height_scale, 16.0f);
+  cr_expect_eq(o->job.bake.rays, 250);
+  cr_expect_eq(o->job.channel, BB_CHANNEL_VALVE);
+  cr_expect(bb_command_has_job(bb_command_describe(c)));
+  bb_command_free(c);
+}
