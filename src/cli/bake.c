@@ -18,10 +18,12 @@ typedef struct printer {
   const bb_command_options *o;
   int batch;
   int counts[5]; /* by bb_job_outcome */
+  cli_progress *progress; /* cleared before a report is printed */
 } printer;
 
 static void print_report(void *user, const bb_job_report *r) {
   printer *p = user;
+  cli_progress_finish(p->progress);
   p->counts[r->outcome]++;
   if (r->outcome == BB_JOB_FAILED)
     cli_error_line(r->error.message[0] ? r->error.message : bb_status_name(r->status));
@@ -76,9 +78,9 @@ int cli_run_job(const cli_run *r) {
   bb_status st = bb_command_plan(r->command, &hooks, &job, &err);
   if (st != BB_OK)
     return cli_library_error(name, st, &err);
-  printer p = {r->options, r->options->job.out_dir != NULL, {0}};
   cli_progress progress;
   cli_progress_start(&progress, name, r->options->quiet);
+  printer p = {r->options, r->options->job.out_dir != NULL, {0}, &progress};
   st = bb_job_run(job, cli_progress_fn(&progress), &progress, print_report, &p, &err);
   cli_progress_finish(&progress);
   int rc = BB_EXIT_OK;
