@@ -1251,8 +1251,8 @@ typedef struct bb_bake_options {
                                  the first; 3 or more: Rec. 709 luma of R, G,
                                  B), clamped to [0, 1], multiplies rho at each
                                  vertex, linear over each triangle. Not owned;
-                                 with bounce_albedo 0 it bounces with rho 1
-                                 (the map's albedo as it is) */
+                                 ignored while bounce_albedo is 0 (a job given
+                                 only bounce_albedo_file bounces with rho 1) */
   int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
                                  times; 0 (default): converged (each
                                  triangle's light estimated from what it

@@ -82,8 +82,6 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
 void bb__bake_resolve(bb_bake_options *o) {
   if (o->outputs & BB_OUTPUTS_TRACED)
     o->slices = bb_bake_slices(o);
-  if (o->bounce_albedo_map && o->bounce_albedo == 0.0)
-    o->bounce_albedo = 1.0; /* a map alone bounces with its albedo as it is */
 }
 
 bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err) {

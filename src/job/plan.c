@@ -786,8 +786,12 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = bb__bake_prepare(&job->options.bake, &job->options.bake, err);
   if (st == BB_OK)
     st = read_bake_maps(job, err);
-  if (st == BB_OK)
-    bb__bake_resolve(&job->options.bake); /* a map's rho */
+  /* The job's rule (bake --bounce-albedo FILE without --bounce): a map
+   * alone bounces with its albedo as it is, rho 1. bb_bake itself ignores a
+   * map while rho is 0, as bumpbake.h says. */
+  if (st == BB_OK && job->options.bake.bounce_albedo_map &&
+      job->options.bake.bounce_albedo == 0.0)
+    job->options.bake.bounce_albedo = 1.0;
   if (st == BB_OK && job->batch)
     st = check_template(job->name_template, err);
   if (st == BB_OK)
