@@ -288,7 +288,7 @@ $(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dir
 	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
 $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
                 $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
