@@ -428,10 +428,14 @@ static inline __attribute__((always_inline)) lanes_z lanes_load(const float *z) 
   return __builtin_convertvector(f, lanes_z);
 }
 
-/* a < b ? a : b in each lane, as the scalar code takes its minima. */
-static inline __attribute__((always_inline)) lanes_z lanes_min(lanes_z a, lanes_z b) {
-  const lanes_mask less = a < b;
-  return (lanes_z)(((lanes_mask)a & less) | ((lanes_mask)b & ~less));
+/* *out = *a < *b ? *a : *b in each lane, as the scalar code takes its
+ * minima (out may be b). Pointers, not vector arguments: clang refuses a
+ * 4-double vector argument in the target_clones default (non-AVX) clone,
+ * which `make fuzz` builds with. */
+static inline __attribute__((always_inline)) void lanes_min(lanes_z *out, const lanes_z *a,
+                                                            const lanes_z *b) {
+  const lanes_mask less = *a < *b;
+  *out = (lanes_z)(((lanes_mask)*a & less) | ((lanes_mask)*b & ~less));
 }
 
 /* step_heights for the lines side by side, the first at texel (bx, by). */
@@ -515,13 +519,17 @@ static void profile_fill_lanes(const sweep_job *job, const fill_block *fb, int x
           CHORD_RISE(z[i - 2], z[i], z[i + 1], u[i - 2], u[i], u[i + 1]) + job->open_a[i - base];
       const lanes_z wide_b =
           CHORD_RISE(z[i - 1], z[i], z[i + 2], u[i - 1], u[i], u[i + 2]) + job->open_b[i - base];
-      rise[i] = lanes_min(lanes_min(wide_a, wide_b), rise[i]);
+      lanes_z wide;
+      lanes_min(&wide, &wide_a, &wide_b);
+      lanes_min(&rise[i], &wide, &rise[i]);
     }
     for (int s = 0; s < s1 - s0; s++) {
       const int st = base + s * tcount - 1, e = st + tcount;
       if (st < 0) continue;
-      for (int k = st + 1; k < e; k++)
-        rise[k] = lanes_min(CHORD_RISE(z[st], z[k], z[e], u[st], u[k], u[e]), rise[k]);
+      for (int k = st + 1; k < e; k++) {
+        const lanes_z chord = CHORD_RISE(z[st], z[k], z[e], u[st], u[k], u[e]);
+        lanes_min(&rise[k], &chord, &rise[k]);
+      }
     }
     if (s0 == 0) rise[0] = (lanes_z){0} + 1.0; /* the first point is an end */
     /* the verdicts of points 0 .. n-2 (the last waits for the next block) */
