@@ -507,12 +507,25 @@ bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
     data += level_bytes(info->format, w, hh, d);
     w = w > 1 ? w / 2 : 1, hh = hh > 1 ? hh / 2 : 1, d = d > 1 ? d / 2 : 1;
   }
-  data *= (uint64_t)(info->frames > 0 ? info->frames : 1) * (uint64_t)faces;
-  info->data_size = (long)data;
   if (level_bytes(info->format, 1, 1, 1) == 0) {
     st = bb__fail(err, BB_ERR_FORMAT, "%s: unknown VTF image format %d", path, info->format);
     goto done;
   }
+  /* One frame's levels fit 64 bits (65535^3 x 16 x 8/7 < 2^53), their
+   * product with frames x faces may not: 32768^3 x 16 x 32768 frames
+   * wraps to 0 and would pass the check below. Past the file's size it
+   * is truncated, whatever the product. */
+  const uint64_t copies = (uint64_t)(info->frames > 0 ? info->frames : 1) * (uint64_t)faces;
+  if (data > file_size / copies) {
+    st = bb__fail(err, BB_ERR_FORMAT,
+                  "%s: truncated VTF: its header declares %llu bytes of image data a frame "
+                  "x %llu frames and faces, the file has %llu bytes",
+                  path, (unsigned long long)data, (unsigned long long)copies,
+                  (unsigned long long)file_size);
+    goto done;
+  }
+  data *= copies;
+  info->data_size = (long)data;
   /* Each part said where it lies: the low-resolution image and the image
    * data are checked apart (a low-resolution resource past the end once
    * gave "needs 3636 bytes, the file has 3636"). */
@@ -524,7 +537,7 @@ bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
                   (unsigned long long)file_size);
     goto done;
   }
-  if (image_at + data > file_size) {
+  if (image_at > file_size || data > file_size - image_at) {
     st = bb__fail(err, BB_ERR_FORMAT,
                   "%s: truncated VTF: its image data (%llu bytes at offset %llu) ends past "
                   "the end of the file (%llu bytes)",

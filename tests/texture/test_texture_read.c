@@ -70,6 +70,11 @@ static void spill(const char *path, const unsigned char *data, size_t size) {
   cr_assert_eq(fclose(f), 0);
 }
 
+static void put_u16(unsigned char *p, unsigned v) {
+  p[0] = (unsigned char)(v & 0xff);
+  p[1] = (unsigned char)(v >> 8);
+}
+
 static void put_u32(unsigned char *p, uint32_t v) {
   for (int k = 0; k < 4; k++)
     p[k] = (unsigned char)(v >> (8 * k));
@@ -340,6 +345,35 @@ Test(texture_read, hostile_vtf_headers) {
   free(v3);
   free(f);
 #undef CASE
+}
+
+/* The header's declared data size is levels x frames x faces: 32768^3
+ * RGBA32323232F texels (2^49 bytes a frame) x 32768 frames is 2^64, which
+ * wrapped to 0 in 64 bits and passed the "truncated" check, so info
+ * answered for a 200-byte file declaring 16 EiB. */
+Test(texture_read, vtf_declared_size_product_does_not_wrap) {
+  size_t size;
+  unsigned char *f = valid_vtf(2, &size);
+  put_u16(f + 16, 32768);
+  put_u16(f + 18, 32768);
+  put_u16(f + 24, 32768); /* frames */
+  put_u32(f + 52, 29);    /* RGBA32323232F */
+  f[56] = 1;              /* one level */
+  put_u16(f + 63, 32768); /* depth */
+  const char *path = in_dir("wraps.vtf");
+  spill(path, f, size);
+  bb_vtf_info info;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
+  cr_assert_not_null(strstr(err.message, "truncated VTF"), "%s", err.message);
+  cr_assert_not_null(strstr(err.message, path), "%s", err.message);
+  cr_assert_null(strchr(err.message, '\n'), "%s", err.message);
+  expect_refused(path, "declared size wrapping to 0");
+  /* one frame of the same is refused too, by the plain check */
+  put_u16(f + 24, 1);
+  spill(path, f, size);
+  cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
+  free(f);
 }
 
 Test(texture_read, hostile_sizes_are_refused_before_allocating) {
