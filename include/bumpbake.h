@@ -518,6 +518,32 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 /* Frees info->description and clears it; safe on a zeroed struct. */
 void bb_vtf_info_free(bb_vtf_info *info);
 
+/* What a DDS file's header says (bb_dds_read_info), as bb_image_read reads
+ * it: the same checks, so a file this describes is one the reader takes. */
+typedef struct bb_dds_info {
+  int width, height;     /* of the top level, in texels */
+  int mip_count;         /* levels stored, 1 when the header declares none */
+  char fourcc[5];        /* the pixel format's FourCC ("DXT1", "ATI2", "DX10"),
+                            "" for an uncompressed masked format */
+  int dxgi_format;       /* the DX10 header's DXGI_FORMAT code, 0 without one */
+  char format_name[32];  /* as read: "DXT1", "DXT5", "BC4", "BC5" (legacy
+                            FourCCs), "BC1_UNORM", "R16G16B16A16_FLOAT"... (DX10),
+                            and for a masked format its channels' widths:
+                            "R5G6B5", "R8G8B8A8", "L8A8", "A8" */
+  char compression[8];   /* "BC1" to "BC5", or "none" */
+  uint32_t pixel_flags;  /* DDS_PIXELFORMAT flags: 0x1 ALPHAPIXELS, 0x2 ALPHA,
+                            0x4 FOURCC, 0x40 RGB, 0x20000 LUMINANCE,
+                            0x80000000 NORMAL (NVIDIA's: a tangent-space normal map) */
+  uint32_t caps2;        /* DDSCAPS2 (0x200 cube map, 0x200000 volume) */
+} bb_dds_info;
+
+/* Reads the header of the DDS file at path, an untrusted file, with the
+ * checks bb_image_read makes (every level within the file, mip count
+ * within the chain). Errors: BB_ERR_IO (missing, unreadable),
+ * BB_ERR_FORMAT (not a DDS, truncated, a format bumpbake does not read),
+ * BB_ERR_SIZE (zero or over BB_MAX_DIMENSION a side). Nothing to free. */
+bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
+
 /* Valve's name of the TEXTUREFLAGS_* bit `bit` (0..31) as Source SDK 2013
  * spells it without the prefix ("CLAMPS", "NORMAL", "SSBUMP"), or NULL for
  * an unused bit or one out of range. */

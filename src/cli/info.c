@@ -22,6 +22,8 @@ typedef struct file_info {
   bb_provenance_class provenance;
   int is_vtf;
   bb_vtf_info vtf; /* when is_vtf */
+  int is_dds;
+  bb_dds_info dds; /* when is_dds */
 } file_info;
 
 /* The names of the flags set, "SSBUMP NORMAL" (unnamed bits as hex). */
@@ -36,6 +38,23 @@ static void flag_names(uint32_t flags, char *out, size_t cap) {
                  : snprintf(out + n, cap - n, "%s0x%08x", n ? " " : "", 1u << bit);
     n += w > 0 ? (size_t)w : 0;
   }
+}
+
+/* The names of a DDS pixel format's flags set, "FOURCC NORMAL". */
+static void dds_flag_names(uint32_t flags, char *out, size_t cap) {
+  static const struct {
+    uint32_t bit;
+    const char *name;
+  } names[] = {{0x1u, "ALPHAPIXELS"}, {0x2u, "ALPHA"},       {0x4u, "FOURCC"},
+               {0x40u, "RGB"},        {0x200u, "YUV"},       {0x20000u, "LUMINANCE"},
+               {0x80000000u, "NORMAL"}};
+  size_t n = 0;
+  out[0] = '\0';
+  for (size_t k = 0; k < sizeof names / sizeof names[0] && n < cap; k++)
+    if (flags & names[k].bit) {
+      int w = snprintf(out + n, cap - n, "%s%s", n ? " " : "", names[k].name);
+      n += w > 0 ? (size_t)w : 0;
+    }
 }
 
 /* ------------------------------------------------------------------ text */
@@ -69,6 +88,27 @@ static void print_text(const char *path, const file_info *f) {
            v->low_res_width, v->low_res_height, (double)v->reflectivity[0],
            (double)v->reflectivity[1], (double)v->reflectivity[2], (double)v->bump_scale,
            v->frames, v->frames == 1 ? "" : "s");
+  }
+  if (f->is_dds) {
+    const bb_dds_info *d = &f->dds;
+    char names[256];
+    dds_flag_names(d->pixel_flags, names, sizeof names);
+    /* "BC1 (FourCC DXT1)", "BC5 (DX10 BC5_UNORM = 83)", "R8G8B8A8, uncompressed" */
+    const int blocks = strcmp(d->compression, "none") != 0;
+    char what[96];
+    if (d->dxgi_format && blocks)
+      snprintf(what, sizeof what, "%s (DX10 %s = %d)", d->compression, d->format_name,
+               d->dxgi_format);
+    else if (d->dxgi_format)
+      snprintf(what, sizeof what, "%s (DX10 DXGI format %d), uncompressed", d->format_name,
+               d->dxgi_format);
+    else if (d->fourcc[0])
+      snprintf(what, sizeof what, "%s (FourCC %s)%s", blocks ? d->compression : d->format_name,
+               d->fourcc, blocks ? "" : ", uncompressed");
+    else
+      snprintf(what, sizeof what, "%s, uncompressed", d->format_name);
+    printf("dds: %s, %d mip level%s, pixel format flags 0x%08x (%s)\n", what, d->mip_count,
+           d->mip_count == 1 ? "" : "s", (unsigned)d->pixel_flags, names[0] ? names : "none");
   }
   if (f->provenance == BB_PROVENANCE_NONE) {
     printf("no bumpbake provenance\n");
@@ -138,6 +178,29 @@ static void print_json(const char *path, const file_info *f) {
     cli_json_int(&j, "frames", v->frames);
     cli_json_close(&j, '}');
   }
+  if (f->is_dds) {
+    const bb_dds_info *d = &f->dds;
+    char names[256];
+    dds_flag_names(d->pixel_flags, names, sizeof names);
+    cli_json_open(&j, "dds", '{');
+    cli_json_string(&j, "format", d->format_name);
+    cli_json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
+    cli_json_int(&j, "dxgi_format", d->dxgi_format);
+    cli_json_string(&j, "compression", d->compression);
+    cli_json_int(&j, "mip_count", d->mip_count);
+    cli_json_int(&j, "pixel_flags", (long)d->pixel_flags);
+    cli_json_open(&j, "pixel_flag_names", '[');
+    for (const char *p = names; *p;) {
+      const size_t n = strcspn(p, " ");
+      char one[32];
+      snprintf(one, sizeof one, "%.*s", (int)n, p);
+      cli_json_string(&j, NULL, one);
+      p += n + (p[n] == ' ');
+    }
+    cli_json_close(&j, ']');
+    cli_json_int(&j, "caps2", (long)d->caps2);
+    cli_json_close(&j, '}');
+  }
   cli_json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
   if (f->provenance == BB_PROVENANCE_INTACT)
     json_provenance(&j, i->description);
@@ -176,6 +239,8 @@ static int info_file(const info_args *a, const char *path, int index) {
   f.provenance = bb_provenance_classify(f.info.description);
   if (strcmp(f.info.format_name, "vtf") == 0 && bb_vtf_read_info(path, &f.vtf, &err) == BB_OK)
     f.is_vtf = 1;
+  if (strcmp(f.info.format_name, "dds") == 0 && bb_dds_read_info(path, &f.dds, &err) == BB_OK)
+    f.is_dds = 1;
   if (a->json) {
     print_json(path, &f);
   } else {

@@ -24,6 +24,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 enum { DDS_HEADER_BYTES = 148, DDSD_MIPMAPCOUNT = 0x20000, TEXTURE2D = 3 };
 
@@ -228,5 +229,65 @@ bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, b
       widest = f.bits[c] > widest ? f.bits[c] : widest;
     layout->bits_per_sample = widest;
   }
+  return BB_OK;
+}
+
+/* ------------------------------------------------------------------ info */
+
+/* A masked format's name from its channels' widths: "R5G6B5", "L8A8". */
+static void masked_name(const bb__texel_format *f, const char *letters, char *out, size_t cap) {
+  size_t n = 0;
+  out[0] = '\0';
+  for (int c = 0; c < f->channels && c < 4 && n < cap; c++) {
+    const int w = snprintf(out + n, cap - n, "%c%d", letters[c], f->bits[c]);
+    n += w > 0 ? (size_t)w : 0;
+  }
+}
+
+bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
+  if (!info)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_dds_read_info: info is NULL");
+  memset(info, 0, sizeof *info);
+  if (!path)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_dds_read_info: path is NULL");
+  int fd;
+  bb_status st = bb__input_open(path, &fd, err);
+  if (st != BB_OK)
+    return st;
+  bb__texture_layout layout;
+  unsigned char h[DDS_HEADER_BYTES];
+  memset(h, 0, sizeof h);
+  st = bb__dds_layout(fd, path, &layout, err);
+  if (st == BB_OK && bb__input_read_at(fd, h, sizeof h, 0) < 128)
+    st = bb__fail(err, BB_ERR_IO, "%s: cannot read its header again", path);
+  close(fd);
+  if (st != BB_OK)
+    return st;
+  const unsigned char *pf = h + 76;
+  const bb__texel_format *f = &layout.format;
+  info->width = layout.width;
+  info->height = layout.height;
+  info->mip_count = layout.levels;
+  info->pixel_flags = u32_at(pf + 4);
+  info->caps2 = u32_at(h + 112);
+  if (info->pixel_flags & DDPF_FOURCC) {
+    for (int k = 0; k < 4; k++) /* read formats only: printable */
+      info->fourcc[k] = (char)pf[8 + k];
+    if (fourcc_is(pf + 8, "DX10"))
+      info->dxgi_format = (int)u32_at(h + 128);
+  }
+  if (f->kind == BB__TEXELS_PACKED)
+    masked_name(f,
+                (info->pixel_flags & DDPF_RGB)         ? "RGBA"
+                : (info->pixel_flags & DDPF_LUMINANCE) ? "LA"
+                                                       : "A",
+                info->format_name, sizeof info->format_name);
+  else
+    snprintf(info->format_name, sizeof info->format_name, "%s", f->name);
+  static const char *const blocks[] = {[BB__BLOCK_BC1] = "BC1", [BB__BLOCK_BC2] = "BC2",
+                                       [BB__BLOCK_BC3] = "BC3", [BB__BLOCK_BC4] = "BC4",
+                                       [BB__BLOCK_BC5] = "BC5"};
+  snprintf(info->compression, sizeof info->compression, "%s",
+           f->kind == BB__TEXELS_BLOCKS ? blocks[f->block] : "none");
   return BB_OK;
 }

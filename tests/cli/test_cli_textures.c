@@ -220,6 +220,41 @@ Test(cli_textures, info_reads_a_vtf_header) {
   cli_result_free(&r);
 }
 
+/* info on a DDS says what it stores: the block format or the texel
+ * layout, the FourCC or DXGI code, the mips, the pixel format's flags. */
+Test(cli_textures, info_reads_a_dds_header) {
+  relief(tmp("h.png"), 32, 32);
+  cli_result r = RUN("bake", tmp("h.png"), "--scale", "4", "--rays", "16", "--normal",
+                     tmp("n.dds"), "--ssbump", tmp("s.dds"), "--fast-compression");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("bake", tmp("h.png"), "--scale", "4", "--rays", "16", "--normal", tmp("f.dds"),
+          "--texture-format", "rgba16f", "--nomip");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("info", tmp("n.dds"), tmp("s.dds"), tmp("f.dds"));
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "dds: BC5 (FourCC ATI2), 6 mip levels, pixel format flags 0x80000004 "
+                          "(FOURCC NORMAL)"),
+            "%s", r.out);
+  cr_expect(strstr(r.out, "dds: BC1 (FourCC DXT1), 6 mip levels"), "%s", r.out);
+  cr_expect(strstr(r.out, "dds: R16G16B16A16_FLOAT (DX10 DXGI format 10), uncompressed, "
+                          "1 mip level,"),
+            "%s", r.out);
+  cli_result_free(&r);
+  r = RUN("info", "--json", tmp("n.dds"));
+  cr_expect(strstr(r.out, "\"dds\":{\"format\":\"BC5\",\"fourcc\":\"ATI2\",\"dxgi_format\":0,"
+                          "\"compression\":\"BC5\",\"mip_count\":6,") &&
+                strstr(r.out, "\"pixel_flag_names\":[\"FOURCC\",\"NORMAL\"]"),
+            "%s", r.out);
+  cli_result_free(&r);
+  /* the library's call refuses what its reader refuses, naming the file */
+  bb_dds_info d;
+  bb_error err = {{0}};
+  cr_expect_eq(bb_dds_read_info(tmp("h.png"), &d, &err), BB_ERR_FORMAT);
+  cr_expect(strstr(err.message, "h.png"), "%s", err.message);
+}
+
 /* A fixture of fixtures/ (BB_FIXTURES), as an absolute path. */
 static const char *fixture(const char *name) {
   static char path[4096];
