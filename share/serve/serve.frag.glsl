@@ -4,7 +4,13 @@
 // ssbump is lit here by the same formulas as there (docs/commands/render.md,
 // "Formulas"): the dynamic light sat(sum_c s_c (l.B_c)) on the ssbump,
 // max(0, N.l) on the normal map, times ao in "normal x ao"; relief is
-// ssbump_relief_shade seen from a camera as `render --view AZ,EL --relief`.
+// relief_hit seen from a camera as `render --view AZ,EL --relief`, the
+// ssbump met lit by the same light (ssbump_relief_shade's diffuse term
+// with no lightmaps). The basis directions B_c are the bake's own (a
+// uniform): Half-Life 2's are ssbump_relief.glsl's SSBUMP_B0..B2, and a
+// bake with --basis FILE of 3 other directions is lit with those; a basis
+// of more than 3 does not fit the page's ssbump texture, whose lit modes
+// the page then turns off.
 
 uniform sampler2D uSsbumpAo;     // ssbump s_0..s_2 in RGB, ao in A
 uniform sampler2D uNormalHeight; // (N + 1) / 2 in RGB, the smoothed height in A
@@ -22,6 +28,7 @@ uniform vec3 uView;              // towards the camera (relief)
 uniform vec2 uRight, uToward;    // the screen's right and the way to the camera, on the plane
 uniform float uStretch;          // 1 / sin(view elevation)
 uniform float uDepth;            // the relief's depth in texels: the bake's --scale
+uniform vec3 uBasis[3];          // the bake's basis directions B_0..B_2 (tangent frame, +y down)
 out vec4 fragColor;
 
 vec3 decode_vector(vec3 c) {
@@ -29,6 +36,12 @@ vec3 decode_vector(vec3 c) {
     if (uNormalYUp > 0.5) n.y = -n.y;
     float len = length(n);
     return len > 0.0 ? n / len : vec3(0.0, 0.0, 1.0);
+}
+
+// ssbump_dynamic in the bake's basis: sat(sum_c s_c (l.B_c)).
+float ssbump_lit(vec3 s, vec3 l) {
+    vec3 lb = vec3(dot(l, uBasis[0]), dot(l, uBasis[1]), dot(l, uBasis[2]));
+    return clamp(dot(s, lb), 0.0, 1.0);
 }
 
 void main() {
@@ -43,12 +56,11 @@ void main() {
         // camera, its pixel (i, j) at the point p = (i, j)
         float si = p.x - 0.5 * extent.x, sj = (p.y - 0.5 * extent.y) * uStretch;
         vec2 point = 0.5 * extent + si * uRight + sj * uToward;
-        rgb = ssbump_relief_shade(uHeight, uSsbumpAo, uSize, point, uView, uDepth, uLight,
-                                  vec3(1.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(1.0),
-                                  0.0, 0.0);
+        vec2 hit = relief_hit(uHeight, uSize, point, uView, uDepth);
+        rgb = vec3(ssbump_lit(textureLod(uSsbumpAo, (hit + 0.5) / uSize, 0.0).rgb, uLight));
     } else if (uMode == 0) {
         vec3 s = textureLod(uSsbumpAo, uv, 0.0).rgb;
-        rgb = vec3(ssbump_dynamic(s, uLight));
+        rgb = vec3(ssbump_lit(s, uLight));
     } else if (uMode == 1 || uMode == 2) {
         vec3 n = decode_vector(textureLod(uNormalHeight, uv, 0.0).rgb);
         float lit = max(0.0, dot(n, uLight));

@@ -18,6 +18,8 @@ let state = null;         // the server's last state
 let loading = 0;          // the bake id being fetched, 0 when none
 let drawPending = false;
 const bakeScale = {};      // each bake's --scale by id: the depth of its relief
+const bakeBasis = {};      // each bake's basis directions by id: the ssbump's lighting
+const SSBUMP_MODES = [0, 8];  // the modes that light the ssbump with the basis
 
 function fail(message) {
   $("error").textContent = message;
@@ -93,6 +95,7 @@ async function setup() {
     const name = gl.getActiveUniform(program, i).name;
     uniforms[name] = gl.getUniformLocation(program, name);
   }
+  uniforms.uBasis = gl.getUniformLocation(program, "uBasis");  // the array, from element 0
   ["uSsbumpAo", "uNormalHeight", "uBent", "uWeights", "uHeight"].forEach((name, unit) => {
     gl.uniform1i(uniforms[name], unit);
   });
@@ -218,6 +221,8 @@ function draw() {
   gl.uniform2f(uniforms.uRight, toward[1], -toward[0]);
   gl.uniform1f(uniforms.uStretch, 1 / view[2]);
   gl.uniform1f(uniforms.uDepth, bakeScale[maps.id] || (state ? state.params.scale : 1));
+  const basis = bakeBasis[maps.id];
+  if (basis && basis.length === 3) gl.uniform3fv(uniforms.uBasis, basis.flat());
   gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
   gl.finish();
   document.body.dataset.drawnBake = String(maps.id);
@@ -257,16 +262,33 @@ function showState(s) {
   if (s.bake) {
     const b = s.bake;
     bakeScale[b.id] = b.scale;
+    bakeBasis[b.id] = b.basis_vectors;
+    showBasis(b);
     $("times").textContent = `${b.width} x ${b.height}, ${b.slices} slices, ${b.threads} threads: ` +
       `${b.seconds.toFixed(3)} s (load ${b.seconds_load.toFixed(3)}, smooth ${b.seconds_smooth.toFixed(3)}, ` +
       `pyramid ${b.seconds_pyramid.toFixed(3)}, trace ${b.seconds_trace.toFixed(3)}, ` +
       `derive ${b.seconds_derive.toFixed(3)})`;
     $("provenance").textContent = b.provenance;
-    if (b.basis_count !== 3) fail("the maps are in a basis of " + b.basis_count +
-                                  " directions: the page lights Half-Life 2's 3");
     if ((!maps || b.id > maps.id) && !loading) loadMaps().catch((e) => fail(String(e)));
   }
   requestDraw();
+}
+
+// The ssbump's lit modes take the bake's 3 basis directions; a basis of
+// more does not fit the page's ssbump texture (3 channels and ao): those
+// modes are turned off, saying why, rather than lit wrongly.
+function showBasis(b) {
+  const lit = b.basis_count === 3;
+  const v = (x) => "(" + x.map((c) => c.toFixed(3)).join(", ") + ")";
+  $("basis-note").textContent = lit
+    ? "ssbump lit in the bake's basis " + b.basis + (b.basis === "hl2" ? " (Half-Life 2's)" :
+      ": " + b.basis_vectors.map(v).join(" "))
+    : "basis " + b.basis + " has " + b.basis_count + " directions: the page lights an " +
+      "ssbump of 3 (its texture holds 3), so \"ssbump, lit\" and relief are off; " +
+      "\"ssbump map\" and \"basis weights\" show the first 3 channels";
+  for (const m of SSBUMP_MODES)
+    document.querySelector('#mode option[value="' + m + '"]').disabled = !lit;
+  if (!lit && SSBUMP_MODES.includes(Number($("mode").value))) $("mode").value = "1";
 }
 
 async function post(path) {

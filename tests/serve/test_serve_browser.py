@@ -227,3 +227,108 @@ def test_nothing_is_written_unless_asked(work):
     names = sorted(os.listdir(work))
     assert all(n == "height.png" or n.startswith("height_") for n in names), names
     assert not any(n.startswith(".~") for n in names), names
+
+
+# ------------------------------------------------------------ other bases
+
+# The page's picture in a mode, one pixel per texel, as rows top first
+# (RGB bytes, base64).
+PIXELS_JS = """
+const [w, h, az, el, mode] = arguments;
+canvas.width = w; canvas.height = h;
+light.azimuth = az; light.elevation = el;
+document.getElementById('mode').value = String(mode);
+document.getElementById('tile').checked = false;
+draw();
+const px = new Uint8Array(4 * w * h);
+gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+const rgb = new Uint8Array(3 * w * h);
+for (let y = 0; y < h; y++)
+  for (let x = 0; x < w; x++)
+    for (let k = 0; k < 3; k++) rgb[3 * (y * w + x) + k] = px[4 * ((h - 1 - y) * w + x) + k];
+let s = '';
+for (let i = 0; i < rgb.length; i += 8192) s += String.fromCharCode(...rgb.subarray(i, i + 8192));
+return btoa(s);
+"""
+
+
+def light_vector(az, el):
+    import math
+    a, e = math.radians(az), math.radians(el)
+    return [math.cos(e) * math.cos(a), -math.cos(e) * math.sin(a), math.sin(e)]
+
+
+def test_a_custom_basis_lights_the_ssbump_in_its_own_directions(tmp_path):
+    import base64
+    import math
+
+    import numpy as np
+
+    # Half-Life 2's directions turned 40 degrees about z: lit as HL2's, the
+    # picture would be another one
+    turn = math.radians(40)
+    hl2 = [(math.sqrt(2 / 3), 0, 1 / math.sqrt(3)),
+           (-1 / math.sqrt(6), 1 / math.sqrt(2), 1 / math.sqrt(3)),
+           (-1 / math.sqrt(6), -1 / math.sqrt(2), 1 / math.sqrt(3))]
+    mine = [(x * math.cos(turn) - y * math.sin(turn), x * math.sin(turn) + y * math.cos(turn), z)
+            for x, y, z in hl2]
+    basis = tmp_path / "turned.basis"
+    basis.write_text("".join("%.12f %.12f %.12f\n" % v for v in mine))
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
+    server = sb.Server(BIN, str(tmp_path / "height.png"),
+                       ["--scale", "32", "--basis", str(basis), "--quiet"])
+    driver = sb.start_browser()
+    try:
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
+        bake = state(server)["bake"]
+        assert bake["basis"].startswith("vectors:") and bake["basis_count"] == 3, bake["basis"]
+        assert np.allclose(bake["basis_vectors"], mine, atol=1e-7), bake["basis_vectors"]
+        note = driver.find_element("id", "basis-note").text
+        assert bake["basis"] in note and "(0.625, 0.525, 0.577)" in note, note
+        w, h = bake["width"], bake["height"]
+        with urllib.request.urlopen(server.url + "map/ssbump_ao", timeout=30) as r:
+            s = np.frombuffer(r.read(), np.uint8).reshape(h, w, 4)[:, :, :3] / 255.0
+        for az, el in ((0, 20), (200, 35)):
+            page = np.frombuffer(base64.b64decode(driver.execute_script(PIXELS_JS, w, h, az, el, 0)),
+                                 np.uint8).reshape(h, w, 3).astype(int)
+            l = np.array(light_vector(az, el))
+
+            def lit(directions):
+                lb = np.array(directions) @ l
+                return np.round(np.clip(s @ lb, 0, 1) * 255).astype(int)
+
+            worst = np.abs(page[:, :, 0] - lit(mine)).max()
+            as_hl2 = np.abs(page[:, :, 0] - lit(hl2)).max()
+            print("custom basis, light %d,%d: worst %d against its basis, %d against HL2's"
+                  % (az, el, worst, as_hl2))
+            assert worst <= 1, worst
+            assert as_hl2 > 8, "the page lit the turned basis as Half-Life 2's"
+        driver.set_window_size(1100, 760)
+        driver.execute_script("fitCanvas(); document.getElementById('mode').value = '0';"
+                              "light.azimuth = 135; light.elevation = 45; showLight(); draw();")
+        shot(driver, "7-custom-basis")
+    finally:
+        sb.stop_browser(driver)
+        server.close()
+
+
+def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
+    server = sb.Server(BIN, str(tmp_path / "height.png"),
+                       ["--scale", "32", "--basis", "hl2+z", "--quiet"])
+    driver = sb.start_browser()
+    try:
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
+        note = driver.find_element("id", "basis-note").text
+        assert "hl2+z has 4 directions" in note, note
+        assert driver.execute_script(
+            "return [0, 8].map((m) => document.querySelector("
+            "'#mode option[value=\"' + m + '\"]').disabled)") == [True, True]
+        assert driver.execute_script("return document.getElementById('mode').value") == "1"
+        assert stats(driver)["mean"] > 20  # the normal map, lit
+        shot(driver, "8-basis-of-4")
+    finally:
+        sb.stop_browser(driver)
+        server.close()

@@ -36,7 +36,8 @@ typedef struct serve_bake {
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */
-  int normal_y_up, basis_count;
+  int normal_y_up;
+  bb_basis basis;          /* the basis of the ssbump and weights: the page lights with it */
   double scale;            /* the bake's --scale: the relief's depth */
 } serve_bake;
 

@@ -180,7 +180,7 @@ static void bake_once(serve_state *s, long wanted) {
       pthread_mutex_init(&b->tex_lock, NULL);
       b->maps = result; /* kept for the textures */
       memset(&result, 0, sizeof result);
-      b->basis_count = b->maps.basis.count;
+      b->basis = b->maps.basis;
       b->report = *rep;
       b->report.input = NULL;
       b->command = bb_job_command_text(&o, input);

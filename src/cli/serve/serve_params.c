@@ -47,7 +47,17 @@ static void add_bake(cli_json *j, serve_bake *b) {
   cli_json_int(j, "slices", r->slices);
   cli_json_number(j, "scale", b->scale);
   cli_json_bool(j, "normal_y_up", b->normal_y_up);
-  cli_json_int(j, "basis_count", b->basis_count);
+  /* the page lights the ssbump with these directions (sat(sum_c s_c l.B_c)) */
+  cli_json_string(j, "basis", b->basis.name);
+  cli_json_int(j, "basis_count", b->basis.count);
+  cli_json_open(j, "basis_vectors", '[');
+  for (int c = 0; c < b->basis.count; c++) {
+    cli_json_open(j, NULL, '[');
+    for (int k = 0; k < 3; k++)
+      cli_json_number(j, NULL, b->basis.vector[c][k]);
+    cli_json_close(j, ']');
+  }
+  cli_json_close(j, ']');
   cli_json_string(j, "command", b->command);
   cli_json_string(j, "provenance", b->provenance);
   cli_json_close(j, '}');
