@@ -2521,6 +2521,16 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
 bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
                            void *progress_user, bb_bake_result *result, bb_error *err);
 
+/* Writes input i's files (maps, Valve's file, slope files, material,
+ * depfile) from result, the maps bb_job_bake_item of this same job kept,
+ * as bb_job_run_item would write them after its own bake: the same bytes,
+ * with no second read or bake (the report's figures are the bake's). The
+ * caller keeps result. Errors: BB_ERR_ARGUMENT (i not baked by this job,
+ * result missing a map the job writes or of another size, Valve's detail
+ * variant, which reads the input again: bb_job_run_item), and those of
+ * writing. Sets the report's outcome and error as bb_job_run_item does. */
+bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb_error *err);
+
 /* Called after each input of bb_job_run with its report. */
 typedef void (*bb_job_report_fn)(void *user, const bb_job_report *report);
 

@@ -319,7 +319,8 @@ $("write").addEventListener("click", async () => {
   $("write-error").textContent = "";
   try {
     const r = await post("write");
-    $("write-result").textContent = "wrote " + r.outputs.map((o) => o.path).join(", ");
+    $("write-result").textContent = "wrote " + r.outputs.map((o) => o.path).join(", ") +
+      (r.from === "memory" ? " (the maps shown, not baked again)" : " (baked again: a change was pending)");
   } catch (e) {
     $("write-error").textContent = e.message;
   }

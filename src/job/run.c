@@ -434,6 +434,53 @@ bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn pro
   return st;
 }
 
+bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb_error *err) {
+  if (!job || i < 0 || i >= job->count || !result)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job write: bad arguments");
+  bb__job_item *item = &job->items[i];
+  bb_job_report *r = &item->report;
+  if (r->width <= 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job write: %s has not been baked by this job",
+                    item->input);
+  /* Valve's detail variant scales by the height as read, which the maps
+   * do not hold: bb_job_run_item reads it again. */
+  if (job->options.valve_detail)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "job write: %s: Valve's detail variant reads the input again "
+                    "(bb_job_run_item writes it)",
+                    item->input);
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    const bb_image *m = bb_bake_result_image(result, (bb_output_kind)k);
+    const int needed = item->paths[k] || (k == BB_OUTPUT_FILTERED && job->slope_path);
+    if (needed && (!m || !m->pixels || m->width != r->width || m->height != r->height))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "job write: %s: the maps given have no %s of %d x %d (another bake?)",
+                      item->input, kind_info(k)->name, r->width, r->height);
+  }
+  baked b;
+  memset(&b, 0, sizeof b);
+  b.result = *result; /* borrowed: given back before baked_free */
+  r->outcome = BB_JOB_PENDING;
+  r->status = BB_OK;
+  memset(&r->error, 0, sizeof r->error);
+  bb_status st = BB_OK;
+  if (job->valve_path)
+    st = make_valve(job, item, &b, &r->error);
+  if (st == BB_OK && job->slope_path)
+    st = make_slope(job, item, &b, &r->error);
+  if (st == BB_OK)
+    st = write_item(job, item, &b, &r->error);
+  memset(&b.result, 0, sizeof b.result);
+  baked_free(&b);
+  if (st != BB_OK) {
+    if (err)
+      *err = r->error;
+    return fail_item(r, st, NULL);
+  }
+  r->outcome = BB_JOB_BAKED;
+  return BB_OK;
+}
+
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user) {
   if (!job || i < 0 || i >= job->count)
     return BB_ERR_ARGUMENT;

@@ -150,6 +150,73 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
   bb_job_free(job);
 }
 
+/* A file's bytes (size in *size), malloc'd. */
+static unsigned char *file_bytes(const char *path, size_t *size) {
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "%s", path);
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  unsigned char *data = malloc((size_t)n + 1);
+  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
+  fclose(f);
+  *size = (size_t)n;
+  return data;
+}
+
+/* bb_job_write_item (serve's "write"): the files of the maps bake_item
+ * kept, byte for byte the ones bb_job_run_item writes after its own bake
+ * (8-bit PNGs, a float EXR, the slope map and its lit preview, provenance
+ * in each), with kinds asked besides in the maps given. */
+Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
+  const char *input = height_file();
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.bake.rays = 16;
+  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
+  o.paths[BB_OUTPUT_NORMAL] = tmp("n.png");
+  o.paths[BB_OUTPUT_AO] = tmp("ao.exr");
+  o.slope_path = tmp("slope.png");
+  o.slope_lit = 1;
+  o.force = 1;
+  o.command = "bumpbake bake h.png --scale 4 --rays 16 ...";
+  const char *files[] = {tmp("s.png"), tmp("n.png"), tmp("ao.exr"), tmp("slope.png"),
+                         tmp("slope_lit.png")};
+  enum { FILES = sizeof files / sizeof files[0] };
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_bake_result kept;
+  cr_expect_eq(bb_job_write_item(job, 0, &(bb_bake_result){0}, &err), BB_ERR_ARGUMENT,
+               "not baked yet");
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, NULL, NULL, &kept, &err), BB_OK, "%s",
+               err.message);
+  bb_bake_result missing = kept;
+  memset(&missing.ao, 0, sizeof missing.ao);
+  cr_expect_eq(bb_job_write_item(job, 0, &missing, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "no ao of 8 x 8"), "%s", err.message);
+  cr_assert_eq(bb_job_write_item(job, 0, &kept, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_job_report_get(job, 0)->outcome, BB_JOB_BAKED);
+  unsigned char *written[FILES];
+  size_t sizes[FILES];
+  for (int k = 0; k < FILES; k++) {
+    written[k] = file_bytes(files[k], &sizes[k]);
+    cr_assert_eq(remove(files[k]), 0);
+  }
+  bb_bake_result_free(&kept);
+  cr_assert_eq(bb_job_run_item(job, 0, NULL, NULL), BB_OK);
+  for (int k = 0; k < FILES; k++) {
+    size_t size;
+    unsigned char *again = file_bytes(files[k], &size);
+    cr_expect(size == sizes[k] && memcmp(again, written[k], size) == 0,
+              "%s: bb_job_write_item's bytes differ from bb_job_run_item's", files[k]);
+    free(again);
+    free(written[k]);
+  }
+  bb_job_free(job);
+}
+
 static int cancel_at_once(void *user, long done, long total) {
   (void)user, (void)done, (void)total;
   return 1;

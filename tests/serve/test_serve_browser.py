@@ -138,6 +138,8 @@ def test_write_is_the_bake_commands_bytes(page, server, work):
     sb.wait_for(lambda: page.find_element("id", "write-result").text
                 or page.find_element("id", "write-error").text, SLOW, "the write")
     assert page.find_element("id", "write-error").text == ""
+    # the maps shown were written, not baked again
+    assert "(the maps shown, not baked again)" in page.find_element("id", "write-result").text
     command = page.find_element("id", "command").text
     words = shlex.split(command)
     outputs = [words[i + 1] for i, w in enumerate(words) if w in ("--normal", "--ssbump", "--ao")]

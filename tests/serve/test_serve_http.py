@@ -6,6 +6,7 @@ make test runs (no Chromium needed)."""
 import http.client
 import json
 import os
+import shlex
 import shutil
 import subprocess
 import time
@@ -194,3 +195,39 @@ def test_the_brightness_map_switches_on_and_off(tmp_path):
         assert status == 400 and "no --brightness FILE" in json.loads(body)["error"]
     finally:
         s.close()
+
+
+def test_write_writes_the_maps_shown_as_bake_would(served):
+    s, d = served
+    # the maps shown are the line's bake: written from memory, no second bake
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+    assert status == 200, body
+    reply = json.loads(body)
+    assert reply["from"] == "memory", reply
+    paths = [o["path"] for o in reply["outputs"]]
+    assert sorted(os.path.basename(p) for p in paths) == ["h_ao.png", "h_normal.png",
+                                                          "h_ssbump.png"]
+    written = {p: open(p, "rb").read() for p in paths}
+    for p in paths:
+        os.remove(p)
+    words = shlex.split(state(s)["command"])
+    assert words[:2] == ["bumpbake", "bake"]
+    subprocess.run([BIN, *words[1:]], check=True, timeout=SLOW,
+                   stdout=subprocess.DEVNULL)
+    for p in paths:
+        assert open(p, "rb").read() == written[p], p + " differs from bumpbake bake's"
+        os.remove(p)
+    # after a broken save the maps shown are not the file's: "write" does
+    # what bake would (bake again, and fail on the file), writing nothing
+    good = open(d / "h.png", "rb").read()
+    before = state(s)["bake"]["id"]
+    sb.save_by_rename(good[: len(good) // 3], str(d / "h.png"))
+    sb.wait_for(lambda: state(s)["error"], SLOW, "the broken save's error")
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+    assert status == 422 and "h.png" in json.loads(body)["error"], body
+    assert not any(os.path.exists(p) for p in paths)
+    # a good save again: from memory again
+    sb.save_by_rename(good, str(d / "h.png"))
+    wait_bake(s, before, "the bake of the good save")
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+    assert status == 200 and json.loads(body)["from"] == "memory", body

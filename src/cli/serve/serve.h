@@ -28,9 +28,12 @@ typedef struct serve_bake {
   int refs; /* under serve_state.lock */
   long id;
   int width, height;
-  pthread_mutex_t tex_lock;            /* makes tex[] and frees maps */
+  pthread_mutex_t tex_lock;            /* makes tex[]; serialises writes of maps */
   unsigned char *tex[SERVE_TEX_COUNT]; /* NULL until asked */
-  bb_bake_result maps;                 /* the bake's maps, until every texture is made */
+  bb_job *job;                         /* the job that baked them (its report) */
+  bb_bake_result maps;                 /* the bake's float maps: the textures and a
+                                          "write" (bb_job_write_item) are made of them */
+  long wanted;                         /* the request it answered (serve_state.wanted) */
   double seconds;          /* from the start of the bake to its maps */
   double seconds_textures; /* making the textures asked so far */
   bb_job_report report;    /* the job's figures (input pointer not kept) */

@@ -2,7 +2,8 @@
  * control asks, plans the job of the current options and bakes its input
  * through it (bb_job_bake_item: the very read and bake `bumpbake bake`
  * runs, nothing written), then publishes the maps, which become the
- * page's 8-bit textures as the page asks for them.
+ * page's 8-bit textures as the page asks for them; the job and the float
+ * maps are kept for "write" (bb_job_write_item).
  * A newer request cancels the bake in flight through the progress
  * callback; a failure keeps the last good maps and shows why. */
 #include "common.h"
@@ -31,6 +32,7 @@ void serve_bake_release(serve_bake *b) {
   for (int t = 0; t < SERVE_TEX_COUNT; t++)
     free(b->tex[t]);
   bb_bake_result_free(&b->maps);
+  bb_job_free(b->job);
   pthread_mutex_destroy(&b->tex_lock);
   free(b->provenance);
   free(b->command);
@@ -118,11 +120,6 @@ const unsigned char *serve_bake_texture(serve_bake *b, int t) {
       default: fill(b->tex[t], n, &r->weights, 0, NULL); break;
       }
     }
-    int all = 1;
-    for (int k = 0; k < SERVE_TEX_COUNT; k++)
-      all &= b->tex[k] != NULL;
-    if (all) /* the floats are not needed any more */
-      bb_bake_result_free(&b->maps);
     b->seconds_textures += now_seconds() - t0;
   }
   pthread_mutex_unlock(&b->tex_lock);
@@ -184,10 +181,13 @@ static void bake_once(serve_state *s, long wanted) {
       b->report = *rep;
       b->report.input = NULL;
       b->command = bb_job_command_text(&o, input);
-      b->provenance = provenance_of(&o, rep, &result, b->command, input);
+      b->provenance = provenance_of(&o, rep, &b->maps, b->command, input);
       b->normal_y_up = o.bake.normal_y_up;
       b->scale = (double)o.bake.height_scale;
       b->seconds = now_seconds() - t0;
+      b->job = job; /* kept: "write" writes these maps through it */
+      job = NULL;
+      b->wanted = wanted;
     } else {
       st = BB_ERR_MEMORY;
       snprintf(err.message, sizeof err.message, "out of memory");

@@ -264,38 +264,96 @@ static enum MHD_Result apply_params(server *sv, struct MHD_Connection *c) {
   return send_json(c, MHD_HTTP_OK, serve_state_json(sv->s));
 }
 
+/* The bake shown with a reference held, when it is what the `bumpbake
+ * bake` line of the options now would bake: no save or control came after
+ * it (nothing pending, in flight or failed since), and its command line is
+ * the one of the options now. Else NULL. The caller holds the lock. */
+static serve_bake *bake_of_now(serve_state *s, const bb_job_options *o) {
+  serve_bake *b = s->current;
+  if (!b || !b->job || s->baking || s->error[0] || atomic_load(&s->wanted) != s->done ||
+      b->wanted != s->done)
+    return NULL;
+  char *command = bb_job_command_text(o, s->height_path);
+  const int same = command && b->command && strcmp(command, b->command) == 0;
+  free(command);
+  if (!same)
+    return NULL;
+  b->refs++;
+  return b;
+}
+
 /* POST write: the maps written through the job, as the `bumpbake bake`
- * line the page shows would write them; the reply is the line `bake
- * --json` prints. */
+ * line the page shows would write them: from the maps shown when they are
+ * that line's bake (bb_job_write_item on the job that baked them: the same
+ * bytes, no second bake), else by baking again (bb_job_run_item: a save
+ * or control still pending, or Valve's detail variant). The reply is the
+ * line `bake --json` prints, with "from" saying which. */
 static enum MHD_Result write_maps(server *sv, struct MHD_Connection *c) {
   bb_job_options o;
   pthread_mutex_lock(&sv->s->lock);
   serve_job_options(sv->s, &o);
   const char *input = sv->s->height_path;
+  serve_bake *b = bake_of_now(sv->s, &o);
   pthread_mutex_unlock(&sv->s->lock);
   bb_error err = {{0}};
+  bb_status st = BB_ERR_ARGUMENT;
+  const char *from = "memory";
   bb_job *job = NULL;
-  bb_status st = bb_job_plan(&input, 1, &o, &job, &err);
-  if (st == BB_OK) {
-    st = bb_job_run_item(job, 0, NULL, NULL);
-    if (st != BB_OK)
-      err = bb_job_report_get(job, 0)->error;
-  }
-  if (st != BB_OK) {
-    bb_job_free(job);
-    return send_error(c, 422,
-                      err.message[0] ? err.message : bb_status_name(st));
-  }
-  /* what `bumpbake bake --json` prints of it */
   char *text = NULL;
   size_t size = 0;
-  FILE *f = open_memstream(&text, &size);
-  if (f) {
-    cli_job_json_to(f, &o.bake, bb_job_report_get(job, 0), "written");
-    fclose(f);
+  if (b) {
+    pthread_mutex_lock(&b->tex_lock); /* one write of its job at a time */
+    st = bb_job_write_item(b->job, 0, &b->maps, &err);
+    if (st == BB_OK) {
+      FILE *f = open_memstream(&text, &size);
+      if (f) {
+        cli_job_json_to(f, &o.bake, bb_job_report_get(b->job, 0), "written");
+        fclose(f);
+      }
+    }
+    pthread_mutex_unlock(&b->tex_lock);
   }
-  bb_job_free(job);
-  return send_json(c, MHD_HTTP_OK, text);
+  if (st == BB_ERR_ARGUMENT) { /* not this bake's line, or a file it cannot write */
+    from = "bake";
+    free(text);
+    text = NULL;
+    memset(&err, 0, sizeof err);
+    st = bb_job_plan(&input, 1, &o, &job, &err);
+    if (st == BB_OK) {
+      st = bb_job_run_item(job, 0, NULL, NULL);
+      if (st != BB_OK)
+        err = bb_job_report_get(job, 0)->error;
+    }
+    if (st == BB_OK) {
+      FILE *f = open_memstream(&text, &size);
+      if (f) {
+        cli_job_json_to(f, &o.bake, bb_job_report_get(job, 0), "written");
+        fclose(f);
+      }
+    }
+    bb_job_free(job);
+  }
+  if (b) {
+    pthread_mutex_lock(&sv->s->lock);
+    serve_bake_release(b);
+    pthread_mutex_unlock(&sv->s->lock);
+  }
+  if (!sv->s->quiet && st == BB_OK)
+    fprintf(stderr, "serve: wrote the maps (%s)\n",
+            strcmp(from, "memory") ? "baked again" : "from the bake shown");
+  if (st != BB_OK) {
+    free(text);
+    return send_error(c, 422, err.message[0] ? err.message : bb_status_name(st));
+  }
+  /* {"from": "memory" or "bake", then bake --json's keys} */
+  char *reply = NULL;
+  if (text && text[0] == '{') {
+    const size_t cap = strlen(text) + 32;
+    if ((reply = malloc(cap)))
+      snprintf(reply, cap, "{\"from\":\"%s\",%s", from, text + 1);
+  }
+  free(text);
+  return send_json(c, MHD_HTTP_OK, reply);
 }
 
 /* --------------------------------------------------------------- routing */
