@@ -2521,6 +2521,22 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
 bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
                            void *progress_user, bb_bake_result *result, bb_error *err);
 
+/* What a long-running caller that bakes again and again (bumpbake serve)
+ * keeps warm between bakes: the ray set of the last bake, reused while
+ * slices, power and basis are the same, and, process-wide, the bakes'
+ * freed buffers, kept in the heap for the next bake of the same size
+ * (glibc's allocator told not to return buffers up to 32 MiB to the
+ * system: no page faults or zeroing again; the memory of the largest bake
+ * stays with the process). A bake with a context is a cold bake's bits.
+ * One bake at a time per context. */
+typedef struct bb_bake_context bb_bake_context;
+bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
+void bb_bake_context_free(bb_bake_context *context);
+
+/* The bakes of job (bb_job_bake_item, bb_job_run_item) use context from
+ * now on (NULL: cold again). context must outlive them. */
+void bb_job_use_context(bb_job *job, bb_bake_context *context);
+
 /* Writes input i's files (maps, Valve's file, slope files, material,
  * depfile) from result, the maps bb_job_bake_item of this same job kept,
  * as bb_job_run_item would write them after its own bake: the same bytes,

@@ -126,16 +126,19 @@ static void ssbump_cap(bb_image *ssbump) {
  * nothing needs it; the normal map is made after the trace, when vis is
  * gone, and ssbump without one takes its normals a band at a time. */
 static bb_status trace_and_derive(const bb_bake_options *o, int threads, int keep_vis,
-                                  bb_bake_result *r, bb_error *err) {
+                                  bb_bake_context *context, bb_bake_result *r, bb_error *err) {
   double t0 = bb__now_seconds();
   bb_image z = {0};
   bb_pyramid *pyramid = NULL;
   bb_rayset rays = {0};
+  int rays_owned = 1; /* a context lends its ray set */
   trace_progress progress = {o->trace.progress, o->trace.progress_user, 0, 0};
   bb_status st = scaled_heights(&r->filtered, o->height_scale, &z, err);
   if (st == BB_OK) st = bb__pyramid_build(&z, o->smooth.addressing, threads, &pyramid, err);
   bb_image_free(&z);
-  if (st == BB_OK) st = bb__rayset_make(o->slices, o->power, &o->basis, threads, &rays, err);
+  if (st == BB_OK)
+    st = bb__context_rayset(context, o->slices, o->power, &o->basis, threads, &rays, &rays_owned,
+                            err);
   double t1 = bb__now_seconds();
   r->seconds_pyramid = t1 - t0;
   if (st == BB_OK) {
@@ -163,7 +166,8 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     r->seconds_bounce = t3 - t2;
     t2 = t3;
   }
-  bb__rayset_release(&rays);
+  if (rays_owned)
+    bb__rayset_release(&rays);
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
       BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);
@@ -248,15 +252,15 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
     memset(r, 0, sizeof *r);
   bb_status st = bb__bake_prepare(o, &prepared, err);
   /* no flag: height is only read */
-  return st == BB_OK ? bb__bake((bb_image *)height, &prepared, 0, r, err) : st;
+  return st == BB_OK ? bb__bake((bb_image *)height, &prepared, 0, NULL, r, err) : st;
 }
 
 static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
-                             bb_bake_result *r, bb_error *err);
+                             bb_bake_context *context, bb_bake_result *r, bb_error *err);
 
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
-                   bb_bake_result *r, bb_error *err) {
-  bb_status st = bake_stages(height, o, flags, r, err);
+                   bb_bake_context *context, bb_bake_result *r, bb_error *err) {
+  bb_status st = bake_stages(height, o, flags, context, r, err);
   if (flags & BB__BAKE_TAKE_HEIGHT)
     bb_image_free(height);
   return st;
@@ -273,7 +277,7 @@ static bb_status check_memory(const bb_image *height, const bb_bake_options *o, 
 }
 
 static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
-                             bb_bake_result *r, bb_error *err) {
+                             bb_bake_context *context, bb_bake_result *r, bb_error *err) {
   memset(r, 0, sizeof *r);
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
@@ -293,7 +297,7 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   const int threads = bb__thread_count(o->trace.threads);
   st = smooth_and_normals(height, o, threads, (flags & BB__BAKE_TAKE_HEIGHT) != 0, r, err);
   if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED))
-    st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), r, err);
+    st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), context, r, err);
   if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
     if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);

@@ -62,8 +62,18 @@ void bb__bake_resolve(bb_bake_options *o);
  * pixels once it is smoothed (4 bytes a texel), on success or failure. */
 enum { BB__BAKE_DROP_VIS = 1, BB__BAKE_TAKE_HEIGHT = 2 };
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
-                   bb_bake_result *r, bb_error *err);
-/* (o prepared by bb__bake_prepare: it is not checked again.) */
+                   bb_bake_context *context, bb_bake_result *r, bb_error *err);
+/* (o prepared by bb__bake_prepare: it is not checked again. context may
+ * be NULL: a cold bake.) */
+
+/* context.c: the ray set of these parameters into *rays: context's own,
+ * lent (*owned 0), built anew when the last one's parameters differ; or,
+ * without a context, built for the caller to release (*owned 1). */
+bb_status bb__context_rayset(bb_bake_context *context, int slices, double power,
+                             const bb_basis *basis, int threads, bb_rayset *rays,
+                             int *owned, bb_error *err);
+/* Ray sets the context has built (tests: 1 after two bakes alike). */
+long bb__context_rayset_builds(const bb_bake_context *context);
 
 /* The most bytes bb__bake with flags allocates at one time for a width x
  * height bake with options o (memory.c follows its stages), counting

@@ -89,6 +89,7 @@ struct bb_job {
   char *vmt_text;           /* the material's bytes, made by the plan */
   size_t vmt_size;
   bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
+  bb_bake_context *context; /* bb_job_use_context's, or NULL: cold bakes */
   bb__job_item *items;
   int count;
   int batch;                /* 1: out_dir names the outputs */

@@ -380,7 +380,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
      * as it is done with them (Valve's detail reads the height again) */
     const unsigned flags =
         BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
-    st = bb__bake(&b->height, &o, flags, &b->result, &bake_err);
+    st = bb__bake(&b->height, &o, flags, job->context, &b->result, &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
@@ -432,6 +432,11 @@ bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn pro
   }
   baked_free(&b);
   return st;
+}
+
+void bb_job_use_context(bb_job *job, bb_bake_context *context) {
+  if (job)
+    job->context = context;
 }
 
 bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb_error *err) {

@@ -5,6 +5,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "bake/bake_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -215,6 +216,77 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
     free(written[k]);
   }
   bb_job_free(job);
+}
+
+/* The maps of input 0 of a job of these slices and basis, baked through
+ * context (NULL: cold). */
+static bb_bake_result bake_with(const char *input, int slices, const char *basis,
+                                bb_bake_context *context) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.bake.slices = slices;
+  o.bake.bounce_albedo = 0.5; /* the bounce reads the ray set too */
+  o.bake.trace.threads = 2;
+  cr_assert_eq(bb_basis_parse(basis, &o.bake.basis, NULL), BB_OK);
+  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_job_use_context(job, context);
+  bb_bake_result r;
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, NULL, NULL, &r, &err), BB_OK, "%s",
+               err.message);
+  bb_job_free(job);
+  return r;
+}
+
+static void expect_same_maps(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
+  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+    const bb_image *x = bb_bake_result_image(a, (bb_output_kind)k);
+    const bb_image *y = bb_bake_result_image(b, (bb_output_kind)k);
+    if (!x || !x->pixels) {
+      cr_expect(!y || !y->pixels, "%s: kind %d", what, k);
+      continue;
+    }
+    cr_assert(y && y->pixels && x->width == y->width && x->channels == y->channels,
+              "%s: kind %d", what, k);
+    cr_expect_eq(memcmp(x->pixels, y->pixels,
+                        sizeof(float) * (size_t)x->width * (size_t)x->height *
+                            (size_t)x->channels),
+                 0, "%s: kind %d differs from a cold bake's", what, k);
+  }
+  cr_expect_str_eq(a->rayset_id, b->rayset_id, "%s", what);
+}
+
+/* A bake through a context (serve's warm bakes: the ray set kept, the
+ * buffers reused) is a cold bake's bits, the second one too, and a change
+ * of slices or basis builds the ray set of the new ones. */
+Test(job, a_warm_bake_is_a_cold_bakes_bits) {
+  const char *input = height_file();
+  bb_bake_context *context = NULL;
+  cr_assert_eq(bb_bake_context_new(&context, NULL), BB_OK);
+  bb_bake_result cold = bake_with(input, 8, "hl2", NULL);
+  for (int round = 0; round < 2; round++) {
+    bb_bake_result warm = bake_with(input, 8, "hl2", context);
+    expect_same_maps(&cold, &warm, round ? "the second warm bake" : "the first warm bake");
+    bb_bake_result_free(&warm);
+  }
+  cr_expect_eq(bb__context_rayset_builds(context), 1, "the ray set was built once");
+  bb_bake_result_free(&cold);
+  const struct {
+    int slices;
+    const char *basis;
+  } changes[] = {{12, "hl2"}, {12, "hl2+z"}, {8, "hl2"}};
+  for (int c = 0; c < 3; c++) {
+    cold = bake_with(input, changes[c].slices, changes[c].basis, NULL);
+    bb_bake_result warm = bake_with(input, changes[c].slices, changes[c].basis, context);
+    expect_same_maps(&cold, &warm, changes[c].basis);
+    cr_expect_eq(bb__context_rayset_builds(context), 2 + c);
+    bb_bake_result_free(&cold);
+    bb_bake_result_free(&warm);
+  }
+  bb_bake_context_free(context);
 }
 
 static int cancel_at_once(void *user, long done, long total) {

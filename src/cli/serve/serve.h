@@ -68,6 +68,7 @@ typedef struct serve_state {
   char error[1024];       /* the last bake's failure, "" after a success */
   serve_bake *current;    /* the last good bake, or NULL */
   long next_id;
+  bb_bake_context *context; /* the bake thread's warm ray set and buffers */
   const char *watched[SERVE_MAX_WATCHED];
   int watched_count;
   int quiet;

@@ -165,6 +165,7 @@ static void bake_once(serve_state *s, long wanted) {
   serve_bake *b = NULL;
   bb_status st = bb_job_plan(&input, 1, &o, &job, &err);
   if (st == BB_OK) {
+    bb_job_use_context(job, s->context); /* this thread's bakes only */
     progress_ctx p = {s, wanted};
     st = bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, on_progress, &p, &result, &err);
   }
@@ -185,6 +186,7 @@ static void bake_once(serve_state *s, long wanted) {
       b->normal_y_up = o.bake.normal_y_up;
       b->scale = (double)o.bake.height_scale;
       b->seconds = now_seconds() - t0;
+      bb_job_use_context(job, NULL); /* "write" may run it on another thread */
       b->job = job; /* kept: "write" writes these maps through it */
       job = NULL;
       b->wanted = wanted;
