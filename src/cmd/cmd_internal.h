@@ -116,11 +116,9 @@ void bb__option_spelling(const bb__option *o, char *out, size_t cap);
  * those that determine the output with BB_OPTION_RECORDED (text.c). */
 void bb__add_options(const bb_command *c, unsigned flags, bb__text *t);
 
-/* Runs (results.c): a file written, added to result; a failure about path
- * (its message names path once). */
+/* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
                          bb_error *err);
-bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e);
 /* The command line the outputs of c record: its record, else
  * bb_command_text's (malloc'd; NULL when out of memory). */
 char *bb__command_record(const bb_command *c);

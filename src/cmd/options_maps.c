@@ -2,12 +2,12 @@
  * ssbump2normal, combine, program), their options described once and their
  * rules. */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "maps/maps_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #define AT(member) offsetof(bb_command_options, member)
 #define RECORDED BB_OPTION_RECORDED
@@ -51,35 +51,11 @@ static const bb__option *const n2s_options[] = {
     &opt_n2s_output, &opt_n2s_normal_y, &bb__opt_depth_like_input, &bb__opt_mips, TEXTURE_ROWS,
     &bb__opt_quiet, &bb__opt_help, NULL};
 
-/* Valve's normal2ssbump output name: the input up to its first "_normal"
- * (any case), else up to its first '.', then "_ssbump.tga". Valve's tool
- * searches the whole path; this searches the file name only, so a directory
- * such as maps_normal/ or v1.2/ is left alone. */
-static char *valve_weights_name(const char *input) {
-  const char *slash = strrchr(input, '/');
-  const char *name = slash ? slash + 1 : input;
-  const char *cut = NULL;
-  for (const char *p = name; *p && !cut; p++)
-    if (strncasecmp(p, "_normal", 7) == 0)
-      cut = p;
-  if (!cut)
-    cut = strchr(name, '.');
-  if (!cut)
-    cut = name + strlen(name);
-  const size_t keep = (size_t)(cut - input);
-  char *out = malloc(keep + sizeof "_ssbump.tga");
-  if (out) {
-    memcpy(out, input, keep);
-    strcpy(out + keep, "_ssbump.tga");
-  }
-  return out;
-}
-
 static bb_status n2s_check(bb_command *c, bb_error *err) {
   if (c->in_memory)
     return BB_OK;
   if (!c->options.output) {
-    char *name = valve_weights_name(c->inputs[0]);
+    char *name = bb__job_valve_weights_name(c->inputs[0]);
     c->options.output = name ? bb__command_keep(c, name) : NULL;
     free(name);
     if (!c->options.output)

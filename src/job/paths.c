@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 /* ------------------------------------------------------------ path parts */
@@ -48,6 +49,29 @@ char *bb_path_with_suffix(const char *path, const char *suffix) {
   char *out = malloc(len);
   if (out)
     snprintf(out, len, "%.*s%s", (int)stem, path, suffix);
+  return out;
+}
+
+/* Valve's normal2ssbump output name: the input up to its first "_normal"
+ * (any case), else up to its first '.', then "_ssbump.tga". Valve's tool
+ * searches the whole path; this searches the file name only, so a directory
+ * such as maps_normal/ or v1.2/ is left alone. */
+char *bb__job_valve_weights_name(const char *input) {
+  const char *name = bb__file_name(input);
+  const char *cut = NULL;
+  for (const char *p = name; *p && !cut; p++)
+    if (strncasecmp(p, "_normal", 7) == 0)
+      cut = p;
+  if (!cut)
+    cut = strchr(name, '.');
+  if (!cut)
+    cut = name + strlen(name);
+  const size_t keep = (size_t)(cut - input);
+  char *out = malloc(keep + sizeof "_ssbump.tga");
+  if (out) {
+    memcpy(out, input, keep);
+    strcpy(out + keep, "_ssbump.tga");
+  }
   return out;
 }
 
