@@ -30,13 +30,14 @@
       &bb__opt_fast_compression
 
 /* The one output of a map command against the files it reads, with
- * --depth, --mips and the texture settings (bb_outputs_check). */
+ * --depth, --mips and the texture settings (bb__job_output_check). */
 static bb_status check_output(const bb_command *c, const char *const *reads, int read_count,
                               bb_error *err) {
   const bb_command_options *o = &c->options;
-  const bb_output_spec spec = {o->output, "output", 0, o->job.depth, o->job.mips, 0, 0, 0,
-                               BB_RANGE_UNIT, &o->job.texture};
-  return bb_outputs_check(&spec, 1, reads, read_count, err);
+  /* "output": what it holds is known when it is made (a program's) */
+  const bb__job_output out = {o->output, "output", BB_RANGE_UNIT, o->job.depth, NULL,
+                              o->job.mips, &o->job.texture};
+  return bb__job_output_check(&out, 0, reads, read_count, err);
 }
 
 /* ------------------------------------------------------- normal2ssbump */

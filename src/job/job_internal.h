@@ -172,6 +172,13 @@ typedef struct bb__job_output {
   const bb_texture_options *texture; /* a .vtf's or .dds's settings, or NULL */
 } bb__job_output;
 
+/* o's path (or, frames > 0, every frame's: bb_render_frame_path; a .gif
+ * path is one animation) checked before any work (bb_outputs_check): its
+ * format, depth and mips, its directory, and that it is none of the
+ * reads[0..read_count-1] under any spelling. */
+bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *const *reads,
+                               int read_count, bb_error *err);
+
 /* img written to o->path with s's provenance, staged and put in place (a
  * failure leaves the old file); errors name the path once. */
 bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__job_source *s,

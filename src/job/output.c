@@ -56,6 +56,39 @@ static int is_gif(const char *path) {
   return dot && strcasecmp(dot, ".gif") == 0;
 }
 
+bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *const *reads,
+                               int read_count, bb_error *err) {
+  const int gif = o->path && is_gif(o->path);
+  const int n = frames && !gif ? frames : 1;
+  bb_output_spec *specs = calloc((size_t)n, sizeof *specs);
+  char **names = calloc((size_t)n, sizeof *names);
+  bb_status st = specs && names ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  for (int f = 0; f < n && st == BB_OK; f++) {
+    const char *path = o->path;
+    if (frames && !gif) {
+      if (!(names[f] = bb_render_frame_path(o->path, f, frames)))
+        st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
+      path = names[f];
+    }
+    /* a GIF is written by the animation writer, not bb_image_write: its
+     * name is checked as a file's, its format by the command */
+    specs[f] = (bb_output_spec){.path = path,
+                                .kind = o->kind,
+                                .depth = o->depth,
+                                .mips = o->mips,
+                                .text = path && is_gif(path),
+                                .range = o->range,
+                                .texture = o->texture};
+  }
+  if (st == BB_OK)
+    st = bb_outputs_check(specs, n, reads, read_count, err);
+  for (int f = 0; names && f < n; f++)
+    free(names[f]);
+  free(names);
+  free(specs);
+  return st;
+}
+
 /* One frame made and staged under a temporary name; the caller commits it. */
 static bb_status stage_frame(const bb__job_output *o, const bb__job_frames *f, int frame,
                              const char *path, bb_staged_file **staged, bb_error *err) {
