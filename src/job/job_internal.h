@@ -16,10 +16,6 @@ const char *bb__file_name(const char *path);
 /* The directory part of path ("." when none) into dir (capacity cap). */
 void bb__directory_part(const char *path, char *dir, size_t cap);
 
-/* The lower-case extension of path's last component, without the dot ("" when
- * none), into buf (capacity cap); returns buf. */
-const char *bb__extension(const char *path, char *buf, size_t cap);
-
 /* normal2ssbump's output without -o, as Valve's tool names it (paths.c):
  * the input up to its first "_normal" (any case), else up to its first
  * '.', then "_ssbump.tga" (malloc'd; NULL when out of memory). */
