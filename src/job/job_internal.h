@@ -149,8 +149,11 @@ typedef struct bb__job_source {
   const char *extra;            /* the output's own key=value lines, or NULL */
 } bb__job_source;
 
-/* The provenance text of an output of kind made from s (malloc'd, NULL when
- * out of memory): every output's, a bake's maps' too. */
+/* The provenance of an output of kind made from s (its input recorded by
+ * file name, or input_text as it is), and its text (malloc'd, NULL when out
+ * of memory): every output's, a bake's maps' and what an up-to-date check
+ * expects of them too. */
+bb_provenance bb__job_provenance(const bb__job_source *s, const char *kind);
 char *bb__job_describe(const bb__job_source *s, const char *kind);
 
 /* The depth an output is written with: the one asked, else the input's

@@ -12,17 +12,21 @@
 #include <string.h>
 #include <strings.h>
 
-char *bb__job_describe(const bb__job_source *s, const char *kind) {
+bb_provenance bb__job_provenance(const bb__job_source *s, const char *kind) {
   const char *input = s->input_text ? s->input_text : s->input ? bb__file_name(s->input) : NULL;
-  const bb_provenance p = {.command = s->command,
-                           .input_name = input,
-                           .input_hash = s->input_hash,
-                           .output_kind = kind,
-                           .options = s->bake,
-                           .channel = s->channel,
-                           .rayset_id = s->rayset_id,
-                           .input_file_hash = s->input_file_hash,
-                           .extra = s->extra};
+  return (bb_provenance){.command = s->command,
+                         .input_name = input,
+                         .input_hash = s->input_hash,
+                         .output_kind = kind,
+                         .options = s->bake,
+                         .channel = s->channel,
+                         .rayset_id = s->rayset_id,
+                         .input_file_hash = s->input_file_hash,
+                         .extra = s->extra};
+}
+
+char *bb__job_describe(const bb__job_source *s, const char *kind) {
+  const bb_provenance p = bb__job_provenance(s, kind);
   return bb_provenance_format(&p);
 }
 

@@ -78,8 +78,12 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
       continue;
     /* A texture's settings are part of its provenance (bb_image_write adds them). */
     char *texture = bb_texture_provenance(item->paths[k], &job->options.texture);
-    bb_provenance want = {NULL, NULL, 0, kind_info(k)->name, &o, job->options.channel,
-                          rayset[0] ? rayset : NULL, item->file_hash, texture};
+    const bb__job_source s = {.input_file_hash = item->file_hash,
+                              .bake = &o,
+                              .channel = job->options.channel,
+                              .rayset_id = rayset[0] ? rayset : NULL,
+                              .extra = texture};
+    const bb_provenance want = bb__job_provenance(&s, kind_info(k)->name);
     bb_output_state state;
     const bb_depth depth = output_depth(job, k, item->paths[k], bits, is_float);
     char why[200] = "";
