@@ -1401,33 +1401,32 @@ bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image
 
 /* ---------------------------------------------------- ssbump to normal */
 
-/* What a three-channel basis map holds. */
-typedef enum bb_ssbump_kind {
-  BB_SSBUMP_LINEAR = 0, /* s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump */
-  BB_SSBUMP_SQUARED     /* w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake --weights */
-} bb_ssbump_kind;
-
-/* The normal of a basis map, the paper's "sum of the basis vectors weighted
- * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
- * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
- * f(s) = s for BB_SSBUMP_LINEAR and sqrt(max(0, s)) for BB_SSBUMP_SQUARED (the
- * square root undoes normal2ssbump's square, so both kinds give back N
- * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
- * A map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
- * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
-                              bb_image *normals, bb_error *err);
-
-/* ------------------------------------------------------------- combine */
-
-/* The kind of map combine works on; it fixes the operators and the flat,
- * unoccluded texel (ssbump 1/sqrt(3), weights 1/3, ao 1, normal (0, 0, 1)). */
+/* The kind of a map a conversion or combine works on; it fixes the
+ * operators and the flat, unoccluded texel (ssbump 1/sqrt(3), weights 1/3,
+ * ao 1, normal (0, 0, 1)). What a three-channel basis map holds is
+ * BB_MAP_SSBUMP (s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump)
+ * or BB_MAP_WEIGHTS (w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake
+ * --weights). */
 typedef enum bb_map_kind {
   BB_MAP_SSBUMP = 0, /* 3 basis channels (further channels: see bb_combine_detail) */
   BB_MAP_WEIGHTS,    /* normal2ssbump's weights, 3 basis channels */
   BB_MAP_AO,         /* 1 channel */
   BB_MAP_NORMAL      /* decoded unit normals, 3 channels */
 } bb_map_kind;
+
+/* The normal of a basis map, the paper's "sum of the basis vectors weighted
+ * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
+ * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
+ * f(s) = s for BB_MAP_SSBUMP and sqrt(max(0, s)) for BB_MAP_WEIGHTS (the
+ * square root undoes normal2ssbump's square, so both kinds give back N
+ * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
+ * A map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
+ * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
+bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
+                              bb_image *normals, bb_error *err);
+
+/* ------------------------------------------------------------- combine */
+
 
 /* Parses "ssbump", "weights", "ao", "normal" (any case). */
 bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
@@ -2792,7 +2791,7 @@ typedef struct bb_command_options {
   bb_renderbump_options renderbump; /* renderbumpflat */
   const char *height_output;    /* renderbumpflat --height */
   bb_map_kind map_kind;         /* combine --kind */
-  bb_ssbump_kind ssbump_kind;   /* ssbump2normal --kind */
+  bb_map_kind ssbump_kind;      /* ssbump2normal --kind: BB_MAP_SSBUMP or _WEIGHTS */
   double mix;                   /* combine --mix */
   const char *mask;             /* combine --mask */
   int detail;                   /* combine --detail */

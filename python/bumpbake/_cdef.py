@@ -235,11 +235,6 @@ typedef struct bb_valve_options {
   int ao_in_alpha;
 } bb_valve_options;
 
-typedef enum bb_ssbump_kind {
-  BB_SSBUMP_LINEAR = 0,
-  BB_SSBUMP_SQUARED
-} bb_ssbump_kind;
-
 typedef enum bb_map_kind {
   BB_MAP_SSBUMP = 0,
   BB_MAP_WEIGHTS,
@@ -580,7 +575,7 @@ typedef struct bb_command_options {
   bb_renderbump_options renderbump;
   const char *height_output;
   bb_map_kind map_kind;
-  bb_ssbump_kind ssbump_kind;
+  bb_map_kind ssbump_kind;
   double mix;
   const char *mask;
   int detail;
@@ -678,7 +673,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
+bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
 bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,

@@ -42,7 +42,7 @@ def normal2ssbump(normals, basis="hl2"):
     return _take(out)
 
 
-_SSBUMP_KINDS = {"ssbump": "BB_SSBUMP_LINEAR", "weights": "BB_SSBUMP_SQUARED"}
+_SSBUMP_KINDS = {"ssbump": "BB_MAP_SSBUMP", "weights": "BB_MAP_WEIGHTS"}
 
 
 def ssbump2normal(ssbump, kind="ssbump"):

@@ -71,7 +71,8 @@ struct bb__command {
   bb_status (*check)(bb_command *c, bb_error *err);
   /* its job's options (commands through the job); NULL: none */
   bb_status (*job)(bb_command *c, bb_job_options *o, bb_error *err);
-  /* its run without a job (render, sheet, the map commands); NULL: none */
+  /* its run when it makes one map or picture (render, sheet, the map
+   * commands): read and make here, write through the job (job/output.c) */
   bb__run_fn run;
 };
 
@@ -116,15 +117,14 @@ void bb__option_spelling(const bb__option *o, char *out, size_t cap);
  * those that determine the output with BB_OPTION_RECORDED (text.c). */
 void bb__add_options(const bb_command *c, unsigned flags, bb__text *t);
 
-/* Runs (results.c): a file written, added to result; a failure about path
- * (its message names path once). */
+/* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
                          bb_error *err);
-bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e);
 /* The command line the outputs of c record: its record, else
  * bb_command_text's (malloc'd; NULL when out of memory). */
 char *bb__command_record(const bb_command *c);
-/* The runs of the commands without a job (run_render.c, run_maps.c). */
+/* The runs of the commands that make one map or picture (run_render.c,
+ * run_maps.c); their writes go through the job (bb__job_write). */
 bb_status bb__run_render(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                          bb_error *err);
 bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,

@@ -43,7 +43,7 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
   bb_compare_limits_init(&o->limits);
   bb_renderbump_options_init(&o->renderbump);
   o->map_kind = BB_MAP_SSBUMP;
-  o->ssbump_kind = BB_SSBUMP_LINEAR;
+  o->ssbump_kind = BB_MAP_SSBUMP;
   if (def->init)
     def->init(o);
   *out = c;

@@ -42,7 +42,7 @@ int bb__parse_normal_y(const char *text, int *value) {
 
 /* ssbump2normal --kind: what a basis map holds */
 const char *bb__name_ssbump_kind(int i) {
-  return i == BB_SSBUMP_LINEAR ? "ssbump" : i == BB_SSBUMP_SQUARED ? "weights" : NULL;
+  return i == BB_MAP_SSBUMP ? "ssbump" : i == BB_MAP_WEIGHTS ? "weights" : NULL;
 }
 int bb__parse_ssbump_kind(const char *text, int *value) {
   for (int i = 0; i < 2; i++)

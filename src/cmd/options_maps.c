@@ -2,12 +2,12 @@
  * ssbump2normal, combine, program), their options described once and their
  * rules. */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "maps/maps_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #define AT(member) offsetof(bb_command_options, member)
 #define RECORDED BB_OPTION_RECORDED
@@ -30,13 +30,14 @@
       &bb__opt_fast_compression
 
 /* The one output of a map command against the files it reads, with
- * --depth, --mips and the texture settings (bb_outputs_check). */
+ * --depth, --mips and the texture settings (bb__job_output_check). */
 static bb_status check_output(const bb_command *c, const char *const *reads, int read_count,
                               bb_error *err) {
   const bb_command_options *o = &c->options;
-  const bb_output_spec spec = {o->output, "output", 0, o->job.depth, o->job.mips, 0, 0, 0,
-                               BB_RANGE_UNIT, &o->job.texture};
-  return bb_outputs_check(&spec, 1, reads, read_count, err);
+  /* "output": what it holds is known when it is made (a program's) */
+  const bb__job_output out = {o->output, "output", BB_RANGE_UNIT, o->job.depth, NULL,
+                              o->job.mips, &o->job.texture};
+  return bb__job_output_check(&out, 0, reads, read_count, err);
 }
 
 /* ------------------------------------------------------- normal2ssbump */
@@ -51,35 +52,11 @@ static const bb__option *const n2s_options[] = {
     &opt_n2s_output, &opt_n2s_normal_y, &bb__opt_depth_like_input, &bb__opt_mips, TEXTURE_ROWS,
     &bb__opt_quiet, &bb__opt_help, NULL};
 
-/* Valve's normal2ssbump output name: the input up to its first "_normal"
- * (any case), else up to its first '.', then "_ssbump.tga". Valve's tool
- * searches the whole path; this searches the file name only, so a directory
- * such as maps_normal/ or v1.2/ is left alone. */
-static char *valve_weights_name(const char *input) {
-  const char *slash = strrchr(input, '/');
-  const char *name = slash ? slash + 1 : input;
-  const char *cut = NULL;
-  for (const char *p = name; *p && !cut; p++)
-    if (strncasecmp(p, "_normal", 7) == 0)
-      cut = p;
-  if (!cut)
-    cut = strchr(name, '.');
-  if (!cut)
-    cut = name + strlen(name);
-  const size_t keep = (size_t)(cut - input);
-  char *out = malloc(keep + sizeof "_ssbump.tga");
-  if (out) {
-    memcpy(out, input, keep);
-    strcpy(out + keep, "_ssbump.tga");
-  }
-  return out;
-}
-
 static bb_status n2s_check(bb_command *c, bb_error *err) {
   if (c->in_memory)
     return BB_OK;
   if (!c->options.output) {
-    char *name = valve_weights_name(c->inputs[0]);
+    char *name = bb__job_valve_weights_name(c->inputs[0]);
     c->options.output = name ? bb__command_keep(c, name) : NULL;
     free(name);
     if (!c->options.output)

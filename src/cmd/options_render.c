@@ -2,6 +2,7 @@
  * and sheet), each described once, and those two commands with their
  * rules. */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "render/render_internal.h"
 
 #include <math.h>
@@ -443,31 +444,9 @@ static bb_status render_check(bb_command *c, bb_error *err) {
     reads[n_reads++] = height;
   if (o->albedo)
     reads[n_reads++] = o->albedo;
-  const int gif = has_extension(o->output, ".gif");
-  const int n = o->orbit && !gif ? o->orbit : 1;
-  bb_output_spec *specs = calloc((size_t)n, sizeof *specs);
-  char **frames = calloc((size_t)n, sizeof *frames);
-  bb_status st = specs && frames ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
-  for (int f = 0; f < n && st == BB_OK; f++) {
-    const char *path = o->output;
-    if (o->orbit && !gif) {
-      if (!(frames[f] = bb_render_frame_path(o->output, f, o->orbit)))
-        st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
-      path = frames[f];
-    }
-    /* a GIF is written by the animation writer, not bb_image_write: its
-     * name is checked as a file's, its format here */
-    specs[f] = (bb_output_spec){path, o->render_compare ? "comparison" : "render", 0,
-                                o->job.depth, 0, has_extension(path, ".gif"), 0, 0,
-                                BB_RANGE_UNIT, NULL};
-  }
-  if (st == BB_OK)
-    st = bb_outputs_check(specs, n, reads, n_reads, err);
-  for (int f = 0; frames && f < n; f++)
-    free(frames[f]);
-  free(frames);
-  free(specs);
-  return st;
+  const bb__job_output out = {o->output, o->render_compare ? "comparison" : "render",
+                              BB_RANGE_UNIT, o->job.depth, NULL, 0, NULL};
+  return bb__job_output_check(&out, o->orbit, reads, n_reads, err);
 }
 
 const bb__command bb__command_render = {
@@ -509,9 +488,8 @@ static bb_status sheet_check(bb_command *c, bb_error *err) {
                     "lights the ssbump, normal or ao");
   if (!o->output)
     return BB_OK;
-  const bb_output_spec spec = {o->output, "sheet", 0, o->job.depth, 0, 0, 0, 0, BB_RANGE_UNIT,
-                               NULL};
-  return bb_outputs_check(&spec, 1, (const char *const *)c->inputs, c->input_count, err);
+  const bb__job_output out = {o->output, "sheet", BB_RANGE_UNIT, o->job.depth, NULL, 0, NULL};
+  return bb__job_output_check(&out, 0, (const char *const *)c->inputs, c->input_count, err);
 }
 
 const bb__command bb__command_sheet = {

@@ -1,17 +1,8 @@
-/* results.c: what a run wrote (bb_command_result), and a failure about a
- * file named once. */
+/* results.c: what a run wrote (bb_command_result). */
 #include "cmd/cmd_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e) {
-  const char *why = e && e->message[0] ? e->message : bb_status_name(st);
-  const size_t n = strlen(path);
-  if (strncmp(why, path, n) == 0 && why[n] == ':')
-    return bb__fail(err, st, "%s", why);
-  return bb__fail(err, st, "%s: %s", path, why);
-}
 
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
                          bb_error *err) {

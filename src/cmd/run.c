@@ -1,6 +1,7 @@
-/* run.c: a checked command run in one call (bb_command_run): through its
- * job (bake, normal, height2ssbump), or by its own run (run_render.c,
- * run_maps.c); what it wrote, for the caller to report. */
+/* run.c: a checked command run in one call (bb_command_run): planned and
+ * run as a job (bake, normal, height2ssbump), or read and made by its own
+ * run and written through the job (run_render.c, run_maps.c); what it
+ * wrote, for the caller to report. */
 #include "cmd/cmd_internal.h"
 
 #include <stdlib.h>

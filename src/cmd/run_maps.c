@@ -1,10 +1,9 @@
 /* run_maps.c: the runs of the commands that turn maps into maps
- * (normal2ssbump, ssbump2normal, combine, program), as the command line
- * runs them: read, convert, write with provenance (the command line, the
- * input's name and the hash of its decoded pixels, the kind; no bake
- * parameters: the command holds every option). (These commands have no
- * job yet.) */
+ * (normal2ssbump, ssbump2normal, combine, program): read, convert, and
+ * the result written by the job (job/output.c: depth, provenance, staged
+ * write), its path checked against the inputs before (bb_command_check). */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -23,40 +22,26 @@ static bb_status check_hl2(const char *path, const bb_image *img, const bb_image
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
 }
 
-/* The depth to write with: the one asked, else the input's where the
- * format holds it (bb_depth_like_input). */
-static bb_depth output_depth(bb_depth asked, const bb_image_info *input, const char *path) {
-  if (asked != BB_DEPTH_DEFAULT || !input)
-    return asked;
-  return bb_depth_like_input(input->bits_per_sample, input->is_float, path);
-}
-
-static const char *file_name(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
-/* Writes img with provenance; input_name (a file name, or a program's
- * text) and input may be NULL. */
-static bb_status write_map(const bb_command *c, const char *input_name, const bb_image *input,
-                           const char *kind, const bb_image *img, bb_range range, bb_depth depth,
-                           bb_command_result *r, bb_error *err) {
+/* The command's one output, as the job writes it (bb__job_write): the
+ * depth asked, else like's where the format holds it; provenance of the
+ * command line, the input (input: a file's path, or text: a program's
+ * text) and the hash of its decoded pixels, the kind; no bake parameters
+ * (the command holds every option). */
+static bb_status write_map(const bb_command *c, const char *input, const char *text,
+                           const bb_image *pixels, const bb_image_info *like, const char *kind,
+                           const bb_image *img, bb_range range, bb_command_result *r,
+                           bb_error *err) {
   const bb_command_options *o = &c->options;
   char *record = bb__command_record(c);
-  bb_provenance p = {record, input_name, input ? bb_image_hash(input) : 0, kind, NULL,
-                     BB_CHANNEL_AUTO, NULL, 0, NULL};
-  char *description = record ? bb_provenance_format(&p) : NULL;
-  bb_status st = BB_OK;
-  if (!description) {
-    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->output);
-  } else {
-    const bb_output_file file = {o->output, kind, img, range, depth, o->job.mips, description,
-                                 NULL, 0, &o->job.texture};
-    bb_error e = {{0}};
-    if ((st = bb_outputs_write(&file, 1, 1, &e)) != BB_OK)
-      bb__fail_at(err, st, o->output, &e);
-  }
-  free(description);
+  if (!record)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->output);
+  const bb__job_source source = {.command = record,
+                                 .input = input,
+                                 .input_text = text,
+                                 .input_hash = pixels ? bb_image_hash(pixels) : 0};
+  const bb__job_output out = {o->output, kind, range, o->job.depth, like, o->job.mips,
+                              &o->job.texture};
+  bb_status st = bb__job_write(&out, img, &source, err);
   free(record);
   return st == BB_OK ? bb__result_add(r, kind, o->output, err) : st;
 }
@@ -107,8 +92,7 @@ bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
       bb__fail_at(err, st, input, &e);
   }
   if (st == BB_OK)
-    st = write_map(c, file_name(input), &values, "weights", &weights, BB_RANGE_UNIT,
-                   output_depth(o->job.depth, &info, o->output), r, err);
+    st = write_map(c, input, NULL, &values, &info, "weights", &weights, BB_RANGE_UNIT, r, err);
   bb_image_free(&weights);
   bb_image_free(&normals);
   bb_image_free(&values);
@@ -136,8 +120,7 @@ bb_status bb__run_ssbump2normal(bb_command *c, const bb_command_hooks *hooks,
   if (st == BB_OK) {
     if (o->maps_normal_y_up)
       bb_image_flip_green(&normals);
-    st = write_map(c, file_name(input), &ssbump, "normal", &normals, BB_RANGE_SIGNED,
-                   output_depth(o->job.depth, &info, o->output), r, err);
+    st = write_map(c, input, NULL, &ssbump, &info, "normal", &normals, BB_RANGE_SIGNED, r, err);
   }
   bb_image_free(&normals);
   bb_image_free(&ssbump);
@@ -234,9 +217,8 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
     const int normal = a->map_kind == BB_MAP_NORMAL;
     if (normal && a->maps_normal_y_up)
       bb_image_flip_green(&out); /* back to the inputs' convention */
-    st = write_map(c, file_name(in[0]), &m[0].file, bb_map_kind_name(a->map_kind), &out,
-                   normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT,
-                   output_depth(a->job.depth, &m[0].info, a->output), r, err);
+    st = write_map(c, in[0], NULL, &m[0].file, &m[0].info, bb_map_kind_name(a->map_kind), &out,
+                   normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, r, err);
   }
   bb_image_free(&out);
   bb_image_free(&mask);
@@ -266,8 +248,8 @@ bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_comma
   st = bb_program_run(program, &po, &out, &is_normal, err);
   bb_program_free(program);
   if (st == BB_OK)
-    st = write_map(c, text, NULL, is_normal ? "normal" : "colour", &out,
-                   is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, o->job.depth, r, err);
+    st = write_map(c, NULL, text, NULL, NULL, is_normal ? "normal" : "colour", &out,
+                   is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, r, err);
   bb_image_free(&out);
   return st;
 }

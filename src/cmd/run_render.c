@@ -1,14 +1,14 @@
-/* run_render.c: render's and sheet's runs, as the command line runs them:
- * the maps read (or baked from a HEIGHT), the picture (or every frame of an
- * orbit, or the contact sheet) made and written with provenance, all or
- * nothing. (These commands have no job yet; what a job does for bake,
- * naming and staging, is done here by hand.) */
+/* run_render.c: render's and sheet's runs: the maps read (or baked from a
+ * HEIGHT), the picture (or every frame of an orbit, or the contact sheet)
+ * made, and written by the job (job/output.c: frame names, provenance,
+ * staged all-or-nothing writes), the paths checked against the inputs
+ * before (bb_command_check). */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 /* What render reads from its options. */
 typedef struct render_args {
@@ -25,11 +25,6 @@ static unsigned needed_maps(const render_args *a) {
   if (a->compare)
     return BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO;
   return bb_render_mode_needs(a->render.mode);
-}
-
-static int has_extension(const char *path, const char *ext) {
-  const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash + 1 : path, '.');
-  return dot && strcasecmp(dot, ext) == 0;
 }
 
 /* Everything a picture is made from, and what the provenance says of it. */
@@ -203,121 +198,69 @@ static bb_status make_picture(const render_args *a, const render_inputs *in, dou
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, a->output, &e);
 }
 
-/* The provenance of one picture: the input's keys, the bake's when a
- * height was baked, then the render's (bb_render_provenance). */
-static char *describe(const render_args *a, const char *command_line, const render_inputs *in,
-                      double azimuth, int frame) {
+/* The render's own provenance lines of one picture (bb_render_provenance). */
+static char *render_lines(const render_args *a, const render_inputs *in, double azimuth,
+                          int frame) {
   bb_render_options o = a->render;
   o.light_azimuth = azimuth;
   bb_render_sources sources = in->sources;
   sources.frame = frame;
   sources.frames = a->orbit;
-  char *extra = bb_render_provenance(&sources, &o);
-  if (!extra)
-    return NULL;
-  const char *slash = strrchr(in->input, '/');
-  const int baked = a->height_path != NULL;
-  const int traced = baked && (a->bake.outputs & BB_OUTPUTS_TRACED);
-  bb_provenance p = {command_line,
-                     slash ? slash + 1 : in->input,
-                     in->input_hash,
-                     a->compare ? "render-compare" : "render",
-                     baked ? &a->bake : NULL,
-                     baked ? a->o->job.channel : BB_CHANNEL_AUTO,
-                     traced ? in->bake.rayset_id : NULL,
-                     baked ? in->source.file_hash : 0,
-                     extra};
-  char *text = bb_provenance_format(&p);
-  free(extra);
-  return text;
-}
-
-/* Encodes one picture under a temporary name; the caller commits it. */
-static bb_status stage_picture(const render_args *a, const char *command_line,
-                               const render_inputs *in, double azimuth, int frame,
-                               const char *path, int *labels, bb_staged_file **staged,
-                               bb_error *err) {
-  bb_image picture = {0};
-  bb_status st = make_picture(a, in, azimuth, &picture, labels, err);
-  char *text = st == BB_OK ? describe(a, command_line, in, azimuth, frame) : NULL;
-  if (st == BB_OK && !text)
-    st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  if (st == BB_OK) {
-    const bb_write_options wo = {a->o->job.depth, BB_RANGE_UNIT, text, NULL};
-    bb_error e = {{0}};
-    st = bb_image_write_staged(path, &picture, &wo, staged, &e);
-    if (st != BB_OK)
-      bb__fail_at(err, st, path, &e);
-  }
-  free(text);
-  bb_image_free(&picture);
-  return st;
+  return bb_render_provenance(&sources, &o);
 }
 
 static double frame_azimuth(const render_args *a, int frame) {
   return a->render.light_azimuth + 360.0 * frame / (a->orbit ? a->orbit : 1);
 }
 
-/* The picture, or every frame of an orbit, staged one by one (a frame in
- * memory at a time) and then put in place together: an orbit interrupted
- * or failed leaves the old frames, all of them. */
-static bb_status write_pictures(const render_args *a, const char *command_line,
-                                const render_inputs *in, bb_command_result *result,
-                                bb_error *err) {
-  const int n = a->orbit ? a->orbit : 1;
-  bb_staged_file **staged = calloc((size_t)n, sizeof *staged);
-  char **paths = calloc((size_t)n, sizeof *paths);
-  const char **kinds = calloc((size_t)n, sizeof *kinds);
-  bb_status st = staged && paths && kinds ? BB_OK
-                                          : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory",
-                                                     a->output);
-  for (int f = 0; f < n && st == BB_OK; f++) {
-    paths[f] = a->orbit ? bb_render_frame_path(a->output, f, a->orbit) : strdup(a->output);
-    kinds[f] = a->compare ? "comparison" : "render";
-    st = paths[f] ? stage_picture(a, command_line, in, frame_azimuth(a, f), f, paths[f],
-                                  &result->labels_drawn, &staged[f], err)
-                  : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", a->output);
-  }
-  if (st == BB_OK)
-    st = bb_staged_files_commit(staged, kinds, n, err);
-  for (int f = 0; staged && f < n; f++)
-    if (st != BB_OK)
-      bb_staged_file_discard(staged[f]);
-  for (int f = 0; st == BB_OK && f < n; f++)
-    st = bb__result_add(result, kinds[f], paths[f], err);
-  result->frames = a->orbit;
-  for (int f = 0; paths && f < n; f++)
-    free(paths[f]);
-  free(paths);
-  free(kinds);
-  free(staged);
+/* What the job's frames (bb__job_write_frames) are made from. */
+typedef struct render_frames {
+  const render_args *a;
+  const render_inputs *in;
+  int *labels_drawn;
+} render_frames;
+
+static bb_status make_frame(void *user, int frame, bb_image *picture, char **extra,
+                            bb_error *err) {
+  const render_frames *f = user;
+  const double azimuth = frame_azimuth(f->a, frame);
+  bb_status st = make_picture(f->a, f->in, azimuth, picture, f->labels_drawn, err);
+  if (st == BB_OK && extra)
+    *extra = render_lines(f->a, f->in, azimuth, frame);
   return st;
 }
 
-static bb_status write_gif(const render_args *a, const render_inputs *in,
-                           bb_command_result *result, bb_error *err) {
-  bb_animation *anim = NULL;
-  bb_error e = {{0}};
-  bb_status st = BB_OK;
-  for (int f = 0; f < a->orbit && st == BB_OK; f++) {
-    bb_image picture = {0};
-    st = make_picture(a, in, frame_azimuth(a, f), &picture, &result->labels_drawn, err);
-    if (st == BB_OK && !anim)
-      st = bb_animation_open(a->output, picture.width, picture.height, 10.0, &anim, &e);
-    if (st == BB_OK)
-      st = bb_animation_add_frame(anim, &picture, &e);
-    if (st != BB_OK && e.message[0])
-      bb__fail_at(err, st, a->output, &e);
-    bb_image_free(&picture);
-  }
-  if (st != BB_OK) {
-    bb_animation_abort(anim);
-    return st;
-  }
-  if ((st = bb_animation_close(anim, &e)) != BB_OK)
-    return bb__fail_at(err, st, a->output, &e);
+/* The picture, or every frame of an orbit (or its GIF), written by the job
+ * with the input's keys, the bake's when a height was baked, then the
+ * render's. */
+static bb_status write_pictures(const render_args *a, const char *command_line,
+                                const render_inputs *in, bb_command_result *result,
+                                bb_error *err) {
+  const int baked = a->height_path != NULL;
+  const int traced = baked && (a->bake.outputs & BB_OUTPUTS_TRACED);
+  const bb__job_source source = {.command = command_line,
+                                 .input = in->input,
+                                 .input_hash = in->input_hash,
+                                 .input_file_hash = baked ? in->source.file_hash : 0,
+                                 .bake = baked ? &a->bake : NULL,
+                                 .channel = baked ? a->o->job.channel : BB_CHANNEL_AUTO,
+                                 .rayset_id = traced ? in->bake.rayset_id : NULL};
+  render_frames user = {a, in, &result->labels_drawn};
+  const bb__job_frames frames = {a->orbit, a->compare ? "render-compare" : "render", &source,
+                                 make_frame, &user};
+  const bb__job_output out = {a->output, a->compare ? "comparison" : "render", BB_RANGE_UNIT,
+                              a->o->job.depth, NULL, 0, NULL};
+  char **paths = NULL;
+  int count = 0;
+  const char *kind = NULL;
+  bb_status st = bb__job_write_frames(&out, &frames, &paths, &count, &kind, err);
+  for (int f = 0; st == BB_OK && f < count; f++)
+    st = bb__result_add(result, kind, paths[f], err);
   result->frames = a->orbit;
-  return bb__result_add(result, "orbit", a->output, err);
+  for (int f = 0; f < count; f++)
+    free(paths[f]);
+  free(paths);
+  return st;
 }
 
 bb_status bb__run_render(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
@@ -333,9 +276,7 @@ bb_status bb__run_render(bb_command *c, const bb_command_hooks *hooks, bb_comman
   bb_status st = a.height_path ? bake_height(&a, &in, err) : load_maps(&a, &in, err);
   if (st == BB_OK)
     st = load_albedo(&a, &in, err);
-  if (st == BB_OK && a.orbit && has_extension(a.output, ".gif"))
-    st = write_gif(&a, &in, r, err);
-  else if (st == BB_OK)
+  if (st == BB_OK)
     st = write_pictures(&a, record, &in, r, err);
   inputs_free(&in);
   free(record);
@@ -411,23 +352,6 @@ bb_status bb_command_picture(bb_command *c, const bb_image *height, const bb_ren
   return st;
 }
 
-/* The sheet's provenance: the height's and the bake's keys, then the lit
- * panel's options. */
-static char *describe_sheet(const bb_command_options *a, const bb_sheet_options *sheet,
-                            const char *command_line, const char *input,
-                            const bb_height_source *source, const bb_bake_result *result) {
-  char *extra = bb_render_options_describe(&sheet->lit);
-  if (!extra)
-    return NULL;
-  const char *slash = strrchr(input, '/');
-  bb_provenance p = {command_line, slash ? slash + 1 : input, source->height_hash, "sheet",
-                     &a->job.bake, a->job.channel, result->rayset_id, source->file_hash,
-                     extra};
-  char *text = bb_provenance_format(&p);
-  free(extra);
-  return text;
-}
-
 bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                         bb_error *err) {
   const bb_command_options *a = &c->options;
@@ -441,7 +365,7 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
   memset(&result, 0, sizeof result);
   bb_height_source source;
   bb_error e = {{0}};
-  char *text = NULL, *record = bb__command_record(c);
+  char *extra = NULL, *record = bb__command_record(c);
   bb_status st = record ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
   if (st == BB_OK &&
       (st = bb_height_file_read(input, a->job.channel, a->job.bake.height_scale,
@@ -450,17 +374,24 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
     bb__fail_at(err, st, input, &e);
   if (st == BB_OK)
     st = sheet_picture(a, hooks, &height, input, &result, &picture, &r->labels_drawn, err);
-  if (st == BB_OK && !(text = describe_sheet(a, &sheet, record, input, &source, &result)))
+  /* the height's and the bake's keys, then the lit panel's options */
+  if (st == BB_OK && !(extra = bb_render_options_describe(&sheet.lit)))
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", a->output);
   if (st == BB_OK) {
-    const bb_output_file file = {a->output, "sheet", &picture, BB_RANGE_UNIT, a->job.depth,
-                                 0, text, NULL, 0, NULL};
-    if ((st = bb_outputs_write(&file, 1, 1, &e)) != BB_OK)
-      bb__fail_at(err, st, a->output, &e);
+    const bb__job_source s = {.command = record,
+                              .input = input,
+                              .input_hash = source.height_hash,
+                              .input_file_hash = source.file_hash,
+                              .bake = &a->job.bake,
+                              .channel = a->job.channel,
+                              .rayset_id = result.rayset_id,
+                              .extra = extra};
+    const bb__job_output out = {a->output, "sheet", BB_RANGE_UNIT, a->job.depth, NULL, 0, NULL};
+    st = bb__job_write(&out, &picture, &s, err);
   }
   if (st == BB_OK)
     st = bb__result_add(r, "sheet", a->output, err);
-  free(text);
+  free(extra);
   free(record);
   bb_image_free(&picture);
   bb_bake_result_free(&result);

@@ -29,6 +29,14 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...) {
   return status;
 }
 
+bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e) {
+  const char *why = e && e->message[0] ? e->message : bb_status_name(st);
+  const size_t n = strlen(path);
+  if (strncmp(why, path, n) == 0 && why[n] == ':')
+    return bb__fail(err, st, "%s", why);
+  return bb__fail(err, st, "%s: %s", path, why);
+}
+
 bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                          bb_error *err) {
   memset(img, 0, sizeof *img);

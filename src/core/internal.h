@@ -23,6 +23,10 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 #endif
     ;
 
+/* A failure about the file path, st with e's message (else st's name),
+ * naming path once: e's message as it is when it already starts "PATH:". */
+bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e);
+
 /* Finds name among names[0..count-1] (NULL entries skipped), comparing
  * with or without case, into *index: BB_OK, or BB_ERR_ARGUMENT with "WHAT
  * must be one of a, b, c (got 'x')". Every enum parser of the library uses

@@ -1,6 +1,7 @@
 /* compare_files.c: two image files compared as OpenImageIO's idiff compares
  * them, their provenance key by key, and the image of their differences. */
 #include "core/internal.h"
+#include "image/formats.h"
 #include "job/job_internal.h"
 
 #include <math.h>
@@ -11,10 +12,9 @@
  * typical golden differences (1e-5) to 0, so the image is scaled to make the
  * largest finite difference white and NaN/infinite differences clip to 1. */
 static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
-  char ext[16];
   bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
   const size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
-  if (strcmp(bb__extension(path, ext, sizeof ext), "exr") == 0) {
+  if (bb__path_has_extension(path, "exr")) {
     wo.depth = BB_DEPTH_FLOAT;
   } else {
     double max_finite = 0;

@@ -16,9 +16,10 @@ const char *bb__file_name(const char *path);
 /* The directory part of path ("." when none) into dir (capacity cap). */
 void bb__directory_part(const char *path, char *dir, size_t cap);
 
-/* The lower-case extension of path's last component, without the dot ("" when
- * none), into buf (capacity cap); returns buf. */
-const char *bb__extension(const char *path, char *buf, size_t cap);
+/* normal2ssbump's output without -o, as Valve's tool names it (paths.c):
+ * the input up to its first "_normal" (any case), else up to its first
+ * '.', then "_ssbump.tga" (malloc'd; NULL when out of memory). */
+char *bb__job_valve_weights_name(const char *input);
 
 /* Which file a path names, worked out once (paths.c): the file itself when
  * it exists, and the directory entry a write of it replaces (its
@@ -132,5 +133,75 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
 
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);
+
+/* ------------------------------------------- one map or picture (output.c) */
+
+/* Where an output came from, as its provenance records it
+ * (bb_provenance_format). */
+typedef struct bb__job_source {
+  const char *command;          /* the command line the output records */
+  const char *input;            /* the input's path (its file name is recorded), or NULL */
+  const char *input_text;       /* else an input recorded as it is (a program's text) */
+  uint64_t input_hash;          /* bb_image_hash of the input's pixels, 0: none */
+  uint64_t input_file_hash;     /* bb_file_hash of its bytes, 0: unknown */
+  const bb_bake_options *bake;  /* the bake's, when a height was baked */
+  bb_channel channel;           /* the height's channel rule, when baked */
+  const char *rayset_id;        /* when something was traced */
+  const char *extra;            /* the output's own key=value lines, or NULL */
+} bb__job_source;
+
+/* The provenance of an output of kind made from s (its input recorded by
+ * file name, or input_text as it is), and its text (malloc'd, NULL when out
+ * of memory): every output's, a bake's maps' and what an up-to-date check
+ * expects of them too. */
+bb_provenance bb__job_provenance(const bb__job_source *s, const char *kind);
+char *bb__job_describe(const bb__job_source *s, const char *kind);
+
+/* The depth an output is written with: the one asked, else the input's
+ * (bits_per_sample, is_float) where path's format holds it. */
+bb_depth bb__job_depth(bb_depth asked, int bits_per_sample, int is_float, const char *path);
+
+/* The one file of a command that makes one map or picture. */
+typedef struct bb__job_output {
+  const char *path;
+  const char *kind;              /* what it is, in messages and the written list */
+  bb_range range;
+  bb_depth depth;                /* asked */
+  const bb_image_info *like;     /* the input a default depth follows, or NULL */
+  int mips;                      /* a mip chain, where the format holds one */
+  const bb_texture_options *texture; /* a .vtf's or .dds's settings, or NULL */
+} bb__job_output;
+
+/* o's path (or, frames > 0, every frame's: bb_render_frame_path; a .gif
+ * path is one animation) checked before any work (bb_outputs_check): its
+ * format, depth and mips, its directory, and that it is none of the
+ * reads[0..read_count-1] under any spelling. */
+bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *const *reads,
+                               int read_count, bb_error *err);
+
+/* img written to o->path with s's provenance, staged and put in place (a
+ * failure leaves the old file); errors name the path once. */
+bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__job_source *s,
+                        bb_error *err);
+
+/* A picture, or the frames of an orbit, made one at a time: frame's
+ * picture and its own provenance lines (*extra, malloc'd; extra is NULL
+ * for a GIF, which stores none). */
+typedef bb_status (*bb__job_frame_fn)(void *user, int frame, bb_image *picture, char **extra,
+                                      bb_error *err);
+typedef struct bb__job_frames {
+  int frames;                    /* 0: one picture at o->path; else an orbit */
+  const char *recorded_kind;     /* the kind the provenance records */
+  const bb__job_source *source;
+  bb__job_frame_fn make;
+  void *user;
+} bb__job_frames;
+
+/* The picture, or an orbit's frames (bb_render_frame_path's names; a .gif
+ * path: one animation), each staged as it is made, then all put in place
+ * together or none. *written (malloc'd paths, *count of them) and *kind
+ * ("orbit" for an animation, else o->kind) say what was written. */
+bb_status bb__job_write_frames(const bb__job_output *o, const bb__job_frames *f, char ***written,
+                               int *count, const char **kind, bb_error *err);
 
 #endif /* BB_JOB_INTERNAL_H */

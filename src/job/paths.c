@@ -3,6 +3,7 @@
  * directories. */
 #include "core/internal.h"
 #include "files/safe_file.h"
+#include "image/formats.h"
 #include "job/job_internal.h"
 
 #include <errno.h>
@@ -10,6 +11,7 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 /* ------------------------------------------------------------ path parts */
@@ -29,16 +31,6 @@ void bb__directory_part(const char *path, char *dir, size_t cap) {
     snprintf(dir, cap, "%.*s", (int)(slash - path), path);
 }
 
-const char *bb__extension(const char *path, char *buf, size_t cap) {
-  const char *dot = strrchr(bb__file_name(path), '.');
-  size_t n = 0;
-  if (dot)
-    for (const char *c = dot + 1; *c && n + 1 < cap; c++)
-      buf[n++] = (char)((*c >= 'A' && *c <= 'Z') ? *c - 'A' + 'a' : *c);
-  buf[n] = '\0';
-  return buf;
-}
-
 char *bb_path_with_suffix(const char *path, const char *suffix) {
   if (!path || !suffix)
     return NULL;
@@ -48,6 +40,29 @@ char *bb_path_with_suffix(const char *path, const char *suffix) {
   char *out = malloc(len);
   if (out)
     snprintf(out, len, "%.*s%s", (int)stem, path, suffix);
+  return out;
+}
+
+/* Valve's normal2ssbump output name: the input up to its first "_normal"
+ * (any case), else up to its first '.', then "_ssbump.tga". Valve's tool
+ * searches the whole path; this searches the file name only, so a directory
+ * such as maps_normal/ or v1.2/ is left alone. */
+char *bb__job_valve_weights_name(const char *input) {
+  const char *name = bb__file_name(input);
+  const char *cut = NULL;
+  for (const char *p = name; *p && !cut; p++)
+    if (strncasecmp(p, "_normal", 7) == 0)
+      cut = p;
+  if (!cut)
+    cut = strchr(name, '.');
+  if (!cut)
+    cut = name + strlen(name);
+  const size_t keep = (size_t)(cut - input);
+  char *out = malloc(keep + sizeof "_ssbump.tga");
+  if (out) {
+    memcpy(out, input, keep);
+    strcpy(out + keep, "_ssbump.tga");
+  }
   return out;
 }
 
@@ -153,17 +168,17 @@ bb_texture_options bb__job_texture_of(const bb_texture_options *given, const cha
 }
 
 static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) {
-  char ext[16];
+  char ext[17]; /* ".ext" (bb__extension_of), 15 characters of it at most */
+  bb__extension_of(o->path, ext, sizeof ext);
   if (late) {
     if (o->mips && !bb_path_supports_mips(o->path))
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: --mips needs a .tif or .exr output", o->path);
     const int room = bb_path_max_channels(o->path);
     if (o->channels > room)
       return bb__fail(err, BB_ERR_ARGUMENT,
-                      "%s: %s has %d channels and .%s files hold at most %d (write it as "
+                      "%s: %s has %d channels and %s files hold at most %d (write it as "
                       ".exr or .tif)",
-                      o->path, o->kind ? o->kind : "the image", o->channels,
-                      bb__extension(o->path, ext, sizeof ext), room);
+                      o->path, o->kind ? o->kind : "the image", o->channels, ext, room);
     if (bb_path_is_texture_format(o->path) && o->width > 0 && o->channels > 0) {
       const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
       return bb_texture_check(o->path, o->width, o->height, o->channels, &t, err);
@@ -171,19 +186,19 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
     return BB_OK;
   }
   if (!bb_path_is_writable_format(o->path)) {
-    if (!bb__extension(o->path, ext, sizeof ext)[0])
+    if (!ext[0] || !ext[1]) /* none, or a bare dot */
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: no extension to choose the format by (use .png, .tga, .tif, "
                       ".tiff, .exr, .vtf or .dds)",
                       o->path);
     return bb__fail(err, BB_ERR_ARGUMENT,
-                    "%s: unknown output format '.%s' (use .png, .tga, .tif, .tiff, .exr, .vtf "
+                    "%s: unknown output format '%s' (use .png, .tga, .tif, .tiff, .exr, .vtf "
                     "or .dds)",
                     o->path, ext);
   }
   if (!bb_path_supports_depth(o->path, o->depth))
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in .%s files%s",
-                    o->path, bb_depth_name(o->depth), bb__extension(o->path, ext, sizeof ext),
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in %s files%s",
+                    o->path, bb_depth_name(o->depth), ext,
                     bb_path_is_texture_format(o->path) ? " (their texture format sets it)" : "");
   return BB_OK;
 }

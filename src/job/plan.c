@@ -6,6 +6,7 @@
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "files/safe_file.h"
+#include "image/formats.h"
 #include "job/job_internal.h"
 #include "render/render_internal.h"
 
@@ -365,12 +366,13 @@ static bb_status check_channels(const bb_job *job, const char *path, int kind, b
   const int room = bb_path_max_channels(path);
   if (bb_output_kind_get((bb_output_kind)kind)->channels != 0 || basis->count <= room)
     return BB_OK;
-  char ext[16];
+  char ext[17];
+  bb__extension_of(path, ext, sizeof ext);
   return bb__fail(err, BB_ERR_ARGUMENT,
-                  "%s: --basis %s gives %s %d channels and .%s files hold at most %d (write it "
+                  "%s: --basis %s gives %s %d channels and %s files hold at most %d (write it "
                   "as .exr or .tif)",
                   path, job->basis_file ? job->basis_file : basis->name, kind_name(kind),
-                  basis->count, bb__extension(path, ext, sizeof ext), room);
+                  basis->count, ext, room);
 }
 
 /* The channels a map of kind has (one per basis direction for weights
@@ -702,8 +704,7 @@ static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err
 }
 
 static int is_vtf(const char *path) {
-  char ext[8];
-  return strcmp(bb__extension(path, ext, sizeof ext), "vtf") == 0;
+  return bb__path_has_extension(path, "vtf");
 }
 
 /* The material of a single input: its bump map is the ssbump .vtf, else

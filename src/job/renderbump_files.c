@@ -1,6 +1,7 @@
 /* renderbump_files.c: a flat render bump's normal map and height written
  * as files, together, with what made them. */
 #include "core/internal.h"
+#include "job/job_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,10 +22,11 @@ static char *describe(const bb_renderbump_result *r, const bb_renderbump_options
     return NULL;
   }
   snprintf(extra + n, 32, "normal_y=%s\n", normal_y_up ? "up" : "down");
-  const char *slash = strrchr(model, '/');
-  bb_provenance p = {command,  slash ? slash + 1 : model, model_hash, kind, NULL,
-                     BB_CHANNEL_AUTO, NULL, 0, extra};
-  char *text = bb_provenance_format(&p);
+  const bb__job_source s = {.command = command,
+                            .input = model,
+                            .input_hash = model_hash,
+                            .extra = extra};
+  char *text = bb__job_describe(&s, kind);
   free(extra);
   return text;
 }

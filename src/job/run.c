@@ -23,8 +23,8 @@ static const bb_output_kind_info *kind_info(int kind) {
  * the input's depth where the format holds it unless a depth was asked. */
 static bb_depth output_depth(const bb_job *job, int kind, const char *path, int bits,
                              int is_float) {
-  if (kind == BB_OUTPUT_FILTERED && job->options.depth == BB_DEPTH_DEFAULT)
-    return bb_depth_like_input(bits, is_float, path);
+  if (kind == BB_OUTPUT_FILTERED)
+    return bb__job_depth(job->options.depth, bits, is_float, path);
   return job->options.depth;
 }
 
@@ -78,8 +78,12 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
       continue;
     /* A texture's settings are part of its provenance (bb_image_write adds them). */
     char *texture = bb_texture_provenance(item->paths[k], &job->options.texture);
-    bb_provenance want = {NULL, NULL, 0, kind_info(k)->name, &o, job->options.channel,
-                          rayset[0] ? rayset : NULL, item->file_hash, texture};
+    const bb__job_source s = {.input_file_hash = item->file_hash,
+                              .bake = &o,
+                              .channel = job->options.channel,
+                              .rayset_id = rayset[0] ? rayset : NULL,
+                              .extra = texture};
+    const bb_provenance want = bb__job_provenance(&s, kind_info(k)->name);
     bb_output_state state;
     const bb_depth depth = output_depth(job, k, item->paths[k], bits, is_float);
     char why[200] = "";
@@ -220,16 +224,14 @@ static char *describe(const bb_job *job, const char *command, const baked *b,
   const int traced = (job->options.bake.outputs & BB_OUTPUTS_TRACED) != 0;
   /* Valve's file names the channel its rule took (alpha, or the grey) */
   const bb_channel channel = job->valve_path ? r->source.channel : job->options.channel;
-  bb_provenance p = {command,
-                     bb__file_name(r->input),
-                     r->source.height_hash,
-                     kind,
-                     &job->options.bake,
-                     channel,
-                     traced ? b->result.rayset_id : NULL,
-                     r->source.file_hash,
-                     NULL};
-  return bb_provenance_format(&p);
+  const bb__job_source s = {.command = command,
+                            .input = r->input,
+                            .input_hash = r->source.height_hash,
+                            .input_file_hash = r->source.file_hash,
+                            .bake = &job->options.bake,
+                            .channel = channel,
+                            .rayset_id = traced ? b->result.rayset_id : NULL};
+  return bb__job_describe(&s, kind);
 }
 
 /* The depfile rule of one input: its outputs depend on it (and on the basis

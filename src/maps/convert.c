@@ -46,12 +46,12 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float,
   return BB_OK;
 }
 
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
+bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err) {
   if (!normals)
     return bb__fail(err, BB_ERR_ARGUMENT, "ssbump to normal: normals is NULL");
   memset(normals, 0, sizeof *normals);
-  if (kind != BB_SSBUMP_LINEAR && kind != BB_SSBUMP_SQUARED)
+  if (kind != BB_MAP_SSBUMP && kind != BB_MAP_WEIGHTS)
     return bb__fail(err, BB_ERR_ARGUMENT, "ssbump to normal: unknown kind %d", (int)kind);
   bb_status st = bb__check_channels(ssbump, 3, "ssbump", err);
   if (st == BB_OK)
@@ -69,7 +69,7 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_ssbump_kind kind,
   for (size_t i = 0; i < n; i++)
     for (int c = 0; c < 3; c++) {
       float s = ssbump->pixels[i * (size_t)ssbump->channels + (size_t)c];
-      if (kind == BB_SSBUMP_SQUARED)
+      if (kind == BB_MAP_WEIGHTS)
         s = sqrtf(s > 0.0f ? s : 0.0f);
       weights.pixels[3 * i + (size_t)c] = s;
     }

@@ -165,6 +165,25 @@ Test(cli_render, orbit_as_gif_and_as_frames) {
   bb_image_free(&img);
 }
 
+/* Every frame of an orbit is checked against the inputs before anything is
+ * made: a frame named as an input map is refused, and nothing is written. */
+Test(cli_render, an_orbit_frame_that_is_an_input_is_refused) {
+  cli_result r = RUN("bake", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16",
+                     "--ssbump", tmp("o_001.png"), "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  bb_image before = read_image(tmp("o_001.png"), NULL);
+  r = RUN("render", "--ssbump", tmp("o_001.png"), "--orbit", "3", "--light", "30,25", "-o",
+          tmp("o.png"));
+  expect_one_line_error(&r, 1, "o_001.png: output would overwrite the input file");
+  cli_result_free(&r);
+  cr_assert_eq(files_starting_with("o_"), 1, "no frame was written");
+  bb_image after = read_image(tmp("o_001.png"), NULL);
+  cr_assert_eq(bb_image_hash(&before), bb_image_hash(&after), "the input is untouched");
+  bb_image_free(&before);
+  bb_image_free(&after);
+}
+
 Test(cli_render, bit_identical_for_any_thread_count) {
   const char *outs[2] = {tmp("t1.png"), tmp("t2.png")};
   for (int i = 0; i < 2; i++) {
