@@ -615,6 +615,7 @@ typedef struct bb_command_result {
 # Functions, in header order.
 FUNCTIONS = """
 const char *bb_status_name(bb_status status);
+bb_status bb_image_size_check(int width, int height, int channels, bb_error *err);
 bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                          bb_error *err);
 void bb_image_free(bb_image *img);

@@ -224,6 +224,13 @@ class _Image:
         elif a.ndim != 3:
             raise _argument_error(
                 f"{what} must be an (H, W) or (H, W, C) array (got shape {a.shape})")
+        if a.size:  # the library's size rule from the shape, before any copy (a
+            # broadcast view of one value can stand for terabytes)
+            err = _ffi.new("bb_error *")
+            rows, cols, chans = (min(n, _INT_MAX) for n in a.shape)
+            st = _lib.bb_image_size_check(cols, rows, chans, err)
+            if st != _lib.BB_OK:
+                raise _exception(st, f"{what}: {_message(err, st)}", arrays=True)
         if a.dtype.kind == "u":  # value / max code, as integer files are read
             a = a.astype(np.float32) / np.float32(np.iinfo(a.dtype).max)
         elif a.dtype.kind != "f":
