@@ -187,6 +187,8 @@ def _kinds_mask(command, kinds, what="outputs", noun="output"):
 
 
 def _channel(channel):
+    if channel is None:
+        return _lib.BB_CHANNEL_AUTO
     return _parse("bb_channel_parse", "bb_channel", channel, "channel")
 
 

@@ -87,7 +87,7 @@ def _spell(option, value, what):
             return _c_text(value, what)
         if kind in (_lib.BB_OPTION_INT, _lib.BB_OPTION_NUMBER):
             return _spell_number(value, kind == _lib.BB_OPTION_INT).encode()
-        if kind == _lib.BB_OPTION_TEXT:  # a version (7.3), flags (0x4 as an int)
+        if kind in (_lib.BB_OPTION_TEXT, _lib.BB_OPTION_WORD):  # 7.3, flags 4, depth 16
             return _spell_number(value, isinstance(value, numbers.Integral)).encode()
         if kind == _lib.BB_OPTION_WORDS:
             words = list(value)
@@ -188,7 +188,12 @@ class Command:
         err = _ffi.new("bb_error *")
         st = _lib.bb_command_check(self._c, err)
         if st != _lib.BB_OK:
-            raise _exception(st, f"{self.function}: {self.spelled(_message(err, st))}")
+            message = f"{self.function}: {self.spelled(_message(err, st))}"
+            if any(o.flags & _lib.BB_OPTION_REQUIRED and not self.given(_text(o.name))
+                   and keyword(o) + " is required" in message
+                   for o in options(self.name)):
+                raise TypeError(message)  # a missing argument, as Python says it
+            raise _exception(st, message)
 
     def given(self, key):
         return bool(_lib.bb_command_given(self._c, key.encode()))
