@@ -789,6 +789,9 @@ int bb_command_has_job(const bb_command_info *command);
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
+bb_status bb_command_picture(bb_command *command, const bb_image *height,
+                             const bb_render_maps *maps, const bb_command_hooks *hooks,
+                             bb_image *out, int *labels_drawn, bb_error *err);
 bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 const char *bb_normal_y_name(int normal_y_up);
 const char *bb_addressing_name(bb_addressing addressing);

@@ -64,10 +64,10 @@ def keywords(command, client=False, files=True):
 def _spell_number(value, integer):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError
-    if integer:
-        if not isinstance(value, numbers.Integral):
-            raise TypeError
+    if isinstance(value, numbers.Integral):
         return str(int(value))
+    if integer:
+        raise TypeError
     return repr(float(value))
 
 
@@ -145,9 +145,11 @@ class Command:
                             f"{key!r}{hint}")
         return o
 
-    def set(self, key, value):
+    def set(self, key, value, skip_default=False):
         """Sets keyword key (None: left at its default; a flag False: not
-        given) through the library's parser."""
+        given) through the library's parser. skip_default: a value spelled
+        as the option's default is left ungiven (a file bake's provenance
+        then records what the command line typed without it records)."""
         o = self.option(key)
         if value is None:
             return
@@ -157,10 +159,22 @@ class Command:
             if not value:
                 return
         text = _spell(o, value, f"{self.function}: {key}")
+        if skip_default and text is not None:
+            buf = _ffi.new("char[256]")
+            _lib.bb_option_default_text(self._info, o, buf, 256)
+            if _ffi.string(buf) == text:
+                return
         err = _ffi.new("bb_error *")
         st = _lib.bb_command_set(self._c, o.name, _ffi.NULL if text is None else text, err)
         if st != _lib.BB_OK:
-            raise _exception(st, f"{self.function}: {self.spelled(_message(err, st))}")
+            raise _exception(st, self.prefixed(_message(err, st)))
+
+    def prefixed(self, message):
+        """The library's message, spelled for Python, after the function's
+        name (once)."""
+        message = self.spelled(message)
+        return message if message.startswith(self.name + ":") else \
+            f"{self.function}: {message}"
 
     def spelled(self, message):
         """The library's message with its options named as Python's
@@ -170,9 +184,9 @@ class Command:
             return keyword(o) if o != _ffi.NULL else m.group(0)
         return re.sub(r"(?<![\w-])--([a-z][a-z0-9-]*)", keyword_of, message)
 
-    def set_all(self, values):
+    def set_all(self, values, skip_default=False):
         for key, value in values.items():
-            self.set(key, value)
+            self.set(key, value, skip_default)
 
     def add_input(self, value):
         err = _ffi.new("bb_error *")
@@ -188,7 +202,7 @@ class Command:
         err = _ffi.new("bb_error *")
         st = _lib.bb_command_check(self._c, err)
         if st != _lib.BB_OK:
-            message = f"{self.function}: {self.spelled(_message(err, st))}"
+            message = self.prefixed(_message(err, st))
             if any(o.flags & _lib.BB_OPTION_REQUIRED and not self.given(_text(o.name))
                    and keyword(o) + " is required" in message
                    for o in options(self.name)):

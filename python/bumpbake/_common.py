@@ -110,7 +110,10 @@ def _c_bytes(value, what):
 
 
 def _c_text(value, what):
-    """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes)."""
+    """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes);
+    TypeError for anything else (bytes included: text is str)."""
+    if not isinstance(value, str):
+        raise TypeError(f"{what} must be a str (got {value!r})")
     return _c_bytes(value.encode(), what)
 
 

@@ -135,7 +135,7 @@ class BakeJob:
             vectors = _basis(basis)[0]  # an array of directions: no command-line spelling
         else:
             options["basis"] = basis
-        c.set_all(options)
+        c.set_all(options, skip_default=True)
         c.record(a["command"], a["command_options"])
         c.check()
         if vectors is not None:
