@@ -121,6 +121,9 @@ class BakeJob:
             if kind not in OUTPUTS:
                 raise _argument_error(f"bake: unknown map {kind!r} in outputs "
                                       f"(one of {', '.join(OUTPUTS)})")
+        if a.get("scheduler") is not None:
+            raise TypeError("bake: scheduler is the command line's: from Python, "
+                            "bumpbake.dask.bake_files(client=...) runs a batch on a cluster")
         options = {k: v for k, v in a.items()
                    if k not in ("outputs", "prefix", "notes", "command", "command_options",
                                 "force", "basis")}

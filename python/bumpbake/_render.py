@@ -247,8 +247,8 @@ class RenderBump:
 
 
 def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=False,
-                   rect=None, tile=False, threads=0, *, output=None, height_output=None,
-                   normal_y="down", notes="warn"):
+                   rect=None, tile=False, threads=0, *, output=None, height=None,
+                   height_output=None, normal_y="down", notes="warn"):
     """DOOM 3's RenderBumpFlat of a model file (anything Assimp reads) as
     `bumpbake renderbumpflat` makes it: the model projected orthographically
     along axis ("-y" DOOM 3's, "+y", "+z", "-z", "+x", "-x") onto rect
@@ -262,6 +262,10 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
     green). The library's note when the texels come out not square (with the
     size or rect that keeps them square) goes to notes ("warn": a
     NoteWarning, "ignore", or a callable) and to the result's notes."""
+    if height is not None:  # the command line's --height (height_output: its old name)
+        if height_output is not None:
+            raise TypeError("renderbumpflat: give height or height_output, not both")
+        height_output = height
     o = _ffi.new("bb_renderbump_options *")
     _lib.bb_renderbump_options_init(o)
     try:
