@@ -246,9 +246,9 @@ class RenderBump:
     notes: list              # the library's notes ("texels are ... times as wide")
 
 
-def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=False,
-                   rect=None, tile=False, threads=0, *, output=None, height=None,
-                   height_output=None, normal_y="down", notes="warn"):
+def renderbumpflat(model, size=None, samples=None, axis=None, face_normals=False, rect=None,
+                   tile=False, threads=None, *, output=None, height=None, height_output=None,
+                   normal_y=None, notes="warn"):
     """DOOM 3's RenderBumpFlat of a model file (anything Assimp reads) as
     `bumpbake renderbumpflat` makes it: the model projected orthographically
     along axis ("-y" DOOM 3's, "+y", "+z", "-z", "+x", "-x") onto rect
@@ -256,60 +256,36 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
     rectangle), samples x samples per texel of an image of size (width,
     height); face_normals: the triangles' plane normals even where the
     model has vertex normals; tile: geometry outside rect wraps into it
-    (needs rect). Returns a RenderBump (arrays +Y down). With output (and
-    height_output) the files are also written all or nothing, with
-    provenance, as the command line writes them (normal_y="up" flips their
+    (needs rect). Returns a RenderBump (arrays +Y down). With output or height
+    (height_output: its old name) the files are also written all or
+    nothing, with provenance, as the command line writes them (the normal
+    map to output, default MODEL_local.tga; normal_y="up" flips their
     green). The library's note when the texels come out not square (with the
     size or rect that keeps them square) goes to notes ("warn": a
     NoteWarning, "ignore", or a callable) and to the result's notes."""
-    if height is not None:  # the command line's --height (height_output: its old name)
-        if height_output is not None:
+    if height_output is not None:  # the old name of the command line's --height
+        if height is not None:
             raise TypeError("renderbumpflat: give height or height_output, not both")
-        height_output = height
-    o = _ffi.new("bb_renderbump_options *")
-    _lib.bb_renderbump_options_init(o)
-    try:
-        o.width, o.height = (_int("renderbumpflat", "size", v) for v in size)
-    except (TypeError, ValueError):
-        raise _argument_error(f"renderbumpflat: size must be (width, height) "
-                              f"(got {size!r})") from None
-    o.samples = _int("renderbumpflat", "samples", samples)
-    o.axis = _parse("bb_axis_parse", "bb_axis", axis, "axis")
-    o.face_normals = int(bool(face_normals))
-    if rect is not None:
-        try:
-            o.rect = [float(v) for v in rect]
-        except (TypeError, ValueError, IndexError):
-            raise _argument_error(f"renderbumpflat: rect must be (left, bottom, right, top) "
-                                  f"(got {rect!r})") from None
-        o.rect_given = 1
-    if tile and rect is None:  # the bounding rectangle has nothing outside to wrap
-        raise _argument_error("renderbumpflat: tile needs rect: the tile the sculpt repeats "
-                              "with")
-    o.tile = int(bool(tile))
-    o.threads = _int("renderbumpflat", "threads", threads)
+        height = height_output
     _check_notes(notes)
+    c = Command("renderbumpflat")
+    path = _path(model, "model")
+    c.add_input(path)
+    c.set_all(dict(size=size, samples=samples, axis=axis, face_normals=face_normals,
+                   rect=rect, tile=tile, threads=threads, normal_y=normal_y, output=output,
+                   height=height))
+    c.check()  # ranges, tile needs rect, the outputs apart and not over the model
+    o = _ffi.new("bb_renderbump_options *")
+    o[0] = c.options.renderbump
     heard = []
     note = _ffi.callback("bb_note_fn",
                          lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
     o.note = note
-    green_up = _normal_y_up("renderbumpflat", normal_y)
-    path = _path(model, "model")
+    green_up = c.options.maps_normal_y_up
+    writes = output is not None or height is not None
+    out_path = _ffi.string(c.options.output) if writes else None
+    height_path = _ffi.string(c.options.height_output) if height is not None else None
     err = _ffi.new("bb_error *")
-    if output is not None:
-        out_path = _path(output, "output")
-        height_path = _path(height_output, "height_output") if height_output is not None \
-            else None
-        # The C strings, owned here for as long as the specs point at them.
-        strings = [_ffi.new("char[]", v) for v in (out_path, height_path or b"", b"normal",
-                                                   b"height", path)]
-        specs = _ffi.new("bb_output_spec[2]", [
-            {"path": strings[0], "kind": strings[2], "channels": 4},
-            {"path": strings[1], "kind": strings[3], "channels": 1}])
-        reads = _ffi.new("char *[1]", [strings[4]])
-        _check(_lib.bb_outputs_check(specs, 2 if height_path else 1, reads, 1, err), err)
-    elif height_output is not None:
-        raise _argument_error("renderbumpflat: height_output needs output")
     mesh = _ffi.new("bb_mesh *")
     result = _ffi.new("bb_renderbump_result *")
     try:
@@ -317,7 +293,7 @@ def renderbumpflat(model, size=(256, 256), samples=4, axis="-y", face_normals=Fa
         _check(_lib.bb_renderbump_flat(mesh, o, result, err), err)
         _dispatch_notes(heard, notes, stacklevel=2)
         model_hash = _lib.bb_mesh_hash(mesh)
-        if output is not None:
+        if writes:
             _check(_lib.bb_renderbump_write(result, o, int(green_up), path, model_hash,
                                             _ffi.NULL, out_path,
                                             height_path if height_path else _ffi.NULL, err), err)

@@ -204,7 +204,7 @@ def test_renderbumpflat_refusals(fixtures, tmp_path):
     model = os.path.join(fixtures, "rivet_panel.obj")
     with pytest.raises(bumpbake.ArgumentError, match="tile needs rect"):
         bumpbake.renderbumpflat(model, tile=True)
-    with pytest.raises(bumpbake.ArgumentError, match="samples per side must be in 1..16 \(got 17\)"):
+    with pytest.raises(bumpbake.ArgumentError, match=r"samples must be in 1..16 \(got 17\)"):
         bumpbake.renderbumpflat(model, samples=17)
     with pytest.raises(bumpbake.ArgumentError, match="axis must be one of"):
         bumpbake.renderbumpflat(model, axis="w")
