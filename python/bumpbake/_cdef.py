@@ -689,6 +689,8 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err);
+bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err);
 bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
 void bb_program_free(bb_program *program);
 void bb_program_options_init(bb_program_options *o);

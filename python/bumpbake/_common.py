@@ -20,7 +20,7 @@ from . import _library
 
 _ffi, _lib, library_path = _library.load()
 
-_INT_MIN, _INT_MAX = -(2**31), 2**31 - 1
+_INT_MAX = 2**31 - 1
 
 
 class Error(Exception):
@@ -123,16 +123,6 @@ def _path(value, what="path"):
     if not isinstance(value, (str, bytes, os.PathLike)):
         raise TypeError(f"{what} must be a path (got {value!r})")
     return _c_bytes(os.fsencode(value), what)
-
-
-def _int(command, name, value):
-    try:
-        value = int(value.__index__())
-    except AttributeError:
-        raise TypeError(f"{command}: {name} must be an integer (got {value!r})") from None
-    if not _INT_MIN <= value <= _INT_MAX:
-        raise _argument_error(f"{command}: {name} {value} is out of range")
-    return value
 
 
 def _parse(parser, ctype, text, what):

@@ -2,13 +2,12 @@
 compared as idiff compares them (compare)."""
 
 import dataclasses
-import math
 import os
 import typing
 
 from ._bake import _KINDS
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi, _int,
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi,
                       _lib, _path, _text, _texture_options)
 
 

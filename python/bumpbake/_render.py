@@ -6,11 +6,10 @@ import os
 
 import numpy as np
 
-from ._bake import _IN_MEMORY, _height_field, _normal_y_up
+from ._bake import _IN_MEMORY, _height_field
 from ._command import Command
 from ._common import (_Image, _argument_error, _array, _check, _check_notes, _dispatch_notes,
-                      _exception, _ffi, _int, _lib, _message, _note_text, _parse, _path, _take,
-                      _text)
+                      _exception, _ffi, _lib, _message, _note_text, _path, _take, _text)
 
 # The default light of bb_render_options_init: on, at this azimuth and
 # elevation (degrees).

@@ -84,10 +84,14 @@ def test_combine_blends_and_overlays():
     assert not np.array_equal(bumpbake.combine(a, flat8, detail=True), a)
     n = bumpbake.combine(maps["normal"], -maps["normal"] * [1, 1, -1], mix=0.5, kind="normal")
     np.testing.assert_allclose(np.linalg.norm(n, axis=2), 1, atol=1e-6)
-    with pytest.raises(bumpbake.ArgumentError, match="exactly one of mix, mask and detail"):
+    with pytest.raises(bumpbake.ArgumentError,
+                       match="exactly one of mix, mask, detail and brightness"):
         bumpbake.combine(a, b, mix=0.5, detail=True)
-    with pytest.raises(bumpbake.ArgumentError, match="map kind must be one of"):
+    with pytest.raises(bumpbake.ArgumentError, match="kind must be one of"):
         bumpbake.combine(a, b, mix=0.5, kind="height")
+    # brightness: the paper's modulation, the command line's --brightness
+    half = np.full((32, 32), 0.5, np.float32)
+    np.testing.assert_allclose(bumpbake.combine(a, brightness=half), 0.5 * a, atol=1e-6)
 
 
 # ------------------------------------------------------------- program
