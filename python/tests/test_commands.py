@@ -297,3 +297,21 @@ def test_the_option_table_is_the_librarys():
     assert rows["rays"][3] == "256" and rows["rays"][4] == "1..65536"
     assert rows["bounces"][4] == "0..64"
     assert "bounce" in bumpbake.BAKE_PARAMETERS and "brightness" in bumpbake.BAKE_PARAMETERS
+
+
+def test_the_python_reference_names_every_command_and_bake_keyword():
+    """docs/python.md's table of which function takes which command's
+    options names every command (serve aside, as it says), and its bake()
+    entry every keyword of `bumpbake bake` for arrays."""
+    with open(os.path.join(ROOT, "docs", "python.md"), encoding="utf-8") as f:
+        doc = f.read()
+    table = doc[doc.index("| command | Python |"):doc.index("Not in Python, by design")]
+    rows = [line.split("|")[1] for line in table.splitlines()[2:] if line.startswith("|")]
+    listed = {name.strip() for row in rows for name in row.split(",")}
+    assert listed == set(FUNCTIONS), listed ^ set(FUNCTIONS)
+    for names in FUNCTIONS.values():
+        for name in names:
+            assert f"`{name}`" in table and hasattr(bumpbake, name), name
+    entry = " ".join(doc[doc.index("- `bake(height, scale"):doc.index("- `normal(height")].split())
+    for key in bumpbake.BAKE_PARAMETERS + ("channel",):
+        assert key in entry, key
