@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _command
 from ._common import (_argument_error, _array, _c_text, _check, _exception, _ffi, _Image, _lib,
-                      _message, _parse, _path, _text)
+                      _message, _parse, _path, _progress_hook, _text)
 
 
 def _output_kind_table():
@@ -161,9 +161,6 @@ def _bake_command(function, scale, options, mask, command="bake"):
 def _bake_options(command, scale, **options):
     """(bb_bake_options *, basis file or None) of bake's keyword arguments,
     through the library's command (parsed and checked there)."""
-    if scale is None:
-        raise TypeError(f"{command}: scale is required (texels of displacement per unit "
-                        "of height)")
     traced = sum(1 << _KINDS[k][0] for k in TRACED_OUTPUTS)
     c, maps = _bake_command(command, scale, options, traced)
     o = _ffi.new("bb_bake_options *")
@@ -212,17 +209,7 @@ def _run_bake(command, height, channel, options, progress=None):
     cancels the bake and is raised once the library has stopped."""
     field = _height_field(command, height, channel)
     raised = []
-
-    def on_progress(user, done, total):
-        if progress is not None and total > 0:
-            return 1 if progress(done, total) else 0
-        return 0
-
-    def on_error(exc_type, exc, tb):
-        raised.append(exc)
-        return 1  # cancel
-
-    cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+    cb = _progress_hook(progress, raised)
     options.trace.progress = cb
     result = _ffi.new("bb_bake_result *")
     err = _ffi.new("bb_error *")

@@ -66,6 +66,28 @@ def _check_notes(notes):
     return notes
 
 
+def _progress_hook(progress, raised, stop=None):
+    """The bb_progress_fn every long call hands the library: progress(done,
+    total) (may be None) may return True to cancel; an exception in it
+    (KeyboardInterrupt from Ctrl-C included: the callback runs on the
+    calling thread, so Python's signal handler raises there) cancels too and
+    is kept in raised, to be raised once the library has stopped. stop():
+    cancel when it says so. Keep the callback alive for the call."""
+
+    def on_progress(user, done, total):
+        if stop is not None and stop():
+            return 1
+        if progress is not None and total > 0:  # (0, 0): a checkpoint, not progress
+            return 1 if progress(done, total) else 0
+        return 0
+
+    def on_error(exc_type, exc, tb):
+        raised.append(exc)
+        return 1  # cancel
+
+    return _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+
+
 def _status_name(status):
     return _ffi.string(_lib.bb_status_name(status)).decode()
 

@@ -9,7 +9,7 @@ import typing
 from ._bake import OUTPUTS, _basis
 from ._command import Command
 from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _exception, _ffi,
-                      _lib, _message, _note_text, _path, _status_name, _text)
+                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _text)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -250,21 +250,10 @@ class BakeJob:
             self._notes[i] = []
             return self.report(i)
         raised = []
-
-        def on_progress(user, done, total):
-            if self._note_raised:
-                return 1  # a note the caller made an error: nothing is written
-            if progress is not None and total > 0:  # (0, 0): the notes' checkpoint
-                return 1 if progress(done, total) else 0
-            return 0
-
-        def on_error(exc_type, exc, tb):
-            raised.append(exc)
-            return 1  # cancel
-
         # Always there: a Ctrl-C during a long trace lands in this Python
-        # callback (it runs on the calling thread), which cancels the bake.
-        cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+        # callback (it runs on the calling thread), which cancels the bake;
+        # so does a note the caller made an error (nothing is written).
+        cb = _progress_hook(progress, raised, stop=lambda: bool(self._note_raised))
         self._pending = []
         self._note_raised = []
         self._note_stacklevel = stacklevel

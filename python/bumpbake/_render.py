@@ -9,7 +9,8 @@ import numpy as np
 from ._bake import _IN_MEMORY, _height_field
 from ._command import Command
 from ._common import (_Image, _argument_error, _array, _check, _check_notes, _dispatch_notes,
-                      _exception, _ffi, _lib, _message, _note_text, _path, _take, _text)
+                      _exception, _ffi, _lib, _message, _note_text, _path, _progress_hook,
+                      _take, _text)
 
 # The default light of bb_render_options_init: on, at this azimuth and
 # elevation (degrees).
@@ -50,18 +51,8 @@ def _picture(c, height, maps, progress):
     if height is not None:
         field = _height_field(c.function, height, c.options.job.channel)
     raised = []
-
-    def on_progress(user, done, total):
-        if progress is not None and total > 0:
-            return 1 if progress(done, total) else 0
-        return 0
-
-    def on_error(exc_type, exc, tb):
-        raised.append(exc)
-        return 1  # cancel
-
     hooks = _ffi.new("bb_command_hooks *")
-    cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+    cb = _progress_hook(progress, raised)
     hooks.progress = cb
     out = _ffi.new("bb_image *")
     labels = _ffi.new("int *")
@@ -195,17 +186,7 @@ def run(command, *inputs, progress=None, notes="warn", **options):
     note = _ffi.callback("bb_note_fn",
                          lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
     raised = []
-
-    def on_progress(user, done, total):
-        if progress is not None and total > 0:
-            return 1 if progress(done, total) else 0
-        return 0
-
-    def on_error(exc_type, exc, tb):
-        raised.append(exc)
-        return 1
-
-    cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+    cb = _progress_hook(progress, raised)
     hooks = _ffi.new("bb_command_hooks *")
     hooks.note, hooks.progress = note, cb
     result = _ffi.new("bb_command_result *")

@@ -13,6 +13,7 @@ import pytest
 
 import bumpbake
 from bumpbake import _command
+from test_jobs import files_of
 from bumpbake._common import _lib, _text
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -138,16 +139,6 @@ def test_values_are_refused_with_the_librarys_words():
 
 def cli(*args, cwd=None):
     return subprocess.run([BIN, *map(str, args)], capture_output=True, text=True, cwd=cwd)
-
-
-def files_of(directory):
-    out = {}
-    for base, _, names in os.walk(directory):
-        for name in names:
-            path = os.path.join(base, name)
-            with open(path, "rb") as f:
-                out[os.path.relpath(path, directory)] = f.read()
-    return out
 
 
 needs_cli = pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
