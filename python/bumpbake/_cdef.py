@@ -616,6 +616,7 @@ typedef struct bb_command_result {
 FUNCTIONS = """
 const char *bb_status_name(bb_status status);
 bb_status bb_image_size_check(int width, int height, int channels, bb_error *err);
+void bb_image_flip_green(bb_image *img);
 bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                          bb_error *err);
 void bb_image_free(bb_image *img);

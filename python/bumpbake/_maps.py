@@ -28,13 +28,31 @@ def decode_normals(values, is_float=False, normal_y="down", normalize=True):
     return _take(out)
 
 
-def normal2ssbump(normals, basis="hl2"):
+def _green_up(array, what):
+    """An _Image of a copy of array with its green negated: an OpenGL-style
+    (normal_y="up") array of normals in the library's +Y down (the
+    caller's array is left alone)."""
+    src = _Image(what, array)  # the shape checked before the copy
+    flipped = src.array.copy()
+    flipped[..., 1] *= -1
+    return _Image(what, flipped)
+
+
+def normal2ssbump(normals, basis="hl2", *, normal_y=None):
     """Valve's normal2ssbump: the basis weights w_c = sat(N.B_c)^2 /
     sum_k sat(N.B_k)^2 of unit normals (H, W, 3), +Y down (decode a file
     with decode_normals), one channel per direction of basis (bake()'s
     basis argument). A normal facing away from every direction gets 1 /
-    count in each. Returns float32 (H, W, count)."""
+    count in each. normal_y="up": the normals' green is +Y up (OpenGL), as
+    the command line's --normal-y reads a file. Returns float32 (H, W,
+    count)."""
+    c = Command("normal2ssbump")
+    c.set("normal_y", normal_y)
+    c.in_memory()
+    c.check()
     src = _Image("normal2ssbump: normals", normals, channels=(3,))
+    if c.options.maps_normal_y_up:
+        src = _green_up(normals, "normal2ssbump: normals")
     b, _ = _basis(basis)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
@@ -42,15 +60,17 @@ def normal2ssbump(normals, basis="hl2"):
     return _take(out)
 
 
-def ssbump2normal(ssbump, kind=None):
+def ssbump2normal(ssbump, kind=None, *, normal_y=None):
     """The normal of a Half-Life 2 basis map: N = normalize(sum_c f(s_c)
     B_c) over channels 0..2 (a fourth, Valve's alpha, is ignored), f(s) = s
     for kind "ssbump" (bake's ssbump, height2ssbump) and sqrt(s) for
     "weights" (normal2ssbump's, whose square it undoes). A texel of no
     weight gives (0, 0, 1). More than 4 channels (another basis) is refused.
-    Returns float32 (H, W, 3), +Y down."""
+    Returns float32 (H, W, 3), +Y down (normal_y="up": +Y up, as the
+    command line's --normal-y writes the map)."""
     c = Command("ssbump2normal")
     c.set("kind", kind)
+    c.set("normal_y", normal_y)
     c.in_memory()
     c.check()
     src = _Image("ssbump2normal: ssbump", ssbump)
@@ -58,6 +78,8 @@ def ssbump2normal(ssbump, kind=None):
     err = _ffi.new("bb_error *")
     _check(_lib.bb_ssbump_to_normal(src.image, c.options.ssbump_kind, out, err), err,
            arrays=True)
+    if c.options.maps_normal_y_up:
+        _lib.bb_image_flip_green(out)
     return _take(out)
 
 
@@ -75,7 +97,7 @@ def _mask_field(mask):
 
 
 def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_depth=None, *,
-            brightness=None):
+            brightness=None, normal_y=None):
     """Combines two maps of the same size, as `bumpbake combine` does;
     exactly one of mix, mask, detail and brightness (the library's rule).
 
@@ -91,10 +113,11 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
     ssbump), so a flat detail read from such a file leaves a unchanged bit
     for bit. brightness (an (H, W) grey array; b not given): a times it,
     the paper's brightness modulation (bb_combine_brightness). kind:
-    "ssbump" (default), "weights", "ao" or "normal". Returns float32 with
-    a's channels (3 for normals)."""
+    "ssbump" (default), "weights", "ao" or "normal"; normal_y="up": normals
+    in and out have +Y up (OpenGL), as the command line's --normal-y.
+    Returns float32 with a's channels (3 for normals)."""
     c = Command("combine")
-    c.set_all(dict(mix=mix, detail=detail, kind=kind))
+    c.set_all(dict(mix=mix, detail=detail, kind=kind, normal_y=normal_y))
     for key, value in (("mask", mask), ("brightness", brightness)):
         if value is not None:
             c.set(key, _IN_MEMORY)
@@ -103,6 +126,10 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
     if brightness is None and b is None:
         raise TypeError("combine: b is required (the second map) unless brightness is given")
     k = c.options.map_kind
+    up = c.options.maps_normal_y_up and k == _lib.BB_MAP_NORMAL
+    if up:
+        a = _green_up(a, "combine: a").array
+        b = _green_up(b, "combine: b").array if b is not None else None
     ia = _Image("combine: a", a)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
@@ -133,6 +160,8 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
             if field is not None:
                 _lib.bb_image_free(field)
     _check(st, err, arrays=True)
+    if up:
+        _lib.bb_image_flip_green(out)
     return _take(out)
 
 

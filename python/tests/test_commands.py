@@ -306,3 +306,20 @@ def test_the_python_reference_names_every_command_and_bake_keyword():
     entry = " ".join(doc[doc.index("- `bake(height, scale"):doc.index("- `normal(height")].split())
     for key in bumpbake.BAKE_PARAMETERS + ("channel",):
         assert key in entry, key
+
+
+def test_normal_y_up_arrays_are_read_and_written_as_the_cli_reads_files():
+    n = bumpbake.bake(np.random.default_rng(5).random((16, 16), np.float32), 8,
+                      outputs=("normal",))["normal"]
+    up = n * np.float32([1, -1, 1])
+    np.testing.assert_array_equal(bumpbake.normal2ssbump(up, normal_y="up"),
+                                  bumpbake.normal2ssbump(n))
+    assert up[0, 0, 1] == -n[0, 0, 1]  # the caller's array is left alone
+    s = bumpbake.normal2ssbump(n)
+    np.testing.assert_array_equal(bumpbake.ssbump2normal(s, kind="weights", normal_y="up"),
+                                  bumpbake.ssbump2normal(s, kind="weights") * [1, -1, 1])
+    np.testing.assert_array_equal(
+        bumpbake.combine(up, up[::-1], mix=0.5, kind="normal", normal_y="up"),
+        bumpbake.combine(n, n[::-1] * 1, mix=0.5, kind="normal") * [1, -1, 1])
+    with pytest.raises(bumpbake.ArgumentError, match="normal_y must be one of down, up"):
+        bumpbake.normal2ssbump(n, normal_y="sideways")
