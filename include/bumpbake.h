@@ -206,6 +206,12 @@ typedef struct bb_image {
  * figure. Errors: BB_ERR_IO (neither can be read). */
 bb_status bb_memory_available(uint64_t *bytes, const char **source, bb_error *err);
 
+/* The size rule of bb_image_alloc, without allocating: BB_OK, or its
+ * error (BB_ERR_SIZE, BB_ERR_ARGUMENT) for an image of that size, so a
+ * caller can refuse one before making it (Python checks an array's shape
+ * before copying it). */
+bb_status bb_image_size_check(int width, int height, int channels, bb_error *err);
+
 /* Allocates a zeroed image. Rejects sizes <= 0, over BB_MAX_DIMENSION or
  * BB_MAX_PIXELS, and channel counts outside 1..64 (overflow-checked).
  * Returns BB_ERR_SIZE, BB_ERR_ARGUMENT or BB_ERR_MEMORY on failure, leaving

@@ -29,7 +29,7 @@ from ._files import (Comparison, ImageInfo, VtfInfo, compare, file_hash, info, r
                      write_vmt)
 from ._jobs import BakeJob, BakeReport, bake_file, bake_files
 from ._maps import combine, decode_normals, mips, normal2ssbump, program, ssbump2normal
-from ._render import DEFAULT_LIGHT, RenderBump, render, renderbumpflat, sheet
+from ._render import DEFAULT_LIGHT, RenderBump, render, renderbumpflat, run, sheet
 from . import _library  # noqa: F401 (bumpbake._library.candidates, SONAME)
 
 __all__ = [
@@ -37,6 +37,6 @@ __all__ = [
     "DEFAULT_LIGHT", "DEFAULT_OUTPUTS", "DEFAULTS", "Error", "ImageInfo", "NoteWarning",
     "OUTPUTS", "RenderBump", "TRACED_OUTPUTS", "bake", "bake_file", "bake_files", "basis",
     "combine", "compare", "decode_normals", "file_hash", "info", "library_path", "mips",
-    "normal", "normal2ssbump", "program", "read", "render", "renderbumpflat", "sheet",
+    "normal", "normal2ssbump", "program", "read", "render", "renderbumpflat", "run", "sheet",
     "ssbump2normal", "VtfInfo", "write", "write_vmt",
 ]

@@ -6,8 +6,9 @@ import os
 
 import numpy as np
 
-from ._common import (_argument_error, _array, _check, _ffi, _Image, _int, _lib, _parse, _path,
-                      _text)
+from . import _command
+from ._common import (_argument_error, _array, _c_text, _check, _exception, _ffi, _Image, _lib,
+                      _message, _parse, _path, _progress_hook, _text)
 
 
 def _output_kind_table():
@@ -50,15 +51,23 @@ def _library_defaults():
 # parameter left at None keeps them.
 DEFAULTS = _library_defaults()
 
-# The keyword arguments of every bake (bake(), bake_files(), sheet() ...).
-BAKE_PARAMETERS = ("rays", "slices", "filter_radius", "filter_threshold", "bias", "power",
-                   "basis", "normal_filter", "normal_y", "clamp", "threads")
+# The keyword arguments of every bake (bake(), bake_files(), sheet() ...):
+# `bumpbake bake`'s options that are not about files, from the library's
+# descriptions (scale and channel are named on their own).
+BAKE_PARAMETERS = tuple(k for k in _command.keywords("bake", files=False)
+                        if k not in ("scale", "channel"))
 
 
 def _normal_y_up(command, normal_y):
-    if normal_y not in ("down", "up"):
-        raise _argument_error(f"{command}: normal_y must be one of down|up (got {normal_y!r})")
-    return normal_y == "up"
+    """normal_y ("down" or "up") by the library's parser (bb_normal_y_parse)."""
+    if not isinstance(normal_y, str):
+        raise TypeError(f"{command}: normal_y must be a str (got {normal_y!r})")
+    out = _ffi.new("int *")
+    err = _ffi.new("bb_error *")
+    st = _lib.bb_normal_y_parse(_c_text(normal_y, "normal_y"), out, err)
+    if st != _lib.BB_OK:
+        raise _exception(st, f"{command}: {_message(err, st)}")
+    return bool(out[0])
 
 
 def _basis(spec):
@@ -89,46 +98,77 @@ def basis(spec):
     return np.array([[b.vector[c][k] for k in range(3)] for c in range(b.count)])
 
 
-def _bake_options(command, scale, rays=None, slices=None, filter_radius=None,
-                  filter_threshold=None, bias=None, power=None, basis=None, normal_filter=None,
-                  normal_y=None, clamp=None, threads=None):
-    """(bb_bake_options *, basis file or None) from bake's keyword arguments;
-    None keeps the library's default. Checked by the library
-    (bb_bake_options_check) once the outputs are known."""
+_IN_MEMORY = b"(array)"  # what an option naming a file reads when an array is given
+
+
+class _BakeMaps:
+    """The maps a bake of arrays multiplies by (bounce_albedo, brightness),
+    each an array or a file's path: the option is set for the library's
+    rules, the image handed to bb_bake. Keeps the images alive."""
+
+    def __init__(self, command, values):
+        self.images = {}
+        self._keep, self._read = [], []
+        for key in ("bounce_albedo", "brightness"):
+            value = values.pop(key, None)
+            if value is None:
+                continue
+            if isinstance(value, (str, bytes, os.PathLike)):
+                command.set(key, value)
+                img = _ffi.new("bb_image *")
+                err = _ffi.new("bb_error *")
+                _check(_lib.bb_image_read(_path(value, key), img, _ffi.NULL, err), err)
+                self._read.append(img)
+            else:
+                command.set(key, _IN_MEMORY)
+                src = _Image(f"{command.function}: {key}", value)
+                self._keep.append(src)
+                img = src.image
+            self.images[key] = img
+
+        # An (N, 3) array of directions has no command-line spelling: the
+        # library makes the basis of it (bb_basis_from_vectors), set after.
+        spec = values.get("basis")
+        self.basis = None
+        if spec is not None and not isinstance(spec, (str, bytes, os.PathLike)):
+            self.basis = _basis(values.pop("basis"))[0]
+
+    def fill(self, o):
+        if self.basis is not None:
+            o.basis = self.basis[0]
+        o.bounce_albedo_map = self.images.get("bounce_albedo", _ffi.NULL)
+        o.brightness = self.images.get("brightness", _ffi.NULL)
+
+    def free(self):
+        for img in self._read:
+            _lib.bb_image_free(img)
+        self._read = []
+
+
+def _bake_command(function, scale, options, mask, command="bake"):
+    """The library's command for a bake of arrays: keywords set through its
+    parsers, checked for images in memory with the maps asked (mask)."""
+    c = _command.Command(command, function)
+    options = dict(options)
+    maps = _BakeMaps(c, options)
+    c.set("scale", scale)
+    c.set_all(options)
+    c.in_memory(mask)
+    c.check()
+    return c, maps
+
+
+def _bake_options(command, scale, **options):
+    """(bb_bake_options *, basis file or None) of bake's keyword arguments,
+    through the library's command (parsed and checked there)."""
+    traced = sum(1 << _KINDS[k][0] for k in TRACED_OUTPUTS)
+    c, maps = _bake_command(command, scale, options, traced)
     o = _ffi.new("bb_bake_options *")
-    _lib.bb_bake_options_init(o)
-    if scale is None:
-        raise TypeError(f"{command}: scale is required (texels of displacement per unit "
-                        "of height)")
-    o.height_scale = float(scale)
-    if rays is not None:
-        o.rays = _int(command, "rays", rays)
-    if slices is not None:
-        o.slices = _int(command, "slices", slices)
-        if o.slices == 0:  # 0 means "from rays" to the library
-            raise _argument_error(f"{command}: slices must be in 1..{_lib.BB_MAX_SLICES} (got 0)")
-    if filter_radius is not None:
-        o.smooth.radius_texels = _int(command, "filter_radius", filter_radius)
-    if filter_threshold is not None:
-        o.smooth.threshold = float(filter_threshold)
-    if bias is not None:
-        o.trace.bias_texels = float(bias)
-    if power is not None:
-        o.power = float(power)
-    basis_file = None
-    if basis is not None:
-        b, basis_file = _basis(basis)
-        o.basis = b[0]
-    if normal_filter is not None:
-        o.normal_filter = _parse("bb_normal_filter_parse", "bb_normal_filter", normal_filter,
-                                 "normal_filter")
-    if normal_y is not None:
-        o.normal_y_up = _normal_y_up(command, normal_y)
-    if clamp is not None:
-        o.smooth.addressing = _lib.BB_ADDRESS_CLAMP if clamp else _lib.BB_ADDRESS_PERIODIC
-    if threads is not None:
-        o.trace.threads = _int(command, "threads", threads)
-    return o, basis_file
+    o[0] = c.options.job.bake
+    if maps.basis is not None:
+        o.basis = maps.basis[0]
+    maps.free()
+    return o, _text(c.options.job.basis_file)
 
 
 def _kinds_mask(command, kinds, what="outputs", noun="output"):
@@ -144,6 +184,8 @@ def _kinds_mask(command, kinds, what="outputs", noun="output"):
 
 
 def _channel(channel):
+    if channel is None:
+        return _lib.BB_CHANNEL_AUTO
     return _parse("bb_channel_parse", "bb_channel", channel, "channel")
 
 
@@ -151,7 +193,7 @@ def _height_field(command, height, channel):
     """The 1-channel bb_image the library bakes, by the library's channel rule
     (which also refuses NaN, infinite and empty heights). Free with bb_image_free."""
     src = _Image(f"{command}: height", height)
-    which = _channel(channel)
+    which = channel if isinstance(channel, int) else _channel(channel)
     field = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
     st = _lib.bb_height_from_image(src.image, src.alpha, which, field, err)
@@ -159,30 +201,49 @@ def _height_field(command, height, channel):
     return field
 
 
-def _run_bake(command, height, channel, options):
+def _run_bake(command, height, channel, options, progress=None):
     """bb_bake of an array: the result, to free with bb_bake_result_free, and
-    the height field baked (to free with bb_image_free)."""
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_bake_options_check(options, err), err)  # bad options before a bad height
+    the height field baked (to free with bb_image_free). progress(done,
+    total) may return True to cancel; an exception it raises (Ctrl-C's
+    KeyboardInterrupt included: the callback always runs, on this thread)
+    cancels the bake and is raised once the library has stopped."""
     field = _height_field(command, height, channel)
+    raised = []
+    cb = _progress_hook(progress, raised)
+    options.trace.progress = cb
     result = _ffi.new("bb_bake_result *")
-    st = _lib.bb_bake(field, options, result, err)  # cffi releases the GIL here
+    err = _ffi.new("bb_error *")
+    try:
+        st = _lib.bb_bake(field, options, result, err)  # cffi releases the GIL here
+    finally:
+        options.trace.progress = _ffi.NULL
     if st != _lib.BB_OK:
         _lib.bb_image_free(field)
+        if raised:
+            raise raised[0]
         _check(st, err, arrays=True)
     return result, field
 
 
-def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filter_radius=None,
-         filter_threshold=None, bias=None, power=None, basis=None, normal_filter=None,
-         normal_y=None, clamp=None, channel="auto", threads=None):
+def _bake_arrays(function, height, scale, options, mask, progress, command="bake"):
+    c, maps = _bake_command(function, scale, options, mask, command)
+    try:
+        o = _ffi.new("bb_bake_options *")
+        o[0] = c.options.job.bake
+        maps.fill(o)
+        channel = c.options.job.channel
+        return _run_bake(function, height, channel, o, progress)
+    finally:
+        maps.free()
+
+
+def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
     """Bakes the maps named in outputs from a height array in one pass and
-    returns {name: float32 array}. See the module doc for the conventions."""
+    returns {name: float32 array}. See the module doc for the conventions.
+    Options: `bumpbake bake`'s that are not about files (BAKE_PARAMETERS,
+    channel), named as its long options with '_' for '-'."""
     kinds, mask = _kinds_mask("bake", outputs)
-    o, _ = _bake_options("bake", scale, rays, slices, filter_radius, filter_threshold, bias,
-                         power, basis, normal_filter, normal_y, clamp, threads)
-    o.outputs = mask  # only these are computed
-    result, field = _run_bake("bake", height, channel, o)
+    result, field = _bake_arrays("bake", height, scale, options, mask, progress)
     try:
         return {k: _array(_lib.bb_bake_result_image(result, _KINDS[k][0])) for k in kinds}
     finally:
@@ -190,15 +251,12 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, rays=None, slices=None, filt
         _lib.bb_image_free(field)
 
 
-def normal(height, scale, *, filter_radius=None, filter_threshold=None,
-           normal_filter=None, normal_y=None, clamp=None, channel="auto"):
+def normal(height, scale, *, progress=None, **options):
     """Smooths the height and returns its unit normals, float32 (H, W, 3),
-    as `bumpbake normal` makes them (nothing is traced)."""
-    o, _ = _bake_options("normal", scale, filter_radius=filter_radius,
-                         filter_threshold=filter_threshold, normal_filter=normal_filter,
-                         normal_y=normal_y, clamp=clamp)
-    o.outputs = 1 << _lib.BB_OUTPUT_NORMAL
-    result, field = _run_bake("normal", height, channel, o)
+    as `bumpbake normal` makes them (nothing is traced). Options: `bumpbake
+    normal`'s that are not about files."""
+    result, field = _bake_arrays("normal", height, scale, options,
+                                 1 << _lib.BB_OUTPUT_NORMAL, progress, command="normal")
     try:
         return _array(result.normal)
     finally:
@@ -208,39 +266,20 @@ def normal(height, scale, *, filter_radius=None, filter_threshold=None,
 
 _PARAMETERS = f"""
 
-Parameters (as `bumpbake bake --help`; None keeps the library's default):
+Parameters (as the command line's, named with '_' for '-'; None or
+absent keeps the library's default):
     height: (H, W) heights, or (H, W, C) with C = 2 grey + alpha, 3 RGB,
         4 RGBA; float arrays are used as they are, unsigned integer ones as
         value / max code.
-    scale: texels of displacement per unit of height, > 0 (required).
     outputs (bake): names from {", ".join(OUTPUTS)}; default
         {", ".join(DEFAULT_OUTPUTS)}. ssbump, ao and bent trace horizons.
-    rays (bake): ray budget, default {DEFAULTS["rays"]}, 1..65536: round(sqrt(rays))
-        azimuth slices, as Valve's tool counts rays.
-    slices (bake): azimuth slices, 1..256; overrides rays.
-    filter_radius: bilateral smoothing radius in texels, default
-        {DEFAULTS["filter_radius"]}, 0..4096, 0 = off.
-    filter_threshold: smoothing range threshold, default
-        {DEFAULTS["filter_threshold"]:.7g}, > 0.
-    bias (bake): ray origin lift in texels, default {DEFAULTS["bias"]:g}, 0..1e6.
-    power (bake): exponent of the basis lobes, default {DEFAULTS["power"]:g}, 1..1e6.
-    basis (bake): the directions of ssbump and weights, one channel each:
-        "hl2" (default), "hl2+z" (adds (0, 0, 1)), "dirs:N" (N in 3..16
-        evenly spread in azimuth at Half-Life 2's elevation), a basis file
-        (lines "x y z", # comments) or an (N, 3) array of directions.
-    normal_filter: "vertex" (centred on the texel's vertex), "valve"
-        (Valve's), "central" or "sobel"; default "{DEFAULTS["normal_filter"]}".
-    normal_y: "down" (Source, DirectX) or "up" (OpenGL); default
-        "{DEFAULTS["normal_y"]}".
-    clamp: extend the border texels instead of tiling; default {DEFAULTS["clamp"]}.
-    channel: "auto" (grey, or the mean of R, G, B; alpha when the image
-        shows Valve's convention), "r", "g", "b", "a", "luma", "mean" or
-        "valve".
-    threads (bake): worker threads, default {DEFAULTS["threads"]} = all cores,
-        0..4096; results are identical for any count.
-
+    bounce_albedo, brightness: an array or an image file's path.
+    progress: progress(done, total) may return True to cancel (Ctrl-C
+        cancels too).
+{{options}}
 Raises ArgumentError (a ValueError) with the library's message for a bad
-parameter or height, TypeError for a wrong type, Error otherwise.
+parameter or height, TypeError for a wrong type or an unknown keyword,
+Error otherwise.
 """
-bake.__doc__ += _PARAMETERS
-normal.__doc__ += _PARAMETERS
+bake.__doc__ += _PARAMETERS.format(options=_command.doc("bake", files=False))
+normal.__doc__ += _PARAMETERS.format(options=_command.doc("normal", files=False))

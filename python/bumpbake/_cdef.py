@@ -610,6 +610,8 @@ typedef struct bb_command_result {
 # Functions, in header order.
 FUNCTIONS = """
 const char *bb_status_name(bb_status status);
+bb_status bb_image_size_check(int width, int height, int channels, bb_error *err);
+void bb_image_flip_green(bb_image *img);
 bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                          bb_error *err);
 void bb_image_free(bb_image *img);
@@ -683,6 +685,8 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err);
+bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err);
 bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
 void bb_program_free(bb_program *program);
 void bb_program_options_init(bb_program_options *o);
@@ -783,6 +787,9 @@ int bb_command_has_job(const bb_command_info *command);
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
+bb_status bb_command_picture(bb_command *command, const bb_image *height,
+                             const bb_render_maps *maps, const bb_command_hooks *hooks,
+                             bb_image *out, int *labels_drawn, bb_error *err);
 bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 const char *bb_normal_y_name(int normal_y_up);
 const char *bb_addressing_name(bb_addressing addressing);

@@ -20,7 +20,7 @@ from . import _library
 
 _ffi, _lib, library_path = _library.load()
 
-_INT_MIN, _INT_MAX = -(2**31), 2**31 - 1
+_INT_MAX = 2**31 - 1
 
 
 class Error(Exception):
@@ -64,6 +64,28 @@ def _check_notes(notes):
     if notes not in ("warn", "ignore") and not callable(notes):
         raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {notes!r})")
     return notes
+
+
+def _progress_hook(progress, raised, stop=None):
+    """The bb_progress_fn every long call hands the library: progress(done,
+    total) (may be None) may return True to cancel; an exception in it
+    (KeyboardInterrupt from Ctrl-C included: the callback runs on the
+    calling thread, so Python's signal handler raises there) cancels too and
+    is kept in raised, to be raised once the library has stopped. stop():
+    cancel when it says so. Keep the callback alive for the call."""
+
+    def on_progress(user, done, total):
+        if stop is not None and stop():
+            return 1
+        if progress is not None and total > 0:  # (0, 0): a checkpoint, not progress
+            return 1 if progress(done, total) else 0
+        return 0
+
+    def on_error(exc_type, exc, tb):
+        raised.append(exc)
+        return 1  # cancel
+
+    return _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
 
 
 def _status_name(status):
@@ -110,7 +132,10 @@ def _c_bytes(value, what):
 
 
 def _c_text(value, what):
-    """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes)."""
+    """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes);
+    TypeError for anything else (bytes included: text is str)."""
+    if not isinstance(value, str):
+        raise TypeError(f"{what} must be a str (got {value!r})")
     return _c_bytes(value.encode(), what)
 
 
@@ -120,16 +145,6 @@ def _path(value, what="path"):
     if not isinstance(value, (str, bytes, os.PathLike)):
         raise TypeError(f"{what} must be a path (got {value!r})")
     return _c_bytes(os.fsencode(value), what)
-
-
-def _int(command, name, value):
-    try:
-        value = int(value.__index__())
-    except AttributeError:
-        raise TypeError(f"{command}: {name} must be an integer (got {value!r})") from None
-    if not _INT_MIN <= value <= _INT_MAX:
-        raise _argument_error(f"{command}: {name} {value} is out of range")
-    return value
 
 
 def _parse(parser, ctype, text, what):
@@ -224,6 +239,13 @@ class _Image:
         elif a.ndim != 3:
             raise _argument_error(
                 f"{what} must be an (H, W) or (H, W, C) array (got shape {a.shape})")
+        if a.size:  # the library's size rule from the shape, before any copy (a
+            # broadcast view of one value can stand for terabytes)
+            err = _ffi.new("bb_error *")
+            rows, cols, chans = (min(n, _INT_MAX) for n in a.shape)
+            st = _lib.bb_image_size_check(cols, rows, chans, err)
+            if st != _lib.BB_OK:
+                raise _exception(st, f"{what}: {_message(err, st)}", arrays=True)
         if a.dtype.kind == "u":  # value / max code, as integer files are read
             a = a.astype(np.float32) / np.float32(np.iinfo(a.dtype).max)
         elif a.dtype.kind != "f":

@@ -2,12 +2,12 @@
 compared as idiff compares them (compare)."""
 
 import dataclasses
-import math
 import os
 import typing
 
 from ._bake import _KINDS
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi, _int,
+from ._command import Command
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi,
                       _lib, _path, _text, _texture_options)
 
 
@@ -48,14 +48,16 @@ _PROVENANCE_CLASSES = {_lib.BB_PROVENANCE_NONE: "none", _lib.BB_PROVENANCE_INTAC
 
 def _provenance_dict(text):
     """The key=value lines of intact provenance as {key: value}, values as
-    written (strings), as `bumpbake info --json` prints them; a repeated
-    key keeps its first value, as the library reads it."""
-    out = {}
-    for line in text.splitlines():
-        key, eq, value = line.partition("=")
-        if eq:
-            out.setdefault(key, value)
-    return out
+    written (strings), by the library's one reading (bb_provenance_entries),
+    as `bumpbake info --json` prints them."""
+    raw = text.encode("utf-8", "surrogateescape")
+    count = _lib.bb_provenance_entries(raw, _ffi.NULL, 0)
+    entries = _ffi.new("bb_provenance_entry[]", max(count, 1))
+    count = _lib.bb_provenance_entries(raw, entries, count)
+    def part(p, n):
+        return _ffi.unpack(p, n).decode("utf-8", "surrogateescape")
+    return {part(e.key, e.key_length): part(e.value, e.value_length)
+            for e in (entries[i] for i in range(count))}
 
 
 @dataclasses.dataclass
@@ -288,14 +290,16 @@ def _diff_pairs(text, a, b):
             for key in (line.partition(": ")[0] for line in text.splitlines())]
 
 
-def compare(a, b, *, fail=1e-6, failpercent=0.0, hardfail=math.inf, allowfailures=0,
-            warn=1e-6, warnpercent=0.0, hardwarn=math.inf, diff=None):
+def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=None,
+            warn=None, warnpercent=None, hardwarn=None, diff=None):
     """Compares two image files channel by channel as OpenImageIO's idiff
     (and `bumpbake compare`) do, and their provenance key by key, and
     returns a Comparison: `assert bumpbake.compare(out, golden,
     fail=1e-4).passed` guards a golden image.
 
-    Tolerances are idiff's, absolute, in the images' float units: a pixel
+    Tolerances are idiff's (defaults: fail and warn 1e-6, failpercent and
+    warnpercent 0, hardfail and hardwarn inf, allowfailures 0; None keeps
+    them), absolute, in the images' float units: a pixel
     fails when a channel differs by more than fail, warns by more than
     warn. Verdict: PASS when at most allowfailures pixels fail; else FAILURE
     when more than failpercent % fail or any difference exceeds hardfail;
@@ -306,20 +310,18 @@ def compare(a, b, *, fail=1e-6, failpercent=0.0, hardfail=math.inf, allowfailure
     that cannot be written is reported (diff_error), not raised.
     Raises Error when a file cannot be read (idiff's exit 4),
     ArgumentError for a bad tolerance or diff path."""
-    limits = _ffi.new("bb_compare_limits *")
-    limits.fail, limits.fail_percent, limits.hard_fail = fail, failpercent, hardfail
-    limits.warn, limits.warn_percent, limits.hard_warn = warn, warnpercent, hardwarn
-    limits.allow_failures = _int("compare", "allowfailures", allowfailures)
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_compare_limits_check(limits, err), err)  # before the diff's path
+    c = Command("compare")
     pa, pb = _path(a), _path(b)
-    pd = _ffi.NULL
-    if diff is not None:
-        pd = _path(diff)
-        strings = [_ffi.new("char[]", s) for s in (pd, b"diff", pa, pb)]
-        spec = _ffi.new("bb_output_spec *", {"path": strings[0], "kind": strings[1]})
-        reads = _ffi.new("char *[2]", strings[2:])
-        _check(_lib.bb_outputs_check(spec, 1, reads, 2, err), err)
+    c.add_input(pa)
+    c.add_input(pb)
+    c.set_all(dict(fail=fail, failpercent=failpercent, hardfail=hardfail,
+                   allowfailures=allowfailures, warn=warn, warnpercent=warnpercent,
+                   hardwarn=hardwarn, diff=diff), skip_default=True)  # inf: none
+    c.check()  # the limits by their one rule, the diff's path against the inputs
+    limits = _ffi.new("bb_compare_limits *")
+    limits[0] = c.options.limits
+    pd = _path(diff) if diff is not None else _ffi.NULL
+    err = _ffi.new("bb_error *")
     r = _ffi.new("bb_compare_report *")
     _check(_lib.bb_compare_files(pa, pb, limits, pd, r, err), err)
     try:

@@ -1,14 +1,15 @@
 """Bakes of files and batches (bb_job_*): what `bumpbake bake` does, with
 the same files, provenance, up-to-date decisions and depfiles."""
 
+import collections.abc
 import dataclasses
 import os
 import typing
 
-from ._bake import BAKE_PARAMETERS, OUTPUTS, _bake_options, _channel, _kinds_mask
-from ._common import (_argument_error, _c_bytes, _c_text, _check, _check_notes, _depth,
-                      _dispatch_notes, _exception, _ffi, _lib, _message, _note_text, _path,
-                      _status_name, _text, _texture_options)
+from ._bake import OUTPUTS, _basis
+from ._command import Command
+from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _exception, _ffi,
+                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _text)
 
 _OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
              _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
@@ -86,13 +87,10 @@ class BakeJob:
 
     def __init__(self, inputs, out_dir=None, *, maps=None, name=None, outputs=None,
                  prefix=None, slope=None, lit=None, force=False, keep_going=False,
-                 depfile=None, depth=None, mips=False, channel="auto", scale=None,
+                 depfile=None, depth=None, mips=False, channel=None, scale=None,
                  notes="warn", command=None, command_options=None, texture_format=None,
                  vtf_version=None, vtf_flags=None, nomip=False, fast_compression=False,
                  vmt=None, materials=None, basetexture=None, _trace=None, **options):
-        for key in options:
-            if key not in BAKE_PARAMETERS:
-                raise TypeError(f"bake: unexpected keyword argument {key!r}")
         self._args = dict(out_dir=out_dir, maps=maps, name=name, outputs=outputs, prefix=prefix,
                           slope=slope, lit=lit, force=force, keep_going=keep_going,
                           depfile=depfile, depth=depth, mips=mips, channel=channel,
@@ -105,72 +103,51 @@ class BakeJob:
         self._trace = _trace  # a bb_trace_fn callback, kept alive with the job
         if isinstance(inputs, (str, bytes, os.PathLike)):
             inputs = [inputs]
-        self._plan([_path(p, "input") for p in inputs], self._args, options)
+        elif not isinstance(inputs, (list, tuple)):
+            raise TypeError(f"bake: inputs must be a path or a list of paths (got {inputs!r})")
+        self._plan([_path(p, "input") for p in inputs], self._args)
 
-    def _plan(self, inputs, a, options):
-        o = _ffi.new("bb_job_options *")
-        _lib.bb_job_options_init(o)
-        keep = []  # every C string the options point to, alive as long as the job
-
-        def c(value):
-            if value is None:
-                return _ffi.NULL
-            s = _ffi.new("char[]", _c_bytes(value, "a path") if isinstance(value, bytes)
-                         else _c_text(value, "text"))
-            keep.append(s)
-            return s
-
-        bake, basis_file = _bake_options("bake", a["scale"], **options)
-        o.bake = bake[0]
-        if self._trace is not None:
-            o.bake.trace.trace = self._trace
-        for key in ("command", "command_options"):
-            if a[key] is not None:
-                if not isinstance(a[key], str):
-                    raise TypeError(f"bake: {key} must be a str (got {a[key]!r})")
-                setattr(o, key, c(a[key]))
-        o.basis_file = c(basis_file)
-        o.channel = _channel(a["channel"])
-        o.depth = _depth(a["depth"])
-        o.mips = int(bool(a["mips"]))
-        o.force = int(bool(a["force"]))
-        o.keep_going = int(bool(a["keep_going"]))
-        if a["depfile"] is not None:
-            o.depfile = c(_path(a["depfile"], "depfile"))
-        _texture_options("bake", a["texture_format"], a["vtf_version"], a["vtf_flags"],
-                         a["nomip"], a["fast_compression"], out=_ffi.addressof(o, "texture"))
-        for field, key in (("vmt", "vmt"), ("vmt_materials", "materials"),
-                           ("vmt_basetexture", "basetexture")):
-            if a[key] is not None:
-                setattr(o, field, c(_path(a[key], key)))
-        if a["out_dir"] is not None:
-            if a["outputs"] or a["prefix"] is not None or a["slope"] is not None:
-                raise _argument_error("bake: out_dir names the outputs: choose them with maps, "
-                                      "not outputs, prefix or slope")
-            o.out_dir = c(_path(a["out_dir"], "out_dir"))
-            if a["maps"] is not None:
-                _, o.maps = _kinds_mask("bake", a["maps"], "maps", "map")
-            if a["name"] is not None:
-                o.name_template = c(a["name"])
+    def _command(self, inputs, a):
+        """The library's `bake` command of the arguments: each keyword set
+        as the command line's option of that name (prefix is -o), checked
+        by the library."""
+        c = Command("bake")
+        for p in inputs:
+            c.add_input(p)
+        outputs = a["outputs"]
+        if outputs is not None and not isinstance(outputs, collections.abc.Mapping):
+            raise TypeError(f"bake: outputs must be a dict {{kind: path}} (got {outputs!r})")
+        for kind in outputs or {}:
+            if kind not in OUTPUTS:
+                raise _argument_error(f"bake: unknown map {kind!r} in outputs "
+                                      f"(one of {', '.join(OUTPUTS)})")
+        if a.get("scheduler") is not None:
+            raise TypeError("bake: scheduler is the command line's: from Python, "
+                            "bumpbake.dask.bake_files(client=...) runs a batch on a cluster")
+        options = {k: v for k, v in a.items()
+                   if k not in ("outputs", "prefix", "notes", "command", "command_options",
+                                "force", "basis")}
+        options.update(outputs or {})
+        options["output"] = a["prefix"]
+        # A single bake always bakes (the command line's); force=False asks
+        # for the up-to-date check first (run()).
+        options["force"] = a["force"] if a["out_dir"] is not None else None
+        basis = a.get("basis")
+        vectors = None
+        if basis is not None and not isinstance(basis, (str, bytes, os.PathLike)):
+            vectors = _basis(basis)[0]  # an array of directions: no command-line spelling
         else:
-            if a["maps"] is not None or a["name"] is not None:
-                raise _argument_error("bake: maps and name are for batches: give out_dir")
-            for kind, path in (a["outputs"] or {}).items():
-                if kind not in OUTPUTS:
-                    raise _argument_error(f"bake: unknown map {kind!r} in outputs "
-                                          f"(one of {', '.join(OUTPUTS)})")
-                o.paths[OUTPUTS.index(kind)] = c(_path(path, f"outputs[{kind!r}]"))
-            if a["prefix"] is not None:
-                o.prefix = c(_path(a["prefix"], "prefix"))
-            if a["slope"] is not None:
-                o.slope_path = c(_path(a["slope"], "slope"))
-            if a["lit"] is not None:
-                try:
-                    o.slope_lit_azimuth, o.slope_lit_elevation = map(float, a["lit"])
-                except (TypeError, ValueError):
-                    raise _argument_error(f"bake: lit must be (azimuth, elevation) in degrees "
-                                          f"(got {a['lit']!r})") from None
-                o.slope_lit = 1
+            options["basis"] = basis
+        c.set_all(options, skip_default=True)
+        c.record(a["command"], a["command_options"])
+        c.check()
+        if vectors is not None:
+            _ffi.cast("bb_command_options *", c.options).job.bake.basis = vectors[0]
+        return c
+
+    def _plan(self, inputs, a):
+        self._cmd = self._command(inputs, a)
+        self._single = a["out_dir"] is None
         # Notes are handed out as they come, on the caller's terms (a
         # warning, a callable), and kept for the report. One the caller
         # turns into an exception cannot raise through C: it is kept, the
@@ -181,16 +158,16 @@ class BakeJob:
         self._note_raised = []
         self._note_stacklevel = None
         self._note = _ffi.callback("bb_note_fn", self._on_note)
-        o.note = self._note
-        self._options = o
-        self._keep = keep
-        arr = [_ffi.new("char[]", p) for p in inputs]
+        hooks = _ffi.new("bb_command_hooks *")
+        hooks.note = self._note
+        if self._trace is not None:
+            hooks.trace = self._trace
         err = _ffi.new("bb_error *")
         job = _ffi.new("bb_job **")
-        _check(_lib.bb_job_plan(arr, len(arr), o, job, err), err)
+        _check(_lib.bb_command_plan(self._cmd.handle, hooks, job, err), err)
         self._job = _ffi.gc(job[0], _lib.bb_job_free)
         self._count = _lib.bb_job_count(self._job)
-        self._status = [None] * self._count  # "not run" overrides
+        self._status = [None] * self._count  # "not run", "up to date" overrides
         self._notes = [[] for _ in range(self._count)]
 
     def _on_note(self, user, path, text):
@@ -237,16 +214,10 @@ class BakeJob:
 
     def command_text(self, i=0):
         """The command input i's outputs record in their provenance (key
-        "command"): `bumpbake bake INPUT` and the options that differ from
-        their defaults, as bb_job_command_text spells them. Typing this
+        "command"): `bumpbake bake INPUT` and the options given that
+        determine the output, as bb_command_text spells them. Typing this
         command gives byte-identical files."""
-        text = _lib.bb_job_command_text(self._options, self._raw(i).input)
-        if text == _ffi.NULL:
-            raise MemoryError("bb_job_command_text")
-        try:
-            return _text(text)
-        finally:
-            _lib.free(text)
+        return self._cmd.text(_ffi.string(self._raw(i).input))
 
     # ---------------------------------------------------------------- work
 
@@ -274,22 +245,15 @@ class BakeJob:
 
     def _run(self, i, progress, stacklevel):
         self._raw(i)
+        if self._single and not self._args["force"] and self.check_current(i):
+            self._status[i] = "up to date"
+            self._notes[i] = []
+            return self.report(i)
         raised = []
-
-        def on_progress(user, done, total):
-            if self._note_raised:
-                return 1  # a note the caller made an error: nothing is written
-            if progress is not None and total > 0:  # (0, 0): the notes' checkpoint
-                return 1 if progress(done, total) else 0
-            return 0
-
-        def on_error(exc_type, exc, tb):
-            raised.append(exc)
-            return 1  # cancel
-
         # Always there: a Ctrl-C during a long trace lands in this Python
-        # callback (it runs on the calling thread), which cancels the bake.
-        cb = _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
+        # callback (it runs on the calling thread), which cancels the bake;
+        # so does a note the caller made an error (nothing is written).
+        cb = _progress_hook(progress, raised, stop=lambda: bool(self._note_raised))
         self._pending = []
         self._note_raised = []
         self._note_stacklevel = stacklevel

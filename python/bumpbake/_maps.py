@@ -1,9 +1,9 @@
 """Maps on arrays: decoding normal maps, Valve's conversions, combining,
 DOOM 3 image programs and mip chains, each one call of the library."""
 
-from ._bake import _basis, _normal_y_up
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi, _lib,
-                      _parse, _path, _take)
+from ._bake import _IN_MEMORY, _basis, _normal_y_up
+from ._command import Command
+from ._common import _Image, _array, _c_text, _check, _depth, _ffi, _lib, _path, _take
 from ._files import _signed
 
 
@@ -28,13 +28,31 @@ def decode_normals(values, is_float=False, normal_y="down", normalize=True):
     return _take(out)
 
 
-def normal2ssbump(normals, basis="hl2"):
+def _green_up(array, what):
+    """An _Image of a copy of array with its green negated: an OpenGL-style
+    (normal_y="up") array of normals in the library's +Y down (the
+    caller's array is left alone)."""
+    src = _Image(what, array)  # the shape checked before the copy
+    flipped = src.array.copy()
+    flipped[..., 1] *= -1
+    return _Image(what, flipped)
+
+
+def normal2ssbump(normals, basis="hl2", *, normal_y=None):
     """Valve's normal2ssbump: the basis weights w_c = sat(N.B_c)^2 /
     sum_k sat(N.B_k)^2 of unit normals (H, W, 3), +Y down (decode a file
     with decode_normals), one channel per direction of basis (bake()'s
     basis argument). A normal facing away from every direction gets 1 /
-    count in each. Returns float32 (H, W, count)."""
+    count in each. normal_y="up": the normals' green is +Y up (OpenGL), as
+    the command line's --normal-y reads a file. Returns float32 (H, W,
+    count)."""
+    c = Command("normal2ssbump")
+    c.set("normal_y", normal_y)
+    c.in_memory()
+    c.check()
     src = _Image("normal2ssbump: normals", normals, channels=(3,))
+    if c.options.maps_normal_y_up:
+        src = _green_up(normals, "normal2ssbump: normals")
     b, _ = _basis(basis)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
@@ -42,23 +60,26 @@ def normal2ssbump(normals, basis="hl2"):
     return _take(out)
 
 
-_SSBUMP_KINDS = {"ssbump": "BB_MAP_SSBUMP", "weights": "BB_MAP_WEIGHTS"}
-
-
-def ssbump2normal(ssbump, kind="ssbump"):
+def ssbump2normal(ssbump, kind=None, *, normal_y=None):
     """The normal of a Half-Life 2 basis map: N = normalize(sum_c f(s_c)
     B_c) over channels 0..2 (a fourth, Valve's alpha, is ignored), f(s) = s
     for kind "ssbump" (bake's ssbump, height2ssbump) and sqrt(s) for
     "weights" (normal2ssbump's, whose square it undoes). A texel of no
     weight gives (0, 0, 1). More than 4 channels (another basis) is refused.
-    Returns float32 (H, W, 3), +Y down."""
-    if kind not in _SSBUMP_KINDS:
-        raise _argument_error(f"ssbump2normal: kind must be one of ssbump|weights (got {kind!r})")
+    Returns float32 (H, W, 3), +Y down (normal_y="up": +Y up, as the
+    command line's --normal-y writes the map)."""
+    c = Command("ssbump2normal")
+    c.set("kind", kind)
+    c.set("normal_y", normal_y)
+    c.in_memory()
+    c.check()
     src = _Image("ssbump2normal: ssbump", ssbump)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
-    _check(_lib.bb_ssbump_to_normal(src.image, getattr(_lib, _SSBUMP_KINDS[kind]), out, err),
-           err, arrays=True)
+    _check(_lib.bb_ssbump_to_normal(src.image, c.options.ssbump_kind, out, err), err,
+           arrays=True)
+    if c.options.maps_normal_y_up:
+        _lib.bb_image_flip_green(out)
     return _take(out)
 
 
@@ -75,9 +96,10 @@ def _mask_field(mask):
     return None, field
 
 
-def combine(a, b, mix=None, mask=None, detail=False, kind="ssbump", detail_depth=None):
+def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_depth=None, *,
+            brightness=None, normal_y=None):
     """Combines two maps of the same size, as `bumpbake combine` does;
-    exactly one of mix, mask and detail.
+    exactly one of mix, mask, detail and brightness (the library's rule).
 
     mix=T or mask (an (H, W) array, or an image whose grey / mean of R, G,
     B is taken; clamped to 0..1): (1 - T) a + T b, linear for "ssbump",
@@ -89,15 +111,33 @@ def combine(a, b, mix=None, mask=None, detail=False, kind="ssbump", detail_depth
     texel, exact (detail_depth None) or as a file of detail_depth (8, 16,
     "half", "float") stores it (bb_map_flat_texel: 147/255 in an 8-bit
     ssbump), so a flat detail read from such a file leaves a unchanged bit
-    for bit. Returns float32 with a's channels (3 for normals)."""
-    given = (mix is not None) + (mask is not None) + bool(detail)
-    if given != 1:
-        raise _argument_error("combine: give exactly one of mix, mask and detail")
-    k = _parse("bb_map_kind_parse", "bb_map_kind", kind, "kind")
-    ia, ib = _Image("combine: a", a), _Image("combine: b", b)
+    for bit. brightness (an (H, W) grey array; b not given): a times it,
+    the paper's brightness modulation (bb_combine_brightness). kind:
+    "ssbump" (default), "weights", "ao" or "normal"; normal_y="up": normals
+    in and out have +Y up (OpenGL), as the command line's --normal-y.
+    Returns float32 with a's channels (3 for normals)."""
+    c = Command("combine")
+    c.set_all(dict(mix=mix, detail=detail, kind=kind, normal_y=normal_y))
+    for key, value in (("mask", mask), ("brightness", brightness)):
+        if value is not None:
+            c.set(key, _IN_MEMORY)
+    c.in_memory()
+    c.check()
+    if brightness is None and b is None:
+        raise TypeError("combine: b is required (the second map) unless brightness is given")
+    k = c.options.map_kind
+    up = c.options.maps_normal_y_up and k == _lib.BB_MAP_NORMAL
+    if up:
+        a = _green_up(a, "combine: a").array
+        b = _green_up(b, "combine: b").array if b is not None else None
+    ia = _Image("combine: a", a)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
-    if detail:
+    if brightness is not None:
+        ib = _Image("combine: brightness", brightness)
+        st = _lib.bb_combine_brightness(ia.image, ib.image, k, out, err)
+    elif detail:
+        ib = _Image("combine: b", b)
         flat = _ffi.NULL
         if detail_depth is not None:
             d = _depth(detail_depth)
@@ -108,17 +148,20 @@ def combine(a, b, mix=None, mask=None, detail=False, kind="ssbump", detail_depth
             _lib.bb_map_flat_texel(k, bits, int(is_float), flat)
         st = _lib.bb_combine_detail(ia.image, ib.image, k, flat, out, err)
     else:
+        ib = _Image("combine: b", b)
         keep, field = (None, None)
         m = _ffi.NULL
         if mask is not None:
             keep, field = _mask_field(mask)
             m = keep.image if keep is not None else field
         try:
-            st = _lib.bb_combine_blend(ia.image, ib.image, m, float(mix or 0.0), k, out, err)
+            st = _lib.bb_combine_blend(ia.image, ib.image, m, c.options.mix, k, out, err)
         finally:
             if field is not None:
                 _lib.bb_image_free(field)
     _check(st, err, arrays=True)
+    if up:
+        _lib.bb_image_flip_green(out)
     return _take(out)
 
 

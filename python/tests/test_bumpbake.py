@@ -175,26 +175,26 @@ def test_same_bits_as_the_command_line(tmp_path):
 @pytest.mark.parametrize("kwargs, message", [
     ({"rays": 0}, "bake: rays must be in 1..65536 (got 0)"),
     ({"rays": 70000}, "bake: rays must be in 1..65536 (got 70000)"),
-    ({"scale": 0}, "bake: height scale must be > 0 (got 0)"),
-    ({"scale": float("nan")}, "bake: height scale must be > 0"),
+    ({"scale": 0}, "bake: scale must be > 0 (got 0)"),
+    ({"scale": float("nan")}, "bake: scale needs a number (got 'nan')"),
     ({"bias": -1}, "bake: bias must be in 0..1e6 (got -1)"),
     ({"bias": 2e6}, "bake: bias must be in 0..1e6 (got 2e6)"),
     ({"power": 0.5}, "bake: power must be in 1..1e6 (got 0.5)"),
     ({"power": 2e6}, "bake: power must be in 1..1e6"),
-    ({"filter_threshold": 0}, "bake: filter threshold must be > 0 (got 0)"),
-    ({"filter_radius": -1}, "bake: filter radius must be in 0..4096 (got -1)"),
-    ({"filter_radius": 4097}, "bake: filter radius must be in 0..4096 (got 4097)"),
+    ({"filter_threshold": 0}, "bake: filter_threshold must be > 0 (got 0)"),
+    ({"filter_radius": -1}, "bake: filter_radius must be in 0..4096 (got -1)"),
+    ({"filter_radius": 4097}, "bake: filter_radius must be in 0..4096 (got 4097)"),
     ({"threads": -1}, "bake: threads must be in 0..4096 (got -1)"),
     ({"threads": 4097}, "bake: threads must be in 0..4096 (got 4097)"),
-    ({"rays": 2**40}, "bake: rays 1099511627776 is out of range"),
-    ({"basis": "hl3"}, "basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of directions "
+    ({"rays": 2**40}, "bake: rays must be in 1..65536 (got 1099511627776)"),
+    ({"basis": "hl3"}, "bake: basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of directions "
                         "(got 'hl3': No such file or directory)"),
-    ({"basis": "dirs:2"}, "basis dirs:N needs a whole N in 3..16 (got 'dirs:2')"),
+    ({"basis": "dirs:2"}, "bake: basis dirs:N needs a whole N in 3..16 (got 'dirs:2')"),
     ({"basis": [[0, 0, 1], [1, 0, 0], [0, 0, 0]]}, "basis: vector 2: the zero vector"),
     ({"basis": np.zeros((3, 2))}, "basis vectors must be an (N, 3) array"),
-    ({"normal_filter": "box"}, "normal filter must be one of vertex, valve, central, sobel"),
-    ({"normal_y": "left"}, "bake: normal_y must be one of down|up (got 'left')"),
-    ({"channel": "z"}, "channel must be one of auto, r, g, b, a, luma, mean, valve (got 'z')"),
+    ({"normal_filter": "box"}, "bake: normal_filter must be one of valve, central, sobel, vertex (got 'box')"),
+    ({"normal_y": "left"}, "bake: normal_y must be one of down, up (got 'left')"),
+    ({"channel": "z"}, "bake: channel must be one of auto, r, g, b, a, luma, mean, valve (got 'z')"),
     ({"channel": "a"}, "channel 'a' asked of an image with no alpha (1 channels)"),
     ({"outputs": ("normal", "shadow")}, "bake: unknown output 'shadow'"),
     ({"outputs": ()}, "bake: nothing to make: outputs is empty"),
@@ -272,8 +272,13 @@ def test_the_gil_is_released_while_baking():
 # ---------------------------------------------------------------- loading
 
 def test_docstrings_show_the_library_defaults():
-    assert "default 256, 1..65536" in bumpbake.bake.__doc__
-    assert 'default "vertex"' in bumpbake.normal.__doc__
+    """The docstrings are written from the library's descriptions."""
+    doc = " ".join(bumpbake.bake.__doc__.split())
+    assert "rays: ray budget" in doc and "(default 256; 1..65536)" in doc
+    assert "normal_filter: normal estimator" in bumpbake.normal.__doc__
+    assert "(default vertex)" in bumpbake.normal.__doc__
+    for key in bumpbake.BAKE_PARAMETERS:
+        assert f"    {key}: " in bumpbake.bake.__doc__, key
     assert bumpbake.DEFAULTS["rays"] == 256 and bumpbake.DEFAULTS["bias"] == pytest.approx(0.55)
 
 

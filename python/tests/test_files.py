@@ -61,8 +61,9 @@ def test_allowed_failures_and_hard_limits(tmp_path):
     assert bumpbake.compare(a, b, failpercent=10, warnpercent=10, hardwarn=0.1).result == "WARNING"
     with pytest.raises(bumpbake.ArgumentError, match=r"failpercent must be in 0..100 \(got 150\)"):
         bumpbake.compare(a, b, failpercent=150)
-    with pytest.raises(bumpbake.ArgumentError, match="fail must be >= 0"):
+    with pytest.raises(bumpbake.ArgumentError, match="fail needs a number"):
         bumpbake.compare(a, b, fail=math.nan)
+    assert bumpbake.compare(a, b, fail=0.3, hardfail=math.inf).result == "PASS"
     with pytest.raises(bumpbake.Error, match="missing.exr") as e:
         bumpbake.compare(a, tmp_path / "missing.exr")
     assert not isinstance(e.value, bumpbake.ArgumentError)

@@ -136,11 +136,11 @@ def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):
 @pytest.mark.parametrize("kwargs, error, message", [
     ({"name": "../{stem}.png"}, bumpbake.ArgumentError,
      "--name ../{stem}.png: '..' would leave the output directory"),
-    ({"maps": ("normal", "shine")}, bumpbake.ArgumentError, "bake: unknown map 'shine'"),
+    ({"maps": ("normal", "shine")}, bumpbake.ArgumentError, "bake: maps: unknown map 'shine'"),
     ({"depth": 12}, bumpbake.ArgumentError, "depth must be one of 8, 16, half, float"),
     ({"rays": 0}, bumpbake.ArgumentError, "bake: rays must be in 1..65536 (got 0)"),
     ({"mips": True}, bumpbake.ArgumentError, "--mips needs a .tif or .exr output"),
-    ({"texture_format": "dxt7"}, bumpbake.ArgumentError, "texture format must be one of"),
+    ({"texture_format": "dxt7"}, bumpbake.ArgumentError, "texture_format must be one of"),
     ({"vtf_version": "7.9"}, bumpbake.ArgumentError, "VTF version must be 7.2, 7.3, 7.4 or 7.5"),
     ({"vtf_flags": -1}, bumpbake.ArgumentError, "VTF flags must be a 32-bit number"),
     ({"vmt": "m.vmt"}, bumpbake.ArgumentError, "--vmt writes one material"),

@@ -123,7 +123,12 @@ static void weights_row(void *user, int y) {
 
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
                             bb_error *err) {
-  return bb__derive_weights(normals, basis, 0, out, err);
+  /* A caller's normals may hold NaN (a bake's never do: its heights are
+   * checked), which would come out as 1 / count in every channel. */
+  bb_status st = check_image(normals, "normal", 3, 3, err);
+  if (st == BB_OK)
+    st = bb__check_finite(normals, 3, "normals", err);
+  return st == BB_OK ? bb__derive_weights(normals, basis, 0, out, err) : st;
 }
 
 bb_status bb__derive_weights(const bb_image *normals, const bb_basis *basis, int threads,

@@ -37,9 +37,7 @@ bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_er
   return bb__fail(err, st, "%s: %s", path, why);
 }
 
-bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
-                         bb_error *err) {
-  memset(img, 0, sizeof *img);
+bb_status bb_image_size_check(int width, int height, int channels, bb_error *err) {
   if (width <= 0 || height <= 0)
     return bb__fail(err, BB_ERR_SIZE, "zero or negative image size %dx%d", width, height);
   if (width > BB_MAX_DIMENSION || height > BB_MAX_DIMENSION ||
@@ -49,6 +47,15 @@ bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                     height, BB_MAX_DIMENSION, (long)BB_MAX_PIXELS);
   if (channels < 1 || channels > 64)
     return bb__fail(err, BB_ERR_ARGUMENT, "unsupported channel count %d", channels);
+  return BB_OK;
+}
+
+bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
+                         bb_error *err) {
+  memset(img, 0, sizeof *img);
+  bb_status st = bb_image_size_check(width, height, channels, err);
+  if (st != BB_OK)
+    return st;
   /* width*height <= 2^26 and channels <= 64, so the product fits in size_t. */
   size_t count = (size_t)width * (size_t)height * (size_t)channels;
   img->pixels = calloc(count, sizeof(float));

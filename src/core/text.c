@@ -4,6 +4,7 @@
 
 #include "core/internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,18 +77,27 @@ void bb__text_free(bb__text *t) {
   memset(t, 0, sizeof *t);
 }
 
+/* The shortest %g that reads back as v has an exponent for a whole number
+ * of more digits than it needs (30 as "3e+01"): a user types 30. */
+static void whole_number_plainly(double v, char *buf, size_t cap) {
+  if (strstr(buf, "e+") && fabs(v) < 1e15)
+    snprintf(buf, cap, "%.0f", v);
+}
+
 void bb__float_text(float v, char *buf, size_t cap) {
   for (int digits = 1; digits <= 9; digits++) {
     snprintf(buf, cap, "%.*g", digits, (double)v);
     if (strtof(buf, NULL) == v)
-      return;
+      break;
   }
+  whole_number_plainly(v, buf, cap);
 }
 
 void bb__double_text(double v, char *buf, size_t cap) {
   for (int digits = 1; digits <= 17; digits++) {
     snprintf(buf, cap, "%.*g", digits, v);
     if (strtod(buf, NULL) == v)
-      return;
+      break;
   }
+  whole_number_plainly(v, buf, cap);
 }

@@ -334,7 +334,10 @@ static bb_status check_map(const bb_image *img, const char *what, int min_channe
   if (first && (img->width != first->width || img->height != first->height))
     return bb__fail(err, BB_ERR_ARGUMENT, "render: the %s map is %dx%d, the others %dx%d",
                     what, img->width, img->height, first->width, first->height);
-  return BB_OK;
+  /* NaN or infinite values would light as black or white, silently */
+  char name[64];
+  snprintf(name, sizeof name, "render: the %s map", what);
+  return bb__check_finite(img, min_channels, name, err);
 }
 
 /* The maps a mode reads, checked; *size receives the first one. */

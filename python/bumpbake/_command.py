@@ -1,0 +1,283 @@
+"""The generic driver over the library's descriptions of its commands
+(bb_command_*, bb_option_*): every Python function that does what a
+`bumpbake` command does takes that command's options as keyword arguments,
+named as the command line's long options with '_' for '-' (filter_radius
+for --filter-radius). A keyword is set through the library's parser for
+its option (bb_command_set) and checked by the library with the other
+options (bb_command_check): ranges, defaults and the rules between options
+have their one home there, and a refusal carries the library's words. A
+mistyped keyword gives the library's nearest option ("did you mean").
+
+Python values become the option's text by its type: a flag takes True
+(False or None: not given), numbers are spelled exactly (repr), a word
+list or several numbers take a sequence, a path str, bytes or
+os.PathLike.
+"""
+
+import numbers
+import os
+import re
+
+import numpy as np
+
+from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
+                      _message, _text)
+
+_TYPE_NAMES = ("flag", "integer", "number", "word", "words", "numbers", "text", "path")
+
+
+def _info(command):
+    info = _lib.bb_command_info_find(command.encode())
+    if info == _ffi.NULL:
+        raise ValueError(f"no command {command!r}")
+    return info
+
+
+def options(command):
+    """The options of a command, in the order of its --help: a list of
+    bb_option_info (cdata, static)."""
+    info = _info(command)
+    return [_lib.bb_command_option(info, i) for i in range(info.option_count)]
+
+
+def keyword(option):
+    """The Python keyword of an option (bb_option_info): its long name with
+    '_' for '-'."""
+    return _text(option.name).replace("-", "_")
+
+
+def keywords(command, client=False, files=True):
+    """The keywords of a command's options, in --help order: without the
+    command line's own ones (--help, -q, --json: BB_OPTION_CLIENT) unless
+    client, and without those about files (BB_OPTION_FILES: names, formats,
+    batches) when files is False (a function on arrays)."""
+    out = []
+    for o in options(command):
+        if o.flags & _lib.BB_OPTION_CLIENT and not client:
+            continue
+        if o.flags & _lib.BB_OPTION_FILES and not files:
+            continue
+        out.append(keyword(o))
+    return tuple(out)
+
+
+def _spell_number(value, integer):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if integer:
+        raise TypeError
+    return repr(float(value))
+
+
+def _spell(option, value, what):
+    """The text bb_command_set takes for value, by the option's type."""
+    kind = option.type
+    try:
+        if kind == _lib.BB_OPTION_FLAG:
+            return None  # (its type checked by set)
+        if kind == _lib.BB_OPTION_PATH:
+            if isinstance(value, bytes):
+                return _c_bytes(value, what)
+            if isinstance(value, (str, os.PathLike)):
+                return _c_bytes(os.fsencode(value), what)
+            raise TypeError
+        if isinstance(value, str) and kind != _lib.BB_OPTION_INT:
+            return _c_text(value, what)
+        if kind in (_lib.BB_OPTION_INT, _lib.BB_OPTION_NUMBER):
+            return _spell_number(value, kind == _lib.BB_OPTION_INT).encode()
+        if kind in (_lib.BB_OPTION_TEXT, _lib.BB_OPTION_WORD):  # 7.3, flags 4, depth 16
+            return _spell_number(value, isinstance(value, numbers.Integral)).encode()
+        if kind == _lib.BB_OPTION_WORDS:
+            words = list(value)
+            if not all(isinstance(w, str) for w in words):
+                raise TypeError
+            return _c_text(",".join(words), what)
+        if kind == _lib.BB_OPTION_NUMBERS:
+            sep = " " if option.values > 1 else ","
+            return sep.join(_spell_number(v, False) for v in value).encode()
+        raise TypeError
+    except TypeError:
+        raise TypeError(f"{what} must be {_expected(option)} (got {value!r})") from None
+
+
+def _expected(option):
+    kind = option.type
+    if kind == _lib.BB_OPTION_FLAG:
+        return "True or False"
+    if kind == _lib.BB_OPTION_PATH:
+        return "a path (str, bytes or os.PathLike)"
+    if kind == _lib.BB_OPTION_WORDS:
+        return "a str or a sequence of str"
+    if kind == _lib.BB_OPTION_NUMBERS:
+        return f"a str or a sequence of {option.count} numbers"
+    if kind in (_lib.BB_OPTION_INT, _lib.BB_OPTION_NUMBER, _lib.BB_OPTION_TEXT):
+        return "an integer" if kind == _lib.BB_OPTION_INT else "a number or a str"
+    return "a str"
+
+
+class Command:
+    """One use of a library command (bb_command): keywords set, inputs
+    added, checked, then planned, run or drawn by the library."""
+
+    def __init__(self, name, function=None):
+        self.name = name
+        self.function = function or name  # how messages name the Python call
+        err = _ffi.new("bb_error *")
+        out = _ffi.new("bb_command **")
+        _check(_lib.bb_command_new(name.encode(), out, err), err)
+        self._c = _ffi.gc(out[0], _lib.bb_command_free)
+        self._info = _lib.bb_command_describe(self._c)
+
+    def option(self, key):
+        """The option of keyword key; TypeError naming the nearest when none."""
+        if not isinstance(key, str) or "-" in key:
+            o = _ffi.NULL
+        else:
+            o = _lib.bb_option_find(self._info, key.encode(), 0)
+        if o == _ffi.NULL or o.flags & _lib.BB_OPTION_CLIENT:
+            near = _lib.bb_option_nearest(self._info, str(key).encode(), 0)
+            hint = ""
+            if near != _ffi.NULL and not near.flags & _lib.BB_OPTION_CLIENT:
+                hint = f" (did you mean {keyword(near)!r}?)"
+            raise TypeError(f"{self.function}() got an unexpected keyword argument "
+                            f"{key!r}{hint}")
+        return o
+
+    def set(self, key, value, skip_default=False):
+        """Sets keyword key (None: left at its default; a flag False: not
+        given) through the library's parser. skip_default: a value spelled
+        as the option's default is left ungiven (a file bake's provenance
+        then records what the command line typed without it records)."""
+        o = self.option(key)
+        if value is None:
+            return
+        if o.type == _lib.BB_OPTION_FLAG:
+            if not isinstance(value, (bool, numbers.Integral, np.bool_)) or value not in (0, 1):
+                raise TypeError(f"{self.function}: {key} must be True or False (got {value!r})")
+            if not value:
+                return
+        text = _spell(o, value, f"{self.function}: {key}")
+        if skip_default and text is not None:
+            buf = _ffi.new("char[256]")
+            _lib.bb_option_default_text(self._info, o, buf, 256)
+            if _ffi.string(buf) == text:
+                return
+        err = _ffi.new("bb_error *")
+        st = _lib.bb_command_set(self._c, o.name, _ffi.NULL if text is None else text, err)
+        if st != _lib.BB_OK:
+            raise _exception(st, self.prefixed(_message(err, st)))
+
+    def prefixed(self, message):
+        """The library's message, spelled for Python, after the function's
+        name (once)."""
+        message = self.spelled(message)
+        return message if message.startswith(self.name + ":") else \
+            f"{self.function}: {message}"
+
+    def spelled(self, message):
+        """The library's message with its options named as Python's
+        keywords ("--filter-radius" as "filter_radius")."""
+        def keyword_of(m):
+            o = _lib.bb_option_find(self._info, m.group(1).encode(), 0)
+            return keyword(o) if o != _ffi.NULL else m.group(0)
+        return re.sub(r"(?<![\w-])--([a-z][a-z0-9-]*)", keyword_of, message)
+
+    def set_all(self, values, skip_default=False):
+        for key, value in values.items():
+            self.set(key, value, skip_default)
+
+    def add_input(self, value):
+        err = _ffi.new("bb_error *")
+        if not isinstance(value, bytes):
+            value = os.fsencode(value)
+        _check(_lib.bb_command_add_input(self._c, _c_bytes(value, "input"), err), err)
+
+    def in_memory(self, maps=0):
+        """For images in memory (arrays): options about files are refused."""
+        _lib.bb_command_set_in_memory(self._c, maps)
+
+    def check(self):
+        err = _ffi.new("bb_error *")
+        st = _lib.bb_command_check(self._c, err)
+        if st != _lib.BB_OK:
+            message = self.prefixed(_message(err, st))
+            if any(o.flags & _lib.BB_OPTION_REQUIRED and not self.given(_text(o.name))
+                   and keyword(o) + " is required" in message
+                   for o in options(self.name)):
+                raise TypeError(message)  # a missing argument, as Python says it
+            raise _exception(st, message)
+
+    def given(self, key):
+        return bool(_lib.bb_command_given(self._c, key.encode()))
+
+    @property
+    def options(self):
+        """The checked options (bb_command_options cdata, owned by the command)."""
+        return _lib.bb_command_options_of(self._c)
+
+    def text(self, input=None, recorded=True):
+        """The command as bb_command_text spells it (recorded: the options
+        that determine what is made, as provenance records them)."""
+        flags = _lib.BB_OPTION_RECORDED if recorded else 0
+        if input is not None and not isinstance(input, bytes):
+            input = os.fsencode(input)
+        raw = _lib.bb_command_text(self._c, input if input is not None else _ffi.NULL, flags)
+        if raw == _ffi.NULL:
+            raise MemoryError("bb_command_text")
+        try:
+            return _text(raw)
+        finally:
+            _lib.free(raw)
+
+    def record(self, line=None, options=None):
+        err = _ffi.new("bb_error *")
+        for what, value in (("command", line), ("command_options", options)):
+            if value is not None and not isinstance(value, str):
+                raise TypeError(f"{self.function}: {what} must be a str (got {value!r})")
+        _check(_lib.bb_command_set_record(
+            self._c, _c_text(line, "command") if line is not None else _ffi.NULL,
+            _c_text(options, "command_options") if options is not None else _ffi.NULL, err),
+            err)
+
+    @property
+    def handle(self):
+        return self._c
+
+
+def option_table(command):
+    """[(keyword, type, value, default, range, help)] of a command's options,
+    as the library describes them (docs, tests)."""
+    info = _info(command)
+    rows = []
+    buf = _ffi.new("char[512]")
+    for o in options(command):
+        _lib.bb_option_value_text(o, buf, 512)
+        value = _text(buf)
+        _lib.bb_option_default_text(info, o, buf, 512)
+        default = _text(buf)
+        _lib.bb_option_range_text(o, buf, 512)
+        rows.append((keyword(o), _TYPE_NAMES[o.type], value, default, _text(buf),
+                     _text(o.help)))
+    return rows
+
+
+def argument_error(command, message):
+    return _argument_error(f"{command}: {message}")
+
+
+def doc(command, files=True, skip=()):
+    """The keyword arguments of a command as a docstring's lines, from the
+    library's descriptions: "keyword: help (default D; R)"."""
+    import textwrap
+    lines = []
+    for key, _, value, default, range_text, help in option_table(command):
+        o = _lib.bb_option_find(_info(command), key.encode(), 0)
+        if key in skip or o.flags & _lib.BB_OPTION_CLIENT or (
+                not files and o.flags & _lib.BB_OPTION_FILES):
+            continue
+        extra = "; ".join(x for x in (default and f"default {default}", range_text) if x)
+        text = f"{key}: {help}" + (f" ({extra})" if extra else "")
+        lines += textwrap.wrap(text, 76, initial_indent="    ", subsequent_indent="        ")
+    return "\n".join(lines) + "\n"

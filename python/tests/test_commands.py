@@ -1,0 +1,325 @@
+"""Python's keyword arguments are the library's descriptions of the
+commands (bb_command_*, bb_option_*): every option of every command has a
+Python keyword, values are set and checked by the library, and what Python
+writes is the command line's bytes."""
+
+import os
+import shutil
+import signal
+import subprocess
+
+import numpy as np
+import pytest
+
+import bumpbake
+from bumpbake import _command
+from test_jobs import files_of
+from bumpbake._common import _lib, _text
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BIN = os.environ.get("BB_BIN", os.path.join(ROOT, "build", "bumpbake"))
+FIXTURES = os.path.join(ROOT, "fixtures")
+
+# The Python functions that do what each command does. run() runs every
+# command that writes files, with all of its options; the others work on
+# arrays (and take the options that are not about files) or are the
+# command's own function.
+FUNCTIONS = {
+    "bake": ("bake_file", "bake_files", "bake", "run"),
+    "normal": ("normal", "run"),
+    "height2ssbump": ("run",),
+    "compare": ("compare",),
+    "info": ("info",),
+    "renderbumpflat": ("renderbumpflat",),
+    "render": ("render", "run"),
+    "sheet": ("sheet", "run"),
+    "normal2ssbump": ("normal2ssbump", "run"),
+    "ssbump2normal": ("ssbump2normal", "run"),
+    "combine": ("combine", "run"),
+    "program": ("program", "run"),
+}
+
+# Options with no Python keyword, and why. Every option the library marks
+# BB_OPTION_CLIENT (--help, -q, --json: how the command line prints) is one
+# too: Python returns reports and raises errors instead.
+NOT_IN_PYTHON = {
+    ("bake", "scheduler"): "a cluster from Python is bumpbake.dask.bake_files(client=...)",
+    ("serve", None): "the command line's HTTP preview server (bake() and render() make "
+                     "what it shows)",
+}
+
+
+def commands():
+    return [_text(_lib.bb_command_info_get(i).name) for i in range(_lib.bb_command_count())]
+
+
+def call_with(name, command, key, value):
+    """Calls Python function name with keyword key = value, the rest as
+    small valid arguments; returns the exception raised (or None)."""
+    h = np.zeros((8, 8), np.float32)
+    n = np.zeros((8, 8, 3), np.float32)
+    n[..., 2] = 1
+    f = getattr(bumpbake, name)
+    calls = {
+        "bake_file": lambda kw: f("missing.png", **kw),
+        "bake_files": lambda kw: f("missing.png", "out", **kw),
+        "bake": lambda kw: f(h, 1, **kw),
+        "normal": lambda kw: f(h, 1, **kw),
+        "run": lambda kw: f(command, **kw),
+        "compare": lambda kw: f("a.png", "b.png", **kw),
+        "info": lambda kw: f("a.png", **kw),
+        "renderbumpflat": lambda kw: f("m.obj", **kw),
+        "render": lambda kw: f(normal=n, **kw),
+        "sheet": lambda kw: f(h, 1, **kw),
+        "normal2ssbump": lambda kw: f(n, **kw),
+        "ssbump2normal": lambda kw: f(n, **kw),
+        "combine": lambda kw: f(n, n, **kw),
+        "program": lambda kw: f("_flat", **kw),
+    }
+    try:
+        calls[name]({key: value})
+    except Exception as e:  # noqa: BLE001: what was raised is the answer
+        return e
+    return None
+
+
+def knows(name, command, key):
+    """Whether Python function name takes keyword key: a value of no
+    option's type is refused as a bad value, not as an unknown keyword."""
+    e = call_with(name, command, key, object())
+    return not (isinstance(e, TypeError) and "unexpected keyword argument" in str(e))
+
+
+def test_every_option_of_every_command_has_a_python_keyword(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert set(FUNCTIONS) | {"serve"} == set(commands())
+    missing = []
+    for command in commands():
+        for o in _command.options(command):
+            key = _command.keyword(o)
+            if o.flags & _lib.BB_OPTION_CLIENT or (command, None) in NOT_IN_PYTHON or \
+                    (command, key) in NOT_IN_PYTHON:
+                continue
+            if not any(knows(name, command, key) for name in FUNCTIONS[command]):
+                missing.append(f"{command} --{_text(o.name)}")
+    assert not missing, f"CLI options with no Python keyword: {missing}"
+
+
+def test_the_walk_fails_on_an_unknown_keyword():
+    """The probe above can fail: a keyword no option has is refused as
+    unknown, with the library's nearest option."""
+    assert not knows("bake", "bake", "raise_the_roof")
+    e = call_with("bake_file", "bake", "bounse", 0.3)
+    assert isinstance(e, TypeError)
+    assert str(e) == "bake() got an unexpected keyword argument 'bounse' (did you mean " \
+                     "'bounce'?)"
+    # the command line's own options are not Python's
+    e = call_with("bake", "bake", "json", True)
+    assert isinstance(e, TypeError) and "unexpected keyword argument 'json'" in str(e)
+
+
+def test_values_are_refused_with_the_librarys_words():
+    h = np.zeros((8, 8), np.float32)
+    with pytest.raises(bumpbake.ArgumentError, match=r"^bake: bounce must be in 0\.\.1 "
+                                                     r"\(got 2\)$"):
+        bumpbake.bake(h, 1, bounce=2.0)
+    with pytest.raises(bumpbake.ArgumentError, match="bounces must be in 0..64"):
+        bumpbake.bake(h, 1, bounce=0.5, bounces=65)
+    with pytest.raises(bumpbake.ArgumentError, match="bounces does nothing without"):
+        bumpbake.bake(h, 1, outputs=("ao",), bounces=3)
+    with pytest.raises(bumpbake.ArgumentError, match="is about files"):
+        bumpbake.bake(h, 1, depth=16)
+    with pytest.raises(TypeError, match="rays must be an integer"):
+        bumpbake.bake(h, 1, rays="64")
+    with pytest.raises(TypeError, match="clamp must be True or False"):
+        bumpbake.bake(h, 1, clamp="no")
+    # 5e-324 is a number: spelled exactly (repr), not as a word
+    assert bumpbake.bake(h, 1, outputs=("ao",), rays=4, bounce=5e-324)["ao"].shape == (8, 8)
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([BIN, *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+needs_cli = pytest.mark.skipif(not os.access(BIN, os.X_OK), reason=f"{BIN} not built")
+
+
+@needs_cli
+def test_a_bounce_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch):
+    """bake_file with bounce, bounces, bounce_albedo and brightness, and the
+    command its provenance records typed: the same files, byte for byte;
+    bake() of the same height gives the same pixels."""
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), "rock.png")
+    albedo = np.full((128, 128), 0.5, np.float32)
+    albedo[:, 64:] = 0.9
+    bumpbake.write("albedo.png", albedo)
+    bright = np.full((128, 128), 0.8, np.float32)
+    bumpbake.write("bright.png", bright)
+    settings = dict(scale=16, rays=16, bounce=0.3, bounces=2, bounce_albedo="albedo.png",
+                    brightness="bright.png")
+    outputs = {"ao": "py/ao.exr", "ssbump": "py/ssbump.exr"}
+    os.makedirs("py")
+    job = bumpbake.BakeJob("rock.png", outputs=outputs, **settings)
+    command = job.command_text(0)
+    assert command == ("bumpbake bake rock.png --scale 16 --rays 16 --bounce 0.3 --bounces 2 "
+                       "--bounce-albedo albedo.png --brightness bright.png "
+                       "--ssbump py/ssbump.exr --ao py/ao.exr")
+    report = bumpbake.bake_file("rock.png", outputs, **settings)
+    assert report.status == "baked"
+    ours = files_of("py")
+    shutil.rmtree("py")
+    os.makedirs("py")
+    done = cli(*command.split()[1:])
+    assert done.returncode == 0, done.stderr
+    theirs = files_of("py")
+    assert sorted(ours) == ["ao.exr", "ssbump.exr"] == sorted(theirs)
+    assert [k for k in ours if ours[k] != theirs[k]] == []
+
+    arrays = bumpbake.bake(bumpbake.read("rock.png"), 16, outputs=("ao", "ssbump"), rays=16,
+                           bounce=0.3, bounces=2, bounce_albedo=bumpbake.read("albedo.png"),
+                           brightness="bright.png")
+    np.testing.assert_array_equal(arrays["ao"], bumpbake.read("py/ao.exr"))
+    np.testing.assert_array_equal(arrays["ssbump"], bumpbake.read("py/ssbump.exr"))
+
+
+@needs_cli
+def test_a_relief_render_is_the_clis(tmp_path, monkeypatch):
+    """render --relief from Python: run() writes the command line's bytes;
+    render(height=...) gives its pixels."""
+    for side in ("py", "cli"):
+        os.makedirs(tmp_path / side)
+        shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / side / "rock.png")
+    monkeypatch.chdir(tmp_path / "py")
+    options = dict(scale=8, rays=16, relief=True, view=(30, 40))
+    written = bumpbake.run("render", "rock.png", output="r.exr", **options)
+    assert written == [("render", "r.exr")]
+    # typed as the library spells the command Python ran (its provenance)
+    done = cli("render", "rock.png", "--scale", 8, "--rays", 16, "--view", "30,40", "--relief",
+               "--output", "r.exr", cwd=tmp_path / "cli")
+    assert done.returncode == 0, done.stderr
+    with open("r.exr", "rb") as a, open(tmp_path / "cli" / "r.exr", "rb") as b:
+        assert a.read() == b.read()
+    picture = bumpbake.render(height=bumpbake.read("rock.png"), **options)
+    np.testing.assert_array_equal(picture, bumpbake.read("r.exr"))
+    flat = bumpbake.render(height=bumpbake.read("rock.png"), scale=8, rays=16, view=(30, 40))
+    assert not np.array_equal(flat, picture)  # the relief did something
+    with pytest.raises(bumpbake.ArgumentError, match="relief needs view"):
+        bumpbake.render(height=bumpbake.read("rock.png"), scale=8, relief=True)
+
+
+def test_huge_broadcast_arrays_are_refused_from_their_shape():
+    """A view of one value standing for gigabytes is refused by the
+    library's size rule before anything is copied."""
+    for view in (np.broadcast_to(np.float32(0.5), (40000, 30000)),
+                 np.broadcast_to(np.uint8(7), (70000, 70000)),
+                 np.broadcast_to(np.float32(0.5), (100000, 100000))):
+        with pytest.raises(bumpbake.ArgumentError, match="over the maximum"):
+            bumpbake.bake(view, 4)
+        with pytest.raises(bumpbake.ArgumentError, match="over the maximum"):
+            bumpbake.normal(view, 4)
+
+
+def test_an_array_bake_is_cancelled_by_its_progress_and_by_ctrl_c():
+    h = np.random.default_rng(3).random((256, 256), np.float32)
+    calls = []
+
+    def stop(done, total):
+        calls.append(done)
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        bumpbake.bake(h, 8, rays=4096, outputs=("ao",), progress=stop)
+    assert len(calls) == 1  # cancelled at the first call
+
+    # A real SIGINT during the trace: Python's handler raises in the
+    # progress callback, which cancels the bake.
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.2)
+        with pytest.raises(KeyboardInterrupt):
+            bumpbake.bake(np.tile(h, (4, 4)), 8, rays=65536, outputs=("ao",), threads=1)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+@needs_cli
+def test_nan_normals_are_refused_by_python_and_the_cli(tmp_path):
+    n = np.zeros((8, 8, 3), np.float32)
+    n[..., 2] = 1
+    n[2, 3, 0] = np.nan
+    with pytest.raises(bumpbake.ArgumentError, match=r"texel \(3, 2\) channel 0 is NaN"):
+        bumpbake.normal2ssbump(n)
+    with pytest.raises(bumpbake.ArgumentError, match=r"texel \(3, 2\) channel 0 is NaN"):
+        bumpbake.render(normal=n, mode="normal")
+    with pytest.raises(bumpbake.ArgumentError, match="is NaN"):
+        bumpbake.render(normal=n, ssbump=np.ones((8, 8, 3), np.float32) * np.nan)
+    bumpbake.write(tmp_path / "n.exr", n, kind="normal")
+    for args in (("normal2ssbump", "n.exr", "-o", "s.png"),
+                 ("render", "--normal", "n.exr", "--mode", "normal", "-o", "r.png")):
+        done = cli(*args, cwd=tmp_path)
+        assert done.returncode == 1 and "channel 0 is NaN" in done.stderr, done.stderr
+    assert not (tmp_path / "s.png").exists() and not (tmp_path / "r.png").exists()
+
+
+def test_wrong_types_are_type_errors_not_internal_ones(tmp_path):
+    with pytest.raises(TypeError, match=r"outputs must be a dict \{kind: path\}"):
+        bumpbake.bake_file(tmp_path / "h.png", ["a.png"], scale=4)
+    with pytest.raises(TypeError, match="description must be a str"):
+        bumpbake.write(tmp_path / "t.png", np.zeros((4, 4), np.float32), description=b"x")
+    with pytest.raises(TypeError, match="inputs must be a path or a list"):
+        bumpbake.bake_files(42, tmp_path, scale=4)
+
+
+def test_whole_numbers_are_spelled_as_typed():
+    """30 is recorded as 30, not as the shortest %g that reads back (3e+01)."""
+    job = bumpbake.BakeJob(os.path.join(FIXTURES, "rock06_128.png"),
+                           outputs={"normal": "n.png"}, scale=30, rays=100, bias=1e6)
+    assert job.command_text(0).split()[3:] == ["--scale", "30", "--rays", "100", "--bias",
+                                               "1000000", "--normal", "n.png"]
+
+
+def test_the_option_table_is_the_librarys():
+    rows = {row[0]: row for row in _command.option_table("bake")}
+    assert rows["rays"][3] == "256" and rows["rays"][4] == "1..65536"
+    assert rows["bounces"][4] == "0..64"
+    assert "bounce" in bumpbake.BAKE_PARAMETERS and "brightness" in bumpbake.BAKE_PARAMETERS
+
+
+def test_the_python_reference_names_every_command_and_bake_keyword():
+    """docs/python.md's table of which function takes which command's
+    options names every command (serve aside, as it says), and its bake()
+    entry every keyword of `bumpbake bake` for arrays."""
+    with open(os.path.join(ROOT, "docs", "python.md"), encoding="utf-8") as f:
+        doc = f.read()
+    table = doc[doc.index("| command | Python |"):doc.index("Not in Python, by design")]
+    rows = [line.split("|")[1] for line in table.splitlines()[2:] if line.startswith("|")]
+    listed = {name.strip() for row in rows for name in row.split(",")}
+    assert listed == set(FUNCTIONS), listed ^ set(FUNCTIONS)
+    for names in FUNCTIONS.values():
+        for name in names:
+            assert f"`{name}`" in table and hasattr(bumpbake, name), name
+    entry = " ".join(doc[doc.index("- `bake(height, scale"):doc.index("- `normal(height")].split())
+    for key in bumpbake.BAKE_PARAMETERS + ("channel",):
+        assert key in entry, key
+
+
+def test_normal_y_up_arrays_are_read_and_written_as_the_cli_reads_files():
+    n = bumpbake.bake(np.random.default_rng(5).random((16, 16), np.float32), 8,
+                      outputs=("normal",))["normal"]
+    up = n * np.float32([1, -1, 1])
+    np.testing.assert_array_equal(bumpbake.normal2ssbump(up, normal_y="up"),
+                                  bumpbake.normal2ssbump(n))
+    assert up[0, 0, 1] == -n[0, 0, 1]  # the caller's array is left alone
+    s = bumpbake.normal2ssbump(n)
+    np.testing.assert_array_equal(bumpbake.ssbump2normal(s, kind="weights", normal_y="up"),
+                                  bumpbake.ssbump2normal(s, kind="weights") * [1, -1, 1])
+    np.testing.assert_array_equal(
+        bumpbake.combine(up, up[::-1], mix=0.5, kind="normal", normal_y="up"),
+        bumpbake.combine(n, n[::-1] * 1, mix=0.5, kind="normal") * [1, -1, 1])
+    with pytest.raises(bumpbake.ArgumentError, match="normal_y must be one of down, up"):
+        bumpbake.normal2ssbump(n, normal_y="sideways")
