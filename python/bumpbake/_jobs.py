@@ -171,6 +171,18 @@ class BakeJob:
                     raise _argument_error(f"bake: lit must be (azimuth, elevation) in degrees "
                                           f"(got {a['lit']!r})") from None
                 o.slope_lit = 1
+        self._options = o
+        self._keep = keep
+        arr = [_ffi.new("char[]", p) for p in inputs]
+
+        def plan(note, job, err):
+            o.note = note
+            return _lib.bb_job_plan(arr, len(arr), o, job, err)
+        self._adopt(plan)
+
+    def _adopt(self, plan):
+        """Plans the job through plan(note, job, err) (bb_job_plan, or
+        bb_command_plan for a command), with the notes hook."""
         # Notes are handed out as they come, on the caller's terms (a
         # warning, a callable), and kept for the report. One the caller
         # turns into an exception cannot raise through C: it is kept, the
@@ -181,13 +193,9 @@ class BakeJob:
         self._note_raised = []
         self._note_stacklevel = None
         self._note = _ffi.callback("bb_note_fn", self._on_note)
-        o.note = self._note
-        self._options = o
-        self._keep = keep
-        arr = [_ffi.new("char[]", p) for p in inputs]
         err = _ffi.new("bb_error *")
         job = _ffi.new("bb_job **")
-        _check(_lib.bb_job_plan(arr, len(arr), o, job, err), err)
+        _check(plan(self._note, job, err), err)
         self._job = _ffi.gc(job[0], _lib.bb_job_free)
         self._count = _lib.bb_job_count(self._job)
         self._status = [None] * self._count  # "not run" overrides

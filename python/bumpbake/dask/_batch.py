@@ -12,6 +12,7 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
+from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
 from ._shared import client_directory, client_of, variable_value, worker_threads
 
@@ -75,15 +76,18 @@ class _Stop:
 
 def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
     """On a worker: bakes inputs (indices in the batch) of one chunk with
-    the batch's arguments; returns [(index, BakeReport or None: not run)].
+    the batch's arguments (a dict of keyword arguments, or the Command); returns [(index, BakeReport or None: not run)].
     stop (a _Stop or None) says which inputs no longer start; a failure
     lowers it when stop_on_failure. Each input is checked again (a chunk
     run a second time, after its worker died, skips what the first run
     finished) and written all or nothing, as bb_job_run_item does."""
     out = []
     with client_directory(directory):
-        job = BakeJob(inputs, args["out_dir"], notes="ignore",
-                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        if isinstance(args, Command):  # handed over by the CLI: planned by the library
+            job = CommandJob(args.data, inputs, notes="ignore", threads=1)
+        else:
+            job = BakeJob(inputs, args["out_dir"], notes="ignore",
+                          **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
         for k, index in enumerate(indices):
             if stop is not None and stop.reached(index):
                 out.append((index, None))
@@ -114,7 +118,7 @@ def sweep_temporaries(directories):
 
 def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=False,
                keep_going=False, depfile=None, check=True, progress=None, notes="warn",
-               chunk_size=None, command_options=None, **options):
+               chunk_size=None, command_options=None, _command=None, **options):
     """Bakes height files and directories of them into out_dir on a Dask
     cluster, as `bumpbake bake INPUT... --out-dir OUT_DIR` does on one
     machine, and returns one BakeReport per input, in input order.
@@ -155,8 +159,12 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     """
     client = client_of(client)
     directory = os.getcwd()
-    job = BakeJob(inputs, out_dir, maps=maps, name=name, force=force, keep_going=keep_going,
-                  depfile=depfile, notes=notes, command_options=command_options, **options)
+    if _command is not None:  # the CLI's command (bumpbake bake --scheduler): its own options
+        job = CommandJob(_command.data, notes=notes)
+        force, keep_going, depfile = (job._args[k] for k in ("force", "keep_going", "depfile"))
+    else:
+        job = BakeJob(inputs, out_dir, maps=maps, name=name, force=force, keep_going=keep_going,
+                      depfile=depfile, notes=notes, command_options=command_options, **options)
     count = len(job)
     reports = [None] * count
     pending = []
@@ -166,10 +174,13 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
             reports[i].status = "up to date"
         else:
             pending.append(i)
-    args = dict(job._args, depfile=None, keep_going=True)
-    args.setdefault("threads", 1)
-    if args["threads"] is None:
-        args["threads"] = 1
+    if _command is not None:
+        args = _command
+    else:
+        args = dict(job._args, depfile=None, keep_going=True)
+        args.setdefault("threads", 1)
+        if args["threads"] is None:
+            args["threads"] = 1
     inputs_planned = job.inputs
     size = chunk_size or chunk_size_for(len(pending), worker_threads(client))
     if not isinstance(size, int) or size < 1:

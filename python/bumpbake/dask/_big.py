@@ -25,6 +25,7 @@ from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _k
 from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
+from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
 from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
                       worker_threads)
@@ -137,10 +138,21 @@ def _take_back(key, entry):
 
 
 def _bake_options_of(task):
-    options = {k: v for k, v in task["options"].items()}
-    o, _ = _bake_options("bake", task["scale"], **options)
+    """(bb_bake_options * of task's bake, its bb_channel, what must stay
+    alive while they are used): from bake_big's keyword arguments, or from
+    the command the CLI handed over, set up again by the library in the
+    client's directory (a basis file named relative to it)."""
+    if "command" in task:
+        with client_directory(task["directory"]):
+            command = Command(task["command"])
+        o = _ffi.new("bb_bake_options *")
+        o[0] = command.options.job.bake
+        channel = command.options.job.channel
+    else:
+        o, _ = _bake_options("bake", task["scale"], **task["options"])
+        channel, command = _channel(task["channel"]), None
     o.outputs = _kinds_mask("bake", TRACED_OUTPUTS)[1]
-    return o
+    return o, channel, command
 
 
 def _build(task, threads):
@@ -150,14 +162,13 @@ def _build(task, threads):
     err = _ffi.new("bb_error *")
     height = _ffi.new("bb_image *")
     source = _ffi.new("bb_height_source *")
-    _check(_lib.bb_height_file_read(_path(task["path"]), _channel(task["channel"]),
-                                    float(task["scale"]), _ffi.NULL, _ffi.NULL, height,
-                                    source, err), err)
+    o, channel, keep = _bake_options_of(task)
+    _check(_lib.bb_height_file_read(_path(task["path"]), channel, o.height_scale, _ffi.NULL,
+                                    _ffi.NULL, height, source, err), err)
     try:
         if source.file_hash != task["file_hash"]:
             raise Error(f"{task['path']}: the file changed while it was baked (a worker read "
                         "other bytes than the bake's)", "i/o error")
-        o = _bake_options_of(task)
         o.trace.threads = threads
         pyramid = _ffi.new("bb_pyramid **")
         rays = _ffi.new("bb_rayset **")
@@ -187,7 +198,8 @@ def _horizons(task, slices, threads):
     entry = _acquire(task["key"], lambda: _build(task, threads))
     try:
         o = _ffi.new("bb_trace_options *")
-        o[0] = _bake_options_of(task).trace
+        bake, _, keep = _bake_options_of(task)
+        o[0] = bake.trace
         o.threads = threads
         c_slices = _ffi.new("int[]", slices)
         images = _ffi.new("bb_image[]", len(slices))
@@ -297,14 +309,19 @@ def _drive(directory, input, args, task):
     cluster; returns (BakeReport, what the split did)."""
     with client_directory(directory):
         own = this_worker_threads()
-        args = dict(args)
-        if args.get("threads") is None:
-            args["threads"] = own
         lib_threads = task.pop("horizon_threads")
-        hook = _SplitTrace(task, lib_threads, args["threads"] or own)
-        callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
-        job = BakeJob(input, None, notes="ignore", _trace=callback,
-                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        if isinstance(args, Command):  # handed over by the CLI: planned by the library
+            hook = _SplitTrace(task, lib_threads, own)
+            callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
+            job = CommandJob(args.data, notes="ignore", threads=own, _trace=callback)
+        else:
+            args = dict(args)
+            if args.get("threads") is None:
+                args["threads"] = own
+            hook = _SplitTrace(task, lib_threads, args["threads"] or own)
+            callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
+            job = BakeJob(input, None, notes="ignore", _trace=callback,
+                          **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
         hook.job = job
         report = job.run(0)
         if hook.raised is not None and not isinstance(hook.raised, Error):
@@ -314,7 +331,7 @@ def _drive(directory, input, args, task):
 
 def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=None,
              depfile=None, force=True, check=True, notes="warn", command=None,
-             horizon_threads=None, **options):
+             horizon_threads=None, _command=None, **options):
     """Bakes one height file into the files named, as bumpbake.bake_file
     (and `bumpbake bake INPUT --normal FILE ...`) does, with its trace
     split over the workers of a Dask cluster; returns its BakeReport. The
@@ -342,27 +359,36 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     """
     client = client_of(client)
     directory = os.getcwd()
-    job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
-                  depfile=depfile, force=force, notes=notes, command=command, **options)
+    if _command is not None:  # the CLI's command (bumpbake bake --scheduler): always baked
+        job = CommandJob(_command.data, notes=notes)
+        args, force = _command, True
+        slices = _lib.bb_bake_slices(_ffi.addressof(_command.options.job, "bake"))
+    else:
+        job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
+                      depfile=depfile, force=force, notes=notes, command=command, **options)
+        args = dict(job._args, force=True)
     if not force and job.check_current(0):
         report = job.report(0)
         report.status = "up to date"
         return report
-    args = dict(job._args, force=True)
     planned = job.inputs[0]
-    basis = options.get("basis")
-    task_options = {k: v for k, v in options.items()
-                    if k in BAKE_PARAMETERS and k != "threads"}
-    if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
-            os.fsdecode(basis) not in ("hl2", "hl2+z") and not os.fsdecode(basis).startswith(
-                "dirs:"):
-        task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
-    tasks = max(1, (_lib_slices(task_options) + 1) // 2)
+    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned)}
+    if _command is not None:
+        task.update(command=_command.data, directory=directory)
+    else:
+        basis = options.get("basis")
+        task_options = {k: v for k, v in options.items()
+                        if k in BAKE_PARAMETERS and k != "threads"}
+        if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
+                os.fsdecode(basis) not in ("hl2", "hl2+z") and \
+                not os.fsdecode(basis).startswith("dirs:"):
+            task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
+        slices = _lib_slices(task_options)
+        task.update(scale=args["scale"], channel=args["channel"], options=task_options)
+    tasks = max(1, (slices + 1) // 2)
     if horizon_threads is None:
         horizon_threads = max(1, worker_threads(client) // tasks)
-    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
-            "scale": args["scale"], "channel": args["channel"], "options": task_options,
-            "horizon_threads": int(horizon_threads)}
+    task["horizon_threads"] = int(horizon_threads)
     # Set when the client gives up (Ctrl-C): the driver stops at the next
     # group of slices, writing nothing (a running task cannot be killed).
     task["stop"] = f"bumpbake-big-stop-{task['key']}"
