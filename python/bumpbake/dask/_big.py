@@ -27,8 +27,8 @@ from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
 from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
-from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
-                      worker_threads)
+from ._shared import (NoteDesk, client_directory, client_of, notes_can_raise,
+                      this_worker_threads, variable_value, worker_threads)
 
 # -------------------------------------------------- a worker's trace inputs
 
@@ -310,17 +310,18 @@ def _drive(directory, input, args, task):
     with client_directory(directory):
         own = this_worker_threads()
         lib_threads = task.pop("horizon_threads")
+        notes = task.pop("notes")  # "ignore", or the client's NoteDesk asker
         if isinstance(args, Command):  # handed over by the CLI: planned by the library
             hook = _SplitTrace(task, lib_threads, own)
             callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
-            job = CommandJob(args.data, notes="ignore", threads=own, _trace=callback)
+            job = CommandJob(args.data, notes=notes, threads=own, _trace=callback)
         else:
             args = dict(args)
             if args.get("threads") is None:
                 args["threads"] = own
             hook = _SplitTrace(task, lib_threads, args["threads"] or own)
             callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
-            job = BakeJob(input, None, notes="ignore", _trace=callback,
+            job = BakeJob(input, None, notes=notes, _trace=callback,
                           **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
         hook.job = job
         report = job.run(0)
@@ -331,7 +332,7 @@ def _drive(directory, input, args, task):
 
 def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=None,
              depfile=None, force=True, check=True, notes="warn", command=None,
-             horizon_threads=None, _command=None, **options):
+             horizon_threads=None, _command=None, _ask_notes=None, **options):
     """Bakes one height file into the files named, as bumpbake.bake_file
     (and `bumpbake bake INPUT --normal FILE ...`) does, with its trace
     split over the workers of a Dask cluster; returns its BakeReport. The
@@ -394,10 +395,18 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     task["stop"] = f"bumpbake-big-stop-{task['key']}"
     stop = distributed.Variable(task["stop"], client=client)
     stop.set(0)
+    # A note the caller may make an error is dispatched here before the
+    # driver writes anything; the others once the bake is over.
+    desk = None
+    if notes_can_raise(notes) if _ask_notes is None else _ask_notes:
+        desk = NoteDesk(client, task["key"], notes, stacklevel=4)
+        task["notes"] = desk.asker(task["stop"], 1)
+    else:
+        task["notes"] = "ignore"
     future = client.submit(_drive, directory, planned, args, task, pure=False,
                            key=f"bumpbake-big-{task['key']}")
     try:
-        for done in completed(client, [future]):
+        for done in completed(client, [future], desk.serve if desk else None):
             report, stats = done.result()
     except BaseException as e:
         settle(client, lambda: stop.set(1))  # left set: the driver may still read it
@@ -409,10 +418,13 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
         # Released at once: a future still held (by an exception's
         # traceback) makes Dask bake again when the driver's worker is lost.
         future.release()
+        if desk is not None:
+            settle(client, lambda: desk.queue.close())
     stop.delete()
     report.cluster = stats
     sweep_temporaries({os.path.dirname(p) or "." for p in report.outputs.values()})
-    _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
+    if desk is None:  # (else each was dispatched as the driver read it)
+        _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
     if check:
         _raise_failures([report], None)
     return report

@@ -160,12 +160,13 @@ def run(command):
     with connect(_text(o.scheduler), quiet=True) as client:
         if command.text("out_dir") is not None:
             reports = bake_files(None, None, client=client, check=False, notes=_note,
-                                 _command=command)
+                                 _command=command, _ask_notes=False)
             for r in reports:
                 _print_report(r, as_json, quiet, batch=True)
             _summary(reports, as_json, quiet)
             return 1 if any(r.status == "failed" for r in reports) else 0
-        report = bake_big(None, client=client, check=False, notes=_note, _command=command)
+        report = bake_big(None, client=client, check=False, notes=_note, _command=command,
+                          _ask_notes=False)
         _print_report(report, as_json, quiet, batch=False)
         return 1 if report.status == "failed" else 0
 
