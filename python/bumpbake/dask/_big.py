@@ -13,6 +13,7 @@ once per worker process and bake, and finds its slices' horizons
 """
 
 import collections
+import concurrent.futures
 import os
 import threading
 import time
@@ -29,6 +30,15 @@ from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
 from ._shared import (NoteDesk, client_directory, client_of, notes_can_raise,
                       this_worker_threads, variable_value, worker_threads)
+
+# Groups of slices whose horizons are fetched ahead of the one being added
+# up (each holds 8 bytes a texel while it waits).
+_AHEAD = 2
+# Threads adding the horizons up on the driver: all its machine's cores
+# (0); the sums are the same bits for any count.
+_DRIVER_THREADS = 0
+# Seconds between the driver's looks at the client's stop variable.
+_LOOK_EVERY = 0.5
 
 # -------------------------------------------------- a worker's trace inputs
 
@@ -218,10 +228,9 @@ class _SplitTrace:
     """The bake's trace hook on the driver (bb_trace_fn): horizon tasks
     for every slice, added up here by rank as they arrive."""
 
-    def __init__(self, task, lib_threads, own_threads):
+    def __init__(self, task, lib_threads):
         self.task = task
         self.lib_threads = lib_threads
-        self.own_threads = own_threads
         self.job = None
         self.raised = None
         self.stats = {}
@@ -258,10 +267,20 @@ class _SplitTrace:
                 futures = [client.submit(_horizons, task, [order[r] for r in g], self.lib_threads,
                                          key=f"bumpbake-horizons-{task['key']}-{k}", pure=False)
                            for k, g in enumerate(groups)]
+                # The next groups' horizons come over (and who ran them is
+                # asked) on other threads while this one adds a group up.
+                fetcher = concurrent.futures.ThreadPoolExecutor(_AHEAD)
+
+                def fetch(future):
+                    return future.result(), client.who_has([future]).get(future.key, ())
+
+                fetched = [fetcher.submit(fetch, f) for f in futures[:_AHEAD]]
+                next_look = 0.0
                 try:
                     for k, (g, future) in enumerate(zip(groups, futures)):
-                        got = future.result()
-                        holders = client.who_has([future]).get(future.key, ())
+                        got, holders = fetched[k].result()
+                        if k + _AHEAD < len(futures):
+                            fetched.append(fetcher.submit(fetch, futures[k + _AHEAD]))
                         for worker in holders or ("?",):
                             ran[worker] = ran.get(worker, 0) + len(g)
                             break
@@ -280,11 +299,14 @@ class _SplitTrace:
                                 options.progress_user, g[-1] + 1, n):
                             raise _exception(_lib.BB_ERR_CANCELLED,
                                              "trace: cancelled by the progress callback")
-                        if variable_value(task["stop"], 1, client=client):
-                            raise _exception(_lib.BB_ERR_CANCELLED,
-                                             "trace: cancelled by the client")
-                    _check(_lib.bb_trace_finish(rays, vis, self.own_threads, err), err)
+                        if time.monotonic() >= next_look:  # a round trip: not every group
+                            next_look = time.monotonic() + _LOOK_EVERY
+                            if variable_value(task["stop"], 1, client=client):
+                                raise _exception(_lib.BB_ERR_CANCELLED,
+                                                 "trace: cancelled by the client")
+                    _check(_lib.bb_trace_finish(rays, vis, _DRIVER_THREADS, err), err)
                 finally:
+                    fetcher.shutdown(wait=False, cancel_futures=True)
                     client.cancel([f for f in futures if not f.done()])
                     for f in futures:  # none left for Dask to run again
                         f.release()
@@ -301,7 +323,7 @@ class _SplitTrace:
         img.width, img.height, img.channels = horizon.shape[1], horizon.shape[0], 1
         keep = _ffi.from_buffer("float[]", np.ascontiguousarray(horizon, dtype=np.float32))
         img.pixels = keep
-        _check(_lib.bb_trace_accumulate(rays, rank, img, vis, self.own_threads, err), err)
+        _check(_lib.bb_trace_accumulate(rays, rank, img, vis, _DRIVER_THREADS, err), err)
 
 
 def _drive(directory, input, args, task):
@@ -312,14 +334,14 @@ def _drive(directory, input, args, task):
         lib_threads = task.pop("horizon_threads")
         notes = task.pop("notes")  # "ignore", or the client's NoteDesk asker
         if isinstance(args, Command):  # handed over by the CLI: planned by the library
-            hook = _SplitTrace(task, lib_threads, own)
+            hook = _SplitTrace(task, lib_threads)
             callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
             job = CommandJob(args.data, notes=notes, threads=own, _trace=callback)
         else:
             args = dict(args)
             if args.get("threads") is None:
                 args["threads"] = own
-            hook = _SplitTrace(task, lib_threads, args["threads"] or own)
+            hook = _SplitTrace(task, lib_threads)
             callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
             job = BakeJob(input, None, notes=notes, _trace=callback,
                           **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
