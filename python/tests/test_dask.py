@@ -276,9 +276,9 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
         '{"summary":{"files":6,"baked":0,"up_to_date":6,"failed":0,"not_run":0}}')
     quiet = batch + ["-q", "--force", "--depfile", "out.d"]
     assert cli(*quiet, "--scheduler", address).stdout == ""
-    forced = files_of("out")
+    forced, depfile = files_of("out"), open("out.d").read()
     cli(*quiet)
-    assert files_of("out") == forced
+    assert files_of("out") == forced and open("out.d").read() == depfile
 
     single = ["bake", "heights/h01.png", "--scale", "16", "--slices", "8", "-o", "one/m"]
     os.makedirs("one")
@@ -526,3 +526,25 @@ def test_a_note_made_an_error_writes_nothing(tmp_path, monkeypatch, client):
         bumpbake.dask.bake_big("heights/h01.png", {"ao": "big_ao.png"}, client=client,
                                scale=64, slices=4)
     assert os.path.exists("big_ao.png")
+
+
+def test_a_forced_batch_with_a_depfile_is_baked_once(tmp_path, monkeypatch, client):
+    """The depfile is the client's: it learns what the workers baked by
+    finding each input up to date. With force, its job baked every input
+    a second time, on the client."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 3)
+    on_the_client = []
+    run = bumpbake.BakeJob.run
+
+    def counted(self, i, progress=None):
+        report = run(self, i, progress)
+        on_the_client.append(report.status)
+        return report
+
+    monkeypatch.setattr(bumpbake.BakeJob, "run", counted)
+    reports = bumpbake.dask.bake_files("heights", "out", client=client, scale=SCALE, slices=4,
+                                       maps="ao", force=True, depfile="out.d")
+    assert [r.status for r in reports] == ["baked"] * 3
+    assert on_the_client == ["up to date"] * 3
+    assert open("out.d").read().count(": heights/h0") == 3

@@ -255,12 +255,19 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     depfile_error = None
     if depfile is not None:
         # The client's job learns what the workers made: each baked input is
-        # now up to date (its bytes hashed, its outputs' headers read).
+        # now up to date (its bytes hashed, its outputs' headers read). A
+        # forced job would bake it again here: that one is planned unforced.
+        # (Not yet for the CLI's command: the library's flags take no "0".)
+        depjob = job
+        if force and _command is None:
+            depjob = BakeJob(job.inputs, out_dir, maps=maps, name=name, keep_going=keep_going,
+                             depfile=depfile, notes="ignore", command_options=command_options,
+                             **options)
         for i in range(count):
             if reports[i].ok:
-                job.run(i)
+                depjob.run(i)
         try:
-            job.write_depfile()
+            depjob.write_depfile()
         except _common.Error as e:
             depfile_error = e
     if desk is None:  # (else each was dispatched as its worker read it)
