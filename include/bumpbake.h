@@ -2875,6 +2875,23 @@ const char *bb_command_input(const bb_command *command, int index);
  * out of memory. */
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 
+/* The hand-over of a checked command to another process (bake
+ * --scheduler hands its command to Python's bumpbake.dask): its inputs,
+ * every option given with the text it was set from, and its record, as
+ * bytes (NUL-separated fields, *size of them). malloc'd; NULL when out of
+ * memory. */
+char *bb_command_handover(const bb_command *command, size_t *size);
+
+/* The command of a hand-over, set again through bb_command_set,
+ * bb_command_add_input and bb_command_set_record and checked
+ * (bb_command_check): the same options, parsed by the same functions.
+ * inputs not NULL: those input_count inputs in place of the hand-over's (a
+ * part of a batch, planned on a worker). Free with bb_command_free.
+ * Errors: BB_ERR_ARGUMENT (not a hand-over of this version, or what
+ * bb_command_check refuses), BB_ERR_MEMORY. */
+bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
+                                   int input_count, bb_command **out, bb_error *err);
+
 /* The command line the outputs record as their provenance's "command",
  * when it is not the one bb_command_text spells: a command-line client
  * gives the words as typed with those of options that are not

@@ -835,6 +835,16 @@ if "$PY" -c 'import distributed' 2>/dev/null; then
   port=$("$PY" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
   TLIM=120 run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "tcp://127.0.0.1:$port"
   TMAX=15 MSG="connection refused" finish
+  # A port that accepts and never speaks Dask: the connection's own bound
+  # (10 s), not Dask's 30 s. (The test suite asserts which bound fired.)
+  begin 32.6h "bake --scheduler ADDRESS that accepts and never answers"
+  LISTENER=$( ("$PY" -c 'import socket, time
+s = socket.socket(); s.bind(("127.0.0.1", 0)); s.listen(8)
+print(s.getsockname()[1], flush=True); time.sleep(120)' >"$W/32.6h.port" 2>/dev/null & echo $!) )
+  for _ in $(seq 100); do [ -s "$W/32.6h.port" ] && break; sleep 0.1; done
+  TLIM=120 run "$BIN" bake h.png --scale 8 --normal n.png --scheduler "tcp://127.0.0.1:$(cat "$W/32.6h.port")"
+  kill "$LISTENER" 2>/dev/null
+  TMAX=25 MSG="no Dask scheduler answered within 10 s" finish
 else
   skip 32.6 "bake --scheduler: malformed and refused addresses" "no python3-distributed"
 fi

@@ -779,6 +779,9 @@ const bb_command_options *bb_command_options_of(const bb_command *command);
 int bb_command_input_count(const bb_command *command);
 const char *bb_command_input(const bb_command *command, int index);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
+char *bb_command_handover(const bb_command *command, size_t *size);
+bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
+                                   int input_count, bb_command **out, bb_error *err);
 bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
                                 bb_error *err);
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,

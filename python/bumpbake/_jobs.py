@@ -148,6 +148,18 @@ class BakeJob:
     def _plan(self, inputs, a):
         self._cmd = self._command(inputs, a)
         self._single = a["out_dir"] is None
+
+        def plan(note, job, err):
+            hooks = _ffi.new("bb_command_hooks *")
+            hooks.note = note
+            if self._trace is not None:
+                hooks.trace = self._trace
+            return _lib.bb_command_plan(self._cmd.handle, hooks, job, err)
+        self._adopt(plan)
+
+    def _adopt(self, plan):
+        """Plans the job through plan(note, job, err) (bb_command_plan of
+        this job's command, or of a handed-over one), with the notes hook."""
         # Notes are handed out as they come, on the caller's terms (a
         # warning, a callable), and kept for the report. One the caller
         # turns into an exception cannot raise through C: it is kept, the
@@ -158,13 +170,9 @@ class BakeJob:
         self._note_raised = []
         self._note_stacklevel = None
         self._note = _ffi.callback("bb_note_fn", self._on_note)
-        hooks = _ffi.new("bb_command_hooks *")
-        hooks.note = self._note
-        if self._trace is not None:
-            hooks.trace = self._trace
         err = _ffi.new("bb_error *")
         job = _ffi.new("bb_job **")
-        _check(_lib.bb_command_plan(self._cmd.handle, hooks, job, err), err)
+        _check(plan(self._note, job, err), err)
         self._job = _ffi.gc(job[0], _lib.bb_job_free)
         self._count = _lib.bb_job_count(self._job)
         self._status = [None] * self._count  # "not run", "up to date" overrides

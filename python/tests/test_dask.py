@@ -10,6 +10,7 @@ import shutil
 import signal
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -254,9 +255,11 @@ def test_a_worker_killed_in_the_middle_of_a_batch(tmp_path, monkeypatch, client,
 
 
 def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, client, cli):
-    """`bumpbake bake ... --scheduler ADDRESS` (the C program execs
-    `python3 -m bumpbake.dask` with the same arguments): a batch and a
-    single map, each the bytes of the same command without --scheduler."""
+    """`bumpbake bake ... --scheduler ADDRESS` (the C program checks and
+    plans the command, then hands it to bumpbake.dask): a batch and a
+    single map, each the bytes of the same command without --scheduler,
+    options that do not change the output (-q, --json, --force, --depfile)
+    included: the files record the command as the CLI does."""
     monkeypatch.chdir(tmp_path)
     heights("heights", 6)
     address = client.scheduler.address
@@ -271,6 +274,11 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     again = cli(*batch, "--scheduler=" + address, "--json")
     assert again.stdout.splitlines()[-1] == (
         '{"summary":{"files":6,"baked":0,"up_to_date":6,"failed":0,"not_run":0}}')
+    quiet = batch + ["-q", "--force", "--depfile", "out.d"]
+    assert cli(*quiet, "--scheduler", address).stdout == ""
+    forced, depfile = files_of("out"), open("out.d").read()
+    cli(*quiet)
+    assert files_of("out") == forced and open("out.d").read() == depfile
 
     single = ["bake", "heights/h01.png", "--scale", "16", "--slices", "8", "-o", "one/m"]
     os.makedirs("one")
@@ -283,12 +291,22 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     bad = cli("bake", "heights/h01.png", "heights/h02.png", "--scale", "16", "--scheduler",
               address, "-o", "x", check=False)
     assert bad.returncode == 2 and "several HEIGHT files need --out-dir DIR" in bad.stderr
-    # what the cluster does not bake is refused, saying so, before anything
-    refused = cli("bake", "heights/h01.png", "--scale", "16", "--bounce", "0.5", "-o", "b/m",
-                  "--scheduler", address, check=False)
-    assert refused.returncode == 2 and refused.stderr.count("\n") == 1
-    assert "--bounce is not available with --scheduler" in refused.stderr
-    assert not os.path.exists("b")
+    # the library's checks and plan, before Python starts: a clash, an
+    # output over an input, with the CLI's words and exit codes
+    clash = cli("bake", "heights", "--scale", "16", "--out-dir", "heights", "--maps", "normal",
+                "--name", "h00.png", "--scheduler", "tcp://127.0.0.1:1", check=False)
+    assert clash.returncode == 2 and "would overwrite the input" in clash.stderr
+    # what the library bakes, the cluster bakes: inter-reflection, a batch
+    # and one split map, the bytes of one machine
+    for args, d in ((["heights", "--out-dir", "bb", "--maps", "ao,ssbump"], "bb"),
+                    (["heights/h01.png", "--ao", "b/a.png", "--ssbump", "b/s.png"], "b")):
+        bounce = ["bake", *args, "--scale", "16", "--slices", "4", "--bounce", "0.5"]
+        os.makedirs(d, exist_ok=True)
+        cli(*bounce, "--scheduler", address)
+        os.rename(d, d + "_dask")
+        os.makedirs(d)
+        cli(*bounce)
+        assert files_of(d + "_dask") == files_of(d) and len(files_of(d)) in (2, 12)
 
 
 def test_the_cli_with_a_scheduler_imports_nothing_from_the_working_directory(
@@ -345,14 +363,60 @@ def test_a_big_bake_its_client_gives_up_writes_nothing(tmp_path, monkeypatch, cl
     assert sorted(os.listdir(".")) == ["h00.png"], "an output was written"
 
 
-def test_the_cli_knows_every_option_of_the_c_program(cli):
-    """--scheduler re-reads the C program's arguments in Python, with
-    getopt's prefixes: the two must know the same options to read a
-    prefix the same way."""
-    from bumpbake.dask import _cli
-    help_text = cli("bake", "--help").stdout
-    c_options = set(re.findall(r"^\s+(?:-\w, )?--([a-z-]+)", help_text, re.M))
-    assert c_options == set(_cli._VALUED + _cli._FLAGS + _cli._NOT_ON_A_CLUSTER)
+def test_a_handed_over_command_is_the_command(tmp_path, monkeypatch):
+    """The hand-over (bb_command_handover, bb_command_from_handover) sets
+    every option of bake again from the text it was set from: the command
+    read back spells every option as the one handed over; a chunk's inputs
+    replace the batch's; what is not a hand-over is refused."""
+    from bumpbake._common import _check, _ffi, _lib, _text
+    from bumpbake.dask._command import Command, CommandJob
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 2)
+    with open("basis.txt", "w") as f:
+        f.write("1 0 0.5\n-0.5 0.8 0.5\n-0.5 -0.8 0.5\n")
+    err = _ffi.new("bb_error *")
+    out = _ffi.new("bb_command **")
+    _check(_lib.bb_command_new(b"bake", out, err), err)
+    c = _ffi.gc(out[0], _lib.bb_command_free)
+    given = {"scale": "12.5", "slices": "6", "filter-radius": "2", "filter-threshold": "0.01",
+             "bias": "0.3", "power": "1.5", "basis": "basis.txt", "normal-filter": "sobel",
+             "normal-y": "up", "threads": "2", "clamp": None, "channel": "r", "depth": "16",
+             "mips": None, "bounce": "0.25", "bounces": "3", "out-dir": "out",
+             "maps": "normal,ao", "name": "{kind}/{stem}.tif", "keep-going": None,
+             "force": None, "depfile": "o.d", "json": None, "quiet": None,
+             "scheduler": "tcp://h:1"}
+    for name, text in given.items():
+        _check(_lib.bb_command_set(c, name.encode(), text.encode() if text else _ffi.NULL,
+                                   err), err)
+    _check(_lib.bb_command_add_input(c, b"heights", err), err)
+    _check(_lib.bb_command_set_record(c, b"bumpbake bake heights ...", b"--scale 12.5", err),
+           err)
+    _check(_lib.bb_command_check(c, err), err)
+    size = _ffi.new("size_t *")
+    data = _lib.bb_command_handover(c, size)
+    handed = bytes(_ffi.buffer(data, size[0]))
+    _lib.free(data)
+
+    def spelled(command):
+        text = _lib.bb_command_text(command, _ffi.NULL, 0)
+        try:
+            return _text(text)
+        finally:
+            _lib.free(text)
+
+    back = Command(handed)
+    assert spelled(back.c) == spelled(c)
+    assert all(_lib.bb_command_given(back.c, n.encode()) for n in given)
+    assert back.options.json == 1 and back.options.quiet == 1  # the printer's, too
+    assert _text(back.options.scheduler) == "tcp://h:1"
+    chunk = Command(handed, ["heights/h01.png"])
+    assert spelled(chunk.c).startswith("bumpbake bake heights/h01.png --scale 12.5")
+    job = CommandJob(handed, ["heights/h01.png"], notes="ignore")
+    assert job.inputs == ["heights/h01.png"]
+    assert job.report(0).outputs == {"normal": "out/normal/h01.tif", "ao": "out/ao/h01.tif"}
+    for bad in (b"", b"bake\0", handed[:-4], handed.replace(b"input\0", b"inpux\0")):
+        with pytest.raises(bumpbake.ArgumentError, match="hand-over"):
+            Command(bad)
 
 
 def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, client, cli):
@@ -400,3 +464,87 @@ def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, c
     os.makedirs("materials/rock")
     cli(*single)
     assert files_of("materials") == split
+
+
+def _idle(client):
+    """Waits until no task of bumpbake's runs or waits on the cluster."""
+    deadline = time.monotonic() + 600  # a hang guard, not a bound on time
+    while any(client.processing().values()):
+        assert time.monotonic() < deadline, client.processing()
+        time.sleep(0.05)
+
+
+def test_a_note_made_an_error_writes_nothing(tmp_path, monkeypatch, client):
+    """A note the caller makes an error (a warnings filter, a notes callable
+    that raises) means nothing of its input is written, on the cluster as
+    in bake_file: the worker that read the input asks the client before
+    writing, the client raises, and that input is cancelled. The batch then
+    stops as when the client gives up: nothing starts after it."""
+    from bumpbake import NoteWarning
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 3)  # 16-bit: no note at scale 64
+    h = bumpbake.read("heights/h01.png")
+    os.remove("heights/h01.png")
+    bumpbake.write("heights/h01.png", h, kind="height", depth=8)  # 8 bits at 64: terraces
+
+    def noted_input_written(out):
+        _idle(client)
+        return [n for n in os.listdir(out) if n.startswith("h01")] if os.path.isdir(out) else []
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NoteWarning)
+        with pytest.raises(NoteWarning, match="8-bit heights"):
+            bumpbake.dask.bake_files("heights", "a", client=client, scale=64, slices=4,
+                                     maps="ao", keep_going=True)
+        assert noted_input_written("a") == []
+        with pytest.raises(NoteWarning, match="8-bit heights"):
+            bumpbake.dask.bake_big("heights/h01.png", {"ao": "big_ao.png"}, client=client,
+                                   scale=64, slices=4)
+        _idle(client)
+        assert not os.path.exists("big_ao.png")
+
+    def refuse(line):
+        raise RuntimeError(f"refused: {line}")
+
+    with pytest.raises(RuntimeError, match="refused: heights/h01.png: 8-bit"):
+        bumpbake.dask.bake_files("heights", "b", client=client, scale=64, slices=4,
+                                 maps="ao", notes=refuse, chunk_size=1)
+    assert noted_input_written("b") == []
+    with pytest.raises(RuntimeError, match="refused"):
+        bumpbake.dask.bake_big("heights/h01.png", {"ao": "big_ao.png"}, client=client,
+                               scale=64, slices=4, notes=refuse)
+    _idle(client)
+    assert not os.path.exists("big_ao.png")
+
+    # a note that stays a note: every file, the note given once
+    seen = []
+    reports = bumpbake.dask.bake_files("heights", "c", client=client, scale=64, slices=4,
+                                       maps="ao", notes=seen.append)
+    assert [r.status for r in reports] == ["baked"] * 3
+    assert len(seen) == 1 and seen[0].startswith("heights/h01.png: 8-bit")
+    with pytest.warns(NoteWarning, match="8-bit heights"):
+        bumpbake.dask.bake_big("heights/h01.png", {"ao": "big_ao.png"}, client=client,
+                               scale=64, slices=4)
+    assert os.path.exists("big_ao.png")
+
+
+def test_a_forced_batch_with_a_depfile_is_baked_once(tmp_path, monkeypatch, client):
+    """The depfile is the client's: it learns what the workers baked by
+    finding each input up to date. With force, its job baked every input
+    a second time, on the client."""
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 3)
+    on_the_client = []
+    run = bumpbake.BakeJob.run
+
+    def counted(self, i, progress=None):
+        report = run(self, i, progress)
+        on_the_client.append(report.status)
+        return report
+
+    monkeypatch.setattr(bumpbake.BakeJob, "run", counted)
+    reports = bumpbake.dask.bake_files("heights", "out", client=client, scale=SCALE, slices=4,
+                                       maps="ao", force=True, depfile="out.d")
+    assert [r.status for r in reports] == ["baked"] * 3
+    assert on_the_client == ["up to date"] * 3
+    assert open("out.d").read().count(": heights/h0") == 3

@@ -8,6 +8,7 @@ dask-worker without a nanny), as a user starts them, so they can be
 killed."""
 
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -26,7 +27,10 @@ from bumpbake.dask import _connect  # noqa: E402
 from test_dask import heights  # noqa: E402
 
 PYTHON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-START_TIMEOUT = 120  # seconds a scheduler or worker may take to start (a loaded machine)
+# Seconds before a wait counts as a hang: a guard, never a bound on speed
+# (no load makes a start, a batch's first files or a lost cluster take
+# this long). The bounds on time themselves are make hostile's (32.6, 32.7).
+HANG_GUARD = 600
 
 
 def _free_port():
@@ -52,9 +56,9 @@ class Cluster:
         self.worker = subprocess.Popen(
             [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads",
              "1", "--no-nanny", "--memory-limit", "0", "--no-dashboard"], **quiet)
-        self.client = distributed.Client(self.address, timeout=START_TIMEOUT,
+        self.client = distributed.Client(self.address, timeout=HANG_GUARD,
                                          set_as_default=False)
-        self.client.wait_for_workers(1, timeout=START_TIMEOUT)
+        self.client.wait_for_workers(1, timeout=HANG_GUARD)
 
     def close(self):
         self.client.close(timeout=10)
@@ -128,15 +132,16 @@ def test_a_refused_connection_is_one_line_at_once(tmp_path, monkeypatch, cli):
 
 def test_an_unanswered_connection_is_reported_within_the_timeout():
     """A port that accepts and never speaks Dask (a listening socket that
-    is never served): the handshake's bound, not Dask's 30 s."""
+    is never served): the bound given fires (Dask says which: "after 1 s"),
+    not Dask's own 30 s. How long it takes is make hostile's (32.6h)."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen(1)
         address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
-        t0 = time.monotonic()
         with pytest.raises(bumpbake.Error, match="cannot reach the Dask scheduler") as e:
             _connect.connect(address, timeout=1)
-        assert time.monotonic() - t0 < 25, "Dask's own 30 s"
+        assert "within 1 s" in str(e.value), str(e.value)
+        assert re.search(r"after 1(\.0)? ?s\b", str(e.value)), str(e.value)  # Dask's words
         assert "\n" not in str(e.value)
 
 
@@ -187,20 +192,21 @@ def test_the_scheduler_killed_in_a_batch_is_one_line(tmp_path, monkeypatch, cli,
     heights("in", 40, side=96)
     bake = cli.start("bake", "in", "--scale", "16", "--out-dir", "out", "--maps",
                      "normal,ssbump,ao", "-q", "--scheduler", cluster.address)
-    _wait_for_files("out", 3, bake, time.monotonic() + START_TIMEOUT)
+    _wait_for_files("out", 3, bake, time.monotonic() + HANG_GUARD)
     cluster.scheduler.kill()
-    t0 = time.monotonic()
-    _, err = bake.communicate(timeout=120)
-    lost_after = time.monotonic() - t0
+    _, err = bake.communicate(timeout=HANG_GUARD)
     assert bake.returncode == 1, err
-    assert "the Dask cluster was lost" in _one_line(err)
-    assert lost_after < 60, lost_after  # 35 s and a traceback before
-    cluster.worker.wait(timeout=120)  # its chunk ended: nothing more comes
+    # the connection's close was seen (35 s and a traceback before), not
+    # the wait for workers; how soon is make hostile's (32.7a)
+    assert re.search(r"the Dask cluster was lost: the connection to the scheduler \S+ closed$",
+                     _one_line(err).rstrip("\n")), err
+    cluster.worker.wait(timeout=HANG_GUARD)  # its chunk ended: nothing more comes
     assert len(_whole("out")) < 120
 
 
 def test_the_only_worker_killed_is_lost_within_a_bound(tmp_path, monkeypatch, cluster):
-    """It waited for ever for a worker; now WORKERLESS_WAIT seconds."""
+    """It waited for ever for a worker; now WORKERLESS_WAIT seconds, and the
+    message says that this wait fired (how soon: make hostile's 32.7b)."""
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(_connect, "WORKERLESS_WAIT", 2)
     heights("in", 30, side=96)
@@ -211,12 +217,10 @@ def test_the_only_worker_killed_is_lost_within_a_bound(tmp_path, monkeypatch, cl
             cluster.worker.kill()
             killed.append(done)
 
-    t0 = time.monotonic()
-    with pytest.raises(_connect.ClusterLost, match="no worker left") as e:
+    with pytest.raises(_connect.ClusterLost, match=r"no worker left on \S+ for 2 s$") as e:
         bumpbake.dask.bake_files("in", "out", client=cluster.client, scale=16,
                                  maps=("normal", "ao"), chunk_size=1, progress=kill_the_worker)
     assert killed and "\n" not in str(e.value)
-    assert time.monotonic() - t0 < START_TIMEOUT
     assert len(_whole("out")) < 60
 
 
@@ -233,9 +237,9 @@ def test_ctrl_c_on_the_client_leaves_later_inputs_untouched(tmp_path, monkeypatc
     heights("in", 12, side=400)  # seconds an input on one loaded thread
     bake = cli.start("bake", "in", "--scale", "16", "--slices", "32", "--out-dir", "out",
                      "--maps", "ao", "-q", "--keep-going", "--scheduler", cluster.address)
-    _wait_for_files("out", 1, bake, time.monotonic() + START_TIMEOUT)
+    _wait_for_files("out", 1, bake, time.monotonic() + HANG_GUARD)
     bake.send_signal(signal.SIGINT)
-    _, err = bake.communicate(timeout=60)
+    _, err = bake.communicate(timeout=HANG_GUARD)
     assert bake.returncode == 130, err
     at_exit = sorted(os.listdir("out"))
 
@@ -243,7 +247,7 @@ def test_ctrl_c_on_the_client_leaves_later_inputs_untouched(tmp_path, monkeypatc
         return [k for keys in cluster.client.run(lambda dask_worker: list(
             dask_worker.active_threads.values())).values() for k in keys]
 
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + HANG_GUARD
     while busy():
         assert time.monotonic() < deadline, busy()
         time.sleep(0.1)

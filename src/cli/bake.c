@@ -71,7 +71,7 @@ static void print_summary(const char *command, const printer *p, int files) {
 int cli_run_job(const cli_run *r) {
   const char *name = bb_command_describe(r->command)->name;
   if (r->options->scheduler)
-    return cli_cluster_exec(r->typed_count, r->typed); /* returns only on failure */
+    return cli_cluster_exec(r); /* returns only on failure */
   const bb_command_hooks hooks = {cli_note, NULL, NULL, NULL, NULL, NULL};
   bb_job *job = NULL;
   bb_error err = {{0}};

@@ -28,8 +28,6 @@ struct cli_run {
   const bb_command_options *options; /* bb_command_options_of(command) */
   const char *record;   /* the command line its outputs record: the words as typed,
                            less those of options that do not change the output */
-  char **typed;         /* the arguments as typed (argv[0] the command's name) */
-  int typed_count;
 };
 
 /* Each command's run: what it does with the library and what it prints;

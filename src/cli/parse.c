@@ -331,7 +331,7 @@ static int parse_and_run(parse *p, int (*run)(const cli_run *r)) {
     cli_error_line("out of memory");
     return BB_EXIT_FAILURE;
   }
-  cli_run r = {p->command, bb_command_options_of(p->command), line, p->argv, p->argc};
+  cli_run r = {p->command, bb_command_options_of(p->command), line};
   rc = BB_EXIT_FAILURE;
   for (size_t i = 0; !run && i < sizeof runners / sizeof runners[0]; i++)
     if (!strcmp(runners[i].name, p->info->name))

@@ -85,6 +85,8 @@ struct bb_command {
   unsigned char given[BB__MAX_OPTIONS];
   double values[BB__MAX_OPTIONS][BB__MAX_NUMBERS]; /* the numbers each option set */
   int value_count[BB__MAX_OPTIONS];
+  const char *texts[BB__MAX_OPTIONS]; /* the text each option was set from (NULL: a
+                                        flag), owned: a hand-over sets it again */
   char **strings;                    /* owned copies the options point to */
   int string_count, string_capacity;
   char **inputs;

@@ -115,6 +115,10 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
                         : bb__set_generic(c, o, text, values, &count, err);
   if (st != BB_OK)
     return st;
+  if (text && !(c->texts[i] = bb__command_keep(c, text)))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  if (!text)
+    c->texts[i] = NULL;
   c->given[i] = 1;
   c->value_count[i] = count < BB__MAX_NUMBERS ? count : BB__MAX_NUMBERS;
   memcpy(c->values[i], values, sizeof values);

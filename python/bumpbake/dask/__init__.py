@@ -12,10 +12,10 @@ bake_files: a batch planned on the client, its stale inputs baked on the
 workers in chunks. bake_big: one map whose trace (the sweeps of its
 slices) is split over the workers and added up in the single machine's
 order, so its files are a single bake's bit for bit. Workers open the
-client's paths (shared storage). `python3 -m bumpbake.dask bake ...` is
-the same from the command line (what `bumpbake bake --scheduler ADDRESS`
-runs). docs/cluster.md says how to start a cluster and what each worker
-holds.
+client's paths (shared storage). `bumpbake bake ... --scheduler ADDRESS`
+is the same from the command line: the C program checks and plans the
+command and hands it to _command, which runs it with these.
+docs/cluster.md says how to start a cluster and what each worker holds.
 """
 
 try:

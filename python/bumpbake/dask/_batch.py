@@ -12,8 +12,10 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
+from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
-from ._shared import client_directory, client_of, variable_value, worker_threads
+from ._shared import (NoteDesk, NoteRefused, client_directory, client_of, notes_can_raise,
+                      variable_value, worker_threads)
 
 # Inputs per chunk: enough chunks that the last ones end together (the
 # scheduler hands a chunk to whichever worker thread is free), few enough
@@ -73,22 +75,32 @@ class _Stop:
                 distributed.Variable(self.name).set(index)
 
 
-def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure):
+def _bake_chunk(directory, inputs, indices, args, stop, stop_on_failure, notes="ignore"):
     """On a worker: bakes inputs (indices in the batch) of one chunk with
-    the batch's arguments; returns [(index, BakeReport or None: not run)].
+    the batch's arguments (a dict of keyword arguments, or the Command); returns [(index, BakeReport or None: not run)].
     stop (a _Stop or None) says which inputs no longer start; a failure
     lowers it when stop_on_failure. Each input is checked again (a chunk
     run a second time, after its worker died, skips what the first run
-    finished) and written all or nothing, as bb_job_run_item does."""
+    finished) and written all or nothing, as bb_job_run_item does. notes:
+    "ignore", or the client's NoteDesk asker: an input whose note the
+    client makes an error is cancelled, nothing of it written, and
+    reported not run."""
     out = []
     with client_directory(directory):
-        job = BakeJob(inputs, args["out_dir"], notes="ignore",
-                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        if isinstance(args, Command):  # handed over by the CLI: planned by the library
+            job = CommandJob(args.data, inputs, notes=notes, threads=1)
+        else:
+            job = BakeJob(inputs, args["out_dir"], notes=notes,
+                          **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
         for k, index in enumerate(indices):
             if stop is not None and stop.reached(index):
                 out.append((index, None))
                 continue
-            report = job.run(k, progress=stop.abandoned if stop is not None else None)
+            try:
+                report = job.run(k, progress=stop.abandoned if stop is not None else None)
+            except NoteRefused:
+                out.append((index, None))
+                continue
             if report.status == "failed" and stop_on_failure:
                 stop.lower(index)
             out.append((index, report))
@@ -114,7 +126,8 @@ def sweep_temporaries(directories):
 
 def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=False,
                keep_going=False, depfile=None, check=True, progress=None, notes="warn",
-               chunk_size=None, command_options=None, **options):
+               chunk_size=None, command_options=None, _command=None, _ask_notes=None,
+               **options):
     """Bakes height files and directories of them into out_dir on a Dask
     cluster, as `bumpbake bake INPUT... --out-dir OUT_DIR` does on one
     machine, and returns one BakeReport per input, in input order.
@@ -155,8 +168,12 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     """
     client = client_of(client)
     directory = os.getcwd()
-    job = BakeJob(inputs, out_dir, maps=maps, name=name, force=force, keep_going=keep_going,
-                  depfile=depfile, notes=notes, command_options=command_options, **options)
+    if _command is not None:  # the CLI's command (bumpbake bake --scheduler): its own options
+        job = CommandJob(_command.data, notes=notes)
+        force, keep_going, depfile = (job._args[k] for k in ("force", "keep_going", "depfile"))
+    else:
+        job = BakeJob(inputs, out_dir, maps=maps, name=name, force=force, keep_going=keep_going,
+                      depfile=depfile, notes=notes, command_options=command_options, **options)
     count = len(job)
     reports = [None] * count
     pending = []
@@ -166,10 +183,13 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
             reports[i].status = "up to date"
         else:
             pending.append(i)
-    args = dict(job._args, depfile=None, keep_going=True)
-    args.setdefault("threads", 1)
-    if args["threads"] is None:
-        args["threads"] = 1
+    if _command is not None:
+        args = _command
+    else:
+        args = dict(job._args, depfile=None, keep_going=True)
+        args.setdefault("threads", 1)
+        if args["threads"] is None:
+            args["threads"] = 1
     inputs_planned = job.inputs
     size = chunk_size or chunk_size_for(len(pending), worker_threads(client))
     if not isinstance(size, int) or size < 1:
@@ -180,6 +200,14 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     # every chunk before its next input, keep_going or not.
     stop = _Stop(f"bumpbake-stop-{token}")
     distributed.Variable(stop.name, client=client).set(_NO_STOP)
+    # Notes the caller may make errors are dispatched here before the
+    # worker writes anything of their input; the others once it is over.
+    desk = None
+    if notes_can_raise(notes) if _ask_notes is None else _ask_notes:
+        desk = NoteDesk(client, token, notes, stacklevel=4)
+        worker_notes = desk.asker(stop.name, -1)
+    else:
+        worker_notes = "ignore"
     chunks = [pending[c:c + size] for c in range(0, len(pending), size)]
     futures = {}
 
@@ -189,11 +217,11 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     try:
         for n, chunk in enumerate(chunks):
             f = client.submit(_bake_chunk, directory, [inputs_planned[i] for i in chunk], chunk,
-                              args, stop, not keep_going,
+                              args, stop, not keep_going, worker_notes,
                               key=f"bumpbake-chunk-{token}-{n}", pure=False)
             futures[f] = chunk
         done = count - len(pending)
-        for f in completed(client, list(futures)):
+        for f in completed(client, list(futures), desk.serve if desk else None):
             for index, report in f.result():
                 reports[index] = report
                 done += 1
@@ -217,6 +245,8 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
             f.release()
         futures.clear()
         settle(client, lambda: distributed.Variable(stop.name, client=client).delete())
+        if desk is not None:
+            settle(client, lambda: desk.queue.close())
     for i in range(count):
         if reports[i] is None:
             reports[i] = job.report(i)
@@ -225,16 +255,24 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
     depfile_error = None
     if depfile is not None:
         # The client's job learns what the workers made: each baked input is
-        # now up to date (its bytes hashed, its outputs' headers read).
+        # now up to date (its bytes hashed, its outputs' headers read). A
+        # forced job would bake it again here: that one is planned unforced.
+        # (Not yet for the CLI's command: the library's flags take no "0".)
+        depjob = job
+        if force and _command is None:
+            depjob = BakeJob(job.inputs, out_dir, maps=maps, name=name, keep_going=keep_going,
+                             depfile=depfile, notes="ignore", command_options=command_options,
+                             **options)
         for i in range(count):
             if reports[i].ok:
-                job.run(i)
+                depjob.run(i)
         try:
-            job.write_depfile()
+            depjob.write_depfile()
         except _common.Error as e:
             depfile_error = e
-    for r in reports:
-        _dispatch_notes(r.notes, job._notes_policy, stacklevel=2)
+    if desk is None:  # (else each was dispatched as its worker read it)
+        for r in reports:
+            _dispatch_notes(r.notes, job._notes_policy, stacklevel=2)
     if check:
         _raise_failures(reports, depfile_error)
     elif depfile_error:

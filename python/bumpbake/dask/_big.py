@@ -13,6 +13,7 @@ once per worker process and bake, and finds its slices' horizons
 """
 
 import collections
+import concurrent.futures
 import os
 import threading
 import time
@@ -25,9 +26,19 @@ from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _k
 from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
+from ._command import Command, CommandJob
 from ._connect import ClusterLost, completed, settle
-from ._shared import (client_directory, client_of, this_worker_threads, variable_value,
-                      worker_threads)
+from ._shared import (NoteDesk, client_directory, client_of, notes_can_raise,
+                      this_worker_threads, variable_value, worker_threads)
+
+# Groups of slices whose horizons are fetched ahead of the one being added
+# up (each holds 8 bytes a texel while it waits).
+_AHEAD = 2
+# Threads adding the horizons up on the driver: all its machine's cores
+# (0); the sums are the same bits for any count.
+_DRIVER_THREADS = 0
+# Seconds between the driver's looks at the client's stop variable.
+_LOOK_EVERY = 0.5
 
 # -------------------------------------------------- a worker's trace inputs
 
@@ -137,10 +148,21 @@ def _take_back(key, entry):
 
 
 def _bake_options_of(task):
-    options = {k: v for k, v in task["options"].items()}
-    o, _ = _bake_options("bake", task["scale"], **options)
+    """(bb_bake_options * of task's bake, its bb_channel, what must stay
+    alive while they are used): from bake_big's keyword arguments, or from
+    the command the CLI handed over, set up again by the library in the
+    client's directory (a basis file named relative to it)."""
+    if "command" in task:
+        with client_directory(task["directory"]):
+            command = Command(task["command"])
+        o = _ffi.new("bb_bake_options *")
+        o[0] = command.options.job.bake
+        channel = command.options.job.channel
+    else:
+        o, _ = _bake_options("bake", task["scale"], **task["options"])
+        channel, command = _channel(task["channel"]), None
     o.outputs = _kinds_mask("bake", TRACED_OUTPUTS)[1]
-    return o
+    return o, channel, command
 
 
 def _build(task, threads):
@@ -150,14 +172,13 @@ def _build(task, threads):
     err = _ffi.new("bb_error *")
     height = _ffi.new("bb_image *")
     source = _ffi.new("bb_height_source *")
-    _check(_lib.bb_height_file_read(_path(task["path"]), _channel(task["channel"]),
-                                    float(task["scale"]), _ffi.NULL, _ffi.NULL, height,
-                                    source, err), err)
+    o, channel, keep = _bake_options_of(task)
+    _check(_lib.bb_height_file_read(_path(task["path"]), channel, o.height_scale, _ffi.NULL,
+                                    _ffi.NULL, height, source, err), err)
     try:
         if source.file_hash != task["file_hash"]:
             raise Error(f"{task['path']}: the file changed while it was baked (a worker read "
                         "other bytes than the bake's)", "i/o error")
-        o = _bake_options_of(task)
         o.trace.threads = threads
         pyramid = _ffi.new("bb_pyramid **")
         rays = _ffi.new("bb_rayset **")
@@ -187,7 +208,8 @@ def _horizons(task, slices, threads):
     entry = _acquire(task["key"], lambda: _build(task, threads))
     try:
         o = _ffi.new("bb_trace_options *")
-        o[0] = _bake_options_of(task).trace
+        bake, _, keep = _bake_options_of(task)
+        o[0] = bake.trace
         o.threads = threads
         c_slices = _ffi.new("int[]", slices)
         images = _ffi.new("bb_image[]", len(slices))
@@ -206,10 +228,9 @@ class _SplitTrace:
     """The bake's trace hook on the driver (bb_trace_fn): horizon tasks
     for every slice, added up here by rank as they arrive."""
 
-    def __init__(self, task, lib_threads, own_threads):
+    def __init__(self, task, lib_threads):
         self.task = task
         self.lib_threads = lib_threads
-        self.own_threads = own_threads
         self.job = None
         self.raised = None
         self.stats = {}
@@ -246,10 +267,20 @@ class _SplitTrace:
                 futures = [client.submit(_horizons, task, [order[r] for r in g], self.lib_threads,
                                          key=f"bumpbake-horizons-{task['key']}-{k}", pure=False)
                            for k, g in enumerate(groups)]
+                # The next groups' horizons come over (and who ran them is
+                # asked) on other threads while this one adds a group up.
+                fetcher = concurrent.futures.ThreadPoolExecutor(_AHEAD)
+
+                def fetch(future):
+                    return future.result(), client.who_has([future]).get(future.key, ())
+
+                fetched = [fetcher.submit(fetch, f) for f in futures[:_AHEAD]]
+                next_look = 0.0
                 try:
                     for k, (g, future) in enumerate(zip(groups, futures)):
-                        got = future.result()
-                        holders = client.who_has([future]).get(future.key, ())
+                        got, holders = fetched[k].result()
+                        if k + _AHEAD < len(futures):
+                            fetched.append(fetcher.submit(fetch, futures[k + _AHEAD]))
                         for worker in holders or ("?",):
                             ran[worker] = ran.get(worker, 0) + len(g)
                             break
@@ -268,11 +299,14 @@ class _SplitTrace:
                                 options.progress_user, g[-1] + 1, n):
                             raise _exception(_lib.BB_ERR_CANCELLED,
                                              "trace: cancelled by the progress callback")
-                        if variable_value(task["stop"], 1, client=client):
-                            raise _exception(_lib.BB_ERR_CANCELLED,
-                                             "trace: cancelled by the client")
-                    _check(_lib.bb_trace_finish(rays, vis, self.own_threads, err), err)
+                        if time.monotonic() >= next_look:  # a round trip: not every group
+                            next_look = time.monotonic() + _LOOK_EVERY
+                            if variable_value(task["stop"], 1, client=client):
+                                raise _exception(_lib.BB_ERR_CANCELLED,
+                                                 "trace: cancelled by the client")
+                    _check(_lib.bb_trace_finish(rays, vis, _DRIVER_THREADS, err), err)
                 finally:
+                    fetcher.shutdown(wait=False, cancel_futures=True)
                     client.cancel([f for f in futures if not f.done()])
                     for f in futures:  # none left for Dask to run again
                         f.release()
@@ -289,7 +323,7 @@ class _SplitTrace:
         img.width, img.height, img.channels = horizon.shape[1], horizon.shape[0], 1
         keep = _ffi.from_buffer("float[]", np.ascontiguousarray(horizon, dtype=np.float32))
         img.pixels = keep
-        _check(_lib.bb_trace_accumulate(rays, rank, img, vis, self.own_threads, err), err)
+        _check(_lib.bb_trace_accumulate(rays, rank, img, vis, _DRIVER_THREADS, err), err)
 
 
 def _drive(directory, input, args, task):
@@ -297,14 +331,20 @@ def _drive(directory, input, args, task):
     cluster; returns (BakeReport, what the split did)."""
     with client_directory(directory):
         own = this_worker_threads()
-        args = dict(args)
-        if args.get("threads") is None:
-            args["threads"] = own
         lib_threads = task.pop("horizon_threads")
-        hook = _SplitTrace(task, lib_threads, args["threads"] or own)
-        callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
-        job = BakeJob(input, None, notes="ignore", _trace=callback,
-                      **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
+        notes = task.pop("notes")  # "ignore", or the client's NoteDesk asker
+        if isinstance(args, Command):  # handed over by the CLI: planned by the library
+            hook = _SplitTrace(task, lib_threads)
+            callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
+            job = CommandJob(args.data, notes=notes, threads=own, _trace=callback)
+        else:
+            args = dict(args)
+            if args.get("threads") is None:
+                args["threads"] = own
+            hook = _SplitTrace(task, lib_threads)
+            callback = _ffi.callback("bb_trace_fn", hook, error=_lib.BB_ERR_IO)
+            job = BakeJob(input, None, notes=notes, _trace=callback,
+                          **{k: v for k, v in args.items() if k not in ("out_dir", "notes")})
         hook.job = job
         report = job.run(0)
         if hook.raised is not None and not isinstance(hook.raised, Error):
@@ -314,7 +354,7 @@ def _drive(directory, input, args, task):
 
 def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=None,
              depfile=None, force=True, check=True, notes="warn", command=None,
-             horizon_threads=None, **options):
+             horizon_threads=None, _command=None, _ask_notes=None, **options):
     """Bakes one height file into the files named, as bumpbake.bake_file
     (and `bumpbake bake INPUT --normal FILE ...`) does, with its trace
     split over the workers of a Dask cluster; returns its BakeReport. The
@@ -342,36 +382,53 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     """
     client = client_of(client)
     directory = os.getcwd()
-    job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
-                  depfile=depfile, force=force, notes=notes, command=command, **options)
+    if _command is not None:  # the CLI's command (bumpbake bake --scheduler): always baked
+        job = CommandJob(_command.data, notes=notes)
+        args, force = _command, True
+        slices = _lib.bb_bake_slices(_ffi.addressof(_command.options.job, "bake"))
+    else:
+        job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
+                      depfile=depfile, force=force, notes=notes, command=command, **options)
+        args = dict(job._args, force=True)
     if not force and job.check_current(0):
         report = job.report(0)
         report.status = "up to date"
         return report
-    args = dict(job._args, force=True)
     planned = job.inputs[0]
-    basis = options.get("basis")
-    task_options = {k: v for k, v in options.items()
-                    if k in BAKE_PARAMETERS and k != "threads"}
-    if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
-            os.fsdecode(basis) not in ("hl2", "hl2+z") and not os.fsdecode(basis).startswith(
-                "dirs:"):
-        task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
-    tasks = max(1, (_lib_slices(task_options) + 1) // 2)
+    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned)}
+    if _command is not None:
+        task.update(command=_command.data, directory=directory)
+    else:
+        basis = options.get("basis")
+        task_options = {k: v for k, v in options.items()
+                        if k in BAKE_PARAMETERS and k != "threads"}
+        if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
+                os.fsdecode(basis) not in ("hl2", "hl2+z") and \
+                not os.fsdecode(basis).startswith("dirs:"):
+            task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
+        slices = _lib_slices(task_options)
+        task.update(scale=args["scale"], channel=args["channel"], options=task_options)
+    tasks = max(1, (slices + 1) // 2)
     if horizon_threads is None:
         horizon_threads = max(1, worker_threads(client) // tasks)
-    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
-            "scale": args["scale"], "channel": args["channel"], "options": task_options,
-            "horizon_threads": int(horizon_threads)}
+    task["horizon_threads"] = int(horizon_threads)
     # Set when the client gives up (Ctrl-C): the driver stops at the next
     # group of slices, writing nothing (a running task cannot be killed).
     task["stop"] = f"bumpbake-big-stop-{task['key']}"
     stop = distributed.Variable(task["stop"], client=client)
     stop.set(0)
+    # A note the caller may make an error is dispatched here before the
+    # driver writes anything; the others once the bake is over.
+    desk = None
+    if notes_can_raise(notes) if _ask_notes is None else _ask_notes:
+        desk = NoteDesk(client, task["key"], notes, stacklevel=4)
+        task["notes"] = desk.asker(task["stop"], 1)
+    else:
+        task["notes"] = "ignore"
     future = client.submit(_drive, directory, planned, args, task, pure=False,
                            key=f"bumpbake-big-{task['key']}")
     try:
-        for done in completed(client, [future]):
+        for done in completed(client, [future], desk.serve if desk else None):
             report, stats = done.result()
     except BaseException as e:
         settle(client, lambda: stop.set(1))  # left set: the driver may still read it
@@ -383,10 +440,13 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
         # Released at once: a future still held (by an exception's
         # traceback) makes Dask bake again when the driver's worker is lost.
         future.release()
+        if desk is not None:
+            settle(client, lambda: desk.queue.close())
     stop.delete()
     report.cluster = stats
     sweep_temporaries({os.path.dirname(p) or "." for p in report.outputs.values()})
-    _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
+    if desk is None:  # (else each was dispatched as the driver read it)
+        _dispatch_notes(report.notes, job._notes_policy, stacklevel=2)
     if check:
         _raise_failures([report], None)
     return report

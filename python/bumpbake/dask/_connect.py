@@ -122,8 +122,9 @@ def alive(client):
     return client.status == "running"
 
 
-def completed(client, futures):
-    """Yields futures as they finish, watching the cluster meanwhile: raises
+def completed(client, futures, each_poll=None):
+    """Yields futures as they finish, watching the cluster meanwhile (and
+    calling each_poll(), when given, at every look): raises
     ClusterLost when the client lost its scheduler, or when no worker was
     left for WORKERLESS_WAIT seconds; a task whose workers kept dying, or
     that a worker cannot load (bumpbake not installed there), is one
@@ -133,6 +134,8 @@ def completed(client, futures):
     workerless_since = None
     next_look = 0.0
     while pending:
+        if each_poll is not None:
+            each_poll()
         try:
             # distributed.wait, with this client rather than the default one
             done = client.sync(distributed.client._wait, list(pending), timeout=_POLL,

@@ -1,14 +1,17 @@
 """What bumpbake's Dask tasks share: the client to use, the client's
-directory on the workers, and thread counts."""
+directory on the workers, thread counts, and the notes the client
+dispatches before a worker writes."""
 
 import asyncio
 import contextlib
 import os
 import threading
+import uuid
+import warnings
 
 import distributed
 
-from .._common import _argument_error
+from .._common import NoteWarning, _argument_error, _dispatch_notes
 
 
 def client_of(client):
@@ -100,3 +103,75 @@ def variable_value(name, gone, client=None):
         return distributed.Variable(name, client=client).get(timeout=_VARIABLE_WAIT)
     except (TimeoutError, asyncio.TimeoutError):
         return gone
+
+
+# ----------------------------------------------- notes made into errors
+
+class NoteRefused(Exception):
+    """On a worker: the client made a note about the input an error; the
+    input is cancelled before anything of it is written."""
+
+    status = "cancelled"
+
+
+def notes_can_raise(policy):
+    """Whether dispatching a note with policy may raise: a callable may; a
+    warning may when a filter makes NoteWarning (or a class above it) an
+    error; "ignore" never does."""
+    if policy == "ignore":
+        return False
+    if callable(policy):
+        return True
+    return any(f[0] == "error" and issubclass(NoteWarning, f[2]) for f in warnings.filters)
+
+
+class NoteDesk:
+    """Notes of the inputs baked on the workers, dispatched on the client
+    (a warning, the caller's callable) as they come and before anything of
+    their input is written, as bake_file dispatches them: a worker that
+    reads an input with a note asks here (a distributed.Queue) and waits
+    for the answer (a distributed.Variable); a note the caller makes an
+    error is raised here, and the worker cancels that input, writing
+    nothing of it."""
+
+    def __init__(self, client, token, policy, stacklevel):
+        self.name = f"bumpbake-notes-{token}"
+        self.queue = distributed.Queue(self.name, client=client)
+        self.client, self.policy, self.stacklevel = client, policy, stacklevel
+
+    def asker(self, stop, stopped_at):
+        """The notes callable for the workers' jobs (picklable); stop: the
+        name of the bake's stop variable, which holds stopped_at (or is
+        gone) once the client gave up: no answer will come."""
+        return _AskTheClient(self.name, stop, stopped_at)
+
+    def serve(self):
+        """Dispatches the notes asked so far and answers each; raises what
+        the caller's policy raised (after telling the worker)."""
+        for reply, line in self.queue.get(batch=True):
+            try:
+                _dispatch_notes([line], self.policy, self.stacklevel + 1)
+            except BaseException:
+                distributed.Variable(reply, client=self.client).set("refused")
+                raise
+            distributed.Variable(reply, client=self.client).set("go")
+
+
+class _AskTheClient:
+    def __init__(self, name, stop, stopped_at):
+        self.name, self.stop, self.stopped_at = name, stop, stopped_at
+
+    def __call__(self, line):
+        reply = f"{self.name}-{uuid.uuid4().hex}"
+        distributed.Queue(self.name).put((reply, line))
+        while True:
+            answer = variable_value(reply, None)
+            if answer is not None:
+                distributed.Variable(reply).delete()
+                break
+            stop = variable_value(self.stop, None)
+            if stop is None or stop == self.stopped_at:  # the client gave up: no answer
+                answer = "refused"
+                break
+        if answer != "go":
+            raise NoteRefused(f"{line} (made an error by the caller)")
