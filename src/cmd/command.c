@@ -109,6 +109,8 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   const bb__option *o = c->def->options[i];
   if (o->info.type != BB_OPTION_FLAG && !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
+  if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") && o->set)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out", o->info.name);
   double values[BB__MAX_NUMBERS] = {0};
   int count = o->info.type == BB_OPTION_NUMBERS ? o->info.count : 1;
   bb_status st = o->set ? o->set(c, o, text, values, &count, err)
@@ -119,7 +121,9 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   if (!text)
     c->texts[i] = NULL;
-  c->given[i] = 1;
+  c->given[i] = !(o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0"));
+  if (!c->given[i])
+    c->texts[i] = NULL;
   c->value_count[i] = count < BB__MAX_NUMBERS ? count : BB__MAX_NUMBERS;
   memcpy(c->values[i], values, sizeof values);
   c->checked = 0;

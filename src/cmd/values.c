@@ -168,6 +168,12 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
   *count = o->info.type == BB_OPTION_INT || o->info.type == BB_OPTION_NUMBER;
   switch (o->info.type) {
   case BB_OPTION_FLAG:
+    /* "0" (Python's False) unsets the flag; bb_command_set then counts it
+     * as not given. */
+    if (text && !strcmp(text, "0") && o->field == BB__FIELD_INT) {
+      *(int *)field = 0;
+      return BB_OK;
+    }
     if (text && *text && strcmp(text, "1") != 0)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s takes no value", name);
     if (o->field == BB__FIELD_INT)

@@ -249,3 +249,20 @@ Test(cmd, height2ssbump_plans_a_job) {
   cr_expect(bb_command_has_job(bb_command_describe(c)));
   bb_command_free(c);
 }
+
+/* A flag takes "1" and "0" as bumpbake.h says (Python's True and False):
+ * "0" unsets it, and the command no longer counts it as given; a flag
+ * whose setter does more than set it refuses "0" with one line. */
+Test(cmd, a_flag_set_to_0_is_unset) {
+  bb_command *c = command("bake", (const char *const[]){"h.png", "--out-dir", "out", NULL});
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_set(c, "force", "1", &err), BB_OK, "%s", err.message);
+  cr_assert(bb_command_given(c, "force"));
+  cr_assert_eq(bb_command_set(c, "force", "0", &err), BB_OK, "%s", err.message);
+  cr_expect_not(bb_command_given(c, "force"));
+  cr_expect_eq(bb_command_options_of(c)->job.force, 0);
+  cr_expect_eq(bb_command_set(c, "clamp", "0", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--clamp cannot be unset: leave it out");
+  cr_expect_eq(bb_command_set(c, "force", "2", &err), BB_ERR_ARGUMENT);
+  bb_command_free(c);
+}
