@@ -2452,7 +2452,9 @@ typedef struct bb_job_report {
  * counts once. Every option and every output path is checked here, before
  * any bake (bb_outputs_check for each input's outputs against every input;
  * clashes across the whole batch; the depfile against every input and
- * output); out_dir and the template's subfolders are created. Errors:
+ * output); out_dir and the template's subfolders, or a single input's
+ * output folders (not the depfile's), are created. A directory as the one
+ * input without out_dir is BB_ERR_ARGUMENT. Errors:
  * BB_ERR_ARGUMENT (a usage error: bad option, template or map name, a
  * clash, no output), BB_ERR_IO (an output over an input, a directory that
  * cannot be made or read), BB_ERR_MEMORY. On success *out receives the
