@@ -230,6 +230,19 @@ Test(cmd, a_file_option_given_twice_is_refused) {
   bb_command_free(c);
 }
 
+/* A colour above a float's largest is too large, said so; a denormal is
+ * a number like any other. */
+Test(cmd, a_value_past_a_float_is_too_large_and_a_denormal_a_number) {
+  refused("render", (const char *[]){"--normal", "n.png", "--mode", "normal", "--light-color",
+                                     "3e39,1,1", "--output", "r.png", NULL},
+          "--light-color is too large: at most 3.40282e38, a float's largest (got 3e39)");
+  const char *denormal[] = {"h.png", "--scale", "1", "--ao", "a.png", "--bounce", "5e-324",
+                            NULL};
+  bb_command *c = command("bake", denormal);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  bb_command_free(c);
+}
+
 /* Names: an unknown option or command gets the nearest, Python's spelling
  * (filter_radius) finds the option, the enums' own names are the words. */
 Test(cmd, names_and_did_you_mean) {
