@@ -148,7 +148,10 @@ static bb_status read_directory(const char *dir, char ***names, int *count, bb_e
   return BB_OK;
 }
 
-/* Adds the regular files of dir that are not maps bumpbake baked. */
+/* Adds the image files of dir that are not maps bumpbake baked; a
+ * subdirectory is left out (not below). Anything else under an image's
+ * name (a dangling link, a FIFO) is an input that fails at its bake with
+ * its reason, as a corrupt image does, rather than left out unsaid. */
 static bb_status add_directory(input_list *l, const char *dir, bb_error *err) {
   char **names;
   int count;
@@ -158,7 +161,9 @@ static bb_status add_directory(input_list *l, const char *dir, bb_error *err) {
     struct stat s;
     if (!path)
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", dir);
-    else if (stat(path, &s) == 0 && S_ISREG(s.st_mode) && !is_baked_map(path))
+    else if (stat(path, &s) != 0 || !S_ISREG(s.st_mode))
+      st = stat(path, &s) == 0 && S_ISDIR(s.st_mode) ? BB_OK : add_input(l, path, err);
+    else if (!is_baked_map(path))
       st = add_input(l, path, err);
     free(path);
   }
