@@ -2448,6 +2448,10 @@ typedef struct bb_job_report {
   double horizons;            /* texels x slices */
   double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
       seconds_derive, seconds_write;
+  /* (last, so a report read through an older declaration keeps its layout) */
+  int bounces;                /* bb_bake_result.bounces: passes of inter-reflection
+                                 gathered, 0 when none */
+  double seconds_bounce;      /* the inter-reflection's part, after seconds_trace */
 } bb_job_report;
 
 /* Plans a job over inputs[0..input_count-1]: files, and directories, which

@@ -400,6 +400,8 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     r->seconds_pyramid = res->seconds_pyramid;
     r->seconds_trace = res->seconds_trace;
     r->seconds_derive = res->seconds_derive;
+    r->bounces = res->bounces;
+    r->seconds_bounce = res->seconds_bounce;
   }
   return st;
 }
