@@ -167,3 +167,24 @@ Test(cli_messages, a_map_named_twice_is_a_usage_error) {
                         tmp("s.png"), "--ssbump",   tmp("s.vtf"), NULL};
   harness_expect_refusal(NULL, args, 2, "--ssbump is given twice", 0);
 }
+
+/* combine takes -q as every command that writes files does: the wrote
+ * line without it, nothing with it. */
+Test(cli_messages, combine_takes_quiet) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  cli_result r = harness_run((const char *[]){"normal", tmp("h.png"), "--scale", "4", "-o",
+                                              tmp("n.png"), "-q", NULL});
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"combine", tmp("n.png"), tmp("n.png"), "--mix", "0.5", "-o",
+                                   tmp("c.png"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "wrote "), "%s", r.out);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"combine", tmp("n.png"), tmp("n.png"), "--mix", "0.5", "-o",
+                                   tmp("q.png"), "-q", NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.out, "%s", r.out);
+  cr_expect(file_exists(tmp("q.png")));
+  cli_result_free(&r);
+}
