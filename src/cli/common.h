@@ -48,7 +48,8 @@ void cli_printf_line(const char *fmt, ...)
     ;
 
 /* The library's notes (bb_note_fn) as "bumpbake: PATH: note: TEXT" on
- * stderr. user is unused. */
+ * stderr. user: the command's cli_progress, whose bar is cleared first so
+ * the note starts its own line, or NULL. */
 void cli_note(void *user, const char *path, const char *text);
 
 /* The note for a picture whose labels could not be drawn (render, sheet). */
