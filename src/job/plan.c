@@ -739,24 +739,31 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
                     job->vmt);
   /* bb_vmt_text checks the material's own name (.vmt, no texture's). */
   const bb_vmt_options v = {job->vmt_materials, bump, job->vmt_basetexture, is_ssbump};
-  bb_status st = bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
-  if (st == BB_OK && !job->vmt_basetexture && job->options.note)
+  return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
+}
+
+/* Said once the plan holds (a refused plan says only why). */
+static void note_material(const bb_job *job) {
+  if (job->vmt && !job->vmt_basetexture && job->options.note)
     job->options.note(job->options.note_user, job->vmt,
                       "the material has no $basetexture (no colour map): give --basetexture "
                       "FILE.vtf, or add the line to the .vmt");
-  return st;
 }
 
 /* Creates path's directory and its parents when missing (mkdir -p). */
+/* A name taken by a file is left to the outputs' check, which says which
+ * output it stops; a failure names the output too. */
 static bb_status create_directory_of(const char *path, bb_error *err) {
   if (!path)
     return BB_OK;
   char dir[PATH_MAX];
   bb__directory_part(path, dir, sizeof dir);
   struct stat s;
-  if (stat(dir, &s) == 0 && S_ISDIR(s.st_mode))
+  if (stat(dir, &s) == 0)
     return BB_OK;
-  return bb_directory_create(dir, err);
+  bb_error e = {{0}};
+  bb_status st = bb_directory_create(dir, &e);
+  return st == BB_OK ? BB_OK : bb__fail(err, st, "%s: cannot write: %s", path, e.message);
 }
 
 /* Creates out_dir and every directory the outputs' names need: a batch's
@@ -846,6 +853,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     return st;
   }
   init_reports(job);
+  note_material(job);
   *out = job;
   return BB_OK;
 }

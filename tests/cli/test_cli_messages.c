@@ -137,7 +137,10 @@ Test(cli_messages, a_single_bake_creates_its_output_folders) {
   write_bytes(tmp("file"), "x", 1);
   const char *blocked[] = {"bake",     tmp("h.png"),      "--scale", "4",
                            "--normal", tmp("file/n.png"), NULL};
-  harness_expect_refusal(NULL, blocked, 1, "file: cannot create directory", 3);
+  harness_expect_refusal(NULL, blocked, 1, "file/n.png: cannot write: ", 3);
+  const char *below[] = {"bake", tmp("h.png"), "--scale", "4", "--normal",
+                         tmp("file/sub/n.png"), NULL};
+  harness_expect_refusal(NULL, below, 1, "file/sub/n.png: cannot write: ", 4);
 }
 
 /* A material names its colour map only when told (--basetexture): one
