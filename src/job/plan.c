@@ -742,13 +742,6 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
   return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }
 
-/* Said once the plan holds (a refused plan says only why). */
-static void note_material(const bb_job *job) {
-  if (job->vmt && !job->vmt_basetexture && job->options.note)
-    job->options.note(job->options.note_user, job->vmt,
-                      "the material has no $basetexture (no colour map): give --basetexture "
-                      "FILE.vtf, or add the line to the .vmt");
-}
 
 /* Creates path's directory and its parents when missing (mkdir -p). */
 /* A name taken by a file is left to the outputs' check, which says which
@@ -853,7 +846,6 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     return st;
   }
   init_reports(job);
-  note_material(job);
   *out = job;
   return BB_OK;
 }
