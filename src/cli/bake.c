@@ -75,7 +75,7 @@ int cli_run_job(const cli_run *r) {
   /* The bar is the notes' user: a note clears it before its line. */
   cli_progress progress;
   cli_progress_start(&progress, name, r->options->quiet);
-  const bb_command_hooks hooks = {cli_note, &progress, NULL, NULL, NULL, NULL};
+  const bb_command_hooks hooks = {cli_progress_note, &progress, NULL, NULL, NULL, NULL};
   bb_job *job = NULL;
   bb_error err = {{0}};
   bb_status st = bb_command_plan(r->command, &hooks, &job, &err);

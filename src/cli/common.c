@@ -3,7 +3,6 @@
 #include "common.h"
 #include "cli.h"
 #include "json.h"
-#include "progress.h"
 
 #include <signal.h>
 #include <stdarg.h>
@@ -72,8 +71,7 @@ void cli_printf_line(const char *fmt, ...) {
 }
 
 void cli_note(void *user, const char *path, const char *text) {
-  if (user)
-    cli_progress_finish(user);
+  (void)user;
   char line[2048], safe[4 * sizeof line];
   if (path)
     snprintf(line, sizeof line, "%s: note: %s", path, text);

@@ -48,8 +48,7 @@ void cli_printf_line(const char *fmt, ...)
     ;
 
 /* The library's notes (bb_note_fn) as "bumpbake: PATH: note: TEXT" on
- * stderr. user: the command's cli_progress, whose bar is cleared first so
- * the note starts its own line, or NULL. */
+ * stderr. user is unused. */
 void cli_note(void *user, const char *path, const char *text);
 
 /* The note for a picture whose labels could not be drawn (render, sheet). */

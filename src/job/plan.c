@@ -742,10 +742,9 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
   return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }
 
-
-/* Creates path's directory and its parents when missing (mkdir -p). */
-/* A name taken by a file is left to the outputs' check, which says which
- * output it stops; a failure names the output too. */
+/* Creates path's directory and its parents when missing (mkdir -p). A name
+ * taken by a file is left to the outputs' check, which says which output it
+ * stops; a failure names the output too. */
 static bb_status create_directory_of(const char *path, bb_error *err) {
   if (!path)
     return BB_OK;

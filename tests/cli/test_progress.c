@@ -25,7 +25,7 @@ Test(progress, a_note_clears_the_bar_before_its_line) {
     if (!draw)
       _exit(3);
     draw(&p, 1, 2);
-    cli_note(&p, "h.png", "a note");
+    cli_progress_note(&p, "h.png", "a note");
     _exit(0);
   }
   size_t got = 0;
