@@ -426,9 +426,12 @@ typedef enum bb_texture_map {
 
 /* VTF header flags (Valve's TEXTUREFLAGS_*) the writer sets, for
  * bb_texture_options.vtf_flags and bb_vtf_info.flags. */
-#define BB_VTF_FLAG_EIGHTBITALPHA 0x00002000u /* set when a 4-channel image keeps alpha */
+#define BB_VTF_FLAG_ONEBITALPHA 0x00001000u  /* never written: refused in vtf_flags */
+#define BB_VTF_FLAG_EIGHTBITALPHA 0x00002000u /* set when a 4-channel image keeps alpha;
+                                                 refused in vtf_flags otherwise */
 #define BB_VTF_FLAG_NORMAL 0x00000080u
-#define BB_VTF_FLAG_NOMIP 0x00000100u         /* set, with NOLOD, without mips */
+#define BB_VTF_FLAG_NOMIP 0x00000100u         /* set, with NOLOD, without mips;
+                                                 refused in vtf_flags with them */
 #define BB_VTF_FLAG_NOLOD 0x00000200u
 #define BB_VTF_FLAG_ENVMAP 0x00004000u        /* a cube map: refused (one face is written) */
 #define BB_VTF_FLAG_SSBUMP 0x08000000u
@@ -447,7 +450,9 @@ typedef struct bb_texture_options {
   int vtf_version;           /* VTF minor version: 2 (7.2, the default, read by every
                                 Source branch) to 5; 3 and up hold provenance */
   uint32_t vtf_flags;        /* VTF flags added to the map's (BB_VTF_FLAG_* or any
-                                other TEXTUREFLAGS_* bit; ENVMAP is refused) */
+                                other TEXTUREFLAGS_* bit); those the file would
+                                contradict are refused: ENVMAP, ONEBITALPHA,
+                                EIGHTBITALPHA without alpha, NOMIP with mips */
   const char *description;   /* provenance text ("key=value" lines) or NULL. VTF 7.3
                                 and up store it as a "KVD" (key-value data) resource,
                                 "bumpbake" { "key" "value" ... }; VTF 7.2 and DDS have
@@ -2474,6 +2479,10 @@ typedef struct bb_job_report {
   double horizons;            /* texels x slices */
   double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
       seconds_derive, seconds_write;
+  /* (last, so a report read through an older declaration keeps its layout) */
+  int bounces;                /* bb_bake_result.bounces: passes of inter-reflection
+                                 gathered, 0 when none */
+  double seconds_bounce;      /* the inter-reflection's part, after seconds_trace */
 } bb_job_report;
 
 /* Plans a job over inputs[0..input_count-1]: files, and directories, which
@@ -2483,7 +2492,9 @@ typedef struct bb_job_report {
  * counts once. Every option and every output path is checked here, before
  * any bake (bb_outputs_check for each input's outputs against every input;
  * clashes across the whole batch; the depfile against every input and
- * output); out_dir and the template's subfolders are created. Errors:
+ * output); out_dir and the template's subfolders, or a single input's
+ * output folders (not the depfile's), are created. A directory as the one
+ * input without out_dir is BB_ERR_ARGUMENT. Errors:
  * BB_ERR_ARGUMENT (a usage error: bad option, template or map name, a
  * clash, no output), BB_ERR_IO (an output over an input, a directory that
  * cannot be made or read), BB_ERR_MEMORY. On success *out receives the

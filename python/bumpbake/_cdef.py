@@ -515,6 +515,8 @@ typedef struct bb_job_report {
   double horizons;
   double seconds_load, seconds_smooth, seconds_pyramid, seconds_trace,
       seconds_derive, seconds_write;
+  int bounces;
+  double seconds_bounce;
 } bb_job_report;
 
 typedef enum bb_option_type {

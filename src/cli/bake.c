@@ -72,14 +72,15 @@ int cli_run_job(const cli_run *r) {
   const char *name = bb_command_describe(r->command)->name;
   if (r->options->scheduler)
     return cli_cluster_exec(r); /* returns only on failure */
-  const bb_command_hooks hooks = {cli_note, NULL, NULL, NULL, NULL, NULL};
+  /* The bar is the notes' user: a note clears it before its line. */
+  cli_progress progress;
+  cli_progress_start(&progress, name, r->options->quiet);
+  const bb_command_hooks hooks = {cli_progress_note, &progress, NULL, NULL, NULL, NULL};
   bb_job *job = NULL;
   bb_error err = {{0}};
   bb_status st = bb_command_plan(r->command, &hooks, &job, &err);
   if (st != BB_OK)
     return cli_library_error(name, st, &err);
-  cli_progress progress;
-  cli_progress_start(&progress, name, r->options->quiet);
   printer p = {r->options, r->options->job.out_dir != NULL, {0}, &progress};
   st = bb_job_run(job, cli_progress_fn(&progress), &progress, print_report, &p, &err);
   cli_progress_finish(&progress);

@@ -48,6 +48,10 @@ void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
   cli_json_string(&j, "addressing", bb_addressing_name(b->smooth.addressing));
   cli_json_string(&j, "channel", bb_height_source_channel(&r->source));
   cli_json_number(&j, "threads", r->threads);
+  if (r->bounces > 0) { /* as provenance: rho (1 for an albedo map alone) and the count asked */
+    cli_json_number(&j, "bounce", b->bounce_albedo > 0.0 ? b->bounce_albedo : 1.0);
+    cli_json_number(&j, "bounces", b->bounces);
+  }
   cli_json_close(&j, '}');
 
   cli_json_open(&j, "seconds", '{');
@@ -55,6 +59,8 @@ void cli_job_json_to(FILE *f, const bb_bake_options *b, const bb_job_report *r,
   cli_json_number(&j, "smooth", r->seconds_smooth);
   cli_json_number(&j, "pyramid", r->seconds_pyramid);
   cli_json_number(&j, "trace", r->seconds_trace);
+  if (r->bounces > 0)
+    cli_json_number(&j, "bounce", r->seconds_bounce);
   cli_json_number(&j, "derive", r->seconds_derive);
   cli_json_number(&j, "write", r->seconds_write);
   cli_json_close(&j, '}');

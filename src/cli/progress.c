@@ -59,3 +59,9 @@ void cli_progress_finish(cli_progress *p) {
   fflush(stderr);
   p->shown = 0;
 }
+
+void cli_progress_note(void *user, const char *path, const char *text) {
+  if (user)
+    cli_progress_finish(user);
+  cli_note(NULL, path, text);
+}

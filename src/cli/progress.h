@@ -29,4 +29,9 @@ void cli_progress_attach(cli_progress *p, const char *label, int quiet,
 /* Clears the bar's line if one was drawn. */
 void cli_progress_finish(cli_progress *p);
 
+/* The library's notes (bb_note_fn) while a bar may be up: user is the
+ * cli_progress, whose bar is cleared first so the note starts its own line
+ * (then as cli_note). */
+void cli_progress_note(void *user, const char *path, const char *text);
+
 #endif /* BB_CLI_PROGRESS_H */

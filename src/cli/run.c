@@ -12,7 +12,7 @@ static int run_and_report(const cli_run *r) {
   const char *name = bb_command_describe(r->command)->name;
   cli_progress progress;
   cli_progress_start(&progress, name, r->options->quiet);
-  const bb_command_hooks hooks = {cli_note, NULL, cli_progress_fn(&progress), &progress,
+  const bb_command_hooks hooks = {cli_progress_note, &progress, cli_progress_fn(&progress), &progress,
                                   NULL, NULL};
   bb_command_result result;
   bb_error err = {{0}};

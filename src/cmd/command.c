@@ -111,6 +111,20 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
   if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") && o->set)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out", o->info.name);
+  /* A file option names one file: a second, different name would leave
+   * the first unwritten (or unread) without a word. The job writes one
+   * file per map, so a map wanted twice is baked twice. */
+  if (c->given[i] && o->info.type == BB_OPTION_PATH && o->field == BB__FIELD_STRING) {
+    const char *was = *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+    if (was && strcmp(was, text) != 0) {
+      char spelled[80];
+      bb__option_spelling(o, spelled, sizeof spelled);
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "%s is given twice ('%.200s', then '%.200s'): it names one file; "
+                      "run once per file",
+                      spelled, was, text);
+    }
+  }
   double values[BB__MAX_NUMBERS] = {0};
   int count = o->info.type == BB_OPTION_NUMBERS ? o->info.count : 1;
   bb_status st = o->set ? o->set(c, o, text, values, &count, err)

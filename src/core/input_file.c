@@ -26,6 +26,9 @@ bb_status bb__input_open(const char *path, int *fd_out, bb_error *err) {
    * waiting for one; it is cleared below for the regular file we keep. */
   int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
   if (fd < 0) {
+    struct stat link;
+    if (errno == ENOENT && lstat(path, &link) == 0 && S_ISLNK(link.st_mode))
+      return bb__fail(err, BB_ERR_IO, "%s: no such file (a symbolic link to a missing file)", path);
     if (errno == ENOENT || errno == ENOTDIR) return bb__fail(err, BB_ERR_IO, "%s: no such file", path);
     if (errno == EISDIR) return bb__fail(err, BB_ERR_IO, "%s: is a directory", path);
     return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));

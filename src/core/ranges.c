@@ -62,6 +62,13 @@ bb_status bb__range_check(const bb__range *r, double v, const char *who, bb_erro
     snprintf(got, sizeof got, "%.0f", v);
   else
     bb__number_text(v, got, sizeof got);
+  /* A range whose top is a float's largest shows none ("colour must be >=
+   * 0"): above it, say so rather than repeat the bottom. */
+  if (v > r->max && !strstr(range, "..") && !strstr(range, "<="))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s is too large: at most %s, a float's largest (got %s)",
+                    who ? who : r->what, (bb__number_text(r->max, range, sizeof range), range),
+                    got);
   const int interval = strstr(range, "..") != NULL;
   return bb__fail(err, BB_ERR_ARGUMENT, "%s must be %s%s (got %s)", who ? who : r->what,
                   interval ? "in " : "", range, got);

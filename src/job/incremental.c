@@ -48,6 +48,9 @@ bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err) {
     const char *reason = strncmp(why.message, path, n) == 0 && !strncmp(why.message + n, ": ", 2)
                              ? why.message + n + 2
                              : why.message;
+    /* "cannot read: " once: the open's own reason may already say it. */
+    if (strncmp(reason, "cannot read: ", 13) == 0)
+      reason += 13;
     return bb__fail(err, BB_ERR_IO, "%s: cannot read: %s", path, reason);
   }
   FILE *f = fdopen(fd, "rb");

@@ -149,7 +149,10 @@ static bb_status read_directory(const char *dir, char ***names, int *count, bb_e
   return BB_OK;
 }
 
-/* Adds the regular files of dir that are not maps bumpbake baked. */
+/* Adds the image files of dir that are not maps bumpbake baked; a
+ * subdirectory is left out (not below). Anything else under an image's
+ * name (a dangling link, a FIFO) is an input that fails at its bake with
+ * its reason, as a corrupt image does, rather than left out unsaid. */
 static bb_status add_directory(input_list *l, const char *dir, bb_error *err) {
   char **names;
   int count;
@@ -159,7 +162,9 @@ static bb_status add_directory(input_list *l, const char *dir, bb_error *err) {
     struct stat s;
     if (!path)
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", dir);
-    else if (stat(path, &s) == 0 && S_ISREG(s.st_mode) && !is_baked_map(path))
+    else if (stat(path, &s) != 0 || !S_ISREG(s.st_mode))
+      st = stat(path, &s) == 0 && S_ISDIR(s.st_mode) ? BB_OK : add_input(l, path, err);
+    else if (!is_baked_map(path))
       st = add_input(l, path, err);
     free(path);
   }
@@ -546,9 +551,15 @@ const char *bb__job_valve_kind(const bb_job_options *o) {
 
 /* Options only a batch uses, refused without out_dir (force is not one: a
  * single input may skip its bake when its outputs are current). */
-static bb_status check_single(const bb_job_options *o, int input_count, bb_error *err) {
+static bb_status check_single(const bb_job_options *o, const char *const *inputs,
+                              int input_count, bb_error *err) {
   if (input_count > 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "several HEIGHT files need --out-dir DIR");
+  /* A directory is a batch's input: its maps need a folder, not names. */
+  struct stat s;
+  if (inputs[0] && stat(inputs[0], &s) == 0 && S_ISDIR(s.st_mode))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s is a directory: a batch of its heights needs --out-dir DIR", inputs[0]);
   const char *batch_only = o->name_template ? "--name"
                            : o->maps        ? "--maps"
                            : o->keep_going  ? "--keep-going"
@@ -575,7 +586,8 @@ static bb_status check_single(const bb_job_options *o, int input_count, bb_error
   return st;
 }
 
-static bb_status check_options(const bb_job_options *o, int input_count, bb_error *err) {
+static bb_status check_options(const bb_job_options *o, const char *const *inputs,
+                               int input_count, bb_error *err) {
   if (input_count < 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "no input given");
   if (o->out_dir) {
@@ -592,7 +604,7 @@ static bb_status check_options(const bb_job_options *o, int input_count, bb_erro
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "--vmt writes one material: bake one input with --ssbump FILE.vtf");
   } else {
-    bb_status st = check_single(o, input_count, err);
+    bb_status st = check_single(o, inputs, input_count, err);
     if (st != BB_OK)
       return st;
   }
@@ -731,20 +743,36 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
   return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }
 
-/* Creates out_dir and every directory the outputs' names need. */
+/* Creates path's directory and its parents when missing (mkdir -p). A name
+ * taken by a file is left to the outputs' check, which says which output it
+ * stops; a failure names the output too. */
+static bb_status create_directory_of(const char *path, bb_error *err) {
+  if (!path)
+    return BB_OK;
+  char dir[PATH_MAX];
+  bb__directory_part(path, dir, sizeof dir);
+  struct stat s;
+  if (stat(dir, &s) == 0)
+    return BB_OK;
+  bb_error e = {{0}};
+  bb_status st = bb_directory_create(dir, &e);
+  return st == BB_OK ? BB_OK : bb__fail(err, st, "%s: cannot write: %s", path, e.message);
+}
+
+/* Creates out_dir and every directory the outputs' names need: a batch's
+ * template subfolders, a single input's named files' folders (as a batch
+ * creates its out_dir; the depfile's folder is the build system's). */
 static bb_status create_directories(const bb_job *job, bb_error *err) {
-  bb_status st = bb_directory_create(job->out_dir, err);
-  for (int i = 0; i < job->count && st == BB_OK; i++)
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
-      const char *path = job->items[i].paths[k];
-      if (!path)
-        continue;
-      char dir[PATH_MAX];
-      bb__directory_part(path, dir, sizeof dir);
-      struct stat s;
-      if (stat(dir, &s) != 0 || !S_ISDIR(s.st_mode))
-        st = bb_directory_create(dir, err);
-    }
+  bb_status st = job->out_dir ? bb_directory_create(job->out_dir, err) : BB_OK;
+  for (int i = 0; i < job->count && st == BB_OK; i++) {
+    for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++)
+      st = create_directory_of(job->items[i].paths[k], err);
+    if (st == BB_OK)
+      st = create_directory_of(job->items[i].slope_lit_path, err);
+  }
+  const char *single[] = {job->valve_path, job->slope_path, job->vmt};
+  for (size_t i = 0; i < sizeof single / sizeof *single && st == BB_OK && !job->batch; i++)
+    st = create_directory_of(single[i], err);
   return st;
 }
 
@@ -774,7 +802,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
   if (!out || !o || (input_count > 0 && !inputs))
     return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
   *out = NULL;
-  bb_status st = check_options(o, input_count, err);
+  bb_status st = check_options(o, inputs, input_count, err);
   if (st != BB_OK)
     return st;
   bb_job *job = calloc(1, sizeof *job);
@@ -807,7 +835,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = name_outputs(job, &job->items[i], err);
   if (st == BB_OK && job->batch)
     st = check_batch_paths(job, err);
-  if (st == BB_OK && job->batch)
+  if (st == BB_OK)
     st = create_directories(job, err);
   for (int i = 0; i < job->count && st == BB_OK; i++)
     st = check_item_outputs(job, &job->items[i], err);

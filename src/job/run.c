@@ -363,6 +363,12 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
                              job->options.bake.height_scale, job->options.note,
                              job->options.note_user, &b->height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;
+  /* A material naming no colour map: said with the input's notes, so a
+   * caller that takes notes as errors stops before anything is written. */
+  if (st == BB_OK && job->vmt && !job->vmt_basetexture && job->options.note)
+    job->options.note(job->options.note_user, job->vmt,
+                      "the material has no $basetexture (no colour map): give --basetexture "
+                      "FILE.vtf, or add the line to the .vmt");
   /* The input's notes have been given: a caller that takes one as an
    * error cancels here, before anything is baked or written (progress
    * (0, 0): a checkpoint, no work done yet). */
@@ -402,6 +408,8 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     r->seconds_pyramid = res->seconds_pyramid;
     r->seconds_trace = res->seconds_trace;
     r->seconds_derive = res->seconds_derive;
+    r->bounces = res->bounces;
+    r->seconds_bounce = res->seconds_bounce;
   }
   return st;
 }

@@ -651,6 +651,23 @@ static bb_status apply_view(const bb_render_options *o, bb_image *img, bb_error 
   return BB_OK;
 }
 
+/* Each colour is a float, but their sum and product can pass a float's
+ * largest (light 3e38 with a specular highlight): a texel gone infinite is
+ * refused with what to lower, never written as inf or as clipped white. */
+static bb_status check_finite(const bb_image *img, bb_error *err) {
+  const size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+  for (size_t i = 0; i < n; i++)
+    if (isinf(img->pixels[i])) {
+      char largest[32];
+      bb__number_text(FLT_MAX, largest, sizeof largest);
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "render: too bright: a texel passes a float's largest value (%s); "
+                      "lower the light colour, lightmap or specular strength",
+                      largest);
+    }
+  return BB_OK;
+}
+
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err) {
   if (!out)
@@ -704,6 +721,8 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
         *out = cropped;
     }
   }
+  if (st == BB_OK)
+    st = check_finite(out, err);
   if (st != BB_OK)
     bb_image_free(out);
   return st;

@@ -26,20 +26,22 @@ typedef struct format_info {
   int exact;         /* 1: exactly max_channels (bc4) */
   int has_alpha;
   int vtf, dds;      /* 1 when the container has it */
+  const char *vtf_name; /* Valve's name, as --texture-format takes it for a .vtf
+                           (dxt1, dxt5), where it differs */
 } format_info;
 
 /* In bb_texture_format order, DEFAULT first. */
 static const format_info formats[] = {
-    {"default", 0, 0, 4, 0, 0, 1, 1},
-    {"bc1", 1 + BB__BLOCK_BC1, 0, 3, 0, 0, 1, 1},
-    {"bc3", 1 + BB__BLOCK_BC3, 0, 4, 0, 1, 1, 1},
-    {"bc4", 1 + BB__BLOCK_BC4, 0, 1, 1, 0, 0, 1},
-    {"bc5", 1 + BB__BLOCK_BC5, 0, 2, 0, 0, 0, 1},
-    {"bgr888", 0, 3, 3, 0, 0, 1, 0},
-    {"bgra8888", 0, 4, 4, 0, 1, 1, 0},
-    {"rgba8", 0, 4, 4, 0, 1, 0, 1},
-    {"rgba16f", 0, 8, 4, 0, 1, 1, 1},
-    {"rgba32f", 0, 16, 4, 0, 1, 0, 1},
+    {"default", 0, 0, 4, 0, 0, 1, 1, NULL},
+    {"bc1", 1 + BB__BLOCK_BC1, 0, 3, 0, 0, 1, 1, "dxt1"},
+    {"bc3", 1 + BB__BLOCK_BC3, 0, 4, 0, 1, 1, 1, "dxt5"},
+    {"bc4", 1 + BB__BLOCK_BC4, 0, 1, 1, 0, 0, 1, NULL},
+    {"bc5", 1 + BB__BLOCK_BC5, 0, 2, 0, 0, 0, 1, NULL},
+    {"bgr888", 0, 3, 3, 0, 0, 1, 0, NULL},
+    {"bgra8888", 0, 4, 4, 0, 1, 1, 0, NULL},
+    {"rgba8", 0, 4, 4, 0, 1, 0, 1, NULL},
+    {"rgba16f", 0, 8, 4, 0, 1, 1, 1, NULL},
+    {"rgba32f", 0, 16, 4, 0, 1, 0, 1, NULL},
 };
 enum { FORMAT_COUNT = (int)(sizeof formats / sizeof formats[0]) };
 
@@ -60,6 +62,12 @@ enum { NAME_COUNT = (int)(sizeof format_names / sizeof format_names[0]) };
 
 static const format_info *info_of(bb_texture_format format) {
   return (int)format >= 0 && (int)format < FORMAT_COUNT ? &formats[format] : NULL;
+}
+
+/* The format's name in messages about a file of container c: Valve's for a
+ * VTF (dxt1, as a Source modder types it), the DDS one otherwise (bc1). */
+static const char *name_in(const format_info *f, bb__container c) {
+  return c == BB__CONTAINER_VTF && f->vtf_name ? f->vtf_name : f->name;
 }
 
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err) {
@@ -166,7 +174,8 @@ static void container_formats(bb__container c, char *buf, size_t cap) {
   for (int k = 1; k < FORMAT_COUNT; k++) {
     if (!(c == BB__CONTAINER_VTF ? formats[k].vtf : formats[k].dds))
       continue;
-    int n = snprintf(buf + used, cap - used, "%s%s", used ? ", " : "", formats[k].name);
+    int n = snprintf(buf + used, cap - used, "%s%s", used ? ", " : "",
+                     name_in(&formats[k], c));
     if (n < 0 || (size_t)n >= cap - used)
       break;
     used += (size_t)n;
@@ -184,6 +193,34 @@ static bb_texture_format default_format(bb__container c, bb_texture_map map, int
   case 3: return BB_TEXTURE_FORMAT_BC1;
   default: return BB_TEXTURE_FORMAT_BC3;
   }
+}
+
+/* The flags that say what a VTF holds (alpha, a mip chain) are the
+ * writer's: one added by the caller that the file would contradict is
+ * refused, as readers (the engine, VTFLib, `info`) believe the flags. */
+static bb_status check_vtf_flags(const char *path, int width, int height, int channels,
+                                 const bb_texture_options *o, bb_texture_format fmt,
+                                 bb_error *err) {
+  const format_info *f = info_of(fmt);
+  const int alpha = channels == 4 && f->has_alpha; /* as vtf.c sets EIGHTBITALPHA */
+  const uint32_t extra = o->vtf_flags;
+  if (extra & BB_VTF_FLAG_ONEBITALPHA)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: the ONEBITALPHA flag (0x%08x) says the file has 1-bit alpha, and "
+                    "the %s file has %s",
+                    path, BB_VTF_FLAG_ONEBITALPHA, name_in(f, BB__CONTAINER_VTF),
+                    alpha ? "8-bit alpha" : "none");
+  if ((extra & BB_VTF_FLAG_EIGHTBITALPHA) && !alpha)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: the EIGHTBITALPHA flag (0x%08x) says the file has alpha, and the %s "
+                    "file of a %d-channel image has none",
+                    path, BB_VTF_FLAG_EIGHTBITALPHA, name_in(f, BB__CONTAINER_VTF), channels);
+  if ((extra & BB_VTF_FLAG_NOMIP) && o->mips && (width > 1 || height > 1))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: the NOMIP flag (0x%08x) says the file has no mip chain, and it has "
+                    "one: write it without mips (--nomip), which sets the flag",
+                    path, BB_VTF_FLAG_NOMIP);
+  return BB_OK;
 }
 
 bb_status bb__texture_resolve(const char *path, int width, int height, int channels,
@@ -237,17 +274,21 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
     char names[128];
     container_formats(c, names, sizeof names);
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: %s has no format %s (it has %s)", path, kind,
-                    f->name, names);
+                    name_in(f, c), names);
   }
   const int holds = fmt == BB_TEXTURE_FORMAT_BC5 && o->map == BB_TEXTURE_MAP_NORMAL
                         ? 3
                         : f->max_channels;
   if (channels > holds || (f->exact && channels != holds))
     return bb__fail(err, BB_ERR_ARGUMENT,
-                    "%s: format %s holds %s%d channel%s, and the %s has %d", path, f->name,
+                    "%s: format %s holds %s%d channel%s, and the %s has %d", path,
+                    name_in(f, c),
                     f->exact ? "" : "at most ", holds, holds == 1 ? "" : "s",
                     o->map == BB_TEXTURE_MAP_NORMAL ? "normal map" : "image", channels);
   if (c == BB__CONTAINER_VTF) {
+    bb_status st = check_vtf_flags(path, width, height, channels, o, fmt, err);
+    if (st != BB_OK)
+      return st;
     if (!is_power_of_two(width) || !is_power_of_two(height))
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: %d x %d: Source textures need a power of two on each side "
@@ -258,10 +299,14 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: %d x %d: a VTF side is at most 32768",
                       path, width, height);
   }
-  if (f->block && (width % 4 != 0 || height % 4 != 0))
+  /* A VTF stores a side under 4 texels (1 or 2: a power of two) as one
+   * padded 4 x 4 block, as Valve's tools write the smallest mips and 1 x 1
+   * and 2 x 2 textures; a DDS's top level needs whole blocks (Direct3D). */
+  const int padded_vtf = c == BB__CONTAINER_VTF && (width < 4 || height < 4);
+  if (f->block && !padded_vtf && (width % 4 != 0 || height % 4 != 0))
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "%s: %d x %d: block compression (%s) needs sides that are multiples of 4",
-                    path, width, height, f->name);
+                    path, width, height, name_in(f, c));
   if (format)
     *format = fmt;
   return BB_OK;

@@ -104,8 +104,10 @@ static void reflectivity(const bb_image *top, bb_texture_map map, float out[3]) 
 }
 
 /* The provenance as a KeyValues block, "bumpbake" { "key" "value" ... },
- * '"' and '\' escaped with '\', NUL-terminated (the NUL is part of the
- * chunk, as VTFEdit writes its KVD). malloc'd; *size counts the NUL. */
+ * '"' and '\' escaped with '\'. malloc'd and NUL-terminated, but *size
+ * leaves the NUL out: the chunk is the text alone, as KeyValues readers
+ * take a buffer of known size (Valve's LoadFromBuffer; srctools' parser
+ * stops at a NUL inside the text as at an unfinished file). */
 static char *kvd_text(const char *description, size_t *size) {
   const size_t n = strlen(description);
   /* Each character may double, and each line adds a tab, four quotes, a
@@ -141,7 +143,6 @@ static char *kvd_text(const char *description, size_t *size) {
     line = *end ? end + 1 : end;
   }
   k += (size_t)snprintf(out + k, cap - k, "}\n");
-  out[k++] = '\0';
   *size = k;
   return out;
 }

@@ -171,6 +171,29 @@ Test(cli_batch, keep_going_past_a_bad_file) {
   cli_result_free(&r);
 }
 
+/* A directory's dangling link or FIFO under an image's name is reported
+ * as a corrupt image is (it was left out without a word); a subdirectory
+ * named like an image is not an input (a batch does not go below). */
+Test(cli_batch, a_directorys_dangling_link_is_reported_like_a_corrupt_image) {
+  make_dir(tmp("in"));
+  height_file(tmp("in/a.png"), 1);
+  cr_assert_eq(symlink("gone.png", tmp("in/b.png")), 0);
+  write_text(tmp("in/c.png"), "not a png\n");
+  cr_assert_eq(mkfifo(tmp("in/d.png"), 0644), 0);
+  make_dir(tmp("in/e.png"));
+  cli_result r = RUN_IN(harness_dir, "bake", "in", FAST, "--out-dir", "out", "--keep-going");
+  cr_expect_eq(r.code, 1, "%s", r.err);
+  cr_expect(strstr(r.err, "bumpbake: in/b.png: ") &&
+                strstr(r.err, "a symbolic link to a missing file"),
+            "%s", r.err);
+  cr_expect(strstr(r.err, "bumpbake: in/c.png: "), "%s", r.err);
+  cr_expect(strstr(r.err, "bumpbake: in/d.png: ") && strstr(r.err, "is a FIFO"), "%s", r.err);
+  cr_expect(!strstr(r.err, "e.png"), "%s", r.err);
+  cr_expect(strstr(r.out, "bake: 4 files: 1 baked, 0 up to date, 3 failed"), "%s", r.out);
+  cr_expect(file_exists(tmp("out/a_ao.png")));
+  cli_result_free(&r);
+}
+
 static void run_batch(const char *what, const char *extra, const char *expect) {
   cli_result r = extra ? RUN_IN(harness_dir, "bake", "a.png", "b.png", FAST, "--out-dir",
                                 "out", extra)

@@ -62,6 +62,32 @@ Test(cli_bounce, bounce_lightens_ao_and_zero_changes_nothing) {
   bb_image_free(&b);
 }
 
+/* --json gives the bounce as docs/commands/bake.md says: rho and the
+ * bounces asked among the parameters, its seconds among the stages (a
+ * bounce bake's stages left most of its time out); none without it. */
+Test(cli_bounce, json_gives_the_bounce_and_its_seconds) {
+  height_file(tmp("h.png"));
+  cli_result r = harness_run((const char *[]){"bake", tmp("h.png"), FAST, "--bounce", "0.6",
+                                              "--bounces", "2", "--ao", tmp("b.exr"), "--json",
+                                              NULL});
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "\"threads\":") && strstr(r.out, ",\"bounce\":0.6,\"bounces\":2}"),
+            "%s", r.out);
+  const char *seconds = strstr(r.out, "\"seconds\":{");
+  cr_assert_not_null(seconds, "%s", r.out);
+  double trace = -1, bounce = -1;
+  const char *t = strstr(seconds, "\"trace\":");
+  cr_assert_not_null(t, "%s", r.out);
+  cr_expect_eq(sscanf(t, "\"trace\":%lf,\"bounce\":%lf", &trace, &bounce), 2, "%s", r.out);
+  cr_expect_gt(bounce, 0.0, "%s", r.out);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"bake", tmp("h.png"), FAST, "--ao", tmp("a.exr"), "--json",
+                                   NULL});
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cr_expect(!strstr(r.out, "bounce"), "no bounce, no key: %s", r.out);
+  cli_result_free(&r);
+}
+
 /* A brightness of 0.5 halves an ssbump that nothing clips; the maps are
  * inputs: an output over one is refused, and the depfile lists them. */
 Test(cli_bounce, brightness_and_albedo_maps_are_inputs) {

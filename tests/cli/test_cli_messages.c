@@ -95,3 +95,99 @@ Test(cli_messages, notes_about_the_input) {
   cr_expect(strstr(r.err, "a JPEG height"), "%s", r.err);
   cli_result_free(&r);
 }
+
+/* A directory given without --out-dir is a batch without its folder: a
+ * usage error naming --out-dir, with or without -o (it was exit 1, "is a
+ * directory", with -o). */
+Test(cli_messages, a_directory_without_out_dir_is_a_usage_error) {
+  cr_assert_eq(mkdir(tmp("heights"), 0755), 0);
+  dome(tmp("heights/h.png"), 1, BB_DEPTH_16);
+  const char *plain[] = {"bake", tmp("heights"), "--scale", "4", NULL};
+  harness_expect_refusal(NULL, plain, 2,
+                         "is a directory: a batch of its heights needs --out-dir DIR", 0);
+  const char *prefix[] = {"bake", tmp("heights"), "--scale", "4", "-o", tmp("p"), NULL};
+  harness_expect_refusal(NULL, prefix, 2, "needs --out-dir DIR", 1);
+  const char *named[] = {"bake",     tmp("heights"), "--scale", "4",
+                         "--normal", tmp("n.png"),   NULL};
+  harness_expect_refusal(NULL, named, 2, "needs --out-dir DIR", 2);
+}
+
+/* A single bake makes the folders its outputs are named in, as a batch
+ * makes its --out-dir (mkdir -p): maps, -o's prefix, the slope map and
+ * its preview, a material. */
+Test(cli_messages, a_single_bake_creates_its_output_folders) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  cli_result r = harness_run((const char *[]){
+      "bake", tmp("h.png"), "--scale", "4", "--rays", "4", "--normal", tmp("a/b/n.png"),
+      "--slope", tmp("s/slope.png"), "--lit", "0,45", "--ssbump",
+      tmp("game/materials/x/s.vtf"), "--vmt", tmp("game/materials/y/s.vmt"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  const char *made[] = {"a/b/n.png", "s/slope.png", "s/slope_lit.png",
+                        "game/materials/x/s.vtf", "game/materials/y/s.vmt"};
+  for (size_t i = 0; i < sizeof made / sizeof *made; i++)
+    cr_expect(file_exists(tmp(made[i])), "%s not written", made[i]);
+  r = harness_run((const char *[]){"bake", tmp("h.png"), "--scale", "4", "-o",
+                                   tmp("c/d/rock"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(file_exists(tmp("c/d/rock_normal.png")) &&
+            file_exists(tmp("c/d/rock_ao.png")));
+  cli_result_free(&r);
+  /* A file where a folder should be is still an error, and nothing is made. */
+  write_bytes(tmp("file"), "x", 1);
+  const char *blocked[] = {"bake",     tmp("h.png"),      "--scale", "4",
+                           "--normal", tmp("file/n.png"), NULL};
+  harness_expect_refusal(NULL, blocked, 1, "file/n.png: cannot write: ", 3);
+  const char *below[] = {"bake", tmp("h.png"), "--scale", "4", "--normal",
+                         tmp("file/sub/n.png"), NULL};
+  harness_expect_refusal(NULL, below, 1, "file/sub/n.png: cannot write: ", 4);
+}
+
+/* A material names its colour map only when told (--basetexture): one
+ * without it gets a note, one with it none. */
+Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  cr_assert_eq(mkdir(tmp("materials"), 0755), 0);
+  cli_result r = harness_run(
+      (const char *[]){"bake", tmp("h.png"), "--scale", "4", "--rays", "4", "--ssbump",
+                       tmp("materials/s.vtf"), "--vmt", tmp("materials/s.vmt"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.err, "s.vmt: note: the material has no $basetexture"), "%s", r.err);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--rays", "4",
+                                   "--ssbump", tmp("materials/s.vtf"), "--vmt",
+                                   tmp("materials/s.vmt"), "--basetexture",
+                                   tmp("materials/colour.vtf"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(!strstr(r.err, "$basetexture"), "%s", r.err);
+  cli_result_free(&r);
+}
+
+/* A map named twice is a usage error before any bake, not a file dropped. */
+Test(cli_messages, a_map_named_twice_is_a_usage_error) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  const char *args[] = {"bake",       tmp("h.png"), "--scale",    "4", "--ssbump",
+                        tmp("s.png"), "--ssbump",   tmp("s.vtf"), NULL};
+  harness_expect_refusal(NULL, args, 2, "--ssbump is given twice", 0);
+}
+
+/* combine takes -q as every command that writes files does: the wrote
+ * line without it, nothing with it. */
+Test(cli_messages, combine_takes_quiet) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  cli_result r = harness_run((const char *[]){"normal", tmp("h.png"), "--scale", "4", "-o",
+                                              tmp("n.png"), "-q", NULL});
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"combine", tmp("n.png"), tmp("n.png"), "--mix", "0.5", "-o",
+                                   tmp("c.png"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "wrote "), "%s", r.out);
+  cli_result_free(&r);
+  r = harness_run((const char *[]){"combine", tmp("n.png"), tmp("n.png"), "--mix", "0.5", "-o",
+                                   tmp("q.png"), "-q", NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.out, "%s", r.out);
+  cr_expect(file_exists(tmp("q.png")));
+  cli_result_free(&r);
+}

@@ -207,6 +207,42 @@ Test(cmd, options_that_do_nothing_are_refused) {
   bb_command_free(c);
 }
 
+/* A file option names one file: given again with another name, the first
+ * would be dropped without a word (--ssbump s.png --ssbump s.vtf wrote the
+ * VTF alone). The same name twice is harmless. */
+Test(cmd, a_file_option_given_twice_is_refused) {
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ssbump", "s.png", "--ssbump",
+                                   "s.vtf", NULL},
+          "--ssbump is given twice ('s.png', then 's.vtf'): it names one file; run once per "
+          "file");
+  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--depfile",
+                                   "a.d", "--depfile", "b.d", NULL},
+          "--depfile is given twice ('a.d', then 'b.d'): it names one file; run once per file");
+  refused("render", (const char *[]){"--normal", "n.png", "--normal", "m.png", "--output",
+                                     "r.png", NULL},
+          "--normal is given twice ('n.png', then 'm.png'): it names one file; run once per "
+          "file");
+  const char *same[] = {"h.png", "--scale", "1", "--ssbump", "s.png", "--ssbump", "s.png",
+                        NULL};
+  bb_command *c = command("bake", same);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_OUTPUT_SSBUMP], "s.png");
+  bb_command_free(c);
+}
+
+/* A colour above a float's largest is too large, said so; a denormal is
+ * a number like any other. */
+Test(cmd, a_value_past_a_float_is_too_large_and_a_denormal_a_number) {
+  refused("render", (const char *[]){"--normal", "n.png", "--mode", "normal", "--light-color",
+                                     "3e39,1,1", "--output", "r.png", NULL},
+          "--light-color is too large: at most 3.40282e38, a float's largest (got 3e39)");
+  const char *denormal[] = {"h.png", "--scale", "1", "--ao", "a.png", "--bounce", "5e-324",
+                            NULL};
+  bb_command *c = command("bake", denormal);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  bb_command_free(c);
+}
+
 /* Names: an unknown option or command gets the nearest, Python's spelling
  * (filter_radius) finds the option, the enums' own names are the words. */
 Test(cmd, names_and_did_you_mean) {

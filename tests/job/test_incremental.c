@@ -44,6 +44,32 @@ Test(incremental, file_hash_refuses_missing_files_and_directories) {
   cr_expect(strstr(err.message, "cannot read: is a directory"), "%s", err.message);
 }
 
+/* A file that cannot be opened says "cannot read" once (a batch printed
+ * "h.png: cannot read: cannot read: Permission denied"). As root the
+ * check runs in a child that has given up root. */
+Test(incremental, file_hash_says_cannot_read_once) {
+  write_bytes(tmp("locked"), "x", 1);
+  cr_assert_eq(chmod(tmp("locked"), 0), 0);
+  const pid_t pid = fork();
+  cr_assert(pid >= 0);
+  if (pid == 0) {
+    if (geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0))
+      _exit(3);
+    uint64_t h = 1;
+    bb_error err = {{0}};
+    if (bb_file_hash(tmp("locked"), &h, &err) != BB_ERR_IO)
+      _exit(4);
+    if (strstr(err.message, "cannot read: cannot read"))
+      _exit(1);
+    _exit(strstr(err.message, ": cannot read: Permission denied") ? 0 : 2);
+  }
+  int status = 0;
+  cr_assert_eq(waitpid(pid, &status, 0), pid);
+  cr_expect(WIFEXITED(status) && WEXITSTATUS(status) == 0,
+            "child: %d (1: prefix repeated, 2: other words, 3: setuid, 4: no error)",
+            WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+}
+
 /* The id is the one bb_bake records, without building anything. */
 Test(incremental, rayset_id_is_the_bakes) {
   bb_image h;

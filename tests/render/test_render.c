@@ -503,6 +503,36 @@ Test(render, bad_arguments_are_refused) {
   bb_image_free(&ao_small);
 }
 
+/* A light that passes a float's largest value is refused with what is
+ * wrong: too large, said as such (not "must be >= 0"), or a picture that
+ * would hold infinities (each colour a float, their highlight sum not). */
+Test(render, a_light_too_bright_for_a_float_says_so) {
+  scene sc;
+  scene_make(&sc, 8, 8, flat, 4.0f, 16);
+  bb_render_options o;
+  options(&o, BB_RENDER_SSBUMP, 0, 90); /* overhead: diffuse 1, highlight 1 */
+  bb_error err = {{0}};
+  bb_image out;
+  o.light_color[0] = o.light_color[1] = o.light_color[2] = 3.4e38f;
+  o.specular_exponent = 8.0;
+  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_str_eq(err.message, "render: too bright: a texel passes a float's largest value "
+                                "(3.40282e38); lower the light colour, lightmap or specular "
+                                "strength");
+  cr_assert_null(out.pixels);
+  o.specular_exponent = 0.0; /* 3.4e38 alone stays finite */
+  bb_image img = render(&sc.maps, &o);
+  bb_image_free(&img);
+  o.light_color[0] = INFINITY;
+  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_str_eq(err.message, "render: light colour is too large: at most 3.40282e38, a "
+                                "float's largest (got inf)");
+  o.light_color[0] = -1.0f;
+  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_str_eq(err.message, "render: light colour must be >= 0 (got -1)");
+  scene_free(&sc);
+}
+
 /* ------------------------------------------------------------ describe */
 
 Test(render, describe_names_every_option) {

@@ -206,6 +206,11 @@ Test(vtf, resources_7_3_hold_the_provenance) {
     data += (size_t)((s + 3) / 4) * (size_t)((s + 3) / 4) * 8;
   cr_assert_eq(size, image + data);
   const char *text = (const char *)f + kvd + 4;
+  /* The chunk is the KeyValues text alone: no NUL inside its size (a NUL
+   * counted in it made srctools' parser stop as at an unfinished file). */
+  cr_assert_null(memchr(text, '\0', kvd_size), "a NUL inside the KVD chunk");
+  cr_assert(kvd_size > 2 && memcmp(text + kvd_size - 2, "}\n", 2) == 0,
+            "the chunk ends with the block's brace and a newline");
   cr_assert_not_null(strstr(text, "\"bumpbake\"\n{\n"), "%s", text);
   cr_assert_not_null(strstr(text, "\t\"command\" \"bumpbake bake \\\"a b.png\\\" --scale 64\"\n"),
                      "%s", text);
@@ -322,6 +327,50 @@ static float half_to_float(unsigned h) {
   return (float)((h >> 15) ? -v : v);
 }
 
+/* Valve's tools write DXT1 textures under 4 texels a side (1 x 1, 2 x 2,
+ * 8 x 2) as one 4 x 4 block a level covering the smaller image, as every
+ * chain's smallest mips are: written, and read back at their size. */
+Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
+  make_dir();
+  const int sizes[][2] = {{1, 1}, {2, 2}, {8, 2}, {2, 16}};
+  for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
+    const int w = sizes[i][0], h = sizes[i][1];
+    bb_image img = pattern(w, h, 3, 2);
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.format = BB_TEXTURE_FORMAT_BC1;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
+                 err.message);
+    size_t size;
+    unsigned char *f = slurp(in_dir("s.vtf"), &size);
+    /* Every level a whole number of blocks; the low-res image (the top
+     * level itself, at most 16 x 16) too. */
+    const size_t low = (size_t)((w + 3) / 4) * (size_t)((h + 3) / 4) * 8;
+    int levels = 0;
+    size_t data = 0;
+    for (int a = w, b = h;; a = a > 1 ? a / 2 : 1, b = b > 1 ? b / 2 : 1) {
+      data += (size_t)((a + 3) / 4) * (size_t)((b + 3) / 4) * 8;
+      levels++;
+      if (a == 1 && b == 1)
+        break;
+    }
+    cr_assert_eq(f[56], levels, "%d x %d: mip count", w, h);
+    cr_assert(f[61] == w && f[62] == h, "low-res size");
+    cr_assert_eq(size, 80 + low + data, "%d x %d: header, low-res blocks, levels", w, h);
+    free(f);
+    bb_image back;
+    cr_assert_eq(bb_image_read(in_dir("s.vtf"), &back, NULL, &err), BB_OK, "%s", err.message);
+    cr_assert(back.width == w && back.height == h, "read %d x %d", back.width, back.height);
+    for (size_t k = 0; k < (size_t)w * (size_t)h * 3; k++)
+      cr_assert(fabsf(back.pixels[k] - img.pixels[k]) < 0.07f, "%d x %d texel value %zu", w, h,
+                k);
+    bb_image_free(&back);
+    bb_image_free(&img);
+  }
+  remove_dir();
+}
+
 Test(vtf, texel_formats) {
   /* BGR888 and BGRA8888 in Valve's byte order; RGBA16161616F halves of
    * what the engine samples (normals as 0.5 + 0.5 N); DXT5's code. */
@@ -435,10 +484,18 @@ Test(vtf, usage_errors) {
   expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
                  "power of two on each side (resize to 128 x 64)");
   expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BGR8, 2, 0, "power of two");
-  expect_refused(&tiny, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
-                 "multiples of 4");
+  bb_image six = pattern(8, 6, 3, 0);
+  bb_texture_options dds;
+  bb_texture_options_init(&dds);
+  bb_error e6 = {{0}};
+  cr_assert_eq(bb_texture_write(in_dir("six.dds"), &six, &dds, &e6), BB_ERR_ARGUMENT);
+  cr_assert_not_null(strstr(e6.message, "block compression (bc1) needs sides that are multiples "
+                                        "of 4"),
+                     "%s", e6.message);
+  bb_image_free(&six);
+  /* A VTF's formats by Valve's names, as a modder types them. */
   expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 2, 0,
-                 "format bc1 holds at most 3 channels");
+                 "format dxt1 holds at most 3 channels");
   expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGR8, 2, 0,
                  "format bgr888 holds at most 3 channels");
   expect_refused(&ao, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 2, 0, "VTF has no format bc4");
@@ -449,7 +506,21 @@ Test(vtf, usage_errors) {
   expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, "7.1");
   expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_ENVMAP,
                  "ENVMAP");
-  /* 2 x 2 is fine uncompressed, and so is one channel in DXT1 (grey). */
+  /* Flags that would contradict the file: readers believe them. */
+  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2,
+                 BB_VTF_FLAG_EIGHTBITALPHA,
+                 "the EIGHTBITALPHA flag (0x00002000) says the file has alpha, and the dxt1 "
+                 "file of a 3-channel image has none");
+  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 2,
+                 BB_VTF_FLAG_EIGHTBITALPHA, "the dxt5 file of a 3-channel image has none");
+  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_NOMIP,
+                 "the NOMIP flag (0x00000100) says the file has no mip chain, and it has one");
+  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 2, 0x1000u,
+                 "ONEBITALPHA flag (0x00001000) says the file has 1-bit alpha, and the "
+                 "bgra8888 file has 8-bit alpha");
+  /* 2 x 2 is fine uncompressed, and so is one channel in DXT1 (grey). A
+   * DXT1 VTF of 1 x 1, 2 x 2, 8 x 2 is one padded block a level (as the
+   * smallest mips are). */
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGR8;
