@@ -1,7 +1,7 @@
 /* test_memory.c: what bb_memory_available finds under a container's memory
  * limit. In a 450 MB memory cgroup a 4096 x 4096 bake was killed by the
  * kernel with no message: only MemAvailable and RLIMIT_AS were read. The
- * reader takes a root directory, so each case is a made-up /proc and
+ * reader takes a scratch_dir directory, so each case is a made-up /proc and
  * /sys/fs/cgroup tree (cgroup v2 and v1, limits set above the process's own
  * group, a container's mount of its own subtree); `make hostile` runs a bake
  * in a real one. */
@@ -15,29 +15,19 @@
 #include <sys/stat.h>
 
 #include "core/internal.h"
+#include "scratch_dir.h"
 
 #define MIB (1024.0 * 1024.0)
 
-static char root[64];
+static void make_scratch_dir(void) { scratch_dir_make("bb_memory"); }
 
-static void make_root(void) {
-  snprintf(root, sizeof root, "/tmp/bb_memory_XXXXXX");
-  cr_assert_not_null(mkdtemp(root));
-}
-
-static void remove_root(void) {
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", root);
-  cr_assert_eq(system(cmd), 0);
-}
-
-TestSuite(memory, .init = make_root, .fini = remove_root);
+TestSuite(memory, .init = make_scratch_dir, .fini = scratch_dir_remove);
 
 /* Writes text to ROOT/path, making its directories. */
 static void put(const char *path, const char *text) {
   char full[512];
-  snprintf(full, sizeof full, "%s/%s", root, path);
-  for (char *s = full + strlen(root) + 1; (s = strchr(s, '/')) != NULL; s++) {
+  snprintf(full, sizeof full, "%s/%s", scratch_dir, path);
+  for (char *s = full + strlen(scratch_dir) + 1; (s = strchr(s, '/')) != NULL; s++) {
     *s = '\0';
     mkdir(full, 0755);
     *s = '/';
@@ -52,7 +42,7 @@ static void put(const char *path, const char *text) {
 static double available(const char **source) {
   uint64_t bytes = 0;
   bb_error err = {{0}};
-  cr_assert_eq(bb__memory_available_at(root, &bytes, source, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__memory_available_at(scratch_dir, &bytes, source, &err), BB_OK, "%s", err.message);
   return (double)bytes / MIB;
 }
 
@@ -64,7 +54,7 @@ Test(memory, a_cgroup_v2_limit_above_the_process_group_counts) {
   machine();
   put("proc/self/cgroup", "0::/batch/job7\n");
   put("proc/self/mountinfo",
-      "22 1 0:20 / / rw - ext4 /dev/root rw\n"
+      "22 1 0:20 / / rw - ext4 /dev/scratch_dir rw\n"
       "30 22 0:26 / /sys/fs/cgroup rw,nosuid - cgroup2 cgroup2 rw,nsdelegate\n");
   put("sys/fs/cgroup/batch/job7/memory.max", "max\n");
   put("sys/fs/cgroup/batch/job7/memory.current", "104857600\n");
@@ -90,14 +80,14 @@ Test(memory, a_cgroup_v1_limit_less_its_usage) {
   put("sys/fs/cgroup/cpu,memory/docker/c1/memory.usage_in_bytes", "314572800\n");
   put("sys/fs/cgroup/cpu,memory/docker/c1/memory.stat",
       "cache 0\ninactive_file 5\ntotal_inactive_file 104857600\n");
-  /* cgroup v2 holds no limit here (no memory.max at its root) */
+  /* cgroup v2 holds no limit here (no memory.max at its scratch_dir) */
   const char *source = NULL;
   cr_expect_float_eq(available(&source), 1024.0 - 200.0, 1e-9);
   cr_expect_str_eq(source, "cgroup memory.limit_in_bytes");
 }
 
 /* Inside a container the cgroup file system is often its own subtree,
- * mounted at /sys/fs/cgroup/memory with mountinfo's root naming it. */
+ * mounted at /sys/fs/cgroup/memory with mountinfo's scratch_dir naming it. */
 Test(memory, a_container_mounting_its_own_subtree) {
   machine();
   put("proc/self/cgroup", "9:memory:/kubepods/pod1/c2\n");

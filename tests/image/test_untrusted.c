@@ -3,12 +3,14 @@
  * call runs in a child with an alarm, so a regression that blocks fails
  * here instead of hanging the suite. */
 #define _DEFAULT_SOURCE /* wait4 (child_call.h) */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw (scratch_dir.h) */
 
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
 #include "image/height_channel.h"
 #include "child_call.h"
+#include "scratch_dir.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -27,28 +29,9 @@
 #include <time.h>
 #include <unistd.h>
 
-static char tmpdir[256];
+static void make_scratch_dir(void) { scratch_dir_make("bb_untrusted"); }
 
-static void make_tmpdir(void) {
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/bb-test-untrusted-XXXXXX");
-  cr_assert_not_null(mkdtemp(tmpdir), "mkdtemp: %s", strerror(errno));
-}
-
-static void remove_tmpdir(void) {
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  cr_assert_eq(system(cmd), 0);
-}
-
-TestSuite(untrusted, .init = make_tmpdir, .fini = remove_tmpdir, .timeout = 600);
-
-static const char *tmp_path(const char *name) {
-  static char buf[4][512];
-  static int next = 0;
-  char *p = buf[next++ % 4];
-  snprintf(p, 512, "%s/%s", tmpdir, name);
-  return p;
-}
+TestSuite(untrusted, .init = make_scratch_dir, .fini = scratch_dir_remove, .timeout = 600);
 
 /* --------------------------------------------- every reader of the library */
 
@@ -116,13 +99,13 @@ static void expect_refused_at_once(const char *path, const char *what) {
 }
 
 Test(untrusted, a_fifo_is_refused_by_every_reader_without_blocking) {
-  const char *fifo = tmp_path("pipe.png");
+  const char *fifo = in_scratch_dir("pipe.png");
   cr_assert_eq(mkfifo(fifo, 0600), 0, "mkfifo: %s", strerror(errno));
   expect_refused_at_once(fifo, "is a FIFO, not a regular file");
 }
 
 Test(untrusted, a_device_is_refused_by_every_reader) {
-  const char *link = tmp_path("zero.png");
+  const char *link = in_scratch_dir("zero.png");
   cr_assert_eq(symlink("/dev/zero", link), 0, "symlink: %s", strerror(errno));
   expect_refused_at_once(link, "is a device, not a regular file");
 }
@@ -132,7 +115,7 @@ Test(untrusted, a_device_is_refused_by_every_reader) {
 /* What the calls of fn wrote on file descriptor 2 (then restored), as a
  * malloc'd string: the library must print nothing there, whoever asks. */
 static char *stderr_during(void (*fn)(const char *path), const char *path) {
-  const char *capture = tmp_path("stderr.txt");
+  const char *capture = in_scratch_dir("stderr.txt");
   fflush(stderr);
   int saved = dup(STDERR_FILENO);
   int fd = open(capture, O_WRONLY | O_CREAT | O_TRUNC, 0600);
@@ -186,9 +169,9 @@ static unsigned char *noise_png(size_t *size) {
     img.pixels[i] = (float)(s >> 8) / 16777216.0f;
   }
   bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(tmp_path("noise.png"), &img, &o, NULL), BB_OK);
+  cr_assert_eq(bb_image_write(in_scratch_dir("noise.png"), &img, &o, NULL), BB_OK);
   bb_image_free(&img);
-  FILE *f = fopen(tmp_path("noise.png"), "rb");
+  FILE *f = fopen(in_scratch_dir("noise.png"), "rb");
   cr_assert_not_null(f);
   unsigned char *bytes = malloc(1 << 20);
   *size = fread(bytes, 1, 1 << 20, f);
@@ -204,7 +187,7 @@ static unsigned char *noise_png(size_t *size) {
 Test(untrusted, a_damaged_png_prints_nothing_on_stderr) {
   size_t n;
   unsigned char *png = noise_png(&n);
-  const char *cut = tmp_path("cut.png"), *crc = tmp_path("crc.png"), *header = tmp_path("ihdr.png");
+  const char *cut = in_scratch_dir("cut.png"), *crc = in_scratch_dir("crc.png"), *header = in_scratch_dir("ihdr.png");
   write_bytes(cut, png, n / 2);
   png[n / 2] ^= 0x55; /* inside the pixel data: the chunk's CRC no longer matches */
   write_bytes(crc, png, n);
@@ -281,9 +264,9 @@ static void write_text(const char *path, const char *text) {
  * the file is written whole (or, had the watcher won the race for the
  * directory itself, refused cleanly). */
 Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
-  const char *out_dir = tmp_path("shared"), *decoy = tmp_path("decoy");
+  const char *out_dir = in_scratch_dir("shared"), *decoy = in_scratch_dir("decoy");
   char target[600];
-  snprintf(target, sizeof target, "%s", tmp_path("precious.txt"));
+  snprintf(target, sizeof target, "%s", in_scratch_dir("precious.txt"));
   cr_assert_eq(mkdir(out_dir, 0777), 0);
   cr_assert_eq(mkdir(decoy, 0777), 0);
   write_text(target, "precious\n");
@@ -371,7 +354,7 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
   cr_assert_eq(bb_image_alloc(&img, 2048, 2048, 4, NULL), BB_OK);
   for (size_t i = 0; i < 2048u * 2048u * 4u; i++)
     img.pixels[i] = (float)((i * 2654435761u) >> 8 & 255) / 255.0f;
-  const char *capture = tmp_path("stderr.txt");
+  const char *capture = in_scratch_dir("stderr.txt");
   int failed = 0, written = 0;
   for (int margin_mib = 0; margin_mib <= 40; margin_mib += 1) {
     fflush(NULL);
@@ -385,7 +368,7 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
       rl.rlim_cur = rl.rlim_max = data_bytes() + ((size_t)margin_mib << 20);
       setrlimit(RLIMIT_DATA, &rl);
       bb_error err = {{0}};
-      bb_status st = bb_image_write(tmp_path("short.png"), &img, NULL, &err);
+      bb_status st = bb_image_write(in_scratch_dir("short.png"), &img, NULL, &err);
       if (st != BB_OK && (!err.message[0] || strchr(err.message, '\n'))) _exit(3);
       _exit(st == BB_OK ? 0 : 1);
     }

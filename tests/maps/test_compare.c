@@ -1,7 +1,10 @@
 /* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a
  * process. */
+#define _XOPEN_SOURCE 700 /* mkdtemp, nftw (scratch_dir.h) */
+
 #include "bumpbake.h"
 #include "hostile_headers.h"
+#include "scratch_dir.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
@@ -240,28 +243,6 @@ static int run(char *out, size_t cap, const char *fmt, ...) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-static char tmp_dir[64];
-
-static void make_tmp_dir(void) {
-  snprintf(tmp_dir, sizeof tmp_dir, "/tmp/bb-compare-XXXXXX");
-  cr_assert_not_null(mkdtemp(tmp_dir));
-}
-
-static void remove_tmp_dir(void) {
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
-  if (system(cmd) != 0)
-    fprintf(stderr, "cannot remove %s\n", tmp_dir);
-}
-
-static const char *tmp_file(const char *name) {
-  static char paths[8][160];
-  static int next;
-  char *p = paths[next++ % 8];
-  snprintf(p, sizeof paths[0], "%s/%s", tmp_dir, name);
-  return p;
-}
-
 /* Writes a w x h x c float image whose values are value_at(i) to name in the
  * temp dir (format from the extension) and returns its path. */
 static const char *write_image(const char *name, int w, int h, int c, const float *values,
@@ -271,7 +252,7 @@ static const char *write_image(const char *name, int w, int h, int c, const floa
   memcpy(img.pixels, values, sizeof(float) * (size_t)(w * h * c));
   bb_write_options wo = {
       .depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT, .description = description};
-  const char *path = tmp_file(name);
+  const char *path = in_scratch_dir(name);
   bb_error err = {{0}};
   cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
@@ -289,12 +270,12 @@ static const char *ramp_with(const char *name, int changed, float delta) {
 }
 
 static void cli_setup(void) {
-  make_tmp_dir();
+  scratch_dir_make("bb_compare");
   for (int i = 0; i < 16; i++)
     ramp[i] = (float)i / 16.0f;
 }
 
-TestSuite(compare_cli, .init = cli_setup, .fini = remove_tmp_dir, .timeout = 300);
+TestSuite(compare_cli, .init = cli_setup, .fini = scratch_dir_remove, .timeout = 300);
 
 Test(compare_cli, identical_files_pass_with_exit_0) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 0, 0);
@@ -421,13 +402,13 @@ Test(compare_cli, different_size_or_channels_exit_3) {
 
 Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
   const char *a = ramp_with("a.exr", 0, 0);
-  const char *junk = tmp_file("junk.png");
+  const char *junk = in_scratch_dir("junk.png");
   FILE *f = fopen(junk, "w");
   cr_assert_not_null(f);
   fputs("this is not a png", f);
   fclose(f);
   char out[4096];
-  cr_assert_eq(run(out, sizeof out, "compare %s %s", a, tmp_file("missing.exr")), 4, "%s",
+  cr_assert_eq(run(out, sizeof out, "compare %s %s", a, in_scratch_dir("missing.exr")), 4, "%s",
                out);
   cr_assert_not_null(strstr(out, "bumpbake: "), "%s", out);
   cr_assert_not_null(strstr(out, "missing.exr"), "%s", out);
@@ -451,14 +432,14 @@ Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
  * one of 65535 channels. */
 Test(compare_cli, a_file_over_the_size_limit_is_unreadable_exit_4) {
   const char *a = ramp_with("a.exr", 0, 0);
-  cr_assert_eq(write_png_header(tmp_file("wide.png"), 65535, 65535), 0);
-  cr_assert_eq(write_dds_header(tmp_file("big.dds"), 65536, 65536), 0);
-  cr_assert_eq(write_tiled_tiff(tmp_file("tiles.tif"), 1, 1, 16384, 16384), 0);
-  cr_assert_eq(write_hostile_tiff(tmp_file("channels.tif"), 4, 4, 65535), 0);
+  cr_assert_eq(write_png_header(in_scratch_dir("wide.png"), 65535, 65535), 0);
+  cr_assert_eq(write_dds_header(in_scratch_dir("big.dds"), 65536, 65536), 0);
+  cr_assert_eq(write_tiled_tiff(in_scratch_dir("tiles.tif"), 1, 1, 16384, 16384), 0);
+  cr_assert_eq(write_hostile_tiff(in_scratch_dir("channels.tif"), 4, 4, 65535), 0);
   const char *files[] = {"wide.png", "big.dds", "tiles.tif", "channels.tif"};
   for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
     char out[4096];
-    const char *path = tmp_file(files[i]);
+    const char *path = in_scratch_dir(files[i]);
     cr_expect_eq(run(out, sizeof out, "compare %s %s", i % 2 ? a : path, i % 2 ? path : a), 4,
                  "%s: %s", files[i], out);
     cr_expect(strstr(out, files[i]), "%s: %s", files[i], out);
@@ -468,10 +449,10 @@ Test(compare_cli, a_file_over_the_size_limit_is_unreadable_exit_4) {
 Test(compare_cli, diff_exr_holds_raw_absolute_differences) {
   const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 2, 0.125f);
   char out[4096];
-  cr_assert_eq(run(out, sizeof out, "compare %s %s --diff %s", a, b, tmp_file("d.exr")),
+  cr_assert_eq(run(out, sizeof out, "compare %s %s --diff %s", a, b, in_scratch_dir("d.exr")),
                2, "%s", out);
   bb_image d = {0};
-  cr_assert_eq(bb_image_read(tmp_file("d.exr"), &d, NULL, NULL), BB_OK);
+  cr_assert_eq(bb_image_read(in_scratch_dir("d.exr"), &d, NULL, NULL), BB_OK);
   cr_assert_eq(d.width, 4);
   cr_assert_eq(d.channels, 1);
   for (int i = 0; i < 16; i++) {
@@ -489,9 +470,9 @@ Test(compare_cli, diff_png_is_scaled_so_the_largest_difference_is_white) {
   v[7] += 0.002f;
   const char *b = write_image("b.exr", 4, 4, 1, v, NULL);
   char out[4096];
-  run(out, sizeof out, "compare %s %s --diff %s", a, b, tmp_file("d.png"));
+  run(out, sizeof out, "compare %s %s --diff %s", a, b, in_scratch_dir("d.png"));
   bb_image d = {0};
-  cr_assert_eq(bb_image_read(tmp_file("d.png"), &d, NULL, NULL), BB_OK, "%s", out);
+  cr_assert_eq(bb_image_read(in_scratch_dir("d.png"), &d, NULL, NULL), BB_OK, "%s", out);
   cr_assert_float_eq(d.pixels[3], 1.0f, 1e-6);
   cr_assert_float_eq(d.pixels[7], 0.2f, 1.0 / 255, "0.002 / 0.01 of full scale");
   cr_assert_eq(d.pixels[0], 0.0f);
@@ -556,7 +537,7 @@ Test(compare_cli, info_prints_size_format_and_provenance) {
 
 Test(compare_cli, info_on_unreadable_file_is_one_line_and_exit_1) {
   char out[4096];
-  cr_assert_eq(run(out, sizeof out, "info %s", tmp_file("missing.png")), 1, "%s", out);
+  cr_assert_eq(run(out, sizeof out, "info %s", in_scratch_dir("missing.png")), 1, "%s", out);
   cr_assert(strncmp(out, "bumpbake: ", 10) == 0, "%s", out);
   char *nl = strchr(out, '\n');
   cr_assert(nl && nl[1] == '\0', "one line: %s", out);
@@ -580,7 +561,7 @@ Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
   for (int i = 0; i < 256; i++)
     v[i] = (float)((i * 37) % 256) / 255.0f;
   const char *height = write_image("h.png", 16, 16, 1, v, NULL);
-  const char *ssbump = tmp_file("ssbump.exr");
+  const char *ssbump = in_scratch_dir("ssbump.exr");
   char out[4096];
   int code = run(out, sizeof out,
                  "bake %s --scale 5 --rays 16 --power 2 --clamp --basis hl2+z --quiet "
@@ -614,7 +595,7 @@ Test(compare_cli, info_takes_several_files_and_reads_headers_only) {
   /* The same TIFF cut in the middle of its pixels: header whole, pixels not.
    * (TIFF, not PNG: libpng's longjmp out of a truncated PNG leaks a few
    * bytes inside OpenImageIO, which the sanitized build reports.) */
-  const char *cut = tmp_file("cut.tif");
+  const char *cut = in_scratch_dir("cut.tif");
   struct stat st;
   cr_assert_eq(stat(b, &st), 0);
   char cmd[512];
@@ -647,7 +628,7 @@ Test(compare_cli, info_json_is_one_object_per_file) {
   const char *a = write_image("a.exr", 4, 4, 1, ramp, p16);
   /* A name JSON must escape: quote, backslash, tab. */
   const char *odd = write_image("o\"d\\d\t.png", 4, 4, 3, (float[48]){0}, "made elsewhere");
-  const char *missing = tmp_file("missing.png");
+  const char *missing = in_scratch_dir("missing.png");
   char out[8192];
   cr_assert_eq(run(out, sizeof out, "info --json %s '%s' %s", a, odd, missing), 1,
                "a missing file: exit 1: %s", out);
@@ -678,11 +659,11 @@ Test(compare_cli, tga_provenance_is_compared_key_by_key) {
   write_image("h1.png", 16, 16, 1, v, NULL);
   write_image("h2.png", 16, 16, 1, v, NULL);
   char out[8192];
-  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 4", tmp_file("h1.png")), 0, "%s",
+  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 4", in_scratch_dir("h1.png")), 0, "%s",
                out);
-  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 8", tmp_file("h2.png")), 0, "%s",
+  cr_assert_eq(run(out, sizeof out, "height2ssbump -r 4 %s 8", in_scratch_dir("h2.png")), 0, "%s",
                out);
-  const char *t1 = tmp_file("h1-ssbump.tga"), *t2 = tmp_file("h2-ssbump.tga");
+  const char *t1 = in_scratch_dir("h1-ssbump.tga"), *t2 = in_scratch_dir("h2-ssbump.tga");
   cr_assert_eq(run(out, sizeof out, "info %s", t1), 0, "%s", out);
   cr_assert_not_null(strstr(out, "provenance:\n"), "intact, not cut: %s", out);
   cr_assert_not_null(strstr(out, "\ninput=h1.png\n"), "%s", out);
@@ -766,7 +747,7 @@ Test(compare_cli, limits_out_of_range_are_refused) {
   cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
   /* Before any read: the files need not exist. */
   bb_compare_report r;
-  cr_expect_eq(bb_compare_files(tmp_file("none1.png"), tmp_file("none2.png"), &l, NULL, &r,
+  cr_expect_eq(bb_compare_files(in_scratch_dir("none1.png"), in_scratch_dir("none2.png"), &l, NULL, &r,
                                 &err),
                BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");

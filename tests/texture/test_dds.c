@@ -22,19 +22,7 @@
 
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
-
-static char dir[64];
-
-static void make_dir(void) {
-  snprintf(dir, sizeof dir, "/tmp/bb_dds_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void) {
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  cr_assert_eq(system(cmd), 0);
-}
+#include "scratch_dir.h"
 
 static const char *golden(const char *name) {
   static char path[512];
@@ -141,7 +129,7 @@ static const round_trip cases[] = {
 };
 
 Test(dds, round_trip_through_the_reader) {
-  make_dir();
+  scratch_dir_make("bb_dds");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const round_trip *t = &cases[c];
     bb_image img = read_golden(t->golden);
@@ -150,7 +138,7 @@ Test(dds, round_trip_through_the_reader) {
     o.format = t->format;
     o.map = t->map;
     char path[160];
-    snprintf(path, sizeof path, "%s/%zu.dds", dir, c);
+    snprintf(path, sizeof path, "%s/%zu.dds", scratch_dir, c);
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     bb_image *chain = NULL;
@@ -190,7 +178,7 @@ Test(dds, round_trip_through_the_reader) {
     bb_mip_chain_free(chain, count);
     bb_image_free(&img);
   }
-  remove_dir();
+  scratch_dir_remove();
 }
 
 static uint32_t u32_at(const unsigned char *p) {
@@ -198,7 +186,7 @@ static uint32_t u32_at(const unsigned char *p) {
 }
 
 Test(dds, headers) {
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image img = read_golden("rock06_32_normal.exr");
   struct {
     bb_texture_format format;
@@ -219,7 +207,7 @@ Test(dds, headers) {
     o.format = want[c].format;
     o.map = BB_TEXTURE_MAP_NORMAL;
     char path[160];
-    snprintf(path, sizeof path, "%s/h%zu.dds", dir, c);
+    snprintf(path, sizeof path, "%s/h%zu.dds", scratch_dir, c);
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
@@ -258,7 +246,7 @@ Test(dds, headers) {
     free(f);
   }
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 /* binary16 to float, written from IEEE 754 (the test's own, not Imath's). */
@@ -271,7 +259,7 @@ static float half_to_float(unsigned h) {
 Test(dds, float_formats_hold_the_values) {
   /* OpenImageIO (2.4, and its newest) reads no float DDS: the test reads the
    * levels itself, by the layout, and compares every texel. */
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image img = read_golden("noise16_ssbump.exr");
   bb_image *chain = NULL;
   int count = 0;
@@ -281,7 +269,7 @@ Test(dds, float_formats_hold_the_values) {
     bb_texture_options_init(&o);
     o.format = half ? BB_TEXTURE_FORMAT_RGBA16F : BB_TEXTURE_FORMAT_RGBA32F;
     char path[160];
-    snprintf(path, sizeof path, "%s/f%d.dds", dir, half);
+    snprintf(path, sizeof path, "%s/f%d.dds", scratch_dir, half);
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
@@ -312,7 +300,7 @@ Test(dds, float_formats_hold_the_values) {
   }
   bb_mip_chain_free(chain, count);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
@@ -320,15 +308,15 @@ Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
    * and the reader's decoder (libsquish's) and the test's own (exact) give
    * texels within one code of each other (libsquish rounds down), the same
    * through either container. */
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image img = read_golden("rock06_32_ssbump.exr");
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.map = BB_TEXTURE_MAP_SSBUMP;
   o.format = BB_TEXTURE_FORMAT_BC1;
   char dds[160], vtf[160];
-  snprintf(dds, sizeof dds, "%s/s.dds", dir);
-  snprintf(vtf, sizeof vtf, "%s/s.vtf", dir);
+  snprintf(dds, sizeof dds, "%s/s.dds", scratch_dir);
+  snprintf(vtf, sizeof vtf, "%s/s.vtf", scratch_dir);
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(dds, &img, &o, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_texture_write(vtf, &img, &o, &err), BB_OK, "%s", err.message);
@@ -359,11 +347,11 @@ Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
   free(d);
   free(v);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(dds, same_bytes_for_any_thread_count) {
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image img = read_golden("rock06_32_normal.exr");
   unsigned char *first = NULL;
   size_t first_size = 0;
@@ -374,7 +362,7 @@ Test(dds, same_bytes_for_any_thread_count) {
     o.format = BB_TEXTURE_FORMAT_BC1;
     o.threads = threads;
     char path[160];
-    snprintf(path, sizeof path, "%s/t%d.dds", dir, threads);
+    snprintf(path, sizeof path, "%s/t%d.dds", scratch_dir, threads);
     cr_assert_eq(bb_texture_write(path, &img, &o, NULL), BB_OK);
     size_t size;
     unsigned char *f = slurp(path, &size);
@@ -388,16 +376,16 @@ Test(dds, same_bytes_for_any_thread_count) {
   }
   free(first);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(dds, non_power_of_two_mips) {
   /* 96 x 80: DDS takes any multiple of 4; levels halve down to 1 x 1
    * (48 x 40, ..., 3 x 2, 1 x 1), partial blocks below 4 texels. */
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image img = read_golden("noise16_ao.exr");
   char path[160];
-  snprintf(path, sizeof path, "%s/n.dds", dir);
+  snprintf(path, sizeof path, "%s/n.dds", scratch_dir);
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
   const int want[][2] = {{96, 80}, {48, 40}, {24, 20}, {12, 10}, {6, 5}, {3, 2}, {1, 1}};
@@ -413,7 +401,7 @@ Test(dds, non_power_of_two_mips) {
     bb_image_free(&dec);
   }
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 static void expect_refused(const char *name, const bb_image *img, bb_texture_map map,
@@ -423,7 +411,7 @@ static void expect_refused(const char *name, const bb_image *img, bb_texture_map
   o.map = map;
   o.format = format;
   char path[160];
-  snprintf(path, sizeof path, "%s/%s", dir, name);
+  snprintf(path, sizeof path, "%s/%s", scratch_dir, name);
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, img, &o, &err), BB_ERR_ARGUMENT, "%s: %s", name,
                err.message);
@@ -435,7 +423,7 @@ static void expect_refused(const char *name, const bb_image *img, bb_texture_map
 }
 
 Test(dds, usage_errors) {
-  make_dir();
+  scratch_dir_make("bb_dds");
   bb_image normal = read_golden("rock06_32_normal.exr");
   bb_image ssbump = read_golden("rock06_32_ssbump.exr");
   bb_image ao = read_golden("rock06_32_ao.exr");
@@ -457,16 +445,16 @@ Test(dds, usage_errors) {
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_RGBA8;
   char path[160];
-  snprintf(path, sizeof path, "%s/pit.dds", dir);
+  snprintf(path, sizeof path, "%s/pit.dds", scratch_dir);
   cr_assert_eq(bb_texture_write(path, &pit, &o, NULL), BB_OK);
   /* NaN texels: BB_ERR_VALUE, nothing written. */
   ao.pixels[77] = NAN;
-  snprintf(path, sizeof path, "%s/nan.dds", dir);
+  snprintf(path, sizeof path, "%s/nan.dds", scratch_dir);
   cr_assert_eq(bb_texture_write(path, &ao, NULL, NULL), BB_ERR_VALUE);
   cr_assert_eq(access(path, F_OK), -1);
   bb_image_free(&normal);
   bb_image_free(&ssbump);
   bb_image_free(&ao);
   bb_image_free(&pit);
-  remove_dir();
+  scratch_dir_remove();
 }

@@ -26,29 +26,11 @@
 
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
+#include "scratch_dir.h"
 
-static char dir[64];
+static void make_scratch_dir(void) { scratch_dir_make("bb_texread"); }
 
-static void make_dir(void) {
-  snprintf(dir, sizeof dir, "/tmp/bb_texread_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void) {
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  cr_assert_eq(system(cmd), 0);
-}
-
-TestSuite(texture_read, .init = make_dir, .fini = remove_dir);
-
-static const char *in_dir(const char *name) {
-  static char path[4][256];
-  static int k;
-  k = (k + 1) % 4;
-  snprintf(path[k], sizeof path[k], "%s/%s", dir, name);
-  return path[k];
-}
+TestSuite(texture_read, .init = make_scratch_dir, .fini = scratch_dir_remove);
 
 static unsigned char *slurp(const char *path, size_t *size) {
   FILE *f = fopen(path, "rb");
@@ -140,7 +122,7 @@ Test(texture_read, vtf_every_format_version_and_level) {
         o.mips = mips;
         o.fast = 1;
         o.description = "key=value";
-        const char *path = in_dir("t.vtf");
+        const char *path = in_scratch_dir("t.vtf");
         bb_error err = {{0}};
         cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
         size_t size;
@@ -198,7 +180,7 @@ Test(texture_read, vtf_header_agrees_with_the_pixels_and_channels_can_be_picked)
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGRA8;
-  const char *path = in_dir("h.vtf");
+  const char *path = in_scratch_dir("h.vtf");
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   int w, h, c;
@@ -230,7 +212,7 @@ Test(texture_read, dds_with_a_dx10_header) {
     bb_texture_options o;
     bb_texture_options_init(&o);
     o.format = half ? BB_TEXTURE_FORMAT_RGBA16F : BB_TEXTURE_FORMAT_RGBA32F;
-    const char *path = in_dir(half ? "f16.dds" : "f32.dds");
+    const char *path = in_scratch_dir(half ? "f16.dds" : "f32.dds");
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     for (int level = 0; level < count; level++) {
@@ -285,7 +267,7 @@ static unsigned char *valid_vtf(int minor, size_t *size) {
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGR8;
   o.vtf_version = minor;
-  const char *path = in_dir("valid.vtf");
+  const char *path = in_scratch_dir("valid.vtf");
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
@@ -297,7 +279,7 @@ Test(texture_read, hostile_vtf_headers) {
   unsigned char *v2 = valid_vtf(2, &size);
   const unsigned char *base = v2;
   unsigned char *f = malloc(size);
-  const char *path = in_dir("bad.vtf");
+  const char *path = in_scratch_dir("bad.vtf");
 #define CASE(what, edit)                                                                       \
   do {                                                                                         \
     memcpy(f, base, size);                                                                     \
@@ -360,7 +342,7 @@ Test(texture_read, vtf_declared_size_product_does_not_wrap) {
   put_u32(f + 52, 29);    /* RGBA32323232F */
   f[56] = 1;              /* one level */
   put_u16(f + 63, 32768); /* depth */
-  const char *path = in_dir("wraps.vtf");
+  const char *path = in_scratch_dir("wraps.vtf");
   spill(path, f, size);
   bb_vtf_info info;
   bb_error err = {{0}};
@@ -391,7 +373,7 @@ Test(texture_read, hostile_sizes_are_refused_before_allocating) {
   h[56] = 1;
   put_u32(h + 57, 0xffffffffu); /* no low-resolution image */
   h[63] = 1;
-  const char *path = in_dir("huge.vtf");
+  const char *path = in_scratch_dir("huge.vtf");
   spill(path, h, 80);
   cr_assert_eq(truncate(path, 80 + 65535LL * 65535LL), 0);
   expect_refused(path, "65535 x 65535 VTF");
@@ -412,7 +394,7 @@ Test(texture_read, hostile_sizes_are_refused_before_allocating) {
   put_u32(h + 128, 61); /* R8_UNORM */
   put_u32(h + 132, 3);
   put_u32(h + 140, 1);
-  path = in_dir("huge.dds");
+  path = in_scratch_dir("huge.dds");
   spill(path, h, 148);
   cr_assert_eq(truncate(path, 148 + 65536LL * 65536LL), 0);
   cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_ERR_SIZE, "%s", err.message);
@@ -424,14 +406,14 @@ Test(texture_read, hostile_dx10_dds_headers) {
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_RGBA16F;
-  const char *valid = in_dir("valid.dds");
+  const char *valid = in_scratch_dir("valid.dds");
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(valid, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   size_t size;
   unsigned char *v = slurp(valid, &size);
   unsigned char *f = malloc(size);
-  const char *path = in_dir("bad.dds");
+  const char *path = in_scratch_dir("bad.dds");
 #define CASE(what, edit)                                                                       \
   do {                                                                                         \
     memcpy(f, v, size);                                                                        \
@@ -464,7 +446,7 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BC1;
-  const char *path = in_dir("mips.dds");
+  const char *path = in_scratch_dir("mips.dds");
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
@@ -523,7 +505,7 @@ static unsigned char *layered_vtf(int minor, int frames, size_t *size) {
 }
 
 Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
-  const char *path = in_dir("frames.vtf");
+  const char *path = in_scratch_dir("frames.vtf");
   for (int minor = 2; minor <= 5; minor += 3)
     for (int frames = 1; frames <= 3; frames += 2) {
       size_t size;
@@ -582,7 +564,7 @@ Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
    * and looped for ever on a zero mask: bumpbake's reader takes DXT2/DXT4
    * as DXT3/DXT5 (premultiplied colour, read as stored) and refuses masks
    * it cannot use, in one line. */
-  const char *path = in_dir("legacy.dds");
+  const char *path = in_scratch_dir("legacy.dds");
   size_t size;
   for (int k = 0; k < 2; k++) {
     unsigned char *f = legacy_dds(16, 16, 0x4, k ? "DXT4" : "DXT2", 0, NULL, 16 * 16, &size);
@@ -639,7 +621,7 @@ Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
   free(f);
   /* A DDS under another name is still read by bumpbake's reader. */
   f = legacy_dds(16, 16, 0x4, "DXT1", 0, NULL, 128, &size);
-  path = in_dir("really_a_dds.png");
+  path = in_scratch_dir("really_a_dds.png");
   spill(path, f, size);
   bb_image img;
   bb_image_info info;

@@ -18,27 +18,7 @@
 #include "bumpbake.h"
 #include "texture/blocks.h"
 #include "texture/texture_oracle.h"
-
-static char dir[64];
-
-static void make_dir(void) {
-  snprintf(dir, sizeof dir, "/tmp/bb_vtf_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void) {
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  cr_assert_eq(system(cmd), 0);
-}
-
-static const char *in_dir(const char *name) {
-  static char path[2][160];
-  static int k;
-  k ^= 1;
-  snprintf(path[k], sizeof path[k], "%s/%s", dir, name);
-  return path[k];
-}
+#include "scratch_dir.h"
 
 static unsigned char *slurp(const char *path, size_t *size) {
   FILE *f = fopen(path, "rb");
@@ -108,16 +88,16 @@ static void expected_reflectivity(const bb_image *img, double out[3]) {
 }
 
 Test(vtf, header_byte_for_byte_7_2) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img = pattern(64, 32, 3, 0);
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.map = BB_TEXTURE_MAP_SSBUMP;
   o.description = "bumpbake_version=x\nscale=64\n"; /* 7.2 has no room: left out */
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_dir("s.vtf"), &size);
+  unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
   cr_assert_eq(memcmp(f, "VTF\0", 4), 0, "magic");
   cr_assert_eq(oracle_u32(f + 4), 7, "major version");
   cr_assert_eq(oracle_u32(f + 8), 2, "minor version");
@@ -159,7 +139,7 @@ Test(vtf, header_byte_for_byte_7_2) {
   cr_assert(w == 1 && h == 1);
 
   bb_vtf_info info;
-  cr_assert_eq(bb_vtf_read_info(in_dir("s.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("s.vtf"), &info, &err), BB_OK, "%s", err.message);
   cr_assert(info.version_major == 7 && info.version_minor == 2 && info.header_size == 80);
   cr_assert(info.width == 64 && info.height == 32 && info.depth == 1 && info.frames == 1);
   cr_assert_eq(info.flags, BB_VTF_FLAG_SSBUMP);
@@ -171,11 +151,11 @@ Test(vtf, header_byte_for_byte_7_2) {
   bb_vtf_info_free(&info);
   free(f);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, resources_7_3_hold_the_provenance) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img = pattern(32, 32, 3, 1);
   bb_texture_options o;
   bb_texture_options_init(&o);
@@ -185,9 +165,9 @@ Test(vtf, resources_7_3_hold_the_provenance) {
       "bumpbake_version=0.2.0\ncommand=bumpbake bake \"a b.png\" --scale 64\nscale=64\n";
   o.description = provenance;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_dir("n.vtf"), &size);
+  unsigned char *f = slurp(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 8), 3);
   cr_assert_eq(oracle_u32(f + 12), 80 + 3 * 8, "header size with 3 resources");
   cr_assert_eq(oracle_u32(f + 20), 0x80u, "flags: NORMAL");
@@ -215,27 +195,27 @@ Test(vtf, resources_7_3_hold_the_provenance) {
   cr_assert_not_null(strstr(text, "\t\"command\" \"bumpbake bake \\\"a b.png\\\" --scale 64\"\n"),
                      "%s", text);
   bb_vtf_info info;
-  cr_assert_eq(bb_vtf_read_info(in_dir("n.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("n.vtf"), &info, &err), BB_OK, "%s", err.message);
   cr_assert_eq(info.resource_count, 3);
   cr_assert_str_eq(info.description, provenance);
   bb_vtf_info_free(&info);
   free(f);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
   /* Level k's bytes are what the codec makes of the mip chain's level k,
    * and the test's own decoder finds the map in them within BC1's error. */
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img = pattern(64, 64, 3, 2);
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.map = BB_TEXTURE_MAP_SSBUMP;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_dir("s.vtf"), &size);
+  unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
   bb_image *chain = NULL;
   int count = 0;
   cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &count, NULL), BB_OK);
@@ -275,11 +255,11 @@ Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
   bb_mip_chain_free(chain, count);
   free(f);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, flags_from_the_map_and_the_caller) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image rgb = pattern(16, 16, 3, 0), normal = pattern(16, 16, 3, 1),
            rgba = pattern(16, 16, 4, 0);
   const struct {
@@ -305,10 +285,10 @@ Test(vtf, flags_from_the_map_and_the_caller) {
     o.mips = cases[c].mips;
     o.vtf_flags = cases[c].extra;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
+    cr_assert_eq(bb_texture_write(in_scratch_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
                  err.message);
     size_t size;
-    unsigned char *f = slurp(in_dir("f.vtf"), &size);
+    unsigned char *f = slurp(in_scratch_dir("f.vtf"), &size);
     cr_assert_eq(oracle_u32(f + 20), cases[c].want, "case %zu: flags 0x%08x, want 0x%08x", c,
                  oracle_u32(f + 20), cases[c].want);
     cr_assert_eq(f[56], cases[c].mips ? 5 : 1, "case %zu: mip count", c);
@@ -317,7 +297,7 @@ Test(vtf, flags_from_the_map_and_the_caller) {
   bb_image_free(&rgb);
   bb_image_free(&normal);
   bb_image_free(&rgba);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 /* binary16 to float, from IEEE 754 (not Imath's). */
@@ -331,7 +311,7 @@ static float half_to_float(unsigned h) {
  * 8 x 2) as one 4 x 4 block a level covering the smaller image, as every
  * chain's smallest mips are: written, and read back at their size. */
 Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   const int sizes[][2] = {{1, 1}, {2, 2}, {8, 2}, {2, 16}};
   for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
     const int w = sizes[i][0], h = sizes[i][1];
@@ -340,10 +320,10 @@ Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
     bb_texture_options_init(&o);
     o.format = BB_TEXTURE_FORMAT_BC1;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
+    cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
                  err.message);
     size_t size;
-    unsigned char *f = slurp(in_dir("s.vtf"), &size);
+    unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
     /* Every level a whole number of blocks; the low-res image (the top
      * level itself, at most 16 x 16) too. */
     const size_t low = (size_t)((w + 3) / 4) * (size_t)((h + 3) / 4) * 8;
@@ -360,7 +340,7 @@ Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
     cr_assert_eq(size, 80 + low + data, "%d x %d: header, low-res blocks, levels", w, h);
     free(f);
     bb_image back;
-    cr_assert_eq(bb_image_read(in_dir("s.vtf"), &back, NULL, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_image_read(in_scratch_dir("s.vtf"), &back, NULL, &err), BB_OK, "%s", err.message);
     cr_assert(back.width == w && back.height == h, "read %d x %d", back.width, back.height);
     for (size_t k = 0; k < (size_t)w * (size_t)h * 3; k++)
       cr_assert(fabsf(back.pixels[k] - img.pixels[k]) < 0.07f, "%d x %d texel value %zu", w, h,
@@ -368,13 +348,13 @@ Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
     bb_image_free(&back);
     bb_image_free(&img);
   }
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, texel_formats) {
   /* BGR888 and BGRA8888 in Valve's byte order; RGBA16161616F halves of
    * what the engine samples (normals as 0.5 + 0.5 N); DXT5's code. */
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 4, NULL), BB_OK);
   for (int i = 0; i < 16; i++) {
@@ -396,9 +376,9 @@ Test(vtf, texel_formats) {
     o.format = cases[c].format;
     o.mips = 0;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_texture_write(in_scratch_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
-    unsigned char *f = slurp(in_dir("t.vtf"), &size);
+    unsigned char *f = slurp(in_scratch_dir("t.vtf"), &size);
     cr_assert_eq(oracle_u32(f + 52), (uint32_t)cases[c].code);
     cr_assert_eq(size, 80 + 8 + cases[c].top, "header, 4 x 4 low-res DXT1, one level");
     const unsigned char *t = f + 88;
@@ -420,9 +400,9 @@ Test(vtf, texel_formats) {
   o.format = BB_TEXTURE_FORMAT_BGR8;
   o.map = BB_TEXTURE_MAP_NORMAL;
   o.mips = 0;
-  cr_assert_eq(bb_texture_write(in_dir("n.vtf"), &n, &o, NULL), BB_OK);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &n, &o, NULL), BB_OK);
   size_t size;
-  unsigned char *f = slurp(in_dir("n.vtf"), &size);
+  unsigned char *f = slurp(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 52), 3);
   /* B: 0.5f + 0.5f * 0.8f is 0.89999998f, 229.49999 codes, so 229; G: 0.5
    * exactly, rounded half up to 128; R: 0.8, 204. */
@@ -430,11 +410,11 @@ Test(vtf, texel_formats) {
   free(f);
   bb_image_free(&n);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, same_bytes_for_any_thread_count) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img = pattern(128, 64, 3, 0);
   unsigned char *first = NULL;
   size_t first_size = 0;
@@ -443,9 +423,9 @@ Test(vtf, same_bytes_for_any_thread_count) {
     bb_texture_options_init(&o);
     o.map = BB_TEXTURE_MAP_SSBUMP;
     o.threads = threads;
-    cr_assert_eq(bb_texture_write(in_dir("d.vtf"), &img, &o, NULL), BB_OK);
+    cr_assert_eq(bb_texture_write(in_scratch_dir("d.vtf"), &img, &o, NULL), BB_OK);
     size_t size;
-    unsigned char *f = slurp(in_dir("d.vtf"), &size);
+    unsigned char *f = slurp(in_scratch_dir("d.vtf"), &size);
     if (!first) {
       first = f, first_size = size;
       continue;
@@ -455,7 +435,7 @@ Test(vtf, same_bytes_for_any_thread_count) {
   }
   free(first);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 static void expect_refused(const bb_image *img, bb_texture_map map, bb_texture_format format,
@@ -467,17 +447,17 @@ static void expect_refused(const bb_image *img, bb_texture_map map, bb_texture_f
   o.vtf_version = version;
   o.vtf_flags = flags;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_dir("bad.vtf"), img, &o, &err), BB_ERR_ARGUMENT, "%s",
+  cr_assert_eq(bb_texture_write(in_scratch_dir("bad.vtf"), img, &o, &err), BB_ERR_ARGUMENT, "%s",
                err.message);
   cr_assert_not_null(strstr(err.message, words), "'%s' lacks '%s'", err.message, words);
-  cr_assert_eq(bb_texture_check(in_dir("bad.vtf"), img->width, img->height, img->channels, &o,
+  cr_assert_eq(bb_texture_check(in_scratch_dir("bad.vtf"), img->width, img->height, img->channels, &o,
                                 NULL),
                BB_ERR_ARGUMENT);
-  cr_assert_eq(access(in_dir("bad.vtf"), F_OK), -1, "nothing written");
+  cr_assert_eq(access(in_scratch_dir("bad.vtf"), F_OK), -1, "nothing written");
 }
 
 Test(vtf, usage_errors) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image odd = pattern(96, 80, 3, 0), tiny = pattern(2, 2, 3, 0),
            rgba = pattern(16, 16, 4, 0), ao = pattern(16, 16, 1, 0),
            rgb = pattern(16, 16, 3, 0);
@@ -488,7 +468,7 @@ Test(vtf, usage_errors) {
   bb_texture_options dds;
   bb_texture_options_init(&dds);
   bb_error e6 = {{0}};
-  cr_assert_eq(bb_texture_write(in_dir("six.dds"), &six, &dds, &e6), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("six.dds"), &six, &dds, &e6), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(e6.message, "block compression (bc1) needs sides that are multiples "
                                         "of 4"),
                      "%s", e6.message);
@@ -524,8 +504,8 @@ Test(vtf, usage_errors) {
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGR8;
-  cr_assert_eq(bb_texture_write(in_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
-  cr_assert_eq(bb_texture_write(in_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
   bb_texture_format fmt;
   cr_assert_eq(bb_texture_format_parse("DXT5", &fmt, NULL), BB_OK);
   cr_assert_eq(fmt, BB_TEXTURE_FORMAT_BC3);
@@ -541,24 +521,24 @@ Test(vtf, usage_errors) {
   bb_image_free(&rgba);
   bb_image_free(&ao);
   bb_image_free(&rgb);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, read_info_refuses_broken_files) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   bb_image img = pattern(32, 32, 3, 0);
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.vtf_version = 4;
   o.description = "a=b\n";
-  cr_assert_eq(bb_texture_write(in_dir("g.vtf"), &img, &o, NULL), BB_OK);
+  cr_assert_eq(bb_texture_write(in_scratch_dir("g.vtf"), &img, &o, NULL), BB_OK);
   size_t size;
-  unsigned char *good = slurp(in_dir("g.vtf"), &size);
+  unsigned char *good = slurp(in_scratch_dir("g.vtf"), &size);
   bb_vtf_info info;
   bb_error err = {{0}};
   /* Truncated by one byte: the image data no longer fits. */
-  spill(in_dir("t.vtf"), good, size - 1);
-  cr_assert_eq(bb_vtf_read_info(in_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
+  spill(in_scratch_dir("t.vtf"), good, size - 1);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
   cr_assert_null(info.description);
   /* The low-resolution resource's offset past the end (the image data
@@ -570,8 +550,8 @@ Test(vtf, read_info_refuses_broken_files) {
   const uint32_t past = (uint32_t)size + 100;
   for (int i = 0; i < 4; i++)
     moved[84 + i] = (unsigned char)(past >> (8 * i));
-  spill(in_dir("l.vtf"), moved, size);
-  cr_assert_eq(bb_vtf_read_info(in_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
+  spill(in_scratch_dir("l.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
   char want[160];
   snprintf(want, sizeof want, "low-resolution image (128 bytes at offset %u) ends past the end "
            "of the file (%zu bytes)", past, size);
@@ -580,8 +560,8 @@ Test(vtf, read_info_refuses_broken_files) {
   memcpy(moved, good, size);
   for (int i = 0; i < 4; i++)
     moved[92 + i] = (unsigned char)(past >> (8 * i));
-  spill(in_dir("i.vtf"), moved, size);
-  cr_assert_eq(bb_vtf_read_info(in_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
+  spill(in_scratch_dir("i.vtf"), moved, size);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
   size_t data = 0; /* DXT1, 32 x 32 down to 1 x 1 */
   for (int side = 32; side >= 1; side /= 2)
     data += (size_t)((side + 3) / 4) * (size_t)((side + 3) / 4) * 8;
@@ -590,18 +570,18 @@ Test(vtf, read_info_refuses_broken_files) {
   cr_expect_not_null(strstr(err.message, want), "%s", err.message);
   free(moved);
   /* Not a VTF; a version from the future; a resource count past the header. */
-  spill(in_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
-  cr_assert_eq(bb_vtf_read_info(in_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
+  spill(in_scratch_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
   unsigned char *bad = malloc(size);
   memcpy(bad, good, size);
   bad[8] = 9;
-  spill(in_dir("v.vtf"), bad, size);
-  cr_assert_eq(bb_vtf_read_info(in_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
+  spill(in_scratch_dir("v.vtf"), bad, size);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
   memcpy(bad, good, size);
   bad[68] = 200;
-  spill(in_dir("r.vtf"), bad, size);
-  cr_assert_eq(bb_vtf_read_info(in_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
-  cr_assert_eq(bb_vtf_read_info(in_dir("missing.vtf"), &info, &err), BB_ERR_IO);
+  spill(in_scratch_dir("r.vtf"), bad, size);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("missing.vtf"), &info, &err), BB_ERR_IO);
   /* Every byte of the header and dictionary set to each of 0, 1, 0x7f,
    * 0xff in turn: OK or FORMAT, never a crash or an out-of-bounds read
    * (the sanitized build checks). */
@@ -610,8 +590,8 @@ Test(vtf, read_info_refuses_broken_files) {
     for (int v = 0; v < 4; v++) {
       memcpy(bad, good, size);
       bad[at] = values[v];
-      spill(in_dir("m.vtf"), bad, size);
-      bb_status st = bb_vtf_read_info(in_dir("m.vtf"), &info, &err);
+      spill(in_scratch_dir("m.vtf"), bad, size);
+      bb_status st = bb_vtf_read_info(in_scratch_dir("m.vtf"), &info, &err);
       cr_assert(st == BB_OK || st == BB_ERR_FORMAT, "byte %zu = %d: %s", at, values[v],
                 err.message);
       bb_vtf_info_free(&info);
@@ -619,16 +599,16 @@ Test(vtf, read_info_refuses_broken_files) {
   free(bad);
   free(good);
   bb_image_free(&img);
-  remove_dir();
+  scratch_dir_remove();
 }
 
 Test(vtf, material) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   char materials[160], bump[200], base[200], vmt[200];
-  snprintf(materials, sizeof materials, "%s/game/materials", dir);
-  snprintf(bump, sizeof bump, "%s/game/materials/./wood/wall020_height-ssbump.vtf", dir);
-  snprintf(base, sizeof base, "%s/game/materials/wood/../wood/wall020.vtf", dir);
-  snprintf(vmt, sizeof vmt, "%s/wall020.vmt", dir);
+  snprintf(materials, sizeof materials, "%s/game/materials", scratch_dir);
+  snprintf(bump, sizeof bump, "%s/game/materials/./wood/wall020_height-ssbump.vtf", scratch_dir);
+  snprintf(base, sizeof base, "%s/game/materials/wood/../wood/wall020.vtf", scratch_dir);
+  snprintf(vmt, sizeof vmt, "%s/wall020.vmt", scratch_dir);
   bb_vmt_options o = {materials, bump, base, 1};
   bb_error err = {{0}};
   cr_assert_eq(bb_vmt_write(vmt, &o, &err), BB_OK, "%s", err.message);
@@ -643,55 +623,55 @@ Test(vtf, material) {
   free(text);
   /* A bump map outside the materials, not a VTF, or unquotable: refused. */
   char outside[200];
-  snprintf(outside, sizeof outside, "%s/game/textures/rock.vtf", dir);
+  snprintf(outside, sizeof outside, "%s/game/textures/rock.vtf", scratch_dir);
   bb_vmt_options bad = {materials, outside, NULL, 1};
-  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_vmt_write(in_scratch_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "not inside the materials folder"), "%s", err.message);
-  snprintf(outside, sizeof outside, "%s/game/materials/rock.tga", dir);
-  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  snprintf(outside, sizeof outside, "%s/game/materials/rock.tga", scratch_dir);
+  cr_assert_eq(bb_vmt_write(in_scratch_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "must be a .vtf"), "%s", err.message);
-  snprintf(outside, sizeof outside, "%s/game/materials/a\"b.vtf", dir);
-  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
+  snprintf(outside, sizeof outside, "%s/game/materials/a\"b.vtf", scratch_dir);
+  cr_assert_eq(bb_vmt_write(in_scratch_dir("x.vmt"), &bad, &err), BB_ERR_ARGUMENT);
   bb_vmt_options none = {materials, NULL, NULL, 1};
-  cr_assert_eq(bb_vmt_write(in_dir("x.vmt"), &none, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(access(in_dir("x.vmt"), F_OK), -1);
-  remove_dir();
+  cr_assert_eq(bb_vmt_write(in_scratch_dir("x.vmt"), &none, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(access(in_scratch_dir("x.vmt"), F_OK), -1);
+  scratch_dir_remove();
 }
 
 /* bb_vmt_write (what Python's write_vmt calls) turned the texture it names
  * into a 103-byte material, and overwrote a PNG: a material's name ends in
  * .vmt and is no other name of a texture it names, as for bake --vmt. */
 Test(vtf, a_material_never_overwrites_a_texture_or_another_file) {
-  make_dir();
+  scratch_dir_make("bb_vtf");
   char materials[160], bump[200], alias[200];
-  snprintf(materials, sizeof materials, "%s/materials", dir);
+  snprintf(materials, sizeof materials, "%s/materials", scratch_dir);
   cr_assert_eq(mkdir(materials, 0755), 0);
-  snprintf(bump, sizeof bump, "%s/materials/s.vtf", dir);
-  snprintf(alias, sizeof alias, "%s/materials/s.vmt", dir);
+  snprintf(bump, sizeof bump, "%s/materials/s.vtf", scratch_dir);
+  snprintf(alias, sizeof alias, "%s/materials/s.vmt", scratch_dir);
   spill(bump, (const unsigned char *)"VTF\0 texture", 12);
-  spill(in_dir("x.png"), (const unsigned char *)"png bytes", 9);
+  spill(in_scratch_dir("x.png"), (const unsigned char *)"png bytes", 9);
   bb_vmt_options o = {NULL, bump, NULL, 1};
   bb_error err = {{0}};
   cr_expect_eq(bb_vmt_write(bump, &o, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "ends in .vmt"), "%s", err.message);
-  cr_expect_eq(bb_vmt_write(in_dir("x.png"), &o, &err), BB_ERR_ARGUMENT);
-  cr_expect_eq(bb_vmt_write(in_dir("x.VMT.png"), &o, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_vmt_write(in_scratch_dir("x.png"), &o, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_vmt_write(in_scratch_dir("x.VMT.png"), &o, &err), BB_ERR_ARGUMENT);
   /* s.vmt a hard link of the texture: the same file under a .vmt name. */
   cr_assert_eq(link(bump, alias), 0);
   cr_expect_eq(bb_vmt_write(alias, &o, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "would overwrite the texture"), "%s", err.message);
-  bb_vmt_options base = {NULL, in_dir("materials/t.vtf"), bump, 1};
+  bb_vmt_options base = {NULL, in_scratch_dir("materials/t.vtf"), bump, 1};
   cr_expect_eq(bb_vmt_write(alias, &base, &err), BB_ERR_ARGUMENT);
   size_t size;
   unsigned char *bytes = slurp(bump, &size);
   cr_expect(size == 12 && memcmp(bytes, "VTF\0 texture", 12) == 0, "the texture was changed");
   free(bytes);
-  bytes = slurp(in_dir("x.png"), &size);
+  bytes = slurp(in_scratch_dir("x.png"), &size);
   cr_expect(size == 9 && memcmp(bytes, "png bytes", 9) == 0, "the PNG was changed");
   free(bytes);
   /* Upper case is a .vmt too. */
-  cr_expect_eq(bb_vmt_write(in_dir("materials/M.VMT"), &o, &err), BB_OK, "%s", err.message);
-  remove_dir();
+  cr_expect_eq(bb_vmt_write(in_scratch_dir("materials/M.VMT"), &o, &err), BB_OK, "%s", err.message);
+  scratch_dir_remove();
 }
 
 /* --vtf-version and --vtf-flags as the library reads them for every client. */
