@@ -53,7 +53,9 @@ static int refused(const parse *p, bb_status st, const bb_error *err) {
     return p->usage;
   }
   cli_error_line(err->message[0] ? err->message : bb_status_name(st));
-  return BB_EXIT_FAILURE;
+  /* compare's 1 is a verdict (a warning, as idiff's): every refusal of
+   * compare is its usage exit, 4, as a file it cannot read is. */
+  return p->usage == BB_EXIT_USAGE ? BB_EXIT_FAILURE : p->usage;
 }
 
 static void leave_out(parse *p, int from, int to) {

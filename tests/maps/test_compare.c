@@ -426,6 +426,15 @@ Test(compare_cli, unreadable_file_or_bad_arguments_exit_4) {
   }
 }
 
+/* A diff that would overwrite a compared file is refused before anything
+ * is read: exit 4 as every other refusal of compare (1 is a warning). */
+Test(compare_cli, a_diff_over_an_input_exits_4) {
+  const char *a = ramp_with("a.exr", 0, 0), *b = ramp_with("b.exr", 0, 0);
+  char out[4096];
+  cr_assert_eq(run(out, sizeof out, "compare %s %s --diff %s", a, b, a), 4, "%s", out);
+  cr_assert_not_null(strstr(out, "would overwrite the input"), "%s", out);
+}
+
 /* A file over the size limit cannot be read: idiff's 4, as for any file
  * that cannot be read, not 3 ("different size"), which bumpbake gave for
  * a 65535 x 65535 PNG header, an oversize DDS, a TIFF of huge tiles and
