@@ -1042,7 +1042,10 @@ struct bb_trace_options {
                            else only these texels, by max-mip marches */
   bb_progress_fn progress; /* may be NULL; called from one thread as the
                               work goes (per slice, or every 50 ms); a
-                              nonzero return cancels */
+                              nonzero return cancels. In bb_bake also
+                              with done 0 and total 0 (a checkpoint, no
+                              progress) every 50 ms while it smooths and
+                              makes normals, so those stages cancel too */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls

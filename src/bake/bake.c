@@ -187,7 +187,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     bb_image_free(&r->vis);
   if (st == BB_OK && normal_later)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
-                             o->smooth.addressing, threads, &r->normal, err);
+                             o->smooth.addressing, threads, NULL, &r->normal, err);
   if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
     bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_BENT)))
@@ -203,7 +203,11 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
                                     int threads, int take_height, bb_bake_result *r,
                                     bb_error *err) {
   double t0 = bb__now_seconds();
-  bb_status st = bb__smooth_bilateral(height, height, &o->smooth, threads, &r->filtered, err);
+  /* Neither stage reports progress; both are cancel points (Ctrl-C in
+   * Python, a newer save in serve): a large map smooths for seconds. */
+  const bb__checkpoint checkpoint = {o->trace.progress, o->trace.progress_user};
+  bb_status st =
+      bb__smooth_bilateral(height, height, &o->smooth, threads, &checkpoint, &r->filtered, err);
   if (take_height) /* smoothed: the bake reads only its own maps from now on */
     bb_image_free((bb_image *)height);
   double t1 = bb__now_seconds();
@@ -213,7 +217,7 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
                           !wants(o, BB_OUTPUTS_TRACED));
   if (st == BB_OK && normal_now)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
-                             o->smooth.addressing, threads, &r->normal, err);
+                             o->smooth.addressing, threads, &checkpoint, &r->normal, err);
   if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)))
     st = bb__derive_weights(&r->normal, &o->basis, threads, &r->weights, err);
   r->seconds_derive = bb__now_seconds() - t1;

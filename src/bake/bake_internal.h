@@ -11,11 +11,11 @@
  * Every stage splits its work into items whose results do not depend on
  * the split, so any thread count gives the same bits. */
 bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
-                               const bb_smooth_options *o, int threads, bb_image *out,
-                               bb_error *err);
+                               const bb_smooth_options *o, int threads,
+                               const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
 bb_status bb__normals_compute(const bb_image *height, float height_scale,
                               bb_normal_filter filter, bb_addressing addressing, int threads,
-                              bb_image *out, bb_error *err);
+                              const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
 /* Rows y0 .. y1-1 of bb__normals_compute's normals of height (finite
  * heights; the same bits), into rows: (y1 - y0) x width x 3 floats. For a
  * stage that needs the normals a band at a time, without the whole image. */

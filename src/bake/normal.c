@@ -284,12 +284,12 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
 bb_status bb_normals_compute(const bb_image *height, float height_scale,
                              bb_normal_filter filter, bb_addressing addressing,
                              bb_image *out, bb_error *err) {
-  return bb__normals_compute(height, height_scale, filter, addressing, 0, out, err);
+  return bb__normals_compute(height, height_scale, filter, addressing, 0, NULL, out, err);
 }
 
 bb_status bb__normals_compute(const bb_image *height, float height_scale,
                               bb_normal_filter filter, bb_addressing addressing, int threads,
-                              bb_image *out, bb_error *err) {
+                              const bb__checkpoint *checkpoint, bb_image *out, bb_error *err) {
   bb_status st = check_arguments(height, height_scale, filter, addressing, out, err);
   if (st != BB_OK)
     return st;
@@ -298,7 +298,7 @@ bb_status bb__normals_compute(const bb_image *height, float height_scale,
     return st;
   normal_job job = {height, (double)height_scale, filter, addressing, out, 0};
   const int bands = height->height / BAND_ROWS + (height->height % BAND_ROWS != 0);
-  st = bb__parallel_for(bands, threads, normal_band, &job, NULL, NULL, err);
+  st = bb__parallel_for_checked(bands, threads, normal_band, &job, checkpoint, err);
   if (st != BB_OK)
     bb_image_free(out);
   return st;

@@ -248,12 +248,12 @@ static bb_status copy_image(const bb_image *in, bb_image *out, bb_error *err) {
 
 bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
                               const bb_smooth_options *o, bb_image *out, bb_error *err) {
-  return bb__smooth_bilateral(in, guide, o, 0, out, err);
+  return bb__smooth_bilateral(in, guide, o, 0, NULL, out, err);
 }
 
 bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
-                               const bb_smooth_options *o, int threads, bb_image *out,
-                               bb_error *err) {
+                               const bb_smooth_options *o, int threads,
+                               const bb__checkpoint *checkpoint, bb_image *out, bb_error *err) {
   bb_status st = check_arguments(in, guide, o, out, err);
   if (st != BB_OK)
     return st;
@@ -277,7 +277,7 @@ bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
   if (st == BB_OK) {
     smooth_job job = {in,    guide, out, &kernel, (double)o->threshold, o->addressing,
                       column};
-    st = bb__parallel_for(in->height, threads, smooth_row, &job, NULL, NULL, err);
+    st = bb__parallel_for_checked(in->height, threads, smooth_row, &job, checkpoint, err);
     if (st != BB_OK)
       bb_image_free(out);
   }

@@ -28,7 +28,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *giv
   /* bb_bake's stages, with its operations: smooth, then z = scale * h in
    * float, then the pyramid of z */
   bb_image filtered = {0}, z = {0};
-  st = bb__smooth_bilateral(height, height, &o->smooth, threads, &filtered, err);
+  st = bb__smooth_bilateral(height, height, &o->smooth, threads, NULL, &filtered, err);
   if (st == BB_OK) st = bb_image_alloc(&z, filtered.width, filtered.height, 1, err);
   if (st == BB_OK) {
     const size_t n = (size_t)z.width * (size_t)z.height;

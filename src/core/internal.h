@@ -109,6 +109,18 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
                            bb_progress_fn progress, void *progress_user,
                            bb_error *err);
 
+/* A cancel point for a stage that reports no progress of its own (smooth,
+ * normals): the caller's progress called with done 0 and total 0 ("a
+ * checkpoint", bumpbake.h) from the calling thread every 50 ms while the
+ * stage runs; a nonzero return cancels it as bb__parallel_for does. A NULL
+ * checkpoint, or one without fn, is bb__parallel_for without progress. */
+typedef struct bb__checkpoint {
+  bb_progress_fn fn;
+  void *user;
+} bb__checkpoint;
+bb_status bb__parallel_for_checked(int items, int threads, bb__work_fn fn, void *user,
+                                   const bb__checkpoint *checkpoint, bb_error *err);
+
 /* 64-bit FNV-1a: the hash of an empty input, and one step over the four
  * bytes of v, little-endian whatever the host (so hashes recorded on one
  * machine check on another). For bb_image_hash and bb_mesh_hash (hash.c). */

@@ -76,3 +76,16 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
     return bb__fail(err, BB_ERR_CANCELLED, "cancelled by the progress callback");
   return BB_OK;
 }
+
+static int checkpoint_poll(void *user, long done, long total) {
+  const bb__checkpoint *checkpoint = user;
+  (void)done, (void)total;
+  return checkpoint->fn(checkpoint->user, 0, 0);
+}
+
+bb_status bb__parallel_for_checked(int items, int threads, bb__work_fn fn, void *user,
+                                   const bb__checkpoint *checkpoint, bb_error *err) {
+  if (!checkpoint || !checkpoint->fn)
+    return bb__parallel_for(items, threads, fn, user, NULL, NULL, err);
+  return bb__parallel_for(items, threads, fn, user, checkpoint_poll, (void *)checkpoint, err);
+}

@@ -381,6 +381,32 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
   bb_image_free(&h);
 }
 
+/* Smoothing and normals report no progress but are cancel points: a bake
+ * of the normal map alone (no trace) calls the callback with (0, 0), a
+ * checkpoint, and stops when it says so. */
+Test(bake, smoothing_and_normals_are_cancel_points) {
+  bb_image h = harness_field(64, 48, 0.0f);
+  noise_field(&h, 5);
+  bb_bake_options o;
+  bb_bake_options_init(&o);
+  o.height_scale = 8.0f;
+  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL);
+  cancel_state go = {0, -1, -1, -1};
+  o.trace.progress = cancel_after;
+  o.trace.progress_user = &go;
+  bb_bake_result r = harness_bake(&h, &o);
+  cr_assert_eq(go.last_done, 0);
+  cr_assert_eq(go.last_total, 0, "a checkpoint, not progress");
+  bb_bake_result_free(&r);
+  cancel_state stop = {0, 0, -1, -1};
+  o.trace.progress_user = &stop;
+  bb_error err;
+  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_CANCELLED);
+  cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
+  cr_assert_null(r.normal.pixels);
+  bb_image_free(&h);
+}
+
 /* A region is traced by marches on the thread pool, which polls the
  * callback; cancelling there stops the workers and returns no image. */
 Test(bake, progress_callback_cancels_a_region_trace) {
