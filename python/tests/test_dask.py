@@ -548,3 +548,44 @@ def test_a_forced_batch_with_a_depfile_is_baked_once(tmp_path, monkeypatch, clie
     assert [r.status for r in reports] == ["baked"] * 3
     assert on_the_client == ["up to date"] * 3
     assert open("out.d").read().count(": heights/h0") == 3
+
+
+def test_the_command_lines_forced_batch_with_a_depfile_is_baked_once(tmp_path, monkeypatch,
+                                                                     client):
+    """The same for `bumpbake bake --scheduler --force --depfile`: the
+    client's depfile job is the handed-over command without --force (a
+    flag set to "0"), so it finds each input the workers baked up to date
+    rather than baking it again."""
+    from bumpbake._common import _check, _ffi, _lib
+    from bumpbake.dask._command import Command
+    monkeypatch.chdir(tmp_path)
+    heights("heights", 3)
+    err = _ffi.new("bb_error *")
+    out = _ffi.new("bb_command **")
+    _check(_lib.bb_command_new(b"bake", out, err), err)
+    c = _ffi.gc(out[0], _lib.bb_command_free)
+    for name, text in {"scale": str(SCALE), "slices": "4", "out-dir": "out", "maps": "ao",
+                       "force": None, "depfile": "out.d"}.items():
+        _check(_lib.bb_command_set(c, name.encode(), text.encode() if text else _ffi.NULL,
+                                   err), err)
+    _check(_lib.bb_command_add_input(c, b"heights", err), err)
+    _check(_lib.bb_command_set_record(c, b"bumpbake bake heights", b"", err), err)
+    _check(_lib.bb_command_check(c, err), err)
+    size = _ffi.new("size_t *")
+    data = _lib.bb_command_handover(c, size)
+    handed = bytes(_ffi.buffer(data, size[0]))
+    _lib.free(data)
+    on_the_client = []
+    run = bumpbake.BakeJob.run
+
+    def counted(self, i, progress=None):
+        report = run(self, i, progress)
+        on_the_client.append(report.status)
+        return report
+
+    monkeypatch.setattr(bumpbake.BakeJob, "run", counted)
+    reports = bumpbake.dask.bake_files(None, None, client=client, check=False, notes="ignore",
+                                       _command=Command(handed), _ask_notes=False)
+    assert [r.status for r in reports] == ["baked"] * 3
+    assert on_the_client == ["up to date"] * 3
+    assert open("out.d").read().count(": heights/h0") == 3

@@ -257,9 +257,10 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
         # The client's job learns what the workers made: each baked input is
         # now up to date (its bytes hashed, its outputs' headers read). A
         # forced job would bake it again here: that one is planned unforced.
-        # (Not yet for the CLI's command: the library's flags take no "0".)
         depjob = job
-        if force and _command is None:
+        if force and _command is not None:
+            depjob = CommandJob(_command.data, notes="ignore", unforced=True)
+        elif force:
             depjob = BakeJob(job.inputs, out_dir, maps=maps, name=name, keep_going=keep_going,
                              depfile=depfile, notes="ignore", command_options=command_options,
                              **options)

@@ -62,13 +62,18 @@ class CommandJob(BakeJob):
     from keyword arguments: the library reads every option. Runs, reports
     and notes as BakeJob's."""
 
-    def __init__(self, data, inputs=None, *, notes="warn", threads=None, _trace=None):
+    def __init__(self, data, inputs=None, *, notes="warn", threads=None, unforced=False,
+                 _trace=None):
         self._notes_policy = _check_notes(notes)
         self._trace = _trace
         self._data = bytes(data)
         self._command = Command(data, inputs)
         if threads is not None:  # the library's threads per bake, unless --threads
             self._command.default("threads", str(threads))
+        if unforced:  # the command without --force (a flag set to "0" is unset)
+            err = _ffi.new("bb_error *")
+            _check(_lib.bb_command_set(self._command.c, b"force", b"0", err), err)
+            _check(_lib.bb_command_check(self._command.c, err), err)
         job = self._command.options.job
         self._args = dict(out_dir=self._command.text("out_dir"), keep_going=bool(job.keep_going),
                           force=bool(job.force), depfile=self._command.text("depfile"))
