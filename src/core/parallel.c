@@ -26,6 +26,11 @@ typedef struct work_queue {
   int items;
   atomic_int next;
   atomic_long done;
+  /* The worker that ends the last item wakes the polling caller at once,
+   * rather than at its next 50 ms tick (a stage's end, late by up to 50 ms,
+   * is time a serve re-bake waits). */
+  pthread_mutex_t lock;
+  pthread_cond_t finished;
 } work_queue;
 
 static void *worker(void *arg) {
@@ -34,15 +39,36 @@ static void *worker(void *arg) {
     int item = atomic_fetch_add(&q->next, 1);
     if (item >= q->items) break;
     q->fn(q->user, item);
-    atomic_fetch_add(&q->done, 1);
+    if (atomic_fetch_add(&q->done, 1) + 1 == q->items) {
+      pthread_mutex_lock(&q->lock);
+      pthread_cond_broadcast(&q->finished);
+      pthread_mutex_unlock(&q->lock);
+    }
   }
   return NULL;
+}
+
+/* Waits until every item is done or 50 ms have passed. */
+static void wait_a_tick(work_queue *q) {
+  struct timespec until;
+  clock_gettime(CLOCK_REALTIME, &until);
+  until.tv_nsec += 50 * 1000 * 1000;
+  if (until.tv_nsec >= 1000 * 1000 * 1000) {
+    until.tv_sec++;
+    until.tv_nsec -= 1000 * 1000 * 1000;
+  }
+  pthread_mutex_lock(&q->lock);
+  while (atomic_load(&q->done) < q->items)
+    if (pthread_cond_timedwait(&q->finished, &q->lock, &until) != 0)
+      break; /* the tick: ask the progress again */
+  pthread_mutex_unlock(&q->lock);
 }
 
 bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
                            bb_progress_fn progress, void *progress_user,
                            bb_error *err) {
-  work_queue q = {.fn = fn, .user = user, .items = items};
+  work_queue q = {.fn = fn, .user = user, .items = items, .lock = PTHREAD_MUTEX_INITIALIZER,
+                  .finished = PTHREAD_COND_INITIALIZER};
   atomic_init(&q.next, 0);
   atomic_init(&q.done, 0);
   int n = bb__thread_count(threads);
@@ -66,11 +92,12 @@ bb_status bb__parallel_for(int items, int threads, bb__work_fn fn, void *user,
         atomic_store(&q.next, items); /* no new items; those running finish */
         break;
       }
-      struct timespec ts = {0, 50 * 1000 * 1000};
-      nanosleep(&ts, NULL);
+      wait_a_tick(&q);
     }
   }
   for (int i = 0; i < started; i++) pthread_join(tids[i], NULL);
+  pthread_cond_destroy(&q.finished);
+  pthread_mutex_destroy(&q.lock);
   if (!cancelled && progress) cancelled = progress(progress_user, items, items) != 0;
   if (cancelled)
     return bb__fail(err, BB_ERR_CANCELLED, "cancelled by the progress callback");
