@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "bake/bake_internal.h"
+#include "file_bytes.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -149,20 +150,6 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
   }
   bb_bake_result_free(&kept);
   bb_job_free(job);
-}
-
-/* A file's bytes (size in *size), malloc'd. */
-static unsigned char *file_bytes(const char *path, size_t *size) {
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc((size_t)n + 1);
-  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
-  fclose(f);
-  *size = (size_t)n;
-  return data;
 }
 
 /* bb_job_write_item (serve's "write"): the files of the maps bake_item

@@ -9,6 +9,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "file_bytes.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -16,20 +17,6 @@
 #include <string.h>
 
 TestSuite(write_threads, .init = harness_setup, .fini = harness_teardown, .timeout = 120);
-
-static unsigned char *slurp(const char *path, size_t *size) {
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc((size_t)n + 1);
-  cr_assert_not_null(data);
-  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
-  fclose(f);
-  *size = (size_t)n;
-  return data;
-}
 
 /* 256 x 256 texels of waves and a little hash noise, so that every chunk
  * and block differs and compresses differently; channels 1 or 3; signed
@@ -112,7 +99,7 @@ Test(write_threads, same_bytes_on_any_thread_count) {
     cr_assert_eq(bb_outputs_write(files, FILES, threads, &err), BB_OK, "%s", err.message);
     for (int i = 0; i < FILES; i++) {
       size_t size;
-      unsigned char *bytes = slurp(paths[i], &size);
+      unsigned char *bytes = file_bytes(paths[i], &size);
       if (threads == 1) {
         first[i] = bytes, first_size[i] = size;
         continue;

@@ -23,6 +23,7 @@
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
+#include "file_bytes.h"
 
 static const char *golden(const char *name) {
   static char path[512];
@@ -36,19 +37,6 @@ static bb_image read_golden(const char *name) {
   bb_error err = {{0}};
   cr_assert_eq(bb_image_read(golden(name), &img, NULL, &err), BB_OK, "%s", err.message);
   return img;
-}
-
-static unsigned char *slurp(const char *path, size_t *size) {
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc((size_t)n);
-  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
-  fclose(f);
-  *size = (size_t)n;
-  return data;
 }
 
 /* Worst and rms error (8-bit codes) of decoded against ref's channels, each
@@ -211,7 +199,7 @@ Test(dds, headers) {
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
-    unsigned char *f = slurp(path, &size);
+    unsigned char *f = file_bytes(path, &size);
     const int block = want[c].format <= BB_TEXTURE_FORMAT_BC5;
     const int dx10 = want[c].dxgi != 0;
     cr_assert_eq(memcmp(f, "DDS ", 4), 0);
@@ -273,7 +261,7 @@ Test(dds, float_formats_hold_the_values) {
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
-    unsigned char *f = slurp(path, &size);
+    unsigned char *f = file_bytes(path, &size);
     const unsigned char *p = f + 148;
     for (int k = 0; k < count; k++) {
       const bb_image *l = &chain[k];
@@ -321,7 +309,7 @@ Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
   cr_assert_eq(bb_texture_write(dds, &img, &o, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_texture_write(vtf, &img, &o, &err), BB_OK, "%s", err.message);
   size_t dsize, vsize;
-  unsigned char *d = slurp(dds, &dsize), *v = slurp(vtf, &vsize);
+  unsigned char *d = file_bytes(dds, &dsize), *v = file_bytes(vtf, &vsize);
   int w, h;
   size_t at = oracle_vtf_level_offset(v, vsize, 0, &w, &h);
   cr_assert(at > 0 && w == 128 && h == 128);
@@ -365,7 +353,7 @@ Test(dds, same_bytes_for_any_thread_count) {
     snprintf(path, sizeof path, "%s/t%d.dds", scratch_dir, threads);
     cr_assert_eq(bb_texture_write(path, &img, &o, NULL), BB_OK);
     size_t size;
-    unsigned char *f = slurp(path, &size);
+    unsigned char *f = file_bytes(path, &size);
     if (!first) {
       first = f, first_size = size;
     } else {

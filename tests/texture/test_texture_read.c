@@ -27,30 +27,11 @@
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
+#include "file_bytes.h"
 
 static void make_scratch_dir(void) { scratch_dir_make("bb_texread"); }
 
 TestSuite(texture_read, .init = make_scratch_dir, .fini = scratch_dir_remove);
-
-static unsigned char *slurp(const char *path, size_t *size) {
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc((size_t)n + 1);
-  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
-  fclose(f);
-  *size = (size_t)n;
-  return data;
-}
-
-static void spill(const char *path, const unsigned char *data, size_t size) {
-  FILE *f = fopen(path, "wb");
-  cr_assert_not_null(f);
-  cr_assert_eq(fwrite(data, 1, size, f), size);
-  cr_assert_eq(fclose(f), 0);
-}
 
 static void put_u16(unsigned char *p, unsigned v) {
   p[0] = (unsigned char)(v & 0xff);
@@ -126,7 +107,7 @@ Test(texture_read, vtf_every_format_version_and_level) {
         bb_error err = {{0}};
         cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
         size_t size;
-        unsigned char *file = slurp(path, &size);
+        unsigned char *file = file_bytes(path, &size);
         const int want_levels = mips ? 6 : 1; /* 32 x 16 down to 1 x 1 */
         for (int level = 0; level < want_levels; level++) {
           bb_image got;
@@ -271,7 +252,7 @@ static unsigned char *valid_vtf(int minor, size_t *size) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
-  return slurp(path, size);
+  return file_bytes(path, size);
 }
 
 Test(texture_read, hostile_vtf_headers) {
@@ -284,7 +265,7 @@ Test(texture_read, hostile_vtf_headers) {
   do {                                                                                         \
     memcpy(f, base, size);                                                                     \
     edit;                                                                                      \
-    spill(path, f, size);                                                                      \
+    file_bytes_write(path, f, size);                                                                      \
     expect_refused(path, what);                                                                \
   } while (0)
   CASE("unread format (P8)", put_u32(f + 52, 7));
@@ -299,11 +280,11 @@ Test(texture_read, hostile_vtf_headers) {
   CASE("65535 x 65535 RGBA32323232F", (f[16] = f[17] = f[18] = f[19] = 0xff, put_u32(f + 52, 29), f[56] = 1));
   CASE("64 frames", f[24] = 64);
   /* The last level (the largest, written last) cut short by one byte. */
-  spill(path, v2, size - 1);
+  file_bytes_write(path, v2, size - 1);
   expect_refused(path, "truncated last level");
-  spill(path, v2, 40);
+  file_bytes_write(path, v2, 40);
   expect_refused(path, "truncated header");
-  spill(path, (const unsigned char *)"not a texture at all, not at all", 33);
+  file_bytes_write(path, (const unsigned char *)"not a texture at all, not at all", 33);
   expect_refused(path, "not a VTF");
   free(v2);
   free(f);
@@ -312,7 +293,7 @@ Test(texture_read, hostile_vtf_headers) {
   unsigned char *v3 = valid_vtf(3, &size);
   f = malloc(size);
   memcpy(f, v3, size);
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   bb_image ok;
   bb_error err = {{0}};
   cr_assert_eq(bb_image_read(path, &ok, NULL, &err), BB_OK, "%s", err.message);
@@ -343,7 +324,7 @@ Test(texture_read, vtf_declared_size_product_does_not_wrap) {
   f[56] = 1;              /* one level */
   put_u16(f + 63, 32768); /* depth */
   const char *path = in_scratch_dir("wraps.vtf");
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   bb_vtf_info info;
   bb_error err = {{0}};
   cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
@@ -353,7 +334,7 @@ Test(texture_read, vtf_declared_size_product_does_not_wrap) {
   expect_refused(path, "declared size wrapping to 0");
   /* one frame of the same is refused too, by the plain check */
   put_u16(f + 24, 1);
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
   free(f);
 }
@@ -374,7 +355,7 @@ Test(texture_read, hostile_sizes_are_refused_before_allocating) {
   put_u32(h + 57, 0xffffffffu); /* no low-resolution image */
   h[63] = 1;
   const char *path = in_scratch_dir("huge.vtf");
-  spill(path, h, 80);
+  file_bytes_write(path, h, 80);
   cr_assert_eq(truncate(path, 80 + 65535LL * 65535LL), 0);
   expect_refused(path, "65535 x 65535 VTF");
   bb_image img;
@@ -395,7 +376,7 @@ Test(texture_read, hostile_sizes_are_refused_before_allocating) {
   put_u32(h + 132, 3);
   put_u32(h + 140, 1);
   path = in_scratch_dir("huge.dds");
-  spill(path, h, 148);
+  file_bytes_write(path, h, 148);
   cr_assert_eq(truncate(path, 148 + 65536LL * 65536LL), 0);
   cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_ERR_SIZE, "%s", err.message);
   cr_assert_not_null(strstr(err.message, "over the maximum"), "%s", err.message);
@@ -411,14 +392,14 @@ Test(texture_read, hostile_dx10_dds_headers) {
   cr_assert_eq(bb_texture_write(valid, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   size_t size;
-  unsigned char *v = slurp(valid, &size);
+  unsigned char *v = file_bytes(valid, &size);
   unsigned char *f = malloc(size);
   const char *path = in_scratch_dir("bad.dds");
 #define CASE(what, edit)                                                                       \
   do {                                                                                         \
     memcpy(f, v, size);                                                                        \
     edit;                                                                                      \
-    spill(path, f, size);                                                                      \
+    file_bytes_write(path, f, size);                                                                      \
     expect_refused(path, what);                                                                \
   } while (0)
   CASE("width 2^31", put_u32(f + 16, 0x80000000u));
@@ -430,9 +411,9 @@ Test(texture_read, hostile_dx10_dds_headers) {
   CASE("depth 2", put_u32(f + 24, 2));
   CASE("larger than the file", (put_u32(f + 12, 64), put_u32(f + 16, 64)));
 #undef CASE
-  spill(path, v, size - 1);
+  file_bytes_write(path, v, size - 1);
   expect_refused(path, "truncated last level");
-  spill(path, v, 100);
+  file_bytes_write(path, v, 100);
   expect_refused(path, "truncated header");
   free(v);
   free(f);
@@ -451,7 +432,7 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   size_t size;
-  unsigned char *f = slurp(path, &size);
+  unsigned char *f = file_bytes(path, &size);
   int levels = 0;
   bb_image level;
   cr_assert_eq(bb_image_read_mip(path, 4, &level, NULL, &levels, &err), BB_OK, "%s",
@@ -459,7 +440,7 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   cr_assert(levels == 5 && level.width == 1 && level.height == 1);
   bb_image_free(&level);
   put_u32(f + 28, 65029);
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   expect_refused(path, "65029 mip levels");
   cr_assert_eq(bb_image_read_info(path, NULL, NULL, NULL, NULL, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "65029 mip levels"), "%s", err.message);
@@ -510,7 +491,7 @@ Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
     for (int frames = 1; frames <= 3; frames += 2) {
       size_t size;
       unsigned char *f = layered_vtf(minor, frames, &size);
-      spill(path, f, size);
+      file_bytes_write(path, f, size);
       for (int k = 0; k < 4; k++) {
         bb_image img;
         int levels = 0;
@@ -528,7 +509,7 @@ Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
         bb_image_free(&img);
       }
       /* The last frame of the top level cut short: refused. */
-      spill(path, f, size - 1);
+      file_bytes_write(path, f, size - 1);
       expect_refused(path, "truncated last frame");
       free(f);
     }
@@ -568,7 +549,7 @@ Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
   size_t size;
   for (int k = 0; k < 2; k++) {
     unsigned char *f = legacy_dds(16, 16, 0x4, k ? "DXT4" : "DXT2", 0, NULL, 16 * 16, &size);
-    spill(path, f, size);
+    file_bytes_write(path, f, size);
     bb_image img;
     bb_error err = {{0}};
     cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
@@ -595,7 +576,7 @@ Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     unsigned char *f =
         legacy_dds(16, 16, cases[k].flags, NULL, cases[k].bits, cases[k].masks, 16 * 16 * 4, &size);
-    spill(path, f, size);
+    file_bytes_write(path, f, size);
     if (cases[k].ok) {
       bb_image img;
       bb_error err = {{0}};
@@ -616,13 +597,13 @@ Test(texture_read, legacy_dds_headers_openimageio_crashed_or_hung_on) {
     free(f);
   }
   unsigned char *f = legacy_dds(16, 16, 0x4, "BC7X", 0, NULL, 256, &size);
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   expect_refused(path, "unknown FourCC");
   free(f);
   /* A DDS under another name is still read by bumpbake's reader. */
   f = legacy_dds(16, 16, 0x4, "DXT1", 0, NULL, 128, &size);
   path = in_scratch_dir("really_a_dds.png");
-  spill(path, f, size);
+  file_bytes_write(path, f, size);
   bb_image img;
   bb_image_info info;
   bb_error err = {{0}};

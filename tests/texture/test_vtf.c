@@ -19,26 +19,7 @@
 #include "texture/blocks.h"
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
-
-static unsigned char *slurp(const char *path, size_t *size) {
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc((size_t)n + 1);
-  cr_assert_eq(fread(data, 1, (size_t)n, f), (size_t)n);
-  fclose(f);
-  *size = (size_t)n;
-  return data;
-}
-
-static void spill(const char *path, const unsigned char *data, size_t size) {
-  FILE *f = fopen(path, "wb");
-  cr_assert_not_null(f);
-  cr_assert_eq(fwrite(data, 1, size, f), size);
-  cr_assert_eq(fclose(f), 0);
-}
+#include "file_bytes.h"
 
 /* A map of w x h in [0, 1]: waves, different in each channel (normal 0);
  * a field of unit normals leaning with the waves (1); or waves whose
@@ -97,7 +78,7 @@ Test(vtf, header_byte_for_byte_7_2) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
+  unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
   cr_assert_eq(memcmp(f, "VTF\0", 4), 0, "magic");
   cr_assert_eq(oracle_u32(f + 4), 7, "major version");
   cr_assert_eq(oracle_u32(f + 8), 2, "minor version");
@@ -167,7 +148,7 @@ Test(vtf, resources_7_3_hold_the_provenance) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_scratch_dir("n.vtf"), &size);
+  unsigned char *f = file_bytes(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 8), 3);
   cr_assert_eq(oracle_u32(f + 12), 80 + 3 * 8, "header size with 3 resources");
   cr_assert_eq(oracle_u32(f + 20), 0x80u, "flags: NORMAL");
@@ -215,7 +196,7 @@ Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
+  unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
   bb_image *chain = NULL;
   int count = 0;
   cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &count, NULL), BB_OK);
@@ -288,7 +269,7 @@ Test(vtf, flags_from_the_map_and_the_caller) {
     cr_assert_eq(bb_texture_write(in_scratch_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
                  err.message);
     size_t size;
-    unsigned char *f = slurp(in_scratch_dir("f.vtf"), &size);
+    unsigned char *f = file_bytes(in_scratch_dir("f.vtf"), &size);
     cr_assert_eq(oracle_u32(f + 20), cases[c].want, "case %zu: flags 0x%08x, want 0x%08x", c,
                  oracle_u32(f + 20), cases[c].want);
     cr_assert_eq(f[56], cases[c].mips ? 5 : 1, "case %zu: mip count", c);
@@ -323,7 +304,7 @@ Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
     cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
                  err.message);
     size_t size;
-    unsigned char *f = slurp(in_scratch_dir("s.vtf"), &size);
+    unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
     /* Every level a whole number of blocks; the low-res image (the top
      * level itself, at most 16 x 16) too. */
     const size_t low = (size_t)((w + 3) / 4) * (size_t)((h + 3) / 4) * 8;
@@ -378,7 +359,7 @@ Test(vtf, texel_formats) {
     bb_error err = {{0}};
     cr_assert_eq(bb_texture_write(in_scratch_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
-    unsigned char *f = slurp(in_scratch_dir("t.vtf"), &size);
+    unsigned char *f = file_bytes(in_scratch_dir("t.vtf"), &size);
     cr_assert_eq(oracle_u32(f + 52), (uint32_t)cases[c].code);
     cr_assert_eq(size, 80 + 8 + cases[c].top, "header, 4 x 4 low-res DXT1, one level");
     const unsigned char *t = f + 88;
@@ -402,7 +383,7 @@ Test(vtf, texel_formats) {
   o.mips = 0;
   cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &n, &o, NULL), BB_OK);
   size_t size;
-  unsigned char *f = slurp(in_scratch_dir("n.vtf"), &size);
+  unsigned char *f = file_bytes(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 52), 3);
   /* B: 0.5f + 0.5f * 0.8f is 0.89999998f, 229.49999 codes, so 229; G: 0.5
    * exactly, rounded half up to 128; R: 0.8, 204. */
@@ -425,7 +406,7 @@ Test(vtf, same_bytes_for_any_thread_count) {
     o.threads = threads;
     cr_assert_eq(bb_texture_write(in_scratch_dir("d.vtf"), &img, &o, NULL), BB_OK);
     size_t size;
-    unsigned char *f = slurp(in_scratch_dir("d.vtf"), &size);
+    unsigned char *f = file_bytes(in_scratch_dir("d.vtf"), &size);
     if (!first) {
       first = f, first_size = size;
       continue;
@@ -533,11 +514,11 @@ Test(vtf, read_info_refuses_broken_files) {
   o.description = "a=b\n";
   cr_assert_eq(bb_texture_write(in_scratch_dir("g.vtf"), &img, &o, NULL), BB_OK);
   size_t size;
-  unsigned char *good = slurp(in_scratch_dir("g.vtf"), &size);
+  unsigned char *good = file_bytes(in_scratch_dir("g.vtf"), &size);
   bb_vtf_info info;
   bb_error err = {{0}};
   /* Truncated by one byte: the image data no longer fits. */
-  spill(in_scratch_dir("t.vtf"), good, size - 1);
+  file_bytes_write(in_scratch_dir("t.vtf"), good, size - 1);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
   cr_assert_null(info.description);
@@ -550,7 +531,7 @@ Test(vtf, read_info_refuses_broken_files) {
   const uint32_t past = (uint32_t)size + 100;
   for (int i = 0; i < 4; i++)
     moved[84 + i] = (unsigned char)(past >> (8 * i));
-  spill(in_scratch_dir("l.vtf"), moved, size);
+  file_bytes_write(in_scratch_dir("l.vtf"), moved, size);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
   char want[160];
   snprintf(want, sizeof want, "low-resolution image (128 bytes at offset %u) ends past the end "
@@ -560,7 +541,7 @@ Test(vtf, read_info_refuses_broken_files) {
   memcpy(moved, good, size);
   for (int i = 0; i < 4; i++)
     moved[92 + i] = (unsigned char)(past >> (8 * i));
-  spill(in_scratch_dir("i.vtf"), moved, size);
+  file_bytes_write(in_scratch_dir("i.vtf"), moved, size);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
   size_t data = 0; /* DXT1, 32 x 32 down to 1 x 1 */
   for (int side = 32; side >= 1; side /= 2)
@@ -570,16 +551,16 @@ Test(vtf, read_info_refuses_broken_files) {
   cr_expect_not_null(strstr(err.message, want), "%s", err.message);
   free(moved);
   /* Not a VTF; a version from the future; a resource count past the header. */
-  spill(in_scratch_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
+  file_bytes_write(in_scratch_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
   unsigned char *bad = malloc(size);
   memcpy(bad, good, size);
   bad[8] = 9;
-  spill(in_scratch_dir("v.vtf"), bad, size);
+  file_bytes_write(in_scratch_dir("v.vtf"), bad, size);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
   memcpy(bad, good, size);
   bad[68] = 200;
-  spill(in_scratch_dir("r.vtf"), bad, size);
+  file_bytes_write(in_scratch_dir("r.vtf"), bad, size);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_eq(bb_vtf_read_info(in_scratch_dir("missing.vtf"), &info, &err), BB_ERR_IO);
   /* Every byte of the header and dictionary set to each of 0, 1, 0x7f,
@@ -590,7 +571,7 @@ Test(vtf, read_info_refuses_broken_files) {
     for (int v = 0; v < 4; v++) {
       memcpy(bad, good, size);
       bad[at] = values[v];
-      spill(in_scratch_dir("m.vtf"), bad, size);
+      file_bytes_write(in_scratch_dir("m.vtf"), bad, size);
       bb_status st = bb_vtf_read_info(in_scratch_dir("m.vtf"), &info, &err);
       cr_assert(st == BB_OK || st == BB_ERR_FORMAT, "byte %zu = %d: %s", at, values[v],
                 err.message);
@@ -613,7 +594,7 @@ Test(vtf, material) {
   bb_error err = {{0}};
   cr_assert_eq(bb_vmt_write(vmt, &o, &err), BB_OK, "%s", err.message);
   size_t size;
-  char *text = (char *)slurp(vmt, &size);
+  char *text = (char *)file_bytes(vmt, &size);
   text[size] = '\0';
   cr_assert_str_eq(text, "// Source material written by bumpbake " BB_VERSION_STRING "\n"
                          "\"LightmappedGeneric\"\n{\n"
@@ -648,8 +629,8 @@ Test(vtf, a_material_never_overwrites_a_texture_or_another_file) {
   cr_assert_eq(mkdir(materials, 0755), 0);
   snprintf(bump, sizeof bump, "%s/materials/s.vtf", scratch_dir);
   snprintf(alias, sizeof alias, "%s/materials/s.vmt", scratch_dir);
-  spill(bump, (const unsigned char *)"VTF\0 texture", 12);
-  spill(in_scratch_dir("x.png"), (const unsigned char *)"png bytes", 9);
+  file_bytes_write(bump, (const unsigned char *)"VTF\0 texture", 12);
+  file_bytes_write(in_scratch_dir("x.png"), (const unsigned char *)"png bytes", 9);
   bb_vmt_options o = {NULL, bump, NULL, 1};
   bb_error err = {{0}};
   cr_expect_eq(bb_vmt_write(bump, &o, &err), BB_ERR_ARGUMENT);
@@ -663,10 +644,10 @@ Test(vtf, a_material_never_overwrites_a_texture_or_another_file) {
   bb_vmt_options base = {NULL, in_scratch_dir("materials/t.vtf"), bump, 1};
   cr_expect_eq(bb_vmt_write(alias, &base, &err), BB_ERR_ARGUMENT);
   size_t size;
-  unsigned char *bytes = slurp(bump, &size);
+  unsigned char *bytes = file_bytes(bump, &size);
   cr_expect(size == 12 && memcmp(bytes, "VTF\0 texture", 12) == 0, "the texture was changed");
   free(bytes);
-  bytes = slurp(in_scratch_dir("x.png"), &size);
+  bytes = file_bytes(in_scratch_dir("x.png"), &size);
   cr_expect(size == 9 && memcmp(bytes, "png bytes", 9) == 0, "the PNG was changed");
   free(bytes);
   /* Upper case is a .vmt too. */
