@@ -221,8 +221,8 @@ def bake_files(inputs, out_dir, *, client=None, maps=None, name=None, force=Fals
                               key=f"bumpbake-chunk-{token}-{n}", pure=False)
             futures[f] = chunk
         done = count - len(pending)
-        for f in completed(client, list(futures), desk.serve if desk else None):
-            for index, report in f.result():
+        for _, result in completed(client, list(futures), desk.serve if desk else None):
+            for index, report in result:
                 reports[index] = report
                 done += 1
             if progress is not None and progress(done, count):

@@ -428,8 +428,7 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     future = client.submit(_drive, directory, planned, args, task, pure=False,
                            key=f"bumpbake-big-{task['key']}")
     try:
-        for done in completed(client, [future], desk.serve if desk else None):
-            report, stats = done.result()
+        (_, (report, stats)), = completed(client, [future], desk.serve if desk else None)
     except BaseException as e:
         settle(client, lambda: stop.set(1))  # left set: the driver may still read it
         settle(client, lambda: client.cancel([future]))

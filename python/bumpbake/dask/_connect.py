@@ -123,13 +123,14 @@ def alive(client):
 
 
 def completed(client, futures, each_poll=None):
-    """Yields futures as they finish, watching the cluster meanwhile (and
-    calling each_poll(), when given, at every look): raises
-    ClusterLost when the client lost its scheduler, or when no worker was
-    left for WORKERLESS_WAIT seconds; a task whose workers kept dying, or
-    that a worker cannot load (bumpbake not installed there), is one
-    bumpbake.Error too. A future that failed otherwise is yielded: its
-    result() raises the task's own error."""
+    """Yields (future, its result) as the futures finish, watching the
+    cluster meanwhile (and calling each_poll(), when given, at every look):
+    raises ClusterLost when the client lost its scheduler (also when it
+    goes between a task's end and the fetch of its result), or when no
+    worker was left for WORKERLESS_WAIT seconds; a task whose workers kept
+    dying, or that a worker cannot load (bumpbake not installed there), is
+    one bumpbake.Error too. A task that failed otherwise raises its own
+    error here."""
     pending = set(futures)
     workerless_since = None
     next_look = 0.0
@@ -152,7 +153,12 @@ def completed(client, futures, each_poll=None):
                 raise _lost(client)
             if f.status == "error":
                 _raise_cluster_error(f.exception())
-            yield f
+                f.result()  # raises the task's own error
+            try:
+                result = f.result()
+            except OSError:  # the result comes over the scheduler's connection
+                raise _lost(client) from None
+            yield f, result
         if not alive(client):
             raise _lost(client)
         now = time.monotonic()
