@@ -23,7 +23,10 @@
 # in one process and split over 2 workers; `make bench-cluster` runs it
 # alone, with 16384 x 16384 too), 12 `bumpbake serve`'s save-to-pixels
 # latency in headless Chromium against the cold bake + render pair
-# (tools/bench_serve.py), then a summary table.
+# (tools/bench_serve.py), 13 the loop before and after: an older build
+# (BENCH_BEFORE=DIR, its build directory) and this one in turns, the
+# stages of a bake, the writes, the kernel, a bounce's cost and the whole
+# bake (tools/bench_loop.py; skipped without BENCH_BEFORE), then a summary table.
 # Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -47,6 +50,8 @@
 #   BENCH_CLUSTER=0        skip section 11 (about 15 minutes and 3 GB of
 #                          files in build/bench/cluster)
 #   BENCH_SERVE=0          skip section 12
+#   BENCH_BEFORE=DIR       an older build directory (with bumpbake and tools/)
+#                          for section 13; BENCH_PAIRS=N its pairs (3)
 #   BENCH_SECTIONS="9 10"  run only the sections listed (default: every one);
 #                          the summary then has only their figures
 #
@@ -681,6 +686,16 @@ if want 12; then
     echo "skipped (BENCH_SERVE=0)"
   elif ! /usr/bin/python3 tools/bench_serve.py "$bin" | tee "$out/serve.txt"; then
     fail "tools/bench_serve.py failed"
+  fi
+fi
+
+if want 13; then
+  section "13. The loop, before and after (tools/bench_loop.py, BENCH_BEFORE)"
+  if [ -z "${BENCH_BEFORE:-}" ]; then
+    echo "skipped: BENCH_BEFORE names no older build to compare with"
+  elif ! /usr/bin/python3 tools/bench_loop.py "$BENCH_BEFORE" "$(dirname "$bin")" \
+    --pairs "${BENCH_PAIRS:-3}" --rock "$rock" | tee "$out/loop.txt"; then
+    fail "tools/bench_loop.py failed"
   fi
 fi
 
