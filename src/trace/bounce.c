@@ -96,6 +96,16 @@ static const int slot_upper[FACES] = {0, 0, 1, 0, 1, 1};
  * of half 0 are (0,0), (1,0), (0,1); of half 1, (1,0), (1,1), (0,1). */
 static const int slot_corner[FACES] = {0, 1, 0, 2, 2, 1};
 
+/* v modulo n, in [0, n): without a division when v is within one period
+ * of it (the neighbours and lattice steps of the image's own texels). */
+static inline long wrap(long v, long n) {
+  if (v >= 0 && v < n) return v;
+  if (v >= n && v < 2 * n) return v - n;
+  if (v < 0 && v >= -n) return v + n;
+  const long r = v % n;
+  return r < 0 ? r + n : r;
+}
+
 /* What the corners reflect is kept cell by cell, so the three corners of a
  * triangle lie together: ((cell * 2 + half) * 3 + corner) * channels.
  * The index of vertex (x, y)'s slot f, or SIZE_MAX where the cell lies
@@ -118,9 +128,7 @@ static inline const float *triangle_corners(const bb_pyramid *p, const float *ra
                                             long cy, int upper, int channels) {
   long x = cx, y = cy;
   if (p->addressing == BB_ADDRESS_PERIODIC) {
-    x %= p->width, y %= p->height;
-    if (x < 0) x += p->width;
-    if (y < 0) y += p->height;
+    x = wrap(x, p->width), y = wrap(y, p->height);
   } else {
     x = x < 0 ? 0 : (x >= p->width ? p->width - 1 : x);
     y = y < 0 ? 0 : (y >= p->height ? p->height - 1 : y);
@@ -130,12 +138,8 @@ static inline const float *triangle_corners(const bb_pyramid *p, const float *ra
 }
 
 static inline size_t vertex_at(const bb_pyramid *p, long x, long y) {
-  if (p->addressing == BB_ADDRESS_PERIODIC) {
-    long wx = x % p->width, wy = y % p->height;
-    if (wx < 0) wx += p->width;
-    if (wy < 0) wy += p->height;
-    return (size_t)wy * (size_t)p->width + (size_t)wx;
-  }
+  if (p->addressing == BB_ADDRESS_PERIODIC)
+    return (size_t)wrap(y, p->height) * (size_t)p->width + (size_t)wrap(x, p->width);
   const long cx = x < 0 ? 0 : (x >= p->width ? p->width - 1 : x);
   const long cy = y < 0 ? 0 : (y >= p->height ? p->height - 1 : y);
   return (size_t)cy * (size_t)p->width + (size_t)cx;
@@ -396,12 +400,11 @@ static scratch *slot_take(bounce_ctx *ctx) {
 /* The corners' direct light: what slice s's sector above max(horizon,
  * plane of f, 0) gives each corner f of vertex (x, y), as its blocked part,
  * n_f . G, added to sums. */
-static void direct_texel(const bounce_ctx *ctx, int s, double dx, double dy, long x, long y,
-                         float horizon, float *sums) {
+static void direct_texel(const bounce_ctx *ctx, int s, double dx, double dy,
+                         const double n[FACES][3], float horizon, float *sums) {
   const vtables *vt = ctx->vt;
   const int channels = ctx->channels;
-  double n[FACES][3], base[3 * MAX_CHANNELS], own[3 * MAX_CHANNELS];
-  vertex_faces(ctx->p, x, y, n);
+  double base[3 * MAX_CHANNELS], own[3 * MAX_CHANNELS];
   const double floor_t = horizon > 0.0f ? (double)horizon : 0.0;
   vtables_eval(vt, s, floor_t, base);
   for (int f = 0; f < FACES; f++) {
@@ -450,6 +453,8 @@ typedef struct gather {
   double plane[FACES], plane_theta[FACES], plane_sin2[FACES], plane_sincos[FACES];
   double plane_low, plane_high; /* the lowest and highest of the planes */
   double last_t, last_theta; /* the last atan taken: bands chain */
+  double last_tex_t, last_sin2, last_sin; /* PASS_TEXEL: the last band's far end's
+                                             sin^2 and sin of its atan */
   double acc[FACES * MAX_CHANNELS];
   /* PASS_SURFACE: over bands above every corner's plane, n_f . w is linear
    * in n_f: what they bring is summed once, per channel the integrals of
@@ -476,8 +481,14 @@ static void band_add(gather *g, double ta, double tb, double theta_a, double the
                      const double *r) {
   const int channels = g->channels;
   if (g->mode == PASS_TEXEL) {
-    const double w_ao = g->half_width * (sin2(tb) - sin2(ta));
-    const double w_solid = 2.0 * g->half_width * (tb / sqrt(1.0 + tb * tb) - ta / sqrt(1.0 + ta * ta));
+    /* bands chain: the last band's far end is most often this one's near */
+    double s2a, sna;
+    if (ta == g->last_tex_t) s2a = g->last_sin2, sna = g->last_sin;
+    else s2a = sin2(ta), sna = ta / sqrt(1.0 + ta * ta);
+    const double s2b = sin2(tb), snb = tb / sqrt(1.0 + tb * tb);
+    g->last_tex_t = tb, g->last_sin2 = s2b, g->last_sin = snb;
+    const double w_ao = g->half_width * (s2b - s2a);
+    const double w_solid = 2.0 * g->half_width * (snb - sna);
     g->acc[0] += w_ao * r[0];
     for (int k = 1; k < channels; k++) g->acc[k] += w_solid * r[k];
     return;
@@ -538,12 +549,13 @@ static void band_pieces(gather *g, const segment *seg, double sa, double sb) {
   /* The mean of the ends is off where the point met moves unevenly over a
    * wide band and the radiance changes along the segment: only then is
    * the band cut (a tall wall seen from its foot, not a short segment). */
-  double change = 0.0;
-  for (int k = 0; k < channels; k++) {
-    const double c = fabs((double)seg->far[k] - (double)seg->near[k]);
-    change = c > change ? c : change;
-  }
   const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : (fabs(ta) < fabs(tb) ? fabs(ta) : fabs(tb));
+  double change = 0.0; /* only for a wide band: most are narrow */
+  if ((tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND)
+    for (int k = 0; k < channels; k++) {
+      const double c = fabs((double)seg->far[k] - (double)seg->near[k]);
+      change = c > change ? c : change;
+    }
   if (fabs(at_b - at_a) * change > 0.01 && (tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND) {
     theta_a = theta_of(g, ta), theta_b = atan(tb); /* the bound above is not the width */
     pieces = (int)ceil((theta_b - theta_a) / WIDE_BAND);
@@ -617,9 +629,7 @@ static void template_segments(const bb__line_view *line, template_segment *ts) {
 static inline long step_coordinate(const bb__line_view *line, long base, long step, int along_x) {
   const long v = base + step * (along_x ? line->a : line->b);
   if (line->p->addressing != BB_ADDRESS_PERIODIC) return v;
-  const long n = along_x ? line->p->width : line->p->height;
-  const long r = v % n;
-  return r < 0 ? r + n : r;
+  return wrap(v, along_x ? line->p->width : line->p->height);
 }
 
 static inline double step_start_z(const line_profile *lp, long ps);
@@ -668,41 +678,51 @@ static void profile_build(const bounce_ctx *ctx, const bb__line_view *line,
 /* How many steps from profile step ps on (forward) or back (behind) lie
  * wholly under the ray of slope `seen` from the origin: the largest
  * aligned block of the pyramid that does, within `room` steps; 0 when
- * none. near: the block's near end's distance. */
+ * none. near: the block's near end's distance. The pyramid is climbed
+ * from its smallest blocks: a block that fails every test fails them
+ * for every larger block holding it (aligned the same way, within the
+ * room and the profile, its top no lower, its far end no nearer), so
+ * the first to fail ends the climb, most often at once. */
 static long block_under(const line_profile *lp, long ps, int forward, double near, double oz,
                         double seen, long room) {
-  for (int k = lp->levels - 1; k >= 1; k--) {
+  long found = 0;
+  for (int k = 1; k < lp->levels; k++) {
     const long size = 1L << k;
-    if (size > room) continue;
+    if (size > room) break;
     const long first = forward ? ps : ps - size + 1;
-    if (first < 0 || first + size > lp->line->steps || (first & (size - 1))) continue;
+    if (first < 0 || first + size > lp->line->steps || (first & (size - 1))) break;
     double top = lp->mip[lp->level_at[k] + (first >> k)];
     if (!forward) top = fmax(top, step_start_z(lp, first)); /* visited going back */
-    if (top - oz <= seen * (seen >= 0.0 ? near : near + (double)size)) return size;
+    if (!(top - oz <= seen * (seen >= 0.0 ? near : near + (double)size))) break;
+    found = size;
   }
-  return 0;
+  return found;
 }
 
 /* The radiance at the near (0) or far (1) end of point q's segment. */
-static const float *point_radiance(line_profile *lp, long q, int far) {
+static void point_radiance_fill(line_profile *lp, long q, float *out);
+static inline const float *point_radiance(line_profile *lp, long q, int far) {
   const int channels = lp->channels;
   float *out = lp->radiance + (size_t)q * 2 * (size_t)channels;
-  if (!lp->ready[q]) {
-    const long s = q / lp->count;
-    const template_segment *g = &lp->segments[q - s * lp->count];
-    const float *corners = triangle_corners(lp->line->p, lp->ctx->radiance, lp->step_x[s] + g->cx,
-                                            lp->step_y[s] + g->cy, g->upper, channels);
-    for (int c = 0; c < channels; c++) {
-      double near = 0.0, farther = 0.0;
-      for (int i = 0; i < 3; i++) {
-        near += g->near[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
-        farther += g->far[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
-      }
-      out[c] = (float)near, out[channels + c] = (float)farther;
-    }
-    lp->ready[q] = 1;
-  }
+  if (!lp->ready[q]) point_radiance_fill(lp, q, out); /* the first ask only: out of line */
   return out + (far ? channels : 0);
+}
+
+static void point_radiance_fill(line_profile *lp, long q, float *out) {
+  const int channels = lp->channels;
+  const long s = q / lp->count;
+  const template_segment *g = &lp->segments[q - s * lp->count];
+  const float *corners = triangle_corners(lp->line->p, lp->ctx->radiance, lp->step_x[s] + g->cx,
+                                          lp->step_y[s] + g->cy, g->upper, channels);
+  for (int c = 0; c < channels; c++) {
+    double near = 0.0, farther = 0.0;
+    for (int i = 0; i < 3; i++) {
+      near += g->near[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
+      farther += g->far[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
+    }
+    out[c] = (float)near, out[channels + c] = (float)farther;
+  }
+  lp->ready[q] = 1;
 }
 
 /* The band [seen, upto] of slopes (per step) over the segment from (d0,
@@ -719,10 +739,7 @@ static void seen_band(gather *g, double d0, double z0, double d1, double z1, con
 static inline long step_at(const line_profile *lp, long origin_step, long r, int forward) {
   long ps = forward ? origin_step + r : origin_step - r;
   const long steps = lp->line->steps;
-  if (lp->line->round) {
-    ps %= steps;
-    return ps < 0 ? ps + steps : ps;
-  }
+  if (lp->line->round) return wrap(ps, steps);
   return ps >= 0 && ps < steps ? ps : -1;
 }
 
@@ -878,12 +895,12 @@ static void gather_slice(gather *g, const bounce_ctx *ctx, int s, const bb__line
   g->cx = sin(hi) - sin(lo);
   g->cy = cos(lo) - cos(hi);
   g->last_t = NAN;
+  g->last_tex_t = NAN;
 }
 
-/* PASS_SURFACE: the corners of vertex (x, y) as seen along slice s. */
-static void gather_corners(gather *g, const bb_pyramid *p, long x, long y, double dx, double dy) {
-  double n[FACES][3];
-  vertex_faces(p, x, y, n);
+/* PASS_SURFACE: the corners of a vertex, its faces' normals n, as seen
+ * along slice s. */
+static void gather_corners(gather *g, const double n[FACES][3], double dx, double dy) {
   for (int f = 0; f < FACES; f++) {
     const double plane = -(n[f][0] * dx + n[f][1] * dy) / n[f][2];
     g->horizontal[f] = n[f][0] * g->cx + n[f][1] * g->cy;
@@ -909,16 +926,20 @@ static void gather_share(gather *g) {
 static void line_hook(void *user, const bb__line_view *line) {
   bounce_ctx *ctx = user;
   const int channels = ctx->channels, W = line->p->width;
+  /* texel by texel, both sides of the line with one vertex_faces: each
+   * texel's sums take the sides in the same order as side by side */
   if (ctx->mode == PASS_DIRECT) {
-    for (int side = 0; side < 2; side++) {
-      const bb__sweep_dir *dir = line->dir[side];
-      if (!dir) continue;
-      const int s = dir->slice;
-      const double dx = ctx->rs->slice_dir[2 * s], dy = ctx->rs->slice_dir[2 * s + 1];
-      for (int j = 0; j < line->len; j++) {
-        const size_t v = line->texel[j];
-        direct_texel(ctx, s, dx, dy, (long)(v % (size_t)W), (long)(v / (size_t)W),
-                     line->found[side][j], ctx->sums + v * FACES * (size_t)channels);
+    for (int j = 0; j < line->len; j++) {
+      const size_t v = line->texel[j];
+      double n[FACES][3];
+      vertex_faces(ctx->p, (long)(v % (size_t)W), (long)(v / (size_t)W), n);
+      for (int side = 0; side < 2; side++) {
+        const bb__sweep_dir *dir = line->dir[side];
+        if (!dir) continue;
+        const int s = dir->slice;
+        const double dx = ctx->rs->slice_dir[2 * s], dy = ctx->rs->slice_dir[2 * s + 1];
+        direct_texel(ctx, s, dx, dy, (const double(*)[3])n, line->found[side][j],
+                     ctx->sums + v * FACES * (size_t)channels);
       }
     }
     return;
@@ -936,24 +957,30 @@ static void line_hook(void *user, const bb__line_view *line) {
                      .z = sc->z, .step_max = sc->step_max, .mip = sc->mip, .step_x = sc->step_x,
                      .step_y = sc->step_y, .radiance = sc->radiance, .ready = sc->ready};
   profile_build(ctx, line, ts, &lp);
-  for (int side = 0; side < 2; side++) {
-    const bb__sweep_dir *dir = line->dir[side];
-    if (!dir) continue;
-    const int s = dir->slice;
-    gather g;
-    gather_slice(&g, ctx, s, line);
-    const double dx = ctx->rs->slice_dir[2 * s], dy = ctx->rs->slice_dir[2 * s + 1];
-    const int lanes = ctx->mode == PASS_SURFACE ? FACES * channels : channels;
-    for (int j = 0; j < line->len; j++) {
-      const size_t v = line->texel[j];
-      if (ctx->mode == PASS_SURFACE)
-        gather_corners(&g, line->p, (long)(v % (size_t)W), (long)(v / (size_t)W), dx, dy);
-      for (int i = 0; i < lanes; i++) g.acc[i] = 0.0;
-      for (int i = 0; i < 2 * channels; i++) g.above[i] = 0.0;
-      scan_origin(&g, &lp, j, side == 0, line->found[side][j], line->tangent_key[side][j]);
-      if (ctx->mode == PASS_SURFACE) gather_share(&g);
+  gather g[2];
+  for (int side = 0; side < 2; side++)
+    if (line->dir[side]) gather_slice(&g[side], ctx, line->dir[side]->slice, line);
+  const int lanes = ctx->mode == PASS_SURFACE ? FACES * channels : channels;
+  for (int j = 0; j < line->len; j++) {
+    const size_t v = line->texel[j];
+    double n[FACES][3];
+    if (ctx->mode == PASS_SURFACE)
+      vertex_faces(line->p, (long)(v % (size_t)W), (long)(v / (size_t)W), n);
+    for (int side = 0; side < 2; side++) {
+      const bb__sweep_dir *dir = line->dir[side];
+      if (!dir) continue;
+      gather *gs = &g[side];
+      if (ctx->mode == PASS_SURFACE) {
+        const int s = dir->slice;
+        gather_corners(gs, (const double(*)[3])n, ctx->rs->slice_dir[2 * s],
+                       ctx->rs->slice_dir[2 * s + 1]);
+      }
+      for (int i = 0; i < lanes; i++) gs->acc[i] = 0.0;
+      for (int i = 0; i < 2 * channels; i++) gs->above[i] = 0.0;
+      scan_origin(gs, &lp, j, side == 0, line->found[side][j], line->tangent_key[side][j]);
+      if (ctx->mode == PASS_SURFACE) gather_share(gs);
       float *out = ctx->sums + v * (size_t)lanes;
-      for (int i = 0; i < lanes; i++) out[i] += (float)g.acc[i];
+      for (int i = 0; i < lanes; i++) out[i] += (float)gs->acc[i];
     }
   }
   atomic_flag_clear(&sc->busy);
@@ -966,7 +993,7 @@ static void line_hook(void *user, const bb__line_view *line) {
  * a periodic shift of the map changes. */
 typedef unsigned __int128 exact_sum;
 static inline exact_sum fixed(double v) {
-  return (exact_sum)(uint64_t)llround(ldexp(v, 40));
+  return (exact_sum)(uint64_t)llround(v * 0x1p40); /* ldexp(v, 40): exact, as a product */
 }
 
 typedef struct driver {
