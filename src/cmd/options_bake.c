@@ -147,7 +147,7 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
       return bb__fail(err, BB_ERR_ARGUMENT, "--maps: unknown map '%.*s' (one of %s)",
                       (int)(n < 64 ? n : 64), s, choices);
     }
-    maps |= BB_OUTPUT_BIT(kind);
+    maps |= BB_MAP_BIT(kind);
     s += n + (s[n] == ',');
   }
   if (!maps)
@@ -158,8 +158,8 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
 
 static void print_maps(const bb_command *c, const bb__option *o, bb__text *t) {
   int first = 1;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-    if (c->options.job.maps & BB_OUTPUT_BIT(k)) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (c->options.job.maps & BB_MAP_BIT(k)) {
       bb__text_printf(t, "%s%s", first ? "" : ",", o->names(k));
       first = 0;
     }
@@ -202,7 +202,7 @@ static bb_status set_dump(bb_command *c, const bb__option *o, const char *text, 
                           int *count, bb_error *err) {
   bb_status st = bb__set_generic(c, o, text, values, count, err);
   if (st == BB_OK)
-    c->options.job.paths[BB_OUTPUT_FILTERED] = "filtered.tga";
+    c->options.job.paths[BB_MAP_FILTERED] = "filtered.tga";
   return st;
 }
 
@@ -360,17 +360,17 @@ static const bb__option opt_brightness = {
             .help = (help_)},                                                              \
    .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_])}
 static const bb__option opt_out_normal =
-    ROW_MAP_OUT("normal", BB_OUTPUT_NORMAL, "write the normal map");
+    ROW_MAP_OUT("normal", BB_MAP_NORMAL, "write the normal map");
 static const bb__option opt_out_weights =
-    ROW_MAP_OUT("weights", BB_OUTPUT_WEIGHTS, "write the basis weights (normal2ssbump)");
+    ROW_MAP_OUT("weights", BB_MAP_WEIGHTS, "write the basis weights (normal2ssbump)");
 static const bb__option opt_out_ssbump =
-    ROW_MAP_OUT("ssbump", BB_OUTPUT_SSBUMP, "write the self-shadowed bump map (traces)");
+    ROW_MAP_OUT("ssbump", BB_MAP_SSBUMP, "write the self-shadowed bump map (traces)");
 static const bb__option opt_out_ao =
-    ROW_MAP_OUT("ao", BB_OUTPUT_AO, "write the ambient occlusion (traces)");
+    ROW_MAP_OUT("ao", BB_MAP_AO, "write the ambient occlusion (traces)");
 static const bb__option opt_out_bent =
-    ROW_MAP_OUT("bent", BB_OUTPUT_BENT, "write the bent normal (traces)");
+    ROW_MAP_OUT("bent", BB_MAP_BENT, "write the bent normal (traces)");
 static const bb__option opt_out_filtered =
-    ROW_MAP_OUT("filtered", BB_OUTPUT_FILTERED, "write the smoothed height");
+    ROW_MAP_OUT("filtered", BB_MAP_FILTERED, "write the smoothed height");
 
 static const bb__option opt_slope = {
     .info = {.name = "slope", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
@@ -580,7 +580,7 @@ static const bb__option opt_normal_output = {
     .info = {.name = "output", .short_name = 'o', .value_name = "OUT", .type = BB_OPTION_PATH,
              .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_REQUIRED | BB_OPTION_FILES,
              .help = "normal map to write (.png .tga .tif .exr); required"},
-    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_OUTPUT_NORMAL])};
+    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL])};
 
 static const bb__option opt_quiet_normal = {
     .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,
@@ -595,7 +595,7 @@ static const bb__option *const normal_options[] = {
     &bb__opt_json, &opt_quiet_normal, &bb__opt_help, NULL};
 
 static void normal_init(bb_command_options *o) {
-  o->job.bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL); /* no rays, nothing else */
+  o->job.bake.outputs = BB_MAP_BIT(BB_MAP_NORMAL); /* no rays, nothing else */
 }
 
 static bb_status normal_job(bb_command *c, bb_job_options *o, bb_error *err) {

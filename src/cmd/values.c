@@ -64,7 +64,8 @@ void bb__choices(const bb__option *o, char *out, size_t cap) {
     const char *name = o->names(i);
     if (!name || !strcmp(name, "unknown"))
       break;
-    if (!strcmp(name, "default")) /* the enum's "not asked", no word of its own */
+    if (!strcmp(name, "default") || !name[0]) /* the enum's "not asked", or a value
+                                                  the option does not take */
       continue;
     int n = snprintf(out + used, cap - used, "%s%s", used ? "|" : "", name);
     if (n < 0 || (size_t)n >= cap - used)

@@ -226,7 +226,7 @@ Test(cmd, a_file_option_given_twice_is_refused) {
                         NULL};
   bb_command *c = command("bake", same);
   cr_expect_eq(bb_command_check(c, NULL), BB_OK);
-  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_OUTPUT_SSBUMP], "s.png");
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
   bb_command_free(c);
 }
 
