@@ -63,16 +63,4 @@ KIND_WORDS(map_kind, BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_WEIGHTS) |
 KIND_WORDS(output_kind, BB_MAPS_BAKED)
 
 /* ssbump2normal --kind: what a basis map holds */
-const char *bb__name_ssbump_kind(int i) {
-  if (i < 0 || i >= BB_MAP_KIND_COUNT)
-    return NULL;
-  return i == BB_MAP_SSBUMP ? "ssbump" : i == BB_MAP_WEIGHTS ? "weights" : "";
-}
-int bb__parse_ssbump_kind(const char *text, int *value) {
-  for (int i = 0; i < BB_MAP_KIND_COUNT; i++)
-    if (bb__name_ssbump_kind(i)[0] && !strcmp(text, bb__name_ssbump_kind(i))) {
-      *value = i;
-      return 1;
-    }
-  return 0;
-}
+KIND_WORDS(ssbump_kind, BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_WEIGHTS))

@@ -302,3 +302,24 @@ Test(cmd, a_flag_set_to_0_is_unset) {
   cr_expect_eq(bb_command_set(c, "force", "2", &err), BB_ERR_ARGUMENT);
   bb_command_free(c);
 }
+
+/* ssbump2normal --kind and combine --kind: one parser, the library's
+ * (bb_map_kind_parse, any case), each taking its own kinds. */
+Test(cmd, kind_options_take_the_librarys_words) {
+  const char *s2n[] = {"--kind", "Weights", NULL};
+  bb_command *c = command("ssbump2normal", s2n);
+  cr_expect_eq(bb_command_options_of(c)->ssbump_kind, BB_MAP_WEIGHTS);
+  bb_command_free(c);
+  const char *comb[] = {"--kind", "WEIGHTS", NULL};
+  c = command("combine", comb);
+  cr_expect_eq(bb_command_options_of(c)->map_kind, BB_MAP_WEIGHTS);
+  bb_command_free(c);
+  const char *kinds[] = {"normal", "ao", "bent", "slope"};
+  for (int i = 0; i < 4; i++) {
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_new("ssbump2normal", &c, &err), BB_OK);
+    cr_expect_eq(bb_command_set(c, "kind", kinds[i], &err), BB_ERR_ARGUMENT, "%s", kinds[i]);
+    cr_expect(strstr(err.message, "weights, ssbump"), "%s", err.message);
+    bb_command_free(c);
+  }
+}
