@@ -73,30 +73,6 @@ static void print_threads(const bb_command *c, const bb__option *o, bb__text *t)
   bb__text_printf(t, "%d", c->options.job.bake.trace.threads);
 }
 
-static bb_status set_clamp(bb_command *c, const bb__option *o, const char *text,
-                           double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.bake.smooth.addressing = BB_ADDRESS_CLAMP;
-  return st;
-}
-
-static bb_status set_nomip(bb_command *c, const bb__option *o, const char *text,
-                           double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.texture.mips = 0;
-  return st;
-}
-
-static bb_status set_fast(bb_command *c, const bb__option *o, const char *text,
-                          double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.texture.fast = 1;
-  return st;
-}
-
 /* --vtf-version and --vtf-flags: the library's parsers of them. */
 static bb_status set_vtf_version(bb_command *c, const bb__option *o, const char *text,
                                  double *values, int *count, bb_error *err) {
@@ -197,15 +173,6 @@ static void elevation_range(char *out, size_t cap) {
   snprintf(out, cap, "degrees, EL %s", r);
 }
 
-/* height2ssbump -D: Valve's ./filtered.tga. */
-static bb_status set_dump(bb_command *c, const bb__option *o, const char *text, double *values,
-                          int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.paths[BB_MAP_FILTERED] = "filtered.tga";
-  return st;
-}
-
 /* ------------------------------------------------------------ the rows */
 
 #define ROW_SCALE(flags_)                                                                 \
@@ -290,7 +257,7 @@ const bb__option bb__opt_threads = {
 const bb__option bb__opt_clamp = {
     .info = {.name = "clamp", .type = BB_OPTION_FLAG, .flags = RECORDED,
              .default_text = "periodic", .help = "extend border texels instead of tiling"},
-    .set = set_clamp};
+    .sets = {BB__FIELD_ENUM, AT(job.bake.smooth.addressing), BB_ADDRESS_CLAMP, NULL}};
 
 const bb__option bb__opt_channel = {
     .info = {.name = "channel", .type = BB_OPTION_WORD, .count = 1, .values = 1,
@@ -482,14 +449,14 @@ const bb__option bb__opt_nomip = {
     .info = {.name = "nomip", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .applies = "a .vtf or .dds output",
              .help = "write .vtf/.dds without their mip chain (vtex's nomip)"},
-    .set = set_nomip, .applies = bb__applies_texture};
+    .sets = {BB__FIELD_INT, AT(job.texture.mips), 0, NULL}, .applies = bb__applies_texture};
 
 const bb__option bb__opt_fast_compression = {
     .info = {.name = "fast-compression", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "off", .applies = "a .vtf or .dds output",
              .help = "block-compress with libsquish's range fit: far faster, ~1-2 dB lower "
                      "PSNR on DXT1/DXT5"},
-    .set = set_fast, .applies = bb__applies_texture};
+    .sets = {BB__FIELD_INT, AT(job.texture.fast), 1, NULL}, .applies = bb__applies_texture};
 
 static const bb__option opt_vmt = {
     .info = {.name = "vmt", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
@@ -630,7 +597,7 @@ static const bb__option opt_valve_dump = {
     .info = {.name = "dump-filtered", .short_name = 'D', .type = BB_OPTION_FLAG,
              .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .help = "also write the filtered height as ./filtered.tga"},
-    .set = set_dump};
+    .sets = {BB__FIELD_STRING, AT(job.paths[BB_MAP_FILTERED]), 0, "filtered.tga"}};
 static const bb__option opt_valve_detail = {
     .info = {.name = "detail", .short_name = 'd', .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "off",

@@ -160,6 +160,19 @@ static bb_status parse_word(const bb__option *o, const char *text, int *value, b
                   text);
 }
 
+/* A given flag's other field (bb__flag_sets). */
+static void set_flag_sets(bb_command *c, const bb__flag_sets *s) {
+  void *field = (char *)&c->options + s->offset;
+  switch (s->field) {
+  case BB__FIELD_INT:
+  case BB__FIELD_ENUM: *(int *)field = s->value; break;
+  case BB__FIELD_STRING: *(const char **)field = s->text; break;
+  case BB__FIELD_NONE:
+  case BB__FIELD_FLOAT:
+  case BB__FIELD_DOUBLE: break;
+  }
+}
+
 bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
                           double *values, int *count, bb_error *err) {
   char name[80];
@@ -179,6 +192,7 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
       return bb__fail(err, BB_ERR_ARGUMENT, "%s takes no value", name);
     if (o->field == BB__FIELD_INT)
       *(int *)field = 1;
+    set_flag_sets(c, &o->sets);
     return BB_OK;
   case BB_OPTION_INT:
     st = parse_integer(o, text, &values[0], err);

@@ -323,3 +323,22 @@ Test(cmd, kind_options_take_the_librarys_words) {
     bb_command_free(c);
   }
 }
+
+/* Flags that set one other field (the option table's bb__flag_sets): set
+ * when given, and refused as "0" since they cannot be unset. */
+Test(cmd, flags_set_their_field) {
+  const char *bake[] = {"--scale", "2", "--clamp", "--nomip", "--fast-compression", NULL};
+  bb_command *c = command("bake", bake);
+  const bb_command_options *o = bb_command_options_of(c);
+  cr_expect_eq(o->job.bake.smooth.addressing, BB_ADDRESS_CLAMP);
+  cr_expect_eq(o->job.texture.mips, 0);
+  cr_expect_eq(o->job.texture.fast, 1);
+  bb_error err = {{0}};
+  cr_expect_eq(bb_command_set(c, "nomip", "0", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--nomip cannot be unset: leave it out");
+  bb_command_free(c);
+  cr_assert_eq(bb_command_new("height2ssbump", &c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_set(c, "dump-filtered", NULL, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
+  bb_command_free(c);
+}
