@@ -135,7 +135,7 @@ static int texture_seeds(const char *dir, const char *out) {
       bb_texture_options o;
       bb_texture_options_init(&o);
       o.format = dds[f];
-      o.map = dds[f] == BB_TEXTURE_FORMAT_BC5 ? BB_TEXTURE_MAP_NORMAL : BB_TEXTURE_MAP_PLAIN;
+      o.map = dds[f] == BB_TEXTURE_FORMAT_BC5 ? BB_MAP_NORMAL : BB_MAP_PLAIN;
       o.fast = 1;
       snprintf(tmp, sizeof tmp, "%s/seed.dds", out);
       snprintf(name, sizeof name, "texture%d_%s.dds", c, bb_texture_format_name(dds[f]));

@@ -258,6 +258,72 @@ typedef enum bb_range {
   BB_RANGE_SIGNED    /* [-1, 1] stored as (0.5 + 0.5 * value) * max code (normals) */
 } bb_range;
 
+/* ----------------------------------------------------------- map kinds */
+
+/* Every kind of map bumpbake makes, reads or writes, named once. The first
+ * BB_MAP_BAKED_COUNT are the maps a bake makes, in the order of this enum
+ * everywhere (the command line's options, JSON, Python's bumpbake.OUTPUTS,
+ * the bits of bb_bake_options.outputs). New kinds are appended. */
+typedef enum bb_map_kind {
+  BB_MAP_NORMAL = 0, /* unit N, 3 channels */
+  BB_MAP_WEIGHTS,    /* w_c = sat(N.B_c)^2 / sum (normal2ssbump), one channel per
+                        basis direction */
+  BB_MAP_SSBUMP,     /* s_c = max(0, N.B_c) vis_c, one channel per basis
+                        direction (traced) */
+  BB_MAP_AO,         /* ambient occlusion, 1 channel (traced) */
+  BB_MAP_BENT,       /* bent normal, 3 channels (traced) */
+  BB_MAP_FILTERED,   /* the smoothed height h, 1 channel */
+  BB_MAP_SLOPE,      /* flipcode's slope bytes / 255 in channel 0 */
+  BB_MAP_PLAIN,      /* any other image (a height, a colour, a packed map) */
+  BB_MAP_KIND_COUNT  /* number of kinds, not a kind */
+} bb_map_kind;
+
+/* The kinds a bake makes: BB_MAP_NORMAL .. BB_MAP_FILTERED. */
+#define BB_MAP_BAKED_COUNT 6
+/* Bit of a kind in bb_bake_options.outputs and other masks of maps. */
+#define BB_MAP_BIT(kind) (1u << (unsigned)(kind))
+/* Every kind a bake makes (the default of bb_bake_options.outputs). */
+#define BB_MAPS_BAKED ((1u << (unsigned)BB_MAP_BAKED_COUNT) - 1u)
+/* The kinds that need the tracer: ssbump, ao and bent. */
+#define BB_MAPS_TRACED \
+  (BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_AO) | BB_MAP_BIT(BB_MAP_BENT))
+
+/* What one kind is, so a client can list, name and store the maps without
+ * a table of its own. Static data; never freed. */
+typedef struct bb_map_kind_info {
+  const char *name;        /* "normal", "weights", "ssbump", "ao", "bent",
+                              "filtered", "slope", "plain": names in
+                              provenance, files, JSON, options */
+  const char *description; /* one line for help texts */
+  int channels;            /* channels of the image; 0 = one per basis
+                              direction (bb_basis.count) */
+  int file_channels;       /* channels a file of the kind needs at least (3
+                              for a basis map: Half-Life 2's basis); what
+                              bb_combine_* and bb_render_map_read act on */
+  bb_range range;          /* values: BB_RANGE_SIGNED in [-1, 1] (normal,
+                              bent), else BB_RANGE_UNIT in [0, 1] (the
+                              filtered height of a float input may leave it) */
+  int needs_trace;         /* 1: made only by tracing (ssbump, ao, bent) */
+  int unit_vectors;        /* 1: unit vectors (normal, bent): read decoded
+                              (bb_normal_map_decode), mips renormalised
+                              (BB_MIP_RENORMALIZE), DDS default BC5 */
+  uint32_t vtf_flags;      /* the VTF flag a texture of it carries:
+                              BB_VTF_FLAG_NORMAL (normal, bent),
+                              BB_VTF_FLAG_SSBUMP (ssbump, weights: Source's
+                              shaders then use the ssbump blend), else 0 */
+} bb_map_kind_info;
+
+/* The description of kind, or NULL for a value outside
+ * 0..BB_MAP_KIND_COUNT-1. */
+const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
+
+/* The kind named name (bb_map_kind_info.name, any case); returns 0 on
+ * success, BB_ERR_ARGUMENT for an unknown name (out untouched). */
+bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
+
+/* The name of kind, or "unknown". */
+const char *bb_map_kind_name(bb_map_kind kind);
+
 /* =====================================================================
  * files: checked, all-or-nothing writes of files; provenance texts read
  * ===================================================================== */
@@ -413,17 +479,6 @@ bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
  * 0x hexadecimal or 0 octal (strtoul's base 0), no sign. */
 bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 
-/* What the image is: it picks the mip rule, the VTF flags and the value range. */
-typedef enum bb_texture_map {
-  BB_TEXTURE_MAP_PLAIN = 0, /* ao, heights, weights...: values in [0, 1], mips
-                               averaged, no VTF flag */
-  BB_TEXTURE_MAP_NORMAL,    /* unit vectors in [-1, 1] (normal, bent normal): mips
-                               renormalised, VTF flag NORMAL, DDS default BC5 */
-  BB_TEXTURE_MAP_SSBUMP     /* a self-shadowed bump map, values in [0, 1]: mips
-                               averaged, VTF flag SSBUMP (which also makes Source's
-                               shaders use the ssbump blend) */
-} bb_texture_map;
-
 /* VTF header flags (Valve's TEXTUREFLAGS_*) the writer sets, for
  * bb_texture_options.vtf_flags and bb_vtf_info.flags. */
 #define BB_VTF_FLAG_ONEBITALPHA 0x00001000u  /* never written: refused in vtf_flags */
@@ -438,7 +493,8 @@ typedef enum bb_texture_map {
 
 typedef struct bb_texture_options {
   bb_texture_format format;  /* BB_TEXTURE_FORMAT_DEFAULT: see above */
-  bb_texture_map map;        /* what the image is */
+  bb_map_kind map;           /* what the image is: its kind's mip rule and VTF
+                                flags (bb_map_kind_info), default BB_MAP_PLAIN */
   int mips;                  /* 1: the full chain down to 1 x 1, by bb_mip_chain
                                 (BB_MIP_RENORMALIZE for normal maps, BB_MIP_AVERAGE
                                 otherwise); 0: the image alone */
@@ -1208,48 +1264,6 @@ bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image
 
 /* ---------------------------------------------------------------- bake */
 
-/* The maps a bake can make, in the order of this enum everywhere (the
- * command line's options, JSON, Python's bumpbake.OUTPUTS). New kinds are
- * appended. */
-typedef enum bb_output_kind {
-  BB_OUTPUT_NORMAL = 0, /* unit N, 3 channels */
-  BB_OUTPUT_WEIGHTS,    /* w_c, one channel per basis direction */
-  BB_OUTPUT_SSBUMP,     /* s_c, one channel per basis direction (traced) */
-  BB_OUTPUT_AO,         /* ao, 1 channel (traced) */
-  BB_OUTPUT_BENT,       /* bent normal, 3 channels (traced) */
-  BB_OUTPUT_FILTERED,   /* the smoothed height h, 1 channel */
-  BB_OUTPUT_KIND_COUNT  /* number of kinds, not a kind */
-} bb_output_kind;
-
-/* Bit of a kind in bb_bake_options.outputs. */
-#define BB_OUTPUT_BIT(kind) (1u << (unsigned)(kind))
-/* Every kind (the default of bb_bake_options.outputs). */
-#define BB_OUTPUTS_ALL ((1u << (unsigned)BB_OUTPUT_KIND_COUNT) - 1u)
-/* The kinds that need the tracer: ssbump, ao and bent. */
-#define BB_OUTPUTS_TRACED \
-  (BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_AO) | BB_OUTPUT_BIT(BB_OUTPUT_BENT))
-
-/* What one output kind is, so a client can list, name and store the maps
- * without a table of its own. Static data; never freed. */
-typedef struct bb_output_kind_info {
-  const char *name;        /* "normal", "weights", "ssbump", "ao", "bent",
-                              "filtered": names in provenance, files, JSON */
-  const char *description; /* one line for help texts */
-  int channels;            /* channels of the image; 0 = one per basis
-                              direction (bb_basis.count) */
-  bb_range range;          /* values: BB_RANGE_SIGNED in [-1, 1] (normal,
-                              bent), else BB_RANGE_UNIT in [0, 1] (the
-                              filtered height of a float input may leave it) */
-  int needs_trace;         /* 1: made only by tracing (ssbump, ao, bent) */
-} bb_output_kind_info;
-
-/* The description of kind, or NULL for a value outside
- * 0..BB_OUTPUT_KIND_COUNT-1. */
-const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
-
-/* The kind named name (as bb_output_kind_info.name); returns 0 on success,
- * -1 for an unknown name (out untouched). */
-bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err);
 
 
 typedef struct bb_bake_options {
@@ -1269,8 +1283,8 @@ typedef struct bb_bake_options {
                                  ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
-  unsigned outputs;           /* the maps to make: BB_OUTPUT_BIT(kind)s,
-                                 default BB_OUTPUTS_ALL, not 0. Nothing else
+  unsigned outputs;           /* the maps to make: BB_MAP_BIT(kind)s,
+                                 default BB_MAPS_BAKED, not 0. Nothing else
                                  is computed: no trace without a traced kind
                                  (then rays and slices are not checked); a map
                                  another needs is made and freed (bent needs
@@ -1369,7 +1383,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
+const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 
 void bb_bake_result_free(bb_bake_result *r);
 
@@ -1421,13 +1435,6 @@ bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image
  * BB_MAP_SSBUMP (s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump)
  * or BB_MAP_WEIGHTS (w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake
  * --weights). */
-typedef enum bb_map_kind {
-  BB_MAP_SSBUMP = 0, /* 3 basis channels (further channels: see bb_combine_detail) */
-  BB_MAP_WEIGHTS,    /* normal2ssbump's weights, 3 basis channels */
-  BB_MAP_AO,         /* 1 channel */
-  BB_MAP_NORMAL      /* decoded unit normals, 3 channels */
-} bb_map_kind;
-
 /* The normal of a basis map, the paper's "sum of the basis vectors weighted
  * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
  * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
@@ -1442,14 +1449,11 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
 /* ------------------------------------------------------------- combine */
 
 
-/* Parses "ssbump", "weights", "ao", "normal" (any case). */
-bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
-const char *bb_map_kind_name(bb_map_kind kind);
+/* combine works on BB_MAP_SSBUMP, BB_MAP_WEIGHTS, BB_MAP_AO and
+ * BB_MAP_NORMAL; other kinds are BB_ERR_ARGUMENT. Its operators act on the
+ * kind's bb_map_kind_info.file_channels: 3, or 1 for ao. */
 
-/* Channels the kind's operators act on: 3, or 1 for ao. */
-int bb_map_kind_channels(bb_map_kind kind);
-
-/* The flat, unoccluded texel of kind (channels 0..bb_map_kind_channels-1 of
+/* The flat, unoccluded texel of kind (channels 0..file_channels-1 of
  * texel) as it reads back from a file of that sample depth: an integer file
  * of bits_per_sample bits stores it rounded to a code (an 8-bit ssbump holds
  * 147/255, an 8-bit normal map 128/255, which decodes to x = y = 1/255), a
@@ -1827,20 +1831,12 @@ char *bb_render_options_describe(const bb_render_options *o);
 
 /* ------------------------------------------------------ rendering files */
 
-/* The maps a render can read from files instead of baking a height. */
-typedef enum bb_render_map {
-  BB_RENDER_MAP_NORMAL = 0, /* a normal map, >= 3 channels, decoded to unit N */
-  BB_RENDER_MAP_SSBUMP,     /* >= 3 channels, Half-Life 2's basis */
-  BB_RENDER_MAP_AO,         /* channel 0 */
-  BB_RENDER_MAP_BENT,       /* a bent normal, decoded as a normal map */
-  BB_RENDER_MAP_SLOPE,      /* flipcode's slope bytes / 255 in channel 0 */
-  BB_RENDER_MAP_COUNT       /* number of kinds, not a kind */
-} bb_render_map;
-
-/* "normal", "ssbump", "ao", "bent", "slope" (the command line's options and
- * provenance's map_KIND keys); "unknown" for other values. */
-const char *bb_render_map_name(bb_render_map kind);
-
+/* The maps a render can read from files instead of baking a height:
+ * BB_MAP_NORMAL (>= 3 channels, decoded to unit N), BB_MAP_SSBUMP (>= 3
+ * channels, Half-Life 2's basis), BB_MAP_AO (channel 0), BB_MAP_BENT
+ * (decoded as a normal map), BB_MAP_SLOPE (flipcode's slope bytes / 255 in
+ * channel 0); their names are the command line's options and provenance's
+ * map_KIND keys. */
 /* Reads a map file for a render and checks it for its kind: channels
  * enough, Half-Life 2's basis for an ssbump (bb_basis_map_check), and the
  * size of like when like is not NULL; normal and bent maps are decoded to
@@ -1848,14 +1844,14 @@ const char *bb_render_map_name(bb_render_map kind);
  * *hash (may be NULL) receives bb_image_hash of what the file decoded to.
  * Errors name the file: those of bb_image_read, BB_ERR_ARGUMENT for a map
  * that is not what its kind needs. */
-bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_up,
+bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
 
 /* What a render lit, for its provenance. */
 typedef struct bb_render_sources {
   const char *height;   /* the height file baked for it, or NULL: maps read */
-  const char *maps[BB_RENDER_MAP_COUNT]; /* the map files read, NULL when not */
+  const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
   int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
   const char *albedo;   /* the albedo file, or NULL */
   uint64_t albedo_hash; /* bb_image_hash of the albedo read */
@@ -2367,13 +2363,13 @@ const char *bb_compare_report_result(const bb_compare_report *report);
 
 /* Most files one input's bake writes: Valve's packed file, the maps, the
  * slope map and its lit preview, and a Source material. */
-#define BB_JOB_MAX_OUTPUTS (BB_OUTPUT_KIND_COUNT + 4)
+#define BB_JOB_MAX_OUTPUTS (BB_MAP_BAKED_COUNT + 4)
 /* A batch's file names: the input's stem, the map's name, the input's
  * extension ("{{" and "}}" are braces). */
 #define BB_JOB_DEFAULT_NAME "{stem}_{kind}.png"
 /* The maps a batch writes unless told: Valve's trio. */
 #define BB_JOB_DEFAULT_MAPS \
-  (BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_AO))
+  (BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_AO))
 
 typedef struct bb_job_options {
   bb_bake_options bake;      /* every bake parameter; .outputs is set from
@@ -2391,7 +2387,7 @@ typedef struct bb_job_options {
   const char *brightness_file; /* a brightness map (bake.brightness), read once
                                 by the plan, or NULL */
   /* One input, outputs named one by one (out_dir NULL): */
-  const char *paths[BB_OUTPUT_KIND_COUNT]; /* by bb_output_kind; NULL = not written */
+  const char *paths[BB_MAP_BAKED_COUNT]; /* by bb_map_kind; NULL = not written */
   const char *prefix;        /* also PREFIX_KIND.png for each of
                                 BB_JOB_DEFAULT_MAPS not named in paths, or NULL */
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
@@ -2404,7 +2400,7 @@ typedef struct bb_job_options {
   const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"
                                 makes subfolders, created as needed; a name
                                 must stay inside out_dir */
-  unsigned maps;             /* BB_OUTPUT_BIT(kind)s; 0: BB_JOB_DEFAULT_MAPS */
+  unsigned maps;             /* BB_MAP_BIT(kind)s; 0: BB_JOB_DEFAULT_MAPS */
   int force;                 /* 1: bake inputs whose outputs are up to date too */
   int keep_going;            /* 1: go on after an input fails (bb_job_run) */
   const char *depfile;       /* a Make/Ninja depfile to write, or NULL */
@@ -2467,7 +2463,7 @@ typedef struct bb_job_file {
 typedef struct bb_job_report {
   const char *input;          /* the path as planned (a directory's file: DIR/NAME) */
   int output_count;
-  bb_job_file outputs[BB_JOB_MAX_OUTPUTS]; /* in bb_output_kind order, then slope */
+  bb_job_file outputs[BB_JOB_MAX_OUTPUTS]; /* in bb_map_kind order, then slope */
   bb_job_outcome outcome;
   bb_status status;           /* BB_OK unless FAILED */
   bb_error error;             /* why it FAILED ("PATH: reason") */
@@ -2530,7 +2526,7 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
 
 /* Reads and bakes input i exactly as bb_job_run_item does, but writes
  * nothing and keeps the maps: the job's kinds and those in `also`
- * (BB_OUTPUT_BITs; the maps of the job's kinds are the bits
+ * (BB_MAP_BITs; the maps of the job's kinds are the bits
  * bb_job_run_item would write) go to *result, to be freed with
  * bb_bake_result_free. Fills the report's figures (size, source, threads,
  * slices, seconds) and leaves its outcome alone; for a live view of an
@@ -2797,8 +2793,8 @@ typedef struct bb_command_options {
                                    sheet, combine, ...: the default filled in by
                                    bb_command_check where the command has one) */
   bb_render_options render;     /* render's picture; sheet's lit panel */
-  const char *render_maps[5];   /* render --normal, --ssbump, --ao, --bent, --slope
-                                   (by bb_render_map) */
+  const char *render_maps[BB_MAP_KIND_COUNT]; /* render --normal, --ssbump, --ao,
+                                   --bent, --slope (by bb_map_kind) */
   const char *albedo;           /* render --albedo */
   int render_compare;           /* render --compare */
   int orbit;                    /* render --orbit: frames, 0: one picture */
@@ -2866,7 +2862,7 @@ bb_status bb_command_check(bb_command *command, bb_error *err);
 /* The command runs on images in memory (Python's bumpbake.bake(array),
  * render(...) on arrays), not on files: its inputs are the caller's (not
  * counted), options with BB_OPTION_FILES are refused and none is required,
- * and maps (BB_OUTPUT_BIT(kind)s; 0 for a command that bakes no maps) are
+ * and maps (BB_MAP_BIT(kind)s; 0 for a command that bakes no maps) are
  * the maps asked, for the rules that look at them (--bounce needs a traced
  * map). Call before bb_command_check. */
 void bb_command_set_in_memory(bb_command *command, unsigned maps);

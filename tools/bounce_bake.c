@@ -66,7 +66,7 @@ static int parse_args(int argc, char **argv, args *a) {
   a->bake.smooth.radius_texels = 0;
   a->bake.normal_filter = BB_NORMAL_VALVE;
   a->bake.bounce_albedo = 0.5;
-  a->bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_AO) | BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP);
+  a->bake.outputs = BB_MAP_BIT(BB_MAP_AO) | BB_MAP_BIT(BB_MAP_SSBUMP);
   double v;
   if (parse_number(argv[2], 1e-9, 1e30, &v)) return usage("SCALE must be > 0");
   a->bake.height_scale = (float)v;

@@ -115,16 +115,9 @@ static int read_any(const char *path, int level, bb_image *out) {
   return 0;
 }
 
-static int parse_map(const char *name, bb_texture_map *map) {
-  if (strcmp(name, "plain") == 0)
-    *map = BB_TEXTURE_MAP_PLAIN;
-  else if (strcmp(name, "normal") == 0)
-    *map = BB_TEXTURE_MAP_NORMAL;
-  else if (strcmp(name, "ssbump") == 0)
-    *map = BB_TEXTURE_MAP_SSBUMP;
-  else
-    return -1;
-  return 0;
+/* A map kind as the library names it (plain, normal, ssbump, ...). */
+static int parse_map(const char *name, bb_map_kind *map) {
+  return bb_map_kind_parse(name, map, NULL) == BB_OK ? 0 : -1;
 }
 
 static int cmd_write(int argc, char **argv) {
@@ -161,7 +154,7 @@ static int cmd_write(int argc, char **argv) {
     st = bb_texture_write(argv[1], &img, &o, &err);
   } else {
     bb_write_options w = {BB_DEPTH_DEFAULT,
-                          o.map == BB_TEXTURE_MAP_NORMAL ? BB_RANGE_SIGNED : BB_RANGE_UNIT, NULL, NULL};
+                          bb_map_kind_get(o.map)->range, NULL, NULL};
     st = bb_image_write(argv[1], &img, &w, &err);
   }
   const double seconds = now() - t0;
@@ -198,7 +191,7 @@ static int cmd_decode(int argc, char **argv) {
 static int cmd_compare(int argc, char **argv) {
   if (argc < 2)
     return fail("compare REF DECODED [--map M] [--channels N] [--level K]", NULL);
-  bb_texture_map map = BB_TEXTURE_MAP_PLAIN;
+  bb_map_kind map = BB_MAP_PLAIN;
   int channels = 0, level = 0;
   for (int i = 2; i + 1 < argc; i += 2) {
     if (strcmp(argv[i], "--map") == 0) {
@@ -219,7 +212,7 @@ static int cmd_compare(int argc, char **argv) {
   if (level > 0) {
     bb_image *chain = NULL;
     int count = 0;
-    if (bb_mip_chain(&ref, map == BB_TEXTURE_MAP_NORMAL ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE,
+    if (bb_mip_chain(&ref, bb_map_kind_get(map)->unit_vectors ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE,
                      &chain, &count, &err) != BB_OK)
       return fail(argv[0], &err);
     if (level >= count)
@@ -237,7 +230,7 @@ static int cmd_compare(int argc, char **argv) {
     channels = ref.channels == 1 && dec.channels >= 3 ? 3 : ref.channels;
   if (channels > dec.channels)
     channels = dec.channels;
-  const int normal = map == BB_TEXTURE_MAP_NORMAL;
+  const int normal = bb_map_kind_get(map)->unit_vectors;
   double se = 0, sum = 0, max = 0, angle_sum = 0, angle_max = 0, z_max = 0;
   size_t n = (size_t)ref.width * (size_t)ref.height, samples = 0;
   for (size_t i = 0; i < n; i++) {

@@ -12,10 +12,10 @@ from ._common import (_argument_error, _array, _c_text, _check, _exception, _ffi
 
 
 def _output_kind_table():
-    """{name: (bb_output_kind, needs trace, signed)} in the library's order."""
+    """{name: (bb_map_kind, needs trace, signed)} in the library's order."""
     table = {}
-    for k in range(_lib.BB_OUTPUT_KIND_COUNT):
-        info = _lib.bb_output_kind_get(k)
+    for k in range(_lib.BB_MAP_BAKED_COUNT):
+        info = _lib.bb_map_kind_get(k)
         table[_text(info.name)] = (k, bool(info.needs_trace),
                                    info.range == _lib.BB_RANGE_SIGNED)
     return table
@@ -256,7 +256,7 @@ def normal(height, scale, *, progress=None, **options):
     as `bumpbake normal` makes them (nothing is traced). Options: `bumpbake
     normal`'s that are not about files."""
     result, field = _bake_arrays("normal", height, scale, options,
-                                 1 << _lib.BB_OUTPUT_NORMAL, progress, command="normal")
+                                 1 << _lib.BB_MAP_NORMAL, progress, command="normal")
     try:
         return _array(result.normal)
     finally:

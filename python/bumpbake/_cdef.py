@@ -7,7 +7,7 @@ header and checks every size, offset, enum value and function signature
 declared here, so a change to the header fails that test, naming what to
 update. Declarations are the header's as they are, in its order, comments
 dropped and array sizes and constants written as numbers (BB_MAX_BASIS 16,
-BB_OUTPUT_KIND_COUNT 6, BB_JOB_MAX_OUTPUTS 10; the VTF flags in decimal), which
+BB_MAP_BAKED_COUNT 6, BB_MAP_KIND_COUNT 8, BB_JOB_MAX_OUTPUTS 10; the VTF flags in decimal), which
 cffi needs; the test checks those numbers too.
 """
 
@@ -69,6 +69,29 @@ typedef enum bb_range {
   BB_RANGE_SIGNED
 } bb_range;
 
+typedef enum bb_map_kind {
+  BB_MAP_NORMAL = 0,
+  BB_MAP_WEIGHTS,
+  BB_MAP_SSBUMP,
+  BB_MAP_AO,
+  BB_MAP_BENT,
+  BB_MAP_FILTERED,
+  BB_MAP_SLOPE,
+  BB_MAP_PLAIN,
+  BB_MAP_KIND_COUNT
+} bb_map_kind;
+
+typedef struct bb_map_kind_info {
+  const char *name;
+  const char *description;
+  int channels;
+  int file_channels;
+  bb_range range;
+  int needs_trace;
+  int unit_vectors;
+  uint32_t vtf_flags;
+} bb_map_kind_info;
+
 typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_DEFAULT = 0,
   BB_TEXTURE_FORMAT_BC1,
@@ -82,15 +105,9 @@ typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_RGBA32F
 } bb_texture_format;
 
-typedef enum bb_texture_map {
-  BB_TEXTURE_MAP_PLAIN = 0,
-  BB_TEXTURE_MAP_NORMAL,
-  BB_TEXTURE_MAP_SSBUMP
-} bb_texture_map;
-
 typedef struct bb_texture_options {
   bb_texture_format format;
-  bb_texture_map map;
+  bb_map_kind map;
   int mips;
   int fast;
   int threads;
@@ -178,24 +195,6 @@ struct bb_trace_options {
   void *trace_user;
 };
 
-typedef enum bb_output_kind {
-  BB_OUTPUT_NORMAL = 0,
-  BB_OUTPUT_WEIGHTS,
-  BB_OUTPUT_SSBUMP,
-  BB_OUTPUT_AO,
-  BB_OUTPUT_BENT,
-  BB_OUTPUT_FILTERED,
-  BB_OUTPUT_KIND_COUNT
-} bb_output_kind;
-
-typedef struct bb_output_kind_info {
-  const char *name;
-  const char *description;
-  int channels;
-  bb_range range;
-  int needs_trace;
-} bb_output_kind_info;
-
 typedef struct bb_bake_options {
   float height_scale;
   int rays;
@@ -234,13 +233,6 @@ typedef struct bb_valve_options {
   int normal_map;
   int ao_in_alpha;
 } bb_valve_options;
-
-typedef enum bb_map_kind {
-  BB_MAP_SSBUMP = 0,
-  BB_MAP_WEIGHTS,
-  BB_MAP_AO,
-  BB_MAP_NORMAL
-} bb_map_kind;
 
 typedef struct bb_program bb_program;
 
@@ -325,15 +317,6 @@ typedef struct bb_render_options {
   const bb_image *relief_height;
   double relief_depth;
 } bb_render_options;
-
-typedef enum bb_render_map {
-  BB_RENDER_MAP_NORMAL = 0,
-  BB_RENDER_MAP_SSBUMP,
-  BB_RENDER_MAP_AO,
-  BB_RENDER_MAP_BENT,
-  BB_RENDER_MAP_SLOPE,
-  BB_RENDER_MAP_COUNT
-} bb_render_map;
 
 typedef struct bb_panel_layout {
   int columns;
@@ -566,7 +549,7 @@ typedef struct bb_command_options {
   bb_job_options job;
   const char *output;
   bb_render_options render;
-  const char *render_maps[5];
+  const char *render_maps[8];
   const char *albedo;
   int render_compare;
   int orbit;
@@ -624,6 +607,7 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
                              bb_image_info *info, bb_error *err);
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const char *bb_depth_name(bb_depth depth);
+const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
 const char *bb_texture_format_name(bb_texture_format format);
 bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
@@ -666,8 +650,6 @@ bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *hor
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
                             bb_error *err);
-const bb_output_kind_info *bb_output_kind_get(bb_output_kind kind);
-bb_status bb_output_kind_parse(const char *name, bb_output_kind *out, bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
 int bb_bake_slices(const bb_bake_options *o);
 bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
@@ -675,11 +657,10 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_output_kind kind);
+const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
-bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
                        float texel[3]);
 bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
@@ -704,7 +685,7 @@ bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *
 void bb_render_options_init(bb_render_options *o);
 bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err);
-bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_up,
+bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
 void bb_panel_layout_init(bb_panel_layout *l);
@@ -809,6 +790,8 @@ CONSTANTS = """
 #define BB_MAX_RAYS 65536
 #define BB_MAX_SLICES 256
 #define BB_MAX_BASIS 16
+#define BB_MAP_BAKED_COUNT 6
+#define BB_MAPS_BAKED 63
 #define BB_COMPARE_DIFFERENT_SIZE 3
 #define BB_JOB_MAX_OUTPUTS 10
 #define BB_JOB_DEFAULT_MAPS 13

@@ -157,7 +157,7 @@ _UNIT_KINDS = ("height", "colour", "render")
 
 def _signed(command, kind):
     """True when kind's values are signed unit vectors ([-1, 1]: normal and
-    bent, as bb_output_kind_info says), False for unit values ([0, 1])."""
+    bent, as bb_map_kind_info says), False for unit values ([0, 1])."""
     if kind in _KINDS:
         return _KINDS[kind][2]
     if kind in _UNIT_KINDS:

@@ -21,7 +21,9 @@ DEFAULT_LIGHT = (_DEFAULT_RENDER.light_azimuth, _DEFAULT_RENDER.light_elevation)
 _AUTO = object()  # light not given: on, unless lightmaps are
 
 
+# The maps render() reads, as bb_map_kind values by their names.
 _MAPS = ("normal", "ssbump", "ao", "bent", "slope")
+_MAP_KINDS = {name: getattr(_lib, "BB_MAP_" + name.upper()) for name in _MAPS}
 
 
 def _set_lighting(c, light, lightmap):
@@ -117,13 +119,13 @@ def render(normal=None, ssbump=None, ao=None, bent=None, slope=None, albedo=None
     err = _ffi.new("bb_error *")
     like = _ffi.NULL
     try:
-        for index, name in enumerate(_MAPS):
+        for name in _MAPS:
             value = given[name]
             if value is None:
                 continue
             if isinstance(value, (str, bytes, os.PathLike)):
                 img = _ffi.new("bb_image *")
-                st = _lib.bb_render_map_read(_path(value, name), index, green_up, like,
+                st = _lib.bb_render_map_read(_path(value, name), _MAP_KINDS[name], green_up, like,
                                              img, _ffi.NULL, err)
                 _check(st, err)
                 read.append(img)

@@ -170,8 +170,8 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     bb__rayset_release(&rays);
   bb_pyramid_free(pyramid);
   const unsigned ssbump_or_bent =
-      BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_BENT);
-  const int normal_later = wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL)) && !r->normal.pixels;
+      BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_BENT);
+  const int normal_later = wants(o, BB_MAP_BIT(BB_MAP_NORMAL)) && !r->normal.pixels;
   if (st == BB_OK && wants(o, ssbump_or_bent))
     st = r->normal.pixels
              ? bb__derive_ssbump(&r->normal, &r->vis, &o->basis, threads, &r->ssbump, err)
@@ -179,18 +179,18 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
                                              o->smooth.addressing, &r->vis, &o->basis, threads,
                                              &r->ssbump, err);
   if (st == BB_OK && r->ssbump.pixels && o->bounce_albedo > 0.0) ssbump_cap(&r->ssbump);
-  if (!normal_later && !wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
+  if (!normal_later && !wants(o, BB_MAP_BIT(BB_MAP_FILTERED)))
     bb_image_free(&r->filtered);
-  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_AO)))
+  if (st == BB_OK && wants(o, BB_MAP_BIT(BB_MAP_AO)))
     st = bb__derive_ao(&r->vis, threads, &r->ao, err);
   if (!keep_vis)
     bb_image_free(&r->vis);
   if (st == BB_OK && normal_later)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
                              o->smooth.addressing, threads, NULL, &r->normal, err);
-  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED)))
+  if (!wants(o, BB_MAP_BIT(BB_MAP_FILTERED)))
     bb_image_free(&r->filtered);
-  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_BENT)))
+  if (st == BB_OK && wants(o, BB_MAP_BIT(BB_MAP_BENT)))
     st = bb__derive_bent(&r->ssbump, &o->basis, threads, &r->bent, err);
   r->seconds_derive += bb__now_seconds() - t2;
   return st;
@@ -212,13 +212,13 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
     bb_image_free((bb_image *)height);
   double t1 = bb__now_seconds();
   r->seconds_smooth = t1 - t0;
-  const int normal_now = wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)) ||
-                         (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL)) &&
-                          !wants(o, BB_OUTPUTS_TRACED));
+  const int normal_now = wants(o, BB_MAP_BIT(BB_MAP_WEIGHTS)) ||
+                         (wants(o, BB_MAP_BIT(BB_MAP_NORMAL)) &&
+                          !wants(o, BB_MAPS_TRACED));
   if (st == BB_OK && normal_now)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
                              o->smooth.addressing, threads, &checkpoint, &r->normal, err);
-  if (st == BB_OK && wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)))
+  if (st == BB_OK && wants(o, BB_MAP_BIT(BB_MAP_WEIGHTS)))
     st = bb__derive_weights(&r->normal, &o->basis, threads, &r->weights, err);
   r->seconds_derive = bb__now_seconds() - t1;
   return st;
@@ -228,8 +228,8 @@ static bb_status smooth_and_normals(const bb_image *height, const bb_bake_option
  * derived before, from the ssbump's own directions). */
 static bb_status brightness(const bb_bake_options *o, int threads, bb_bake_result *r,
                             bb_error *err) {
-  bb_image *maps[2] = {wants(o, BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP)) ? &r->ssbump : NULL,
-                       wants(o, BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS)) ? &r->weights : NULL};
+  bb_image *maps[2] = {wants(o, BB_MAP_BIT(BB_MAP_SSBUMP)) ? &r->ssbump : NULL,
+                       wants(o, BB_MAP_BIT(BB_MAP_WEIGHTS)) ? &r->weights : NULL};
   for (int i = 0; i < 2; i++) {
     if (!maps[i] || !maps[i]->pixels) continue;
     bb_image scaled;
@@ -244,9 +244,9 @@ static bb_status brightness(const bb_bake_options *o, int threads, bb_bake_resul
 
 /* Frees what was made only because another map needed it. */
 static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
-  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_FILTERED))) bb_image_free(&r->filtered);
-  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_free(&r->normal);
-  if (!wants(o, BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP))) bb_image_free(&r->ssbump);
+  if (!wants(o, BB_MAP_BIT(BB_MAP_FILTERED))) bb_image_free(&r->filtered);
+  if (!wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb_image_free(&r->normal);
+  if (!wants(o, BB_MAP_BIT(BB_MAP_SSBUMP))) bb_image_free(&r->ssbump);
 }
 
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
@@ -300,11 +300,11 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   r->basis = o->basis;
   const int threads = bb__thread_count(o->trace.threads);
   st = smooth_and_normals(height, o, threads, (flags & BB__BAKE_TAKE_HEIGHT) != 0, r, err);
-  if (st == BB_OK && wants(o, BB_OUTPUTS_TRACED))
+  if (st == BB_OK && wants(o, BB_MAPS_TRACED))
     st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), context, r, err);
   if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
-    if (wants(o, BB_OUTPUT_BIT(BB_OUTPUT_NORMAL))) bb_image_flip_green(&r->normal);
+    if (wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb_image_flip_green(&r->normal);
     if (r->bent.pixels) bb_image_flip_green(&r->bent);
   }
   if (st == BB_ERR_CANCELLED)

@@ -56,10 +56,10 @@ double bb__bake_memory(int width, int height, const bb_bake_options *o, unsigned
   const double t = (double)width * (double)height, texel = 4.0 * t;
   const int lobes = o->basis.count > 0 ? o->basis.count : 3;
   const int threads = bb__thread_count(o->trace.threads);
-  const int traced = wants(o, BB_OUTPUTS_TRACED);
-  const unsigned normal = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL), weights = BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS),
-                 ssbump = BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP), ao = BB_OUTPUT_BIT(BB_OUTPUT_AO),
-                 bent = BB_OUTPUT_BIT(BB_OUTPUT_BENT), filtered = BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  const int traced = wants(o, BB_MAPS_TRACED);
+  const unsigned normal = BB_MAP_BIT(BB_MAP_NORMAL), weights = BB_MAP_BIT(BB_MAP_WEIGHTS),
+                 ssbump = BB_MAP_BIT(BB_MAP_SSBUMP), ao = BB_MAP_BIT(BB_MAP_AO),
+                 bent = BB_MAP_BIT(BB_MAP_BENT), filtered = BB_MAP_BIT(BB_MAP_FILTERED);
   ledger l = {held, held};
   take(&l, texel); /* smoothed height */
   if (flags & BB__BAKE_TAKE_HEIGHT)

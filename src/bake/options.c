@@ -29,7 +29,7 @@ void bb_bake_options_init(bb_bake_options *o) {
   o->power = 1.0;
   bb_basis_init(&o->basis);
   o->normal_filter = BB_NORMAL_VERTEX;
-  o->outputs = BB_OUTPUTS_ALL;
+  o->outputs = BB_MAPS_BAKED;
 }
 
 int bb_bake_slices(const bb_bake_options *o) {
@@ -46,12 +46,12 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
   if (!o)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing options");
   bb_status st = in_range(&bb__range_height_scale, (double)o->height_scale, err);
-  if (st == BB_OK && (o->outputs == 0 || (o->outputs & ~BB_OUTPUTS_ALL) != 0))
+  if (st == BB_OK && (o->outputs == 0 || (o->outputs & ~BB_MAPS_BAKED) != 0))
     st = bb__fail(err, BB_ERR_ARGUMENT,
-                  "bake: outputs must be a non-empty set of BB_OUTPUT_BIT(kind) (got 0x%x)",
+                  "bake: outputs must be a non-empty set of BB_MAP_BIT(kind) (got 0x%x)",
                   o->outputs);
   /* the trace's options mean nothing without a trace */
-  if (st == BB_OK && (o->outputs & BB_OUTPUTS_TRACED)) {
+  if (st == BB_OK && (o->outputs & BB_MAPS_TRACED)) {
     if (!o->slices)
       st = in_range(&bb__range_rays, o->rays, err);
     else
@@ -80,7 +80,7 @@ bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
 }
 
 void bb__bake_resolve(bb_bake_options *o) {
-  if (o->outputs & BB_OUTPUTS_TRACED)
+  if (o->outputs & BB_MAPS_TRACED)
     o->slices = bb_bake_slices(o);
 }
 

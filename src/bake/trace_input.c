@@ -20,7 +20,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *giv
   bb_bake_options prepared;
   const bb_bake_options *o = &prepared;
   bb_status st = bb__bake_prepare(given, &prepared, err);
-  if (st == BB_OK && !(o->outputs & BB_OUTPUTS_TRACED))
+  if (st == BB_OK && !(o->outputs & BB_MAPS_TRACED))
     st = bb__fail(err, BB_ERR_ARGUMENT, "bake: the outputs asked need no trace");
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
   if (st != BB_OK) return st;

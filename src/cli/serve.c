@@ -27,18 +27,18 @@ static int name_outputs(bb_job_options *job, const char *height) {
       *dot = '\0';
   }
   int named = 0;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     named |= job->paths[k] != NULL;
   if (named && !job->prefix)
     return 0; /* the outputs the command line named, and only those */
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    if (!(BB_JOB_DEFAULT_MAPS & BB_OUTPUT_BIT(k)) || job->paths[k])
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    if (!(BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k)) || job->paths[k])
       continue;
     size_t n = strlen(prefix) + 32;
     char *path = malloc(n); /* lives as long as the process */
     if (!path)
       return -1;
-    snprintf(path, n, "%s_%s.png", prefix, bb_output_kind_get((bb_output_kind)k)->name);
+    snprintf(path, n, "%s_%s.png", prefix, bb_map_kind_get((bb_map_kind)k)->name);
     job->paths[k] = path;
   }
   job->prefix = NULL;

@@ -39,6 +39,16 @@ typedef int (*bb__applies_fn)(const bb_command *c);
 typedef const char *(*bb__name_fn)(int i);
 typedef int (*bb__parse_fn)(const char *text, int *value);
 
+/* What a FLAG sets when given besides its own field (if any): the field at
+ * offset to value (INT, ENUM) or to text (STRING, a constant). field NONE:
+ * nothing. A flag that sets one cannot be unset ("0"). */
+typedef struct bb__flag_sets {
+  bb__field field;
+  size_t offset;             /* in bb_command_options */
+  int value;
+  const char *text;
+} bb__flag_sets;
+
 struct bb__option {
   bb_option_info info;       /* first: a bb_option_info * is a bb__option * */
   bb__field field;
@@ -52,6 +62,7 @@ struct bb__option {
   bb__applies_fn applies;    /* NULL: always applies */
   const char *required_note; /* REQUIRED: what it is, after "is required" */
   void (*range_words)(char *out, size_t cap); /* a range spelled from constants */
+  bb__flag_sets sets;        /* FLAG: the other field it sets when given */
 };
 
 typedef struct bb__command bb__command;

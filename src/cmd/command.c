@@ -109,7 +109,8 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   const bb__option *o = c->def->options[i];
   if (o->info.type != BB_OPTION_FLAG && !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
-  if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") && o->set)
+  if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") &&
+      (o->set || o->sets.field != BB__FIELD_NONE))
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out", o->info.name);
   /* A file option names one file: a second, different name would leave
    * the first unwritten (or unread) without a word. The job writes one

@@ -23,7 +23,6 @@ ENUM_WORDS(texture_format, bb_texture_format, bb_texture_format_parse, bb_textur
 ENUM_WORDS(render_mode, bb_render_mode, bb_render_mode_parse, bb_render_mode_name)
 ENUM_WORDS(albedo_mode, bb_albedo_mode, bb_albedo_mode_parse, bb_albedo_mode_name)
 ENUM_WORDS(axis, bb_axis, bb_axis_parse, bb_axis_name)
-ENUM_WORDS(map_kind, bb_map_kind, bb_map_kind_parse, bb_map_kind_name)
 
 /* --depth: "default" is no word of its own */
 const char *bb__name_depth(int i) { return bb_depth_name((bb_depth)i); }
@@ -40,28 +39,28 @@ int bb__parse_normal_y(const char *text, int *value) {
   return bb_normal_y_parse(text, value, NULL) == BB_OK;
 }
 
-/* ssbump2normal --kind: what a basis map holds */
-const char *bb__name_ssbump_kind(int i) {
-  return i == BB_MAP_SSBUMP ? "ssbump" : i == BB_MAP_WEIGHTS ? "weights" : NULL;
-}
-int bb__parse_ssbump_kind(const char *text, int *value) {
-  for (int i = 0; i < 2; i++)
-    if (!strcmp(text, bb__name_ssbump_kind(i))) {
-      *value = i;
-      return 1;
-    }
-  return 0;
-}
+/* Map kinds as words: the library's names and parser (bb_map_kind_name,
+ * bb_map_kind_parse), each option taking its own kinds; "" names a kind the
+ * option does not take. */
+#define KIND_WORDS(stem, kinds)                                                         \
+  const char *bb__name_##stem(int i) {                                                   \
+    if (i < 0 || i >= BB_MAP_KIND_COUNT)                                                 \
+      return NULL;                                                                       \
+    return ((kinds) & BB_MAP_BIT(i)) ? bb_map_kind_name((bb_map_kind)i) : "";            \
+  }                                                                                      \
+  int bb__parse_##stem(const char *text, int *value) {                                   \
+    bb_map_kind k;                                                                       \
+    if (bb_map_kind_parse(text, &k, NULL) != BB_OK || !((kinds) & BB_MAP_BIT(k)))        \
+      return 0;                                                                          \
+    *value = (int)k;                                                                     \
+    return 1;                                                                            \
+  }
 
+/* combine --kind: the maps combine's operators know */
+KIND_WORDS(map_kind, BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_WEIGHTS) |
+                         BB_MAP_BIT(BB_MAP_AO) | BB_MAP_BIT(BB_MAP_NORMAL))
 /* --maps: the bake's maps */
-const char *bb__name_output_kind(int i) {
-  const bb_output_kind_info *k = bb_output_kind_get((bb_output_kind)i);
-  return k ? k->name : NULL;
-}
-int bb__parse_output_kind(const char *text, int *value) {
-  bb_output_kind k;
-  if (bb_output_kind_parse(text, &k, NULL) != BB_OK)
-    return 0;
-  *value = (int)k;
-  return 1;
-}
+KIND_WORDS(output_kind, BB_MAPS_BAKED)
+
+/* ssbump2normal --kind: what a basis map holds */
+KIND_WORDS(ssbump_kind, BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_WEIGHTS))

@@ -73,30 +73,6 @@ static void print_threads(const bb_command *c, const bb__option *o, bb__text *t)
   bb__text_printf(t, "%d", c->options.job.bake.trace.threads);
 }
 
-static bb_status set_clamp(bb_command *c, const bb__option *o, const char *text,
-                           double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.bake.smooth.addressing = BB_ADDRESS_CLAMP;
-  return st;
-}
-
-static bb_status set_nomip(bb_command *c, const bb__option *o, const char *text,
-                           double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.texture.mips = 0;
-  return st;
-}
-
-static bb_status set_fast(bb_command *c, const bb__option *o, const char *text,
-                          double *values, int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.texture.fast = 1;
-  return st;
-}
-
 /* --vtf-version and --vtf-flags: the library's parsers of them. */
 static bb_status set_vtf_version(bb_command *c, const bb__option *o, const char *text,
                                  double *values, int *count, bb_error *err) {
@@ -147,7 +123,7 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
       return bb__fail(err, BB_ERR_ARGUMENT, "--maps: unknown map '%.*s' (one of %s)",
                       (int)(n < 64 ? n : 64), s, choices);
     }
-    maps |= BB_OUTPUT_BIT(kind);
+    maps |= BB_MAP_BIT(kind);
     s += n + (s[n] == ',');
   }
   if (!maps)
@@ -158,8 +134,8 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
 
 static void print_maps(const bb_command *c, const bb__option *o, bb__text *t) {
   int first = 1;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-    if (c->options.job.maps & BB_OUTPUT_BIT(k)) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (c->options.job.maps & BB_MAP_BIT(k)) {
       bb__text_printf(t, "%s%s", first ? "" : ",", o->names(k));
       first = 0;
     }
@@ -195,15 +171,6 @@ static void elevation_range(char *out, size_t cap) {
   char r[32];
   bb__range_text(&bb__range_light_elevation, r, sizeof r);
   snprintf(out, cap, "degrees, EL %s", r);
-}
-
-/* height2ssbump -D: Valve's ./filtered.tga. */
-static bb_status set_dump(bb_command *c, const bb__option *o, const char *text, double *values,
-                          int *count, bb_error *err) {
-  bb_status st = bb__set_generic(c, o, text, values, count, err);
-  if (st == BB_OK)
-    c->options.job.paths[BB_OUTPUT_FILTERED] = "filtered.tga";
-  return st;
 }
 
 /* ------------------------------------------------------------ the rows */
@@ -290,7 +257,7 @@ const bb__option bb__opt_threads = {
 const bb__option bb__opt_clamp = {
     .info = {.name = "clamp", .type = BB_OPTION_FLAG, .flags = RECORDED,
              .default_text = "periodic", .help = "extend border texels instead of tiling"},
-    .set = set_clamp};
+    .sets = {BB__FIELD_ENUM, AT(job.bake.smooth.addressing), BB_ADDRESS_CLAMP, NULL}};
 
 const bb__option bb__opt_channel = {
     .info = {.name = "channel", .type = BB_OPTION_WORD, .count = 1, .values = 1,
@@ -360,17 +327,17 @@ static const bb__option opt_brightness = {
             .help = (help_)},                                                              \
    .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_])}
 static const bb__option opt_out_normal =
-    ROW_MAP_OUT("normal", BB_OUTPUT_NORMAL, "write the normal map");
+    ROW_MAP_OUT("normal", BB_MAP_NORMAL, "write the normal map");
 static const bb__option opt_out_weights =
-    ROW_MAP_OUT("weights", BB_OUTPUT_WEIGHTS, "write the basis weights (normal2ssbump)");
+    ROW_MAP_OUT("weights", BB_MAP_WEIGHTS, "write the basis weights (normal2ssbump)");
 static const bb__option opt_out_ssbump =
-    ROW_MAP_OUT("ssbump", BB_OUTPUT_SSBUMP, "write the self-shadowed bump map (traces)");
+    ROW_MAP_OUT("ssbump", BB_MAP_SSBUMP, "write the self-shadowed bump map (traces)");
 static const bb__option opt_out_ao =
-    ROW_MAP_OUT("ao", BB_OUTPUT_AO, "write the ambient occlusion (traces)");
+    ROW_MAP_OUT("ao", BB_MAP_AO, "write the ambient occlusion (traces)");
 static const bb__option opt_out_bent =
-    ROW_MAP_OUT("bent", BB_OUTPUT_BENT, "write the bent normal (traces)");
+    ROW_MAP_OUT("bent", BB_MAP_BENT, "write the bent normal (traces)");
 static const bb__option opt_out_filtered =
-    ROW_MAP_OUT("filtered", BB_OUTPUT_FILTERED, "write the smoothed height");
+    ROW_MAP_OUT("filtered", BB_MAP_FILTERED, "write the smoothed height");
 
 static const bb__option opt_slope = {
     .info = {.name = "slope", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
@@ -482,14 +449,14 @@ const bb__option bb__opt_nomip = {
     .info = {.name = "nomip", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .applies = "a .vtf or .dds output",
              .help = "write .vtf/.dds without their mip chain (vtex's nomip)"},
-    .set = set_nomip, .applies = bb__applies_texture};
+    .sets = {BB__FIELD_INT, AT(job.texture.mips), 0, NULL}, .applies = bb__applies_texture};
 
 const bb__option bb__opt_fast_compression = {
     .info = {.name = "fast-compression", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "off", .applies = "a .vtf or .dds output",
              .help = "block-compress with libsquish's range fit: far faster, ~1-2 dB lower "
                      "PSNR on DXT1/DXT5"},
-    .set = set_fast, .applies = bb__applies_texture};
+    .sets = {BB__FIELD_INT, AT(job.texture.fast), 1, NULL}, .applies = bb__applies_texture};
 
 static const bb__option opt_vmt = {
     .info = {.name = "vmt", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
@@ -580,7 +547,7 @@ static const bb__option opt_normal_output = {
     .info = {.name = "output", .short_name = 'o', .value_name = "OUT", .type = BB_OPTION_PATH,
              .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_REQUIRED | BB_OPTION_FILES,
              .help = "normal map to write (.png .tga .tif .exr); required"},
-    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_OUTPUT_NORMAL])};
+    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL])};
 
 static const bb__option opt_quiet_normal = {
     .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,
@@ -595,7 +562,7 @@ static const bb__option *const normal_options[] = {
     &bb__opt_json, &opt_quiet_normal, &bb__opt_help, NULL};
 
 static void normal_init(bb_command_options *o) {
-  o->job.bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL); /* no rays, nothing else */
+  o->job.bake.outputs = BB_MAP_BIT(BB_MAP_NORMAL); /* no rays, nothing else */
 }
 
 static bb_status normal_job(bb_command *c, bb_job_options *o, bb_error *err) {
@@ -630,7 +597,7 @@ static const bb__option opt_valve_dump = {
     .info = {.name = "dump-filtered", .short_name = 'D', .type = BB_OPTION_FLAG,
              .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .help = "also write the filtered height as ./filtered.tga"},
-    .set = set_dump};
+    .sets = {BB__FIELD_STRING, AT(job.paths[BB_MAP_FILTERED]), 0, "filtered.tga"}};
 static const bb__option opt_valve_detail = {
     .info = {.name = "detail", .short_name = 'd', .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "off",

@@ -251,15 +251,15 @@ static const bb__option opt_output = {
             .values = 1, .flags = RECORDED, .default_text = (default_), .help = (help_)},   \
    .field = BB__FIELD_STRING, .offset = AT(render_maps[map_])}
 static const bb__option opt_in_normal = ROW_MAP_IN(
-    "normal", BB_RENDER_MAP_NORMAL, "baked normal map to light (instead of HEIGHT)", NULL);
+    "normal", BB_MAP_NORMAL, "baked normal map to light (instead of HEIGHT)", NULL);
 static const bb__option opt_in_ssbump =
-    ROW_MAP_IN("ssbump", BB_RENDER_MAP_SSBUMP, "baked ssbump to light (instead of HEIGHT)", NULL);
+    ROW_MAP_IN("ssbump", BB_MAP_SSBUMP, "baked ssbump to light (instead of HEIGHT)", NULL);
 static const bb__option opt_in_ao =
-    ROW_MAP_IN("ao", BB_RENDER_MAP_AO, "baked ambient occlusion (instead of HEIGHT)", NULL);
+    ROW_MAP_IN("ao", BB_MAP_AO, "baked ambient occlusion (instead of HEIGHT)", NULL);
 static const bb__option opt_in_bent = ROW_MAP_IN(
-    "bent", BB_RENDER_MAP_BENT, "baked bent normal for the specular", "from the ssbump");
+    "bent", BB_MAP_BENT, "baked bent normal for the specular", "from the ssbump");
 static const bb__option opt_in_slope =
-    ROW_MAP_IN("slope", BB_RENDER_MAP_SLOPE,
+    ROW_MAP_IN("slope", BB_MAP_SLOPE,
                "baked flipcode slope map for --mode slope (instead of HEIGHT)", NULL);
 
 static const bb__option opt_albedo = {
@@ -363,13 +363,13 @@ static void lights(bb_command *c) {
 /* A HEIGHT or the maps the picture needs, not both; what --relief,
  * --orbit and a GIF need. */
 static bb_status render_check(bb_command *c, bb_error *err) {
-  static const unsigned map_need[BB_RENDER_MAP_COUNT] = {
-      BB_RENDER_NEEDS_NORMAL, BB_RENDER_NEEDS_SSBUMP, BB_RENDER_NEEDS_AO, 0,
-      BB_RENDER_NEEDS_SLOPE};
+  static const unsigned map_need[BB_MAP_KIND_COUNT] = {
+      [BB_MAP_NORMAL] = BB_RENDER_NEEDS_NORMAL, [BB_MAP_SSBUMP] = BB_RENDER_NEEDS_SSBUMP,
+      [BB_MAP_AO] = BB_RENDER_NEEDS_AO, [BB_MAP_SLOPE] = BB_RENDER_NEEDS_SLOPE};
   bb_command_options *o = &c->options;
   lights(c);
   int any_map = 0;
-  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
     any_map |= o->render_maps[m] != NULL;
   const char *height = c->input_count ? c->inputs[0] : NULL;
   if (height && any_map)
@@ -390,11 +390,11 @@ static bb_status render_check(bb_command *c, bb_error *err) {
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "missing HEIGHT or baked maps (usage: bumpbake render %s)",
                     bb__command_render.info.synopsis);
-  for (int m = 0; !height && m < BB_RENDER_MAP_COUNT; m++)
+  for (int m = 0; !height && m < BB_MAP_KIND_COUNT; m++)
     if ((needed_maps(o) & map_need[m]) && !o->render_maps[m])
       return bb__fail(err, BB_ERR_ARGUMENT, "%s needs --%s FILE (or a HEIGHT to bake)",
                       o->render_compare ? "--compare" : bb_render_mode_name(o->render.mode),
-                      bb_render_map_name((bb_render_map)m));
+                      bb_map_kind_name((bb_map_kind)m));
   /* before any pixel is read, from the files' headers: the maps' size, the
    * picture the options make of it, the memory the render takes
    * (bb_render_files_check); a tile or crop the input cannot take is a
@@ -402,14 +402,14 @@ static bb_status render_check(bb_command *c, bb_error *err) {
   if (!c->in_memory) {
     bb_render_sources files;
     memset(&files, 0, sizeof files);
-    for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+    for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
       files.maps[m] = o->render_maps[m];
     files.height = height;
     files.albedo = o->albedo;
     bb_bake_options bake = o->job.bake;
     const int traced = (needed_maps(o) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
-    bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
-                   (traced ? BB_OUTPUTS_TRACED : 0u);
+    bake.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_FILTERED) |
+                   (traced ? BB_MAPS_TRACED : 0u);
     int w = 0, h = 0;
     bb_error why = {{0}};
     bb_status st = bb_render_files_check(&files, &bake, &o->render, o->render_compare, o->output,
@@ -435,9 +435,9 @@ static bb_status render_check(bb_command *c, bb_error *err) {
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: GIF files are 8-bit", o->output);
   }
   /* the output against every file read, every frame of an orbit */
-  const char *reads[BB_RENDER_MAP_COUNT + 2];
+  const char *reads[BB_MAP_KIND_COUNT + 2];
   int n_reads = 0;
-  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
     if (o->render_maps[m])
       reads[n_reads++] = o->render_maps[m];
   if (height)

@@ -24,7 +24,7 @@ static int outputs(const bb_command *c, const char **out) {
     out[n++] = o->job.name_template ? o->job.name_template : BB_JOB_DEFAULT_NAME;
     return n;
   }
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     if (o->job.paths[k])
       out[n++] = o->job.paths[k];
   if (o->job.slope_path)
@@ -37,7 +37,7 @@ static int outputs(const bb_command *c, const char **out) {
 }
 
 static int any_output(const bb_command *c, const char *ext, const char *also) {
-  const char *paths[BB_OUTPUT_KIND_COUNT + 4];
+  const char *paths[BB_MAP_BAKED_COUNT + 4];
   const int n = outputs(c, paths);
   for (int i = 0; i < n; i++)
     if (has_extension(paths[i], ext) || (also && has_extension(paths[i], also)))
@@ -59,18 +59,18 @@ static unsigned maps_asked(const bb_command *c) {
   if (c->in_memory)
     return c->memory_maps;
   if (!strcmp(c->def->info.name, "serve"))
-    return BB_OUTPUTS_ALL; /* its page shows every map */
+    return BB_MAPS_BAKED; /* its page shows every map */
   if (j->out_dir)
     return j->maps ? j->maps : BB_JOB_DEFAULT_MAPS;
   unsigned maps = j->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     if (j->paths[k])
-      maps |= BB_OUTPUT_BIT(k);
+      maps |= BB_MAP_BIT(k);
   return maps;
 }
 
 int bb__applies_traced(const bb_command *c) {
-  return (maps_asked(c) & BB_OUTPUTS_TRACED) != 0;
+  return (maps_asked(c) & BB_MAPS_TRACED) != 0;
 }
 
 int bb__applies_bounces(const bb_command *c) {
@@ -79,5 +79,5 @@ int bb__applies_bounces(const bb_command *c) {
 
 int bb__applies_brightness(const bb_command *c) {
   return (maps_asked(c) &
-          (BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS))) != 0;
+          (BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_WEIGHTS))) != 0;
 }

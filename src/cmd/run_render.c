@@ -32,7 +32,7 @@ typedef struct render_inputs {
   bb_image height;
   bb_height_source source; /* the height's, when one was baked */
   bb_bake_result bake;
-  bb_image maps[BB_RENDER_MAP_COUNT]; /* read from files */
+  bb_image maps[BB_MAP_KIND_COUNT]; /* read from files */
   bb_image albedo;
   bb_image slope;      /* made from the bake's filtered height for --mode slope */
   bb_render_maps view; /* pointers into the above */
@@ -44,7 +44,7 @@ typedef struct render_inputs {
 static void inputs_free(render_inputs *in) {
   bb_image_free(&in->height);
   bb_bake_result_free(&in->bake);
-  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
     bb_image_free(&in->maps[m]);
   bb_image_free(&in->albedo);
   bb_image_free(&in->slope);
@@ -73,13 +73,13 @@ static bb_status check_view(const render_args *a, const bb_image *size, bb_error
 static bb_status load_maps(const render_args *a, render_inputs *in, bb_error *err) {
   const bb_image *size = NULL;
   in->sources.maps_normal_y_up = a->green_up;
-  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++) {
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++) {
     const char *path = a->o->render_maps[m];
     if (!path)
       continue;
     bb_error e = {{0}};
     uint64_t hash = 0;
-    bb_status st = bb_render_map_read(path, (bb_render_map)m, a->green_up, size, &in->maps[m],
+    bb_status st = bb_render_map_read(path, (bb_map_kind)m, a->green_up, size, &in->maps[m],
                                       &hash, &e);
     if (st != BB_OK)
       return bb__fail_at(err, st, path, &e);
@@ -94,15 +94,15 @@ static bb_status load_maps(const render_args *a, render_inputs *in, bb_error *er
   bb_status st = check_view(a, size, err);
   if (st != BB_OK)
     return st;
-  for (int m = 0; m < BB_RENDER_MAP_COUNT; m++) {
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++) {
     const bb_image *map = in->maps[m].pixels ? &in->maps[m] : NULL;
-    switch ((bb_render_map)m) {
-    case BB_RENDER_MAP_NORMAL: in->view.normal = map; break;
-    case BB_RENDER_MAP_SSBUMP: in->view.ssbump = map; break;
-    case BB_RENDER_MAP_AO: in->view.ao = map; break;
-    case BB_RENDER_MAP_BENT: in->view.bent = map; break;
-    case BB_RENDER_MAP_SLOPE: in->view.slope = map; break;
-    case BB_RENDER_MAP_COUNT: break;
+    switch ((bb_map_kind)m) {
+    case BB_MAP_NORMAL: in->view.normal = map; break;
+    case BB_MAP_SSBUMP: in->view.ssbump = map; break;
+    case BB_MAP_AO: in->view.ao = map; break;
+    case BB_MAP_BENT: in->view.bent = map; break;
+    case BB_MAP_SLOPE: in->view.slope = map; break;
+    default: break;
     }
   }
   return BB_OK;
@@ -119,8 +119,8 @@ static bb_status bake_for_picture(render_args *a, const bb_image *height, const 
   if (st != BB_OK)
     return st;
   const int traced = (needed_maps(a) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
-  a->bake.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED) |
-                    (traced ? BB_OUTPUTS_TRACED : 0u);
+  a->bake.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_FILTERED) |
+                    (traced ? BB_MAPS_TRACED : 0u);
   a->bake.trace.progress = hooks ? hooks->progress : NULL;
   a->bake.trace.progress_user = hooks ? hooks->progress_user : NULL;
   bb_error e = {{0}};
@@ -237,7 +237,7 @@ static bb_status write_pictures(const render_args *a, const char *command_line,
                                 const render_inputs *in, bb_command_result *result,
                                 bb_error *err) {
   const int baked = a->height_path != NULL;
-  const int traced = baked && (a->bake.outputs & BB_OUTPUTS_TRACED);
+  const int traced = baked && (a->bake.outputs & BB_MAPS_TRACED);
   const bb__job_source source = {.command = command_line,
                                  .input = in->input,
                                  .input_hash = in->input_hash,

@@ -64,7 +64,8 @@ void bb__choices(const bb__option *o, char *out, size_t cap) {
     const char *name = o->names(i);
     if (!name || !strcmp(name, "unknown"))
       break;
-    if (!strcmp(name, "default")) /* the enum's "not asked", no word of its own */
+    if (!strcmp(name, "default") || !name[0]) /* the enum's "not asked", or a value
+                                                  the option does not take */
       continue;
     int n = snprintf(out + used, cap - used, "%s%s", used ? "|" : "", name);
     if (n < 0 || (size_t)n >= cap - used)
@@ -159,6 +160,19 @@ static bb_status parse_word(const bb__option *o, const char *text, int *value, b
                   text);
 }
 
+/* A given flag's other field (bb__flag_sets). */
+static void set_flag_sets(bb_command *c, const bb__flag_sets *s) {
+  void *field = (char *)&c->options + s->offset;
+  switch (s->field) {
+  case BB__FIELD_INT:
+  case BB__FIELD_ENUM: *(int *)field = s->value; break;
+  case BB__FIELD_STRING: *(const char **)field = s->text; break;
+  case BB__FIELD_NONE:
+  case BB__FIELD_FLOAT:
+  case BB__FIELD_DOUBLE: break;
+  }
+}
+
 bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
                           double *values, int *count, bb_error *err) {
   char name[80];
@@ -178,6 +192,7 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
       return bb__fail(err, BB_ERR_ARGUMENT, "%s takes no value", name);
     if (o->field == BB__FIELD_INT)
       *(int *)field = 1;
+    set_flag_sets(c, &o->sets);
     return BB_OK;
   case BB_OPTION_INT:
     st = parse_integer(o, text, &values[0], err);

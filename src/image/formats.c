@@ -141,7 +141,7 @@ void bb__texture_options_of(const bb_write_options *options, bb_texture_options 
     *out = *o->texture;
   } else {
     bb_texture_options_init(out);
-    out->map = o->range == BB_RANGE_SIGNED ? BB_TEXTURE_MAP_NORMAL : BB_TEXTURE_MAP_PLAIN;
+    out->map = o->range == BB_RANGE_SIGNED ? BB_MAP_NORMAL : BB_MAP_PLAIN;
   }
   if (o->description) out->description = o->description;
 }

@@ -17,9 +17,9 @@
 
 /* The levels to write: bb_mip_chain of img by the map's rule (it also
  * rejects NaN and infinite texels). */
-static bb_status texture_chain(const bb_image *img, bb_texture_map map, bb_image **levels,
+static bb_status texture_chain(const bb_image *img, bb_map_kind map, bb_image **levels,
                                int *count, bb_error *err) {
-  return bb_mip_chain(img, bb__mip_filter(map == BB_TEXTURE_MAP_NORMAL), levels, count, err);
+  return bb_mip_chain(img, bb__mip_filter(bb_map_kind_get(map)->unit_vectors), levels, count, err);
 }
 
 /* A caller's chain must be one bb_mip_chain could have made (each level

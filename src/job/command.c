@@ -104,10 +104,10 @@ static void add_settings(bb__text *t, const bb_job_options *o) {
 /* The outputs: one by one, or a batch's directory, maps and names. */
 static void add_outputs(bb__text *t, const bb_job_options *o) {
   if (!o->out_dir) {
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       if (o->paths[k]) {
         char name[32];
-        snprintf(name, sizeof name, "--%s", bb_output_kind_get((bb_output_kind)k)->name);
+        snprintf(name, sizeof name, "--%s", bb_map_kind_get((bb_map_kind)k)->name);
         add_option(t, name, o->paths[k]);
       }
     if (o->slope_path)
@@ -125,10 +125,10 @@ static void add_outputs(bb__text *t, const bb_job_options *o) {
   const unsigned maps = o->maps ? o->maps : BB_JOB_DEFAULT_MAPS;
   if (maps != BB_JOB_DEFAULT_MAPS) {
     char list[128] = "";
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-      if (maps & BB_OUTPUT_BIT(k))
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+      if (maps & BB_MAP_BIT(k))
         snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? "," : "",
-                 bb_output_kind_get((bb_output_kind)k)->name);
+                 bb_map_kind_get((bb_map_kind)k)->name);
     add_option(t, "--maps", list);
   }
   if (o->name_template)

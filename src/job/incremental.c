@@ -84,7 +84,7 @@ void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
     return;
   out[0] = '\0';
   bb_bake_options prepared;
-  if (!o || !(o->outputs & BB_OUTPUTS_TRACED) || bb__bake_prepare(o, &prepared, NULL) != BB_OK)
+  if (!o || !(o->outputs & BB_MAPS_TRACED) || bb__bake_prepare(o, &prepared, NULL) != BB_OK)
     return;
   bb__rayset_id(prepared.slices, o->power, &o->basis, out, cap);
 }

@@ -71,7 +71,7 @@ char *bb__depfile_text(const bb__dep_rule *rules, int count, size_t *size);
  * options' own for a single input). */
 typedef struct bb__job_item {
   char *input;
-  char *paths[BB_OUTPUT_KIND_COUNT]; /* NULL = kind not written */
+  char *paths[BB_MAP_BAKED_COUNT]; /* NULL = kind not written */
   char *slope_lit_path;              /* single input with slope_lit */
   uint64_t file_hash;                /* the bytes checked for currency, 0 = not yet */
   bb_job_report report;

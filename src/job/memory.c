@@ -23,7 +23,7 @@ static double sample_bytes(bb_depth depth, const char *path) {
  * float, made whether it is written or not, and every level in the file's
  * format (4/3 of the top level's bytes), twice for colour blocks (range
  * fit's candidates beside cluster fit's, texture/blocks.h). */
-static double texture_bytes(const bb_job *job, const char *path, const bb_output_kind_info *kind,
+static double texture_bytes(const bb_job *job, const char *path, const bb_map_kind_info *kind,
                             int w, int h, int channels) {
   const bb_texture_options t = bb__job_texture_of(&job->options.texture, kind->name, kind->range);
   bb_texture_format format;
@@ -48,10 +48,10 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
    * quantised copy (its mip chain in float too), the files encoded side by
    * side */
   double encode = 0.0;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (!item->paths[k])
       continue;
-    const bb_output_kind_info *kind = bb_output_kind_get((bb_output_kind)k);
+    const bb_map_kind_info *kind = bb_map_kind_get((bb_map_kind)k);
     const int c = kind->channels ? kind->channels : o->basis.count;
     const double samples = t * c;
     if (bb_path_is_texture_format(item->paths[k])) {

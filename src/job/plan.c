@@ -21,7 +21,7 @@
 #include <unistd.h>
 
 static const char *kind_name(int kind) {
-  return bb_output_kind_get((bb_output_kind)kind)->name;
+  return bb_map_kind_get((bb_map_kind)kind)->name;
 }
 
 static char *copy(const char *s) {
@@ -87,7 +87,7 @@ static int is_baked_map(const char *path) {
   int baked = 0;
   if (bb_provenance_classify(info.description) != BB_PROVENANCE_NONE &&
       bb_provenance_value(info.description, "output", kind, sizeof kind))
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       baked |= strcmp(kind, kind_name(k)) == 0;
   bb_image_info_free(&info);
   return baked;
@@ -272,8 +272,8 @@ static bb_status name_outputs(bb_job *job, bb__job_item *item, bb_error *err) {
   char stem[1024], ext[64], name[4096];
   split_name(item->input, stem, sizeof stem, ext, sizeof ext);
   const char *tmpl = job->name_template ? job->name_template : BB_JOB_DEFAULT_NAME;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    if (!(job->options.bake.outputs & BB_OUTPUT_BIT(k)))
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    if (!(job->options.bake.outputs & BB_MAP_BIT(k)))
       continue;
     const char *fields[3] = {stem, kind_name(k), ext};
     bb_status st = expand_name(tmpl, fields, name, sizeof name, err);
@@ -322,7 +322,7 @@ static int by_path(const void *a, const void *b) {
  * made the same way under one directory, so equal files have equal
  * spellings), and outputs that are one of the inputs. */
 static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
-  planned_output *outs = malloc((size_t)job->count * BB_OUTPUT_KIND_COUNT * sizeof *outs);
+  planned_output *outs = malloc((size_t)job->count * BB_MAP_BAKED_COUNT * sizeof *outs);
   bb__file_identity *in = malloc((size_t)job->count * sizeof *in);
   bb_status st = BB_OK;
   if (!outs || !in)
@@ -330,7 +330,7 @@ static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
   int n = 0;
   for (int i = 0; i < job->count && st == BB_OK; i++) {
     in[i] = bb__file_identify(job->items[i].input);
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       if (job->items[i].paths[k])
         outs[n++] = (planned_output){job->items[i].paths[k], i, k};
   }
@@ -369,7 +369,7 @@ static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
 static bb_status check_channels(const bb_job *job, const char *path, int kind, bb_error *err) {
   const bb_basis *basis = &job->options.bake.basis;
   const int room = bb_path_max_channels(path);
-  if (bb_output_kind_get((bb_output_kind)kind)->channels != 0 || basis->count <= room)
+  if (bb_map_kind_get((bb_map_kind)kind)->channels != 0 || basis->count <= room)
     return BB_OK;
   char ext[17];
   bb__extension_of(path, ext, sizeof ext);
@@ -383,7 +383,7 @@ static bb_status check_channels(const bb_job *job, const char *path, int kind, b
 /* The channels a map of kind has (one per basis direction for weights
  * and ssbump). */
 static int kind_channels(const bb_job *job, int kind) {
-  const int c = bb_output_kind_get((bb_output_kind)kind)->channels;
+  const int c = bb_map_kind_get((bb_map_kind)kind)->channels;
   return c ? c : job->options.bake.basis.count;
 }
 
@@ -393,7 +393,7 @@ static int kind_channels(const bb_job *job, int kind) {
 static void texture_input_size(const bb__job_item *item, int *width, int *height) {
   *width = *height = 0;
   int textures = 0;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     textures |= item->paths[k] && bb_path_is_texture_format(item->paths[k]);
   if (textures && bb_image_read_info(item->input, width, height, NULL, NULL, NULL) != BB_OK)
     *width = *height = 0;
@@ -406,7 +406,7 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
   int kinds[BB_JOB_MAX_OUTPUTS];
   int n = 0, width, height;
   texture_input_size(item, &width, &height);
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     if (item->paths[k]) {
       kinds[n] = k;
       specs[n++] = (bb_output_spec){item->paths[k],
@@ -421,7 +421,7 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
                                     0,
                                     width,
                                     height,
-                                    bb_output_kind_get((bb_output_kind)k)->range,
+                                    bb_map_kind_get((bb_map_kind)k)->range,
                                     &job->options.texture};
     }
   const int maps = n;
@@ -476,7 +476,7 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
     int t = 0;
     if (job->valve_path)
       targets[t++] = job->valve_path;
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       if (item->paths[k])
         targets[t++] = item->paths[k];
     if (job->slope_path)
@@ -530,14 +530,14 @@ static unsigned asked_kinds(const bb_job_options *o) {
   if (o->out_dir)
     return o->maps ? o->maps : BB_JOB_DEFAULT_MAPS;
   unsigned mask = o->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     if (o->paths[k])
-      mask |= BB_OUTPUT_BIT(k);
+      mask |= BB_MAP_BIT(k);
   if (o->slope_path)
-    mask |= BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+    mask |= BB_MAP_BIT(BB_MAP_FILTERED);
   if (o->valve_path)
-    mask |= BB_OUTPUT_BIT(o->valve.normal_map ? BB_OUTPUT_NORMAL : BB_OUTPUT_SSBUMP) |
-            BB_OUTPUT_BIT(o->valve.ao_in_alpha ? BB_OUTPUT_AO : BB_OUTPUT_FILTERED);
+    mask |= BB_MAP_BIT(o->valve.normal_map ? BB_MAP_NORMAL : BB_MAP_SSBUMP) |
+            BB_MAP_BIT(o->valve.ao_in_alpha ? BB_MAP_AO : BB_MAP_FILTERED);
   return mask;
 }
 
@@ -592,13 +592,13 @@ static bb_status check_options(const bb_job_options *o, const char *const *input
     return bb__fail(err, BB_ERR_ARGUMENT, "no input given");
   if (o->out_dir) {
     int named = o->slope_path != NULL || o->prefix != NULL || o->valve_path != NULL;
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       named |= o->paths[k] != NULL;
     if (named)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "--out-dir names the outputs: choose the maps with --maps, not -o, "
                       "--MAP FILE or --slope");
-    if (o->maps & ~BB_OUTPUTS_ALL)
+    if (o->maps & ~BB_MAPS_BAKED)
       return bb__fail(err, BB_ERR_ARGUMENT, "maps: unknown map bits 0x%x", o->maps);
     if (o->vmt)
       return bb__fail(err, BB_ERR_ARGUMENT,
@@ -692,11 +692,11 @@ static bb_status read_bake_maps(bb_job *job, bb_error *err) {
  * where a prefix is given. */
 static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err) {
   bb__job_item *item = &job->items[0];
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (o->paths[k]) {
       if (!(item->paths[k] = strdup(o->paths[k])))
         return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-    } else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_OUTPUT_BIT(k))) {
+    } else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k))) {
       const size_t len = strlen(o->prefix) + strlen(kind_name(k)) + sizeof "_.png";
       if (!(item->paths[k] = malloc(len)))
         return bb__fail(err, BB_ERR_MEMORY, "out of memory");
@@ -726,7 +726,7 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
   if (!job->vmt)
     return BB_OK;
   const bb__job_item *item = &job->items[0];
-  const char *ssbump = item->paths[BB_OUTPUT_SSBUMP], *normal = item->paths[BB_OUTPUT_NORMAL];
+  const char *ssbump = item->paths[BB_MAP_SSBUMP], *normal = item->paths[BB_MAP_NORMAL];
   int is_ssbump = ssbump && is_vtf(ssbump);
   const char *bump = is_ssbump ? ssbump : normal && is_vtf(normal) ? normal : NULL;
   if (job->valve_path) { /* Valve's file is the bump map, whatever it is named */
@@ -765,7 +765,7 @@ static bb_status create_directory_of(const char *path, bb_error *err) {
 static bb_status create_directories(const bb_job *job, bb_error *err) {
   bb_status st = job->out_dir ? bb_directory_create(job->out_dir, err) : BB_OK;
   for (int i = 0; i < job->count && st == BB_OK; i++) {
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++)
       st = create_directory_of(job->items[i].paths[k], err);
     if (st == BB_OK)
       st = create_directory_of(job->items[i].slope_lit_path, err);
@@ -785,7 +785,7 @@ static void init_reports(bb_job *job) {
     if (job->valve_path)
       r->outputs[r->output_count++] =
           (bb_job_file){bb__job_valve_kind(&job->options), job->valve_path};
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       if (item->paths[k])
         r->outputs[r->output_count++] = (bb_job_file){kind_name(k), item->paths[k]};
     if (job->slope_path)
@@ -827,7 +827,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = gather_inputs(job, inputs, input_count, err);
   if (st == BB_OK && !job->batch)
     st = name_single(job, o, err);
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK && !job->batch; k++)
+  for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK && !job->batch; k++)
     job->options.paths[k] = job->items[0].paths[k]; /* the job's copies */
   if (st == BB_OK && !job->batch)
     st = plan_material(job, err);
@@ -860,7 +860,7 @@ void bb_job_free(bb_job *job) {
     return;
   for (int i = 0; i < job->count; i++) {
     free(job->items[i].input);
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       free(job->items[i].paths[k]);
     free(job->items[i].slope_lit_path);
   }

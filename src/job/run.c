@@ -15,15 +15,15 @@
 #include <time.h>
 #include <unistd.h>
 
-static const bb_output_kind_info *kind_info(int kind) {
-  return bb_output_kind_get((bb_output_kind)kind);
+static const bb_map_kind_info *kind_info(int kind) {
+  return bb_map_kind_get((bb_map_kind)kind);
 }
 
 /* The depth kind is written with: the job's, but the filtered height keeps
  * the input's depth where the format holds it unless a depth was asked. */
 static bb_depth output_depth(const bb_job *job, int kind, const char *path, int bits,
                              int is_float) {
-  if (kind == BB_OUTPUT_FILTERED)
+  if (kind == BB_MAP_FILTERED)
     return bb__job_depth(job->options.depth, bits, is_float, path);
   return job->options.depth;
 }
@@ -73,7 +73,7 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
     is_float = info.is_float;
     bb_image_info_free(&info);
   }
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (!item->paths[k])
       continue;
     /* A texture's settings are part of its provenance (bb_image_write adds them). */
@@ -221,7 +221,7 @@ static bb_status make_valve(const bb_job *job, const bb__job_item *item, baked *
 /* The provenance text of one output of item. */
 static char *describe(const bb_job *job, const char *command, const baked *b,
                       const bb_job_report *r, const char *kind) {
-  const int traced = (job->options.bake.outputs & BB_OUTPUTS_TRACED) != 0;
+  const int traced = (job->options.bake.outputs & BB_MAPS_TRACED) != 0;
   /* Valve's file names the channel its rule took (alpha, or the grey) */
   const bb_channel channel = job->valve_path ? r->source.channel : job->options.channel;
   const bb__job_source s = {.command = command,
@@ -290,13 +290,13 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT && st == BB_OK; k++) {
+  for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++) {
     if (!item->paths[k])
       continue;
     b->descriptions[n] = describe(job, command, b, r, kind_info(k)->name);
     files[n] = (bb_output_file){item->paths[k],
                                 kind_info(k)->name,
-                                bb_bake_result_image(&b->result, (bb_output_kind)k),
+                                bb_bake_result_image(&b->result, (bb_map_kind)k),
                                 kind_info(k)->range,
                                 output_depth(job, k, item->paths[k], r->source.bits_per_sample,
                                              r->source.is_float),
@@ -431,7 +431,7 @@ bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn pro
     memset(result, 0, sizeof *result);
   if (!job || i < 0 || i >= job->count || !result)
     return bb__fail(err, BB_ERR_ARGUMENT, "job bake: bad arguments");
-  if (also & ~(unsigned)BB_OUTPUTS_ALL)
+  if (also & ~(unsigned)BB_MAPS_BAKED)
     return bb__fail(err, BB_ERR_ARGUMENT, "job bake: unknown map bits 0x%x", also);
   baked b;
   memset(&b, 0, sizeof b);
@@ -464,9 +464,9 @@ bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb
                     "job write: %s: Valve's detail variant reads the input again "
                     "(bb_job_run_item writes it)",
                     item->input);
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    const bb_image *m = bb_bake_result_image(result, (bb_output_kind)k);
-    const int needed = item->paths[k] || (k == BB_OUTPUT_FILTERED && job->slope_path);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    const bb_image *m = bb_bake_result_image(result, (bb_map_kind)k);
+    const int needed = item->paths[k] || (k == BB_MAP_FILTERED && job->slope_path);
     if (needed && (!m || !m->pixels || m->width != r->width || m->height != r->height))
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "job write: %s: the maps given have no %s of %d x %d (another bake?)",

@@ -14,28 +14,25 @@
 #include <string.h>
 #include <strings.h>
 
-static const char *const KIND_NAMES[] = {
-    [BB_MAP_SSBUMP] = "ssbump",
-    [BB_MAP_WEIGHTS] = "weights",
-    [BB_MAP_AO] = "ao",
-    [BB_MAP_NORMAL] = "normal",
-};
-#define KIND_COUNT ((int)(sizeof KIND_NAMES / sizeof KIND_NAMES[0]))
-
-bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
-  int k;
-  bb_status st = bb__parse_name("map kind", name, KIND_NAMES, KIND_COUNT, 1, &k, err);
-  if (st == BB_OK)
-    *out = (bb_map_kind)k;
-  return st;
+/* The channels combine's operators act on (bb_map_kind_info.file_channels:
+ * 3, or 1 for ao), 0 for a kind combine does not work on. */
+static int combine_channels(bb_map_kind kind) {
+  switch (kind) {
+  case BB_MAP_SSBUMP:
+  case BB_MAP_WEIGHTS:
+  case BB_MAP_AO:
+  case BB_MAP_NORMAL:
+    return bb_map_kind_get(kind)->file_channels;
+  default:
+    return 0;
+  }
 }
 
-const char *bb_map_kind_name(bb_map_kind kind) {
-  return ((int)kind >= 0 && (int)kind < KIND_COUNT) ? KIND_NAMES[kind] : "unknown";
-}
-
-int bb_map_kind_channels(bb_map_kind kind) {
-  return kind == BB_MAP_AO ? 1 : 3;
+static bb_status check_kind(bb_map_kind kind, const char *what, bb_error *err) {
+  if (combine_channels(kind))
+    return BB_OK;
+  return bb__fail(err, BB_ERR_ARGUMENT, "%s: map kind %s is not one of ssbump, weights, ao, normal",
+                  what, bb_map_kind_name(kind));
 }
 
 /* The exact flat value of channel c, encoded as a file stores it (normals
@@ -50,8 +47,9 @@ static double flat_encoded(bb_map_kind kind, int c) {
     return 1.0;
   case BB_MAP_NORMAL:
     return c == 2 ? 1.0 : 0.5;
+  default:
+    return 0.0;
   }
-  return 0.0;
 }
 
 /* v as a half float holds it: 11 significant bits (values here are normal
@@ -64,7 +62,7 @@ static double round_to_half(double v) {
 
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
                        float texel[3]) {
-  for (int c = 0; c < bb_map_kind_channels(kind); c++) {
+  for (int c = 0; c < combine_channels(kind); c++) {
     double v = flat_encoded(kind, c);
     if (is_float) {
       /* Float files store normals raw: N = 2 v - 1 of the encoded flat. */
@@ -90,8 +88,10 @@ const bb__range bb__range_mix = {"blend factor", 0.0, 1.0, 0, 0};
 
 static bb_status check_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
                              float mix, bb_map_kind kind, bb_error *err) {
-  const int need = bb_map_kind_channels(kind);
-  bb_status st = bb__check_channels(a, need, "first map", err);
+  const int need = combine_channels(kind);
+  bb_status st = check_kind(kind, "blend", err);
+  if (st == BB_OK)
+    st = bb__check_channels(a, need, "first map", err);
   if (st == BB_OK)
     st = bb__check_channels(b, need, "second map", err);
   if (st == BB_OK)
@@ -176,8 +176,10 @@ bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image 
 
 static bb_status check_detail(const bb_image *base, const bb_image *detail,
                               bb_map_kind kind, const float *flat, bb_error *err) {
-  const int need = bb_map_kind_channels(kind);
-  bb_status st = bb__check_channels(base, need, "base", err);
+  const int need = combine_channels(kind);
+  bb_status st = check_kind(kind, "detail", err);
+  if (st == BB_OK)
+    st = bb__check_channels(base, need, "base", err);
   if (st == BB_OK)
     st = bb__check_channels(detail, need, "detail", err);
   if (st == BB_OK)
@@ -240,7 +242,7 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
   bb_map_flat_texel(kind, 32, 1, exact);
   if (!flat)
     flat = exact;
-  const int need = bb_map_kind_channels(kind), channels = base->channels;
+  const int need = combine_channels(kind), channels = base->channels;
   const size_t n = (size_t)base->width * (size_t)base->height;
   for (size_t i = 0; i < n; i++) {
     const float *tb = base->pixels + i * (size_t)channels;
@@ -265,9 +267,9 @@ bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "brightness: a normal map has no room for a brightness (unit vectors); "
                     "give it to the ssbump or the weights");
-  if (strcmp(bb_map_kind_name(kind), "unknown") == 0)
-    return bb__fail(err, BB_ERR_ARGUMENT, "brightness: unknown map kind %d", (int)kind);
-  const int need = bb_map_kind_channels(kind);
+  if (!combine_channels(kind))
+    return check_kind(kind, "brightness", err);
+  const int need = combine_channels(kind);
   bb_status st = bb__check_channels(map, need, "brightness: the map", err);
   if (st == BB_OK && need == 3) st = bb__check_hl2_map(map, NULL, "brightness: the map", err);
   if (st == BB_OK) st = bb__check_finite(map, map->channels, "brightness: the map", err);

@@ -102,8 +102,8 @@ bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_op
   const char *first = NULL;
   double kept = 0.0, reading = 0.0;
   /* Each file's header, in the order they are read; every map of one size. */
-  for (int m = 0; m <= BB_RENDER_MAP_COUNT; m++) {
-    const char *path = m < BB_RENDER_MAP_COUNT ? files->maps[m] : files->height;
+  for (int m = 0; m <= BB_MAP_KIND_COUNT; m++) {
+    const char *path = m < BB_MAP_KIND_COUNT ? files->maps[m] : files->height;
     if (!path)
       continue;
     int fw = 0, fh = 0, channels = 0;
@@ -124,7 +124,7 @@ bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_op
     if (over_read_limits(texels, channels))
       return BB_OK; /* the read refuses it, as a file too large */
     double peak, keeps;
-    if (m == BB_RENDER_MAP_COUNT) {
+    if (m == BB_MAP_KIND_COUNT) {
       /* a height baked first: its read (the channels its rule needs, then
        * the height), then the bake, whose result the picture is lit from */
       const double read = ((channels < 4 ? channels : 4) + 1) * 4.0 * texels;
@@ -133,7 +133,7 @@ bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_op
       peak = read > baked ? read : baked;
       keeps = 4.0 * texels + maps; /* the height, and the maps the picture is lit from */
     } else {
-      map_bytes(texels, channels, m == BB_RENDER_MAP_NORMAL || m == BB_RENDER_MAP_BENT, &peak,
+      map_bytes(texels, channels, bb_map_kind_get((bb_map_kind)m)->unit_vectors, &peak,
                 &keeps);
     }
     if (kept + peak > reading)

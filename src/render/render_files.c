@@ -8,27 +8,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const struct {
-  const char *name;       /* option name and provenance key */
-  int channels;           /* at least */
-  int is_vector;          /* decoded as a normal map */
-  const char *channels_why;
-} map_kinds[BB_RENDER_MAP_COUNT] = {
-    {"normal", 3, 1, "X, Y, Z"},
-    {"ssbump", 3, 0, "R, G, B = the basis B0, B1, B2"},
-    {"ao", 1, 0, "grey"},
-    {"bent", 3, 1, "X, Y, Z"},
-    {"slope", 1, 0, "flipcode's slope byte, as bake --slope writes"},
+/* What a file of each kind a render reads holds, for the message that
+ * refuses one of too few channels; NULL: a kind a render does not read. */
+static const char *const channels_why[BB_MAP_KIND_COUNT] = {
+    [BB_MAP_NORMAL] = "X, Y, Z",
+    [BB_MAP_SSBUMP] = "R, G, B = the basis B0, B1, B2",
+    [BB_MAP_AO] = "grey",
+    [BB_MAP_BENT] = "X, Y, Z",
+    [BB_MAP_SLOPE] = "flipcode's slope byte, as bake --slope writes",
 };
 
-const char *bb_render_map_name(bb_render_map kind) {
-  return (int)kind >= 0 && kind < BB_RENDER_MAP_COUNT ? map_kinds[kind].name : "unknown";
-}
-
-bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_up,
+bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err) {
-  if (!out || (int)kind < 0 || kind >= BB_RENDER_MAP_COUNT)
+  if (!out || (int)kind < 0 || kind >= BB_MAP_KIND_COUNT || !channels_why[kind])
     return bb__fail(err, BB_ERR_ARGUMENT, "render map read: bad arguments");
   memset(out, 0, sizeof *out);
   bb_image raw = {0};
@@ -37,9 +30,10 @@ bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_
   if (st != BB_OK)
     return st;
   bb_error why = {{0}};
-  const int channels = map_kinds[kind].channels;
+  const bb_map_kind_info *k = bb_map_kind_get(kind);
+  const int channels = k->file_channels;
   const int is_float = info.is_float;
-  if (kind == BB_RENDER_MAP_SSBUMP)
+  if (kind == BB_MAP_SSBUMP)
     st = bb_basis_map_check(&raw, info.description, &why);
   bb_image_info_free(&info);
   if (st != BB_OK)
@@ -47,12 +41,12 @@ bb_status bb_render_map_read(const char *path, bb_render_map kind, int normal_y_
   else if (raw.channels < channels)
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %d channel%s; %s %s map needs %d (%s)", path,
                   raw.channels, raw.channels == 1 ? "" : "s",
-                  (kind == BB_RENDER_MAP_AO || kind == BB_RENDER_MAP_SSBUMP) ? "an" : "a",
-                  map_kinds[kind].name, channels, map_kinds[kind].channels_why);
+                  (kind == BB_MAP_AO || kind == BB_MAP_SSBUMP) ? "an" : "a",
+                  k->name, channels, channels_why[kind]);
   else if (like && (raw.width != like->width || raw.height != like->height))
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %dx%d, but the other maps are %dx%d", path,
                   raw.width, raw.height, like->width, like->height);
-  if (st == BB_OK && map_kinds[kind].is_vector) {
+  if (st == BB_OK && k->unit_vectors) {
     bb_normal_decode_options decode;
     bb_normal_decode_options_init(&decode);
     decode.normal_y_up = normal_y_up;
@@ -97,12 +91,12 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
     failed |= add_line(&text, &length, "render_from", "height");
   } else {
     failed |= add_line(&text, &length, "render_from", "maps");
-    if (s->maps[BB_RENDER_MAP_NORMAL] || s->maps[BB_RENDER_MAP_BENT])
+    if (s->maps[BB_MAP_NORMAL] || s->maps[BB_MAP_BENT])
       failed |= add_line(&text, &length, "map_normal_y", s->maps_normal_y_up ? "up" : "down");
-    for (int m = 0; m < BB_RENDER_MAP_COUNT; m++)
+    for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
       if (s->maps[m]) {
         char key[32];
-        snprintf(key, sizeof key, "map_%s", map_kinds[m].name);
+        snprintf(key, sizeof key, "map_%s", bb_map_kind_name((bb_map_kind)m));
         failed |= add_line(&text, &length, key, file_name_of(s->maps[m]));
       }
   }

@@ -91,7 +91,7 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *chain, int levels,
   case BB_TEXTURE_FORMAT_BC4: put_u32(h + 84, fourcc("ATI1")); break;
   case BB_TEXTURE_FORMAT_BC5:
     put_u32(h + 84, fourcc("ATI2"));
-    if (o->map == BB_TEXTURE_MAP_NORMAL)
+    if (bb_map_kind_get(o->map)->unit_vectors)
       pf_flags |= DDPF_NORMAL;
     break;
   case BB_TEXTURE_FORMAT_RGBA8:

@@ -132,7 +132,7 @@ void bb_texture_options_init(bb_texture_options *o) {
     return;
   memset(o, 0, sizeof *o);
   o->format = BB_TEXTURE_FORMAT_DEFAULT;
-  o->map = BB_TEXTURE_MAP_PLAIN;
+  o->map = BB_MAP_PLAIN;
   o->mips = 1;
   o->vtf_version = 2;
 }
@@ -182,10 +182,10 @@ static void container_formats(bb__container c, char *buf, size_t cap) {
   }
 }
 
-static bb_texture_format default_format(bb__container c, bb_texture_map map, int channels) {
+static bb_texture_format default_format(bb__container c, bb_map_kind map, int channels) {
   if (c == BB__CONTAINER_VTF)
     return channels == 4 ? BB_TEXTURE_FORMAT_BC3 : BB_TEXTURE_FORMAT_BC1;
-  if (map == BB_TEXTURE_MAP_NORMAL)
+  if (bb_map_kind_get(map)->unit_vectors)
     return BB_TEXTURE_FORMAT_BC5;
   switch (channels) {
   case 1: return BB_TEXTURE_FORMAT_BC4;
@@ -235,7 +235,7 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
   const char *kind = c == BB__CONTAINER_VTF ? "VTF" : "DDS";
   if (c == BB__CONTAINER_NONE)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: not a texture file name (.vtf or .dds)", path);
-  if ((int)o->map < BB_TEXTURE_MAP_PLAIN || (int)o->map > BB_TEXTURE_MAP_SSBUMP)
+  if (!bb_map_kind_get(o->map))
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: unknown texture map kind %d", path, (int)o->map);
   const format_info *f = info_of(o->format);
   if (!f)
@@ -263,7 +263,7 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "%s: a %s texture holds at most 4 channels (the image has %d)", path,
                     kind, channels);
-  if (o->map == BB_TEXTURE_MAP_NORMAL && channels < 3)
+  if (bb_map_kind_get(o->map)->unit_vectors && channels < 3)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "%s: a normal map needs 3 channels (the image has %d)", path, channels);
   bb_texture_format fmt = o->format == BB_TEXTURE_FORMAT_DEFAULT
@@ -276,7 +276,7 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: %s has no format %s (it has %s)", path, kind,
                     name_in(f, c), names);
   }
-  const int holds = fmt == BB_TEXTURE_FORMAT_BC5 && o->map == BB_TEXTURE_MAP_NORMAL
+  const int holds = fmt == BB_TEXTURE_FORMAT_BC5 && bb_map_kind_get(o->map)->unit_vectors
                         ? 3
                         : f->max_channels;
   if (channels > holds || (f->exact && channels != holds))
@@ -284,7 +284,7 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
                     "%s: format %s holds %s%d channel%s, and the %s has %d", path,
                     name_in(f, c),
                     f->exact ? "" : "at most ", holds, holds == 1 ? "" : "s",
-                    o->map == BB_TEXTURE_MAP_NORMAL ? "normal map" : "image", channels);
+                    bb_map_kind_get(o->map)->unit_vectors ? "normal map" : "image", channels);
   if (c == BB__CONTAINER_VTF) {
     bb_status st = check_vtf_flags(path, width, height, channels, o, fmt, err);
     if (st != BB_OK)
@@ -319,7 +319,7 @@ bb_status bb_texture_check(const char *path, int width, int height, int channels
 
 /* ------------------------------------------------------------- encoding */
 
-void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]) {
+void bb__texture_texel(const bb_image *img, int unit_vectors, size_t i, float rgba[4]) {
   const float *t = img->pixels + i * (size_t)img->channels;
   switch (img->channels) {
   case 1: rgba[0] = rgba[1] = rgba[2] = t[0]; rgba[3] = 1.0f; break;
@@ -327,7 +327,7 @@ void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float 
   case 3: rgba[0] = t[0]; rgba[1] = t[1]; rgba[2] = t[2]; rgba[3] = 1.0f; break;
   default: memcpy(rgba, t, 4 * sizeof(float)); break;
   }
-  if (map == BB_TEXTURE_MAP_NORMAL)
+  if (unit_vectors)
     for (int c = 0; c < 3; c++)
       rgba[c] = 0.5f + 0.5f * rgba[c];
 }
@@ -354,7 +354,7 @@ static void put_f32(unsigned char *p, float v) {
 /* The block codec's view of a level: its texels as the engine samples them. */
 typedef struct level_source {
   const bb_image *level;
-  bb_texture_map map;
+  int unit_vectors; /* bb_map_kind_info.unit_vectors */
 } level_source;
 
 static void level_texels(const void *source, int x0, int y0, int w, int h, float rgba[64]) {
@@ -362,18 +362,18 @@ static void level_texels(const void *source, int x0, int y0, int w, int h, float
   const size_t width = (size_t)s->level->width;
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++)
-      bb__texture_texel(s->level, s->map, (size_t)(y0 + y) * width + (size_t)(x0 + x),
+      bb__texture_texel(s->level, s->unit_vectors, (size_t)(y0 + y) * width + (size_t)(x0 + x),
                         rgba + 4 * (4 * y + x));
 }
 
 /* One level in a texel format, texel by texel. */
-static void encode_texels(const bb_image *level, bb_texture_map map, bb_texture_format format,
+static void encode_texels(const bb_image *level, int unit_vectors, bb_texture_format format,
                           int texel_bytes, unsigned char *out) {
   const size_t n = (size_t)level->width * (size_t)level->height;
   unsigned char *p = out;
   for (size_t i = 0; i < n; i++) {
     float t[4];
-    bb__texture_texel(level, map, i, t);
+    bb__texture_texel(level, unit_vectors, i, t);
     switch (format) {
     case BB_TEXTURE_FORMAT_BGR8:
       p[0] = to_byte(t[2]), p[1] = to_byte(t[1]), p[2] = to_byte(t[0]);
@@ -398,18 +398,19 @@ static void encode_texels(const bb_image *level, bb_texture_map map, bb_texture_
   }
 }
 
-bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_texture_map map,
+bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_kind map,
                                     bb_texture_format format, int fast, int threads,
                                     unsigned char *const *out, bb_error *err) {
   const format_info *f = info_of(format);
-  if (!f || format == BB_TEXTURE_FORMAT_DEFAULT || count < 1 || !levels || !out)
-    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad levels or format");
+  const bb_map_kind_info *kind = bb_map_kind_get(map);
+  if (!f || !kind || format == BB_TEXTURE_FORMAT_DEFAULT || count < 1 || !levels || !out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad levels, kind or format");
   for (int k = 0; k < count; k++)
     if (!levels[k].pixels || !out[k])
       return bb__fail(err, BB_ERR_ARGUMENT, "texture: bad level %d", k);
   if (!f->block) {
     for (int k = 0; k < count; k++)
-      encode_texels(&levels[k], map, format, f->texel_bytes, out[k]);
+      encode_texels(&levels[k], kind->unit_vectors, format, f->texel_bytes, out[k]);
     return BB_OK;
   }
   level_source *sources = malloc((size_t)count * sizeof *sources);
@@ -419,7 +420,7 @@ bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_textur
     st = bb__fail(err, BB_ERR_MEMORY, "texture: out of memory");
   } else {
     for (int k = 0; k < count; k++) {
-      sources[k] = (level_source){&levels[k], map};
+      sources[k] = (level_source){&levels[k], kind->unit_vectors};
       images[k] = (bb__block_image){levels[k].width, levels[k].height, level_texels,
                                     &sources[k], out[k]};
     }
@@ -431,7 +432,7 @@ bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_textur
   return st;
 }
 
-bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
+bb_status bb__texture_encode(const bb_image *level, bb_map_kind map,
                              bb_texture_format format, int fast, int threads,
                              unsigned char *out, bb_error *err) {
   if (!level)
@@ -452,11 +453,11 @@ void bb_texture_options_for(bb_texture_options *o, const char *kind, bb_range ra
     return;
   const char *k = kind ? kind : "";
   if (kind_is(k, "ssbump") || kind_is(k, "detail-ssbump") || kind_is(k, "weights")) {
-    o->map = BB_TEXTURE_MAP_SSBUMP;
+    o->map = BB_MAP_SSBUMP;
   } else if (range == BB_RANGE_SIGNED) {
-    o->map = BB_TEXTURE_MAP_NORMAL;
+    o->map = BB_MAP_NORMAL;
   } else {
-    o->map = BB_TEXTURE_MAP_PLAIN;
+    o->map = BB_MAP_PLAIN;
     if (strncmp(k, "normal+", 7) == 0) /* packed already: flagged, not re-packed */
       o->vtf_flags |= BB_VTF_FLAG_NORMAL;
   }

@@ -42,20 +42,21 @@ size_t bb__texture_level_bytes(bb_texture_format format, int width, int height);
 int bb__texture_format_has_alpha(bb_texture_format format);
 
 /* Texel i of img as the engine samples it (see bumpbake.h): R, G, B, A,
- * normal maps mapped to 0.5 + 0.5 v; not clamped. */
-void bb__texture_texel(const bb_image *img, bb_texture_map map, size_t i, float rgba[4]);
+ * unit vectors (bb_map_kind_info.unit_vectors) mapped to 0.5 + 0.5 v; not
+ * clamped. */
+void bb__texture_texel(const bb_image *img, int unit_vectors, size_t i, float rgba[4]);
 
 /* Encodes levels[0..count-1] into out[k], bb__texture_level_bytes(format,
  * levels[k]) bytes each, little-endian. Block formats compress all the
  * levels in one job on `threads` threads (0 = all cores), the same bytes on
  * any count; fast: the codec's range fit alone, else BB__FIT_BEST (blocks.h). Pass the largest
  * level first: its rows are handed out first, the small levels' fill in. */
-bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_texture_map map,
+bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_kind map,
                                     bb_texture_format format, int fast, int threads,
                                     unsigned char *const *out, bb_error *err);
 
 /* bb__texture_encode_levels of one level. */
-bb_status bb__texture_encode(const bb_image *level, bb_texture_map map,
+bb_status bb__texture_encode(const bb_image *level, bb_map_kind map,
                              bb_texture_format format, int fast, int threads,
                              unsigned char *out, bb_error *err);
 

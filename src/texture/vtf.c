@@ -84,7 +84,8 @@ static int vtf_code(bb_texture_format format) {
 
 /* vtex's and VTFLib's reflectivity: per channel, the mean over the top
  * level of (code / 255)^2.2, code the texel's 8-bit value. */
-static void reflectivity(const bb_image *top, bb_texture_map map, float out[3]) {
+static void reflectivity(const bb_image *top, bb_map_kind map, float out[3]) {
+  const int unit_vectors = bb_map_kind_get(map)->unit_vectors;
   double table[256];
   for (int i = 0; i < 256; i++)
     table[i] = pow(i / 255.0, 2.2);
@@ -92,7 +93,7 @@ static void reflectivity(const bb_image *top, bb_texture_map map, float out[3]) 
   const size_t n = (size_t)top->width * (size_t)top->height;
   for (size_t i = 0; i < n; i++) {
     float t[4];
-    bb__texture_texel(top, map, i, t);
+    bb__texture_texel(top, unit_vectors, i, t);
     for (int c = 0; c < 3; c++) {
       double u = t[c] > 0.0f ? (double)t[c] : 0.0;
       u = u < 1.0 ? u : 1.0;
@@ -158,10 +159,7 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *chain, int levels,
   const size_t low_bytes = bb__texture_level_bytes(BB_TEXTURE_FORMAT_BC1, low->width, low->height);
 
   uint32_t flags = o->vtf_flags;
-  if (o->map == BB_TEXTURE_MAP_NORMAL)
-    flags |= BB_VTF_FLAG_NORMAL;
-  if (o->map == BB_TEXTURE_MAP_SSBUMP)
-    flags |= BB_VTF_FLAG_SSBUMP;
+  flags |= bb_map_kind_get(o->map)->vtf_flags;
   if (!o->mips)
     flags |= BB_VTF_FLAG_NOMIP | BB_VTF_FLAG_NOLOD;
   if (img->channels == 4 && bb__texture_format_has_alpha(format))

@@ -307,17 +307,17 @@ Test(bake, output_mask_makes_only_what_was_asked) {
   o.slices = 6;
   o.normal_y_up = 1; /* the flip applies to what is kept, once */
   bb_bake_result all = harness_bake(&h, &o);
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    o.outputs = BB_OUTPUT_BIT(k);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    o.outputs = BB_MAP_BIT(k);
     bb_bake_result one = harness_bake(&h, &o);
-    const int traced = bb_output_kind_get((bb_output_kind)k)->needs_trace;
-    for (int j = 0; j < BB_OUTPUT_KIND_COUNT; j++) {
-      const bb_image *img = bb_bake_result_image(&one, (bb_output_kind)j);
+    const int traced = bb_map_kind_get((bb_map_kind)k)->needs_trace;
+    for (int j = 0; j < BB_MAP_BAKED_COUNT; j++) {
+      const bb_image *img = bb_bake_result_image(&one, (bb_map_kind)j);
       if (j != k) {
         cr_assert_null(img->pixels, "asked %d, made %d", k, j);
         continue;
       }
-      const bb_image *ref = bb_bake_result_image(&all, (bb_output_kind)j);
+      const bb_image *ref = bb_bake_result_image(&all, (bb_map_kind)j);
       cr_assert_eq(img->channels, ref->channels);
       cr_assert_eq(memcmp(img->pixels, ref->pixels, image_bytes(ref)), 0, "kind %d", k);
     }
@@ -326,7 +326,7 @@ Test(bake, output_mask_makes_only_what_was_asked) {
     bb_bake_result_free(&one);
   }
   /* Without a traced map, the trace's options are not even checked. */
-  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_FILTERED);
+  o.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_FILTERED);
   o.rays = 0;
   bb_bake_result r = harness_bake(&h, &o);
   cr_assert_not_null(r.normal.pixels);
@@ -373,8 +373,8 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
     cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_CANCELLED);
     cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
     cr_assert_str_eq(bb_status_name(BB_ERR_CANCELLED), "cancelled");
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-      cr_assert_null(bb_bake_result_image(&r, (bb_output_kind)k)->pixels, "kind %d", k);
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+      cr_assert_null(bb_bake_result_image(&r, (bb_map_kind)k)->pixels, "kind %d", k);
     cr_assert_null(r.vis.pixels);
     bb_bake_result_free(&r);
   }
@@ -390,7 +390,7 @@ Test(bake, smoothing_and_normals_are_cancel_points) {
   bb_bake_options o;
   bb_bake_options_init(&o);
   o.height_scale = 8.0f;
-  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL);
+  o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
   cancel_state go = {0, -1, -1, -1};
   o.trace.progress = cancel_after;
   o.trace.progress_user = &go;
@@ -455,8 +455,8 @@ Test(bake, options_check_holds_every_limit) {
       {2, 0, -1, "bake: bias must be in 0..1e6 (got -1)"},
       {3, 1e6, 1.5e6, "bake: power must be in 1..1e6 (got 1.5e6)"},
       {3, 1, 0.5, "bake: power must be in 1..1e6 (got 0.5)"},
-      {4, BB_OUTPUTS_ALL, 0, "bake: outputs must be a non-empty set"},
-      {4, 1, BB_OUTPUTS_ALL + 1, "bake: outputs must be a non-empty set"},
+      {4, BB_MAPS_BAKED, 0, "bake: outputs must be a non-empty set"},
+      {4, 1, BB_MAPS_BAKED + 1, "bake: outputs must be a non-empty set"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     for (int bad = 0; bad < 2; bad++) {

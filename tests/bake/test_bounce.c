@@ -39,10 +39,10 @@ static int same_image(const bb_image *a, const bb_image *b) {
 }
 
 static void expect_same_bake(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-    cr_expect(same_image(bb_bake_result_image(a, (bb_output_kind)k),
-                         bb_bake_result_image(b, (bb_output_kind)k)),
-              "%s: %s differs", what, bb_output_kind_get((bb_output_kind)k)->name);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    cr_expect(same_image(bb_bake_result_image(a, (bb_map_kind)k),
+                         bb_bake_result_image(b, (bb_map_kind)k)),
+              "%s: %s differs", what, bb_map_kind_get((bb_map_kind)k)->name);
   cr_expect(same_image(&a->vis, &b->vis), "%s: vis differs", what);
 }
 
@@ -206,16 +206,16 @@ Test(bounce, any_thread_count_and_periodic_shift_give_the_same_bits) {
   o.trace.threads = 2;
   bb_bake_result s = harness_bake(&shifted, &o);
   cr_expect_eq(s.bounces, one.bounces);
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    const bb_image *a = bb_bake_result_image(&one, (bb_output_kind)k);
-    const bb_image *b = bb_bake_result_image(&s, (bb_output_kind)k);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    const bb_image *a = bb_bake_result_image(&one, (bb_map_kind)k);
+    const bb_image *b = bb_bake_result_image(&s, (bb_map_kind)k);
     int differ = 0;
     for (int y = 0; y < H; y++)
       for (int x = 0; x < W; x++)
         differ += memcmp(at(a, x, y), at(b, (x + sx) % W, (y + sy) % H),
                          (size_t)a->channels * sizeof(float)) != 0;
     cr_expect_eq(differ, 0, "%s: %d texels differ after a periodic shift",
-                 bb_output_kind_get((bb_output_kind)k)->name, differ);
+                 bb_map_kind_get((bb_map_kind)k)->name, differ);
   }
   bb_bake_result_free(&one);
   bb_bake_result_free(&s);

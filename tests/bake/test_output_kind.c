@@ -1,4 +1,5 @@
-/* test_output_kind.c: the library's table of the maps a bake makes. */
+/* test_output_kind.c: the library's table of map kinds (bb_map_kind_info),
+ * the first BB_MAP_BAKED_COUNT of which a bake makes. */
 #include <criterion/criterion.h>
 
 #include <string.h>
@@ -6,37 +7,49 @@
 #include "bumpbake.h"
 
 Test(output_kind, table_lists_every_kind_in_enum_order) {
-  static const char *names[] = {"normal", "weights", "ssbump", "ao", "bent", "filtered"};
-  static const int channels[] = {3, 0, 0, 1, 3, 1};
+  static const char *names[] = {"normal", "weights",  "ssbump", "ao",
+                                "bent",   "filtered", "slope",  "plain"};
+  static const int channels[] = {3, 0, 0, 1, 3, 1, 1, 0};
+  static const int file_channels[] = {3, 3, 3, 1, 3, 1, 1, 1};
   static const bb_range ranges[] = {BB_RANGE_SIGNED, BB_RANGE_UNIT, BB_RANGE_UNIT,
-                                    BB_RANGE_UNIT,   BB_RANGE_SIGNED, BB_RANGE_UNIT};
-  cr_assert_eq(BB_OUTPUT_KIND_COUNT, 6);
+                                    BB_RANGE_UNIT,   BB_RANGE_SIGNED, BB_RANGE_UNIT,
+                                    BB_RANGE_UNIT,   BB_RANGE_UNIT};
+  static const uint32_t vtf_flags[] = {BB_VTF_FLAG_NORMAL, BB_VTF_FLAG_SSBUMP,
+                                       BB_VTF_FLAG_SSBUMP, 0, BB_VTF_FLAG_NORMAL, 0, 0, 0};
+  cr_assert_eq(BB_MAP_BAKED_COUNT, 6);
+  cr_assert_eq(BB_MAP_KIND_COUNT, 8);
   unsigned traced = 0;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    const bb_output_kind_info *info = bb_output_kind_get((bb_output_kind)k);
+  for (int k = 0; k < BB_MAP_KIND_COUNT; k++) {
+    const bb_map_kind_info *info = bb_map_kind_get((bb_map_kind)k);
     cr_assert_not_null(info);
     cr_assert_str_eq(info->name, names[k]);
+    cr_assert_str_eq(bb_map_kind_name((bb_map_kind)k), names[k]);
     cr_assert(info->description && info->description[0]);
     cr_assert_eq(info->channels, channels[k], "%s", names[k]);
+    cr_assert_eq(info->file_channels, file_channels[k], "%s", names[k]);
     cr_assert_eq(info->range, ranges[k], "%s", names[k]);
+    cr_assert_eq(info->unit_vectors, info->range == BB_RANGE_SIGNED, "%s", names[k]);
+    cr_assert_eq(info->vtf_flags, vtf_flags[k], "%s", names[k]);
     if (info->needs_trace)
-      traced |= BB_OUTPUT_BIT(k);
-    bb_output_kind parsed = BB_OUTPUT_KIND_COUNT;
-    cr_assert_eq(bb_output_kind_parse(names[k], &parsed, NULL), 0);
+      traced |= BB_MAP_BIT(k);
+    bb_map_kind parsed = BB_MAP_KIND_COUNT;
+    cr_assert_eq(bb_map_kind_parse(names[k], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, k);
   }
-  cr_assert_eq(traced, BB_OUTPUTS_TRACED);
-  cr_assert_eq(BB_OUTPUTS_ALL, 0x3fu);
+  cr_assert_eq(traced, BB_MAPS_TRACED);
+  cr_assert_eq(BB_MAPS_BAKED, 0x3fu);
 }
 
 Test(output_kind, unknown_kinds_are_refused) {
-  cr_assert_null(bb_output_kind_get(BB_OUTPUT_KIND_COUNT));
-  cr_assert_null(bb_output_kind_get((bb_output_kind)-1));
-  bb_output_kind k = BB_OUTPUT_AO;
-  cr_assert_eq(bb_output_kind_parse("shadow", &k, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_output_kind_parse("Normal", &k, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_output_kind_parse(NULL, &k, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(k, BB_OUTPUT_AO, "untouched on failure");
+  cr_assert_null(bb_map_kind_get(BB_MAP_KIND_COUNT));
+  cr_assert_null(bb_map_kind_get((bb_map_kind)-1));
+  cr_assert_str_eq(bb_map_kind_name(BB_MAP_KIND_COUNT), "unknown");
+  bb_map_kind k = BB_MAP_AO;
+  cr_assert_eq(bb_map_kind_parse("shadow", &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_map_kind_parse(NULL, &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(k, BB_MAP_AO, "untouched on failure");
+  cr_assert_eq(bb_map_kind_parse("Normal", &k, NULL), BB_OK, "any case");
+  cr_assert_eq(k, BB_MAP_NORMAL);
 }
 
 /* Each kind's image in a result is the field of its name, and it has the
@@ -55,14 +68,14 @@ Test(output_kind, result_images_match_the_table) {
   bb_error err;
   cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
   const bb_image *fields[] = {&r.normal, &r.weights, &r.ssbump, &r.ao, &r.bent, &r.filtered};
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    const bb_image *img = bb_bake_result_image(&r, (bb_output_kind)k);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    const bb_image *img = bb_bake_result_image(&r, (bb_map_kind)k);
     cr_assert_eq(img, fields[k], "kind %d", k);
-    const int want = bb_output_kind_get((bb_output_kind)k)->channels;
+    const int want = bb_map_kind_get((bb_map_kind)k)->channels;
     cr_assert_eq(img->channels, want ? want : 5, "kind %d", k);
   }
-  cr_assert_null(bb_bake_result_image(&r, BB_OUTPUT_KIND_COUNT));
-  cr_assert_null(bb_bake_result_image(NULL, BB_OUTPUT_NORMAL));
+  cr_assert_null(bb_bake_result_image(&r, BB_MAP_BAKED_COUNT));
+  cr_assert_null(bb_bake_result_image(NULL, BB_MAP_NORMAL));
   bb_bake_result_free(&r);
   bb_image_free(&h);
 }

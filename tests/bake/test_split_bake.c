@@ -100,10 +100,10 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     cr_assert_eq(bb_bake(&height, &with_hook, &split, &err), BB_OK, "%s", err.message);
     cr_assert_eq(u.calls, 1);
     cr_assert_eq(plain.bounces > 0, cases[c].bounce > 0.0, "bounces %d", plain.bounces);
-    for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-      assert_same(bb_bake_result_image(&plain, (bb_output_kind)k),
-                  bb_bake_result_image(&split, (bb_output_kind)k),
-                  bb_output_kind_get((bb_output_kind)k)->name);
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+      assert_same(bb_bake_result_image(&plain, (bb_map_kind)k),
+                  bb_bake_result_image(&split, (bb_map_kind)k),
+                  bb_map_kind_get((bb_map_kind)k)->name);
     assert_same(&plain.vis, &split.vis, "vis");
     cr_assert_eq(plain.horizons_found, split.horizons_found);
     cr_assert_str_eq(plain.rayset_id, split.rayset_id);
@@ -141,7 +141,7 @@ Test(split_bake, a_trace_that_fails_or_makes_the_wrong_image_fails_the_bake) {
   cr_assert_eq(bb_bake(&height, &o, &r, &err), BB_ERR_IO);
   cr_assert(strstr(err.message, "worker tcp://10.0.0.2 lost"), "%s", err.message);
   o.trace.trace = NULL;
-  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL);
+  o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
   bb_pyramid *p;
   bb_rayset *rs;
   cr_assert_eq(bb_bake_trace_input(&height, &o, &p, &rs, &err), BB_ERR_ARGUMENT,

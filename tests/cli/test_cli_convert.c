@@ -70,7 +70,7 @@ Test(cli_convert, help_lists_options_and_defaults) {
   const char *commands[] = {"normal2ssbump", "ssbump2normal"};
   const char *must[2][4] = {
       {"--normal-y", "NAME_ssbump.tga", "--depth", "2 code / max - 1"},
-      {"--kind", "ssbump|weights", "--normal-y", "sqrt(w_c)"}};
+      {"--kind", "weights|ssbump", "--normal-y", "sqrt(w_c)"}};
   for (int c = 0; c < 2; c++) {
     cli_result r = RUN(commands[c], "--help");
     cr_expect_eq(r.code, 0);

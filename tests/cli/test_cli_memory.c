@@ -39,8 +39,8 @@ static double job_estimate(const char *input, unsigned outputs, int side) {
   o.bake.slices = 2;
   o.bake.trace.threads = 2;
   static const char *names[] = {"n.png", "w.png", "s.png", "a.png", "b.png", "f.png"};
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-    if (outputs & BB_OUTPUT_BIT(k)) o.paths[k] = tmp(names[k]);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (outputs & BB_MAP_BIT(k)) o.paths[k] = tmp(names[k]);
   bb_job *job = NULL;
   bb_error err;
   cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
@@ -56,8 +56,8 @@ static long peak_kib(const char *input, unsigned outputs) {
   const char *args[32] = {"bake", input, "--scale", "32", "--slices", "2", "--threads", "2",
                           "-q"};
   int n = 9;
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++)
-    if (outputs & BB_OUTPUT_BIT(k)) args[n++] = flags[k], args[n++] = tmp(names[k]);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (outputs & BB_MAP_BIT(k)) args[n++] = flags[k], args[n++] = tmp(names[k]);
   args[n] = NULL;
   cli_result r = harness_run(args);
   cr_assert_eq(r.code, 0, "%s", r.err);
@@ -70,9 +70,9 @@ Test(cli_memory, the_estimate_bounds_the_peak_closely) {
   const char *big = tmp("big.png"), *tiny = tmp("tiny.png");
   write_height(big, SIDE);
   write_height(tiny, 8);
-  const unsigned ssbump_ao = BB_OUTPUT_BIT(BB_OUTPUT_SSBUMP) | BB_OUTPUT_BIT(BB_OUTPUT_AO);
-  const unsigned sets[] = {ssbump_ao, ssbump_ao | BB_OUTPUT_BIT(BB_OUTPUT_NORMAL),
-                           BB_OUTPUT_BIT(BB_OUTPUT_NORMAL), BB_OUTPUTS_ALL};
+  const unsigned ssbump_ao = BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_AO);
+  const unsigned sets[] = {ssbump_ao, ssbump_ao | BB_MAP_BIT(BB_MAP_NORMAL),
+                           BB_MAP_BIT(BB_MAP_NORMAL), BB_MAPS_BAKED};
   const double texels = (double)SIDE * SIDE;
   for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
     /* the program, its libraries and OpenImageIO's plugins: a bake of 8 x 8 */

@@ -226,7 +226,7 @@ Test(cmd, a_file_option_given_twice_is_refused) {
                         NULL};
   bb_command *c = command("bake", same);
   cr_expect_eq(bb_command_check(c, NULL), BB_OK);
-  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_OUTPUT_SSBUMP], "s.png");
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
   bb_command_free(c);
 }
 
@@ -300,5 +300,45 @@ Test(cmd, a_flag_set_to_0_is_unset) {
   cr_expect_eq(bb_command_set(c, "clamp", "0", &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "--clamp cannot be unset: leave it out");
   cr_expect_eq(bb_command_set(c, "force", "2", &err), BB_ERR_ARGUMENT);
+  bb_command_free(c);
+}
+
+/* ssbump2normal --kind and combine --kind: one parser, the library's
+ * (bb_map_kind_parse, any case), each taking its own kinds. */
+Test(cmd, kind_options_take_the_librarys_words) {
+  const char *s2n[] = {"--kind", "Weights", NULL};
+  bb_command *c = command("ssbump2normal", s2n);
+  cr_expect_eq(bb_command_options_of(c)->ssbump_kind, BB_MAP_WEIGHTS);
+  bb_command_free(c);
+  const char *comb[] = {"--kind", "WEIGHTS", NULL};
+  c = command("combine", comb);
+  cr_expect_eq(bb_command_options_of(c)->map_kind, BB_MAP_WEIGHTS);
+  bb_command_free(c);
+  const char *kinds[] = {"normal", "ao", "bent", "slope"};
+  for (int i = 0; i < 4; i++) {
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_new("ssbump2normal", &c, &err), BB_OK);
+    cr_expect_eq(bb_command_set(c, "kind", kinds[i], &err), BB_ERR_ARGUMENT, "%s", kinds[i]);
+    cr_expect(strstr(err.message, "weights, ssbump"), "%s", err.message);
+    bb_command_free(c);
+  }
+}
+
+/* Flags that set one other field (the option table's bb__flag_sets): set
+ * when given, and refused as "0" since they cannot be unset. */
+Test(cmd, flags_set_their_field) {
+  const char *bake[] = {"--scale", "2", "--clamp", "--nomip", "--fast-compression", NULL};
+  bb_command *c = command("bake", bake);
+  const bb_command_options *o = bb_command_options_of(c);
+  cr_expect_eq(o->job.bake.smooth.addressing, BB_ADDRESS_CLAMP);
+  cr_expect_eq(o->job.texture.mips, 0);
+  cr_expect_eq(o->job.texture.fast, 1);
+  bb_error err = {{0}};
+  cr_expect_eq(bb_command_set(c, "nomip", "0", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--nomip cannot be unset: leave it out");
+  bb_command_free(c);
+  cr_assert_eq(bb_command_new("height2ssbump", &c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_set(c, "dump-filtered", NULL, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
   bb_command_free(c);
 }

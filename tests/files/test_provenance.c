@@ -37,7 +37,7 @@ static bb_bake_options sample_options(void) {
   bb_basis_init(&o.basis);
   o.normal_filter = BB_NORMAL_VALVE;
   o.normal_y_up = 0;
-  o.outputs = BB_OUTPUTS_ALL;
+  o.outputs = BB_MAPS_BAKED;
   return o;
 }
 

@@ -88,7 +88,7 @@ Test(incremental, rayset_id_is_the_bakes) {
   o.slices = 9;
   bb_bake_rayset_id(&o, id, sizeof id);
   cr_expect_str_eq(id, "bb-horizon-v1:a9:p2.5:dirs:5");
-  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL);
+  o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
   bb_bake_rayset_id(&o, id, sizeof id);
   cr_expect_str_eq(id, "");
   bb_bake_result_free(&r);

@@ -68,7 +68,7 @@ Test(job, command_text_spells_the_options_as_typed) {
   bb_job_options_init(&o);
   o.bake.height_scale = 16.0f;
   o.out_dir = "out";
-  o.maps = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_AO);
+  o.maps = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_AO);
   char *text = bb_job_command_text(&o, "heights/a.png");
   cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
   free(text);
@@ -91,7 +91,7 @@ Test(job, command_text_spells_the_texture_options) {
   bb_job_options o;
   bb_job_options_init(&o);
   o.bake.height_scale = 64.0f;
-  o.paths[BB_OUTPUT_SSBUMP] = "m/rock-ssbump.vtf";
+  o.paths[BB_MAP_SSBUMP] = "m/rock-ssbump.vtf";
   o.texture.threads = 1;
   char *text = bb_job_command_text(&o, "h.png");
   cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
@@ -120,14 +120,14 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
   bb_job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
-  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
-  o.paths[BB_OUTPUT_AO] = tmp("ao.exr");
+  o.paths[BB_MAP_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
+  o.paths[BB_MAP_AO] = tmp("ao.exr");
   o.force = 1;
   bb_job *job = NULL;
   bb_error err = {{0}};
   cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_bake_result kept;
-  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUT_BIT(BB_OUTPUT_BENT), NULL, NULL, &kept, &err),
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_MAP_BIT(BB_MAP_BENT), NULL, NULL, &kept, &err),
                BB_OK, "%s", err.message);
   cr_expect_eq(access(tmp("s.exr"), F_OK), -1, "bake_item wrote a file");
   cr_expect_not_null(kept.bent.pixels, "the kind asked besides");
@@ -162,9 +162,9 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   bb_job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
-  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
-  o.paths[BB_OUTPUT_NORMAL] = tmp("n.png");
-  o.paths[BB_OUTPUT_AO] = tmp("ao.exr");
+  o.paths[BB_MAP_SSBUMP] = tmp("s.png");
+  o.paths[BB_MAP_NORMAL] = tmp("n.png");
+  o.paths[BB_MAP_AO] = tmp("ao.exr");
   o.slope_path = tmp("slope.png");
   o.slope_lit = 1;
   o.force = 1;
@@ -178,7 +178,7 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   bb_bake_result kept;
   cr_expect_eq(bb_job_write_item(job, 0, &(bb_bake_result){0}, &err), BB_ERR_ARGUMENT,
                "not baked yet");
-  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, NULL, NULL, &kept, &err), BB_OK, "%s",
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &kept, &err), BB_OK, "%s",
                err.message);
   bb_bake_result missing = kept;
   memset(&missing.ao, 0, sizeof missing.ao);
@@ -216,22 +216,22 @@ static bb_bake_result bake_with(const char *input, int slices, const char *basis
   o.bake.bounce_albedo = 0.5; /* the bounce reads the ray set too */
   o.bake.trace.threads = 2;
   cr_assert_eq(bb_basis_parse(basis, &o.bake.basis, NULL), BB_OK);
-  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
+  o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
   bb_error err = {{0}};
   cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_job_use_context(job, context);
   bb_bake_result r;
-  cr_assert_eq(bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, NULL, NULL, &r, &err), BB_OK, "%s",
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &r, &err), BB_OK, "%s",
                err.message);
   bb_job_free(job);
   return r;
 }
 
 static void expect_same_maps(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
-  for (int k = 0; k < BB_OUTPUT_KIND_COUNT; k++) {
-    const bb_image *x = bb_bake_result_image(a, (bb_output_kind)k);
-    const bb_image *y = bb_bake_result_image(b, (bb_output_kind)k);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    const bb_image *x = bb_bake_result_image(a, (bb_map_kind)k);
+    const bb_image *y = bb_bake_result_image(b, (bb_map_kind)k);
     if (!x || !x->pixels) {
       cr_expect(!y || !y->pixels, "%s: kind %d", what, k);
       continue;
@@ -287,7 +287,7 @@ Test(job, bake_item_cancelled_keeps_nothing) {
   bb_job_options o;
   bb_job_options_init(&o);
   o.bake.height_scale = 4.0f;
-  o.paths[BB_OUTPUT_SSBUMP] = tmp("s.png");
+  o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
   bb_error err = {{0}};
   cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);

@@ -52,8 +52,8 @@ Test(combine, kind_names) {
   cr_assert_neq(bb_map_kind_parse("height", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_WEIGHTS, "a failed parse must not write");
   cr_assert_str_eq(bb_map_kind_name(BB_MAP_SSBUMP), "ssbump");
-  cr_assert_eq(bb_map_kind_channels(BB_MAP_AO), 1);
-  cr_assert_eq(bb_map_kind_channels(BB_MAP_NORMAL), 3);
+  cr_assert_eq(bb_map_kind_get(BB_MAP_AO)->file_channels, 1);
+  cr_assert_eq(bb_map_kind_get(BB_MAP_NORMAL)->file_channels, 3);
 }
 
 Test(combine, flat_texels_as_files_hold_them) {

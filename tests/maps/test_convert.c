@@ -34,7 +34,7 @@ static bb_bake_result bake(const bb_image *h, float scale) {
   bb_bake_options o;
   bb_bake_options_init(&o);
   o.height_scale = scale;
-  o.outputs = BB_OUTPUT_BIT(BB_OUTPUT_NORMAL) | BB_OUTPUT_BIT(BB_OUTPUT_WEIGHTS);
+  o.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_WEIGHTS);
   bb_bake_result r;
   bb_error err;
   cr_assert_eq(bb_bake(h, &o, &r, &err), BB_OK, "%s", err.message);

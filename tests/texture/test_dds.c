@@ -79,7 +79,7 @@ static errors measure(const bb_image *ref, const bb_image *dec, int channels, in
 
 typedef struct round_trip {
   const char *golden;
-  bb_texture_map map;
+  bb_map_kind map;
   bb_texture_format format;
   int channels_read;  /* channels the reader hands back */
   int compare;        /* channels compared */
@@ -96,24 +96,24 @@ typedef struct round_trip {
 static const round_trip cases[] = {
     /* BC1, 5:6:5 end points, 4 colours a block: 81.1 / 8.16, 138.2 / 13.17,
      * 25.5 / 2.96 (grey ao, R, G and B compared), 119.5 / 12.62. */
-    {"rock06_32_normal.exr", BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BC1, 3, 3, 90, 9.0},
-    {"rock06_32_ssbump.exr", BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC1, 3, 3, 152, 14.5},
-    {"rock06_32_ao.exr", BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 3, 3, 28, 3.3},
-    {"noise16_ssbump.exr", BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC1, 3, 3, 132, 14.0},
+    {"rock06_32_normal.exr", BB_MAP_NORMAL, BB_TEXTURE_FORMAT_BC1, 3, 3, 90, 9.0},
+    {"rock06_32_ssbump.exr", BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC1, 3, 3, 152, 14.5},
+    {"rock06_32_ao.exr", BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 3, 3, 28, 3.3},
+    {"noise16_ssbump.exr", BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC1, 3, 3, 132, 14.0},
     /* BC3, BC1's colour (4-colour mode) and a BC4 alpha block: 138.2 /
      * 13.17 (opaque, so as BC1), 125.6 / 15.47 (4 directions, the 4th in
      * alpha). */
-    {"rock06_32_ssbump.exr", BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 4, 3, 152, 14.5},
-    {"bricks_clamp_ssbump.exr", BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 4, 4, 139, 17.0},
+    {"rock06_32_ssbump.exr", BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 4, 3, 152, 14.5},
+    {"bricks_clamp_ssbump.exr", BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 4, 4, 139, 17.0},
     /* BC4, 8-bit end points and 8 steps: 10.4 / 1.51, 6.2 / 0.98. */
-    {"rock06_32_ao.exr", BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 1, 1, 11.5, 1.7},
-    {"noise16_ao.exr", BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 1, 1, 7, 1.1},
+    {"rock06_32_ao.exr", BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 1, 1, 11.5, 1.7},
+    {"noise16_ao.exr", BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 1, 1, 7, 1.1},
     /* BC5, two BC4 blocks, x and y: 15.3 / 2.58, 13.4 / 2.17 (z below). */
-    {"rock06_32_normal.exr", BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 3, 2, 17, 2.9},
-    {"noise16_normal.exr", BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 3, 2, 15, 2.4},
+    {"rock06_32_normal.exr", BB_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 3, 2, 17, 2.9},
+    {"noise16_normal.exr", BB_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 3, 2, 15, 2.4},
     /* RGBA8, rounding alone: 0.5 / 0.28. */
-    {"rock06_32_ssbump.exr", BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_RGBA8, 4, 3, 0.5001, 0.3},
-    {"rock06_32_normal.exr", BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_RGBA8, 4, 3, 0.5001, 0.3},
+    {"rock06_32_ssbump.exr", BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_RGBA8, 4, 3, 0.5001, 0.3},
+    {"rock06_32_normal.exr", BB_MAP_NORMAL, BB_TEXTURE_FORMAT_RGBA8, 4, 3, 0.5001, 0.3},
 };
 
 Test(dds, round_trip_through_the_reader) {
@@ -132,7 +132,7 @@ Test(dds, round_trip_through_the_reader) {
     bb_image *chain = NULL;
     int count = 0;
     cr_assert_eq(bb_mip_chain(&img,
-                              t->map == BB_TEXTURE_MAP_NORMAL ? BB_MIP_RENORMALIZE
+                              t->map == BB_MAP_NORMAL ? BB_MIP_RENORMALIZE
                                                               : BB_MIP_AVERAGE,
                               &chain, &count, &err),
                  BB_OK);
@@ -148,7 +148,7 @@ Test(dds, round_trip_through_the_reader) {
       cr_assert_eq(dec.height, chain[k].height, "%s level %d height", t->golden, k);
       cr_assert_eq(dec.channels, t->channels_read, "%s: %d channels read", t->golden,
                    dec.channels);
-      errors e = measure(&chain[k], &dec, t->compare, t->map == BB_TEXTURE_MAP_NORMAL);
+      errors e = measure(&chain[k], &dec, t->compare, t->map == BB_MAP_NORMAL);
       if (k == 0)
         cr_expect_leq(e.rms, t->rms_bound, "%s %s: rms %.2f codes", t->golden,
                       bb_texture_format_name(t->format), e.rms);
@@ -193,7 +193,7 @@ Test(dds, headers) {
     bb_texture_options o;
     bb_texture_options_init(&o);
     o.format = want[c].format;
-    o.map = BB_TEXTURE_MAP_NORMAL;
+    o.map = BB_MAP_NORMAL;
     char path[160];
     snprintf(path, sizeof path, "%s/h%zu.dds", scratch_dir, c);
     bb_error err = {{0}};
@@ -300,7 +300,7 @@ Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
   bb_image img = read_golden("rock06_32_ssbump.exr");
   bb_texture_options o;
   bb_texture_options_init(&o);
-  o.map = BB_TEXTURE_MAP_SSBUMP;
+  o.map = BB_MAP_SSBUMP;
   o.format = BB_TEXTURE_FORMAT_BC1;
   char dds[160], vtf[160];
   snprintf(dds, sizeof dds, "%s/s.dds", scratch_dir);
@@ -346,7 +346,7 @@ Test(dds, same_bytes_for_any_thread_count) {
   for (int threads = 1; threads <= 3; threads++) {
     bb_texture_options o;
     bb_texture_options_init(&o);
-    o.map = BB_TEXTURE_MAP_NORMAL;
+    o.map = BB_MAP_NORMAL;
     o.format = BB_TEXTURE_FORMAT_BC1;
     o.threads = threads;
     char path[160];
@@ -392,7 +392,7 @@ Test(dds, non_power_of_two_mips) {
   scratch_dir_remove();
 }
 
-static void expect_refused(const char *name, const bb_image *img, bb_texture_map map,
+static void expect_refused(const char *name, const bb_image *img, bb_map_kind map,
                            bb_texture_format format, const char *words) {
   bb_texture_options o;
   bb_texture_options_init(&o);
@@ -416,17 +416,17 @@ Test(dds, usage_errors) {
   bb_image ssbump = read_golden("rock06_32_ssbump.exr");
   bb_image ao = read_golden("rock06_32_ao.exr");
   bb_image pit = read_golden("pit_rays64_ao.exr");
-  expect_refused("a.dds", &ssbump, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC4,
+  expect_refused("a.dds", &ssbump, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC4,
                  "holds 1 channel");
-  expect_refused("b.dds", &ssbump, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC5,
+  expect_refused("b.dds", &ssbump, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC5,
                  "holds at most 2 channels");
-  expect_refused("c.dds", &normal, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BGR8,
+  expect_refused("c.dds", &normal, BB_MAP_NORMAL, BB_TEXTURE_FORMAT_BGR8,
                  "DDS has no format bgr888");
-  expect_refused("d.dds", &ao, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_DEFAULT,
+  expect_refused("d.dds", &ao, BB_MAP_NORMAL, BB_TEXTURE_FORMAT_DEFAULT,
                  "normal map needs 3 channels");
-  expect_refused("e.dds", &pit, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4,
+  expect_refused("e.dds", &pit, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4,
                  "multiples of 4");
-  expect_refused("f.png", &ao, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT,
+  expect_refused("f.png", &ao, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT,
                  "not a texture file name");
   /* 65 x 65 is fine uncompressed. */
   bb_texture_options o;

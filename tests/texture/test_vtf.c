@@ -73,7 +73,7 @@ Test(vtf, header_byte_for_byte_7_2) {
   bb_image img = pattern(64, 32, 3, 0);
   bb_texture_options o;
   bb_texture_options_init(&o);
-  o.map = BB_TEXTURE_MAP_SSBUMP;
+  o.map = BB_MAP_SSBUMP;
   o.description = "bumpbake_version=x\nscale=64\n"; /* 7.2 has no room: left out */
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
@@ -140,7 +140,7 @@ Test(vtf, resources_7_3_hold_the_provenance) {
   bb_image img = pattern(32, 32, 3, 1);
   bb_texture_options o;
   bb_texture_options_init(&o);
-  o.map = BB_TEXTURE_MAP_NORMAL;
+  o.map = BB_MAP_NORMAL;
   o.vtf_version = 3;
   const char *provenance =
       "bumpbake_version=0.2.0\ncommand=bumpbake bake \"a b.png\" --scale 64\nscale=64\n";
@@ -192,7 +192,7 @@ Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
   bb_image img = pattern(64, 64, 3, 2);
   bb_texture_options o;
   bb_texture_options_init(&o);
-  o.map = BB_TEXTURE_MAP_SSBUMP;
+  o.map = BB_MAP_SSBUMP;
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
@@ -245,18 +245,18 @@ Test(vtf, flags_from_the_map_and_the_caller) {
            rgba = pattern(16, 16, 4, 0);
   const struct {
     const bb_image *img;
-    bb_texture_map map;
+    bb_map_kind map;
     bb_texture_format format;
     int mips;
     uint32_t extra, want;
   } cases[] = {
-      {&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x08000000u},
-      {&normal, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x00000080u},
-      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0},
-      {&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 0, 0, 0x08000300u},
-      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0x0000000cu, 0x0000000cu},
-      {&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0x00002000u},
-      {&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0},
+      {&rgb, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x08000000u},
+      {&normal, BB_MAP_NORMAL, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0x00000080u},
+      {&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, 0},
+      {&rgb, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 0, 0, 0x08000300u},
+      {&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0x0000000cu, 0x0000000cu},
+      {&rgba, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0x00002000u},
+      {&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 1, 0, 0},
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     bb_texture_options o;
@@ -379,7 +379,7 @@ Test(vtf, texel_formats) {
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGR8;
-  o.map = BB_TEXTURE_MAP_NORMAL;
+  o.map = BB_MAP_NORMAL;
   o.mips = 0;
   cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &n, &o, NULL), BB_OK);
   size_t size;
@@ -402,7 +402,7 @@ Test(vtf, same_bytes_for_any_thread_count) {
   for (int threads = 1; threads <= 4; threads++) {
     bb_texture_options o;
     bb_texture_options_init(&o);
-    o.map = BB_TEXTURE_MAP_SSBUMP;
+    o.map = BB_MAP_SSBUMP;
     o.threads = threads;
     cr_assert_eq(bb_texture_write(in_scratch_dir("d.vtf"), &img, &o, NULL), BB_OK);
     size_t size;
@@ -419,7 +419,7 @@ Test(vtf, same_bytes_for_any_thread_count) {
   scratch_dir_remove();
 }
 
-static void expect_refused(const bb_image *img, bb_texture_map map, bb_texture_format format,
+static void expect_refused(const bb_image *img, bb_map_kind map, bb_texture_format format,
                            int version, uint32_t flags, const char *words) {
   bb_texture_options o;
   bb_texture_options_init(&o);
@@ -442,9 +442,9 @@ Test(vtf, usage_errors) {
   bb_image odd = pattern(96, 80, 3, 0), tiny = pattern(2, 2, 3, 0),
            rgba = pattern(16, 16, 4, 0), ao = pattern(16, 16, 1, 0),
            rgb = pattern(16, 16, 3, 0);
-  expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
+  expect_refused(&odd, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, 0,
                  "power of two on each side (resize to 128 x 64)");
-  expect_refused(&odd, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BGR8, 2, 0, "power of two");
+  expect_refused(&odd, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BGR8, 2, 0, "power of two");
   bb_image six = pattern(8, 6, 3, 0);
   bb_texture_options dds;
   bb_texture_options_init(&dds);
@@ -455,28 +455,28 @@ Test(vtf, usage_errors) {
                      "%s", e6.message);
   bb_image_free(&six);
   /* A VTF's formats by Valve's names, as a modder types them. */
-  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 2, 0,
+  expect_refused(&rgba, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC1, 2, 0,
                  "format dxt1 holds at most 3 channels");
-  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGR8, 2, 0,
+  expect_refused(&rgba, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BGR8, 2, 0,
                  "format bgr888 holds at most 3 channels");
-  expect_refused(&ao, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 2, 0, "VTF has no format bc4");
-  expect_refused(&rgb, BB_TEXTURE_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 2, 0, "VTF has no format bc5");
-  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_RGBA32F, 2, 0,
+  expect_refused(&ao, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BC4, 2, 0, "VTF has no format bc4");
+  expect_refused(&rgb, BB_MAP_NORMAL, BB_TEXTURE_FORMAT_BC5, 2, 0, "VTF has no format bc5");
+  expect_refused(&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_RGBA32F, 2, 0,
                  "VTF has no format rgba32f");
-  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 6, 0, "7.6");
-  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, "7.1");
-  expect_refused(&rgb, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_ENVMAP,
+  expect_refused(&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 6, 0, "7.6");
+  expect_refused(&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 1, 0, "7.1");
+  expect_refused(&rgb, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_ENVMAP,
                  "ENVMAP");
   /* Flags that would contradict the file: readers believe them. */
-  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2,
+  expect_refused(&rgb, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2,
                  BB_VTF_FLAG_EIGHTBITALPHA,
                  "the EIGHTBITALPHA flag (0x00002000) says the file has alpha, and the dxt1 "
                  "file of a 3-channel image has none");
-  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 2,
+  expect_refused(&rgb, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_BC3, 2,
                  BB_VTF_FLAG_EIGHTBITALPHA, "the dxt5 file of a 3-channel image has none");
-  expect_refused(&rgb, BB_TEXTURE_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_NOMIP,
+  expect_refused(&rgb, BB_MAP_SSBUMP, BB_TEXTURE_FORMAT_DEFAULT, 2, BB_VTF_FLAG_NOMIP,
                  "the NOMIP flag (0x00000100) says the file has no mip chain, and it has one");
-  expect_refused(&rgba, BB_TEXTURE_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 2, 0x1000u,
+  expect_refused(&rgba, BB_MAP_PLAIN, BB_TEXTURE_FORMAT_BGRA8, 2, 0x1000u,
                  "ONEBITALPHA flag (0x00001000) says the file has 1-bit alpha, and the "
                  "bgra8888 file has 8-bit alpha");
   /* 2 x 2 is fine uncompressed, and so is one channel in DXT1 (grey). A

@@ -167,7 +167,7 @@ static void bake_once(serve_state *s, long wanted) {
   if (st == BB_OK) {
     bb_job_use_context(job, s->context); /* this thread's bakes only */
     progress_ctx p = {s, wanted};
-    st = bb_job_bake_item(job, 0, BB_OUTPUTS_ALL, on_progress, &p, &result, &err);
+    st = bb_job_bake_item(job, 0, BB_MAPS_BAKED, on_progress, &p, &result, &err);
   }
   if (st == BB_OK) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
