@@ -4,6 +4,7 @@ before anything is baked; one map split over the workers is the single
 process's bake bit for bit; a worker killed in the middle of a batch
 changes nothing of the result."""
 
+import json
 import os
 import re
 import shutil
@@ -274,6 +275,14 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     again = cli(*batch, "--scheduler=" + address, "--json")
     assert again.stdout.splitlines()[-1] == (
         '{"summary":{"files":6,"baked":0,"up_to_date":6,"failed":0,"not_run":0}}')
+    # a baked input's JSON line is the command line's (the library's
+    # lines, bb_job_report_lines): the same members, the same parameters
+    lines = [json.loads(line) for line in
+             (cli(*batch, "--json", "--force", *more).stdout.splitlines()[0]
+              for more in (("--scheduler", address), ()))]
+    for line in lines:
+        del line["seconds"], line["parameters"]["threads"]
+    assert lines[0] == lines[1] and lines[0]["status"] == "baked"
     quiet = batch + ["-q", "--force", "--depfile", "out.d"]
     assert cli(*quiet, "--scheduler", address).stdout == ""
     forced, depfile = files_of("out"), open("out.d").read()

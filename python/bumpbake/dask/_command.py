@@ -7,9 +7,10 @@ mean there) and runs it on the cluster: a batch (--out-dir) as
 bake_files, one map as bake_big, its trace split over the workers. The
 files record the command as the CLI records it without --scheduler (the
 record travels with the command), so they are the bytes the same command
-writes on one machine. It prints what the CLI prints (wrote/up to date
-lines, the batch's summary, --json lines) and exits as it does: 0, 1 when
-an input failed, 2 for a usage error."""
+writes on one machine. It prints what the CLI prints, by the library's
+lines of each report the cluster sends back and of the batch's summary
+(bb_job_report_lines, bb_job_summary_lines: the C program's too), and
+exits as it does: 0, 1 when an input failed, 2 for a usage error."""
 
 import json
 import os
@@ -105,50 +106,48 @@ class CommandJob(BakeJob):
 # ----------------------------------------------------------------- the run
 
 
-def _print_report(report, as_json, quiet, batch):
-    if report.status == "failed":
-        print(f"bumpbake: {report.error}", file=sys.stderr)
-    if report.status == "not run":
-        return
-    if as_json:
-        line = {"input": report.input}
-        if batch or report.status != "baked":
-            line["status"] = report.status
-        if report.status == "baked":
-            line.update(width=report.width, height=report.height,
-                        parameters={"slices": report.slices, "rayset": report.rayset,
-                                    "channel": report.channel, "threads": report.threads},
-                        seconds=report.seconds, horizons=report.horizons)
-            if report.cluster:
-                line["cluster"] = report.cluster
-        elif report.status == "failed":
-            line["exit_code"] = 1
-        line["outputs"] = [{"kind": k, "path": p} for k, p in report.outputs.items()
-                           if not k.startswith("slope") or report.status != "baked"]
-        print(json.dumps(line, separators=(",", ":")))
-    elif not quiet and report.status in ("baked", "up to date"):
-        verb = "wrote" if report.status == "baked" else "up to date"
-        for kind, path in report.outputs.items():
-            print(f"{verb} {kind} {path}")
+_OUTCOME = {"pending": _lib.BB_JOB_PENDING, "baked": _lib.BB_JOB_BAKED,
+            "up to date": _lib.BB_JOB_CURRENT, "failed": _lib.BB_JOB_FAILED,
+            "not run": _lib.BB_JOB_NOT_RUN}
+
+
+def _printed(text):
+    """Prints the library's lines (bb_job_report_lines, bb_job_summary_lines)."""
+    if text == _ffi.NULL:
+        raise MemoryError("bumpbake: out of memory")
+    try:
+        sys.stdout.write(_text(text))
+    finally:
+        _lib.free(text)
     sys.stdout.flush()
 
 
-def _summary(reports, as_json, quiet):
-    count = {s: sum(r.status == s for r in reports)
-             for s in ("baked", "up to date", "failed", "not run")}
-    if as_json:
-        print(json.dumps({"summary": {"files": len(reports), "baked": count["baked"],
-                                      "up_to_date": count["up to date"],
-                                      "failed": count["failed"],
-                                      "not_run": count["not run"]}}, separators=(",", ":")))
-    elif not quiet:
-        line = (f"bake: {len(reports)} file{'' if len(reports) == 1 else 's'}: "
-                f"{count['baked']} baked, {count['up to date']} up to date, "
-                f"{count['failed']} failed")
-        if count["not run"]:
-            line += (f", {count['not run']} not run (stopped at the first failure; "
-                     "--keep-going goes on)")
-        print(line)
+def _print_report(command, report, batch):
+    """What the C program prints of a report, by the library's lines: the
+    report (a worker's, sent back) as a bb_job_report again."""
+    if report.status == "failed":
+        print(f"bumpbake: {report.error}", file=sys.stderr)
+    r = _ffi.new("bb_job_report *")
+    _ffi.memmove(r, report._bytes, min(len(report._bytes), _ffi.sizeof(r[0])))
+    keep = [_ffi.new("char[]", _path(report.input))]
+    r.input = keep[0]
+    r.outcome = _OUTCOME[report.status]
+    r.output_count = len(report.outputs)
+    for k, (kind, path) in enumerate(report.outputs.items()):
+        keep += [_ffi.new("char[]", kind.encode()), _ffi.new("char[]", _path(path))]
+        r.outputs[k].kind, r.outputs[k].path = keep[-2], keep[-1]
+    extra = _ffi.NULL
+    if report.cluster:  # where bake_big's trace ran
+        extra = b'"cluster":' + json.dumps(report.cluster, separators=(",", ":")).encode()
+    _printed(_lib.bb_job_report_lines(command.options, r, batch, extra))
+
+
+def _summary(command, reports):
+    counts = _ffi.new("int[5]")
+    for r in reports:
+        counts[_OUTCOME[r.status]] += 1
+    name = _lib.bb_command_describe(command.c).name
+    _printed(_lib.bb_job_summary_lines(command.options, name, counts, len(reports)))
 
 
 def _note(line):
@@ -161,19 +160,17 @@ def run(command):
     """Runs a handed-over bake command on its cluster; the exit code."""
     from . import bake_big, bake_files
     from ._connect import connect
-    o = command.options
-    as_json, quiet = bool(o.json), bool(o.quiet)
-    with connect(_text(o.scheduler), quiet=True) as client:
+    with connect(_text(command.options.scheduler), quiet=True) as client:
         if command.text("out_dir") is not None:
             reports = bake_files(None, None, client=client, check=False, notes=_note,
                                  _command=command, _ask_notes=False)
             for r in reports:
-                _print_report(r, as_json, quiet, batch=True)
-            _summary(reports, as_json, quiet)
+                _print_report(command, r, batch=True)
+            _summary(command, reports)
             return 1 if any(r.status == "failed" for r in reports) else 0
         report = bake_big(None, client=client, check=False, notes=_note, _command=command,
                           _ask_notes=False)
-        _print_report(report, as_json, quiet, batch=False)
+        _print_report(command, report, batch=False)
         return 1 if report.status == "failed" else 0
 
 
