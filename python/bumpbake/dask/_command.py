@@ -16,46 +16,10 @@ import json
 import os
 import sys
 
+from .._command import Command
 from .._common import (ArgumentError, Error, _check, _check_notes, _ffi, _lib, _path,
                        _text)
 from .._jobs import BakeJob
-
-
-class Command:
-    """A command handed over by the C program, set up and checked by the
-    library; pickles as its hand-over bytes. inputs: a part of the batch
-    in place of its inputs (a chunk, planned on a worker)."""
-
-    def __init__(self, data, inputs=None):
-        self.data = bytes(data)
-        keep = [_ffi.new("char[]", _path(p, "input")) for p in inputs or ()]
-        c_inputs = _ffi.new("char *[]", keep) if inputs is not None else _ffi.NULL
-        out = _ffi.new("bb_command **")
-        err = _ffi.new("bb_error *")
-        _check(_lib.bb_command_from_handover(self.data, len(self.data), c_inputs,
-                                             len(keep), out, err), err)
-        self.c = _ffi.gc(out[0], _lib.bb_command_free)
-
-    def __reduce__(self):
-        return (Command, (self.data,))
-
-    def default(self, name, text):
-        """Sets option name from text unless the command gave it (a
-        cluster's choice where the user made none: threads per task)."""
-        if not _lib.bb_command_given(self.c, name.encode()):
-            err = _ffi.new("bb_error *")
-            _check(_lib.bb_command_set(self.c, name.encode(), text.encode(), err), err)
-            _check(_lib.bb_command_check(self.c, err), err)
-
-    @property
-    def options(self):
-        """The command's bb_command_options (owned by the command)."""
-        return _lib.bb_command_options_of(self.c)
-
-    def text(self, name):
-        """The text of a string option of the job's, or None."""
-        value = getattr(self.options.job, name)
-        return None if value == _ffi.NULL else _text(value)
 
 
 class CommandJob(BakeJob):
@@ -67,17 +31,16 @@ class CommandJob(BakeJob):
                  _trace=None):
         self._notes_policy = _check_notes(notes)
         self._trace = _trace
-        self._data = bytes(data)
-        self._command = Command(data, inputs)
+        self._cmd = command = Command.from_handover(data, inputs)
         if threads is not None:  # the library's threads per bake, unless --threads
-            self._command.default("threads", str(threads))
+            command.default("threads", str(threads))
         if unforced:  # the command without --force (a flag set to "0" is unset)
             err = _ffi.new("bb_error *")
-            _check(_lib.bb_command_set(self._command.c, b"force", b"0", err), err)
-            _check(_lib.bb_command_check(self._command.c, err), err)
-        job = self._command.options.job
-        self._args = dict(out_dir=self._command.text("out_dir"), keep_going=bool(job.keep_going),
-                          force=bool(job.force), depfile=self._command.text("depfile"))
+            _check(_lib.bb_command_set(command.handle, b"force", b"0", err), err)
+            _check(_lib.bb_command_check(command.handle, err), err)
+        job = command.options.job
+        self._args = dict(out_dir=command.job_text("out_dir"), keep_going=bool(job.keep_going),
+                          force=bool(job.force), depfile=command.job_text("depfile"))
         self._single = False  # the command line's single bake always bakes
         hooks = _ffi.new("bb_command_hooks *")
         if _trace is not None:
@@ -85,22 +48,11 @@ class CommandJob(BakeJob):
 
         def plan(note, out, err):
             hooks.note = note
-            return _lib.bb_command_plan(self._command.c, hooks, out, err)
+            return _lib.bb_command_plan(command.handle, hooks, out, err)
         self._adopt(plan)
 
     def __reduce__(self):
-        return (CommandJob, (self._data, self.inputs))
-
-    def command_text(self, i=0):
-        """The command input i's outputs record (bb_command_text)."""
-        text = _lib.bb_command_text(self._command.c, self._raw(i).input,
-                                    _lib.BB_OPTION_RECORDED)
-        if text == _ffi.NULL:
-            raise MemoryError("bb_command_text")
-        try:
-            return _text(text)
-        finally:
-            _lib.free(text)
+        return (CommandJob, (self._cmd.data, self.inputs))
 
 
 # ----------------------------------------------------------------- the run
@@ -146,8 +98,8 @@ def _summary(command, reports):
     counts = _ffi.new("int[5]")
     for r in reports:
         counts[_OUTCOME[r.status]] += 1
-    name = _lib.bb_command_describe(command.c).name
-    _printed(_lib.bb_job_summary_lines(command.options, name, counts, len(reports)))
+    _printed(_lib.bb_job_summary_lines(command.options, command.name.encode(), counts,
+                                       len(reports)))
 
 
 def _note(line):
@@ -161,7 +113,7 @@ def run(command):
     from . import bake_big, bake_files
     from ._connect import connect
     with connect(_text(command.options.scheduler), quiet=True) as client:
-        if command.text("out_dir") is not None:
+        if command.job_text("out_dir") is not None:
             reports = bake_files(None, None, client=client, check=False, notes=_note,
                                  _command=command, _ask_notes=False)
             for r in reports:
@@ -179,7 +131,7 @@ def main(fd):
     try:
         with os.fdopen(fd, "rb") as f:
             data = f.read()
-        return run(Command(data))
+        return run(Command.from_handover(data))
     except ArgumentError as e:
         print(f"bumpbake bake: {e}", file=sys.stderr)
         return 2
