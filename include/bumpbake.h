@@ -2998,10 +2998,10 @@ bb_status bb_command_picture(bb_command *command, const bb_image *height,
  * free(); NULL when out of memory. */
 char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
                           const char *extra_json);
-/* A batch's summary line of command (its name) over files inputs, counts
- * indexed by bb_job_outcome (5 of them): "COMMAND: N files: B baked, C up
- * to date, F failed[, R not run (...)]", or its JSON line; "" with quiet.
- * To free(); NULL when out of memory. */
+/* A batch's summary line of command (its name) over files inputs, with
+ * counts[k] the inputs whose outcome is k (a bb_job_outcome, 5 of them):
+ * "COMMAND: N files: B baked, C up to date, F failed[, R not run (...)]",
+ * or its JSON line; "" with quiet. To free(); NULL when out of memory. */
 char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
                            int files);
 
