@@ -261,10 +261,9 @@ $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
 
-# The tools print JSON with the CLI's one writer (src/cli/json.c).
-TOOL_JSON := $(BUILD)/src/cli/json.o
-$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(TOOL_JSON) $(LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $< $(TOOL_JSON) $(LIB) $(LDLIBS)
+# The tools print JSON with the library's one writer (bb_json, src/core/json.c).
+$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
 
 $(FUZZ_REPLAY_OBJ): $(BUILD)/fuzz/%.o: fuzz/%.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)

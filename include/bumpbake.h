@@ -53,6 +53,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -2977,6 +2978,64 @@ void bb_command_result_free(bb_command_result *result);
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
+
+/* ------------------------------- what a job prints, and the JSON writer */
+
+/* The lines `bumpbake bake` (bake, normal, height2ssbump) prints on stdout
+ * of one input's report r, as o (json, quiet) asks, the command line's
+ * and its --scheduler run's alike: "wrote KIND PATH" or "up to date KIND
+ * PATH" per file (control characters escaped, bb_text_printable), or with
+ * json the input's JSON line (bb_job_report_json; with batch a "status"
+ * and, for an input not baked, the short line: input, status, exit_code
+ * when it failed, every output). Nothing for an input not run, nor for a
+ * failure without json (its error is the caller's line on stderr).
+ * extra_json (may be NULL): members written before "outputs" of a baked
+ * input's line ("\"cluster\":{...}"). Returns the text, "" when none, to
+ * free(); NULL when out of memory. */
+char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+                          const char *extra_json);
+/* A batch's summary line of command (its name) over files inputs, with
+ * counts[k] the inputs whose outcome is k (a bb_job_outcome, 5 of them):
+ * "COMMAND: N files: B baked, C up to date, F failed[, R not run (...)]",
+ * or its JSON line; "" with quiet. To free(); NULL when out of memory. */
+char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
+                           int files);
+
+/* The JSON object of r (an input baked with options b), without a
+ * newline: input, status (when not NULL), size, the parameters used (the
+ * channel the rule took, the threads that ran), seconds per stage,
+ * horizons, extra_json's members (may be NULL) and the maps written. */
+void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
+                        const char *status, const char *extra_json);
+
+/* Writes s to f as a quoted JSON string, always valid UTF-8 and never cut:
+ * '"' and '\' escaped, newline, carriage return and tab as \n, \r, \t,
+ * other control characters (C0, DEL, C1) as \u00XX; UTF-8 passes through;
+ * a byte that is not part of UTF-8 (a file name in another encoding)
+ * becomes the lone surrogate \udcXX, which Python's json and
+ * os.fsencode() turn back into the same byte. NULL writes null. */
+void bb_json_quoted(FILE *f, const char *s);
+
+/* The one JSON writer of the library, the command line and the tools:
+ * one-line objects; fields are separated by commas automatically. Values
+ * are written as they come; nesting is the caller's to balance. */
+typedef struct bb_json {
+  FILE *f;
+  int need_comma; /* a value was written at the current nesting level */
+} bb_json;
+
+/* Opens an object or array; key is its field name, NULL at the top level
+ * or inside an array. open is '{' or '['. */
+void bb_json_open(bb_json *j, const char *key, char open);
+void bb_json_close(bb_json *j, char close);
+/* A string field; value NULL writes null. key NULL inside arrays. */
+void bb_json_string(bb_json *j, const char *key, const char *value);
+/* A number with 9 significant digits (every float reads back exactly);
+ * JSON has no NaN or infinity, so those are written as null. */
+void bb_json_number(bb_json *j, const char *key, double value);
+/* An integer, exactly (counts, sizes, exit codes). */
+void bb_json_int(bb_json *j, const char *key, long long value);
+void bb_json_bool(bb_json *j, const char *key, int value);
 
 /* ------------------------------------------------- names of enums printed */
 

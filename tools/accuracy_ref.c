@@ -26,7 +26,6 @@
  */
 #include "bumpbake.h"
 #include "core/internal.h"
-#include "cli/json.h"
 #include "trace/rayset.h"
 #include "trace/testing.h"
 
@@ -367,7 +366,7 @@ static bb_status rules_run(const args *a, const job *j, int rows, bb_error *err)
   if (st == BB_OK) st = bb__parallel_for(rows, 0, rule_row, &r, NULL, NULL, err);
   if (st == BB_OK) {
     printf("{\"map\":");
-    cli_json_quoted(stdout, a->map);
+    bb_json_quoted(stdout, a->map);
     printf(",\"scale\":%g,\"stride\":%d,\"azimuths\":%d,\"texels\":%ld,\"rules\":[", a->scale,
            a->stride, a->azimuths, r.texels);
     fprintf(stderr, "%-9s %6s %9s %9s %9s %9s  (ssmax: the ssbump channel of largest mean |error|)\n",
@@ -436,7 +435,7 @@ static int read_matching(const char *path, int width, int height, int channels, 
 
 static int compare_all(const args *a, const job *j, int width, int height) {
   printf("{\"map\":");
-  cli_json_quoted(stdout, a->map);
+  bb_json_quoted(stdout, a->map);
   printf(",\"scale\":%g,\"stride\":%d,\"azimuths\":%d,\"reach\":%g,\"texels\":%ld,\"results\":[",
          a->scale, a->stride, a->azimuths, a->reach,
          (long)((height + a->stride - 1) / a->stride) * j->columns);
@@ -449,7 +448,7 @@ static int compare_all(const args *a, const job *j, int width, int height) {
     }
     const stats sa = difference(j, &ao, j->ao, 0, 1);
     printf("%s{\"name\":", r ? "," : "");
-    cli_json_quoted(stdout, a->name[r]);
+    bb_json_quoted(stdout, a->name[r]);
     printf(",\"ao\":{\"mean\":%.6g,\"mean_abs\":%.6g},\"ssbump\":[", sa.mean, sa.mean_abs);
     fprintf(stderr, "accuracy_ref: %-10s ao %+.5f / %.5f", a->name[r], sa.mean, sa.mean_abs);
     for (int c = 0; c < 3; c++) {

@@ -19,7 +19,6 @@
  * bad command line.
  */
 #include "bumpbake.h"
-#include "cli/json.h"
 #include "trace/march.h"
 #include "trace/rayset.h"
 
@@ -279,12 +278,12 @@ static double per_second(double work, double seconds) {
 
 static void print_json(const args *a, const field *f, const trace_run *t, const results *r) {
   printf("{\"map\":");
-  cli_json_quoted(stdout, a->map);
+  bb_json_quoted(stdout, a->map);
   printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"slices\":%d,\"threads\":%d,"
          "\"addressing\":\"%s\",\"bias\":%g,\"rayset\":",
          f->z.width, f->z.height, a->scale, a->rays, f->rs->slice_count, a->threads,
          a->addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a->bias);
-  cli_json_quoted(stdout, f->rs->id);
+  bb_json_quoted(stdout, f->rs->id);
   printf(",\"trace_s\":%.6f,\"trace_runs\":%d,\"horizons\":%.0f,\"horizons_per_s\":%.6g,"
          "\"subset_texels\":%d,\"subset_horizons\":%ld,\"positive_fraction\":%.6g,"
          "\"march_s\":%.6f,\"march_runs\":%d,\"march_horizons_per_s\":%.6g,"

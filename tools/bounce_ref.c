@@ -56,7 +56,6 @@
  */
 #include "bumpbake.h"
 #include "core/internal.h"
-#include "cli/json.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -652,7 +651,7 @@ static int run_trace(int argc, char **argv) {
     /* the mean value, the mean standard error per texel and that of the mean */
     const long texels = (long)rows * j.columns;
     printf("{\"map\":");
-    cli_json_quoted(stdout, a.map);
+    bb_json_quoted(stdout, a.map);
     printf(",\"scale\":%g,\"rho\":%g,\"bounces\":%d,\"paths\":%d,\"stride\":%d,\"texels\":%ld,"
            "\"seconds\":%.3f,\"channels\":[",
            a.scale, a.rho, a.bounces, a.paths, a.stride, texels, seconds);
@@ -773,7 +772,7 @@ static int run_compare(int argc, char **argv) {
       }
     }
   printf("{\"reference\":");
-  cli_json_quoted(stdout, ref_path);
+  bb_json_quoted(stdout, ref_path);
   printf(",\"texels\":%ld,\"reference_se\":[", texels);
   fprintf(stderr, "bounce_ref: %s: %ld texels; reference standard error per texel / of the mean:",
           ref_path, texels);
@@ -829,7 +828,7 @@ static int run_compare(int argc, char **argv) {
         }
       }
     printf("%s{\"name\":", printed++ ? "," : "");
-    cli_json_quoted(stdout, text);
+    bb_json_quoted(stdout, text);
     printf(",\"channels\":[");
     fprintf(stderr, "bounce_ref: %-12s", text);
     for (int c = 0; c < channels; c++) {

@@ -14,7 +14,6 @@
  * command line.
  */
 #include "bumpbake.h"
-#include "cli/json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -66,9 +65,9 @@ static int report(const char *pa, const char *pb, const bb_image *a, const bb_im
     return 1;
   }
   printf("{\"a\":");
-  cli_json_quoted(stdout, pa);
+  bb_json_quoted(stdout, pa);
   printf(",\"b\":");
-  cli_json_quoted(stdout, pb);
+  bb_json_quoted(stdout, pb);
   printf(",\"width\":%d,\"height\":%d,\"channels\":[", a->width, a->height);
   for (int c = 0; c < a->channels; c++) {
     channel_stats s = channel_difference(a, b, c, scratch);

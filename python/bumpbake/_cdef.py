@@ -782,6 +782,11 @@ const char *bb_addressing_name(bb_addressing addressing);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 const char *bb_provenance_class_name(bb_provenance_class c);
 long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
+/* what a job prints (bumpbake bake --scheduler) */
+char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+                          const char *extra_json);
+char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
+                           int files);
 """
 
 # Constants of the header (#define), by value: cffi reads only literals.

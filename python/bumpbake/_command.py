@@ -21,7 +21,7 @@ import re
 import numpy as np
 
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
-                      _message, _text)
+                      _message, _path, _text)
 
 _TYPE_NAMES = ("flag", "integer", "number", "word", "words", "numbers", "text", "path")
 
@@ -119,16 +119,57 @@ def _expected(option):
 
 class Command:
     """One use of a library command (bb_command): keywords set, inputs
-    added, checked, then planned, run or drawn by the library."""
+    added, checked, then planned, run or drawn by the library. Or, by
+    from_handover, the command the C program handed over (`bumpbake bake
+    --scheduler`), set up and checked by the library; that one pickles as
+    its hand-over bytes (data)."""
 
-    def __init__(self, name, function=None):
+    def __init__(self, name, function=None, _handle=None):
         self.name = name
         self.function = function or name  # how messages name the Python call
-        err = _ffi.new("bb_error *")
-        out = _ffi.new("bb_command **")
-        _check(_lib.bb_command_new(name.encode(), out, err), err)
-        self._c = _ffi.gc(out[0], _lib.bb_command_free)
+        self.data = None  # the hand-over bytes (from_handover)
+        if _handle is None:
+            err = _ffi.new("bb_error *")
+            out = _ffi.new("bb_command **")
+            _check(_lib.bb_command_new(name.encode(), out, err), err)
+            _handle = out[0]
+        self._c = _ffi.gc(_handle, _lib.bb_command_free)
         self._info = _lib.bb_command_describe(self._c)
+
+    @classmethod
+    def from_handover(cls, data, inputs=None):
+        """The command of bb_command_handover's bytes (bb_command_from_handover:
+        the same parsers and checks as the C program's). inputs: a part of
+        the batch in place of its inputs (a chunk, planned on a worker)."""
+        data = bytes(data)
+        keep = [_ffi.new("char[]", _path(p, "input")) for p in inputs or ()]
+        c_inputs = _ffi.new("char *[]", keep) if inputs is not None else _ffi.NULL
+        out = _ffi.new("bb_command **")
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_command_from_handover(data, len(data), c_inputs, len(keep), out, err),
+               err)
+        command = cls(_text(_lib.bb_command_describe(out[0]).name), _handle=out[0])
+        command.data = data
+        return command
+
+    def __reduce__(self):
+        if self.data is None:
+            raise TypeError("a Command pickles only when handed over (from_handover)")
+        return (Command.from_handover, (self.data,))
+
+    def default(self, name, text):
+        """Sets option name (its long name) from text unless the command
+        gave it (a cluster's choice where the user made none: threads per
+        task), and checks the command again."""
+        if not self.given(name):
+            err = _ffi.new("bb_error *")
+            _check(_lib.bb_command_set(self._c, name.encode(), text.encode(), err), err)
+            _check(_lib.bb_command_check(self._c, err), err)
+
+    def job_text(self, name):
+        """The text of a string option of the job's (out_dir), or None."""
+        value = getattr(self.options.job, name)
+        return None if value == _ffi.NULL else _text(value)
 
     def option(self, key):
         """The option of keyword key; TypeError naming the nearest when none."""

@@ -38,6 +38,9 @@ class BakeReport:
     notes: list = dataclasses.field(default_factory=list)    # "PATH: text" lines
     cluster: typing.Optional[dict] = None  # bumpbake.dask.bake_big: where the trace ran
     _code: int = dataclasses.field(default=0, repr=False, compare=False)  # bb_status
+    # the bb_job_report's bytes (its pointers stale), for the library's
+    # lines of it (bumpbake bake --scheduler prints them: bb_job_report_lines)
+    _bytes: bytes = dataclasses.field(default=b"", repr=False, compare=False)
 
     @property
     def ok(self):
@@ -48,7 +51,8 @@ class BakeReport:
 def _report(r, status=None):
     out = BakeReport(input=_text(r.input), status=status or _OUTCOMES[r.outcome],
                      outputs={_text(r.outputs[k].kind): _text(r.outputs[k].path)
-                              for k in range(r.output_count)})
+                              for k in range(r.output_count)},
+                     _bytes=bytes(_ffi.buffer(r)))
     out.reason = _text(r.reason) or None
     if r.outcome == _lib.BB_JOB_FAILED:
         out.error = _message(r.error, r.status)

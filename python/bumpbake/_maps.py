@@ -3,7 +3,7 @@ DOOM 3 image programs and mip chains, each one call of the library."""
 
 from ._bake import _IN_MEMORY, _basis, _normal_y_up
 from ._command import Command
-from ._common import _Image, _array, _c_text, _check, _depth, _ffi, _lib, _path, _take
+from ._common import _Image, _array, _c_text, _check, _depth, _ffi, _lib, _take
 from ._files import _signed
 
 
@@ -165,7 +165,7 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
     return _take(out)
 
 
-def program(text, base=None, allow_outside_base=False):
+def program(text, base=None, allow_outside_base=False, **options):
     """Evaluates a DOOM 3 image program ("addnormals(a_local.tga,
     heightmap(a_h.tga, 4))") as `bumpbake program` does: image names are
     files, relative to base (a directory; None: the current one), and must
@@ -175,18 +175,24 @@ def program(text, base=None, allow_outside_base=False):
     the program makes a normal map (heightmap, addnormals, smoothnormals or
     _flat in it), else RGBA colour, float32 (H, W, 4) in [0, 1]. A syntax
     error is ArgumentError giving the column; a file that cannot be read,
-    Error naming it."""
+    Error naming it. Keywords are the command's options (base,
+    allow_outside_base), set and checked by the library; those about the
+    file written (output, depth, ...) are run("program", text, ...)'s."""
     if not isinstance(text, str):
         raise TypeError(f"program: text must be a str (got {text!r})")
+    c = Command("program")
+    c.add_input(_c_text(text, "program"))
+    c.set_all(dict(options, base=base, allow_outside_base=allow_outside_base))
+    c.in_memory()
+    c.check()
     err = _ffi.new("bb_error *")
     prog = _ffi.new("bb_program **")
     _check(_lib.bb_program_parse(_c_text(text, "program"), prog, err), err)
     prog = _ffi.gc(prog[0], _lib.bb_program_free)
     o = _ffi.new("bb_program_options *")
     _lib.bb_program_options_init(o)
-    base_dir = _ffi.new("char[]", _path(base, "base")) if base is not None else _ffi.NULL
-    o.base_dir = base_dir
-    o.allow_outside_base = int(bool(allow_outside_base))
+    o.base_dir = c.options.base_dir
+    o.allow_outside_base = c.options.allow_outside_base
     out = _ffi.new("bb_image *")
     is_normal = _ffi.new("int *")
     _check(_lib.bb_program_run(prog, o, out, is_normal, err), err)

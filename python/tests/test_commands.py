@@ -102,7 +102,25 @@ def test_every_option_of_every_command_has_a_python_keyword(tmp_path, monkeypatc
                 continue
             if not any(knows(name, command, key) for name in FUNCTIONS[command]):
                 missing.append(f"{command} --{_text(o.name)}")
+            # an option not about files is every function's (program's
+            # too, not run()'s alone)
+            if not o.flags & _lib.BB_OPTION_FILES:
+                missing += [f"{name}() of {command} --{_text(o.name)}"
+                            for name in FUNCTIONS[command] if not knows(name, command, key)]
     assert not missing, f"CLI options with no Python keyword: {missing}"
+
+
+def test_program_takes_its_keywords_through_the_library(tmp_path, monkeypatch):
+    """program()'s keywords are the command's options, set and checked by
+    the library (Command): the options about the file written are run()'s,
+    refused in the library's words; a mistyped one gets the nearest."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(bumpbake.ArgumentError, match="^program: depth is about files"):
+        bumpbake.program("_flat", depth=16)
+    e = call_with("program", "program", "bace", ".")
+    assert isinstance(e, TypeError) and "(did you mean 'base'?)" in str(e)
+    flat, is_normal = bumpbake.program("_flat", base=tmp_path)
+    assert is_normal and flat.shape[-1] == 3
 
 
 def test_the_walk_fails_on_an_unknown_keyword():

@@ -4,6 +4,7 @@ before anything is baked; one map split over the workers is the single
 process's bake bit for bit; a worker killed in the middle of a batch
 changes nothing of the result."""
 
+import json
 import os
 import re
 import shutil
@@ -274,6 +275,14 @@ def test_the_cli_with_a_scheduler_runs_the_same_code(tmp_path, monkeypatch, clie
     again = cli(*batch, "--scheduler=" + address, "--json")
     assert again.stdout.splitlines()[-1] == (
         '{"summary":{"files":6,"baked":0,"up_to_date":6,"failed":0,"not_run":0}}')
+    # a baked input's JSON line is the command line's (the library's
+    # lines, bb_job_report_lines): the same members, the same parameters
+    lines = [json.loads(line) for line in
+             (cli(*batch, "--json", "--force", *more).stdout.splitlines()[0]
+              for more in (("--scheduler", address), ()))]
+    for line in lines:
+        del line["seconds"], line["parameters"]["threads"]
+    assert lines[0] == lines[1] and lines[0]["status"] == "baked"
     quiet = batch + ["-q", "--force", "--depfile", "out.d"]
     assert cli(*quiet, "--scheduler", address).stdout == ""
     forced, depfile = files_of("out"), open("out.d").read()
@@ -369,7 +378,8 @@ def test_a_handed_over_command_is_the_command(tmp_path, monkeypatch):
     read back spells every option as the one handed over; a chunk's inputs
     replace the batch's; what is not a hand-over is refused."""
     from bumpbake._common import _check, _ffi, _lib, _text
-    from bumpbake.dask._command import Command, CommandJob
+    from bumpbake._command import Command
+    from bumpbake.dask._command import CommandJob
     monkeypatch.chdir(tmp_path)
     heights("heights", 2)
     with open("basis.txt", "w") as f:
@@ -404,19 +414,19 @@ def test_a_handed_over_command_is_the_command(tmp_path, monkeypatch):
         finally:
             _lib.free(text)
 
-    back = Command(handed)
-    assert spelled(back.c) == spelled(c)
-    assert all(_lib.bb_command_given(back.c, n.encode()) for n in given)
+    back = Command.from_handover(handed)
+    assert spelled(back.handle) == spelled(c)
+    assert all(_lib.bb_command_given(back.handle, n.encode()) for n in given)
     assert back.options.json == 1 and back.options.quiet == 1  # the printer's, too
     assert _text(back.options.scheduler) == "tcp://h:1"
-    chunk = Command(handed, ["heights/h01.png"])
-    assert spelled(chunk.c).startswith("bumpbake bake heights/h01.png --scale 12.5")
+    chunk = Command.from_handover(handed, ["heights/h01.png"])
+    assert spelled(chunk.handle).startswith("bumpbake bake heights/h01.png --scale 12.5")
     job = CommandJob(handed, ["heights/h01.png"], notes="ignore")
     assert job.inputs == ["heights/h01.png"]
     assert job.report(0).outputs == {"normal": "out/normal/h01.tif", "ao": "out/ao/h01.tif"}
     for bad in (b"", b"bake\0", handed[:-4], handed.replace(b"input\0", b"inpux\0")):
         with pytest.raises(bumpbake.ArgumentError, match="hand-over"):
-            Command(bad)
+            Command.from_handover(bad)
 
 
 def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, client, cli):
@@ -557,7 +567,7 @@ def test_the_command_lines_forced_batch_with_a_depfile_is_baked_once(tmp_path, m
     flag set to "0"), so it finds each input the workers baked up to date
     rather than baking it again."""
     from bumpbake._common import _check, _ffi, _lib
-    from bumpbake.dask._command import Command
+    from bumpbake._command import Command
     monkeypatch.chdir(tmp_path)
     heights("heights", 3)
     err = _ffi.new("bb_error *")
@@ -585,7 +595,7 @@ def test_the_command_lines_forced_batch_with_a_depfile_is_baked_once(tmp_path, m
 
     monkeypatch.setattr(bumpbake.BakeJob, "run", counted)
     reports = bumpbake.dask.bake_files(None, None, client=client, check=False, notes="ignore",
-                                       _command=Command(handed), _ask_notes=False)
+                                       _command=Command.from_handover(handed), _ask_notes=False)
     assert [r.status for r in reports] == ["baked"] * 3
     assert on_the_client == ["up to date"] * 3
     assert open("out.d").read().count(": heights/h0") == 3

@@ -2,7 +2,6 @@
  * subcommand shares. */
 #include "common.h"
 #include "cli.h"
-#include "json.h"
 
 #include <signal.h>
 #include <stdarg.h>

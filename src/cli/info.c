@@ -3,7 +3,6 @@
  * headers only: no pixel is decoded. */
 #include "cli.h"
 #include "common.h"
-#include "json.h"
 
 #include "bumpbake.h"
 
@@ -127,8 +126,8 @@ static void print_text(const char *path, const file_info *f) {
 /* The key=value lines of intact provenance as a JSON object of strings, as
  * the library reads them (bb_provenance_entries); values are kept as
  * written: exact, and the same for every key. */
-static void json_provenance(cli_json *j, const char *text) {
-  cli_json_open(j, "provenance", '{');
+static void json_provenance(bb_json *j, const char *text) {
+  bb_json_open(j, "provenance", '{');
   const long count = bb_provenance_entries(text, NULL, 0);
   bb_provenance_entry *entries = count > 0 ? malloc((size_t)count * sizeof *entries) : NULL;
   if (entries)
@@ -138,76 +137,76 @@ static void json_provenance(cli_json *j, const char *text) {
     char *key = strndup(entries[i].key, entries[i].key_length);
     char *value = strndup(entries[i].value, entries[i].value_length);
     if (key && value)
-      cli_json_string(j, key, value);
+      bb_json_string(j, key, value);
     free(key);
     free(value);
   }
   free(entries);
-  cli_json_close(j, '}');
+  bb_json_close(j, '}');
 }
 
 static void print_json(const char *path, const file_info *f) {
   const bb_image_info *i = &f->info;
-  cli_json j = {stdout, 0};
-  cli_json_open(&j, NULL, '{');
-  cli_json_string(&j, "path", path);
-  cli_json_int(&j, "width", f->width);
-  cli_json_int(&j, "height", f->height);
-  cli_json_int(&j, "channels", f->channels);
-  cli_json_string(&j, "format", i->format_name);
-  cli_json_int(&j, "bits_per_sample", i->bits_per_sample);
-  cli_json_bool(&j, "float", i->is_float);
-  cli_json_int(&j, "alpha_channel", i->alpha_channel);
+  bb_json j = {stdout, 0};
+  bb_json_open(&j, NULL, '{');
+  bb_json_string(&j, "path", path);
+  bb_json_int(&j, "width", f->width);
+  bb_json_int(&j, "height", f->height);
+  bb_json_int(&j, "channels", f->channels);
+  bb_json_string(&j, "format", i->format_name);
+  bb_json_int(&j, "bits_per_sample", i->bits_per_sample);
+  bb_json_bool(&j, "float", i->is_float);
+  bb_json_int(&j, "alpha_channel", i->alpha_channel);
   if (f->is_vtf) {
     const bb_vtf_info *v = &f->vtf;
     char text[512];
-    cli_json_open(&j, "vtf", '{');
+    bb_json_open(&j, "vtf", '{');
     snprintf(text, sizeof text, "%d.%d", v->version_major, v->version_minor);
-    cli_json_string(&j, "version", text);
-    cli_json_string(&j, "format", v->format_name);
-    cli_json_int(&j, "format_code", v->format);
-    cli_json_int(&j, "mip_count", v->mip_count);
-    cli_json_int(&j, "flags", (long)v->flags);
-    cli_json_open(&j, "flag_names", '[');
+    bb_json_string(&j, "version", text);
+    bb_json_string(&j, "format", v->format_name);
+    bb_json_int(&j, "format_code", v->format);
+    bb_json_int(&j, "mip_count", v->mip_count);
+    bb_json_int(&j, "flags", (long)v->flags);
+    bb_json_open(&j, "flag_names", '[');
     for (int bit = 0; bit < 32; bit++)
       if ((v->flags & (1u << bit)) && bb_vtf_flag_name(bit))
-        cli_json_string(&j, NULL, bb_vtf_flag_name(bit));
-    cli_json_close(&j, ']');
-    cli_json_int(&j, "low_res_width", v->low_res_width);
-    cli_json_int(&j, "low_res_height", v->low_res_height);
-    cli_json_int(&j, "frames", v->frames);
-    cli_json_close(&j, '}');
+        bb_json_string(&j, NULL, bb_vtf_flag_name(bit));
+    bb_json_close(&j, ']');
+    bb_json_int(&j, "low_res_width", v->low_res_width);
+    bb_json_int(&j, "low_res_height", v->low_res_height);
+    bb_json_int(&j, "frames", v->frames);
+    bb_json_close(&j, '}');
   }
   if (f->is_dds) {
     const bb_dds_info *d = &f->dds;
     char names[256];
     dds_flag_names(d->pixel_flags, names, sizeof names);
-    cli_json_open(&j, "dds", '{');
-    cli_json_string(&j, "format", d->format_name);
-    cli_json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
-    cli_json_int(&j, "dxgi_format", d->dxgi_format);
-    cli_json_string(&j, "compression", d->compression);
-    cli_json_int(&j, "mip_count", d->mip_count);
-    cli_json_int(&j, "pixel_flags", (long)d->pixel_flags);
-    cli_json_open(&j, "pixel_flag_names", '[');
+    bb_json_open(&j, "dds", '{');
+    bb_json_string(&j, "format", d->format_name);
+    bb_json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
+    bb_json_int(&j, "dxgi_format", d->dxgi_format);
+    bb_json_string(&j, "compression", d->compression);
+    bb_json_int(&j, "mip_count", d->mip_count);
+    bb_json_int(&j, "pixel_flags", (long)d->pixel_flags);
+    bb_json_open(&j, "pixel_flag_names", '[');
     for (const char *p = names; *p;) {
       const size_t n = strcspn(p, " ");
       char one[32];
       snprintf(one, sizeof one, "%.*s", (int)n, p);
-      cli_json_string(&j, NULL, one);
+      bb_json_string(&j, NULL, one);
       p += n + (p[n] == ' ');
     }
-    cli_json_close(&j, ']');
-    cli_json_int(&j, "caps2", (long)d->caps2);
-    cli_json_close(&j, '}');
+    bb_json_close(&j, ']');
+    bb_json_int(&j, "caps2", (long)d->caps2);
+    bb_json_close(&j, '}');
   }
-  cli_json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
+  bb_json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
   if (f->provenance == BB_PROVENANCE_INTACT)
     json_provenance(&j, i->description);
   else
-    cli_json_string(&j, "provenance", NULL);
-  cli_json_string(&j, "description", i->description);
-  cli_json_close(&j, '}');
+    bb_json_string(&j, "provenance", NULL);
+  bb_json_string(&j, "description", i->description);
+  bb_json_close(&j, '}');
   fputc('\n', stdout);
 }
 
@@ -217,11 +216,11 @@ static void report_error(const info_args *a, const char *path, const bb_error *e
   cli_file_error(path, err->message);
   if (!a->json)
     return;
-  cli_json j = {stdout, 0};
-  cli_json_open(&j, NULL, '{');
-  cli_json_string(&j, "path", path);
-  cli_json_string(&j, "error", err->message);
-  cli_json_close(&j, '}');
+  bb_json j = {stdout, 0};
+  bb_json_open(&j, NULL, '{');
+  bb_json_string(&j, "path", path);
+  bb_json_string(&j, "error", err->message);
+  bb_json_close(&j, '}');
   fputc('\n', stdout);
 }
 

@@ -12,7 +12,8 @@ import distributed
 from .. import _common
 from .._common import _argument_error, _check, _dispatch_notes, _ffi, _lib, _path
 from .._jobs import BakeJob, _raise_failures
-from ._command import Command, CommandJob
+from .._command import Command
+from ._command import CommandJob
 from ._connect import ClusterLost, completed, settle
 from ._shared import (NoteDesk, NoteRefused, client_directory, client_of, notes_can_raise,
                       variable_value, worker_threads)

@@ -26,7 +26,8 @@ from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _k
 from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
-from ._command import Command, CommandJob
+from .._command import Command
+from ._command import CommandJob
 from ._connect import ClusterLost, completed, settle
 from ._shared import (NoteDesk, client_directory, client_of, notes_can_raise,
                       this_worker_threads, variable_value, worker_threads)
@@ -154,7 +155,7 @@ def _bake_options_of(task):
     client's directory (a basis file named relative to it)."""
     if "command" in task:
         with client_directory(task["directory"]):
-            command = Command(task["command"])
+            command = Command.from_handover(task["command"])
         o = _ffi.new("bb_bake_options *")
         o[0] = command.options.job.bake
         channel = command.options.job.channel

@@ -7,54 +7,19 @@ mean there) and runs it on the cluster: a batch (--out-dir) as
 bake_files, one map as bake_big, its trace split over the workers. The
 files record the command as the CLI records it without --scheduler (the
 record travels with the command), so they are the bytes the same command
-writes on one machine. It prints what the CLI prints (wrote/up to date
-lines, the batch's summary, --json lines) and exits as it does: 0, 1 when
-an input failed, 2 for a usage error."""
+writes on one machine. It prints what the CLI prints, by the library's
+lines of each report the cluster sends back and of the batch's summary
+(bb_job_report_lines, bb_job_summary_lines: the C program's too), and
+exits as it does: 0, 1 when an input failed, 2 for a usage error."""
 
 import json
 import os
 import sys
 
+from .._command import Command
 from .._common import (ArgumentError, Error, _check, _check_notes, _ffi, _lib, _path,
                        _text)
 from .._jobs import BakeJob
-
-
-class Command:
-    """A command handed over by the C program, set up and checked by the
-    library; pickles as its hand-over bytes. inputs: a part of the batch
-    in place of its inputs (a chunk, planned on a worker)."""
-
-    def __init__(self, data, inputs=None):
-        self.data = bytes(data)
-        keep = [_ffi.new("char[]", _path(p, "input")) for p in inputs or ()]
-        c_inputs = _ffi.new("char *[]", keep) if inputs is not None else _ffi.NULL
-        out = _ffi.new("bb_command **")
-        err = _ffi.new("bb_error *")
-        _check(_lib.bb_command_from_handover(self.data, len(self.data), c_inputs,
-                                             len(keep), out, err), err)
-        self.c = _ffi.gc(out[0], _lib.bb_command_free)
-
-    def __reduce__(self):
-        return (Command, (self.data,))
-
-    def default(self, name, text):
-        """Sets option name from text unless the command gave it (a
-        cluster's choice where the user made none: threads per task)."""
-        if not _lib.bb_command_given(self.c, name.encode()):
-            err = _ffi.new("bb_error *")
-            _check(_lib.bb_command_set(self.c, name.encode(), text.encode(), err), err)
-            _check(_lib.bb_command_check(self.c, err), err)
-
-    @property
-    def options(self):
-        """The command's bb_command_options (owned by the command)."""
-        return _lib.bb_command_options_of(self.c)
-
-    def text(self, name):
-        """The text of a string option of the job's, or None."""
-        value = getattr(self.options.job, name)
-        return None if value == _ffi.NULL else _text(value)
 
 
 class CommandJob(BakeJob):
@@ -66,17 +31,16 @@ class CommandJob(BakeJob):
                  _trace=None):
         self._notes_policy = _check_notes(notes)
         self._trace = _trace
-        self._data = bytes(data)
-        self._command = Command(data, inputs)
+        self._cmd = command = Command.from_handover(data, inputs)
         if threads is not None:  # the library's threads per bake, unless --threads
-            self._command.default("threads", str(threads))
+            command.default("threads", str(threads))
         if unforced:  # the command without --force (a flag set to "0" is unset)
             err = _ffi.new("bb_error *")
-            _check(_lib.bb_command_set(self._command.c, b"force", b"0", err), err)
-            _check(_lib.bb_command_check(self._command.c, err), err)
-        job = self._command.options.job
-        self._args = dict(out_dir=self._command.text("out_dir"), keep_going=bool(job.keep_going),
-                          force=bool(job.force), depfile=self._command.text("depfile"))
+            _check(_lib.bb_command_set(command.handle, b"force", b"0", err), err)
+            _check(_lib.bb_command_check(command.handle, err), err)
+        job = command.options.job
+        self._args = dict(out_dir=command.job_text("out_dir"), keep_going=bool(job.keep_going),
+                          force=bool(job.force), depfile=command.job_text("depfile"))
         self._single = False  # the command line's single bake always bakes
         hooks = _ffi.new("bb_command_hooks *")
         if _trace is not None:
@@ -84,71 +48,58 @@ class CommandJob(BakeJob):
 
         def plan(note, out, err):
             hooks.note = note
-            return _lib.bb_command_plan(self._command.c, hooks, out, err)
+            return _lib.bb_command_plan(command.handle, hooks, out, err)
         self._adopt(plan)
 
     def __reduce__(self):
-        return (CommandJob, (self._data, self.inputs))
-
-    def command_text(self, i=0):
-        """The command input i's outputs record (bb_command_text)."""
-        text = _lib.bb_command_text(self._command.c, self._raw(i).input,
-                                    _lib.BB_OPTION_RECORDED)
-        if text == _ffi.NULL:
-            raise MemoryError("bb_command_text")
-        try:
-            return _text(text)
-        finally:
-            _lib.free(text)
+        return (CommandJob, (self._cmd.data, self.inputs))
 
 
 # ----------------------------------------------------------------- the run
 
 
-def _print_report(report, as_json, quiet, batch):
-    if report.status == "failed":
-        print(f"bumpbake: {report.error}", file=sys.stderr)
-    if report.status == "not run":
-        return
-    if as_json:
-        line = {"input": report.input}
-        if batch or report.status != "baked":
-            line["status"] = report.status
-        if report.status == "baked":
-            line.update(width=report.width, height=report.height,
-                        parameters={"slices": report.slices, "rayset": report.rayset,
-                                    "channel": report.channel, "threads": report.threads},
-                        seconds=report.seconds, horizons=report.horizons)
-            if report.cluster:
-                line["cluster"] = report.cluster
-        elif report.status == "failed":
-            line["exit_code"] = 1
-        line["outputs"] = [{"kind": k, "path": p} for k, p in report.outputs.items()
-                           if not k.startswith("slope") or report.status != "baked"]
-        print(json.dumps(line, separators=(",", ":")))
-    elif not quiet and report.status in ("baked", "up to date"):
-        verb = "wrote" if report.status == "baked" else "up to date"
-        for kind, path in report.outputs.items():
-            print(f"{verb} {kind} {path}")
+_OUTCOME = {"pending": _lib.BB_JOB_PENDING, "baked": _lib.BB_JOB_BAKED,
+            "up to date": _lib.BB_JOB_CURRENT, "failed": _lib.BB_JOB_FAILED,
+            "not run": _lib.BB_JOB_NOT_RUN}
+
+
+def _printed(text):
+    """Prints the library's lines (bb_job_report_lines, bb_job_summary_lines)."""
+    if text == _ffi.NULL:
+        raise MemoryError("bumpbake: out of memory")
+    try:
+        sys.stdout.write(_text(text))
+    finally:
+        _lib.free(text)
     sys.stdout.flush()
 
 
-def _summary(reports, as_json, quiet):
-    count = {s: sum(r.status == s for r in reports)
-             for s in ("baked", "up to date", "failed", "not run")}
-    if as_json:
-        print(json.dumps({"summary": {"files": len(reports), "baked": count["baked"],
-                                      "up_to_date": count["up to date"],
-                                      "failed": count["failed"],
-                                      "not_run": count["not run"]}}, separators=(",", ":")))
-    elif not quiet:
-        line = (f"bake: {len(reports)} file{'' if len(reports) == 1 else 's'}: "
-                f"{count['baked']} baked, {count['up to date']} up to date, "
-                f"{count['failed']} failed")
-        if count["not run"]:
-            line += (f", {count['not run']} not run (stopped at the first failure; "
-                     "--keep-going goes on)")
-        print(line)
+def _print_report(command, report, batch):
+    """What the C program prints of a report, by the library's lines: the
+    report (a worker's, sent back) as a bb_job_report again."""
+    if report.status == "failed":
+        print(f"bumpbake: {report.error}", file=sys.stderr)
+    r = _ffi.new("bb_job_report *")
+    _ffi.memmove(r, report._bytes, min(len(report._bytes), _ffi.sizeof(r[0])))
+    keep = [_ffi.new("char[]", _path(report.input))]
+    r.input = keep[0]
+    r.outcome = _OUTCOME[report.status]
+    r.output_count = len(report.outputs)
+    for k, (kind, path) in enumerate(report.outputs.items()):
+        keep += [_ffi.new("char[]", kind.encode()), _ffi.new("char[]", _path(path))]
+        r.outputs[k].kind, r.outputs[k].path = keep[-2], keep[-1]
+    extra = _ffi.NULL
+    if report.cluster:  # where bake_big's trace ran
+        extra = b'"cluster":' + json.dumps(report.cluster, separators=(",", ":")).encode()
+    _printed(_lib.bb_job_report_lines(command.options, r, batch, extra))
+
+
+def _summary(command, reports):
+    counts = _ffi.new("int[5]")
+    for r in reports:
+        counts[_OUTCOME[r.status]] += 1
+    _printed(_lib.bb_job_summary_lines(command.options, command.name.encode(), counts,
+                                       len(reports)))
 
 
 def _note(line):
@@ -161,19 +112,17 @@ def run(command):
     """Runs a handed-over bake command on its cluster; the exit code."""
     from . import bake_big, bake_files
     from ._connect import connect
-    o = command.options
-    as_json, quiet = bool(o.json), bool(o.quiet)
-    with connect(_text(o.scheduler), quiet=True) as client:
-        if command.text("out_dir") is not None:
+    with connect(_text(command.options.scheduler), quiet=True) as client:
+        if command.job_text("out_dir") is not None:
             reports = bake_files(None, None, client=client, check=False, notes=_note,
                                  _command=command, _ask_notes=False)
             for r in reports:
-                _print_report(r, as_json, quiet, batch=True)
-            _summary(reports, as_json, quiet)
+                _print_report(command, r, batch=True)
+            _summary(command, reports)
             return 1 if any(r.status == "failed" for r in reports) else 0
         report = bake_big(None, client=client, check=False, notes=_note, _command=command,
                           _ask_notes=False)
-        _print_report(report, as_json, quiet, batch=False)
+        _print_report(command, report, batch=False)
         return 1 if report.status == "failed" else 0
 
 
@@ -182,7 +131,7 @@ def main(fd):
     try:
         with os.fdopen(fd, "rb") as f:
             data = f.read()
-        return run(Command(data))
+        return run(Command.from_handover(data))
     except ArgumentError as e:
         print(f"bumpbake bake: {e}", file=sys.stderr)
         return 2

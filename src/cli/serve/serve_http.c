@@ -7,8 +7,6 @@
  * those that change something must carry an X-Bumpbake header (which a
  * page of another origin cannot send without asking first); with
  * --address, every path also starts with a random token. */
-#include "job_json.h"
-#include "json.h"
 #include "serve.h"
 
 #include <arpa/inet.h>
@@ -65,10 +63,10 @@ static enum MHD_Result send_error(struct MHD_Connection *c, unsigned status, con
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return send_text(c, status, msg);
-  cli_json j = {f, 0};
-  cli_json_open(&j, NULL, '{');
-  cli_json_string(&j, "error", msg);
-  cli_json_close(&j, '}');
+  bb_json j = {f, 0};
+  bb_json_open(&j, NULL, '{');
+  bb_json_string(&j, "error", msg);
+  bb_json_close(&j, '}');
   fclose(f);
   return send_json(c, status, text);
 }
@@ -307,7 +305,7 @@ static enum MHD_Result write_maps(server *sv, struct MHD_Connection *c) {
     if (st == BB_OK) {
       FILE *f = open_memstream(&text, &size);
       if (f) {
-        cli_job_json_to(f, &o.bake, bb_job_report_get(b->job, 0), "written");
+        bb_job_report_json(f, &o.bake, bb_job_report_get(b->job, 0), "written", NULL);
         fclose(f);
       }
     }
@@ -327,7 +325,7 @@ static enum MHD_Result write_maps(server *sv, struct MHD_Connection *c) {
     if (st == BB_OK) {
       FILE *f = open_memstream(&text, &size);
       if (f) {
-        cli_job_json_to(f, &o.bake, bb_job_report_get(job, 0), "written");
+        bb_job_report_json(f, &o.bake, bb_job_report_get(job, 0), "written", NULL);
         fclose(f);
       }
     }

@@ -2,7 +2,6 @@
  * JSON, and its controls (scale, rays, slices, bias, bounce, bounces,
  * brightness) applied to the bake options after the library's own checks
  * (bb_bake_options_check), whose words a refusal shows. */
-#include "json.h"
 #include "serve.h"
 
 #include <math.h>
@@ -12,55 +11,55 @@
 
 /* ---------------------------------------------------------------- state */
 
-static void add_params(cli_json *j, const serve_state *s) {
+static void add_params(bb_json *j, const serve_state *s) {
   const bb_bake_options *b = &s->settings.bake;
-  cli_json_open(j, "params", '{');
-  cli_json_number(j, "scale", (double)b->height_scale);
-  cli_json_int(j, "rays", b->rays);
-  cli_json_int(j, "slices", b->slices);
-  cli_json_int(j, "slices_traced", bb_bake_slices(b));
-  cli_json_number(j, "bias", b->trace.bias_texels);
-  cli_json_number(j, "bounce", b->bounce_albedo);
-  cli_json_int(j, "bounces", b->bounces);
-  cli_json_string(j, "brightness_file", s->brightness_file);
-  cli_json_bool(j, "brightness", s->use_brightness);
-  cli_json_close(j, '}');
+  bb_json_open(j, "params", '{');
+  bb_json_number(j, "scale", (double)b->height_scale);
+  bb_json_int(j, "rays", b->rays);
+  bb_json_int(j, "slices", b->slices);
+  bb_json_int(j, "slices_traced", bb_bake_slices(b));
+  bb_json_number(j, "bias", b->trace.bias_texels);
+  bb_json_number(j, "bounce", b->bounce_albedo);
+  bb_json_int(j, "bounces", b->bounces);
+  bb_json_string(j, "brightness_file", s->brightness_file);
+  bb_json_bool(j, "brightness", s->use_brightness);
+  bb_json_close(j, '}');
 }
 
-static void add_bake(cli_json *j, serve_bake *b) {
-  cli_json_open(j, "bake", '{');
-  cli_json_int(j, "id", b->id);
-  cli_json_int(j, "width", b->width);
-  cli_json_int(j, "height", b->height);
-  cli_json_number(j, "seconds", b->seconds);
+static void add_bake(bb_json *j, serve_bake *b) {
+  bb_json_open(j, "bake", '{');
+  bb_json_int(j, "id", b->id);
+  bb_json_int(j, "width", b->width);
+  bb_json_int(j, "height", b->height);
+  bb_json_number(j, "seconds", b->seconds);
   const bb_job_report *r = &b->report;
-  cli_json_number(j, "seconds_load", r->seconds_load);
-  cli_json_number(j, "seconds_smooth", r->seconds_smooth);
-  cli_json_number(j, "seconds_pyramid", r->seconds_pyramid);
-  cli_json_number(j, "seconds_trace", r->seconds_trace);
-  cli_json_number(j, "seconds_derive", r->seconds_derive);
+  bb_json_number(j, "seconds_load", r->seconds_load);
+  bb_json_number(j, "seconds_smooth", r->seconds_smooth);
+  bb_json_number(j, "seconds_pyramid", r->seconds_pyramid);
+  bb_json_number(j, "seconds_trace", r->seconds_trace);
+  bb_json_number(j, "seconds_derive", r->seconds_derive);
   pthread_mutex_lock(&b->tex_lock);
   const double textures = b->seconds_textures;
   pthread_mutex_unlock(&b->tex_lock);
-  cli_json_number(j, "seconds_textures", textures);
-  cli_json_int(j, "threads", r->threads);
-  cli_json_int(j, "slices", r->slices);
-  cli_json_number(j, "scale", b->scale);
-  cli_json_bool(j, "normal_y_up", b->normal_y_up);
+  bb_json_number(j, "seconds_textures", textures);
+  bb_json_int(j, "threads", r->threads);
+  bb_json_int(j, "slices", r->slices);
+  bb_json_number(j, "scale", b->scale);
+  bb_json_bool(j, "normal_y_up", b->normal_y_up);
   /* the page lights the ssbump with these directions (sat(sum_c s_c l.B_c)) */
-  cli_json_string(j, "basis", b->basis.name);
-  cli_json_int(j, "basis_count", b->basis.count);
-  cli_json_open(j, "basis_vectors", '[');
+  bb_json_string(j, "basis", b->basis.name);
+  bb_json_int(j, "basis_count", b->basis.count);
+  bb_json_open(j, "basis_vectors", '[');
   for (int c = 0; c < b->basis.count; c++) {
-    cli_json_open(j, NULL, '[');
+    bb_json_open(j, NULL, '[');
     for (int k = 0; k < 3; k++)
-      cli_json_number(j, NULL, b->basis.vector[c][k]);
-    cli_json_close(j, ']');
+      bb_json_number(j, NULL, b->basis.vector[c][k]);
+    bb_json_close(j, ']');
   }
-  cli_json_close(j, ']');
-  cli_json_string(j, "command", b->command);
-  cli_json_string(j, "provenance", b->provenance);
-  cli_json_close(j, '}');
+  bb_json_close(j, ']');
+  bb_json_string(j, "command", b->command);
+  bb_json_string(j, "provenance", b->provenance);
+  bb_json_close(j, '}');
 }
 
 char *serve_state_json(serve_state *s) {
@@ -69,21 +68,21 @@ char *serve_state_json(serve_state *s) {
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return NULL;
-  cli_json j = {f, 0};
+  bb_json j = {f, 0};
   pthread_mutex_lock(&s->lock);
   bb_job_options o;
   serve_job_options(s, &o);
   char *command = bb_job_command_text(&o, s->height_path);
-  cli_json_open(&j, NULL, '{');
-  cli_json_string(&j, "height", s->height_path);
-  cli_json_bool(&j, "baking", s->baking);
-  cli_json_number(&j, "progress", s->progress);
-  cli_json_string(&j, "error", s->error);
-  cli_json_string(&j, "command", command);
+  bb_json_open(&j, NULL, '{');
+  bb_json_string(&j, "height", s->height_path);
+  bb_json_bool(&j, "baking", s->baking);
+  bb_json_number(&j, "progress", s->progress);
+  bb_json_string(&j, "error", s->error);
+  bb_json_string(&j, "command", command);
   add_params(&j, s);
   if (s->current)
     add_bake(&j, s->current);
-  cli_json_close(&j, '}');
+  bb_json_close(&j, '}');
   pthread_mutex_unlock(&s->lock);
   free(command);
   if (fclose(f) != 0) {

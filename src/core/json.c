@@ -1,12 +1,11 @@
-/* json.c: the one JSON writer of the command line and the tools (see
- * cli_json.h). */
-#include "json.h"
+/* json.c: the one JSON writer of the library, the command line and the
+ * tools (bumpbake.h: bb_json). */
 
 #include "bumpbake.h"
 
 #include <math.h>
 
-void cli_json_quoted(FILE *f, const char *s) {
+void bb_json_quoted(FILE *f, const char *s) {
   if (!s) {
     fputs("null", f);
     return;
@@ -51,33 +50,33 @@ void cli_json_quoted(FILE *f, const char *s) {
 }
 
 /* The separator and "key": that precede every value. */
-static void json_begin_value(cli_json *j, const char *key) {
+static void json_begin_value(bb_json *j, const char *key) {
   if (j->need_comma)
     fputc(',', j->f);
   if (key) {
-    cli_json_quoted(j->f, key);
+    bb_json_quoted(j->f, key);
     fputc(':', j->f);
   }
   j->need_comma = 1;
 }
 
-void cli_json_open(cli_json *j, const char *key, char open) {
+void bb_json_open(bb_json *j, const char *key, char open) {
   json_begin_value(j, key);
   fputc(open, j->f);
   j->need_comma = 0;
 }
 
-void cli_json_close(cli_json *j, char close) {
+void bb_json_close(bb_json *j, char close) {
   fputc(close, j->f);
   j->need_comma = 1;
 }
 
-void cli_json_string(cli_json *j, const char *key, const char *value) {
+void bb_json_string(bb_json *j, const char *key, const char *value) {
   json_begin_value(j, key);
-  cli_json_quoted(j->f, value);
+  bb_json_quoted(j->f, value);
 }
 
-void cli_json_number(cli_json *j, const char *key, double value) {
+void bb_json_number(bb_json *j, const char *key, double value) {
   json_begin_value(j, key);
   if (isfinite(value))
     fprintf(j->f, "%.9g", value);
@@ -85,12 +84,12 @@ void cli_json_number(cli_json *j, const char *key, double value) {
     fputs("null", j->f);
 }
 
-void cli_json_int(cli_json *j, const char *key, long long value) {
+void bb_json_int(bb_json *j, const char *key, long long value) {
   json_begin_value(j, key);
   fprintf(j->f, "%lld", value);
 }
 
-void cli_json_bool(cli_json *j, const char *key, int value) {
+void bb_json_bool(bb_json *j, const char *key, int value) {
   json_begin_value(j, key);
   fputs(value ? "true" : "false", j->f);
 }
