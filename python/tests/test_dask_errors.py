@@ -224,6 +224,36 @@ def test_the_only_worker_killed_is_lost_within_a_bound(tmp_path, monkeypatch, cl
     assert len(_whole("out")) < 60
 
 
+def test_a_result_lost_with_the_only_worker_is_lost_within_a_bound(monkeypatch, cluster):
+    """A task finished on the only worker, which dies between the wait that
+    saw it finish and the fetch of its result: the scheduler waits for a
+    worker to compute it again, and the fetch waited with it for ever (seen
+    once in make test); now WORKERLESS_WAIT seconds."""
+    import concurrent.futures
+    monkeypatch.setattr(_connect, "WORKERLESS_WAIT", 2)
+    alive = _connect.alive
+
+    def kill_then_alive(client):  # the first look after the wait: kill the worker there
+        if cluster.worker.poll() is None:
+            cluster.worker.kill()
+            cluster.worker.wait(timeout=HANG_GUARD)
+            deadline = time.monotonic() + HANG_GUARD
+            while client.scheduler_info()["workers"]:
+                assert time.monotonic() < deadline
+                time.sleep(0.05)
+        return alive(client)
+
+    monkeypatch.setattr(_connect, "alive", kill_then_alive)
+    f = cluster.client.submit(sum, [1, 2, 3], pure=False)
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    run = pool.submit(lambda: list(_connect.completed(cluster.client, [f])))
+    try:
+        with pytest.raises(_connect.ClusterLost, match=r"no worker left on \S+ for 2 s$"):
+            run.result(timeout=HANG_GUARD)
+    finally:
+        pool.shutdown(wait=False)
+
+
 # ---------------------------------------------------------------- Ctrl-C
 
 def test_ctrl_c_on_the_client_leaves_later_inputs_untouched(tmp_path, monkeypatch, cli,

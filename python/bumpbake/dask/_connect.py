@@ -132,8 +132,7 @@ def completed(client, futures, each_poll=None):
     one bumpbake.Error too. A task that failed otherwise raises its own
     error here."""
     pending = set(futures)
-    workerless_since = None
-    next_look = 0.0
+    workers = _WorkerWatch(client)
     while pending:
         if each_poll is not None:
             each_poll()
@@ -154,29 +153,62 @@ def completed(client, futures, each_poll=None):
             if f.status == "error":
                 _raise_cluster_error(f.exception())
                 f.result()  # raises the task's own error
-            try:
-                result = f.result()
-            except OSError:  # the result comes over the scheduler's connection
-                raise _lost(client) from None
-            yield f, result
+            yield f, _result(client, f, workers, each_poll)
         if not alive(client):
             raise _lost(client)
+        if pending:
+            workers.look()
+
+
+class _WorkerWatch:
+    """Raises ClusterLost at a look when no worker was left for
+    WORKERLESS_WAIT seconds; looks at most every _WORKERS_EVERY seconds."""
+
+    def __init__(self, client):
+        self.client = client
+        self.workerless_since = None
+        self.next_look = 0.0
+
+    def look(self):
         now = time.monotonic()
-        if pending and now >= next_look:
-            next_look = now + _WORKERS_EVERY
-            try:
-                workers = len(client.scheduler_info()["workers"])
-            except Exception:  # noqa: BLE001
-                if not alive(client):
-                    raise _lost(client) from None
-                raise
-            if workers:
-                workerless_since = None
-            elif workerless_since is None:
-                workerless_since = now
-            elif now - workerless_since >= WORKERLESS_WAIT:
-                raise ClusterLost(f"the Dask cluster was lost: no worker left on "
-                                  f"{client.scheduler.address} for {WORKERLESS_WAIT:g} s")
+        if now < self.next_look:
+            return
+        self.next_look = now + _WORKERS_EVERY
+        try:
+            workers = len(self.client.scheduler_info()["workers"])
+        except Exception:  # noqa: BLE001
+            if not alive(self.client):
+                raise _lost(self.client) from None
+            raise
+        if workers:
+            self.workerless_since = None
+        elif self.workerless_since is None:
+            self.workerless_since = now
+        elif now - self.workerless_since >= WORKERLESS_WAIT:
+            raise ClusterLost(f"the Dask cluster was lost: no worker left on "
+                              f"{self.client.scheduler.address} for {WORKERLESS_WAIT:g} s")
+
+
+def _result(client, f, workers, each_poll):
+    """A finished future's result, fetched a _POLL at a time: when the worker
+    holding it dies before the fetch, the scheduler computes the task again
+    on another worker, or waits for one for ever; the watch bounds that wait
+    as it bounds the tasks'."""
+    while True:
+        try:
+            return f.result(timeout=_POLL)
+        except TimeoutError:  # (before OSError, of which it is a subclass)
+            pass
+        except OSError:  # the result comes over the scheduler's connection
+            raise _lost(client) from None
+        if not alive(client) or f.status == "cancelled":
+            raise _lost(client)
+        if f.status == "error":
+            _raise_cluster_error(f.exception())
+            f.result()  # raises the task's own error
+        if each_poll is not None:
+            each_poll()
+        workers.look()
 
 
 def _lost(client):
