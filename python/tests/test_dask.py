@@ -196,6 +196,12 @@ def test_one_map_split_over_the_workers_is_the_single_bake(tmp_path, monkeypatch
     assert c["slices"] == slices and c["tasks"] == slices // 2
     assert sum(c["slices_by_worker"].values()) == slices
     assert c["bytes_received"] == slices * 69 * 61 * 4
+    # each group is counted on the worker that traced it; what moved is
+    # what the other worker traced (the driver's own are taken from its
+    # memory)
+    assert set(c["slices_by_worker"]) <= set(client.nthreads()) and c["driver"] in client.nthreads()
+    assert c["bytes_moved"] == (slices - c["slices_by_worker"].get(c["driver"], 0)) * 69 * 61 * 4
+    assert 0 <= c["seconds_adding"] <= c["seconds_trace"] <= c["seconds_driver"]
     monkeypatch.chdir(tmp_path / "single")
     single = bumpbake.bake_file("in/map.png", outputs, **options)
     assert single.status == "baked"

@@ -14,6 +14,7 @@ once per worker process and bake, and finds its slices' horizons
 
 import collections
 import concurrent.futures
+import inspect
 import os
 import threading
 import time
@@ -204,8 +205,8 @@ def _owned_array(img):
 
 
 def _horizons(task, slices, threads):
-    """On a worker: the horizons of slices ({slice: float32 (H, W)}) of
-    task's bake, found by the sweeps the single machine runs."""
+    """On a worker: (its address, the horizons of slices: {slice: float32
+    (H, W)}) of task's bake, found by the sweeps the single machine runs."""
     entry = _acquire(task["key"], lambda: _build(task, threads))
     try:
         o = _ffi.new("bb_trace_options *")
@@ -217,7 +218,8 @@ def _horizons(task, slices, threads):
         err = _ffi.new("bb_error *")
         _check(_lib.bb_trace_horizons(entry.pyramid, entry.rays, o, c_slices, len(slices),
                                       images, err), err)
-        return {s: _owned_array(images[k]) for k, s in enumerate(slices)}
+        return (distributed.get_worker().address,
+                {s: _owned_array(images[k]) for k, s in enumerate(slices)})
     finally:
         _release(entry)
 
@@ -235,6 +237,7 @@ class _SplitTrace:
         self.job = None
         self.raised = None
         self.stats = {}
+        self.started = None  # when the trace began (time.monotonic())
 
     def __call__(self, user, pyramid, rays, options, vis, err):
         # Nothing may raise through C: the exception is kept for the driver
@@ -249,7 +252,7 @@ class _SplitTrace:
                 else _STATUS.get(getattr(e, "status", None), _lib.BB_ERR_IO)
 
     def _trace(self, pyramid, rays, options, vis, err):
-        t0 = time.monotonic()
+        t0 = self.started = time.monotonic()
         n = _lib.bb_rayset_slice_count(rays)
         lobes = _lib.bb_rayset_lobe_count(rays)
         order = _ffi.new("int[]", n)
@@ -259,10 +262,15 @@ class _SplitTrace:
         # A slice and the next in the order (its opposite, when it has one)
         # go together: bb_trace_horizons sweeps them once.
         groups = [list(range(k, min(k + 2, n))) for k in range(0, n, 2)]
-        me = distributed.get_worker().address
+        here = distributed.get_worker()
+        me = here.address
         loan = _lend(task["key"], pyramid, rays)
         moved = received = 0
         ran = {}
+        # Where the driver's time goes: waiting for horizons, fetching them
+        # (on the fetch threads, overlapping the rest), adding them up.
+        waited = fetching = adding = 0.0
+        cpu0 = _cpu()
         try:
             with distributed.worker_client() as client:
                 futures = [client.submit(_horizons, task, [order[r] for r in g], self.lib_threads,
@@ -273,27 +281,33 @@ class _SplitTrace:
                 fetcher = concurrent.futures.ThreadPoolExecutor(_AHEAD)
 
                 def fetch(future):
-                    return future.result(), client.who_has([future]).get(future.key, ())
+                    distributed.wait(future)
+                    t = time.monotonic()
+                    (worker, got), = _gather(client, future, here)
+                    return got, worker, time.monotonic() - t
 
                 fetched = [fetcher.submit(fetch, f) for f in futures[:_AHEAD]]
                 next_look = 0.0
                 try:
                     for k, (g, future) in enumerate(zip(groups, futures)):
-                        got, holders = fetched[k].result()
+                        t = time.monotonic()
+                        got, worker, seconds = fetched[k].result()
+                        waited += time.monotonic() - t
+                        fetching += seconds
                         if k + _AHEAD < len(futures):
                             fetched.append(fetcher.submit(fetch, futures[k + _AHEAD]))
-                        for worker in holders or ("?",):
-                            ran[worker] = ran.get(worker, 0) + len(g)
-                            break
+                        ran[worker] = ran.get(worker, 0) + len(g)
                         size = sum(a.nbytes for a in got.values())
                         received += size
-                        if me not in holders:
+                        if worker != me:
                             moved += size
                         if k == 0:
                             h, w = got[order[0]].shape
                             _check(_lib.bb_image_alloc(vis, w, h, 1 + lobes, err), err)
+                        t = time.monotonic()
                         for r in g:
                             self._accumulate(rays, r, got[order[r]], vis, err)
+                        adding += time.monotonic() - t
                         del got
                         future.release()
                         if options.progress != _ffi.NULL and options.progress(
@@ -305,7 +319,9 @@ class _SplitTrace:
                             if variable_value(task["stop"], 1, client=client):
                                 raise _exception(_lib.BB_ERR_CANCELLED,
                                                  "trace: cancelled by the client")
+                    t = time.monotonic()
                     _check(_lib.bb_trace_finish(rays, vis, _DRIVER_THREADS, err), err)
+                    adding += time.monotonic() - t
                 finally:
                     fetcher.shutdown(wait=False, cancel_futures=True)
                     client.cancel([f for f in futures if not f.done()])
@@ -316,7 +332,9 @@ class _SplitTrace:
             _take_back(task["key"], loan)
         self.stats = {"slices": n, "tasks": len(groups), "slices_by_worker": ran,
                       "bytes_received": received, "bytes_moved": moved,
-                      "driver": me, "seconds_trace": time.monotonic() - t0}
+                      "driver": me, "seconds_trace": time.monotonic() - t0,
+                      "seconds_waiting": waited, "seconds_fetching": fetching,
+                      "seconds_adding": adding, "cpu_seconds_trace": _cpu() - cpu0}
         return _lib.BB_OK
 
     def _accumulate(self, rays, rank, horizon, vis, err):
@@ -327,9 +345,31 @@ class _SplitTrace:
         _check(_lib.bb_trace_accumulate(rays, rank, img, vis, _DRIVER_THREADS, err), err)
 
 
+def _gather(client, future, here):
+    """[future's result], taken from the memory of the worker here when it
+    holds it (a group traced on the driver's own worker: the arrays as
+    they are), else fetched from the worker that does. future.result()
+    fetches even a result held here over a socket, serialised and copied:
+    4 bytes a texel a slice. (Client._gather's local_worker is Dask's own
+    way for a worker's client; a Dask without it fetches as before.)"""
+    if _LOCAL_GATHER:
+        return client.sync(client._gather, [future], local_worker=here)
+    return [future.result()]
+
+
+_LOCAL_GATHER = "local_worker" in inspect.signature(distributed.Client._gather).parameters
+
+
+def _cpu():
+    """CPU seconds (user and system) of this process so far."""
+    t = os.times()
+    return t.user + t.system
+
+
 def _drive(directory, input, args, task):
     """On a worker: the bake of input with its trace split over the
     cluster; returns (BakeReport, what the split did)."""
+    t0, cpu0 = time.monotonic(), _cpu()
     with client_directory(directory):
         own = this_worker_threads()
         lib_threads = task.pop("horizon_threads")
@@ -350,6 +390,9 @@ def _drive(directory, input, args, task):
         report = job.run(0)
         if hook.raised is not None and not isinstance(hook.raised, Error):
             raise hook.raised  # the cluster's (a lost worker, a cancel), not the bake's
+        hook.stats.update(seconds_driver=time.monotonic() - t0, cpu_seconds_driver=_cpu() - cpu0)
+        if hook.started is not None:
+            hook.stats["seconds_before_trace"] = hook.started - t0
         return report, hook.stats
 
 
@@ -374,9 +417,15 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     4 bytes a texel for every slice traced away from the driver, and the
     input file, read by every worker from shared storage.
 
-    The report's `cluster` says where the slices ran and what moved:
-    {"slices", "tasks", "slices_by_worker", "bytes_received",
-    "bytes_moved", "driver", "seconds_trace"}. horizon_threads: the
+    The report's `cluster` says where the slices ran, what moved and
+    where the driver's time went: {"slices", "tasks", "slices_by_worker",
+    "bytes_received", "bytes_moved", "driver", "seconds_trace",
+    "seconds_waiting" (for horizons), "seconds_fetching" (them, on threads
+    beside the adding), "seconds_adding" (them up, and finishing),
+    "cpu_seconds_trace", "seconds_driver", "cpu_seconds_driver" (of the
+    driver's worker process, with the horizon tasks it ran),
+    "seconds_before_trace" (reading, smoothing, the pyramid)}.
+    horizon_threads: the
     library's threads in each horizon task (default: the cluster's threads
     over the tasks, at least 1). Other arguments as bumpbake.bake_file's
     (force defaults to True, as there: bake even when up to date).
