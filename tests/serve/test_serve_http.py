@@ -88,6 +88,11 @@ def test_the_server_refuses(served):
     assert request(s.url, "DELETE")[0] == 405
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=0")
     assert status == 400 and "rays" in json.loads(body)["error"]
+    # a control's value is parsed by bake's option of its name: bake's words
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=x")
+    assert status == 400 and json.loads(body)["error"] == "--rays needs an integer (got 'x')"
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=8&bias=near")
+    assert status == 400 and json.loads(body)["error"] == "--bias needs a number (got 'near')"
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?path=/etc/passwd")
     assert status == 400 and "unknown control" in json.loads(body)["error"]
     assert sorted(os.listdir(d)) == ["h.png"]  # nothing written unless asked

@@ -1,10 +1,11 @@
 /* serve_params.c: the page's side of the options: the state it draws as
  * JSON, and its controls (scale, rays, slices, bias, bounce, bounces,
- * brightness) applied to the bake options after the library's own checks
- * (bb_bake_options_check), whose words a refusal shows. */
+ * brightness) applied to the bake options: each bake control parsed as
+ * `bumpbake bake` parses its option of that name (bb_command_set), its range
+ * checked by the library (bb_bake_options_check), whose words a refusal
+ * shows. */
 #include "serve.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,49 +95,23 @@ char *serve_state_json(serve_state *s) {
 
 /* --------------------------------------------------------------- controls */
 
-/* The whole text a finite number, else a refusal naming the control. */
-static int number(const char *name, const char *text, double *out, char *err, size_t cap) {
-  char *end = NULL;
-  double v = strtod(text, &end);
-  if (!text[0] || *end || !isfinite(v)) {
-    snprintf(err, cap, "%s: '%.40s' is not a number", name, text);
-    return -1;
-  }
-  *out = v;
-  return 0;
-}
-
-static int integer(const char *name, const char *text, int *out, char *err, size_t cap) {
-  double v;
-  if (number(name, text, &v, err, cap) != 0)
-    return -1;
-  if (v != floor(v) || v < -2147483647.0 || v > 2147483647.0) {
-    snprintf(err, cap, "%s: '%.40s' is not a whole number", name, text);
-    return -1;
-  }
-  *out = (int)v;
-  return 0;
-}
-
-static int apply_one(serve_state *s, bb_bake_options *b, int *use_brightness, const char *name,
+/* A bake control (scale, rays, slices, bias, bounce, bounces) is the bake
+ * command's option of its name: set on cmd through the library's parser
+ * (bb_command_set), which refuses a value with the words every client
+ * prints ("--rays needs an integer (got 'x')"). brightness is serve's own
+ * switch. */
+static int apply_one(serve_state *s, bb_command *cmd, int *use_brightness, const char *name,
                      const char *value, char *err, size_t cap) {
-  double v;
-  if (!strcmp(name, "scale")) {
-    if (number(name, value, &v, err, cap))
-      return -1;
-    b->height_scale = (float)v;
-    return 0;
-  }
-  if (!strcmp(name, "rays"))
-    return integer(name, value, &b->rays, err, cap);
-  if (!strcmp(name, "slices"))
-    return integer(name, value, &b->slices, err, cap);
-  if (!strcmp(name, "bias"))
-    return number(name, value, &b->trace.bias_texels, err, cap);
-  if (!strcmp(name, "bounce"))
-    return number(name, value, &b->bounce_albedo, err, cap);
-  if (!strcmp(name, "bounces"))
-    return integer(name, value, &b->bounces, err, cap);
+  static const char *const controls[] = {"scale", "rays", "slices", "bias", "bounce", "bounces"};
+  for (size_t i = 0; i < sizeof controls / sizeof controls[0]; i++)
+    if (!strcmp(name, controls[i])) {
+      bb_error e = {{0}};
+      if (bb_command_set(cmd, name, value, &e) != BB_OK) {
+        snprintf(err, cap, "%s", e.message);
+        return -1;
+      }
+      return 0;
+    }
   if (!strcmp(name, "brightness")) {
     if (!s->brightness_file) {
       snprintf(err, cap, "brightness: no --brightness FILE was given to serve");
@@ -153,14 +128,40 @@ static int apply_one(serve_state *s, bb_bake_options *b, int *use_brightness, co
   return -1;
 }
 
+/* The controls set on cmd, their parsed values, over the settings b. */
+static void take_controls(const bb_command *cmd, bb_bake_options *b) {
+  const bb_bake_options *p = &bb_command_options_of(cmd)->job.bake;
+  if (bb_command_given(cmd, "scale"))
+    b->height_scale = p->height_scale;
+  if (bb_command_given(cmd, "rays"))
+    b->rays = p->rays;
+  if (bb_command_given(cmd, "slices"))
+    b->slices = p->slices;
+  if (bb_command_given(cmd, "bias"))
+    b->trace.bias_texels = p->trace.bias_texels;
+  if (bb_command_given(cmd, "bounce"))
+    b->bounce_albedo = p->bounce_albedo;
+  if (bb_command_given(cmd, "bounces"))
+    b->bounces = p->bounces;
+}
+
 int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
                        int count, char *err, size_t cap) {
-  bb_bake_options b = s->settings.bake;
+  bb_command *cmd = NULL;
+  bb_error e = {{0}};
+  if (bb_command_new("bake", &cmd, &e) != BB_OK) {
+    snprintf(err, cap, "%s", e.message);
+    return -1;
+  }
   int use_brightness = s->use_brightness;
   for (int i = 0; i < count; i++)
-    if (apply_one(s, &b, &use_brightness, names[i], values[i], err, cap) != 0)
+    if (apply_one(s, cmd, &use_brightness, names[i], values[i], err, cap) != 0) {
+      bb_command_free(cmd);
       return -1;
-  bb_error e = {{0}};
+    }
+  bb_bake_options b = s->settings.bake;
+  take_controls(cmd, &b);
+  bb_command_free(cmd);
   if (bb_bake_options_check(&b, &e) != BB_OK) {
     snprintf(err, cap, "%s", e.message);
     return -1;
