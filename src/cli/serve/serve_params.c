@@ -6,6 +6,7 @@
  * shows. */
 #include "serve.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,16 +96,24 @@ char *serve_state_json(serve_state *s) {
 
 /* --------------------------------------------------------------- controls */
 
-/* A bake control (scale, rays, slices, bias, bounce, bounces) is the bake
- * command's option of its name: set on cmd through the library's parser
- * (bb_command_set), which refuses a value with the words every client
- * prints ("--rays needs an integer (got 'x')"). brightness is serve's own
- * switch. */
+/* The bake controls: bake's options of these names (parsed by the library,
+ * bb_command_set, which refuses a value with the words every client prints:
+ * "--rays needs an integer (got 'x')"), and where each lands in the bake
+ * options. brightness is serve's own switch. */
+#define CONTROL(name, member) \
+  {name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member)}
+static const struct {
+  const char *name;
+  size_t offset, size;
+} controls[] = {CONTROL("scale", height_scale), CONTROL("rays", rays),
+                CONTROL("slices", slices),      CONTROL("bias", trace.bias_texels),
+                CONTROL("bounce", bounce_albedo), CONTROL("bounces", bounces)};
+#define CONTROL_COUNT (sizeof controls / sizeof controls[0])
+
 static int apply_one(serve_state *s, bb_command *cmd, int *use_brightness, const char *name,
                      const char *value, char *err, size_t cap) {
-  static const char *const controls[] = {"scale", "rays", "slices", "bias", "bounce", "bounces"};
-  for (size_t i = 0; i < sizeof controls / sizeof controls[0]; i++)
-    if (!strcmp(name, controls[i])) {
+  for (size_t i = 0; i < CONTROL_COUNT; i++)
+    if (!strcmp(name, controls[i].name)) {
       bb_error e = {{0}};
       if (bb_command_set(cmd, name, value, &e) != BB_OK) {
         snprintf(err, cap, "%s", e.message);
@@ -130,19 +139,11 @@ static int apply_one(serve_state *s, bb_command *cmd, int *use_brightness, const
 
 /* The controls set on cmd, their parsed values, over the settings b. */
 static void take_controls(const bb_command *cmd, bb_bake_options *b) {
-  const bb_bake_options *p = &bb_command_options_of(cmd)->job.bake;
-  if (bb_command_given(cmd, "scale"))
-    b->height_scale = p->height_scale;
-  if (bb_command_given(cmd, "rays"))
-    b->rays = p->rays;
-  if (bb_command_given(cmd, "slices"))
-    b->slices = p->slices;
-  if (bb_command_given(cmd, "bias"))
-    b->trace.bias_texels = p->trace.bias_texels;
-  if (bb_command_given(cmd, "bounce"))
-    b->bounce_albedo = p->bounce_albedo;
-  if (bb_command_given(cmd, "bounces"))
-    b->bounces = p->bounces;
+  const bb_bake_options *parsed = &bb_command_options_of(cmd)->job.bake;
+  for (size_t i = 0; i < CONTROL_COUNT; i++)
+    if (bb_command_given(cmd, controls[i].name))
+      memcpy((char *)b + controls[i].offset, (const char *)parsed + controls[i].offset,
+             controls[i].size);
 }
 
 int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
