@@ -130,14 +130,21 @@ typedef struct job {
   float *ao, *ssbump; /* per reference texel: 1 and 3 values */
 } job;
 
-/* The integral of (a cos + c sin) cos over [start, pi/2]: a lobe above an
- * elevation, where a = B's horizontal part along the azimuth, c = Bz > 0. */
-static double lobe_above(const double b[3], double phi, double t) {
-  const double a = b[0] * cos(phi) + b[1] * sin(phi), c = b[2];
-  const double start = fmax(atan(fmax(t, 0.0)), atan2(-a, c)), end = 0.5 * BB__PI;
+/* The integral of (a cos + c sin) cos over [start, pi/2], where a = B's
+ * horizontal part along the azimuth, c = Bz > 0: the lobe open above the
+ * elevation start (not below the lobe's own edge atan2(-a, c): callers
+ * take the larger). */
+static double lobe_open(double a, double c, double start) {
+  const double end = 0.5 * BB__PI;
   if (start >= end) return 0.0;
   return a * ((end - start) / 2 + (sin(2 * end) - sin(2 * start)) / 4) +
          c * (1.0 - sin(start) * sin(start)) / 2;
+}
+
+/* The lobe of b open above the horizon of tangent t at azimuth phi. */
+static double lobe_above(const double b[3], double phi, double t) {
+  const double a = b[0] * cos(phi) + b[1] * sin(phi), c = b[2];
+  return lobe_open(a, c, fmax(atan(fmax(t, 0.0)), atan2(-a, c)));
 }
 
 static void reference_row(void *user, int row) {
@@ -177,8 +184,9 @@ static void reference_row(void *user, int row) {
  * is also found along each of the S slices' lattice directions (the bake's
  * own, from bb_rayset_make), and each rule turns those S horizons into a
  * horizon at every one of the N reference azimuths; ao and ssbump are then
- * integrated over the N azimuths exactly as the reference's own horizons
- * are, by the same function, so what differs is the rule alone:
+ * integrated over the N azimuths with the reference's own lobe integral
+ * (lobe_open) and compared with the reference (reference_row), so what
+ * differs is the rule alone:
  *
  *   const     the bake's: each slice's horizon over the sector halfway to
  *             its neighbours (an azimuth bin a sector edge cuts is split)
@@ -210,13 +218,9 @@ static void rule_add(const rule_job *r, int k, double theta, double weight, doub
   if (theta > 0.5 * BB__PI) theta = 0.5 * BB__PI;
   const double co = cos(theta);
   sums[0] += weight * co * co;
-  for (int c = 0; c < 3; c++) {
-    const double alpha = r->alpha[3 * k + c], a = r->a[3 * k + c], bz = r->j->basis[c][2];
-    const double start = theta > alpha ? theta : alpha;
-    if (start >= 0.5 * BB__PI) continue;
-    const double cs = cos(start), ss = sin(start);
-    sums[1 + c] += weight * (a * ((0.5 * BB__PI - start) / 2 - 2.0 * ss * cs / 4) + bz * cs * cs / 2);
-  }
+  for (int c = 0; c < 3; c++)
+    sums[1 + c] += weight * lobe_open(r->a[3 * k + c], r->j->basis[c][2],
+                                      fmax(theta, r->alpha[3 * k + c]));
 }
 
 static double elevation(double t) { return atan(t > 0.0 ? t : 0.0); }
@@ -259,23 +263,17 @@ static void rule_row(void *user, int row) {
   const job *j = r->j;
   const args *a = j->a;
   const int y = row * a->stride;
-  double *dense = malloc((size_t)r->n * sizeof(double));
-  if (!dense) abort();
   for (int i = 0; i < j->columns; i++) {
     const int x = i * a->stride;
     const long at = (long)row * j->columns + i;
     const bb__ray base = {{x, y, (double)*bb_image_texel(j->z, x, y) + a->bias}, {1, 0, 0}};
     const float *n = bb_image_texel(j->normal, x, y);
-    double all[4] = {0}, open[4] = {0};
-    for (int k = 0; k < r->n; k++) {
-      bb__ray ray = base;
-      ray.direction[0] = r->cosphi[k], ray.direction[1] = r->sinphi[k];
-      dense[k] = bb__ray_horizon(j->p, &ray, a->reach);
+    double all[4] = {0}; /* the lobes open to the whole hemisphere */
+    for (int k = 0; k < r->n; k++)
       rule_add(r, k, 0.0, 1.0, all);
-      rule_add(r, k, elevation(dense[k]), 1.0, open);
-    }
-    float ref[4];
-    rule_finish(r, open, all, n, ref);
+    /* the dense reference of this texel (reference_row) */
+    const float ref[4] = {j->ao[at], j->ssbump[3 * at], j->ssbump[3 * at + 1],
+                          j->ssbump[3 * at + 2]};
     /* a hashed turn in [0, 1) per texel for the rotated sets */
     uint32_t hash = (uint32_t)x * 73856093u ^ (uint32_t)y * 19349663u;
     hash ^= hash >> 13, hash *= 0x5bd1e995u, hash ^= hash >> 15;
@@ -328,7 +326,6 @@ static void rule_row(void *user, int row) {
       }
     }
   }
-  free(dense);
 }
 
 /* Per slice count and rule: mean |error| and bias of ao and each ssbump channel. */
@@ -490,7 +487,7 @@ int main(int argc, char **argv) {
     j.ao = malloc((size_t)rows * (size_t)j.columns * sizeof(float));
     j.ssbump = malloc(3 * (size_t)rows * (size_t)j.columns * sizeof(float));
     if (!j.ao || !j.ssbump) st = bb__fail(&err, BB_ERR_MEMORY, "out of memory");
-    if (st == BB_OK && a.results)
+    if (st == BB_OK) /* the dense reference, which results and rules compare with */
       st = bb__parallel_for(rows, 0, reference_row, &j, NULL, NULL, &err);
     if (st == BB_OK && a.slice_counts) st = rules_run(&a, &j, rows, &err);
   }
