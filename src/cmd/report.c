@@ -60,8 +60,8 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
   bb_json_string(&j, "addressing", bb_addressing_name(b->smooth.addressing));
   bb_json_string(&j, "channel", bb_height_source_channel(&r->source));
   bb_json_number(&j, "threads", r->threads);
-  if (r->bounces >
-      0) { /* as provenance: rho (1 for an albedo map alone) and the count asked */
+  if (r->bounces > 0) {
+    /* as provenance: rho (1 for an albedo map alone) and the count asked */
     bb_json_number(&j, "bounce", b->bounce_albedo > 0.0 ? b->bounce_albedo : 1.0);
     bb_json_number(&j, "bounces", b->bounces);
   }
