@@ -11,9 +11,10 @@ from ._command import Command
 from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _exception, _ffi,
                       _lib, _message, _note_text, _path, _progress_hook, _status_name, _text)
 
-_OUTCOMES = {_lib.BB_JOB_PENDING: "pending", _lib.BB_JOB_BAKED: "baked",
-             _lib.BB_JOB_CURRENT: "up to date", _lib.BB_JOB_FAILED: "failed",
-             _lib.BB_JOB_NOT_RUN: "not run"}
+# A report's status: the library's name of its outcome ("up to date", ...).
+_OUTCOMES = {k: _text(_lib.bb_job_outcome_name(k))
+             for k in (_lib.BB_JOB_PENDING, _lib.BB_JOB_BAKED, _lib.BB_JOB_CURRENT,
+                       _lib.BB_JOB_FAILED, _lib.BB_JOB_NOT_RUN)}
 
 _SECONDS = ("load", "smooth", "pyramid", "trace", "derive", "write")
 

@@ -19,7 +19,7 @@ import sys
 from .._command import Command
 from .._common import (ArgumentError, Error, _check, _check_notes, _ffi, _lib, _path,
                        _text)
-from .._jobs import BakeJob
+from .._jobs import _OUTCOMES, BakeJob
 
 
 class CommandJob(BakeJob):
@@ -58,9 +58,7 @@ class CommandJob(BakeJob):
 # ----------------------------------------------------------------- the run
 
 
-_OUTCOME = {"pending": _lib.BB_JOB_PENDING, "baked": _lib.BB_JOB_BAKED,
-            "up to date": _lib.BB_JOB_CURRENT, "failed": _lib.BB_JOB_FAILED,
-            "not run": _lib.BB_JOB_NOT_RUN}
+_OUTCOME = {name: outcome for outcome, name in _OUTCOMES.items()}  # status -> outcome
 
 
 def _printed(text):
