@@ -2679,11 +2679,14 @@ typedef enum bb_option_type {
   BB_OPTION_PATH      /* a file or directory, not empty */
 } bb_option_type;
 
-/* Which of a command's uses an option belongs to. */
+/* Which of a command's uses an option belongs to (for --help and the
+ * reference pages). The job is where the rule lives: bb_job_plan refuses a
+ * single bake's options in a batch and a batch's without out_dir, for
+ * every client (bb_command_plan, and callers of the job API). */
 typedef enum bb_option_mode {
   BB_MODE_ANY = 0,    /* every use */
   BB_MODE_SINGLE,     /* one input, outputs named one by one */
-  BB_MODE_BATCH       /* a batch (bake --out-dir): refused without it */
+  BB_MODE_BATCH       /* a batch (bake --out-dir) */
 } bb_option_mode;
 
 /* bb_option_info.flags */

@@ -144,6 +144,7 @@ def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):
     ({"vtf_version": "7.9"}, bumpbake.ArgumentError, "VTF version must be 7.2, 7.3, 7.4 or 7.5"),
     ({"vtf_flags": -1}, bumpbake.ArgumentError, "VTF flags must be a 32-bit number"),
     ({"vmt": "m.vmt"}, bumpbake.ArgumentError, "--vmt writes one material"),
+    ({"lit": (45, 30)}, bumpbake.ArgumentError, "--lit previews one slope map"),
     ({"name": "{stem}_{kind}.vtf"}, bumpbake.ArgumentError,
      "Source textures need a power of two on each side"),
 ])
@@ -155,6 +156,15 @@ def test_bad_jobs_are_refused_before_any_bake(tmp_path, fixtures, kwargs, error,
     assert not list(tmp_path.glob("out/*"))
     with pytest.raises(TypeError, match="scale is required"):
         bumpbake.bake_files(fixtures, tmp_path / "out")
+
+
+@pytest.mark.parametrize("kwargs", [{"maps": "ao"}, {"name": "{stem}.png"},
+                                    {"keep_going": True}])
+def test_a_batchs_options_are_refused_in_a_single_bake(tmp_path, fixtures, kwargs):
+    with pytest.raises(bumpbake.ArgumentError, match="is for batches: give --out-dir DIR"):
+        bumpbake.bake_file(os.path.join(fixtures, "pit_65x65.png"),
+                           {"ao": tmp_path / "a.png"}, scale=4, **kwargs)
+    assert not list(tmp_path.iterdir())
 
 
 def test_an_output_over_an_input_is_an_io_error(tmp_path, fixtures):

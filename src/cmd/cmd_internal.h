@@ -174,6 +174,7 @@ int bb__applies_vtf(const bb_command *c);
 int bb__applies_traced(const bb_command *c);
 int bb__applies_bounces(const bb_command *c);
 int bb__applies_brightness(const bb_command *c);
+int bb__applies_batch(const bb_command *c);
 
 /* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
 #define BB__ENUM_WORDS(stem)                                                             \

@@ -225,17 +225,6 @@ static bb_status check_ranges(const bb_command *c, bb_error *err) {
   return BB_OK;
 }
 
-/* An option of a batch given without one. */
-static bb_status check_modes(const bb_command *c, bb_error *err) {
-  for (int i = 0; c->def->options[i]; i++) {
-    const bb__option *o = c->def->options[i];
-    if (c->given[i] && o->info.mode == BB_MODE_BATCH && !c->options.job.out_dir)
-      return bb__fail(err, BB_ERR_ARGUMENT, "--%s is for batches: give --out-dir DIR",
-                      o->info.name);
-  }
-  return BB_OK;
-}
-
 /* An option given where it would do nothing. */
 static bb_status check_applies(const bb_command *c, bb_error *err) {
   for (int i = 0; c->def->options[i]; i++) {
@@ -255,8 +244,6 @@ bb_status bb_command_check(bb_command *c, bb_error *err) {
     st = check_ranges(c, err);
   if (st == BB_OK)
     st = check_required(c, err);
-  if (st == BB_OK)
-    st = check_modes(c, err);
   if (st == BB_OK)
     st = check_applies(c, err);
   if (st == BB_OK && c->def->check)

@@ -389,8 +389,9 @@ static const bb__option opt_keep_going = {
 
 static const bb__option opt_force = {
     .info = {.name = "force", .type = BB_OPTION_FLAG, .flags = BB_OPTION_FILES, .mode = BB_MODE_BATCH,
+             .applies = "--out-dir DIR",
              .help = "a batch bakes inputs whose outputs are up to date, too"},
-    .field = BB__FIELD_INT, .offset = AT(job.force)};
+    .field = BB__FIELD_INT, .offset = AT(job.force), .applies = bb__applies_batch};
 
 static const bb__option opt_depfile = {
     .info = {.name = "depfile", .value_name = "FILE", .type = BB_OPTION_PATH, .flags = BB_OPTION_FILES, .count = 1,

@@ -4,6 +4,7 @@
  * an option given where its rule says it would do nothing, as --depth 16
  * with a .vtf is refused. */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <string.h>
 #include <strings.h>
@@ -53,20 +54,19 @@ int bb__applies_vtf(const bb_command *c) {
   return any_output(c, "vtf", NULL);
 }
 
-/* The bake's maps c asks for. */
+/* The bake's maps c asks for: the job's rule (bb__job_maps_asked), or
+ * those of a bake in memory, or serve's (its page shows every map). */
 static unsigned maps_asked(const bb_command *c) {
-  const bb_job_options *j = &c->options.job;
   if (c->in_memory)
     return c->memory_maps;
   if (!strcmp(c->def->info.name, "serve"))
-    return BB_MAPS_BAKED; /* its page shows every map */
-  if (j->out_dir)
-    return j->maps ? j->maps : BB_JOB_DEFAULT_MAPS;
-  unsigned maps = j->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    if (j->paths[k])
-      maps |= BB_MAP_BIT(k);
-  return maps;
+    return BB_MAPS_BAKED;
+  return bb__job_maps_asked(&c->options.job);
+}
+
+/* --force: a single bake always bakes (bb__command_bake's job). */
+int bb__applies_batch(const bb_command *c) {
+  return c->options.job.out_dir != NULL;
 }
 
 int bb__applies_traced(const bb_command *c) {

@@ -122,6 +122,11 @@ int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out)
 bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
                                       bb_range range);
 
+/* The maps o asks for: the named paths (and the filtered height the slope
+ * map is made from, what Valve's file packs), or a batch's maps. The
+ * commands' rules of what an option applies to read it too. */
+unsigned bb__job_maps_asked(const bb_job_options *o);
+
 /* The kind of Valve's packed file (bb_job_options.valve_path): "ssbump+height",
  * "normal+ao", "detail-ssbump+height"... */
 const char *bb__job_valve_kind(const bb_job_options *o);

@@ -524,9 +524,7 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
 
 /* ------------------------------------------------------------------- plan */
 
-/* The kinds asked: the named paths (and the filtered height the slope map
- * is made from, what Valve's file packs), or a batch's maps. */
-static unsigned asked_kinds(const bb_job_options *o) {
+unsigned bb__job_maps_asked(const bb_job_options *o) {
   if (o->out_dir)
     return o->maps ? o->maps : BB_JOB_DEFAULT_MAPS;
   unsigned mask = o->prefix ? BB_JOB_DEFAULT_MAPS : 0u;
@@ -549,8 +547,12 @@ const char *bb__job_valve_kind(const bb_job_options *o) {
   return o->valve.ao_in_alpha ? "ssbump+ao" : "ssbump+height";
 }
 
-/* Options only a batch uses, refused without out_dir (force is not one: a
- * single input may skip its bake when its outputs are current). */
+/* The rules of a single bake's options, and of the options only a batch
+ * uses (refused without out_dir), for every client: the commands' option
+ * rows say which use an option belongs to (bb_option_info.mode), and a test
+ * walks them against these checks. force is not a batch's only: a single
+ * input may skip its bake when its outputs are current (the bake command
+ * always bakes one, and refuses --force without --out-dir). */
 static bb_status check_single(const bb_job_options *o, const char *const *inputs,
                               int input_count, bb_error *err) {
   if (input_count > 1)
@@ -578,7 +580,7 @@ static bb_status check_single(const bb_job_options *o, const char *const *inputs
                               : BB_OK;
   if (st == BB_OK && o->valve_path && o->valve_detail && o->valve.normal_map)
     st = bb__fail(err, BB_ERR_ARGUMENT, "-d makes a detail ssbump; it cannot be used with -n");
-  if (st == BB_OK && !asked_kinds(o))
+  if (st == BB_OK && !bb__job_maps_asked(o))
     st = bb__fail(err, BB_ERR_ARGUMENT,
                   "nothing to write: give -o PREFIX or at least one of --normal, "
                   "--weights, --ssbump, --ao, --bent, --filtered, --slope (or --out-dir DIR "
@@ -603,6 +605,9 @@ static bb_status check_options(const bb_job_options *o, const char *const *input
     if (o->vmt)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "--vmt writes one material: bake one input with --ssbump FILE.vtf");
+    if (o->slope_lit)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--lit previews one slope map: bake one input with --slope FILE");
   } else {
     bb_status st = check_single(o, inputs, input_count, err);
     if (st != BB_OK)
@@ -622,7 +627,7 @@ static bb_status check_options(const bb_job_options *o, const char *const *input
 static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *err) {
   job->options = *o;
   job->asked_slices = o->bake.slices;
-  job->options.bake.outputs = asked_kinds(o);
+  job->options.bake.outputs = bb__job_maps_asked(o);
   job->batch = o->out_dir != NULL;
   job->basis_file = copy(o->basis_file);
   job->out_dir = copy(o->out_dir);

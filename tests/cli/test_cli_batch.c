@@ -285,13 +285,17 @@ Test(cli_batch, single_bakes_are_unchanged_and_batch_options_need_out_dir) {
                           "wrote ao p_ao.png\n");
   cli_result_free(&r);
   static const char *const batch_only[][2] = {
-      {"--name", "{stem}.png"}, {"--maps", "normal"}, {"--keep-going", NULL}, {"--force", NULL}};
-  for (size_t i = 0; i < 4; i++)
+      {"--name", "{stem}.png"}, {"--maps", "normal"}, {"--keep-going", NULL}};
+  for (size_t i = 0; i < 3; i++)
     harness_expect_refusal(
         harness_dir,
         (const char *const[]){"bake", "a.png", FAST, "-o", "q", batch_only[i][0],
                               batch_only[i][1], NULL},
         2, "is for batches: give --out-dir DIR", i);
+  /* a single bake always bakes: --force would do nothing */
+  harness_expect_refusal(harness_dir,
+                         (const char *const[]){"bake", "a.png", FAST, "-o", "q", "--force", NULL},
+                         2, "--force does nothing without --out-dir DIR", 3);
   height_file(tmp("b.png"), 2);
   harness_expect_refusal(harness_dir,
                          (const char *const[]){"bake", "a.png", "b.png", FAST, "-o", "q", NULL},

@@ -174,6 +174,52 @@ Test(cmd, ranges_are_the_library_constants) {
   bb_command_free(c);
 }
 
+/* An option of the other use refused by the command or its plan (the
+ * job's rule, bb_job_plan), in words naming it or --out-dir. */
+static void refused_in_use(const char *const *base, const bb_option_info *o) {
+  static const char *const values[] = {[BB_OPTION_PATH] = "x.png",
+                                       [BB_OPTION_WORDS] = "normal",
+                                       [BB_OPTION_TEXT] = "{stem}_{kind}.png",
+                                       [BB_OPTION_NUMBERS] = "45,30"};
+  bb_command *c = command("bake", base);
+  bb_error err = {{0}};
+  const char *value = o->type == BB_OPTION_FLAG ? NULL : values[o->type];
+  if (o->type != BB_OPTION_FLAG)
+    cr_assert_not_null(value, "--%s: no test value for its type", o->name);
+  bb_status st = bb_command_set(c, o->name, value, &err);
+  if (st == BB_OK)
+    st = bb_command_check(c, &err);
+  bb_job *job = NULL;
+  if (st == BB_OK)
+    st = bb_command_plan(c, NULL, &job, &err);
+  char spelled[64];
+  snprintf(spelled, sizeof spelled, "--%s", o->name);
+  cr_expect_eq(st, BB_ERR_ARGUMENT, "--%s in the other use: accepted", o->name);
+  cr_expect(strstr(err.message, spelled) || strstr(err.message, "--out-dir"),
+            "--%s: refused in other words: %s", o->name, err.message);
+  bb_job_free(job);
+  bb_command_free(c);
+}
+
+/* Every option the descriptions give to one use (a batch's, a single
+ * bake's) is refused in the other: the rows and the job's rules agree. */
+Test(cmd, each_option_of_one_use_is_refused_in_the_other) {
+  const bb_command_info *bake = bb_command_info_find("bake");
+  const char *single[] = {"h.png", "--scale", "1", "--output", "p", NULL};
+  const char *batch[] = {"h.png", "--scale", "1", "--out-dir", "o", NULL};
+  int walked[3] = {0};
+  for (int i = 0; i < bake->option_count; i++) {
+    const bb_option_info *o = bb_command_option(bake, i);
+    if (o->mode == BB_MODE_BATCH)
+      refused_in_use(single, o);
+    else if (o->mode == BB_MODE_SINGLE && strcmp(o->name, "output") != 0)
+      refused_in_use(batch, o);
+    walked[o->mode]++;
+  }
+  cr_expect_geq(walked[BB_MODE_BATCH], 4, "name, maps, keep-going, force");
+  cr_expect_geq(walked[BB_MODE_SINGLE], 10, "-o, the six maps, --slope, --lit, --vmt...");
+}
+
 /* An option given where it does nothing is refused, naming what it needs. */
 Test(cmd, options_that_do_nothing_are_refused) {
   refused("bake", (const char *[]){"h.png", "--scale", "1", "--normal", "n.png",
@@ -198,7 +244,7 @@ Test(cmd, options_that_do_nothing_are_refused) {
                                    NULL},
           "--materials needs a path (got '')");
   refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--force", NULL},
-          "--force is for batches: give --out-dir DIR");
+          "--force does nothing without --out-dir DIR");
   /* a batch's name template stands for its outputs */
   const char *batch[] = {"h.png", "--scale", "1", "--out-dir", "o", "--name",
                          "{stem}_{kind}.vtf", "--texture-format", "bc3", NULL};
