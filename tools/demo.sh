@@ -8,13 +8,8 @@ set -euo pipefail
 
 bin=${1:?usage: tools/demo.sh path/to/bumpbake}
 input=fixtures/rock06_height.png
-# The fixture is copied into fixtures/ by the fixtures issue; until then the
-# shared copy beside the checkout (or beside the worktrees) is used.
-for alt in ../shared/fixtures ../../shared/fixtures; do
-  [ -f "$input" ] || input=$alt/rock06_height.png
-done
 if [ ! -f "$input" ]; then
-  echo "demo: rock06_height.png not found in fixtures/ or ../shared/fixtures/" >&2
+  echo "demo: $input not found (run it from the checkout's top directory)" >&2
   exit 1
 fi
 

@@ -50,7 +50,7 @@ def obj_mtllib(path, mtl):
 
 
 def deep_gltf(path, n):
-    # The issue's own: a chain of n nodes, each the child of the one before.
+    # A chain of n nodes, each the child of the one before.
     n = int(n)
     write(path, json.dumps({"asset": {"version": "2.0"}, "scene": 0,
                             "scenes": [{"nodes": [0]}],

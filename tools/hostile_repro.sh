@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# hostile_repro.sh BIN: reruns every reproduction of a hostile input (hostile files,
-# second round: its 15 numbered cases with their variants, and the minor
-# paragraph's compare of NaN and flat model), and issue 32's security and
-# memory items (32.N: code from the working directory, outputs that are not
-# regular files, a memory cgroup, a render's picture) against the binary
+# hostile_repro.sh BIN: reruns every reproduction of a hostile input (the hostile
+# files: 15 numbered cases with their variants, and the compares of NaN and
+# of a flat model), and the security and memory cases (32.N: code from the
+# working directory, outputs that are not regular files, a memory cgroup, a
+# render's picture, the cluster path) against the binary
 # BIN, one line per case: its id, what ran, and CLEAN or NOT CLEAN with the
 # reasons.
 #
-# Clean is what the issue asks: a refusal exits non-zero with one line on
+# Clean means: a refusal exits non-zero with one line on
 # stderr (a case that should work exits 0), nothing is killed by a signal,
 # no control character is printed, the time and peak memory (GNU time's %M,
 # children included) stay within the case's bound, and no file is changed,
@@ -288,7 +288,7 @@ done
 # ----------------------------------- 5. headers that declare huge allocations
 
 # Each file is read by info and by bake twice: under `ulimit -v 2000000`,
-# as the issue asks, and with no limit but the safety net, where what the
+# the bound a user's shell may set, and with no limit but the safety net, where what the
 # header made the reader allocate shows in the peak memory. A refusal from
 # the header says what is wrong: a reason that is an allocation failing
 # (the reader allocated first) is not clean.
@@ -369,8 +369,8 @@ WANT_RC="1 2" finish
 
 # --------------------------------- 8. a link planted at a TIFF's temporary
 
-# A watcher in the shared output directory (another user, as the issue's
-# threat is, when this runs as root) swaps every temporary file of the
+# A watcher in the shared output directory (another user, the threat of a
+# shared directory, when this runs as root) swaps every temporary file of the
 # writer for a link to precious.txt, and moves every private directory
 # aside for one of its own full of such links, while a mip-mapped TIFF is
 # written. Clean: precious.txt keeps its bytes in every trial, and each
@@ -669,13 +669,13 @@ sweep_case 15d "bake h.png --scale 8 -o out/r" bake h.png --scale 8 --rays 16 -o
 sweep_case 15e "renderbumpflat rivet_panel.obj" renderbumpflat m.obj --size 128 128 -o out/p.tga
 sweep_case 15f "render h.png --scale 8" render h.png --scale 8 --rays 16 -o out/x.png
 
-# ------------------------------------------ issue 32: security, memory
+# ------------------------------------------------- 32: security, memory
 
 # 32.1: `bake --scheduler` ran `python3 -m bumpbake.dask`, which put the
 # working directory first on sys.path: a numpy.py, distributed/ or
 # bumpbake/ there ran. Each stub here leaves RAN behind if it runs. The
 # address is not one, so the run ends at once; what Python then says about
-# it (a traceback: issue 32 #6) is not judged here, only what was imported.
+# it (a traceback: case 32.6) is not judged here, only what was imported.
 scheduler_case() { # ID DESC ENV...
   local id=$1 desc=$2; shift 2
   begin "$id" "$desc"
@@ -817,7 +817,7 @@ if scale=$(grep -ao 'scale [0-9.e+-]*' "$OUTF" "$ERRF" | head -n 1 | awk '{ prin
 fi
 report
 
-# ---------------------------------------------- issue 32: the cluster path
+# ---------------------------------------------------- 32: the cluster path
 
 # 32.6: a malformed --scheduler gave a 27-44-line traceback and exit 1; it is
 # a usage error (one line, exit 2) found before connecting. A refused

@@ -39,7 +39,7 @@ static void write_gltf(const char *path, const char *uri) {
   write_text(path, text);
 }
 
-/* The reproductions of the issue, as a user runs them: one line, exit 1,
+/* Hostile models, as a user runs them: one line, exit 1,
  * nothing written, nothing of /etc/passwd printed. */
 Test(mesh_cli, renderbumpflat_refuses_hostile_models_with_one_line) {
   write_gltf(tmp("passwd.gltf"), "/etc/passwd");

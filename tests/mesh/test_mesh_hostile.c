@@ -148,10 +148,10 @@ static void expect_refused(const char *path, bb_status status, const char *part)
 
 /* ------------------------------------------------- 1. files it may read */
 
-/* The glTF of the issue, run from its directory: its buffer is
- * /etc/passwd. Before, the load succeeded with the file's bytes as vertex
- * coordinates. (With a directory in the model's name, Assimp looks for
- * "DIR//etc/passwd": inside, missing, an error of its own.) */
+/* A glTF run from its directory whose buffer is /etc/passwd: read, the
+ * file's bytes would become vertex coordinates. (With a directory in the
+ * model's name, Assimp looks for "DIR//etc/passwd": inside, missing, an
+ * error of its own.) */
 Test(mesh_hostile, a_gltf_buffer_outside_the_directory_is_refused) {
   cr_assert_eq(chdir(harness_dir), 0);
   write_gltf("passwd.gltf", "/etc/passwd", 1, 1);
@@ -204,9 +204,9 @@ Test(mesh_hostile, buffers_inside_the_directory_and_data_uris_load) {
 }
 
 /* mtllib naming /etc/passwd, ../../../../etc/shadow and a link out: each
- * was opened and read silently before. Run from the models' directory,
- * as in the issue: Assimp puts an OBJ's own directory, when its name has
- * one, in front of the .mtl's name. */
+ * must be refused, not read. Run from the models' directory, as a user
+ * runs them: Assimp puts an OBJ's own directory, when its name has one, in
+ * front of the .mtl's name. */
 Test(mesh_hostile, an_obj_mtllib_outside_the_directory_is_refused) {
   cr_assert_eq(chdir(harness_dir), 0);
   cr_assert_eq(mkdir("a", 0755), 0);
