@@ -19,7 +19,9 @@ typedef enum bb__field {
   BB__FIELD_FLOAT,
   BB__FIELD_DOUBLE,
   BB__FIELD_STRING,   /* const char *, owned by the command */
-  BB__FIELD_ENUM      /* an enum, stored as int (enums of the API are int-sized) */
+  BB__FIELD_ENUM,     /* an enum, stored as int (enums of the API are int-sized) */
+  BB__FIELD_ANGLES    /* AZ,EL: double azimuth, then double elevation (the range's);
+                         sets (bb__flag_sets) turns the light or camera on */
 } bb__field;
 
 /* The most numbers one option holds (--rect L B R T). */
@@ -62,7 +64,7 @@ struct bb__option {
   bb__applies_fn applies;    /* NULL: always applies */
   const char *required_note; /* REQUIRED: what it is, after "is required" */
   void (*range_words)(char *out, size_t cap); /* a range spelled from constants */
-  bb__flag_sets sets;        /* FLAG: the other field it sets when given */
+  bb__flag_sets sets;        /* FLAG, ANGLES: the other field it sets when given */
 };
 
 typedef struct bb__command bb__command;

@@ -141,37 +141,6 @@ static void print_maps(const bb_command *c, const bb__option *o, bb__text *t) {
     }
 }
 
-/* --lit AZ,EL: the slope map's lit preview. */
-static bb_status set_lit(bb_command *c, const bb__option *o, const char *text, double *values,
-                         int *count, bb_error *err) {
-  bb_status st = bb__parse_numbers(o, text, 2, 0, values, err);
-  if (st != BB_OK)
-    return st;
-  c->options.job.slope_lit = 1;
-  c->options.job.slope_lit_azimuth = values[0];
-  c->options.job.slope_lit_elevation = values[1];
-  values[0] = values[1]; /* the range is the elevation's */
-  *count = 1;
-  return BB_OK;
-}
-
-static void print_angles(bb__text *t, double az, double el) {
-  char a[40], e[40];
-  bb__double_text(az, a, sizeof a);
-  bb__double_text(el, e, sizeof e);
-  bb__text_printf(t, "%s,%s", a, e);
-}
-
-static void print_lit(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  print_angles(t, c->options.job.slope_lit_azimuth, c->options.job.slope_lit_elevation);
-}
-
-static void elevation_range(char *out, size_t cap) {
-  char r[32];
-  bb__range_text(&bb__range_light_elevation, r, sizeof r);
-  snprintf(out, cap, "degrees, EL %s", r);
-}
 
 /* ------------------------------------------------------------ the rows */
 
@@ -346,13 +315,19 @@ static const bb__option opt_slope = {
                      "(8-bit .png .tga .tif)"},
     .field = BB__FIELD_STRING, .offset = AT(job.slope_path)};
 
+/* --lit is an AZ,EL field (BB__FIELD_ANGLES): two doubles. */
+_Static_assert(offsetof(bb_job_options, slope_lit_elevation) ==
+                   offsetof(bb_job_options, slope_lit_azimuth) + sizeof(double),
+               "--lit: azimuth, then elevation");
+
 static const bb__option opt_lit = {
     .info = {.name = "lit", .value_name = "AZ,EL", .type = BB_OPTION_NUMBERS, .count = 2,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES, .default_text = "",
              .help = "also write the slope map lit through its 16x16 table as FILE_lit (AZ 0 = "
                      "light from the right, 90 = from the top, as render's --light)"},
-    .range = &bb__range_light_elevation, .range_of = "elevation", .set = set_lit,
-    .print = print_lit, .range_words = elevation_range};
+    .field = BB__FIELD_ANGLES, .offset = AT(job.slope_lit_azimuth),
+    .sets = {BB__FIELD_INT, AT(job.slope_lit), 1, NULL},
+    .range = &bb__range_light_elevation, .range_of = "elevation"};
 
 static const bb__option opt_prefix = {
     .info = {.name = "output", .short_name = 'o', .value_name = "PREFIX",

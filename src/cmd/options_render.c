@@ -21,38 +21,6 @@ static const bb__range range_panel_size = {"panel size", 16, 4096, 0, 1};
 
 /* ----------------------------------------------------------- set & print */
 
-static void print_angles(bb__text *t, double az, double el) {
-  char a[40], e[40];
-  bb__double_text(az, a, sizeof a);
-  bb__double_text(el, e, sizeof e);
-  bb__text_printf(t, "%s,%s", a, e);
-}
-
-/* --light AZ,EL: the dynamic light (on). */
-static bb_status set_light(bb_command *c, const bb__option *o, const char *text,
-                           double *values, int *count, bb_error *err) {
-  bb_status st = bb__parse_numbers(o, text, 2, 0, values, err);
-  if (st != BB_OK)
-    return st;
-  c->options.render.light_azimuth = values[0];
-  c->options.render.light_elevation = values[1];
-  c->options.render.dynamic_light = 1;
-  values[0] = values[1]; /* the range is the elevation's */
-  *count = 1;
-  return BB_OK;
-}
-
-static void print_light(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  print_angles(t, c->options.render.light_azimuth, c->options.render.light_elevation);
-}
-
-static void light_range(char *out, size_t cap) {
-  char r[32];
-  bb__range_text(&bb__range_light_elevation, r, sizeof r);
-  snprintf(out, cap, "EL %s", r);
-}
-
 static bb_status set_light_color(bb_command *c, const bb__option *o, const char *text,
                                  double *values, int *count, bb_error *err) {
   bb_status st = bb__parse_numbers(o, text, 3, 0, values, err);
@@ -167,32 +135,15 @@ static void print_crop(const bb_command *c, const bb__option *o, bb__text *t) {
   bb__text_printf(t, "%d,%d,%d,%d", r->crop_x, r->crop_y, r->crop_width, r->crop_height);
 }
 
-/* --view AZ,EL: a camera (on). */
-static bb_status set_view(bb_command *c, const bb__option *o, const char *text, double *values,
-                          int *count, bb_error *err) {
-  bb_status st = bb__parse_numbers(o, text, 2, 0, values, err);
-  if (st != BB_OK)
-    return st;
-  c->options.render.view = 1;
-  c->options.render.view_azimuth = values[0];
-  c->options.render.view_elevation = values[1];
-  values[0] = values[1];
-  *count = 1;
-  return BB_OK;
-}
-
-static void print_view(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  print_angles(t, c->options.render.view_azimuth, c->options.render.view_elevation);
-}
-
-static void view_range(char *out, size_t cap) {
-  char r[32];
-  bb__range_text(&bb__range_view_elevation, r, sizeof r);
-  snprintf(out, cap, "EL %s", r);
-}
-
 /* ------------------------------------------------------------ the rows */
+
+/* --light and --view are AZ,EL fields (BB__FIELD_ANGLES): two doubles. */
+_Static_assert(offsetof(bb_render_options, light_elevation) ==
+                   offsetof(bb_render_options, light_azimuth) + sizeof(double),
+               "--light: azimuth, then elevation");
+_Static_assert(offsetof(bb_render_options, view_elevation) ==
+                   offsetof(bb_render_options, view_azimuth) + sizeof(double),
+               "--view: azimuth, then elevation");
 
 static const bb__option opt_mode = {
     .info = {.name = "mode", .type = BB_OPTION_WORD, .count = 1, .values = 1,
@@ -207,9 +158,9 @@ static const bb__option opt_light = {
              .values = 1, .flags = RECORDED,
              .help = "dynamic light, degrees: azimuth 0 = from the right, 90 = from the top "
                      "(counter-clockwise on screen), elevation 90 = overhead"},
-    .range = &bb__range_light_elevation, .range_of = "elevation", .set = set_light,
-    .print = print_light,
-    .range_words = light_range};
+    .field = BB__FIELD_ANGLES, .offset = AT(render.light_azimuth),
+    .sets = {BB__FIELD_INT, AT(render.dynamic_light), 1, NULL},
+    .range = &bb__range_light_elevation, .range_of = "elevation"};
 
 static const bb__option opt_light_color = {
     .info = {.name = "light-color", .value_name = "R,G,B", .type = BB_OPTION_NUMBERS,
@@ -304,9 +255,9 @@ static const bb__option opt_view = {
              .values = 1, .flags = RECORDED, .default_text = "overhead",
              .help = "a camera at azimuth AZ (as --light's) and elevation EL degrees, the "
                      "surface tiling (270,30: from the bottom, receding up)"},
-    .range = &bb__range_view_elevation, .range_of = "elevation", .set = set_view,
-    .print = print_view,
-    .range_words = view_range};
+    .field = BB__FIELD_ANGLES, .offset = AT(render.view_azimuth),
+    .sets = {BB__FIELD_INT, AT(render.view), 1, NULL},
+    .range = &bb__range_view_elevation, .range_of = "elevation"};
 
 static const bb__option opt_relief = {
     .info = {.name = "relief", .type = BB_OPTION_FLAG, .flags = RECORDED, .default_text = "off",

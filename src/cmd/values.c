@@ -169,8 +169,24 @@ static void set_flag_sets(bb_command *c, const bb__flag_sets *s) {
   case BB__FIELD_STRING: *(const char **)field = s->text; break;
   case BB__FIELD_NONE:
   case BB__FIELD_FLOAT:
-  case BB__FIELD_DOUBLE: break;
+  case BB__FIELD_DOUBLE:
+  case BB__FIELD_ANGLES: break;
   }
+}
+
+/* AZ,EL into the two doubles at the field; the range is the elevation's. */
+static bb_status set_angles(bb_command *c, const bb__option *o, const char *text,
+                            double *values, int *count, bb_error *err) {
+  bb_status st = bb__parse_numbers(o, text, 2, 0, values, err);
+  if (st != BB_OK)
+    return st;
+  double *angles = field_of(c, o);
+  angles[0] = values[0];
+  angles[1] = values[1];
+  set_flag_sets(c, &o->sets);
+  values[0] = values[1];
+  *count = 1;
+  return BB_OK;
 }
 
 bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
@@ -225,8 +241,11 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
     *(const char **)field = kept;
     return BB_OK;
   }
-  case BB_OPTION_WORDS:
   case BB_OPTION_NUMBERS:
+    if (o->field == BB__FIELD_ANGLES)
+      return set_angles(c, o, text, values, count, err);
+    break;
+  case BB_OPTION_WORDS:
     break;
   }
   return bb__fail(err, BB_ERR_ARGUMENT, "%s: no parser", name);
@@ -256,6 +275,13 @@ void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
   case BB__FIELD_ENUM:
     bb__text_add(t, o->names(*(const int *)field));
     return;
+  case BB__FIELD_ANGLES: {
+    char el[48];
+    bb__double_text(((const double *)field)[0], buf, sizeof buf);
+    bb__double_text(((const double *)field)[1], el, sizeof el);
+    bb__text_printf(t, "%s,%s", buf, el);
+    return;
+  }
   case BB__FIELD_NONE:
     return;
   }
