@@ -612,6 +612,11 @@ typedef struct bb_dds_info {
  * BB_ERR_SIZE (zero or over BB_MAX_DIMENSION a side). Nothing to free. */
 bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
 
+/* The name of DDS_PIXELFORMAT flag bit `bit` (0..31) without its DDPF_
+ * prefix ("ALPHAPIXELS", "FOURCC", "RGB", "LUMINANCE"; bit 31 NVIDIA's
+ * "NORMAL"), or NULL for an unused bit or one out of range. */
+const char *bb_dds_pixel_flag_name(int bit);
+
 /* Valve's name of the TEXTUREFLAGS_* bit `bit` (0..31) as Source SDK 2013
  * spells it without the prefix ("CLAMPS", "NORMAL", "SSBUMP"), or NULL for
  * an unused bit or one out of range. */

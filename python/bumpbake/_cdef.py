@@ -134,6 +134,17 @@ typedef struct bb_vtf_info {
   char *description;
 } bb_vtf_info;
 
+typedef struct bb_dds_info {
+  int width, height;
+  int mip_count;
+  char fourcc[5];
+  int dxgi_format;
+  char format_name[32];
+  char compression[8];
+  uint32_t pixel_flags;
+  uint32_t caps2;
+} bb_dds_info;
+
 typedef struct bb_vmt_options {
   const char *materials_dir;
   const char *bumpmap;
@@ -616,6 +627,8 @@ void bb_texture_options_init(bb_texture_options *options);
 int bb_path_is_texture_format(const char *path);
 bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 void bb_vtf_info_free(bb_vtf_info *info);
+bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
+const char *bb_dds_pixel_flag_name(int bit);
 const char *bb_vtf_flag_name(int bit);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);

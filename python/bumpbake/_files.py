@@ -76,6 +76,7 @@ class ImageInfo:
     description: typing.Optional[str]  # the stored text (provenance or another
                                        # tool's ImageDescription), or None
     vtf: typing.Optional["VtfInfo"] = None  # a .vtf's header, else None
+    dds: typing.Optional["DdsInfo"] = None  # a .dds's header, else None
 
 
 @dataclasses.dataclass
@@ -103,13 +104,46 @@ class VtfInfo:
     data_size: int          # bytes of image data the header declares
 
 
+@dataclasses.dataclass
+class DdsInfo:
+    """What a DirectDraw Surface's (.dds) header says (bb_dds_read_info), as
+    `bumpbake info` prints it."""
+    width: int
+    height: int
+    mip_count: int
+    fourcc: typing.Optional[str]  # "DXT1", "ATI2", "DX10"; None: a masked format
+    dxgi_format: int        # the DX10 header's DXGI_FORMAT code, 0 without one
+    format_name: str        # "DXT1", "BC5_UNORM", "R8G8B8A8", ...
+    compression: str        # "BC1" to "BC5", or "none"
+    pixel_flags: int        # DDS_PIXELFORMAT flags
+    pixel_flag_names: list  # the library's names of the bits set: ["FOURCC"], ...
+    caps2: int              # DDSCAPS2 (cube map, volume)
+
+
+def _flag_names(flags, name_of):
+    return [_text(name_of(bit)) for bit in range(32)
+            if flags >> bit & 1 and name_of(bit) != _ffi.NULL]
+
+
+def _dds_info(path):
+    d = _ffi.new("bb_dds_info *")
+    err = _ffi.new("bb_error *")
+    _check(_lib.bb_dds_read_info(path, d, err), err)
+    return DdsInfo(
+        width=d.width, height=d.height, mip_count=d.mip_count,
+        fourcc=_text(d.fourcc) or None, dxgi_format=d.dxgi_format,
+        format_name=_text(d.format_name), compression=_text(d.compression),
+        pixel_flags=d.pixel_flags,
+        pixel_flag_names=_flag_names(d.pixel_flags, _lib.bb_dds_pixel_flag_name),
+        caps2=d.caps2)
+
+
 def _vtf_info(path):
     v = _ffi.new("bb_vtf_info *")
     err = _ffi.new("bb_error *")
     _check(_lib.bb_vtf_read_info(path, v, err), err)
     try:
-        names = [_text(_lib.bb_vtf_flag_name(bit)) for bit in range(32)
-                 if v.flags >> bit & 1 and _lib.bb_vtf_flag_name(bit) != _ffi.NULL]
+        names = _flag_names(v.flags, _lib.bb_vtf_flag_name)
         return VtfInfo(
             version=f"{v.version_major}.{v.version_minor}", header_size=v.header_size,
             width=v.width, height=v.height, depth=v.depth, frames=v.frames,
@@ -127,7 +161,8 @@ def info(path):
     """What an image file is, from its header alone (no pixel is decoded),
     as `bumpbake info` reports it: an ImageInfo; for a Source texture
     (.vtf) also its header's version, format, flags and mips (.vtf, a
-    VtfInfo). Raises Error with the library's message when the file cannot
+    VtfInfo), for a DirectDraw Surface its format and flags (.dds, a
+    DdsInfo). Raises Error with the library's message when the file cannot
     be read."""
     w, h, c = (_ffi.new("int *") for _ in range(3))
     i = _ffi.new("bb_image_info *")
@@ -144,7 +179,8 @@ def info(path):
             bits_per_sample=i.bits_per_sample, is_float=bool(i.is_float),
             alpha_channel=i.alpha_channel, provenance_class=klass,
             provenance=_provenance_dict(description) if klass == "intact" else None,
-            description=description, vtf=_vtf_info(p) if fmt == "vtf" else None)
+            description=description, vtf=_vtf_info(p) if fmt == "vtf" else None,
+            dds=_dds_info(p) if fmt == "dds" else None)
     finally:
         _lib.bb_image_info_free(i)
 

@@ -5,6 +5,8 @@ error (DDS through OpenImageIO, VTF and float DDS through bumpbake's own
 reader), the command line's bytes and up-to-date decisions, and the
 library's refusals."""
 
+import dataclasses
+import json
 import os
 import shutil
 
@@ -138,6 +140,19 @@ def test_dds_read_back_through_openimageio(tmp_path, rock):
     bumpbake.write(path, rock["ao"], kind="ao", texture_format="rgba8")
     codes = np.floor(rock["ao"] * 255 + 0.5)
     assert np.abs(bumpbake.read(path)[..., 0] * 255 - codes).max() < 1e-3
+
+
+@pytest.mark.parametrize("kind, fmt", [("normal", None), ("ao", None),
+                                       ("normal", "rgba8"), ("ssbump", "rgba16f")])
+def test_dds_info_is_what_the_command_line_says(tmp_path, rock, cli, kind, fmt):
+    path = tmp_path / "m.dds"
+    bumpbake.write(path, rock[kind], kind=kind, texture_format=fmt)
+    d = bumpbake.info(path).dds
+    said = json.loads(cli("info", "--json", path).stdout)["dds"]
+    said["format_name"] = said.pop("format")  # as VtfInfo names it
+    assert dataclasses.asdict(d) == {**said, "width": 128, "height": 128}
+    assert d.pixel_flag_names and all(n.isupper() for n in d.pixel_flag_names)
+    assert bumpbake.info(path).vtf is None
 
 
 def test_vtf_and_float_dds_read_back(tmp_path, rock):

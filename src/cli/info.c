@@ -25,35 +25,29 @@ typedef struct file_info {
   bb_dds_info dds; /* when is_dds */
 } file_info;
 
-/* The names of the flags set, "SSBUMP NORMAL" (unnamed bits as hex). */
-static void flag_names(uint32_t flags, char *out, size_t cap) {
+/* The names of the flags set, by the library's name of each bit ("SSBUMP
+ * NORMAL"; unnamed bits as hex). */
+static void flag_names(uint32_t flags, const char *(*name_of)(int bit), char *out, size_t cap) {
   size_t n = 0;
   out[0] = '\0';
   for (int bit = 0; bit < 32 && n < cap; bit++) {
     if (!(flags & (1u << bit)))
       continue;
-    const char *name = bb_vtf_flag_name(bit);
+    const char *name = name_of(bit);
     int w = name ? snprintf(out + n, cap - n, "%s%s", n ? " " : "", name)
                  : snprintf(out + n, cap - n, "%s0x%08x", n ? " " : "", 1u << bit);
     n += w > 0 ? (size_t)w : 0;
   }
 }
 
-/* The names of a DDS pixel format's flags set, "FOURCC NORMAL". */
-static void dds_flag_names(uint32_t flags, char *out, size_t cap) {
-  static const struct {
-    uint32_t bit;
-    const char *name;
-  } names[] = {{0x1u, "ALPHAPIXELS"}, {0x2u, "ALPHA"},       {0x4u, "FOURCC"},
-               {0x40u, "RGB"},        {0x200u, "YUV"},       {0x20000u, "LUMINANCE"},
-               {0x80000000u, "NORMAL"}};
-  size_t n = 0;
-  out[0] = '\0';
-  for (size_t k = 0; k < sizeof names / sizeof names[0] && n < cap; k++)
-    if (flags & names[k].bit) {
-      int w = snprintf(out + n, cap - n, "%s%s", n ? " " : "", names[k].name);
-      n += w > 0 ? (size_t)w : 0;
-    }
+/* The names of the flags set, as a JSON array (unnamed bits left out). */
+static void json_flag_names(bb_json *j, const char *key, uint32_t flags,
+                            const char *(*name_of)(int bit)) {
+  bb_json_open(j, key, '[');
+  for (int bit = 0; bit < 32; bit++)
+    if ((flags & (1u << bit)) && name_of(bit))
+      bb_json_string(j, NULL, name_of(bit));
+  bb_json_close(j, ']');
 }
 
 /* ------------------------------------------------------------------ text */
@@ -78,7 +72,7 @@ static void print_text(const char *path, const file_info *f) {
   if (f->is_vtf) {
     const bb_vtf_info *v = &f->vtf;
     char names[512];
-    flag_names(v->flags, names, sizeof names);
+    flag_names(v->flags, bb_vtf_flag_name, names, sizeof names);
     printf("vtf: version %d.%d, %s, %d mip level%s, flags 0x%08x (%s)\n", v->version_major,
            v->version_minor, v->format_name, v->mip_count, v->mip_count == 1 ? "" : "s",
            (unsigned)v->flags, names[0] ? names : "none");
@@ -91,7 +85,7 @@ static void print_text(const char *path, const file_info *f) {
   if (f->is_dds) {
     const bb_dds_info *d = &f->dds;
     char names[256];
-    dds_flag_names(d->pixel_flags, names, sizeof names);
+    flag_names(d->pixel_flags, bb_dds_pixel_flag_name, names, sizeof names);
     /* "BC1 (FourCC DXT1)", "BC5 (DX10 BC5_UNORM = 83)", "R8G8B8A8, uncompressed" */
     const int blocks = strcmp(d->compression, "none") != 0;
     char what[96];
@@ -167,11 +161,7 @@ static void print_json(const char *path, const file_info *f) {
     bb_json_int(&j, "format_code", v->format);
     bb_json_int(&j, "mip_count", v->mip_count);
     bb_json_int(&j, "flags", (long)v->flags);
-    bb_json_open(&j, "flag_names", '[');
-    for (int bit = 0; bit < 32; bit++)
-      if ((v->flags & (1u << bit)) && bb_vtf_flag_name(bit))
-        bb_json_string(&j, NULL, bb_vtf_flag_name(bit));
-    bb_json_close(&j, ']');
+    json_flag_names(&j, "flag_names", v->flags, bb_vtf_flag_name);
     bb_json_int(&j, "low_res_width", v->low_res_width);
     bb_json_int(&j, "low_res_height", v->low_res_height);
     bb_json_int(&j, "frames", v->frames);
@@ -179,8 +169,6 @@ static void print_json(const char *path, const file_info *f) {
   }
   if (f->is_dds) {
     const bb_dds_info *d = &f->dds;
-    char names[256];
-    dds_flag_names(d->pixel_flags, names, sizeof names);
     bb_json_open(&j, "dds", '{');
     bb_json_string(&j, "format", d->format_name);
     bb_json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
@@ -188,15 +176,7 @@ static void print_json(const char *path, const file_info *f) {
     bb_json_string(&j, "compression", d->compression);
     bb_json_int(&j, "mip_count", d->mip_count);
     bb_json_int(&j, "pixel_flags", (long)d->pixel_flags);
-    bb_json_open(&j, "pixel_flag_names", '[');
-    for (const char *p = names; *p;) {
-      const size_t n = strcspn(p, " ");
-      char one[32];
-      snprintf(one, sizeof one, "%.*s", (int)n, p);
-      bb_json_string(&j, NULL, one);
-      p += n + (p[n] == ' ');
-    }
-    bb_json_close(&j, ']');
+    json_flag_names(&j, "pixel_flag_names", d->pixel_flags, bb_dds_pixel_flag_name);
     bb_json_int(&j, "caps2", (long)d->caps2);
     bb_json_close(&j, '}');
   }

@@ -291,3 +291,17 @@ bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
            f->kind == BB__TEXELS_BLOCKS ? blocks[f->block] : "none");
   return BB_OK;
 }
+
+const char *bb_dds_pixel_flag_name(int bit) {
+  /* Microsoft's DDS_PIXELFORMAT dwFlags (DDPF_*), and NVIDIA's normal-map bit. */
+  switch (bit) {
+  case 0: return "ALPHAPIXELS";
+  case 1: return "ALPHA";
+  case 2: return "FOURCC";
+  case 6: return "RGB";
+  case 9: return "YUV";
+  case 17: return "LUMINANCE";
+  case 31: return "NORMAL";
+  default: return NULL;
+  }
+}
