@@ -2201,8 +2201,14 @@ bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
 int bb_same_file(const char *a, const char *b);
 
 /* path without the extension of its last component, plus suffix ("rock.png",
- * "-ssbump.tga" -> "rock-ssbump.tga"), malloc'd; NULL when out of memory. */
+ * "-ssbump.tga" -> "rock-ssbump.tga"; a name's leading dot starts no
+ * extension), malloc'd; NULL when out of memory. */
 char *bb_path_with_suffix(const char *path, const char *suffix);
+
+/* The file -o PREFIX (bb_job_options.prefix) names for kind:
+ * "PREFIX_KIND.png" for the kinds of BB_JOB_DEFAULT_MAPS, malloc'd; NULL for
+ * another kind, a NULL prefix or out of memory. */
+char *bb_job_prefix_path(const char *prefix, bb_map_kind kind);
 
 /* Creates directory path and its missing parents (mode 0777 less the
  * umask), as mkdir -p. An existing directory is fine. Errors: BB_ERR_IO

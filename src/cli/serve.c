@@ -13,36 +13,26 @@
 #include <string.h>
 #include <unistd.h>
 
-/* The write action's files: as bake's -o PREFIX names them, spelled out
- * one by one (--normal P_normal.png ...) so that the command line the page
- * shows is the whole job; PREFIX defaults to HEIGHT without its extension. */
+/* The write action's files: as bake's -o PREFIX names them
+ * (bb_job_prefix_path), spelled out one by one (--normal P_normal.png ...)
+ * so that the command line the page shows is the whole job; PREFIX
+ * defaults to HEIGHT without its extension. */
 static int name_outputs(bb_job_options *job, const char *height) {
-  char prefix[PATH_MAX];
-  if (job->prefix) {
-    snprintf(prefix, sizeof prefix, "%s", job->prefix);
-  } else {
-    snprintf(prefix, sizeof prefix, "%s", height);
-    char *dot = strrchr(prefix, '.'), *slash = strrchr(prefix, '/');
-    if (dot && (!slash || dot > slash + 1))
-      *dot = '\0';
-  }
   int named = 0;
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     named |= job->paths[k] != NULL;
   if (named && !job->prefix)
     return 0; /* the outputs the command line named, and only those */
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    if (!(BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k)) || job->paths[k])
-      continue;
-    size_t n = strlen(prefix) + 32;
-    char *path = malloc(n); /* lives as long as the process */
-    if (!path)
-      return -1;
-    snprintf(path, n, "%s_%s.png", prefix, bb_map_kind_get((bb_map_kind)k)->name);
-    job->paths[k] = path;
-  }
+  char *stem = job->prefix ? NULL : bb_path_with_suffix(height, "");
+  const char *prefix = job->prefix ? job->prefix : stem;
+  int rc = prefix ? 0 : -1;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT && rc == 0; k++)
+    if ((BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k)) && !job->paths[k] &&
+        !(job->paths[k] = bb_job_prefix_path(prefix, (bb_map_kind)k))) /* kept */
+      rc = -1;
+  free(stem);
   job->prefix = NULL;
-  return 0;
+  return rc;
 }
 
 int cli_run_serve(const cli_run *r) {

@@ -34,13 +34,26 @@ void bb__directory_part(const char *path, char *dir, size_t cap) {
 char *bb_path_with_suffix(const char *path, const char *suffix) {
   if (!path || !suffix)
     return NULL;
-  const char *dot = strrchr(bb__file_name(path), '.');
-  size_t stem = dot ? (size_t)(dot - path) : strlen(path);
+  /* a dot that begins the name (".png") starts no extension, as
+   * Python's os.path.splitext has it */
+  const char *name = bb__file_name(path), *dot = strrchr(name, '.');
+  size_t stem = dot && dot > name ? (size_t)(dot - path) : strlen(path);
   size_t len = stem + strlen(suffix) + 1;
   char *out = malloc(len);
   if (out)
     snprintf(out, len, "%.*s%s", (int)stem, path, suffix);
   return out;
+}
+
+char *bb_job_prefix_path(const char *prefix, bb_map_kind kind) {
+  if (!prefix || (unsigned)kind >= BB_MAP_BAKED_COUNT || !(BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(kind)))
+    return NULL;
+  const char *name = bb_map_kind_get(kind)->name;
+  const size_t len = strlen(prefix) + strlen(name) + sizeof "_.png";
+  char *path = malloc(len);
+  if (path)
+    snprintf(path, len, "%s_%s.png", prefix, name);
+  return path;
 }
 
 /* Valve's normal2ssbump output name: the input up to its first "_normal"

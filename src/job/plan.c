@@ -702,10 +702,8 @@ static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err
       if (!(item->paths[k] = strdup(o->paths[k])))
         return bb__fail(err, BB_ERR_MEMORY, "out of memory");
     } else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k))) {
-      const size_t len = strlen(o->prefix) + strlen(kind_name(k)) + sizeof "_.png";
-      if (!(item->paths[k] = malloc(len)))
+      if (!(item->paths[k] = bb_job_prefix_path(o->prefix, (bb_map_kind)k)))
         return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-      snprintf(item->paths[k], len, "%s_%s.png", o->prefix, kind_name(k));
     }
   }
   if (o->slope_path && o->slope_lit) {

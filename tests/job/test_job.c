@@ -299,3 +299,33 @@ Test(job, bake_item_cancelled_keeps_nothing) {
   cr_expect_eq(bb_job_bake_item(job, 1, 0u, NULL, NULL, &kept, &err), BB_ERR_ARGUMENT);
   bb_job_free(job);
 }
+
+/* -o PREFIX's names, one rule for bake and serve; a name's leading dot is
+ * no extension (as Python's os.path.splitext). */
+Test(job, prefix_and_suffix_names) {
+  static const struct {
+    bb_map_kind kind;
+    const char *want; /* NULL: -o does not write it */
+  } cases[] = {{BB_MAP_NORMAL, "out/r_normal.png"}, {BB_MAP_SSBUMP, "out/r_ssbump.png"},
+               {BB_MAP_AO, "out/r_ao.png"},         {BB_MAP_BENT, NULL},
+               {BB_MAP_FILTERED, NULL},             {BB_MAP_SLOPE, NULL}};
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    char *got = bb_job_prefix_path("out/r", cases[i].kind);
+    if (cases[i].want)
+      cr_expect_str_eq(got ? got : "(null)", cases[i].want);
+    else
+      cr_expect_null(got, "kind %d", (int)cases[i].kind);
+    free(got);
+  }
+  cr_expect_null(bb_job_prefix_path(NULL, BB_MAP_NORMAL));
+  static const char *const suffixed[][3] = {{"rock.png", "-ssbump.tga", "rock-ssbump.tga"},
+                                            {"a.b/rock", "_x", "a.b/rock_x"},
+                                            {"d/.png", "", "d/.png"},
+                                            {"d/.hidden.png", "", "d/.hidden"},
+                                            {"rock.tar.png", "", "rock.tar"}};
+  for (size_t i = 0; i < sizeof suffixed / sizeof suffixed[0]; i++) {
+    char *got = bb_path_with_suffix(suffixed[i][0], suffixed[i][1]);
+    cr_expect_str_eq(got ? got : "(null)", suffixed[i][2], "%s", suffixed[i][0]);
+    free(got);
+  }
+}
