@@ -66,34 +66,44 @@ static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_close(j, '}');
 }
 
-char *serve_state_json(serve_state *s) {
+/* The JSON text write(j, arg) makes, malloc'd; NULL when out of memory. */
+static char *json_text(void (*write)(bb_json *j, void *arg), void *arg) {
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return NULL;
   bb_json j = {f, 0};
-  pthread_mutex_lock(&s->lock);
-  bb_job_options o;
-  serve_job_options(s, &o);
-  char *command = bb_job_command_text(&o, s->height_path);
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "height", s->height_path);
-  bb_json_bool(&j, "baking", s->baking);
-  bb_json_number(&j, "progress", s->progress);
-  bb_json_string(&j, "error", s->error);
-  bb_json_string(&j, "command", command);
-  add_params(&j, s);
-  if (s->current)
-    add_bake(&j, s->current);
-  bb_json_close(&j, '}');
-  pthread_mutex_unlock(&s->lock);
-  free(command);
+  write(&j, arg);
   if (fclose(f) != 0) {
     free(text);
     return NULL;
   }
   return text;
+}
+
+static void write_state(bb_json *j, void *arg) {
+  serve_state *s = arg;
+  pthread_mutex_lock(&s->lock);
+  bb_job_options o;
+  serve_job_options(s, &o);
+  char *command = bb_job_command_text(&o, s->height_path);
+  bb_json_open(j, NULL, '{');
+  bb_json_string(j, "height", s->height_path);
+  bb_json_bool(j, "baking", s->baking);
+  bb_json_number(j, "progress", s->progress);
+  bb_json_string(j, "error", s->error);
+  bb_json_string(j, "command", command);
+  add_params(j, s);
+  if (s->current)
+    add_bake(j, s->current);
+  bb_json_close(j, '}');
+  pthread_mutex_unlock(&s->lock);
+  free(command);
+}
+
+char *serve_state_json(serve_state *s) {
+  return json_text(write_state, s);
 }
 
 /* --------------------------------------------------------------- controls */
@@ -197,25 +207,19 @@ static void add_range(bb_json *j, const char *key, const char *command,
   bb_json_close(j, '}');
 }
 
-char *serve_ranges_json(void) {
-  char *text = NULL;
-  size_t size = 0;
-  FILE *f = open_memstream(&text, &size);
-  if (!f)
-    return NULL;
-  bb_json j = {f, 0};
-  bb_json_open(&j, NULL, '{');
+static void write_ranges(bb_json *j, void *arg) {
+  (void)arg;
+  bb_json_open(j, NULL, '{');
   /* the bake controls: bake's options of their names */
   for (size_t i = 0; i < CONTROL_COUNT; i++)
-    add_range(&j, controls[i].name, "bake", controls[i].name);
+    add_range(j, controls[i].name, "bake", controls[i].name);
   /* the picture's camera and light, as render's --view AZ,EL and --light
    * AZ,EL take them: their range is the elevation's ("range EL 1..90") */
-  add_range(&j, "view_elevation", "render", "view");
-  add_range(&j, "light_elevation", "render", "light");
-  bb_json_close(&j, '}');
-  if (fclose(f) != 0) {
-    free(text);
-    return NULL;
-  }
-  return text;
+  add_range(j, "view_elevation", "render", "view");
+  add_range(j, "light_elevation", "render", "light");
+  bb_json_close(j, '}');
+}
+
+char *serve_ranges_json(void) {
+  return json_text(write_ranges, NULL);
 }
