@@ -538,14 +538,17 @@ int bb_path_is_texture_format(const char *path);
 bb_status bb_texture_check(const char *path, int width, int height, int channels,
                            const bb_texture_options *options, bb_error *err);
 
-/* Sets options->map for a file of an output kind: SSBUMP for the kinds
- * "ssbump", "ssbump+...", "detail-ssbump..." and "weights" (normal2ssbump's,
- * an ssbump without shadows, which Source loads the same way); NORMAL for
- * an image of BB_RANGE_SIGNED (normal and bent normal maps); PLAIN for the
- * rest, with BB_VTF_FLAG_NORMAL added for a normal map already packed into
- * [0, 1] (the kinds "normal+...", height2ssbump -n's). bb_outputs_write
- * applies it to every .vtf and .dds it writes, bb_outputs_check to every
- * one it checks. */
+/* Sets options->map for a file of an output kind (a kind string as
+ * bb_output_file's: NAME or NAME+EXTRA, a NAME map with EXTRA in its last
+ * channel, "ssbump+height") holding values of range: the kind NAME names
+ * (bb_map_kind_info.name, or "detail-ssbump", an ssbump), whose facts then
+ * decide its mip rule, DDS default and VTF flags; except that a normal or
+ * bent map not of BB_RANGE_SIGNED was packed into [0, 1] already ("normal+ao",
+ * height2ssbump -n's): PLAIN, with the kind's BB_VTF_FLAG_NORMAL added to
+ * options->vtf_flags. Any other kind ("height", "colour", "render", ...):
+ * NORMAL for BB_RANGE_SIGNED values, else PLAIN. bb_outputs_write applies
+ * it to every .vtf and .dds it writes, bb_outputs_check to every one it
+ * checks. */
 void bb_texture_options_for(bb_texture_options *options, const char *kind, bb_range range);
 
 /* The "key=value" lines bb_image_write adds to a texture's provenance, so

@@ -3,7 +3,8 @@
 // bake ("map/NAME": 8-bit RGBA, X-Bake-Id saying which bake), draws them
 // with WebGL 2 (serve.frag.glsl after shaders/ssbump_relief.glsl), relights
 // as the light is dragged, and sends the controls ("params") and the write
-// action ("write"). Once a bake's maps are drawn, <body data-drawn-bake>
+// action ("write"). The inputs' ranges are the library's ("ranges": the
+// options' descriptions), none of the page's own. Once a bake's maps are drawn, <body data-drawn-bake>
 // holds its id and data-drawn-at the time (Date.now()), for tests.
 "use strict";
 
@@ -20,12 +21,20 @@ let drawPending = false;
 const bakeScale = {};      // each bake's --scale by id: the depth of its relief
 const bakeBasis = {};      // each bake's basis directions by id: the ssbump's lighting
 const SSBUMP_MODES = [0, 8];  // the modes that light the ssbump with the basis
+let ranges = {};          // the server's "ranges": {name: {min, max, min_exclusive}}
 
 function fail(message) {
   $("error").textContent = message;
 }
 
 // -------------------------------------------------------------- the light
+
+// v within range r ({min, max}, either missing: no bound).
+function clamp(v, r) {
+  if (r && r.max !== undefined) v = Math.min(r.max, v);
+  if (r && r.min !== undefined) v = Math.max(r.min, v);
+  return v;
+}
 
 // bb_light_direction: azimuth 0 from the right, 90 from the top; +y is down.
 function direction(azimuthDeg, elevationDeg) {
@@ -46,7 +55,7 @@ function dragLight(event) {
   const dy = 1 - (event.clientY - r.top) / r.height * 2;
   const radius = Math.min(1, Math.hypot(dx, dy));
   light.azimuth = (Math.atan2(dy, dx) * 180 / Math.PI + 360) % 360;
-  light.elevation = Math.max(1, Math.acos(radius) * 180 / Math.PI);
+  light.elevation = clamp(Math.acos(radius) * 180 / Math.PI, ranges.light_elevation);
   showLight();
   requestDraw();
 }
@@ -72,8 +81,11 @@ function compile(type, source) {
 
 async function setup() {
   if (!gl) throw new Error("this browser has no WebGL 2");
-  const [relief, frag] = await Promise.all(
-    ["ssbump_relief.glsl", "serve.frag.glsl"].map((f) => fetch(f).then((r) => r.text())));
+  const [relief, frag, got] = await Promise.all(
+    ["ssbump_relief.glsl", "serve.frag.glsl", "ranges"].map((f) => fetch(f).then(
+      (r) => f === "ranges" ? r.json() : r.text())));
+  ranges = got;
+  showRanges();
   const vs = "#version 300 es\nin vec2 aPos;\nvoid main() { gl_Position = vec4(aPos, 0.0, 1.0); }\n";
   const fs = "#version 300 es\nprecision highp float;\nprecision highp int;\n" +
              "precision highp sampler2D;\n" + relief + "\n" + frag;
@@ -210,7 +222,7 @@ function draw() {
   gl.uniform3fv(uniforms.uLight, direction(light.azimuth, light.elevation));
   gl.uniform1f(uniforms.uNormalYUp, state && state.bake && state.bake.normal_y_up ? 1 : 0);
   // render's camera (job_init): towards it, the screen's right, the stretch
-  const el = Math.min(90, Math.max(1, Number($("view-el").value) || 30));
+  const el = clamp(Number($("view-el").value) || 30, ranges.view_elevation);
   const view = direction(Number($("view-az").value) || 0, el);
   let toward = [view[0], view[1]];
   const horizontal = Math.hypot(view[0], view[1]);
@@ -244,6 +256,22 @@ window.bbCanvasStats = function () {
 // ---------------------------------------------------------------- state
 
 const PARAMS = ["scale", "rays", "slices", "bias", "bounce", "bounces"];
+
+// The library's range of an input as its min and max: a bottom the range
+// leaves out ("scale > 0") is no HTML min, which would let it in.
+function bound(input, r) {
+  if (!r) return;
+  if (r.min !== undefined && !r.min_exclusive) input.min = String(r.min);
+  if (r.max !== undefined) input.max = String(r.max);
+}
+
+function showRanges() {
+  for (const p of PARAMS) {
+    // slices 0 is "from rays" (a bake's slices 0), below --slices's range
+    bound($("p-" + p), p === "slices" ? { max: ranges[p] && ranges[p].max } : ranges[p]);
+  }
+  bound($("view-el"), ranges.view_elevation);
+}
 
 function showState(s) {
   state = s;

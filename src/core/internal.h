@@ -34,6 +34,29 @@ bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_er
 bb_status bb__parse_name(const char *what, const char *name, const char *const *names,
                          int count, int ignore_case, int *index, bb_error *err);
 
+/* -------------------------------------------------------- map kinds */
+
+/* The map kind of an output's kind string (bb_output_file.kind,
+ * bb_output_spec.kind), whose facts (bb_map_kind_info: mip rule, DDS
+ * default, VTF flags) a texture of it takes; the one place such strings
+ * are read. A kind string is NAME or NAME+EXTRA, a NAME map with EXTRA in
+ * its last channel (Valve's "ssbump+height", "ssbump+ao", "normal+height",
+ * "normal+ao", "detail-ssbump+height", "detail-ssbump+ao"; renderbumpflat's
+ * "normal+coverage"). NAME is a kind's name ("normal", "weights",
+ * "ssbump", ...), or "detail-ssbump" (height2ssbump -d: an ssbump). Then:
+ *   - the kind NAME names, when range is its own, or it does not hold unit
+ *     vectors (an ssbump with a height in alpha is still an ssbump);
+ *   - PLAIN for a unit-vector kind (normal, bent) of another range: its
+ *     vectors were packed into [0, 1] already (0.5 + 0.5 N, height2ssbump
+ *     -n's), codes to average, not vectors to renormalise; the kind's VTF
+ *     flag (NORMAL) is added to *vtf_flags (when not NULL);
+ *   - any other kind ("height", "colour", "render", "comparison", "sheet",
+ *     "diff", "slope_lit", "material", NULL ...) has no map of its own:
+ *     NORMAL for BB_RANGE_SIGNED values (bumpbake's signed images are unit
+ *     vectors), else PLAIN.
+ * Names are compared exactly, as the library spells them. */
+bb_map_kind bb__map_kind_of_output(const char *kind, bb_range range, uint32_t *vtf_flags);
+
 /* ----------------------------------------------------------------- ranges */
 
 /* The range of one parameter, written once where the parameter's struct

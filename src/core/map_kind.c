@@ -3,6 +3,8 @@
  * mip rule and VTF flags, the files a render reads, combine's channels). */
 #include "core/internal.h"
 
+#include <string.h>
+
 /* In bb_map_kind order. */
 static const bb_map_kind_info kinds[BB_MAP_KIND_COUNT] = {
     [BB_MAP_NORMAL] = {"normal", "the unit normal N", 3, 3, BB_RANGE_SIGNED, 0, 1,
@@ -41,4 +43,44 @@ bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
 const char *bb_map_kind_name(bb_map_kind kind) {
   const bb_map_kind_info *k = bb_map_kind_get(kind);
   return k ? k->name : "unknown";
+}
+
+/* --------------------------------------------------- an output's kind */
+
+/* First parts of output kind strings that are not a kind's name, and the
+ * kind they are: Valve's height2ssbump -d writes a detail ssbump (the
+ * ssbump times the input's colour), stored as an ssbump. */
+static const struct {
+  const char *name;
+  bb_map_kind kind;
+} aliases[] = {{"detail-ssbump", BB_MAP_SSBUMP}};
+
+/* The kind named by the first n characters of text (exactly, as the
+ * library spells its kinds), or -1. */
+static int kind_named(const char *text, size_t n) {
+  for (int k = 0; k < BB_MAP_KIND_COUNT; k++)
+    if (strlen(kinds[k].name) == n && strncmp(text, kinds[k].name, n) == 0)
+      return k;
+  for (size_t i = 0; i < sizeof aliases / sizeof aliases[0]; i++)
+    if (strlen(aliases[i].name) == n && strncmp(text, aliases[i].name, n) == 0)
+      return (int)aliases[i].kind;
+  return -1;
+}
+
+bb_map_kind bb__map_kind_of_output(const char *kind, bb_range range,
+                                   uint32_t *vtf_flags) {
+  const char *text = kind ? kind : "";
+  const char *plus = strchr(text, '+');
+  const int k = kind_named(text, plus ? (size_t)(plus - text) : strlen(text));
+  if (k < 0) /* no kind of its own: signed values are unit vectors */
+    return range == BB_RANGE_SIGNED ? BB_MAP_NORMAL : BB_MAP_PLAIN;
+  const bb_map_kind_info *info = &kinds[k];
+  if (info->unit_vectors && range != info->range) {
+    /* the vectors were packed into [0, 1] already (0.5 + 0.5 N): codes to
+     * average and store as they are, in a texture flagged as the kind's */
+    if (vtf_flags)
+      *vtf_flags |= info->vtf_flags;
+    return BB_MAP_PLAIN;
+  }
+  return (bb_map_kind)k;
 }

@@ -442,25 +442,11 @@ bb_status bb__texture_encode(const bb_image *level, bb_map_kind map,
 
 /* ----------------------------------------------------- maps, provenance */
 
-/* 1 when kind is name or starts with name and '+' ("ssbump+height"). */
-static int kind_is(const char *kind, const char *name) {
-  const size_t n = strlen(name);
-  return strncmp(kind, name, n) == 0 && (kind[n] == '\0' || kind[n] == '+');
-}
-
+/* The map of an output kind string, as the library reads every one
+ * (bb__map_kind_of_output: core/map_kind.c). */
 void bb_texture_options_for(bb_texture_options *o, const char *kind, bb_range range) {
-  if (!o)
-    return;
-  const char *k = kind ? kind : "";
-  if (kind_is(k, "ssbump") || kind_is(k, "detail-ssbump") || kind_is(k, "weights")) {
-    o->map = BB_MAP_SSBUMP;
-  } else if (range == BB_RANGE_SIGNED) {
-    o->map = BB_MAP_NORMAL;
-  } else {
-    o->map = BB_MAP_PLAIN;
-    if (strncmp(k, "normal+", 7) == 0) /* packed already: flagged, not re-packed */
-      o->vtf_flags |= BB_VTF_FLAG_NORMAL;
-  }
+  if (o)
+    o->map = bb__map_kind_of_output(kind, range, &o->vtf_flags);
 }
 
 char *bb_texture_provenance(const char *path, const bb_texture_options *options) {

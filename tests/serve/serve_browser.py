@@ -94,3 +94,33 @@ def save_by_rename(source_bytes, path):
     with open(tmp, "wb") as f:
         f.write(source_bytes)
     os.rename(tmp, path)
+
+
+def _bounds(text):
+    """{"min", "max", "min_exclusive"} of a range as help prints it (the
+    library's bb_option_range_text: "1..65536", "> 0", ">= 0", "EL 0..90")."""
+    text = re.sub(r"^[A-Z]+ ", "", text.strip())
+    m = re.fullmatch(r"(-?[\d.e+-]+)\.\.(-?[\d.e+-]+)", text)
+    if m:
+        return {"min": float(m.group(1)), "max": float(m.group(2)), "min_exclusive": False}
+    m = re.fullmatch(r"(>=?) (-?[\d.e+-]+)", text)
+    if m:
+        return {"min": float(m.group(2)), "min_exclusive": m.group(1) == ">"}
+    raise ValueError("a range help does not print: %r" % text)
+
+
+def library_ranges(binary):
+    """The ranges of the page's inputs as `bumpbake bake --help` and
+    `bumpbake render --help` print them: the library's words, read apart
+    from the server's "ranges"."""
+    found = {}
+    for command, names in (("bake", {n: n for n in ("scale", "rays", "slices", "bias",
+                                                   "bounce", "bounces")}),
+                           ("render", {"view": "view_elevation", "light": "light_elevation"})):
+        text = subprocess.run([binary, command, "--help"], capture_output=True, text=True,
+                              check=True).stdout
+        for line in text.splitlines():
+            m = re.match(r"\s+(?:-\w, )?--([\w-]+) .*; range (.*)$", line)
+            if m and m.group(1) in names:
+                found[names[m.group(1)]] = _bounds(m.group(2))
+    return found

@@ -73,6 +73,54 @@ def test_page_draws_the_ssbump(page):
     shot(page, "1-ssbump")
 
 
+FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
+
+
+def test_the_inputs_carry_the_librarys_ranges(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    library = sb.library_ranges(BIN)
+    got = page.execute_script(
+        "return Object.fromEntries([...document.querySelectorAll('input[type=number]')]"
+        ".map((i) => [i.id, [i.min, i.max]]))")
+    inputs = {"p-" + p: p for p in ("scale", "rays", "slices", "bias", "bounce", "bounces")}
+    inputs["view-el"] = "view_elevation"
+    for element, name in inputs.items():
+        want = library[name]
+        low, high = got[element]
+        # an excluded bottom ("scale > 0") is no HTML min, which would admit
+        # it; slices 0 is "from rays", below --slices's 1..256
+        if want["min_exclusive"] or name == "slices":
+            assert low == "", (element, low)
+        else:
+            assert float(low) == want["min"], (element, low, want)
+        if "max" in want:
+            assert float(high) == want["max"], (element, high, want)
+        else:
+            assert high == "" or float(high) >= FLOAT_MAX, (element, high)
+    assert got["view-az"] == ["", ""]  # any azimuth
+    # the light dragged past the rim stops at the library's lowest elevation,
+    # at the centre it is overhead
+    light = library["light_elevation"]
+    edges = page.execute_script(
+        "const r = canvas.getBoundingClientRect(), y = r.top + r.height / 2;"
+        "dragLight({clientX: r.right + 100, clientY: y}); const low = light.elevation;"
+        "dragLight({clientX: r.left + r.width / 2, clientY: y}); const high = light.elevation;"
+        "dragLight({clientX: r.right + 100, clientY: y}); draw(); return [low, high];")
+    assert edges == [light["min"], light["max"]], edges
+    assert page.find_element("id", "light-text").text == "0,%d" % light["min"]
+    shot(page, "1b-light-at-the-rim")  # grazing: the relief's long shadows
+    page.execute_script("light.azimuth = 135; light.elevation = 45; showLight(); draw();")
+    # a view below the library's lowest elevation is drawn at it (relief)
+    view = library["view_elevation"]
+    pictures = page.execute_script(
+        "const el = document.getElementById('view-el'), mode = document.getElementById('mode');"
+        "mode.value = '8'; const out = [];"
+        "for (const v of [arguments[0], arguments[0] - 20, arguments[0] + 10]) {"
+        "  el.value = String(v); draw(); out.push(bbCanvasStats().hash); }"
+        "el.value = '30'; mode.value = '0'; draw(); return out;", view["min"])
+    assert pictures[0] == pictures[1] != pictures[2], pictures
+
+
 def test_dragging_the_light_relights(page):
     from selenium.webdriver.common.action_chains import ActionChains
 

@@ -6,6 +6,7 @@ make test runs (no Chromium needed)."""
 import http.client
 import json
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -96,6 +97,36 @@ def test_the_server_refuses(served):
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?path=/etc/passwd")
     assert status == 400 and "unknown control" in json.loads(body)["error"]
     assert sorted(os.listdir(d)) == ["h.png"]  # nothing written unless asked
+
+
+FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
+
+
+def test_the_page_takes_its_ranges_from_the_library(served):
+    s, _ = served
+    status, body = request(s.url, path="ranges")
+    assert status == 200
+    served_ranges = json.loads(body)
+    library = sb.library_ranges(BIN)
+    assert sorted(served_ranges) == sorted(library) == sorted(
+        ["scale", "rays", "slices", "bias", "bounce", "bounces", "view_elevation",
+         "light_elevation"])
+    for name, want in library.items():
+        got = served_ranges[name]
+        assert got["min"] == want["min"] and got["min_exclusive"] == want["min_exclusive"], name
+        if "max" in want:
+            assert got["max"] == want["max"], name
+        else:
+            assert got.get("max", FLOAT_MAX) >= FLOAT_MAX, name
+    # the page's files say none of their own (the progress bar's max is a fraction)
+    status, html = request(s.url, path="index.html")
+    assert status == 200
+    inputs = re.findall(r"<input[^>]*>", html.decode())
+    assert inputs and not [i for i in inputs if re.search(r"\b(min|max)=", i)], inputs
+    status, js = request(s.url, path="serve.js")
+    assert status == 200
+    code = re.sub(r"//.*", "", js.decode())  # the comments may say "90 = overhead"
+    assert not re.search(r"\b90\b", code), "an elevation's top in serve.js"
 
 
 def test_with_address_every_path_needs_the_token(tmp_path):

@@ -281,6 +281,68 @@ Test(vtf, flags_from_the_map_and_the_caller) {
   scratch_dir_remove();
 }
 
+/* Every kind string the commands, the job and Python write a texture of
+ * takes its map from the kind's own facts (bb_map_kind_info); Valve's
+ * composites and the kinds of no map are resolved as bb_texture_options_for
+ * says, the caller's own flags kept. */
+Test(vtf, the_map_of_every_output_kind) {
+  const uint32_t N = BB_VTF_FLAG_NORMAL;
+  const struct {
+    const char *kind;
+    bb_range range;
+    bb_map_kind map;
+    uint32_t added;
+  } cases[] = {
+      /* the maps a bake writes, by their names */
+      {"normal", BB_RANGE_SIGNED, BB_MAP_NORMAL, 0},
+      {"weights", BB_RANGE_UNIT, BB_MAP_WEIGHTS, 0},
+      {"ssbump", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      {"ao", BB_RANGE_UNIT, BB_MAP_AO, 0},
+      {"bent", BB_RANGE_SIGNED, BB_MAP_BENT, 0},
+      {"filtered", BB_RANGE_UNIT, BB_MAP_FILTERED, 0},
+      {"slope", BB_RANGE_UNIT, BB_MAP_SLOPE, 0},
+      {"plain", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      /* Valve's height2ssbump: the map, and its alpha */
+      {"ssbump+height", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      {"ssbump+ao", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      {"detail-ssbump+height", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      {"detail-ssbump+ao", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      {"detail-ssbump", BB_RANGE_UNIT, BB_MAP_SSBUMP, 0},
+      /* normals packed into [0, 1] already: codes, flagged */
+      {"normal+height", BB_RANGE_UNIT, BB_MAP_PLAIN, N},
+      {"normal+ao", BB_RANGE_UNIT, BB_MAP_PLAIN, N},
+      {"normal+coverage", BB_RANGE_UNIT, BB_MAP_PLAIN, N},
+      {"normal", BB_RANGE_UNIT, BB_MAP_PLAIN, N},
+      {"bent", BB_RANGE_UNIT, BB_MAP_PLAIN, N},
+      {"normal+coverage", BB_RANGE_SIGNED, BB_MAP_NORMAL, 0},
+      /* no map of their own: by their values */
+      {"height", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"colour", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"render", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"comparison", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"sheet", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"diff", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"slope_lit", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"ssbumps", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"", BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {NULL, BB_RANGE_UNIT, BB_MAP_PLAIN, 0},
+      {"colour", BB_RANGE_SIGNED, BB_MAP_NORMAL, 0},
+      {NULL, BB_RANGE_SIGNED, BB_MAP_NORMAL, 0},
+  };
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.vtf_flags = 0x4u; /* the caller's: kept */
+    bb_texture_options_for(&o, cases[c].kind, cases[c].range);
+    cr_assert_eq(o.map, cases[c].map, "%s: map %s, want %s",
+                 cases[c].kind ? cases[c].kind : "NULL", bb_map_kind_name(o.map),
+                 bb_map_kind_name(cases[c].map));
+    cr_assert_eq(o.vtf_flags, 0x4u | cases[c].added, "%s: flags 0x%x",
+                 cases[c].kind ? cases[c].kind : "NULL", (unsigned)o.vtf_flags);
+  }
+  bb_texture_options_for(NULL, "normal", BB_RANGE_SIGNED); /* no options: nothing */
+}
+
 /* binary16 to float, from IEEE 754 (not Imath's). */
 static float half_to_float(unsigned h) {
   const int e = (h >> 10) & 31, m = h & 1023;

@@ -105,6 +105,11 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
 
 /* serve_params.c: the state as one JSON object (malloc'd), as the page reads it. */
 char *serve_state_json(serve_state *s);
+/* serve_params.c: the ranges of the page's inputs (JSON, malloc'd): each
+ * bake control's ("scale", "rays", "slices", "bias", "bounce", "bounces"),
+ * "view_elevation" and "light_elevation", as {"min", "max", "min_exclusive"}
+ * from the library's descriptions of the options (bb_option_bounds). */
+char *serve_ranges_json(void);
 /* serve_params.c: applies the page's control values (name=value pairs:
  * scale, rays, slices, bias, bounce, bounces, brightness) to the state,
  * all or none, after the library's checks; 0, or -1 with the library's

@@ -1,12 +1,13 @@
 /* serve_http.c: `bumpbake serve`'s HTTP side, on libmicrohttpd (a thread
  * per connection): the page and its scripts, the state as JSON and as
- * server-sent events, the textures of the last good bake as raw 8-bit
- * RGBA, the controls and the "write" action. Every path is one of a fixed
- * few: no part of a request names a file. Requests must come for the host
- * they were served as (a page elsewhere cannot rebind a name to us), and
- * those that change something must carry an X-Bumpbake header (which a
- * page of another origin cannot send without asking first); with
- * --address, every path also starts with a random token. */
+ * server-sent events, the ranges of the page's inputs (the library's), the
+ * textures of the last good bake as raw 8-bit RGBA, the controls and the
+ * "write" action. Every path is one of a fixed few: no part of a request
+ * names a file. Requests must come for the host they were served as (a page
+ * elsewhere cannot rebind a name to us), and those that change something
+ * must carry an X-Bumpbake header (which a page of another origin cannot
+ * send without asking first); with --address, every path also starts with
+ * a random token. */
 #include "serve.h"
 
 #include <arpa/inet.h>
@@ -395,6 +396,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
   }
   if (!strcmp(path, "state"))
     return send_json(c, MHD_HTTP_OK, serve_state_json(sv->s));
+  if (!strcmp(path, "ranges"))
+    return send_json(c, MHD_HTTP_OK, serve_ranges_json());
   if (!strcmp(path, "events"))
     return send_events(sv, c);
   if (!strncmp(path, "map/", 4))

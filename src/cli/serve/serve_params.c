@@ -1,11 +1,13 @@
 /* serve_params.c: the page's side of the options: the state it draws as
- * JSON, and its controls (scale, rays, slices, bias, bounce, bounces,
+ * JSON, the ranges of its inputs as the library describes the options
+ * (bb_option_bounds), and its controls (scale, rays, slices, bias, bounce, bounces,
  * brightness) applied to the bake options: each bake control parsed as
  * `bumpbake bake` parses its option of that name (bb_command_set), its range
  * checked by the library (bb_bake_options_check), whose words a refusal
  * shows. */
 #include "serve.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -64,34 +66,44 @@ static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_close(j, '}');
 }
 
-char *serve_state_json(serve_state *s) {
+/* The JSON text write(j, arg) makes, malloc'd; NULL when out of memory. */
+static char *json_text(void (*write)(bb_json *j, void *arg), void *arg) {
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return NULL;
   bb_json j = {f, 0};
-  pthread_mutex_lock(&s->lock);
-  bb_job_options o;
-  serve_job_options(s, &o);
-  char *command = bb_job_command_text(&o, s->height_path);
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "height", s->height_path);
-  bb_json_bool(&j, "baking", s->baking);
-  bb_json_number(&j, "progress", s->progress);
-  bb_json_string(&j, "error", s->error);
-  bb_json_string(&j, "command", command);
-  add_params(&j, s);
-  if (s->current)
-    add_bake(&j, s->current);
-  bb_json_close(&j, '}');
-  pthread_mutex_unlock(&s->lock);
-  free(command);
+  write(&j, arg);
   if (fclose(f) != 0) {
     free(text);
     return NULL;
   }
   return text;
+}
+
+static void write_state(bb_json *j, void *arg) {
+  serve_state *s = arg;
+  pthread_mutex_lock(&s->lock);
+  bb_job_options o;
+  serve_job_options(s, &o);
+  char *command = bb_job_command_text(&o, s->height_path);
+  bb_json_open(j, NULL, '{');
+  bb_json_string(j, "height", s->height_path);
+  bb_json_bool(j, "baking", s->baking);
+  bb_json_number(j, "progress", s->progress);
+  bb_json_string(j, "error", s->error);
+  bb_json_string(j, "command", command);
+  add_params(j, s);
+  if (s->current)
+    add_bake(j, s->current);
+  bb_json_close(j, '}');
+  pthread_mutex_unlock(&s->lock);
+  free(command);
+}
+
+char *serve_state_json(serve_state *s) {
+  return json_text(write_state, s);
 }
 
 /* --------------------------------------------------------------- controls */
@@ -172,4 +184,42 @@ int serve_apply_params(serve_state *s, const char *const *names, const char *con
   s->version++;
   pthread_cond_broadcast(&s->changed);
   return 0;
+}
+
+/* ----------------------------------------------------------------- ranges */
+
+/* One input's range as the library describes its option: "min" and
+ * "max" where finite, "min_exclusive" when the bottom is not allowed
+ * ("scale > 0"). An option without a numeric range writes nothing. */
+static void add_range(bb_json *j, const char *key, const char *command,
+                      const char *option) {
+  const bb_option_info *o = bb_option_find(bb_command_info_find(command), option, 0);
+  double min, max;
+  int min_exclusive;
+  if (!bb_option_bounds(o, &min, &max, &min_exclusive))
+    return;
+  bb_json_open(j, key, '{');
+  if (isfinite(min))
+    bb_json_number(j, "min", min);
+  if (isfinite(max))
+    bb_json_number(j, "max", max);
+  bb_json_bool(j, "min_exclusive", min_exclusive);
+  bb_json_close(j, '}');
+}
+
+static void write_ranges(bb_json *j, void *arg) {
+  (void)arg;
+  bb_json_open(j, NULL, '{');
+  /* the bake controls: bake's options of their names */
+  for (size_t i = 0; i < CONTROL_COUNT; i++)
+    add_range(j, controls[i].name, "bake", controls[i].name);
+  /* the picture's camera and light, as render's --view AZ,EL and --light
+   * AZ,EL take them: their range is the elevation's ("range EL 1..90") */
+  add_range(j, "view_elevation", "render", "view");
+  add_range(j, "light_elevation", "render", "light");
+  bb_json_close(j, '}');
+}
+
+char *serve_ranges_json(void) {
+  return json_text(write_ranges, NULL);
 }
