@@ -141,7 +141,7 @@ void bb__texture_options_of(const bb_write_options *options, bb_texture_options 
     *out = *o->texture;
   } else {
     bb_texture_options_init(out);
-    out->map = o->range == BB_RANGE_SIGNED ? BB_MAP_NORMAL : BB_MAP_PLAIN;
+    out->map = bb__map_kind_of_output(NULL, o->range, NULL); /* no kind: by range */
   }
   if (o->description) out->description = o->description;
 }
