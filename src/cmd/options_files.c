@@ -280,4 +280,4 @@ const bb__command bb__command_renderbumpflat = {
                  "oversampled, with alpha = coverage.",
              .inputs = "MODEL", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof rbf_options / sizeof rbf_options[0]) - 1},
-    .options = rbf_options, .init = rbf_init, .check = rbf_check};
+    .options = rbf_options, .init = rbf_init, .check = rbf_check, .run = bb__run_renderbumpflat};
