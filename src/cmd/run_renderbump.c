@@ -22,8 +22,8 @@ static void note_of_model(void *user, const char *path, const char *text) {
 }
 
 /* The run; render (the caller's, or run's own) holds the render after. */
-static bb_status run(bb_command *c, const bb_command_hooks *hooks, bb_renderbump_result *render,
-                     bb_command_result *r, bb_error *err) {
+static bb_status run(bb_command *c, const bb_command_hooks *hooks,
+                     bb_renderbump_result *render, bb_command_result *r, bb_error *err) {
   const bb_command_options *o = &c->options;
   const char *model = c->inputs[0];
   bb_mesh mesh;
@@ -48,8 +48,8 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks, bb_renderbump
   char *record = bb__command_record(c);
   if (!record)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->output);
-  st = bb_renderbump_write(render, &ro, o->maps_normal_y_up, model, render->model_hash, record,
-                           o->output, o->height_output, err);
+  st = bb_renderbump_write(render, &ro, o->maps_normal_y_up, model, render->model_hash,
+                           record, o->output, o->height_output, err);
   free(record);
   if (st == BB_OK)
     st = bb__result_add(r, "normal", o->output, err);
@@ -81,7 +81,8 @@ bb_status bb_command_renderbump(bb_command *c, const bb_command_hooks *hooks,
   if (c->def->run != bb__run_renderbumpflat)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s is not renderbumpflat", c->def->info.name);
   if (!c->checked)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the command is not checked (bb_command_check)",
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: the command is not checked (bb_command_check)",
                     c->def->info.name);
   bb_status st = run(c, hooks, render, result, err);
   if (st != BB_OK) {

@@ -18,8 +18,12 @@
 #include "file_bytes.h"
 #include "scratch_dir.h"
 
-static void setup(void) { scratch_dir_make("bb_rbf_run"); }
-static void teardown(void) { scratch_dir_remove(); }
+static void setup(void) {
+  scratch_dir_make("bb_rbf_run");
+}
+static void teardown(void) {
+  scratch_dir_remove();
+}
 
 TestSuite(renderbump_run, .init = setup, .fini = teardown, .timeout = 120);
 
@@ -51,6 +55,15 @@ static bb_command *command(const char *name, const char *const *words) {
   return c;
 }
 
+/* c checked and run by bb_command_renderbump, which must succeed. */
+static void render_checked(bb_command *c, bb_renderbump_result *render,
+                           bb_command_result *written) {
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_renderbump(c, NULL, render, written, &err), BB_OK, "%s",
+               err.message);
+}
+
 static int exists(const char *path) {
   struct stat st;
   return stat(path, &st) == 0;
@@ -71,15 +84,13 @@ Test(renderbump_run, writes_both_files_with_provenance_and_hands_back_the_render
   char normal[512], height[512];
   snprintf(normal, sizeof normal, "%s", in_scratch_dir("n.tga"));
   snprintf(height, sizeof height, "%s", in_scratch_dir("h.png"));
-  bb_command *c = command("renderbumpflat", (const char *const[]){model, "--size", "16 16",
-                                                                     "--output", normal,
-                                                                     "--height", height, NULL});
-  bb_error err = {{0}};
-  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  bb_command *c = command("renderbumpflat",
+                          (const char *const[]){model, "--size", "16 16", "--output",
+                                                normal, "--height", height, NULL});
   bb_renderbump_result render;
   bb_command_result written;
-  cr_assert_eq(bb_command_renderbump(c, NULL, &render, &written, &err), BB_OK, "%s",
-               err.message);
+  render_checked(c, &render, &written);
+  bb_error err = {{0}};
   cr_assert_eq(written.file_count, 2);
   cr_expect_str_eq(written.files[0].kind, "normal");
   cr_expect_str_eq(written.files[0].path, normal);
@@ -96,16 +107,19 @@ Test(renderbump_run, writes_both_files_with_provenance_and_hands_back_the_render
   /* the height 16-bit where the format holds it; each file's kind recorded */
   int w, h, ch;
   bb_image_info info = {0};
-  cr_assert_eq(bb_image_read_info(height, &w, &h, &ch, &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_image_read_info(height, &w, &h, &ch, &info, &err), BB_OK, "%s",
+               err.message);
   cr_expect_eq(info.bits_per_sample, 16);
   cr_assert_not_null(info.description);
   cr_expect(strstr(info.description, "\noutput=height\n"), "%s", info.description);
   cr_expect(strstr(info.description, "command=bumpbake renderbumpflat "), "%s",
             info.description);
   bb_image_info_free(&info);
-  cr_assert_eq(bb_image_read_info(normal, &w, &h, &ch, &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_image_read_info(normal, &w, &h, &ch, &info, &err), BB_OK, "%s",
+               err.message);
   cr_expect_eq(info.bits_per_sample, 8);
-  cr_expect(strstr(info.description, "\noutput=normal+coverage\n"), "%s", info.description);
+  cr_expect(strstr(info.description, "\noutput=normal+coverage\n"), "%s",
+            info.description);
   bb_image_info_free(&info);
   bb_renderbump_result_free(&render);
   bb_command_result_free(&written);
@@ -118,20 +132,19 @@ Test(renderbump_run, writes_both_files_with_provenance_and_hands_back_the_render
 
 Test(renderbump_run, in_memory_writes_nothing) {
   const char *model = pyramid();
-  bb_command *c = command("renderbumpflat", (const char *const[]){model, "--size", "8 8", NULL});
+  bb_command *c =
+      command("renderbumpflat", (const char *const[]){model, "--size", "8 8", NULL});
   bb_command_set_in_memory(c, 0);
-  bb_error err = {{0}};
-  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
   bb_renderbump_result render;
   bb_command_result written;
-  cr_assert_eq(bb_command_renderbump(c, NULL, &render, &written, &err), BB_OK, "%s",
-               err.message);
+  render_checked(c, &render, &written);
   cr_expect_eq(written.file_count, 0);
   cr_expect_eq(render.height.width, 8);
   cr_expect_not(exists(in_scratch_dir("pyramid_local.tga")));
   bb_renderbump_result_free(&render);
   bb_command_free(c);
   /* files are refused in memory */
+  bb_error err = {{0}};
   c = command("renderbumpflat",
               (const char *const[]){model, "--output", in_scratch_dir("n.png"), NULL});
   bb_command_set_in_memory(c, 0);
@@ -147,8 +160,8 @@ Test(renderbump_run, a_failed_write_leaves_the_old_files) {
   char normal[512], height[512];
   snprintf(normal, sizeof normal, "%s", in_scratch_dir("n.png"));
   snprintf(height, sizeof height, "%s", in_scratch_dir("h.tif"));
-  const char *const first[] = {model, "--size", "8 8", "--output", normal, "--height", height,
-                               NULL};
+  const char *const first[] = {model,  "--size",   "8 8",  "--output",
+                               normal, "--height", height, NULL};
   bb_command *c = command("renderbumpflat", first);
   bb_error err = {{0}};
   bb_command_result written;
@@ -159,8 +172,8 @@ Test(renderbump_run, a_failed_write_leaves_the_old_files) {
   size_t old_size;
   unsigned char *old = file_bytes(normal, &old_size);
 
-  const char *const second[] = {model, "--size", "16 8", "--output", normal,
-                                "--height", height, NULL};
+  const char *const second[] = {model,  "--size",   "16 8", "--output",
+                                normal, "--height", height, NULL};
   c = command("renderbumpflat", second);
   cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
   cr_assert_eq(unlink(height), 0);
@@ -172,7 +185,8 @@ Test(renderbump_run, a_failed_write_leaves_the_old_files) {
   cr_expect_null(render.normal.pixels);
   size_t size;
   unsigned char *now = file_bytes(normal, &size);
-  cr_expect(size == old_size && memcmp(now, old, size) == 0, "the normal map was replaced");
+  cr_expect(size == old_size && memcmp(now, old, size) == 0,
+            "the normal map was replaced");
   cr_expect_eq(temporaries(), 0);
   free(now);
   free(old);
@@ -217,16 +231,18 @@ Test(renderbump_run, the_diff_is_checked_against_the_inputs_and_its_format) {
   bb_error err = {{0}};
   bb_command *c = command("compare", (const char *const[]){a, b, "--diff", over, NULL});
   cr_expect_eq(bb_command_check(c, &err), BB_ERR_IO);
-  cr_expect(strstr(err.message, "output would overwrite the input file"), "%s", err.message);
+  cr_expect(strstr(err.message, "output would overwrite the input file"), "%s",
+            err.message);
   bb_command_free(c);
   /* a GIF is no animation here: refused as bb_image_write refuses it */
-  c = command("compare", (const char *const[]){a, b, "--diff", in_scratch_dir("d.gif"), NULL});
+  c = command("compare",
+              (const char *const[]){a, b, "--diff", in_scratch_dir("d.gif"), NULL});
   cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "unknown output format '.gif'"), "%s", err.message);
   bb_command_free(c);
   /* and so for a map command's output, before the map is made */
-  c = command("normal2ssbump", (const char *const[]){a, "--output", in_scratch_dir("w.gif"),
-                                                    NULL});
+  c = command("normal2ssbump",
+              (const char *const[]){a, "--output", in_scratch_dir("w.gif"), NULL});
   cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "unknown output format '.gif'"), "%s", err.message);
   bb_command_free(c);
@@ -246,7 +262,8 @@ Test(renderbump_run, the_diff_is_float_in_exr_and_scaled_elsewhere) {
   for (int k = 0; k < 2; k++) {
     bb_compare_report r;
     bb_error err = {{0}};
-    cr_assert_eq(bb_compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s",
+                 err.message);
     cr_expect(r.diff_written, "%s", r.diff_error.message);
     bb_compare_report_free(&r);
     bb_image img;
