@@ -25,6 +25,8 @@ static void note_of_model(void *user, const char *path, const char *text) {
 static bb_status run(bb_command *c, const bb_command_hooks *hooks,
                      bb_renderbump_result *render, bb_command_result *r, bb_error *err) {
   const bb_command_options *o = &c->options;
+  if (c->input_count < 1) /* checked in memory, without its MODEL */
+    return bb__fail(err, BB_ERR_ARGUMENT, "renderbumpflat: a MODEL is needed");
   const char *model = c->inputs[0];
   bb_mesh mesh;
   memset(&mesh, 0, sizeof mesh);

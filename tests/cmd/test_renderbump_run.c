@@ -143,6 +143,14 @@ Test(renderbump_run, in_memory_writes_nothing) {
   cr_expect_not(exists(in_scratch_dir("pyramid_local.tga")));
   bb_renderbump_result_free(&render);
   bb_command_free(c);
+  /* in memory the input count is not checked: the run asks for its model */
+  c = command("renderbumpflat", (const char *const[]){NULL});
+  bb_command_set_in_memory(c, 0);
+  bb_error none = {{0}};
+  cr_assert_eq(bb_command_check(c, &none), BB_OK, "%s", none.message);
+  cr_expect_eq(bb_command_renderbump(c, NULL, &render, &written, &none), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(none.message, "renderbumpflat: a MODEL is needed");
+  bb_command_free(c);
   /* files are refused in memory */
   bb_error err = {{0}};
   c = command("renderbumpflat",
