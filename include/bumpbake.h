@@ -2106,6 +2106,8 @@ typedef struct bb_renderbump_result {
                           for this height; 0 when the surface is flat */
   int used_vertex_normals; /* 1 when some texel used interpolated normals */
   size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
+  size_t triangles, vertices; /* the mesh's counts */
+  uint64_t model_hash;     /* bb_mesh_hash of the mesh, as its files record it */
 } bb_renderbump_result;
 
 /* DOOM 3's RenderBumpFlat on the CPU: projects mesh orthographically along
@@ -2972,8 +2974,8 @@ typedef struct bb_command_result {
  * those through the job (bake, normal, height2ssbump) are planned and run
  * (stopping at the first failing input; bb_command_plan and bb_job_run for
  * each input's report); render, sheet, normal2ssbump, ssbump2normal,
- * combine and program read their inputs, make their picture or map and
- * write it all or nothing with provenance (its command the record, else
+ * combine, program and renderbumpflat read their inputs, make their
+ * picture, map or render bump and write it all or nothing with provenance (its command the record, else
  * bb_command_text's). hooks may be NULL. Fills result (free it with
  * bb_command_result_free) on success. Errors name the file: those of the
  * reads, the bake and the writes; BB_ERR_ARGUMENT for an unchecked command
@@ -2981,6 +2983,21 @@ typedef struct bb_command_result {
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
+
+/* renderbumpflat's run (bb_command_run's), handing back what it rendered
+ * as well: the model (the command's input) read through bb_mesh_load_noted
+ * (its note to hooks->note), rendered by bb_renderbump_flat (its notes to
+ * hooks->note, naming the model) into render (allocated; free with
+ * bb_renderbump_result_free), and its files written by
+ * bb_renderbump_write with the command's record, listed in result (free
+ * with bb_command_result_free): "normal", then "height" when asked. A
+ * command set in memory (bb_command_set_in_memory, before its check)
+ * writes nothing. Errors: BB_ERR_ARGUMENT (not a checked renderbumpflat),
+ * those of the load and the render naming the model, those of the write;
+ * render and result are then empty. */
+bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hooks,
+                                bb_renderbump_result *render, bb_command_result *result,
+                                bb_error *err);
 
 /* Render's or sheet's picture of images in memory, with the options of a
  * command checked for them (bb_command_set_in_memory): height, when not

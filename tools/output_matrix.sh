@@ -127,6 +127,19 @@ run sheet sheet in/rock06_128.png --scale 16 -o out/sheet.png --panel-size 64
 run rbf renderbumpflat -size 128 64 in/rivet_panel.obj -o out/rbf_local.tga --height out/rbf_height.png
 run rbf_tile renderbumpflat --size 64 64 in/rivet_panel.obj --rect 0 0 1 1 --tile -o out/rbf_tile.exr \
   --axis -y --samples 2
+run rbf_exr renderbumpflat -size 32 24 in/rivet_panel.obj -o out/rbf_exr.tif --height out/rbf_exr_h.exr \
+  --normal-y up -q
+run rbf_tga renderbumpflat -size 32 32 in/rivet_panel.obj -o out/rbf_tga.png --height out/rbf_tga_h.tga
+mkdir -p rbf_dir && cp in/rivet_panel.obj rbf_dir/
+printf 'mtllib missing.mtl\n' | cat - in/rivet_panel.obj >rbf_dir/rivet_mtl.obj
+run rbf_default renderbumpflat -size 16 16 rbf_dir/rivet_panel.obj
+run rbf_mtl renderbumpflat -size 16 16 rbf_dir/rivet_mtl.obj --height rbf_dir/rivet_mtl_h.tif
+printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >in/flat.obj
+run rbf_flat renderbumpflat -size 8 8 in/flat.obj -o out/rbf_flat.png --height out/rbf_flat_h.png
+run err_rbf_same renderbumpflat in/rivet_panel.obj -o out/rbf_same.png --height out/./rbf_same.png
+run err_rbf_ext renderbumpflat in/rivet_panel.obj --height out/rbf_h.jpg
+run err_rbf_gif renderbumpflat in/rivet_panel.obj -o out/rbf.gif
+run err_rbf_dir renderbumpflat in/rivet_panel.obj -o out/nowhere/rbf.png
 
 # What it prints about files.
 run info info out/rock_p1_normal.png out/g_noise16_ao.exr out/rbf_local.tga
@@ -134,6 +147,13 @@ run info_json info --json out/rock_mips_ssbump.exr out/orbit_001.png
 run compare compare out/rock_p1_ssbump.png out/rock_p2_ssbump.png
 run compare2 compare out/rock_p1_ao.tif out/rock_16_ao.tif --json --diff out/compare_diff.exr
 run compare3 compare out/normal.png out/rock_c1_normal.png -failpercent 50
+run compare_png compare out/rock_p1_ao.tif out/rock_16_ao.tif --diff out/compare_diff.png -q
+run compare_tif compare out/rock_p1_normal.png out/rock_c1_normal.png --diff out/compare_diff.tif
+run compare_same compare out/rock_p1_ao.tif out/rock_p1_ao.tif --diff out/compare_same.exr
+run err_diff_over compare out/rock_p1_ao.tif out/rock_16_ao.tif --diff out/../out/rock_16_ao.tif
+run err_diff_ext compare out/rock_p1_ao.tif out/rock_16_ao.tif --diff out/diff.jpg
+run err_diff_gif compare out/rock_p1_ao.tif out/rock_16_ao.tif --diff out/diff.gif
+run err_n2s_gif normal2ssbump out/normal.png -o out/n2s.gif
 
 # Errors: messages and exit codes.
 run err_scale bake $rock --ao out/x.png
@@ -141,4 +161,4 @@ run err_same bake $rock --scale 4 --ao out/x.png --ssbump out/x.png
 run err_ext bake $rock --scale 4 --ao out/x.jpg
 run err_missing bake in/missing.png --scale 4 --ao out/x.png
 run err_over bake $rock --scale 4 --ao $rock
-echo "output_matrix: $(find out batch_out h2s h2s2 -type f | wc -l) files in $dir"
+echo "output_matrix: $(find out batch_out h2s h2s2 rbf_dir -type f | wc -l) files in $dir"

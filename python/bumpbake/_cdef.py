@@ -382,6 +382,8 @@ typedef struct bb_renderbump_result {
   double height_scale;
   int used_vertex_normals;
   size_t triangles_drawn;
+  size_t triangles, vertices;
+  uint64_t model_hash;
 } bb_renderbump_result;
 
 typedef enum bb_provenance_class {
@@ -786,6 +788,9 @@ int bb_command_has_job(const bb_command_info *command);
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
+bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hooks,
+                                bb_renderbump_result *render, bb_command_result *result,
+                                bb_error *err);
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);

@@ -174,7 +174,7 @@ def sheet(height, scale, *, light=_AUTO, lightmap=None, progress=None, **options
 def run(command, *inputs, progress=None, notes="warn", **options):
     """Runs a `bumpbake` command that writes files (bake, normal,
     height2ssbump, render, sheet, normal2ssbump, ssbump2normal, combine,
-    program) as the command line runs it, with its options as keywords
+    program, renderbumpflat) as the command line runs it, with its options as keywords
     (the long options with '_' for '-'; a flag takes True, several numbers
     a sequence), and returns [(kind, path)] of the files written: the
     command line's bytes. progress: as bake()'s; notes as bake_file()'s."""
@@ -242,51 +242,44 @@ def renderbumpflat(model, size=None, samples=None, axis=None, face_normals=False
     (height_output: its old name) the files are also written all or
     nothing, with provenance, as the command line writes them (the normal
     map to output, default MODEL_local.tga; normal_y="up" flips their
-    green). The library's note when the texels come out not square (with the
-    size or rect that keeps them square) goes to notes ("warn": a
-    NoteWarning, "ignore", or a callable) and to the result's notes."""
+    green; the files record the command as bb_command_text spells it). The
+    library runs it all (bb_command_renderbump), as for the command line.
+    Its notes, each naming the model (the texels come out not square, with
+    the size or rect that keeps them square; a file the model names is
+    missing), go to notes ("warn": a NoteWarning, "ignore", or a callable)
+    and to the result's notes."""
     if height_output is not None:  # the old name of the command line's --height
         if height is not None:
             raise TypeError("renderbumpflat: give height or height_output, not both")
         height = height_output
     _check_notes(notes)
     c = Command("renderbumpflat")
-    path = _path(model, "model")
-    c.add_input(path)
+    c.add_input(_path(model, "model"))
     c.set_all(dict(size=size, samples=samples, axis=axis, face_normals=face_normals,
                    rect=rect, tile=tile, threads=threads, normal_y=normal_y, output=output,
                    height=height))
+    if output is None and height is None:
+        c.in_memory()  # nothing to write
     c.check()  # ranges, tile needs rect, the outputs apart and not over the model
-    o = _ffi.new("bb_renderbump_options *")
-    o[0] = c.options.renderbump
     heard = []
     note = _ffi.callback("bb_note_fn",
                          lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
-    o.note = note
-    green_up = c.options.maps_normal_y_up
-    writes = output is not None or height is not None
-    out_path = _ffi.string(c.options.output) if writes else None
-    height_path = _ffi.string(c.options.height_output) if height is not None else None
+    hooks = _ffi.new("bb_command_hooks *")
+    hooks.note = note
     err = _ffi.new("bb_error *")
-    mesh = _ffi.new("bb_mesh *")
     result = _ffi.new("bb_renderbump_result *")
+    written = _ffi.new("bb_command_result *")
+    _check(_lib.bb_command_renderbump(c.handle, hooks, result, written, err), err)
     try:
-        _check(_lib.bb_mesh_load(path, mesh, err), err)
-        _check(_lib.bb_renderbump_flat(mesh, o, result, err), err)
         _dispatch_notes(heard, notes, stacklevel=2)
-        model_hash = _lib.bb_mesh_hash(mesh)
-        if writes:
-            _check(_lib.bb_renderbump_write(result, o, int(green_up), path, model_hash,
-                                            _ffi.NULL, out_path,
-                                            height_path if height_path else _ffi.NULL, err), err)
         return RenderBump(
             normal=_array(result.normal, squeeze=False), height=_array(result.height),
             rect=tuple(result.rect), depth_min=result.depth_min, depth_max=result.depth_max,
             texel_size=result.texel_size, texel_aspect=result.texel_aspect,
             height_scale=result.height_scale,
             used_vertex_normals=bool(result.used_vertex_normals),
-            triangles_drawn=int(result.triangles_drawn), triangles=int(mesh.triangle_count),
-            vertices=int(mesh.vertex_count), model_hash=int(model_hash), notes=heard)
+            triangles_drawn=int(result.triangles_drawn), triangles=int(result.triangles),
+            vertices=int(result.vertices), model_hash=int(result.model_hash), notes=heard)
     finally:
+        _lib.bb_command_result_free(written)
         _lib.bb_renderbump_result_free(result)
-        _lib.bb_mesh_free(mesh)

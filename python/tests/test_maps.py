@@ -4,6 +4,7 @@ renderbumpflat against the command line's output of the same operation."""
 
 import os
 import re
+import shutil
 
 import numpy as np
 import pytest
@@ -173,6 +174,34 @@ def test_render_sheet_and_renderbumpflat_are_the_clis(tmp_path, fixtures, cli):
     assert f"{rb.height_scale:.6g}" == printed
     assert rb.normal.shape == (32, 64, 4) and rb.height.shape == (32, 64)
     assert rb.triangles > 0 and rb.texel_aspect != 1
+
+
+def test_renderbumpflat_files_are_the_clis_bytes(tmp_path, fixtures, cli, monkeypatch):
+    """One run in the library for both: the same words give the same bytes,
+    the command line recorded in each; the arrays are the files' pixels;
+    the model's notes name it."""
+    for side in ("cli", "py"):
+        (tmp_path / side).mkdir()
+        shutil.copy(os.path.join(fixtures, "rivet_panel.obj"), tmp_path / side / "m.obj")
+    words = ["renderbumpflat", "m.obj", "--size", "48", "40", "--output", "n.tif",
+             "--height", "h.png", "--normal-y", "up"]
+    out = cli(*words, cwd=tmp_path / "cli")
+    assert "wrote normal n.tif" in out.stdout and "wrote height h.png" in out.stdout
+    assert "m.obj: note: texels are" in out.stderr
+    monkeypatch.chdir(tmp_path / "py")
+    with pytest.warns(bumpbake.NoteWarning, match=r"^m\.obj: texels are"):
+        rb = bumpbake.renderbumpflat("m.obj", size=(48, 40), output="n.tif", height="h.png",
+                                     normal_y="up")
+    for name in ("n.tif", "h.png"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    assert f"height scale {rb.height_scale:.6g} texels" in out.stdout
+    assert f"{rb.triangles} triangles" in out.stdout
+    np.testing.assert_allclose(bumpbake.read("h.png"), rb.height, atol=0.5 / 65535)
+    # Without output or height nothing is written; the arrays are the same.
+    before = sorted(os.listdir("."))
+    again = bumpbake.renderbumpflat("m.obj", size=(48, 40), notes="ignore")
+    assert sorted(os.listdir(".")) == before
+    np.testing.assert_array_equal(again.normal, rb.normal)
 
 
 def test_flat_maps_under_an_overhead_light_render_white():

@@ -152,6 +152,10 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
                           bb_error *err);
 bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                           bb_error *err);
+/* renderbumpflat's run (run_renderbump.c): the model rendered, its files
+ * written through the job (bb_renderbump_write). */
+bb_status bb__run_renderbumpflat(bb_command *c, const bb_command_hooks *hooks,
+                                 bb_command_result *r, bb_error *err);
 
 /* A render's tile and crop for maps of width x height (options_render.c):
  * BB_ERR_ARGUMENT when the tiled picture is over the maximum or the crop

@@ -1,6 +1,7 @@
 /* options_files.c: the commands about files and models (compare, info,
  * renderbumpflat), their options described once and their rules. */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "maps/maps_internal.h"
 #include "mesh/mesh_internal.h"
 
@@ -84,9 +85,8 @@ static void compare_init(bb_command_options *o) {
 static bb_status compare_check(bb_command *c, bb_error *err) {
   if (!c->options.diff)
     return BB_OK;
-  const bb_output_spec diff = {c->options.diff, "diff", 0, BB_DEPTH_DEFAULT, 0, 0, 0, 0,
-                               BB_RANGE_UNIT, NULL};
-  return bb_outputs_check(&diff, 1, (const char *const *)c->inputs, 2, err);
+  const bb__job_output diff = bb__compare_diff_output(c->options.diff);
+  return bb__job_output_check(&diff, 0, (const char *const *)c->inputs, 2, err);
 }
 
 const bb__command bb__command_compare = {
@@ -247,12 +247,15 @@ static void rbf_init(bb_command_options *o) {
 }
 
 /* --tile needs --rect; the normal map's default name; the outputs apart and
- * not over the model. */
+ * not over the model, as the job writes them (bb__renderbump_outputs). In
+ * memory, nothing is written. */
 static bb_status rbf_check(bb_command *c, bb_error *err) {
   bb_command_options *o = &c->options;
   if (o->renderbump.tile && !o->renderbump.rect_given)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "--tile needs --rect L B R T: the tile the sculpt repeats with");
+  if (c->in_memory)
+    return BB_OK;
   if (!o->output) {
     char *name = bb_path_with_suffix(c->inputs[0], "_local.tga");
     o->output = name ? bb__command_keep(c, name) : NULL;
@@ -262,11 +265,9 @@ static bb_status rbf_check(bb_command *c, bb_error *err) {
   }
   if (o->height_output && bb_same_file(o->height_output, o->output))
     return bb__fail(err, BB_ERR_ARGUMENT, "--height and the normal map are both %s", o->output);
-  const bb_output_spec specs[2] = {
-      {o->output, "normal", 4, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_SIGNED, NULL},
-      {o->height_output, "height", 1, BB_DEPTH_DEFAULT, 0, 0, 0, 0, BB_RANGE_UNIT, NULL}};
-  return bb_outputs_check(specs, o->height_output ? 2 : 1, (const char *const *)c->inputs, 1,
-                          err);
+  bb__job_output out[2];
+  const int count = bb__renderbump_outputs(o->output, o->height_output, out);
+  return bb__job_outputs_check(out, count, (const char *const *)c->inputs, 1, err);
 }
 
 const bb__command bb__command_renderbumpflat = {
@@ -279,4 +280,4 @@ const bb__command bb__command_renderbumpflat = {
                  "oversampled, with alpha = coverage.",
              .inputs = "MODEL", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof rbf_options / sizeof rbf_options[0]) - 1},
-    .options = rbf_options, .init = rbf_init, .check = rbf_check};
+    .options = rbf_options, .init = rbf_init, .check = rbf_check, .run = bb__run_renderbumpflat};

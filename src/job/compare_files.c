@@ -8,15 +8,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Writes |A-B|. EXR keeps the raw differences; integer formats would round
- * typical golden differences (1e-5) to 0, so the image is scaled to make the
- * largest finite difference white and NaN/infinite differences clip to 1. */
+bb__job_output bb__compare_diff_output(const char *path) {
+  return (bb__job_output){.path = path,
+                          .kind = "diff",
+                          .range = BB_RANGE_UNIT,
+                          .depth = bb__path_has_extension(path, "exr") ? BB_DEPTH_FLOAT
+                                                                      : BB_DEPTH_DEFAULT};
+}
+
+/* Writes |A-B| through the job. EXR keeps the raw differences; integer
+ * formats would round typical golden differences (1e-5) to 0, so the image
+ * is scaled to make the largest finite difference white and NaN/infinite
+ * differences clip to 1. */
 static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
-  bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
+  const bb__job_output out = bb__compare_diff_output(path);
   const size_t n = (size_t)diff->width * (size_t)diff->height * (size_t)diff->channels;
-  if (bb__path_has_extension(path, "exr")) {
-    wo.depth = BB_DEPTH_FLOAT;
-  } else {
+  if (out.depth != BB_DEPTH_FLOAT) {
     double max_finite = 0;
     for (size_t i = 0; i < n; i++)
       if (isfinite(diff->pixels[i]) && diff->pixels[i] > max_finite)
@@ -26,7 +33,7 @@ static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
         diff->pixels[i] =
             isfinite(diff->pixels[i]) ? (float)(diff->pixels[i] / max_finite) : 1.0f;
   }
-  return bb_image_write(path, diff, &wo, err);
+  return bb__job_write(&out, diff, NULL, err);
 }
 
 static void compare_provenance(const bb_image_info *ia, const bb_image_info *ib,

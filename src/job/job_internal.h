@@ -166,12 +166,16 @@ char *bb__job_describe(const bb__job_source *s, const char *kind);
  * (bits_per_sample, is_float) where path's format holds it. */
 bb_depth bb__job_depth(bb_depth asked, int bits_per_sample, int is_float, const char *path);
 
-/* The one file of a command that makes one map or picture. */
+/* A file of a command that is not a bake: its map or picture, one of a
+ * render bump's files, compare's diff. The command hands the job its
+ * depth as data: the one asked, or the one its output is written with
+ * where the format holds it (a render bump's 16-bit height, the diff's
+ * float EXR). */
 typedef struct bb__job_output {
   const char *path;
   const char *kind;              /* what it is, in messages and the written list */
   bb_range range;
-  bb_depth depth;                /* asked */
+  bb_depth depth;                /* asked, or the command's own */
   const bb_image_info *like;     /* the input a default depth follows, or NULL */
   int mips;                      /* a mip chain, where the format holds one */
   const bb_texture_options *texture; /* a .vtf's or .dds's settings, or NULL */
@@ -184,8 +188,28 @@ typedef struct bb__job_output {
 bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *const *reads,
                                int read_count, bb_error *err);
 
-/* img written to o->path with s's provenance, staged and put in place (a
- * failure leaves the old file); errors name the path once. */
+/* The outputs o[0..count-1] of one command (no frames), checked together
+ * as bb__job_output_check checks one: each as above, and no two on one
+ * file. */
+bb_status bb__job_outputs_check(const bb__job_output *o, int count, const char *const *reads,
+                                int read_count, bb_error *err);
+
+/* One file of a set written together: where and how, its pixels, and
+ * where they came from (NULL: no provenance is stored). */
+typedef struct bb__job_file {
+  const bb__job_output *output;
+  const bb_image *image;
+  const bb__job_source *source;
+  const char *recorded_kind; /* the kind its provenance records; NULL: output->kind */
+} bb__job_file;
+
+/* files[0..count-1] written all or nothing (bb_outputs_write): each with
+ * its depth and its provenance, staged, then put in place together (a
+ * failure or an interruption leaves every old file). Errors: one file's
+ * name its path once; a set's are bb_outputs_write's. */
+bb_status bb__job_write_set(const bb__job_file *files, int count, bb_error *err);
+
+/* bb__job_write_set of the one file o (img, with s's provenance). */
 bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__job_source *s,
                         bb_error *err);
 
@@ -208,5 +232,21 @@ typedef struct bb__job_frames {
  * ("orbit" for an animation, else o->kind) say what was written. */
 bb_status bb__job_write_frames(const bb__job_output *o, const bb__job_frames *f, char ***written,
                                int *count, const char **kind, bb_error *err);
+
+/* ------------------------------ a render bump's files, compare's diff */
+
+/* A flat render bump's files as the job checks and writes them
+ * (renderbump_files.c): out[0] the normal map at normal_path (RGB = N,
+ * encoded 0.5 + 0.5 N in files that hold integers, range UNIT, else raw,
+ * range SIGNED), out[1], when
+ * height_path is not NULL, the height (range UNIT, 16-bit where the
+ * format holds it). The count. */
+int bb__renderbump_outputs(const char *normal_path, const char *height_path,
+                           bb__job_output out[2]);
+
+/* compare's |A - B| at path as the job checks and writes it
+ * (compare_files.c): float in .exr (raw differences), the format's depth
+ * elsewhere (scaled to a maximum of 1); no provenance. */
+bb__job_output bb__compare_diff_output(const char *path);
 
 #endif /* BB_JOB_INTERNAL_H */

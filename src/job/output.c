@@ -1,10 +1,12 @@
-/* output.c: the job's rules for a command that makes one map or picture
- * (normal2ssbump, ssbump2normal, combine, program, render, sheet), the
- * ones a bake's outputs follow in run.c: the depth a default follows, the
- * provenance assembled from where the output came from, and the write,
- * staged and put in place all or nothing (every frame of an orbit with
- * the others). The outputs' paths were checked against the inputs before
- * any work (bb_outputs_check, paths.c). */
+/* output.c: the job's rules for the commands that are not bakes
+ * (normal2ssbump, ssbump2normal, combine, program, render, sheet,
+ * renderbumpflat, compare's diff), the ones a bake's outputs follow in
+ * run.c: the depth a default follows, the provenance assembled from where
+ * each output came from, and the write, staged and put in place all or
+ * nothing (a command's files together, every frame of an orbit with the
+ * others). The outputs' paths were checked against the inputs before any
+ * work (bb__job_output_check, bb__job_outputs_check: bb_outputs_check,
+ * paths.c). */
 #include "core/internal.h"
 #include "job/job_internal.h"
 
@@ -40,17 +42,41 @@ static bb_depth depth_of(const bb__job_output *o) {
   return bb__job_depth(o->depth, o->like->bits_per_sample, o->like->is_float, o->path);
 }
 
+bb_status bb__job_write_set(const bb__job_file *files, int count, bb_error *err) {
+  bb_output_file *out = calloc((size_t)count, sizeof *out);
+  char **texts = calloc((size_t)count, sizeof *texts);
+  bb_status st = out && texts ? BB_OK
+                              : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory",
+                                         files[0].output->path);
+  for (int i = 0; i < count && st == BB_OK; i++) {
+    const bb__job_output *o = files[i].output;
+    const char *kind = files[i].recorded_kind ? files[i].recorded_kind : o->kind;
+    if (files[i].source && !(texts[i] = bb__job_describe(files[i].source, kind)))
+      st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->path);
+    out[i] = (bb_output_file){o->path, o->kind,   files[i].image, o->range, depth_of(o),
+                              o->mips, texts[i], NULL,           0,        o->texture};
+  }
+  if (st == BB_OK) {
+    /* one file's message names its path once; a set's name the file at
+     * fault and what was (not) written */
+    bb_error e = {{0}};
+    st = bb_outputs_write(out, count, count, &e);
+    if (st != BB_OK && count == 1)
+      bb__fail_at(err, st, out[0].path, &e);
+    else if (st != BB_OK)
+      bb__fail(err, st, "%s", e.message);
+  }
+  for (int i = 0; texts && i < count; i++)
+    free(texts[i]);
+  free(texts);
+  free(out);
+  return st;
+}
+
 bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__job_source *s,
                         bb_error *err) {
-  char *description = bb__job_describe(s, o->kind);
-  if (!description)
-    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->path);
-  const bb_output_file file = {o->path, o->kind,      img,  o->range, depth_of(o),
-                               o->mips, description, NULL, 0,        o->texture};
-  bb_error e = {{0}};
-  bb_status st = bb_outputs_write(&file, 1, 1, &e);
-  free(description);
-  return st == BB_OK ? BB_OK : bb__fail_at(err, st, o->path, &e);
+  const bb__job_file file = {o, img, s, NULL};
+  return bb__job_write_set(&file, 1, err);
 }
 
 /* ---------------------------------------------------------------- frames */
@@ -60,33 +86,51 @@ static int is_gif(const char *path) {
   return dot && strcasecmp(dot, ".gif") == 0;
 }
 
+/* What bb_outputs_check checks of o written at path (o's, or a frame's).
+ * A GIF animation is written by the animation writer, not bb_image_write:
+ * its name is checked as a file's, its format by the command; a .gif that
+ * is not an animation is refused as bb_image_write refuses it. */
+static bb_output_spec spec_of(const bb__job_output *o, const char *path, int animation) {
+  return (bb_output_spec){.path = path,
+                          .kind = o->kind,
+                          .depth = o->depth,
+                          .mips = o->mips,
+                          .text = animation && path && is_gif(path),
+                          .range = o->range,
+                          .texture = o->texture};
+}
+
+bb_status bb__job_outputs_check(const bb__job_output *o, int count, const char *const *reads,
+                                int read_count, bb_error *err) {
+  bb_output_spec *specs = calloc((size_t)count, sizeof *specs);
+  if (!specs)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  for (int i = 0; i < count; i++)
+    specs[i] = spec_of(&o[i], o[i].path, 0);
+  bb_status st = bb_outputs_check(specs, count, reads, read_count, err);
+  free(specs);
+  return st;
+}
+
 bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *const *reads,
                                int read_count, bb_error *err) {
   const int gif = o->path && is_gif(o->path);
-  const int n = frames && !gif ? frames : 1;
-  bb_output_spec *specs = calloc((size_t)n, sizeof *specs);
-  char **names = calloc((size_t)n, sizeof *names);
+  if (!frames || gif) {
+    bb_output_spec spec = spec_of(o, o->path, frames > 0);
+    return bb_outputs_check(&spec, 1, reads, read_count, err);
+  }
+  bb_output_spec *specs = calloc((size_t)frames, sizeof *specs);
+  char **names = calloc((size_t)frames, sizeof *names);
   bb_status st = specs && names ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
-  for (int f = 0; f < n && st == BB_OK; f++) {
-    const char *path = o->path;
-    if (frames && !gif) {
-      if (!(names[f] = bb_render_frame_path(o->path, f, frames)))
-        st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
-      path = names[f];
-    }
-    /* a GIF is written by the animation writer, not bb_image_write: its
-     * name is checked as a file's, its format by the command */
-    specs[f] = (bb_output_spec){.path = path,
-                                .kind = o->kind,
-                                .depth = o->depth,
-                                .mips = o->mips,
-                                .text = path && is_gif(path),
-                                .range = o->range,
-                                .texture = o->texture};
+  for (int f = 0; f < frames && st == BB_OK; f++) {
+    if (!(names[f] = bb_render_frame_path(o->path, f, frames)))
+      st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    else
+      specs[f] = spec_of(o, names[f], 1);
   }
   if (st == BB_OK)
-    st = bb_outputs_check(specs, n, reads, read_count, err);
-  for (int f = 0; names && f < n; f++)
+    st = bb_outputs_check(specs, frames, reads, read_count, err);
+  for (int f = 0; names && f < frames; f++)
     free(names[f]);
   free(names);
   free(specs);

@@ -630,10 +630,14 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
   free(job.has_normal);
   free(job.bin_start);
   free(job.bins);
-  if (st != BB_OK)
+  if (st != BB_OK) {
     bb_renderbump_result_free(result);
-  else
-    bb__renderbump_notes(o, result);
+    return st;
+  }
+  result->triangles = mesh->triangle_count;
+  result->vertices = mesh->vertex_count;
+  result->model_hash = bb_mesh_hash(mesh);
+  bb__renderbump_notes(o, result);
   return st;
 }
 

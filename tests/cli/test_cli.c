@@ -1259,6 +1259,76 @@ Test(cli, sigint_mid_write_leaves_no_temporary) {
   interrupt_mid_write(SIGINT);
 }
 
+/* renderbumpflat's two files, interrupted while the new ones are being
+ * written over old ones (a temporary exists, both finals are still the
+ * old size): both stay the old files, and no temporary is left. */
+static int rbf_mid_write(const char *const *finals, const long *old_sizes) {
+  if (count_entries(harness_dir, ".bb-tmp-") == 0)
+    return 0;
+  for (int i = 0; finals[i]; i++) {
+    struct stat st;
+    if (stat(finals[i], &st) != 0 || (long)st.st_size != old_sizes[i])
+      return 0;
+  }
+  return 1;
+}
+
+Test(cli, renderbumpflat_interrupted_mid_write_leaves_the_old_files, .timeout = 300) {
+  const char *model = tmp("slope_rbf.obj");
+  write_bytes(model, slope_obj, strlen(slope_obj));
+  const char *finals[] = {tmp("rbf_n.tga"), tmp("rbf_h.png"), NULL};
+  unsigned char *old[2];
+  size_t old_size[2];
+  long sizes[2];
+  const char *args[] = {"renderbumpflat", model, "-size", "2048", "2048", "--samples", "1",
+                        "-o", finals[0], "--height", finals[1], "-q", NULL};
+  for (int attempt = 0; attempt < 5; attempt++) {
+    run_ok_in(NULL, (const char *[]){"renderbumpflat", model, "-size", "8", "8", "-o",
+                                     finals[0], "--height", finals[1], "-q", NULL});
+    for (int i = 0; i < 2; i++) {
+      old[i] = read_bytes(finals[i], &old_size[i]);
+      sizes[i] = (long)old_size[i];
+    }
+    FILE *out = tmpfile(), *err = tmpfile();
+    pid_t pid = harness_spawn(NULL, &harness_no_limits, args, out, err);
+    int caught = 0, status = 0;
+    double deadline = harness_seconds_now() + 120;
+    while (!caught && harness_seconds_now() < deadline && waitpid(pid, &status, WNOHANG) == 0) {
+      if (!rbf_mid_write(finals, sizes)) {
+        usleep(500);
+        continue;
+      }
+      kill(pid, SIGSTOP);
+      cr_assert_eq(waitpid(pid, &status, WUNTRACED), pid);
+      caught = rbf_mid_write(finals, sizes);
+      if (caught)
+        kill(pid, SIGTERM);
+      kill(pid, SIGCONT);
+    }
+    if (caught)
+      cr_assert_eq(waitpid(pid, &status, 0), pid);
+    else if (waitpid(pid, &status, 0) != pid)
+      cr_assert_fail("lost the child");
+    fclose(out);
+    fclose(err);
+    int same = caught;
+    for (int i = 0; i < 2; i++) {
+      size_t n;
+      unsigned char *now = read_bytes(finals[i], &n);
+      same = same && n == old_size[i] && memcmp(now, old[i], n) == 0;
+      free(now);
+      free(old[i]);
+    }
+    if (!caught) /* the write slipped between look and stop: again */
+      continue;
+    cr_expect(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM, "status %#x", status);
+    cr_expect(same, "an interrupted renderbumpflat replaced an old file");
+    cr_expect_eq(count_entries(harness_dir, ".bb-tmp-"), 0, "a temporary was left");
+    return;
+  }
+  cr_assert_fail("could not catch the write in 5 attempts");
+}
+
 /* Item 5: finite heights whose product with the scale overflows. */
 static float huge_height(int x, int y, int c) {
   (void)c;
