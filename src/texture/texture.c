@@ -185,7 +185,9 @@ static void container_formats(bb__container c, char *buf, size_t cap) {
 static bb_texture_format default_format(bb__container c, bb_map_kind map, int channels) {
   if (c == BB__CONTAINER_VTF)
     return channels == 4 ? BB_TEXTURE_FORMAT_BC3 : BB_TEXTURE_FORMAT_BC1;
-  if (bb_map_kind_get(map)->unit_vectors)
+  /* BC5 keeps x and y (z rebuilt); a normal map with an alpha to keep
+   * (renderbumpflat's coverage) is BC3, as in a VTF */
+  if (bb_map_kind_get(map)->unit_vectors && channels < 4)
     return BB_TEXTURE_FORMAT_BC5;
   switch (channels) {
   case 1: return BB_TEXTURE_FORMAT_BC4;

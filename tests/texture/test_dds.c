@@ -446,3 +446,39 @@ Test(dds, usage_errors) {
   bb_image_free(&pit);
   scratch_dir_remove();
 }
+
+/* A normal map with an alpha to keep (renderbumpflat's coverage) is BC3 by
+ * default, as in a VTF; BC5 would drop the alpha. */
+Test(dds, a_normal_map_with_alpha_is_bc3) {
+  scratch_dir_make("bb_dds");
+  bb_image normal = read_golden("rock06_32_normal.exr");
+  bb_image ao = read_golden("rock06_32_ao.exr");
+  bb_image rgba;
+  cr_assert_eq(bb_image_alloc(&rgba, normal.width, normal.height, 4, NULL), BB_OK);
+  for (size_t i = 0; i < (size_t)normal.width * (size_t)normal.height; i++) {
+    for (int c = 0; c < 3; c++)
+      rgba.pixels[4 * i + (size_t)c] = normal.pixels[3 * i + (size_t)c];
+    rgba.pixels[4 * i + 3] = ao.pixels[i];
+  }
+  bb_texture_options o;
+  bb_texture_options_init(&o);
+  o.map = BB_MAP_NORMAL;
+  char path[160];
+  snprintf(path, sizeof path, "%s/rgba_normal.dds", scratch_dir);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_texture_write(path, &rgba, &o, &err), BB_OK, "%s", err.message);
+  bb_dds_info d;
+  cr_assert_eq(bb_dds_read_info(path, &d, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(d.fourcc, "DXT5");
+  bb_image back = {0};
+  cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(back.channels, 4);
+  double worst = 0;
+  for (size_t i = 0; i < (size_t)back.width * (size_t)back.height; i++)
+    worst = fmax(worst, fabs(back.pixels[4 * i + 3] - ao.pixels[i]));
+  cr_expect_lt(worst, 0.07, "alpha kept within BC3's error (worst %g)", worst);
+  bb_image_free(&back);
+  bb_image_free(&rgba);
+  bb_image_free(&ao);
+  bb_image_free(&normal);
+}
