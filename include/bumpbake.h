@@ -2360,9 +2360,11 @@ void bb_compare_report_free(bb_compare_report *report);
 
 /* idiff's exit code for a report, which `bumpbake compare` exits with: the
  * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
- * the sizes or channel counts differ. (An unreadable file is no report:
- * idiff and `bumpbake compare` exit 4.) */
+ * the sizes or channel counts differ. An unreadable file (bb_compare_files
+ * failing) is no report: idiff's BB_COMPARE_CANNOT_READ, which compare's
+ * usage errors exit with too (bb_command_info.usage_exit). */
 #define BB_COMPARE_DIFFERENT_SIZE 3
+#define BB_COMPARE_CANNOT_READ 4
 int bb_compare_report_exit_code(const bb_compare_report *report);
 
 /* idiff's word for a report's outcome, as `bumpbake compare` prints it:

@@ -22,8 +22,6 @@
 #include <stdlib.h>
 #include <strings.h>
 
-enum { COMPARE_CANNOT_READ = 4 };
-
 typedef struct compare_args {
   const char *path_a, *path_b;
   bb_compare_limits limits;
@@ -168,7 +166,7 @@ int cli_run_compare(const cli_run *run) {
     /* A file that cannot be read, a file over the size limits included,
      * is idiff's 4; two readable files of different sizes are a report
      * (same_shape 0, exit 3), never an error. */
-    return COMPARE_CANNOT_READ;
+    return BB_COMPARE_CANNOT_READ;
   }
   int code;
   if (!r.same_shape) {

@@ -101,7 +101,8 @@ const bb__command bb__command_compare = {
                  "warn when more than -warnpercent % warn or any difference > -hardwarn.\n"
                  "Exit: 0 pass, 1 warning, 2 failure, 3 different size or channels,\n"
                  "4 unreadable file or bad arguments.",
-             .inputs = "A B", .min_inputs = 2, .max_inputs = 2, .usage_exit = 4,
+             .inputs = "A B", .min_inputs = 2, .max_inputs = 2,
+             .usage_exit = BB_COMPARE_CANNOT_READ,
              .option_count = (int)(sizeof compare_options / sizeof compare_options[0]) - 1},
     .options = compare_options, .init = compare_init, .check = compare_check};
 
