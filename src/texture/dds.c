@@ -25,28 +25,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum {
-  DDSD_CAPS = 0x1,
-  DDSD_HEIGHT = 0x2,
-  DDSD_WIDTH = 0x4,
-  DDSD_PITCH = 0x8,
-  DDSD_PIXELFORMAT = 0x1000,
-  DDSD_MIPMAPCOUNT = 0x20000,
-  DDSD_LINEARSIZE = 0x80000,
-  DDPF_ALPHAPIXELS = 0x1,
-  DDPF_FOURCC = 0x4,
-  DDPF_RGB = 0x40,
-  DDSCAPS_COMPLEX = 0x8,
-  DDSCAPS_TEXTURE = 0x1000,
-  DDSCAPS_MIPMAP = 0x400000,
-  DXGI_FORMAT_R32G32B32A32_FLOAT = 2,
-  DXGI_FORMAT_R16G16B16A16_FLOAT = 10,
-  D3D10_RESOURCE_DIMENSION_TEXTURE2D = 3
-};
-/* NVIDIA's flag for normal maps (nvtt writes it; OpenImageIO reads it as
- * "rebuild z from x and y" for BC5). */
-#define DDPF_NORMAL 0x80000000u
-
 static uint32_t fourcc(const char c[4]) {
   return (uint32_t)(unsigned char)c[0] | (uint32_t)(unsigned char)c[1] << 8 |
          (uint32_t)(unsigned char)c[2] << 16 | (uint32_t)(unsigned char)c[3] << 24;

@@ -1,4 +1,5 @@
-/* dds.h: DirectX's DDS texture container, written (dds.c). */
+/* dds.h: DirectX's DDS texture container, written (dds.c) and read
+ * (dds_read.c): the header's flags, by Microsoft's names, and the writer. */
 #ifndef BB_TEXTURE_DDS_H
 #define BB_TEXTURE_DDS_H
 
@@ -8,6 +9,34 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The header's flags and codes (Microsoft's DDS_HEADER, DDS_PIXELFORMAT,
+ * DDS_HEADER_DXT10), as the writer sets them and the reader reads them. */
+enum {
+  DDSD_CAPS = 0x1,
+  DDSD_HEIGHT = 0x2,
+  DDSD_WIDTH = 0x4,
+  DDSD_PITCH = 0x8,
+  DDSD_PIXELFORMAT = 0x1000,
+  DDSD_MIPMAPCOUNT = 0x20000,
+  DDSD_LINEARSIZE = 0x80000,
+  DDPF_ALPHAPIXELS = 0x1,
+  DDPF_ALPHA = 0x2,
+  DDPF_FOURCC = 0x4,
+  DDPF_RGB = 0x40,
+  DDPF_YUV = 0x200,
+  DDPF_LUMINANCE = 0x20000,
+  DDSCAPS_COMPLEX = 0x8,
+  DDSCAPS_TEXTURE = 0x1000,
+  DDSCAPS_MIPMAP = 0x400000,
+  DDSCAPS2_VOLUME = 0x200000,
+  DXGI_FORMAT_R32G32B32A32_FLOAT = 2,
+  DXGI_FORMAT_R16G16B16A16_FLOAT = 10,
+  D3D10_RESOURCE_DIMENSION_TEXTURE2D = 3
+};
+/* NVIDIA's flag for normal maps (nvtt writes it; OpenImageIO reads it as
+ * "rebuild z from x and y" for BC5). */
+#define DDPF_NORMAL 0x80000000u
 
 /* Writes img as a DDS file into f (open, unfinished: the caller finishes or
  * discards it), in format (resolved by bb__texture_resolve, which has

@@ -18,6 +18,7 @@
 #include "core/input_file.h"
 #include "core/internal.h"
 #include "texture/blocks.h"
+#include "texture/dds.h"
 #include "texture/texture_layout.h"
 
 #include <errno.h>
@@ -26,7 +27,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-enum { DDS_HEADER_BYTES = 148, DDSD_MIPMAPCOUNT = 0x20000, TEXTURE2D = 3 };
+enum { DDS_HEADER_BYTES = 148 };
 
 #define T(name, kind, block, samples, channels, s0, s1, s2, s3)                                \
   { name, kind, block, samples, channels, {s0, s1, s2, s3}, {0, 0, 0, 0}, 0 }
@@ -61,15 +62,6 @@ static uint32_t u32_at(const unsigned char *p) {
   return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
-enum {
-  DDPF_ALPHAPIXELS = 0x1,
-  DDPF_ALPHA = 0x2,
-  DDPF_FOURCC = 0x4,
-  DDPF_RGB = 0x40,
-  DDPF_LUMINANCE = 0x20000,
-  DDSCAPS2_VOLUME = 0x200000
-};
-#define DDPF_NORMAL 0x80000000u
 
 static int fourcc_is(const unsigned char *p, const char *code) { return !memcmp(p, code, 4); }
 
@@ -162,7 +154,7 @@ bb_status bb__dds_layout(int fd, const char *path, bb__texture_layout *layout, b
   bb__texel_format f;
   if (dx10) {
     const uint32_t dxgi = u32_at(h + 128), dimension = u32_at(h + 132);
-    if (dimension != TEXTURE2D || depth > 1)
+    if (dimension != D3D10_RESOURCE_DIMENSION_TEXTURE2D || depth > 1)
       return bb__fail(err, BB_ERR_FORMAT,
                       "%s: DDS resource dimension %u, depth %u: only 2D textures are read", path,
                       dimension, depth);
@@ -293,15 +285,15 @@ bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
 }
 
 const char *bb_dds_pixel_flag_name(int bit) {
-  /* Microsoft's DDS_PIXELFORMAT dwFlags (DDPF_*), and NVIDIA's normal-map bit. */
-  switch (bit) {
-  case 0: return "ALPHAPIXELS";
-  case 1: return "ALPHA";
-  case 2: return "FOURCC";
-  case 6: return "RGB";
-  case 9: return "YUV";
-  case 17: return "LUMINANCE";
-  case 31: return "NORMAL";
-  default: return NULL;
-  }
+  static const struct {
+    uint32_t flag;
+    const char *name;
+  } names[] = {{DDPF_ALPHAPIXELS, "ALPHAPIXELS"}, {DDPF_ALPHA, "ALPHA"},
+               {DDPF_FOURCC, "FOURCC"},           {DDPF_RGB, "RGB"},
+               {DDPF_YUV, "YUV"},                 {DDPF_LUMINANCE, "LUMINANCE"},
+               {DDPF_NORMAL, "NORMAL"}};
+  for (size_t i = 0; bit >= 0 && bit < 32 && i < sizeof names / sizeof names[0]; i++)
+    if (names[i].flag == 1u << bit)
+      return names[i].name;
+  return NULL;
 }
