@@ -18,8 +18,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define ONEBITALPHA 0x00001000u
-
 #define T(name, kind, block, samples, channels, s0, s1, s2, s3)                                \
   { name, kind, block, samples, channels, {s0, s1, s2, s3}, {0, 0, 0, 0}, 0 }
 #define P(name, channels, s0, b0, s1, b1, s2, b2, s3, b3)                                      \
@@ -113,9 +111,10 @@ bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, b
     return st;
   }
   bb__texel_format f = VTF_TEXELS[v.format];
-  if (v.format == 13 && (v.flags & ONEBITALPHA))
+  if (v.format == BB__VTF_DXT1 && (v.flags & BB_VTF_FLAG_ONEBITALPHA))
     f.channels = 4; /* DXT1 with its 1-bit alpha in use */
-  if (has_droppable_alpha(v.format) && !(v.flags & (BB_VTF_FLAG_EIGHTBITALPHA | ONEBITALPHA)))
+  if (has_droppable_alpha(v.format) &&
+      !(v.flags & (BB_VTF_FLAG_EIGHTBITALPHA | BB_VTF_FLAG_ONEBITALPHA)))
     f.channels = 3;
   /* Each level holds every frame and face; frame 0, face 0 comes first. */
   const int faces = (v.flags & BB_VTF_FLAG_ENVMAP) ? (v.version_minor < 5 && v.first_frame != 0xffff ? 7 : 6) : 1;
