@@ -4,8 +4,9 @@
 // with WebGL 2 (serve.frag.glsl after shaders/ssbump_relief.glsl), relights
 // as the light is dragged, and sends the controls ("params") and the write
 // action ("write"). The inputs' ranges are the library's ("ranges": the
-// options' descriptions), none of the page's own. Once a bake's maps are drawn, <body data-drawn-bake>
-// holds its id and data-drawn-at the time (Date.now()), for tests.
+// options' descriptions), none of the page's own. Once a bake's maps are
+// drawn, <body data-drawn-bake> holds its id and data-drawn-at the time
+// (Date.now()), for tests.
 "use strict";
 
 const $ = (id) => document.getElementById(id);

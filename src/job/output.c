@@ -43,6 +43,8 @@ static bb_depth depth_of(const bb__job_output *o) {
 }
 
 bb_status bb__job_write_set(const bb__job_file *files, int count, bb_error *err) {
+  if (!files || count < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "job write: no file");
   bb_output_file *out = calloc((size_t)count, sizeof *out);
   char **texts = calloc((size_t)count, sizeof *texts);
   bb_status st = out && texts ? BB_OK

@@ -1,7 +1,7 @@
 /* serve_params.c: the page's side of the options: the state it draws as
  * JSON, the ranges of its inputs as the library describes the options
- * (bb_option_bounds), and its controls (scale, rays, slices, bias, bounce, bounces,
- * brightness) applied to the bake options: each bake control parsed as
+ * (bb_option_bounds), and its controls (scale, rays, slices, bias, bounce,
+ * bounces, brightness) applied to the bake options: each bake control parsed as
  * `bumpbake bake` parses its option of that name (bb_command_set), its range
  * checked by the library (bb_bake_options_check), whose words a refusal
  * shows. */
