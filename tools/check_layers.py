@@ -19,8 +19,9 @@ prints every offence and exits 1, or prints one line and exits 0.
 import argparse
 import os
 import re
-import subprocess
 import sys
+
+from object_symbols import links
 
 ORDER_LINE = re.compile(r"^\s*(?:`|    )?([a-z]+(?:\s*<\s*[a-z]+)+)`?\s*$")
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
@@ -92,28 +93,10 @@ def include_offences(src, rank):
     return offences, count
 
 
-def symbols(path):
-    """(defined, used) global symbols of one object file."""
-    out = subprocess.run(["nm", "-g", path], capture_output=True, text=True, check=True).stdout
-    defined, used = set(), set()
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[1] in "TDBRVWiu":
-            defined.add(parts[2])
-        elif len(parts) == 2 and parts[0] == "U":
-            used.add(parts[1])
-    return defined, used
-
-
 def call_offences(objects, rank):
     """Objects are build/.../src/FAMILY/NAME.o: their family is the folder."""
     family = {o: os.path.basename(os.path.dirname(o)) for o in objects}
-    defined_by, uses = {}, {}
-    for obj in objects:
-        defined, used = symbols(obj)
-        uses[obj] = used
-        for sym in defined:
-            defined_by.setdefault(sym, obj)
+    defined_by, uses = links(objects)
     offences = []
     for obj in objects:
         for sym in sorted(uses[obj]):
