@@ -154,7 +154,7 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-serve check-circles check-layers check-docs bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-circles check-layers check-docs api-report bench bench-cluster goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -358,6 +358,19 @@ check-circles: $(LIB_OBJ) $(CLI_OBJ)
 check-layers: $(LIB_OBJ) $(CLI_OBJ)
 	@$(PYTHON) tools/check_layers.py --families '$(FAMILIES)' $(LIB_OBJ) $(CLI_OBJ)
 	@$(PYTHON) tests/tools/test_check_layers.py
+
+# Who uses which export (tools/api_uses.py): the exports and the public
+# header's lines, how many exports the CLI, serve, Python and the installed
+# C client each use, and what no client uses; one row per export in
+# build/api_uses.tsv. A report, never part of `make test`.
+SERVE_OBJ := $(SERVE_C:%.c=$(BUILD)/%.o)
+api-report: lib $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
+	@$(PYTHON) tools/api_uses.py --shared $(BUILD)/libbumpbake.so --header $(wildcard include/*.h) \
+	  --library $(LIB_OBJ) --client cli $(filter-out $(SERVE_OBJ),$(CLI_OBJ)) \
+	  --client serve $(SERVE_OBJ) --python python/bumpbake \
+	  --source install_client tests/install_client.c \
+	  --tests tests $(TEST_OBJ) --tests tools $(TOOL_OBJ) --tests fuzz $(FUZZ_REPLAY_OBJ) \
+	  --together program cli serve --both program python --table $(BUILD)/api_uses.tsv
 
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.
