@@ -29,24 +29,10 @@
  *   BB_ERR_ARGUMENT with a message listing the names accepted.
  * docs/conventions.md gives the frame, units and formulas in full.
  *
- * The header reads family by family, each using only the ones before it
- * (the folders of src/, in the order of docs/how-it-works.md, "Layers"):
- *   core     status, errors, images, limits
- *   files    checked, all-or-nothing writes of files; provenance texts read
- *   texture  engine textures (VTF, DDS) and Source materials
- *   image    reading and writing image files, mip chains, animations, the
- *            height input
- *   trace    bases, the max-mip pyramid, ray sets, the tracer
- *   bake     smoothing, normals, derived maps, bb_bake
- *   maps     Valve's files, conversions, combining, programs, slope maps,
- *            comparing images
- *   render   lighting the maps, pictures, contact sheets
- *   mesh     models and DOOM 3's flat render bump
- *   job      the whole job on files: provenance, output paths, writing all
- *            or nothing, bakes of files and batches, depfiles, up-to-date
- *            checks
- *   commands every command and option described once, checked, and planned
- *            through the job
+ * The header reads family by family, each using only the ones before it:
+ * the folders of src/, in the order of docs/how-it-works.md ("Layers").
+ * Each family's section opens with its folder's name and what it holds;
+ * `make check-layers` holds the sections to that order.
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -2667,7 +2653,7 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
                           bb_error *err);
 
 /* =====================================================================
- * commands: every command of `bumpbake`, its options and their rules,
+ * cmd: every command of `bumpbake`, its options and their rules,
  * described once
  * ===================================================================== */
 

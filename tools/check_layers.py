@@ -11,8 +11,9 @@ may use itself and the families before it, never one after it:
 - calls: an object of src/FAMILY2/ may use a global symbol (nm) defined by
   an object of FAMILY2 or of a family before it, not one after it.
 It also fails when a folder of src/ holding sources is missing from the
-order, when --families (the Makefile's FAMILIES) is not the order without
-cli, or when the README's "Layout" table lists the folders in another order.
+order, when --families (the Makefile's FAMILIES) or the sections of
+include/bumpbake.h are not the order without cli, or when the README's
+"Layout" table lists the folders in another order.
 `make check-layers` runs it over the library's and the CLI's objects; it
 prints every offence and exits 1, or prints one line and exits 0.
 """
@@ -55,6 +56,15 @@ def readme_order(root):
             if m:
                 folders.append(m.group(1))
     return folders
+
+
+def header_order(root):
+    """The families of the public header's sections, in its order: each
+    section opens with a rule of '=' and a line " * FAMILY: what it holds"."""
+    path = os.path.join(root, "include", "bumpbake.h")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    return re.findall(r"^/\* =+\n \* ([a-z]+):", text, re.M)
 
 
 def family_of(path, src):
@@ -129,12 +139,17 @@ def main(argv):
     for name in order:
         if not os.path.isdir(os.path.join(src, name)):
             offences.append(f"docs/how-it-works.md names {name}, which is not a folder of src/")
-    if args.families is not None and args.families.split() != [f for f in order if f != "cli"]:
+    library = [f for f in order if f != "cli"]
+    if args.families is not None and args.families.split() != library:
         offences.append(f"the Makefile's FAMILIES ({args.families}) are not the order of "
                         f"docs/how-it-works.md without cli ({' '.join(order)})")
     readme = readme_order(root)
     if readme and readme != order:
         offences.append(f"README.md's Layout lists {' '.join(readme)}, not {' '.join(order)}")
+    header = header_order(root)
+    if header != library:
+        offences.append(f"include/bumpbake.h's sections are {' '.join(header)}, not the order "
+                        f"without cli ({' '.join(library)})")
     includes, count = include_offences(src, rank)
     offences += includes
     offences += call_offences(args.objects, rank)
