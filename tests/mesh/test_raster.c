@@ -11,39 +11,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The box scan, as bb__band_draw did it before: every sample whose centre
- * lies in the triangle's box, through the same inside test and depth
- * rule. */
-static void sample_span(double lo, double hi, int n, int count, int *first, int *last) {
-  double f = ceil(lo * n - 0.5), l = floor(hi * n - 0.5);
-  *first = f < 0.0 ? 0 : (f > count ? count : (int)f);
-  *last = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
-}
-
+/* The box scan, as bb__band_draw did it before: every sample of the
+ * triangle's box, through the rasteriser's own row terms and sample test.
+ * Only the row runs (bb__band_draw's clipping) are left to compare. */
 static void box_scan_draw(bb__sample_band *band, const bb__raster_setup *s, int32_t id) {
-  const int n = band->per_texel;
   int i0, i1, j0, j1;
-  sample_span(s->box[0], s->box[2], n, band->columns, &i0, &i1);
-  sample_span(s->box[1], s->box[3], n, band->first_row + band->rows, &j0, &j1);
-  if (j0 < band->first_row)
-    j0 = band->first_row;
+  bb__raster_box(band, s, &i0, &i1, &j0, &j1);
   for (int j = j0; j <= j1; j++) {
-    const double v = (j + 0.5) / n;
-    const double row0 = s->b[0] * v + s->c[0], row1 = s->b[1] * v + s->c[1],
-                 row2 = s->b[2] * v + s->c[2];
-    double *depth = band->depth + (long)(j - band->first_row) * band->columns;
-    int32_t *winner = band->winner + (long)(j - band->first_row) * band->columns;
-    for (int i = i0; i <= i1; i++) {
-      const double u = (i + 0.5) / n;
-      const double e0 = s->a[0] * u + row0, e1 = s->a[1] * u + row1, e2 = s->a[2] * u + row2;
-      if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0)
-        continue;
-      const double d = (e0 * s->d[0] + e1 * s->d[1] + e2 * s->d[2]) * s->inv_area;
-      if (winner[i] < 0 || d > depth[i]) {
-        winner[i] = id;
-        depth[i] = d;
-      }
-    }
+    const bb__raster_row r = bb__raster_row_at(band, s, j);
+    for (int i = i0; i <= i1; i++)
+      bb__raster_sample(s, &r, i, band->per_texel, id);
   }
 }
 
@@ -83,7 +60,8 @@ static void random_triangle(int kind, int W, int H, int n, bb__raster_tri *t) {
     break;
   case 6: /* vertices on sample centres: edges through samples */
     for (int k = 0; k < 3; k++)
-      t->u[k] = (floor(uniform() * W * n) + 0.5) / n, t->v[k] = (floor(uniform() * H * n) + 0.5) / n;
+      t->u[k] = (floor(uniform() * W * n) + 0.5) / n,
+      t->v[k] = (floor(uniform() * H * n) + 0.5) / n;
     break;
   default:
     break;
@@ -99,7 +77,8 @@ Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
       bb__sample_band a = {W * n, H * n - first, first, n, NULL, NULL}, b = a;
       size_t count = (size_t)a.columns * (size_t)a.rows;
       a.depth = malloc(count * sizeof(double)), b.depth = malloc(count * sizeof(double));
-      a.winner = malloc(count * sizeof(int32_t)), b.winner = malloc(count * sizeof(int32_t));
+      a.winner = malloc(count * sizeof(int32_t)),
+      b.winner = malloc(count * sizeof(int32_t));
       cr_assert(a.depth && b.depth && a.winner && b.winner);
       for (size_t k = 0; k < count; k++)
         a.winner[k] = b.winner[k] = -1, a.depth[k] = b.depth[k] = 0.0;
@@ -137,7 +116,8 @@ Test(raster, a_pile_of_triangles_is_refused_and_a_spread_is_not) {
   bb_renderbump_result r;
   bb_error err = {{0}};
   cr_expect_eq(bb_renderbump_flat(&pile, &o, &r, &err), BB_ERR_SIZE);
-  cr_expect(strstr(err.message, "over the 256 layers a render may draw"), "%s", err.message);
+  cr_expect(strstr(err.message, "over the 256 layers a render may draw"), "%s",
+            err.message);
   cr_expect_null(r.normal.pixels);
   bb_mesh_free(&pile);
 
