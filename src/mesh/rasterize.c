@@ -65,11 +65,23 @@ void bb__raster_weights(const bb__raster_setup *s, double u, double v, double w[
 }
 
 /* First and last sample index i whose centre (i + 0.5) / n lies in [lo, hi],
- * clipped to 0 .. count-1; *last < *first when there is none. */
+ * clipped to 0 .. count-1; *last < *first when there is none. The
+ * estimates from lo * n and hi * n round, and are one off when a centre
+ * lies on lo or hi (a vertex on a sample): they are stepped until the
+ * centre, computed as the drawing computes it, agrees. */
 static void sample_span(double lo, double hi, int n, int count, int *first, int *last) {
   double f = ceil(lo * n - 0.5), l = floor(hi * n - 0.5);
-  *first = f < 0.0 ? 0 : (f > count ? count : (int)f);
-  *last = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
+  int i = f < 0.0 ? 0 : (f > count ? count : (int)f);
+  while (i > 0 && ((i - 1) + 0.5) / n >= lo)
+    i--;
+  while (i < count && !((i + 0.5) / n >= lo))
+    i++;
+  int j = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
+  while (j < count - 1 && ((j + 1) + 0.5) / n <= hi)
+    j++;
+  while (j >= 0 && !((j + 0.5) / n <= hi))
+    j--;
+  *first = i, *last = j;
 }
 
 void bb__raster_box(const bb__sample_band *band, const bb__raster_setup *s, int *i0,

@@ -1,6 +1,7 @@
 /* test_raster.c: the rasteriser's row runs against a scan of each
- * triangle's whole box (what it did before), sample for sample, and the
- * bound on what a flat render bump may draw. */
+ * triangle's whole box (what it did before), sample for sample, the box
+ * itself against every sample centre, and the bound on what a flat render
+ * bump may draw. */
 #include "bumpbake.h"
 #include "mesh/rasterize.h"
 
@@ -97,6 +98,86 @@ Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
                    "depths differ, %d samples per texel, band from row %d", n, first);
       free(a.depth), free(b.depth), free(a.winner), free(b.winner);
     }
+  }
+}
+
+/* The first and last of count sample centres (i + 0.5) / n in [lo, hi],
+ * found by looking at each one; last < first when there is none. */
+static void centres_within(double lo, double hi, int n, int from, int count, int *first,
+                           int *last) {
+  *first = count, *last = -1;
+  for (int i = from; i < count; i++) {
+    const double centre = (i + 0.5) / n;
+    if (centre >= lo && centre <= hi) {
+      if (*first == count)
+        *first = i;
+      *last = i;
+    }
+  }
+}
+
+/* The box's columns and rows are the sample centres it holds, within the
+ * band, for triangles of every kind (edges on centres, far outside). */
+Test(raster, the_box_holds_exactly_the_sample_centres_inside_it) {
+  const int W = 37, H = 23;
+  for (int n = 1; n <= 16; n += (n < 4 ? 1 : 5)) {
+    for (int first = 0; first < H * n; first += H * n / 3) {
+      const bb__sample_band band = {W * n, H * n - first, first, n, NULL, NULL};
+      for (int id = 0; id < 2000; id++) {
+        bb__raster_tri t;
+        random_triangle(id % 7, W, H, n, &t);
+        bb__raster_setup s;
+        if (!bb__raster_setup_make(&t, &s))
+          continue;
+        int i0, i1, j0, j1, want_i0, want_i1, want_j0, want_j1;
+        bb__raster_box(&band, &s, &i0, &i1, &j0, &j1);
+        centres_within(s.box[0], s.box[2], n, 0, band.columns, &want_i0, &want_i1);
+        centres_within(s.box[1], s.box[3], n, first, first + band.rows, &want_j0,
+                       &want_j1);
+        if (want_i1 < want_i0 || want_j1 < want_j0) {
+          cr_assert(i1 < i0 || j1 < j0, "triangle %d (n %d, from row %d): box not empty",
+                    id, n, first);
+          continue;
+        }
+        cr_assert(i0 == want_i0 && i1 == want_i1 && j0 == want_j0 && j1 == want_j1,
+                  "triangle %d (n %d, from row %d): box %d..%d x %d..%d, centres %d..%d "
+                  "x %d..%d",
+                  id, n, first, i0, i1, j0, j1, want_i0, want_i1, want_j0, want_j1);
+      }
+    }
+  }
+}
+
+/* A right angle on a sample centre, its legs along the row and the column
+ * (so both its edges are exactly 0 there): the sample is inside, and
+ * drawn, at the box's first corner and at its last, at every centre of
+ * every sampling. */
+Test(raster, a_right_angle_on_a_sample_centre_draws_that_sample) {
+  const int W = 6, H = 5;
+  for (int n = 1; n <= 16; n++) {
+    bb__sample_band band = {W * n, H * n, 0, n, NULL, NULL};
+    const size_t count = (size_t)band.columns * (size_t)band.rows;
+    band.depth = calloc(count, sizeof(double)),
+    band.winner = malloc(count * sizeof(int32_t));
+    cr_assert(band.depth && band.winner);
+    for (size_t k = 0; k < count; k++)
+      band.winner[k] = -1;
+    int32_t id = 0;
+    for (int j = 0; j < band.rows; j++)
+      for (int i = 0; i < band.columns; i++)
+        for (int leg = -2; leg <= 2; leg += 4, id++) {
+          const double u = (i + 0.5) / n, v = (j + 0.5) / n;
+          /* nearer than everything drawn before, so the sample is its own */
+          bb__raster_tri t = {{u, u + leg, u}, {v, v, v + leg}, {id, id, id}};
+          bb__raster_setup s;
+          cr_assert(bb__raster_setup_make(&t, &s));
+          bb__band_draw(&band, &s, id);
+          cr_assert_eq(
+              band.winner[(size_t)j * (size_t)band.columns + (size_t)i], id,
+              "%d samples per texel: the corner on sample (%d, %d), legs %+d, not drawn",
+              n, i, j, leg);
+        }
+    free(band.depth), free(band.winner);
   }
 }
 
