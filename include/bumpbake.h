@@ -51,6 +51,11 @@ extern "C" {
  * ===================================================================== */
 
 #define BB_VERSION_STRING "0.4.0"
+/* The ABI's number: libbumpbake.so's soname is libbumpbake.so.0.N. It
+ * changes only when a change breaks programs built against the last
+ * release (`make check-abi` says so), not with each release: one that
+ * only adds functions keeps it. */
+#define BB_ABI_VERSION 4
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
@@ -2706,6 +2711,9 @@ typedef enum bb_option_mode {
                                       names, format settings, a batch, a cluster;
                                       not for images in memory (bb_command_set_in_memory) */
 
+/* The descriptions below are the library's static data, handed out by
+ * pointer only: a program never makes, copies or steps through an array of
+ * them, so a release may append fields at their end and keep the ABI. */
 typedef struct bb_option_info {
   const char *name;        /* the long name without "--" ("filter-radius"); Python's
                               keyword is it with '-' as '_' (filter_radius) */
