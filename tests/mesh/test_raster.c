@@ -69,6 +69,14 @@ static void random_triangle(int kind, int W, int H, int n, bb__raster_tri *t) {
   }
 }
 
+/* Triangle id of the sequence above (its kind id % 7), set up; 0 when it
+ * has no area. */
+static int random_setup(int32_t id, int W, int H, int n, bb__raster_setup *s) {
+  bb__raster_tri t;
+  random_triangle(id % 7, W, H, n, &t);
+  return bb__raster_setup_make(&t, s);
+}
+
 /* Thousands of triangles of every kind, drawn in order into bands of
  * every sampling: each sample's winner and depth equal the box scan's. */
 Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
@@ -84,10 +92,8 @@ Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
       for (size_t k = 0; k < count; k++)
         a.winner[k] = b.winner[k] = -1, a.depth[k] = b.depth[k] = 0.0;
       for (int32_t id = 0; id < 3500; id++) {
-        bb__raster_tri t;
-        random_triangle(id % 7, W, H, n, &t);
         bb__raster_setup s;
-        if (!bb__raster_setup_make(&t, &s))
+        if (!random_setup(id, W, H, n, &s))
           continue;
         bb__band_draw(&a, &s, id);
         box_scan_draw(&b, &s, id);
@@ -124,10 +130,8 @@ Test(raster, the_box_holds_exactly_the_sample_centres_inside_it) {
     for (int first = 0; first < H * n; first += H * n / 3) {
       const bb__sample_band band = {W * n, H * n - first, first, n, NULL, NULL};
       for (int id = 0; id < 2000; id++) {
-        bb__raster_tri t;
-        random_triangle(id % 7, W, H, n, &t);
         bb__raster_setup s;
-        if (!bb__raster_setup_make(&t, &s))
+        if (!random_setup(id, W, H, n, &s))
           continue;
         int i0, i1, j0, j1, want_i0, want_i1, want_j0, want_j1;
         bb__raster_box(&band, &s, &i0, &i1, &j0, &j1);
