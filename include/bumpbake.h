@@ -29,24 +29,10 @@
  *   BB_ERR_ARGUMENT with a message listing the names accepted.
  * docs/conventions.md gives the frame, units and formulas in full.
  *
- * The header reads family by family, each using only the ones before it
- * (the folders of src/, in the order of docs/how-it-works.md, "Layers"):
- *   core     status, errors, images, limits
- *   files    checked, all-or-nothing writes of files; provenance texts read
- *   texture  engine textures (VTF, DDS) and Source materials
- *   image    reading and writing image files, mip chains, animations, the
- *            height input
- *   trace    bases, the max-mip pyramid, ray sets, the tracer
- *   bake     smoothing, normals, derived maps, bb_bake
- *   maps     Valve's files, conversions, combining, programs, slope maps,
- *            comparing images
- *   render   lighting the maps, pictures, contact sheets
- *   mesh     models and DOOM 3's flat render bump
- *   job      the whole job on files: provenance, output paths, writing all
- *            or nothing, bakes of files and batches, depfiles, up-to-date
- *            checks
- *   commands every command and option described once, checked, and planned
- *            through the job
+ * The header reads family by family, each using only the ones before it:
+ * the folders of src/, in the order of docs/how-it-works.md ("Layers").
+ * Each family's section opens with its folder's name and what it holds;
+ * `make check-layers` holds the sections to that order.
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -65,6 +51,11 @@ extern "C" {
  * ===================================================================== */
 
 #define BB_VERSION_STRING "0.4.0"
+/* The ABI's number: libbumpbake.so's soname is libbumpbake.so.0.N. It
+ * changes only when a change breaks programs built against the last
+ * release (`make check-abi` says so), not with each release: one that
+ * only adds functions keeps it. */
+#define BB_ABI_VERSION 4
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
@@ -2667,7 +2658,7 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
                           bb_error *err);
 
 /* =====================================================================
- * commands: every command of `bumpbake`, its options and their rules,
+ * cmd: every command of `bumpbake`, its options and their rules,
  * described once
  * ===================================================================== */
 
@@ -2720,6 +2711,9 @@ typedef enum bb_option_mode {
                                       names, format settings, a batch, a cluster;
                                       not for images in memory (bb_command_set_in_memory) */
 
+/* The descriptions below are the library's static data, handed out by
+ * pointer only: a program never makes, copies or steps through an array of
+ * them, so a release may append fields at their end and keep the ABI. */
 typedef struct bb_option_info {
   const char *name;        /* the long name without "--" ("filter-radius"); Python's
                               keyword is it with '-' as '_' (filter_radius) */
