@@ -54,10 +54,6 @@ int cli_run_serve(const cli_run *r) {
   s.brightness_file = a->job.brightness_file;
   s.use_brightness = s.brightness_file != NULL;
   s.quiet = a->quiet;
-  /* the ray set and the buffers stay warm from one bake to the next */
-  bb_error context_err = {{0}};
-  if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
-    return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
   s.watched[s.watched_count++] = height;
   const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
                         a->job.basis_file};
@@ -80,27 +76,42 @@ int cli_run_serve(const cli_run *r) {
   if (st != BB_OK)
     return cli_library_error("serve", st, &err);
 
+  /* the ray set and the buffers stay warm from one bake to the next */
+  bb_error context_err = {{0}};
+  if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
+    return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
+
+  /* Listening comes before any bake, so a port already taken ends serve
+   * before a bake starts; every thread started before a failure is
+   * stopped and joined before the command they read is freed. */
   char message[512];
-  if (serve_watch_start(&s, message, sizeof message) != 0) {
+  serve_watch *watch = NULL;
+  if (serve_watch_start(&s, &watch, message, sizeof message) != 0) {
+    bb_bake_context_free(s.context);
     cli_error_line(message);
+    return BB_EXIT_FAILURE;
+  }
+  serve_http_options http = {a->address, a->port, a->address != NULL};
+  char url[256];
+  if (serve_http_start(&s, &http, url, sizeof url) != 0) {
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
+    char line[400];
+    snprintf(line, sizeof line, "serve: %s", url);
+    cli_error_line(line);
     return BB_EXIT_FAILURE;
   }
   pthread_t baker;
   if (pthread_create(&baker, NULL, serve_bake_thread, &s) != 0) {
+    serve_http_stop(&s);
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
     cli_error_line("serve: cannot start the bake thread");
     return BB_EXIT_FAILURE;
   }
   pthread_mutex_lock(&s.lock);
   serve_request_bake(&s);
   pthread_mutex_unlock(&s.lock);
-  serve_http_options http = {a->address, a->port, a->address != NULL};
-  char url[256];
-  if (serve_http_start(&s, &http, url, sizeof url) != 0) {
-    char line[400];
-    snprintf(line, sizeof line, "serve: %s", url);
-    cli_error_line(line);
-    return BB_EXIT_FAILURE;
-  }
   printf("serve: %s (Ctrl-C stops)\n", url);
   fflush(stdout);
   for (;;)

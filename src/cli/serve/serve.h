@@ -7,7 +7,6 @@
 #define BB_CLI_SERVE_H
 
 #include "bumpbake.h"
-#include "bumpbake.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -72,10 +71,11 @@ typedef struct serve_state {
   const char *watched[SERVE_MAX_WATCHED];
   int watched_count;
   int quiet;
-  int quit;
+  atomic_int quit;        /* the process is stopping: the bake in flight is cancelled */
 } serve_state;
 
-/* serve_bake.c: the bake thread (runs until state->quit). */
+/* serve_bake.c: the bake thread (runs until state->quit; a bake in flight
+ * is cancelled when it is set). */
 void *serve_bake_thread(void *state);
 /* Asks for a new bake (a save or a control changed); the caller holds the lock. */
 void serve_request_bake(serve_state *s);
@@ -89,9 +89,13 @@ void serve_job_options(const serve_state *s, bb_job_options *o);
 
 /* serve_watch.c: watches the directories of s->watched with inotify and
  * asks for a bake when one of the files is saved (renamed over, or written
- * and closed, or quiet for a moment after a write). Returns 0, or -1 with
- * a message in err (capacity cap) when inotify cannot be set up. */
-int serve_watch_start(serve_state *s, char *err, size_t cap);
+ * and closed, or quiet for a moment after a write), on a thread of its
+ * own. Returns 0 with the watch in *out, or -1 with a message in err
+ * (capacity cap) when inotify cannot be set up. */
+typedef struct serve_watch serve_watch;
+int serve_watch_start(serve_state *s, serve_watch **out, char *err, size_t cap);
+/* Stops the watch's thread, waits for it and frees w (NULL: nothing). */
+void serve_watch_stop(serve_watch *w);
 
 /* serve_http.c: the server. */
 typedef struct serve_http_options {
@@ -102,6 +106,8 @@ typedef struct serve_http_options {
 /* Starts serving s; the URL of the page into url (capacity cap). Returns 0,
  * or -1 with a message in url. */
 int serve_http_start(serve_state *s, const serve_http_options *o, char *url, size_t cap);
+/* Stops the server started for s: its threads end before it returns. */
+void serve_http_stop(serve_state *s);
 
 /* serve_params.c: the state as one JSON object (malloc'd), as the page reads it. */
 char *serve_state_json(serve_state *s);

@@ -65,7 +65,7 @@ typedef struct progress_ctx {
  * cancels when a newer request came. */
 static int on_progress(void *user, long done, long total) {
   progress_ctx *p = user;
-  if (atomic_load(&p->s->wanted) != p->wanted)
+  if (atomic_load(&p->s->wanted) != p->wanted || atomic_load(&p->s->quit))
     return 1;
   double now = now_seconds();
   pthread_mutex_lock(&p->s->lock);
@@ -240,3 +240,4 @@ void *serve_bake_thread(void *arg) {
   pthread_mutex_unlock(&s->lock);
   return NULL;
 }
+

@@ -419,8 +419,15 @@ static int random_token(char *out, size_t cap) {
   return 0;
 }
 
+static server sv; /* lives as long as the process */
+
+void serve_http_stop(serve_state *s) {
+  if (sv.s == s && sv.daemon)
+    MHD_stop_daemon(sv.daemon);
+  sv.daemon = NULL;
+}
+
 int serve_http_start(serve_state *s, const serve_http_options *o, char *url, size_t cap) {
-  static server sv; /* lives as long as the process */
   memset(&sv, 0, sizeof sv);
   sv.s = s;
   const char *address = o->address ? o->address : "127.0.0.1";

@@ -12,10 +12,12 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <pthread.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/eventfd.h>
 #include <sys/inotify.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -24,14 +26,17 @@
 /* How long a file written without a close must stay unchanged. */
 #define QUIET_MS 150
 
-typedef struct watch {
+struct serve_watch {
   serve_state *s;
   int fd;
+  int stop_fd;                     /* an eventfd: written to stop the thread */
+  pthread_t thread;
   int wd[SERVE_MAX_WATCHED];       /* the watch of each file's directory */
   const char *base[SERVE_MAX_WATCHED];
   int pending;                     /* a write without a close was seen */
   struct stat last[SERVE_MAX_WATCHED];
-} watch;
+};
+typedef struct serve_watch watch;
 
 static const char *base_name(const char *path) {
   const char *slash = strrchr(path, '/');
@@ -89,10 +94,12 @@ static int read_events(watch *w) {
 static void *watch_thread(void *arg) {
   watch *w = arg;
   for (;;) {
-    struct pollfd pfd = {w->fd, POLLIN, 0};
-    int ready = poll(&pfd, 1, w->pending ? QUIET_MS : -1);
+    struct pollfd pfd[2] = {{w->fd, POLLIN, 0}, {w->stop_fd, POLLIN, 0}};
+    int ready = poll(pfd, 2, w->pending ? QUIET_MS : -1);
     if (ready < 0 && errno != EINTR)
       break;
+    if (ready > 0 && pfd[1].revents)
+      break; /* serve_watch_stop */
     if (ready > 0) {
       int seen = read_events(w);
       if (seen == 2) {
@@ -110,7 +117,16 @@ static void *watch_thread(void *arg) {
   return NULL;
 }
 
-int serve_watch_start(serve_state *s, char *err, size_t cap) {
+static void watch_free(watch *w) {
+  if (w->fd >= 0)
+    close(w->fd);
+  if (w->stop_fd >= 0)
+    close(w->stop_fd);
+  free(w);
+}
+
+int serve_watch_start(serve_state *s, serve_watch **out, char *err, size_t cap) {
+  *out = NULL;
   watch *w = calloc(1, sizeof *w);
   if (!w) {
     snprintf(err, cap, "out of memory");
@@ -118,9 +134,11 @@ int serve_watch_start(serve_state *s, char *err, size_t cap) {
   }
   w->s = s;
   w->fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (w->fd < 0) {
-    snprintf(err, cap, "cannot watch the inputs: inotify: %s", strerror(errno));
-    free(w);
+  w->stop_fd = eventfd(0, EFD_CLOEXEC);
+  if (w->fd < 0 || w->stop_fd < 0) {
+    snprintf(err, cap, "cannot watch the inputs: %s: %s", w->fd < 0 ? "inotify" : "eventfd",
+             strerror(errno));
+    watch_free(w);
     return -1;
   }
   for (int i = 0; i < s->watched_count; i++) {
@@ -135,18 +153,25 @@ int serve_watch_start(serve_state *s, char *err, size_t cap) {
                                  IN_MOVED_TO | IN_CLOSE_WRITE | IN_MODIFY | IN_CREATE);
     if (w->wd[i] < 0) {
       snprintf(err, cap, "cannot watch %s: %s", dir, strerror(errno));
-      close(w->fd);
-      free(w);
+      watch_free(w);
       return -1;
     }
   }
-  pthread_t t;
-  if (pthread_create(&t, NULL, watch_thread, w) != 0) {
+  if (pthread_create(&w->thread, NULL, watch_thread, w) != 0) {
     snprintf(err, cap, "cannot start the watch thread");
-    close(w->fd);
-    free(w);
+    watch_free(w);
     return -1;
   }
-  pthread_detach(t);
+  *out = w;
   return 0;
+}
+
+void serve_watch_stop(serve_watch *w) {
+  if (!w)
+    return;
+  const uint64_t one = 1;
+  if (write(w->stop_fd, &one, sizeof one) != (ssize_t)sizeof one)
+    return; /* cannot happen on an eventfd below its maximum; the thread keeps w */
+  pthread_join(w->thread, NULL);
+  watch_free(w);
 }
