@@ -104,6 +104,39 @@ def test_the_server_refuses(served):
     assert sorted(os.listdir(d)) == ["h.png"]  # nothing written unless asked
 
 
+def response_headers(url, method="GET", headers=None, path=""):
+    u = urllib.parse.urlsplit(url)
+    c = http.client.HTTPConnection(u.hostname, u.port, timeout=30)
+    c.request(method, u.path + path, headers=headers or {})
+    r = c.getresponse()
+    got = {k.lower(): v for k, v in r.getheaders()}
+    c.close()  # an event stream is left unread
+    return r.status, got
+
+
+def test_no_page_may_frame_it_and_it_loads_nothing_from_elsewhere(served):
+    s, _ = served
+    cases = [("GET", {}, ""), ("GET", {}, "index.html"), ("GET", {}, "serve.js"),
+             ("GET", {}, "serve.css"), ("GET", {}, "state"), ("GET", {}, "ranges"),
+             ("GET", {}, "map/ssbump_ao"), ("GET", {}, "events"), ("GET", {}, "nothing"),
+             ("HEAD", {}, ""), ("GET", {"Host": "attacker.example:80"}, ""),
+             ("DELETE", {}, ""), ("POST", {}, "write"),
+             ("POST", {"X-Bumpbake": "1"}, "params?rays=x")]
+    for method, headers, path in cases:
+        status, got = response_headers(s.url, method, headers, path)
+        what = "%s /%s -> %d" % (method, path, status)
+        assert got.get("x-frame-options") == "DENY", what
+        csp = [d.strip() for d in got.get("content-security-policy", "").split(";")]
+        assert "frame-ancestors 'none'" in csp, (what, csp)
+        assert "default-src 'none'" in csp and "script-src 'self'" in csp, (what, csp)
+        assert not [d for d in csp if "unsafe" in d or "*" in d or "http" in d], (what, csp)
+        assert got.get("x-content-type-options") == "nosniff", what
+    # the page has no inline script or style the policy would stop
+    html = request(s.url, path="index.html")[1].decode()
+    assert not re.search(r"<script(?![^>]*\bsrc=)", html) and "<style" not in html
+    assert not re.search(r"\sstyle=|\son[a-z]+=", html)
+
+
 FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
 
 

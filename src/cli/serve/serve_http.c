@@ -32,17 +32,32 @@ typedef struct server {
 
 /* ------------------------------------------------------------ responses */
 
+/* Every response's headers: its type, never cached, never sniffed as
+ * another type, and never shown in a frame (a page elsewhere cannot lay
+ * the page under a decoy and have a click "write the maps"); the page
+ * runs, styles and fetches only what this server sends. */
+static const char *const policy = "default-src 'none'; script-src 'self'; style-src 'self'; "
+                                  "connect-src 'self'; img-src 'self' data:; base-uri 'none'; "
+                                  "form-action 'none'; frame-ancestors 'none'";
+
+static enum MHD_Result queue(struct MHD_Connection *c, unsigned status, struct MHD_Response *r,
+                             const char *type) {
+  MHD_add_response_header(r, "Content-Type", type);
+  MHD_add_response_header(r, "Cache-Control", "no-store");
+  MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
+  MHD_add_response_header(r, "X-Frame-Options", "DENY");
+  MHD_add_response_header(r, "Content-Security-Policy", policy);
+  enum MHD_Result ret = MHD_queue_response(c, status, r);
+  MHD_destroy_response(r);
+  return ret;
+}
+
 static enum MHD_Result send_bytes(struct MHD_Connection *c, unsigned status, const char *type,
                                   const void *data, size_t size, enum MHD_ResponseMemoryMode mode) {
   struct MHD_Response *r = MHD_create_response_from_buffer(size, (void *)data, mode);
   if (!r)
     return MHD_NO;
-  MHD_add_response_header(r, "Content-Type", type);
-  MHD_add_response_header(r, "Cache-Control", "no-store");
-  MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
-  enum MHD_Result ret = MHD_queue_response(c, status, r);
-  MHD_destroy_response(r);
-  return ret;
+  return queue(c, status, r, type);
 }
 
 static enum MHD_Result send_text(struct MHD_Connection *c, unsigned status, const char *text) {
@@ -137,14 +152,10 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c, const 
     texture_free(r);
     return MHD_NO;
   }
-  MHD_add_response_header(resp, "Content-Type", "application/octet-stream");
-  MHD_add_response_header(resp, "Cache-Control", "no-store");
   MHD_add_response_header(resp, "X-Bake-Id", id);
   MHD_add_response_header(resp, "X-Width", w);
   MHD_add_response_header(resp, "X-Height", h);
-  enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_OK, resp);
-  MHD_destroy_response(resp);
-  return ret;
+  return queue(c, MHD_HTTP_OK, resp, "application/octet-stream");
 }
 
 /* --------------------------------------------------------------- events */
@@ -219,11 +230,7 @@ static enum MHD_Result send_events(server *sv, struct MHD_Connection *c) {
     event_free(e);
     return MHD_NO;
   }
-  MHD_add_response_header(r, "Content-Type", "text/event-stream");
-  MHD_add_response_header(r, "Cache-Control", "no-store");
-  enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_OK, r);
-  MHD_destroy_response(r);
-  return ret;
+  return queue(c, MHD_HTTP_OK, r, "text/event-stream");
 }
 
 /* ------------------------------------------------------------- controls */

@@ -20,10 +20,11 @@
 
 EMBED(serve_index_html, "share/serve/index.html");
 EMBED(serve_js, "share/serve/serve.js");
+EMBED(serve_css, "share/serve/serve.css");
 EMBED(serve_frag_glsl, "share/serve/serve.frag.glsl");
 EMBED(serve_relief_glsl, "shaders/ssbump_relief.glsl");
 
-static serve_asset assets[4];
+static serve_asset assets[5];
 
 static void init_assets(void) {
   {
@@ -36,6 +37,8 @@ static void init_assets(void) {
     assets[3] = (serve_asset){"ssbump_relief.glsl", "text/plain; charset=utf-8",
                               serve_relief_glsl,
                               (size_t)(serve_relief_glsl_end - serve_relief_glsl)};
+    assets[4] = (serve_asset){"serve.css", "text/css; charset=utf-8", serve_css,
+                              (size_t)(serve_css_end - serve_css)};
   }
 }
 
