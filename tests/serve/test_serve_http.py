@@ -305,3 +305,218 @@ def test_write_writes_the_maps_shown_as_bake_would(served):
     wait_bake(s, before, "the bake of the good save")
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
     assert status == 200 and json.loads(body)["from"] == "memory", body
+
+
+# ------------------------------------------------------ slow and many clients
+
+def slow_sockets(url, count, first=b"GET / HTTP/1.1\r\n"):
+    """count connections that have sent first and nothing more yet."""
+    import socket
+
+    u = urllib.parse.urlsplit(url)
+    socks = []
+    for _ in range(count):
+        k = socket.create_connection((u.hostname, u.port), timeout=10)
+        if first:
+            k.sendall(first)
+        socks.append(k)
+    return socks
+
+
+def closed_by_server(k, timeout):
+    """1 when the server closed k (end of file or a reset) within timeout."""
+    import socket
+
+    k.settimeout(timeout)
+    try:
+        return k.recv(4096) == b""
+    except (ConnectionResetError, BrokenPipeError):
+        return True
+    except socket.timeout:
+        return False
+
+
+def test_the_page_loads_while_70_slow_clients_hold_connections(served):
+    import time
+
+    s, _ = served
+    socks = slow_sockets(s.url, 70)
+    try:
+        for k in socks:  # a header line each, as a slowloris sends them
+            k.sendall(b"X-Slow: 1\r\n")
+        t0 = time.monotonic()
+        assert request(s.url)[0] == 200
+        assert request(s.url, path="state")[0] == 200
+        assert request(s.url, path="map/ssbump_ao")[0] == 200
+        assert time.monotonic() - t0 < 20
+        # headers that take longer than the bound are cut, a line every 2 s
+        # or not: well within 25 s every slow connection is closed
+        end = time.monotonic() + 25
+        open_ = list(socks)
+        while open_ and time.monotonic() < end:
+            for k in list(open_):
+                try:
+                    k.sendall(b"X-Slow: 2\r\n")
+                except OSError:
+                    open_.remove(k)
+                    continue
+                if closed_by_server(k, 0.01):
+                    open_.remove(k)
+            time.sleep(2)
+        assert not open_, "%d slow connections still open after 25 s" % len(open_)
+    finally:
+        for k in socks:
+            k.close()
+
+
+def open_event_streams(url, count, refused_ok=False):
+    """count /events streams, each read up to its first event; with
+    refused_ok, None when one is refused (503: too many)."""
+    import socket
+
+    u = urllib.parse.urlsplit(url)
+    streams = []
+    for _ in range(count):
+        k = socket.create_connection((u.hostname, u.port), timeout=10)
+        streams.append(k)
+        k.sendall(("GET %sevents HTTP/1.1\r\nHost: %s\r\n\r\n" % (u.path, u.netloc)).encode())
+        got = b""
+        while b"\r\n\r\n" not in got or (got.startswith(b"HTTP/1.1 200")
+                                          and b"data: " not in got):
+            chunk = k.recv(65536)
+            assert chunk, "an event stream closed before its first event: %r" % got[:200]
+            got += chunk
+        if refused_ok and got.startswith(b"HTTP/1.1 503"):
+            for x in streams:
+                x.close()
+            return None
+        assert got.startswith(b"HTTP/1.1 200"), got[:100]
+    return streams
+
+
+STREAM_LIMIT = 256  # serve_http.c: event streams at once
+
+
+def test_event_streams_leave_room_and_free_their_slot_when_the_client_goes(served):
+    import time
+
+    s, _ = served
+    streams = open_event_streams(s.url, STREAM_LIMIT)
+    try:
+        assert request(s.url)[0] == 200  # the page, beside them
+        assert response_headers(s.url, path="events")[0] == 503  # too many streams
+    finally:
+        for k in streams:
+            k.close()
+    # their slots come back within seconds of the clients leaving
+    t0 = time.monotonic()
+    streams = sb.wait_for(lambda: open_event_streams(s.url, STREAM_LIMIT, refused_ok=True), 30,
+                          "every stream's slot free again", interval=0.2)
+    print("%d streams again after %.2f s" % (STREAM_LIMIT, time.monotonic() - t0))
+    try:
+        assert request(s.url, path="state")[0] == 200
+    finally:
+        for k in streams:
+            k.close()
+
+
+def test_with_address_one_client_has_a_bounded_share(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"),
+                  ["--scale", "8", "--rays", "16", "--address", "127.0.0.1", "--quiet"])
+    socks = []
+    try:
+        assert request(s.url)[0] == 200
+        socks = slow_sockets(s.url, 80, first=b"")
+        # the server closes what is over one client's share at once
+        refused = [k for k in socks if closed_by_server(k, 0.5)]
+        assert 8 <= len(refused) < 80, len(refused)
+        for k in socks:
+            k.close()
+        socks = []
+        assert sb.wait_for(lambda: request(s.url)[0] == 200, 30, "the page again")
+    finally:
+        for k in socks:
+            k.close()
+        s.close()
+
+
+# ------------------------------------------------------------- memory bound
+
+def sanitized(pid):
+    """1 when the process runs under AddressSanitizer (make DEBUG=1), whose
+    quarantine keeps freed memory: its RSS says nothing of serve's."""
+    with open("/proc/%d/maps" % pid) as f:
+        return "libasan" in f.read()
+
+
+def memory_mb(pid, key):
+    """VmRSS or VmHWM (the peak) of a process, in MB."""
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) / 1024
+    raise AssertionError("no %s for %d" % (key, pid))
+
+
+@pytest.fixture
+def served_1024(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_height.png"), tmp_path / "h.png")
+    s = sb.Server(BIN, str(tmp_path / "h.png"), ["--scale", "64", "--rays", "16"])
+    wait_bake(s, 0, "the first bake")
+    yield s, tmp_path
+    s.close()
+
+
+def test_concurrent_writes_are_one_write_at_a_time(served_1024):
+    import concurrent.futures
+
+    s, d = served_1024
+    base = memory_mb(s.proc.pid, "VmRSS")
+    # a control changed: the maps shown are not the line's, so a write bakes
+    status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=63")
+    assert status == 200
+    with concurrent.futures.ThreadPoolExecutor(12) as pool:
+        replies = list(pool.map(lambda _: request(s.url, "POST", {"X-Bumpbake": "1"}, "write"),
+                                range(12)))
+    assert [r[0] for r in replies] == [200] * 12, replies
+    peak = memory_mb(s.proc.pid, "VmHWM")
+    asan = sanitized(s.proc.pid)
+    words = shlex.split(state(s)["command"])
+    assert "63" in words
+    s.close()
+    err = s.proc.stderr.read()
+    writes = err.count("serve: wrote the maps")
+    print("12 writes at once: %d runs, RSS %.0f MB before, peak %.0f MB" % (writes, base, peak))
+    # the requests that wait while one write runs are answered by the next
+    assert 1 <= writes <= 3, err
+    # one bake of a 1024 x 1024 height at a time besides the one shown
+    assert peak < base + 400 or asan, (base, peak)
+
+
+def test_stalled_downloads_do_not_hold_the_maps(served_1024):
+    import socket
+
+    s, d = served_1024
+    u = urllib.parse.urlsplit(s.url)
+    base = memory_mb(s.proc.pid, "VmRSS")
+    stalled = []
+    try:
+        last = state(s)["bake"]["id"]
+        for i in range(8):
+            k = socket.create_connection((u.hostname, u.port), timeout=10)
+            k.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            k.sendall(("GET %smap/ssbump_ao HTTP/1.1\r\nHost: %s\r\n\r\n"
+                       % (u.path, u.netloc)).encode())
+            assert k.recv(1024).startswith(b"HTTP/1.1 200")
+            stalled.append(k)  # read no further
+            status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=%d" % (70 + i))
+            assert status == 200
+            last = wait_bake(s, last, "bake %d" % i)["bake"]["id"]
+        rss = memory_mb(s.proc.pid, "VmRSS")
+        print("8 stalled downloads of 8 bakes: RSS %.0f MB, from %.0f MB" % (rss, base))
+        assert rss < base + 150 or sanitized(s.proc.pid), (base, rss)
+        assert request(s.url)[0] == 200
+    finally:
+        for k in stalled:
+            k.close()

@@ -1,6 +1,7 @@
 /* serve.h: what the parts of `bumpbake serve` share (src/cli/serve/): the
- * state one bake thread, one watch thread and the HTTP server's connection
- * threads read and change under one lock. The bakes go through the
+ * state one bake thread, one watch thread and the HTTP server's threads
+ * (its polling thread, the writer and the ticker) read and change under
+ * one lock. The bakes go through the
  * library's job (bb_job_bake_item, bb_job_run_item); nothing here is a
  * bake rule. */
 #ifndef BB_CLI_SERVE_H
@@ -21,20 +22,28 @@ enum {
 };
 
 /* One finished bake: published at once, its textures made when first
- * asked (the picture shown asks for one first), freed with its last
- * reference (a response may still be sending it when a newer one lands). */
+ * asked (the picture shown asks for one first). The state holds the bake
+ * shown and the one before it (downloads in flight when a newer one lands
+ * finish from it); a request holds a reference while it reads the bake.
+ * The float maps and the job, the bulk of a bake, are used only while the
+ * bake is the one shown (a "write" from memory, textures made): once it
+ * is not, they are freed as soon as their last user is done (maps_shed),
+ * so what serve holds does not grow with the requests that hold bakes. */
 typedef struct serve_bake {
   int refs; /* under serve_state.lock */
+  int maps_users;                      /* under serve_state.lock: users of maps and job */
+  int maps_shed;                       /* not shown any more: maps and job go with
+                                          their last user */
   long id;
   int width, height;
-  pthread_mutex_t tex_lock;            /* makes tex[]; serialises writes of maps */
+  pthread_mutex_t tex_lock;            /* makes tex[] (then under serve_state.lock) */
   unsigned char *tex[SERVE_TEX_COUNT]; /* NULL until asked */
   bb_job *job;                         /* the job that baked them (its report) */
   bb_bake_result maps;                 /* the bake's float maps: the textures and a
                                           "write" (bb_job_write_item) are made of them */
   long wanted;                         /* the request it answered (serve_state.wanted) */
   double seconds;          /* from the start of the bake to its maps */
-  double seconds_textures; /* making the textures asked so far */
+  double seconds_textures; /* making the textures asked so far (under serve_state.lock) */
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */
@@ -66,6 +75,7 @@ typedef struct serve_state {
   double last_progress_seconds;
   char error[1024];       /* the last bake's failure, "" after a success */
   serve_bake *current;    /* the last good bake, or NULL */
+  serve_bake *previous;   /* the one before it, or NULL (its maps shed) */
   long next_id;
   bb_bake_context *context; /* the bake thread's warm ray set and buffers */
   const char *watched[SERVE_MAX_WATCHED];
@@ -81,9 +91,15 @@ void *serve_bake_thread(void *state);
 void serve_request_bake(serve_state *s);
 /* Drops one reference; the caller holds the lock. */
 void serve_bake_release(serve_bake *b);
+/* The bake shown, with a reference and the use of its maps and job; NULL
+ * when there is none. The caller holds the lock; serve_maps_done ends the
+ * use (also with the lock held), then serve_bake_release. */
+serve_bake *serve_maps_use(serve_state *s);
+void serve_maps_done(serve_bake *b);
 /* Texture t of b (4 x width x height bytes), made on first use; NULL when
- * out of memory. Any thread, with a reference held. */
-const unsigned char *serve_bake_texture(serve_bake *b, int t);
+ * out of memory, or when it was not made while b was shown. Any thread,
+ * with a reference held and the lock not. */
+const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t);
 /* The job options a bake or a write uses now (the caller holds the lock). */
 void serve_job_options(const serve_state *s, bb_job_options *o);
 

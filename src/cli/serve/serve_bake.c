@@ -26,17 +26,44 @@ void serve_request_bake(serve_state *s) {
   pthread_cond_signal(&s->work);
 }
 
+static void free_maps(serve_bake *b) {
+  bb_bake_result_free(&b->maps);
+  bb_job_free(b->job);
+  b->job = NULL;
+}
+
 void serve_bake_release(serve_bake *b) {
   if (!b || --b->refs > 0)
     return;
   for (int t = 0; t < SERVE_TEX_COUNT; t++)
     free(b->tex[t]);
-  bb_bake_result_free(&b->maps);
-  bb_job_free(b->job);
+  free_maps(b);
   pthread_mutex_destroy(&b->tex_lock);
   free(b->provenance);
   free(b->command);
   free(b);
+}
+
+serve_bake *serve_maps_use(serve_state *s) {
+  serve_bake *b = s->current;
+  if (!b || b->maps_shed)
+    return NULL;
+  b->refs++;
+  b->maps_users++;
+  return b;
+}
+
+void serve_maps_done(serve_bake *b) {
+  if (--b->maps_users == 0 && b->maps_shed)
+    free_maps(b);
+}
+
+/* b is no longer shown: its maps and job go now, or with their last user.
+ * The caller holds the lock. */
+static void shed_maps(serve_bake *b) {
+  b->maps_shed = 1;
+  if (b->maps_users == 0)
+    free_maps(b);
 }
 
 void serve_job_options(const serve_state *s, bb_job_options *o) {
@@ -106,24 +133,39 @@ static void fill(unsigned char *tex, size_t n, const bb_image *img, int is_vecto
   }
 }
 
-const unsigned char *serve_bake_texture(serve_bake *b, int t) {
+static void make_texture(serve_bake *b, int t) {
+  const size_t n = (size_t)b->width * (size_t)b->height;
+  const bb_bake_result *r = &b->maps;
+  if ((b->tex[t] = malloc(4 * n))) {
+    switch (t) {
+    case SERVE_TEX_SSBUMP_AO: fill(b->tex[t], n, &r->ssbump, 0, &r->ao); break;
+    case SERVE_TEX_NORMAL_HEIGHT: fill(b->tex[t], n, &r->normal, 1, &r->filtered); break;
+    case SERVE_TEX_BENT: fill(b->tex[t], n, &r->bent, 1, NULL); break;
+    default: fill(b->tex[t], n, &r->weights, 0, NULL); break;
+    }
+  }
+}
+
+const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t) {
   pthread_mutex_lock(&b->tex_lock);
   if (!b->tex[t]) {
-    const double t0 = now_seconds();
-    const size_t n = (size_t)b->width * (size_t)b->height;
-    const bb_bake_result *r = &b->maps;
-    if ((b->tex[t] = malloc(4 * n))) {
-      switch (t) {
-      case SERVE_TEX_SSBUMP_AO: fill(b->tex[t], n, &r->ssbump, 0, &r->ao); break;
-      case SERVE_TEX_NORMAL_HEIGHT: fill(b->tex[t], n, &r->normal, 1, &r->filtered); break;
-      case SERVE_TEX_BENT: fill(b->tex[t], n, &r->bent, 1, NULL); break;
-      default: fill(b->tex[t], n, &r->weights, 0, NULL); break;
-      }
+    pthread_mutex_lock(&s->lock);
+    const int usable = !b->maps_shed;
+    if (usable)
+      b->maps_users++;
+    pthread_mutex_unlock(&s->lock);
+    if (usable) {
+      const double t0 = now_seconds();
+      make_texture(b, t);
+      pthread_mutex_lock(&s->lock);
+      b->seconds_textures += now_seconds() - t0;
+      serve_maps_done(b);
+      pthread_mutex_unlock(&s->lock);
     }
-    b->seconds_textures += now_seconds() - t0;
   }
+  const unsigned char *tex = b->tex[t];
   pthread_mutex_unlock(&b->tex_lock);
-  return b->tex[t];
+  return tex;
 }
 
 /* The ssbump's provenance as the job records it in the file it writes. */
@@ -203,7 +245,9 @@ static void bake_once(serve_state *s, long wanted) {
   s->done = wanted;
   if (st == BB_OK) {
     b->id = ++s->next_id;
-    serve_bake_release(s->current);
+    serve_bake_release(s->previous);
+    if ((s->previous = s->current))
+      shed_maps(s->previous);
     s->current = b;
     s->error[0] = '\0';
     if (!s->quiet)

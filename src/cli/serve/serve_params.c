@@ -42,10 +42,7 @@ static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_number(j, "seconds_pyramid", r->seconds_pyramid);
   bb_json_number(j, "seconds_trace", r->seconds_trace);
   bb_json_number(j, "seconds_derive", r->seconds_derive);
-  pthread_mutex_lock(&b->tex_lock);
-  const double textures = b->seconds_textures;
-  pthread_mutex_unlock(&b->tex_lock);
-  bb_json_number(j, "seconds_textures", textures);
+  bb_json_number(j, "seconds_textures", b->seconds_textures);
   bb_json_int(j, "threads", r->threads);
   bb_json_int(j, "slices", r->slices);
   bb_json_number(j, "scale", b->scale);
