@@ -349,7 +349,7 @@ $("write").addEventListener("click", async () => {
   try {
     const r = await post("write");
     $("write-result").textContent = "wrote " + r.outputs.map((o) => o.path).join(", ") +
-      (r.from === "memory" ? " (the maps shown, not baked again)" : " (baked again: a change was pending)");
+      (r.from === "memory" ? " (the maps shown, not baked again)" : " (baked again: " + r.reason + ")");
   } catch (e) {
     $("write-error").textContent = e.message;
   }

@@ -27,10 +27,10 @@ def browser_missing():
 class Server:
     """bumpbake serve HEIGHT ARGS... on 127.0.0.1, any free port."""
 
-    def __init__(self, binary, height, args):
+    def __init__(self, binary, height, args, cwd=None):
         self.proc = subprocess.Popen(
             [binary, "serve", height, "--port", "0", *args],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd)
         line = self.proc.stdout.readline()
         m = re.search(r"(http://\S+)", line)
         if not m:

@@ -520,3 +520,67 @@ def test_stalled_downloads_do_not_hold_the_maps(served_1024):
     finally:
         for k in stalled:
             k.close()
+
+
+# ---------------------------------------------------------------- the watch
+
+def test_a_folder_moved_away_and_made_again_keeps_the_watch(tmp_path):
+    os.mkdir(tmp_path / "sub")
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "sub" / "h.png")
+    s = sb.Server(BIN, "sub/h.png", ["--scale", "8", "--rays", "16", "--quiet"],
+                  cwd=str(tmp_path))
+    try:
+        first = wait_bake(s, 0, "the first bake")["bake"]["id"]
+        os.rename(tmp_path / "sub", tmp_path / "sub2")
+        # the height is gone from its path: the page says so
+        st = sb.wait_for(lambda: (lambda x: x if x["error"] else None)(state(s)), 60,
+                         "the height's loss reported")
+        assert "sub/h.png" in st["error"], st["error"]
+        os.mkdir(tmp_path / "sub")
+        with open(os.path.join(FIXTURES, "bricks_128x64.png"), "rb") as f:
+            sb.save_by_rename(f.read(), str(tmp_path / "sub" / "h.png"))
+        st = sb.wait_for(lambda: (lambda x: x if x.get("bake", {}).get("height") == 64
+                                  and not x["baking"] else None)(state(s)), 60,
+                         "the save in the new folder baked")
+        assert st["error"] == "" and st["bake"]["id"] > first
+        # and the folder moved away is not watched any more
+        last = st["bake"]["id"]
+        with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
+            sb.save_by_rename(f.read(), str(tmp_path / "sub2" / "h.png"))
+        time.sleep(1.5)
+        assert state(s)["bake"]["id"] == last
+    finally:
+        s.close()
+
+
+def test_a_deleted_height_is_reported(served):
+    s, d = served
+    assert state(s)["error"] == ""
+    os.remove(d / "h.png")
+    st = sb.wait_for(lambda: (lambda x: x if x["error"] else None)(state(s)), 60,
+                     "the deletion reported")
+    assert "h.png" in st["error"] and st["bake"]["id"] >= 1
+    # the maps shown stay; "write" does what bake would: fail on the file
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+    assert status == 422 and "h.png" in json.loads(body)["error"], body
+    assert sorted(os.listdir(d)) == []
+
+
+def test_write_from_memory_only_while_the_height_is_the_one_baked(served, tmp_path_factory):
+    s, d = served
+    # a change the watch cannot see: written through a second name of the
+    # file in another folder (inotify reports it to that folder only)
+    other = tmp_path_factory.mktemp("other")
+    os.link(d / "h.png", other / "same.png")
+    with open(os.path.join(FIXTURES, "bricks_128x64.png"), "rb") as f:
+        bricks = f.read()
+    with open(other / "same.png", "r+b") as f:
+        f.truncate(0)
+        f.write(bricks)
+    time.sleep(1)
+    assert state(s)["bake"]["height"] == 128, "the watch saw it: no test"
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+    assert status == 200, body
+    reply = json.loads(body)
+    assert reply["from"] == "bake" and reply["height"] == 64, reply
+    assert "h.png" in reply.get("reason", ""), reply

@@ -21,6 +21,9 @@ enum {
   SERVE_TEX_COUNT
 };
 
+/* The watched files: the height and the maps the options read. */
+enum { SERVE_MAX_WATCHED = 4 };
+
 /* One finished bake: published at once, its textures made when first
  * asked (the picture shown asks for one first). The state holds the bake
  * shown and the one before it (downloads in flight when a newer one lands
@@ -47,13 +50,12 @@ typedef struct serve_bake {
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
   char *command;           /* the `bumpbake bake` line that writes these maps */
+  uint64_t input_hashes[SERVE_MAX_WATCHED]; /* bb_file_hash of serve_state.watched[i]
+                                              as baked (0: unreadable) */
   int normal_y_up;
   bb_basis basis;          /* the basis of the ssbump and weights: the page lights with it */
   double scale;            /* the bake's --scale: the relief's depth */
 } serve_bake;
-
-/* The watched files: the height and the maps the options read. */
-enum { SERVE_MAX_WATCHED = 4 };
 
 typedef struct serve_state {
   pthread_mutex_t lock;
@@ -100,6 +102,10 @@ void serve_maps_done(serve_bake *b);
  * out of memory, or when it was not made while b was shown. Any thread,
  * with a reference held and the lock not. */
 const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t);
+/* The first watched file (0: the height) whose bytes are not those b was
+ * baked from, or -1 when every one is as baked. Reads the files; the
+ * caller does not hold the lock (watched is set before any thread runs). */
+int serve_inputs_changed(const serve_state *s, const serve_bake *b);
 /* The job options a bake or a write uses now (the caller holds the lock). */
 void serve_job_options(const serve_state *s, bb_job_options *o);
 

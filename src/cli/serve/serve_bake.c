@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 static double now_seconds(void) {
@@ -64,6 +65,15 @@ static void shed_maps(serve_bake *b) {
   b->maps_shed = 1;
   if (b->maps_users == 0)
     free_maps(b);
+}
+
+int serve_inputs_changed(const serve_state *s, const serve_bake *b) {
+  for (int i = 0; i < s->watched_count; i++) {
+    uint64_t now = 0;
+    if (bb_file_hash(s->watched[i], &now, NULL) != BB_OK || now != b->input_hashes[i])
+      return i;
+  }
+  return -1;
 }
 
 void serve_job_options(const serve_state *s, bb_job_options *o) {
@@ -186,6 +196,40 @@ static char *provenance_of(const bb_job_options *o, const bb_job_report *rep,
 
 /* ----------------------------------------------------------------- bake */
 
+/* Planning a job creates its outputs' folders; a bake writes nothing, not
+ * even a folder, until the page asks. So a bake whose outputs' folder is
+ * gone (the height's folder moved away, say) is not planned: it fails
+ * with the height's own error when the height is gone too (the library's
+ * words, read without a plan), else saying which folder is missing. 1 when
+ * it fails so (message in err). */
+static int folder_gone(const bb_job_options *o, const char *input, bb_error *err) {
+  const char *paths[BB_MAP_BAKED_COUNT + 3];
+  int n = 0;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (o->paths[k])
+      paths[n++] = o->paths[k];
+  const char *single[] = {o->slope_path, o->valve_path, o->vmt};
+  for (size_t i = 0; i < sizeof single / sizeof *single; i++)
+    if (single[i])
+      paths[n++] = single[i];
+  for (int i = 0; i < n; i++) {
+    const char *slash = strrchr(paths[i], '/');
+    if (!slash || slash == paths[i])
+      continue;
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - paths[i]), paths[i]);
+    struct stat st;
+    if (stat(dir, &st) == 0)
+      continue;
+    if (bb_image_read_info(input, NULL, NULL, NULL, NULL, err) == BB_OK)
+      snprintf(err->message, sizeof err->message,
+               "%.200s: its folder %.200s is gone (serve makes none until \"write\")",
+               paths[i], dir);
+    return 1;
+  }
+  return 0;
+}
+
 /* One bake of the options as they are now; publishes it or the error. */
 static void bake_once(serve_state *s, long wanted) {
   bb_job_options o;
@@ -200,12 +244,19 @@ static void bake_once(serve_state *s, long wanted) {
   pthread_mutex_unlock(&s->lock);
 
   const double t0 = now_seconds();
+  /* The other files the bake reads, hashed before it reads them: a change
+   * after this shows at a write, which then bakes again (the height's own
+   * hash is the job's, of the bytes it decoded). */
+  uint64_t hashes[SERVE_MAX_WATCHED] = {0};
+  for (int i = 1; i < s->watched_count; i++)
+    if (bb_file_hash(s->watched[i], &hashes[i], NULL) != BB_OK)
+      hashes[i] = 0;
   bb_error err = {{0}};
   bb_job *job = NULL;
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   serve_bake *b = NULL;
-  bb_status st = bb_job_plan(&input, 1, &o, &job, &err);
+  bb_status st = folder_gone(&o, input, &err) ? BB_ERR_IO : bb_job_plan(&input, 1, &o, &job, &err);
   if (st == BB_OK) {
     bb_job_use_context(job, s->context); /* this thread's bakes only */
     progress_ctx p = {s, wanted};
@@ -215,6 +266,8 @@ static void bake_once(serve_state *s, long wanted) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
     if ((b = calloc(1, sizeof *b))) {
       b->refs = 1;
+      memcpy(b->input_hashes, hashes, sizeof hashes);
+      b->input_hashes[0] = rep->source.file_hash;
       b->width = rep->width;
       b->height = rep->height;
       pthread_mutex_init(&b->tex_lock, NULL);

@@ -25,6 +25,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <limits.h>
 #include <microhttpd.h>
 #include <netinet/in.h>
 #include <stdio.h>
@@ -430,9 +431,22 @@ static char *write_maps(serve_state *s, unsigned *status) {
   bb_error err = {{0}};
   bb_status st = BB_ERR_ARGUMENT;
   const char *from = "memory";
+  char reason[PATH_MAX + 64] = "a save or a control came after the bake shown";
   bb_job *job = NULL;
   char *text = NULL;
   size_t size = 0;
+  /* the maps shown are only the file's while the file is the one baked:
+   * a change the watch did not see (a second name of the file elsewhere,
+   * a network file system) bakes again */
+  const int changed = b ? serve_inputs_changed(s, b) : -1;
+  if (changed >= 0) {
+    snprintf(reason, sizeof reason, "%s changed since the bake shown", s->watched[changed]);
+    pthread_mutex_lock(&s->lock);
+    serve_maps_done(b);
+    serve_bake_release(b);
+    pthread_mutex_unlock(&s->lock);
+    b = NULL;
+  }
   if (b) {
     st = bb_job_write_item(b->job, 0, &b->maps, &err);
     if (st == BB_OK) {
@@ -443,6 +457,8 @@ static char *write_maps(serve_state *s, unsigned *status) {
       }
     }
   }
+  if (b && st == BB_ERR_ARGUMENT)
+    snprintf(reason, sizeof reason, "the line reads the height again to write its maps");
   if (st == BB_ERR_ARGUMENT) { /* not this bake's line, or a file it cannot write */
     from = "bake";
     free(text);
@@ -477,12 +493,22 @@ static char *write_maps(serve_state *s, unsigned *status) {
     *status = 422;
     return error_json(err.message[0] ? err.message : bb_status_name(st));
   }
-  /* {"from": "memory" or "bake", then bake --json's keys} */
+  /* {"from": "memory" or "bake", "reason" when baked again, then bake
+   * --json's keys} */
   char *reply = NULL;
-  if (text && text[0] == '{') {
-    const size_t cap = strlen(text) + 32;
-    if ((reply = malloc(cap)))
-      snprintf(reply, cap, "{\"from\":\"%s\",%s", from, text + 1);
+  size_t reply_size = 0;
+  FILE *f = text && text[0] == '{' ? open_memstream(&reply, &reply_size) : NULL;
+  if (f) {
+    bb_json j = {f, 0};
+    bb_json_open(&j, NULL, '{');
+    bb_json_string(&j, "from", from);
+    if (strcmp(from, "memory"))
+      bb_json_string(&j, "reason", reason);
+    fprintf(f, ",%s", text + 1);
+    if (fclose(f) != 0) {
+      free(reply);
+      reply = NULL;
+    }
   }
   free(text);
   *status = reply ? MHD_HTTP_OK : MHD_HTTP_INTERNAL_SERVER_ERROR;
