@@ -2866,6 +2866,15 @@ const bb_command_info *bb_command_describe(const bb_command *command);
 bb_status bb_command_set(bb_command *command, const char *name, const char *text,
                          bb_error *err);
 
+/* Puts option name back at its default, as if it had never been set: the
+ * rules (bb_command_check) and the text (bb_command_text) no longer see
+ * it. For a client whose control goes back to the value it starts at
+ * (bumpbake serve's page). Errors: BB_ERR_ARGUMENT "unknown option ..."
+ * as bb_command_set says it, and "--NAME cannot be unset: leave it out"
+ * for an option whose parser sets more than its one value (--basis);
+ * BB_ERR_MEMORY. An option not set is left as it is. */
+bb_status bb_command_unset(bb_command *command, const char *name, bb_error *err);
+
 /* Adds a positional argument (an input file, or height2ssbump's
  * BUMPSCALE) in order. Errors: BB_ERR_ARGUMENT (one too many, a
  * BUMPSCALE that is no number), BB_ERR_MEMORY. */

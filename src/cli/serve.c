@@ -54,6 +54,16 @@ int cli_run_serve(const cli_run *r) {
   s.brightness_file = a->job.brightness_file;
   s.use_brightness = s.brightness_file != NULL;
   s.quiet = a->quiet;
+  /* the page's controls change a copy of the command line's command */
+  size_t handover_size = 0;
+  char *handover = bb_command_handover(r->command, &handover_size);
+  bb_error copy_err = {{0}};
+  bb_status copied = handover ? bb_command_from_handover(handover, handover_size, NULL, 0,
+                                                         &s.command, &copy_err)
+                              : BB_ERR_MEMORY;
+  free(handover);
+  if (copied != BB_OK)
+    return cli_library_error("serve", copied, &copy_err);
   s.watched[s.watched_count++] = height;
   const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
                         a->job.basis_file};

@@ -584,3 +584,48 @@ def test_write_from_memory_only_while_the_height_is_the_one_baked(served, tmp_pa
     reply = json.loads(body)
     assert reply["from"] == "bake" and reply["height"] == 64, reply
     assert "h.png" in reply.get("reason", ""), reply
+
+
+# ------------------------------------------- the controls, as the CLI checks
+
+def cli_refusal(*args):
+    """What `bumpbake bake` says of these options, without its prefix."""
+    r = subprocess.run([BIN, "bake", os.path.join(FIXTURES, "rock06_128.png"), "-o",
+                        "/nonexistent/x", *args], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    return r.stderr.strip().split(": ", 1)[1]
+
+
+def params(server, query):
+    status, body = request(server.url, "POST", {"X-Bumpbake": "1"}, "params?" + query)
+    return status, json.loads(body)
+
+
+def test_the_controls_are_checked_as_the_command_line_is(served):
+    s, _ = served
+    # bounces without bounce: the CLI refuses it, so does the page, in its words
+    status, body = params(s, "bounces=3")
+    assert status == 400 and body["error"] == cli_refusal("--scale", "16", "--bounces", "3")
+    assert "--bounces" not in state(s)["command"]
+    # a NUL in a value is no end of it: refused as the text it is
+    status, body = params(s, "scale=1%00x")
+    assert status == 400 and body["error"] == "--scale needs a number (got '1\\0x')", body
+    status, body = params(s, "sca%00le=1")
+    assert status == 400 and "unknown control" in body["error"], body
+    assert state(s)["params"]["scale"] == 16
+    # with bounce, bounces is taken; bounce back to 0 alone is refused,
+    # both back to their defaults leave both out of the line
+    status, body = params(s, "bounce=0.5&bounces=3")
+    assert status == 200, body
+    assert "--bounce 0.5 --bounces 3" in state(s)["command"]
+    status, body = params(s, "bounce=0")
+    assert status == 400 and body["error"] == cli_refusal("--scale", "16", "--bounces", "3")
+    status, body = params(s, "bounce=0&bounces=0")
+    assert status == 200, body
+    assert "--bounce" not in state(s)["command"]
+    # slices 0 is "from rays": --slices left out, not refused as out of 1..256
+    status, body = params(s, "slices=8")
+    assert status == 200 and "--slices 8" in state(s)["command"]
+    status, body = params(s, "slices=0&rays=64")
+    assert status == 200, body
+    assert "--slices" not in state(s)["command"] and "--rays 64" in state(s)["command"]

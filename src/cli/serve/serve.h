@@ -64,7 +64,10 @@ typedef struct serve_state {
   long version;           /* bumped on every change a page shows */
   /* what to bake: the command line's options, changed by the page's controls */
   const char *height_path;
-  bb_job_options settings; /* the bake's parameters as the command line gave them */
+  bb_job_options settings; /* the bake's parameters: the command line's, then the
+                              page's controls' (from command) */
+  bb_command *command;    /* the page's command: serve's command line with the page's
+                             controls set, checked as the command line is */
   bb_job_options job;     /* paths of a "write"; bake filled from settings */
   const char *brightness_file; /* the command line's --brightness, or NULL */
   int use_brightness;     /* the page's switch (1 when given) */
@@ -139,11 +142,15 @@ char *serve_state_json(serve_state *s);
  * from the library's descriptions of the options (bb_option_bounds). */
 char *serve_ranges_json(void);
 /* serve_params.c: applies the page's control values (name=value pairs:
- * scale, rays, slices, bias, bounce, bounces, brightness) to the state,
- * all or none, after the library's checks; 0, or -1 with the library's
- * words in err. The caller holds the lock. */
+ * scale, rays, slices, bias, bounce, bounces, brightness; sizes[i] the
+ * bytes of values[i], which may hold a NUL) to the state, all or none:
+ * each set on a copy of the page's command by bake's option of its name
+ * (a value at the option's default leaves the option out, as the line the
+ * page shows does), then the copy checked as the command line is
+ * (bb_command_check: ranges and the rules between options). 0, or -1
+ * with the library's words in err. The caller holds the lock. */
 int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
-                       int count, char *err, size_t cap);
+                       const size_t *sizes, int count, char *err, size_t cap);
 
 /* serve_page.c: the page's files, embedded at build time. */
 typedef struct serve_asset {

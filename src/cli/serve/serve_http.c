@@ -364,34 +364,50 @@ static enum MHD_Result send_events(server *sv, struct MHD_Connection *c) {
 
 typedef struct param_list {
   const char *name[16], *value[16];
+  size_t size[16];
+  char *spelled_name[16]; /* a name holding a NUL, "\\0" for it (malloc'd) */
   int count, too_many;
 } param_list;
 
 static enum MHD_Result collect_param(void *cls, enum MHD_ValueKind kind, const char *key,
-                                     const char *value) {
+                                     size_t key_size, const char *value, size_t value_size) {
   (void)kind;
   param_list *p = cls;
   if (p->count == 16) {
     p->too_many = 1;
     return MHD_NO;
   }
-  p->name[p->count] = key;
-  p->value[p->count++] = value ? value : "";
+  const int i = p->count++;
+  p->name[i] = key;
+  if (memchr(key, '\0', key_size) && (p->spelled_name[i] = malloc(key_size + 1))) {
+    for (size_t k = 0; k < key_size; k++)
+      p->spelled_name[i][k] = key[k] ? key[k] : '?';
+    p->spelled_name[i][key_size] = '\0';
+    p->name[i] = p->spelled_name[i];
+  }
+  p->value[i] = value ? value : "";
+  p->size[i] = value ? value_size : 0;
   return MHD_YES;
 }
 
 /* POST params?scale=64&rays=256...: all or none applied, then a re-bake. */
 static enum MHD_Result apply_params(server *sv, struct MHD_Connection *c) {
-  param_list p = {{0}, {0}, 0, 0};
-  MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, collect_param, &p);
-  if (p.too_many)
-    return send_error(c, MHD_HTTP_BAD_REQUEST, "too many values");
+  param_list p;
+  memset(&p, 0, sizeof p);
+  MHD_get_connection_values_n(c, MHD_GET_ARGUMENT_KIND, collect_param, &p);
   char err[512] = "";
-  pthread_mutex_lock(&sv->s->lock);
-  int rc = serve_apply_params(sv->s, p.name, p.value, p.count, err, sizeof err);
-  if (rc == 0)
-    serve_request_bake(sv->s); /* cancels the bake in flight */
-  pthread_mutex_unlock(&sv->s->lock);
+  int rc = -1;
+  if (p.too_many) {
+    snprintf(err, sizeof err, "too many values");
+  } else {
+    pthread_mutex_lock(&sv->s->lock);
+    rc = serve_apply_params(sv->s, p.name, p.value, p.size, p.count, err, sizeof err);
+    if (rc == 0)
+      serve_request_bake(sv->s); /* cancels the bake in flight */
+    pthread_mutex_unlock(&sv->s->lock);
+  }
+  for (int i = 0; i < p.count; i++)
+    free(p.spelled_name[i]);
   if (rc != 0)
     return send_error(c, MHD_HTTP_BAD_REQUEST, err);
   return send_json(c, MHD_HTTP_OK, serve_state_json(sv->s));
