@@ -179,6 +179,17 @@ const char *bb_status_name(bb_status status);
  * Returns out. The command line prints every line through it. */
 const char *bb_text_printable(const char *s, char *out, size_t cap);
 
+/* word quoted for a POSIX shell: as it is when every byte is a letter, a
+ * digit, one of "@%+=:,./-_" or a byte of UTF-8 beyond ASCII (so plain
+ * paths and values keep their bytes), else in single quotes with each
+ * quote in it given as '\'' ("my rock.png" -> 'my rock.png', "" -> '').
+ * sh reads back the word itself, whatever its bytes. Every command line
+ * the library spells (the provenance's command, bb_job_command_text,
+ * bb_command_text) quotes its words so; a client that records the words
+ * typed (bb_command_set_record) quotes them with this. malloc'd; NULL
+ * when word is NULL or out of memory. */
+char *bb_text_shell_quoted(const char *word);
+
 /* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
  * the end of the string or bytes that are not UTF-8 (overlong forms,
  * surrogates and code points past U+10FFFF included). */

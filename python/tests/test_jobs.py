@@ -117,6 +117,22 @@ def test_single_bake_names_its_outputs(tmp_path, fixtures):
     assert bumpbake.bake_file(src, {"normal": out}, scale=9, force=False).status == "baked"
 
 
+def test_the_recorded_command_is_quoted_for_a_shell(tmp_path, monkeypatch, fixtures):
+    """The provenance's command, as Python records it (bb_command_text),
+    quotes every word for a POSIX shell: typed in one, a name with a blank
+    or a ';' is one word, and runs nothing."""
+    import shlex
+
+    monkeypatch.chdir(tmp_path)
+    name = "my rock;x.png"
+    shutil.copy(os.path.join(fixtures, "pit_65x65.png"), name)
+    report = bumpbake.bake_file(name, {"ao": "a o.png"}, scale=8, rays=16)
+    assert report.status == "baked"
+    command = bumpbake.info("a o.png").provenance["command"]
+    assert command == "bumpbake bake 'my rock;x.png' --scale 8 --rays 16 --ao 'a o.png'"
+    assert shlex.split(command)[2] == name
+
+
 def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):
     heights = tmp_path / "heights"
     make_heights(heights, fixtures)

@@ -74,7 +74,18 @@ Test(cmd, recorded_text_spells_what_changes_the_output) {
   c = command("bake", more);
   text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
   cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name {kind}/{stem}.tif");
+                         "--mips --out-dir out --name '{kind}/{stem}.tif'");
+  free(text);
+  bb_command_free(c);
+
+  /* quoted for a POSIX shell, inputs and values alike */
+  const char *odd[] = {"my rock.png", "--scale", "8", "--normal", "$HOME/n.png", NULL};
+  c = command("bake", odd);
+  text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake 'my rock.png' --scale 8 --normal '$HOME/n.png'");
+  free(text);
+  text = bb_command_text(c, "a;b.png", BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake 'a;b.png' --scale 8 --normal '$HOME/n.png'");
   free(text);
   bb_command_free(c);
 }

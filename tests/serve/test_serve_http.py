@@ -629,3 +629,33 @@ def test_the_controls_are_checked_as_the_command_line_is(served):
     status, body = params(s, "slices=0&rays=64")
     assert status == 200, body
     assert "--slices" not in state(s)["command"] and "--rays 64" in state(s)["command"]
+
+
+# ------------------------------------------------ the line, typed in a shell
+
+@pytest.mark.parametrize("name", ["x;touch PWNED;y.png", "my rock.png", "it's $HOME.png"])
+def test_the_line_shown_is_quoted_for_a_shell(tmp_path, name):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / name)
+    s = sb.Server(BIN, name, ["--scale", "8", "--rays", "16", "--quiet"], cwd=str(tmp_path))
+    try:
+        st = wait_bake(s, 0, "the first bake")
+        line = st["command"]
+        assert st["bake"]["command"] == line
+        words = shlex.split(line)
+        assert words[:3] == ["bumpbake", "bake", name], line
+        status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+        assert status == 200, body
+        paths = [o["path"] for o in json.loads(body)["outputs"]]
+        written = {p: open(os.path.join(tmp_path, p), "rb").read() for p in paths}
+        for p in paths:
+            os.remove(os.path.join(tmp_path, p))
+        # the line as it is, typed in sh, with this build's bumpbake
+        r = subprocess.run(["sh", "-c", 'bumpbake() { "$BB" "$@"; }; ' + line],
+                           cwd=str(tmp_path), env=dict(os.environ, BB=BIN),
+                           capture_output=True, text=True, timeout=SLOW)
+        assert r.returncode == 0, r.stderr
+        assert not os.path.exists(tmp_path / "PWNED")
+        for p in paths:
+            assert open(os.path.join(tmp_path, p), "rb").read() == written[p], p
+    finally:
+        s.close()
