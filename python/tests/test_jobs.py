@@ -4,6 +4,7 @@ failures, notes, cancelling, and a job sent to another process."""
 
 import json
 import os
+import shlex
 import pickle
 import shutil
 import signal
@@ -58,7 +59,7 @@ def test_a_batch_is_the_cli_batch_byte_for_byte(tmp_path, monkeypatch, fixtures,
     command = job.command_text(0)
     assert command == ("bumpbake bake heights/bricks_128x64.png --scale 16 --out-dir out "
                        "--maps normal,ao")
-    options = command.split()[3:]  # what follows "bumpbake bake INPUT"
+    options = shlex.split(command)[3:]  # what follows "bumpbake bake INPUT"
 
     reports = bumpbake.bake_files("heights", "out", maps=MAPS, scale=16, depfile="py.d")
     assert [r.status for r in reports] == ["baked"] * 4
@@ -121,8 +122,6 @@ def test_the_recorded_command_is_quoted_for_a_shell(tmp_path, monkeypatch, fixtu
     """The provenance's command, as Python records it (bb_command_text),
     quotes every word for a POSIX shell: typed in one, a name with a blank
     or a ';' is one word, and runs nothing."""
-    import shlex
-
     monkeypatch.chdir(tmp_path)
     name = "my rock;x.png"
     shutil.copy(os.path.join(fixtures, "pit_65x65.png"), name)

@@ -25,8 +25,19 @@ void bb__add_options(const bb_command *c, unsigned flags, bb__text *t) {
       bb__print_generic(c, o, &value);
     if (value.failed)
       t->failed = 1;
-    bb__text_add(t, " ");
-    bb__text_add_word(t, value.data ? value.data : "");
+    /* an option of several words ("--size 48 40") gives each its own */
+    const char *v = value.data ? value.data : "";
+    do {
+      const char *blank = o->info.values > 1 ? strchr(v, ' ') : NULL;
+      const size_t n = blank ? (size_t)(blank - v) : strlen(v);
+      char *word = strndup(v, n);
+      if (!word)
+        t->failed = 1;
+      bb__text_add(t, " ");
+      bb__text_add_word(t, word ? word : "");
+      free(word);
+      v = blank ? blank + 1 : v + n;
+    } while (*v);
     bb__text_free(&value);
   }
 }
