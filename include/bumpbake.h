@@ -1121,7 +1121,12 @@ struct bb_trace_options {
                               nonzero return cancels. In bb_bake also
                               with done 0 and total 0 (a checkpoint, no
                               progress) every 50 ms while it smooths and
-                              makes normals, so those stages cancel too */
+                              makes normals, so those stages cancel too;
+                              with inter-reflection (bounce_albedo > 0) the
+                              units run once over the trace and the
+                              bounces: the first bb_bake_slices(o) are the
+                              trace's (one a slice), the rest the
+                              bounces' */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls
