@@ -1,9 +1,9 @@
 /* serve.c: `bumpbake serve`, a bake seen live: the height baked with
  * bake's options, watched, re-baked on every save, and shown lit in the
  * browser (src/cli/serve/). This file keeps the command line's words. */
+#include "serve/serve.h"
 #include "cli.h"
 #include "common.h"
-#include "serve/serve.h"
 
 #include <arpa/inet.h>
 #include <limits.h>
@@ -53,6 +53,8 @@ int cli_run_serve(const cli_run *r) {
   s.job = named;
   s.brightness_file = a->job.brightness_file;
   s.use_brightness = s.brightness_file != NULL;
+  s.albedo_file = a->albedo; /* render's --albedo and --light-color light the picture */
+  memcpy(s.light_color, a->render.light_color, sizeof s.light_color);
   s.quiet = a->quiet;
   /* the page's controls change a copy of the command line's command */
   size_t handover_size = 0;
@@ -66,7 +68,7 @@ int cli_run_serve(const cli_run *r) {
     return cli_library_error("serve", copied, &copy_err);
   s.watched[s.watched_count++] = height;
   const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
-                        a->job.basis_file};
+                        a->job.basis_file, a->albedo};
   for (size_t i = 0; i < sizeof also / sizeof also[0]; i++)
     if (also[i])
       s.watched[s.watched_count++] = also[i];

@@ -148,7 +148,7 @@ def test_the_page_takes_its_ranges_from_the_library(served):
     library = sb.library_ranges(BIN)
     assert sorted(served_ranges) == sorted(library) == sorted(
         ["scale", "rays", "slices", "bias", "bounce", "bounces", "view_elevation",
-         "light_elevation"])
+         "light_elevation", "light_color"])
     for name, want in library.items():
         got = served_ranges[name]
         assert got["min"] == want["min"] and got["min_exclusive"] == want["min_exclusive"], name
@@ -659,3 +659,32 @@ def test_the_line_shown_is_quoted_for_a_shell(tmp_path, name):
             assert open(os.path.join(tmp_path, p), "rb").read() == written[p], p
     finally:
         s.close()
+
+
+# ------------------------------------------------------------- the progress
+
+def test_the_state_names_the_stage_running_bounce_included(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    # 32 slices: a trace of tenths of a second, the bounces' seconds
+    s = sb.Server(BIN, str(tmp_path / "h.png"),
+                  ["--scale", "16", "--rays", "1024", "--bounce", "0.5", "--quiet"])
+    seen = []
+    try:
+        end = time.monotonic() + SLOW
+        while time.monotonic() < end:
+            st = state(s)
+            if st["baking"] and (not seen or seen[-1] != st["stage"]):
+                seen.append(st["stage"])
+            if st.get("bake"):
+                break
+            time.sleep(0.01)
+        assert st.get("bake"), "no bake in %d s" % SLOW
+        assert st["stage"] is None and not st["baking"]
+    finally:
+        s.close()
+    print("stages seen:", seen)
+    # in the order they run; a short one may pass between two looks
+    order = ["load and smooth", "trace", "bounce", "derive"]
+    assert seen and all(x in order for x in seen), seen
+    assert [order.index(x) for x in seen] == sorted(order.index(x) for x in seen), seen
+    assert "trace" in seen and "bounce" in seen, seen

@@ -18,11 +18,13 @@ enum {
   SERVE_TEX_NORMAL_HEIGHT, /* the normal (N + 1) / 2 in RGB, the smoothed height in A */
   SERVE_TEX_BENT,          /* the bent normal (Nb + 1) / 2 in RGB, A 255 */
   SERVE_TEX_WEIGHTS,       /* the basis weights w_0..w_2 in RGB, A 255 */
+  SERVE_TEX_ALBEDO,        /* --albedo FILE as read with this bake (grey: R = G = B),
+                              A 255; made with the bake, NULL without one */
   SERVE_TEX_COUNT
 };
 
-/* The watched files: the height and the maps the options read. */
-enum { SERVE_MAX_WATCHED = 4 };
+/* The watched files: the height, the maps the options read and the albedo. */
+enum { SERVE_MAX_WATCHED = 5 };
 
 /* One finished bake: published at once, its textures made when first
  * asked (the picture shown asks for one first). The state holds the bake
@@ -33,10 +35,10 @@ enum { SERVE_MAX_WATCHED = 4 };
  * is not, they are freed as soon as their last user is done (maps_shed),
  * so what serve holds does not grow with the requests that hold bakes. */
 typedef struct serve_bake {
-  int refs; /* under serve_state.lock */
-  int maps_users;                      /* under serve_state.lock: users of maps and job */
-  int maps_shed;                       /* not shown any more: maps and job go with
-                                          their last user */
+  int refs;       /* under serve_state.lock */
+  int maps_users; /* under serve_state.lock: users of maps and job */
+  int maps_shed;  /* not shown any more: maps and job go with
+                     their last user */
   long id;
   int width, height;
   pthread_mutex_t tex_lock;            /* makes tex[] (then under serve_state.lock) */
@@ -45,7 +47,7 @@ typedef struct serve_bake {
   bb_bake_result maps;                 /* the bake's float maps: the textures and a
                                           "write" (bb_job_write_item) are made of them */
   long wanted;                         /* the request it answered (serve_state.wanted) */
-  double seconds;          /* from the start of the bake to its maps */
+  double seconds;                      /* from the start of the bake to its maps */
   double seconds_textures; /* making the textures asked so far (under serve_state.lock) */
   bb_job_report report;    /* the job's figures (input pointer not kept) */
   char *provenance;        /* the ssbump's provenance as the job writes it */
@@ -53,8 +55,8 @@ typedef struct serve_bake {
   uint64_t input_hashes[SERVE_MAX_WATCHED]; /* bb_file_hash of serve_state.watched[i]
                                               as baked (0: unreadable) */
   int normal_y_up;
-  bb_basis basis;          /* the basis of the ssbump and weights: the page lights with it */
-  double scale;            /* the bake's --scale: the relief's depth */
+  bb_basis basis; /* the basis of the ssbump and weights: the page lights with it */
+  double scale;   /* the bake's --scale: the relief's depth */
 } serve_bake;
 
 typedef struct serve_state {
@@ -64,29 +66,33 @@ typedef struct serve_state {
   long version;           /* bumped on every change a page shows */
   /* what to bake: the command line's options, changed by the page's controls */
   const char *height_path;
-  bb_job_options settings; /* the bake's parameters: the command line's, then the
-                              page's controls' (from command) */
-  bb_command *command;    /* the page's command: serve's command line with the page's
-                             controls set, checked as the command line is */
-  bb_job_options job;     /* paths of a "write"; bake filled from settings */
+  bb_job_options settings;     /* the bake's parameters: the command line's, then the
+                                  page's controls' (from command) */
+  bb_command *command;         /* the page's command: serve's command line with the page's
+                                  controls set, checked as the command line is */
+  bb_job_options job;          /* paths of a "write"; bake filled from settings */
   const char *brightness_file; /* the command line's --brightness, or NULL */
-  int use_brightness;     /* the page's switch (1 when given) */
-  atomic_long wanted;     /* bumped by a save or a control: the bake in flight
-                             for an older value is cancelled */
-  long done;              /* the wanted value last baked (or failed) */
+  int use_brightness;          /* the page's switch (1 when given) */
+  atomic_long wanted;          /* bumped by a save or a control: the bake in flight
+                                  for an older value is cancelled */
+  long done;                   /* the wanted value last baked (or failed) */
+  const char *albedo_file;     /* --albedo FILE (render's row), or NULL */
+  float light_color[3];        /* --light-color R,G,B (render's row), then the page's */
   /* what is going on */
   int baking;
-  double progress;        /* 0..1 of the bake in flight */
+  double progress;   /* 0..1 of the bake in flight */
+  const char *stage; /* the stage it runs ("load and smooth", "trace", "bounce",
+                        "derive"), from its progress callback */
   double last_progress_seconds;
-  char error[1024];       /* the last bake's failure, "" after a success */
-  serve_bake *current;    /* the last good bake, or NULL */
-  serve_bake *previous;   /* the one before it, or NULL (its maps shed) */
+  char error[1024];     /* the last bake's failure, "" after a success */
+  serve_bake *current;  /* the last good bake, or NULL */
+  serve_bake *previous; /* the one before it, or NULL (its maps shed) */
   long next_id;
   bb_bake_context *context; /* the bake thread's warm ray set and buffers */
   const char *watched[SERVE_MAX_WATCHED];
   int watched_count;
   int quiet;
-  atomic_int quit;        /* the process is stopping: the bake in flight is cancelled */
+  atomic_int quit; /* the process is stopping: the bake in flight is cancelled */
 } serve_state;
 
 /* serve_bake.c: the bake thread (runs until state->quit; a bake in flight
@@ -138,8 +144,9 @@ void serve_http_stop(serve_state *s);
 char *serve_state_json(serve_state *s);
 /* serve_params.c: the ranges of the page's inputs (JSON, malloc'd): each
  * bake control's ("scale", "rays", "slices", "bias", "bounce", "bounces"),
- * "view_elevation" and "light_elevation", as {"min", "max", "min_exclusive"}
- * from the library's descriptions of the options (bb_option_bounds). */
+ * "view_elevation", "light_elevation" and "light_color", as {"min", "max",
+ * "min_exclusive"} from the library's descriptions of the options
+ * (bb_option_bounds). */
 char *serve_ranges_json(void);
 /* serve_params.c: applies the page's control values (name=value pairs:
  * scale, rays, slices, bias, bounce, bounces, brightness; sizes[i] the
@@ -147,10 +154,13 @@ char *serve_ranges_json(void);
  * each set on a copy of the page's command by bake's option of its name
  * (a value at the option's default leaves the option out, as the line the
  * page shows does), then the copy checked as the command line is
- * (bb_command_check: ranges and the rules between options). 0, or -1
- * with the library's words in err. The caller holds the lock. */
-int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
-                       const size_t *sizes, int count, char *err, size_t cap);
+ * (bb_command_check: ranges and the rules between options); light-color
+ * is render's --light-color, a light of the picture (*rebake 0 when
+ * nothing else changed). 0, or -1 with the library's words in err. The
+ * caller holds the lock. */
+int serve_apply_params(serve_state *s, const char *const *names,
+                       const char *const *values, const size_t *sizes, int count,
+                       int *rebake, char *err, size_t cap);
 
 /* serve_page.c: the page's files, embedded at build time. */
 typedef struct serve_asset {

@@ -37,15 +37,15 @@
 #include <time.h>
 
 enum {
-  HEADER_SECONDS = 10,    /* from a connection's start, or its last request's end */
-  IDLE_SECONDS = 10,      /* MHD_OPTION_CONNECTION_TIMEOUT: nothing moved that long */
+  HEADER_SECONDS = 10, /* from a connection's start, or its last request's end */
+  IDLE_SECONDS = 10,   /* MHD_OPTION_CONNECTION_TIMEOUT: nothing moved that long */
   CONNECTION_LIMIT = 2048,
-  PER_CLIENT_LIMIT = 64,  /* with --address: a browser opens 6 or so */
+  PER_CLIENT_LIMIT = 64, /* with --address: a browser opens 6 or so */
   STREAM_LIMIT = 256,
   KEEPALIVE_SECONDS = 2,
-  TICK_MS = 250,          /* the ticker's period: the bounds hold within it */
+  TICK_MS = 250,                 /* the ticker's period: the bounds hold within it */
   CONNECTION_MEMORY = 32 * 1024, /* a request's headers and MHD's buffers */
-  BLOCK_BYTES = 32 * 1024 /* a download's buffer */
+  BLOCK_BYTES = 32 * 1024        /* a download's buffer */
 };
 
 /* A connection, from its accept to its close: when it started waiting for
@@ -92,16 +92,16 @@ typedef struct request {
 typedef struct server {
   serve_state *s;
   struct MHD_Daemon *daemon;
-  char prefix[64];    /* "/" or "/TOKEN/" */
-  char host[128];     /* the Host header requests must carry ("127.0.0.1:8077") */
-  char host_alt[128]; /* "localhost:8077" for the loopback, else "" */
-  int check_host;     /* without a token: the Host header is checked */
+  char prefix[64];      /* "/" or "/TOKEN/" */
+  char host[128];       /* the Host header requests must carry ("127.0.0.1:8077") */
+  char host_alt[128];   /* "localhost:8077" for the loopback, else "" */
+  int check_host;       /* without a token: the Host header is checked */
   pthread_mutex_t lock; /* the lists below */
   pthread_cond_t wake;  /* the writer's queue */
   tracked *connections;
   event_stream *streams;
   int stream_count;
-  write_wait *writes;   /* the writer's queue, newest first */
+  write_wait *writes; /* the writer's queue, newest first */
   int stop;
   pthread_t ticker, writer;
   int threads; /* 1: ticker and writer run */
@@ -119,12 +119,13 @@ static double now_seconds(void) {
  * another type, and never shown in a frame (a page elsewhere cannot lay
  * the page under a decoy and have a click "write the maps"); the page
  * runs, styles and fetches only what this server sends. */
-static const char *const policy = "default-src 'none'; script-src 'self'; style-src 'self'; "
-                                  "connect-src 'self'; img-src 'self' data:; base-uri 'none'; "
-                                  "form-action 'none'; frame-ancestors 'none'";
+static const char *const policy =
+    "default-src 'none'; script-src 'self'; style-src 'self'; "
+    "connect-src 'self'; img-src 'self' data:; base-uri 'none'; "
+    "form-action 'none'; frame-ancestors 'none'";
 
-static enum MHD_Result queue(struct MHD_Connection *c, unsigned status, struct MHD_Response *r,
-                             const char *type) {
+static enum MHD_Result queue(struct MHD_Connection *c, unsigned status,
+                             struct MHD_Response *r, const char *type) {
   MHD_add_response_header(r, "Content-Type", type);
   MHD_add_response_header(r, "Cache-Control", "no-store");
   MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
@@ -135,15 +136,17 @@ static enum MHD_Result queue(struct MHD_Connection *c, unsigned status, struct M
   return ret;
 }
 
-static enum MHD_Result send_bytes(struct MHD_Connection *c, unsigned status, const char *type,
-                                  const void *data, size_t size, enum MHD_ResponseMemoryMode mode) {
+static enum MHD_Result send_bytes(struct MHD_Connection *c, unsigned status,
+                                  const char *type, const void *data, size_t size,
+                                  enum MHD_ResponseMemoryMode mode) {
   struct MHD_Response *r = MHD_create_response_from_buffer(size, (void *)data, mode);
   if (!r)
     return MHD_NO;
   return queue(c, status, r, type);
 }
 
-static enum MHD_Result send_text(struct MHD_Connection *c, unsigned status, const char *text) {
+static enum MHD_Result send_text(struct MHD_Connection *c, unsigned status,
+                                 const char *text) {
   return send_bytes(c, status, "text/plain; charset=utf-8", text, strlen(text),
                     MHD_RESPMEM_MUST_COPY);
 }
@@ -152,7 +155,8 @@ static enum MHD_Result send_text(struct MHD_Connection *c, unsigned status, cons
 static enum MHD_Result send_json(struct MHD_Connection *c, unsigned status, char *json) {
   if (!json)
     return send_text(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "out of memory");
-  return send_bytes(c, status, "application/json", json, strlen(json), MHD_RESPMEM_MUST_FREE);
+  return send_bytes(c, status, "application/json", json, strlen(json),
+                    MHD_RESPMEM_MUST_FREE);
 }
 
 /* {"error": message}, malloc'd; NULL when out of memory. */
@@ -170,7 +174,8 @@ static char *error_json(const char *msg) {
   return text;
 }
 
-static enum MHD_Result send_error(struct MHD_Connection *c, unsigned status, const char *msg) {
+static enum MHD_Result send_error(struct MHD_Connection *c, unsigned status,
+                                  const char *msg) {
   return send_json(c, status, error_json(msg));
 }
 
@@ -192,7 +197,7 @@ static ssize_t texture_reader(void *cls, uint64_t pos, char *buf, size_t max) {
     return MHD_CONTENT_READER_END_OF_STREAM;
   serve_state *s = r->s;
   pthread_mutex_lock(&s->lock);
-  serve_bake *b = s->current && s->current->id == r->bake_id ? s->current
+  serve_bake *b = s->current && s->current->id == r->bake_id     ? s->current
                   : s->previous && s->previous->id == r->bake_id ? s->previous
                                                                  : NULL;
   if (b)
@@ -209,14 +214,15 @@ static ssize_t texture_reader(void *cls, uint64_t pos, char *buf, size_t max) {
 }
 
 static const char *const texture_names[SERVE_TEX_COUNT] = {"ssbump_ao", "normal_height",
-                                                           "bent", "weights"};
+                                                           "bent", "weights", "albedo"};
 
 /* One texture of the last good bake; X-Bake-Id says which bake it is. */
-static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c, const char *name) {
+static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c,
+                                    const char *name) {
   int t = 0;
   while (t < SERVE_TEX_COUNT && strcmp(texture_names[t], name) != 0)
     t++;
-  if (t == SERVE_TEX_COUNT)
+  if (t == SERVE_TEX_COUNT || (t == SERVE_TEX_ALBEDO && !sv->s->albedo_file))
     return send_text(c, MHD_HTTP_NOT_FOUND, "no such map");
   serve_state *s = sv->s;
   pthread_mutex_lock(&s->lock);
@@ -242,7 +248,8 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c, const 
   serve_bake_release(b);
   pthread_mutex_unlock(&s->lock);
   if (!r) /* out of memory, or a newer bake landed before it was made */
-    return send_text(c, MHD_HTTP_SERVICE_UNAVAILABLE, made ? "out of memory" : "a newer bake");
+    return send_text(c, MHD_HTTP_SERVICE_UNAVAILABLE,
+                     made ? "out of memory" : "a newer bake");
   struct MHD_Response *resp =
       MHD_create_response_from_callback(r->size, BLOCK_BYTES, texture_reader, r, free);
   if (!resp) {
@@ -370,7 +377,8 @@ typedef struct param_list {
 } param_list;
 
 static enum MHD_Result collect_param(void *cls, enum MHD_ValueKind kind, const char *key,
-                                     size_t key_size, const char *value, size_t value_size) {
+                                     size_t key_size, const char *value,
+                                     size_t value_size) {
   (void)kind;
   param_list *p = cls;
   if (p->count == 16) {
@@ -401,8 +409,10 @@ static enum MHD_Result apply_params(server *sv, struct MHD_Connection *c) {
     snprintf(err, sizeof err, "too many values");
   } else {
     pthread_mutex_lock(&sv->s->lock);
-    rc = serve_apply_params(sv->s, p.name, p.value, p.size, p.count, err, sizeof err);
-    if (rc == 0)
+    int rebake = 0;
+    rc = serve_apply_params(sv->s, p.name, p.value, p.size, p.count, &rebake, err,
+                            sizeof err);
+    if (rc == 0 && rebake)
       serve_request_bake(sv->s); /* cancels the bake in flight */
     pthread_mutex_unlock(&sv->s->lock);
   }
@@ -456,7 +466,8 @@ static char *write_maps(serve_state *s, unsigned *status) {
    * a network file system) bakes again */
   const int changed = b ? serve_inputs_changed(s, b) : -1;
   if (changed >= 0) {
-    snprintf(reason, sizeof reason, "%s changed since the bake shown", s->watched[changed]);
+    snprintf(reason, sizeof reason, "%s changed since the bake shown",
+             s->watched[changed]);
     pthread_mutex_lock(&s->lock);
     serve_maps_done(b);
     serve_bake_release(b);
@@ -590,7 +601,8 @@ static enum MHD_Result queue_write(server *sv, struct MHD_Connection *c, request
 
 static int host_ok(const server *sv, struct MHD_Connection *c) {
   const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host");
-  return host && (strcmp(host, sv->host) == 0 || (sv->host_alt[0] && !strcmp(host, sv->host_alt)));
+  return host && (strcmp(host, sv->host) == 0 ||
+                  (sv->host_alt[0] && !strcmp(host, sv->host_alt)));
 }
 
 /* The connection's record, marked as no longer waiting for headers. */
@@ -606,8 +618,9 @@ static void headers_arrived(server *sv, struct MHD_Connection *c) {
 }
 
 static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *url,
-                              const char *method, const char *version, const char *upload_data,
-                              size_t *upload_data_size, void **con_cls) {
+                              const char *method, const char *version,
+                              const char *upload_data, size_t *upload_data_size,
+                              void **con_cls) {
   (void)version;
   (void)upload_data;
   server *sv = cls;
@@ -618,7 +631,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
       return MHD_NO;
     *con_cls = rq;
     /* no request of the page has a body: one is refused before it is read */
-    const char *length = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
+    const char *length =
+        MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
     if ((length && strcmp(length, "0") != 0) ||
         MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Transfer-Encoding"))
       return send_text(c, MHD_HTTP_CONTENT_TOO_LARGE, "no request takes a body");
@@ -753,8 +767,10 @@ static void *ticker_thread(void *arg) {
       /* a client that closed its end: nothing more to read, ever */
       char byte;
       const ssize_t n = e->fd >= 0 ? recv(e->fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT) : -1;
-      e->gone = n == 0 || (n < 0 && e->fd >= 0 && errno != EAGAIN && errno != EWOULDBLOCK);
-      if (e->gone || e->sent_version != version || now - e->last_sent >= KEEPALIVE_SECONDS) {
+      e->gone =
+          n == 0 || (n < 0 && e->fd >= 0 && errno != EAGAIN && errno != EWOULDBLOCK);
+      if (e->gone || e->sent_version != version ||
+          now - e->last_sent >= KEEPALIVE_SECONDS) {
         e->suspended = 0;
         MHD_resume_connection(e->conn);
       }
@@ -854,9 +870,9 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
       flags, (uint16_t)o->port, NULL, NULL, handle, &sv, MHD_OPTION_SOCK_ADDR,
       (struct sockaddr *)&addr, MHD_OPTION_CONNECTION_LIMIT, connection_limit(),
       MHD_OPTION_PER_IP_CONNECTION_LIMIT, per_client, MHD_OPTION_CONNECTION_TIMEOUT,
-      (unsigned)IDLE_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)CONNECTION_MEMORY,
-      MHD_OPTION_NOTIFY_CONNECTION, connection_seen, &sv, MHD_OPTION_NOTIFY_COMPLETED,
-      request_done, &sv, MHD_OPTION_END);
+      (unsigned)IDLE_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
+      (size_t)CONNECTION_MEMORY, MHD_OPTION_NOTIFY_CONNECTION, connection_seen, &sv,
+      MHD_OPTION_NOTIFY_COMPLETED, request_done, &sv, MHD_OPTION_END);
   if (!sv.daemon) {
     snprintf(url, cap, "cannot listen on %s port %d: %s", address, o->port,
              errno ? strerror(errno) : "libmicrohttpd refused");
@@ -879,7 +895,8 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
     return -1;
   }
   sv.threads = 1;
-  const union MHD_DaemonInfo *info = MHD_get_daemon_info(sv.daemon, MHD_DAEMON_INFO_BIND_PORT);
+  const union MHD_DaemonInfo *info =
+      MHD_get_daemon_info(sv.daemon, MHD_DAEMON_INFO_BIND_PORT);
   const int port = info ? (int)info->port : o->port;
   snprintf(sv.prefix, sizeof sv.prefix, "/");
   if (o->token) {

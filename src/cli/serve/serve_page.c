@@ -7,15 +7,15 @@
 
 #include <string.h>
 
-#define EMBED(symbol, path)                                                               \
-  __asm__(".section .rodata\n"                                                          \
-          ".global " #symbol "\n"                                                       \
-          ".type " #symbol ", @object\n"                                                \
-          ".balign 16\n" #symbol ":\n"                                                  \
-          ".incbin \"" path "\"\n"                                                      \
-          ".global " #symbol "_end\n" #symbol "_end:\n"                                 \
-          ".byte 0\n"                                                                   \
-          ".previous\n");                                                               \
+#define EMBED(symbol, path)                                                              \
+  __asm__(".section .rodata\n"                                                           \
+          ".global " #symbol "\n"                                                        \
+          ".type " #symbol ", @object\n"                                                 \
+          ".balign 16\n" #symbol ":\n"                                                   \
+          ".incbin \"" path "\"\n"                                                       \
+          ".global " #symbol "_end\n" #symbol "_end:\n"                                  \
+          ".byte 0\n"                                                                    \
+          ".previous\n");                                                                \
   extern const unsigned char symbol[], symbol##_end[]
 
 EMBED(serve_index_html, "share/serve/index.html");
@@ -32,8 +32,9 @@ static void init_assets(void) {
                               (size_t)(serve_index_html_end - serve_index_html)};
     assets[1] = (serve_asset){"serve.js", "text/javascript; charset=utf-8", serve_js,
                               (size_t)(serve_js_end - serve_js)};
-    assets[2] = (serve_asset){"serve.frag.glsl", "text/plain; charset=utf-8", serve_frag_glsl,
-                              (size_t)(serve_frag_glsl_end - serve_frag_glsl)};
+    assets[2] =
+        (serve_asset){"serve.frag.glsl", "text/plain; charset=utf-8", serve_frag_glsl,
+                      (size_t)(serve_frag_glsl_end - serve_frag_glsl)};
     assets[3] = (serve_asset){"ssbump_relief.glsl", "text/plain; charset=utf-8",
                               serve_relief_glsl,
                               (size_t)(serve_relief_glsl_end - serve_relief_glsl)};

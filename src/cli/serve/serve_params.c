@@ -27,6 +27,11 @@ static void add_params(bb_json *j, const serve_state *s) {
   bb_json_int(j, "bounces", b->bounces);
   bb_json_string(j, "brightness_file", s->brightness_file);
   bb_json_bool(j, "brightness", s->use_brightness);
+  bb_json_string(j, "albedo_file", s->albedo_file);
+  bb_json_open(j, "light_color", '[');
+  for (int k = 0; k < 3; k++)
+    bb_json_number(j, NULL, (double)s->light_color[k]);
+  bb_json_close(j, ']');
   bb_json_close(j, '}');
 }
 
@@ -58,6 +63,7 @@ static void add_bake(bb_json *j, serve_bake *b) {
     bb_json_close(j, ']');
   }
   bb_json_close(j, ']');
+  bb_json_bool(j, "albedo", b->tex[SERVE_TEX_ALBEDO] != NULL);
   bb_json_string(j, "command", b->command);
   bb_json_string(j, "provenance", b->provenance);
   bb_json_close(j, '}');
@@ -88,7 +94,10 @@ static void write_state(bb_json *j, void *arg) {
   bb_json_open(j, NULL, '{');
   bb_json_string(j, "height", s->height_path);
   bb_json_bool(j, "baking", s->baking);
+  bb_json_string(j, "stage", s->baking ? s->stage : NULL);
   bb_json_number(j, "progress", s->progress);
+  /* a save or a control asked for a bake not yet begun or done */
+  bb_json_bool(j, "pending", atomic_load(&s->wanted) != s->done);
   bb_json_string(j, "error", s->error);
   bb_json_string(j, "command", command);
   add_params(j, s);
@@ -109,13 +118,13 @@ char *serve_state_json(serve_state *s) {
  * bb_command_set, which refuses a value with the words every client prints:
  * "--rays needs an integer (got 'x')"), and where each lands in the bake
  * options. brightness is serve's switch of its --brightness FILE. */
-#define CONTROL(name, member) \
-  {name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member)}
+#define CONTROL(name, member)                                                            \
+  { name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member) }
 static const struct {
   const char *name;
   size_t offset, size;
-} controls[] = {CONTROL("scale", height_scale), CONTROL("rays", rays),
-                CONTROL("slices", slices),      CONTROL("bias", trace.bias_texels),
+} controls[] = {CONTROL("scale", height_scale),   CONTROL("rays", rays),
+                CONTROL("slices", slices),        CONTROL("bias", trace.bias_texels),
                 CONTROL("bounce", bounce_albedo), CONTROL("bounces", bounces)};
 #define CONTROL_COUNT (sizeof controls / sizeof controls[0])
 
@@ -138,19 +147,21 @@ static char *spelled(const char *text, size_t size) {
 
 /* Sets control name to value on cmd (brightness: its file, or unset); a
  * bake control at its default is unset. 0, or -1 with the words in err. */
-static int apply_one(const serve_state *s, bb_command *cmd, const char *name, const char *value,
-                     char *err, size_t cap) {
+static int apply_one(const serve_state *s, bb_command *cmd, const char *name,
+                     const char *value, int *rebake, char *err, size_t cap) {
   bb_error e = {{0}};
   for (size_t i = 0; i < CONTROL_COUNT; i++) {
     if (strcmp(name, controls[i].name))
       continue;
+    *rebake = 1;
     if (bb_command_set(cmd, name, value, &e) != BB_OK) {
       snprintf(err, cap, "%s", e.message);
       return -1;
     }
     bb_job_options d;
     bb_job_options_init(&d);
-    const char *now = (const char *)&bb_command_options_of(cmd)->job.bake + controls[i].offset;
+    const char *now =
+        (const char *)&bb_command_options_of(cmd)->job.bake + controls[i].offset;
     if (!memcmp(now, (const char *)&d.bake + controls[i].offset, controls[i].size) &&
         bb_command_unset(cmd, name, &e) != BB_OK) {
       snprintf(err, cap, "%s", e.message);
@@ -158,6 +169,20 @@ static int apply_one(const serve_state *s, bb_command *cmd, const char *name, co
     }
     return 0;
   }
+  if (!strcmp(name, "light-color")) { /* render's row: a light of the picture */
+    bb_render_options r;
+    bb_render_options_init(&r);
+    bb_status st = bb_command_set(cmd, name, value, &e);
+    const float *now = bb_command_options_of(cmd)->render.light_color;
+    if (st == BB_OK && !memcmp(now, r.light_color, sizeof r.light_color))
+      st = bb_command_unset(cmd, name, &e);
+    if (st != BB_OK) {
+      snprintf(err, cap, "%s", e.message);
+      return -1;
+    }
+    return 0;
+  }
+  *rebake = 1;
   if (!strcmp(name, "brightness")) {
     if (!s->brightness_file) {
       snprintf(err, cap, "brightness: no --brightness FILE was given to serve");
@@ -180,8 +205,10 @@ static int apply_one(const serve_state *s, bb_command *cmd, const char *name, co
   return -1;
 }
 
-int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
-                       const size_t *sizes, int count, char *err, size_t cap) {
+int serve_apply_params(serve_state *s, const char *const *names,
+                       const char *const *values, const size_t *sizes, int count,
+                       int *rebake, char *err, size_t cap) {
+  *rebake = 0;
   bb_command *next = NULL;
   bb_error e = {{0}};
   size_t size = 0;
@@ -195,7 +222,7 @@ int serve_apply_params(serve_state *s, const char *const *names, const char *con
   int rc = 0;
   for (int i = 0; i < count && rc == 0; i++) {
     char *value = spelled(values[i], sizes[i]);
-    rc = value ? apply_one(s, next, names[i], value, err, cap) : -1;
+    rc = value ? apply_one(s, next, names[i], value, rebake, err, cap) : -1;
     if (!value)
       snprintf(err, cap, "out of memory");
     free(value);
@@ -212,9 +239,11 @@ int serve_apply_params(serve_state *s, const char *const *names, const char *con
    * and files the command line named, owned by its command) stay */
   const bb_bake_options *b = &bb_command_options_of(next)->job.bake;
   for (size_t i = 0; i < CONTROL_COUNT; i++)
-    memcpy((char *)&s->settings.bake + controls[i].offset, (const char *)b + controls[i].offset,
-           controls[i].size);
+    memcpy((char *)&s->settings.bake + controls[i].offset,
+           (const char *)b + controls[i].offset, controls[i].size);
   s->use_brightness = bb_command_given(next, "brightness");
+  memcpy(s->light_color, bb_command_options_of(next)->render.light_color,
+         sizeof s->light_color);
   bb_command_free(s->command);
   s->command = next;
   s->version++;
@@ -253,6 +282,7 @@ static void write_ranges(bb_json *j, void *arg) {
    * AZ,EL take them: their range is the elevation's ("range EL 1..90") */
   add_range(j, "view_elevation", "render", "view");
   add_range(j, "light_elevation", "render", "light");
+  add_range(j, "light_color", "render", "light-color");
   bb_json_close(j, '}');
 }
 

@@ -22,8 +22,8 @@
 
 #include <errno.h>
 #include <limits.h>
-#include <pthread.h>
 #include <poll.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,23 +38,23 @@
 
 /* What a file's directory gets told, and its parent about it. */
 #define DIR_EVENTS                                                                       \
-  (IN_MOVED_TO | IN_CLOSE_WRITE | IN_MODIFY | IN_CREATE | IN_DELETE | IN_MOVED_FROM |     \
+  (IN_MOVED_TO | IN_CLOSE_WRITE | IN_MODIFY | IN_CREATE | IN_DELETE | IN_MOVED_FROM |    \
    IN_DELETE_SELF | IN_MOVE_SELF)
 #define PARENT_EVENTS (IN_CREATE | IN_MOVED_TO | IN_ONLYDIR)
 
 struct serve_watch {
   serve_state *s;
   int fd;
-  int stop_fd;                     /* an eventfd: written to stop the thread */
+  int stop_fd; /* an eventfd: written to stop the thread */
   pthread_t thread;
   /* per watched file: */
   char dir[SERVE_MAX_WATCHED][PATH_MAX];    /* its directory as its path names it */
   char parent[SERVE_MAX_WATCHED][PATH_MAX]; /* that directory's parent, "" for none */
   const char *dir_name[SERVE_MAX_WATCHED];  /* the directory's name in the parent */
-  int wd[SERVE_MAX_WATCHED];       /* the watch of its directory, -1 while it is gone */
+  int wd[SERVE_MAX_WATCHED]; /* the watch of its directory, -1 while it is gone */
   int parent_wd[SERVE_MAX_WATCHED];
   const char *base[SERVE_MAX_WATCHED];
-  int pending;                     /* a write without a close was seen */
+  int pending; /* a write without a close was seen */
   struct stat last[SERVE_MAX_WATCHED];
 };
 typedef struct serve_watch watch;
@@ -77,7 +77,8 @@ static int stable(watch *w) {
     struct stat st;
     memset(&st, 0, sizeof st);
     stat(w->s->watched[i], &st);
-    if (st.st_size != w->last[i].st_size || st.st_mtim.tv_sec != w->last[i].st_mtim.tv_sec ||
+    if (st.st_size != w->last[i].st_size ||
+        st.st_mtim.tv_sec != w->last[i].st_mtim.tv_sec ||
         st.st_mtim.tv_nsec != w->last[i].st_mtim.tv_nsec)
       same = 0;
     w->last[i] = st;
@@ -154,7 +155,8 @@ static int read_events(watch *w) {
       const struct inotify_event *e = (const struct inotify_event *)p;
       p += sizeof *e + e->len;
       for (int i = 0; i < w->s->watched_count; i++) {
-        if (e->wd == w->wd[i] && (e->mask & (IN_DELETE_SELF | IN_MOVE_SELF | IN_IGNORED))) {
+        if (e->wd == w->wd[i] &&
+            (e->mask & (IN_DELETE_SELF | IN_MOVE_SELF | IN_IGNORED))) {
           disarm(w, i);
           arm(w, i); /* there again already (renamed back): watched again */
           seen = 2;
@@ -219,8 +221,8 @@ int serve_watch_start(serve_state *s, serve_watch **out, char *err, size_t cap) 
   w->fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
   w->stop_fd = eventfd(0, EFD_CLOEXEC);
   if (w->fd < 0 || w->stop_fd < 0) {
-    snprintf(err, cap, "cannot watch the inputs: %s: %s", w->fd < 0 ? "inotify" : "eventfd",
-             strerror(errno));
+    snprintf(err, cap, "cannot watch the inputs: %s: %s",
+             w->fd < 0 ? "inotify" : "eventfd", strerror(errno));
     watch_free(w);
     return -1;
   }
