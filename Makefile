@@ -457,8 +457,10 @@ goldens: ensure-deps
 # outside their directory, FIFOs, huge headers, outputs over inputs, links at
 # temporaries, signals in a commit, depfile names, escapes, JSON, address
 # space; code from the working directory, outputs that are not regular
-# files, a memory cgroup, renders too large) against the binary, a line per
-# case, in about two minutes (tools/hostile_repro.sh; not part of make test:
+# files, a memory cgroup, renders too large; `bumpbake serve` as a server:
+# slow clients, 1,000 connections, stalled downloads, concurrent writes,
+# malformed HTTP, tools/hostile_serve.py) against the binary, a line per
+# case, in about five minutes (tools/hostile_repro.sh; not part of make test:
 # its bounds are wall-clock).
 hostile: $(BIN)
 	@./tools/hostile_repro.sh $(BIN)

@@ -170,6 +170,17 @@ const char *bb_status_name(bb_status status);
  * Returns out. The command line prints every line through it. */
 const char *bb_text_printable(const char *s, char *out, size_t cap);
 
+/* word quoted for a POSIX shell: as it is when every byte is a letter, a
+ * digit, one of "@%+=:,./-_" or a byte of UTF-8 beyond ASCII (so plain
+ * paths and values keep their bytes), else in single quotes with each
+ * quote in it given as '\'' ("my rock.png" -> 'my rock.png', "" -> '').
+ * sh reads back the word itself, whatever its bytes. Every command line
+ * the library spells (the provenance's command, bb_job_command_text,
+ * bb_command_text) quotes its words so; a client that records the words
+ * typed (bb_command_set_record) quotes them with this. malloc'd; NULL
+ * when word is NULL or out of memory. */
+char *bb_text_shell_quoted(const char *word);
+
 /* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
  * the end of the string or bytes that are not UTF-8 (overlong forms,
  * surrogates and code points past U+10FFFF included). */
@@ -1101,7 +1112,12 @@ struct bb_trace_options {
                               nonzero return cancels. In bb_bake also
                               with done 0 and total 0 (a checkpoint, no
                               progress) every 50 ms while it smooths and
-                              makes normals, so those stages cancel too */
+                              makes normals, so those stages cancel too;
+                              with inter-reflection (bounce_albedo > 0) the
+                              units run once over the trace and the
+                              bounces: the first bb_bake_slices(o) are the
+                              trace's (one a slice), the rest the
+                              bounces' */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls
@@ -2859,6 +2875,15 @@ const bb_command_info *bb_command_describe(const bb_command *command);
  * --rays?)"). An option set again takes the new value. */
 bb_status bb_command_set(bb_command *command, const char *name, const char *text,
                          bb_error *err);
+
+/* Puts option name back at its default, as if it had never been set: the
+ * rules (bb_command_check) and the text (bb_command_text) no longer see
+ * it. For a client whose control goes back to the value it starts at
+ * (bumpbake serve's page). Errors: BB_ERR_ARGUMENT "unknown option ..."
+ * as bb_command_set says it, and "--NAME cannot be unset: leave it out"
+ * for an option whose parser sets more than its one value (--basis);
+ * BB_ERR_MEMORY. An option not set is left as it is. */
+bb_status bb_command_unset(bb_command *command, const char *name, bb_error *err);
 
 /* Adds a positional argument (an input file, or height2ssbump's
  * BUMPSCALE) in order. Errors: BB_ERR_ARGUMENT (one too many, a
