@@ -325,6 +325,26 @@ bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
 /* The name of kind, or "unknown". */
 const char *bb_map_kind_name(bb_map_kind kind);
 
+/* The rule of what a map records in its provenance, which every writer and
+ * reader of provenance follows: 1 when the pixels of a map of output kind
+ * `kind` (as provenance records it under "output": "normal", "ao", ...; a
+ * kind of parts, "ssbump+height", records what any part records, "height"
+ * being the filtered height) can change with the bake parameter recorded
+ * under `key`, 0 when they cannot: a normal map does not depend on "rays",
+ * "rayset", "bias", "power", "basis", "bounce" or "brightness", the
+ * filtered height on "scale" either, ao not on "normal_filter" or
+ * "normal_y", and ao on "power" and "basis" only with inter-reflection
+ * (bounce nonzero: the text has a "bounce" key); without it, ao's "rayset"
+ * is recorded as the ray set's scheme and slices only ("bb-horizon-v1:a16").
+ * A bake's outputs record only such keys (bb_provenance_format), the
+ * up-to-date check (bb_output_check) and bb_provenance_diff compare only
+ * them, so a parameter that does not change a map neither makes it stale
+ * nor shows in its diff, also against a file written before the rule that
+ * holds them all. 1 for keys that are no bake parameter (bumpbake_version,
+ * input_file_hash, channel, a texture's or a render's keys) and for kinds
+ * that are not a bake's maps ("render", "normal+coverage"). */
+int bb_map_kind_records(const char *kind, const char *key, int bounce);
+
 /* =====================================================================
  * files: checked, all-or-nothing writes of files; provenance texts read
  * ===================================================================== */
@@ -387,7 +407,10 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 
 /* Writes into out (capacity cap) the keys whose values differ between two
  * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
- * when either text is NULL). Keys "command" and "output" are ignored. Returns
+ * when either text is NULL). Keys "command" and "output" are ignored, and so
+ * is a key neither text's kind ("output") records (bb_map_kind_records:
+ * "rays" of a normal map; an ao's "rayset" is compared by its scheme and
+ * slices alone without inter-reflection). Returns
  * the number of differing keys, or -1 when out of memory. Time is
  * O(n log n) in the number of lines, whatever the texts hold. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
@@ -2155,7 +2178,10 @@ typedef struct bb_provenance {
  * input_file_hash when known, output, scale, rays, rayset, filter_radius,
  * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
  * channel), malloc'd; the caller
- * frees it. A basis of the caller's vectors ("vectors:HASH") adds
+ * frees it. With options (a bake's map), only the parameters output_kind
+ * records are written (bb_map_kind_records: a normal map has no rays,
+ * rayset, bias, power or basis; ao's rayset is its scheme and slices);
+ * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
  * Options in use add, after addressing: bounce (rho) and bounces when
  * bounce_albedo > 0, with bounce_albedo_map (bb_image_hash of the map, 16
@@ -2650,9 +2676,10 @@ typedef enum bb_output_state {
  * writes with the same value, and no key that text lacks, except "command"
  * and "input" (the command line and the input's name, which do not change a
  * pixel) and "input_hash" (the decoded height's hash, implied by
- * input_file_hash and channel): so the bumpbake version, the input file's
- * bytes, the output kind and every parameter that affects pixels must
- * match; and when its samples have the depth `depth` gives in path's format
+ * input_file_hash and channel), and keys the file's kind does not record
+ * (bb_map_kind_records: a normal map written before the rule, with "rays",
+ * is current): so the bumpbake version, the input file's bytes, the output
+ * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
  * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
  * level exactly when mip_mapped. expected->input_file_hash must be set
  * (nonzero): without it nothing is CURRENT. A file that cannot be read is
