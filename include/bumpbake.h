@@ -2397,6 +2397,134 @@ int bb_compare_report_exit_code(const bb_compare_report *report);
  * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
 const char *bb_compare_report_result(const bb_compare_report *report);
 
+/* ---------------------------------------------------------- golden suites */
+
+/* A suite check (`bumpbake check`): every map of a suite compared with its
+ * golden, as bb_compare_files compares two files, in one run: a tree of new
+ * files against a tree of goldens by relative name, or a batch baked in
+ * memory (bake --out-dir GOLDEN's maps, nothing written) against the files
+ * it would write. Each map is a case with idiff's verdict under limits
+ * chosen per map kind or file name; a run can update the goldens where a
+ * case does not pass, and writes a JUnit XML file and an HTML report. */
+
+/* How a case ended. */
+typedef enum bb_check_status {
+  BB_CHECK_PASS = 0,       /* within the limits (idiff's exit 0) */
+  BB_CHECK_WARNING,        /* idiff's warning (1) */
+  BB_CHECK_FAILURE,        /* idiff's failure (2) */
+  BB_CHECK_DIFFERENT_SIZE, /* sizes or channel counts differ (3) */
+  BB_CHECK_UNREADABLE,     /* a file that cannot be read, a link leaving its
+                              tree, an input that would not bake (4) */
+  BB_CHECK_MISSING,        /* a golden nothing new matches (a failure: 2) */
+  BB_CHECK_EXTRA           /* a new map without a golden (a failure: 2) */
+} bb_check_status;
+
+/* One case: a map and its golden. Strings belong to the check. */
+typedef struct bb_check_case {
+  const char *name;            /* the golden's path relative to the golden tree */
+  const char *golden;          /* the golden's path */
+  const char *fresh;           /* the new file's path; for a bake, the height
+                                  it was baked from */
+  const char *kind;            /* the map's kind, as its provenance records it
+                                  ("normal"; "" when unknown) */
+  bb_check_status status;
+  int exit_code;               /* idiff's: 0 to 4; MISSING and EXTRA 2 */
+  bb_compare_limits limits;    /* what it was judged by */
+  int width, height, channels;             /* of the golden (0: not read) */
+  int new_width, new_height, new_channels; /* of the new map (0: not made) */
+  bb_compare_stats stats;      /* when both were compared (same size) */
+  const char *provenance_diff; /* "key: golden -> new" lines (bb_provenance_diff;
+                                  "" when the same), NULL when not compared
+                                  (either side without intact provenance) */
+  const char *message;         /* why UNREADABLE, MISSING or EXTRA; else "" */
+  int updated;                 /* 1: its golden was written by the update */
+  const char *update_error;    /* why the update could not write it, or NULL */
+  double seconds;              /* the time its comparison took */
+} bb_check_case;
+
+/* A planned check. Opaque; not thread-safe. */
+typedef struct bb_check bb_check;
+
+/* A check is planned from its command (bb_check_plan, with the commands
+ * below); bb_check_free frees it. */
+void bb_check_free(bb_check *check);
+
+/* Called with each case as it is decided (and its golden updated). */
+typedef void (*bb_check_case_fn)(void *user, const bb_check_case *c);
+
+/* The heights of a check with --bake, in the order of the batch (a
+ * directory's images sorted); 0 without. */
+int bb_check_input_count(const bb_check *check);
+/* Height i's path as the batch planned it (a directory's file: DIR/NAME),
+ * or NULL. */
+const char *bb_check_input(const bb_check *check, int i);
+
+/* Bakes height i in memory (progress as bb_job_run_item's, which may
+ * cancel) and decides a case for each of its maps against the file the
+ * batch would write (what reading that file back would give, its
+ * provenance as the batch would record it), then with --update writes the
+ * maps that did not pass (and only those) as the batch writes them. An
+ * input that does not bake is an UNREADABLE case per map. Errors:
+ * BB_ERR_ARGUMENT (i out of range), BB_ERR_CANCELLED, BB_ERR_MEMORY. */
+bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
+                             void *progress_user, bb_check_case_fn each, void *user,
+                             bb_error *err);
+
+/* The cases that are not an input's: of two trees every pair (sorted by
+ * name: both have it, MISSING, EXTRA); of a bake the goldens no input makes
+ * (an image in GOLDEN, at any depth, whose provenance says bumpbake baked
+ * it: MISSING). Names starting with '.' and files of other extensions are
+ * not cases; a link is followed only to a file inside its tree; nothing
+ * else is followed. */
+bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
+                            bb_error *err);
+
+/* bb_check_run_input of every input, then bb_check_run_rest. */
+bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
+                       bb_check_case_fn each, void *user, bb_error *err);
+
+/* The cases decided (and imported) so far, in order. */
+int bb_check_case_count(const bb_check *check);
+const bb_check_case *bb_check_case_get(const bb_check *check, int i);
+
+/* The exit code of the worst case (the largest: 0 pass .. 4 unreadable;
+ * MISSING and EXTRA 2), a case whose golden was updated counting as a pass;
+ * 0 when there is none. */
+int bb_check_exit_code(const bb_check *check);
+
+/* "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE", "UNREADABLE", "MISSING",
+ * "EXTRA"; "unknown" else. Static text. */
+const char *bb_check_status_name(bb_check_status status);
+
+/* What the command line prints of a case, as the command's options (json,
+ * quiet) ask: a case that does not pass as "STATUS NAME (KIND): what" and
+ * its provenance differences indented, one line "updated NAME" for a
+ * golden written; nothing for a pass; with json one JSON line per case.
+ * To free(); NULL when out of memory. */
+char *bb_check_case_lines(const bb_check *check, const bb_check_case *c);
+
+/* The summary line ("check: N maps: P passed, W warnings, F failed, ...") or
+ * its JSON line; "" with quiet. To free(); NULL when out of memory. */
+char *bb_check_summary_lines(const bb_check *check);
+
+/* Writes the reports the command asked for, of every case so far: the
+ * JUnit XML file (a test case per map; a failure's message carries its
+ * statistics and provenance differences) and the HTML report's index.html
+ * (its pictures are made as the cases are; pictures an earlier report left
+ * in its folder are removed). Errors: those of writing. */
+bb_status bb_check_write_reports(bb_check *check, bb_error *err);
+
+/* The cases from first on as bytes (*size of them; malloc'd, NULL when out
+ * of memory or a picture cannot be written), for another process's check
+ * of the same command to import: a cluster's workers each check some inputs
+ * and the client reports them all. The HTML pictures they name are files of
+ * the report's directory, written first. */
+char *bb_check_export(bb_check *check, int first, size_t *size);
+
+/* Adds the cases of an export (bb_check_export), as if decided here.
+ * Errors: BB_ERR_ARGUMENT (not an export of this version), BB_ERR_MEMORY. */
+bb_status bb_check_import(bb_check *check, const char *data, size_t size, bb_error *err);
+
 /* -------------------------------------------------------------- bake jobs */
 
 /* What `bumpbake bake` does, as one plan and its run: inputs (height files,
@@ -2853,6 +2981,10 @@ typedef struct bb_command_options {
   int panel_size;               /* sheet --panel-size */
   bb_compare_limits limits;     /* compare */
   const char *diff;             /* compare --diff */
+  const char *limit_rules;      /* check --limits: "KIND|PATTERN: -fail T ...; ..." */
+  int check_bake;               /* check --bake: the inputs after GOLDEN are heights */
+  int update;                   /* check --update */
+  const char *junit, *html;     /* check --junit FILE, --html DIR */
   bb_renderbump_options renderbump; /* renderbumpflat */
   const char *height_output;    /* renderbumpflat --height */
   bb_map_kind map_kind;         /* combine --kind */
@@ -2984,6 +3116,20 @@ typedef struct bb_command_hooks {
  * job. */
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
                           bb_error *err);
+
+/* Plans a checked `check` command (bb_command_check): GOLDEN and NEW, two
+ * directories (or two files), or GOLDEN and heights with --bake, a batch
+ * whose out-dir is GOLDEN, planned as bake plans it (every option and name
+ * checked; nothing written, no directory made) unless --update; the
+ * limits (idiff's options, then --limits' rules by kind or name); the
+ * reports asked (--junit FILE, --html DIR; the report's directory is made,
+ * and the pictures a run of it left before removed). hooks (may be NULL):
+ * the bake's notes. Free with bb_check_free. Errors: BB_ERR_ARGUMENT (not
+ * a checked check command), BB_ERR_IO (GOLDEN or NEW is not there: GOLDEN
+ * may be missing only with --update, which makes it), those of the bake's
+ * plan. */
+bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
+                        bb_error *err);
 
 /* 1 when the command writes through the job (bb_command_plan plans it). */
 int bb_command_has_job(const bb_command_info *command);
