@@ -2473,7 +2473,7 @@ bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
 /* The cases that are not an input's: of two trees every pair (sorted by
  * name: both have it, MISSING, EXTRA); of a bake the goldens no input makes
  * (an image in GOLDEN, at any depth, whose provenance says bumpbake baked
- * it: MISSING). Names starting with '.' and files of other extensions are
+ * it, under a name the batch's template gives a kind it writes: MISSING). Names starting with '.' and files of other extensions are
  * not cases; a link is followed only to a file inside its tree; nothing
  * else is followed. */
 bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,

@@ -141,6 +141,13 @@ const char *bb__job_valve_kind(const bb_job_options *o);
 bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
                        unsigned flags, bb_job **out, bb_error *err);
 
+/* A batch's name template's fields {stem}, {kind} and {ext} ("{{" and "}}"
+ * are braces) expanded with fields[0..2] into out (capacity cap): the name
+ * of a map (plan.c), or with "*" for stem and extension the pattern of the
+ * names a template can give a kind (a golden check's). */
+bb_status bb__job_expand_name(const char *tmpl, const char *const fields[3], char *out,
+                              size_t cap, bb_error *err);
+
 /* bb_outputs_check; directories 0: leaves out the check of the outputs'
  * directories and of what their names hold now (paths.c). */
 bb_status bb__outputs_check(const bb_output_spec *outputs, int count, const char *const *reads,

@@ -226,10 +226,8 @@ static bb_status check_inside(const char *tmpl, const char *input, const char *n
   return BB_OK;
 }
 
-/* Expands the template's fields {stem}, {kind} and {ext} ("{{" and "}}" are
- * braces) into out (capacity cap). */
-static bb_status expand_name(const char *tmpl, const char *const fields[3], char *out,
-                             size_t cap, bb_error *err) {
+bb_status bb__job_expand_name(const char *tmpl, const char *const fields[3], char *out,
+                              size_t cap, bb_error *err) {
   static const char *const names[3] = {"stem", "kind", "ext"};
   size_t used = 0;
   for (const char *s = tmpl; *s;) {
@@ -276,7 +274,7 @@ static bb_status name_outputs(bb_job *job, bb__job_item *item, bb_error *err) {
     if (!(job->options.bake.outputs & BB_MAP_BIT(k)))
       continue;
     const char *fields[3] = {stem, kind_name(k), ext};
-    bb_status st = expand_name(tmpl, fields, name, sizeof name, err);
+    bb_status st = bb__job_expand_name(tmpl, fields, name, sizeof name, err);
     if (st == BB_OK)
       st = check_inside(tmpl, item->input, name, err);
     if (st != BB_OK)
