@@ -209,7 +209,8 @@ static const char PAGE_HEAD[] =
     "section.case{border-left:6px solid;padding:10px 14px;margin:0 0 "
     "22px;background:#26292c}\n"
     ".views{display:flex;flex-wrap:wrap;gap:16px;margin:10px 0;align-items:flex-start}\n"
-    "figure{margin:0}.view figcaption{font-size:12px;color:#aaa;margin-top:3px}\n"
+    "figure{margin:0}.view{width:min-content}\n"
+    ".view figcaption{font-size:12px;color:#aaa;margin-top:3px}\n"
     ".frame{position:relative;overflow:hidden;background:#111}\n"
     ".frame img{position:absolute;top:0;image-rendering:pixelated;max-width:none}\n"
     ".over{position:absolute;inset:0;overflow:hidden}\n"
@@ -272,11 +273,10 @@ static void put_views(bb__text *t, const bb__check_case *k) {
     bb__text_printf(t, "<figure class=\"view %s\">", names[i]);
     put_frame(t, k, i, scale, "");
     if (i == 2)
-      bb__text_printf(
-          t,
-          "<figcaption>difference, heat (white: |golden - new| = %.4g, square "
-          "root scale; NaN against a number: white)</figcaption>",
-          k->heat_max);
+      bb__text_printf(t,
+                      "<figcaption>difference: black none, white %.4g (square root "
+                      "scale; a NaN against a number white too)</figcaption>",
+                      k->heat_max);
     else
       bb__text_printf(t, "<figcaption>%s</figcaption>", names[i]);
     bb__text_add(t, "</figure>");
