@@ -195,13 +195,14 @@ Test(cli_check, goldens_no_input_makes_are_missing_and_maps_without_golden_extra
   cr_expect_eq(r.code, 2, "%s%s", r.out, r.err);
   cr_expect(strstr(r.out, "EXTRA c_normal.png") && strstr(r.out, "EXTRA c_ao.png"), "%s",
             r.out);
-  cr_expect(strstr(r.out, "MISSING b_normal.png") && strstr(r.out, "MISSING b_ao.png"), "%s",
-            r.out);
+  cr_expect(strstr(r.out, "MISSING b_normal.png") && strstr(r.out, "MISSING b_ao.png"),
+            "%s", r.out);
   /* the ssbump goldens are not this check's: it bakes no ssbump */
   cr_expect_null(strstr(r.out, "ssbump"), "%s", r.out);
   cr_expect_null(strstr(r.out, "plain.png"), "%s", r.out);
-  cr_expect(strstr(r.out, "check: 6 maps: 2 passed, 0 warnings, 0 failed, 0 of another size, "
-                          "0 unreadable, 2 missing, 2 extra"),
+  cr_expect(strstr(r.out,
+                   "check: 6 maps: 2 passed, 0 warnings, 0 failed, 0 of another size, "
+                   "0 unreadable, 2 missing, 2 extra"),
             "%s", r.out);
   cli_result_free(&r);
   /* goldens of another template beside these are another suite's too */
@@ -405,4 +406,37 @@ Test(cli_check, usage_errors_exit_4_and_write_nothing) {
                          "two directories"};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     harness_expect_refusal(NULL, cases[i], 4, parts[i], i);
+}
+
+/* ------------------------------------------------ what a map records */
+
+/* A map records only what its pixels depend on: --rays and --power do not
+ * bake a normal map again, nor show in compare's diff of it. */
+Test(cli_check, a_normal_map_is_current_and_same_whatever_the_trace) {
+  make_dir(tmp("h"));
+  height_file(tmp("h/a.png"), 1);
+  cli_result r = RUN("bake", tmp("h"), "--out-dir", tmp("o"), FAST, "--maps",
+                     "normal,weights,filtered", "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("bake", tmp("h"), "--out-dir", tmp("o"), FAST, "--maps",
+          "normal,weights,filtered", "--rays", "64", "--slices", "7", "--power", "2",
+          "--bias", "1");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "0 baked, 1 up to date"), "%s", r.out);
+  cli_result_free(&r);
+  r = RUN("bake", tmp("h/a.png"), FAST, "--slices", "7", "--normal", tmp("n7.png"),
+          "--ao", tmp("a7.png"), "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN("compare", tmp("o/a_normal.png"), tmp("n7.png"));
+  cr_expect_eq(r.code, 0, "%s", r.out);
+  cr_expect_null(strstr(r.out, "provenance differs"), "%s", r.out);
+  cli_result_free(&r);
+  /* an ao does depend on the slices */
+  r = RUN("bake", tmp("h/a.png"), FAST, "--ao", tmp("a4.png"), "-q");
+  cli_result_free(&r);
+  r = RUN("compare", tmp("a4.png"), tmp("a7.png"));
+  cr_expect(strstr(r.out, "rayset: bb-horizon-v1:a4 -> bb-horizon-v1:a7"), "%s", r.out);
+  cli_result_free(&r);
 }
