@@ -65,7 +65,6 @@ static bb_status tree_add(tree *t, const char *rel, const char *refused) {
   return BB_OK;
 }
 
-
 /* Deeper than this, a tree is refused: no suite nests so far, and the
  * walk's memory stays bounded. */
 enum { MAX_TREE_DEPTH = 64 };
@@ -221,11 +220,12 @@ static char *join(const char *root, const char *rel) {
  * of name, decided and added. */
 static bb_status tree_case(bb_check *c, const char *name, const char *golden,
                            const char *golden_refused, const char *fresh,
-                           const char *fresh_refused, bb_check_case_fn each, void *user) {
+                           const char *fresh_refused, bb_check_case_fn each, void *user,
+                           bb_error *err) {
   const double t0 = bb__now_seconds();
   bb__check_case *k = bb__check_case_new(name, golden, fresh, NULL);
   if (!k)
-    return bb__fail(NULL, BB_ERR_MEMORY, "out of memory");
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   side g, n;
   memset(&g, 0, sizeof g);
   memset(&n, 0, sizeof n);
@@ -256,17 +256,17 @@ static bb_status tree_case(bb_check *c, const char *name, const char *golden,
                                  g.info.description,       n.info.description,
                                  raw_signed(&g, kind),     raw_signed(&n, kind)};
   bb_status st =
-      bb__check_decide(c, k, &sides, status, status == BB_CHECK_PASS ? NULL : why);
+      bb__check_decide(c, k, &sides, status, status == BB_CHECK_PASS ? NULL : why, err);
   side_free(&g);
   side_free(&n);
-  if (st == BB_OK && c->setup.update)
-    st = update_from_tree(k);
+  if (st == BB_OK && c->setup.update && update_from_tree(k) != BB_OK)
+    st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
   k->pub.seconds = bb__now_seconds() - t0;
   if (st != BB_OK) {
     bb__check_case_free(k);
-    return bb__fail(NULL, st, "out of memory");
+    return st;
   }
-  return bb__check_add(c, k, each, user);
+  return bb__check_add(c, k, each, user, err);
 }
 
 /* Two trees, paired by relative name (both sorted: one merge). */
@@ -293,9 +293,7 @@ static bb_status check_trees(bb_check *c, bb_check_case_fn each, void *user,
       st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
     else
       st = tree_case(c, rel, gp, gf ? gf->refused : NULL, np, nf ? nf->refused : NULL,
-                     each, user);
-    if (st != BB_OK)
-      bb__fail(err, st, "out of memory");
+                     each, user, err);
     free(gp);
     free(np);
     i += order <= 0;
@@ -309,9 +307,8 @@ static bb_status check_trees(bb_check *c, bb_check_case_fn each, void *user,
 /* One file against another: a case named by the golden's file name. */
 static bb_status check_files(bb_check *c, bb_check_case_fn each, void *user,
                              bb_error *err) {
-  bb_status st =
-      tree_case(c, bb__file_name(c->golden), c->golden, NULL, c->fresh, NULL, each, user);
-  return st == BB_OK ? BB_OK : bb__fail(err, st, "out of memory");
+  return tree_case(c, bb__file_name(c->golden), c->golden, NULL, c->fresh, NULL, each,
+                   user, err);
 }
 
 /* ------------------------------------------------- a bake's missing goldens */
@@ -370,6 +367,7 @@ static bb_status check_unmade(bb_check *c, bb_check_case_fn each, void *user,
         made[n++] = job->items[i].paths[k] + root + 1;
   qsort(made, n, sizeof *made, by_string);
   tree g;
+  memset(&g, 0, sizeof g);
   struct stat s;
   bb_status st = stat(c->golden, &s) == 0 ? tree_read(&g, c->golden, err) : BB_OK;
   if (st != BB_OK || !g.root) {
@@ -384,8 +382,8 @@ static bb_status check_unmade(bb_check *c, bb_check_case_fn each, void *user,
     char *path = join(c->golden, rel);
     if (!path)
       st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
-    else if (is_baked_map(path) && tree_case(c, rel, path, NULL, NULL, NULL, each, user))
-      st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    else if (is_baked_map(path))
+      st = tree_case(c, rel, path, NULL, NULL, NULL, each, user, err);
     free(path);
   }
   tree_free(&g);
@@ -432,7 +430,6 @@ bb_status bb_check_run(bb_check *c, bb_progress_fn progress, void *progress_user
 }
 
 /* ------------------------------------------------------- what is printed */
-
 
 static void json_case(FILE *f, const bb_check_case *k) {
   bb_json j = {f, 0};
@@ -806,8 +803,8 @@ bb_status bb_check_import(bb_check *c, const char *data, size_t size, bb_error *
       return r.bad ? bb__fail(err, BB_ERR_ARGUMENT, "check import: a case is cut short")
                    : bb__fail(err, BB_ERR_MEMORY, "out of memory");
     }
-    if (bb__check_add(c, k, NULL, NULL) != BB_OK)
-      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    if (bb__check_add(c, k, NULL, NULL, err) != BB_OK)
+      return BB_ERR_MEMORY;
   }
   return BB_OK;
 }

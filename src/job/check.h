@@ -98,14 +98,16 @@ void bb__check_case_free(bb__check_case *k);
 /* Decides k from sides under its limits (chosen here from its kind and
  * name): the statistics, the verdict, the provenance differences, and the
  * report's pictures. status BB_CHECK_PASS asks for the comparison; any
- * other is kept with message. Returns BB_OK, or BB_ERR_MEMORY. */
+ * other is kept with message. Returns BB_OK, or the error of drawing its
+ * pictures, BB_ERR_MEMORY. */
 bb_status bb__check_decide(bb_check *check, bb__check_case *k,
                            const bb__check_sides *sides, bb_check_status status,
-                           const char *message);
+                           const char *message, bb_error *err);
 
-/* Adds k to the check's cases (taking it) and calls each with it. */
+/* Adds k to the check's cases (taking it, freed on failure too) and calls
+ * each with it. */
 bb_status bb__check_add(bb_check *check, bb__check_case *k, bb_check_case_fn each,
-                        void *user);
+                        void *user, bb_error *err);
 
 /* Why the link at path is not followed (it leads out of the tree whose
  * real path is real_root, to nothing, or to no regular file), or NULL; and

@@ -75,7 +75,7 @@ static bb_check_status read_golden(const char *root, const char *path, bb_image 
 /* The case of map kind of input i, decided; *update gets its bit when the
  * golden should be written. */
 static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *result,
-                          bb__check_case **out, unsigned *update) {
+                          bb__check_case **out, unsigned *update, bb_error *err) {
   bb_job *job = bb__check_job(c);
   const char *path = job->items[i].paths[kind];
   const bb_map_kind_info *info = bb_map_kind_get((bb_map_kind)kind);
@@ -90,7 +90,7 @@ static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *re
   if (!k || !description) {
     bb__check_case_free(k);
     free(description);
-    return bb__fail(NULL, BB_ERR_MEMORY, "out of memory");
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   }
   const bb_depth depth = bb__job_map_depth(job, i, kind);
   bb_image fresh = {0}, golden = {0};
@@ -118,7 +118,7 @@ static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *re
                                  golden_info.is_float && info->range == BB_RANGE_SIGNED,
                                  stored_float && info->range == BB_RANGE_SIGNED};
   bb_status st =
-      bb__check_decide(c, k, &sides, status, status == BB_CHECK_PASS ? NULL : why);
+      bb__check_decide(c, k, &sides, status, status == BB_CHECK_PASS ? NULL : why, err);
   bb_image_free(&fresh);
   bb_image_free(&golden);
   bb_image_info_free(&golden_info);
@@ -137,7 +137,7 @@ static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *re
 
 /* The cases of an input that did not bake: one per map, with its reason. */
 static bb_status unbaked_cases(bb_check *c, int i, const bb_error *why,
-                               bb_check_case_fn each, void *user) {
+                               bb_check_case_fn each, void *user, bb_error *err) {
   bb_job *job = bb__check_job(c);
   size_t skip = strlen(job->out_dir);
   while (skip > 1 && job->out_dir[skip - 1] == '/')
@@ -150,10 +150,10 @@ static bb_status unbaked_cases(bb_check *c, int i, const bb_error *why,
     bb__check_case *kc = bb__check_case_new(path + skip + 1, path, job->items[i].input,
                                             bb_map_kind_name((bb_map_kind)k));
     const bb__check_sides none = {0};
-    st = kc ? bb__check_decide(c, kc, &none, BB_CHECK_UNREADABLE, why->message)
-            : BB_ERR_MEMORY;
+    st = kc ? bb__check_decide(c, kc, &none, BB_CHECK_UNREADABLE, why->message, err)
+            : bb__fail(err, BB_ERR_MEMORY, "out of memory");
     if (st == BB_OK)
-      st = bb__check_add(c, kc, each, user);
+      st = bb__check_add(c, kc, each, user, err);
     else
       bb__check_case_free(kc);
   }
@@ -169,20 +169,20 @@ bb_status bb_check_run_input(bb_check *c, int i, bb_progress_fn progress,
   bb_bake_result result;
   bb_error why = {{0}};
   bb_status st = bb_job_bake_item(job, i, 0u, progress, progress_user, &result, &why);
-  if (st == BB_ERR_CANCELLED || st == BB_ERR_MEMORY) {
+  if (st == BB_ERR_CANCELLED) {
     if (err)
       *err = why;
     return st;
   }
+  /* an input that would not bake (unreadable, too large for the memory)
+   * leaves its maps uncompared: cases that say why */
   if (st != BB_OK)
-    return unbaked_cases(c, i, &why, each, user) == BB_OK
-               ? BB_OK
-               : bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    return unbaked_cases(c, i, &why, each, user, err);
   bb__check_case *cases[BB_MAP_BAKED_COUNT] = {0};
   unsigned update = 0;
   for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++)
     if (job->items[i].paths[k])
-      st = map_case(c, i, k, &result, &cases[k], &update);
+      st = map_case(c, i, k, &result, &cases[k], &update, err);
   if (st == BB_OK && bb__check_setup_of(c)->update && update) {
     bb_error e = {{0}};
     const int written = bb__job_write_maps(job, i, &result, update, &e) == BB_OK;
@@ -191,16 +191,16 @@ bb_status bb_check_run_input(bb_check *c, int i, bb_progress_fn progress,
         cases[k]->pub.updated = written;
         if (!written && !cases[k]->update_error &&
             !(cases[k]->update_error = strdup(e.message)))
-          st = BB_ERR_MEMORY;
+          st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
       }
   }
   bb_bake_result_free(&result);
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (cases[k] && st == BB_OK)
-      st = bb__check_add(c, cases[k], each, user);
+      st = bb__check_add(c, cases[k], each, user, err);
     else
       bb__check_case_free(cases[k]);
     cases[k] = NULL;
   }
-  return st == BB_OK ? BB_OK : bb__fail(err, st, "out of memory");
+  return st;
 }

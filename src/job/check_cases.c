@@ -1,9 +1,9 @@
-#define _XOPEN_SOURCE 700 /* realpath */
 /* check_cases.c: a golden check and its cases: the check made from its
  * setup, the limits of a map (idiff's options, then the rules that select
  * it), a case decided (two images compared, their provenance diffed, the
  * report's pictures drawn) and added, and what a case found in words. The
  * runs that make cases are check.c's and check_bake.c's. */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "core/internal.h"
 #include "job/check.h"
 #include "job/job_internal.h"
@@ -241,14 +241,14 @@ static void kind_from(const bb__check_sides *s, char *kind, size_t cap) {
 }
 
 bb_status bb__check_decide(bb_check *c, bb__check_case *k, const bb__check_sides *s,
-                           bb_check_status status, const char *message) {
+                           bb_check_status status, const char *message, bb_error *err) {
   if (!k->kind[0]) {
     char kind[64];
     kind_from(s, kind, sizeof kind);
     if (kind[0]) {
       free(k->kind);
       if (!(k->kind = strdup(kind)))
-        return bb__fail(NULL, BB_ERR_MEMORY, "out of memory");
+        return bb__fail(err, BB_ERR_MEMORY, "out of memory");
     }
   }
   k->pub.limits = bb__check_limits(c, k->kind, k->name);
@@ -264,7 +264,7 @@ bb_status bb__check_decide(bb_check *c, bb__check_case *k, const bb__check_sides
   if (status == BB_CHECK_PASS && s->golden && s->fresh) {
     const bb_compare_limits *l = &k->pub.limits;
     bb_status st = bb_compare_images(s->golden, s->fresh, l->fail, l->warn, &k->pub.stats,
-                                     NULL, NULL);
+                                     NULL, err);
     if (st != BB_OK)
       return st;
     switch (bb_compare_judge(&k->pub.stats, l)) {
@@ -281,28 +281,22 @@ bb_status bb__check_decide(bb_check *c, bb__check_case *k, const bb__check_sides
   }
   k->pub.status = status;
   if (message && !(k->message = strdup(message)))
-    return bb__fail(NULL, BB_ERR_MEMORY, "out of memory");
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   if (s->golden && s->fresh)
     k->provenance_diff = provenance_diff(s->golden_text, s->fresh_text);
   publish(k);
-  if (c->html) {
-    bb_error e = {{0}};
-    if (bb__check_pictures(&c->atlas, c->html, k, s, &e) != BB_OK && !k->update_error &&
-        !(k->update_error = strdup(e.message)))
-      return BB_ERR_MEMORY;
-    publish(k);
-  }
-  return BB_OK;
+  /* a report that cannot be drawn stops the run: its pictures would lie */
+  return c->html ? bb__check_pictures(&c->atlas, c->html, k, s, err) : BB_OK;
 }
 
-bb_status bb__check_add(bb_check *c, bb__check_case *k, bb_check_case_fn each,
-                        void *user) {
+bb_status bb__check_add(bb_check *c, bb__check_case *k, bb_check_case_fn each, void *user,
+                        bb_error *err) {
   if (c->count == c->capacity) {
     const int cap = c->capacity ? 2 * c->capacity : 64;
     bb__check_case **grown = realloc(c->cases, (size_t)cap * sizeof *grown);
     if (!grown) {
       bb__check_case_free(k);
-      return bb__fail(NULL, BB_ERR_MEMORY, "out of memory");
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
     }
     c->cases = grown;
     c->capacity = cap;
