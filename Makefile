@@ -160,7 +160,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-serve check-circles check-layers check-docs check-abi abi-dump api-report bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
+        bench bench-cluster bench-check goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -176,7 +177,9 @@ PYTHON   := /usr/bin/python3
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
 # python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
-# a Dask cluster (its tests run a LocalCluster). strace: a test (and make
+# a Dask cluster (its tests run a LocalCluster). python3-junitparser: a test
+# reads `bumpbake check --junit`'s file as CI servers do; python3-yaml: a test
+# runs docs/goldens.md's CI jobs. strace: a test (and make
 # hostile) delivers a signal in the middle of a commit; time: make hostile's
 # peak memory (GNU time's %M). abigail-tools: abidw and abidiff, the ABI
 # check.
@@ -184,7 +187,8 @@ DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libi
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build python3-distributed python3-dask strace time \
-            libmicrohttpd-dev chromium chromium-driver python3-selenium abigail-tools
+            libmicrohttpd-dev chromium chromium-driver python3-selenium python3-junitparser \
+            python3-yaml abigail-tools
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -194,7 +198,7 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium' >/dev/null 2>&1 \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium, junitparser, yaml' >/dev/null 2>&1 \
 	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 \
 	    && command -v abidw >/dev/null 2>&1 && command -v abidiff >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
@@ -345,8 +349,8 @@ test: ensure-deps
 # each other, the check that no family reaches up to a later one, the
 # check that the command reference and the man page say what --help says
 # and the check of the ABI against the last release's.
-check: check-unit check-install check-python check-serve check-circles check-layers check-docs \
-       check-abi
+check: check-unit check-install check-python check-serve check-report check-circles check-layers \
+       check-docs check-abi
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -431,9 +435,28 @@ check-serve: $(BIN)
 	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
 	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
 
+# `bumpbake check --html`'s report in headless Chromium (tests/report/): every
+# picture loads from the folder and nothing else, the flip and the slider
+# work, a failure shows golden, new and difference. Skipped, saying why,
+# without chromium, chromium-driver or python3-selenium. Screenshots:
+# build/report-test/.
+check-report: $(BIN) lib
+	@echo "report: check --html's page in headless Chromium (tests/report)"
+	@cd tests/report && BB_BIN=$(abspath $(BIN)) BB_REPORT_SHOTS=$(abspath $(BUILD))/report-test \
+	  PYTHONPATH=$(abspath python) BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) \
+	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
+
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# A golden suite of 200 maps from the fixtures checked three ways
+# (tools/bench_check.sh, for docs/performance.md "Golden checks"): the bake
+# alone, check --bake (the same bake, writing nothing) and the bake then
+# compare once per map; wall, CPU and peak memory, medians of 3 rounds.
+bench-check: ensure-deps
+	@$(MAKE) --no-print-directory all lib
+	@BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) ./tools/bench_check.sh $(BIN)
 
 # bumpbake on a Dask cluster of this machine (2 worker processes) against
 # one process, with cmp of their files (tools/bench_cluster.sh, for
