@@ -13,6 +13,16 @@
 bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
                                const bb_smooth_options *o, int threads,
                                const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
+/* bb__smooth_bilateral's texels of a rectangle only, x0 .. x0+width-1 by
+ * y0 .. y0+height-1 (taken through the addressing: periodic ones may pass
+ * the sides and wrap), written into out, which already holds the whole
+ * image's smoothing: the same bits as smoothing all of it. The guide's
+ * heights must be finite. */
+bb_status bb__smooth_region(const bb_image *in, const bb_image *guide,
+                            const bb_smooth_options *o, int x0, int y0, int width,
+                            int height, int threads, bb_image *out, bb_error *err);
+/* How far (texels, along each axis) a smoothed texel reads its input. */
+int bb__smooth_reach(int radius_texels);
 bb_status bb__normals_compute(const bb_image *height, float height_scale,
                               bb_normal_filter filter, bb_addressing addressing, int threads,
                               const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
@@ -36,6 +46,17 @@ bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
 bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_error *err);
 bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
                           bb_image *out, bb_error *err);
+/* One texel of the derived maps, as the stages above make it (the same
+ * bits), for a bake that derives a few texels again: weights and ssbump of
+ * a normal n, ssbump from the texel's visibility (ao, then a channel per
+ * direction), bent from its ssbump before brightness; brightness as
+ * bb__derive_brightness scales every channel of a texel by the grey of its
+ * brightness map. */
+void bb__derive_texel_weights(const bb_basis *basis, const float n[3], float *weights);
+void bb__derive_texel_ssbump(const bb_basis *basis, const float n[3], const float *vis,
+                             float *ssbump);
+void bb__derive_texel_bent(const bb_basis *basis, const float *ssbump, float bent[3]);
+void bb__derive_texel_brightness(const float *map, int channels, float grey, float *out);
 
 
 /* The ranges of bb_bake_options' fields, the one home of each (options.c);
@@ -65,6 +86,37 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
                    bb_bake_context *context, bb_bake_result *r, bb_error *err);
 /* (o prepared by bb__bake_prepare: it is not checked again. context may
  * be NULL: a cold bake.) */
+
+/* What a bake whose context keeps it (rebake.c) takes from the stages:
+ * every texel's horizon in each slice, written to the caller's
+ * horizons[s] (width x height floats each), and the max-mip pyramid,
+ * handed over instead of freed (the caller frees it, on failure too). */
+typedef struct bb__bake_keep {
+  float *const *horizons;
+  bb_pyramid *pyramid;
+} bb__bake_keep;
+/* bake_stages for such a bake: nothing dropped (vis and the smoothed
+ * height stay in r whatever o asks), the same maps and bits. */
+bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
+                           bb_bake_context *context, bb__bake_keep *keep,
+                           bb_bake_result *r, bb_error *err);
+
+/* rebake.c: a bake through a context that keeps what it made
+ * (bb_bake_context_keep): again only where the height changed since the
+ * context's last bake of the same size and options, else whole; r as
+ * bb__bake fills it (flags as there, but height is not freed). changed
+ * (may be NULL) receives bb_bake_context_bake's rectangle. */
+bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_region *changed, bb_error *err);
+/* The kept state (rebake.c), and the context's accessors to it
+ * (context.c): 1 when bakes through context keep (NULL: 0). */
+typedef struct bb__kept bb__kept;
+void bb__kept_free(bb__kept *kept);
+int bb__context_keeps(const bb_bake_context *context);
+bb__kept **bb__context_kept(bb_bake_context *context);
+/* For tests: 1 when the context's last bake was edit-local. */
+int bb__context_last_local(const bb_bake_context *context);
 
 /* context.c: the ray set of these parameters into *rays: context's own,
  * lent (*owned 0), built anew when the last one's parameters differ; or,

@@ -20,6 +20,8 @@ struct bb_bake_context {
   double power;
   bb_basis basis;
   long rayset_builds; /* ray sets built through the context (tests) */
+  int keep;           /* bb_bake_context_keep's */
+  bb__kept *kept;     /* what the last bake made, while keep */
 };
 
 bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err) {
@@ -41,7 +43,26 @@ void bb_bake_context_free(bb_bake_context *c) {
     return;
   if (c->have_rays)
     bb__rayset_release(&c->rays);
+  bb__kept_free(c->kept);
   free(c);
+}
+
+void bb_bake_context_keep(bb_bake_context *c, int keep) {
+  if (!c)
+    return;
+  c->keep = keep != 0;
+  if (!c->keep) {
+    bb__kept_free(c->kept);
+    c->kept = NULL;
+  }
+}
+
+int bb__context_keeps(const bb_bake_context *c) {
+  return c && c->keep;
+}
+
+bb__kept **bb__context_kept(bb_bake_context *c) {
+  return &c->kept;
 }
 
 static int same_basis(const bb_basis *a, const bb_basis *b) {
