@@ -287,7 +287,10 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
       bb_image_free(height);
     return st;
   }
+  const bb_region whole = {0, 0, height ? height->width : 0, height ? height->height : 0};
   bb_status st = bake_stages(height, o, flags, context, NULL, r, err);
+  if (st == BB_OK && context)
+    bb__context_set_changed(context, whole);
   if (flags & BB__BAKE_TAKE_HEIGHT)
     bb_image_free(height);
   return st;

@@ -115,6 +115,8 @@ typedef struct bb__kept bb__kept;
 void bb__kept_free(bb__kept *kept);
 int bb__context_keeps(const bb_bake_context *context);
 bb__kept **bb__context_kept(bb_bake_context *context);
+/* What bb_bake_context_changed says from now on. */
+void bb__context_set_changed(bb_bake_context *context, bb_region changed);
 /* For tests: 1 when the context's last bake was edit-local. */
 int bb__context_last_local(const bb_bake_context *context);
 

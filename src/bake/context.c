@@ -22,6 +22,7 @@ struct bb_bake_context {
   long rayset_builds; /* ray sets built through the context (tests) */
   int keep;           /* bb_bake_context_keep's */
   bb__kept *kept;     /* what the last bake made, while keep */
+  bb_region changed;  /* what the last bake changed (bb_bake_context_changed) */
 };
 
 bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err) {
@@ -63,6 +64,15 @@ int bb__context_keeps(const bb_bake_context *c) {
 
 bb__kept **bb__context_kept(bb_bake_context *c) {
   return &c->kept;
+}
+
+void bb__context_set_changed(bb_bake_context *c, bb_region changed) {
+  if (c)
+    c->changed = changed;
+}
+
+bb_region bb_bake_context_changed(const bb_bake_context *c) {
+  return c ? c->changed : (bb_region){0, 0, 0, 0};
 }
 
 static int same_basis(const bb_basis *a, const bb_basis *b) {

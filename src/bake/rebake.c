@@ -23,6 +23,7 @@
 #include "trace/retrace.h"
 
 #include <float.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -184,13 +185,20 @@ static bb_status changed_rect(const bb_image *a, const float *b, const rect *wit
   if (!cols)
     return bb__fail(err, BB_ERR_MEMORY, "bake: out of memory");
   unsigned char *rows = cols + w;
-  for (int j = 0; j < within->height; j++)
+  const size_t row_bytes = (size_t)within->width * sizeof(float);
+  for (int j = 0; j < within->height; j++) {
+    /* most rows are the same throughout: one memcmp, when not wrapping */
+    const float *row_b = b + (size_t)j * (size_t)within->width;
+    if (within->x0 + within->width <= w &&
+        memcmp(a->pixels + rect_texel(within, 0, j, w, h), row_b, row_bytes) == 0)
+      continue;
     for (int i = 0; i < within->width; i++) {
       const size_t t = rect_texel(within, i, j, w, h);
       if (memcmp(&a->pixels[t], &b[(size_t)j * (size_t)within->width + (size_t)i],
                  sizeof(float)) != 0)
         cols[t % (size_t)w] = 1, rows[t / (size_t)w] = 1;
     }
+  }
   rect o;
   span_of(cols, w, periodic, &o.x0, &o.width);
   span_of(rows, h, periodic, &o.y0, &o.height);
@@ -587,6 +595,19 @@ static bb_status what_changed(bb__kept *k, const bb_image *height,
   return BB_OK;
 }
 
+/* Is every texel of r one bb__check_scaled_height passes? */
+static int scaled_ok(const bb_image *height, const rect *r, float height_scale) {
+  for (int j = 0; j < r->height; j++)
+    for (int i = 0; i < r->width; i++) {
+      const double z =
+          (double)height_scale *
+          (double)height->pixels[rect_texel(r, i, j, height->width, height->height)];
+      if (!(fabs(z) <= BB_MAX_HEIGHT_TEXELS))
+        return 0;
+    }
+  return 1;
+}
+
 /* Can the kept bake be baked again for height with o, edit by edit? */
 static int can_edit(const bb__kept *k, const bb_image *height, const bb_bake_options *o) {
   return k && height->width == k->width && height->height == k->height &&
@@ -605,15 +626,15 @@ static bb_status bake_plain(bb_bake_context *context, const bb_image *height,
       bb_image_free(&r->filtered);
     if (flags & BB__BAKE_DROP_VIS)
       bb_image_free(&r->vis);
-    if (changed)
-      *changed = (bb_region){0, 0, height->width, height->height};
+    *changed = (bb_region){0, 0, height->width, height->height};
   }
   return st;
 }
 
-bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
-                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
-                           bb_region *changed, bb_error *err) {
+/* bb__context_bake; changed is not NULL. */
+static bb_status context_bake(bb_bake_context *context, const bb_image *height,
+                              const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                              bb_region *changed, bb_error *err) {
   memset(r, 0, sizeof *r);
   bb__kept **kp = bb__context_kept(context);
   bb__kept *k = *kp;
@@ -621,16 +642,23 @@ bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
   bb_status st = BB_OK;
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
-  if (k && keepable && can_edit(k, height, o) &&
-      bb__check_scaled_height(height, o->height_scale, NULL) == BB_OK) {
+  if (k && keepable && can_edit(k, height, o)) {
     /* a checkpoint before anything kept is touched */
     if (o->trace.progress && o->trace.progress(o->trace.progress_user, 0, 0))
       return bb__fail(err, BB_ERR_CANCELLED, "bake: cancelled by the progress callback");
     rect rh;
     int brightness_changed = 0;
     st = what_changed(k, height, o, &rh, &brightness_changed, err);
-    if (st == BB_OK && (double)rh.width * (double)rh.height <=
-                           WHOLE_SHARE * (double)k->width * (double)k->height) {
+    if (st != BB_OK) { /* (a brightness the whole bake refuses as well) */
+      bb__kept_free(k);
+      *kp = NULL;
+      return st;
+    }
+    /* a height the whole bake refuses can only be so at a changed texel
+     * (the rest is the kept one's): the whole bake says so, in its words */
+    const double share =
+        (double)rh.width * (double)rh.height / ((double)k->width * (double)k->height);
+    if (scaled_ok(height, &rh, o->height_scale) && share <= WHOLE_SHARE) {
       const int threads = bb__thread_count(o->trace.threads);
       k->o.trace.threads = o->trace.threads;
       st = bake_edit(context, k, height, o, &rh, threads, r, err);
@@ -638,8 +666,7 @@ bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
         st = copy_out(k, flags, r, err);
       if (st == BB_OK) {
         k->last_local = 1;
-        if (changed)
-          *changed = k->changed;
+        *changed = k->changed;
         return BB_OK;
       }
       bb_bake_result_free(r);
@@ -650,8 +677,6 @@ bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
         bb__fail(err, st, "bake: cancelled by the progress callback");
       return st;
     }
-    if (st != BB_OK)
-      return st;
   }
   /* whole: the kept bake (if any) goes first, its memory with it */
   bb__kept_free(k);
@@ -681,21 +706,26 @@ bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
     *kp = NULL;
     return st;
   }
-  if (changed)
-    *changed = (bb_region){0, 0, height->width, height->height};
+  *changed = (bb_region){0, 0, height->width, height->height};
   return BB_OK;
+}
+
+bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_region *changed, bb_error *err) {
+  bb_region got = {0, 0, 0, 0};
+  const bb_status st = context_bake(context, height, o, flags, r, &got, err);
+  if (st == BB_OK) {
+    bb__context_set_changed(context, got);
+    if (changed)
+      *changed = got;
+  }
+  return st;
 }
 
 int bb__context_last_local(const bb_bake_context *context) {
   bb__kept *const *kp = bb__context_kept((bb_bake_context *)context);
   return *kp && (*kp)->last_local;
-}
-
-bb_region bb_bake_context_changed(const bb_bake_context *context) {
-  if (!context)
-    return (bb_region){0, 0, 0, 0};
-  bb__kept *const *kp = bb__context_kept((bb_bake_context *)context);
-  return *kp ? (*kp)->changed : (bb_region){0, 0, 0, 0};
 }
 
 bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,

@@ -54,10 +54,13 @@ int cli_run_serve(const cli_run *r) {
   s.brightness_file = a->job.brightness_file;
   s.use_brightness = s.brightness_file != NULL;
   s.quiet = a->quiet;
-  /* the ray set and the buffers stay warm from one bake to the next */
+  /* the ray set and the buffers stay warm from one bake to the next, and
+   * what the last bake made: a save that changes part of the height bakes
+   * again only what the change reaches (the same bits) */
   bb_error context_err = {{0}};
   if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
     return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
+  bb_bake_context_keep(s.context, 1);
   s.watched[s.watched_count++] = height;
   const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
                         a->job.basis_file};
