@@ -281,12 +281,6 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o,
 
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
                    bb_bake_context *context, bb_bake_result *r, bb_error *err) {
-  if (bb__context_keeps(context)) {
-    bb_status st = bb__context_bake(context, height, o, flags, r, NULL, err);
-    if (flags & BB__BAKE_TAKE_HEIGHT)
-      bb_image_free(height);
-    return st;
-  }
   const bb_region whole = {0, 0, height ? height->width : 0, height ? height->height : 0};
   bb_status st = bake_stages(height, o, flags, context, NULL, r, err);
   if (st == BB_OK && context)

@@ -109,12 +109,20 @@ bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
 bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
                            const bb_bake_options *o, unsigned flags, bb_bake_result *r,
                            bb_region *changed, bb_error *err);
-/* The kept state (rebake.c), and the context's accessors to it
- * (context.c): 1 when bakes through context keep (NULL: 0). */
+/* bb__bake through context: bb__context_bake when it keeps (height freed
+ * as BB__BAKE_TAKE_HEIGHT says), bb__bake otherwise. For the job. */
+bb_status bb__bake_through(bb_bake_context *context, bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_error *err);
+/* The kept bake (rebake.c), held by the context (context.c): 1 when bakes
+ * through context keep (NULL: 0); what it holds (NULL: nothing); and
+ * kept in its place, freed by kept_free when it goes (the one before it
+ * goes now; NULL, NULL: nothing kept). */
 typedef struct bb__kept bb__kept;
-void bb__kept_free(bb__kept *kept);
 int bb__context_keeps(const bb_bake_context *context);
-bb__kept **bb__context_kept(bb_bake_context *context);
+bb__kept *bb__context_kept(const bb_bake_context *context);
+void bb__context_hold(bb_bake_context *context, bb__kept *kept,
+                      void (*kept_free)(bb__kept *));
 /* What bb_bake_context_changed says from now on. */
 void bb__context_set_changed(bb_bake_context *context, bb_region changed);
 /* For tests: 1 when the context's last bake was edit-local. */

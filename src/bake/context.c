@@ -4,7 +4,9 @@
  * time, so a bake with it is a cold bake's bits), and the process's heap
  * kept from handing the bake's freed buffers back to the system, so the
  * next bake of the same size finds them mapped (no page faults, no
- * zeroing by the kernel). */
+ * zeroing by the kernel). With bb_bake_context_keep, it also holds what
+ * the last bake made, for the next to bake again only what an edit
+ * reaches (rebake.c). */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "trace/rayset.h"
@@ -21,7 +23,10 @@ struct bb_bake_context {
   bb_basis basis;
   long rayset_builds; /* ray sets built through the context (tests) */
   int keep;           /* bb_bake_context_keep's */
-  bb__kept *kept;     /* what the last bake made, while keep */
+  bb__kept *kept;     /* what the last bake made, while keep (rebake.c's) */
+  void (*kept_free)(bb__kept *); /* and how it goes: rebake.c's, which
+                                    this file does not call by name (the
+                                    kept bake is rebake.c's business) */
   bb_region changed;  /* what the last bake changed (bb_bake_context_changed) */
 };
 
@@ -44,7 +49,7 @@ void bb_bake_context_free(bb_bake_context *c) {
     return;
   if (c->have_rays)
     bb__rayset_release(&c->rays);
-  bb__kept_free(c->kept);
+  bb__context_hold(c, NULL, NULL);
   free(c);
 }
 
@@ -52,18 +57,23 @@ void bb_bake_context_keep(bb_bake_context *c, int keep) {
   if (!c)
     return;
   c->keep = keep != 0;
-  if (!c->keep) {
-    bb__kept_free(c->kept);
-    c->kept = NULL;
-  }
+  if (!c->keep)
+    bb__context_hold(c, NULL, NULL);
 }
 
 int bb__context_keeps(const bb_bake_context *c) {
   return c && c->keep;
 }
 
-bb__kept **bb__context_kept(bb_bake_context *c) {
-  return &c->kept;
+bb__kept *bb__context_kept(const bb_bake_context *c) {
+  return c->kept;
+}
+
+void bb__context_hold(bb_bake_context *c, bb__kept *kept, void (*kept_free)(bb__kept *)) {
+  if (c->kept && c->kept != kept)
+    c->kept_free(c->kept);
+  c->kept = kept;
+  c->kept_free = kept_free;
 }
 
 void bb__context_set_changed(bb_bake_context *c, bb_region changed) {

@@ -74,7 +74,7 @@ static int needs_normals(const bb_bake_options *o) {
          wants(o, BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_WEIGHTS));
 }
 
-void bb__kept_free(bb__kept *k) {
+static void kept_free(bb__kept *k) {
   if (!k)
     return;
   bb_image_free(&k->height_in);
@@ -340,7 +340,7 @@ static bb_status bake_whole(bb_bake_context *context, const bb_image *height,
     *out = k;
     return BB_OK;
   }
-  bb__kept_free(k);
+  kept_free(k);
   return st;
 }
 
@@ -636,8 +636,7 @@ static bb_status context_bake(bb_bake_context *context, const bb_image *height,
                               const bb_bake_options *o, unsigned flags, bb_bake_result *r,
                               bb_region *changed, bb_error *err) {
   memset(r, 0, sizeof *r);
-  bb__kept **kp = bb__context_kept(context);
-  bb__kept *k = *kp;
+  bb__kept *k = bb__context_kept(context);
   const int keepable = o->bounce_albedo <= 0.0 && !o->trace.trace;
   bb_status st = BB_OK;
   if (!height || !height->pixels || height->channels != 1)
@@ -650,8 +649,7 @@ static bb_status context_bake(bb_bake_context *context, const bb_image *height,
     int brightness_changed = 0;
     st = what_changed(k, height, o, &rh, &brightness_changed, err);
     if (st != BB_OK) { /* (a brightness the whole bake refuses as well) */
-      bb__kept_free(k);
-      *kp = NULL;
+      bb__context_hold(context, NULL, NULL);
       return st;
     }
     /* a height the whole bake refuses can only be so at a changed texel
@@ -660,7 +658,6 @@ static bb_status context_bake(bb_bake_context *context, const bb_image *height,
         (double)rh.width * (double)rh.height / ((double)k->width * (double)k->height);
     if (scaled_ok(height, &rh, o->height_scale) && share <= WHOLE_SHARE) {
       const int threads = bb__thread_count(o->trace.threads);
-      k->o.trace.threads = o->trace.threads;
       st = bake_edit(context, k, height, o, &rh, threads, r, err);
       if (st == BB_OK)
         st = copy_out(k, flags, r, err);
@@ -669,18 +666,16 @@ static bb_status context_bake(bb_bake_context *context, const bb_image *height,
         *changed = k->changed;
         return BB_OK;
       }
+      /* half made: let it go */
       bb_bake_result_free(r);
-      memset(r, 0, sizeof *r);
-      bb__kept_free(k);
-      *kp = NULL;
+      bb__context_hold(context, NULL, NULL);
       if (st == BB_ERR_CANCELLED)
         bb__fail(err, st, "bake: cancelled by the progress callback");
       return st;
     }
   }
   /* whole: the kept bake (if any) goes first, its memory with it */
-  bb__kept_free(k);
-  *kp = NULL;
+  bb__context_hold(context, NULL, NULL);
   if (!keepable)
     return bake_plain(context, height, o, flags, r, changed, err);
   /* what is kept, and the maps the caller gets as copies of the kept ones:
@@ -690,22 +685,20 @@ static bb_status context_bake(bb_bake_context *context, const bb_image *height,
   if (bb__memory_check(bake + kept_bytes(height->width, height->height, o) + maps, "bake",
                        NULL) != BB_OK)
     return bake_plain(context, height, o, flags, r, changed, err);
-  st = bake_whole(context, height, o, kp, r, err);
+  st = bake_whole(context, height, o, &k, r, err);
   if (st == BB_ERR_MEMORY) { /* the estimate fell short: as above */
     bb_bake_result_free(r);
     return bake_plain(context, height, o, flags, r, changed, err);
   }
   if (st == BB_OK)
-    st = copy_out(*kp, flags, r, err);
-  if (st == BB_OK)
-    (*kp)->last_local = 0;
+    st = copy_out(k, flags, r, err);
   if (st != BB_OK) {
     bb_bake_result_free(r);
-    memset(r, 0, sizeof *r);
-    bb__kept_free(*kp);
-    *kp = NULL;
+    kept_free(k);
     return st;
   }
+  k->last_local = 0;
+  bb__context_hold(context, k, kept_free);
   *changed = (bb_region){0, 0, height->width, height->height};
   return BB_OK;
 }
@@ -724,8 +717,19 @@ bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
 }
 
 int bb__context_last_local(const bb_bake_context *context) {
-  bb__kept *const *kp = bb__context_kept((bb_bake_context *)context);
-  return *kp && (*kp)->last_local;
+  const bb__kept *k = bb__context_kept(context);
+  return k && k->last_local;
+}
+
+bb_status bb__bake_through(bb_bake_context *context, bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_error *err) {
+  if (!bb__context_keeps(context))
+    return bb__bake(height, o, flags, context, r, err);
+  const bb_status st = bb__context_bake(context, height, o, flags, r, NULL, err);
+  if (flags & BB__BAKE_TAKE_HEIGHT)
+    bb_image_free(height);
+  return st;
 }
 
 bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,

@@ -374,6 +374,23 @@ Test(rebake, bad_height_refused_then_baked) {
   got = context_bake(c, &h, &o, NULL);
   equals_whole(&got, &h, &o, "after a refused height");
   bb_bake_result_free(&got);
+  /* a brightness map gone bad, likewise */
+  bb_image bright;
+  cr_assert_eq(bb_image_alloc(&bright, 40, 36, 1, NULL), BB_OK);
+  for (int i = 0; i < 40 * 36; i++)
+    bright.pixels[i] = 0.8f;
+  o.brightness = &bright;
+  got = context_bake(c, &h, &o, NULL);
+  bb_bake_result_free(&got);
+  bright.pixels[77] = INFINITY;
+  cr_expect_eq(bb_bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb_bake(&h, &o, &none, &whole), BB_ERR_VALUE);
+  cr_expect_str_eq(err.message, whole.message);
+  bright.pixels[77] = 0.5f;
+  got = context_bake(c, &h, &o, NULL);
+  equals_whole(&got, &h, &o, "after a refused brightness map");
+  bb_bake_result_free(&got);
+  bb_image_free(&bright);
   bb_bake_context_free(c);
   bb_image_free(&h);
 }
