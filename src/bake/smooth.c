@@ -237,6 +237,23 @@ static bb_status check_guide_finite(const bb_image *guide, bb_error *err) {
   return BB_OK;
 }
 
+/* The cut kernel of o's radius and the table of addressed columns for an
+ * image of in's width (smooth_job.column); free both when done. */
+static bb_status smoother_make(const bb_image *in, const bb_smooth_options *o,
+                               cut_kernel *kernel, int **column, bb_error *err) {
+  bb_status st = kernel_make(o->radius_texels, kernel, err);
+  if (st != BB_OK)
+    return st;
+  *column = malloc((size_t)(in->width + 2 * kernel->reach) * sizeof **column);
+  if (!*column) {
+    free(kernel->taps);
+    return bb__fail(err, BB_ERR_MEMORY, "smooth: cannot allocate the column table");
+  }
+  for (int i = 0; i < in->width + 2 * kernel->reach; i++)
+    (*column)[i] = bb__address(i - kernel->reach, in->width, o->addressing);
+  return BB_OK;
+}
+
 static bb_status copy_image(const bb_image *in, bb_image *out, bb_error *err) {
   bb_status st = bb_image_alloc(out, in->width, in->height, in->channels, err);
   if (st != BB_OK)
@@ -263,15 +280,9 @@ bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
     return st;
 
   cut_kernel kernel;
-  if ((st = kernel_make(o->radius_texels, &kernel, err)) != BB_OK)
+  int *column = NULL;
+  if ((st = smoother_make(in, o, &kernel, &column, err)) != BB_OK)
     return st;
-  int *column = malloc((size_t)(in->width + 2 * kernel.reach) * sizeof *column);
-  if (!column) {
-    free(kernel.taps);
-    return bb__fail(err, BB_ERR_MEMORY, "smooth: cannot allocate the column table");
-  }
-  for (int i = 0; i < in->width + 2 * kernel.reach; i++)
-    column[i] = bb__address(i - kernel.reach, in->width, o->addressing);
 
   st = bb_image_alloc(out, in->width, in->height, in->channels, err);
   if (st == BB_OK) {
@@ -340,15 +351,9 @@ bb_status bb__smooth_region(const bb_image *in, const bb_image *guide,
     return BB_OK;
   }
   cut_kernel kernel;
-  if ((st = kernel_make(o->radius_texels, &kernel, err)) != BB_OK)
+  int *column = NULL;
+  if ((st = smoother_make(in, o, &kernel, &column, err)) != BB_OK)
     return st;
-  int *column = malloc((size_t)(in->width + 2 * kernel.reach) * sizeof *column);
-  if (!column) {
-    free(kernel.taps);
-    return bb__fail(err, BB_ERR_MEMORY, "smooth: cannot allocate the column table");
-  }
-  for (int i = 0; i < in->width + 2 * kernel.reach; i++)
-    column[i] = bb__address(i - kernel.reach, in->width, o->addressing);
   region_job job = {
       {in, guide, out, &kernel, (double)o->threshold, o->addressing, column},
       x0,

@@ -276,6 +276,14 @@ static bb_bake_context *keeping_context(void) {
   return c;
 }
 
+/* A keeping context that has baked h with o once (whole). */
+static bb_bake_context *baked_once(const bb_image *h, const bb_bake_options *o) {
+  bb_bake_context *c = keeping_context();
+  bb_bake_result got = context_bake(c, h, o, NULL);
+  bb_bake_result_free(&got);
+  return c;
+}
+
 /* The same height again changes nothing; other options, or another size,
  * bake whole. */
 Test(rebake, what_is_baked_again) {
@@ -359,9 +367,8 @@ Test(rebake, bad_height_refused_then_baked) {
   rng r = {23u};
   bb_image h = relief(40, 36, &r);
   bb_bake_options o = options_of(BB_ADDRESS_CLAMP, BB_MAPS_BAKED);
-  bb_bake_context *c = keeping_context();
-  bb_bake_result got = context_bake(c, &h, &o, NULL);
-  bb_bake_result_free(&got);
+  bb_bake_context *c = baked_once(&h, &o);
+  bb_bake_result got;
   const float good = h.pixels[5 * 40 + 5];
   h.pixels[5 * 40 + 5] = NAN;
   bb_error err = {{0}}, whole = {{0}};
@@ -407,9 +414,8 @@ Test(rebake, cancelled_edit_then_whole) {
   rng r = {24u};
   bb_image h = relief(48, 48, &r);
   bb_bake_options o = options_of(BB_ADDRESS_PERIODIC, BB_MAPS_BAKED);
-  bb_bake_context *c = keeping_context();
-  bb_bake_result got = context_bake(c, &h, &o, NULL);
-  bb_bake_result_free(&got);
+  bb_bake_context *c = baked_once(&h, &o);
+  bb_bake_result got;
   h.pixels[20 * 48 + 20] += 0.3f;
   int calls = 0;
   o.trace.progress = cancel_at;
