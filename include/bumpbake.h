@@ -1414,17 +1414,18 @@ void bb_bake_context_free(bb_bake_context *context);
  * (bb_bake_context_bake, and a job's after bb_job_use_context) keep what
  * they made: the height, its smoothing and max-mip pyramid, each texel's
  * horizon in every slice, its visibility and normal, and the maps; about
- * 4 x slices + 90 bytes a texel for the default maps and basis (154 at 16
- * slices: 161 MB at 1024 x 1024), while the context lives. A bake of a
- * height of the same size with the same options then bakes again only
- * what the change can reach (docs/how-it-works.md, "Edits"): the
- * smoothing around the changed texels, the pyramid's nodes above them,
- * along the lines of each slice that cross them the horizons the change
- * can move (out to every texel a tall new peak shadows), and the texels
- * derived from those; and it gives the bits of a whole bake of the new
- * height. Inter-reflection (bounce_albedo > 0) and a caller's trace
- * (o->trace.trace) bake whole every time. keep 0 (the default) lets what
- * was kept go. */
+ * 4 x slices + 70 bytes a texel for the default maps and basis (134 at 16
+ * slices: 141 MB at 1024 x 1024; 24 more with every map), while the
+ * context lives (a machine that cannot hold it bakes whole, keeping
+ * nothing). A bake of a height of the same size with the same options
+ * then bakes again only what the change can reach (docs/how-it-works.md,
+ * "Edits"): the smoothing around the changed texels, the pyramid's nodes
+ * above them, along the lines of each slice that cross them the horizons
+ * the change can move (out to every texel a tall new peak shadows), and
+ * the texels derived from those; and it gives the bits of a whole bake of
+ * the new height. A change over a quarter of the texels, inter-reflection
+ * (bounce_albedo > 0) and a caller's trace (o->trace.trace) bake whole.
+ * keep 0 (the default) lets what was kept go. */
 void bb_bake_context_keep(bb_bake_context *context, int keep);
 
 /* bb_bake of height with o through context: the same checks, maps and

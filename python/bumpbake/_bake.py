@@ -254,8 +254,8 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
 class BakeContext:
     """Bakes of a height that changes a little at a time, as an editor or a
     live preview makes them (bb_bake_context with bb_bake_context_keep):
-    the first bake is whole, and keeps what it made (about 4 x slices + 90
-    bytes a texel: 160 MB at 1024 x 1024); each later bake() of a height of
+    the first bake is whole, and keeps what it made (about 4 x slices + 70
+    bytes a texel: 141 MB at 1024 x 1024); each later bake() of a height of
     the same size with the same scale, outputs and options bakes again only
     what the change can reach, and returns exactly the maps bake() would.
     Inter-reflection (bounce) bakes whole every time. `changed` is the
