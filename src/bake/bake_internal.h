@@ -134,6 +134,8 @@ int bb__context_last_local(const bb_bake_context *context);
 bb_status bb__context_rayset(bb_bake_context *context, int slices, double power,
                              const bb_basis *basis, int threads, bb_rayset *rays,
                              int *owned, bb_error *err);
+/* 1 when two bases are the same directions of the same name. */
+int bb__same_basis(const bb_basis *a, const bb_basis *b);
 /* Ray sets the context has built (tests: 1 after two bakes alike). */
 long bb__context_rayset_builds(const bb_bake_context *context);
 

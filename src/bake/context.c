@@ -85,7 +85,7 @@ bb_region bb_bake_context_changed(const bb_bake_context *c) {
   return c ? c->changed : (bb_region){0, 0, 0, 0};
 }
 
-static int same_basis(const bb_basis *a, const bb_basis *b) {
+int bb__same_basis(const bb_basis *a, const bb_basis *b) {
   return a->count == b->count && strcmp(a->name, b->name) == 0 &&
          memcmp(a->vector, b->vector, sizeof a->vector) == 0;
 }
@@ -96,7 +96,8 @@ bb_status bb__context_rayset(bb_bake_context *c, int slices, double power,
   *owned = 1;
   if (!c)
     return bb__rayset_make(slices, power, basis, threads, rays, err);
-  if (!(c->have_rays && c->slices == slices && c->power == power && same_basis(&c->basis, basis))) {
+  if (!(c->have_rays && c->slices == slices && c->power == power &&
+        bb__same_basis(&c->basis, basis))) {
     bb_rayset made = {0};
     bb_status st = bb__rayset_make(slices, power, basis, threads, &made, err);
     if (st != BB_OK)

@@ -91,11 +91,6 @@ static void kept_free(bb__kept *k) {
   free(k);
 }
 
-static int same_basis(const bb_basis *a, const bb_basis *b) {
-  return a->count == b->count && strcmp(a->name, b->name) == 0 &&
-         memcmp(a->vector, b->vector, sizeof a->vector) == 0;
-}
-
 /* Would o bake what the kept bake baked (its maps from the same height)? */
 static int same_options(const bb__kept *k, const bb_bake_options *o) {
   const bb_bake_options *a = &k->o;
@@ -104,7 +99,7 @@ static int same_options(const bb__kept *k, const bb_bake_options *o) {
          a->smooth.threshold == o->smooth.threshold &&
          a->smooth.addressing == o->smooth.addressing &&
          a->trace.bias_texels == o->trace.bias_texels && a->power == o->power &&
-         same_basis(&a->basis, &o->basis) && a->normal_filter == o->normal_filter &&
+         bb__same_basis(&a->basis, &o->basis) && a->normal_filter == o->normal_filter &&
          a->normal_y_up == o->normal_y_up && a->outputs == o->outputs &&
          k->has_brightness == (o->brightness != NULL);
 }
