@@ -1426,6 +1426,54 @@ const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 
 void bb_bake_result_free(bb_bake_result *r);
 
+/* ------------------------------------------------------- bake contexts */
+
+/* What a long-running caller that bakes again and again (bumpbake serve,
+ * an editor) keeps warm between bakes: the ray set of the last bake,
+ * reused while slices, power and basis are the same, and, process-wide,
+ * the bakes' freed buffers, kept in the heap for the next bake of the same
+ * size (glibc's allocator told not to return buffers up to 32 MiB to the
+ * system: no page faults or zeroing again; the memory of the largest bake
+ * stays with the process). A bake with a context is a cold bake's bits.
+ * One bake at a time per context. */
+typedef struct bb_bake_context bb_bake_context;
+bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
+void bb_bake_context_free(bb_bake_context *context);
+
+/* Edit-local bakes. With keep 1 the bakes through context
+ * (bb_bake_context_bake, and a job's after bb_job_use_context) keep what
+ * they made: the height, its smoothing and max-mip pyramid, each texel's
+ * horizon in every slice, its visibility and normal, and the maps; about
+ * 4 x slices + 70 bytes a texel for the default maps and basis (134 at 16
+ * slices: 141 MB at 1024 x 1024; 24 more with every map), while the
+ * context lives (a machine that cannot hold it bakes whole, keeping
+ * nothing). A bake of a height of the same size with the same options
+ * then bakes again only what the change can reach (docs/how-it-works.md,
+ * "Edits"): the smoothing around the changed texels, the pyramid's nodes
+ * above them, along the lines of each slice that cross them the horizons
+ * the change can move (out to every texel a tall new peak shadows), and
+ * the texels derived from those; and it gives the bits of a whole bake of
+ * the new height. A change over a quarter of the texels, inter-reflection
+ * (bounce_albedo > 0) and a caller's trace (o->trace.trace) bake whole.
+ * keep 0 (the default) lets what was kept go. */
+void bb_bake_context_keep(bb_bake_context *context, int keep);
+
+/* bb_bake of height with o through context: the same checks, maps and
+ * bits; result as bb_bake fills it (free it with bb_bake_result_free),
+ * its seconds and horizons_found those of the work done. changed (may be
+ * NULL) receives the texels whose maps may differ from those of the
+ * context's bake before: a rectangle inside the image, the whole image
+ * after a whole bake, width 0 when nothing changed; texels across the
+ * edge of a periodic map make it span the whole width (or height). */
+bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
+                               const bb_bake_options *o, bb_bake_result *result,
+                               bb_region *changed, bb_error *err);
+
+/* The changed rectangle of the context's last bake, as
+ * bb_bake_context_bake gives it (for a bake made through a job); width 0
+ * before any. */
+bb_region bb_bake_context_changed(const bb_bake_context *context);
+
 /* =====================================================================
  * maps: Valve's files, converting, combining, programs, slope maps, compare
  * Every function here works on decoded values: normals as N in [-1, 1]
@@ -2715,18 +2763,6 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
  * as bb_job_run_item. */
 bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
                            void *progress_user, bb_bake_result *result, bb_error *err);
-
-/* What a long-running caller that bakes again and again (bumpbake serve)
- * keeps warm between bakes: the ray set of the last bake, reused while
- * slices, power and basis are the same, and, process-wide, the bakes'
- * freed buffers, kept in the heap for the next bake of the same size
- * (glibc's allocator told not to return buffers up to 32 MiB to the
- * system: no page faults or zeroing again; the memory of the largest bake
- * stays with the process). A bake with a context is a cold bake's bits.
- * One bake at a time per context. */
-typedef struct bb_bake_context bb_bake_context;
-bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
-void bb_bake_context_free(bb_bake_context *context);
 
 /* The bakes of job (bb_job_bake_item, bb_job_run_item) use context from
  * now on (NULL: cold again). context must outlive them. */

@@ -25,8 +25,8 @@ bumpbake._library.
 
 from ._common import ArgumentError, Error, NoteWarning, library_path, _ffi, _lib  # noqa: F401 (tests)
 from ._check import CheckCase, CheckResult, check
-from ._bake import (BAKE_PARAMETERS, DEFAULT_OUTPUTS, DEFAULTS, OUTPUTS, TRACED_OUTPUTS, bake,
-                    basis, normal)
+from ._bake import (BAKE_PARAMETERS, DEFAULT_OUTPUTS, DEFAULTS, OUTPUTS, TRACED_OUTPUTS,
+                    BakeContext, bake, basis, normal)
 from ._files import (Comparison, DdsInfo, ImageInfo, VtfInfo, compare, file_hash, info, read,
                      write, write_vmt)
 from ._jobs import BakeJob, BakeReport, bake_file, bake_files
@@ -35,8 +35,8 @@ from ._render import DEFAULT_LIGHT, RenderBump, render, renderbumpflat, run, she
 from . import _library  # noqa: F401 (bumpbake._library.candidates, SONAME)
 
 __all__ = [
-    "ArgumentError", "BAKE_PARAMETERS", "BakeJob", "BakeReport", "CheckCase", "CheckResult",
-    "Comparison",
+    "ArgumentError", "BAKE_PARAMETERS", "BakeContext", "BakeJob", "BakeReport", "CheckCase",
+    "CheckResult", "Comparison",
     "DdsInfo", "DEFAULT_LIGHT", "DEFAULT_OUTPUTS", "DEFAULTS", "Error", "ImageInfo", "NoteWarning",
     "OUTPUTS", "RenderBump", "TRACED_OUTPUTS", "bake", "bake_file", "bake_files", "basis",
     "check", "combine", "compare", "decode_normals", "file_hash", "info", "library_path", "mips",

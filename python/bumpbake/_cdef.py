@@ -240,6 +240,8 @@ typedef struct bb_bake_result {
   double seconds_bounce;
 } bb_bake_result;
 
+typedef struct bb_bake_context bb_bake_context;
+
 typedef struct bb_valve_options {
   int normal_map;
   int ao_in_alpha;
@@ -709,6 +711,13 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
+bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
+void bb_bake_context_free(bb_bake_context *context);
+void bb_bake_context_keep(bb_bake_context *context, int keep);
+bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
+                               const bb_bake_options *o, bb_bake_result *result,
+                               bb_region *changed, bb_error *err);
+bb_region bb_bake_context_changed(const bb_bake_context *context);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,

@@ -390,7 +390,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
      * as it is done with them (Valve's detail reads the height again) */
     const unsigned flags =
         BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
-    st = bb__bake(&b->height, &o, flags, job->context, &b->result, &bake_err);
+    st = bb__bake_through(job->context, &b->height, &o, flags, &b->result, &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
