@@ -333,8 +333,9 @@ uninstall:
 	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 
 # ---- the README's commands ---------------------------------------------------
+# The demo builds only the command it runs, on every core.
 demo: ensure-deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(NPROC) $(BIN)
 	@./tools/demo.sh $(BIN)
 
 # The build runs on every core (a fresh clone compiles ~70 files); the checks
@@ -423,7 +424,7 @@ PY_SANITIZE := $(if $(PY_PRELOAD),LD_PRELOAD="$(PY_PRELOAD)" ASAN_OPTIONS=detect
 check-python: $(BIN) lib
 	cd python && BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) BB_BIN=$(abspath $(BIN)) \
 	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
-	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
+	  $(PYTHON) -m pytest -q -p no:cacheprovider --durations=10 tests
 
 # `bumpbake serve` in headless Chromium (tests/serve/): the page draws, relights,
 # re-bakes on a save by rename and on a control, keeps the last maps after a
