@@ -9,20 +9,24 @@
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
 #include "image/description.h"
+#include "image/formats.h"
 #include "image/header_probe.h"
 #include "image/oiio_calls.h"
 #include "image/oiio_guard.h"
 #include "image/oiio_setup.h"
 #include "image/png_hooks.h"
 #include "image/read_limits.h"
+#include "image/signatures.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,12 +67,14 @@ class OiioPngLeakScope {
 public:
   explicit OiioPngLeakScope(bool png) : active_(png) {
 #ifdef BB_ASAN_BUILD
-    if (active_) __lsan_disable();
+    if (active_)
+      __lsan_disable();
 #endif
   }
   ~OiioPngLeakScope() {
 #ifdef BB_ASAN_BUILD
-    if (active_) __lsan_enable();
+    if (active_)
+      __lsan_enable();
 #endif
   }
   OiioPngLeakScope(const OiioPngLeakScope &) = delete;
@@ -98,7 +104,9 @@ public:
   CheckedInput(FILE *file, const char *path) : IOFile(file, Read), file_(file) {
     m_filename = path;
   }
-  ~CheckedInput() override { std::fclose(file_); }
+  ~CheckedInput() override {
+    std::fclose(file_);
+  }
   void close() override {} // readers never own it; the destructor closes
   CheckedInput(const CheckedInput &) = delete;
   CheckedInput &operator=(const CheckedInput &) = delete;
@@ -116,10 +124,12 @@ std::unique_ptr<CheckedInput> open_checked(const char *path, bool reading, bb_st
                                            bb_error *err) {
   int fd;
   *st = bb__input_open(path, &fd, err);
-  if (*st != BB_OK) return nullptr;
+  if (*st != BB_OK)
+    return nullptr;
   bb__probe probe;
   *st = bb__probe_header(fd, path, &probe, err);
-  if (*st == BB_OK) *st = bb__read_check_probe(path, &probe, reading ? 1 : 0, err);
+  if (*st == BB_OK)
+    *st = bb__read_check_probe(path, &probe, reading ? 1 : 0, err);
   if (*st != BB_OK) {
     close(fd);
     return nullptr;
@@ -145,35 +155,135 @@ struct opened_input {
   bool png = false;
 };
 
-// Opens path through its checked descriptor (readers that cannot read
-// through a proxy open the name, checked a moment before), for `reading`
-// pixels or only headers, and makes OpenImageIO's refusals one line.
+// The OpenImageIO format whose reader path's extension names ("" when none
+// does), from OpenImageIO's own list of its readers' extensions.
+std::string format_of_extension(const char *path) {
+  static const std::map<std::string, std::string> formats = [] {
+    std::map<std::string, std::string> m;
+    // "openexr:exr,sxr;tiff:tif,tiff;...": each format and its extensions.
+    for (const std::string &entry :
+         OIIO::Strutil::splits(OIIO::get_string_attribute("extension_list"), ";")) {
+      const size_t colon = entry.find(':');
+      if (colon == std::string::npos)
+        continue;
+      const std::string format = entry.substr(0, colon);
+      for (const std::string &ext : OIIO::Strutil::splits(entry.substr(colon + 1), ","))
+        m.emplace(ext, format);
+    }
+    return m;
+  }();
+  char ext[32];
+  bb__extension_of(path, ext, sizeof ext);
+  if (!ext[0])
+    return std::string();
+  auto it = formats.find(ext + 1);
+  return it == formats.end() ? std::string() : it->second;
+}
+
+// The format the first bytes of the checked file name ("" when none).
+std::string format_of_content(CheckedInput &file) {
+  unsigned char head[BB_SIGNATURE_BYTES];
+  const size_t n = file.pread(head, sizeof head, 0);
+  const char *format = bb__format_by_content(head, n);
+  return format ? format : std::string();
+}
+
+// Opens the checked file with format's reader alone (never OpenImageIO's
+// walk through every reader when one refuses), through the descriptor
+// where the reader reads proxies, else by the name, checked a moment
+// before. nullptr and the reader's reason in *why when it refuses.
+std::unique_ptr<ImageInput> open_as(const std::string &format, const char *path,
+                                    CheckedInput &file, bool png, std::string *why) {
+  std::unique_ptr<ImageInput> in = ImageInput::create(format); // by name: reads nothing
+  if (!in) {
+    *why = OIIO::geterror();
+    return nullptr;
+  }
+  if (in->supports("ioproxy") && !in->set_ioproxy(&file)) {
+    *why = in->geterror();
+    return nullptr;
+  }
+  file.seek(0);
+  ImageSpec config, spec;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  bool ok;
+  {
+    OiioPngLeakScope png_leak(png);
+    ok = in->open(path, spec, config);
+  }
+  if (!ok) {
+    *why = in->geterror();
+    if (why->empty())
+      *why = OIIO::geterror();
+    return nullptr;
+  }
+  return in;
+}
+
+// Opens path through its checked descriptor, for `reading` pixels or only
+// headers, and makes OpenImageIO's refusals one line. The extension's
+// reader reads the file unless the file lacks that format's signature;
+// when it refuses, the reader the file's first bytes name (a PNG named
+// .tga) is the one other tried. A file neither names is refused at once,
+// naming the format its extension promised.
 opened_input open_input(const char *path, bool reading, bb_status *st, bb_error *err) {
   opened_input opened;
   opened.file = open_checked(path, reading, st, err);
-  if (!opened.file) return opened;
+  if (!opened.file)
+    return opened;
   bb::oiio_setup();
   (void)bb__png_hooks_set(); // links the hooks on libpng (png_hooks.c)
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
   opened.png = OiioPngLeakScope::applies_to(path);
-  {
-    OiioPngLeakScope png_leak(opened.png);
-    // create(do_open = true), not open(): open() with a config first asks
-    // the extension's reader whether the file is its own by opening the
-    // name (valid_file), then reads the name; create hands every reader
-    // the proxy.
-    opened.in = ImageInput::create(path, true, &config, opened.file.get());
+  const std::string promised = format_of_extension(path);
+  const std::string content = format_of_content(*opened.file);
+  std::string why;
+  if (!promised.empty() &&
+      (content == promised || !bb__format_has_signature(promised.c_str())))
+    opened.in = open_as(promised, path, *opened.file, opened.png, &why);
+  if (!opened.in && !content.empty() && content != promised) {
+    std::string why_content;
+    opened.in = open_as(content, path, *opened.file, opened.png, &why_content);
+    if (why.empty())
+      why = why_content;
   }
-  if (!opened.in) {
-    std::string why = OIIO::geterror();
-    if (is_limit_refusal(why))
-      *st = bb__fail(err, BB_ERR_SIZE,
-                     "%s: too large to read: %s (bumpbake reads at most %.0f MiB of samples)",
-                     path, bb::first_line(why).c_str(), oiio_imagesize_limit() / (double)MiB);
+  if (opened.in)
+    return opened;
+  if (is_limit_refusal(why)) {
+    *st =
+        bb__fail(err, BB_ERR_SIZE,
+                 "%s: too large to read: %s (bumpbake reads at most %.0f MiB of samples)",
+                 path, bb::first_line(why).c_str(), oiio_imagesize_limit() / (double)MiB);
+  } else if (!content.empty()) {
+    *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                   bb::one_line(why).c_str());
+  } else if (promised.empty()) {
+    char ext[32];
+    bb__extension_of(path, ext, sizeof ext);
+    if (ext[0])
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: no image format has the extension '%s', and "
+          "its first bytes name none",
+          path, ext);
     else
-      *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                     bb::one_line(why).c_str());
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: no extension names its format, and its first "
+          "bytes name none",
+          path);
+  } else {
+    const char *name = bb__format_display_name(promised.c_str());
+    if (why.empty())
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: its extension says %s, but it does not carry "
+          "%s's signature, nor any other format's",
+          path, name, name);
+    else
+      *st = bb__fail(err, BB_ERR_FORMAT,
+                     "%s: not a readable image: its extension says %s, but the %s reader "
+                     "refuses it (%s), and its first bytes name no other format",
+                     path, name, name, bb::one_line(why).c_str());
   }
   return opened;
 }
@@ -191,14 +301,16 @@ bb__image_header header_of(const ImageSpec &spec) {
   h.file_bytes = (double)spec.image_bytes(true);
   h.sample_bytes = (int)spec.format.size();
   for (const TypeDesc &t : spec.channelformats)
-    if ((int)t.size() > h.sample_bytes) h.sample_bytes = (int)t.size();
+    if ((int)t.size() > h.sample_bytes)
+      h.sample_bytes = (int)t.size();
   h.format = spec.format.c_str();
   return h;
 }
 
 bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *info,
                     const char *path, bb_error *err) {
-  if (!info) return BB_OK;
+  if (!info)
+    return BB_OK;
   info->alpha_channel = spec.alpha_channel;
   info->is_float = spec.format.is_floating_point() ? 1 : 0;
   // oiio:BitsPerSample tells 1-, 2-, 4-, 10- or 12-bit files from their carrier type.
@@ -230,9 +342,9 @@ std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &
     const int y0 = spec.y + y, y1 = spec.y + y + rows;
     OiioPngLeakScope png_leak(png);
     bool ok = spec.tile_width > 0
-                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1, spec.z,
-                                  spec.z + 1, first, first + out->channels, TypeDesc::FLOAT,
-                                  dst)
+                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1,
+                                  spec.z, spec.z + 1, first, first + out->channels,
+                                  TypeDesc::FLOAT, dst)
                   : in.read_scanlines(0, miplevel, y0, y1, spec.z, first,
                                       first + out->channels, TypeDesc::FLOAT, dst);
     if (!ok || in.has_error()) {
@@ -246,7 +358,8 @@ std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &
 // Mip levels of subimage 0 of an opened file, from its headers.
 int count_levels(ImageInput &in) {
   int levels = 0;
-  while (in.seek_subimage(0, levels)) levels++;
+  while (in.seek_subimage(0, levels))
+    levels++;
   (void)in.geterror(); // the failed seek past the last level queued a message
   return levels;
 }
@@ -255,16 +368,19 @@ bb_status read_image(const char *path, int first, int count, int level, bb_image
                      bb_image_info *info, int *level_count, bb_error *err) {
   bb_status st;
   opened_input opened = open_input(path, true, &st, err);
-  if (!opened.in) return st;
+  if (!opened.in)
+    return st;
   ImageInput *in = opened.in.get();
   if (level_count || level != 0) {
     const int levels = count_levels(*in);
-    if (level_count) *level_count = levels;
+    if (level_count)
+      *level_count = levels;
     if (level < 0 || level >= levels)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: no mip level %d (the file has %d)", path,
                       level, levels);
     if (!in->seek_subimage(0, level))
-      return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, bb::one_line(in->geterror()).c_str());
+      return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path,
+                      bb::one_line(in->geterror()).c_str());
   }
   const ImageSpec spec = in->spec();
   if (count < 0) {
@@ -273,14 +389,17 @@ bb_status read_image(const char *path, int first, int count, int level, bb_image
   }
   const bb__image_header h = header_of(spec);
   st = bb__read_check_size(path, &h, count, err);
-  if (st != BB_OK) return st;
+  if (st != BB_OK)
+    return st;
   if (first < 0 || count < 1 || first + count > spec.nchannels)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: channels %d..%d asked of a %d-channel image",
-                    path, first, first + count - 1, spec.nchannels);
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "%s: channels %d..%d asked of a %d-channel image", path, first,
+                    first + count - 1, spec.nchannels);
 
   bb_error alloc_err;
   st = bb_image_alloc(out, spec.width, spec.height, count, &alloc_err);
-  if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
+  if (st != BB_OK)
+    return bb__fail(err, st, "%s: %s", path, alloc_err.message);
 
   std::string why = read_bands(*in, opened.png, level, spec, first, out);
   if (!why.empty())
@@ -300,7 +419,8 @@ void oiio_setup() {
     const int our_mb = (int)(oiio_imagesize_limit() / MiB);
     if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
       OIIO::attribute("limits:imagesize_MB", our_mb);
-    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
+    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 ||
+        channels > 64)
       OIIO::attribute("limits:channels", 64);
     if (!OIIO::getattribute("exr_threads", exr_threads) || exr_threads != -1)
       OIIO::attribute("exr_threads", -1);
@@ -323,14 +443,19 @@ bb_status bb__oiio_read_header(const char *path, int *width, int *height, int *c
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in) return st;
+    if (!opened.in)
+      return st;
     const ImageSpec &spec = opened.in->spec();
     const bb__image_header h = header_of(spec);
     st = bb__read_check_shape(path, &h, err);
-    if (st != BB_OK) return st;
-    if (width) *width = spec.width;
-    if (height) *height = spec.height;
-    if (channels) *channels = spec.nchannels;
+    if (st != BB_OK)
+      return st;
+    if (width)
+      *width = spec.width;
+    if (height)
+      *height = spec.height;
+    if (channels)
+      *channels = spec.nchannels;
     return fill_info(*opened.in, spec, info, path, err);
   });
 }
@@ -339,7 +464,8 @@ bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in) return st;
+    if (!opened.in)
+      return st;
     *levels = count_levels(*opened.in);
     return BB_OK;
   });
@@ -349,9 +475,11 @@ bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in) return st;
+    if (!opened.in)
+      return st;
     int n = 0;
-    while (n < 1000000 && opened.in->seek_subimage(n, 0)) n++;
+    while (n < 1000000 && opened.in->seek_subimage(n, 0))
+      n++;
     (void)opened.in->geterror(); // seeking past the last subimage records an error
     *frames = n;
     return BB_OK;
@@ -362,7 +490,8 @@ char *bb__oiio_extension_list(void) {
   return bb::guard_value<char *>(nullptr, []() -> char * {
     const std::string list = OIIO::get_string_attribute("extension_list");
     char *copy = static_cast<char *>(std::malloc(list.size() + 1));
-    if (copy) std::memcpy(copy, list.c_str(), list.size() + 1);
+    if (copy)
+      std::memcpy(copy, list.c_str(), list.size() + 1);
     return copy;
   });
 }
