@@ -4,8 +4,8 @@
  * writes a bake's).
  */
 
-#include "core/internal.h"
 #include "files/provenance.h"
+#include "core/internal.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -267,8 +267,8 @@ static int first_missing(const char *from, const char *other, int from_is_have,
   return 0;
 }
 
-int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
-                            char *reason, size_t cap) {
+int bb__provenance_mismatch(const char *have, const char *want,
+                            const char *const *ignored, char *reason, size_t cap) {
   if (reason && cap)
     reason[0] = '\0';
   return first_missing(want, have, 0, ignored, reason, cap) ||
@@ -291,9 +291,12 @@ static int is_entry_line(const char *line, size_t n) {
 
 const char *bb_provenance_class_name(bb_provenance_class c) {
   switch (c) {
-  case BB_PROVENANCE_NONE: return "none";
-  case BB_PROVENANCE_INTACT: return "intact";
-  case BB_PROVENANCE_DAMAGED: return "damaged";
+  case BB_PROVENANCE_NONE:
+    return "none";
+  case BB_PROVENANCE_INTACT:
+    return "intact";
+  case BB_PROVENANCE_DAMAGED:
+    return "damaged";
   }
   return "unknown";
 }
@@ -325,12 +328,29 @@ bb_provenance_class bb_provenance_classify(const char *description) {
  * producers (renderbumpflat's axis, rect, ...: parameters too), then what
  * names the file, and the long command line last. NULL marks where the
  * other keys go; lines of one rank keep their text order. */
-static const char *const PACK_ORDER[] = {
-    "bumpbake_version", "input_hash", "input_file_hash", "scale", "rays", "rayset",
-    "filter_radius",
-    "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
-    "addressing",       "bounce",     "bounces", "bounce_albedo_map", "brightness",
-    "channel",          NULL,         "output", "input",         "command"};
+static const char *const PACK_ORDER[] = {"bumpbake_version",
+                                         "input_hash",
+                                         "input_file_hash",
+                                         "scale",
+                                         "rays",
+                                         "rayset",
+                                         "filter_radius",
+                                         "filter_threshold",
+                                         "bias",
+                                         "power",
+                                         "basis",
+                                         "normal_filter",
+                                         "normal_y",
+                                         "addressing",
+                                         "bounce",
+                                         "bounces",
+                                         "bounce_albedo_map",
+                                         "brightness",
+                                         "channel",
+                                         NULL,
+                                         "output",
+                                         "input",
+                                         "command"};
 enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
 
 /* Rank of a line's key in PACK_ORDER (the NULL entry's for other keys). */
@@ -362,8 +382,25 @@ static int pack_line(const char *line, size_t n, int rows, int row_chars, char *
   return 0;
 }
 
-int bb__provenance_pack(const char *description, int rows, int row_chars, char *out) {
+/* Appends line [line, line + n) to the NUL-terminated overflow text
+ * (capacity cap; NULL: none kept) when it fits whole, '\n'-separated. */
+static void keep_overflow(const char *line, size_t n, char *overflow, size_t cap) {
+  if (!overflow)
+    return;
+  size_t used = strlen(overflow), sep = used ? 1 : 0;
+  if (used + sep + n + 1 > cap)
+    return;
+  if (sep)
+    overflow[used++] = '\n';
+  memcpy(overflow + used, line, n);
+  overflow[used + n] = '\0';
+}
+
+static int pack(const char *description, int rows, int row_chars, char *out,
+                char *overflow, size_t overflow_cap) {
   memset(out, 0, (size_t)rows * (size_t)(row_chars + 1));
+  if (overflow && overflow_cap)
+    overflow[0] = '\0';
   int dropped = 0;
   /* One pass per rank keeps the order stable without sorting or memory. */
   for (int rank = 0; rank < PACK_RANKS; rank++) {
@@ -376,9 +413,20 @@ int bb__provenance_pack(const char *description, int rows, int row_chars, char *
         n--;
       if (n == 0 || pack_rank(&e) != rank) /* a line without '=' ranks as other */
         continue;
-      if (!pack_line(line, n, rows, row_chars, out))
+      if (!pack_line(line, n, rows, row_chars, out)) {
         dropped++;
+        keep_overflow(line, n, overflow, overflow_cap);
+      }
     }
   }
   return dropped;
+}
+
+int bb__provenance_pack(const char *description, int rows, int row_chars, char *out) {
+  return pack(description, rows, row_chars, out, NULL, 0);
+}
+
+int bb__provenance_pack_overflow(const char *description, int rows, int row_chars,
+                                 char *out, char *overflow, size_t overflow_cap) {
+  return pack(description, rows, row_chars, out, overflow, overflow_cap);
 }
