@@ -8,6 +8,7 @@
 #include "job/job_internal.h"
 
 #include <fcntl.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -373,6 +374,18 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     job->options.note(job->options.note_user, job->vmt,
                       "the material has no $basetexture (no colour map): give --basetexture "
                       "FILE.vtf, or add the line to the .vmt");
+  /* A colour map named but not there (a typo, or one made later): Source
+   * draws its missing-texture checkerboard until it is. */
+  struct stat base;
+  if (st == BB_OK && job->vmt_basetexture && job->options.note &&
+      (stat(job->vmt_basetexture, &base) != 0 || !S_ISREG(base.st_mode))) {
+    char text[PATH_MAX + 160];
+    snprintf(text, sizeof text,
+             "--basetexture %s is not a file (yet): Source draws the material's colour as its "
+             "missing-texture checkerboard until it is",
+             job->vmt_basetexture);
+    job->options.note(job->options.note_user, job->vmt, text);
+  }
   /* The input's notes have been given: a caller that takes one as an
    * error cancels here, before anything is baked or written (progress
    * (0, 0): a checkpoint, no work done yet). */

@@ -157,7 +157,7 @@ bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, si
     if (find_materials(o->bumpmap, found, sizeof found) != 0)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: no folder named \"materials\" above %s: name the game's materials "
-                      "folder",
+                      "folder with --materials DIR",
                       path, o->bumpmap);
     materials = found;
   }

@@ -144,7 +144,8 @@ Test(cli_messages, a_single_bake_creates_its_output_folders) {
 }
 
 /* A material names its colour map only when told (--basetexture): one
- * without it gets a note, one with it none. */
+ * without it gets a note, one naming a colour map that is not there
+ * another, one naming a file none. */
 Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
   dome(tmp("h.png"), 1, BB_DEPTH_16);
   cr_assert_eq(mkdir(tmp("materials"), 0755), 0);
@@ -160,7 +161,29 @@ Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
                                    tmp("materials/colour.vtf"), NULL});
   cr_expect_eq(r.code, 0, "%s", r.err);
   cr_expect(!strstr(r.err, "$basetexture"), "%s", r.err);
+  cr_expect(strstr(r.err, "s.vmt: note: --basetexture ") &&
+                strstr(r.err, "materials/colour.vtf is not a file (yet)"),
+            "%s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
   cli_result_free(&r);
+  cr_assert_eq(link(tmp("materials/s.vtf"), tmp("materials/colour.vtf")), 0);
+  r = harness_run((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--rays", "4",
+                                   "--ssbump", tmp("materials/s.vtf"), "--vmt",
+                                   tmp("materials/s.vmt"), "--basetexture",
+                                   tmp("materials/colour.vtf"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.err);
+  cli_result_free(&r);
+}
+
+/* A material outside any folder named materials names the option that
+ * says where the game's materials are. */
+Test(cli_messages, a_material_outside_materials_names_the_option) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  const char *args[] = {"bake", tmp("h.png"), "--scale", "4", "--rays", "4", "--ssbump",
+                        tmp("s.vtf"), "--vmt", tmp("s.vmt"), NULL};
+  harness_expect_refusal(NULL, args, 2, "name the game's materials folder with --materials DIR",
+                         0);
 }
 
 /* A map named twice is a usage error before any bake, not a file dropped. */
