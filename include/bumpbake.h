@@ -2712,7 +2712,9 @@ typedef enum bb_option_mode {
                                       kept in the provenance's command; the others
                                       (-q, --json, --threads, --depfile...) are not */
 #define BB_OPTION_CLIENT 0x2u      /* how a command-line client prints (--help, --json,
-                                      -q): nothing for the library to do */
+                                      -q) or where it runs the command (bake
+                                      --scheduler): nothing for the library's run
+                                      to do, and no keyword of Python's */
 #define BB_OPTION_SINGLE_DASH 0x4u /* also spelled with one dash (idiff's -fail,
                                       DOOM 3's -size) */
 #define BB_OPTION_REQUIRED 0x8u    /* the command refuses to run without it */

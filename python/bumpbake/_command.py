@@ -21,9 +21,15 @@ import re
 import numpy as np
 
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
-                      _message, _path, _text)
+                      _message, _path, _shown, _text)
 
 _TYPE_NAMES = ("flag", "integer", "number", "word", "words", "numbers", "text", "path")
+
+# What Python offers for an option of the command line's own
+# (BB_OPTION_CLIENT) besides the reports and exceptions it returns.
+_CLIENT_ONLY = {
+    "scheduler": "from Python, bumpbake.dask.bake_files(client=...) runs a batch on a cluster",
+}
 
 
 def _info(command):
@@ -99,7 +105,7 @@ def _spell(option, value, what):
             return sep.join(_spell_number(v, False) for v in value).encode()
         raise TypeError
     except TypeError:
-        raise TypeError(f"{what} must be {_expected(option)} (got {value!r})") from None
+        raise TypeError(f"{what} must be {_expected(option)} (got {_shown(value)})") from None
 
 
 def _expected(option):
@@ -177,13 +183,19 @@ class Command:
             o = _ffi.NULL
         else:
             o = _lib.bb_option_find(self._info, key.encode(), 0)
-        if o == _ffi.NULL or o.flags & _lib.BB_OPTION_CLIENT:
+        # "bake()", "run('bake')": how Python names the call
+        call = self.function if self.function.endswith(")") else self.function + "()"
+        if o != _ffi.NULL and o.flags & _lib.BB_OPTION_CLIENT:
+            name = _text(o.name)
+            raise TypeError(f"{call} got an unexpected keyword argument {key!r} "
+                            f"(--{name} is the command line's own: "
+                            f"{_CLIENT_ONLY.get(name, 'Python returns reports and raises')})")
+        if o == _ffi.NULL:
             near = _lib.bb_option_nearest(self._info, str(key).encode(), 0)
             hint = ""
             if near != _ffi.NULL and not near.flags & _lib.BB_OPTION_CLIENT:
                 hint = f" (did you mean {keyword(near)!r}?)"
-            raise TypeError(f"{self.function}() got an unexpected keyword argument "
-                            f"{key!r}{hint}")
+            raise TypeError(f"{call} got an unexpected keyword argument {key!r}{hint}")
         return o
 
     def set(self, key, value, skip_default=False):
@@ -196,7 +208,7 @@ class Command:
             return
         if o.type == _lib.BB_OPTION_FLAG:
             if not isinstance(value, (bool, numbers.Integral, np.bool_)) or value not in (0, 1):
-                raise TypeError(f"{self.function}: {key} must be True or False (got {value!r})")
+                raise TypeError(f"{self.function}: {key} must be True or False (got {_shown(value)})")
             if not value:
                 return
         text = _spell(o, value, f"{self.function}: {key}")
@@ -276,7 +288,7 @@ class Command:
         err = _ffi.new("bb_error *")
         for what, value in (("command", line), ("command_options", options)):
             if value is not None and not isinstance(value, str):
-                raise TypeError(f"{self.function}: {what} must be a str (got {value!r})")
+                raise TypeError(f"{self.function}: {what} must be a str (got {_shown(value)})")
         _check(_lib.bb_command_set_record(
             self._c, _c_text(line, "command") if line is not None else _ffi.NULL,
             _c_text(options, "command_options") if options is not None else _ffi.NULL, err),

@@ -199,7 +199,7 @@ def _signed(command, kind):
     if kind in _UNIT_KINDS:
         return False
     raise _argument_error(f"{command}: kind must be one of "
-                          f"{', '.join(tuple(_KINDS) + _UNIT_KINDS)} (got {kind!r})")
+                          f"{', '.join(tuple(_KINDS) + _UNIT_KINDS)} (got {_shown(kind)})")
 
 
 def write(path, array, *, kind="colour", depth=None, mips=False, description=None,

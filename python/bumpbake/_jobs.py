@@ -9,7 +9,7 @@ import typing
 from ._bake import OUTPUTS, _basis
 from ._command import Command
 from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _exception, _ffi,
-                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _text)
+                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _shown, _text)
 
 # A report's status: the library's name of its outcome ("up to date", ...).
 _OUTCOMES = {k: _text(_lib.bb_job_outcome_name(k))
@@ -109,7 +109,7 @@ class BakeJob:
         if isinstance(inputs, (str, bytes, os.PathLike)):
             inputs = [inputs]
         elif not isinstance(inputs, (list, tuple)):
-            raise TypeError(f"bake: inputs must be a path or a list of paths (got {inputs!r})")
+            raise TypeError(f"bake: inputs must be a path or a list of paths (got {_shown(inputs)})")
         self._plan([_path(p, "input") for p in inputs], self._args)
 
     def _command(self, inputs, a):
@@ -121,14 +121,11 @@ class BakeJob:
             c.add_input(p)
         outputs = a["outputs"]
         if outputs is not None and not isinstance(outputs, collections.abc.Mapping):
-            raise TypeError(f"bake: outputs must be a dict {{kind: path}} (got {outputs!r})")
+            raise TypeError(f"bake: outputs must be a dict {{kind: path}} (got {_shown(outputs)})")
         for kind in outputs or {}:
             if kind not in OUTPUTS:
                 raise _argument_error(f"bake: unknown map {kind!r} in outputs "
                                       f"(one of {', '.join(OUTPUTS)})")
-        if a.get("scheduler") is not None:
-            raise TypeError("bake: scheduler is the command line's: from Python, "
-                            "bumpbake.dask.bake_files(client=...) runs a batch on a cluster")
         options = {k: v for k, v in a.items()
                    if k not in ("outputs", "prefix", "notes", "command", "command_options",
                                 "force", "basis")}

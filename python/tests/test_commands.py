@@ -40,10 +40,10 @@ FUNCTIONS = {
 }
 
 # Options with no Python keyword, and why. Every option the library marks
-# BB_OPTION_CLIENT (--help, -q, --json: how the command line prints) is one
-# too: Python returns reports and raises errors instead.
+# BB_OPTION_CLIENT (--help, -q, --json: how the command line prints; bake
+# --scheduler: a cluster from Python is bumpbake.dask.bake_files(client=...))
+# is one too: Python returns reports and raises errors instead.
 NOT_IN_PYTHON = {
-    ("bake", "scheduler"): "a cluster from Python is bumpbake.dask.bake_files(client=...)",
     ("serve", None): "the command line's HTTP preview server (bake() and render() make "
                      "what it shows)",
 }
@@ -341,3 +341,53 @@ def test_normal_y_up_arrays_are_read_and_written_as_the_cli_reads_files():
         bumpbake.combine(n, n[::-1] * 1, mix=0.5, kind="normal") * [1, -1, 1])
     with pytest.raises(bumpbake.ArgumentError, match="normal_y must be one of down, up"):
         bumpbake.normal2ssbump(n, normal_y="sideways")
+
+
+def test_run_refuses_what_is_not_a_command_or_a_path(tmp_path, monkeypatch):
+    """run() took any command value (AttributeError from None, 5 or bytes),
+    ran "bake\\0" as bake, turned an array into its text (a multi-line "no
+    such file") and baked locally with scheduler= the docs refuse."""
+    monkeypatch.chdir(tmp_path)
+    h = np.zeros((8, 8), np.float32)
+    bumpbake.write("h.png", h)
+    for command in (None, 5, b"bake"):
+        with pytest.raises(TypeError, match=r"^run: command must be a str \(got "):
+            bumpbake.run(command, "h.png", scale=8, normal="n.png")
+    with pytest.raises(ValueError, match="embedded null byte"):
+        bumpbake.run("bake\0", "h.png", scale=8, normal="n.png")
+    with pytest.raises(TypeError) as e:
+        bumpbake.run("bake", np.zeros((64, 64), np.float32), scale=8, normal="n.png")
+    assert "\n" not in str(e.value) and "input 1 must be a path" in str(e.value), str(e.value)
+    assert "numpy array of shape (64, 64)" in str(e.value)
+    with pytest.raises(TypeError) as e:
+        bumpbake.run("bake", "h.png", normal=np.zeros((64, 64), np.float32), scale=8)
+    assert "\n" not in str(e.value) and "normal must be a path" in str(e.value), str(e.value)
+    with pytest.raises(TypeError, match=r"^run\('bake'\) got an unexpected keyword argument "
+                                        r"'scheduler' \(--scheduler is the command line's own"):
+        bumpbake.run("bake", "h.png", scale=8, output="q", scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(TypeError, match="unexpected keyword argument 'scheduler'"):
+        bumpbake.bake_file("h.png", {"normal": "n.png"}, scale=8, scheduler="tcp://h:1")
+    assert sorted(os.listdir(".")) == ["h.png"]
+    # height2ssbump's BUMPSCALE is a number, given as one
+    assert bumpbake.run("height2ssbump", "h.png", 4, rays=4, notes="ignore") == [
+        ("ssbump+height", "h-ssbump.tga")]
+
+
+def test_a_large_file_no_reader_knows_is_refused_at_once(tmp_path):
+    """A 2 GiB file of zeros (sparse) named .png: refused in one line
+    naming the format its extension promised, without reading it through
+    (it took OpenImageIO's walk through every reader minutes)."""
+    z = tmp_path / "z.png"
+    with open(z, "wb") as f:
+        f.truncate(2 << 30)
+    before = os.times()
+    for call in (lambda: bumpbake.read(z), lambda: bumpbake.info(z),
+                 lambda: bumpbake.bake_file(z, {"normal": tmp_path / "n.png"}, scale=8),
+                 lambda: bumpbake.run("bake", z, scale=8, normal=tmp_path / "n.png")):
+        with pytest.raises(bumpbake.Error, match="z.png: not a readable image: its extension "
+                                                 "says PNG") as e:
+            call()
+        assert "\n" not in str(e.value)
+    after = os.times()
+    assert (after.user - before.user) + (after.system - before.system) < 2.0
+    assert sorted(os.listdir(tmp_path)) == ["z.png"]

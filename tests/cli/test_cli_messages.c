@@ -214,3 +214,46 @@ Test(cli_messages, combine_takes_quiet) {
   cr_expect(file_exists(tmp("q.png")));
   cli_result_free(&r);
 }
+
+/* A --scheduler address that cannot be one is a usage error of the
+ * library's check, exit 2 before any Python or Dask starts (it took Python
+ * and Dask 5 to 10 s to say so). BUMPBAKE_PYTHON names a stand-in that
+ * leaves a mark when started: a well-formed address does start it. */
+Test(cli_messages, a_bad_scheduler_address_is_refused_before_python_starts) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  FILE *f = fopen(tmp("python"), "w");
+  cr_assert_not_null(f);
+  fprintf(f, "#!/bin/sh\ntouch '%s'\nexit 1\n", tmp("started"));
+  cr_assert_eq(fclose(f), 0);
+  cr_assert_eq(chmod(tmp("python"), 0755), 0);
+  cr_assert_eq(setenv("BUMPBAKE_PYTHON", tmp("python"), 1), 0);
+  static const char *bad[] = {"garbage",
+                              "file:///tmp/x",
+                              "tcp://",
+                              "tcp://h:0",
+                              "tcp://h:port",
+                              "tcp://[::1]",
+                              "fe80::1:8786",
+                              "inproc://x",
+                              "tcp://user@h:1",
+                              "tcp://a b:1",
+                              "",
+                              "tcp://h:1\x1b[2J"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    const char *args[] = {"bake",       tmp("h.png"),  "--scale", "4", "--normal",
+                          tmp("n.png"), "--scheduler", bad[i],    NULL};
+    cli_result r = harness_run(args);
+    harness_expect_error(&r, 2, "bumpbake bake: --scheduler", bad[i]);
+    cr_expect(!strchr(r.err, '\x1b'), "%s", r.err);
+    cr_expect_lt(r.cpu_seconds, 1.0, "'%s' took %.2f s of CPU", bad[i], r.cpu_seconds);
+    cli_result_free(&r);
+    cr_expect(!file_exists(tmp("started")), "'%s' started Python", bad[i]);
+  }
+  const char *good[] = {"bake",       tmp("h.png"),  "--scale",           "4", "--normal",
+                        tmp("n.png"), "--scheduler", "tcp://127.0.0.1:1", NULL};
+  cli_result r = harness_run(good);
+  cr_expect_neq(r.code, 0);
+  cli_result_free(&r);
+  cr_expect(file_exists(tmp("started")), "a well-formed address did not start Python");
+  unsetenv("BUMPBAKE_PYTHON");
+}
