@@ -4,8 +4,8 @@
  * writes a bake's).
  */
 
-#include "files/provenance.h"
 #include "core/internal.h"
+#include "files/provenance.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -267,8 +267,8 @@ static int first_missing(const char *from, const char *other, int from_is_have,
   return 0;
 }
 
-int bb__provenance_mismatch(const char *have, const char *want,
-                            const char *const *ignored, char *reason, size_t cap) {
+int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
+                            char *reason, size_t cap) {
   if (reason && cap)
     reason[0] = '\0';
   return first_missing(want, have, 0, ignored, reason, cap) ||
@@ -291,12 +291,9 @@ static int is_entry_line(const char *line, size_t n) {
 
 const char *bb_provenance_class_name(bb_provenance_class c) {
   switch (c) {
-  case BB_PROVENANCE_NONE:
-    return "none";
-  case BB_PROVENANCE_INTACT:
-    return "intact";
-  case BB_PROVENANCE_DAMAGED:
-    return "damaged";
+  case BB_PROVENANCE_NONE: return "none";
+  case BB_PROVENANCE_INTACT: return "intact";
+  case BB_PROVENANCE_DAMAGED: return "damaged";
   }
   return "unknown";
 }
@@ -328,29 +325,12 @@ bb_provenance_class bb_provenance_classify(const char *description) {
  * producers (renderbumpflat's axis, rect, ...: parameters too), then what
  * names the file, and the long command line last. NULL marks where the
  * other keys go; lines of one rank keep their text order. */
-static const char *const PACK_ORDER[] = {"bumpbake_version",
-                                         "input_hash",
-                                         "input_file_hash",
-                                         "scale",
-                                         "rays",
-                                         "rayset",
-                                         "filter_radius",
-                                         "filter_threshold",
-                                         "bias",
-                                         "power",
-                                         "basis",
-                                         "normal_filter",
-                                         "normal_y",
-                                         "addressing",
-                                         "bounce",
-                                         "bounces",
-                                         "bounce_albedo_map",
-                                         "brightness",
-                                         "channel",
-                                         NULL,
-                                         "output",
-                                         "input",
-                                         "command"};
+static const char *const PACK_ORDER[] = {
+    "bumpbake_version", "input_hash", "input_file_hash", "scale", "rays", "rayset",
+    "filter_radius",
+    "filter_threshold", "bias",       "power", "basis",  "normal_filter", "normal_y",
+    "addressing",       "bounce",     "bounces", "bounce_albedo_map", "brightness",
+    "channel",          NULL,         "output", "input",         "command"};
 enum { PACK_RANKS = sizeof PACK_ORDER / sizeof PACK_ORDER[0] };
 
 /* Rank of a line's key in PACK_ORDER (the NULL entry's for other keys). */

@@ -12,8 +12,8 @@
  * pixels), whole lines as many as fit, and join the text again when it is
  * read. Other text is left to OpenImageIO. */
 #include "image/description.h"
-#include "files/provenance.h"
 #include "image/formats.h"
+#include "files/provenance.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -23,8 +23,7 @@ enum { TGA_COMMENT_ROWS = 4, TGA_COMMENT_CHARS = 80, TGA_IMAGE_ID_CHARS = 255 };
 static char *copy_of(const char *s) {
   size_t n = strlen(s) + 1;
   char *c = malloc(n);
-  if (c)
-    memcpy(c, s, n);
+  if (c) memcpy(c, s, n);
   return c;
 }
 
@@ -36,19 +35,16 @@ static int is_fitted(const char *path, const char *description) {
 }
 
 char *bb__description_to_store(const char *path, const char *description) {
-  if (!is_fitted(path, description))
-    return copy_of(description);
+  if (!is_fitted(path, description)) return copy_of(description);
   char rows[TGA_COMMENT_ROWS][TGA_COMMENT_CHARS + 1];
   bb__provenance_pack(description, TGA_COMMENT_ROWS, TGA_COMMENT_CHARS, &rows[0][0]);
   char *flat = malloc(sizeof rows);
-  if (!flat)
-    return NULL;
+  if (!flat) return NULL;
   size_t n = 0;
   for (int r = 0; r < TGA_COMMENT_ROWS && rows[r][0]; r++) {
     /* pad the previous row to its 81 bytes */
     size_t row_start = (size_t)r * (TGA_COMMENT_CHARS + 1);
-    while (n < row_start)
-      flat[n++] = '\n';
+    while (n < row_start) flat[n++] = '\n';
     size_t len = strlen(rows[r]);
     memcpy(flat + n, rows[r], len);
     n += len;
@@ -105,9 +101,7 @@ void bb__description_as_read(const char *format_name, char *desc) {
     return;
   size_t n = 0;
   for (const char *c = desc; *c; c++)
-    if (*c != '\n' || (n > 0 && desc[n - 1] != '\n'))
-      desc[n++] = *c;
-  while (n > 0 && desc[n - 1] == '\n')
-    n--;
+    if (*c != '\n' || (n > 0 && desc[n - 1] != '\n')) desc[n++] = *c;
+  while (n > 0 && desc[n - 1] == '\n') n--;
   desc[n] = '\0';
 }

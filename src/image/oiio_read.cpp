@@ -67,14 +67,12 @@ class OiioPngLeakScope {
 public:
   explicit OiioPngLeakScope(bool png) : active_(png) {
 #ifdef BB_ASAN_BUILD
-    if (active_)
-      __lsan_disable();
+    if (active_) __lsan_disable();
 #endif
   }
   ~OiioPngLeakScope() {
 #ifdef BB_ASAN_BUILD
-    if (active_)
-      __lsan_enable();
+    if (active_) __lsan_enable();
 #endif
   }
   OiioPngLeakScope(const OiioPngLeakScope &) = delete;
@@ -104,9 +102,7 @@ public:
   CheckedInput(FILE *file, const char *path) : IOFile(file, Read), file_(file) {
     m_filename = path;
   }
-  ~CheckedInput() override {
-    std::fclose(file_);
-  }
+  ~CheckedInput() override { std::fclose(file_); }
   void close() override {} // readers never own it; the destructor closes
   CheckedInput(const CheckedInput &) = delete;
   CheckedInput &operator=(const CheckedInput &) = delete;
@@ -124,12 +120,10 @@ std::unique_ptr<CheckedInput> open_checked(const char *path, bool reading, bb_st
                                            bb_error *err) {
   int fd;
   *st = bb__input_open(path, &fd, err);
-  if (*st != BB_OK)
-    return nullptr;
+  if (*st != BB_OK) return nullptr;
   bb__probe probe;
   *st = bb__probe_header(fd, path, &probe, err);
-  if (*st == BB_OK)
-    *st = bb__read_check_probe(path, &probe, reading ? 1 : 0, err);
+  if (*st == BB_OK) *st = bb__read_check_probe(path, &probe, reading ? 1 : 0, err);
   if (*st != BB_OK) {
     close(fd);
     return nullptr;
@@ -301,16 +295,14 @@ bb__image_header header_of(const ImageSpec &spec) {
   h.file_bytes = (double)spec.image_bytes(true);
   h.sample_bytes = (int)spec.format.size();
   for (const TypeDesc &t : spec.channelformats)
-    if ((int)t.size() > h.sample_bytes)
-      h.sample_bytes = (int)t.size();
+    if ((int)t.size() > h.sample_bytes) h.sample_bytes = (int)t.size();
   h.format = spec.format.c_str();
   return h;
 }
 
 bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *info,
                     const char *path, bb_error *err) {
-  if (!info)
-    return BB_OK;
+  if (!info) return BB_OK;
   info->alpha_channel = spec.alpha_channel;
   info->is_float = spec.format.is_floating_point() ? 1 : 0;
   // oiio:BitsPerSample tells 1-, 2-, 4-, 10- or 12-bit files from their carrier type.
@@ -323,9 +315,9 @@ bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *
     if (!info->description)
       return bb__fail(err, BB_ERR_MEMORY, "%s: cannot allocate the description", path);
     std::memcpy(info->description, desc.c_str(), desc.size() + 1);
-    info->description =
-        bb__description_join(in.format_name(), info->description,
-                             spec.get_string_attribute("targa:ImageID").c_str());
+    info->description = bb__description_join(
+        in.format_name(), info->description,
+        spec.get_string_attribute("targa:ImageID").c_str());
     bb__description_as_read(in.format_name(), info->description);
   }
   return BB_OK;
@@ -345,9 +337,9 @@ std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &
     const int y0 = spec.y + y, y1 = spec.y + y + rows;
     OiioPngLeakScope png_leak(png);
     bool ok = spec.tile_width > 0
-                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1,
-                                  spec.z, spec.z + 1, first, first + out->channels,
-                                  TypeDesc::FLOAT, dst)
+                  ? in.read_tiles(0, miplevel, spec.x, spec.x + spec.width, y0, y1, spec.z,
+                                  spec.z + 1, first, first + out->channels, TypeDesc::FLOAT,
+                                  dst)
                   : in.read_scanlines(0, miplevel, y0, y1, spec.z, first,
                                       first + out->channels, TypeDesc::FLOAT, dst);
     if (!ok || in.has_error()) {
@@ -361,8 +353,7 @@ std::string read_bands(ImageInput &in, bool png, int miplevel, const ImageSpec &
 // Mip levels of subimage 0 of an opened file, from its headers.
 int count_levels(ImageInput &in) {
   int levels = 0;
-  while (in.seek_subimage(0, levels))
-    levels++;
+  while (in.seek_subimage(0, levels)) levels++;
   (void)in.geterror(); // the failed seek past the last level queued a message
   return levels;
 }
@@ -371,19 +362,16 @@ bb_status read_image(const char *path, int first, int count, int level, bb_image
                      bb_image_info *info, int *level_count, bb_error *err) {
   bb_status st;
   opened_input opened = open_input(path, true, &st, err);
-  if (!opened.in)
-    return st;
+  if (!opened.in) return st;
   ImageInput *in = opened.in.get();
   if (level_count || level != 0) {
     const int levels = count_levels(*in);
-    if (level_count)
-      *level_count = levels;
+    if (level_count) *level_count = levels;
     if (level < 0 || level >= levels)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: no mip level %d (the file has %d)", path,
                       level, levels);
     if (!in->seek_subimage(0, level))
-      return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path,
-                      bb::one_line(in->geterror()).c_str());
+      return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, bb::one_line(in->geterror()).c_str());
   }
   const ImageSpec spec = in->spec();
   if (count < 0) {
@@ -392,17 +380,14 @@ bb_status read_image(const char *path, int first, int count, int level, bb_image
   }
   const bb__image_header h = header_of(spec);
   st = bb__read_check_size(path, &h, count, err);
-  if (st != BB_OK)
-    return st;
+  if (st != BB_OK) return st;
   if (first < 0 || count < 1 || first + count > spec.nchannels)
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "%s: channels %d..%d asked of a %d-channel image", path, first,
-                    first + count - 1, spec.nchannels);
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: channels %d..%d asked of a %d-channel image",
+                    path, first, first + count - 1, spec.nchannels);
 
   bb_error alloc_err;
   st = bb_image_alloc(out, spec.width, spec.height, count, &alloc_err);
-  if (st != BB_OK)
-    return bb__fail(err, st, "%s: %s", path, alloc_err.message);
+  if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
 
   std::string why = read_bands(*in, opened.png, level, spec, first, out);
   if (!why.empty())
@@ -422,8 +407,7 @@ void oiio_setup() {
     const int our_mb = (int)(oiio_imagesize_limit() / MiB);
     if (!OIIO::getattribute("limits:imagesize_MB", mb) || mb <= 0 || mb > our_mb)
       OIIO::attribute("limits:imagesize_MB", our_mb);
-    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 ||
-        channels > 64)
+    if (!OIIO::getattribute("limits:channels", channels) || channels <= 0 || channels > 64)
       OIIO::attribute("limits:channels", 64);
     if (!OIIO::getattribute("exr_threads", exr_threads) || exr_threads != -1)
       OIIO::attribute("exr_threads", -1);
@@ -446,19 +430,14 @@ bb_status bb__oiio_read_header(const char *path, int *width, int *height, int *c
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in)
-      return st;
+    if (!opened.in) return st;
     const ImageSpec &spec = opened.in->spec();
     const bb__image_header h = header_of(spec);
     st = bb__read_check_shape(path, &h, err);
-    if (st != BB_OK)
-      return st;
-    if (width)
-      *width = spec.width;
-    if (height)
-      *height = spec.height;
-    if (channels)
-      *channels = spec.nchannels;
+    if (st != BB_OK) return st;
+    if (width) *width = spec.width;
+    if (height) *height = spec.height;
+    if (channels) *channels = spec.nchannels;
     return fill_info(*opened.in, spec, info, path, err);
   });
 }
@@ -467,8 +446,7 @@ bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in)
-      return st;
+    if (!opened.in) return st;
     *levels = count_levels(*opened.in);
     return BB_OK;
   });
@@ -478,11 +456,9 @@ bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err) {
   return bb::guard(err, path, bb::READING, [&] {
     bb_status st;
     opened_input opened = open_input(path, false, &st, err);
-    if (!opened.in)
-      return st;
+    if (!opened.in) return st;
     int n = 0;
-    while (n < 1000000 && opened.in->seek_subimage(n, 0))
-      n++;
+    while (n < 1000000 && opened.in->seek_subimage(n, 0)) n++;
     (void)opened.in->geterror(); // seeking past the last subimage records an error
     *frames = n;
     return BB_OK;
@@ -493,8 +469,7 @@ char *bb__oiio_extension_list(void) {
   return bb::guard_value<char *>(nullptr, []() -> char * {
     const std::string list = OIIO::get_string_attribute("extension_list");
     char *copy = static_cast<char *>(std::malloc(list.size() + 1));
-    if (copy)
-      std::memcpy(copy, list.c_str(), list.size() + 1);
+    if (copy) std::memcpy(copy, list.c_str(), list.size() + 1);
     return copy;
   });
 }

@@ -8,15 +8,15 @@
 #include "image/formats.h"
 #include "image/oiio_calls.h"
 #include "image/oiio_guard.h"
-#include "image/oiio_proxy.h"
 #include "image/oiio_setup.h"
+#include "image/oiio_proxy.h"
 #include "image/quantise.h"
 
 #include <cstdlib>
 #include <cstring>
 #include <memory>
-#include <new>
 #include <optional>
+#include <new>
 
 using OIIO::ImageOutput;
 using OIIO::ImageSpec;
@@ -27,8 +27,7 @@ namespace bb {
 bb_status write_staged(const char *path, const encoder_fn &encode, bb_staged_file *f,
                        bb_error *err) {
   bb_status st = bb__safe_open(f, path, err);
-  if (st != BB_OK)
-    return st;
+  if (st != BB_OK) return st;
   std::string why;
   {
     StagedOutput proxy(f, f->temp_path);
@@ -75,9 +74,7 @@ void set_common_attributes(ImageSpec &spec) {
 namespace {
 
 struct free_deleter {
-  void operator()(void *p) const {
-    std::free(p);
-  }
+  void operator()(void *p) const { std::free(p); }
 };
 template <typename T> using malloced = std::unique_ptr<T, free_deleter>;
 
@@ -89,8 +86,7 @@ template <typename T> malloced<T> codes_of(const bb_image *img, bb_range range) 
     codes = bb__quantise_8(img, range);
   else
     codes = bb__quantise_16(img, range);
-  if (!codes)
-    throw std::bad_alloc();
+  if (!codes) throw std::bad_alloc();
   return malloced<T>(codes);
 }
 
@@ -98,32 +94,25 @@ template <typename T> malloced<T> codes_of(const bb_image *img, bb_range range) 
 // format) through proxy. Returns "" on success, else OIIO's reason.
 std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy *proxy,
                          const bb_image *img, bb_depth depth, bb_range range,
-                         const char *description, int threads,
-                         const char *exr_compression) {
+                         const char *description, int threads, const char *exr_compression) {
   ImageSpec spec(img->width, img->height, img->channels, bb::file_type_of(depth));
   bb::set_common_attributes(spec);
   if (description) {
     malloced<char> stored(bb__description_to_store(file_name.c_str(), description));
-    if (!stored)
-      throw std::bad_alloc();
+    if (!stored) throw std::bad_alloc();
     spec.attribute("ImageDescription", stored.get());
     malloced<char> overflow(bb__description_overflow(file_name.c_str(), description));
-    if (!overflow)
-      throw std::bad_alloc();
-    if (overflow.get()[0])
-      spec.attribute("targa:ImageID", overflow.get());
+    if (!overflow) throw std::bad_alloc();
+    if (overflow.get()[0]) spec.attribute("targa:ImageID", overflow.get());
   }
-  if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT)
-    spec.attribute("compression", "zip");
+  if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
 
   // OpenEXR compresses chunks from open() to close(), and out is destroyed
   // (closed, should an error leave it open) before this scope ends.
   std::optional<bb::ExrWriteThreads> exr_threads;
-  if (bb__path_has_extension(file_name.c_str(), "exr"))
-    exr_threads.emplace(threads);
+  if (bb__path_has_extension(file_name.c_str(), "exr")) exr_threads.emplace(threads);
   auto out = ImageOutput::create(file_name, proxy);
-  if (!out)
-    return bb::one_line(OIIO::geterror());
+  if (!out) return bb::one_line(OIIO::geterror());
   if (!out->supports("ioproxy"))
     return std::string("internal error: the ") + out->format_name() +
            " writer cannot write through a checked output";
@@ -148,8 +137,7 @@ std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy
     // +1%; float: -29%, +3%).
     spec.attribute("tiff:zipquality", 1);
   }
-  if (!out->open(file_name, spec))
-    return bb::one_line(out->geterror());
+  if (!out->open(file_name, spec)) return bb::one_line(out->geterror());
 
   bool ok;
   if (depth == BB_DEPTH_8)
@@ -164,18 +152,16 @@ std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy
   // queues "failed TIFFWriteCustomDirectory() of the Exif data" on every
   // successful write. Reading the queue also clears it.
   std::string why = out->geterror();
-  if (!ok)
-    return bb::one_line(why);
+  if (!ok) return bb::one_line(why);
   return std::string();
 }
 
 } // namespace
 
-extern "C" bb_status bb__oiio_write_image(const char *path, const bb_image *img,
-                                          bb_depth depth, bb_range range,
-                                          const char *description, int threads,
-                                          const char *exr_compression, bb_staged_file *f,
-                                          bb_error *err) {
+extern "C" bb_status bb__oiio_write_image(const char *path, const bb_image *img, bb_depth depth,
+                                          bb_range range, const char *description,
+                                          int threads, const char *exr_compression,
+                                          bb_staged_file *f, bb_error *err) {
   return bb::guard(err, path, bb::WRITING, [&] {
     bb::oiio_setup();
     return bb::write_staged(

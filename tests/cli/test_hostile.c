@@ -6,7 +6,7 @@
  * ends in one line and a non-zero exit, with nothing changed that should
  * not be. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
-#define _DEFAULT_SOURCE   /* wait4 (cli_harness.h) */
+#define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
 #include "bumpbake.h"
 #include "cli_harness.h"
@@ -81,10 +81,9 @@ Test(hostile, fifos_and_devices_are_refused_by_every_command) {
     };
     for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
       cli_result r = harness_run_in(harness_dir, runs[i].args);
-      cr_expect_eq(r.code, runs[i].code, "%s %s: exit %d: %s", runs[i].args[0],
-                   runs[i].name, r.code, r.err);
-      cr_expect_eq(harness_lines(r.err), 1, "%s %s: %s", runs[i].args[0], runs[i].name,
-                   r.err);
+      cr_expect_eq(r.code, runs[i].code, "%s %s: exit %d: %s", runs[i].args[0], runs[i].name,
+                   r.code, r.err);
+      cr_expect_eq(harness_lines(r.err), 1, "%s %s: %s", runs[i].args[0], runs[i].name, r.err);
       cr_expect(strstr(r.err, runs[i].name), "%s: %s", runs[i].args[0], r.err);
       /* (a FIFO that blocked would hit the suite's timeout; /dev/zero read
        * without end spins: CPU time, which load does not stretch) */
@@ -144,12 +143,8 @@ Test(hostile, a_large_file_no_reader_knows_is_refused_by_every_command) {
 /* What stands at a name, as lstat sees it: 'f' FIFO, 'l' link, 'r' regular. */
 static char kind_at(const char *path) {
   struct stat st;
-  if (lstat(path, &st) != 0)
-    return '-';
-  return S_ISFIFO(st.st_mode)  ? 'f'
-         : S_ISLNK(st.st_mode) ? 'l'
-         : S_ISREG(st.st_mode) ? 'r'
-                               : '?';
+  if (lstat(path, &st) != 0) return '-';
+  return S_ISFIFO(st.st_mode) ? 'f' : S_ISLNK(st.st_mode) ? 'l' : S_ISREG(st.st_mode) ? 'r' : '?';
 }
 
 /* An output that exists and is not a regular file (a FIFO, a device, a
@@ -169,19 +164,11 @@ Test(hostile, outputs_that_are_not_regular_files_are_never_replaced) {
     const char *name, *part;
   } runs[] = {
       {{"bake", "h.png", FAST, "--normal", "fifo.png"}, "fifo.png", "is a FIFO"},
-      {{"bake", "h.png", FAST, "--ssbump", "null.png"},
-       "null.png",
-       "symbolic link (to a character device)"},
-      {{"bake", "h.png", FAST, "--ssbump", "materials/s.vtf", "--vmt", "null.vmt"},
-       "null.vmt",
-       "symbolic link"},
-      {{"bake", "h.png", FAST, "--out-dir", "out", "--maps", "normal"},
-       "out/h_normal.png",
-       "is a FIFO"},
+      {{"bake", "h.png", FAST, "--ssbump", "null.png"}, "null.png", "symbolic link (to a character device)"},
+      {{"bake", "h.png", FAST, "--ssbump", "materials/s.vtf", "--vmt", "null.vmt"}, "null.vmt", "symbolic link"},
+      {{"bake", "h.png", FAST, "--out-dir", "out", "--maps", "normal"}, "out/h_normal.png", "is a FIFO"},
       {{"normal", "h.png", "--scale", "4", "-o", "fifo.png"}, "fifo.png", "is a FIFO"},
-      {{"render", "h.png", "--scale", "6", "--rays", "16", "-o", "null.png"},
-       "null.png",
-       "symbolic link"},
+      {{"render", "h.png", "--scale", "6", "--rays", "16", "-o", "null.png"}, "null.png", "symbolic link"},
   };
   for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
     char what[64];
@@ -195,8 +182,7 @@ Test(hostile, outputs_that_are_not_regular_files_are_never_replaced) {
   cr_expect_eq(kind_at(tmp("out/h_normal.png")), 'f');
   cr_expect_eq(kind_at(tmp("null.png")), 'l');
   cr_expect_eq(kind_at(tmp("null.vmt")), 'l');
-  cr_expect(!file_exists(tmp("materials/s.vtf")),
-            "the texture of a refused material was written");
+  cr_expect(!file_exists(tmp("materials/s.vtf")), "the texture of a refused material was written");
   /* The library's own writers refuse them too. */
   bb_error err;
   cr_expect_eq(bb_file_write(tmp("fifo.png"), "x", 1, &err), BB_ERR_IO);
@@ -215,8 +201,7 @@ Test(hostile, outputs_that_are_not_regular_files_are_never_replaced) {
     harness_expect_error(&r, 1, "is a character device", "a device node");
     cli_result_free(&r);
     struct stat st;
-    cr_expect(lstat(tmp("full.png"), &st) == 0 && S_ISCHR(st.st_mode),
-              "the device was replaced");
+    cr_expect(lstat(tmp("full.png"), &st) == 0 && S_ISCHR(st.st_mode), "the device was replaced");
   }
 }
 
@@ -229,28 +214,23 @@ Test(hostile, a_depfile_is_written_through_a_stream) {
   cr_assert_eq(symlink("/dev/null", tmp("null.d")), 0);
   cr_assert_eq(symlink("/dev/full", tmp("full.d")), 0);
   cr_assert_eq(mkfifo(tmp("fifo.d"), 0644), 0);
-  cli_result r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n.png",
-                        "--depfile", "null.d");
+  cli_result r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n.png", "--depfile", "null.d");
   cr_expect_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   cr_expect_eq(kind_at(tmp("null.d")), 'l');
   cr_expect(file_exists(tmp("n.png")));
-  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n2.png", "--depfile",
-             "full.d");
-  harness_expect_error(&r, 1, "No space left on device; the maps were written",
-                       "/dev/full");
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n2.png", "--depfile", "full.d");
+  harness_expect_error(&r, 1, "No space left on device; the maps were written", "/dev/full");
   cli_result_free(&r);
   cr_expect_eq(kind_at(tmp("full.d")), 'l');
-  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n3.png", "--depfile",
-             "fifo.d");
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n3.png", "--depfile", "fifo.d");
   harness_expect_error(&r, 1, "no process reads the FIFO", "a FIFO without a reader");
   cli_result_free(&r);
   /* With a reader (open before the bake, read after it: the rule fits in
    * the pipe's buffer), the rule arrives through the FIFO. */
   const int reader = open(tmp("fifo.d"), O_RDONLY | O_NONBLOCK);
   cr_assert_geq(reader, 0);
-  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n4.png", "--depfile",
-             "fifo.d");
+  r = RUN_IN(harness_dir, "bake", "h.png", FAST, "--normal", "n4.png", "--depfile", "fifo.d");
   cr_expect_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
   char line[256] = "";
@@ -273,22 +253,22 @@ Test(hostile, render_never_writes_over_what_it_reads) {
   height_file(tmp("a.png")); /* an albedo */
   size_t size;
   unsigned char *albedo = slurp_file(tmp("a.png"), &size);
-  const char *over_albedo[] = {"render",     "--ssbump", tmp("s.png"), "--albedo",
-                               tmp("a.png"), "-o",       tmp("a.png"), NULL};
+  const char *over_albedo[] = {"render", "--ssbump", tmp("s.png"), "--albedo", tmp("a.png"),
+                               "-o", tmp("a.png"), NULL};
   harness_expect_refusal(NULL, over_albedo, 1, "would overwrite the input", 1);
   cr_expect(unchanged(tmp("a.png"), albedo, size), "the albedo was replaced");
   free(albedo);
-  const char *over_height[] = {"render", tmp("h.png"), "--scale",  "6",
-                               "--rays", "16",         "--albedo", tmp("a.png"),
-                               "-o",     tmp("h.png"), NULL};
+  const char *over_height[] = {"render", tmp("h.png"), "--scale", "6", "--rays", "16",
+                               "--albedo", tmp("a.png"), "-o",
+                               tmp("h.png"), NULL};
   harness_expect_refusal(NULL, over_height, 1, "would overwrite the input", 2);
   /* An orbit's frame r_000.png is the ssbump it lights. */
-  r = harness_run(
-      (const char *[]){"bake", tmp("h.png"), FAST, "--ssbump", tmp("r_000.png"), NULL});
+  r = harness_run((const char *[]){"bake", tmp("h.png"), FAST, "--ssbump", tmp("r_000.png"),
+                                   NULL});
   cli_result_free(&r);
   unsigned char *frame = slurp_file(tmp("r_000.png"), &size);
-  const char *over_frame[] = {"render", "--ssbump", tmp("r_000.png"), "--orbit",
-                              "2",      "-o",       tmp("r.png"),     NULL};
+  const char *over_frame[] = {"render", "--ssbump", tmp("r_000.png"), "--orbit", "2", "-o",
+                              tmp("r.png"), NULL};
   harness_expect_refusal(NULL, over_frame, 1, "would overwrite the input", 3);
   cr_expect(unchanged(tmp("r_000.png"), frame, size), "a frame replaced its input");
   cr_expect(!file_exists(tmp("r_001.png")), "a frame was written");
@@ -302,17 +282,15 @@ Test(hostile, render_never_writes_over_what_it_reads) {
 Test(hostile, template_names_stay_inside_the_out_dir) {
   cr_assert_eq(mkdir(tmp("in"), 0755), 0);
   height_file(tmp("in/...png"));
-  const char *args[] = {"bake",   tmp("in/...png"),    FAST, "--out-dir", tmp("out"),
-                        "--name", "{stem}/{kind}.png", NULL};
+  const char *args[] = {"bake", tmp("in/...png"), FAST, "--out-dir", tmp("out"), "--name",
+                        "{stem}/{kind}.png", NULL};
   harness_expect_refusal(NULL, args, 2, "would leave the output directory", 4);
   cr_expect(!file_exists(tmp("normal.png")) && !file_exists(tmp("out/normal.png")));
-  const char *literal[] = {
-      "bake",   tmp("in/...png"),       FAST, "--out-dir", tmp("out"),
-      "--name", "../{stem}_{kind}.png", NULL};
+  const char *literal[] = {"bake", tmp("in/...png"), FAST, "--out-dir", tmp("out"), "--name",
+                           "../{stem}_{kind}.png", NULL};
   harness_expect_refusal(NULL, literal, 2, "would leave the output directory", 5);
-  const char *absolute[] = {
-      "bake",   tmp("in/...png"),         FAST, "--out-dir", tmp("out"),
-      "--name", "/tmp/{stem}_{kind}.png", NULL};
+  const char *absolute[] = {"bake", tmp("in/...png"), FAST, "--out-dir", tmp("out"), "--name",
+                            "/tmp/{stem}_{kind}.png", NULL};
   harness_expect_refusal(NULL, absolute, 2, "relative to the output directory", 6);
 }
 
@@ -331,18 +309,16 @@ Test(hostile, a_signal_during_a_commit_leaves_the_set_whole) {
   height_file(tmp("h.png"));
   const char *bin = harness_binary();
   char command[16384];
-  snprintf(
-      command, sizeof command,
-      "cd '%s' && '%s' bake h.png --scale 4 --slices 4 -o r --bent r_bent.exr -q && "
-      "cp r_normal.png n0 && cp r_ao.png a0 && cp r_bent.exr b0 && "
-      "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=SIGINT:when=2 "
-      "'%s' bake h.png --scale 9 --slices 4 -o r --bent r_bent.exr -q; "
-      "cmp -s r_normal.png n0; n=$?; cmp -s r_ao.png a0; a=$?; cmp -s r_bent.exr b0; "
-      "b=$?; test $n = $a && test $a = $b",
-      tmp(""), bin, bin);
-  cr_expect_eq(system(command), 0,
-               "after a SIGINT in the renames, some maps are new and "
-               "some old");
+  snprintf(command, sizeof command,
+           "cd '%s' && '%s' bake h.png --scale 4 --slices 4 -o r --bent r_bent.exr -q && "
+           "cp r_normal.png n0 && cp r_ao.png a0 && cp r_bent.exr b0 && "
+           "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=SIGINT:when=2 "
+           "'%s' bake h.png --scale 9 --slices 4 -o r --bent r_bent.exr -q; "
+           "cmp -s r_normal.png n0; n=$?; cmp -s r_ao.png a0; a=$?; cmp -s r_bent.exr b0; "
+           "b=$?; test $n = $a && test $a = $b",
+           tmp(""), bin, bin);
+  cr_expect_eq(system(command), 0, "after a SIGINT in the renames, some maps are new and "
+                                   "some old");
   cr_expect_eq(files_starting_with(".bb-tmp"), 0, "a temporary was left");
 }
 
@@ -354,20 +330,17 @@ Test(hostile, a_signal_during_an_orbit_commit_leaves_the_frames_whole) {
   height_file(tmp("h.png"));
   const char *bin = harness_binary();
   char command[16384];
-  snprintf(
-      command, sizeof command,
-      "cd '%s' && '%s' render h.png --scale 6 --rays 16 --orbit 4 --light 0,30 -o x.png "
-      "-q "
-      "&& for i in 0 1 2 3; do cp x_00$i.png old$i; done && "
-      "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=SIGINT:when=2 "
-      "'%s' render h.png --scale 6 --rays 16 --orbit 4 --light 0,60 -o x.png -q; "
-      "test $? = 130 || exit 2; new=0; for i in 0 1 2 3; do cmp -s x_00$i.png old$i || "
-      "new=$((new + 1)); done; test $new = 0 || test $new = 4",
-      tmp(""), bin, bin);
+  snprintf(command, sizeof command,
+           "cd '%s' && '%s' render h.png --scale 6 --rays 16 --orbit 4 --light 0,30 -o x.png -q "
+           "&& for i in 0 1 2 3; do cp x_00$i.png old$i; done && "
+           "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=SIGINT:when=2 "
+           "'%s' render h.png --scale 6 --rays 16 --orbit 4 --light 0,60 -o x.png -q; "
+           "test $? = 130 || exit 2; new=0; for i in 0 1 2 3; do cmp -s x_00$i.png old$i || "
+           "new=$((new + 1)); done; test $new = 0 || test $new = 4",
+           tmp(""), bin, bin);
   int status = system(command);
   cr_expect_neq(WEXITSTATUS(status), 2, "the interrupted orbit did not exit 130");
-  cr_expect_eq(status, 0,
-               "after a SIGINT in the renames, some frames are new and some old");
+  cr_expect_eq(status, 0, "after a SIGINT in the renames, some frames are new and some old");
   cr_expect_eq(files_starting_with(".bb-tmp"), 0, "a temporary was left");
 }
 
@@ -380,8 +353,8 @@ Test(hostile, an_unwritable_depfile_is_refused_before_the_bake) {
     cr_skip_test("root writes into read-only directories");
   height_file(tmp("h.png"));
   cr_assert_eq(mkdir(tmp("ro"), 0555), 0);
-  const char *args[] = {"bake",        tmp("h.png"), FAST,          "--ao",
-                        tmp("ao.png"), "--depfile",  tmp("ro/h.d"), NULL};
+  const char *args[] = {"bake", tmp("h.png"), FAST, "--ao", tmp("ao.png"), "--depfile",
+                        tmp("ro/h.d"), NULL};
   harness_expect_refusal(NULL, args, 1, "ro", 7);
   cr_expect(!file_exists(tmp("ao.png")), "the map was written");
 }
@@ -408,11 +381,10 @@ Test(hostile, a_depfile_on_a_full_or_read_only_file_system_leaves_the_maps) {
   cr_assert_eq(mkdir(tmp("ro"), 0755), 0);
   const char *bin = harness_binary();
   char command[16384];
-  snprintf(
-      command, sizeof command,
-      "cd '%s' && '%s' bake h.png --scale 4 --slices 4 --ao ao.png --normal n.png -q && "
-      "cp ao.png ao0 && cp n.png n0",
-      tmp(""), bin);
+  snprintf(command, sizeof command,
+           "cd '%s' && '%s' bake h.png --scale 4 --slices 4 --ao ao.png --normal n.png -q && "
+           "cp ao.png ao0 && cp n.png n0",
+           tmp(""), bin);
   cr_assert_eq(system(command), 0);
   static const struct {
     const char *setup, *depfile;
@@ -424,8 +396,7 @@ Test(hostile, a_depfile_on_a_full_or_read_only_file_system_leaves_the_maps) {
   };
   for (size_t i = 0; i < 2; i++) {
     snprintf(command, sizeof command,
-             "cd '%s' && %s sh -c '%s exec \"$0\" \"$@\"' '%s' bake h.png --scale 9 "
-             "--slices 4 "
+             "cd '%s' && %s sh -c '%s exec \"$0\" \"$@\"' '%s' bake h.png --scale 9 --slices 4 "
              "--ao ao.png --normal n.png --depfile %s 2>err.txt; echo $? >code.txt",
              tmp(""), ns, places[i].setup, bin, places[i].depfile);
     cr_assert_eq(system(command), 0);
@@ -449,8 +420,8 @@ Test(hostile, a_depfile_on_a_full_or_read_only_file_system_leaves_the_maps) {
 Test(hostile, a_depfile_on_a_directory_is_refused_before_the_bake) {
   height_file(tmp("h.png"));
   cr_assert_eq(mkdir(tmp("d"), 0755), 0);
-  const char *args[] = {"bake",        tmp("h.png"), FAST,     "--ao",
-                        tmp("ao.png"), "--depfile",  tmp("d"), NULL};
+  const char *args[] = {"bake", tmp("h.png"), FAST, "--ao", tmp("ao.png"), "--depfile",
+                        tmp("d"), NULL};
   harness_expect_refusal(NULL, args, 1, "is a directory", 8);
   cr_expect(!file_exists(tmp("ao.png")));
 }
@@ -459,20 +430,20 @@ Test(hostile, a_depfile_on_a_directory_is_refused_before_the_bake) {
  * backslash before a space is written as GCC writes it (\\\ ). */
 Test(hostile, depfile_names_are_escaped_or_refused) {
   height_file(tmp("t\tx.png"));
-  const char *tab[] = {"bake",       tmp("t\tx.png"), FAST,       "--normal",
-                       tmp("o.png"), "--depfile",     tmp("o.d"), NULL};
+  const char *tab[] = {"bake", tmp("t\tx.png"), FAST, "--normal", tmp("o.png"), "--depfile",
+                       tmp("o.d"), NULL};
   harness_expect_refusal(NULL, tab, 1, "a tab", 9);
   static const char *const bad[] = {"c:d.png", "e=f.png", "g;h.png", "i%j.png",
                                     "k?l.png", "m*n.png", "p[q].png"};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     height_file(tmp(bad[i]));
-    const char *args[] = {"bake",       tmp(bad[i]), FAST,       "--normal",
-                          tmp("o.png"), "--depfile", tmp("o.d"), NULL};
+    const char *args[] = {"bake", tmp(bad[i]), FAST, "--normal", tmp("o.png"), "--depfile",
+                          tmp("o.d"), NULL};
     harness_expect_refusal(NULL, args, 1, "which a depfile cannot say", 10);
   }
   height_file(tmp("a\\ b#.png"));
-  const char *ok[] = {"bake",       tmp("a\\ b#.png"), FAST,       "--normal",
-                      tmp("o.png"), "--depfile",       tmp("o.d"), NULL};
+  const char *ok[] = {"bake", tmp("a\\ b#.png"), FAST, "--normal", tmp("o.png"), "--depfile",
+                      tmp("o.d"), NULL};
   cli_result r = harness_run(ok);
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
@@ -498,12 +469,10 @@ Test(hostile, depfile_names_read_back_in_make_and_ninja_or_are_refused) {
     cr_assert_eq(mkdir(cwd, 0755), 0);
     snprintf(path, sizeof path, "%s/%s", dir, names[i]);
     height_file(tmp(path));
-    cli_result r =
-        RUN_IN(cwd, "bake", names[i], FAST, "--normal", "o.png", "--depfile", "o.d");
+    cli_result r = RUN_IN(cwd, "bake", names[i], FAST, "--normal", "o.png", "--depfile", "o.d");
     if (r.code == 1 && strstr(r.err, "which a depfile cannot say")) {
       snprintf(path, sizeof path, "%s/o.png", dir);
-      cr_expect(!file_exists(tmp(path)), "%s: refused, but the map was written",
-                names[i]);
+      cr_expect(!file_exists(tmp(path)), "%s: refused, but the map was written", names[i]);
       cli_result_free(&r);
       continue;
     }
@@ -511,18 +480,16 @@ Test(hostile, depfile_names_read_back_in_make_and_ninja_or_are_refused) {
     cli_result_free(&r);
     /* make: the output is up to date only if the input's name reads back. */
     char command[512];
-    snprintf(
-        command, sizeof command,
-        "cd '%s' && printf 'include o.d\\n' >mk && make -q -f mk o.png >make.log 2>&1",
-        cwd);
+    snprintf(command, sizeof command,
+             "cd '%s' && printf 'include o.d\\n' >mk && make -q -f mk o.png >make.log 2>&1",
+             cwd);
     cr_expect_eq(system(command), 0, "%s: make misreads the depfile", names[i]);
     /* ninja: a rule whose depfile is this one; -t deps lists what it read. */
-    snprintf(
-        command, sizeof command,
-        "cd '%s' && mv o.d o.d.src && printf 'rule r\\n  command = cp o.d.src o.d && "
-        "touch o.png\\n  depfile = o.d\\n  deps = gcc\\nbuild o.png: r\\n' >build.ninja "
-        "&& ninja >ninja.log 2>&1 && ninja -t deps o.png >deps.log 2>&1",
-        cwd);
+    snprintf(command, sizeof command,
+             "cd '%s' && mv o.d o.d.src && printf 'rule r\\n  command = cp o.d.src o.d && "
+             "touch o.png\\n  depfile = o.d\\n  deps = gcc\\nbuild o.png: r\\n' >build.ninja "
+             "&& ninja >ninja.log 2>&1 && ninja -t deps o.png >deps.log 2>&1",
+             cwd);
     cr_assert_eq(system(command), 0, "%s: ninja failed", names[i]);
     snprintf(path, sizeof path, "%s/deps.log", dir);
     size_t size;
@@ -542,33 +509,23 @@ Test(hostile, program_images_stay_inside_the_base) {
   height_file(tmp("outside.png"));
   height_file(tmp("base/inside.png"));
   cr_assert_eq(symlink(tmp("outside.png"), tmp("base/link.png")), 0);
-  const char *up[] = {
-      "program", "invertColor(../outside.png)", "--base", tmp("base"), "-o", tmp("o.png"),
-      NULL};
+  const char *up[] = {"program", "invertColor(../outside.png)", "--base", tmp("base"), "-o",
+                      tmp("o.png"), NULL};
   harness_expect_refusal(NULL, up, 1, "outside the base directory", 11);
-  const char *absolute[] = {
-      "program", "invertColor(/etc/passwd)", "--base", tmp("base"), "-o", tmp("o.png"),
-      NULL};
+  const char *absolute[] = {"program", "invertColor(/etc/passwd)", "--base", tmp("base"),
+                            "-o", tmp("o.png"), NULL};
   harness_expect_refusal(NULL, absolute, 1, "an absolute path", 12);
-  const char *link[] = {
-      "program", "invertColor(link.png)", "--base", tmp("base"), "-o", tmp("o.png"),
-      NULL};
+  const char *link[] = {"program", "invertColor(link.png)", "--base", tmp("base"), "-o",
+                        tmp("o.png"), NULL};
   harness_expect_refusal(NULL, link, 1, "outside the base directory", 13);
   cr_expect(!file_exists(tmp("o.png")));
-  const char *inside[] = {
-      "program", "invertColor(inside.png)", "--base", tmp("base"), "-o", tmp("o.png"),
-      NULL};
+  const char *inside[] = {"program", "invertColor(inside.png)", "--base", tmp("base"), "-o",
+                          tmp("o.png"), NULL};
   cli_result r = harness_run(inside);
   cr_expect_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
-  const char *allowed[] = {"program",
-                           "invertColor(../outside.png)",
-                           "--base",
-                           tmp("base"),
-                           "--allow-outside-base",
-                           "-o",
-                           tmp("o2.png"),
-                           NULL};
+  const char *allowed[] = {"program", "invertColor(../outside.png)", "--base", tmp("base"),
+                           "--allow-outside-base", "-o", tmp("o2.png"), NULL};
   r = harness_run(allowed);
   cr_expect_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
@@ -582,9 +539,8 @@ Test(hostile, program_images_stay_inside_the_base) {
 Test(hostile, printed_text_never_drives_the_terminal) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
-  const bb_write_options wo = {
-      BB_DEPTH_8, BB_RANGE_UNIT,
-      "bumpbake_version=x\ncommand=\x1b]0;pwned\x07\x1b[31mred\xff\n", NULL};
+  const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
+                               "bumpbake_version=x\ncommand=\x1b]0;pwned\x07\x1b[31mred\xff\n", NULL};
   cr_assert_eq(bb_image_write(tmp("e.png"), &img, &wo, NULL), BB_OK);
   const char *name = "bad\x1b[2J\xff.png";
   cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);
@@ -624,9 +580,7 @@ Test(hostile, bidirectional_controls_from_a_file_are_escaped) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_write(tmp("k.vtf"), &img, &t, &err), BB_OK, "%s", err.message);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
-                               "a\xe2\x81\xa6"
-                               "b\xe2\x81\xa9 \xd8\x9c \xe2\x80\x8f\xe2\x80\xaa",
-                               NULL};
+                               "a\xe2\x81\xa6" "b\xe2\x81\xa9 \xd8\x9c \xe2\x80\x8f\xe2\x80\xaa", NULL};
   const char *name = "n\xe2\x80\x8e.png";
   cr_assert_eq(bb_image_write(tmp("d.png"), &img, &wo, NULL), BB_OK);
   cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);
@@ -635,30 +589,25 @@ Test(hostile, bidirectional_controls_from_a_file_are_escaped) {
                            {"info", tmp("d.png"), NULL},
                            {"info", tmp(name), NULL},
                            {"info", tmp("gone\xe2\x80\xae.png"), NULL}};
-  const char *shown[] = {"a\\xe2\\x80\\xaegnp.exe", "a\\xe2\\x81\\xa6b",
-                         "n\\xe2\\x80\\x8e.png", "gone\\xe2\\x80\\xae.png"};
+  const char *shown[] = {"a\\xe2\\x80\\xaegnp.exe", "a\\xe2\\x81\\xa6b", "n\\xe2\\x80\\x8e.png",
+                         "gone\\xe2\\x80\\xae.png"};
   for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
     cli_result r = harness_run(runs[i]);
-    cr_expect(!has_control(r.out) && !has_control(r.err),
-              "info %zu printed a control: %s%s", i, r.out, r.err);
-    cr_expect(strstr(r.out, shown[i]) || strstr(r.err, shown[i]),
-              "info %zu lacks %s: %s%s", i, shown[i], r.out, r.err);
+    cr_expect(!has_control(r.out) && !has_control(r.err), "info %zu printed a control: %s%s", i,
+              r.out, r.err);
+    cr_expect(strstr(r.out, shown[i]) || strstr(r.err, shown[i]), "info %zu lacks %s: %s%s", i,
+              shown[i], r.out, r.err);
     cli_result_free(&r);
   }
   /* The rule itself: what it escapes, and what it leaves (accents, CJK). */
   char out[256];
-  cr_expect_str_eq(
-      bb_text_printable(
-          "\xd8\x9c|\xe2\x80\x8f|\xe2\x80\xaa|\xe2\x81\xa9|\x1b|\xc2\x9b|\xff", out,
-          sizeof out),
-      "\\xd8\\x9c|\\xe2\\x80\\x8f|\\xe2\\x80\\xaa|\\xe2\\x81\\xa9|\\x1b|\\xc2\\x9b|"
-      "\\xff");
-  cr_expect_str_eq(bb_text_printable(
-                       "h\xc3\xa9ight \xe9\xab\x98\xe3\x81\x95 \xe2\x80\x94 \xe2\x80\xaf",
-                       out, sizeof out),
+  cr_expect_str_eq(bb_text_printable("\xd8\x9c|\xe2\x80\x8f|\xe2\x80\xaa|\xe2\x81\xa9|\x1b|\xc2\x9b|\xff",
+                                     out, sizeof out),
+                   "\\xd8\\x9c|\\xe2\\x80\\x8f|\\xe2\\x80\\xaa|\\xe2\\x81\\xa9|\\x1b|\\xc2\\x9b|\\xff");
+  cr_expect_str_eq(bb_text_printable("h\xc3\xa9ight \xe9\xab\x98\xe3\x81\x95 \xe2\x80\x94 \xe2\x80\xaf",
+                                     out, sizeof out),
                    "h\xc3\xa9ight \xe9\xab\x98\xe3\x81\x95 \xe2\x80\x94 \xe2\x80\xaf");
-  cr_expect_str_eq(bb_text_printable("ab\xe2\x80\xae", out, 8), "ab",
-                   "a control cut short");
+  cr_expect_str_eq(bb_text_printable("ab\xe2\x80\xae", out, 8), "ab", "a control cut short");
 }
 
 /* The other text a file brings: a basis file's line and a program's text
@@ -673,8 +622,7 @@ Test(hostile, basis_lines_program_text_and_batch_names_are_printed_escaped) {
   cr_assert_eq(mkdir(tmp("in"), 0755), 0);
   height_file(tmp("in/bad\x1b[2J\xc2\x9b.png"));
   const char *runs[][16] = {
-      {"bake", tmp("h.png"), FAST, "--basis", tmp("b.txt"), "--ssbump", tmp("o.png"),
-       NULL},
+      {"bake", tmp("h.png"), FAST, "--basis", tmp("b.txt"), "--ssbump", tmp("o.png"), NULL},
       {"program", "invertColor(\x1b]0;pwned\x07\x1b[31m)", "-o", tmp("o.png"), NULL},
       {"bake", tmp("in"), FAST, "--out-dir", tmp("out"), "--maps", "normal", NULL},
   };
@@ -745,19 +693,16 @@ static long documented_start_kib(void) {
  * line saying it is out of memory (or that the bake's estimate does not
  * fit what is available), nothing written (renderbumpflat said
  * "not a readable model: std::bad_alloc" at 460 and 470 MB before). */
-Test(hostile, past_the_documented_start_up_minimum_every_run_ends_cleanly,
-     .timeout = 600) {
+Test(hostile, past_the_documented_start_up_minimum_every_run_ends_cleanly, .timeout = 600) {
 #if defined(__SANITIZE_ADDRESS__)
   cr_skip_test("ASan reserves terabytes of address space");
 #endif
   const long start_kib = documented_start_kib();
-  cr_assert_gt(start_kib, 100000,
-               "docs/limits.md gives no start-up minimum for --version");
+  cr_assert_gt(start_kib, 100000, "docs/limits.md gives no start-up minimum for --version");
   const run_limits at_minimum = {-1, start_kib * 1024};
-  cli_result r =
-      harness_run_limited(NULL, &at_minimum, (const char *const[]){"--version", NULL});
-  cr_expect_eq(r.code, 0, "the documented minimum of %ld KiB does not start: exit %d",
-               start_kib, r.code);
+  cli_result r = harness_run_limited(NULL, &at_minimum, (const char *const[]){"--version", NULL});
+  cr_expect_eq(r.code, 0, "the documented minimum of %ld KiB does not start: exit %d", start_kib,
+               r.code);
   cli_result_free(&r);
   height_file(tmp("h.png"));
   const char *fixtures = getenv("BB_FIXTURES");
@@ -765,7 +710,7 @@ Test(hostile, past_the_documented_start_up_minimum_every_run_ends_cleanly,
   snprintf(model, sizeof model, "%s/rivet_panel.obj", fixtures ? fixtures : "fixtures");
   cr_assert_eq(mkdir(tmp("out"), 0755), 0);
   const long limits_kib[] = {430000, 460000, 470000, start_kib + 8000, 500000,
-                             540000, 600000, 800000, 1600000};
+                             540000, 600000,  800000, 1600000};
   for (size_t i = 0; i < sizeof limits_kib / sizeof limits_kib[0]; i++) {
     const run_limits lim = {-1, limits_kib[i] * 1024};
     const char *const runs[][16] = {
@@ -776,15 +721,13 @@ Test(hostile, past_the_documented_start_up_minimum_every_run_ends_cleanly,
       r = harness_run_limited(NULL, &lim, runs[k]);
       const int before_main = r.code == 127 || r.code == 134 || r.code == 139;
       if (before_main) {
-        cr_expect_lt(limits_kib[i], start_kib,
-                     "%s at %ld KiB, over the documented minimum: "
-                     "exit %d: %s",
-                     runs[k][0], limits_kib[i], r.code, r.err);
+        cr_expect_lt(limits_kib[i], start_kib, "%s at %ld KiB, over the documented minimum: "
+                     "exit %d: %s", runs[k][0], limits_kib[i], r.code, r.err);
       } else if (r.code != 0) {
-        cr_expect_eq(r.code, 1, "%s at %ld KiB: exit %d: %s", runs[k][0], limits_kib[i],
-                     r.code, r.err);
-        cr_expect_eq(harness_lines(r.err), 1, "%s at %ld KiB: %s", runs[k][0],
-                     limits_kib[i], r.err);
+        cr_expect_eq(r.code, 1, "%s at %ld KiB: exit %d: %s", runs[k][0], limits_kib[i], r.code,
+                     r.err);
+        cr_expect_eq(harness_lines(r.err), 1, "%s at %ld KiB: %s", runs[k][0], limits_kib[i],
+                     r.err);
         /* An allocation that failed, or the bake's estimate refused first. */
         cr_expect(strstr(r.err, "out of memory") || strstr(r.err, " of memory; "),
                   "%s at %ld KiB: %s", runs[k][0], limits_kib[i], r.err);
@@ -799,8 +742,7 @@ Test(hostile, past_the_documented_start_up_minimum_every_run_ends_cleanly,
       }
       cli_result_free(&r);
       char command[1024];
-      snprintf(command, sizeof command, "rm -rf '%s'/* '%s'/.bb-tmp*", tmp("out"),
-               tmp("out"));
+      snprintf(command, sizeof command, "rm -rf '%s'/* '%s'/.bb-tmp*", tmp("out"), tmp("out"));
       cr_assert_eq(system(command), 0);
     }
   }

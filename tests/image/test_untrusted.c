@@ -2,22 +2,22 @@
  * files are untrusted"): FIFOs and devices under an input's name. Each
  * call runs in a child with an alarm, so a regression that blocks fails
  * here instead of hanging the suite. */
-#define _DEFAULT_SOURCE   /* wait4 (child_call.h) */
+#define _DEFAULT_SOURCE /* wait4 (child_call.h) */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw (scratch_dir.h) */
 
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
-#include "child_call.h"
 #include "image/height_channel.h"
+#include "child_call.h"
 #include "scratch_dir.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <poll.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdatomic.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,12 +29,9 @@
 #include <time.h>
 #include <unistd.h>
 
-static void make_scratch_dir(void) {
-  scratch_dir_make("bb_untrusted");
-}
+static void make_scratch_dir(void) { scratch_dir_make("bb_untrusted"); }
 
-TestSuite(untrusted, .init = make_scratch_dir, .fini = scratch_dir_remove,
-          .timeout = 600);
+TestSuite(untrusted, .init = make_scratch_dir, .fini = scratch_dir_remove, .timeout = 600);
 
 /* --------------------------------------------- every reader of the library */
 
@@ -77,9 +74,9 @@ static const struct {
   const char *name;
   child_call_fn fn;
 } READERS[] = {
-    {"bb_image_read", call_read},         {"bb_image_read_info", call_read_info},
+    {"bb_image_read", call_read},       {"bb_image_read_info", call_read_info},
     {"bb_image_read_mip", call_read_mip}, {"bb_image_frame_count", call_frame_count},
-    {"bb_basis_load", call_basis_load},   {"bb_file_hash", call_file_hash},
+    {"bb_basis_load", call_basis_load}, {"bb_file_hash", call_file_hash},
 };
 
 /* Every reader refuses path at once: BB_ERR_IO, one line naming the file
@@ -90,11 +87,10 @@ static void expect_refused_at_once(const char *path, const char *what) {
     child_outcome o = child_call(READERS[i].fn, path, 10, 0);
     cr_expect_eq(o.signal, 0, "%s(%s): killed by signal %d after %.1f s (it blocked)",
                  READERS[i].name, path, o.signal, o.seconds);
-    if (o.signal)
-      continue;
+    if (o.signal) continue;
     cr_expect_eq(o.status, BB_ERR_IO, "%s(%s): %s", READERS[i].name, path, o.message);
-    cr_expect(strstr(o.message, path) && strstr(o.message, what), "%s: '%s'",
-              READERS[i].name, o.message);
+    cr_expect(strstr(o.message, path) && strstr(o.message, what), "%s: '%s'", READERS[i].name,
+              o.message);
     cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", READERS[i].name, o.message);
     /* (one that blocked is killed by its alarm: the signal above) */
     cr_expect_lt(o.cpu_seconds, 0.5, "%s(%s) took %.2f s of CPU", READERS[i].name, path,
@@ -289,8 +285,7 @@ static unsigned char *noise_png(size_t *size) {
 Test(untrusted, a_damaged_png_prints_nothing_on_stderr) {
   size_t n;
   unsigned char *png = noise_png(&n);
-  const char *cut = in_scratch_dir("cut.png"), *crc = in_scratch_dir("crc.png"),
-             *header = in_scratch_dir("ihdr.png");
+  const char *cut = in_scratch_dir("cut.png"), *crc = in_scratch_dir("crc.png"), *header = in_scratch_dir("ihdr.png");
   write_bytes(cut, png, n / 2);
   png[n / 2] ^= 0x55; /* inside the pixel data: the chunk's CRC no longer matches */
   write_bytes(crc, png, n);
@@ -330,23 +325,19 @@ static void *plant_links(void *arg) {
   int moved = 0;
   while (!atomic_load(&p->stop)) {
     struct pollfd pfd = {in, POLLIN, 0};
-    if (poll(&pfd, 1, 5) <= 0)
-      continue;
+    if (poll(&pfd, 1, 5) <= 0) continue;
     ssize_t n = read(in, buf, sizeof buf);
     for (char *at = buf; n > 0 && at < buf + n;) {
       const struct inotify_event *ev = (const struct inotify_event *)at;
       at += sizeof *ev + ev->len;
-      if (!ev->len || strncmp(ev->name, ".bb-tmp-", 8) != 0)
-        continue;
+      if (!ev->len || strncmp(ev->name, ".bb-tmp-", 8) != 0) continue;
       char path[700], away[700];
       snprintf(path, sizeof path, "%s/%s", p->dir, ev->name);
       struct stat st;
-      if (lstat(path, &st) != 0 || S_ISLNK(st.st_mode))
-        continue; /* gone, or its own link */
+      if (lstat(path, &st) != 0 || S_ISLNK(st.st_mode)) continue; /* gone, or its own link */
       if (S_ISDIR(st.st_mode)) {
         snprintf(away, sizeof away, "%s/moved-%d", p->dir, moved++);
-        if (rename(path, away) == 0 && symlink(p->decoy, path) == 0)
-          p->dirs++;
+        if (rename(path, away) == 0 && symlink(p->decoy, path) == 0) p->dirs++;
       } else if (unlink(path) == 0 && symlink(p->target, path) == 0) {
         p->files++;
       }
@@ -386,11 +377,10 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
   bb_image img, *levels = NULL;
   int count_made = 0;
   cr_assert_eq(bb_image_alloc(&img, 256, 128, 3, NULL), BB_OK);
-  for (size_t i = 0; i < 256u * 128u * 3u; i++)
-    img.pixels[i] = (float)(i % 97) / 97.0f;
+  for (size_t i = 0; i < 256u * 128u * 3u; i++) img.pixels[i] = (float)(i % 97) / 97.0f;
   bb_error err;
-  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count_made, &err), BB_OK,
-               "%s", err.message);
+  cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count_made, &err), BB_OK, "%s",
+               err.message);
   cr_assert_eq(count_made, 9);
 
   planter p = {out_dir, target, decoy, 0, 0, 0};
@@ -422,18 +412,17 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
   cr_assert_not_null(f);
   size_t n = fread(text, 1, sizeof text - 1, f);
   fclose(f);
-  cr_expect(
-      n == 9 && strcmp(text, "precious\n") == 0,
-      "the target was written through (%zu bytes; %d files, %d directories replaced)", n,
-      p.files, p.dirs);
+  cr_expect(n == 9 && strcmp(text, "precious\n") == 0,
+            "the target was written through (%zu bytes; %d files, %d directories replaced)", n,
+            p.files, p.dirs);
   /* With the watcher gone the write goes through (while it runs, a loaded
    * machine lets it win every race: every trial then refused cleanly). */
   unlink(out);
   cr_expect_eq(bb_image_write_mips(out, levels, count_made, NULL, &err), BB_OK, "%s",
                err.message);
   cr_expect_gt(p.files + p.dirs, 0, "the watcher never acted");
-  cr_log_info("%d of 5 written; the watcher replaced %d files and %d directories",
-              written, p.files, p.dirs);
+  cr_log_info("%d of 5 written; the watcher replaced %d files and %d directories", written,
+              p.files, p.dirs);
   bb_mip_chain_free(levels, count_made);
   bb_image_free(&img);
 }
@@ -450,10 +439,8 @@ static size_t data_bytes(void) {
   char line[256];
   size_t kib = 0;
   while (f && fgets(line, sizeof line, f))
-    if (sscanf(line, "VmData: %zu kB", &kib) == 1)
-      break;
-  if (f)
-    fclose(f);
+    if (sscanf(line, "VmData: %zu kB", &kib) == 1) break;
+  if (f) fclose(f);
   return kib * 1024;
 }
 
@@ -480,8 +467,7 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
       setrlimit(RLIMIT_DATA, &rl);
       bb_error err = {{0}};
       bb_status st = bb_image_write(in_scratch_dir("short.png"), &img, NULL, &err);
-      if (st != BB_OK && (!err.message[0] || strchr(err.message, '\n')))
-        _exit(3);
+      if (st != BB_OK && (!err.message[0] || strchr(err.message, '\n'))) _exit(3);
       _exit(st == BB_OK ? 0 : 1);
     }
     int status = 0;
@@ -489,15 +475,11 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
     cr_assert(WIFEXITED(status), "margin %d MiB: killed by signal %d", margin_mib,
               WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     cr_expect_neq(WEXITSTATUS(status), 3, "margin %d MiB: a bad message", margin_mib);
-    if (WEXITSTATUS(status) == 0)
-      written++;
-    else
-      failed++;
+    if (WEXITSTATUS(status) == 0) written++; else failed++;
     FILE *f = fopen(capture, "r");
     char said[512] = {0};
     size_t n = f ? fread(said, 1, sizeof said - 1, f) : 0;
-    if (f)
-      fclose(f);
+    if (f) fclose(f);
     cr_expect_eq(n, 0, "margin %d MiB: stderr got '%s'", margin_mib, said);
   }
   cr_log_info("%d writes failed short of memory, %d succeeded", failed, written);
