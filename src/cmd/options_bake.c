@@ -9,8 +9,8 @@
 #include <arpa/inet.h>
 #include <ctype.h>
 #include <float.h>
-#include <netinet/in.h>
 #include <math.h>
+#include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -459,7 +459,8 @@ static const bb__option opt_basetexture = {
  * PROTOCOL://HOST:PORT or HOST:PORT (tcp), checked here so that a usage
  * error is one line and exit 2 before any Python or Dask starts: the host a
  * name, an IPv4 address or [an IPv6 one], the port 1..65535. */
-#define SCHEDULER_EXAMPLE "tcp://HOST:PORT, e.g. tcp://10.0.0.1:8786 (dask-scheduler prints it)"
+#define SCHEDULER_EXAMPLE                                                                \
+  "tcp://HOST:PORT, e.g. tcp://10.0.0.1:8786 (dask-scheduler prints it)"
 
 static int is_host_name(const char *host, size_t n) {
   if (n < 1 || n > 253)
@@ -488,14 +489,16 @@ static bb_status check_scheduler(const char *text, bb_error *err) {
   for (size_t i = 0; i < len; i++)
     if ((unsigned char)text[i] <= 0x20 || (unsigned char)text[i] == 0x7f)
       return bb__fail(err, BB_ERR_ARGUMENT,
-                      "--scheduler '%s': control characters or spaces in the address", shown);
+                      "--scheduler '%s': control characters or spaces in the address",
+                      shown);
   if (rest) {
     const size_t n = (size_t)(rest - text);
     if (n >= sizeof scheme)
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "--scheduler '%s': unknown protocol (one of tcp, tls, ws, wss, ucx); "
-                      "give %s",
-                      shown, SCHEDULER_EXAMPLE);
+      return bb__fail(
+          err, BB_ERR_ARGUMENT,
+          "--scheduler '%s': unknown protocol (one of tcp, tls, ws, wss, ucx); "
+          "give %s",
+          shown, SCHEDULER_EXAMPLE);
     for (size_t i = 0; i < n; i++)
       scheme[i] = (char)tolower((unsigned char)text[i]);
     scheme[n] = '\0';
@@ -513,14 +516,15 @@ static bb_status check_scheduler(const char *text, bb_error *err) {
   for (size_t i = 0; i < sizeof schemes / sizeof schemes[0]; i++)
     known |= !strcmp(scheme, schemes[i]);
   if (!known)
-    return bb__fail(err, BB_ERR_ARGUMENT,
-                    "--scheduler '%s': unknown protocol '%s' (one of tcp, tls, ws, wss, ucx); "
-                    "give %s",
-                    shown, scheme, SCHEDULER_EXAMPLE);
+    return bb__fail(
+        err, BB_ERR_ARGUMENT,
+        "--scheduler '%s': unknown protocol '%s' (one of tcp, tls, ws, wss, ucx); "
+        "give %s",
+        shown, scheme, SCHEDULER_EXAMPLE);
   if (strpbrk(rest, "/?#@"))
     return bb__fail(err, BB_ERR_ARGUMENT,
-                    "--scheduler '%s': an address has no path, query or user: give %s", shown,
-                    SCHEDULER_EXAMPLE);
+                    "--scheduler '%s': an address has no path, query or user: give %s",
+                    shown, SCHEDULER_EXAMPLE);
   const char *port;
   if (rest[0] == '[') {
     const char *end = strchr(rest, ']');
@@ -530,10 +534,11 @@ static bb_status check_scheduler(const char *text, bb_error *err) {
     char host[64];
     unsigned char any[sizeof(struct in6_addr)];
     const size_t n = (size_t)(end - rest - 1);
-    if (n >= sizeof host || (memcpy(host, rest + 1, n), host[n] = '\0',
-                             inet_pton(AF_INET6, host, any) != 1))
-      return bb__fail(err, BB_ERR_ARGUMENT, "--scheduler '%s': '%.*s' is not an IPv6 address",
-                      shown, (int)(n < 64 ? n : 64), rest + 1);
+    if (n >= sizeof host ||
+        (memcpy(host, rest + 1, n), host[n] = '\0', inet_pton(AF_INET6, host, any) != 1))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--scheduler '%s': '%.*s' is not an IPv6 address", shown,
+                      (int)(n < 64 ? n : 64), rest + 1);
     if (end[1] != ':')
       return bb__fail(err, BB_ERR_ARGUMENT, "--scheduler '%s': no port: give %s", shown,
                       SCHEDULER_EXAMPLE);
@@ -545,9 +550,10 @@ static bb_status check_scheduler(const char *text, bb_error *err) {
                       SCHEDULER_EXAMPLE);
     const size_t n = (size_t)(colon - rest);
     if (memchr(rest, ':', n))
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "--scheduler '%s': an IPv6 address goes in brackets: %s://[%.*s]:%s",
-                      shown, scheme, (int)(n < 64 ? n : 64), rest, colon + 1);
+      return bb__fail(
+          err, BB_ERR_ARGUMENT,
+          "--scheduler '%s': an IPv6 address goes in brackets: %s://[%.*s]:%s", shown,
+          scheme, (int)(n < 64 ? n : 64), rest, colon + 1);
     if (!is_host_name(rest, n))
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "--scheduler '%s': '%.*s' is not a host name or address", shown,
@@ -563,8 +569,8 @@ static bb_status check_scheduler(const char *text, bb_error *err) {
   }
   if (!digits || number < 1 || number > 65535)
     return bb__fail(err, BB_ERR_ARGUMENT,
-                    "--scheduler '%s': the port '%.16s' is not a number from 1 to 65535", shown,
-                    port);
+                    "--scheduler '%s': the port '%.16s' is not a number from 1 to 65535",
+                    shown, port);
   return BB_OK;
 }
 
@@ -576,12 +582,20 @@ static bb_status set_scheduler(bb_command *c, const bb__option *o, const char *t
 }
 
 static const bb__option opt_scheduler = {
-    .info = {.name = "scheduler", .value_name = "ADDRESS", .type = BB_OPTION_TEXT, .flags = BB_OPTION_CLIENT | BB_OPTION_FILES, .count = 1,
-             .values = 1,
-             .help = "bake on the Dask cluster of this scheduler (tcp://host:8786): a batch's "
-                     "inputs on its workers, a single map's trace split over them "
-                     "(docs/cluster.md)"},
-    .field = BB__FIELD_STRING, .offset = AT(scheduler), .set = set_scheduler};
+    .info =
+        {.name = "scheduler",
+         .value_name = "ADDRESS",
+         .type = BB_OPTION_TEXT,
+         .flags = BB_OPTION_CLIENT | BB_OPTION_FILES,
+         .count = 1,
+         .values = 1,
+         .help =
+             "bake on the Dask cluster of this scheduler (tcp://host:8786): a batch's "
+             "inputs on its workers, a single map's trace split over them "
+             "(docs/cluster.md)"},
+    .field = BB__FIELD_STRING,
+    .offset = AT(scheduler),
+    .set = set_scheduler};
 
 /* -------------------------------------------------------------- bake */
 

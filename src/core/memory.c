@@ -103,7 +103,8 @@ static uint64_t group_room(const char *dir, int v2) {
     return UINT64_MAX;
   (void)read_number(dir, v2 ? "memory.current" : "memory.usage_in_bytes", &usage);
   uint64_t cache =
-      v2 ? 0 : stat_value(dir, "total_active_file") + stat_value(dir, "total_inactive_file");
+      v2 ? 0
+         : stat_value(dir, "total_active_file") + stat_value(dir, "total_inactive_file");
   if (!cache)
     cache = stat_value(dir, "active_file") + stat_value(dir, "inactive_file");
   const uint64_t used = usage > cache ? usage - cache : 0;

@@ -22,8 +22,8 @@ int bb__provenance_pack(const char *description, int rows, int row_chars, char *
 /* bb__provenance_pack, and the lines that did not fit into overflow
  * (capacity overflow_cap, NUL-terminated): whole lines in the order they
  * were left out, '\n'-separated, as many as fit. */
-int bb__provenance_pack_overflow(const char *description, int rows, int row_chars, char *out,
-                                 char *overflow, size_t overflow_cap);
+int bb__provenance_pack_overflow(const char *description, int rows, int row_chars,
+                                 char *out, char *overflow, size_t overflow_cap);
 
 /* 1 when two provenance texts differ in a key not in `ignored` (a
  * NULL-terminated list): a key of want missing from have or holding

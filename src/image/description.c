@@ -35,7 +35,8 @@ static int is_fitted(const char *path, const char *description) {
 }
 
 char *bb__description_to_store(const char *path, const char *description) {
-  if (!is_fitted(path, description)) return copy_of(description);
+  if (!is_fitted(path, description))
+    return copy_of(description);
   char rows[TGA_COMMENT_ROWS][TGA_COMMENT_CHARS + 1];
   bb__provenance_pack(description, TGA_COMMENT_ROWS, TGA_COMMENT_CHARS, &rows[0][0]);
   char *flat = malloc(sizeof rows);

@@ -315,9 +315,9 @@ bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *
     if (!info->description)
       return bb__fail(err, BB_ERR_MEMORY, "%s: cannot allocate the description", path);
     std::memcpy(info->description, desc.c_str(), desc.size() + 1);
-    info->description = bb__description_join(
-        in.format_name(), info->description,
-        spec.get_string_attribute("targa:ImageID").c_str());
+    info->description =
+        bb__description_join(in.format_name(), info->description,
+                             spec.get_string_attribute("targa:ImageID").c_str());
     bb__description_as_read(in.format_name(), info->description);
   }
   return BB_OK;

@@ -380,10 +380,11 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
   if (st == BB_OK && job->vmt_basetexture && job->options.note &&
       (stat(job->vmt_basetexture, &base) != 0 || !S_ISREG(base.st_mode))) {
     char text[PATH_MAX + 160];
-    snprintf(text, sizeof text,
-             "--basetexture %s is not a file (yet): Source draws the material's colour as its "
-             "missing-texture checkerboard until it is",
-             job->vmt_basetexture);
+    snprintf(
+        text, sizeof text,
+        "--basetexture %s is not a file (yet): Source draws the material's colour as its "
+        "missing-texture checkerboard until it is",
+        job->vmt_basetexture);
     job->options.note(job->options.note_user, job->vmt, text);
   }
   /* The input's notes have been given: a caller that takes one as an

@@ -790,7 +790,8 @@ Test(cli, height2ssbump_without_alpha_uses_mean_and_says_so) {
  * the provenance whole. */
 Test(cli, height2ssbump_records_its_command) {
   write_image(tmp("wall.tga"), 16, 16, 4, grey_with_low_alpha);
-  run_ok_in(harness_dir, (const char *[]){"height2ssbump", "-r", "16", "wall.tga", "4", NULL});
+  run_ok_in(harness_dir,
+            (const char *[]){"height2ssbump", "-r", "16", "wall.tga", "4", NULL});
   bb_image_info info;
   bb_error err;
   cr_assert_eq(bb_image_read_info(tmp("wall-ssbump.tga"), NULL, NULL, NULL, &info, &err),

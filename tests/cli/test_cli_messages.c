@@ -180,10 +180,10 @@ Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
  * says where the game's materials are. */
 Test(cli_messages, a_material_outside_materials_names_the_option) {
   dome(tmp("h.png"), 1, BB_DEPTH_16);
-  const char *args[] = {"bake", tmp("h.png"), "--scale", "4", "--rays", "4", "--ssbump",
-                        tmp("s.vtf"), "--vmt", tmp("s.vmt"), NULL};
-  harness_expect_refusal(NULL, args, 2, "name the game's materials folder with --materials DIR",
-                         0);
+  const char *args[] = {"bake",     tmp("h.png"), "--scale", "4",          "--rays", "4",
+                        "--ssbump", tmp("s.vtf"), "--vmt",   tmp("s.vmt"), NULL};
+  harness_expect_refusal(NULL, args, 2,
+                         "name the game's materials folder with --materials DIR", 0);
 }
 
 /* A map named twice is a usage error before any bake, not a file dropped. */

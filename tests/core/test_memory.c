@@ -96,11 +96,14 @@ Test(memory, page_cache_active_or_not_counts_as_room) {
   put("proc/self/cgroup", "4:memory:/docker/c1\n");
   put("proc/self/mountinfo",
       "32 31 0:29 / /sys/fs/cgroup/memory rw - cgroup cgroup rw,memory\n");
-  put("sys/fs/cgroup/memory/docker/c1/memory.limit_in_bytes", "3221225472\n");   /* 3072 MiB */
-  put("sys/fs/cgroup/memory/docker/c1/memory.usage_in_bytes", "2942304256\n");   /* 2806 MiB */
+  put("sys/fs/cgroup/memory/docker/c1/memory.limit_in_bytes",
+      "3221225472\n"); /* 3072 MiB */
+  put("sys/fs/cgroup/memory/docker/c1/memory.usage_in_bytes",
+      "2942304256\n"); /* 2806 MiB */
   put("sys/fs/cgroup/memory/docker/c1/memory.stat",
       "cache 2600000000\nactive_file 1\ninactive_file 1\n"
-      "total_active_file 2275409920\ntotal_inactive_file 104857600\n"); /* 2170 + 100 MiB */
+      "total_active_file 2275409920\ntotal_inactive_file 104857600\n"); /* 2170 + 100 MiB
+                                                                         */
   const char *source = NULL;
   cr_expect_float_eq(available(&source), 3072.0 - (2806.0 - 2270.0), 1e-9);
   cr_expect_str_eq(source, "cgroup memory.limit_in_bytes");
@@ -113,8 +116,8 @@ Test(memory, page_cache_active_or_not_counts_as_room) {
   put("proc/self/mountinfo", "30 22 0:26 / /sys/fs/cgroup rw - cgroup2 cgroup2 rw\n");
   put("sys/fs/cgroup/job/memory.max", "3221225472\n");
   put("sys/fs/cgroup/job/memory.current", "2942304256\n");
-  put("sys/fs/cgroup/job/memory.stat",
-      "anon 500000000\nfile 2380267520\nactive_file 2275409920\ninactive_file 104857600\n");
+  put("sys/fs/cgroup/job/memory.stat", "anon 500000000\nfile 2380267520\nactive_file "
+                                       "2275409920\ninactive_file 104857600\n");
   cr_expect_float_eq(available(&source), 3072.0 - (2806.0 - 2270.0), 1e-9);
   cr_expect_str_eq(source, "cgroup memory.max");
 }

@@ -317,8 +317,9 @@ Test(provenance, pack_keeps_whole_lines_pixel_keys_first) {
     cr_assert_null(strstr(rows[r], "command="), "row %d: %s", r, rows[r]);
   /* What is left out, whole lines as many as fit: the command line. */
   char overflow[256];
-  cr_assert_eq(bb__provenance_pack_overflow(text, 4, 80, &rows[0][0], overflow, sizeof overflow),
-               1);
+  cr_assert_eq(
+      bb__provenance_pack_overflow(text, 4, 80, &rows[0][0], overflow, sizeof overflow),
+      1);
   cr_assert_str_eq(overflow, "command=bumpbake height2ssbump -r 250 -f 10 "
                              "textures/rock/rock_height_2048.tga 64");
   cr_assert_eq(bb__provenance_pack_overflow(text, 4, 80, &rows[0][0], overflow, 40), 1);
