@@ -2891,6 +2891,20 @@ bb_status bb_command_check(bb_command *command, bb_error *err);
  * map). Call before bb_command_check. */
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
 
+/* How a command's messages name its options: as the command line spells
+ * them (the default), or as keyword arguments, for a client that takes its
+ * options so (Python; a page whose controls bear the options' names). */
+typedef enum bb_spelling {
+  BB_SPELLING_COMMAND_LINE = 0, /* "--filter-radius", "give -o PREFIX" */
+  BB_SPELLING_KEYWORDS          /* "filter_radius", "give output=PREFIX" */
+} bb_spelling;
+
+/* Sets how the messages of command's calls (bb_command_set, _check, _plan,
+ * _run, _picture, _renderbump, and the notes of their hooks) name the
+ * command's options: the library words each refusal once, and the option
+ * rows know both spellings. */
+void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
+
 /* 1 when option name was set. */
 int bb_command_given(const bb_command *command, const char *name);
 /* The options as set (defaults elsewhere); owned by command. */

@@ -526,6 +526,10 @@ typedef enum bb_option_type {
   BB_OPTION_PATH
 } bb_option_type;
 
+typedef enum bb_spelling {
+  BB_SPELLING_COMMAND_LINE = 0,
+  BB_SPELLING_KEYWORDS
+} bb_spelling;
 typedef enum bb_option_mode {
   BB_MODE_ANY = 0,
   BB_MODE_SINGLE,
@@ -772,6 +776,7 @@ bb_status bb_command_set(bb_command *command, const char *name, const char *text
 bb_status bb_command_add_input(bb_command *command, const char *text, bb_error *err);
 bb_status bb_command_check(bb_command *command, bb_error *err);
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
+void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
 const bb_command_options *bb_command_options_of(const bb_command *command);
 int bb_command_input_count(const bb_command *command);

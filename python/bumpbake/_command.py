@@ -16,7 +16,6 @@ os.PathLike.
 
 import numbers
 import os
-import re
 
 import numpy as np
 
@@ -139,6 +138,8 @@ class Command:
             out = _ffi.new("bb_command **")
             _check(_lib.bb_command_new(name.encode(), out, err), err)
             _handle = out[0]
+            # its refusals name the options as this package's keywords
+            _lib.bb_command_set_spelling(_handle, _lib.BB_SPELLING_KEYWORDS)
         self._c = _ffi.gc(_handle, _lib.bb_command_free)
         self._info = _lib.bb_command_describe(self._c)
 
@@ -223,19 +224,10 @@ class Command:
             raise _exception(st, self.prefixed(_message(err, st)))
 
     def prefixed(self, message):
-        """The library's message, spelled for Python, after the function's
-        name (once)."""
-        message = self.spelled(message)
+        """The library's message (its options spelled as keywords by the
+        library, bb_command_set_spelling) after the function's name, once."""
         return message if message.startswith(self.name + ":") else \
             f"{self.function}: {message}"
-
-    def spelled(self, message):
-        """The library's message with its options named as Python's
-        keywords ("--filter-radius" as "filter_radius")."""
-        def keyword_of(m):
-            o = _lib.bb_option_find(self._info, m.group(1).encode(), 0)
-            return keyword(o) if o != _ffi.NULL else m.group(0)
-        return re.sub(r"(?<![\w-])--([a-z][a-z0-9-]*)", keyword_of, message)
 
     def set_all(self, values, skip_default=False):
         for key, value in values.items():

@@ -8,7 +8,7 @@ import typing
 from ._bake import _KINDS
 from ._command import Command
 from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi,
-                      _lib, _path, _text, _texture_options)
+                      _lib, _path, _shown, _text, _texture_options)
 
 
 def read(path):

@@ -206,7 +206,7 @@ def run(command, *inputs, progress=None, notes="warn", **options):
     if st != _lib.BB_OK:
         if raised:
             raise raised[0]
-        raise _exception(st, _message(err, st))
+        raise _exception(st, c.prefixed(_message(err, st)))
     try:
         _dispatch_notes(heard, notes, stacklevel=2)
         return [(_text(result.files[i].kind), _text(result.files[i].path))

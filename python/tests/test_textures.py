@@ -288,7 +288,7 @@ def test_what_a_texture_cannot_hold_is_refused_before_any_work(tmp_path, fixture
             {"ssbump": tmp_path / "s.png"}, scale=8, vmt=tmp_path / "s.vmt")
     refused("one material", bumpbake.bake_files, [pit, pit], tmp_path / "out", scale=8,
             name="{stem}_{kind}.vtf", vmt=tmp_path / "s.vmt")
-    refused("give --vmt", bumpbake.bake_file, pit, {"ssbump": tmp_path / "s.png"}, scale=8,
+    refused("give vmt=FILE", bumpbake.bake_file, pit, {"ssbump": tmp_path / "s.png"}, scale=8,
             materials=tmp_path)
     assert os.listdir(tmp_path) == []
 

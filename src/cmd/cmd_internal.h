@@ -107,6 +107,7 @@ struct bb_command {
   char *record_line, *record_options;
   int checked;                       /* bb_command_check passed */
   int in_memory;                     /* images in memory, not files */
+  bb_spelling spelling;              /* how its messages name its options */
   unsigned memory_maps;              /* ... and the maps asked of them */
 };
 
@@ -131,6 +132,26 @@ void bb__option_spelling(const bb__option *o, char *out, size_t cap);
 /* The options given, " --name value" each, in the order of --help; only
  * those that determine the output with BB_OPTION_RECORDED (text.c). */
 void bb__add_options(const bb_command *c, unsigned flags, bb__text *t);
+
+/* message (capacity cap) with c's options spelled as c's client spells
+ * them (bb_command_set_spelling); nothing changes for the command line's
+ * spelling (spelling.c). */
+void bb__respell(const bb_command *c, char *message, size_t cap);
+/* st, after err's message is respelled when st is not BB_OK: every public
+ * call on a command returns through it. */
+bb_status bb__spelled(const bb_command *c, bb_status st, bb_error *err);
+
+/* hooks whose notes reach the caller respelled: h (kept alive by the
+ * caller for the call) or, for the command line's spelling or no note
+ * function, hooks itself. */
+typedef struct bb__spelled_hooks {
+  const bb_command *command;
+  const bb_command_hooks *caller;
+  bb_command_hooks hooks;
+} bb__spelled_hooks;
+const bb_command_hooks *bb__spelled_hooks_of(const bb_command *c,
+                                             const bb_command_hooks *hooks,
+                                             bb__spelled_hooks *h);
 
 /* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,

@@ -95,7 +95,8 @@ const char *bb_command_input(const bb_command *c, int i) {
 
 /* --------------------------------------------------------------- setting */
 
-bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_error *err) {
+static bb_status set_option(bb_command *c, const char *name, const char *text,
+                            bb_error *err) {
   if (!c || !name)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
   const int i = bb__option_find(c->def, name);
@@ -145,7 +146,7 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   return BB_OK;
 }
 
-bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
+static bb_status add_input(bb_command *c, const char *text, bb_error *err) {
   if (!c || !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no input given");
   if (c->def->add_input) {
@@ -236,7 +237,7 @@ static bb_status check_applies(const bb_command *c, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_command_check(bb_command *c, bb_error *err) {
+static bb_status check(bb_command *c, bb_error *err) {
   if (!c)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: none to check");
   bb_status st = c->in_memory ? BB_OK : check_inputs(c, err);
@@ -271,8 +272,8 @@ bb_status bb_command_set_record(bb_command *c, const char *line, const char *opt
 
 /* ------------------------------------------------------------------ plan */
 
-bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
-                          bb_error *err) {
+static bb_status plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
+                      bb_error *err) {
   if (!c || !job)
     return bb__fail(err, BB_ERR_ARGUMENT, "command plan: bad arguments");
   *job = NULL;
@@ -313,4 +314,24 @@ bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job *
   st = bb__job_plan((const char *const *)c->inputs, inputs, &o, 1, job, err);
   free(canonical);
   return st;
+}
+
+bb_status bb_command_set(bb_command *c, const char *name, const char *text,
+                         bb_error *err) {
+  return bb__spelled(c, set_option(c, name, text, err), err);
+}
+
+bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
+  return bb__spelled(c, add_input(c, text, err), err);
+}
+
+bb_status bb_command_check(bb_command *c, bb_error *err) {
+  return bb__spelled(c, check(c, err), err);
+}
+
+bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
+                          bb_error *err) {
+  /* (the job keeps hooks' note function past this call: a run respells
+   * its notes, bb_command_run) */
+  return bb__spelled(c, plan(c, hooks, job, err), err);
 }

@@ -388,3 +388,70 @@ Test(cmd, flags_set_their_field) {
   cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
   bb_command_free(c);
 }
+
+/* The same refusal, as the command line words it and as keyword arguments
+ * (Python, serve's page) read it: every option of the command respelled
+ * from its row, the value's name joined to its keyword, nothing else. */
+Test(cmd, refusals_are_spelled_in_the_clients_words) {
+  static const struct {
+    const char *const words[8];
+    const char *line, *keywords;
+  } cases[] = {
+      {{"h.png", "--scale", "8", "--bounce", "2", NULL},
+       "--bounce must be in 0..1 (got 2)",
+       "bounce must be in 0..1 (got 2)"},
+      {{"h.png", "--scale", "8", "--filter-radius", "9999", NULL},
+       "--filter-radius must be in 0..4096 (got 9999)",
+       "filter_radius must be in 0..4096 (got 9999)"},
+      {{"h.png", "--scale", "8", "--bounces", "3", "--normal", "n.png", NULL},
+       "--bounces does nothing without --bounce RHO or --bounce-albedo FILE",
+       "bounces does nothing without bounce=RHO or bounce_albedo=FILE"},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+    for (int keywords = 0; keywords < 2; keywords++) {
+      bb_command *c = NULL;
+      bb_error err = {{0}};
+      cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+      if (keywords)
+        bb_command_set_spelling(c, BB_SPELLING_KEYWORDS);
+      const char *const *w = cases[k].words;
+      cr_assert_eq(bb_command_add_input(c, w[0], &err), BB_OK);
+      for (int i = 1; w[i]; i += 2)
+        cr_assert_eq(bb_command_set(c, w[i] + 2, w[i + 1], &err), BB_OK, "%s",
+                     err.message);
+      cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
+      cr_expect_str_eq(err.message, keywords ? cases[k].keywords : cases[k].line);
+      bb_command_free(c);
+    }
+  /* the plan's refusals: a short option and its value's name; a path that
+   * holds an option's name stays as it is */
+  for (int keywords = 0; keywords < 2; keywords++) {
+    bb_command *c = NULL;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+    if (keywords)
+      bb_command_set_spelling(c, BB_SPELLING_KEYWORDS);
+    cr_assert_eq(bb_command_add_input(c, "/tmp/--normal/h.png", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "scale", "8", &err), BB_OK);
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    bb_job *job = NULL;
+    cr_expect_eq(bb_command_plan(c, NULL, &job, &err), BB_ERR_ARGUMENT);
+    cr_expect_str_eq(
+        err.message,
+        keywords ? "nothing to write: give output=PREFIX or at least one of "
+                   "normal, weights, ssbump, ao, bent, filtered, slope (or "
+                   "out_dir=DIR for a batch)"
+                 : "nothing to write: give -o PREFIX or at least one of --normal, "
+                   "--weights, --ssbump, --ao, --bent, --filtered, --slope (or "
+                   "--out-dir DIR for a batch)");
+    cr_assert_eq(bb_command_set(c, "normal", "/tmp/--normal/x.exr", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "mips", "1", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "depth", "8", &err), BB_OK);
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    cr_expect_eq(bb_command_plan(c, NULL, &job, &err), BB_ERR_ARGUMENT);
+    cr_expect(strstr(err.message, "/tmp/--normal/x.exr: "), "%s", err.message);
+    cr_expect(strstr(err.message, keywords ? " depth 8 " : " --depth 8 "), "%s",
+              err.message);
+    bb_command_free(c);
+  }
+}

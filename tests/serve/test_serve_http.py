@@ -89,11 +89,18 @@ def test_the_server_refuses(served):
     assert request(s.url, "DELETE")[0] == 405
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=0")
     assert status == 400 and "rays" in json.loads(body)["error"]
-    # a control's value is parsed by bake's option of its name: bake's words
+    # a control's value is parsed by bake's option of its name: bake's words,
+    # the option named as the control (as Python's keyword)
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?rays=x")
-    assert status == 400 and json.loads(body)["error"] == "--rays needs an integer (got 'x')"
+    assert status == 400 and json.loads(body)["error"] == "rays needs an integer (got 'x')"
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=8&bias=near")
-    assert status == 400 and json.loads(body)["error"] == "--bias needs a number (got 'near')"
+    assert status == 400 and json.loads(body)["error"] == "bias needs a number (got 'near')"
+    # a range in the same words as Python's bake(h, 8, bounce=2) and the CLI's
+    # --bounce 2: the bounce albedo is "bounce" everywhere
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?bounce=2")
+    assert status == 400 and json.loads(body)["error"] == "bake: bounce must be in 0..1 (got 2)"
+    status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=0")
+    assert status == 400 and json.loads(body)["error"] == "bake: scale must be > 0 (got 0)"
     status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?path=/etc/passwd")
     assert status == 400 and "unknown control" in json.loads(body)["error"]
     assert sorted(os.listdir(d)) == ["h.png"]  # nothing written unless asked

@@ -109,9 +109,10 @@ char *serve_state_json(serve_state *s) {
 /* --------------------------------------------------------------- controls */
 
 /* The bake controls: bake's options of these names (parsed by the library,
- * bb_command_set, which refuses a value with the words every client prints:
- * "--rays needs an integer (got 'x')"), and where each lands in the bake
- * options. brightness is serve's own switch. */
+ * bb_command_set, which refuses a value with the words every client prints,
+ * the option spelled as the control: "rays needs an integer (got 'x')"),
+ * and where each lands in the bake options. brightness is serve's own
+ * switch. */
 #define CONTROL(name, member) \
   {name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member)}
 static const struct {
@@ -166,6 +167,8 @@ int serve_apply_params(serve_state *s, const char *const *names, const char *con
     snprintf(err, cap, "%s", e.message);
     return -1;
   }
+  /* the page's controls bear the options' names: its refusals name them so */
+  bb_command_set_spelling(cmd, BB_SPELLING_KEYWORDS);
   int use_brightness = s->use_brightness;
   for (int i = 0; i < count; i++)
     if (apply_one(s, cmd, &use_brightness, names[i], values[i], err, cap) != 0) {
