@@ -2356,6 +2356,18 @@ typedef struct bb_compare_report {
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err);
 
+/* What bb_compare_files(a, b, ..., diff_path) will take, from the two
+ * headers alone, before a pixel is read: the memory at its peak (A held
+ * while B is read, then, with a diff, both, |A - B| and its encoder's
+ * copy), refused when it will not fit (BB_ERR_MEMORY: "A: comparing two
+ * 16384 x 16384 images of 4 channels needs about 12.6 GiB of memory; 2.4
+ * GiB is available (RLIMIT_AS)"), and said through note (may be NULL),
+ * naming a, when it is over BB_MAX_READ_BYTES ("comparing ... takes about
+ * 12.6 GiB of memory (20.1 GiB is available)"). bb_compare_files makes the
+ * same check first, without the note. Errors: the header reads'. */
+bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+                                 bb_note_fn note, void *note_user, bb_error *err);
+
 void bb_compare_report_free(bb_compare_report *report);
 
 /* idiff's exit code for a report, which `bumpbake compare` exits with: the

@@ -738,6 +738,8 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
 const char *bb_height_source_channel(const bb_height_source *source);
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err);
+bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+                                 bb_note_fn note, void *note_user, bb_error *err);
 void bb_compare_report_free(bb_compare_report *report);
 int bb_compare_report_exit_code(const bb_compare_report *report);
 const char *bb_compare_report_result(const bb_compare_report *report);

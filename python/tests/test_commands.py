@@ -265,6 +265,40 @@ def test_an_array_bake_is_cancelled_by_its_progress_and_by_ctrl_c():
         signal.signal(signal.SIGALRM, old)
 
 
+def test_ctrl_c_stops_a_bounce_bake_inside_a_slice():
+    """Ctrl-C during a bake with bounce: a bounce pass's slice at 1024 x
+    1024 takes seconds (2048 x 2048 took 18 s to stop), so its line sweeps
+    ask the progress every 50 ms, as a stage without progress does; the
+    bake stops within a bundle of lines. Measured in CPU time from the
+    moment the interrupt is armed (0.3 s before it comes), which load does
+    not stretch: the rest of a slice took several seconds of it."""
+    h = np.random.default_rng(5).random((1024, 1024), np.float32)
+    armed = []
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    def progress(done, total):
+        # the trace and the bounce's direct pass are done: the passes of
+        # long slices have started
+        if done * 7 >= total and not armed:
+            armed.append(os.times())
+            signal.setitimer(signal.ITIMER_REAL, 0.3)
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            bumpbake.bake(h, 16, rays=16, bounce=0.5, outputs=("ao",), progress=progress,
+                          threads=2)
+        stopped = os.times()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert armed
+    cpu = (stopped.user - armed[0].user) + (stopped.system - armed[0].system)
+    assert cpu < 3.0, f"{cpu:.1f} s of CPU from arming Ctrl-C to the stop"
+
+
 @needs_cli
 def test_nan_normals_are_refused_by_python_and_the_cli(tmp_path):
     n = np.zeros((8, 8, 3), np.float32)

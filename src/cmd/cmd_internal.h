@@ -153,6 +153,10 @@ const bb_command_hooks *bb__spelled_hooks_of(const bb_command *c,
                                              const bb_command_hooks *hooks,
                                              bb__spelled_hooks *h);
 
+/* A note, through hooks, of what a render of files will cost when that is
+ * over what any read takes (bb__memory_note): said before it starts. */
+void bb__render_cost_note(const bb_command *c, const bb_command_hooks *hooks);
+
 /* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,
                          bb_error *err);

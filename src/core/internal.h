@@ -202,6 +202,13 @@ bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char 
  * (MemAvailable)". BB_OK when nothing can be known. */
 bb_status bb__memory_check(double need, const char *what, bb_error *err);
 
+/* What a job that fits will cost, to say before it starts: "WHAT takes
+ * about 8.0 GiB of memory (20.9 GiB is available)" into out (cap bytes)
+ * and 1 when need is over BB_MAX_READ_BYTES (what any read may take
+ * whatever its size: past it, only a large input costs that much and a
+ * while), else 0 and out empty. */
+int bb__memory_note(double need, const char *what, char *out, size_t cap);
+
 /* (text.c, beside bb__text_append and bb__text_add) */
 void bb__text_printf(bb__text *t, const char *fmt, ...)
 #if defined(__GNUC__)

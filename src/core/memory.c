@@ -289,3 +289,18 @@ bb_status bb__memory_check(double need, const char *what, bb_error *err) {
   return bb__fail(err, BB_ERR_MEMORY, "%s needs about %s of memory; %s is available (%s)",
                   what, a, b, source);
 }
+
+int bb__memory_note(double need, const char *what, char *out, size_t cap) {
+  if (cap)
+    out[0] = '\0';
+  if (need <= (double)BB_MAX_READ_BYTES || !cap)
+    return 0;
+  char a[32], b[32] = "";
+  size_text(need, a, sizeof a);
+  uint64_t room = 0;
+  if (bb_memory_available(&room, NULL, NULL) == BB_OK)
+    size_text((double)room, b, sizeof b);
+  snprintf(out, cap, "%s takes about %s of memory%s%s%s", what, a, b[0] ? " (" : "", b,
+           b[0] ? " is available)" : "");
+  return 1;
+}

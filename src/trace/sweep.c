@@ -1213,14 +1213,15 @@ static bb_status check_dir(const bb__sweep_dir *dir, int hooked, bb_error *err) 
 bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
                           const bb__sweep_dir *opposite, double bias, int threads,
                           long long_line, bb_error *err) {
-  return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL, NULL,
-                                err);
+  return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL,
+                                NULL, NULL, err);
 }
 
-bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
                                  const bb__sweep_dir *opposite, double bias, int threads,
                                  long long_line, bb__line_hook hook, void *hook_ctx,
-                                 bb_error *err) {
+                                 const bb__checkpoint *checkpoint, bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
@@ -1268,7 +1269,8 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sw
     if (!job.scratch) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
     if (st == BB_OK) {
       for (int i = 0; i < job.scratch_count; i++) atomic_flag_clear(&job.scratch[i].busy);
-      st = bb__parallel_for(bundles, threads, sweep_bundle, &job, NULL, NULL, err);
+      st =
+          bb__parallel_for_checked(bundles, threads, sweep_bundle, &job, checkpoint, err);
       for (int i = 0; i < job.scratch_count; i++) scratch_release(&job.scratch[i]);
     }
     free(job.scratch);

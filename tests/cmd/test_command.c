@@ -2,13 +2,18 @@
  * through their parsers, their ranges checked against the library's one
  * range each, the rules between options, the command spelled back as text
  * (what provenance records, and a hand-over that reads back the same). */
+#define _XOPEN_SOURCE 700 /* mkdtemp */
+
 #include "bumpbake.h"
+#include "cmd/cmd_internal.h"
+#include "hostile_headers.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static bb_command *command(const char *name, const char *const *words) {
   bb_command *c = NULL;
@@ -454,4 +459,43 @@ Test(cmd, refusals_are_spelled_in_the_clients_words) {
               err.message);
     bb_command_free(c);
   }
+}
+
+/* A render of large maps says what it will take before it reads them (the
+ * note of bb_command_run's hooks), as a comparison does: a 4096 x 8192
+ * map of RGBA floats (a 148-byte DDS header, the rest a hole) is 1.1 GiB
+ * to render; a small one says nothing. */
+static void keep_note(void *user, const char *path, const char *text) {
+  snprintf(user, 512, "%s: %s", path, text);
+}
+
+Test(cmd, a_large_render_says_its_cost_before_it_starts) {
+  char dir[] = "/tmp/bb-render-cost-XXXXXX";
+  cr_assert_not_null(mkdtemp(dir));
+  char big[64], small[64], out[64];
+  snprintf(big, sizeof big, "%s/n.dds", dir);
+  snprintf(small, sizeof small, "%s/s.dds", dir);
+  snprintf(out, sizeof out, "%s/r.png", dir);
+  cr_assert_eq(write_dds_float_header(big, 4096, 8192), 0);
+  cr_assert_eq(write_dds_float_header(small, 64, 64), 0);
+  for (int k = 0; k < 2; k++) {
+    bb_command *c =
+        command("render", (const char *const[]){"--normal", k ? small : big, "--mode",
+                                                "normal", "--output", out, NULL});
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    char note[512] = "";
+    const bb_command_hooks hooks = {.note = keep_note, .note_user = note};
+    bb__render_cost_note(c, &hooks);
+    if (k)
+      cr_expect_str_empty(note);
+    else
+      cr_expect(
+          strstr(note, "/r.png: a 4096 x 8192 render takes about 1.1 GiB of memory ("),
+          "%s", note);
+    bb_command_free(c);
+  }
+  unlink(big);
+  unlink(small);
+  rmdir(dir);
 }
