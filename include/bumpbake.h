@@ -2962,6 +2962,16 @@ bb_status bb_command_from_handover(const char *data, size_t size, const char *co
 bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
                                 bb_error *err);
 
+/* The command line the file path records when the command writes its map
+ * to several files (bake --ssbump s.png --ssbump s.vtf: one bake, each file
+ * in its format): a command-line client gives the words as typed less
+ * those of the map's other files, so each file records what a bake of it
+ * alone records. Without one, such a file records the command as
+ * bb_command_text spells it with only that file for its map. Errors:
+ * BB_ERR_MEMORY. */
+bb_status bb_command_set_record_of(bb_command *command, const char *path,
+                                   const char *line, bb_error *err);
+
 /* What a caller hooks into a command's run; every field may be NULL. */
 typedef struct bb_command_hooks {
   bb_note_fn note;      /* notes about the inputs */

@@ -295,7 +295,7 @@ static const bb__option opt_brightness = {
   {.info = {.name = (name_), .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,    \
             .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,      \
             .help = (help_)},                                                              \
-   .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_])}
+   .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_]), .repeats = 1}
 static const bb__option opt_out_normal =
     ROW_MAP_OUT("normal", BB_MAP_NORMAL, "write the normal map");
 static const bb__option opt_out_weights =
@@ -643,6 +643,9 @@ const bb__command bb__command_bake = {
                  "With --clamp the trace takes 2.3 to 3.4 times as long. See\n"
                  "docs/performance.md and docs/accuracy.md.\n"
                  "\n"
+                 "A map option given again writes the bake's map to a further file, in\n"
+                 "its own format: --ssbump s.png --ssbump s.vtf traces once.\n"
+                 "\n"
                  "Batches: bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST]\n"
                  "bakes every HEIGHT (a directory: the images in it, sorted, not below it)\n"
                  "in one process into DIR/--name, and skips an input whose outputs are\n"
@@ -658,7 +661,7 @@ static const bb__option opt_normal_output = {
     .info = {.name = "output", .short_name = 'o', .value_name = "OUT", .type = BB_OPTION_PATH,
              .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_REQUIRED | BB_OPTION_FILES,
              .help = "normal map to write (.png .tga .tif .exr); required"},
-    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL])};
+    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL]), .repeats = 1};
 
 static const bb__option opt_quiet_normal = {
     .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,

@@ -64,6 +64,10 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
     snprintf(reason, cap, "a slope map is asked");
     return 0;
   }
+  if (item->more_count) { /* nor a map's further files: baked every time */
+    snprintf(reason, cap, "a map is written to several files");
+    return 0;
+  }
   bb_bake_options o = job->options.bake;
   char rayset[64];
   bb_bake_rayset_id(&o, rayset, sizeof rayset);
@@ -295,21 +299,26 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
-  for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++) {
-    if (!item->paths[k])
-      continue;
-    b->descriptions[n] = describe(job, command, b, r, kind_info(k)->name);
-    files[n] = (bb_output_file){item->paths[k],
-                                kind_info(k)->name,
-                                bb_bake_result_image(&b->result, (bb_map_kind)k),
-                                kind_info(k)->range,
-                                output_depth(job, k, item->paths[k], r->source.bits_per_sample,
-                                             r->source.is_float),
-                                job->options.mips,
-                                b->descriptions[n],
-                                NULL,
-                                0,
-                                &job->options.texture};
+  /* every file of every map, a map written to several files from the one
+   * bake, each recording its own command where it has one */
+  int kinds[BB_JOB_MAX_OUTPUTS];
+  const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+  const int map_files = bb__job_map_files(item, kinds, paths, commands);
+  for (int f = 0; f < map_files && st == BB_OK; f++) {
+    const int k = kinds[f];
+    b->descriptions[n] =
+        describe(job, commands[f] ? commands[f] : command, b, r, kind_info(k)->name);
+    files[n] = (bb_output_file){
+        paths[f],
+        kind_info(k)->name,
+        bb_bake_result_image(&b->result, (bb_map_kind)k),
+        kind_info(k)->range,
+        output_depth(job, k, paths[f], r->source.bits_per_sample, r->source.is_float),
+        job->options.mips,
+        b->descriptions[n],
+        NULL,
+        0,
+        &job->options.texture};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }

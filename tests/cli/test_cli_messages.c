@@ -186,12 +186,88 @@ Test(cli_messages, a_material_outside_materials_names_the_option) {
                          "name the game's materials folder with --materials DIR", 0);
 }
 
-/* A map named twice is a usage error before any bake, not a file dropped. */
-Test(cli_messages, a_map_named_twice_is_a_usage_error) {
+/* The bytes of path, or NULL (*size then 0). */
+static unsigned char *bytes_of(const char *path, size_t *size) {
+  *size = 0;
+  FILE *f = fopen(path, "rb");
+  if (!f)
+    return NULL;
+  unsigned char *data = malloc(1 << 20);
+  cr_assert_not_null(data);
+  *size = fread(data, 1, 1 << 20, f);
+  fclose(f);
+  return data;
+}
+
+static void expect_same_bytes(const char *a, const char *b) {
+  size_t na, nb;
+  unsigned char *da = bytes_of(a, &na), *db = bytes_of(b, &nb);
+  cr_expect(da && db && na && na == nb && !memcmp(da, db, na),
+            "%s (%zu bytes) != %s (%zu)", a, na, b, nb);
+  free(da);
+  free(db);
+}
+
+/* A map named twice is written to both files from one bake, each in its
+ * format and each the bytes a bake of it alone writes (its provenance
+ * records the command less the map's other file); the other maps record
+ * the command as typed. */
+Test(cli_messages, a_map_named_twice_is_written_to_both_from_one_bake) {
   dome(tmp("h.png"), 1, BB_DEPTH_16);
-  const char *args[] = {"bake",       tmp("h.png"), "--scale",    "4", "--ssbump",
-                        tmp("s.png"), "--ssbump",   tmp("s.vtf"), NULL};
-  harness_expect_refusal(NULL, args, 2, "--ssbump is given twice", 0);
+  cr_assert_eq(mkdir(tmp("both"), 0700), 0);
+  cr_assert_eq(mkdir(tmp("one"), 0700), 0);
+  const char *h = tmp("h.png");
+  cli_result r = RUN_IN(tmp("both"), "bake", h, "--scale", "4", "--rays", "4", "--ssbump",
+                        "s.png", "--normal", "n.png", "--ssbump=s.vtf", "--json");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "\"s.png\"") && strstr(r.out, "\"s.vtf\""), "%s", r.out);
+  cli_result_free(&r);
+  r = RUN_IN(tmp("one"), "bake", h, "--scale", "4", "--rays", "4", "--ssbump", "s.png",
+             "--normal", "n.png", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN_IN(tmp("one"), "bake", h, "--scale", "4", "--rays", "4", "--normal", "n.png",
+             "--ssbump=s.vtf", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  expect_same_bytes(tmp("both/s.png"), tmp("one/s.png"));
+  expect_same_bytes(tmp("both/s.vtf"), tmp("one/s.vtf"));
+  bb_image_info info;
+  bb_image n = harness_read(tmp("both/n.png"), &info);
+  char command[512];
+  snprintf(command, sizeof command,
+           "\ncommand=bumpbake bake %s --scale 4 --rays 4 --ssbump s.png --normal n.png "
+           "--ssbump=s.vtf\n",
+           h);
+  cr_expect(info.description && strstr(info.description, command), "%s",
+            info.description ? info.description : "(none)");
+  bb_image_info_free(&info);
+  bb_image_free(&n);
+  /* the same name twice is one file; a batch names its maps by --maps */
+  r = RUN_IN(tmp("both"), "bake", h, "--scale", "4", "--rays", "4", "--ao", "a.png",
+             "--ao", "a.png");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(harness_lines(r.out), 1, "%s", r.out);
+  cli_result_free(&r);
+  const char *batch[] = {"bake", h,       "--scale", "4",     "--out-dir", tmp("o"),
+                         "--ao", "a.png", "--ao",    "b.png", NULL};
+  harness_expect_refusal(NULL, batch, 2, "--out-dir names the outputs", 0);
+}
+
+/* Ten files at most, said before any bake. */
+Test(cli_messages, a_map_written_to_too_many_files_is_a_usage_error) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  const char *args[32] = {"bake", tmp("h.png"), "--scale", "4", "--normal", tmp("n.png")};
+  int n = 6;
+  char names[10][16];
+  for (int i = 0; i < 10; i++) {
+    snprintf(names[i], sizeof names[i], "%d.png", i);
+    args[n++] = "--ao";
+    args[n++] = tmp(names[i]);
+  }
+  args[n] = NULL;
+  harness_expect_refusal(NULL, args, 2, "a bake writes at most 10 files", 0);
+  cr_expect_not(file_exists(tmp("n.png")));
 }
 
 /* combine takes -q as every command that writes files does: the wrote
