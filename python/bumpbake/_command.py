@@ -11,7 +11,7 @@ mistyped keyword gives the library's nearest option ("did you mean").
 Python values become the option's text by its type: a flag takes True
 (False or None: not given), numbers are spelled exactly (repr), a word
 list or several numbers take a sequence, a path str, bytes or
-os.PathLike.
+os.PathLike (a map's file option a list of them: one bake, one file each).
 """
 
 import numbers
@@ -212,6 +212,16 @@ class Command:
                 raise TypeError(f"{self.function}: {key} must be True or False (got {_shown(value)})")
             if not value:
                 return
+        if o.type == _lib.BB_OPTION_PATH and isinstance(value, (list, tuple)) and value:
+            # several files: the option given once per file, as the command
+            # line gives it (a map written to each; the library refuses a
+            # second file where an option names one)
+            for one in value:
+                if isinstance(one, (list, tuple)):
+                    raise TypeError(f"{self.function}: {key} must be a path or a list of "
+                                    f"paths (got {_shown(value)})")
+                self.set(key, one, skip_default)
+            return
         text = _spell(o, value, f"{self.function}: {key}")
         if skip_default and text is not None:
             buf = _ffi.new("char[256]")

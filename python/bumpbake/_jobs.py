@@ -24,7 +24,8 @@ class BakeReport:
     """What became of one input of a bake (bumpbake.bake_files, BakeJob)."""
     input: str             # the path as planned (a directory's file: DIR/NAME)
     status: str            # "pending", "baked", "up to date", "failed", "not run"
-    outputs: dict          # {kind: path} it writes ("normal", ..., "slope", "slope_lit")
+    outputs: dict          # {kind: path} it writes ("normal", ..., "slope", "slope_lit");
+                           # a map written to several files: {kind: [path, ...]}
     error: typing.Optional[str] = None         # why it failed: "PATH: reason"
     error_status: typing.Optional[str] = None  # the bb_status name of the failure
     reason: typing.Optional[str] = None  # why its outputs were not up to date
@@ -50,10 +51,16 @@ class BakeReport:
 
 
 def _report(r, status=None):
+    outputs = {}
+    for k in range(r.output_count):  # a map written to several files: a list of them
+        kind, path = _text(r.outputs[k].kind), _text(r.outputs[k].path)
+        was = outputs.get(kind)
+        if was is None:
+            outputs[kind] = path
+        else:
+            outputs[kind] = (was if isinstance(was, list) else [was]) + [path]
     out = BakeReport(input=_text(r.input), status=status or _OUTCOMES[r.outcome],
-                     outputs={_text(r.outputs[k].kind): _text(r.outputs[k].path)
-                              for k in range(r.output_count)},
-                     _bytes=bytes(_ffi.buffer(r)))
+                     outputs=outputs, _bytes=bytes(_ffi.buffer(r)))
     out.reason = _text(r.reason) or None
     if r.outcome == _lib.BB_JOB_FAILED:
         out.error = _message(r.error, r.status)
@@ -380,7 +387,8 @@ def bake_file(input, outputs=None, *, prefix=None, slope=None, lit=None, depfile
     """Bakes one height file into the files named, as `bumpbake bake INPUT
     --normal FILE ...` does, and returns its BakeReport.
 
-    outputs: {kind: path} for kinds of OUTPUTS; prefix: also PREFIX_normal.png,
+    outputs: {kind: path} for kinds of OUTPUTS (a list of paths: the map
+    written to each, in its format, from the one bake); prefix: also PREFIX_normal.png,
     PREFIX_ssbump.png and PREFIX_ao.png where not named (bake's -o);
     slope: flipcode's slope map (8-bit .png .tga .tif) and lit=(azimuth,
     elevation) its lit preview, written as SLOPE_lit.EXT. force (default

@@ -202,6 +202,48 @@ def test_a_bounce_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch):
 
 
 @needs_cli
+def test_a_map_written_to_several_files_is_one_bake_and_the_clis(tmp_path, monkeypatch):
+    """A list of paths for a map's keyword writes the map to each file,
+    each in its format, from one bake: run() and bake_file() write the
+    command line's bytes, and each file is what a bake of it alone writes."""
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), "rock.png")
+    settings = dict(scale=8, rays=4)
+    for d in ("py", "cli", "alone", "file"):
+        os.makedirs(d)
+    monkeypatch.chdir(tmp_path / "py")
+    wrote = bumpbake.run("bake", "../rock.png", normal="n.png",
+                         ssbump=["s.png", "s.tga", "s.vtf"], **settings)
+    assert wrote == [("normal", "n.png"), ("ssbump", "s.png"), ("ssbump", "s.tga"),
+                     ("ssbump", "s.vtf")]
+    done = cli("bake", "../rock.png", "--scale", "8", "--rays", "4", "--normal", "n.png",
+               "--ssbump", "s.png", "--ssbump", "s.tga", "--ssbump", "s.vtf",
+               cwd=tmp_path / "cli")
+    assert done.returncode == 0, done.stderr
+    monkeypatch.chdir(tmp_path / "alone")
+    for name in ("s.png", "s.tga", "s.vtf"):
+        bumpbake.run("bake", "../rock.png", normal="n.png", ssbump=name, **settings)
+    monkeypatch.chdir(tmp_path / "file")
+    outputs = {"normal": "n.png", "ssbump": ["s.png", "s.vtf"]}
+    report = bumpbake.bake_file("../rock.png", outputs, **settings)
+    assert report.outputs == {"normal": "n.png", "ssbump": ["s.png", "s.vtf"]}
+    monkeypatch.chdir(tmp_path)
+    ours, theirs, alone = files_of("py"), files_of("cli"), files_of("alone")
+    assert sorted(ours) == ["n.png", "s.png", "s.tga", "s.vtf"] == sorted(theirs)
+    assert [k for k in ours if ours[k] != theirs[k]] == []
+    assert [k for k in ("s.png", "s.tga", "s.vtf") if ours[k] != alone[k]] == []
+    made = files_of("file")
+    assert sorted(made) == ["n.png", "s.png", "s.vtf"]
+    assert made["s.png"] == alone["s.png"] and made["s.vtf"] == alone["s.vtf"]
+    assert b"--ssbump s.png --ssbump s.tga --ssbump s.vtf" in ours["n.png"]
+    with pytest.raises(bumpbake.ArgumentError, match="basetexture is given twice"):
+        bumpbake.run("bake", "rock.png", ssbump="x.png", basetexture=["a.vtf", "b.vtf"],
+                     **settings)
+    with pytest.raises(TypeError, match="ssbump must be a path or a list of paths"):
+        bumpbake.run("bake", "rock.png", ssbump=["x.png", ["y.png"]], **settings)
+
+
+@needs_cli
 def test_a_relief_render_is_the_clis(tmp_path, monkeypatch):
     """render --relief from Python: run() writes the command line's bytes;
     render(height=...) gives its pixels."""
