@@ -89,6 +89,8 @@ struct bb__command {
   /* its run when it makes one map or picture (render, sheet, the map
    * commands): read and make here, write through the job (job/output.c) */
   bb__run_fn run;
+  /* notes said before run starts (what it will cost); NULL: none */
+  void (*before_run)(const bb_command *c, const bb_command_hooks *hooks);
 };
 
 /* The most options one command has. */
@@ -167,10 +169,6 @@ typedef struct bb__spelled_hooks {
 const bb_command_hooks *bb__spelled_hooks_of(const bb_command *c,
                                              const bb_command_hooks *hooks,
                                              bb__spelled_hooks *h);
-
-/* A note, through hooks, of what a render of files will cost when that is
- * over what any read takes (bb__memory_note): said before it starts. */
-void bb__render_cost_note(const bb_command *c, const bb_command_hooks *hooks);
 
 /* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,

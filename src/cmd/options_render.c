@@ -322,7 +322,9 @@ static void render_files(const bb_command *c, bb_render_sources *files,
                   (traced ? BB_MAPS_TRACED : 0u);
 }
 
-void bb__render_cost_note(const bb_command *c, const bb_command_hooks *hooks) {
+/* A note, through hooks, of what a render of files will cost when that is
+ * over what any read takes (bb__memory_note): said before it starts. */
+static void render_cost_note(const bb_command *c, const bb_command_hooks *hooks) {
   if (!hooks || !hooks->note || c->in_memory)
     return;
   bb_render_sources files;
@@ -440,7 +442,8 @@ const bb__command bb__command_render = {
                  "already baked\n(--normal-y up: those files are OpenGL-style).",
              .inputs = "HEIGHT", .min_inputs = 0, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof render_options / sizeof render_options[0]) - 1},
-    .options = render_options, .init = render_init, .check = render_check, .run = bb__run_render};
+    .options = render_options, .init = render_init, .check = render_check, .run = bb__run_render,
+    .before_run = render_cost_note};
 
 /* ------------------------------------------------------------- sheet */
 

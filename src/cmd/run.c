@@ -38,8 +38,11 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks, bb_command_re
   bb_status st;
   if (c->def->job)
     st = run_job(c, hooks, r, err);
-  else if (c->def->run)
+  else if (c->def->run) {
+    if (c->def->before_run)
+      c->def->before_run(c, hooks);
     st = c->def->run(c, hooks, r, err);
+  }
   else
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s writes no file to run", c->def->info.name);
   if (st != BB_OK)

@@ -273,7 +273,6 @@ bb_status bb__run_render(bb_command *c, const bb_command_hooks *hooks, bb_comman
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   render_inputs in;
   memset(&in, 0, sizeof in);
-  bb__render_cost_note(c, hooks);
   bb_status st = a.height_path ? bake_height(&a, &in, err) : load_maps(&a, &in, err);
   if (st == BB_OK)
     st = load_albedo(&a, &in, err);
