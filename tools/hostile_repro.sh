@@ -884,19 +884,20 @@ fi
 
 # 42.3: a cgroup's page cache counted as used: with a 3.0 GB limit and
 # 2.74 GB used, 2.17 GB of it active_file, a 4096^2 bake was refused. Here
-# a 700 MB file is read inside a 1 GB cgroup (its pages then the group's
-# cache), then a 4096^2 bake (about 640 MB) must run.
+# a 700 MB file is written and read inside a 1 GB cgroup (its pages the group's
+# cache, active once read again: pages are the group's that first brought
+# them in), then a 4096^2 bake (about 300 MB) must run.
 begin 42.3 "bake 4096^2 in a 1 GB cgroup whose page cache holds 700 MB"
 hx make flat_png h4096.png 4096 4096
-head -c 734003200 /dev/urandom >"$W/big/cache.bin"
-fill_then_bake='cat "$0" >/dev/null && cat "$0" >/dev/null && exec "$@"'
+fill_then_bake='head -c 734003200 /dev/urandom >"$0" && cat "$0" >/dev/null &&
+  cat "$0" >/dev/null && exec "$@"'
 if command -v systemd-run >/dev/null 2>&1 && systemd-run --scope -q -p MemoryMax=1G true 2>/dev/null; then
   TLIM=120 run systemd-run --scope -q -p MemoryMax=1G sh -c "$fill_then_bake" "$W/big/cache.bin" \
     "$BIN" bake h4096.png --scale 8 --rays 16 --normal n.png -q
   WANT=ok TMAX=60 MMAX=1024 ALLOW='^n\.png$' finish
 elif make_memory_cgroup 1073741824; then
-  TLIM=120 run sh -c 'echo $$ >"$0/cgroup.procs" && cat "$1" >/dev/null && cat "$1" >/dev/null &&
-    shift && exec "$@"' \
+  TLIM=120 run sh -c 'echo $$ >"$0/cgroup.procs" && head -c 734003200 /dev/urandom >"$1" &&
+    cat "$1" >/dev/null && cat "$1" >/dev/null && shift && exec "$@"' \
     "$cgroup_dir" "$W/big/cache.bin" "$BIN" bake h4096.png --scale 8 --rays 16 --normal n.png -q
   rmdir "$cgroup_dir" 2>/dev/null
   WANT=ok TMAX=60 MMAX=1024 ALLOW='^n\.png$' finish
@@ -963,6 +964,32 @@ begin 42.5b "render --normal big.dds --mode normal -o r.png"
 run "$BIN" render --normal "$W/big/big.dds" --mode normal -o r.png
 TMAX=3 MMAX=300 MSG="render needs about" finish
 rm -f "$W/big/big.dds"
+
+# Within the address space (8192^2: about 3.2 GiB to compare, 2.1 GiB to
+# render) the cost is said before the work starts; Ctrl-C 3 s in then ends
+# it with nothing written.
+"$PY" -c 'import struct, sys
+w = h = 8192
+b = b"DDS " + struct.pack("<7I", 124, 0x1007, h, w, w * 16, 0, 1) + b"\0" * 44
+b += struct.pack("<II4s5I", 32, 4, b"DX10", 0, 0, 0, 0, 0) + struct.pack("<5I", 0x1000, 0, 0, 0, 0)
+b += struct.pack("<5I", 2, 3, 0, 1, 0)
+open(sys.argv[1], "wb").write(b)' "$W/big/mid.dds"
+truncate -s $((148 + 8192 * 8192 * 16)) "$W/big/mid.dds"
+said_first='import select, signal, subprocess, sys, time
+child = subprocess.Popen(sys.argv[1:], stderr=subprocess.PIPE, text=True)
+ready = select.select([child.stderr], [], [], 3)[0]
+line = child.stderr.readline().strip() if ready else ""
+child.send_signal(signal.SIGINT)
+child.communicate()
+print("said first: %s; exit %d" % (line or "nothing in 3 s", child.returncode))
+sys.exit(0 if " takes about " in line and child.returncode != 0 else 1)'
+begin 42.5c "compare mid.dds mid.dds (8192^2 RGBA32F): its cost said first"
+run "$PY" -c "$said_first" "$BIN" compare "$W/big/mid.dds" "$W/big/mid.dds"
+WANT=ok TMAX=15 MMAX=4000 finish
+begin 42.5d "render --normal mid.dds -o r.png: its cost said first"
+run "$PY" -c "$said_first" "$BIN" render --normal "$W/big/mid.dds" --mode normal -o r.png
+WANT=ok TMAX=15 MMAX=4000 finish
+rm -f "$W/big/mid.dds"
 
 # ---------------------------------------------------- 32: the cluster path
 
