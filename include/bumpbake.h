@@ -2437,6 +2437,18 @@ typedef struct bb_compare_report {
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err);
 
+/* What bb_compare_files(a, b, ..., diff_path) will take, from the two
+ * headers alone, before a pixel is read: the memory at its peak (A held
+ * while B is read, then, with a diff, both, |A - B| and its encoder's
+ * copy), refused when it will not fit (BB_ERR_MEMORY: "A: comparing two
+ * 16384 x 16384 images of 4 channels needs about 12.6 GiB of memory; 2.4
+ * GiB is available (RLIMIT_AS)"), and said through note (may be NULL),
+ * naming a, when it is over BB_MAX_READ_BYTES ("comparing ... takes about
+ * 12.6 GiB of memory (20.1 GiB is available)"). bb_compare_files makes the
+ * same check first, without the note. Errors: the header reads'. */
+bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+                                 bb_note_fn note, void *note_user, bb_error *err);
+
 void bb_compare_report_free(bb_compare_report *report);
 
 /* idiff's exit code for a report, which `bumpbake compare` exits with: the
@@ -2910,7 +2922,9 @@ typedef enum bb_option_mode {
                                       kept in the provenance's command; the others
                                       (-q, --json, --threads, --depfile...) are not */
 #define BB_OPTION_CLIENT 0x2u      /* how a command-line client prints (--help, --json,
-                                      -q): nothing for the library to do */
+                                      -q) or where it runs the command (bake
+                                      --scheduler): nothing for the library's run
+                                      to do, and no keyword of Python's */
 #define BB_OPTION_SINGLE_DASH 0x4u /* also spelled with one dash (idiff's -fail,
                                       DOOM 3's -size) */
 #define BB_OPTION_REQUIRED 0x8u    /* the command refuses to run without it */
@@ -3103,6 +3117,20 @@ bb_status bb_command_check(bb_command *command, bb_error *err);
  * map). Call before bb_command_check. */
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
 
+/* How a command's messages name its options: as the command line spells
+ * them (the default), or as keyword arguments, for a client that takes its
+ * options so (Python; a page whose controls bear the options' names). */
+typedef enum bb_spelling {
+  BB_SPELLING_COMMAND_LINE = 0, /* "--filter-radius", "give -o PREFIX" */
+  BB_SPELLING_KEYWORDS          /* "filter_radius", "give output=PREFIX" */
+} bb_spelling;
+
+/* Sets how the messages of command's calls (bb_command_set, _check, _plan,
+ * _run, _picture, _renderbump, and the notes of their hooks) name the
+ * command's options: the library words each refusal once, and the option
+ * rows know both spellings. */
+void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
+
 /* 1 when option name was set. */
 int bb_command_given(const bb_command *command, const char *name);
 /* The options as set (defaults elsewhere); owned by command. */
@@ -3147,6 +3175,16 @@ bb_status bb_command_from_handover(const char *data, size_t size, const char *co
  * Either may be NULL. Errors: BB_ERR_MEMORY. */
 bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
                                 bb_error *err);
+
+/* The command line the file path records when the command writes its map
+ * to several files (bake --ssbump s.png --ssbump s.vtf: one bake, each file
+ * in its format): a command-line client gives the words as typed less
+ * those of the map's other files, so each file records what a bake of it
+ * alone records. Without one, such a file records the command as
+ * bb_command_text spells it with only that file for its map. Errors:
+ * BB_ERR_MEMORY. */
+bb_status bb_command_set_record_of(bb_command *command, const char *path,
+                                   const char *line, bb_error *err);
 
 /* What a caller hooks into a command's run; every field may be NULL. */
 typedef struct bb_command_hooks {

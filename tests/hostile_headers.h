@@ -74,6 +74,36 @@ static inline int write_dds_header(const char *path, uint32_t width, uint32_t he
   return hostile_write(path, b, sizeof b);
 }
 
+/* A DDS of width x height in DX10's R32G32B32A32_FLOAT (a 148-byte
+ * header), its file made as long as its samples by a hole (sparse: it
+ * costs no disk), so every read accepts it: 4 GiB for 16384 x 16384. */
+static inline int write_dds_float_header(const char *path, uint32_t width,
+                                         uint32_t height) {
+  unsigned char b[148];
+  memset(b, 0, sizeof b);
+  memcpy(b, "DDS ", 4);
+  hostile_put32(b + 4, 124);    /* dwSize */
+  hostile_put32(b + 8, 0x100F); /* CAPS | HEIGHT | WIDTH | PITCH | PIXELFORMAT */
+  hostile_put32(b + 12, height);
+  hostile_put32(b + 16, width);
+  hostile_put32(b + 20, width * 16); /* pitch */
+  hostile_put32(b + 28, 1);          /* mip levels */
+  hostile_put32(b + 76, 32);         /* the pixel format: its size, */
+  hostile_put32(b + 80, 0x4);        /* FOURCC, */
+  memcpy(b + 84, "DX10", 4);
+  hostile_put32(b + 108, 0x1000); /* caps: a texture */
+  hostile_put32(b + 128, 2);      /* DXGI_FORMAT_R32G32B32A32_FLOAT */
+  hostile_put32(b + 132, 3);      /* a 2D texture */
+  hostile_put32(b + 140, 1);      /* one in the array */
+  FILE *f = fopen(path, "wb");
+  if (!f)
+    return -1;
+  int ok = fwrite(b, 1, sizeof b, f) == sizeof b &&
+           fseeko(f, (off_t)sizeof b + (off_t)width * height * 16 - 1, SEEK_SET) == 0 &&
+           fputc(0, f) == 0;
+  return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 /* A progressive JPEG (SOF2) of one component declaring width x height: a
  * quantisation table, a one-code Huffman table and a DC scan of 8 zero
  * bytes (126 bytes). libjpeg buffers a progressive image whole, 2 bytes a

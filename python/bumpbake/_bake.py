@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _command
 from ._common import (_argument_error, _array, _c_text, _check, _exception, _ffi, _Image, _lib,
-                      _message, _parse, _path, _progress_hook, _text)
+                      _message, _parse, _path, _progress_hook, _shown, _text)
 
 
 def _output_kind_table():
@@ -61,7 +61,7 @@ BAKE_PARAMETERS = tuple(k for k in _command.keywords("bake", files=False)
 def _normal_y_up(command, normal_y):
     """normal_y ("down" or "up") by the library's parser (bb_normal_y_parse)."""
     if not isinstance(normal_y, str):
-        raise TypeError(f"{command}: normal_y must be a str (got {normal_y!r})")
+        raise TypeError(f"{command}: normal_y must be a str (got {_shown(normal_y)})")
     out = _ffi.new("int *")
     err = _ffi.new("bb_error *")
     st = _lib.bb_normal_y_parse(_c_text(normal_y, "normal_y"), out, err)

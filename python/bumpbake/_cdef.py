@@ -559,6 +559,10 @@ typedef enum bb_option_type {
   BB_OPTION_PATH
 } bb_option_type;
 
+typedef enum bb_spelling {
+  BB_SPELLING_COMMAND_LINE = 0,
+  BB_SPELLING_KEYWORDS
+} bb_spelling;
 typedef enum bb_option_mode {
   BB_MODE_ANY = 0,
   BB_MODE_SINGLE,
@@ -778,6 +782,8 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
 const char *bb_height_source_channel(const bb_height_source *source);
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err);
+bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+                                 bb_note_fn note, void *note_user, bb_error *err);
 void bb_compare_report_free(bb_compare_report *report);
 int bb_compare_report_exit_code(const bb_compare_report *report);
 const char *bb_compare_report_result(const bb_compare_report *report);
@@ -835,6 +841,7 @@ bb_status bb_command_set(bb_command *command, const char *name, const char *text
 bb_status bb_command_add_input(bb_command *command, const char *text, bb_error *err);
 bb_status bb_command_check(bb_command *command, bb_error *err);
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
+void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
 const bb_command_options *bb_command_options_of(const bb_command *command);
 int bb_command_input_count(const bb_command *command);

@@ -11,19 +11,24 @@ mistyped keyword gives the library's nearest option ("did you mean").
 Python values become the option's text by its type: a flag takes True
 (False or None: not given), numbers are spelled exactly (repr), a word
 list or several numbers take a sequence, a path str, bytes or
-os.PathLike.
+os.PathLike (a map's file option a list of them: one bake, one file each).
 """
 
 import numbers
 import os
-import re
 
 import numpy as np
 
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
-                      _message, _path, _text)
+                      _message, _path, _shown, _text)
 
 _TYPE_NAMES = ("flag", "integer", "number", "word", "words", "numbers", "text", "path")
+
+# What Python offers for an option of the command line's own
+# (BB_OPTION_CLIENT) besides the reports and exceptions it returns.
+_CLIENT_ONLY = {
+    "scheduler": "from Python, bumpbake.dask.bake_files(client=...) runs a batch on a cluster",
+}
 
 
 def _info(command):
@@ -99,7 +104,7 @@ def _spell(option, value, what):
             return sep.join(_spell_number(v, False) for v in value).encode()
         raise TypeError
     except TypeError:
-        raise TypeError(f"{what} must be {_expected(option)} (got {value!r})") from None
+        raise TypeError(f"{what} must be {_expected(option)} (got {_shown(value)})") from None
 
 
 def _expected(option):
@@ -133,6 +138,8 @@ class Command:
             out = _ffi.new("bb_command **")
             _check(_lib.bb_command_new(name.encode(), out, err), err)
             _handle = out[0]
+            # its refusals name the options as this package's keywords
+            _lib.bb_command_set_spelling(_handle, _lib.BB_SPELLING_KEYWORDS)
         self._c = _ffi.gc(_handle, _lib.bb_command_free)
         self._info = _lib.bb_command_describe(self._c)
 
@@ -177,13 +184,19 @@ class Command:
             o = _ffi.NULL
         else:
             o = _lib.bb_option_find(self._info, key.encode(), 0)
-        if o == _ffi.NULL or o.flags & _lib.BB_OPTION_CLIENT:
+        # "bake()", "run('bake')": how Python names the call
+        call = self.function if self.function.endswith(")") else self.function + "()"
+        if o != _ffi.NULL and o.flags & _lib.BB_OPTION_CLIENT:
+            name = _text(o.name)
+            raise TypeError(f"{call} got an unexpected keyword argument {key!r} "
+                            f"(--{name} is the command line's own: "
+                            f"{_CLIENT_ONLY.get(name, 'Python returns reports and raises')})")
+        if o == _ffi.NULL:
             near = _lib.bb_option_nearest(self._info, str(key).encode(), 0)
             hint = ""
             if near != _ffi.NULL and not near.flags & _lib.BB_OPTION_CLIENT:
                 hint = f" (did you mean {keyword(near)!r}?)"
-            raise TypeError(f"{self.function}() got an unexpected keyword argument "
-                            f"{key!r}{hint}")
+            raise TypeError(f"{call} got an unexpected keyword argument {key!r}{hint}")
         return o
 
     def set(self, key, value, skip_default=False):
@@ -196,9 +209,19 @@ class Command:
             return
         if o.type == _lib.BB_OPTION_FLAG:
             if not isinstance(value, (bool, numbers.Integral, np.bool_)) or value not in (0, 1):
-                raise TypeError(f"{self.function}: {key} must be True or False (got {value!r})")
+                raise TypeError(f"{self.function}: {key} must be True or False (got {_shown(value)})")
             if not value:
                 return
+        if o.type == _lib.BB_OPTION_PATH and isinstance(value, (list, tuple)) and value:
+            # several files: the option given once per file, as the command
+            # line gives it (a map written to each; the library refuses a
+            # second file where an option names one)
+            for one in value:
+                if isinstance(one, (list, tuple)):
+                    raise TypeError(f"{self.function}: {key} must be a path or a list of "
+                                    f"paths (got {_shown(value)})")
+                self.set(key, one, skip_default)
+            return
         text = _spell(o, value, f"{self.function}: {key}")
         if skip_default and text is not None:
             buf = _ffi.new("char[256]")
@@ -211,19 +234,10 @@ class Command:
             raise _exception(st, self.prefixed(_message(err, st)))
 
     def prefixed(self, message):
-        """The library's message, spelled for Python, after the function's
-        name (once)."""
-        message = self.spelled(message)
+        """The library's message (its options spelled as keywords by the
+        library, bb_command_set_spelling) after the function's name, once."""
         return message if message.startswith(self.name + ":") else \
             f"{self.function}: {message}"
-
-    def spelled(self, message):
-        """The library's message with its options named as Python's
-        keywords ("--filter-radius" as "filter_radius")."""
-        def keyword_of(m):
-            o = _lib.bb_option_find(self._info, m.group(1).encode(), 0)
-            return keyword(o) if o != _ffi.NULL else m.group(0)
-        return re.sub(r"(?<![\w-])--([a-z][a-z0-9-]*)", keyword_of, message)
 
     def set_all(self, values, skip_default=False):
         for key, value in values.items():
@@ -276,7 +290,7 @@ class Command:
         err = _ffi.new("bb_error *")
         for what, value in (("command", line), ("command_options", options)):
             if value is not None and not isinstance(value, str):
-                raise TypeError(f"{self.function}: {what} must be a str (got {value!r})")
+                raise TypeError(f"{self.function}: {what} must be a str (got {_shown(value)})")
         _check(_lib.bb_command_set_record(
             self._c, _c_text(line, "command") if line is not None else _ffi.NULL,
             _c_text(options, "command_options") if options is not None else _ffi.NULL, err),

@@ -62,7 +62,7 @@ def _dispatch_notes(notes, policy, stacklevel):
 
 def _check_notes(notes):
     if notes not in ("warn", "ignore") and not callable(notes):
-        raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {notes!r})")
+        raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {_shown(notes)})")
     return notes
 
 
@@ -131,11 +131,22 @@ def _c_bytes(value, what):
     return value
 
 
+def _shown(value):
+    """A value as a message shows it: its repr when short and on one line,
+    else what it is (an array's shape and type: its repr spans lines)."""
+    text = repr(value)
+    if len(text) <= 80 and "\n" not in text:
+        return text
+    if isinstance(value, np.ndarray):
+        return f"a numpy array of shape {value.shape} ({value.dtype})"
+    return f"a {type(value).__module__}.{type(value).__qualname__}"
+
+
 def _c_text(value, what):
     """A str for a C string, UTF-8, refusing an embedded NUL (_c_bytes);
     TypeError for anything else (bytes included: text is str)."""
     if not isinstance(value, str):
-        raise TypeError(f"{what} must be a str (got {value!r})")
+        raise TypeError(f"{what} must be a str (got {_shown(value)})")
     return _c_bytes(value.encode(), what)
 
 
@@ -143,14 +154,14 @@ def _path(value, what="path"):
     """A path (str, bytes or os.PathLike) as the bytes the library opens;
     ValueError for an embedded NUL."""
     if not isinstance(value, (str, bytes, os.PathLike)):
-        raise TypeError(f"{what} must be a path (got {value!r})")
+        raise TypeError(f"{what} must be a path (got {_shown(value)})")
     return _c_bytes(os.fsencode(value), what)
 
 
 def _parse(parser, ctype, text, what):
     """An enum value by the library's own parser; its message when refused."""
     if not isinstance(text, str):
-        raise TypeError(f"{what} must be a str (got {text!r})")
+        raise TypeError(f"{what} must be a str (got {_shown(text)})")
     out = _ffi.new(f"{ctype} *")
     err = _ffi.new("bb_error *")
     _check(getattr(_lib, parser)(_c_text(text, what), out, err), err)
@@ -178,7 +189,7 @@ def _vtf_text(command, name, value):
     """value as text for the library's parsers: str as given, an int in
     decimal, a float as Python spells it (7.3); else TypeError."""
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-        raise TypeError(f"{command}: {name} must be a str or a number (got {value!r})")
+        raise TypeError(f"{command}: {name} must be a str or a number (got {_shown(value)})")
     return value if isinstance(value, str) else repr(value)
 
 
@@ -197,7 +208,7 @@ def _vtf_flags(command, value):
     """TEXTUREFLAGS_* bits: an int, or text as --vtf-flags takes it ("0x4")
     (bb_vtf_flags_parse)."""
     if isinstance(value, float):
-        raise TypeError(f"{command}: vtf_flags must be an int or a str (got {value!r})")
+        raise TypeError(f"{command}: vtf_flags must be an int or a str (got {_shown(value)})")
     out = _ffi.new("uint32_t *")
     err = _ffi.new("bb_error *")
     if _lib.bb_vtf_flags_parse(_c_text(_vtf_text(command, "vtf_flags", value), "vtf_flags"), out,

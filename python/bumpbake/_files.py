@@ -7,8 +7,9 @@ import typing
 
 from ._bake import _KINDS
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _depth, _ffi,
-                      _lib, _path, _text, _texture_options)
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _check_notes, _depth,
+                      _dispatch_notes, _ffi, _lib, _note_text, _path, _shown, _text,
+                      _texture_options)
 
 
 def read(path):
@@ -199,7 +200,7 @@ def _signed(command, kind):
     if kind in _UNIT_KINDS:
         return False
     raise _argument_error(f"{command}: kind must be one of "
-                          f"{', '.join(tuple(_KINDS) + _UNIT_KINDS)} (got {kind!r})")
+                          f"{', '.join(tuple(_KINDS) + _UNIT_KINDS)} (got {_shown(kind)})")
 
 
 def write(path, array, *, kind="colour", depth=None, mips=False, description=None,
@@ -327,7 +328,7 @@ def _diff_pairs(text, a, b):
 
 
 def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=None,
-            warn=None, warnpercent=None, hardwarn=None, diff=None):
+            warn=None, warnpercent=None, hardwarn=None, diff=None, notes="warn"):
     """Compares two image files channel by channel as OpenImageIO's idiff
     (and `bumpbake compare`) do, and their provenance key by key, and
     returns a Comparison: `assert bumpbake.compare(out, golden,
@@ -344,8 +345,11 @@ def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=N
     "DIFFERENT SIZE" (exit code 3). diff: a path to write |A - B| to (raw
     in .exr, scaled so the largest difference is white elsewhere); a diff
     that cannot be written is reported (diff_error), not raised.
-    Raises Error when a file cannot be read (idiff's exit 4),
-    ArgumentError for a bad tolerance or diff path."""
+    Raises Error when a file cannot be read (idiff's exit 4) or the
+    comparison will not fit in memory (worked out from the headers before
+    a pixel is read), ArgumentError for a bad tolerance or diff path. A
+    comparison over 1 GiB of memory says so first, as a note (notes: as
+    bake_file()'s)."""
     c = Command("compare")
     pa, pb = _path(a), _path(b)
     c.add_input(pa)
@@ -358,6 +362,12 @@ def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=N
     limits[0] = c.options.limits
     pd = _path(diff) if diff is not None else _ffi.NULL
     err = _ffi.new("bb_error *")
+    _check_notes(notes)
+    heard = []
+    note = _ffi.callback("bb_note_fn",
+                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
+    _check(_lib.bb_compare_files_check(pa, pb, pd, note, _ffi.NULL, err), err)
+    _dispatch_notes(heard, notes, stacklevel=2)
     r = _ffi.new("bb_compare_report *")
     _check(_lib.bb_compare_files(pa, pb, limits, pd, r, err), err)
     try:

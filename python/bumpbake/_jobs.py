@@ -9,7 +9,7 @@ import typing
 from ._bake import OUTPUTS, _basis
 from ._command import Command
 from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _exception, _ffi,
-                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _text)
+                      _lib, _message, _note_text, _path, _progress_hook, _status_name, _shown, _text)
 
 # A report's status: the library's name of its outcome ("up to date", ...).
 _OUTCOMES = {k: _text(_lib.bb_job_outcome_name(k))
@@ -24,7 +24,8 @@ class BakeReport:
     """What became of one input of a bake (bumpbake.bake_files, BakeJob)."""
     input: str             # the path as planned (a directory's file: DIR/NAME)
     status: str            # "pending", "baked", "up to date", "failed", "not run"
-    outputs: dict          # {kind: path} it writes ("normal", ..., "slope", "slope_lit")
+    outputs: dict          # {kind: path} it writes ("normal", ..., "slope", "slope_lit");
+                           # a map written to several files: {kind: [path, ...]}
     error: typing.Optional[str] = None         # why it failed: "PATH: reason"
     error_status: typing.Optional[str] = None  # the bb_status name of the failure
     reason: typing.Optional[str] = None  # why its outputs were not up to date
@@ -50,10 +51,16 @@ class BakeReport:
 
 
 def _report(r, status=None):
+    outputs = {}
+    for k in range(r.output_count):  # a map written to several files: a list of them
+        kind, path = _text(r.outputs[k].kind), _text(r.outputs[k].path)
+        was = outputs.get(kind)
+        if was is None:
+            outputs[kind] = path
+        else:
+            outputs[kind] = (was if isinstance(was, list) else [was]) + [path]
     out = BakeReport(input=_text(r.input), status=status or _OUTCOMES[r.outcome],
-                     outputs={_text(r.outputs[k].kind): _text(r.outputs[k].path)
-                              for k in range(r.output_count)},
-                     _bytes=bytes(_ffi.buffer(r)))
+                     outputs=outputs, _bytes=bytes(_ffi.buffer(r)))
     out.reason = _text(r.reason) or None
     if r.outcome == _lib.BB_JOB_FAILED:
         out.error = _message(r.error, r.status)
@@ -109,7 +116,7 @@ class BakeJob:
         if isinstance(inputs, (str, bytes, os.PathLike)):
             inputs = [inputs]
         elif not isinstance(inputs, (list, tuple)):
-            raise TypeError(f"bake: inputs must be a path or a list of paths (got {inputs!r})")
+            raise TypeError(f"bake: inputs must be a path or a list of paths (got {_shown(inputs)})")
         self._plan([_path(p, "input") for p in inputs], self._args)
 
     def _command(self, inputs, a):
@@ -121,14 +128,11 @@ class BakeJob:
             c.add_input(p)
         outputs = a["outputs"]
         if outputs is not None and not isinstance(outputs, collections.abc.Mapping):
-            raise TypeError(f"bake: outputs must be a dict {{kind: path}} (got {outputs!r})")
+            raise TypeError(f"bake: outputs must be a dict {{kind: path}} (got {_shown(outputs)})")
         for kind in outputs or {}:
             if kind not in OUTPUTS:
                 raise _argument_error(f"bake: unknown map {kind!r} in outputs "
                                       f"(one of {', '.join(OUTPUTS)})")
-        if a.get("scheduler") is not None:
-            raise TypeError("bake: scheduler is the command line's: from Python, "
-                            "bumpbake.dask.bake_files(client=...) runs a batch on a cluster")
         options = {k: v for k, v in a.items()
                    if k not in ("outputs", "prefix", "notes", "command", "command_options",
                                 "force", "basis")}
@@ -383,7 +387,8 @@ def bake_file(input, outputs=None, *, prefix=None, slope=None, lit=None, depfile
     """Bakes one height file into the files named, as `bumpbake bake INPUT
     --normal FILE ...` does, and returns its BakeReport.
 
-    outputs: {kind: path} for kinds of OUTPUTS; prefix: also PREFIX_normal.png,
+    outputs: {kind: path} for kinds of OUTPUTS (a list of paths: the map
+    written to each, in its format, from the one bake); prefix: also PREFIX_normal.png,
     PREFIX_ssbump.png and PREFIX_ao.png where not named (bake's -o);
     slope: flipcode's slope map (8-bit .png .tga .tif) and lit=(azimuth,
     elevation) its lit preview, written as SLOPE_lit.EXT. force (default

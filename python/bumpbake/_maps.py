@@ -3,7 +3,7 @@ DOOM 3 image programs and mip chains, each one call of the library."""
 
 from ._bake import _IN_MEMORY, _basis, _normal_y_up
 from ._command import Command
-from ._common import _Image, _array, _c_text, _check, _depth, _ffi, _lib, _take
+from ._common import _Image, _array, _c_text, _check, _depth, _ffi, _lib, _shown, _take
 from ._files import _signed
 
 
@@ -179,7 +179,7 @@ def program(text, base=None, allow_outside_base=False, **options):
     allow_outside_base), set and checked by the library; those about the
     file written (output, depth, ...) are run("program", text, ...)'s."""
     if not isinstance(text, str):
-        raise TypeError(f"program: text must be a str (got {text!r})")
+        raise TypeError(f"program: text must be a str (got {_shown(text)})")
     c = Command("program")
     c.add_input(_c_text(text, "program"))
     c.set_all(dict(options, base=base, allow_outside_base=allow_outside_base))

@@ -2,15 +2,16 @@
 bake's contact sheet (sheet) and DOOM 3's RenderBumpFlat (renderbumpflat)."""
 
 import dataclasses
+import numbers
 import os
 
 import numpy as np
 
 from ._bake import _IN_MEMORY, _height_field
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _check, _check_notes, _dispatch_notes,
-                      _exception, _ffi, _lib, _message, _note_text, _path, _progress_hook,
-                      _take, _text)
+from ._common import (_Image, _argument_error, _array, _c_text, _check, _check_notes,
+                      _dispatch_notes, _exception, _ffi, _lib, _message, _note_text, _path,
+                      _progress_hook, _shown, _take, _text)
 
 # The default light of bb_render_options_init: on, at this azimuth and
 # elevation (degrees).
@@ -36,7 +37,7 @@ def _set_lighting(c, light, lightmap):
         values = np.asarray(lightmap, dtype=np.float64)
         if values.shape != (3, 3):
             raise _argument_error(f"{c.function}: lightmap must be 'basis' or 3 colours, "
-                                  f"shape (3, 3) (got {lightmap!r})")
+                                  f"shape (3, 3) (got {_shown(lightmap)})")
         lightmap = ",".join(repr(float(v)) for v in values.reshape(-1))
     c.set("lightmap", lightmap)
 
@@ -179,9 +180,17 @@ def run(command, *inputs, progress=None, notes="warn", **options):
     a sequence), and returns [(kind, path)] of the files written: the
     command line's bytes. progress: as bake()'s; notes as bake_file()'s."""
     _check_notes(notes)
-    c = Command(command, f"run({command!r})")
-    for value in inputs:
-        c.add_input(value if isinstance(value, (str, bytes, os.PathLike)) else str(value))
+    if not isinstance(command, str):
+        raise TypeError(f"run: command must be a str (got {_shown(command)})")
+    c = Command(_c_text(command, "run: command").decode(), f"run({command!r})")
+    for i, value in enumerate(inputs):
+        # a path, or a number (height2ssbump's BUMPSCALE) spelled as typed
+        if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+            value = str(value)
+        elif not isinstance(value, (str, bytes, os.PathLike)):
+            raise TypeError(f"run({command!r}): input {i + 1} must be a path (str, bytes or "
+                            f"os.PathLike) or a number (got {_shown(value)})")
+        c.add_input(value)
     c.set_all(options)
     c.check()
     heard = []
@@ -197,7 +206,7 @@ def run(command, *inputs, progress=None, notes="warn", **options):
     if st != _lib.BB_OK:
         if raised:
             raise raised[0]
-        raise _exception(st, _message(err, st))
+        raise _exception(st, c.prefixed(_message(err, st)))
     try:
         _dispatch_notes(heard, notes, stacklevel=2)
         return [(_text(result.files[i].kind), _text(result.files[i].path))

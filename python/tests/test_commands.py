@@ -42,10 +42,10 @@ FUNCTIONS = {
 }
 
 # Options with no Python keyword, and why. Every option the library marks
-# BB_OPTION_CLIENT (--help, -q, --json: how the command line prints) is one
-# too: Python returns reports and raises errors instead.
+# BB_OPTION_CLIENT (--help, -q, --json: how the command line prints; bake
+# --scheduler: a cluster from Python is bumpbake.dask.bake_files(client=...))
+# is one too: Python returns reports and raises errors instead.
 NOT_IN_PYTHON = {
-    ("bake", "scheduler"): "a cluster from Python is bumpbake.dask.bake_files(client=...)",
     ("check", "bake"): "check(golden, heights=...) bakes; the command line says --bake",
     ("serve", None): "the command line's HTTP preview server (bake() and render() make "
                      "what it shows)",
@@ -206,6 +206,48 @@ def test_a_bounce_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch):
 
 
 @needs_cli
+def test_a_map_written_to_several_files_is_one_bake_and_the_clis(tmp_path, monkeypatch):
+    """A list of paths for a map's keyword writes the map to each file,
+    each in its format, from one bake: run() and bake_file() write the
+    command line's bytes, and each file is what a bake of it alone writes."""
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), "rock.png")
+    settings = dict(scale=8, rays=4)
+    for d in ("py", "cli", "alone", "file"):
+        os.makedirs(d)
+    monkeypatch.chdir(tmp_path / "py")
+    wrote = bumpbake.run("bake", "../rock.png", normal="n.png",
+                         ssbump=["s.png", "s.tga", "s.vtf"], **settings)
+    assert wrote == [("normal", "n.png"), ("ssbump", "s.png"), ("ssbump", "s.tga"),
+                     ("ssbump", "s.vtf")]
+    done = cli("bake", "../rock.png", "--scale", "8", "--rays", "4", "--normal", "n.png",
+               "--ssbump", "s.png", "--ssbump", "s.tga", "--ssbump", "s.vtf",
+               cwd=tmp_path / "cli")
+    assert done.returncode == 0, done.stderr
+    monkeypatch.chdir(tmp_path / "alone")
+    for name in ("s.png", "s.tga", "s.vtf"):
+        bumpbake.run("bake", "../rock.png", normal="n.png", ssbump=name, **settings)
+    monkeypatch.chdir(tmp_path / "file")
+    outputs = {"normal": "n.png", "ssbump": ["s.png", "s.vtf"]}
+    report = bumpbake.bake_file("../rock.png", outputs, **settings)
+    assert report.outputs == {"normal": "n.png", "ssbump": ["s.png", "s.vtf"]}
+    monkeypatch.chdir(tmp_path)
+    ours, theirs, alone = files_of("py"), files_of("cli"), files_of("alone")
+    assert sorted(ours) == ["n.png", "s.png", "s.tga", "s.vtf"] == sorted(theirs)
+    assert [k for k in ours if ours[k] != theirs[k]] == []
+    assert [k for k in ("s.png", "s.tga", "s.vtf") if ours[k] != alone[k]] == []
+    made = files_of("file")
+    assert sorted(made) == ["n.png", "s.png", "s.vtf"]
+    assert made["s.png"] == alone["s.png"] and made["s.vtf"] == alone["s.vtf"]
+    assert b"--ssbump s.png --ssbump s.tga --ssbump s.vtf" in ours["n.png"]
+    with pytest.raises(bumpbake.ArgumentError, match="basetexture is given twice"):
+        bumpbake.run("bake", "rock.png", ssbump="x.png", basetexture=["a.vtf", "b.vtf"],
+                     **settings)
+    with pytest.raises(TypeError, match="ssbump must be a path or a list of paths"):
+        bumpbake.run("bake", "rock.png", ssbump=["x.png", ["y.png"]], **settings)
+
+
+@needs_cli
 def test_a_relief_render_is_the_clis(tmp_path, monkeypatch):
     """render --relief from Python: run() writes the command line's bytes;
     render(height=...) gives its pixels."""
@@ -267,6 +309,40 @@ def test_an_array_bake_is_cancelled_by_its_progress_and_by_ctrl_c():
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def test_ctrl_c_stops_a_bounce_bake_inside_a_slice():
+    """Ctrl-C during a bake with bounce: a bounce pass's slice at 1024 x
+    1024 takes seconds (2048 x 2048 took 18 s to stop), so its line sweeps
+    ask the progress every 50 ms, as a stage without progress does; the
+    bake stops within a bundle of lines. Measured in CPU time from the
+    moment the interrupt is armed (0.3 s before it comes), which load does
+    not stretch: the rest of a slice took several seconds of it."""
+    h = np.random.default_rng(5).random((1024, 1024), np.float32)
+    armed = []
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    def progress(done, total):
+        # the trace and the bounce's direct pass are done: the passes of
+        # long slices have started
+        if done * 7 >= total and not armed:
+            armed.append(os.times())
+            signal.setitimer(signal.ITIMER_REAL, 0.3)
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            bumpbake.bake(h, 16, rays=16, bounce=0.5, outputs=("ao",), progress=progress,
+                          threads=2)
+        stopped = os.times()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert armed
+    cpu = (stopped.user - armed[0].user) + (stopped.system - armed[0].system)
+    assert cpu < 3.0, f"{cpu:.1f} s of CPU from arming Ctrl-C to the stop"
 
 
 @needs_cli
@@ -345,3 +421,53 @@ def test_normal_y_up_arrays_are_read_and_written_as_the_cli_reads_files():
         bumpbake.combine(n, n[::-1] * 1, mix=0.5, kind="normal") * [1, -1, 1])
     with pytest.raises(bumpbake.ArgumentError, match="normal_y must be one of down, up"):
         bumpbake.normal2ssbump(n, normal_y="sideways")
+
+
+def test_run_refuses_what_is_not_a_command_or_a_path(tmp_path, monkeypatch):
+    """run() took any command value (AttributeError from None, 5 or bytes),
+    ran "bake\\0" as bake, turned an array into its text (a multi-line "no
+    such file") and baked locally with scheduler= the docs refuse."""
+    monkeypatch.chdir(tmp_path)
+    h = np.zeros((8, 8), np.float32)
+    bumpbake.write("h.png", h)
+    for command in (None, 5, b"bake"):
+        with pytest.raises(TypeError, match=r"^run: command must be a str \(got "):
+            bumpbake.run(command, "h.png", scale=8, normal="n.png")
+    with pytest.raises(ValueError, match="embedded null byte"):
+        bumpbake.run("bake\0", "h.png", scale=8, normal="n.png")
+    with pytest.raises(TypeError) as e:
+        bumpbake.run("bake", np.zeros((64, 64), np.float32), scale=8, normal="n.png")
+    assert "\n" not in str(e.value) and "input 1 must be a path" in str(e.value), str(e.value)
+    assert "numpy array of shape (64, 64)" in str(e.value)
+    with pytest.raises(TypeError) as e:
+        bumpbake.run("bake", "h.png", normal=np.zeros((64, 64), np.float32), scale=8)
+    assert "\n" not in str(e.value) and "normal must be a path" in str(e.value), str(e.value)
+    with pytest.raises(TypeError, match=r"^run\('bake'\) got an unexpected keyword argument "
+                                        r"'scheduler' \(--scheduler is the command line's own"):
+        bumpbake.run("bake", "h.png", scale=8, output="q", scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(TypeError, match="unexpected keyword argument 'scheduler'"):
+        bumpbake.bake_file("h.png", {"normal": "n.png"}, scale=8, scheduler="tcp://h:1")
+    assert sorted(os.listdir(".")) == ["h.png"]
+    # height2ssbump's BUMPSCALE is a number, given as one
+    assert bumpbake.run("height2ssbump", "h.png", 4, rays=4, notes="ignore") == [
+        ("ssbump+height", "h-ssbump.tga")]
+
+
+def test_a_large_file_no_reader_knows_is_refused_at_once(tmp_path):
+    """A 2 GiB file of zeros (sparse) named .png: refused in one line
+    naming the format its extension promised, without reading it through
+    (it took OpenImageIO's walk through every reader minutes)."""
+    z = tmp_path / "z.png"
+    with open(z, "wb") as f:
+        f.truncate(2 << 30)
+    before = os.times()
+    for call in (lambda: bumpbake.read(z), lambda: bumpbake.info(z),
+                 lambda: bumpbake.bake_file(z, {"normal": tmp_path / "n.png"}, scale=8),
+                 lambda: bumpbake.run("bake", z, scale=8, normal=tmp_path / "n.png")):
+        with pytest.raises(bumpbake.Error, match="z.png: not a readable image: its extension "
+                                                 "says PNG") as e:
+            call()
+        assert "\n" not in str(e.value)
+    after = os.times()
+    assert (after.user - before.user) + (after.system - before.system) < 2.0
+    assert sorted(os.listdir(tmp_path)) == ["z.png"]

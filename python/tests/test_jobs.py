@@ -150,16 +150,16 @@ def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):
 
 @pytest.mark.parametrize("kwargs, error, message", [
     ({"name": "../{stem}.png"}, bumpbake.ArgumentError,
-     "--name ../{stem}.png: '..' would leave the output directory"),
+     "name ../{stem}.png: '..' would leave the output directory"),
     ({"maps": ("normal", "shine")}, bumpbake.ArgumentError, "bake: maps: unknown map 'shine'"),
     ({"depth": 12}, bumpbake.ArgumentError, "depth must be one of 8, 16, half, float"),
     ({"rays": 0}, bumpbake.ArgumentError, "bake: rays must be in 1..65536 (got 0)"),
-    ({"mips": True}, bumpbake.ArgumentError, "--mips needs a .tif or .exr output"),
+    ({"mips": True}, bumpbake.ArgumentError, "mips needs a .tif or .exr output"),
     ({"texture_format": "dxt7"}, bumpbake.ArgumentError, "texture_format must be one of"),
     ({"vtf_version": "7.9"}, bumpbake.ArgumentError, "VTF version must be 7.2, 7.3, 7.4 or 7.5"),
     ({"vtf_flags": -1}, bumpbake.ArgumentError, "VTF flags must be a 32-bit number"),
-    ({"vmt": "m.vmt"}, bumpbake.ArgumentError, "--vmt writes one material"),
-    ({"lit": (45, 30)}, bumpbake.ArgumentError, "--lit previews one slope map"),
+    ({"vmt": "m.vmt"}, bumpbake.ArgumentError, "vmt writes one material"),
+    ({"lit": (45, 30)}, bumpbake.ArgumentError, "lit previews one slope map"),
     ({"name": "{stem}_{kind}.vtf"}, bumpbake.ArgumentError,
      "Source textures need a power of two on each side"),
 ])
@@ -176,7 +176,7 @@ def test_bad_jobs_are_refused_before_any_bake(tmp_path, fixtures, kwargs, error,
 @pytest.mark.parametrize("kwargs", [{"maps": "ao"}, {"name": "{stem}.png"},
                                     {"keep_going": True}])
 def test_a_batchs_options_are_refused_in_a_single_bake(tmp_path, fixtures, kwargs):
-    with pytest.raises(bumpbake.ArgumentError, match="is for batches: give --out-dir DIR"):
+    with pytest.raises(bumpbake.ArgumentError, match="is for batches: give out_dir=DIR"):
         bumpbake.bake_file(os.path.join(fixtures, "pit_65x65.png"),
                            {"ao": tmp_path / "a.png"}, scale=4, **kwargs)
     assert not list(tmp_path.iterdir())

@@ -229,7 +229,7 @@ def test_flat_maps_under_an_overhead_light_render_white():
                                [1, 0.5, 0.25], atol=1e-6)
     with pytest.raises(bumpbake.ArgumentError, match="elevation must be in 0..90"):
         bumpbake.render(**flat, light=(0, 95))
-    with pytest.raises(bumpbake.ArgumentError, match="slope needs slope FILE"):
+    with pytest.raises(bumpbake.ArgumentError, match="slope needs slope=FILE"):
         bumpbake.render(**flat, mode="slope")
 
 

@@ -289,7 +289,7 @@ def test_what_a_texture_cannot_hold_is_refused_before_any_work(tmp_path, fixture
             {"ssbump": tmp_path / "s.png"}, scale=8, vmt=tmp_path / "s.vmt")
     refused("one material", bumpbake.bake_files, [pit, pit], tmp_path / "out", scale=8,
             name="{stem}_{kind}.vtf", vmt=tmp_path / "s.vmt")
-    refused("give --vmt", bumpbake.bake_file, pit, {"ssbump": tmp_path / "s.png"}, scale=8,
+    refused("give vmt=FILE", bumpbake.bake_file, pit, {"ssbump": tmp_path / "s.png"}, scale=8,
             materials=tmp_path)
     assert os.listdir(tmp_path) == []
 
@@ -326,3 +326,20 @@ def test_write_vmt_refuses_what_bake_vmt_refuses(tmp_path):
         bumpbake.write_vmt(stone / "s.vmt", texture)
     assert texture.read_bytes() == b"VTF\0 a texture" and png.read_bytes() == b"a png"
     assert sorted(os.listdir(stone)) == ["s.vmt", "s.vtf", "x.png"]
+
+
+def test_a_name_with_a_newline_is_refused_in_one_line(tmp_path):
+    """A newline (or an escape sequence) in a path came back inside the
+    message, splitting it: the library writes it as \\x0a, as the command
+    line prints it."""
+    materials = tmp_path / "materials"
+    materials.mkdir()
+    for path, bump in ((materials / "a\nb.txt", materials / "s.vtf"),
+                       (materials / "x.vmt", materials / "s\nx.vtf"),
+                       (materials / "x\x1b[2J.txt", materials / "s.vtf")):
+        with pytest.raises(bumpbake.ArgumentError) as e:
+            bumpbake.write_vmt(path, bump)
+        message = str(e.value)
+        assert "\n" not in message and "\x1b" not in message and message.isprintable(), message
+        assert "\\x0a" in message or "\\x1b" in message, message
+    assert os.listdir(materials) == []

@@ -10,14 +10,14 @@
 #include <math.h>
 #include <string.h>
 
-const bb__range bb__range_height_scale = {"height scale", 0.0, FLT_MAX, 1, 0};
+const bb__range bb__range_height_scale = {"scale", 0.0, FLT_MAX, 1, 0};
 const bb__range bb__range_rays = {"rays", 1, BB_MAX_RAYS, 0, 1};
 const bb__range bb__range_slices = {"slices", 1, BB_MAX_SLICES, 0, 1};
 const bb__range bb__range_filter_radius = {"filter radius", 0, BB_MAX_FILTER_RADIUS, 0, 1};
 const bb__range bb__range_filter_threshold = {"filter threshold", 0.0, FLT_MAX, 1, 0};
 const bb__range bb__range_bias = {"bias", 0.0, BB_MAX_BIAS_TEXELS, 0, 0};
 const bb__range bb__range_power = {"power", 1.0, BB_MAX_POWER, 0, 0};
-const bb__range bb__range_bounce_albedo = {"bounce albedo", 0.0, 1.0, 0, 0};
+const bb__range bb__range_bounce_albedo = {"bounce", 0.0, 1.0, 0, 0};
 const bb__range bb__range_bounces = {"bounces", 0, BB_MAX_BOUNCES, 0, 1};
 
 void bb_bake_options_init(bb_bake_options *o) {

@@ -36,9 +36,13 @@ void cli_error_line(const char *message) {
 
 void cli_file_error(const char *path, const char *reason) {
   const char *why = reason && *reason ? reason : "unknown error";
-  size_t n = strlen(path);
+  /* the library's messages show a path escaped (bb_text_printable) */
+  char shown[4096];
+  bb_text_printable(path, shown, sizeof shown);
+  size_t n = strlen(path), m = strlen(shown);
   char line[8192];
-  if (strncmp(why, path, n) == 0 && why[n] == ':')
+  if ((strncmp(why, path, n) == 0 && why[n] == ':') ||
+      (strncmp(why, shown, m) == 0 && why[m] == ':'))
     snprintf(line, sizeof line, "%s", why);
   else
     snprintf(line, sizeof line, "%s: %s", path, why);

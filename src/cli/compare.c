@@ -160,7 +160,11 @@ int cli_run_compare(const cli_run *run) {
                           o->limits, o->diff, o->json, o->quiet};
   bb_compare_report r;
   bb_error err = {{0}};
-  bb_status st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);
+  /* what it will cost, said before it starts when that is much */
+  bb_status st =
+      bb_compare_files_check(a.path_a, a.path_b, a.diff_path, cli_note, NULL, &err);
+  if (st == BB_OK)
+    st = bb_compare_files(a.path_a, a.path_b, &a.limits, a.diff_path, &r, &err);
   if (st != BB_OK) {
     cli_error_line(err.message[0] ? err.message : bb_status_name(st));
     /* A file that cannot be read, a file over the size limits included,

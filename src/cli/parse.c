@@ -36,6 +36,8 @@ typedef struct parse {
   char **word;   /* the word as recorded (a short cluster less a letter) */
   char *dropped; /* 1: the word is left out of the record */
   char *is_option; /* 1: the word belongs to an option (not a positional) */
+  const bb_option_info **file_of; /* the file option the word belongs to */
+  const char **file_value;        /* ... and the file it names */
   int usage;     /* the command's usage exit code */
 } parse;
 
@@ -167,8 +169,13 @@ static int check_long_words(const parse *p, int argc, char **argv, int long_only
  * ("-qn") loses only its letter. */
 static void record_option(parse *p, const bb_option_info *o, int c, int first, int after,
                           const int *map) {
-  for (int w = first; w < after; w++)
+  for (int w = first; w < after; w++) {
     p->is_option[map[w]] = 1;
+    if (o->type == BB_OPTION_PATH) {
+      p->file_of[map[w]] = o;
+      p->file_value[map[w]] = optarg;
+    }
+  }
   if (o->flags & BB_OPTION_RECORDED)
     return;
   const int at = map[first];
@@ -281,9 +288,11 @@ static int run_getopt(parse *p, int argc, char **argv, const int *map) {
 
 /* "bumpbake NAME WORDS..." of the recorded words, each quoted for a POSIX
  * shell by the library (bb_text_shell_quoted); options only (a batch's
- * provenance: "bumpbake bake INPUT OPTIONS") when options_only. NULL when
- * out of memory. */
-static char *recorded(const parse *p, int options_only) {
+ * provenance: "bumpbake bake INPUT OPTIONS") when options_only. With
+ * file_of, the words of file_of's other files (those not naming file) are
+ * left out too. NULL when out of memory. */
+static char *recorded_of(const parse *p, int options_only, const bb_option_info *file_of,
+                         const char *file) {
   size_t len = strlen("bumpbake ") + strlen(p->argv[0]) + 1, used = 0;
   char *text = malloc(len);
   if (!text)
@@ -293,6 +302,8 @@ static char *recorded(const parse *p, int options_only) {
     used = (size_t)snprintf(text, len, "bumpbake %s", p->argv[0]);
   for (int w = 1; w < p->argc; w++) {
     if (p->dropped[w] || (options_only && (!p->is_option[w] || !strcmp(p->argv[w], "--"))))
+      continue;
+    if (file_of && p->file_of[w] == file_of && strcmp(p->file_value[w], file))
       continue;
     char *word = bb_text_shell_quoted(p->word[w]);
     char *grown = word ? realloc(text, used + strlen(word) + 2) : NULL;
@@ -306,6 +317,39 @@ static char *recorded(const parse *p, int options_only) {
     free(word);
   }
   return text;
+}
+
+static char *recorded(const parse *p, int options_only) {
+  return recorded_of(p, options_only, NULL, NULL);
+}
+
+/* A map the library writes to several files (--ssbump s.png --ssbump
+ * s.vtf, one bake): each file records the words as typed less those of
+ * the map's other files, what a bake of that file alone records. */
+static bb_status record_files(const parse *p, bb_error *err) {
+  for (int w = 1; w < p->argc; w++) {
+    const bb_option_info *o = p->file_of[w];
+    if (!o || p->dropped[w])
+      continue;
+    int seen = 0, others = 0;
+    for (int v = 1; v < p->argc; v++) {
+      if (p->file_of[v] != o)
+        continue;
+      if (v < w && !strcmp(p->file_value[v], p->file_value[w]))
+        seen = 1;
+      others |= strcmp(p->file_value[v], p->file_value[w]) != 0;
+    }
+    if (seen || !others)
+      continue;
+    char *line = recorded_of(p, 0, o, p->file_value[w]);
+    if (!line)
+      return BB_ERR_MEMORY;
+    bb_status st = bb_command_set_record_of(p->command, p->file_value[w], line, err);
+    free(line);
+    if (st != BB_OK)
+      return st;
+  }
+  return BB_OK;
 }
 
 /* -------------------------------------------------------------- the run */
@@ -335,11 +379,16 @@ static int parse_and_run(parse *p, int (*run)(const cli_run *r)) {
   if (st != BB_OK)
     return refused(p, st, &err);
   char *line = recorded(p, 0), *options = recorded(p, 1);
-  if (!line || !options || bb_command_set_record(p->command, line, options, &err) != BB_OK) {
+  st = line && options ? bb_command_set_record(p->command, line, options, &err)
+                       : BB_ERR_MEMORY;
+  if (st == BB_OK)
+    st = record_files(p, &err);
+  if (st != BB_OK) {
     free(line);
     free(options);
-    cli_error_line("out of memory");
-    return BB_EXIT_FAILURE;
+    if (st == BB_ERR_MEMORY)
+      cli_error_line("out of memory");
+    return st == BB_ERR_MEMORY ? BB_EXIT_FAILURE : refused(p, st, &err);
   }
   cli_run r = {p->command, bb_command_options_of(p->command), line};
   rc = BB_EXIT_FAILURE;
@@ -364,14 +413,20 @@ int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r)) {
     cli_error_line(err.message);
     return BB_EXIT_USAGE;
   }
-  parse p = {bb_command_describe(command), command, argc, NULL, NULL, NULL, NULL,
-             bb_command_describe(command)->usage_exit};
+  parse p = {.info = bb_command_describe(command),
+             .command = command,
+             .argc = argc,
+             .usage = bb_command_describe(command)->usage_exit};
   /* getopt writes into argv (it may permute): the words as typed are kept */
   p.argv = malloc(((size_t)argc + 1) * sizeof *p.argv);
   p.word = calloc((size_t)argc + 1, sizeof *p.word);
   p.is_option = calloc((size_t)argc + 1, 1);
   p.dropped = calloc((size_t)argc + 1, 1);
-  int rc = p.argv && p.word && p.is_option && p.dropped ? 0 : BB_EXIT_FAILURE;
+  p.file_of = calloc((size_t)argc + 1, sizeof *p.file_of);
+  p.file_value = calloc((size_t)argc + 1, sizeof *p.file_value);
+  int rc = p.argv && p.word && p.is_option && p.dropped && p.file_of && p.file_value
+               ? 0
+               : BB_EXIT_FAILURE;
   for (int i = 0; !rc && i < argc; i++) {
     p.argv[i] = argv[i];
     if (!(p.word[i] = strdup(argv[i])))
@@ -387,6 +442,8 @@ int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r)) {
   free(p.argv);
   free(p.is_option);
   free(p.dropped);
+  free(p.file_of);
+  free(p.file_value);
   bb_command_free(command);
   return rc;
 }

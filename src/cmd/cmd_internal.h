@@ -65,6 +65,8 @@ struct bb__option {
   const char *required_note; /* REQUIRED: what it is, after "is required" */
   void (*range_words)(char *out, size_t cap); /* a range spelled from constants */
   bb__flag_sets sets;        /* FLAG, ANGLES: the other field it sets when given */
+  int repeats;               /* a map's file (PATH, STRING at job.paths[kind]): given
+                                again, a further file of the same map */
 };
 
 typedef struct bb__command bb__command;
@@ -87,6 +89,8 @@ struct bb__command {
   /* its run when it makes one map or picture (render, sheet, the map
    * commands): read and make here, write through the job (job/output.c) */
   bb__run_fn run;
+  /* notes said before run starts (what it will cost); NULL: none */
+  void (*before_run)(const bb_command *c, const bb_command_hooks *hooks);
 };
 
 /* The most options one command has. */
@@ -106,7 +110,16 @@ struct bb_command {
   int input_count;
   char *record_line, *record_options;
   int checked;                       /* bb_command_check passed */
+  /* The further files of options that repeat (a map written to several
+   * files, each in its format, from one bake): which option, which file. */
+  int more_count;
+  int more_option[BB_JOB_MAX_OUTPUTS];
+  const char *more_path[BB_JOB_MAX_OUTPUTS]; /* owned: strings */
+  /* The command line each such file records (bb_command_set_record_of). */
+  int file_record_count;
+  char *file_record_path[BB_JOB_MAX_OUTPUTS], *file_record_line[BB_JOB_MAX_OUTPUTS];
   int in_memory;                     /* images in memory, not files */
+  bb_spelling spelling;              /* how its messages name its options */
   unsigned memory_maps;              /* ... and the maps asked of them */
 };
 
@@ -128,9 +141,34 @@ char *bb__command_keep(bb_command *c, const char *text);
 /* "--name" (or "-x" for a short-only spelling), for messages. */
 void bb__option_spelling(const bb__option *o, char *out, size_t cap);
 
-/* The options given, " --name value" each, in the order of --help; only
- * those that determine the output with BB_OPTION_RECORDED (text.c). */
+/* The options given, " --name value" each, in the order of --help (an
+ * option given more than once, each time); only those that determine the
+ * output with BB_OPTION_RECORDED (text.c). */
 void bb__add_options(const bb_command *c, unsigned flags, bb__text *t);
+/* The same for the one file path of option `option` (an option that
+ * repeats): that option spelled once, naming it. */
+void bb__add_options_of_file(const bb_command *c, unsigned flags, int option,
+                             const char *path, bb__text *t);
+
+/* message (capacity cap) with c's options spelled as c's client spells
+ * them (bb_command_set_spelling); nothing changes for the command line's
+ * spelling (spelling.c). */
+void bb__respell(const bb_command *c, char *message, size_t cap);
+/* st, after err's message is respelled when st is not BB_OK: every public
+ * call on a command returns through it. */
+bb_status bb__spelled(const bb_command *c, bb_status st, bb_error *err);
+
+/* hooks whose notes reach the caller respelled: h (kept alive by the
+ * caller for the call) or, for the command line's spelling or no note
+ * function, hooks itself. */
+typedef struct bb__spelled_hooks {
+  const bb_command *command;
+  const bb_command_hooks *caller;
+  bb_command_hooks hooks;
+} bb__spelled_hooks;
+const bb_command_hooks *bb__spelled_hooks_of(const bb_command *c,
+                                             const bb_command_hooks *hooks,
+                                             bb__spelled_hooks *h);
 
 /* Runs (results.c): a file written, added to result. */
 bb_status bb__result_add(bb_command_result *r, const char *kind, const char *path,

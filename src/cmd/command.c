@@ -9,6 +9,7 @@
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,6 +62,10 @@ void bb_command_free(bb_command *c) {
   free(c->inputs);
   free(c->record_line);
   free(c->record_options);
+  for (int r = 0; r < c->file_record_count; r++) {
+    free(c->file_record_path[r]);
+    free(c->file_record_line[r]);
+  }
   free(c);
 }
 
@@ -95,7 +100,8 @@ const char *bb_command_input(const bb_command *c, int i) {
 
 /* --------------------------------------------------------------- setting */
 
-bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_error *err) {
+static bb_status set_option(bb_command *c, const char *name, const char *text,
+                            bb_error *err) {
   if (!c || !name)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
   const int i = bb__option_find(c->def, name);
@@ -112,9 +118,30 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") &&
       (o->set || o->sets.field != BB__FIELD_NONE))
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out", o->info.name);
-  /* A file option names one file: a second, different name would leave
-   * the first unwritten (or unread) without a word. The job writes one
-   * file per map, so a map wanted twice is baked twice. */
+  /* A map's file given again is a further file of the map, written from
+   * the same bake in its own format (--ssbump s.png --ssbump s.vtf); the
+   * same name again is the same file. */
+  if (c->given[i] && o->repeats && text) {
+    const char *was =
+        *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+    int known = was && !strcmp(was, text);
+    for (int m = 0; m < c->more_count; m++)
+      known |= c->more_option[m] == i && !strcmp(c->more_path[m], text);
+    if (known)
+      return BB_OK;
+    if (c->more_count + 1 >= BB_JOB_MAX_OUTPUTS) /* its first file, the others */
+      return bb__fail(err, BB_ERR_ARGUMENT, "a bake writes at most %d files",
+                      BB_JOB_MAX_OUTPUTS);
+    const char *kept = bb__command_keep(c, text);
+    if (!kept)
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    c->more_option[c->more_count] = i;
+    c->more_path[c->more_count++] = kept;
+    c->checked = 0;
+    return BB_OK;
+  }
+  /* Any other file option names one file: a second, different name would
+   * leave the first unwritten (or unread) without a word. */
   if (c->given[i] && o->info.type == BB_OPTION_PATH && o->field == BB__FIELD_STRING) {
     const char *was = *(const char *const *)(const void *)((const char *)&c->options + o->offset);
     if (was && strcmp(was, text) != 0) {
@@ -188,13 +215,20 @@ bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
   bb_command_free(fresh);
   c->given[i] = 0;
   c->texts[i] = NULL;
+  int kept = 0; /* its further files go too */
+  for (int m = 0; m < c->more_count; m++)
+    if (c->more_option[m] != i) {
+      c->more_option[kept] = c->more_option[m];
+      c->more_path[kept++] = c->more_path[m];
+    }
+  c->more_count = kept;
   c->value_count[i] = 0;
   memset(c->values[i], 0, sizeof c->values[i]);
   c->checked = 0;
   return BB_OK;
 }
 
-bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
+static bb_status add_input(bb_command *c, const char *text, bb_error *err) {
   if (!c || !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no input given");
   if (c->def->add_input) {
@@ -285,7 +319,7 @@ static bb_status check_applies(const bb_command *c, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_command_check(bb_command *c, bb_error *err) {
+static bb_status check(bb_command *c, bb_error *err) {
   if (!c)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: none to check");
   bb_status st = c->in_memory ? BB_OK : check_inputs(c, err);
@@ -318,10 +352,96 @@ bb_status bb_command_set_record(bb_command *c, const char *line, const char *opt
   return BB_OK;
 }
 
+bb_status bb_command_set_record_of(bb_command *c, const char *path, const char *line,
+                                   bb_error *err) {
+  if (!c || !path || !line)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no file record");
+  int r = 0;
+  while (r < c->file_record_count && strcmp(c->file_record_path[r], path))
+    r++;
+  if (r == BB_JOB_MAX_OUTPUTS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: more file records than files");
+  char *p = strdup(path), *l = strdup(line);
+  if (!p || !l) {
+    free(p);
+    free(l);
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  }
+  if (r < c->file_record_count) {
+    free(c->file_record_path[r]);
+    free(c->file_record_line[r]);
+  } else {
+    c->file_record_count++;
+  }
+  c->file_record_path[r] = p;
+  c->file_record_line[r] = l;
+  return BB_OK;
+}
+
+/* The further files of the maps given more than once, and the command line
+ * each file of such a map records: its own record (the command line less
+ * the map's other files), else the command as the library spells it for
+ * that file. The strings go to kept (freed by the caller). */
+static bb_status more_files(const bb_command *c, bb__job_more *more, int *kinds,
+                            const char **paths, const char **commands, char **kept,
+                            int *kept_count, bb_error *err) {
+  memset(more, 0, sizeof *more);
+  *kept_count = 0;
+  if (!c->more_count)
+    return BB_OK;
+  const size_t first_path = offsetof(bb_command_options, job.paths);
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    int n = 0;
+    for (int m = 0; m < c->more_count; m++)
+      n += c->more_option[m] == i;
+    if (!n || !o->repeats)
+      continue;
+    const int kind = (int)((o->offset - first_path) / sizeof(char *));
+    const char *first =
+        *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+    /* the option's files: its first, then the others, in the order given */
+    for (int m = -1; m < c->more_count; m++) {
+      if (m >= 0 && c->more_option[m] != i)
+        continue;
+      const char *path = m < 0 ? first : c->more_path[m];
+      const char *record = NULL;
+      for (int r = 0; r < c->file_record_count; r++)
+        if (!strcmp(c->file_record_path[r], path))
+          record = c->file_record_line[r];
+      char *text = NULL;
+      if (!record) {
+        bb__text t = {0};
+        bb__text_printf(&t, "bumpbake %s", c->def->info.name);
+        for (int k = 0; k < c->input_count; k++) {
+          bb__text_add(&t, " ");
+          bb__text_add_word(&t, c->inputs[k]);
+        }
+        bb__add_options_of_file(c, BB_OPTION_RECORDED, i, path, &t);
+        if (!(text = bb__text_take(&t)))
+          return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+        kept[(*kept_count)++] = text;
+        record = text;
+      }
+      if (m < 0) {
+        more->first_commands[kind] = record;
+      } else {
+        kinds[more->count] = kind;
+        paths[more->count] = path;
+        commands[more->count++] = record;
+      }
+    }
+  }
+  more->kinds = kinds;
+  more->paths = paths;
+  more->commands = commands;
+  return BB_OK;
+}
+
 /* ------------------------------------------------------------------ plan */
 
-bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
-                          bb_error *err) {
+static bb_status plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
+                      bb_error *err) {
   if (!c || !job)
     return bb__fail(err, BB_ERR_ARGUMENT, "command plan: bad arguments");
   *job = NULL;
@@ -376,8 +496,36 @@ bb_status bb__command_plan(bb_command *c, const bb_command_hooks *hooks,
   }
   /* height2ssbump's second positional is its scale, not an input */
   const int inputs = o.valve_path ? 1 : c->input_count;
-  st = bb__job_plan((const char *const *)c->inputs + first_input, inputs - first_input, &o,
-                    flags | BB__PLAN_CHECKED, job, err);
+  bb__job_more more;
+  int kinds[BB_JOB_MAX_OUTPUTS], kept_count = 0;
+  const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+  char *kept[2 * BB_JOB_MAX_OUTPUTS];
+  st = more_files(c, &more, kinds, paths, commands, kept, &kept_count, err);
+  if (st == BB_OK)
+    st = bb__job_plan((const char *const *)c->inputs + first_input, inputs - first_input, &o,
+                      flags | BB__PLAN_CHECKED, &more, job, err);
+  for (int k = 0; k < kept_count; k++)
+    free(kept[k]);
   free(canonical);
   return st;
+}
+
+bb_status bb_command_set(bb_command *c, const char *name, const char *text,
+                         bb_error *err) {
+  return bb__spelled(c, set_option(c, name, text, err), err);
+}
+
+bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
+  return bb__spelled(c, add_input(c, text, err), err);
+}
+
+bb_status bb_command_check(bb_command *c, bb_error *err) {
+  return bb__spelled(c, check(c, err), err);
+}
+
+bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job **job,
+                          bb_error *err) {
+  /* (the job keeps hooks' note function past this call: a run respells
+   * its notes, bb_command_run) */
+  return bb__spelled(c, plan(c, hooks, job, err), err);
 }

@@ -5,8 +5,8 @@
  *
  * The bytes are NUL-terminated fields: the magic, the command's name, then
  * records ("input" TEXT, "option" NAME TEXT, "flag" NAME, "record" LINE,
- * "record-options" TEXT), then "end". An option's TEXT is the one it was
- * set from (bb_command_set), never a value printed and parsed again. */
+ * "record-options" TEXT, "record-of" PATH LINE), then "end". An option's TEXT is the one
+ * it was set from (bb_command_set), never a value printed and parsed again. */
 #include "cmd/cmd_internal.h"
 
 #include <stdlib.h>
@@ -36,6 +36,11 @@ char *bb_command_handover(const bb_command *c, size_t *size) {
     if (c->texts[i])
       field(&t, c->texts[i]);
   }
+  for (int m = 0; m < c->more_count; m++) { /* a map's further files, set again after */
+    field(&t, "option");
+    field(&t, c->def->options[c->more_option[m]]->info.name);
+    field(&t, c->more_path[m]);
+  }
   if (c->record_line) {
     field(&t, "record");
     field(&t, c->record_line);
@@ -43,6 +48,11 @@ char *bb_command_handover(const bb_command *c, size_t *size) {
   if (c->record_options) {
     field(&t, "record-options");
     field(&t, c->record_options);
+  }
+  for (int r = 0; r < c->file_record_count; r++) {
+    field(&t, "record-of");
+    field(&t, c->file_record_path[r]);
+    field(&t, c->file_record_line[r]);
   }
   field(&t, "end");
   *size = t.length;
@@ -90,6 +100,10 @@ static bb_status replay(bb_command *c, const char *data, size_t size, size_t at,
       line = (char *)a;
     } else if (!strcmp(tag, "record-options")) {
       options = (char *)a;
+    } else if (!strcmp(tag, "record-of")) {
+      st = next(data, size, &at, &b)
+               ? bb_command_set_record_of(c, a, b, err)
+               : bb__fail(err, BB_ERR_ARGUMENT, "command hand-over: cut short");
     } else {
       st = bb__fail(err, BB_ERR_ARGUMENT, "command hand-over: unknown field '%.32s'", tag);
     }

@@ -7,9 +7,10 @@
 #include "render/render_internal.h"
 
 #include <arpa/inet.h>
+#include <ctype.h>
 #include <float.h>
-#include <netinet/in.h>
 #include <math.h>
+#include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -294,7 +295,7 @@ const bb__option bb__opt_brightness = {
   {.info = {.name = (name_), .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,    \
             .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,      \
             .help = (help_)},                                                              \
-   .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_])}
+   .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_]), .repeats = 1}
 static const bb__option opt_out_normal =
     ROW_MAP_OUT("normal", BB_MAP_NORMAL, "write the normal map");
 static const bb__option opt_out_weights =
@@ -454,13 +455,147 @@ static const bb__option opt_basetexture = {
              .help = "the colour .vtf the material names as $basetexture"},
     .field = BB__FIELD_STRING, .offset = AT(job.vmt_basetexture)};
 
+/* --scheduler: a Dask scheduler's address as `dask-scheduler` prints it,
+ * PROTOCOL://HOST:PORT or HOST:PORT (tcp), checked here so that a usage
+ * error is one line and exit 2 before any Python or Dask starts: the host a
+ * name, an IPv4 address or [an IPv6 one], the port 1..65535. */
+#define SCHEDULER_EXAMPLE                                                                \
+  "tcp://HOST:PORT, e.g. tcp://10.0.0.1:8786 (dask-scheduler prints it)"
+
+static int is_host_name(const char *host, size_t n) {
+  if (n < 1 || n > 253)
+    return 0;
+  for (size_t i = 0; i < n; i++) {
+    const char ch = host[i];
+    const int word = isalnum((unsigned char)ch) || ch == '_';
+    if (!word && ((ch != '.' && ch != '-') || i == 0 || i == n - 1))
+      return 0;
+  }
+  return 1;
+}
+
+static bb_status check_scheduler(const char *text, bb_error *err) {
+  char shown[80];
+  bb_text_printable(text, shown, sizeof shown);
+  const char *rest = strstr(text, "://");
+  char scheme[16] = "tcp";
+  size_t len = strlen(text);
+  int blank = 1;
+  for (size_t i = 0; i < len; i++)
+    blank &= isspace((unsigned char)text[i]) != 0;
+  if (blank)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--scheduler: an empty address: give %s",
+                    SCHEDULER_EXAMPLE);
+  for (size_t i = 0; i < len; i++)
+    if ((unsigned char)text[i] <= 0x20 || (unsigned char)text[i] == 0x7f)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--scheduler '%s': control characters or spaces in the address",
+                      shown);
+  if (rest) {
+    const size_t n = (size_t)(rest - text);
+    if (n >= sizeof scheme)
+      return bb__fail(
+          err, BB_ERR_ARGUMENT,
+          "--scheduler '%s': unknown protocol (one of tcp, tls, ws, wss, ucx); "
+          "give %s",
+          shown, SCHEDULER_EXAMPLE);
+    for (size_t i = 0; i < n; i++)
+      scheme[i] = (char)tolower((unsigned char)text[i]);
+    scheme[n] = '\0';
+    rest += 3;
+  } else {
+    rest = text;
+  }
+  if (!strcmp(scheme, "inproc"))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--scheduler '%s': inproc:// addresses exist only inside one Python "
+                    "process; give %s",
+                    shown, SCHEDULER_EXAMPLE);
+  static const char *const schemes[] = {"tcp", "tls", "ws", "wss", "ucx"};
+  int known = 0;
+  for (size_t i = 0; i < sizeof schemes / sizeof schemes[0]; i++)
+    known |= !strcmp(scheme, schemes[i]);
+  if (!known)
+    return bb__fail(
+        err, BB_ERR_ARGUMENT,
+        "--scheduler '%s': unknown protocol '%s' (one of tcp, tls, ws, wss, ucx); "
+        "give %s",
+        shown, scheme, SCHEDULER_EXAMPLE);
+  if (strpbrk(rest, "/?#@"))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--scheduler '%s': an address has no path, query or user: give %s",
+                    shown, SCHEDULER_EXAMPLE);
+  const char *port;
+  if (rest[0] == '[') {
+    const char *end = strchr(rest, ']');
+    if (!end)
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--scheduler '%s': '[' without ']' around the IPv6 address", shown);
+    char host[64];
+    unsigned char any[sizeof(struct in6_addr)];
+    const size_t n = (size_t)(end - rest - 1);
+    if (n >= sizeof host ||
+        (memcpy(host, rest + 1, n), host[n] = '\0', inet_pton(AF_INET6, host, any) != 1))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--scheduler '%s': '%.*s' is not an IPv6 address", shown,
+                      (int)(n < 64 ? n : 64), rest + 1);
+    if (end[1] != ':')
+      return bb__fail(err, BB_ERR_ARGUMENT, "--scheduler '%s': no port: give %s", shown,
+                      SCHEDULER_EXAMPLE);
+    port = end + 2;
+  } else {
+    const char *colon = strrchr(rest, ':');
+    if (!colon)
+      return bb__fail(err, BB_ERR_ARGUMENT, "--scheduler '%s': no port: give %s", shown,
+                      SCHEDULER_EXAMPLE);
+    const size_t n = (size_t)(colon - rest);
+    if (memchr(rest, ':', n))
+      return bb__fail(
+          err, BB_ERR_ARGUMENT,
+          "--scheduler '%s': an IPv6 address goes in brackets: %s://[%.*s]:%s", shown,
+          scheme, (int)(n < 64 ? n : 64), rest, colon + 1);
+    if (!is_host_name(rest, n))
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "--scheduler '%s': '%.*s' is not a host name or address", shown,
+                      (int)(n < 64 ? n : 64), rest);
+    port = colon + 1;
+  }
+  long number = 0;
+  int digits = port[0] != '\0';
+  for (const char *d = port; *d && digits; d++) {
+    digits = isdigit((unsigned char)*d) != 0;
+    if (number <= 65535)
+      number = number * 10 + (*d - '0');
+  }
+  if (!digits || number < 1 || number > 65535)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--scheduler '%s': the port '%.16s' is not a number from 1 to 65535",
+                    shown, port);
+  return BB_OK;
+}
+
+static bb_status set_scheduler(bb_command *c, const bb__option *o, const char *text,
+                               double *values, int *count, bb_error *err) {
+  *count = 0;
+  bb_status st = check_scheduler(text, err);
+  return st == BB_OK ? bb__set_generic(c, o, text, values, count, err) : st;
+}
+
 static const bb__option opt_scheduler = {
-    .info = {.name = "scheduler", .value_name = "ADDRESS", .type = BB_OPTION_TEXT, .flags = BB_OPTION_FILES, .count = 1,
-             .values = 1,
-             .help = "bake on the Dask cluster of this scheduler (tcp://host:8786): a batch's "
-                     "inputs on its workers, a single map's trace split over them "
-                     "(docs/cluster.md)"},
-    .field = BB__FIELD_STRING, .offset = AT(scheduler)};
+    .info =
+        {.name = "scheduler",
+         .value_name = "ADDRESS",
+         .type = BB_OPTION_TEXT,
+         .flags = BB_OPTION_CLIENT | BB_OPTION_FILES,
+         .count = 1,
+         .values = 1,
+         .help =
+             "bake on the Dask cluster of this scheduler (tcp://host:8786): a batch's "
+             "inputs on its workers, a single map's trace split over them "
+             "(docs/cluster.md)"},
+    .field = BB__FIELD_STRING,
+    .offset = AT(scheduler),
+    .set = set_scheduler};
 
 /* -------------------------------------------------------------- bake */
 
@@ -508,6 +643,9 @@ const bb__command bb__command_bake = {
                  "With --clamp the trace takes 2.3 to 3.4 times as long. See\n"
                  "docs/performance.md and docs/accuracy.md.\n"
                  "\n"
+                 "A map option given again writes the bake's map to a further file, in\n"
+                 "its own format: --ssbump s.png --ssbump s.vtf traces once.\n"
+                 "\n"
                  "Batches: bumpbake bake HEIGHT|DIR... --scale S --out-dir DIR [--maps LIST]\n"
                  "bakes every HEIGHT (a directory: the images in it, sorted, not below it)\n"
                  "in one process into DIR/--name, and skips an input whose outputs are\n"
@@ -523,7 +661,7 @@ static const bb__option opt_normal_output = {
     .info = {.name = "output", .short_name = 'o', .value_name = "OUT", .type = BB_OPTION_PATH,
              .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_REQUIRED | BB_OPTION_FILES,
              .help = "normal map to write (.png .tga .tif .exr); required"},
-    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL])};
+    .field = BB__FIELD_STRING, .offset = AT(job.paths[BB_MAP_NORMAL]), .repeats = 1};
 
 static const bb__option opt_quiet_normal = {
     .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,

@@ -272,6 +272,43 @@ static unsigned needed_maps(const bb_command_options *o) {
   return bb_render_mode_needs(o->render.mode);
 }
 
+/* The files a render of c reads, and the bake of its HEIGHT (the maps the
+ * picture is lit from), for the estimates before any pixel is read. */
+static void render_files(const bb_command *c, bb_render_sources *files,
+                         bb_bake_options *bake) {
+  const bb_command_options *o = &c->options;
+  memset(files, 0, sizeof *files);
+  for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
+    files->maps[m] = o->render_maps[m];
+  files->height = c->input_count ? c->inputs[0] : NULL;
+  files->albedo = o->albedo;
+  *bake = o->job.bake;
+  const int traced =
+      (needed_maps(o) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
+  bake->outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_FILTERED) |
+                  (traced ? BB_MAPS_TRACED : 0u);
+}
+
+/* A note, through hooks, of what a render of files will cost when that is
+ * over what any read takes (bb__memory_note): said before it starts. */
+static void render_cost_note(const bb_command *c, const bb_command_hooks *hooks) {
+  if (!hooks || !hooks->note || c->in_memory)
+    return;
+  bb_render_sources files;
+  bb_bake_options bake;
+  render_files(c, &files, &bake);
+  const bb_command_options *o = &c->options;
+  double need = 0.0;
+  const char *path = NULL;
+  char what[128], text[256];
+  bb_error ignored = {{0}};
+  if (bb__render_files_need(&files, &bake, &o->render, o->render_compare, o->output,
+                            o->job.depth, NULL, NULL, &need, &path, what, sizeof what,
+                            &ignored) == BB_OK &&
+      bb__memory_note(need, what, text, sizeof text))
+    hooks->note(hooks->note_user, path, text);
+}
+
 /* A lightmap without --light is the only light. */
 static void lights(bb_command *c) {
   if (c->options.render.static_light && !bb__given(c, "light"))
@@ -319,15 +356,8 @@ static bb_status render_check(bb_command *c, bb_error *err) {
    * usage error, anything else the files' */
   if (!c->in_memory) {
     bb_render_sources files;
-    memset(&files, 0, sizeof files);
-    for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
-      files.maps[m] = o->render_maps[m];
-    files.height = height;
-    files.albedo = o->albedo;
-    bb_bake_options bake = o->job.bake;
-    const int traced = (needed_maps(o) & (BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO)) != 0;
-    bake.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_FILTERED) |
-                   (traced ? BB_MAPS_TRACED : 0u);
+    bb_bake_options bake;
+    render_files(c, &files, &bake);
     int w = 0, h = 0;
     bb_error why = {{0}};
     bb_status st = bb_render_files_check(&files, &bake, &o->render, o->render_compare, o->output,
@@ -379,7 +409,8 @@ const bb__command bb__command_render = {
                  "already baked\n(--normal-y up: those files are OpenGL-style).",
              .inputs = "HEIGHT", .min_inputs = 0, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof render_options / sizeof render_options[0]) - 1},
-    .options = render_options, .init = render_init, .check = render_check, .run = bb__run_render};
+    .options = render_options, .init = render_init, .check = render_check, .run = bb__run_render,
+    .before_run = render_cost_note};
 
 /* ------------------------------------------------------------- sheet */
 

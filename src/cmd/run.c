@@ -26,8 +26,8 @@ static bb_status run_job(bb_command *c, const bb_command_hooks *hooks, bb_comman
   return st;
 }
 
-bb_status bb_command_run(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
-                         bb_error *err) {
+static bb_status run(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                     bb_error *err) {
   if (!c || !r)
     return bb__fail(err, BB_ERR_ARGUMENT, "command run: bad arguments");
   memset(r, 0, sizeof *r);
@@ -38,11 +38,21 @@ bb_status bb_command_run(bb_command *c, const bb_command_hooks *hooks, bb_comman
   bb_status st;
   if (c->def->job)
     st = run_job(c, hooks, r, err);
-  else if (c->def->run)
+  else if (c->def->run) {
+    if (c->def->before_run)
+      c->def->before_run(c, hooks);
     st = c->def->run(c, hooks, r, err);
+  }
   else
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s writes no file to run", c->def->info.name);
   if (st != BB_OK)
     bb_command_result_free(r);
   return st;
+}
+
+bb_status bb_command_run(bb_command *c, const bb_command_hooks *hooks,
+                         bb_command_result *r, bb_error *err) {
+  bb__spelled_hooks h;
+  return bb__spelled(c, run(c, c ? bb__spelled_hooks_of(c, hooks, &h) : hooks, r, err),
+                     err);
 }

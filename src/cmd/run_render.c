@@ -304,9 +304,9 @@ static bb_status sheet_picture(const bb_command_options *a, const bb_command_hoo
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, what, &e);
 }
 
-bb_status bb_command_picture(bb_command *c, const bb_image *height, const bb_render_maps *maps,
-                             const bb_command_hooks *hooks, bb_image *out, int *labels_drawn,
-                             bb_error *err) {
+static bb_status picture(bb_command *c, const bb_image *height,
+                         const bb_render_maps *maps, const bb_command_hooks *hooks,
+                         bb_image *out, int *labels_drawn, bb_error *err) {
   if (!c || !out)
     return bb__fail(err, BB_ERR_ARGUMENT, "picture: bad arguments");
   memset(out, 0, sizeof *out);
@@ -397,4 +397,15 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
   bb_bake_result_free(&result);
   bb_image_free(&height);
   return st;
+}
+
+bb_status bb_command_picture(bb_command *c, const bb_image *height,
+                             const bb_render_maps *maps, const bb_command_hooks *hooks,
+                             bb_image *out, int *labels_drawn, bb_error *err) {
+  bb__spelled_hooks h;
+  return bb__spelled(c,
+                     picture(c, height, maps,
+                             c ? bb__spelled_hooks_of(c, hooks, &h) : hooks, out,
+                             labels_drawn, err),
+                     err);
 }

@@ -69,9 +69,9 @@ bb_status bb__run_renderbumpflat(bb_command *c, const bb_command_hooks *hooks,
   return st;
 }
 
-bb_status bb_command_renderbump(bb_command *c, const bb_command_hooks *hooks,
-                                bb_renderbump_result *render, bb_command_result *result,
-                                bb_error *err) {
+static bb_status renderbump(bb_command *c, const bb_command_hooks *hooks,
+                            bb_renderbump_result *render, bb_command_result *result,
+                            bb_error *err) {
   if (render)
     memset(render, 0, sizeof *render);
   if (result) {
@@ -92,4 +92,14 @@ bb_status bb_command_renderbump(bb_command *c, const bb_command_hooks *hooks,
     bb_command_result_free(result);
   }
   return st;
+}
+
+bb_status bb_command_renderbump(bb_command *c, const bb_command_hooks *hooks,
+                                bb_renderbump_result *render, bb_command_result *result,
+                                bb_error *err) {
+  bb__spelled_hooks h;
+  return bb__spelled(
+      c,
+      renderbump(c, c ? bb__spelled_hooks_of(c, hooks, &h) : hooks, render, result, err),
+      err);
 }

@@ -9,12 +9,18 @@
 
 /* " --name value" of every option given, in the order of --help; only
  * those that determine what is made when recorded. */
-void bb__add_options(const bb_command *c, unsigned flags, bb__text *t) {
+static void add_options(const bb_command *c, unsigned flags, int only_option,
+                        const char *only_path, bb__text *t) {
   for (int i = 0; c->def->options[i]; i++) {
     const bb__option *o = c->def->options[i];
     if (!c->given[i] || (o->info.flags & BB_OPTION_CLIENT) ||
         ((flags & BB_OPTION_RECORDED) && !(o->info.flags & BB_OPTION_RECORDED)))
       continue;
+    if (i == only_option) { /* one file of a map written to several */
+      bb__text_printf(t, " --%s ", o->info.name);
+      bb__text_add_word(t, only_path);
+      continue;
+    }
     bb__text_printf(t, " --%s", o->info.name);
     if (o->info.type == BB_OPTION_FLAG)
       continue;
@@ -39,7 +45,21 @@ void bb__add_options(const bb_command *c, unsigned flags, bb__text *t) {
       v = blank ? blank + 1 : v + n;
     } while (*v);
     bb__text_free(&value);
+    for (int m = 0; m < c->more_count; m++)
+      if (c->more_option[m] == i) {
+        bb__text_printf(t, " --%s ", o->info.name);
+        bb__text_add_word(t, c->more_path[m]);
+      }
   }
+}
+
+void bb__add_options(const bb_command *c, unsigned flags, bb__text *t) {
+  add_options(c, flags, -1, NULL, t);
+}
+
+void bb__add_options_of_file(const bb_command *c, unsigned flags, int option,
+                             const char *path, bb__text *t) {
+  add_options(c, flags, option, path, t);
 }
 
 char *bb_command_text(const bb_command *c, const char *input, unsigned flags) {

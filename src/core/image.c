@@ -19,20 +19,38 @@ const char *bb_status_name(bb_status status) {
   return "unknown status";
 }
 
+/* A message is one line, safe to show, whatever a name in it holds: a
+ * control character (a newline in a path, an escape sequence), a
+ * bidirectional control or bytes that are not UTF-8 are written as \xNN,
+ * as the command line prints text (bb_text_printable), so every client
+ * shows the same single line. */
 bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...) {
   if (err) {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(err->message, sizeof err->message, fmt, ap);
     va_end(ap);
+    char shown[4 * sizeof err->message];
+    bb_text_printable(err->message, shown, sizeof shown);
+    size_t n = strlen(shown);
+    if (n >= sizeof err->message)
+      n = sizeof err->message - 1;
+    memcpy(err->message, shown, n);
+    err->message[n] = '\0';
   }
   return status;
 }
 
+size_t bb__message_names(const char *message, const char *path) {
+  char shown[4 * sizeof(((bb_error *)0)->message)];
+  bb_text_printable(path, shown, sizeof shown);
+  const size_t n = strlen(shown);
+  return strncmp(message, shown, n) == 0 && message[n] == ':' ? n : 0;
+}
+
 bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e) {
   const char *why = e && e->message[0] ? e->message : bb_status_name(st);
-  const size_t n = strlen(path);
-  if (strncmp(why, path, n) == 0 && why[n] == ':')
+  if (bb__message_names(why, path))
     return bb__fail(err, st, "%s", why);
   return bb__fail(err, st, "%s: %s", path, why);
 }

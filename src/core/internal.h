@@ -16,7 +16,9 @@ extern "C" {
 #endif
 
 /* Writes a printf-style message into err (when not NULL) and returns status,
- * so error paths read: return bb__fail(err, BB_ERR_IO, "%s: ...", path); */
+ * so error paths read: return bb__fail(err, BB_ERR_IO, "%s: ...", path).
+ * The message is one line, safe to print: what bb_text_printable escapes
+ * (controls, bytes that are not UTF-8) is written as \xNN. */
 bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -26,6 +28,10 @@ bb_status bb__fail(bb_error *err, bb_status status, const char *fmt, ...)
 /* A failure about the file path, st with e's message (else st's name),
  * naming path once: e's message as it is when it already starts "PATH:". */
 bb_status bb__fail_at(bb_error *err, bb_status st, const char *path, const bb_error *e);
+
+/* The length of path as a message shows it (bb__fail's escapes) when
+ * message starts with it and a ':', else 0. */
+size_t bb__message_names(const char *message, const char *path);
 
 /* Finds name among names[0..count-1] (NULL entries skipped), comparing
  * with or without case, into *index: BB_OK, or BB_ERR_ARGUMENT with "WHAT
@@ -214,6 +220,13 @@ bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char 
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */
 bb_status bb__memory_check(double need, const char *what, bb_error *err);
+
+/* What a job that fits will cost, to say before it starts: "WHAT takes
+ * about 8.0 GiB of memory (20.9 GiB is available)" into out (cap bytes)
+ * and 1 when need is over BB_MAX_READ_BYTES (what any read may take
+ * whatever its size: past it, only a large input costs that much and a
+ * while), else 0 and out empty. */
+int bb__memory_note(double need, const char *what, char *out, size_t cap);
 
 /* (text.c, beside bb__text_append and bb__text_add) */
 void bb__text_printf(bb__text *t, const char *fmt, ...)

@@ -53,8 +53,12 @@ static uint64_t address_space_used(void) {
  * the kernel with no message. Every cgroup from the process's own up to
  * its hierarchy's root may set one (v2: memory.max; v1, with the memory
  * controller: memory.limit_in_bytes); the room under each is its limit
- * less what the group uses, its reclaimable page cache (inactive_file)
- * not counted, as MemAvailable counts the machine's. */
+ * less what the group uses, its page cache (active_file and
+ * inactive_file: file pages the kernel reclaims before it kills anything)
+ * not counted, as MemAvailable counts the machine's. cgroup v1 names the
+ * same counts with a total_ prefix for the group and its children, as
+ * memory.usage_in_bytes counts them; its unprefixed ones are the group's
+ * own pages alone. */
 
 /* The number at the start of DIR/NAME; 0 when it reads, -1 when missing
  * or "max" (no limit) or not a number. */
@@ -98,9 +102,11 @@ static uint64_t group_room(const char *dir, int v2) {
   if (read_number(dir, v2 ? "memory.max" : "memory.limit_in_bytes", &limit) != 0)
     return UINT64_MAX;
   (void)read_number(dir, v2 ? "memory.current" : "memory.usage_in_bytes", &usage);
-  uint64_t cache = stat_value(dir, v2 ? "inactive_file" : "total_inactive_file");
-  if (!v2 && !cache)
-    cache = stat_value(dir, "inactive_file");
+  uint64_t cache =
+      v2 ? 0
+         : stat_value(dir, "total_active_file") + stat_value(dir, "total_inactive_file");
+  if (!cache)
+    cache = stat_value(dir, "active_file") + stat_value(dir, "inactive_file");
   const uint64_t used = usage > cache ? usage - cache : 0;
   return limit > used ? limit - used : 0;
 }
@@ -282,4 +288,19 @@ bb_status bb__memory_check(double need, const char *what, bb_error *err) {
   size_text((double)room, b, sizeof b);
   return bb__fail(err, BB_ERR_MEMORY, "%s needs about %s of memory; %s is available (%s)",
                   what, a, b, source);
+}
+
+int bb__memory_note(double need, const char *what, char *out, size_t cap) {
+  if (cap)
+    out[0] = '\0';
+  if (need <= (double)BB_MAX_READ_BYTES || !cap)
+    return 0;
+  char a[32], b[32] = "";
+  size_text(need, a, sizeof a);
+  uint64_t room = 0;
+  if (bb_memory_available(&room, NULL, NULL) == BB_OK)
+    size_text((double)room, b, sizeof b);
+  snprintf(out, cap, "%s takes about %s of memory%s%s%s", what, a, b[0] ? " (" : "", b,
+           b[0] ? " is available)" : "");
+  return 1;
 }

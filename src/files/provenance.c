@@ -406,8 +406,25 @@ static int pack_line(const char *line, size_t n, int rows, int row_chars, char *
   return 0;
 }
 
-int bb__provenance_pack(const char *description, int rows, int row_chars, char *out) {
+/* Appends line [line, line + n) to the NUL-terminated overflow text
+ * (capacity cap; NULL: none kept) when it fits whole, '\n'-separated. */
+static void keep_overflow(const char *line, size_t n, char *overflow, size_t cap) {
+  if (!overflow)
+    return;
+  size_t used = strlen(overflow), sep = used ? 1 : 0;
+  if (used + sep + n + 1 > cap)
+    return;
+  if (sep)
+    overflow[used++] = '\n';
+  memcpy(overflow + used, line, n);
+  overflow[used + n] = '\0';
+}
+
+static int pack(const char *description, int rows, int row_chars, char *out,
+                char *overflow, size_t overflow_cap) {
   memset(out, 0, (size_t)rows * (size_t)(row_chars + 1));
+  if (overflow && overflow_cap)
+    overflow[0] = '\0';
   int dropped = 0;
   /* One pass per rank keeps the order stable without sorting or memory. */
   for (int rank = 0; rank < PACK_RANKS; rank++) {
@@ -420,9 +437,20 @@ int bb__provenance_pack(const char *description, int rows, int row_chars, char *
         n--;
       if (n == 0 || pack_rank(&e) != rank) /* a line without '=' ranks as other */
         continue;
-      if (!pack_line(line, n, rows, row_chars, out))
+      if (!pack_line(line, n, rows, row_chars, out)) {
         dropped++;
+        keep_overflow(line, n, overflow, overflow_cap);
+      }
     }
   }
   return dropped;
+}
+
+int bb__provenance_pack(const char *description, int rows, int row_chars, char *out) {
+  return pack(description, rows, row_chars, out, NULL, 0);
+}
+
+int bb__provenance_pack_overflow(const char *description, int rows, int row_chars,
+                                 char *out, char *overflow, size_t overflow_cap) {
+  return pack(description, rows, row_chars, out, overflow, overflow_cap);
 }

@@ -19,6 +19,12 @@ extern "C" {
  * rows * (row_chars + 1) bytes. Returns how many lines did not fit. */
 int bb__provenance_pack(const char *description, int rows, int row_chars, char *out);
 
+/* bb__provenance_pack, and the lines that did not fit into overflow
+ * (capacity overflow_cap, NUL-terminated): whole lines in the order they
+ * were left out, '\n'-separated, as many as fit. */
+int bb__provenance_pack_overflow(const char *description, int rows, int row_chars,
+                                 char *out, char *overflow, size_t overflow_cap);
+
 /* 1 when two provenance texts differ in a key not in `ignored` (a
  * NULL-terminated list): a key of want missing from have or holding
  * another value there, or a key have holds and want lacks (first

@@ -9,21 +9,25 @@
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
 #include "image/description.h"
+#include "image/formats.h"
 #include "image/header_probe.h"
 #include "image/oiio_calls.h"
 #include "image/oiio_guard.h"
 #include "image/oiio_setup.h"
 #include "image/png_hooks.h"
 #include "image/read_limits.h"
+#include "image/signatures.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -146,35 +150,135 @@ struct opened_input {
   bool png = false;
 };
 
-// Opens path through its checked descriptor (readers that cannot read
-// through a proxy open the name, checked a moment before), for `reading`
-// pixels or only headers, and makes OpenImageIO's refusals one line.
+// The OpenImageIO format whose reader path's extension names ("" when none
+// does), from OpenImageIO's own list of its readers' extensions.
+std::string format_of_extension(const char *path) {
+  static const std::map<std::string, std::string> formats = [] {
+    std::map<std::string, std::string> m;
+    // "openexr:exr,sxr;tiff:tif,tiff;...": each format and its extensions.
+    for (const std::string &entry :
+         OIIO::Strutil::splits(OIIO::get_string_attribute("extension_list"), ";")) {
+      const size_t colon = entry.find(':');
+      if (colon == std::string::npos)
+        continue;
+      const std::string format = entry.substr(0, colon);
+      for (const std::string &ext : OIIO::Strutil::splits(entry.substr(colon + 1), ","))
+        m.emplace(ext, format);
+    }
+    return m;
+  }();
+  char ext[32];
+  bb__extension_of(path, ext, sizeof ext);
+  if (!ext[0])
+    return std::string();
+  auto it = formats.find(ext + 1);
+  return it == formats.end() ? std::string() : it->second;
+}
+
+// The format the first bytes of the checked file name ("" when none).
+std::string format_of_content(CheckedInput &file) {
+  unsigned char head[BB_SIGNATURE_BYTES];
+  const size_t n = file.pread(head, sizeof head, 0);
+  const char *format = bb__format_by_content(head, n);
+  return format ? format : std::string();
+}
+
+// Opens the checked file with format's reader alone (never OpenImageIO's
+// walk through every reader when one refuses), through the descriptor
+// where the reader reads proxies, else by the name, checked a moment
+// before. nullptr and the reader's reason in *why when it refuses.
+std::unique_ptr<ImageInput> open_as(const std::string &format, const char *path,
+                                    CheckedInput &file, bool png, std::string *why) {
+  std::unique_ptr<ImageInput> in = ImageInput::create(format); // by name: reads nothing
+  if (!in) {
+    *why = OIIO::geterror();
+    return nullptr;
+  }
+  if (in->supports("ioproxy") && !in->set_ioproxy(&file)) {
+    *why = in->geterror();
+    return nullptr;
+  }
+  file.seek(0);
+  ImageSpec config, spec;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  bool ok;
+  {
+    OiioPngLeakScope png_leak(png);
+    ok = in->open(path, spec, config);
+  }
+  if (!ok) {
+    *why = in->geterror();
+    if (why->empty())
+      *why = OIIO::geterror();
+    return nullptr;
+  }
+  return in;
+}
+
+// Opens path through its checked descriptor, for `reading` pixels or only
+// headers, and makes OpenImageIO's refusals one line. The extension's
+// reader reads the file unless the file lacks that format's signature;
+// when it refuses, the reader the file's first bytes name (a PNG named
+// .tga) is the one other tried. A file neither names is refused at once,
+// naming the format its extension promised.
 opened_input open_input(const char *path, bool reading, bb_status *st, bb_error *err) {
   opened_input opened;
   opened.file = open_checked(path, reading, st, err);
-  if (!opened.file) return opened;
+  if (!opened.file)
+    return opened;
   bb::oiio_setup();
   (void)bb__png_hooks_set(); // links the hooks on libpng (png_hooks.c)
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
   opened.png = OiioPngLeakScope::applies_to(path);
-  {
-    OiioPngLeakScope png_leak(opened.png);
-    // create(do_open = true), not open(): open() with a config first asks
-    // the extension's reader whether the file is its own by opening the
-    // name (valid_file), then reads the name; create hands every reader
-    // the proxy.
-    opened.in = ImageInput::create(path, true, &config, opened.file.get());
+  const std::string promised = format_of_extension(path);
+  const std::string content = format_of_content(*opened.file);
+  std::string why;
+  if (!promised.empty() &&
+      (content == promised || !bb__format_has_signature(promised.c_str())))
+    opened.in = open_as(promised, path, *opened.file, opened.png, &why);
+  if (!opened.in && !content.empty() && content != promised) {
+    std::string why_content;
+    opened.in = open_as(content, path, *opened.file, opened.png, &why_content);
+    if (why.empty())
+      why = why_content;
   }
-  if (!opened.in) {
-    std::string why = OIIO::geterror();
-    if (is_limit_refusal(why))
-      *st = bb__fail(err, BB_ERR_SIZE,
-                     "%s: too large to read: %s (bumpbake reads at most %.0f MiB of samples)",
-                     path, bb::first_line(why).c_str(), oiio_imagesize_limit() / (double)MiB);
+  if (opened.in)
+    return opened;
+  if (is_limit_refusal(why)) {
+    *st =
+        bb__fail(err, BB_ERR_SIZE,
+                 "%s: too large to read: %s (bumpbake reads at most %.0f MiB of samples)",
+                 path, bb::first_line(why).c_str(), oiio_imagesize_limit() / (double)MiB);
+  } else if (!content.empty()) {
+    *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
+                   bb::one_line(why).c_str());
+  } else if (promised.empty()) {
+    char ext[32];
+    bb__extension_of(path, ext, sizeof ext);
+    if (ext[0])
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: no image format has the extension '%s', and "
+          "its first bytes name none",
+          path, ext);
     else
-      *st = bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path,
-                     bb::one_line(why).c_str());
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: no extension names its format, and its first "
+          "bytes name none",
+          path);
+  } else {
+    const char *name = bb__format_display_name(promised.c_str());
+    if (why.empty())
+      *st = bb__fail(
+          err, BB_ERR_FORMAT,
+          "%s: not a readable image: its extension says %s, but it does not carry "
+          "%s's signature, nor any other format's",
+          path, name, name);
+    else
+      *st = bb__fail(err, BB_ERR_FORMAT,
+                     "%s: not a readable image: its extension says %s, but the %s reader "
+                     "refuses it (%s), and its first bytes name no other format",
+                     path, name, name, bb::one_line(why).c_str());
   }
   return opened;
 }
@@ -212,6 +316,9 @@ bb_status fill_info(const ImageInput &in, const ImageSpec &spec, bb_image_info *
     if (!info->description)
       return bb__fail(err, BB_ERR_MEMORY, "%s: cannot allocate the description", path);
     std::memcpy(info->description, desc.c_str(), desc.size() + 1);
+    info->description =
+        bb__description_join(in.format_name(), info->description,
+                             spec.get_string_attribute("targa:ImageID").c_str());
     bb__description_as_read(in.format_name(), info->description);
   }
   return BB_OK;

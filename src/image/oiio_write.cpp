@@ -101,6 +101,11 @@ std::string encode_image(const std::string &file_name, OIIO::Filesystem::IOProxy
     malloced<char> stored(bb__description_to_store(file_name.c_str(), description));
     if (!stored) throw std::bad_alloc();
     spec.attribute("ImageDescription", stored.get());
+    malloced<char> overflow(bb__description_overflow(file_name.c_str(), description));
+    if (!overflow)
+      throw std::bad_alloc();
+    if (overflow.get()[0])
+      spec.attribute("targa:ImageID", overflow.get());
   }
   if (depth == BB_DEPTH_HALF || depth == BB_DEPTH_FLOAT) spec.attribute("compression", "zip");
 

@@ -56,6 +56,53 @@ static void compare_provenance(const bb_image_info *ia, const bb_image_info *ib,
   }
 }
 
+/* Bytes a file's samples take as stored, from its header: what the read
+ * holds beside the floats while it decodes. */
+static double stored_bytes(int width, int height, int channels,
+                           const bb_image_info *info) {
+  const int bits = info->bits_per_sample > 0 ? info->bits_per_sample : 32;
+  return (double)width * height * channels * ((bits + 7) / 8);
+}
+
+bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+                                 bb_note_fn note, void *note_user, bb_error *err) {
+  if (!a || !b)
+    return bb__fail(err, BB_ERR_ARGUMENT, "compare: bad arguments");
+  int w[2], h[2], c[2];
+  bb_image_info info[2];
+  const char *paths[2] = {a, b};
+  for (int i = 0; i < 2; i++) {
+    bb_status st = bb_image_read_info(paths[i], &w[i], &h[i], &c[i], &info[i], err);
+    bb_image_info_free(&info[i]); /* (its description; the sizes stay) */
+    if (st != BB_OK)
+      return st;
+  }
+  /* A held while B is read (its floats and its stored samples), then,
+   * with a diff, both and |A - B| and the encoder's copy of it. */
+  double floats[2], reads[2];
+  for (int i = 0; i < 2; i++) {
+    floats[i] = (double)w[i] * h[i] * c[i] * sizeof(float);
+    reads[i] = floats[i] + stored_bytes(w[i], h[i], c[i], &info[i]);
+  }
+  double peak = reads[0] > floats[0] + reads[1] ? reads[0] : floats[0] + reads[1];
+  const int same = w[0] == w[1] && h[0] == h[1] && c[0] == c[1];
+  if (same && diff_path) {
+    const double texels = (double)w[0] * h[0] * c[0];
+    const double diffing =
+        3.0 * floats[0] + texels * bb__encoded_sample_bytes(diff_path, BB_DEPTH_DEFAULT);
+    peak = diffing > peak ? diffing : peak;
+  }
+  const double need = peak * 1.05 + 32.0 * 1024 * 1024;
+  char what[128], named[4400], text[256];
+  snprintf(what, sizeof what, "comparing %s %d x %d image%s of %d channel%s",
+           same ? "two" : "a", w[0], h[0], same ? "s" : "", c[0], c[0] == 1 ? "" : "s");
+  snprintf(named, sizeof named, "%s: %s", a, what);
+  bb_status st = bb__memory_check(need, named, err);
+  if (st == BB_OK && note && bb__memory_note(need, what, text, sizeof text))
+    note(note_user, a, text);
+  return st;
+}
+
 bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err) {
   if (!a || !b || !report)
@@ -71,7 +118,10 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
     return checked;
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
-  bb_status st = bb_image_read(a, &x, &ix, err);
+  /* what it will take, from the headers, before a pixel is read */
+  bb_status st = bb_compare_files_check(a, b, diff_path, NULL, NULL, err);
+  if (st == BB_OK)
+    st = bb_image_read(a, &x, &ix, err);
   if (st == BB_OK)
     st = bb_image_read(b, &y, &iy, err);
   if (st == BB_OK) {

@@ -55,9 +55,10 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
     source = &local;
   memset(source, 0, sizeof *source);
   /* The bytes are hashed before they are decoded: provenance must never
-   * pair a newer file's hash with an older file's pixels. A file that is
-   * missing or no regular file is said as the image reader says it. */
-  bb_status st = bb__input_check(path, err);
+   * pair a newer file's hash with an older file's pixels. The header is
+   * read first, so a file that is missing, no regular file or no image is
+   * refused as the image reader says it, before its bytes are all read. */
+  bb_status st = bb_image_read_info(path, NULL, NULL, NULL, NULL, err);
   if (st == BB_OK)
     st = bb_file_hash(path, &source->file_hash, err);
   if (st != BB_OK)

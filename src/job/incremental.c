@@ -44,10 +44,9 @@ bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err) {
   int fd;
   bb_error why;
   if (bb__input_open(path, &fd, &why) != BB_OK) {
-    size_t n = strlen(path);
-    const char *reason = strncmp(why.message, path, n) == 0 && !strncmp(why.message + n, ": ", 2)
-                             ? why.message + n + 2
-                             : why.message;
+    const size_t n = bb__message_names(why.message, path);
+    const char *reason =
+        n && why.message[n + 1] == ' ' ? why.message + n + 2 : why.message;
     /* "cannot read: " once: the open's own reason may already say it. */
     if (strncmp(reason, "cannot read: ", 13) == 0)
       reason += 13;

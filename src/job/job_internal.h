@@ -73,6 +73,17 @@ typedef struct bb__job_item {
   char *input;
   char *paths[BB_MAP_BAKED_COUNT]; /* NULL = kind not written */
   char *slope_lit_path;              /* single input with slope_lit */
+  /* A single input's further files of its maps (one bake writes a map to
+   * several files, each in its format): more_kinds[i]'s map to
+   * more_paths[i], in the order given. */
+  int more_count;
+  int more_kinds[BB_JOB_MAX_OUTPUTS];
+  char *more_paths[BB_JOB_MAX_OUTPUTS];
+  /* The command each file of a map written to several files records (the
+   * command less the map's other files, what a bake of that file alone
+   * records); NULL: the job's command. */
+  char *commands[BB_MAP_BAKED_COUNT];
+  char *more_commands[BB_JOB_MAX_OUTPUTS];
   uint64_t file_hash;                /* the bytes checked for currency, 0 = not yet */
   bb_job_report report;
 } bb__job_item;
@@ -132,14 +143,35 @@ unsigned bb__job_maps_asked(const bb_job_options *o);
  * "normal+ao", "detail-ssbump+height"... */
 const char *bb__job_valve_kind(const bb_job_options *o);
 
+/* A single input's maps written to several files (a command's --MAP FILE
+ * given more than once): count further files, kinds[i]'s map to paths[i],
+ * and the command each records (commands[i]; first_commands[kind] for the
+ * first file of a map, o->paths[kind]; NULL: the job's command). */
+typedef struct bb__job_more {
+  int count;
+  const int *kinds;
+  const char *const *paths;
+  const char *const *commands;
+  const char *first_commands[BB_MAP_BAKED_COUNT];
+} bb__job_more;
+
 /* bb_job_plan; flags: BB__PLAN_CHECKED: o's bake options were checked
  * already (a command's, cmd/plan.c) and are only resolved
  * (bb__bake_resolve); BB__PLAN_READ_ONLY: a plan whose outputs are read,
- * not written (a golden check): no directory is made, and none need exist. */
+ * not written (a golden check): no directory is made, and none need exist;
+ * more (may be NULL): the further files of a single input's maps. */
 #define BB__PLAN_CHECKED 1u
 #define BB__PLAN_READ_ONLY 2u
 bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                       unsigned flags, bb_job **out, bb_error *err);
+                       unsigned flags, const bb__job_more *more, bb_job **out,
+                       bb_error *err);
+
+/* The map files of item in the order they are listed and written: each
+ * map's first file (item->paths[kind]), then its further ones, by kind;
+ * kinds, paths and commands (a file's own, NULL: the job's) hold
+ * BB_JOB_MAX_OUTPUTS entries. The count. */
+int bb__job_map_files(const bb__job_item *item, int *kinds, const char **paths,
+                      const char **commands);
 
 /* A batch's name template's fields {stem}, {kind} and {ext} ("{{" and "}}"
  * are braces) expanded with fields[0..2] into out (capacity cap): the name

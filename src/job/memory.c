@@ -48,18 +48,19 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
    * quantised copy (its mip chain in float too), the files encoded side by
    * side */
   double encode = 0.0;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    if (!item->paths[k])
-      continue;
-    const bb_map_kind_info *kind = bb_map_kind_get((bb_map_kind)k);
+  int kinds[BB_JOB_MAX_OUTPUTS];
+  const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+  const int files = bb__job_map_files(item, kinds, paths, commands);
+  for (int f = 0; f < files; f++) {
+    const bb_map_kind_info *kind = bb_map_kind_get((bb_map_kind)kinds[f]);
     const int c = kind->channels ? kind->channels : o->basis.count;
     const double samples = t * c;
-    if (bb_path_is_texture_format(item->paths[k])) {
-      encode += texture_bytes(job, item->paths[k], kind, w, h, c);
+    if (bb_path_is_texture_format(paths[f])) {
+      encode += texture_bytes(job, paths[f], kind, w, h, c);
       continue;
     }
     const double mips = job->options.mips ? 4.0 / 3.0 : 1.0;
-    encode += samples * mips * sample_bytes(job->options.depth, item->paths[k]) +
+    encode += samples * mips * sample_bytes(job->options.depth, paths[f]) +
               (job->options.mips ? samples * mips * 4.0 : 0.0);
   }
   if (job->slope_path)

@@ -404,25 +404,20 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
   int kinds[BB_JOB_MAX_OUTPUTS];
   int n = 0, width, height;
   texture_input_size(item, &width, &height);
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    if (item->paths[k]) {
-      kinds[n] = k;
-      specs[n++] = (bb_output_spec){item->paths[k],
-                                    kind_name(k),
-                                    /* the basis message below is the clearer one
-                                       for other formats */
-                                    bb_path_is_texture_format(item->paths[k])
-                                        ? kind_channels(job, k)
-                                        : 0,
-                                    job->options.depth,
-                                    job->options.mips,
-                                    0,
-                                    width,
-                                    height,
-                                    bb_map_kind_get((bb_map_kind)k)->range,
-                                    &job->options.texture};
-    }
-  const int maps = n;
+  int map_kinds[BB_JOB_MAX_OUTPUTS];
+  const char *map_paths[BB_JOB_MAX_OUTPUTS], *map_commands[BB_JOB_MAX_OUTPUTS];
+  const int maps = bb__job_map_files(item, map_kinds, map_paths, map_commands);
+  for (int f = 0; f < maps; f++) {
+    const int k = map_kinds[f];
+    kinds[n] = k;
+    specs[n++] = (bb_output_spec){
+        map_paths[f], kind_name(k),
+        /* the basis message below is the clearer one
+           for other formats */
+        bb_path_is_texture_format(map_paths[f]) ? kind_channels(job, k) : 0,
+        job->options.depth, job->options.mips, 0, width, height,
+        bb_map_kind_get((bb_map_kind)k)->range, &job->options.texture};
+  }
   if (job->valve_path) {
     if (!width && bb_path_is_texture_format(job->valve_path) &&
         bb_image_read_info(item->input, &width, &height, NULL, NULL, NULL) != BB_OK)
@@ -475,9 +470,9 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
     int t = 0;
     if (job->valve_path)
       targets[t++] = job->valve_path;
-    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      if (item->paths[k])
-        targets[t++] = item->paths[k];
+    int kinds[BB_JOB_MAX_OUTPUTS];
+    const char *commands[BB_JOB_MAX_OUTPUTS];
+    t += bb__job_map_files(item, kinds, targets + t, commands);
     if (job->slope_path)
       targets[t++] = job->slope_path;
     if (item->slope_lit_path)
@@ -692,6 +687,52 @@ static bb_status read_bake_maps(bb_job *job, bb_error *err) {
   return st;
 }
 
+int bb__job_map_files(const bb__job_item *item, int *kinds, const char **paths,
+                      const char **commands) {
+  int n = 0;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    if (!item->paths[k])
+      continue;
+    kinds[n] = k, paths[n] = item->paths[k], commands[n++] = item->commands[k];
+    for (int i = 0; i < item->more_count; i++)
+      if (item->more_kinds[i] == k)
+        kinds[n] = k, paths[n] = item->more_paths[i],
+        commands[n++] = item->more_commands[i];
+  }
+  return n;
+}
+
+/* The further files of a single input's maps, and the command each file of
+ * such a map records: a map given more than once is still one bake. */
+static bb_status name_more(bb_job *job, const bb_job_options *o, const bb__job_more *more,
+                           bb_error *err) {
+  bb__job_item *item = &job->items[0];
+  int outputs = 0;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    outputs += item->paths[k] != NULL;
+  outputs += (o->valve_path != NULL) + (o->slope_path != NULL) + (o->slope_lit != 0) +
+             (o->vmt != NULL);
+  if (outputs + more->count > BB_JOB_MAX_OUTPUTS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "a bake writes at most %d files (%d asked)",
+                    BB_JOB_MAX_OUTPUTS, outputs + more->count);
+  for (int i = 0; i < more->count; i++) {
+    const int k = more->kinds[i];
+    if (k < 0 || k >= BB_MAP_BAKED_COUNT || !o->paths[k] || !more->paths[i])
+      return bb__fail(err, BB_ERR_ARGUMENT,
+                      "job plan: a further file of a map not asked");
+    item->more_kinds[i] = k;
+    if (!(item->more_paths[i] = strdup(more->paths[i])) ||
+        (more->commands[i] && !(item->more_commands[i] = strdup(more->commands[i]))))
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+    item->more_count = i + 1;
+  }
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (more->first_commands[k] && item->paths[k] &&
+        !(item->commands[k] = strdup(more->first_commands[k])))
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  return BB_OK;
+}
+
 /* A single input's outputs, as named, and PREFIX_KIND.png for Valve's trio
  * where a prefix is given. */
 static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err) {
@@ -728,9 +769,19 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
   if (!job->vmt)
     return BB_OK;
   const bb__job_item *item = &job->items[0];
-  const char *ssbump = item->paths[BB_MAP_SSBUMP], *normal = item->paths[BB_MAP_NORMAL];
-  int is_ssbump = ssbump && is_vtf(ssbump);
-  const char *bump = is_ssbump ? ssbump : normal && is_vtf(normal) ? normal : NULL;
+  /* the .vtf among each map's files */
+  const char *ssbump = NULL, *normal = NULL;
+  int kinds[BB_JOB_MAX_OUTPUTS];
+  const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+  const int files = bb__job_map_files(item, kinds, paths, commands);
+  for (int f = files - 1; f >= 0; f--) {
+    if (kinds[f] == BB_MAP_SSBUMP && is_vtf(paths[f]))
+      ssbump = paths[f];
+    if (kinds[f] == BB_MAP_NORMAL && is_vtf(paths[f]))
+      normal = paths[f];
+  }
+  int is_ssbump = ssbump != NULL;
+  const char *bump = is_ssbump ? ssbump : normal;
   if (job->valve_path) { /* Valve's file is the bump map, whatever it is named */
     bump = job->valve_path;
     is_ssbump = !job->options.valve.normal_map;
@@ -767,8 +818,11 @@ static bb_status create_directory_of(const char *path, bb_error *err) {
 static bb_status create_directories(const bb_job *job, bb_error *err) {
   bb_status st = job->out_dir ? bb_directory_create(job->out_dir, err) : BB_OK;
   for (int i = 0; i < job->count && st == BB_OK; i++) {
-    for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++)
-      st = create_directory_of(job->items[i].paths[k], err);
+    int kinds[BB_JOB_MAX_OUTPUTS];
+    const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+    const int files = bb__job_map_files(&job->items[i], kinds, paths, commands);
+    for (int f = 0; f < files && st == BB_OK; f++)
+      st = create_directory_of(paths[f], err);
     if (st == BB_OK)
       st = create_directory_of(job->items[i].slope_lit_path, err);
   }
@@ -787,9 +841,11 @@ static void init_reports(bb_job *job) {
     if (job->valve_path)
       r->outputs[r->output_count++] =
           (bb_job_file){bb__job_valve_kind(&job->options), job->valve_path};
-    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      if (item->paths[k])
-        r->outputs[r->output_count++] = (bb_job_file){kind_name(k), item->paths[k]};
+    int kinds[BB_JOB_MAX_OUTPUTS];
+    const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+    const int files = bb__job_map_files(item, kinds, paths, commands);
+    for (int f = 0; f < files; f++)
+      r->outputs[r->output_count++] = (bb_job_file){kind_name(kinds[f]), paths[f]};
     if (job->slope_path)
       r->outputs[r->output_count++] = (bb_job_file){"slope", job->slope_path};
     if (item->slope_lit_path)
@@ -800,7 +856,8 @@ static void init_reports(bb_job *job) {
 }
 
 bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                       unsigned flags, bb_job **out, bb_error *err) {
+                       unsigned flags, const bb__job_more *more, bb_job **out,
+                       bb_error *err) {
   if (!out || !o || (input_count > 0 && !inputs))
     return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
   *out = NULL;
@@ -830,6 +887,8 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = gather_inputs(job, inputs, input_count, err);
   if (st == BB_OK && !job->batch)
     st = name_single(job, o, err);
+  if (st == BB_OK && !job->batch && more)
+    st = name_more(job, o, more, err);
   for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK && !job->batch; k++)
     job->options.paths[k] = job->items[0].paths[k]; /* the job's copies */
   if (st == BB_OK && !job->batch)
@@ -855,7 +914,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
 
 bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
                       bb_job **out, bb_error *err) {
-  return bb__job_plan(inputs, input_count, o, 0, out, err);
+  return bb__job_plan(inputs, input_count, o, 0, NULL, out, err);
 }
 
 void bb_job_free(bb_job *job) {
@@ -863,8 +922,14 @@ void bb_job_free(bb_job *job) {
     return;
   for (int i = 0; i < job->count; i++) {
     free(job->items[i].input);
-    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
       free(job->items[i].paths[k]);
+      free(job->items[i].commands[k]);
+    }
+    for (int m = 0; m < job->items[i].more_count; m++) {
+      free(job->items[i].more_paths[m]);
+      free(job->items[i].more_commands[m]);
+    }
     free(job->items[i].slope_lit_path);
   }
   free(job->items);

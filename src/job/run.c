@@ -8,6 +8,7 @@
 #include "job/job_internal.h"
 
 #include <fcntl.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,6 +62,10 @@ static int material_is_current(const bb_job *job) {
 static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, size_t cap) {
   if (job->slope_path) { /* the slope files are not judged: baked every time */
     snprintf(reason, cap, "a slope map is asked");
+    return 0;
+  }
+  if (item->more_count) { /* nor a map's further files: baked every time */
+    snprintf(reason, cap, "a map is written to several files");
     return 0;
   }
   bb_bake_options o = job->options.bake;
@@ -146,7 +151,11 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) 
     return bb__fail(err, BB_ERR_ARGUMENT, "job check: bad arguments");
   bb__job_item *item = &job->items[i];
   *current = 0;
-  bb_status st = bb_file_hash(item->input, &item->file_hash, err);
+  /* An input that is no image is refused by its header, before all its
+   * bytes are hashed. */
+  bb_status st = bb_image_read_info(item->input, NULL, NULL, NULL, NULL, err);
+  if (st == BB_OK)
+    st = bb_file_hash(item->input, &item->file_hash, err);
   if (st != BB_OK)
     return st;
   *current = item_is_current(job, item, item->report.reason, sizeof item->report.reason);
@@ -291,21 +300,28 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
-  for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++) {
-    if (!item->paths[k] || (b->only && !(b->only & BB_MAP_BIT(k))))
+  /* every file of every map, a map written to several files from the one
+   * bake, each recording its own command where it has one */
+  int kinds[BB_JOB_MAX_OUTPUTS];
+  const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];
+  const int map_files = bb__job_map_files(item, kinds, paths, commands);
+  for (int f = 0; f < map_files && st == BB_OK; f++) {
+    const int k = kinds[f];
+    if (b->only && !(b->only & BB_MAP_BIT(k)))
       continue;
-    b->descriptions[n] = describe(job, command, &b->result, r, kind_info(k)->name);
-    files[n] = (bb_output_file){item->paths[k],
-                                kind_info(k)->name,
-                                bb_bake_result_image(&b->result, (bb_map_kind)k),
-                                kind_info(k)->range,
-                                output_depth(job, k, item->paths[k], r->source.bits_per_sample,
-                                             r->source.is_float),
-                                job->options.mips,
-                                b->descriptions[n],
-                                NULL,
-                                0,
-                                &job->options.texture};
+    b->descriptions[n] = describe(job, commands[f] ? commands[f] : command, &b->result, r,
+                                  kind_info(k)->name);
+    files[n] = (bb_output_file){
+        paths[f],
+        kind_info(k)->name,
+        bb_bake_result_image(&b->result, (bb_map_kind)k),
+        kind_info(k)->range,
+        output_depth(job, k, paths[f], r->source.bits_per_sample, r->source.is_float),
+        job->options.mips,
+        b->descriptions[n],
+        NULL,
+        0,
+        &job->options.texture};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
@@ -371,6 +387,19 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     job->options.note(job->options.note_user, job->vmt,
                       "the material has no $basetexture (no colour map): give --basetexture "
                       "FILE.vtf, or add the line to the .vmt");
+  /* A colour map named but not there (a typo, or one made later): Source
+   * draws its missing-texture checkerboard until it is. */
+  struct stat base;
+  if (st == BB_OK && job->vmt_basetexture && job->options.note &&
+      (stat(job->vmt_basetexture, &base) != 0 || !S_ISREG(base.st_mode))) {
+    char text[PATH_MAX + 160];
+    snprintf(
+        text, sizeof text,
+        "--basetexture %s is not a file (yet): Source draws the material's colour as its "
+        "missing-texture checkerboard until it is",
+        job->vmt_basetexture);
+    job->options.note(job->options.note_user, job->vmt, text);
+  }
   /* The input's notes have been given: a caller that takes one as an
    * error cancels here, before anything is baked or written (progress
    * (0, 0): a checkpoint, no work done yet). */

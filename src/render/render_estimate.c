@@ -7,6 +7,7 @@
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "image/formats.h"
+#include "render/render_internal.h"
 
 #include <stdio.h>
 
@@ -89,9 +90,15 @@ static int over_read_limits(double texels, int channels) {
   return texels > (double)BB_MAX_PIXELS || channels * 4.0 * texels > cap;
 }
 
-bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_options *bake,
-                                const bb_render_options *o, int compare, const char *output,
-                                bb_depth depth, int *width, int *height, bb_error *err) {
+bb_status bb__render_files_need(const bb_render_sources *files,
+                                const bb_bake_options *bake, const bb_render_options *o,
+                                int compare, const char *output, bb_depth depth,
+                                int *width, int *height, double *need, const char **named,
+                                char *what, size_t what_cap, bb_error *err) {
+  *need = 0.0;
+  *named = NULL;
+  if (what_cap)
+    what[0] = '\0';
   if (width)
     *width = 0;
   if (height)
@@ -160,9 +167,24 @@ bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_op
   bb_status st = bb_render_estimate(w, h, o, compare, output, depth, &pw, &ph, &picture, err);
   if (st != BB_OK)
     return st;
-  const double need = (reading > kept + picture ? reading : kept + picture) * 1.05 +
-                      32.0 * 1024 * 1024;
-  char what[512];
-  snprintf(what, sizeof what, "%s: a %d x %d render", output ? output : first, pw, ph);
-  return bb__memory_check(need, what, err);
+  *need =
+      (reading > kept + picture ? reading : kept + picture) * 1.05 + 32.0 * 1024 * 1024;
+  *named = output ? output : first;
+  snprintf(what, what_cap, "a %d x %d render", pw, ph);
+  return BB_OK;
+}
+
+bb_status bb_render_files_check(const bb_render_sources *files,
+                                const bb_bake_options *bake, const bb_render_options *o,
+                                int compare, const char *output, bb_depth depth,
+                                int *width, int *height, bb_error *err) {
+  double need = 0.0;
+  const char *path = NULL;
+  char what[128], named[4200];
+  bb_status st = bb__render_files_need(files, bake, o, compare, output, depth, width,
+                                       height, &need, &path, what, sizeof what, err);
+  if (st != BB_OK || need <= 0.0)
+    return st;
+  snprintf(named, sizeof named, "%s: %s", path, what);
+  return bb__memory_check(need, named, err);
 }

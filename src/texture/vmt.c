@@ -155,10 +155,11 @@ bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, si
   const char *materials = o->materials_dir;
   if (!materials || !*materials) {
     if (find_materials(o->bumpmap, found, sizeof found) != 0)
-      return bb__fail(err, BB_ERR_ARGUMENT,
-                      "%s: no folder named \"materials\" above %s: name the game's materials "
-                      "folder",
-                      path, o->bumpmap);
+      return bb__fail(
+          err, BB_ERR_ARGUMENT,
+          "%s: no folder named \"materials\" above %s: name the game's materials "
+          "folder with --materials DIR",
+          path, o->bumpmap);
     materials = found;
   }
   char bump[PATH_MAX], base[PATH_MAX];

@@ -1057,9 +1057,11 @@ static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err)
                      rs->slice_step[2 * s + 1] == -rs->slice_step[2 * order[k + 1] + 1];
     const bb__sweep_dir along = {rs, s, NULL, NULL};
     const bb__sweep_dir opposite = {rs, pair ? order[k + 1] : 0, NULL, NULL};
-    st = bb__sweep_lines_hooked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
-                                pair ? &opposite : NULL, bias, o->threads, 0, line_hook, ctx,
-                                err);
+    /* a slice of a pass at 2048 x 2048 takes seconds: cancel inside it */
+    const bb__checkpoint cancel = {o->progress, o->progress_user};
+    st = bb__sweep_lines_hooked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
+                                &along, pair ? &opposite : NULL, bias, o->threads, 0,
+                                line_hook, ctx, &cancel, err);
     k += pair ? 2 : 1;
     if (st == BB_OK && atomic_load(&ctx->out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");

@@ -1283,8 +1283,8 @@ static bb_status check_dir(const bb__sweep_dir *dir, int hooked, bb_error *err) 
 bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
                           const bb__sweep_dir *opposite, double bias, int threads,
                           long long_line, bb_error *err) {
-  return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL, NULL,
-                                err);
+  return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL,
+                                NULL, NULL, err);
 }
 
 /* The parts of a sweep every entry shares: the checks, both sides, the
@@ -1333,7 +1333,8 @@ static void job_end(sweep_job *job) {
 /* Sweeps the job's items (x, y, len each) on all threads, a bundle of
  * them per work item. */
 static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *len,
-                         int count, int threads, bb_error *err) {
+                         int count, int threads, const bb__checkpoint *checkpoint,
+                         bb_error *err) {
   job->item_x = x;
   job->item_y = y;
   job->item_len = len;
@@ -1345,7 +1346,7 @@ static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   for (int i = 0; i < job->scratch_count; i++)
     atomic_flag_clear(&job->scratch[i].busy);
-  bb_status st = bb__parallel_for(bundles, threads, sweep_bundle, job, NULL, NULL, err);
+  bb_status st = bb__parallel_for_checked(bundles, threads, sweep_bundle, job, checkpoint, err);
   for (int i = 0; i < job->scratch_count; i++)
     scratch_release(&job->scratch[i]);
   free(job->scratch);
@@ -1359,7 +1360,7 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
                                  const bb__sweep_dir *along,
                                  const bb__sweep_dir *opposite, double bias, int threads,
                                  long long_line, bb__line_hook hook, void *hook_ctx,
-                                 bb_error *err) {
+                                 const bb__checkpoint *checkpoint, bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (!along && !opposite)
     return BB_OK;
@@ -1382,7 +1383,7 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
   }
   if (failed) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   if (st == BB_OK)
-    st = job_run(&job, it.x, it.y, it.len, it.count, threads, err);
+    st = job_run(&job, it.x, it.y, it.len, it.count, threads, checkpoint, err);
   items_free(&it);
   job_end(&job);
   return st;
@@ -1448,7 +1449,7 @@ bb_status bb__sweep_stretches(const bb_pyramid *p, int a, int b,
                     job.period, len[i]);
   }
   if (st == BB_OK)
-    st = job_run(&job, x, y, len, count, threads, err);
+    st = job_run(&job, x, y, len, count, threads, NULL, err);
   free(x);
   free(y);
   free(len);

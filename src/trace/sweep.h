@@ -4,6 +4,7 @@
 #define BB_TRACE_SWEEP_H
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -86,11 +87,15 @@ typedef struct bb__line_view {
 typedef void (*bb__line_hook)(void *ctx, const bb__line_view *line);
 
 /* bb__sweep_lines with a hook for every line in place of the sums (the
- * directions' sums may then be NULL). */
-bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+ * directions' sums may then be NULL). checkpoint (may be NULL): asked every
+ * 50 ms from the calling thread while the lines are swept, a nonzero
+ * answer cancelling the sweep between bundles of lines (BB_ERR_CANCELLED),
+ * for sweeps that take long enough to need it (bounce.c's passes). */
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
                                  const bb__sweep_dir *opposite, double bias, int threads,
                                  long long_line, bb__line_hook hook, void *hook_ctx,
-                                 bb_error *err);
+                                 const bb__checkpoint *checkpoint, bb_error *err);
 
 /* ------------------------------------------------------ parts of lines */
 

@@ -821,6 +821,29 @@ Test(cli, height2ssbump_without_alpha_uses_mean_and_says_so) {
   expect_uniform8(tmp("rgb-ssbump.tga"), 4, (const int[]){s, s, s, 128}, 1);
 }
 
+/* Its TGA records the command line as every writing command's output does:
+ * the comment's four rows of 80 characters cannot hold it beside the
+ * parameters, so it goes to the header's image ID and is read back into
+ * the provenance whole. */
+Test(cli, height2ssbump_records_its_command) {
+  write_image(tmp("wall.tga"), 16, 16, 4, grey_with_low_alpha);
+  run_ok_in(harness_dir,
+            (const char *[]){"height2ssbump", "-r", "16", "wall.tga", "4", NULL});
+  bb_image_info info;
+  bb_error err;
+  cr_assert_eq(bb_image_read_info(tmp("wall-ssbump.tga"), NULL, NULL, NULL, &info, &err),
+               BB_OK, "%s", err.message);
+  cr_assert_not_null(info.description);
+  cr_expect_eq(bb_provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
+               info.description);
+  cr_expect(strstr(info.description, "\ncommand=bumpbake height2ssbump -r 16 wall.tga 4"),
+            "%s", info.description);
+  cr_expect(strstr(info.description, "\nfilter_threshold=") &&
+                strstr(info.description, "\ninput=wall.tga"),
+            "%s", info.description);
+  bb_image_info_free(&info);
+}
+
 /* ---------------------------------------------------------- renderbumpflat */
 
 /* A 16 x 16 plate in the XZ plane (facing -y, DOOM 3's side) with a square

@@ -144,7 +144,8 @@ Test(cli_messages, a_single_bake_creates_its_output_folders) {
 }
 
 /* A material names its colour map only when told (--basetexture): one
- * without it gets a note, one with it none. */
+ * without it gets a note, one naming a colour map that is not there
+ * another, one naming a file none. */
 Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
   dome(tmp("h.png"), 1, BB_DEPTH_16);
   cr_assert_eq(mkdir(tmp("materials"), 0755), 0);
@@ -160,15 +161,113 @@ Test(cli_messages, a_material_without_a_base_texture_gets_a_note) {
                                    tmp("materials/colour.vtf"), NULL});
   cr_expect_eq(r.code, 0, "%s", r.err);
   cr_expect(!strstr(r.err, "$basetexture"), "%s", r.err);
+  cr_expect(strstr(r.err, "s.vmt: note: --basetexture ") &&
+                strstr(r.err, "materials/colour.vtf is not a file (yet)"),
+            "%s", r.err);
+  cr_expect_eq(harness_lines(r.err), 1, "%s", r.err);
+  cli_result_free(&r);
+  cr_assert_eq(link(tmp("materials/s.vtf"), tmp("materials/colour.vtf")), 0);
+  r = harness_run((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--rays", "4",
+                                   "--ssbump", tmp("materials/s.vtf"), "--vmt",
+                                   tmp("materials/s.vmt"), "--basetexture",
+                                   tmp("materials/colour.vtf"), NULL});
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_str_empty(r.err);
   cli_result_free(&r);
 }
 
-/* A map named twice is a usage error before any bake, not a file dropped. */
-Test(cli_messages, a_map_named_twice_is_a_usage_error) {
+/* A material outside any folder named materials names the option that
+ * says where the game's materials are. */
+Test(cli_messages, a_material_outside_materials_names_the_option) {
   dome(tmp("h.png"), 1, BB_DEPTH_16);
-  const char *args[] = {"bake",       tmp("h.png"), "--scale",    "4", "--ssbump",
-                        tmp("s.png"), "--ssbump",   tmp("s.vtf"), NULL};
-  harness_expect_refusal(NULL, args, 2, "--ssbump is given twice", 0);
+  const char *args[] = {"bake",     tmp("h.png"), "--scale", "4",          "--rays", "4",
+                        "--ssbump", tmp("s.vtf"), "--vmt",   tmp("s.vmt"), NULL};
+  harness_expect_refusal(NULL, args, 2,
+                         "name the game's materials folder with --materials DIR", 0);
+}
+
+/* The bytes of path, or NULL (*size then 0). */
+static unsigned char *bytes_of(const char *path, size_t *size) {
+  *size = 0;
+  FILE *f = fopen(path, "rb");
+  if (!f)
+    return NULL;
+  unsigned char *data = malloc(1 << 20);
+  cr_assert_not_null(data);
+  *size = fread(data, 1, 1 << 20, f);
+  fclose(f);
+  return data;
+}
+
+static void expect_same_bytes(const char *a, const char *b) {
+  size_t na, nb;
+  unsigned char *da = bytes_of(a, &na), *db = bytes_of(b, &nb);
+  cr_expect(da && db && na && na == nb && !memcmp(da, db, na),
+            "%s (%zu bytes) != %s (%zu)", a, na, b, nb);
+  free(da);
+  free(db);
+}
+
+/* A map named twice is written to both files from one bake, each in its
+ * format and each the bytes a bake of it alone writes (its provenance
+ * records the command less the map's other file); the other maps record
+ * the command as typed. */
+Test(cli_messages, a_map_named_twice_is_written_to_both_from_one_bake) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  cr_assert_eq(mkdir(tmp("both"), 0700), 0);
+  cr_assert_eq(mkdir(tmp("one"), 0700), 0);
+  const char *h = tmp("h.png");
+  cli_result r = RUN_IN(tmp("both"), "bake", h, "--scale", "4", "--rays", "4", "--ssbump",
+                        "s.png", "--normal", "n.png", "--ssbump=s.vtf", "--json");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect(strstr(r.out, "\"s.png\"") && strstr(r.out, "\"s.vtf\""), "%s", r.out);
+  cli_result_free(&r);
+  r = RUN_IN(tmp("one"), "bake", h, "--scale", "4", "--rays", "4", "--ssbump", "s.png",
+             "--normal", "n.png", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  r = RUN_IN(tmp("one"), "bake", h, "--scale", "4", "--rays", "4", "--normal", "n.png",
+             "--ssbump=s.vtf", "-q");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  expect_same_bytes(tmp("both/s.png"), tmp("one/s.png"));
+  expect_same_bytes(tmp("both/s.vtf"), tmp("one/s.vtf"));
+  bb_image_info info;
+  bb_image n = harness_read(tmp("both/n.png"), &info);
+  char command[512];
+  snprintf(command, sizeof command,
+           "\ncommand=bumpbake bake %s --scale 4 --rays 4 --ssbump s.png --normal n.png "
+           "--ssbump=s.vtf\n",
+           h);
+  cr_expect(info.description && strstr(info.description, command), "%s",
+            info.description ? info.description : "(none)");
+  bb_image_info_free(&info);
+  bb_image_free(&n);
+  /* the same name twice is one file; a batch names its maps by --maps */
+  r = RUN_IN(tmp("both"), "bake", h, "--scale", "4", "--rays", "4", "--ao", "a.png",
+             "--ao", "a.png");
+  cr_expect_eq(r.code, 0, "%s", r.err);
+  cr_expect_eq(harness_lines(r.out), 1, "%s", r.out);
+  cli_result_free(&r);
+  const char *batch[] = {"bake", h,       "--scale", "4",     "--out-dir", tmp("o"),
+                         "--ao", "a.png", "--ao",    "b.png", NULL};
+  harness_expect_refusal(NULL, batch, 2, "--out-dir names the outputs", 0);
+}
+
+/* Ten files at most, said before any bake. */
+Test(cli_messages, a_map_written_to_too_many_files_is_a_usage_error) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  const char *args[32] = {"bake", tmp("h.png"), "--scale", "4", "--normal", tmp("n.png")};
+  int n = 6;
+  char names[10][16];
+  for (int i = 0; i < 10; i++) {
+    snprintf(names[i], sizeof names[i], "%d.png", i);
+    args[n++] = "--ao";
+    args[n++] = tmp(names[i]);
+  }
+  args[n] = NULL;
+  harness_expect_refusal(NULL, args, 2, "a bake writes at most 10 files", 0);
+  cr_expect_not(file_exists(tmp("n.png")));
 }
 
 /* combine takes -q as every command that writes files does: the wrote
@@ -190,4 +289,47 @@ Test(cli_messages, combine_takes_quiet) {
   cr_expect_str_empty(r.out, "%s", r.out);
   cr_expect(file_exists(tmp("q.png")));
   cli_result_free(&r);
+}
+
+/* A --scheduler address that cannot be one is a usage error of the
+ * library's check, exit 2 before any Python or Dask starts (it took Python
+ * and Dask 5 to 10 s to say so). BUMPBAKE_PYTHON names a stand-in that
+ * leaves a mark when started: a well-formed address does start it. */
+Test(cli_messages, a_bad_scheduler_address_is_refused_before_python_starts) {
+  dome(tmp("h.png"), 1, BB_DEPTH_16);
+  FILE *f = fopen(tmp("python"), "w");
+  cr_assert_not_null(f);
+  fprintf(f, "#!/bin/sh\ntouch '%s'\nexit 1\n", tmp("started"));
+  cr_assert_eq(fclose(f), 0);
+  cr_assert_eq(chmod(tmp("python"), 0755), 0);
+  cr_assert_eq(setenv("BUMPBAKE_PYTHON", tmp("python"), 1), 0);
+  static const char *bad[] = {"garbage",
+                              "file:///tmp/x",
+                              "tcp://",
+                              "tcp://h:0",
+                              "tcp://h:port",
+                              "tcp://[::1]",
+                              "fe80::1:8786",
+                              "inproc://x",
+                              "tcp://user@h:1",
+                              "tcp://a b:1",
+                              "",
+                              "tcp://h:1\x1b[2J"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    const char *args[] = {"bake",       tmp("h.png"),  "--scale", "4", "--normal",
+                          tmp("n.png"), "--scheduler", bad[i],    NULL};
+    cli_result r = harness_run(args);
+    harness_expect_error(&r, 2, "bumpbake bake: --scheduler", bad[i]);
+    cr_expect(!strchr(r.err, '\x1b'), "%s", r.err);
+    cr_expect_lt(r.cpu_seconds, 1.0, "'%s' took %.2f s of CPU", bad[i], r.cpu_seconds);
+    cli_result_free(&r);
+    cr_expect(!file_exists(tmp("started")), "'%s' started Python", bad[i]);
+  }
+  const char *good[] = {"bake",       tmp("h.png"),  "--scale",           "4", "--normal",
+                        tmp("n.png"), "--scheduler", "tcp://127.0.0.1:1", NULL};
+  cli_result r = harness_run(good);
+  cr_expect_neq(r.code, 0);
+  cli_result_free(&r);
+  cr_expect(file_exists(tmp("started")), "a well-formed address did not start Python");
+  unsetenv("BUMPBAKE_PYTHON");
 }

@@ -96,6 +96,50 @@ Test(hostile, fifos_and_devices_are_refused_by_every_command) {
   }
 }
 
+/* A 2 GiB file of zeros (sparse) named .png: every command refuses it in
+ * one line naming the format its extension promised, in well under a
+ * second of CPU (OpenImageIO's fallback through every reader, and the hash
+ * of the file's bytes before its header was looked at, took minutes). The
+ * other extensions are the library's test (untrusted). */
+Test(hostile, a_large_file_no_reader_knows_is_refused_by_every_command) {
+  height_file(tmp("h.png"));
+  cli_result baked = RUN("bake", tmp("h.png"), FAST, "--ssbump", tmp("s.png"));
+  cr_assert_eq(baked.code, 0, "%s", baked.err);
+  cli_result_free(&baked);
+  cr_assert_eq(mkdir(tmp("batch"), 0755), 0);
+  int fd = open(tmp("batch/z.png"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  cr_assert(fd >= 0 && ftruncate(fd, (off_t)2 << 30) == 0);
+  close(fd);
+  cr_assert_eq(link(tmp("batch/z.png"), tmp("z.png")), 0);
+  const struct {
+    const char *args[16];
+    int code;
+  } runs[] = {
+      {{"info", "z.png"}, 1},
+      {{"bake", "z.png", FAST, "--normal", "o.png"}, 1},
+      {{"bake", "batch", "--out-dir", "out", FAST}, 1},
+      {{"normal", "z.png", "--scale", "4", "-o", "o.png"}, 1},
+      {{"height2ssbump", "z.png", "4"}, 1},
+      {{"compare", "h.png", "z.png"}, 4},
+      {{"render", "z.png", "--scale", "6", "-o", "o.png"}, 1},
+      {{"render", "--ssbump", "s.png", "--albedo", "z.png", "-o", "o.png"}, 1},
+      {{"sheet", "z.png", "--scale", "6", "-o", "o.png"}, 1},
+      {{"program", "invertColor(z.png)", "-o", "o.png"}, 1},
+      {{"normal2ssbump", "z.png", "-o", "o.png"}, 1},
+      {{"combine", "z.png", "h.png", "--mix", "0.5", "-o", "o.png"}, 1},
+  };
+  for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+    cli_result r = harness_run_in(harness_dir, runs[i].args);
+    cr_expect_eq(r.code, runs[i].code, "%s: exit %d: %s", runs[i].args[0], r.code, r.err);
+    cr_expect(strstr(r.err, "z.png: not a readable image: its extension says PNG"),
+              "%s: %s", runs[i].args[0], r.err);
+    cr_expect_lt(r.cpu_seconds, 1.5, "%s took %.1f s of CPU", runs[i].args[0],
+                 r.cpu_seconds);
+    cli_result_free(&r);
+    cr_expect(!file_exists(tmp("o.png")), "%s wrote its output", runs[i].args[0]);
+  }
+}
+
 /* What stands at a name, as lstat sees it: 'f' FIFO, 'l' link, 'r' regular. */
 static char kind_at(const char *path) {
   struct stat st;

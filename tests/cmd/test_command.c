@@ -2,13 +2,18 @@
  * through their parsers, their ranges checked against the library's one
  * range each, the rules between options, the command spelled back as text
  * (what provenance records, and a hand-over that reads back the same). */
+#define _XOPEN_SOURCE 700 /* mkdtemp */
+
 #include "bumpbake.h"
+#include "cmd/cmd_internal.h"
+#include "hostile_headers.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static bb_command *command(const char *name, const char *const *words) {
   bb_command *c = NULL;
@@ -265,13 +270,10 @@ Test(cmd, options_that_do_nothing_are_refused) {
 }
 
 /* A file option names one file: given again with another name, the first
- * would be dropped without a word (--ssbump s.png --ssbump s.vtf wrote the
- * VTF alone). The same name twice is harmless. */
-Test(cmd, a_file_option_given_twice_is_refused) {
-  refused("bake", (const char *[]){"h.png", "--scale", "1", "--ssbump", "s.png", "--ssbump",
-                                   "s.vtf", NULL},
-          "--ssbump is given twice ('s.png', then 's.vtf'): it names one file; run once per "
-          "file");
+ * would be dropped without a word. A map's file is the exception: given
+ * again, a further file of the same bake (--ssbump s.png --ssbump s.vtf),
+ * spelled again in the command's text. The same name twice is harmless. */
+Test(cmd, a_file_option_given_twice_is_refused_but_a_map_takes_several) {
   refused("bake", (const char *[]){"h.png", "--scale", "1", "--ao", "a.png", "--depfile",
                                    "a.d", "--depfile", "b.d", NULL},
           "--depfile is given twice ('a.d', then 'b.d'): it names one file; run once per file");
@@ -284,6 +286,19 @@ Test(cmd, a_file_option_given_twice_is_refused) {
   bb_command *c = command("bake", same);
   cr_expect_eq(bb_command_check(c, NULL), BB_OK);
   cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
+  char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect(text && strstr(text, " --ssbump s.png") && !strstr(text, "--ssbump s.png --"),
+            "%s", text);
+  free(text);
+  bb_command_free(c);
+  const char *two[] = {"h.png", "--scale",  "1",     "--ssbump",
+                       "s.png", "--ssbump", "s.vtf", NULL};
+  c = command("bake", two);
+  cr_expect_eq(bb_command_check(c, NULL), BB_OK);
+  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
+  text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect(text && strstr(text, " --ssbump s.png --ssbump s.vtf"), "%s", text);
+  free(text);
   bb_command_free(c);
 }
 
@@ -398,6 +413,113 @@ Test(cmd, flags_set_their_field) {
   cr_assert_eq(bb_command_set(c, "dump-filtered", NULL, &err), BB_OK, "%s", err.message);
   cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
   bb_command_free(c);
+}
+
+/* The same refusal, as the command line words it and as keyword arguments
+ * (Python, serve's page) read it: every option of the command respelled
+ * from its row, the value's name joined to its keyword, nothing else. */
+Test(cmd, refusals_are_spelled_in_the_clients_words) {
+  static const struct {
+    const char *const words[8];
+    const char *line, *keywords;
+  } cases[] = {
+      {{"h.png", "--scale", "8", "--bounce", "2", NULL},
+       "--bounce must be in 0..1 (got 2)",
+       "bounce must be in 0..1 (got 2)"},
+      {{"h.png", "--scale", "8", "--filter-radius", "9999", NULL},
+       "--filter-radius must be in 0..4096 (got 9999)",
+       "filter_radius must be in 0..4096 (got 9999)"},
+      {{"h.png", "--scale", "8", "--bounces", "3", "--normal", "n.png", NULL},
+       "--bounces does nothing without --bounce RHO or --bounce-albedo FILE",
+       "bounces does nothing without bounce=RHO or bounce_albedo=FILE"},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+    for (int keywords = 0; keywords < 2; keywords++) {
+      bb_command *c = NULL;
+      bb_error err = {{0}};
+      cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+      if (keywords)
+        bb_command_set_spelling(c, BB_SPELLING_KEYWORDS);
+      const char *const *w = cases[k].words;
+      cr_assert_eq(bb_command_add_input(c, w[0], &err), BB_OK);
+      for (int i = 1; w[i]; i += 2)
+        cr_assert_eq(bb_command_set(c, w[i] + 2, w[i + 1], &err), BB_OK, "%s",
+                     err.message);
+      cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
+      cr_expect_str_eq(err.message, keywords ? cases[k].keywords : cases[k].line);
+      bb_command_free(c);
+    }
+  /* the plan's refusals: a short option and its value's name; a path that
+   * holds an option's name stays as it is */
+  for (int keywords = 0; keywords < 2; keywords++) {
+    bb_command *c = NULL;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+    if (keywords)
+      bb_command_set_spelling(c, BB_SPELLING_KEYWORDS);
+    cr_assert_eq(bb_command_add_input(c, "/tmp/--normal/h.png", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "scale", "8", &err), BB_OK);
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    bb_job *job = NULL;
+    cr_expect_eq(bb_command_plan(c, NULL, &job, &err), BB_ERR_ARGUMENT);
+    cr_expect_str_eq(
+        err.message,
+        keywords ? "nothing to write: give output=PREFIX or at least one of "
+                   "normal, weights, ssbump, ao, bent, filtered, slope (or "
+                   "out_dir=DIR for a batch)"
+                 : "nothing to write: give -o PREFIX or at least one of --normal, "
+                   "--weights, --ssbump, --ao, --bent, --filtered, --slope (or "
+                   "--out-dir DIR for a batch)");
+    cr_assert_eq(bb_command_set(c, "normal", "/tmp/--normal/x.exr", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "mips", "1", &err), BB_OK);
+    cr_assert_eq(bb_command_set(c, "depth", "8", &err), BB_OK);
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    cr_expect_eq(bb_command_plan(c, NULL, &job, &err), BB_ERR_ARGUMENT);
+    cr_expect(strstr(err.message, "/tmp/--normal/x.exr: "), "%s", err.message);
+    cr_expect(strstr(err.message, keywords ? " depth 8 " : " --depth 8 "), "%s",
+              err.message);
+    bb_command_free(c);
+  }
+}
+
+/* A render of large maps says what it will take before it reads them (the
+ * note of bb_command_run's hooks), as a comparison does: a 4096 x 8192
+ * map of RGBA floats (a 148-byte DDS header, the rest a hole) is 1.1 GiB
+ * to render; a small one says nothing. */
+static void keep_note(void *user, const char *path, const char *text) {
+  snprintf(user, 512, "%s: %s", path, text);
+}
+
+Test(cmd, a_large_render_says_its_cost_before_it_starts) {
+  char dir[] = "/tmp/bb-render-cost-XXXXXX";
+  cr_assert_not_null(mkdtemp(dir));
+  char big[64], small[64], out[64];
+  snprintf(big, sizeof big, "%s/n.dds", dir);
+  snprintf(small, sizeof small, "%s/s.dds", dir);
+  snprintf(out, sizeof out, "%s/r.png", dir);
+  cr_assert_eq(write_dds_float_header(big, 4096, 8192), 0);
+  cr_assert_eq(write_dds_float_header(small, 64, 64), 0);
+  for (int k = 0; k < 2; k++) {
+    bb_command *c =
+        command("render", (const char *const[]){"--normal", k ? small : big, "--mode",
+                                                "normal", "--output", out, NULL});
+    bb_error err = {{0}};
+    cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+    char note[512] = "";
+    const bb_command_hooks hooks = {.note = keep_note, .note_user = note};
+    cr_assert_not_null(c->def->before_run); /* what bb_command_run says first */
+    c->def->before_run(c, &hooks);
+    if (k)
+      cr_expect_str_empty(note);
+    else
+      cr_expect(
+          strstr(note, "/r.png: a 4096 x 8192 render takes about 1.1 GiB of memory ("),
+          "%s", note);
+    bb_command_free(c);
+  }
+  unlink(big);
+  unlink(small);
+  rmdir(dir);
 }
 
 /* bb_command_unset: an option back at its default and no longer given,

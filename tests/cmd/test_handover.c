@@ -102,3 +102,41 @@ Test(handover, refuses_what_is_not_one) {
   free(data);
   bb_command_free(c);
 }
+
+/* A map written to several files travels with its further files and the
+ * command line each file records, and plans as the same files. */
+Test(handover, carries_a_map_written_to_several_files) {
+  const char *inputs[] = {"h.png", NULL};
+  const char *const options[][2] = {{"scale", "8"},
+                                    {"ssbump", "s.png"},
+                                    {"normal", "n.png"},
+                                    {"ssbump", "s.tga"},
+                                    {NULL, NULL}};
+  bb_command *c = bake(inputs, options);
+  bb_error err = {{0}};
+  cr_assert_eq(
+      bb_command_set_record(c, "bumpbake bake h.png --scale 8 ...", "--scale 8", &err),
+      BB_OK);
+  cr_assert_eq(
+      bb_command_set_record_of(c, "s.tga", "bumpbake bake h.png --scale 8 s.tga", &err),
+      BB_OK);
+  size_t size = 0;
+  char *data = bb_command_handover(c, &size);
+  cr_assert(data && size > 0);
+  bb_command *back = NULL;
+  cr_assert_eq(bb_command_from_handover(data, size, NULL, 0, &back, &err), BB_OK, "%s",
+               err.message);
+  char *a = spelled(c), *b = spelled(back);
+  cr_expect_str_eq(b, a);
+  cr_expect(strstr(a, "--ssbump s.png --ssbump s.tga"), "%s", a);
+  size_t again = 0;
+  char *data_back = bb_command_handover(back, &again);
+  cr_expect(again == size && !memcmp(data, data_back, size),
+            "the record of s.tga is lost");
+  free(data_back);
+  free(a);
+  free(b);
+  free(data);
+  bb_command_free(back);
+  bb_command_free(c);
+}

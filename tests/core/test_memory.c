@@ -86,6 +86,42 @@ Test(memory, a_cgroup_v1_limit_less_its_usage) {
   cr_expect_str_eq(source, "cgroup memory.limit_in_bytes");
 }
 
+/* The kernel reclaims a group's page cache, active or not, before it
+ * kills anything: a 3.0 GB cgroup v1 limit with 2.74 GB used, 2.17 GB of
+ * it active_file, has 2.5 GB of room, not the 0.26 GB that refused a
+ * 4096 x 4096 bake ("needs about 637 MiB; 369 MiB is available"). cgroup
+ * v2 counts both the same way. */
+Test(memory, page_cache_active_or_not_counts_as_room) {
+  machine();
+  put("proc/self/cgroup", "4:memory:/docker/c1\n");
+  put("proc/self/mountinfo",
+      "32 31 0:29 / /sys/fs/cgroup/memory rw - cgroup cgroup rw,memory\n");
+  put("sys/fs/cgroup/memory/docker/c1/memory.limit_in_bytes",
+      "3221225472\n"); /* 3072 MiB */
+  put("sys/fs/cgroup/memory/docker/c1/memory.usage_in_bytes",
+      "2942304256\n"); /* 2806 MiB */
+  put("sys/fs/cgroup/memory/docker/c1/memory.stat",
+      "cache 2600000000\nactive_file 1\ninactive_file 1\n"
+      "total_active_file 2275409920\ntotal_inactive_file 104857600\n"); /* 2170 + 100 MiB
+                                                                         */
+  const char *source = NULL;
+  cr_expect_float_eq(available(&source), 3072.0 - (2806.0 - 2270.0), 1e-9);
+  cr_expect_str_eq(source, "cgroup memory.limit_in_bytes");
+  /* Without the total_ counts (no children to sum), the group's own. */
+  put("sys/fs/cgroup/memory/docker/c1/memory.stat",
+      "active_file 2275409920\ninactive_file 104857600\n");
+  cr_expect_float_eq(available(&source), 3072.0 - (2806.0 - 2270.0), 1e-9);
+  /* cgroup v2: memory.stat's active_file and inactive_file. */
+  put("proc/self/cgroup", "0::/job\n");
+  put("proc/self/mountinfo", "30 22 0:26 / /sys/fs/cgroup rw - cgroup2 cgroup2 rw\n");
+  put("sys/fs/cgroup/job/memory.max", "3221225472\n");
+  put("sys/fs/cgroup/job/memory.current", "2942304256\n");
+  put("sys/fs/cgroup/job/memory.stat", "anon 500000000\nfile 2380267520\nactive_file "
+                                       "2275409920\ninactive_file 104857600\n");
+  cr_expect_float_eq(available(&source), 3072.0 - (2806.0 - 2270.0), 1e-9);
+  cr_expect_str_eq(source, "cgroup memory.max");
+}
+
 /* Inside a container the cgroup file system is often its own subtree,
  * mounted at /sys/fs/cgroup/memory with mountinfo's scratch_dir naming it. */
 Test(memory, a_container_mounting_its_own_subtree) {

@@ -110,6 +110,104 @@ Test(untrusted, a_device_is_refused_by_every_reader) {
   expect_refused_at_once(link, "is a device, not a regular file");
 }
 
+/* ------------------------------------------- large files no reader knows */
+
+static bb_status call_height_file_read(const char *path, bb_error *err) {
+  bb_image h;
+  bb_status st =
+      bb_height_file_read(path, BB_CHANNEL_AUTO, 8.0f, NULL, NULL, &h, NULL, err);
+  bb_image_free(&h);
+  return st;
+}
+
+/* A 2 GiB file of zeros (sparse: it costs no disk) under each extension,
+ * and the format its message must name. OpenImageIO 2.4 handed a file its
+ * extension's reader refused to every other reader, the DICOM reader last,
+ * which read it to the end: minutes for 2 GiB, and the DICOM, PNM and IFF
+ * readers did so under their own extensions too. */
+Test(untrusted, a_large_file_no_reader_knows_is_refused_at_once) {
+  static const struct {
+    const char *name, *promised;
+  } files[] = {
+      {"z.png", "PNG"},
+      {"z.exr", "OpenEXR"},
+      {"z.tga", "TGA"},
+      {"z.tif", "TIFF"},
+      {"z.jpg", "JPEG"},
+      {"z.hdr", "Radiance HDR"},
+      {"z.dds", "DDS"},
+      {"z.gif", "GIF"},
+      {"z.ppm", "PNM"},
+      {"z.iff", "IFF"},
+      {"z.dcm", "DICOM"},
+      {"z.bmp", "BMP"},
+      {"z.unknown", "no image format has the extension '.unknown'"},
+      {"z", "no extension names its format"},
+  };
+  static const struct {
+    const char *name;
+    child_call_fn fn;
+  } readers[] = {
+      {"bb_image_read", call_read},
+      {"bb_image_read_info", call_read_info},
+      {"bb_image_read_mip", call_read_mip},
+      {"bb_image_frame_count", call_frame_count},
+      {"bb_height_file_read", call_height_file_read},
+  };
+  for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+    const char *path = in_scratch_dir(files[f].name);
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    cr_assert(fd >= 0 && ftruncate(fd, (off_t)2 << 30) == 0, "%s: %s", path,
+              strerror(errno));
+    close(fd);
+    for (size_t i = 0; i < sizeof readers / sizeof readers[0]; i++) {
+      child_outcome o = child_call(readers[i].fn, path, 10, 0);
+      cr_expect_eq(o.signal, 0, "%s(%s): killed by signal %d after %.1f s",
+                   readers[i].name, files[f].name, o.signal, o.seconds);
+      if (o.signal)
+        continue;
+      cr_expect_eq(o.status, BB_ERR_FORMAT, "%s(%s): %s", readers[i].name, files[f].name,
+                   o.message);
+      cr_expect(strstr(o.message, path) && strstr(o.message, files[f].promised),
+                "%s(%s): '%s'", readers[i].name, files[f].name, o.message);
+      cr_expect_null(strchr(o.message, '\n'), "%s: '%s'", readers[i].name, o.message);
+      cr_expect_lt(o.cpu_seconds, 0.5, "%s(%s) took %.2f s of CPU", readers[i].name,
+                   files[f].name, o.cpu_seconds);
+    }
+    unlink(path);
+  }
+}
+
+/* Files under another format's extension, or none, are read by what their
+ * first bytes say, as before: a PNG named .tga, .foo or nothing at all. */
+Test(untrusted, an_image_under_another_extension_is_read_by_its_signature) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, 8, 4, 1, NULL), BB_OK);
+  for (int i = 0; i < 32; i++)
+    img.pixels[i] = (float)i / 31.0f;
+  bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
+  cr_assert_eq(bb_image_write(in_scratch_dir("real.png"), &img, &o, NULL), BB_OK);
+  bb_image_free(&img);
+  cr_assert_eq(bb_image_read(in_scratch_dir("real.png"), &img, NULL, NULL), BB_OK);
+  static const char *names[] = {"png_as.tga", "png_as.exr", "png_as.foo", "png_as"};
+  for (size_t n = 0; n < sizeof names / sizeof names[0]; n++) {
+    cr_assert_eq(
+        rename(in_scratch_dir(n ? names[n - 1] : "real.png"), in_scratch_dir(names[n])),
+        0);
+    bb_image back;
+    bb_image_info info;
+    bb_error err;
+    cr_assert_eq(bb_image_read(in_scratch_dir(names[n]), &back, &info, &err), BB_OK,
+                 "%s: %s", names[n], err.message);
+    cr_expect_str_eq(info.format_name, "png", "%s", names[n]);
+    cr_expect(back.width == 8 && back.height == 4 && back.channels == 1, "%s", names[n]);
+    cr_expect_eq(memcmp(back.pixels, img.pixels, sizeof(float) * 32), 0, "%s", names[n]);
+    bb_image_free(&back);
+    bb_image_info_free(&info);
+  }
+  bb_image_free(&img);
+}
+
 /* ------------------------------------------------------ third-party messages */
 
 /* What the calls of fn wrote on file descriptor 2 (then restored), as a

@@ -1,8 +1,10 @@
 /* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a
  * process. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw (scratch_dir.h) */
+#define _DEFAULT_SOURCE   /* wait4 (child_call.h) */
 
 #include "bumpbake.h"
+#include "child_call.h"
 #include "hostile_headers.h"
 #include "scratch_dir.h"
 
@@ -453,6 +455,51 @@ Test(compare_cli, a_file_over_the_size_limit_is_unreadable_exit_4) {
                  "%s: %s", files[i], out);
     cr_expect(strstr(out, files[i]), "%s: %s", files[i], out);
   }
+}
+
+/* A 148-byte DDS header declaring 16384 x 16384 RGBA floats (a sparse 4 GiB
+ * file) is within the read's limits, but comparing two took 60 s and 8.5
+ * GB: what a comparison will take is worked out from the headers before a
+ * pixel is read, refused with the figures when it will not fit, and said
+ * when it is large (over what any read takes: 1 GiB). */
+static void keep_note(void *user, const char *path, const char *text) {
+  snprintf(user, 512, "%s: %s", path, text);
+}
+
+static bb_status check_pair(const char *path, bb_error *err) {
+  return bb_compare_files_check(path, path, NULL, NULL, NULL, err);
+}
+
+Test(compare_cli, a_large_comparison_says_its_cost_before_it_starts) {
+  const char *huge = in_scratch_dir("huge.dds"), *big = in_scratch_dir("big.dds");
+  cr_assert_eq(write_dds_float_header(huge, 16384, 16384), 0);
+  cr_assert_eq(write_dds_float_header(big, 4096, 8192), 0);
+  /* under 2 GB of address space: refused from the headers, with both figures */
+  child_outcome o = child_call(check_pair, huge, 30, 2000L << 20);
+  cr_expect_eq(o.status, BB_ERR_MEMORY, "%s", o.message);
+  cr_expect(strstr(o.message,
+                   "huge.dds: comparing two 16384 x 16384 images of 4 channels "
+                   "needs about 12.6 GiB of memory; "),
+            "%s", o.message);
+  cr_expect_lt(o.max_rss_kib, 200 * 1024, "it read pixels: %ld KiB", o.max_rss_kib);
+  bb_error err = {{0}};
+  char note[512] = "";
+  uint64_t room = 0;
+  cr_assert_eq(bb_memory_available(&room, NULL, NULL), BB_OK);
+  if ((double)room < 2.0 * (1 << 30))
+    cr_skip_test("less than 2 GiB of memory available for the note's case");
+  /* 4096 x 8192 RGBA floats: 512 MiB a file, 1.6 GiB to compare: said */
+  cr_assert_eq(bb_compare_files_check(big, big, NULL, keep_note, note, &err), BB_OK, "%s",
+               err.message);
+  cr_expect(strstr(note,
+                   "big.dds: comparing two 4096 x 8192 images of 4 channels takes about "
+                   "1.6 GiB of memory ("),
+            "%s", note);
+  /* a small one: nothing to say */
+  note[0] = '\0';
+  const char *a = ramp_with("a.exr", 0, 0);
+  cr_assert_eq(bb_compare_files_check(a, a, NULL, keep_note, note, &err), BB_OK);
+  cr_expect_str_empty(note);
 }
 
 Test(compare_cli, diff_exr_holds_raw_absolute_differences) {
