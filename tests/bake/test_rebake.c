@@ -202,14 +202,16 @@ static void edits_equal_whole(int w, int h, bb_addressing addressing, int bright
 
 TestSuite(rebake);
 
+/* 20 edits give each of the 5 kinds on each of the 4 thread counts once
+ * (edit e is kind e % 5 on threads[e % 4]); 10 give each kind twice. */
 Test(rebake, periodic_edits_equal_whole_bakes) {
-  edits_equal_whole(97, 61, BB_ADDRESS_PERIODIC, 0, BB_MAPS_BAKED, 25, 1u);
-  edits_equal_whole(128, 128, BB_ADDRESS_PERIODIC, 0, BB_MAPS_BAKED, 15, 2u);
+  edits_equal_whole(97, 61, BB_ADDRESS_PERIODIC, 0, BB_MAPS_BAKED, 20, 1u);
+  edits_equal_whole(128, 128, BB_ADDRESS_PERIODIC, 0, BB_MAPS_BAKED, 10, 2u);
 }
 
 Test(rebake, clamped_edits_equal_whole_bakes) {
-  edits_equal_whole(97, 61, BB_ADDRESS_CLAMP, 0, BB_MAPS_BAKED, 25, 3u);
-  edits_equal_whole(64, 120, BB_ADDRESS_CLAMP, 0, BB_MAPS_BAKED, 15, 4u);
+  edits_equal_whole(97, 61, BB_ADDRESS_CLAMP, 0, BB_MAPS_BAKED, 20, 3u);
+  edits_equal_whole(64, 120, BB_ADDRESS_CLAMP, 0, BB_MAPS_BAKED, 10, 4u);
 }
 
 Test(rebake, edits_with_brightness_equal_whole_bakes) {

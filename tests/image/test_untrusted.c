@@ -481,6 +481,10 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
     size_t n = f ? fread(said, 1, sizeof said - 1, f) : 0;
     if (f) fclose(f);
     cr_expect_eq(n, 0, "margin %d MiB: stderr got '%s'", margin_mib, said);
+    /* A larger margin only writes again, the same way: past the failures,
+     * three writes that went through are enough. */
+    if (failed > 0 && written >= 3)
+      break;
   }
   cr_log_info("%d writes failed short of memory, %d succeeded", failed, written);
   cr_expect_gt(failed, 0, "no margin was short of memory");
