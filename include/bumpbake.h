@@ -441,8 +441,8 @@ int bb_provenance_value(const char *description, const char *key, char *out, siz
 
 /* A texture an engine loads as it is: Valve's VTF (Source) or DirectX's DDS
  * (Unreal, Unity, Godot, id Tech and most others), with its mip chain and
- * block compression (BC1..BC5, by Debian's libsquish). OpenImageIO reads DDS
- * but writes neither, so bumpbake writes both containers itself.
+ * block compression (BC1..BC5, by bumpbake's own codec). OpenImageIO reads
+ * DDS but writes neither, so bumpbake writes both containers itself.
  *
  * Every format stores what the engine samples: values in [0, 1] as they
  * are and normal maps as 0.5 + 0.5 N, the float formats included (a shader
@@ -689,7 +689,8 @@ void bb_image_info_free(bb_image_info *info);
  * file starting with "DDS ", read by bumpbake too, as OpenImageIO 2.4's
  * reader crashes on hostile headers: DXT1 to DXT5, BC4, BC5, masked RGB,
  * luminance and alpha, and with a DX10 header RGBA16F, RGBA32F and more;
- * format_name "dds"); blocks are decoded by libsquish. info may be NULL.
+ * format_name "dds"); blocks are decoded by the exact rules of Direct3D's
+ * specification (bumpbake's codec). info may be NULL.
  * The file must be a regular one (a FIFO, a device or a directory is
  * refused at once) and is read through the descriptor that was checked.
  * Errors: BB_ERR_IO (missing, unreadable, not a regular file),

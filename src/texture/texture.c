@@ -423,11 +423,12 @@ bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_ki
   } else {
     for (int k = 0; k < count; k++) {
       sources[k] = (level_source){&levels[k], kind->unit_vectors};
-      images[k] = (bb__block_image){levels[k].width, levels[k].height, level_texels,
+      images[k] = (bb__block_image){levels[k].width, levels[k].height,
+                                    (bb__block_format)(f->block - 1), level_texels,
                                     &sources[k], out[k]};
     }
-    st = bb__blocks_compress_images(images, count, (bb__block_format)(f->block - 1),
-                                    fast ? BB__FIT_RANGE : BB__FIT_BEST, threads, err);
+    st = bb__blocks_compress_images(images, count, fast ? BB__FIT_QUICK : BB__FIT_BEST,
+                                    threads, NULL, NULL, err);
   }
   free(images);
   free(sources);
