@@ -109,6 +109,12 @@ Test(cli_textures, what_a_texture_cannot_hold_is_refused_first) {
   expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
                                   tmp("o.vtf"), "--texture-format", "bc5", NULL},
                  "VTF has no format bc5");
+  /* a name no container has: the names as --help lists them, a VTF's in
+   * Valve's spelling */
+  expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
+                                  tmp("o.vtf"), "--texture-format", "dxt3", NULL},
+                 "--texture-format must be one of dxt1, dxt5, bgr888, bgra8888, rgba16f "
+                 "(vtf); bc1, bc3, bc4, bc5, rgba8, rgba16f, rgba32f (dds) (got 'dxt3')");
   expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
                                   tmp("o.png"), "--vmt", tmp("o.vmt"), NULL},
                  "needs a .vtf bump map");
