@@ -29,24 +29,10 @@
  *   BB_ERR_ARGUMENT with a message listing the names accepted.
  * docs/conventions.md gives the frame, units and formulas in full.
  *
- * The header reads family by family, each using only the ones before it
- * (the folders of src/, in the order of docs/how-it-works.md, "Layers"):
- *   core     status, errors, images, limits
- *   files    checked, all-or-nothing writes of files; provenance texts read
- *   texture  engine textures (VTF, DDS) and Source materials
- *   image    reading and writing image files, mip chains, animations, the
- *            height input
- *   trace    bases, the max-mip pyramid, ray sets, the tracer
- *   bake     smoothing, normals, derived maps, bb_bake
- *   maps     Valve's files, conversions, combining, programs, slope maps,
- *            comparing images
- *   render   lighting the maps, pictures, contact sheets
- *   mesh     models and DOOM 3's flat render bump
- *   job      the whole job on files: provenance, output paths, writing all
- *            or nothing, bakes of files and batches, depfiles, up-to-date
- *            checks
- *   commands every command and option described once, checked, and planned
- *            through the job
+ * The header reads family by family, each using only the ones before it:
+ * the folders of src/, in the order of docs/how-it-works.md ("Layers").
+ * Each family's section opens with its folder's name and what it holds;
+ * `make check-layers` holds the sections to that order.
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -65,6 +51,11 @@ extern "C" {
  * ===================================================================== */
 
 #define BB_VERSION_STRING "0.4.0"
+/* The ABI's number: libbumpbake.so's soname is libbumpbake.so.0.N. It
+ * changes only when a change breaks programs built against the last
+ * release (`make check-abi` says so), not with each release: one that
+ * only adds functions keeps it. */
+#define BB_ABI_VERSION 4
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
@@ -178,6 +169,17 @@ const char *bb_status_name(bb_status status);
  * which "a\u202egnp.exe" shows as "aexe.png") and bytes that are not UTF-8.
  * Returns out. The command line prints every line through it. */
 const char *bb_text_printable(const char *s, char *out, size_t cap);
+
+/* word quoted for a POSIX shell: as it is when every byte is a letter, a
+ * digit, one of "@%+=:,./-_" or a byte of UTF-8 beyond ASCII (so plain
+ * paths and values keep their bytes), else in single quotes with each
+ * quote in it given as '\'' ("my rock.png" -> 'my rock.png', "" -> '').
+ * sh reads back the word itself, whatever its bytes. Every command line
+ * the library spells (the provenance's command, bb_job_command_text,
+ * bb_command_text) quotes its words so; a client that records the words
+ * typed (bb_command_set_record) quotes them with this. malloc'd; NULL
+ * when word is NULL or out of memory. */
+char *bb_text_shell_quoted(const char *word);
 
 /* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
  * the end of the string or bytes that are not UTF-8 (overlong forms,
@@ -1111,7 +1113,12 @@ struct bb_trace_options {
                               nonzero return cancels. In bb_bake also
                               with done 0 and total 0 (a checkpoint, no
                               progress) every 50 ms while it smooths and
-                              makes normals, so those stages cancel too */
+                              makes normals, so those stages cancel too;
+                              with inter-reflection (bounce_albedo > 0) the
+                              units run once over the trace and the
+                              bounces: the first bb_bake_slices(o) are the
+                              trace's (one a slice), the rest the
+                              bounces' */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls
@@ -2668,7 +2675,7 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
                           bb_error *err);
 
 /* =====================================================================
- * commands: every command of `bumpbake`, its options and their rules,
+ * cmd: every command of `bumpbake`, its options and their rules,
  * described once
  * ===================================================================== */
 
@@ -2721,6 +2728,9 @@ typedef enum bb_option_mode {
                                       names, format settings, a batch, a cluster;
                                       not for images in memory (bb_command_set_in_memory) */
 
+/* The descriptions below are the library's static data, handed out by
+ * pointer only: a program never makes, copies or steps through an array of
+ * them, so a release may append fields at their end and keep the ABI. */
 typedef struct bb_option_info {
   const char *name;        /* the long name without "--" ("filter-radius"); Python's
                               keyword is it with '-' as '_' (filter_radius) */
@@ -2866,6 +2876,15 @@ const bb_command_info *bb_command_describe(const bb_command *command);
  * --rays?)"). An option set again takes the new value. */
 bb_status bb_command_set(bb_command *command, const char *name, const char *text,
                          bb_error *err);
+
+/* Puts option name back at its default, as if it had never been set: the
+ * rules (bb_command_check) and the text (bb_command_text) no longer see
+ * it. For a client whose control goes back to the value it starts at
+ * (bumpbake serve's page). Errors: BB_ERR_ARGUMENT "unknown option ..."
+ * as bb_command_set says it, and "--NAME cannot be unset: leave it out"
+ * for an option whose parser sets more than its one value (--basis);
+ * BB_ERR_MEMORY. An option not set is left as it is. */
+bb_status bb_command_unset(bb_command *command, const char *name, bb_error *err);
 
 /* Adds a positional argument (an input file, or height2ssbump's
  * BUMPSCALE) in order. Errors: BB_ERR_ARGUMENT (one too many, a

@@ -22,8 +22,8 @@
 # batch, two half batches and bumpbake.dask.bake_files; one 8192 x 8192 map
 # in one process and split over 2 workers; `make bench-cluster` runs it
 # alone, with 16384 x 16384 too), 12 `bumpbake serve`'s save-to-pixels
-# latency in headless Chromium against the cold bake + render pair
-# (tools/bench_serve.py), 13 the loop before and after: an older build
+# latency in headless Chromium against the cold bake + render pair, for a
+# save of the whole height and of a 32 x 32 edit (tools/bench_serve.py), 13 the loop before and after: an older build
 # (BENCH_BEFORE=DIR, its build directory) and this one in turns, the
 # stages of a bake, the writes, the kernel, a bounce's cost and the whole
 # bake (tools/bench_loop.py; skipped without BENCH_BEFORE), then a summary table.
@@ -686,6 +686,8 @@ if want 12; then
     echo "skipped (BENCH_SERVE=0)"
   elif ! /usr/bin/python3 tools/bench_serve.py "$bin" | tee "$out/serve.txt"; then
     fail "tools/bench_serve.py failed"
+  elif ! /usr/bin/python3 tools/bench_serve.py "$bin" --edit 32 | tee "$out/serve_edit.txt"; then
+    fail "tools/bench_serve.py --edit 32 failed"
   fi
 fi
 

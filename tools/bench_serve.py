@@ -2,7 +2,9 @@
 """bench_serve.py BIN: `bumpbake serve`'s save-to-pixels latency.
 
 From the rename() of a new 1024 x 1024 height (fixtures/rock06_height.png
-and its inverse, made with `bumpbake program invertColor`, in turns) over
+and its inverse, made with `bumpbake program invertColor`, in turns; with
+--edit N, the height and a copy with one N x N block raised, a brush
+stroke's worth, in turns) over
 the served file to the page in headless Chromium showing that save's ssbump
 (its <body data-drawn-bake> moves on; data-drawn-at is the page's clock,
 Date.now(), the same wall clock as time.time() here), at serve's default
@@ -12,7 +14,11 @@ state it publishes) and the cold pair of today, `bumpbake bake` then
 `bumpbake render` of its ssbump, each its own process, run in turns with
 the saves (medians).
 
-  tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S]
+  tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S] [--edit N]
+
+A full re-bake is the save of the inverse (every texel changed); --edit 32
+saves a 32 x 32 edit, what a re-bake of only what changed would speed up
+(it needs the Python package and numpy, to write the edited height).
 
 make bench runs it as section 12. Needs chromium, chromium-driver and
 python3-selenium (make deps); prints why and exits 0 without them.
@@ -44,12 +50,31 @@ def run(cmd):
     return time.time() - t0
 
 
+def edited(height, out, n):
+    """height with an n x n block near its middle raised by a smooth bump
+    (a brush stroke), 16-bit, through the Python package."""
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import numpy as np
+    import bumpbake
+
+    h = np.array(bumpbake.read(height), dtype=np.float32)
+    if h.ndim == 3:
+        h = h[:, :, 0]
+    y0, x0 = h.shape[0] // 2 - n // 2, h.shape[1] // 2 - n // 2
+    r = (np.arange(n) - (n - 1) / 2) / (n / 2)
+    bump = np.clip(1 - (r[:, None] ** 2 + r[None, :] ** 2), 0, 1)
+    h[y0:y0 + n, x0:x0 + n] = np.clip(h[y0:y0 + n, x0:x0 + n] + 0.1 * bump, 0, 1)
+    bumpbake.write(out, h, kind="height", depth=16)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("bin")
     ap.add_argument("--saves", type=int, default=10)
     ap.add_argument("--height", default=os.path.join(ROOT, "fixtures", "rock06_height.png"))
     ap.add_argument("--scale", default="64")
+    ap.add_argument("--edit", type=int, default=0,
+                    help="save an N x N block raised, not the whole height inverted")
     a = ap.parse_args()
     binary = os.path.abspath(a.bin)
     why = sb.browser_missing()
@@ -59,10 +84,13 @@ def main():
     work = tempfile.mkdtemp(prefix="bb-bench-serve-")
     served = os.path.join(work, "height.png")
     variant = os.path.join(work, "variant.png")
-    subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
-                    "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
-                    "-o", variant],
-                   check=True, stdout=subprocess.DEVNULL)
+    if a.edit:
+        edited(a.height, variant, a.edit)
+    else:
+        subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
+                        "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
+                        "-o", variant],
+                       check=True, stdout=subprocess.DEVNULL)
     with open(a.height, "rb") as f:
         original = f.read()
     with open(variant, "rb") as f:
@@ -110,8 +138,9 @@ def main():
     cold_bake = med(c[0] for c in cold)
     cold_pair = med(c[0] + c[1] for c in cold)
     print()
-    print("save-to-pixels, median of %d saves:      %.3f s (min %.3f, max %.3f)"
-          % (len(latencies), lat, min(latencies), max(latencies)))
+    what = "a %d x %d edit" % (a.edit, a.edit) if a.edit else "the whole height changed"
+    print("save-to-pixels (%s), median of %d saves: %.3f s (min %.3f, max %.3f)"
+          % (what, len(latencies), lat, min(latencies), max(latencies)))
     print("the bake inside serve, median:           %.3f s" % bk)
     print("save-to-pixels minus the bake, median:   %.3f s"
           % med(l - b for l, b in zip(latencies, bakes)))

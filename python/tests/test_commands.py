@@ -4,6 +4,7 @@ Python keyword, values are set and checked by the library, and what Python
 writes is the command line's bytes."""
 
 import os
+import shlex
 import shutil
 import signal
 import subprocess
@@ -188,7 +189,7 @@ def test_a_bounce_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch):
     ours = files_of("py")
     shutil.rmtree("py")
     os.makedirs("py")
-    done = cli(*command.split()[1:])
+    done = cli(*shlex.split(command)[1:])
     assert done.returncode == 0, done.stderr
     theirs = files_of("py")
     assert sorted(ours) == ["ao.exr", "ssbump.exr"] == sorted(theirs)
@@ -297,7 +298,7 @@ def test_whole_numbers_are_spelled_as_typed():
     """30 is recorded as 30, not as the shortest %g that reads back (3e+01)."""
     job = bumpbake.BakeJob(os.path.join(FIXTURES, "rock06_128.png"),
                            outputs={"normal": "n.png"}, scale=30, rays=100, bias=1e6)
-    assert job.command_text(0).split()[3:] == ["--scale", "30", "--rays", "100", "--bias",
+    assert shlex.split(job.command_text(0))[3:] == ["--scale", "30", "--rays", "100", "--bias",
                                                "1000000", "--normal", "n.png"]
 
 

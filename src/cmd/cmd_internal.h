@@ -167,6 +167,8 @@ bb_status bb__render_view_check(const bb_render_options *o, int width, int heigh
 bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
                           double *values, int *count, bb_error *err);
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t);
+/* "v0,v1,..." of n floats, each the shortest that reads back the same. */
+void bb__print_floats(bb__text *t, const float *v, int n);
 /* count numbers of text (comma-separated, or blank-separated when the
  * option takes several words) into v; BB_ERR_ARGUMENT naming the option. */
 bb_status bb__parse_numbers(const bb__option *o, const char *text, int count, int integers,
@@ -204,7 +206,8 @@ extern const bb__option bb__opt_scale, bb__opt_scale_optional, bb__opt_rays,
     bb__opt_normal_filter, bb__opt_normal_y, bb__opt_threads, bb__opt_clamp, bb__opt_channel,
     bb__opt_depth, bb__opt_depth_like_input, bb__opt_depth_of_format, bb__opt_mips,
     bb__opt_json, bb__opt_quiet, bb__opt_help, bb__opt_texture_format, bb__opt_vtf_version,
-    bb__opt_vtf_flags, bb__opt_nomip, bb__opt_fast_compression;
+    bb__opt_vtf_flags, bb__opt_nomip, bb__opt_fast_compression, bb__opt_light_color,
+    bb__opt_albedo;
 
 /* The options' tables (options_*.c). */
 extern const bb__command bb__command_bake, bb__command_normal, bb__command_height2ssbump,

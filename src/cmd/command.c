@@ -145,6 +145,55 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   return BB_OK;
 }
 
+/* The bytes of an option's field, or 0 for one its set function writes. */
+static size_t field_size(int field) {
+  switch (field) {
+  case BB__FIELD_INT:
+  case BB__FIELD_ENUM:
+    return sizeof(int);
+  case BB__FIELD_FLOAT:
+    return sizeof(float);
+  case BB__FIELD_DOUBLE:
+    return sizeof(double);
+  case BB__FIELD_STRING:
+    return sizeof(const char *);
+  case BB__FIELD_ANGLES:
+    return 2 * sizeof(double);
+  default:
+    return 0;
+  }
+}
+
+bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
+  if (!c || !name)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
+  const int i = bb__option_find(c->def, name);
+  if (i < 0)
+    return bb_command_set(c, name, NULL, err); /* its words for an unknown name */
+  const bb__option *o = c->def->options[i];
+  const size_t size = field_size(o->field);
+  if (o->set || o->sets.field != BB__FIELD_NONE || !size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out",
+                    o->info.name);
+  if (!c->given[i])
+    return BB_OK;
+  /* the default is a fresh command's (its init included); a default
+   * string is a constant, never one of that command's copies */
+  bb_command *fresh = NULL;
+  bb_status st = bb_command_new(c->def->info.name, &fresh, err);
+  if (st != BB_OK)
+    return st;
+  memcpy((char *)&c->options + o->offset, (const char *)&fresh->options + o->offset,
+         size);
+  bb_command_free(fresh);
+  c->given[i] = 0;
+  c->texts[i] = NULL;
+  c->value_count[i] = 0;
+  memset(c->values[i], 0, sizeof c->values[i]);
+  c->checked = 0;
+  return BB_OK;
+}
+
 bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
   if (!c || !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no input given");

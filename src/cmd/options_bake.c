@@ -652,6 +652,33 @@ const bb__command bb__command_height2ssbump = {
              .option_count = (int)(sizeof h2s_options / sizeof h2s_options[0]) - 1},
     .options = h2s_options, .init = h2s_init, .add_input = h2s_input, .job = h2s_job};
 
+/* --------------------------------------- render's light, shared with serve */
+
+static bb_status set_light_color(bb_command *c, const bb__option *o, const char *text,
+                                 double *values, int *count, bb_error *err) {
+  bb_status st = bb__parse_numbers(o, text, 3, 0, values, err);
+  for (int k = 0; k < 3 && st == BB_OK; k++)
+    c->options.render.light_color[k] = (float)values[k];
+  *count = 3;
+  return st;
+}
+
+static void print_light_color(const bb_command *c, const bb__option *o, bb__text *t) {
+  (void)o;
+  bb__print_floats(t, c->options.render.light_color, 3);
+}
+
+const bb__option bb__opt_light_color = {
+    .info = {.name = "light-color", .value_name = "R,G,B", .type = BB_OPTION_NUMBERS,
+             .count = 3, .values = 1, .flags = RECORDED, .help = "colour of the dynamic light"},
+    .range = &bb__range_colour, .set = set_light_color, .print = print_light_color};
+
+const bb__option bb__opt_albedo = {
+    .info = {.name = "albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = RECORDED, .default_text = "white",
+             .help = "colour map multiplying the diffuse light (same size as the maps)"},
+    .field = BB__FIELD_STRING, .offset = AT(albedo)};
+
 /* --------------------------------------------------------------- serve */
 
 static const bb__range range_port = {"port", 0, 65535, 0, 1};
@@ -688,7 +715,8 @@ static const bb__option *const serve_options[] = {
     &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
     &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
     &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
-    &bb__opt_fast_compression, &opt_port, &opt_address, &opt_serve_quiet, &bb__opt_help, NULL};
+    &bb__opt_fast_compression, &bb__opt_light_color, &bb__opt_albedo, &opt_port, &opt_address,
+    &opt_serve_quiet, &bb__opt_help, NULL};
 
 static void serve_init(bb_command_options *o) {
   o->port = 8077; /* the documented port serve listens on unless told */
@@ -701,8 +729,9 @@ const bb__command bb__command_serve = {
              .description =
                  "Bakes HEIGHT, serves a page that shows its maps lit in the browser (the\n"
                  "ssbump under a light you drag, normal-mapped, ao, bent normal, basis\n"
-                 "weights, relief; tiled to show seams) and re-bakes when HEIGHT, or a\n"
-                 "map the options read, is saved, or when a control on the page changes.\n"
+                 "weights, relief; tiled to show seams; --albedo and --light-color as\n"
+                 "render's) and re-bakes when HEIGHT, or a map the options read, is saved,\n"
+                 "or when a control on the page changes.\n"
                  "Nothing is written until the page's \"write\" asks: then the maps are\n"
                  "written as the `bumpbake bake` line the page shows would write them\n"
                  "(PREFIX_normal.png, PREFIX_ssbump.png, PREFIX_ao.png by default, PREFIX\n"

@@ -164,6 +164,9 @@ typedef struct bb__text {
 void bb__text_append(bb__text *t, const char *s, size_t n);
 /* Appends the string s. */
 void bb__text_add(bb__text *t, const char *s);
+/* Appends word quoted for a POSIX shell, as bb_text_shell_quoted spells it:
+ * every command line the library spells puts its words through it. */
+void bb__text_add_word(bb__text *t, const char *word);
 
 /* Checks of images, with the same words in every family (image_checks.c). */
 /* BB_ERR_VALUE naming the first texel whose channels 0..channels-1 are not

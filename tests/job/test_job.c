@@ -81,7 +81,21 @@ Test(job, command_text_spells_the_options_as_typed) {
   o.name_template = "{kind}/{stem}.tif";
   text = bb_job_command_text(&o, "a.png");
   cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name {kind}/{stem}.tif");
+                         "--mips --out-dir out --name '{kind}/{stem}.tif'");
+  free(text);
+}
+
+/* The line is quoted for a POSIX shell (bb_text_shell_quoted): typed in
+ * one, a name with a blank or a ';' is one word, and runs nothing. */
+Test(job, command_text_is_quoted_for_a_shell) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 8.0f;
+  o.paths[BB_MAP_NORMAL] = "out dir/n.png";
+  o.brightness_file = "it's.png";
+  char *text = bb_job_command_text(&o, "x;touch PWNED;y.png");
+  cr_expect_str_eq(text, "bumpbake bake 'x;touch PWNED;y.png' --scale 8 --brightness "
+                         "'it'\\''s.png' --normal 'out dir/n.png'");
   free(text);
 }
 
