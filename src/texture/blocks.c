@@ -75,6 +75,67 @@ static void compress_row(void *user, int item) {
   }
 }
 
+/* ---------------------------------------------------------------- watch */
+
+/* The calling thread's watch (bb__blocks_watch_thread). */
+static _Thread_local bb__blocks_watch *watched;
+
+void bb__blocks_watch_init(bb__blocks_watch *w, long total, bb_progress_fn progress,
+                           void *progress_user) {
+  memset(w, 0, sizeof *w);
+  pthread_mutex_init(&w->lock, NULL);
+  w->total = total;
+  w->progress = progress;
+  w->progress_user = progress_user;
+}
+
+void bb__blocks_watch_destroy(bb__blocks_watch *w) {
+  pthread_mutex_destroy(&w->lock);
+}
+
+void bb__blocks_watch_thread(bb__blocks_watch *w) {
+  watched = w;
+}
+
+/* One compression's progress under a watch: its rows done so far. */
+typedef struct watched_run {
+  bb__blocks_watch *w;
+  long reported; /* this run's rows already added to w->done */
+} watched_run;
+
+/* Adds the run's rows done since the last call to the watch's and tells
+ * the watch's progress (done clamped to the total counted beforehand). */
+static int watch_progress(void *user, long done, long total) {
+  (void)total;
+  watched_run *run = user;
+  bb__blocks_watch *w = run->w;
+  pthread_mutex_lock(&w->lock);
+  w->done += done - run->reported;
+  run->reported = done;
+  const long shown = w->done < w->total ? w->done : w->total;
+  const int stop = w->progress ? w->progress(w->progress_user, shown, w->total) : 0;
+  pthread_mutex_unlock(&w->lock);
+  return stop;
+}
+
+static void watch_begin(bb__blocks_watch *w) {
+  pthread_mutex_lock(&w->lock);
+  if (w->running++ == 0)
+    w->started = bb__now_seconds();
+  pthread_mutex_unlock(&w->lock);
+}
+
+static void watch_end(watched_run *run, long rows) {
+  bb__blocks_watch *w = run->w;
+  pthread_mutex_lock(&w->lock);
+  w->done += rows - run->reported;
+  if (--w->running == 0)
+    w->seconds += bb__now_seconds() - w->started;
+  pthread_mutex_unlock(&w->lock);
+}
+
+/* ------------------------------------------------------------ compressing */
+
 bb_status bb__blocks_compress_images(const bb__block_image *images, int count,
                                      bb__block_fit fit, int threads,
                                      bb_progress_fn progress, void *progress_user,
@@ -104,9 +165,23 @@ bb_status bb__blocks_compress_images(const bb__block_image *images, int count,
     else
       j.first_row[k + 1] = j.first_row[k] + rows;
   }
-  if (st == BB_OK && count > 0)
+  /* Under a watch (and no progress of the caller's own), the rows count in
+   * the watch's stage. */
+  watched_run run = {watched, 0};
+  if (run.w && !progress) {
+    progress = watch_progress;
+    progress_user = &run;
+  } else {
+    run.w = NULL;
+  }
+  if (st == BB_OK && count > 0) {
+    if (run.w)
+      watch_begin(run.w);
     st = bb__parallel_for(j.first_row[count], threads, compress_row, &j, progress,
                           progress_user, err);
+    if (run.w)
+      watch_end(&run, st == BB_OK ? j.first_row[count] : run.reported);
+  }
   free(j.first_row);
   return st;
 }

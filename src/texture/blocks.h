@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 
+#include <pthread.h>
 #include <stddef.h>
 
 #ifdef __cplusplus
@@ -69,6 +70,30 @@ bb_status bb__blocks_compress_images(const bb__block_image *images, int count,
                                      bb__block_fit fit, int threads,
                                      bb_progress_fn progress, void *progress_user,
                                      bb_error *err);
+
+/* A watch over the block compressions a caller's threads start (the
+ * job's write stage, which stages its files side by side): rows of blocks
+ * done, reported to progress against total (counted by the caller
+ * beforehand: bb__texture_block_rows), and the wall seconds during which
+ * at least one compression ran. A compression started on a thread after
+ * bb__blocks_watch_thread(w) there is counted in w; progress is called
+ * under w's lock, so from one thread at a time, and a nonzero return
+ * cancels that compression (BB_ERR_CANCELLED). */
+typedef struct bb__blocks_watch {
+  pthread_mutex_t lock;
+  long done, total;
+  int running; /* compressions in flight */
+  double started, seconds;
+  bb_progress_fn progress; /* may be NULL */
+  void *progress_user;
+} bb__blocks_watch;
+
+void bb__blocks_watch_init(bb__blocks_watch *w, long total, bb_progress_fn progress,
+                           void *progress_user);
+void bb__blocks_watch_destroy(bb__blocks_watch *w);
+/* The watch of the compressions the calling thread starts from now on
+ * (NULL: none). */
+void bb__blocks_watch_thread(bb__blocks_watch *w);
 
 /* bb__blocks_compress_images of one image given as width x height texels
  * of rgba (4 floats per texel, row-major) into out. */
