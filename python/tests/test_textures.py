@@ -212,6 +212,10 @@ def test_one_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch, fixtures, cli
                        "--vmt game/materials/rock/rock.vmt")
     report = bumpbake.bake_file("rock.png", outputs, **settings)
     assert report.outputs["material"] == "game/materials/rock/rock.vmt"
+    # the blocks' compression: a part of the write, its own figure
+    assert 0 < report.seconds["compress"] <= report.seconds["write"]
+    png = bumpbake.bake_file("rock.png", {"ssbump": "s.png"}, scale=32, rays=64)
+    assert png.seconds["compress"] == 0
     ours = files_of("game")
     shutil.rmtree("game")
     os.makedirs("game/materials/rock")
