@@ -19,6 +19,16 @@
 extern "C" {
 #endif
 
+/* Sixteen terms, one a texel, summed as four lanes of four and then the
+ * lanes: the order a 4-wide vector sum takes, fixed whatever the compiler
+ * makes of it, so an error depends on the texels alone. */
+static inline float bb__sum16(const float e[16]) {
+  float lane[4];
+  for (int l = 0; l < 4; l++)
+    lane[l] = ((e[l] + e[4 + l]) + e[8 + l]) + e[12 + l];
+  return (lane[0] + lane[1]) + (lane[2] + lane[3]);
+}
+
 /* Encodes channels 0, 1, 2 of the texels of texels[4 * i + c] (i = 4 y +
  * x; values in [0, 1], clamped; NaN counts as 0) whose bit i is set in
  * mask (at least one) into an 8-byte BC1 colour block. three: 3-colour

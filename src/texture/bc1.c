@@ -232,15 +232,6 @@ typedef struct fit {
   int index[16];
 } fit;
 
-/* Sixteen terms summed as four lanes of four, then the lanes: the order
- * a 4-wide vector sum takes, fixed whatever the compiler makes of it. */
-static float sum16(const float e[16]) {
-  float lane[4];
-  for (int l = 0; l < 4; l++)
-    lane[l] = ((e[l] + e[4 + l]) + e[8 + l]) + e[12 + l];
-  return (lane[0] + lane[1]) + (lane[2] + lane[3]);
-}
-
 /* f's palette as the decoder will read it: end points that pack to the
  * same 16 bits make a 3-colour block whatever the mode asked, all its
  * colours (but black) the one colour. */
@@ -270,7 +261,7 @@ static void assess(const block *b, fit *f) {
     index[i] = c * (2 + c23 - c01) + c01;
     e[i] = b->w[i] * (c ? m23 : m01);
   }
-  f->error = sum16(e);
+  f->error = bb__sum16(e);
 }
 
 static void keep_better(fit *best, const fit *f) {
@@ -396,7 +387,7 @@ static void local_search(const block *b, fit *f, int passes) {
           const float m01 = s1 < s0 ? s1 : s0, m23 = s3 < s2 ? s3 : s2;
           t[i] = b->w[i] * (m23 < m01 ? m23 : m01);
         }
-        const float e = sum16(t);
+        const float e = bb__sum16(t);
         if (e < best)
           best = e, best_a = a, best_b = bq;
       }

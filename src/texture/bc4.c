@@ -45,14 +45,6 @@ typedef struct block {
   float x[16], w[16];
 } block;
 
-/* Sixteen terms summed as four lanes of four, then the lanes (as bc1.c). */
-static float sum16(const float e[16]) {
-  float lane[4];
-  for (int l = 0; l < 4; l++)
-    lane[l] = ((e[l] + e[4 + l]) + e[8 + l]) + e[12 + l];
-  return (lane[0] + lane[1]) + (lane[2] + lane[3]);
-}
-
 /* The error of the block against the values of (a0, a1), each texel at
  * its nearest value. */
 static float block_error(const block *b, int a0, int a1) {
@@ -69,7 +61,7 @@ static float block_error(const block *b, int a0, int a1) {
     }
     e[i] = b->w[i] * best;
   }
-  return sum16(e);
+  return bb__sum16(e);
 }
 
 /* The index of each texel's nearest value of (a0, a1), the first of equals. */
