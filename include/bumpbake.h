@@ -2553,7 +2553,8 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
  * and the job is not forced, else reads, bakes and writes its maps all or
  * nothing (BB_JOB_BAKED), filling its report. progress (may be NULL)
  * follows the bake, then the block compression of its engine textures
- * (units anew: bb_job_stage), and may cancel either; it is also called once with done 0
+ * (units anew: bb_job_stage; called from the writer's threads, one call
+ * at a time), and may cancel either; it is also called once with done 0
  * and total 0 when the input has been read and its notes given, before the
  * bake: a nonzero return there (a note the caller takes as an error)
  * cancels with nothing baked or written. Returns the report's status; a
