@@ -158,7 +158,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-serve check-circles check-layers check-docs check-abi abi-dump api-report bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
+        bench bench-cluster bench-check goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -174,7 +175,9 @@ PYTHON   := /usr/bin/python3
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
 # python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
-# a Dask cluster (its tests run a LocalCluster). strace: a test (and make
+# a Dask cluster (its tests run a LocalCluster). python3-junitparser: a test
+# reads `bumpbake check --junit`'s file as CI servers do; python3-yaml: a test
+# runs docs/goldens.md's CI jobs. strace: a test (and make
 # hostile) delivers a signal in the middle of a commit; time: make hostile's
 # peak memory (GNU time's %M). abigail-tools: abidw and abidiff, the ABI
 # check.
@@ -182,7 +185,8 @@ DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build python3-distributed python3-dask strace time \
-            libmicrohttpd-dev chromium chromium-driver python3-selenium abigail-tools
+            libmicrohttpd-dev chromium chromium-driver python3-selenium python3-junitparser \
+            python3-yaml abigail-tools
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -192,7 +196,7 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium' >/dev/null 2>&1 \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium, junitparser, yaml' >/dev/null 2>&1 \
 	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 \
 	    && command -v abidw >/dev/null 2>&1 && command -v abidiff >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
@@ -327,8 +331,9 @@ uninstall:
 	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 
 # ---- the README's commands ---------------------------------------------------
+# The demo builds only the command it runs, on every core.
 demo: ensure-deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(NPROC) $(BIN)
 	@./tools/demo.sh $(BIN)
 
 # The build runs on every core (a fresh clone compiles ~70 files); the checks
@@ -343,8 +348,8 @@ test: ensure-deps
 # each other, the check that no family reaches up to a later one, the
 # check that the command reference and the man page say what --help says
 # and the check of the ABI against the last release's.
-check: check-unit check-install check-python check-serve check-circles check-layers check-docs \
-       check-abi
+check: check-unit check-install check-python check-serve check-report check-circles check-layers \
+       check-docs check-abi
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -417,7 +422,7 @@ PY_SANITIZE := $(if $(PY_PRELOAD),LD_PRELOAD="$(PY_PRELOAD)" ASAN_OPTIONS=detect
 check-python: $(BIN) lib
 	cd python && BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) BB_BIN=$(abspath $(BIN)) \
 	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
-	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
+	  $(PYTHON) -m pytest -q -p no:cacheprovider --durations=10 tests
 
 # `bumpbake serve` in headless Chromium (tests/serve/): the page draws, relights,
 # re-bakes on a save by rename and on a control, keeps the last maps after a
@@ -429,9 +434,28 @@ check-serve: $(BIN)
 	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
 	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
 
+# `bumpbake check --html`'s report in headless Chromium (tests/report/): every
+# picture loads from the folder and nothing else, the flip and the slider
+# work, a failure shows golden, new and difference. Skipped, saying why,
+# without chromium, chromium-driver or python3-selenium. Screenshots:
+# build/report-test/.
+check-report: $(BIN) lib
+	@echo "report: check --html's page in headless Chromium (tests/report)"
+	@cd tests/report && BB_BIN=$(abspath $(BIN)) BB_REPORT_SHOTS=$(abspath $(BUILD))/report-test \
+	  PYTHONPATH=$(abspath python) BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) \
+	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
+
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# A golden suite of 200 maps from the fixtures checked three ways
+# (tools/bench_check.sh, for docs/performance.md "Golden checks"): the bake
+# alone, check --bake (the same bake, writing nothing) and the bake then
+# compare once per map; wall, CPU and peak memory, medians of 3 rounds.
+bench-check: ensure-deps
+	@$(MAKE) --no-print-directory all lib
+	@BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) ./tools/bench_check.sh $(BIN)
 
 # bumpbake on a Dask cluster of this machine (2 worker processes) against
 # one process, with cmp of their files (tools/bench_cluster.sh, for

@@ -14,11 +14,13 @@ state it publishes) and the cold pair of today, `bumpbake bake` then
 `bumpbake render` of its ssbump, each its own process, run in turns with
 the saves (medians).
 
-  tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S] [--edit N]
+  tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S]
+                       [--edit SIDE]
 
-A full re-bake is the save of the inverse (every texel changed); --edit 32
-saves a 32 x 32 edit, what a re-bake of only what changed would speed up
-(it needs the Python package and numpy, to write the edited height).
+--edit SIDE: each save changes a SIDE x SIDE region only (a soft brush of
+0.1 of the height at the map's middle, added and taken away in turns,
+written with the bumpbake Python package beside the build): serve bakes
+it again where it changed (a context that keeps, bb_bake_context_keep).
 
 make bench runs it as section 12. Needs chromium, chromium-driver and
 python3-selenium (make deps); prints why and exits 0 without them.
@@ -50,21 +52,25 @@ def run(cmd):
     return time.time() - t0
 
 
-def edited(height, out, n):
-    """height with an n x n block near its middle raised by a smooth bump
-    (a brush stroke), 16-bit, through the Python package."""
+def brush(binary, height, out, side):
+    """height with a side x side soft brush of 0.1 added at its middle, as a
+    16-bit PNG (the library's reader and writer, through the package)."""
+    os.environ.setdefault("BUMPBAKE_LIBRARY", os.path.dirname(binary))
     sys.path.insert(0, os.path.join(ROOT, "python"))
     import numpy as np
     import bumpbake
-
-    h = np.array(bumpbake.read(height), dtype=np.float32)
+    h = bumpbake.read(height)
     if h.ndim == 3:
-        h = h[:, :, 0]
-    y0, x0 = h.shape[0] // 2 - n // 2, h.shape[1] // 2 - n // 2
-    r = (np.arange(n) - (n - 1) / 2) / (n / 2)
-    bump = np.clip(1 - (r[:, None] ** 2 + r[None, :] ** 2), 0, 1)
-    h[y0:y0 + n, x0:x0 + n] = np.clip(h[y0:y0 + n, x0:x0 + n] + 0.1 * bump, 0, 1)
-    bumpbake.write(out, h, kind="height", depth=16)
+        h = h[..., 0]
+    rows, cols = h.shape
+    y, x = np.mgrid[0:side, 0:side].astype(np.float64)
+    r = side / 2.0
+    d2 = ((x + 0.5 - r) / r) ** 2 + ((y + 0.5 - r) / r) ** 2
+    bump = np.where(d2 < 1.0, 0.1 * (1.0 - d2) ** 2, 0.0)
+    y0, x0 = rows // 2 - side // 2, cols // 2 - side // 2
+    h = h.astype(np.float64)
+    h[y0:y0 + side, x0:x0 + side] += bump
+    bumpbake.write(out, np.clip(h, 0.0, 1.0).astype(np.float32), kind="height", depth=16)
 
 
 def main():
@@ -73,8 +79,7 @@ def main():
     ap.add_argument("--saves", type=int, default=10)
     ap.add_argument("--height", default=os.path.join(ROOT, "fixtures", "rock06_height.png"))
     ap.add_argument("--scale", default="64")
-    ap.add_argument("--edit", type=int, default=0,
-                    help="save an N x N block raised, not the whole height inverted")
+    ap.add_argument("--edit", type=int, default=0)
     a = ap.parse_args()
     binary = os.path.abspath(a.bin)
     why = sb.browser_missing()
@@ -85,7 +90,7 @@ def main():
     served = os.path.join(work, "height.png")
     variant = os.path.join(work, "variant.png")
     if a.edit:
-        edited(a.height, variant, a.edit)
+        brush(binary, a.height, variant, a.edit)
     else:
         subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
                         "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
@@ -108,7 +113,7 @@ def main():
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, 300, "the first bake drawn")
         for i in range(a.saves):
             before = sb.drawn_bake(driver)
-            data = inverted if i % 2 == 0 else original
+            data = inverted if i % 2 == 0 else original  # (--edit: edited, not inverted)
             tmp = os.path.join(work, ".~height.png")
             with open(tmp, "wb") as f:
                 f.write(data)

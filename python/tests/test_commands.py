@@ -30,6 +30,7 @@ FUNCTIONS = {
     "normal": ("normal", "run"),
     "height2ssbump": ("run",),
     "compare": ("compare",),
+    "check": ("check",),
     "info": ("info",),
     "renderbumpflat": ("renderbumpflat",),
     "render": ("render", "run"),
@@ -45,6 +46,7 @@ FUNCTIONS = {
 # too: Python returns reports and raises errors instead.
 NOT_IN_PYTHON = {
     ("bake", "scheduler"): "a cluster from Python is bumpbake.dask.bake_files(client=...)",
+    ("check", "bake"): "check(golden, heights=...) bakes; the command line says --bake",
     ("serve", None): "the command line's HTTP preview server (bake() and render() make "
                      "what it shows)",
 }
@@ -68,6 +70,7 @@ def call_with(name, command, key, value):
         "normal": lambda kw: f(h, 1, **kw),
         "run": lambda kw: f(command, **kw),
         "compare": lambda kw: f("a.png", "b.png", **kw),
+        "check": lambda kw: f("g", "n", **kw),
         "info": lambda kw: f("a.png", **kw),
         "renderbumpflat": lambda kw: f("m.obj", **kw),
         "render": lambda kw: f(normal=n, **kw),

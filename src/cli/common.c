@@ -69,6 +69,13 @@ void cli_printf_line(const char *fmt, ...) {
   va_end(ap);
 }
 
+void cli_put_lines(char *text) {
+  if (text)
+    fputs(text, stdout);
+  free(text);
+  fflush(stdout);
+}
+
 void cli_note(void *user, const char *path, const char *text) {
   (void)user;
   char line[2048], safe[4 * sizeof line];

@@ -46,6 +46,11 @@ void cli_printf_line(const char *fmt, ...)
 #endif
     ;
 
+/* The library's lines (bb_job_report_lines, bb_check_case_lines, ...: the
+ * library made them printable) on stdout, flushed; text is freed (NULL:
+ * nothing). */
+void cli_put_lines(char *text);
+
 /* The library's notes (bb_note_fn) as "bumpbake: PATH: note: TEXT" on
  * stderr. user is unused. */
 void cli_note(void *user, const char *path, const char *text);

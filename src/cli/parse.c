@@ -20,6 +20,7 @@ typedef struct runner {
 static const runner runners[] = {
     {"normal", cli_run_job},          {"bake", cli_run_job},
     {"height2ssbump", cli_run_job},   {"compare", cli_run_compare},
+    {"check", cli_run_check},
     {"info", cli_run_info},           {"renderbumpflat", cli_run_renderbumpflat},
     {"render", cli_run_render},       {"sheet", cli_run_sheet},
     {"normal2ssbump", cli_run_normal2ssbump}, {"ssbump2normal", cli_run_ssbump2normal},

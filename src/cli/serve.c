@@ -88,10 +88,13 @@ int cli_run_serve(const cli_run *r) {
   if (st != BB_OK)
     return cli_library_error("serve", st, &err);
 
-  /* the ray set and the buffers stay warm from one bake to the next */
+  /* the ray set and the buffers stay warm from one bake to the next, and
+   * what the last bake made: a save that changes part of the height bakes
+   * again only what the change reaches (the same bits) */
   bb_error context_err = {{0}};
   if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
     return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
+  bb_bake_context_keep(s.context, 1);
 
   /* Listening comes before any bake, so a port already taken ends serve
    * before a bake starts; every thread started before a failure is

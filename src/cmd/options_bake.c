@@ -162,7 +162,7 @@ const bb__option bb__opt_scale_optional = ROW_SCALE(0);
 const bb__option bb__opt_rays = ROW_RAYS(0);
 static const bb__option opt_rays_valve = ROW_RAYS('r');
 
-static const bb__option opt_slices = {
+const bb__option bb__opt_slices = {
     .info = {.name = "slices", .value_name = "A", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "from --rays",
              .help = "azimuth slices, each integrated exactly above its horizon (overrides "
@@ -196,7 +196,7 @@ const bb__option bb__opt_power = {
              .values = 1, .flags = RECORDED, .help = "exponent of the basis lobes max(0, w.B)^P"},
     .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.power), .range = &bb__range_power};
 
-static const bb__option opt_basis = {
+const bb__option bb__opt_basis = {
     .info = {.name = "basis", .value_name = "hl2|hl2+z|dirs:N|FILE", .type = BB_OPTION_TEXT,
              .count = 1, .values = 1, .flags = RECORDED,
              .help = "directions occlusion is projected on, one channel each: Half-Life 2's, N "
@@ -256,7 +256,7 @@ const bb__option bb__opt_mips = {
                      "renormalised"},
     .field = BB__FIELD_INT, .offset = AT(job.mips)};
 
-static const bb__option opt_bounce = {
+const bb__option bb__opt_bounce = {
     .info = {.name = "bounce", .value_name = "RHO", .type = BB_OPTION_NUMBER, .count = 1,
              .values = 1, .flags = RECORDED,
              .default_text = "0 (none; 1 with --bounce-albedo)",
@@ -266,7 +266,7 @@ static const bb__option opt_bounce = {
     .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.bounce_albedo),
     .range = &bb__range_bounce_albedo, .applies = bb__applies_traced};
 
-static const bb__option opt_bounces = {
+const bb__option bb__opt_bounces = {
     .info = {.name = "bounces", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "0 (until converged)",
              .applies = "--bounce RHO or --bounce-albedo FILE",
@@ -274,7 +274,7 @@ static const bb__option opt_bounces = {
     .field = BB__FIELD_INT, .offset = AT(job.bake.bounces), .range = &bb__range_bounces,
     .applies = bb__applies_bounces};
 
-static const bb__option opt_bounce_albedo = {
+const bb__option bb__opt_bounce_albedo = {
     .info = {.name = "bounce-albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED,
              .applies = "a traced map (--ssbump, --ao, --bent)",
@@ -282,7 +282,7 @@ static const bb__option opt_bounce_albedo = {
     .field = BB__FIELD_STRING, .offset = AT(job.bounce_albedo_file),
     .applies = bb__applies_traced};
 
-static const bb__option opt_brightness = {
+const bb__option bb__opt_brightness = {
     .info = {.name = "brightness", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED, .applies = "an ssbump or weights map",
              .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights (a "
@@ -342,7 +342,7 @@ static const bb__option opt_out_dir = {
              .help = "a batch: bake every HEIGHT (files, or directories of images) into DIR"},
     .field = BB__FIELD_STRING, .offset = AT(job.out_dir)};
 
-static const bb__option opt_maps = {
+const bb__option bb__opt_maps = {
     .info = {.name = "maps", .value_name = "LIST", .type = BB_OPTION_WORDS, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "normal,ssbump,ao",
@@ -350,7 +350,7 @@ static const bb__option opt_maps = {
     .names = bb__name_output_kind, .parse = bb__parse_output_kind, .set = set_maps,
     .print = print_maps};
 
-static const bb__option opt_name = {
+const bb__option bb__opt_name = {
     .info = {.name = "name", .value_name = "TEMPLATE", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = BB_JOB_DEFAULT_NAME, .range_text = "{stem} {kind} {ext}",
@@ -465,13 +465,13 @@ static const bb__option opt_scheduler = {
 /* -------------------------------------------------------------- bake */
 
 static const bb__option *const bake_options[] = {
-    &bb__opt_scale, &bb__opt_rays, &opt_slices, &bb__opt_filter_radius,
-    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &opt_basis,
+    &bb__opt_scale, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
     &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
-    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &opt_bounce, &opt_bounces,
-    &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce, &bb__opt_bounces,
+    &bb__opt_bounce_albedo, &bb__opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
     &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
-    &opt_out_dir, &opt_maps, &opt_name, &opt_keep_going, &opt_force, &opt_depfile,
+    &opt_out_dir, &bb__opt_maps, &bb__opt_name, &opt_keep_going, &opt_force, &opt_depfile,
     &bb__opt_json, &opt_quiet_bake, &bb__opt_texture_format, &bb__opt_vtf_version,
     &bb__opt_vtf_flags, &bb__opt_nomip, &bb__opt_fast_compression, &opt_vmt, &opt_materials,
     &opt_basetexture, &opt_scheduler, &bb__opt_help, NULL};
@@ -708,11 +708,11 @@ static const bb__option opt_address = {
 static const bb__option opt_serve_quiet = ROW_QUIET('q', "print only the URL, not each bake");
 
 static const bb__option *const serve_options[] = {
-    &bb__opt_scale, &bb__opt_rays, &opt_slices, &bb__opt_filter_radius,
-    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &opt_basis,
+    &bb__opt_scale, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
     &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
-    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &opt_bounce, &opt_bounces,
-    &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce, &bb__opt_bounces,
+    &bb__opt_bounce_albedo, &bb__opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
     &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
     &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
     &bb__opt_fast_compression, &bb__opt_light_color, &bb__opt_albedo, &opt_port, &opt_address,

@@ -57,6 +57,22 @@ bb_status bb__parse_name(const char *what, const char *name, const char *const *
  * Names are compared exactly, as the library spells them. */
 bb_map_kind bb__map_kind_of_output(const char *kind, bb_range range, uint32_t *vtf_flags);
 
+/* What a map's provenance records of one key (bb_map_kind_records, the
+ * rule's one home, map_kind.c): the key's value, nothing, or of a ray
+ * set's id only the scheme and slices (ao without inter-reflection:
+ * "bb-horizon-v1:a16", the lobes' power and basis leave it). */
+typedef enum bb__key_use {
+  BB__KEY_DROPPED = 0,
+  BB__KEY_RECORDED,
+  BB__KEY_SLICES
+} bb__key_use;
+bb__key_use bb__map_kind_key(const char *kind, const char *key, size_t key_length,
+                             int bounce);
+
+/* The length of a ray set's id (length bytes at id, not terminated) up to
+ * its slices: "bb-horizon-v1:a16" of "bb-horizon-v1:a16:p1:hl2". */
+size_t bb__rayset_slices_length(const char *id, size_t length);
+
 /* ----------------------------------------------------------------- ranges */
 
 /* The range of one parameter, written once where the parameter's struct

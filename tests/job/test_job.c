@@ -404,3 +404,71 @@ Test(job, block_compression_is_a_stage_of_its_own) {
     bb_job_free(job);
   }
 }
+
+/* A 16-bit height of w x h with a bump at (bx, by), written to path. */
+static void bump_file(const char *path, int w, int h, int bx, int by) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, w, h, 1, NULL), BB_OK);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      const double d2 = (x - bx) * (x - bx) + (y - by) * (y - by);
+      img.pixels[y * w + x] =
+          (float)(0.3 + 0.2 * sin(0.4 * x) * cos(0.3 * y) + 0.3 * exp(-d2 / 2.0));
+    }
+  harness_write(path, &img, BB_DEPTH_16, BB_RANGE_UNIT);
+  bb_image_free(&img);
+}
+
+/* bumpbake serve's way: the bakes of a job through a context that keeps
+ * (bb_bake_context_keep) bake a changed file again where it changed, and
+ * keep the maps a job without a context makes. */
+Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
+  const char *input = tmp("edited.png");
+  bump_file(input, 48, 40, 10, 10);
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 16.0f;
+  o.paths[BB_MAP_SSBUMP] = tmp("e_ssbump.exr");
+  o.force = 1;
+  bb_bake_context *context = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_bake_context_new(&context, &err), BB_OK);
+  bb_bake_context_keep(context, 1);
+  for (int edit = 0; edit < 3; edit++) {
+    if (edit > 0)
+      bump_file(input, 48, 40, 10 + 3 * edit, 10 + edit);
+    bb_job *job = NULL, *cold = NULL;
+    cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_job_plan(&input, 1, &o, &cold, &err), BB_OK, "%s", err.message);
+    bb_job_use_context(job, context);
+    bb_bake_result kept, whole;
+    cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &kept, &err), BB_OK,
+                 "%s", err.message);
+    cr_assert_eq(bb_job_bake_item(cold, 0, BB_MAPS_BAKED, NULL, NULL, &whole, &err),
+                 BB_OK, "%s", err.message);
+    const bb_region changed = bb_bake_context_changed(context);
+    if (edit > 0) {
+      cr_expect(bb__context_last_local(context), "edit %d was baked whole", edit);
+      cr_expect(changed.x0 <= 10 && changed.x0 + changed.width > 10 + 3 * edit &&
+                    changed.y0 <= 10 && changed.y0 + changed.height > 10 + edit,
+                "edit %d: %dx%d at (%d, %d) changed", edit, changed.width, changed.height,
+                changed.x0, changed.y0);
+    }
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+      const bb_image *a = bb_bake_result_image(&kept, (bb_map_kind)k);
+      const bb_image *b = bb_bake_result_image(&whole, (bb_map_kind)k);
+      cr_assert_eq(a->pixels != NULL, b->pixels != NULL);
+      if (a->pixels)
+        cr_expect(
+            memcmp(a->pixels, b->pixels,
+                   (size_t)a->width * (size_t)a->height * (size_t)a->channels * 4) == 0,
+            "edit %d: map %d differs from the job's without a context", edit, k);
+    }
+    cr_expect_null(kept.vis.pixels, "the job's bake lets vis go, as without a context");
+    bb_bake_result_free(&kept);
+    bb_bake_result_free(&whole);
+    bb_job_free(job);
+    bb_job_free(cold);
+  }
+  bb_bake_context_free(context);
+}

@@ -389,9 +389,16 @@ static void bake_once(serve_state *s, long wanted) {
       shed_maps(s->previous);
     s->current = b;
     s->error[0] = '\0';
-    if (!s->quiet)
-      fprintf(stderr, "serve: bake %ld: %dx%d in %.3f s\n", b->id, b->width, b->height,
-              b->seconds);
+    if (!s->quiet) {
+      /* a save baked again where it changed says where */
+      const bb_region c = bb_bake_context_changed(s->context);
+      char where[96] = "";
+      if (c.width < b->width || c.height < b->height)
+        snprintf(where, sizeof where, ", again where it changed (%dx%d at %d,%d)", c.width,
+                 c.height, c.x0, c.y0);
+      fprintf(stderr, "serve: bake %ld: %dx%d in %.3f s%s\n", b->id, b->width, b->height,
+              b->seconds, where);
+    }
   } else if (st != BB_ERR_CANCELLED) {
     /* the last good maps stay on the page, with why the new ones are not */
     snprintf(s->error, sizeof s->error, "%s",
