@@ -33,7 +33,7 @@ TEST_INCLUDES := -Iinclude -Isrc -Itests
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
 # and calling the library's own global functions directly, as without -fPIC.
 LIB_CFLAGS := -fPIC -fno-semantic-interposition
-PKGS    := OpenImageIO criterion assimp libsquish Imath libpng libjpeg OpenEXR libmicrohttpd
+PKGS    := OpenImageIO criterion assimp Imath libpng libjpeg OpenEXR libmicrohttpd
 OIIO_CFLAGS := $(shell pkg-config --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS   := $(shell pkg-config --libs OpenImageIO 2>/dev/null)
 # libpng: src/image/png_hooks.c sets quiet error handlers and bounded
@@ -49,17 +49,15 @@ CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null)
 # Assimp reads and writes meshes (src/mesh/mesh_assimp.cpp only).
 ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
-# libsquish compresses BC1..BC5 blocks (src/texture/squish.cpp only). Imath's
-# half.h (C, header only) converts floats to half for VTF and DDS.
-SQUISH_CFLAGS := $(shell pkg-config --cflags libsquish 2>/dev/null)
-SQUISH_LIBS   := $(shell pkg-config --libs libsquish 2>/dev/null)
+# Imath's half.h (C, header only) converts floats to half for VTF and DDS;
+# the blocks of both are bumpbake's own codec (src/texture/bc1.c, bc4.c).
 # libmicrohttpd: the HTTP server of `bumpbake serve` (src/cli/serve/ only,
 # linked into the CLI, not the library).
 MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
 MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
 # OpenEXR's IlmThread: bumpbake's provider for its pool (src/image/exr_pool.cpp).
 EXR_POOL_LIBS := $(filter -lIlmThread%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(SQUISH_LIBS) $(PNG_LIBS) $(PROBE_LIBS) $(EXR_POOL_LIBS) -lm -pthread
+LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(PNG_LIBS) $(PROBE_LIBS) $(EXR_POOL_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -183,7 +181,7 @@ PYTHON   := /usr/bin/python3
 # hostile) delivers a signal in the middle of a commit; time: make hostile's
 # peak memory (GNU time's %M). abigail-tools: abidw and abidiff, the ABI
 # check.
-DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
+DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build python3-distributed python3-dask strace time \
@@ -221,7 +219,7 @@ ensure-fuzz-deps: ensure-deps
 # with, rewritten only when those change: a changed CFLAGS, DEBUG or
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
-COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS)
+COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
@@ -242,7 +240,7 @@ $(BUILD)/%.o: %.c $(BUILD)/compile.flags
 
 $(BUILD)/src/%.o: src/%.cpp $(BUILD)/compile.flags
 	@mkdir -p $(@D)
-	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) -c $< -o $@
+	$(CXX) $(CXXFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) -c $< -o $@
 
 -include $(ALL_OBJ:.o=.d)
 
@@ -530,7 +528,7 @@ $(FUZZ_BUILD)/src/%.o: src/%.c
 
 $(FUZZ_BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
-	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) $(SQUISH_CFLAGS) \
+	clang++ $(FUZZ_CXXFLAGS) -MMD -MP $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) \
 	  $(PNG_CFLAGS) $(PROBE_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
 
 -include $(FUZZ_LIB_OBJ:.o=.d) $(FUZZ_CLI_OBJ:.o=.d)

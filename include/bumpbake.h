@@ -466,8 +466,8 @@ int bb_provenance_value(const char *description, const char *key, char *out, siz
 
 /* A texture an engine loads as it is: Valve's VTF (Source) or DirectX's DDS
  * (Unreal, Unity, Godot, id Tech and most others), with its mip chain and
- * block compression (BC1..BC5, by Debian's libsquish). OpenImageIO reads DDS
- * but writes neither, so bumpbake writes both containers itself.
+ * block compression (BC1..BC5, by bumpbake's own codec). OpenImageIO reads
+ * DDS but writes neither, so bumpbake writes both containers itself.
  *
  * Every format stores what the engine samples: values in [0, 1] as they
  * are and normal maps as 0.5 + 0.5 N, the float formats included (a shader
@@ -524,9 +524,9 @@ typedef struct bb_texture_options {
   int mips;                  /* 1: the full chain down to 1 x 1, by bb_mip_chain
                                 (BB_MIP_RENORMALIZE for normal maps, BB_MIP_AVERAGE
                                 otherwise); 0: the image alone */
-  int fast;                  /* 1: the codec's range fit, about 40 times faster than
-                                its cluster fit (0) and 1-2 dB lower PSNR on BC1/BC3;
-                                BC4 and BC5 are the same either way */
+  int fast;                  /* 1: the codec's quick fit of colour blocks (BC1,
+                                BC3's colour): about 40% less time, 0.05 to 0.1 dB
+                                lower PSNR; BC4 and BC5 are the same either way */
   int threads;               /* block compression threads, 0 = all cores; the bytes
                                 are the same for any count */
   int vtf_version;           /* VTF minor version: 2 (7.2, the default, read by every
@@ -714,7 +714,8 @@ void bb_image_info_free(bb_image_info *info);
  * file starting with "DDS ", read by bumpbake too, as OpenImageIO 2.4's
  * reader crashes on hostile headers: DXT1 to DXT5, BC4, BC5, masked RGB,
  * luminance and alpha, and with a DX10 header RGBA16F, RGBA32F and more;
- * format_name "dds"); blocks are decoded by libsquish. info may be NULL.
+ * format_name "dds"); blocks are decoded by the exact rules of Direct3D's
+ * specification (bumpbake's codec). info may be NULL.
  * The file must be a regular one (a FIFO, a device or a directory is
  * refused at once) and is read through the descriptor that was checked.
  * Errors: BB_ERR_IO (missing, unreadable, not a regular file),
@@ -2722,6 +2723,8 @@ typedef struct bb_job_report {
   int bounces;                /* bb_bake_result.bounces: passes of inter-reflection
                                  gathered, 0 when none */
   double seconds_bounce;      /* the inter-reflection's part, after seconds_trace */
+  double seconds_compress;    /* the engine textures' block compression (.vtf,
+                                 .dds), a part of seconds_write; 0 when none */
 } bb_job_report;
 
 /* Plans a job over inputs[0..input_count-1]: files, and directories, which
@@ -2747,6 +2750,13 @@ void bb_job_free(bb_job *job);
 int bb_job_count(const bb_job *job);
 const bb_job_report *bb_job_report_get(const bb_job *job, int i);
 
+/* The stage the input running in bb_job_run_item (or bb_job_run) is at,
+ * for a progress callback that names it: "bake" (reading and baking: the
+ * units of bb_trace_options.progress), "compress" (the 4 x 4 blocks of
+ * its .vtf and .dds files: the units are rows of blocks, over every level
+ * of every such file), or NULL between them. */
+const char *bb_job_stage(const bb_job *job);
+
 /* Whether every output of input i is what baking it now would write
  * (bb_output_check of each, from the files' headers; no pixel is decoded):
  * *current is 1 or 0, and the report's reason says why not. The input's
@@ -2756,7 +2766,9 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 /* Runs input i: skips it (BB_JOB_CURRENT) when its outputs are up to date
  * and the job is not forced, else reads, bakes and writes its maps all or
  * nothing (BB_JOB_BAKED), filling its report. progress (may be NULL)
- * follows the bake and may cancel it; it is also called once with done 0
+ * follows the bake, then the block compression of its engine textures
+ * (units anew: bb_job_stage; called from the writer's threads, one call
+ * at a time), and may cancel either; it is also called once with done 0
  * and total 0 when the input has been read and its notes given, before the
  * bake: a nonzero return there (a note the caller takes as an error)
  * cancels with nothing baked or written. Returns the report's status; a

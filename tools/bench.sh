@@ -14,7 +14,7 @@
 # (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
 # libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
 # one process against one process each), 9 engine textures (tools/bench_blocks.sh:
-# block compression's PSNR and worst error per format and map, libsquish
+# block compression's PSNR and worst error per format and map, bumpbake's codec
 # against nvcompress, and the time of a 2048 x 2048 VTF DXT1 with mips against
 # PNG), 10 inter-reflection (tools/bench_bounce.sh: bake --bounce against a
 # path tracer and exact radiosity, and its cost), 11 a Dask cluster of this
@@ -767,15 +767,15 @@ if [ "$batch_ok" = 1 ]; then
 fi
 if [ "$blocks_ok" = 1 ]; then
   summary_row "ssbump VTF DXT1, rock06 1024 (PSNR dB)" \
-    "$(blocks_field '^squish +ssbump +vtf bc1' 6)" \
-    "worst $(blocks_field '^squish +ssbump +vtf bc1' 8) codes of 255"
+    "$(blocks_field '^bumpbake +ssbump +vtf bc1' 6)" \
+    "worst $(blocks_field '^bumpbake +ssbump +vtf bc1' 8) codes of 255"
   summary_row "normal DDS BC5, rock06 1024 (PSNR dB)" \
-    "$(blocks_field '^squish +normal +dds bc5' 6)" \
-    "mean angle $(blocks_field '^squish +normal +dds bc5' 12) deg"
+    "$(blocks_field '^bumpbake +normal +dds bc5' 6)" \
+    "mean angle $(blocks_field '^bumpbake +normal +dds bc5' 12) deg"
   for size in 1024 2048; do
     summary_row "${size}^2 ssbump: VTF DXT1 + mips, $threads thr (s)" \
       "$(blocks_field "^$size +vtf --threads 2 " 5)" \
-      "DDS BC1 $(blocks_field "^$size +dds --threads 2 " 5) s; PNG $(blocks_field "^$size +png " 3) s; range fit $(blocks_field "^$size +vtf --fast" 6) s"
+      "DDS BC1 $(blocks_field "^$size +dds --threads 2 " 5) s; PNG $(blocks_field "^$size +png " 3) s; quick fit $(blocks_field "^$size +vtf --fast" 6) s"
   done
   for f in png exr-float exr-half vtf dds; do
     summary_row "bake's write stage, $f (x the stages)" "$(blocks_field "^$f: " 6)" \

@@ -51,7 +51,7 @@ ours() {
   channels=
   [ "$format" = bc5 ] && channels="--channels 2"
   # shellcheck disable=SC2086
-  row "squish$(printf '%s' "$*" | sed 's/--fast/-fast/')" "$map" "$ext $format" "$file" --map "$kind" $channels
+  row "bumpbake$(printf '%s' "$*" | sed 's/--fast/-fast/')" "$map" "$ext $format" "$file" --map "$kind" $channels
   echo "$seconds" >"$file.seconds"
 }
 
@@ -130,7 +130,7 @@ if command -v nvcompress >/dev/null 2>&1; then
   done
 fi
 echo "(png: 8-bit through OpenImageIO; vtf: DXT1 + all mip levels + low-res; dds: BC1 + mips;"
-echo " --fast: range fit alone; nvcompress: the whole process, from the 8-bit PNG, its own threads)"
+echo " --fast: the quick fit; nvcompress: the whole process, from the 8-bit PNG, its own threads)"
 
 echo "== the write stage of a bake against its trace: rock06 1024 x 1024, scale 128, 256 rays,"
 echo "   2 threads (bake --json's stages), median of 3"

@@ -546,6 +546,7 @@ typedef struct bb_job_report {
       seconds_derive, seconds_write;
   int bounces;
   double seconds_bounce;
+  double seconds_compress;
 } bb_job_report;
 
 typedef enum bb_option_type {
@@ -812,6 +813,7 @@ bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_o
 void bb_job_free(bb_job *job);
 int bb_job_count(const bb_job *job);
 const bb_job_report *bb_job_report_get(const bb_job *job, int i);
+const char *bb_job_stage(const bb_job *job);
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);

@@ -230,7 +230,7 @@ def write(path, array, *, kind="colour", depth=None, mips=False, description=Non
     vtf_flags (TEXTUREFLAGS_* bits added to the kind's own: SSBUMP for
     "ssbump" and "weights", NORMAL for "normal" and "bent"), nomip (no mip
     chain; a texture has the full one by default, whatever mips says),
-    fast_compression (the block codec's range fit). depth must be None.
+    fast_compression (the block codec's quick fit of colour blocks). depth must be None.
     Raises ArgumentError for a format that cannot hold the depth, mips or
     channels, a texture size or format its container cannot take (a VTF
     side not a power of two, a block format's side not a multiple of 4),

@@ -16,7 +16,7 @@ _OUTCOMES = {k: _text(_lib.bb_job_outcome_name(k))
              for k in (_lib.BB_JOB_PENDING, _lib.BB_JOB_BAKED, _lib.BB_JOB_CURRENT,
                        _lib.BB_JOB_FAILED, _lib.BB_JOB_NOT_RUN)}
 
-_SECONDS = ("load", "smooth", "pyramid", "trace", "derive", "write")
+_SECONDS = ("load", "smooth", "pyramid", "trace", "derive", "compress", "write")
 
 
 @dataclasses.dataclass

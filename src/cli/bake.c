@@ -41,6 +41,7 @@ int cli_run_job(const cli_run *r) {
   bb_status st = bb_command_plan(r->command, &hooks, &job, &err);
   if (st != BB_OK)
     return cli_library_error(name, st, &err);
+  progress.job = job; /* the bar names the block compression stage */
   printer p = {r->options, r->options->job.out_dir != NULL, {0}, &progress};
   st = bb_job_run(job, cli_progress_fn(&progress), &progress, print_report, &p, &err);
   cli_progress_finish(&progress);

@@ -12,10 +12,19 @@ enum { PROGRESS_BAR_WIDTH = 20 };
 /* Never cancels: Ctrl-C ends the process (cli_install_signal_handlers). */
 static int progress_draw(void *user, long done, long total) {
   cli_progress *p = user;
-  double now = cli_now_seconds(), elapsed = now - p->start_seconds;
-  /* Short bakes stay silent; long ones redraw ten times a second at most. */
-  if (elapsed < 1.0 || total <= 0 || now - p->last_draw_seconds < 0.1)
+  const double now = cli_now_seconds(), elapsed = now - p->start_seconds;
+  /* A job's block compression is a stage of its own: its units start
+   * anew, and so does the ETA's clock. */
+  const char *stage = p->job ? bb_job_stage(p->job) : NULL;
+  if (stage != p->stage)
+    p->stage = stage, p->stage_seconds = now, p->redraw = 1;
+  const int compressing = stage && !strcmp(stage, "compress");
+  /* Short bakes stay silent; long ones redraw ten times a second at most,
+   * and at once when the stage changes or its work is done. */
+  if (elapsed < 1.0 || total <= 0 ||
+      (!p->redraw && done < total && now - p->last_draw_seconds < 0.1))
     return 0;
+  p->redraw = 0;
   p->last_draw_seconds = now;
   double frac = done <= 0 ? 0.0 : (double)done / (double)total;
   if (frac > 1.0)
@@ -25,9 +34,10 @@ static int progress_draw(void *user, long done, long total) {
   for (int i = 0; i < PROGRESS_BAR_WIDTH; i++)
     bar[i] = i < filled ? '#' : '.';
   bar[PROGRESS_BAR_WIDTH] = '\0';
-  fprintf(stderr, "\r%s [%s] %3d%%", p->label, bar, (int)(frac * 100.0));
+  fprintf(stderr, "\r%s%s [%s] %3d%%", p->label, compressing ? ": compressing blocks" : "",
+          bar, (int)(frac * 100.0));
   if (frac > 0.0)
-    fprintf(stderr, " ETA %.1fs", elapsed * (1.0 - frac) / frac);
+    fprintf(stderr, " ETA %.1fs", (now - p->stage_seconds) * (1.0 - frac) / frac);
   fputs("\033[K", stderr); /* erase what a longer previous line left */
   fflush(stderr);
   p->shown = 1;
@@ -37,7 +47,7 @@ static int progress_draw(void *user, long done, long total) {
 void cli_progress_start(cli_progress *p, const char *label, int quiet) {
   memset(p, 0, sizeof *p);
   p->label = label;
-  p->start_seconds = cli_now_seconds();
+  p->start_seconds = p->stage_seconds = cli_now_seconds();
   p->active = !quiet && isatty(STDERR_FILENO);
 }
 

@@ -11,7 +11,11 @@
  * print nothing, and only when stderr is a terminal. */
 typedef struct cli_progress {
   const char *label;
-  double start_seconds;
+  const bb_job *job;    /* names the stage when set: "bake: compressing blocks" */
+  const char *stage;    /* the job's stage at the last call (bb_job_stage) */
+  double start_seconds; /* of the command: the bar waits a second */
+  double stage_seconds; /* when the stage began: the ETA's clock */
+  int redraw;           /* the stage changed: draw at the next chance */
   double last_draw_seconds;
   int shown;  /* a line is on screen and must be cleared */
   int active; /* stderr is a terminal and the command is not quiet */

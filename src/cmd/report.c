@@ -75,6 +75,9 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
   if (r->bounces > 0)
     bb_json_number(&j, "bounce", r->seconds_bounce);
   bb_json_number(&j, "derive", r->seconds_derive);
+  if (r->seconds_compress > 0)
+    /* the engine textures' block compression, a part of the write */
+    bb_json_number(&j, "compress", r->seconds_compress);
   bb_json_number(&j, "write", r->seconds_write);
   bb_json_close(&j, '}');
 

@@ -145,11 +145,25 @@ static bb_status parse_word(const bb__option *o, const char *text, int *value, b
     return BB_OK;
   char name[80], choices[256];
   bb__option_spelling(o, name, sizeof name);
+  char listed[320] = "";
+  if (o->info.range_text) {
+    /* The words as --help gives them, grouped as there (texture formats by
+     * container: dxt1 for a VTF, bc1 for a DDS), ", " between the words of
+     * a group. */
+    size_t used = 0;
+    for (const char *r = o->info.range_text; *r && used + 3 < sizeof listed; r++) {
+      if (*r == ' ' && r > o->info.range_text && r[-1] != ';' && r[1] != '(')
+        listed[used++] = ',';
+      listed[used++] = *r;
+    }
+    listed[used] = '\0';
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s must be one of %s (got '%.64s')", name, listed,
+                    text);
+  }
   bb__choices(o, choices, sizeof choices);
   for (char *bar = strchr(choices, '|'); bar; bar = strchr(bar, '|'))
     *bar = ',';
   /* ", " between the words, as every enum parser of the library lists them */
-  char listed[320] = "";
   for (const char *w = choices; *w;) {
     const size_t n = strcspn(w, ",");
     snprintf(listed + strlen(listed), sizeof listed - strlen(listed), "%s%.*s",

@@ -106,6 +106,7 @@ struct bb_job {
   int count;
   int batch;                /* 1: out_dir names the outputs */
   char prerequisite_basis;  /* 1: basis_file is a prerequisite (a vectors basis) */
+  const char *stage;        /* bb_job_stage: "bake", "compress" or NULL */
   char read_only;           /* 1: planned with BB__PLAN_READ_ONLY */
 };
 
@@ -133,6 +134,17 @@ int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out)
  * (paths.c). */
 bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
                                       bb_range range);
+
+/* bb_outputs_write with the block compression of its engine textures
+ * counted in watch (may be NULL): the job's compress stage, its progress
+ * and seconds (texture/blocks.h). */
+struct bb__blocks_watch;
+bb_status bb__outputs_write(const bb_output_file *files, int count, int threads,
+                            struct bb__blocks_watch *watch, bb_error *err);
+
+/* Rows of 4 x 4 blocks the engine textures among files compress
+ * (bb__texture_block_rows): a compress stage's total. */
+long bb__outputs_block_rows(const bb_output_file *files, int count);
 
 /* The maps o asks for: the named paths (and the filtered height the slope
  * map is made from, what Valve's file packs), or a batch's maps. The

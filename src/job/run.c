@@ -6,6 +6,7 @@
 #include "core/internal.h"
 #include "files/safe_file.h"
 #include "job/job_internal.h"
+#include "texture/blocks.h"
 
 #include <fcntl.h>
 #include <limits.h>
@@ -283,7 +284,8 @@ static bb_status write_depfile(const bb_job *job, const bb__job_item *item, cons
 /* The files of one input: its maps, the slope files, and a single input's
  * depfile, written together (a depfile written through a stream comes
  * after them). */
-static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error *err) {
+static bb_status write_item(bb_job *job, bb__job_item *item, baked *b,
+                            bb_progress_fn progress, void *progress_user, bb_error *err) {
   bb_job_report *r = &item->report;
   char *command = bb__job_command_of(job, item);
   if (!command && (job->command || job->command_options))
@@ -360,8 +362,19 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
                                     BB_DEPTH_DEFAULT, 0, NULL, b->depfile_text, size, NULL};
   }
   const double t0 = bb__now_seconds();
+  /* The engine textures' block compression is a stage of its own: its
+   * progress (rows of blocks, stage "compress") and its seconds, a part
+   * of the write's. */
+  bb__blocks_watch watch;
+  bb__blocks_watch_init(&watch, st == BB_OK ? bb__outputs_block_rows(files, n) : 0, progress,
+                        progress_user);
+  if (watch.total > 0)
+    job->stage = "compress";
   if (st == BB_OK)
-    st = bb_outputs_write(files, n, b->result.threads, err);
+    st = bb__outputs_write(files, n, b->result.threads, &watch, err);
+  job->stage = NULL;
+  r->seconds_compress = watch.seconds;
+  bb__blocks_watch_destroy(&watch);
   if (st == BB_OK && depfile_stream)
     st = write_depfile(job, item, "the maps were written", err);
   r->seconds_write = bb__now_seconds() - t0;
@@ -375,6 +388,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
                                bb_error *err) {
   bb_job_report *r = &item->report;
   const double t0 = bb__now_seconds();
+  job->stage = "bake";
   bb_status st = bb__job_memory_check(job, item, err);
   if (st == BB_OK)
     st = bb_height_file_read(item->input, job->options.channel,
@@ -442,6 +456,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
     r->bounces = res->bounces;
     r->seconds_bounce = res->seconds_bounce;
   }
+  job->stage = NULL;
   return st;
 }
 
@@ -451,9 +466,13 @@ static bb_status bake_item(bb_job *job, bb__job_item *item, bb_progress_fn progr
   memset(&b, 0, sizeof b);
   bb_status st = read_and_bake(job, item, 0u, progress, progress_user, &b, err);
   if (st == BB_OK)
-    st = write_item(job, item, &b, err);
+    st = write_item(job, item, &b, progress, progress_user, err);
   baked_free(&b);
   return st;
+}
+
+const char *bb_job_stage(const bb_job *job) {
+  return job ? job->stage : NULL;
 }
 
 bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
@@ -518,7 +537,7 @@ static bb_status write_maps(bb_job *job, int i, const bb_bake_result *result, un
   if (st == BB_OK && job->slope_path && !only)
     st = make_slope(job, item, &b, &r->error);
   if (st == BB_OK)
-    st = write_item(job, item, &b, &r->error);
+    st = write_item(job, item, &b, NULL, NULL, &r->error);
   memset(&b.result, 0, sizeof b.result);
   baked_free(&b);
   if (st != BB_OK) {

@@ -9,6 +9,8 @@
 #include "image/image_write.h"
 #include "image/oiio.h"
 #include "job/job_internal.h"
+#include "texture/blocks.h"
+#include "texture/texture.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -68,6 +70,7 @@ typedef struct staged {
   bb_staged_file *handle; /* NULL when staging failed */
   bb_status status;
   bb_error error;
+  bb__blocks_watch *watch; /* the set's block compression stage, or NULL */
 } staged;
 
 /* Text bytes under a temporary name, synced: the staged twin of bb_file_write. */
@@ -118,7 +121,9 @@ static void stage_one(void *user, int item) {
     /* A texture makes its own chain (its mips option), as the map its kind is. */
     const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
     const bb_write_options wo = {o->depth, o->range, o->description, &t};
+    bb__blocks_watch_thread(s->watch);
     s->status = bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
+    bb__blocks_watch_thread(NULL);
     return;
   }
   const bb_write_options wo = {o->depth, o->range, o->description, NULL};
@@ -172,7 +177,25 @@ bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kind
   return st;
 }
 
+long bb__outputs_block_rows(const bb_output_file *files, int count) {
+  long rows = 0;
+  for (int i = 0; files && i < count; i++) {
+    const bb_output_file *o = &files[i];
+    if (!o->image || !bb_path_is_texture_format(o->path))
+      continue;
+    const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
+    rows += bb__texture_block_rows(o->path, o->image->width, o->image->height,
+                                   o->image->channels, &t);
+  }
+  return rows;
+}
+
 bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err) {
+  return bb__outputs_write(files, count, threads, NULL, err);
+}
+
+bb_status bb__outputs_write(const bb_output_file *files, int count, int threads,
+                            bb__blocks_watch *watch, bb_error *err) {
   if (count < 0 || (count > 0 && !files))
     return bb__fail(err, BB_ERR_ARGUMENT, "outputs write: bad arguments");
   if (count == 0)
@@ -181,7 +204,7 @@ bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, 
   if (!set)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", files[0].path);
   for (int i = 0; i < count; i++)
-    set[i].file = &files[i], set[i].threads = threads;
+    set[i].file = &files[i], set[i].threads = threads, set[i].watch = watch;
   /* Files are encoded side by side, at most one thread per file; within a
    * file, an engine texture's blocks and an OpenEXR file's chunks are
    * compressed on `threads` more (the bytes are the same on any count). */

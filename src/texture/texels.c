@@ -1,5 +1,5 @@
 /* texels.c: a texture level's stored texels decoded into floats: 4 x 4
- * blocks through the block codec (blocks.h, libsquish), 8- and 16-bit
+ * blocks through the block codec (blocks.h), 8- and 16-bit
  * normalised samples as v / 255 and v / 65535 (as OpenImageIO reads 8- and
  * 16-bit files), half floats through Imath's C conversion, packed texels
  * (DDS's bit masks; 5:6:5, 5:5:5:1, 4:4:4:4) channel by channel. */

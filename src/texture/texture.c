@@ -127,6 +127,30 @@ size_t bb__texture_level_bytes(bb_texture_format format, int width, int height) 
   return (size_t)width * (size_t)height * (size_t)f->texel_bytes;
 }
 
+long bb__texture_block_rows(const char *path, int width, int height, int channels,
+                            const bb_texture_options *options) {
+  bb_texture_format format;
+  bb_error ignored;
+  if (bb__texture_resolve(path, width, height, channels, options, &format, &ignored) != BB_OK)
+    return 0;
+  const format_info *f = info_of(format);
+  if (!f || !f->block)
+    return 0;
+  const int mips = options ? options->mips : 1;
+  long rows = 0;
+  int low = bb__texture_container(path) != BB__CONTAINER_VTF; /* 1: found, or none */
+  for (int w = width, h = height, k = 0;; k++) {
+    if (k == 0 || mips)
+      rows += (h + 3) / 4;
+    if (!low && w <= 16 && h <= 16) /* the low-resolution image: DXT1 */
+      rows += (h + 3) / 4, low = 1;
+    if ((w == 1 && h == 1) || (!mips && low))
+      break;
+    w = w / 2 > 1 ? w / 2 : 1, h = h / 2 > 1 ? h / 2 : 1;
+  }
+  return rows;
+}
+
 void bb_texture_options_init(bb_texture_options *o) {
   if (!o)
     return;
@@ -423,11 +447,12 @@ bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_ki
   } else {
     for (int k = 0; k < count; k++) {
       sources[k] = (level_source){&levels[k], kind->unit_vectors};
-      images[k] = (bb__block_image){levels[k].width, levels[k].height, level_texels,
+      images[k] = (bb__block_image){levels[k].width, levels[k].height,
+                                    (bb__block_format)(f->block - 1), level_texels,
                                     &sources[k], out[k]};
     }
-    st = bb__blocks_compress_images(images, count, (bb__block_format)(f->block - 1),
-                                    fast ? BB__FIT_RANGE : BB__FIT_BEST, threads, err);
+    st = bb__blocks_compress_images(images, count, fast ? BB__FIT_QUICK : BB__FIT_BEST,
+                                    threads, NULL, NULL, err);
   }
   free(images);
   free(sources);

@@ -35,6 +35,13 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
                             const bb_texture_options *options, struct bb_staged_file *f,
                             bb_error *err);
 
+/* Rows of 4 x 4 blocks the texture file path of a width x height image of
+ * `channels` channels, written with options, compresses: every level
+ * written (and a VTF's low-resolution image); 0 for a texel format or a
+ * request bb__texture_resolve refuses. */
+long bb__texture_block_rows(const char *path, int width, int height, int channels,
+                            const bb_texture_options *options);
+
 /* Bytes of a width x height level in format. */
 size_t bb__texture_level_bytes(bb_texture_format format, int width, int height);
 
@@ -49,7 +56,7 @@ void bb__texture_texel(const bb_image *img, int unit_vectors, size_t i, float rg
 /* Encodes levels[0..count-1] into out[k], bb__texture_level_bytes(format,
  * levels[k]) bytes each, little-endian. Block formats compress all the
  * levels in one job on `threads` threads (0 = all cores), the same bytes on
- * any count; fast: the codec's range fit alone, else BB__FIT_BEST (blocks.h). Pass the largest
+ * any count; fast: the codec's quick fit (BB__FIT_QUICK), else BB__FIT_BEST (blocks.h). Pass the largest
  * level first: its rows are handed out first, the small levels' fill in. */
 bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_kind map,
                                     bb_texture_format format, int fast, int threads,

@@ -3,7 +3,7 @@
  * or hangs on hostile headers: see dds_read.c) laid out by their own
  * readers (vtf_read.c, dds_read.c), every offset checked against the
  * file, and a level's stored texels decoded into floats (texels.c, blocks
- * through libsquish). image/texture_read.c reads them as images. */
+ * through the block codec). image/texture_read.c reads them as images. */
 #ifndef BB_TEXTURE_TEXTURE_LAYOUT_H
 #define BB_TEXTURE_TEXTURE_LAYOUT_H
 

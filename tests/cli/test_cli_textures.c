@@ -109,6 +109,12 @@ Test(cli_textures, what_a_texture_cannot_hold_is_refused_first) {
   expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
                                   tmp("o.vtf"), "--texture-format", "bc5", NULL},
                  "VTF has no format bc5");
+  /* a name no container has: the names as --help lists them, a VTF's in
+   * Valve's spelling */
+  expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
+                                  tmp("o.vtf"), "--texture-format", "dxt3", NULL},
+                 "--texture-format must be one of dxt1, dxt5, bgr888, bgra8888, rgba16f "
+                 "(vtf); bc1, bc3, bc4, bc5, rgba8, rgba16f, rgba32f (dds) (got 'dxt3')");
   expect_refused((const char *[]){"bake", tmp("h.png"), "--scale", "4", "--ssbump",
                                   tmp("o.png"), "--vmt", tmp("o.vmt"), NULL},
                  "needs a .vtf bump map");
@@ -277,10 +283,11 @@ static double json_number(const char *json, const char *key) {
 Test(cli_textures, vtf_round_trip_within_block_error) {
   /* rock06 at 128 x 128, scale 32: rough for its size, so a 4 x 4 block
    * spans several features (the worst case of tests/texture/test_dds.c's
-   * goldens). Measured with libsquish 1.15's cluster fit, max / rms in
-   * 8-bit codes against the 8-bit PNG: ssbump DXT1 and DXT5 109 / 13.2,
-   * normal DXT1 68 / 8.2; BGR888 exact; RGBA16161616F the PNG's rounding
-   * (0.5 code) and the half's (2^-11). The bounds sit ~10% above. */
+   * goldens). Measured 2026-12-07, max / rms in 8-bit codes against the
+   * 8-bit PNG: ssbump DXT1 and DXT5 103 / 13.19, normal DXT1 70 / 8.15
+   * (libsquish's cluster fit, before: 109 / 13.2 and 68 / 8.2); BGR888
+   * exact; RGBA16161616F the PNG's rounding (0.5 code) and the half's
+   * (2^-11). The bounds sit ~10% above. */
   const char *height = fixture("rock06_128.png");
   cli_result r = RUN("bake", height, "--scale", "32", "--rays", "32", "--ssbump", tmp("s.png"),
                      "--normal", tmp("n.png"));
@@ -290,8 +297,8 @@ Test(cli_textures, vtf_round_trip_within_block_error) {
     const char *map, *format, *png;
     double max, rms; /* codes */
   } cases[] = {
-      {"--ssbump", "dxt1", "s.png", 120, 14.5}, {"--ssbump", "dxt5", "s.png", 120, 14.5},
-      {"--normal", "dxt1", "n.png", 75, 9.0},   {"--ssbump", "bgr888", "s.png", 1e-4, 1e-4},
+      {"--ssbump", "dxt1", "s.png", 114, 14.5}, {"--ssbump", "dxt5", "s.png", 114, 14.5},
+      {"--normal", "dxt1", "n.png", 77, 9.0},   {"--ssbump", "bgr888", "s.png", 1e-4, 1e-4},
       {"--ssbump", "bgra8888", "s.png", 1e-4, 1e-4},
       {"--ssbump", "rgba16f", "s.png", 0.5 + 255.0 / 2048.0, 0.5 + 255.0 / 2048.0},
   };

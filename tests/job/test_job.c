@@ -344,6 +344,67 @@ Test(job, prefix_and_suffix_names) {
   }
 }
 
+/* The progress of a job's input as a caller sees it: each call's stage
+ * (bb_job_stage) and figures. */
+typedef struct stage_log {
+  bb_job *job;
+  int calls, bake_calls, compress_calls;
+  long last_done, total;
+  int backwards; /* a compress call whose done fell */
+} stage_log;
+
+static int log_stage(void *user, long done, long total) {
+  stage_log *l = user;
+  const char *stage = bb_job_stage(l->job);
+  l->calls++;
+  if (stage && !strcmp(stage, "bake")) {
+    l->bake_calls++;
+  } else if (stage && !strcmp(stage, "compress")) {
+    if (l->compress_calls++ && done < l->last_done)
+      l->backwards = 1;
+    l->last_done = done, l->total = total;
+  }
+  return 0;
+}
+
+Test(job, block_compression_is_a_stage_of_its_own) {
+  /* An 8 x 8 height written as a VTF (DXT1, mips 8 to 1: 2 + 1 + 1 + 1
+   * rows of blocks, and the 8 x 8 low-resolution image's 2) and a DDS ao
+   * (BC4, 2 + 1 + 1 + 1): after the bake's calls, the compress stage's,
+   * their total the 12 rows, done rising to it; its seconds a part of the
+   * write's. Without an engine texture: no such stage, no seconds. */
+  const char *input = height_file();
+  for (int textures = 1; textures >= 0; textures--) {
+    bb_job_options o;
+    bb_job_options_init(&o);
+    o.bake.height_scale = 4.0f;
+    o.bake.rays = 16;
+    o.paths[BB_MAP_SSBUMP] = textures ? tmp("s.vtf") : tmp("s.png");
+    o.paths[BB_MAP_AO] = textures ? tmp("ao.dds") : tmp("ao.png");
+    o.force = 1;
+    bb_job *job = NULL;
+    bb_error err = {{0}};
+    cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+    stage_log l = {job, 0, 0, 0, 0, 0, 0};
+    cr_assert_eq(bb_job_run_item(job, 0, log_stage, &l), BB_OK);
+    cr_expect_null(bb_job_stage(job), "no stage once run");
+    const bb_job_report *r = bb_job_report_get(job, 0);
+    cr_expect_gt(l.bake_calls, 0);
+    if (textures) {
+      cr_expect_gt(l.compress_calls, 0);
+      cr_expect_eq(l.total, 12, "rows of blocks: %ld", l.total);
+      cr_expect_eq(l.last_done, 12, "done at the end: %ld", l.last_done);
+      cr_expect_not(l.backwards);
+      cr_expect(r->seconds_compress > 0 && r->seconds_compress <= r->seconds_write,
+                "compress %g s of write %g s", r->seconds_compress, r->seconds_write);
+    } else {
+      cr_expect_eq(l.compress_calls, 0);
+      cr_expect_eq(r->seconds_compress, 0.0);
+    }
+    bb_job_free(job);
+  }
+}
+
 /* A 16-bit height of w x h with a bump at (bx, by), written to path. */
 static void bump_file(const char *path, int w, int h, int bx, int by) {
   bb_image img;
