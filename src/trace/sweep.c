@@ -815,8 +815,8 @@ walk_next(const sweep_job *job, const profile *pr, walk *w, int forward, void *s
       break;
     const double u = next->u + w->du;
     w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, key);
-    if (state)
-      job->visitor->push(state, forward ? 0 : 1, &w->h[w->size - 1]);
+    if (state && job->visitor->push)
+      job->visitor->push(state, forward ? 0 : 1, w->h, w->size);
     w->q += forward ? -1 : 1;
   }
   const int tangent = query(job, pr, w->h, w->size, w->j, forward);
@@ -1386,8 +1386,7 @@ bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
                                  const bb__sweep_dir *opposite, double bias, int threads,
                                  const bb__walk_visitor *visitor, void *ctx,
                                  const bb__checkpoint *checkpoint, bb_error *err) {
-  if (!visitor || !visitor->line_begin || !visitor->push || !visitor->origin ||
-      !visitor->line_end)
+  if (!visitor || !visitor->line_begin || !visitor->origin || !visitor->line_end)
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: a walk visitor needs every call");
   const sweep_extra extra = {NULL, NULL, visitor, ctx, checkpoint};
   return sweep_lines(p, a, b, along, opposite, bias, threads, 0, &extra, err);

@@ -113,8 +113,9 @@ typedef struct bb__walk_visitor {
    * memory (the sweep then fails with BB_ERR_MEMORY). */
   void *(*line_begin)(void *ctx, const bb__line_view *line);
   /* Each point pushed on side k's hull, nearer to the origins still to come
-   * than every point pushed before it. */
-  void (*push)(void *state, int side, const bb__walk_point *p);
+   * than every point pushed before it: hull[size - 1], the hull as it now is
+   * (the array origin() is given). May be NULL. */
+  void (*push)(void *state, int side, const bb__walk_point *hull, int size);
   /* Origin j (texel j of the line, at u0 along the walk, height oz) once
    * every point beyond it is pushed: the hull hull[0..size-1] (the upper
    * hull of those points, nearest last), the index of its tangent vertex (-1
