@@ -117,7 +117,7 @@ while IFS=: read -r m path scale; do
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_bb" --rho "$rho" "${common[@]}" \
       >"$out/${m}_${rho}_bb.json" || { fail "bounce_bake $path"; continue; }
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_hp" --rho "$rho" "${common[@]}" \
-      --exact 0 --surface-exact 0 --far 0 --surface-far 0 >"$out/${m}_${rho}_hp.json" || { fail "bounce_bake $path"; continue; }
+      --small-band 1e6 --steep 0 >"$out/${m}_${rho}_hp.json" || { fail "bounce_bake $path"; continue; }
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_none" --rho 0 "${common[@]}" \
       >/dev/null || { fail "bounce_bake $path"; continue; }
     if "$tools/bounce_ref" compare "$ref" "$path" "$scale" \
