@@ -65,14 +65,20 @@ LDFLAGS += -fsanitize=address,undefined
 endif
 
 # ---- version, soname and install layout ------------------------------------
-# The version lives once, in the public header.
+# The version and the ABI's number live once, in the public header.
 VERSION := $(shell sed -n 's/.*define BB_VERSION_STRING "\(.*\)"$$/\1/p' include/bumpbake.h)
-version_word = $(word $(1),$(subst ., ,$(VERSION)))
-# The soname names the ABI. While the version is 0.x any minor release may
-# change the public structs, so the soname carries major.minor
-# (libbumpbake.so.0.1); from 1.0 on, the major alone. Bump the header's
-# version when a public struct or signature changes.
-SOVERSION := $(if $(filter 0,$(call version_word,1)),0.$(call version_word,2),$(call version_word,1))
+ABI_VERSION := $(shell sed -n 's/^\#define BB_ABI_VERSION \([0-9]*\)$$/\1/p' include/bumpbake.h)
+# The soname names the ABI, not the release: libbumpbake.so.0.N, N =
+# BB_ABI_VERSION. As Debian does, it changes only when abidiff says it must:
+# when a change breaks programs built against the last release (a function
+# removed or changed, a public struct changed), `make check-abi` fails until
+# BB_ABI_VERSION is raised (once between two releases), and fails as well on
+# a raise nothing needs. A release that only adds functions keeps the
+# soname. Each release stores its ABI (`make abi-dump`, abi/).
+ifeq ($(ABI_VERSION),)
+$(error include/bumpbake.h has no line "#define BB_ABI_VERSION N")
+endif
+SOVERSION := 0.$(ABI_VERSION)
 SONAME    := libbumpbake.so.$(SOVERSION)
 SHLIB_REAL:= libbumpbake.so.$(VERSION)
 
@@ -154,7 +160,8 @@ TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
-        check-python check-serve check-circles check-layers check-docs bench bench-cluster goldens docs docs-reference install \
+        check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
+        bench bench-cluster bench-check goldens docs docs-reference install \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -170,14 +177,18 @@ PYTHON   := /usr/bin/python3
 # check their exit codes agree; ninja-build: a test has ninja read a bake's
 # --depfile. Both tests skip without them, so ensure-deps installs them.
 # python3-distributed and python3-dask: bumpbake.dask, batches and big maps on
-# a Dask cluster (its tests run a LocalCluster). strace: a test (and make
+# a Dask cluster (its tests run a LocalCluster). python3-junitparser: a test
+# reads `bumpbake check --junit`'s file as CI servers do; python3-yaml: a test
+# runs docs/goldens.md's CI jobs. strace: a test (and make
 # hostile) delivers a signal in the middle of a commit; time: make hostile's
-# peak memory (GNU time's %M).
+# peak memory (GNU time's %M). abigail-tools: abidw and abidiff, the ABI
+# check.
 DEB_PKGS := libopenimageio-dev libcriterion-dev libassimp-dev libsquish-dev libimath-dev \
             libpng-dev libjpeg-dev libopenexr-dev pkg-config g++ make \
             python3 python3-cffi python3-numpy python3-pytest fonts-dejavu-core \
             openimageio-tools ninja-build python3-distributed python3-dask strace time \
-            libmicrohttpd-dev chromium chromium-driver python3-selenium
+            libmicrohttpd-dev chromium chromium-driver python3-selenium python3-junitparser \
+            python3-yaml abigail-tools
 LABEL_FONT := /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 deps:
 	$(SUDO) apt-get update
@@ -187,8 +198,9 @@ ensure-deps:
 	@if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists $(PKGS) \
 	    && command -v $(CXX) >/dev/null 2>&1 && [ -f $(LABEL_FONT) ] \
 	    && command -v idiff >/dev/null 2>&1 && command -v ninja >/dev/null 2>&1 \
-	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium' >/dev/null 2>&1 \
-	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1; then :; \
+	    && $(PYTHON) -c 'import cffi, numpy, pytest, dask, distributed, selenium, junitparser, yaml' >/dev/null 2>&1 \
+	    && command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 \
+	    && command -v abidw >/dev/null 2>&1 && command -v abidiff >/dev/null 2>&1; then :; \
 	 else echo "bumpbake: installing missing build dependencies (make deps)"; $(MAKE) --no-print-directory deps; fi
 
 # libFuzzer needs clang and its runtimes (Debian 12: clang 14); only `make
@@ -321,8 +333,9 @@ uninstall:
 	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 
 # ---- the README's commands ---------------------------------------------------
+# The demo builds only the command it runs, on every core.
 demo: ensure-deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(NPROC) $(BIN)
 	@./tools/demo.sh $(BIN)
 
 # The build runs on every core (a fresh clone compiles ~70 files); the checks
@@ -334,9 +347,11 @@ test: ensure-deps
 
 # Everything `make test` runs: the Criterion suite, the install check, the
 # Python tests, serve's page in a browser, the check that no two files need
-# each other, the check that no family reaches up to a later one and the
-# check that the command reference and the man page say what --help says.
-check: check-unit check-install check-python check-serve check-circles check-layers check-docs
+# each other, the check that no family reaches up to a later one, the
+# check that the command reference and the man page say what --help says
+# and the check of the ABI against the last release's.
+check: check-unit check-install check-python check-serve check-report check-circles check-layers \
+       check-docs check-abi
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
@@ -359,6 +374,36 @@ check-layers: $(LIB_OBJ) $(CLI_OBJ)
 	@$(PYTHON) tools/check_layers.py --families '$(FAMILIES)' $(LIB_OBJ) $(CLI_OBJ)
 	@$(PYTHON) tests/tools/test_check_layers.py
 
+# The shared library's ABI against the last release's, stored in abi/
+# (tools/check_abi.sh, libabigail): additions pass; a function removed or
+# changed, or a public struct changed, fails, naming it, unless
+# BB_ABI_VERSION (the soname) was raised since; a soname raised for nothing
+# fails too. abi/bumpbake.abignore lists the changes that break no program.
+# Its test (tests/tools/test_check_abi.py) shows the check on a small
+# library built against this header and changed copies of it.
+# `make abi-dump`, at a release only (after setting its BB_VERSION_STRING):
+# stores the release's ABI, what check-abi compares with until the next.
+ABI_STORED       := abi/libbumpbake.abi
+ABI_SUPPRESSIONS := abi/bumpbake.abignore
+check-abi: lib
+	@./tools/check_abi.sh check $(ABI_STORED) $(SHLIB) include $(ABI_SUPPRESSIONS)
+	@$(PYTHON) tests/tools/test_check_abi.py
+abi-dump: check-abi
+	@./tools/check_abi.sh dump $(SHLIB) include $(ABI_STORED)
+
+# Who uses which export (tools/api_uses.py): the exports and the public
+# header's lines, how many exports the CLI, serve, Python and the installed
+# C client each use, and what no client uses; one row per export in
+# build/api_uses.tsv. A report, never part of `make test`.
+SERVE_OBJ := $(SERVE_C:%.c=$(BUILD)/%.o)
+api-report: lib $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
+	@$(PYTHON) tools/api_uses.py --shared $(BUILD)/libbumpbake.so --header $(wildcard include/*.h) \
+	  --library $(LIB_OBJ) --client cli $(filter-out $(SERVE_OBJ),$(CLI_OBJ)) \
+	  --client serve $(SERVE_OBJ) --python python/bumpbake \
+	  --source install_client tests/install_client.c \
+	  --tests tests $(TEST_OBJ) --tests tools $(TOOL_OBJ) --tests fuzz $(FUZZ_REPLAY_OBJ) \
+	  --together program cli serve --both program python --table $(BUILD)/api_uses.tsv
+
 # Criterion suite (unit, property, CLI and golden tests); the CLI tests run
 # the binary named by BB_BIN.
 check-unit: $(BIN) $(TESTBIN) $(TOOLS)
@@ -379,7 +424,7 @@ PY_SANITIZE := $(if $(PY_PRELOAD),LD_PRELOAD="$(PY_PRELOAD)" ASAN_OPTIONS=detect
 check-python: $(BIN) lib
 	cd python && BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) BB_BIN=$(abspath $(BIN)) \
 	  BB_CC="$(CC)" PYTHONDONTWRITEBYTECODE=1 $(PY_SANITIZE) \
-	  $(PYTHON) -m pytest -q -p no:cacheprovider tests
+	  $(PYTHON) -m pytest -q -p no:cacheprovider --durations=10 tests
 
 # `bumpbake serve` in headless Chromium (tests/serve/): the page draws, relights,
 # re-bakes on a save by rename and on a control, keeps the last maps after a
@@ -391,9 +436,28 @@ check-serve: $(BIN)
 	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
 	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
 
+# `bumpbake check --html`'s report in headless Chromium (tests/report/): every
+# picture loads from the folder and nothing else, the flip and the slider
+# work, a failure shows golden, new and difference. Skipped, saying why,
+# without chromium, chromium-driver or python3-selenium. Screenshots:
+# build/report-test/.
+check-report: $(BIN) lib
+	@echo "report: check --html's page in headless Chromium (tests/report)"
+	@cd tests/report && BB_BIN=$(abspath $(BIN)) BB_REPORT_SHOTS=$(abspath $(BUILD))/report-test \
+	  PYTHONPATH=$(abspath python) BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) \
+	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .
+
 bench: ensure-deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@./tools/bench.sh $(BIN)
+
+# A golden suite of 200 maps from the fixtures checked three ways
+# (tools/bench_check.sh, for docs/performance.md "Golden checks"): the bake
+# alone, check --bake (the same bake, writing nothing) and the bake then
+# compare once per map; wall, CPU and peak memory, medians of 3 rounds.
+bench-check: ensure-deps
+	@$(MAKE) --no-print-directory all lib
+	@BUMPBAKE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) ./tools/bench_check.sh $(BIN)
 
 # bumpbake on a Dask cluster of this machine (2 worker processes) against
 # one process, with cmp of their files (tools/bench_cluster.sh, for
@@ -417,8 +481,10 @@ goldens: ensure-deps
 # outside their directory, FIFOs, huge headers, outputs over inputs, links at
 # temporaries, signals in a commit, depfile names, escapes, JSON, address
 # space; code from the working directory, outputs that are not regular
-# files, a memory cgroup, renders too large) against the binary, a line per
-# case, in about two minutes (tools/hostile_repro.sh; not part of make test:
+# files, a memory cgroup, renders too large; `bumpbake serve` as a server:
+# slow clients, 1,000 connections, stalled downloads, concurrent writes,
+# malformed HTTP, tools/hostile_serve.py) against the binary, a line per
+# case, in about five minutes (tools/hostile_repro.sh; not part of make test:
 # its bounds are wall-clock).
 hostile: $(BIN)
 	@./tools/hostile_repro.sh $(BIN)

@@ -29,24 +29,10 @@
  *   BB_ERR_ARGUMENT with a message listing the names accepted.
  * docs/conventions.md gives the frame, units and formulas in full.
  *
- * The header reads family by family, each using only the ones before it
- * (the folders of src/, in the order of docs/how-it-works.md, "Layers"):
- *   core     status, errors, images, limits
- *   files    checked, all-or-nothing writes of files; provenance texts read
- *   texture  engine textures (VTF, DDS) and Source materials
- *   image    reading and writing image files, mip chains, animations, the
- *            height input
- *   trace    bases, the max-mip pyramid, ray sets, the tracer
- *   bake     smoothing, normals, derived maps, bb_bake
- *   maps     Valve's files, conversions, combining, programs, slope maps,
- *            comparing images
- *   render   lighting the maps, pictures, contact sheets
- *   mesh     models and DOOM 3's flat render bump
- *   job      the whole job on files: provenance, output paths, writing all
- *            or nothing, bakes of files and batches, depfiles, up-to-date
- *            checks
- *   commands every command and option described once, checked, and planned
- *            through the job
+ * The header reads family by family, each using only the ones before it:
+ * the folders of src/, in the order of docs/how-it-works.md ("Layers").
+ * Each family's section opens with its folder's name and what it holds;
+ * `make check-layers` holds the sections to that order.
  */
 #ifndef BUMPBAKE_H
 #define BUMPBAKE_H
@@ -65,6 +51,11 @@ extern "C" {
  * ===================================================================== */
 
 #define BB_VERSION_STRING "0.4.0"
+/* The ABI's number: libbumpbake.so's soname is libbumpbake.so.0.N. It
+ * changes only when a change breaks programs built against the last
+ * release (`make check-abi` says so), not with each release: one that
+ * only adds functions keeps it. */
+#define BB_ABI_VERSION 5
 
 /* Largest accepted image: each side at most BB_MAX_DIMENSION texels and at
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
@@ -178,6 +169,17 @@ const char *bb_status_name(bb_status status);
  * which "a\u202egnp.exe" shows as "aexe.png") and bytes that are not UTF-8.
  * Returns out. The command line prints every line through it. */
 const char *bb_text_printable(const char *s, char *out, size_t cap);
+
+/* word quoted for a POSIX shell: as it is when every byte is a letter, a
+ * digit, one of "@%+=:,./-_" or a byte of UTF-8 beyond ASCII (so plain
+ * paths and values keep their bytes), else in single quotes with each
+ * quote in it given as '\'' ("my rock.png" -> 'my rock.png', "" -> '').
+ * sh reads back the word itself, whatever its bytes. Every command line
+ * the library spells (the provenance's command, bb_job_command_text,
+ * bb_command_text) quotes its words so; a client that records the words
+ * typed (bb_command_set_record) quotes them with this. malloc'd; NULL
+ * when word is NULL or out of memory. */
+char *bb_text_shell_quoted(const char *word);
 
 /* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
  * the end of the string or bytes that are not UTF-8 (overlong forms,
@@ -325,6 +327,26 @@ bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
 /* The name of kind, or "unknown". */
 const char *bb_map_kind_name(bb_map_kind kind);
 
+/* The rule of what a map records in its provenance, which every writer and
+ * reader of provenance follows: 1 when the pixels of a map of output kind
+ * `kind` (as provenance records it under "output": "normal", "ao", ...; a
+ * kind of parts, "ssbump+height", records what any part records, "height"
+ * being the filtered height) can change with the bake parameter recorded
+ * under `key`, 0 when they cannot: a normal map does not depend on "rays",
+ * "rayset", "bias", "power", "basis", "bounce" or "brightness", the
+ * filtered height on "scale" either, ao not on "normal_filter" or
+ * "normal_y", and ao on "power" and "basis" only with inter-reflection
+ * (bounce nonzero: the text has a "bounce" key); without it, ao's "rayset"
+ * is recorded as the ray set's scheme and slices only ("bb-horizon-v1:a16").
+ * A bake's outputs record only such keys (bb_provenance_format), the
+ * up-to-date check (bb_output_check) and bb_provenance_diff compare only
+ * them, so a parameter that does not change a map neither makes it stale
+ * nor shows in its diff, also against a file written before the rule that
+ * holds them all. 1 for keys that are no bake parameter (bumpbake_version,
+ * input_file_hash, channel, a texture's or a render's keys) and for kinds
+ * that are not a bake's maps ("render", "normal+coverage"). */
+int bb_map_kind_records(const char *kind, const char *key, int bounce);
+
 /* =====================================================================
  * files: checked, all-or-nothing writes of files; provenance texts read
  * ===================================================================== */
@@ -387,7 +409,10 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 
 /* Writes into out (capacity cap) the keys whose values differ between two
  * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
- * when either text is NULL). Keys "command" and "output" are ignored. Returns
+ * when either text is NULL). Keys "command" and "output" are ignored, and so
+ * is a key neither text's kind ("output") records (bb_map_kind_records:
+ * "rays" of a normal map; an ao's "rayset" is compared by its scheme and
+ * slices alone without inter-reflection). Returns
  * the number of differing keys, or -1 when out of memory. Time is
  * O(n log n) in the number of lines, whatever the texts hold. */
 int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
@@ -1110,7 +1135,15 @@ struct bb_trace_options {
                               nonzero return cancels. In bb_bake also
                               with done 0 and total 0 (a checkpoint, no
                               progress) every 50 ms while it smooths and
-                              makes normals, so those stages cancel too */
+                              makes normals, so those stages cancel too;
+                              with inter-reflection (bounce_albedo > 0) the
+                              units run once over the trace and the
+                              bounces: with a trace function of the
+                              caller's, the first bb_bake_slices(o) are
+                              the trace's (one a slice), the rest the
+                              bounces'; without one, the bounces' sweeps
+                              find the horizons too and every unit is
+                              theirs */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls
@@ -1395,6 +1428,54 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 
 void bb_bake_result_free(bb_bake_result *r);
+
+/* ------------------------------------------------------- bake contexts */
+
+/* What a long-running caller that bakes again and again (bumpbake serve,
+ * an editor) keeps warm between bakes: the ray set of the last bake,
+ * reused while slices, power and basis are the same, and, process-wide,
+ * the bakes' freed buffers, kept in the heap for the next bake of the same
+ * size (glibc's allocator told not to return buffers up to 32 MiB to the
+ * system: no page faults or zeroing again; the memory of the largest bake
+ * stays with the process). A bake with a context is a cold bake's bits.
+ * One bake at a time per context. */
+typedef struct bb_bake_context bb_bake_context;
+bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
+void bb_bake_context_free(bb_bake_context *context);
+
+/* Edit-local bakes. With keep 1 the bakes through context
+ * (bb_bake_context_bake, and a job's after bb_job_use_context) keep what
+ * they made: the height, its smoothing and max-mip pyramid, each texel's
+ * horizon in every slice, its visibility and normal, and the maps; about
+ * 4 x slices + 70 bytes a texel for the default maps and basis (134 at 16
+ * slices: 141 MB at 1024 x 1024; 24 more with every map), while the
+ * context lives (a machine that cannot hold it bakes whole, keeping
+ * nothing). A bake of a height of the same size with the same options
+ * then bakes again only what the change can reach (docs/how-it-works.md,
+ * "Edits"): the smoothing around the changed texels, the pyramid's nodes
+ * above them, along the lines of each slice that cross them the horizons
+ * the change can move (out to every texel a tall new peak shadows), and
+ * the texels derived from those; and it gives the bits of a whole bake of
+ * the new height. A change over a quarter of the texels, inter-reflection
+ * (bounce_albedo > 0) and a caller's trace (o->trace.trace) bake whole.
+ * keep 0 (the default) lets what was kept go. */
+void bb_bake_context_keep(bb_bake_context *context, int keep);
+
+/* bb_bake of height with o through context: the same checks, maps and
+ * bits; result as bb_bake fills it (free it with bb_bake_result_free),
+ * its seconds and horizons_found those of the work done. changed (may be
+ * NULL) receives the texels whose maps may differ from those of the
+ * context's bake before: a rectangle inside the image, the whole image
+ * after a whole bake, width 0 when nothing changed; texels across the
+ * edge of a periodic map make it span the whole width (or height). */
+bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
+                               const bb_bake_options *o, bb_bake_result *result,
+                               bb_region *changed, bb_error *err);
+
+/* The changed rectangle of the context's last bake, as
+ * bb_bake_context_bake gives it (for a bake made through a job); width 0
+ * before any. */
+bb_region bb_bake_context_changed(const bb_bake_context *context);
 
 /* =====================================================================
  * maps: Valve's files, converting, combining, programs, slope maps, compare
@@ -2155,7 +2236,10 @@ typedef struct bb_provenance {
  * input_file_hash when known, output, scale, rays, rayset, filter_radius,
  * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
  * channel), malloc'd; the caller
- * frees it. A basis of the caller's vectors ("vectors:HASH") adds
+ * frees it. With options (a bake's map), only the parameters output_kind
+ * records are written (bb_map_kind_records: a normal map has no rays,
+ * rayset, bias, power or basis; ao's rayset is its scheme and slices);
+ * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
  * Options in use add, after addressing: bounce (rho) and bounces when
  * bounce_albedo > 0, with bounce_albedo_map (bb_image_hash of the map, 16
@@ -2371,6 +2455,134 @@ int bb_compare_report_exit_code(const bb_compare_report *report);
  * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
 const char *bb_compare_report_result(const bb_compare_report *report);
 
+/* ---------------------------------------------------------- golden suites */
+
+/* A suite check (`bumpbake check`): every map of a suite compared with its
+ * golden, as bb_compare_files compares two files, in one run: a tree of new
+ * files against a tree of goldens by relative name, or a batch baked in
+ * memory (bake --out-dir GOLDEN's maps, nothing written) against the files
+ * it would write. Each map is a case with idiff's verdict under limits
+ * chosen per map kind or file name; a run can update the goldens where a
+ * case does not pass, and writes a JUnit XML file and an HTML report. */
+
+/* How a case ended. */
+typedef enum bb_check_status {
+  BB_CHECK_PASS = 0,       /* within the limits (idiff's exit 0) */
+  BB_CHECK_WARNING,        /* idiff's warning (1) */
+  BB_CHECK_FAILURE,        /* idiff's failure (2) */
+  BB_CHECK_DIFFERENT_SIZE, /* sizes or channel counts differ (3) */
+  BB_CHECK_UNREADABLE,     /* a file that cannot be read, a link leaving its
+                              tree, an input that would not bake (4) */
+  BB_CHECK_MISSING,        /* a golden nothing new matches (a failure: 2) */
+  BB_CHECK_EXTRA           /* a new map without a golden (a failure: 2) */
+} bb_check_status;
+
+/* One case: a map and its golden. Strings belong to the check. */
+typedef struct bb_check_case {
+  const char *name;            /* the golden's path relative to the golden tree */
+  const char *golden;          /* the golden's path */
+  const char *fresh;           /* the new file's path; for a bake, the height
+                                  it was baked from */
+  const char *kind;            /* the map's kind, as its provenance records it
+                                  ("normal"; "" when unknown) */
+  bb_check_status status;
+  int exit_code;               /* idiff's: 0 to 4; MISSING and EXTRA 2 */
+  bb_compare_limits limits;    /* what it was judged by */
+  int width, height, channels;             /* of the golden (0: not read) */
+  int new_width, new_height, new_channels; /* of the new map (0: not made) */
+  bb_compare_stats stats;      /* when both were compared (same size) */
+  const char *provenance_diff; /* "key: golden -> new" lines (bb_provenance_diff;
+                                  "" when the same), NULL when not compared
+                                  (either side without intact provenance) */
+  const char *message;         /* why UNREADABLE, MISSING or EXTRA; else "" */
+  int updated;                 /* 1: its golden was written by the update */
+  const char *update_error;    /* why the update could not write it, or NULL */
+  double seconds;              /* the time its comparison took */
+} bb_check_case;
+
+/* A planned check. Opaque; not thread-safe. */
+typedef struct bb_check bb_check;
+
+/* A check is planned from its command (bb_check_plan, with the commands
+ * below); bb_check_free frees it. */
+void bb_check_free(bb_check *check);
+
+/* Called with each case as it is decided (and its golden updated). */
+typedef void (*bb_check_case_fn)(void *user, const bb_check_case *c);
+
+/* The heights of a check with --bake, in the order of the batch (a
+ * directory's images sorted); 0 without. */
+int bb_check_input_count(const bb_check *check);
+/* Height i's path as the batch planned it (a directory's file: DIR/NAME),
+ * or NULL. */
+const char *bb_check_input(const bb_check *check, int i);
+
+/* Bakes height i in memory (progress as bb_job_run_item's, which may
+ * cancel) and decides a case for each of its maps against the file the
+ * batch would write (what reading that file back would give, its
+ * provenance as the batch would record it), then with --update writes the
+ * maps that did not pass (and only those) as the batch writes them. An
+ * input that does not bake is an UNREADABLE case per map. Errors:
+ * BB_ERR_ARGUMENT (i out of range), BB_ERR_CANCELLED, BB_ERR_MEMORY. */
+bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
+                             void *progress_user, bb_check_case_fn each, void *user,
+                             bb_error *err);
+
+/* The cases that are not an input's: of two trees every pair (sorted by
+ * name: both have it, MISSING, EXTRA); of a bake the goldens no input makes
+ * (an image in GOLDEN, at any depth, whose provenance says bumpbake baked
+ * it, under a name the batch's template gives a kind it writes: MISSING). Names starting with '.' and files of other extensions are
+ * not cases; a link is followed only to a file inside its tree; nothing
+ * else is followed. */
+bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
+                            bb_error *err);
+
+/* bb_check_run_input of every input, then bb_check_run_rest. */
+bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
+                       bb_check_case_fn each, void *user, bb_error *err);
+
+/* The cases decided (and imported) so far, in order. */
+int bb_check_case_count(const bb_check *check);
+const bb_check_case *bb_check_case_get(const bb_check *check, int i);
+
+/* The exit code of the worst case (the largest: 0 pass .. 4 unreadable;
+ * MISSING and EXTRA 2), a case whose golden was updated counting as a pass;
+ * 0 when there is none. */
+int bb_check_exit_code(const bb_check *check);
+
+/* "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE", "UNREADABLE", "MISSING",
+ * "EXTRA"; "unknown" else. Static text. */
+const char *bb_check_status_name(bb_check_status status);
+
+/* What the command line prints of a case, as the command's options (json,
+ * quiet) ask: a case that does not pass as "STATUS NAME (KIND): what" and
+ * its provenance differences indented, one line "updated NAME" for a
+ * golden written; nothing for a pass; with json one JSON line per case.
+ * To free(); NULL when out of memory. */
+char *bb_check_case_lines(const bb_check *check, const bb_check_case *c);
+
+/* The summary line ("check: N maps: P passed, W warnings, F failed, ...") or
+ * its JSON line; "" with quiet. To free(); NULL when out of memory. */
+char *bb_check_summary_lines(const bb_check *check);
+
+/* Writes the reports the command asked for, of every case so far: the
+ * JUnit XML file (a test case per map; a failure's message carries its
+ * statistics and provenance differences) and the HTML report's index.html
+ * (its pictures are made as the cases are; pictures an earlier report left
+ * in its folder are removed). Errors: those of writing. */
+bb_status bb_check_write_reports(bb_check *check, bb_error *err);
+
+/* The cases from first on as bytes (*size of them; malloc'd, NULL when out
+ * of memory or a picture cannot be written), for another process's check
+ * of the same command to import: a cluster's workers each check some inputs
+ * and the client reports them all. The HTML pictures they name are files of
+ * the report's directory, written first. */
+char *bb_check_export(bb_check *check, int first, size_t *size);
+
+/* Adds the cases of an export (bb_check_export), as if decided here.
+ * Errors: BB_ERR_ARGUMENT (not an export of this version), BB_ERR_MEMORY. */
+bb_status bb_check_import(bb_check *check, const char *data, size_t size, bb_error *err);
+
 /* -------------------------------------------------------------- bake jobs */
 
 /* What `bumpbake bake` does, as one plan and its run: inputs (height files,
@@ -2555,18 +2767,6 @@ bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *pro
 bb_status bb_job_bake_item(bb_job *job, int i, unsigned also, bb_progress_fn progress,
                            void *progress_user, bb_bake_result *result, bb_error *err);
 
-/* What a long-running caller that bakes again and again (bumpbake serve)
- * keeps warm between bakes: the ray set of the last bake, reused while
- * slices, power and basis are the same, and, process-wide, the bakes'
- * freed buffers, kept in the heap for the next bake of the same size
- * (glibc's allocator told not to return buffers up to 32 MiB to the
- * system: no page faults or zeroing again; the memory of the largest bake
- * stays with the process). A bake with a context is a cold bake's bits.
- * One bake at a time per context. */
-typedef struct bb_bake_context bb_bake_context;
-bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
-void bb_bake_context_free(bb_bake_context *context);
-
 /* The bakes of job (bb_job_bake_item, bb_job_run_item) use context from
  * now on (NULL: cold again). context must outlive them. */
 void bb_job_use_context(bb_job *job, bb_bake_context *context);
@@ -2650,9 +2850,10 @@ typedef enum bb_output_state {
  * writes with the same value, and no key that text lacks, except "command"
  * and "input" (the command line and the input's name, which do not change a
  * pixel) and "input_hash" (the decoded height's hash, implied by
- * input_file_hash and channel): so the bumpbake version, the input file's
- * bytes, the output kind and every parameter that affects pixels must
- * match; and when its samples have the depth `depth` gives in path's format
+ * input_file_hash and channel), and keys the file's kind does not record
+ * (bb_map_kind_records: a normal map written before the rule, with "rays",
+ * is current): so the bumpbake version, the input file's bytes, the output
+ * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
  * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
  * level exactly when mip_mapped. expected->input_file_hash must be set
  * (nonzero): without it nothing is CURRENT. A file that cannot be read is
@@ -2667,7 +2868,7 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
                           bb_error *err);
 
 /* =====================================================================
- * commands: every command of `bumpbake`, its options and their rules,
+ * cmd: every command of `bumpbake`, its options and their rules,
  * described once
  * ===================================================================== */
 
@@ -2720,6 +2921,9 @@ typedef enum bb_option_mode {
                                       names, format settings, a batch, a cluster;
                                       not for images in memory (bb_command_set_in_memory) */
 
+/* The descriptions below are the library's static data, handed out by
+ * pointer only: a program never makes, copies or steps through an array of
+ * them, so a release may append fields at their end and keep the ABI. */
 typedef struct bb_option_info {
   const char *name;        /* the long name without "--" ("filter-radius"); Python's
                               keyword is it with '-' as '_' (filter_radius) */
@@ -2826,6 +3030,10 @@ typedef struct bb_command_options {
   int panel_size;               /* sheet --panel-size */
   bb_compare_limits limits;     /* compare */
   const char *diff;             /* compare --diff */
+  const char *limit_rules;      /* check --limits: "KIND|PATTERN: -fail T ...; ..." */
+  int check_bake;               /* check --bake: the inputs after GOLDEN are heights */
+  int update;                   /* check --update */
+  const char *junit, *html;     /* check --junit FILE, --html DIR */
   bb_renderbump_options renderbump; /* renderbumpflat */
   const char *height_output;    /* renderbumpflat --height */
   bb_map_kind map_kind;         /* combine --kind */
@@ -2865,6 +3073,15 @@ const bb_command_info *bb_command_describe(const bb_command *command);
  * --rays?)"). An option set again takes the new value. */
 bb_status bb_command_set(bb_command *command, const char *name, const char *text,
                          bb_error *err);
+
+/* Puts option name back at its default, as if it had never been set: the
+ * rules (bb_command_check) and the text (bb_command_text) no longer see
+ * it. For a client whose control goes back to the value it starts at
+ * (bumpbake serve's page). Errors: BB_ERR_ARGUMENT "unknown option ..."
+ * as bb_command_set says it, and "--NAME cannot be unset: leave it out"
+ * for an option whose parser sets more than its one value (--basis);
+ * BB_ERR_MEMORY. An option not set is left as it is. */
+bb_status bb_command_unset(bb_command *command, const char *name, bb_error *err);
 
 /* Adds a positional argument (an input file, or height2ssbump's
  * BUMPSCALE) in order. Errors: BB_ERR_ARGUMENT (one too many, a
@@ -2957,6 +3174,20 @@ typedef struct bb_command_hooks {
  * job. */
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
                           bb_error *err);
+
+/* Plans a checked `check` command (bb_command_check): GOLDEN and NEW, two
+ * directories (or two files), or GOLDEN and heights with --bake, a batch
+ * whose out-dir is GOLDEN, planned as bake plans it (every option and name
+ * checked; nothing written, no directory made) unless --update; the
+ * limits (idiff's options, then --limits' rules by kind or name); the
+ * reports asked (--junit FILE, --html DIR; the report's directory is made,
+ * and the pictures a run of it left before removed). hooks (may be NULL):
+ * the bake's notes. Free with bb_check_free. Errors: BB_ERR_ARGUMENT (not
+ * a checked check command), BB_ERR_IO (GOLDEN or NEW is not there: GOLDEN
+ * may be missing only with --update, which makes it), those of the bake's
+ * plan. */
+bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
+                        bb_error *err);
 
 /* 1 when the command writes through the job (bb_command_plan plans it). */
 int bb_command_has_job(const bb_command_info *command);

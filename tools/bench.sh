@@ -23,10 +23,14 @@
 # in one process and split over 2 workers; `make bench-cluster` runs it
 # alone, with 16384 x 16384 too), 12 `bumpbake serve`'s save-to-pixels
 # latency in headless Chromium against the cold bake + render pair
-# (tools/bench_serve.py), 13 the loop before and after: an older build
+# (tools/bench_serve.py; again with saves of a 32 x 32 edit), 13 the loop
+# before and after: an older build
 # (BENCH_BEFORE=DIR, its build directory) and this one in turns, the
 # stages of a bake, the writes, the kernel, a bounce's cost and the whole
-# bake (tools/bench_loop.py; skipped without BENCH_BEFORE), then a summary table.
+# bake (tools/bench_loop.py; skipped without BENCH_BEFORE), 14 edit-local
+# bakes (build/tools/bench_rebake: a 32 x 32 brush at five places of rock,
+# the CPU of a bake through a keeping context against a whole bake, the
+# same bits checked), then a summary table.
 # Everything it writes goes into build/bench/.
 #
 # Timing rule: a measurement whose first run takes under 10 s is run 3 times
@@ -686,7 +690,19 @@ if want 12; then
     echo "skipped (BENCH_SERVE=0)"
   elif ! /usr/bin/python3 tools/bench_serve.py "$bin" | tee "$out/serve.txt"; then
     fail "tools/bench_serve.py failed"
+  elif ! /usr/bin/python3 tools/bench_serve.py "$bin" --edit 32 | tee "$out/serve_edit.txt"; then
+    fail "tools/bench_serve.py --edit 32 failed"
   fi
+fi
+
+if want 14; then
+  section "14. Edit-local bakes: a 32 x 32 brush on rock, against whole bakes (build/tools/bench_rebake)"
+  for at in 496,496 300,700 800,200 100,100 600,900; do
+    if ! "$(dirname "$bin")/tools/bench_rebake" "$rock" 64 --runs 5 --threads "$threads" --at "$at" \
+      >> "$out/rebake.json"; then
+      fail "bench_rebake differs from the whole bake (or failed) at $at"
+    fi
+  done
 fi
 
 if want 13; then

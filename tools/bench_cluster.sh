@@ -45,7 +45,7 @@ work=$root/build/bench/cluster
 mkdir -p "$work"
 python=${PYTHON:-/usr/bin/python3}
 export PYTHONPATH=$root/python${PYTHONPATH:+:$PYTHONPATH}
-export BUMPBAKE_LIBRARY=${BUMPBAKE_LIBRARY:-$build/libbumpbake.so.0.4}
+export BUMPBAKE_LIBRARY=${BUMPBAKE_LIBRARY:-$build/libbumpbake.so.0.5}
 helper=$root/tools/bench_cluster.py
 
 load() { cut -d' ' -f1-3 /proc/loadavg; }

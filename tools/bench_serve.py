@@ -2,7 +2,9 @@
 """bench_serve.py BIN: `bumpbake serve`'s save-to-pixels latency.
 
 From the rename() of a new 1024 x 1024 height (fixtures/rock06_height.png
-and its inverse, made with `bumpbake program invertColor`, in turns) over
+and its inverse, made with `bumpbake program invertColor`, in turns; with
+--edit N, the height and a copy with one N x N block raised, a brush
+stroke's worth, in turns) over
 the served file to the page in headless Chromium showing that save's ssbump
 (its <body data-drawn-bake> moves on; data-drawn-at is the page's clock,
 Date.now(), the same wall clock as time.time() here), at serve's default
@@ -13,6 +15,12 @@ state it publishes) and the cold pair of today, `bumpbake bake` then
 the saves (medians).
 
   tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S]
+                       [--edit SIDE]
+
+--edit SIDE: each save changes a SIDE x SIDE region only (a soft brush of
+0.1 of the height at the map's middle, added and taken away in turns,
+written with the bumpbake Python package beside the build): serve bakes
+it again where it changed (a context that keeps, bb_bake_context_keep).
 
 make bench runs it as section 12. Needs chromium, chromium-driver and
 python3-selenium (make deps); prints why and exits 0 without them.
@@ -44,12 +52,34 @@ def run(cmd):
     return time.time() - t0
 
 
+def brush(binary, height, out, side):
+    """height with a side x side soft brush of 0.1 added at its middle, as a
+    16-bit PNG (the library's reader and writer, through the package)."""
+    os.environ.setdefault("BUMPBAKE_LIBRARY", os.path.dirname(binary))
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import numpy as np
+    import bumpbake
+    h = bumpbake.read(height)
+    if h.ndim == 3:
+        h = h[..., 0]
+    rows, cols = h.shape
+    y, x = np.mgrid[0:side, 0:side].astype(np.float64)
+    r = side / 2.0
+    d2 = ((x + 0.5 - r) / r) ** 2 + ((y + 0.5 - r) / r) ** 2
+    bump = np.where(d2 < 1.0, 0.1 * (1.0 - d2) ** 2, 0.0)
+    y0, x0 = rows // 2 - side // 2, cols // 2 - side // 2
+    h = h.astype(np.float64)
+    h[y0:y0 + side, x0:x0 + side] += bump
+    bumpbake.write(out, np.clip(h, 0.0, 1.0).astype(np.float32), kind="height", depth=16)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("bin")
     ap.add_argument("--saves", type=int, default=10)
     ap.add_argument("--height", default=os.path.join(ROOT, "fixtures", "rock06_height.png"))
     ap.add_argument("--scale", default="64")
+    ap.add_argument("--edit", type=int, default=0)
     a = ap.parse_args()
     binary = os.path.abspath(a.bin)
     why = sb.browser_missing()
@@ -59,10 +89,13 @@ def main():
     work = tempfile.mkdtemp(prefix="bb-bench-serve-")
     served = os.path.join(work, "height.png")
     variant = os.path.join(work, "variant.png")
-    subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
-                    "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
-                    "-o", variant],
-                   check=True, stdout=subprocess.DEVNULL)
+    if a.edit:
+        brush(binary, a.height, variant, a.edit)
+    else:
+        subprocess.run([binary, "program", "invertColor(%s)" % os.path.basename(a.height),
+                        "--base", os.path.dirname(os.path.abspath(a.height)), "--depth", "16",
+                        "-o", variant],
+                       check=True, stdout=subprocess.DEVNULL)
     with open(a.height, "rb") as f:
         original = f.read()
     with open(variant, "rb") as f:
@@ -80,7 +113,7 @@ def main():
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, 300, "the first bake drawn")
         for i in range(a.saves):
             before = sb.drawn_bake(driver)
-            data = inverted if i % 2 == 0 else original
+            data = inverted if i % 2 == 0 else original  # (--edit: edited, not inverted)
             tmp = os.path.join(work, ".~height.png")
             with open(tmp, "wb") as f:
                 f.write(data)
@@ -110,8 +143,9 @@ def main():
     cold_bake = med(c[0] for c in cold)
     cold_pair = med(c[0] + c[1] for c in cold)
     print()
-    print("save-to-pixels, median of %d saves:      %.3f s (min %.3f, max %.3f)"
-          % (len(latencies), lat, min(latencies), max(latencies)))
+    what = "a %d x %d edit" % (a.edit, a.edit) if a.edit else "the whole height changed"
+    print("save-to-pixels (%s), median of %d saves: %.3f s (min %.3f, max %.3f)"
+          % (what, len(latencies), lat, min(latencies), max(latencies)))
     print("the bake inside serve, median:           %.3f s" % bk)
     print("save-to-pixels minus the bake, median:   %.3f s"
           % med(l - b for l, b in zip(latencies, bakes)))

@@ -11,21 +11,9 @@ one line and exits 0.
 """
 import collections
 import os
-import subprocess
 import sys
 
-
-def symbols(path):
-    """(defined, used) global symbols of one object file."""
-    out = subprocess.run(["nm", "-g", path], capture_output=True, text=True, check=True).stdout
-    defined, used = set(), set()
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[1] in "TDBRVWiu":
-            defined.add(parts[2])
-        elif len(parts) == 2 and parts[0] == "U":
-            used.add(parts[1])
-    return defined, used
+from object_symbols import links
 
 
 def circles(graph):
@@ -73,12 +61,7 @@ def circles(graph):
 
 
 def main(objects):
-    defined_by, uses = {}, {}
-    for obj in objects:
-        defined, used = symbols(obj)
-        uses[obj] = used
-        for sym in defined:
-            defined_by.setdefault(sym, obj)
+    defined_by, uses = links(objects)
     graph = collections.defaultdict(set)
     for obj in objects:
         graph[obj]

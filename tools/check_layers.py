@@ -11,16 +11,18 @@ may use itself and the families before it, never one after it:
 - calls: an object of src/FAMILY2/ may use a global symbol (nm) defined by
   an object of FAMILY2 or of a family before it, not one after it.
 It also fails when a folder of src/ holding sources is missing from the
-order, when --families (the Makefile's FAMILIES) is not the order without
-cli, or when the README's "Layout" table lists the folders in another order.
+order, when --families (the Makefile's FAMILIES) or the sections of
+include/bumpbake.h are not the order without cli, or when the README's
+"Layout" table lists the folders in another order.
 `make check-layers` runs it over the library's and the CLI's objects; it
 prints every offence and exits 1, or prints one line and exits 0.
 """
 import argparse
 import os
 import re
-import subprocess
 import sys
+
+from object_symbols import links
 
 ORDER_LINE = re.compile(r"^\s*(?:`|    )?([a-z]+(?:\s*<\s*[a-z]+)+)`?\s*$")
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
@@ -54,6 +56,15 @@ def readme_order(root):
             if m:
                 folders.append(m.group(1))
     return folders
+
+
+def header_order(root):
+    """The families of the public header's sections, in its order: each
+    section opens with a rule of '=' and a line " * FAMILY: what it holds"."""
+    path = os.path.join(root, "include", "bumpbake.h")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    return re.findall(r"^/\* =+\n \* ([a-z]+):", text, re.M)
 
 
 def family_of(path, src):
@@ -92,28 +103,10 @@ def include_offences(src, rank):
     return offences, count
 
 
-def symbols(path):
-    """(defined, used) global symbols of one object file."""
-    out = subprocess.run(["nm", "-g", path], capture_output=True, text=True, check=True).stdout
-    defined, used = set(), set()
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[1] in "TDBRVWiu":
-            defined.add(parts[2])
-        elif len(parts) == 2 and parts[0] == "U":
-            used.add(parts[1])
-    return defined, used
-
-
 def call_offences(objects, rank):
     """Objects are build/.../src/FAMILY/NAME.o: their family is the folder."""
     family = {o: os.path.basename(os.path.dirname(o)) for o in objects}
-    defined_by, uses = {}, {}
-    for obj in objects:
-        defined, used = symbols(obj)
-        uses[obj] = used
-        for sym in defined:
-            defined_by.setdefault(sym, obj)
+    defined_by, uses = links(objects)
     offences = []
     for obj in objects:
         for sym in sorted(uses[obj]):
@@ -146,12 +139,17 @@ def main(argv):
     for name in order:
         if not os.path.isdir(os.path.join(src, name)):
             offences.append(f"docs/how-it-works.md names {name}, which is not a folder of src/")
-    if args.families is not None and args.families.split() != [f for f in order if f != "cli"]:
+    library = [f for f in order if f != "cli"]
+    if args.families is not None and args.families.split() != library:
         offences.append(f"the Makefile's FAMILIES ({args.families}) are not the order of "
                         f"docs/how-it-works.md without cli ({' '.join(order)})")
     readme = readme_order(root)
     if readme and readme != order:
         offences.append(f"README.md's Layout lists {' '.join(readme)}, not {' '.join(order)}")
+    header = header_order(root)
+    if header != library:
+        offences.append(f"include/bumpbake.h's sections are {' '.join(header)}, not the order "
+                        f"without cli ({' '.join(library)})")
     includes, count = include_offences(src, rank)
     offences += includes
     offences += call_offences(args.objects, rank)

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # hostile_repro.sh BIN: reruns every reproduction of a hostile input (the hostile
 # files: 15 numbered cases with their variants, and the compares of NaN and
-# of a flat model), and the security and memory cases (32.N: code from the
+# of a flat model), the security and memory cases (32.N: code from the
 # working directory, outputs that are not regular files, a memory cgroup, a
-# render's picture, the cluster path) against the binary
+# render's picture, the cluster path) and `bumpbake serve` probed as a
+# server (39.N, tools/hostile_serve.py) against the binary
 # BIN, one line per case: its id, what ran, and CLEAN or NOT CLEAN with the
 # reasons.
 #
@@ -19,10 +20,11 @@
 #
 # Self-contained: it makes its files in a temporary directory and removes
 # it (HOSTILE_KEEP=1 keeps it, with each case's output in log/); about a
-# minute and a half on 2 cores (`make hostile`). Needs python3,
-# /usr/bin/time and timeout; uses strace (case 9), unshare (case 10),
-# setpriv (case 8, when run as root), make and ninja (case 11) where they
-# are installed and says SKIPPED where they are not.
+# minute and a half on 2 cores, and three more for the server (`make
+# hostile`). Needs python3, /usr/bin/time and timeout; uses strace (case
+# 9), unshare (case 10), setpriv (case 8, when run as root), make and
+# ninja (case 11) where they are installed and says SKIPPED where they are
+# not.
 set -u
 
 if [ $# -ne 1 ] || [ ! -x "$1" ]; then
@@ -925,6 +927,30 @@ sys.exit(128 - rc if rc < 0 else rc)' "$BIN" bake in --scale 8 --out-dir out -q 
   SIGOK=1 WANT_RC=130 FAIL_LINES="0 1" TMAX=60 ALLOW='^out(/|$)' finish
 else
   skip 32.7 "bake --scheduler: a cluster lost, Ctrl-C" "no python3-distributed"
+fi
+
+# ------------------------------------------------------------ 39: the server
+#
+# `bumpbake serve` probed as a server (tools/hostile_serve.py, which prints
+# one line per case in this script's form): a port already taken, framing,
+# slow clients, 1,000 connections, event streams dropped, one address's
+# share, stalled downloads, concurrent writes, malformed HTTP, the
+# controls, a folder moved under the watch, names a shell takes apart;
+# serve alive, the page loading during each attack, its RSS under the
+# documented bound. Traffic to 127.0.0.1 only.
+serve_finished=0
+while IFS= read -r line; do
+  case $line in
+    *" cases tried, "*) serve_finished=1 ;;
+    *"NOT CLEAN"*) printf '%s\n' "$line"; tried=$((tried + 1)); not_clean_ids+=("${line%% *}") ;;
+    *" CLEAN "*) printf '%s\n' "$line"; tried=$((tried + 1)); clean=$((clean + 1)) ;;
+    *) printf '%s\n' "$line" ;;
+  esac
+done < <(cd "$W" && "$PY" "$ROOT/tools/hostile_serve.py" "$BIN" 2>&1)
+if [ "$serve_finished" != 1 ]; then
+  tried=$((tried + 1))
+  not_clean_ids+=("39")
+  echo "39    tools/hostile_serve.py did not finish                            NOT CLEAN"
 fi
 
 [ ${#not_clean_ids[@]} -gt 0 ] && echo "not clean: ${not_clean_ids[*]}"

@@ -3,7 +3,8 @@
 # folders of tests/), so `make test` says what it is doing as it goes: a
 # line as each suite of a family finishes (a long family, cli, runs for
 # minutes), a line per family with its count and time, the failures in
-# full, and the total at the end. Exits 1 when any test failed.
+# full, the total and the ten slowest tests at the end (where the suite's
+# time goes). Exits 1 when any test failed.
 #
 # No test bounds the wall clock (a busy machine stretches it: CI shares its
 # cores); tests bound CPU time, and the suites' timeouts are hang guards
@@ -16,7 +17,8 @@ now() { date +%s.%N; }
 start=$(now)
 failed=0 total=0
 log=$(mktemp "${TMPDIR:-/tmp}/bb_tests.XXXXXX")
-trap 'rm -f "$log"' EXIT
+times=$(mktemp "${TMPDIR:-/tmp}/bb_times.XXXXXX")
+trap 'rm -f "$log" "$times"' EXIT
 # Tests per suite ("suite: N tests" in --list), to tell when one is done.
 declare -A in_suite
 while read -r suite n; do in_suite[$suite]=$n; done < <("$bin" --list 2>&1 |
@@ -40,6 +42,9 @@ for dir in tests/*/; do
       esac
       verdict=${line:1:4} name=${line:7} suite=${name%%::*}
       [[ "|$suites|" == *"|$suite|"* ]] || continue # another family's, filtered out
+      # "[PASS] suite::test: (1.23s)": the test's own time, for the slowest list
+      [[ $line =~ ^\[(PASS|FAIL)\]\ ([^:]+::[^:]+):\ \(([0-9.]+)s\) ]] &&
+        printf '%s %s\n' "${BASH_REMATCH[3]}" "${BASH_REMATCH[2]}" >>"$times"
       [ "$verdict" = SKIP ] && [[ $line == *"Test is disabled"* ]] && continue
       done_var=done_$suite fail_var=fail_$suite
       printf -v "$done_var" '%d' $((${!done_var:-0} + 1))
@@ -65,6 +70,8 @@ for dir in tests/*/; do
   fi
   : >"$log"
 done
+echo "test: the ten slowest Criterion tests (seconds, each on one of 2 jobs):"
+sort -rn "$times" | head -n 10 | awk '{ printf "test:   %6.1f  %s\n", $1, $2 }'
 printf 'test: %d Criterion tests in %.0f s%s\n' "$total" "$(echo "$(now) - $start" | bc)" \
   "$([ $failed = 0 ] && echo ', all passed' || echo ', SOME FAILED')"
 exit $failed

@@ -7,6 +7,7 @@ libbumpbake (the library behind the command), on numpy arrays and on files.
     maps["ssbump"]        # float32 array, (H, W, 3)
     reports = bumpbake.bake_files("heights/", "maps/", maps=("normal", "ao"), scale=16)
     assert bumpbake.compare("maps/rock_normal.png", "golden/rock_normal.png").passed
+    assert bumpbake.check("goldens", heights=["heights/"], scale=16).passed
 
 Arrays follow the library's conventions (include/bumpbake.h): row 0 is the
 top row, x = column to the right, y = row downwards, z out of the surface;
@@ -23,8 +24,9 @@ bumpbake._library.
 """
 
 from ._common import ArgumentError, Error, NoteWarning, library_path, _ffi, _lib  # noqa: F401 (tests)
-from ._bake import (BAKE_PARAMETERS, DEFAULT_OUTPUTS, DEFAULTS, OUTPUTS, TRACED_OUTPUTS, bake,
-                    basis, normal)
+from ._check import CheckCase, CheckResult, check
+from ._bake import (BAKE_PARAMETERS, DEFAULT_OUTPUTS, DEFAULTS, OUTPUTS, TRACED_OUTPUTS,
+                    BakeContext, bake, basis, normal)
 from ._files import (Comparison, DdsInfo, ImageInfo, VtfInfo, compare, file_hash, info, read,
                      write, write_vmt)
 from ._jobs import BakeJob, BakeReport, bake_file, bake_files
@@ -33,10 +35,11 @@ from ._render import DEFAULT_LIGHT, RenderBump, render, renderbumpflat, run, she
 from . import _library  # noqa: F401 (bumpbake._library.candidates, SONAME)
 
 __all__ = [
-    "ArgumentError", "BAKE_PARAMETERS", "BakeJob", "BakeReport", "Comparison",
+    "ArgumentError", "BAKE_PARAMETERS", "BakeContext", "BakeJob", "BakeReport", "CheckCase",
+    "CheckResult", "Comparison",
     "DdsInfo", "DEFAULT_LIGHT", "DEFAULT_OUTPUTS", "DEFAULTS", "Error", "ImageInfo", "NoteWarning",
     "OUTPUTS", "RenderBump", "TRACED_OUTPUTS", "bake", "bake_file", "bake_files", "basis",
-    "combine", "compare", "decode_normals", "file_hash", "info", "library_path", "mips",
+    "check", "combine", "compare", "decode_normals", "file_hash", "info", "library_path", "mips",
     "normal", "normal2ssbump", "program", "read", "render", "renderbumpflat", "run", "sheet",
     "ssbump2normal", "VtfInfo", "write", "write_vmt",
 ]

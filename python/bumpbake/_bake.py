@@ -251,6 +251,76 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
         _lib.bb_image_free(field)
 
 
+class BakeContext:
+    """Bakes of a height that changes a little at a time, as an editor or a
+    live preview makes them (bb_bake_context with bb_bake_context_keep):
+    the first bake is whole, and keeps what it made (about 4 x slices + 70
+    bytes a texel: 141 MB at 1024 x 1024); each later bake() of a height of
+    the same size with the same scale, outputs and options bakes again only
+    what the change can reach, and returns exactly the maps bake() would.
+    Inter-reflection (bounce) bakes whole every time. `changed` is the
+    rectangle (x, y, width, height) of texels whose maps may differ from the
+    bake before (the whole image after a whole bake, width 0 when nothing
+    changed). One bake at a time; close() (or a with block) lets the kept
+    bake go."""
+
+    def __init__(self):
+        out = _ffi.new("bb_bake_context **")
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_bake_context_new(out, err), err)
+        self._context = out[0]
+        _lib.bb_bake_context_keep(self._context, 1)
+        self.changed = (0, 0, 0, 0)
+
+    def bake(self, height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
+        """bake()'s maps of height, {name: float32 array}, baked again only
+        where height changed since the last bake (same parameters as bake())."""
+        if self._context is None:
+            raise ValueError("BakeContext.bake: the context is closed")
+        kinds, mask = _kinds_mask("BakeContext.bake", outputs)
+        c, maps = _bake_command("BakeContext.bake", scale, options, mask)
+        field = None
+        try:
+            o = _ffi.new("bb_bake_options *")
+            o[0] = c.options.job.bake
+            maps.fill(o)
+            field = _height_field("BakeContext.bake", height, c.options.job.channel)
+            raised = []
+            cb = _progress_hook(progress, raised)
+            o.trace.progress = cb
+            result = _ffi.new("bb_bake_result *")
+            changed = _ffi.new("bb_region *")
+            err = _ffi.new("bb_error *")
+            st = _lib.bb_bake_context_bake(self._context, field, o, result, changed, err)
+            if st != _lib.BB_OK:
+                if raised:
+                    raise raised[0]
+                _check(st, err, arrays=True)
+            try:
+                self.changed = (changed.x0, changed.y0, changed.width, changed.height)
+                return {k: _array(_lib.bb_bake_result_image(result, _KINDS[k][0])) for k in kinds}
+            finally:
+                _lib.bb_bake_result_free(result)
+        finally:
+            maps.free()
+            if field is not None:
+                _lib.bb_image_free(field)
+
+    def close(self):
+        if self._context is not None:
+            _lib.bb_bake_context_free(self._context)
+            self._context = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        self.close()
+
+
 def normal(height, scale, *, progress=None, **options):
     """Smooths the height and returns its unit normals, float32 (H, W, 3),
     as `bumpbake normal` makes them (nothing is traced). Options: `bumpbake
@@ -282,4 +352,5 @@ parameter or height, TypeError for a wrong type or an unknown keyword,
 Error otherwise.
 """
 bake.__doc__ += _PARAMETERS.format(options=_command.doc("bake", files=False))
+BakeContext.bake.__doc__ += _PARAMETERS.format(options=_command.doc("bake", files=False))
 normal.__doc__ += _PARAMETERS.format(options=_command.doc("normal", files=False))

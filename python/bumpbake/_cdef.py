@@ -240,6 +240,8 @@ typedef struct bb_bake_result {
   double seconds_bounce;
 } bb_bake_result;
 
+typedef struct bb_bake_context bb_bake_context;
+
 typedef struct bb_valve_options {
   int normal_map;
   int ao_in_alpha;
@@ -448,6 +450,37 @@ typedef struct bb_compare_report {
   bb_error diff_error;
 } bb_compare_report;
 
+typedef enum bb_check_status {
+  BB_CHECK_PASS = 0,
+  BB_CHECK_WARNING,
+  BB_CHECK_FAILURE,
+  BB_CHECK_DIFFERENT_SIZE,
+  BB_CHECK_UNREADABLE,
+  BB_CHECK_MISSING,
+  BB_CHECK_EXTRA
+} bb_check_status;
+
+typedef struct bb_check_case {
+  const char *name;
+  const char *golden;
+  const char *fresh;
+  const char *kind;
+  bb_check_status status;
+  int exit_code;
+  bb_compare_limits limits;
+  int width, height, channels;
+  int new_width, new_height, new_channels;
+  bb_compare_stats stats;
+  const char *provenance_diff;
+  const char *message;
+  int updated;
+  const char *update_error;
+  double seconds;
+} bb_check_case;
+
+typedef struct bb_check bb_check;
+typedef void (*bb_check_case_fn)(void *user, const bb_check_case *c);
+
 typedef struct bb_job_options {
   bb_bake_options bake;
   bb_channel channel;
@@ -570,6 +603,10 @@ typedef struct bb_command_options {
   int panel_size;
   bb_compare_limits limits;
   const char *diff;
+  const char *limit_rules;
+  int check_bake;
+  int update;
+  const char *junit, *html;
   bb_renderbump_options renderbump;
   const char *height_output;
   bb_map_kind map_kind;
@@ -674,6 +711,13 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
 void bb_bake_result_free(bb_bake_result *r);
+bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
+void bb_bake_context_free(bb_bake_context *context);
+void bb_bake_context_keep(bb_bake_context *context, int keep);
+bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
+                               const bb_bake_options *o, bb_bake_result *result,
+                               bb_region *changed, bb_error *err);
+bb_region bb_bake_context_changed(const bb_bake_context *context);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
@@ -737,6 +781,25 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
 void bb_compare_report_free(bb_compare_report *report);
 int bb_compare_report_exit_code(const bb_compare_report *report);
 const char *bb_compare_report_result(const bb_compare_report *report);
+void bb_check_free(bb_check *check);
+int bb_check_input_count(const bb_check *check);
+const char *bb_check_input(const bb_check *check, int i);
+bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
+                             void *progress_user, bb_check_case_fn each, void *user,
+                             bb_error *err);
+bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
+                            bb_error *err);
+bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
+                       bb_check_case_fn each, void *user, bb_error *err);
+int bb_check_case_count(const bb_check *check);
+const bb_check_case *bb_check_case_get(const bb_check *check, int i);
+int bb_check_exit_code(const bb_check *check);
+const char *bb_check_status_name(bb_check_status status);
+char *bb_check_case_lines(const bb_check *check, const bb_check_case *c);
+char *bb_check_summary_lines(const bb_check *check);
+bb_status bb_check_write_reports(bb_check *check, bb_error *err);
+char *bb_check_export(bb_check *check, int first, size_t *size);
+bb_status bb_check_import(bb_check *check, const char *data, size_t size, bb_error *err);
 void bb_job_options_init(bb_job_options *o);
 bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
                       bb_job **out, bb_error *err);
@@ -799,6 +862,9 @@ const char *bb_normal_y_name(int normal_y_up);
 const char *bb_addressing_name(bb_addressing addressing);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 const char *bb_provenance_class_name(bb_provenance_class c);
+int bb_map_kind_records(const char *kind, const char *key, int bounce);
+bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
+                        bb_error *err);
 long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 /* what a job prints (bumpbake bake --scheduler) */
 char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,

@@ -27,7 +27,7 @@ from . import _cdef
 
 # libbumpbake's soname (the Makefile's SONAME); it changes with the ABI, and
 # with it the declarations in _cdef.py. tests/test_cdef.py checks both.
-SONAME = "libbumpbake.so.0.4"
+SONAME = "libbumpbake.so.0.5"
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 _SOURCE_ROOT = os.path.dirname(os.path.dirname(_PACKAGE_DIR))

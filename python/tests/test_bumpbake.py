@@ -360,3 +360,45 @@ def test_an_installed_package_loads_the_recorded_library_or_says_what_to_do(tmp_
     assert tried.startswith(f"{gone} (no such file); {bumpbake._library.SONAME} by the dynamic "
                             "loader's search")
     assert "build" not in tried and "pkg-config" not in tried
+
+
+# ------------------------------------------------------- edit-local bakes
+
+@pytest.mark.parametrize("clamp", [False, True])
+def test_bake_context_equals_whole_bakes_after_edits(clamp):
+    rng = np.random.default_rng(7)
+    y, x = np.mgrid[0:61, 0:83].astype(np.float64)
+    h = (0.5 + 0.2 * np.sin(0.3 * x) * np.cos(0.2 * y) + 0.05 * rng.random((61, 83)))
+    h = h.astype(np.float32)
+    brightness = (0.5 + rng.random((61, 83, 3))).astype(np.float32)
+    options = dict(outputs=bumpbake.OUTPUTS, clamp=clamp, brightness=brightness)
+    with bumpbake.BakeContext() as context:
+        first = context.bake(h, 16, **options)
+        assert context.changed == (0, 0, 83, 61)
+        for key, value in bumpbake.bake(h, 16, **options).items():
+            np.testing.assert_array_equal(first[key], value)
+        for edit in range(4):
+            if edit == 3:  # a tall peak at an edge
+                h[0:4, 80:83] += 1.5
+            else:
+                r, c = rng.integers(0, 61), rng.integers(0, 83)
+                h[r:r + 5, c:c + 3] += np.float32(rng.normal() * 0.1)
+            if edit == 1:
+                brightness[10, 10] = 2.0
+            got = context.bake(h, 16, threads=1 + edit % 2, **options)
+            x0, y0, width, height = context.changed
+            assert 0 < width * height < 83 * 61 or edit == 3
+            want = bumpbake.bake(h, 16, **options)
+            for key in bumpbake.OUTPUTS:  # the whole bake's bits
+                np.testing.assert_array_equal(got[key], want[key], err_msg=f"{key}, edit {edit}")
+        again = context.bake(h, 16, **options)
+        assert context.changed[2] == 0  # the same height: nothing changed
+        np.testing.assert_array_equal(again["ssbump"], want["ssbump"])
+
+
+def test_bake_context_refuses_as_bake_does():
+    with bumpbake.BakeContext() as context:
+        with pytest.raises(bumpbake.ArgumentError, match="scale"):
+            context.bake(np.zeros((8, 8), np.float32), 0)
+    with pytest.raises(ValueError, match="closed"):
+        context.bake(np.zeros((8, 8), np.float32), 4)

@@ -4,6 +4,7 @@ Python keyword, values are set and checked by the library, and what Python
 writes is the command line's bytes."""
 
 import os
+import shlex
 import shutil
 import signal
 import subprocess
@@ -29,6 +30,7 @@ FUNCTIONS = {
     "normal": ("normal", "run"),
     "height2ssbump": ("run",),
     "compare": ("compare",),
+    "check": ("check",),
     "info": ("info",),
     "renderbumpflat": ("renderbumpflat",),
     "render": ("render", "run"),
@@ -44,6 +46,7 @@ FUNCTIONS = {
 # too: Python returns reports and raises errors instead.
 NOT_IN_PYTHON = {
     ("bake", "scheduler"): "a cluster from Python is bumpbake.dask.bake_files(client=...)",
+    ("check", "bake"): "check(golden, heights=...) bakes; the command line says --bake",
     ("serve", None): "the command line's HTTP preview server (bake() and render() make "
                      "what it shows)",
 }
@@ -67,6 +70,7 @@ def call_with(name, command, key, value):
         "normal": lambda kw: f(h, 1, **kw),
         "run": lambda kw: f(command, **kw),
         "compare": lambda kw: f("a.png", "b.png", **kw),
+        "check": lambda kw: f("g", "n", **kw),
         "info": lambda kw: f("a.png", **kw),
         "renderbumpflat": lambda kw: f("m.obj", **kw),
         "render": lambda kw: f(normal=n, **kw),
@@ -188,7 +192,7 @@ def test_a_bounce_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch):
     ours = files_of("py")
     shutil.rmtree("py")
     os.makedirs("py")
-    done = cli(*command.split()[1:])
+    done = cli(*shlex.split(command)[1:])
     assert done.returncode == 0, done.stderr
     theirs = files_of("py")
     assert sorted(ours) == ["ao.exr", "ssbump.exr"] == sorted(theirs)
@@ -297,7 +301,7 @@ def test_whole_numbers_are_spelled_as_typed():
     """30 is recorded as 30, not as the shortest %g that reads back (3e+01)."""
     job = bumpbake.BakeJob(os.path.join(FIXTURES, "rock06_128.png"),
                            outputs={"normal": "n.png"}, scale=30, rays=100, bias=1e6)
-    assert job.command_text(0).split()[3:] == ["--scale", "30", "--rays", "100", "--bias",
+    assert shlex.split(job.command_text(0))[3:] == ["--scale", "30", "--rays", "100", "--bias",
                                                "1000000", "--normal", "n.png"]
 
 

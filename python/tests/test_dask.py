@@ -7,6 +7,7 @@ changes nothing of the result."""
 import json
 import os
 import re
+import shlex
 import shutil
 import signal
 import threading
@@ -76,7 +77,7 @@ def test_a_batch_is_the_cli_batch_and_a_rerun_bakes_nothing(tmp_path, monkeypatc
     os.rename("out", "out_dask")
 
     job = bumpbake.BakeJob("heights", "out", maps=maps, scale=SCALE, rays=64)
-    options = job.command_text(0).split()[3:]
+    options = shlex.split(job.command_text(0))[3:]
     assert options == ["--scale", "16", "--rays", "64", "--out-dir", "out"]
     cli("bake", "heights", *options)  # as typed: -q, --depfile would be recorded too
     ours, theirs = files_of("out_dask"), files_of("out")
@@ -223,7 +224,7 @@ def test_split_bake_is_the_cli_bake(tmp_path, monkeypatch, client, cli):
     command = bumpbake.BakeJob("h00.png", outputs={"ssbump": "s.png", "ao": "a.png"},
                                scale=SCALE, slices=8, clamp=True).command_text(0)
     assert command == "bumpbake bake h00.png --scale 16 --slices 8 --clamp --ssbump s.png --ao a.png"
-    cli(*command.split()[1:])
+    cli(*shlex.split(command)[1:])
     assert files_of(".") == split and report.status == "baked"
 
 
@@ -463,7 +464,7 @@ def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, c
     # the format by its first name (bc3 is dxt5), as bb_texture_format_name spells it
     assert command.endswith("--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip")
     os.rename("out", "out_api")
-    cli("bake", "heights", *command.split()[3:])
+    cli("bake", "heights", *shlex.split(command)[3:])
     assert files_of("out_api") == files_of("out")
 
     # one map split over the workers: a .vtf, a .dds and the material

@@ -41,23 +41,32 @@ def _free_port():
 
 class Cluster:
     """dask-scheduler and one dask-worker (one thread, no nanny: killed, it
-    stays dead) as subprocesses on 127.0.0.1."""
+    stays dead) as subprocesses on 127.0.0.1. The scheduler picks its own
+    port and says it in a scheduler file: a port found free beforehand may
+    be taken by another program before the scheduler binds it, and the
+    client then waits on a stranger."""
 
     def __init__(self, directory, package=True):
-        self.address = f"tcp://127.0.0.1:{_free_port()}"
         env = dict(os.environ, PYTHONPATH=PYTHON_DIR)
         if not package:  # a worker that cannot import bumpbake
             del env["PYTHONPATH"]
         quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
                      cwd=directory)
+        scheduler_file = os.path.join(directory, ".scheduler.json")
         self.scheduler = subprocess.Popen(
             [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-             "--port", self.address.rsplit(":", 1)[1], "--no-dashboard"], **quiet)
+             "--port", "0", "--scheduler-file", scheduler_file, "--no-dashboard"], **quiet)
+        deadline = time.monotonic() + HANG_GUARD
+        while not os.path.exists(scheduler_file):
+            assert self.scheduler.poll() is None, "dask-scheduler exited"
+            assert time.monotonic() < deadline, "dask-scheduler did not start"
+            time.sleep(0.05)
+        self.client = distributed.Client(scheduler_file=scheduler_file, timeout=HANG_GUARD,
+                                         set_as_default=False)
+        self.address = self.client.scheduler.address
         self.worker = subprocess.Popen(
             [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads",
              "1", "--no-nanny", "--memory-limit", "0", "--no-dashboard"], **quiet)
-        self.client = distributed.Client(self.address, timeout=HANG_GUARD,
-                                         set_as_default=False)
         self.client.wait_for_workers(1, timeout=HANG_GUARD)
 
     def close(self):

@@ -4,6 +4,7 @@ failures, notes, cancelling, and a job sent to another process."""
 
 import json
 import os
+import shlex
 import pickle
 import shutil
 import signal
@@ -58,7 +59,7 @@ def test_a_batch_is_the_cli_batch_byte_for_byte(tmp_path, monkeypatch, fixtures,
     command = job.command_text(0)
     assert command == ("bumpbake bake heights/bricks_128x64.png --scale 16 --out-dir out "
                        "--maps normal,ao")
-    options = command.split()[3:]  # what follows "bumpbake bake INPUT"
+    options = shlex.split(command)[3:]  # what follows "bumpbake bake INPUT"
 
     reports = bumpbake.bake_files("heights", "out", maps=MAPS, scale=16, depfile="py.d")
     assert [r.status for r in reports] == ["baked"] * 4
@@ -115,6 +116,20 @@ def test_single_bake_names_its_outputs(tmp_path, fixtures):
     assert bumpbake.bake_file(src, {"normal": out}, scale=8).status == "baked"
     assert bumpbake.bake_file(src, {"normal": out}, scale=8, force=False).status == "up to date"
     assert bumpbake.bake_file(src, {"normal": out}, scale=9, force=False).status == "baked"
+
+
+def test_the_recorded_command_is_quoted_for_a_shell(tmp_path, monkeypatch, fixtures):
+    """The provenance's command, as Python records it (bb_command_text),
+    quotes every word for a POSIX shell: typed in one, a name with a blank
+    or a ';' is one word, and runs nothing."""
+    monkeypatch.chdir(tmp_path)
+    name = "my rock;x.png"
+    shutil.copy(os.path.join(fixtures, "pit_65x65.png"), name)
+    report = bumpbake.bake_file(name, {"ao": "a o.png"}, scale=8, rays=16)
+    assert report.status == "baked"
+    command = bumpbake.info("a o.png").provenance["command"]
+    assert command == "bumpbake bake 'my rock;x.png' --scale 8 --rays 16 --ao 'a o.png'"
+    assert shlex.split(command)[2] == name
 
 
 def test_failures_stop_the_batch_unless_keep_going(tmp_path, fixtures):

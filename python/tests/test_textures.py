@@ -8,6 +8,7 @@ library's refusals."""
 import dataclasses
 import json
 import os
+import shlex
 import shutil
 
 import numpy as np
@@ -213,7 +214,7 @@ def test_one_bake_is_the_clis_byte_for_byte(tmp_path, monkeypatch, fixtures, cli
     ours = files_of("game")
     shutil.rmtree("game")
     os.makedirs("game/materials/rock")
-    cli(*command.split()[1:])
+    cli(*shlex.split(command)[1:])
     theirs = files_of("game")
     assert sorted(ours) == sorted(theirs) == [
         "materials/rock/rock-ssbump.vtf", "materials/rock/rock.vmt",
@@ -241,7 +242,7 @@ def test_batches_of_textures_are_the_clis_and_only_vtf_73_is_up_to_date(
         reports = bumpbake.bake_files("heights", out, **options)
         assert [r.status for r in reports] == ["baked"] * 2
         os.rename(out, out + "_py")
-        cli(*command.split()[1:2], "heights", *command.split()[3:])
+        cli(*shlex.split(command)[1:2], "heights", *shlex.split(command)[3:])
         ours, theirs = files_of(out + "_py"), files_of(out)
         assert len(ours) == 6 and sorted(ours) == sorted(theirs), out
         assert [name for name in ours if ours[name] != theirs[name]] == [], out

@@ -6,7 +6,8 @@
 // max(0, N.l) on the normal map, times ao in "normal x ao"; relief is
 // relief_hit seen from a camera as `render --view AZ,EL --relief`, the
 // ssbump met lit by the same light (ssbump_relief_shade's diffuse term
-// with no lightmaps). The basis directions B_c are the bake's own (a
+// with no lightmaps); the lit modes are times render's --albedo A and
+// --light-color C, as render's output A (dynamic) C is. The basis directions B_c are the bake's own (a
 // uniform): Half-Life 2's are ssbump_relief.glsl's SSBUMP_B0..B2, and a
 // bake with --basis FILE of 3 other directions is lit with those; a basis
 // of more than 3 does not fit the page's ssbump texture, whose lit modes
@@ -17,12 +18,17 @@ uniform sampler2D uNormalHeight; // (N + 1) / 2 in RGB, the smoothed height in A
 uniform sampler2D uBent;         // (Nb + 1) / 2
 uniform sampler2D uWeights;      // basis weights
 uniform sampler2D uHeight;       // the smoothed height in R (for the relief)
+uniform sampler2D uAlbedo;       // render's --albedo, RGB (grey: R = G = B)
 uniform vec2 uSize;              // the maps' size in texels
 uniform vec2 uCanvas;            // the drawing buffer's size in pixels
-uniform float uTile;             // 1, or 2 to show seams
+uniform vec2 uExtent;            // the maps shown: uSize, or twice it tiled 2 x 2
+uniform float uZoom;             // drawing buffer pixels a texel
+uniform vec2 uCenter;            // the point of the maps (texels) at the picture's centre
 uniform int uMode;               // 0 ssbump lit, 1 normal lit, 2 normal x ao lit, 3 ao,
                                  // 4 bent normal, 5 weights, 6 ssbump map, 7 height, 8 relief
 uniform vec3 uLight;             // towards the light, tangent frame (+y down)
+uniform vec3 uLightColor;        // render's --light-color C (1, 1, 1 where nothing is lit)
+uniform float uUseAlbedo;        // 1: the lit modes are times the albedo A
 uniform float uNormalYUp;        // 1: the maps were baked with --normal-y up
 uniform vec3 uView;              // towards the camera (relief)
 uniform vec2 uRight, uToward;    // the screen's right and the way to the camera, on the plane
@@ -45,11 +51,13 @@ float ssbump_lit(vec3 s, vec3 l) {
 }
 
 void main() {
-    // the pixel's point on the (tiled) maps, texels, y down; texel (i, j) at (i, j)
-    vec2 screen = vec2(gl_FragCoord.x, uCanvas.y - gl_FragCoord.y) / uCanvas;
-    vec2 extent = uSize * uTile;
-    vec2 p = screen * extent - 0.5;
+    // the pixel's point on the (tiled) maps, texels, y down; texel (i, j) at
+    // (i, j); fitted, uCenter is the extent's middle and uZoom canvas / extent
+    vec2 pixel = vec2(gl_FragCoord.x, uCanvas.y - gl_FragCoord.y);
+    vec2 extent = uExtent;
+    vec2 p = uCenter + (pixel - 0.5 * uCanvas) / uZoom - 0.5;
     vec2 uv = (p + 0.5) / uSize;
+    vec3 albedo = uUseAlbedo > 0.5 ? textureLod(uAlbedo, uv, 0.0).rgb : vec3(1.0);
     vec3 rgb;
     if (uMode == 8) {
         // render's view_pixel: the picture of the tiled maps seen by the
@@ -57,6 +65,7 @@ void main() {
         float si = p.x - 0.5 * extent.x, sj = (p.y - 0.5 * extent.y) * uStretch;
         vec2 point = 0.5 * extent + si * uRight + sj * uToward;
         vec2 hit = relief_hit(uHeight, uSize, point, uView, uDepth);
+        if (uUseAlbedo > 0.5) albedo = textureLod(uAlbedo, (hit + 0.5) / uSize, 0.0).rgb;
         rgb = vec3(ssbump_lit(textureLod(uSsbumpAo, (hit + 0.5) / uSize, 0.0).rgb, uLight));
     } else if (uMode == 0) {
         vec3 s = textureLod(uSsbumpAo, uv, 0.0).rgb;
@@ -77,6 +86,9 @@ void main() {
     } else {
         rgb = vec3(textureLod(uHeight, uv, 0.0).r);
     }
-    // linear values written as they are, as `bumpbake render` writes a PNG
+    // render's output A * light * C in the lit modes (uLightColor is 1 and
+    // albedo 1 in the others); linear values written as they are, as
+    // `bumpbake render` writes a PNG
+    if (uMode <= 2 || uMode == 8) rgb *= albedo * uLightColor;
     fragColor = vec4(clamp(rgb, 0.0, 1.0), 1.0);
 }

@@ -4,7 +4,9 @@
 // with WebGL 2 (serve.frag.glsl after shaders/ssbump_relief.glsl), relights
 // as the light is dragged, and sends the controls ("params") and the write
 // action ("write"). The inputs' ranges are the library's ("ranges": the
-// options' descriptions), none of the page's own. Once a bake's maps are
+// options' descriptions), none of the page's own. The picture zooms and
+// pans, shows the bake before in turns with the last (A/B), and is dimmed,
+// saying why, whenever it is not the maps of now. Once a bake's maps are
 // drawn, <body data-drawn-bake> holds its id and data-drawn-at the time
 // (Date.now()), for tests.
 "use strict";
@@ -12,20 +14,34 @@
 const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 const gl = canvas.getContext("webgl2", { preserveDrawingBuffer: true, antialias: false });
-const TEXTURES = ["ssbump_ao", "normal_height", "bent", "weights"];
+// The maps' textures by name, and the texture unit of each; the height
+// texture (unit 4) is made from normal_height's alpha.
+const TEXTURES = ["ssbump_ao", "normal_height", "bent", "weights", "albedo"];
+const UNITS = { ssbump_ao: 0, normal_height: 1, bent: 2, weights: 3, height: 4, albedo: 5 };
 const light = { azimuth: 135, elevation: 45 };  // render's default light
-let program = null, uniforms = {}, textures = {}, heightTexture = null;
-let maps = null;          // {id, width, height} of the textures loaded
+let program = null, uniforms = {};
+// A bake's maps on the GPU: {id, width, height, tex: {name: WebGLTexture}}.
+// current is the last bake loaded, previous the one before it (A/B).
+let current = null, previous = null, showB = false;
 let state = null;         // the server's last state
-let loading = 0;          // the bake id being fetched, 0 when none
+let loading = 0;          // 1 while a bake's maps are fetched
 let drawPending = false;
 const bakeScale = {};      // each bake's --scale by id: the depth of its relief
 const bakeBasis = {};      // each bake's basis directions by id: the ssbump's lighting
 const SSBUMP_MODES = [0, 8];  // the modes that light the ssbump with the basis
+const LIT_MODES = [0, 1, 2, 8];  // the modes a light (and a colour map) lights
+const RELIEF_MODE = 8;           // the one mode seen from a camera
 let ranges = {};          // the server's "ranges": {name: {min, max, min_exclusive}}
+// The camera on the picture: canvas pixels a texel (0: fit the maps), and
+// the texel at the picture's centre.
+const camera = { zoom: 0, cx: 0, cy: 0 };
 
 function fail(message) {
   $("error").textContent = message;
+}
+
+function shown() {
+  return showB && previous ? previous : current;
 }
 
 // -------------------------------------------------------------- the light
@@ -61,12 +77,106 @@ function dragLight(event) {
   requestDraw();
 }
 
+// ------------------------------------------------------- zoom, pan, 1:1
+
+// The maps' extent on the picture (tiled 2 x 2 or not), texels.
+function extent() {
+  const m = shown(), tile = $("tile").checked ? 2 : 1;
+  return m ? [m.width * tile, m.height * tile] : [1, 1];
+}
+
+function fitZoom() {
+  const [w, h] = extent();
+  return Math.min(canvas.width / w, canvas.height / h);
+}
+
+function zoomNow() {
+  return camera.zoom || fitZoom();
+}
+
+function showZoom() {
+  $("zoom-text").textContent = camera.zoom ? Math.round(camera.zoom * 100) + "%"
+                                           : "fit (" + Math.round(fitZoom() * 100) + "%)";
+}
+
+function setZoom(zoom, px, py) {
+  // the texel under canvas pixel (px, py) stays under it
+  const [w, h] = extent(), z0 = zoomNow();
+  const cx = camera.zoom ? camera.cx : w / 2, cy = camera.zoom ? camera.cy : h / 2;
+  const tx = cx + (px - canvas.width / 2) / z0, ty = cy + (py - canvas.height / 2) / z0;
+  camera.zoom = Math.min(64, Math.max(1 / 64, zoom));
+  camera.cx = tx - (px - canvas.width / 2) / camera.zoom;
+  camera.cy = ty - (py - canvas.height / 2) / camera.zoom;
+  showZoom();
+  requestDraw();
+}
+
+function fit() {
+  camera.zoom = 0;
+  showZoom();
+  requestDraw();
+}
+
+function canvasPoint(event) {
+  const r = canvas.getBoundingClientRect();
+  return [(event.clientX - r.left) * canvas.width / r.width,
+          (event.clientY - r.top) * canvas.height / r.height];
+}
+
+canvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  const [px, py] = canvasPoint(e);
+  setZoom(zoomNow() * Math.pow(1.25, e.deltaY < 0 ? 1 : -1), px, py);
+}, { passive: false });
+
+let panFrom = null;
 canvas.addEventListener("pointerdown", (e) => {
   canvas.setPointerCapture(e.pointerId);
+  if (e.button === 1 || e.shiftKey) {
+    if (!camera.zoom) setZoom(fitZoom(), canvas.width / 2, canvas.height / 2);
+    panFrom = { x: e.clientX, y: e.clientY, cx: camera.cx, cy: camera.cy };
+    e.preventDefault();
+    return;
+  }
   dragLight(e);
 });
 canvas.addEventListener("pointermove", (e) => {
-  if (e.buttons) dragLight(e);
+  if (!e.buttons) return;
+  if (panFrom) {
+    const r = canvas.getBoundingClientRect(), z = zoomNow();
+    camera.cx = panFrom.cx - (e.clientX - panFrom.x) * canvas.width / r.width / z;
+    camera.cy = panFrom.cy - (e.clientY - panFrom.y) * canvas.height / r.height / z;
+    requestDraw();
+  } else {
+    dragLight(e);
+  }
+});
+canvas.addEventListener("pointerup", () => { panFrom = null; });
+canvas.addEventListener("auxclick", (e) => e.preventDefault());
+$("zoom-fit").addEventListener("click", fit);
+$("zoom-1").addEventListener("click", () => setZoom(1, canvas.width / 2, canvas.height / 2));
+
+// ------------------------------------------------------------------ A/B
+
+function showAB() {
+  const ab = $("ab");
+  ab.disabled = !previous;
+  ab.classList.toggle("on", showB && !!previous);
+  $("ab-text").textContent = !current ? "" : showB && previous
+    ? "B: bake " + previous.id + " (the one before)" : "A: bake " + current.id +
+      (previous ? " (B: bake " + previous.id + ")" : "");
+}
+
+function toggleAB() {
+  showB = !showB && !!previous;
+  showAB();
+  showStale();
+  requestDraw();
+}
+
+$("ab").addEventListener("click", toggleAB);
+document.addEventListener("keydown", (e) => {
+  if ((e.key === "b" || e.key === "B") && !(e.target instanceof HTMLInputElement)) toggleAB();
 });
 
 // ---------------------------------------------------------------- WebGL
@@ -109,33 +219,39 @@ async function setup() {
     uniforms[name] = gl.getUniformLocation(program, name);
   }
   uniforms.uBasis = gl.getUniformLocation(program, "uBasis");  // the array, from element 0
-  ["uSsbumpAo", "uNormalHeight", "uBent", "uWeights", "uHeight"].forEach((name, unit) => {
-    gl.uniform1i(uniforms[name], unit);
-  });
+  const samplers = { uSsbumpAo: "ssbump_ao", uNormalHeight: "normal_height", uBent: "bent",
+                     uWeights: "weights", uHeight: "height", uAlbedo: "albedo" };
+  for (const [name, texture] of Object.entries(samplers))
+    gl.uniform1i(uniforms[name], UNITS[texture]);
 }
 
-function makeTexture(unit) {
+function makeTexture(unit, internal, format, w, h, bytes) {
   const t = gl.createTexture();
   gl.activeTexture(gl.TEXTURE0 + unit);
   gl.bindTexture(gl.TEXTURE_2D, t);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
-  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);  // as render samples
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.REPEAT);  // the maps tile
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.REPEAT);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, gl.UNSIGNED_BYTE, bytes);
   return t;
 }
 
-function upload(unit, internal, format, w, h, bytes) {
-  gl.activeTexture(gl.TEXTURE0 + unit);
-  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-  gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, gl.UNSIGNED_BYTE, bytes);
+function freeMaps(m) {
+  if (m) for (const t of Object.values(m.tex)) gl.deleteTexture(t);
 }
 
-// The textures each mode reads (serve.frag.glsl); the height texture is
-// made from normal_height's alpha.
+// The textures each mode reads (serve.frag.glsl), and the albedo where it
+// is drawn.
 function texturesOf(mode) {
-  return { 0: ["ssbump_ao"], 3: ["ssbump_ao"], 6: ["ssbump_ao"], 4: ["bent"], 5: ["weights"] }[mode]
-         || ["ssbump_ao", "normal_height"];
+  const names = { 0: ["ssbump_ao"], 3: ["ssbump_ao"], 6: ["ssbump_ao"], 4: ["bent"],
+                  5: ["weights"] }[mode] || ["ssbump_ao", "normal_height"];
+  return albedoUsed(mode) ? names.concat(["albedo"]) : names;
+}
+
+function albedoUsed(mode) {
+  return !!(state && state.params.albedo_file && $("albedo").checked && LIT_MODES.includes(mode));
 }
 
 // Fetches names of the last good bake; they must all be of one bake (id,
@@ -144,7 +260,10 @@ function texturesOf(mode) {
 async function fetchMaps(names, id) {
   const replies = await Promise.all(names.map((name) => fetch("map/" + name)));
   for (const r of replies)
-    if (!r.ok) throw new Error("map: " + r.status + " " + (await r.text()));
+    if (!r.ok) {
+      if (r.status === 503) return null;  // a newer bake landed first: fetch that one
+      throw new Error("map: " + r.status + " " + (await r.text()));
+    }
   const ids = replies.map((r) => Number(r.headers.get("X-Bake-Id")));
   const data = await Promise.all(replies.map((r) => r.arrayBuffer()));
   if (ids.some((x) => x !== ids[0]) || (id && ids[0] !== id)) return null;
@@ -152,23 +271,22 @@ async function fetchMaps(names, id) {
            h: Number(replies[0].headers.get("X-Height")), data: data };
 }
 
-function uploadMaps(names, got) {
+function uploadMaps(m, names, got) {
   names.forEach((name, i) => {
-    const unit = TEXTURES.indexOf(name);
-    if (!textures[name]) textures[name] = makeTexture(unit);
-    upload(unit, gl.RGBA8, gl.RGBA, got.w, got.h, new Uint8Array(got.data[i]));
+    const bytes = new Uint8Array(got.data[i]);
+    m.tex[name] = makeTexture(UNITS[name], gl.RGBA8, gl.RGBA, got.w, got.h, bytes);
     if (name === "normal_height") {
       // the relief reads the height's first channel (ssbump_relief.glsl's relief_h)
-      const nh = new Uint8Array(got.data[i]), n = got.w * got.h, height = new Uint8Array(n);
-      for (let k = 0; k < n; k++) height[k] = nh[4 * k + 3];
-      if (!heightTexture) heightTexture = makeTexture(4);
-      upload(4, gl.R8, gl.RED, got.w, got.h, height);
+      const n = got.w * got.h, height = new Uint8Array(n);
+      for (let k = 0; k < n; k++) height[k] = bytes[4 * k + 3];
+      m.tex.height = makeTexture(UNITS.height, gl.R8, gl.RED, got.w, got.h, height);
     }
   });
 }
 
 // A new bake: first the textures the picture shown needs, drawn at once,
 // then the others (so a save shows as soon as its ssbump has arrived).
+// The bake it replaces becomes B once the new one is whole.
 async function loadMaps() {
   loading = 1;
   try {
@@ -176,69 +294,103 @@ async function loadMaps() {
       const first = texturesOf(Number($("mode").value));
       const got = await fetchMaps(first, 0);
       if (!got) continue;  // a bake landed in between: again
-      const rest = TEXTURES.filter((t) => !first.includes(t));
-      uploadMaps(first, got);
-      maps = { id: got.id, width: got.w, height: got.h };
+      const m = { id: got.id, width: got.w, height: got.h, tex: {} };
+      uploadMaps(m, first, got);
+      const before = current;
+      current = m;
+      if (before && before !== previous && before.whole) {
+        freeMaps(previous);
+        previous = before;
+      } else if (before && before !== previous) {
+        freeMaps(before);  // cut short by this one: not a bake to compare with
+      }
+      showB = false;
       fitCanvas();
       draw();
-      const others = await fetchMaps(rest, got.id);
-      if (others) uploadMaps(rest, others);
-      else continue;  // newer maps already: load them whole
+      const rest = TEXTURES.filter((t) => !first.includes(t) &&
+                                         (t !== "albedo" || (state && state.bake && state.bake.albedo)));
+      const others = rest.length ? await fetchMaps(rest, got.id) : { data: [] };
+      if (!others) continue;  // newer maps already: load them whole
+      uploadMaps(m, rest, { w: got.w, h: got.h, data: others.data });
+      m.whole = true;
       draw();
       break;
     }
   } finally {
     loading = 0;
+    showAB();
+    showStale();
   }
-  if (state && state.bake && state.bake.id > maps.id) loadMaps();
+  if (state && state.bake && state.bake.id > current.id) loadMaps();
 }
 
 // The picture keeps the maps' shape, its longer side 640 pixels.
 function fitCanvas() {
-  const tall = maps.height > maps.width;
-  const w = tall ? Math.round(640 * maps.width / maps.height) : 640;
-  const h = tall ? 640 : Math.round(640 * maps.height / maps.width);
+  const m = shown(), tall = m.height > m.width;
+  const w = tall ? Math.round(640 * m.width / m.height) : 640;
+  const h = tall ? 640 : Math.round(640 * m.height / m.width);
   if (canvas.width !== w || canvas.height !== h) {
     canvas.width = w;
     canvas.height = h;
     canvas.style.width = w + "px";
     canvas.style.height = h + "px";
   }
+  showZoom();
 }
 
 function requestDraw() {
-  if (drawPending || !maps) return;
+  if (drawPending || !current) return;
   drawPending = true;
   requestAnimationFrame(() => { drawPending = false; draw(); });
 }
 
+// A view input's value within the library's range, the box showing the
+// value drawn once it is left (0 is the range's bottom, not the default).
+function viewValue(input, r, fallback, commit) {
+  const typed = input.value.trim() === "" ? NaN : Number(input.value);
+  const v = Number.isFinite(typed) ? clamp(typed, r) : fallback;
+  if (commit && String(v) !== input.value) input.value = String(v);
+  return v;
+}
+
 function draw() {
-  if (!maps) return;
-  const mode = Number($("mode").value), tile = $("tile").checked ? 2 : 1;
+  const m = shown();
+  if (!m) return;
+  const mode = Number($("mode").value), [w, h] = extent();
+  for (const [name, t] of Object.entries(m.tex)) {
+    gl.activeTexture(gl.TEXTURE0 + UNITS[name]);
+    gl.bindTexture(gl.TEXTURE_2D, t);
+  }
   gl.viewport(0, 0, canvas.width, canvas.height);
-  gl.uniform2f(uniforms.uSize, maps.width, maps.height);
+  gl.uniform2f(uniforms.uSize, m.width, m.height);
   gl.uniform2f(uniforms.uCanvas, canvas.width, canvas.height);
-  gl.uniform1f(uniforms.uTile, tile);
+  gl.uniform2f(uniforms.uExtent, w, h);
+  gl.uniform1f(uniforms.uZoom, zoomNow());
+  gl.uniform2f(uniforms.uCenter, camera.zoom ? camera.cx : w / 2, camera.zoom ? camera.cy : h / 2);
   gl.uniform1i(uniforms.uMode, mode);
   gl.uniform3fv(uniforms.uLight, direction(light.azimuth, light.elevation));
+  const color = state ? state.params.light_color : [1, 1, 1];
+  gl.uniform3fv(uniforms.uLightColor, LIT_MODES.includes(mode) ? color : [1, 1, 1]);
+  gl.uniform1f(uniforms.uUseAlbedo, albedoUsed(mode) && m.tex.albedo ? 1 : 0);
   gl.uniform1f(uniforms.uNormalYUp, state && state.bake && state.bake.normal_y_up ? 1 : 0);
   // render's camera (job_init): towards it, the screen's right, the stretch
-  const el = clamp(Number($("view-el").value) || 30, ranges.view_elevation);
-  const view = direction(Number($("view-az").value) || 0, el);
+  const az = viewValue($("view-az"), null, 270, false);
+  const el = viewValue($("view-el"), ranges.view_elevation, 30, false);
+  const view = direction(az, el);
   let toward = [view[0], view[1]];
   const horizontal = Math.hypot(view[0], view[1]);
   if (horizontal > 1e-9) toward = [view[0] / horizontal, view[1] / horizontal];
-  else { const d = direction(Number($("view-az").value) || 0, 0); toward = [d[0], d[1]]; }
+  else { const d = direction(az, 0); toward = [d[0], d[1]]; }
   gl.uniform3fv(uniforms.uView, view);
   gl.uniform2f(uniforms.uToward, toward[0], toward[1]);
   gl.uniform2f(uniforms.uRight, toward[1], -toward[0]);
   gl.uniform1f(uniforms.uStretch, 1 / view[2]);
-  gl.uniform1f(uniforms.uDepth, bakeScale[maps.id] || (state ? state.params.scale : 1));
-  const basis = bakeBasis[maps.id];
+  gl.uniform1f(uniforms.uDepth, bakeScale[m.id] || (state ? state.params.scale : 1));
+  const basis = bakeBasis[m.id];
   if (basis && basis.length === 3) gl.uniform3fv(uniforms.uBasis, basis.flat());
   gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
   gl.finish();
-  document.body.dataset.drawnBake = String(maps.id);
+  document.body.dataset.drawnBake = String(m.id);
   document.body.dataset.drawnAt = String(Date.now());
 }
 
@@ -274,18 +426,69 @@ function showRanges() {
   bound($("view-el"), ranges.view_elevation);
 }
 
+// Why the picture is not the maps of now, or "" when it is.
+function staleReason(s) {
+  if (!s || !current) return "";
+  const of = "the picture is bake " + shown().id + "'s";
+  if (s.baking)
+    return "baking: " + (s.stage || "starting") + ", " + Math.round(100 * s.progress) + "%; " + of;
+  if (s.pending) return "a bake is waiting to start; " + of;
+  if (s.error) return s.error + "\n" + of + ", the last that baked";
+  if (s.bake && s.bake.id > current.id) return "loading bake " + s.bake.id + "; " + of;
+  if (showB && previous) return "B: bake " + previous.id + ", the one before the last";
+  return "";
+}
+
+function showStale() {
+  const why = staleReason(state);
+  $("view").classList.toggle("stale", why !== "" && !(showB && previous && !state.baking &&
+                                                       !state.pending && !state.error));
+  $("stale").textContent = why;
+}
+
+// The view's controls where they apply: the light (its colour, the colour
+// map) in the lit modes, the camera in relief.
+function showControls() {
+  const mode = Number($("mode").value), lit = LIT_MODES.includes(mode);
+  $("light-controls").classList.toggle("hidden", !lit);
+  $("light-readout").classList.toggle("hidden", !lit);
+  $("view-controls").classList.toggle("hidden", mode !== RELIEF_MODE);
+  $("albedo-label").classList.toggle("hidden", !(state && state.params.albedo_file));
+}
+
+// The command line, its words kept whole on a line (a word longer than
+// the line breaks where it must): a box per word, the blanks between them
+// (copied as they are).
+function showCommand(line) {
+  const el = $("command");
+  if (el.dataset.line === line) return;
+  el.dataset.line = line;
+  el.textContent = "";
+  line.split(" ").forEach((word, i) => {
+    if (i) el.appendChild(document.createTextNode(" "));
+    const span = document.createElement("span");
+    span.className = "word";
+    span.textContent = word;
+    el.appendChild(span);
+  });
+}
+
 function showState(s) {
   state = s;
   $("height").textContent = s.height;
-  $("command").textContent = s.command;
+  showCommand(s.command);
   $("progress").value = s.baking ? s.progress : (s.bake ? 1 : 0);
-  $("status").textContent = s.baking ? "baking... " + Math.round(100 * s.progress) + "%"
+  $("status").textContent = s.baking ? "baking: " + (s.stage || "starting") + ", " +
+                                       Math.round(100 * s.progress) + "%"
                                      : (s.bake ? "bake " + s.bake.id + " shown" : "no bake yet");
   $("error").textContent = s.error ? s.error + " (the last good maps stay shown)" : "";
   for (const p of PARAMS) {
     const input = $("p-" + p);
     if (document.activeElement !== input) input.value = s.params[p];
   }
+  if (document.activeElement !== $("light-color"))
+    $("light-color").value = s.params.light_color.map((x) => +x.toPrecision(7)).join(",");
+  $("albedo-name").textContent = s.params.albedo_file ? "(" + s.params.albedo_file + ")" : "";
   $("brightness-label").style.display = s.params.brightness_file ? "" : "none";
   $("p-brightness").checked = s.params.brightness;
   if (s.bake) {
@@ -298,8 +501,10 @@ function showState(s) {
       `pyramid ${b.seconds_pyramid.toFixed(3)}, trace ${b.seconds_trace.toFixed(3)}, ` +
       `derive ${b.seconds_derive.toFixed(3)})`;
     $("provenance").textContent = b.provenance;
-    if ((!maps || b.id > maps.id) && !loading) loadMaps().catch((e) => fail(String(e)));
+    if ((!current || b.id > current.id) && !loading) loadMaps().catch((e) => fail(String(e)));
   }
+  showControls();
+  showStale();
   requestDraw();
 }
 
@@ -327,10 +532,7 @@ async function post(path) {
   return body;
 }
 
-async function sendParams() {
-  const query = PARAMS.map((p) => p + "=" + encodeURIComponent($("p-" + p).value));
-  if (state && state.params.brightness_file)
-    query.push("brightness=" + ($("p-brightness").checked ? "on" : "off"));
+async function sendParams(query) {
   $("controls-error").textContent = "";
   try {
     showState(await post("params?" + query.join("&")));
@@ -339,9 +541,38 @@ async function sendParams() {
   }
 }
 
-for (const p of PARAMS) $("p-" + p).addEventListener("change", sendParams);
-$("p-brightness").addEventListener("change", sendParams);
-for (const id of ["mode", "tile", "view-az", "view-el"]) $(id).addEventListener("input", requestDraw);
+function sendBakeControls() {
+  const query = PARAMS.map((p) => p + "=" + encodeURIComponent($("p-" + p).value));
+  if (state && state.params.brightness_file)
+    query.push("brightness=" + ($("p-brightness").checked ? "on" : "off"));
+  sendParams(query);
+}
+
+for (const p of PARAMS) $("p-" + p).addEventListener("change", sendBakeControls);
+$("p-brightness").addEventListener("change", sendBakeControls);
+// render's --light-color, parsed and checked by the library
+$("light-color").addEventListener("change", () =>
+  sendParams(["light-color=" + encodeURIComponent($("light-color").value)]));
+$("mode").addEventListener("input", () => {
+  showControls();
+  const m = current, need = texturesOf(Number($("mode").value));
+  if (m && m.whole && need.some((t) => !m.tex[t]) && !loading) {
+    current = null;  // not all of it here yet: the bake shown again, whole
+    freeMaps(m);
+    loadMaps().catch((e) => fail(String(e)));
+  }
+  requestDraw();
+});
+$("tile").addEventListener("input", () => { showZoom(); requestDraw(); });
+$("albedo").addEventListener("input", requestDraw);
+for (const id of ["view-az", "view-el"]) {
+  $(id).addEventListener("input", requestDraw);
+  $(id).addEventListener("change", () => {
+    viewValue($("view-az"), null, 270, true);
+    viewValue($("view-el"), ranges.view_elevation, 30, true);
+    requestDraw();
+  });
+}
 
 $("write").addEventListener("click", async () => {
   $("write-result").textContent = "";
@@ -349,13 +580,14 @@ $("write").addEventListener("click", async () => {
   try {
     const r = await post("write");
     $("write-result").textContent = "wrote " + r.outputs.map((o) => o.path).join(", ") +
-      (r.from === "memory" ? " (the maps shown, not baked again)" : " (baked again: a change was pending)");
+      (r.from === "memory" ? " (the maps shown, not baked again)" : " (baked again: " + r.reason + ")");
   } catch (e) {
     $("write-error").textContent = e.message;
   }
 });
 
 showLight();
+showControls();
 setup().then(() => {
   const events = new EventSource("events");
   events.onmessage = (e) => showState(JSON.parse(e.data));

@@ -7,6 +7,7 @@
 #include "trace/bounce.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
+#include "trace/retrace.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -128,7 +129,8 @@ static void ssbump_cap(bb_image *ssbump) {
  * nothing needs it; the normal map is made after the trace, when vis is
  * gone, and ssbump without one takes its normals a band at a time. */
 static bb_status trace_and_derive(const bb_bake_options *o, int threads, int keep_vis,
-                                  bb_bake_context *context, bb_bake_result *r, bb_error *err) {
+                                  bb_bake_context *context, bb__bake_keep *keep,
+                                  bb_bake_result *r, bb_error *err) {
   double t0 = bb__now_seconds();
   bb_image z = {0};
   bb_pyramid *pyramid = NULL;
@@ -158,10 +160,16 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     }
     if (o->trace.trace)
       st = caller_trace(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+    else if (keep)
+      st = bb__trace_keeping_horizons(pyramid, &rays, &whole, keep->horizons, &r->vis,
+                                      err);
     else if (o->bounce_albedo > 0.0) /* the bounce's passes are the trace */
       r->horizons_found = (double)pyramid->width * (double)pyramid->height * rays.slice_count;
     else
       st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+    if (st == BB_OK && keep)
+      r->horizons_found =
+          (double)pyramid->width * (double)pyramid->height * rays.slice_count;
   }
   double t2 = bb__now_seconds();
   r->seconds_trace = t2 - t1;
@@ -173,7 +181,11 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   }
   if (rays_owned)
     bb__rayset_release(&rays);
-  bb_pyramid_free(pyramid);
+  if (keep && st == BB_OK)
+    keep->pyramid = pyramid; /* the kept bake's */
+  else
+    bb_pyramid_free(pyramid);
+  const int keep_filtered = wants(o, BB_MAP_BIT(BB_MAP_FILTERED)) || keep;
   const unsigned ssbump_or_bent =
       BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_BENT);
   const int normal_later = wants(o, BB_MAP_BIT(BB_MAP_NORMAL)) && !r->normal.pixels;
@@ -184,7 +196,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
                                              o->smooth.addressing, &r->vis, &o->basis, threads,
                                              &r->ssbump, err);
   if (st == BB_OK && r->ssbump.pixels && o->bounce_albedo > 0.0) ssbump_cap(&r->ssbump);
-  if (!normal_later && !wants(o, BB_MAP_BIT(BB_MAP_FILTERED)))
+  if (!normal_later && !keep_filtered)
     bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_MAP_BIT(BB_MAP_AO)))
     st = bb__derive_ao(&r->vis, threads, &r->ao, err);
@@ -193,7 +205,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
   if (st == BB_OK && normal_later)
     st = bb__normals_compute(&r->filtered, o->height_scale, o->normal_filter,
                              o->smooth.addressing, threads, NULL, &r->normal, err);
-  if (!wants(o, BB_MAP_BIT(BB_MAP_FILTERED)))
+  if (!keep_filtered)
     bb_image_free(&r->filtered);
   if (st == BB_OK && wants(o, BB_MAP_BIT(BB_MAP_BENT)))
     st = bb__derive_bent(&r->ssbump, &o->basis, threads, &r->bent, err);
@@ -247,9 +259,12 @@ static bb_status brightness(const bb_bake_options *o, int threads, bb_bake_resul
   return BB_OK;
 }
 
-/* Frees what was made only because another map needed it. */
-static void drop_unasked(const bb_bake_options *o, bb_bake_result *r) {
-  if (!wants(o, BB_MAP_BIT(BB_MAP_FILTERED))) bb_image_free(&r->filtered);
+/* Frees what was made only because another map needed it (a kept bake
+ * keeps its smoothed height). */
+static void drop_unasked(const bb_bake_options *o, const bb__bake_keep *keep,
+                         bb_bake_result *r) {
+  if (!wants(o, BB_MAP_BIT(BB_MAP_FILTERED)) && !keep)
+    bb_image_free(&r->filtered);
   if (!wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb_image_free(&r->normal);
   if (!wants(o, BB_MAP_BIT(BB_MAP_SSBUMP))) bb_image_free(&r->ssbump);
 }
@@ -264,12 +279,16 @@ bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_resu
   return st == BB_OK ? bb__bake((bb_image *)height, &prepared, 0, NULL, r, err) : st;
 }
 
-static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
-                             bb_bake_context *context, bb_bake_result *r, bb_error *err);
+static bb_status bake_stages(const bb_image *height, const bb_bake_options *o,
+                             unsigned flags, bb_bake_context *context,
+                             bb__bake_keep *keep, bb_bake_result *r, bb_error *err);
 
 bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
                    bb_bake_context *context, bb_bake_result *r, bb_error *err) {
-  bb_status st = bake_stages(height, o, flags, context, r, err);
+  const bb_region whole = {0, 0, height ? height->width : 0, height ? height->height : 0};
+  bb_status st = bake_stages(height, o, flags, context, NULL, r, err);
+  if (st == BB_OK && context)
+    bb__context_set_changed(context, whole);
   if (flags & BB__BAKE_TAKE_HEIGHT)
     bb_image_free(height);
   return st;
@@ -285,8 +304,15 @@ static bb_status check_memory(const bb_image *height, const bb_bake_options *o, 
                           what, err);
 }
 
-static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, unsigned flags,
-                             bb_bake_context *context, bb_bake_result *r, bb_error *err) {
+bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
+                           bb_bake_context *context, bb__bake_keep *keep,
+                           bb_bake_result *r, bb_error *err) {
+  return bake_stages(height, o, 0, context, keep, r, err);
+}
+
+static bb_status bake_stages(const bb_image *height, const bb_bake_options *o,
+                             unsigned flags, bb_bake_context *context,
+                             bb__bake_keep *keep, bb_bake_result *r, bb_error *err) {
   memset(r, 0, sizeof *r);
   if (!height || !height->pixels || height->channels != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: need a 1-channel height field");
@@ -306,7 +332,8 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
   const int threads = bb__thread_count(o->trace.threads);
   st = smooth_and_normals(height, o, threads, (flags & BB__BAKE_TAKE_HEIGHT) != 0, r, err);
   if (st == BB_OK && wants(o, BB_MAPS_TRACED))
-    st = trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), context, r, err);
+    st =
+        trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), context, keep, r, err);
   if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
     if (wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb_image_flip_green(&r->normal);
@@ -318,7 +345,7 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o, u
     bb_bake_result_free(r);
     return st;
   }
-  drop_unasked(o, r);
+  drop_unasked(o, keep, r);
   r->threads = threads;
   return BB_OK;
 }

@@ -13,6 +13,16 @@
 bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
                                const bb_smooth_options *o, int threads,
                                const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
+/* bb__smooth_bilateral's texels of a rectangle only, x0 .. x0+width-1 by
+ * y0 .. y0+height-1 (taken through the addressing: periodic ones may pass
+ * the sides and wrap), written into out, which already holds the whole
+ * image's smoothing: the same bits as smoothing all of it. The guide's
+ * heights must be finite. */
+bb_status bb__smooth_region(const bb_image *in, const bb_image *guide,
+                            const bb_smooth_options *o, int x0, int y0, int width,
+                            int height, int threads, bb_image *out, bb_error *err);
+/* How far (texels, along each axis) a smoothed texel reads its input. */
+int bb__smooth_reach(int radius_texels);
 bb_status bb__normals_compute(const bb_image *height, float height_scale,
                               bb_normal_filter filter, bb_addressing addressing, int threads,
                               const bb__checkpoint *checkpoint, bb_image *out, bb_error *err);
@@ -36,6 +46,17 @@ bb_status bb__derive_ssbump(const bb_image *normals, const bb_image *vis,
 bb_status bb__derive_ao(const bb_image *vis, int threads, bb_image *out, bb_error *err);
 bb_status bb__derive_bent(const bb_image *ssbump, const bb_basis *basis, int threads,
                           bb_image *out, bb_error *err);
+/* One texel of the derived maps, as the stages above make it (the same
+ * bits), for a bake that derives a few texels again: weights and ssbump of
+ * a normal n, ssbump from the texel's visibility (ao, then a channel per
+ * direction), bent from its ssbump before brightness; brightness as
+ * bb__derive_brightness scales every channel of a texel by the grey of its
+ * brightness map. */
+void bb__derive_texel_weights(const bb_basis *basis, const float n[3], float *weights);
+void bb__derive_texel_ssbump(const bb_basis *basis, const float n[3], const float *vis,
+                             float *ssbump);
+void bb__derive_texel_bent(const bb_basis *basis, const float *ssbump, float bent[3]);
+void bb__derive_texel_brightness(const float *map, int channels, float grey, float *out);
 
 
 /* The ranges of bb_bake_options' fields, the one home of each (options.c);
@@ -66,12 +87,55 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
 /* (o prepared by bb__bake_prepare: it is not checked again. context may
  * be NULL: a cold bake.) */
 
+/* What a bake whose context keeps it (rebake.c) takes from the stages:
+ * every texel's horizon in each slice, written to the caller's
+ * horizons[s] (width x height floats each), and the max-mip pyramid,
+ * handed over instead of freed (the caller frees it, on failure too). */
+typedef struct bb__bake_keep {
+  float *const *horizons;
+  bb_pyramid *pyramid;
+} bb__bake_keep;
+/* bake_stages for such a bake: nothing dropped (vis and the smoothed
+ * height stay in r whatever o asks), the same maps and bits. */
+bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
+                           bb_bake_context *context, bb__bake_keep *keep,
+                           bb_bake_result *r, bb_error *err);
+
+/* rebake.c: a bake through a context that keeps what it made
+ * (bb_bake_context_keep): again only where the height changed since the
+ * context's last bake of the same size and options, else whole; r as
+ * bb__bake fills it (flags as there, but height is not freed). changed
+ * (may be NULL) receives bb_bake_context_bake's rectangle. */
+bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_region *changed, bb_error *err);
+/* bb__bake through context: bb__context_bake when it keeps (height freed
+ * as BB__BAKE_TAKE_HEIGHT says), bb__bake otherwise. For the job. */
+bb_status bb__bake_through(bb_bake_context *context, bb_image *height,
+                           const bb_bake_options *o, unsigned flags, bb_bake_result *r,
+                           bb_error *err);
+/* The kept bake (rebake.c), held by the context (context.c): 1 when bakes
+ * through context keep (NULL: 0); what it holds (NULL: nothing); and
+ * kept in its place, freed by kept_free when it goes (the one before it
+ * goes now; NULL, NULL: nothing kept). */
+typedef struct bb__kept bb__kept;
+int bb__context_keeps(const bb_bake_context *context);
+bb__kept *bb__context_kept(const bb_bake_context *context);
+void bb__context_hold(bb_bake_context *context, bb__kept *kept,
+                      void (*kept_free)(bb__kept *));
+/* What bb_bake_context_changed says from now on. */
+void bb__context_set_changed(bb_bake_context *context, bb_region changed);
+/* For tests: 1 when the context's last bake was edit-local. */
+int bb__context_last_local(const bb_bake_context *context);
+
 /* context.c: the ray set of these parameters into *rays: context's own,
  * lent (*owned 0), built anew when the last one's parameters differ; or,
  * without a context, built for the caller to release (*owned 1). */
 bb_status bb__context_rayset(bb_bake_context *context, int slices, double power,
                              const bb_basis *basis, int threads, bb_rayset *rays,
                              int *owned, bb_error *err);
+/* 1 when two bases are the same directions of the same name. */
+int bb__same_basis(const bb_basis *a, const bb_basis *b);
 /* Ray sets the context has built (tests: 1 after two bakes alike). */
 long bb__context_rayset_builds(const bb_bake_context *context);
 

@@ -4,7 +4,9 @@
  * time, so a bake with it is a cold bake's bits), and the process's heap
  * kept from handing the bake's freed buffers back to the system, so the
  * next bake of the same size finds them mapped (no page faults, no
- * zeroing by the kernel). */
+ * zeroing by the kernel). With bb_bake_context_keep, it also holds what
+ * the last bake made, for the next to bake again only what an edit
+ * reaches (rebake.c). */
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "trace/rayset.h"
@@ -20,6 +22,12 @@ struct bb_bake_context {
   double power;
   bb_basis basis;
   long rayset_builds; /* ray sets built through the context (tests) */
+  int keep;           /* bb_bake_context_keep's */
+  bb__kept *kept;     /* what the last bake made, while keep (rebake.c's) */
+  void (*kept_free)(bb__kept *); /* and how it goes: rebake.c's, which
+                                    this file does not call by name (the
+                                    kept bake is rebake.c's business) */
+  bb_region changed;  /* what the last bake changed (bb_bake_context_changed) */
 };
 
 bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err) {
@@ -41,10 +49,43 @@ void bb_bake_context_free(bb_bake_context *c) {
     return;
   if (c->have_rays)
     bb__rayset_release(&c->rays);
+  bb__context_hold(c, NULL, NULL);
   free(c);
 }
 
-static int same_basis(const bb_basis *a, const bb_basis *b) {
+void bb_bake_context_keep(bb_bake_context *c, int keep) {
+  if (!c)
+    return;
+  c->keep = keep != 0;
+  if (!c->keep)
+    bb__context_hold(c, NULL, NULL);
+}
+
+int bb__context_keeps(const bb_bake_context *c) {
+  return c && c->keep;
+}
+
+bb__kept *bb__context_kept(const bb_bake_context *c) {
+  return c->kept;
+}
+
+void bb__context_hold(bb_bake_context *c, bb__kept *kept, void (*kept_free)(bb__kept *)) {
+  if (c->kept && c->kept != kept)
+    c->kept_free(c->kept);
+  c->kept = kept;
+  c->kept_free = kept_free;
+}
+
+void bb__context_set_changed(bb_bake_context *c, bb_region changed) {
+  if (c)
+    c->changed = changed;
+}
+
+bb_region bb_bake_context_changed(const bb_bake_context *c) {
+  return c ? c->changed : (bb_region){0, 0, 0, 0};
+}
+
+int bb__same_basis(const bb_basis *a, const bb_basis *b) {
   return a->count == b->count && strcmp(a->name, b->name) == 0 &&
          memcmp(a->vector, b->vector, sizeof a->vector) == 0;
 }
@@ -55,7 +96,8 @@ bb_status bb__context_rayset(bb_bake_context *c, int slices, double power,
   *owned = 1;
   if (!c)
     return bb__rayset_make(slices, power, basis, threads, rays, err);
-  if (!(c->have_rays && c->slices == slices && c->power == power && same_basis(&c->basis, basis))) {
+  if (!(c->have_rays && c->slices == slices && c->power == power &&
+        bb__same_basis(&c->basis, basis))) {
     bb_rayset made = {0};
     bb_status st = bb__rayset_make(slices, power, basis, threads, &made, err);
     if (st != BB_OK)

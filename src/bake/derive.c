@@ -101,24 +101,65 @@ static size_t row_start(const bb_image *img, int y) {
   return (size_t)y * (size_t)img->width;
 }
 
+/* One texel of each map, for the rows below and for a bake that derives
+ * texels one by one (bb__derive_texel_*): the same operations, so the same
+ * bits. */
+static inline void weights_texel(const double (*basis)[3], int count, const float *n,
+                                 float *out) {
+  double w[BB_MAX_BASIS], sum = 0.0;
+  for (int c = 0; c < count; c++) {
+    double s = saturate(dot3(n, basis[c]));
+    w[c] = s * s;
+    sum += w[c];
+  }
+  /* A normal facing away from every direction has no preferred one. */
+  for (int c = 0; c < count; c++)
+    out[c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / count);
+}
+
+/* v: the basis channels of the texel's visibility (after ao) */
+static inline void ssbump_texel(const double (*basis)[3], int count, const float *n,
+                                const float *v, float *s) {
+  for (int c = 0; c < count; c++)
+    s[c] = (float)(max0(dot3(n, basis[c])) * (double)v[c]);
+}
+
+static inline void bent_texel(const double (*basis)[3], int count, const float *s,
+                              float *o) {
+  double b[3] = {0.0, 0.0, 0.0};
+  for (int c = 0; c < count; c++)
+    for (int k = 0; k < 3; k++)
+      b[k] += (double)s[c] * basis[c][k];
+  double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+  /* Fully shadowed: no light direction to bend towards, so report straight up. */
+  if (!(len > 0.0)) {
+    o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
+    return;
+  }
+  for (int k = 0; k < 3; k++)
+    o[k] = (float)(b[k] / len);
+}
+
+void bb__derive_texel_weights(const bb_basis *basis, const float n[3], float *weights) {
+  weights_texel(basis->vector, basis->count, n, weights);
+}
+
+void bb__derive_texel_ssbump(const bb_basis *basis, const float n[3], const float *vis,
+                             float *ssbump) {
+  ssbump_texel(basis->vector, basis->count, n, vis + 1, ssbump);
+}
+
+void bb__derive_texel_bent(const bb_basis *basis, const float *ssbump, float bent[3]) {
+  bent_texel(basis->vector, basis->count, ssbump, bent);
+}
+
 static void weights_row(void *user, int y) {
   const derive_job *job = user;
   const bb_image *normals = job->in;
   const size_t first = row_start(normals, y), end = first + (size_t)normals->width;
-  for (size_t i = first; i < end; i++) {
-    const float *n = normals->pixels + 3 * i;
-    const int count = job->count;
-    double w[BB_MAX_BASIS], sum = 0.0;
-    for (int c = 0; c < count; c++) {
-      double s = saturate(dot3(n, job->basis[c]));
-      w[c] = s * s;
-      sum += w[c];
-    }
-    /* A normal facing away from every direction has no preferred one. */
-    float *out = job->out->pixels + (size_t)count * i;
-    for (int c = 0; c < count; c++)
-      out[c] = (float)(sum > 0.0 ? w[c] / sum : 1.0 / count);
-  }
+  for (size_t i = first; i < end; i++)
+    weights_texel(job->basis, job->count, normals->pixels + 3 * i,
+                  job->out->pixels + (size_t)job->count * i);
 }
 
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
@@ -153,13 +194,10 @@ static void ssbump_row(void *user, int y) {
   const bb_image *vis = job->vis;
   const int count = job->count;
   const size_t first = row_start(vis, y), end = first + (size_t)vis->width;
-  for (size_t i = first; i < end; i++) {
-    const float *n = job->in->pixels + 3 * i;
-    const float *v = vis->pixels + (size_t)vis->channels * i + 1; /* skip ao */
-    float *s = job->out->pixels + (size_t)count * i;
-    for (int c = 0; c < count; c++)
-      s[c] = (float)(max0(dot3(n, job->basis[c])) * (double)v[c]);
-  }
+  for (size_t i = first; i < end; i++)
+    ssbump_texel(job->basis, count, job->in->pixels + 3 * i,
+                 vis->pixels + (size_t)vis->channels * i + 1 /* skip ao */,
+                 job->out->pixels + (size_t)count * i);
 }
 
 bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
@@ -195,13 +233,10 @@ static void ssbump_of_row(const derive_job *job, const float *normals, int y) {
   const bb_image *vis = job->vis;
   const int count = job->count;
   const size_t first = row_start(vis, y);
-  for (int x = 0; x < vis->width; x++) {
-    const float *n = normals + 3 * (size_t)x;
-    const float *v = vis->pixels + (size_t)vis->channels * (first + (size_t)x) + 1;
-    float *s = job->out->pixels + (size_t)count * (first + (size_t)x);
-    for (int c = 0; c < count; c++)
-      s[c] = (float)(max0(dot3(n, job->basis[c])) * (double)v[c]);
-  }
+  for (int x = 0; x < vis->width; x++)
+    ssbump_texel(job->basis, count, normals + 3 * (size_t)x,
+                 vis->pixels + (size_t)vis->channels * (first + (size_t)x) + 1,
+                 job->out->pixels + (size_t)count * (first + (size_t)x));
 }
 
 /* Rows of texels the fused derive computes normals for at a time. */
@@ -294,22 +329,9 @@ static void bent_row(void *user, int y) {
   const bb_image *ssbump = job->in;
   const int count = job->count;
   const size_t first = row_start(ssbump, y), end = first + (size_t)ssbump->width;
-  for (size_t i = first; i < end; i++) {
-    const float *s = ssbump->pixels + (size_t)count * i;
-    double b[3] = {0.0, 0.0, 0.0};
-    for (int c = 0; c < count; c++)
-      for (int k = 0; k < 3; k++)
-        b[k] += (double)s[c] * job->basis[c][k];
-    double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    float *o = job->out->pixels + 3 * i;
-    /* Fully shadowed: no light direction to bend towards, so report straight up. */
-    if (!(len > 0.0)) {
-      o[0] = 0.0f, o[1] = 0.0f, o[2] = 1.0f;
-      continue;
-    }
-    for (int k = 0; k < 3; k++)
-      o[k] = (float)(b[k] / len);
-  }
+  for (size_t i = first; i < end; i++)
+    bent_texel(job->basis, count, ssbump->pixels + (size_t)count * i,
+               job->out->pixels + 3 * i);
 }
 
 bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
@@ -369,21 +391,33 @@ typedef struct brightness_job {
   int cap_one;  /* 1: a scaled channel holds at most 1, the texel scaled down to keep ratios */
 } brightness_job;
 
+static inline void brightness_texel(const float *in, int channels, int scaled,
+                                    int cap_one, float grey, float *out) {
+  memcpy(out, in, (size_t)channels * sizeof(float));
+  double b = (double)grey;
+  if (!(b > 0.0))
+    b = 0.0;
+  double largest = 0.0;
+  for (int c = 0; c < scaled; c++)
+    largest = fmax(largest, (double)in[c] * b);
+  if (cap_one && largest > 1.0)
+    b /= largest;
+  for (int c = 0; c < scaled; c++)
+    out[c] = (float)((double)in[c] * b);
+}
+
+void bb__derive_texel_brightness(const float *map, int channels, float grey, float *out) {
+  brightness_texel(map, channels, channels, 1, grey, out);
+}
+
 static void brightness_row(void *user, int y) {
   const brightness_job *job = user;
-  const int channels = job->map->channels, scaled = job->scaled;
+  const int channels = job->map->channels;
   const size_t first = row_start(job->map, y), end = first + (size_t)job->map->width;
-  for (size_t i = first; i < end; i++) {
-    const float *in = job->map->pixels + i * (size_t)channels;
-    float *out = job->out->pixels + i * (size_t)channels;
-    memcpy(out, in, (size_t)channels * sizeof(float));
-    double b = (double)job->grey->pixels[i];
-    if (!(b > 0.0)) b = 0.0;
-    double largest = 0.0;
-    for (int c = 0; c < scaled; c++) largest = fmax(largest, (double)in[c] * b);
-    if (job->cap_one && largest > 1.0) b /= largest;
-    for (int c = 0; c < scaled; c++) out[c] = (float)((double)in[c] * b);
-  }
+  for (size_t i = first; i < end; i++)
+    brightness_texel(job->map->pixels + i * (size_t)channels, channels, job->scaled,
+                     job->cap_one, job->grey->pixels[i],
+                     job->out->pixels + i * (size_t)channels);
 }
 
 bb_status bb__derive_brightness(const bb_image *map, int scaled, const bb_image *brightness,

@@ -237,6 +237,23 @@ static bb_status check_guide_finite(const bb_image *guide, bb_error *err) {
   return BB_OK;
 }
 
+/* The cut kernel of o's radius and the table of addressed columns for an
+ * image of in's width (smooth_job.column); free both when done. */
+static bb_status smoother_make(const bb_image *in, const bb_smooth_options *o,
+                               cut_kernel *kernel, int **column, bb_error *err) {
+  bb_status st = kernel_make(o->radius_texels, kernel, err);
+  if (st != BB_OK)
+    return st;
+  *column = malloc((size_t)(in->width + 2 * kernel->reach) * sizeof **column);
+  if (!*column) {
+    free(kernel->taps);
+    return bb__fail(err, BB_ERR_MEMORY, "smooth: cannot allocate the column table");
+  }
+  for (int i = 0; i < in->width + 2 * kernel->reach; i++)
+    (*column)[i] = bb__address(i - kernel->reach, in->width, o->addressing);
+  return BB_OK;
+}
+
 static bb_status copy_image(const bb_image *in, bb_image *out, bb_error *err) {
   bb_status st = bb_image_alloc(out, in->width, in->height, in->channels, err);
   if (st != BB_OK)
@@ -263,15 +280,9 @@ bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
     return st;
 
   cut_kernel kernel;
-  if ((st = kernel_make(o->radius_texels, &kernel, err)) != BB_OK)
+  int *column = NULL;
+  if ((st = smoother_make(in, o, &kernel, &column, err)) != BB_OK)
     return st;
-  int *column = malloc((size_t)(in->width + 2 * kernel.reach) * sizeof *column);
-  if (!column) {
-    free(kernel.taps);
-    return bb__fail(err, BB_ERR_MEMORY, "smooth: cannot allocate the column table");
-  }
-  for (int i = 0; i < in->width + 2 * kernel.reach; i++)
-    column[i] = bb__address(i - kernel.reach, in->width, o->addressing);
 
   st = bb_image_alloc(out, in->width, in->height, in->channels, err);
   if (st == BB_OK) {
@@ -284,4 +295,76 @@ bb_status bb__smooth_bilateral(const bb_image *in, const bb_image *guide,
   free(column);
   free(kernel.taps);
   return st;
+}
+
+/* ------------------------------------------------------------- regions */
+
+typedef struct region_job {
+  smooth_job smooth;
+  int x0, y0, width; /* the rectangle's left column and top row (addressed), its width */
+} region_job;
+
+/* Row `item` of the rectangle: its texels one by one, smooth_texel's sum,
+ * which the blocks of a whole row reproduce bit for bit. */
+static void smooth_region_row(void *user, int item) {
+  const region_job *job = user;
+  const bb_image *in = job->smooth.in;
+  const int reach = job->smooth.kernel->reach, w = in->width;
+  const int y = bb__address(job->y0 + item, in->height, job->smooth.addressing);
+  size_t row[2 * (MAX_REACH) + 1];
+  for (int dy = -reach; dy <= reach; dy++)
+    row[dy + reach] =
+        (size_t)bb__address(y + dy, in->height, job->smooth.addressing) * (size_t)w;
+  const size_t guide_stride = (size_t)job->smooth.guide->channels;
+  for (int i = 0; i < job->width; i++) {
+    const int x = bb__address(job->x0 + i, w, job->smooth.addressing);
+    const size_t texel = (size_t)y * (size_t)w + (size_t)x; /* row[reach] + x */
+    smooth_texel(&job->smooth, row, x,
+                 (double)job->smooth.guide->pixels[texel * guide_stride],
+                 job->smooth.out->pixels + texel * (size_t)in->channels);
+  }
+}
+
+bb_status bb__smooth_region(const bb_image *in, const bb_image *guide,
+                            const bb_smooth_options *o, int x0, int y0, int width,
+                            int height, int threads, bb_image *out, bb_error *err) {
+  bb_status st = check_arguments(in, guide, o, out, err);
+  if (st != BB_OK)
+    return st;
+  if (!out->pixels || out->width != in->width || out->height != in->height ||
+      out->channels != in->channels)
+    return bb__fail(err, BB_ERR_ARGUMENT, "smooth: the output must be the input's size");
+  if (width > in->width)
+    width = in->width;
+  if (height > in->height)
+    height = in->height;
+  if (o->radius_texels == 0) {
+    for (int j = 0; j < height; j++)
+      for (int i = 0; i < width; i++) {
+        const size_t t =
+            (size_t)bb__address(y0 + j, in->height, o->addressing) * (size_t)in->width +
+            (size_t)bb__address(x0 + i, in->width, o->addressing);
+        memcpy(out->pixels + t * (size_t)in->channels,
+               in->pixels + t * (size_t)in->channels,
+               (size_t)in->channels * sizeof(float));
+      }
+    return BB_OK;
+  }
+  cut_kernel kernel;
+  int *column = NULL;
+  if ((st = smoother_make(in, o, &kernel, &column, err)) != BB_OK)
+    return st;
+  region_job job = {
+      {in, guide, out, &kernel, (double)o->threshold, o->addressing, column},
+      x0,
+      y0,
+      width};
+  st = bb__parallel_for(height, threads, smooth_region_row, &job, NULL, NULL, err);
+  free(column);
+  free(kernel.taps);
+  return st;
+}
+
+int bb__smooth_reach(int radius_texels) {
+  return radius_texels > 0 ? cut_reach(radius_texels) : 0;
 }

@@ -19,21 +19,13 @@ typedef struct printer {
   cli_progress *progress; /* cleared before a report is printed */
 } printer;
 
-/* The library's lines of a report (bb_job_report_lines), on stdout. */
-static void put(char *text) {
-  if (text)
-    fputs(text, stdout);
-  free(text);
-  fflush(stdout);
-}
-
 static void print_report(void *user, const bb_job_report *r) {
   printer *p = user;
   cli_progress_finish(p->progress);
   p->counts[r->outcome]++;
   if (r->outcome == BB_JOB_FAILED)
     cli_error_line(r->error.message[0] ? r->error.message : bb_status_name(r->status));
-  put(bb_job_report_lines(p->o, r, p->batch, NULL));
+  cli_put_lines(bb_job_report_lines(p->o, r, p->batch, NULL));
 }
 
 int cli_run_job(const cli_run *r) {
@@ -61,7 +53,7 @@ int cli_run_job(const cli_run *r) {
       cli_error_line(err.message);
   }
   if (p.batch)
-    put(bb_job_summary_lines(p.o, name, p.counts, bb_job_count(job)));
+    cli_put_lines(bb_job_summary_lines(p.o, name, p.counts, bb_job_count(job)));
   bb_job_free(job);
   return rc;
 }

@@ -8,7 +8,8 @@
 
 #include <stdio.h>
 
-/* Exit codes of every subcommand except compare (which follows idiff). */
+/* Exit codes of every subcommand except compare and check (which follow
+ * idiff). */
 enum { BB_EXIT_OK = 0, BB_EXIT_FAILURE = 1, BB_EXIT_USAGE = 2 };
 
 /* Runs the command named argv[0] with the arguments after it: parsed
@@ -40,6 +41,7 @@ int cli_run_ssbump2normal(const cli_run *r);
 int cli_run_combine(const cli_run *r);
 int cli_run_program(const cli_run *r);
 int cli_run_compare(const cli_run *r);
+int cli_run_check(const cli_run *r);
 int cli_run_info(const cli_run *r);
 int cli_run_renderbumpflat(const cli_run *r);
 int cli_run_serve(const cli_run *r); /* serve.c */

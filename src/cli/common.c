@@ -1,4 +1,4 @@
-/* common.c: the messages, lines, command line and signal handling every
+/* common.c: the messages, lines and signal handling every
  * subcommand shares. */
 #include "common.h"
 #include "cli.h"
@@ -69,6 +69,13 @@ void cli_printf_line(const char *fmt, ...) {
   va_end(ap);
 }
 
+void cli_put_lines(char *text) {
+  if (text)
+    fputs(text, stdout);
+  free(text);
+  fflush(stdout);
+}
+
 void cli_note(void *user, const char *path, const char *text) {
   (void)user;
   char line[2048], safe[4 * sizeof line];
@@ -84,25 +91,6 @@ void cli_no_font_note(const char *command) {
           "bumpbake %s: no font found for the labels (install fonts-dejavu-core, or set "
           "BUMPBAKE_FONT to a font file); drawn without labels\n",
           command);
-}
-
-/* --------------------------------------------------------- command line */
-
-char *cli_command_line(int argc, char **argv) {
-  size_t len = strlen("bumpbake") + 1;
-  for (int i = 0; i < argc; i++)
-    len += strlen(argv[i]) + 1;
-  char *line = malloc(len);
-  if (!line) {
-    fprintf(stderr, "bumpbake: out of memory\n");
-    return NULL;
-  }
-  strcpy(line, "bumpbake");
-  for (int i = 0; i < argc; i++) {
-    strcat(line, " ");
-    strcat(line, argv[i]);
-  }
-  return line;
 }
 
 double cli_now_seconds(void) {

@@ -1,8 +1,7 @@
 /* common.h: what every subcommand prints the same way: usage errors, file
  * errors, notes and plain lines (all of them one line, with control
  * characters escaped so no file name or provenance text can drive the
- * terminal), the command line recorded in provenance, signals and the
- * clock. Nothing here is part of the library. */
+ * terminal), signals and the clock. Nothing here is part of the library. */
 #ifndef BB_CLI_COMMON_H
 #define BB_CLI_COMMON_H
 
@@ -47,6 +46,11 @@ void cli_printf_line(const char *fmt, ...)
 #endif
     ;
 
+/* The library's lines (bb_job_report_lines, bb_check_case_lines, ...: the
+ * library made them printable) on stdout, flushed; text is freed (NULL:
+ * nothing). */
+void cli_put_lines(char *text);
+
 /* The library's notes (bb_note_fn) as "bumpbake: PATH: note: TEXT" on
  * stderr. user is unused. */
 void cli_note(void *user, const char *path, const char *text);
@@ -55,12 +59,7 @@ void cli_note(void *user, const char *path, const char *text);
 void cli_no_font_note(const char *command);
 
 
-/* ------------------------------------------------- command line, signals */
-
-/* "bumpbake " + argv joined with spaces (the command line provenance
- * records), malloc'd; prints why and returns NULL when out of memory. Call
- * it before parsing: getopt_long permutes argv. */
-char *cli_command_line(int argc, char **argv);
+/* ---------------------------------------------------------------- signals */
 
 /* Installs the CLI's signal handling, first thing in main: SIGINT, SIGTERM
  * and SIGHUP remove the temporaries of writes in progress and end the

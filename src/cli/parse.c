@@ -20,6 +20,7 @@ typedef struct runner {
 static const runner runners[] = {
     {"normal", cli_run_job},          {"bake", cli_run_job},
     {"height2ssbump", cli_run_job},   {"compare", cli_run_compare},
+    {"check", cli_run_check},
     {"info", cli_run_info},           {"renderbumpflat", cli_run_renderbumpflat},
     {"render", cli_run_render},       {"sheet", cli_run_sheet},
     {"normal2ssbump", cli_run_normal2ssbump}, {"ssbump2normal", cli_run_ssbump2normal},
@@ -278,24 +279,31 @@ static int run_getopt(parse *p, int argc, char **argv, const int *map) {
   return 0;
 }
 
-/* "bumpbake NAME WORDS..." of the recorded words; options only (a batch's
- * provenance: "bumpbake bake INPUT OPTIONS") when options_only. */
+/* "bumpbake NAME WORDS..." of the recorded words, each quoted for a POSIX
+ * shell by the library (bb_text_shell_quoted); options only (a batch's
+ * provenance: "bumpbake bake INPUT OPTIONS") when options_only. NULL when
+ * out of memory. */
 static char *recorded(const parse *p, int options_only) {
-  size_t len = strlen("bumpbake ") + strlen(p->argv[0]) + 1;
-  for (int w = 1; w < p->argc; w++)
-    len += strlen(p->word[w]) + 1;
+  size_t len = strlen("bumpbake ") + strlen(p->argv[0]) + 1, used = 0;
   char *text = malloc(len);
   if (!text)
     return NULL;
   text[0] = '\0';
   if (!options_only)
-    snprintf(text, len, "bumpbake %s", p->argv[0]);
+    used = (size_t)snprintf(text, len, "bumpbake %s", p->argv[0]);
   for (int w = 1; w < p->argc; w++) {
     if (p->dropped[w] || (options_only && (!p->is_option[w] || !strcmp(p->argv[w], "--"))))
       continue;
-    if (text[0])
-      strcat(text, " ");
-    strcat(text, p->word[w]);
+    char *word = bb_text_shell_quoted(p->word[w]);
+    char *grown = word ? realloc(text, used + strlen(word) + 2) : NULL;
+    if (!grown) {
+      free(word);
+      free(text);
+      return NULL;
+    }
+    text = grown;
+    used += (size_t)sprintf(text + used, "%s%s", used ? " " : "", word);
+    free(word);
   }
   return text;
 }

@@ -20,13 +20,15 @@ static void print_summary(const char *model, const bb_renderbump_options *o,
 /* The one number the height is useless without: printed even with -q. */
 static void print_height_scale(const char *height, bb_axis axis,
                                const bb_renderbump_result *r) {
+  char *word = bb_text_shell_quoted(height); /* the line, typed in a shell */
   if (r->height_scale > 0.0)
     cli_printf_line("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)",
-                    r->height_scale, height, r->height_scale);
+                    r->height_scale, word ? word : height, r->height_scale);
   else
     cli_printf_line("height scale 0: the model is flat along %s, so its height is 0 "
                     "everywhere and a bake of it would trace nothing",
                     bb_axis_name(axis));
+  free(word);
 }
 
 int cli_run_renderbumpflat(const cli_run *r) {

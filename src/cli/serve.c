@@ -1,9 +1,9 @@
 /* serve.c: `bumpbake serve`, a bake seen live: the height baked with
  * bake's options, watched, re-baked on every save, and shown lit in the
  * browser (src/cli/serve/). This file keeps the command line's words. */
+#include "serve/serve.h"
 #include "cli.h"
 #include "common.h"
-#include "serve/serve.h"
 
 #include <arpa/inet.h>
 #include <limits.h>
@@ -53,14 +53,22 @@ int cli_run_serve(const cli_run *r) {
   s.job = named;
   s.brightness_file = a->job.brightness_file;
   s.use_brightness = s.brightness_file != NULL;
+  s.albedo_file = a->albedo; /* render's --albedo and --light-color light the picture */
+  memcpy(s.light_color, a->render.light_color, sizeof s.light_color);
   s.quiet = a->quiet;
-  /* the ray set and the buffers stay warm from one bake to the next */
-  bb_error context_err = {{0}};
-  if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
-    return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
+  /* the page's controls change a copy of the command line's command */
+  size_t handover_size = 0;
+  char *handover = bb_command_handover(r->command, &handover_size);
+  bb_error copy_err = {{0}};
+  bb_status copied = handover ? bb_command_from_handover(handover, handover_size, NULL, 0,
+                                                         &s.command, &copy_err)
+                              : BB_ERR_MEMORY;
+  free(handover);
+  if (copied != BB_OK)
+    return cli_library_error("serve", copied, &copy_err);
   s.watched[s.watched_count++] = height;
   const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
-                        a->job.basis_file};
+                        a->job.basis_file, a->albedo};
   for (size_t i = 0; i < sizeof also / sizeof also[0]; i++)
     if (also[i])
       s.watched[s.watched_count++] = also[i];
@@ -80,27 +88,45 @@ int cli_run_serve(const cli_run *r) {
   if (st != BB_OK)
     return cli_library_error("serve", st, &err);
 
+  /* the ray set and the buffers stay warm from one bake to the next, and
+   * what the last bake made: a save that changes part of the height bakes
+   * again only what the change reaches (the same bits) */
+  bb_error context_err = {{0}};
+  if (bb_bake_context_new(&s.context, &context_err) != BB_OK)
+    return cli_library_error("serve", BB_ERR_MEMORY, &context_err);
+  bb_bake_context_keep(s.context, 1);
+
+  /* Listening comes before any bake, so a port already taken ends serve
+   * before a bake starts; every thread started before a failure is
+   * stopped and joined before the command they read is freed. */
   char message[512];
-  if (serve_watch_start(&s, message, sizeof message) != 0) {
+  serve_watch *watch = NULL;
+  if (serve_watch_start(&s, &watch, message, sizeof message) != 0) {
+    bb_bake_context_free(s.context);
     cli_error_line(message);
+    return BB_EXIT_FAILURE;
+  }
+  serve_http_options http = {a->address, a->port, a->address != NULL};
+  char url[256];
+  if (serve_http_start(&s, &http, url, sizeof url) != 0) {
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
+    char line[400];
+    snprintf(line, sizeof line, "serve: %s", url);
+    cli_error_line(line);
     return BB_EXIT_FAILURE;
   }
   pthread_t baker;
   if (pthread_create(&baker, NULL, serve_bake_thread, &s) != 0) {
+    serve_http_stop(&s);
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
     cli_error_line("serve: cannot start the bake thread");
     return BB_EXIT_FAILURE;
   }
   pthread_mutex_lock(&s.lock);
   serve_request_bake(&s);
   pthread_mutex_unlock(&s.lock);
-  serve_http_options http = {a->address, a->port, a->address != NULL};
-  char url[256];
-  if (serve_http_start(&s, &http, url, sizeof url) != 0) {
-    char line[400];
-    snprintf(line, sizeof line, "serve: %s", url);
-    cli_error_line(line);
-    return BB_EXIT_FAILURE;
-  }
   printf("serve: %s (Ctrl-C stops)\n", url);
   fflush(stdout);
   for (;;)

@@ -167,6 +167,8 @@ bb_status bb__render_view_check(const bb_render_options *o, int width, int heigh
 bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
                           double *values, int *count, bb_error *err);
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t);
+/* "v0,v1,..." of n floats, each the shortest that reads back the same. */
+void bb__print_floats(bb__text *t, const float *v, int n);
 /* count numbers of text (comma-separated, or blank-separated when the
  * option takes several words) into v; BB_ERR_ARGUMENT naming the option. */
 bb_status bb__parse_numbers(const bb__option *o, const char *text, int count, int integers,
@@ -204,12 +206,36 @@ extern const bb__option bb__opt_scale, bb__opt_scale_optional, bb__opt_rays,
     bb__opt_normal_filter, bb__opt_normal_y, bb__opt_threads, bb__opt_clamp, bb__opt_channel,
     bb__opt_depth, bb__opt_depth_like_input, bb__opt_depth_of_format, bb__opt_mips,
     bb__opt_json, bb__opt_quiet, bb__opt_help, bb__opt_texture_format, bb__opt_vtf_version,
-    bb__opt_vtf_flags, bb__opt_nomip, bb__opt_fast_compression;
+    bb__opt_vtf_flags, bb__opt_nomip, bb__opt_fast_compression, bb__opt_light_color,
+    bb__opt_albedo, bb__opt_slices, bb__opt_basis, bb__opt_bounce, bb__opt_bounces,
+    bb__opt_bounce_albedo, bb__opt_brightness, bb__opt_maps, bb__opt_name;
 
 /* The options' tables (options_*.c). */
 extern const bb__command bb__command_bake, bb__command_normal, bb__command_height2ssbump,
     bb__command_compare, bb__command_info, bb__command_renderbumpflat, bb__command_render,
     bb__command_sheet, bb__command_normal2ssbump, bb__command_ssbump2normal,
-    bb__command_combine, bb__command_program, bb__command_serve;
+    bb__command_combine, bb__command_program, bb__command_serve, bb__command_check;
+
+/* The job of a checked command (cmd/command.c): bb_command_plan with the
+ * command's job options made by job_of, its inputs from first_input on,
+ * and the job's plan flags (BB__PLAN_READ_ONLY: a golden check's batch,
+ * which writes nothing). check --bake plans its batch so. */
+bb_status bb__command_plan(bb_command *c, const bb_command_hooks *hooks,
+                           bb_status (*job_of)(bb_command *c, bb_job_options *o, bb_error *err),
+                           int first_input, unsigned flags, bb_job **job, bb_error *err);
+
+/* check --bake's job options from the command's bake options
+ * (options_files.c): bake's batch into GOLDEN. */
+bb_status bb__check_job_options(bb_command *c, bb_job_options *o, bb_error *err);
+
+/* check --limits' rules (run_check.c): "SELECTOR: -option value ...",
+ * separated by ';' or new lines; SELECTOR a map kind's name or a pattern of
+ * names; the options idiff's limits, parsed and checked by compare's rows.
+ * *rules malloc'd (bb__check_rules_free), *count of them. BB_ERR_ARGUMENT
+ * naming the rule at fault. */
+struct bb__check_rule;
+bb_status bb__check_rules_parse(const char *text, struct bb__check_rule **rules, int *count,
+                                bb_error *err);
+void bb__check_rules_free(struct bb__check_rule *rules, int count);
 
 #endif /* BB_CMD_INTERNAL_H */

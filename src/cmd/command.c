@@ -145,6 +145,55 @@ bb_status bb_command_set(bb_command *c, const char *name, const char *text, bb_e
   return BB_OK;
 }
 
+/* The bytes of an option's field, or 0 for one its set function writes. */
+static size_t field_size(int field) {
+  switch (field) {
+  case BB__FIELD_INT:
+  case BB__FIELD_ENUM:
+    return sizeof(int);
+  case BB__FIELD_FLOAT:
+    return sizeof(float);
+  case BB__FIELD_DOUBLE:
+    return sizeof(double);
+  case BB__FIELD_STRING:
+    return sizeof(const char *);
+  case BB__FIELD_ANGLES:
+    return 2 * sizeof(double);
+  default:
+    return 0;
+  }
+}
+
+bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
+  if (!c || !name)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
+  const int i = bb__option_find(c->def, name);
+  if (i < 0)
+    return bb_command_set(c, name, NULL, err); /* its words for an unknown name */
+  const bb__option *o = c->def->options[i];
+  const size_t size = field_size(o->field);
+  if (o->set || o->sets.field != BB__FIELD_NONE || !size)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out",
+                    o->info.name);
+  if (!c->given[i])
+    return BB_OK;
+  /* the default is a fresh command's (its init included); a default
+   * string is a constant, never one of that command's copies */
+  bb_command *fresh = NULL;
+  bb_status st = bb_command_new(c->def->info.name, &fresh, err);
+  if (st != BB_OK)
+    return st;
+  memcpy((char *)&c->options + o->offset, (const char *)&fresh->options + o->offset,
+         size);
+  bb_command_free(fresh);
+  c->given[i] = 0;
+  c->texts[i] = NULL;
+  c->value_count[i] = 0;
+  memset(c->values[i], 0, sizeof c->values[i]);
+  c->checked = 0;
+  return BB_OK;
+}
+
 bb_status bb_command_add_input(bb_command *c, const char *text, bb_error *err) {
   if (!c || !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no input given");
@@ -278,11 +327,18 @@ bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job *
   *job = NULL;
   if (!c->def->job)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s writes no job", c->def->info.name);
+  return bb__command_plan(c, hooks, c->def->job, 0, 0, job, err);
+}
+
+bb_status bb__command_plan(bb_command *c, const bb_command_hooks *hooks,
+                           bb_status (*job_of)(bb_command *c, bb_job_options *o, bb_error *err),
+                           int first_input, unsigned flags, bb_job **job, bb_error *err) {
+  *job = NULL;
   if (!c->checked)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: the command is not checked (bb_command_check)",
                     c->def->info.name);
   bb_job_options o;
-  bb_status st = c->def->job(c, &o, err);
+  bb_status st = job_of(c, &o, err);
   if (st != BB_OK)
     return st;
   /* the provenance's command: the line as typed less what does not change
@@ -302,6 +358,16 @@ bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job *
     if (!canonical)
       return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   }
+  /* A batch's outputs name its output directory, as bake --out-dir's do,
+   * also when the command names it otherwise (check --bake's GOLDEN). */
+  if (o.out_dir && bb__option_find(c->def, "out-dir") < 0) {
+    bb__text t = {0};
+    bb__text_printf(&t, "%s%s--out-dir %s", o.command_options ? o.command_options : "",
+                    o.command_options && *o.command_options ? " " : "", o.out_dir);
+    free(canonical);
+    if (!(o.command_options = canonical = bb__text_take(&t)))
+      return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  }
   if (hooks) {
     o.note = hooks->note;
     o.note_user = hooks->note_user;
@@ -310,7 +376,8 @@ bb_status bb_command_plan(bb_command *c, const bb_command_hooks *hooks, bb_job *
   }
   /* height2ssbump's second positional is its scale, not an input */
   const int inputs = o.valve_path ? 1 : c->input_count;
-  st = bb__job_plan((const char *const *)c->inputs, inputs, &o, 1, job, err);
+  st = bb__job_plan((const char *const *)c->inputs + first_input, inputs - first_input, &o,
+                    flags | BB__PLAN_CHECKED, job, err);
   free(canonical);
   return st;
 }

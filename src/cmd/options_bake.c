@@ -162,7 +162,7 @@ const bb__option bb__opt_scale_optional = ROW_SCALE(0);
 const bb__option bb__opt_rays = ROW_RAYS(0);
 static const bb__option opt_rays_valve = ROW_RAYS('r');
 
-static const bb__option opt_slices = {
+const bb__option bb__opt_slices = {
     .info = {.name = "slices", .value_name = "A", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "from --rays",
              .help = "azimuth slices, each integrated exactly above its horizon (overrides "
@@ -196,7 +196,7 @@ const bb__option bb__opt_power = {
              .values = 1, .flags = RECORDED, .help = "exponent of the basis lobes max(0, w.B)^P"},
     .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.power), .range = &bb__range_power};
 
-static const bb__option opt_basis = {
+const bb__option bb__opt_basis = {
     .info = {.name = "basis", .value_name = "hl2|hl2+z|dirs:N|FILE", .type = BB_OPTION_TEXT,
              .count = 1, .values = 1, .flags = RECORDED,
              .help = "directions occlusion is projected on, one channel each: Half-Life 2's, N "
@@ -256,7 +256,7 @@ const bb__option bb__opt_mips = {
                      "renormalised"},
     .field = BB__FIELD_INT, .offset = AT(job.mips)};
 
-static const bb__option opt_bounce = {
+const bb__option bb__opt_bounce = {
     .info = {.name = "bounce", .value_name = "RHO", .type = BB_OPTION_NUMBER, .count = 1,
              .values = 1, .flags = RECORDED,
              .default_text = "0 (none; 1 with --bounce-albedo)",
@@ -266,7 +266,7 @@ static const bb__option opt_bounce = {
     .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.bounce_albedo),
     .range = &bb__range_bounce_albedo, .applies = bb__applies_traced};
 
-static const bb__option opt_bounces = {
+const bb__option bb__opt_bounces = {
     .info = {.name = "bounces", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "0 (until converged)",
              .applies = "--bounce RHO or --bounce-albedo FILE",
@@ -274,7 +274,7 @@ static const bb__option opt_bounces = {
     .field = BB__FIELD_INT, .offset = AT(job.bake.bounces), .range = &bb__range_bounces,
     .applies = bb__applies_bounces};
 
-static const bb__option opt_bounce_albedo = {
+const bb__option bb__opt_bounce_albedo = {
     .info = {.name = "bounce-albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED,
              .applies = "a traced map (--ssbump, --ao, --bent)",
@@ -282,7 +282,7 @@ static const bb__option opt_bounce_albedo = {
     .field = BB__FIELD_STRING, .offset = AT(job.bounce_albedo_file),
     .applies = bb__applies_traced};
 
-static const bb__option opt_brightness = {
+const bb__option bb__opt_brightness = {
     .info = {.name = "brightness", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED, .applies = "an ssbump or weights map",
              .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights (a "
@@ -342,7 +342,7 @@ static const bb__option opt_out_dir = {
              .help = "a batch: bake every HEIGHT (files, or directories of images) into DIR"},
     .field = BB__FIELD_STRING, .offset = AT(job.out_dir)};
 
-static const bb__option opt_maps = {
+const bb__option bb__opt_maps = {
     .info = {.name = "maps", .value_name = "LIST", .type = BB_OPTION_WORDS, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "normal,ssbump,ao",
@@ -350,7 +350,7 @@ static const bb__option opt_maps = {
     .names = bb__name_output_kind, .parse = bb__parse_output_kind, .set = set_maps,
     .print = print_maps};
 
-static const bb__option opt_name = {
+const bb__option bb__opt_name = {
     .info = {.name = "name", .value_name = "TEMPLATE", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = BB_JOB_DEFAULT_NAME, .range_text = "{stem} {kind} {ext}",
@@ -465,13 +465,13 @@ static const bb__option opt_scheduler = {
 /* -------------------------------------------------------------- bake */
 
 static const bb__option *const bake_options[] = {
-    &bb__opt_scale, &bb__opt_rays, &opt_slices, &bb__opt_filter_radius,
-    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &opt_basis,
+    &bb__opt_scale, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
     &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
-    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &opt_bounce, &opt_bounces,
-    &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce, &bb__opt_bounces,
+    &bb__opt_bounce_albedo, &bb__opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
     &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
-    &opt_out_dir, &opt_maps, &opt_name, &opt_keep_going, &opt_force, &opt_depfile,
+    &opt_out_dir, &bb__opt_maps, &bb__opt_name, &opt_keep_going, &opt_force, &opt_depfile,
     &bb__opt_json, &opt_quiet_bake, &bb__opt_texture_format, &bb__opt_vtf_version,
     &bb__opt_vtf_flags, &bb__opt_nomip, &bb__opt_fast_compression, &opt_vmt, &opt_materials,
     &opt_basetexture, &opt_scheduler, &bb__opt_help, NULL};
@@ -652,6 +652,33 @@ const bb__command bb__command_height2ssbump = {
              .option_count = (int)(sizeof h2s_options / sizeof h2s_options[0]) - 1},
     .options = h2s_options, .init = h2s_init, .add_input = h2s_input, .job = h2s_job};
 
+/* --------------------------------------- render's light, shared with serve */
+
+static bb_status set_light_color(bb_command *c, const bb__option *o, const char *text,
+                                 double *values, int *count, bb_error *err) {
+  bb_status st = bb__parse_numbers(o, text, 3, 0, values, err);
+  for (int k = 0; k < 3 && st == BB_OK; k++)
+    c->options.render.light_color[k] = (float)values[k];
+  *count = 3;
+  return st;
+}
+
+static void print_light_color(const bb_command *c, const bb__option *o, bb__text *t) {
+  (void)o;
+  bb__print_floats(t, c->options.render.light_color, 3);
+}
+
+const bb__option bb__opt_light_color = {
+    .info = {.name = "light-color", .value_name = "R,G,B", .type = BB_OPTION_NUMBERS,
+             .count = 3, .values = 1, .flags = RECORDED, .help = "colour of the dynamic light"},
+    .range = &bb__range_colour, .set = set_light_color, .print = print_light_color};
+
+const bb__option bb__opt_albedo = {
+    .info = {.name = "albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = RECORDED, .default_text = "white",
+             .help = "colour map multiplying the diffuse light (same size as the maps)"},
+    .field = BB__FIELD_STRING, .offset = AT(albedo)};
+
 /* --------------------------------------------------------------- serve */
 
 static const bb__range range_port = {"port", 0, 65535, 0, 1};
@@ -681,14 +708,15 @@ static const bb__option opt_address = {
 static const bb__option opt_serve_quiet = ROW_QUIET('q', "print only the URL, not each bake");
 
 static const bb__option *const serve_options[] = {
-    &bb__opt_scale, &bb__opt_rays, &opt_slices, &bb__opt_filter_radius,
-    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &opt_basis,
+    &bb__opt_scale, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
     &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
-    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &opt_bounce, &opt_bounces,
-    &opt_bounce_albedo, &opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce, &bb__opt_bounces,
+    &bb__opt_bounce_albedo, &bb__opt_brightness, &opt_out_normal, &opt_out_weights, &opt_out_ssbump,
     &opt_out_ao, &opt_out_bent, &opt_out_filtered, &opt_slope, &opt_lit, &opt_prefix,
     &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
-    &bb__opt_fast_compression, &opt_port, &opt_address, &opt_serve_quiet, &bb__opt_help, NULL};
+    &bb__opt_fast_compression, &bb__opt_light_color, &bb__opt_albedo, &opt_port, &opt_address,
+    &opt_serve_quiet, &bb__opt_help, NULL};
 
 static void serve_init(bb_command_options *o) {
   o->port = 8077; /* the documented port serve listens on unless told */
@@ -701,8 +729,9 @@ const bb__command bb__command_serve = {
              .description =
                  "Bakes HEIGHT, serves a page that shows its maps lit in the browser (the\n"
                  "ssbump under a light you drag, normal-mapped, ao, bent normal, basis\n"
-                 "weights, relief; tiled to show seams) and re-bakes when HEIGHT, or a\n"
-                 "map the options read, is saved, or when a control on the page changes.\n"
+                 "weights, relief; tiled to show seams; --albedo and --light-color as\n"
+                 "render's) and re-bakes when HEIGHT, or a map the options read, is saved,\n"
+                 "or when a control on the page changes.\n"
                  "Nothing is written until the page's \"write\" asks: then the maps are\n"
                  "written as the `bumpbake bake` line the page shows would write them\n"
                  "(PREFIX_normal.png, PREFIX_ssbump.png, PREFIX_ao.png by default, PREFIX\n"

@@ -29,33 +29,40 @@ static void print_allow_failures(const bb_command *c, const bb__option *o, bb__t
   bb__text_printf(t, "%ld", c->options.limits.allow_failures);
 }
 
-#define ROW_LIMIT(name_, value_, member_, range_, help_)                                   \
+/* idiff's limits: compare's (recorded: they decide its diff) and check's
+ * (not: a golden check's record is its bake's), the same rows else. */
+#define ROW_LIMIT(name_, value_, member_, range_, help_, flags_)                           \
   {.info = {.name = (name_), .value_name = (value_), .type = BB_OPTION_NUMBER, .count = 1, \
-            .values = 1, .flags = IDIFF, .help = (help_)},                                 \
+            .values = 1, .flags = (flags_), .help = (help_)},                              \
    .field = BB__FIELD_DOUBLE, .offset = AT(limits.member_), .range = &(range_)}
-static const bb__option opt_fail =
-    ROW_LIMIT("fail", "T", fail, bb__range_compare_threshold,
-              "a pixel fails when a channel differs by more than T");
-static const bb__option opt_fail_percent =
-    ROW_LIMIT("failpercent", "P", fail_percent, bb__range_compare_percent,
-              "failing pixels allowed, in % of all (then a warning)");
-static const bb__option opt_hard_fail =
-    ROW_LIMIT("hardfail", "T", hard_fail, bb__range_compare_threshold,
-              "fail when any difference exceeds T, even within -failpercent");
-static const bb__option opt_allow_failures = {
-    .info = {.name = "allowfailures", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
-             .values = 1, .flags = IDIFF,
-             .help = "pass when at most N pixels fail, by any amount"},
-    .range = &bb__range_compare_count, .set = set_allow_failures, .print = print_allow_failures};
-static const bb__option opt_warn =
-    ROW_LIMIT("warn", "T", warn, bb__range_compare_threshold,
-              "a pixel warns when a channel differs by more than T");
-static const bb__option opt_warn_percent =
-    ROW_LIMIT("warnpercent", "P", warn_percent, bb__range_compare_percent,
-              "warning pixels allowed, in % of all");
-static const bb__option opt_hard_warn =
-    ROW_LIMIT("hardwarn", "T", hard_warn, bb__range_compare_threshold,
-              "warn when any difference exceeds T");
+#define ROW_ALLOW_FAILURES(flags_)                                                          \
+  {.info = {.name = "allowfailures", .value_name = "N", .type = BB_OPTION_INT, .count = 1, \
+            .values = 1, .flags = (flags_),                                                \
+            .help = "pass when at most N pixels fail, by any amount"},                     \
+   .range = &bb__range_compare_count, .set = set_allow_failures,                           \
+   .print = print_allow_failures}
+#define LIMIT_ROWS(stem_, flags_)                                                           \
+  static const bb__option stem_##fail =                                                     \
+      ROW_LIMIT("fail", "T", fail, bb__range_compare_threshold,                             \
+                "a pixel fails when a channel differs by more than T", flags_);             \
+  static const bb__option stem_##fail_percent =                                             \
+      ROW_LIMIT("failpercent", "P", fail_percent, bb__range_compare_percent,                \
+                "failing pixels allowed, in % of all (then a warning)", flags_);            \
+  static const bb__option stem_##hard_fail =                                                \
+      ROW_LIMIT("hardfail", "T", hard_fail, bb__range_compare_threshold,                    \
+                "fail when any difference exceeds T, even within -failpercent", flags_);    \
+  static const bb__option stem_##allow_failures = ROW_ALLOW_FAILURES(flags_);               \
+  static const bb__option stem_##warn =                                                     \
+      ROW_LIMIT("warn", "T", warn, bb__range_compare_threshold,                             \
+                "a pixel warns when a channel differs by more than T", flags_);             \
+  static const bb__option stem_##warn_percent =                                             \
+      ROW_LIMIT("warnpercent", "P", warn_percent, bb__range_compare_percent,                \
+                "warning pixels allowed, in % of all", flags_);                             \
+  static const bb__option stem_##hard_warn =                                                \
+      ROW_LIMIT("hardwarn", "T", hard_warn, bb__range_compare_threshold,                    \
+                "warn when any difference exceeds T", flags_);
+LIMIT_ROWS(opt_, IDIFF)
+LIMIT_ROWS(opt_check_, BB_OPTION_SINGLE_DASH)
 static const bb__option opt_diff = {
     .info = {.name = "diff", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED | BB_OPTION_FILES,
@@ -105,6 +112,141 @@ const bb__command bb__command_compare = {
              .usage_exit = BB_COMPARE_CANNOT_READ,
              .option_count = (int)(sizeof compare_options / sizeof compare_options[0]) - 1},
     .options = compare_options, .init = compare_init, .check = compare_check};
+
+/* --------------------------------------------------------------- check */
+
+static const bb__option opt_limits = {
+    .info = {.name = "limits", .value_name = "RULES", .type = BB_OPTION_TEXT, .count = 1,
+             .values = 1,
+             .help = "limits by map kind or file name, idiff's options after each: \"ao: "
+                     "-fail 1e-3; *_normal.png: -fail 0.004\" (';' or a new line between "
+                     "rules, '#' a comment; the last that selects a map wins)"},
+    .field = BB__FIELD_STRING, .offset = AT(limit_rules)};
+static const bb__option opt_update = {
+    .info = {.name = "update", .type = BB_OPTION_FLAG, .flags = BB_OPTION_FILES,
+             .default_text = "off",
+             .help = "write new goldens where a map does not pass (and only there), saying "
+                     "what changed"},
+    .field = BB__FIELD_INT, .offset = AT(update)};
+static const bb__option opt_junit = {
+    .info = {.name = "junit", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = BB_OPTION_FILES,
+             .help = "write a JUnit XML report: a test case per map"},
+    .field = BB__FIELD_STRING, .offset = AT(junit)};
+static const bb__option opt_html = {
+    .info = {.name = "html", .value_name = "DIR", .type = BB_OPTION_PATH, .count = 1,
+             .values = 1, .flags = BB_OPTION_FILES,
+             .help = "write an HTML report into DIR (index.html, img/): thumbnails, and "
+                     "golden, new, difference, flip and slider of each map that does not pass"},
+    .field = BB__FIELD_STRING, .offset = AT(html)};
+static const bb__option opt_bake = {
+    .info = {.name = "bake", .type = BB_OPTION_FLAG, .flags = BB_OPTION_FILES,
+             .default_text = "off",
+             .help = "the inputs after GOLDEN are heights (files or directories), baked in "
+                     "memory as bake HEIGHT... --out-dir GOLDEN bakes them"},
+    .field = BB__FIELD_INT, .offset = AT(check_bake)};
+static const bb__option opt_check_json = {
+    .info = {.name = "json", .type = BB_OPTION_FLAG, .flags = BB_OPTION_CLIENT,
+             .default_text = "off", .help = "print a JSON line per map and one for the summary"},
+    .field = BB__FIELD_INT, .offset = AT(json)};
+static const bb__option opt_check_quiet = {
+    .info = {.name = "quiet", .short_name = 'q', .type = BB_OPTION_FLAG,
+             .flags = BB_OPTION_CLIENT, .default_text = "off",
+             .help = "print nothing; the exit code tells"},
+    .field = BB__FIELD_INT, .offset = AT(quiet)};
+
+/* The options a batch of bake takes that check --bake takes too. */
+static const bb__option *const check_bake_rows[] = {
+    &bb__opt_scale_optional, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
+    &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
+    &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads, &bb__opt_clamp,
+    &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce, &bb__opt_bounces,
+    &bb__opt_bounce_albedo, &bb__opt_brightness, &bb__opt_maps, &bb__opt_name,
+    &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
+    &bb__opt_fast_compression, NULL};
+
+static const bb__option *const check_options[] = {
+    &opt_check_fail, &opt_check_fail_percent, &opt_check_hard_fail, &opt_check_allow_failures,
+    &opt_check_warn, &opt_check_warn_percent, &opt_check_hard_warn, &opt_limits, &opt_update,
+    &opt_junit, &opt_html, &opt_bake, &bb__opt_scale_optional, &bb__opt_rays, &bb__opt_slices,
+    &bb__opt_filter_radius, &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power,
+    &bb__opt_basis, &bb__opt_normal_filter, &bb__opt_normal_y, &bb__opt_threads,
+    &bb__opt_clamp, &bb__opt_channel, &bb__opt_depth, &bb__opt_mips, &bb__opt_bounce,
+    &bb__opt_bounces, &bb__opt_bounce_albedo, &bb__opt_brightness, &bb__opt_maps,
+    &bb__opt_name, &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags,
+    &bb__opt_nomip, &bb__opt_fast_compression, &opt_check_json, &opt_check_quiet,
+    &bb__opt_help, NULL};
+
+static void check_init(bb_command_options *o) {
+  bb_compare_limits_init(&o->limits);
+}
+
+/* GOLDEN is the batch's output directory: the bake options' rules (a
+ * traced map asked, a .vtf name) then read as a batch's. */
+static bb_status check_add_input(bb_command *c, int i, const char *text, bb_error *err) {
+  if (i == 0 && !(c->options.job.out_dir = bb__command_keep(c, text)))
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  return BB_OK;
+}
+
+static int is_bake_row(const bb__option *o) {
+  for (int i = 0; check_bake_rows[i]; i++)
+    if (check_bake_rows[i] == o)
+      return 1;
+  return 0;
+}
+
+static bb_status check_check(bb_command *c, bb_error *err) {
+  const bb_command_options *o = &c->options;
+  if (!c->in_memory && !o->check_bake && c->input_count != 2)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "check GOLDEN NEW compares two trees (or files); heights to bake need "
+                    "--bake");
+  for (int i = 0; c->def->options[i] && !o->check_bake; i++)
+    if (c->given[i] && is_bake_row(c->def->options[i]))
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s is a bake's option: give --bake and heights",
+                      c->def->options[i]->info.name);
+  if (o->check_bake && !bb__given(c, "scale"))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "--scale is required with --bake (texels of displacement per unit of "
+                    "height)");
+  /* --limits' rules are read when the check is planned (bb_check_plan) */
+  bb_status st = BB_OK;
+  if (o->junit && c->input_count) {
+    const bb_output_spec junit = {.path = o->junit, .kind = "junit", .text = 1};
+    st = bb_outputs_check(&junit, 1, (const char *const *)c->inputs, c->input_count, err);
+  }
+  return st;
+}
+
+bb_status bb__check_job_options(bb_command *c, bb_job_options *o, bb_error *err) {
+  (void)err;
+  *o = c->options.job; /* out_dir: GOLDEN (check_add_input) */
+  o->force = 1;
+  return BB_OK;
+}
+
+const bb__command bb__command_check = {
+    .info = {.name = "check",
+             .summary = "check a suite of maps against goldens (trees or a bake; reports)",
+             .synopsis = "GOLDEN NEW [OPTIONS] | GOLDEN HEIGHT... --bake --scale S [OPTIONS]",
+             .description =
+                 "Compares every map with its golden as compare does (idiff's options and\n"
+                 "verdicts, the provenance diff): GOLDEN and NEW, two directories paired by\n"
+                 "relative name (a golden without a new map is MISSING, a new map without a\n"
+                 "golden EXTRA: failures) or two files; or with --bake, the heights baked in\n"
+                 "memory as bake HEIGHT... --out-dir GOLDEN bakes them, each map compared\n"
+                 "with the file it would write (nothing is written). --limits sets idiff's\n"
+                 "options per map kind or file name. --update writes the goldens of the\n"
+                 "maps that do not pass, and only those. Prints each map that does not pass\n"
+                 "and a summary. Exit: the worst map's, as idiff's: 0 pass, 1 warning,\n"
+                 "2 failure (also missing or extra), 3 different size or channels,\n"
+                 "4 unreadable file or bad arguments.",
+             .inputs = "GOLDEN NEW", .min_inputs = 2, .max_inputs = -1,
+             .usage_exit = BB_COMPARE_CANNOT_READ,
+             .option_count = (int)(sizeof check_options / sizeof check_options[0]) - 1},
+    .options = check_options, .init = check_init, .add_input = check_add_input,
+    .check = check_check};
 
 /* ---------------------------------------------------------------- info */
 

@@ -21,28 +21,6 @@ static const bb__range range_panel_size = {"panel size", 16, 4096, 0, 1};
 
 /* ----------------------------------------------------------- set & print */
 
-static bb_status set_light_color(bb_command *c, const bb__option *o, const char *text,
-                                 double *values, int *count, bb_error *err) {
-  bb_status st = bb__parse_numbers(o, text, 3, 0, values, err);
-  for (int k = 0; k < 3 && st == BB_OK; k++)
-    c->options.render.light_color[k] = (float)values[k];
-  *count = 3;
-  return st;
-}
-
-static void print_floats(bb__text *t, const float *v, int n) {
-  for (int k = 0; k < n; k++) {
-    char buf[32];
-    bb__float_text(v[k], buf, sizeof buf);
-    bb__text_printf(t, "%s%s", k ? "," : "", buf);
-  }
-}
-
-static void print_light_color(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  print_floats(t, c->options.render.light_color, 3);
-}
-
 /* --lightmap basis|R,G,B,R,G,B,R,G,B: the static light (on). */
 static bb_status set_lightmap(bb_command *c, const bb__option *o, const char *text,
                               double *values, int *count, bb_error *err) {
@@ -93,7 +71,7 @@ static void print_lightmap(const bb_command *c, const bb__option *o, bb__text *t
   }
   for (int l = 0; l < 3; l++) {
     bb__text_add(t, l ? "," : "");
-    print_floats(t, r->lightmap[l], 3);
+    bb__print_floats(t, r->lightmap[l], 3);
   }
 }
 
@@ -162,11 +140,6 @@ static const bb__option opt_light = {
     .sets = {BB__FIELD_INT, AT(render.dynamic_light), 1, NULL},
     .range = &bb__range_light_elevation, .range_of = "elevation"};
 
-static const bb__option opt_light_color = {
-    .info = {.name = "light-color", .value_name = "R,G,B", .type = BB_OPTION_NUMBERS,
-             .count = 3, .values = 1, .flags = RECORDED, .help = "colour of the dynamic light"},
-    .range = &bb__range_colour, .set = set_light_color, .print = print_light_color};
-
 static const bb__option opt_lightmap = {
     .info = {.name = "lightmap", .value_name = "basis|R,G,B,R,G,B,R,G,B",
              .type = BB_OPTION_TEXT, .count = 1, .values = 1, .flags = RECORDED,
@@ -212,12 +185,6 @@ static const bb__option opt_in_bent = ROW_MAP_IN(
 static const bb__option opt_in_slope =
     ROW_MAP_IN("slope", BB_MAP_SLOPE,
                "baked flipcode slope map for --mode slope (instead of HEIGHT)", NULL);
-
-static const bb__option opt_albedo = {
-    .info = {.name = "albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
-             .values = 1, .flags = RECORDED, .default_text = "white",
-             .help = "colour map multiplying the diffuse light (same size as the maps)"},
-    .field = BB__FIELD_STRING, .offset = AT(albedo)};
 
 static const bb__option opt_albedo_mode = {
     .info = {.name = "albedo-mode", .type = BB_OPTION_WORD, .count = 1, .values = 1,
@@ -284,8 +251,8 @@ static const bb__option *const render_options[] = {
     &bb__opt_scale_optional, &bb__opt_rays, &bb__opt_filter_radius, &bb__opt_filter_threshold,
     &bb__opt_bias, &bb__opt_power, &bb__opt_normal_filter, &opt_normal_y_maps,
     &bb__opt_threads, &bb__opt_clamp, &bb__opt_channel, &opt_in_normal, &opt_in_ssbump,
-    &opt_in_ao, &opt_in_bent, &opt_in_slope, &opt_mode, &opt_light, &opt_light_color,
-    &opt_lightmap, &opt_specular, &opt_specular_strength, &opt_albedo, &opt_albedo_mode,
+    &opt_in_ao, &opt_in_bent, &opt_in_slope, &opt_mode, &opt_light, &bb__opt_light_color,
+    &opt_lightmap, &opt_specular, &opt_specular_strength, &bb__opt_albedo, &opt_albedo_mode,
     &opt_compare, &opt_tile, &opt_crop, &opt_orbit, &opt_view, &opt_relief, &opt_output,
     &bb__opt_depth, &bb__opt_quiet, &bb__opt_help, NULL};
 
@@ -419,7 +386,7 @@ const bb__command bb__command_render = {
 static const bb__option *const sheet_options[] = {
     &bb__opt_scale, &bb__opt_rays, &bb__opt_filter_radius, &bb__opt_filter_threshold,
     &bb__opt_bias, &bb__opt_power, &bb__opt_normal_filter, &bb__opt_threads, &bb__opt_clamp,
-    &bb__opt_channel, &opt_mode, &opt_light, &opt_light_color, &opt_lightmap, &opt_specular,
+    &bb__opt_channel, &opt_mode, &opt_light, &bb__opt_light_color, &opt_lightmap, &opt_specular,
     &opt_specular_strength, &opt_panel_size, &opt_output, &bb__opt_depth, &bb__opt_quiet,
     &bb__opt_help, NULL};
 

@@ -6,7 +6,7 @@
 
 const bb__command *const bb__commands[] = {
     &bb__command_normal, &bb__command_bake, &bb__command_height2ssbump,
-    &bb__command_compare, &bb__command_info, &bb__command_renderbumpflat,
+    &bb__command_compare, &bb__command_check, &bb__command_info, &bb__command_renderbumpflat,
     &bb__command_render, &bb__command_sheet, &bb__command_normal2ssbump,
     &bb__command_ssbump2normal, &bb__command_combine, &bb__command_program,
     &bb__command_serve,

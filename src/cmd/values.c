@@ -251,6 +251,14 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
   return bb__fail(err, BB_ERR_ARGUMENT, "%s: no parser", name);
 }
 
+void bb__print_floats(bb__text *t, const float *v, int n) {
+  for (int k = 0; k < n; k++) {
+    char buf[32];
+    bb__float_text(v[k], buf, sizeof buf);
+    bb__text_printf(t, "%s%s", k ? "," : "", buf);
+  }
+}
+
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
   const void *field = field_of_const(c, o);
   char buf[48];

@@ -57,6 +57,22 @@ bb_status bb__parse_name(const char *what, const char *name, const char *const *
  * Names are compared exactly, as the library spells them. */
 bb_map_kind bb__map_kind_of_output(const char *kind, bb_range range, uint32_t *vtf_flags);
 
+/* What a map's provenance records of one key (bb_map_kind_records, the
+ * rule's one home, map_kind.c): the key's value, nothing, or of a ray
+ * set's id only the scheme and slices (ao without inter-reflection:
+ * "bb-horizon-v1:a16", the lobes' power and basis leave it). */
+typedef enum bb__key_use {
+  BB__KEY_DROPPED = 0,
+  BB__KEY_RECORDED,
+  BB__KEY_SLICES
+} bb__key_use;
+bb__key_use bb__map_kind_key(const char *kind, const char *key, size_t key_length,
+                             int bounce);
+
+/* The length of a ray set's id (length bytes at id, not terminated) up to
+ * its slices: "bb-horizon-v1:a16" of "bb-horizon-v1:a16:p1:hl2". */
+size_t bb__rayset_slices_length(const char *id, size_t length);
+
 /* ----------------------------------------------------------------- ranges */
 
 /* The range of one parameter, written once where the parameter's struct
@@ -164,6 +180,9 @@ typedef struct bb__text {
 void bb__text_append(bb__text *t, const char *s, size_t n);
 /* Appends the string s. */
 void bb__text_add(bb__text *t, const char *s);
+/* Appends word quoted for a POSIX shell, as bb_text_shell_quoted spells it:
+ * every command line the library spells puts its words through it. */
+void bb__text_add_word(bb__text *t, const char *word);
 
 /* Checks of images, with the same words in every family (image_checks.c). */
 /* BB_ERR_VALUE naming the first texel whose channels 0..channels-1 are not

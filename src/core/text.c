@@ -1,6 +1,7 @@
 /* text.c: the library's one growable text (bb__text, core/internal.h), for
- * provenance and the command lines it records, and numbers spelled the
- * shortest way that reads back as the same value. */
+ * provenance and the command lines it records, a word quoted for a POSIX
+ * shell (those command lines' words), and numbers spelled the shortest way
+ * that reads back as the same value. */
 
 #include "core/internal.h"
 
@@ -32,6 +33,47 @@ void bb__text_append(bb__text *t, const char *s, size_t n) {
 void bb__text_add(bb__text *t, const char *s) {
   if (s) /* a string not set adds nothing */
     bb__text_append(t, s, strlen(s));
+}
+
+/* A byte no POSIX shell (nor bash) treats specially anywhere in a word:
+ * letters, digits, "@%+=:,./-_" and the bytes of UTF-8 beyond ASCII. */
+static int shell_plain(unsigned char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+         c >= 0x80 || (c && strchr("@%+=:,./-_", c));
+}
+
+void bb__text_add_word(bb__text *t, const char *word) {
+  if (!word)
+    return;
+  int plain = word[0] != '\0';
+  for (const char *p = word; *p && plain; p++)
+    plain = shell_plain((unsigned char)*p);
+  if (plain) {
+    bb__text_add(t, word);
+    return;
+  }
+  /* Single quotes keep every byte as it is; a quote ends them, is given
+   * escaped, and they start again: it's -> 'it'\''s'. */
+  bb__text_add(t, "'");
+  for (const char *p = word, *q; *p; p = q) {
+    q = strchr(p, '\'');
+    if (!q) {
+      bb__text_add(t, p);
+      break;
+    }
+    bb__text_append(t, p, (size_t)(q - p));
+    bb__text_add(t, "'\\''");
+    q++;
+  }
+  bb__text_add(t, "'");
+}
+
+char *bb_text_shell_quoted(const char *word) {
+  if (!word)
+    return NULL;
+  bb__text t = {0};
+  bb__text_add_word(&t, word);
+  return bb__text_take(&t);
 }
 
 void bb__text_printf(bb__text *t, const char *fmt, ...) {

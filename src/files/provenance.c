@@ -64,6 +64,40 @@ int bb_provenance_value(const char *description, const char *key, char *out, siz
   return 1;
 }
 
+/* What decides which keys of a text count: the kind it records ("output")
+ * and whether its bake reflected light (a "bounce" key), by the rule of
+ * bb_map_kind_records, so a key a map does not depend on is neither a
+ * difference nor a reason to bake again, also in a text written before
+ * the rule that records it. */
+typedef struct text_kind {
+  char kind[64]; /* "" (any key counts) when there is none or it is too long */
+  int bounce;
+} text_kind;
+
+static void kind_of(const char *text_, text_kind *k) {
+  entry e;
+  k->kind[0] = '\0';
+  if (find_entry(text_, "output", 6, &e) && e.value_length < sizeof k->kind) {
+    memcpy(k->kind, e.value, e.value_length);
+    k->kind[e.value_length] = '\0';
+  }
+  k->bounce = find_entry(text_, "bounce", 6, &e);
+}
+
+/* 0 when neither kind records e's key (a diff of two texts, or a file
+ * against what writing it would make, counts a key either side's kind
+ * records); else 1, e's value cut to what they record of it. */
+static int kinds_record(const text_kind *a, const text_kind *b, entry *e) {
+  const bb__key_use ua = bb__map_kind_key(a->kind, e->key, e->key_length, a->bounce);
+  const bb__key_use ub = bb__map_kind_key(b->kind, e->key, e->key_length, b->bounce);
+  if (ua == BB__KEY_RECORDED || ub == BB__KEY_RECORDED)
+    return 1;
+  if (ua == BB__KEY_DROPPED && ub == BB__KEY_DROPPED)
+    return 0;
+  e->value_length = bb__rayset_slices_length(e->value, e->value_length);
+  return 1;
+}
+
 static int is_ignored_key(const entry *e) {
   /* The command line names temporary paths and "output" the map kind; both
    * differ between a golden and a re-bake without any pixel changing. */
@@ -140,9 +174,11 @@ static int by_order(const void *p, const void *q) {
   return (x->order > y->order) - (x->order < y->order);
 }
 
-/* Returns 0, or -1 when out of memory. with_ignored: "command" and "output"
- * count too. */
-static int index_entries(const char *text_, entry_index *index, int with_ignored) {
+/* Returns 0, or -1 when out of memory. kinds NULL: every key counts, as
+ * written ("command", "output" and the keys the kind does not record, as
+ * bb_provenance_entries reads them); else those a diff compares, the keys
+ * either of kinds[0..1] records. */
+static int index_entries(const char *text_, entry_index *index, const text_kind *kinds) {
   size_t lines = 1;
   for (const char *c = text_; *c; c++)
     lines += *c == '\n';
@@ -153,7 +189,8 @@ static int index_entries(const char *text_, entry_index *index, int with_ignored
   entry e;
   const char *cursor = text_;
   for (size_t order = 0; next_entry(&cursor, &e); order++)
-    if (e.key_length && (with_ignored || !is_ignored_key(&e)))
+    if (e.key_length &&
+        (!kinds || (!is_ignored_key(&e) && kinds_record(&kinds[0], &kinds[1], &e))))
       index->entries[index->count++] = (keyed_entry){e, order};
   qsort(index->entries, index->count, sizeof *index->entries, by_key_then_order);
   /* A repeated key: only its first occurrence counts. */
@@ -187,7 +224,10 @@ int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   if (!a || !b)
     return 0;
   entry_index ia = {0}, ib = {0};
-  if (index_entries(a, &ia, 0) != 0 || index_entries(b, &ib, 0) != 0) {
+  text_kind kinds[2];
+  kind_of(a, &kinds[0]);
+  kind_of(b, &kinds[1]);
+  if (index_entries(a, &ia, kinds) != 0 || index_entries(b, &ib, kinds) != 0) {
     free(ia.entries);
     free(ib.entries);
     return -1;
@@ -222,7 +262,7 @@ long bb_provenance_entries(const char *description, bb_provenance_entry *entries
   if (!description)
     return 0;
   entry_index index = {0};
-  if (index_entries(description, &index, 1) != 0)
+  if (index_entries(description, &index, NULL) != 0)
     return -1;
   qsort(index.entries, index.count, sizeof *index.entries, by_order);
   for (size_t i = 0; i < index.count && i < cap && entries; i++) {
@@ -250,10 +290,14 @@ static int is_listed(const entry *e, const char *const *keys) {
 static int first_missing(const char *from, const char *other, int from_is_have,
                          const char *const *ignored, char *reason, size_t cap) {
   entry e, o;
+  text_kind kinds[2];
+  kind_of(from, &kinds[0]);
+  kind_of(other, &kinds[1]);
   for (const char *cursor = from; next_entry(&cursor, &e);) {
-    if (!e.key_length || is_listed(&e, ignored))
+    if (!e.key_length || is_listed(&e, ignored) || !kinds_record(&kinds[0], &kinds[1], &e))
       continue;
-    int found = find_entry(other, e.key, e.key_length, &o);
+    int found = find_entry(other, e.key, e.key_length, &o) &&
+                kinds_record(&kinds[0], &kinds[1], &o);
     if (found && same_value(&e, &o))
       continue;
     size_t used = 0;

@@ -31,6 +31,14 @@ bb_status bb__image_read_channels(const char *path, int first_channel, int chann
                                   bb_image *out, bb_image_info *info, bb_error *err);
 
 
+/* What bb_image_read of path gives back of img written there at depth
+ * (BB_DEPTH_DEFAULT: the format's) with range, bit for bit, made in memory
+ * (as_read.c): the top level, a mip chain's too. Allocates out.
+ * BB_ERR_FORMAT for an engine texture (.vtf, .dds: its blocks are made by
+ * writing it) or an unknown extension. */
+bb_status bb__image_as_read(const char *path, const bb_image *img, bb_depth depth,
+                            bb_range range, bb_image *out, bb_error *err);
+
 /* The filter of a map's mip chain (mips.c): a normal map's levels
  * renormalised, any other's averaged. */
 bb_mip_filter bb__mip_filter(int normal_map);

@@ -30,6 +30,13 @@ bb_status bb__oiio_read_header(const char *path, int *width, int *height, int *c
 bb_status bb__oiio_level_count(const char *path, int *levels, bb_error *err);
 bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err);
 
+/* The n floats a read hands back of samples stored at depth: samples are
+ * codes (uint8_t for BB_DEPTH_8, uint16_t for BB_DEPTH_16) scaled as a read
+ * of an integer file scales them, or floats (BB_DEPTH_HALF) rounded to half
+ * as a write rounds them and widened again. */
+bb_status bb__oiio_samples_as_read(const void *samples, int depth, size_t n, float *out,
+                                   bb_error *err);
+
 /* OpenImageIO's "extension_list" ("tiff:tif,tiff;png:png;..."), malloc'd,
  * or NULL. */
 char *bb__oiio_extension_list(void);

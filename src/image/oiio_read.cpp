@@ -20,6 +20,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -354,6 +355,36 @@ bb_status bb__oiio_frame_count(const char *path, int *frames, bb_error *err) {
     while (n < 1000000 && opened.in->seek_subimage(n, 0)) n++;
     (void)opened.in->geterror(); // seeking past the last subimage records an error
     *frames = n;
+    return BB_OK;
+  });
+}
+
+bb_status bb__oiio_samples_as_read(const void *samples, int depth, size_t n, float *out,
+                                   bb_error *err) {
+  return bb::guard(err, "samples", bb::READING, [&] {
+    // OpenImageIO's own conversions, in pieces of an int's count: the
+    // floats a read of such a file hands back (codes scaled by 1 / max
+    // code; half floats widened), and a write's float-to-half rounding.
+    const TypeDesc stored = depth == BB_DEPTH_8    ? TypeDesc::UINT8
+                            : depth == BB_DEPTH_16 ? TypeDesc::UINT16
+                                                   : TypeDesc::HALF;
+    const size_t piece = (size_t)1 << 28;
+    std::unique_ptr<std::uint16_t[]> halves;
+    if (depth == BB_DEPTH_HALF) halves.reset(new std::uint16_t[n < piece ? n : piece]);
+    for (size_t at = 0; at < n; at += piece) {
+      const int count = (int)(n - at < piece ? n - at : piece);
+      bool ok;
+      if (depth == BB_DEPTH_HALF) {
+        ok = OIIO::convert_pixel_values(TypeDesc::FLOAT, (const float *)samples + at,
+                                        TypeDesc::HALF, halves.get(), count) &&
+             OIIO::convert_pixel_values(TypeDesc::HALF, halves.get(), TypeDesc::FLOAT,
+                                        out + at, count);
+      } else {
+        const char *from = (const char *)samples + at * stored.size();
+        ok = OIIO::convert_pixel_values(stored, from, TypeDesc::FLOAT, out + at, count);
+      }
+      if (!ok) return bb__fail(err, BB_ERR_FORMAT, "samples: cannot convert them");
+    }
     return BB_OK;
   });
 }

@@ -1,7 +1,8 @@
 /* command.c: the "command" a job's outputs record in their provenance: the
  * caller's command line when it gave one, else the bake's options written
  * out as `bumpbake bake` spells them, so the same job writes the same bytes
- * from the command line and from Python. */
+ * from the command line and from Python. Every word is quoted for a POSIX
+ * shell (bb__text_add_word): typed in one, the line is that job. */
 #include "core/internal.h"
 #include "job/job_internal.h"
 
@@ -15,7 +16,7 @@ static void add_option(bb__text *t, const char *name, const char *value) {
   bb__text_add(t, name);
   if (value) {
     bb__text_add(t, " ");
-    bb__text_add(t, value);
+    bb__text_add_word(t, value);
   }
 }
 
@@ -170,7 +171,7 @@ char *bb_job_command_text(const bb_job_options *o, const char *input) {
     return NULL;
   bb__text t = {0};
   bb__text_add(&t, "bumpbake bake ");
-  bb__text_add(&t, input);
+  bb__text_add_word(&t, input);
   add_settings(&t, o);
   add_outputs(&t, o);
   add_texture(&t, o);
@@ -189,10 +190,12 @@ char *bb__job_command_of(const bb_job *job, const bb__job_item *item) {
     as_given.bake.slices = job->asked_slices;
     return bb_job_command_text(&as_given, item->input);
   }
-  /* "bumpbake bake INPUT OPTIONS", as a batch run by hand records it. */
+  /* "bumpbake bake INPUT OPTIONS", as a batch run by hand records it (the
+   * options as the caller's record quoted them, or as bb__add_options
+   * does). */
   bb__text t = {0};
   bb__text_add(&t, "bumpbake bake ");
-  bb__text_add(&t, item->input);
+  bb__text_add_word(&t, item->input);
   if (job->command_options[0]) {
     bb__text_add(&t, " ");
     bb__text_add(&t, job->command_options);

@@ -95,6 +95,7 @@ struct bb_job {
   int count;
   int batch;                /* 1: out_dir names the outputs */
   char prerequisite_basis;  /* 1: basis_file is a prerequisite (a vectors basis) */
+  char read_only;           /* 1: planned with BB__PLAN_READ_ONLY */
 };
 
 /* The most bytes reading, baking and writing item's input of w x h texels
@@ -131,10 +132,38 @@ unsigned bb__job_maps_asked(const bb_job_options *o);
  * "normal+ao", "detail-ssbump+height"... */
 const char *bb__job_valve_kind(const bb_job_options *o);
 
-/* bb_job_plan; options_checked 1: o's bake options were checked already
- * (a command's, cmd/plan.c) and are only resolved (bb__bake_resolve). */
+/* bb_job_plan; flags: BB__PLAN_CHECKED: o's bake options were checked
+ * already (a command's, cmd/plan.c) and are only resolved
+ * (bb__bake_resolve); BB__PLAN_READ_ONLY: a plan whose outputs are read,
+ * not written (a golden check): no directory is made, and none need exist. */
+#define BB__PLAN_CHECKED 1u
+#define BB__PLAN_READ_ONLY 2u
 bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                       int options_checked, bb_job **out, bb_error *err);
+                       unsigned flags, bb_job **out, bb_error *err);
+
+/* A batch's name template's fields {stem}, {kind} and {ext} ("{{" and "}}"
+ * are braces) expanded with fields[0..2] into out (capacity cap): the name
+ * of a map (plan.c), or with "*" for stem and extension the pattern of the
+ * names a template can give a kind (a golden check's). */
+bb_status bb__job_expand_name(const char *tmpl, const char *const fields[3], char *out,
+                              size_t cap, bb_error *err);
+
+/* bb_outputs_check; directories 0: leaves out the check of the outputs'
+ * directories and of what their names hold now (paths.c). */
+bb_status bb__outputs_check(const bb_output_spec *outputs, int count, const char *const *reads,
+                            int read_count, int directories, bb_error *err);
+
+/* What a golden check needs of a batch's maps (run.c), after input i was
+ * baked by this job (bb_job_bake_item, its report filled): the depth map
+ * kind is written with; the provenance text it records (malloc'd, NULL when
+ * out of memory); and the maps of `maps` (BB_MAP_BIT(kind)s; 0: none)
+ * written from result as bb_job_write_item writes them, all or nothing,
+ * the other files of the input left as they are. */
+bb_depth bb__job_map_depth(const bb_job *job, int i, int kind);
+char *bb__job_map_description(const bb_job *job, int i, const bb_bake_result *result,
+                              int kind);
+bb_status bb__job_write_maps(bb_job *job, int i, const bb_bake_result *result, unsigned maps,
+                             bb_error *err);
 
 /* The provenance "command" of item i (malloc'd, NULL when out of memory). */
 char *bb__job_command_of(const bb_job *job, const bb__job_item *item);

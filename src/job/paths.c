@@ -218,6 +218,11 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
 
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err) {
+  return bb__outputs_check(outputs, count, reads, read_count, 1, err);
+}
+
+bb_status bb__outputs_check(const bb_output_spec *outputs, int count, const char *const *reads,
+                            int read_count, int directories, bb_error *err) {
   if (count < 0 || (count > 0 && !outputs) || read_count < 0 || (read_count > 0 && !reads))
     return bb__fail(err, BB_ERR_ARGUMENT, "outputs check: bad arguments");
   /* Each name is looked up once; the comparisons are then in memory, so
@@ -247,7 +252,7 @@ bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
     for (int r = 0; r < read_count && st == BB_OK; r++)
       if (reads[r] && bb__same_file_identity(&in[r], &ids[k]))
         st = bb__fail(err, BB_ERR_IO, "%s: output would overwrite the input file", o->path);
-    if (st == BB_OK)
+    if (st == BB_OK && directories)
       st = bb__check_output_directory(o->path, err);
     if (st == BB_OK && !o->text)
       st = check_format(o, 1, err);

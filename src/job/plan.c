@@ -226,10 +226,8 @@ static bb_status check_inside(const char *tmpl, const char *input, const char *n
   return BB_OK;
 }
 
-/* Expands the template's fields {stem}, {kind} and {ext} ("{{" and "}}" are
- * braces) into out (capacity cap). */
-static bb_status expand_name(const char *tmpl, const char *const fields[3], char *out,
-                             size_t cap, bb_error *err) {
+bb_status bb__job_expand_name(const char *tmpl, const char *const fields[3], char *out,
+                              size_t cap, bb_error *err) {
   static const char *const names[3] = {"stem", "kind", "ext"};
   size_t used = 0;
   for (const char *s = tmpl; *s;) {
@@ -276,7 +274,7 @@ static bb_status name_outputs(bb_job *job, bb__job_item *item, bb_error *err) {
     if (!(job->options.bake.outputs & BB_MAP_BIT(k)))
       continue;
     const char *fields[3] = {stem, kind_name(k), ext};
-    bb_status st = expand_name(tmpl, fields, name, sizeof name, err);
+    bb_status st = bb__job_expand_name(tmpl, fields, name, sizeof name, err);
     if (st == BB_OK)
       st = check_inside(tmpl, item->input, name, err);
     if (st != BB_OK)
@@ -455,7 +453,8 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
                                   BB_RANGE_UNIT, NULL};
   }
   const char *reads[BB__JOB_MAX_READS];
-  bb_status st = bb_outputs_check(specs, n, reads, bb__job_reads(job, item, reads), err);
+  bb_status st =
+      bb__outputs_check(specs, n, reads, bb__job_reads(job, item, reads), !job->read_only, err);
   for (int i = 0; i < maps && st == BB_OK; i++)
     st = check_channels(job, specs[i].path, kinds[i], err);
   return st;
@@ -801,7 +800,7 @@ static void init_reports(bb_job *job) {
 }
 
 bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                       int options_checked, bb_job **out, bb_error *err) {
+                       unsigned flags, bb_job **out, bb_error *err) {
   if (!out || !o || (input_count > 0 && !inputs))
     return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
   *out = NULL;
@@ -812,7 +811,8 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
   if (!job)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   st = copy_options(job, o, err);
-  if (st == BB_OK && options_checked)
+  job->read_only = (flags & BB__PLAN_READ_ONLY) != 0;
+  if (st == BB_OK && (flags & BB__PLAN_CHECKED))
     bb__bake_resolve(&job->options.bake);
   else if (st == BB_OK)
     st = bb__bake_prepare(&job->options.bake, &job->options.bake, err);
@@ -838,7 +838,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = name_outputs(job, &job->items[i], err);
   if (st == BB_OK && job->batch)
     st = check_batch_paths(job, err);
-  if (st == BB_OK)
+  if (st == BB_OK && !job->read_only)
     st = create_directories(job, err);
   for (int i = 0; i < job->count && st == BB_OK; i++)
     st = check_item_outputs(job, &job->items[i], err);

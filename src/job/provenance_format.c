@@ -47,61 +47,104 @@ static void put_double(bb__text *t, const char *key, double value) {
   put(t, key, buf);
 }
 
-/* The basis by name; a caller's vectors (named by their hash) are also
- * written out, "x y z" per direction joined by "; " (a basis file's lines),
- * so the file records what to bake it again with. */
-static void put_basis(bb__text *t, const bb_basis *b) {
-  put(t, "basis", b->name);
-  if (strncmp(b->name, "vectors:", 8) != 0 || b->count < 1 || b->count > BB_MAX_BASIS)
-    return;
-  char line[BB_MAX_BASIS * 3 * 26 + 1];
-  size_t used = 0;
-  line[0] = '\0';
-  for (int c = 0; c < b->count; c++)
-    for (int k = 0; k < 3; k++) {
-      char number[32];
-      format_double(number, sizeof number, b->vector[c][k]);
-      used += (size_t)snprintf(line + used, sizeof line - used, "%s%s",
-                               k ? " " : (c ? "; " : ""), number);
-    }
-  put(t, "basis_vectors", line);
-}
-
 static void put_int(bb__text *t, const char *key, long value) {
   char buf[32];
   snprintf(buf, sizeof buf, "%ld", value);
   put(t, key, buf);
 }
 
-static void put_scale_and_rays(bb__text *t, const bb_bake_options *o) {
-  put_float(t, "scale", o->height_scale);
-  put_int(t, "rays", o->rays);
+/* A bake's parameter, put only when the output's kind records it
+ * (bb_map_kind_records: a normal map does not record the trace's). */
+typedef struct bake_keys {
+  bb__text *t;
+  const char *kind;
+  int bounce;
+} bake_keys;
+
+static int records(const bake_keys *k, const char *key) {
+  return bb__map_kind_key(k->kind, key, strlen(key), k->bounce) != BB__KEY_DROPPED;
 }
 
-static void put_smoothing_and_tracing(bb__text *t, const bb_bake_options *o) {
-  put_int(t, "filter_radius", o->smooth.radius_texels);
-  put_float(t, "filter_threshold", o->smooth.threshold);
-  put_double(t, "bias", o->trace.bias_texels);
-  put_double(t, "power", o->power);
-  put_basis(t, &o->basis);
-  put(t, "normal_filter", bb_normal_filter_name(o->normal_filter));
-  put(t, "normal_y", o->normal_y_up ? "up" : "down");
-  put(t, "addressing", o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
+static void put_bake(const bake_keys *k, const char *key, const char *value) {
+  if (records(k, key))
+    put(k->t, key, value);
+}
+
+static void put_bake_float(const bake_keys *k, const char *key, float value) {
+  if (records(k, key))
+    put_float(k->t, key, value);
+}
+
+static void put_bake_double(const bake_keys *k, const char *key, double value) {
+  if (records(k, key))
+    put_double(k->t, key, value);
+}
+
+static void put_bake_int(const bake_keys *k, const char *key, long value) {
+  if (records(k, key))
+    put_int(k->t, key, value);
+}
+
+/* The basis by name; a caller's vectors (named by their hash) are also
+ * written out, "x y z" per direction joined by "; " (a basis file's lines),
+ * so the file records what to bake it again with. */
+static void put_basis(const bake_keys *k, const bb_basis *b) {
+  put_bake(k, "basis", b->name);
+  if (strncmp(b->name, "vectors:", 8) != 0 || b->count < 1 || b->count > BB_MAX_BASIS)
+    return;
+  char line[BB_MAX_BASIS * 3 * 26 + 1];
+  size_t used = 0;
+  line[0] = '\0';
+  for (int c = 0; c < b->count; c++)
+    for (int i = 0; i < 3; i++) {
+      char number[32];
+      format_double(number, sizeof number, b->vector[c][i]);
+      used += (size_t)snprintf(line + used, sizeof line - used, "%s%s",
+                               i ? " " : (c ? "; " : ""), number);
+    }
+  put_bake(k, "basis_vectors", line);
+}
+
+/* The ray set's id, or its scheme and slices where the kind records only
+ * those (ao without inter-reflection). */
+static void put_rayset(const bake_keys *k, const char *id) {
+  switch (bb__map_kind_key(k->kind, "rayset", 6, k->bounce)) {
+  case BB__KEY_DROPPED: return;
+  case BB__KEY_RECORDED: put(k->t, "rayset", id); return;
+  case BB__KEY_SLICES: {
+    char cut[64];
+    snprintf(cut, sizeof cut, "%.*s", (int)bb__rayset_slices_length(id, strlen(id)), id);
+    put(k->t, "rayset", cut);
+    return;
+  }
+  }
+}
+
+static void put_smoothing_and_tracing(const bake_keys *k, const bb_bake_options *o) {
+  put_bake_int(k, "filter_radius", o->smooth.radius_texels);
+  put_bake_float(k, "filter_threshold", o->smooth.threshold);
+  put_bake_double(k, "bias", o->trace.bias_texels);
+  put_bake_double(k, "power", o->power);
+  put_basis(k, &o->basis);
+  put_bake(k, "normal_filter", bb_normal_filter_name(o->normal_filter));
+  put_bake(k, "normal_y", o->normal_y_up ? "up" : "down");
+  put_bake(k, "addressing",
+           o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
   /* Inter-reflection and brightness only when used, so the provenance of
    * a bake without them (and its up-to-date check) stays as it was. Maps
    * are named by bb_image_hash of their pixels as given. */
   char hash[32];
   if (o->bounce_albedo > 0.0) {
-    put_double(t, "bounce", o->bounce_albedo);
-    put_int(t, "bounces", o->bounces);
+    put_bake_double(k, "bounce", o->bounce_albedo);
+    put_bake_int(k, "bounces", o->bounces);
     if (o->bounce_albedo_map) {
       snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->bounce_albedo_map));
-      put(t, "bounce_albedo_map", hash);
+      put_bake(k, "bounce_albedo_map", hash);
     }
   }
   if (o->brightness) {
     snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->brightness));
-    put(t, "brightness", hash);
+    put_bake(k, "brightness", hash);
   }
 }
 
@@ -121,12 +164,18 @@ char *bb_provenance_format(const bb_provenance *p) {
     put(&t, "input_file_hash", hash);
   }
   put(&t, "output", p->output_kind);
-  /* The key order is fixed so two texts line up when read side by side. */
-  if (p->options)
-    put_scale_and_rays(&t, p->options);
-  put(&t, "rayset", p->rayset_id ? p->rayset_id : "none");
-  if (p->options)
-    put_smoothing_and_tracing(&t, p->options);
+  /* The key order is fixed so two texts line up when read side by side.
+   * A bake's maps record only the parameters their kind depends on; other
+   * outputs (without bake options) record the ray set as they always have. */
+  const bake_keys k = {&t, p->output_kind, p->options && p->options->bounce_albedo > 0.0};
+  if (p->options) {
+    put_bake_float(&k, "scale", p->options->height_scale);
+    put_bake_int(&k, "rays", p->options->rays);
+    put_rayset(&k, p->rayset_id ? p->rayset_id : "none");
+    put_smoothing_and_tracing(&k, p->options);
+  } else {
+    put(&t, "rayset", p->rayset_id ? p->rayset_id : "none");
+  }
   put(&t, "channel", bb_channel_name(p->channel));
   if (p->extra) {
     /* Lines of the caller's, each ended by a newline. */

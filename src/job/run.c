@@ -157,6 +157,7 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) 
 
 /* Everything one input's bake makes, and the provenance texts of its files. */
 typedef struct baked {
+  unsigned only;     /* the maps to write: BB_MAP_BIT(kind)s; 0: every file */
   bb_image height;
   bb_bake_result result;
   bb_image valve;    /* Valve's packed file (job->valve_path) */
@@ -219,7 +220,7 @@ static bb_status make_valve(const bb_job *job, const bb__job_item *item, baked *
 }
 
 /* The provenance text of one output of item. */
-static char *describe(const bb_job *job, const char *command, const baked *b,
+static char *describe(const bb_job *job, const char *command, const bb_bake_result *result,
                       const bb_job_report *r, const char *kind) {
   const int traced = (job->options.bake.outputs & BB_MAPS_TRACED) != 0;
   /* Valve's file names the channel its rule took (alpha, or the grey) */
@@ -230,7 +231,7 @@ static char *describe(const bb_job *job, const char *command, const baked *b,
                             .input_file_hash = r->source.file_hash,
                             .bake = &job->options.bake,
                             .channel = channel,
-                            .rayset_id = traced ? b->result.rayset_id : NULL};
+                            .rayset_id = traced ? result->rayset_id : NULL};
   return bb__job_describe(&s, kind);
 }
 
@@ -281,9 +282,9 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   bb_output_file files[BB_JOB_MAX_OUTPUTS + 1]; /* the maps, slope files, material, depfile */
   int n = 0;
   bb_status st = BB_OK;
-  if (job->valve_path) {
+  if (job->valve_path && !b->only) {
     const char *kind = bb__job_valve_kind(&job->options);
-    b->descriptions[n] = describe(job, command, b, r, kind);
+    b->descriptions[n] = describe(job, command, &b->result, r, kind);
     files[n] = (bb_output_file){job->valve_path, kind, &b->valve, BB_RANGE_UNIT,
                                 job->options.depth, 0, b->descriptions[n], NULL, 0,
                                 &job->options.texture};
@@ -291,9 +292,9 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
   for (int k = 0; k < BB_MAP_BAKED_COUNT && st == BB_OK; k++) {
-    if (!item->paths[k])
+    if (!item->paths[k] || (b->only && !(b->only & BB_MAP_BIT(k))))
       continue;
-    b->descriptions[n] = describe(job, command, b, r, kind_info(k)->name);
+    b->descriptions[n] = describe(job, command, &b->result, r, kind_info(k)->name);
     files[n] = (bb_output_file){item->paths[k],
                                 kind_info(k)->name,
                                 bb_bake_result_image(&b->result, (bb_map_kind)k),
@@ -311,14 +312,14 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
   /* The slope map is its bytes (8-bit, no mip levels: an average of slope
    * bytes means nothing); its preview is a picture at the job's depth. */
   if (st == BB_OK && b->slope.pixels) {
-    b->descriptions[n] = describe(job, command, b, r, "slope");
+    b->descriptions[n] = describe(job, command, &b->result, r, "slope");
     files[n] = (bb_output_file){job->slope_path, "slope", &b->slope, BB_RANGE_UNIT,
                                 BB_DEPTH_8, 0, b->descriptions[n], NULL, 0, NULL};
     if (!b->descriptions[n++])
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
   if (st == BB_OK && b->slope_lit.pixels) {
-    b->descriptions[n] = describe(job, command, b, r, "slope_lit");
+    b->descriptions[n] = describe(job, command, &b->result, r, "slope_lit");
     files[n] = (bb_output_file){item->slope_lit_path, "slope_lit", &b->slope_lit,
                                 BB_RANGE_UNIT, job->options.depth, 0, b->descriptions[n],
                                 NULL, 0, NULL};
@@ -326,11 +327,12 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b, bb_error 
       st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", item->input);
   }
   free(command);
-  if (st == BB_OK && job->vmt)
+  if (st == BB_OK && job->vmt && !b->only)
     files[n++] = (bb_output_file){job->vmt, "material", NULL, BB_RANGE_UNIT, BB_DEPTH_DEFAULT,
                                   0, NULL, job->vmt_text, job->vmt_size, NULL};
-  const int depfile_stream = job->depfile && !job->batch && bb__safe_is_stream(job->depfile);
-  if (st == BB_OK && job->depfile && !job->batch && !depfile_stream) {
+  const int depfile_stream =
+      job->depfile && !job->batch && !b->only && bb__safe_is_stream(job->depfile);
+  if (st == BB_OK && job->depfile && !job->batch && !b->only && !depfile_stream) {
     /* One input's depfile goes in with its maps: all of them or none. */
     const char *targets[BB_JOB_MAX_OUTPUTS], *prereq[BB__JOB_MAX_READS];
     bb__dep_rule rule = rule_of(job, item, targets, prereq);
@@ -388,7 +390,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
      * as it is done with them (Valve's detail reads the height again) */
     const unsigned flags =
         BB__BAKE_DROP_VIS | (job->options.valve_detail ? 0u : BB__BAKE_TAKE_HEIGHT);
-    st = bb__bake(&b->height, &o, flags, job->context, &b->result, &bake_err);
+    st = bb__bake_through(job->context, &b->height, &o, flags, &b->result, &bake_err);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", item->input, bake_err.message);
   }
@@ -449,7 +451,9 @@ void bb_job_use_context(bb_job *job, bb_bake_context *context) {
     job->context = context;
 }
 
-bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb_error *err) {
+/* bb_job_write_item, or with only (BB_MAP_BIT(kind)s) just those maps. */
+static bb_status write_maps(bb_job *job, int i, const bb_bake_result *result, unsigned only,
+                            bb_error *err) {
   if (!job || i < 0 || i >= job->count || !result)
     return bb__fail(err, BB_ERR_ARGUMENT, "job write: bad arguments");
   bb__job_item *item = &job->items[i];
@@ -475,13 +479,14 @@ bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb
   baked b;
   memset(&b, 0, sizeof b);
   b.result = *result; /* borrowed: given back before baked_free */
+  b.only = only;
   r->outcome = BB_JOB_PENDING;
   r->status = BB_OK;
   memset(&r->error, 0, sizeof r->error);
   bb_status st = BB_OK;
-  if (job->valve_path)
+  if (job->valve_path && !only)
     st = make_valve(job, item, &b, &r->error);
-  if (st == BB_OK && job->slope_path)
+  if (st == BB_OK && job->slope_path && !only)
     st = make_slope(job, item, &b, &r->error);
   if (st == BB_OK)
     st = write_item(job, item, &b, &r->error);
@@ -494,6 +499,32 @@ bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb
   }
   r->outcome = BB_JOB_BAKED;
   return BB_OK;
+}
+
+bb_status bb_job_write_item(bb_job *job, int i, const bb_bake_result *result, bb_error *err) {
+  return write_maps(job, i, result, 0u, err);
+}
+
+bb_status bb__job_write_maps(bb_job *job, int i, const bb_bake_result *result, unsigned maps,
+                             bb_error *err) {
+  return maps ? write_maps(job, i, result, maps, err) : BB_OK;
+}
+
+bb_depth bb__job_map_depth(const bb_job *job, int i, int kind) {
+  const bb__job_item *item = &job->items[i];
+  return output_depth(job, kind, item->paths[kind], item->report.source.bits_per_sample,
+                      item->report.source.is_float);
+}
+
+char *bb__job_map_description(const bb_job *job, int i, const bb_bake_result *result,
+                              int kind) {
+  const bb__job_item *item = &job->items[i];
+  char *command = bb__job_command_of(job, item);
+  if (!command && (job->command || job->command_options))
+    return NULL;
+  char *text = describe(job, command, result, &item->report, kind_info(kind)->name);
+  free(command);
+  return text;
 }
 
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user) {

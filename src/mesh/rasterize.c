@@ -65,20 +65,32 @@ void bb__raster_weights(const bb__raster_setup *s, double u, double v, double w[
 }
 
 /* First and last sample index i whose centre (i + 0.5) / n lies in [lo, hi],
- * clipped to 0 .. count-1; *last < *first when there is none. */
+ * clipped to 0 .. count-1; *last < *first when there is none. The
+ * estimates from lo * n and hi * n round, and are one off when a centre
+ * lies on lo or hi (a vertex on a sample): they are stepped until the
+ * centre, computed as the drawing computes it, agrees. */
 static void sample_span(double lo, double hi, int n, int count, int *first, int *last) {
   double f = ceil(lo * n - 0.5), l = floor(hi * n - 0.5);
-  *first = f < 0.0 ? 0 : (f > count ? count : (int)f);
-  *last = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
+  int i = f < 0.0 ? 0 : (f > count ? count : (int)f);
+  while (i > 0 && ((i - 1) + 0.5) / n >= lo)
+    i--;
+  while (i < count && !((i + 0.5) / n >= lo))
+    i++;
+  int j = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
+  while (j < count - 1 && ((j + 1) + 0.5) / n <= hi)
+    j++;
+  while (j >= 0 && !((j + 0.5) / n <= hi))
+    j--;
+  *first = i, *last = j;
 }
 
-/* Edge k's value at sample column i of a row whose own term is row: the
- * one expression every inside test uses. fl(a u + row) never decreases in
- * u when a > 0 and never increases when a < 0 (rounding is monotone), so
- * the columns where it is >= 0 are one run reaching an end of the row. */
-static inline double edge_at(double a, double row, int i, int n) {
-  const double u = (i + 0.5) / n;
-  return a * u + row;
+void bb__raster_box(const bb__sample_band *band, const bb__raster_setup *s, int *i0,
+                    int *i1, int *j0, int *j1) {
+  const int n = band->per_texel;
+  sample_span(s->box[0], s->box[2], n, band->columns, i0, i1);
+  sample_span(s->box[1], s->box[3], n, band->first_row + band->rows, j0, j1);
+  if (*j0 < band->first_row)
+    *j0 = band->first_row;
 }
 
 /* Narrows [*lo, *hi] to the columns where edge (a, row) is >= 0: from the
@@ -97,15 +109,15 @@ static void clip_to_edge(double a, double row, int n, int *lo, int *hi) {
   double x = (-row / a) * n - 0.5;
   int c = !(x >= *lo) ? *lo : (!(x <= *hi) ? *hi : (int)x);
   if (a > 0.0) { /* inside from the crossing rightwards: find the first inside column */
-    while (c > *lo && edge_at(a, row, c - 1, n) >= 0.0)
+    while (c > *lo && bb__raster_edge(a, row, c - 1, n) >= 0.0)
       c--;
-    while (c <= *hi && !(edge_at(a, row, c, n) >= 0.0))
+    while (c <= *hi && !(bb__raster_edge(a, row, c, n) >= 0.0))
       c++;
     *lo = c;
   } else { /* inside leftwards: find the last inside column */
-    while (c < *hi && edge_at(a, row, c + 1, n) >= 0.0)
+    while (c < *hi && bb__raster_edge(a, row, c + 1, n) >= 0.0)
       c++;
-    while (c >= *lo && !(edge_at(a, row, c, n) >= 0.0))
+    while (c >= *lo && !(bb__raster_edge(a, row, c, n) >= 0.0))
       c--;
     *hi = c;
   }
@@ -114,32 +126,16 @@ static void clip_to_edge(double a, double row, int n, int *lo, int *hi) {
 void bb__band_draw(bb__sample_band *band, const bb__raster_setup *s, int32_t id) {
   const int n = band->per_texel;
   int i0, i1, j0, j1;
-  sample_span(s->box[0], s->box[2], n, band->columns, &i0, &i1);
-  sample_span(s->box[1], s->box[3], n, band->first_row + band->rows, &j0, &j1);
-  if (j0 < band->first_row)
-    j0 = band->first_row;
+  bb__raster_box(band, s, &i0, &i1, &j0, &j1);
   for (int j = j0; j <= j1; j++) {
-    const double v = (j + 0.5) / n;
-    const double row0 = s->b[0] * v + s->c[0], row1 = s->b[1] * v + s->c[1],
-                 row2 = s->b[2] * v + s->c[2];
+    const bb__raster_row r = bb__raster_row_at(band, s, j);
     /* Only the columns the triangle covers in this row are visited: its
      * cost is what it draws plus a few tests per row, not its box. */
     int lo = i0, hi = i1;
-    clip_to_edge(s->a[0], row0, n, &lo, &hi);
-    clip_to_edge(s->a[1], row1, n, &lo, &hi);
-    clip_to_edge(s->a[2], row2, n, &lo, &hi);
-    double *depth = band->depth + (long)(j - band->first_row) * band->columns;
-    int32_t *winner = band->winner + (long)(j - band->first_row) * band->columns;
-    for (int i = lo; i <= hi; i++) {
-      const double e0 = edge_at(s->a[0], row0, i, n), e1 = edge_at(s->a[1], row1, i, n),
-                   e2 = edge_at(s->a[2], row2, i, n);
-      if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0)
-        continue;
-      const double d = (e0 * s->d[0] + e1 * s->d[1] + e2 * s->d[2]) * s->inv_area;
-      if (winner[i] < 0 || d > depth[i]) {
-        winner[i] = id;
-        depth[i] = d;
-      }
-    }
+    clip_to_edge(s->a[0], r.term[0], n, &lo, &hi);
+    clip_to_edge(s->a[1], r.term[1], n, &lo, &hi);
+    clip_to_edge(s->a[2], r.term[2], n, &lo, &hi);
+    for (int i = lo; i <= hi; i++)
+      bb__raster_sample(s, &r, i, n, id);
   }
 }

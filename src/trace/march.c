@@ -560,13 +560,15 @@ static void lattice_init(lattice *L, direction *d, const bb_pyramid *p, int x, i
 /* One slice's horizon from a texel: the march, or the brute-force twin when
  * brute. hint as in march(). */
 static float slice_horizon(const bb_pyramid *p, int x, int y, double bias, int a, int b,
-                           int brute, double *hint) {
+                           int brute, double *hint, double best, double from_steps) {
   lattice L;
   direction d;
   lattice_init(&L, &d, p, x, y, a, b);
   walker w;
   const double oz = (double)p->z[(size_t)y * (size_t)p->width + (size_t)x] + bias;
-  walker_init(&w, p, &d, &L, x, y, oz, 0.0);
+  walker_init(&w, p, &d, &L, x, y, oz, best > 0.0 ? best : 0.0);
+  if (from_steps > 0.0)
+    jump_to(&w, from_steps * L.length);
   /* a breakpoint n / m <= cap steps away lies within cap + 1 steps of geometry */
   const goal g = {0.0, INFINITY,
                   p->addressing == BB_ADDRESS_PERIODIC ? ((double)L.cap + 1.0) * L.length
@@ -579,14 +581,19 @@ static float slice_horizon(const bb_pyramid *p, int x, int y, double bias, int a
 }
 
 float bb__slice_horizon(const bb_pyramid *p, int x, int y, double bias, int a, int b) {
-  return slice_horizon(p, x, y, bias, a, b, 0, NULL);
+  return slice_horizon(p, x, y, bias, a, b, 0, NULL, 0.0, 0.0);
 }
 
 float bb__slice_horizon_hinted(const bb_pyramid *p, int x, int y, double bias, int a, int b,
                                double *hint) {
-  return slice_horizon(p, x, y, bias, a, b, 0, hint);
+  return slice_horizon(p, x, y, bias, a, b, 0, hint, 0.0, 0.0);
+}
+
+float bb__slice_horizon_above(const bb_pyramid *p, int x, int y, double bias, int a,
+                              int b, double slope, double from_steps) {
+  return slice_horizon(p, x, y, bias, a, b, 0, NULL, slope, from_steps);
 }
 
 float bb__slice_horizon_brute(const bb_pyramid *p, int x, int y, double bias, int a, int b) {
-  return slice_horizon(p, x, y, bias, a, b, 1, NULL);
+  return slice_horizon(p, x, y, bias, a, b, 1, NULL, 0.0, 0.0);
 }

@@ -34,6 +34,14 @@ float bb__slice_horizon_brute(const bb_pyramid *p, int x, int y, double bias, in
  * tries first; the horizon found is the same. */
 float bb__slice_horizon_hinted(const bb_pyramid *p, int x, int y, double bias, int a, int b,
                                double *hint);
+/* bb__slice_horizon for a texel whose horizon is known to be at least
+ * `slope` per step, the canonical slope of one of its breakpoints, and to
+ * be no other breakpoint's within from_steps steps (a sweep's tangent over
+ * that much of the line): the march starts from that slope and that
+ * distance, so whole nodes below it are skipped from the start, and finds
+ * the same horizon. */
+float bb__slice_horizon_above(const bb_pyramid *p, int x, int y, double bias, int a,
+                              int b, double slope, double from_steps);
 
 /* Steps after which a periodic line of step (a, b) comes back to its start. */
 long bb__line_period(const bb_pyramid *p, int a, int b);

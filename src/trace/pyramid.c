@@ -186,6 +186,144 @@ bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing address
   return BB_OK;
 }
 
+/* ------------------------------------------------------------- updates */
+
+/* The node columns (or rows) of level k whose cells meet the cells
+ * [first, first + count) of an axis of n cells at level 0 (periodic: the
+ * interval may pass n and wrap), as up to three intervals lo[i]..hi[i]. */
+static int nodes_of(const bb_pyramid *p, int k, int first, int count, int n, int nodes,
+                    int *lo, int *hi) {
+  int spans = 0;
+  if (count >= n) {
+    lo[0] = 0, hi[0] = nodes - 1;
+    return 1;
+  }
+  /* the interval as plain ones inside [0, n) */
+  int s[2], e[2], parts = 0;
+  if (first + count <= n) {
+    s[parts] = first, e[parts++] = first + count - 1;
+  } else {
+    s[parts] = first, e[parts++] = n - 1;
+    s[parts] = 0, e[parts++] = first + count - 1 - n;
+  }
+  for (int i = 0; i < parts; i++)
+    lo[spans] = s[i] >> k, hi[spans++] = e[i] >> k;
+  /* the last node's cells past n are the first ones again (periodic) or
+   * the border cell (clamp: inside the last node already) */
+  const long past = ((long)nodes << k) - n;
+  if (past > 0 && p->addressing == BB_ADDRESS_PERIODIC)
+    for (int i = 0; i < parts; i++)
+      if (s[i] < past) {
+        lo[spans] = hi[spans] = nodes - 1;
+        spans++;
+        break;
+      }
+  return spans;
+}
+
+/* Node (i, j) of level k >= 1 again: the max of its four children when
+ * all of them exist, which cover its cells exactly; otherwise (the last
+ * node of an odd level, whose cells past the side are addressed) from the
+ * cells, as the build takes it. */
+static void node_update(bb_pyramid *p, int k, int i, int j) {
+  const int cw = p->level_width[k - 1], ch = p->level_height[k - 1];
+  float m;
+  if (2 * i + 1 < cw && 2 * j + 1 < ch) {
+    const float *c = p->level_max[k - 1];
+    const size_t r0 = (size_t)(2 * j) * (size_t)cw, r1 = r0 + (size_t)cw;
+    m = c[r0 + (size_t)(2 * i)];
+    if (c[r0 + (size_t)(2 * i + 1)] > m)
+      m = c[r0 + (size_t)(2 * i + 1)];
+    if (c[r1 + (size_t)(2 * i)] > m)
+      m = c[r1 + (size_t)(2 * i)];
+    if (c[r1 + (size_t)(2 * i + 1)] > m)
+      m = c[r1 + (size_t)(2 * i + 1)];
+  } else {
+    const int span = 1 << k, w = p->width;
+    m = -FLT_MAX;
+    for (int y = j * span; y < (j + 1) * span; y++) {
+      const float *row =
+          p->level_max[0] + (size_t)bb__address(y, p->height, p->addressing) * (size_t)w;
+      const float v = addressed_max(row, 1, w, i * span, span, p->addressing);
+      if (v > m)
+        m = v;
+    }
+  }
+  p->level_max[k][(size_t)j * (size_t)p->level_width[k] + (size_t)i] = m;
+}
+
+bb_status bb__pyramid_update(bb_pyramid *p, int x0, int y0, int width, int height,
+                             float old_min) {
+  const int w = p->width, h = p->height;
+  if (width <= 0 || height <= 0)
+    return BB_OK;
+  /* the cells with a changed corner: one more to the left and above */
+  int cx = x0 - 1, cw = width + 1, cy = y0 - 1, ch = height + 1;
+  if (p->addressing == BB_ADDRESS_PERIODIC) {
+    cx = bb__wrap(cx, w), cy = bb__wrap(cy, h);
+  } else {
+    if (cx < 0)
+      cx = 0, cw--;
+    if (cy < 0)
+      cy = 0, ch--;
+  }
+  if (cw > w)
+    cw = w;
+  if (ch > h)
+    ch = h;
+  int lo_x[3], hi_x[3], lo_y[3], hi_y[3];
+  const int nx = nodes_of(p, 0, cx, cw, w, w, lo_x, hi_x);
+  const int ny = nodes_of(p, 0, cy, ch, h, h, lo_y, hi_y);
+  for (int a = 0; a < ny; a++)
+    for (int y = lo_y[a]; y <= hi_y[a]; y++) {
+      /* a row of cells at a time: build_cells_row's own arithmetic */
+      const float *r0 = p->z + (size_t)y * (size_t)w;
+      const float *r1 = p->z + (size_t)bb__address(y + 1, h, p->addressing) * (size_t)w;
+      for (int b = 0; b < nx; b++)
+        for (int x = lo_x[b]; x <= hi_x[b]; x++) {
+          const int x1 = x + 1 < w ? x + 1 : bb__address(x + 1, w, p->addressing);
+          float m = r0[x];
+          if (r0[x1] > m)
+            m = r0[x1];
+          if (r1[x] > m)
+            m = r1[x];
+          if (r1[x1] > m)
+            m = r1[x1];
+          p->level_max[0][(size_t)y * (size_t)w + (size_t)x] = m;
+        }
+    }
+  for (int k = 1; k < p->levels; k++) {
+    const int mx = nodes_of(p, k, cx, cw, w, p->level_width[k], lo_x, hi_x);
+    const int my = nodes_of(p, k, cy, ch, h, p->level_height[k], lo_y, hi_y);
+    for (int a = 0; a < my; a++)
+      for (int j = lo_y[a]; j <= hi_y[a]; j++)
+        for (int b = 0; b < mx; b++)
+          for (int i = lo_x[b]; i <= hi_x[b]; i++)
+            node_update(p, k, i, j);
+  }
+  p->global_max = p->level_max[p->levels - 1][0];
+  /* the least height: a rescan only when the old least one may have gone */
+  float changed_min = FLT_MAX;
+  for (int y = 0; y < height; y++)
+    for (int x = 0; x < width; x++) {
+      const float v = p->z[(size_t)bb__address(y0 + y, h, p->addressing) * (size_t)w +
+                           (size_t)bb__address(x0 + x, w, p->addressing)];
+      if (v < changed_min)
+        changed_min = v;
+    }
+  if (changed_min <= p->global_min) {
+    p->global_min = changed_min;
+  } else if (old_min <= p->global_min) {
+    const size_t n = (size_t)w * (size_t)h;
+    p->global_min = p->z[0];
+    for (size_t i = 1; i < n; i++)
+      if (p->z[i] < p->global_min)
+        p->global_min = p->z[i];
+  }
+  p->border_max = border_max(p);
+  return BB_OK;
+}
+
 void bb_pyramid_free(bb_pyramid *p) {
   if (!p) return;
   for (int k = 0; k < p->levels; k++) free(p->level_max[k]);

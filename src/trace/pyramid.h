@@ -23,4 +23,13 @@ struct bb_pyramid {
 bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing addressing,
                             int threads, bb_pyramid **out, bb_error *err);
 
+/* The heights of the vertices x0 .. x0+width-1 by y0 .. y0+height-1 of
+ * p->z have been changed by the caller (periodic: the rectangle may pass
+ * the right and bottom sides and wrap; clamp: inside the image). The nodes
+ * over them, the global max and min and the border max are brought up to
+ * date: the pyramid bb_pyramid_build makes of the new heights, bit for
+ * bit. old_min: the least of the heights the rectangle held before. */
+bb_status bb__pyramid_update(bb_pyramid *p, int x0, int y0, int width, int height,
+                             float old_min);
+
 #endif /* BB_TRACE_PYRAMID_H */

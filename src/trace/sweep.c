@@ -65,7 +65,9 @@ typedef struct sweep_side {
   bb__slice_integral integral;
 } sweep_side;
 
-typedef enum line_kind { LINE_ROUND, LINE_CHUNK, LINE_CLAMPED } line_kind;
+/* Whole periodic lines swept once round; chunks of long periodic lines;
+ * whole clamped lines; a caller's stretches (bb__sweep_stretches). */
+typedef enum line_kind { LINE_ROUND, LINE_CHUNK, LINE_CLAMPED, LINE_STRETCH } line_kind;
 
 typedef struct sweep_job {
   const bb_pyramid *p;
@@ -76,8 +78,9 @@ typedef struct sweep_job {
   const int *item_x, *item_y,
       *item_len; /* first texel and texels of each line or chunk */
   int item_count;
-  long period;   /* periodic: steps of a line */
-  int lookahead; /* chunks: steps profiled past each end */
+  const bb__stretch *stretch; /* LINE_STRETCH: each item's extent and exact sides */
+  long period;    /* periodic: steps of a line */
+  int lookahead;  /* chunks: steps profiled past each end */
   double bias;
   int channels;         /* floats per texel in the sums */
   sweep_side side[2];   /* along (a, b) and along (-a, -b) */
@@ -191,6 +194,10 @@ typedef struct profile {
    * (horizons_of_line) */
   double *tangent_z[2];
   int64_t *tangent_key[2];
+  /* per side (0: ahead, 1: behind): is a horizon that the points beyond
+   * the profile could beat marched instead (chunks, a caller's stretches)? */
+  int vouch[2];
+  const unsigned char *want; /* a caller's stretch: bb__stretch.want, or NULL */
 } profile;
 
 /* The points of a block of steps of one line (profile_fill) or of LANES
@@ -713,18 +720,26 @@ static void horizons_of_line(const sweep_job *job, const profile *pr, int k) {
   float *restrict found = pr->found[k];
   for (int j = 0; j < pr->len; j++) {
     const double oz = pr->vz[j] + job->bias;
-    const double slope = tangent_slope(job, tz[j], tkey[j], oz, forward);
-    found[j] = horizon_of(job, k, slope);
-    if (job->kind != LINE_CHUNK)
+    found[j] = horizon_of(job, k, tangent_slope(job, tz[j], tkey[j], oz, forward));
+  }
+  if (!pr->vouch[k])
+    return;
+  /* (a loop of its own: the whole lines' loop above stays a plain one) */
+  const unsigned char *want = pr->want, bit = (unsigned char)(1 << k);
+  for (int j = 0; j < pr->len; j++) {
+    if (want && !(want[j] & bit))
       continue;
-    const double beyond =
-        forward ? (double)(pr->first_step + pr->steps - j) : (double)(j - pr->first_step);
+    const double oz = pr->vz[j] + job->bias;
+    const double slope = tangent_slope(job, tz[j], tkey[j], oz, forward);
+    const double beyond = forward ? (double)(pr->first_step + pr->steps - j)
+                                  : (double)(j - pr->first_step);
     if (!vouched(job, slope, oz, beyond)) {
       const size_t texel = pr->texel[j];
-      const int x = (int)(texel % (size_t)job->p->width),
-                y = (int)(texel / (size_t)job->p->width);
-      found[j] =
-          bb__slice_horizon(job->p, x, y, job->bias, job->side[k].a, job->side[k].b);
+      const int x = (int)(texel % (size_t)job->p->width), y = (int)(texel / (size_t)job->p->width);
+      /* the profile holds every point within `beyond` steps (a step less:
+       * the march's first cell may reach back into it) */
+      found[j] = bb__slice_horizon_above(job->p, x, y, job->bias, job->side[k].a,
+                                         job->side[k].b, slope, beyond - 1.0);
     }
   }
 }
@@ -917,7 +932,8 @@ static bb__line_view line_view_of(const sweep_job *job, const profile *pr, int x
                               .dir = {job->side[0].dir, job->side[1].dir},
                               .found = {job->side[0].dir ? pr->found[0] : NULL,
                                         job->side[1].dir ? pr->found[1] : NULL},
-                              .tangent_key = {pr->tangent_key[0], pr->tangent_key[1]}};
+                              .tangent_key = {pr->tangent_key[0], pr->tangent_key[1]},
+                              .want = pr->want};
   return line;
 }
 
@@ -997,6 +1013,18 @@ static int steps_to_flat(const sweep_job *job, long x, long y, int sa, int sb) {
   return steps + 1;
 }
 
+/* A clamped line's profile: ahead, the steps up to the first flat one,
+ * which ends on a flat vertex; behind, the steps back to the first flat one
+ * and one more, so that its first vertex is in the profile too (a step may
+ * hold no other point than its end). */
+static void clamped_extent(const sweep_job *job, int x, int y, int len, int *before,
+                           int *after) {
+  const long ex = (long)x + (long)(len - 1) * job->a,
+             ey = (long)y + (long)(len - 1) * job->b;
+  *after = steps_to_flat(job, ex, ey, job->a, job->b) - 1;
+  *before = steps_to_flat(job, (long)x - job->a, (long)y - job->b, -job->a, -job->b) + 1;
+}
+
 /* The steps a work item profiles, before and after its texels. */
 static void item_extent(const sweep_job *job, int item, int *before, int *after) {
   const int x = job->item_x[item], y = job->item_y[item], len = job->item_len[item];
@@ -1004,16 +1032,10 @@ static void item_extent(const sweep_job *job, int item, int *before, int *after)
     *before = 0, *after = 0;
   } else if (job->kind == LINE_CHUNK) {
     *before = job->lookahead, *after = job->lookahead;
+  } else if (job->kind == LINE_STRETCH) {
+    *before = job->stretch[item].before, *after = job->stretch[item].after;
   } else {
-    /* ahead, the steps up to the first flat one, which ends on a flat
-     * vertex; behind, the steps back to the first flat one and one more, so
-     * that its first vertex is in the profile too (a step may hold no other
-     * point than its end) */
-    const long ex = (long)x + (long)(len - 1) * job->a,
-               ey = (long)y + (long)(len - 1) * job->b;
-    *after = steps_to_flat(job, ex, ey, job->a, job->b) - 1;
-    *before =
-        steps_to_flat(job, (long)x - job->a, (long)y - job->b, -job->a, -job->b) + 1;
+    clamped_extent(job, x, y, len, before, after);
   }
 }
 
@@ -1196,6 +1218,13 @@ static void sweep_bundle(void *user, int bundle) {
       for (int l = 0; l < lanes; l++) {
         pr[l].len = job->item_len[item];
         pr[l].steps = item_steps(job, item, &pr[l].first_step);
+        pr[l].vouch[0] = pr[l].vouch[1] = job->kind == LINE_CHUNK;
+        pr[l].want = NULL;
+        if (job->kind == LINE_STRETCH) {
+          pr[l].vouch[0] = !job->stretch[item].exact_ahead;
+          pr[l].vouch[1] = !job->stretch[item].exact_behind;
+          pr[l].want = job->stretch[item].want;
+        }
       }
       if (lanes > 1)
         profile_fill_lanes(job, &fb, x0, y0, pr);
@@ -1291,6 +1320,31 @@ static int periodic_lines(const bb_pyramid *p, int a, int b, long period, int ch
   return 0;
 }
 
+/* The inverse of v modulo n (v and n coprime, n >= 1), in [0, n). */
+static long inverse_mod(long v, long n) {
+  long r0 = n, r1 = ((v % n) + n) % n, t0 = 0, t1 = 1;
+  while (r1) {
+    const long q = r0 / r1, r = r0 - q * r1, t = t0 - q * t1;
+    r0 = r1, r1 = r, t0 = t1, t1 = t;
+  }
+  return ((t0 % n) + n) % n;
+}
+
+void bb__line_seed(const bb_pyramid *p, int a, int b, int x, int y, int *x0, int *y0) {
+  /* periodic_lines' seeds: y0 = y mod h, reached k1 steps back (mod H / h),
+   * and there the line's texels in row y0 are x0 plus multiples of
+   * gcd((H / h) a, W) */
+  const long W = p->width, H = p->height, h = bb__gcd(b, H), rows = H / h;
+  const long y_seed = ((long)y % h + h) % h;
+  const long k1 = rows == 1 ? 0
+                            : (((long)y - y_seed) / h % rows + rows) % rows *
+                                  inverse_mod(b / h, rows) % rows;
+  const long columns = bb__gcd(rows * a, W);
+  const long x_back = (((long)x - k1 % W * (a % W)) % W + W) % W;
+  *x0 = (int)(x_back % columns);
+  *y0 = (int)y_seed;
+}
+
 static void job_template(sweep_job *job, template_point *pts) {
   const bb_pyramid *p = job->p;
   job->points = pts;
@@ -1357,8 +1411,87 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
                                 NULL, err);
 }
 
-/* What a sweep does per line besides finding its horizons: the hook, the
- * visitor (which also polls the checkpoint) or neither (the sums). */
+/* The parts of a sweep every entry shares: the checks, both sides, the
+ * template and the kink filter's chords, and the tables of both sides'
+ * lobes at once when both add to sums. job_end frees what it made. */
+static bb_status job_start(sweep_job *job, template_point *pts, const bb_pyramid *p,
+                           int a, int b, const bb__sweep_dir *along,
+                           const bb__sweep_dir *opposite, double bias, bb__line_hook hook,
+                           void *hook_ctx, const bb__walk_visitor *visitor,
+                           void *visitor_ctx, bb_error *err) {
+  if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
+  const int custom = hook != NULL || visitor != NULL;
+  bb_status st = check_dir(along, custom, err);
+  if (st == BB_OK) st = check_dir(opposite, custom, err);
+  if (st != BB_OK)
+    return st;
+  *job = (sweep_job){.p = p,
+                     .a = a,
+                     .b = b,
+                     .bias = bias,
+                     .hook = hook,
+                     .hook_ctx = hook_ctx,
+                     .visitor = visitor,
+                     .visitor_ctx = visitor_ctx};
+  job->side[0] = (sweep_side){along, a, b, bb__step_inverse(a, b), {0}};
+  job->side[1] = (sweep_side){opposite, -a, -b, bb__step_inverse(a, b), {0}};
+  if (along)
+    job->side[0].integral = bb__slice_integral_of(along->rs, along->slice);
+  if (opposite)
+    job->side[1].integral = bb__slice_integral_of(opposite->rs, opposite->slice);
+  job->channels = 1 + (along ? along : opposite)->rs->basis_count;
+  atomic_init(&job->out_of_memory, 0);
+  job_template(job, pts);
+  if (!job_chords(job))
+    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  if (along && opposite && along->sums && opposite->sums && job->channels == 4 && !custom) {
+    job->table4 = aligned_alloc(sizeof(bb__channels4),
+                                8 * BB__TABLE_INTERVALS * sizeof(bb__channels4));
+    if (job->table4) {
+      bb__slice_table4(&job->side[0].integral, job->table4);
+      bb__slice_table4(&job->side[1].integral, job->table4 + 4 * BB__TABLE_INTERVALS);
+    } /* else the lobes one by one */
+  }
+  return BB_OK;
+}
+
+static void job_end(sweep_job *job) {
+  free(job->open_a);
+  free(job->open_b);
+  free(job->table4);
+}
+
+/* Sweeps the job's items (x, y, len each) on all threads, a bundle of
+ * them per work item, polling checkpoint (may be NULL). */
+static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *len,
+                         int count, int threads, const bb__checkpoint *checkpoint,
+                         bb_error *err) {
+  job->item_x = x;
+  job->item_y = y;
+  job->item_len = len;
+  job->item_count = count;
+  const int bundles = (count + BUNDLE - 1) / BUNDLE;
+  job->scratch_count = imin(imin(bb__thread_count(threads), bundles), 256);
+  job->scratch = calloc((size_t)imax(job->scratch_count, 1), sizeof(scratch));
+  if (!job->scratch)
+    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  for (int i = 0; i < job->scratch_count; i++)
+    atomic_flag_clear(&job->scratch[i].busy);
+  bb_status st =
+      bb__parallel_for_checked(bundles, threads, sweep_bundle, job, checkpoint, err);
+  for (int i = 0; i < job->scratch_count; i++)
+    scratch_release(&job->scratch[i]);
+  free(job->scratch);
+  job->scratch = NULL;
+  if (st == BB_OK && atomic_load(&job->out_of_memory))
+    st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
+  return st;
+}
+
+/* What a whole-image sweep does per line besides finding its horizons:
+ * the hook, the visitor (whose sweep also polls the checkpoint) or neither
+ * (the sums). */
 typedef struct sweep_extra {
   bb__line_hook hook;
   void *hook_ctx;
@@ -1367,76 +1500,17 @@ typedef struct sweep_extra {
   const bb__checkpoint *checkpoint;
 } sweep_extra;
 
-static bb_status sweep_lines(const bb_pyramid *p, int a, int b,
-                             const bb__sweep_dir *along, const bb__sweep_dir *opposite,
-                             double bias, int threads, long long_line,
-                             const sweep_extra *extra, bb_error *err);
-
-bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
-                                 const bb__sweep_dir *along,
-                                 const bb__sweep_dir *opposite, double bias, int threads,
-                                 long long_line, bb__line_hook hook, void *hook_ctx,
-                                 bb_error *err) {
-  const sweep_extra extra = {hook, hook_ctx, NULL, NULL, NULL};
-  return sweep_lines(p, a, b, along, opposite, bias, threads, long_line, &extra, err);
-}
-
-bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
-                                 const bb__sweep_dir *along,
-                                 const bb__sweep_dir *opposite, double bias, int threads,
-                                 const bb__walk_visitor *visitor, void *ctx,
-                                 const bb__checkpoint *checkpoint, bb_error *err) {
-  if (!visitor || !visitor->line_begin || !visitor->origin || !visitor->line_end)
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a walk visitor needs every call");
-  const sweep_extra extra = {NULL, NULL, visitor, ctx, checkpoint};
-  return sweep_lines(p, a, b, along, opposite, bias, threads, 0, &extra, err);
-}
-
-static bb_status sweep_lines(const bb_pyramid *p, int a, int b,
-                             const bb__sweep_dir *along, const bb__sweep_dir *opposite,
-                             double bias, int threads, long long_line,
-                             const sweep_extra *extra, bb_error *err) {
-  const bb__line_hook hook = extra->hook ? extra->hook : NULL;
-  void *const hook_ctx = extra->hook_ctx;
+static bb_status sweep_whole(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                             const bb__sweep_dir *opposite, double bias, int threads,
+                             long long_line, const sweep_extra *extra, bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
-  if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP ||
-      (a == 0 && b == 0))
-    return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a,
-                    b);
-  const int custom = hook != NULL || extra->visitor != NULL;
-  bb_status st = check_dir(along, custom, err);
-  if (st == BB_OK)
-    st = check_dir(opposite, custom, err);
-  if (st != BB_OK || (!along && !opposite))
+  if (!along && !opposite)
+    return BB_OK;
+  sweep_job job;
+  bb_status st = job_start(&job, pts, p, a, b, along, opposite, bias, extra->hook,
+                           extra->hook_ctx, extra->visitor, extra->visitor_ctx, err);
+  if (st != BB_OK)
     return st;
-  sweep_job job = {.p = p,
-                   .a = a,
-                   .b = b,
-                   .bias = bias,
-                   .hook = hook,
-                   .hook_ctx = hook_ctx,
-                   .visitor = extra->visitor,
-                   .visitor_ctx = extra->visitor_ctx};
-  job.side[0] = (sweep_side){along, a, b, bb__step_inverse(a, b), {0}};
-  job.side[1] = (sweep_side){opposite, -a, -b, bb__step_inverse(a, b), {0}};
-  if (along)
-    job.side[0].integral = bb__slice_integral_of(along->rs, along->slice);
-  if (opposite)
-    job.side[1].integral = bb__slice_integral_of(opposite->rs, opposite->slice);
-  job.channels = 1 + (along ? along : opposite)->rs->basis_count;
-  atomic_init(&job.out_of_memory, 0);
-  job_template(&job, pts);
-  if (!job_chords(&job))
-    return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
-  if (along && opposite && along->sums && opposite->sums && job.channels == 4 &&
-      !custom) {
-    job.table4 = aligned_alloc(sizeof(bb__channels4),
-                               8 * BB__TABLE_INTERVALS * sizeof(bb__channels4));
-    if (job.table4) {
-      bb__slice_table4(&job.side[0].integral, job.table4);
-      bb__slice_table4(&job.side[1].integral, job.table4 + 4 * BB__TABLE_INTERVALS);
-    } /* else the lobes one by one */
-  }
   items it = {0};
   int failed;
   if (p->addressing == BB_ADDRESS_CLAMP) {
@@ -1451,33 +1525,98 @@ static bb_status sweep_lines(const bb_pyramid *p, int a, int b,
     failed = periodic_lines(p, a, b, job.period,
                             job.kind == LINE_CHUNK ? job.lookahead : 0, &it);
   }
-  if (failed)
-    st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
-  if (st == BB_OK) {
-    job.item_x = it.x;
-    job.item_y = it.y;
-    job.item_len = it.len;
-    job.item_count = it.count;
-    const int bundles = (it.count + BUNDLE - 1) / BUNDLE;
-    job.scratch_count = imin(imin(bb__thread_count(threads), bundles), 256);
-    job.scratch = calloc((size_t)imax(job.scratch_count, 1), sizeof(scratch));
-    if (!job.scratch)
-      st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
-    if (st == BB_OK) {
-      for (int i = 0; i < job.scratch_count; i++)
-        atomic_flag_clear(&job.scratch[i].busy);
-      st = bb__parallel_for_checked(bundles, threads, sweep_bundle, &job,
-                                    extra->checkpoint, err);
-      for (int i = 0; i < job.scratch_count; i++)
-        scratch_release(&job.scratch[i]);
-    }
-    free(job.scratch);
-    if (st == BB_OK && atomic_load(&job.out_of_memory))
-      st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for a line sweep");
-  }
+  if (failed) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  if (st == BB_OK)
+    st = job_run(&job, it.x, it.y, it.len, it.count, threads, extra->checkpoint, err);
   items_free(&it);
-  free(job.open_a);
-  free(job.open_b);
-  free(job.table4);
+  job_end(&job);
+  return st;
+}
+
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 long long_line, bb__line_hook hook, void *hook_ctx,
+                                 bb_error *err) {
+  const sweep_extra extra = {hook, hook_ctx, NULL, NULL, NULL};
+  return sweep_whole(p, a, b, along, opposite, bias, threads, long_line, &extra, err);
+}
+
+bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 const bb__walk_visitor *visitor, void *ctx,
+                                 const bb__checkpoint *checkpoint, bb_error *err) {
+  if (!visitor || !visitor->line_begin || !visitor->origin || !visitor->line_end)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a walk visitor needs every call");
+  const sweep_extra extra = {NULL, NULL, visitor, ctx, checkpoint};
+  return sweep_whole(p, a, b, along, opposite, bias, threads, 0, &extra, err);
+}
+
+void bb__clamped_line_extent(const bb_pyramid *p, int a, int b, int x, int y, int len,
+                             int *before, int *after) {
+  template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
+  sweep_job job = {.p = p, .a = a, .b = b};
+  job_template(&job, pts);
+  clamped_extent(&job, x, y, len, before, after);
+}
+
+long bb__sweep_long_line(int a, int b) {
+  template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
+  return LONG_LINE_POINTS / build_template(a, b, pts);
+}
+
+int bb__sweep_template(int a, int b, bb__template_point *out) {
+  return build_template(a, b, out);
+}
+
+void bb__sweep_template_extent(int a, int b, bb__template_extent *out) {
+  template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
+  const int count = build_template(a, b, pts);
+  *out = (bb__template_extent){0, 0,           0,
+                               0, pts[0].frac, count > 1 ? pts[count - 2].frac : 0.0};
+  for (int k = 0; k < count; k++) {
+    out->min_dx = imin(out->min_dx, imin(pts[k].x1, pts[k].x2));
+    out->max_dx = imax(out->max_dx, imax(pts[k].x1, pts[k].x2));
+    out->min_dy = imin(out->min_dy, imin(pts[k].y1, pts[k].y2));
+    out->max_dy = imax(out->max_dy, imax(pts[k].y1, pts[k].y2));
+  }
+}
+
+bb_status bb__sweep_stretches(const bb_pyramid *p, int a, int b,
+                              const bb__sweep_dir *along, const bb__sweep_dir *opposite,
+                              double bias, int threads, const bb__stretch *stretches,
+                              int count, int round, bb__line_hook hook, void *hook_ctx,
+                              bb_error *err) {
+  template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
+  if ((!along && !opposite) || count == 0)
+    return BB_OK;
+  if (round && p->addressing != BB_ADDRESS_PERIODIC)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a clamped line is not swept round");
+  sweep_job job;
+  bb_status st =
+      job_start(&job, pts, p, a, b, along, opposite, bias, hook, hook_ctx, NULL, NULL, err);
+  if (st != BB_OK)
+    return st;
+  job.kind = round ? LINE_ROUND : LINE_STRETCH;
+  job.stretch = stretches;
+  if (round)
+    job.period = bb__line_period(p, a, b);
+  int *x = malloc((size_t)count * sizeof(int)), *y = malloc((size_t)count * sizeof(int)),
+      *len = malloc((size_t)count * sizeof(int));
+  if (!x || !y || !len)
+    st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
+  for (int i = 0; st == BB_OK && i < count; i++) {
+    x[i] = stretches[i].x, y[i] = stretches[i].y, len[i] = stretches[i].len;
+    if (round && len[i] != job.period)
+      st = bb__fail(err, BB_ERR_ARGUMENT, "trace: a round line has %ld texels, not %d",
+                    job.period, len[i]);
+  }
+  if (st == BB_OK)
+    st = job_run(&job, x, y, len, count, threads, NULL, err);
+  free(x);
+  free(y);
+  free(len);
+  job_end(&job);
   return st;
 }

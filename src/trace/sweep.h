@@ -79,6 +79,7 @@ typedef struct bb__line_view {
   const bb__sweep_dir *dir[2];
   const float *found[2];
   const int64_t *tangent_key[2];
+  const unsigned char *want; /* the stretch's (bb__stretch), NULL: all */
 } bb__line_view;
 
 /* Called once per line, from the sweep's worker threads, instead of adding
@@ -142,5 +143,66 @@ bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
  * last, u growing away from the origin) of largest slope from the origin
  * (u0, z0) behind every point; -1 when size is 0. The sweeps' own search. */
 int bb__hull_tangent(const bb__walk_point *hull, int size, double u0, double z0);
+
+/* ------------------------------------------------------ parts of lines */
+
+/* A stretch of one line for bb__sweep_stretches: the line's texels 0 ..
+ * len-1, texel 0 at (x, y) (periodic coordinates in the image; clamped ones
+ * may start anywhere on a line), profiled `before` steps behind texel 0
+ * and `after` steps past texel len-1. On a side marked exact the profile
+ * holds everything that can decide a horizon (a clamped line's, out to
+ * where it turns flat); on the other sides a texel whose horizon the points
+ * beyond the profile could beat (bb_pyramid's global max at their nearest
+ * distance) is marched, which finds the same bits, as for the chunks of a
+ * long line. */
+typedef struct bb__stretch {
+  int x, y, len;
+  int before, after;
+  int exact_behind, exact_ahead;
+  /* NULL, or per texel bit k set when the caller wants its horizon along
+   * side k (0: (a, b), 1: (-a, -b)); a horizon not wanted is never marched
+   * and may be wrong where the profile cannot vouch for it */
+  const unsigned char *want;
+} bb__stretch;
+
+/* bb__sweep_lines_hooked over the given stretches of lines only. With
+ * round 1 (periodic addressing), each is a whole line of the period's
+ * texels (before and after unused), swept once round as the whole trace
+ * sweeps it: from the line's texel the whole trace starts at
+ * (bb__line_seed), the same bits. */
+bb_status bb__sweep_stretches(const bb_pyramid *p, int a, int b,
+                              const bb__sweep_dir *along, const bb__sweep_dir *opposite,
+                              double bias, int threads, const bb__stretch *stretches,
+                              int count, int round, bb__line_hook hook, void *hook_ctx,
+                              bb_error *err);
+
+/* The texel at which bb__sweep_lines starts the periodic line of step
+ * (a, b) through texel (x, y). */
+void bb__line_seed(const bb_pyramid *p, int a, int b, int x, int y, int *x0, int *y0);
+
+/* The steps the whole trace profiles before and after the clamped line of
+ * step (a, b) whose first texel is (x, y) and which has len texels: out to
+ * where the surface turns flat at either end. */
+void bb__clamped_line_extent(const bb_pyramid *p, int a, int b, int x, int y, int len,
+                             int *before, int *after);
+
+/* Periodic lines of step (a, b) longer than this many steps are swept in
+ * chunks (bb__sweep_lines with long_line 0). */
+long bb__sweep_long_line(int a, int b);
+
+/* The breakpoints of the step from (0, 0) to (a, b), by rising u, the next
+ * texel last, as the sweeps compute them (offset1 and offset2 unset): into
+ * out (room for 4 BB__MAX_LATTICE_STEP + 1); returns their count. */
+int bb__sweep_template(int a, int b, bb__template_point *out);
+
+/* Where the breakpoints of the step from a texel read vertices, relative to
+ * the texel (the texel itself included), and the fraction of the step at
+ * which its first point lies and its last point before the next texel (0
+ * when it has none). */
+typedef struct bb__template_extent {
+  int min_dx, max_dx, min_dy, max_dy;
+  double first_frac, last_inner_frac;
+} bb__template_extent;
+void bb__sweep_template_extent(int a, int b, bb__template_extent *out);
 
 #endif /* BB_TRACE_SWEEP_H */

@@ -5,6 +5,7 @@
 #include "trace/integrate.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"
+#include "trace/retrace.h"
 #include "trace/sweep.h"
 #include "trace/testing.h"
 
@@ -26,6 +27,7 @@ typedef struct trace_job {
   int channels;      /* 1 + basis_count */
   int *order;        /* slices in the order every path adds them up */
   float *vis;        /* sums of what the slices lose, then the visibility */
+  float *const *horizons; /* NULL, or per slice every texel's horizon (kept) */
 } trace_job;
 
 static int opposite_steps(const bb_rayset *rs, int s, int t) {
@@ -112,8 +114,11 @@ static bb_status trace_sweeps(trace_job *job, bb_error *err) {
   for (int k = 0; st == BB_OK && k < rs->slice_count;) {
     const int s = job->order[k];
     const int pair = k + 1 < rs->slice_count && opposite_steps(rs, s, job->order[k + 1]);
-    const bb__sweep_dir along = {rs, s, job->vis, NULL};
-    const bb__sweep_dir opposite = {rs, pair ? job->order[k + 1] : 0, job->vis, NULL};
+    const int t = pair ? job->order[k + 1] : 0;
+    const bb__sweep_dir along = {rs, s, job->vis,
+                                 job->horizons ? job->horizons[s] : NULL};
+    const bb__sweep_dir opposite = {rs, t, job->vis,
+                                    job->horizons ? job->horizons[t] : NULL};
     st = bb__sweep_lines(job->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1], &along,
                          pair ? &opposite : NULL, job->o->bias_texels, job->o->threads, 0, err);
     k += pair ? 2 : 1;
@@ -142,13 +147,16 @@ static bb_status check_trace(const bb_pyramid *p, const bb_rayset *rs, const bb_
   return BB_OK;
 }
 
-bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
-                                   const bb_trace_options *o, bb__trace_path path,
-                                   bb_image *vis, bb_error *err) {
+/* The batch trace by path; with horizons (the sweeps, the whole image),
+ * every texel's horizon in slice s is also written to horizons[s]. */
+static bb_status trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
+                                 const bb_trace_options *o, bb__trace_path path,
+                                 float *const *horizons, bb_image *vis, bb_error *err) {
   memset(vis, 0, sizeof *vis);
   bb_status st = check_trace(p, rs, o, err);
   if (st != BB_OK) return st;
-  trace_job job = {.p = p, .rs = rs, .o = o, .channels = 1 + rs->basis_count};
+  trace_job job = {
+      .p = p, .rs = rs, .o = o, .channels = 1 + rs->basis_count, .horizons = horizons};
   job.region = o->region.width ? o->region : (bb_region){0, 0, p->width, p->height};
   job.order = malloc((size_t)rs->slice_count * sizeof(int));
   if (!job.order || order_slices(rs, job.order) != 0)
@@ -168,6 +176,30 @@ bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
   free(job.order);
   if (st != BB_OK) bb_image_free(vis);
   return st;
+}
+
+bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
+                                   const bb_trace_options *o, bb__trace_path path,
+                                   bb_image *vis, bb_error *err) {
+  return trace_occlusion(p, rs, o, path, NULL, vis, err);
+}
+
+bb_status bb__trace_keeping_horizons(const bb_pyramid *p, const bb_rayset *rs,
+                                     const bb_trace_options *o, float *const *horizons,
+                                     bb_image *vis, bb_error *err) {
+  if (o && o->region.width != 0)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: horizons are kept for the whole image");
+  return trace_occlusion(p, rs, o, BB__TRACE_SWEEP, horizons, vis, err);
+}
+
+void bb__trace_texel(const bb_rayset *rs, const int *order, const float *const *horizons,
+                     size_t texel, float *vis) {
+  memset(vis, 0, (size_t)(1 + rs->basis_count) * sizeof *vis);
+  for (int k = 0; k < rs->slice_count; k++) {
+    const bb__slice_integral si = bb__slice_integral_of(rs, order[k]);
+    bb__slice_accumulate(&si, horizons[order[k]][texel], vis);
+  }
+  finish_texel(rs, vis);
 }
 
 bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,

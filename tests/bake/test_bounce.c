@@ -139,6 +139,46 @@ Test(bounce, progress_is_monotone_over_the_whole_bake) {
   bb_image_free(&h);
 }
 
+/* The trace's part of the units is bb_bake_slices(o), one a slice, as
+ * bumpbake.h says (a client names the stage from it: bumpbake serve): a
+ * trace of the caller's, counting the calls made while it runs, sees them
+ * end at exactly that; the inter-reflection's calls come after, beyond it. */
+typedef struct trace_count {
+  progress_log *log;
+  int calls_in_trace;
+} trace_count;
+
+static bb_status counting_trace(void *user, const bb_pyramid *p, const bb_rayset *rs,
+                                const bb_trace_options *o, bb_image *vis, bb_error *err) {
+  trace_count *t = user;
+  double found = 0.0;
+  bb_status st = bb_trace_occlusion(p, rs, o, vis, &found, err);
+  t->calls_in_trace = t->log->calls;
+  return st;
+}
+
+Test(bounce, the_trace_is_the_first_slices_units) {
+  bb_image h = load_fixture("noise_96x80.png");
+  bb_bake_options o = options(8.0f, 256, 0.5);
+  progress_log l = {{0}, {0}, 0, 0};
+  trace_count t = {&l, 0};
+  o.trace.progress = log_progress;
+  o.trace.progress_user = &l;
+  o.trace.trace = counting_trace;
+  o.trace.trace_user = &t;
+  bb_bake_result r = harness_bake(&h, &o);
+  const long slices = bb_bake_slices(&o);
+  cr_assert(t.calls_in_trace > 0 && t.calls_in_trace < l.calls, "%d of %d calls",
+            t.calls_in_trace, l.calls);
+  cr_expect_eq(l.done[t.calls_in_trace - 1], slices, "the trace ends at %ld, not %ld",
+               l.done[t.calls_in_trace - 1], slices);
+  for (int i = t.calls_in_trace; i < l.calls && i < 256; i++)
+    cr_expect_geq(l.done[i], slices, "call %d after the trace: %ld", i, l.done[i]);
+  cr_expect_gt(l.done[l.calls - 1], slices);
+  bb_bake_result_free(&r);
+  bb_image_free(&h);
+}
+
 /* ---- what bouncing light may and may not do ------------------------------- */
 
 Test(bounce, never_darker_and_ao_never_above_one) {

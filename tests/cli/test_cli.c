@@ -413,6 +413,43 @@ Test(cli, bake_of_flat_map) {
   bb_image_free(&img);
 }
 
+/* The command line recorded is quoted for a POSIX shell: pasted into one,
+ * a name with a blank or a ';' stays one word and runs nothing. A batch
+ * records each input's name quoted the same way. */
+Test(cli, the_recorded_command_is_quoted_for_a_shell) {
+  const char *in = tmp("my rock;x.png"), *ss = tmp("s s.png");
+  write_image(in, 16, 16, 1, mid_grey);
+  cli_result r = RUN("bake", in, "--scale", "8", "--rays", "16", "--ssbump", ss);
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  bb_image_info info;
+  bb_image img = read_image(ss, &info);
+  char command[1024];
+  snprintf(command, sizeof command, "command=bumpbake bake '%s' --scale 8 --rays 16 --ssbump '%s'\n",
+           in, ss);
+  cr_expect(info.description && strstr(info.description, command), "%s lacks '%s'",
+            info.description ? info.description : "(none)", command);
+  bb_image_info_free(&info);
+  bb_image_free(&img);
+
+  const char *dir = tmp("in"), *out = tmp("out");
+  cr_assert_eq(mkdir(dir, 0755), 0);
+  write_image(tmp("in/a b.png"), 8, 8, 1, mid_grey);
+  r = RUN("bake", dir, "--scale", "4", "--rays", "16", "--out-dir", out, "--maps", "ao",
+          "--name", "{stem} {kind}.png", "-q");
+  cr_assert_eq(r.code, 0, "%s", r.err);
+  cli_result_free(&r);
+  img = read_image(tmp("out/a b ao.png"), &info);
+  snprintf(command, sizeof command,
+           "command=bumpbake bake '%s/a b.png' --scale 4 --rays 16 --out-dir %s --maps ao "
+           "--name '{stem} {kind}.png'\n",
+           dir, out);
+  cr_expect(info.description && strstr(info.description, command), "%s lacks '%s'",
+            info.description ? info.description : "(none)", command);
+  bb_image_info_free(&info);
+  bb_image_free(&img);
+}
+
 Test(cli, bake_prefix_and_quiet) {
   const char *in = tmp("flat.png");
   write_image(in, 8, 8, 1, mid_grey);

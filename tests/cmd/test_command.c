@@ -74,7 +74,18 @@ Test(cmd, recorded_text_spells_what_changes_the_output) {
   c = command("bake", more);
   text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
   cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name {kind}/{stem}.tif");
+                         "--mips --out-dir out --name '{kind}/{stem}.tif'");
+  free(text);
+  bb_command_free(c);
+
+  /* quoted for a POSIX shell, inputs and values alike */
+  const char *odd[] = {"my rock.png", "--scale", "8", "--normal", "$HOME/n.png", NULL};
+  c = command("bake", odd);
+  text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake 'my rock.png' --scale 8 --normal '$HOME/n.png'");
+  free(text);
+  text = bb_command_text(c, "a;b.png", BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake 'a;b.png' --scale 8 --normal '$HOME/n.png'");
   free(text);
   bb_command_free(c);
 }
@@ -386,5 +397,46 @@ Test(cmd, flags_set_their_field) {
   cr_assert_eq(bb_command_new("height2ssbump", &c, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_command_set(c, "dump-filtered", NULL, &err), BB_OK, "%s", err.message);
   cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
+  bb_command_free(c);
+}
+
+/* bb_command_unset: an option back at its default and no longer given,
+ * so the rules see the command as if it had never been set (a page's
+ * control put back to its default is left out of the line it shows);
+ * an option whose setter does more than set its field refuses, as "0"
+ * does for such a flag. */
+Test(cmd, unset_puts_an_option_back_at_its_default) {
+  const char *words[] = {"h.png", "--scale", "8", "--ssbump", "s.png", "--bounce", "0.5",
+                         "--bounces", "3", "--slices", "8", NULL};
+  bb_command *c = command("bake", words);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_unset(c, "bounce", &err), BB_OK, "%s", err.message);
+  cr_expect_not(bb_command_given(c, "bounce"));
+  cr_expect_eq(bb_command_options_of(c)->job.bake.bounce_albedo, 0.0);
+  /* the line without --bounce is the CLI's refusal */
+  cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--bounces does nothing without --bounce RHO or --bounce-albedo FILE");
+  cr_assert_eq(bb_command_unset(c, "bounces", &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_unset(c, "slices", &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_options_of(c)->job.bake.slices, 0);
+  cr_expect_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 8 --ssbump s.png");
+  free(text);
+  /* an option never set: nothing to do; one unknown: the usual words */
+  cr_expect_eq(bb_command_unset(c, "bias", &err), BB_OK);
+  cr_expect_eq(bb_command_unset(c, "rayz", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "unknown option '--rayz' (did you mean --rays?)");
+  /* a setter of its own (--basis also reads a file) cannot be undone */
+  cr_assert_eq(bb_command_set(c, "basis", "hl2+z", &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_unset(c, "basis", &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--basis cannot be unset: leave it out");
+  bb_command_free(c);
+  /* a command's own default (serve's port) comes back too */
+  const char *serve[] = {"h.png", "--scale", "8", "--port", "9000", NULL};
+  c = command("serve", serve);
+  cr_assert_eq(bb_command_unset(c, "port", &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_options_of(c)->port, 8077);
   bb_command_free(c);
 }

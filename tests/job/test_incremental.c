@@ -177,9 +177,20 @@ Test(incremental, a_changed_parameter_input_or_kind_is_stale) {
   p = f.p;
   p.output_kind = "ao";
   cr_expect_eq(check(tmp("n.png"), &p, BB_DEPTH_DEFAULT, 0, NULL, 0), BB_OUTPUT_STALE);
+  /* A normal map does not depend on the trace: another ray set or ray
+   * count leaves it current; an ssbump's are stale. */
   p = f.p;
   p.rayset_id = NULL;
+  bb_bake_options fewer = f.options;
+  fewer.rays = 64;
+  p.options = &fewer;
   cr_expect_eq(check(tmp("n.png"), &p, BB_DEPTH_DEFAULT, 0, reason, sizeof reason),
+               BB_OUTPUT_CURRENT, "%s", reason);
+  bb_provenance ssbump = f.p;
+  ssbump.output_kind = "ssbump";
+  write_described(tmp("s.png"), &ssbump, BB_DEPTH_DEFAULT);
+  ssbump.rayset_id = NULL;
+  cr_expect_eq(check(tmp("s.png"), &ssbump, BB_DEPTH_DEFAULT, 0, reason, sizeof reason),
                BB_OUTPUT_STALE);
   cr_expect(strstr(reason, "rayset:"), "%s", reason);
   p = f.p;

@@ -81,7 +81,21 @@ Test(job, command_text_spells_the_options_as_typed) {
   o.name_template = "{kind}/{stem}.tif";
   text = bb_job_command_text(&o, "a.png");
   cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name {kind}/{stem}.tif");
+                         "--mips --out-dir out --name '{kind}/{stem}.tif'");
+  free(text);
+}
+
+/* The line is quoted for a POSIX shell (bb_text_shell_quoted): typed in
+ * one, a name with a blank or a ';' is one word, and runs nothing. */
+Test(job, command_text_is_quoted_for_a_shell) {
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 8.0f;
+  o.paths[BB_MAP_NORMAL] = "out dir/n.png";
+  o.brightness_file = "it's.png";
+  char *text = bb_job_command_text(&o, "x;touch PWNED;y.png");
+  cr_expect_str_eq(text, "bumpbake bake 'x;touch PWNED;y.png' --scale 8 --brightness "
+                         "'it'\\''s.png' --normal 'out dir/n.png'");
   free(text);
 }
 
@@ -328,4 +342,72 @@ Test(job, prefix_and_suffix_names) {
     cr_expect_str_eq(got ? got : "(null)", suffixed[i][2], "%s", suffixed[i][0]);
     free(got);
   }
+}
+
+/* A 16-bit height of w x h with a bump at (bx, by), written to path. */
+static void bump_file(const char *path, int w, int h, int bx, int by) {
+  bb_image img;
+  cr_assert_eq(bb_image_alloc(&img, w, h, 1, NULL), BB_OK);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      const double d2 = (x - bx) * (x - bx) + (y - by) * (y - by);
+      img.pixels[y * w + x] =
+          (float)(0.3 + 0.2 * sin(0.4 * x) * cos(0.3 * y) + 0.3 * exp(-d2 / 2.0));
+    }
+  harness_write(path, &img, BB_DEPTH_16, BB_RANGE_UNIT);
+  bb_image_free(&img);
+}
+
+/* bumpbake serve's way: the bakes of a job through a context that keeps
+ * (bb_bake_context_keep) bake a changed file again where it changed, and
+ * keep the maps a job without a context makes. */
+Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
+  const char *input = tmp("edited.png");
+  bump_file(input, 48, 40, 10, 10);
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 16.0f;
+  o.paths[BB_MAP_SSBUMP] = tmp("e_ssbump.exr");
+  o.force = 1;
+  bb_bake_context *context = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_bake_context_new(&context, &err), BB_OK);
+  bb_bake_context_keep(context, 1);
+  for (int edit = 0; edit < 3; edit++) {
+    if (edit > 0)
+      bump_file(input, 48, 40, 10 + 3 * edit, 10 + edit);
+    bb_job *job = NULL, *cold = NULL;
+    cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_job_plan(&input, 1, &o, &cold, &err), BB_OK, "%s", err.message);
+    bb_job_use_context(job, context);
+    bb_bake_result kept, whole;
+    cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &kept, &err), BB_OK,
+                 "%s", err.message);
+    cr_assert_eq(bb_job_bake_item(cold, 0, BB_MAPS_BAKED, NULL, NULL, &whole, &err),
+                 BB_OK, "%s", err.message);
+    const bb_region changed = bb_bake_context_changed(context);
+    if (edit > 0) {
+      cr_expect(bb__context_last_local(context), "edit %d was baked whole", edit);
+      cr_expect(changed.x0 <= 10 && changed.x0 + changed.width > 10 + 3 * edit &&
+                    changed.y0 <= 10 && changed.y0 + changed.height > 10 + edit,
+                "edit %d: %dx%d at (%d, %d) changed", edit, changed.width, changed.height,
+                changed.x0, changed.y0);
+    }
+    for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+      const bb_image *a = bb_bake_result_image(&kept, (bb_map_kind)k);
+      const bb_image *b = bb_bake_result_image(&whole, (bb_map_kind)k);
+      cr_assert_eq(a->pixels != NULL, b->pixels != NULL);
+      if (a->pixels)
+        cr_expect(
+            memcmp(a->pixels, b->pixels,
+                   (size_t)a->width * (size_t)a->height * (size_t)a->channels * 4) == 0,
+            "edit %d: map %d differs from the job's without a context", edit, k);
+    }
+    cr_expect_null(kept.vis.pixels, "the job's bake lets vis go, as without a context");
+    bb_bake_result_free(&kept);
+    bb_bake_result_free(&whole);
+    bb_job_free(job);
+    bb_job_free(cold);
+  }
+  bb_bake_context_free(context);
 }

@@ -1,6 +1,7 @@
 /* test_raster.c: the rasteriser's row runs against a scan of each
- * triangle's whole box (what it did before), sample for sample, and the
- * bound on what a flat render bump may draw. */
+ * triangle's whole box (what it did before), sample for sample, the box
+ * itself against every sample centre, and the bound on what a flat render
+ * bump may draw. */
 #include "bumpbake.h"
 #include "mesh/rasterize.h"
 
@@ -11,39 +12,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The box scan, as bb__band_draw did it before: every sample whose centre
- * lies in the triangle's box, through the same inside test and depth
- * rule. */
-static void sample_span(double lo, double hi, int n, int count, int *first, int *last) {
-  double f = ceil(lo * n - 0.5), l = floor(hi * n - 0.5);
-  *first = f < 0.0 ? 0 : (f > count ? count : (int)f);
-  *last = l >= count ? count - 1 : (l < -1.0 ? -1 : (int)l);
-}
-
+/* The box scan, as bb__band_draw did it before: every sample of the
+ * triangle's box, through the rasteriser's own row terms and sample test.
+ * Only the row runs (bb__band_draw's clipping) are left to compare. */
 static void box_scan_draw(bb__sample_band *band, const bb__raster_setup *s, int32_t id) {
-  const int n = band->per_texel;
   int i0, i1, j0, j1;
-  sample_span(s->box[0], s->box[2], n, band->columns, &i0, &i1);
-  sample_span(s->box[1], s->box[3], n, band->first_row + band->rows, &j0, &j1);
-  if (j0 < band->first_row)
-    j0 = band->first_row;
+  bb__raster_box(band, s, &i0, &i1, &j0, &j1);
   for (int j = j0; j <= j1; j++) {
-    const double v = (j + 0.5) / n;
-    const double row0 = s->b[0] * v + s->c[0], row1 = s->b[1] * v + s->c[1],
-                 row2 = s->b[2] * v + s->c[2];
-    double *depth = band->depth + (long)(j - band->first_row) * band->columns;
-    int32_t *winner = band->winner + (long)(j - band->first_row) * band->columns;
-    for (int i = i0; i <= i1; i++) {
-      const double u = (i + 0.5) / n;
-      const double e0 = s->a[0] * u + row0, e1 = s->a[1] * u + row1, e2 = s->a[2] * u + row2;
-      if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0)
-        continue;
-      const double d = (e0 * s->d[0] + e1 * s->d[1] + e2 * s->d[2]) * s->inv_area;
-      if (winner[i] < 0 || d > depth[i]) {
-        winner[i] = id;
-        depth[i] = d;
-      }
-    }
+    const bb__raster_row r = bb__raster_row_at(band, s, j);
+    for (int i = i0; i <= i1; i++)
+      bb__raster_sample(s, &r, i, band->per_texel, id);
   }
 }
 
@@ -83,11 +61,20 @@ static void random_triangle(int kind, int W, int H, int n, bb__raster_tri *t) {
     break;
   case 6: /* vertices on sample centres: edges through samples */
     for (int k = 0; k < 3; k++)
-      t->u[k] = (floor(uniform() * W * n) + 0.5) / n, t->v[k] = (floor(uniform() * H * n) + 0.5) / n;
+      t->u[k] = (floor(uniform() * W * n) + 0.5) / n,
+      t->v[k] = (floor(uniform() * H * n) + 0.5) / n;
     break;
   default:
     break;
   }
+}
+
+/* Triangle id of the sequence above (its kind id % 7), set up; 0 when it
+ * has no area. */
+static int random_setup(int32_t id, int W, int H, int n, bb__raster_setup *s) {
+  bb__raster_tri t;
+  random_triangle(id % 7, W, H, n, &t);
+  return bb__raster_setup_make(&t, s);
 }
 
 /* Thousands of triangles of every kind, drawn in order into bands of
@@ -99,15 +86,14 @@ Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
       bb__sample_band a = {W * n, H * n - first, first, n, NULL, NULL}, b = a;
       size_t count = (size_t)a.columns * (size_t)a.rows;
       a.depth = malloc(count * sizeof(double)), b.depth = malloc(count * sizeof(double));
-      a.winner = malloc(count * sizeof(int32_t)), b.winner = malloc(count * sizeof(int32_t));
+      a.winner = malloc(count * sizeof(int32_t)),
+      b.winner = malloc(count * sizeof(int32_t));
       cr_assert(a.depth && b.depth && a.winner && b.winner);
       for (size_t k = 0; k < count; k++)
         a.winner[k] = b.winner[k] = -1, a.depth[k] = b.depth[k] = 0.0;
       for (int32_t id = 0; id < 3500; id++) {
-        bb__raster_tri t;
-        random_triangle(id % 7, W, H, n, &t);
         bb__raster_setup s;
-        if (!bb__raster_setup_make(&t, &s))
+        if (!random_setup(id, W, H, n, &s))
           continue;
         bb__band_draw(&a, &s, id);
         box_scan_draw(&b, &s, id);
@@ -118,6 +104,84 @@ Test(raster, row_runs_draw_exactly_what_the_box_scan_draws) {
                    "depths differ, %d samples per texel, band from row %d", n, first);
       free(a.depth), free(b.depth), free(a.winner), free(b.winner);
     }
+  }
+}
+
+/* The first and last of count sample centres (i + 0.5) / n in [lo, hi],
+ * found by looking at each one; last < first when there is none. */
+static void centres_within(double lo, double hi, int n, int from, int count, int *first,
+                           int *last) {
+  *first = count, *last = -1;
+  for (int i = from; i < count; i++) {
+    const double centre = (i + 0.5) / n;
+    if (centre >= lo && centre <= hi) {
+      if (*first == count)
+        *first = i;
+      *last = i;
+    }
+  }
+}
+
+/* The box's columns and rows are the sample centres it holds, within the
+ * band, for triangles of every kind (edges on centres, far outside). */
+Test(raster, the_box_holds_exactly_the_sample_centres_inside_it) {
+  const int W = 37, H = 23;
+  for (int n = 1; n <= 16; n += (n < 4 ? 1 : 5)) {
+    for (int first = 0; first < H * n; first += H * n / 3) {
+      const bb__sample_band band = {W * n, H * n - first, first, n, NULL, NULL};
+      for (int id = 0; id < 2000; id++) {
+        bb__raster_setup s;
+        if (!random_setup(id, W, H, n, &s))
+          continue;
+        int i0, i1, j0, j1, want_i0, want_i1, want_j0, want_j1;
+        bb__raster_box(&band, &s, &i0, &i1, &j0, &j1);
+        centres_within(s.box[0], s.box[2], n, 0, band.columns, &want_i0, &want_i1);
+        centres_within(s.box[1], s.box[3], n, first, first + band.rows, &want_j0,
+                       &want_j1);
+        if (want_i1 < want_i0 || want_j1 < want_j0) {
+          cr_assert(i1 < i0 || j1 < j0, "triangle %d (n %d, from row %d): box not empty",
+                    id, n, first);
+          continue;
+        }
+        cr_assert(i0 == want_i0 && i1 == want_i1 && j0 == want_j0 && j1 == want_j1,
+                  "triangle %d (n %d, from row %d): box %d..%d x %d..%d, centres %d..%d "
+                  "x %d..%d",
+                  id, n, first, i0, i1, j0, j1, want_i0, want_i1, want_j0, want_j1);
+      }
+    }
+  }
+}
+
+/* A right angle on a sample centre, its legs along the row and the column
+ * (so both its edges are exactly 0 there): the sample is inside, and
+ * drawn, at the box's first corner and at its last, at every centre of
+ * every sampling. */
+Test(raster, a_right_angle_on_a_sample_centre_draws_that_sample) {
+  const int W = 6, H = 5;
+  for (int n = 1; n <= 16; n++) {
+    bb__sample_band band = {W * n, H * n, 0, n, NULL, NULL};
+    const size_t count = (size_t)band.columns * (size_t)band.rows;
+    band.depth = calloc(count, sizeof(double)),
+    band.winner = malloc(count * sizeof(int32_t));
+    cr_assert(band.depth && band.winner);
+    for (size_t k = 0; k < count; k++)
+      band.winner[k] = -1;
+    int32_t id = 0;
+    for (int j = 0; j < band.rows; j++)
+      for (int i = 0; i < band.columns; i++)
+        for (int leg = -2; leg <= 2; leg += 4, id++) {
+          const double u = (i + 0.5) / n, v = (j + 0.5) / n;
+          /* nearer than everything drawn before, so the sample is its own */
+          bb__raster_tri t = {{u, u + leg, u}, {v, v, v + leg}, {id, id, id}};
+          bb__raster_setup s;
+          cr_assert(bb__raster_setup_make(&t, &s));
+          bb__band_draw(&band, &s, id);
+          cr_assert_eq(
+              band.winner[(size_t)j * (size_t)band.columns + (size_t)i], id,
+              "%d samples per texel: the corner on sample (%d, %d), legs %+d, not drawn",
+              n, i, j, leg);
+        }
+    free(band.depth), free(band.winner);
   }
 }
 
@@ -137,7 +201,8 @@ Test(raster, a_pile_of_triangles_is_refused_and_a_spread_is_not) {
   bb_renderbump_result r;
   bb_error err = {{0}};
   cr_expect_eq(bb_renderbump_flat(&pile, &o, &r, &err), BB_ERR_SIZE);
-  cr_expect(strstr(err.message, "over the 256 layers a render may draw"), "%s", err.message);
+  cr_expect(strstr(err.message, "over the 256 layers a render may draw"), "%s",
+            err.message);
   cr_expect_null(r.normal.pixels);
   bb_mesh_free(&pile);
 

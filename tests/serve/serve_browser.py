@@ -27,10 +27,10 @@ def browser_missing():
 class Server:
     """bumpbake serve HEIGHT ARGS... on 127.0.0.1, any free port."""
 
-    def __init__(self, binary, height, args):
+    def __init__(self, binary, height, args, cwd=None):
         self.proc = subprocess.Popen(
             [binary, "serve", height, "--port", "0", *args],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd)
         line = self.proc.stdout.readline()
         m = re.search(r"(http://\S+)", line)
         if not m:
@@ -54,6 +54,7 @@ def start_browser(width=1100, height=760):
     profile = tempfile.mkdtemp(prefix="bb-chromium-")
     options = webdriver.ChromeOptions()
     options.binary_location = CHROMIUM
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})  # the console, for tests
     for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic",
                  "--no-first-run", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync",
@@ -116,7 +117,8 @@ def library_ranges(binary):
     found = {}
     for command, names in (("bake", {n: n for n in ("scale", "rays", "slices", "bias",
                                                    "bounce", "bounces")}),
-                           ("render", {"view": "view_elevation", "light": "light_elevation"})):
+                           ("render", {"view": "view_elevation", "light": "light_elevation",
+                                       "light-color": "light_color"})):
         text = subprocess.run([binary, command, "--help"], capture_output=True, text=True,
                               check=True).stdout
         for line in text.splitlines():

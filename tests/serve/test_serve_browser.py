@@ -70,7 +70,116 @@ def test_page_draws_the_ssbump(page):
     assert 20 < s["mean"] < 235, s
     assert page.find_element("id", "error").text == ""
     assert "bumpbake bake" in page.find_element("id", "command").text
+    assert not is_stale(page)
+    # nothing the page asked for was missing (a favicon included)
+    missing = [e["message"] for e in page.get_log("browser")
+               if "404" in e["message"] or "Failed to load" in e["message"]]
+    assert not missing, missing
     shot(page, "1-ssbump")
+
+
+def is_stale(driver):
+    return driver.execute_script("return document.getElementById('view').classList"
+                                 ".contains('stale')")
+
+
+def stale_text(driver):
+    return driver.execute_script("return document.getElementById('stale').textContent")
+
+
+def visible(driver, element_id):
+    return driver.execute_script(
+        "const e = document.getElementById(arguments[0]);"
+        "return !!(e.offsetWidth || e.offsetHeight || e.getClientRects().length)", element_id)
+
+
+def test_the_view_controls_show_only_where_they_apply(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    expect = {"0": (True, False), "1": (True, False), "2": (True, False), "3": (False, False),
+              "4": (False, False), "5": (False, False), "6": (False, False),
+              "7": (False, False), "8": (True, True)}
+    for mode, (light_shown, view_shown) in expect.items():
+        page.execute_script("const m = document.getElementById('mode'); m.value = arguments[0];"
+                            "m.dispatchEvent(new Event('input'))", mode)
+        assert visible(page, "light-controls") == light_shown, mode
+        assert visible(page, "light-readout") == light_shown, mode
+        assert visible(page, "view-controls") == view_shown, mode
+        if mode == "8":
+            shot(page, "1c-relief-controls")
+    page.execute_script("const m = document.getElementById('mode'); m.value = '0';"
+                        "m.dispatchEvent(new Event('input'))")
+
+
+def test_the_view_elevation_box_takes_and_shows_what_is_drawn(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    view = sb.library_ranges(BIN)["view_elevation"]
+    el = page.find_element("id", "view-el")
+    # the default is a value the box accepts (its min and step allow it)
+    assert el.get_attribute("value") == "30"
+    assert page.execute_script("return arguments[0].checkValidity()", el)
+
+    def picture_at(text):
+        return page.execute_script(
+            "const el = document.getElementById('view-el'), m = document.getElementById('mode');"
+            "m.value = '8'; el.value = arguments[0]; el.dispatchEvent(new Event('change'));"
+            "draw(); return [el.value, bbCanvasStats().hash];", text)
+
+    low, high = int(view["min"]), int(view["max"])
+    at_low, at_high, at_30 = picture_at(str(low)), picture_at(str(high)), picture_at("30")
+    assert picture_at("0") == [str(low), at_low[1]]        # 0 draws at the bottom, not at 30
+    assert picture_at("95") == [str(high), at_high[1]]     # the box shows what is drawn
+    assert at_low[1] != at_30[1] != at_high[1]
+    picture_at("30")
+    page.execute_script("document.getElementById('mode').value = '0'; draw();")
+
+
+def test_the_light_readout_is_legible_on_white(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    colours = page.execute_script(
+        "const s = getComputedStyle(document.getElementById('light-readout'));"
+        "return [s.color, s.backgroundColor];")
+
+    def rgba(css):
+        v = [float(x) for x in css[css.index("(") + 1:-1].split(",")]
+        return v + [1.0] * (4 - len(v))
+
+    def luminance(c):
+        lin = [(x / 255 / 12.92 if x / 255 <= 0.04045 else ((x / 255 + 0.055) / 1.055) ** 2.4)
+               for x in c[:3]]
+        return 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+
+    fg, bg = rgba(colours[0]), rgba(colours[1])
+    # the background over a white map
+    under = [bg[k] * bg[3] + 255 * (1 - bg[3]) for k in range(3)]
+    ratio = (luminance(fg) + 0.05) / (luminance(under) + 0.05)
+    assert ratio >= 4.5, (colours, ratio)  # WCAG's contrast for text
+
+
+def test_the_command_line_wraps_between_words(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    # each word of the shown command sits on one line, unless it is as wide
+    # as the line itself; and the command does wrap
+    got = page.execute_script("""
+        const el = document.getElementById('command'), width = el.clientWidth;
+        const lines = new Set(), split = [];
+        for (const span of el.querySelectorAll('.word')) {
+          const rects = [...span.getClientRects()];
+          const r = document.createRange();
+          r.selectNodeContents(span);
+          const tops = new Set([...r.getClientRects()].map((x) => Math.round(x.top)));
+          tops.forEach((t) => lines.add(t));
+          if (tops.size > 1 && span.getBoundingClientRect().width < width - 1)
+            split.push(span.textContent);
+        }
+        return [el.textContent, lines.size, split];""")
+    text, line_count, split = got
+    assert text == state_command(page), text
+    assert line_count > 1, "the command fits one line: no wrapping to check (%r)" % text
+    assert not split, split
+
+
+def state_command(page):
+    return page.execute_script("return state.command")
 
 
 FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
@@ -171,14 +280,98 @@ def test_a_broken_save_keeps_the_last_maps(page, server, work):
     sb.wait_for(lambda: page.find_element("id", "error").text, SLOW, "the error shown")
     assert "height.png" in page.find_element("id", "error").text
     assert sb.drawn_bake(page) == old
-    assert stats(page)["hash"] == before["hash"]
+    assert stats(page)["hash"] == before["hash"]  # the pixels drawn; the page dims them
     assert state(server)["bake"]["id"] == old
+    # the picture marked stale, saying why
+    sb.wait_for(lambda: is_stale(page), 30, "the picture marked stale")
+    assert "height.png" in stale_text(page) and ("bake %d" % old) in stale_text(page)
     shot(page, "5-broken-save")
     # the next good save clears it
     with open(os.path.join(FIXTURES, "rock06_128.png"), "rb") as f:
         sb.save_by_rename(f.read(), str(work / "height.png"))
     sb.wait_for(lambda: sb.drawn_bake(page) > old, SLOW, "the good save's bake drawn")
     assert page.find_element("id", "error").text == ""
+    sb.wait_for(lambda: not is_stale(page), 30, "the picture no longer stale")
+
+
+def test_a_deleted_height_is_reported_on_the_page(page, server, work):
+    old = sb.drawn_bake(page)
+    with open(work / "height.png", "rb") as f:
+        kept = f.read()
+    os.remove(work / "height.png")
+    try:
+        sb.wait_for(lambda: is_stale(page) and "height.png" in stale_text(page), SLOW,
+                    "the deletion shown")
+        assert "height.png" in page.find_element("id", "error").text
+        assert sb.drawn_bake(page) == old
+        shot(page, "5b-deleted-height")
+    finally:
+        sb.save_by_rename(kept, str(work / "height.png"))
+    sb.wait_for(lambda: sb.drawn_bake(page) > old and not is_stale(page), SLOW,
+                "the height back, baked")
+
+
+def test_zoom_pan_and_one_to_one(page):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    page.execute_script("fit(); draw();")
+    fitted = stats(page)["hash"]
+    page.find_element("id", "zoom-1").click()
+    sb.wait_for(lambda: page.find_element("id", "zoom-text").text == "100%", 10, "1:1")
+    page.execute_script("draw()")
+    one = stats(page)
+    assert one["hash"] != fitted
+    shot(page, "10-one-to-one")
+    # a wheel turn zooms in about the pointer: a texel covers more pixels
+    page.execute_script(
+        "const r = canvas.getBoundingClientRect();"
+        "canvas.dispatchEvent(new WheelEvent('wheel', {deltaY: -100, clientX: r.left + 100,"
+        " clientY: r.top + 100, bubbles: true, cancelable: true})); draw();")
+    assert page.find_element("id", "zoom-text").text == "125%"
+    zoomed = stats(page)["hash"]
+    assert zoomed != one["hash"]
+    # shift-drag pans: the picture moves, the light does not
+    light_before = page.find_element("id", "light-text").text
+    page.execute_script(
+        "const r = canvas.getBoundingClientRect(), x = r.left + 300, y = r.top + 300;"
+        "const ev = (type, dx) => new PointerEvent(type, {clientX: x + dx, clientY: y,"
+        " shiftKey: true, buttons: 1, button: 0, pointerId: 1, bubbles: true});"
+        "canvas.dispatchEvent(ev('pointerdown', 0)); canvas.dispatchEvent(ev('pointermove', 60));"
+        "canvas.dispatchEvent(ev('pointerup', 60)); draw();")
+    assert stats(page)["hash"] != zoomed
+    assert page.find_element("id", "light-text").text == light_before
+    shot(page, "11-zoomed-panned")
+    page.find_element("id", "zoom-fit").click()
+    page.execute_script("draw()")
+    assert stats(page)["hash"] == fitted
+    assert page.find_element("id", "zoom-text").text.startswith("fit")
+
+
+def test_a_and_b_are_the_last_two_bakes(page, server):
+    sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    before = sb.drawn_bake(page)
+    a_hash = stats(page)["hash"]
+    scale = page.find_element("id", "p-scale")
+    old_scale = state(server)["params"]["scale"]
+    new_scale = 13 if old_scale != 13 else 14
+    page.execute_script("arguments[0].value = arguments[1];"
+                        "arguments[0].dispatchEvent(new Event('change'))", scale, str(new_scale))
+    sb.wait_for(lambda: sb.drawn_bake(page) > before and
+                page.execute_script("return current && current.whole && !!previous"),
+                SLOW, "the new bake drawn whole")
+    after = sb.drawn_bake(page)
+    new_hash = stats(page)["hash"]
+    assert new_hash != a_hash
+    page.find_element("id", "ab").click()
+    assert sb.drawn_bake(page) == before
+    assert stats(page)["hash"] == a_hash
+    assert ("bake %d" % before) in page.find_element("id", "ab-text").text
+    shot(page, "12-b-the-bake-before")
+    page.find_element("id", "ab").click()
+    assert sb.drawn_bake(page) == after and stats(page)["hash"] == new_hash
+    # the scale back as the tests after this one expect it
+    page.execute_script("arguments[0].value = arguments[1];"
+                        "arguments[0].dispatchEvent(new Event('change'))", scale, str(old_scale))
+    sb.wait_for(lambda: sb.drawn_bake(page) > after, SLOW, "the scale back")
 
 
 def test_write_is_the_bake_commands_bytes(page, server, work):
@@ -379,6 +572,96 @@ def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path):
         assert driver.execute_script("return document.getElementById('mode').value") == "1"
         assert stats(driver)["mean"] > 20  # the normal map, lit
         shot(driver, "8-basis-of-4")
+    finally:
+        sb.stop_browser(driver)
+        server.close()
+
+
+# ------------------------------------------------------ a bake in flight
+
+def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
+    server = sb.Server(BIN, str(tmp_path / "height.png"),
+                       ["--scale", "16", "--rays", "1024", "--bounce", "0.5", "--quiet"])
+    driver = sb.start_browser()
+    try:
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) >= 1 and not is_stale(driver), 3 * SLOW,
+                    "the first bake drawn")
+        driver.execute_script(
+            "const s = document.getElementById('p-scale'); s.value = '48';"
+            "s.dispatchEvent(new Event('change'))")
+        sb.wait_for(lambda: is_stale(driver) and "baking: " in stale_text(driver),
+                    SLOW, "the bake shown as running")
+        assert "the picture is bake 1's" in stale_text(driver)
+        assert driver.find_element("id", "status").text.startswith("baking: ")
+        shot(driver, "9-stale-while-baking")
+        sb.wait_for(lambda: "baking: bounce" in stale_text(driver), 3 * SLOW,
+                    "the bounce shown as the stage")
+        shot(driver, "9b-stale-bounce-stage")
+        sb.wait_for(lambda: sb.drawn_bake(driver) >= 2 and not is_stale(driver), 3 * SLOW,
+                    "the new bake drawn")
+    finally:
+        sb.stop_browser(driver)
+        server.close()
+
+
+# ------------------------------------------ a colour map and a light colour
+
+def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
+    import base64
+
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
+    albedo = str(tmp_path / "colour.png")  # a colourful map of the same size: a normal map
+    subprocess.run([BIN, "bake", str(tmp_path / "height.png"), "--scale", "16", "--normal",
+                    albedo, "-q"], check=True, timeout=SLOW)
+    server = sb.Server(BIN, str(tmp_path / "height.png"),
+                       ["--scale", "32", "--albedo", albedo, "--light-color", "1,0.8,0.6",
+                        "--quiet"])
+    driver = sb.start_browser()
+    try:
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
+        sb.wait_for(lambda: driver.execute_script("return current && current.whole"), SLOW,
+                    "every map loaded")
+        st = state(server)
+        assert st["params"]["light_color"] == [1, 0.800000011920929, 0.6000000238418579] or \
+            [round(x, 6) for x in st["params"]["light_color"]] == [1, 0.8, 0.6]
+        assert st["bake"]["albedo"] is True
+        assert driver.find_element("id", "light-color").get_attribute("value") == "1,0.8,0.6"
+        shot(driver, "13-albedo-light-colour")
+        status = urllib.request.urlopen(urllib.request.Request(
+            server.url + "write", method="POST", headers={"X-Bumpbake": "1"}), timeout=SLOW).status
+        assert status == 200
+        ssbump = str(tmp_path / "height_ssbump.png")
+        out = str(tmp_path / "render.png")
+        for mode, light in ((0, "135,45"), (1, "250,30")):
+            maps = (["--ssbump", ssbump] if mode == 0 else
+                    ["--normal", str(tmp_path / "height_normal.png"), "--mode", "normal"])
+            subprocess.run([BIN, "render", *maps, "--albedo", albedo, "--light-color",
+                            "1,0.8,0.6", "--light", light, "-o", out], check=True,
+                           timeout=SLOW, stdout=subprocess.DEVNULL)
+            with open(out, "rb") as f:
+                png = base64.b64encode(f.read()).decode()
+            az, el = (float(v) for v in light.split(","))
+            driver.set_script_timeout(60)
+            diff = driver.execute_async_script(COMPARE_JS, png, st["bake"]["width"],
+                                               st["bake"]["height"], az, el, mode)
+            print("page against render --albedo --light-color, mode %d: %s" % (mode, diff))
+            assert diff["worst"] <= 1 and diff["mean"] < 0.05, diff
+        # the light colour is render's row: checked by the library, no re-bake
+        bake = st["bake"]["id"]
+        refused = driver.execute_script(
+            "const c = document.getElementById('light-color'); c.value = '1,x,1';"
+            "c.dispatchEvent(new Event('change'));")
+        sb.wait_for(lambda: driver.find_element("id", "controls-error").text, 30, "the refusal")
+        assert "--light-color" in driver.find_element("id", "controls-error").text
+        driver.execute_script(
+            "const c = document.getElementById('light-color'); c.value = '0.2,0.4,1';"
+            "c.dispatchEvent(new Event('change'));")
+        sb.wait_for(lambda: state(server)["params"]["light_color"][2] == 1 and
+                    state(server)["params"]["light_color"][0] < 0.3, 30, "the new colour")
+        assert state(server)["bake"]["id"] == bake and refused is None
     finally:
         sb.stop_browser(driver)
         server.close()

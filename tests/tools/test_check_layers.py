@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """test_check_layers.py: tools/check_layers.py passes this tree's sources and
 refuses, in a copy of them, an upward include (by folder and by relative
-path), an upward call between two objects, a folder missing from the order
-and a Makefile order that differs. `make check-layers` runs it after the
-check itself; it prints one line, or what failed and exits 1."""
+path), an upward call between two objects, a folder missing from the order,
+a Makefile order that differs and the public header's sections in another
+order. `make check-layers` runs it after the check itself; it prints one
+line, or what failed and exits 1."""
 import os
 import shutil
 import subprocess
@@ -28,9 +29,11 @@ def expect(name, root, status, words, *args):
 
 
 def copy_tree(dst):
-    """docs/how-it-works.md, README.md and the sources of src/."""
+    """docs/how-it-works.md, README.md, include/bumpbake.h and the sources of src/."""
     os.makedirs(os.path.join(dst, "docs"))
     shutil.copy(os.path.join(ROOT, "docs", "how-it-works.md"), os.path.join(dst, "docs"))
+    os.makedirs(os.path.join(dst, "include"))
+    shutil.copy(os.path.join(ROOT, "include", "bumpbake.h"), os.path.join(dst, "include"))
     shutil.copy(os.path.join(ROOT, "README.md"), dst)
     shutil.copytree(os.path.join(ROOT, "src"), os.path.join(dst, "src"),
                     ignore=lambda d, names: [n for n in names if n.endswith((".o", ".d"))])
@@ -85,11 +88,24 @@ def main():
 
         expect("a Makefile order that differs", tree, 1, ["FAMILIES"],
                "--families", "core image files")
+
+        # The header's sections: two swapped, then one named otherwise.
+        header = os.path.join(tree, "include", "bumpbake.h")
+        saved = open(header, encoding="utf-8").read()
+        for name, text in (("swapped", saved.replace("\n * trace:", "\n * TRACE:")
+                            .replace("\n * image:", "\n * trace:").replace("\n * TRACE:", "\n * image:")),
+                           ("renamed", saved.replace("\n * cmd:", "\n * commands:"))):
+            with open(header, "w", encoding="utf-8") as f:
+                f.write(text)
+            expect(f"the header's sections {name}", tree, 1, ["include/bumpbake.h's sections"])
+        with open(header, "w", encoding="utf-8") as f:
+            f.write(saved)
+        expect("the header restored", tree, 0, ["point down"])
     if failures:
         print("test_check_layers: FAILED\n" + "\n".join(failures))
         return 1
     print("test_check_layers: upward includes (by folder, relative), an upward call, a folder "
-          "outside the order and another Makefile order are refused")
+          "outside the order, another Makefile order and header sections out of order are refused")
     return 0
 
 

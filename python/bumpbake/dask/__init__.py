@@ -9,7 +9,8 @@ big maps spread over many machines, the bytes one machine writes.
                                     scale=64)
 
 bake_files: a batch planned on the client, its stale inputs baked on the
-workers in chunks. bake_big: one map whose trace (the sweeps of its
+workers in chunks. check_files: a golden suite (bumpbake.check with heights) baked and
+compared on the workers, reported by the client. bake_big: one map whose trace (the sweeps of its
 slices) is split over the workers and added up in the single machine's
 order, so its files are a single bake's bit for bit. Workers open the
 client's paths (shared storage). `bumpbake bake ... --scheduler ADDRESS`
@@ -27,6 +28,7 @@ except ImportError as e:
 
 from ._batch import bake_files
 from ._big import bake_big
+from ._check import check_files
 from ._connect import ClusterLost
 
-__all__ = ["ClusterLost", "bake_big", "bake_files"]
+__all__ = ["ClusterLost", "bake_big", "bake_files", "check_files"]

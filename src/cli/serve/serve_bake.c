@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 static double now_seconds(void) {
@@ -26,17 +27,53 @@ void serve_request_bake(serve_state *s) {
   pthread_cond_signal(&s->work);
 }
 
+static void free_maps(serve_bake *b) {
+  bb_bake_result_free(&b->maps);
+  bb_job_free(b->job);
+  b->job = NULL;
+}
+
 void serve_bake_release(serve_bake *b) {
   if (!b || --b->refs > 0)
     return;
   for (int t = 0; t < SERVE_TEX_COUNT; t++)
     free(b->tex[t]);
-  bb_bake_result_free(&b->maps);
-  bb_job_free(b->job);
+  free_maps(b);
   pthread_mutex_destroy(&b->tex_lock);
   free(b->provenance);
   free(b->command);
   free(b);
+}
+
+serve_bake *serve_maps_use(serve_state *s) {
+  serve_bake *b = s->current;
+  if (!b || b->maps_shed)
+    return NULL;
+  b->refs++;
+  b->maps_users++;
+  return b;
+}
+
+void serve_maps_done(serve_bake *b) {
+  if (--b->maps_users == 0 && b->maps_shed)
+    free_maps(b);
+}
+
+/* b is no longer shown: its maps and job go now, or with their last user.
+ * The caller holds the lock. */
+static void shed_maps(serve_bake *b) {
+  b->maps_shed = 1;
+  if (b->maps_users == 0)
+    free_maps(b);
+}
+
+int serve_inputs_changed(const serve_state *s, const serve_bake *b) {
+  for (int i = 0; i < s->watched_count; i++) {
+    uint64_t now = 0;
+    if (bb_file_hash(s->watched[i], &now, NULL) != BB_OK || now != b->input_hashes[i])
+      return i;
+  }
+  return -1;
 }
 
 void serve_job_options(const serve_state *s, bb_job_options *o) {
@@ -49,8 +86,8 @@ void serve_job_options(const serve_state *s, bb_job_options *o) {
   o->texture = s->settings.texture;
   o->basis_file = s->settings.basis_file;
   o->brightness_file = s->use_brightness ? s->brightness_file : NULL;
-  o->force = 1;       /* a single bake always bakes */
-  o->command = NULL;  /* provenance: bb_job_command_text, the line the page shows */
+  o->force = 1;      /* a single bake always bakes */
+  o->command = NULL; /* provenance: bb_job_command_text, the line the page shows */
   o->note = NULL;
 }
 
@@ -58,20 +95,45 @@ void serve_job_options(const serve_state *s, bb_job_options *o) {
 
 typedef struct progress_ctx {
   serve_state *s;
-  long wanted; /* the request this bake answers */
+  long wanted;      /* the request this bake answers */
+  long slices;      /* with inter-reflection, the trace's units of the whole (bumpbake.h:
+                       bb_bake_slices); 0 without */
+  long most, total; /* the furthest done seen, and the whole */
 } progress_ctx;
 
-/* Records the fraction for the page (ten times a second at most) and
- * cancels when a newer request came. */
+/* The stage running, from what the progress callback said so far: nothing
+ * yet while the height is read and smoothed, then the trace's units (the
+ * first slices ones with inter-reflection, the bounces' after them), then
+ * the derived maps once the whole is done. */
+static const char *stage_of(const progress_ctx *p) {
+  if (p->most == 0)
+    return "load and smooth";
+  if (p->most >= p->total)
+    return "derive";
+  return p->slices && p->most > p->slices ? "bounce" : "trace";
+}
+
+/* Records the fraction and the stage for the page (a stage at once, the
+ * fraction ten times a second at most) and cancels when a newer request
+ * came. */
 static int on_progress(void *user, long done, long total) {
   progress_ctx *p = user;
-  if (atomic_load(&p->s->wanted) != p->wanted)
+  if (atomic_load(&p->s->wanted) != p->wanted || atomic_load(&p->s->quit))
     return 1;
+  if (total > 0) {
+    p->total = total;
+    if (done > p->most)
+      p->most = done;
+  }
+  const char *stage = stage_of(p);
   double now = now_seconds();
   pthread_mutex_lock(&p->s->lock);
-  if (total > 0 && now - p->s->last_progress_seconds >= 0.1) {
+  const int moved = total > 0 && now - p->s->last_progress_seconds >= 0.1;
+  if (moved || stage != p->s->stage) {
     p->s->last_progress_seconds = now;
-    p->s->progress = (double)done / (double)total;
+    if (total > 0)
+      p->s->progress = (double)done / (double)total;
+    p->s->stage = stage;
     p->s->version++;
     pthread_cond_broadcast(&p->s->changed);
   }
@@ -90,13 +152,15 @@ static unsigned char unit_byte(float v) {
 }
 
 /* Channels c0..c2 of img (or of nothing: 0) into RGB of tex, unit values or
- * signed vectors ((v + 1) / 2), and alpha from channel 0 of alpha_img. */
+ * signed vectors ((v + 1) / 2), and alpha from channel 0 of alpha_img; a
+ * grey img (1 or 2 channels) fills R, G and B alike. */
 static void fill(unsigned char *tex, size_t n, const bb_image *img, int is_vector,
                  const bb_image *alpha_img) {
+  const int grey = img && img->channels < 3;
   for (size_t i = 0; i < n; i++) {
     for (int c = 0; c < 3; c++) {
-      float v = img && img->pixels && c < img->channels
-                    ? img->pixels[i * (size_t)img->channels + (size_t)c]
+      float v = img && img->pixels && (grey || c < img->channels)
+                    ? img->pixels[i * (size_t)img->channels + (size_t)(grey ? 0 : c)]
                     : 0.0f;
       tex[4 * i + (size_t)c] = unit_byte(is_vector ? 0.5f * (v + 1.0f) : v);
     }
@@ -106,29 +170,55 @@ static void fill(unsigned char *tex, size_t n, const bb_image *img, int is_vecto
   }
 }
 
-const unsigned char *serve_bake_texture(serve_bake *b, int t) {
+static void make_texture(serve_bake *b, int t) {
+  const size_t n = (size_t)b->width * (size_t)b->height;
+  const bb_bake_result *r = &b->maps;
+  if ((b->tex[t] = malloc(4 * n))) {
+    switch (t) {
+    case SERVE_TEX_SSBUMP_AO:
+      fill(b->tex[t], n, &r->ssbump, 0, &r->ao);
+      break;
+    case SERVE_TEX_NORMAL_HEIGHT:
+      fill(b->tex[t], n, &r->normal, 1, &r->filtered);
+      break;
+    case SERVE_TEX_BENT:
+      fill(b->tex[t], n, &r->bent, 1, NULL);
+      break;
+    case SERVE_TEX_WEIGHTS:
+      fill(b->tex[t], n, &r->weights, 0, NULL);
+      break;
+    default:
+      break; /* the albedo is made with the bake */
+    }
+  }
+}
+
+const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t) {
   pthread_mutex_lock(&b->tex_lock);
   if (!b->tex[t]) {
-    const double t0 = now_seconds();
-    const size_t n = (size_t)b->width * (size_t)b->height;
-    const bb_bake_result *r = &b->maps;
-    if ((b->tex[t] = malloc(4 * n))) {
-      switch (t) {
-      case SERVE_TEX_SSBUMP_AO: fill(b->tex[t], n, &r->ssbump, 0, &r->ao); break;
-      case SERVE_TEX_NORMAL_HEIGHT: fill(b->tex[t], n, &r->normal, 1, &r->filtered); break;
-      case SERVE_TEX_BENT: fill(b->tex[t], n, &r->bent, 1, NULL); break;
-      default: fill(b->tex[t], n, &r->weights, 0, NULL); break;
-      }
+    pthread_mutex_lock(&s->lock);
+    const int usable = !b->maps_shed;
+    if (usable)
+      b->maps_users++;
+    pthread_mutex_unlock(&s->lock);
+    if (usable) {
+      const double t0 = now_seconds();
+      make_texture(b, t);
+      pthread_mutex_lock(&s->lock);
+      b->seconds_textures += now_seconds() - t0;
+      serve_maps_done(b);
+      pthread_mutex_unlock(&s->lock);
     }
-    b->seconds_textures += now_seconds() - t0;
   }
+  const unsigned char *tex = b->tex[t];
   pthread_mutex_unlock(&b->tex_lock);
-  return b->tex[t];
+  return tex;
 }
 
 /* The ssbump's provenance as the job records it in the file it writes. */
 static char *provenance_of(const bb_job_options *o, const bb_job_report *rep,
-                           const bb_bake_result *r, const char *command, const char *input) {
+                           const bb_bake_result *r, const char *command,
+                           const char *input) {
   const char *name = strrchr(input, '/');
   bb_provenance p = {command,
                      name ? name + 1 : input,
@@ -144,6 +234,78 @@ static char *provenance_of(const bb_job_options *o, const bb_job_report *rep,
 
 /* ----------------------------------------------------------------- bake */
 
+/* Planning a job creates its outputs' folders; a bake writes nothing, not
+ * even a folder, until the page asks. So a bake whose outputs' folder is
+ * gone (the height's folder moved away, say) is not planned: it fails
+ * with the height's own error when the height is gone too (the library's
+ * words, read without a plan), else saying which folder is missing. 1 when
+ * it fails so (message in err). */
+static int folder_gone(const bb_job_options *o, const char *input, bb_error *err) {
+  const char *paths[BB_MAP_BAKED_COUNT + 3];
+  int n = 0;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    if (o->paths[k])
+      paths[n++] = o->paths[k];
+  const char *single[] = {o->slope_path, o->valve_path, o->vmt};
+  for (size_t i = 0; i < sizeof single / sizeof *single; i++)
+    if (single[i])
+      paths[n++] = single[i];
+  for (int i = 0; i < n; i++) {
+    const char *slash = strrchr(paths[i], '/');
+    if (!slash || slash == paths[i])
+      continue;
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - paths[i]), paths[i]);
+    struct stat st;
+    if (stat(dir, &st) == 0)
+      continue;
+    if (bb_image_read_info(input, NULL, NULL, NULL, NULL, err) == BB_OK)
+      snprintf(err->message, sizeof err->message,
+               "%.200s: its folder %.200s is gone (serve makes none until \"write\")",
+               paths[i], dir);
+    return 1;
+  }
+  return 0;
+}
+
+/* render's --albedo as the page draws it, read with each bake (a save of
+ * it bakes again): 8-bit RGBA into *tex, NULL without one. The words of a
+ * refusal are render's. */
+static bb_status read_albedo(const char *path, int width, int height, unsigned char **tex,
+                             bb_error *err) {
+  *tex = NULL;
+  if (!path)
+    return BB_OK;
+  bb_image albedo = {0};
+  bb_status st = bb_image_read(path, &albedo, NULL, err);
+  if (st == BB_OK && (albedo.width != width || albedo.height != height)) {
+    snprintf(err->message, sizeof err->message,
+             "%.300s: albedo is %dx%d, but the maps are %dx%d", path, albedo.width,
+             albedo.height, width, height);
+    st = BB_ERR_SIZE;
+  }
+  const size_t n = (size_t)width * (size_t)height;
+  if (st == BB_OK && !(*tex = malloc(4 * n))) {
+    snprintf(err->message, sizeof err->message, "out of memory");
+    st = BB_ERR_MEMORY;
+  }
+  if (st == BB_OK)
+    fill(*tex, n, &albedo, 0, NULL);
+  bb_image_free(&albedo);
+  return st;
+}
+
+/* The maps of one bake of input through job: the job's read and bake of the
+ * height (bb_job_bake_item, the read and bake `bumpbake bake` runs). The one
+ * step a bake of only what an edit changed would stand in for. */
+static bb_status bake_maps(serve_state *s, bb_job *job, progress_ctx *p,
+                           bb_bake_result *result, bb_error *err) {
+  bb_job_use_context(job, s->context); /* this thread's bakes only */
+  bb_status st = bb_job_bake_item(job, 0, BB_MAPS_BAKED, on_progress, p, result, err);
+  bb_job_use_context(job, NULL); /* "write" may run it on another thread */
+  return st;
+}
+
 /* One bake of the options as they are now; publishes it or the error. */
 static void bake_once(serve_state *s, long wanted) {
   bb_job_options o;
@@ -151,6 +313,7 @@ static void bake_once(serve_state *s, long wanted) {
   serve_job_options(s, &o);
   const char *input = s->height_path;
   s->baking = 1;
+  s->stage = "load and smooth";
   s->progress = 0.0;
   s->last_progress_seconds = 0.0;
   s->version++;
@@ -158,21 +321,36 @@ static void bake_once(serve_state *s, long wanted) {
   pthread_mutex_unlock(&s->lock);
 
   const double t0 = now_seconds();
+  /* The other files the bake reads, hashed before it reads them: a change
+   * after this shows at a write, which then bakes again (the height's own
+   * hash is the job's, of the bytes it decoded). */
+  uint64_t hashes[SERVE_MAX_WATCHED] = {0};
+  for (int i = 1; i < s->watched_count; i++)
+    if (bb_file_hash(s->watched[i], &hashes[i], NULL) != BB_OK)
+      hashes[i] = 0;
   bb_error err = {{0}};
   bb_job *job = NULL;
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   serve_bake *b = NULL;
-  bb_status st = bb_job_plan(&input, 1, &o, &job, &err);
+  bb_status st =
+      folder_gone(&o, input, &err) ? BB_ERR_IO : bb_job_plan(&input, 1, &o, &job, &err);
   if (st == BB_OK) {
-    bb_job_use_context(job, s->context); /* this thread's bakes only */
-    progress_ctx p = {s, wanted};
-    st = bb_job_bake_item(job, 0, BB_MAPS_BAKED, on_progress, &p, &result, &err);
+    const int bounces = o.bake.bounce_albedo > 0.0 || o.bounce_albedo_file;
+    progress_ctx p = {s, wanted, bounces ? bb_bake_slices(&o.bake) : 0, 0, 0};
+    st = bake_maps(s, job, &p, &result, &err);
+  }
+  unsigned char *albedo = NULL;
+  if (st == BB_OK) {
+    const bb_job_report *rep = bb_job_report_get(job, 0);
+    st = read_albedo(s->albedo_file, rep->width, rep->height, &albedo, &err);
   }
   if (st == BB_OK) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
     if ((b = calloc(1, sizeof *b))) {
       b->refs = 1;
+      memcpy(b->input_hashes, hashes, sizeof hashes);
+      b->input_hashes[0] = rep->source.file_hash;
       b->width = rep->width;
       b->height = rep->height;
       pthread_mutex_init(&b->tex_lock, NULL);
@@ -185,8 +363,9 @@ static void bake_once(serve_state *s, long wanted) {
       b->provenance = provenance_of(&o, rep, &b->maps, b->command, input);
       b->normal_y_up = o.bake.normal_y_up;
       b->scale = (double)o.bake.height_scale;
+      b->tex[SERVE_TEX_ALBEDO] = albedo;
+      albedo = NULL;
       b->seconds = now_seconds() - t0;
-      bb_job_use_context(job, NULL); /* "write" may run it on another thread */
       b->job = job; /* kept: "write" writes these maps through it */
       job = NULL;
       b->wanted = wanted;
@@ -197,18 +376,29 @@ static void bake_once(serve_state *s, long wanted) {
   }
   bb_bake_result_free(&result);
   bb_job_free(job);
+  free(albedo);
 
   pthread_mutex_lock(&s->lock);
   s->baking = 0;
+  s->stage = NULL;
   s->done = wanted;
   if (st == BB_OK) {
     b->id = ++s->next_id;
-    serve_bake_release(s->current);
+    serve_bake_release(s->previous);
+    if ((s->previous = s->current))
+      shed_maps(s->previous);
     s->current = b;
     s->error[0] = '\0';
-    if (!s->quiet)
-      fprintf(stderr, "serve: bake %ld: %dx%d in %.3f s\n", b->id, b->width, b->height,
-              b->seconds);
+    if (!s->quiet) {
+      /* a save baked again where it changed says where */
+      const bb_region c = bb_bake_context_changed(s->context);
+      char where[96] = "";
+      if (c.width < b->width || c.height < b->height)
+        snprintf(where, sizeof where, ", again where it changed (%dx%d at %d,%d)", c.width,
+                 c.height, c.x0, c.y0);
+      fprintf(stderr, "serve: bake %ld: %dx%d in %.3f s%s\n", b->id, b->width, b->height,
+              b->seconds, where);
+    }
   } else if (st != BB_ERR_CANCELLED) {
     /* the last good maps stay on the page, with why the new ones are not */
     snprintf(s->error, sizeof s->error, "%s",

@@ -1,10 +1,10 @@
 /* serve_params.c: the page's side of the options: the state it draws as
  * JSON, the ranges of its inputs as the library describes the options
  * (bb_option_bounds), and its controls (scale, rays, slices, bias, bounce,
- * bounces, brightness) applied to the bake options: each bake control parsed as
- * `bumpbake bake` parses its option of that name (bb_command_set), its range
- * checked by the library (bb_bake_options_check), whose words a refusal
- * shows. */
+ * bounces, brightness) applied to the bake options: each set on the page's
+ * command as `bumpbake bake` sets its option of that name (bb_command_set),
+ * the whole checked as the command line is (bb_command_check), whose
+ * words a refusal shows. */
 #include "serve.h"
 
 #include <math.h>
@@ -27,6 +27,11 @@ static void add_params(bb_json *j, const serve_state *s) {
   bb_json_int(j, "bounces", b->bounces);
   bb_json_string(j, "brightness_file", s->brightness_file);
   bb_json_bool(j, "brightness", s->use_brightness);
+  bb_json_string(j, "albedo_file", s->albedo_file);
+  bb_json_open(j, "light_color", '[');
+  for (int k = 0; k < 3; k++)
+    bb_json_number(j, NULL, (double)s->light_color[k]);
+  bb_json_close(j, ']');
   bb_json_close(j, '}');
 }
 
@@ -42,10 +47,7 @@ static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_number(j, "seconds_pyramid", r->seconds_pyramid);
   bb_json_number(j, "seconds_trace", r->seconds_trace);
   bb_json_number(j, "seconds_derive", r->seconds_derive);
-  pthread_mutex_lock(&b->tex_lock);
-  const double textures = b->seconds_textures;
-  pthread_mutex_unlock(&b->tex_lock);
-  bb_json_number(j, "seconds_textures", textures);
+  bb_json_number(j, "seconds_textures", b->seconds_textures);
   bb_json_int(j, "threads", r->threads);
   bb_json_int(j, "slices", r->slices);
   bb_json_number(j, "scale", b->scale);
@@ -61,6 +63,7 @@ static void add_bake(bb_json *j, serve_bake *b) {
     bb_json_close(j, ']');
   }
   bb_json_close(j, ']');
+  bb_json_bool(j, "albedo", b->tex[SERVE_TEX_ALBEDO] != NULL);
   bb_json_string(j, "command", b->command);
   bb_json_string(j, "provenance", b->provenance);
   bb_json_close(j, '}');
@@ -91,7 +94,10 @@ static void write_state(bb_json *j, void *arg) {
   bb_json_open(j, NULL, '{');
   bb_json_string(j, "height", s->height_path);
   bb_json_bool(j, "baking", s->baking);
+  bb_json_string(j, "stage", s->baking ? s->stage : NULL);
   bb_json_number(j, "progress", s->progress);
+  /* a save or a control asked for a bake not yet begun or done */
+  bb_json_bool(j, "pending", atomic_load(&s->wanted) != s->done);
   bb_json_string(j, "error", s->error);
   bb_json_string(j, "command", command);
   add_params(j, s);
@@ -111,28 +117,72 @@ char *serve_state_json(serve_state *s) {
 /* The bake controls: bake's options of these names (parsed by the library,
  * bb_command_set, which refuses a value with the words every client prints:
  * "--rays needs an integer (got 'x')"), and where each lands in the bake
- * options. brightness is serve's own switch. */
-#define CONTROL(name, member) \
-  {name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member)}
+ * options. brightness is serve's switch of its --brightness FILE. */
+#define CONTROL(name, member)                                                            \
+  { name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member) }
 static const struct {
   const char *name;
   size_t offset, size;
-} controls[] = {CONTROL("scale", height_scale), CONTROL("rays", rays),
-                CONTROL("slices", slices),      CONTROL("bias", trace.bias_texels),
+} controls[] = {CONTROL("scale", height_scale),   CONTROL("rays", rays),
+                CONTROL("slices", slices),        CONTROL("bias", trace.bias_texels),
                 CONTROL("bounce", bounce_albedo), CONTROL("bounces", bounces)};
 #define CONTROL_COUNT (sizeof controls / sizeof controls[0])
 
-static int apply_one(serve_state *s, bb_command *cmd, int *use_brightness, const char *name,
-                     const char *value, char *err, size_t cap) {
-  for (size_t i = 0; i < CONTROL_COUNT; i++)
-    if (!strcmp(name, controls[i].name)) {
-      bb_error e = {{0}};
-      if (bb_command_set(cmd, name, value, &e) != BB_OK) {
-        snprintf(err, cap, "%s", e.message);
-        return -1;
-      }
-      return 0;
+/* text of size bytes as a string, a NUL in it spelled "\0" (so the
+ * parser refuses it as the text it is, not the part before it). malloc'd. */
+static char *spelled(const char *text, size_t size) {
+  char *out = malloc(2 * size + 1), *o = out;
+  for (size_t i = 0; out && i < size; i++) {
+    if (text[i] == '\0') {
+      *o++ = '\\';
+      *o++ = '0';
+    } else {
+      *o++ = text[i];
     }
+  }
+  if (out)
+    *o = '\0';
+  return out;
+}
+
+/* Sets control name to value on cmd (brightness: its file, or unset); a
+ * bake control at its default is unset. 0, or -1 with the words in err. */
+static int apply_one(const serve_state *s, bb_command *cmd, const char *name,
+                     const char *value, int *rebake, char *err, size_t cap) {
+  bb_error e = {{0}};
+  for (size_t i = 0; i < CONTROL_COUNT; i++) {
+    if (strcmp(name, controls[i].name))
+      continue;
+    *rebake = 1;
+    if (bb_command_set(cmd, name, value, &e) != BB_OK) {
+      snprintf(err, cap, "%s", e.message);
+      return -1;
+    }
+    bb_job_options d;
+    bb_job_options_init(&d);
+    const char *now =
+        (const char *)&bb_command_options_of(cmd)->job.bake + controls[i].offset;
+    if (!memcmp(now, (const char *)&d.bake + controls[i].offset, controls[i].size) &&
+        bb_command_unset(cmd, name, &e) != BB_OK) {
+      snprintf(err, cap, "%s", e.message);
+      return -1;
+    }
+    return 0;
+  }
+  if (!strcmp(name, "light-color")) { /* render's row: a light of the picture */
+    bb_render_options r;
+    bb_render_options_init(&r);
+    bb_status st = bb_command_set(cmd, name, value, &e);
+    const float *now = bb_command_options_of(cmd)->render.light_color;
+    if (st == BB_OK && !memcmp(now, r.light_color, sizeof r.light_color))
+      st = bb_command_unset(cmd, name, &e);
+    if (st != BB_OK) {
+      snprintf(err, cap, "%s", e.message);
+      return -1;
+    }
+    return 0;
+  }
+  *rebake = 1;
   if (!strcmp(name, "brightness")) {
     if (!s->brightness_file) {
       snprintf(err, cap, "brightness: no --brightness FILE was given to serve");
@@ -142,45 +192,60 @@ static int apply_one(serve_state *s, bb_command *cmd, int *use_brightness, const
       snprintf(err, cap, "brightness: 'on' or 'off'");
       return -1;
     }
-    *use_brightness = !strcmp(value, "on");
+    const bb_status st = !strcmp(value, "on")
+                             ? bb_command_set(cmd, "brightness", s->brightness_file, &e)
+                             : bb_command_unset(cmd, "brightness", &e);
+    if (st != BB_OK) {
+      snprintf(err, cap, "%s", e.message);
+      return -1;
+    }
     return 0;
   }
   snprintf(err, cap, "unknown control '%.40s'", name);
   return -1;
 }
 
-/* The controls set on cmd, their parsed values, over the settings b. */
-static void take_controls(const bb_command *cmd, bb_bake_options *b) {
-  const bb_bake_options *parsed = &bb_command_options_of(cmd)->job.bake;
-  for (size_t i = 0; i < CONTROL_COUNT; i++)
-    if (bb_command_given(cmd, controls[i].name))
-      memcpy((char *)b + controls[i].offset, (const char *)parsed + controls[i].offset,
-             controls[i].size);
-}
-
-int serve_apply_params(serve_state *s, const char *const *names, const char *const *values,
-                       int count, char *err, size_t cap) {
-  bb_command *cmd = NULL;
+int serve_apply_params(serve_state *s, const char *const *names,
+                       const char *const *values, const size_t *sizes, int count,
+                       int *rebake, char *err, size_t cap) {
+  *rebake = 0;
+  bb_command *next = NULL;
   bb_error e = {{0}};
-  if (bb_command_new("bake", &cmd, &e) != BB_OK) {
-    snprintf(err, cap, "%s", e.message);
+  size_t size = 0;
+  char *copy = bb_command_handover(s->command, &size);
+  if (!copy || bb_command_from_handover(copy, size, NULL, 0, &next, &e) != BB_OK) {
+    free(copy);
+    snprintf(err, cap, "%s", copy ? e.message : "out of memory");
     return -1;
   }
-  int use_brightness = s->use_brightness;
-  for (int i = 0; i < count; i++)
-    if (apply_one(s, cmd, &use_brightness, names[i], values[i], err, cap) != 0) {
-      bb_command_free(cmd);
-      return -1;
-    }
-  bb_bake_options b = s->settings.bake;
-  take_controls(cmd, &b);
-  bb_command_free(cmd);
-  if (bb_bake_options_check(&b, &e) != BB_OK) {
+  free(copy);
+  int rc = 0;
+  for (int i = 0; i < count && rc == 0; i++) {
+    char *value = spelled(values[i], sizes[i]);
+    rc = value ? apply_one(s, next, names[i], value, rebake, err, cap) : -1;
+    if (!value)
+      snprintf(err, cap, "out of memory");
+    free(value);
+  }
+  if (rc == 0 && bb_command_check(next, &e) != BB_OK) {
     snprintf(err, cap, "%s", e.message);
+    rc = -1;
+  }
+  if (rc != 0) {
+    bb_command_free(next);
     return -1;
   }
-  s->settings.bake = b;
-  s->use_brightness = use_brightness;
+  /* the controls' values, as checked; the rest of the settings (paths
+   * and files the command line named, owned by its command) stay */
+  const bb_bake_options *b = &bb_command_options_of(next)->job.bake;
+  for (size_t i = 0; i < CONTROL_COUNT; i++)
+    memcpy((char *)&s->settings.bake + controls[i].offset,
+           (const char *)b + controls[i].offset, controls[i].size);
+  s->use_brightness = bb_command_given(next, "brightness");
+  memcpy(s->light_color, bb_command_options_of(next)->render.light_color,
+         sizeof s->light_color);
+  bb_command_free(s->command);
+  s->command = next;
   s->version++;
   pthread_cond_broadcast(&s->changed);
   return 0;
@@ -217,6 +282,7 @@ static void write_ranges(bb_json *j, void *arg) {
    * AZ,EL take them: their range is the elevation's ("range EL 1..90") */
   add_range(j, "view_elevation", "render", "view");
   add_range(j, "light_elevation", "render", "light");
+  add_range(j, "light_color", "render", "light-color");
   bb_json_close(j, '}');
 }
 
