@@ -11,7 +11,7 @@
  * What the surface reflects. Each triangle's light is kept at its three
  * corners: for vertex v and each of its 6 triangles f ("slots"),
  * R = rho(v) / pi E_k(v, n_f), the irradiance of channel k on f's own plane
- * a quarter texel (`lift`) above v (at v itself its neighbours shadow it in
+ * a tenth of a texel (`lift`) above v (at v itself its neighbours shadow it in
  * every valley as no point inside the triangle is), blended linearly over
  * the triangle. A steep triangle (one rising more than `steep` texels: a
  * cliff one texel wide) is lit very differently at its foot and its top, so

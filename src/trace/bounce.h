@@ -23,8 +23,8 @@ typedef struct bb__bounce_options {
                              column of samples (0: none) */
   int column_samples;     /* samples up a column, >= 2 */
   int surface_slices;     /* slices of the bounces after the first, whose
-                             light is smooth; 0: half the trace's, at least
-                             4 (or the trace's, when fewer) */
+                             light is smooth; 0: a quarter of the trace's,
+                             at least 4 (or the trace's, when fewer) */
   /* the tangents of elevation of the fixed rays the gathers follow, rising,
    * NAN after the last: the texels' (from 0 up) and the samples' (below
    * their horizontal too) */
@@ -44,11 +44,12 @@ typedef struct bb__bounce_options {
 } bb__bounce_options;
 
 /* The defaults a bake uses (rho, albedo and bias left at 0/NULL): bounces
- * 0 with 1 estimate pass, lift 0.25, columns on triangles rising more than
- * 2 texels with 5 samples, the direct light over the trace's slices and the
- * surface passes over half of them, the texels' rays at tangents 0, 0.35,
- * 1 and 2.75 and the samples' at -2.75, -1, -0.35 and those.
- * docs/conventions.md "Inter-reflection" says why. */
+ * 0 with 1 estimate pass, lift 0.1, columns on triangles rising more than
+ * 2 texels with 5 samples, the direct light and the texels' gathers over
+ * the trace's sweeps (half each), the surface passes over a quarter of its
+ * slices, the texels' rays at tangents 0 and 1 and the samples' at -1 and
+ * 0, bands under tangent 0.25 seeing their horizon point, at most 48 hull
+ * vertices known (chain 0). docs/conventions.md "Inter-reflection" says why. */
 void bb__bounce_options_init(bb__bounce_options *o);
 
 /* The work bb__bounce_add does with these options and ray set, in the
