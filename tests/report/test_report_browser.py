@@ -129,7 +129,9 @@ def test_golden_new_and_difference_show_what_changed(page):
 def test_the_flip_and_the_slider(page):
     section = page.find_element("css selector", "section.case")
     flip = section.find_element("css selector", ".frame.flip")
-    page.execute_script("arguments[0].scrollIntoView()", flip)
+    # centred: scrolled to the top, the sticky header would cover the frames'
+    # first rows and the screenshots would compare the header's text
+    page.execute_script("arguments[0].scrollIntoView({block: 'center'})", flip)
     before = _pixels(shot(page, "flip-golden.png", flip))
     caption = lambda: page.execute_script(  # noqa: E731
         "return arguments[0].parentNode.querySelector('figcaption').textContent", flip)
