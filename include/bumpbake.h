@@ -1139,9 +1139,12 @@ struct bb_trace_options {
                               makes normals, so those stages cancel too;
                               with inter-reflection (bounce_albedo > 0) the
                               units run once over the trace and the
-                              bounces: the first bb_bake_slices(o) are the
-                              trace's (one a slice), the rest the
-                              bounces' */
+                              bounces: with a trace function of the
+                              caller's, the first bb_bake_slices(o) are
+                              the trace's (one a slice), the rest the
+                              bounces'; without one, the bounces' sweeps
+                              find the horizons too and every unit is
+                              theirs */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
                            bb_trace_occlusion; else bb_bake calls

@@ -31,8 +31,14 @@
 #    height (renderbumpflat of fixtures/rivet_panel.obj, tiled, at its own
 #    scale) at 256 and 512 (medians of 3); rock06 1024 x 1024 at scale 128
 #    (1 run; BOUNCE_LARGE=0 skips it).
+# 4. CPU by size: `bumpbake bake --ao --ssbump` on rock06 resized to 256,
+#    512, 1024 and 2048 (BOUNCE_SIZES) at scale size/16, with and without
+#    --bounce 0.5, 2 threads, CPU seconds (user + system), medians of 3; the
+#    ratio (goal: at most 3, not growing with size) and the bounce's CPU
+#    per texel and slice.
 #
-# Environment: BOUNCE_PATHS (65536), BOUNCE_STRIDE (8), BOUNCE_LARGE (1).
+# Environment: BOUNCE_PATHS (65536), BOUNCE_STRIDE (8), BOUNCE_LARGE (1),
+# BOUNCE_SIZES ("256 512 1024 2048").
 # Everything it writes goes into build/bench/bounce/. Exits 1 when a step
 # fails, 0 otherwise (whatever the figures).
 set -euo pipefail
@@ -117,7 +123,7 @@ while IFS=: read -r m path scale; do
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_bb" --rho "$rho" "${common[@]}" \
       >"$out/${m}_${rho}_bb.json" || { fail "bounce_bake $path"; continue; }
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_hp" --rho "$rho" "${common[@]}" \
-      --exact 0 --surface-exact 0 --far 0 --surface-far 0 >"$out/${m}_${rho}_hp.json" || { fail "bounce_bake $path"; continue; }
+      --small-band 1e6 --steep 0 >"$out/${m}_${rho}_hp.json" || { fail "bounce_bake $path"; continue; }
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_none" --rho 0 "${common[@]}" \
       >/dev/null || { fail "bounce_bake $path"; continue; }
     if "$tools/bounce_ref" compare "$ref" "$path" "$scale" \
@@ -201,4 +207,33 @@ fi
 echo "(ratio: with over without, a bounce's cost over a bake's; passes: of the bounce, 2 when" \
   "converged; the bake's defaults otherwise: smoothing radius 10, the vertex normal, 256 rays;" \
   "medians of 3 runs, 1 run on 1024 x 1024)"
+
+section "4. CPU by size: bake --ao --ssbump with and without --bounce 0.5 (rock06, scale size/16)"
+# The issue's measure: CPU seconds (user + system) of the whole command,
+# medians of 3 runs taken in turns; the bounce's CPU per texel and slice
+# (16 slices) is (with - without) / (size^2 16).
+printf '%-6s %10s %10s %8s %16s
+' size without with ratio "bounce ns/texel/slice"
+cpu_of() { # prints the CPU seconds of one run of "$@"
+  /usr/bin/time -o "$out/cpu.txt" -f '%U %S' "$@" >/dev/null 2>&1 || return 1
+  awk '{ print $1 + $2 }' "$out/cpu.txt"
+}
+if rock=$(find_fixture rock06_height.png); then
+  for n in ${BOUNCE_SIZES:-256 512 1024 2048}; do
+    map=$out/rock_size$n.png
+    [ -f "$map" ] && [ "$map" -nt "$rock" ] ||
+      oiiotool "$rock" --resize "${n}x$n" -d uint16 -o "$map" || { fail "resize $n"; continue; }
+    w=() b=()
+    for i in 1 2 3; do
+      cmd=("$bin" bake "$map" --scale $((n / 16)) --ao "$out/size_ao.png" --ssbump "$out/size_ss.png"
+        --threads "$threads" -q)
+      w+=("$(cpu_of "${cmd[@]}")") || { fail "bake $n"; continue 2; }
+      b+=("$(cpu_of "${cmd[@]}" --bounce 0.5)") || { fail "bake --bounce $n"; continue 2; }
+    done
+    mw=$(printf '%s\n' "${w[@]}" | sort -g | sed -n 2p)
+    mb=$(printf '%s\n' "${b[@]}" | sort -g | sed -n 2p)
+    awk -v n="$n" -v a="$mw" -v b="$mb" 'BEGIN {
+      printf "%-6s %9.2fs %9.2fs %7.2fx %16.0f\n", n, a, b, b / a, (b - a) / (n * n * 16) * 1e9 }'
+  done
+fi
 exit "$status"

@@ -4,16 +4,19 @@
  *   bounce_bake MAP SCALE PREFIX [--rays N] [--rho R] [--bounces N]
  *               [--bias B] [--filter-radius R] [--normal-filter NAME]
  *               [--clamp] [--threads T]
- *               [--exact N] [--surface-exact N] [--far N] [--surface-far N] [--lift L]
+ *               [--lift L] [--steep S] [--column-samples N]
  *               [--estimate-passes N] [--surface-slices N]
+ *               [--texel-slopes T,T,...] [--surface-slopes T,T,...]
+ *               [--small-band T] [--chain N]
  *
  * Writes PREFIX.ao.exr and PREFIX.ss.exr. Without the settings of the last
  * line it is bb_bake with bounce_albedo = R (the library's own defaults,
  * what `bumpbake bake --bounce R` makes); with any of them, the same
  * stages run one by one (smooth, normals, pyramid, trace, bb__bounce_add
- * with those settings, derive), so the bench can show what, say, the
- * horizon-point approximation (--exact 0 --surface-exact 0 --far 0
- * --surface-far 0) costs.
+ * with those settings, derive), so the bench can show what, say, fewer
+ * fixed rays (--texel-slopes 0) or no columns (--steep 0) cost, or the
+ * horizon-point approximation (--small-band 1e6 --steep 0: every band sees
+ * its horizon point's light).
  * Defaults: 256 rays, rho 0.5, bounces 0, bias 0.55, filter radius 0 (no
  * smoothing, as README "Accuracy"), Valve's normal. Prints one JSON line
  * (seconds of the trace and of the bounce, bounces followed) on stdout;
@@ -34,9 +37,10 @@ static int usage(const char *reason) {
           "bounce_bake: %s\n"
           "usage: bounce_bake MAP SCALE PREFIX [--rays N] [--rho R] [--bounces N] [--bias B]\n"
           "                   [--filter-radius R] [--normal-filter NAME] [--clamp] [--threads T]\n"
-          "                   [--exact N] [--surface-exact N] [--far N] [--surface-far N]\n"
-          "                   [--lift L]\n"
-          "                   [--estimate-passes N] [--surface-slices N]\n",
+          "                   [--lift L] [--steep S] [--column-samples N]\n"
+          "                   [--estimate-passes N] [--surface-slices N]\n"
+          "                   [--texel-slopes T,T,...] [--surface-slopes T,T,...]\n"
+          "                   [--small-band T] [--chain N]\n",
           reason);
   return 2;
 }
@@ -48,6 +52,22 @@ static int parse_number(const char *s, double lo, double hi, double *out) {
   if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi) return 1;
   *out = v;
   return 0;
+}
+
+/* "t0,t1,...": rising tangents into slopes, NAN after the last. */
+static int slopes_parse(const char *text, double *slopes) {
+  int n = 0;
+  for (const char *at = text; *at && n < BB__BOUNCE_MAX_SLOPES;) {
+    char *end;
+    errno = 0;
+    const double v = strtod(at, &end);
+    if (errno || end == at || !isfinite(v) || (n && !(v > slopes[n - 1]))) return 1;
+    slopes[n++] = v;
+    at = *end == ',' ? end + 1 : end;
+    if (*end && *end != ',') return 1;
+  }
+  for (int k = n; k < BB__BOUNCE_MAX_SLOPES; k++) slopes[k] = NAN;
+  return n == 0;
 }
 
 typedef struct args {
@@ -83,6 +103,12 @@ static int parse_args(int argc, char **argv, args *a) {
       if (bb_normal_filter_parse(s, &a->bake.normal_filter, &err) != BB_OK) return usage(err.message);
       continue;
     }
+    if (!strcmp(o, "--texel-slopes") || !strcmp(o, "--surface-slopes")) {
+      double *slopes = o[2] == 't' ? a->bounce.texel_slopes : a->bounce.surface_slopes;
+      if (slopes_parse(s, slopes)) return usage("slopes are up to 8 rising numbers, comma separated");
+      a->inner = 1;
+      continue;
+    }
     if (parse_number(s, 0.0, 1e9, &v)) return usage("bad option value");
     if (!strcmp(o, "--rays")) a->bake.rays = (int)v;
     else if (!strcmp(o, "--rho")) a->bake.bounce_albedo = v;
@@ -90,11 +116,11 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--bias")) a->bake.trace.bias_texels = v;
     else if (!strcmp(o, "--filter-radius")) a->bake.smooth.radius_texels = (int)v;
     else if (!strcmp(o, "--threads")) a->bake.trace.threads = (int)v;
-    else if (!strcmp(o, "--exact")) a->bounce.exact_steps = (int)v, a->inner = 1;
-    else if (!strcmp(o, "--surface-exact")) a->bounce.surface_exact_steps = (int)v, a->inner = 1;
-    else if (!strcmp(o, "--far")) a->bounce.far_steps = (int)v, a->inner = 1;
-    else if (!strcmp(o, "--surface-far")) a->bounce.surface_far_steps = (int)v, a->inner = 1;
     else if (!strcmp(o, "--lift")) a->bounce.lift = v, a->inner = 1;
+    else if (!strcmp(o, "--steep")) a->bounce.steep = v, a->inner = 1;
+    else if (!strcmp(o, "--column-samples") && v >= 2) a->bounce.column_samples = (int)v, a->inner = 1;
+    else if (!strcmp(o, "--chain")) a->bounce.chain = (int)v, a->inner = 1;
+    else if (!strcmp(o, "--small-band")) a->bounce.small_band = v, a->inner = 1;
     else if (!strcmp(o, "--estimate-passes")) a->bounce.estimate_passes = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-slices")) a->bounce.surface_slices = (int)v, a->inner = 1;
     else return usage("unknown option");

@@ -96,14 +96,16 @@ static int trace_progress_of(void *user, long done, long total) {
 }
 
 /* Inter-reflection, added to r->vis (bounce.c); the trace did trace_work
- * of the progress before it. */
+ * of the progress before it. With r->vis not yet made, the bounce's passes
+ * are the trace too (its sweeps find the texels' horizons, and r->vis is
+ * bb_trace_occlusion's, bit for bit, before the bounce is added). */
 static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
                         const bb_rayset *rays, int threads, long trace_work, bb_bake_result *r,
                         bb_error *err) {
   bb_image grey = {0};
   bb_status st = BB_OK;
   if (o->bounce_albedo_map)
-    st = albedo_grey(o->bounce_albedo_map, r->vis.width, r->vis.height, &grey, err);
+    st = albedo_grey(o->bounce_albedo_map, pyramid->width, pyramid->height, &grey, err);
   bb__bounce_options bo;
   bounce_options(o, threads, &bo);
   bo.albedo = grey.pixels ? &grey : NULL;
@@ -148,7 +150,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     bb_trace_options whole = o->trace;
     whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
     whole.threads = threads;
-    if (o->bounce_albedo > 0.0 && o->trace.progress) {
+    if (o->bounce_albedo > 0.0 && o->trace.progress && o->trace.trace) {
       bb__bounce_options bo;
       bounce_options(o, threads, &bo);
       progress.span = (long)rays.slice_count * BB__BOUNCE_TRACE_WORK;
@@ -161,6 +163,8 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     else if (keep)
       st = bb__trace_keeping_horizons(pyramid, &rays, &whole, keep->horizons, &r->vis,
                                       err);
+    else if (o->bounce_albedo > 0.0) /* the bounce's passes are the trace */
+      r->horizons_found = (double)pyramid->width * (double)pyramid->height * rays.slice_count;
     else
       st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
     if (st == BB_OK && keep)

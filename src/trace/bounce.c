@@ -1,6 +1,6 @@
 /* bounce.c: inter-reflection: the light the surrounding height field
- * reflects into each texel's ao and lobes, worked out from the horizons the
- * line sweeps find.
+ * reflects into each texel's ao and lobes, gathered from what the line
+ * sweeps' own walks see.
  *
  * The model (docs/conventions.md "Inter-reflection"). Every triangle is
  * Lambertian with albedo rho; the sky of channel k (ao: radiance 1; lobe c:
@@ -8,78 +8,81 @@
  * it again. A texel's blocked directions no longer bring nothing: each
  * brings the radiance of the surface it meets.
  *
- * What a triangle reflects is kept at its corners: for vertex v and each of
- * its 6 triangles f ("slots", below), R = rho(v) / pi E_k(v, n_f), the
- * irradiance of channel k on f's own plane near v. Over a triangle the
- * radiance is the linear blend of its three corners: a wall one cell wide
- * gets its own light at its top and at its foot, which a vertex normal
- * (half wall, half floor or plateau) would not give. The vertex itself is
- * a poor place to sample a triangle's light, since in every valley its
- * neighbours shadow it as no point inside the triangle is: the corners are
- * sampled `lift` (a quarter texel) above it, which took the bias of the
- * bounced light on the test maps from -0.001 to under 0.0003 (README
- * "Accuracy").
+ * What the surface reflects. Each triangle's light is kept at its three
+ * corners: for vertex v and each of its 6 triangles f ("slots"),
+ * R = rho(v) / pi E_k(v, n_f), the irradiance of channel k on f's own plane
+ * a tenth of a texel (`lift`) above v (at v itself its neighbours shadow it in
+ * every valley as no point inside the triangle is), blended linearly over
+ * the triangle. A steep triangle (one rising more than `steep` texels: a
+ * cliff one texel wide) is lit very differently at its foot and its top, so
+ * it gets a column instead: its light at `column_samples` heights from its
+ * foot to its top, sampled in front of it (above its lowest vertex, on its
+ * own plane), and read at the height where a ray meets it.
  *
- * E_k(v, n_f) is integrated per slice like the bake's visibility: the
- * sector above max(horizon, f's plane along the slice, 0) gives n_f .
+ * E is integrated per slice like the bake's visibility: the sector above
+ * max(horizon, the plane's own elevation along the slice, 0) gives n .
  * integral of sky_k(w) w dw over it, from tables of the three components
- * (built here, like integrate.c's, in q = t / (1 + t)). The bounces after
- * the first add what the surface below the horizons reflects, gathered the
- * same way over every direction above f's plane (the surface below the
- * horizontal too: a wall's foot sees the floor there).
+ * (built here, like integrate.c's, in q = t / (1 + t)).
  *
- * The gather. Along a slice's line the surface is a profile of breakpoints
- * (the sweeps' template, every point of it: between two neighbours the
- * profile lies in one triangle). Walking from the origin towards the
- * horizon's own point, the profile is seen where its slope from the origin
- * rises above every nearer point's: each such piece of a segment is a band
- * of elevations in which the rays meet that segment, at a point found from
- * the band's slope, with the radiance blended there. The last band ends at
- * the horizon. Every breakpoint counts within exact_steps lattice steps;
- * further on only the texels (the surface between two taken as straight),
- * stretches wholly under the rays passed at once through a max pyramid
- * over the steps; past far_steps the band left meets the horizon's own
- * point (at 0 and 0 steps that is the whole blocked band: the
- * horizon-point approximation, measured in README "Accuracy"). A band's
- * weight is exact (ao: w.z; lobes: solid angle; a corner: n_f . w above its
- * plane), its radiance the mean of its ends, or of finer pieces when it
- * spans more than 0.1 radians over which the radiance changes.
+ * The gather. Along a slice's line the surface is a profile, and the sweep
+ * walks it with the upper hull of the points beyond each origin. An origin
+ * sees, in its blocked band of elevations, the hull's vertices from the
+ * nearest up to its tangent point (the horizon's), each rising above every
+ * nearer point; and for a few fixed slopes shared by the whole line, where
+ * that ray first meets the profile (a stack per slope of the points beyond,
+ * in coordinates sheared by it: the first point above a ray is the first
+ * greater element, found in the stack from its near end). These known
+ * points of the visible surface, in order of elevation, stand for it: the
+ * band between two of them meets the straight chord between them, its
+ * radiance blended along the chord, in pieces when the band is wide. Every
+ * point is pushed once on each stack, each origin asks each stack once, so
+ * a pass costs time proportional to texels x slices, whatever the map's
+ * size or relief.
  *
- * Passes (each a sweep of every slice, in the trace's order, so every sum
- * is made in a fixed order and the result is the same on any thread
- * count): the direct light of every corner; then, for each further bounce,
- * the light its corners gather from the surface, over half the slices (the
- * light of later bounces is smooth); last, what each texel's origin
- * (lifted by the bake's bias) gathers, added to its visibility. With
- * bounces N that is N - 1 surface passes from the first bounce. With
- * bounces 0 (converged) the corners start from an estimate of all their
- * light (estimate_ratio), one surface pass gathers from it, and the rest
- * of the series, close to geometric, is added as the last move times
- * lambda / (1 - lambda), lambda the ratio of the last two moves summed
- * over every corner. Progress counts every pass's slices, weighted by
- * what they cost (slice_work).
+ * Passes (each a sweep of every slice of its set, in the trace's order, so
+ * every sum is made in a fixed order and the result is the same on any
+ * thread count): the direct light of every corner and column sample; then,
+ * for the bounces after the first, what they gather from the surface (over
+ * a set of fewer slices: that light is smooth), from below their
+ * horizontal too; last, what each texel's origin (lifted by the bake's
+ * bias) gathers, added to its visibility. With bounces N that is N - 1
+ * surface passes from the first bounce. With bounces 0 (converged) each
+ * sample starts from an estimate of all its light (estimate_ratio),
+ * estimate_passes surface passes gather from it, and the rest of the
+ * series, close to geometric, is added as the last move times
+ * lambda / (1 - lambda), lambda the ratio of the last two moves summed over
+ * every sample. Progress counts every pass's sweeps, weighted by what they
+ * cost (pass_work); each sweep polls the caller's progress every 50 ms, so
+ * a cancel is seen within a fraction of a second.
  */
-#include "core/internal.h"
 #include "trace/bounce.h"
+#include "core/internal.h"
 #include "trace/integrate.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include "trace/sweep.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { FACES = 6, MAX_CHANNELS = 1 + BB_MAX_BASIS };
-#define WIDE_BAND 0.1 /* radians: a band wider than this is cut into pieces */
-#define STEEPEST 1e15 /* a slope standing for straight down */
+enum { FACES = 6, MAX_CHANNELS = 1 + BB_MAX_BASIS, MAX_SLOPES = 8, MAX_KNOWN = 48 };
+#define WIDE_BAND 0.1           /* radians: a band wider than this is cut into pieces */
+#define TAN_WIDE_BAND 0.1003347 /* its tangent */
+#define CHANGE_PER_PIECE 0.02   /* radiance: a band's pieces change by at most this */
+#define FLAT_CHANGE 1e-3 /* radiance: a band changing less sees the mean of its ends */
+#define MAX_PIECES 2
+#define CROSSING_WALK 64 /* breakpoints a ray's crossing is looked for among */
+#define THIN_BAND                                                                        \
+  0.05 /* tangent: a face's plane this little above its horizon is not clipped */
 
 typedef enum pass_mode {
-  PASS_DIRECT,  /* corners: what the sky's open sectors give */
-  PASS_SURFACE, /* corners: what the surface below the horizons reflects */
+  PASS_DIRECT,  /* samples: what the sky's open sectors give */
+  PASS_SURFACE, /* samples: what the surface reflects to them */
   PASS_TEXEL    /* texels' origins: what the surface reflects to them */
 } pass_mode;
 
@@ -99,9 +102,12 @@ static const int slot_corner[FACES] = {0, 1, 0, 2, 2, 1};
 /* v modulo n, in [0, n): without a division when v is within one period
  * of it (the neighbours and lattice steps of the image's own texels). */
 static inline long wrap(long v, long n) {
-  if (v >= 0 && v < n) return v;
-  if (v >= n && v < 2 * n) return v - n;
-  if (v < 0 && v >= -n) return v + n;
+  if (v >= 0 && v < n)
+    return v;
+  if (v >= n && v < 2 * n)
+    return v - n;
+  if (v < 0 && v >= -n)
+    return v + n;
   const long r = v % n;
   return r < 0 ? r + n : r;
 }
@@ -110,22 +116,26 @@ static inline long wrap(long v, long n) {
  * triangle lie together: ((cell * 2 + half) * 3 + corner) * channels.
  * The index of vertex (x, y)'s slot f, or SIZE_MAX where the cell lies
  * outside a clamped image (corner_fixup fills its border cells). */
-static inline size_t corner_index(const bb_pyramid *p, long x, long y, int f, int channels) {
+static inline size_t corner_index(const bb_pyramid *p, long x, long y, int f,
+                                  int channels) {
   long cx = x + slot_dx[f], cy = y + slot_dy[f];
   if (p->addressing == BB_ADDRESS_PERIODIC) {
-    if (cx < 0) cx += p->width;
-    if (cy < 0) cy += p->height;
+    if (cx < 0)
+      cx += p->width;
+    if (cy < 0)
+      cy += p->height;
   } else if (cx < 0 || cy < 0) {
     return SIZE_MAX;
   }
   const size_t cell = (size_t)cy * (size_t)p->width + (size_t)cx;
-  return ((cell * 2 + (size_t)slot_upper[f]) * 3 + (size_t)slot_corner[f]) * (size_t)channels;
+  return ((cell * 2 + (size_t)slot_upper[f]) * 3 + (size_t)slot_corner[f]) *
+         (size_t)channels;
 }
 
 /* The three corners of half `upper` of cell (cx, cy) (any coordinates:
  * periodic ones wrap, clamped ones are held to the image's cells). */
-static inline const float *triangle_corners(const bb_pyramid *p, const float *radiance, long cx,
-                                            long cy, int upper, int channels) {
+static inline const float *triangle_corners(const bb_pyramid *p, const float *radiance,
+                                            long cx, long cy, int upper, int channels) {
   long x = cx, y = cy;
   if (p->addressing == BB_ADDRESS_PERIODIC) {
     x = wrap(x, p->width), y = wrap(y, p->height);
@@ -149,24 +159,6 @@ static inline double height_at(const bb_pyramid *p, long x, long y) {
   return (double)p->z[vertex_at(p, x, y)];
 }
 
-/* The normals of the 6 triangles around vertex (x, y): face_normal's
- * arithmetic, each of the 7 heights around it read once. */
-static void vertex_faces(const bb_pyramid *p, long x, long y, double n[FACES][3]) {
-  double z[3][3]; /* z[1 + dy][1 + dx]; (-1, -1) and (+1, +1) are no triangle's corner */
-  for (int j = -1; j <= 1; j++)
-    for (int i = -1; i <= 1; i++)
-      if (i != j || i == 0) z[1 + j][1 + i] = height_at(p, x + i, y + j);
-  for (int f = 0; f < FACES; f++) {
-    const int cx = 1 + slot_dx[f], cy = 1 + slot_dy[f]; /* the cell's (0, 0) in z */
-    if (slot_upper[f])
-      n[f][0] = z[cy + 1][cx] - z[cy + 1][cx + 1], n[f][1] = z[cy][cx + 1] - z[cy + 1][cx + 1];
-    else
-      n[f][0] = z[cy][cx] - z[cy][cx + 1], n[f][1] = z[cy][cx] - z[cy + 1][cx];
-    const double len = sqrt(n[f][0] * n[f][0] + n[f][1] * n[f][1] + 1.0);
-    n[f][0] /= len, n[f][1] /= len, n[f][2] = 1.0 / len;
-  }
-}
-
 /* ------------------------------------------------ vector sector tables */
 
 /* For slice s and channel k (0: ao's sky, 1 + c: lobe c), component j of
@@ -178,7 +170,7 @@ static void vertex_faces(const bb_pyramid *p, long x, long y, double n[FACES][3]
  * per interval. Good to about 1e-7 of the sector's share: bounced light is
  * scaled by rho and by the blocked part of the sky, so this is far under
  * anything a map shows. */
-enum { RING_NODES = 24, THETA_NODES = 8 };
+enum { RING_NODES = 16, THETA_NODES = 4, VT_INTERVALS = 64 };
 
 typedef struct rules {
   double ring_x[RING_NODES], ring_w[RING_NODES];
@@ -194,9 +186,10 @@ typedef struct lobe_ring {
 /* Adds to out[0..2] the integral over psi in [a, b] of
  * max(0, A cos psi + C)^P (cos(psi + beta), sin(psi + beta), 1); zero_a,
  * zero_b: the lobe vanishes at that end. */
-static void ring_piece(const lobe_ring *l, double A, double C, double a, double b, int zero_a,
-                       int zero_b, double out[3]) {
-  if (!(b > a)) return;
+static void ring_piece(const lobe_ring *l, double A, double C, double a, double b,
+                       int zero_a, int zero_b, double out[3]) {
+  if (!(b > a))
+    return;
   if (zero_a && zero_b) {
     const double mid = 0.5 * (a + b);
     ring_piece(l, A, C, a, mid, 1, 0, out);
@@ -207,11 +200,15 @@ static void ring_piece(const lobe_ring *l, double A, double C, double a, double 
   for (int i = 0; i < RING_NODES; i++) {
     const double x = 0.5 * (l->r->ring_x[i] + 1.0), w = 0.5 * l->r->ring_w[i];
     double psi, jacobian;
-    if (zero_a) psi = a + length * x * x, jacobian = 2.0 * length * x;
-    else if (zero_b) psi = b - length * x * x, jacobian = 2.0 * length * x;
-    else psi = a + length * x, jacobian = length;
+    if (zero_a)
+      psi = a + length * x * x, jacobian = 2.0 * length * x;
+    else if (zero_b)
+      psi = b - length * x * x, jacobian = 2.0 * length * x;
+    else
+      psi = a + length * x, jacobian = length;
     const double v = A * cos(psi) + C;
-    if (!(v > 0.0)) continue;
+    if (!(v > 0.0))
+      continue;
     const double f = (l->power == 1.0 ? v : pow(v, l->power)) * w * jacobian;
     out[0] += f * cos(psi + l->beta);
     out[1] += f * sin(psi + l->beta);
@@ -260,22 +257,24 @@ static void uniform_ring_at(double lo, double hi, double theta, double out[3]) {
 }
 
 typedef struct vtables {
-  int channels;       /* 1 + lobes */
-  size_t per_slice;   /* doubles of one slice's table */
-  double *coef;       /* per slice: interval k, channel k, component j: 4 coefficients */
-  double *total;      /* per slice: 3 per channel */
+  int channels;     /* 1 + lobes */
+  size_t per_slice; /* doubles of one slice's table */
+  double *coef;     /* per slice: interval k, channel k, component j: 4 coefficients */
+  double *total;    /* per slice: 3 per channel */
   double all[3 * MAX_CHANNELS]; /* the totals summed over the slices */
 } vtables;
 
 typedef struct table_job {
   const bb_rayset *rs;
+  const double *sector;        /* 2 per slice: the azimuths its tables cover */
+  const unsigned char *wanted; /* per slice: its tables are built (NULL: all) */
   vtables *t;
   const rules *r;
 } table_job;
 
 static void ring_of(const table_job *job, int s, int k, double theta, double out[3]) {
   const bb_rayset *rs = job->rs;
-  const double lo = rs->sector[2 * s], hi = rs->sector[2 * s + 1];
+  const double lo = job->sector[2 * s], hi = job->sector[2 * s + 1];
   if (k == 0) {
     uniform_ring_at(lo, hi, theta, out);
     return;
@@ -289,7 +288,9 @@ static void ring_of(const table_job *job, int s, int k, double theta, double out
 static void build_slice(void *user, int s) {
   table_job *job = user;
   vtables *t = job->t;
-  enum { N = BB__TABLE_INTERVALS };
+  if (job->wanted && !job->wanted[s])
+    return;
+  enum { N = VT_INTERVALS };
   const int channels = t->channels, width = 3 * channels;
   double *coef = t->coef + (size_t)s * t->per_slice;
   double *total = t->total + (size_t)s * (size_t)width;
@@ -298,7 +299,8 @@ static void build_slice(void *user, int s) {
     double value[3] = {0.0, 0.0, 0.0}, ring[3];
     double theta = 0.0, slope[3];
     ring_of(job, s, k, 0.0, ring);
-    for (int j = 0; j < 3; j++) slope[j] = ring[j]; /* cos 0 = 1, dtheta/dq = 1 at q = 0 */
+    for (int j = 0; j < 3; j++)
+      slope[j] = ring[j]; /* cos 0 = 1, dtheta/dq = 1 at q = 0 */
     for (int i = 0; i < N; i++) {
       const double q1 = (double)(i + 1) * h, theta1 = atan2(q1, 1.0 - q1);
       double step[3] = {0.0, 0.0, 0.0};
@@ -306,7 +308,8 @@ static void build_slice(void *user, int s) {
       for (int n = 0; n < THETA_NODES; n++) {
         const double th = mid + half * job->r->theta_x[n];
         ring_of(job, s, k, th, ring);
-        for (int j = 0; j < 3; j++) step[j] += job->r->theta_w[n] * ring[j] * cos(th);
+        for (int j = 0; j < 3; j++)
+          step[j] += job->r->theta_w[n] * ring[j] * cos(th);
       }
       const double dtheta_dq = 1.0 / ((1.0 - q1) * (1.0 - q1) + q1 * q1);
       ring_of(job, s, k, theta1, ring);
@@ -323,24 +326,32 @@ static void build_slice(void *user, int s) {
       }
       theta = theta1;
     }
-    for (int j = 0; j < 3; j++) total[3 * k + j] = value[j];
+    for (int j = 0; j < 3; j++)
+      total[3 * k + j] = value[j];
   }
 }
 
-static bb_status vtables_build(const bb_rayset *rs, int threads, vtables *t, bb_error *err) {
+/* The tables of rs's slices, each over sector[2 s] .. sector[2 s + 1]
+ * (NULL: the slice's own), those wanted only (NULL: all). */
+static bb_status vtables_build(const bb_rayset *rs, const double *sector,
+                               const unsigned char *wanted, int threads, vtables *t,
+                               bb_error *err) {
   memset(t, 0, sizeof *t);
   t->channels = 1 + rs->basis_count;
-  t->per_slice = (size_t)BB__TABLE_INTERVALS * 3 * (size_t)t->channels * 4;
-  t->coef = malloc((size_t)rs->slice_count * t->per_slice * sizeof(double));
-  t->total = malloc((size_t)rs->slice_count * 3 * (size_t)t->channels * sizeof(double));
-  if (!t->coef || !t->total) return bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
+  t->per_slice = (size_t)VT_INTERVALS * 3 * (size_t)t->channels * 4;
+  t->coef = calloc((size_t)rs->slice_count * t->per_slice, sizeof(double));
+  t->total = calloc((size_t)rs->slice_count * 3 * (size_t)t->channels, sizeof(double));
+  if (!t->coef || !t->total)
+    return bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
   rules r;
   bb__gauss_legendre(RING_NODES, r.ring_x, r.ring_w);
   bb__gauss_legendre(THETA_NODES, r.theta_x, r.theta_w);
-  table_job job = {rs, t, &r};
-  bb_status st = bb__parallel_for(rs->slice_count, threads, build_slice, &job, NULL, NULL, err);
+  table_job job = {rs, sector ? sector : rs->sector, wanted, t, &r};
+  bb_status st =
+      bb__parallel_for(rs->slice_count, threads, build_slice, &job, NULL, NULL, err);
   for (int s = 0; s < rs->slice_count; s++) /* in slice order, whatever the threads did */
-    for (int i = 0; i < 3 * t->channels; i++) t->all[i] += t->total[(size_t)s * 3 * (size_t)t->channels + (size_t)i];
+    for (int i = 0; i < 3 * t->channels; i++)
+      t->all[i] += t->total[(size_t)s * 3 * (size_t)t->channels + (size_t)i];
   return st;
 }
 
@@ -353,255 +364,166 @@ static void vtables_free(vtables *t) {
 static void vtables_eval(const vtables *t, int s, double tan_el, double *g) {
   const int width = 3 * t->channels;
   if (!(tan_el > 0.0)) {
-    for (int i = 0; i < width; i++) g[i] = 0.0;
+    for (int i = 0; i < width; i++)
+      g[i] = 0.0;
     return;
   }
-  if (tan_el > 1e100) tan_el = 1e100;
-  const double x = tan_el / (1.0 + tan_el) * BB__TABLE_INTERVALS;
+  if (tan_el > 1e100)
+    tan_el = 1e100;
+  const double x = tan_el / (1.0 + tan_el) * VT_INTERVALS;
   int k = (int)x;
-  if (k > BB__TABLE_INTERVALS - 1) k = BB__TABLE_INTERVALS - 1;
+  if (k > VT_INTERVALS - 1)
+    k = VT_INTERVALS - 1;
   const double f = x - (double)k;
   const double *coef = t->coef + (size_t)s * t->per_slice + (size_t)k * (size_t)width * 4;
-  for (int i = 0; i < width; i++) g[i] = BB__HERMITE(coef, f, i);
+  for (int i = 0; i < width; i++)
+    g[i] = BB__HERMITE(coef, f, i);
+}
+
+/* ------------------------------------------------------------- columns */
+
+/* The corners of half `upper` of a cell, offsets from its (0, 0) vertex. */
+static const int corner_ox[2][3] = {{0, 1, 0}, {1, 1, 0}};
+static const int corner_oy[2][3] = {{0, 0, 1}, {0, 1, 1}};
+
+/* Steep triangles (cell * 2 + half) and the light of each at several
+ * heights: its column. A column's samples lie above its triangle's lowest
+ * vertex (an image texel: the sweeps' origins are texels), from `lift`
+ * above it up to the triangle's top, evenly spaced, each lit on the
+ * triangle's own plane. */
+typedef struct columns {
+  int count, samples;
+  int *of_triangle; /* per triangle: its column, or -1 */
+  int *start; /* per vertex, and one more: its columns are list[start[v] .. start[v + 1])
+               */
+  int *list;
+  int *vertex;                     /* per column: the texel below it */
+  unsigned char *top;              /* per column: the triangle's corner at its top */
+  double *normal;                  /* per column: the triangle's unit normal (3) */
+  float *z;                        /* per column: its samples' heights */
+  float *direct, *radiance, *sums; /* per column: samples x channels */
+} columns;
+
+static void columns_free(columns *c) {
+  free(c->of_triangle), free(c->start), free(c->list), free(c->vertex), free(c->top),
+      free(c->normal);
+  free(c->z), free(c->direct), free(c->radiance), free(c->sums);
+  memset(c, 0, sizeof *c);
+}
+
+/* The columns of every triangle rising more than steep texels (none when
+ * steep <= 0 or samples < 2); 1 when out of memory. */
+static int columns_build(const bb_pyramid *p, double steep, int samples, double lift,
+                         int channels, columns *c) {
+  memset(c, 0, sizeof *c);
+  const long W = p->width, H = p->height;
+  const size_t triangles = (size_t)W * (size_t)H * 2, vertices = (size_t)W * (size_t)H;
+  c->samples = samples;
+  c->of_triangle = malloc(triangles * sizeof(int));
+  c->start = calloc(vertices + 1, sizeof(int));
+  if (!c->of_triangle || !c->start)
+    return 1;
+  for (size_t t = 0; t < triangles; t++)
+    c->of_triangle[t] = -1;
+  if (!(steep > 0.0) || samples < 2)
+    return 0;
+  /* count, then fill: the columns numbered in triangle order */
+  for (int pass = 0; pass < 2; pass++) {
+    int n = 0;
+    for (long cy = 0; cy < H; cy++)
+      for (long cx = 0; cx < W; cx++)
+        for (int u = 0; u < 2; u++) {
+          double z[3];
+          int low = 0, high = 0;
+          for (int k = 0; k < 3; k++) {
+            z[k] = height_at(p, cx + corner_ox[u][k], cy + corner_oy[u][k]);
+            if (z[k] < z[low])
+              low = k;
+            if (z[k] > z[high])
+              high = k;
+          }
+          if (!(z[high] - z[low] > steep))
+            continue;
+          if (pass == 1) {
+            const size_t v = vertex_at(p, cx + corner_ox[u][low], cy + corner_oy[u][low]);
+            c->of_triangle[((size_t)cy * (size_t)W + (size_t)cx) * 2 + (size_t)u] = n;
+            c->vertex[n] = (int)v;
+            c->top[n] = (unsigned char)high;
+            double *nv = c->normal + 3 * (size_t)n;
+            if (u)
+              nv[0] = z[2] - z[1], nv[1] = z[0] - z[1];
+            else
+              nv[0] = z[0] - z[1], nv[1] = z[0] - z[2];
+            const double len = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + 1.0);
+            nv[0] /= len, nv[1] /= len, nv[2] = 1.0 / len;
+            const double bottom = z[low] + lift,
+                         top = z[high] > bottom ? z[high] : bottom;
+            for (int i = 0; i < samples; i++)
+              c->z[(size_t)n * (size_t)samples + (size_t)i] =
+                  (float)(bottom + (top - bottom) * i / (samples - 1));
+            c->start[v + 1]++;
+          }
+          n++;
+        }
+    if (pass == 0) {
+      c->count = n;
+      const size_t lanes = (size_t)n * (size_t)samples * (size_t)channels;
+      c->vertex = malloc(((size_t)n + 1) * sizeof(int));
+      c->top = malloc((size_t)n + 1);
+      c->list = malloc(((size_t)n + 1) * sizeof(int));
+      c->normal = malloc(((size_t)n + 1) * 3 * sizeof(double));
+      c->z = malloc(((size_t)n + 1) * (size_t)samples * sizeof(float));
+      c->direct = malloc((lanes + 1) * sizeof(float));
+      c->radiance = malloc((lanes + 1) * sizeof(float));
+      c->sums = malloc((lanes + 1) * sizeof(float));
+      if (!c->vertex || !c->top || !c->list || !c->normal || !c->z || !c->direct ||
+          !c->radiance || !c->sums)
+        return 1;
+    }
+  }
+  for (size_t v = 0; v < vertices; v++)
+    c->start[v + 1] += c->start[v];
+  int *fill = calloc(vertices, sizeof(int));
+  if (!fill)
+    return 1;
+  for (int n = 0; n < c->count; n++) {
+    const size_t v = (size_t)c->vertex[n];
+    c->list[c->start[v] + fill[v]++] = n;
+  }
+  free(fill);
+  return 0;
+}
+
+/* A column's light at height z, linear between its samples, and bent to
+ * meet its triangle's own top corner (top, channels values) at its top:
+ * the samples stand a texel in front of the surface at most, which on a
+ * cliff sees as the surface does, and on a slope of 2 or 3 misses a few
+ * percent of the surface's light towards its top. */
+static inline void column_light(const columns *c, int n, double z, const float *top,
+                                int channels, double *out) {
+  const float *zs = c->z + (size_t)n * (size_t)c->samples;
+  const float *r = c->radiance + (size_t)n * (size_t)c->samples * (size_t)channels;
+  const int last = c->samples - 1;
+  int i = 0;
+  double t = 0.0;
+  if (z >= (double)zs[last])
+    i = last - 1, t = 1.0;
+  else if (z > (double)zs[0]) {
+    while (i < last - 1 && z > (double)zs[i + 1])
+      i++;
+    t = (z - (double)zs[i]) / ((double)zs[i + 1] - (double)zs[i]);
+  }
+  const double up = ((double)i + t) / last; /* how far up the column */
+  for (int k = 0; k < channels; k++) {
+    const double a = (double)r[(size_t)i * (size_t)channels + (size_t)k];
+    const double b = (double)r[(size_t)(i + 1) * (size_t)channels + (size_t)k];
+    const double miss =
+        (double)top[k] - (double)r[(size_t)last * (size_t)channels + (size_t)k];
+    out[k] = a + t * (b - a) + up * miss;
+  }
 }
 
 /* ------------------------------------------------------------ the passes */
-
-typedef struct scratch {
-  atomic_flag busy;
-  size_t points, steps;
-  double *z, *step_max, *mip;
-  long *step_x, *step_y;
-  float *radiance;
-  unsigned char *ready;
-} scratch;
-
-typedef struct bounce_ctx {
-  const bb_pyramid *p;
-  const bb_rayset *rs;
-  const vtables *vt;
-  pass_mode mode;
-  int channels;
-  int exact_steps, far_steps;
-  float *sums;          /* DIRECT: blocked per corner; SURFACE: gathered per corner
-                           (FACES x channels per vertex); TEXEL: channels per texel */
-  const float *radiance; /* FACES x channels per vertex: what each corner reflects */
-  scratch *slots;
-  int slot_count;
-  atomic_int out_of_memory;
-} bounce_ctx;
-
-static scratch *slot_take(bounce_ctx *ctx) {
-  for (;;)
-    for (int i = 0; i < ctx->slot_count; i++)
-      if (!atomic_flag_test_and_set(&ctx->slots[i].busy)) return &ctx->slots[i];
-}
-
-/* The corners' direct light: what slice s's sector above max(horizon,
- * plane of f, 0) gives each corner f of vertex (x, y), as its blocked part,
- * n_f . G, added to sums. */
-static void direct_texel(const bounce_ctx *ctx, int s, double dx, double dy,
-                         const double n[FACES][3], float horizon, float *sums) {
-  const vtables *vt = ctx->vt;
-  const int channels = ctx->channels;
-  double base[3 * MAX_CHANNELS], own[3 * MAX_CHANNELS];
-  const double floor_t = horizon > 0.0f ? (double)horizon : 0.0;
-  vtables_eval(vt, s, floor_t, base);
-  for (int f = 0; f < FACES; f++) {
-    const double plane = -(n[f][0] * dx + n[f][1] * dy) / n[f][2];
-    const double *g = base;
-    if (plane > floor_t) {
-      vtables_eval(vt, s, plane, own);
-      g = own;
-    }
-    float *out = sums + (size_t)f * (size_t)channels;
-    for (int k = 0; k < channels; k++)
-      out[k] += (float)(n[f][0] * g[3 * k] + n[f][1] * g[3 * k + 1] + n[f][2] * g[3 * k + 2]);
-  }
-}
-
-/* --- the gather ---------------------------------------------------------- */
-
-/* A segment of the profile seen from an origin: its near end (d0 steps
- * away, z0 above the origin) and far end, and their radiance. */
-typedef struct segment {
-  double d0, z0, d1, z1;
-  const float *near, *far;
-} segment;
-
-/* Where, along a segment (0 near .. 1 far), the ray of slope sigma (per
- * step) meets it. */
-static inline double segment_at(const segment *g, double sigma) {
-  const double den = (g->z1 - g->z0) - sigma * (g->d1 - g->d0);
-  if (!(den > 0.0)) return 1.0;
-  const double s = (sigma * g->d0 - g->z0) / den;
-  return s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
-}
-
-/* What one origin gathers over one slice, and how it weighs a band. */
-typedef struct gather {
-  const bounce_ctx *ctx;
-  int channels;
-  pass_mode mode;
-  double inverse_length; /* texels per step: slopes per step to tangents */
-  double half_width;     /* the sector's (hi - lo) / 2 */
-  double cx, cy;         /* PASS_SURFACE: integral over the sector of cos, sin of azimuth */
-  /* PASS_SURFACE: per corner, n_f's weight of cos^2 (n_x cx + n_y cy) and
-   * of sin cos (n_z (hi - lo) / 2), and its plane's tangent along the
-   * slice with that tangent's atan, sin^2 and sin cos */
-  double horizontal[FACES], vertical[FACES];
-  double plane[FACES], plane_theta[FACES], plane_sin2[FACES], plane_sincos[FACES];
-  double plane_low, plane_high; /* the lowest and highest of the planes */
-  double last_t, last_theta; /* the last atan taken: bands chain */
-  double last_tex_t, last_sin2, last_sin; /* PASS_TEXEL: the last band's far end's
-                                             sin^2 and sin of its atan */
-  double acc[FACES * MAX_CHANNELS];
-  /* PASS_SURFACE: over bands above every corner's plane, n_f . w is linear
-   * in n_f: what they bring is summed once, per channel the integrals of
-   * cos^2 and the change of sin^2, shared out at the end (gather_share) */
-  double above[2 * MAX_CHANNELS];
-} gather;
-
-static inline double sin2(double t) { /* sin^2 of atan t */
-  return t * t / (1.0 + t * t);
-}
-
-static inline double sincos_of(double t) { /* sin cos of atan t */
-  return t / (1.0 + t * t);
-}
-
-static inline double theta_of(gather *g, double t) {
-  if (t != g->last_t) g->last_t = t, g->last_theta = atan(t);
-  return g->last_theta;
-}
-
-/* Adds the band of tangents [ta, tb] seeing radiance r (channels values);
- * theta_a, theta_b: their atan when known, else NAN. */
-static void band_add(gather *g, double ta, double tb, double theta_a, double theta_b,
-                     const double *r) {
-  const int channels = g->channels;
-  if (g->mode == PASS_TEXEL) {
-    /* bands chain: the last band's far end is most often this one's near */
-    double s2a, sna;
-    if (ta == g->last_tex_t) s2a = g->last_sin2, sna = g->last_sin;
-    else s2a = sin2(ta), sna = ta / sqrt(1.0 + ta * ta);
-    const double s2b = sin2(tb), snb = tb / sqrt(1.0 + tb * tb);
-    g->last_tex_t = tb, g->last_sin2 = s2b, g->last_sin = snb;
-    const double w_ao = g->half_width * (s2b - s2a);
-    const double w_solid = 2.0 * g->half_width * (snb - sna);
-    g->acc[0] += w_ao * r[0];
-    for (int k = 1; k < channels; k++) g->acc[k] += w_solid * r[k];
-    return;
-  }
-  if (!(tb > g->plane_low)) return; /* under every corner's plane */
-  if (isnan(theta_a)) theta_a = theta_of(g, ta);
-  if (isnan(theta_b)) theta_b = theta_of(g, tb);
-  g->last_t = tb, g->last_theta = theta_b;
-  const double s2b = sin2(tb), scb = sincos_of(tb);
-  if (ta >= g->plane_high) {
-    const double cos2 = 0.5 * (theta_b - theta_a) + 0.5 * (scb - sincos_of(ta));
-    const double sc = s2b - sin2(ta);
-    for (int k = 0; k < channels; k++) {
-      g->above[2 * k] += cos2 * r[k];
-      g->above[2 * k + 1] += sc * r[k];
-    }
-    return;
-  }
-  const double s2a = sin2(ta), sca = sincos_of(ta);
-  for (int f = 0; f < FACES; f++) {
-    double th_a = theta_a, s2 = s2a, sc = sca;
-    if (g->plane[f] > ta) {
-      if (!(tb > g->plane[f])) continue;
-      if (isnan(g->plane_theta[f])) g->plane_theta[f] = atan(g->plane[f]); /* when first met */
-      th_a = g->plane_theta[f], s2 = g->plane_sin2[f], sc = g->plane_sincos[f];
-    }
-    const double cos2 = 0.5 * (theta_b - th_a) + 0.5 * (scb - sc);
-    const double w = g->horizontal[f] * cos2 + g->vertical[f] * (s2b - s2);
-    double *out = g->acc + (size_t)f * (size_t)channels;
-    for (int k = 0; k < channels; k++) out[k] += w * r[k];
-  }
-}
-
-/* The band of slopes (per step) [sa, sb] over segment seg: its radiance
- * blended where the band's ends meet it; a band wider than WIDE_BAND
- * radians over which the point met moves, in pieces; a corner's band
- * across the highest plane, in two (below it the corners differ). */
-static void band_pieces(gather *g, const segment *seg, double sa, double sb);
-static void band_on_segment(gather *g, const segment *seg, double sa, double sb) {
-  if (g->mode == PASS_SURFACE) {
-    const double high = g->plane_high / g->inverse_length;
-    if (sb <= g->plane_low / g->inverse_length) return;
-    if (sa < high && sb > high) {
-      band_pieces(g, seg, sa, high);
-      band_pieces(g, seg, high, sb);
-      return;
-    }
-  }
-  band_pieces(g, seg, sa, sb);
-}
-
-static void band_pieces(gather *g, const segment *seg, double sa, double sb) {
-  const int channels = g->channels;
-  const double ta = sa * g->inverse_length, tb = sb * g->inverse_length;
-  const double at_a = segment_at(seg, sa), at_b = segment_at(seg, sb);
-  int pieces = 1;
-  double theta_a = 0.0, theta_b = 0.0;
-  /* The mean of the ends is off where the point met moves unevenly over a
-   * wide band and the radiance changes along the segment: only then is
-   * the band cut (a tall wall seen from its foot, not a short segment). */
-  const double nearest = ta < 0.0 && tb > 0.0 ? 0.0 : (fabs(ta) < fabs(tb) ? fabs(ta) : fabs(tb));
-  double change = 0.0; /* only for a wide band: most are narrow */
-  if ((tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND)
-    for (int k = 0; k < channels; k++) {
-      const double c = fabs((double)seg->far[k] - (double)seg->near[k]);
-      change = c > change ? c : change;
-    }
-  if (fabs(at_b - at_a) * change > 0.01 && (tb - ta) / (1.0 + nearest * nearest) > WIDE_BAND) {
-    theta_a = theta_of(g, ta), theta_b = atan(tb); /* the bound above is not the width */
-    pieces = (int)ceil((theta_b - theta_a) / WIDE_BAND);
-    if (pieces < 1) pieces = 1;
-  }
-  double prev_t = ta, prev_at = at_a, prev_theta = pieces > 1 ? theta_a : NAN;
-  for (int i = 1; i <= pieces; i++) {
-    const double theta = i == pieces ? (pieces > 1 ? theta_b : NAN)
-                                     : theta_a + (theta_b - theta_a) * i / pieces;
-    const double t = i == pieces ? tb : tan(theta);
-    const double at = i == pieces ? at_b : segment_at(seg, t / g->inverse_length);
-    const double mid = 0.5 * (prev_at + at);
-    double r[MAX_CHANNELS];
-    for (int k = 0; k < channels; k++)
-      r[k] = (double)seg->near[k] + mid * ((double)seg->far[k] - (double)seg->near[k]);
-    band_add(g, prev_t, t, prev_theta, theta, r);
-    prev_t = t, prev_at = at, prev_theta = theta;
-  }
-}
-
-/* A line's profile for a gather, point by point in the order of u (step
- * by step, the template's points; the last of a step is the next texel):
- * each point's height; the highest point of each step, so a gather can
- * pass over what lies below its rays; and, made when first asked for, the
- * radiance at the two ends of the segment from the point before it to it,
- * blended over the segment's triangle. */
-typedef struct line_profile {
-  const bounce_ctx *ctx;
-  const bb__line_view *line;
-  const struct template_segment *segments;
-  int count;       /* points per step */
-  int channels;
-  long total;      /* points */
-  long origin0;    /* the profile step of texel 0 */
-  double *z;
-  double *step_max;
-  double *mip;     /* levels 1.. of step_max's max pyramid: block i of level
-                      k (2^k steps from step i 2^k) at mip[level_at[k] + i] */
-  long level_at[64];
-  int levels;
-  long *step_x, *step_y; /* each step's first texel */
-  float *radiance; /* 2 x channels per point: its segment's near and far end */
-  unsigned char *ready;
-  double z_begin;  /* the vertex before the first point (lines with ends) */
-  double frac[4 * BB__MAX_LATTICE_STEP + 1];
-} line_profile;
 
 /* Which triangle a template segment lies in, relative to its step's start
  * texel, and its corners' weights at the segment's ends. */
@@ -611,8 +533,10 @@ typedef struct template_segment {
 } template_segment;
 
 static void corner_weights(int upper, double fx, double fy, double w[3]) {
-  if (upper) w[0] = 1.0 - fy, w[1] = fx + fy - 1.0, w[2] = 1.0 - fx;
-  else w[0] = 1.0 - fx - fy, w[1] = fx, w[2] = fy;
+  if (upper)
+    w[0] = 1.0 - fy, w[1] = fx + fy - 1.0, w[2] = 1.0 - fx;
+  else
+    w[0] = 1.0 - fx - fy, w[1] = fx, w[2] = fy;
 }
 
 static void template_segments(const bb__line_view *line, template_segment *ts) {
@@ -621,288 +545,270 @@ static void template_segments(const bb__line_view *line, template_segment *ts) {
     const double mx = 0.5 * (f0 + f1) * line->a, my = 0.5 * (f0 + f1) * line->b;
     ts[k].cx = (int)floor(mx), ts[k].cy = (int)floor(my);
     ts[k].upper = (mx - ts[k].cx) + (my - ts[k].cy) > 1.0;
-    corner_weights(ts[k].upper, f0 * line->a - ts[k].cx, f0 * line->b - ts[k].cy, ts[k].near);
-    corner_weights(ts[k].upper, f1 * line->a - ts[k].cx, f1 * line->b - ts[k].cy, ts[k].far);
+    corner_weights(ts[k].upper, f0 * line->a - ts[k].cx, f0 * line->b - ts[k].cy,
+                   ts[k].near);
+    corner_weights(ts[k].upper, f1 * line->a - ts[k].cx, f1 * line->b - ts[k].cy,
+                   ts[k].far);
   }
 }
 
-static inline long step_coordinate(const bb__line_view *line, long base, long step, int along_x) {
-  const long v = base + step * (along_x ? line->a : line->b);
-  if (line->p->addressing != BB_ADDRESS_PERIODIC) return v;
-  return wrap(v, along_x ? line->p->width : line->p->height);
+/* An entry of a slope's stack: a point beyond the origins (walk
+ * coordinates), z - slope u, and the point just nearer than it along the
+ * profile the sweep kept (set when that one is pushed; until then, the
+ * origin's own vertex). */
+typedef struct entry {
+  double s;
+  bb__walk_point p, pred;
+  int has_pred;
+} entry;
+
+/* A worker's buffers, kept from one line to the next and grown as needed. */
+typedef struct scratch {
+  atomic_flag busy;
+  size_t points, lanes, len;
+  entry *stack[2][MAX_SLOPES];
+  float *acc[2];         /* per side: what each texel gathered (offset[j] ..) */
+  size_t *offset;        /* per texel, and one more */
+  long *step_x, *step_y; /* per profiled step (line_state) */
+  size_t steps;
+  float *used[2]; /* PASS_TEXEL: the horizon each texel's gather went up to */
+  float *last[2]; /* PASS_TEXEL: the radiance of its highest known point */
+} scratch;
+
+typedef struct bounce_ctx {
+  const bb_pyramid *p;
+  const bb_rayset *rs;
+  const vtables *vt;
+  pass_mode mode;
+  int channels;
+  double lift;          /* the samples' lift (DIRECT, SURFACE) or the bias (TEXEL) */
+  const float *normals; /* unit normals of the triangles of cells -1 .. W-1, -1 .. H-1 */
+  columns *cols;
+  int slopes;
+  double slope[MAX_SLOPES]; /* tangents of the fixed rays, rising */
+  int chain;                /* the hull vertices an origin knows at most */
+  double small_band;        /* TEXEL: a horizon under this is a small band */
+  float *sums;              /* DIRECT: per vertex, FACES x channels: what the sky's vector
+                               integrals miss on each face; SURFACE: gathered per corner;
+                               TEXEL: channels per texel */
+  float *vectors; /* DIRECT: per vertex, 3 x channels: the vector integrals blocked */
+  float
+      *horizons; /* when the passes are the trace too: per texel, each slice's horizon */
+  float *fill;   /* per texel, the weights of its blocked bands (ao, solid angle) over
+                    the slices it gathers in and over those it does not (TEXEL_FILL) */
+  int corner_hull; /* DIRECT: the sweep is the trace's, at the texels' bias; the
+                      corners' horizons are asked of its hulls at their lift */
+  double corner_lift;
+  const float
+      *radiance; /* FACES x channels per vertex, by cell: what each corner reflects */
+  scratch *slots;
+  int slot_count;
+  atomic_int out_of_memory;
+} bounce_ctx;
+
+static scratch *slot_take(bounce_ctx *ctx) {
+  for (;;)
+    for (int i = 0; i < ctx->slot_count; i++)
+      if (!atomic_flag_test_and_set(&ctx->slots[i].busy))
+        return &ctx->slots[i];
 }
 
-static inline double step_start_z(const line_profile *lp, long ps);
-
-static void profile_build(const bounce_ctx *ctx, const bb__line_view *line,
-                          const template_segment *ts, line_profile *lp) {
-  const bb_pyramid *p = line->p;
-  const int count = line->point_count;
-  lp->ctx = ctx;
-  lp->segments = ts;
-  lp->total = (long)line->steps * count;
-  lp->origin0 = line->round ? 0 : -line->first_step;
-  for (int k = 0; k < count; k++) lp->frac[k] = line->points[k].frac;
-  memset(lp->ready, 0, (size_t)lp->total);
-  for (int s = 0; s < line->steps; s++) {
-    const long step = line->first_step + s;
-    const long bx = step_coordinate(line, line->x0, step, 1);
-    const long by = step_coordinate(line, line->y0, step, 0);
-    lp->step_x[s] = bx, lp->step_y[s] = by;
-    double top = -INFINITY;
-    for (int k = 0; k < count; k++) {
-      const bb__template_point *t = &line->points[k];
-      const double z = bb__lattice_height(height_at(p, bx + t->x1, by + t->y1),
-                                          height_at(p, bx + t->x2, by + t->y2), t->w);
-      lp->z[(size_t)s * (size_t)count + (size_t)k] = z;
-      top = z > top ? z : top;
-    }
-    lp->step_max[s] = top;
+static void scratch_release(scratch *sc) {
+  for (int s = 0; s < 2; s++) {
+    for (int k = 0; k < MAX_SLOPES; k++)
+      free(sc->stack[s][k]);
+    free(sc->acc[s]), free(sc->used[s]), free(sc->last[s]);
   }
-  lp->z_begin = height_at(p, step_coordinate(line, line->x0, line->first_step, 1),
-                          step_coordinate(line, line->y0, line->first_step, 0));
-  /* the max pyramid over the steps, for passing over long stretches */
-  long n = line->steps, at = 0;
-  const double *below = lp->step_max;
-  lp->levels = 1;
-  while (n > 1 && lp->levels < 63) {
-    const long m = (n + 1) / 2;
-    double *level = lp->mip + at;
-    for (long i = 0; i < m; i++)
-      level[i] = 2 * i + 1 < n ? fmax(below[2 * i], below[2 * i + 1]) : below[2 * i];
-    lp->level_at[lp->levels++] = at;
-    below = level, at += m, n = m;
-  }
+  free(sc->offset), free(sc->step_x), free(sc->step_y);
 }
 
-/* How many steps from profile step ps on (forward) or back (behind) lie
- * wholly under the ray of slope `seen` from the origin: the largest
- * aligned block of the pyramid that does, within `room` steps; 0 when
- * none. near: the block's near end's distance. The pyramid is climbed
- * from its smallest blocks: a block that fails every test fails them
- * for every larger block holding it (aligned the same way, within the
- * room and the profile, its top no lower, its far end no nearer), so
- * the first to fail ends the climb, most often at once. */
-static long block_under(const line_profile *lp, long ps, int forward, double near, double oz,
-                        double seen, long room) {
-  long found = 0;
-  for (int k = 1; k < lp->levels; k++) {
-    const long size = 1L << k;
-    if (size > room) break;
-    const long first = forward ? ps : ps - size + 1;
-    if (first < 0 || first + size > lp->line->steps || (first & (size - 1))) break;
-    double top = lp->mip[lp->level_at[k] + (first >> k)];
-    if (!forward) top = fmax(top, step_start_z(lp, first)); /* visited going back */
-    if (!(top - oz <= seen * (seen >= 0.0 ? near : near + (double)size))) break;
-    found = size;
-  }
-  return found;
-}
-
-/* The radiance at the near (0) or far (1) end of point q's segment. */
-static void point_radiance_fill(line_profile *lp, long q, float *out);
-static inline const float *point_radiance(line_profile *lp, long q, int far) {
-  const int channels = lp->channels;
-  float *out = lp->radiance + (size_t)q * 2 * (size_t)channels;
-  if (!lp->ready[q]) point_radiance_fill(lp, q, out); /* the first ask only: out of line */
-  return out + (far ? channels : 0);
-}
-
-static void point_radiance_fill(line_profile *lp, long q, float *out) {
-  const int channels = lp->channels;
-  const long s = q / lp->count;
-  const template_segment *g = &lp->segments[q - s * lp->count];
-  const float *corners = triangle_corners(lp->line->p, lp->ctx->radiance, lp->step_x[s] + g->cx,
-                                          lp->step_y[s] + g->cy, g->upper, channels);
-  for (int c = 0; c < channels; c++) {
-    double near = 0.0, farther = 0.0;
-    for (int i = 0; i < 3; i++) {
-      near += g->near[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
-      farther += g->far[i] * (double)corners[(size_t)i * (size_t)channels + (size_t)c];
-    }
-    out[c] = (float)near, out[channels + c] = (float)farther;
-  }
-  lp->ready[q] = 1;
-}
-
-/* The band [seen, upto] of slopes (per step) over the segment from (d0,
- * z0) to (d1, z1) (heights above the origin), whose ends have the
- * radiance near and far. */
-static void seen_band(gather *g, double d0, double z0, double d1, double z1, const float *near,
-                      const float *far, double seen, double upto) {
-  const segment seg = {d0, z0, d1, z1, near, far};
-  band_on_segment(g, &seg, seen, upto);
-}
-
-/* Index of the profile step `r` steps from the origin's (forward: 0 is
- * its own; behind: 1 is the one before it), or -1 outside the profile. */
-static inline long step_at(const line_profile *lp, long origin_step, long r, int forward) {
-  long ps = forward ? origin_step + r : origin_step - r;
-  const long steps = lp->line->steps;
-  if (lp->line->round) return wrap(ps, steps);
-  return ps >= 0 && ps < steps ? ps : -1;
-}
-
-/* Height of the vertex at the start of profile step ps. */
-static inline double step_start_z(const line_profile *lp, long ps) {
-  if (ps > 0) return lp->z[(size_t)ps * (size_t)lp->count - 1];
-  return lp->line->round ? lp->z[lp->total - 1] : lp->z_begin;
-}
-
-/* Texel j's gather along one side of the line (forward: along (a, b)), up
- * to its horizon (tangent t_h per texel) and the horizon's point: the
- * bands of the profile it sees, into g->acc. A point is seen when it
- * rises above every nearer one. Within exact_steps steps every point of
- * the profile counts; further, up to far_steps, only the texels (the
- * surface between two of them taken as straight); what is left then
- * meets the horizon's own point. Distances are whole steps plus the
- * template's fraction, the same whatever texel the line starts at. */
-static void scan_origin(gather *g, line_profile *lp, int j, int forward, float t_h,
-                        int64_t tangent_key) {
-  const bb__line_view *line = lp->line;
-  const int count = lp->count, last = count - 1;
-  const long exact = g->ctx->exact_steps, limit = g->ctx->far_steps;
-  if (!(t_h > 0.0f) && g->mode == PASS_TEXEL) return; /* nothing blocked */
-  const double oz = line->vz[j] + line->bias;
-  const double top = (double)t_h / g->inverse_length; /* the horizon's slope per step */
-  const long origin_step = lp->origin0 + j;
-  /* the tangent point: its step counted away from the origin (ahead: 0 is
-   * the origin's own step; behind: 1 is the step before it) and index */
-  const long tangent_r = forward ? bb__key_step(tangent_key) : -bb__key_step(tangent_key);
-  const int tangent_k = bb__key_point(tangent_key);
-  /* the steepest slope so far: a texel's H starts at 0; a corner also sees
-   * the surface below (on steep triangles a good part of its light) */
-  double seen = g->mode == PASS_TEXEL ? 0.0 : -STEEPEST;
-  const float *last_far = NULL;
-  long r = forward ? 0 : 1;
-  for (; r <= tangent_r && r < (forward ? limit : limit + 1); r++) {
-    const long ps = step_at(lp, origin_step, r, forward);
-    if (ps < 0) break;
-    /* the step's near and far ends (going away from the origin) */
-    const double d_near = forward ? (double)r : (double)(r - 1), d_far = d_near + 1.0;
-    /* far out, whole stretches under the ray are passed at once */
-    if (seen > -STEEPEST && r >= (forward ? exact : exact + 1)) {
-      const long room = (tangent_r - 1) - r + 1 < limit - r ? (tangent_r - 1) - r + 1 : limit - r;
-      const long skip = block_under(lp, ps, forward, forward ? (double)r : (double)(r - 1), oz,
-                                    seen, room);
-      if (skip > 1) {
-        r += skip - 1;
-        continue;
-      }
-    }
-    /* under the ray through the steepest point so far: the points visited
-     * here are the step's own going forward, and going back the step's
-     * start vertex instead of its end vertex */
-    const double highest = forward ? lp->step_max[ps] : fmax(lp->step_max[ps], step_start_z(lp, ps));
-    if (seen > -STEEPEST && highest - oz <= seen * (seen >= 0.0 ? d_near : d_far)) continue;
-    const size_t base = (size_t)ps * (size_t)count;
-    if (r < (forward ? exact : exact + 1)) {
-      /* every point, from the near end: forward k = 0.. (k - 1 before
-       * it), behind k = count - 2.. down to -1 (the step's start vertex) */
-      double d0 = d_near, z0 = (forward ? step_start_z(lp, ps) : lp->z[base + (size_t)last]) - oz;
-      for (int i = 0; i < count; i++) {
-        const int k = forward ? i : last - 1 - i;
-        const double d = forward ? (double)r + lp->frac[k] : (double)r - (k >= 0 ? lp->frac[k] : 0.0);
-        const double z = (k >= 0 ? lp->z[base + (size_t)k] : step_start_z(lp, ps)) - oz;
-        if (z > seen * d) {
-          const double slope = z / d, upto = slope < top ? slope : top;
-          /* the segment's own index: forward the point's, behind the one after */
-          const long q = (long)base + (forward ? k : k + 1);
-          const float *near = point_radiance(lp, q, forward ? 0 : 1);
-          const float *far = point_radiance(lp, q, forward ? 1 : 0);
-          if (upto > seen) seen_band(g, d0, z0, d, z, near, far, seen, upto);
-          seen = slope, last_far = far;
-          if (seen >= top) return;
-        }
-        /* the point's own step and index: behind, the start vertex is the
-         * last point of the step after it (further away) */
-        const long id_r = !forward && k < 0 ? r + 1 : r;
-        const int id_k = k < 0 ? last : k;
-        if (id_r == tangent_r && id_k == tangent_k) goto remainder;
-        d0 = d, z0 = z;
-      }
-    } else {
-      /* the far end's texel only, seen along the straight line from the
-       * near end's; the radiance at each end from the segment beside it */
-      const double z0 = (forward ? step_start_z(lp, ps) : lp->z[base + (size_t)last]) - oz;
-      const double z = (forward ? lp->z[base + (size_t)last] : step_start_z(lp, ps)) - oz;
-      /* the horizon's point inside this step: left to the remainder */
-      if (r == tangent_r && (!forward || tangent_k != last)) break;
-      if (z > seen * d_far) {
-        const double slope = z / d_far, upto = slope < top ? slope : top;
-        const float *near = forward ? point_radiance(lp, (long)base, 0)
-                                    : point_radiance(lp, (long)base + last, 1);
-        const float *far = forward ? point_radiance(lp, (long)base + last, 1)
-                                   : point_radiance(lp, (long)base, 0);
-        if (upto > seen) seen_band(g, d_near, z0, d_far, z, near, far, seen, upto);
-        seen = slope, last_far = far;
-        if (seen >= top) return;
-      }
-      if (forward ? r == tangent_r : r + 1 == tangent_r && tangent_k == last) break;
-    }
-  }
-remainder:
-  if (seen >= top) return;
-  {
-    /* What is left meets the horizon's own point (the scan was cut short,
-     * or rounding kept it a hair under the horizon). */
-    const float *at = NULL;
-    const long ps = step_at(lp, origin_step, tangent_r, forward);
-    if (ps >= 0) {
-      const long q = ps * count + tangent_k;
-      if (forward) at = point_radiance(lp, q, 1);
-      else if (tangent_k < last) at = point_radiance(lp, q + 1, 0);
-      else {
-        const long next = step_at(lp, origin_step, tangent_r - 1, 0);
-        if (next >= 0) at = point_radiance(lp, next * count, 0);
-      }
-    }
-    if (!at) at = last_far;
-    if (!at) return;
-    double rad[MAX_CHANNELS];
-    for (int c = 0; c < g->channels; c++) rad[c] = (double)at[c];
-    band_add(g, seen * g->inverse_length, (double)t_h, NAN, NAN, rad);
-  }
-}
-
-static int scratch_reserve(scratch *sc, size_t steps, size_t points, int channels) {
-  if (points <= sc->points && steps <= sc->steps) return 1;
-  free(sc->z), free(sc->step_max), free(sc->step_x), free(sc->step_y);
-  free(sc->radiance), free(sc->ready), free(sc->mip);
-  sc->mip = malloc((steps + 64) * sizeof(double));
-  sc->z = malloc(points * sizeof(double));
-  sc->radiance = malloc(points * 2 * (size_t)channels * sizeof(float));
-  sc->ready = malloc(points);
-  sc->step_max = malloc(steps * sizeof(double));
+static int scratch_steps(scratch *sc, size_t steps) {
+  if (steps <= sc->steps)
+    return 1;
+  free(sc->step_x), free(sc->step_y);
   sc->step_x = malloc(steps * sizeof(long));
   sc->step_y = malloc(steps * sizeof(long));
-  const int ok = sc->z && sc->radiance && sc->ready && sc->step_max && sc->step_x && sc->step_y &&
-                 sc->mip;
-  sc->points = ok ? points : 0;
-  sc->steps = ok ? steps : 0;
-  return ok;
+  sc->steps = sc->step_x && sc->step_y ? steps : 0;
+  return sc->steps != 0;
 }
 
-/* The setup of one origin's gather over slice s. */
-static void gather_slice(gather *g, const bounce_ctx *ctx, int s, const bb__line_view *line) {
+static int scratch_reserve(scratch *sc, size_t points, size_t lanes, size_t len,
+                           int channels) {
+  if (points > sc->points) {
+    sc->points = 0;
+    for (int s = 0; s < 2; s++) {
+      for (int k = 0; k < MAX_SLOPES; k++) {
+        free(sc->stack[s][k]);
+        sc->stack[s][k] = malloc(points * sizeof(entry));
+        if (!sc->stack[s][k])
+          return 0;
+      }
+    }
+    sc->points = points;
+  }
+  if (lanes > sc->lanes) {
+    sc->lanes = 0;
+    for (int s = 0; s < 2; s++) {
+      free(sc->acc[s]);
+      sc->acc[s] = malloc(lanes * sizeof(float));
+      if (!sc->acc[s])
+        return 0;
+    }
+    sc->lanes = lanes;
+  }
+  if (len > sc->len) {
+    sc->len = 0;
+    free(sc->offset);
+    sc->offset = malloc((len + 1) * sizeof(size_t));
+    if (!sc->offset)
+      return 0;
+    for (int s = 0; s < 2; s++) {
+      free(sc->used[s]), free(sc->last[s]);
+      sc->used[s] = malloc(len * sizeof(float));
+      sc->last[s] = malloc(len * (size_t)channels * sizeof(float));
+      if (!sc->used[s] || !sc->last[s])
+        return 0;
+    }
+    sc->len = len;
+  }
+  return 1;
+}
+
+/* The unit normal of half `upper` of cell (cx, cy), -1 <= cx < W, -1 <= cy < H. */
+static inline const float *triangle_normal(const bounce_ctx *ctx, long cx, long cy,
+                                           int upper) {
+  const size_t row = (size_t)ctx->p->width + 1;
+  return ctx->normals +
+         (((size_t)(cy + 1) * row + (size_t)(cx + 1)) * 2 + (size_t)upper) * 3;
+}
+
+/* The normals of the 6 triangles around vertex (x, y), in slot order. */
+static void vertex_normals(const bounce_ctx *ctx, long x, long y, double n[FACES][3]) {
+  for (int f = 0; f < FACES; f++) {
+    const float *t = triangle_normal(ctx, x + slot_dx[f], y + slot_dy[f], slot_upper[f]);
+    n[f][0] = (double)t[0], n[f][1] = (double)t[1], n[f][2] = (double)t[2];
+  }
+}
+
+typedef struct normals_job {
+  const bb_pyramid *p;
+  float *normals;
+} normals_job;
+
+/* Row cy - 1 of the triangles' normals (the plane through each triangle's
+ * corners). */
+static void normals_row(void *user, int row) {
+  const normals_job *job = user;
+  const bb_pyramid *p = job->p;
+  const long cy = row - 1, W = p->width;
+  float *out = job->normals + (size_t)row * (size_t)(W + 1) * 6;
+  for (long cx = -1; cx < W; cx++, out += 6) {
+    const double z00 = height_at(p, cx, cy), z10 = height_at(p, cx + 1, cy);
+    const double z01 = height_at(p, cx, cy + 1), z11 = height_at(p, cx + 1, cy + 1);
+    const double n[2][2] = {{z00 - z10, z00 - z01}, {z01 - z11, z10 - z11}};
+    for (int u = 0; u < 2; u++) {
+      const double len = sqrt(n[u][0] * n[u][0] + n[u][1] * n[u][1] + 1.0);
+      out[3 * u] = (float)(n[u][0] / len), out[3 * u + 1] = (float)(n[u][1] / len);
+      out[3 * u + 2] = (float)(1.0 / len);
+    }
+  }
+}
+
+/* What one origin's gather over one slice weighs: per side, the sector's
+ * constants; per origin, its faces. */
+typedef struct gather {
+  int channels;
+  pass_mode mode;
+  double inverse_length; /* steps per texel: slopes per step to tangents */
+  double half_width;     /* the sector's (hi - lo) / 2 */
+  double cx, cy;         /* integral over the sector of cos, sin of azimuth */
+  double dx, dy;         /* the slice's unit direction */
+  /* PASS_SURFACE: per face, n's weight of cos^2 (n_x cx + n_y cy) and of
+   * sin cos (n_z (hi - lo) / 2), and its plane's tangent along the slice
+   * with that tangent's atan, sin^2 and sin cos */
+  int faces;
+  double horizontal[FACES], vertical[FACES];
+  double plane[FACES], plane_theta[FACES], plane_sin2[FACES], plane_sincos[FACES];
+  double plane_low, plane_high; /* the lowest and highest of the planes */
+  double acc[FACES * MAX_CHANNELS];
+  /* PASS_SURFACE: over bands above every face's plane, n . w is linear in
+   * n: what they bring is summed once, per channel the integrals of cos^2
+   * and the change of sin^2, shared out at the end (gather_share) */
+  double above[2 * MAX_CHANNELS];
+} gather;
+
+/* One line's state while it is walked. */
+typedef struct line_state {
+  bounce_ctx *ctx;
+  scratch *sc;
+  bb__line_view line;
+  int count;
+  template_segment ts[4 * BB__MAX_LATTICE_STEP + 1];
+  double frac[4 * BB__MAX_LATTICE_STEP + 1];
+  double inverse_length;
+  double sigma[MAX_SLOPES]; /* the fixed rays' slopes per step */
+  int size[2][MAX_SLOPES];
+  gather side[2];
+  long *step_x, *step_y; /* each profiled step's first texel (periodic: wrapped) */
+  int narrow;            /* periodic and the image narrower than a step can reach */
+} line_state;
+
+/* Step s's first texel (any step: round lines' copies one period on or
+ * back fold onto the profile's). */
+static inline void step_start(const line_state *ls, long s, long *x, long *y) {
+  const bb__line_view *l = &ls->line;
+  if (l->round)
+    s = s < 0 ? s + l->len : (s >= l->len ? s - l->len : s);
+  const long i = s - l->first_step;
+  if (i >= 0 && i < l->steps) {
+    *x = ls->step_x[i], *y = ls->step_y[i];
+    return;
+  }
+  *x = l->x0 + s * l->a, *y = l->y0 + s * l->b;
+  if (l->p->addressing == BB_ADDRESS_PERIODIC)
+    *x = wrap(*x, l->p->width), *y = wrap(*y, l->p->height);
+}
+
+/* A coordinate a template's offset away from a wrapped step start, back in
+ * the image (periodic) or held to it (clamped). */
+static inline long fold(const line_state *ls, long v, long n) {
+  if (ls->line.p->addressing != BB_ADDRESS_PERIODIC)
+    return v < 0 ? 0 : (v >= n ? n - 1 : v);
+  if (ls->narrow)
+    return wrap(v, n);
+  return v < 0 ? v + n : (v >= n ? v - n : v);
+}
+
+static inline double sin2(double t) { /* sin^2 of atan t */
+  return t * t / (1.0 + t * t);
+}
+
+static inline double sincos_of(double t) { /* sin cos of atan t */
+  return t / (1.0 + t * t);
+}
+
+static inline double sin_of(double t) { /* sin of atan t */
+  return t / sqrt(1.0 + t * t);
+}
+
+static void gather_side(gather *g, const bounce_ctx *ctx, int s, double inverse_length) {
   const bb_rayset *rs = ctx->rs;
-  g->ctx = ctx;
   g->channels = ctx->channels;
   g->mode = ctx->mode;
   g->half_width = rs->half_width[s];
-  g->inverse_length = bb__step_inverse(line->a, line->b);
+  g->inverse_length = inverse_length;
   const double lo = rs->sector[2 * s], hi = rs->sector[2 * s + 1];
   g->cx = sin(hi) - sin(lo);
   g->cy = cos(lo) - cos(hi);
-  g->last_t = NAN;
-  g->last_tex_t = NAN;
+  g->dx = rs->slice_dir[2 * s], g->dy = rs->slice_dir[2 * s + 1];
 }
 
-/* PASS_SURFACE: the corners of a vertex, its faces' normals n, as seen
- * along slice s. */
-static void gather_corners(gather *g, const double n[FACES][3], double dx, double dy) {
-  for (int f = 0; f < FACES; f++) {
-    const double plane = -(n[f][0] * dx + n[f][1] * dy) / n[f][2];
+/* The faces of a sample (PASS_SURFACE): normals n[faces], as seen along
+ * the gather's slice. */
+static void gather_faces(gather *g, const double (*n)[3], int faces) {
+  g->faces = faces;
+  for (int f = 0; f < faces; f++) {
+    const double plane = -(n[f][0] * g->dx + n[f][1] * g->dy) / n[f][2];
     g->horizontal[f] = n[f][0] * g->cx + n[f][1] * g->cy;
     g->vertical[f] = n[f][2] * g->half_width;
     g->plane[f] = plane;
@@ -914,185 +820,918 @@ static void gather_corners(gather *g, const double n[FACES][3], double dx, doubl
   }
 }
 
-/* PASS_SURFACE: what the bands above every plane brought, to each corner. */
+static void gather_clear(gather *g) {
+  const int lanes = g->mode == PASS_TEXEL ? g->channels : g->faces * g->channels;
+  for (int i = 0; i < lanes; i++)
+    g->acc[i] = 0.0;
+  for (int i = 0; i < 2 * g->channels; i++)
+    g->above[i] = 0.0;
+}
+
+/* PASS_SURFACE: what the bands above every plane brought, to each face. */
 static void gather_share(gather *g) {
   const int channels = g->channels;
-  for (int f = 0; f < FACES; f++)
+  for (int f = 0; f < g->faces; f++)
     for (int k = 0; k < channels; k++)
       g->acc[f * channels + k] +=
           g->horizontal[f] * g->above[2 * k] + g->vertical[f] * g->above[2 * k + 1];
 }
 
-static void line_hook(void *user, const bb__line_view *line) {
-  bounce_ctx *ctx = user;
-  const int channels = ctx->channels, W = line->p->width;
-  /* texel by texel, both sides of the line with one vertex_faces: each
-   * texel's sums take the sides in the same order as side by side */
-  if (ctx->mode == PASS_DIRECT) {
-    for (int j = 0; j < line->len; j++) {
-      const size_t v = line->texel[j];
-      double n[FACES][3];
-      vertex_faces(ctx->p, (long)(v % (size_t)W), (long)(v / (size_t)W), n);
-      for (int side = 0; side < 2; side++) {
-        const bb__sweep_dir *dir = line->dir[side];
-        if (!dir) continue;
-        const int s = dir->slice;
-        const double dx = ctx->rs->slice_dir[2 * s], dy = ctx->rs->slice_dir[2 * s + 1];
-        direct_texel(ctx, s, dx, dy, (const double(*)[3])n, line->found[side][j],
-                     ctx->sums + v * FACES * (size_t)channels);
+/* Adds the band of tangents [ta, tb] seeing radiance r (channels values);
+ * theta_a, theta_b, their atan, are read by PASS_SURFACE only. A texel
+ * weighs a band by w.z (ao) or by its solid angle (lobes), both algebraic
+ * in the tangents. */
+static void band_add(gather *g, double ta, double tb, double theta_a, double theta_b,
+                     const double *r) {
+  const int channels = g->channels;
+  if (g->mode == PASS_TEXEL) {
+    const double w_ao = g->half_width * (sin2(tb) - sin2(ta));
+    const double w_solid = 2.0 * g->half_width * (sin_of(tb) - sin_of(ta));
+    g->acc[0] += w_ao * r[0];
+    for (int k = 1; k < channels; k++)
+      g->acc[k] += w_solid * r[k];
+    return;
+  }
+  if (!(tb > g->plane_low))
+    return; /* under every face's plane */
+  const double s2b = sin2(tb), scb = sincos_of(tb);
+  if (ta >= g->plane_high) {
+    const double cos2 = 0.5 * (theta_b - theta_a) + 0.5 * (scb - sincos_of(ta));
+    const double sc = s2b - sin2(ta);
+    for (int k = 0; k < channels; k++) {
+      g->above[2 * k] += cos2 * r[k];
+      g->above[2 * k + 1] += sc * r[k];
+    }
+    return;
+  }
+  const double s2a = sin2(ta), sca = sincos_of(ta);
+  for (int f = 0; f < g->faces; f++) {
+    double th_a = theta_a, s2 = s2a, sc = sca;
+    if (g->plane[f] > ta) {
+      if (!(tb > g->plane[f]))
+        continue;
+      if (isnan(g->plane_theta[f]))
+        g->plane_theta[f] = atan(g->plane[f]); /* when first met */
+      th_a = g->plane_theta[f], s2 = g->plane_sin2[f], sc = g->plane_sincos[f];
+    }
+    const double cos2 = 0.5 * (theta_b - th_a) + 0.5 * (scb - sc);
+    const double w = g->horizontal[f] * cos2 + g->vertical[f] * (s2b - s2);
+    double *out = g->acc + (size_t)f * (size_t)channels;
+    for (int k = 0; k < channels; k++)
+      out[k] += w * r[k];
+  }
+}
+
+/* The atan a pass needs of a tangent: PASS_SURFACE's weights read it. */
+static inline double theta_for(const gather *g, double t) {
+  return g->mode == PASS_SURFACE ? atan(t) : NAN;
+}
+
+/* A point of the visible surface an origin knows: its slope per step from
+ * the origin, its tangent (and atan, for PASS_SURFACE), where it is
+ * relative to the origin (steps along the walk, height) and on the
+ * profile, and its radiance. */
+typedef struct known {
+  double sigma, t, theta;
+  double d, z;
+  long step;   /* template segment `segment` of step `step` holds it, */
+  int segment; /* at fraction `at` of the segment; -1: not known */
+  double at;
+  double r[MAX_CHANNELS];
+} known;
+
+/* Where a gather's origin is: walk coordinates, and which way it walks. */
+typedef struct origin_at {
+  double u0, oz;
+  int side;
+} origin_at;
+
+/* The radiance of the surface on template segment k of step s of the line
+ * (from point k - 1, or the step's start, to point k), at fraction t of it
+ * (its height z, for a column). */
+static void segment_light(const line_state *ls, long s, int k, double t, double z,
+                          double *out) {
+  const bounce_ctx *ctx = ls->ctx;
+  const bb_pyramid *p = ctx->p;
+  const int channels = ctx->channels;
+  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  const template_segment *g = &ls->ts[k];
+  long bx, by;
+  step_start(ls, s, &bx, &by);
+  const long cx = fold(ls, bx + g->cx, p->width), cy = fold(ls, by + g->cy, p->height);
+  const size_t triangle =
+      ((size_t)cy * (size_t)p->width + (size_t)cx) * 2 + (size_t)g->upper;
+  const int column = ctx->cols->of_triangle[triangle];
+  const float *corners = ctx->radiance + triangle * 3 * (size_t)channels;
+  if (column >= 0) {
+    column_light(ctx->cols, column, z,
+                 corners + (size_t)ctx->cols->top[column] * (size_t)channels, channels,
+                 out);
+    return;
+  }
+  double w[3];
+  for (int i = 0; i < 3; i++)
+    w[i] = g->near[i] + t * (g->far[i] - g->near[i]);
+  for (int c = 0; c < channels; c++)
+    out[c] = w[0] * (double)corners[c] + w[1] * (double)corners[channels + c] +
+             w[2] * (double)corners[2 * channels + c];
+}
+
+/* The radiance at a profile point (its key) on the face towards an origin
+ * before it along the line (smaller u) or after it. */
+static void point_light(const line_state *ls, int64_t key, double z, int before,
+                        known *q) {
+  long s = bb__key_step(key);
+  int k = bb__key_point(key);
+  if (!before && ++k == ls->count)
+    k = 0, s++;
+  q->step = s, q->segment = k, q->at = before ? 1.0 : 0.0;
+  segment_light(ls, s, k, q->at, z, q->r);
+}
+
+/* The radiance at u along the line (steps from its texel 0) and height z,
+ * where no key says which segment holds it. */
+static void surface_light(const line_state *ls, double u, double z, double *out) {
+  const double fl = floor(u);
+  const long s = (long)fl;
+  const double f = u - fl;
+  int k = 0;
+  while (k < ls->count - 1 && ls->frac[k] < f)
+    k++;
+  const double f0 = k ? ls->frac[k - 1] : 0.0, f1 = ls->frac[k];
+  segment_light(ls, s, k, (f - f0) / (f1 - f0), z, out);
+}
+
+/* The band between two known points, meeting the chord between them: the
+ * mean of their radiance; or, when the radiance changes along it, pieces
+ * of it cut at evenly spaced points of the chord (where a ray grazes a
+ * long slope, the point it meets moves fast, so even cuts in angle would
+ * not do), none wider than WIDE_BAND radians, each seeing the light
+ * between its ends: when both ends lie on one straight segment the chord
+ * is the surface, and its own light is read (a column's is not linear);
+ * when they are within a step of each other, the chord runs close to the
+ * surface, and the light of the surface under or over it is read;
+ * otherwise the chord's ends' light is blended. */
+static void band_between(const line_state *ls, gather *g, const known *a, const known *b,
+                         const origin_at *o) {
+  const int channels = g->channels;
+  if (!(b->t > a->t))
+    return;
+  double change = 0.0;
+  for (int k = 0; k < channels; k++) {
+    const double c = fabs(b->r[k] - a->r[k]);
+    change = c > change ? c : change;
+  }
+  double r[MAX_CHANNELS];
+  if (change < FLAT_CHANGE) { /* too little to matter how it spreads */
+    for (int k = 0; k < channels; k++)
+      r[k] = 0.5 * (a->r[k] + b->r[k]);
+    band_add(g, a->t, b->t, a->theta, b->theta, r);
+    return;
+  }
+  const int same = a->segment >= 0 && a->step == b->step && a->segment == b->segment;
+  const int close =
+      !same && a->segment >= 0 && b->segment >= 0 && labs(a->step - b->step) <= 1;
+  if (g->mode == PASS_TEXEL && !same && !close) {
+    /* the radiance linear along the chord (lambda 0 .. 1), each channel's
+     * weight W(lambda) a function of the ray through the chord's point:
+     * integral of L dW = L_a (W_b - W_a) + (L_b - L_a) (W_b - mean of W),
+     * the mean by Simpson's rule */
+    const double dm = 0.5 * (a->d + b->d), zm = 0.5 * (a->z + b->z);
+    double tm = zm / dm * g->inverse_length;
+    tm = tm < a->t ? a->t : (tm > b->t ? b->t : tm);
+    const double ao_a = sin2(a->t), ao_b = sin2(b->t), ao_m = sin2(tm);
+    const double so_a = sin_of(a->t), so_b = sin_of(b->t), so_m = sin_of(tm);
+    const double w_ao = g->half_width * (ao_b - ao_a);
+    const double m_ao = g->half_width * (ao_b - (ao_a + 4.0 * ao_m + ao_b) / 6.0);
+    const double w_solid = 2.0 * g->half_width * (so_b - so_a);
+    const double m_solid =
+        2.0 * g->half_width * (so_b - (so_a + 4.0 * so_m + so_b) / 6.0);
+    g->acc[0] += a->r[0] * w_ao + (b->r[0] - a->r[0]) * m_ao;
+    for (int k = 1; k < channels; k++)
+      g->acc[k] += a->r[k] * w_solid + (b->r[k] - a->r[k]) * m_solid;
+    return;
+  }
+  int pieces = (int)(change / CHANGE_PER_PIECE) + 1;
+  pieces = pieces > MAX_PIECES ? MAX_PIECES : pieces;
+  /* the band's width in radians, atan of (tb - ta) / (1 + ta tb), without it when narrow
+   */
+  const double spread = (b->t - a->t) / (1.0 + a->t * b->t);
+  if (spread > TAN_WIDE_BAND) {
+    const int by_angle = (int)(atan(spread) / WIDE_BAND) + 1;
+    pieces = pieces > by_angle ? pieces : by_angle;
+  }
+  double prev_t = a->t, prev_theta = a->theta, prev_at = 0.0;
+  for (int i = 1; i <= pieces; i++) {
+    const double at = (double)i / pieces;
+    double t = b->t, theta = b->theta;
+    if (i < pieces) { /* the ray through the chord's point at `at` */
+      const double d = a->d + at * (b->d - a->d), z = a->z + at * (b->z - a->z);
+      t = z / d * g->inverse_length;
+      t = t < prev_t ? prev_t : (t > b->t ? b->t : t);
+      theta = theta_for(g, t);
+    }
+    const double mid = 0.5 * (prev_at + at);
+    if (same)
+      segment_light(ls, a->step, a->segment, a->at + mid * (b->at - a->at),
+                    o->oz + a->z + mid * (b->z - a->z), r);
+    else if (close) {
+      const double u = o->u0 + a->d + mid * (b->d - a->d);
+      surface_light(ls, o->side ? -u : u, o->oz + a->z + mid * (b->z - a->z), r);
+    } else
+      for (int k = 0; k < channels; k++)
+        r[k] = a->r[k] + mid * (b->r[k] - a->r[k]);
+    band_add(g, prev_t, t, prev_theta, theta, r);
+    prev_t = t, prev_theta = theta, prev_at = at;
+  }
+}
+
+/* The first entry of a stack (size entries, nearest last) whose sheared
+ * height is above q, searched from the near end; NULL when none is. */
+static const entry *stack_find(const entry *e, int size, double q) {
+  if (size <= 0)
+    return NULL;
+  int hi = size - 1; /* entries above hi are at or under q */
+  if (e[hi].s > q)
+    return &e[hi];
+  int step = 1, lo = hi;
+  for (;;) { /* gallop away from the near end */
+    lo = hi - step;
+    if (lo < 0) {
+      lo = -1;
+      break;
+    }
+    if (e[lo].s > q)
+      break;
+    hi = lo, step *= 2;
+  }
+  if (lo < 0 && !(e[0].s > q))
+    return NULL;
+  if (lo < 0)
+    lo = 0;
+  /* e[lo] above q, e[hi] not: the last above before hi */
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    if (e[mid].s > q)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return &e[lo];
+}
+
+/* A point pushed on a side's hull: its place on each fixed ray's stack. */
+static void on_push(void *state, int side, const bb__walk_point *hull, int pushed) {
+  line_state *ls = state;
+  const bb__walk_point *p = &hull[pushed - 1];
+  for (int k = 0; k < ls->ctx->slopes; k++) {
+    entry *e = ls->sc->stack[side][k];
+    int size = ls->size[side][k];
+    const double s = p->z - ls->sigma[k] * p->u;
+    const int before = size;
+    while (size > 0 && e[size - 1].s <= s)
+      size--;
+    if (size == before && size > 0)
+      e[size - 1].pred = *p, e[size - 1].has_pred = 1;
+    e[size].s = s, e[size].p = *p, e[size].has_pred = 0;
+    ls->size[side][k] = size + 1;
+  }
+}
+
+/* The height of template point k of step s of the line (any step: periodic
+ * coordinates wrap, clamped ones are held to the image). */
+static double template_height(const line_state *ls, long s, int k) {
+  const bb__template_point *t = &ls->line.points[k];
+  const bb_pyramid *p = ls->ctx->p;
+  long bx, by;
+  step_start(ls, s, &bx, &by);
+  const size_t W = (size_t)p->width;
+  const size_t i1 = (size_t)fold(ls, by + t->y1, p->height) * W +
+                    (size_t)fold(ls, bx + t->x1, p->width);
+  const size_t i2 = (size_t)fold(ls, by + t->y2, p->height) * W +
+                    (size_t)fold(ls, bx + t->x2, p->width);
+  return bb__lattice_height((double)p->z[i1], (double)p->z[i2], t->w);
+}
+
+/* The segment of the whole profile (every breakpoint, not only the points
+ * the sweep kept) where the ray of slope sigma from (u0, oz) first meets
+ * it, given e, the first kept point above the ray: into a (under the ray)
+ * and b (above it), walk coordinates. The points the sweep dropped between
+ * e and the kept point before it lie under the chord between those two, a
+ * convex run, which the ray, under e and over its predecessor, crosses
+ * once: so the crossing is found going back from e to the first point
+ * under the ray (within a bounded walk; past it, or past the predecessor,
+ * the chord to the predecessor, or to the origin's own vertex, stands in).
+ * Returns 1 when a and b are neighbours on the profile, their keys set. */
+static int ray_crossing(const line_state *ls, int side, const entry *e, double u0,
+                        double oz, double vz, double sigma, bb__walk_point *a,
+                        bb__walk_point *b) {
+  const bb__walk_point pred = e->has_pred ? e->pred : (bb__walk_point){u0, vz, 0};
+  *b = e->p, *a = pred;
+  if (e->has_pred && bb__key_step(e->p.key) == bb__key_step(pred.key) &&
+      bb__key_point(e->p.key) == bb__key_point(pred.key) + (side ? -1 : 1))
+    return 1; /* neighbours already */
+  const int count = ls->count,
+            dir = side ? 1 : -1; /* towards the origin, in template order */
+  long s = bb__key_step(e->p.key);
+  int k = bb__key_point(e->p.key);
+  const double step_u = side ? -1.0 : 1.0;
+  for (int walked = 0; walked < CROSSING_WALK; walked++) {
+    k += dir;
+    if (k < 0)
+      k = count - 1, s--;
+    else if (k >= count)
+      k = 0, s++;
+    const double u = step_u * ((double)s + ls->frac[k]);
+    /* the predecessor and the origin's vertex lie under the ray: the walk
+     * stops at them at the latest */
+    if (u < pred.u - 1e-9 || u < u0 - 1e-9)
+      return 0;
+    const double z = template_height(ls, s, k);
+    if (z - sigma * (u - u0) <= oz) {
+      *a = (bb__walk_point){u, z, (int64_t)s * BB__KEY_STEP + k};
+      return 1;
+    }
+    *b = (bb__walk_point){u, z, (int64_t)s * BB__KEY_STEP + k};
+  }
+  return 0;
+}
+
+/* What an origin at (u0, oz) (walk coordinates; its vertex at vz) knows of
+ * the surface it sees between slopes low and top (per step; top its
+ * horizon's, reached at hull vertex `tangent`): the fixed rays' first
+ * points, the hull's vertices on the way to the tangent, the tangent
+ * itself, in rising order, into out. Returns how many. */
+static int known_points(const line_state *ls, const gather *g, int side, double u0,
+                        double oz, double vz, const bb__walk_point *hull, int tangent,
+                        int size, double low, double top, known *pool,
+                        const known **out) {
+  const double inv = ls->inverse_length;
+  const int before = side == 0; /* the faces seen: those towards the origin */
+  known *rays = pool, *chain = pool + MAX_SLOPES;
+  int nr = 0, nc = 0;
+  for (int k = 0; k < ls->ctx->slopes; k++) {
+    const double sigma = ls->sigma[k];
+    if (!(sigma < top))
+      break;
+    if (sigma < low)
+      continue;
+    const entry *e =
+        stack_find(ls->sc->stack[side][k], ls->size[side][k], oz - sigma * u0);
+    if (!e)
+      continue;
+    bb__walk_point a, b;
+    const int neighbours = ray_crossing(ls, side, e, u0, oz, vz, sigma, &a, &b);
+    const double den = (b.z - a.z) - sigma * (b.u - a.u);
+    double lambda = den > 0.0 ? (oz + sigma * (a.u - u0) - a.z) / den : 1.0;
+    lambda = lambda < 0.0 ? 0.0 : (lambda > 1.0 ? 1.0 : lambda);
+    known *q = &rays[nr++];
+    const double u = a.u + lambda * (b.u - a.u);
+    q->sigma = sigma, q->t = sigma * inv, q->theta = theta_for(g, q->t);
+    q->d = u - u0, q->z = a.z + lambda * (b.z - a.z) - oz;
+    if (neighbours) { /* the segment between them: the farther's along (a, b), the
+                         nearer's back */
+      q->step = bb__key_step(side ? a.key : b.key),
+      q->segment = bb__key_point(side ? a.key : b.key);
+      q->at = side ? 1.0 - lambda : lambda;
+      segment_light(ls, q->step, q->segment, q->at, q->z + oz, q->r);
+    } else {
+      q->step = LONG_MIN, q->segment = -1, q->at = 0.0;
+      surface_light(ls, side ? -u : u, q->z + oz, q->r);
+    }
+  }
+  if (tangent >= 0) {
+    /* a long way up a dome: every stride-th vertex, and the tangent */
+    const int span = size - tangent, most = ls->ctx->chain;
+    const int stride = span <= most ? 1 : (span + most - 2) / (most > 1 ? most - 1 : 1);
+    for (int i = most > 1 ? size - 1 : tangent;; i -= stride) {
+      if (i < tangent)
+        i = tangent;
+      const double d = hull[i].u - u0, z = hull[i].z - oz;
+      double sigma = i == tangent ? top : z / d;
+      if (sigma > top)
+        sigma = top;
+      if (sigma > low) {
+        known *q = &chain[nc++];
+        q->sigma = sigma, q->t = sigma * inv, q->theta = theta_for(g, q->t);
+        q->d = d, q->z = z;
+        point_light(ls, hull[i].key, hull[i].z, before, q);
+      }
+      if (i == tangent)
+        break;
+    }
+  }
+  int n = 0, a = 0, b = 0;
+  while (a < nr || b < nc)
+    out[n++] =
+        b >= nc || (a < nr && rays[a].sigma <= chain[b].sigma) ? &rays[a++] : &chain[b++];
+  return n;
+}
+
+/* What an origin knows of a small band: its tangent point alone (and the
+ * band below it sees that point's light). */
+static int horizon_point(const line_state *ls, const gather *g, int side, double u0,
+                         double oz, const bb__walk_point *hull, int tangent, double top,
+                         known *pool, const known **out) {
+  if (tangent < 0)
+    return 0;
+  known *q = pool;
+  q->sigma = top, q->t = top * ls->inverse_length, q->theta = theta_for(g, q->t);
+  q->d = hull[tangent].u - u0, q->z = hull[tangent].z - oz;
+  point_light(ls, hull[tangent].key, hull[tangent].z, side == 0, q);
+  out[0] = q;
+  return 1;
+}
+
+/* The bands from slope low up to the last known point: below the first,
+ * its own radiance; between two, the chord between them. */
+static void gather_bands(const line_state *ls, gather *g, const known *const *q, int n,
+                         double low, const origin_at *o) {
+  if (n == 0)
+    return;
+  const double t_low = low * g->inverse_length;
+  if (q[0]->t > t_low)
+    band_add(g, t_low, q[0]->t, theta_for(g, t_low), q[0]->theta, q[0]->r);
+  for (int i = 1; i < n; i++)
+    band_between(ls, g, q[i - 1], q[i], o);
+}
+
+/* The horizon (tangent, >= 0) from a point of height z at u0 over the
+ * hull, and the index of its tangent vertex. */
+static double horizon_from(const line_state *ls, const bb__walk_point *hull, int size,
+                           double u0, double z, int *tangent) {
+  const int i = bb__hull_tangent(hull, size, u0, z);
+  *tangent = i;
+  if (i < 0)
+    return 0.0;
+  const double t = (hull[i].z - z) / (hull[i].u - u0) * ls->inverse_length;
+  return t > 0.0 ? t : 0.0;
+}
+
+/* A face's direct light along slice s: what the sector above max(horizon,
+ * its plane, 0) gives it, as its blocked part n . G, into out. */
+static void direct_face(const bounce_ctx *ctx, int s, double dx, double dy,
+                        const double *n, double horizon, float *out) {
+  double g[3 * MAX_CHANNELS];
+  const double plane = -(n[0] * dx + n[1] * dy) / n[2];
+  vtables_eval(ctx->vt, s, fmax(fmax(horizon, plane), 0.0), g);
+  for (int k = 0; k < ctx->channels; k++)
+    out[k] += (float)(n[0] * g[3 * k] + n[1] * g[3 * k + 1] + n[2] * g[3 * k + 2]);
+}
+
+/* A vertex's corners' direct light along slice s (from the horizon the
+ * sweep found, lifted by `lift`): the vector integrals blocked below
+ * max(horizon, 0), once for the vertex, and for each face whose plane
+ * rises above that, the part between the two, n . (G(plane) - G(h)). */
+static void direct_corners(const bounce_ctx *ctx, int s, double dx, double dy, size_t v,
+                           float horizon) {
+  const int channels = ctx->channels, width = 3 * channels;
+  const bb_pyramid *p = ctx->p;
+  double base[3 * MAX_CHANNELS], own[3 * MAX_CHANNELS];
+  const double floor_t = horizon > 0.0f ? (double)horizon : 0.0;
+  vtables_eval(ctx->vt, s, floor_t, base);
+  float *vec = ctx->vectors + v * (size_t)width;
+  for (int i = 0; i < width; i++)
+    vec[i] += (float)base[i];
+  const long x = (long)(v % (size_t)p->width), y = (long)(v / (size_t)p->width);
+  float *corr = ctx->sums + v * FACES * (size_t)channels;
+  for (int f = 0; f < FACES; f++) {
+    const float *n = triangle_normal(ctx, x + slot_dx[f], y + slot_dy[f], slot_upper[f]);
+    const double plane = -((double)n[0] * dx + (double)n[1] * dy) / (double)n[2];
+    /* the band between the horizon and the plane, behind the face: thin,
+     * it weighs about its width squared (n . w vanishes on the plane) */
+    if (!(plane > floor_t + THIN_BAND))
+      continue;
+    vtables_eval(ctx->vt, s, plane, own);
+    for (int k = 0; k < channels; k++)
+      corr[f * channels + k] +=
+          (float)((double)n[0] * (own[3 * k] - base[3 * k]) +
+                  (double)n[1] * (own[3 * k + 1] - base[3 * k + 1]) +
+                  (double)n[2] * (own[3 * k + 2] - base[3 * k + 2]));
+  }
+}
+
+static void on_origin(void *state, int side, int j, double u0, double oz,
+                      const bb__walk_point *hull, int size, int tangent, float horizon) {
+  line_state *ls = state;
+  bounce_ctx *ctx = ls->ctx;
+  const int channels = ctx->channels;
+  const int s = ls->line.dir[side]->slice;
+  gather *g = &ls->side[side];
+  float *acc = ls->sc->acc[side] + ls->sc->offset[j];
+  const double vz = ls->line.vz[j], inv = ls->inverse_length;
+  known pool[MAX_SLOPES + MAX_KNOWN];
+  const known *q[MAX_SLOPES + MAX_KNOWN];
+  if (ctx->mode == PASS_TEXEL) {
+    ls->sc->used[side][j] = horizon;
+    if (!(horizon > 0.0f))
+      return;
+    /* a small band sees, near enough, its horizon point's light */
+    const int small = (double)horizon < ctx->small_band;
+    const int n = small ? horizon_point(ls, g, side, u0, oz, hull, tangent,
+                                        (double)horizon / inv, pool, q)
+                        : known_points(ls, g, side, u0, oz, vz, hull, tangent, size, 0.0,
+                                       (double)horizon / inv, pool, q);
+    gather_clear(g);
+    gather_bands(ls, g, q, n, 0.0, &(origin_at){u0, oz, side});
+    float *last = ls->sc->last[side] + (size_t)j * (size_t)channels;
+    for (int k = 0; k < channels; k++) {
+      acc[k] += (float)g->acc[k];
+      last[k] = n ? (float)q[n - 1]->r[k] : 0.0f;
+    }
+    return;
+  }
+  const size_t v = ls->line.texel[j];
+  const columns *cols = ctx->cols;
+  const int first = cols->start[v], last = cols->start[v + 1], samples = cols->samples;
+  float *col_acc = acc + (ctx->mode == PASS_SURFACE ? FACES * channels : 0);
+  if (ctx->mode ==
+      PASS_DIRECT) { /* the corners are done at the line's end, the columns here */
+    if (ctx->corner_hull) {
+      int t;
+      ls->sc->used[side][j] =
+          (float)horizon_from(ls, hull, size, u0, vz + ctx->corner_lift, &t);
+    }
+    for (int c = first; c < last; c++) {
+      const int col = cols->list[c];
+      const double *cn = cols->normal + 3 * (size_t)col;
+      for (int i = 0; i < samples; i++) {
+        int t;
+        const double z = (double)cols->z[(size_t)col * (size_t)samples + (size_t)i];
+        direct_face(ctx, s, g->dx, g->dy, cn, horizon_from(ls, hull, size, u0, z, &t),
+                    col_acc);
+        col_acc += channels;
       }
     }
     return;
   }
-  scratch *sc = slot_take(ctx);
-  const size_t points = (size_t)line->steps * (size_t)line->point_count;
-  if (!scratch_reserve(sc, (size_t)line->steps, points, channels)) {
-    atomic_store(&ctx->out_of_memory, 1);
-    atomic_flag_clear(&sc->busy);
-    return;
+  /* PASS_SURFACE: every face of the vertex's corners, then each column's samples */
+  double n[FACES][3];
+  vertex_normals(ctx, (long)(v % (size_t)ctx->p->width),
+                 (long)(v / (size_t)ctx->p->width), n);
+  gather_faces(g, (const double(*)[3])n, FACES);
+  gather_clear(g);
+  const double low = g->plane_low / inv;
+  const int small = (double)horizon - g->plane_low < ctx->small_band;
+  int count = small ? horizon_point(ls, g, side, u0, oz, hull, tangent,
+                                    fmax((double)horizon / inv, low), pool, q)
+                    : known_points(ls, g, side, u0, oz, vz, hull, tangent, size, low,
+                                   fmax((double)horizon / inv, low), pool, q);
+  gather_bands(ls, g, q, count, low, &(origin_at){u0, oz, side});
+  gather_share(g);
+  for (int i = 0; i < FACES * channels; i++)
+    acc[i] += (float)g->acc[i];
+  for (int c = first; c < last; c++) {
+    const int col = cols->list[c];
+    const double(*cn)[3] = (const double(*)[3])(cols->normal + 3 * (size_t)col);
+    gather_faces(g, cn, 1);
+    const double lo = g->plane_low / inv;
+    for (int i = 0; i < samples; i++) {
+      const double z = (double)cols->z[(size_t)col * (size_t)samples + (size_t)i];
+      int t;
+      const double h = horizon_from(ls, hull, size, u0, z, &t);
+      gather_clear(g);
+      count = known_points(ls, g, side, u0, z, vz, hull, t, size, lo, fmax(h / inv, lo),
+                           pool, q);
+      gather_bands(ls, g, q, count, lo, &(origin_at){u0, z, side});
+      gather_share(g);
+      for (int k = 0; k < channels; k++)
+        col_acc[k] += (float)g->acc[k];
+      col_acc += channels;
+    }
   }
-  template_segment ts[4 * BB__MAX_LATTICE_STEP + 1];
-  template_segments(line, ts);
-  line_profile lp = {.line = line, .count = line->point_count, .channels = channels,
-                     .z = sc->z, .step_max = sc->step_max, .mip = sc->mip, .step_x = sc->step_x,
-                     .step_y = sc->step_y, .radiance = sc->radiance, .ready = sc->ready};
-  profile_build(ctx, line, ts, &lp);
-  gather g[2];
-  for (int side = 0; side < 2; side++)
-    if (line->dir[side]) gather_slice(&g[side], ctx, line->dir[side]->slice, line);
-  const int lanes = ctx->mode == PASS_SURFACE ? FACES * channels : channels;
+}
+
+static void *on_line_begin(void *user, const bb__line_view *line) {
+  bounce_ctx *ctx = user;
+  scratch *sc = slot_take(ctx);
+  const int channels = ctx->channels;
+  const columns *cols = ctx->cols;
+  const size_t points =
+      ctx->mode != PASS_DIRECT ? (size_t)line->steps * (size_t)line->point_count + 2 : 1;
+  const size_t len = (size_t)line->len;
+  if (!scratch_reserve(sc, points, 1, len, channels)) {
+    atomic_flag_clear(&sc->busy);
+    return NULL;
+  }
+  /* the accumulators' room: per texel its lanes */
+  size_t lanes = 0;
+  for (size_t j = 0; j < len; j++) {
+    sc->offset[j] = lanes;
+    if (ctx->mode == PASS_TEXEL) {
+      lanes += (size_t)channels;
+      continue;
+    }
+    const size_t v = line->texel[j];
+    lanes += (size_t)channels *
+             ((ctx->mode == PASS_SURFACE ? FACES : 0) +
+              (size_t)(cols->start[v + 1] - cols->start[v]) * (size_t)cols->samples);
+  }
+  sc->offset[len] = lanes;
+  line_state *ls = malloc(sizeof *ls);
+  if (!ls || !scratch_reserve(sc, points, lanes + 1, len, channels) ||
+      !scratch_steps(sc, (size_t)line->steps)) {
+    free(ls);
+    atomic_flag_clear(&sc->busy);
+    return NULL;
+  }
+  ls->ctx = ctx, ls->sc = sc, ls->line = *line, ls->count = line->point_count;
+  ls->step_x = sc->step_x, ls->step_y = sc->step_y;
+  const bb_pyramid *p = ctx->p;
+  const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
+  ls->narrow = periodic && (p->width <= 2 * BB__MAX_LATTICE_STEP + 2 ||
+                            p->height <= 2 * BB__MAX_LATTICE_STEP + 2);
+  for (int i = 0; i < line->steps; i++) {
+    const long s = line->first_step + i;
+    long x = line->x0 + s * line->a, y = line->y0 + s * line->b;
+    if (periodic)
+      x = wrap(x, p->width), y = wrap(y, p->height);
+    ls->step_x[i] = x, ls->step_y[i] = y;
+  }
+  template_segments(line, ls->ts);
+  for (int k = 0; k < ls->count; k++)
+    ls->frac[k] = line->points[k].frac;
+  ls->inverse_length = bb__step_inverse(line->a, line->b);
+  for (int k = 0; k < ctx->slopes; k++)
+    ls->sigma[k] = ctx->slope[k] / ls->inverse_length;
+  for (int side = 0; side < 2; side++) {
+    for (int k = 0; k < MAX_SLOPES; k++)
+      ls->size[side][k] = 0;
+    if (!line->dir[side])
+      continue;
+    gather_side(&ls->side[side], ctx, line->dir[side]->slice, ls->inverse_length);
+    memset(sc->acc[side], 0, lanes * sizeof(float));
+  }
+  return ls;
+}
+
+/* After the walks: each texel's gathers added to the pass's sums, along
+ * (a, b) first, then along (-a, -b), as the slices' order wants (and when
+ * the pass is the trace too, what its horizons lose, added as the trace
+ * adds it); in a chunk, a texel whose horizon the sweep marched (the chunk
+ * could not vouch for it) has the band above its chunk's tangent met at
+ * that tangent's radiance. PASS_DIRECT works out its corners here, from
+ * the horizons the sweep found. */
+static void on_line_end(void *state, const bb__line_view *line) {
+  line_state *ls = state;
+  bounce_ctx *ctx = ls->ctx;
+  scratch *sc = ls->sc;
+  const int channels = ctx->channels;
+  const columns *cols = ctx->cols;
+  const int slices = ctx->rs->slice_count;
   for (int j = 0; j < line->len; j++) {
     const size_t v = line->texel[j];
-    double n[FACES][3];
-    if (ctx->mode == PASS_SURFACE)
-      vertex_faces(line->p, (long)(v % (size_t)W), (long)(v / (size_t)W), n);
     for (int side = 0; side < 2; side++) {
-      const bb__sweep_dir *dir = line->dir[side];
-      if (!dir) continue;
-      gather *gs = &g[side];
-      if (ctx->mode == PASS_SURFACE) {
-        const int s = dir->slice;
-        gather_corners(gs, (const double(*)[3])n, ctx->rs->slice_dir[2 * s],
-                       ctx->rs->slice_dir[2 * s + 1]);
+      if (!line->dir[side])
+        continue;
+      const float *acc = sc->acc[side] + sc->offset[j];
+      const float found = line->found[side][j];
+      if (ctx->horizons)
+        ctx->horizons[v * (size_t)slices + (size_t)line->dir[side]->slice] = found;
+      if (ctx->fill && found > 0.0f && (ctx->mode == PASS_TEXEL || ctx->corner_hull)) {
+        /* the texel's band's weights: ao's, solid angle's */
+        const gather *g = &ls->side[side];
+        float *w = ctx->fill + v * 4 + (ctx->mode == PASS_TEXEL ? 0 : 2);
+        w[0] += (float)(g->half_width * sin2((double)found));
+        w[1] += (float)(2.0 * g->half_width * sin_of((double)found));
       }
-      for (int i = 0; i < lanes; i++) gs->acc[i] = 0.0;
-      for (int i = 0; i < 2 * channels; i++) gs->above[i] = 0.0;
-      scan_origin(gs, &lp, j, side == 0, line->found[side][j], line->tangent_key[side][j]);
-      if (ctx->mode == PASS_SURFACE) gather_share(gs);
-      float *out = ctx->sums + v * (size_t)lanes;
-      for (int i = 0; i < lanes; i++) out[i] += (float)gs->acc[i];
+      if (ctx->mode == PASS_TEXEL) {
+        float *out = ctx->sums + v * (size_t)channels;
+        const float used = sc->used[side][j];
+        double extra[MAX_CHANNELS] = {0};
+        if (found > used) {
+          gather *g = &ls->side[side];
+          gather_clear(g);
+          double r[MAX_CHANNELS];
+          for (int k = 0; k < channels; k++)
+            r[k] = (double)sc->last[side][(size_t)j * (size_t)channels + (size_t)k];
+          band_add(g, (double)used, (double)found, NAN, NAN, r);
+          for (int k = 0; k < channels; k++)
+            extra[k] = g->acc[k];
+        }
+        for (int k = 0; k < channels; k++)
+          out[k] += (float)((double)acc[k] + extra[k]);
+        continue;
+      }
+      if (ctx->mode == PASS_DIRECT) {
+        const gather *g = &ls->side[side];
+        direct_corners(ctx, line->dir[side]->slice, g->dx, g->dy, v,
+                       ctx->corner_hull ? sc->used[side][j] : found);
+      } else {
+        float *out = ctx->sums + v * FACES * (size_t)channels;
+        for (int i = 0; i < FACES * channels; i++)
+          out[i] += acc[i];
+        acc += FACES * channels;
+      }
+      for (int c = cols->start[v]; c < cols->start[v + 1]; c++) {
+        float *col_out =
+            cols->sums + (size_t)cols->list[c] * (size_t)cols->samples * (size_t)channels;
+        for (int i = 0; i < cols->samples * channels; i++)
+          col_out[i] += acc[i];
+        acc += cols->samples * channels;
+      }
     }
   }
   atomic_flag_clear(&sc->busy);
+  free(ls);
 }
 
 /* ------------------------------------------------------------ the driver */
 
 /* A move in fixed point (2^-40 of the sky's radiance), summed exactly: the
  * sum, and so the tail, does not depend on the order of the texels, which
- * a periodic shift of the map changes. */
+ * a periodic shift of the map changes. v >= 0 and far under 2^12, so
+ * v 2^40 + 1/2 is exact and its truncation is llround's, without the call. */
 typedef unsigned __int128 exact_sum;
 static inline exact_sum fixed(double v) {
-  return (exact_sum)(uint64_t)llround(v * 0x1p40); /* ldexp(v, 40): exact, as a product */
+  return (exact_sum)(uint64_t)(v * 0x1p40 + 0.5); /* ldexp(v, 40): exact, as a product */
 }
 
 typedef struct driver {
   bounce_ctx ctx;
   const bb__bounce_options *o;
-  const bb_rayset *fine; /* the trace's slices: the direct light and the texels */
+  const bb_rayset *fine; /* the trace's slices: the texels' */
   const int *order;
-  bb_rayset coarse;      /* the further bounces' slices (none: the trace's) */
-  int *coarse_order;
+  bb_rayset surface_set; /* the further bounces' slices (none: the trace's) */
+  int *surface_order;
+  vtables vt;
+  columns cols;
+  float *normals;  /* the triangles' unit normals (bounce_ctx) */
   float *direct;   /* E of every corner from the sky (FACES x channels per vertex) */
-  float *radiance; /* what every corner reflects now */
+  float *radiance; /* what every corner reflects now, by cell */
   const float *albedo;
   exact_sum *row_sum;
-  double tail; /* the last move's multiple added as the series' rest (0: none) */
+  double tail;          /* the last move's multiple added as the series' rest (0: none) */
   long work, work_done; /* bb__bounce_work, and what the passes so far did */
+  bb__checkpoint checkpoint;
 } driver;
 
-static void zero_row(void *user, int y) {
+static void zero_rows(void *user, int y) {
   driver *d = user;
-  const size_t n = (size_t)d->ctx.p->width * FACES * (size_t)d->ctx.channels;
-  memset(d->ctx.sums + (size_t)y * n, 0, n * sizeof(float));
+  const size_t W = (size_t)d->ctx.p->width, C = (size_t)d->ctx.channels;
+  memset(d->ctx.sums + (size_t)y * W * FACES * C, 0, W * FACES * C * sizeof(float));
+  memset(d->ctx.vectors + (size_t)y * W * 3 * C, 0, W * 3 * C * sizeof(float));
 }
 
-/* What one slice of each pass costs, in a trace's slices (instructions,
- * rock06 256 x 256 at scale 32, callgrind): the progress's weights. */
-static int slice_work(pass_mode mode) {
-  return mode == PASS_DIRECT ? 3 : mode == PASS_SURFACE ? 16 : 10;
+/* What one slice of each pass costs against one of the trace's
+ * (instructions, rock06 at 512 x 512, scale 32, callgrind): the progress's
+ * weights. The texel pass is the trace itself too when the bake asks. */
+static int pass_work(pass_mode mode) {
+  return mode == PASS_DIRECT ? 2 : mode == PASS_SURFACE ? 4 : 3;
 }
 
 static int surface_passes(const bb__bounce_options *o) {
-  if (o->bounces > 0) return o->bounces - 1;
-  return o->estimate_passes > 1 ? o->estimate_passes : 1;
+  if (o->bounces > 0)
+    return o->bounces - 1;
+  return o->estimate_passes > 0 ? o->estimate_passes : 0;
 }
 
-static int coarse_slices(const bb_rayset *rs, const bb__bounce_options *o) {
-  const int n = o->surface_slices;
-  if (n > 0) return n < rs->slice_count ? n : rs->slice_count;
-  return rs->slice_count / 2 >= 4 ? rs->slice_count / 2 : rs->slice_count;
+/* A pass's slices: wanted when set (at most the trace's), else the trace's
+ * divided by `divide`, at least 4 (or the trace's, when fewer). */
+static int slice_set(const bb_rayset *rs, int wanted, int divide) {
+  if (wanted > 0)
+    return wanted < rs->slice_count ? wanted : rs->slice_count;
+  const int n = rs->slice_count / divide;
+  return n >= 4 ? n : (rs->slice_count < 4 ? rs->slice_count : 4);
+}
+
+/* Whether the slice of rank k and the next share a sweep (opposite steps). */
+static int sweep_pairs(const bb_rayset *rs, const int *order, int k) {
+  return k + 1 < rs->slice_count &&
+         rs->slice_step[2 * order[k]] == -rs->slice_step[2 * order[k + 1]] &&
+         rs->slice_step[2 * order[k] + 1] == -rs->slice_step[2 * order[k + 1] + 1];
+}
+
+/* The trace's slices are split between the direct light and the texels'
+ * gathers (the sweeps of even rank and those of odd) once there are 4 of
+ * them or more; fewer, and each pass sweeps them all. */
+static int split_slices(const bb_rayset *rs) {
+  return rs->slice_count >= 4;
 }
 
 long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o) {
-  return (long)rs->slice_count * (slice_work(PASS_DIRECT) + slice_work(PASS_TEXEL)) +
-         (long)surface_passes(o) * coarse_slices(rs, o) * slice_work(PASS_SURFACE);
+  const long direct = split_slices(rs) ? rs->slice_count / 2 : rs->slice_count;
+  const long texel = split_slices(rs) ? rs->slice_count - direct : rs->slice_count;
+  return direct * pass_work(PASS_DIRECT) + texel * pass_work(PASS_TEXEL) +
+         (long)surface_passes(o) * slice_set(rs, o->surface_slices, 4) *
+             pass_work(PASS_SURFACE);
 }
 
-static bb_status run_pass(driver *d, pass_mode mode, double bias, bb_error *err) {
+/* The direct light's sectors when the slices are split: each slice swept
+ * for it (even rank) stands for its own sector and half of each
+ * neighbouring one in azimuth, swept for the texels only; wanted[s] marks
+ * the first. Slices are numbered by azimuth, their sectors contiguous. */
+static void direct_sectors(const bb_rayset *rs, const int *order, double *sector,
+                           unsigned char *wanted) {
+  const int n = rs->slice_count;
+  memset(wanted, 0, (size_t)n);
+  for (int k = 0, rank = 0; k < n; rank++) {
+    const int pair = sweep_pairs(rs, order, k);
+    if (rank % 2 == 0)
+      wanted[order[k]] = 1, wanted[order[k + pair]] = 1;
+    k += pair ? 2 : 1;
+  }
+  for (int s = 0; s < n; s++) {
+    sector[2 * s] = rs->sector[2 * s], sector[2 * s + 1] = rs->sector[2 * s + 1];
+    if (!wanted[s])
+      continue;
+    const int before = (s + n - 1) % n, after = (s + 1) % n;
+    if (!wanted[before])
+      sector[2 * s] -= rs->half_width[before];
+    if (!wanted[after])
+      sector[2 * s + 1] += rs->half_width[after];
+  }
+}
+
+static const bb__walk_visitor gather_visitor = {on_line_begin, on_push, on_origin,
+                                                on_line_end};
+static const bb__walk_visitor direct_visitor = {on_line_begin, NULL, on_origin,
+                                                on_line_end};
+
+/* The sweeps of a pass, in the order of its ray set's slices: every one
+ * (parity -1), or those of even or odd rank (0, 1): the trace's halves. */
+static bb_status run_pass(driver *d, pass_mode mode, int parity, bb_error *err) {
   bounce_ctx *ctx = &d->ctx;
-  const int coarse = mode == PASS_SURFACE && d->coarse.slice_count;
-  const bb_rayset *rs = coarse ? &d->coarse : d->fine;
-  const int *order = coarse ? d->coarse_order : d->order;
   const bb__bounce_options *o = d->o;
+  const bb_rayset *rs = d->fine;
+  const int *order = d->order;
+  if (mode == PASS_SURFACE && d->surface_set.slice_count)
+    rs = &d->surface_set, order = d->surface_order;
   ctx->rs = rs;
   ctx->mode = mode;
-  ctx->exact_steps = mode == PASS_TEXEL ? o->exact_steps : o->surface_exact_steps;
-  ctx->far_steps = mode == PASS_TEXEL ? o->far_steps : o->surface_far_steps;
-  bb_status st = bb__parallel_for(ctx->p->height, o->threads, zero_row, d, NULL, NULL, err);
-  for (int k = 0; st == BB_OK && k < rs->slice_count;) {
+  /* a sweep of the trace's slices finds the texels' horizons, at its bias */
+  ctx->lift = mode == PASS_TEXEL || ctx->corner_hull ? o->bias : o->lift;
+  const double *slopes = mode == PASS_TEXEL ? o->texel_slopes : o->surface_slopes;
+  ctx->slopes = 0;
+  ctx->chain = o->chain > 0 && o->chain < MAX_KNOWN ? o->chain : MAX_KNOWN;
+  ctx->small_band = o->small_band;
+  for (int k = 0; k < MAX_SLOPES && mode != PASS_DIRECT && !isnan(slopes[k]); k++)
+    ctx->slope[ctx->slopes++] = slopes[k];
+  bb_status st = BB_OK;
+  if (mode == PASS_TEXEL) {
+    const size_t n =
+        (size_t)ctx->p->width * (size_t)ctx->p->height * (size_t)ctx->channels;
+    memset(ctx->sums, 0, n * sizeof(float));
+  } else {
+    st = bb__parallel_for(ctx->p->height, o->threads, zero_rows, d, NULL, NULL, err);
+    const size_t lanes =
+        (size_t)d->cols.count * (size_t)d->cols.samples * (size_t)ctx->channels;
+    if (lanes)
+      memset(d->cols.sums, 0, lanes * sizeof(float));
+  }
+  const bb__walk_visitor *visitor =
+      mode == PASS_DIRECT ? &direct_visitor : &gather_visitor;
+  int swept = 0; /* slices so far */
+  for (int k = 0, rank = 0; st == BB_OK && k < rs->slice_count; rank++) {
     const int s = order[k];
-    const int pair = k + 1 < rs->slice_count &&
-                     rs->slice_step[2 * s] == -rs->slice_step[2 * order[k + 1]] &&
-                     rs->slice_step[2 * s + 1] == -rs->slice_step[2 * order[k + 1] + 1];
-    const bb__sweep_dir along = {rs, s, NULL, NULL};
-    const bb__sweep_dir opposite = {rs, pair ? order[k + 1] : 0, NULL, NULL};
-    /* a slice of a pass at 2048 x 2048 takes seconds: cancel inside it */
-    const bb__checkpoint cancel = {o->progress, o->progress_user};
-    st = bb__sweep_lines_hooked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
-                                &along, pair ? &opposite : NULL, bias, o->threads, 0,
-                                line_hook, ctx, &cancel, err);
+    const int pair = sweep_pairs(rs, order, k);
     k += pair ? 2 : 1;
+    if (parity >= 0 && rank % 2 != parity)
+      continue;
+    const bb__sweep_dir along = {rs, s, NULL, NULL};
+    const bb__sweep_dir opposite = {rs, pair ? order[k - 1] : 0, NULL, NULL};
+    st = bb__sweep_lines_walked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
+                                &along, pair ? &opposite : NULL, ctx->lift, o->threads,
+                                visitor, ctx, o->progress ? &d->checkpoint : NULL, err);
+    swept += pair ? 2 : 1;
     if (st == BB_OK && atomic_load(&ctx->out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");
     /* monotone over the whole: what the passes before this one did, and
      * this one's slices so far */
-    const long done = o->progress_before + d->work_done + (long)k * slice_work(mode);
+    const long done = o->progress_before + d->work_done + (long)swept * pass_work(mode);
     const long total = o->progress_before + d->work + o->progress_after;
     if (st == BB_OK && o->progress && o->progress(o->progress_user, done, total))
       st = bb__fail(err, BB_ERR_CANCELLED, "bounce: cancelled by the progress callback");
   }
-  d->work_done += (long)rs->slice_count * slice_work(mode);
+  if (st == BB_ERR_CANCELLED)
+    bb__fail(err, st, "bounce: cancelled by the progress callback");
+  d->work_done += (long)swept * pass_work(mode);
   return st;
 }
 
-/* Bounces 0 starts from an estimate of each corner's converged light: as
+/* Bounces 0 starts from an estimate of each sample's converged light: as
  * though every surface it sees were as bright as itself, the light it
  * reflects is its first bounce times 1 / (1 - lambda), lambda = rho beta,
  * beta the part of its hemisphere (cosine-weighted) that the surface
- * blocks, 1 - E_ao / pi (held under 0.9). One surface pass from there
- * brings the texels within what 4 or 5 passes from the first bounce did
- * (docs/accuracy.md "Inter-reflection"). Lobes take the ao channel's
+ * blocks, 1 - E_ao / pi (held under 0.9). Lobes take the ao channel's
  * ratio: the surfaces seen are lit by the same lobe. */
-static double estimate_ratio(const driver *d, double rho, size_t v, int f) {
-  const double e_ao = (double)d->direct[(v * FACES + (size_t)f) * (size_t)d->ctx.channels];
+static double estimate_gain(const driver *d, double rho, double e_ao) {
+  if (d->o->bounces)
+    return 1.0;
   double beta = 1.0 - e_ao / BB__PI;
   beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
-  const double lambda = rho * beta;
-  return lambda < 0.9 ? lambda : 0.9;
+  double lambda = rho * beta;
+  lambda = lambda < 0.9 ? lambda : 0.9;
+  return 1.0 / (1.0 - lambda);
 }
 
-/* After the direct pass: each corner's E from the sky, and its radiance. */
+static double rho_at(const driver *d, size_t v) {
+  return d->o->rho * (d->albedo ? (double)d->albedo[v] : 1.0);
+}
+
+/* After the direct pass: each corner's E from the sky (all of it, less
+ * what its face's blocked vector integrals and its corrections took), and
+ * its radiance. */
 static void direct_row(void *user, int y) {
   driver *d = user;
   const bounce_ctx *ctx = &d->ctx;
@@ -1100,20 +1739,26 @@ static void direct_row(void *user, int y) {
   exact_sum sum = 0;
   for (int x = 0; x < W; x++) {
     const size_t v = (size_t)y * (size_t)W + (size_t)x;
-    const double rho = d->o->rho * (d->albedo ? (double)d->albedo[v] : 1.0);
+    const double rho = rho_at(d, v);
     double n[FACES][3];
-    vertex_faces(ctx->p, x, y, n);
+    vertex_normals(ctx, x, y, n);
+    const float *blocked = ctx->vectors + v * 3 * (size_t)channels;
     for (int f = 0; f < FACES; f++) {
       const size_t out = corner_index(ctx->p, x, y, f, channels);
+      double gain = 1.0;
       for (int k = 0; k < channels; k++) {
         const size_t i = (v * FACES + (size_t)f) * (size_t)channels + (size_t)k;
-        const double *all = ctx->vt->all + 3 * k;
-        const double e = n[f][0] * all[0] + n[f][1] * all[1] + n[f][2] * all[2] - (double)ctx->sums[i];
+        double open[3];
+        for (int j = 0; j < 3; j++)
+          open[j] = ctx->vt->all[3 * k + j] - (double)blocked[3 * k + j];
+        const double e = n[f][0] * open[0] + n[f][1] * open[1] + n[f][2] * open[2] -
+                         (double)ctx->sums[i];
         d->direct[i] = (float)(e > 0.0 ? e : 0.0);
+        if (k == 0)
+          gain = estimate_gain(d, rho, (double)d->direct[i]);
         if (out != SIZE_MAX) {
-          /* the first bounce, or (bounces 0) the corner's estimate of all */
-          const double gain = d->o->bounces ? 1.0 : 1.0 / (1.0 - estimate_ratio(d, rho, v, f));
-          d->radiance[out + (size_t)k] = (float)(rho / BB__PI * (double)d->direct[i] * gain);
+          d->radiance[out + (size_t)k] =
+              (float)(rho / BB__PI * (double)d->direct[i] * gain);
           sum += fixed((double)d->radiance[out + (size_t)k]);
         }
       }
@@ -1122,12 +1767,39 @@ static void direct_row(void *user, int y) {
   d->row_sum[y] = sum;
 }
 
-/* After a surface pass: how far each corner's radiance would move, summed
+/* The same for the columns (the direct pass added what each sample's sky
+ * loses). */
+static exact_sum direct_columns(driver *d) {
+  columns *c = &d->cols;
+  const int channels = d->ctx.channels;
+  exact_sum sum = 0;
+  for (int n = 0; n < c->count; n++) {
+    const double *nv = c->normal + 3 * (size_t)n;
+    const double rho = rho_at(d, (size_t)c->vertex[n]);
+    for (int i = 0; i < c->samples; i++) {
+      const size_t at = ((size_t)n * (size_t)c->samples + (size_t)i) * (size_t)channels;
+      double gain = 1.0;
+      for (int k = 0; k < channels; k++) {
+        const double *all = d->vt.all + 3 * k;
+        const double e = nv[0] * all[0] + nv[1] * all[1] + nv[2] * all[2] -
+                         (double)c->sums[at + (size_t)k];
+        c->direct[at + (size_t)k] = (float)(e > 0.0 ? e : 0.0);
+        if (k == 0)
+          gain = estimate_gain(d, rho, (double)c->direct[at]);
+        c->radiance[at + (size_t)k] =
+            (float)(rho / BB__PI * (double)c->direct[at + (size_t)k] * gain);
+        sum += fixed((double)c->radiance[at + (size_t)k]);
+      }
+    }
+  }
+  return sum;
+}
+
+/* After a surface pass: how far each sample's radiance would move, summed
  * per row; then the move, and with it, when the bounces stop here, the
  * rest of the series estimated as geometric. */
-static double corner_radiance(const driver *d, size_t v, size_t i) {
-  const double rho = d->o->rho * (d->albedo ? (double)d->albedo[v] : 1.0);
-  const double e = (double)d->direct[i] + (double)d->ctx.sums[i];
+static double sample_radiance(double rho, float direct, float gathered) {
+  const double e = (double)direct + (double)gathered;
   return rho / BB__PI * (e > 0.0 ? e : 0.0);
 }
 
@@ -1138,13 +1810,16 @@ static void change_row(void *user, int y) {
   exact_sum sum = 0;
   for (size_t x = 0; x < W; x++) {
     const size_t v = (size_t)y * W + x;
+    const double rho = rho_at(d, v);
     for (int f = 0; f < FACES; f++) {
       const size_t out = corner_index(d->ctx.p, (long)x, y, f, channels);
-      if (out == SIZE_MAX) continue;
+      if (out == SIZE_MAX)
+        continue;
       for (int k = 0; k < channels; k++) {
         const size_t i = (v * FACES + (size_t)f) * (size_t)channels + (size_t)k;
-        sum += fixed(fabs((double)(float)corner_radiance(d, v, i) -
-                          (double)d->radiance[out + (size_t)k]));
+        sum +=
+            fixed(fabs((double)(float)sample_radiance(rho, d->direct[i], d->ctx.sums[i]) -
+                       (double)d->radiance[out + (size_t)k]));
       }
     }
   }
@@ -1157,16 +1832,38 @@ static void update_row(void *user, int y) {
   const size_t W = (size_t)d->ctx.p->width;
   for (size_t x = 0; x < W; x++) {
     const size_t v = (size_t)y * W + x;
+    const double rho = rho_at(d, v);
     for (int f = 0; f < FACES; f++) {
       const size_t out = corner_index(d->ctx.p, (long)x, y, f, channels);
-      if (out == SIZE_MAX) continue;
+      if (out == SIZE_MAX)
+        continue;
       for (int k = 0; k < channels; k++) {
         const size_t i = (v * FACES + (size_t)f) * (size_t)channels + (size_t)k;
-        const double r = corner_radiance(d, v, i);
-        d->radiance[out + (size_t)k] = (float)(r + d->tail * (r - (double)d->radiance[out + (size_t)k]));
+        const double r = sample_radiance(rho, d->direct[i], d->ctx.sums[i]);
+        d->radiance[out + (size_t)k] =
+            (float)(r + d->tail * (r - (double)d->radiance[out + (size_t)k]));
       }
     }
   }
+}
+
+/* The columns' move (update 0) or their update (1). */
+static exact_sum columns_step(driver *d, int update) {
+  columns *c = &d->cols;
+  const int channels = d->ctx.channels;
+  exact_sum sum = 0;
+  for (int n = 0; n < c->count; n++) {
+    const double rho = rho_at(d, (size_t)c->vertex[n]);
+    for (size_t i = (size_t)n * (size_t)c->samples * (size_t)channels;
+         i < (size_t)(n + 1) * (size_t)c->samples * (size_t)channels; i++) {
+      const double r = sample_radiance(rho, c->direct[i], c->sums[i]);
+      if (update)
+        c->radiance[i] = (float)(r + d->tail * (r - (double)c->radiance[i]));
+      else
+        sum += fixed(fabs((double)(float)r - (double)c->radiance[i]));
+    }
+  }
+  return sum;
 }
 
 /* Clamp mode: the last column and row of cells reach vertices past the
@@ -1176,10 +1873,12 @@ static void update_row(void *user, int y) {
  * from, on either triangle. */
 static void corner_fixup(driver *d) {
   const bb_pyramid *p = d->ctx.p;
-  if (p->addressing == BB_ADDRESS_PERIODIC) return;
+  if (p->addressing == BB_ADDRESS_PERIODIC)
+    return;
   const size_t C = (size_t)d->ctx.channels, W = (size_t)p->width, H = (size_t)p->height;
   float *r = d->radiance;
-#define CORNER(cell, half, corner) (r + (((cell) * 2 + (size_t)(half)) * 3 + (size_t)(corner)) * C)
+#define CORNER(cell, half, corner)                                                       \
+  (r + (((cell)*2 + (size_t)(half)) * 3 + (size_t)(corner)) * C)
 #define COPY(to, from) memcpy((to), (from), C * sizeof(float))
   for (size_t y = 0; y + 1 < H; y++) { /* x = W - 1: (1,0) from (0,0), (1,1) from (0,1) */
     const size_t cell = y * W + W - 1;
@@ -1196,7 +1895,8 @@ static void corner_fixup(driver *d) {
   const size_t last = H * W - 1; /* only its (0,0) corner is inside */
   for (int half = 0; half < 2; half++)
     for (int corner = 0; corner < 3; corner++)
-      if (half || corner) COPY(CORNER(last, half, corner), CORNER(last, 0, 0));
+      if (half || corner)
+        COPY(CORNER(last, half, corner), CORNER(last, 0, 0));
 #undef COPY
 #undef CORNER
 }
@@ -1206,95 +1906,191 @@ typedef struct finish_job {
   bb_image *vis;
 } finish_job;
 
+/* When the passes were the trace too: each texel's losses added up from
+ * its stored horizons, slice by slice in the order every trace adds them
+ * (bb_trace_slice_order), with the trace's own integration, so the sums,
+ * once finished, are bb_trace_occlusion's visibility bit for bit. */
+static void trace_row(void *user, int y) {
+  const finish_job *job = user;
+  const driver *d = job->d;
+  const bb_rayset *rs = d->fine;
+  const int channels = d->ctx.channels, W = job->vis->width, n = rs->slice_count;
+  for (int x = 0; x < W; x++) {
+    const size_t v = (size_t)y * (size_t)W + (size_t)x;
+    float *sums = job->vis->pixels + v * (size_t)channels;
+    const float *h = d->ctx.horizons + v * (size_t)n;
+    for (int k = 0; k < channels; k++)
+      sums[k] = 0.0f;
+    for (int k = 0; k < n; k++) {
+      const bb__slice_integral si = bb__slice_integral_of(rs, d->order[k]);
+      bb__slice_accumulate(&si, h[d->order[k]], sums);
+    }
+  }
+}
+
 static void finish_row(void *user, int y) {
   const finish_job *job = user;
   const bounce_ctx *ctx = &job->d->ctx;
-  const bb_rayset *rs = ctx->rs;
+  const bb_rayset *rs = job->d->fine;
   const int channels = ctx->channels, W = job->vis->width;
   for (int x = 0; x < W; x++) {
     const size_t v = (size_t)y * (size_t)W + (size_t)x;
     float *out = job->vis->pixels + v * (size_t)job->vis->channels;
     const float *sum = ctx->sums + v * (size_t)channels;
-    const double ao = (double)out[0] + (double)sum[0] / BB__PI;
+    /* the slices it did not gather in see what those it gathered in saw,
+     * per unit of their bands' weights */
+    double scale[2] = {1.0, 1.0};
+    if (ctx->fill) {
+      const float *w = ctx->fill + v * 4;
+      for (int i = 0; i < 2; i++)
+        if (w[i] > 0.0f)
+          scale[i] += (double)w[2 + i] / (double)w[i];
+    }
+    const double ao = (double)out[0] + (double)sum[0] * scale[0] / BB__PI;
     out[0] = (float)(ao < 1.0 ? ao : 1.0);
     for (int k = 1; k < channels; k++)
-      out[k] = (float)((double)out[k] + (double)sum[k] / rs->total[k]);
+      out[k] = (float)((double)out[k] + (double)sum[k] * scale[1] / rs->total[k]);
   }
 }
 
 void bb__bounce_options_init(bb__bounce_options *o) {
   memset(o, 0, sizeof *o);
   o->estimate_passes = 1;
-  o->lift = 0.25;
-  o->exact_steps = 4;
-  o->surface_exact_steps = 1;
-  o->far_steps = 1024;
-  o->surface_far_steps = 16;
+  o->lift = 0.1;
+  o->steep = 2.0;
+  o->small_band = 0.25;
+  o->column_samples = 5;
+  static const double texel[] = {0.0, 1.0};
+  static const double surface[] = {-1.0, 0.0};
+  for (int k = 0; k < BB__BOUNCE_MAX_SLOPES; k++) {
+    o->texel_slopes[k] = k < (int)(sizeof texel / sizeof texel[0]) ? texel[k] : NAN;
+    o->surface_slopes[k] =
+        k < (int)(sizeof surface / sizeof surface[0]) ? surface[k] : NAN;
+  }
 }
 
-bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bounce_options *o,
-                         bb_image *vis, int *bounces_done, bb_error *err) {
-  if (bounces_done) *bounces_done = 0;
-  if (!p || !rs || !o || !vis || !vis->pixels || vis->width != p->width ||
-      vis->height != p->height || vis->channels != 1 + rs->basis_count)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bounce: the visibility does not match the pyramid");
+/* A ray set of `slices` slices for a pass (none when it is the trace's),
+ * with the order its sweeps take. */
+static bb_status pass_set(const bb_rayset *rs, int slices, int threads, bb_rayset *out,
+                          int **order, bb_error *err) {
+  if (slices >= rs->slice_count)
+    return BB_OK;
+  bb_basis basis = {.count = rs->basis_count, .name = "bounce"};
+  memcpy(basis.vector, rs->basis, sizeof basis.vector);
+  bb_status st = bb__rayset_make(slices, rs->power, &basis, threads, out, err);
+  *order = st == BB_OK ? malloc((size_t)slices * sizeof(int)) : NULL;
+  if (st == BB_OK && (!*order || bb_trace_slice_order(out, *order, NULL) != BB_OK))
+    st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
+  return st;
+}
+
+bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
+                         const bb__bounce_options *o, bb_image *vis, int *bounces_done,
+                         bb_error *err) {
+  if (bounces_done)
+    *bounces_done = 0;
+  const int traced = vis && !vis->pixels; /* the passes are the trace too */
+  if (!p || !rs || !o || !vis ||
+      (!traced && (vis->width != p->width || vis->height != p->height ||
+                   vis->channels != 1 + rs->basis_count)))
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "bounce: the visibility does not match the pyramid");
   if (o->albedo && (o->albedo->width != p->width || o->albedo->height != p->height ||
                     o->albedo->channels != 1))
-    return bb__fail(err, BB_ERR_ARGUMENT, "bounce: the albedo map does not match the height");
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "bounce: the albedo map does not match the height");
   const int channels = 1 + rs->basis_count, threads = bb__thread_count(o->threads);
+  const int split = split_slices(rs);
   const size_t texels = (size_t)p->width * (size_t)p->height;
   const size_t corners = texels * FACES * (size_t)channels;
-  vtables vt = {0};
-  driver d = {.o = o, .albedo = o->albedo ? o->albedo->pixels : NULL};
+  driver d = {.o = o,
+              .albedo = o->albedo ? o->albedo->pixels : NULL,
+              .checkpoint = {o->progress, o->progress_user}};
   bounce_ctx *ctx = &d.ctx;
-  ctx->p = p, ctx->rs = rs, ctx->vt = &vt, ctx->channels = channels;
+  ctx->p = p, ctx->rs = rs, ctx->vt = &d.vt, ctx->channels = channels,
+  ctx->cols = &d.cols;
+  ctx->corner_lift = o->lift;
   atomic_init(&ctx->out_of_memory, 0);
   int *order = malloc((size_t)rs->slice_count * sizeof(int));
+  double *sector = malloc((size_t)rs->slice_count * 2 * sizeof(double));
+  unsigned char *wanted = malloc((size_t)rs->slice_count);
+  const size_t normal_floats = ((size_t)p->width + 1) * ((size_t)p->height + 1) * 6;
+  d.normals = malloc(normal_floats * sizeof(float));
   ctx->sums = malloc(corners * sizeof(float));
+  ctx->vectors = malloc(texels * 3 * (size_t)channels * sizeof(float));
   d.direct = malloc(corners * sizeof(float));
   d.radiance = malloc(corners * sizeof(float));
   d.row_sum = malloc((size_t)p->height * sizeof *d.row_sum);
+  if (traced)
+    ctx->horizons = malloc(texels * (size_t)rs->slice_count * sizeof(float));
+  if (split)
+    ctx->fill = calloc(texels * 4, sizeof(float));
   ctx->slot_count = threads < 256 ? threads : 256;
   ctx->slots = calloc((size_t)ctx->slot_count, sizeof(scratch));
   bb_status st = BB_OK;
-  if (!order || !ctx->sums || !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
+  if (!order || !sector || !wanted || !d.normals || !ctx->sums || !ctx->vectors ||
+      !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
+      (traced && !ctx->horizons) || (split && !ctx->fill) ||
       bb_trace_slice_order(rs, order, NULL) != BB_OK)
-    st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)", corners / (size_t)channels);
+    st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)",
+                  corners / (size_t)channels);
+  ctx->normals = d.normals;
   d.order = order;
   d.fine = rs;
-  const int surface_slices = coarse_slices(rs, o);
   d.work = bb__bounce_work(rs, o);
-  if (st == BB_OK && surface_slices < rs->slice_count) {
-    bb_basis basis = {.count = rs->basis_count, .name = "bounce"};
-    memcpy(basis.vector, rs->basis, sizeof basis.vector);
-    st = bb__rayset_make(surface_slices, rs->power, &basis, o->threads, &d.coarse, err);
-    d.coarse_order = st == BB_OK ? malloc((size_t)surface_slices * sizeof(int)) : NULL;
-    if (st == BB_OK && (!d.coarse_order ||
-                        bb_trace_slice_order(&d.coarse, d.coarse_order, NULL) != BB_OK))
-      st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory");
+  if (st == BB_OK)
+    st = pass_set(rs, slice_set(rs, o->surface_slices, 4), o->threads, &d.surface_set,
+                  &d.surface_order, err);
+  if (st == BB_OK &&
+      columns_build(p, o->steep, o->column_samples, o->lift, channels, &d.cols))
+    st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for the columns");
+  for (int i = 0; st == BB_OK && i < ctx->slot_count; i++)
+    atomic_flag_clear(&ctx->slots[i].busy);
+  if (st == BB_OK) {
+    normals_job nj = {p, d.normals};
+    st = bb__parallel_for(p->height + 1, o->threads, normals_row, &nj, NULL, NULL, err);
   }
-  for (int i = 0; st == BB_OK && i < ctx->slot_count; i++) atomic_flag_clear(&ctx->slots[i].busy);
-  if (st == BB_OK) st = vtables_build(rs, o->threads, &vt, err);
-  if (st == BB_OK) st = run_pass(&d, PASS_DIRECT, o->lift, err);
-  if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, direct_row, &d, NULL, NULL, err);
-  if (st == BB_OK) corner_fixup(&d);
+  /* The direct light: over the trace's sweeps of even rank (they find the
+   * texels' horizons too), the corners asking their hulls at their lift;
+   * or, with fewer than 4 slices, a pass of its own over all of them */
+  if (split)
+    direct_sectors(rs, order, sector, wanted);
+  if (st == BB_OK)
+    st = vtables_build(rs, split ? sector : NULL, split ? wanted : NULL, o->threads,
+                       &d.vt, err);
+  ctx->corner_hull = split;
+  if (st == BB_OK)
+    st = run_pass(&d, PASS_DIRECT, split ? 0 : -1, err);
+  ctx->corner_hull = 0;
+  if (st == BB_OK)
+    st = bb__parallel_for(p->height, o->threads, direct_row, &d, NULL, NULL, err);
+  exact_sum last_sum = 0;
+  if (st == BB_OK) {
+    corner_fixup(&d);
+    for (int y = 0; y < p->height; y++)
+      last_sum += d.row_sum[y];
+    last_sum += direct_columns(&d);
+  }
   ctx->radiance = d.radiance;
-  /* The bounces: each pass adds what the corners gather of the last one.
+  /* The bounces: each pass adds what the samples gather of the last one.
    * bounces N: N - 1 passes from the first bounce. bounces 0: the passes
    * from the estimate; the terms left are then about the last move times
    * lambda / (1 - lambda), lambda the ratio of the last two moves summed
-   * over every corner (the series of bounces is close to geometric), and
+   * over every sample (the series of bounces is close to geometric), and
    * that is added. */
+  float *horizons = ctx->horizons;
+  ctx->horizons = NULL; /* the surface passes' slices are their own */
   int done = 1;
-  exact_sum last_sum = 0;
-  for (int y = 0; st == BB_OK && y < p->height; y++) last_sum += d.row_sum[y];
   const int passes = surface_passes(o);
   for (int pass = 0; st == BB_OK && pass < passes; pass++) {
-    st = run_pass(&d, PASS_SURFACE, o->lift, err);
-    if (st == BB_OK) st = bb__parallel_for(p->height, o->threads, change_row, &d, NULL, NULL, err);
-    if (st != BB_OK) break;
-    exact_sum sum = 0;
-    for (int y = 0; y < p->height; y++) sum += d.row_sum[y];
+    st = run_pass(&d, PASS_SURFACE, -1, err);
+    if (st == BB_OK)
+      st = bb__parallel_for(p->height, o->threads, change_row, &d, NULL, NULL, err);
+    if (st != BB_OK)
+      break;
+    exact_sum sum = columns_step(&d, 0);
+    for (int y = 0; y < p->height; y++)
+      sum += d.row_sum[y];
     d.tail = 0.0;
     if (o->bounces == 0 && pass == passes - 1 && last_sum > 0) {
       double lambda = (double)sum / (double)last_sum;
@@ -1303,28 +2099,46 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs, const bb__bou
     }
     last_sum = sum;
     st = bb__parallel_for(p->height, o->threads, update_row, &d, NULL, NULL, err);
-    if (st == BB_OK) corner_fixup(&d);
+    columns_step(&d, 1);
+    if (st == BB_OK)
+      corner_fixup(&d);
     done++;
   }
-  if (st == BB_OK) st = run_pass(&d, PASS_TEXEL, o->bias, err);
-  if (st == BB_OK) {
-    finish_job fj = {&d, vis};
+  ctx->horizons = horizons;
+  /* the texels' gathers, over the trace's sweeps of odd rank (or all) */
+  if (st == BB_OK)
+    st = run_pass(&d, PASS_TEXEL, split ? 1 : -1, err);
+  finish_job fj = {&d, vis};
+  if (st == BB_OK && traced) {
+    st = bb_image_alloc(vis, p->width, p->height, channels, err);
+    if (st == BB_OK)
+      st = bb__parallel_for(p->height, o->threads, trace_row, &fj, NULL, NULL, err);
+    if (st == BB_OK)
+      st = bb_trace_finish(rs, vis, o->threads, err);
+  }
+  if (st == BB_OK)
     st = bb__parallel_for(p->height, o->threads, finish_row, &fj, NULL, NULL, err);
-  }
-  if (st == BB_OK && bounces_done) *bounces_done = done;
-  for (int i = 0; ctx->slots && i < ctx->slot_count; i++) {
-    scratch *sc = &ctx->slots[i];
-    free(sc->z), free(sc->step_max), free(sc->step_x), free(sc->step_y);
-    free(sc->radiance), free(sc->ready), free(sc->mip);
-  }
+  if (st != BB_OK && traced)
+    bb_image_free(vis);
+  if (st == BB_OK && bounces_done)
+    *bounces_done = done;
+  for (int i = 0; ctx->slots && i < ctx->slot_count; i++)
+    scratch_release(&ctx->slots[i]);
   free(ctx->slots);
-  vtables_free(&vt);
+  vtables_free(&d.vt);
+  columns_free(&d.cols);
   free(order);
+  free(sector);
+  free(wanted);
+  free(d.normals);
   free(ctx->sums);
+  free(ctx->vectors);
+  free(ctx->horizons);
+  free(ctx->fill);
   free(d.direct);
   free(d.radiance);
   free(d.row_sum);
-  bb__rayset_release(&d.coarse);
-  free(d.coarse_order);
+  bb__rayset_release(&d.surface_set);
+  free(d.surface_order);
   return st;
 }

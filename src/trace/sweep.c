@@ -38,12 +38,12 @@
  * texel is written by one of them per slice, in the slices' fixed order.
  */
 
+#include "trace/sweep.h"
 #include "core/internal.h"
 #include "trace/integrate.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
-#include "trace/sweep.h"
 #include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -75,14 +75,15 @@ typedef struct sweep_job {
   template_point *points; /* the step's breakpoints, the next texel last */
   int point_count;
   line_kind kind;
-  const int *item_x, *item_y, *item_len; /* first texel and texels of each line or chunk */
+  const int *item_x, *item_y,
+      *item_len; /* first texel and texels of each line or chunk */
   int item_count;
   const bb__stretch *stretch; /* LINE_STRETCH: each item's extent and exact sides */
   long period;    /* periodic: steps of a line */
   int lookahead;  /* chunks: steps profiled past each end */
   double bias;
-  int channels;   /* floats per texel in the sums */
-  sweep_side side[2]; /* along (a, b) and along (-a, -b) */
+  int channels;         /* floats per texel in the sums */
+  sweep_side side[2];   /* along (a, b) and along (-a, -b) */
   int reach_x, reach_y; /* how far template vertices lie from a step's texel */
   /* the template's offsets, fractions and weights, each in one array */
   long offset1[4 * BB__MAX_LATTICE_STEP + 1], offset2[4 * BB__MAX_LATTICE_STEP + 1];
@@ -95,10 +96,13 @@ typedef struct sweep_job {
   bb__channels4 *table4; /* both sides' tables by channels (integrate.h), when 3 lobes */
   struct scratch *scratch; /* a slot per thread (sweep_bundle) */
   int scratch_count;
+  const bb__walk_visitor *visitor; /* NULL: the sums or the hook */
+  void *visitor_ctx;
 } sweep_job;
 
 static int cmp_frac(const void *pa, const void *pb) {
-  const double a = ((const template_point *)pa)->frac, b = ((const template_point *)pb)->frac;
+  const double a = ((const template_point *)pa)->frac,
+               b = ((const template_point *)pb)->frac;
   return a < b ? -1 : a > b;
 }
 
@@ -113,8 +117,8 @@ static inline int sign(int v) {
 
 static template_point template_at(int m, int i, long r, int x1, int y1, int x2, int y2) {
   const double inverse = bb__lattice_inverse(m);
-  return (template_point){(double)i / m, m, i, inverse, bb__lattice_weight(r, inverse),
-                          x1, y1, x2, y2, 0, 0};
+  return (template_point){
+      (double)i / m, m, i, inverse, bb__lattice_weight(r, inverse), x1, y1, x2, y2, 0, 0};
 }
 
 /* Breakpoints of the step from (0, 0) to (a, b), sorted by u, computed from
@@ -137,7 +141,8 @@ static int build_template(int a, int b, template_point *out) {
   for (int i = 1; i < md; i++) { /* diagonals x + y = K, from (c+1, K-1-c) to (c, K-c) */
     const long num = (long)i * a, col = floor_div(num, md);
     const int row = i * sign(a + b) - 1 - (int)col;
-    out[n++] = template_at(md, i, md - (num - col * md), (int)col + 1, row, (int)col, row + 1);
+    out[n++] =
+        template_at(md, i, md - (num - col * md), (int)col + 1, row, (int)col, row + 1);
   }
   out[n++] = template_at(1, 1, 0, a, b, a, b); /* the next texel */
   qsort(out, (size_t)n, sizeof *out, cmp_frac);
@@ -159,10 +164,7 @@ static inline int imin(int a, int b) {
  * step it belongs to and its template point, step * KEY_STEP + tp (a shift
  * of the step by d adds d * KEY_STEP). Fields are stored one by one: a copy
  * of the whole struct costs shuffles between registers. */
-typedef struct point {
-  double u, z;
-  int64_t key;
-} point;
+typedef bb__walk_point point;
 
 #define KEY_STEP BB__KEY_STEP /* > 4 * BB__MAX_LATTICE_STEP + 1 template points */
 
@@ -201,10 +203,10 @@ typedef struct profile {
 /* The points of a block of steps of one line (profile_fill) or of LANES
  * lines side by side (profile_fill_lanes), for the kink filter. */
 typedef struct fill_block {
-  double *u;    /* the points' u, the same for every line */
-  double *z;    /* their heights, point-major, the lines side by side */
-  double *rise; /* likewise; a point is kept when > 0 */
-  int64_t *key; /* lines side by side: the points' keys */
+  double *u;     /* the points' u, the same for every line */
+  double *z;     /* their heights, point-major, the lines side by side */
+  double *rise;  /* likewise; a point is kept when > 0 */
+  int64_t *key;  /* lines side by side: the points' keys */
   int64_t *kept; /* lines side by side: a bit per point and line */
 } fill_block;
 
@@ -295,14 +297,14 @@ static inline void put_point(point *pt, double u, double z, int64_t key) {
  * difference of doubles is 0 only when they are equal, and keeps its
  * sign). The heights may be vectors of lines side by side (profile_fill_lanes),
  * the u are the same for all of them. */
-#define CHORD_RISE(zl, zm, zr, ul, um, ur)                                                      \
+#define CHORD_RISE(zl, zm, zr, ul, um, ur)                                               \
   (((zm) - (zl)) * ((ur) - (ul)) - ((zr) - (zl)) * ((um) - (ul)))
 
 /* Copies the points of steps s0 .. s1-1 of the block out of the block
  * arrays (the step s0 starts at index base) and moves the count on past
  * those kept; the block's last point is left for the next block. */
-static inline int keep_points(const sweep_job *job, const fill_block *fb, const profile *pr,
-                              int s0, int s1, int base, int count) {
+static inline int keep_points(const sweep_job *job, const fill_block *fb,
+                              const profile *pr, int s0, int s1, int base, int count) {
   const int tcount = job->point_count;
   const double *restrict u = fb->u, *restrict z = fb->z;
   const double *restrict rise = fb->rise;
@@ -323,12 +325,14 @@ static inline int keep_points(const sweep_job *job, const fill_block *fb, const 
  * while they are in the cache. */
 static int highest_point(const point *pt, int from, int to, int best) {
   if (from == 0) {
-    if (to == 0) return 0;
+    if (to == 0)
+      return 0;
     best = 0, from = 1;
   }
   double best_z = pt[best].z;
   for (int q = from; q < to; q++)
-    if (pt[q].z > best_z) best = q, best_z = pt[q].z;
+    if (pt[q].z > best_z)
+      best = q, best_z = pt[q].z;
   return best;
 }
 
@@ -341,7 +345,8 @@ static void profile_fill(const sweep_job *job, const fill_block *fb, int x0, int
   int bx = coordinate_at(p, (long)x0 + (long)pr->first_step * job->a, p->width);
   int by = coordinate_at(p, (long)y0 + (long)pr->first_step * job->b, p->height);
   const int periodic = p->addressing == BB_ADDRESS_PERIODIC;
-  const int sa = periodic ? job->a % p->width : job->a, sb = periodic ? job->b % p->height : job->b;
+  const int sa = periodic ? job->a % p->width : job->a,
+            sb = periodic ? job->b % p->height : job->b;
   double *restrict u = fb->u, *restrict z = fb->z;
   double *restrict rise = fb->rise;
   int count = 0, top = 0;
@@ -358,7 +363,8 @@ static void profile_fill(const sweep_job *job, const fill_block *fb, int x0, int
       }
       step_heights(job, bx, by, z + n);
       const double ju = (double)j;
-      for (int k = 0; k < tcount; k++) u[n + k] = ju + frac[k];
+      for (int k = 0; k < tcount; k++)
+        u[n + k] = ju + frac[k];
       n += tcount;
     }
     /* point i is kept when above the chord of its neighbours, a form the
@@ -369,23 +375,27 @@ static void profile_fill(const sweep_job *job, const fill_block *fb, int x0, int
      * +infinity where they do not, which leaves the verdict above) */
     for (int i = 2; i < n - 2; i++) {
       const double wide_a =
-          CHORD_RISE(z[i - 2], z[i], z[i + 1], u[i - 2], u[i], u[i + 1]) + job->open_a[i - base];
+          CHORD_RISE(z[i - 2], z[i], z[i + 1], u[i - 2], u[i], u[i + 1]) +
+          job->open_a[i - base];
       const double wide_b =
-          CHORD_RISE(z[i - 1], z[i], z[i + 2], u[i - 1], u[i], u[i + 2]) + job->open_b[i - base];
+          CHORD_RISE(z[i - 1], z[i], z[i + 2], u[i - 1], u[i], u[i + 2]) +
+          job->open_b[i - base];
       const double wide = wide_a < wide_b ? wide_a : wide_b;
       rise[i] = wide < rise[i] ? wide : rise[i];
     }
     /* the chord from each step's start vertex to its end vertex */
     for (int s = 0; s < s1 - s0; s++) {
       const int st = base + s * tcount - 1, e = st + tcount;
-      if (st < 0) continue;
+      if (st < 0)
+        continue;
       const double zs = z[st], ze = z[e], us = u[st], ue = u[e];
       for (int k = st + 1; k < e; k++) {
         const double full = CHORD_RISE(zs, z[k], ze, us, u[k], ue);
         rise[k] = full < rise[k] ? full : rise[k];
       }
     }
-    if (s0 == 0) rise[0] = 1.0; /* the first point is an end */
+    if (s0 == 0)
+      rise[0] = 1.0; /* the first point is an end */
     const int first_kept = count;
     if (s0 > 0) { /* the previous block's last point, carried at index 1 */
       put_point(&pr->pt[count], u[1], z[1], key_of(pr->first_step + s0 - 1, tcount - 1));
@@ -439,8 +449,8 @@ static inline __attribute__((always_inline)) lanes_z lanes_load(const float *z) 
  * minima (out may be b). Pointers, not vector arguments: clang refuses a
  * 4-double vector argument in the target_clones default (non-AVX) clone,
  * which `make fuzz` builds with. */
-static inline __attribute__((always_inline)) void lanes_min(lanes_z *out, const lanes_z *a,
-                                                            const lanes_z *b) {
+static inline __attribute__((always_inline)) void
+lanes_min(lanes_z *out, const lanes_z *a, const lanes_z *b) {
   const lanes_mask less = *a < *b;
   *out = (lanes_z)(((lanes_mask)*a & less) | ((lanes_mask)*b & ~less));
 }
@@ -449,19 +459,21 @@ static inline __attribute__((always_inline)) void lanes_min(lanes_z *out, const 
 static inline void step_heights_lanes(const sweep_job *job, int bx, int by, lanes_z *zs) {
   const bb_pyramid *p = job->p;
   const int tcount = job->point_count;
-  if (bx >= job->reach_x && bx + LANES - 1 < p->width - job->reach_x && by >= job->reach_y &&
-      by < p->height - job->reach_y) {
+  if (bx >= job->reach_x && bx + LANES - 1 < p->width - job->reach_x &&
+      by >= job->reach_y && by < p->height - job->reach_y) {
     const float *here = p->z + (size_t)by * (size_t)p->width + (size_t)bx;
     for (int k = 0; k < tcount; k++) {
-      const lanes_z za = lanes_load(here + job->offset1[k]), zb = lanes_load(here + job->offset2[k]);
+      const lanes_z za = lanes_load(here + job->offset1[k]),
+                    zb = lanes_load(here + job->offset2[k]);
       zs[k] = za + (zb - za) * job->weight[k]; /* bb__lattice_height */
     }
   } else {
     for (int k = 0; k < tcount; k++) {
       const template_point *t = &job->points[k];
       for (int l = 0; l < LANES; l++)
-        zs[k][l] = bb__lattice_height(field_z(p, bx + l + t->x1, by + t->y1),
-                                      field_z(p, bx + l + t->x2, by + t->y2), job->weight[k]);
+        zs[k][l] =
+            bb__lattice_height(field_z(p, bx + l + t->x1, by + t->y1),
+                               field_z(p, bx + l + t->x2, by + t->y2), job->weight[k]);
     }
   }
 }
@@ -470,13 +482,15 @@ static inline void step_heights_lanes(const sweep_job *job, int bx, int by, lane
  * profile from pt[count]; kept[w] holds, for every line, a bit per point of
  * the block's points 64 w .. 64 w + 63. Returns the new count. Only the
  * kept points are visited (a third of them on rock06). */
-static inline int keep_lane(const fill_block *fb, const lanes_mask *kept, int l, int i0, int i1,
-                            point *restrict pt, int count) {
+static inline int keep_lane(const fill_block *fb, const lanes_mask *kept, int l, int i0,
+                            int i1, point *restrict pt, int count) {
   const lanes_z *z = (const lanes_z *)fb->z;
   for (int w = i0 / 64; w * 64 < i1; w++) {
     uint64_t bits = (uint64_t)kept[w][l];
-    if (w * 64 < i0) bits &= ~0ull << (i0 - w * 64);
-    if (i1 - w * 64 < 64) bits &= ~(~0ull << (i1 - w * 64));
+    if (w * 64 < i0)
+      bits &= ~0ull << (i0 - w * 64);
+    if (i1 - w * 64 < 64)
+      bits &= ~(~0ull << (i1 - w * 64));
     for (; bits; bits &= bits - 1) {
       const int i = w * 64 + __builtin_ctzll(bits);
       put_point(&pt[count++], fb->u[i], z[i][l], fb->key[i]);
@@ -516,29 +530,34 @@ static void profile_fill_lanes(const sweep_job *job, const fill_block *fb, int x
         }
       step_heights_lanes(job, bx, by, z + n);
       const double js = (double)s;
-      for (int k = 0; k < tcount; k++) u[n + k] = js + frac[k], key[n + k] = key_of(s, k);
+      for (int k = 0; k < tcount; k++)
+        u[n + k] = js + frac[k], key[n + k] = key_of(s, k);
       n += tcount;
     }
     for (int i = 1; i < n - 1; i++)
       rise[i] = CHORD_RISE(z[i - 1], z[i], z[i + 1], u[i - 1], u[i], u[i + 1]);
     for (int i = 2; i < n - 2; i++) {
       const lanes_z wide_a =
-          CHORD_RISE(z[i - 2], z[i], z[i + 1], u[i - 2], u[i], u[i + 1]) + job->open_a[i - base];
+          CHORD_RISE(z[i - 2], z[i], z[i + 1], u[i - 2], u[i], u[i + 1]) +
+          job->open_a[i - base];
       const lanes_z wide_b =
-          CHORD_RISE(z[i - 1], z[i], z[i + 2], u[i - 1], u[i], u[i + 2]) + job->open_b[i - base];
+          CHORD_RISE(z[i - 1], z[i], z[i + 2], u[i - 1], u[i], u[i + 2]) +
+          job->open_b[i - base];
       lanes_z wide;
       lanes_min(&wide, &wide_a, &wide_b);
       lanes_min(&rise[i], &wide, &rise[i]);
     }
     for (int s = 0; s < s1 - s0; s++) {
       const int st = base + s * tcount - 1, e = st + tcount;
-      if (st < 0) continue;
+      if (st < 0)
+        continue;
       for (int k = st + 1; k < e; k++) {
         const lanes_z chord = CHORD_RISE(z[st], z[k], z[e], u[st], u[k], u[e]);
         lanes_min(&rise[k], &chord, &rise[k]);
       }
     }
-    if (s0 == 0) rise[0] = (lanes_z){0} + 1.0; /* the first point is an end */
+    if (s0 == 0)
+      rise[0] = (lanes_z){0} + 1.0; /* the first point is an end */
     /* the verdicts of points 0 .. n-2 (the last waits for the next block) */
     for (int w = 0; w * 64 < n - 1; w++) {
       lanes_mask bits = {0};
@@ -594,8 +613,10 @@ static inline int hull_push(point *restrict v, int size, double qu, double qz,
     size -= one + two;
     more = two;
   }
-  while (more && size >= 2 && under(&v[size - 1], &v[size - 2], qu, qz)) size--;
-  if (size >= 1 && v[size - 1].z <= qz) size = 0;
+  while (more && size >= 2 && under(&v[size - 1], &v[size - 2], qu, qz))
+    size--;
+  if (size >= 1 && v[size - 1].z <= qz)
+    size = 0;
   put_point(&v[size], qu, qz, key);
   return size + 1;
 }
@@ -616,20 +637,27 @@ static inline int steeper(const point *far, double du, double dz, double u0, dou
  * time. The tests and where the walk stops are those of a plain walk. */
 static inline int hull_tangent(const point *v, int size, double u0, double z0) {
   int i = size - 1;
-  if (i < 0) return -1; /* nothing there (a chunk's first origin, one step in) */
+  if (i < 0)
+    return -1; /* nothing there (a chunk's first origin, one step in) */
   double du = v[i].u - u0, dz = v[i].z - z0;
-  if (i == 0 || !steeper(&v[i - 1], du, dz, u0, z0)) return i;
+  if (i == 0 || !steeper(&v[i - 1], du, dz, u0, z0))
+    return i;
   i--, du = v[i].u - u0, dz = v[i].z - z0;
   if (i >= 2) {
     const double du1 = v[i - 1].u - u0, dz1 = v[i - 1].z - z0;
     const int one = steeper(&v[i - 1], du, dz, u0, z0);
     const int two = one & steeper(&v[i - 2], du1, dz1, u0, z0);
-    if (!two) return i - one;
+    if (!two)
+      return i - one;
     i -= 2, du = v[i].u - u0, dz = v[i].z - z0;
   }
   while (i > 0 && steeper(&v[i - 1], du, dz, u0, z0))
     i--, du = v[i].u - u0, dz = v[i].z - z0;
   return i;
+}
+
+int bb__hull_tangent(const bb__walk_point *hull, int size, double u0, double z0) {
+  return hull_tangent(hull, size, u0, z0);
 }
 
 /* The canonical slope per step from an origin of height oz to the point of
@@ -662,9 +690,9 @@ static int vouched(const sweep_job *job, double slope, double oz, double distanc
  * out after them (horizons_of_line). The walks' loops then carry only the
  * hull, with fewer values live across them, and the divisions of
  * neighbouring texels overlap in a loop of their own. */
-static inline __attribute__((always_inline)) void query(const sweep_job *job, const profile *pr,
-                                                       const point *h, int size, int j,
-                                                       int forward) {
+static inline __attribute__((always_inline)) int query(const sweep_job *job,
+                                                       const profile *pr, const point *h,
+                                                       int size, int j, int forward) {
   const int L = pr->len;
   const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
   const double oz = pr->vz[texel_j] + job->bias;
@@ -678,6 +706,7 @@ static inline __attribute__((always_inline)) void query(const sweep_job *job, co
     pr->tangent_z[k][texel_j] = -INFINITY;
     pr->tangent_key[k][texel_j] = key_of(forward ? 0 : -2, job->point_count - 1);
   }
+  return i;
 }
 
 /* The horizons of a line's texels along side k, from the tangents its walk
@@ -735,11 +764,11 @@ typedef struct stretch {
 typedef struct walk {
   point *h;
   int size;
-  const point *pt;     /* the profile */
+  const point *pt; /* the profile */
   const stretch *st;
-  int stretches, r;    /* the stretch under way */
+  int stretches, r;     /* the stretch under way */
   const point *q, *end; /* its next point, and the point past its last */
-  double du;           /* its shift */
+  double du;            /* its shift */
   int64_t dkey;
   int j; /* the next origin */
 } walk;
@@ -750,7 +779,8 @@ static inline int walk_enter(walk *w, int forward) {
   const int dq = forward ? -1 : 1;
   for (; w->r < w->stretches; w->r++) {
     const stretch *s = &w->st[w->r];
-    if ((s->to - s->from) * dq < 0) continue;
+    if ((s->to - s->from) * dq < 0)
+      continue;
     w->q = w->pt + s->from;
     w->end = w->pt + s->to + dq;
     w->du = (double)s->shift, w->dkey = (int64_t)s->shift * KEY_STEP;
@@ -767,26 +797,46 @@ static walk walk_start(const profile *pr, point *h, const stretch *st, int stret
   return w;
 }
 
+/* A visited walk's origin: the visitor is told of it with the horizon its
+ * tangent makes, worked out as horizons_of_line does. */
+static void visit_origin(const sweep_job *job, const profile *pr, const walk *w,
+                         int forward, int tangent, void *state) {
+  const int L = pr->len, j = w->j;
+  const int texel_j = j < 0 ? j + L : (j >= L ? j - L : j);
+  const double oz = pr->vz[texel_j] + job->bias;
+  const int k = forward ? 0 : 1;
+  const double slope = tangent_slope(job, pr->tangent_z[k][texel_j],
+                                     pr->tangent_key[k][texel_j], oz, forward);
+  job->visitor->origin(state, k, texel_j, forward ? (double)j : -(double)j, oz, w->h,
+                       w->size, tangent, horizon_of(job, k, slope));
+}
+
 /* The walk's next origin: the points beyond it are pushed, then it asks the
- * hull for its tangent. */
-static inline __attribute__((always_inline)) void walk_next(const sweep_job *job,
-                                                           const profile *pr, walk *w,
-                                                           int forward) {
-  const int64_t beyond = forward ? (int64_t)w->j * KEY_STEP
-                                 : key_of(w->j - 1, job->point_count - 1);
+ * hull for its tangent. A visited walk (state not NULL) also tells the
+ * visitor of each push and each origin. */
+static inline __attribute__((always_inline)) void
+walk_next(const sweep_job *job, const profile *pr, walk *w, int forward, void *state) {
+  const int64_t beyond =
+      forward ? (int64_t)w->j * KEY_STEP : key_of(w->j - 1, job->point_count - 1);
   for (;;) {
     if (w->q == w->end) {
       w->r++;
-      if (!walk_enter(w, forward)) break;
+      if (!walk_enter(w, forward))
+        break;
     }
     const point *next = w->q;
     const int64_t key = next->key + w->dkey;
-    if (forward ? key < beyond : key >= beyond) break;
+    if (forward ? key < beyond : key >= beyond)
+      break;
     const double u = next->u + w->du;
     w->size = hull_push(w->h, w->size, forward ? u : -u, next->z, key);
+    if (state && job->visitor->push)
+      job->visitor->push(state, forward ? 0 : 1, w->h, w->size);
     w->q += forward ? -1 : 1;
   }
-  query(job, pr, w->h, w->size, w->j, forward);
+  const int tangent = query(job, pr, w->h, w->size, w->j, forward);
+  if (state)
+    visit_origin(job, pr, w, forward, tangent, state);
   w->j += forward ? -1 : 1;
 }
 
@@ -795,18 +845,40 @@ static inline __attribute__((always_inline)) void walk_next(const sweep_job *job
  * stored in the same hull; the two hulls are independent, so the processor
  * overlaps the two chains. The walks write different horizons (found[0],
  * found[1]), so the results are those of one walk after the other. */
-static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind,
-                      int origins) {
+static inline __attribute__((always_inline)) void
+walk_pair_with(const sweep_job *job, const profile *pr, walk *ahead, walk *behind,
+               int origins, void *state) {
   walk a = ahead ? *ahead : (walk){0}, b = behind ? *behind : (walk){0};
   if (ahead && behind)
     for (int i = 0; i < origins; i++) {
-      walk_next(job, pr, &a, 1);
-      walk_next(job, pr, &b, 0);
+      walk_next(job, pr, &a, 1, state);
+      walk_next(job, pr, &b, 0, state);
     }
   else if (ahead)
-    for (int i = 0; i < origins; i++) walk_next(job, pr, &a, 1);
+    for (int i = 0; i < origins; i++)
+      walk_next(job, pr, &a, 1, state);
   else if (behind)
-    for (int i = 0; i < origins; i++) walk_next(job, pr, &b, 0);
+    for (int i = 0; i < origins; i++)
+      walk_next(job, pr, &b, 0, state);
+}
+
+/* The trace's walks, and a visited line's (the visitor's state). */
+static void walk_pair_traced(const sweep_job *job, const profile *pr, walk *ahead,
+                             walk *behind, int origins) {
+  walk_pair_with(job, pr, ahead, behind, origins, NULL);
+}
+
+static void walk_pair_visited(const sweep_job *job, const profile *pr, walk *ahead,
+                              walk *behind, int origins, void *state) {
+  walk_pair_with(job, pr, ahead, behind, origins, state);
+}
+
+static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk *behind,
+                      int origins, void *state) {
+  if (state)
+    walk_pair_visited(job, pr, ahead, behind, origins, state);
+  else
+    walk_pair_traced(job, pr, ahead, behind, origins);
 }
 
 /* Once round a periodic line of L steps (points in u (0, L]), from its
@@ -814,7 +886,8 @@ static void walk_pair(const sweep_job *job, const profile *pr, walk *ahead, walk
  * backwards, for origins from just below it down to u*, so each sees
  * (j, u* + L]. Along (-a, -b): from the copy one period back, forwards, for
  * origins from just above it up to u*, so each sees [u* - L, j). */
-static void walk_round(const sweep_job *job, const profile *pr, point *h[2]) {
+static void walk_round(const sweep_job *job, const profile *pr, point *h[2],
+                       void *state) {
   const int top = pr->top, n = pr->count, L = pr->len;
   const double u_top = pr->pt[top].u;
   const stretch down[2] = {{top, 0, L}, {n - 1, top + 1, 0}};
@@ -822,16 +895,17 @@ static void walk_round(const sweep_job *job, const profile *pr, point *h[2]) {
   const int first = (int)ceil(u_top), last = (int)floor(u_top);
   walk ahead = walk_start(pr, h[0], down, 2, first + L - 1, 1);
   walk behind = walk_start(pr, h[1], up, 2, last - L + 1, 0);
-  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL, L);
+  walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL,
+            L, state);
 }
 
 /* A line with ends (a clamped line, or a chunk): every point, every origin. */
-static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
+static void walk_line(const sweep_job *job, const profile *pr, point *h[2], void *state) {
   const stretch down = {pr->count - 1, 0, 0}, up = {0, pr->count - 1, 0};
   walk ahead = walk_start(pr, h[0], &down, 1, pr->len - 1, 1);
   walk behind = walk_start(pr, h[1], &up, 1, 0, 0);
   walk_pair(job, pr, job->side[0].dir ? &ahead : NULL, job->side[1].dir ? &behind : NULL,
-            pr->len);
+            pr->len, state);
 }
 
 /* The line's horizons from its tangents, and what its texels lose to them,
@@ -839,45 +913,60 @@ static void walk_line(const sweep_job *job, const profile *pr, point *h[2]) {
  * slices' order wants. The walks only find tangents; integrating here, in
  * loops of their own, lets the divisions and table reads of neighbouring
  * texels overlap. */
+static bb__line_view line_view_of(const sweep_job *job, const profile *pr, int x0,
+                                  int y0) {
+  const bb__line_view line = {.p = job->p,
+                              .a = job->a,
+                              .b = job->b,
+                              .points = job->points,
+                              .point_count = job->point_count,
+                              .round = job->kind == LINE_ROUND,
+                              .x0 = x0,
+                              .y0 = y0,
+                              .first_step = pr->first_step,
+                              .steps = pr->steps,
+                              .len = pr->len,
+                              .texel = pr->texel,
+                              .vz = pr->vz,
+                              .bias = job->bias,
+                              .dir = {job->side[0].dir, job->side[1].dir},
+                              .found = {job->side[0].dir ? pr->found[0] : NULL,
+                                        job->side[1].dir ? pr->found[1] : NULL},
+                              .tangent_key = {pr->tangent_key[0], pr->tangent_key[1]},
+                              .want = pr->want};
+  return line;
+}
+
 PROFILE_CLONES
-static void integrate_line(const sweep_job *job, const profile *pr, int x0, int y0) {
+static void integrate_line(const sweep_job *job, const profile *pr, int x0, int y0,
+                           void *state) {
   const int channels = job->channels;
   for (int k = 0; k < 2; k++)
-    if (job->side[k].dir) horizons_of_line(job, pr, k);
-  if (job->hook) {
-    const bb__line_view line = {.p = job->p,
-                                .a = job->a,
-                                .b = job->b,
-                                .points = job->points,
-                                .point_count = job->point_count,
-                                .round = job->kind == LINE_ROUND,
-                                .x0 = x0,
-                                .y0 = y0,
-                                .first_step = pr->first_step,
-                                .steps = pr->steps,
-                                .len = pr->len,
-                                .texel = pr->texel,
-                                .vz = pr->vz,
-                                .bias = job->bias,
-                                .dir = {job->side[0].dir, job->side[1].dir},
-                                .found = {job->side[0].dir ? pr->found[0] : NULL,
-                                          job->side[1].dir ? pr->found[1] : NULL},
-                                .tangent_key = {pr->tangent_key[0], pr->tangent_key[1]},
-                                .want = pr->want};
-    job->hook(job->hook_ctx, &line);
+    if (job->side[k].dir)
+      horizons_of_line(job, pr, k);
+  if (job->hook || state) {
+    const bb__line_view line = line_view_of(job, pr, x0, y0);
+    if (state)
+      job->visitor->line_end(state, &line);
+    else
+      job->hook(job->hook_ctx, &line);
     return;
   }
   for (int k = 0; k < 2; k++) {
     const bb__sweep_dir *dir = job->side[k].dir;
-    if (!dir || !dir->horizon) continue;
-    for (int j = 0; j < pr->len; j++) dir->horizon[pr->texel[j]] = pr->found[k][j];
+    if (!dir || !dir->horizon)
+      continue;
+    for (int j = 0; j < pr->len; j++)
+      dir->horizon[pr->texel[j]] = pr->found[k][j];
   }
   if (job->side[0].dir && job->side[1].dir && job->side[0].dir->sums &&
       job->side[1].dir->sums) {
-    const bb__slice_integral *along = &job->side[0].integral, *opposite = &job->side[1].integral;
+    const bb__slice_integral *along = &job->side[0].integral,
+                             *opposite = &job->side[1].integral;
     float *sums = job->side[0].dir->sums;
     if (job->table4) {
-      const bb__channels4 *t_along = job->table4, *t_opposite = job->table4 + 4 * BB__TABLE_INTERVALS;
+      const bb__channels4 *t_along = job->table4,
+                          *t_opposite = job->table4 + 4 * BB__TABLE_INTERVALS;
       for (int j = 0; j < pr->len; j++) {
         float *texel_sums = sums + pr->texel[j] * 4;
         bb__slice_accumulate4(along, t_along, pr->found[0][j], texel_sums);
@@ -894,7 +983,8 @@ static void integrate_line(const sweep_job *job, const profile *pr, int x0, int 
   }
   for (int k = 0; k < 2; k++) {
     const bb__sweep_dir *dir = job->side[k].dir;
-    if (!dir || !dir->sums) continue; /* horizons only */
+    if (!dir || !dir->sums)
+      continue; /* horizons only */
     for (int j = 0; j < pr->len; j++)
       bb__slice_accumulate(&job->side[k].integral, pr->found[k][j],
                            dir->sums + pr->texel[j] * (size_t)channels);
@@ -907,8 +997,10 @@ static void integrate_line(const sweep_job *job, const profile *pr, int x0, int 
  * clamped to the same height along each axis the line moves on? */
 static int step_is_flat(const sweep_job *job, long x, long y) {
   const bb_pyramid *p = job->p;
-  const int flat_x = job->a == 0 || x + job->min_dx >= p->width - 1 || x + job->max_dx <= 0;
-  const int flat_y = job->b == 0 || y + job->min_dy >= p->height - 1 || y + job->max_dy <= 0;
+  const int flat_x =
+      job->a == 0 || x + job->min_dx >= p->width - 1 || x + job->max_dx <= 0;
+  const int flat_y =
+      job->b == 0 || y + job->min_dy >= p->height - 1 || y + job->max_dy <= 0;
   return flat_x && flat_y;
 }
 
@@ -916,7 +1008,8 @@ static int step_is_flat(const sweep_job *job, long x, long y) {
  * first flat step, inclusive. */
 static int steps_to_flat(const sweep_job *job, long x, long y, int sa, int sb) {
   int steps = 0;
-  while (!step_is_flat(job, x, y)) x += sa, y += sb, steps++;
+  while (!step_is_flat(job, x, y))
+    x += sa, y += sb, steps++;
   return steps + 1;
 }
 
@@ -965,11 +1058,20 @@ static int item_steps(const sweep_job *job, int item, int *first_step) {
 
 /* Walks a line's profile and adds up its horizons. */
 static void walk_and_integrate(sweep_job *job, profile *pr, int x0, int y0, point *h[2]) {
+  void *state = NULL;
+  if (job->visitor) {
+    const bb__line_view line = line_view_of(job, pr, x0, y0);
+    state = job->visitor->line_begin(job->visitor_ctx, &line);
+    if (!state) {
+      atomic_store(&job->out_of_memory, 1);
+      return;
+    }
+  }
   if (job->kind == LINE_ROUND)
-    walk_round(job, pr, h);
+    walk_round(job, pr, h, state);
   else
-    walk_line(job, pr, h);
-  integrate_line(job, pr, x0, y0);
+    walk_line(job, pr, h, state);
+  integrate_line(job, pr, x0, y0, state);
 }
 
 /* Do items item .. item + LANES - 1 make a group for profile_fill_lanes? */
@@ -979,7 +1081,8 @@ static int lanes_from(const sweep_job *job, int item, int last) {
     return 0;
   for (int l = 1; l < LANES; l++)
     if (job->item_x[item + l] != job->item_x[item] + l ||
-        job->item_y[item + l] != job->item_y[item] || job->item_len[item + l] != job->item_len[item])
+        job->item_y[item + l] != job->item_y[item] ||
+        job->item_len[item + l] != job->item_len[item])
       return 0;
   return 1;
 }
@@ -1004,7 +1107,8 @@ typedef struct scratch {
 } scratch;
 
 static void scratch_release(scratch *sc) {
-  for (int l = 0; l < LANES; l++) free(sc->pt[l]), free(sc->vz[l]), free(sc->texel[l]);
+  for (int l = 0; l < LANES; l++)
+    free(sc->pt[l]), free(sc->vz[l]), free(sc->texel[l]);
   free(sc->h[0]);
   free(sc->h[1]);
   free(sc->block_u);
@@ -1014,13 +1118,14 @@ static void scratch_release(scratch *sc) {
   free(sc->block_kept);
   free(sc->found[0]);
   free(sc->found[1]);
-  for (int k = 0; k < 2; k++) free(sc->tangent_z[k]), free(sc->tangent_key[k]);
+  for (int k = 0; k < 2; k++)
+    free(sc->tangent_z[k]), free(sc->tangent_key[k]);
 }
 
 /* Room for `points` profile points and `len` texels in lane 0 and the
  * walks, and for lane_points and len in every lane; 0 when out of memory. */
-static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, size_t lane_points,
-                           size_t len) {
+static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points,
+                           size_t lane_points, size_t len) {
   if (!sc->block_u) {
     const size_t block = (size_t)BLOCK_STEPS * (size_t)job->point_count + 2;
     sc->block_u = malloc(block * sizeof(double));
@@ -1028,8 +1133,10 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
     sc->block_z = aligned_alloc(sizeof(lanes_z), block * sizeof(lanes_z));
     sc->block_rise = aligned_alloc(sizeof(lanes_z), block * sizeof(lanes_z));
     sc->block_key = malloc(block * sizeof(int64_t));
-    sc->block_kept = aligned_alloc(sizeof(lanes_mask), (block / 64 + 1) * sizeof(lanes_mask));
-    if (!sc->block_u || !sc->block_z || !sc->block_rise || !sc->block_key || !sc->block_kept)
+    sc->block_kept =
+        aligned_alloc(sizeof(lanes_mask), (block / 64 + 1) * sizeof(lanes_mask));
+    if (!sc->block_u || !sc->block_z || !sc->block_rise || !sc->block_key ||
+        !sc->block_kept)
       return 0;
   }
   if (points > sc->points) {
@@ -1038,7 +1145,8 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
     sc->h[0] = malloc(points * sizeof(point));
     sc->h[1] = malloc(points * sizeof(point));
     sc->points = sc->pt[0] && sc->h[0] && sc->h[1] ? points : 0;
-    if (!sc->points) return 0;
+    if (!sc->points)
+      return 0;
   }
   if (lane_points > sc->lane_points) {
     int ok = 1;
@@ -1048,7 +1156,8 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
       ok = ok && sc->pt[l];
     }
     sc->lane_points = ok ? lane_points : 0;
-    if (!ok) return 0;
+    if (!ok)
+      return 0;
   }
   if (len > sc->len) {
     int ok = 1;
@@ -1066,7 +1175,8 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
       ok = ok && sc->found[k] && sc->tangent_z[k] && sc->tangent_key[k];
     }
     sc->len = ok ? len : 0;
-    if (!ok) return 0;
+    if (!ok)
+      return 0;
   }
   return 1;
 }
@@ -1074,7 +1184,8 @@ static int scratch_reserve(scratch *sc, const sweep_job *job, size_t points, siz
 static scratch *scratch_take(sweep_job *job) {
   for (;;)
     for (int i = 0; i < job->scratch_count; i++)
-      if (!atomic_flag_test_and_set(&job->scratch[i].busy)) return &job->scratch[i];
+      if (!atomic_flag_test_and_set(&job->scratch[i].busy))
+        return &job->scratch[i];
 }
 
 static void sweep_bundle(void *user, int bundle) {
@@ -1084,7 +1195,8 @@ static void sweep_bundle(void *user, int bundle) {
   for (int item = first; item < last; item++) {
     steps = imax(steps, item_steps(job, item, &first_step));
     len = imax(len, job->item_len[item]);
-    if (lanes_from(job, item, last)) lane_steps = imax(lane_steps, job->item_len[item]);
+    if (lanes_from(job, item, last))
+      lane_steps = imax(lane_steps, job->item_len[item]);
   }
   scratch *sc = scratch_take(job);
   const size_t tcount = (size_t)job->point_count;
@@ -1094,7 +1206,9 @@ static void sweep_bundle(void *user, int bundle) {
                            sc->block_kept};
     profile pr[LANES];
     for (int l = 0; l < LANES; l++)
-      pr[l] = (profile){.pt = sc->pt[l], .vz = sc->vz[l], .texel = sc->texel[l],
+      pr[l] = (profile){.pt = sc->pt[l],
+                        .vz = sc->vz[l],
+                        .texel = sc->texel[l],
                         .found = {sc->found[0], sc->found[1]},
                         .tangent_z = {sc->tangent_z[0], sc->tangent_z[1]},
                         .tangent_key = {sc->tangent_key[0], sc->tangent_key[1]}};
@@ -1116,7 +1230,8 @@ static void sweep_bundle(void *user, int bundle) {
         profile_fill_lanes(job, &fb, x0, y0, pr);
       else
         profile_fill(job, &fb, x0, y0, pr);
-      for (int l = 0; l < lanes; l++) walk_and_integrate(job, &pr[l], x0 + l, y0, sc->h);
+      for (int l = 0; l < lanes; l++)
+        walk_and_integrate(job, &pr[l], x0 + l, y0, sc->h);
       item += lanes;
     }
   } else {
@@ -1135,12 +1250,16 @@ static int items_add(items *it, int x, int y, int len) {
   if (it->count == it->capacity) {
     const int capacity = it->capacity ? 2 * it->capacity : 1024;
     int *nx = realloc(it->x, (size_t)capacity * sizeof(int));
-    if (nx) it->x = nx;
+    if (nx)
+      it->x = nx;
     int *ny = realloc(it->y, (size_t)capacity * sizeof(int));
-    if (ny) it->y = ny;
+    if (ny)
+      it->y = ny;
     int *nl = realloc(it->len, (size_t)capacity * sizeof(int));
-    if (nl) it->len = nl;
-    if (!nx || !ny || !nl) return -1;
+    if (nl)
+      it->len = nl;
+    if (!nx || !ny || !nl)
+      return -1;
     it->capacity = capacity;
   }
   it->x[it->count] = x, it->y[it->count] = y, it->len[it->count] = len;
@@ -1163,10 +1282,13 @@ static inline int inside(const bb_pyramid *p, long x, long y) {
 static int clamped_lines(const bb_pyramid *p, int a, int b, items *it) {
   for (int y = 0; y < p->height; y++)
     for (int x = 0; x < p->width; x++) {
-      if (inside(p, (long)x - a, (long)y - b)) continue;
+      if (inside(p, (long)x - a, (long)y - b))
+        continue;
       int len = 0;
-      for (long px = x, py = y; inside(p, px, py); px += a, py += b) len++;
-      if (items_add(it, x, y, len)) return -1;
+      for (long px = x, py = y; inside(p, px, py); px += a, py += b)
+        len++;
+      if (items_add(it, x, y, len))
+        return -1;
     }
   return 0;
 }
@@ -1184,13 +1306,15 @@ static int periodic_lines(const bb_pyramid *p, int a, int b, long period, int ch
   for (long y0 = 0; y0 < h; y0++)
     for (long x0 = 0; x0 < columns; x0++) {
       if (!chunk_len) {
-        if (items_add(it, (int)x0, (int)y0, (int)period)) return -1;
+        if (items_add(it, (int)x0, (int)y0, (int)period))
+          return -1;
         continue;
       }
       for (long j = 0; j < period; j += chunk_len) {
         const int x = (int)((x0 + (j % W) * (a % W) % W + W) % W);
         const int y = (int)((y0 + (j % H) * (b % H) % H + H) % H);
-        if (items_add(it, x, y, (int)(period - j < chunk_len ? period - j : chunk_len))) return -1;
+        if (items_add(it, x, y, (int)(period - j < chunk_len ? period - j : chunk_len)))
+          return -1;
       }
     }
   return 0;
@@ -1284,7 +1408,7 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
                           const bb__sweep_dir *opposite, double bias, int threads,
                           long long_line, bb_error *err) {
   return bb__sweep_lines_hooked(p, a, b, along, opposite, bias, threads, long_line, NULL,
-                                NULL, NULL, err);
+                                NULL, err);
 }
 
 /* The parts of a sweep every entry shares: the checks, both sides, the
@@ -1293,15 +1417,23 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
 static bb_status job_start(sweep_job *job, template_point *pts, const bb_pyramid *p,
                            int a, int b, const bb__sweep_dir *along,
                            const bb__sweep_dir *opposite, double bias, bb__line_hook hook,
-                           void *hook_ctx, bb_error *err) {
+                           void *hook_ctx, const bb__walk_visitor *visitor,
+                           void *visitor_ctx, bb_error *err) {
   if (abs(a) > BB__MAX_LATTICE_STEP || abs(b) > BB__MAX_LATTICE_STEP || (a == 0 && b == 0))
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: lattice step (%d, %d) out of range", a, b);
-  bb_status st = check_dir(along, hook != NULL, err);
-  if (st == BB_OK) st = check_dir(opposite, hook != NULL, err);
+  const int custom = hook != NULL || visitor != NULL;
+  bb_status st = check_dir(along, custom, err);
+  if (st == BB_OK) st = check_dir(opposite, custom, err);
   if (st != BB_OK)
     return st;
-  *job = (sweep_job){
-      .p = p, .a = a, .b = b, .bias = bias, .hook = hook, .hook_ctx = hook_ctx};
+  *job = (sweep_job){.p = p,
+                     .a = a,
+                     .b = b,
+                     .bias = bias,
+                     .hook = hook,
+                     .hook_ctx = hook_ctx,
+                     .visitor = visitor,
+                     .visitor_ctx = visitor_ctx};
   job->side[0] = (sweep_side){along, a, b, bb__step_inverse(a, b), {0}};
   job->side[1] = (sweep_side){opposite, -a, -b, bb__step_inverse(a, b), {0}};
   if (along)
@@ -1313,7 +1445,7 @@ static bb_status job_start(sweep_job *job, template_point *pts, const bb_pyramid
   job_template(job, pts);
   if (!job_chords(job))
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
-  if (along && opposite && along->sums && opposite->sums && job->channels == 4 && !hook) {
+  if (along && opposite && along->sums && opposite->sums && job->channels == 4 && !custom) {
     job->table4 = aligned_alloc(sizeof(bb__channels4),
                                 8 * BB__TABLE_INTERVALS * sizeof(bb__channels4));
     if (job->table4) {
@@ -1331,7 +1463,7 @@ static void job_end(sweep_job *job) {
 }
 
 /* Sweeps the job's items (x, y, len each) on all threads, a bundle of
- * them per work item. */
+ * them per work item, polling checkpoint (may be NULL). */
 static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *len,
                          int count, int threads, const bb__checkpoint *checkpoint,
                          bb_error *err) {
@@ -1346,7 +1478,8 @@ static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   for (int i = 0; i < job->scratch_count; i++)
     atomic_flag_clear(&job->scratch[i].busy);
-  bb_status st = bb__parallel_for_checked(bundles, threads, sweep_bundle, job, checkpoint, err);
+  bb_status st =
+      bb__parallel_for_checked(bundles, threads, sweep_bundle, job, checkpoint, err);
   for (int i = 0; i < job->scratch_count; i++)
     scratch_release(&job->scratch[i]);
   free(job->scratch);
@@ -1356,17 +1489,26 @@ static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *
   return st;
 }
 
-bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
-                                 const bb__sweep_dir *along,
-                                 const bb__sweep_dir *opposite, double bias, int threads,
-                                 long long_line, bb__line_hook hook, void *hook_ctx,
-                                 const bb__checkpoint *checkpoint, bb_error *err) {
+/* What a whole-image sweep does per line besides finding its horizons:
+ * the hook, the visitor (whose sweep also polls the checkpoint) or neither
+ * (the sums). */
+typedef struct sweep_extra {
+  bb__line_hook hook;
+  void *hook_ctx;
+  const bb__walk_visitor *visitor;
+  void *visitor_ctx;
+  const bb__checkpoint *checkpoint;
+} sweep_extra;
+
+static bb_status sweep_whole(const bb_pyramid *p, int a, int b, const bb__sweep_dir *along,
+                             const bb__sweep_dir *opposite, double bias, int threads,
+                             long long_line, const sweep_extra *extra, bb_error *err) {
   template_point pts[4 * BB__MAX_LATTICE_STEP + 1];
   if (!along && !opposite)
     return BB_OK;
   sweep_job job;
-  bb_status st =
-      job_start(&job, pts, p, a, b, along, opposite, bias, hook, hook_ctx, err);
+  bb_status st = job_start(&job, pts, p, a, b, along, opposite, bias, extra->hook,
+                           extra->hook_ctx, extra->visitor, extra->visitor_ctx, err);
   if (st != BB_OK)
     return st;
   items it = {0};
@@ -1376,17 +1518,39 @@ bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
     failed = clamped_lines(p, a, b, &it);
   } else {
     job.period = bb__line_period(p, a, b);
-    if (long_line <= 0) long_line = LONG_LINE_POINTS / job.point_count;
+    if (long_line <= 0)
+      long_line = LONG_LINE_POINTS / job.point_count;
     job.kind = job.period <= long_line ? LINE_ROUND : LINE_CHUNK;
     job.lookahead = (int)(long_line < CHUNK_STEPS ? long_line : CHUNK_STEPS);
-    failed = periodic_lines(p, a, b, job.period, job.kind == LINE_CHUNK ? job.lookahead : 0, &it);
+    failed = periodic_lines(p, a, b, job.period,
+                            job.kind == LINE_CHUNK ? job.lookahead : 0, &it);
   }
   if (failed) st = bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   if (st == BB_OK)
-    st = job_run(&job, it.x, it.y, it.len, it.count, threads, checkpoint, err);
+    st = job_run(&job, it.x, it.y, it.len, it.count, threads, extra->checkpoint, err);
   items_free(&it);
   job_end(&job);
   return st;
+}
+
+bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 long long_line, bb__line_hook hook, void *hook_ctx,
+                                 bb_error *err) {
+  const sweep_extra extra = {hook, hook_ctx, NULL, NULL, NULL};
+  return sweep_whole(p, a, b, along, opposite, bias, threads, long_line, &extra, err);
+}
+
+bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 const bb__walk_visitor *visitor, void *ctx,
+                                 const bb__checkpoint *checkpoint, bb_error *err) {
+  if (!visitor || !visitor->line_begin || !visitor->origin || !visitor->line_end)
+    return bb__fail(err, BB_ERR_ARGUMENT, "trace: a walk visitor needs every call");
+  const sweep_extra extra = {NULL, NULL, visitor, ctx, checkpoint};
+  return sweep_whole(p, a, b, along, opposite, bias, threads, 0, &extra, err);
 }
 
 void bb__clamped_line_extent(const bb_pyramid *p, int a, int b, int x, int y, int len,
@@ -1431,7 +1595,7 @@ bb_status bb__sweep_stretches(const bb_pyramid *p, int a, int b,
     return bb__fail(err, BB_ERR_ARGUMENT, "trace: a clamped line is not swept round");
   sweep_job job;
   bb_status st =
-      job_start(&job, pts, p, a, b, along, opposite, bias, hook, hook_ctx, err);
+      job_start(&job, pts, p, a, b, along, opposite, bias, hook, hook_ctx, NULL, NULL, err);
   if (st != BB_OK)
     return st;
   job.kind = round ? LINE_ROUND : LINE_STRETCH;

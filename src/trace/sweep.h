@@ -9,7 +9,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-
 /* One direction of a line sweep: slice s of rs, whose loss at each texel is
  * added to sums (1 + basis_count floats per texel); horizon (may be NULL)
  * receives each texel's horizon (tests, and bb_trace_horizons, which gives
@@ -37,9 +36,10 @@ bb_status bb__sweep_lines(const bb_pyramid *p, int a, int b, const bb__sweep_dir
  * there is bb__lattice_height(z(x1, y1), z(x2, y2), w), w = r / m, at n / m
  * steps from an origin k whole steps behind the step, n = k m + i. */
 typedef struct bb__template_point {
-  double frac;     /* i / m, in (0, 1]: for ordering and hull geometry */
-  int m, i;        /* m = 1, i = 1: the next texel, a vertex */
-  double inverse_m, w; /* bb__lattice_inverse(m), bb__lattice_weight(r, m) (0: the vertex) */
+  double frac; /* i / m, in (0, 1]: for ordering and hull geometry */
+  int m, i;    /* m = 1, i = 1: the next texel, a vertex */
+  double inverse_m,
+      w; /* bb__lattice_inverse(m), bb__lattice_weight(r, m) (0: the vertex) */
   int x1, y1, x2, y2;
   long offset1, offset2; /* x + y * width of the two vertices, for interior steps */
 } bb__template_point;
@@ -73,8 +73,8 @@ typedef struct bb__line_view {
   int x0, y0;
   int first_step, steps; /* the steps profiled: first_step .. first_step + steps - 1 */
   int len;
-  const size_t *texel;   /* image index of texel j */
-  const double *vz;      /* height of texel j */
+  const size_t *texel; /* image index of texel j */
+  const double *vz;    /* height of texel j */
   double bias;
   const bb__sweep_dir *dir[2];
   const float *found[2];
@@ -87,15 +87,62 @@ typedef struct bb__line_view {
 typedef void (*bb__line_hook)(void *ctx, const bb__line_view *line);
 
 /* bb__sweep_lines with a hook for every line in place of the sums (the
- * directions' sums may then be NULL). checkpoint (may be NULL): asked every
- * 50 ms from the calling thread while the lines are swept, a nonzero
- * answer cancelling the sweep between bundles of lines (BB_ERR_CANCELLED),
- * for sweeps that take long enough to need it (bounce.c's passes). */
+ * directions' sums may then be NULL). */
 bb_status bb__sweep_lines_hooked(const bb_pyramid *p, int a, int b,
                                  const bb__sweep_dir *along,
                                  const bb__sweep_dir *opposite, double bias, int threads,
                                  long long_line, bb__line_hook hook, void *hook_ctx,
+                                 bb_error *err);
+
+/* ------------------------------------------------ walks for other passes */
+
+/* A point of a line as a walk sees it: u, steps from the line's texel 0
+ * (negated along (-a, -b), so that u grows away from every origin the walk
+ * asks about), its height, and its key (bb__key_step of it is its step,
+ * never negated, plus bb__key_point its template point). */
+typedef struct bb__walk_point {
+  double u, z;
+  int64_t key;
+} bb__walk_point;
+
+/* What a pass sees of a sweep's walks (bb__sweep_lines_walked). Each line
+ * is walked on one worker thread, both sides at once (their calls
+ * interleave; side 0 walks along (a, b), side 1 along (-a, -b)). */
+typedef struct bb__walk_visitor {
+  /* Before a line's walks (its texels and heights are known, not its
+   * horizons): the state the calls below receive, or NULL when out of
+   * memory (the sweep then fails with BB_ERR_MEMORY). */
+  void *(*line_begin)(void *ctx, const bb__line_view *line);
+  /* Each point pushed on side k's hull, nearer to the origins still to come
+   * than every point pushed before it: hull[size - 1], the hull as it now is
+   * (the array origin() is given). May be NULL. */
+  void (*push)(void *state, int side, const bb__walk_point *hull, int size);
+  /* Origin j (texel j of the line, at u0 along the walk, height oz) once
+   * every point beyond it is pushed: the hull hull[0..size-1] (the upper
+   * hull of those points, nearest last), the index of its tangent vertex (-1
+   * when there is none) and the horizon that vertex makes, the trace's bits
+   * (in a chunk the sweep may later march the texel instead: line_end's
+   * found[] says). */
+  void (*origin)(void *state, int side, int j, double u0, double oz,
+                 const bb__walk_point *hull, int size, int tangent, float horizon);
+  /* After the walks, with every horizon found (line->found, tangent_key);
+   * the state is not used again after it. */
+  void (*line_end)(void *state, const bb__line_view *line);
+} bb__walk_visitor;
+
+/* bb__sweep_lines with a visitor of its walks in place of the sums (the
+ * directions' sums may be NULL); checkpoint (may be NULL) is polled every
+ * 50 ms and may cancel (BB_ERR_CANCELLED). */
+bb_status bb__sweep_lines_walked(const bb_pyramid *p, int a, int b,
+                                 const bb__sweep_dir *along,
+                                 const bb__sweep_dir *opposite, double bias, int threads,
+                                 const bb__walk_visitor *visitor, void *ctx,
                                  const bb__checkpoint *checkpoint, bb_error *err);
+
+/* The index of the vertex of hull[0..size-1] (a walk's upper hull, nearest
+ * last, u growing away from the origin) of largest slope from the origin
+ * (u0, z0) behind every point; -1 when size is 0. The sweeps' own search. */
+int bb__hull_tangent(const bb__walk_point *hull, int size, double u0, double z0);
 
 /* ------------------------------------------------------ parts of lines */
 

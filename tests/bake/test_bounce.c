@@ -116,7 +116,9 @@ Test(bounce, progress_is_monotone_over_the_whole_bake) {
     o.trace.progress = log_progress;
     o.trace.progress_user = &l;
     bb_bake_result r = harness_bake(&h, &o);
-    cr_assert(l.calls > 16 && l.calls <= 256, "bounces %d: %d calls", counts[c], l.calls);
+    /* a call after every sweep of every pass: at least the 8 sweeps of the
+     * trace's 16 slices, which the direct light and the texels' gathers share */
+    cr_assert(l.calls >= 8 && l.calls <= 256, "bounces %d: %d calls", counts[c], l.calls);
     for (int i = 0; i < l.calls; i++) {
       cr_assert_eq(l.total[i], l.total[0], "bounces %d: the whole changes at call %d (%ld, then %ld)",
                    counts[c], i, l.total[0], l.total[i]);
@@ -125,12 +127,13 @@ Test(bounce, progress_is_monotone_over_the_whole_bake) {
       if (i)
         cr_assert(l.done[i] >= l.done[i - 1], "bounces %d: back from %ld to %ld at call %d",
                   counts[c], l.done[i - 1], l.done[i], i);
+      /* no sweep is a large part of the whole: the bar moves all along */
+      cr_expect_leq((l.done[i] - (i ? l.done[i - 1] : 0)) * 5, l.total[0],
+                    "bounces %d: call %d moves from %ld to %ld of %ld", counts[c], i,
+                    i ? l.done[i - 1] : 0, l.done[i], l.total[0]);
     }
     cr_expect_eq(l.done[l.calls - 1], l.total[0], "bounces %d: ends at %ld of %ld", counts[c],
                  l.done[l.calls - 1], l.total[0]);
-    /* the trace is its first part, not the whole: 16 slices of a much larger total */
-    cr_expect_lt(l.done[7] * 4, l.total[0], "bounces %d: the trace's sweeps weigh %ld of %ld",
-                 counts[c], l.done[7], l.total[0]);
     bb_bake_result_free(&r);
   }
   bb_image_free(&h);
@@ -226,7 +229,14 @@ Test(bounce, flat_stays_exactly_one) {
   bb_image_free(&h);
 }
 
-Test(bounce, any_thread_count_and_periodic_shift_give_the_same_bits) {
+/* Any thread count gives the same bits. A periodic shift gives the same
+ * bits where the bounce has no part (normal, weights, filtered); where it
+ * has, the gathers' choices (how many pieces a band is cut into, whether a
+ * band is small enough to see its horizon point only) are thresholds on
+ * walk coordinates counted from a line's first texel, which the shift
+ * moves, so a texel near a threshold can fall the other way: within 0.001
+ * in ao and 0.005 in ssbump and bent. */
+Test(bounce, any_thread_count_gives_the_same_bits_and_a_periodic_shift_close_ones) {
   bb_image h = load_fixture("noise_96x80.png");
   const int W = h.width, H = h.height, sx = 37, sy = 11;
   bb_image shifted = harness_field(W, H, 0.0f);
@@ -250,12 +260,19 @@ Test(bounce, any_thread_count_and_periodic_shift_give_the_same_bits) {
     const bb_image *a = bb_bake_result_image(&one, (bb_map_kind)k);
     const bb_image *b = bb_bake_result_image(&s, (bb_map_kind)k);
     int differ = 0;
+    double most = 0.0;
     for (int y = 0; y < H; y++)
-      for (int x = 0; x < W; x++)
-        differ += memcmp(at(a, x, y), at(b, (x + sx) % W, (y + sy) % H),
-                         (size_t)a->channels * sizeof(float)) != 0;
-    cr_expect_eq(differ, 0, "%s: %d texels differ after a periodic shift",
-                 bb_map_kind_get((bb_map_kind)k)->name, differ);
+      for (int x = 0; x < W; x++) {
+        const float *va = at(a, x, y), *vb = at(b, (x + sx) % W, (y + sy) % H);
+        differ += memcmp(va, vb, (size_t)a->channels * sizeof(float)) != 0;
+        for (int c = 0; c < a->channels; c++) most = fmax(most, fabs((double)va[c] - (double)vb[c]));
+      }
+    const double within =
+        k == BB_MAP_AO ? 0.001 : (BB_MAPS_TRACED & BB_MAP_BIT(k) ? 0.005 : 0.0);
+    cr_log_info("%s: %d texels differ after a periodic shift, by at most %.3g",
+                bb_map_kind_get((bb_map_kind)k)->name, differ, most);
+    cr_expect(most <= within, "%s: %d texels differ after a periodic shift, by at most %g",
+              bb_map_kind_get((bb_map_kind)k)->name, differ, most);
   }
   bb_bake_result_free(&one);
   bb_bake_result_free(&s);
@@ -555,19 +572,18 @@ Test(bounce, trench_matches_the_exact_2d_radiosity) {
 }
 
 /* The wall case: walls many texels high rising within one texel (a trench
- * cut into a plateau at a high scale), where the light of a wall is the
- * linear blend of its top and foot corners over one triangle. The light
- * the bounce adds to ao, to convergence, on the floor's centre line and
- * one texel from a wall's foot, against the exact 2D radiosity. Walls 8
- * high are within 0.002; deeper ones are far too bright (the blend gives
- * the middle of a wall the mean of its lit top and its dark foot, where
- * the true light falls off fast below the top: docs/accuracy.md "The wall
- * case"), and this holds what they are now: under 1.5 times the exact
- * added light at 32 high, under 3.5 times at 64. */
+ * cut into a plateau at a high scale). The light the bounce adds to ao, to
+ * convergence, on the floor's centre line and one texel from a wall's
+ * foot, against the exact 2D radiosity. A wall's light is its column's,
+ * sampled at 5 heights from its foot to its top, so the light that falls
+ * off fast below the top is seen where it is; between the samples it is
+ * linear. Walls 8 high are within 0.0025; deeper ones a little too bright
+ * still (docs/accuracy.md "The wall case"), and this holds what they are
+ * now: within 10% of the exact added light at 32 high, 25% at 64. */
 Test(bounce, deep_trench_walls_against_the_exact_2d_radiosity, .timeout = 120) {
   const int W = 21;
   const double heights[] = {8.0, 32.0, 64.0}, rho = 0.5, bias = 0.55;
-  const double within[] = {0.002, 0.5, 2.5}; /* of the exact added light, beyond 0.002 */
+  const double within[] = {0.0, 0.1, 0.25}; /* of the exact added light, beyond 0.0025 */
   const int xs[] = {(W - 1) / 2, 2};
   bb_image height = harness_field(W, 8, 0.0f);
   for (int y = 0; y < 8; y++)
@@ -584,7 +600,7 @@ Test(bounce, deep_trench_walls_against_the_exact_2d_radiosity, .timeout = 120) {
       const double added = at(&r.ao, x, 4)[0] - at(&base.ao, x, 4)[0];
       cr_log_info("wall %g high, x %d: added %.5f, exact %.5f (%+.5f, %+.1f%%)", heights[i], x,
                   added, exact, added - exact, 100.0 * (added - exact) / exact);
-      cr_expect(fabs(added - exact) <= (i ? within[i] * exact : 0.0) + 0.002,
+      cr_expect(fabs(added - exact) <= within[i] * exact + 0.0025,
                 "walls %g high, x %d: the bounce adds %.5f to ao, exactly %.5f", heights[i], x,
                 added, exact);
     }
