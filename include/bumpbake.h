@@ -2763,7 +2763,9 @@ const char *bb_job_stage(const bb_job *job);
 /* Whether every output of input i is what baking it now would write
  * (bb_output_check of each, from the files' headers; no pixel is decoded):
  * *current is 1 or 0, and the report's reason says why not. The input's
- * bytes are hashed. Errors: BB_ERR_IO (the input cannot be read). */
+ * bytes are hashed, unless its header is refused: such an input is not
+ * current (the reason is the refusal its bake gives). Errors: BB_ERR_IO
+ * (the input cannot be read). */
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 
 /* Runs input i: skips it (BB_JOB_CURRENT) when its outputs are up to date

@@ -152,11 +152,21 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err) 
     return bb__fail(err, BB_ERR_ARGUMENT, "job check: bad arguments");
   bb__job_item *item = &job->items[i];
   *current = 0;
-  /* An input that is no image is refused by its header, before all its
-   * bytes are hashed. */
-  bb_status st = bb_image_read_info(item->input, NULL, NULL, NULL, NULL, err);
-  if (st == BB_OK)
-    st = bb_file_hash(item->input, &item->file_hash, err);
+  /* An input that is no image is not current, judged by its header before
+   * all its bytes are hashed: its bake refuses it in the same words. */
+  bb_error refused = {{0}};
+  bb_status st = bb_image_read_info(item->input, NULL, NULL, NULL, NULL, &refused);
+  if (st != BB_OK && st != BB_ERR_IO) {
+    snprintf(item->report.reason, sizeof item->report.reason, "%.*s",
+             (int)sizeof item->report.reason - 1, refused.message);
+    return BB_OK;
+  }
+  if (st != BB_OK) {
+    if (err)
+      *err = refused;
+    return st;
+  }
+  st = bb_file_hash(item->input, &item->file_hash, err);
   if (st != BB_OK)
     return st;
   *current = item_is_current(job, item, item->report.reason, sizeof item->report.reason);

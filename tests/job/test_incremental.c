@@ -279,3 +279,36 @@ Test(incremental, readable_formats_by_extension) {
   cr_expect(!bb_path_is_readable_format("x.d"));
   cr_expect(!bb_path_is_readable_format(NULL));
 }
+
+/* An input whose header is refused is not current, and the check says the
+ * refusal rather than failing: a batch's check of every input first (Python
+ * on a cluster) then bakes the others, and the bake reports that one. A
+ * missing input is still an error. */
+Test(incremental, an_input_that_is_no_image_is_not_current) {
+  cr_assert_eq(mkdir(tmp("in"), 0755), 0);
+  write_bytes(tmp("in/bad.png"), "\x89PNG\r\n\x1a\n not really", 20);
+  bb_image h;
+  cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
+  harness_write(tmp("in/good.png"), &h, BB_DEPTH_8, BB_RANGE_UNIT);
+  bb_image_free(&h);
+  bb_job_options o;
+  bb_job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.out_dir = tmp("out");
+  o.maps = BB_MAP_BIT(BB_MAP_NORMAL);
+  const char *inputs[] = {tmp("in")};
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_job_plan(inputs, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_job_count(job), 2);
+  int current = 1;
+  cr_expect_eq(bb_job_check_current(job, 0, &current, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(current, 0);
+  const char *reason = bb_job_report_get(job, 0)->reason;
+  cr_expect(strstr(reason, "bad.png") && strstr(reason, "not a readable image"), "%s", reason);
+  cr_expect_eq(bb_job_check_current(job, 1, &current, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(current, 0);
+  cr_assert_eq(unlink(tmp("in/good.png")), 0);
+  cr_expect_eq(bb_job_check_current(job, 1, &current, &err), BB_ERR_IO);
+  bb_job_free(job);
+}
