@@ -1767,13 +1767,51 @@ static void direct_row(void *user, int y) {
   d->row_sum[y] = sum;
 }
 
+/* The columns' loops run in chunks of this many columns on every thread
+ * (steep relief has millions of samples: serial, they kept a cancel
+ * waiting a second), each chunk's sum kept apart; the sums are integers,
+ * so their total is the same in any order. */
+enum { COLUMN_CHUNK = 4096 };
+typedef struct columns_job {
+  driver *d;
+  int update;      /* columns_step_chunk: move the radiance rather than sum the change */
+  exact_sum *sums; /* by chunk */
+} columns_job;
+
+static int column_chunks(const columns *c) {
+  return (c->count + COLUMN_CHUNK - 1) / COLUMN_CHUNK;
+}
+
+/* Runs fn over the columns' chunks, polling the checkpoint, and adds the
+ * chunks' sums into *sum. */
+static bb_status columns_run(driver *d, bb__work_fn fn, int update, exact_sum *sum,
+                             bb_error *err) {
+  const int chunks = column_chunks(&d->cols);
+  if (chunks == 0)
+    return BB_OK;
+  columns_job job = {d, update, calloc((size_t)chunks, sizeof(exact_sum))};
+  if (!job.sums)
+    return bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for the columns");
+  bb_status st = bb__parallel_for_checked(chunks, d->o->threads, fn, &job,
+                                          d->o->progress ? &d->checkpoint : NULL, err);
+  for (int i = 0; i < chunks; i++)
+    *sum += job.sums[i];
+  free(job.sums);
+  return st;
+}
+
 /* The same for the columns (the direct pass added what each sample's sky
  * loses). */
-static exact_sum direct_columns(driver *d) {
+static void direct_columns_chunk(void *user, int chunk) {
+  columns_job *job = user;
+  driver *d = job->d;
   columns *c = &d->cols;
   const int channels = d->ctx.channels;
+  const int last = chunk * COLUMN_CHUNK + COLUMN_CHUNK < c->count
+                       ? chunk * COLUMN_CHUNK + COLUMN_CHUNK
+                       : c->count;
   exact_sum sum = 0;
-  for (int n = 0; n < c->count; n++) {
+  for (int n = chunk * COLUMN_CHUNK; n < last; n++) {
     const double *nv = c->normal + 3 * (size_t)n;
     const double rho = rho_at(d, (size_t)c->vertex[n]);
     for (int i = 0; i < c->samples; i++) {
@@ -1792,7 +1830,7 @@ static exact_sum direct_columns(driver *d) {
       }
     }
   }
-  return sum;
+  job->sums[chunk] = sum;
 }
 
 /* After a surface pass: how far each sample's radiance would move, summed
@@ -1848,22 +1886,26 @@ static void update_row(void *user, int y) {
 }
 
 /* The columns' move (update 0) or their update (1). */
-static exact_sum columns_step(driver *d, int update) {
+static void columns_step_chunk(void *user, int chunk) {
+  columns_job *job = user;
+  driver *d = job->d;
   columns *c = &d->cols;
-  const int channels = d->ctx.channels;
+  const size_t per_column = (size_t)c->samples * (size_t)d->ctx.channels;
+  const int last = chunk * COLUMN_CHUNK + COLUMN_CHUNK < c->count
+                       ? chunk * COLUMN_CHUNK + COLUMN_CHUNK
+                       : c->count;
   exact_sum sum = 0;
-  for (int n = 0; n < c->count; n++) {
+  for (int n = chunk * COLUMN_CHUNK; n < last; n++) {
     const double rho = rho_at(d, (size_t)c->vertex[n]);
-    for (size_t i = (size_t)n * (size_t)c->samples * (size_t)channels;
-         i < (size_t)(n + 1) * (size_t)c->samples * (size_t)channels; i++) {
+    for (size_t i = (size_t)n * per_column; i < (size_t)(n + 1) * per_column; i++) {
       const double r = sample_radiance(rho, c->direct[i], c->sums[i]);
-      if (update)
+      if (job->update)
         c->radiance[i] = (float)(r + d->tail * (r - (double)c->radiance[i]));
       else
         sum += fixed(fabs((double)(float)r - (double)c->radiance[i]));
     }
   }
-  return sum;
+  job->sums[chunk] = sum;
 }
 
 /* Clamp mode: the last column and row of cells reach vertices past the
@@ -2035,6 +2077,8 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)",
                   corners / (size_t)channels);
   ctx->normals = d.normals;
+  /* every step after the allocations polls the caller's progress */
+  const bb__checkpoint *checkpoint = o->progress ? &d.checkpoint : NULL;
   d.order = order;
   d.fine = rs;
   d.work = bb__bounce_work(rs, o);
@@ -2048,7 +2092,7 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
     atomic_flag_clear(&ctx->slots[i].busy);
   if (st == BB_OK) {
     normals_job nj = {p, d.normals};
-    st = bb__parallel_for(p->height + 1, o->threads, normals_row, &nj, NULL, NULL, err);
+    st = bb__parallel_for_checked(p->height + 1, o->threads, normals_row, &nj, checkpoint, err);
   }
   /* The direct light: over the trace's sweeps of even rank (they find the
    * texels' horizons too), the corners asking their hulls at their lift;
@@ -2063,13 +2107,13 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
     st = run_pass(&d, PASS_DIRECT, split ? 0 : -1, err);
   ctx->corner_hull = 0;
   if (st == BB_OK)
-    st = bb__parallel_for(p->height, o->threads, direct_row, &d, NULL, NULL, err);
+    st = bb__parallel_for_checked(p->height, o->threads, direct_row, &d, checkpoint, err);
   exact_sum last_sum = 0;
   if (st == BB_OK) {
     corner_fixup(&d);
     for (int y = 0; y < p->height; y++)
       last_sum += d.row_sum[y];
-    last_sum += direct_columns(&d);
+    st = columns_run(&d, direct_columns_chunk, 0, &last_sum, err);
   }
   ctx->radiance = d.radiance;
   /* The bounces: each pass adds what the samples gather of the last one.
@@ -2085,10 +2129,12 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
   for (int pass = 0; st == BB_OK && pass < passes; pass++) {
     st = run_pass(&d, PASS_SURFACE, -1, err);
     if (st == BB_OK)
-      st = bb__parallel_for(p->height, o->threads, change_row, &d, NULL, NULL, err);
+      st = bb__parallel_for_checked(p->height, o->threads, change_row, &d, checkpoint, err);
+    exact_sum sum = 0;
+    if (st == BB_OK)
+      st = columns_run(&d, columns_step_chunk, 0, &sum, err);
     if (st != BB_OK)
       break;
-    exact_sum sum = columns_step(&d, 0);
     for (int y = 0; y < p->height; y++)
       sum += d.row_sum[y];
     d.tail = 0.0;
@@ -2098,8 +2144,9 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
       d.tail = lambda / (1.0 - lambda);
     }
     last_sum = sum;
-    st = bb__parallel_for(p->height, o->threads, update_row, &d, NULL, NULL, err);
-    columns_step(&d, 1);
+    st = bb__parallel_for_checked(p->height, o->threads, update_row, &d, checkpoint, err);
+    if (st == BB_OK)
+      st = columns_run(&d, columns_step_chunk, 1, &(exact_sum){0}, err);
     if (st == BB_OK)
       corner_fixup(&d);
     done++;
@@ -2112,12 +2159,12 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
   if (st == BB_OK && traced) {
     st = bb_image_alloc(vis, p->width, p->height, channels, err);
     if (st == BB_OK)
-      st = bb__parallel_for(p->height, o->threads, trace_row, &fj, NULL, NULL, err);
+      st = bb__parallel_for_checked(p->height, o->threads, trace_row, &fj, checkpoint, err);
     if (st == BB_OK)
       st = bb_trace_finish(rs, vis, o->threads, err);
   }
   if (st == BB_OK)
-    st = bb__parallel_for(p->height, o->threads, finish_row, &fj, NULL, NULL, err);
+    st = bb__parallel_for_checked(p->height, o->threads, finish_row, &fj, checkpoint, err);
   if (st != BB_OK && traced)
     bb_image_free(vis);
   if (st == BB_OK && bounces_done)

@@ -90,6 +90,10 @@ typedef struct sweep_job {
   double frac[4 * BB__MAX_LATTICE_STEP + 1], weight[4 * BB__MAX_LATTICE_STEP + 1];
   int min_dx, max_dx, min_dy, max_dy; /* template vertex offsets */
   atomic_int out_of_memory;
+  /* set when the checkpoint cancels: the bundles running stop at their next
+   * line (a walked line can take tens of ms, a bundle seconds) */
+  atomic_int cancelled;
+  const bb__checkpoint *checkpoint; /* the caller's (job_run) */
   double *open_a, *open_b; /* where the wider chords apply (job_chords) */
   bb__line_hook hook;      /* NULL: the sums; else called per line */
   void *hook_ctx;
@@ -1212,7 +1216,8 @@ static void sweep_bundle(void *user, int bundle) {
                         .found = {sc->found[0], sc->found[1]},
                         .tangent_z = {sc->tangent_z[0], sc->tangent_z[1]},
                         .tangent_key = {sc->tangent_key[0], sc->tangent_key[1]}};
-    for (int item = first; item < last;) {
+    for (int item = first; item < last && !atomic_load_explicit(&job->cancelled,
+                                                                  memory_order_relaxed);) {
       const int x0 = job->item_x[item], y0 = job->item_y[item];
       const int lanes = lanes_from(job, item, last) ? LANES : 1;
       for (int l = 0; l < lanes; l++) {
@@ -1442,6 +1447,7 @@ static bb_status job_start(sweep_job *job, template_point *pts, const bb_pyramid
     job->side[1].integral = bb__slice_integral_of(opposite->rs, opposite->slice);
   job->channels = 1 + (along ? along : opposite)->rs->basis_count;
   atomic_init(&job->out_of_memory, 0);
+  atomic_init(&job->cancelled, 0);
   job_template(job, pts);
   if (!job_chords(job))
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
@@ -1462,6 +1468,15 @@ static void job_end(sweep_job *job) {
   free(job->table4);
 }
 
+/* The job's checkpoint, which also tells the running bundles to stop. */
+static int job_checkpoint(void *user, long done, long total) {
+  sweep_job *job = user;
+  const int stop = job->checkpoint->fn(job->checkpoint->user, done, total);
+  if (stop)
+    atomic_store(&job->cancelled, 1);
+  return stop;
+}
+
 /* Sweeps the job's items (x, y, len each) on all threads, a bundle of
  * them per work item, polling checkpoint (may be NULL). */
 static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *len,
@@ -1478,8 +1493,10 @@ static bb_status job_run(sweep_job *job, const int *x, const int *y, const int *
     return bb__fail(err, BB_ERR_MEMORY, "trace: out of memory for line sweeps");
   for (int i = 0; i < job->scratch_count; i++)
     atomic_flag_clear(&job->scratch[i].busy);
-  bb_status st =
-      bb__parallel_for_checked(bundles, threads, sweep_bundle, job, checkpoint, err);
+  job->checkpoint = checkpoint;
+  const bb__checkpoint own = {job_checkpoint, job};
+  bb_status st = bb__parallel_for_checked(bundles, threads, sweep_bundle, job,
+                                          checkpoint && checkpoint->fn ? &own : NULL, err);
   for (int i = 0; i < job->scratch_count; i++)
     scratch_release(&job->scratch[i]);
   free(job->scratch);
