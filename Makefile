@@ -104,22 +104,23 @@ PC_LIBS_PRIVATE = $(LDLIBS) -lstdc++
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
 
-# ---- start-up: the early-link trick (opt-in) ---------------------------------
-# OpenImageIO on Debian 12 loads 261 shared libraries, and most of bumpbake's
-# ~0.2 s start-up is the dynamic linker looking up symbols: each lookup walks
-# the libraries in load order up to the one defining it, and a few large C++
-# libraries deep in that order (OpenVDB, GDAL, Xerces, GEOS...) look up tens
-# of thousands of their own symbols. Naming them first on the CLI's link line
-# (they are loaded anyway) makes those walks short. It names Debian 12
-# library paths found with ldd at link time, so it is opt-in:
-# `make EARLY_LINK=1`. `make bench` measures start-up both ways.
-EARLY_LINK ?= 0
-EARLY_LIB_PATTERN := ^lib(openvdb|xerces-c|gdal|geos|crypto|proj|poppler|dcmdata|gdcmMSFF|rsvg-2)[.-]
-# Deferred (=), so ldd runs only when a binary is linked with it.
-EARLY_LIBS = $(shell ldd "$$(pkg-config --variable=libdir OpenImageIO)/libOpenImageIO.so" \
-  2>/dev/null | awk '$$1 ~ /$(EARLY_LIB_PATTERN)/ && $$3 ~ /^\// {print $$3}')
-EARLY_LINK_FLAGS = $(if $(strip $(EARLY_LIBS)),-Wl$(comma)--push-state$(comma)--no-as-needed $(EARLY_LIBS) -Wl$(comma)--pop-state)
+# ---- start-up: the early link ------------------------------------------------
+# OpenImageIO on Debian 12 loads about 260 shared libraries, and most of a
+# bumpbake process's start-up is the dynamic linker looking up their
+# symbols: each lookup walks the libraries in load order up to the one
+# defining it, and a few large C++ libraries deep in that order (OpenVDB,
+# Xerces, GDAL...) look up tens of thousands of their own symbols. The CLI
+# and the test binary name every library the probe loads first on their
+# link line, the one the most lookups end in first ($(BUILD)/link-order.txt,
+# written by tools/link_order.sh at build time): they are loaded anyway,
+# and the walks are short (bumpbake --version: half the CPU; each Criterion
+# test is a process of its own). `make EARLY_LINK=0` links them plainly;
+# `make bench` measures start-up both ways.
+EARLY_LINK ?= 1
+LINK_ORDER := $(BUILD)/link-order.txt
+EARLY_LINK_FLAGS = -Wl$(comma)--push-state$(comma)--no-as-needed $$(cat $(LINK_ORDER)) -Wl$(comma)--pop-state
 CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
+EARLY_DEPS = $(if $(filter 1,$(EARLY_LINK)),$(LINK_ORDER))
 comma := ,
 
 # ---- sources and products ----------------------------------------------------
@@ -135,7 +136,7 @@ SERVE_C  := src/cli/serve.c $(wildcard src/cli/serve/*.c)
 # The page it serves, embedded into serve_page.o at build time.
 SERVE_ASSETS := $(wildcard share/serve/*) shaders/ssbump_relief.glsl
 TEST_C   := $(wildcard tests/*/test_*.c)
-TOOL_C   := $(wildcard tools/*.c)
+TOOL_C   := $(filter-out tools/link_probe.c,$(wildcard tools/*.c))
 
 LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
 CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o)
@@ -155,7 +156,7 @@ TESTBIN  := $(BUILD)/bb_tests
 TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 # The CLI linked other ways, for `make bench`'s start-up comparison, and the
 # Criterion suite, whose trench test section 10 (tools/bench_bounce.sh) reads.
-BENCH_BINS := $(BUILD)/bench/bumpbake-early $(BUILD)/bench/bumpbake-shared $(TESTBIN)
+BENCH_BINS := $(BUILD)/bench/bumpbake-plain $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
@@ -261,12 +262,20 @@ $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
 # The CLI links the static library: it starts as fast as with the shared one
 # (`make bench` measures both) and the installed binary finds no library at
 # run time but OpenImageIO's.
-$(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
+$(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
-$(BUILD)/bench/bumpbake-early: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
+# The probe and the order it gives (tools/link_order.sh; empty where the
+# loader ignores LD_DEBUG, and the link is then the plain one).
+$(BUILD)/tools/link_probe: tools/link_probe.c $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(EARLY_LINK_FLAGS) $(LDLIBS) $(MHD_LIBS)
+	$(CXX) $(LDFLAGS) -o $@ -x c $< -Wl,--no-as-needed $(LDLIBS) $(MHD_LIBS)
+$(LINK_ORDER): $(BUILD)/tools/link_probe tools/link_order.sh
+	tools/link_order.sh $< >$@.tmp && mv $@.tmp $@
+
+$(BUILD)/bench/bumpbake-plain: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
+	@mkdir -p $(@D)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS) $(MHD_LIBS)
 $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
@@ -279,9 +288,9 @@ $(FUZZ_REPLAY_OBJ): $(BUILD)/fuzz/%.o: fuzz/%.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(TEST_INCLUDES) $(DEPFLAGS) -DLLVMFuzzerTestOneInput=bb_$* -c $< -o $@
 
-$(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags
+$(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) \
-	  $(CRIT_LIBS) $(LDLIBS)
+	  $(CLI_EARLY) $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
 # The installed program: the CLI with src/cli/installed_dirs.c compiled
@@ -296,7 +305,7 @@ $(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dir
                                    $(BUILD)/compile.flags
 	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
 $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
-                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags
+                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
 	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the

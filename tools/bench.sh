@@ -11,7 +11,7 @@
 # dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps, at
 # 64, 256 and 1024 rays and at 6, 10 and 12 slices,
 # 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
-# (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=1 and linked to
+# (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=0 and linked to
 # libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
 # one process against one process each), 9 engine textures (tools/bench_blocks.sh:
 # block compression's PSNR and worst error per format and map, bumpbake's codec
@@ -601,11 +601,12 @@ fi
 
 if want 7; then
 section "7. Start-up: bumpbake --version, the CLI linked three ways"
-echo "static: build/bumpbake as built (libbumpbake.a); early: the same with OpenImageIO's"
-echo "heaviest libraries named first (make EARLY_LINK=1); shared: linked to libbumpbake.so."
+echo "static: build/bumpbake as built (libbumpbake.a, OpenImageIO's libraries named first in the"
+echo "order of tools/link_order.sh); plain: the same linked plainly (make EARLY_LINK=0);"
+echo "shared: linked to libbumpbake.so."
 startup_ok=0
 startup_bins=(static="$bin")
-for variant in early shared; do
+for variant in plain shared; do
   b=$(dirname "$bin")/bench/bumpbake-$variant
   [ -x "$b" ] && startup_bins+=("$variant=$b")
 done
@@ -752,7 +753,7 @@ elif want 2; then
   summary_row "peer" "not available" "$peer_reason"
 fi
 if [ "$startup_ok" = 1 ]; then
-  for variant in static early shared; do
+  for variant in static plain shared; do
     [ -n "$(startup_field "$variant" 2)" ] || continue
     summary_row "start-up, $variant (s)" "$(startup_field "$variant" 2)" \
       "x$(startup_field "$variant" 5) of static; $(startup_field "$variant" 6) M instructions"
