@@ -499,6 +499,7 @@ function showState(s) {
     $("times").textContent = `${b.width} x ${b.height}, ${b.slices} slices, ${b.threads} threads: ` +
       `${b.seconds.toFixed(3)} s (load ${b.seconds_load.toFixed(3)}, smooth ${b.seconds_smooth.toFixed(3)}, ` +
       `pyramid ${b.seconds_pyramid.toFixed(3)}, trace ${b.seconds_trace.toFixed(3)}, ` +
+      (b.seconds_bounce > 0 ? `bounce ${b.seconds_bounce.toFixed(3)}, ` : "") +
       `derive ${b.seconds_derive.toFixed(3)})`;
     $("provenance").textContent = b.provenance;
     if ((!current || b.id > current.id) && !loading) loadMaps().catch((e) => fail(String(e)));

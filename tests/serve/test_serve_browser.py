@@ -7,6 +7,7 @@ Screenshots go to build/serve-test/ (BB_SERVE_SHOTS) to be looked at."""
 
 import json
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -581,8 +582,10 @@ def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path):
 
 def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path):
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
+    # 4096 rays: the bounce (which is the trace too) takes about a second
+    # here, long enough to be seen in each of its stages
     server = sb.Server(BIN, str(tmp_path / "height.png"),
-                       ["--scale", "16", "--rays", "1024", "--bounce", "0.5", "--quiet"])
+                       ["--scale", "16", "--rays", "4096", "--bounce", "0.5", "--quiet"])
     driver = sb.start_browser()
     try:
         driver.get(server.url)
@@ -591,16 +594,26 @@ def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path):
         driver.execute_script(
             "const s = document.getElementById('p-scale'); s.value = '48';"
             "s.dispatchEvent(new Event('change'))")
-        sb.wait_for(lambda: is_stale(driver) and "baking: " in stale_text(driver),
-                    SLOW, "the bake shown as running")
-        assert "the picture is bake 1's" in stale_text(driver)
-        assert driver.find_element("id", "status").text.startswith("baking: ")
+
+        # one snapshot of the page: the status and the dimmed picture's
+        # note are read together (read apart, the bake could end between)
+        def running():
+            view = driver.execute_script(
+                "return [document.getElementById('view').classList.contains('stale'),"
+                " document.getElementById('stale').textContent,"
+                " document.getElementById('status').textContent]")
+            return view if view[0] and "baking: " in view[1] else None
+        stale, note, status = sb.wait_for(running, SLOW, "the bake shown as running")
+        assert "the picture is bake 1's" in note
+        assert status.startswith("baking: "), status
         shot(driver, "9-stale-while-baking")
         sb.wait_for(lambda: "baking: bounce" in stale_text(driver), 3 * SLOW,
                     "the bounce shown as the stage")
         shot(driver, "9b-stale-bounce-stage")
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 2 and not is_stale(driver), 3 * SLOW,
                     "the new bake drawn")
+        # the bake's stages name the bounce, where its time went
+        assert re.search(r"bounce \d+\.\d{3}, derive", driver.find_element("id", "times").text)
     finally:
         sb.stop_browser(driver)
         server.close()

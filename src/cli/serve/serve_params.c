@@ -46,6 +46,7 @@ static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_number(j, "seconds_smooth", r->seconds_smooth);
   bb_json_number(j, "seconds_pyramid", r->seconds_pyramid);
   bb_json_number(j, "seconds_trace", r->seconds_trace);
+  bb_json_number(j, "seconds_bounce", r->seconds_bounce);
   bb_json_number(j, "seconds_derive", r->seconds_derive);
   bb_json_number(j, "seconds_textures", b->seconds_textures);
   bb_json_int(j, "threads", r->threads);
