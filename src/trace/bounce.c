@@ -1566,6 +1566,11 @@ typedef struct driver {
   bb__checkpoint checkpoint;
 } driver;
 
+/* The caller's progress as a checkpoint for a step, or NULL without one. */
+static const bb__checkpoint *checkpoint_of(const driver *d) {
+  return d->o->progress ? &d->checkpoint : NULL;
+}
+
 static void zero_rows(void *user, int y) {
   driver *d = user;
   const size_t W = (size_t)d->ctx.p->width, C = (size_t)d->ctx.channels;
@@ -1692,7 +1697,7 @@ static bb_status run_pass(driver *d, pass_mode mode, int parity, bb_error *err) 
     const bb__sweep_dir opposite = {rs, pair ? order[k - 1] : 0, NULL, NULL};
     st = bb__sweep_lines_walked(ctx->p, rs->slice_step[2 * s], rs->slice_step[2 * s + 1],
                                 &along, pair ? &opposite : NULL, ctx->lift, o->threads,
-                                visitor, ctx, o->progress ? &d->checkpoint : NULL, err);
+                                visitor, ctx, checkpoint_of(d), err);
     swept += pair ? 2 : 1;
     if (st == BB_OK && atomic_load(&ctx->out_of_memory))
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");
@@ -1782,6 +1787,12 @@ static int column_chunks(const columns *c) {
   return (c->count + COLUMN_CHUNK - 1) / COLUMN_CHUNK;
 }
 
+/* One past the last column of a chunk. */
+static int chunk_end(const columns *c, int chunk) {
+  const int end = (chunk + 1) * COLUMN_CHUNK;
+  return end < c->count ? end : c->count;
+}
+
 /* Runs fn over the columns' chunks, polling the checkpoint, and adds the
  * chunks' sums into *sum. */
 static bb_status columns_run(driver *d, bb__work_fn fn, int update, exact_sum *sum,
@@ -1792,8 +1803,8 @@ static bb_status columns_run(driver *d, bb__work_fn fn, int update, exact_sum *s
   columns_job job = {d, update, calloc((size_t)chunks, sizeof(exact_sum))};
   if (!job.sums)
     return bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for the columns");
-  bb_status st = bb__parallel_for_checked(chunks, d->o->threads, fn, &job,
-                                          d->o->progress ? &d->checkpoint : NULL, err);
+  bb_status st =
+      bb__parallel_for_checked(chunks, d->o->threads, fn, &job, checkpoint_of(d), err);
   for (int i = 0; i < chunks; i++)
     *sum += job.sums[i];
   free(job.sums);
@@ -1807,9 +1818,7 @@ static void direct_columns_chunk(void *user, int chunk) {
   driver *d = job->d;
   columns *c = &d->cols;
   const int channels = d->ctx.channels;
-  const int last = chunk * COLUMN_CHUNK + COLUMN_CHUNK < c->count
-                       ? chunk * COLUMN_CHUNK + COLUMN_CHUNK
-                       : c->count;
+  const int last = chunk_end(c, chunk);
   exact_sum sum = 0;
   for (int n = chunk * COLUMN_CHUNK; n < last; n++) {
     const double *nv = c->normal + 3 * (size_t)n;
@@ -1891,9 +1900,7 @@ static void columns_step_chunk(void *user, int chunk) {
   driver *d = job->d;
   columns *c = &d->cols;
   const size_t per_column = (size_t)c->samples * (size_t)d->ctx.channels;
-  const int last = chunk * COLUMN_CHUNK + COLUMN_CHUNK < c->count
-                       ? chunk * COLUMN_CHUNK + COLUMN_CHUNK
-                       : c->count;
+  const int last = chunk_end(c, chunk);
   exact_sum sum = 0;
   for (int n = chunk * COLUMN_CHUNK; n < last; n++) {
     const double rho = rho_at(d, (size_t)c->vertex[n]);
@@ -2078,7 +2085,7 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
                   corners / (size_t)channels);
   ctx->normals = d.normals;
   /* every step after the allocations polls the caller's progress */
-  const bb__checkpoint *checkpoint = o->progress ? &d.checkpoint : NULL;
+  const bb__checkpoint *checkpoint = checkpoint_of(&d);
   d.order = order;
   d.fine = rs;
   d.work = bb__bounce_work(rs, o);
