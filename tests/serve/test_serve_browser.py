@@ -362,13 +362,15 @@ def test_a_and_b_are_the_last_two_bakes(page, server):
     after = sb.drawn_bake(page)
     new_hash = stats(page)["hash"]
     assert new_hash != a_hash
+    # the toggle draws on the next animation frame, not within the click
     page.find_element("id", "ab").click()
-    assert sb.drawn_bake(page) == before
+    sb.wait_for(lambda: sb.drawn_bake(page) == before, SLOW, "B drawn")
     assert stats(page)["hash"] == a_hash
     assert ("bake %d" % before) in page.find_element("id", "ab-text").text
     shot(page, "12-b-the-bake-before")
     page.find_element("id", "ab").click()
-    assert sb.drawn_bake(page) == after and stats(page)["hash"] == new_hash
+    sb.wait_for(lambda: sb.drawn_bake(page) == after, SLOW, "A drawn again")
+    assert stats(page)["hash"] == new_hash
     # the scale back as the tests after this one expect it
     page.execute_script("arguments[0].value = arguments[1];"
                         "arguments[0].dispatchEvent(new Event('change'))", scale, str(old_scale))
