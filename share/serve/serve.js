@@ -1,6 +1,7 @@
 // serve.js: the page of `bumpbake serve`. It follows the server's state
 // through server-sent events ("events"), fetches the textures of each new
-// bake ("map/NAME": 8-bit RGBA, X-Bake-Id saying which bake), draws them
+// bake ("map/NAME": 8-bit RGBA, X-Bake-Id saying which bake; an edit of
+// the bake shown as the rectangle it changed, "map/NAME?since=ID"), draws them
 // with WebGL 2 (serve.frag.glsl after shaders/ssbump_relief.glsl), relights
 // as the light is dragged, and sends the controls ("params") and the write
 // action ("write"). The inputs' ranges are the library's ("ranges": the
@@ -255,10 +256,13 @@ function albedoUsed(mode) {
 }
 
 // Fetches names of the last good bake; they must all be of one bake (id,
-// or any when id is 0). Returns {id, w, h, data} or null when a newer bake
-// landed in between.
-async function fetchMaps(names, id) {
-  const replies = await Promise.all(names.map((name) => fetch("map/" + name)));
+// or any when id is 0). Returns {id, w, h, data, regions} or null when a
+// newer bake landed in between. With since (a bake held whole), a bake
+// that is an edit of it comes as the rectangles it changed: regions[i] is
+// [x0, y0, width, height] of data[i] (X-Region), null for a whole texture.
+async function fetchMaps(names, id, since) {
+  const query = since ? "?since=" + since : "";
+  const replies = await Promise.all(names.map((name) => fetch("map/" + name + query)));
   for (const r of replies)
     if (!r.ok) {
       if (r.status === 503) return null;  // a newer bake landed first: fetch that one
@@ -267,8 +271,12 @@ async function fetchMaps(names, id) {
   const ids = replies.map((r) => Number(r.headers.get("X-Bake-Id")));
   const data = await Promise.all(replies.map((r) => r.arrayBuffer()));
   if (ids.some((x) => x !== ids[0]) || (id && ids[0] !== id)) return null;
+  const regions = replies.map((r) => {
+    const v = r.headers.get("X-Region");
+    return v === null ? null : v.split(",").map(Number);
+  });
   return { id: ids[0], w: Number(replies[0].headers.get("X-Width")),
-           h: Number(replies[0].headers.get("X-Height")), data: data };
+           h: Number(replies[0].headers.get("X-Height")), data: data, regions: regions };
 }
 
 function uploadMaps(m, names, got) {
@@ -277,39 +285,106 @@ function uploadMaps(m, names, got) {
     m.tex[name] = makeTexture(UNITS[name], gl.RGBA8, gl.RGBA, got.w, got.h, bytes);
     if (name === "normal_height") {
       // the relief reads the height's first channel (ssbump_relief.glsl's relief_h)
-      const n = got.w * got.h, height = new Uint8Array(n);
-      for (let k = 0; k < n; k++) height[k] = bytes[4 * k + 3];
-      m.tex.height = makeTexture(UNITS.height, gl.R8, gl.RED, got.w, got.h, height);
+      m.tex.height = makeTexture(UNITS.height, gl.R8, gl.RED, got.w, got.h, alphaOf(bytes));
     }
   });
 }
 
-// A new bake: first the textures the picture shown needs, drawn at once,
-// then the others (so a save shows as soon as its ssbump has arrived).
+// The alpha bytes of RGBA texels: the height of normal_height.
+function alphaOf(bytes) {
+  const n = bytes.length / 4, alpha = new Uint8Array(n);
+  for (let k = 0; k < n; k++) alpha[k] = bytes[4 * k + 3];
+  return alpha;
+}
+
+// A copy of texture t (w x h, on the GPU: a bake's maps stay whole for A/B).
+let copyFrom = null;
+function copyTexture(unit, t, internal, format, w, h) {
+  const copy = makeTexture(unit, internal, format, w, h, null);
+  if (!copyFrom) copyFrom = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.READ_FRAMEBUFFER, copyFrom);
+  gl.framebufferTexture2D(gl.READ_FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, t, 0);
+  gl.copyTexSubImage2D(gl.TEXTURE_2D, 0, 0, 0, 0, 0, w, h);
+  gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
+  return copy;
+}
+
+// The maps of an edit of bake base (whole): base's textures copied, each
+// with the rectangle the edit changed (got, fetched since base) written in.
+function patchedMaps(base, names, got) {
+  const m = { id: got.id, width: got.w, height: got.h, tex: {} };
+  for (const [name, t] of Object.entries(base.tex)) {
+    const r8 = name === "height";
+    m.tex[name] = copyTexture(UNITS[name], t, r8 ? gl.R8 : gl.RGBA8, r8 ? gl.RED : gl.RGBA,
+                              got.w, got.h);
+  }
+  names.forEach((name, i) => {
+    const [x0, y0, w, h] = got.regions[i], bytes = new Uint8Array(got.data[i]);
+    if (!w || !h) return;
+    gl.activeTexture(gl.TEXTURE0 + UNITS[name]);
+    gl.bindTexture(gl.TEXTURE_2D, m.tex[name]);
+    gl.texSubImage2D(gl.TEXTURE_2D, 0, x0, y0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, bytes);
+    if (name === "normal_height") {
+      gl.activeTexture(gl.TEXTURE0 + UNITS.height);
+      gl.bindTexture(gl.TEXTURE_2D, m.tex.height);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, x0, y0, w, h, gl.RED, gl.UNSIGNED_BYTE,
+                       alphaOf(bytes));
+    }
+  });
+  m.whole = true;
+  return m;
+}
+
+// current becomes m; the bake it replaces becomes B if it was whole.
+function showMaps(m) {
+  const before = current;
+  current = m;
+  if (before && before !== previous && before.whole) {
+    freeMaps(previous);
+    previous = before;
+  } else if (before && before !== previous) {
+    freeMaps(before);  // cut short by this one: not a bake to compare with
+  }
+  showB = false;
+  fitCanvas();
+  draw();
+}
+
+// An edit of the bake shown (whole) comes as what it changed: asked for
+// every texture the shown bake has, since it. True when it was drawn so;
+// false when the server sent whole textures (not an edit of it: they are
+// dropped and fetched as a new bake's) or a newer bake landed in between.
+async function loadEdit() {
+  const base = current;
+  const names = Object.keys(base.tex).filter((name) => name !== "height");
+  const got = await fetchMaps(names, 0, base.id);
+  if (!got || got.regions.some((r) => r === null) || current !== base ||
+      got.w !== base.width || got.h !== base.height)
+    return false;
+  showMaps(patchedMaps(base, names, got));
+  return true;
+}
+
+// A new bake: an edit of the bake shown as the texels it changed; else
+// first the textures the picture shown needs, drawn at once, then the
+// others (so a save shows as soon as its ssbump has arrived).
 // The bake it replaces becomes B once the new one is whole.
 async function loadMaps() {
   loading = 1;
   try {
     for (;;) {
+      const bake = state && state.bake;
+      if (current && current.whole && bake && bake.base === current.id && await loadEdit())
+        break;
       const first = texturesOf(Number($("mode").value));
-      const got = await fetchMaps(first, 0);
+      const got = await fetchMaps(first, 0, 0);
       if (!got) continue;  // a bake landed in between: again
       const m = { id: got.id, width: got.w, height: got.h, tex: {} };
       uploadMaps(m, first, got);
-      const before = current;
-      current = m;
-      if (before && before !== previous && before.whole) {
-        freeMaps(previous);
-        previous = before;
-      } else if (before && before !== previous) {
-        freeMaps(before);  // cut short by this one: not a bake to compare with
-      }
-      showB = false;
-      fitCanvas();
-      draw();
+      showMaps(m);
       const rest = TEXTURES.filter((t) => !first.includes(t) &&
                                          (t !== "albedo" || (state && state.bake && state.bake.albedo)));
-      const others = rest.length ? await fetchMaps(rest, got.id) : { data: [] };
+      const others = rest.length ? await fetchMaps(rest, got.id, 0) : { data: [] };
       if (!others) continue;  // newer maps already: load them whole
       uploadMaps(m, rest, { w: got.w, h: got.h, data: others.data });
       m.whole = true;

@@ -680,3 +680,57 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
     finally:
         sb.stop_browser(driver)
         server.close()
+
+
+MODES_JS = """
+const out = [];
+for (let mode = 0; mode <= 8; mode++) {
+  document.getElementById('mode').value = String(mode);
+  draw();
+  out.push(bbCanvasStats().hash);
+}
+return out;
+"""
+
+
+def test_an_edit_draws_what_a_fresh_page_draws(tmp_path):
+    import numpy as np
+
+    def save_pgm(path, h):
+        sb.save_by_rename(b"P5\n128 128\n65535\n" + h.astype(">u2").tobytes(), path)
+
+    y, x = np.mgrid[0:128, 0:128] * (2 * np.pi / 128)
+    h = 0.5 + 0.2 * np.sin(3 * x) * np.cos(2 * y) + 0.05 * np.random.RandomState(3).rand(128, 128)
+    h = np.round(h * 65535).astype(np.uint16)
+    height, albedo = str(tmp_path / "h.pgm"), str(tmp_path / "albedo.pgm")
+    save_pgm(height, h)
+    save_pgm(albedo, np.round(65535 * (0.3 + 0.6 * (x / (2 * np.pi)))).astype(np.uint16))
+    server = sb.Server(BIN, height, ["--scale", "16", "--albedo", albedo, "--quiet"])
+    driver = sb.start_browser()
+    try:
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) == 1 and
+                    driver.execute_script("return current.whole"), SLOW, "the first bake whole")
+        first = driver.execute_script(MODES_JS)
+        h[60:66, 40:46] += 600
+        save_pgm(height, h)
+        sb.wait_for(lambda: sb.drawn_bake(driver) == 2, SLOW, "the edit drawn")
+        assert state(server)["bake"]["base"] == 1
+        # it came as the rectangle the edit changed: asked since bake 1
+        fetched = driver.execute_script(
+            "return performance.getEntriesByType('resource').map((e) => e.name)")
+        assert any(n.endswith("map/ssbump_ao?since=1") for n in fetched), fetched
+        edited = driver.execute_script(MODES_JS)
+        assert edited[0] != first[0]  # the picture changed
+        # B is bake 1 as it was drawn
+        driver.execute_script("toggleAB(); draw();")
+        sb.wait_for(lambda: sb.drawn_bake(driver) == 1, SLOW, "B drawn")
+        assert driver.execute_script(MODES_JS) == first
+        # a fresh page loads bake 2 whole: the same pixels in every mode
+        driver.get(server.url)
+        sb.wait_for(lambda: sb.drawn_bake(driver) == 2 and
+                    driver.execute_script("return current.whole"), SLOW, "bake 2 loaded whole")
+        assert driver.execute_script(MODES_JS) == edited
+    finally:
+        sb.stop_browser(driver)
+        server.close()

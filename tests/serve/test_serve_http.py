@@ -688,3 +688,77 @@ def test_the_state_names_the_stage_running_bounce_included(tmp_path):
     assert seen and all(x in order for x in seen), seen
     assert [order.index(x) for x in seen] == sorted(order.index(x) for x in seen), seen
     assert "trace" in seen and "bounce" in seen, seen
+
+
+TEXTURE_NAMES = ["ssbump_ao", "normal_height", "bent", "weights"]
+
+
+def get_map(server, name, since=None):
+    """(status, headers, body) of map/NAME, ?since=ID when given."""
+    u = urllib.parse.urlsplit(server.url)
+    c = http.client.HTTPConnection(u.hostname, u.port, timeout=30)
+    c.request("GET", u.path + "map/" + name + ("?since=%d" % since if since else ""))
+    r = c.getresponse()
+    got = {k.lower(): v for k, v in r.getheaders()}
+    body = r.read()
+    c.close()
+    return r.status, got, body
+
+
+def save_pgm(path, h):
+    """h (uint16, rows x columns) saved by rename as a 16-bit PGM: a file
+    format needing no encoder to write, which bumpbake reads."""
+    rows, cols = h.shape
+    sb.save_by_rename(b"P5\n%d %d\n65535\n" % (cols, rows) + h.astype(">u2").tobytes(), path)
+
+
+def test_an_edit_is_sent_as_the_rectangle_it_changed(tmp_path):
+    import numpy as np
+
+    y, x = np.mgrid[0:128, 0:128] * (2 * np.pi / 128)
+    h = 0.5 + 0.2 * np.sin(3 * x) * np.cos(2 * y) + 0.05 * np.random.RandomState(7).rand(128, 128)
+    h = np.round(h * 65535).astype(np.uint16)
+    path = str(tmp_path / "h.pgm")
+    save_pgm(path, h)
+    s = sb.Server(BIN, path, ["--scale", "16", "--rays", "16", "--quiet"])
+    try:
+        before = wait_bake(s, 0, "the first bake")["bake"]
+        assert before["base"] == 0 and before["changed"] == [0, 0, 128, 128]
+        # a block raised in the middle, then one across the periodic edge
+        edits = [((60, 66), (40, 46)), ((90, 96), (-2, 4))]
+        for (r0, r1), (c0, c1) in edits:
+            shown = {n: get_map(s, n)[2] for n in TEXTURE_NAMES}
+            rows = np.arange(r0, r1) % 128
+            cols = np.arange(c0, c1) % 128
+            h[np.ix_(rows, cols)] += 600  # a brush of 0.01: 0.15 texels at scale 16
+            save_pgm(path, h)
+            bake = wait_bake(s, before["id"], "the edit's bake")["bake"]
+            x0, y0, w, hh = bake["changed"]
+            assert bake["base"] == before["id"], (bake["base"], bake["changed"], bake["id"])
+            assert 0 < w * hh < 128 * 128 / 4, bake["changed"]
+            assert all(x0 <= c < x0 + w for c in cols) and all(y0 <= r < y0 + hh for r in rows)
+            for name in TEXTURE_NAMES:
+                status, headers, part = get_map(s, name, since=before["id"])
+                assert status == 200 and headers["x-bake-id"] == str(bake["id"])
+                assert headers["x-region"] == "%d,%d,%d,%d" % (x0, y0, w, hh)
+                assert len(part) == 4 * w * hh
+                whole = get_map(s, name)[2]
+                patched = np.frombuffer(shown[name], np.uint8).reshape(128, 128, 4).copy()
+                patched[y0:y0 + hh, x0:x0 + w] = np.frombuffer(part, np.uint8).reshape(hh, w, 4)
+                # the bake before with the rectangle written in is the new bake, bit for bit
+                assert patched.tobytes() == whole, name
+                if name == "ssbump_ao":
+                    assert whole != shown[name]  # the edit changed the picture
+            # a since that is not the bake's base: the whole texture
+            status, headers, body = get_map(s, "ssbump_ao", since=before["id"] + 100)
+            assert status == 200 and "x-region" not in headers and len(body) == 4 * 128 * 128
+            before = bake
+        # a control changes every texel: a whole bake, no base
+        status, _ = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?scale=12")
+        assert status == 200
+        bake = wait_bake(s, before["id"], "the control's bake")["bake"]
+        assert bake["base"] == 0 and bake["changed"] == [0, 0, 128, 128]
+        status, headers, body = get_map(s, "bent", since=before["id"])
+        assert "x-region" not in headers and len(body) == 4 * 128 * 128
+    finally:
+        s.close()

@@ -43,6 +43,14 @@ typedef struct serve_bake {
   int width, height;
   pthread_mutex_t tex_lock;            /* makes tex[] (then under serve_state.lock) */
   unsigned char *tex[SERVE_TEX_COUNT]; /* NULL until asked */
+  /* An edit's bake: base_id names the bake whose maps are this one's
+   * outside changed (the library's changed rectangle: the bake context's
+   * bake before was that bake, and every other file read is as it read
+   * them), 0 when there is none; part[t] is texture t's changed rectangle
+   * alone (4 x its width x height bytes, row by row), made when asked. */
+  long base_id;
+  bb_region changed;
+  unsigned char *part[SERVE_TEX_COUNT];
   bb_job *job;                         /* the job that baked them (its report) */
   bb_bake_result maps;                 /* the bake's float maps: the textures and a
                                           "write" (bb_job_write_item) are made of them */
@@ -89,6 +97,8 @@ typedef struct serve_state {
   serve_bake *previous; /* the one before it, or NULL (its maps shed) */
   long next_id;
   bb_bake_context *context; /* the bake thread's warm ray set and buffers */
+  long context_id;          /* the published bake that the context's last bake is
+                               (its changed rectangle is against it), 0: none */
   const char *watched[SERVE_MAX_WATCHED];
   int watched_count;
   int quiet;
@@ -111,6 +121,13 @@ void serve_maps_done(serve_bake *b);
  * out of memory, or when it was not made while b was shown. Any thread,
  * with a reference held and the lock not. */
 const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t);
+/* Texture t of b within b->changed only, as serve_bake_texture makes it
+ * (b->base_id is not 0); the albedo, read whole with every bake and the
+ * same as the base's, has an empty rectangle. NULL when out of memory or
+ * when b is no longer shown; a pointer to nothing for an empty rectangle. */
+const unsigned char *serve_bake_part(serve_state *s, serve_bake *b, int t);
+/* The rectangle of texture t that serve_bake_part gives. */
+bb_region serve_part_region(const serve_bake *b, int t);
 /* The first watched file (0: the height) whose bytes are not those b was
  * baked from, or -1 when every one is as baked. Reads the files; the
  * caller does not hold the lock (watched is set before any thread runs). */

@@ -36,8 +36,10 @@ static void free_maps(serve_bake *b) {
 void serve_bake_release(serve_bake *b) {
   if (!b || --b->refs > 0)
     return;
-  for (int t = 0; t < SERVE_TEX_COUNT; t++)
+  for (int t = 0; t < SERVE_TEX_COUNT; t++) {
     free(b->tex[t]);
+    free(b->part[t]);
+  }
   free_maps(b);
   pthread_mutex_destroy(&b->tex_lock);
   free(b->provenance);
@@ -153,49 +155,74 @@ static unsigned char unit_byte(float v) {
 
 /* Channels c0..c2 of img (or of nothing: 0) into RGB of tex, unit values or
  * signed vectors ((v + 1) / 2), and alpha from channel 0 of alpha_img; a
- * grey img (1 or 2 channels) fills R, G and B alike. */
-static void fill(unsigned char *tex, size_t n, const bb_image *img, int is_vector,
-                 const bb_image *alpha_img) {
+ * grey img (1 or 2 channels) fills R, G and B alike. The texels of region
+ * r of maps width texels wide, row by row (tex holds r's texels only). */
+static void fill(unsigned char *tex, int width, bb_region r, const bb_image *img,
+                 int is_vector, const bb_image *alpha_img) {
   const int grey = img && img->channels < 3;
-  for (size_t i = 0; i < n; i++) {
-    for (int c = 0; c < 3; c++) {
-      float v = img && img->pixels && (grey || c < img->channels)
-                    ? img->pixels[i * (size_t)img->channels + (size_t)(grey ? 0 : c)]
-                    : 0.0f;
-      tex[4 * i + (size_t)c] = unit_byte(is_vector ? 0.5f * (v + 1.0f) : v);
+  size_t o = 0;
+  for (int y = r.y0; y < r.y0 + r.height; y++)
+    for (int x = r.x0; x < r.x0 + r.width; x++, o += 4) {
+      const size_t i = (size_t)y * (size_t)width + (size_t)x;
+      for (int c = 0; c < 3; c++) {
+        float v = img && img->pixels && (grey || c < img->channels)
+                      ? img->pixels[i * (size_t)img->channels + (size_t)(grey ? 0 : c)]
+                      : 0.0f;
+        tex[o + (size_t)c] = unit_byte(is_vector ? 0.5f * (v + 1.0f) : v);
+      }
+      tex[o + 3] = alpha_img && alpha_img->pixels
+                       ? unit_byte(alpha_img->pixels[i * (size_t)alpha_img->channels])
+                       : 255;
     }
-    tex[4 * i + 3] = alpha_img && alpha_img->pixels
-                         ? unit_byte(alpha_img->pixels[i * (size_t)alpha_img->channels])
-                         : 255;
-  }
 }
 
-static void make_texture(serve_bake *b, int t) {
-  const size_t n = (size_t)b->width * (size_t)b->height;
-  const bb_bake_result *r = &b->maps;
-  if ((b->tex[t] = malloc(4 * n))) {
-    switch (t) {
-    case SERVE_TEX_SSBUMP_AO:
-      fill(b->tex[t], n, &r->ssbump, 0, &r->ao);
-      break;
-    case SERVE_TEX_NORMAL_HEIGHT:
-      fill(b->tex[t], n, &r->normal, 1, &r->filtered);
-      break;
-    case SERVE_TEX_BENT:
-      fill(b->tex[t], n, &r->bent, 1, NULL);
-      break;
-    case SERVE_TEX_WEIGHTS:
-      fill(b->tex[t], n, &r->weights, 0, NULL);
-      break;
-    default:
-      break; /* the albedo is made with the bake */
-    }
-  }
+static bb_region whole_of(const serve_bake *b) {
+  return (bb_region){0, 0, b->width, b->height};
 }
 
-const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t) {
+/* Texture t of b's maps within r (malloc'd, 4 bytes a texel), or NULL when
+ * out of memory or for the albedo, which is made with the bake. */
+static unsigned char *make_texture(const serve_bake *b, int t, bb_region r) {
+  const bb_bake_result *m = &b->maps;
+  unsigned char *tex = malloc(4 * (size_t)r.width * (size_t)r.height);
+  if (!tex)
+    return NULL;
+  switch (t) {
+  case SERVE_TEX_SSBUMP_AO:
+    fill(tex, b->width, r, &m->ssbump, 0, &m->ao);
+    break;
+  case SERVE_TEX_NORMAL_HEIGHT:
+    fill(tex, b->width, r, &m->normal, 1, &m->filtered);
+    break;
+  case SERVE_TEX_BENT:
+    fill(tex, b->width, r, &m->bent, 1, NULL);
+    break;
+  case SERVE_TEX_WEIGHTS:
+    fill(tex, b->width, r, &m->weights, 0, NULL);
+    break;
+  default:
+    free(tex);
+    return NULL;
+  }
+  return tex;
+}
+
+bb_region serve_part_region(const serve_bake *b, int t) {
+  return t == SERVE_TEX_ALBEDO || b->changed.width <= 0 || b->changed.height <= 0
+             ? (bb_region){0, 0, 0, 0}
+             : b->changed;
+}
+
+/* *slot, made from b's maps within r when it is not yet (while b is the
+ * bake shown: its maps go once it is not). An empty region gives a
+ * pointer to nothing. Holds b's tex_lock. */
+static const unsigned char *texture_in(serve_state *s, serve_bake *b, int t, bb_region r,
+                                       unsigned char **slot) {
+  static const unsigned char nothing[1];
+  if (r.width <= 0 || r.height <= 0)
+    return nothing;
   pthread_mutex_lock(&b->tex_lock);
-  if (!b->tex[t]) {
+  if (!*slot && t != SERVE_TEX_ALBEDO) {
     pthread_mutex_lock(&s->lock);
     const int usable = !b->maps_shed;
     if (usable)
@@ -203,16 +230,24 @@ const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t) {
     pthread_mutex_unlock(&s->lock);
     if (usable) {
       const double t0 = now_seconds();
-      make_texture(b, t);
+      *slot = make_texture(b, t, r);
       pthread_mutex_lock(&s->lock);
       b->seconds_textures += now_seconds() - t0;
       serve_maps_done(b);
       pthread_mutex_unlock(&s->lock);
     }
   }
-  const unsigned char *tex = b->tex[t];
+  const unsigned char *tex = *slot;
   pthread_mutex_unlock(&b->tex_lock);
   return tex;
+}
+
+const unsigned char *serve_bake_texture(serve_state *s, serve_bake *b, int t) {
+  return texture_in(s, b, t, whole_of(b), &b->tex[t]);
+}
+
+const unsigned char *serve_bake_part(serve_state *s, serve_bake *b, int t) {
+  return texture_in(s, b, t, serve_part_region(b, t), &b->part[t]);
 }
 
 /* The ssbump's provenance as the job records it in the file it writes. */
@@ -290,7 +325,7 @@ static bb_status read_albedo(const char *path, int width, int height, unsigned c
     st = BB_ERR_MEMORY;
   }
   if (st == BB_OK)
-    fill(*tex, n, &albedo, 0, NULL);
+    fill(*tex, width, (bb_region){0, 0, width, height}, &albedo, 0, NULL);
   bb_image_free(&albedo);
   return st;
 }
@@ -304,6 +339,23 @@ static bb_status bake_maps(serve_state *s, bb_job *job, progress_ctx *p,
   bb_status st = bb_job_bake_item(job, 0, BB_MAPS_BAKED, on_progress, p, result, err);
   bb_job_use_context(job, NULL); /* "write" may run it on another thread */
   return st;
+}
+
+/* Is b, baked through the context, an edit of the bake shown: the
+ * context's bake before was it (context_id), the library changed only a
+ * rectangle (or nothing), and every other file read (brightness, albedo...)
+ * has the bytes it had? Then b's maps are shown's outside b->changed. */
+static int is_edit_of(const serve_bake *b, const serve_bake *shown, long context_id,
+                      int watched_count) {
+  if (!shown || shown->id != context_id || shown->width != b->width ||
+      shown->height != b->height)
+    return 0;
+  if (b->changed.width == b->width && b->changed.height == b->height)
+    return 0; /* baked whole */
+  for (int i = 1; i < watched_count; i++)
+    if (b->input_hashes[i] != shown->input_hashes[i])
+      return 0;
+  return 1;
 }
 
 /* One bake of the options as they are now; publishes it or the error. */
@@ -340,6 +392,8 @@ static void bake_once(serve_state *s, long wanted) {
     progress_ctx p = {s, wanted, bounces ? bb_bake_slices(&o.bake) : 0, 0, 0};
     st = bake_maps(s, job, &p, &result, &err);
   }
+  const int context_baked = st == BB_OK; /* the context's last bake is this one now */
+  const bb_region changed = bb_bake_context_changed(s->context);
   unsigned char *albedo = NULL;
   if (st == BB_OK) {
     const bb_job_report *rep = bb_job_report_get(job, 0);
@@ -384,6 +438,10 @@ static void bake_once(serve_state *s, long wanted) {
   s->done = wanted;
   if (st == BB_OK) {
     b->id = ++s->next_id;
+    b->changed = changed;
+    if (is_edit_of(b, s->current, s->context_id, s->watched_count))
+      b->base_id = s->current->id;
+    s->context_id = b->id;
     serve_bake_release(s->previous);
     if ((s->previous = s->current))
       shed_maps(s->previous);
@@ -399,7 +457,10 @@ static void bake_once(serve_state *s, long wanted) {
       fprintf(stderr, "serve: bake %ld: %dx%d in %.3f s%s\n", b->id, b->width, b->height,
               b->seconds, where);
     }
-  } else if (st != BB_ERR_CANCELLED) {
+  } else if (context_baked) {
+    s->context_id = 0; /* baked but not shown: the next change is against it */
+  }
+  if (st != BB_OK && st != BB_ERR_CANCELLED) {
     /* the last good maps stay on the page, with why the new ones are not */
     snprintf(s->error, sizeof s->error, "%s",
              err.message[0] ? err.message : bb_status_name(st));

@@ -188,6 +188,7 @@ typedef struct texture_read {
   serve_state *s;
   long bake_id;
   int t;
+  int part; /* serve_bake_part's bytes, not the whole texture's */
   uint64_t size;
 } texture_read;
 
@@ -206,7 +207,8 @@ static ssize_t texture_reader(void *cls, uint64_t pos, char *buf, size_t max) {
   if (!b)
     return MHD_CONTENT_READER_END_WITH_ERROR; /* two bakes newer: fetch again */
   const size_t n = r->size - pos < max ? (size_t)(r->size - pos) : max;
-  memcpy(buf, b->tex[r->t] + pos, n); /* made before the download began */
+  /* made before the download began */
+  memcpy(buf, (r->part ? b->part : b->tex)[r->t] + pos, n);
   pthread_mutex_lock(&s->lock);
   serve_bake_release(b);
   pthread_mutex_unlock(&s->lock);
@@ -216,7 +218,19 @@ static ssize_t texture_reader(void *cls, uint64_t pos, char *buf, size_t max) {
 static const char *const texture_names[SERVE_TEX_COUNT] = {"ssbump_ao", "normal_height",
                                                            "bent", "weights", "albedo"};
 
-/* One texture of the last good bake; X-Bake-Id says which bake it is. */
+/* The bake id of ?since=ID (a bake the page holds whole), or 0. */
+static long since_of(struct MHD_Connection *c) {
+  const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "since");
+  char *end = NULL;
+  const long id = v ? strtol(v, &end, 10) : 0;
+  return v && end != v && !*end && id > 0 ? id : 0;
+}
+
+/* One texture of the last good bake; X-Bake-Id says which bake it is.
+ * With ?since=ID, when that bake is an edit of bake ID (serve_bake's
+ * base_id), only the texels it changed: X-Region says which
+ * ("x0,y0,width,height"; "0,0,0,0" when none did), the body is that
+ * rectangle's texels row by row, and the rest is bake ID's. */
 static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c,
                                     const char *name) {
   int t = 0;
@@ -224,6 +238,7 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c,
     t++;
   if (t == SERVE_TEX_COUNT || (t == SERVE_TEX_ALBEDO && !sv->s->albedo_file))
     return send_text(c, MHD_HTTP_NOT_FOUND, "no such map");
+  const long since = since_of(c);
   serve_state *s = sv->s;
   pthread_mutex_lock(&s->lock);
   serve_bake *b = s->current;
@@ -232,18 +247,25 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c,
   pthread_mutex_unlock(&s->lock);
   if (!b)
     return send_text(c, MHD_HTTP_SERVICE_UNAVAILABLE, "no bake yet");
-  const int made = serve_bake_texture(s, b, t) != NULL;
+  const int part = since && b->base_id == since;
+  const bb_region region = part ? serve_part_region(b, t) : (bb_region){0, 0, 0, 0};
+  const int made =
+      (part ? serve_bake_part(s, b, t) : serve_bake_texture(s, b, t)) != NULL;
   texture_read *r = made ? calloc(1, sizeof *r) : NULL;
   if (r) {
     r->s = s;
     r->bake_id = b->id;
     r->t = t;
-    r->size = 4 * (uint64_t)b->width * (uint64_t)b->height;
+    r->part = part;
+    r->size = part ? 4 * (uint64_t)region.width * (uint64_t)region.height
+                   : 4 * (uint64_t)b->width * (uint64_t)b->height;
   }
-  char id[32], w[16], h[16];
+  char id[32], w[16], h[16], where[64];
   snprintf(id, sizeof id, "%ld", b->id);
   snprintf(w, sizeof w, "%d", b->width);
   snprintf(h, sizeof h, "%d", b->height);
+  snprintf(where, sizeof where, "%d,%d,%d,%d", region.x0, region.y0, region.width,
+           region.height);
   pthread_mutex_lock(&s->lock);
   serve_bake_release(b);
   pthread_mutex_unlock(&s->lock);
@@ -259,6 +281,8 @@ static enum MHD_Result send_texture(server *sv, struct MHD_Connection *c,
   MHD_add_response_header(resp, "X-Bake-Id", id);
   MHD_add_response_header(resp, "X-Width", w);
   MHD_add_response_header(resp, "X-Height", h);
+  if (part)
+    MHD_add_response_header(resp, "X-Region", where);
   return queue(c, MHD_HTTP_OK, resp, "application/octet-stream");
 }
 

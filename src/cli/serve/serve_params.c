@@ -38,6 +38,15 @@ static void add_params(bb_json *j, const serve_state *s) {
 static void add_bake(bb_json *j, serve_bake *b) {
   bb_json_open(j, "bake", '{');
   bb_json_int(j, "id", b->id);
+  /* an edit of bake "base": its maps outside "changed" are that bake's
+   * (map/NAME?since=BASE gives the rectangle alone); 0 when it is not */
+  bb_json_int(j, "base", b->base_id);
+  bb_json_open(j, "changed", '[');
+  const bb_region edit = b->base_id ? b->changed : (bb_region){0, 0, b->width, b->height};
+  const int where[4] = {edit.x0, edit.y0, edit.width, edit.height};
+  for (int k = 0; k < 4; k++)
+    bb_json_int(j, NULL, where[k]);
+  bb_json_close(j, ']');
   bb_json_int(j, "width", b->width);
   bb_json_int(j, "height", b->height);
   bb_json_number(j, "seconds", b->seconds);
