@@ -722,6 +722,10 @@ def test_an_edit_draws_what_a_fresh_page_draws(tmp_path):
         assert any(n.endswith("map/ssbump_ao?since=1") for n in fetched), fetched
         edited = driver.execute_script(MODES_JS)
         assert edited[0] != first[0]  # the picture changed
+        driver.execute_script("document.getElementById('mode').value = '0';"
+                              "camera.zoom = 10; camera.cx = 43; camera.cy = 63; draw();")
+        shot(driver, "13-an-edit-drawn-from-its-rectangle")
+        driver.execute_script("fit(); draw();")
         # B is bake 1 as it was drawn
         driver.execute_script("toggleAB(); draw();")
         sb.wait_for(lambda: sb.drawn_bake(driver) == 1, SLOW, "B drawn")
