@@ -160,7 +160,7 @@ BENCH_BINS := $(BUILD)/bench/bumpbake-plain $(BUILD)/bench/bumpbake-shared $(TES
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
-        bench bench-cluster bench-check goldens docs docs-reference install check-after-unit \
+        bench bench-cluster bench-check goldens docs docs-reference install check-others \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
 all: $(BIN) lib $(TOOLS)
@@ -357,15 +357,26 @@ test: ensure-deps
 # each other, the check that no family reaches up to a later one, the
 # check that the command reference and the man page say what --help says
 # and the check of the ABI against the last release's.
-# The unit tests take both cores; the checks after them mostly wait (on
-# Dask's workers, on Chromium, on installs: about 70 s of CPU in 180 s),
-# so they run side by side, each one's output printed whole as it ends.
-check: check-unit
-	@echo "test: now the install, the Python package, the serve and report pages in Chromium and the"
-	@echo "test: docs, ABI and layer checks, side by side (each one's output as it ends)"
-	@$(MAKE) --no-print-directory -j$(NPROC) --output-sync=target check-after-unit
-check-after-unit: check-install check-python check-serve check-report check-circles check-layers \
-                  check-docs check-abi
+# The unit tests take both cores; the other checks mostly wait (on Dask's
+# workers, on Chromium, on installs: about 70 s of CPU in 180 s), so they
+# run side by side with the unit tests and with each other, their output
+# kept (build/check-others.log) and printed whole once the unit tests end.
+# A command the shell starts with & ignores SIGINT; the tests of Ctrl-C
+# need it as a terminal delivers it, so env gives it back its default.
+CHECK_OTHERS_LOG := $(BUILD)/check-others.log
+check: $(BIN) $(TESTBIN) $(TOOLS) lib
+	@echo "test: the install, the Python package, the serve and report pages in Chromium and the docs,"
+	@echo "test: ABI and layer checks start beside the unit tests; their output follows the unit tests'"
+	@env --default-signal=INT,QUIT $(MAKE) --no-print-directory -j$(NPROC) --output-sync=target check-others \
+	  >$(CHECK_OTHERS_LOG) 2>&1 & others=$$!; \
+	$(MAKE) --no-print-directory check-unit; unit=$$?; \
+	echo "test: the unit tests are done; waiting for the other checks"; \
+	wait $$others; status=$$?; cat $(CHECK_OTHERS_LOG); \
+	if [ $$unit -ne 0 ] || [ $$status -ne 0 ]; then \
+	  echo "test: FAILED ($$([ $$unit -ne 0 ] && echo 'unit tests ')$$([ $$status -ne 0 ] && echo 'other checks'))"; \
+	  exit 1; fi
+check-others: check-install check-python check-serve check-report check-circles check-layers \
+              check-docs check-abi
 
 # docs/commands/*.md's option tables and docs/bumpbake.1 are generated from
 # each command's --help (tools/gen_docs.py): `make docs-reference` rewrites
