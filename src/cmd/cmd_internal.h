@@ -7,22 +7,11 @@
 
 #include "bumpbake.h"
 #include "core/internal.h"
+#include "job/bake_rows.h"
 
 #include <stddef.h>
 
 typedef struct bb__option bb__option;
-
-/* Where a generic option's value goes in bb_command_options. */
-typedef enum bb__field {
-  BB__FIELD_NONE = 0, /* the option's set function writes it */
-  BB__FIELD_INT,      /* int (flags set 1) */
-  BB__FIELD_FLOAT,
-  BB__FIELD_DOUBLE,
-  BB__FIELD_STRING,   /* const char *, owned by the command */
-  BB__FIELD_ENUM,     /* an enum, stored as int (enums of the API are int-sized) */
-  BB__FIELD_ANGLES    /* AZ,EL: double azimuth, then double elevation (the range's);
-                         sets (bb__flag_sets) turns the light or camera on */
-} bb__field;
 
 /* The most numbers one option holds (--rect L B R T). */
 #define BB__MAX_NUMBERS 4
@@ -36,23 +25,12 @@ typedef bb_status (*bb__set_fn)(bb_command *c, const bb__option *o, const char *
 typedef void (*bb__print_fn)(const bb_command *c, const bb__option *o, bb__text *t);
 /* 1 when the option does something in c as it stands. */
 typedef int (*bb__applies_fn)(const bb_command *c);
-/* An enum's name for value i ("unknown" or NULL past the last), and its
- * parser (with the enum's aliases and case rules): 1 and *value, or 0. */
-typedef const char *(*bb__name_fn)(int i);
-typedef int (*bb__parse_fn)(const char *text, int *value);
-
-/* What a FLAG sets when given besides its own field (if any): the field at
- * offset to value (INT, ENUM) or to text (STRING, a constant). field NONE:
- * nothing. A flag that sets one cannot be unset ("0"). */
-typedef struct bb__flag_sets {
-  bb__field field;
-  size_t offset;             /* in bb_command_options */
-  int value;
-  const char *text;
-} bb__flag_sets;
 
 struct bb__option {
   bb_option_info info;       /* first: a bb_option_info * is a bb__option * */
+  const bb__bake_row *job;   /* a bake option's row (job/bake_rows.h): its name,
+                                field, words and printing, in place of field,
+                                offset, names and sets (bb__option_field...) */
   bb__field field;
   size_t offset;             /* of the field in bb_command_options */
   const bb__range *range;    /* INT, NUMBER(S): each number's range */
@@ -126,6 +104,14 @@ struct bb_command {
 /* The commands' descriptions (commands.c), in bumpbake --help's order. */
 extern const bb__command *const bb__commands[];
 extern const int bb__command_total;
+
+/* An option's field, its offset in bb_command_options, what it sets as a
+ * flag (offset in bb_command_options) and its words: its bake row's when it
+ * has one (values.c). */
+bb__field bb__option_field(const bb__option *o);
+size_t bb__option_offset(const bb__option *o);
+bb__flag_sets bb__option_sets(const bb__option *o);
+bb__name_fn bb__option_names(const bb__option *o);
 
 /* 1 when the first length characters of name are option's name ('_'
  * read as '-'). */
@@ -221,22 +207,6 @@ int bb__applies_traced(const bb_command *c);
 int bb__applies_bounces(const bb_command *c);
 int bb__applies_brightness(const bb_command *c);
 int bb__applies_batch(const bb_command *c);
-
-/* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
-#define BB__ENUM_WORDS(stem)                                                             \
-  const char *bb__name_##stem(int i);                                                    \
-  int bb__parse_##stem(const char *text, int *value);
-BB__ENUM_WORDS(normal_filter)
-BB__ENUM_WORDS(channel)
-BB__ENUM_WORDS(texture_format)
-BB__ENUM_WORDS(render_mode)
-BB__ENUM_WORDS(albedo_mode)
-BB__ENUM_WORDS(axis)
-BB__ENUM_WORDS(map_kind)
-BB__ENUM_WORDS(depth)
-BB__ENUM_WORDS(normal_y)
-BB__ENUM_WORDS(ssbump_kind)
-BB__ENUM_WORDS(output_kind)
 
 /* Rows several commands share (options_bake.c). */
 extern const bb__option bb__opt_scale, bb__opt_scale_optional, bb__opt_rays,

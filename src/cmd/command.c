@@ -116,14 +116,14 @@ static bb_status set_option(bb_command *c, const char *name, const char *text,
   if (o->info.type != BB_OPTION_FLAG && !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
   if (o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0") &&
-      (o->set || o->sets.field != BB__FIELD_NONE))
+      (o->set || bb__option_sets(o).field != BB__FIELD_NONE))
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out", o->info.name);
   /* A map's file given again is a further file of the map, written from
    * the same bake in its own format (--ssbump s.png --ssbump s.vtf); the
    * same name again is the same file. */
   if (c->given[i] && o->repeats && text) {
-    const char *was =
-        *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+    const char *was = *(const char *const *)(const void *)((const char *)&c->options +
+                                                            bb__option_offset(o));
     int known = was && !strcmp(was, text);
     for (int m = 0; m < c->more_count; m++)
       known |= c->more_option[m] == i && !strcmp(c->more_path[m], text);
@@ -142,8 +142,9 @@ static bb_status set_option(bb_command *c, const char *name, const char *text,
   }
   /* Any other file option names one file: a second, different name would
    * leave the first unwritten (or unread) without a word. */
-  if (c->given[i] && o->info.type == BB_OPTION_PATH && o->field == BB__FIELD_STRING) {
-    const char *was = *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+  if (c->given[i] && o->info.type == BB_OPTION_PATH && bb__option_field(o) == BB__FIELD_STRING) {
+    const char *was = *(const char *const *)(const void *)((const char *)&c->options +
+                                                            bb__option_offset(o));
     if (was && strcmp(was, text) != 0) {
       char spelled[80];
       bb__option_spelling(o, spelled, sizeof spelled);
@@ -198,8 +199,9 @@ bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
   if (i < 0)
     return bb_command_set(c, name, NULL, err); /* its words for an unknown name */
   const bb__option *o = c->def->options[i];
-  const size_t size = field_size(o->field);
-  if (o->set || o->sets.field != BB__FIELD_NONE || !size)
+  const size_t size = field_size(bb__option_field(o));
+  const size_t offset = bb__option_offset(o);
+  if (o->set || bb__option_sets(o).field != BB__FIELD_NONE || !size)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out",
                     o->info.name);
   if (!c->given[i])
@@ -210,8 +212,7 @@ bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
   bb_status st = bb_command_new(c->def->info.name, &fresh, err);
   if (st != BB_OK)
     return st;
-  memcpy((char *)&c->options + o->offset, (const char *)&fresh->options + o->offset,
-         size);
+  memcpy((char *)&c->options + offset, (const char *)&fresh->options + offset, size);
   bb_command_free(fresh);
   c->given[i] = 0;
   c->texts[i] = NULL;
@@ -397,9 +398,10 @@ static bb_status more_files(const bb_command *c, bb__job_more *more, int *kinds,
       n += c->more_option[m] == i;
     if (!n || !o->repeats)
       continue;
-    const int kind = (int)((o->offset - first_path) / sizeof(char *));
+    const size_t offset = bb__option_offset(o);
+    const int kind = (int)((offset - first_path) / sizeof(char *));
     const char *first =
-        *(const char *const *)(const void *)((const char *)&c->options + o->offset);
+        *(const char *const *)(const void *)((const char *)&c->options + offset);
     /* the option's files: its first, then the others, in the order given */
     for (int m = -1; m < c->more_count; m++) {
       if (m >= 0 && c->more_option[m] != i)

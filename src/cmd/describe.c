@@ -116,7 +116,7 @@ void bb_option_range_text(const bb_option_info *option, char *out, size_t cap) {
     snprintf(out, cap, "%s", option->range_text);
   else if (o->range_words)
     o->range_words(out, cap);
-  else if (o->range && o->field == BB__FIELD_ANGLES) {
+  else if (o->range && bb__option_field(o) == BB__FIELD_ANGLES) {
     char r[32];
     bb__range_text(o->range, r, sizeof r);
     snprintf(out, cap, "EL %s", r);

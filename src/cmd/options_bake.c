@@ -44,12 +44,6 @@ static bb_status set_basis(bb_command *c, const bb__option *o, const char *text,
   return BB_OK;
 }
 
-static void print_basis(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  const bb_job_options *j = &c->options.job;
-  bb__text_add(t, j->basis_file ? j->basis_file : j->bake.basis.name);
-}
-
 static void basis_range(char *out, size_t cap) {
   snprintf(out, cap, "N 3..%d", BB_MAX_BASIS);
 }
@@ -74,7 +68,8 @@ static void print_threads(const bb_command *c, const bb__option *o, bb__text *t)
   bb__text_printf(t, "%d", c->options.job.bake.trace.threads);
 }
 
-/* --vtf-version and --vtf-flags: the library's parsers of them. */
+/* --vtf-version and --vtf-flags: the library's parsers of them (their rows
+ * print them). */
 static bb_status set_vtf_version(bb_command *c, const bb__option *o, const char *text,
                                  double *values, int *count, bb_error *err) {
   *count = 0;
@@ -85,11 +80,6 @@ static bb_status set_vtf_version(bb_command *c, const bb__option *o, const char 
   return BB_OK;
 }
 
-static void print_vtf_version(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  bb__text_printf(t, "7.%d", c->options.job.texture.vtf_version);
-}
-
 static bb_status set_vtf_flags(bb_command *c, const bb__option *o, const char *text,
                                double *values, int *count, bb_error *err) {
   *count = 0;
@@ -98,11 +88,6 @@ static bb_status set_vtf_flags(bb_command *c, const bb__option *o, const char *t
   if (bb_vtf_flags_parse(text, &c->options.job.texture.vtf_flags, &e) != BB_OK)
     return bb__fail(err, BB_ERR_ARGUMENT, "--vtf-flags: %s", e.message);
   return BB_OK;
-}
-
-static void print_vtf_flags(const bb_command *c, const bb__option *o, bb__text *t) {
-  (void)o;
-  bb__text_printf(t, "0x%x", (unsigned)c->options.job.texture.vtf_flags);
 }
 
 /* --maps LIST: the bake's map names, comma-separated. */
@@ -133,90 +118,90 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
   return BB_OK;
 }
 
-static void print_maps(const bb_command *c, const bb__option *o, bb__text *t) {
-  int first = 1;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    if (c->options.job.maps & BB_MAP_BIT(k)) {
-      bb__text_printf(t, "%s%s", first ? "" : ",", o->names(k));
-      first = 0;
-    }
-}
-
 
 /* ------------------------------------------------------------ the rows */
 
 #define ROW_SCALE(flags_)                                                                 \
-  {.info = {.name = "scale", .value_name = "S", .type = BB_OPTION_NUMBER, .count = 1,     \
-            .values = 1, .flags = RECORDED | (flags_), .default_text = "(required)",       \
-            .help = "height scale: texels of displacement per unit of normalised height"}, \
-   .field = BB__FIELD_FLOAT, .offset = AT(job.bake.height_scale),                          \
-   .range = &bb__range_height_scale,                                                       \
+  {.info = {.name = bb__row_scale.name,                                                   \
+            .value_name = "S", .type = BB_OPTION_NUMBER, .count = 1,                      \
+            .values = 1, .flags = RECORDED | (flags_), .default_text = "(required)",      \
+            .help = "height scale: texels of displacement per unit of normalised height"},\
+   .job = &bb__row_scale,                                                                 \
+   .range = &bb__range_height_scale,                                                      \
    .required_note = "texels of displacement per unit of height"}
 const bb__option bb__opt_scale = ROW_SCALE(BB_OPTION_REQUIRED);
 const bb__option bb__opt_scale_optional = ROW_SCALE(0);
 
-#define ROW_RAYS(short_)                                                                   \
-  {.info = {.name = "rays", .short_name = (short_), .value_name = "N",                    \
-            .type = BB_OPTION_INT, .count = 1, .values = 1, .flags = RECORDED,             \
-            .help = "ray budget, as Valve's -r: round(sqrt(N)) azimuth slices"},           \
-   .field = BB__FIELD_INT, .offset = AT(job.bake.rays), .range = &bb__range_rays}
+#define ROW_RAYS(short_)                                                                  \
+  {.info = {.name = bb__row_rays.name,                                                    \
+            .short_name = (short_), .value_name = "N",                                    \
+            .type = BB_OPTION_INT, .count = 1, .values = 1, .flags = RECORDED,            \
+            .help = "ray budget, as Valve's -r: round(sqrt(N)) azimuth slices"},          \
+   .job = &bb__row_rays, .range = &bb__range_rays}
 const bb__option bb__opt_rays = ROW_RAYS(0);
 static const bb__option opt_rays_valve = ROW_RAYS('r');
 
 const bb__option bb__opt_slices = {
-    .info = {.name = "slices", .value_name = "A", .type = BB_OPTION_INT, .count = 1,
+    .info = {.name = bb__row_slices.name,
+             .value_name = "A", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "from --rays",
              .help = "azimuth slices, each integrated exactly above its horizon (overrides "
                      "--rays)"},
-    .field = BB__FIELD_INT, .offset = AT(job.bake.slices), .range = &bb__range_slices};
+    .job = &bb__row_slices, .range = &bb__range_slices};
 
-#define ROW_FILTER_RADIUS(short_)                                                          \
-  {.info = {.name = "filter-radius", .short_name = (short_), .value_name = "R",           \
-            .type = BB_OPTION_INT, .count = 1, .values = 1, .flags = RECORDED,             \
-            .help = "bilateral smoothing radius in texels, 0 = off"},                      \
-   .field = BB__FIELD_INT, .offset = AT(job.bake.smooth.radius_texels),                    \
+#define ROW_FILTER_RADIUS(short_)                                                         \
+  {.info = {.name = bb__row_filter_radius.name,                                           \
+            .short_name = (short_), .value_name = "R",                                    \
+            .type = BB_OPTION_INT, .count = 1, .values = 1, .flags = RECORDED,            \
+            .help = "bilateral smoothing radius in texels, 0 = off"},                     \
+   .job = &bb__row_filter_radius,                                                         \
    .range = &bb__range_filter_radius}
 const bb__option bb__opt_filter_radius = ROW_FILTER_RADIUS(0);
 static const bb__option opt_filter_radius_valve = ROW_FILTER_RADIUS('f');
 
 const bb__option bb__opt_filter_threshold = {
-    .info = {.name = "filter-threshold", .value_name = "T", .type = BB_OPTION_NUMBER,
+    .info = {.name = bb__row_filter_threshold.name,
+             .value_name = "T", .type = BB_OPTION_NUMBER,
              .count = 1, .values = 1, .flags = RECORDED,
              .help = "smoothing range threshold in normalised height (2/255 = 0.00784)"},
-    .field = BB__FIELD_FLOAT, .offset = AT(job.bake.smooth.threshold),
+    .job = &bb__row_filter_threshold,
     .range = &bb__range_filter_threshold};
 
 const bb__option bb__opt_bias = {
-    .info = {.name = "bias", .value_name = "B", .type = BB_OPTION_NUMBER, .count = 1,
+    .info = {.name = bb__row_bias.name,
+             .value_name = "B", .type = BB_OPTION_NUMBER, .count = 1,
              .values = 1, .flags = RECORDED,
              .help = "ray origin lift above the vertex in texels (0.55 = Valve's offset)"},
-    .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.trace.bias_texels), .range = &bb__range_bias};
+    .job = &bb__row_bias, .range = &bb__range_bias};
 
 const bb__option bb__opt_power = {
-    .info = {.name = "power", .value_name = "P", .type = BB_OPTION_NUMBER, .count = 1,
+    .info = {.name = bb__row_power.name,
+             .value_name = "P", .type = BB_OPTION_NUMBER, .count = 1,
              .values = 1, .flags = RECORDED, .help = "exponent of the basis lobes max(0, w.B)^P"},
-    .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.power), .range = &bb__range_power};
+    .job = &bb__row_power, .range = &bb__range_power};
 
 const bb__option bb__opt_basis = {
-    .info = {.name = "basis", .value_name = "hl2|hl2+z|dirs:N|FILE", .type = BB_OPTION_TEXT,
+    .info = {.name = bb__row_basis.name,
+             .value_name = "hl2|hl2+z|dirs:N|FILE", .type = BB_OPTION_TEXT,
              .count = 1, .values = 1, .flags = RECORDED,
              .help = "directions occlusion is projected on, one channel each: Half-Life 2's, N "
                      "evenly spread, or a file of x y z lines (docs/commands/bake.md, "
                      "\"Bases\")"},
-    .set = set_basis, .print = print_basis, .range_words = basis_range};
+    .job = &bb__row_basis, .set = set_basis, .range_words = basis_range};
 
 const bb__option bb__opt_normal_filter = {
-    .info = {.name = "normal-filter", .type = BB_OPTION_WORD, .count = 1, .values = 1,
+    .info = {.name = bb__row_normal_filter.name,
+             .type = BB_OPTION_WORD, .count = 1, .values = 1,
              .flags = RECORDED,
              .help = "normal estimator (vertex: centred on the ray origin; valve: Valve's)"},
-    .field = BB__FIELD_ENUM, .offset = AT(job.bake.normal_filter),
-    .names = bb__name_normal_filter, .parse = bb__parse_normal_filter};
+    .job = &bb__row_normal_filter, .parse = bb__parse_normal_filter};
 
 const bb__option bb__opt_normal_y = {
-    .info = {.name = "normal-y", .type = BB_OPTION_WORD, .count = 1, .values = 1,
+    .info = {.name = bb__row_normal_y.name,
+             .type = BB_OPTION_WORD, .count = 1, .values = 1,
              .flags = RECORDED,
              .help = "green axis: down = Source/DirectX, up = OpenGL (flips green)"},
-    .field = BB__FIELD_INT, .offset = AT(job.bake.normal_y_up), .names = bb__name_normal_y,
+    .job = &bb__row_normal_y,
     .parse = bb__parse_normal_y};
 
 const bb__option bb__opt_threads = {
@@ -225,23 +210,25 @@ const bb__option bb__opt_threads = {
     .range = &bb__range_threads, .set = set_threads, .print = print_threads};
 
 const bb__option bb__opt_clamp = {
-    .info = {.name = "clamp", .type = BB_OPTION_FLAG, .flags = RECORDED,
+    .info = {.name = bb__row_clamp.name, .type = BB_OPTION_FLAG, .flags = RECORDED,
              .default_text = "periodic", .help = "extend border texels instead of tiling"},
-    .sets = {BB__FIELD_ENUM, AT(job.bake.smooth.addressing), BB_ADDRESS_CLAMP, NULL}};
+    .job = &bb__row_clamp};
 
 const bb__option bb__opt_channel = {
-    .info = {.name = "channel", .type = BB_OPTION_WORD, .count = 1, .values = 1,
+    .info = {.name = bb__row_channel.name,
+             .type = BB_OPTION_WORD, .count = 1, .values = 1,
              .flags = RECORDED,
              .help = "height channel (auto: the grey; alpha where it holds the height, as "
                      "Valve's tools keep it; else the mean of R, G, B; a note says which)"},
-    .field = BB__FIELD_ENUM, .offset = AT(job.channel), .names = bb__name_channel,
+    .job = &bb__row_channel,
     .parse = bb__parse_channel};
 
-#define ROW_DEPTH(default_, help_)                                                         \
-  {.info = {.name = "depth", .type = BB_OPTION_WORD, .count = 1, .values = 1,             \
-            .flags = RECORDED | BB_OPTION_FILES, .default_text = (default_),               \
-            .help = (help_)},                                                              \
-   .field = BB__FIELD_ENUM, .offset = AT(job.depth), .names = bb__name_depth,              \
+#define ROW_DEPTH(default_, help_)                                                        \
+  {.info = {.name = bb__row_depth.name,                                                   \
+            .type = BB_OPTION_WORD, .count = 1, .values = 1,                              \
+            .flags = RECORDED | BB_OPTION_FILES, .default_text = (default_),              \
+            .help = (help_)},                                                             \
+   .job = &bb__row_depth,                                                                 \
    .parse = bb__parse_depth}
 const bb__option bb__opt_depth =
     ROW_DEPTH("by format", "sample depth (default: 8 for png/tga/tif, float for exr)");
@@ -252,69 +239,76 @@ const bb__option bb__opt_depth_of_format =
     ROW_DEPTH("8 (png/tga/tif) or float (exr)", "sample depth of the output");
 
 const bb__option bb__opt_mips = {
-    .info = {.name = "mips", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
+    .info = {.name = bb__row_mips.name,
+             .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .help = "write mip-mapped files (.tif/.exr): each level box-filtered, normals "
                      "renormalised"},
-    .field = BB__FIELD_INT, .offset = AT(job.mips)};
+    .job = &bb__row_mips};
 
 const bb__option bb__opt_bounce = {
-    .info = {.name = "bounce", .value_name = "RHO", .type = BB_OPTION_NUMBER, .count = 1,
+    .info = {.name = bb__row_bounce.name,
+             .value_name = "RHO", .type = BB_OPTION_NUMBER, .count = 1,
              .values = 1, .flags = RECORDED,
              .default_text = "0 (none; 1 with --bounce-albedo)",
              .applies = "a traced map (--ssbump, --ao, --bent)",
              .help = "inter-reflection: ao, ssbump and bent include the light the relief "
                      "reflects, albedo RHO (docs/commands/bake.md)"},
-    .field = BB__FIELD_DOUBLE, .offset = AT(job.bake.bounce_albedo),
+    .job = &bb__row_bounce,
     .range = &bb__range_bounce_albedo, .applies = bb__applies_traced};
 
 const bb__option bb__opt_bounces = {
-    .info = {.name = "bounces", .value_name = "N", .type = BB_OPTION_INT, .count = 1,
+    .info = {.name = bb__row_bounces.name,
+             .value_name = "N", .type = BB_OPTION_INT, .count = 1,
              .values = 1, .flags = RECORDED, .default_text = "0 (until converged)",
              .applies = "--bounce RHO or --bounce-albedo FILE",
              .help = "bounces of reflected light to follow"},
-    .field = BB__FIELD_INT, .offset = AT(job.bake.bounces), .range = &bb__range_bounces,
+    .job = &bb__row_bounces, .range = &bb__range_bounces,
     .applies = bb__applies_bounces};
 
 const bb__option bb__opt_bounce_albedo = {
-    .info = {.name = "bounce-albedo", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_bounce_albedo.name,
+             .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED,
              .applies = "a traced map (--ssbump, --ao, --bent)",
              .help = "albedo map (grey; RGB: luma) of the height's size, times RHO"},
-    .field = BB__FIELD_STRING, .offset = AT(job.bounce_albedo_file),
+    .job = &bb__row_bounce_albedo,
     .applies = bb__applies_traced};
 
 const bb__option bb__opt_brightness = {
-    .info = {.name = "brightness", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_brightness.name,
+             .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED, .applies = "an ssbump or weights map",
              .help = "brightness map (grey; RGB: luma) multiplying ssbump and weights (a "
                      "texel over 1 is scaled down whole)"},
-    .field = BB__FIELD_STRING, .offset = AT(job.brightness_file),
+    .job = &bb__row_brightness,
     .applies = bb__applies_brightness};
 
-#define ROW_MAP_OUT(name_, kind_, help_)                                                   \
-  {.info = {.name = (name_), .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,    \
-            .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,      \
-            .help = (help_)},                                                              \
-   .field = BB__FIELD_STRING, .offset = AT(job.paths[kind_]), .repeats = 1}
+#define ROW_MAP_OUT(row_, help_)                                                          \
+  {.info = {.name = (row_).name, .value_name = "FILE", .type = BB_OPTION_PATH,           \
+            .count = 1, .values = 1, .mode = BB_MODE_SINGLE,                              \
+            .flags = RECORDED | BB_OPTION_FILES,                                          \
+            .help = (help_)},                                                             \
+   .job = &(row_), .repeats = 1}
 static const bb__option opt_out_normal =
-    ROW_MAP_OUT("normal", BB_MAP_NORMAL, "write the normal map");
+    ROW_MAP_OUT(bb__row_normal, "write the normal map");
 static const bb__option opt_out_weights =
-    ROW_MAP_OUT("weights", BB_MAP_WEIGHTS, "write the basis weights (normal2ssbump)");
+    ROW_MAP_OUT(bb__row_weights, "write the basis weights (normal2ssbump)");
 static const bb__option opt_out_ssbump =
-    ROW_MAP_OUT("ssbump", BB_MAP_SSBUMP, "write the self-shadowed bump map (traces)");
+    ROW_MAP_OUT(bb__row_ssbump, "write the self-shadowed bump map (traces)");
 static const bb__option opt_out_ao =
-    ROW_MAP_OUT("ao", BB_MAP_AO, "write the ambient occlusion (traces)");
+    ROW_MAP_OUT(bb__row_ao, "write the ambient occlusion (traces)");
 static const bb__option opt_out_bent =
-    ROW_MAP_OUT("bent", BB_MAP_BENT, "write the bent normal (traces)");
+    ROW_MAP_OUT(bb__row_bent, "write the bent normal (traces)");
 static const bb__option opt_out_filtered =
-    ROW_MAP_OUT("filtered", BB_MAP_FILTERED, "write the smoothed height");
+    ROW_MAP_OUT(bb__row_filtered, "write the smoothed height");
 
 static const bb__option opt_slope = {
-    .info = {.name = "slope", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_slope.name,
+             .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,
              .help = "write flipcode's slope map: 1 byte per texel, dx low nibble, dy high "
                      "(8-bit .png .tga .tif)"},
-    .field = BB__FIELD_STRING, .offset = AT(job.slope_path)};
+    .job = &bb__row_slope};
 
 /* --lit is an AZ,EL field (BB__FIELD_ANGLES): two doubles. */
 _Static_assert(offsetof(bb_job_options, slope_lit_elevation) ==
@@ -322,12 +316,12 @@ _Static_assert(offsetof(bb_job_options, slope_lit_elevation) ==
                "--lit: azimuth, then elevation");
 
 static const bb__option opt_lit = {
-    .info = {.name = "lit", .value_name = "AZ,EL", .type = BB_OPTION_NUMBERS, .count = 2,
+    .info = {.name = bb__row_lit.name,
+             .value_name = "AZ,EL", .type = BB_OPTION_NUMBERS, .count = 2,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES, .default_text = "",
              .help = "also write the slope map lit through its 16x16 table as FILE_lit (AZ 0 = "
                      "light from the right, 90 = from the top, as render's --light)"},
-    .field = BB__FIELD_ANGLES, .offset = AT(job.slope_lit_azimuth),
-    .sets = {BB__FIELD_INT, AT(job.slope_lit), 1, NULL},
+    .job = &bb__row_lit,
     .range = &bb__range_light_elevation, .range_of = "elevation"};
 
 static const bb__option opt_prefix = {
@@ -338,25 +332,27 @@ static const bb__option opt_prefix = {
     .field = BB__FIELD_STRING, .offset = AT(job.prefix)};
 
 static const bb__option opt_out_dir = {
-    .info = {.name = "out-dir", .value_name = "DIR", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_out_dir.name,
+             .value_name = "DIR", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .flags = RECORDED | BB_OPTION_FILES,
              .help = "a batch: bake every HEIGHT (files, or directories of images) into DIR"},
-    .field = BB__FIELD_STRING, .offset = AT(job.out_dir)};
+    .job = &bb__row_out_dir};
 
 const bb__option bb__opt_maps = {
-    .info = {.name = "maps", .value_name = "LIST", .type = BB_OPTION_WORDS, .count = 1,
+    .info = {.name = bb__row_maps.name,
+             .value_name = "LIST", .type = BB_OPTION_WORDS, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "normal,ssbump,ao",
              .help = "the maps a batch writes, comma-separated"},
-    .names = bb__name_output_kind, .parse = bb__parse_output_kind, .set = set_maps,
-    .print = print_maps};
+    .job = &bb__row_maps, .parse = bb__parse_output_kind, .set = set_maps};
 
 const bb__option bb__opt_name = {
-    .info = {.name = "name", .value_name = "TEMPLATE", .type = BB_OPTION_TEXT, .count = 1,
+    .info = {.name = bb__row_name.name,
+             .value_name = "TEMPLATE", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .mode = BB_MODE_BATCH, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = BB_JOB_DEFAULT_NAME, .range_text = "{stem} {kind} {ext}",
              .help = "a batch's file names: the input's stem, the map, the input's extension"},
-    .field = BB__FIELD_STRING, .offset = AT(job.name_template)};
+    .job = &bb__row_name};
 
 static const bb__option opt_keep_going = {
     .info = {.name = "keep-going", .type = BB_OPTION_FLAG, .flags = BB_OPTION_FILES, .mode = BB_MODE_BATCH,
@@ -395,65 +391,72 @@ const bb__option bb__opt_help = {
 
 /* Engine textures (.vtf, .dds) and a Source material. */
 const bb__option bb__opt_texture_format = {
-    .info = {.name = "texture-format", .value_name = "NAME", .type = BB_OPTION_WORD,
+    .info = {.name = bb__row_texture_format.name,
+             .value_name = "NAME", .type = BB_OPTION_WORD,
              .count = 1, .values = 1, .flags = RECORDED | BB_OPTION_FILES, .default_text = "default",
              .range_text = "dxt1 dxt5 bgr888 bgra8888 rgba16f (vtf); bc1 bc3 bc4 bc5 rgba8 "
                            "rgba16f rgba32f (dds)",
              .applies = "a .vtf or .dds output",
              .help = ".vtf/.dds format; default: VTF DXT1 (DXT5 with alpha); DDS BC5 normals, "
                      "BC4 grey, BC1 colour (docs/textures.md)"},
-    .field = BB__FIELD_ENUM, .offset = AT(job.texture.format),
-    .names = bb__name_texture_format, .parse = bb__parse_texture_format,
+    .job = &bb__row_texture_format, .parse = bb__parse_texture_format,
     .applies = bb__applies_texture};
 
 const bb__option bb__opt_vtf_version = {
-    .info = {.name = "vtf-version", .value_name = "7.N", .type = BB_OPTION_TEXT, .count = 1,
+    .info = {.name = bb__row_vtf_version.name,
+             .value_name = "7.N", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .flags = RECORDED | BB_OPTION_FILES, .default_text = "7.2", .range_text = "7.2..7.5",
              .applies = "a .vtf output",
              .help = "VTF version: 7.2 loads in every Source branch; 7.3 and up keep "
                      "provenance"},
-    .set = set_vtf_version, .print = print_vtf_version, .applies = bb__applies_vtf};
+    .job = &bb__row_vtf_version, .set = set_vtf_version, .applies = bb__applies_vtf};
 
 const bb__option bb__opt_vtf_flags = {
-    .info = {.name = "vtf-flags", .value_name = "HEX", .type = BB_OPTION_TEXT, .count = 1,
+    .info = {.name = bb__row_vtf_flags.name,
+             .value_name = "HEX", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .flags = RECORDED | BB_OPTION_FILES, .default_text = "0",
              .applies = "a .vtf output",
              .help = "TEXTUREFLAGS_* bits added to the map's own (SSBUMP, NORMAL), e.g. 0x4 "
                      "= CLAMPS"},
-    .set = set_vtf_flags, .print = print_vtf_flags, .applies = bb__applies_vtf};
+    .job = &bb__row_vtf_flags, .set = set_vtf_flags, .applies = bb__applies_vtf};
 
 const bb__option bb__opt_nomip = {
-    .info = {.name = "nomip", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
+    .info = {.name = bb__row_nomip.name,
+             .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES, .default_text = "off",
              .applies = "a .vtf or .dds output",
              .help = "write .vtf/.dds without their mip chain (vtex's nomip)"},
-    .sets = {BB__FIELD_INT, AT(job.texture.mips), 0, NULL}, .applies = bb__applies_texture};
+    .job = &bb__row_nomip, .applies = bb__applies_texture};
 
 const bb__option bb__opt_fast_compression = {
-    .info = {.name = "fast-compression", .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
+    .info = {.name = bb__row_fast_compression.name,
+             .type = BB_OPTION_FLAG, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "off", .applies = "a .vtf or .dds output",
              .help = "block-compress DXT1/DXT5 colour with a quicker fit: ~40% less time "
                      "writing, ~0.1 dB lower PSNR"},
-    .sets = {BB__FIELD_INT, AT(job.texture.fast), 1, NULL}, .applies = bb__applies_texture};
+    .job = &bb__row_fast_compression, .applies = bb__applies_texture};
 
 static const bb__option opt_vmt = {
-    .info = {.name = "vmt", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_vmt.name,
+             .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,
              .help = "also write a Source material (LightmappedGeneric) naming the .vtf bump "
                      "map"},
-    .field = BB__FIELD_STRING, .offset = AT(job.vmt)};
+    .job = &bb__row_vmt};
 
 static const bb__option opt_materials = {
-    .info = {.name = "materials", .value_name = "DIR", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_materials.name,
+             .value_name = "DIR", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,
              .default_text = "the folder named materials above the bump map",
              .help = "the game's materials folder the material's paths are relative to"},
-    .field = BB__FIELD_STRING, .offset = AT(job.vmt_materials)};
+    .job = &bb__row_materials};
 
 static const bb__option opt_basetexture = {
-    .info = {.name = "basetexture", .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
+    .info = {.name = bb__row_basetexture.name,
+             .value_name = "FILE", .type = BB_OPTION_PATH, .count = 1,
              .values = 1, .mode = BB_MODE_SINGLE, .flags = RECORDED | BB_OPTION_FILES,
              .help = "the colour .vtf the material names as $basetexture"},
-    .field = BB__FIELD_STRING, .offset = AT(job.vmt_basetexture)};
+    .job = &bb__row_basetexture};
 
 /* --scheduler: a Dask scheduler's address as `dask-scheduler` prints it,
  * PROTOCOL://HOST:PORT or HOST:PORT (tcp), checked here so that a usage

@@ -60,8 +60,9 @@ void bb__option_spelling(const bb__option *o, char *out, size_t cap) {
 void bb__choices(const bb__option *o, char *out, size_t cap) {
   size_t used = 0;
   out[0] = '\0';
-  for (int i = 0; o->names && i < 64; i++) {
-    const char *name = o->names(i);
+  const bb__name_fn names = bb__option_names(o);
+  for (int i = 0; names && i < 64; i++) {
+    const char *name = names(i);
     if (!name || !strcmp(name, "unknown"))
       break;
     if (!strcmp(name, "default") || !name[0]) /* the enum's "not asked", or a value
@@ -74,12 +75,28 @@ void bb__choices(const bb__option *o, char *out, size_t cap) {
   }
 }
 
-static void *field_of(bb_command *c, const bb__option *o) {
-  return (char *)&c->options + o->offset;
+bb__field bb__option_field(const bb__option *o) {
+  return o->job ? o->job->field : o->field;
 }
 
-static const void *field_of_const(const bb_command *c, const bb__option *o) {
-  return (const char *)&c->options + o->offset;
+size_t bb__option_offset(const bb__option *o) {
+  return o->job ? offsetof(bb_command_options, job) + o->job->offset : o->offset;
+}
+
+bb__flag_sets bb__option_sets(const bb__option *o) {
+  if (!o->job)
+    return o->sets;
+  bb__flag_sets s = o->job->sets;
+  s.offset += offsetof(bb_command_options, job);
+  return s;
+}
+
+bb__name_fn bb__option_names(const bb__option *o) {
+  return o->job ? o->job->names : o->names;
+}
+
+static void *field_of(bb_command *c, const bb__option *o) {
+  return (char *)&c->options + bb__option_offset(o);
 }
 
 /* The integer of text: the whole text, decimal. */
@@ -175,12 +192,13 @@ static bb_status parse_word(const bb__option *o, const char *text, int *value, b
 }
 
 /* A given flag's other field (bb__flag_sets). */
-static void set_flag_sets(bb_command *c, const bb__flag_sets *s) {
-  void *field = (char *)&c->options + s->offset;
-  switch (s->field) {
+static void set_flag_sets(bb_command *c, const bb__option *o) {
+  const bb__flag_sets s = bb__option_sets(o);
+  void *field = (char *)&c->options + s.offset;
+  switch (s.field) {
   case BB__FIELD_INT:
-  case BB__FIELD_ENUM: *(int *)field = s->value; break;
-  case BB__FIELD_STRING: *(const char **)field = s->text; break;
+  case BB__FIELD_ENUM: *(int *)field = s.value; break;
+  case BB__FIELD_STRING: *(const char **)field = s.text; break;
   case BB__FIELD_NONE:
   case BB__FIELD_FLOAT:
   case BB__FIELD_DOUBLE:
@@ -197,7 +215,7 @@ static bb_status set_angles(bb_command *c, const bb__option *o, const char *text
   double *angles = field_of(c, o);
   angles[0] = values[0];
   angles[1] = values[1];
-  set_flag_sets(c, &o->sets);
+  set_flag_sets(c, o);
   values[0] = values[1];
   *count = 1;
   return BB_OK;
@@ -208,38 +226,39 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
   char name[80];
   bb__option_spelling(o, name, sizeof name);
   void *field = field_of(c, o);
+  const bb__field kind = bb__option_field(o);
   bb_status st = BB_OK;
   *count = o->info.type == BB_OPTION_INT || o->info.type == BB_OPTION_NUMBER;
   switch (o->info.type) {
   case BB_OPTION_FLAG:
     /* "0" (Python's False) unsets the flag; bb_command_set then counts it
      * as not given. */
-    if (text && !strcmp(text, "0") && o->field == BB__FIELD_INT) {
+    if (text && !strcmp(text, "0") && kind == BB__FIELD_INT) {
       *(int *)field = 0;
       return BB_OK;
     }
     if (text && *text && strcmp(text, "1") != 0)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s takes no value", name);
-    if (o->field == BB__FIELD_INT)
+    if (kind == BB__FIELD_INT)
       *(int *)field = 1;
-    set_flag_sets(c, &o->sets);
+    set_flag_sets(c, o);
     return BB_OK;
   case BB_OPTION_INT:
     st = parse_integer(o, text, &values[0], err);
-    if (st == BB_OK && o->field == BB__FIELD_INT)
+    if (st == BB_OK && kind == BB__FIELD_INT)
       *(int *)field = (int)values[0];
     return st;
   case BB_OPTION_NUMBER:
     st = parse_number(o, text, &values[0], err);
-    if (st == BB_OK && o->field == BB__FIELD_FLOAT)
+    if (st == BB_OK && kind == BB__FIELD_FLOAT)
       *(float *)field = (float)values[0];
-    else if (st == BB_OK && o->field == BB__FIELD_DOUBLE)
+    else if (st == BB_OK && kind == BB__FIELD_DOUBLE)
       *(double *)field = values[0];
     return st;
   case BB_OPTION_WORD: {
     int v = 0;
     st = parse_word(o, text, &v, err);
-    if (st == BB_OK && (o->field == BB__FIELD_ENUM || o->field == BB__FIELD_INT))
+    if (st == BB_OK && (kind == BB__FIELD_ENUM || kind == BB__FIELD_INT))
       *(int *)field = v;
     return st;
   }
@@ -247,7 +266,7 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
   case BB_OPTION_TEXT: {
     if (o->info.type == BB_OPTION_PATH && !*text)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s needs a path (got '')", name);
-    if (o->field != BB__FIELD_STRING)
+    if (kind != BB__FIELD_STRING)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: no field to set", name);
     char *kept = bb__command_keep(c, text);
     if (!kept)
@@ -256,7 +275,7 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
     return BB_OK;
   }
   case BB_OPTION_NUMBERS:
-    if (o->field == BB__FIELD_ANGLES)
+    if (kind == BB__FIELD_ANGLES)
       return set_angles(c, o, text, values, count, err);
     break;
   case BB_OPTION_WORDS:
@@ -274,37 +293,9 @@ void bb__print_floats(bb__text *t, const float *v, int n) {
 }
 
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
-  const void *field = field_of_const(c, o);
-  char buf[48];
-  switch (o->field) {
-  case BB__FIELD_INT:
-    if (o->info.type == BB_OPTION_WORD)
-      bb__text_add(t, o->names(*(const int *)field));
-    else if (o->info.type != BB_OPTION_FLAG)
-      bb__text_printf(t, "%d", *(const int *)field);
-    return;
-  case BB__FIELD_FLOAT:
-    bb__float_text(*(const float *)field, buf, sizeof buf);
-    bb__text_add(t, buf);
-    return;
-  case BB__FIELD_DOUBLE:
-    bb__double_text(*(const double *)field, buf, sizeof buf);
-    bb__text_add(t, buf);
-    return;
-  case BB__FIELD_STRING:
-    bb__text_add(t, *(const char *const *)field);
-    return;
-  case BB__FIELD_ENUM:
-    bb__text_add(t, o->names(*(const int *)field));
-    return;
-  case BB__FIELD_ANGLES: {
-    char el[48];
-    bb__double_text(((const double *)field)[0], buf, sizeof buf);
-    bb__double_text(((const double *)field)[1], el, sizeof el);
-    bb__text_printf(t, "%s,%s", buf, el);
-    return;
-  }
-  case BB__FIELD_NONE:
-    return;
-  }
+  if (o->job)
+    bb__bake_row_value(o->job, &c->options.job, 1, t);
+  else
+    bb__field_text(o->field, o->info.type == BB_OPTION_FLAG, o->names,
+                   (const char *)&c->options + o->offset, 1, t);
 }

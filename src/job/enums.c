@@ -1,7 +1,9 @@
 /* enums.c: the library's enums as the options' words: each parsed by its
  * own parser (with its aliases) and named by its own _name function, so a
- * word list is never typed twice. */
-#include "cmd/cmd_internal.h"
+ * word list is never typed twice. Below the commands, so that the job
+ * writes a bake's options with the words the commands read
+ * (bake_rows.c). */
+#include "job/bake_rows.h"
 
 #include <string.h>
 

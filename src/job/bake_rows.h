@@ -1,0 +1,119 @@
+/* bake_rows.h: the bake's options described once, below the commands (not
+ * public): each row is an option's name, where its value is in
+ * bb_job_options, how the value is written as the command line takes it,
+ * and when it differs from bb_job_options_init's. bb_job_command_text
+ * walks bb__bake_rows to spell a job as `bumpbake bake`; the commands
+ * family's rows of these options (cmd/options_bake.c) point at them for
+ * their name, field, words and printing, and add what only a command needs
+ * (help, ranges, parsers, rules). Also the kinds of field a value is and
+ * the library's enums as words (enums.c), which both families use. */
+#ifndef BB_JOB_BAKE_ROWS_H
+#define BB_JOB_BAKE_ROWS_H
+
+#include "bumpbake.h"
+#include "core/internal.h"
+
+#include <stddef.h>
+
+/* Where an option's value goes: the kind of its field. */
+typedef enum bb__field {
+  BB__FIELD_NONE = 0, /* the option's set function writes it */
+  BB__FIELD_INT,      /* int (flags set 1) */
+  BB__FIELD_FLOAT,
+  BB__FIELD_DOUBLE,
+  BB__FIELD_STRING, /* const char *, owned by the command */
+  BB__FIELD_ENUM,   /* an enum, stored as int (enums of the API are int-sized) */
+  BB__FIELD_ANGLES  /* AZ,EL: double azimuth, then double elevation (the range's);
+                       sets (bb__flag_sets) turns the light or camera on */
+} bb__field;
+
+/* An enum's name for value i ("unknown" or NULL past the last), and its
+ * parser (with the enum's aliases and case rules): 1 and *value, or 0. */
+typedef const char *(*bb__name_fn)(int i);
+typedef int (*bb__parse_fn)(const char *text, int *value);
+
+/* What a FLAG sets when given besides its own field (if any): the field at
+ * offset to value (INT, ENUM) or to text (STRING, a constant). field NONE:
+ * nothing. A flag that sets one cannot be unset ("0"). offset is in the
+ * struct the row describes: bb_job_options for a bake row, and
+ * bb_command_options for a row of the commands' own. */
+typedef struct bb__flag_sets {
+  bb__field field;
+  size_t offset;
+  int value;
+  const char *text;
+} bb__flag_sets;
+
+/* Which bakes write a row: every one, a single bake's (no out_dir), or a
+ * batch's (out_dir). */
+typedef enum bb__row_when {
+  BB__ROW_ALWAYS = 0,
+  BB__ROW_SINGLE,
+  BB__ROW_BATCH
+} bb__row_when;
+
+typedef struct bb__bake_row {
+  char name[24];   /* the option without "--": its one spelling (an array,
+                      so a command's row can name it in a constant) */
+  int flag;        /* takes no value */
+  bb__field field; /* the value, at offset in bb_job_options */
+  size_t offset;
+  bb__name_fn names;  /* an enum's words (ENUM, and INT read as a word) */
+  bb__flag_sets sets; /* a flag's other field, in bb_job_options */
+  /* the value as the option takes it; NULL: by field */
+  void (*print)(const bb_job_options *o, bb__text *t);
+  /* 1 when o's value is not d's (the defaults'); NULL: the field differs,
+   * or for a flag that sets a field, that field holds the flag's value */
+  int (*differs)(const bb_job_options *o, const bb_job_options *d);
+  bb__row_when when;
+} bb__bake_row;
+
+/* The rows, one per option of `bumpbake bake` that determines the output,
+ * each named by its option (-- and '-' as '_'). */
+extern const bb__bake_row bb__row_scale, bb__row_rays, bb__row_slices,
+    bb__row_filter_radius, bb__row_filter_threshold, bb__row_bias, bb__row_power,
+    bb__row_basis, bb__row_normal_filter, bb__row_normal_y, bb__row_clamp,
+    bb__row_channel, bb__row_depth, bb__row_mips, bb__row_bounce, bb__row_bounces,
+    bb__row_bounce_albedo, bb__row_brightness, bb__row_normal, bb__row_weights,
+    bb__row_ssbump, bb__row_ao, bb__row_bent, bb__row_filtered, bb__row_slope,
+    bb__row_lit, bb__row_out_dir, bb__row_maps, bb__row_name, bb__row_texture_format,
+    bb__row_vtf_version, bb__row_vtf_flags, bb__row_nomip, bb__row_fast_compression,
+    bb__row_vmt, bb__row_materials, bb__row_basetexture;
+
+/* The rows in the order of `bumpbake bake --help`, NULL-terminated: the
+ * order a job's command spells them in. */
+extern const bb__bake_row *const bb__bake_rows[];
+
+/* 1 when row r is written for o: o is a bake of the row's kind and its
+ * value differs from d's (bb_job_options_init's). */
+int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
+                         const bb_job_options *d);
+
+/* Row r's value in o as the option takes it (nothing for a flag). plain: a
+ * whole number as typed ("30"), as the commands spell their options; 0: the
+ * shortest %g ("3e+01"), as a job's recorded command always has. */
+void bb__bake_row_value(const bb__bake_row *r, const bb_job_options *o, int plain,
+                        bb__text *t);
+
+/* A value of kind field at `at` as an option takes it: an enum's word (by
+ * names), a number, a string, "AZ,EL"; nothing for a flag (flag) or NONE. */
+void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *at,
+                    int plain, bb__text *t);
+
+/* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
+#define BB__ENUM_WORDS(stem)                                                             \
+  const char *bb__name_##stem(int i);                                                    \
+  int bb__parse_##stem(const char *text, int *value);
+BB__ENUM_WORDS(normal_filter)
+BB__ENUM_WORDS(channel)
+BB__ENUM_WORDS(texture_format)
+BB__ENUM_WORDS(render_mode)
+BB__ENUM_WORDS(albedo_mode)
+BB__ENUM_WORDS(axis)
+BB__ENUM_WORDS(map_kind)
+BB__ENUM_WORDS(depth)
+BB__ENUM_WORDS(normal_y)
+BB__ENUM_WORDS(ssbump_kind)
+BB__ENUM_WORDS(output_kind)
+
+#endif /* BB_JOB_BAKE_ROWS_H */
