@@ -294,8 +294,8 @@ void bb__print_floats(bb__text *t, const float *v, int n) {
 
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
   if (o->job)
-    bb__bake_row_value(o->job, &c->options.job, 1, t);
+    bb__bake_row_value(o->job, &c->options.job, t);
   else
     bb__field_text(o->field, o->info.type == BB_OPTION_FLAG, o->names,
-                   (const char *)&c->options + o->offset, 1, t);
+                   (const char *)&c->options + o->offset, t);
 }

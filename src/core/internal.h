@@ -241,13 +241,9 @@ void bb__text_free(bb__text *t);
 
 /* The shortest decimal that reads back as the same float or double
  * ("36.8083", not "36.8082962"), as a user would type it: a whole number
- * plainly ("30"). The _shortest forms keep the shortest %g as it is
- * ("3e+01"), as a job's recorded command has always spelled it
- * (bb_job_command_text). */
+ * plainly ("30", not the shortest %g "3e+01"). */
 void bb__float_text(float v, char *buf, size_t cap);
 void bb__double_text(double v, char *buf, size_t cap);
-void bb__float_shortest(float v, char *buf, size_t cap);
-void bb__double_shortest(double v, char *buf, size_t cap);
 
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);

@@ -227,11 +227,8 @@ int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
 }
 
 void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *value,
-                    int plain, bb__text *t) {
+                    bb__text *t) {
   char buf[48], el[48];
-  void (*float_text)(float, char *, size_t) = plain ? bb__float_text : bb__float_shortest;
-  void (*double_text)(double, char *, size_t) =
-      plain ? bb__double_text : bb__double_shortest;
   switch (field) {
   case BB__FIELD_INT:
   case BB__FIELD_ENUM:
@@ -241,19 +238,19 @@ void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *va
       bb__text_printf(t, "%d", *(const int *)value);
     return;
   case BB__FIELD_FLOAT:
-    float_text(*(const float *)value, buf, sizeof buf);
+    bb__float_text(*(const float *)value, buf, sizeof buf);
     bb__text_add(t, buf);
     return;
   case BB__FIELD_DOUBLE:
-    double_text(*(const double *)value, buf, sizeof buf);
+    bb__double_text(*(const double *)value, buf, sizeof buf);
     bb__text_add(t, buf);
     return;
   case BB__FIELD_STRING:
     bb__text_add(t, *(const char *const *)value);
     return;
   case BB__FIELD_ANGLES:
-    double_text(((const double *)value)[0], buf, sizeof buf);
-    double_text(((const double *)value)[1], el, sizeof el);
+    bb__double_text(((const double *)value)[0], buf, sizeof buf);
+    bb__double_text(((const double *)value)[1], el, sizeof el);
     bb__text_printf(t, "%s,%s", buf, el);
     return;
   case BB__FIELD_NONE:
@@ -261,12 +258,11 @@ void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *va
   }
 }
 
-void bb__bake_row_value(const bb__bake_row *r, const bb_job_options *o, int plain,
-                        bb__text *t) {
+void bb__bake_row_value(const bb__bake_row *r, const bb_job_options *o, bb__text *t) {
   if (r->flag)
     return;
   if (r->print)
     r->print(o, t);
   else
-    bb__field_text(r->field, r->flag, r->names, at(o, r->offset), plain, t);
+    bb__field_text(r->field, r->flag, r->names, at(o, r->offset), t);
 }

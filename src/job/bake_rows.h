@@ -89,16 +89,14 @@ extern const bb__bake_row *const bb__bake_rows[];
 int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
                          const bb_job_options *d);
 
-/* Row r's value in o as the option takes it (nothing for a flag). plain: a
- * whole number as typed ("30"), as the commands spell their options; 0: the
- * shortest %g ("3e+01"), as a job's recorded command always has. */
-void bb__bake_row_value(const bb__bake_row *r, const bb_job_options *o, int plain,
-                        bb__text *t);
+/* Row r's value in o as the option takes it (nothing for a flag), a
+ * number as a user types it (bb__float_text: "30", "36.8083"). */
+void bb__bake_row_value(const bb__bake_row *r, const bb_job_options *o, bb__text *t);
 
 /* A value of kind field at `at` as an option takes it: an enum's word (by
  * names), a number, a string, "AZ,EL"; nothing for a flag (flag) or NONE. */
 void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *at,
-                    int plain, bb__text *t);
+                    bb__text *t);
 
 /* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
 #define BB__ENUM_WORDS(stem)                                                             \

@@ -31,7 +31,7 @@ char *bb_job_command_text(const bb_job_options *o, const char *input) {
     if (r->flag)
       continue;
     bb__text value = {0};
-    bb__bake_row_value(r, o, 0, &value);
+    bb__bake_row_value(r, o, &value);
     bb__text_add(&t, " ");
     bb__text_add_word(&t, value.data ? value.data : "");
     t.failed |= value.failed;

@@ -15,21 +15,20 @@
 /* A value other than the default for each row, and what it needs given
  * with it (a batch's options need --out-dir; --lit needs --slope). Each is
  * spelled as the job spells it back: the enum's own word (bc3, not its
- * alias dxt5), and no whole number of two digits or more in a float, which
- * the job's record writes as the shortest %g (30 as 3e+01). */
+ * alias dxt5), a number as a user types it. */
 typedef struct sample {
   const char *name, *value; /* value NULL: a flag */
   const char *needs, *needs_value;
 } sample;
 
 static const sample samples[] = {
-    {"scale", "3", NULL, NULL},
+    {"scale", "30", NULL, NULL}, /* a whole number: 30, not "3e+01" */
     {"rays", "64", NULL, NULL},
     {"slices", "12", NULL, NULL},
     {"filter-radius", "3", NULL, NULL},
     {"filter-threshold", "0.25", NULL, NULL},
     {"bias", "0.5", NULL, NULL},
-    {"power", "2", NULL, NULL},
+    {"power", "20", NULL, NULL},
     {"basis", "dirs:6", NULL, NULL},
     {"normal-filter", "valve", NULL, NULL},
     {"normal-y", "up", NULL, NULL},
