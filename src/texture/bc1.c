@@ -428,9 +428,12 @@ static void refine(const block *b, fit *f, int rounds) {
 static void local_search(const block *b, fit *f, int passes) {
   static const int move[6][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}, {1, -1}, {-1, 1}};
   int moved = 0;
-  for (int pass = 0; pass < passes && f->error > 0; pass++) {
+  /* channels tried since the last move: at 3, every channel has been tried
+   * on f as it stands and found no gain, and would find none again */
+  int unmoved = 0;
+  for (int pass = 0; pass < passes && f->error > 0 && unmoved < 3; pass++) {
     const float before = f->error;
-    for (int c = 0; c < 3; c++) {
+    for (int c = 0; c < 3 && unmoved < 3; c++) {
       /* the other channels' part of each texel's distance to each colour,
        * four texels a lane each (as assess) */
       float p[4][3];
@@ -483,7 +486,9 @@ static void local_search(const block *b, fit *f, int passes) {
           best = e, best_a = a, best_b = bq;
       }
       if (best < f->error)
-        f->q[0][c] = best_a, f->q[1][c] = best_b, f->error = best, moved = 1;
+        f->q[0][c] = best_a, f->q[1][c] = best_b, f->error = best, moved = 1, unmoved = 0;
+      else
+        unmoved++;
     }
     if (!(f->error < before))
       break;
@@ -760,7 +765,9 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
     const float v0 = cov[0] * axis[0] + cov[1] * axis[1] + cov[2] * axis[2];
     const float v1 = cov[1] * axis[0] + cov[3] * axis[1] + cov[4] * axis[2];
     const float v2 = cov[2] * axis[0] + cov[4] * axis[1] + cov[5] * axis[2];
-    const float m = fmaxf(fabsf(v0), fmaxf(fabsf(v1), fabsf(v2)));
+    /* the largest magnitude (no NaN here: the texels are clamped) */
+    const float a0 = fabsf(v0), a1 = fabsf(v1), a2 = fabsf(v2);
+    const float m12 = a1 > a2 ? a1 : a2, m = a0 > m12 ? a0 : m12;
     if (!(m > 0))
       break;
     axis[0] = v0 / m, axis[1] = v1 / m, axis[2] = v2 / m;
