@@ -447,19 +447,18 @@ static void local_search(const block *b, fit *f, int passes) {
           rest[j][g] = v4_add(v4_mul(d1, d1), v4_mul(d2, d2));
         }
       const int top = levels[c], qa = f->q[0][c], qb = f->q[1][c];
+      /* a move making both end points one colour needs the others equal */
+      const int others_equal = f->q[0][c1] == f->q[1][c1] && f->q[0][c2] == f->q[1][c2];
       int best_a = qa, best_b = qb;
       float best = f->error;
       for (int m = 0; m < 6; m++) {
         const int a = qa + move[m][0], bq = qb + move[m][1];
         if (a < 0 || a > top || bq < 0 || bq > top)
           continue;
-        int ends[2][3];
-        memcpy(ends, f->q, sizeof ends);
-        ends[0][c] = a, ends[1][c] = bq;
-        if (!f->three && pack(ends[0]) == pack(ends[1])) {
+        if (!f->three && others_equal && a == bq) {
           /* a one-colour block: every channel's colours change */
           fit g = *f;
-          memcpy(g.q, ends, sizeof ends);
+          g.q[0][c] = a, g.q[1][c] = bq;
           assess(b, &g);
           if (g.error < best)
             best = g.error, best_a = a, best_b = bq;
