@@ -413,6 +413,9 @@ static void refine(const block *b, fit *f, int rounds) {
     fit g;
     if (!fit_indices(b, f->index, f->three, &g))
       return;
+    /* the same end points (in the same mode) score the same: no gain */
+    if (g.three == f->three && memcmp(g.q, f->q, sizeof g.q) == 0)
+      return;
     assess(b, &g);
     if (!(g.error < f->error))
       return;
