@@ -77,6 +77,9 @@ static inline float v4_lane(v4 a, int l) {
 static inline v4 v4_div(v4 a, v4 b) {
   return _mm_div_ps(a, b);
 }
+static inline void v4_store(float *p, v4 a) {
+  _mm_storeu_ps(p, a);
+}
 /* round_up (below) of each lane into i[0..3]: floor(x + 0.5) */
 static inline void v4_store_round_up(v4 a, int i[4]) {
   const __m128 y = _mm_add_ps(a, _mm_set1_ps(0.5f));
@@ -133,6 +136,10 @@ static inline v4 v4_trunc(v4 a) {
 #undef V4_LANES
 static inline float v4_lane(v4 a, int l) {
   return a.f[l];
+}
+static inline void v4_store(float *p, v4 a) {
+  for (int l = 0; l < 4; l++)
+    p[l] = a.f[l];
 }
 static inline v4 v4_div(v4 a, v4 b) {
   v4 r;
@@ -712,25 +719,30 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
   int first = 0;
   while (first < 15 && !(mask >> first & 1))
     first++;
-  float lo[3] = {255, 255, 255}, hi[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+  /* each texel's channels a lane each (the fourth, alpha, unused) */
+  const v4 zero = v4_all(0.0f), one = v4_all(1.0f), code = v4_all(255.0f);
+  v4 lo4 = code, hi4 = zero, sum4 = zero;
   b.n = 0;
   for (int i = 0; i < 16; i++) {
     const int in = mask >> i & 1, s = in ? i : first;
     b.w[i] = in ? 1.0f : 0.0f;
-    for (int c = 0; c < 3; c++) {
-      const float v = texels[4 * s + c];
-      const float x = v > 0 ? (v < 1 ? v * 255.0f : 255.0f) : 0.0f; /* NaN: 0 */
-      b.x[c][i] = x;
-      b.rgb1[i][c] = x;
-      lo[c] = x < lo[c] ? x : lo[c];
-      hi[c] = x > hi[c] ? x : hi[c];
-      mean[c] += b.w[i] * x;
-    }
+    const v4 v = v4_load(texels + 4 * s);
+    /* v > 0 ? (v < 1 ? 255 v : 255) : 0 (NaN: 0) */
+    const v4 x = v4_select_lt(zero, v, v4_select_lt(v, one, v4_mul(v, code), code), zero);
+    v4_store(b.rgb1[i], x);
     b.rgb1[i][3] = 1.0f;
+    for (int c = 0; c < 3; c++)
+      b.x[c][i] = b.rgb1[i][c];
+    lo4 = v4_min(x, lo4);
+    hi4 = v4_max(x, hi4);
+    sum4 = v4_add(sum4, v4_mul(v4_all(b.w[i]), x));
     b.n += b.w[i];
   }
-  for (int c = 0; c < 3; c++)
-    mean[c] /= b.n;
+  float lo[3], hi[3], mean[3];
+  for (int c = 0; c < 3; c++) {
+    lo[c] = v4_lane(lo4, c), hi[c] = v4_lane(hi4, c);
+    mean[c] = v4_lane(sum4, c) / b.n;
+  }
   fit best;
   best.error = INFINITY;
   /* One colour (to the 8-bit code): the pair whose in-between colour is
@@ -778,12 +790,25 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
   if (!(len2 > 0)) /* no spread left: the box's diagonal */
     for (int c = 0; c < 3; c++)
       axis[c] = hi[c] - lo[c], len2 += axis[c] * axis[c];
-  float t[16], tmin = 0, tmax = 0;
-  for (int i = 0; i < 16; i++) {
-    t[i] = (b.x[0][i] - mean[0]) * axis[0] + (b.x[1][i] - mean[1]) * axis[1] +
-           (b.x[2][i] - mean[2]) * axis[2];
-    tmin = t[i] < tmin ? t[i] : tmin;
-    tmax = t[i] > tmax ? t[i] : tmax;
+  /* each texel's place along the axis, four texels a lane each; the
+   * extremes from 0 (a minimum or maximum of the same values in any
+   * order: the same bits) */
+  float t[16];
+  v4 tmin4 = zero, tmax4 = zero;
+  for (int g = 0; g < 16; g += 4) {
+    const v4 tg = v4_add(
+        v4_add(v4_mul(v4_sub(v4_load(b.x[0] + g), v4_all(mean[0])), v4_all(axis[0])),
+               v4_mul(v4_sub(v4_load(b.x[1] + g), v4_all(mean[1])), v4_all(axis[1]))),
+        v4_mul(v4_sub(v4_load(b.x[2] + g), v4_all(mean[2])), v4_all(axis[2])));
+    v4_store(t + g, tg);
+    tmin4 = v4_min(tg, tmin4);
+    tmax4 = v4_max(tg, tmax4);
+  }
+  float tmin = 0, tmax = 0;
+  for (int l = 0; l < 4; l++) {
+    const float lmin = v4_lane(tmin4, l), lmax = v4_lane(tmax4, l);
+    tmin = lmin < tmin ? lmin : tmin;
+    tmax = lmax > tmax ? lmax : tmax;
   }
   float ends[2][3];
   for (int c = 0; c < 3; c++) {
