@@ -30,6 +30,30 @@ static void renormalize(bb_image *img) {
   }
 }
 
+/* The level below up when both its sides are even: each texel the mean
+ * of the 2 x 2 above it, summed row by row and scaled, (((a + b) + c) +
+ * d) / 4, which is what OpenImageIO's box resize gives at exactly half
+ * (the same bits: tools' checks on rock06's maps, and the output matrix),
+ * at a small part of its cost (its resize was 430 M instructions of a
+ * 1024 x 1024 VTF write, about a whole PNG write). */
+static bb_status halve_even(const bb_image *up, bb_image *out, bb_error *err) {
+  const int w = up->width / 2, h = up->height / 2;
+  const size_t ch = (size_t)up->channels, row = (size_t)up->width * ch;
+  bb_status st = bb_image_alloc(out, w, h, up->channels, err);
+  if (st != BB_OK)
+    return st;
+  for (int y = 0; y < h; y++) {
+    const float *p = up->pixels + (size_t)(2 * y) * row, *q = p + row;
+    float *o = out->pixels + (size_t)y * (size_t)w * ch;
+    for (size_t x = 0; x < (size_t)w; x++)
+      for (size_t c = 0; c < ch; c++) {
+        const size_t i = 2 * x * ch + c;
+        o[x * ch + c] = (((p[i] + p[i + ch]) + q[i]) + q[i + ch]) / 4.0f;
+      }
+  }
+  return BB_OK;
+}
+
 bb_mip_filter bb__mip_filter(int normal_map) {
   return normal_map ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
 }
@@ -67,8 +91,10 @@ bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **lev
                sizeof(float));
   for (int k = 1; k < n && st == BB_OK; k++) {
     const bb_image *up = &chain[k - 1];
-    st =
-        bb__image_resize_box(up, half_of(up->width), half_of(up->height), &chain[k], err);
+    st = up->width % 2 == 0 && up->height % 2 == 0
+             ? halve_even(up, &chain[k], err)
+             : bb__image_resize_box(up, half_of(up->width), half_of(up->height), &chain[k],
+                                    err);
     if (st == BB_OK && filter == BB_MIP_RENORMALIZE)
       renormalize(&chain[k]);
   }

@@ -74,6 +74,29 @@ static inline float v4_lane(v4 a, int l) {
   _mm_storeu_ps(f, a);
   return f[l];
 }
+static inline v4 v4_div(v4 a, v4 b) {
+  return _mm_div_ps(a, b);
+}
+static inline void v4_store(float *p, v4 a) {
+  _mm_storeu_ps(p, a);
+}
+/* round_up (below) of each lane into i[0..3]: floor(x + 0.5) */
+static inline void v4_store_round_up(v4 a, int i[4]) {
+  const __m128 y = _mm_add_ps(a, _mm_set1_ps(0.5f));
+  const __m128i t = _mm_cvttps_epi32(y);
+  /* (float)t > y: one less (all ones in a mask is -1) */
+  const __m128i over = _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(t), y));
+  _mm_storeu_si128((__m128i *)(void *)i, _mm_add_epi32(t, over));
+}
+/* a < b ? x : y, lane by lane */
+static inline v4 v4_select_lt(v4 a, v4 b, v4 x, v4 y) {
+  const __m128 m = _mm_cmplt_ps(a, b);
+  return _mm_or_ps(_mm_and_ps(m, x), _mm_andnot_ps(m, y));
+}
+/* the lanes (small whole numbers) as ints into i[0..3] */
+static inline void v4_store_int(v4 a, int i[4]) {
+  _mm_storeu_si128((__m128i *)(void *)i, _mm_cvttps_epi32(a));
+}
 #else
 typedef struct {
   float f[4];
@@ -114,7 +137,41 @@ static inline v4 v4_trunc(v4 a) {
 static inline float v4_lane(v4 a, int l) {
   return a.f[l];
 }
+static inline void v4_store(float *p, v4 a) {
+  for (int l = 0; l < 4; l++)
+    p[l] = a.f[l];
+}
+static inline v4 v4_div(v4 a, v4 b) {
+  v4 r;
+  for (int l = 0; l < 4; l++)
+    r.f[l] = a.f[l] / b.f[l];
+  return r;
+}
+static inline void v4_store_round_up(v4 a, int i[4]) {
+  for (int l = 0; l < 4; l++) {
+    const float y = a.f[l] + 0.5f;
+    const int t = (int)y;
+    i[l] = (float)t > y ? t - 1 : t;
+  }
+}
+static inline v4 v4_select_lt(v4 a, v4 b, v4 x, v4 y) {
+  v4 r;
+  for (int l = 0; l < 4; l++)
+    r.f[l] = a.f[l] < b.f[l] ? x.f[l] : y.f[l];
+  return r;
+}
+static inline void v4_store_int(v4 a, int i[4]) {
+  for (int l = 0; l < 4; l++)
+    i[l] = (int)a.f[l];
+}
 #endif
+
+/* The sum of the lanes as bb__sum16 ends: (0 + 1) + (2 + 3). With a lane
+ * per texel of a row of four, each lane summed down the rows first, a
+ * block's sum comes out in bb__sum16's order. */
+static inline float v4_sum(v4 a) {
+  return (v4_lane(a, 0) + v4_lane(a, 1)) + (v4_lane(a, 2) + v4_lane(a, 3));
+}
 
 /* Grid levels of the 5:6:5 channels. */
 static const int levels[3] = {31, 63, 31};
@@ -220,6 +277,7 @@ void bb__bc1_decode(const unsigned char block[8], int four, unsigned char rgba[6
 typedef struct block {
   float x[3][16];
   float w[16];
+  float rgb1[16][4]; /* texel i's R, G, B and 1, for sums over the channels at once */
   float n; /* texels of the image */
 } block;
 
@@ -243,25 +301,35 @@ static void palette_of(const fit *f, float p[4][3]) {
 }
 
 /* f's error, each texel at its nearest colour (the first of equals),
- * and those colours' indices. */
+ * and those colours' indices: four texels at a time, a lane each (each
+ * lane's operations those of one texel, so the same bits as one by one). */
 static void assess(const block *b, fit *f) {
-  float p[4][3], e[16];
+  float p[4][3];
   palette_of(f, p);
-  const float *x0 = b->x[0], *x1 = b->x[1], *x2 = b->x[2];
-  int *index = f->index;
-  for (int i = 0; i < 16; i++) {
-#define DIST(j)                                                                          \
-  ((x0[i] - p[j][0]) * (x0[i] - p[j][0]) + (x1[i] - p[j][1]) * (x1[i] - p[j][1]) +       \
-   (x2[i] - p[j][2]) * (x2[i] - p[j][2]))
-    const float d0 = DIST(0), d1 = DIST(1), d2 = DIST(2), d3 = DIST(3);
-#undef DIST
-    const int c01 = d1 < d0, c23 = d3 < d2;
-    const float m01 = c01 ? d1 : d0, m23 = c23 ? d3 : d2;
-    const int c = m23 < m01;
-    index[i] = c * (2 + c23 - c01) + c01;
-    e[i] = b->w[i] * (c ? m23 : m01);
+  v4 colour[4][3];
+  for (int j = 0; j < 4; j++)
+    for (int c = 0; c < 3; c++)
+      colour[j][c] = v4_all(p[j][c]);
+  const v4 zero = v4_all(0), one = v4_all(1), two = v4_all(2), three = v4_all(3);
+  v4 sum = zero;
+  for (int g = 0; g < 16; g += 4) {
+    const v4 x0 = v4_load(b->x[0] + g), x1 = v4_load(b->x[1] + g),
+             x2 = v4_load(b->x[2] + g);
+    v4 d[4];
+    for (int j = 0; j < 4; j++) {
+      const v4 e0 = v4_sub(x0, colour[j][0]), e1 = v4_sub(x1, colour[j][1]),
+               e2 = v4_sub(x2, colour[j][2]);
+      d[j] = v4_add(v4_add(v4_mul(e0, e0), v4_mul(e1, e1)), v4_mul(e2, e2));
+    }
+    /* nearest of 0 and 1, of 2 and 3, then of the two (ties: the first) */
+    const v4 m01 = v4_min(d[1], d[0]), m23 = v4_min(d[3], d[2]);
+    const v4 i01 = v4_select_lt(d[1], d[0], one, zero);
+    const v4 i23 = v4_select_lt(d[3], d[2], three, two);
+    v4_store_int(v4_select_lt(m23, m01, i23, i01), f->index + g);
+    const v4 e = v4_mul(v4_load(b->w + g), v4_min(m23, m01));
+    sum = g ? v4_add(sum, e) : e;
   }
-  f->error = bb__sum16(e);
+  f->error = v4_sum(sum);
 }
 
 static void keep_better(fit *best, const fit *f) {
@@ -279,15 +347,18 @@ static const int weight6[2][4] = {{6, 0, 4, 2}, {6, 0, 3, 3}};
  * pair's colours alone). 0 when the indices leave the end points free (one
  * class, or only the two equal-weighted ones). */
 static int fit_indices(const block *b, const int index[16], int three, fit *out) {
-  float count[4] = {0, 0, 0, 0}, sum[3][4] = {{0}};
+  /* each class's sums of R, G, B and its count, a lane each (each lane
+   * summed in the texels' order, as one channel at a time would be) */
+  v4 sum[4];
+  for (int j = 0; j < 4; j++)
+    sum[j] = v4_all(0);
   for (int i = 0; i < 16; i++) {
     const int j = index[i];
-    count[j] += b->w[i];
-    for (int c = 0; c < 3; c++)
-      sum[c][j] += b->w[i] * b->x[c][i];
+    sum[j] = v4_add(sum[j], v4_mul(v4_all(b->w[i]), v4_load(b->rgb1[i])));
   }
-  float aa = 0, bb = 0, ab = 0, wa[4];
+  float count[4], aa = 0, bb = 0, ab = 0, wa[4];
   for (int j = 0; j < 4; j++) {
+    count[j] = v4_lane(sum[j], 3);
     wa[j] = (float)weight6[three][j] / 6.0f;
     aa += count[j] * wa[j] * wa[j];
     bb += count[j] * (1.0f - wa[j]) * (1.0f - wa[j]);
@@ -297,28 +368,47 @@ static int fit_indices(const block *b, const int index[16], int three, fit *out)
   if (!(det > 1e-3f))
     return 0;
   out->three = three;
+  /* the three channels side by side, a lane each */
+  v4 ax = v4_all(0), bx = v4_all(0);
+  for (int j = 0; j < 4; j++) {
+    ax = v4_add(ax, v4_mul(v4_all(wa[j]), sum[j]));
+    bx = v4_add(bx, v4_mul(v4_all(1.0f - wa[j]), sum[j]));
+  }
+  const v4 scale = v4_set(31.0f / 255.0f, 63.0f / 255.0f, 31.0f / 255.0f, 0.0f);
+  const v4 vdet = v4_all(det), vaa = v4_all(aa), vbb = v4_all(bb), vab = v4_all(ab);
+  /* the grid points either side of each least-squares end (the nearest
+   * pair when it lies off the grid) */
+  int fa[4], fb[4];
+  v4_store_round_up(
+      v4_sub(v4_mul(v4_div(v4_sub(v4_mul(ax, vbb), v4_mul(bx, vab)), vdet), scale),
+             v4_all(0.5f)),
+      fa);
+  v4_store_round_up(
+      v4_sub(v4_mul(v4_div(v4_sub(v4_mul(bx, vaa), v4_mul(ax, vab)), vdet), scale),
+             v4_all(0.5f)),
+      fb);
   for (int c = 0; c < 3; c++) {
-    float ax = 0, bx = 0;
-    for (int j = 0; j < 4; j++)
-      ax += wa[j] * sum[c][j], bx += (1.0f - wa[j]) * sum[c][j];
     const int top = levels[c];
-    const float scale = (float)top / 255.0f;
-    /* the grid points either side of each least-squares end (the nearest
-     * pair when it lies off the grid) */
-    int fa = round_up((ax * bb - bx * ab) / det * scale - 0.5f);
-    int fb = round_up((bx * aa - ax * ab) / det * scale - 0.5f);
-    fa = fa < 0 ? 0 : fa > top - 1 ? top - 1 : fa;
-    fb = fb < 0 ? 0 : fb > top - 1 ? top - 1 : fb;
-    float best = 0;
-    for (int m = 0; m < 4; m++) {
-      const int qa = fa + (m & 1), qb = fb + (m >> 1);
-      float v[4];
-      channel_colours(c, qa, qb, three, v);
-      float e = 0;
-      for (int j = 0; j < 4; j++)
-        e += v[j] * (count[j] * v[j] - 2.0f * sum[c][j]);
-      if (m == 0 || e < best)
-        best = e, out->q[0][c] = qa, out->q[1][c] = qb;
+    fa[c] = fa[c] < 0 ? 0 : fa[c] > top - 1 ? top - 1 : fa[c];
+    fb[c] = fb[c] < 0 ? 0 : fb[c] > top - 1 ? top - 1 : fb[c];
+  }
+  const v4 twice[4] = {v4_mul(v4_all(2.0f), sum[0]), v4_mul(v4_all(2.0f), sum[1]),
+                       v4_mul(v4_all(2.0f), sum[2]), v4_mul(v4_all(2.0f), sum[3])};
+  float best[3] = {0, 0, 0};
+  for (int m = 0; m < 4; m++) {
+    float v[3][4];
+    for (int c = 0; c < 3; c++)
+      channel_colours(c, fa[c] + (m & 1), fb[c] + (m >> 1), three, v[c]);
+    /* sum over the classes of v (count v - 2 sum), each channel a lane */
+    v4 e = v4_all(0);
+    for (int j = 0; j < 4; j++) {
+      const v4 vj = v4_set(v[0][j], v[1][j], v[2][j], 0.0f);
+      e = v4_add(e, v4_mul(vj, v4_sub(v4_mul(v4_all(count[j]), vj), twice[j])));
+    }
+    for (int c = 0; c < 3; c++) {
+      const float ec = v4_lane(e, c);
+      if (m == 0 || ec < best[c])
+        best[c] = ec, out->q[0][c] = fa[c] + (m & 1), out->q[1][c] = fb[c] + (m >> 1);
     }
   }
   return 1;
@@ -329,6 +419,9 @@ static void refine(const block *b, fit *f, int rounds) {
   for (int r = 0; r < rounds; r++) {
     fit g;
     if (!fit_indices(b, f->index, f->three, &g))
+      return;
+    /* the same end points (in the same mode) score the same: no gain */
+    if (g.three == f->three && memcmp(g.q, f->q, sizeof g.q) == 0)
       return;
     assess(b, &g);
     if (!(g.error < f->error))
@@ -345,31 +438,37 @@ static void refine(const block *b, fit *f, int rounds) {
 static void local_search(const block *b, fit *f, int passes) {
   static const int move[6][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}, {1, -1}, {-1, 1}};
   int moved = 0;
-  for (int pass = 0; pass < passes && f->error > 0; pass++) {
+  /* channels tried since the last move: at 3, every channel has been tried
+   * on f as it stands and found no gain, and would find none again */
+  int unmoved = 0;
+  for (int pass = 0; pass < passes && f->error > 0 && unmoved < 3; pass++) {
     const float before = f->error;
-    for (int c = 0; c < 3; c++) {
-      float p[4][3], rest[4][16];
+    for (int c = 0; c < 3 && unmoved < 3; c++) {
+      /* the other channels' part of each texel's distance to each colour,
+       * four texels a lane each (as assess) */
+      float p[4][3];
       palette_of(f, p);
       const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      v4 rest[4][4];
       for (int j = 0; j < 4; j++)
-        for (int i = 0; i < 16; i++) {
-          const float d1 = b->x[c1][i] - p[j][c1], d2 = b->x[c2][i] - p[j][c2];
-          rest[j][i] = d1 * d1 + d2 * d2;
+        for (int g = 0; g < 4; g++) {
+          const v4 d1 = v4_sub(v4_load(b->x[c1] + 4 * g), v4_all(p[j][c1]));
+          const v4 d2 = v4_sub(v4_load(b->x[c2] + 4 * g), v4_all(p[j][c2]));
+          rest[j][g] = v4_add(v4_mul(d1, d1), v4_mul(d2, d2));
         }
       const int top = levels[c], qa = f->q[0][c], qb = f->q[1][c];
+      /* a move making both end points one colour needs the others equal */
+      const int others_equal = f->q[0][c1] == f->q[1][c1] && f->q[0][c2] == f->q[1][c2];
       int best_a = qa, best_b = qb;
       float best = f->error;
       for (int m = 0; m < 6; m++) {
         const int a = qa + move[m][0], bq = qb + move[m][1];
         if (a < 0 || a > top || bq < 0 || bq > top)
           continue;
-        int ends[2][3];
-        memcpy(ends, f->q, sizeof ends);
-        ends[0][c] = a, ends[1][c] = bq;
-        if (!f->three && pack(ends[0]) == pack(ends[1])) {
+        if (!f->three && others_equal && a == bq) {
           /* a one-colour block: every channel's colours change */
           fit g = *f;
-          memcpy(g.q, ends, sizeof ends);
+          g.q[0][c] = a, g.q[1][c] = bq;
           assess(b, &g);
           if (g.error < best)
             best = g.error, best_a = a, best_b = bq;
@@ -377,22 +476,28 @@ static void local_search(const block *b, fit *f, int passes) {
         }
         float v[4];
         channel_colours(c, a, bq, f->three, v);
-        const float *x = b->x[c];
-        float t[16];
-        for (int i = 0; i < 16; i++) {
-          const float d0 = x[i] - v[0], d1 = x[i] - v[1], d2 = x[i] - v[2],
-                      d3 = x[i] - v[3];
-          const float s0 = rest[0][i] + d0 * d0, s1 = rest[1][i] + d1 * d1;
-          const float s2 = rest[2][i] + d2 * d2, s3 = rest[3][i] + d3 * d3;
-          const float m01 = s1 < s0 ? s1 : s0, m23 = s3 < s2 ? s3 : s2;
-          t[i] = b->w[i] * (m23 < m01 ? m23 : m01);
+        const v4 v0 = v4_all(v[0]), v1 = v4_all(v[1]), v2 = v4_all(v[2]), v3 = v4_all(v[3]);
+        v4 sum = v4_all(0);
+        for (int g = 0; g < 4; g++) {
+          const v4 x = v4_load(b->x[c] + 4 * g);
+          const v4 d0 = v4_sub(x, v0), d1 = v4_sub(x, v1), d2 = v4_sub(x, v2),
+                   d3 = v4_sub(x, v3);
+          const v4 s0 = v4_add(rest[0][g], v4_mul(d0, d0));
+          const v4 s1 = v4_add(rest[1][g], v4_mul(d1, d1));
+          const v4 s2 = v4_add(rest[2][g], v4_mul(d2, d2));
+          const v4 s3 = v4_add(rest[3][g], v4_mul(d3, d3));
+          const v4 t = v4_mul(v4_load(b->w + 4 * g),
+                              v4_min(v4_min(s3, s2), v4_min(s1, s0)));
+          sum = g ? v4_add(sum, t) : t;
         }
-        const float e = bb__sum16(t);
+        const float e = v4_sum(sum);
         if (e < best)
           best = e, best_a = a, best_b = bq;
       }
       if (best < f->error)
-        f->q[0][c] = best_a, f->q[1][c] = best_b, f->error = best, moved = 1;
+        f->q[0][c] = best_a, f->q[1][c] = best_b, f->error = best, moved = 1, unmoved = 0;
+      else
+        unmoved++;
     }
     if (!(f->error < before))
       break;
@@ -614,23 +719,30 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
   int first = 0;
   while (first < 15 && !(mask >> first & 1))
     first++;
-  float lo[3] = {255, 255, 255}, hi[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+  /* each texel's channels a lane each (the fourth, alpha, unused) */
+  const v4 zero = v4_all(0.0f), one = v4_all(1.0f), code = v4_all(255.0f);
+  v4 lo4 = code, hi4 = zero, sum4 = zero;
   b.n = 0;
   for (int i = 0; i < 16; i++) {
     const int in = mask >> i & 1, s = in ? i : first;
     b.w[i] = in ? 1.0f : 0.0f;
-    for (int c = 0; c < 3; c++) {
-      const float v = texels[4 * s + c];
-      const float x = v > 0 ? (v < 1 ? v * 255.0f : 255.0f) : 0.0f; /* NaN: 0 */
-      b.x[c][i] = x;
-      lo[c] = x < lo[c] ? x : lo[c];
-      hi[c] = x > hi[c] ? x : hi[c];
-      mean[c] += b.w[i] * x;
-    }
+    const v4 v = v4_load(texels + 4 * s);
+    /* v > 0 ? (v < 1 ? 255 v : 255) : 0 (NaN: 0) */
+    const v4 x = v4_select_lt(zero, v, v4_select_lt(v, one, v4_mul(v, code), code), zero);
+    v4_store(b.rgb1[i], x);
+    b.rgb1[i][3] = 1.0f;
+    for (int c = 0; c < 3; c++)
+      b.x[c][i] = b.rgb1[i][c];
+    lo4 = v4_min(x, lo4);
+    hi4 = v4_max(x, hi4);
+    sum4 = v4_add(sum4, v4_mul(v4_all(b.w[i]), x));
     b.n += b.w[i];
   }
-  for (int c = 0; c < 3; c++)
-    mean[c] /= b.n;
+  float lo[3], hi[3], mean[3];
+  for (int c = 0; c < 3; c++) {
+    lo[c] = v4_lane(lo4, c), hi[c] = v4_lane(hi4, c);
+    mean[c] = v4_lane(sum4, c) / b.n;
+  }
   fit best;
   best.error = INFINITY;
   /* One colour (to the 8-bit code): the pair whose in-between colour is
@@ -667,7 +779,9 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
     const float v0 = cov[0] * axis[0] + cov[1] * axis[1] + cov[2] * axis[2];
     const float v1 = cov[1] * axis[0] + cov[3] * axis[1] + cov[4] * axis[2];
     const float v2 = cov[2] * axis[0] + cov[4] * axis[1] + cov[5] * axis[2];
-    const float m = fmaxf(fabsf(v0), fmaxf(fabsf(v1), fabsf(v2)));
+    /* the largest magnitude (no NaN here: the texels are clamped) */
+    const float a0 = fabsf(v0), a1 = fabsf(v1), a2 = fabsf(v2);
+    const float m12 = a1 > a2 ? a1 : a2, m = a0 > m12 ? a0 : m12;
     if (!(m > 0))
       break;
     axis[0] = v0 / m, axis[1] = v1 / m, axis[2] = v2 / m;
@@ -676,12 +790,25 @@ void bb__bc1_encode(const float texels[64], int mask, int three, int quick,
   if (!(len2 > 0)) /* no spread left: the box's diagonal */
     for (int c = 0; c < 3; c++)
       axis[c] = hi[c] - lo[c], len2 += axis[c] * axis[c];
-  float t[16], tmin = 0, tmax = 0;
-  for (int i = 0; i < 16; i++) {
-    t[i] = (b.x[0][i] - mean[0]) * axis[0] + (b.x[1][i] - mean[1]) * axis[1] +
-           (b.x[2][i] - mean[2]) * axis[2];
-    tmin = t[i] < tmin ? t[i] : tmin;
-    tmax = t[i] > tmax ? t[i] : tmax;
+  /* each texel's place along the axis, four texels a lane each; the
+   * extremes from 0 (a minimum or maximum of the same values in any
+   * order: the same bits) */
+  float t[16];
+  v4 tmin4 = zero, tmax4 = zero;
+  for (int g = 0; g < 16; g += 4) {
+    const v4 tg = v4_add(
+        v4_add(v4_mul(v4_sub(v4_load(b.x[0] + g), v4_all(mean[0])), v4_all(axis[0])),
+               v4_mul(v4_sub(v4_load(b.x[1] + g), v4_all(mean[1])), v4_all(axis[1]))),
+        v4_mul(v4_sub(v4_load(b.x[2] + g), v4_all(mean[2])), v4_all(axis[2])));
+    v4_store(t + g, tg);
+    tmin4 = v4_min(tg, tmin4);
+    tmax4 = v4_max(tg, tmax4);
+  }
+  float tmin = 0, tmax = 0;
+  for (int l = 0; l < 4; l++) {
+    const float lmin = v4_lane(tmin4, l), lmax = v4_lane(tmax4, l);
+    tmin = lmin < tmin ? lmin : tmin;
+    tmax = lmax > tmax ? lmax : tmax;
   }
   float ends[2][3];
   for (int c = 0; c < 3; c++) {

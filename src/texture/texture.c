@@ -383,13 +383,41 @@ typedef struct level_source {
   int unit_vectors; /* bb_map_kind_info.unit_vectors */
 } level_source;
 
+/* bb__texture_texel for a block's texels, a row at a time: the same
+ * values, with the channel count's case chosen once a row rather than
+ * once a texel (this runs for every texel of every level written). */
 static void level_texels(const void *source, int x0, int y0, int w, int h, float rgba[64]) {
   const level_source *s = source;
-  const size_t width = (size_t)s->level->width;
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++)
-      bb__texture_texel(s->level, s->unit_vectors, (size_t)(y0 + y) * width + (size_t)(x0 + x),
-                        rgba + 4 * (4 * y + x));
+  const bb_image *img = s->level;
+  const size_t width = (size_t)img->width, ch = (size_t)img->channels;
+  for (int y = 0; y < h; y++) {
+    const float *t = img->pixels + ((size_t)(y0 + y) * width + (size_t)x0) * ch;
+    float *o = rgba + 16 * y;
+    switch (img->channels) {
+    case 1:
+      for (int x = 0; x < w; x++)
+        o[4 * x] = o[4 * x + 1] = o[4 * x + 2] = t[x], o[4 * x + 3] = 1.0f;
+      break;
+    case 2:
+      for (int x = 0; x < w; x++)
+        o[4 * x] = t[2 * x], o[4 * x + 1] = t[2 * x + 1], o[4 * x + 2] = 0.0f,
+                o[4 * x + 3] = 1.0f;
+      break;
+    case 3:
+      for (int x = 0; x < w; x++)
+        o[4 * x] = t[3 * x], o[4 * x + 1] = t[3 * x + 1], o[4 * x + 2] = t[3 * x + 2],
+                o[4 * x + 3] = 1.0f;
+      break;
+    default:
+      for (int x = 0; x < w; x++)
+        memcpy(o + 4 * x, t + ch * (size_t)x, 4 * sizeof(float));
+      break;
+    }
+    if (s->unit_vectors)
+      for (int x = 0; x < w; x++)
+        for (int c = 0; c < 3; c++)
+          o[4 * x + c] = 0.5f + 0.5f * o[4 * x + c];
+  }
 }
 
 /* One level in a texel format, texel by texel. */

@@ -1,6 +1,7 @@
 /* test_mips.c: mip chains (sizes, box averages, renormalised normals), the
  * paper's claim that the mip of an ssbump lights like the mean of the lit
- * texels, and mip-mapped TIFF and EXR files read back level by level. */
+ * texels, mip-mapped TIFF and EXR files read back level by level, and the
+ * direct halving of even sides giving OpenImageIO's box resize's bits. */
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -10,6 +11,7 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "image/oiio.h"
 
 static bb_image noise(int w, int h, int channels, unsigned seed, float lo, float hi) {
   bb_image img;
@@ -269,4 +271,35 @@ Test(mips, refusals) {
   bb_image_free(&grey);
   bb_mip_chain_free(levels, count);
   bb_image_free(&img);
+}
+
+Test(mips, even_levels_have_the_bits_of_openimageios_box_resize) {
+  /* bb_mip_chain halves a level with even sides itself (mips.c): each
+   * level must hold the bits OpenImageIO's box resize gives from the one
+   * above, on values of every sign and size (some tiny, some large). */
+  const int channels[3] = {1, 3, 4};
+  for (int k = 0; k < 3; k++) {
+    bb_image img = noise(96, 64, channels[k], 7u + (unsigned)k, -3.0f, 3.0f);
+    const size_t n = (size_t)96 * 64 * (size_t)channels[k];
+    for (size_t i = 0; i < n; i += 7)
+      img.pixels[i] *= i % 3 == 0 ? 1e6f : i % 3 == 1 ? 1e-30f : 1e-40f; /* 1e-40: subnormal */
+    bb_image *levels = NULL;
+    int count = 0;
+    cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count, NULL), BB_OK);
+    cr_assert_eq(count, 7); /* 96 x 64 .. 6 x 4, 3 x 2; then 1 x 1 from odd 3 x 2 */
+    for (int l = 1; l < count; l++) {
+      const bb_image *up = &levels[l - 1];
+      bb_image oiio;
+      cr_assert_eq(bb__image_resize_box(up, levels[l].width, levels[l].height, &oiio, NULL),
+                   BB_OK);
+      const size_t bytes = (size_t)oiio.width * (size_t)oiio.height *
+                           (size_t)oiio.channels * sizeof(float);
+      cr_assert_eq(memcmp(oiio.pixels, levels[l].pixels, bytes), 0,
+                   "%d channels, level %d (%d x %d)", channels[k], l, oiio.width,
+                   oiio.height);
+      bb_image_free(&oiio);
+    }
+    bb_mip_chain_free(levels, count);
+    bb_image_free(&img);
+  }
 }
