@@ -27,6 +27,7 @@ let current = null, previous = null, showB = false;
 let state = null;         // the server's last state
 let loading = 0;          // 1 while a bake's maps are fetched
 let drawPending = false;
+let drawnFrom = "";        // the state's values the picture was last drawn with (showState)
 const bakeScale = {};      // each bake's --scale by id: the depth of its relief
 const bakeBasis = {};      // each bake's basis directions by id: the ssbump's lighting
 const SSBUMP_MODES = [0, 8];  // the modes that light the ssbump with the basis
@@ -581,7 +582,15 @@ function showState(s) {
   }
   showControls();
   showStale();
-  requestDraw();
+  // Drawn again only when what the picture reads from the state changed:
+  // a bake's progress, ten times a second, would draw the same picture
+  // (a SwiftShader draw is CPU the bake needs).
+  const inputs = JSON.stringify([s.params.light_color, s.params.albedo_file, s.params.scale,
+                                 s.bake ? s.bake.normal_y_up : null]);
+  if (inputs !== drawnFrom) {
+    drawnFrom = inputs;
+    requestDraw();
+  }
 }
 
 // The ssbump's lit modes take the bake's 3 basis directions; a basis of
