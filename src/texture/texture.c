@@ -345,17 +345,35 @@ bb_status bb_texture_check(const char *path, int width, int height, int channels
 
 /* ------------------------------------------------------------- encoding */
 
-void bb__texture_texel(const bb_image *img, int unit_vectors, size_t i, float rgba[4]) {
-  const float *t = img->pixels + i * (size_t)img->channels;
+void bb__texture_texels(const bb_image *img, int unit_vectors, size_t i, size_t n,
+                        float *rgba) {
+  const size_t ch = (size_t)img->channels;
+  const float *t = img->pixels + i * ch;
+  float *o = rgba;
   switch (img->channels) {
-  case 1: rgba[0] = rgba[1] = rgba[2] = t[0]; rgba[3] = 1.0f; break;
-  case 2: rgba[0] = t[0]; rgba[1] = t[1]; rgba[2] = 0.0f; rgba[3] = 1.0f; break;
-  case 3: rgba[0] = t[0]; rgba[1] = t[1]; rgba[2] = t[2]; rgba[3] = 1.0f; break;
-  default: memcpy(rgba, t, 4 * sizeof(float)); break;
+  case 1:
+    for (size_t x = 0; x < n; x++)
+      o[4 * x] = o[4 * x + 1] = o[4 * x + 2] = t[x], o[4 * x + 3] = 1.0f;
+    break;
+  case 2:
+    for (size_t x = 0; x < n; x++)
+      o[4 * x] = t[2 * x], o[4 * x + 1] = t[2 * x + 1], o[4 * x + 2] = 0.0f,
+              o[4 * x + 3] = 1.0f;
+    break;
+  case 3:
+    for (size_t x = 0; x < n; x++)
+      o[4 * x] = t[3 * x], o[4 * x + 1] = t[3 * x + 1], o[4 * x + 2] = t[3 * x + 2],
+              o[4 * x + 3] = 1.0f;
+    break;
+  default:
+    for (size_t x = 0; x < n; x++)
+      memcpy(o + 4 * x, t + ch * x, 4 * sizeof(float));
+    break;
   }
   if (unit_vectors)
-    for (int c = 0; c < 3; c++)
-      rgba[c] = 0.5f + 0.5f * rgba[c];
+    for (size_t x = 0; x < n; x++)
+      for (size_t c = 0; c < 3; c++)
+        o[4 * x + c] = 0.5f + 0.5f * o[4 * x + c];
 }
 
 /* Round half up to 0..255, NaN to 0 (as 8-bit image files are written). */
@@ -383,41 +401,13 @@ typedef struct level_source {
   int unit_vectors; /* bb_map_kind_info.unit_vectors */
 } level_source;
 
-/* bb__texture_texel for a block's texels, a row at a time: the same
- * values, with the channel count's case chosen once a row rather than
- * once a texel (this runs for every texel of every level written). */
+/* A block's texels, a row at a time. */
 static void level_texels(const void *source, int x0, int y0, int w, int h, float rgba[64]) {
   const level_source *s = source;
-  const bb_image *img = s->level;
-  const size_t width = (size_t)img->width, ch = (size_t)img->channels;
-  for (int y = 0; y < h; y++) {
-    const float *t = img->pixels + ((size_t)(y0 + y) * width + (size_t)x0) * ch;
-    float *o = rgba + 16 * y;
-    switch (img->channels) {
-    case 1:
-      for (int x = 0; x < w; x++)
-        o[4 * x] = o[4 * x + 1] = o[4 * x + 2] = t[x], o[4 * x + 3] = 1.0f;
-      break;
-    case 2:
-      for (int x = 0; x < w; x++)
-        o[4 * x] = t[2 * x], o[4 * x + 1] = t[2 * x + 1], o[4 * x + 2] = 0.0f,
-                o[4 * x + 3] = 1.0f;
-      break;
-    case 3:
-      for (int x = 0; x < w; x++)
-        o[4 * x] = t[3 * x], o[4 * x + 1] = t[3 * x + 1], o[4 * x + 2] = t[3 * x + 2],
-                o[4 * x + 3] = 1.0f;
-      break;
-    default:
-      for (int x = 0; x < w; x++)
-        memcpy(o + 4 * x, t + ch * (size_t)x, 4 * sizeof(float));
-      break;
-    }
-    if (s->unit_vectors)
-      for (int x = 0; x < w; x++)
-        for (int c = 0; c < 3; c++)
-          o[4 * x + c] = 0.5f + 0.5f * o[4 * x + c];
-  }
+  const size_t width = (size_t)s->level->width;
+  for (int y = 0; y < h; y++)
+    bb__texture_texels(s->level, s->unit_vectors, (size_t)(y0 + y) * width + (size_t)x0,
+                       (size_t)w, rgba + 16 * y);
 }
 
 /* One level in a texel format, texel by texel. */
@@ -427,7 +417,7 @@ static void encode_texels(const bb_image *level, int unit_vectors, bb_texture_fo
   unsigned char *p = out;
   for (size_t i = 0; i < n; i++) {
     float t[4];
-    bb__texture_texel(level, unit_vectors, i, t);
+    bb__texture_texels(level, unit_vectors, i, 1, t);
     switch (format) {
     case BB_TEXTURE_FORMAT_BGR8:
       p[0] = to_byte(t[2]), p[1] = to_byte(t[1]), p[2] = to_byte(t[0]);

@@ -48,10 +48,13 @@ size_t bb__texture_level_bytes(bb_texture_format format, int width, int height);
 /* 1 when format stores an alpha channel. */
 int bb__texture_format_has_alpha(bb_texture_format format);
 
-/* Texel i of img as the engine samples it (see bumpbake.h): R, G, B, A,
- * unit vectors (bb_map_kind_info.unit_vectors) mapped to 0.5 + 0.5 v; not
- * clamped. */
-void bb__texture_texel(const bb_image *img, int unit_vectors, size_t i, float rgba[4]);
+/* Texels i..i+n-1 of img as the engine samples them (see bumpbake.h): R,
+ * G, B, A each into rgba (4 n floats), unit vectors
+ * (bb_map_kind_info.unit_vectors) mapped to 0.5 + 0.5 v; not clamped. The
+ * channel count's case is chosen once a call: a block codec reads a row of
+ * a block at a time. */
+void bb__texture_texels(const bb_image *img, int unit_vectors, size_t i, size_t n,
+                        float *rgba);
 
 /* Encodes levels[0..count-1] into out[k], bb__texture_level_bytes(format,
  * levels[k]) bytes each, little-endian. Block formats compress all the

@@ -93,7 +93,7 @@ static void reflectivity(const bb_image *top, bb_map_kind map, float out[3]) {
   const size_t n = (size_t)top->width * (size_t)top->height;
   for (size_t i = 0; i < n; i++) {
     float t[4];
-    bb__texture_texel(top, unit_vectors, i, t);
+    bb__texture_texels(top, unit_vectors, i, 1, t);
     for (int c = 0; c < 3; c++) {
       double u = t[c] > 0.0f ? (double)t[c] : 0.0;
       u = u < 1.0 ? u : 1.0;
