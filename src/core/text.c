@@ -126,28 +126,20 @@ static void whole_number_plainly(double v, char *buf, size_t cap) {
     snprintf(buf, cap, "%.0f", v);
 }
 
-static void float_shortest(float v, char *buf, size_t cap) {
+void bb__float_text(float v, char *buf, size_t cap) {
   for (int digits = 1; digits <= 9; digits++) {
     snprintf(buf, cap, "%.*g", digits, (double)v);
     if (strtof(buf, NULL) == v)
-      return;
+      break;
   }
-}
-
-static void double_shortest(double v, char *buf, size_t cap) {
-  for (int digits = 1; digits <= 17; digits++) {
-    snprintf(buf, cap, "%.*g", digits, v);
-    if (strtod(buf, NULL) == v)
-      return;
-  }
-}
-
-void bb__float_text(float v, char *buf, size_t cap) {
-  float_shortest(v, buf, cap);
   whole_number_plainly(v, buf, cap);
 }
 
 void bb__double_text(double v, char *buf, size_t cap) {
-  double_shortest(v, buf, cap);
+  for (int digits = 1; digits <= 17; digits++) {
+    snprintf(buf, cap, "%.*g", digits, v);
+    if (strtod(buf, NULL) == v)
+      break;
+  }
   whole_number_plainly(v, buf, cap);
 }

@@ -449,7 +449,7 @@ static void bake_once(serve_state *s, long wanted) {
     s->error[0] = '\0';
     if (!s->quiet) {
       /* a save baked again where it changed says where */
-      const bb_region c = bb_bake_context_changed(s->context);
+      const bb_region c = b->changed;
       char where[96] = "";
       if (c.width < b->width || c.height < b->height)
         snprintf(where, sizeof where, ", again where it changed (%dx%d at %d,%d)", c.width,
