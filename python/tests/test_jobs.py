@@ -185,7 +185,7 @@ def test_a_batchs_options_are_refused_in_a_single_bake(tmp_path, fixtures, kwarg
 def test_an_output_over_an_input_is_an_io_error(tmp_path, fixtures):
     src = tmp_path / "h.png"
     shutil.copy(os.path.join(fixtures, "pit_65x65.png"), src)
-    with pytest.raises(bumpbake.Error, match="output would overwrite the input") as e:
+    with pytest.raises(bumpbake.Error, match="h.png: would overwrite the input ") as e:
         bumpbake.bake_file(src, {"normal": tmp_path / "." / "h.png"}, scale=4)
     assert e.value.status == "i/o error" and not isinstance(e.value, bumpbake.ArgumentError)
 

@@ -2,6 +2,7 @@
  * and sheet), each described once, and those two commands with their
  * rules. */
 #include "cmd/cmd_internal.h"
+#include "core/file_names.h"
 #include "job/job_internal.h"
 #include "render/render_internal.h"
 
@@ -260,11 +261,6 @@ static void render_init(bb_command_options *o) {
   (void)o; /* bb_render_options_init's defaults */
 }
 
-static int has_extension(const char *path, const char *ext) {
-  const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash + 1 : path, '.');
-  return dot && strcasecmp(dot, ext) == 0;
-}
-
 /* The maps the picture reads: the mode's, or all three for --compare. */
 static unsigned needed_maps(const bb_command_options *o) {
   if (o->render_compare)
@@ -375,7 +371,7 @@ static bb_status render_check(bb_command *c, bb_error *err) {
     return BB_OK; /* the generic check says -o is required */
   if (o->orbit && !o->render.dynamic_light)
     return bb__fail(err, BB_ERR_ARGUMENT, "--orbit circles the dynamic light: give --light");
-  if (has_extension(o->output, ".gif")) {
+  if (bb__path_has_extension(o->output, "gif")) {
     if (!o->orbit)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: GIF is for --orbit animations; use .png or .exr", o->output);

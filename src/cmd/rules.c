@@ -4,17 +4,11 @@
  * an option given where its rule says it would do nothing, as --depth 16
  * with a .vtf is refused. */
 #include "cmd/cmd_internal.h"
+#include "core/file_names.h"
 #include "job/job_internal.h"
 
 #include <string.h>
 #include <strings.h>
-
-static int has_extension(const char *path, const char *ext) {
-  if (!path)
-    return 0;
-  const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash + 1 : path, '.');
-  return dot && strcasecmp(dot + 1, ext) == 0;
-}
 
 /* The files c writes whose formats are known before it runs (a batch's
  * name template stands for all of its files); the count. */
@@ -41,7 +35,7 @@ static int any_output(const bb_command *c, const char *ext, const char *also) {
   const char *paths[BB_MAP_BAKED_COUNT + 4];
   const int n = outputs(c, paths);
   for (int i = 0; i < n; i++)
-    if (has_extension(paths[i], ext) || (also && has_extension(paths[i], also)))
+    if (bb__path_has_extension(paths[i], ext) || (also && bb__path_has_extension(paths[i], also)))
       return 1;
   return 0;
 }

@@ -12,6 +12,7 @@
  * handler can walk (bb_tempfiles_remove): only lock-free atomics, unlink(2),
  * rmdir(2) and clock_gettime(2) are used there, all async-signal-safe. */
 
+#include "core/file_names.h"
 #include "core/internal.h"
 #include "files/safe_file.h"
 #include <errno.h>
@@ -123,14 +124,9 @@ void bb_tempfiles_remove(void) {
 
 /* ------------------------------------------------------------ file names */
 
-static const char *base_name(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
 /* The extension of path's last component, with its dot, or "". */
 static const char *extension_of(const char *path) {
-  const char *dot = strrchr(base_name(path), '.');
+  const char *dot = bb__file_extension(path);
   return dot ? dot : "";
 }
 
@@ -140,7 +136,7 @@ static const char *extension_of(const char *path) {
 static char *temp_name(const char *path, const char *ext, uint64_t *seed) {
   static const char ALNUM[] =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
-  const char *base = base_name(path);
+  const char *base = bb__file_name(path);
   size_t dir_len = (size_t)(base - path);
   size_t len = dir_len + sizeof ".bb-tmp-XXXXXX" + strlen(ext);
   char *name = malloc(len);
@@ -653,7 +649,7 @@ bb_status bb__safe_finish(bb_staged_file *f, bb_error *err) {
  * undone, so a directory that refuses fsync (some filesystems do) is not an
  * error of the write. */
 static void sync_directory_of(const char *path) {
-  const char *base = base_name(path);
+  const char *base = bb__file_name(path);
   char dir[PATH_MAX];
   if (base == path)
     snprintf(dir, sizeof dir, ".");

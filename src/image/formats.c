@@ -3,6 +3,7 @@
  * holds, and the checks of a write before any encoder runs. No OpenImageIO
  * here: these are bumpbake's rules. */
 #include "image/formats.h"
+#include "core/file_names.h"
 #include "core/internal.h"
 #include "image/oiio.h"
 #include "texture/texture.h"
@@ -30,27 +31,16 @@ static const format_rule FORMATS[] = {
     {".exr", BB_DEPTH_FLOAT, BIT(BB_DEPTH_HALF) | BIT(BB_DEPTH_FLOAT), 64, 1},
 };
 
-/* The dot of the last component's extension, or NULL. */
-static const char *extension_start(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return strrchr(slash ? slash + 1 : path, '.');
-}
-
 void bb__extension_of(const char *path, char *out, size_t cap) {
   if (!cap) return;
-  const char *dot = path ? extension_start(path) : NULL;
+  const char *dot = bb__file_extension(path);
   size_t n = 0;
   for (; dot && dot[n] && n + 1 < cap; n++) out[n] = (char)tolower((unsigned char)dot[n]);
   out[n] = '\0';
 }
 
-int bb__path_has_extension(const char *path, const char *ext) {
-  const char *dot = path ? extension_start(path) : NULL;
-  return dot && strcasecmp(dot + 1, ext) == 0;
-}
-
 static const format_rule *find_format(const char *path) {
-  const char *dot = path ? extension_start(path) : NULL;
+  const char *dot = bb__file_extension(path);
   if (!dot) return NULL;
   for (size_t i = 0; i < sizeof FORMATS / sizeof FORMATS[0]; i++)
     if (strcasecmp(dot, FORMATS[i].ext) == 0) return &FORMATS[i];

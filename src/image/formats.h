@@ -5,6 +5,7 @@
 #define BB_IMAGE_FORMATS_H
 
 #include "bumpbake.h"
+#include "core/file_names.h" /* bb__path_has_extension */
 
 #include <stddef.h>
 
@@ -15,9 +16,6 @@ extern "C" {
 /* The extension of path's last component, lower-cased, with its dot
  * ("" when it has none), into out (cap bytes, cut to fit). */
 void bb__extension_of(const char *path, char *out, size_t cap);
-
-/* 1 when the extension of path (any case) is ext ("exr", without the dot). */
-int bb__path_has_extension(const char *path, const char *ext);
 
 /* Bytes a sample of path's format takes at depth (BB_DEPTH_DEFAULT: the
  * format's own) in the copy its encoder makes: 1, 2 or 4; 4 for an engine

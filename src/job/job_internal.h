@@ -4,43 +4,20 @@
 #define BB_JOB_INTERNAL_H
 
 #include "bumpbake.h"
+#include "core/file_names.h" /* bb__file_name, bb__file_extension */
+#include "files/file_identity.h"
 
 #include <stddef.h>
 #include <sys/types.h>
 
 /* ------------------------------------------------------------ path parts */
 
-/* The last component of path (after the last '/'). */
-const char *bb__file_name(const char *path);
-
-/* The directory part of path ("." when none) into dir (capacity cap). */
-void bb__directory_part(const char *path, char *dir, size_t cap);
 
 /* normal2ssbump's output without -o, as Valve's tool names it (paths.c):
  * the input up to its first "_normal" (any case), else up to its first
  * '.', then "_ssbump.tga" (malloc'd; NULL when out of memory). */
 char *bb__job_valve_weights_name(const char *input);
 
-/* Which file a path names, worked out once (paths.c): the file itself when
- * it exists, and the directory entry a write of it replaces (its
- * directory's device and inode and its last component) when the directory
- * exists. path and name point into the caller's string. */
-typedef struct bb__file_identity {
-  int exists;
-  dev_t dev;
-  ino_t ino;
-  int dir_exists;
-  dev_t dir_dev;
-  ino_t dir_ino;
-  const char *name;
-  const char *path;
-} bb__file_identity;
-bb__file_identity bb__file_identify(const char *path);
-
-/* 1 when a and b name one file: one existing file under two names (links,
- * "./", ".."), or, for files not made yet, the same name in the same
- * directory however it is spelled; else the same spelling. */
-int bb__same_file_identity(const bb__file_identity *a, const bb__file_identity *b);
 
 /* BB_OK when path's directory exists and is a directory and path itself is
  * nothing yet or a regular file (bb__safe_check_target); else BB_ERR_IO

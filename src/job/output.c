@@ -83,10 +83,7 @@ bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__
 
 /* ---------------------------------------------------------------- frames */
 
-static int is_gif(const char *path) {
-  const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash + 1 : path, '.');
-  return dot && strcasecmp(dot, ".gif") == 0;
-}
+static int is_gif(const char *path) { return bb__path_has_extension(path, "gif"); }
 
 /* What bb_outputs_check checks of o written at path (o's, or a frame's).
  * A GIF animation is written by the animation writer, not bb_image_write:

@@ -16,28 +16,11 @@
 
 /* ------------------------------------------------------------ path parts */
 
-const char *bb__file_name(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
-void bb__directory_part(const char *path, char *dir, size_t cap) {
-  const char *slash = strrchr(path, '/');
-  if (!slash)
-    snprintf(dir, cap, ".");
-  else if (slash == path)
-    snprintf(dir, cap, "/");
-  else
-    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
-}
-
 char *bb_path_with_suffix(const char *path, const char *suffix) {
   if (!path || !suffix)
     return NULL;
-  /* a dot that begins the name (".png") starts no extension, as
-   * Python's os.path.splitext has it */
-  const char *name = bb__file_name(path), *dot = strrchr(name, '.');
-  size_t stem = dot && dot > name ? (size_t)(dot - path) : strlen(path);
+  const char *dot = bb__file_extension(path);
+  size_t stem = dot ? (size_t)(dot - path) : strlen(path);
   size_t len = stem + strlen(suffix) + 1;
   char *out = malloc(len);
   if (out)
@@ -80,37 +63,6 @@ char *bb__job_valve_weights_name(const char *input) {
 }
 
 /* ------------------------------------------------------------ same file */
-
-bb__file_identity bb__file_identify(const char *path) {
-  bb__file_identity id = {0};
-  id.path = path;
-  struct stat st;
-  if (stat(path, &st) == 0) {
-    id.exists = 1;
-    id.dev = st.st_dev;
-    id.ino = st.st_ino;
-  }
-  char dir[PATH_MAX];
-  bb__directory_part(path, dir, sizeof dir);
-  if (stat(dir, &st) == 0) {
-    id.dir_exists = 1;
-    id.dir_dev = st.st_dev;
-    id.dir_ino = st.st_ino;
-  }
-  id.name = bb__file_name(path);
-  return id;
-}
-
-int bb__same_file_identity(const bb__file_identity *a, const bb__file_identity *b) {
-  /* Two names of one existing file (symbolic or hard links, "./", ".."). */
-  if (a->exists && b->exists)
-    return a->dev == b->dev && a->ino == b->ino;
-  /* Files not made yet: the same name in the same directory, however the
-   * directory is spelled. */
-  if (a->dir_exists && b->dir_exists)
-    return a->dir_dev == b->dir_dev && a->dir_ino == b->dir_ino && strcmp(a->name, b->name) == 0;
-  return strcmp(a->path, b->path) == 0;
-}
 
 int bb_same_file(const char *a, const char *b) {
   if (!a || !b)
@@ -251,7 +203,7 @@ bb_status bb__outputs_check(const bb_output_spec *outputs, int count, const char
       st = check_format(o, 0, err);
     for (int r = 0; r < read_count && st == BB_OK; r++)
       if (reads[r] && bb__same_file_identity(&in[r], &ids[k]))
-        st = bb__fail(err, BB_ERR_IO, "%s: output would overwrite the input file", o->path);
+        st = bb__refuse_output_over_input(err, o->path, reads[r]);
     if (st == BB_OK && directories)
       st = bb__check_output_directory(o->path, err);
     if (st == BB_OK && !o->text)

@@ -198,10 +198,7 @@ static bb_status gather_inputs(bb_job *job, const char *const *inputs, int input
  * (after the last dot; "" when none). */
 static void split_name(const char *input, char *stem, size_t stem_cap, char *ext,
                        size_t ext_cap) {
-  const char *base = bb__file_name(input);
-  const char *dot = strrchr(base, '.');
-  if (dot == base) /* ".hidden": all stem */
-    dot = NULL;
+  const char *base = bb__file_name(input), *dot = bb__file_extension(input);
   size_t n = dot ? (size_t)(dot - base) : strlen(base);
   snprintf(stem, stem_cap, "%.*s", (int)n, base);
   snprintf(ext, ext_cap, "%s", dot ? dot + 1 : "");
@@ -336,9 +333,7 @@ static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
     const bb__file_identity out = bb__file_identify(outs[i].path);
     for (int j = 0; j < job->count && out.exists && st == BB_OK; j++)
       if (same_existing_file(&in[j], &out))
-        st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %s of %s would overwrite the input %s",
-                      outs[i].path, kind_name(outs[i].kind), job->items[outs[i].item].input,
-                      job->items[j].input);
+        st = bb__refuse_output_over_input(err, outs[i].path, job->items[j].input);
   }
   if (st == BB_OK && n > 1) {
     qsort(outs, (size_t)n, sizeof *outs, by_path);
@@ -485,8 +480,7 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
       return st;
     for (int p = 0; p < rule.prerequisite_count; p++)
       if (bb_same_file(prereq[p], path))
-        return bb__fail(err, BB_ERR_IO, "%s: the depfile would overwrite a file the bake reads",
-                        path);
+        return bb__refuse_output_over_input(err, path, prereq[p]);
     for (int k = 0; k < t; k++)
       if (bb_same_file(targets[k], path))
         return bb__fail(err, BB_ERR_ARGUMENT, "--depfile %s is also an output of the bake",
@@ -748,7 +742,7 @@ static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err
   }
   if (o->slope_path && o->slope_lit) {
     /* The preview is the map's name with "_lit" before its extension. */
-    const char *dot = strrchr(bb__file_name(o->slope_path), '.');
+    const char *dot = bb__file_extension(o->slope_path);
     const size_t stem = dot ? (size_t)(dot - o->slope_path) : strlen(o->slope_path);
     const size_t len = strlen(o->slope_path) + sizeof "_lit";
     if (!(item->slope_lit_path = malloc(len)))

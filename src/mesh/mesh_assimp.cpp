@@ -6,6 +6,7 @@
 // to the model's directory; mesh_load.c runs it in a child process.
 
 #include "core/input_file.h"
+#include "core/file_names.h"
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
 #include "files/safe_file.h"
@@ -529,8 +530,7 @@ const export_format EXPORTS[] = {
     {".obj", "objnomtl"}, {".ply", "plyb"}, {".stl", "stlb"}, {".glb", "glb2"}};
 
 const export_format *find_export(const char *path) {
-  const char *slash = std::strrchr(path, '/');
-  const char *dot = std::strrchr(slash ? slash + 1 : path, '.');
+  const char *dot = bb__file_extension(path);
   if (!dot) return nullptr;
   std::string ext(dot);
   for (char &c : ext) c = (char)std::tolower((unsigned char)c);

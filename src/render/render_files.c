@@ -1,6 +1,7 @@
 /* render_files.c: what a render reads from files and what its pictures
  * record of them: the map files checked and decoded for their kind, the
  * provenance keys of a render, and the names of an orbit's frames. */
+#include "core/file_names.h"
 #include "core/internal.h"
 
 #include <inttypes.h>
@@ -76,11 +77,6 @@ static int add_line(char **text, size_t *length, const char *key, const char *va
   return 0;
 }
 
-static const char *file_name_of(const char *path) {
-  const char *slash = strrchr(path, '/');
-  return slash ? slash + 1 : path;
-}
-
 char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o) {
   if (!s || !o)
     return NULL;
@@ -97,13 +93,13 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
       if (s->maps[m]) {
         char key[32];
         snprintf(key, sizeof key, "map_%s", bb_map_kind_name((bb_map_kind)m));
-        failed |= add_line(&text, &length, key, file_name_of(s->maps[m]));
+        failed |= add_line(&text, &length, key, bb__file_name(s->maps[m]));
       }
   }
   if (s->albedo) {
     char hash[32];
     snprintf(hash, sizeof hash, "%016" PRIx64, s->albedo_hash);
-    failed |= add_line(&text, &length, "albedo", file_name_of(s->albedo));
+    failed |= add_line(&text, &length, "albedo", bb__file_name(s->albedo));
     failed |= add_line(&text, &length, "albedo_hash", hash);
   }
   char *options = bb_render_options_describe(o);
@@ -136,7 +132,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
 char *bb_render_frame_path(const char *output, int frame, int frames) {
   if (!output)
     return NULL;
-  const char *dot = strrchr(file_name_of(output), '.');
+  const char *dot = bb__file_extension(output);
   size_t stem = dot ? (size_t)(dot - output) : strlen(output);
   size_t len = strlen(output) + 8;
   char *path = malloc(len);

@@ -1,6 +1,7 @@
 /* texture.c: what the VTF and DDS writers share: formats, checks, the mip
  * chain and the encoding of a level (see texture.h). */
 
+#include "core/file_names.h"
 #include "core/internal.h"
 #include "texture/blocks.h"
 #include "texture/texture.h"
@@ -164,8 +165,7 @@ void bb_texture_options_init(bb_texture_options *o) {
 /* ------------------------------------------------------------- checks */
 
 bb__container bb__texture_container(const char *path) {
-  const char *slash = path ? strrchr(path, '/') : NULL;
-  const char *dot = path ? strrchr(slash ? slash : path, '.') : NULL;
+  const char *dot = bb__file_extension(path);
   if (!dot)
     return BB__CONTAINER_NONE;
   if (strcasecmp(dot, ".vtf") == 0)

@@ -1,6 +1,7 @@
 /* vmt.c: Source material files (.vmt) naming a bake's VTF textures. */
 
 #include "core/internal.h"
+#include "files/file_identity.h"
 
 #include <limits.h>
 #include <stdio.h>
@@ -119,9 +120,10 @@ static int find_materials(const char *bumpmap, char *out, size_t cap) {
 /* 1 when a and b both exist and are one file (hard links, a symbolic
  * link to the other, a directory spelled two ways). */
 static int same_existing_file(const char *a, const char *b) {
-  struct stat sa, sb;
-  return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-         sa.st_ino == sb.st_ino;
+  if (!a || !b)
+    return 0;
+  const bb__file_identity ia = bb__file_identify(a), ib = bb__file_identify(b);
+  return ia.exists && ib.exists && bb__same_file_identity(&ia, &ib);
 }
 
 /* The material's own name: a .vmt, and not a texture it names (a texture
