@@ -2684,6 +2684,12 @@ typedef struct bb_job_options {
  * the texture defaults (bb_texture_options_init), no outputs. */
 void bb_job_options_init(bb_job_options *o);
 
+/* The file a bake with options o writes for map kind, the one rule for
+ * it: o->paths[kind] when named, else -o PREFIX's bb_job_prefix_path for
+ * the kinds of BB_JOB_DEFAULT_MAPS, else none. *path is a malloc'd copy,
+ * or NULL for none; BB_ERR_MEMORY when out of memory. */
+bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err);
+
 /* A planned job: opaque. */
 typedef struct bb_job bb_job;
 

@@ -13,10 +13,10 @@
 #include <string.h>
 #include <unistd.h>
 
-/* The write action's files: as bake's -o PREFIX names them
- * (bb_job_prefix_path), spelled out one by one (--normal P_normal.png ...)
- * so that the command line the page shows is the whole job; PREFIX
- * defaults to HEIGHT without its extension. */
+/* The write action's files: as bake names them (bb_job_map_file), spelled
+ * out one by one (--normal P_normal.png ...) so that the command line the
+ * page shows is the whole job; with no output named, -o PREFIX defaults to
+ * HEIGHT without its extension. */
 static int name_outputs(bb_job_options *job, const char *height) {
   int named = 0;
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
@@ -24,11 +24,11 @@ static int name_outputs(bb_job_options *job, const char *height) {
   if (named && !job->prefix)
     return 0; /* the outputs the command line named, and only those */
   char *stem = job->prefix ? NULL : bb_path_with_suffix(height, "");
-  const char *prefix = job->prefix ? job->prefix : stem;
-  int rc = prefix ? 0 : -1;
+  bb_job_options with = *job;
+  with.prefix = job->prefix ? job->prefix : stem;
+  int rc = with.prefix ? 0 : -1;
   for (int k = 0; k < BB_MAP_BAKED_COUNT && rc == 0; k++)
-    if ((BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k)) && !job->paths[k] &&
-        !(job->paths[k] = bb_job_prefix_path(prefix, (bb_map_kind)k))) /* kept */
+    if (bb_job_map_file(&with, (bb_map_kind)k, &job->paths[k], NULL) != BB_OK) /* kept */
       rc = -1;
   free(stem);
   job->prefix = NULL;

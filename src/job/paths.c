@@ -39,6 +39,19 @@ char *bb_job_prefix_path(const char *prefix, bb_map_kind kind) {
   return path;
 }
 
+bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err) {
+  *path = NULL;
+  if ((unsigned)kind >= BB_MAP_BAKED_COUNT)
+    return BB_OK;
+  if (o->paths[kind])
+    *path = strdup(o->paths[kind]);
+  else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(kind)))
+    *path = bb_job_prefix_path(o->prefix, kind);
+  else
+    return BB_OK;
+  return *path ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
+}
+
 /* Valve's normal2ssbump output name: the input up to its first "_normal"
  * (any case), else up to its first '.', then "_ssbump.tga". Valve's tool
  * searches the whole path; this searches the file name only, so a directory

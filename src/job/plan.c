@@ -732,13 +732,9 @@ static bb_status name_more(bb_job *job, const bb_job_options *o, const bb__job_m
 static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err) {
   bb__job_item *item = &job->items[0];
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    if (o->paths[k]) {
-      if (!(item->paths[k] = strdup(o->paths[k])))
-        return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-    } else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(k))) {
-      if (!(item->paths[k] = bb_job_prefix_path(o->prefix, (bb_map_kind)k)))
-        return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-    }
+    bb_status st = bb_job_map_file(o, (bb_map_kind)k, &item->paths[k], err);
+    if (st != BB_OK)
+      return st;
   }
   if (o->slope_path && o->slope_lit) {
     /* The preview is the map's name with "_lit" before its extension. */
