@@ -72,8 +72,7 @@ extern const bb__range bb__range_height_scale, bb__range_rays, bb__range_slices,
  * memory estimate, the ray set) reads out->slices and checks nothing. */
 bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err);
 /* bb__bake_prepare without the check, for options already checked (a
- * command's, cmd/): the one place rays become slices (and a bounce albedo
- * map without a rho bounces with rho 1). */
+ * command's, cmd/): the one place rays become slices. */
 void bb__bake_resolve(bb_bake_options *o);
 
 /* bb_bake for a caller that only writes the maps (the job), which lets go

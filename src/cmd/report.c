@@ -3,6 +3,7 @@
  * --scheduler run in Python, which calls these with the reports its
  * cluster sent back. */
 #include "bumpbake.h"
+#include "job/job_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -61,8 +62,9 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
   bb_json_string(&j, "channel", bb_height_source_channel(&r->source));
   bb_json_number(&j, "threads", r->threads);
   if (r->bounces > 0) {
-    /* as provenance: rho (1 for an albedo map alone) and the count asked */
-    bb_json_number(&j, "bounce", b->bounce_albedo > 0.0 ? b->bounce_albedo : 1.0);
+    /* as provenance: the rho used (a bounce ran, so a rho of 0 came with
+     * an albedo map) and the count asked */
+    bb_json_number(&j, "bounce", bb__bounce_rho(b->bounce_albedo, 1));
     bb_json_number(&j, "bounces", b->bounces);
   }
   bb_json_close(&j, '}');

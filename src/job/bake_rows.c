@@ -5,6 +5,7 @@
  * --bounce-albedo, --lit needs --slope, a batch writes --out-dir, --maps
  * and --name and a single bake its map files. */
 #include "job/bake_rows.h"
+#include "job/job_internal.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -32,10 +33,11 @@ static int basis_differs(const bb_job_options *o, const bb_job_options *d) {
   return o->basis_file || strcmp(o->bake.basis.name, d->bake.basis.name) != 0;
 }
 
-/* --bounce 1 is what --bounce-albedo FILE means unless told. */
+/* --bounce is written when the rho it gives differs from the one the
+ * command means without it (bb__bounce_rho: 1 with --bounce-albedo). */
 static int bounce_differs(const bb_job_options *o, const bb_job_options *d) {
-  return o->bake.bounce_albedo != d->bake.bounce_albedo &&
-         !(o->bounce_albedo_file && o->bake.bounce_albedo == 1.0);
+  const int map = o->bounce_albedo_file != NULL;
+  return bb__bounce_rho(o->bake.bounce_albedo, map) != bb__bounce_rho(d->bake.bounce_albedo, map);
 }
 
 /* --lit lights the slope map: nothing without one. */

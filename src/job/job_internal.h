@@ -24,6 +24,14 @@ char *bb__job_valve_weights_name(const char *input);
  * "PATH: cannot write: ...". */
 bb_status bb__check_output_directory(const char *path, bb_error *err);
 
+/* ------------------------------------------------------------ the bounce */
+
+/* The rho a bake bounces with, the job's one rule for it: the rho asked,
+ * or 1 when none is (0) and an albedo map is given (bake --bounce-albedo
+ * FILE without --bounce: the map bounces as it is). bb_bake itself ignores
+ * a map while rho is 0, as bumpbake.h says. */
+double bb__bounce_rho(double asked, int albedo_map);
+
 /* --------------------------------------------------------------- depfiles */
 
 /* One rule of a depfile: every target depends on every prerequisite. */

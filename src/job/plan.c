@@ -36,6 +36,10 @@ void bb_job_options_init(bb_job_options *o) {
   bb_texture_options_init(&o->texture);
 }
 
+double bb__bounce_rho(double asked, int albedo_map) {
+  return asked == 0.0 && albedo_map ? 1.0 : asked;
+}
+
 /* ----------------------------------------------------------------- inputs */
 
 /* 1 when a and b are one existing file (an input named twice, an output
@@ -865,12 +869,9 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
     st = bb__bake_prepare(&job->options.bake, &job->options.bake, err);
   if (st == BB_OK)
     st = read_bake_maps(job, err);
-  /* The job's rule (bake --bounce-albedo FILE without --bounce): a map
-   * alone bounces with its albedo as it is, rho 1. bb_bake itself ignores a
-   * map while rho is 0, as bumpbake.h says. */
-  if (st == BB_OK && job->options.bake.bounce_albedo_map &&
-      job->options.bake.bounce_albedo == 0.0)
-    job->options.bake.bounce_albedo = 1.0;
+  if (st == BB_OK)
+    job->options.bake.bounce_albedo = bb__bounce_rho(job->options.bake.bounce_albedo,
+                                                     job->options.bake.bounce_albedo_map != NULL);
   if (st == BB_OK && job->batch)
     st = check_template(job->name_template, err);
   if (st == BB_OK)
