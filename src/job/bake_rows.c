@@ -124,8 +124,8 @@ const bb__bake_row bb__row_slope = {ROW("slope", STRING, slope_path),
 const bb__bake_row bb__row_lit = {ROW("lit", ANGLES, slope_lit_azimuth),
                                   .sets = {BB__FIELD_INT, AT(slope_lit), 1, NULL},
                                   .differs = lit_differs, .when = BB__ROW_SINGLE};
-const bb__bake_row bb__row_out_dir = {ROW("out-dir", STRING, out_dir),
-                                      .when = BB__ROW_BATCH};
+/* --out-dir is what makes a batch: any bake may give it. */
+const bb__bake_row bb__row_out_dir = {ROW("out-dir", STRING, out_dir)};
 const bb__bake_row bb__row_maps = {.name = "maps",
                                    .names = bb__name_output_kind,
                                    .print = print_maps,
@@ -145,9 +145,12 @@ const bb__bake_row bb__row_fast_compression = {
     .name = "fast-compression",
     .flag = 1,
     .sets = {BB__FIELD_INT, AT(texture.fast), 1, NULL}};
-const bb__bake_row bb__row_vmt = {ROW("vmt", STRING, vmt)};
-const bb__bake_row bb__row_materials = {ROW("materials", STRING, vmt_materials)};
-const bb__bake_row bb__row_basetexture = {ROW("basetexture", STRING, vmt_basetexture)};
+/* One material for one bake: a batch refuses them (plan.c). */
+const bb__bake_row bb__row_vmt = {ROW("vmt", STRING, vmt), .when = BB__ROW_SINGLE};
+const bb__bake_row bb__row_materials = {ROW("materials", STRING, vmt_materials),
+                                        .when = BB__ROW_SINGLE};
+const bb__bake_row bb__row_basetexture = {ROW("basetexture", STRING, vmt_basetexture),
+                                          .when = BB__ROW_SINGLE};
 
 const bb__bake_row *const bb__bake_rows[] = {&bb__row_scale,
                                              &bb__row_rays,

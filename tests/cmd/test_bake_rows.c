@@ -199,6 +199,13 @@ Test(bake_rows, bakes_recorded_options_are_the_rows_in_help_order) {
                  bb__bake_rows[next]->name);
     cr_expect_str_eq(info->name, o->job->name);
     cr_expect_eq(o->job->flag, info->type == BB_OPTION_FLAG, "--%s", info->name);
+    /* The use an option belongs to, as --help says it and as the job's
+     * command writes it, is one: a single bake's, a batch's or any. */
+    static const bb_option_mode mode_of_when[] = {
+        [BB__ROW_ALWAYS] = BB_MODE_ANY, [BB__ROW_SINGLE] = BB_MODE_SINGLE,
+        [BB__ROW_BATCH] = BB_MODE_BATCH};
+    cr_expect_eq(info->mode, mode_of_when[o->job->when],
+                 "--%s: --help gives it to one use, the job's row to another", info->name);
     next++;
   }
   cr_expect_null(bb__bake_rows[next], "the row --%s is no option of bake",
