@@ -97,20 +97,15 @@ class BakeJob:
     and write_depfile().
     """
 
-    def __init__(self, inputs, out_dir=None, *, maps=None, name=None, outputs=None,
-                 prefix=None, slope=None, lit=None, force=False, keep_going=False,
-                 depfile=None, depth=None, mips=False, channel=None, scale=None,
-                 notes="warn", command=None, command_options=None, texture_format=None,
-                 vtf_version=None, vtf_flags=None, nomip=False, fast_compression=False,
-                 vmt=None, materials=None, basetexture=None, _trace=None, **options):
-        self._args = dict(out_dir=out_dir, maps=maps, name=name, outputs=outputs, prefix=prefix,
-                          slope=slope, lit=lit, force=force, keep_going=keep_going,
-                          depfile=depfile, depth=depth, mips=mips, channel=channel,
-                          scale=scale, notes=notes, command=command,
-                          command_options=command_options, texture_format=texture_format,
-                          vtf_version=vtf_version, vtf_flags=vtf_flags, nomip=nomip,
-                          fast_compression=fast_compression, vmt=vmt, materials=materials,
-                          basetexture=basetexture, **options)
+    # The keywords Python reads itself; every other keyword is the `bake`
+    # command's option of that name (maps, name, scale, depfile, vmt...),
+    # spelled, checked and refused by the library's option rows.
+    def __init__(self, inputs, out_dir=None, *, outputs=None, prefix=None, force=False,
+                 keep_going=False, notes="warn", command=None, command_options=None,
+                 _trace=None, **options):
+        self._args = dict(out_dir=out_dir, outputs=outputs, prefix=prefix, force=force,
+                          keep_going=keep_going, notes=notes, command=command,
+                          command_options=command_options, **options)
         self._notes_policy = _check_notes(notes)
         self._trace = _trace  # a bb_trace_fn callback, kept alive with the job
         if isinstance(inputs, (str, bytes, os.PathLike)):
