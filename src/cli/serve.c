@@ -27,9 +27,12 @@ static int name_outputs(bb_job_options *job, const char *height) {
   bb_job_options with = *job;
   with.prefix = job->prefix ? job->prefix : stem;
   int rc = with.prefix ? 0 : -1;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT && rc == 0; k++)
-    if (bb_job_map_file(&with, (bb_map_kind)k, &job->paths[k], NULL) != BB_OK) /* kept */
+  for (int k = 0; k < BB_MAP_BAKED_COUNT && rc == 0; k++) {
+    char *path = NULL;
+    if (bb_job_map_file(&with, (bb_map_kind)k, &path, NULL) != BB_OK)
       rc = -1;
+    job->paths[k] = path; /* kept */
+  }
   free(stem);
   job->prefix = NULL;
   return rc;
