@@ -85,7 +85,7 @@ static inline void harness_set_limit(int resource, long value) {
  * a program that loads OpenImageIO's 260 libraries (0.25 to 0.3 s of CPU in
  * the dynamic linker each time). HARNESS_EXEC: fork and exec the binary:
  * for what is about the process itself (its peak memory, its start-up, its
- * resource limits, signals sent to it) and for `serve`, which the test
+ * address-space limit, signals sent to it) and for `serve`, which the test
  * binary does not link. */
 typedef enum { HARNESS_CALL, HARNESS_EXEC } harness_how;
 
@@ -243,11 +243,15 @@ static inline cli_result harness_run_how(const char *cwd, const run_limits *lim,
   return r;
 }
 
-/* Runs the binary under lim (exec: an address-space limit and the peak
- * memory are the program's own, not this test process's copy). */
+/* Runs bumpbake under lim: the binary when an address space is limited
+ * or none is (an address-space limit and the peak memory of a memory test
+ * are the program's own, not a copy of this test process), the CLI's code
+ * in a forked child under a file-size limit alone (it bounds the child's
+ * writes either way). */
 static inline cli_result harness_run_limited(const char *cwd, const run_limits *lim,
                                              const char *const *args) {
-  return harness_run_how(cwd, lim, args, HARNESS_EXEC);
+  const int file_size_alone = lim->file_size_bytes >= 0 && lim->address_space_bytes < 0;
+  return harness_run_how(cwd, lim, args, file_size_alone ? HARNESS_CALL : HARNESS_EXEC);
 }
 
 /* Runs the binary itself: for a test of its peak memory or its start. */
