@@ -9,6 +9,15 @@
 
 #include "cli/cli.h"
 
+/* Under AddressSanitizer (make DEBUG=1) the executed program checks for
+ * leaks at its exit; a called CLI leaves by _exit, so it checks first. */
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/lsan_interface.h>
+#define HARNESS_LEAK_CHECK() __lsan_do_leak_check()
+#else
+#define HARNESS_LEAK_CHECK() ((void)0)
+#endif
+
 #include <dirent.h>
 #include <ftw.h>
 #include <signal.h>
@@ -193,6 +202,7 @@ static inline pid_t harness_start(const char *cwd, const run_limits *lim,
       /* the program's exit, less the test's atexit handlers (Criterion's) */
       int code = cli_main(argc, (char **)argv, NULL);
       fflush(NULL);
+      HARNESS_LEAK_CHECK(); /* ends the child with LeakSanitizer's code on a leak */
       _exit(code);
     }
     execv(binary, (char *const *)argv);
