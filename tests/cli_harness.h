@@ -1,10 +1,22 @@
-/* cli_harness.h: running the bumpbake binary from a Criterion test (fork +
- * exec, stdout and stderr captured) and a temporary directory per test.
+/* cli_harness.h: running bumpbake from a Criterion test (fork, then the
+ * CLI's code called in the child or the binary executed: harness_start;
+ * stdout and stderr captured) and a temporary directory per test.
  * Header-only: each test file that runs the CLI includes it once. */
 #ifndef BB_CLI_HARNESS_H
 #define BB_CLI_HARNESS_H
 
 #include <criterion/criterion.h>
+
+#include "cli/cli.h"
+
+/* Under AddressSanitizer (make DEBUG=1) the executed program checks for
+ * leaks at its exit; a called CLI leaves by _exit, so it checks first. */
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/lsan_interface.h>
+#define HARNESS_LEAK_CHECK() __lsan_do_leak_check()
+#else
+#define HARNESS_LEAK_CHECK() ((void)0)
+#endif
 
 #include <dirent.h>
 #include <ftw.h>
@@ -76,20 +88,97 @@ static inline void harness_set_limit(int resource, long value) {
     _exit(125);
 }
 
-/* Forks and execs bumpbake with args (NULL-terminated, without argv[0]) in
- * cwd (NULL = ours) under lim, stdout and stderr to out and err: no shell,
- * so nothing is reinterpreted. Returns the pid. */
-static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
-                                  const char *const *args, FILE *out, FILE *err) {
+/* How a run starts. HARNESS_CALL: fork, and the child calls the CLI's
+ * entry (cli_main, program_entry.c, linked into this binary) and exits
+ * with its code: the same code as build/bumpbake without a second exec of
+ * a program that loads OpenImageIO's 260 libraries (0.25 to 0.3 s of CPU in
+ * the dynamic linker each time). HARNESS_EXEC: fork and exec the binary:
+ * for what is about the process itself (its peak memory, its start-up, its
+ * address-space limit, signals sent to it) and for `serve`, which the test
+ * binary does not link. */
+typedef enum { HARNESS_CALL, HARNESS_EXEC } harness_how;
+
+/* Number of threads of this process (/proc/self/status), 0 if unknown. */
+static inline int harness_threads(void) {
+  FILE *f = fopen("/proc/self/status", "r");
+  if (!f)
+    return 0;
+  char line[256];
+  int n = 0;
+  while (fgets(line, sizeof line, f))
+    if (sscanf(line, "Threads: %d", &n) == 1)
+      break;
+  fclose(f);
+  return n;
+}
+
+/* Threads of the test process when its test began (harness_setup): the
+ * main one and those every process of this binary has before any test
+ * code runs (Criterion's, and a logging library's idle pool that
+ * OpenImageIO's dependencies start when they load); 0 before. */
+static int harness_threads_at_setup;
+
+/* Whether a run may call the CLI in a forked child: only when the test
+ * has started no thread that is still alive (a fork copies no other
+ * thread, so a pool the test started, OpenImageIO's or bumpbake's, would
+ * be left in the child without its threads), when BB_BIN
+ * names the bumpbake built beside this test binary (the CLI linked in is
+ * then the one BB_BIN would run; another binary is run as it is), when
+ * BB_CLI_EXEC is unset or 0 (BB_CLI_EXEC=1 runs every CLI test by exec)
+ * and when the command is not serve. */
+static inline int harness_may_call(const char *const *args) {
+  static int same_binary = -1;
+  if (same_binary < 0) {
+    char self[4096], beside[4200];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    same_binary = 0;
+    if (n > 0) {
+      self[n] = '\0';
+      char *slash = strrchr(self, '/');
+      if (slash) {
+        *slash = '\0';
+        snprintf(beside, sizeof beside, "%s/bumpbake", self);
+        char resolved[4096];
+        same_binary = realpath(beside, resolved) && !strcmp(resolved, harness_binary());
+      }
+    }
+  }
+  const char *force = getenv("BB_CLI_EXEC");
+  return same_binary && !(force && *force && strcmp(force, "0")) &&
+         !(args[0] && !strcmp(args[0], "serve")) && harness_threads_at_setup > 0 &&
+         harness_threads() == harness_threads_at_setup;
+}
+
+/* The state exec gives a program: a signal the test caught is back to its
+ * default (ignored ones stay ignored, the mask is kept, as across exec). */
+static inline void harness_exec_signal_state(void) {
+  for (int sig = 1; sig <= SIGRTMAX; sig++) {
+    struct sigaction sa;
+    if (sig == SIGKILL || sig == SIGSTOP || sigaction(sig, NULL, &sa) != 0)
+      continue;
+    if (sa.sa_handler != SIG_IGN && sa.sa_handler != SIG_DFL)
+      signal(sig, SIG_DFL);
+  }
+}
+
+/* Forks and runs bumpbake with args (NULL-terminated, without argv[0]) in
+ * cwd (NULL = ours) under lim, stdout and stderr to out and err, as how
+ * says (HARNESS_CALL falls back to exec where harness_may_call says no): no
+ * shell, so nothing is reinterpreted. Returns the pid. */
+static inline pid_t harness_start(const char *cwd, const run_limits *lim,
+                                  const char *const *args, FILE *out, FILE *err,
+                                  harness_how how) {
   const char *argv[64] = {"bumpbake"};
+  int argc = 1;
   for (int i = 0; args[i]; i++) {
     cr_assert_lt(i, 62, "too many arguments");
-    argv[i + 1] = args[i];
+    argv[argc++] = args[i];
   }
   /* Resolved here, not in the child: the child may chdir first, and a
    * failed assertion there would report from a process Criterion does not
    * know. */
   const char *binary = harness_binary();
+  const int call = how == HARNESS_CALL && harness_may_call(args);
   fflush(NULL);
   pid_t pid = fork();
   cr_assert(pid >= 0);
@@ -98,6 +187,8 @@ static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
     dup2(fileno(err), STDERR_FILENO);
     if (cwd && chdir(cwd) != 0)
       _exit(126);
+    if (call)
+      harness_exec_signal_state();
     /* The CLI keeps a signal ignored when it was ignored at its start (as
      * under nohup); a test runner started in the background by a
      * non-interactive shell ignores SIGINT, so give the child the defaults
@@ -107,10 +198,23 @@ static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
     signal(SIGHUP, SIG_DFL);
     harness_set_limit(RLIMIT_FSIZE, lim->file_size_bytes);
     harness_set_limit(RLIMIT_AS, lim->address_space_bytes);
+    if (call) {
+      /* the program's exit, less the test's atexit handlers (Criterion's) */
+      int code = cli_main(argc, (char **)argv, NULL);
+      fflush(NULL);
+      HARNESS_LEAK_CHECK(); /* ends the child with LeakSanitizer's code on a leak */
+      _exit(code);
+    }
     execv(binary, (char *const *)argv);
     _exit(127);
   }
   return pid;
+}
+
+/* Forks and execs bumpbake with args: for a test that signals it. */
+static inline pid_t harness_spawn(const char *cwd, const run_limits *lim,
+                                  const char *const *args, FILE *out, FILE *err) {
+  return harness_start(cwd, lim, args, out, err, HARNESS_EXEC);
 }
 
 /* User plus system CPU time of a rusage: what a test may bound, as no
@@ -126,13 +230,14 @@ static inline double harness_seconds_now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Runs bumpbake with args in cwd (NULL = ours) under lim and waits for it. */
-static inline cli_result harness_run_limited(const char *cwd, const run_limits *lim,
-                                             const char *const *args) {
+/* Runs bumpbake with args in cwd (NULL = ours) under lim, as how says, and
+ * waits for it. */
+static inline cli_result harness_run_how(const char *cwd, const run_limits *lim,
+                                         const char *const *args, harness_how how) {
   FILE *out = tmpfile(), *err = tmpfile();
   cr_assert(out && err);
   double t0 = harness_seconds_now();
-  pid_t pid = harness_spawn(cwd, lim, args, out, err);
+  pid_t pid = harness_start(cwd, lim, args, out, err, how);
   int status = 0;
   struct rusage usage;
   cr_assert(wait4(pid, &status, 0, &usage) == pid);
@@ -148,8 +253,25 @@ static inline cli_result harness_run_limited(const char *cwd, const run_limits *
   return r;
 }
 
+/* Runs bumpbake under lim: the binary when an address space is limited
+ * or none is (an address-space limit and the peak memory of a memory test
+ * are the program's own, not a copy of this test process), the CLI's code
+ * in a forked child under a file-size limit alone (it bounds the child's
+ * writes either way). */
+static inline cli_result harness_run_limited(const char *cwd, const run_limits *lim,
+                                             const char *const *args) {
+  const int file_size_alone = lim->file_size_bytes >= 0 && lim->address_space_bytes < 0;
+  return harness_run_how(cwd, lim, args, file_size_alone ? HARNESS_CALL : HARNESS_EXEC);
+}
+
+/* Runs the binary itself: for a test of its peak memory or its start. */
+static inline cli_result harness_run_exec(const char *const *args) {
+  return harness_run_how(NULL, &harness_no_limits, args, HARNESS_EXEC);
+}
+
+/* Runs the CLI's code in a forked child (or the binary, harness_may_call). */
 static inline cli_result harness_run_in(const char *cwd, const char *const *args) {
-  return harness_run_limited(cwd, &harness_no_limits, args);
+  return harness_run_how(cwd, &harness_no_limits, args, HARNESS_CALL);
 }
 
 static inline cli_result harness_run(const char *const *args) {
@@ -179,6 +301,7 @@ static inline int harness_remove(const char *path, const struct stat *st, int fl
 }
 
 static inline void harness_setup(void) {
+  harness_threads_at_setup = harness_threads();
   snprintf(harness_dir, sizeof harness_dir, "/tmp/bb_cli_XXXXXX");
   cr_assert_not_null(mkdtemp(harness_dir));
 }

@@ -20,6 +20,12 @@ int bb_cli_command(int argc, char **argv);
 /* One command about to run: checked by the library. */
 typedef struct cli_run cli_run;
 
+/* The program: `bumpbake ARGS...` (argv[0] the program's name) from its
+ * start to its exit code: --help, --version, each command. serve is
+ * `bumpbake serve`'s run: main.c passes serve.c's; the test binary, which
+ * links no serve, passes NULL and runs `serve` through the program. */
+int cli_main(int argc, char **argv, int (*serve)(const cli_run *r));
+
 /* bb_cli_command with the run of run (serve's, which the test binary does
  * not link), else the command's own. */
 int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r));

@@ -1422,3 +1422,56 @@ Test(cli, truncated_png_is_one_line_also_under_sanitizers) {
   expect_failure((const char *[]){"normal", in, "--scale", "2", "-o", out, NULL}, "cut.png",
                  out, in);
 }
+
+/* ------------------------------------------- the CLI called, not executed */
+
+/* The harness runs most CLI tests by calling the CLI's code (linked into
+ * this binary) in a forked child instead of executing build/bumpbake
+ * (cli_harness.h, harness_start): both must answer alike, byte for byte:
+ * stdout, stderr, the exit code and the files written, for --version,
+ * --help, usage errors, a bake of four maps and info on one of them. */
+Test(cli, the_called_cli_answers_as_the_executed_binary) {
+  const char *force = getenv("BB_CLI_EXEC");
+  if (force && *force && strcmp(force, "0"))
+    cr_skip_test("BB_CLI_EXEC is set: every run executes the binary");
+  write_image(tmp("h.png"), 24, 20, 1, ramp_down);
+  cr_assert(mkdir(tmp("out"), 0755) == 0);
+  const char *const runs[][16] = {
+      {"--version", NULL},
+      {"--help", NULL},
+      {"--frobnicate", NULL},
+      {"bake", tmp("h.png"), "--scale", "-1", NULL},
+      {"bake", tmp("h.png"), "--scale", "8", "--rays", "16", "--out-dir", tmp("out"), "--maps",
+       "normal,ssbump,ao,bent", NULL},
+      {"info", tmp("out/h_normal.png"), NULL},
+  };
+  static const char *const maps[] = {"out/h_normal.png", "out/h_ssbump.png", "out/h_ao.png",
+                                     "out/h_bent.png"};
+  enum { MAPS = sizeof maps / sizeof maps[0] };
+  unsigned char *bytes[MAPS] = {0};
+  size_t sizes[MAPS] = {0};
+  for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+    cr_assert(harness_may_call(runs[i]), "run %zu would not be called in a child", i);
+    cli_result called = harness_run(runs[i]);
+    if (i == 4) /* the bake: keep what the call wrote, for the binary to write again */
+      for (size_t m = 0; m < MAPS; m++) {
+        bytes[m] = read_bytes(tmp(maps[m]), &sizes[m]);
+        cr_assert_eq(remove(tmp(maps[m])), 0);
+      }
+    cli_result executed = harness_run_exec(runs[i]);
+    cr_expect_eq(called.code, executed.code, "run %zu: exit %d called, %d executed", i,
+                 called.code, executed.code);
+    cr_expect_str_eq(called.out, executed.out, "run %zu: stdout differs", i);
+    cr_expect_str_eq(called.err, executed.err, "run %zu: stderr differs", i);
+    cli_result_free(&called);
+    cli_result_free(&executed);
+  }
+  for (size_t m = 0; m < MAPS; m++) {
+    size_t n = 0;
+    unsigned char *again = read_bytes(tmp(maps[m]), &n);
+    cr_expect(n == sizes[m] && memcmp(again, bytes[m], n) == 0,
+              "%s differs between the call and the binary", maps[m]);
+    free(again);
+    free(bytes[m]);
+  }
+}
