@@ -718,7 +718,7 @@ static void write_block(const fit *f, unsigned char out[8]) {
  * least-squares fit leaves above `cluster_over` gets the cluster-fit start
  * too: below it the start seldom wins (on rock06's ssbump at 1024 x 1024,
  * skipping it below 256 cost 0.002 dB and saved 18% of the instructions;
- * from 256 to 400, with the wide window cut to 57 splits, 0.002 to 0.004
+ * from 256 to 400, with the wide window cut to 57 splits, 0.002 to 0.007
  * dB on the ssbumps and 0.04 at most on any map, each still above
  * libsquish's cluster fit, for 13% fewer instructions). The
  * wide window of splits is for blocks also above `wide_over` whose texels
