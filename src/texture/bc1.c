@@ -534,39 +534,80 @@ static void one_colour(float v, int top, int three, int *qa, int *qb) {
     }
 }
 
-/* Offsets of the three boundaries, those within one step first: the 27
- * of the narrow window, then the rest of the 125 of the wide one. */
-static signed char split_offsets[125][3];
+/* A split's sums of the squared weights of end point 0 (aa) and 1 (bb)
+ * and of their products (ab), end point 0's weights 0, 1/3, 2/3, 1 over
+ * the runs of i, j - i, k - j and n - k texels, and 1 / (aa bb - ab^2)
+ * (0 when that is too small to fit: the split is skipped). */
+static void split_terms(int i, int j, int k, int n, float terms[4]) {
+  const float n0 = (float)i, n1 = (float)(j - i), n2 = (float)(k - j), n3 = (float)(n - k);
+  const float aa = (n1 + 4.0f * n2) * (1.0f / 9.0f) + n3;
+  const float bb = n0 + (4.0f * n1 + n2) * (1.0f / 9.0f);
+  const float ab = 2.0f * (n1 + n2) * (1.0f / 9.0f), det = aa * bb - ab * ab;
+  terms[0] = aa, terms[1] = bb, terms[2] = ab;
+  terms[3] = det > 1e-3f ? 1.0f / det : 0.0f;
+}
+
+/* split_terms of every split of a whole block (n = 16), made once (a
+ * block tries up to 125 of them), split i, j, k's at split_row[k] +
+ * split_row2[j] + i (0 <= i <= j <= k <= 16: 969 splits). */
+static float split_terms_16[969][4];
+static int split_row[17], split_row2[17];
+/* The order of the offsets of the three boundaries, [di + 2][dj + 2][dk +
+ * 2]: those within one step first (the 27 of the narrow window), then the
+ * rest of the 57 of the wide one (two steps at most, three in all), then
+ * the rest of the 125, which are not tried (on the ssbumps and normal maps
+ * of rock06, lava01, a noise map and the rivet panel they gained 0.002 dB
+ * at most, for 6% of the instructions). */
+static unsigned char offset_rank[5][5][5];
+
 static void offsets_make(void) {
+  for (int k = 0; k <= 16; k++) {
+    split_row[k] = k * (k + 1) * (k + 2) / 6;
+    split_row2[k] = k * (k + 1) / 2;
+  }
+  for (int k = 0; k <= 16; k++)
+    for (int j = 0; j <= k; j++)
+      for (int i = 0; i <= j; i++)
+        split_terms(i, j, k, 16, split_terms_16[split_row[k] + split_row2[j] + i]);
   int m = 0;
-  for (int wide = 0; wide < 2; wide++)
+  for (int ring = 0; ring < 3; ring++)
     for (int di = -2; di <= 2; di++)
       for (int dj = -2; dj <= 2; dj++)
         for (int dk = -2; dk <= 2; dk++) {
           const int near = abs(di) <= 1 && abs(dj) <= 1 && abs(dk) <= 1;
-          if (near != !wide)
+          const int wide = !near && abs(di) + abs(dj) + abs(dk) <= 3;
+          if (ring != (near ? 0 : wide ? 1 : 2))
             continue;
-          split_offsets[m][0] = (signed char)di, split_offsets[m][1] = (signed char)dj;
-          split_offsets[m][2] = (signed char)dk;
+          offset_rank[di + 2][dj + 2][dk + 2] = (unsigned char)m;
           m++;
         }
 }
-/* The cluster-fit start: the texels sorted along the axis, split into the
- * four indices' runs (i texels at end point 1, then j - i at colour 3, k -
- * j at colour 2, the rest at end point 0: squish's total orderings), for
- * the splits within a texel of where the extremes' palette splits them;
- * each scored by squish's measure (least-squares end points for the split,
- * rounded to the grid, their error given the split). The best split's
- * indices are fitted as any others. 0 when none fits. */
-static int cluster_start(const block *b, const float t[16], int wide, fit *out) {
-  int order[16], n = 0;
+
+/* The texels of the image (w > 0) in order of t, equals in the order of
+ * their places (an insertion sort), their count in *n. */
+static void sort_texels(const block *b, const float t[16], int order[16], int *n) {
+  int m = 0;
   for (int i = 0; i < 16; i++)
     if (b->w[i] > 0) {
-      int k = n++;
+      int k = m++;
       for (; k > 0 && t[order[k - 1]] > t[i]; k--)
         order[k] = order[k - 1];
       order[k] = i;
     }
+  *n = m;
+}
+
+/* The cluster-fit start: the texels sorted along the axis, split into the
+ * four indices' runs (i texels at end point 1, then j - i at colour 3, k -
+ * j at colour 2, the rest at end point 0: squish's total orderings), for
+ * the splits within a texel of where the extremes' palette splits them
+ * (wide: two texels, three moves in all);
+ * each scored by squish's measure (least-squares end points for the split,
+ * rounded to the grid, their error given the split). The best split's
+ * indices are fitted as any others. 0 when none fits. */
+static int cluster_start(const block *b, const float t[16], int wide, fit *out) {
+  int order[16], n;
+  sort_texels(b, t, order, &n);
   /* prefix sums of the sorted texels, R, G, B and 0 */
   float sum[17][4];
   memset(sum[0], 0, sizeof sum[0]);
@@ -590,45 +631,48 @@ static int cluster_start(const block *b, const float t[16], int wide, fit *out) 
   const v4 zero = v4_all(0.0f), top = v4_all(255.0f), third_of = v4_all(1.0f / 3.0f);
   const v4 total = v4_load(sum[n]);
   float best = 0;
-  int found = 0, bi = 0, bj = 0, bk = 0;
-  /* the splits to try: each boundary moved by up to one texel (two, wide) */
+  int found = 0, best_rank = 0, bi = 0, bj = 0, bk = 0;
+  /* The splits to try: each boundary moved by up to one texel (narrow:
+   * 27 offsets), or (wide) by up to two with at most three moves in all
+   * (57), those that are splits; of equals the first in the offsets'
+   * order (their rank). */
   static pthread_once_t offsets_once = PTHREAD_ONCE_INIT;
   pthread_once(&offsets_once, offsets_make);
-  const signed char(*offsets)[3] = split_offsets;
-  const int tries = wide ? 125 : 27;
-  for (int m = 0; m < tries; m++) {
-    const int i = split[0] + offsets[m][0], j = split[1] + offsets[m][1],
-              k = split[2] + offsets[m][2];
-    if (i < 0 || j < i || k < j || k > n)
-      continue;
-    /* end point 0's weights 0, 1/3, 2/3, 1 over the runs */
-    const float n0 = (float)i, n1 = (float)(j - i), n2 = (float)(k - j),
-                n3 = (float)(n - k);
-    const float aa = (n1 + 4.0f * n2) * (1.0f / 9.0f) + n3;
-    const float bb = n0 + (4.0f * n1 + n2) * (1.0f / 9.0f);
-    const float ab = 2.0f * (n1 + n2) * (1.0f / 9.0f), det = aa * bb - ab * ab;
-    if (!(det > 1e-3f))
-      continue;
-    const float inv = 1.0f / det;
-    const v4 bx = v4_mul(
-        v4_add(v4_add(v4_load(sum[i]), v4_load(sum[j])), v4_load(sum[k])), third_of);
-    const v4 ax = v4_sub(total, bx);
-    const v4 vaa = v4_all(aa), vbb = v4_all(bb), vab = v4_all(ab);
-    v4 a = v4_mul(v4_sub(v4_mul(ax, vbb), v4_mul(bx, vab)), v4_all(inv));
-    v4 v = v4_mul(v4_sub(v4_mul(bx, vaa), v4_mul(ax, vab)), v4_all(inv));
-    a = v4_min(v4_max(a, zero), top);
-    v = v4_min(v4_max(v, zero), top);
-    a = v4_mul(v4_trunc(v4_add(v4_mul(a, to_grid), v4_all(0.5f))), from_grid);
-    v = v4_mul(v4_trunc(v4_add(v4_mul(v, to_grid), v4_all(0.5f))), from_grid);
-    /* aa a^2 + bb v^2 + 2 ab a v - 2 (a ax + v bx), per channel */
-    const v4 e4 =
-        v4_sub(v4_add(v4_add(v4_mul(vaa, v4_mul(a, a)), v4_mul(vbb, v4_mul(v, v))),
-                      v4_mul(v4_all(2.0f * ab), v4_mul(a, v))),
-               v4_mul(v4_all(2.0f), v4_add(v4_mul(a, ax), v4_mul(v, bx))));
-    const float e = (v4_lane(e4, 0) + v4_lane(e4, 1)) + v4_lane(e4, 2);
-    if (!found || e < best)
-      best = e, bi = i, bj = j, bk = k, found = 1;
-  }
+  const int r = wide ? 2 : 1, tries = wide ? 57 : 27;
+  const int i1 = split[0] + r < n ? split[0] + r : n, k0 = split[2] - r > 0 ? split[2] - r : 0;
+  for (int i = split[0] - r > 0 ? split[0] - r : 0; i <= i1; i++)
+    for (int j = split[1] - r > i ? split[1] - r : i; j <= split[1] + r && j <= n; j++)
+      for (int k = k0 > j ? k0 : j; k <= split[2] + r && k <= n; k++) {
+        const int rank = offset_rank[i - split[0] + 2][j - split[1] + 2][k - split[2] + 2];
+        if (rank >= tries)
+          continue;
+        float terms[4];
+        if (n == 16)
+          memcpy(terms, split_terms_16[split_row[k] + split_row2[j] + i], sizeof terms);
+        else
+          split_terms(i, j, k, n, terms);
+        const float aa = terms[0], bb = terms[1], ab = terms[2], inv = terms[3];
+        if (!(inv > 0))
+          continue;
+        const v4 bx = v4_mul(
+            v4_add(v4_add(v4_load(sum[i]), v4_load(sum[j])), v4_load(sum[k])), third_of);
+        const v4 ax = v4_sub(total, bx);
+        const v4 vaa = v4_all(aa), vbb = v4_all(bb), vab = v4_all(ab);
+        v4 a = v4_mul(v4_sub(v4_mul(ax, vbb), v4_mul(bx, vab)), v4_all(inv));
+        v4 v = v4_mul(v4_sub(v4_mul(bx, vaa), v4_mul(ax, vab)), v4_all(inv));
+        a = v4_min(v4_max(a, zero), top);
+        v = v4_min(v4_max(v, zero), top);
+        a = v4_mul(v4_trunc(v4_add(v4_mul(a, to_grid), v4_all(0.5f))), from_grid);
+        v = v4_mul(v4_trunc(v4_add(v4_mul(v, to_grid), v4_all(0.5f))), from_grid);
+        /* aa a^2 + bb v^2 + 2 ab a v - 2 (a ax + v bx), per channel */
+        const v4 e4 =
+            v4_sub(v4_add(v4_add(v4_mul(vaa, v4_mul(a, a)), v4_mul(vbb, v4_mul(v, v))),
+                          v4_mul(v4_all(2.0f * ab), v4_mul(a, v))),
+                   v4_mul(v4_all(2.0f), v4_add(v4_mul(a, ax), v4_mul(v, bx))));
+        const float e = (v4_lane(e4, 0) + v4_lane(e4, 1)) + v4_lane(e4, 2);
+        if (!found || e < best || (e == best && rank < best_rank))
+          best = e, best_rank = rank, bi = i, bj = j, bk = k, found = 1;
+      }
   if (!found)
     return 0;
   int index[16];
@@ -673,12 +717,18 @@ static void write_block(const fit *f, unsigned char out[8]) {
  * channels (16 texels 1 code off in each channel: 48). A block the
  * least-squares fit leaves above `cluster_over` gets the cluster-fit start
  * too: below it the start seldom wins (on rock06's ssbump at 1024 x 1024,
- * skipping it there cost 0.002 dB and saved 18% of the instructions). The
+ * skipping it below 256 cost 0.002 dB and saved 18% of the instructions;
+ * from 256 to 400, with the wide window cut to 57 splits, 0.002 to 0.007
+ * dB on the ssbumps and 0.04 at most on any map, each still above
+ * libsquish's cluster fit, for 13% fewer instructions). The
  * wide window of splits is for blocks also above `wide_over` whose texels
  * spread over more than `wide_spread` (squared distances from their
  * mean): +0.01 dB on lava01's rough ssbump, for 7% more instructions on
- * it and 3% on rock06. */
-enum { cluster_over = 256, wide_over = 1000, wide_spread = 3000 };
+ * it and 3% on rock06. The local search's second pass is for blocks the
+ * least-squares fit leaves above `second_over`: below it the pass cost
+ * 2.6% of the instructions for 0.0005 dB on the ssbumps and 0.001 to 0.013
+ * on the normal maps. */
+enum { cluster_over = 400, wide_over = 1000, wide_spread = 3000, second_over = 128 };
 
 /* The fits of 4-colour mode (quick: least squares and one pass of the
  * local search alone), the best kept in *best. */
@@ -697,7 +747,7 @@ static void fit_four(const block *b, const float ends[2][3], const float t[16],
       keep_better(&f, &g);
     }
   }
-  local_search(b, &f, quick ? 1 : 2);
+  local_search(b, &f, quick || first <= second_over ? 1 : 2);
   keep_better(best, &f);
 }
 
