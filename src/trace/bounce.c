@@ -588,14 +588,21 @@ typedef struct bounce_ctx {
   double slope[MAX_SLOPES]; /* tangents of the fixed rays, rising */
   int chain;                /* the hull vertices an origin knows at most */
   double small_band;        /* TEXEL: a horizon under this is a small band */
-  float *sums;              /* DIRECT: per vertex, FACES x channels: what the sky's vector
-                               integrals miss on each face; SURFACE: gathered per corner;
+  float *sums;              /* SURFACE: gathered per corner, FACES x channels per vertex;
                                TEXEL: channels per texel */
-  float *vectors; /* DIRECT: per vertex, 3 x channels: the vector integrals blocked */
-  float
-      *horizons; /* when the passes are the trace too: per texel, each slice's horizon */
-  float *fill;   /* per texel, the weights of its blocked bands (ao, solid angle) over
-                    the slices it gathers in and over those it does not (TEXEL_FILL) */
+  /* DIRECT: the horizon each vertex's corners are lit from, a plane per
+   * slice of the pass (corner_plane[s]: slice s's), turned into light
+   * afterwards row by row (direct_row): the sweep only stores a float */
+  float *corner_horizons;
+  const int *corner_plane;
+  size_t texels; /* the image's: the planes below hold one value per texel each */
+  /* when the passes are the trace too: each slice's horizons, a plane per
+   * slice (texel v of slice s at s * texels + v: a sweep's neighbouring
+   * lines write neighbouring floats, not a cache line per texel) */
+  float *horizons;
+  /* 4 planes: per texel, the weights of its blocked bands (ao, solid angle)
+   * over the slices it gathers in, then over those it does not */
+  float *fill;
   int corner_hull; /* DIRECT: the sweep is the trace's, at the texels' bias; the
                       corners' horizons are asked of its hulls at their lift */
   double corner_lift;
@@ -1280,34 +1287,29 @@ static void direct_face(const bounce_ctx *ctx, int s, double dx, double dy,
 }
 
 /* A vertex's corners' direct light along slice s (from the horizon the
- * sweep found, lifted by `lift`): the vector integrals blocked below
- * max(horizon, 0), once for the vertex, and for each face whose plane
- * rises above that, the part between the two, n . (G(plane) - G(h)). */
-static void direct_corners(const bounce_ctx *ctx, int s, double dx, double dy, size_t v,
-                           float horizon) {
+ * sweep found, lifted by `lift`), added to its sums: the vector integrals
+ * blocked below max(horizon, 0), once for the vertex (vec, 3 x channels),
+ * and for each face (normals n) whose plane rises above that, the part
+ * between the two, n . (G(plane) - G(h)) (corr, FACES x channels). */
+static void direct_corners(const bounce_ctx *ctx, int s, double dx, double dy,
+                           const double (*n)[3], float horizon, float *vec, float *corr) {
   const int channels = ctx->channels, width = 3 * channels;
-  const bb_pyramid *p = ctx->p;
   double base[3 * MAX_CHANNELS], own[3 * MAX_CHANNELS];
   const double floor_t = horizon > 0.0f ? (double)horizon : 0.0;
   vtables_eval(ctx->vt, s, floor_t, base);
-  float *vec = ctx->vectors + v * (size_t)width;
   for (int i = 0; i < width; i++)
     vec[i] += (float)base[i];
-  const long x = (long)(v % (size_t)p->width), y = (long)(v / (size_t)p->width);
-  float *corr = ctx->sums + v * FACES * (size_t)channels;
   for (int f = 0; f < FACES; f++) {
-    const float *n = triangle_normal(ctx, x + slot_dx[f], y + slot_dy[f], slot_upper[f]);
-    const double plane = -((double)n[0] * dx + (double)n[1] * dy) / (double)n[2];
+    const double plane = -(n[f][0] * dx + n[f][1] * dy) / n[f][2];
     /* the band between the horizon and the plane, behind the face: thin,
      * it weighs about its width squared (n . w vanishes on the plane) */
     if (!(plane > floor_t + THIN_BAND))
       continue;
     vtables_eval(ctx->vt, s, plane, own);
     for (int k = 0; k < channels; k++)
-      corr[f * channels + k] +=
-          (float)((double)n[0] * (own[3 * k] - base[3 * k]) +
-                  (double)n[1] * (own[3 * k + 1] - base[3 * k + 1]) +
-                  (double)n[2] * (own[3 * k + 2] - base[3 * k + 2]));
+      corr[f * channels + k] += (float)(n[f][0] * (own[3 * k] - base[3 * k]) +
+                                        n[f][1] * (own[3 * k + 1] - base[3 * k + 1]) +
+                                        n[f][2] * (own[3 * k + 2] - base[3 * k + 2]));
   }
 }
 
@@ -1470,15 +1472,13 @@ static void *on_line_begin(void *user, const bb__line_view *line) {
  * the pass is the trace too, what its horizons lose, added as the trace
  * adds it); in a chunk, a texel whose horizon the sweep marched (the chunk
  * could not vouch for it) has the band above its chunk's tangent met at
- * that tangent's radiance. PASS_DIRECT works out its corners here, from
- * the horizons the sweep found. */
+ * that tangent's radiance. PASS_DIRECT keeps its corners' horizons. */
 static void on_line_end(void *state, const bb__line_view *line) {
   line_state *ls = state;
   bounce_ctx *ctx = ls->ctx;
   scratch *sc = ls->sc;
   const int channels = ctx->channels;
   const columns *cols = ctx->cols;
-  const int slices = ctx->rs->slice_count;
   for (int j = 0; j < line->len; j++) {
     const size_t v = line->texel[j];
     for (int side = 0; side < 2; side++) {
@@ -1487,13 +1487,13 @@ static void on_line_end(void *state, const bb__line_view *line) {
       const float *acc = sc->acc[side] + sc->offset[j];
       const float found = line->found[side][j];
       if (ctx->horizons)
-        ctx->horizons[v * (size_t)slices + (size_t)line->dir[side]->slice] = found;
+        ctx->horizons[(size_t)line->dir[side]->slice * ctx->texels + v] = found;
       if (ctx->fill && found > 0.0f && (ctx->mode == PASS_TEXEL || ctx->corner_hull)) {
         /* the texel's band's weights: ao's, solid angle's */
         const gather *g = &ls->side[side];
-        float *w = ctx->fill + v * 4 + (ctx->mode == PASS_TEXEL ? 0 : 2);
+        float *w = ctx->fill + (ctx->mode == PASS_TEXEL ? 0 : 2) * ctx->texels + v;
         w[0] += (float)(g->half_width * sin2((double)found));
-        w[1] += (float)(2.0 * g->half_width * sin_of((double)found));
+        w[ctx->texels] += (float)(2.0 * g->half_width * sin_of((double)found));
       }
       if (ctx->mode == PASS_TEXEL) {
         float *out = ctx->sums + v * (size_t)channels;
@@ -1514,9 +1514,9 @@ static void on_line_end(void *state, const bb__line_view *line) {
         continue;
       }
       if (ctx->mode == PASS_DIRECT) {
-        const gather *g = &ls->side[side];
-        direct_corners(ctx, line->dir[side]->slice, g->dx, g->dy, v,
-                       ctx->corner_hull ? sc->used[side][j] : found);
+        const size_t plane = (size_t)ctx->corner_plane[line->dir[side]->slice];
+        ctx->corner_horizons[plane * ctx->texels + v] =
+            ctx->corner_hull ? sc->used[side][j] : found;
       } else {
         float *out = ctx->sums + v * FACES * (size_t)channels;
         for (int i = 0; i < FACES * channels; i++)
@@ -1558,6 +1558,9 @@ typedef struct driver {
   columns cols;
   float *normals;  /* the triangles' unit normals (bounce_ctx) */
   float *direct;   /* E of every corner from the sky (FACES x channels per vertex) */
+  int *direct_seq; /* the direct pass's slices in the order it adds them; */
+  int direct_count;
+  int *corner_plane; /* by slice, its place there (-1: not in the pass) */
   float *radiance; /* what every corner reflects now, by cell */
   const float *albedo;
   exact_sum *row_sum;
@@ -1575,7 +1578,6 @@ static void zero_rows(void *user, int y) {
   driver *d = user;
   const size_t W = (size_t)d->ctx.p->width, C = (size_t)d->ctx.channels;
   memset(d->ctx.sums + (size_t)y * W * FACES * C, 0, W * FACES * C * sizeof(float));
-  memset(d->ctx.vectors + (size_t)y * W * 3 * C, 0, W * 3 * C * sizeof(float));
 }
 
 /* What one slice of each pass costs against one of the trace's
@@ -1648,6 +1650,24 @@ static void direct_sectors(const bb_rayset *rs, const int *order, double *sector
   }
 }
 
+/* The slices a pass of the given parity sweeps (run_pass), in the order
+ * each texel gets them: each sweep's along, then its opposite; into seq,
+ * and slice s's place in it into place[s] (-1: not swept). Their count. */
+static int pass_sequence(const bb_rayset *rs, const int *order, int parity, int *seq,
+                         int *place) {
+  int count = 0;
+  for (int s = 0; s < rs->slice_count; s++)
+    place[s] = -1;
+  for (int k = 0, rank = 0; k < rs->slice_count; rank++) {
+    const int pair = sweep_pairs(rs, order, k);
+    if (parity < 0 || rank % 2 == parity)
+      for (int i = 0; i <= pair; i++)
+        place[order[k + i]] = count, seq[count++] = order[k + i];
+    k += pair ? 2 : 1;
+  }
+  return count;
+}
+
 static const bb__walk_visitor gather_visitor = {on_line_begin, on_push, on_origin,
                                                 on_line_end};
 static const bb__walk_visitor direct_visitor = {on_line_begin, NULL, on_origin,
@@ -1678,7 +1698,8 @@ static bb_status run_pass(driver *d, pass_mode mode, int parity, bb_error *err) 
         (size_t)ctx->p->width * (size_t)ctx->p->height * (size_t)ctx->channels;
     memset(ctx->sums, 0, n * sizeof(float));
   } else {
-    st = bb__parallel_for(ctx->p->height, o->threads, zero_rows, d, NULL, NULL, err);
+    if (mode == PASS_SURFACE)
+      st = bb__parallel_for(ctx->p->height, o->threads, zero_rows, d, NULL, NULL, err);
     const size_t lanes =
         (size_t)d->cols.count * (size_t)d->cols.samples * (size_t)ctx->channels;
     if (lanes)
@@ -1735,11 +1756,13 @@ static double rho_at(const driver *d, size_t v) {
 }
 
 /* After the direct pass: each corner's E from the sky (all of it, less
- * what its face's blocked vector integrals and its corrections took), and
+ * what its face's blocked vector integrals and its corrections took, added
+ * up slice by slice in the pass's order from the horizons it kept), and
  * its radiance. */
 static void direct_row(void *user, int y) {
   driver *d = user;
   const bounce_ctx *ctx = &d->ctx;
+  const bb_rayset *rs = d->fine;
   const int channels = ctx->channels, W = ctx->p->width;
   exact_sum sum = 0;
   for (int x = 0; x < W; x++) {
@@ -1747,7 +1770,13 @@ static void direct_row(void *user, int y) {
     const double rho = rho_at(d, v);
     double n[FACES][3];
     vertex_normals(ctx, x, y, n);
-    const float *blocked = ctx->vectors + v * 3 * (size_t)channels;
+    float blocked[3 * MAX_CHANNELS] = {0}, corr[FACES * MAX_CHANNELS] = {0};
+    for (int q = 0; q < d->direct_count; q++) {
+      const int s = d->direct_seq[q];
+      direct_corners(ctx, s, rs->slice_dir[2 * s], rs->slice_dir[2 * s + 1],
+                     (const double(*)[3])n, ctx->corner_horizons[(size_t)q * ctx->texels + v],
+                     blocked, corr);
+    }
     for (int f = 0; f < FACES; f++) {
       const size_t out = corner_index(ctx->p, x, y, f, channels);
       double gain = 1.0;
@@ -1757,7 +1786,7 @@ static void direct_row(void *user, int y) {
         for (int j = 0; j < 3; j++)
           open[j] = ctx->vt->all[3 * k + j] - (double)blocked[3 * k + j];
         const double e = n[f][0] * open[0] + n[f][1] * open[1] + n[f][2] * open[2] -
-                         (double)ctx->sums[i];
+                         (double)corr[f * channels + k];
         d->direct[i] = (float)(e > 0.0 ? e : 0.0);
         if (k == 0)
           gain = estimate_gain(d, rho, (double)d->direct[i]);
@@ -1967,12 +1996,12 @@ static void trace_row(void *user, int y) {
   for (int x = 0; x < W; x++) {
     const size_t v = (size_t)y * (size_t)W + (size_t)x;
     float *sums = job->vis->pixels + v * (size_t)channels;
-    const float *h = d->ctx.horizons + v * (size_t)n;
+    const float *h = d->ctx.horizons + v;
     for (int k = 0; k < channels; k++)
       sums[k] = 0.0f;
     for (int k = 0; k < n; k++) {
       const bb__slice_integral si = bb__slice_integral_of(rs, d->order[k]);
-      bb__slice_accumulate(&si, h[d->order[k]], sums);
+      bb__slice_accumulate(&si, h[(size_t)d->order[k] * d->ctx.texels], sums);
     }
   }
 }
@@ -1990,10 +2019,11 @@ static void finish_row(void *user, int y) {
      * per unit of their bands' weights */
     double scale[2] = {1.0, 1.0};
     if (ctx->fill) {
-      const float *w = ctx->fill + v * 4;
-      for (int i = 0; i < 2; i++)
-        if (w[i] > 0.0f)
-          scale[i] += (double)w[2 + i] / (double)w[i];
+      const float *w = ctx->fill + v;
+      const size_t plane = ctx->texels;
+      for (size_t i = 0; i < 2; i++)
+        if (w[i * plane] > 0.0f)
+          scale[i] += (double)w[(2 + i) * plane] / (double)w[i * plane];
     }
     const double ao = (double)out[0] + (double)sum[0] * scale[0] / BB__PI;
     out[0] = (float)(ao < 1.0 ? ao : 1.0);
@@ -2057,7 +2087,7 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
               .checkpoint = {o->progress, o->progress_user}};
   bounce_ctx *ctx = &d.ctx;
   ctx->p = p, ctx->rs = rs, ctx->vt = &d.vt, ctx->channels = channels,
-  ctx->cols = &d.cols;
+  ctx->cols = &d.cols, ctx->texels = texels;
   ctx->corner_lift = o->lift;
   atomic_init(&ctx->out_of_memory, 0);
   int *order = malloc((size_t)rs->slice_count * sizeof(int));
@@ -2066,7 +2096,8 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
   const size_t normal_floats = ((size_t)p->width + 1) * ((size_t)p->height + 1) * 6;
   d.normals = malloc(normal_floats * sizeof(float));
   ctx->sums = malloc(corners * sizeof(float));
-  ctx->vectors = malloc(texels * 3 * (size_t)channels * sizeof(float));
+  d.direct_seq = malloc((size_t)rs->slice_count * sizeof(int));
+  d.corner_plane = malloc((size_t)rs->slice_count * sizeof(int));
   d.direct = malloc(corners * sizeof(float));
   d.radiance = malloc(corners * sizeof(float));
   d.row_sum = malloc((size_t)p->height * sizeof *d.row_sum);
@@ -2077,12 +2108,21 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
   ctx->slot_count = threads < 256 ? threads : 256;
   ctx->slots = calloc((size_t)ctx->slot_count, sizeof(scratch));
   bb_status st = BB_OK;
-  if (!order || !sector || !wanted || !d.normals || !ctx->sums || !ctx->vectors ||
-      !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
+  if (!order || !sector || !wanted || !d.normals || !ctx->sums || !d.direct_seq ||
+      !d.corner_plane || !d.direct || !d.radiance || !d.row_sum || !ctx->slots ||
       (traced && !ctx->horizons) || (split && !ctx->fill) ||
       bb_trace_slice_order(rs, order, NULL) != BB_OK)
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)",
                   corners / (size_t)channels);
+  if (st == BB_OK) {
+    d.direct_count =
+        pass_sequence(rs, order, split ? 0 : -1, d.direct_seq, d.corner_plane);
+    ctx->corner_plane = d.corner_plane;
+    ctx->corner_horizons = malloc(texels * (size_t)d.direct_count * sizeof(float));
+    if (!ctx->corner_horizons)
+      st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory (%zu corners)",
+                    corners / (size_t)channels);
+  }
   ctx->normals = d.normals;
   /* every step after the allocations polls the caller's progress */
   const bb__checkpoint *checkpoint = checkpoint_of(&d);
@@ -2186,7 +2226,9 @@ bb_status bb__bounce_add(const bb_pyramid *p, const bb_rayset *rs,
   free(wanted);
   free(d.normals);
   free(ctx->sums);
-  free(ctx->vectors);
+  free(ctx->corner_horizons);
+  free(d.direct_seq);
+  free(d.corner_plane);
   free(ctx->horizons);
   free(ctx->fill);
   free(d.direct);
