@@ -3,6 +3,7 @@
  * --scheduler run in Python, which calls these with the reports its
  * cluster sent back. */
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -56,8 +57,8 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
   bb_json_number(&j, "power", b->power);
   bb_json_string(&j, "basis", b->basis.name);
   bb_json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
-  bb_json_string(&j, "normal_y", bb_normal_y_name(b->normal_y_up));
-  bb_json_string(&j, "addressing", bb_addressing_name(b->smooth.addressing));
+  bb_json_string(&j, "normal_y", bb__normal_y_name(b->normal_y_up));
+  bb_json_string(&j, "addressing", bb__addressing_name(b->smooth.addressing));
   bb_json_string(&j, "channel", bb_height_source_channel(&r->source));
   bb_json_number(&j, "threads", r->threads);
   if (r->bounces > 0) {

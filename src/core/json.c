@@ -2,10 +2,11 @@
  * tools (bumpbake.h: bb_json). */
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 #include <math.h>
 
-void bb_json_quoted(FILE *f, const char *s) {
+void bb__json_quoted(FILE *f, const char *s) {
   if (!s) {
     fputs("null", f);
     return;
@@ -13,7 +14,7 @@ void bb_json_quoted(FILE *f, const char *s) {
   fputc('"', f);
   for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
     if (*c >= 0x80) {
-      const size_t n = bb_utf8_sequence((const char *)c);
+      const size_t n = bb__utf8_sequence((const char *)c);
       if (n == 0) /* not UTF-8: the byte as a lone surrogate, as Python's
                      surrogateescape reads it back */
         fprintf(f, "\\udc%02x", *c);
@@ -54,7 +55,7 @@ static void json_begin_value(bb_json *j, const char *key) {
   if (j->need_comma)
     fputc(',', j->f);
   if (key) {
-    bb_json_quoted(j->f, key);
+    bb__json_quoted(j->f, key);
     fputc(':', j->f);
   }
   j->need_comma = 1;
@@ -73,7 +74,7 @@ void bb_json_close(bb_json *j, char close) {
 
 void bb_json_string(bb_json *j, const char *key, const char *value) {
   json_begin_value(j, key);
-  bb_json_quoted(j->f, value);
+  bb__json_quoted(j->f, value);
 }
 
 void bb_json_number(bb_json *j, const char *key, double value) {

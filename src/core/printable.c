@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-size_t bb_utf8_sequence(const char *text) {
+size_t bb__utf8_sequence(const char *text) {
   const unsigned char *s = (const unsigned char *)text;
   if (!s || !s[0])
     return 0;
@@ -47,7 +47,7 @@ static int is_bidi_control(const unsigned char *s, size_t n) {
 static size_t printable_sequence(const unsigned char *s) {
   if (s[0] < 0x80)
     return s[0] >= 0x20 && s[0] != 0x7f;
-  const size_t n = bb_utf8_sequence((const char *)s);
+  const size_t n = bb__utf8_sequence((const char *)s);
   if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
     return 0;
   return is_bidi_control(s, n) ? 0 : n;
@@ -61,7 +61,7 @@ const char *bb_text_printable(const char *s, char *out, size_t cap) {
     size_t n = printable_sequence(p);
     if (n == 0) {
       /* every byte of a control sequence, so none is left to act */
-      const size_t k = p[0] < 0x80 ? 1 : bb_utf8_sequence((const char *)p);
+      const size_t k = p[0] < 0x80 ? 1 : bb__utf8_sequence((const char *)p);
       const size_t bytes = k ? k : 1;
       if (used + 4 * bytes >= cap)
         break;

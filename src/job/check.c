@@ -15,6 +15,8 @@
 #include "core/internal.h"
 #include "files/safe_file.h"
 #include "job/job_internal.h"
+#include "files/provenance.h"
+#include "image/oiio.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -98,7 +100,7 @@ static bb_status walk(tree *t, const char *rel, int depth, bb_error *err) {
       st = walk(t, sub, depth + 1, err);
       continue;
     }
-    if (!bb_path_is_readable_format(e->d_name))
+    if (!bb__path_is_readable_format(e->d_name))
       continue;
     if (S_ISREG(s.st_mode))
       st = tree_add(t, sub, NULL);
@@ -186,9 +188,9 @@ static bb_status copy_file(const char *path, const char *dest, bb_error *err) {
   char dir[PATH_MAX];
   bb__directory_part(dest, dir, sizeof dir);
   if (st == BB_OK)
-    st = bb_directory_create(dir, err);
+    st = bb__directory_create(dir, err);
   if (st == BB_OK)
-    st = bb_file_write(dest, bytes, (size_t)s.st_size, err);
+    st = bb__file_write(dest, bytes, (size_t)s.st_size, err);
   free(bytes);
   return st;
 }
@@ -250,8 +252,8 @@ static bb_status tree_case(bb_check *c, const char *name, const char *golden,
     snprintf(why, sizeof why, "%s", !g.read ? g.why : n.why);
   }
   char kind[64] = "";
-  if (!bb_provenance_value(n.info.description, "output", kind, sizeof kind))
-    bb_provenance_value(g.info.description, "output", kind, sizeof kind);
+  if (!bb__provenance_value(n.info.description, "output", kind, sizeof kind))
+    bb__provenance_value(g.info.description, "output", kind, sizeof kind);
   const bb__check_sides sides = {g.read ? &g.image : NULL, n.read ? &n.image : NULL,
                                  g.info.description,       n.info.description,
                                  raw_signed(&g, kind),     raw_signed(&n, kind)};
@@ -325,9 +327,9 @@ static int is_baked_map(const char *path) {
   char kind[64];
   int baked = 0;
   if (bb_provenance_classify(info.description) == BB_PROVENANCE_INTACT &&
-      bb_provenance_value(info.description, "output", kind, sizeof kind))
+      bb__provenance_value(info.description, "output", kind, sizeof kind))
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      baked |= strcmp(kind, bb_map_kind_name((bb_map_kind)k)) == 0;
+      baked |= strcmp(kind, bb__map_kind_name((bb_map_kind)k)) == 0;
   bb_image_info_free(&info);
   return baked;
 }
@@ -338,7 +340,7 @@ static int could_be_made(const bb_job *job, const char *rel) {
   const char *tmpl = job->name_template ? job->name_template : BB_JOB_DEFAULT_NAME;
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     char pattern[4096];
-    const char *fields[3] = {"*", bb_map_kind_name((bb_map_kind)k), "*"};
+    const char *fields[3] = {"*", bb__map_kind_name((bb_map_kind)k), "*"};
     if ((job->options.bake.outputs & BB_MAP_BIT(k)) &&
         bb__job_expand_name(tmpl, fields, pattern, sizeof pattern, NULL) == BB_OK &&
         fnmatch(pattern, rel, FNM_PATHNAME) == 0)

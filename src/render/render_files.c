@@ -2,6 +2,8 @@
  * record of them: the map files checked and decoded for their kind, the
  * provenance keys of a render, and the names of an orbit's frames. */
 #include "core/internal.h"
+#include "render/render_internal.h"
+#include "trace/basis.h"
 
 #include <inttypes.h>
 #include <stdio.h>
@@ -34,7 +36,7 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
   const int channels = k->file_channels;
   const int is_float = info.is_float;
   if (kind == BB_MAP_SSBUMP)
-    st = bb_basis_map_check(&raw, info.description, &why);
+    st = bb__basis_map_check(&raw, info.description, &why);
   bb_image_info_free(&info);
   if (st != BB_OK)
     bb__fail(err, st, "%s: %s", path, why.message);
@@ -60,7 +62,7 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
     bb_image_free(&raw);
   }
   if (st == BB_OK && hash) /* of the map as decoded */
-    *hash = bb_image_hash(out);
+    *hash = bb__image_hash(out);
   return st;
 }
 
@@ -81,7 +83,7 @@ static const char *file_name_of(const char *path) {
   return slash ? slash + 1 : path;
 }
 
-char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o) {
+char *bb__render_provenance(const bb_render_sources *s, const bb_render_options *o) {
   if (!s || !o)
     return NULL;
   char *text = NULL;
@@ -96,7 +98,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
     for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
       if (s->maps[m]) {
         char key[32];
-        snprintf(key, sizeof key, "map_%s", bb_map_kind_name((bb_map_kind)m));
+        snprintf(key, sizeof key, "map_%s", bb__map_kind_name((bb_map_kind)m));
         failed |= add_line(&text, &length, key, file_name_of(s->maps[m]));
       }
   }
@@ -106,7 +108,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
     failed |= add_line(&text, &length, "albedo", file_name_of(s->albedo));
     failed |= add_line(&text, &length, "albedo_hash", hash);
   }
-  char *options = bb_render_options_describe(o);
+  char *options = bb__render_options_describe(o);
   if (!options)
     failed = 1;
   else {
@@ -133,7 +135,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
   return text;
 }
 
-char *bb_render_frame_path(const char *output, int frame, int frames) {
+char *bb__render_frame_path(const char *output, int frame, int frames) {
   if (!output)
     return NULL;
   const char *dot = strrchr(file_name_of(output), '.');
