@@ -31,6 +31,7 @@
 #include "bake/bake_internal.h"
 #include "trace/basis.h"
 #include "trace/pyramid.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <math.h>

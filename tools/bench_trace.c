@@ -25,6 +25,7 @@
 #include "core/internal.h"
 #include "trace/pyramid.h"
 #include "trace/trace.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <math.h>

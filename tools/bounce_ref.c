@@ -60,6 +60,7 @@
 #include "files/provenance.h"
 #include "image/image_write.h"
 #include "trace/basis.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <limits.h>

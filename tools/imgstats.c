@@ -15,6 +15,7 @@
  */
 #include "bumpbake.h"
 #include "core/internal.h"
+#include "core/json.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -113,3 +113,6 @@ s/\bbb_trace_occlusion\b/bb__trace_occlusion/g
 s/\bbb_trace_options_init\b/bb__trace_options_init/g
 s/\bbb_utf8_sequence\b/bb__utf8_sequence/g
 s/\bbb_vmt_text\b/bb__vmt_text/g
+# The JSON writer leaves the ABI (src/core/json.h; the CLI compiles json.c into itself).
+s/\bbb_json\b/bb__json/g
+s/\bbb_json_(open|close|string|number|int|bool)\b/bb__json_\1/g

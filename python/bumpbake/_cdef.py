@@ -1,4 +1,5 @@
-"""The part of include/bumpbake.h the Python package calls, for cffi.
+"""The part of include/bumpbake.h and bumpbake_cluster.h the Python package
+calls, for cffi.
 
 Every type and function the package uses, and nothing else. The structs must
 match the header field for field, since cffi's ABI mode lays them out from

@@ -252,11 +252,6 @@ double bb__now_seconds(void);
 /* Once in bumpbake.h, now internal (issue 41): no client of the
  * library calls these; the library, tests, tools and fuzz targets do. */
 
-/* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
- * the end of the string or bytes that are not UTF-8 (overlong forms,
- * surrogates and code points past U+10FFFF included). */
-size_t bb__utf8_sequence(const char *s);
-
 /* What this process may still allocate, in bytes: the smallest of what
  * the system has available (MemAvailable of /proc/meminfo, else its free
  * pages); under a container's or service's memory limit, the room left
@@ -302,14 +297,6 @@ const char *bb__map_kind_name(bb_map_kind kind);
  * input_file_hash, channel, a texture's or a render's keys) and for kinds
  * that are not a bake's maps ("render", "normal+coverage"). */
 int bb__map_kind_records(const char *kind, const char *key, int bounce);
-
-/* Writes s to f as a quoted JSON string, always valid UTF-8 and never cut:
- * '"' and '\' escaped, newline, carriage return and tab as \n, \r, \t,
- * other control characters (C0, DEL, C1) as \u00XX; UTF-8 passes through;
- * a byte that is not part of UTF-8 (a file name in another encoding)
- * becomes the lone surrogate \udcXX, which Python's json and
- * os.fsencode() turn back into the same byte. NULL writes null. */
-void bb__json_quoted(FILE *f, const char *s);
 
 #ifdef __cplusplus
 }

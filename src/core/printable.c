@@ -5,28 +5,10 @@
  * window, or show "evil\u202egnp.exe" as "evilexe.png". One rule for every
  * line the command line prints. */
 #include "core/internal.h"
+#include "core/json.h"
 
 #include <stdio.h>
 #include <string.h>
-
-size_t bb__utf8_sequence(const char *text) {
-  const unsigned char *s = (const unsigned char *)text;
-  if (!s || !s[0])
-    return 0;
-  if (s[0] < 0x80)
-    return 1;
-  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
-  if (s[0] > 0xf4)
-    n = 0;
-  for (size_t i = 1; i < n; i++)
-    if ((s[i] & 0xc0) != 0x80)
-      return 0;
-  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
-    return 0; /* overlong, or a surrogate */
-  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
-    return 0; /* overlong, or past U+10FFFF */
-  return n;
-}
 
 /* 1 when the n-byte UTF-8 sequence at s is a bidirectional control:
  * U+061C ALM, U+200E LRM, U+200F RLM, U+202A..U+202E (LRE, RLE, PDF, LRO,

@@ -14,6 +14,7 @@
 
 #include "core/internal.h"
 #include "files/safe_file.h"
+#include "bumpbake_cluster.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>

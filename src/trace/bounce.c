@@ -62,6 +62,7 @@
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include "trace/sweep.h"
+#include "bumpbake_cluster.h"
 
 #include <limits.h>
 #include <math.h>

@@ -9,6 +9,7 @@
 #include "trace/sweep.h"
 #include "trace/testing.h"
 #include "trace/trace.h"
+#include "bumpbake_cluster.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "trace/basis.h"
 
 static bb_image bumps(int w, int h) {

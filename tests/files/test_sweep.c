@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "files/safe_file.h"
 #include "image/image_write.h"
 

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "core/internal.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "trace/basis.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
