@@ -1,7 +1,9 @@
 """The part of include/bumpbake.h and bumpbake_cluster.h the Python package
 calls, for cffi.
 
-Every type and function the package uses, and nothing else. The structs must
+Every type and function the package uses, and nothing else but
+bb_command_count and bb_command_info_get, with which its tests walk the
+commands (tests/test_commands.py). The structs must
 match the header field for field, since cffi's ABI mode lays them out from
 these declarations: tests/test_cdef.py compiles a C program against the real
 header and checks every size, offset, enum value and function signature
@@ -777,6 +779,8 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
+int bb_command_count(void);
+const bb_command_info *bb_command_info_get(int index);
 const bb_command_info *bb_command_info_find(const char *name);
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
