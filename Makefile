@@ -21,9 +21,9 @@ WARN    := -Wall -Wextra -Wshadow -Wconversion -Wstrict-prototypes -Wmissing-pro
 DEPFLAGS:= -MMD -MP
 # Include paths by family: the library sees its private headers (-Isrc:
 # "core/internal.h", "trace/sweep.h"...); the CLI sees the public header and
-# its own folder only, so the build proves it uses nothing but bumpbake.h;
-# tests and tools also see tests/ and src/ (internals they check, the CLI's
-# JSON writer).
+# its own folder only, so the build proves it uses nothing but bumpbake.h
+# (and the JSON writer it compiles into itself, below); tests and tools also
+# see tests/ and src/ (internals they check).
 CFLAGS  += -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(OPT) $(WARN)
 CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow
 LIB_INCLUDES  := -Iinclude -Isrc
@@ -139,7 +139,12 @@ TEST_C   := $(wildcard tests/*/test_*.c)
 TOOL_C   := $(filter-out tools/link_probe.c,$(wildcard tools/*.c))
 
 LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
-CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o)
+# The JSON writer is no part of the library's ABI: the CLI compiles its one
+# source, src/core/json.c (which includes nothing of the library), into
+# itself as cli/json.o; its compare, info and serve include src/core/json.h
+# by its relative path.
+CLI_JSON_OBJ := $(BUILD)/src/cli/json.o
+CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o) $(CLI_JSON_OBJ)
 TEST_OBJ := $(TEST_C:%.c=$(BUILD)/%.o)
 TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
 # The fuzz targets' code, compiled into the test binary to replay the saved
@@ -235,6 +240,10 @@ $(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(CLI_INCLUDES) $(MHD_CFLAGS)
 $(BUILD)/src/cli/serve/serve_page.o: $(SERVE_ASSETS)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
+$(CLI_JSON_OBJ): src/core/json.c $(BUILD)/compile.flags
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(CLI_INCLUDES) $(DEPFLAGS) -c $< -o $@
+
 $(BUILD)/%.o: %.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(EXTRA_CFLAGS) $(DEPFLAGS) -c $< -o $@
@@ -280,7 +289,7 @@ $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
 
-# The tools print JSON with the library's one writer (bb_json, src/core/json.c).
+# The tools print JSON with the library's one writer (bb__json, src/core/json.h).
 $(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
 	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
 
@@ -308,6 +317,9 @@ $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
                 $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
 	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
 
+# The public headers: bumpbake.h, and bumpbake_cluster.h beside it (the
+# advanced calls of drivers that spread the work over machines).
+PUBLIC_HEADERS := include/bumpbake.h include/bumpbake_cluster.h
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
 # (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
@@ -319,7 +331,7 @@ install: $(INSTALL_BIN) lib
 	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so
 	install -m 644 $(LIB) $(DESTDIR)$(LIBDIR)/libbumpbake.a
-	install -m 644 include/bumpbake.h $(DESTDIR)$(INCLUDEDIR)/bumpbake.h
+	install -m 644 $(PUBLIC_HEADERS) $(DESTDIR)$(INCLUDEDIR)/
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	  -e 's|@VERSION@|$(VERSION)|; s|@RPATH@|$(PC_RPATH)|; s|@LIBS_PRIVATE@|$(PC_LIBS_PRIVATE)|' \
@@ -335,7 +347,7 @@ install: $(INSTALL_BIN) lib
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/bumpbake $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL) \
 	  $(DESTDIR)$(LIBDIR)/$(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so \
-	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(DESTDIR)$(INCLUDEDIR)/bumpbake.h \
+	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(addprefix $(DESTDIR)$(INCLUDEDIR)/,$(notdir $(PUBLIC_HEADERS))) \
 	  $(DESTDIR)$(MANDIR)/man1/bumpbake.1 $(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 

@@ -1,4 +1,4 @@
-/* fuzz_compare.c: bb_compare_images on two small images made of raw
+/* fuzz_compare.c: bb__compare_images on two small images made of raw
  * floats (NaN, infinities and denormals included) with fuzzed thresholds.
  * Layout: width-1, height-1, channels-1 (low bits of 3 bytes), 2 floats of
  * thresholds, then A's samples and B's samples. Properties: no crash or
@@ -8,6 +8,7 @@
  * sides, too), infinity where one side is NaN. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
+#include "maps/maps_internal.h"
 
 #include <math.h>
 
@@ -56,7 +57,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   fill(&b, &p, end);
 
   bb_compare_stats s;
-  bb_status st = bb_compare_images(&a, &b, fail, warn, &s, &diff, &err);
+  bb_status st = bb__compare_images(&a, &b, fail, warn, &s, &diff, &err);
   if (bw != w) {
     FUZZ_CHECK(st == BB_ERR_SIZE && diff.pixels == NULL);
   } else if (st == BB_OK) {

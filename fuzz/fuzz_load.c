@@ -11,6 +11,7 @@
 #include "bumpbake.h"
 #include "image/height_channel.h"
 #include "fuzz_common.h"
+#include "image/oiio.h"
 
 #include <math.h>
 
@@ -58,7 +59,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
   /* Frames and mip levels: further subimages and levels, each opened. */
   int frames = 0, levels = 0;
-  if (bb_image_frame_count(path, &frames, &err) == BB_OK) {
+  if (bb__image_frame_count(path, &frames, &err) == BB_OK) {
     FUZZ_CHECK(frames >= 1);
   } else {
     FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);

@@ -1,15 +1,15 @@
-/* fuzz_mesh.c: model bytes -> bb_mesh_load -> bb_renderbump_flat at 16 x 16,
+/* fuzz_mesh.c: model bytes -> bb__mesh_load -> bb__renderbump_flat at 16 x 16,
  * the path of `bumpbake renderbumpflat`. The first byte picks the format
  * by extension (OBJ, glTF JSON, Collada XML, binary glTF) in its low two
  * bits and the render's axis and tiling above; the rest is the file,
  * alone in the scratch directory under its format's name.
  *
- * bb_mesh_load imports in a child process, which libFuzzer does not see;
+ * bb__mesh_load imports in a child process, which libFuzzer does not see;
  * so when the child answered quickly the import is run again here
  * (bb__mesh_import, the same code on a stack of the same size), where
  * coverage, AddressSanitizer and LeakSanitizer see Assimp and the confined
  * I/O. Inputs that crash or stall the child are the bounded failures
- * bb_mesh_load exists for and are not run again.
+ * bb__mesh_load exists for and are not run again.
  *
  * Properties: the caller never crashes, leaks or hangs; a failure is one
  * line naming the model; a mesh is within the limits, its indices in
@@ -18,6 +18,7 @@
 #include "bumpbake.h"
 #include "fuzz_common.h"
 #include "mesh/mesh_import.h"
+#include "mesh/mesh_internal.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -25,7 +26,7 @@
 
 static const char *const NAMES[] = {"m.obj", "m.gltf", "m.dae", "m.glb"};
 
-/* Seconds the child may take here (bb_mesh_load allows minutes); slower
+/* Seconds the child may take here (bb__mesh_load allows minutes); slower
  * inputs end as "took more than" errors instead of slow units. */
 enum { CHILD_CPU_SECONDS = 10, CHILD_WALL_SECONDS = 20 };
 /* The import is run again in this process only after a child this quick. */
@@ -81,17 +82,17 @@ static void compare_with_here(const char *path, bb_status st, const bb_mesh *m,
   pthread_attr_destroy(&attr);
   FUZZ_CHECK(h.status == st);
   if (st == BB_OK) {
-    FUZZ_CHECK(bb_mesh_hash(&h.mesh) == bb_mesh_hash(m));
+    FUZZ_CHECK(bb__mesh_hash(&h.mesh) == bb__mesh_hash(m));
     FUZZ_CHECK(strcmp(h.note, note) == 0);
   } else if (st != BB_ERR_MEMORY) { /* the child's names its memory limit */
     FUZZ_CHECK(strcmp(h.err.message, err->message) == 0);
   }
-  bb_mesh_free(&h.mesh);
+  bb__mesh_free(&h.mesh);
 }
 
 static void render(const bb_mesh *m, uint8_t choice) {
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 16;
   o.samples = 2;
   o.threads = 1;
@@ -104,7 +105,7 @@ static void render(const bb_mesh *m, uint8_t choice) {
   }
   bb_renderbump_result r;
   bb_error err;
-  bb_status st = bb_renderbump_flat(m, &o, &r, &err);
+  bb_status st = bb__renderbump_flat(m, &o, &r, &err);
   FUZZ_CHECK((st == BB_OK) == (r.normal.pixels != NULL));
   if (st != BB_OK) {
     FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);
@@ -154,6 +155,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     compare_with_here(path, st, &m, note, &err);
   if (st == BB_OK)
     render(&m, data[0]);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
   return 0;
 }

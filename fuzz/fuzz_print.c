@@ -9,6 +9,7 @@
 #include "cli/cli.h"
 #include "fuzz_common.h"
 #include "printed_text.h"
+#include "image/image_write.h"
 
 #include <fcntl.h>
 
@@ -73,7 +74,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (bb_image_alloc(&img, 2, 2, 1, NULL) != BB_OK)
     abort();
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, text, NULL};
-  if (bb_image_write(path, &img, &wo, NULL) == BB_OK) {
+  if (bb__image_write(path, &img, &wo, NULL) == BB_OK) {
     char *info[] = {"info", path, NULL};
     char *printed = captured(bb_cli_command, 2, info);
     FUZZ_CHECK(!has_control(printed));

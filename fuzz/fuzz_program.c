@@ -7,6 +7,7 @@
  * name reads outside the base. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
+#include "image/image_write.h"
 
 #include <math.h>
 
@@ -37,7 +38,7 @@ static void write_images(void) {
     char path[256];
     snprintf(path, sizeof path, "%s/%s", fuzz_scratch_dir(), files[f].name);
     const bb_write_options wo = {files[f].depth, BB_RANGE_UNIT, NULL, NULL};
-    if (bb_image_write(path, &img, &wo, NULL) != BB_OK)
+    if (bb__image_write(path, &img, &wo, NULL) != BB_OK)
       abort();
     bb_image_free(&img);
   }

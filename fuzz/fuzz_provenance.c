@@ -1,4 +1,4 @@
-/* fuzz_provenance.c: the provenance parser, bb_provenance_diff, on two
+/* fuzz_provenance.c: the provenance parser, bb__provenance_diff, on two
  * texts (split at the first NUL) and an output capacity taken from the
  * first byte (0, tiny and large), plus the round trip through
  * bb_provenance_format. Properties: no crash or overflow, the output always
@@ -7,6 +7,7 @@
  * differ in the scale alone gives exactly the "scale" difference. */
 #include "bumpbake.h"
 #include "fuzz_common.h"
+#include "files/provenance.h"
 
 static const size_t CAPACITIES[] = {0, 1, 2, 7, 64, 4096};
 
@@ -39,7 +40,7 @@ static void check_diff(const char *a, const char *b, size_t cap) {
   char *out = malloc(cap ? cap : 1);
   if (!out)
     abort();
-  int n = bb_provenance_diff(a, b, cap ? out : NULL, cap);
+  int n = bb__provenance_diff(a, b, cap ? out : NULL, cap);
   FUZZ_CHECK(n >= 0);
   if (cap) {
     FUZZ_CHECK(memchr(out, '\0', cap) != NULL);
@@ -63,8 +64,8 @@ static void check_round_trip(const char *a, const char *b) {
   char *t2 = bb_provenance_format(&p);
   FUZZ_CHECK(t1 && t2);
   char out[4096];
-  FUZZ_CHECK(bb_provenance_diff(t1, t1, out, sizeof out) == 0 && out[0] == '\0');
-  int n = bb_provenance_diff(t1, t2, out, sizeof out);
+  FUZZ_CHECK(bb__provenance_diff(t1, t1, out, sizeof out) == 0 && out[0] == '\0');
+  int n = bb__provenance_diff(t1, t2, out, sizeof out);
   FUZZ_CHECK(n == 1 && strncmp(out, "scale: 2 -> 3\n", sizeof out) == 0);
   free(t1);
   free(t2);
@@ -80,7 +81,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   check_diff(a, b, cap);
   check_diff(b, a, cap);
   char self[64];
-  FUZZ_CHECK(bb_provenance_diff(a, a, self, sizeof self) == 0);
+  FUZZ_CHECK(bb__provenance_diff(a, a, self, sizeof self) == 0);
   check_round_trip(a, b);
   free(a);
   free(b);

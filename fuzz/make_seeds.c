@@ -12,6 +12,10 @@
  * EXRs, in pairs; OUT_DIR/cli: the command lines of the docs' examples;
  * OUT_DIR/mesh: small models of each format fuzz_mesh reads. */
 #include "bumpbake.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "mesh/mesh_internal.h"
+#include "texture/texture.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -127,8 +131,8 @@ static int texture_seeds(const char *dir, const char *out) {
           o.description = "seed=1";
           snprintf(tmp, sizeof tmp, "%s/seed.vtf", out);
           snprintf(name, sizeof name, "texture%d_%s_7.%d%s.vtf", c,
-                   bb_texture_format_name(vtf[f]), version, mips ? "_mips" : "");
-          if (bb_texture_write(tmp, &img, &o, NULL) == BB_OK)
+                   bb__texture_format_name(vtf[f]), version, mips ? "_mips" : "");
+          if (bb__texture_write(tmp, &img, &o, NULL) == BB_OK)
             written += keep_seed(dir, name, tmp, 16);
         }
     for (size_t f = 0; f < sizeof dds / sizeof dds[0]; f++) {
@@ -138,8 +142,8 @@ static int texture_seeds(const char *dir, const char *out) {
       o.map = dds[f] == BB_TEXTURE_FORMAT_BC5 ? BB_MAP_NORMAL : BB_MAP_PLAIN;
       o.fast = 1;
       snprintf(tmp, sizeof tmp, "%s/seed.dds", out);
-      snprintf(name, sizeof name, "texture%d_%s.dds", c, bb_texture_format_name(dds[f]));
-      if (bb_texture_write(tmp, &img, &o, NULL) == BB_OK)
+      snprintf(name, sizeof name, "texture%d_%s.dds", c, bb__texture_format_name(dds[f]));
+      if (bb__texture_write(tmp, &img, &o, NULL) == BB_OK)
         written += keep_seed(dir, name, tmp, 15);
     }
     bb_image_free(&img);
@@ -180,7 +184,7 @@ static void load_seeds(const char *fixtures, const char *out) {
         continue;
       }
       snprintf(tmp, sizeof tmp, "%s/seed%s", out, LOAD_EXT[k]);
-      if (bb_image_write(tmp, &img, NULL, &err) == BB_OK)
+      if (bb__image_write(tmp, &img, NULL, &err) == BB_OK)
         written += keep_seed(dir, name, tmp, k);
     }
     bb_image_free(&img);
@@ -226,7 +230,7 @@ static void load_seeds(const char *fixtures, const char *out) {
       char name[64];
       snprintf(tmp, sizeof tmp, "%s/seed%s", out, depths[i].ext);
       snprintf(name, sizeof name, "depth%d%s", c, depths[i].ext);
-      if (bb_image_write(tmp, &img, &o, NULL) == BB_OK)
+      if (bb__image_write(tmp, &img, &o, NULL) == BB_OK)
         written += keep_seed(dir, name, tmp, depths[i].k);
     }
     bb_image *levels = NULL;
@@ -236,7 +240,7 @@ static void load_seeds(const char *fixtures, const char *out) {
         char name[64];
         snprintf(tmp, sizeof tmp, "%s/seed%s", out, LOAD_EXT[k]);
         snprintf(name, sizeof name, "mips%d%s", c, LOAD_EXT[k]);
-        if (bb_image_write_mips(tmp, levels, count, NULL, NULL) == BB_OK)
+        if (bb__image_write_mips(tmp, levels, count, NULL, NULL) == BB_OK)
           written += keep_seed(dir, name, tmp, k);
       }
       bb_mip_chain_free(levels, count);
@@ -247,17 +251,17 @@ static void load_seeds(const char *fixtures, const char *out) {
   bb_image frame = pattern(16, 12, 3);
   bb_animation *a = NULL;
   snprintf(tmp, sizeof tmp, "%s/seed.gif", out);
-  if (bb_animation_open(tmp, 16, 12, 10.0, &a, NULL) == BB_OK) {
+  if (bb__animation_open(tmp, 16, 12, 10.0, &a, NULL) == BB_OK) {
     int ok = 1;
     for (int f = 0; f < 3 && ok; f++) {
       for (size_t i = 0; i < 16u * 12u * 3u; i++)
         frame.pixels[i] = 1.0f - frame.pixels[i];
-      ok = bb_animation_add_frame(a, &frame, NULL) == BB_OK;
+      ok = bb__animation_add_frame(a, &frame, NULL) == BB_OK;
     }
-    if (ok && bb_animation_close(a, NULL) == BB_OK)
+    if (ok && bb__animation_close(a, NULL) == BB_OK)
       written += keep_seed(dir, "frames.gif", tmp, 7);
     else if (!ok)
-      bb_animation_abort(a);
+      bb__animation_abort(a);
   }
   bb_image_free(&frame);
   written += texture_seeds(dir, out);
@@ -454,7 +458,7 @@ static void write_part(const bb_mesh *m, size_t triangles, const char *path) {
   bb_mesh part;
   bb_error err;
   size_t n = triangles < m->triangle_count ? triangles : m->triangle_count;
-  if (bb_mesh_alloc(&part, 3 * n, n, m->normals != NULL, &err) != BB_OK) {
+  if (bb__mesh_alloc(&part, 3 * n, n, m->normals != NULL, &err) != BB_OK) {
     fprintf(stderr, "make_seeds: %s\n", err.message);
     exit(1);
   }
@@ -464,11 +468,11 @@ static void write_part(const bb_mesh *m, size_t triangles, const char *path) {
       memcpy(part.normals + 3 * i, m->normals + 3 * (size_t)m->indices[i], 3 * sizeof(float));
     part.indices[i] = (uint32_t)i;
   }
-  if (bb_mesh_write(path, &part, &err) != BB_OK) {
+  if (bb__mesh_write(path, &part, &err) != BB_OK) {
     fprintf(stderr, "make_seeds: %s\n", err.message);
     exit(1);
   }
-  bb_mesh_free(&part);
+  bb__mesh_free(&part);
 }
 
 static void mesh_seeds(const char *fixtures, const char *out) {
@@ -477,7 +481,7 @@ static void mesh_seeds(const char *fixtures, const char *out) {
   snprintf(model, sizeof model, "%s/rivet_panel.obj", fixtures);
   bb_mesh panel;
   bb_error err;
-  if (bb_mesh_load(model, &panel, &err) != BB_OK) {
+  if (bb__mesh_load(model, &panel, &err) != BB_OK) {
     fprintf(stderr, "make_seeds: %s\n", err.message);
     exit(1);
   }
@@ -495,7 +499,7 @@ static void mesh_seeds(const char *fixtures, const char *out) {
     write_seed(dir, KINDS[k], &LEAD[k], 1, bytes, size);
     free(bytes);
   }
-  bb_mesh_free(&panel);
+  bb__mesh_free(&panel);
   const unsigned char gltf_lead = 0x01, tiled_gltf_lead = 0x89, dae_lead = 0x02;
   write_seed(dir, "quad.gltf", &gltf_lead, 1, SEED_GLTF, sizeof SEED_GLTF - 1);
   write_seed(dir, "tiled.gltf", &tiled_gltf_lead, 1, SEED_GLTF, sizeof SEED_GLTF - 1);

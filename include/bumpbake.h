@@ -45,7 +45,6 @@
 extern "C" {
 #endif
 
-
 /* =====================================================================
  * core: status, errors, limits, images
  * ===================================================================== */
@@ -61,7 +60,7 @@ extern "C" {
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
  * allocating. What a machine can bake is less: reads and bakes estimate
  * their memory from the sizes first and refuse, naming the estimate and
- * what is available, what will not fit (bb_memory_available). */
+ * what is available, what will not fit (bb__memory_available). */
 #define BB_MAX_DIMENSION 65536
 #define BB_MAX_PIXELS (32768L * 32768L)
 
@@ -71,7 +70,7 @@ extern "C" {
  * file's own samples (texels x channels x bytes per sample, as its header
  * declares them) and the floats decoded (texels x channels read x 4) must
  * fit, checked before anything is allocated, and then what is available
- * (bb_memory_available) must hold them. What a reader allocates to open a
+ * (bb__memory_available) must hold them. What a reader allocates to open a
  * file at all (see bb_image_read_info) stays within BB_MAX_READ_BYTES
  * whatever the size. The first read or write also lowers OpenImageIO's
  * process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16 bytes (16384)
@@ -81,7 +80,7 @@ extern "C" {
  * installs bumpbake's provider for OpenEXR's global pool, unless the
  * process set that pool up first: it compresses the chunks of the EXR files
  * bumpbake writes on the write's threads (bb_outputs_write's, all cores for
- * bb_image_write), and leaves every other read and write of OpenEXR on its
+ * bb__image_write), and leaves every other read and write of OpenEXR on its
  * own thread. */
 #define BB_MAX_READ_BYTES (1L << 30)
 #define BB_MAX_READ_BYTES_PER_TEXEL 16
@@ -93,7 +92,7 @@ extern "C" {
 /* Most threads a bake, render or renderbump accepts (0 = all cores). */
 #define BB_MAX_THREADS 4096
 /* Largest smoothing radius a bake accepts, in texels: beyond a few hundred
- * the window covers any texture anyway. (bb_smooth_bilateral alone takes
+ * the window covers any texture anyway. (bb__smooth_bilateral_all_cores alone takes
  * more.) */
 #define BB_MAX_FILTER_RADIUS 4096
 /* Largest ray origin lift (texels) and lobe power a bake accepts. */
@@ -109,10 +108,10 @@ extern "C" {
  * weights and the trace's sums (memory) and one table per slice (time). */
 #define BB_MAX_BASIS 16
 
-/* Largest mesh bb_mesh_alloc accepts: vertices and triangles each. */
+/* Largest mesh bb__mesh_alloc accepts: vertices and triangles each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
 
-/* What reading one model (bb_mesh_load) may take. Model files are untrusted,
+/* What reading one model (bb__mesh_load) may take. Model files are untrusted,
  * and Assimp's importers build their own structures before bumpbake sees a
  * triangle, so the import runs in a child process held to these limits:
  * - BB_MAX_MODEL_BYTES: the model file and every file it refers to (a glTF's
@@ -181,33 +180,12 @@ const char *bb_text_printable(const char *s, char *out, size_t cap);
  * when word is NULL or out of memory. */
 char *bb_text_shell_quoted(const char *word);
 
-/* The length of the well-formed UTF-8 sequence at s (1 for ASCII), 0 for
- * the end of the string or bytes that are not UTF-8 (overlong forms,
- * surrogates and code points past U+10FFFF included). */
-size_t bb_utf8_sequence(const char *s);
-
 typedef struct bb_image {
   int width;      /* texels */
   int height;     /* texels */
   int channels;   /* interleaved floats per texel */
   float *pixels;  /* width*height*channels floats, row 0 at the top */
 } bb_image;
-
-/* What this process may still allocate, in bytes: the smallest of what
- * the system has available (MemAvailable of /proc/meminfo, else its free
- * pages); under a container's or service's memory limit, the room left
- * below the limit of every cgroup from the process's own up to the top
- * (cgroup v2's memory.max, v1's memory.limit_in_bytes; the limit less the
- * group's usage, its reclaimable page cache not counted); and, under an
- * RLIMIT_AS (ulimit -v), the room left below it (the limit less the
- * address space mapped now). *source (may be NULL) receives which
- * ("MemAvailable", "sysconf free pages", "cgroup memory.max", "cgroup
- * memory.limit_in_bytes", "RLIMIT_AS"). Bakes and reads
- * check their estimate against it before allocating, so one too large is
- * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
- * the process; several processes started at once each see the same
- * figure. Errors: BB_ERR_IO (neither can be read). */
-bb_status bb_memory_available(uint64_t *bytes, const char **source, bb_error *err);
 
 /* The size rule of bb_image_alloc, without allocating: BB_OK, or its
  * error (BB_ERR_SIZE, BB_ERR_ARGUMENT) for an image of that size, so a
@@ -230,9 +208,6 @@ float *bb_image_texel(const bb_image *img, int x, int y);
 
 /* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
 void bb_image_flip_green(bb_image *img);
-
-/* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
-uint64_t bb_image_hash(const bb_image *img);
 
 /* Addressing of texels outside the image. */
 typedef enum bb_addressing {
@@ -320,33 +295,6 @@ typedef struct bb_map_kind_info {
  * 0..BB_MAP_KIND_COUNT-1. */
 const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
 
-/* The kind named name (bb_map_kind_info.name, any case); returns 0 on
- * success, BB_ERR_ARGUMENT for an unknown name (out untouched). */
-bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
-
-/* The name of kind, or "unknown". */
-const char *bb_map_kind_name(bb_map_kind kind);
-
-/* The rule of what a map records in its provenance, which every writer and
- * reader of provenance follows: 1 when the pixels of a map of output kind
- * `kind` (as provenance records it under "output": "normal", "ao", ...; a
- * kind of parts, "ssbump+height", records what any part records, "height"
- * being the filtered height) can change with the bake parameter recorded
- * under `key`, 0 when they cannot: a normal map does not depend on "rays",
- * "rayset", "bias", "power", "basis", "bounce" or "brightness", the
- * filtered height on "scale" either, ao not on "normal_filter" or
- * "normal_y", and ao on "power" and "basis" only with inter-reflection
- * (bounce nonzero: the text has a "bounce" key); without it, ao's "rayset"
- * is recorded as the ray set's scheme and slices only ("bb-horizon-v1:a16").
- * A bake's outputs record only such keys (bb_provenance_format), the
- * up-to-date check (bb_output_check) and bb_provenance_diff compare only
- * them, so a parameter that does not change a map neither makes it stale
- * nor shows in its diff, also against a file written before the rule that
- * holds them all. 1 for keys that are no bake parameter (bumpbake_version,
- * input_file_hash, channel, a texture's or a render's keys) and for kinds
- * that are not a bake's maps ("render", "normal+coverage"). */
-int bb_map_kind_records(const char *kind, const char *key, int bounce);
-
 /* =====================================================================
  * files: checked, all-or-nothing writes of files; provenance texts read
  * ===================================================================== */
@@ -359,63 +307,7 @@ int bb_map_kind_records(const char *kind, const char *key, int bounce);
  * failure changes nothing on disk (bumpbake bake does this). */
 typedef struct bb_staged_file bb_staged_file;
 
-/* Renames the staged file to its path and frees the handle (also when the
- * rename fails, which removes the temporary). Errors: BB_ERR_IO. */
-bb_status bb_staged_file_commit(bb_staged_file *staged, bb_error *err);
-
-/* Removes the staged file's temporary and frees the handle; NULL is fine. */
-void bb_staged_file_discard(bb_staged_file *staged);
-
-/* The destination path of a staged file (owned by the handle). */
-const char *bb_staged_file_path(const bb_staged_file *staged);
-
-/* Writes size bytes of data to path (a text file: a depfile, a list) the way
- * images are written: through a temporary in path's directory, flushed,
- * synced and renamed into place, so path is either untouched or whole. The
- * temporary is removed on failure, and by bb_tempfiles_remove on a signal.
- * A path that exists and is not a regular file (a device, a FIFO, a
- * symbolic link, /dev/stdout) is refused, never renamed over.
- * Errors: BB_ERR_ARGUMENT (no path, or NULL data with a size),
- * BB_ERR_MEMORY, BB_ERR_IO ("PATH: cannot write: reason"). */
-bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err);
-
-/* Removes every temporary file a write of this process has open right now
- * (staged files included). Async-signal-safe: call it from a SIGINT or
- * SIGTERM handler, then re-raise the signal with the default action, and an
- * interrupted run leaves no temporary behind. Only files whose names this
- * library created are removed. A temporary being made on another thread at
- * that moment is waited for (those threads hold SIGINT, SIGTERM and SIGHUP
- * off while they make one), and from then on the process is taken to be
- * ending: a write that starts makes no temporary and fails (BB_ERR_IO). At
- * most 4096 temporaries are tracked at once; further ones are still removed
- * on errors, but not by this function. */
-void bb_tempfiles_remove(void);
-
-/* Removes from directory dir (not below it) the temporaries
- * ".bb-tmp-XXXXXX.EXT" whose writer is gone, and the private directories
- * ".bb-tmp-XXXXXX" some encoders write in with what they hold: a writer
- * holds an advisory lock (flock) on its temporary from its creation until
- * it is renamed into place or removed, and the kernel drops it when the
- * process dies, so one that no process holds is what a process killed
- * outright (SIGKILL, an out-of-memory kill, a lost machine) left behind.
- * Temporaries being written, by this process or any other, on this machine
- * or another sharing the directory (NFS v4 carries flock), are left alone,
- * and so is a private directory holding anything but its staged file. *removed (may be
- * NULL) receives how many were removed. Errors: BB_ERR_ARGUMENT (no dir),
- * BB_ERR_IO (dir cannot be read, an orphan cannot be removed). */
-bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
-
 /* ---------------------------------------------------- provenance texts */
-
-/* Writes into out (capacity cap) the keys whose values differ between two
- * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
- * when either text is NULL). Keys "command" and "output" are ignored, and so
- * is a key neither text's kind ("output") records (bb_map_kind_records:
- * "rays" of a normal map; an ao's "rayset" is compared by its scheme and
- * slices alone without inter-reflection). Returns
- * the number of differing keys, or -1 when out of memory. Time is
- * O(n log n) in the number of lines, whatever the texts hold. */
-int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap);
 
 /* What an image description holds, for readers of provenance. */
 typedef enum bb_provenance_class {
@@ -451,12 +343,6 @@ typedef struct bb_provenance_entry {
  * lines. */
 long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 
-/* The value of key in a provenance text (its first "key=value" line) into
- * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
- * there, 0 when it is not or description is NULL (out is then ""). So a
- * reader can ask which basis a map was baked with ("basis"). */
-int bb_provenance_value(const char *description, const char *key, char *out, size_t cap);
-
 /* =====================================================================
  * texture: engine textures (VTF, DDS) and Source materials, which
  * OpenImageIO does not write
@@ -471,7 +357,7 @@ int bb_provenance_value(const char *description, const char *key, char *out, siz
  *
  * Every format stores what the engine samples: values in [0, 1] as they
  * are and normal maps as 0.5 + 0.5 N, the float formats included (a shader
- * unpacks 2 t - 1 whatever the format; this differs from bb_image_write's
+ * unpacks 2 t - 1 whatever the format; this differs from bb__image_write's
  * float files, which store N). Integer and block formats clamp to [0, 1]
  * and round to 8 bits first. Channels: 1 is grey (v, v, v), 2 are R and G,
  * 3 are R, G, B; alpha is 1 unless the image has a fourth channel. */
@@ -496,8 +382,6 @@ typedef enum bb_texture_format {
 
 /* Parses a format name above (any case); "default" is BB_TEXTURE_FORMAT_DEFAULT. */
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-/* The first name of format ("bc1", ...), "default", or "unknown". */
-const char *bb_texture_format_name(bb_texture_format format);
 /* Parses a VTF version as --vtf-version takes it: "7.2" to "7.5", or the
  * minor number alone ("2" to "5"); *minor receives 2..5. */
 bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
@@ -544,44 +428,6 @@ typedef struct bb_texture_options {
 /* Defaults: format DEFAULT, map PLAIN, mips 1, fast 0, threads 0, VTF 7.2, no
  * extra flag, no description. */
 void bb_texture_options_init(bb_texture_options *options);
-
-/* True (1) when path's extension (any case) is .vtf or .dds, the containers
- * bb_texture_write writes. */
-int bb_path_is_texture_format(const char *path);
-
-/* Checks, before any work, that a width x height image of `channels`
- * channels can go to path (.vtf or .dds) with options, so a caller can
- * refuse a bad request before a long bake. BB_ERR_ARGUMENT with the reason
- * for: another extension; a format the container does not have (VTF: bc1,
- * bc3, bgr888, bgra8888, rgba16f; DDS: bc1, bc3, bc4, bc5, rgba8, rgba16f,
- * rgba32f); a format that cannot hold the channels (bc1 and bgr888 take at
- * most 3, the others 4; bc4 exactly 1; bc5 2, or a normal map's 3); a
- * normal map of fewer than 3 channels; a VTF side that is not a power of
- * two or over 32768 (Source); a block format (bc*) whose width or height is
- * not a multiple of 4; a VTF version outside 2..5 or the ENVMAP flag; an
- * unknown format or map. */
-bb_status bb_texture_check(const char *path, int width, int height, int channels,
-                           const bb_texture_options *options, bb_error *err);
-
-/* Sets options->map for a file of an output kind (a kind string as
- * bb_output_file's: NAME or NAME+EXTRA, a NAME map with EXTRA in its last
- * channel, "ssbump+height") holding values of range: the kind NAME names
- * (bb_map_kind_info.name, or "detail-ssbump", an ssbump), whose facts then
- * decide its mip rule, DDS default and VTF flags; except that a normal or
- * bent map not of BB_RANGE_SIGNED was packed into [0, 1] already ("normal+ao",
- * height2ssbump -n's): PLAIN, with the kind's BB_VTF_FLAG_NORMAL added to
- * options->vtf_flags. Any other kind ("height", "colour", "render", ...):
- * NORMAL for BB_RANGE_SIGNED values, else PLAIN. bb_outputs_write applies
- * it to every .vtf and .dds it writes, bb_outputs_check to every one it
- * checks. */
-void bb_texture_options_for(bb_texture_options *options, const char *kind, bb_range range);
-
-/* The "key=value" lines bb_image_write adds to a texture's provenance, so
- * an up-to-date check sees a changed texture setting: texture (vtf or
- * dds), texture_format, texture_mips, texture_fit (cluster or range), and
- * for VTF vtf_version and vtf_flags (hex). options may be NULL (the
- * defaults). malloc'd; NULL for another extension or out of memory. */
-char *bb_texture_provenance(const char *path, const bb_texture_options *options);
 
 /* What a VTF file's header says (bb_vtf_read_info). */
 typedef struct bb_vtf_info {
@@ -668,7 +514,7 @@ typedef struct bb_vmt_options {
  * without ".vtf", as Source looks textures up. Paths are compared as
  * written, made absolute against the working directory, "." and ".."
  * resolved, symbolic links not followed (the textures need not exist yet).
- * Written as bb_file_write writes. Errors: BB_ERR_ARGUMENT (no path or
+ * Written as bb__file_write writes. Errors: BB_ERR_ARGUMENT (no path or
  * bumpmap; a path not ending in ".vmt" (any case), or naming the same file
  * as the bump map or base texture (a hard link), which would be
  * overwritten; no materials_dir and no "materials" folder above the bump map;
@@ -676,12 +522,6 @@ typedef struct bb_vmt_options {
  * control character in a path, which a material cannot quote);
  * BB_ERR_MEMORY; BB_ERR_IO. */
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
-
-/* The text bb_vmt_write writes, malloc'd into *text (*size bytes), for a
- * caller that writes it with other files (bb_outputs_write). Errors as
- * bb_vmt_write's, without BB_ERR_IO. */
-bb_status bb_vmt_text(const char *path, const bb_vmt_options *options, char **text,
-                      size_t *size, bb_error *err);
 
 /* =====================================================================
  * image: image files in and out, mip chains, animations, the height input
@@ -746,10 +586,6 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
 bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
                             bb_image_info *info, int *level_count, bb_error *err);
 
-/* Number of subimages (frames) in an image file (1 for a VTF or DDS: the
- * frame read). */
-bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err);
-
 /* ------------------------------------------------------ writing images */
 
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
@@ -764,9 +600,6 @@ typedef enum bb_depth {
 
 /* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
-/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
- * for values outside the enum. */
-const char *bb_depth_name(bb_depth depth);
 
 typedef struct bb_write_options {
   bb_depth depth;
@@ -782,102 +615,7 @@ typedef struct bb_write_options {
                               PLAIN otherwise. description overrides its own */
 } bb_write_options;
 
-/* Writes img to path; the format comes from the extension (.png .tga .tif
- * .tiff .exr, and the engine textures .vtf and .dds, written by
- * bb_texture_write with options->texture: depth must then be
- * BB_DEPTH_DEFAULT, the texture format sets it; with a description, the
- * texture's settings are added to it as bb_texture_provenance's lines).
- * Integer formats clamp to the code range and round to nearest.
- * Channels are R, G, B, A for up to 4; an image of more (a basis map with
- * more than 4 directions) has them named B0, B1, ... instead, zero-padded
- * to one width (B00..B15 for 16) because OpenEXR keeps channels sorted by
- * name, and none is alpha.
- * The file is written to a temporary file in the destination directory,
- * every write checked, then flushed, fsynced and closed (checked) and only
- * then renamed into place, so a failure (a full disk included) leaves no
- * partial file and nothing at path. Errors: BB_ERR_FORMAT (unknown
- * extension, depth not supported by the format), BB_ERR_IO (cannot write:
- * the message gives the system's reason, e.g. "No space left on device"). */
-bb_status bb_image_write(const char *path, const bb_image *img,
-                         const bb_write_options *options, bb_error *err);
-
-/* bb_image_write up to, not including, the rename: on success *staged
- * receives the handle; on failure it is NULL and nothing is left on disk.
- * The handle must be passed to bb_staged_file_commit or _discard. */
-bb_status bb_image_write_staged(const char *path, const bb_image *img,
-                                const bb_write_options *options,
-                                bb_staged_file **staged, bb_error *err);
-
-/* True (1) when the extension of path (any case) is one OpenImageIO has a
- * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
- * caller can pick the images out of a directory without opening each file.
- * It says nothing of the file's contents. */
-int bb_path_is_readable_format(const char *path);
-
-/* True (1) when the extension of path names a format bb_image_write knows
- * (.vtf and .dds included). */
-int bb_path_is_writable_format(const char *path);
-
-/* True (1) when bb_image_write can store depth in the format path's extension
- * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
- * bad combination before a long bake rather than after it. */
-int bb_path_supports_depth(const char *path, bb_depth depth);
-
-/* Most channels bb_image_write can store in the format path's extension
- * names: 4 for .png, .tga, .vtf and .dds, 64 for .tif, .tiff and .exr; 0 for an unknown
- * extension. So a caller can refuse a basis with more directions than the
- * file can hold before the bake. */
-int bb_path_max_channels(const char *path);
-
-/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr; .vtf
- * and .dds, which have one unless bb_texture_options.mips is 0). */
-int bb_path_supports_mips(const char *path);
-
-/* Writes a mip chain (levels[0] the largest, each the halved size of the one
- * before, as bb_mip_chain makes it) as one tiled, mip-mapped TIFF or
- * OpenEXR file, every level encoded as bb_image_write encodes an image, and
- * written to a temporary name and renamed as it does; or as a .vtf or .dds
- * texture holding these levels (options->texture's mips is then ignored).
- * Errors as bb_image_write's; BB_ERR_FORMAT for a format without mip maps. */
-bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
-                              const bb_write_options *options, bb_error *err);
-
-/* bb_image_write_mips up to, not including, the rename, as
- * bb_image_write_staged: commit or discard *staged. */
-bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
-                                     const bb_write_options *options,
-                                     bb_staged_file **staged, bb_error *err);
-
 /* ------------------------------------------------------- texture files */
-
-/* Writes img to path as a VTF or DDS texture (by extension), after
- * bb_texture_check; options may be NULL (the defaults). The mip chain is
- * made here (options->mips).
- *
- * VTF (Valve's layout: VTFLib's VTFFormat.h and the Valve Developer
- * Community's "Valve Texture Format" page): an 80-byte header (7.3 and up:
- * followed by a resource dictionary of 8-byte entries), reflectivity the
- * mean of (code / 255)^2.2 per channel over the 8-bit top level (as vtex and
- * VTFLib compute it), bump scale 1, one frame, depth 1, the low-resolution
- * image as DXT1 at the first mip size of at most 16 x 16, then every level,
- * smallest first. Flags: the map's, BB_VTF_FLAG_NOMIP | NOLOD without mips,
- * EIGHTBITALPHA for a 4-channel image in a format with alpha, and
- * options->vtf_flags.
- *
- * DDS: "DDS " and the 124-byte header, levels largest first. BC1 and BC3
- * carry FourCC DXT1 and DXT5; BC4 and BC5 ATI1 and ATI2 (the oldest codes,
- * which every DDS reader knows, OpenImageIO's included); a BC5 normal map
- * also carries the DDPF_NORMAL flag (0x80000000, NVIDIA's), which tells
- * readers that know it (OpenImageIO) to rebuild z. RGBA8 is a 32-bit RGB +
- * alpha pixel format with masks; RGBA16F and RGBA32F need, and get, the
- * DX10 header (DXGI_FORMAT_R16G16B16A16_FLOAT and _R32G32B32A32_FLOAT).
- * OpenImageIO 2.4 reads every DDS written here except those two float ones.
- *
- * The file is written as bb_image_write writes, through a temporary renamed
- * into place. Errors: as bb_texture_check; BB_ERR_VALUE (NaN or infinite
- * texels); BB_ERR_MEMORY; BB_ERR_IO. */
-bb_status bb_texture_write(const char *path, const bb_image *img,
-                           const bb_texture_options *options, bb_error *err);
 
 /* ---------------------------------------------------------- mip chains */
 
@@ -904,25 +642,9 @@ void bb_mip_chain_free(bb_image *levels, int count);
 
 /* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
  * channel, a palette per frame). Frames go to a temporary file in the
- * destination directory; bb_animation_close checks it and renames it into
+ * destination directory; bb__animation_close checks it and renames it into
  * place, so a failure leaves no partial file. GIF stores no provenance. */
 typedef struct bb_animation bb_animation;
-
-/* Starts path (extension .gif) for frames of width x height, shown at
- * frames_per_second (1..100). Errors: BB_ERR_FORMAT (not .gif), BB_ERR_IO. */
-bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
-                            bb_animation **out, bb_error *err);
-
-/* Appends a frame: 3 channels, the open size, values in [0, 1]. On failure
- * the animation stays open; bb_animation_abort it. */
-bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err);
-
-/* Finishes the file, reads it back to check its frame count, renames it into
- * place and frees a, also on failure (then no file is left). */
-bb_status bb_animation_close(bb_animation *a, bb_error *err);
-
-/* Removes the temporary file and frees a; safe on NULL. */
-void bb_animation_abort(bb_animation *a);
 
 /* -------------------------------------------------------- height input */
 
@@ -942,8 +664,6 @@ typedef enum bb_channel {
 
 /* Parses "r", "g", "b", "a", "luma", "mean", "auto", "valve" (any case). */
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
-/* The name bb_channel_parse accepts; "unknown" for other values. */
-const char *bb_channel_name(bb_channel c);
 
 /* The channel the rule takes from img when asked for `channel`: channel
  * itself, except for two rules. BB_CHANNEL_AUTO reads img once and gives
@@ -983,31 +703,6 @@ typedef struct bb_basis {
                                       the vectors); recorded in provenance */
 } bb_basis;
 
-/* The default basis, "hl2": Half-Life 2's B0, B1, B2 (header top). */
-void bb_basis_init(bb_basis *b);
-
-/* Unit vector of Half-Life 2's direction index 0..3 into v (3 is the
- * optional B3 = (0, 0, 1) of "hl2+z"); an index outside gives zeros. */
-void bb_basis_vector(int index, double v[3]);
-
-/* "dirs:N": N directions (3..BB_MAX_BASIS) evenly spread in azimuth at
- * Half-Life 2's elevation asin(1/sqrt(3)) (35.26 degrees):
- *   B_c = (sqrt(2/3) cos(phi_c), sqrt(2/3) sin(phi_c), 1/sqrt(3)),
- *   phi_c = 360 c / N degrees,
- * in the +Y-down frame: B_0 lights from the right (+x) and phi grows from
- * +x towards +y (the bottom of the image), clockwise on screen, the way
- * Half-Life 2's B1 and B2 lie at 120 and 240 degrees. So "dirs:3" is "hl2"
- * bit for bit (a direction of N's that is one of Half-Life 2's takes its
- * constants: "dirs:6" holds B0, B1, B2 in channels 0, 2, 4), and a quarter
- * turn is exact ((0, +-sqrt(2/3)) for N a multiple of 4). BB_ERR_ARGUMENT
- * for N outside 3..BB_MAX_BASIS; out is untouched then. */
-bb_status bb_basis_dirs(int count, bb_basis *out, bb_error *err);
-
-/* A named basis: "hl2", "hl2+z" or "dirs:N" (bb_basis_dirs), exactly as
- * written. BB_ERR_ARGUMENT with a message saying what is accepted for any
- * other text; out is untouched then. */
-bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
-
 /* A basis of count (3..BB_MAX_BASIS) vectors of the caller's, each scaled
  * to unit length; named "vectors:" + the FNV-1a hash of the unit vectors'
  * bits. Rejects (BB_ERR_ARGUMENT, naming the vector's index from 0) a NaN
@@ -1016,43 +711,14 @@ bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
 bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
                                 bb_error *err);
 
-/* Parses a basis file's text: one direction "x y z" per line (numbers as
- * strtod reads them, separated by blanks or commas), '#' starts a comment
- * that runs to the end of the line, blank lines are skipped; then as
- * bb_basis_from_vectors. source names the text in messages, which read
- * "SOURCE:LINE: reason" (BB_ERR_FORMAT for a line that is not three
- * numbers, BB_ERR_ARGUMENT for a vector or a count the basis refuses). */
-bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out,
-                             bb_error *err);
-
-/* Reads a basis file (format: bb_basis_read_text) of at most 64 KiB.
- * Errors: BB_ERR_IO (missing, unreadable, a directory), BB_ERR_SIZE (over
- * 64 KiB), and those of bb_basis_read_text, each naming path. */
-bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
-
-/* Readers of basis maps (render, ssbump2normal, combine --detail) take
- * channels 0..2 as Half-Life 2's B0, B1, B2. BB_OK when a map file (its
- * decoded img and its description, the provenance text, may be NULL) can
- * be one: at most 4 channels, and a provenance basis, if any, that is
- * Half-Life 2's (hl2, hl2+z, dirs:3: bb_basis_is_hl2); else
- * BB_ERR_ARGUMENT saying which ("baked with --basis dirs:6; this reads
- * Half-Life 2's basis (bake with --basis hl2)"). */
-bb_status bb_basis_map_check(const bb_image *img, const char *description, bb_error *err);
-
 /* A basis as the command line names it: "hl2", "hl2+z" or "dirs:N" (a name
  * wins over a file of the same name, which ./NAME reaches), else the path
- * of a basis file (bb_basis_load). BB_ERR_ARGUMENT for a word that is
+ * of a basis file (bb__basis_load). BB_ERR_ARGUMENT for a word that is
  * neither ("basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of
  * directions (got 'x': No such file or directory)") or a dirs:N out of
  * range; a file's own errors otherwise. *from_file (may be NULL) receives 1
  * when spec named a file. out is untouched on failure. */
 bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
-
-/* 1 when b holds Half-Life 2's B0, B1, B2 in channels 0..2 bit for bit
- * ("hl2", "dirs:3", and "hl2+z", whose B3 is a fourth channel), which the
- * consumers of 3-channel basis maps (render, ssbump2normal, Valve's
- * files) assume; else 0. */
-int bb_basis_is_hl2(const bb_basis *b);
 
 /* ------------------------------------------------------------- pyramid */
 
@@ -1060,23 +726,12 @@ int bb_basis_is_hl2(const bb_basis *b);
  * once per bake, read-only afterwards and safe to share between threads. */
 typedef struct bb_pyramid bb_pyramid;
 
-/* Builds the pyramid of a 1-channel field of heights in texels (already
- * multiplied by the height scale). The field is copied. */
-bb_status bb_pyramid_build(const bb_image *height_texels,
-                           bb_addressing addressing, bb_pyramid **out,
-                           bb_error *err);
-
 void bb_pyramid_free(bb_pyramid *p);
 
 /* ------------------------------------------------------------- ray set */
 
-/* Azimuth slices a budget of `rays` rays per texel stands for, as Valve's
- * tool counts rays: round(sqrt(rays)), at least 1 (so -r 250 and 256 both
- * give 16). */
-int bb_slices_for_rays(int rays);
-
 /* The directions the bake integrates over, and how; opaque, built by
- * bb_rayset_make, read-only afterwards and safe to share between threads.
+ * bb__rayset_new, read-only afterwards and safe to share between threads.
  * ("Ray set" is the historical name: nothing is sampled in elevation.)
  * Slice s follows the integer lattice step (a, b) nearest to the azimuth
  * 2 pi (s + 1/2) / A and stands for the azimuth sector halfway to its
@@ -1090,14 +745,6 @@ int bb_slices_for_rays(int rays);
  *   vis_c = 1 - sum_s blocked_c,s(t_s) / total_c
  * so an unobstructed texel gets exactly 1. */
 typedef struct bb_rayset bb_rayset;
-
-/* Builds the slices and their integration tables: slices in
- * 1..BB_MAX_SLICES, power >= 1, one lobe per direction of basis (NULL:
- * "hl2"; copied). The tables cost slices x basis->count x 8 KiB and their
- * build time grows with the same product. On success *out receives the
- * ray set; free it with bb_rayset_free. */
-bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset **out,
-                         bb_error *err);
 
 /* Frees a ray set; NULL is fine. */
 void bb_rayset_free(bb_rayset *rs);
@@ -1114,10 +761,9 @@ const char *bb_rayset_id(const bb_rayset *rs);
 
 typedef struct bb_trace_options bb_trace_options;
 
-/* A trace of the caller's, which bb_bake calls in place of
- * bb_trace_occlusion (bb_trace_options.trace): for the pyramid and ray set
- * the bake built, it fills vis exactly as bb_trace_occlusion(p, rs, o, vis)
- * would: allocated (bb_image_alloc), the pyramid's size, 1 +
+/* A trace of the caller's, which bb_bake calls in place of its own
+ * (bb_trace_options.trace): for the pyramid and ray set the bake built, it
+ * fills vis exactly as the bake's own trace of them with o would: allocated (bb_image_alloc), the pyramid's size, 1 +
  * bb_rayset_lobe_count(rs) channels. A trace split over machines does this
  * with bb_trace_horizons, bb_trace_accumulate and bb_trace_finish, so the
  * bake's maps are a single bake's bits. Returns BB_OK, or an error with err
@@ -1147,71 +793,13 @@ struct bb_trace_options {
                               theirs */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
-                           bb_trace_occlusion; else bb_bake calls
+                           bb__trace_occlusion; else bb_bake calls
                            trace(trace_user, ...) in its place (bb_trace_fn).
-                           bb_trace_occlusion itself ignores it */
+                           bb__trace_occlusion itself ignores it */
   void *trace_user;
 };
 
-void bb_trace_options_init(bb_trace_options *o);
-
-/* Finds every texel's horizon in each slice of rs and integrates it (see
- * bb_rayset). Allocates vis with 1 + bb_rayset_lobe_count(rs) channels: ao, vis_0,
- * vis_1, ... in [0, 1], over the whole pyramid or over o->region (which
- * must lie inside it). Sweeps and marches find the same horizons, so a
- * region's texels are bit-identical to the same texels of a whole trace,
- * and the result is bit-identical for any thread count. horizons_found (may
- * be NULL) receives texels * slices. BB_ERR_CANCELLED when o->progress
- * returned nonzero (vis is then left unallocated). */
-bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
-                             const bb_trace_options *o, bb_image *vis,
-                             double *horizons_found, bb_error *err);
-
-/* A trace split over processes or machines (Python's bumpbake.dask bakes
- * big maps so): each finds the horizons of some of the slices
- * (bb_trace_horizons), and one adds them up (bb_trace_accumulate) in the
- * order every trace adds them (bb_trace_slice_order) and turns the sums into
- * visibilities (bb_trace_finish). The result is bb_trace_occlusion's, bit
- * for bit: the same horizons, the same losses, added in the same order. */
-
-/* The order in which every trace adds its slices' losses to a texel's sums:
- * order[k] is the slice added k-th (k is its rank), for k = 0 ..
- * bb_rayset_slice_count(rs) - 1; each slice is followed by its opposite
- * (lattice step (-a, -b)) when the set has one. Errors: BB_ERR_ARGUMENT,
- * BB_ERR_MEMORY. */
-bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err);
-
-/* The horizon of every texel in count distinct slices of rs, found by the
- * line sweeps bb_trace_occlusion runs: horizons[k] (allocated here: 1
- * channel, the pyramid's size) holds slice slices[k]'s horizons, tangents of
- * elevation >= 0 (rise per texel of horizontal distance; 0 where nothing
- * rises above the origin), the floats the whole trace adds up. A slice and
- * its opposite asked together share one sweep, as they do in the whole
- * trace. o->region must be empty (the whole pyramid); o->bias_texels,
- * o->threads and o->progress (once per sweep) as for bb_trace_occlusion.
- * Memory: 4 bytes per texel per slice, plus a line's profile per thread.
- * Errors: BB_ERR_ARGUMENT (a slice out of range or asked twice, a region),
- * BB_ERR_MEMORY, BB_ERR_CANCELLED; then no image is left allocated. */
-bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
-                            const bb_trace_options *o, const int *slices, int count,
-                            bb_image *horizons, bb_error *err);
-
-/* Adds what slice order[rank] (bb_trace_slice_order) loses at each texel's
- * horizon (horizon: that slice's image from bb_trace_horizons) to sums:
- * 1 + bb_rayset_lobe_count(rs) channels (ao first, then each lobe), the
- * horizons' size, all zeros before rank 0 (bb_image_alloc makes them so).
- * Called for ranks 0, 1, ..., slice count - 1 in turn, each once, it adds
- * what bb_trace_occlusion adds in the order it adds it, so the sums are the
- * same bits; the caller keeps to that order. threads: 0 = all cores (the
- * same bits for any). Errors: BB_ERR_ARGUMENT (rank out of range, sizes or
- * channels that do not match). */
-bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
-                              bb_image *sums, int threads, bb_error *err);
-
-/* Turns sums, once every rank is added, into visibilities in place: ao,
- * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as bb_trace_occlusion
- * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
-bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
+/* A trace split over processes or machines: bumpbake_cluster.h. */
 
 /* =====================================================================
  * bake: smooth -> normals -> pyramid -> trace -> derive
@@ -1224,15 +812,6 @@ typedef struct bb_smooth_options {
   float threshold;       /* T in normalised height units, > 0. Default 2/255 */
   bb_addressing addressing;
 } bb_smooth_options;
-
-void bb_smooth_options_init(bb_smooth_options *o);
-
-/* Valve's tileable bilateral filter (docs/conventions.md "Smoothing") of every
- * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
- * with in's size and channels. */
-bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
-                              const bb_smooth_options *o, bb_image *out,
-                              bb_error *err);
 
 /* ------------------------------------------------------------- normals */
 
@@ -1248,15 +827,7 @@ typedef enum bb_normal_filter {
                           vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
 
-/* Parses "vertex", "valve", "central", "sobel". */
-bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb_normal_filter_name(bb_normal_filter f);
-
-/* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
- * height: 1 channel; out: allocated, 3 channels. */
-bb_status bb_normals_compute(const bb_image *height, float height_scale,
-                             bb_normal_filter filter, bb_addressing addressing,
-                             bb_image *out, bb_error *err);
 
 typedef struct bb_normal_decode_options {
   int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
@@ -1290,24 +861,7 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float,
 bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
                             bb_error *err);
 
-/* ssbump s_c = max(0, N.B_c) * vis_c, for the channels of vis after ao
- * (vis as bb_trace_occlusion makes it: 1 + basis->count channels; with
- * basis NULL, 4 or 5). out (allocated): count channels. */
-bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
-                           const bb_basis *basis, bb_image *out, bb_error *err);
-
-/* ao as a 1-channel image (channel 0 of vis). */
-bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err);
-
-/* Bent normal normalize(sum_c s_c B_c) over the basis' channels of ssbump
- * (basis->count of them; with basis NULL, 3 or 4); (0, 0, 1) where every
- * s_c is 0. out (allocated): 3 channels, +Y down. */
-bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
-                         bb_error *err);
-
 /* ---------------------------------------------------------------- bake */
-
-
 
 typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
@@ -1322,7 +876,7 @@ typedef struct bb_bake_options {
                                  bake (smooth, normals, pyramid, trace,
                                  derive); progress, which may cancel */
   double power;               /* P in 1..BB_MAX_POWER, default 1 */
-  bb_basis basis;             /* default "hl2" (bb_basis_init); weights and
+  bb_basis basis;             /* default "hl2" (bb__basis_init); weights and
                                  ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
@@ -1372,15 +926,9 @@ typedef struct bb_bake_options {
 void bb_bake_options_init(bb_bake_options *o);
 
 /* The azimuth slices o traces with: o->slices when set, else
- * bb_slices_for_rays(o->rays). The one rule; provenance, JSON and the
+ * the slices o->rays asks for (round(sqrt(rays)), at least 1). The one rule; provenance, JSON and the
  * up-to-date check all report it. */
 int bb_bake_slices(const bb_bake_options *o);
-
-/* Checks every field of o as bb_bake does before it starts (ranges in the
- * field comments): BB_OK, or BB_ERR_ARGUMENT with a message such as "bake:
- * filter radius must be in 0..4096 (got 5000)". So a caller can refuse bad
- * options before loading anything. */
-bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 
 /* Everything one bake makes. Images not made are zeroed (pixels NULL). */
 typedef struct bb_bake_result {
@@ -1406,23 +954,12 @@ typedef struct bb_bake_result {
  * field (normalised h), making the maps o->outputs asks for and nothing
  * else (vis is made whenever a traced kind is asked). Results are
  * bit-identical for any o->trace.threads. Fills result; free it with
- * bb_bake_result_free. Errors: those of bb_bake_options_check, BB_ERR_VALUE
+ * bb_bake_result_free. Errors: those of bb__bake_options_check, BB_ERR_VALUE
  * (NaN heights, scale x height overflowing), BB_ERR_MEMORY, and
  * BB_ERR_CANCELLED when o->trace.progress returned nonzero: then nothing is
  * returned (result is zeroed). */
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
-
-/* What bb_bake traces, built alone for a trace split over processes: the
- * max-mip pyramid of the smoothed height scaled to texels, and the ray set
- * of o's slices, power and basis, built by bb_bake's own stages (the same
- * bits), so the horizons found from them (bb_trace_horizons) are those of
- * bb_bake's trace of height with o. Checks o and the height as bb_bake does;
- * o->outputs must ask for a traced kind. On success *pyramid and *rays
- * receive them (free with bb_pyramid_free and bb_rayset_free). Memory:
- * about 13 bytes per texel while building, 5.4 once built. */
-bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
-                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 
 /* The image of kind in r (NULL for an unknown kind); its pixels are NULL
  * when the bake did not make it. Owned by r. */
@@ -1510,7 +1047,7 @@ bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
  * bb_valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
  * input colour smoothed like the height: colour is the decoded input (grey
  * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
- * ignored), smoothed by bb_smooth_bilateral with smooth and guided by
+ * ignored), smoothed by bb__smooth_bilateral_all_cores with smooth and guided by
  * height (the 1-channel height the bake started from), so the factor
  * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
  * input gives 0.5, the neutral value of a mod2x detail texture. All three
@@ -1538,7 +1075,6 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
 
 /* ------------------------------------------------------------- combine */
-
 
 /* combine works on BB_MAP_SSBUMP, BB_MAP_WEIGHTS, BB_MAP_AO and
  * BB_MAP_NORMAL; other kinds are BB_ERR_ARGUMENT. Its operators act on the
@@ -1616,20 +1152,6 @@ bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
 
 void bb_program_free(bb_program *program);
 
-/* The image names a program reads, in the order it reads them (as written,
- * unquoted; _flat is not a file and is left out): up to cap of them into
- * names (pointers into the program, valid until bb_program_free). Returns
- * how many there are, which may exceed cap. For dependency tracking, as
- * id's timestamps, and to keep an output from replacing an input. */
-size_t bb_program_images(const bb_program *program, const char **names, size_t cap);
-
-/* The file a program's image name is read from: name as written when it is
- * absolute or base_dir is NULL or empty, else base_dir/name (base_dir as in
- * bb_program_options). Writes it into out (cap bytes, terminated) and
- * returns its length, as snprintf does: a length >= cap means it did not
- * fit, and bb_program_run refuses such a name rather than read a cut path. */
-int bb_program_image_path(const char *base_dir, const char *name, char *out, size_t cap);
-
 /* Reads the image a program names: fills img (any channel count) and info
  * (may be NULL) as bb_image_read does. */
 typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
@@ -1663,35 +1185,6 @@ bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
 
 /* -------------------------------------------------- flipcode slope map */
 
-/* Packs slopes dx, dy (each clamped to -7..7) into flipcode's byte: dx in
- * the low nibble, dy in the high nibble, each as a 4-bit two's complement
- * number (-1 is 0xF, -7 is 0x9). */
-uint8_t bb_slope_encode(int dx, int dy);
-
-/* Unpacks a slope byte; nibble 0x8 reads as -8 (bb_slope_encode never
- * writes it). */
-void bb_slope_decode(uint8_t byte, int *dx, int *dy);
-
-/* flipcode's slope map of a 1-channel height field h: for texel (x, y),
- * dx = S (h(x+1, y) - h(x, y)) and dy = S (h(x, y+1) - h(x, y)) in texels
- * (S = height_scale; forward differences, neighbours by addressing),
- * rounded to the nearest integer (halves away from 0) and clamped to -7..7.
- * Allocates out: 1 channel holding byte / 255, so an 8-bit file stores the
- * byte itself. */
-bb_status bb_slope_map(const bb_image *height, float height_scale,
-                       bb_addressing addressing, bb_image *out, bb_error *err);
-
-/* The 16 x 16 lighting table: table[byte] = max(0, N.L) with N =
- * normalize(-dx, -dy, 1) for the slopes (dx, dy) the byte decodes to and L
- * a unit light direction (bb_light_direction makes one from azimuth and
- * elevation). Row = high nibble (dy), column = low nibble (dx). */
-void bb_slope_table(const double light[3], float table[256]);
-
-/* Lights a slope map through a table: out = table[byte] per texel, byte =
- * round(255 * slope value). Allocates out: 1 channel. */
-bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image *out,
-                         bb_error *err);
-
 /* ------------------------------------------------------------- compare */
 
 typedef struct bb_compare_stats {
@@ -1700,14 +1193,6 @@ typedef struct bb_compare_stats {
   long pixels;
   long over_fail, over_warn;  /* pixels with any channel over the threshold */
 } bb_compare_stats;
-
-/* Channel-by-channel comparison of two images of equal size and channels
- * (BB_ERR_SIZE otherwise). A pixel counts as over a threshold when any of
- * its channels differs by more than it. diff (may be NULL) receives |a - b|. */
-bb_status bb_compare_images(const bb_image *a, const bb_image *b,
-                            double fail_threshold, double warn_threshold,
-                            bb_compare_stats *stats, bb_image *diff,
-                            bb_error *err);
 
 /* The tolerances of a comparison, as OpenImageIO's idiff takes them (its
  * -fail, -failpercent, -hardfail, -allowfailures, -warn, -warnpercent,
@@ -1723,32 +1208,12 @@ typedef struct bb_compare_limits {
   double hard_warn;     /* any difference above this warns; infinity */
 } bb_compare_limits;
 
-/* Sets idiff's defaults (in the field comments above). */
-void bb_compare_limits_init(bb_compare_limits *limits);
-
-/* BB_OK when every limit is in its range: fail, hard_fail, warn and
- * hard_warn >= 0 (infinity allowed), the percentages in 0..100,
- * allow_failures >= 0; else BB_ERR_ARGUMENT naming the limit by idiff's
- * option ("compare: failpercent must be in 0..100 (got 150)"). NaN is
- * refused. */
-bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
-
 /* A comparison's outcome; the values are idiff's exit codes. */
 typedef enum bb_compare_verdict {
   BB_COMPARE_PASS = 0,
   BB_COMPARE_WARN = 1,
   BB_COMPARE_FAIL = 2
 } bb_compare_verdict;
-
-/* idiff's rule (OpenImageIO 2.4), for stats made by bb_compare_images with
- * thresholds limits->fail and limits->warn: PASS when at most
- * allow_failures pixels fail; else FAIL when more than fail_percent % of
- * the pixels fail or max_abs > hard_fail; else WARN when more than
- * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
- * warnings are only reported once some pixel fails: with no failing pixel
- * the verdict is PASS. */
-bb_compare_verdict bb_compare_judge(const bb_compare_stats *stats,
-                                    const bb_compare_limits *limits);
 
 /* =====================================================================
  * render: lighting the maps, pictures, panels, sheets
@@ -1786,10 +1251,6 @@ typedef enum bb_albedo_mode {
                              detail of mid-grey input (0.5 each) gives 1 */
 } bb_albedo_mode;
 
-/* Parses "multiply", "mod2x", "ssbump". */
-bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err);
-const char *bb_albedo_mode_name(bb_albedo_mode mode);
-
 /* Largest specular exponent a render takes: max(0, N.h)^k is a point far
  * below one texel beyond it. */
 #define BB_MAX_SPECULAR_EXPONENT 100000.0
@@ -1800,28 +1261,14 @@ typedef enum bb_render_mode {
   BB_RENDER_NORMAL,     /* plain normal mapping, no self-shadowing (needs normal) */
   BB_RENDER_NORMAL_AO,  /* normal mapping times ambient occlusion (normal, ao) */
   BB_RENDER_SLOPE       /* flipcode's 1999 slope map lit through its 16 x 16
-                           table (bb_slope_table; needs slope) */
+                           table (bb__slope_table; needs slope) */
 } bb_render_mode;
-
-/* Parses "ssbump", "normal", "ao", "slope". */
-bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err);
 
 /* The maps a mode reads, as BB_RENDER_NEEDS_* bits (0 for an unknown mode). */
 #define BB_RENDER_NEEDS_NORMAL 1u
 #define BB_RENDER_NEEDS_SSBUMP 2u
 #define BB_RENDER_NEEDS_AO 4u
 #define BB_RENDER_NEEDS_SLOPE 8u
-unsigned bb_render_mode_needs(bb_render_mode mode);
-/* The name bb_render_mode_parse accepts; "unknown" for other values. */
-const char *bb_render_mode_name(bb_render_mode mode);
-
-/* Unit direction towards a light at azimuth and elevation in degrees, in the
- * tangent frame (+Y down): azimuth 0 = from the right (+x), 90 = from the
- * top of the image (-y), 180 = from the left, 270 = from the bottom,
- * counter-clockwise as seen on screen; elevation 0 = grazing, 90 = overhead.
- * dir = (cos(el) cos(az), -cos(el) sin(az), sin(el)), exact at multiples of
- * 90 degrees. */
-void bb_light_direction(double azimuth_degrees, double elevation_degrees, double dir[3]);
 
 /* The maps a render reads; all of the same width and height. Pointers not
  * needed by the mode may be NULL. Images may have more channels than used:
@@ -1835,7 +1282,7 @@ typedef struct bb_render_maps {
   const bb_image *ao;     /* ao in channel 0 */
   const bb_image *bent;   /* Nb, >= 3 channels; NULL: computed from ssbump */
   const bb_image *albedo; /* NULL = white; 1 channel = grey, >= 3 = RGB */
-  const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bb_slope_map) */
+  const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bb__slope_map) */
 } bb_render_maps;
 
 typedef struct bb_render_options {
@@ -1880,46 +1327,6 @@ typedef struct bb_render_options {
 
 void bb_render_options_init(bb_render_options *o);
 
-/* Renders maps by o into out (allocated: 3 channels, linear values, 1 =
- * white, not clamped), then tiles and crops it as o says. Bit-identical for
- * any thread count. With o->view the picture is the same size (the maps'
- * times the tiles, then cropped), seen by the camera: pixel (i, j) shows
- * the point of the surface's top plane
- *   C + (i - W'/2) R + (j - H'/2) / sin(el) D,   W' x H' the picture,
- * C its middle, D = (cos az, -sin az) the horizontal way to the viewer and
- * R = (D_y, -D_x) (texels; the maps tile), or with o->relief where the
- * view ray from there meets o->relief_height (README "render"), and the maps are
- * read there bilinearly (texel (x, y) at point (x, y), tiling); the
- * specular highlight takes the view direction V instead of (0, 0, 1). View
- * 270, 90 without relief is the plain render. Errors: BB_ERR_ARGUMENT
- * (missing map for the mode, too few channels, maps of different sizes,
- * option out of range: the message says which), BB_ERR_SIZE,
- * BB_ERR_MEMORY. */
-bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
-                    bb_error *err);
-
-/* The picture a render of maps of width x height makes by o (with compare,
- * bb_render_compare's four-panel grid), worked out from the sizes alone,
- * before anything is read or allocated: *picture_width x *picture_height
- * (the maps' size times o's tiles, then o's crop; may be NULL) and *bytes
- * (may be NULL), the most memory the render takes beyond its maps: the
- * picture as rendered, tiled and cropped (3 floats a texel), and the copy
- * the encoder of output at depth makes of it (output NULL: none, the
- * picture alone). bb_render
- * refuses (BB_ERR_MEMORY) a picture whose estimate is over
- * bb_memory_available before it allocates it. Errors: BB_ERR_SIZE (the
- * tiled picture over BB_MAX_DIMENSION a side or BB_MAX_PIXELS in all),
- * BB_ERR_ARGUMENT (a crop not inside it), each message saying so. */
-bb_status bb_render_estimate(int width, int height, const bb_render_options *o, int compare,
-                             const char *output, bb_depth depth, int *picture_width,
-                             int *picture_height, double *bytes, bb_error *err);
-
-/* "key=value" lines of every option of o that affects pixels (render_mode,
- * light, light_color, lightmap, specular, specular_strength, albedo_mode,
- * tile, crop; view and relief when used), for
- * provenance; malloc'd, the caller frees it. NULL when out of memory. */
-char *bb_render_options_describe(const bb_render_options *o);
-
 /* ------------------------------------------------------ rendering files */
 
 /* The maps a render can read from files instead of baking a height:
@@ -1929,10 +1336,10 @@ char *bb_render_options_describe(const bb_render_options *o);
  * channel 0); their names are the command line's options and provenance's
  * map_KIND keys. */
 /* Reads a map file for a render and checks it for its kind: channels
- * enough, Half-Life 2's basis for an ssbump (bb_basis_map_check), and the
+ * enough, Half-Life 2's basis for an ssbump (bb__basis_map_check), and the
  * size of like when like is not NULL; normal and bent maps are decoded to
  * unit N (bb_normal_map_decode; normal_y_up 1: OpenGL-style files).
- * *hash (may be NULL) receives bb_image_hash of what the file decoded to.
+ * *hash (may be NULL) receives bb__image_hash of what the file decoded to.
  * Errors name the file: those of bb_image_read, BB_ERR_ARGUMENT for a map
  * that is not what its kind needs. */
 bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
@@ -1945,63 +1352,17 @@ typedef struct bb_render_sources {
   const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
   int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
   const char *albedo;   /* the albedo file, or NULL */
-  uint64_t albedo_hash; /* bb_image_hash of the albedo read */
+  uint64_t albedo_hash; /* bb__image_hash of the albedo read */
   int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
 } bb_render_sources;
 
-/* The "key=value" lines a render adds to bb_provenance_format's (as its
- * extra): render_from (height or maps), map_normal_y, map_KIND (file
- * names), albedo and albedo_hash, then bb_render_options_describe's, then
- * frame=F/N for an orbit's frame. malloc'd; NULL when out of memory. */
-char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o);
-
-/* A render of files checked from their headers before any pixel is read,
- * as bakes are: the maps (files->maps) or the height baked first
- * (files->height, with bake, its outputs set) and the albedo
- * (files->albedo, may be NULL); the maps share one size (*width x *height,
- * may be NULL, set as soon as the first header is read); the picture fits
- * (bb_render_estimate, with output and depth); and reading them as
- * floats (for a height, its read and the bake, as bb_bake estimates it),
- * with the picture, fits in bb_memory_available. A file whose header is over the
- * read's limits is left to the read to refuse. Errors: those of
- * bb_image_read_info and bb_render_estimate, BB_ERR_ARGUMENT (maps of two
- * sizes, naming the file), BB_ERR_MEMORY ("OUTPUT: a 32768 x 32768 render
- * needs about 16.3 GiB of memory; 5.4 GiB is available (RLIMIT_AS)"). */
-bb_status bb_render_files_check(const bb_render_sources *files, const bb_bake_options *bake,
-                                const bb_render_options *o, int compare, const char *output,
-                                bb_depth depth, int *width, int *height, bb_error *err);
-
-/* The file of frame `frame` of an orbit of `frames` written to output:
- * OUT_007.png for OUT.png (four digits past 1000 frames). malloc'd; NULL
- * when out of memory. */
-char *bb_render_frame_path(const char *output, int frame, int frames);
-
 /* ---------------------------------------------------- image operations */
-
-/* Repeats in nx x ny times (nx, ny >= 1) into out. */
-bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out, bb_error *err);
-
-/* The window (x, y, width, height) of in, which must lie inside it, into out. */
-bb_status bb_image_crop(const bb_image *in, int x, int y, int width, int height,
-                        bb_image *out, bb_error *err);
-
-/* Resamples in to width x height by area averaging (each output texel is the
- * mean of the input area it covers; enlarging repeats texels). */
-bb_status bb_image_resample(const bb_image *in, int width, int height, bb_image *out,
-                            bb_error *err);
-
-/* A map as it looks in an 8-bit file, as 3-channel RGB in [0, 1]: signed
- * maps (normals) become 0.5 + 0.5 v, unit maps (v - low) / (high - low);
- * 1- and 2-channel maps become grey (channel 0), others show their first
- * three channels. Values are clamped to [0, 1]. */
-bb_status bb_image_to_display(const bb_image *map, bb_range range, float low, float high,
-                              bb_image *rgb, bb_error *err);
 
 /* -------------------------------------------------------------- panels */
 
 /* One picture of a panel grid and the label written under it (may be NULL). */
 typedef struct bb_panel {
-  const bb_image *image; /* 3-channel RGB in [0, 1] (bb_image_to_display) */
+  const bb_image *image; /* 3-channel RGB in [0, 1] (bb__image_to_display) */
   const char *label;
 } bb_panel;
 
@@ -2016,27 +1377,7 @@ typedef struct bb_panel_layout {
   const char *font;   /* font file or name; NULL = look one up (default NULL) */
 } bb_panel_layout;
 
-void bb_panel_layout_init(bb_panel_layout *l);
-
-/* Lays out count panels in a grid on a dark background, each labelled
- * underneath through OpenImageIO's text rendering. Labels need a font: the
- * layout's, else $BUMPBAKE_FONT when set (empty: none), else the first of
- * DejaVu Sans, Liberation Sans, FreeSans, Noto Sans that OpenImageIO finds.
- * With no usable font the grid is drawn without label rows. *labels_drawn
- * (may be NULL) receives 1 when labels were drawn, 0 otherwise. out gets 3
- * channels. */
-bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
-                            bb_image *out, int *labels_drawn, bb_error *err);
-
-/* The paper's comparison: four renders side by side, labelled "normal-mapped",
- * "ssbump", "ssbump + specular" and "ao" (modes normal, ssbump, ssbump with
- * the specular exponent of o or 64 when o has none, ao), each by o
- * otherwise (o->mode is not used). maps needs normal, ssbump and ao. */
-bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
-                            const bb_panel_layout *l, bb_image *out, int *labels_drawn,
-                            bb_error *err);
-
-/* The exponent bb_render_compare uses when o->specular_exponent is 0. */
+/* The exponent bb__render_compare uses when o->specular_exponent is 0. */
 #define BB_COMPARE_SPECULAR_EXPONENT 64.0
 
 /* --------------------------------------------------------------- sheet */
@@ -2046,24 +1387,13 @@ typedef struct bb_sheet_options {
   bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
 } bb_sheet_options;
 
-void bb_sheet_options_init(bb_sheet_options *o);
-
-/* A contact sheet of one bake: height and filtered height (grey, stretched
- * over the height's range), normal, weights, ssbump, ao, bent normal, and
- * the ssbump lit by o->lit; labelled as bb_panels_compose does. height is
- * the bake's input; r a traced bake with normal_y_up = 0 and Half-Life 2's
- * basis (another is BB_ERR_ARGUMENT). */
-bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
-                        const bb_sheet_options *o, bb_image *out, int *labels_drawn,
-                        bb_error *err);
-
 /* =====================================================================
  * mesh: models and DOOM 3's flat render bump
  * ===================================================================== */
 
 /* -------------------------------------------------------------- meshes */
 
-/* A triangle mesh in model units. bb_mesh_load fills one from a file: every
+/* A triangle mesh in model units. bb__mesh_load fills one from a file: every
  * mesh of the file merged, node transforms applied, polygons triangulated,
  * points and lines dropped. */
 typedef struct bb_mesh {
@@ -2074,58 +1404,6 @@ typedef struct bb_mesh {
                         a vertex whose normal is zero or not finite has none */
   uint32_t *indices; /* 3 per triangle, each < vertex_count */
 } bb_mesh;
-
-/* Allocates a zeroed mesh of the given counts (normals only when
- * with_normals). Rejects counts of 0 vertices or over BB_MAX_MESH_ELEMENTS
- * (BB_ERR_SIZE) and failed allocations (BB_ERR_MEMORY), leaving m zeroed. */
-bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
-                        int with_normals, bb_error *err);
-
-/* Frees the arrays and zeroes the struct; safe on a zeroed struct. */
-void bb_mesh_free(bb_mesh *m);
-
-/* 64-bit FNV-1a hash of the counts, positions, normals and indices, for
- * provenance (the input_hash of outputs baked from a mesh). */
-uint64_t bb_mesh_hash(const bb_mesh *m);
-
-/* Reads a model through Assimp (OBJ, PLY, STL, glTF, FBX, Collada, 3DS, ...:
- * anything Assimp imports), merged as described at bb_mesh. Normals are kept
- * when any part of the model has them (vertices of parts without are zero).
- *
- * Model files are untrusted. A model may read only regular files inside its
- * own directory (after following links and ".."; a glTF's buffers, an OBJ's
- * .mtl; embedded data: URIs need no file): naming a file outside it, or a
- * FIFO, device, directory or unreadable file, fails the load. A file it
- * names that does not exist is done without when the format can be (an
- * OBJ's .mtl; a glTF's missing buffer fails), and bb_mesh_load_noted says
- * so. The import runs in a child process (fork) held to BB_MAX_MODEL_BYTES,
- * BB_MAX_MODEL_TRIANGLES, BB_MAX_IMPORT_MEMORY and BB_MAX_IMPORT_SECONDS,
- * on a stack of its own: a model that crashes Assimp (nodes nested 20,000
- * deep) fails the load, not the caller. The child never returns into the
- * caller's code (it ends with _exit) and takes no signal handler of the
- * caller's; a caller that reaps every child from a SIGCHLD handler only
- * loses the check of the child's exit status.
- *
- * Errors: BB_ERR_IO (missing, a directory, a FIFO or device, unreadable, or
- * a file the model names refused as above), BB_ERR_FORMAT (not a model
- * Assimp reads, corrupt, no triangles, the importer crashed), BB_ERR_VALUE
- * (a coordinate is NaN or infinite), BB_ERR_SIZE (over a limit above),
- * BB_ERR_MEMORY (over BB_MAX_IMPORT_MEMORY, or no memory here). */
-bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
-
-/* bb_mesh_load, also saying what the load did without: on success note (cap
- * bytes; NULL or cap 0 for none) holds "" or one line such as "read without
- * bricks.mtl (no such file)"; on failure "". */
-bb_status bb_mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
-                             bb_error *err);
-
-/* Writes m through Assimp's exporters; the format comes from the extension:
- * .obj (without a material file), .ply (binary little-endian), .stl
- * (binary), .glb. Normals are written when m has them. The file is written
- * to a temporary name in the destination directory and renamed into place.
- * Errors: BB_ERR_FORMAT (unknown extension), BB_ERR_ARGUMENT (an index out
- * of range), BB_ERR_IO (cannot write). */
-bb_status bb_mesh_write(const char *path, const bb_mesh *m, bb_error *err);
 
 /* ---------------------------------------------------- flat render bump */
 
@@ -2142,12 +1420,8 @@ typedef enum bb_axis {
   BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
 } bb_axis;
 
-/* Parses "-y", "+y", "+z", "-z", "+x", "-x" ("y" means "+y"). */
-bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err);
 /* "-y", "+z", ...; "unknown" for a value outside the enum. */
 const char *bb_axis_name(bb_axis a);
-/* The model-space unit vectors right, up and out of axis a. */
-void bb_axis_frame(bb_axis a, double right[3], double up[3], double out[3]);
 
 typedef struct bb_renderbump_options {
   int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
@@ -2169,8 +1443,6 @@ typedef struct bb_renderbump_options {
   void *note_user;
 } bb_renderbump_options;
 
-void bb_renderbump_options_init(bb_renderbump_options *o);
-
 /* What a flat render bump makes. */
 typedef struct bb_renderbump_result {
   bb_image normal;   /* 4 channels: unit N in the tangent frame (x right, y
@@ -2189,28 +1461,10 @@ typedef struct bb_renderbump_result {
   int used_vertex_normals; /* 1 when some texel used interpolated normals */
   size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
   size_t triangles, vertices; /* the mesh's counts */
-  uint64_t model_hash;     /* bb_mesh_hash of the mesh, as its files record it */
+  uint64_t model_hash;     /* bb__mesh_hash of the mesh, as its files record it */
 } bb_renderbump_result;
 
-/* DOOM 3's RenderBumpFlat on the CPU: projects mesh orthographically along
- * o->axis onto the rectangle, keeps the front-most surface at each sample
- * (no culling: the side facing the viewer is taken), and averages the
- * samples of each texel into result (allocated; free with
- * bb_renderbump_result_free). Bit-identical for any thread count. Errors:
- * BB_ERR_ARGUMENT (bad options, an index out of range, a degenerate
- * rectangle, nothing facing the viewer), BB_ERR_VALUE (a NaN or infinite
- * coordinate), BB_ERR_SIZE (size over the maximum, or the model covering
- * the image too many times over with tile), BB_ERR_MEMORY. */
-bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
-                             bb_renderbump_result *result, bb_error *err);
-
 void bb_renderbump_result_free(bb_renderbump_result *r);
-
-/* The "key=value" provenance lines of a render (axis, size, samples,
- * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
- * bb_provenance_format's lines; NULL when out of memory. */
-char *bb_renderbump_describe(const bb_renderbump_options *o,
-                             const bb_renderbump_result *r);
 
 /* =====================================================================
  * job: the whole job on files
@@ -2222,7 +1476,7 @@ char *bb_renderbump_describe(const bb_renderbump_options *o,
 typedef struct bb_provenance {
   const char *command;        /* the command line, or NULL */
   const char *input_name;     /* input file name (no directory), or NULL */
-  uint64_t input_hash;        /* bb_image_hash of the decoded input pixels */
+  uint64_t input_hash;        /* bb__image_hash of the decoded input pixels */
   const char *output_kind;    /* "normal", "ssbump", "ao", ... */
   const bb_bake_options *options;
   bb_channel channel;         /* height channel rule used */
@@ -2238,14 +1492,14 @@ typedef struct bb_provenance {
  * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
  * channel), malloc'd; the caller
  * frees it. With options (a bake's map), only the parameters output_kind
- * records are written (bb_map_kind_records: a normal map has no rays,
+ * records are written (bb__map_kind_records: a normal map has no rays,
  * rayset, bias, power or basis; ao's rayset is its scheme and slices);
  * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
  * Options in use add, after addressing: bounce (rho) and bounces when
- * bounce_albedo > 0, with bounce_albedo_map (bb_image_hash of the map, 16
+ * bounce_albedo > 0, with bounce_albedo_map (bb__image_hash of the map, 16
  * hex digits) when it has one; brightness (the brightness map's
- * bb_image_hash) when there is one.
+ * bb__image_hash) when there is one.
  * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
 
@@ -2267,10 +1521,10 @@ typedef struct bb_output_spec {
 } bb_output_spec;
 
 /* Checks every output before any work, so a bad name costs no baking time:
- * BB_ERR_ARGUMENT (usage: an extension bb_image_write does not know, a
+ * BB_ERR_ARGUMENT (usage: an extension bb__image_write does not know, a
  * depth, mip chain or channel count the format cannot hold, a .vtf or .dds
- * of a size or channels its format cannot take (bb_texture_check, with the
- * map bb_texture_options_for(opts, kind, range)), two outputs on
+ * of a size or channels its format cannot take (with the texture options
+ * of the map kind and range name), two outputs on
  * one file under any spelling: "KIND and KIND would both be written to
  * PATH"); BB_ERR_IO (an output that is one of the reads[0..read_count-1]
  * under any spelling, hard or symbolic link: "PATH: output would overwrite
@@ -2278,17 +1532,11 @@ typedef struct bb_output_spec {
  * output that exists and is not a regular file: a directory, a device, a
  * FIFO, a socket or a symbolic link, which the rename that puts an output
  * in place would replace: "PATH: cannot write: is a FIFO, not a regular
- * file"). Messages start with the path. Every write (bb_file_write,
- * bb_image_write and the staged writes) refuses such a name too, at its
+ * file"). Messages start with the path. Every write (bb__file_write,
+ * bb__image_write and the staged writes) refuses such a name too, at its
  * start and again just before its rename. */
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
-
-/* 1 when a and b name the same file: the same device and inode when both
- * exist (symbolic and hard links, "./", ".."), else the same name in the
- * same directory (by the directory's device and inode), else the same
- * spelling. */
-int bb_same_file(const char *a, const char *b);
 
 /* path without the extension of its last component, plus suffix ("rock.png",
  * "-ssbump.tga" -> "rock-ssbump.tga"; a name's leading dot starts no
@@ -2299,11 +1547,6 @@ char *bb_path_with_suffix(const char *path, const char *suffix);
  * "PREFIX_KIND.png" for the kinds of BB_JOB_DEFAULT_MAPS, malloc'd; NULL for
  * another kind, a NULL prefix or out of memory. */
 char *bb_job_prefix_path(const char *prefix, bb_map_kind kind);
-
-/* Creates directory path and its missing parents (mode 0777 less the
- * umask), as mkdir -p. An existing directory is fine. Errors: BB_ERR_IO
- * ("PATH: cannot create directory: REASON"; a part that is a file). */
-bb_status bb_directory_create(const char *path, bb_error *err);
 
 /* ------------------------------------------------------- writing outputs */
 
@@ -2322,7 +1565,7 @@ typedef struct bb_output_file {
   size_t text_size;
   const bb_texture_options *texture; /* a .vtf or .dds file's settings (NULL:
                                 the defaults); its map is set from kind and
-                                range (bb_texture_options_for), its mip chain by
+                                range (bb__texture_options_for), its mip chain by
                                 its own mips, not the file's */
 } bb_output_file;
 
@@ -2337,17 +1580,6 @@ typedef struct bb_output_file {
  * for sets of more than one, or "...; already written: KIND PATH, ...". */
 bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
 
-/* Renames count staged files (bb_image_write_staged, ...) into place in
- * order, as bb_outputs_write does with its set: the process's ending by a
- * signal waits for the last rename (bb_signal_cleanup). Every handle is
- * freed, committed or discarded: when a rename fails, the files after it
- * are discarded and the message says which were already replaced ("PATH:
- * reason; already written: KIND PATH, ..." with kinds[i], which may be
- * NULL). For sets too large to hold in memory at once, such as an
- * orbit's frames: stage each, then commit them together. */
-bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
-                                 bb_error *err);
-
 /* For a SIGINT, SIGTERM or SIGHUP handler (async-signal-safe): removes the
  * temporaries of the writes in flight and ends the process by signal_number
  * with its default action; but while bb_outputs_write is renaming a set
@@ -2357,20 +1589,6 @@ bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kind
 void bb_signal_cleanup(int signal_number);
 
 /* --------------------------------------------------- render bump files */
-
-/* Writes a flat render bump's files together or neither (bb_outputs_write):
- * the normal map at normal_path (RGB = N as bumpbake stores normal maps:
- * 0.5 + 0.5 N in integer files, N in float ones; alpha = the coverage as it
- * is; green flipped for normal_y_up) and, when height_path is not NULL,
- * the height (16-bit where the format holds it). Each records provenance:
- * command, the model's file name and bb_mesh_hash (model_hash), its kind
- * ("normal+coverage", "height"), bb_renderbump_describe's keys and
- * normal_y. Errors as bb_outputs_write's. */
-bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
-                              int normal_y_up, const char *model, uint64_t model_hash,
-                              const char *command, const char *normal_path,
-                              const char *height_path, bb_error *err);
-
 
 /* ----------------------------------------------------------- height files */
 
@@ -2383,7 +1601,7 @@ typedef struct bb_height_source {
   int is_float;           /* 1: float or half samples */
   char format_name[32];   /* OpenImageIO's: "png", "openexr", ... */
   uint64_t file_hash;     /* bb_file_hash of the bytes that were decoded */
-  uint64_t height_hash;   /* bb_image_hash of the height */
+  uint64_t height_hash;   /* bb__image_hash of the height */
 } bb_height_source;
 
 /* Reads the height of the file at path by the channel rule (bb_channel,
@@ -2399,14 +1617,8 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
                               bb_height_source *source, bb_error *err);
 
 /* The name of the channel a height came from: "grey" for a grey image
- * (whose mean is its grey), else bb_channel_name's. */
+ * (whose mean is its grey), else bb__channel_name's. */
 const char *bb_height_source_channel(const bb_height_source *source);
-
-/* The depth nearest an input's (bits_per_sample, is_float) that path's
- * format holds, for outputs that are the height itself: 16 bits for a
- * 16-bit input, float or half for a float or half input; BB_DEPTH_DEFAULT
- * for an 8-bit input or when the format holds nothing deeper (TGA). */
-bb_depth bb_depth_like_input(int bits_per_sample, int is_float, const char *path);
 
 /* --------------------------------------------------------- comparing files */
 
@@ -2416,20 +1628,20 @@ typedef struct bb_compare_report {
                                  else was compared (idiff's exit 3) */
   int width, height, channels;       /* of A */
   int b_width, b_height, b_channels; /* of B */
-  bb_compare_stats stats;     /* per pixel, as bb_compare_images */
-  bb_compare_verdict verdict; /* idiff's rule (bb_compare_judge); FAIL when
+  bb_compare_stats stats;     /* per pixel, as bb__compare_images */
+  bb_compare_verdict verdict; /* idiff's rule (bb__compare_judge); FAIL when
                                  the shapes differ */
   bb_provenance_class provenance_a, provenance_b;
   int provenance_differences; /* keys that differ, or -1 when not compared
                                  (either side not intact provenance) */
   char *provenance_diff;      /* "key: A-value -> B-value" lines
-                                 (bb_provenance_diff), malloc'd, or NULL */
+                                 (bb__provenance_diff), malloc'd, or NULL */
   int diff_written;           /* 1 when diff_path was written */
   bb_error diff_error;        /* why it was not, when asked */
 } bb_compare_report;
 
 /* Compares the image files a and b channel by channel under limits (NULL:
- * idiff's defaults; checked by bb_compare_limits_check before any read),
+ * idiff's defaults; checked by bb__compare_limits_check before any read),
  * as OpenImageIO's idiff does, and their provenance key
  * by key. With diff_path (may be NULL; check it first with
  * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
@@ -2504,7 +1716,7 @@ typedef struct bb_check_case {
   int width, height, channels;             /* of the golden (0: not read) */
   int new_width, new_height, new_channels; /* of the new map (0: not made) */
   bb_compare_stats stats;      /* when both were compared (same size) */
-  const char *provenance_diff; /* "key: golden -> new" lines (bb_provenance_diff;
+  const char *provenance_diff; /* "key: golden -> new" lines (bb__provenance_diff;
                                   "" when the same), NULL when not compared
                                   (either side without intact provenance) */
   const char *message;         /* why UNREADABLE, MISSING or EXTRA; else "" */
@@ -2621,7 +1833,7 @@ typedef struct bb_job_options {
   bb_channel channel;        /* the height channel rule (default AUTO) */
   bb_depth depth;            /* every map's depth; BB_DEPTH_DEFAULT: the
                                 format's, and the filtered height keeps the
-                                input's (bb_depth_like_input) */
+                                input's (bb__depth_like_input) */
   int mips;                  /* 1: mip-mapped files (.tif, .tiff, .exr) */
   const char *basis_file;    /* the file bake.basis came from, or NULL: a
                                 prerequisite in the depfile */
@@ -2637,7 +1849,7 @@ typedef struct bb_job_options {
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
   int slope_lit;             /* 1: also slope_path with "_lit" before its
                                 extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb_light_direction;
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb__light_direction;
                                 azimuth finite, elevation 0..90 */
   /* A batch (out_dir set): */
   const char *out_dir;       /* outputs go to out_dir/name; created when missing */
@@ -2661,7 +1873,7 @@ typedef struct bb_job_options {
   bb_texture_options texture; /* the settings of every .vtf and .dds output
                                 (format, mips, VTF version and flags); each
                                 one's map follows its kind
-                                (bb_texture_options_for); threads 0: the bake's. Sizes and channels are
+                                (bb__texture_options_for); threads 0: the bake's. Sizes and channels are
                                 checked against the input's header when planned */
   const char *vmt;           /* one input: a Source material (.vmt) written with
                                 the maps, its $bumpmap the ssbump .vtf (with
@@ -2831,7 +2043,6 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
  * end. BB_OK when the job has no depfile. */
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 
-
 /* The command line of options o, as the provenance of a job without
  * command or command_options records it: "bumpbake bake INPUT" and then
  * every option that differs from its default, in the order of `bumpbake
@@ -2858,13 +2069,6 @@ char *bb_job_command_text(const bb_job_options *o, const char *input);
  * with the system's reason. */
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
 
-/* The rayset id bb_bake records in result->rayset_id for options o (slices
- * from o->slices, or from o->rays; power; basis), computed without building
- * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
- * any id). "" when o->outputs asks for no traced kind: nothing is traced
- * then, and provenance says rayset=none. */
-void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
-
 /* Whether an existing output is what writing it now would make. */
 typedef enum bb_output_state {
   BB_OUTPUT_CURRENT = 0, /* made from the same input bytes, with the same
@@ -2883,7 +2087,7 @@ typedef enum bb_output_state {
  * and "input" (the command line and the input's name, which do not change a
  * pixel) and "input_hash" (the decoded height's hash, implied by
  * input_file_hash and channel), and keys the file's kind does not record
- * (bb_map_kind_records: a normal map written before the rule, with "rays",
+ * (bb__map_kind_records: a normal map written before the rule, with "rays",
  * is current): so the bumpbake version, the input file's bytes, the output
  * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
  * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
@@ -3000,9 +2204,6 @@ int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);
 /* The command named name, or NULL. */
 const bb_command_info *bb_command_info_find(const char *name);
-/* The command nearest to a mistyped name (at most 2 edits away, for "did
- * you mean"), or NULL. */
-const bb_command_info *bb_command_info_nearest(const char *name);
 
 /* A command's options, in the order of its --help: 0 .. option_count - 1. */
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);
@@ -3021,10 +2222,6 @@ const bb_option_info *bb_option_nearest(const bb_command_info *command, const ch
 /* The option's range as help prints it ("1..65536", "> 0", "0..1e6", its
  * range_text, its choices), into out (capacity cap); "" when it has none. */
 void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
-/* The words a BB_OPTION_WORD or WORDS option takes, '|'-separated
- * ("valve|central|sobel|vertex", the names of the library's enum), into out
- * (capacity cap); "" for other types. */
-void bb_option_choices(const bb_option_info *option, char *out, size_t cap);
 /* How help shows the option's value: its value_name, else its choices
  * ("down|up"); "" for a flag. */
 void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
@@ -3172,23 +2369,6 @@ const char *bb_command_input(const bb_command *command, int index);
  * out of memory. */
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 
-/* The hand-over of a checked command to another process (bake
- * --scheduler hands its command to Python's bumpbake.dask): its inputs,
- * every option given with the text it was set from, and its record, as
- * bytes (NUL-separated fields, *size of them). malloc'd; NULL when out of
- * memory. */
-char *bb_command_handover(const bb_command *command, size_t *size);
-
-/* The command of a hand-over, set again through bb_command_set,
- * bb_command_add_input and bb_command_set_record and checked
- * (bb_command_check): the same options, parsed by the same functions.
- * inputs not NULL: those input_count inputs in place of the hand-over's (a
- * part of a batch, planned on a worker). Free with bb_command_free.
- * Errors: BB_ERR_ARGUMENT (not a hand-over of this version, or what
- * bb_command_check refuses), BB_ERR_MEMORY. */
-bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
-                                   int input_count, bb_command **out, bb_error *err);
-
 /* The command line the outputs record as their provenance's "command",
  * when it is not the one bb_command_text spells: a command-line client
  * gives the words as typed with those of options that are not
@@ -3247,9 +2427,6 @@ bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 
-/* 1 when the command writes through the job (bb_command_plan plans it). */
-int bb_command_has_job(const bb_command_info *command);
-
 /* What a command's run wrote. */
 typedef struct bb_command_result {
   int file_count;
@@ -3276,11 +2453,11 @@ bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
 void bb_command_result_free(bb_command_result *result);
 
 /* renderbumpflat's run (bb_command_run's), handing back what it rendered
- * as well: the model (the command's input) read through bb_mesh_load_noted
- * (its note to hooks->note), rendered by bb_renderbump_flat (its notes to
+ * as well: the model (the command's input) read (its note to
+ * hooks->note), rendered flat (its notes to
  * hooks->note, naming the model) into render (allocated; free with
  * bb_renderbump_result_free), and its files written by
- * bb_renderbump_write with the command's record, listed in result (free
+ * bb__renderbump_write with the command's record, listed in result (free
  * with bb_command_result_free): "normal", then "height" when asked. A
  * command set in memory (bb_command_set_in_memory, before its check)
  * writes nothing. Errors: BB_ERR_ARGUMENT (not a checked renderbumpflat),
@@ -3299,32 +2476,12 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
  * (allocated) receives render's picture (with the light as given: an
  * orbit's first frame) or sheet's contact sheet; *labels_drawn (may be
  * NULL) is 0 when the labels could not be drawn (no font). Errors as
- * bb_bake's, bb_render's, bb_sheet_make's. */
+ * bb_bake's, bb__render's, bb__sheet_make's. */
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
 
-/* ------------------------------- what a job prints, and the JSON writer */
-
-/* The lines `bumpbake bake` (bake, normal, height2ssbump) prints on stdout
- * of one input's report r, as o (json, quiet) asks, the command line's
- * and its --scheduler run's alike: "wrote KIND PATH" or "up to date KIND
- * PATH" per file (control characters escaped, bb_text_printable), or with
- * json the input's JSON line (bb_job_report_json; with batch a "status"
- * and, for an input not baked, the short line: input, status, exit_code
- * when it failed, every output). Nothing for an input not run, nor for a
- * failure without json (its error is the caller's line on stderr).
- * extra_json (may be NULL): members written before "outputs" of a baked
- * input's line ("\"cluster\":{...}"). Returns the text, "" when none, to
- * free(); NULL when out of memory. */
-char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
-                          const char *extra_json);
-/* A batch's summary line of command (its name) over files inputs, with
- * counts[k] the inputs whose outcome is k (a bb_job_outcome, 5 of them):
- * "COMMAND: N files: B baked, C up to date, F failed[, R not run (...)]",
- * or its JSON line; "" with quiet. To free(); NULL when out of memory. */
-char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
-                           int files);
+/* ----------------------------------------------------- what a job prints */
 
 /* The JSON object of r (an input baked with options b), without a
  * newline: input, status (when not NULL), size, the parameters used (the
@@ -3333,42 +2490,10 @@ char *bb_job_summary_lines(const bb_command_options *o, const char *command, con
 void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
                         const char *status, const char *extra_json);
 
-/* Writes s to f as a quoted JSON string, always valid UTF-8 and never cut:
- * '"' and '\' escaped, newline, carriage return and tab as \n, \r, \t,
- * other control characters (C0, DEL, C1) as \u00XX; UTF-8 passes through;
- * a byte that is not part of UTF-8 (a file name in another encoding)
- * becomes the lone surrogate \udcXX, which Python's json and
- * os.fsencode() turn back into the same byte. NULL writes null. */
-void bb_json_quoted(FILE *f, const char *s);
-
-/* The one JSON writer of the library, the command line and the tools:
- * one-line objects; fields are separated by commas automatically. Values
- * are written as they come; nesting is the caller's to balance. */
-typedef struct bb_json {
-  FILE *f;
-  int need_comma; /* a value was written at the current nesting level */
-} bb_json;
-
-/* Opens an object or array; key is its field name, NULL at the top level
- * or inside an array. open is '{' or '['. */
-void bb_json_open(bb_json *j, const char *key, char open);
-void bb_json_close(bb_json *j, char close);
-/* A string field; value NULL writes null. key NULL inside arrays. */
-void bb_json_string(bb_json *j, const char *key, const char *value);
-/* A number with 9 significant digits (every float reads back exactly);
- * JSON has no NaN or infinity, so those are written as null. */
-void bb_json_number(bb_json *j, const char *key, double value);
-/* An integer, exactly (counts, sizes, exit codes). */
-void bb_json_int(bb_json *j, const char *key, long long value);
-void bb_json_bool(bb_json *j, const char *key, int value);
-
 /* ------------------------------------------------- names of enums printed */
 
 /* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
 bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
-const char *bb_normal_y_name(int normal_y_up);
-/* "periodic" or "clamp"; "unknown" for other values. */
-const char *bb_addressing_name(bb_addressing addressing);
 /* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 /* "none", "intact", "damaged"; "unknown" else. */

@@ -30,6 +30,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include "image/image_write.h"
 
 typedef struct cli_result {
   int code;         /* exit code, or 128 + signal when it crashed */
@@ -381,12 +382,12 @@ static inline void harness_expect_refusal(const char *cwd, const char *const *ar
  * bumpbake.h first) */
 #ifdef BUMPBAKE_H
 
-/* Writes img with bb_image_write; the test fails if it cannot. */
+/* Writes img with bb__image_write; the test fails if it cannot. */
 static inline void harness_write(const char *path, const bb_image *img, bb_depth depth,
                                  bb_range range) {
   bb_write_options o = {depth, range, NULL, NULL};
   bb_error err;
-  cr_assert_eq(bb_image_write(path, img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, img, &o, &err), BB_OK, "%s", err.message);
 }
 
 /* Reads a file back; the test fails if it cannot. */

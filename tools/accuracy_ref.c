@@ -11,7 +11,7 @@
  * (default 8 times the longer side), and docs/conventions.md's integrals are taken
  * per azimuth in closed form (power 1): ao from cos^2 of the horizon's
  * elevation, vis_c from the lobe max(0, w.B_c) above it. ssbump uses
- * Valve's normal (bb_normals_compute, BB_NORMAL_VALVE). This shares with the
+ * Valve's normal (bb__normals_compute_all_cores, BB_NORMAL_VALVE). This shares with the
  * bake neither its slices, nor its sweeps, nor its tables: only the
  * breakpoint test of the mesh.
  *
@@ -28,6 +28,10 @@
 #include "core/internal.h"
 #include "trace/rayset.h"
 #include "trace/testing.h"
+#include "bake/bake_internal.h"
+#include "trace/basis.h"
+#include "trace/pyramid.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <math.h>
@@ -182,7 +186,7 @@ static void reference_row(void *user, int row) {
  * --rules S1,S2,...: what azimuth rules would give at S slices, from exact
  * horizons alone (no bake, no tables). At each reference texel the horizon
  * is also found along each of the S slices' lattice directions (the bake's
- * own, from bb_rayset_make), and each rule turns those S horizons into a
+ * own, from bb__rayset_new), and each rule turns those S horizons into a
  * horizon at every one of the N reference azimuths; ao and ssbump are then
  * integrated over the N azimuths with the reference's own lobe integral
  * (lobe_open) and compared with the reference (reference_row), so what
@@ -350,7 +354,7 @@ static bb_status rules_run(const args *a, const job *j, int rows, bb_error *err)
   }
   for (int m = 0; st == BB_OK && m < a->slice_counts; m++) {
     bb_rayset *rs = NULL;
-    st = bb_rayset_make(a->slice_count[m], 1.0, NULL, &rs, err);
+    st = bb__rayset_new(a->slice_count[m], 1.0, NULL, &rs, err);
     if (st != BB_OK) break;
     r.slice_phi[m] = malloc((size_t)rs->slice_count * sizeof(double));
     for (int s = 0; r.slice_phi[m] && s < rs->slice_count; s++) {
@@ -363,7 +367,7 @@ static bb_status rules_run(const args *a, const job *j, int rows, bb_error *err)
   if (st == BB_OK) st = bb__parallel_for(rows, 0, rule_row, &r, NULL, NULL, err);
   if (st == BB_OK) {
     printf("{\"map\":");
-    bb_json_quoted(stdout, a->map);
+    bb__json_quoted(stdout, a->map);
     printf(",\"scale\":%g,\"stride\":%d,\"azimuths\":%d,\"texels\":%ld,\"rules\":[", a->scale,
            a->stride, a->azimuths, r.texels);
     fprintf(stderr, "%-9s %6s %9s %9s %9s %9s  (ssmax: the ssbump channel of largest mean |error|)\n",
@@ -432,7 +436,7 @@ static int read_matching(const char *path, int width, int height, int channels, 
 
 static int compare_all(const args *a, const job *j, int width, int height) {
   printf("{\"map\":");
-  bb_json_quoted(stdout, a->map);
+  bb__json_quoted(stdout, a->map);
   printf(",\"scale\":%g,\"stride\":%d,\"azimuths\":%d,\"reach\":%g,\"texels\":%ld,\"results\":[",
          a->scale, a->stride, a->azimuths, a->reach,
          (long)((height + a->stride - 1) / a->stride) * j->columns);
@@ -445,7 +449,7 @@ static int compare_all(const args *a, const job *j, int width, int height) {
     }
     const stats sa = difference(j, &ao, j->ao, 0, 1);
     printf("%s{\"name\":", r ? "," : "");
-    bb_json_quoted(stdout, a->name[r]);
+    bb__json_quoted(stdout, a->name[r]);
     printf(",\"ao\":{\"mean\":%.6g,\"mean_abs\":%.6g},\"ssbump\":[", sa.mean, sa.mean_abs);
     fprintf(stderr, "accuracy_ref: %-10s ao %+.5f / %.5f", a->name[r], sa.mean, sa.mean_abs);
     for (int c = 0; c < 3; c++) {
@@ -474,16 +478,16 @@ int main(int argc, char **argv) {
   if (st == BB_OK) {
     const float scale = (float)a.scale; /* float times float, as the bake scales */
     for (size_t i = 0; i < (size_t)h.width * (size_t)h.height; i++) z.pixels[i] = scale * h.pixels[i];
-    st = bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, &err);
+    st = bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, &err);
   }
   if (st == BB_OK)
-    st = bb_normals_compute(&h, (float)a.scale, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &normal, &err);
+    st = bb__normals_compute_all_cores(&h, (float)a.scale, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &normal, &err);
   job j = {.a = &a, .p = p, .z = &z, .normal = &normal};
   if (st == BB_OK) {
     if (a.reach == 0.0) a.reach = 8.0 * (h.width > h.height ? h.width : h.height);
     j.columns = (h.width + a.stride - 1) / a.stride;
     const int rows = (h.height + a.stride - 1) / a.stride;
-    for (int c = 0; c < 3; c++) bb_basis_vector(c, j.basis[c]);
+    for (int c = 0; c < 3; c++) bb__basis_vector(c, j.basis[c]);
     j.ao = malloc((size_t)rows * (size_t)j.columns * sizeof(float));
     j.ssbump = malloc(3 * (size_t)rows * (size_t)j.columns * sizeof(float));
     if (!j.ao || !j.ssbump) st = bb__fail(&err, BB_ERR_MEMORY, "out of memory");

@@ -239,7 +239,7 @@ trace_row() {
 
 if want 1; then
 section "1. Trace benchmark (build/tools/bench_trace)"
-echo "bb_trace_occlusion (line sweeps) over every texel; then every slice's horizon at $subset texels"
+echo "bb__trace_occlusion (line sweeps) over every texel; then every slice's horizon at $subset texels"
 echo "one at a time on 1 thread, by the max-mip march and by brute force, and each of those texels"
 echo "traced alone as a one-texel region (marches), compared bit for bit with the whole trace."
 for m in "${maps[@]}"; do

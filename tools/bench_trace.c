@@ -7,7 +7,7 @@
  *
  * Prepares the map as a bake does (bb_height_file_read, the default bilateral
  * smoothing, times SCALE, max-mip pyramid, round(sqrt(RAYS)) slices of power
- * 1 on the HL2 basis, or A slices), times bb_trace_occlusion on THREADS
+ * 1 on the HL2 basis, or A slices), times bb__trace_occlusion on THREADS
  * threads, then finds every slice's horizon at N deterministic texels
  * (default 2000) one at a time on one thread, once by the max-mip march and
  * once by brute force, and traces each of those texels alone as a one-texel
@@ -21,6 +21,11 @@
 #include "bumpbake.h"
 #include "trace/march.h"
 #include "trace/rayset.h"
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "trace/pyramid.h"
+#include "trace/trace.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <math.h>
@@ -92,7 +97,7 @@ static int parse_args(int argc, char **argv, args *a) {
     return usage("SCALE must be a number > 0");
   if (parse_int(argv[3], 1, 65536, &a->rays)) return usage("RAYS must be 1..65536");
   if (parse_int(argv[4], 1, 4096, &a->threads)) return usage("THREADS must be 1..4096");
-  a->slices = bb_slices_for_rays(a->rays);
+  a->slices = bb__slices_for_rays(a->rays);
   for (int i = 5; i < argc; i++) {
     if (!strcmp(argv[i], "--clamp")) {
       a->addressing = BB_ADDRESS_CLAMP;
@@ -144,16 +149,16 @@ static bb_status prepare(const args *a, field *f, bb_error *err) {
   bb_status st = bb_height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &f->height, NULL, err);
   if (st != BB_OK) return st;
   bb_smooth_options so;
-  bb_smooth_options_init(&so);
+  bb__smooth_options_init(&so);
   so.addressing = a->addressing;
-  st = bb_smooth_bilateral(&f->height, &f->height, &so, &f->filtered, err);
+  st = bb__smooth_bilateral_all_cores(&f->height, &f->height, &so, &f->filtered, err);
   if (st == BB_OK) st = bb_image_alloc(&f->z, f->filtered.width, f->filtered.height, 1, err);
   if (st != BB_OK) return st;
   const float scale = (float)a->scale; /* float times float, exactly as the bake scales */
   const size_t n = (size_t)f->z.width * (size_t)f->z.height;
   for (size_t i = 0; i < n; i++) f->z.pixels[i] = scale * f->filtered.pixels[i];
-  st = bb_pyramid_build(&f->z, a->addressing, &f->pyramid, err);
-  if (st == BB_OK) st = bb_rayset_make(a->slices, 1.0, NULL, &f->rs, err);
+  st = bb__pyramid_build_all_cores(&f->z, a->addressing, &f->pyramid, err);
+  if (st == BB_OK) st = bb__rayset_new(a->slices, 1.0, NULL, &f->rs, err);
   return st;
 }
 
@@ -180,7 +185,7 @@ static double run_trace(void *ctx) {
   bb_image_free(&r->vis);
   double t0 = now_seconds();
   bb_status st =
-      bb_trace_occlusion(r->f->pyramid, r->f->rs, &r->options, &r->vis, &r->horizons, &r->err);
+      bb__trace_occlusion(r->f->pyramid, r->f->rs, &r->options, &r->vis, &r->horizons, &r->err);
   double t = now_seconds() - t0;
   return st == BB_OK ? t : -1.0;
 }
@@ -255,7 +260,7 @@ static long region_mismatches(const field *f, const subset *s, const bb_trace_op
   for (int i = 0; i < s->count; i++) {
     one.region = (bb_region){s->x[i], s->y[i], 1, 1};
     bb_image vis = {0};
-    if (bb_trace_occlusion(f->pyramid, f->rs, &one, &vis, NULL, NULL) != BB_OK) return -1;
+    if (bb__trace_occlusion(f->pyramid, f->rs, &one, &vis, NULL, NULL) != BB_OK) return -1;
     n += memcmp(vis.pixels, bb_image_texel(whole, s->x[i], s->y[i]),
                 (size_t)vis.channels * sizeof(float)) != 0;
     bb_image_free(&vis);
@@ -278,12 +283,12 @@ static double per_second(double work, double seconds) {
 
 static void print_json(const args *a, const field *f, const trace_run *t, const results *r) {
   printf("{\"map\":");
-  bb_json_quoted(stdout, a->map);
+  bb__json_quoted(stdout, a->map);
   printf(",\"width\":%d,\"height\":%d,\"scale\":%g,\"rays\":%d,\"slices\":%d,\"threads\":%d,"
          "\"addressing\":\"%s\",\"bias\":%g,\"rayset\":",
          f->z.width, f->z.height, a->scale, a->rays, f->rs->slice_count, a->threads,
          a->addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a->bias);
-  bb_json_quoted(stdout, f->rs->id);
+  bb__json_quoted(stdout, f->rs->id);
   printf(",\"trace_s\":%.6f,\"trace_runs\":%d,\"horizons\":%.0f,\"horizons_per_s\":%.6g,"
          "\"subset_texels\":%d,\"subset_horizons\":%ld,\"positive_fraction\":%.6g,"
          "\"march_s\":%.6f,\"march_runs\":%d,\"march_horizons_per_s\":%.6g,"
@@ -344,7 +349,7 @@ static int bench(const args *a) {
     return 1;
   }
   trace_run t = {.f = &f};
-  bb_trace_options_init(&t.options);
+  bb__trace_options_init(&t.options);
   t.options.threads = a->threads;
   t.options.bias_texels = a->bias;
   results r = {0};

@@ -25,6 +25,11 @@
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/bounce.h"
+#include "bake/bake_internal.h"
+#include "image/image_write.h"
+#include "trace/pyramid.h"
+#include "trace/rayset.h"
+#include "trace/trace.h"
 
 #include <errno.h>
 #include <math.h>
@@ -100,7 +105,7 @@ static int parse_args(int argc, char **argv, args *a) {
     const char *s = argv[++i];
     if (!strcmp(o, "--normal-filter")) {
       bb_error err;
-      if (bb_normal_filter_parse(s, &a->bake.normal_filter, &err) != BB_OK) return usage(err.message);
+      if (bb__normal_filter_parse(s, &a->bake.normal_filter, &err) != BB_OK) return usage(err.message);
       continue;
     }
     if (!strcmp(o, "--texel-slopes") || !strcmp(o, "--surface-slopes")) {
@@ -126,7 +131,7 @@ static int parse_args(int argc, char **argv, args *a) {
     else return usage("unknown option");
   }
   bb_error err;
-  if (bb_bake_options_check(&a->bake, &err) != BB_OK) return usage(err.message);
+  if (bb__bake_options_check(&a->bake, &err) != BB_OK) return usage(err.message);
   return 0;
 }
 
@@ -138,20 +143,20 @@ static bb_status staged_bake(const args *a, const bb_image *height, bb_bake_resu
   bb_pyramid *pyramid = NULL;
   bb_rayset *rays = NULL;
   memset(r, 0, sizeof *r);
-  bb_status st = bb_smooth_bilateral(height, height, &o->smooth, &r->filtered, err);
+  bb_status st = bb__smooth_bilateral_all_cores(height, height, &o->smooth, &r->filtered, err);
   if (st == BB_OK)
-    st = bb_normals_compute(&r->filtered, o->height_scale, o->normal_filter, o->smooth.addressing,
+    st = bb__normals_compute_all_cores(&r->filtered, o->height_scale, o->normal_filter, o->smooth.addressing,
                             &r->normal, err);
   if (st == BB_OK) st = bb_image_alloc(&z, height->width, height->height, 1, err);
   if (st == BB_OK) {
     for (size_t i = 0; i < (size_t)z.width * (size_t)z.height; i++)
       z.pixels[i] = o->height_scale * r->filtered.pixels[i];
-    st = bb_pyramid_build(&z, o->smooth.addressing, &pyramid, err);
+    st = bb__pyramid_build_all_cores(&z, o->smooth.addressing, &pyramid, err);
   }
-  if (st == BB_OK) st = bb_rayset_make(bb_bake_slices(o), o->power, &o->basis, &rays, err);
+  if (st == BB_OK) st = bb__rayset_new(bb_bake_slices(o), o->power, &o->basis, &rays, err);
   const double t0 = bb__now_seconds();
   bb_trace_options to = o->trace;
-  if (st == BB_OK) st = bb_trace_occlusion(pyramid, rays, &to, &r->vis, NULL, err);
+  if (st == BB_OK) st = bb__trace_occlusion(pyramid, rays, &to, &r->vis, NULL, err);
   const double t1 = bb__now_seconds();
   r->seconds_trace = t1 - t0;
   bb__bounce_options bo = a->bounce;
@@ -161,12 +166,12 @@ static bb_status staged_bake(const args *a, const bb_image *height, bb_bake_resu
   bo.threads = o->trace.threads;
   if (st == BB_OK && bo.rho > 0.0) st = bb__bounce_add(pyramid, rays, &bo, &r->vis, &r->bounces, err);
   r->seconds_bounce = bb__now_seconds() - t1;
-  if (st == BB_OK) st = bb_derive_ssbump(&r->normal, &r->vis, &o->basis, &r->ssbump, err);
+  if (st == BB_OK) st = bb__derive_ssbump_all_cores(&r->normal, &r->vis, &o->basis, &r->ssbump, err);
   if (st == BB_OK) { /* a channel of the ssbump holds at most 1, as the bake caps it */
     const size_t n = (size_t)r->ssbump.width * (size_t)r->ssbump.height * (size_t)r->ssbump.channels;
     for (size_t i = 0; i < n; i++) r->ssbump.pixels[i] = fminf(r->ssbump.pixels[i], 1.0f);
   }
-  if (st == BB_OK) st = bb_derive_ao(&r->vis, &r->ao, err);
+  if (st == BB_OK) st = bb__derive_ao_all_cores(&r->vis, &r->ao, err);
   bb_rayset_free(rays);
   bb_pyramid_free(pyramid);
   bb_image_free(&z);
@@ -186,11 +191,11 @@ int main(int argc, char **argv) {
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
   if (st == BB_OK) {
     snprintf(path, sizeof path, "%s.ao.exr", a.prefix);
-    st = bb_image_write(path, &r.ao, &wo, &err);
+    st = bb__image_write(path, &r.ao, &wo, &err);
   }
   if (st == BB_OK) {
     snprintf(path, sizeof path, "%s.ss.exr", a.prefix);
-    st = bb_image_write(path, &r.ssbump, &wo, &err);
+    st = bb__image_write(path, &r.ssbump, &wo, &err);
   }
   if (st != BB_OK) {
     fprintf(stderr, "bounce_bake: %s\n", err.message);

@@ -56,6 +56,11 @@
  */
 #include "bumpbake.h"
 #include "core/internal.h"
+#include "bake/bake_internal.h"
+#include "files/provenance.h"
+#include "image/image_write.h"
+#include "trace/basis.h"
+#include "core/json.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -114,7 +119,7 @@ static int parse_trace_args(int argc, char **argv, args *a) {
   a->map = argv[2];
   a->rho = 0.5, a->bias = 0.55, a->power = 1.0;
   a->paths = DEFAULT_PATHS, a->stride = 8, a->seed = 1;
-  bb_basis_init(&a->basis);
+  bb__basis_init(&a->basis);
   if (parse_number(argv[3], 1e-9, 1e30, &a->scale)) return usage("SCALE must be > 0");
   for (int i = 4; i < argc; i++) {
     const char *o = argv[i];
@@ -137,7 +142,7 @@ static int parse_trace_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--albedo")) a->albedo_path = v;
     else if (!strcmp(o, "--basis")) {
       bb_error err;
-      if (bb_basis_parse(v, &a->basis, &err) != BB_OK) return usage(err.message);
+      if (bb__basis_parse(v, &a->basis, &err) != BB_OK) return usage(err.message);
     } else if (parse_number(v, 0.0, 1e12, &x)) return usage("bad option value");
     else if (!strcmp(o, "--rho") && x <= 1.0) a->rho = x;
     else if (!strcmp(o, "--bias")) a->bias = x;
@@ -632,7 +637,7 @@ static int run_trace(int argc, char **argv) {
            a.paths, a.bias, a.power, a.basis.name,
            a.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic", a.seed);
   bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, description, NULL};
-  if (st == BB_OK && a.out) st = bb_image_write(a.out, &out, &wo, &err);
+  if (st == BB_OK && a.out) st = bb__image_write(a.out, &out, &wo, &err);
   if (st == BB_OK && a.texels) { /* one line per texel: value and standard error */
     for (int t = 0; t < a.texels; t++) {
       const float *v = out.pixels + (size_t)t * (size_t)out.channels;
@@ -651,7 +656,7 @@ static int run_trace(int argc, char **argv) {
     /* the mean value, the mean standard error per texel and that of the mean */
     const long texels = (long)rows * j.columns;
     printf("{\"map\":");
-    bb_json_quoted(stdout, a.map);
+    bb__json_quoted(stdout, a.map);
     printf(",\"scale\":%g,\"rho\":%g,\"bounces\":%d,\"paths\":%d,\"stride\":%d,\"texels\":%ld,"
            "\"seconds\":%.3f,\"channels\":[",
            a.scale, a.rho, a.bounces, a.paths, a.stride, texels, seconds);
@@ -684,7 +689,7 @@ static int run_trace(int argc, char **argv) {
 
 static int read_key(const char *description, const char *key, double *out) {
   char value[128];
-  return bb_provenance_value(description, key, value, sizeof value) &&
+  return bb__provenance_value(description, key, value, sizeof value) &&
                  !parse_number(value, -1e300, 1e300, out)
              ? 0
              : 1;
@@ -703,7 +708,7 @@ static int run_compare(int argc, char **argv) {
   int first = 5;
   if (!strcmp(argv[5], "--normal-filter")) {
     bb_error err;
-    if (argc < 8 || bb_normal_filter_parse(argv[6], &filter, &err) != BB_OK)
+    if (argc < 8 || bb__normal_filter_parse(argv[6], &filter, &err) != BB_OK)
       return usage("bad --normal-filter");
     first = 7;
   }
@@ -720,8 +725,8 @@ static int run_compare(int argc, char **argv) {
       read_key(info.description, "map_width", &width_d) ||
       read_key(info.description, "map_height", &height_d) ||
       read_key(info.description, "bias", &bias) ||
-      !bb_provenance_value(info.description, "basis", basis_name, sizeof basis_name) ||
-      !bb_provenance_value(info.description, "addressing", addressing, sizeof addressing)) {
+      !bb__provenance_value(info.description, "basis", basis_name, sizeof basis_name) ||
+      !bb__provenance_value(info.description, "addressing", addressing, sizeof addressing)) {
     fprintf(stderr, "bounce_ref: %s: not a bounce_ref reference\n", ref_path);
     bb_image_free(&ref);
     bb_image_info_free(&info);
@@ -730,14 +735,14 @@ static int run_compare(int argc, char **argv) {
   clamp_flag = !strcmp(addressing, "clamp");
   bb_image_info_free(&info);
   bb_basis basis;
-  if (bb_basis_parse(basis_name, &basis, &err) != BB_OK) {
+  if (bb__basis_parse(basis_name, &basis, &err) != BB_OK) {
     fprintf(stderr, "bounce_ref: %s: %s\n", ref_path, err.message);
     bb_image_free(&ref);
     return 1;
   }
   const int stride = (int)stride_d, lobes = basis.count, channels = 1 + lobes;
   if (bb_height_file_read(map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err) != BB_OK ||
-      bb_normals_compute(&h, (float)scale, filter,
+      bb__normals_compute_all_cores(&h, (float)scale, filter,
                          clamp_flag ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC, &normal,
                          &err) != BB_OK) {
     fprintf(stderr, "bounce_ref: %s\n", err.message);
@@ -772,7 +777,7 @@ static int run_compare(int argc, char **argv) {
       }
     }
   printf("{\"reference\":");
-  bb_json_quoted(stdout, ref_path);
+  bb__json_quoted(stdout, ref_path);
   printf(",\"texels\":%ld,\"reference_se\":[", texels);
   fprintf(stderr, "bounce_ref: %s: %ld texels; reference standard error per texel / of the mean:",
           ref_path, texels);
@@ -828,7 +833,7 @@ static int run_compare(int argc, char **argv) {
         }
       }
     printf("%s{\"name\":", printed++ ? "," : "");
-    bb_json_quoted(stdout, text);
+    bb__json_quoted(stdout, text);
     printf(",\"channels\":[");
     fprintf(stderr, "bounce_ref: %-12s", text);
     for (int c = 0; c < channels; c++) {

@@ -8,7 +8,8 @@
 #      bumpbake.pc, and --cflags must be the include directory alone) and
 #      with `pkg-config --static --libs` against libbumpbake.a, runs both
 #      and checks they print "ok";
-#   3. checks libbumpbake.so exports exactly the functions of bumpbake.h;
+#   3. checks libbumpbake.so exports exactly the functions of bumpbake.h and
+#      bumpbake_cluster.h;
 #   4. checks the man page renders without warnings and names every command
 #      and option the installed bumpbake's --help lists;
 #   5. a staged install (DESTDIR) lands under DESTDIR with PREFIX's paths;
@@ -47,7 +48,7 @@ if ! "$make" --no-print-directory install DEBUG="$debug" PREFIX="$prefix" LDCONF
   echo "check_install: FAILED: make install PREFIX=$prefix" >&2
   exit 1
 fi
-for f in bin/bumpbake lib/libbumpbake.a lib/libbumpbake.so include/bumpbake.h \
+for f in bin/bumpbake lib/libbumpbake.a lib/libbumpbake.so include/bumpbake.h include/bumpbake_cluster.h \
   lib/pkgconfig/bumpbake.pc share/man/man1/bumpbake.1; do
   [ -e "$prefix/$f" ] || fail "make install did not install $f"
 done
@@ -110,14 +111,14 @@ fi
 # Besides them, png_set_error_fn and png_create_write_struct (src/image/
 # png_hooks.c: they set up the libpng structs OpenImageIO makes, so they
 # must be found before libpng's).
-{ grep -v '^[[:space:]]*typedef' "$prefix/include/bumpbake.h" |
+{ cat "$prefix/include/bumpbake.h" "$prefix/include/bumpbake_cluster.h" | grep -v '^[[:space:]]*typedef' |
     grep -o '\bbb_[a-z0-9_]*[[:space:]]*(' | tr -d '( '
   echo png_set_error_fn; echo png_create_write_struct; } | sort -u >"$tmp/header.sym"
 nm -D --defined-only "$prefix/lib/libbumpbake.so" | awk '{ print $3 }' | sort -u >"$tmp/so.sym"
 if cmp -s "$tmp/header.sym" "$tmp/so.sym"; then
-  pass "libbumpbake.so exports the functions of bumpbake.h and its two libpng hooks, nothing else ($(wc -l <"$tmp/so.sym"))"
+  pass "libbumpbake.so exports the functions of bumpbake.h, bumpbake_cluster.h and its two libpng hooks, nothing else ($(wc -l <"$tmp/so.sym"))"
 else
-  fail "exports differ from bumpbake.h's functions (< header only, > .so only):"
+  fail "exports differ from the functions of bumpbake.h and bumpbake_cluster.h (< headers only, > .so only):"
   diff "$tmp/header.sym" "$tmp/so.sym" | grep '^[<>]' >&2 || true
 fi
 

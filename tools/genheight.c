@@ -9,6 +9,7 @@
  * the format (16-bit for .png/.tif so slopes do not terrace).
  */
 #include "bumpbake.h"
+#include "image/image_write.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -253,7 +254,7 @@ int main(int argc, char **argv) {
       .depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT, .description = description};
   if (wants_16_bits(out))
     wo.depth = BB_DEPTH_16;
-  bb_status st = bb_image_write(out, &img, &wo, &err);
+  bb_status st = bb__image_write(out, &img, &wo, &err);
   bb_image_free(&img);
   if (st != BB_OK) {
     fprintf(stderr, "genheight: %s\n", err.message);

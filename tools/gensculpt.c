@@ -1,5 +1,5 @@
 /* gensculpt.c: writes the project's flat sculpt fixture, a tileable riveted
- * panel, as a model file through bb_mesh_write (Assimp's exporters).
+ * panel, as a model file through bb__mesh_write (Assimp's exporters).
  *
  *   gensculpt OUT.obj|OUT.ply|OUT.stl|OUT.glb
  *
@@ -14,6 +14,7 @@
  * is the same bytes on every run.
  */
 #include "bumpbake.h"
+#include "mesh/mesh_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -240,7 +241,7 @@ int main(int argc, char **argv) {
   build_panel(&b);
   bb_mesh m = {b.vertices, b.triangles, b.positions, b.normals, b.indices};
   bb_error err = {{0}};
-  bb_status st = bb_mesh_write(argv[1], &m, &err);
+  bb_status st = bb__mesh_write(argv[1], &m, &err);
   free(b.positions);
   free(b.normals);
   free(b.indices);

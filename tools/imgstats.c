@@ -14,6 +14,8 @@
  * command line.
  */
 #include "bumpbake.h"
+#include "core/internal.h"
+#include "core/json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -65,9 +67,9 @@ static int report(const char *pa, const char *pb, const bb_image *a, const bb_im
     return 1;
   }
   printf("{\"a\":");
-  bb_json_quoted(stdout, pa);
+  bb__json_quoted(stdout, pa);
   printf(",\"b\":");
-  bb_json_quoted(stdout, pb);
+  bb__json_quoted(stdout, pb);
   printf(",\"width\":%d,\"height\":%d,\"channels\":[", a->width, a->height);
   for (int c = 0; c < a->channels; c++) {
     channel_stats s = channel_difference(a, b, c, scratch);

@@ -55,6 +55,9 @@
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/integrate.h"
+#include "bake/bake_internal.h"
+#include "image/image_write.h"
+#include "trace/basis.h"
 
 #include <errno.h>
 #include <math.h>
@@ -142,7 +145,7 @@ static int write_profile(const char *name, const char *out) {
       *bb_image_texel(&h, x, y) = (float)v;
   }
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
-  const bb_status st = bb_image_write(out, &h, &wo, &err);
+  const bb_status st = bb__image_write(out, &h, &wo, &err);
   bb_image_free(&h);
   if (st != BB_OK)
     fprintf(stderr, "radiosity2d: %s\n", err.message);
@@ -587,7 +590,7 @@ static int parse_options(int argc, char **argv, int first, args *a, const char *
                          int *results_at) {
   a->rho = 0.5, a->bias = 0.55, a->power = 1.0, a->strip = 0.1;
   a->filter = BB_NORMAL_VERTEX;
-  bb_basis_init(&a->basis);
+  bb__basis_init(&a->basis);
   if (results_at)
     *results_at = argc;
   for (int i = first; i < argc; i++) {
@@ -606,10 +609,10 @@ static int parse_options(int argc, char **argv, int first, args *a, const char *
     double x;
     bb_error err;
     if (!strcmp(o, "--basis")) {
-      if (bb_basis_parse(v, &a->basis, &err) != BB_OK)
+      if (bb__basis_parse(v, &a->basis, &err) != BB_OK)
         return usage(err.message);
     } else if (!strcmp(o, "--normal-filter")) {
-      if (bb_normal_filter_parse(v, &a->filter, &err) != BB_OK)
+      if (bb__normal_filter_parse(v, &a->filter, &err) != BB_OK)
         return usage(err.message);
     } else if (!strcmp(o, "--base") && base) {
       *base = v;
@@ -760,7 +763,7 @@ static int run_compare(int argc, char **argv) {
   model m;
   rc = model_make(&a, &k, &h, &m);
   bb_error err;
-  if (!rc && bb_normals_compute(&h, (float)a.scale, a.filter, BB_ADDRESS_CLAMP, &normal,
+  if (!rc && bb__normals_compute_all_cores(&h, (float)a.scale, a.filter, BB_ADDRESS_CLAMP, &normal,
                                 &err) != BB_OK) {
     fprintf(stderr, "radiosity2d: %s\n", err.message);
     rc = 1;

@@ -3,8 +3,8 @@
  *
  *   texture_quality write IN OUT [--format F] [--map plain|normal|ssbump]
  *                   [--fast] [--no-mips] [--threads N] [--vtf-version N]
- *       IN (any image) to OUT: .vtf or .dds by bb_texture_write, any other
- *       extension by bb_image_write (8-bit; normal maps stored signed);
+ *       IN (any image) to OUT: .vtf or .dds by bb__texture_write, any other
+ *       extension by bb__image_write (8-bit; normal maps stored signed);
  *       prints the seconds the write took (in this process, start-up
  *       excluded).
  *   texture_quality decode IN OUT.png [--level K]
@@ -24,6 +24,9 @@
  */
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
+#include "core/internal.h"
+#include "image/image_write.h"
+#include "texture/texture.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -117,7 +120,7 @@ static int read_any(const char *path, int level, bb_image *out) {
 
 /* A map kind as the library names it (plain, normal, ssbump, ...). */
 static int parse_map(const char *name, bb_map_kind *map) {
-  return bb_map_kind_parse(name, map, NULL) == BB_OK ? 0 : -1;
+  return bb__map_kind_parse(name, map, NULL) == BB_OK ? 0 : -1;
 }
 
 static int cmd_write(int argc, char **argv) {
@@ -150,12 +153,12 @@ static int cmd_write(int argc, char **argv) {
     return fail(argv[0], &err);
   const double t0 = now();
   bb_status st;
-  if (bb_path_is_texture_format(argv[1])) {
-    st = bb_texture_write(argv[1], &img, &o, &err);
+  if (bb__path_is_texture_format(argv[1])) {
+    st = bb__texture_write(argv[1], &img, &o, &err);
   } else {
     bb_write_options w = {BB_DEPTH_DEFAULT,
                           bb_map_kind_get(o.map)->range, NULL, NULL};
-    st = bb_image_write(argv[1], &img, &w, &err);
+    st = bb__image_write(argv[1], &img, &w, &err);
   }
   const double seconds = now() - t0;
   bb_image_free(&img);
@@ -182,7 +185,7 @@ static int cmd_decode(int argc, char **argv) {
     for (int k = 0; k < c; k++)
       rgb.pixels[i * (size_t)c + (size_t)k] = img.pixels[i * (size_t)img.channels + (size_t)k];
   bb_write_options w = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
-  bb_status st = bb_image_write(argv[1], &rgb, &w, &err);
+  bb_status st = bb__image_write(argv[1], &rgb, &w, &err);
   bb_image_free(&img);
   bb_image_free(&rgb);
   return st == BB_OK ? 0 : fail(argv[1], &err);

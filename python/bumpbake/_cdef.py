@@ -1,6 +1,9 @@
-"""The part of include/bumpbake.h the Python package calls, for cffi.
+"""The part of include/bumpbake.h and bumpbake_cluster.h the Python package
+calls, for cffi.
 
-Every type and function the package uses, and nothing else. The structs must
+Every type and function the package uses, and nothing else but
+bb_command_count and bb_command_info_get, with which its tests walk the
+commands (tests/test_commands.py). The structs must
 match the header field for field, since cffi's ABI mode lays them out from
 these declarations: tests/test_cdef.py compiles a C program against the real
 header and checks every size, offset, enum value and function signature
@@ -661,14 +664,11 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
-const char *bb_depth_name(bb_depth depth);
 const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-const char *bb_texture_format_name(bb_texture_format format);
 bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
 bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 void bb_texture_options_init(bb_texture_options *options);
-int bb_path_is_texture_format(const char *path);
 bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 void bb_vtf_info_free(bb_vtf_info *info);
 bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
@@ -677,21 +677,16 @@ const char *bb_vtf_flag_name(int bit);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
-const char *bb_channel_name(bb_channel c);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb_normal_filter_name(bb_normal_filter f);
 void bb_normal_decode_options_init(bb_normal_decode_options *o);
 bb_status bb_normal_map_decode(const bb_image *values, int is_float,
                                const bb_normal_decode_options *o, bb_image *normals,
                                bb_error *err);
-void bb_basis_init(bb_basis *b);
-bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err);
 bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
                                 bb_error *err);
-bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err);
 bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);
 void bb_pyramid_free(bb_pyramid *p);
 void bb_rayset_free(bb_rayset *rs);
@@ -709,7 +704,6 @@ bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_i
                             bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
 int bb_bake_slices(const bb_bake_options *o);
-bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
@@ -722,7 +716,6 @@ void bb_bake_context_keep(bb_bake_context *context, int keep);
 bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
                                const bb_bake_options *o, bb_bake_result *result,
                                bb_region *changed, bb_error *err);
-bb_region bb_bake_context_changed(const bb_bake_context *context);
 bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err);
 void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
@@ -742,37 +735,11 @@ bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
-void bb_compare_limits_init(bb_compare_limits *limits);
-bb_status bb_compare_limits_check(const bb_compare_limits *limits, bb_error *err);
-bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err);
-bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err);
 void bb_render_options_init(bb_render_options *o);
-bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
-                    bb_error *err);
 bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
-void bb_panel_layout_init(bb_panel_layout *l);
-bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
-                            const bb_panel_layout *l, bb_image *out, int *labels_drawn,
-                            bb_error *err);
-void bb_sheet_options_init(bb_sheet_options *o);
-bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
-                        const bb_sheet_options *o, bb_image *out, int *labels_drawn,
-                        bb_error *err);
-void bb_mesh_free(bb_mesh *m);
-uint64_t bb_mesh_hash(const bb_mesh *m);
-bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err);
-bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err);
-const char *bb_axis_name(bb_axis a);
-void bb_renderbump_options_init(bb_renderbump_options *o);
-bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
-                             bb_renderbump_result *result, bb_error *err);
 void bb_renderbump_result_free(bb_renderbump_result *r);
-bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
-                              int normal_y_up, const char *model, uint64_t model_hash,
-                              const char *command, const char *normal_path,
-                              const char *height_path, bb_error *err);
 bb_provenance_class bb_provenance_classify(const char *description);
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
@@ -796,8 +763,6 @@ bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
                              bb_error *err);
 bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
                             bb_error *err);
-bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
-                       bb_check_case_fn each, void *user, bb_error *err);
 int bb_check_case_count(const bb_check *check);
 const bb_check_case *bb_check_case_get(const bb_check *check, int i);
 int bb_check_exit_code(const bb_check *check);
@@ -807,32 +772,23 @@ char *bb_check_summary_lines(const bb_check *check);
 bb_status bb_check_write_reports(bb_check *check, bb_error *err);
 char *bb_check_export(bb_check *check, int first, size_t *size);
 bb_status bb_check_import(bb_check *check, const char *data, size_t size, bb_error *err);
-void bb_job_options_init(bb_job_options *o);
-bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                      bb_job **out, bb_error *err);
 void bb_job_free(bb_job *job);
 int bb_job_count(const bb_job *job);
 const bb_job_report *bb_job_report_get(const bb_job *job, int i);
-const char *bb_job_stage(const bb_job *job);
 bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
-char *bb_job_command_text(const bb_job_options *o, const char *input);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
 int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);
 const bb_command_info *bb_command_info_find(const char *name);
-const bb_command_info *bb_command_info_nearest(const char *name);
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length);
 const bb_option_info *bb_option_nearest(const bb_command_info *command, const char *name,
                                         size_t length);
 void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
-void bb_option_choices(const bb_option_info *option, char *out, size_t cap);
 void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
-int bb_option_bounds(const bb_option_info *option, double *min, double *max,
-                     int *min_exclusive);
 void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
                             char *out, size_t cap);
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
@@ -846,8 +802,6 @@ void bb_command_set_in_memory(bb_command *command, unsigned maps);
 void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
 const bb_command_options *bb_command_options_of(const bb_command *command);
-int bb_command_input_count(const bb_command *command);
-const char *bb_command_input(const bb_command *command, int index);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
@@ -856,7 +810,6 @@ bb_status bb_command_set_record(bb_command *command, const char *line, const cha
                                 bb_error *err);
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
                           bb_error *err);
-int bb_command_has_job(const bb_command_info *command);
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
@@ -867,11 +820,7 @@ bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
 bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
-const char *bb_normal_y_name(int normal_y_up);
-const char *bb_addressing_name(bb_addressing addressing);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
-const char *bb_provenance_class_name(bb_provenance_class c);
-int bb_map_kind_records(const char *kind, const char *key, int bounce);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);

@@ -222,7 +222,7 @@ def _texture_options(command, texture_format=None, vtf_version=None, vtf_flags=N
     """A bb_texture_options of the CLI-named settings (None: the library's
     default), filled into out (a bb_texture_options cdata) or a new one.
     Names are parsed by the library; the rest is checked where it is used
-    (bb_texture_check), with its message."""
+    (bb__texture_check), with its message."""
     o = out if out is not None else _ffi.new("bb_texture_options *")
     _lib.bb_texture_options_init(o)
     if texture_format is not None:

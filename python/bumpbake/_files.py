@@ -318,7 +318,7 @@ class Comparison:
 
 
 def _diff_pairs(text, a, b):
-    """(key, value in a, value in b) for each key bb_provenance_diff names
+    """(key, value in a, value in b) for each key bb__provenance_diff names
     in text ("key: A -> B" lines), values taken from the files' own
     provenance (None where a file lacks the key), since a value may hold
     " -> " itself."""

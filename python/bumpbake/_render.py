@@ -233,7 +233,7 @@ class RenderBump:
     triangles_drawn: int     # triangle copies rasterised (tile copies included)
     triangles: int           # of the model
     vertices: int
-    model_hash: int          # bb_mesh_hash, recorded in provenance as model_hash
+    model_hash: int          # bb__mesh_hash, recorded in provenance as model_hash
     notes: list              # the library's notes ("texels are ... times as wide")
 
 

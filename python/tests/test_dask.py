@@ -461,7 +461,7 @@ def test_engine_textures_on_a_cluster_are_the_cli_bytes(tmp_path, monkeypatch, c
                    vtf_version="7.3", texture_format="dxt5", vtf_flags=4, nomip=True)
     bumpbake.dask.bake_files("heights", "out", client=client, **options)
     command = bumpbake.BakeJob("heights", "out", **options).command_text(0)
-    # the format by its first name (bc3 is dxt5), as bb_texture_format_name spells it
+    # the format by its first name (bc3 is dxt5), as bb__texture_format_name spells it
     assert command.endswith("--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip")
     os.rename("out", "out_api")
     cli("bake", "heights", *shlex.split(command)[3:])

@@ -8,6 +8,7 @@
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include "trace/retrace.h"
+#include "trace/trace.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -38,7 +39,7 @@ static bb_status scaled_heights(const bb_image *h, float scale, bb_image *out,
 }
 
 /* The trace of the caller's (bb_trace_options.trace) in place of
- * bb_trace_occlusion; what it makes is checked to be what that would make. */
+ * bb__trace_occlusion; what it makes is checked to be what that would make. */
 static bb_status caller_trace(const bb_pyramid *p, const bb_rayset *rs, const bb_trace_options *o,
                               bb_image *vis, double *horizons_found, bb_error *err) {
   memset(vis, 0, sizeof *vis);
@@ -98,7 +99,7 @@ static int trace_progress_of(void *user, long done, long total) {
 /* Inter-reflection, added to r->vis (bounce.c); the trace did trace_work
  * of the progress before it. With r->vis not yet made, the bounce's passes
  * are the trace too (its sweeps find the texels' horizons, and r->vis is
- * bb_trace_occlusion's, bit for bit, before the bounce is added). */
+ * bb__trace_occlusion's, bit for bit, before the bounce is added). */
 static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
                         const bb_rayset *rays, int threads, long trace_work, bb_bake_result *r,
                         bb_error *err) {
@@ -166,7 +167,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     else if (o->bounce_albedo > 0.0) /* the bounce's passes are the trace */
       r->horizons_found = (double)pyramid->width * (double)pyramid->height * rays.slice_count;
     else
-      st = bb_trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
+      st = bb__trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);
     if (st == BB_OK && keep)
       r->horizons_found =
           (double)pyramid->width * (double)pyramid->height * rays.slice_count;
@@ -295,7 +296,7 @@ bb_status bb__bake(bb_image *height, const bb_bake_options *o, unsigned flags,
 }
 
 /* Before anything is allocated: refuses a bake the machine cannot hold
- * (bb__bake_memory against bb_memory_available), with the figures. */
+ * (bb__bake_memory against bb__memory_available), with the figures. */
 static bb_status check_memory(const bb_image *height, const bb_bake_options *o, unsigned flags,
                               bb_error *err) {
   char what[64];

@@ -65,7 +65,7 @@ extern const bb__range bb__range_height_scale, bb__range_rays, bb__range_slices,
     bb__range_filter_radius, bb__range_filter_threshold, bb__range_bias, bb__range_power,
     bb__range_bounce_albedo, bb__range_bounces;
 
-/* The one check of a bake's options (bb_bake_options_check) and the one
+/* The one check of a bake's options (bb__bake_options_check) and the one
  * place its ray budget becomes azimuth slices: out is in with slices set
  * (bb_bake_slices) when a traced map is asked. Every entry point taking
  * bb_bake_options prepares them once; what runs after (bb__bake, the
@@ -166,5 +166,51 @@ bb_status bb__derive_brightness(const bb_image *map, int scaled, const bb_image 
  * differences (|S h| <= BB_MAX_HEIGHT_TEXELS) at every texel of a 1-channel
  * height; BB_ERR_VALUE names the first texel over it (scaled_height.c). */
 bb_status bb__check_scaled_height(const bb_image *height, float height_scale, bb_error *err);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+void bb__smooth_options_init(bb_smooth_options *o);
+
+/* Valve's tileable bilateral filter (docs/conventions.md "Smoothing") of every
+ * channel of in, guided by channel 0 of guide (guide may be in). Allocates out
+ * with in's size and channels. */
+bb_status bb__smooth_bilateral_all_cores(const bb_image *in, const bb_image *guide,
+                              const bb_smooth_options *o, bb_image *out,
+                              bb_error *err);
+
+/* Unit tangent-space normals (+Y down) of the surface z = height_scale * h.
+ * height: 1 channel; out: allocated, 3 channels. */
+bb_status bb__normals_compute_all_cores(const bb_image *height, float height_scale,
+                             bb_normal_filter filter, bb_addressing addressing,
+                             bb_image *out, bb_error *err);
+
+/* ssbump s_c = max(0, N.B_c) * vis_c, for the channels of vis after ao
+ * (vis as bb__trace_occlusion makes it: 1 + basis->count channels; with
+ * basis NULL, 4 or 5). out (allocated): count channels. */
+bb_status bb__derive_ssbump_all_cores(const bb_image *normals, const bb_image *vis,
+                           const bb_basis *basis, bb_image *out, bb_error *err);
+
+/* ao as a 1-channel image (channel 0 of vis). */
+bb_status bb__derive_ao_all_cores(const bb_image *vis, bb_image *out, bb_error *err);
+
+/* Bent normal normalize(sum_c s_c B_c) over the basis' channels of ssbump
+ * (basis->count of them; with basis NULL, 3 or 4); (0, 0, 1) where every
+ * s_c is 0. out (allocated): 3 channels, +Y down. */
+bb_status bb__derive_bent_all_cores(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
+                         bb_error *err);
+
+/* Checks every field of o as bb_bake does before it starts (ranges in the
+ * field comments): BB_OK, or BB_ERR_ARGUMENT with a message such as "bake:
+ * filter radius must be in 0..4096 (got 5000)". So a caller can refuse bad
+ * options before loading anything. */
+bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err);
+
+/* Once in bumpbake.h beside the functions that stay public there. */
+/* "periodic" or "clamp"; "unknown" for other values. */
+const char *bb__addressing_name(bb_addressing addressing);
+/* Parses "vertex", "valve", "central", "sobel". */
+bb_status bb__normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
+const char *bb__normal_y_name(int normal_y_up);
 
 #endif /* BB_BAKE_INTERNAL_H */

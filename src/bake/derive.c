@@ -84,7 +84,7 @@ static bb_status resolve_basis(const bb_basis *basis, int channels, const char *
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "derive: %s has %d basis channels; without a basis, 3 (hl2) or 4 (hl2+z)",
                     what, channels);
-  return bb_basis_parse(channels == 4 ? "hl2+z" : "hl2", out, err);
+  return bb__basis_parse(channels == 4 ? "hl2+z" : "hl2", out, err);
 }
 
 /* Runs fn over the rows of job->out on `threads` threads (0 = all cores);
@@ -200,7 +200,7 @@ static void ssbump_row(void *user, int y) {
                  job->out->pixels + (size_t)count * i);
 }
 
-bb_status bb_derive_ssbump(const bb_image *normals, const bb_image *vis,
+bb_status bb__derive_ssbump_all_cores(const bb_image *normals, const bb_image *vis,
                            const bb_basis *basis, bb_image *out, bb_error *err) {
   return bb__derive_ssbump(normals, vis, basis, 0, out, err);
 }
@@ -307,7 +307,7 @@ static void ao_row(void *user, int y) {
     job->out->pixels[i] = vis->pixels[(size_t)vis->channels * i];
 }
 
-bb_status bb_derive_ao(const bb_image *vis, bb_image *out, bb_error *err) {
+bb_status bb__derive_ao_all_cores(const bb_image *vis, bb_image *out, bb_error *err) {
   return bb__derive_ao(vis, 0, out, err);
 }
 
@@ -334,7 +334,7 @@ static void bent_row(void *user, int y) {
                job->out->pixels + 3 * i);
 }
 
-bb_status bb_derive_bent(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
+bb_status bb__derive_bent_all_cores(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
                          bb_error *err) {
   return bb__derive_bent(ssbump, basis, 0, out, err);
 }

@@ -10,7 +10,7 @@
 #include <math.h>
 #include <string.h>
 
-bb_status bb_normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err) {
+bb_status bb__normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err) {
   /* In the order of --help (the default first), then mapped to the enum. */
   static const char *const names[] = {"vertex", "valve", "central", "sobel"};
   static const bb_normal_filter filters[] = {BB_NORMAL_VERTEX, BB_NORMAL_VALVE,
@@ -281,7 +281,7 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
   return BB_OK;
 }
 
-bb_status bb_normals_compute(const bb_image *height, float height_scale,
+bb_status bb__normals_compute_all_cores(const bb_image *height, float height_scale,
                              bb_normal_filter filter, bb_addressing addressing,
                              bb_image *out, bb_error *err) {
   return bb__normals_compute(height, height_scale, filter, addressing, 0, NULL, out, err);

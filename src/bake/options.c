@@ -5,6 +5,8 @@
 #include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "trace/basis.h"
+#include "trace/rayset.h"
+#include "trace/trace.h"
 
 #include <float.h>
 #include <math.h>
@@ -24,16 +26,16 @@ void bb_bake_options_init(bb_bake_options *o) {
   memset(o, 0, sizeof *o);
   o->height_scale = 0.0f; /* must be set: there is no meaningful default */
   o->rays = 256;
-  bb_smooth_options_init(&o->smooth);
-  bb_trace_options_init(&o->trace);
+  bb__smooth_options_init(&o->smooth);
+  bb__trace_options_init(&o->trace);
   o->power = 1.0;
-  bb_basis_init(&o->basis);
+  bb__basis_init(&o->basis);
   o->normal_filter = BB_NORMAL_VERTEX;
   o->outputs = BB_MAPS_BAKED;
 }
 
 int bb_bake_slices(const bb_bake_options *o) {
-  return o->slices ? o->slices : bb_slices_for_rays(o->rays);
+  return o->slices ? o->slices : bb__slices_for_rays(o->rays);
 }
 
 static bb_status in_range(const bb__range *r, double v, bb_error *err) {
@@ -42,7 +44,7 @@ static bb_status in_range(const bb__range *r, double v, bb_error *err) {
   return bb__range_check(r, v, who, err);
 }
 
-bb_status bb_bake_options_check(const bb_bake_options *o, bb_error *err) {
+bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err) {
   if (!o)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing options");
   bb_status st = in_range(&bb__range_height_scale, (double)o->height_scale, err);
@@ -85,7 +87,7 @@ void bb__bake_resolve(bb_bake_options *o) {
 }
 
 bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err) {
-  bb_status st = bb_bake_options_check(in, err);
+  bb_status st = bb__bake_options_check(in, err);
   if (st != BB_OK)
     return st;
   *out = *in;
@@ -103,11 +105,11 @@ bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err) {
   return st;
 }
 
-const char *bb_normal_y_name(int normal_y_up) {
+const char *bb__normal_y_name(int normal_y_up) {
   return normal_y_names[normal_y_up ? 1 : 0];
 }
 
-const char *bb_addressing_name(bb_addressing addressing) {
+const char *bb__addressing_name(bb_addressing addressing) {
   switch (addressing) {
   case BB_ADDRESS_PERIODIC: return "periodic";
   case BB_ADDRESS_CLAMP: return "clamp";

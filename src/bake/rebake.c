@@ -21,6 +21,7 @@
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include "trace/retrace.h"
+#include "bumpbake_cluster.h"
 
 #include <float.h>
 #include <math.h>

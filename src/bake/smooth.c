@@ -33,7 +33,7 @@
 /* Most channels bb_image_alloc accepts; sizes the per-texel accumulator. */
 #define MAX_CHANNELS 64
 
-void bb_smooth_options_init(bb_smooth_options *o) {
+void bb__smooth_options_init(bb_smooth_options *o) {
   o->radius_texels = 10;
   o->threshold = 2.0f / 255.0f;
   o->addressing = BB_ADDRESS_PERIODIC;
@@ -263,7 +263,7 @@ static bb_status copy_image(const bb_image *in, bb_image *out, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_smooth_bilateral(const bb_image *in, const bb_image *guide,
+bb_status bb__smooth_bilateral_all_cores(const bb_image *in, const bb_image *guide,
                               const bb_smooth_options *o, bb_image *out, bb_error *err) {
   return bb__smooth_bilateral(in, guide, o, 0, NULL, out, err);
 }

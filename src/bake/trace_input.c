@@ -6,6 +6,7 @@
 #include "core/internal.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
+#include "bumpbake_cluster.h"
 
 #include <stdlib.h>
 

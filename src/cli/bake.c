@@ -7,6 +7,7 @@
 #include "cluster.h"
 #include "common.h"
 #include "progress.h"
+#include "bumpbake_cluster.h"
 
 #include <stdio.h>
 #include <stdlib.h>

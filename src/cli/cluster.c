@@ -11,6 +11,7 @@
 #include "cluster.h"
 #include "cli.h"
 #include "common.h"
+#include "bumpbake_cluster.h"
 
 #include <errno.h>
 #include <limits.h>

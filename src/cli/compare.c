@@ -13,6 +13,7 @@
 #include "common.h"
 
 #include "bumpbake.h"
+#include "../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
 
 #include <float.h>
 #include <limits.h>
@@ -70,56 +71,56 @@ static void print_text_report(const compare_args *a, const bb_compare_report *r)
 }
 
 /* The provenance differences, one string per "key: a -> b" line. */
-static void json_provenance(bb_json *j, const char *prov_diff) {
-  bb_json_open(j, "provenance_diff", '[');
+static void json_provenance(bb__json *j, const char *prov_diff) {
+  bb__json_open(j, "provenance_diff", '[');
   for (const char *line = prov_diff; line && *line;) {
     const char *end = strchr(line, '\n');
     size_t n = end ? (size_t)(end - line) : strlen(line);
     char *one = strndup(line, n);
-    bb_json_string(j, NULL, one ? one : "");
+    bb__json_string(j, NULL, one ? one : "");
     free(one);
     line = end ? end + 1 : line + n;
   }
-  bb_json_close(j, ']');
+  bb__json_close(j, ']');
 }
 
-static void json_paths(bb_json *j, const compare_args *a) {
-  bb_json_string(j, "a", a->path_a);
-  bb_json_string(j, "b", a->path_b);
+static void json_paths(bb__json *j, const compare_args *a) {
+  bb__json_string(j, "a", a->path_a);
+  bb__json_string(j, "b", a->path_b);
 }
 
 static void print_json_report(const compare_args *a, const bb_compare_report *r) {
   const bb_compare_limits *l = &a->limits;
   const bb_compare_stats *s = &r->stats;
-  bb_json j = {stdout, 0};
-  bb_json_open(&j, NULL, '{');
+  bb__json j = {stdout, 0};
+  bb__json_open(&j, NULL, '{');
   json_paths(&j, a);
-  bb_json_int(&j, "width", r->width);
-  bb_json_int(&j, "height", r->height);
-  bb_json_int(&j, "channels", r->channels);
-  bb_json_int(&j, "pixels", s->pixels);
-  bb_json_number(&j, "mean_abs", s->mean_abs);
-  bb_json_number(&j, "rms", s->rms);
-  bb_json_number(&j, "max_abs", s->max_abs); /* null when a NaN differs */
-  bb_json_open(&j, "worst", '{');
-  bb_json_int(&j, "x", s->worst_x);
-  bb_json_int(&j, "y", s->worst_y);
-  bb_json_int(&j, "channel", s->worst_channel);
-  bb_json_close(&j, '}');
+  bb__json_int(&j, "width", r->width);
+  bb__json_int(&j, "height", r->height);
+  bb__json_int(&j, "channels", r->channels);
+  bb__json_int(&j, "pixels", s->pixels);
+  bb__json_number(&j, "mean_abs", s->mean_abs);
+  bb__json_number(&j, "rms", s->rms);
+  bb__json_number(&j, "max_abs", s->max_abs); /* null when a NaN differs */
+  bb__json_open(&j, "worst", '{');
+  bb__json_int(&j, "x", s->worst_x);
+  bb__json_int(&j, "y", s->worst_y);
+  bb__json_int(&j, "channel", s->worst_channel);
+  bb__json_close(&j, '}');
   /* Limits under idiff's option names; infinite hard limits are null. */
-  bb_json_number(&j, "fail", l->fail);
-  bb_json_number(&j, "failpercent", l->fail_percent);
-  bb_json_number(&j, "hardfail", l->hard_fail);
-  bb_json_int(&j, "allowfailures", l->allow_failures);
-  bb_json_int(&j, "over_fail", s->over_fail);
-  bb_json_number(&j, "warn", l->warn);
-  bb_json_number(&j, "warnpercent", l->warn_percent);
-  bb_json_number(&j, "hardwarn", l->hard_warn);
-  bb_json_int(&j, "over_warn", s->over_warn);
+  bb__json_number(&j, "fail", l->fail);
+  bb__json_number(&j, "failpercent", l->fail_percent);
+  bb__json_number(&j, "hardfail", l->hard_fail);
+  bb__json_int(&j, "allowfailures", l->allow_failures);
+  bb__json_int(&j, "over_fail", s->over_fail);
+  bb__json_number(&j, "warn", l->warn);
+  bb__json_number(&j, "warnpercent", l->warn_percent);
+  bb__json_number(&j, "hardwarn", l->hard_warn);
+  bb__json_int(&j, "over_warn", s->over_warn);
   json_provenance(&j, r->provenance_differences > 0 ? r->provenance_diff : "");
-  bb_json_string(&j, "result", bb_compare_report_result(r));
-  bb_json_int(&j, "exit", bb_compare_report_exit_code(r));
-  bb_json_close(&j, '}');
+  bb__json_string(&j, "result", bb_compare_report_result(r));
+  bb__json_int(&j, "exit", bb_compare_report_exit_code(r));
+  bb__json_close(&j, '}');
   fputc('\n', stdout);
 }
 
@@ -132,12 +133,12 @@ static int report_size_mismatch(const compare_args *a, const bb_compare_report *
            a->path_a, r->width, r->height, r->channels, r->channels == 1 ? "" : "s");
   cli_error_line(line);
   if (a->json && !a->quiet) {
-    bb_json j = {stdout, 0};
-    bb_json_open(&j, NULL, '{');
+    bb__json j = {stdout, 0};
+    bb__json_open(&j, NULL, '{');
     json_paths(&j, a);
-    bb_json_string(&j, "result", bb_compare_report_result(r));
-    bb_json_int(&j, "exit", bb_compare_report_exit_code(r));
-    bb_json_close(&j, '}');
+    bb__json_string(&j, "result", bb_compare_report_result(r));
+    bb__json_int(&j, "exit", bb_compare_report_exit_code(r));
+    bb__json_close(&j, '}');
     fputc('\n', stdout);
   }
   return bb_compare_report_exit_code(r);

@@ -5,6 +5,7 @@
 #include "common.h"
 
 #include "bumpbake.h"
+#include "../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,13 +42,13 @@ static void flag_names(uint32_t flags, const char *(*name_of)(int bit), char *ou
 }
 
 /* The names of the flags set, as a JSON array (unnamed bits left out). */
-static void json_flag_names(bb_json *j, const char *key, uint32_t flags,
+static void json_flag_names(bb__json *j, const char *key, uint32_t flags,
                             const char *(*name_of)(int bit)) {
-  bb_json_open(j, key, '[');
+  bb__json_open(j, key, '[');
   for (int bit = 0; bit < 32; bit++)
     if ((flags & (1u << bit)) && name_of(bit))
-      bb_json_string(j, NULL, name_of(bit));
-  bb_json_close(j, ']');
+      bb__json_string(j, NULL, name_of(bit));
+  bb__json_close(j, ']');
 }
 
 /* ------------------------------------------------------------------ text */
@@ -120,8 +121,8 @@ static void print_text(const char *path, const file_info *f) {
 /* The key=value lines of intact provenance as a JSON object of strings, as
  * the library reads them (bb_provenance_entries); values are kept as
  * written: exact, and the same for every key. */
-static void json_provenance(bb_json *j, const char *text) {
-  bb_json_open(j, "provenance", '{');
+static void json_provenance(bb__json *j, const char *text) {
+  bb__json_open(j, "provenance", '{');
   const long count = bb_provenance_entries(text, NULL, 0);
   bb_provenance_entry *entries = count > 0 ? malloc((size_t)count * sizeof *entries) : NULL;
   if (entries)
@@ -131,62 +132,62 @@ static void json_provenance(bb_json *j, const char *text) {
     char *key = strndup(entries[i].key, entries[i].key_length);
     char *value = strndup(entries[i].value, entries[i].value_length);
     if (key && value)
-      bb_json_string(j, key, value);
+      bb__json_string(j, key, value);
     free(key);
     free(value);
   }
   free(entries);
-  bb_json_close(j, '}');
+  bb__json_close(j, '}');
 }
 
 static void print_json(const char *path, const file_info *f) {
   const bb_image_info *i = &f->info;
-  bb_json j = {stdout, 0};
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "path", path);
-  bb_json_int(&j, "width", f->width);
-  bb_json_int(&j, "height", f->height);
-  bb_json_int(&j, "channels", f->channels);
-  bb_json_string(&j, "format", i->format_name);
-  bb_json_int(&j, "bits_per_sample", i->bits_per_sample);
-  bb_json_bool(&j, "float", i->is_float);
-  bb_json_int(&j, "alpha_channel", i->alpha_channel);
+  bb__json j = {stdout, 0};
+  bb__json_open(&j, NULL, '{');
+  bb__json_string(&j, "path", path);
+  bb__json_int(&j, "width", f->width);
+  bb__json_int(&j, "height", f->height);
+  bb__json_int(&j, "channels", f->channels);
+  bb__json_string(&j, "format", i->format_name);
+  bb__json_int(&j, "bits_per_sample", i->bits_per_sample);
+  bb__json_bool(&j, "float", i->is_float);
+  bb__json_int(&j, "alpha_channel", i->alpha_channel);
   if (f->is_vtf) {
     const bb_vtf_info *v = &f->vtf;
     char text[512];
-    bb_json_open(&j, "vtf", '{');
+    bb__json_open(&j, "vtf", '{');
     snprintf(text, sizeof text, "%d.%d", v->version_major, v->version_minor);
-    bb_json_string(&j, "version", text);
-    bb_json_string(&j, "format", v->format_name);
-    bb_json_int(&j, "format_code", v->format);
-    bb_json_int(&j, "mip_count", v->mip_count);
-    bb_json_int(&j, "flags", (long)v->flags);
+    bb__json_string(&j, "version", text);
+    bb__json_string(&j, "format", v->format_name);
+    bb__json_int(&j, "format_code", v->format);
+    bb__json_int(&j, "mip_count", v->mip_count);
+    bb__json_int(&j, "flags", (long)v->flags);
     json_flag_names(&j, "flag_names", v->flags, bb_vtf_flag_name);
-    bb_json_int(&j, "low_res_width", v->low_res_width);
-    bb_json_int(&j, "low_res_height", v->low_res_height);
-    bb_json_int(&j, "frames", v->frames);
-    bb_json_close(&j, '}');
+    bb__json_int(&j, "low_res_width", v->low_res_width);
+    bb__json_int(&j, "low_res_height", v->low_res_height);
+    bb__json_int(&j, "frames", v->frames);
+    bb__json_close(&j, '}');
   }
   if (f->is_dds) {
     const bb_dds_info *d = &f->dds;
-    bb_json_open(&j, "dds", '{');
-    bb_json_string(&j, "format", d->format_name);
-    bb_json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
-    bb_json_int(&j, "dxgi_format", d->dxgi_format);
-    bb_json_string(&j, "compression", d->compression);
-    bb_json_int(&j, "mip_count", d->mip_count);
-    bb_json_int(&j, "pixel_flags", (long)d->pixel_flags);
+    bb__json_open(&j, "dds", '{');
+    bb__json_string(&j, "format", d->format_name);
+    bb__json_string(&j, "fourcc", d->fourcc[0] ? d->fourcc : NULL);
+    bb__json_int(&j, "dxgi_format", d->dxgi_format);
+    bb__json_string(&j, "compression", d->compression);
+    bb__json_int(&j, "mip_count", d->mip_count);
+    bb__json_int(&j, "pixel_flags", (long)d->pixel_flags);
     json_flag_names(&j, "pixel_flag_names", d->pixel_flags, bb_dds_pixel_flag_name);
-    bb_json_int(&j, "caps2", (long)d->caps2);
-    bb_json_close(&j, '}');
+    bb__json_int(&j, "caps2", (long)d->caps2);
+    bb__json_close(&j, '}');
   }
-  bb_json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
+  bb__json_string(&j, "provenance_state", bb_provenance_class_name(f->provenance));
   if (f->provenance == BB_PROVENANCE_INTACT)
     json_provenance(&j, i->description);
   else
-    bb_json_string(&j, "provenance", NULL);
-  bb_json_string(&j, "description", i->description);
-  bb_json_close(&j, '}');
+    bb__json_string(&j, "provenance", NULL);
+  bb__json_string(&j, "description", i->description);
+  bb__json_close(&j, '}');
   fputc('\n', stdout);
 }
 
@@ -196,11 +197,11 @@ static void report_error(const info_args *a, const char *path, const bb_error *e
   cli_file_error(path, err->message);
   if (!a->json)
     return;
-  bb_json j = {stdout, 0};
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "path", path);
-  bb_json_string(&j, "error", err->message);
-  bb_json_close(&j, '}');
+  bb__json j = {stdout, 0};
+  bb__json_open(&j, NULL, '{');
+  bb__json_string(&j, "path", path);
+  bb__json_string(&j, "error", err->message);
+  bb__json_close(&j, '}');
   fputc('\n', stdout);
 }
 

@@ -4,6 +4,7 @@
 #include "serve/serve.h"
 #include "cli.h"
 #include "common.h"
+#include "bumpbake_cluster.h"
 
 #include <arpa/inet.h>
 #include <limits.h>

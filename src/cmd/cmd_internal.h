@@ -177,7 +177,7 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
 bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                           bb_error *err);
 /* renderbumpflat's run (run_renderbump.c): the model rendered, its files
- * written through the job (bb_renderbump_write). */
+ * written through the job (bb__renderbump_write). */
 bb_status bb__run_renderbumpflat(bb_command *c, const bb_command_hooks *hooks,
                                  bb_command_result *r, bb_error *err);
 
@@ -245,5 +245,20 @@ struct bb__check_rule;
 bb_status bb__check_rules_parse(const char *text, struct bb__check_rule **rules, int *count,
                                 bb_error *err);
 void bb__check_rules_free(struct bb__check_rule *rules, int count);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* 1 when the command writes through the job (bb_command_plan plans it). */
+int bb__command_has_job(const bb_command_info *command);
+
+/* Once in bumpbake.h beside the functions that stay public there. */
+/* The command nearest to a mistyped name (at most 2 edits away, for "did
+ * you mean"), or NULL. */
+const bb_command_info *bb__command_info_nearest(const char *name);
+/* The words a BB_OPTION_WORD or WORDS option takes, '|'-separated
+ * ("valve|central|sobel|vertex", the names of the library's enum), into out
+ * (capacity cap); "" for other types. */
+void bb__option_choices(const bb_option_info *option, char *out, size_t cap);
 
 #endif /* BB_CMD_INTERNAL_H */

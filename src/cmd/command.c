@@ -8,6 +8,8 @@
  * from a checked command checks nothing again. */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "maps/maps_internal.h"
+#include "mesh/mesh_internal.h"
 
 #include <stddef.h>
 #include <stdio.h>
@@ -27,7 +29,7 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
   *out = NULL;
   const bb__command *def = find_command(name);
   if (!def) {
-    const bb_command_info *near = bb_command_info_nearest(name ? name : "");
+    const bb_command_info *near = bb__command_info_nearest(name ? name : "");
     if (near)
       return bb__fail(err, BB_ERR_ARGUMENT, "unknown command '%.64s' (did you mean %s?)",
                       name ? name : "", near->name);
@@ -41,8 +43,8 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
   bb_command_options *o = &c->options;
   bb_job_options_init(&o->job);
   bb_render_options_init(&o->render);
-  bb_compare_limits_init(&o->limits);
-  bb_renderbump_options_init(&o->renderbump);
+  bb__compare_limits_init(&o->limits);
+  bb__renderbump_options_init(&o->renderbump);
   o->map_kind = BB_MAP_SSBUMP;
   o->ssbump_kind = BB_MAP_SSBUMP;
   if (def->init)

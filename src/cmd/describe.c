@@ -71,7 +71,7 @@ const bb_option_info *bb_option_find_short(const bb_command_info *command, char 
   return NULL;
 }
 
-void bb_option_choices(const bb_option_info *option, char *out, size_t cap) {
+void bb__option_choices(const bb_option_info *option, char *out, size_t cap) {
   if (!cap)
     return;
   out[0] = '\0';
@@ -88,7 +88,7 @@ void bb_option_value_text(const bb_option_info *option, char *out, size_t cap) {
   if (option->value_name)
     snprintf(out, cap, "%s", option->value_name);
   else
-    bb_option_choices(option, out, cap);
+    bb__option_choices(option, out, cap);
 }
 
 int bb_option_bounds(const bb_option_info *option, double *min, double *max,
@@ -159,6 +159,6 @@ void bb_option_default_text(const bb_command_info *command, const bb_option_info
   bb_command_free(c);
 }
 
-int bb_command_has_job(const bb_command_info *command) {
+int bb__command_has_job(const bb_command_info *command) {
   return command && command_of(command)->job != NULL;
 }

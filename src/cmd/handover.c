@@ -8,6 +8,7 @@
  * "record-options" TEXT, "record-of" PATH LINE), then "end". An option's TEXT is the one
  * it was set from (bb_command_set), never a value printed and parsed again. */
 #include "cmd/cmd_internal.h"
+#include "bumpbake_cluster.h"
 
 #include <stdlib.h>
 #include <string.h>

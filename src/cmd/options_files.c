@@ -84,7 +84,7 @@ static const bb__option *const compare_options[] = {
     &bb__opt_help, NULL};
 
 static void compare_init(bb_command_options *o) {
-  bb_compare_limits_init(&o->limits);
+  bb__compare_limits_init(&o->limits);
 }
 
 /* The diff is checked before the (possibly long) reads, and must not
@@ -178,7 +178,7 @@ static const bb__option *const check_options[] = {
     &bb__opt_help, NULL};
 
 static void check_init(bb_command_options *o) {
-  bb_compare_limits_init(&o->limits);
+  bb__compare_limits_init(&o->limits);
 }
 
 /* GOLDEN is the batch's output directory: the bake options' rules (a
@@ -386,7 +386,7 @@ static const bb__option *const rbf_options[] = {
     &bb__opt_help, NULL};
 
 static void rbf_init(bb_command_options *o) {
-  bb_renderbump_options_init(&o->renderbump);
+  bb__renderbump_options_init(&o->renderbump);
 }
 
 /* --tile needs --rect; the normal map's default name; the outputs apart and
@@ -406,7 +406,7 @@ static bb_status rbf_check(bb_command *c, bb_error *err) {
     if (!o->output)
       return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);
   }
-  if (o->height_output && bb_same_file(o->height_output, o->output))
+  if (o->height_output && bb__same_file(o->height_output, o->output))
     return bb__fail(err, BB_ERR_ARGUMENT, "--height and the normal map are both %s", o->output);
   bb__job_output out[2];
   const int count = bb__renderbump_outputs(o->output, o->height_output, out);

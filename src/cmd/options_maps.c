@@ -4,6 +4,7 @@
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
 #include "maps/maps_internal.h"
+#include "maps/program_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -233,7 +234,7 @@ static bb_status program_check(bb_command *c, bb_error *err) {
     bb_program_free(program);
     return BB_OK;
   }
-  const size_t count = bb_program_images(program, NULL, 0);
+  const size_t count = bb__program_images(program, NULL, 0);
   const char **names = malloc((count ? count : 1) * sizeof *names);
   char (*paths)[4096] = malloc((count ? count : 1) * sizeof *paths);
   const char **reads = malloc((count ? count : 1) * sizeof *reads);
@@ -241,11 +242,11 @@ static bb_status program_check(bb_command *c, bb_error *err) {
     st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
   int n = 0;
   if (st == BB_OK) {
-    bb_program_images(program, names, count);
+    bb__program_images(program, names, count);
     for (size_t i = 0; i < count; i++) {
       /* a name too long to resolve is refused when the program runs, before
        * anything is written; a cut path is no input to compare with */
-      const int len = bb_program_image_path(c->options.base_dir, names[i], paths[n],
+      const int len = bb__program_image_path(c->options.base_dir, names[i], paths[n],
                                             sizeof paths[n]);
       if (len >= 0 && (size_t)len < sizeof paths[n])
         reads[n] = paths[n], n++;

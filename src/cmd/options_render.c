@@ -5,6 +5,7 @@
 #include "core/file_names.h"
 #include "job/job_internal.h"
 #include "render/render_internal.h"
+#include "core/internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -265,7 +266,7 @@ static void render_init(bb_command_options *o) {
 static unsigned needed_maps(const bb_command_options *o) {
   if (o->render_compare)
     return BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO;
-  return bb_render_mode_needs(o->render.mode);
+  return bb__render_mode_needs(o->render.mode);
 }
 
 /* The files a render of c reads, and the bake of its HEIGHT (the maps the
@@ -344,11 +345,11 @@ static bb_status render_check(bb_command *c, bb_error *err) {
   for (int m = 0; !height && m < BB_MAP_KIND_COUNT; m++)
     if ((needed_maps(o) & map_need[m]) && !o->render_maps[m])
       return bb__fail(err, BB_ERR_ARGUMENT, "%s needs --%s FILE (or a HEIGHT to bake)",
-                      o->render_compare ? "--compare" : bb_render_mode_name(o->render.mode),
-                      bb_map_kind_name((bb_map_kind)m));
+                      o->render_compare ? "--compare" : bb__render_mode_name(o->render.mode),
+                      bb__map_kind_name((bb_map_kind)m));
   /* before any pixel is read, from the files' headers: the maps' size, the
    * picture the options make of it, the memory the render takes
-   * (bb_render_files_check); a tile or crop the input cannot take is a
+   * (bb__render_files_check); a tile or crop the input cannot take is a
    * usage error, anything else the files' */
   if (!c->in_memory) {
     bb_render_sources files;
@@ -356,10 +357,10 @@ static bb_status render_check(bb_command *c, bb_error *err) {
     render_files(c, &files, &bake);
     int w = 0, h = 0;
     bb_error why = {{0}};
-    bb_status st = bb_render_files_check(&files, &bake, &o->render, o->render_compare, o->output,
+    bb_status st = bb__render_files_check(&files, &bake, &o->render, o->render_compare, o->output,
                                          o->job.depth, &w, &h, err);
     if (st != BB_OK && w > 0 &&
-        bb_render_estimate(w, h, &o->render, o->render_compare, NULL, BB_DEPTH_DEFAULT, NULL,
+        bb__render_estimate(w, h, &o->render, o->render_compare, NULL, BB_DEPTH_DEFAULT, NULL,
                            NULL, NULL, &why) != BB_OK)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s", why.message);
     if (st == BB_ERR_ARGUMENT)
@@ -419,7 +420,7 @@ static const bb__option *const sheet_options[] = {
 
 static void sheet_init(bb_command_options *o) {
   bb_sheet_options s;
-  bb_sheet_options_init(&s);
+  bb__sheet_options_init(&s);
   o->render = s.lit;
   o->panel_size = s.layout.panel_width;
 }

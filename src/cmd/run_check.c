@@ -7,6 +7,7 @@
 #include "cmd/cmd_internal.h"
 #include "job/check.h"
 #include "job/job_internal.h"
+#include "core/internal.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -37,7 +38,7 @@ void bb__check_rules_free(bb__check_rule *rules, int count) {
 
 static int is_kind_name(const char *s) {
   for (int k = 0; k < BB_MAP_KIND_COUNT; k++)
-    if (!strcmp(s, bb_map_kind_name((bb_map_kind)k)))
+    if (!strcmp(s, bb__map_kind_name((bb_map_kind)k)))
       return 1;
   return 0;
 }
@@ -241,7 +242,7 @@ bb_status bb_check_plan(bb_command *c, const bb_command_hooks *hooks, bb_check *
   bb_status st =
       bb__check_rules_parse(o->limit_rules, &setup.rules, &setup.rule_count, err);
   if (st == BB_OK && fresh && !golden_there && S_ISDIR(fs.st_mode))
-    st = bb_directory_create(golden, err); /* an update into a new tree */
+    st = bb__directory_create(golden, err); /* an update into a new tree */
   if (st == BB_OK && o->check_bake)
     st = bb__command_plan(c, hooks, bb__check_job_options, 1,
                           o->update ? 0u : BB__PLAN_READ_ONLY, &setup.job, err);

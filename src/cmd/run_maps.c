@@ -4,6 +4,8 @@
  * write), its path checked against the inputs before (bb_command_check). */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "core/internal.h"
+#include "trace/basis.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -14,11 +16,11 @@ static bb_status read_map(const char *path, bb_image *img, bb_image_info *info, 
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
 }
 
-/* A map read as Half-Life 2's basis (bb_basis_map_check). */
+/* A map read as Half-Life 2's basis (bb__basis_map_check). */
 static bb_status check_hl2(const char *path, const bb_image *img, const bb_image_info *info,
                            bb_error *err) {
   bb_error e = {{0}};
-  bb_status st = bb_basis_map_check(img, info ? info->description : NULL, &e);
+  bb_status st = bb__basis_map_check(img, info ? info->description : NULL, &e);
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
 }
 
@@ -38,7 +40,7 @@ static bb_status write_map(const bb_command *c, const char *input, const char *t
   const bb__job_source source = {.command = record,
                                  .input = input,
                                  .input_text = text,
-                                 .input_hash = pixels ? bb_image_hash(pixels) : 0};
+                                 .input_hash = pixels ? bb__image_hash(pixels) : 0};
   const bb__job_output out = {o->output, kind, range, o->job.depth, like, o->job.mips,
                               &o->job.texture};
   bb_status st = bb__job_write(&out, img, &source, err);
@@ -217,7 +219,7 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
     const int normal = a->map_kind == BB_MAP_NORMAL;
     if (normal && a->maps_normal_y_up)
       bb_image_flip_green(&out); /* back to the inputs' convention */
-    st = write_map(c, in[0], NULL, &m[0].file, &m[0].info, bb_map_kind_name(a->map_kind), &out,
+    st = write_map(c, in[0], NULL, &m[0].file, &m[0].info, bb__map_kind_name(a->map_kind), &out,
                    normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, r, err);
   }
   bb_image_free(&out);

@@ -5,6 +5,9 @@
  * before (bb_command_check). */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "core/internal.h"
+#include "maps/maps_internal.h"
+#include "render/render_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,7 +27,7 @@ typedef struct render_args {
 static unsigned needed_maps(const render_args *a) {
   if (a->compare)
     return BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_SSBUMP | BB_RENDER_NEEDS_AO;
-  return bb_render_mode_needs(a->render.mode);
+  return bb__render_mode_needs(a->render.mode);
 }
 
 /* Everything a picture is made from, and what the provenance says of it. */
@@ -135,7 +138,7 @@ static bb_status bake_for_picture(render_args *a, const bb_image *height, const 
                               NULL, NULL};
   if (needed_maps(a) & BB_RENDER_NEEDS_SLOPE) {
     /* The slope map bake --slope would write, from the same filtered height. */
-    st = bb_slope_map(&r->filtered, a->bake.height_scale, a->bake.smooth.addressing, &in->slope,
+    st = bb__slope_map(&r->filtered, a->bake.height_scale, a->bake.smooth.addressing, &in->slope,
                       &e);
     if (st != BB_OK)
       return bb__fail_at(err, st, what, &e);
@@ -173,7 +176,7 @@ static bb_status load_albedo(const render_args *a, render_inputs *in, bb_error *
                     in->albedo.width, in->albedo.height, size->width, size->height);
   in->view.albedo = &in->albedo;
   in->sources.albedo = path;
-  in->sources.albedo_hash = bb_image_hash(&in->albedo);
+  in->sources.albedo_hash = bb__image_hash(&in->albedo);
   return BB_OK;
 }
 
@@ -187,10 +190,10 @@ static bb_status make_picture(const render_args *a, const render_inputs *in, dou
   int labels = 1;
   if (a->compare) {
     bb_panel_layout layout;
-    bb_panel_layout_init(&layout);
-    st = bb_render_compare(&in->view, &o, &layout, out, &labels, &e);
+    bb__panel_layout_init(&layout);
+    st = bb__render_compare(&in->view, &o, &layout, out, &labels, &e);
   } else {
-    st = bb_render(&in->view, &o, out, &e);
+    st = bb__render(&in->view, &o, out, &e);
   }
   *labels_drawn &= labels;
   if (st == BB_ERR_ARGUMENT) /* the maps were checked as they were read: the view */
@@ -198,7 +201,7 @@ static bb_status make_picture(const render_args *a, const render_inputs *in, dou
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, a->output, &e);
 }
 
-/* The render's own provenance lines of one picture (bb_render_provenance). */
+/* The render's own provenance lines of one picture (bb__render_provenance). */
 static char *render_lines(const render_args *a, const render_inputs *in, double azimuth,
                           int frame) {
   bb_render_options o = a->render;
@@ -206,7 +209,7 @@ static char *render_lines(const render_args *a, const render_inputs *in, double 
   bb_render_sources sources = in->sources;
   sources.frame = frame;
   sources.frames = a->orbit;
-  return bb_render_provenance(&sources, &o);
+  return bb__render_provenance(&sources, &o);
 }
 
 static double frame_azimuth(const render_args *a, int frame) {
@@ -290,7 +293,7 @@ static bb_status sheet_picture(const bb_command_options *a, const bb_command_hoo
                                bb_bake_result *result, bb_image *picture, int *labels,
                                bb_error *err) {
   bb_sheet_options sheet;
-  bb_sheet_options_init(&sheet);
+  bb__sheet_options_init(&sheet);
   sheet.lit = a->render;
   sheet.layout.panel_width = a->panel_size;
   bb_bake_options bake = a->job.bake;
@@ -300,7 +303,7 @@ static bb_status sheet_picture(const bb_command_options *a, const bb_command_hoo
   bb_status st = bb_bake(height, &bake, result, &e);
   if (st != BB_OK)
     return bb__fail_at(err, st, what, &e);
-  st = bb_sheet_make(height, result, &sheet, picture, labels, &e);
+  st = bb__sheet_make(height, result, &sheet, picture, labels, &e);
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, what, &e);
 }
 
@@ -357,7 +360,7 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
   const bb_command_options *a = &c->options;
   const char *input = c->inputs[0];
   bb_sheet_options sheet;
-  bb_sheet_options_init(&sheet);
+  bb__sheet_options_init(&sheet);
   sheet.lit = a->render;
   sheet.layout.panel_width = a->panel_size;
   bb_image height = {0}, picture = {0};
@@ -375,7 +378,7 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
   if (st == BB_OK)
     st = sheet_picture(a, hooks, &height, input, &result, &picture, &r->labels_drawn, err);
   /* the height's and the bake's keys, then the lit panel's options */
-  if (st == BB_OK && !(extra = bb_render_options_describe(&sheet.lit)))
+  if (st == BB_OK && !(extra = bb__render_options_describe(&sheet.lit)))
     st = bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", a->output);
   if (st == BB_OK) {
     const bb__job_source s = {.command = record,

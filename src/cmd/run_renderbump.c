@@ -5,6 +5,7 @@
  * depth), their paths checked against the model before (bb_command_check). */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "mesh/mesh_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -32,7 +33,7 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks,
   memset(&mesh, 0, sizeof mesh);
   bb_error e = {{0}};
   char note[512];
-  bb_status st = bb_mesh_load_noted(model, &mesh, note, sizeof note, &e);
+  bb_status st = bb__mesh_load_noted(model, &mesh, note, sizeof note, &e);
   const int noted = hooks && hooks->note;
   if (st == BB_OK && note[0] && noted) /* a missing .mtl and the like */
     hooks->note(hooks->note_user, model, note);
@@ -41,8 +42,8 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks,
   ro.note = noted ? note_of_model : NULL;
   ro.note_user = noted ? &notes : NULL;
   if (st == BB_OK)
-    st = bb_renderbump_flat(&mesh, &ro, render, &e);
-  bb_mesh_free(&mesh);
+    st = bb__renderbump_flat(&mesh, &ro, render, &e);
+  bb__mesh_free(&mesh);
   if (st != BB_OK)
     return bb__fail_at(err, st, model, &e);
   if (c->in_memory)
@@ -50,7 +51,7 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks,
   char *record = bb__command_record(c);
   if (!record)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->output);
-  st = bb_renderbump_write(render, &ro, o->maps_normal_y_up, model, render->model_hash,
+  st = bb__renderbump_write(render, &ro, o->maps_normal_y_up, model, render->model_hash,
                            record, o->output, o->height_output, err);
   free(record);
   if (st == BB_OK)

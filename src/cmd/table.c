@@ -45,7 +45,7 @@ static size_t edit_distance(const char *a, size_t na, const char *b) {
   return row[nb];
 }
 
-const bb_command_info *bb_command_info_nearest(const char *name) {
+const bb_command_info *bb__command_info_nearest(const char *name) {
   const bb_command_info *near = NULL;
   size_t best = 3;
   for (int i = 0; name && i < bb__command_total; i++) {

@@ -26,7 +26,7 @@ uint64_t bb__fnv1a_floats(uint64_t h, const float *v, size_t n) {
   return h;
 }
 
-uint64_t bb_image_hash(const bb_image *img) {
+uint64_t bb__image_hash(const bb_image *img) {
   uint64_t h = BB__FNV64_OFFSET;
   if (!img)
     return h;

@@ -63,7 +63,7 @@ bb_status bb__parse_name(const char *what, const char *name, const char *const *
  * Names are compared exactly, as the library spells them. */
 bb_map_kind bb__map_kind_of_output(const char *kind, bb_range range, uint32_t *vtf_flags);
 
-/* What a map's provenance records of one key (bb_map_kind_records, the
+/* What a map's provenance records of one key (bb__map_kind_records, the
  * rule's one home, map_kind.c): the key's value, nothing, or of a ray
  * set's id only the scheme and slices (ao without inter-reflection:
  * "bb-horizon-v1:a16", the lobes' power and basis leave it). */
@@ -168,7 +168,7 @@ bb_status bb__parallel_for_checked(int items, int threads, bb__work_fn fn, void 
 
 /* 64-bit FNV-1a: the hash of an empty input, and one step over the four
  * bytes of v, little-endian whatever the host (so hashes recorded on one
- * machine check on another). For bb_image_hash and bb_mesh_hash (hash.c). */
+ * machine check on another). For bb__image_hash and bb__mesh_hash (hash.c). */
 #define BB__FNV64_OFFSET 0xcbf29ce484222325ULL
 uint64_t bb__fnv1a_u32(uint64_t h, uint32_t v);
 /* bb__fnv1a_u32 over the bits of n floats. */
@@ -208,7 +208,7 @@ bb_status bb__check_channels(const bb_image *img, int min_channels, const char *
  * the flat normal, since such a texel has no direction to keep (vector.c). */
 void bb__normalize3(double v[3]);
 
-/* bb_memory_available, reading /proc and the cgroup files below root
+/* bb__memory_available, reading /proc and the cgroup files below root
  * ("" for the system's own; a test points it at a made-up tree:
  * ROOT/proc/meminfo, ROOT/proc/self/cgroup, ROOT/proc/self/mountinfo and
  * the cgroup directories at ROOT + the mount points it names). RLIMIT_AS
@@ -216,7 +216,7 @@ void bb__normalize3(double v[3]);
 bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char **source,
                                   bb_error *err);
 
-/* BB_OK when need bytes fit in what bb_memory_available says is left, else
+/* BB_OK when need bytes fit in what bb__memory_available says is left, else
  * BB_ERR_MEMORY "WHAT needs about 9.1 GiB of memory; 6.0 GiB is available
  * (MemAvailable)". BB_OK when nothing can be known. */
 bb_status bb__memory_check(double need, const char *what, bb_error *err);
@@ -247,6 +247,56 @@ void bb__double_text(double v, char *buf, size_t cap);
 
 /* Monotonic wall-clock seconds. */
 double bb__now_seconds(void);
+
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* What this process may still allocate, in bytes: the smallest of what
+ * the system has available (MemAvailable of /proc/meminfo, else its free
+ * pages); under a container's or service's memory limit, the room left
+ * below the limit of every cgroup from the process's own up to the top
+ * (cgroup v2's memory.max, v1's memory.limit_in_bytes; the limit less the
+ * group's usage, its reclaimable page cache not counted); and, under an
+ * RLIMIT_AS (ulimit -v), the room left below it (the limit less the
+ * address space mapped now). *source (may be NULL) receives which
+ * ("MemAvailable", "sysconf free pages", "cgroup memory.max", "cgroup
+ * memory.limit_in_bytes", "RLIMIT_AS"). Bakes and reads
+ * check their estimate against it before allocating, so one too large is
+ * refused with the figures (BB_ERR_MEMORY) instead of the kernel killing
+ * the process; several processes started at once each see the same
+ * figure. Errors: BB_ERR_IO (neither can be read). */
+bb_status bb__memory_available(uint64_t *bytes, const char **source, bb_error *err);
+
+/* 64-bit FNV-1a hash of an image's size, channel count and float pixels. */
+uint64_t bb__image_hash(const bb_image *img);
+
+/* The kind named name (bb_map_kind_info.name, any case); returns 0 on
+ * success, BB_ERR_ARGUMENT for an unknown name (out untouched). */
+bb_status bb__map_kind_parse(const char *name, bb_map_kind *out, bb_error *err);
+
+/* The name of kind, or "unknown". */
+const char *bb__map_kind_name(bb_map_kind kind);
+
+/* The rule of what a map records in its provenance, which every writer and
+ * reader of provenance follows: 1 when the pixels of a map of output kind
+ * `kind` (as provenance records it under "output": "normal", "ao", ...; a
+ * kind of parts, "ssbump+height", records what any part records, "height"
+ * being the filtered height) can change with the bake parameter recorded
+ * under `key`, 0 when they cannot: a normal map does not depend on "rays",
+ * "rayset", "bias", "power", "basis", "bounce" or "brightness", the
+ * filtered height on "scale" either, ao not on "normal_filter" or
+ * "normal_y", and ao on "power" and "basis" only with inter-reflection
+ * (bounce nonzero: the text has a "bounce" key); without it, ao's "rayset"
+ * is recorded as the ray set's scheme and slices only ("bb-horizon-v1:a16").
+ * A bake's outputs record only such keys (bb_provenance_format), the
+ * up-to-date check (bb_output_check) and bb__provenance_diff compare only
+ * them, so a parameter that does not change a map neither makes it stale
+ * nor shows in its diff, also against a file written before the rule that
+ * holds them all. 1 for keys that are no bake parameter (bumpbake_version,
+ * input_file_hash, channel, a texture's or a render's keys) and for kinds
+ * that are not a bake's maps ("render", "normal+coverage"). */
+int bb__map_kind_records(const char *kind, const char *key, int bounce);
 
 #ifdef __cplusplus
 }

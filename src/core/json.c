@@ -1,11 +1,31 @@
-/* json.c: the one JSON writer of the library, the command line and the
- * tools (bumpbake.h: bb_json). */
+/* json.c: the one JSON writer of the library and of the command line,
+ * compiled into both (json.h says why), and the UTF-8 reading it shares
+ * with bb_text_printable. It includes nothing of the library. */
 
-#include "bumpbake.h"
+#include "json.h"
 
 #include <math.h>
 
-void bb_json_quoted(FILE *f, const char *s) {
+size_t bb__utf8_sequence(const char *text) {
+  const unsigned char *s = (const unsigned char *)text;
+  if (!s || !s[0])
+    return 0;
+  if (s[0] < 0x80)
+    return 1;
+  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
+  if (s[0] > 0xf4)
+    n = 0;
+  for (size_t i = 1; i < n; i++)
+    if ((s[i] & 0xc0) != 0x80)
+      return 0;
+  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
+    return 0; /* overlong, or a surrogate */
+  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
+    return 0; /* overlong, or past U+10FFFF */
+  return n;
+}
+
+void bb__json_quoted(FILE *f, const char *s) {
   if (!s) {
     fputs("null", f);
     return;
@@ -13,7 +33,7 @@ void bb_json_quoted(FILE *f, const char *s) {
   fputc('"', f);
   for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
     if (*c >= 0x80) {
-      const size_t n = bb_utf8_sequence((const char *)c);
+      const size_t n = bb__utf8_sequence((const char *)c);
       if (n == 0) /* not UTF-8: the byte as a lone surrogate, as Python's
                      surrogateescape reads it back */
         fprintf(f, "\\udc%02x", *c);
@@ -50,33 +70,33 @@ void bb_json_quoted(FILE *f, const char *s) {
 }
 
 /* The separator and "key": that precede every value. */
-static void json_begin_value(bb_json *j, const char *key) {
+static void json_begin_value(bb__json *j, const char *key) {
   if (j->need_comma)
     fputc(',', j->f);
   if (key) {
-    bb_json_quoted(j->f, key);
+    bb__json_quoted(j->f, key);
     fputc(':', j->f);
   }
   j->need_comma = 1;
 }
 
-void bb_json_open(bb_json *j, const char *key, char open) {
+void bb__json_open(bb__json *j, const char *key, char open) {
   json_begin_value(j, key);
   fputc(open, j->f);
   j->need_comma = 0;
 }
 
-void bb_json_close(bb_json *j, char close) {
+void bb__json_close(bb__json *j, char close) {
   fputc(close, j->f);
   j->need_comma = 1;
 }
 
-void bb_json_string(bb_json *j, const char *key, const char *value) {
+void bb__json_string(bb__json *j, const char *key, const char *value) {
   json_begin_value(j, key);
-  bb_json_quoted(j->f, value);
+  bb__json_quoted(j->f, value);
 }
 
-void bb_json_number(bb_json *j, const char *key, double value) {
+void bb__json_number(bb__json *j, const char *key, double value) {
   json_begin_value(j, key);
   if (isfinite(value))
     fprintf(j->f, "%.9g", value);
@@ -84,12 +104,12 @@ void bb_json_number(bb_json *j, const char *key, double value) {
     fputs("null", j->f);
 }
 
-void bb_json_int(bb_json *j, const char *key, long long value) {
+void bb__json_int(bb__json *j, const char *key, long long value) {
   json_begin_value(j, key);
   fprintf(j->f, "%lld", value);
 }
 
-void bb_json_bool(bb_json *j, const char *key, int value) {
+void bb__json_bool(bb__json *j, const char *key, int value) {
   json_begin_value(j, key);
   fputs(value ? "true" : "false", j->f);
 }

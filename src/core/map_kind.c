@@ -29,7 +29,7 @@ const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind) {
   return &kinds[kind];
 }
 
-bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
+bb_status bb__map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
   const char *names[BB_MAP_KIND_COUNT];
   for (int k = 0; k < BB_MAP_KIND_COUNT; k++)
     names[k] = kinds[k].name;
@@ -40,7 +40,7 @@ bb_status bb_map_kind_parse(const char *name, bb_map_kind *out, bb_error *err) {
   return st;
 }
 
-const char *bb_map_kind_name(bb_map_kind kind) {
+const char *bb__map_kind_name(bb_map_kind kind) {
   const bb_map_kind_info *k = bb_map_kind_get(kind);
   return k ? k->name : "unknown";
 }
@@ -181,6 +181,6 @@ size_t bb__rayset_slices_length(const char *id, size_t length) {
   return second ? (size_t)(second - id) : length;
 }
 
-int bb_map_kind_records(const char *kind, const char *key, int bounce) {
+int bb__map_kind_records(const char *kind, const char *key, int bounce) {
   return key && bb__map_kind_key(kind, key, strlen(key), bounce) != BB__KEY_DROPPED;
 }

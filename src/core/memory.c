@@ -263,7 +263,7 @@ bb_status bb__memory_available_at(const char *root, uint64_t *bytes, const char 
   return BB_OK;
 }
 
-bb_status bb_memory_available(uint64_t *bytes, const char **source, bb_error *err) {
+bb_status bb__memory_available(uint64_t *bytes, const char **source, bb_error *err) {
   return bb__memory_available_at("", bytes, source, err);
 }
 
@@ -279,7 +279,7 @@ static void size_text(double bytes, char *out, size_t cap) {
 bb_status bb__memory_check(double need, const char *what, bb_error *err) {
   uint64_t room = 0;
   const char *source = NULL;
-  if (bb_memory_available(&room, &source, NULL) != BB_OK)
+  if (bb__memory_available(&room, &source, NULL) != BB_OK)
     return BB_OK; /* nothing to judge by: the allocations themselves will say */
   if (need <= (double)room)
     return BB_OK;
@@ -298,7 +298,7 @@ int bb__memory_note(double need, const char *what, char *out, size_t cap) {
   char a[32], b[32] = "";
   size_text(need, a, sizeof a);
   uint64_t room = 0;
-  if (bb_memory_available(&room, NULL, NULL) == BB_OK)
+  if (bb__memory_available(&room, NULL, NULL) == BB_OK)
     size_text((double)room, b, sizeof b);
   snprintf(out, cap, "%s takes about %s of memory%s%s%s", what, a, b[0] ? " (" : "", b,
            b[0] ? " is available)" : "");

@@ -5,28 +5,10 @@
  * window, or show "evil\u202egnp.exe" as "evilexe.png". One rule for every
  * line the command line prints. */
 #include "core/internal.h"
+#include "core/json.h"
 
 #include <stdio.h>
 #include <string.h>
-
-size_t bb_utf8_sequence(const char *text) {
-  const unsigned char *s = (const unsigned char *)text;
-  if (!s || !s[0])
-    return 0;
-  if (s[0] < 0x80)
-    return 1;
-  size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 ? 2 : 0;
-  if (s[0] > 0xf4)
-    n = 0;
-  for (size_t i = 1; i < n; i++)
-    if ((s[i] & 0xc0) != 0x80)
-      return 0;
-  if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
-    return 0; /* overlong, or a surrogate */
-  if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
-    return 0; /* overlong, or past U+10FFFF */
-  return n;
-}
 
 /* 1 when the n-byte UTF-8 sequence at s is a bidirectional control:
  * U+061C ALM, U+200E LRM, U+200F RLM, U+202A..U+202E (LRE, RLE, PDF, LRO,
@@ -47,7 +29,7 @@ static int is_bidi_control(const unsigned char *s, size_t n) {
 static size_t printable_sequence(const unsigned char *s) {
   if (s[0] < 0x80)
     return s[0] >= 0x20 && s[0] != 0x7f;
-  const size_t n = bb_utf8_sequence((const char *)s);
+  const size_t n = bb__utf8_sequence((const char *)s);
   if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
     return 0;
   return is_bidi_control(s, n) ? 0 : n;
@@ -61,7 +43,7 @@ const char *bb_text_printable(const char *s, char *out, size_t cap) {
     size_t n = printable_sequence(p);
     if (n == 0) {
       /* every byte of a control sequence, so none is left to act */
-      const size_t k = p[0] < 0x80 ? 1 : bb_utf8_sequence((const char *)p);
+      const size_t k = p[0] < 0x80 ? 1 : bb__utf8_sequence((const char *)p);
       const size_t bytes = k ? k : 1;
       if (used + 4 * bytes >= cap)
         break;

@@ -16,7 +16,7 @@
  *
  * Assimp's readers lose memory on some error paths of hostile models (the
  * glTF reader's base64 decoder throws past the buffer it allocated). In
- * bb_mesh_load that happens in the child process of the import, which
+ * bb__mesh_load that happens in the child process of the import, which
  * exits; the in-process import (bb__mesh_import: fuzz_mesh, tests) stops
  * counting allocations as leaks while, and only while, Assimp imports or
  * post-processes in that thread (src/mesh/mesh_assimp.cpp). */

@@ -53,7 +53,7 @@ static int find_entry(const char *text_, const char *key, size_t key_length, ent
   return 0;
 }
 
-int bb_provenance_value(const char *description, const char *key, char *out, size_t cap) {
+int bb__provenance_value(const char *description, const char *key, char *out, size_t cap) {
   if (out && cap)
     out[0] = '\0';
   entry e;
@@ -66,7 +66,7 @@ int bb_provenance_value(const char *description, const char *key, char *out, siz
 
 /* What decides which keys of a text count: the kind it records ("output")
  * and whether its bake reflected light (a "bounce" key), by the rule of
- * bb_map_kind_records, so a key a map does not depend on is neither a
+ * bb__map_kind_records, so a key a map does not depend on is neither a
  * difference nor a reason to bake again, also in a text written before
  * the rule that records it. */
 typedef struct text_kind {
@@ -217,7 +217,7 @@ static const entry *lookup(const entry_index *index, const entry *key) {
   return NULL;
 }
 
-int bb_provenance_diff(const char *a, const char *b, char *out, size_t cap) {
+int bb__provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   size_t used = 0;
   if (out && cap)
     out[0] = '\0';
@@ -348,7 +348,7 @@ bb_provenance_class bb_provenance_classify(const char *description) {
                        !strstr(description, "\nbumpbake_version=")))
     return BB_PROVENANCE_NONE;
   /* A format that cuts or re-wraps long comments (TGA keeps 4 rows of 80
-   * characters; bb_image_write fits whole lines into them, but other tools
+   * characters; bb__image_write fits whole lines into them, but other tools
    * may not) leaves lines that are not key=value. */
   for (const char *line = description; *line;) {
     const char *end = strchr(line, '\n');

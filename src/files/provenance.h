@@ -34,6 +34,26 @@ int bb__provenance_pack_overflow(const char *description, int rows, int row_char
 int bb__provenance_mismatch(const char *have, const char *want, const char *const *ignored,
                             char *reason, size_t cap);
 
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Writes into out (capacity cap) the keys whose values differ between two
+ * provenance texts, as "key: A-value -> B-value" lines (empty when none, or
+ * when either text is NULL). Keys "command" and "output" are ignored, and so
+ * is a key neither text's kind ("output") records (bb__map_kind_records:
+ * "rays" of a normal map; an ao's "rayset" is compared by its scheme and
+ * slices alone without inter-reflection). Returns
+ * the number of differing keys, or -1 when out of memory. Time is
+ * O(n log n) in the number of lines, whatever the texts hold. */
+int bb__provenance_diff(const char *a, const char *b, char *out, size_t cap);
+
+/* The value of key in a provenance text (its first "key=value" line) into
+ * out (capacity cap, NUL-terminated, cut to fit). Returns 1 when the key is
+ * there, 0 when it is not or description is NULL (out is then ""). So a
+ * reader can ask which basis a map was baked with ("basis"). */
+int bb__provenance_value(const char *description, const char *key, char *out, size_t cap);
+
 #ifdef __cplusplus
 }
 #endif

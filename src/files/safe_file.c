@@ -9,12 +9,13 @@
  * file, and a full disk is an error, never a silent truncation.
  *
  * Temporaries being written are listed in a fixed table that a signal
- * handler can walk (bb_tempfiles_remove): only lock-free atomics, unlink(2),
+ * handler can walk (bb__tempfiles_remove): only lock-free atomics, unlink(2),
  * rmdir(2) and clock_gettime(2) are used there, all async-signal-safe. */
 
 #include "core/file_names.h"
 #include "core/internal.h"
 #include "files/safe_file.h"
+#include "bumpbake_cluster.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -41,7 +42,7 @@ static atomic_int slot_state[TEMP_SLOTS];
 static char slot_path[TEMP_SLOTS][PATH_MAX];
 static int slot_is_dir[TEMP_SLOTS]; /* a private directory (bb__safe_open_private) */
 
-/* Lists path (a file, or a directory when is_dir) for bb_tempfiles_remove;
+/* Lists path (a file, or a directory when is_dir) for bb__tempfiles_remove;
  * returns its slot, or -1 when the table is full (it then loses only its
  * signal-time cleanup). */
 static int register_path(const char *path, int is_dir) {
@@ -73,7 +74,7 @@ static int register_temp(const char *path) { return register_path(path, 0); }
  * temporary left after SIGTERM under load). So every name is made into a
  * file inside a creation: the thread holds SIGINT, SIGTERM and SIGHUP off,
  * so the handler never runs on it there, and counts itself in `creating`;
- * bb_tempfiles_remove first says the process is ending (`closing`), after
+ * bb__tempfiles_remove first says the process is ending (`closing`), after
  * which no creation starts, then waits for those in flight, then walks.
  * (Each side stores before it loads, sequentially consistent: one of the
  * two always sees the other.) */
@@ -100,7 +101,7 @@ void bb__safe_creation_end(const sigset_t *held) {
   pthread_sigmask(SIG_SETMASK, held, NULL);
 }
 
-void bb_tempfiles_remove(void) {
+void bb__tempfiles_remove(void) {
   int saved_errno = errno; /* a handler must leave errno as it found it */
   atomic_store(&closing, 1);
   /* A creation is an open(2), a mkdir(2) or a mip chain's encoding. The
@@ -785,28 +786,28 @@ bb_staged_file *bb__staged_new(void) {
   return f;
 }
 
-const char *bb_staged_file_path(const bb_staged_file *staged) {
+const char *bb__staged_file_path(const bb_staged_file *staged) {
   return staged ? staged->path : NULL;
 }
 
-bb_status bb_staged_file_commit(bb_staged_file *staged, bb_error *err) {
+bb_status bb__staged_file_commit(bb_staged_file *staged, bb_error *err) {
   if (!staged)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_staged_file_commit: NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__staged_file_commit: NULL");
   bb_status st = bb__safe_commit(staged, err);
   free(staged);
   return st;
 }
 
-void bb_staged_file_discard(bb_staged_file *staged) {
+void bb__staged_file_discard(bb_staged_file *staged) {
   if (!staged)
     return;
   bb__safe_discard(staged);
   free(staged);
 }
 
-bb_status bb_file_write(const char *path, const void *data, size_t size, bb_error *err) {
+bb_status bb__file_write(const char *path, const void *data, size_t size, bb_error *err) {
   if (!data && size)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_file_write: no data");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__file_write: no data");
   bb_staged_file f;
   bb_status st = bb__safe_open(&f, path, err);
   if (st != BB_OK)

@@ -25,7 +25,7 @@ extern "C" {
  *
  * - The bytes go to "DIR/.bb-tmp-XXXXXX.EXT" next to path (same
  *   filesystem, so the rename is atomic), registered for
- *   bb_tempfiles_remove() (signal handlers) while it exists.
+ *   bb__tempfiles_remove() (signal handlers) while it exists.
  * - Writes are buffered; every write(2) is checked and retried on short
  *   counts. The first failure (ENOSPC, EFBIG under RLIMIT_FSIZE, EIO...) is
  *   kept and later writes return 0, so a codec that ignores a failed write
@@ -45,7 +45,7 @@ struct bb_staged_file {
   int lock_ready;
   int fd;               /* -1 once closed */
   int error;            /* first errno seen, 0 when none */
-  int slot;             /* registry slot for bb_tempfiles_remove, or -1 */
+  int slot;             /* registry slot for bb__tempfiles_remove, or -1 */
   int64_t pos;          /* position of the next bb__safe_write / read */
   int64_t size;         /* bytes in the file (highest byte written + 1) */
   unsigned char *buffer;
@@ -67,7 +67,7 @@ struct bb_staged_file {
 };
 
 /* A creation: between begin and end the calling thread holds SIGINT,
- * SIGTERM and SIGHUP off, and bb_tempfiles_remove (a signal's cleanup)
+ * SIGTERM and SIGHUP off, and bb__tempfiles_remove (a signal's cleanup)
  * waits for it before it removes the registered temporaries, so a file
  * being made while the handler runs is not left behind. Every temporary
  * is made inside one; so is an encoder's file made by name in a private
@@ -113,7 +113,7 @@ bb_status bb__safe_open(bb_staged_file *f, const char *path, bb_error *err);
  * reached through its descriptor ("/proc/self/fd/N/LEAF"; the directory's
  * path where /proc is not mounted), LEAF being "staged" and path's
  * extension. Nothing exists at that name yet. Both are registered for
- * bb_tempfiles_remove. Then bb__safe_adopt, then commit or discard as for
+ * bb__tempfiles_remove. Then bb__safe_adopt, then commit or discard as for
  * bb__safe_open. Errors: BB_ERR_IO. */
 bb_status bb__safe_open_private(bb_staged_file *f, const char *path, bb_error *err);
 
@@ -139,6 +139,42 @@ void bb__safe_discard(bb_staged_file *f);
 /* A zeroed heap bb_staged_file for the public handle API (NULL when out of
  * memory). */
 bb_staged_file *bb__staged_new(void);
+
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Renames the staged file to its path and frees the handle (also when the
+ * rename fails, which removes the temporary). Errors: BB_ERR_IO. */
+bb_status bb__staged_file_commit(bb_staged_file *staged, bb_error *err);
+
+/* Removes the staged file's temporary and frees the handle; NULL is fine. */
+void bb__staged_file_discard(bb_staged_file *staged);
+
+/* The destination path of a staged file (owned by the handle). */
+const char *bb__staged_file_path(const bb_staged_file *staged);
+
+/* Writes size bytes of data to path (a text file: a depfile, a list) the way
+ * images are written: through a temporary in path's directory, flushed,
+ * synced and renamed into place, so path is either untouched or whole. The
+ * temporary is removed on failure, and by bb__tempfiles_remove on a signal.
+ * A path that exists and is not a regular file (a device, a FIFO, a
+ * symbolic link, /dev/stdout) is refused, never renamed over.
+ * Errors: BB_ERR_ARGUMENT (no path, or NULL data with a size),
+ * BB_ERR_MEMORY, BB_ERR_IO ("PATH: cannot write: reason"). */
+bb_status bb__file_write(const char *path, const void *data, size_t size, bb_error *err);
+
+/* Removes every temporary file a write of this process has open right now
+ * (staged files included). Async-signal-safe: call it from a SIGINT or
+ * SIGTERM handler, then re-raise the signal with the default action, and an
+ * interrupted run leaves no temporary behind. Only files whose names this
+ * library created are removed. A temporary being made on another thread at
+ * that moment is waited for (those threads hold SIGINT, SIGTERM and SIGHUP
+ * off while they make one), and from then on the process is taken to be
+ * ending: a write that starts makes no temporary and fails (BB_ERR_IO). At
+ * most 4096 temporaries are tracked at once; further ones are still removed
+ * on errors, but not by this function. */
+void bb__tempfiles_remove(void);
 
 #ifdef __cplusplus
 }

@@ -4,12 +4,13 @@
 #include "core/internal.h"
 #include "image/formats.h"
 #include "image/oiio_calls.h"
+#include "image/oiio.h"
 
 #include <stddef.h>
 
-bb_status bb_animation_open(const char *path, int width, int height, double frames_per_second,
+bb_status bb__animation_open(const char *path, int width, int height, double frames_per_second,
                             bb_animation **out, bb_error *err) {
-  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_open: out is NULL");
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb__animation_open: out is NULL");
   *out = NULL;
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "animation: path is NULL");
   if (!bb__path_has_extension(path, "gif"))
@@ -22,13 +23,13 @@ bb_status bb_animation_open(const char *path, int width, int height, double fram
   return bb__oiio_gif_open(path, width, height, frames_per_second, out, err);
 }
 
-bb_status bb_animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err) {
+bb_status bb__animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err) {
   return bb__oiio_gif_add(a, frame, err);
 }
 
-bb_status bb_animation_close(bb_animation *a, bb_error *err) {
-  if (!a) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_close: NULL animation");
+bb_status bb__animation_close(bb_animation *a, bb_error *err) {
+  if (!a) return bb__fail(err, BB_ERR_ARGUMENT, "bb__animation_close: NULL animation");
   return bb__oiio_gif_close(a, err);
 }
 
-void bb_animation_abort(bb_animation *a) { bb__oiio_gif_abort(a); }
+void bb__animation_abort(bb_animation *a) { bb__oiio_gif_abort(a); }

@@ -7,6 +7,7 @@
 #include "image/oiio.h"
 #include "image/oiio_calls.h"
 #include "image/quantise.h"
+#include "texture/texture.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -17,7 +18,7 @@ bb_status bb__image_as_read(const char *path, const bb_image *img, bb_depth dept
   if (!img || !img->pixels)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: no image", path);
   const int stored =
-      bb_path_is_texture_format(path) ? -1 : bb__path_resolved_depth(path, depth);
+      bb__path_is_texture_format(path) ? -1 : bb__path_resolved_depth(path, depth);
   if (stored < 0)
     return bb__fail(err, BB_ERR_FORMAT, "%s: its samples are not made in memory", path);
   bb_status st = bb_image_alloc(out, img->width, img->height, img->channels, err);

@@ -28,7 +28,7 @@ const char *bb__depth_words(int depth) {
   return "unknown";
 }
 
-const char *bb_depth_name(bb_depth depth) {
+const char *bb__depth_name(bb_depth depth) {
   if (depth == BB_DEPTH_DEFAULT)
     return "default";
   if ((int)depth < 0 || (int)depth >= DEPTH_COUNT)

@@ -49,20 +49,20 @@ static const format_rule *find_format(const char *path) {
 
 /* The engine textures (texture.c) choose their samples by texture format,
  * hold 4 channels and carry their own mip chain. */
-static int is_texture(const char *path) { return bb_path_is_texture_format(path); }
+static int is_texture(const char *path) { return bb__path_is_texture_format(path); }
 
-int bb_path_is_writable_format(const char *path) {
+int bb__path_is_writable_format(const char *path) {
   return find_format(path) != NULL || is_texture(path);
 }
 
-int bb_path_supports_depth(const char *path, bb_depth depth) {
+int bb__path_supports_depth(const char *path, bb_depth depth) {
   if (is_texture(path)) return depth == BB_DEPTH_DEFAULT;
   const format_rule *f = find_format(path);
   return f && (depth == BB_DEPTH_DEFAULT ||
                ((unsigned)depth < 32 && (f->allowed & BIT((unsigned)depth)) != 0));
 }
 
-int bb_path_max_channels(const char *path) {
+int bb__path_max_channels(const char *path) {
   if (is_texture(path)) return 4;
   const format_rule *f = find_format(path);
   return f ? f->max_channels : 0;
@@ -83,7 +83,7 @@ int bb__path_holds_mips(const char *path) {
   return f && f->holds_mips;
 }
 
-int bb_path_supports_mips(const char *path) { return bb__path_holds_mips(path); }
+int bb__path_supports_mips(const char *path) { return bb__path_holds_mips(path); }
 
 const char *bb__exr_compression(bb_depth depth) {
   return depth == BB_DEPTH_HALF ? "piz" : "none";
@@ -136,7 +136,7 @@ void bb__texture_options_of(const bb_write_options *options, bb_texture_options 
   if (o->description) out->description = o->description;
 }
 
-/* A texture's checks: no sample depth to choose, then bb_texture_check's. */
+/* A texture's checks: no sample depth to choose, then bb__texture_check's. */
 static bb_status texture_check(const char *path, const bb_image *top,
                                const bb_write_options *o, bb_error *err) {
   char ext[16];
@@ -147,7 +147,7 @@ static bb_status texture_check(const char *path, const bb_image *top,
                     path, bb__depth_words(o->depth), (bb__extension_of(path, ext, sizeof ext), ext));
   bb_texture_options t;
   bb__texture_options_of(o, &t);
-  return bb_texture_check(path, top->width, top->height, top->channels, &t, err);
+  return bb__texture_check(path, top->width, top->height, top->channels, &t, err);
 }
 
 bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_options *options,

@@ -25,7 +25,7 @@ double bb__encoded_sample_bytes(const char *path, bb_depth depth);
 /* 1 when path's format can hold a mip chain (.tif, .tiff, .exr, .vtf, .dds). */
 int bb__path_holds_mips(const char *path);
 
-/* Everything bb_image_write checks before encoding: the image (not empty),
+/* Everything bb__image_write checks before encoding: the image (not empty),
  * the options (known enums), the format (known extension) and that it holds
  * the depth and the channel count. *depth receives the depth to write. */
 bb_status bb__write_check(const char *path, const bb_image *img, const bb_write_options *options,
@@ -56,6 +56,29 @@ void bb__texture_options_of(const bb_write_options *options, bb_texture_options 
  * width of count - 1 (B00..B15): OpenEXR keeps channels sorted by name and
  * reads them back in that order. out holds at least 8 bytes. */
 const char *bb__basis_channel_name(int c, int count, char out[8]);
+
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* True (1) when the extension of path names a format bb__image_write knows
+ * (.vtf and .dds included). */
+int bb__path_is_writable_format(const char *path);
+
+/* True (1) when bb__image_write can store depth in the format path's extension
+ * names (BB_DEPTH_DEFAULT fits every known format), so a caller can refuse a
+ * bad combination before a long bake rather than after it. */
+int bb__path_supports_depth(const char *path, bb_depth depth);
+
+/* Most channels bb__image_write can store in the format path's extension
+ * names: 4 for .png, .tga, .vtf and .dds, 64 for .tif, .tiff and .exr; 0 for an unknown
+ * extension. So a caller can refuse a basis with more directions than the
+ * file can hold before the bake. */
+int bb__path_max_channels(const char *path);
+
+/* True (1) when path's format can hold a mip chain (.tif, .tiff, .exr; .vtf
+ * and .dds, which have one unless bb_texture_options.mips is 0). */
+int bb__path_supports_mips(const char *path);
 
 #ifdef __cplusplus
 }

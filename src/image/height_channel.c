@@ -22,7 +22,7 @@ bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err) {
   return st;
 }
 
-const char *bb_channel_name(bb_channel c) {
+const char *bb__channel_name(bb_channel c) {
   if ((int)c < 0 || (int)c >= CHANNEL_COUNT) return "unknown";
   return CHANNEL_NAMES[c];
 }

@@ -26,4 +26,8 @@ typedef struct bb__height_loaded {
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err);
 
+/* Once in bumpbake.h beside the functions that stay public there. */
+/* The name bb_channel_parse accepts; "unknown" for other values. */
+const char *bb__channel_name(bb_channel c);
+
 #endif /* BB_IMAGE_HEIGHT_CHANNEL_H */

@@ -53,7 +53,7 @@ static bb_status resolve_pick(int channels, int alpha_channel, bb_channel channe
     if (!colour)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "channel '%s' asked of a grey image (%d channel%s) with no %s",
-                      bb_channel_name(channel), channels, channels == 1 ? "" : "s",
+                      bb__channel_name(channel), channels, channels == 1 ? "" : "s",
                       channel == BB_CHANNEL_G ? "green" : "blue");
     p->index = channel == BB_CHANNEL_G ? 1 : 2;
     return BB_OK;

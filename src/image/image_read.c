@@ -87,9 +87,9 @@ bb_status bb_image_read_info(const char *path, int *width, int *height, int *cha
   return st;
 }
 
-bb_status bb_image_frame_count(const char *path, int *frames, bb_error *err) {
+bb_status bb__image_frame_count(const char *path, int *frames, bb_error *err) {
   if (!path || !frames)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_frame_count: NULL argument");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_frame_count: NULL argument");
   *frames = 0;
   if (bb__texture_read_applies(path)) { /* frame 0 is what is read */
     bb_status st = bb__texture_read_header(path, NULL, NULL, NULL, NULL, NULL, err);
@@ -126,7 +126,7 @@ static int list_holds(const char *list, const char *ext) {
   return 0;
 }
 
-int bb_path_is_readable_format(const char *path) {
+int bb__path_is_readable_format(const char *path) {
   if (!path) return 0;
   char ext[256];
   bb__extension_of(path, ext, sizeof ext);

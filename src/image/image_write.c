@@ -15,7 +15,7 @@
 #include <string.h>
 
 /* A .vtf or .dds: the write options' texture settings, their lines added
- * to the provenance (bb_texture_provenance), levels[0] alone (given 0) or
+ * to the provenance (bb__texture_provenance), levels[0] alone (given 0) or
  * the caller's chain. */
 static bb_status write_texture(const char *path, const bb_image *levels, int count, int given,
                                const bb_write_options *options, bb_staged_file *f,
@@ -24,7 +24,7 @@ static bb_status write_texture(const char *path, const bb_image *levels, int cou
   bb__texture_options_of(options, &t);
   char *described = NULL;
   if (t.description) {
-    char *lines = bb_texture_provenance(path, &t);
+    char *lines = bb__texture_provenance(path, &t);
     const size_t n = strlen(t.description) + (lines ? strlen(lines) : 0) + 2;
     described = lines ? malloc(n) : NULL;
     if (!described) {
@@ -48,7 +48,7 @@ static bb_status write_image(const char *path, const bb_image *img,
   bb_depth depth;
   bb_status st = bb__write_check(path, img, options, &depth, err);
   if (st != BB_OK) return st;
-  if (bb_path_is_texture_format(path)) return write_texture(path, img, 1, 0, options, f, err);
+  if (bb__path_is_texture_format(path)) return write_texture(path, img, 1, 0, options, f, err);
   st = bb__oiio_write_image(path, img, depth, options ? options->range : BB_RANGE_UNIT,
                             options ? options->description : NULL, threads, NULL, f, err);
   if (st != BB_OK) bb__safe_discard(f);
@@ -61,7 +61,7 @@ static bb_status write_mips(const char *path, const bb_image *levels, int count,
   bb_depth depth;
   bb_status st = bb__write_mips_check(path, levels, count, options, &depth, err);
   if (st != BB_OK) return st;
-  if (bb_path_is_texture_format(path))
+  if (bb__path_is_texture_format(path))
     return write_texture(path, levels, count, 1, options, f, err);
   st = bb__oiio_write_mips(path, levels, count, depth, options ? options->range : BB_RANGE_UNIT,
                            options ? options->description : NULL, threads, f, err);
@@ -69,16 +69,16 @@ static bb_status write_mips(const char *path, const bb_image *levels, int count,
   return st;
 }
 
-bb_status bb_image_write(const char *path, const bb_image *img, const bb_write_options *options,
+bb_status bb__image_write(const char *path, const bb_image *img, const bb_write_options *options,
                          bb_error *err) {
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write: path is NULL");
   bb_staged_file f;
   bb__safe_init(&f);
   bb_status st = write_image(path, img, options, 0, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
 
-bb_status bb_image_write_staged(const char *path, const bb_image *img,
+bb_status bb__image_write_staged_all_cores(const char *path, const bb_image *img,
                                 const bb_write_options *options, bb_staged_file **staged,
                                 bb_error *err) {
   return bb__image_write_staged(path, img, options, 0, staged, err);
@@ -87,9 +87,9 @@ bb_status bb_image_write_staged(const char *path, const bb_image *img,
 bb_status bb__image_write_staged(const char *path, const bb_image *img,
                                  const bb_write_options *options, int threads,
                                  bb_staged_file **staged, bb_error *err) {
-  if (!staged) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: staged is NULL");
+  if (!staged) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write_staged_all_cores: staged is NULL");
   *staged = NULL;
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_staged: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write_staged_all_cores: path is NULL");
   bb_staged_file *f = bb__staged_new();
   if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   bb_status st = write_image(path, img, options, threads, f, err);
@@ -101,16 +101,16 @@ bb_status bb__image_write_staged(const char *path, const bb_image *img,
   return BB_OK;
 }
 
-bb_status bb_image_write_mips(const char *path, const bb_image *levels, int count,
+bb_status bb__image_write_mips(const char *path, const bb_image *levels, int count,
                               const bb_write_options *options, bb_error *err) {
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write_mips: path is NULL");
   bb_staged_file f;
   bb__safe_init(&f);
   bb_status st = write_mips(path, levels, count, options, 0, &f, err);
   return st == BB_OK ? bb__safe_commit(&f, err) : st;
 }
 
-bb_status bb_image_write_mips_staged(const char *path, const bb_image *levels, int count,
+bb_status bb__image_write_mips_staged_all_cores(const char *path, const bb_image *levels, int count,
                                      const bb_write_options *options,
                                      bb_staged_file **staged, bb_error *err) {
   return bb__image_write_mips_staged(path, levels, count, options, 0, staged, err);
@@ -120,9 +120,9 @@ bb_status bb__image_write_mips_staged(const char *path, const bb_image *levels, 
                                       const bb_write_options *options, int threads,
                                       bb_staged_file **staged, bb_error *err) {
   if (!staged)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: staged is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write_mips_staged_all_cores: staged is NULL");
   *staged = NULL;
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_write_mips_staged: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_write_mips_staged_all_cores: path is NULL");
   bb_staged_file *f = bb__staged_new();
   if (!f) return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   bb_status st = write_mips(path, levels, count, options, threads, f, err);

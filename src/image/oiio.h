@@ -10,14 +10,14 @@
 extern "C" {
 #endif
 
-/* Image headers for bb_output_check: the depth bb_image_write stores for
+/* Image headers for bb_output_check: the depth bb__image_write stores for
  * `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1 for an
  * unknown extension (formats.c); and the number of mip levels of subimage 0
  * of the file at path, from its headers (image_read.c). */
 int bb__path_resolved_depth(const char *path, bb_depth depth);
 
 /* A depth as messages say it: "8-bit", "16-bit", "half float", "float",
- * "default", or "unknown" for anything else (depth.c; bb_depth_name is
+ * "default", or "unknown" for anything else (depth.c; bb__depth_name is
  * the word --depth takes). */
 const char *bb__depth_words(int depth);
 bb_status bb__image_level_count(const char *path, int *levels, bb_error *err);
@@ -47,6 +47,41 @@ bb_mip_filter bb__mip_filter(int normal_map);
  * (oiio_mips.cpp). Allocates out. */
 bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,
                                bb_error *err);
+
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Number of subimages (frames) in an image file (1 for a VTF or DDS: the
+ * frame read). */
+bb_status bb__image_frame_count(const char *path, int *frames, bb_error *err);
+
+/* True (1) when the extension of path (any case) is one OpenImageIO has a
+ * reader for (png, tga, tif, exr, jpg, ...: its "extension_list"), so a
+ * caller can pick the images out of a directory without opening each file.
+ * It says nothing of the file's contents. */
+int bb__path_is_readable_format(const char *path);
+
+/* Starts path (extension .gif) for frames of width x height, shown at
+ * frames_per_second (1..100). Errors: BB_ERR_FORMAT (not .gif), BB_ERR_IO. */
+bb_status bb__animation_open(const char *path, int width, int height, double frames_per_second,
+                            bb_animation **out, bb_error *err);
+
+/* Appends a frame: 3 channels, the open size, values in [0, 1]. On failure
+ * the animation stays open; bb__animation_abort it. */
+bb_status bb__animation_add_frame(bb_animation *a, const bb_image *frame, bb_error *err);
+
+/* Finishes the file, reads it back to check its frame count, renames it into
+ * place and frees a, also on failure (then no file is left). */
+bb_status bb__animation_close(bb_animation *a, bb_error *err);
+
+/* Removes the temporary file and frees a; safe on NULL. */
+void bb__animation_abort(bb_animation *a);
+
+/* Once in bumpbake.h beside the functions that stay public there. */
+/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+ * for values outside the enum. */
+const char *bb__depth_name(bb_depth depth);
 
 #ifdef __cplusplus
 }

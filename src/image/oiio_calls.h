@@ -63,7 +63,7 @@ bb_status bb__oiio_write_mips(const char *path, const bb_image *levels, int coun
 
 /* ------------------------------------------------ animations (oiio_gif.cpp) */
 
-/* A GIF being written (checked by animation.c); see bb_animation_open. */
+/* A GIF being written (checked by animation.c); see bb__animation_open. */
 bb_status bb__oiio_gif_open(const char *path, int width, int height, double frames_per_second,
                             bb_animation **out, bb_error *err);
 bb_status bb__oiio_gif_add(bb_animation *a, const bb_image *frame, bb_error *err);

@@ -7,6 +7,7 @@
 #include "image/oiio_setup.h"
 #include "image/oiio_proxy.h"
 #include "image/quantise.h"
+#include "image/oiio.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -21,7 +22,7 @@ using OIIO::TypeDesc;
 
 // The GIF being written: OIIO's writer writes the frames through a
 // StagedOutput into a staged temporary; the final name appears only once
-// bb_animation_close has checked the file.
+// bb__animation_close has checked the file.
 struct bb_animation {
   std::string path;
   bb_staged_file file; // the temporary; discarded unless committed
@@ -105,7 +106,7 @@ bb_status animation_close(bb_animation *a, bb_error *err) {
   if (st != BB_OK) return st;
   int frames = 0;
   bb_error read_err;
-  if (bb_image_frame_count(a->file.temp_path, &frames, &read_err) != BB_OK ||
+  if (bb__image_frame_count(a->file.temp_path, &frames, &read_err) != BB_OK ||
       frames != a->frames)
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: the file holds %d of %d frames", path,
                     frames, a->frames);
@@ -125,7 +126,7 @@ bb_status bb__oiio_gif_open(const char *path, int width, int height, double fram
 }
 
 bb_status bb__oiio_gif_add(bb_animation *a, const bb_image *frame, bb_error *err) {
-  if (!a || !a->out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_animation_add_frame: not open");
+  if (!a || !a->out) return bb__fail(err, BB_ERR_ARGUMENT, "bb__animation_add_frame: not open");
   return bb::guard(err, a->path.c_str(), bb::WRITING,
                    [&] { return animation_add(a, frame, err); });
 }

@@ -1,5 +1,5 @@
-/* texture_write.c: bb_texture_write and the texture branch of
- * bb_image_write: a VTF or DDS file by extension, from one image (its mip
+/* texture_write.c: bb__texture_write and the texture branch of
+ * bb__image_write: a VTF or DDS file by extension, from one image (its mip
  * chain made here) or from a caller's chain, staged and committed as every
  * file the library writes. */
 
@@ -9,6 +9,7 @@
 #include "files/safe_file.h"
 #include "texture/texture.h"
 #include "texture/vtf.h"
+#include "image/image_write.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -107,7 +108,7 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
   return st;
 }
 
-bb_status bb_texture_write(const char *path, const bb_image *img,
+bb_status bb__texture_write(const char *path, const bb_image *img,
                            const bb_texture_options *options, bb_error *err) {
   bb_staged_file f;
   bb__safe_init(&f);

@@ -15,6 +15,9 @@
 #include "core/internal.h"
 #include "files/safe_file.h"
 #include "job/job_internal.h"
+#include "files/provenance.h"
+#include "image/oiio.h"
+#include "core/json.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -98,7 +101,7 @@ static bb_status walk(tree *t, const char *rel, int depth, bb_error *err) {
       st = walk(t, sub, depth + 1, err);
       continue;
     }
-    if (!bb_path_is_readable_format(e->d_name))
+    if (!bb__path_is_readable_format(e->d_name))
       continue;
     if (S_ISREG(s.st_mode))
       st = tree_add(t, sub, NULL);
@@ -186,9 +189,9 @@ static bb_status copy_file(const char *path, const char *dest, bb_error *err) {
   char dir[PATH_MAX];
   bb__directory_part(dest, dir, sizeof dir);
   if (st == BB_OK)
-    st = bb_directory_create(dir, err);
+    st = bb__directory_create(dir, err);
   if (st == BB_OK)
-    st = bb_file_write(dest, bytes, (size_t)s.st_size, err);
+    st = bb__file_write(dest, bytes, (size_t)s.st_size, err);
   free(bytes);
   return st;
 }
@@ -250,8 +253,8 @@ static bb_status tree_case(bb_check *c, const char *name, const char *golden,
     snprintf(why, sizeof why, "%s", !g.read ? g.why : n.why);
   }
   char kind[64] = "";
-  if (!bb_provenance_value(n.info.description, "output", kind, sizeof kind))
-    bb_provenance_value(g.info.description, "output", kind, sizeof kind);
+  if (!bb__provenance_value(n.info.description, "output", kind, sizeof kind))
+    bb__provenance_value(g.info.description, "output", kind, sizeof kind);
   const bb__check_sides sides = {g.read ? &g.image : NULL, n.read ? &n.image : NULL,
                                  g.info.description,       n.info.description,
                                  raw_signed(&g, kind),     raw_signed(&n, kind)};
@@ -325,9 +328,9 @@ static int is_baked_map(const char *path) {
   char kind[64];
   int baked = 0;
   if (bb_provenance_classify(info.description) == BB_PROVENANCE_INTACT &&
-      bb_provenance_value(info.description, "output", kind, sizeof kind))
+      bb__provenance_value(info.description, "output", kind, sizeof kind))
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      baked |= strcmp(kind, bb_map_kind_name((bb_map_kind)k)) == 0;
+      baked |= strcmp(kind, bb__map_kind_name((bb_map_kind)k)) == 0;
   bb_image_info_free(&info);
   return baked;
 }
@@ -338,7 +341,7 @@ static int could_be_made(const bb_job *job, const char *rel) {
   const char *tmpl = job->name_template ? job->name_template : BB_JOB_DEFAULT_NAME;
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     char pattern[4096];
-    const char *fields[3] = {"*", bb_map_kind_name((bb_map_kind)k), "*"};
+    const char *fields[3] = {"*", bb__map_kind_name((bb_map_kind)k), "*"};
     if ((job->options.bake.outputs & BB_MAP_BIT(k)) &&
         bb__job_expand_name(tmpl, fields, pattern, sizeof pattern, NULL) == BB_OK &&
         fnmatch(pattern, rel, FNM_PATHNAME) == 0)
@@ -432,56 +435,56 @@ bb_status bb_check_run(bb_check *c, bb_progress_fn progress, void *progress_user
 /* ------------------------------------------------------- what is printed */
 
 static void json_case(FILE *f, const bb_check_case *k) {
-  bb_json j = {f, 0};
+  bb__json j = {f, 0};
   const bb_compare_stats *s = &k->stats;
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "name", k->name);
-  bb_json_string(&j, "golden", k->golden);
-  bb_json_string(&j, "new", k->fresh);
-  bb_json_string(&j, "kind", k->kind);
-  bb_json_string(&j, "result", bb_check_status_name(k->status));
-  bb_json_int(&j, "exit", k->exit_code);
+  bb__json_open(&j, NULL, '{');
+  bb__json_string(&j, "name", k->name);
+  bb__json_string(&j, "golden", k->golden);
+  bb__json_string(&j, "new", k->fresh);
+  bb__json_string(&j, "kind", k->kind);
+  bb__json_string(&j, "result", bb_check_status_name(k->status));
+  bb__json_int(&j, "exit", k->exit_code);
   if (k->width)
-    bb_json_int(&j, "width", k->width), bb_json_int(&j, "height", k->height),
-        bb_json_int(&j, "channels", k->channels);
+    bb__json_int(&j, "width", k->width), bb__json_int(&j, "height", k->height),
+        bb__json_int(&j, "channels", k->channels);
   if (k->status <= BB_CHECK_FAILURE) {
-    bb_json_int(&j, "pixels", s->pixels);
-    bb_json_number(&j, "mean_abs", s->mean_abs);
-    bb_json_number(&j, "rms", s->rms);
-    bb_json_number(&j, "max_abs", s->max_abs);
-    bb_json_open(&j, "worst", '{');
-    bb_json_int(&j, "x", s->worst_x);
-    bb_json_int(&j, "y", s->worst_y);
-    bb_json_int(&j, "channel", s->worst_channel);
-    bb_json_close(&j, '}');
-    bb_json_number(&j, "fail", k->limits.fail);
-    bb_json_number(&j, "failpercent", k->limits.fail_percent);
-    bb_json_number(&j, "hardfail", k->limits.hard_fail);
-    bb_json_int(&j, "allowfailures", k->limits.allow_failures);
-    bb_json_int(&j, "over_fail", s->over_fail);
-    bb_json_number(&j, "warn", k->limits.warn);
-    bb_json_number(&j, "warnpercent", k->limits.warn_percent);
-    bb_json_number(&j, "hardwarn", k->limits.hard_warn);
-    bb_json_int(&j, "over_warn", s->over_warn);
+    bb__json_int(&j, "pixels", s->pixels);
+    bb__json_number(&j, "mean_abs", s->mean_abs);
+    bb__json_number(&j, "rms", s->rms);
+    bb__json_number(&j, "max_abs", s->max_abs);
+    bb__json_open(&j, "worst", '{');
+    bb__json_int(&j, "x", s->worst_x);
+    bb__json_int(&j, "y", s->worst_y);
+    bb__json_int(&j, "channel", s->worst_channel);
+    bb__json_close(&j, '}');
+    bb__json_number(&j, "fail", k->limits.fail);
+    bb__json_number(&j, "failpercent", k->limits.fail_percent);
+    bb__json_number(&j, "hardfail", k->limits.hard_fail);
+    bb__json_int(&j, "allowfailures", k->limits.allow_failures);
+    bb__json_int(&j, "over_fail", s->over_fail);
+    bb__json_number(&j, "warn", k->limits.warn);
+    bb__json_number(&j, "warnpercent", k->limits.warn_percent);
+    bb__json_number(&j, "hardwarn", k->limits.hard_warn);
+    bb__json_int(&j, "over_warn", s->over_warn);
   }
   if (k->provenance_diff) {
-    bb_json_open(&j, "provenance_diff", '[');
+    bb__json_open(&j, "provenance_diff", '[');
     for (const char *line = k->provenance_diff; *line;) {
       const size_t n = strcspn(line, "\n");
       char *one = strndup(line, n);
-      bb_json_string(&j, NULL, one ? one : "");
+      bb__json_string(&j, NULL, one ? one : "");
       free(one);
       line += n + (line[n] == '\n');
     }
-    bb_json_close(&j, ']');
+    bb__json_close(&j, ']');
   }
   if (k->message[0])
-    bb_json_string(&j, "message", k->message);
-  bb_json_bool(&j, "updated", k->updated);
+    bb__json_string(&j, "message", k->message);
+  bb__json_bool(&j, "updated", k->updated);
   if (k->update_error)
-    bb_json_string(&j, "update_error", k->update_error);
-  bb_json_number(&j, "seconds", k->seconds);
-  bb_json_close(&j, '}');
+    bb__json_string(&j, "update_error", k->update_error);
+  bb__json_number(&j, "seconds", k->seconds);
+  bb__json_close(&j, '}');
   fputc('\n', f);
 }
 
@@ -583,18 +586,18 @@ char *bb_check_summary_lines(const bb_check *c) {
   if (!stream_open(&s))
     return NULL;
   if (c->setup.json) {
-    bb_json j = {s.f, 0};
-    bb_json_open(&j, NULL, '{');
-    bb_json_string(&j, "summary", "check");
-    bb_json_int(&j, "maps", c->count);
+    bb__json j = {s.f, 0};
+    bb__json_open(&j, NULL, '{');
+    bb__json_string(&j, "summary", "check");
+    bb__json_int(&j, "maps", c->count);
     static const char *const keys[] = {"passed",         "warnings",   "failures",
                                        "different_size", "unreadable", "missing",
                                        "extra"};
     for (int k = 0; k <= BB_CHECK_EXTRA; k++)
-      bb_json_int(&j, keys[k], counts[k]);
-    bb_json_int(&j, "updated", updated);
-    bb_json_int(&j, "exit", bb_check_exit_code(c));
-    bb_json_close(&j, '}');
+      bb__json_int(&j, keys[k], counts[k]);
+    bb__json_int(&j, "updated", updated);
+    bb__json_int(&j, "exit", bb_check_exit_code(c));
+    bb__json_close(&j, '}');
     fputc('\n', s.f);
     return stream_take(&s);
   }

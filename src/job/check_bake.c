@@ -8,6 +8,7 @@
 #include "image/oiio.h"
 #include "job/check.h"
 #include "job/job_internal.h"
+#include "texture/texture.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -98,7 +99,7 @@ static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *re
   bb_error e = {{0}};
   char why[sizeof e.message + 64] = "";
   const bb_image *map = bb_bake_result_image(result, (bb_map_kind)kind);
-  bb_status made = bb_path_is_texture_format(path)
+  bb_status made = bb__path_is_texture_format(path)
                        ? texture_as_read(job, path, info->name, map, info->range, depth,
                                          description, &fresh, &e)
                        : bb__image_as_read(path, map, depth, info->range, &fresh, &e);
@@ -148,7 +149,7 @@ static bb_status unbaked_cases(bb_check *c, int i, const bb_error *why,
     if (!path)
       continue;
     bb__check_case *kc = bb__check_case_new(path + skip + 1, path, job->items[i].input,
-                                            bb_map_kind_name((bb_map_kind)k));
+                                            bb__map_kind_name((bb_map_kind)k));
     const bb__check_sides none = {0};
     st = kc ? bb__check_decide(c, kc, &none, BB_CHECK_UNREADABLE, why->message, err)
             : bb__fail(err, BB_ERR_MEMORY, "out of memory");

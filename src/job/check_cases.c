@@ -7,6 +7,8 @@
 #include "core/internal.h"
 #include "job/check.h"
 #include "job/job_internal.h"
+#include "files/provenance.h"
+#include "maps/maps_internal.h"
 
 #include <fnmatch.h>
 #include <limits.h>
@@ -50,7 +52,7 @@ bb_status bb__check_new(bb__check_setup *setup, bb_check **out, bb_error *err) {
   if (c->html) { /* the pictures go to DIR/img as the cases are decided */
     char img[PATH_MAX];
     snprintf(img, sizeof img, "%s/img", c->html);
-    st = bb_directory_create(img, err);
+    st = bb__directory_create(img, err);
   }
   if (st != BB_OK) {
     bb_check_free(c);
@@ -194,7 +196,7 @@ bb__check_case *bb__check_case_new(const char *name, const char *golden,
     bb__check_case_free(k);
     return NULL;
   }
-  bb_compare_limits_init(&k->pub.limits);
+  bb__compare_limits_init(&k->pub.limits);
   publish(k);
   return k;
 }
@@ -226,7 +228,7 @@ static char *provenance_diff(const char *golden, const char *fresh) {
     return NULL;
   const size_t cap = strlen(golden) + strlen(fresh) + 1024;
   char *out = malloc(cap);
-  if (out && bb_provenance_diff(golden, fresh, out, cap) < 0) {
+  if (out && bb__provenance_diff(golden, fresh, out, cap) < 0) {
     free(out);
     out = NULL;
   }
@@ -236,8 +238,8 @@ static char *provenance_diff(const char *golden, const char *fresh) {
 /* The kind a case's files record ("output"), the new one's first. */
 static void kind_from(const bb__check_sides *s, char *kind, size_t cap) {
   kind[0] = '\0';
-  if (!bb_provenance_value(s->fresh_text, "output", kind, cap))
-    bb_provenance_value(s->golden_text, "output", kind, cap);
+  if (!bb__provenance_value(s->fresh_text, "output", kind, cap))
+    bb__provenance_value(s->golden_text, "output", kind, cap);
 }
 
 bb_status bb__check_decide(bb_check *c, bb__check_case *k, const bb__check_sides *s,
@@ -263,11 +265,11 @@ bb_status bb__check_decide(bb_check *c, bb__check_case *k, const bb__check_sides
     status = BB_CHECK_DIFFERENT_SIZE;
   if (status == BB_CHECK_PASS && s->golden && s->fresh) {
     const bb_compare_limits *l = &k->pub.limits;
-    bb_status st = bb_compare_images(s->golden, s->fresh, l->fail, l->warn, &k->pub.stats,
+    bb_status st = bb__compare_images(s->golden, s->fresh, l->fail, l->warn, &k->pub.stats,
                                      NULL, err);
     if (st != BB_OK)
       return st;
-    switch (bb_compare_judge(&k->pub.stats, l)) {
+    switch (bb__compare_judge(&k->pub.stats, l)) {
     case BB_COMPARE_PASS:
       status = BB_CHECK_PASS;
       break;

@@ -11,6 +11,7 @@
  * root scale whose white is the largest finite difference. */
 #include "core/internal.h"
 #include "job/check.h"
+#include "image/image_write.h"
 
 #include <dirent.h>
 #include <limits.h>
@@ -63,7 +64,7 @@ static void shown(const bb_image *img, int signed_raw, int x, int y, float rgb[3
 }
 
 /* The largest difference of any channel at texel i: a NaN against a number
- * is infinite, two NaNs equal (as bb_compare_images counts them). */
+ * is infinite, two NaNs equal (as bb__compare_images counts them). */
 static double texel_difference(const bb_image *a, const bb_image *b, size_t i) {
   double worst = 0;
   for (int c = 0; c < a->channels; c++) {
@@ -173,7 +174,7 @@ static bb_status write_png(const char *dir, const char *name, const bb_image *im
   if ((size_t)snprintf(path, sizeof path, "%s/%s", dir, name) >= sizeof path)
     return bb__fail(err, BB_ERR_IO, "%s: the path is too long", dir);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
-  return bb_image_write(path, img, &wo, err);
+  return bb__image_write(path, img, &wo, err);
 }
 
 /* ---------------------------------------------------------- thumbnails */

@@ -11,6 +11,7 @@
  * nothing. */
 #include "core/internal.h"
 #include "job/check.h"
+#include "files/safe_file.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -78,7 +79,7 @@ static bb_status write_text(const char *path, bb__text *t, bb_error *err) {
     bb__text_free(t);
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   }
-  bb_status st = bb_file_write(path, t->data ? t->data : "", t->length, err);
+  bb_status st = bb__file_write(path, t->data ? t->data : "", t->length, err);
   bb__text_free(t);
   return st;
 }

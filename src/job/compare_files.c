@@ -3,6 +3,8 @@
 #include "core/internal.h"
 #include "image/formats.h"
 #include "job/job_internal.h"
+#include "files/provenance.h"
+#include "maps/maps_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -49,7 +51,7 @@ static void compare_provenance(const bb_image_info *ia, const bb_image_info *ib,
   if (!r->provenance_diff)
     return;
   r->provenance_differences =
-      bb_provenance_diff(ia->description, ib->description, r->provenance_diff, cap);
+      bb__provenance_diff(ia->description, ib->description, r->provenance_diff, cap);
   if (r->provenance_differences < 0) {
     free(r->provenance_diff);
     r->provenance_diff = NULL;
@@ -110,10 +112,10 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
   memset(report, 0, sizeof *report);
   report->provenance_differences = -1;
   bb_compare_limits defaults;
-  bb_compare_limits_init(&defaults);
+  bb__compare_limits_init(&defaults);
   if (!limits)
     limits = &defaults;
-  bb_status checked = bb_compare_limits_check(limits, err);
+  bb_status checked = bb__compare_limits_check(limits, err);
   if (checked != BB_OK)
     return checked;
   bb_image x = {0}, y = {0};
@@ -133,11 +135,11 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
   }
   bb_image diff = {0};
   if (st == BB_OK && report->same_shape) {
-    st = bb_compare_images(&x, &y, limits->fail, limits->warn, &report->stats,
+    st = bb__compare_images(&x, &y, limits->fail, limits->warn, &report->stats,
                            diff_path ? &diff : NULL, err);
     if (st == BB_OK) {
       compare_provenance(&ix, &iy, report);
-      report->verdict = bb_compare_judge(&report->stats, limits);
+      report->verdict = bb__compare_judge(&report->stats, limits);
       if (diff_path)
         report->diff_written = write_diff(diff_path, &diff, &report->diff_error) == BB_OK;
     }

@@ -4,6 +4,13 @@
  * writes a bake's options with the words the commands read
  * (bake_rows.c). */
 #include "job/bake_rows.h"
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "image/height_channel.h"
+#include "image/oiio.h"
+#include "mesh/mesh_internal.h"
+#include "render/render_internal.h"
+#include "texture/texture.h"
 
 #include <string.h>
 
@@ -19,15 +26,15 @@
 
 _Static_assert(sizeof(bb_normal_filter) == sizeof(int), "enums are stored as int");
 
-ENUM_WORDS(normal_filter, bb_normal_filter, bb_normal_filter_parse, bb_normal_filter_name)
-ENUM_WORDS(channel, bb_channel, bb_channel_parse, bb_channel_name)
-ENUM_WORDS(texture_format, bb_texture_format, bb_texture_format_parse, bb_texture_format_name)
-ENUM_WORDS(render_mode, bb_render_mode, bb_render_mode_parse, bb_render_mode_name)
-ENUM_WORDS(albedo_mode, bb_albedo_mode, bb_albedo_mode_parse, bb_albedo_mode_name)
-ENUM_WORDS(axis, bb_axis, bb_axis_parse, bb_axis_name)
+ENUM_WORDS(normal_filter, bb_normal_filter, bb__normal_filter_parse, bb_normal_filter_name)
+ENUM_WORDS(channel, bb_channel, bb_channel_parse, bb__channel_name)
+ENUM_WORDS(texture_format, bb_texture_format, bb_texture_format_parse, bb__texture_format_name)
+ENUM_WORDS(render_mode, bb_render_mode, bb__render_mode_parse, bb__render_mode_name)
+ENUM_WORDS(albedo_mode, bb_albedo_mode, bb__albedo_mode_parse, bb__albedo_mode_name)
+ENUM_WORDS(axis, bb_axis, bb__axis_parse, bb_axis_name)
 
 /* --depth: "default" is no word of its own */
-const char *bb__name_depth(int i) { return bb_depth_name((bb_depth)i); }
+const char *bb__name_depth(int i) { return bb__depth_name((bb_depth)i); }
 int bb__parse_depth(const char *text, int *value) {
   bb_depth d;
   if (bb_depth_parse(text, &d, NULL) != BB_OK)
@@ -41,18 +48,18 @@ int bb__parse_normal_y(const char *text, int *value) {
   return bb_normal_y_parse(text, value, NULL) == BB_OK;
 }
 
-/* Map kinds as words: the library's names and parser (bb_map_kind_name,
- * bb_map_kind_parse), each option taking its own kinds; "" names a kind the
+/* Map kinds as words: the library's names and parser (bb__map_kind_name,
+ * bb__map_kind_parse), each option taking its own kinds; "" names a kind the
  * option does not take. */
 #define KIND_WORDS(stem, kinds)                                                         \
   const char *bb__name_##stem(int i) {                                                   \
     if (i < 0 || i >= BB_MAP_KIND_COUNT)                                                 \
       return NULL;                                                                       \
-    return ((kinds) & BB_MAP_BIT(i)) ? bb_map_kind_name((bb_map_kind)i) : "";            \
+    return ((kinds) & BB_MAP_BIT(i)) ? bb__map_kind_name((bb_map_kind)i) : "";            \
   }                                                                                      \
   int bb__parse_##stem(const char *text, int *value) {                                   \
     bb_map_kind k;                                                                       \
-    if (bb_map_kind_parse(text, &k, NULL) != BB_OK || !((kinds) & BB_MAP_BIT(k)))        \
+    if (bb__map_kind_parse(text, &k, NULL) != BB_OK || !((kinds) & BB_MAP_BIT(k)))        \
       return 0;                                                                          \
     *value = (int)k;                                                                     \
     return 1;                                                                            \

@@ -5,6 +5,7 @@
 #include "core/internal.h"
 #include "image/height_channel.h"
 #include "job/job_internal.h"
+#include "image/formats.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -73,7 +74,7 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
   source->bits_per_sample = loaded.bits_per_sample;
   source->is_float = loaded.is_float;
   snprintf(source->format_name, sizeof source->format_name, "%s", loaded.format_name);
-  source->height_hash = bb_image_hash(height);
+  source->height_hash = bb__image_hash(height);
   say(note, note_user, path, loaded.note);
   note_input(&loaded, height_scale, note, note_user, path);
   return BB_OK;
@@ -86,10 +87,10 @@ const char *bb_height_source_channel(const bb_height_source *source) {
   if (source->grey && (source->channel == BB_CHANNEL_MEAN || source->channel == BB_CHANNEL_LUMA ||
                        source->channel == BB_CHANNEL_AUTO))
     return "grey";
-  return bb_channel_name(source->channel);
+  return bb__channel_name(source->channel);
 }
 
-bb_depth bb_depth_like_input(int bits_per_sample, int is_float, const char *path) {
+bb_depth bb__depth_like_input(int bits_per_sample, int is_float, const char *path) {
   /* The closest the format holds, from the input's own depth downwards. */
   static const bb_depth float_order[] = {BB_DEPTH_FLOAT, BB_DEPTH_HALF, BB_DEPTH_16};
   static const bb_depth half_order[] = {BB_DEPTH_HALF, BB_DEPTH_FLOAT, BB_DEPTH_16};
@@ -103,7 +104,7 @@ bb_depth bb_depth_like_input(int bits_per_sample, int is_float, const char *path
   else if (bits_per_sample > 8)
     order = int16_order, n = 2;
   for (size_t i = 0; i < n; i++)
-    if (bb_path_supports_depth(path, order[i]))
+    if (bb__path_supports_depth(path, order[i]))
       return order[i];
   return BB_DEPTH_DEFAULT;
 }

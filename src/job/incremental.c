@@ -15,6 +15,8 @@
 #include "image/oiio.h"
 #include "files/provenance.h"
 #include "trace/rayset.h"
+#include "job/job_internal.h"
+#include "texture/texture.h"
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -78,7 +80,7 @@ bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err) {
 
 /* ----------------------------------------------------------------- check */
 
-void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
+void bb__bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
   if (!out || !cap)
     return;
   out[0] = '\0';
@@ -88,7 +90,7 @@ void bb_bake_rayset_id(const bb_bake_options *o, char *out, size_t cap) {
   bb__rayset_id(prepared.slices, o->power, &o->basis, out, cap);
 }
 
-/* The depth a file's samples have, as bb_image_write would have asked for
+/* The depth a file's samples have, as bb__image_write would have asked for
  * it; -1 for anything it does not write. */
 static int depth_of(const bb_image_info *info) {
   if (info->is_float)
@@ -185,7 +187,7 @@ bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_de
   } else {
     /* A texture's layout (format, mips, VTF flags) is in its provenance. */
     if (provenance_matches(&info, want, reason, cap) &&
-        (bb_path_is_texture_format(path) ||
+        (bb__path_is_texture_format(path) ||
          layout_matches(path, &info, depth, mip_mapped, reason, cap)))
       *state = BB_OUTPUT_CURRENT;
     bb_image_info_free(&info);

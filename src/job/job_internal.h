@@ -115,7 +115,7 @@ bb_status bb__job_memory_check(const bb_job *job, const bb__job_item *item, bb_e
 int bb__job_reads(const bb_job *job, const bb__job_item *item, const char **out);
 
 /* The settings a .vtf or .dds output of kind and range is written with:
- * given's (NULL: the defaults), the map set by bb_texture_options_for
+ * given's (NULL: the defaults), the map set by bb__texture_options_for
  * (paths.c). */
 bb_texture_options bb__job_texture_of(const bb_texture_options *given, const char *kind,
                                       bb_range range);
@@ -205,7 +205,7 @@ typedef struct bb__job_source {
   const char *command;          /* the command line the output records */
   const char *input;            /* the input's path (its file name is recorded), or NULL */
   const char *input_text;       /* else an input recorded as it is (a program's text) */
-  uint64_t input_hash;          /* bb_image_hash of the input's pixels, 0: none */
+  uint64_t input_hash;          /* bb__image_hash of the input's pixels, 0: none */
   uint64_t input_file_hash;     /* bb_file_hash of its bytes, 0: unknown */
   const bb_bake_options *bake;  /* the bake's, when a height was baked */
   bb_channel channel;           /* the height's channel rule, when baked */
@@ -239,7 +239,7 @@ typedef struct bb__job_output {
   const bb_texture_options *texture; /* a .vtf's or .dds's settings, or NULL */
 } bb__job_output;
 
-/* o's path (or, frames > 0, every frame's: bb_render_frame_path; a .gif
+/* o's path (or, frames > 0, every frame's: bb__render_frame_path; a .gif
  * path is one animation) checked before any work (bb_outputs_check): its
  * format, depth and mips, its directory, and that it is none of the
  * reads[0..read_count-1] under any spelling. */
@@ -284,7 +284,7 @@ typedef struct bb__job_frames {
   void *user;
 } bb__job_frames;
 
-/* The picture, or an orbit's frames (bb_render_frame_path's names; a .gif
+/* The picture, or an orbit's frames (bb__render_frame_path's names; a .gif
  * path: one animation), each staged as it is made, then all put in place
  * together or none. *written (malloc'd paths, *count of them) and *kind
  * ("orbit" for an animation, else o->kind) say what was written. */
@@ -306,5 +306,56 @@ int bb__renderbump_outputs(const char *normal_path, const char *height_path,
  * (compare_files.c): float in .exr (raw differences), the format's depth
  * elsewhere (scaled to a maximum of 1); no provenance. */
 bb__job_output bb__compare_diff_output(const char *path);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* 1 when a and b name the same file: the same device and inode when both
+ * exist (symbolic and hard links, "./", ".."), else the same name in the
+ * same directory (by the directory's device and inode), else the same
+ * spelling. */
+int bb__same_file(const char *a, const char *b);
+
+/* Creates directory path and its missing parents (mode 0777 less the
+ * umask), as mkdir -p. An existing directory is fine. Errors: BB_ERR_IO
+ * ("PATH: cannot create directory: REASON"; a part that is a file). */
+bb_status bb__directory_create(const char *path, bb_error *err);
+
+/* Renames count staged files (bb__image_write_staged_all_cores, ...) into place in
+ * order, as bb_outputs_write does with its set: the process's ending by a
+ * signal waits for the last rename (bb_signal_cleanup). Every handle is
+ * freed, committed or discarded: when a rename fails, the files after it
+ * are discarded and the message says which were already replaced ("PATH:
+ * reason; already written: KIND PATH, ..." with kinds[i], which may be
+ * NULL). For sets too large to hold in memory at once, such as an
+ * orbit's frames: stage each, then commit them together. */
+bb_status bb__staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
+                                 bb_error *err);
+
+/* Writes a flat render bump's files together or neither (bb_outputs_write):
+ * the normal map at normal_path (RGB = N as bumpbake stores normal maps:
+ * 0.5 + 0.5 N in integer files, N in float ones; alpha = the coverage as it
+ * is; green flipped for normal_y_up) and, when height_path is not NULL,
+ * the height (16-bit where the format holds it). Each records provenance:
+ * command, the model's file name and bb__mesh_hash (model_hash), its kind
+ * ("normal+coverage", "height"), bb__renderbump_describe's keys and
+ * normal_y. Errors as bb_outputs_write's. */
+bb_status bb__renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
+                              int normal_y_up, const char *model, uint64_t model_hash,
+                              const char *command, const char *normal_path,
+                              const char *height_path, bb_error *err);
+
+/* The depth nearest an input's (bits_per_sample, is_float) that path's
+ * format holds, for outputs that are the height itself: 16 bits for a
+ * 16-bit input, float or half for a float or half input; BB_DEPTH_DEFAULT
+ * for an 8-bit input or when the format holds nothing deeper (TGA). */
+bb_depth bb__depth_like_input(int bits_per_sample, int is_float, const char *path);
+
+/* The rayset id bb_bake records in result->rayset_id for options o (slices
+ * from o->slices, or from o->rays; power; basis), computed without building
+ * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
+ * any id). "" when o->outputs asks for no traced kind: nothing is traced
+ * then, and provenance says rayset=none. */
+void bb__bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
 
 #endif /* BB_JOB_INTERNAL_H */

@@ -6,6 +6,7 @@
 #include "core/internal.h"
 #include "texture/texture.h"
 #include "job/job_internal.h"
+#include "image/formats.h"
 
 #include <stdio.h>
 
@@ -15,7 +16,7 @@ static double sample_bytes(bb_depth depth, const char *path) {
   case BB_DEPTH_8: return 1.0;
   case BB_DEPTH_16: case BB_DEPTH_HALF: return 2.0;
   case BB_DEPTH_FLOAT: return 4.0;
-  default: return bb_path_max_channels(path) == 4 ? 1.0 : 4.0; /* png/tga 8-bit; exr float */
+  default: return bb__path_max_channels(path) == 4 ? 1.0 : 4.0; /* png/tga 8-bit; exr float */
   }
 }
 
@@ -55,7 +56,7 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
     const bb_map_kind_info *kind = bb_map_kind_get((bb_map_kind)kinds[f]);
     const int c = kind->channels ? kind->channels : o->basis.count;
     const double samples = t * c;
-    if (bb_path_is_texture_format(paths[f])) {
+    if (bb__path_is_texture_format(paths[f])) {
       encode += texture_bytes(job, paths[f], kind, w, h, c);
       continue;
     }
@@ -67,7 +68,7 @@ double bb__job_memory(const bb_job *job, const bb__job_item *item, int w, int h,
     kept += 2 * texel, encode += 2 * t;
   if (job->valve_path) { /* Valve's RGBA file, and for -d the colour read again */
     kept += 4 * texel;
-    encode += bb_path_is_texture_format(job->valve_path)
+    encode += bb__path_is_texture_format(job->valve_path)
                   ? 4.0 * 4.0 * t * 4.0 / 3.0 + 4.0 * t
                   : 4.0 * t * sample_bytes(job->options.depth, job->valve_path);
     if (job->options.valve_detail)

@@ -9,6 +9,10 @@
  * paths.c). */
 #include "core/internal.h"
 #include "job/job_internal.h"
+#include "files/safe_file.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "render/render_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -33,7 +37,7 @@ char *bb__job_describe(const bb__job_source *s, const char *kind) {
 }
 
 bb_depth bb__job_depth(bb_depth asked, int bits_per_sample, int is_float, const char *path) {
-  return asked != BB_DEPTH_DEFAULT ? asked : bb_depth_like_input(bits_per_sample, is_float, path);
+  return asked != BB_DEPTH_DEFAULT ? asked : bb__depth_like_input(bits_per_sample, is_float, path);
 }
 
 static bb_depth depth_of(const bb__job_output *o) {
@@ -86,9 +90,9 @@ bb_status bb__job_write(const bb__job_output *o, const bb_image *img, const bb__
 static int is_gif(const char *path) { return bb__path_has_extension(path, "gif"); }
 
 /* What bb_outputs_check checks of o written at path (o's, or a frame's).
- * A GIF animation is written by the animation writer, not bb_image_write:
+ * A GIF animation is written by the animation writer, not bb__image_write:
  * its name is checked as a file's, its format by the command; a .gif that
- * is not an animation is refused as bb_image_write refuses it. */
+ * is not an animation is refused as bb__image_write refuses it. */
 static bb_output_spec spec_of(const bb__job_output *o, const char *path, int animation) {
   return (bb_output_spec){.path = path,
                           .kind = o->kind,
@@ -122,7 +126,7 @@ bb_status bb__job_output_check(const bb__job_output *o, int frames, const char *
   char **names = calloc((size_t)frames, sizeof *names);
   bb_status st = specs && names ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
   for (int f = 0; f < frames && st == BB_OK; f++) {
-    if (!(names[f] = bb_render_frame_path(o->path, f, frames)))
+    if (!(names[f] = bb__render_frame_path(o->path, f, frames)))
       st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
     else
       specs[f] = spec_of(o, names[f], 1);
@@ -152,7 +156,7 @@ static bb_status stage_frame(const bb__job_output *o, const bb__job_frames *f, i
   if (st == BB_OK) {
     const bb_write_options wo = {o->depth, o->range, text, NULL};
     bb_error e = {{0}};
-    if ((st = bb_image_write_staged(path, &picture, &wo, staged, &e)) != BB_OK)
+    if ((st = bb__image_write_staged_all_cores(path, &picture, &wo, staged, &e)) != BB_OK)
       bb__fail_at(err, st, path, &e);
   }
   free(text);
@@ -174,16 +178,16 @@ static bb_status write_files(const bb__job_output *o, const bb__job_frames *f, c
                      ? BB_OK
                      : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->path);
   for (int i = 0; i < n && st == BB_OK; i++) {
-    paths[i] = f->frames ? bb_render_frame_path(o->path, i, f->frames) : strdup(o->path);
+    paths[i] = f->frames ? bb__render_frame_path(o->path, i, f->frames) : strdup(o->path);
     kinds[i] = o->kind;
     st = paths[i] ? stage_frame(o, f, i, paths[i], &staged[i], err)
                   : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", o->path);
   }
   if (st == BB_OK)
-    st = bb_staged_files_commit(staged, kinds, n, err);
+    st = bb__staged_files_commit(staged, kinds, n, err);
   for (int i = 0; staged && i < n; i++)
     if (st != BB_OK)
-      bb_staged_file_discard(staged[i]);
+      bb__staged_file_discard(staged[i]);
   free(kinds);
   free(staged);
   if (st != BB_OK) {
@@ -198,7 +202,7 @@ static bb_status write_files(const bb__job_output *o, const bb__job_frames *f, c
 }
 
 /* An orbit as one GIF (no provenance: GIF stores none), made and put in
- * place by bb_animation_close. */
+ * place by bb__animation_close. */
 static bb_status write_gif(const bb__job_output *o, const bb__job_frames *f, char ***written,
                            int *count, bb_error *err) {
   bb_animation *anim = NULL;
@@ -208,18 +212,18 @@ static bb_status write_gif(const bb__job_output *o, const bb__job_frames *f, cha
     bb_image picture = {0};
     st = f->make(f->user, i, &picture, NULL, err);
     if (st == BB_OK && !anim)
-      st = bb_animation_open(o->path, picture.width, picture.height, 10.0, &anim, &e);
+      st = bb__animation_open(o->path, picture.width, picture.height, 10.0, &anim, &e);
     if (st == BB_OK)
-      st = bb_animation_add_frame(anim, &picture, &e);
+      st = bb__animation_add_frame(anim, &picture, &e);
     if (st != BB_OK && e.message[0])
       bb__fail_at(err, st, o->path, &e);
     bb_image_free(&picture);
   }
   if (st != BB_OK) {
-    bb_animation_abort(anim);
+    bb__animation_abort(anim);
     return st;
   }
-  if ((st = bb_animation_close(anim, &e)) != BB_OK)
+  if ((st = bb__animation_close(anim, &e)) != BB_OK)
     return bb__fail_at(err, st, o->path, &e);
   char **paths = malloc(sizeof *paths);
   if (!paths || !(paths[0] = strdup(o->path))) {

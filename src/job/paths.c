@@ -5,6 +5,8 @@
 #include "files/safe_file.h"
 #include "image/formats.h"
 #include "job/job_internal.h"
+#include "image/oiio.h"
+#include "texture/texture.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -77,7 +79,7 @@ char *bb__job_valve_weights_name(const char *input) {
 
 /* ------------------------------------------------------------ same file */
 
-int bb_same_file(const char *a, const char *b) {
+int bb__same_file(const char *a, const char *b) {
   if (!a || !b)
     return 0;
   const bb__file_identity ia = bb__file_identify(a), ib = bb__file_identify(b);
@@ -86,7 +88,7 @@ int bb_same_file(const char *a, const char *b) {
 
 /* ----------------------------------------------------------- directories */
 
-bb_status bb_directory_create(const char *path, bb_error *err) {
+bb_status bb__directory_create(const char *path, bb_error *err) {
   if (!path || !*path)
     return bb__fail(err, BB_ERR_ARGUMENT, "no directory name given");
   char buf[PATH_MAX];
@@ -141,7 +143,7 @@ bb_texture_options bb__job_texture_of(const bb_texture_options *given, const cha
     t = *given;
   else
     bb_texture_options_init(&t);
-  bb_texture_options_for(&t, kind, range);
+  bb__texture_options_for(&t, kind, range);
   return t;
 }
 
@@ -149,21 +151,21 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
   char ext[17]; /* ".ext" (bb__extension_of), 15 characters of it at most */
   bb__extension_of(o->path, ext, sizeof ext);
   if (late) {
-    if (o->mips && !bb_path_supports_mips(o->path))
+    if (o->mips && !bb__path_supports_mips(o->path))
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: --mips needs a .tif or .exr output", o->path);
-    const int room = bb_path_max_channels(o->path);
+    const int room = bb__path_max_channels(o->path);
     if (o->channels > room)
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: %s has %d channels and %s files hold at most %d (write it as "
                       ".exr or .tif)",
                       o->path, o->kind ? o->kind : "the image", o->channels, ext, room);
-    if (bb_path_is_texture_format(o->path) && o->width > 0 && o->channels > 0) {
+    if (bb__path_is_texture_format(o->path) && o->width > 0 && o->channels > 0) {
       const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
-      return bb_texture_check(o->path, o->width, o->height, o->channels, &t, err);
+      return bb__texture_check(o->path, o->width, o->height, o->channels, &t, err);
     }
     return BB_OK;
   }
-  if (!bb_path_is_writable_format(o->path)) {
+  if (!bb__path_is_writable_format(o->path)) {
     if (!ext[0] || !ext[1]) /* none, or a bare dot */
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: no extension to choose the format by (use .png, .tga, .tif, "
@@ -174,10 +176,10 @@ static bb_status check_format(const bb_output_spec *o, int late, bb_error *err) 
                     "or .dds)",
                     o->path, ext);
   }
-  if (!bb_path_supports_depth(o->path, o->depth))
+  if (!bb__path_supports_depth(o->path, o->depth))
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: --depth %s is not available in %s files%s",
-                    o->path, bb_depth_name(o->depth), ext,
-                    bb_path_is_texture_format(o->path) ? " (their texture format sets it)" : "");
+                    o->path, bb__depth_name(o->depth), ext,
+                    bb__path_is_texture_format(o->path) ? " (their texture format sets it)" : "");
   return BB_OK;
 }
 

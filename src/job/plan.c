@@ -9,6 +9,10 @@
 #include "image/formats.h"
 #include "job/job_internal.h"
 #include "render/render_internal.h"
+#include "files/provenance.h"
+#include "image/height_channel.h"
+#include "image/oiio.h"
+#include "texture/texture.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -90,7 +94,7 @@ static int is_baked_map(const char *path) {
   char kind[64];
   int baked = 0;
   if (bb_provenance_classify(info.description) != BB_PROVENANCE_NONE &&
-      bb_provenance_value(info.description, "output", kind, sizeof kind))
+      bb__provenance_value(info.description, "output", kind, sizeof kind))
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       baked |= strcmp(kind, kind_name(k)) == 0;
   bb_image_info_free(&info);
@@ -128,7 +132,7 @@ static bb_status read_directory(const char *dir, char ***names, int *count, bb_e
     return bb__fail(err, BB_ERR_IO, "%s: %s", dir, strerror(errno));
   int capacity = 0, failed = 0;
   for (struct dirent *e; !failed && (e = readdir(d));) {
-    if (e->d_name[0] == '.' || !bb_path_is_readable_format(e->d_name))
+    if (e->d_name[0] == '.' || !bb__path_is_readable_format(e->d_name))
       continue;
     if (*count == capacity) {
       capacity = capacity ? 2 * capacity : 32;
@@ -365,7 +369,7 @@ static bb_status check_batch_paths(const bb_job *job, bb_error *err) {
  * hold 4, so "hl2+z" still fits RGBA. */
 static bb_status check_channels(const bb_job *job, const char *path, int kind, bb_error *err) {
   const bb_basis *basis = &job->options.bake.basis;
-  const int room = bb_path_max_channels(path);
+  const int room = bb__path_max_channels(path);
   if (bb_map_kind_get((bb_map_kind)kind)->channels != 0 || basis->count <= room)
     return BB_OK;
   char ext[17];
@@ -391,7 +395,7 @@ static void texture_input_size(const bb__job_item *item, int *width, int *height
   *width = *height = 0;
   int textures = 0;
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    textures |= item->paths[k] && bb_path_is_texture_format(item->paths[k]);
+    textures |= item->paths[k] && bb__path_is_texture_format(item->paths[k]);
   if (textures && bb_image_read_info(item->input, width, height, NULL, NULL, NULL) != BB_OK)
     *width = *height = 0;
 }
@@ -413,12 +417,12 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
         map_paths[f], kind_name(k),
         /* the basis message below is the clearer one
            for other formats */
-        bb_path_is_texture_format(map_paths[f]) ? kind_channels(job, k) : 0,
+        bb__path_is_texture_format(map_paths[f]) ? kind_channels(job, k) : 0,
         job->options.depth, job->options.mips, 0, width, height,
         bb_map_kind_get((bb_map_kind)k)->range, &job->options.texture};
   }
   if (job->valve_path) {
-    if (!width && bb_path_is_texture_format(job->valve_path) &&
+    if (!width && bb__path_is_texture_format(job->valve_path) &&
         bb_image_read_info(item->input, &width, &height, NULL, NULL, NULL) != BB_OK)
       width = height = 0;
     kinds[n] = -1;
@@ -428,7 +432,7 @@ static bb_status check_item_outputs(const bb_job *job, const bb__job_item *item,
   }
   if (job->slope_path) {
     /* The slope map is its bytes: 8-bit, no mips; its preview a picture. */
-    if (!bb_path_supports_depth(job->slope_path, BB_DEPTH_8))
+    if (!bb__path_supports_depth(job->slope_path, BB_DEPTH_8))
       return bb__fail(err, BB_ERR_ARGUMENT,
                       "%s: the slope map is one byte per texel: use .png, .tga or .tif",
                       job->slope_path);
@@ -483,10 +487,10 @@ static bb_status check_depfile(const bb_job *job, bb_error *err) {
     if (st != BB_OK)
       return st;
     for (int p = 0; p < rule.prerequisite_count; p++)
-      if (bb_same_file(prereq[p], path))
+      if (bb__same_file(prereq[p], path))
         return bb__refuse_output_over_input(err, path, prereq[p]);
     for (int k = 0; k < t; k++)
-      if (bb_same_file(targets[k], path))
+      if (bb__same_file(targets[k], path))
         return bb__fail(err, BB_ERR_ARGUMENT, "--depfile %s is also an output of the bake",
                         path);
   }
@@ -562,7 +566,7 @@ static bb_status check_single(const bb_job_options *o, const char *const *inputs
     return bb__fail(err, BB_ERR_ARGUMENT, "%s is for batches: give --out-dir DIR", batch_only);
   if (o->slope_lit && !o->slope_path)
     return bb__fail(err, BB_ERR_ARGUMENT, "--lit previews the slope map: give --slope FILE too");
-  /* bb_light_direction takes any angle; above 90 degrees the light would
+  /* bb__light_direction takes any angle; above 90 degrees the light would
    * come from under the surface. */
   if (o->slope_lit && !isfinite(o->slope_lit_azimuth))
     return bb__fail(err, BB_ERR_ARGUMENT, "--lit azimuth must be finite (got %g)",
@@ -608,7 +612,7 @@ static bb_status check_options(const bb_job_options *o, const char *const *input
   if ((o->vmt_materials || o->vmt_basetexture) && !o->vmt)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "--materials and --basetexture name a material's paths: give --vmt FILE");
-  if (strcmp(bb_channel_name(o->channel), "unknown") == 0)
+  if (strcmp(bb__channel_name(o->channel), "unknown") == 0)
     return bb__fail(err, BB_ERR_ARGUMENT, "unknown height channel %d", (int)o->channel);
   if ((int)o->depth < BB_DEPTH_DEFAULT || o->depth > BB_DEPTH_FLOAT)
     return bb__fail(err, BB_ERR_ARGUMENT, "unknown depth %d", (int)o->depth);
@@ -785,9 +789,9 @@ static bb_status plan_material(bb_job *job, bb_error *err) {
                     "--vmt %s: a material needs a .vtf bump map: write --ssbump (or --normal) "
                     "as a .vtf file",
                     job->vmt);
-  /* bb_vmt_text checks the material's own name (.vmt, no texture's). */
+  /* bb__vmt_text checks the material's own name (.vmt, no texture's). */
   const bb_vmt_options v = {job->vmt_materials, bump, job->vmt_basetexture, is_ssbump};
-  return bb_vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
+  return bb__vmt_text(job->vmt, &v, &job->vmt_text, &job->vmt_size, err);
 }
 
 /* Creates path's directory and its parents when missing (mkdir -p). A name
@@ -802,7 +806,7 @@ static bb_status create_directory_of(const char *path, bb_error *err) {
   if (stat(dir, &s) == 0)
     return BB_OK;
   bb_error e = {{0}};
-  bb_status st = bb_directory_create(dir, &e);
+  bb_status st = bb__directory_create(dir, &e);
   return st == BB_OK ? BB_OK : bb__fail(err, st, "%s: cannot write: %s", path, e.message);
 }
 
@@ -810,7 +814,7 @@ static bb_status create_directory_of(const char *path, bb_error *err) {
  * template subfolders, a single input's named files' folders (as a batch
  * creates its out_dir; the depfile's folder is the build system's). */
 static bb_status create_directories(const bb_job *job, bb_error *err) {
-  bb_status st = job->out_dir ? bb_directory_create(job->out_dir, err) : BB_OK;
+  bb_status st = job->out_dir ? bb__directory_create(job->out_dir, err) : BB_OK;
   for (int i = 0; i < job->count && st == BB_OK; i++) {
     int kinds[BB_JOB_MAX_OUTPUTS];
     const char *paths[BB_JOB_MAX_OUTPUTS], *commands[BB_JOB_MAX_OUTPUTS];

@@ -9,6 +9,7 @@
  */
 
 #include "core/internal.h"
+#include "image/height_channel.h"
 
 #include <inttypes.h>
 #include <stdio.h>
@@ -54,7 +55,7 @@ static void put_int(bb__text *t, const char *key, long value) {
 }
 
 /* A bake's parameter, put only when the output's kind records it
- * (bb_map_kind_records: a normal map does not record the trace's). */
+ * (bb__map_kind_records: a normal map does not record the trace's). */
 typedef struct bake_keys {
   bb__text *t;
   const char *kind;
@@ -132,18 +133,18 @@ static void put_smoothing_and_tracing(const bake_keys *k, const bb_bake_options 
            o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");
   /* Inter-reflection and brightness only when used, so the provenance of
    * a bake without them (and its up-to-date check) stays as it was. Maps
-   * are named by bb_image_hash of their pixels as given. */
+   * are named by bb__image_hash of their pixels as given. */
   char hash[32];
   if (o->bounce_albedo > 0.0) {
     put_bake_double(k, "bounce", o->bounce_albedo);
     put_bake_int(k, "bounces", o->bounces);
     if (o->bounce_albedo_map) {
-      snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->bounce_albedo_map));
+      snprintf(hash, sizeof hash, "%016" PRIx64, bb__image_hash(o->bounce_albedo_map));
       put_bake(k, "bounce_albedo_map", hash);
     }
   }
   if (o->brightness) {
-    snprintf(hash, sizeof hash, "%016" PRIx64, bb_image_hash(o->brightness));
+    snprintf(hash, sizeof hash, "%016" PRIx64, bb__image_hash(o->brightness));
     put_bake(k, "brightness", hash);
   }
 }
@@ -176,7 +177,7 @@ char *bb_provenance_format(const bb_provenance *p) {
   } else {
     put(&t, "rayset", p->rayset_id ? p->rayset_id : "none");
   }
-  put(&t, "channel", bb_channel_name(p->channel));
+  put(&t, "channel", bb__channel_name(p->channel));
   if (p->extra) {
     /* Lines of the caller's, each ended by a newline. */
     size_t n = strlen(p->extra);

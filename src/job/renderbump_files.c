@@ -3,6 +3,8 @@
  * what made it. */
 #include "core/internal.h"
 #include "job/job_internal.h"
+#include "image/formats.h"
+#include "mesh/mesh_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,7 +16,7 @@
  * map. */
 int bb__renderbump_outputs(const char *normal_path, const char *height_path,
                            bb__job_output out[2]) {
-  const int integers = normal_path && bb_path_supports_depth(normal_path, BB_DEPTH_8);
+  const int integers = normal_path && bb__path_supports_depth(normal_path, BB_DEPTH_8);
   out[0] = (bb__job_output){.path = normal_path,
                             .kind = "normal",
                             .range = integers ? BB_RANGE_UNIT : BB_RANGE_SIGNED,
@@ -24,17 +26,17 @@ int bb__renderbump_outputs(const char *normal_path, const char *height_path,
   out[1] = (bb__job_output){.path = height_path,
                             .kind = "height",
                             .range = BB_RANGE_UNIT,
-                            .depth = bb_path_supports_depth(height_path, BB_DEPTH_16)
+                            .depth = bb__path_supports_depth(height_path, BB_DEPTH_16)
                                          ? BB_DEPTH_16
                                          : BB_DEPTH_DEFAULT};
   return 2;
 }
 
-/* The render's own provenance lines (bb_renderbump_describe's) and
+/* The render's own provenance lines (bb__renderbump_describe's) and
  * normal_y, malloc'd; NULL when out of memory. */
 static char *render_lines(const bb_renderbump_result *r, const bb_renderbump_options *o,
                           int normal_y_up) {
-  char *own = bb_renderbump_describe(o, r);
+  char *own = bb__renderbump_describe(o, r);
   if (!own)
     return NULL;
   const size_t n = strlen(own);
@@ -47,7 +49,7 @@ static char *render_lines(const bb_renderbump_result *r, const bb_renderbump_opt
   return extra;
 }
 
-bb_status bb_renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
+bb_status bb__renderbump_write(const bb_renderbump_result *r, const bb_renderbump_options *o,
                               int normal_y_up, const char *model, uint64_t model_hash,
                               const char *command, const char *normal_path,
                               const char *height_path, bb_error *err) {

@@ -7,6 +7,9 @@
 #include "files/safe_file.h"
 #include "job/job_internal.h"
 #include "texture/blocks.h"
+#include "maps/maps_internal.h"
+#include "render/render_internal.h"
+#include "texture/texture.h"
 
 #include <fcntl.h>
 #include <limits.h>
@@ -71,7 +74,7 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
   }
   bb_bake_options o = job->options.bake;
   char rayset[64];
-  bb_bake_rayset_id(&o, rayset, sizeof rayset);
+  bb__bake_rayset_id(&o, rayset, sizeof rayset);
   bb_image_info info;
   int bits = 8, is_float = 0;
   if (bb_image_read_info(item->input, NULL, NULL, NULL, &info, NULL) == BB_OK) {
@@ -82,8 +85,8 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (!item->paths[k])
       continue;
-    /* A texture's settings are part of its provenance (bb_image_write adds them). */
-    char *texture = bb_texture_provenance(item->paths[k], &job->options.texture);
+    /* A texture's settings are part of its provenance (bb__image_write adds them). */
+    char *texture = bb__texture_provenance(item->paths[k], &job->options.texture);
     const bb__job_source s = {.input_file_hash = item->file_hash,
                               .bake = &o,
                               .channel = job->options.channel,
@@ -201,14 +204,14 @@ static void baked_free(baked *b) {
 static bb_status make_slope(const bb_job *job, const bb__job_item *item, baked *b,
                             bb_error *err) {
   const bb_bake_options *o = &job->options.bake;
-  bb_status st = bb_slope_map(&b->result.filtered, o->height_scale, o->smooth.addressing,
+  bb_status st = bb__slope_map(&b->result.filtered, o->height_scale, o->smooth.addressing,
                               &b->slope, err);
   if (st == BB_OK && item->slope_lit_path) {
     double light[3];
     float table[256];
-    bb_light_direction(job->options.slope_lit_azimuth, job->options.slope_lit_elevation, light);
-    bb_slope_table(light, table);
-    st = bb_slope_light(&b->slope, table, &b->slope_lit, err);
+    bb__light_direction(job->options.slope_lit_azimuth, job->options.slope_lit_elevation, light);
+    bb__slope_table(light, table);
+    st = bb__slope_light(&b->slope, table, &b->slope_lit, err);
   }
   return st;
 }
@@ -272,7 +275,7 @@ static bb_status write_depfile_text(const char *path, const char *text, size_t s
                                     const char *written, bb_error *err) {
   bb_error local = {{0}};
   bb_status st = bb__safe_is_stream(path) ? bb__safe_write_through(path, text, size, &local)
-                                          : bb_file_write(path, text, size, &local);
+                                          : bb__file_write(path, text, size, &local);
   if (st != BB_OK)
     bb__fail(err, st, "%s; %s", local.message, written);
   return st;

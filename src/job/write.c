@@ -30,7 +30,7 @@ static atomic_int commits_in_flight;
 static atomic_int pending_signal;
 
 static void die_of(int signal_number) {
-  bb_tempfiles_remove();
+  bb__tempfiles_remove();
   struct sigaction dfl;
   memset(&dfl, 0, sizeof dfl);
   dfl.sa_handler = SIG_DFL;
@@ -73,7 +73,7 @@ typedef struct staged {
   bb__blocks_watch *watch; /* the set's block compression stage, or NULL */
 } staged;
 
-/* Text bytes under a temporary name, synced: the staged twin of bb_file_write. */
+/* Text bytes under a temporary name, synced: the staged twin of bb__file_write. */
 static bb_status stage_text(const bb_output_file *o, bb_staged_file **out, bb_error *err) {
   *out = NULL;
   if (!o->text && o->text_size)
@@ -117,12 +117,12 @@ static void stage_one(void *user, int item) {
     s->status = stage_text(o, &s->handle, &s->error);
     return;
   }
-  if (bb_path_is_texture_format(o->path)) {
+  if (bb__path_is_texture_format(o->path)) {
     /* A texture makes its own chain (its mips option), as the map its kind is. */
     const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
     const bb_write_options wo = {o->depth, o->range, o->description, &t};
     bb__blocks_watch_thread(s->watch);
-    s->status = bb_image_write_staged(o->path, o->image, &wo, &s->handle, &s->error);
+    s->status = bb__image_write_staged_all_cores(o->path, o->image, &wo, &s->handle, &s->error);
     bb__blocks_watch_thread(NULL);
     return;
   }
@@ -134,7 +134,7 @@ static void stage_one(void *user, int item) {
 
 /* --------------------------------------------------------------- commits */
 
-bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
+bb_status bb__staged_files_commit(bb_staged_file **files, const char *const *kinds, int count,
                                  bb_error *err) {
   if (count < 0 || (count > 0 && !files))
     return bb__fail(err, BB_ERR_ARGUMENT, "staged files commit: bad arguments");
@@ -144,8 +144,8 @@ bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kind
   bb_error why = {{0}};
   commit_begin();
   for (int i = 0; i < count && failed < 0; i++) {
-    char *path = done ? strdup(bb_staged_file_path(files[i])) : NULL;
-    bb_status st = bb_staged_file_commit(files[i], &why);
+    char *path = done ? strdup(bb__staged_file_path(files[i])) : NULL;
+    bb_status st = bb__staged_file_commit(files[i], &why);
     files[i] = NULL;
     if (st != BB_OK)
       failed = i, free(path);
@@ -156,7 +156,7 @@ bb_status bb_staged_files_commit(bb_staged_file **files, const char *const *kind
   bb_status st = BB_OK;
   if (failed >= 0) {
     for (int i = failed + 1; i < count; i++) {
-      bb_staged_file_discard(files[i]);
+      bb__staged_file_discard(files[i]);
       files[i] = NULL;
     }
     char reason[2 * sizeof(bb_error)];
@@ -181,7 +181,7 @@ long bb__outputs_block_rows(const bb_output_file *files, int count) {
   long rows = 0;
   for (int i = 0; files && i < count; i++) {
     const bb_output_file *o = &files[i];
-    if (!o->image || !bb_path_is_texture_format(o->path))
+    if (!o->image || !bb__path_is_texture_format(o->path))
       continue;
     const bb_texture_options t = bb__job_texture_of(o->texture, o->kind, o->range);
     rows += bb__texture_block_rows(o->path, o->image->width, o->image->height,
@@ -225,14 +225,14 @@ bb_status bb__outputs_write(const bb_output_file *files, int count, int threads,
         kinds[i] = files[i].kind;
         set[i].handle = NULL;
       }
-      st = bb_staged_files_commit(handles, kinds, count, err);
+      st = bb__staged_files_commit(handles, kinds, count, err);
     }
     free(handles);
     free(kinds);
     failed = -1; /* the commit's message is the whole story */
   }
   for (int i = 0; i < count; i++)
-    bb_staged_file_discard(set[i].handle);
+    bb__staged_file_discard(set[i].handle);
   if (st == BB_OK && failed >= 0) {
     char reason[2 * sizeof(bb_error)];
     snprintf(reason, sizeof reason, "%s",

@@ -32,7 +32,7 @@ static bb_status check_kind(bb_map_kind kind, const char *what, bb_error *err) {
   if (combine_channels(kind))
     return BB_OK;
   return bb__fail(err, BB_ERR_ARGUMENT, "%s: map kind %s is not one of ssbump, weights, ao, normal",
-                  what, bb_map_kind_name(kind));
+                  what, bb__map_kind_name(kind));
 }
 
 /* The exact flat value of channel c, encoded as a file stores it (normals
@@ -70,7 +70,7 @@ void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
         v = 2.0 * v - 1.0;
       v = bits_per_sample == 16 && v != 0.0 ? round_to_half(v) : (double)(float)v;
     } else {
-      /* bb_image_write's rule (round half up), read back as code / max. */
+      /* bb__image_write's rule (round half up), read back as code / max. */
       int bits = bits_per_sample >= 1 && bits_per_sample <= 32 ? bits_per_sample : 8;
       double max_code = ldexp(1.0, bits) - 1.0;
       v = floor(v * max_code + 0.5) / max_code;

@@ -36,7 +36,7 @@ static bb_status check_inputs(const bb_image *a, const bb_image *b, bb_error *er
   return BB_OK;
 }
 
-bb_status bb_compare_images(const bb_image *a, const bb_image *b, double fail_threshold,
+bb_status bb__compare_images(const bb_image *a, const bb_image *b, double fail_threshold,
                             double warn_threshold, bb_compare_stats *stats,
                             bb_image *diff, bb_error *err) {
   bb_status st = check_inputs(a, b, err);
@@ -100,7 +100,7 @@ bb_status bb_compare_images(const bb_image *a, const bb_image *b, double fail_th
   return BB_OK;
 }
 
-void bb_compare_limits_init(bb_compare_limits *limits) {
+void bb__compare_limits_init(bb_compare_limits *limits) {
   limits->fail = 1e-6; /* idiff's defaults */
   limits->fail_percent = 0.0;
   limits->hard_fail = INFINITY;
@@ -114,7 +114,7 @@ const bb__range bb__range_compare_threshold = {"threshold", 0.0, HUGE_VAL, 0, 0}
 const bb__range bb__range_compare_percent = {"percent", 0.0, 100.0, 0, 0};
 const bb__range bb__range_compare_count = {"count", 0.0, HUGE_VAL, 0, 1};
 
-bb_status bb_compare_limits_check(const bb_compare_limits *l, bb_error *err) {
+bb_status bb__compare_limits_check(const bb_compare_limits *l, bb_error *err) {
   if (!l)
     return bb__fail(err, BB_ERR_ARGUMENT, "compare: no limits");
   const struct {
@@ -134,7 +134,7 @@ bb_status bb_compare_limits_check(const bb_compare_limits *l, bb_error *err) {
   return st;
 }
 
-bb_compare_verdict bb_compare_judge(const bb_compare_stats *s,
+bb_compare_verdict bb__compare_judge(const bb_compare_stats *s,
                                     const bb_compare_limits *l) {
   /* The order is idiff's: allowed failures pass before anything else is
    * looked at, so a CI script gets the exit code idiff would give. */

@@ -3,6 +3,7 @@
 
 #include "trace/basis.h"
 #include "core/internal.h"
+#include "bake/bake_internal.h"
 #include <math.h>
 #include <string.h>
 
@@ -58,7 +59,7 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
     st = bb__check_hl2_map(ssbump, NULL, "ssbump", err);
   if (st == BB_OK)
     st = bb__check_finite(ssbump, 3, "ssbump", err);
-  /* The three basis channels alone: bb_derive_bent would read a fourth
+  /* The three basis channels alone: bb__derive_bent_all_cores would read a fourth
    * (Valve's alpha height) as the weight of B3. */
   bb_image weights = {0};
   if (st == BB_OK)
@@ -73,7 +74,7 @@ bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
         s = sqrtf(s > 0.0f ? s : 0.0f);
       weights.pixels[3 * i + (size_t)c] = s;
     }
-  st = bb_derive_bent(&weights, NULL, normals, err);
+  st = bb__derive_bent_all_cores(&weights, NULL, normals, err);
   bb_image_free(&weights);
   return st;
 }

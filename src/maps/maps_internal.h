@@ -25,6 +25,67 @@ extern const bb__range bb__range_mix;
 void bb__add_normals(const double base[3], double dx, double dy, double out[3]);
 
 
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Packs slopes dx, dy (each clamped to -7..7) into flipcode's byte: dx in
+ * the low nibble, dy in the high nibble, each as a 4-bit two's complement
+ * number (-1 is 0xF, -7 is 0x9). */
+uint8_t bb__slope_encode(int dx, int dy);
+
+/* Unpacks a slope byte; nibble 0x8 reads as -8 (bb__slope_encode never
+ * writes it). */
+void bb__slope_decode(uint8_t byte, int *dx, int *dy);
+
+/* flipcode's slope map of a 1-channel height field h: for texel (x, y),
+ * dx = S (h(x+1, y) - h(x, y)) and dy = S (h(x, y+1) - h(x, y)) in texels
+ * (S = height_scale; forward differences, neighbours by addressing),
+ * rounded to the nearest integer (halves away from 0) and clamped to -7..7.
+ * Allocates out: 1 channel holding byte / 255, so an 8-bit file stores the
+ * byte itself. */
+bb_status bb__slope_map(const bb_image *height, float height_scale,
+                       bb_addressing addressing, bb_image *out, bb_error *err);
+
+/* The 16 x 16 lighting table: table[byte] = max(0, N.L) with N =
+ * normalize(-dx, -dy, 1) for the slopes (dx, dy) the byte decodes to and L
+ * a unit light direction (bb__light_direction makes one from azimuth and
+ * elevation). Row = high nibble (dy), column = low nibble (dx). */
+void bb__slope_table(const double light[3], float table[256]);
+
+/* Lights a slope map through a table: out = table[byte] per texel, byte =
+ * round(255 * slope value). Allocates out: 1 channel. */
+bb_status bb__slope_light(const bb_image *slope, const float table[256], bb_image *out,
+                         bb_error *err);
+
+/* Channel-by-channel comparison of two images of equal size and channels
+ * (BB_ERR_SIZE otherwise). A pixel counts as over a threshold when any of
+ * its channels differs by more than it. diff (may be NULL) receives |a - b|. */
+bb_status bb__compare_images(const bb_image *a, const bb_image *b,
+                            double fail_threshold, double warn_threshold,
+                            bb_compare_stats *stats, bb_image *diff,
+                            bb_error *err);
+
+/* Sets idiff's defaults (in the field comments above). */
+void bb__compare_limits_init(bb_compare_limits *limits);
+
+/* BB_OK when every limit is in its range: fail, hard_fail, warn and
+ * hard_warn >= 0 (infinity allowed), the percentages in 0..100,
+ * allow_failures >= 0; else BB_ERR_ARGUMENT naming the limit by idiff's
+ * option ("compare: failpercent must be in 0..100 (got 150)"). NaN is
+ * refused. */
+bb_status bb__compare_limits_check(const bb_compare_limits *limits, bb_error *err);
+
+/* idiff's rule (OpenImageIO 2.4), for stats made by bb__compare_images with
+ * thresholds limits->fail and limits->warn: PASS when at most
+ * allow_failures pixels fail; else FAIL when more than fail_percent % of
+ * the pixels fail or max_abs > hard_fail; else WARN when more than
+ * warn_percent % warn or max_abs > hard_warn; else PASS. As in idiff,
+ * warnings are only reported once some pixel fails: with no failing pixel
+ * the verdict is PASS. */
+bb_compare_verdict bb__compare_judge(const bb_compare_stats *stats,
+                                    const bb_compare_limits *limits);
+
 #ifdef __cplusplus
 }
 #endif

@@ -76,7 +76,7 @@ static bb_status to_rgba(const bb_image *in, int alpha_channel, bb_image *out,
   return BB_OK;
 }
 
-int bb_program_image_path(const char *base_dir, const char *name, char *out, size_t cap) {
+int bb__program_image_path(const char *base_dir, const char *name, char *out, size_t cap) {
   if (!name)
     name = "";
   if (base_dir && *base_dir && name[0] != '/')
@@ -111,7 +111,7 @@ static bb_status check_inside_base(const bb_program_options *o, const char *name
 static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
   const bb_program_options *o = ev->o;
   char path[4096];
-  int len = bb_program_image_path(o->base_dir, n->name, path, sizeof path);
+  int len = bb__program_image_path(o->base_dir, n->name, path, sizeof path);
   /* A cut path would name another file (even an existing one). */
   if (len < 0 || (size_t)len >= sizeof path)
     return bb__fail(ev->err, BB_ERR_ARGUMENT,

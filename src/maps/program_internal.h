@@ -39,4 +39,21 @@ struct bb_program {
 /* The name of an operation as DOOM 3 spells it ("heightmap", "invertAlpha"). */
 const char *bb__program_op_name(prog_op op);
 
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* The image names a program reads, in the order it reads them (as written,
+ * unquoted; _flat is not a file and is left out): up to cap of them into
+ * names (pointers into the program, valid until bb_program_free). Returns
+ * how many there are, which may exceed cap. For dependency tracking, as
+ * id's timestamps, and to keep an output from replacing an input. */
+size_t bb__program_images(const bb_program *program, const char **names, size_t cap);
+
+/* The file a program's image name is read from: name as written when it is
+ * absolute or base_dir is NULL or empty, else base_dir/name (base_dir as in
+ * bb_program_options). Writes it into out (cap bytes, terminated) and
+ * returns its length, as snprintf does: a length >= cap means it did not
+ * fit, and bb_program_run refuses such a name rather than read a cut path. */
+int bb__program_image_path(const char *base_dir, const char *name, char *out, size_t cap);
+
 #endif /* BB_PROGRAM_INTERNAL_H */

@@ -354,7 +354,7 @@ static size_t collect_images(const prog_node *n, const char **names, size_t cap,
   return collect_images(n->args[1], names, cap, count);
 }
 
-size_t bb_program_images(const bb_program *program, const char **names, size_t cap) {
+size_t bb__program_images(const bb_program *program, const char **names, size_t cap) {
   if (!program)
     return 0;
   return collect_images(program->root, names, names ? cap : 0, 0);

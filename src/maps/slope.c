@@ -2,6 +2,7 @@
  * the 16 x 16 table that lights it (docs/commands/bake.md, "Slope map"). */
 
 #include "core/internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 
@@ -9,7 +10,7 @@ static int clamp7(long v) {
   return v < -7 ? -7 : (v > 7 ? 7 : (int)v);
 }
 
-uint8_t bb_slope_encode(int dx, int dy) {
+uint8_t bb__slope_encode(int dx, int dy) {
   unsigned lo = (unsigned)clamp7(dx) & 0xFu, hi = (unsigned)clamp7(dy) & 0xFu;
   return (uint8_t)(hi << 4 | lo);
 }
@@ -19,7 +20,7 @@ static int nibble_value(unsigned nibble) {
   return nibble >= 8 ? (int)nibble - 16 : (int)nibble;
 }
 
-void bb_slope_decode(uint8_t byte, int *dx, int *dy) {
+void bb__slope_decode(uint8_t byte, int *dx, int *dy) {
   if (dx)
     *dx = nibble_value(byte & 0xFu);
   if (dy)
@@ -32,7 +33,7 @@ static int slope_step(double difference_texels) {
   return clamp7(lround(fmax(-8.0, fmin(8.0, difference_texels))));
 }
 
-bb_status bb_slope_map(const bb_image *height, float height_scale,
+bb_status bb__slope_map(const bb_image *height, float height_scale,
                        bb_addressing addressing, bb_image *out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "slope map: out is NULL");
@@ -59,16 +60,16 @@ bb_status bb_slope_map(const bb_image *height, float height_scale,
       double right = *bb_image_texel(height, bb__address(x + 1, w, addressing), y);
       double below = *bb_image_texel(height, x, bb__address(y + 1, h, addressing));
       uint8_t b =
-          bb_slope_encode(slope_step(s * (right - here)), slope_step(s * (below - here)));
+          bb__slope_encode(slope_step(s * (right - here)), slope_step(s * (below - here)));
       *bb_image_texel(out, x, y) = (float)b / 255.0f;
     }
   return BB_OK;
 }
 
-void bb_slope_table(const double light[3], float table[256]) {
+void bb__slope_table(const double light[3], float table[256]) {
   for (int b = 0; b < 256; b++) {
     int dx, dy;
-    bb_slope_decode((uint8_t)b, &dx, &dy);
+    bb__slope_decode((uint8_t)b, &dx, &dy);
     /* The surface rises dx texels per texel to the right and dy downwards. */
     double n[3] = {-(double)dx, -(double)dy, 1.0};
     bb__normalize3(n);
@@ -77,7 +78,7 @@ void bb_slope_table(const double light[3], float table[256]) {
   }
 }
 
-bb_status bb_slope_light(const bb_image *slope, const float table[256], bb_image *out,
+bb_status bb__slope_light(const bb_image *slope, const float table[256], bb_image *out,
                          bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "slope light: out is NULL");

@@ -4,6 +4,7 @@
 
 #include "trace/basis.h"
 #include "core/internal.h"
+#include "bake/bake_internal.h"
 #include <math.h>
 #include <string.h>
 
@@ -110,7 +111,7 @@ bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image
   bb_image rgb = {0}, smoothed = {0};
   st = colour_rgb(colour, &rgb, err);
   if (st == BB_OK)
-    st = bb_smooth_bilateral(&rgb, height, smooth, &smoothed, err);
+    st = bb__smooth_bilateral_all_cores(&rgb, height, smooth, &smoothed, err);
   if (st == BB_OK) {
     const size_t texels = (size_t)rgba->width * (size_t)rgba->height;
     const float inv_sqrt3 = (float)(1.0 / sqrt(3.0));

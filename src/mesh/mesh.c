@@ -1,11 +1,12 @@
 /* mesh.c: the bb_mesh type (allocation, hash) and the projection axes of the
  * flat render bump. Reading and writing files is mesh_assimp.cpp's job. */
 #include "core/internal.h"
+#include "mesh/mesh_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
+bb_status bb__mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
                         int with_normals, bb_error *err) {
   memset(m, 0, sizeof *m);
   if (vertices == 0)
@@ -19,7 +20,7 @@ bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
   m->normals = with_normals ? calloc(3 * vertices, sizeof(float)) : NULL;
   m->indices = calloc(3 * (triangles ? triangles : 1), sizeof(uint32_t));
   if (!m->positions || !m->indices || (with_normals && !m->normals)) {
-    bb_mesh_free(m);
+    bb__mesh_free(m);
     return bb__fail(err, BB_ERR_MEMORY, "cannot allocate a mesh of %zu vertices", vertices);
   }
   m->vertex_count = vertices;
@@ -27,7 +28,7 @@ bb_status bb_mesh_alloc(bb_mesh *m, size_t vertices, size_t triangles,
   return BB_OK;
 }
 
-void bb_mesh_free(bb_mesh *m) {
+void bb__mesh_free(bb_mesh *m) {
   if (!m)
     return;
   free(m->positions);
@@ -36,7 +37,7 @@ void bb_mesh_free(bb_mesh *m) {
   memset(m, 0, sizeof *m);
 }
 
-uint64_t bb_mesh_hash(const bb_mesh *m) {
+uint64_t bb__mesh_hash(const bb_mesh *m) {
   uint64_t h = BB__FNV64_OFFSET;
   if (!m)
     return h;
@@ -69,7 +70,7 @@ static const struct {
 
 enum { AXIS_COUNT = sizeof axes / sizeof axes[0] };
 
-bb_status bb_axis_parse(const char *name, bb_axis *out, bb_error *err) {
+bb_status bb__axis_parse(const char *name, bb_axis *out, bb_error *err) {
   const char *names[AXIS_COUNT];
   for (int i = 0; i < AXIS_COUNT; i++)
     names[i] = axes[i].name;
@@ -94,7 +95,7 @@ static void signed_unit(int axis, double v[3]) {
   v[abs(axis) - 1] = axis > 0 ? 1.0 : -1.0;
 }
 
-void bb_axis_frame(bb_axis a, double right[3], double up[3], double out[3]) {
+void bb__axis_frame(bb_axis a, double right[3], double up[3], double out[3]) {
   if ((int)a < 0 || (int)a >= AXIS_COUNT)
     a = BB_AXIS_NEG_Y;
   signed_unit(axes[a].right, right);

@@ -11,6 +11,7 @@
 #include "core/sanitizer_options.h"
 #include "files/safe_file.h"
 #include "mesh/mesh_import.h"
+#include "mesh/mesh_internal.h"
 #include <assimp/Exporter.hpp>
 #include <assimp/IOStream.hpp>
 #include <assimp/IOSystem.hpp>
@@ -312,7 +313,7 @@ Assimp::IOStream *confined_io::Open(const char *file, const char *mode) {
 // In sanitizer builds, what Assimp allocates while it imports (in this
 // thread) is not a leak to LeakSanitizer: its readers lose memory on some
 // error paths (glTF's base64 decoder throws past the buffer it allocated).
-// bb_mesh_load imports in a child process that exits, so nothing it loses
+// bb__mesh_load imports in a child process that exits, so nothing it loses
 // reaches the caller; this scope keeps those losses from failing the
 // in-process import that fuzzing and tests run, while bumpbake's own
 // allocations before and after the import stay counted (the streams the
@@ -438,12 +439,12 @@ bb_status scene_to_mesh(const char *path, const aiScene *scene, bb_mesh *out, bb
       c.vertices > 3 * (size_t)BB_MAX_MODEL_TRIANGLES)
     return over_limits(path, (double)c.triangles, (double)c.vertices, err);
   bb_error alloc_err = {{0}};
-  bb_status st = bb_mesh_alloc(out, c.vertices, c.triangles, c.any_normals, &alloc_err);
+  bb_status st = bb__mesh_alloc(out, c.vertices, c.triangles, c.any_normals, &alloc_err);
   if (st != BB_OK) return bb__fail(err, st, "%s: %s", path, alloc_err.message);
   size_t v = 0, t = 0;
   for (unsigned i = 0; i < scene->mNumMeshes && st == BB_OK; i++)
     st = copy_mesh(path, scene->mMeshes[i], out, &v, &t, err);
-  if (st != BB_OK) bb_mesh_free(out);
+  if (st != BB_OK) bb__mesh_free(out);
   return st;
 }
 
@@ -639,28 +640,28 @@ bb_status bb__mesh_check_model(const char *path, size_t *size, bb_error *err) {
 bb_status bb__mesh_import(const char *path, bb_mesh *out, char *note, size_t cap,
                           bb_error *err) {
   if (note && cap) note[0] = '\0';
-  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_mesh_load: out is NULL");
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb__mesh_load: out is NULL");
   std::memset(out, 0, sizeof *out);
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_mesh_load: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__mesh_load: path is NULL");
   try {
     std::string said;
     bb_status st = load_mesh(path, out, &said, err);
     if (st == BB_OK && note && cap) std::snprintf(note, cap, "%s", said.c_str());
     return st;
   } catch (const std::bad_alloc &) {
-    bb_mesh_free(out);
+    bb__mesh_free(out);
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory while reading", path);
   } catch (const std::exception &e) {
-    bb_mesh_free(out);
+    bb__mesh_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
   } catch (...) {
-    bb_mesh_free(out);
+    bb__mesh_free(out);
     return bb__fail(err, BB_ERR_FORMAT, "%s: unknown error while reading", path);
   }
 }
 
-bb_status bb_mesh_write(const char *path, const bb_mesh *m, bb_error *err) {
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_mesh_write: path is NULL");
+bb_status bb__mesh_write(const char *path, const bb_mesh *m, bb_error *err) {
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__mesh_write: path is NULL");
   try {
     return write_mesh(path, m, err);
   } catch (const std::bad_alloc &) {

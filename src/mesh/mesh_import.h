@@ -27,7 +27,7 @@ bb_status bb__mesh_check_model(const char *path, size_t *size, bb_error *err);
  * and nothing but regular files, the triangle limits are applied, and the
  * scene becomes one bb_mesh (out, zeroed on failure). note (cap bytes, may
  * be NULL) gets "" or one line naming files that were missing. Nothing
- * bounds Assimp's stack, memory or time here: bb_mesh_load runs this in a
+ * bounds Assimp's stack, memory or time here: bb__mesh_load runs this in a
  * child process (bb__mesh_load_isolated); fuzzing and tests call it
  * directly to see Assimp's code. */
 bb_status bb__mesh_import(const char *path, bb_mesh *out, char *note, size_t cap,
@@ -47,7 +47,7 @@ typedef struct bb__import_limits {
                           fork stays held in the child); 0: never */
 } bb__import_limits;
 
-/* The limits bb_mesh_load uses: BB_MAX_IMPORT_MEMORY, BB__IMPORT_STACK_BYTES,
+/* The limits bb__mesh_load uses: BB_MAX_IMPORT_MEMORY, BB__IMPORT_STACK_BYTES,
  * BB_MAX_IMPORT_SECONDS of CPU, four times that of wall-clock time, and
  * 10 s of standing still. */
 void bb__import_limits_default(bb__import_limits *lim);

@@ -1,4 +1,4 @@
-/* mesh_load.c: bb_mesh_load: the import (mesh_assimp.cpp) in a child
+/* mesh_load.c: bb__mesh_load: the import (mesh_assimp.cpp) in a child
  * process, so that whatever Assimp does with a hostile model (overflow its
  * stack on nodes nested 20,000 deep, allocate without end, loop) ends the
  * child and becomes a one-line error. The mesh comes back through a pipe
@@ -14,6 +14,7 @@
 #include "core/internal.h"
 #include "core/sanitizer_options.h"
 #include "mesh/mesh_import.h"
+#include "mesh/mesh_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -338,7 +339,7 @@ static bb_status receive_mesh(child *c, const char *path, const wire_header *h, 
   if (h->vertices < 1 || h->vertices > 3 * (uint64_t)BB_MAX_MODEL_TRIANGLES ||
       h->triangles < 1 || h->triangles > (uint64_t)BB_MAX_MODEL_TRIANGLES || h->has_normals > 1)
     return bb__fail(err, BB_ERR_FORMAT, "%s: the importer answered a malformed mesh", path);
-  bb_status st = bb_mesh_alloc(out, (size_t)h->vertices, (size_t)h->triangles,
+  bb_status st = bb__mesh_alloc(out, (size_t)h->vertices, (size_t)h->triangles,
                                (int)h->has_normals, err);
   if (st != BB_OK)
     return st;
@@ -346,17 +347,17 @@ static bb_status receive_mesh(child *c, const char *path, const wire_header *h, 
   if (read_exact(c, out->positions, floats) != 0 ||
       (out->normals && read_exact(c, out->normals, floats) != 0) ||
       read_exact(c, out->indices, 3 * out->triangle_count * sizeof(uint32_t)) != 0) {
-    bb_mesh_free(out);
+    bb__mesh_free(out);
     return BB_ERR_IO; /* the caller words it from the child's end */
   }
   for (size_t i = 0; i < 3 * out->triangle_count; i++)
     if (out->indices[i] >= out->vertex_count) {
-      bb_mesh_free(out);
+      bb__mesh_free(out);
       return bb__fail(err, BB_ERR_FORMAT, "%s: the importer answered a malformed mesh", path);
     }
   for (size_t i = 0; i < 3 * out->vertex_count; i++)
     if (!isfinite(out->positions[i])) {
-      bb_mesh_free(out);
+      bb__mesh_free(out);
       return bb__fail(err, BB_ERR_FORMAT, "%s: the importer answered a malformed mesh", path);
     }
   return BB_OK;
@@ -418,7 +419,7 @@ static bb_status receive(child *c, const char *path, const bb__import_limits *li
     if (st == BB_OK) {
       unsigned char extra;
       if (read_exact(c, &extra, 1) == 0 && !c->timed_out) {
-        bb_mesh_free(out); /* more than it announced: not our protocol */
+        bb__mesh_free(out); /* more than it announced: not our protocol */
         st = bb__fail(err, BB_ERR_FORMAT, "%s: the importer answered a malformed mesh", path);
       } else {
         *answered = 1;
@@ -468,7 +469,7 @@ static bb_status one_child(const char *path, const bb__import_limits *lim, doubl
   close(c.fd);
   /* A whole answer from a child that then died is no answer. */
   if (*answered && c.known && !(WIFEXITED(c.status) && WEXITSTATUS(c.status) == 0)) {
-    bb_mesh_free(out);
+    bb__mesh_free(out);
     *answered = 0;
     st = child_failure(&c, path, lim, err);
   }
@@ -483,10 +484,10 @@ bb_status bb__mesh_load_isolated(const char *path, const bb__import_limits *lim,
   if (note && cap)
     note[0] = '\0';
   if (!out)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_mesh_load: out is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__mesh_load: out is NULL");
   memset(out, 0, sizeof *out);
   if (!path)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_mesh_load: path is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__mesh_load: path is NULL");
   /* The model itself first: a FIFO or a file over the limit never reaches
    * a child. */
   size_t size;
@@ -508,13 +509,13 @@ bb_status bb__mesh_load_isolated(const char *path, const bb__import_limits *lim,
   return st;
 }
 
-bb_status bb_mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
+bb_status bb__mesh_load_noted(const char *path, bb_mesh *out, char *note, size_t cap,
                              bb_error *err) {
   bb__import_limits lim;
   bb__import_limits_default(&lim);
   return bb__mesh_load_isolated(path, &lim, out, note, cap, NULL, err);
 }
 
-bb_status bb_mesh_load(const char *path, bb_mesh *out, bb_error *err) {
-  return bb_mesh_load_noted(path, out, NULL, 0, err);
+bb_status bb__mesh_load(const char *path, bb_mesh *out, bb_error *err) {
+  return bb__mesh_load_noted(path, out, NULL, 0, err);
 }

@@ -28,7 +28,7 @@
 /* Target samples per band buffer (12 bytes each). */
 #define BAND_SAMPLES (1L << 18)
 
-void bb_renderbump_options_init(bb_renderbump_options *o) {
+void bb__renderbump_options_init(bb_renderbump_options *o) {
   memset(o, 0, sizeof *o);
   o->width = 256;
   o->height = 256;
@@ -607,7 +607,7 @@ static bb_status render(rb_job *job, bb_error *err) {
   return st;
 }
 
-bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
+bb_status bb__renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o,
                              bb_renderbump_result *result, bb_error *err) {
   if (!o || !result)
     return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: missing options or result");
@@ -623,7 +623,7 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
   job.o = o;
   job.r = result;
   atomic_init(&job.out_of_memory, 0);
-  bb_axis_frame(o->axis, job.right, job.up, job.out);
+  bb__axis_frame(o->axis, job.right, job.up, job.out);
   st = render(&job, err);
   free(job.uvd);
   free(job.normal_t);
@@ -636,14 +636,14 @@ bb_status bb_renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *o
   }
   result->triangles = mesh->triangle_count;
   result->vertices = mesh->vertex_count;
-  result->model_hash = bb_mesh_hash(mesh);
+  result->model_hash = bb__mesh_hash(mesh);
   bb__renderbump_notes(o, result);
   return st;
 }
 
 /* ---------------------------------------------------------- provenance */
 
-char *bb_renderbump_describe(const bb_renderbump_options *o, const bb_renderbump_result *r) {
+char *bb__renderbump_describe(const bb_renderbump_options *o, const bb_renderbump_result *r) {
   if (!o || !r)
     return NULL;
   const size_t cap = 1024;

@@ -1,6 +1,7 @@
 /* image_ops.c: whole-image operations for pictures: tiling, cropping,
  * area resampling and the display encodings of maps. */
 #include "core/internal.h"
+#include "render/render_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -24,7 +25,7 @@ static float *row_of(const bb_image *img, int y) {
   return img->pixels + (size_t)y * (size_t)img->width * (size_t)img->channels;
 }
 
-bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out,
+bb_status bb__image_tile(const bb_image *in, int nx, int ny, bb_image *out,
                         bb_error *err) {
   bb_status st = check_input(in, out, "tile", err);
   if (st != BB_OK)
@@ -47,7 +48,7 @@ bb_status bb_image_tile(const bb_image *in, int nx, int ny, bb_image *out,
   return BB_OK;
 }
 
-bb_status bb_image_crop(const bb_image *in, int x, int y, int width, int height,
+bb_status bb__image_crop(const bb_image *in, int x, int y, int width, int height,
                         bb_image *out, bb_error *err) {
   bb_status st = check_input(in, out, "crop", err);
   if (st != BB_OK)
@@ -139,7 +140,7 @@ static void resample_axis(const bb_image *in, const footprint *f, int horizontal
     }
 }
 
-bb_status bb_image_resample(const bb_image *in, int width, int height, bb_image *out,
+bb_status bb__image_resample(const bb_image *in, int width, int height, bb_image *out,
                             bb_error *err) {
   bb_status st = check_input(in, out, "resample", err);
   if (st != BB_OK)
@@ -172,7 +173,7 @@ static float clamp01(double v) {
   return (float)(v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0);
 }
 
-bb_status bb_image_to_display(const bb_image *map, bb_range range, float low, float high,
+bb_status bb__image_to_display(const bb_image *map, bb_range range, float low, float high,
                               bb_image *rgb, bb_error *err) {
   bb_status st = check_input(map, rgb, "display", err);
   if (st != BB_OK)

@@ -3,6 +3,7 @@
 
 #include "core/internal.h"
 #include "render/text.h"
+#include "render/render_internal.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,7 +16,7 @@ static float *row_of(const bb_image *img, int y) {
 
 /* ----------------------------------------------------------------- grid */
 
-void bb_panel_layout_init(bb_panel_layout *l) {
+void bb__panel_layout_init(bb_panel_layout *l) {
   memset(l, 0, sizeof *l);
   l->columns = 4;
   l->panel_width = 0;
@@ -28,7 +29,7 @@ void bb_panel_layout_init(bb_panel_layout *l) {
 #define LABEL_GREY 0.92f
 
 /* The font labels are drawn with, into font (capacity cap), by the rule of
- * bb_panels_compose; 0 when there is none. */
+ * bb__panels_compose; 0 when there is none. */
 static int find_font(const char *requested, char *font, size_t cap) {
   static const char *const candidates[] = {"DejaVuSans", "LiberationSans-Regular",
                                            "FreeSans", "NotoSans-Regular"};
@@ -142,7 +143,7 @@ static bb_status paste_panel(const bb_image *panel, const grid *g, int x, int y,
   bb_image scaled = {0};
   const bb_image *src = panel;
   if (panel->width != g->cell_width) {
-    bb_status st = bb_image_resample(panel, g->cell_width,
+    bb_status st = bb__image_resample(panel, g->cell_width,
                                      scaled_height(panel, g->cell_width), &scaled, err);
     if (st != BB_OK)
       return st;
@@ -168,7 +169,7 @@ static bb_status draw_label(const char *label, const grid *g, const char *font, 
                        g->font_size, grey, font, err);
 }
 
-bb_status bb_panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
+bb_status bb__panels_compose(const bb_panel *panels, int count, const bb_panel_layout *l,
                             bb_image *out, int *labels_drawn, bb_error *err) {
   if (labels_drawn)
     *labels_drawn = 0;

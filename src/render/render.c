@@ -12,6 +12,7 @@
 #include "trace/basis.h"
 #include "core/internal.h"
 #include "render/render_internal.h"
+#include "maps/maps_internal.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -44,7 +45,7 @@ typedef struct shade_setup {
   double basis[3][3];
   double light[3];       /* l, towards the dynamic light */
   double light_basis[3]; /* l.B_c */
-  float slope_table[256]; /* flipcode's table for l (bb_slope_table) */
+  float slope_table[256]; /* flipcode's table for l (bb__slope_table) */
 } shade_setup;
 
 typedef void (*shade_fn)(const shade_setup *s, const texel_maps *t, shade_terms *out);
@@ -113,7 +114,7 @@ static void shade_ssbump(const shade_setup *s, const texel_maps *t, shade_terms 
     copy3f(t->bent, out->specular_normal);
     return;
   }
-  /* The paper's bent normal, as derive.c's bb_derive_bent computes it. */
+  /* The paper's bent normal, as derive.c's bb__derive_bent_all_cores computes it. */
   double b[3] = {0.0, 0.0, 0.0};
   for (int c = 0; c < 3; c++)
     for (int k = 0; k < 3; k++)
@@ -131,7 +132,7 @@ static void shade_slope(const shade_setup *s, const texel_maps *t, shade_terms *
   double code = 255.0 * (double)t->slope[0] + 0.5;
   int byte = code < 0.0 ? 0 : (code > 255.0 ? 255 : (int)code);
   int dx, dy;
-  bb_slope_decode((uint8_t)byte, &dx, &dy);
+  bb__slope_decode((uint8_t)byte, &dx, &dy);
   double n[3] = {-(double)dx, -(double)dy, 1.0};
   bb__normalize3(n);
   const float nf[3] = {(float)n[0], (float)n[1], (float)n[2]};
@@ -165,7 +166,7 @@ static const mode_info *find_mode(bb_render_mode mode) {
   return NULL;
 }
 
-bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *err) {
+bb_status bb__render_mode_parse(const char *name, bb_render_mode *out, bb_error *err) {
   const char *names[MODE_COUNT];
   for (int i = 0; i < MODE_COUNT; i++)
     names[i] = modes[i].name;
@@ -176,12 +177,12 @@ bb_status bb_render_mode_parse(const char *name, bb_render_mode *out, bb_error *
   return st;
 }
 
-unsigned bb_render_mode_needs(bb_render_mode mode) {
+unsigned bb__render_mode_needs(bb_render_mode mode) {
   const mode_info *m = find_mode(mode);
   return m ? m->needs : 0u;
 }
 
-const char *bb_render_mode_name(bb_render_mode mode) {
+const char *bb__render_mode_name(bb_render_mode mode) {
   const mode_info *m = find_mode(mode);
   return m ? m->name : "unknown";
 }
@@ -190,7 +191,7 @@ const char *bb_render_mode_name(bb_render_mode mode) {
 
 static const char *const albedo_mode_names[] = {"multiply", "mod2x", "ssbump"};
 
-bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err) {
+bb_status bb__albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *err) {
   int i;
   bb_status st = bb__parse_name("albedo mode", name, albedo_mode_names, 3, 0, &i, err);
   if (st == BB_OK)
@@ -198,7 +199,7 @@ bb_status bb_albedo_mode_parse(const char *name, bb_albedo_mode *out, bb_error *
   return st;
 }
 
-const char *bb_albedo_mode_name(bb_albedo_mode mode) {
+const char *bb__albedo_mode_name(bb_albedo_mode mode) {
   int i = (int)mode;
   return i >= 0 && i < 3 ? albedo_mode_names[i] : "unknown";
 }
@@ -224,7 +225,7 @@ static void cos_sin_degrees(double degrees, double *c, double *s) {
   *s = sin(radians);
 }
 
-void bb_light_direction(double azimuth_degrees, double elevation_degrees, double dir[3]) {
+void bb__light_direction(double azimuth_degrees, double elevation_degrees, double dir[3]) {
   double ca, sa, ce, se;
   cos_sin_degrees(azimuth_degrees, &ca, &sa);
   cos_sin_degrees(elevation_degrees, &ce, &se);
@@ -410,27 +411,27 @@ static void job_init(render_job *job, const bb_render_maps *maps,
   job->out = out;
   job->view[2] = 1.0; /* overhead */
   if (o->view) {
-    bb_light_direction(o->view_azimuth, o->view_elevation, job->view);
+    bb__light_direction(o->view_azimuth, o->view_elevation, job->view);
     double horizontal = hypot(job->view[0], job->view[1]);
     if (horizontal > 0.0) {
       job->toward[0] = job->view[0] / horizontal, job->toward[1] = job->view[1] / horizontal;
     } else { /* straight down: the azimuth still turns the picture */
       double d[3];
-      bb_light_direction(o->view_azimuth, 0.0, d);
+      bb__light_direction(o->view_azimuth, 0.0, d);
       job->toward[0] = d[0], job->toward[1] = d[1];
     }
     job->right[0] = job->toward[1], job->right[1] = -job->toward[0];
     job->stretch = 1.0 / job->view[2];
   }
   for (int c = 0; c < 3; c++)
-    bb_basis_vector(c, job->setup.basis[c]);
+    bb__basis_vector(c, job->setup.basis[c]);
   if (o->dynamic_light) {
-    bb_light_direction(o->light_azimuth, o->light_elevation, job->setup.light);
+    bb__light_direction(o->light_azimuth, o->light_elevation, job->setup.light);
     add_specular_light(job, job->setup.light, o->light_color);
   }
   for (int c = 0; c < 3; c++)
     job->setup.light_basis[c] = dot3d(job->setup.light, job->setup.basis[c]);
-  bb_slope_table(job->setup.light, job->setup.slope_table);
+  bb__slope_table(job->setup.light, job->setup.slope_table);
   if (o->static_light)
     for (int c = 0; c < 3; c++)
       add_specular_light(job, job->setup.basis[c], o->lightmap[c]);
@@ -633,7 +634,7 @@ static bb_status apply_view(const bb_render_options *o, bb_image *img, bb_error 
   bb_status st = BB_OK;
   if (o->tile_x > 1 || o->tile_y > 1) {
     bb_image tiled;
-    st = bb_image_tile(img, o->tile_x, o->tile_y, &tiled, err);
+    st = bb__image_tile(img, o->tile_x, o->tile_y, &tiled, err);
     bb_image_free(img);
     if (st != BB_OK)
       return st;
@@ -641,7 +642,7 @@ static bb_status apply_view(const bb_render_options *o, bb_image *img, bb_error 
   }
   if (o->crop_width > 0) {
     bb_image cropped;
-    st = bb_image_crop(img, o->crop_x, o->crop_y, o->crop_width, o->crop_height, &cropped,
+    st = bb__image_crop(img, o->crop_x, o->crop_y, o->crop_width, o->crop_height, &cropped,
                        err);
     bb_image_free(img);
     if (st != BB_OK)
@@ -668,7 +669,7 @@ static bb_status check_finite(const bb_image *img, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
+bb_status bb__render(const bb_render_maps *maps, const bb_render_options *o, bb_image *out,
                     bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "render: out is NULL");
@@ -686,7 +687,7 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
   double picture = 0.0;
   int picture_width = 0, picture_height = 0;
   if (st == BB_OK)
-    st = bb_render_estimate(size->width, size->height, o, 0, NULL, BB_DEPTH_DEFAULT,
+    st = bb__render_estimate(size->width, size->height, o, 0, NULL, BB_DEPTH_DEFAULT,
                             &picture_width, &picture_height, &picture, err);
   if (st == BB_OK) {
     char what[64];
@@ -715,7 +716,7 @@ bb_status bb_render(const bb_render_maps *maps, const bb_render_options *o, bb_i
     st = bb__parallel_for(out->height, o->threads, view_row, &job, NULL, NULL, err);
     if (st == BB_OK && o->crop_width > 0) {
       bb_image cropped;
-      st = bb_image_crop(out, o->crop_x, o->crop_y, o->crop_width, o->crop_height, &cropped, err);
+      st = bb__image_crop(out, o->crop_x, o->crop_y, o->crop_width, o->crop_height, &cropped, err);
       bb_image_free(out);
       if (st == BB_OK)
         *out = cropped;
@@ -760,12 +761,12 @@ static char *append(char *text, size_t *length, const char *fmt, ...) {
   return grown;
 }
 
-char *bb_render_options_describe(const bb_render_options *o) {
+char *bb__render_options_describe(const bb_render_options *o) {
   if (!o)
     return NULL;
   size_t n = 0;
   char *t = calloc(1, 1);
-  t = append(t, &n, "render_mode=%s\n", bb_render_mode_name(o->mode));
+  t = append(t, &n, "render_mode=%s\n", bb__render_mode_name(o->mode));
   if (o->dynamic_light)
     t = append(t, &n, "light=%.9g,%.9g\nlight_color=%.9g,%.9g,%.9g\n", o->light_azimuth,
                o->light_elevation, (double)o->light_color[0], (double)o->light_color[1],
@@ -782,7 +783,7 @@ char *bb_render_options_describe(const bb_render_options *o) {
     t = append(t, &n, "lightmap=none\n");
   }
   t = append(t, &n, "specular=%.9g\nspecular_strength=%.9g\nalbedo_mode=%s\ntile=%dx%d\n",
-             o->specular_exponent, o->specular_strength, bb_albedo_mode_name(o->albedo_mode),
+             o->specular_exponent, o->specular_strength, bb__albedo_mode_name(o->albedo_mode),
              o->tile_x, o->tile_y);
   if (o->crop_width > 0)
     t = append(t, &n, "crop=%d,%d,%d,%d\n", o->crop_x, o->crop_y, o->crop_width,

@@ -1,13 +1,14 @@
 /* render_compare.c: the paper's four-panel comparison: one set of maps
- * rendered four ways (bb_render) and laid out as labelled panels. */
+ * rendered four ways (bb__render) and laid out as labelled panels. */
 #include "core/internal.h"
+#include "render/render_internal.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options *o,
+bb_status bb__render_compare(const bb_render_maps *maps, const bb_render_options *o,
                             const bb_panel_layout *l, bb_image *out, int *labels_drawn,
                             bb_error *err) {
   if (labels_drawn)
@@ -38,11 +39,11 @@ bb_status bb_render_compare(const bb_render_maps *maps, const bb_render_options 
     po.specular_exponent = !kinds[i].specular           ? 0.0
                            : o->specular_exponent > 0.0 ? o->specular_exponent
                                                         : BB_COMPARE_SPECULAR_EXPONENT;
-    st = bb_render(maps, &po, &renders[i], err);
+    st = bb__render(maps, &po, &renders[i], err);
     panels[i] = (bb_panel){&renders[i], kinds[i].label};
   }
   if (st == BB_OK)
-    st = bb_panels_compose(panels, KINDS, l, out, labels_drawn, err);
+    st = bb__panels_compose(panels, KINDS, l, out, labels_drawn, err);
   for (int i = 0; i < KINDS; i++)
     bb_image_free(&renders[i]);
   return st;

@@ -14,7 +14,7 @@
 /* Bytes of one 3-float texel of a picture. */
 #define PICTURE_TEXEL 12.0
 
-bb_status bb_render_estimate(int width, int height, const bb_render_options *o, int compare,
+bb_status bb__render_estimate(int width, int height, const bb_render_options *o, int compare,
                              const char *output, bb_depth depth, int *picture_width,
                              int *picture_height, double *bytes, bb_error *err) {
   if (picture_width)
@@ -58,7 +58,7 @@ bb_status bb_render_estimate(int width, int height, const bb_render_options *o, 
     during = all > grid ? all : grid;
   }
   /* The encoder's copy of what is written, at the output's sample size
-   * (none without an output: the picture alone, as bb_render makes it). */
+   * (none without an output: the picture alone, as bb__render makes it). */
   const double sample = output ? bb__encoded_sample_bytes(output, depth) : 0.0;
   const double encode = written * PICTURE_TEXEL + written * 3.0 * sample;
   const double peak = during * PICTURE_TEXEL > encode ? during * PICTURE_TEXEL : encode;
@@ -164,7 +164,7 @@ bb_status bb__render_files_need(const bb_render_sources *files,
   }
   int pw = 0, ph = 0;
   double picture = 0.0;
-  bb_status st = bb_render_estimate(w, h, o, compare, output, depth, &pw, &ph, &picture, err);
+  bb_status st = bb__render_estimate(w, h, o, compare, output, depth, &pw, &ph, &picture, err);
   if (st != BB_OK)
     return st;
   *need =
@@ -174,7 +174,7 @@ bb_status bb__render_files_need(const bb_render_sources *files,
   return BB_OK;
 }
 
-bb_status bb_render_files_check(const bb_render_sources *files,
+bb_status bb__render_files_check(const bb_render_sources *files,
                                 const bb_bake_options *bake, const bb_render_options *o,
                                 int compare, const char *output, bb_depth depth,
                                 int *width, int *height, bb_error *err) {

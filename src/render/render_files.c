@@ -3,6 +3,8 @@
  * provenance keys of a render, and the names of an orbit's frames. */
 #include "core/file_names.h"
 #include "core/internal.h"
+#include "render/render_internal.h"
+#include "trace/basis.h"
 
 #include <inttypes.h>
 #include <stdio.h>
@@ -35,7 +37,7 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
   const int channels = k->file_channels;
   const int is_float = info.is_float;
   if (kind == BB_MAP_SSBUMP)
-    st = bb_basis_map_check(&raw, info.description, &why);
+    st = bb__basis_map_check(&raw, info.description, &why);
   bb_image_info_free(&info);
   if (st != BB_OK)
     bb__fail(err, st, "%s: %s", path, why.message);
@@ -61,7 +63,7 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
     bb_image_free(&raw);
   }
   if (st == BB_OK && hash) /* of the map as decoded */
-    *hash = bb_image_hash(out);
+    *hash = bb__image_hash(out);
   return st;
 }
 
@@ -77,7 +79,7 @@ static int add_line(char **text, size_t *length, const char *key, const char *va
   return 0;
 }
 
-char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *o) {
+char *bb__render_provenance(const bb_render_sources *s, const bb_render_options *o) {
   if (!s || !o)
     return NULL;
   char *text = NULL;
@@ -92,7 +94,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
     for (int m = 0; m < BB_MAP_KIND_COUNT; m++)
       if (s->maps[m]) {
         char key[32];
-        snprintf(key, sizeof key, "map_%s", bb_map_kind_name((bb_map_kind)m));
+        snprintf(key, sizeof key, "map_%s", bb__map_kind_name((bb_map_kind)m));
         failed |= add_line(&text, &length, key, bb__file_name(s->maps[m]));
       }
   }
@@ -102,7 +104,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
     failed |= add_line(&text, &length, "albedo", bb__file_name(s->albedo));
     failed |= add_line(&text, &length, "albedo_hash", hash);
   }
-  char *options = bb_render_options_describe(o);
+  char *options = bb__render_options_describe(o);
   if (!options)
     failed = 1;
   else {
@@ -129,7 +131,7 @@ char *bb_render_provenance(const bb_render_sources *s, const bb_render_options *
   return text;
 }
 
-char *bb_render_frame_path(const char *output, int frame, int frames) {
+char *bb__render_frame_path(const char *output, int frame, int frames) {
   if (!output)
     return NULL;
   const char *dot = bb__file_extension(output);

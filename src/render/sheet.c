@@ -3,15 +3,16 @@
 
 #include "trace/basis.h"
 #include "core/internal.h"
+#include "render/render_internal.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 enum { SHEET_PANEL_WIDTH = 256 };
 
-void bb_sheet_options_init(bb_sheet_options *o) {
+void bb__sheet_options_init(bb_sheet_options *o) {
   memset(o, 0, sizeof *o);
-  bb_panel_layout_init(&o->layout);
+  bb__panel_layout_init(&o->layout);
   o->layout.panel_width = SHEET_PANEL_WIDTH;
   bb_render_options_init(&o->lit);
 }
@@ -68,16 +69,16 @@ static bb_status lit_panel(const bb_bake_result *r, const bb_render_options *lit
                            sheet_panels *s, bb_image *rgb, bb_error *err) {
   bb_render_maps maps = {&r->normal, &r->ssbump, &r->ao, &r->bent, NULL, NULL};
   bb_image render = {0};
-  bb_status st = bb_render(&maps, lit, &render, err);
+  bb_status st = bb__render(&maps, lit, &render, err);
   if (st == BB_OK)
-    st = bb_image_to_display(&render, BB_RANGE_UNIT, 0.0f, 1.0f, rgb, err);
+    st = bb__image_to_display(&render, BB_RANGE_UNIT, 0.0f, 1.0f, rgb, err);
   bb_image_free(&render);
   if (lit->dynamic_light)
     snprintf(s->lit_label, sizeof s->lit_label, "lit: %s, light %g,%g",
-             bb_render_mode_name(lit->mode), lit->light_azimuth, lit->light_elevation);
+             bb__render_mode_name(lit->mode), lit->light_azimuth, lit->light_elevation);
   else
     snprintf(s->lit_label, sizeof s->lit_label, "lit: %s, lightmaps",
-             bb_render_mode_name(lit->mode));
+             bb__render_mode_name(lit->mode));
   return st;
 }
 
@@ -102,7 +103,7 @@ static bb_status make_panels(const bb_image *height, const bb_bake_result *r,
   };
   bb_status st = BB_OK;
   for (int i = 0; i < SHEET_PANELS - 1 && st == BB_OK; i++) {
-    st = bb_image_to_display(maps[i].map, maps[i].range, maps[i].low, maps[i].high,
+    st = bb__image_to_display(maps[i].map, maps[i].range, maps[i].low, maps[i].high,
                              &s->images[i], err);
     s->panels[i] = (bb_panel){&s->images[i], maps[i].label};
   }
@@ -112,7 +113,7 @@ static bb_status make_panels(const bb_image *height, const bb_bake_result *r,
   return st;
 }
 
-bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
+bb_status bb__sheet_make(const bb_image *height, const bb_bake_result *r,
                         const bb_sheet_options *o, bb_image *out, int *labels_drawn,
                         bb_error *err) {
   if (labels_drawn)
@@ -129,7 +130,7 @@ bb_status bb_sheet_make(const bb_image *height, const bb_bake_result *r,
   memset(&s, 0, sizeof s);
   st = make_panels(height, r, &o->lit, &s, err);
   if (st == BB_OK)
-    st = bb_panels_compose(s.panels, SHEET_PANELS, &o->layout, out, labels_drawn, err);
+    st = bb__panels_compose(s.panels, SHEET_PANELS, &o->layout, out, labels_drawn, err);
   sheet_panels_free(&s);
   return st;
 }

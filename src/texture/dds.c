@@ -91,7 +91,7 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *chain, int levels,
     break;
   default:
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: DDS has no format %s", path,
-                    bb_texture_format_name(format));
+                    bb__texture_format_name(format));
   }
   put_u32(h + 80, pf_flags);
   put_u32(h + 108, DDSCAPS_TEXTURE | (mips ? DDSCAPS_COMPLEX | DDSCAPS_MIPMAP : 0));

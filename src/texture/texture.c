@@ -20,7 +20,7 @@
 /* ------------------------------------------------------------- formats */
 
 typedef struct format_info {
-  const char *name;  /* first name: bb_texture_format_name */
+  const char *name;  /* first name: bb__texture_format_name */
   int block;         /* a bb__block_format + 1, or 0 for texel formats */
   int texel_bytes;   /* texel formats: bytes a texel */
   int max_channels;  /* channels of the image it holds (bc5: 2, or 3 of a normal map) */
@@ -109,7 +109,7 @@ bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err) {
   return BB_OK;
 }
 
-const char *bb_texture_format_name(bb_texture_format format) {
+const char *bb__texture_format_name(bb_texture_format format) {
   const format_info *f = info_of(format);
   return f ? f->name : "unknown";
 }
@@ -175,7 +175,7 @@ bb__container bb__texture_container(const char *path) {
   return BB__CONTAINER_NONE;
 }
 
-int bb_path_is_texture_format(const char *path) {
+int bb__path_is_texture_format(const char *path) {
   return bb__texture_container(path) != BB__CONTAINER_NONE;
 }
 
@@ -338,7 +338,7 @@ bb_status bb__texture_resolve(const char *path, int width, int height, int chann
   return BB_OK;
 }
 
-bb_status bb_texture_check(const char *path, int width, int height, int channels,
+bb_status bb__texture_check(const char *path, int width, int height, int channels,
                            const bb_texture_options *options, bb_error *err) {
   return bb__texture_resolve(path, width, height, channels, options, NULL, err);
 }
@@ -489,12 +489,12 @@ bb_status bb__texture_encode(const bb_image *level, bb_map_kind map,
 
 /* The map of an output kind string, as the library reads every one
  * (bb__map_kind_of_output: core/map_kind.c). */
-void bb_texture_options_for(bb_texture_options *o, const char *kind, bb_range range) {
+void bb__texture_options_for(bb_texture_options *o, const char *kind, bb_range range) {
   if (o)
     o->map = bb__map_kind_of_output(kind, range, &o->vtf_flags);
 }
 
-char *bb_texture_provenance(const char *path, const bb_texture_options *options) {
+char *bb__texture_provenance(const char *path, const bb_texture_options *options) {
   const bb__container c = bb__texture_container(path);
   if (c == BB__CONTAINER_NONE)
     return NULL;
@@ -504,7 +504,7 @@ char *bb_texture_provenance(const char *path, const bb_texture_options *options)
   char text[256];
   int n = snprintf(text, sizeof text,
                    "texture=%s\ntexture_format=%s\ntexture_mips=%d\ntexture_fit=%s",
-                   c == BB__CONTAINER_VTF ? "vtf" : "dds", bb_texture_format_name(o->format),
+                   c == BB__CONTAINER_VTF ? "vtf" : "dds", bb__texture_format_name(o->format),
                    o->mips ? 1 : 0, o->fast ? "range" : "cluster");
   if (c == BB__CONTAINER_VTF && n > 0 && (size_t)n < sizeof text)
     snprintf(text + n, sizeof text - (size_t)n, "\nvtf_version=7.%d\nvtf_flags=0x%08x",

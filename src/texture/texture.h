@@ -21,7 +21,7 @@ typedef enum bb__container {
 /* The container path's extension names (any case). */
 bb__container bb__texture_container(const char *path);
 
-/* bb_texture_check's rules; on success *format is the format to write
+/* bb__texture_check's rules; on success *format is the format to write
  * (BB_TEXTURE_FORMAT_DEFAULT resolved). Messages start with path. */
 bb_status bb__texture_resolve(const char *path, int width, int height, int channels,
                               const bb_texture_options *options, bb_texture_format *format,
@@ -69,6 +69,58 @@ bb_status bb__texture_encode_levels(const bb_image *levels, int count, bb_map_ki
 bb_status bb__texture_encode(const bb_image *level, bb_map_kind map,
                              bb_texture_format format, int fast, int threads,
                              unsigned char *out, bb_error *err);
+
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* True (1) when path's extension (any case) is .vtf or .dds, the containers
+ * bb__texture_write writes. */
+int bb__path_is_texture_format(const char *path);
+
+/* Checks, before any work, that a width x height image of `channels`
+ * channels can go to path (.vtf or .dds) with options, so a caller can
+ * refuse a bad request before a long bake. BB_ERR_ARGUMENT with the reason
+ * for: another extension; a format the container does not have (VTF: bc1,
+ * bc3, bgr888, bgra8888, rgba16f; DDS: bc1, bc3, bc4, bc5, rgba8, rgba16f,
+ * rgba32f); a format that cannot hold the channels (bc1 and bgr888 take at
+ * most 3, the others 4; bc4 exactly 1; bc5 2, or a normal map's 3); a
+ * normal map of fewer than 3 channels; a VTF side that is not a power of
+ * two or over 32768 (Source); a block format (bc*) whose width or height is
+ * not a multiple of 4; a VTF version outside 2..5 or the ENVMAP flag; an
+ * unknown format or map. */
+bb_status bb__texture_check(const char *path, int width, int height, int channels,
+                           const bb_texture_options *options, bb_error *err);
+
+/* Sets options->map for a file of an output kind (a kind string as
+ * bb_output_file's: NAME or NAME+EXTRA, a NAME map with EXTRA in its last
+ * channel, "ssbump+height") holding values of range: the kind NAME names
+ * (bb_map_kind_info.name, or "detail-ssbump", an ssbump), whose facts then
+ * decide its mip rule, DDS default and VTF flags; except that a normal or
+ * bent map not of BB_RANGE_SIGNED was packed into [0, 1] already ("normal+ao",
+ * height2ssbump -n's): PLAIN, with the kind's BB_VTF_FLAG_NORMAL added to
+ * options->vtf_flags. Any other kind ("height", "colour", "render", ...):
+ * NORMAL for BB_RANGE_SIGNED values, else PLAIN. bb_outputs_write applies
+ * it to every .vtf and .dds it writes, bb_outputs_check to every one it
+ * checks. */
+void bb__texture_options_for(bb_texture_options *options, const char *kind, bb_range range);
+
+/* The "key=value" lines bb__image_write adds to a texture's provenance, so
+ * an up-to-date check sees a changed texture setting: texture (vtf or
+ * dds), texture_format, texture_mips, texture_fit (cluster or range), and
+ * for VTF vtf_version and vtf_flags (hex). options may be NULL (the
+ * defaults). malloc'd; NULL for another extension or out of memory. */
+char *bb__texture_provenance(const char *path, const bb_texture_options *options);
+
+/* The text bb_vmt_write writes, malloc'd into *text (*size bytes), for a
+ * caller that writes it with other files (bb_outputs_write). Errors as
+ * bb_vmt_write's, without BB_ERR_IO. */
+bb_status bb__vmt_text(const char *path, const bb_vmt_options *options, char **text,
+                      size_t *size, bb_error *err);
+
+/* Once in bumpbake.h beside the functions that stay public there. */
+/* The first name of format ("bc1", ...), "default", or "unknown". */
+const char *bb__texture_format_name(bb_texture_format format);
 
 #ifdef __cplusplus
 }

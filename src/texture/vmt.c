@@ -2,6 +2,8 @@
 
 #include "core/internal.h"
 #include "files/file_identity.h"
+#include "files/safe_file.h"
+#include "texture/texture.h"
 
 #include <limits.h>
 #include <stdio.h>
@@ -138,7 +140,7 @@ static bb_status check_material_path(const char *path, const bb_vmt_options *o, 
   return BB_OK;
 }
 
-bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, size_t *size,
+bb_status bb__vmt_text(const char *path, const bb_vmt_options *o, char **text, size_t *size,
                       bb_error *err) {
   if (text)
     *text = NULL;
@@ -147,7 +149,7 @@ bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, si
   if (!path || !*path)
     return bb__fail(err, BB_ERR_ARGUMENT, "material: no path");
   if (!text || !size)
-    return bb__fail(err, BB_ERR_ARGUMENT, "%s: bb_vmt_text: NULL argument", path);
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: bb__vmt_text: NULL argument", path);
   if (!o || !o->bumpmap || !*o->bumpmap)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: a material needs its bump map's .vtf", path);
   bb_status checked = check_material_path(path, o, err);
@@ -191,9 +193,9 @@ bb_status bb_vmt_text(const char *path, const bb_vmt_options *o, char **text, si
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *o, bb_error *err) {
   char *text = NULL;
   size_t size = 0;
-  bb_status st = bb_vmt_text(path, o, &text, &size, err);
+  bb_status st = bb__vmt_text(path, o, &text, &size, err);
   if (st == BB_OK)
-    st = bb_file_write(path, text, size, err);
+    st = bb__file_write(path, text, size, err);
   free(text);
   return st;
 }

@@ -7,6 +7,7 @@
 #include "trace/basis.h"
 #include "core/input_file.h"
 #include "core/internal.h"
+#include "files/provenance.h"
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
@@ -16,14 +17,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* Largest basis file bb_basis_load reads: 16 lines of vectors and room for
+/* Largest basis file bb__basis_load reads: 16 lines of vectors and room for
  * generous comments, and a bound on what a wrong path can make it read. */
 #define BASIS_FILE_MAX_BYTES (64 * 1024)
 
 /* docs/conventions.md "Bases", +Y down; index 3 is hl2+z's (0, 0, 1).
  * cos(elevation) = sqrt(2/3) and sin(elevation) = 1/sqrt(3) are written the
  * same way in dirs_vector, so shared directions have the same bits. */
-void bb_basis_vector(int index, double v[3]) {
+void bb__basis_vector(int index, double v[3]) {
   if (index < 0 || index > 3) {
     v[0] = v[1] = v[2] = 0.0;
     return;
@@ -42,11 +43,11 @@ void bb_basis_vector(int index, double v[3]) {
 static void set_hl2(bb_basis *b, int count, const char *name) {
   memset(b, 0, sizeof *b);
   b->count = count;
-  for (int c = 0; c < count; c++) bb_basis_vector(c, b->vector[c]);
+  for (int c = 0; c < count; c++) bb__basis_vector(c, b->vector[c]);
   snprintf(b->name, sizeof b->name, "%s", name);
 }
 
-void bb_basis_init(bb_basis *b) {
+void bb__basis_init(bb_basis *b) {
   set_hl2(b, 3, "hl2");
 }
 
@@ -83,7 +84,7 @@ static void circle_point(int c, int n, double *x, double *y) {
 
 static void dirs_vector(int c, int n, double v[3]) {
   if ((3 * c) % n == 0) { /* one of Half-Life 2's three: its own bits */
-    bb_basis_vector(3 * c / n, v);
+    bb__basis_vector(3 * c / n, v);
     return;
   }
   const double side = sqrt(2.0 / 3.0), up = 1.0 / sqrt(3.0);
@@ -94,7 +95,7 @@ static void dirs_vector(int c, int n, double v[3]) {
   v[2] = up;
 }
 
-bb_status bb_basis_dirs(int count, bb_basis *out, bb_error *err) {
+bb_status bb__basis_dirs(int count, bb_basis *out, bb_error *err) {
   bb_status st = check_count(count, err);
   if (st != BB_OK) return st;
   memset(out, 0, sizeof *out);
@@ -104,9 +105,9 @@ bb_status bb_basis_dirs(int count, bb_basis *out, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err) {
+bb_status bb__basis_parse(const char *name, bb_basis *out, bb_error *err) {
   if (name && strcmp(name, "hl2") == 0) {
-    bb_basis_init(out);
+    bb__basis_init(out);
     return BB_OK;
   }
   if (name && strcmp(name, "hl2+z") == 0) {
@@ -120,7 +121,7 @@ bb_status bb_basis_parse(const char *name, bb_basis *out, bb_error *err) {
     const long n = strtol(digits, &end, 10);
     if (*digits >= '0' && *digits <= '9' && !*end && errno == 0 && n >= 3 &&
         n <= BB_MAX_BASIS)
-      return bb_basis_dirs((int)n, out, err);
+      return bb__basis_dirs((int)n, out, err);
     return bb__fail(err, BB_ERR_ARGUMENT, "basis: dirs:N needs a count N in 3..%d (got '%s')",
                     BB_MAX_BASIS, name);
   }
@@ -202,7 +203,7 @@ static int line_numbers(char *line, double v[3], char *bad, size_t cap) {
   }
 }
 
-bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out,
+bb_status bb__basis_read_text(const char *text, const char *source, bb_basis *out,
                              bb_error *err) {
   if (!text) return bb__fail(err, BB_ERR_ARGUMENT, "basis: no text");
   if (!source) source = "basis";
@@ -249,7 +250,7 @@ bb_status bb_basis_read_text(const char *text, const char *source, bb_basis *out
   return BB_OK;
 }
 
-bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err) {
+bb_status bb__basis_load(const char *path, bb_basis *out, bb_error *err) {
   if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "basis: no path");
   /* A FIFO, a device or a directory is refused before it is read. */
   int fd;
@@ -280,7 +281,7 @@ bb_status bb_basis_load(const char *path, bb_basis *out, bb_error *err) {
     st = bb__fail(err, BB_ERR_FORMAT, "%s: not a text file (it holds a NUL byte)", path);
   if (st == BB_OK) {
     text[n] = '\0';
-    st = bb_basis_read_text(text, path, out, err);
+    st = bb__basis_read_text(text, path, out, err);
   }
   free(text);
   return st;
@@ -305,7 +306,7 @@ bb_status bb__basis_check(const bb_basis *b, const char *who, bb_error *err) {
 
 bb_status bb__check_hl2_map(const bb_image *img, const bb_basis *basis, const char *what,
                             bb_error *err) {
-  if (basis && !bb_basis_is_hl2(basis))
+  if (basis && !bb__basis_is_hl2(basis))
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "%s was baked with --basis %s; this reads Half-Life 2's basis "
                     "(bake with --basis hl2)",
@@ -318,11 +319,11 @@ bb_status bb__check_hl2_map(const bb_image *img, const bb_basis *basis, const ch
   return BB_OK;
 }
 
-int bb_basis_is_hl2(const bb_basis *b) {
+int bb__basis_is_hl2(const bb_basis *b) {
   if (!b || b->count < 3 || b->count > 4) return 0;
   for (int c = 0; c < 3; c++) {
     double v[3];
-    bb_basis_vector(c, v);
+    bb__basis_vector(c, v);
     if (memcmp(v, b->vector[c], sizeof v) != 0) return 0;
   }
   return 1;
@@ -334,7 +335,7 @@ bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_e
   if (!spec || !out)
     return bb__fail(err, BB_ERR_ARGUMENT, "basis: no basis named");
   if (!strcmp(spec, "hl2") || !strcmp(spec, "hl2+z") || !strncmp(spec, "dirs:", 5)) {
-    if (bb_basis_parse(spec, out, NULL) == BB_OK)
+    if (bb__basis_parse(spec, out, NULL) == BB_OK)
       return BB_OK;
     return bb__fail(err, BB_ERR_ARGUMENT, "basis dirs:N needs a whole N in 3..%d (got '%s')",
                     BB_MAX_BASIS, spec);
@@ -347,14 +348,14 @@ bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_e
                     BB_MAX_BASIS, spec, strerror(errno));
   if (from_file)
     *from_file = 1;
-  return bb_basis_load(spec, out, err);
+  return bb__basis_load(spec, out, err);
 }
 
-bb_status bb_basis_map_check(const bb_image *img, const char *description, bb_error *err) {
+bb_status bb__basis_map_check(const bb_image *img, const char *description, bb_error *err) {
   char name[64];
   bb_basis basis;
-  if (bb_provenance_value(description, "basis", name, sizeof name) && name[0] &&
-      (bb_basis_parse(name, &basis, NULL) != BB_OK || !bb_basis_is_hl2(&basis)))
+  if (bb__provenance_value(description, "basis", name, sizeof name) && name[0] &&
+      (bb__basis_parse(name, &basis, NULL) != BB_OK || !bb__basis_is_hl2(&basis)))
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "baked with --basis %s; this reads Half-Life 2's basis (bake with --basis "
                     "hl2)",

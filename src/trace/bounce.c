@@ -62,6 +62,7 @@
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
 #include "trace/sweep.h"
+#include "bumpbake_cluster.h"
 
 #include <limits.h>
 #include <math.h>
@@ -1987,7 +1988,7 @@ typedef struct finish_job {
 /* When the passes were the trace too: each texel's losses added up from
  * its stored horizons, slice by slice in the order every trace adds them
  * (bb_trace_slice_order), with the trace's own integration, so the sums,
- * once finished, are bb_trace_occlusion's visibility bit for bit. */
+ * once finished, are bb__trace_occlusion's visibility bit for bit. */
 static void trace_row(void *user, int y) {
   const finish_job *job = user;
   const driver *d = job->d;

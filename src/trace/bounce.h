@@ -59,7 +59,7 @@ void bb__bounce_options_init(bb__bounce_options *o);
 enum { BB__BOUNCE_TRACE_WORK = 1 };
 long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o);
 
-/* Adds to vis (1 + lobes channels, as bb_trace_occlusion made it for the
+/* Adds to vis (1 + lobes channels, as bb__trace_occlusion made it for the
  * whole pyramid with the same rayset and bias) what the surface reflects
  * (docs/conventions.md "Inter-reflection"): ao += B_ao / pi and
  * vis_c += B_c / total_c, ao capped at 1. The same bits for any thread

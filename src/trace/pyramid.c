@@ -136,7 +136,7 @@ static bb_status check_heights(const bb_image *z, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_pyramid_build(const bb_image *height_texels, bb_addressing addressing,
+bb_status bb__pyramid_build_all_cores(const bb_image *height_texels, bb_addressing addressing,
                            bb_pyramid **out, bb_error *err) {
   return bb__pyramid_build(height_texels, addressing, 0, out, err);
 }

@@ -19,7 +19,7 @@ struct bb_pyramid {
   float border_max;               /* max over the border vertices (clamp mode) */
 };
 
-/* bb_pyramid_build with the bake's thread count (the same bits for any). */
+/* bb__pyramid_build_all_cores with the bake's thread count (the same bits for any). */
 bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing addressing,
                             int threads, bb_pyramid **out, bb_error *err);
 
@@ -27,9 +27,18 @@ bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing address
  * p->z have been changed by the caller (periodic: the rectangle may pass
  * the right and bottom sides and wrap; clamp: inside the image). The nodes
  * over them, the global max and min and the border max are brought up to
- * date: the pyramid bb_pyramid_build makes of the new heights, bit for
+ * date: the pyramid bb__pyramid_build_all_cores makes of the new heights, bit for
  * bit. old_min: the least of the heights the rectangle held before. */
 bb_status bb__pyramid_update(bb_pyramid *p, int x0, int y0, int width, int height,
                              float old_min);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Builds the pyramid of a 1-channel field of heights in texels (already
+ * multiplied by the height scale). The field is copied. */
+bb_status bb__pyramid_build_all_cores(const bb_image *height_texels,
+                           bb_addressing addressing, bb_pyramid **out,
+                           bb_error *err);
 
 #endif /* BB_TRACE_PYRAMID_H */

@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int bb_slices_for_rays(int rays) {
+int bb__slices_for_rays(int rays) {
   const long slices = lround(sqrt(rays > 1 ? (double)rays : 1.0));
   return slices < 1 ? 1 : (slices > BB_MAX_SLICES ? BB_MAX_SLICES : (int)slices);
 }
@@ -125,7 +125,7 @@ static void build_slice_table(void *user, int s) {
                         job->share + (size_t)s * (size_t)rs->basis_count);
 }
 
-bb_status bb_rayset_make(int slices, double power, const bb_basis *basis, bb_rayset **out,
+bb_status bb__rayset_new(int slices, double power, const bb_basis *basis, bb_rayset **out,
                          bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "ray set: out is NULL");
@@ -152,7 +152,7 @@ bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int t
     return bb__fail(err, BB_ERR_ARGUMENT, "ray set: power must be >= 1 (got %g)", power);
   bb_basis hl2;
   if (!basis) {
-    bb_basis_init(&hl2);
+    bb__basis_init(&hl2);
     basis = &hl2;
   }
   bb_status st = bb__basis_check(basis, "ray set", err);

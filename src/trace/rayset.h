@@ -26,7 +26,7 @@ struct bb_rayset {
   char id[64];               /* names the scheme and its parameters, for provenance */
 };
 
-/* bb_rayset_make into a struct of the caller's (a bake keeps it on its
+/* bb__rayset_new into a struct of the caller's (a bake keeps it on its
  * stack), with the bake's thread count (the tables are built in parallel;
  * the same bits for any count). Release it with bb__rayset_release. */
 bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int threads,
@@ -35,8 +35,24 @@ bb_status bb__rayset_make(int slices, double power, const bb_basis *basis, int t
 /* Frees what bb__rayset_make allocated in rs and zeroes it. */
 void bb__rayset_release(bb_rayset *rs);
 
-/* The id bb_rayset_make gives a rayset of these parameters, into out
+/* The id bb__rayset_new gives a rayset of these parameters, into out
  * (capacity cap), without building it. */
 void bb__rayset_id(int slices, double power, const bb_basis *basis, char *out, size_t cap);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the
+ * library calls these; the library, tests, tools and fuzz targets do. */
+
+/* Azimuth slices a budget of `rays` rays per texel stands for, as Valve's
+ * tool counts rays: round(sqrt(rays)), at least 1 (so -r 250 and 256 both
+ * give 16). */
+int bb__slices_for_rays(int rays);
+
+/* Builds the slices and their integration tables: slices in
+ * 1..BB_MAX_SLICES, power >= 1, one lobe per direction of basis (NULL:
+ * "hl2"; copied). The tables cost slices x basis->count x 8 KiB and their
+ * build time grows with the same product. On success *out receives the
+ * ray set; free it with bb_rayset_free. */
+bb_status bb__rayset_new(int slices, double power, const bb_basis *basis, bb_rayset **out,
+                         bb_error *err);
 
 #endif /* BB_TRACE_RAYSET_H */

@@ -7,7 +7,7 @@
 
 #include <stddef.h>
 
-/* bb_trace_occlusion of every texel (by the sweeps: o->region must be
+/* bb__trace_occlusion of every texel (by the sweeps: o->region must be
  * empty) that also writes each texel's horizon in slice s to horizons[s]
  * (width x height floats each, the caller's): the same vis, bit for bit. */
 bb_status bb__trace_keeping_horizons(const bb_pyramid *p, const bb_rayset *rs,

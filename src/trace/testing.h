@@ -46,13 +46,13 @@ double bb__ray_horizon_brute(const bb_pyramid *p, const bb__ray *ray, double max
  * ao, blocked[1 + c] for lobe c (1 + lobe count values). */
 void bb__rayset_blocked(const bb_rayset *rs, int slice, double tan_horizon, double *blocked);
 
-/* How bb_trace_occlusion finds each texel's horizons. */
+/* How bb__trace_occlusion finds each texel's horizons. */
 typedef enum bb__trace_path {
   BB__TRACE_MARCH, /* texel by texel, every slice by a max-mip march */
   BB__TRACE_SWEEP  /* slice by slice, line sweeps */
 } bb__trace_path;
 
-/* bb_trace_occlusion with the path chosen by the caller. For tests. */
+/* bb__trace_occlusion with the path chosen by the caller. For tests. */
 bb_status bb__trace_occlusion_path(const bb_pyramid *p, const bb_rayset *rs,
                                    const bb_trace_options *o, bb__trace_path path,
                                    bb_image *vis, bb_error *err);

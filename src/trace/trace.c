@@ -8,13 +8,15 @@
 #include "trace/retrace.h"
 #include "trace/sweep.h"
 #include "trace/testing.h"
+#include "trace/trace.h"
+#include "bumpbake_cluster.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 /* ------------------------------------------------------------ batch trace */
 
-void bb_trace_options_init(bb_trace_options *o) {
+void bb__trace_options_init(bb_trace_options *o) {
   memset(o, 0, sizeof *o);
   o->bias_texels = 0.55;
 }
@@ -202,7 +204,7 @@ void bb__trace_texel(const bb_rayset *rs, const int *order, const float *const *
   finish_texel(rs, vis);
 }
 
-bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
+bb_status bb__trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
                              const bb_trace_options *o, bb_image *vis,
                              double *horizons_found, bb_error *err) {
   const int whole = o && o->region.width == 0;
@@ -217,7 +219,7 @@ bb_status bb_trace_occlusion(const bb_pyramid *p, const bb_rayset *rs,
 
 /* A trace split over processes: horizons found by any of them, added up by
  * one in the order every path adds them (order_slices), so the sums are the
- * bits bb_trace_occlusion makes. */
+ * bits bb__trace_occlusion makes. */
 
 bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err) {
   if (!rs || !order || rs->slice_count < 1 || rs->slice_count > BB_MAX_SLICES)

@@ -10,6 +10,10 @@
 
 #include "bumpbake.h"
 #include "bake_harness.h"
+#include "bake/bake_internal.h"
+#include "trace/basis.h"
+#include "trace/pyramid.h"
+#include "trace/trace.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -76,7 +80,7 @@ static void known_answer(horizon_fn horizon, const void *ctx, double *ao, double
     open_ao += 1.0 / (1.0 + t * t);
     for (int c = 0; c < 3; c++) {
       double b[3];
-      bb_basis_vector(c, b);
+      bb__basis_vector(c, b);
       open_vis[c] += lobe_above(b, phi, t);
       all_vis[c] += lobe_above(b, phi, 0.0);
     }
@@ -96,7 +100,7 @@ static void expect_answer(const bb_bake_result *r, int x, int y, double ao, cons
   const float *n = at(&r->normal, x, y);
   for (int c = 0; c < 3; c++) {
     double b[3];
-    bb_basis_vector(c, b);
+    bb__basis_vector(c, b);
     const double ndotb = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
     cr_assert_gt(ndotb, 0.1, "%s: the test needs every lobe facing the surface", what);
     const double got = at(&r->ssbump, x, y)[c] / ndotb;
@@ -200,7 +204,7 @@ Test(bake, cylindrical_pit_centre_matches_the_exact_integrals) {
       z.pixels[y * size + x] = (float)depth * h.pixels[y * size + x];
     }
   bb_pyramid *p = NULL;
-  cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  cr_assert_eq(bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
   const pit pt = {p, c, c};
   double ao, vis[3];
   known_answer(pit_horizon, &pt, &ao, vis);
@@ -415,10 +419,10 @@ Test(bake, progress_callback_cancels_a_region_trace) {
   for (int i = 0; i < 64 * 64; i++) h.pixels[i] *= 20.0f;
   bb_pyramid *p = NULL;
   bb_rayset rs;
-  cr_assert_eq(bb_pyramid_build(&h, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  cr_assert_eq(bb__pyramid_build_all_cores(&h, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
   cr_assert_eq(bb__rayset_make(64, 1.0, NULL, 0, &rs, NULL), BB_OK);
   bb_trace_options t;
-  bb_trace_options_init(&t);
+  bb__trace_options_init(&t);
   t.region = (bb_region){0, 0, 64, 64};
   t.threads = 2;
   cancel_state stop = {0, 0, 0, 0};
@@ -426,7 +430,7 @@ Test(bake, progress_callback_cancels_a_region_trace) {
   t.progress_user = &stop;
   bb_image vis;
   bb_error err;
-  cr_assert_eq(bb_trace_occlusion(p, &rs, &t, &vis, NULL, &err), BB_ERR_CANCELLED);
+  cr_assert_eq(bb__trace_occlusion(p, &rs, &t, &vis, NULL, &err), BB_ERR_CANCELLED);
   cr_assert(strstr(err.message, "cancelled"), "%s", err.message);
   cr_assert_null(vis.pixels);
   cr_assert_geq(stop.calls, 1);
@@ -441,7 +445,7 @@ Test(bake, options_check_holds_every_limit) {
   bb_bake_options_init(&o);
   o.height_scale = 4.0f;
   bb_error err;
-  cr_assert_eq(bb_bake_options_check(&o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_options_check(&o, &err), BB_OK, "%s", err.message);
   static const struct {
     int field; /* 0 radius, 1 threads, 2 bias, 3 power, 4 outputs */
     double ok, bad;
@@ -470,7 +474,7 @@ Test(bake, options_check_holds_every_limit) {
       default: c.outputs = (unsigned)v; break;
       }
       memset(&err, 0, sizeof err);
-      bb_status st = bb_bake_options_check(&c, &err);
+      bb_status st = bb__bake_options_check(&c, &err);
       if (!bad) {
         cr_assert_eq(st, BB_OK, "case %zu: %s", i, err.message);
         continue;

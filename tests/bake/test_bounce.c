@@ -14,6 +14,10 @@
 #include "bumpbake.h"
 #include "image/height_channel.h"
 #include "bake_harness.h"
+#include "bake/bake_internal.h"
+#include "image/image_write.h"
+#include "trace/basis.h"
+#include "trace/trace.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -152,7 +156,7 @@ static bb_status counting_trace(void *user, const bb_pyramid *p, const bb_rayset
                                 const bb_trace_options *o, bb_image *vis, bb_error *err) {
   trace_count *t = user;
   double found = 0.0;
-  bb_status st = bb_trace_occlusion(p, rs, o, vis, &found, err);
+  bb_status st = bb__trace_occlusion(p, rs, o, vis, &found, err);
   t->calls_in_trace = t->log->calls;
   return st;
 }
@@ -286,12 +290,12 @@ Test(bounce, options_are_checked) {
   for (size_t i = 0; i < 3; i++) {
     bb_bake_options o = options(4.0f, 16, bad_rho[i]);
     bb_error err;
-    cr_expect_eq(bb_bake_options_check(&o, &err), BB_ERR_ARGUMENT, "rho %g", bad_rho[i]);
+    cr_expect_eq(bb__bake_options_check(&o, &err), BB_ERR_ARGUMENT, "rho %g", bad_rho[i]);
   }
   bb_bake_options o = options(4.0f, 16, 0.5);
   o.bounces = BB_MAX_BOUNCES + 1;
   bb_error err;
-  cr_expect_eq(bb_bake_options_check(&o, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb__bake_options_check(&o, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "bounces") != NULL, "%s", err.message);
   /* an albedo map of another size is named as such */
   bb_image small = harness_field(4, 4, 1.0f);
@@ -383,7 +387,7 @@ Test(bounce, a_plane_reflects_its_closed_form) {
   }
   for (int c = 0; c < 3; c++) {
     double b[3], e = 0.0, total = 0.0;
-    bb_basis_vector(c, b);
+    bb__basis_vector(c, b);
     for (int i = 0; i < ne; i++) {
       const double el = 0.5 * PI * (i + 0.5) / ne;
       for (int j = 0; j < na; j++) {
@@ -670,8 +674,8 @@ Test(bounce, agrees_with_the_path_tracer_on_a_small_map, .timeout = 600) {
   o.normal_filter = BB_NORMAL_VALVE;
   bb_bake_result r = harness_bake(&h, &o);
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(ao, &r.ao, &wo, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_image_write(ss, &r.ssbump, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(ao, &r.ao, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(ss, &r.ssbump, &wo, &err), BB_OK, "%s", err.message);
   snprintf(pair, sizeof pair, "bake=%s,%s", ao, ss);
   char *compare[] = {tool, "compare", ref, map, "8", pair, NULL};
   cr_assert_eq(run_capture(compare, out, sizeof out), 0, "compare failed: %s", out);

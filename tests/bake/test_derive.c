@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
+#include "trace/basis.h"
 
 /* An image of `count` texels, every texel set to the same values. */
 static void make_uniform(bb_image *img, int count, int channels, const float *values) {
@@ -32,7 +34,7 @@ static double dot(const double a[3], const double b[3]) {
 Test(derive, basis_vectors) {
   double b[4][3];
   for (int c = 0; c < 4; c++) {
-    bb_basis_vector(c, b[c]);
+    bb__basis_vector(c, b[c]);
     cr_assert_float_eq(dot(b[c], b[c]), 1.0, 1e-15, "B%d not unit", c);
   }
   cr_assert_float_eq(b[0][0], sqrt(2.0 / 3.0), 1e-15);
@@ -54,9 +56,9 @@ Test(derive, flat_unoccluded_texel) {
   make_uniform(&n, 4, 3, up);
   make_uniform(&vis, 4, 4, all_visible);
   cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
-  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ao_all_cores(&vis, &ao, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
   cr_assert_eq(s.channels, 3);
   cr_assert_eq(ao.channels, 1);
   for (int i = 0; i < 4; i++) {
@@ -79,10 +81,10 @@ Test(derive, flat_with_z_channel) {
   bb_image n = {0}, vis = {0}, s = {0}, bent = {0};
   make_uniform(&n, 1, 3, up);
   make_uniform(&vis, 1, 5, vis5);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
   cr_assert_eq(s.channels, 4);
   cr_assert_float_eq(s.pixels[3], 0.75f, 1e-7f);
-  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
   cr_assert_float_eq(bent.pixels[2], 1.0f, 1e-7f);
   bb_image_free(&n), bb_image_free(&vis), bb_image_free(&s), bb_image_free(&bent);
 }
@@ -92,7 +94,7 @@ Test(derive, normal_along_a_basis_vector_takes_all_weight) {
   cr_assert_eq(bb_image_alloc(&n, 3, 1, 3, NULL), BB_OK);
   for (int c = 0; c < 3; c++) {
     double b[3];
-    bb_basis_vector(c, b);
+    bb__basis_vector(c, b);
     set_normal(&n, c, b[0], b[1], b[2]);
   }
   cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
@@ -107,8 +109,8 @@ Test(derive, normal_along_a_basis_vector_takes_all_weight) {
  * and a normal facing away from every direction falls back to 1/3 each. */
 Test(derive, weights_between_and_beyond) {
   double b0[3], b1[3];
-  bb_basis_vector(0, b0);
-  bb_basis_vector(1, b1);
+  bb__basis_vector(0, b0);
+  bb__basis_vector(1, b1);
   bb_image n = {0}, w = {0};
   cr_assert_eq(bb_image_alloc(&n, 2, 1, 3, NULL), BB_OK);
   set_normal(&n, 0, b0[0] + b1[0], b0[1] + b1[1], b0[2] + b1[2]);
@@ -129,9 +131,9 @@ Test(derive, ssbump_is_zero_where_the_normal_faces_away) {
   make_uniform(&n, 1, 3, zero);
   set_normal(&n, 0, 1.0, 0.0, 0.2);
   make_uniform(&vis, 1, 4, vis4);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
   double b0[3];
-  bb_basis_vector(0, b0);
+  bb__basis_vector(0, b0);
   double n0[3] = {n.pixels[0], n.pixels[1], n.pixels[2]};
   cr_assert_float_eq(s.pixels[0], dot(n0, b0) * 0.9, 1e-6, "vis_0 is channel 1 of vis");
   cr_assert_eq(s.pixels[1], 0.0f);
@@ -145,10 +147,10 @@ Test(derive, bent_of_a_single_light_follows_its_basis_vector) {
   cr_assert_eq(bb_image_alloc(&s, 4, 1, 4, NULL), BB_OK);
   for (int c = 0; c < 4; c++)
     s.pixels[4 * c + c] = 0.4f;
-  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
   for (int c = 0; c < 4; c++) {
     double b[3];
-    bb_basis_vector(c, b);
+    bb__basis_vector(c, b);
     for (int k = 0; k < 3; k++)
       cr_assert_float_eq(bent.pixels[3 * c + k], b[k], 1e-6, "light %d axis %d", c, k);
   }
@@ -159,7 +161,7 @@ Test(derive, bent_of_a_dark_texel_is_straight_up) {
   const float dark[3] = {0.0f, 0.0f, 0.0f};
   bb_image s = {0}, bent = {0};
   make_uniform(&s, 2, 3, dark);
-  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
   for (int i = 0; i < 2; i++)
     cr_assert(bent.pixels[3 * i] == 0.0f && bent.pixels[3 * i + 1] == 0.0f &&
               bent.pixels[3 * i + 2] == 1.0f);
@@ -172,7 +174,7 @@ Test(derive, ao_is_channel_zero) {
   for (int i = 0; i < 6; i++)
     for (int c = 0; c < 4; c++)
       vis.pixels[4 * i + c] = (float)(0.1 * i + 0.01 * c);
-  cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ao_all_cores(&vis, &ao, NULL), BB_OK);
   cr_assert_eq(ao.width, 3);
   cr_assert_eq(ao.height, 2);
   for (int i = 0; i < 6; i++)
@@ -214,12 +216,12 @@ static void check_maps_against_formulas(int count) {
   cr_assert_eq(bb_derive_weights(&n, NULL, &refused, &e), BB_ERR_VALUE);
   cr_assert(strstr(e.message, "texel (26, 2) channel 0 is NaN") != NULL, "%s", e.message);
   cr_assert_null(refused.pixels);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, NULL, &s, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ao(&vis, &ao, NULL), BB_OK);
-  cr_assert_eq(bb_derive_bent(&s, NULL, &bent, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
+  cr_assert_eq(bb__derive_ao_all_cores(&vis, &ao, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
   double b[4][3];
   for (int c = 0; c < count; c++)
-    bb_basis_vector(c, b[c]);
+    bb__basis_vector(c, b[c]);
   for (int i = 0; i < texels; i++) {
     const float *ni = n.pixels + 3 * i, *vi = vis.pixels + (1 + count) * i;
     double d[4], wsum = 0.0, bv[3] = {0.0, 0.0, 0.0};
@@ -268,15 +270,15 @@ Test(derive, rejects_mismatched_inputs) {
   cr_assert_eq(bb_image_alloc(&vis, 4, 4, 4, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&vis2, 4, 4, 2, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&s2, 4, 4, 2, NULL), BB_OK);
-  cr_assert_eq(bb_derive_ssbump(&n_small, &vis, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n_small, &vis, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "4x3") != NULL, "%s", err.message);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis2, NULL, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_derive_ssbump(&vis, &vis, NULL, &out, &err), BB_ERR_ARGUMENT,
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis2, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&vis, &vis, NULL, &out, &err), BB_ERR_ARGUMENT,
                "normals need 3 channels");
   cr_assert_eq(bb_derive_weights(&vis, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb_derive_weights(&n, NULL, &n, &err), BB_ERR_ARGUMENT, "output aliases input");
-  cr_assert_eq(bb_derive_bent(&s2, NULL, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_derive_ao(NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_bent_all_cores(&s2, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_ao_all_cores(NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_null(out.pixels);
   cr_assert_not_null(n.pixels);
   bb_image_free(&n), bb_image_free(&n_small), bb_image_free(&vis);

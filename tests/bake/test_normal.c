@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
 
 #define PI 3.14159265358979323846
 
@@ -22,7 +23,7 @@ static void fill_constant(bb_image *h, float value) {
 static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addressing a,
                     bb_image *out) {
   bb_error err = {{0}};
-  cr_assert_eq(bb_normals_compute(h, scale, f, a, out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__normals_compute_all_cores(h, scale, f, a, out, &err), BB_OK, "%s", err.message);
   cr_assert_eq(out->channels, 3);
   cr_assert_eq(out->width, h->width);
   cr_assert_eq(out->height, h->height);
@@ -31,7 +32,7 @@ static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addre
 Test(normal, filter_names_round_trip) {
   for (size_t i = 0; i < FILTER_COUNT; i++) {
     bb_normal_filter parsed = (bb_normal_filter)-1;
-    cr_assert_eq(bb_normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed, NULL),
+    cr_assert_eq(bb__normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed, NULL),
                  0);
     cr_assert_eq(parsed, all_filters[i]);
   }
@@ -40,8 +41,8 @@ Test(normal, filter_names_round_trip) {
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_CENTRAL), "central");
   cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_SOBEL), "sobel");
   bb_normal_filter f = BB_NORMAL_SOBEL;
-  cr_assert_neq(bb_normal_filter_parse("Valve", &f, NULL), 0);
-  cr_assert_neq(bb_normal_filter_parse("", &f, NULL), 0);
+  cr_assert_neq(bb__normal_filter_parse("Valve", &f, NULL), 0);
+  cr_assert_neq(bb__normal_filter_parse("", &f, NULL), 0);
   cr_assert_eq(f, BB_NORMAL_SOBEL, "a failed parse must not write");
 }
 
@@ -376,24 +377,24 @@ Test(normal, rejects_bad_arguments) {
   cr_assert_eq(bb_image_alloc(&h, 4, 4, 1, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&rgb, 4, 4, 3, NULL), BB_OK);
   cr_assert_eq(
-      bb_normals_compute(&rgb, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
+      bb__normals_compute_all_cores(&rgb, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
       BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "channels") != NULL, "%s", err.message);
   cr_assert_eq(
-      bb_normals_compute(&h, NAN, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
+      bb__normals_compute_all_cores(&h, NAN, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &n, &err),
       BB_ERR_ARGUMENT);
   cr_assert_eq(
-      bb_normals_compute(&h, INFINITY, BB_NORMAL_SOBEL, BB_ADDRESS_CLAMP, &n, &err),
+      bb__normals_compute_all_cores(&h, INFINITY, BB_NORMAL_SOBEL, BB_ADDRESS_CLAMP, &n, &err),
       BB_ERR_ARGUMENT);
   cr_assert_eq(
-      bb_normals_compute(&h, 1.0f, (bb_normal_filter)7, BB_ADDRESS_PERIODIC, &n, &err),
+      bb__normals_compute_all_cores(&h, 1.0f, (bb_normal_filter)7, BB_ADDRESS_PERIODIC, &n, &err),
       BB_ERR_ARGUMENT);
   cr_assert_eq(
-      bb_normals_compute(&h, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &h, &err),
+      bb__normals_compute_all_cores(&h, 1.0f, BB_NORMAL_VALVE, BB_ADDRESS_PERIODIC, &h, &err),
       BB_ERR_ARGUMENT);
   bb_image_texel(&h, 2, 1)[0] = NAN;
   cr_assert_eq(
-      bb_normals_compute(&h, 1.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_PERIODIC, &n, &err),
+      bb__normals_compute_all_cores(&h, 1.0f, BB_NORMAL_CENTRAL, BB_ADDRESS_PERIODIC, &n, &err),
       BB_ERR_VALUE);
   cr_assert(strstr(err.message, "(2, 1)") != NULL, "%s", err.message);
   cr_assert_null(n.pixels);

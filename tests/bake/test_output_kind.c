@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "core/internal.h"
+#include "trace/basis.h"
 
 Test(output_kind, table_lists_every_kind_in_enum_order) {
   static const char *names[] = {"normal", "weights",  "ssbump", "ao",
@@ -23,7 +25,7 @@ Test(output_kind, table_lists_every_kind_in_enum_order) {
     const bb_map_kind_info *info = bb_map_kind_get((bb_map_kind)k);
     cr_assert_not_null(info);
     cr_assert_str_eq(info->name, names[k]);
-    cr_assert_str_eq(bb_map_kind_name((bb_map_kind)k), names[k]);
+    cr_assert_str_eq(bb__map_kind_name((bb_map_kind)k), names[k]);
     cr_assert(info->description && info->description[0]);
     cr_assert_eq(info->channels, channels[k], "%s", names[k]);
     cr_assert_eq(info->file_channels, file_channels[k], "%s", names[k]);
@@ -33,7 +35,7 @@ Test(output_kind, table_lists_every_kind_in_enum_order) {
     if (info->needs_trace)
       traced |= BB_MAP_BIT(k);
     bb_map_kind parsed = BB_MAP_KIND_COUNT;
-    cr_assert_eq(bb_map_kind_parse(names[k], &parsed, NULL), 0);
+    cr_assert_eq(bb__map_kind_parse(names[k], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, k);
   }
   cr_assert_eq(traced, BB_MAPS_TRACED);
@@ -43,12 +45,12 @@ Test(output_kind, table_lists_every_kind_in_enum_order) {
 Test(output_kind, unknown_kinds_are_refused) {
   cr_assert_null(bb_map_kind_get(BB_MAP_KIND_COUNT));
   cr_assert_null(bb_map_kind_get((bb_map_kind)-1));
-  cr_assert_str_eq(bb_map_kind_name(BB_MAP_KIND_COUNT), "unknown");
+  cr_assert_str_eq(bb__map_kind_name(BB_MAP_KIND_COUNT), "unknown");
   bb_map_kind k = BB_MAP_AO;
-  cr_assert_eq(bb_map_kind_parse("shadow", &k, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_map_kind_parse(NULL, &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__map_kind_parse("shadow", &k, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__map_kind_parse(NULL, &k, NULL), BB_ERR_ARGUMENT);
   cr_assert_eq(k, BB_MAP_AO, "untouched on failure");
-  cr_assert_eq(bb_map_kind_parse("Normal", &k, NULL), BB_OK, "any case");
+  cr_assert_eq(bb__map_kind_parse("Normal", &k, NULL), BB_OK, "any case");
   cr_assert_eq(k, BB_MAP_NORMAL);
 }
 
@@ -63,7 +65,7 @@ Test(output_kind, result_images_match_the_table) {
   bb_bake_options_init(&o);
   o.height_scale = 3.0f;
   o.slices = 4;
-  cr_assert_eq(bb_basis_parse("dirs:5", &o.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("dirs:5", &o.basis, NULL), BB_OK);
   bb_bake_result r;
   bb_error err;
   cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);

@@ -12,6 +12,7 @@
 
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
+#include "trace/basis.h"
 
 /* A small deterministic generator, so a failure names an edit to replay. */
 typedef struct rng {
@@ -235,7 +236,7 @@ Test(rebake, edits_with_other_options_equal_whole_bakes) {
    * normals, no smoothing, an odd number of slices (one without an
    * opposite), a power, a wider bias */
   bb_bake_options o = options_of(BB_ADDRESS_PERIODIC, BB_MAPS_BAKED);
-  cr_assert_eq(bb_basis_parse("hl2+z", &o.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("hl2+z", &o.basis, NULL), BB_OK);
   o.normal_y_up = 1;
   edits_equal_whole_with(70, 66, &o, 0, 10, 10u);
   o = options_of(BB_ADDRESS_CLAMP, BB_MAPS_BAKED);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
 
 /* Deterministic pseudo-random numbers in [0, 1) (64-bit LCG, high bits). */
 static double next_random(uint64_t *state) {
@@ -58,10 +59,10 @@ static void check_against_brute_force(int radius, bb_addressing a) {
   cr_assert_eq(bb_image_alloc(&h, 29, 19, 1, &err), BB_OK);
   fill_test_field(&h, 42u + (uint64_t)radius);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   o.radius_texels = radius;
   o.addressing = a;
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &out, &err), BB_OK, "%s", err.message);
   int changed = 0;
   for (int y = 0; y < h.height; y++)
     for (int x = 0; x < h.width; x++) {
@@ -83,7 +84,7 @@ static void check_against_brute_force(int radius, bb_addressing a) {
 Test(smooth, options_defaults) {
   bb_smooth_options o;
   memset(&o, 0xff, sizeof o);
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   cr_assert_eq(o.radius_texels, 10);
   cr_assert_float_eq(o.threshold, 2.0f / 255.0f, 1e-9f);
   cr_assert_eq(o.addressing, BB_ADDRESS_PERIODIC);
@@ -123,10 +124,10 @@ Test(smooth, multichannel_with_separate_guide) {
   fill_test_field(&in, 7);
   fill_test_field(&guide, 8);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   o.radius_texels = 4;
   o.threshold = 5.0f / 255.0f;
-  cr_assert_eq(bb_smooth_bilateral(&in, &guide, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&in, &guide, &o, &out, NULL), BB_OK);
   cr_assert_eq(out.channels, 3);
   for (int y = 0; y < in.height; y++)
     for (int x = 0; x < in.width; x++)
@@ -147,9 +148,9 @@ Test(smooth, radius_zero_is_identity) {
   cr_assert_eq(bb_image_alloc(&h, 37, 23, 2, NULL), BB_OK);
   fill_test_field(&h, 3);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   o.radius_texels = 0;
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &out, NULL), BB_OK);
   cr_assert_eq(out.width, 37);
   cr_assert_eq(out.height, 23);
   cr_assert_eq(out.channels, 2);
@@ -166,8 +167,8 @@ Test(smooth, keeps_edges_above_threshold) {
     for (int x = 0; x < 32; x++)
       bb_image_texel(&h, x, y)[0] = x < 16 ? 0.25f : 0.75f;
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, NULL), BB_OK);
+  bb__smooth_options_init(&o);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &out, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 32; x++)
       cr_assert_float_eq(bb_image_texel(&out, x, y)[0], bb_image_texel(&h, x, y)[0],
@@ -188,9 +189,9 @@ Test(smooth, periodic_shift_is_exact) {
       bb_image_texel(&shifted, (x + dx) % w, (y + dy) % hgt)[0] =
           bb_image_texel(&h, x, y)[0];
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &out, NULL), BB_OK);
-  cr_assert_eq(bb_smooth_bilateral(&shifted, &shifted, &o, &out_shifted, NULL), BB_OK);
+  bb__smooth_options_init(&o);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&shifted, &shifted, &o, &out_shifted, NULL), BB_OK);
   for (int y = 0; y < hgt; y++)
     for (int x = 0; x < w; x++) {
       float a = bb_image_texel(&out, x, y)[0];
@@ -211,9 +212,9 @@ Test(smooth, repeated_runs_are_identical) {
   cr_assert_eq(bb_image_alloc(&h, 64, 200, 1, NULL), BB_OK);
   fill_test_field(&h, 5);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &a, NULL), BB_OK);
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &b, NULL), BB_OK);
+  bb__smooth_options_init(&o);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &a, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &b, NULL), BB_OK);
   cr_assert_eq(memcmp(a.pixels, b.pixels, 64 * 200 * sizeof(float)), 0);
   bb_image_free(&h);
   bb_image_free(&a);
@@ -232,12 +233,12 @@ static void check_blocks_match_texels(int width, int radius, float threshold,
   for (int i = 0; i < width * 9; i++)
     two.pixels[2 * i] = two.pixels[2 * i + 1] = h.pixels[i];
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   o.radius_texels = radius;
   o.threshold = threshold;
   o.addressing = a;
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &one_out, NULL), BB_OK);
-  cr_assert_eq(bb_smooth_bilateral(&two, &h, &o, &two_out, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &one_out, NULL), BB_OK);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&two, &h, &o, &two_out, NULL), BB_OK);
   for (int y = 0; y < 9; y++)
     for (int x = 0; x < width; x++) {
       float got = bb_image_texel(&one_out, x, y)[0];
@@ -270,10 +271,10 @@ static bb_status smooth_with(int radius, float threshold, const bb_image *guide,
   bb_image h = {0}, out = {0};
   cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
+  bb__smooth_options_init(&o);
   o.radius_texels = radius;
   o.threshold = threshold;
-  bb_status st = bb_smooth_bilateral(&h, guide ? guide : &h, &o, &out, err);
+  bb_status st = bb__smooth_bilateral_all_cores(&h, guide ? guide : &h, &o, &out, err);
   if (st != BB_OK)
     cr_assert_null(out.pixels, "a failed call must leave no output");
   bb_image_free(&h);
@@ -315,8 +316,8 @@ Test(smooth, rejects_output_aliasing_input) {
   bb_image h = {0};
   cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
   bb_smooth_options o;
-  bb_smooth_options_init(&o);
-  cr_assert_eq(bb_smooth_bilateral(&h, &h, &o, &h, NULL), BB_ERR_ARGUMENT);
+  bb__smooth_options_init(&o);
+  cr_assert_eq(bb__smooth_bilateral_all_cores(&h, &h, &o, &h, NULL), BB_ERR_ARGUMENT);
   cr_assert_not_null(h.pixels, "the input must survive");
   bb_image_free(&h);
 }

@@ -9,6 +9,8 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
+#include "trace/basis.h"
 
 static bb_image bumps(int w, int h) {
   bb_image img;
@@ -89,7 +91,7 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     o.slices = cases[c].slices;
     o.smooth.addressing = cases[c].a;
     o.bounce_albedo = cases[c].bounce;
-    cr_assert_eq(bb_basis_parse(cases[c].basis, &o.basis, NULL), BB_OK);
+    cr_assert_eq(bb__basis_parse(cases[c].basis, &o.basis, NULL), BB_OK);
     bb_bake_result plain, split;
     bb_error err;
     cr_assert_eq(bb_bake(&height, &o, &plain, &err), BB_OK, "%s", err.message);

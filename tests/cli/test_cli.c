@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "cli_harness.h"
+#include "image/image_write.h"
 
 /* The whole content of a file (malloc'd), its size in *size. */
 static unsigned char *read_bytes(const char *path, size_t *size) {
@@ -55,7 +56,7 @@ static void write_image(const char *path, int w, int h, int channels, texel_fn v
       for (int c = 0; c < channels; c++)
         bb_image_texel(&img, x, y)[c] = value(x, y, c);
   bb_write_options o = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
 }
 
@@ -691,7 +692,7 @@ Test(cli, filtered_keeps_the_input_depth) {
   for (int i = 0; i < 256; i++)
     h.pixels[i] = (float)(i * 97 % 256) / 255.0f + 1.0f / 65535.0f * (float)(i % 7);
   bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(in, &h, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(in, &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   const struct {
     const char *out, *depth;

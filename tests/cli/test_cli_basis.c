@@ -7,6 +7,8 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "files/provenance.h"
+#include "trace/basis.h"
 
 #include <math.h>
 
@@ -63,15 +65,15 @@ Test(cli_basis, dirs_writes_a_channel_per_direction_to_exr_and_tiff) {
   bb_bake_options_init(&o);
   o.height_scale = 6.0f;
   o.slices = 8;
-  cr_assert_eq(bb_basis_parse("dirs:6", &o.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("dirs:6", &o.basis, NULL), BB_OK);
   bb_bake_result want;
   cr_assert_eq(bb_bake(&height, &o, &want, NULL), BB_OK);
   cr_assert(harness_same_pixels(&s, &want.ssbump), "ssbump.exr holds the library's bits");
   cr_assert_leq(harness_max_difference(&w, &want.weights), 0.5 / 255 + 1e-6);
   char *text = description_of(tmp("s.exr")), value[64];
-  cr_assert(bb_provenance_value(text, "basis", value, sizeof value));
+  cr_assert(bb__provenance_value(text, "basis", value, sizeof value));
   cr_assert_str_eq(value, "dirs:6");
-  cr_assert(!bb_provenance_value(text, "basis_vectors", value, sizeof value),
+  cr_assert(!bb__provenance_value(text, "basis_vectors", value, sizeof value),
             "a named basis needs no vectors");
   free(text);
   bb_bake_result_free(&want);
@@ -168,14 +170,14 @@ Test(cli_basis, a_basis_file_is_recorded_by_its_vectors) {
   cr_assert_eq(bb_bake(&height, &o, &want, NULL), BB_OK);
   cr_assert(harness_same_pixels(&s, &want.ssbump));
   char *text = description_of(tmp("s.tif")), value[1024];
-  cr_assert(bb_provenance_value(text, "basis", value, sizeof value));
+  cr_assert(bb__provenance_value(text, "basis", value, sizeof value));
   cr_assert_str_eq(value, o.basis.name);
-  cr_assert(bb_provenance_value(text, "basis_vectors", value, sizeof value));
+  cr_assert(bb__provenance_value(text, "basis_vectors", value, sizeof value));
   /* "x y z; ..." reads back, through a basis file's parser, as the basis. */
   for (char *c = value; *c; c++)
     if (*c == ';') *c = '\n';
   bb_basis again;
-  cr_assert_eq(bb_basis_read_text(value, "provenance", &again, NULL), BB_OK, "%s", value);
+  cr_assert_eq(bb__basis_read_text(value, "provenance", &again, NULL), BB_OK, "%s", value);
   cr_assert(memcmp(again.vector, o.basis.vector, sizeof again.vector) == 0);
   free(text);
   bb_bake_result_free(&want);

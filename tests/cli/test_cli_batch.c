@@ -7,6 +7,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "files/provenance.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -114,7 +115,7 @@ Test(cli_batch, name_template_and_maps) {
   cr_assert_eq(bb_image_read_info(tmp("out/ao-{a}.tif"), NULL, NULL, NULL, &info, NULL), BB_OK);
   cr_expect_str_eq(info.format_name, "tiff");
   char value[256];
-  cr_expect(bb_provenance_value(info.description, "command", value, sizeof value));
+  cr_expect(bb__provenance_value(info.description, "command", value, sizeof value));
   cr_expect(strncmp(value, "bumpbake bake a.tif ", 20) == 0,
             "each output's command bakes its own input: %s", value);
   bb_image_info_free(&info);

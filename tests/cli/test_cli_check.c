@@ -9,6 +9,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "files/provenance.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -172,7 +173,7 @@ Test(cli_check, update_writes_only_what_did_not_pass_then_passes) {
            n = harness_read(tmp("a_ssbump.png"), &ni);
   cr_expect(harness_same_pixels(&g, &n));
   char out_dir[64];
-  cr_expect(bb_provenance_value(gi.description, "command", out_dir, sizeof out_dir));
+  cr_expect(bb__provenance_value(gi.description, "command", out_dir, sizeof out_dir));
   cr_expect(strstr(gi.description, "--out-dir "), "the golden records its batch: %s",
             gi.description);
   bb_image_free(&g);

@@ -7,6 +7,7 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "job/job_internal.h"
+#include "image/image_write.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -27,7 +28,7 @@ static void write_height(const char *path, int side) {
                             0.2 * (double)(s >> 11) / 9007199254740992.0);
   }
   bb_write_options wo = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(path, &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(path, &img, &wo, NULL), BB_OK);
   bb_image_free(&img);
 }
 

@@ -7,6 +7,10 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "hostile_headers.h"
+#include "core/internal.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "render/render_internal.h"
 
 #include <math.h>
 
@@ -147,7 +151,7 @@ Test(cli_render, orbit_as_gif_and_as_frames) {
   cr_assert(strstr(r.out, "(5 frames)"), "%s", r.out);
   cli_result_free(&r);
   int frames = 0;
-  cr_assert_eq(bb_image_frame_count(tmp("orbit.gif"), &frames, NULL), BB_OK);
+  cr_assert_eq(bb__image_frame_count(tmp("orbit.gif"), &frames, NULL), BB_OK);
   cr_assert_eq(frames, 5);
 
   r = RUN("render", fixture("pit_65x65.png"), "--scale", "8", "--rays", "16", "--orbit",
@@ -179,7 +183,7 @@ Test(cli_render, an_orbit_frame_that_is_an_input_is_refused) {
   cli_result_free(&r);
   cr_assert_eq(files_starting_with("o_"), 1, "no frame was written");
   bb_image after = read_image(tmp("o_001.png"), NULL);
-  cr_assert_eq(bb_image_hash(&before), bb_image_hash(&after), "the input is untouched");
+  cr_assert_eq(bb__image_hash(&before), bb__image_hash(&after), "the input is untouched");
   bb_image_free(&before);
   bb_image_free(&after);
 }
@@ -253,7 +257,7 @@ Test(cli_render, tiles_over_the_maximum) {
   bb_image h;
   cr_assert_eq(bb_image_alloc(&h, 4097, 4097, 1, NULL), BB_OK);
   bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp("big.png"), &h, &wo, NULL), BB_OK);
   bb_image_free(&h);
   cli_result r =
       RUN("render", tmp("big.png"), "--scale", "8", "--tile", "8", "-o", tmp("o.png"));
@@ -265,7 +269,7 @@ Test(cli_render, tiles_over_the_maximum) {
 /* render --normal n4096.png --tile 8 ran 62 s at 16 GB peak, and an 8192
  * map tiled 8 times was refused "over the maximum" only after 8 s and 1.7
  * GB: the picture is now worked out from the headers, before any pixel is
- * read (bb_render_files_check), as bakes are. The maps here are headers
+ * read (bb__render_files_check), as bakes are. The maps here are headers
  * without pixels (write_png_header): reading them would fail, so only the
  * check before the read can give these answers. */
 Test(cli_render, a_picture_too_large_is_refused_before_any_pixel_is_read) {
@@ -305,34 +309,34 @@ Test(cli_render, the_render_estimate) {
   int w = 0, h = 0;
   double bytes = 0.0;
   bb_error err = {{0}};
-  cr_assert_eq(bb_render_estimate(4096, 4096, &o, 0, "r.png", BB_DEPTH_DEFAULT, &w, &h, &bytes,
+  cr_assert_eq(bb__render_estimate(4096, 4096, &o, 0, "r.png", BB_DEPTH_DEFAULT, &w, &h, &bytes,
                                   &err), BB_OK, "%s", err.message);
   cr_expect(w == 32768 && h == 32768);
   /* the tiled picture (12 bytes a texel) and its 8-bit RGB copy */
   cr_expect_float_eq(bytes, 32768.0 * 32768.0 * 15.0, 1.0);
-  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, "r.exr", BB_DEPTH_DEFAULT, NULL, NULL,
+  cr_expect_eq(bb__render_estimate(4096, 4096, &o, 0, "r.exr", BB_DEPTH_DEFAULT, NULL, NULL,
                                   &bytes, &err), BB_OK);
   cr_expect_float_eq(bytes, 32768.0 * 32768.0 * 24.0, 1.0); /* float EXR */
   o.crop_width = o.crop_height = 100;
-  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, &w, &h, &bytes,
+  cr_expect_eq(bb__render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, &w, &h, &bytes,
                                   &err), BB_OK);
   cr_expect(w == 100 && h == 100);
   cr_expect_float_eq(bytes, (4096.0 * 4096.0 + 32768.0 * 32768.0) * 12.0, 1.0);
   o.crop_x = 32700;
-  cr_expect_eq(bb_render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
+  cr_expect_eq(bb__render_estimate(4096, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
                                   &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "not inside the 32768x32768 picture"), "%s", err.message);
   o.crop_width = 0;
-  cr_expect_eq(bb_render_estimate(4097, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
+  cr_expect_eq(bb__render_estimate(4097, 4096, &o, 0, NULL, BB_DEPTH_DEFAULT, NULL, NULL, NULL,
                                   &err), BB_ERR_SIZE);
-  /* bb_render itself refuses a picture over what is left, before
+  /* bb__render itself refuses a picture over what is left, before
    * allocating it (here under no limit at all: more than the limits). */
   bb_image map;
   cr_assert_eq(bb_image_alloc(&map, 8192, 8192, 3, NULL), BB_OK);
   const bb_render_maps maps = {&map, NULL, NULL, NULL, NULL, NULL};
   o.mode = BB_RENDER_NORMAL;
   bb_image out;
-  cr_expect_eq(bb_render(&maps, &o, &out, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__render(&maps, &o, &out, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "over the maximum"), "%s", err.message);
   bb_image_free(&map);
 }

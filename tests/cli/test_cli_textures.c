@@ -10,6 +10,7 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "job/job_internal.h"
 
 #include <math.h>
 
@@ -39,7 +40,7 @@ Test(cli_textures, one_command_makes_a_source_material_and_a_dds) {
   relief(tmp("rock.png"), 64, 64);
   char dir[256], ssbump[300], vmt[300], dds[300];
   snprintf(dir, sizeof dir, "%s", tmp("game/materials/rock"));
-  cr_assert_eq(bb_directory_create(dir, NULL), BB_OK);
+  cr_assert_eq(bb__directory_create(dir, NULL), BB_OK);
   snprintf(ssbump, sizeof ssbump, "%s/rock-ssbump.vtf", dir);
   snprintf(vmt, sizeof vmt, "%s/rock.vmt", dir);
   snprintf(dds, sizeof dds, "%s/rock_normal.dds", dir);
@@ -138,7 +139,7 @@ Test(cli_textures, what_a_texture_cannot_hold_is_refused_first) {
 
 Test(cli_textures, valve_commands_write_vtf) {
   relief(tmp("h.png"), 32, 32);
-  cr_assert_eq(bb_directory_create(tmp("materials/x"), NULL), BB_OK);
+  cr_assert_eq(bb__directory_create(tmp("materials/x"), NULL), BB_OK);
   /* height2ssbump: RGBA (height in alpha), so DXT5 with EIGHTBITALPHA. */
   cli_result r = RUN("height2ssbump", "-r", "16", tmp("h.png"), "4", "-o",
                      tmp("materials/x/h-ssbump.vtf"), "--vmt", tmp("materials/x/h.vmt"));
@@ -177,7 +178,7 @@ Test(cli_textures, valve_commands_write_vtf) {
 }
 
 Test(cli_textures, a_batch_of_vtf_is_judged_by_its_provenance) {
-  cr_assert_eq(bb_directory_create(tmp("in"), NULL), BB_OK);
+  cr_assert_eq(bb__directory_create(tmp("in"), NULL), BB_OK);
   relief(tmp("in/a.png"), 32, 32);
   const char *base[] = {"bake", tmp("in"), "--scale", "4", "--rays", "16", "--out-dir",
                         tmp("out"), "--name", "{stem}-{kind}.vtf", "--vtf-version", "7.3"};

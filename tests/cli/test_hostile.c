@@ -11,6 +11,8 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "printed_text.h"
+#include "files/safe_file.h"
+#include "image/image_write.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -185,12 +187,12 @@ Test(hostile, outputs_that_are_not_regular_files_are_never_replaced) {
   cr_expect(!file_exists(tmp("materials/s.vtf")), "the texture of a refused material was written");
   /* The library's own writers refuse them too. */
   bb_error err;
-  cr_expect_eq(bb_file_write(tmp("fifo.png"), "x", 1, &err), BB_ERR_IO);
+  cr_expect_eq(bb__file_write(tmp("fifo.png"), "x", 1, &err), BB_ERR_IO);
   cr_expect(strstr(err.message, "is a FIFO"), "%s", err.message);
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
   bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, NULL, NULL};
-  cr_expect_eq(bb_image_write(tmp("null.png"), &img, &wo, &err), BB_ERR_IO);
+  cr_expect_eq(bb__image_write(tmp("null.png"), &img, &wo, &err), BB_ERR_IO);
   bb_image_free(&img);
   cr_expect_eq(kind_at(tmp("fifo.png")), 'f');
   cr_expect_eq(kind_at(tmp("null.png")), 'l');
@@ -541,9 +543,9 @@ Test(hostile, printed_text_never_drives_the_terminal) {
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
                                "bumpbake_version=x\ncommand=\x1b]0;pwned\x07\x1b[31mred\xff\n", NULL};
-  cr_assert_eq(bb_image_write(tmp("e.png"), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp("e.png"), &img, &wo, NULL), BB_OK);
   const char *name = "bad\x1b[2J\xff.png";
-  cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp(name), &img, &wo, NULL), BB_OK);
   bb_image_free(&img);
   const char *runs[][6] = {{"info", tmp("e.png"), NULL},
                            {"info", tmp(name), NULL},
@@ -578,12 +580,12 @@ Test(hostile, bidirectional_controls_from_a_file_are_escaped) {
   t.format = BB_TEXTURE_FORMAT_BGR8;
   t.description = "bumpbake_version=x\ncommand=a\xe2\x80\xaegnp.exe\n";
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(tmp("k.vtf"), &img, &t, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(tmp("k.vtf"), &img, &t, &err), BB_OK, "%s", err.message);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT,
                                "a\xe2\x81\xa6" "b\xe2\x81\xa9 \xd8\x9c \xe2\x80\x8f\xe2\x80\xaa", NULL};
   const char *name = "n\xe2\x80\x8e.png";
-  cr_assert_eq(bb_image_write(tmp("d.png"), &img, &wo, NULL), BB_OK);
-  cr_assert_eq(bb_image_write(tmp(name), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp("d.png"), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp(name), &img, &wo, NULL), BB_OK);
   bb_image_free(&img);
   const char *runs[][4] = {{"info", tmp("k.vtf"), NULL},
                            {"info", tmp("d.png"), NULL},
@@ -654,7 +656,7 @@ Test(hostile, json_keeps_long_keys_and_values_whole) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, NULL), BB_OK);
   const bb_write_options wo = {BB_DEPTH_8, BB_RANGE_UNIT, text, NULL};
-  cr_assert_eq(bb_image_write(tmp("long.png"), &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp("long.png"), &img, &wo, NULL), BB_OK);
   bb_image_free(&img);
   cli_result r = RUN("info", "--json", tmp("long.png"));
   cr_expect_eq(r.code, 0, "%s", r.err);

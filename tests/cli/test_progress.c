@@ -5,6 +5,7 @@
 
 #include "cli/common.h"
 #include "cli/progress.h"
+#include "image/image_write.h"
 
 #include <criterion/criterion.h>
 #include <pty.h>
@@ -64,7 +65,7 @@ Test(progress, a_jobs_block_compression_has_its_own_bar) {
       _exit(3);
     for (int i = 0; i < 64 * 64; i++)
       h.pixels[i] = (float)((i * 7) % 13) / 12.0f;
-    if (bb_image_write(height, &h, NULL, NULL) != BB_OK)
+    if (bb__image_write(height, &h, NULL, NULL) != BB_OK)
       _exit(4);
     bb_job_options o;
     bb_job_options_init(&o);

@@ -332,7 +332,7 @@ Test(cmd, names_and_did_you_mean) {
                    "--normal-filter must be one of valve, central, sobel, vertex (got 'fancy')");
   bb_command_free(c);
   char words[128];
-  bb_option_choices(bb_option_find(bb_command_info_find("bake"), "normal-y", 0), words,
+  bb__option_choices(bb_option_find(bb_command_info_find("bake"), "normal-y", 0), words,
                     sizeof words);
   cr_expect_str_eq(words, "down|up");
 }
@@ -354,7 +354,7 @@ Test(cmd, height2ssbump_plans_a_job) {
   cr_expect_eq(o->job.bake.height_scale, 16.0f);
   cr_expect_eq(o->job.bake.rays, 250);
   cr_expect_eq(o->job.channel, BB_CHANNEL_VALVE);
-  cr_expect(bb_command_has_job(bb_command_describe(c)));
+  cr_expect(bb__command_has_job(bb_command_describe(c)));
   bb_command_free(c);
 }
 
@@ -376,7 +376,7 @@ Test(cmd, a_flag_set_to_0_is_unset) {
 }
 
 /* ssbump2normal --kind and combine --kind: one parser, the library's
- * (bb_map_kind_parse, any case), each taking its own kinds. */
+ * (bb__map_kind_parse, any case), each taking its own kinds. */
 Test(cmd, kind_options_take_the_librarys_words) {
   const char *s2n[] = {"--kind", "Weights", NULL};
   bb_command *c = command("ssbump2normal", s2n);

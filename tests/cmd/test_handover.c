@@ -4,6 +4,7 @@
  * command, words with blanks included; a chunk's inputs replace the
  * batch's; what is not a hand-over of this version is refused. */
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 
 #include <criterion/criterion.h>
 #include <stdlib.h>

@@ -17,6 +17,8 @@
 #include "bumpbake.h"
 #include "file_bytes.h"
 #include "scratch_dir.h"
+#include "image/image_write.h"
+#include "mesh/mesh_internal.h"
 
 static void setup(void) {
   scratch_dir_make("bb_rbf_run");
@@ -101,9 +103,9 @@ Test(renderbump_run, writes_both_files_with_provenance_and_hands_back_the_render
   cr_expect_eq(render.normal.width, 16);
   cr_expect(render.height_scale > 0);
   bb_mesh mesh = {0};
-  cr_assert_eq(bb_mesh_load(model, &mesh, &err), BB_OK, "%s", err.message);
-  cr_expect_eq(render.model_hash, bb_mesh_hash(&mesh));
-  bb_mesh_free(&mesh);
+  cr_assert_eq(bb__mesh_load(model, &mesh, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(render.model_hash, bb__mesh_hash(&mesh));
+  bb__mesh_free(&mesh);
   /* the height 16-bit where the format holds it; each file's kind recorded */
   int w, h, ch;
   bb_image_info info = {0};
@@ -225,7 +227,7 @@ static void grey_png(const char *path, float value) {
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 1, &err), BB_OK);
   for (int i = 0; i < 16; i++)
     img.pixels[i] = value * (float)(i % 3);
-  cr_assert_eq(bb_image_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
 }
 
@@ -242,7 +244,7 @@ Test(renderbump_run, the_diff_is_checked_against_the_inputs_and_its_format) {
   cr_expect(strstr(err.message, ": would overwrite the input "), "%s",
             err.message);
   bb_command_free(c);
-  /* a GIF is no animation here: refused as bb_image_write refuses it */
+  /* a GIF is no animation here: refused as bb__image_write refuses it */
   c = command("compare",
               (const char *const[]){a, b, "--diff", in_scratch_dir("d.gif"), NULL});
   cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);

@@ -1,4 +1,4 @@
-/* test_memory.c: what bb_memory_available finds under a container's memory
+/* test_memory.c: what bb__memory_available finds under a container's memory
  * limit. In a 450 MB memory cgroup a 4096 x 4096 bake was killed by the
  * kernel with no message: only MemAvailable and RLIMIT_AS were read. The
  * reader takes a scratch_dir directory, so each case is a made-up /proc and

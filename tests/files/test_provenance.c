@@ -2,6 +2,8 @@
 #include "files/provenance.h"
 #include "bumpbake.h"
 #include "core/internal.h" /* bb__provenance_pack */
+#include "image/image_write.h"
+#include "trace/basis.h"
 
 #include <criterion/criterion.h>
 #include <inttypes.h>
@@ -34,7 +36,7 @@ static bb_bake_options sample_options(void) {
   o.smooth.addressing = BB_ADDRESS_PERIODIC;
   o.trace.bias_texels = 0.55;
   o.power = 1.0;
-  bb_basis_init(&o.basis);
+  bb__basis_init(&o.basis);
   o.normal_filter = BB_NORMAL_VALVE;
   o.normal_y_up = 0;
   o.outputs = BB_MAPS_BAKED;
@@ -73,26 +75,26 @@ Test(provenance, hash_is_fnv1a_of_little_endian_size_and_float_bits) {
   /* 0.5f = 0x3f000000, -2.0f = 0xc0000000, little-endian. */
   const unsigned char bytes[] = {2, 0, 0, 0, 1, 0,    0, 0, 1, 0,
                                  0, 0, 0, 0, 0, 0x3f, 0, 0, 0, 0xc0};
-  cr_assert_eq(bb_image_hash(&img), reference_fnv1a(bytes, sizeof bytes));
+  cr_assert_eq(bb__image_hash(&img), reference_fnv1a(bytes, sizeof bytes));
 }
 
 Test(provenance, hash_changes_with_a_pixel_or_the_shape) {
   float px[6] = {0, 0.25f, 0.5f, 0.75f, 1, 0};
   bb_image a = {.width = 3, .height = 2, .channels = 1, .pixels = px};
-  uint64_t base = bb_image_hash(&a);
+  uint64_t base = bb__image_hash(&a);
   bb_image b = a;
   b.width = 2;
   b.height = 3;
-  cr_assert_neq(bb_image_hash(&b), base, "same floats, transposed shape");
+  cr_assert_neq(bb__image_hash(&b), base, "same floats, transposed shape");
   b = a;
   b.channels = 2;
   b.width = 1;
   b.height = 3;
-  cr_assert_neq(bb_image_hash(&b), base, "same floats as 2 channels");
+  cr_assert_neq(bb__image_hash(&b), base, "same floats as 2 channels");
   px[4] = nextafterf(1.0f, 2.0f);
-  cr_assert_neq(bb_image_hash(&a), base, "one ulp in one pixel");
+  cr_assert_neq(bb__image_hash(&a), base, "one ulp in one pixel");
   px[4] = 1.0f;
-  cr_assert_eq(bb_image_hash(&a), base, "restored pixel gives the same hash");
+  cr_assert_eq(bb__image_hash(&a), base, "restored pixel gives the same hash");
 }
 
 Test(provenance, format_lists_every_key_in_order) {
@@ -206,7 +208,7 @@ Test(provenance, diff_of_identical_texts_is_empty) {
   bb_provenance p = sample_provenance(&o);
   char *a = bb_provenance_format(&p);
   char out[512] = "junk";
-  cr_assert_eq(bb_provenance_diff(a, a, out, sizeof out), 0);
+  cr_assert_eq(bb__provenance_diff(a, a, out, sizeof out), 0);
   cr_assert_str_eq(out, "");
   free(a);
 }
@@ -214,7 +216,7 @@ Test(provenance, diff_of_identical_texts_is_empty) {
 Test(provenance, diff_names_changed_keys_and_ignores_command_and_output) {
   bb_bake_options oa = sample_options(), ob = sample_options();
   ob.height_scale = 32.0f;
-  cr_assert_eq(bb_basis_parse("hl2+z", &ob.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("hl2+z", &ob.basis, NULL), BB_OK);
   bb_provenance pa = sample_provenance(&oa), pb = sample_provenance(&ob);
   pb.command = "bumpbake bake /tmp/x/in.png --scale 32";
   /* kinds that record the same keys (an ssbump and height2ssbump -d's) */
@@ -223,7 +225,7 @@ Test(provenance, diff_names_changed_keys_and_ignores_command_and_output) {
   char *a = bb_provenance_format(&pa);
   char *b = bb_provenance_format(&pb);
   char out[1024];
-  int n = bb_provenance_diff(a, b, out, sizeof out);
+  int n = bb__provenance_diff(a, b, out, sizeof out);
   cr_assert_eq(n, 2, "scale and basis differ; got:\n%s", out);
   cr_assert_not_null(strstr(out, "scale: 16 -> 32\n"), "got:\n%s", out);
   char expect[128];
@@ -239,18 +241,18 @@ Test(provenance, diff_reports_keys_missing_on_either_side) {
   const char *a = "bumpbake_version=0.1.0\nscale=16\nold_key=1\n";
   const char *b = "bumpbake_version=0.1.0\nscale=16\nnew_key=2";
   char out[256];
-  cr_assert_eq(bb_provenance_diff(a, b, out, sizeof out), 2);
+  cr_assert_eq(bb__provenance_diff(a, b, out, sizeof out), 2);
   cr_assert_str_eq(out, "old_key: 1 -> (none)\nnew_key: (none) -> 2\n");
 }
 
 Test(provenance, diff_with_null_text_or_tiny_buffer) {
   char out[8] = "junk";
-  cr_assert_eq(bb_provenance_diff(NULL, "a=1\n", out, sizeof out), 0);
+  cr_assert_eq(bb__provenance_diff(NULL, "a=1\n", out, sizeof out), 0);
   cr_assert_str_eq(out, "");
   /* The count is right even when the lines do not fit; out stays terminated. */
-  cr_assert_eq(bb_provenance_diff("a=1\nb=2\n", "a=3\nb=4\n", out, sizeof out), 2);
+  cr_assert_eq(bb__provenance_diff("a=1\nb=2\n", "a=3\nb=4\n", out, sizeof out), 2);
   cr_assert_eq(strlen(out), sizeof out - 1);
-  cr_assert_eq(bb_provenance_diff("a=1\n", "a=2\n", NULL, 0), 1);
+  cr_assert_eq(bb__provenance_diff("a=1\n", "a=2\n", NULL, 0), 1);
 }
 
 Test(provenance, classify_tells_intact_from_damaged_and_foreign_text) {
@@ -351,7 +353,7 @@ Test(provenance, survives_a_tga_file_as_whole_lines) {
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 4, NULL), BB_OK);
   bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_UNIT, text, NULL};
   bb_error err = {{0}};
-  cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image back = {0};
   bb_image_info info;
   cr_assert_eq(bb_image_read(path, &back, &info, &err), BB_OK, "%s", err.message);
@@ -398,8 +400,8 @@ Test(provenance, survives_a_tga_file_as_whole_lines) {
 /* Repeated keys count once (their first value), in either text. */
 Test(provenance, diff_counts_the_first_of_repeated_keys) {
   char out[256];
-  cr_assert_eq(bb_provenance_diff("k=1\nk=2\nz=0\n", "z=0\nk=1\nk=3\n", out, sizeof out), 0);
-  cr_assert_eq(bb_provenance_diff("k=2\nk=1\n", "k=1\nk=2\n", out, sizeof out), 1);
+  cr_assert_eq(bb__provenance_diff("k=1\nk=2\nz=0\n", "z=0\nk=1\nk=3\n", out, sizeof out), 0);
+  cr_assert_eq(bb__provenance_diff("k=2\nk=1\n", "k=1\nk=2\n", out, sizeof out), 1);
   cr_assert_str_eq(out, "k: 2 -> 1\n");
 }
 
@@ -423,7 +425,7 @@ Test(provenance, diff_of_huge_texts_is_fast, .timeout = 300) {
    * this (the quadratic diff it guards against took minutes of CPU). */
   struct timespec t0, t1;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
-  int n = bb_provenance_diff(a, b, out, sizeof out);
+  int n = bb__provenance_diff(a, b, out, sizeof out);
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
   double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
   cr_assert_eq(n, 99, "key0 is 0 either way; every 1000th other key differs");

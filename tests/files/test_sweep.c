@@ -13,6 +13,9 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
+#include "files/safe_file.h"
+#include "image/image_write.h"
 
 static char dir[256];
 
@@ -65,7 +68,7 @@ static void killed_writer(const char *path) {
   if (pid == 0) {
     bb_image img = small();
     bb_staged_file *f = NULL;
-    if (bb_image_write_staged(path, &img, NULL, &f, NULL) != BB_OK) _exit(3);
+    if (bb__image_write_staged_all_cores(path, &img, NULL, &f, NULL) != BB_OK) _exit(3);
     raise(SIGKILL);
     _exit(4);
   }
@@ -80,7 +83,7 @@ static bb_status stage_tiff_mips(const char *path, bb_staged_file **f) {
   bb_image img = small(), *levels = NULL;
   int count = 0;
   bb_status st = bb_mip_chain(&img, BB_MIP_AVERAGE, &levels, &count, NULL);
-  if (st == BB_OK) st = bb_image_write_mips_staged(path, levels, count, NULL, f, NULL);
+  if (st == BB_OK) st = bb__image_write_mips_staged_all_cores(path, levels, count, NULL, f, NULL);
   bb_mip_chain_free(levels, count);
   bb_image_free(&img);
   return st;
@@ -114,10 +117,10 @@ static pid_t live_writer(const char *path, int *go) {
     close(up[0]), close(down[1]);
     bb_image img = small();
     bb_staged_file *f = NULL;
-    if (bb_image_write_staged(path, &img, NULL, &f, NULL) != BB_OK) _exit(3);
+    if (bb__image_write_staged_all_cores(path, &img, NULL, &f, NULL) != BB_OK) _exit(3);
     char c = 'r';
     if (write(up[1], &c, 1) != 1 || read(down[0], &c, 1) != 1) _exit(5);
-    _exit(bb_staged_file_commit(f, NULL) == BB_OK ? 0 : 6);
+    _exit(bb__staged_file_commit(f, NULL) == BB_OK ? 0 : 6);
   }
   close(up[1]), close(down[0]);
   char c;
@@ -139,7 +142,7 @@ Test(sweep, removes_only_what_killed_writers_left, .init = make_dir, .fini = rem
   snprintf(other, sizeof other, "%s/here.png", dir);
   bb_image img = small();
   bb_staged_file *mine = NULL;
-  cr_assert_eq(bb_image_write_staged(other, &img, NULL, &mine, NULL), BB_OK);
+  cr_assert_eq(bb__image_write_staged_all_cores(other, &img, NULL, &mine, NULL), BB_OK);
   snprintf(look, sizeof look, "%s/there.exr", dir);
   int go = -1;
   const pid_t there = live_writer(look, &go);
@@ -157,7 +160,7 @@ Test(sweep, removes_only_what_killed_writers_left, .init = make_dir, .fini = rem
   cr_assert_eq(temporaries(), 3, "the two live temporaries and the look-alike stay");
 
   /* the live writers still commit */
-  cr_assert_eq(bb_staged_file_commit(mine, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__staged_file_commit(mine, &err), BB_OK, "%s", err.message);
   char c = 'g';
   cr_assert_eq(write(go, &c, 1), 1);
   close(go);
@@ -207,7 +210,7 @@ Test(sweep, removes_the_private_directories_killed_writers_left, .init = make_di
   cr_assert_eq(bb_tempfiles_sweep(dir, &removed, &err), BB_OK, "%s", err.message);
   cr_assert_eq(removed, 1);
   cr_assert_eq(temporaries(), 1, "the live writer's directory stays");
-  cr_assert_eq(bb_staged_file_commit(mine, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__staged_file_commit(mine, &err), BB_OK, "%s", err.message);
   cr_assert_eq(temporaries(), 0);
   cr_assert_eq(access(live, F_OK), 0);
 }

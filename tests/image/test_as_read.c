@@ -7,6 +7,7 @@
 #include "bumpbake.h"
 #include "image/oiio.h"
 #include "scratch_dir.h"
+#include "image/image_write.h"
 
 #include <math.h>
 #include <string.h>
@@ -48,7 +49,7 @@ Test(as_read, matches_a_write_and_a_read_bit_for_bit) {
       bb_error err = {{0}};
       if (!isfinite(img.pixels[7]) || cases[c].depth == BB_DEPTH_HALF)
         img.pixels[7] = 3.25f; /* half holds up to 65504 */
-      cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s: %s", name,
+      cr_assert_eq(bb__image_write(path, &img, &wo, &err), BB_OK, "%s: %s", name,
                    err.message);
       bb_image back, made;
       cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);

@@ -3,6 +3,7 @@
 
 #include "bumpbake.h"
 #include "image/height_channel.h"
+#include "image/image_write.h"
 
 #include <errno.h>
 #include <math.h>
@@ -74,7 +75,7 @@ static void check_rule_as(const bb_image *img, int alpha_channel, bb_channel ch,
     for (int x = 0; x < img->width; x++)
       cr_assert_eq(*bb_image_texel(&h, x, y), expected(img, x, y, as),
                    "%d channels, '%s' as '%s', texel (%d, %d)", img->channels,
-                   bb_channel_name(ch), bb_channel_name(as), x, y);
+                   bb__channel_name(ch), bb__channel_name(as), x, y);
   bb_image_free(&h);
 }
 
@@ -82,14 +83,14 @@ static void check_rule(const bb_image *img, int alpha_channel, bb_channel ch) {
   bb_image h;
   bb_error err = {{0}};
   cr_assert_eq(bb_height_from_image(img, alpha_channel, ch, &h, &err), BB_OK, "%s: %s",
-               bb_channel_name(ch), err.message);
+               bb__channel_name(ch), err.message);
   cr_assert_eq(h.channels, 1);
   cr_assert_eq(h.width, img->width);
   cr_assert_eq(h.height, img->height);
   for (int y = 0; y < img->height; y++)
     for (int x = 0; x < img->width; x++)
       cr_assert_eq(*bb_image_texel(&h, x, y), expected(img, x, y, ch),
-                   "%d channels, '%s', texel (%d, %d)", img->channels, bb_channel_name(ch), x,
+                   "%d channels, '%s', texel (%d, %d)", img->channels, bb__channel_name(ch), x,
                    y);
   bb_image_free(&h);
 }
@@ -99,7 +100,7 @@ static void check_refused(const bb_image *img, int alpha_channel, bb_channel ch,
   bb_image h = {5, 5, 1, (float *)&h};
   bb_error err = {{0}};
   cr_assert_eq(bb_height_from_image(img, alpha_channel, ch, &h, &err), want, "%s",
-               bb_channel_name(ch));
+               bb__channel_name(ch));
   cr_assert_null(h.pixels);
   cr_assert_neq(err.message[0], '\0');
 }
@@ -114,7 +115,7 @@ Test(load, parse_every_name_and_back) {
     bb_channel c = (bb_channel)99;
     cr_assert_eq(bb_channel_parse(names[i], &c, NULL), 0, "%s", names[i]);
     cr_assert_eq(c, values[i]);
-    cr_assert_str_eq(bb_channel_name(values[i]), names[i]);
+    cr_assert_str_eq(bb__channel_name(values[i]), names[i]);
   }
 }
 
@@ -128,7 +129,7 @@ Test(load, parse_ignores_case_and_rejects_others) {
   cr_assert_neq(bb_channel_parse(NULL, &c, NULL), 0);
   cr_assert_neq(bb_channel_parse("r ", &c, NULL), 0);
   cr_assert_eq(c, BB_CHANNEL_R, "a failed parse changed the output");
-  cr_assert_str_eq(bb_channel_name((bb_channel)42), "unknown");
+  cr_assert_str_eq(bb__channel_name((bb_channel)42), "unknown");
 }
 
 /* ---------------------------------------------------- rule on buffers */
@@ -347,7 +348,7 @@ Test(load, empty_image_is_refused) {
 static void write_file(const char *name, const bb_image *img, bb_depth depth) {
   bb_write_options o = {depth, BB_RANGE_UNIT, NULL, NULL};
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path(name), img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path(name), img, &o, &err), BB_OK, "%s", err.message);
 }
 
 /* Loads name with the rule and compares with expected() on the written
@@ -360,7 +361,7 @@ static void check_load(const char *name, const bb_image *img, bb_channel ch, dou
   for (int y = 0; y < img->height; y++)
     for (int x = 0; x < img->width; x++)
       cr_assert_float_eq(*bb_image_texel(&h, x, y), expected(img, x, y, ch), tol,
-                         "%s '%s' texel (%d, %d)", name, bb_channel_name(ch), x, y);
+                         "%s '%s' texel (%d, %d)", name, bb__channel_name(ch), x, y);
   bb_image_free(&h);
 }
 

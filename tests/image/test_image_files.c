@@ -3,6 +3,11 @@
 
 #include "bumpbake.h"
 #include "hostile_tiff.h"
+#include "files/safe_file.h"
+#include "image/formats.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "mesh/mesh_internal.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -130,7 +135,7 @@ static void check_round_trip(const char *name, const bb_image *img, bb_depth dep
   const char *path = tmp_path(name);
   bb_write_options o = options(depth, BB_RANGE_UNIT, NULL);
   bb_error err = {{0}};
-  cr_assert_eq(bb_image_write(path, img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, img, &o, &err), BB_OK, "%s", err.message);
 
   bb_image back;
   bb_image_info info;
@@ -241,12 +246,12 @@ Test(image_files, round_trip_basis_maps_of_many_channels) {
     }
     bb_image_free(&img);
   }
-  cr_assert_eq(bb_path_max_channels("a.png"), 4);
-  cr_assert_eq(bb_path_max_channels("a.TGA"), 4);
-  cr_assert_eq(bb_path_max_channels("a.tif"), 64);
-  cr_assert_eq(bb_path_max_channels("a.exr"), 64);
-  cr_assert_eq(bb_path_max_channels("a.jpg"), 0);
-  cr_assert_eq(bb_path_max_channels(NULL), 0);
+  cr_assert_eq(bb__path_max_channels("a.png"), 4);
+  cr_assert_eq(bb__path_max_channels("a.TGA"), 4);
+  cr_assert_eq(bb__path_max_channels("a.tif"), 64);
+  cr_assert_eq(bb__path_max_channels("a.exr"), 64);
+  cr_assert_eq(bb__path_max_channels("a.jpg"), 0);
+  cr_assert_eq(bb__path_max_channels(NULL), 0);
 }
 
 /* ------------------------------------------------------------ encoding */
@@ -261,7 +266,7 @@ static void write_and_read_codes(const char *name, const float *values, int coun
   bb_write_options o = options(depth, range, NULL);
   bb_error err;
   const char *path = tmp_path(name);
-  cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image back;
   cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);
   for (int i = 0; i < count; i++) {
@@ -363,7 +368,7 @@ Test(image_files, float_formats_store_signed_values_raw) {
   img.pixels[2] = 1.5f;
   bb_write_options o = options(BB_DEPTH_DEFAULT, BB_RANGE_SIGNED, NULL);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("raw.exr"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("raw.exr"), &img, &o, &err), BB_OK, "%s", err.message);
   bb_image back;
   cr_assert_eq(bb_image_read(tmp_path("raw.exr"), &back, NULL, &err), BB_OK, "%s", err.message);
   for (int i = 0; i < 3; i++) cr_assert_eq(back.pixels[i], img.pixels[i]);
@@ -379,7 +384,7 @@ static void check_alpha_kept(const char *name) {
   const float px[8] = {0.8f, 0.4f, 0.2f, 0.0f, 0.6f, 0.6f, 0.6f, 0.2f};
   memcpy(img.pixels, px, sizeof px);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path(name), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path(name), &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image back;
   bb_image_info info;
   cr_assert_eq(bb_image_read(tmp_path(name), &back, &info, &err), BB_OK, "%s", err.message);
@@ -401,7 +406,7 @@ static void check_description(const char *name) {
   bb_image img = make_image(3, 2, 3, 0.0f, 1.0f, 8);
   bb_write_options o = options(BB_DEPTH_DEFAULT, BB_RANGE_UNIT, text);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path(name), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path(name), &img, &o, &err), BB_OK, "%s", err.message);
   bb_image back;
   bb_image_info info;
   cr_assert_eq(bb_image_read(tmp_path(name), &back, &info, &err), BB_OK, "%s", err.message);
@@ -422,7 +427,7 @@ Test(image_files, description_round_trips_tga) { check_description("d.tga"); }
 Test(image_files, no_description_reads_as_null) {
   bb_image img = make_image(3, 2, 1, 0.0f, 1.0f, 9);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("n.png"), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("n.png"), &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image back;
   bb_image_info info;
   cr_assert_eq(bb_image_read(tmp_path("n.png"), &back, &info, &err), BB_OK, "%s", err.message);
@@ -438,7 +443,7 @@ Test(image_files, unknown_extension_is_a_format_error) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 10);
   bb_error err;
   const char *path = tmp_path("out.xyz");
-  cr_assert_eq(bb_image_write(path, &img, NULL, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__image_write(path, &img, NULL, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "unknown output format '.xyz'"), "%s", err.message);
   cr_assert_not_null(strstr(err.message, path), "%s", err.message);
   cr_assert_not(file_exists(path));
@@ -447,21 +452,21 @@ Test(image_files, unknown_extension_is_a_format_error) {
 }
 
 Test(image_files, writable_format_by_extension_ignores_case) {
-  cr_assert(bb_path_is_writable_format("a.png"));
-  cr_assert(bb_path_is_writable_format("dir.d/A.PNG"));
-  cr_assert(bb_path_is_writable_format("x.TiFf"));
-  cr_assert(bb_path_is_writable_format("x.tga"));
-  cr_assert(bb_path_is_writable_format("x.exr"));
-  cr_assert_not(bb_path_is_writable_format("x.jpg"));
-  cr_assert_not(bb_path_is_writable_format("noext"));
-  cr_assert_not(bb_path_is_writable_format("dir.png/noext"));
-  cr_assert_not(bb_path_is_writable_format(NULL));
+  cr_assert(bb__path_is_writable_format("a.png"));
+  cr_assert(bb__path_is_writable_format("dir.d/A.PNG"));
+  cr_assert(bb__path_is_writable_format("x.TiFf"));
+  cr_assert(bb__path_is_writable_format("x.tga"));
+  cr_assert(bb__path_is_writable_format("x.exr"));
+  cr_assert_not(bb__path_is_writable_format("x.jpg"));
+  cr_assert_not(bb__path_is_writable_format("noext"));
+  cr_assert_not(bb__path_is_writable_format("dir.png/noext"));
+  cr_assert_not(bb__path_is_writable_format(NULL));
 }
 
 Test(image_files, upper_case_extension_writes_that_format) {
   bb_image img = make_image(2, 2, 3, 0.0f, 1.0f, 11);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("UP.TIF"), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("UP.TIF"), &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image back;
   bb_image_info info;
   cr_assert_eq(bb_image_read(tmp_path("UP.TIF"), &back, &info, &err), BB_OK, "%s", err.message);
@@ -474,7 +479,7 @@ static void check_depth_refused(const char *name, bb_depth depth) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 12);
   bb_write_options o = options(depth, BB_RANGE_UNIT, NULL);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path(name), &img, &o, &err), BB_ERR_FORMAT, "%s", name);
+  cr_assert_eq(bb__image_write(tmp_path(name), &img, &o, &err), BB_ERR_FORMAT, "%s", name);
   cr_assert_not_null(strstr(err.message, "not supported"), "%s", err.message);
   cr_assert_not(file_exists(tmp_path(name)));
   bb_image_free(&img);
@@ -495,10 +500,10 @@ Test(image_files, unknown_enum_values_are_argument_errors) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 12);
   bb_write_options o = options((bb_depth)42, BB_RANGE_UNIT, NULL);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("x.png"), &img, &o, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_write(tmp_path("x.png"), &img, &o, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "42"), "%s", err.message);
   o = options(BB_DEPTH_DEFAULT, (bb_range)-1, NULL);
-  cr_assert_eq(bb_image_write(tmp_path("x.png"), &img, &o, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_write(tmp_path("x.png"), &img, &o, &err), BB_ERR_ARGUMENT);
   cr_assert_not(file_exists(tmp_path("x.png")));
   bb_image_free(&img);
 }
@@ -506,18 +511,18 @@ Test(image_files, unknown_enum_values_are_argument_errors) {
 Test(image_files, too_many_channels_for_png_is_a_format_error) {
   bb_image img = make_image(2, 2, 5, 0.0f, 1.0f, 13);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("five.png"), &img, NULL, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__image_write(tmp_path("five.png"), &img, NULL, &err), BB_ERR_FORMAT);
   cr_assert_not(file_exists(tmp_path("five.png")));
   /* TIFF holds any count. */
-  cr_assert_eq(bb_image_write(tmp_path("five.tif"), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("five.tif"), &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
 }
 
 Test(image_files, empty_image_is_an_argument_error) {
   bb_image img = {0, 0, 0, NULL};
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("e.png"), &img, NULL, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_image_write(tmp_path("e.png"), NULL, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_write(tmp_path("e.png"), &img, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_write(tmp_path("e.png"), NULL, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert_not(file_exists(tmp_path("e.png")));
 }
 
@@ -533,7 +538,7 @@ Test(image_files, unwritable_directory_is_an_io_error) {
     snprintf(path, sizeof path, "%s/ro/out.png", tmpdir);
   }
   bb_error err;
-  cr_assert_eq(bb_image_write(path, &img, NULL, &err), BB_ERR_IO);
+  cr_assert_eq(bb__image_write(path, &img, NULL, &err), BB_ERR_IO);
   cr_assert_not_null(strstr(err.message, "cannot write"), "%s", err.message);
   cr_assert_not_null(strstr(err.message, path), "%s", err.message);
   cr_assert_not(file_exists(path));
@@ -543,7 +548,7 @@ Test(image_files, unwritable_directory_is_an_io_error) {
 Test(image_files, missing_directory_is_an_io_error) {
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 15);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("nodir/out.exr"), &img, NULL, &err), BB_ERR_IO);
+  cr_assert_eq(bb__image_write(tmp_path("nodir/out.exr"), &img, NULL, &err), BB_ERR_IO);
   cr_assert_not_null(strstr(err.message, "cannot write"), "%s", err.message);
   bb_image_free(&img);
 }
@@ -554,7 +559,7 @@ Test(image_files, failed_rename_leaves_no_temporary_file) {
   bb_image img = make_image(4, 4, 3, 0.0f, 1.0f, 16);
   cr_assert_eq(mkdir(tmp_path("taken.png"), 0700), 0);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("taken.png"), &img, NULL, &err), BB_ERR_IO);
+  cr_assert_eq(bb__image_write(tmp_path("taken.png"), &img, NULL, &err), BB_ERR_IO);
   cr_assert_not_null(strstr(err.message, "cannot write"), "%s", err.message);
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   struct stat st;
@@ -566,7 +571,7 @@ Test(image_files, failed_rename_leaves_no_temporary_file) {
 Test(image_files, successful_write_leaves_no_temporary_file) {
   bb_image img = make_image(4, 4, 3, 0.0f, 1.0f, 17);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("ok.exr"), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("ok.exr"), &img, NULL, &err), BB_OK, "%s", err.message);
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   cr_assert_eq(count_entries(tmpdir, "ok.exr"), 1);
   bb_image_free(&img);
@@ -577,8 +582,8 @@ Test(image_files, overwrite_replaces_content_with_umask_mode) {
   bb_image a = make_image(4, 4, 1, 0.0f, 1.0f, 18);
   bb_image b = make_image(3, 5, 1, 0.0f, 1.0f, 19);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("o.png"), &a, NULL, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_image_write(tmp_path("o.png"), &b, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("o.png"), &a, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("o.png"), &b, NULL, &err), BB_OK, "%s", err.message);
   bb_image back;
   cr_assert_eq(bb_image_read(tmp_path("o.png"), &back, NULL, &err), BB_OK, "%s", err.message);
   cr_assert_eq(back.width, 3);
@@ -591,14 +596,14 @@ Test(image_files, overwrite_replaces_content_with_umask_mode) {
   bb_image_free(&b);
 }
 
-/* bb_file_write: the bytes, whole, replacing what was there; nothing left
+/* bb__file_write: the bytes, whole, replacing what was there; nothing left
  * behind and the destination untouched when it cannot be written. */
 Test(image_files, file_write_replaces_whole_and_fails_cleanly) {
   const char *path = tmp_path("deps.d");
   bb_error err;
-  cr_assert_eq(bb_file_write(path, "old rule\n", 9, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__file_write(path, "old rule\n", 9, &err), BB_OK, "%s", err.message);
   const char text[] = "a.png b.png: in.png\n";
-  cr_assert_eq(bb_file_write(path, text, sizeof text - 1, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__file_write(path, text, sizeof text - 1, &err), BB_OK, "%s", err.message);
   char back[64] = {0};
   FILE *f = fopen(path, "rb");
   cr_assert_not_null(f);
@@ -606,19 +611,19 @@ Test(image_files, file_write_replaces_whole_and_fails_cleanly) {
   fclose(f);
   cr_assert_eq(n, sizeof text - 1);
   cr_assert_str_eq(back, text);
-  cr_assert_eq(bb_file_write(path, "", 0, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__file_write(path, "", 0, &err), BB_OK, "%s", err.message);
   cr_assert_eq(file_size(path), 0, "an empty write leaves an empty file");
 
   cr_assert_eq(mkdir(tmp_path("taken.d"), 0700), 0);
-  cr_assert_eq(bb_file_write(tmp_path("taken.d"), text, 4, &err), BB_ERR_IO);
+  cr_assert_eq(bb__file_write(tmp_path("taken.d"), text, 4, &err), BB_ERR_IO);
   cr_assert_not_null(strstr(err.message, "cannot write"), "%s", err.message);
   struct stat st;
   cr_assert_eq(stat(tmp_path("taken.d"), &st), 0);
   cr_assert(S_ISDIR(st.st_mode), "the destination was replaced");
-  cr_assert_eq(bb_file_write(tmp_path("nodir/x.d"), text, 4, &err), BB_ERR_IO);
+  cr_assert_eq(bb__file_write(tmp_path("nodir/x.d"), text, 4, &err), BB_ERR_IO);
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
-  cr_assert_eq(bb_file_write(path, NULL, 4, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_file_write(NULL, text, 4, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__file_write(path, NULL, 4, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__file_write(NULL, text, 4, &err), BB_ERR_ARGUMENT);
 }
 
 /* --------------------------------------------------------- read errors */
@@ -650,7 +655,7 @@ Test(image_files, unreadable_file_is_an_io_error) {
     cr_skip_test("root reads files whatever their mode");
   }
   bb_image img = make_image(2, 2, 1, 0.0f, 1.0f, 20);
-  cr_assert_eq(bb_image_write(tmp_path("secret.png"), &img, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(tmp_path("secret.png"), &img, NULL, NULL), BB_OK);
   cr_assert_eq(chmod(tmp_path("secret.png"), 0), 0);
   check_read_fails(tmp_path("secret.png"), BB_ERR_IO, "cannot read");
   bb_image_free(&img);
@@ -691,7 +696,7 @@ static void check_truncation_detected(const char *name, double keep) {
   bb_image img = make_image(64, 64, 3, 0.0f, 1.0f, 21);
   bb_error err;
   const char *path = tmp_path(name);
-  cr_assert_eq(bb_image_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
   long size = file_size(path);
   cr_assert_eq(truncate(path, (off_t)((double)size * keep)), 0);
   mute_stderr();
@@ -778,7 +783,7 @@ Test(image_files, zero_size_image_is_a_size_error) {
 Test(image_files, read_info_of_grey_alpha_png) {
   bb_image img = make_image(3, 3, 2, 0.0f, 1.0f, 22);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("ga.png"), &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(tmp_path("ga.png"), &img, NULL, &err), BB_OK, "%s", err.message);
   bb_image back;
   bb_image_info info;
   cr_assert_eq(bb_image_read(tmp_path("ga.png"), &back, &info, &err), BB_OK, "%s", err.message);
@@ -789,14 +794,14 @@ Test(image_files, read_info_of_grey_alpha_png) {
 }
 
 Test(image_files, supports_depth_follows_the_format_table) {
-  cr_assert(bb_path_supports_depth("a.png", BB_DEPTH_16));
-  cr_assert(bb_path_supports_depth("a.PNG", BB_DEPTH_DEFAULT));
-  cr_assert_not(bb_path_supports_depth("a.tga", BB_DEPTH_16));
-  cr_assert_not(bb_path_supports_depth("a.png", BB_DEPTH_HALF));
-  cr_assert(bb_path_supports_depth("dir.x/a.exr", BB_DEPTH_HALF));
-  cr_assert(bb_path_supports_depth("a.tiff", BB_DEPTH_FLOAT));
-  cr_assert_not(bb_path_supports_depth("a.jpg", BB_DEPTH_DEFAULT));
-  cr_assert_not(bb_path_supports_depth(NULL, BB_DEPTH_8));
+  cr_assert(bb__path_supports_depth("a.png", BB_DEPTH_16));
+  cr_assert(bb__path_supports_depth("a.PNG", BB_DEPTH_DEFAULT));
+  cr_assert_not(bb__path_supports_depth("a.tga", BB_DEPTH_16));
+  cr_assert_not(bb__path_supports_depth("a.png", BB_DEPTH_HALF));
+  cr_assert(bb__path_supports_depth("dir.x/a.exr", BB_DEPTH_HALF));
+  cr_assert(bb__path_supports_depth("a.tiff", BB_DEPTH_FLOAT));
+  cr_assert_not(bb__path_supports_depth("a.jpg", BB_DEPTH_DEFAULT));
+  cr_assert_not(bb__path_supports_depth(NULL, BB_DEPTH_8));
 }
 
 /* ----------------------------------------------------------------- full disk */
@@ -858,20 +863,20 @@ typedef struct limited_write {
 /* Three frames of img (3 channels) as an animated GIF. */
 static bb_status write_gif(const char *path, const bb_image *img, bb_error *err) {
   bb_animation *a = NULL;
-  bb_status st = bb_animation_open(path, img->width, img->height, 10.0, &a, err);
-  for (int k = 0; k < 3 && st == BB_OK; k++) st = bb_animation_add_frame(a, img, err);
+  bb_status st = bb__animation_open(path, img->width, img->height, 10.0, &a, err);
+  for (int k = 0; k < 3 && st == BB_OK; k++) st = bb__animation_add_frame(a, img, err);
   if (st != BB_OK) {
-    bb_animation_abort(a);
+    bb__animation_abort(a);
     return st;
   }
-  return bb_animation_close(a, err);
+  return bb__animation_close(a, err);
 }
 
 /* A grid mesh of img's size (two triangles per cell), heights from img. */
 static bb_status write_mesh(const char *path, const bb_image *img, bb_error *err) {
   const int w = img->width, h = img->height;
   bb_mesh m;
-  bb_status st = bb_mesh_alloc(&m, (size_t)w * (size_t)h, 2 * (size_t)(w - 1) * (size_t)(h - 1),
+  bb_status st = bb__mesh_alloc(&m, (size_t)w * (size_t)h, 2 * (size_t)(w - 1) * (size_t)(h - 1),
                                0, err);
   if (st != BB_OK) return st;
   for (int y = 0; y < h; y++)
@@ -888,8 +893,8 @@ static bb_status write_mesh(const char *path, const bb_image *img, bb_error *err
       memcpy(t, quad, sizeof quad);
       t += 6;
     }
-  st = bb_mesh_write(path, &m, err);
-  bb_mesh_free(&m);
+  st = bb__mesh_write(path, &m, err);
+  bb__mesh_free(&m);
   return st;
 }
 
@@ -899,7 +904,7 @@ static bb_status write_mip_file(const char *path, const bb_image *img, bb_depth 
   int count = 0;
   bb_status st = bb_mip_chain(img, BB_MIP_AVERAGE, &levels, &count, err);
   bb_write_options o = options(depth, BB_RANGE_UNIT, "provenance text");
-  if (st == BB_OK) st = bb_image_write_mips(path, levels, count, &o, err);
+  if (st == BB_OK) st = bb__image_write_mips(path, levels, count, &o, err);
   bb_mip_chain_free(levels, count);
   return st;
 }
@@ -916,10 +921,10 @@ static bb_status write_with_limit(const void *arg, bb_error *err) {
   case WRITE_MESH: return write_mesh(w->path, w->img, err);
   case WRITE_IMAGE: break;
   }
-  return bb_image_write(w->path, w->img, &o, err);
+  return bb__image_write(w->path, w->img, &o, err);
 }
 
-/* Runs bb_image_write in a child whose files may not grow past limit bytes
+/* Runs bb__image_write in a child whose files may not grow past limit bytes
  * (RLIMIT_FSIZE: the small filesystem a test can make without root), with
  * SIGXFSZ ignored so that writes fail with EFBIG as on a full disk. Every
  * write of a test that uses this must happen in such a child: a fork after
@@ -1036,7 +1041,7 @@ Test(image_files, mip_files_are_the_same_bytes_every_time) {
     for (int k = 0; k < 2; k++) {
       char path[600];
       snprintf(path, sizeof path, "%s/%s", tmpdir, names[f][k]);
-      cr_assert_eq(bb_image_write_mips(path, levels, count, &o, &err), BB_OK, "%s",
+      cr_assert_eq(bb__image_write_mips(path, levels, count, &o, &err), BB_OK, "%s",
                    err.message);
       FILE *in = fopen(path, "rb");
       cr_assert_not_null(in);
@@ -1081,7 +1086,7 @@ Test(image_files, files_written_seconds_apart_are_the_same_bytes) {
       const time_t start = time(NULL);
       while (k == 1 && time(NULL) == start)
         nanosleep(&(struct timespec){0, 20000000}, NULL); /* into the next second */
-      cr_assert_eq(bb_image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+      cr_assert_eq(bb__image_write(path, &img, &o, &err), BB_OK, "%s", err.message);
       bytes[k] = slurp_file(path, &sizes[k]);
     }
     cr_expect(sizes[0] == sizes[1] && !memcmp(bytes[0], bytes[1], sizes[0]),
@@ -1098,7 +1103,7 @@ Test(image_files, failed_write_keeps_the_previous_file) {
   bb_image new_img = make_image(128, 128, 3, 0.0f, 1.0f, 42);
   const char *path = tmp_path("keep.png");
   bb_error err;
-  cr_assert_eq(bb_image_write(path, &old_img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &old_img, NULL, &err), BB_OK, "%s", err.message);
   long before = file_size(path);
   char msg[600];
   cr_assert_eq(write_under_file_size_limit(path, &new_img, BB_DEPTH_8, 1000, msg, sizeof msg),
@@ -1119,12 +1124,12 @@ Test(image_files, staged_write_appears_only_on_commit) {
   const char *path = tmp_path("staged.exr");
   bb_staged_file *f = NULL;
   bb_error err;
-  cr_assert_eq(bb_image_write_staged(path, &img, NULL, &f, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write_staged_all_cores(path, &img, NULL, &f, &err), BB_OK, "%s", err.message);
   cr_assert_not_null(f);
-  cr_assert_str_eq(bb_staged_file_path(f), path);
+  cr_assert_str_eq(bb__staged_file_path(f), path);
   cr_assert_not(file_exists(path), "nothing at the final name before the commit");
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 1, "the staged file waits");
-  cr_assert_eq(bb_staged_file_commit(f, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__staged_file_commit(f, &err), BB_OK, "%s", err.message);
   cr_assert(file_exists(path));
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   bb_image back;
@@ -1138,14 +1143,14 @@ Test(image_files, staged_write_discard_leaves_nothing) {
   bb_image img = make_image(16, 16, 1, 0.0f, 1.0f, 44);
   bb_staged_file *f = NULL;
   bb_error err;
-  cr_assert_eq(bb_image_write_staged(tmp_path("gone.png"), &img, NULL, &f, &err), BB_OK,
+  cr_assert_eq(bb__image_write_staged_all_cores(tmp_path("gone.png"), &img, NULL, &f, &err), BB_OK,
                "%s", err.message);
-  bb_staged_file_discard(f);
-  bb_staged_file_discard(NULL);
+  bb__staged_file_discard(f);
+  bb__staged_file_discard(NULL);
   cr_assert_eq(count_entries(tmpdir, ""), 2, "only . and .. are left");
   /* A failed staging gives no handle. */
   f = (bb_staged_file *)&err; /* any non-NULL value must be overwritten */
-  cr_assert_eq(bb_image_write_staged(tmp_path("x.jpg2"), &img, NULL, &f, &err),
+  cr_assert_eq(bb__image_write_staged_all_cores(tmp_path("x.jpg2"), &img, NULL, &f, &err),
                BB_ERR_FORMAT);
   cr_assert_null(f);
   bb_image_free(&img);
@@ -1156,25 +1161,25 @@ Test(image_files, staged_write_discard_leaves_nothing) {
 Test(image_files, tempfiles_remove_takes_pending_temporaries_only) {
   bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("done.png"), &img, NULL, &err), BB_OK, "%s",
+  cr_assert_eq(bb__image_write(tmp_path("done.png"), &img, NULL, &err), BB_OK, "%s",
                err.message);
   bb_staged_file *a = NULL, *b = NULL, *m = NULL;
-  cr_assert_eq(bb_image_write_staged(tmp_path("a.tif"), &img, NULL, &a, &err), BB_OK);
-  cr_assert_eq(bb_image_write_staged(tmp_path("b.exr"), &img, NULL, &b, &err), BB_OK);
+  cr_assert_eq(bb__image_write_staged_all_cores(tmp_path("a.tif"), &img, NULL, &a, &err), BB_OK);
+  cr_assert_eq(bb__image_write_staged_all_cores(tmp_path("b.exr"), &img, NULL, &b, &err), BB_OK);
   /* A mip-mapped TIFF waits in a private directory of its own. */
   bb_image *chain = NULL;
   int levels = 0;
   cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &levels, &err), BB_OK);
-  cr_assert_eq(bb_image_write_mips_staged(tmp_path("m.tif"), chain, levels, NULL, &m, &err),
+  cr_assert_eq(bb__image_write_mips_staged_all_cores(tmp_path("m.tif"), chain, levels, NULL, &m, &err),
                BB_OK, "%s", err.message);
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 3);
-  bb_tempfiles_remove();
+  bb__tempfiles_remove();
   cr_assert_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   cr_assert(file_exists(tmp_path("done.png")));
   /* The handles are still freed normally; their commit now fails. */
-  cr_assert_eq(bb_staged_file_commit(a, &err), BB_ERR_IO);
-  cr_assert_eq(bb_staged_file_commit(m, &err), BB_ERR_IO);
-  bb_staged_file_discard(b);
+  cr_assert_eq(bb__staged_file_commit(a, &err), BB_ERR_IO);
+  cr_assert_eq(bb__staged_file_commit(m, &err), BB_ERR_IO);
+  bb__staged_file_discard(b);
   cr_assert_not(file_exists(tmp_path("a.tif")));
   cr_assert_not(file_exists(tmp_path("m.tif")));
   bb_mip_chain_free(chain, levels);
@@ -1188,16 +1193,16 @@ Test(image_files, tempfiles_remove_takes_pending_temporaries_only) {
 Test(image_files, no_temporary_is_made_once_the_cleanup_has_run) {
   bb_image img = make_image(8, 8, 1, 0.0f, 1.0f, 45);
   bb_error err;
-  bb_tempfiles_remove();
-  cr_expect_eq(bb_image_write(tmp_path("late.png"), &img, NULL, &err), BB_ERR_IO);
+  bb__tempfiles_remove();
+  cr_expect_eq(bb__image_write(tmp_path("late.png"), &img, NULL, &err), BB_ERR_IO);
   bb_staged_file *staged = NULL;
-  cr_expect_eq(bb_image_write_staged(tmp_path("late.exr"), &img, NULL, &staged, &err),
+  cr_expect_eq(bb__image_write_staged_all_cores(tmp_path("late.exr"), &img, NULL, &staged, &err),
                BB_ERR_IO);
   bb_image *chain = NULL;
   int levels = 0;
   cr_assert_eq(bb_mip_chain(&img, BB_MIP_AVERAGE, &chain, &levels, &err), BB_OK);
-  cr_expect_eq(bb_image_write_mips(tmp_path("late.tif"), chain, levels, NULL, &err), BB_ERR_IO);
-  cr_expect_eq(bb_file_write(tmp_path("late.d"), "x: y\n", 5, &err), BB_ERR_IO);
+  cr_expect_eq(bb__image_write_mips(tmp_path("late.tif"), chain, levels, NULL, &err), BB_ERR_IO);
+  cr_expect_eq(bb__file_write(tmp_path("late.d"), "x: y\n", 5, &err), BB_ERR_IO);
   cr_expect_eq(count_entries(tmpdir, ".bb-tmp-"), 0);
   cr_expect_not(file_exists(tmp_path("late.png")));
   cr_expect_not(file_exists(tmp_path("late.tif")));
@@ -1288,7 +1293,7 @@ Test(image_files, read_header_matches_the_full_read) {
   bb_image img = make_image(13, 7, 4, 0.0f, 1.0f, 46);
   bb_write_options o = options(BB_DEPTH_16, BB_RANGE_UNIT, "made by a test");
   bb_error err;
-  cr_assert_eq(bb_image_write(tmp_path("hdr.png"), &img, &o, &err), BB_OK, "%s",
+  cr_assert_eq(bb__image_write(tmp_path("hdr.png"), &img, &o, &err), BB_OK, "%s",
                err.message);
   int w, h, c;
   bb_image_info hi, fi;
@@ -1324,10 +1329,10 @@ Test(image_files, depth_names_round_trip_and_others_are_refused) {
     bb_depth d = BB_DEPTH_DEFAULT;
     cr_assert_eq(bb_depth_parse(names[i], &d, NULL), BB_OK, "%s", names[i]);
     cr_expect_eq(d, depths[i], "%s", names[i]);
-    cr_expect_str_eq(bb_depth_name(d), names[i]);
+    cr_expect_str_eq(bb__depth_name(d), names[i]);
   }
-  cr_expect_str_eq(bb_depth_name(BB_DEPTH_DEFAULT), "default");
-  cr_expect_str_eq(bb_depth_name((bb_depth)99), "unknown");
+  cr_expect_str_eq(bb__depth_name(BB_DEPTH_DEFAULT), "default");
+  cr_expect_str_eq(bb__depth_name((bb_depth)99), "unknown");
   bb_depth d = BB_DEPTH_16;
   bb_error err = {{0}};
   cr_assert_eq(bb_depth_parse("32", &d, &err), BB_ERR_ARGUMENT);

@@ -12,6 +12,8 @@
 
 #include "bumpbake.h"
 #include "image/oiio.h"
+#include "image/formats.h"
+#include "image/image_write.h"
 
 static bb_image noise(int w, int h, int channels, unsigned seed, float lo, float hi) {
   bb_image img;
@@ -209,10 +211,10 @@ Test(mips, files_hold_every_level) {
   bb_image *levels = chain(&img, BB_MIP_AVERAGE, &count);
   for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
     const char *path = temp_path(files[f].ext);
-    cr_assert(bb_path_supports_mips(path));
+    cr_assert(bb__path_supports_mips(path));
     bb_write_options o = {files[f].depth, BB_RANGE_UNIT, "test=1\n", NULL};
     bb_error err;
-    cr_assert_eq(bb_image_write_mips(path, levels, count, &o, &err), BB_OK, "%s",
+    cr_assert_eq(bb__image_write_mips(path, levels, count, &o, &err), BB_OK, "%s",
                  err.message);
     /* bb_image_read sees level 0, with the provenance. */
     bb_image top;
@@ -250,14 +252,14 @@ Test(mips, refusals) {
   bb_image *levels = chain(&img, BB_MIP_AVERAGE, &count);
   bb_error err;
   const char *png = temp_path("png");
-  cr_assert(!bb_path_supports_mips(png));
-  cr_assert_eq(bb_image_write_mips(png, levels, count, NULL, &err), BB_ERR_FORMAT);
+  cr_assert(!bb__path_supports_mips(png));
+  cr_assert_eq(bb__image_write_mips(png, levels, count, NULL, &err), BB_ERR_FORMAT);
   cr_assert(access(png, F_OK) != 0, "no file");
   /* A chain whose levels do not halve is not a mip chain. */
   const char *tif = temp_path("tif");
   bb_image swapped = levels[1];
   levels[1] = levels[2];
-  cr_assert_eq(bb_image_write_mips(tif, levels, count, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_write_mips(tif, levels, count, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "mip level 1"), "%s", err.message);
   cr_assert(access(tif, F_OK) != 0, "no file");
   levels[2] = levels[1];

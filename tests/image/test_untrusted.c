@@ -11,6 +11,9 @@
 #include "image/height_channel.h"
 #include "child_call.h"
 #include "scratch_dir.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "trace/basis.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -57,12 +60,12 @@ static bb_status call_read_mip(const char *path, bb_error *err) {
 
 static bb_status call_frame_count(const char *path, bb_error *err) {
   int frames;
-  return bb_image_frame_count(path, &frames, err);
+  return bb__image_frame_count(path, &frames, err);
 }
 
 static bb_status call_basis_load(const char *path, bb_error *err) {
   bb_basis b;
-  return bb_basis_load(path, &b, err);
+  return bb__basis_load(path, &b, err);
 }
 
 static bb_status call_file_hash(const char *path, bb_error *err) {
@@ -75,8 +78,8 @@ static const struct {
   child_call_fn fn;
 } READERS[] = {
     {"bb_image_read", call_read},       {"bb_image_read_info", call_read_info},
-    {"bb_image_read_mip", call_read_mip}, {"bb_image_frame_count", call_frame_count},
-    {"bb_basis_load", call_basis_load}, {"bb_file_hash", call_file_hash},
+    {"bb_image_read_mip", call_read_mip}, {"bb__image_frame_count", call_frame_count},
+    {"bb__basis_load", call_basis_load}, {"bb_file_hash", call_file_hash},
 };
 
 /* Every reader refuses path at once: BB_ERR_IO, one line naming the file
@@ -151,7 +154,7 @@ Test(untrusted, a_large_file_no_reader_knows_is_refused_at_once) {
       {"bb_image_read", call_read},
       {"bb_image_read_info", call_read_info},
       {"bb_image_read_mip", call_read_mip},
-      {"bb_image_frame_count", call_frame_count},
+      {"bb__image_frame_count", call_frame_count},
       {"bb_height_file_read", call_height_file_read},
   };
   for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
@@ -186,7 +189,7 @@ Test(untrusted, an_image_under_another_extension_is_read_by_its_signature) {
   for (int i = 0; i < 32; i++)
     img.pixels[i] = (float)i / 31.0f;
   bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(in_scratch_dir("real.png"), &img, &o, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(in_scratch_dir("real.png"), &img, &o, NULL), BB_OK);
   bb_image_free(&img);
   cr_assert_eq(bb_image_read(in_scratch_dir("real.png"), &img, NULL, NULL), BB_OK);
   static const char *names[] = {"png_as.tga", "png_as.exr", "png_as.foo", "png_as"};
@@ -267,7 +270,7 @@ static unsigned char *noise_png(size_t *size) {
     img.pixels[i] = (float)(s >> 8) / 16777216.0f;
   }
   bb_write_options o = {BB_DEPTH_16, BB_RANGE_UNIT, NULL, NULL};
-  cr_assert_eq(bb_image_write(in_scratch_dir("noise.png"), &img, &o, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(in_scratch_dir("noise.png"), &img, &o, NULL), BB_OK);
   bb_image_free(&img);
   FILE *f = fopen(in_scratch_dir("noise.png"), "rb");
   cr_assert_not_null(f);
@@ -392,7 +395,7 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
   int written = 0;
   for (int trial = 0; trial < 5; trial++) {
     unlink(out);
-    bb_status st = bb_image_write_mips(out, levels, count_made, NULL, &err);
+    bb_status st = bb__image_write_mips(out, levels, count_made, NULL, &err);
     if (st == BB_OK) {
       written++;
       int count = 0;
@@ -418,7 +421,7 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
   /* With the watcher gone the write goes through (while it runs, a loaded
    * machine lets it win every race: every trial then refused cleanly). */
   unlink(out);
-  cr_expect_eq(bb_image_write_mips(out, levels, count_made, NULL, &err), BB_OK, "%s",
+  cr_expect_eq(bb__image_write_mips(out, levels, count_made, NULL, &err), BB_OK, "%s",
                err.message);
   cr_expect_gt(p.files + p.dirs, 0, "the watcher never acted");
   cr_log_info("%d of 5 written; the watcher replaced %d files and %d directories", written,
@@ -466,7 +469,7 @@ Test(untrusted, a_png_write_short_of_memory_prints_nothing_on_stderr) {
       rl.rlim_cur = rl.rlim_max = data_bytes() + ((size_t)margin_mib << 20);
       setrlimit(RLIMIT_DATA, &rl);
       bb_error err = {{0}};
-      bb_status st = bb_image_write(in_scratch_dir("short.png"), &img, NULL, &err);
+      bb_status st = bb__image_write(in_scratch_dir("short.png"), &img, NULL, &err);
       if (st != BB_OK && (!err.message[0] || strchr(err.message, '\n'))) _exit(3);
       _exit(st == BB_OK ? 0 : 1);
     }

@@ -1,4 +1,4 @@
-/* test_incremental.c: bb_file_hash, bb_bake_rayset_id and bb_output_check:
+/* test_incremental.c: bb_file_hash, bb__bake_rayset_id and bb_output_check:
  * an output is current only when its provenance, depth and mip levels are
  * what writing it now would give. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
@@ -6,6 +6,10 @@
 
 #include "bumpbake.h"
 #include "cli_harness.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
+#include "job/job_internal.h"
+#include "trace/basis.h"
 
 #include <stdio.h>
 
@@ -79,17 +83,17 @@ Test(incremental, rayset_id_is_the_bakes) {
   o.height_scale = 2.0f;
   o.rays = 40;
   o.power = 2.5;
-  cr_assert_eq(bb_basis_parse("dirs:5", &o.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("dirs:5", &o.basis, NULL), BB_OK);
   bb_bake_result r;
   cr_assert_eq(bb_bake(&h, &o, &r, NULL), BB_OK);
   char id[64];
-  bb_bake_rayset_id(&o, id, sizeof id);
+  bb__bake_rayset_id(&o, id, sizeof id);
   cr_expect_str_eq(id, r.rayset_id);
   o.slices = 9;
-  bb_bake_rayset_id(&o, id, sizeof id);
+  bb__bake_rayset_id(&o, id, sizeof id);
   cr_expect_str_eq(id, "bb-horizon-v1:a9:p2.5:dirs:5");
   o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
-  bb_bake_rayset_id(&o, id, sizeof id);
+  bb__bake_rayset_id(&o, id, sizeof id);
   cr_expect_str_eq(id, "");
   bb_bake_result_free(&r);
   bb_image_free(&h);
@@ -116,7 +120,7 @@ static void write_output(const char *path, const char *description, bb_depth dep
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 3, NULL), BB_OK);
   bb_write_options wo = {depth, BB_RANGE_SIGNED, description, NULL};
   bb_error err;
-  cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
 }
 
@@ -270,14 +274,14 @@ Test(incremental, bad_arguments) {
 }
 
 Test(incremental, readable_formats_by_extension) {
-  cr_expect(bb_path_is_readable_format("a.png"));
-  cr_expect(bb_path_is_readable_format("dir.d/A.TIF"));
-  cr_expect(bb_path_is_readable_format("x.exr"));
-  cr_expect(bb_path_is_readable_format("x.jpg"));
-  cr_expect(!bb_path_is_readable_format("notes.txt"));
-  cr_expect(!bb_path_is_readable_format("Makefile"));
-  cr_expect(!bb_path_is_readable_format("x.d"));
-  cr_expect(!bb_path_is_readable_format(NULL));
+  cr_expect(bb__path_is_readable_format("a.png"));
+  cr_expect(bb__path_is_readable_format("dir.d/A.TIF"));
+  cr_expect(bb__path_is_readable_format("x.exr"));
+  cr_expect(bb__path_is_readable_format("x.jpg"));
+  cr_expect(!bb__path_is_readable_format("notes.txt"));
+  cr_expect(!bb__path_is_readable_format("Makefile"));
+  cr_expect(!bb__path_is_readable_format("x.d"));
+  cr_expect(!bb__path_is_readable_format(NULL));
 }
 
 /* An input whose header is refused is not current, and the check says the

@@ -7,6 +7,7 @@
 #include "cli_harness.h"
 #include "bake/bake_internal.h"
 #include "file_bytes.h"
+#include "trace/basis.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -229,7 +230,7 @@ static bb_bake_result bake_with(const char *input, int slices, const char *basis
   o.bake.slices = slices;
   o.bake.bounce_albedo = 0.5; /* the bounce reads the ray set too */
   o.bake.trace.threads = 2;
-  cr_assert_eq(bb_basis_parse(basis, &o.bake.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse(basis, &o.bake.basis, NULL), BB_OK);
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
   bb_error err = {{0}};

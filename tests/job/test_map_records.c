@@ -1,9 +1,14 @@
-/* test_map_records.c: what a map's provenance records (bb_map_kind_records)
+/* test_map_records.c: what a map's provenance records (bb__map_kind_records)
  * held to the pixels: every kind baked with each parameter changed, a key
  * recorded exactly when the kind's pixels change; and the rule followed by
  * the writer, the up-to-date check and the diff, also against a text
  * written before the rule (every key recorded). */
 #include "bumpbake.h"
+#include "core/internal.h"
+#include "files/provenance.h"
+#include "image/image_write.h"
+#include "maps/maps_internal.h"
+#include "trace/basis.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
@@ -52,7 +57,7 @@ typedef struct maps {
 static void bake(const bb_image *h, const bb_bake_options *o, maps *m) {
   bb_error err = {{0}};
   cr_assert_eq(bb_bake(h, o, &m->r, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_slope_map(&m->r.filtered, o->height_scale, o->smooth.addressing,
+  cr_assert_eq(bb__slope_map(&m->r.filtered, o->height_scale, o->smooth.addressing,
                             &m->slope, &err),
                BB_OK, "%s", err.message);
 }
@@ -100,7 +105,7 @@ static void more_power(bb_bake_options *o) {
   o->power = 2.0;
 }
 static void other_basis(bb_bake_options *o) {
-  cr_assert_eq(bb_basis_parse("dirs:4", &o->basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("dirs:4", &o->basis, NULL), BB_OK);
 }
 static void other_filter(bb_bake_options *o) {
   o->normal_filter = BB_NORMAL_SOBEL;
@@ -157,11 +162,11 @@ static void hold_rule(const bb_bake_options *base, int bounce, const change *c,
     maps after;
     bake(&h, &o, &after);
     for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
-      const char *kind = bb_map_kind_name(kinds[k]);
+      const char *kind = bb__map_kind_name(kinds[k]);
       const int changed =
           !same_pixels(image_of(&before, kinds[k]), image_of(&after, kinds[k]));
       const int recorded =
-          bb_map_kind_records(kind, c[i].key, bounce || o.bounce_albedo > 0);
+          bb__map_kind_records(kind, c[i].key, bounce || o.bounce_albedo > 0);
       cr_expect_eq(changed, recorded, "%s%s: %s %s the pixels but the rule says %s",
                    bounce ? "with inter-reflection, " : "", kind, c[i].key,
                    changed ? "changes" : "leaves",
@@ -198,20 +203,20 @@ Test(map_records, with_inter_reflection_ao_depends_on_the_lobes) {
 
 Test(map_records, kinds_of_parts_and_unknown_kinds) {
   /* Valve's packed files record what any part records */
-  cr_assert(bb_map_kind_records("ssbump+height", "normal_filter", 0));
-  cr_assert(!bb_map_kind_records("ssbump+height", "normal_y", 0));
-  cr_assert(bb_map_kind_records("normal+height", "normal_y", 0));
-  cr_assert(!bb_map_kind_records("normal+height", "rays", 0));
-  cr_assert(bb_map_kind_records("normal+ao", "rays", 0));
-  cr_assert(!bb_map_kind_records("detail-ssbump+height", "normal_y", 0));
+  cr_assert(bb__map_kind_records("ssbump+height", "normal_filter", 0));
+  cr_assert(!bb__map_kind_records("ssbump+height", "normal_y", 0));
+  cr_assert(bb__map_kind_records("normal+height", "normal_y", 0));
+  cr_assert(!bb__map_kind_records("normal+height", "rays", 0));
+  cr_assert(bb__map_kind_records("normal+ao", "rays", 0));
+  cr_assert(!bb__map_kind_records("detail-ssbump+height", "normal_y", 0));
   /* what is not a bake's parameter, and what is not a bake's map, is kept */
-  cr_assert(bb_map_kind_records("normal", "bumpbake_version", 0));
-  cr_assert(bb_map_kind_records("normal", "input_file_hash", 0));
-  cr_assert(bb_map_kind_records("normal", "texture_format", 0));
-  cr_assert(bb_map_kind_records("render", "rays", 0));
-  cr_assert(bb_map_kind_records("normal+coverage", "rayset", 0));
-  cr_assert(bb_map_kind_records(NULL, "rays", 0));
-  cr_assert(!bb_map_kind_records("normal", NULL, 0));
+  cr_assert(bb__map_kind_records("normal", "bumpbake_version", 0));
+  cr_assert(bb__map_kind_records("normal", "input_file_hash", 0));
+  cr_assert(bb__map_kind_records("normal", "texture_format", 0));
+  cr_assert(bb__map_kind_records("render", "rays", 0));
+  cr_assert(bb__map_kind_records("normal+coverage", "rayset", 0));
+  cr_assert(bb__map_kind_records(NULL, "rays", 0));
+  cr_assert(!bb__map_kind_records("normal", NULL, 0));
 }
 
 /* ------------------------------------------------- the rule in use */
@@ -281,13 +286,13 @@ Test(map_records, a_diff_against_a_text_with_every_key_lists_what_counts) {
   old_text(old_ao, sizeof old_ao, "ao");
   bb_bake_options o = base_options(); /* rays 64: another ray set */
   char *now = describe("normal", &o, NULL);
-  int n = bb_provenance_diff(old_normal, now, out, sizeof out);
+  int n = bb__provenance_diff(old_normal, now, out, sizeof out);
   cr_expect(same_version ? n == 0 : n == 1 && strstr(out, "bumpbake_version:"), "%s",
             out);
   /* as an ao: rays and the ray set's slices count, the lobes of its id do
    * not, nor the normals' keys */
   char *ao = describe("ao", &o, "bb-horizon-v1:a8:p2:dirs:5");
-  n = bb_provenance_diff(old_ao, ao, out, sizeof out);
+  n = bb__provenance_diff(old_ao, ao, out, sizeof out);
   cr_expect(strstr(out, "rays: 256 -> 64\n") &&
                 strstr(out, "rayset: bb-horizon-v1:a16 -> "
                             "bb-horizon-v1:a8\n"),
@@ -295,7 +300,7 @@ Test(map_records, a_diff_against_a_text_with_every_key_lists_what_counts) {
   cr_expect_eq(n, same_version ? 2 : 3, "%s", out);
   o.rays = 256;
   char *ao_256 = describe("ao", &o, "bb-horizon-v1:a16:p2:dirs:5");
-  n = bb_provenance_diff(old_ao, ao_256, out, sizeof out);
+  n = bb__provenance_diff(old_ao, ao_256, out, sizeof out);
   cr_expect_eq(n, same_version ? 0 : 1, "%s", out);
   free(now);
   free(ao);
@@ -313,7 +318,7 @@ Test(map_records, a_file_with_every_key_is_current_when_only_those_differ) {
   bb_image img;
   cr_assert_eq(bb_image_alloc(&img, 4, 4, 3, NULL), BB_OK);
   const bb_write_options wo = {BB_DEPTH_DEFAULT, BB_RANGE_SIGNED, text, NULL};
-  cr_assert_eq(bb_image_write(path, &img, &wo, NULL), BB_OK);
+  cr_assert_eq(bb__image_write(path, &img, &wo, NULL), BB_OK);
   bb_bake_options o = base_options();
   o.rays = 9;
   o.power = 3;

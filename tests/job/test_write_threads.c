@@ -10,6 +10,7 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "file_bytes.h"
+#include "job/job_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -84,7 +85,7 @@ Test(write_threads, same_bytes_on_any_thread_count) {
   for (int threads = 1; threads <= 3; threads++) {
     char sub[16];
     snprintf(sub, sizeof sub, "t%d", threads);
-    cr_assert_eq(bb_directory_create(tmp(sub), NULL), BB_OK);
+    cr_assert_eq(bb__directory_create(tmp(sub), NULL), BB_OK);
     bb_output_file files[FILES];
     const char *paths[FILES];
     for (int i = 0; i < FILES; i++) {

@@ -10,6 +10,10 @@
 
 #include "bumpbake.h"
 #include "bake_harness.h"
+#include "bake/bake_internal.h"
+#include "core/internal.h"
+#include "files/provenance.h"
+#include "trace/basis.h"
 
 static bb_image image(int w, int h, int channels, const float *texel) {
   bb_image img;
@@ -67,8 +71,8 @@ Test(brightness, over_one_clips_the_brightness_and_keeps_the_direction) {
   cr_expect_float_eq(out.pixels[1], 0.5, 1e-7);
   cr_expect_float_eq(out.pixels[2], 0.1 / 0.6, 1e-7);
   bb_image bent_a, bent_b;
-  cr_assert_eq(bb_derive_bent(&map, NULL, &bent_a, NULL), BB_OK);
-  cr_assert_eq(bb_derive_bent(&out, NULL, &bent_b, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&map, NULL, &bent_a, NULL), BB_OK);
+  cr_assert_eq(bb__derive_bent_all_cores(&out, NULL, &bent_b, NULL), BB_OK);
   for (int k = 0; k < 3; k++) cr_expect_float_eq(bent_a.pixels[k], bent_b.pixels[k], 1e-6);
   /* a flat texel takes sqrt(3) before it clips */
   const float flat[3] = {0.57735027f, 0.57735027f, 0.57735027f};
@@ -137,7 +141,7 @@ Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
   cr_expect_eq(memcmp(lit.ao.pixels, plain.ao.pixels, (size_t)W * (size_t)H * sizeof(float)), 0);
   cr_expect_eq(memcmp(lit.bent.pixels, plain.bent.pixels, n3 * sizeof(float)), 0);
   /* and with a basis of 6 directions, every one of them */
-  cr_assert_eq(bb_basis_parse("dirs:6", &o.basis, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("dirs:6", &o.basis, NULL), BB_OK);
   bb_bake_result six = harness_bake(&h, &o);
   o.brightness = NULL;
   bb_bake_result six_plain = harness_bake(&h, &o);
@@ -166,8 +170,8 @@ Test(brightness, provenance_names_the_maps_it_was_made_with) {
   bb_provenance p = {.output_kind = "ssbump", .options = &o};
   char *text = bb_provenance_format(&p), value[64];
   cr_assert_not_null(text);
-  cr_expect_eq(bb_provenance_value(text, "brightness", value, sizeof value), 0);
-  cr_expect_eq(bb_provenance_value(text, "bounce", value, sizeof value), 0);
+  cr_expect_eq(bb__provenance_value(text, "brightness", value, sizeof value), 0);
+  cr_expect_eq(bb__provenance_value(text, "bounce", value, sizeof value), 0);
   free(text);
   bb_image b = harness_field(3, 3, 0.5f), albedo = harness_field(3, 3, 0.25f);
   o.brightness = &b;
@@ -175,15 +179,15 @@ Test(brightness, provenance_names_the_maps_it_was_made_with) {
   o.bounce_albedo_map = &albedo;
   text = bb_provenance_format(&p);
   char want[32];
-  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb_image_hash(&b));
-  cr_expect_eq(bb_provenance_value(text, "brightness", value, sizeof value), 1);
+  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb__image_hash(&b));
+  cr_expect_eq(bb__provenance_value(text, "brightness", value, sizeof value), 1);
   cr_expect_str_eq(value, want);
-  cr_expect_eq(bb_provenance_value(text, "bounce", value, sizeof value), 1);
+  cr_expect_eq(bb__provenance_value(text, "bounce", value, sizeof value), 1);
   cr_expect_str_eq(value, "0.4");
-  cr_expect_eq(bb_provenance_value(text, "bounces", value, sizeof value), 1);
+  cr_expect_eq(bb__provenance_value(text, "bounces", value, sizeof value), 1);
   cr_expect_str_eq(value, "0");
-  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb_image_hash(&albedo));
-  cr_expect_eq(bb_provenance_value(text, "bounce_albedo_map", value, sizeof value), 1);
+  snprintf(want, sizeof want, "%016llx", (unsigned long long)bb__image_hash(&albedo));
+  cr_expect_eq(bb__provenance_value(text, "bounce_albedo_map", value, sizeof value), 1);
   cr_expect_str_eq(value, want);
   free(text);
   bb_image_free(&b), bb_image_free(&albedo);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "core/internal.h"
 
 static bb_image noise_map(int w, int h, int channels, unsigned seed, float lo, float hi) {
   bb_image img;
@@ -45,13 +46,13 @@ static int same_bits(const bb_image *a, const bb_image *b) {
 
 Test(combine, kind_names) {
   bb_map_kind k = BB_MAP_AO;
-  cr_assert_eq(bb_map_kind_parse("normal", &k, NULL), 0);
+  cr_assert_eq(bb__map_kind_parse("normal", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_NORMAL);
-  cr_assert_eq(bb_map_kind_parse("Weights", &k, NULL), 0);
+  cr_assert_eq(bb__map_kind_parse("Weights", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_WEIGHTS);
-  cr_assert_neq(bb_map_kind_parse("height", &k, NULL), 0);
+  cr_assert_neq(bb__map_kind_parse("height", &k, NULL), 0);
   cr_assert_eq(k, BB_MAP_WEIGHTS, "a failed parse must not write");
-  cr_assert_str_eq(bb_map_kind_name(BB_MAP_SSBUMP), "ssbump");
+  cr_assert_str_eq(bb__map_kind_name(BB_MAP_SSBUMP), "ssbump");
   cr_assert_eq(bb_map_kind_get(BB_MAP_AO)->file_channels, 1);
   cr_assert_eq(bb_map_kind_get(BB_MAP_NORMAL)->file_channels, 3);
 }
@@ -152,7 +153,7 @@ Test(combine, flat_detail_leaves_the_base_bit_for_bit) {
           bb_combine_detail(&base, &detail, kinds[k], bits ? flat : NULL, &out, NULL),
           BB_OK);
       cr_assert(same_bits(&out, &base), "%s, %d-bit flat detail changed the base",
-                bb_map_kind_name(kinds[k]), bits ? 8 : 32);
+                bb__map_kind_name(kinds[k]), bits ? 8 : 32);
       bb_image_free(&out);
       bb_image_free(&detail);
     }

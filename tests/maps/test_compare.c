@@ -1,4 +1,4 @@
-/* test_compare.c: bb_compare_images statistics, and `bumpbake compare` / `info` run as a
+/* test_compare.c: bb__compare_images statistics, and `bumpbake compare` / `info` run as a
  * process. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw (scratch_dir.h) */
 #define _DEFAULT_SOURCE   /* wait4 (child_call.h) */
@@ -7,6 +7,9 @@
 #include "child_call.h"
 #include "hostile_headers.h"
 #include "scratch_dir.h"
+#include "core/internal.h"
+#include "image/image_write.h"
+#include "maps/maps_internal.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
@@ -37,7 +40,7 @@ static bb_image wrap(float *px, int w, int h, int c) {
 Test(compare, stats_match_hand_computation) {
   bb_image a = wrap(pair_a, 2, 2, 2), b = wrap(pair_b, 2, 2, 2);
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &b, 0.5, 0.25, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &b, 0.5, 0.25, &s, NULL, NULL), BB_OK);
   cr_assert_float_eq(s.mean_abs, 0.21875, 1e-15);
   cr_assert_float_eq(s.rms, sqrt(0.1171875), 1e-15);
   cr_assert_float_eq(s.max_abs, 0.75, 1e-15);
@@ -53,7 +56,7 @@ Test(compare, stats_match_hand_computation) {
 Test(compare, identical_images_give_zero_everything) {
   bb_image a = wrap(pair_a, 2, 2, 2);
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &a, 0, 0, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &a, 0, 0, &s, NULL, NULL), BB_OK);
   cr_assert_eq(s.mean_abs, 0);
   cr_assert_eq(s.rms, 0);
   cr_assert_eq(s.max_abs, 0);
@@ -65,7 +68,7 @@ Test(compare, a_pixel_counts_once_however_many_channels_differ) {
   float x[6] = {0, 0, 0, 0, 0, 0}, y[6] = {1, 1, 1, 0, 0, 0};
   bb_image a = wrap(x, 2, 1, 3), b = wrap(y, 2, 1, 3);
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &b, 0.5, 0.5, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &b, 0.5, 0.5, &s, NULL, NULL), BB_OK);
   cr_assert_eq(s.over_fail, 1);
   cr_assert_eq(s.worst_channel, 0, "ties go to the first value in scan order");
 }
@@ -75,7 +78,7 @@ Test(compare, nan_is_an_infinite_difference) {
   bb_image a = wrap(x, 2, 2, 1), b = wrap(y, 2, 2, 1);
   bb_compare_stats s;
   bb_image diff = {0};
-  cr_assert_eq(bb_compare_images(&b, &a, 1e30, 1e30, &s, &diff, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&b, &a, 1e30, 1e30, &s, &diff, NULL), BB_OK);
   cr_assert(isinf(s.max_abs) && s.max_abs > 0);
   cr_assert_eq(s.worst_x, 1);
   cr_assert_eq(s.worst_y, 1);
@@ -90,19 +93,19 @@ Test(compare, nan_against_nan_does_not_differ) {
   float x[4] = {0, NAN, 1, NAN};
   bb_image a = wrap(x, 2, 2, 1);
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &a, 0.0, 0.0, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &a, 0.0, 0.0, &s, NULL, NULL), BB_OK);
   cr_assert_eq(s.max_abs, 0.0);
   cr_assert_eq(s.over_fail, 0);
   bb_compare_limits l;
-  bb_compare_limits_init(&l);
-  cr_assert_eq(bb_compare_judge(&s, &l), BB_COMPARE_PASS);
+  bb__compare_limits_init(&l);
+  cr_assert_eq(bb__compare_judge(&s, &l), BB_COMPARE_PASS);
 }
 
 Test(compare, equal_infinities_do_not_differ) {
   float x[2] = {INFINITY, -INFINITY};
   bb_image a = wrap(x, 1, 1, 2);
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &a, 0, 0, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &a, 0, 0, &s, NULL, NULL), BB_OK);
   cr_assert_eq(s.max_abs, 0);
   cr_assert_eq(s.over_fail, 0);
 }
@@ -111,7 +114,7 @@ Test(compare, diff_image_holds_absolute_differences) {
   bb_image a = wrap(pair_a, 2, 2, 2), b = wrap(pair_b, 2, 2, 2);
   bb_compare_stats s;
   bb_image diff = {0};
-  cr_assert_eq(bb_compare_images(&a, &b, 1, 1, &s, &diff, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &b, 1, 1, &s, &diff, NULL), BB_OK);
   cr_assert_eq(diff.width, 2);
   cr_assert_eq(diff.height, 2);
   cr_assert_eq(diff.channels, 2);
@@ -125,9 +128,9 @@ Test(compare, different_shapes_are_a_size_error) {
   bb_image a = wrap(x, 2, 2, 2), b = wrap(y, 4, 1, 2), c = wrap(y, 2, 2, 1);
   bb_compare_stats s;
   bb_error err = {{0}};
-  cr_assert_eq(bb_compare_images(&a, &b, 0, 0, &s, NULL, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__compare_images(&a, &b, 0, 0, &s, NULL, &err), BB_ERR_SIZE);
   cr_assert_neq(err.message[0], '\0');
-  cr_assert_eq(bb_compare_images(&a, &c, 0, 0, &s, NULL, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__compare_images(&a, &c, 0, 0, &s, NULL, &err), BB_ERR_SIZE);
 }
 
 Test(compare, accumulates_in_double) {
@@ -142,7 +145,7 @@ Test(compare, accumulates_in_double) {
     b.pixels[i] = 1e-7f;
   b.pixels[0] = 2.0f;
   bb_compare_stats s;
-  cr_assert_eq(bb_compare_images(&a, &b, 1, 1, &s, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__compare_images(&a, &b, 1, 1, &s, NULL, NULL), BB_OK);
   double expect = (2.0 + ((double)W * H - 1) * (double)1e-7f) / ((double)W * H);
   cr_assert_float_eq(s.mean_abs, expect, expect * 1e-9);
   bb_image_free(&a);
@@ -153,7 +156,7 @@ Test(compare, accumulates_in_double) {
 
 /* One comparison as idiff 2.4.7 judged it: a 10 x 10 image where 2 pixels
  * differ by 0.1 and 3 by 0.01 (over_fail and over_warn as
- * bb_compare_images counts them for the thresholds of the row), and the
+ * bb__compare_images counts them for the thresholds of the row), and the
  * exit code `idiff` itself returned for the same options and images. */
 typedef struct verdict_case {
   const char *idiff_options;
@@ -192,7 +195,7 @@ Test(compare, verdict_follows_idiff_case_by_case) {
   for (size_t i = 0; i < sizeof verdict_cases / sizeof verdict_cases[0]; i++) {
     const verdict_case *c = &verdict_cases[i];
     bb_compare_limits l;
-    bb_compare_limits_init(&l);
+    bb__compare_limits_init(&l);
     l.fail = c->fail;
     l.fail_percent = c->fail_percent;
     l.hard_fail = c->hard_fail;
@@ -201,14 +204,14 @@ Test(compare, verdict_follows_idiff_case_by_case) {
     l.allow_failures = c->allow_failures;
     bb_compare_stats s = {.max_abs = 0.1, .pixels = 100, .over_fail = c->over_fail,
                           .over_warn = c->over_warn};
-    cr_expect_eq(bb_compare_judge(&s, &l), c->expect, "idiff %s gives %d", c->idiff_options,
+    cr_expect_eq(bb__compare_judge(&s, &l), c->expect, "idiff %s gives %d", c->idiff_options,
                  (int)c->expect);
   }
 }
 
 Test(compare, verdict_defaults_are_idiffs) {
   bb_compare_limits l;
-  bb_compare_limits_init(&l);
+  bb__compare_limits_init(&l);
   cr_assert_eq(l.fail, 1e-6);
   cr_assert_eq(l.warn, 1e-6);
   cr_assert(isinf(l.hard_fail) && isinf(l.hard_warn));
@@ -216,9 +219,9 @@ Test(compare, verdict_defaults_are_idiffs) {
   cr_assert_eq(l.warn_percent, 0);
   cr_assert_eq(l.allow_failures, 0);
   bb_compare_stats same = {.pixels = 16};
-  cr_assert_eq(bb_compare_judge(&same, &l), BB_COMPARE_PASS);
+  cr_assert_eq(bb__compare_judge(&same, &l), BB_COMPARE_PASS);
   bb_compare_stats one = {.max_abs = 1e-5, .pixels = 16, .over_fail = 1, .over_warn = 1};
-  cr_assert_eq(bb_compare_judge(&one, &l), BB_COMPARE_FAIL, "one pixel is enough");
+  cr_assert_eq(bb__compare_judge(&one, &l), BB_COMPARE_FAIL, "one pixel is enough");
 }
 
 /* ------------------------------------------------------- the binary, run */
@@ -256,7 +259,7 @@ static const char *write_image(const char *name, int w, int h, int c, const floa
       .depth = BB_DEPTH_DEFAULT, .range = BB_RANGE_UNIT, .description = description};
   const char *path = in_scratch_dir(name);
   bb_error err = {{0}};
-  cr_assert_eq(bb_image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_write(path, &img, &wo, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   return path;
 }
@@ -485,7 +488,7 @@ Test(compare_cli, a_large_comparison_says_its_cost_before_it_starts) {
   bb_error err = {{0}};
   char note[512] = "";
   uint64_t room = 0;
-  cr_assert_eq(bb_memory_available(&room, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__memory_available(&room, NULL, NULL), BB_OK);
   if ((double)room < 2.0 * (1 << 30))
     cr_skip_test("less than 2 GiB of memory available for the note's case");
   /* 4096 x 8192 RGBA floats: 512 MiB a file, 1.6 GiB to compare: said */
@@ -635,7 +638,7 @@ Test(compare_cli, info_of_a_fresh_bake_lists_its_parameters) {
   cr_assert_eq(bb_image_read(height, &img, NULL, NULL), BB_OK);
   char hash[64];
   snprintf(hash, sizeof hash, "\ninput_hash=%016llx\n",
-           (unsigned long long)bb_image_hash(&img));
+           (unsigned long long)bb__image_hash(&img));
   bb_image_free(&img);
   cr_assert_not_null(strstr(out, hash), "input hash of the decoded height: %s", out);
 }
@@ -754,7 +757,7 @@ Test(compare_cli, report_result_and_exit_code_are_idiffs) {
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     bb_compare_limits l;
-    bb_compare_limits_init(&l);
+    bb__compare_limits_init(&l);
     l.allow_failures = cases[i].allow;
     l.fail_percent = cases[i].fail_percent;
     bb_compare_report r;
@@ -773,12 +776,12 @@ Test(compare_cli, report_result_and_exit_code_are_idiffs) {
  * the same answer; bb_compare_files checks them before reading. */
 Test(compare_cli, limits_out_of_range_are_refused) {
   bb_compare_limits l;
-  bb_compare_limits_init(&l);
+  bb__compare_limits_init(&l);
   bb_error err = {{0}};
-  cr_assert_eq(bb_compare_limits_check(&l, &err), BB_OK, "idiff's defaults");
+  cr_assert_eq(bb__compare_limits_check(&l, &err), BB_OK, "idiff's defaults");
   l.hard_fail = l.hard_warn = INFINITY;
   l.fail_percent = l.warn_percent = 100.0;
-  cr_expect_eq(bb_compare_limits_check(&l, &err), BB_OK, "the ends of the ranges");
+  cr_expect_eq(bb__compare_limits_check(&l, &err), BB_OK, "the ends of the ranges");
   const struct {
     int field;
     double value;
@@ -790,16 +793,16 @@ Test(compare_cli, limits_out_of_range_are_refused) {
              {4, -0.5, "compare: warnpercent must be in 0..100 (got -0.5)"},
              {5, -INFINITY, "compare: hardwarn must be >= 0 (got -inf)"}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    bb_compare_limits_init(&l);
+    bb__compare_limits_init(&l);
     double *fields[] = {&l.fail, &l.fail_percent, &l.hard_fail,
                         &l.warn, &l.warn_percent, &l.hard_warn};
     *fields[bad[i].field] = bad[i].value;
-    cr_expect_eq(bb_compare_limits_check(&l, &err), BB_ERR_ARGUMENT, "case %zu", i);
+    cr_expect_eq(bb__compare_limits_check(&l, &err), BB_ERR_ARGUMENT, "case %zu", i);
     cr_expect_str_eq(err.message, bad[i].message);
   }
-  bb_compare_limits_init(&l);
+  bb__compare_limits_init(&l);
   l.allow_failures = -1;
-  cr_expect_eq(bb_compare_limits_check(&l, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb__compare_limits_check(&l, &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
   /* Before any read: the files need not exist. */
   bb_compare_report r;

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "maps/program_internal.h"
 
 /* --------------------------------------------------- an in-memory loader */
 
@@ -177,7 +178,7 @@ Test(program, eight_bit_output_is_within_one_code_of_ids_bytes) {
       int id_bytes[3];
       id_heightmap_bytes(x, y, 4.0f, id_bytes);
       for (int k = 0; k < 3; k++) {
-        /* bb_image_write's 8-bit code for a normal: round(255 (0.5 + 0.5 N)). */
+        /* bb__image_write's 8-bit code for a normal: round(255 (0.5 + 0.5 N)). */
         double n = bb_image_texel(&out, x, y)[k];
         int code = (int)floor(255.0 * (0.5 + 0.5 * n) + 0.5);
         cr_assert_leq(abs(code - id_bytes[k]), 1, "(%d, %d)[%d]: %d vs id's %d", x, y, k,
@@ -416,14 +417,14 @@ Test(program, names_quotes_base_directory_and_missing_files) {
  * the length is snprintf's, so a cut path can be told from a whole one. */
 Test(program, image_path_joins_base_dir_for_relative_names) {
   char out[32];
-  cr_assert_eq(bb_program_image_path("maps", "a.tga", out, sizeof out), 10);
+  cr_assert_eq(bb__program_image_path("maps", "a.tga", out, sizeof out), 10);
   cr_assert_str_eq(out, "maps/a.tga");
-  cr_assert_eq(bb_program_image_path("maps", "/abs/a.tga", out, sizeof out), 10);
+  cr_assert_eq(bb__program_image_path("maps", "/abs/a.tga", out, sizeof out), 10);
   cr_assert_str_eq(out, "/abs/a.tga");
-  cr_assert_eq(bb_program_image_path("", "a.tga", out, sizeof out), 5);
+  cr_assert_eq(bb__program_image_path("", "a.tga", out, sizeof out), 5);
   cr_assert_str_eq(out, "a.tga");
-  cr_assert_eq(bb_program_image_path(NULL, "a.tga", out, sizeof out), 5);
+  cr_assert_eq(bb__program_image_path(NULL, "a.tga", out, sizeof out), 5);
   char small[8];
-  cr_assert_eq(bb_program_image_path("maps", "a.tga", small, sizeof small), 10,
+  cr_assert_eq(bb__program_image_path("maps", "a.tga", small, sizeof small), 10,
                "the whole length, past cap");
 }

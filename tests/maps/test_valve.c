@@ -1,6 +1,7 @@
 /* test_valve.c: Valve's RGBA packing (bb_valve_pack) and detail variant
  * (bb_valve_detail). */
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
@@ -123,7 +124,7 @@ Test(valve, pack_of_a_real_flat_bake) {
 
 static bb_smooth_options smoothing(void) {
   bb_smooth_options s;
-  bb_smooth_options_init(&s);
+  bb__smooth_options_init(&s);
   return s;
 }
 

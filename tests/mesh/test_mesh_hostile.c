@@ -1,12 +1,13 @@
 /* test_mesh_hostile.c: models as an attacker writes them: files
  * named outside the model's directory, FIFOs, devices, nesting that
  * overflows Assimp's stack, instancing and overdraw that multiply the
- * work, through bb_mesh_load (test_mesh_cli.c runs the CLI on them). */
+ * work, through bb__mesh_load (test_mesh_cli.c runs the CLI on them). */
 #define _GNU_SOURCE /* wait4 (cli_harness.h), mkfifo, symlink, realpath */
 
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "mesh/mesh_import.h"
+#include "mesh/mesh_internal.h"
 
 #include <criterion/criterion.h>
 
@@ -125,14 +126,14 @@ static void write_gltf(const char *path, const char *uri, int triangles, int ins
 }
 
 static bb_status load(const char *path, bb_mesh *m, char *note, bb_error *err) {
-  bb_status st = bb_mesh_load_noted(path, m, note, 512, err);
+  bb_status st = bb__mesh_load_noted(path, m, note, 512, err);
   cr_expect(st == BB_OK || (m->positions == NULL && note[0] == '\0'),
             "a failed load leaves the mesh and the note empty");
   cr_expect(strchr(err->message, '\n') == NULL, "one line: %s", err->message);
   return st;
 }
 
-/* Expects bb_mesh_load to refuse path with status and a message holding
+/* Expects bb__mesh_load to refuse path with status and a message holding
  * part (and naming the model). */
 static void expect_refused(const char *path, bb_status status, const char *part) {
   bb_mesh m;
@@ -143,7 +144,7 @@ static void expect_refused(const char *path, bb_status status, const char *part)
   cr_expect(strstr(err.message, part) && strstr(err.message, path),
             "%s: '%s' lacks '%s'", path, err.message, part);
   if (st == BB_OK)
-    bb_mesh_free(&m);
+    bb__mesh_free(&m);
 }
 
 /* ------------------------------------------------- 1. files it may read */
@@ -197,9 +198,9 @@ Test(mesh_hostile, buffers_inside_the_directory_and_data_uris_load) {
     cr_expect_eq(m.triangle_count, 1, "%s", names[i]);
     cr_expect_str_empty(note, "%s: %s", names[i], note);
     if (i == 0)
-      first = bb_mesh_hash(&m);
-    cr_expect_eq(bb_mesh_hash(&m), first, "%s differs from the embedded one", names[i]);
-    bb_mesh_free(&m);
+      first = bb__mesh_hash(&m);
+    cr_expect_eq(bb__mesh_hash(&m), first, "%s differs from the embedded one", names[i]);
+    bb__mesh_free(&m);
   }
 }
 
@@ -232,7 +233,7 @@ Test(mesh_hostile, an_obj_mtllib_outside_the_directory_is_refused) {
   char note[512];
   cr_assert_eq(load("a/b/passwd.obj", &m, note, &err), BB_OK, "%s", err.message);
   cr_expect(strstr(note, "read without /etc/passwd"), "%s", note);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* A .mtl that is a directory (LeakSanitizer: Assimp lost the stream it
@@ -256,7 +257,7 @@ Test(mesh_hostile, a_side_file_that_is_not_a_regular_file_fails_and_a_missing_on
   cr_assert_eq(load(tmp("missing.obj"), &m, note, &err), BB_OK, "%s", err.message);
   cr_expect_eq(m.triangle_count, 1);
   cr_expect(strstr(note, "read without gone.mtl") && strstr(note, "no such file"), "%s", note);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
   /* a glTF cannot do without its buffer */
   write_gltf(tmp("nobin.gltf"), "nothere.bin", 1, 1);
   cr_assert_neq(load(tmp("nobin.gltf"), &m, note, &err), BB_OK);
@@ -331,7 +332,7 @@ Test(mesh_hostile, the_import_runs_on_a_stack_of_its_own) {
                "%s", err.message);
   cr_expect_eq(m.triangle_count, 1);
   cr_expect(clean);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
   lim.stack_bytes = 64 << 10;
   cr_assert_eq(bb__mesh_load_isolated(tmp("tall.gltf"), &lim, &m, NULL, 0, &clean, &err),
                BB_ERR_FORMAT);
@@ -348,14 +349,14 @@ Test(mesh_hostile, the_isolated_load_returns_the_in_process_mesh) {
   const char *fixtures = getenv("BB_FIXTURES");
   char path[PATH_MAX];
   snprintf(path, sizeof path, "%s/rivet_panel.obj", fixtures ? fixtures : "fixtures");
-  cr_assert_eq(bb_mesh_load(path, &m, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__mesh_load(path, &m, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb__mesh_import(path, &here, NULL, 0, &err), BB_OK, "%s", err.message);
   cr_expect_eq(m.vertex_count, here.vertex_count);
   cr_expect_eq(m.triangle_count, here.triangle_count);
   cr_expect(m.normals && here.normals);
-  cr_expect_eq(bb_mesh_hash(&m), bb_mesh_hash(&here));
-  bb_mesh_free(&m);
-  bb_mesh_free(&here);
+  cr_expect_eq(bb__mesh_hash(&m), bb__mesh_hash(&here));
+  bb__mesh_free(&m);
+  bb__mesh_free(&here);
 }
 
 /* --------------------------------------------------------- 3. limits */
@@ -373,7 +374,7 @@ Test(mesh_hostile, instancing_past_the_triangle_limit_is_refused_before_it_is_bu
   char note[512];
   cr_assert_eq(load(tmp("few.gltf"), &m, note, &err), BB_OK, "%s", err.message);
   cr_expect_eq(m.triangle_count, 3000);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* A model over BB_MAX_MODEL_BYTES (a sparse file: no disk used) is refused
@@ -411,7 +412,7 @@ Test(mesh_hostile, the_importer_memory_is_capped) {
   cr_assert_eq(bb__mesh_load_isolated(tmp("grid.obj"), &lim, &m, NULL, 0, NULL, &err), BB_OK,
                "%s", err.message);
   cr_expect_eq(m.triangle_count, 2 * N * N);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
   lim.memory_bytes = 64 << 20; /* the thread's stack and little more */
   bb_status st = bb__mesh_load_isolated(tmp("grid.obj"), &lim, &m, NULL, 0, NULL, &err);
   cr_expect_eq(st, BB_ERR_MEMORY, "%d: %s", st, err.message);
@@ -432,10 +433,10 @@ static void *load_six(void *user) {
   for (int i = 0; i < 6; i++) {
     bb_mesh m;
     bb_error err;
-    l->status[i] = bb_mesh_load(l->path, &m, &err);
-    l->hash[i] = l->status[i] == BB_OK ? bb_mesh_hash(&m) : 0;
+    l->status[i] = bb__mesh_load(l->path, &m, &err);
+    l->hash[i] = l->status[i] == BB_OK ? bb__mesh_hash(&m) : 0;
     if (l->status[i] == BB_OK)
-      bb_mesh_free(&m);
+      bb__mesh_free(&m);
   }
   return NULL;
 }
@@ -447,8 +448,8 @@ Test(mesh_hostile, loads_on_several_threads_at_once_each_get_their_mesh) {
   bb_mesh m;
   bb_error err = {{0}};
   cr_assert_eq(bb__mesh_import(path, &m, NULL, 0, &err), BB_OK, "%s", err.message);
-  uint64_t expected = bb_mesh_hash(&m);
-  bb_mesh_free(&m);
+  uint64_t expected = bb__mesh_hash(&m);
+  bb__mesh_free(&m);
   enum { THREADS = 4 };
   pthread_t threads[THREADS];
   loader loaders[THREADS];

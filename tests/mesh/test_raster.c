@@ -4,6 +4,7 @@
  * bump may draw. */
 #include "bumpbake.h"
 #include "mesh/rasterize.h"
+#include "mesh/mesh_internal.h"
 
 #include <criterion/criterion.h>
 
@@ -190,25 +191,25 @@ Test(raster, a_right_angle_on_a_sample_centre_draws_that_sample) {
 Test(raster, a_pile_of_triangles_is_refused_and_a_spread_is_not) {
   enum { COPIES = 200000 };
   bb_mesh pile, spread;
-  cr_assert_eq(bb_mesh_alloc(&pile, 3, COPIES, 0, NULL), BB_OK);
+  cr_assert_eq(bb__mesh_alloc(&pile, 3, COPIES, 0, NULL), BB_OK);
   const float tri[9] = {0, 0, 0, 1, 0, 0, 1, 0, 1};
   memcpy(pile.positions, tri, sizeof tri);
   for (size_t t = 0; t < COPIES; t++)
     pile.indices[3 * t] = 0, pile.indices[3 * t + 1] = 1, pile.indices[3 * t + 2] = 2;
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 64;
   bb_renderbump_result r;
   bb_error err = {{0}};
-  cr_expect_eq(bb_renderbump_flat(&pile, &o, &r, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__renderbump_flat(&pile, &o, &r, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "over the 256 layers a render may draw"), "%s",
             err.message);
   cr_expect_null(r.normal.pixels);
-  bb_mesh_free(&pile);
+  bb__mesh_free(&pile);
 
   /* a 400 x 250 grid of cells, two triangles each, over the same image */
   enum { NX = 400, NZ = 250 };
-  cr_assert_eq(bb_mesh_alloc(&spread, (NX + 1) * (NZ + 1), 2 * NX * NZ, 0, NULL), BB_OK);
+  cr_assert_eq(bb__mesh_alloc(&spread, (NX + 1) * (NZ + 1), 2 * NX * NZ, 0, NULL), BB_OK);
   for (int k = 0; k <= NZ; k++)
     for (int i = 0; i <= NX; i++) {
       float *p = spread.positions + 3 * (k * (NX + 1) + i);
@@ -222,8 +223,8 @@ Test(raster, a_pile_of_triangles_is_refused_and_a_spread_is_not) {
       memcpy(idx, two, sizeof two);
       idx += 6;
     }
-  cr_expect_eq(bb_renderbump_flat(&spread, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb__renderbump_flat(&spread, &o, &r, &err), BB_OK, "%s", err.message);
   cr_expect_eq(r.triangles_drawn, (size_t)(2 * NX * NZ));
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&spread);
+  bb__mesh_free(&spread);
 }

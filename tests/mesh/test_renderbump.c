@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
+#include "mesh/mesh_internal.h"
 
 #define PI 3.14159265358979323846
 
@@ -40,7 +42,7 @@ static void make_lattice(const lattice *l, bb_mesh *m) {
     for (int i = 0; i < l->nx; i++)
       cells += !(l->skip && l->skip(l->ctx, i, k));
   bb_error err = {{0}};
-  cr_assert_eq(bb_mesh_alloc(m, vx * vz, 2 * cells, l->normal != NULL, &err), BB_OK, "%s",
+  cr_assert_eq(bb__mesh_alloc(m, vx * vz, 2 * cells, l->normal != NULL, &err), BB_OK, "%s",
                err.message);
   for (size_t k = 0; k < vz; k++)
     for (size_t i = 0; i < vx; i++) {
@@ -70,7 +72,7 @@ static void make_lattice(const lattice *l, bb_mesh *m) {
 
 static void render(const bb_mesh *m, const bb_renderbump_options *o, bb_renderbump_result *r) {
   bb_error err = {{0}};
-  cr_assert_eq(bb_renderbump_flat(m, o, r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__renderbump_flat(m, o, r, &err), BB_OK, "%s", err.message);
   cr_assert_eq(r->normal.channels, 4);
   cr_assert_eq(r->normal.width, o->width);
   cr_assert_eq(r->height.channels, 1);
@@ -113,7 +115,7 @@ static double wave_depth(const void *ctx, double x, double z) {
 }
 
 /* The central-difference normal of the stored heights at a vertex, as
- * bb_normals_compute's central estimator makes it, turned to model space:
+ * bb__normals_compute_all_cores's central estimator makes it, turned to model space:
  * tangent (tx, ty, tz) = model (tx, -tz, -ty). */
 static void wave_central_normal(const void *ctx, double x, double z, float n[3]) {
   (void)ctx;
@@ -130,13 +132,13 @@ static void wave_mesh(bb_mesh *m, int with_normals) {
   make_lattice(&l, m);
 }
 
-/* Angles (degrees) between a render and bb_normals_compute's estimate of
+/* Angles (degrees) between a render and bb__normals_compute_all_cores's estimate of
  * the wave with filter f: the largest and the mean over all texels. */
 static void angle_to_estimator(const bb_renderbump_result *r, bb_normal_filter f,
                                double *max_deg, double *mean_deg) {
   bb_image h = {0}, expected = {0};
   wave_image(&h);
-  cr_assert_eq(bb_normals_compute(&h, (float)GRID_SCALE, f, BB_ADDRESS_PERIODIC, &expected,
+  cr_assert_eq(bb__normals_compute_all_cores(&h, (float)GRID_SCALE, f, BB_ADDRESS_PERIODIC, &expected,
                                   NULL),
                BB_OK);
   double sum = 0.0;
@@ -178,7 +180,7 @@ Test(renderbump, face_normals_of_a_height_grid_match_the_valve_estimator) {
   bb_mesh m;
   wave_mesh(&m, 0);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = GRID;
   bb_renderbump_result r;
   render(&m, &o, &r);
@@ -187,7 +189,7 @@ Test(renderbump, face_normals_of_a_height_grid_match_the_valve_estimator) {
   for (int i = 0; i < GRID * GRID; i++)
     cr_assert_eq(r.normal.pixels[4 * i + 3], 1.0f, "the grid covers every texel");
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* Vertex normals (the central differences), texels on the vertices: the
@@ -201,7 +203,7 @@ Test(renderbump, vertex_normals_of_a_tiled_grid_match_central_differences) {
   bb_mesh m;
   wave_mesh(&m, 1);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = GRID;
   o.rect_given = 1;
   o.tile = 1;
@@ -222,7 +224,7 @@ Test(renderbump, vertex_normals_of_a_tiled_grid_match_central_differences) {
   cr_assert_lt(worst, 0.02, "height off by %.4f texels", worst);
   cr_assert_float_eq(r.height_scale, r.depth_max - r.depth_min, 1e-9);
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* --------------------------------------------------------- sphere cap */
@@ -267,7 +269,7 @@ static double cap_error(const bb_renderbump_result *r) {
  * within the vertex normals' bound. */
 Test(renderbump, sphere_cap_gives_its_analytic_normals) {
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 32;
   bb_mesh smooth, faceted;
   cap_mesh(&smooth, 1);
@@ -289,8 +291,8 @@ Test(renderbump, sphere_cap_gives_its_analytic_normals) {
   bb_renderbump_result_free(&rff);
   bb_renderbump_result_free(&rs);
   bb_renderbump_result_free(&rf);
-  bb_mesh_free(&smooth);
-  bb_mesh_free(&faceted);
+  bb__mesh_free(&smooth);
+  bb__mesh_free(&faceted);
 }
 
 /* The front-most surface is taken whatever the winding, and vertex normals
@@ -298,7 +300,7 @@ Test(renderbump, sphere_cap_gives_its_analytic_normals) {
  * every triangle, or negating every normal, changes nothing. */
 Test(renderbump, winding_and_normal_sign_do_not_matter) {
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 24;
   bb_mesh m;
   cap_mesh(&m, 1);
@@ -319,7 +321,7 @@ Test(renderbump, winding_and_normal_sign_do_not_matter) {
   cr_assert(same_pixels(&base.height, &other.height));
   bb_renderbump_result_free(&other);
   bb_renderbump_result_free(&base);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* ------------------------------------------------------------- coverage */
@@ -344,7 +346,7 @@ Test(renderbump, a_hole_has_alpha_0_and_the_rest_1) {
   bb_mesh m;
   hole_mesh(&m);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 16;
   bb_renderbump_result r;
   render(&m, &o, &r);
@@ -358,7 +360,7 @@ Test(renderbump, a_hole_has_alpha_0_and_the_rest_1) {
     }
   cr_assert_eq(r.height_scale, 0.0, "a flat plane has no height");
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* Covered fraction of texel (i, j) of a 32 x 32 image of [0, 32]^2 under
@@ -377,10 +379,10 @@ static double exact_coverage(int i, int j) {
 static void quad_scene(const float corners[12], int side, bb_mesh *m,
                        bb_renderbump_options *o) {
   static const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
-  cr_assert_eq(bb_mesh_alloc(m, 4, 2, 0, NULL), BB_OK);
+  cr_assert_eq(bb__mesh_alloc(m, 4, 2, 0, NULL), BB_OK);
   memcpy(m->positions, corners, 12 * sizeof(float));
   memcpy(m->indices, tris, sizeof tris);
-  bb_renderbump_options_init(o);
+  bb__renderbump_options_init(o);
   o->width = o->height = side;
   o->rect_given = 1;
   double rect[4] = {0, 0, side, side};
@@ -403,7 +405,7 @@ static void coverage_errors(int samples, double *max_err, double *mean_err) {
       *mean_err += e / (32 * 32);
     }
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* One sample per texel gives alpha 0 or 1 along a slanted edge (errors up
@@ -441,7 +443,7 @@ Test(renderbump, tile_wraps_what_crosses_the_edges) {
     cr_assert_eq(r.triangles_drawn, tile ? 4u : 2u, "tile copies");
     bb_renderbump_result_free(&r);
   }
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* ----------------------------------------------------------------- axes */
@@ -450,11 +452,11 @@ Test(renderbump, axis_names_and_frames) {
   static const char *const names[] = {"-y", "+y", "+z", "-z", "+x", "-x"};
   for (int a = 0; a < 6; a++) {
     bb_axis parsed;
-    cr_assert_eq(bb_axis_parse(names[a], &parsed, NULL), 0);
+    cr_assert_eq(bb__axis_parse(names[a], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, a);
     cr_assert_str_eq(bb_axis_name((bb_axis)a), names[a]);
     double r[3], u[3], o[3];
-    bb_axis_frame((bb_axis)a, r, u, o);
+    bb__axis_frame((bb_axis)a, r, u, o);
     /* right x up = out: a right-handed frame, so no view is a mirror. */
     double c[3] = {r[1] * u[2] - r[2] * u[1], r[2] * u[0] - r[0] * u[2],
                    r[0] * u[1] - r[1] * u[0]};
@@ -462,11 +464,11 @@ Test(renderbump, axis_names_and_frames) {
       cr_assert_eq(c[k], o[k], "%s", names[a]);
   }
   bb_axis parsed = BB_AXIS_NEG_X;
-  cr_assert_eq(bb_axis_parse("z", &parsed, NULL), 0);
+  cr_assert_eq(bb__axis_parse("z", &parsed, NULL), 0);
   cr_assert_eq(parsed, BB_AXIS_POS_Z);
-  cr_assert_neq(bb_axis_parse("up", &parsed, NULL), 0);
-  cr_assert_neq(bb_axis_parse("", &parsed, NULL), 0);
-  cr_assert_neq(bb_axis_parse("*z", &parsed, NULL), 0);
+  cr_assert_neq(bb__axis_parse("up", &parsed, NULL), 0);
+  cr_assert_neq(bb__axis_parse("", &parsed, NULL), 0);
+  cr_assert_neq(bb__axis_parse("*z", &parsed, NULL), 0);
   cr_assert_eq(parsed, BB_AXIS_POS_Z, "a failed parse must not write");
 }
 
@@ -475,17 +477,17 @@ Test(renderbump, every_axis_sees_the_turned_model_alike) {
   bb_mesh m;
   cap_mesh(&m, 1);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = 20, o.height = 12; /* not square: a swapped frame would show */
   bb_renderbump_result base;
   render(&m, &o, &base);
   double r0[3], u0[3], o0[3];
-  bb_axis_frame(BB_AXIS_NEG_Y, r0, u0, o0);
+  bb__axis_frame(BB_AXIS_NEG_Y, r0, u0, o0);
   for (int a = 1; a < 6; a++) {
     double r[3], u[3], out[3];
-    bb_axis_frame((bb_axis)a, r, u, out);
+    bb__axis_frame((bb_axis)a, r, u, out);
     bb_mesh t;
-    cr_assert_eq(bb_mesh_alloc(&t, m.vertex_count, m.triangle_count, 1, NULL), BB_OK);
+    cr_assert_eq(bb__mesh_alloc(&t, m.vertex_count, m.triangle_count, 1, NULL), BB_OK);
     memcpy(t.indices, m.indices, 3 * m.triangle_count * sizeof(uint32_t));
     for (size_t i = 0; i < m.vertex_count; i++)
       for (int k = 0; k < 3; k++) {
@@ -505,10 +507,10 @@ Test(renderbump, every_axis_sees_the_turned_model_alike) {
     cr_assert(same_pixels(&rt.normal, &base.normal), "axis %s", bb_axis_name((bb_axis)a));
     cr_assert(same_pixels(&rt.height, &base.height), "axis %s", bb_axis_name((bb_axis)a));
     bb_renderbump_result_free(&rt);
-    bb_mesh_free(&t);
+    bb__mesh_free(&t);
   }
   bb_renderbump_result_free(&base);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* --------------------------------------------------------- determinism */
@@ -517,7 +519,7 @@ Test(renderbump, same_bits_for_any_thread_count) {
   bb_mesh m;
   wave_mesh(&m, 1);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = 96, o.height = 80;
   o.threads = 1;
   bb_renderbump_result one;
@@ -531,7 +533,7 @@ Test(renderbump, same_bits_for_any_thread_count) {
     bb_renderbump_result_free(&many);
   }
   bb_renderbump_result_free(&one);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* -------------------------------------------------------- files (Assimp) */
@@ -561,7 +563,7 @@ TestSuite(renderbump_files, .init = make_tmpdir, .fini = remove_tmpdir);
 
 static void load(const char *path, bb_mesh *m) {
   bb_error err = {{0}};
-  cr_assert_eq(bb_mesh_load(path, m, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__mesh_load(path, m, &err), BB_OK, "%s", err.message);
 }
 
 /* The same mesh written as OBJ and as PLY by Assimp's exporters and read
@@ -571,9 +573,9 @@ Test(renderbump_files, obj_and_ply_of_the_same_mesh_give_identical_maps) {
   cap_mesh(&m, 1);
   char obj[128], ply[128];
   bb_error err = {{0}};
-  cr_assert_eq(bb_mesh_write(tmp_path(obj, sizeof obj, "cap.obj"), &m, &err), BB_OK, "%s",
+  cr_assert_eq(bb__mesh_write(tmp_path(obj, sizeof obj, "cap.obj"), &m, &err), BB_OK, "%s",
                err.message);
-  cr_assert_eq(bb_mesh_write(tmp_path(ply, sizeof ply, "cap.ply"), &m, &err), BB_OK, "%s",
+  cr_assert_eq(bb__mesh_write(tmp_path(ply, sizeof ply, "cap.ply"), &m, &err), BB_OK, "%s",
                err.message);
   load(obj, &from_obj);
   load(ply, &from_ply);
@@ -581,7 +583,7 @@ Test(renderbump_files, obj_and_ply_of_the_same_mesh_give_identical_maps) {
   cr_assert_not_null(from_obj.normals);
   cr_assert_not_null(from_ply.normals);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = o.height = 40;
   bb_renderbump_result rm, ro, rp;
   render(&m, &o, &rm);
@@ -593,9 +595,9 @@ Test(renderbump_files, obj_and_ply_of_the_same_mesh_give_identical_maps) {
   bb_renderbump_result_free(&rm);
   bb_renderbump_result_free(&ro);
   bb_renderbump_result_free(&rp);
-  bb_mesh_free(&m);
-  bb_mesh_free(&from_obj);
-  bb_mesh_free(&from_ply);
+  bb__mesh_free(&m);
+  bb__mesh_free(&from_obj);
+  bb__mesh_free(&from_ply);
 }
 
 static void write_text(const char *path, const char *text) {
@@ -608,10 +610,10 @@ static void write_text(const char *path, const char *text) {
 static bb_status load_status(const char *path, char *message, size_t cap) {
   bb_mesh m;
   bb_error err = {{0}};
-  bb_status st = bb_mesh_load(path, &m, &err);
+  bb_status st = bb__mesh_load(path, &m, &err);
   snprintf(message, cap, "%s", err.message);
   if (st == BB_OK)
-    bb_mesh_free(&m);
+    bb__mesh_free(&m);
   else
     cr_assert_null(m.positions, "a failed load leaves the mesh empty");
   return st;
@@ -643,8 +645,8 @@ Test(renderbump_files, unreadable_empty_truncated_and_triangle_free_models_fail,
   bb_mesh cap;
   cap_mesh(&cap, 1);
   char whole[128];
-  cr_assert_eq(bb_mesh_write(tmp_path(whole, sizeof whole, "whole.ply"), &cap, &err), BB_OK);
-  bb_mesh_free(&cap);
+  cr_assert_eq(bb__mesh_write(tmp_path(whole, sizeof whole, "whole.ply"), &cap, &err), BB_OK);
+  bb__mesh_free(&cap);
   FILE *f = fopen(whole, "rb");
   cr_assert_not_null(f);
   char bytes[4096];
@@ -663,7 +665,7 @@ Test(renderbump_files, unreadable_empty_truncated_and_triangle_free_models_fail,
   load(path, &m);
   cr_assert_eq(m.triangle_count, 2);
   cr_assert_null(m.normals);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 Test(renderbump_files, mesh_write_errors_leave_no_file) {
@@ -671,21 +673,21 @@ Test(renderbump_files, mesh_write_errors_leave_no_file) {
   hole_mesh(&m);
   char path[128];
   bb_error err = {{0}};
-  cr_assert_eq(bb_mesh_write(tmp_path(path, sizeof path, "m.xyz"), &m, &err), BB_ERR_FORMAT);
-  cr_assert_eq(bb_mesh_write(tmp_path(path, sizeof path, "no/such/dir/m.obj"), &m, &err),
+  cr_assert_eq(bb__mesh_write(tmp_path(path, sizeof path, "m.xyz"), &m, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__mesh_write(tmp_path(path, sizeof path, "no/such/dir/m.obj"), &m, &err),
                BB_ERR_IO);
   m.indices[5] = (uint32_t)m.vertex_count;
-  cr_assert_eq(bb_mesh_write(tmp_path(path, sizeof path, "bad.ply"), &m, &err),
+  cr_assert_eq(bb__mesh_write(tmp_path(path, sizeof path, "bad.ply"), &m, &err),
                BB_ERR_ARGUMENT);
   cr_assert_neq(access(path, F_OK), 0, "no file after a refused write");
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 /* --------------------------------------------------------------- errors */
 
 Test(renderbump, bad_meshes_and_options_are_refused) {
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   bb_renderbump_result r;
   bb_error err = {{0}};
   bb_mesh m;
@@ -694,83 +696,83 @@ Test(renderbump, bad_meshes_and_options_are_refused) {
   /* seen along +x, the cap (in XZ, facing -y) is edge-on: zero width */
   static const float wall[9] = {0, 0, 0, 0, 1, 0, 0, 0, 1};
   bb_mesh edge_on;
-  cr_assert_eq(bb_mesh_alloc(&edge_on, 3, 1, 0, NULL), BB_OK);
+  cr_assert_eq(bb__mesh_alloc(&edge_on, 3, 1, 0, NULL), BB_OK);
   memcpy(edge_on.positions, wall, sizeof wall);
   edge_on.indices[0] = 0, edge_on.indices[1] = 1, edge_on.indices[2] = 2;
-  cr_assert_eq(bb_renderbump_flat(&edge_on, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&edge_on, &o, &r, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "degenerate"), "%s", err.message);
   cr_assert_null(r.normal.pixels);
-  bb_mesh_free(&edge_on);
+  bb__mesh_free(&edge_on);
 
   o.samples = 0;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
   o.samples = 17;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
-  bb_renderbump_options_init(&o);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  bb__renderbump_options_init(&o);
   o.width = 0;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_SIZE);
-  bb_renderbump_options_init(&o);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_SIZE);
+  bb__renderbump_options_init(&o);
   o.rect_given = 1; /* all zero: left == right */
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
   /* a rectangle far from the model: nothing to see */
   double far_away[4] = {100, 100, 101, 101};
   memcpy(o.rect, far_away, sizeof far_away);
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "no surface"), "%s", err.message);
   /* tiled, the same far rectangle is a window on the repeated cap */
   o.tile = 1;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_OK, "%s", err.message);
   bb_renderbump_result_free(&r);
   /* but not a million tiles away */
   double too_far[4] = {0, 0, 1e-7, 1e-7};
   memcpy(o.rect, too_far, sizeof too_far);
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_SIZE);
 
   /* a rectangle so small that the model's image coordinates overflow */
   double tiny[4] = {0, 0, 1e-310, 1e-310};
   memcpy(o.rect, tiny, sizeof tiny);
   for (o.tile = 0; o.tile < 2; o.tile++)
-    cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT, "tile %d", o.tile);
+    cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT, "tile %d", o.tile);
 
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   m.positions[4] = NAN;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_VALUE);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_VALUE);
   m.positions[4] = 0.0f;
   m.indices[7] = (uint32_t)m.vertex_count;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
   m.triangle_count = 0;
-  cr_assert_eq(bb_renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__renderbump_flat(&m, &o, &r, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "no triangles"), "%s", err.message);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }
 
 Test(renderbump, mesh_hash_sees_every_array) {
   bb_mesh m;
   cap_mesh(&m, 1);
-  uint64_t h0 = bb_mesh_hash(&m);
+  uint64_t h0 = bb__mesh_hash(&m);
   m.positions[10] += 1.0f;
-  uint64_t h1 = bb_mesh_hash(&m);
+  uint64_t h1 = bb__mesh_hash(&m);
   m.positions[10] -= 1.0f;
   m.normals[10] += 1.0f;
-  uint64_t h2 = bb_mesh_hash(&m);
+  uint64_t h2 = bb__mesh_hash(&m);
   m.normals[10] -= 1.0f;
   m.indices[0]++;
-  uint64_t h3 = bb_mesh_hash(&m);
+  uint64_t h3 = bb__mesh_hash(&m);
   m.indices[0]--;
   cr_assert(h0 != h1 && h0 != h2 && h0 != h3);
-  cr_assert_eq(bb_mesh_hash(&m), h0);
-  bb_mesh_free(&m);
+  cr_assert_eq(bb__mesh_hash(&m), h0);
+  bb__mesh_free(&m);
 }
 
 Test(renderbump, describe_lists_the_parameters) {
   bb_mesh m;
   cap_mesh(&m, 1);
   bb_renderbump_options o;
-  bb_renderbump_options_init(&o);
+  bb__renderbump_options_init(&o);
   o.width = 16, o.height = 8;
   bb_renderbump_result r;
   render(&m, &o, &r);
-  char *text = bb_renderbump_describe(&o, &r);
+  char *text = bb__renderbump_describe(&o, &r);
   cr_assert_not_null(text);
   cr_assert(strstr(text, "axis=-y\n") && strstr(text, "size=16x8\n") &&
                 strstr(text, "samples=4\n") && strstr(text, "normals=vertex\n") &&
@@ -780,5 +782,5 @@ Test(renderbump, describe_lists_the_parameters) {
   cr_assert_float_eq(scale, r.height_scale, 1e-6 * r.height_scale);
   free(text);
   bb_renderbump_result_free(&r);
-  bb_mesh_free(&m);
+  bb__mesh_free(&m);
 }

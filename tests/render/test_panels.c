@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "render/render_internal.h"
 
 /* An image whose texel (x, y), channel k holds 100 y + 10 x + k. */
 static bb_image numbered(int width, int height, int channels) {
@@ -32,7 +33,7 @@ static bb_image filled(int width, int height, float r, float g, float b) {
 
 Test(panels, tile_repeats) {
   bb_image in = numbered(3, 2, 2), out;
-  cr_assert_eq(bb_image_tile(&in, 2, 3, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_tile(&in, 2, 3, &out, NULL), BB_OK);
   cr_assert_eq(out.width, 6);
   cr_assert_eq(out.height, 6);
   for (int y = 0; y < 6; y++)
@@ -40,26 +41,26 @@ Test(panels, tile_repeats) {
       for (int k = 0; k < 2; k++)
         cr_assert_eq(bb_image_texel(&out, x, y)[k], bb_image_texel(&in, x % 3, y % 2)[k]);
   bb_image_free(&out);
-  cr_assert_eq(bb_image_tile(&in, 0, 1, &out, NULL), BB_ERR_SIZE);
-  cr_assert_eq(bb_image_tile(&in, 40000, 1, &out, NULL), BB_ERR_SIZE, "over the maximum");
+  cr_assert_eq(bb__image_tile(&in, 0, 1, &out, NULL), BB_ERR_SIZE);
+  cr_assert_eq(bb__image_tile(&in, 40000, 1, &out, NULL), BB_ERR_SIZE, "over the maximum");
   cr_assert_null(out.pixels);
   bb_image_free(&in);
 }
 
 Test(panels, crop_windows) {
   bb_image in = numbered(5, 4, 3), out;
-  cr_assert_eq(bb_image_crop(&in, 1, 2, 3, 2, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_crop(&in, 1, 2, 3, 2, &out, NULL), BB_OK);
   cr_assert_eq(out.width, 3);
   cr_assert_eq(out.height, 2);
   cr_assert_eq(bb_image_texel(&out, 0, 0)[0], 210.0f);
   cr_assert_eq(bb_image_texel(&out, 2, 1)[2], 332.0f);
   bb_image_free(&out);
   bb_error err = {{0}};
-  cr_assert_eq(bb_image_crop(&in, 3, 0, 3, 1, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_crop(&in, 3, 0, 3, 1, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "not inside"), "%s", err.message);
-  cr_assert_eq(bb_image_crop(&in, -1, 0, 1, 1, &out, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_image_crop(&in, 0, 0, 0, 1, &out, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_image_crop(&in, 0, 0, 5, 4, &out, NULL), BB_OK, "the whole image");
+  cr_assert_eq(bb__image_crop(&in, -1, 0, 1, 1, &out, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_crop(&in, 0, 0, 0, 1, &out, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__image_crop(&in, 0, 0, 5, 4, &out, NULL), BB_OK, "the whole image");
   cr_assert_eq(memcmp(out.pixels, in.pixels, sizeof(float) * 60), 0);
   bb_image_free(&out);
   bb_image_free(&in);
@@ -69,18 +70,18 @@ Test(panels, crop_windows) {
  * the mean of a linear ramp and a constant exactly. */
 Test(panels, resample_by_area) {
   bb_image in = numbered(4, 4, 1), out;
-  cr_assert_eq(bb_image_resample(&in, 2, 2, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_resample(&in, 2, 2, &out, NULL), BB_OK);
   cr_assert_float_eq(bb_image_texel(&out, 0, 0)[0], (0 + 10 + 100 + 110) / 4.0, 1e-4);
   cr_assert_float_eq(bb_image_texel(&out, 1, 1)[0], (220 + 230 + 320 + 330) / 4.0, 1e-4);
   bb_image_free(&out);
-  cr_assert_eq(bb_image_resample(&in, 8, 8, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_resample(&in, 8, 8, &out, NULL), BB_OK);
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 8; x++)
       cr_assert_float_eq(bb_image_texel(&out, x, y)[0],
                          bb_image_texel(&in, x / 2, y / 2)[0], 1e-4,
                          "enlarging by 2 repeats texels");
   bb_image_free(&out);
-  cr_assert_eq(bb_image_resample(&in, 3, 1, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_resample(&in, 3, 1, &out, NULL), BB_OK);
   /* Column means of the ramp: rows average to 150; x covers thirds of 4. */
   double sum = 0;
   for (int x = 0; x < 3; x++)
@@ -93,7 +94,7 @@ Test(panels, resample_by_area) {
   bb_image_free(&out);
   bb_image_free(&in);
   bb_image c = filled(7, 5, 0.25f, 0.5f, 0.75f);
-  cr_assert_eq(bb_image_resample(&c, 3, 11, &out, NULL), BB_OK);
+  cr_assert_eq(bb__image_resample(&c, 3, 11, &out, NULL), BB_OK);
   for (int i = 0; i < 33; i++)
     cr_assert_float_eq(out.pixels[3 * i + 1], 0.5f, 1e-6);
   bb_image_free(&out);
@@ -105,20 +106,20 @@ Test(panels, display_encodings) {
   cr_assert_eq(bb_image_alloc(&signed3, 2, 1, 3, NULL), BB_OK);
   const float n[6] = {0.0f, 0.0f, 1.0f, -1.0f, 0.5f, 2.0f};
   memcpy(signed3.pixels, n, sizeof n);
-  cr_assert_eq(bb_image_to_display(&signed3, BB_RANGE_SIGNED, 0, 1, &rgb, NULL), BB_OK);
+  cr_assert_eq(bb__image_to_display(&signed3, BB_RANGE_SIGNED, 0, 1, &rgb, NULL), BB_OK);
   const float expect[6] = {0.5f, 0.5f, 1.0f, 0.0f, 0.75f, 1.0f};
   for (int i = 0; i < 6; i++)
     cr_assert_float_eq(rgb.pixels[i], expect[i], 1e-7, "0.5 + 0.5 N, clamped");
   bb_image_free(&rgb);
   cr_assert_eq(bb_image_alloc(&grey, 3, 1, 1, NULL), BB_OK);
   grey.pixels[0] = 2.0f, grey.pixels[1] = 3.0f, grey.pixels[2] = 7.0f;
-  cr_assert_eq(bb_image_to_display(&grey, BB_RANGE_UNIT, 2.0f, 4.0f, &rgb, NULL), BB_OK);
+  cr_assert_eq(bb__image_to_display(&grey, BB_RANGE_UNIT, 2.0f, 4.0f, &rgb, NULL), BB_OK);
   cr_assert_eq(rgb.channels, 3);
   const float g[9] = {0, 0, 0, 0.5f, 0.5f, 0.5f, 1, 1, 1};
   for (int i = 0; i < 9; i++)
     cr_assert_float_eq(rgb.pixels[i], g[i], 1e-7, "grey, stretched and clamped");
   bb_image_free(&rgb);
-  cr_assert_eq(bb_image_to_display(&grey, BB_RANGE_UNIT, 1.0f, 1.0f, &rgb, NULL),
+  cr_assert_eq(bb__image_to_display(&grey, BB_RANGE_UNIT, 1.0f, 1.0f, &rgb, NULL),
                BB_ERR_ARGUMENT);
   bb_image_free(&grey);
   bb_image_free(&signed3);
@@ -159,7 +160,7 @@ Test(panels, compose_with_labels) {
            c = filled(64, 64, 0, 0, 1);
   bb_panel p[3] = {{&a, "red"}, {&b, "green"}, {&c, NULL}};
   bb_panel_layout l;
-  bb_panel_layout_init(&l);
+  bb__panel_layout_init(&l);
   l.columns = 2;
   l.panel_width = 64;
   l.gap = 4;
@@ -167,7 +168,7 @@ Test(panels, compose_with_labels) {
   bb_image out;
   int labels = -1;
   bb_error err = {{0}};
-  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
+  cr_assert_eq(bb__panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
                err.message);
   cr_assert_eq(labels, 1, "fonts-dejavu-core is a build dependency");
   const int label_h = (12 * 7 + 3) / 4; /* both labels fit 64 pixels at 12 */
@@ -190,7 +191,7 @@ Test(panels, compose_with_labels) {
   bb_image_free(&out);
   /* Narrow panels: one smaller size for every label, a thinner strip. */
   l.panel_width = 16;
-  cr_assert_eq(bb_panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
+  cr_assert_eq(bb__panels_compose(p, 3, &l, &out, &labels, &err), BB_OK, "%s",
                err.message);
   cr_assert_lt(label_strip(&out, 2, 16, 4, 12), label_h, "'green' does not fit 16 at 12");
   bb_image_free(&out);
@@ -204,21 +205,21 @@ Test(panels, compose_without_a_font) {
   bb_image a = filled(48, 16, 0.5f, 0.5f, 0.5f);
   bb_panel p[2] = {{&a, "one"}, {&a, "two"}};
   bb_panel_layout l;
-  bb_panel_layout_init(&l);
+  bb__panel_layout_init(&l);
   l.gap = 2;
   bb_image out;
   int labels = -1;
   cr_assert_eq(setenv("BUMPBAKE_FONT", "/nonexistent/font.ttf", 1), 0);
-  cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
+  cr_assert_eq(bb__panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 0);
   assert_grid(&out, 2, 1, 48, 16, 0, 2);
   bb_image_free(&out);
   cr_assert_eq(setenv("BUMPBAKE_FONT", "", 1), 0);
-  cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
+  cr_assert_eq(bb__panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 0, "an empty BUMPBAKE_FONT means no labels");
   bb_image_free(&out);
   unsetenv("BUMPBAKE_FONT");
-  cr_assert_eq(bb_panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
+  cr_assert_eq(bb__panels_compose(p, 2, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 1);
   assert_grid(&out, 2, 1, 48, 16, (12 * 7 + 3) / 4, 2);
   bb_image_free(&out);
@@ -230,12 +231,12 @@ Test(panels, compose_refuses_bad_panels) {
   cr_assert_eq(bb_image_alloc(&one, 4, 4, 1, NULL), BB_OK);
   bb_panel p = {&one, "x"};
   bb_panel_layout l;
-  bb_panel_layout_init(&l);
+  bb__panel_layout_init(&l);
   bb_image out;
-  cr_assert_eq(bb_panels_compose(&p, 1, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_panels_compose(&p, 0, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__panels_compose(&p, 1, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__panels_compose(&p, 0, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
   l.columns = 0;
-  cr_assert_eq(bb_panels_compose(&p, 1, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__panels_compose(&p, 1, &l, &out, NULL, NULL), BB_ERR_ARGUMENT);
   bb_image_free(&one);
 }
 
@@ -255,10 +256,10 @@ Test(panels, compare_is_four_renders) {
   bb_render_options o;
   bb_render_options_init(&o);
   bb_panel_layout l;
-  bb_panel_layout_init(&l);
+  bb__panel_layout_init(&l);
   bb_image out;
   int labels = 0;
-  cr_assert_eq(bb_render_compare(&m, &o, &l, &out, &labels, NULL), BB_OK);
+  cr_assert_eq(bb__render_compare(&m, &o, &l, &out, &labels, NULL), BB_OK);
   cr_assert_eq(labels, 1);
   assert_grid(&out, 4, 1, 24, 20, label_strip(&out, 1, 20, 8, 12), 8);
   const bb_render_mode modes[4] = {BB_RENDER_NORMAL, BB_RENDER_SSBUMP, BB_RENDER_SSBUMP,
@@ -267,7 +268,7 @@ Test(panels, compare_is_four_renders) {
     o.mode = modes[i];
     o.specular_exponent = i == 2 ? BB_COMPARE_SPECULAR_EXPONENT : 0.0;
     bb_image one;
-    cr_assert_eq(bb_render(&m, &o, &one, NULL), BB_OK);
+    cr_assert_eq(bb__render(&m, &o, &one, NULL), BB_OK);
     for (int y = 0; y < 20; y++)
       cr_assert_eq(memcmp(bb_image_texel(&out, 8 + i * 32, 8 + y),
                           bb_image_texel(&one, 0, y), sizeof(float) * 3 * 24),
@@ -276,7 +277,7 @@ Test(panels, compare_is_four_renders) {
   }
   bb_image_free(&out);
   m.ao = NULL;
-  cr_assert_eq(bb_render_compare(&m, &o, &l, &out, &labels, NULL), BB_ERR_ARGUMENT,
+  cr_assert_eq(bb__render_compare(&m, &o, &l, &out, &labels, NULL), BB_ERR_ARGUMENT,
                "the ao panel needs ao");
   bb_bake_result_free(&r);
   bb_image_free(&h);

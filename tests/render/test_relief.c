@@ -9,6 +9,7 @@
 
 #include "bumpbake.h"
 #include "bake_harness.h"
+#include "render/render_internal.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -48,7 +49,7 @@ static void scene_free(scene *s) {
 static bb_image render(const bb_render_maps *m, const bb_render_options *o) {
   bb_image out;
   bb_error err;
-  cr_assert_eq(bb_render(m, o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__render(m, o, &out, &err), BB_OK, "%s", err.message);
   return out;
 }
 
@@ -128,7 +129,7 @@ static void glsl_shade(const scene *s, double px, double py, const double view[3
   }
 }
 
-/* The camera of bb_render's view: pixel (i, j) on the polygon. */
+/* The camera of bb__render's view: pixel (i, j) on the polygon. */
 static void camera(const double view[3], int width, int height, int i, int j, double p[2]) {
   const double horizontal = sqrt(view[0] * view[0] + view[1] * view[1]);
   const double toward[2] = {view[0] / horizontal, view[1] / horizontal};
@@ -152,8 +153,8 @@ Test(relief, the_preview_evaluates_the_shader_formulas) {
     for (int k = 0; k < 3; k++) o.lightmap[c][k] = c == k ? 0.3f : 0.05f;
   bb_image img = render(&s.maps, &o);
   double view[3], light[3];
-  bb_light_direction(300.0, 25.0, view);
-  bb_light_direction(40.0, 30.0, light);
+  bb__light_direction(300.0, 25.0, view);
+  bb__light_direction(40.0, 30.0, light);
   const int pixels[][2] = {{0, 0}, {5, 7}, {23, 19}, {47, 39}, {31, 2}, {12, 33}, {40, 26}};
   int moved = 0;
   for (size_t n = 0; n < sizeof pixels / sizeof pixels[0]; n++) {
@@ -221,7 +222,7 @@ Test(relief, same_bits_on_any_thread_count_and_cropped) {
     cr_expect_eq(memcmp(bb_image_texel(&crop, 0, y), bb_image_texel(&one, 10, 5 + y),
                         20 * 3 * sizeof(float)),
                  0);
-  char *text = bb_render_options_describe(&o);
+  char *text = bb__render_options_describe(&o);
   cr_expect(strstr(text, "view=200,15\n") && strstr(text, "relief=6\n"), "%s", text);
   free(text);
   bb_image_free(&one), bb_image_free(&three), bb_image_free(&crop);
@@ -236,20 +237,20 @@ Test(relief, refuses_what_it_cannot_draw) {
   bb_image out;
   bb_error err;
   o.relief = 1, o.relief_height = &s.height, o.relief_depth = 6.0;
-  cr_expect_eq(bb_render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "relief without a view");
+  cr_expect_eq(bb__render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "relief without a view");
   o.view = 1;
   o.relief_depth = 0.0;
-  cr_expect_eq(bb_render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "no depth");
+  cr_expect_eq(bb__render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "no depth");
   o.relief_depth = 6.0;
   o.relief_height = NULL;
-  cr_expect_eq(bb_render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "no height");
+  cr_expect_eq(bb__render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "no height");
   cr_expect(strstr(err.message, "relief height") != NULL, "%s", err.message);
   bb_image small = harness_field(8, 8, 0.5f);
   o.relief_height = &small;
-  cr_expect_eq(bb_render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "a height of another size");
+  cr_expect_eq(bb__render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "a height of another size");
   o.relief_height = &s.height;
   o.view_elevation = 0.5;
-  cr_expect_eq(bb_render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "grazing under 1 degree");
+  cr_expect_eq(bb__render(&s.maps, &o, &out, &err), BB_ERR_ARGUMENT, "grazing under 1 degree");
   bb_image_free(&small);
   scene_free(&s);
 }

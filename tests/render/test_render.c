@@ -1,4 +1,4 @@
-/* test_render.c: the lighting of baked maps (bb_render): each formula on flat
+/* test_render.c: the lighting of baked maps (bb__render): each formula on flat
  * maps, which side of a bump is lit, the pit's self-shadowing, threads,
  * albedo, tiling and bad arguments. */
 #include <criterion/criterion.h>
@@ -8,6 +8,9 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "maps/maps_internal.h"
+#include "render/render_internal.h"
+#include "trace/basis.h"
 
 #define SQRT3 1.7320508075688772
 
@@ -70,7 +73,7 @@ static void scene_free(scene *s) {
 static bb_image render(const bb_render_maps *m, const bb_render_options *o) {
   bb_image out;
   bb_error err = {{0}};
-  cr_assert_eq(bb_render(m, o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__render(m, o, &out, &err), BB_OK, "%s", err.message);
   cr_assert_eq(out.channels, 3);
   return out;
 }
@@ -106,50 +109,50 @@ static void options(bb_render_options *o, bb_render_mode mode, double az, double
 
 Test(render, mode_names_and_needs) {
   bb_render_mode m = BB_RENDER_NORMAL;
-  cr_assert_eq(bb_render_mode_parse("ssbump", &m, NULL), 0);
+  cr_assert_eq(bb__render_mode_parse("ssbump", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_SSBUMP);
-  cr_assert_eq(bb_render_mode_parse("ao", &m, NULL), 0);
+  cr_assert_eq(bb__render_mode_parse("ao", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_NORMAL_AO);
-  cr_assert_neq(bb_render_mode_parse("phong", &m, NULL), 0);
+  cr_assert_neq(bb__render_mode_parse("phong", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_NORMAL_AO, "a failed parse must not write");
-  cr_assert_str_eq(bb_render_mode_name(BB_RENDER_NORMAL), "normal");
-  cr_assert_str_eq(bb_render_mode_name((bb_render_mode)77), "unknown");
-  cr_assert_eq(bb_render_mode_needs(BB_RENDER_SSBUMP), BB_RENDER_NEEDS_SSBUMP);
-  cr_assert_eq(bb_render_mode_needs(BB_RENDER_NORMAL_AO),
+  cr_assert_str_eq(bb__render_mode_name(BB_RENDER_NORMAL), "normal");
+  cr_assert_str_eq(bb__render_mode_name((bb_render_mode)77), "unknown");
+  cr_assert_eq(bb__render_mode_needs(BB_RENDER_SSBUMP), BB_RENDER_NEEDS_SSBUMP);
+  cr_assert_eq(bb__render_mode_needs(BB_RENDER_NORMAL_AO),
                BB_RENDER_NEEDS_NORMAL | BB_RENDER_NEEDS_AO);
-  cr_assert_eq(bb_render_mode_needs((bb_render_mode)77), 0u);
-  cr_assert_eq(bb_render_mode_parse("slope", &m, NULL), 0);
+  cr_assert_eq(bb__render_mode_needs((bb_render_mode)77), 0u);
+  cr_assert_eq(bb__render_mode_parse("slope", &m, NULL), 0);
   cr_assert_eq(m, BB_RENDER_SLOPE);
-  cr_assert_eq(bb_render_mode_needs(BB_RENDER_SLOPE), BB_RENDER_NEEDS_SLOPE);
+  cr_assert_eq(bb__render_mode_needs(BB_RENDER_SLOPE), BB_RENDER_NEEDS_SLOPE);
   bb_albedo_mode a = BB_ALBEDO_MULTIPLY;
-  cr_assert_eq(bb_albedo_mode_parse("ssbump", &a, NULL), 0);
+  cr_assert_eq(bb__albedo_mode_parse("ssbump", &a, NULL), 0);
   cr_assert_eq(a, BB_ALBEDO_SSBUMP);
-  cr_assert_neq(bb_albedo_mode_parse("mod4x", &a, NULL), 0);
-  cr_assert_str_eq(bb_albedo_mode_name(BB_ALBEDO_MOD2X), "mod2x");
+  cr_assert_neq(bb__albedo_mode_parse("mod4x", &a, NULL), 0);
+  cr_assert_str_eq(bb__albedo_mode_name(BB_ALBEDO_MOD2X), "mod2x");
 }
 
 /* Azimuth counter-clockwise on screen from the right, +Y down: 90 degrees is
  * the top of the image, which is -y. */
 Test(render, light_direction_frame) {
   double d[3];
-  bb_light_direction(0, 0, d);
+  bb__light_direction(0, 0, d);
   cr_assert(d[0] == 1.0 && d[1] == 0.0 && d[2] == 0.0);
-  bb_light_direction(90, 0, d);
+  bb__light_direction(90, 0, d);
   cr_assert(d[0] == 0.0 && d[1] == -1.0 && d[2] == 0.0, "90 = from the top = -y");
-  bb_light_direction(270, 0, d);
+  bb__light_direction(270, 0, d);
   cr_assert(d[0] == 0.0 && d[1] == 1.0 && d[2] == 0.0, "270 = from the bottom = +y");
-  bb_light_direction(-90, 0, d);
+  bb__light_direction(-90, 0, d);
   cr_assert(d[1] == 1.0, "angles wrap");
-  bb_light_direction(123, 90, d);
+  bb__light_direction(123, 90, d);
   cr_assert(d[0] == 0.0 && d[1] == 0.0 && d[2] == 1.0, "overhead is exactly +z");
-  bb_light_direction(135, 45, d);
+  bb__light_direction(135, 45, d);
   cr_assert_float_eq(d[0], -0.5, 1e-15);
   cr_assert_float_eq(d[1], -0.5, 1e-15, "135 = from the top-left");
   cr_assert_float_eq(d[2], sqrt(0.5), 1e-15);
   /* B0 is the light from azimuth 0 at asin(1/sqrt(3)). */
   double b0[3];
-  bb_basis_vector(0, b0);
-  bb_light_direction(0, asin(1.0 / SQRT3) * 180.0 / 3.14159265358979323846, d);
+  bb__basis_vector(0, b0);
+  bb__light_direction(0, asin(1.0 / SQRT3) * 180.0 / 3.14159265358979323846, d);
   for (int k = 0; k < 3; k++)
     cr_assert_float_eq(d[k], b0[k], 1e-15);
 }
@@ -174,7 +177,7 @@ Test(render, flat_dynamic_light_is_lambert) {
       o.light_color[0] = 1.0f, o.light_color[1] = 0.5f, o.light_color[2] = 0.25f;
       bb_image img = render(&m, &o);
       double rgb[3] = {expected[e], 0.5 * expected[e], 0.25 * expected[e]};
-      assert_uniform(&img, rgb, 1e-6, bb_render_mode_name(modes[i]));
+      assert_uniform(&img, rgb, 1e-6, bb__render_mode_name(modes[i]));
       bb_image_free(&img);
     }
   scene_free(&sc);
@@ -393,7 +396,7 @@ Test(render, bit_identical_for_any_thread_count) {
 /* ------------------------------------------------------- bent and view */
 
 /* Without a bent map the specular normal is the ssbump's bent normal, as
- * bb_derive_bent makes it: the same pixels either way. */
+ * bb__derive_bent_all_cores makes it: the same pixels either way. */
 Test(render, bent_from_the_ssbump_when_missing) {
   scene sc;
   scene_make(&sc, 24, 20, bump, 6.0f, 32);
@@ -437,7 +440,7 @@ Test(render, tile_and_crop) {
   o.crop_x = 15; /* 15 + 6 > 20 */
   bb_image bad;
   bb_error err = {{0}};
-  cr_assert_eq(bb_render(&m, &o, &bad, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &bad, &err), BB_ERR_ARGUMENT);
   cr_assert_null(bad.pixels);
   bb_image_free(&base);
   bb_image_free(&tiled);
@@ -457,46 +460,46 @@ Test(render, bad_arguments_are_refused) {
   bb_error err = {{0}};
 
   bb_render_maps m = {&n3, NULL, NULL, NULL, NULL, NULL};
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "ssbump map is missing"), "%s", err.message);
   m.ssbump = &s1;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "1 channel, needs 3"), "%s", err.message);
   o.mode = BB_RENDER_NORMAL_AO;
   m.ao = &ao_small;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "ao map is 3x4, the others 4x4"), "%s", err.message);
   m.ao = &s1;
   o.light_elevation = 90.5;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "elevation"), "%s", err.message);
   o.light_elevation = 10;
   o.light_color[1] = NAN;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.light_color[1] = 1;
   o.specular_exponent = -1;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.specular_exponent = 0;
   const double bad_strengths[] = {-0.5, 1000.5, NAN};
   for (int k = 0; k < 3; k++) {
     o.specular_strength = bad_strengths[k];
-    cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+    cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
     cr_assert(strstr(err.message, "specular strength must be in 0..1000"), "%s", err.message);
   }
   o.specular_strength = 1;
   o.threads = BB_MAX_THREADS + 1;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "render: threads must be in 0..4096 (got 4097)");
   o.threads = -1;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.threads = 0;
   o.mode = (bb_render_mode)9;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.mode = BB_RENDER_NORMAL;
   o.tile_x = 0;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   o.tile_x = 1;
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_OK, "%s", err.message);
   bb_image_free(&out);
   bb_image_free(&n3);
   bb_image_free(&s1);
@@ -515,7 +518,7 @@ Test(render, a_light_too_bright_for_a_float_says_so) {
   bb_image out;
   o.light_color[0] = o.light_color[1] = o.light_color[2] = 3.4e38f;
   o.specular_exponent = 8.0;
-  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "render: too bright: a texel passes a float's largest value "
                                 "(3.40282e38); lower the light colour, lightmap or specular "
                                 "strength");
@@ -524,11 +527,11 @@ Test(render, a_light_too_bright_for_a_float_says_so) {
   bb_image img = render(&sc.maps, &o);
   bb_image_free(&img);
   o.light_color[0] = INFINITY;
-  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "render: light colour is too large: at most 3.40282e38, a "
                                 "float's largest (got inf)");
   o.light_color[0] = -1.0f;
-  cr_assert_eq(bb_render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&sc.maps, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "render: light colour must be >= 0 (got -1)");
   scene_free(&sc);
 }
@@ -538,7 +541,7 @@ Test(render, a_light_too_bright_for_a_float_says_so) {
 Test(render, describe_names_every_option) {
   bb_render_options o;
   bb_render_options_init(&o);
-  char *text = bb_render_options_describe(&o);
+  char *text = bb__render_options_describe(&o);
   cr_assert_not_null(text);
   cr_assert_str_eq(
       text, "render_mode=ssbump\nlight=135,45\nlight_color=1,1,1\n"
@@ -547,7 +550,7 @@ Test(render, describe_names_every_option) {
   o.dynamic_light = 0;
   o.static_light = 1;
   o.crop_width = 3, o.crop_height = 2, o.crop_x = 1;
-  text = bb_render_options_describe(&o);
+  text = bb__render_options_describe(&o);
   cr_assert(strstr(text, "light=none\nlightmap=1,0,0,0,1,0,0,0,1\n"), "%s", text);
   cr_assert(strstr(text, "crop=1,0,3,2\n"), "%s", text);
   free(text);
@@ -603,7 +606,7 @@ Test(render, slope_map_through_the_table) {
   bb_image slope;
   cr_assert_eq(bb_image_alloc(&slope, 2, 1, 1, NULL), BB_OK);
   slope.pixels[0] = 0.0f;
-  slope.pixels[1] = (float)bb_slope_encode(3, 0) / 255.0f;
+  slope.pixels[1] = (float)bb__slope_encode(3, 0) / 255.0f;
   bb_render_maps m = {NULL, NULL, NULL, NULL, NULL, &slope};
   bb_render_options o;
   options(&o, BB_RENDER_SLOPE, 180.0, 30.0);
@@ -613,7 +616,7 @@ Test(render, slope_map_through_the_table) {
   cr_assert_float_eq(at(&left, 0, 0)[0], 0.5, 1e-6);
   cr_assert_float_eq(at(&right, 0, 0)[0], 0.5, 1e-6);
   double l[3], n[3] = {-3.0 / sqrt(10.0), 0.0, 1.0 / sqrt(10.0)};
-  bb_light_direction(180.0, 30.0, l);
+  bb__light_direction(180.0, 30.0, l);
   cr_assert_float_eq(at(&left, 1, 0)[1], n[0] * l[0] + n[2] * l[2], 1e-6);
   cr_assert_gt(grey_at(&left, 1, 0), 0.8);
   cr_assert_eq(grey_at(&right, 1, 0), 0.0, "the right-hand light is behind the slope");
@@ -622,7 +625,7 @@ Test(render, slope_map_through_the_table) {
   m.slope = NULL;
   bb_image out = {0};
   bb_error err = {{0}};
-  cr_assert_eq(bb_render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&m, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "slope"), "%s", err.message);
   bb_image_free(&slope);
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "render/render_internal.h"
 
 static void bake_small(bb_image *h, bb_bake_result *r, int trace) {
   cr_assert_eq(bb_image_alloc(h, 32, 24, 1, NULL), BB_OK);
@@ -32,12 +33,12 @@ Test(sheet, eight_labelled_panels) {
   bb_bake_result r;
   bake_small(&h, &r, 1);
   bb_sheet_options o;
-  bb_sheet_options_init(&o);
+  bb__sheet_options_init(&o);
   cr_assert_eq(o.layout.panel_width, 256);
   o.layout.panel_width = 32;
   int labels = 0;
   bb_error err = {{0}};
-  cr_assert_eq(bb_sheet_make(&h, &r, &o, &sheet, &labels, &err), BB_OK, "%s",
+  cr_assert_eq(bb__sheet_make(&h, &r, &o, &sheet, &labels, &err), BB_OK, "%s",
                err.message);
   cr_assert_eq(labels, 1);
   /* Labels shrink to fit 32-pixel panels: a strip of 1.75 x 6..12 pixels. */
@@ -69,7 +70,7 @@ Test(sheet, eight_labelled_panels) {
   /* The lit panel (7) is the render of o.lit, clamped to [0, 1]. */
   bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL, NULL};
   bb_image lit;
-  cr_assert_eq(bb_render(&m, &o.lit, &lit, NULL), BB_OK);
+  cr_assert_eq(bb__render(&m, &o.lit, &lit, NULL), BB_OK);
   for (int k = 0; k < 3; k++)
     cr_assert_float_eq(panel_texel(&sheet, 7, 20, 11, label_h)[k],
                        fminf(1.0f, bb_image_texel(&lit, 20, 11)[k]), 1e-6);
@@ -84,9 +85,9 @@ Test(sheet, needs_a_traced_bake) {
   bb_bake_result r;
   bake_small(&h, &r, 0);
   bb_sheet_options o;
-  bb_sheet_options_init(&o);
+  bb__sheet_options_init(&o);
   bb_error err = {{0}};
-  cr_assert_eq(bb_sheet_make(&h, &r, &o, &sheet, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__sheet_make(&h, &r, &o, &sheet, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "traced"), "%s", err.message);
   cr_assert_null(sheet.pixels);
   bb_bake_result_free(&r);

@@ -24,6 +24,8 @@
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
 #include "file_bytes.h"
+#include "image/image_write.h"
+#include "texture/texture.h"
 
 static const char *golden(const char *name) {
   static char path[512];
@@ -131,7 +133,7 @@ Test(dds, round_trip_through_the_reader) {
     char path[160];
     snprintf(path, sizeof path, "%s/%zu.dds", scratch_dir, c);
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     bb_image *chain = NULL;
     int count = 0;
     cr_assert_eq(bb_mip_chain(&img,
@@ -154,13 +156,13 @@ Test(dds, round_trip_through_the_reader) {
       errors e = measure(&chain[k], &dec, t->compare, t->map == BB_MAP_NORMAL);
       if (k == 0)
         cr_expect_leq(e.rms, t->rms_bound, "%s %s: rms %.2f codes", t->golden,
-                      bb_texture_format_name(t->format), e.rms);
+                      bb__texture_format_name(t->format), e.rms);
       worst = e.max > worst ? e.max : worst;
       worst_z = e.z_max > worst_z ? e.z_max : worst_z;
       bb_image_free(&dec);
     }
     cr_expect_leq(worst, t->max_bound, "%s %s: max %.2f codes", t->golden,
-                  bb_texture_format_name(t->format), worst);
+                  bb__texture_format_name(t->format), worst);
     if (t->format == BB_TEXTURE_FORMAT_BC5)
       /* z = sqrt(1 - x^2 - y^2) magnifies x's and y's errors by |x|/z where
        * the surface is steep: measured 34.1 codes (rock06_32, the steepest)
@@ -200,7 +202,7 @@ Test(dds, headers) {
     char path[160];
     snprintf(path, sizeof path, "%s/h%zu.dds", scratch_dir, c);
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
     unsigned char *f = file_bytes(path, &size);
     const int block = want[c].format <= BB_TEXTURE_FORMAT_BC5;
@@ -262,7 +264,7 @@ Test(dds, float_formats_hold_the_values) {
     char path[160];
     snprintf(path, sizeof path, "%s/f%d.dds", scratch_dir, half);
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
     unsigned char *f = file_bytes(path, &size);
     const unsigned char *p = f + 148;
@@ -308,8 +310,8 @@ Test(dds, bc1_same_blocks_as_vtf_and_decoders_agree) {
   snprintf(dds, sizeof dds, "%s/s.dds", scratch_dir);
   snprintf(vtf, sizeof vtf, "%s/s.vtf", scratch_dir);
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(dds, &img, &o, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_texture_write(vtf, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(dds, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(vtf, &img, &o, &err), BB_OK, "%s", err.message);
   size_t dsize, vsize;
   unsigned char *d = file_bytes(dds, &dsize), *v = file_bytes(vtf, &vsize);
   int w, h;
@@ -353,7 +355,7 @@ Test(dds, same_bytes_for_any_thread_count) {
     o.threads = threads;
     char path[160];
     snprintf(path, sizeof path, "%s/t%d.dds", scratch_dir, threads);
-    cr_assert_eq(bb_texture_write(path, &img, &o, NULL), BB_OK);
+    cr_assert_eq(bb__texture_write(path, &img, &o, NULL), BB_OK);
     size_t size;
     unsigned char *f = file_bytes(path, &size);
     if (!first) {
@@ -377,7 +379,7 @@ Test(dds, non_power_of_two_mips) {
   char path[160];
   snprintf(path, sizeof path, "%s/n.dds", scratch_dir);
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(path, &img, NULL, &err), BB_OK, "%s", err.message);
   const int want[][2] = {{96, 80}, {48, 40}, {24, 20}, {12, 10}, {6, 5}, {3, 2}, {1, 1}};
   for (int k = 0; k < 7; k++) {
     bb_image dec = {0};
@@ -403,11 +405,11 @@ static void expect_refused(const char *name, const bb_image *img, bb_map_kind ma
   char path[160];
   snprintf(path, sizeof path, "%s/%s", scratch_dir, name);
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, img, &o, &err), BB_ERR_ARGUMENT, "%s: %s", name,
+  cr_assert_eq(bb__texture_write(path, img, &o, &err), BB_ERR_ARGUMENT, "%s: %s", name,
                err.message);
   cr_assert_not_null(strstr(err.message, words), "%s: '%s' lacks '%s'", name, err.message,
                      words);
-  cr_assert_eq(bb_texture_check(path, img->width, img->height, img->channels, &o, NULL),
+  cr_assert_eq(bb__texture_check(path, img->width, img->height, img->channels, &o, NULL),
                BB_ERR_ARGUMENT);
   cr_assert_eq(access(path, F_OK), -1, "%s: nothing written", name);
 }
@@ -436,11 +438,11 @@ Test(dds, usage_errors) {
   o.format = BB_TEXTURE_FORMAT_RGBA8;
   char path[160];
   snprintf(path, sizeof path, "%s/pit.dds", scratch_dir);
-  cr_assert_eq(bb_texture_write(path, &pit, &o, NULL), BB_OK);
+  cr_assert_eq(bb__texture_write(path, &pit, &o, NULL), BB_OK);
   /* NaN texels: BB_ERR_VALUE, nothing written. */
   ao.pixels[77] = NAN;
   snprintf(path, sizeof path, "%s/nan.dds", scratch_dir);
-  cr_assert_eq(bb_texture_write(path, &ao, NULL, NULL), BB_ERR_VALUE);
+  cr_assert_eq(bb__texture_write(path, &ao, NULL, NULL), BB_ERR_VALUE);
   cr_assert_eq(access(path, F_OK), -1);
   bb_image_free(&normal);
   bb_image_free(&ssbump);
@@ -468,7 +470,7 @@ Test(dds, a_normal_map_with_alpha_is_bc3) {
   char path[160];
   snprintf(path, sizeof path, "%s/rgba_normal.dds", scratch_dir);
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, &rgba, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(path, &rgba, &o, &err), BB_OK, "%s", err.message);
   bb_dds_info d;
   cr_assert_eq(bb_dds_read_info(path, &d, &err), BB_OK, "%s", err.message);
   cr_expect_str_eq(d.fourcc, "DXT5");

@@ -28,6 +28,8 @@
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
 #include "file_bytes.h"
+#include "image/image_write.h"
+#include "image/oiio.h"
 
 static void make_scratch_dir(void) { scratch_dir_make("bb_texread"); }
 
@@ -105,7 +107,7 @@ Test(texture_read, vtf_every_format_version_and_level) {
         o.description = "key=value";
         const char *path = in_scratch_dir("t.vtf");
         bb_error err = {{0}};
-        cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+        cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
         size_t size;
         unsigned char *file = file_bytes(path, &size);
         const int want_levels = mips ? 6 : 1; /* 32 x 16 down to 1 x 1 */
@@ -163,14 +165,14 @@ Test(texture_read, vtf_header_agrees_with_the_pixels_and_channels_can_be_picked)
   o.format = BB_TEXTURE_FORMAT_BGRA8;
   const char *path = in_scratch_dir("h.vtf");
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   int w, h, c;
   bb_image_info info;
   cr_assert_eq(bb_image_read_info(path, &w, &h, &c, &info, &err), BB_OK, "%s", err.message);
   cr_assert(w == 16 && h == 16 && c == 4 && info.alpha_channel == 3 && info.bits_per_sample == 8);
   bb_image_info_free(&info);
   int frames = 0;
-  cr_assert_eq(bb_image_frame_count(path, &frames, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__image_frame_count(path, &frames, &err), BB_OK, "%s", err.message);
   cr_assert_eq(frames, 1);
   /* A height read by the channel rule: the alpha channel alone. */
   bb_image a;
@@ -195,7 +197,7 @@ Test(texture_read, dds_with_a_dx10_header) {
     o.format = half ? BB_TEXTURE_FORMAT_RGBA16F : BB_TEXTURE_FORMAT_RGBA32F;
     const char *path = in_scratch_dir(half ? "f16.dds" : "f32.dds");
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
     for (int level = 0; level < count; level++) {
       bb_image got;
       bb_image_info info;
@@ -250,7 +252,7 @@ static unsigned char *valid_vtf(int minor, size_t *size) {
   o.vtf_version = minor;
   const char *path = in_scratch_dir("valid.vtf");
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   return file_bytes(path, size);
 }
@@ -389,7 +391,7 @@ Test(texture_read, hostile_dx10_dds_headers) {
   o.format = BB_TEXTURE_FORMAT_RGBA16F;
   const char *valid = in_scratch_dir("valid.dds");
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(valid, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(valid, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   size_t size;
   unsigned char *v = file_bytes(valid, &size);
@@ -429,7 +431,7 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   o.format = BB_TEXTURE_FORMAT_BC1;
   const char *path = in_scratch_dir("mips.dds");
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(path, &img, &o, &err), BB_OK, "%s", err.message);
   bb_image_free(&img);
   size_t size;
   unsigned char *f = file_bytes(path, &size);

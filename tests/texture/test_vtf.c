@@ -20,6 +20,9 @@
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
 #include "file_bytes.h"
+#include "core/internal.h"
+#include "image/image_write.h"
+#include "texture/texture.h"
 
 /* A map of w x h in [0, 1]: waves, different in each channel (normal 0);
  * a field of unit normals leaning with the waves (1); or waves whose
@@ -76,7 +79,7 @@ Test(vtf, header_byte_for_byte_7_2) {
   o.map = BB_MAP_SSBUMP;
   o.description = "bumpbake_version=x\nscale=64\n"; /* 7.2 has no room: left out */
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
   unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
   cr_assert_eq(memcmp(f, "VTF\0", 4), 0, "magic");
@@ -146,7 +149,7 @@ Test(vtf, resources_7_3_hold_the_provenance) {
       "bumpbake_version=0.2.0\ncommand=bumpbake bake \"a b.png\" --scale 64\nscale=64\n";
   o.description = provenance;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("n.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
   unsigned char *f = file_bytes(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 8), 3);
@@ -194,7 +197,7 @@ Test(vtf, dxt1_blocks_are_the_codecs_and_decode_close) {
   bb_texture_options_init(&o);
   o.map = BB_MAP_SSBUMP;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
   size_t size;
   unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
   bb_image *chain = NULL;
@@ -266,7 +269,7 @@ Test(vtf, flags_from_the_map_and_the_caller) {
     o.mips = cases[c].mips;
     o.vtf_flags = cases[c].extra;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_scratch_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
+    cr_assert_eq(bb__texture_write(in_scratch_dir("f.vtf"), cases[c].img, &o, &err), BB_OK, "%s",
                  err.message);
     size_t size;
     unsigned char *f = file_bytes(in_scratch_dir("f.vtf"), &size);
@@ -283,7 +286,7 @@ Test(vtf, flags_from_the_map_and_the_caller) {
 
 /* Every kind string the commands, the job and Python write a texture of
  * takes its map from the kind's own facts (bb_map_kind_info); Valve's
- * composites and the kinds of no map are resolved as bb_texture_options_for
+ * composites and the kinds of no map are resolved as bb__texture_options_for
  * says, the caller's own flags kept. */
 Test(vtf, the_map_of_every_output_kind) {
   const uint32_t N = BB_VTF_FLAG_NORMAL;
@@ -333,14 +336,14 @@ Test(vtf, the_map_of_every_output_kind) {
     bb_texture_options o;
     bb_texture_options_init(&o);
     o.vtf_flags = 0x4u; /* the caller's: kept */
-    bb_texture_options_for(&o, cases[c].kind, cases[c].range);
+    bb__texture_options_for(&o, cases[c].kind, cases[c].range);
     cr_assert_eq(o.map, cases[c].map, "%s: map %s, want %s",
-                 cases[c].kind ? cases[c].kind : "NULL", bb_map_kind_name(o.map),
-                 bb_map_kind_name(cases[c].map));
+                 cases[c].kind ? cases[c].kind : "NULL", bb__map_kind_name(o.map),
+                 bb__map_kind_name(cases[c].map));
     cr_assert_eq(o.vtf_flags, 0x4u | cases[c].added, "%s: flags 0x%x",
                  cases[c].kind ? cases[c].kind : "NULL", (unsigned)o.vtf_flags);
   }
-  bb_texture_options_for(NULL, "normal", BB_RANGE_SIGNED); /* no options: nothing */
+  bb__texture_options_for(NULL, "normal", BB_RANGE_SIGNED); /* no options: nothing */
 }
 
 /* binary16 to float, from IEEE 754 (not Imath's). */
@@ -363,7 +366,7 @@ Test(vtf, dxt1_under_4_texels_is_one_padded_block_a_level) {
     bb_texture_options_init(&o);
     o.format = BB_TEXTURE_FORMAT_BC1;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
+    cr_assert_eq(bb__texture_write(in_scratch_dir("s.vtf"), &img, &o, &err), BB_OK, "%d x %d: %s", w, h,
                  err.message);
     size_t size;
     unsigned char *f = file_bytes(in_scratch_dir("s.vtf"), &size);
@@ -419,7 +422,7 @@ Test(vtf, texel_formats) {
     o.format = cases[c].format;
     o.mips = 0;
     bb_error err = {{0}};
-    cr_assert_eq(bb_texture_write(in_scratch_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__texture_write(in_scratch_dir("t.vtf"), &img, &o, &err), BB_OK, "%s", err.message);
     size_t size;
     unsigned char *f = file_bytes(in_scratch_dir("t.vtf"), &size);
     cr_assert_eq(oracle_u32(f + 52), (uint32_t)cases[c].code);
@@ -443,7 +446,7 @@ Test(vtf, texel_formats) {
   o.format = BB_TEXTURE_FORMAT_BGR8;
   o.map = BB_MAP_NORMAL;
   o.mips = 0;
-  cr_assert_eq(bb_texture_write(in_scratch_dir("n.vtf"), &n, &o, NULL), BB_OK);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("n.vtf"), &n, &o, NULL), BB_OK);
   size_t size;
   unsigned char *f = file_bytes(in_scratch_dir("n.vtf"), &size);
   cr_assert_eq(oracle_u32(f + 52), 3);
@@ -466,7 +469,7 @@ Test(vtf, same_bytes_for_any_thread_count) {
     bb_texture_options_init(&o);
     o.map = BB_MAP_SSBUMP;
     o.threads = threads;
-    cr_assert_eq(bb_texture_write(in_scratch_dir("d.vtf"), &img, &o, NULL), BB_OK);
+    cr_assert_eq(bb__texture_write(in_scratch_dir("d.vtf"), &img, &o, NULL), BB_OK);
     size_t size;
     unsigned char *f = file_bytes(in_scratch_dir("d.vtf"), &size);
     if (!first) {
@@ -490,10 +493,10 @@ static void expect_refused(const bb_image *img, bb_map_kind map, bb_texture_form
   o.vtf_version = version;
   o.vtf_flags = flags;
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_write(in_scratch_dir("bad.vtf"), img, &o, &err), BB_ERR_ARGUMENT, "%s",
+  cr_assert_eq(bb__texture_write(in_scratch_dir("bad.vtf"), img, &o, &err), BB_ERR_ARGUMENT, "%s",
                err.message);
   cr_assert_not_null(strstr(err.message, words), "'%s' lacks '%s'", err.message, words);
-  cr_assert_eq(bb_texture_check(in_scratch_dir("bad.vtf"), img->width, img->height, img->channels, &o,
+  cr_assert_eq(bb__texture_check(in_scratch_dir("bad.vtf"), img->width, img->height, img->channels, &o,
                                 NULL),
                BB_ERR_ARGUMENT);
   cr_assert_eq(access(in_scratch_dir("bad.vtf"), F_OK), -1, "nothing written");
@@ -511,7 +514,7 @@ Test(vtf, usage_errors) {
   bb_texture_options dds;
   bb_texture_options_init(&dds);
   bb_error e6 = {{0}};
-  cr_assert_eq(bb_texture_write(in_scratch_dir("six.dds"), &six, &dds, &e6), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("six.dds"), &six, &dds, &e6), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(e6.message, "block compression (bc1) needs sides that are multiples "
                                         "of 4"),
                      "%s", e6.message);
@@ -547,8 +550,8 @@ Test(vtf, usage_errors) {
   bb_texture_options o;
   bb_texture_options_init(&o);
   o.format = BB_TEXTURE_FORMAT_BGR8;
-  cr_assert_eq(bb_texture_write(in_scratch_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
-  cr_assert_eq(bb_texture_write(in_scratch_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
   bb_texture_format fmt;
   cr_assert_eq(bb_texture_format_parse("DXT5", &fmt, NULL), BB_OK);
   cr_assert_eq(fmt, BB_TEXTURE_FORMAT_BC3);
@@ -557,8 +560,8 @@ Test(vtf, usage_errors) {
   bb_error err = {{0}};
   cr_assert_eq(bb_texture_format_parse("dxt9", &fmt, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "bc1"), "%s", err.message);
-  cr_assert(bb_path_is_texture_format("a/B.VTF") && bb_path_is_texture_format("x.dds") &&
-            !bb_path_is_texture_format("x.vtf.png") && !bb_path_is_texture_format("vtf"));
+  cr_assert(bb__path_is_texture_format("a/B.VTF") && bb__path_is_texture_format("x.dds") &&
+            !bb__path_is_texture_format("x.vtf.png") && !bb__path_is_texture_format("vtf"));
   bb_image_free(&odd);
   bb_image_free(&tiny);
   bb_image_free(&rgba);
@@ -574,7 +577,7 @@ Test(vtf, read_info_refuses_broken_files) {
   bb_texture_options_init(&o);
   o.vtf_version = 4;
   o.description = "a=b\n";
-  cr_assert_eq(bb_texture_write(in_scratch_dir("g.vtf"), &img, &o, NULL), BB_OK);
+  cr_assert_eq(bb__texture_write(in_scratch_dir("g.vtf"), &img, &o, NULL), BB_OK);
   size_t size;
   unsigned char *good = file_bytes(in_scratch_dir("g.vtf"), &size);
   bb_vtf_info info;

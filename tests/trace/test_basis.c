@@ -12,13 +12,18 @@
 
 #include "bumpbake.h"
 #include "bake_harness.h"
+#include "bake/bake_internal.h"
+#include "render/render_internal.h"
+#include "trace/basis.h"
+#include "trace/pyramid.h"
+#include "trace/trace.h"
 
 static const double PI = 3.14159265358979323846;
 
 static bb_basis named(const char *name) {
   bb_basis b;
   bb_error err;
-  cr_assert_eq(bb_basis_parse(name, &b, &err), BB_OK, "%s: %s", name, err.message);
+  cr_assert_eq(bb__basis_parse(name, &b, &err), BB_OK, "%s: %s", name, err.message);
   return b;
 }
 
@@ -30,7 +35,7 @@ static int same_bits(const double a[3], const double b[3]) {
 
 Test(basis, names_parse_and_anything_else_is_refused) {
   bb_basis b;
-  bb_basis_init(&b);
+  bb__basis_init(&b);
   cr_assert_eq(b.count, 3);
   cr_assert_str_eq(b.name, "hl2");
   b = named("hl2+z");
@@ -49,11 +54,11 @@ Test(basis, names_parse_and_anything_else_is_refused) {
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     bb_basis kept = named("dirs:5");
     bb_error err;
-    cr_assert_eq(bb_basis_parse(bad[i], &kept, &err), BB_ERR_ARGUMENT, "'%s'", bad[i]);
+    cr_assert_eq(bb__basis_parse(bad[i], &kept, &err), BB_ERR_ARGUMENT, "'%s'", bad[i]);
     cr_expect(strstr(err.message, "dirs:N"), "'%s': %s", bad[i], err.message);
     cr_expect_str_eq(kept.name, "dirs:5", "a failed parse must not write");
   }
-  cr_assert_eq(bb_basis_parse(NULL, &b, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__basis_parse(NULL, &b, NULL), BB_ERR_ARGUMENT);
 }
 
 /* dirs:N as the header defines it: Half-Life 2's elevation, azimuth
@@ -79,7 +84,7 @@ Test(basis, dirs_spreads_directions_evenly_at_hl2s_elevation) {
       }
       if ((3 * c) % n == 0) {
         double hl2[3];
-        bb_basis_vector(3 * c / n, hl2);
+        bb__basis_vector(3 * c / n, hl2);
         cr_assert(same_bits(v, hl2), "%s B%d is Half-Life 2's B%d", name, c, 3 * c / n);
       }
       if ((4 * c) % n == 0) { /* a quarter turn: exactly on an axis */
@@ -95,16 +100,16 @@ Test(basis, dirs_spreads_directions_evenly_at_hl2s_elevation) {
   const bb_basis hl2 = named("hl2"), d3 = named("dirs:3"), d6 = named("dirs:6");
   cr_assert(memcmp(hl2.vector, d3.vector, sizeof hl2.vector) == 0);
   for (int c = 0; c < 3; c++) cr_assert(same_bits(d6.vector[2 * c], hl2.vector[c]));
-  cr_assert(bb_basis_is_hl2(&d3) && bb_basis_is_hl2(&hl2) && !bb_basis_is_hl2(&d6));
-  cr_assert(bb_basis_is_hl2((bb_basis[]){named("hl2+z")}));
-  cr_assert(!bb_basis_is_hl2(NULL));
+  cr_assert(bb__basis_is_hl2(&d3) && bb__basis_is_hl2(&hl2) && !bb__basis_is_hl2(&d6));
+  cr_assert(bb__basis_is_hl2((bb_basis[]){named("hl2+z")}));
+  cr_assert(!bb__basis_is_hl2(NULL));
 }
 
 Test(basis, dirs_refuses_counts_outside_3_to_16) {
   bb_basis b;
   bb_error err;
-  cr_assert_eq(bb_basis_dirs(2, &b, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_basis_dirs(BB_MAX_BASIS + 1, &b, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__basis_dirs(2, &b, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__basis_dirs(BB_MAX_BASIS + 1, &b, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "3..16"), "%s", err.message);
 }
 
@@ -171,7 +176,7 @@ Test(basis, text_has_one_direction_per_line_and_comments) {
                      "0 0 3"; /* no final newline */
   bb_basis b;
   bb_error err;
-  cr_assert_eq(bb_basis_read_text(text, "four.txt", &b, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__basis_read_text(text, "four.txt", &b, &err), BB_OK, "%s", err.message);
   cr_assert_eq(b.count, 4);
   cr_assert_float_eq(b.vector[0][0], sqrt(0.5), 2.3e-16);
   cr_assert_float_eq(b.vector[1][0], -sqrt(0.5), 2.3e-16);
@@ -204,7 +209,7 @@ Test(basis, text_errors_name_the_file_and_line) {
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     bb_basis b = named("hl2");
     bb_error err;
-    cr_expect_eq(bb_basis_read_text(cases[i].text, "f.txt", &b, &err), cases[i].status,
+    cr_expect_eq(bb__basis_read_text(cases[i].text, "f.txt", &b, &err), cases[i].status,
                  "case %zu", i);
     cr_expect_str_eq(err.message, cases[i].message, "case %zu", i);
     cr_expect_str_eq(b.name, "hl2", "case %zu wrote its output", i);
@@ -213,7 +218,7 @@ Test(basis, text_errors_name_the_file_and_line) {
   for (int c = 0; c < 17; c++) strcat(many, "0 0.5 1\n");
   bb_basis b;
   bb_error err;
-  cr_assert_eq(bb_basis_read_text(many, "many.txt", &b, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__basis_read_text(many, "many.txt", &b, &err), BB_ERR_ARGUMENT);
   cr_assert_str_eq(err.message, "many.txt:17: more than 16 directions");
 }
 
@@ -233,37 +238,37 @@ Test(basis, files_load_and_bad_files_are_refused) {
   write_file(path, good, sizeof good - 1);
   bb_basis b;
   bb_error err;
-  cr_assert_eq(bb_basis_load(path, &b, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__basis_load(path, &b, &err), BB_OK, "%s", err.message);
   cr_assert_eq(b.count, 5);
 
-  cr_assert_eq(bb_basis_load(dir, &b, &err), BB_ERR_IO, "a directory");
+  cr_assert_eq(bb__basis_load(dir, &b, &err), BB_ERR_IO, "a directory");
   char missing[300];
   snprintf(missing, sizeof missing, "%s/missing.txt", dir);
-  cr_assert_eq(bb_basis_load(missing, &b, &err), BB_ERR_IO);
+  cr_assert_eq(bb__basis_load(missing, &b, &err), BB_ERR_IO);
   cr_assert(strstr(err.message, missing) && strstr(err.message, "no such file"), "%s",
             err.message);
 
   const char nul[] = "0 0 1\n1 0 1\0\n0 1 1\n";
   write_file(path, nul, sizeof nul - 1);
-  cr_assert_eq(bb_basis_load(path, &b, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__basis_load(path, &b, &err), BB_ERR_FORMAT);
   cr_assert(strstr(err.message, "NUL"), "%s", err.message);
 
   char *big = malloc(64 * 1024 + 1);
   cr_assert_not_null(big);
   memset(big, '#', 64 * 1024 + 1);
   write_file(path, big, 64 * 1024 + 1);
-  cr_assert_eq(bb_basis_load(path, &b, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__basis_load(path, &b, &err), BB_ERR_SIZE);
   big[0] = '\n'; /* exactly 64 KiB of comment after the three lines still loads */
   char text[64 * 1024 + 32];
   snprintf(text, sizeof text, "0 0 1\n1 0 1\n0 1 1\n%.*s", 64 * 1024 - 18, big);
   write_file(path, text, strlen(text));
   cr_assert_eq(strlen(text), 64 * 1024);
-  cr_assert_eq(bb_basis_load(path, &b, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__basis_load(path, &b, &err), BB_OK, "%s", err.message);
   free(big);
 
   const char short_line[] = "0 0 1\n1 0\n";
   write_file(path, short_line, sizeof short_line - 1);
-  cr_assert_eq(bb_basis_load(path, &b, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__basis_load(path, &b, &err), BB_ERR_FORMAT);
   char expect[300];
   snprintf(expect, sizeof expect, "%s:2: 2 numbers; a direction is 3 (x y z)", path);
   cr_assert_str_eq(err.message, expect);
@@ -394,13 +399,13 @@ Test(basis, more_directions_stay_deterministic_on_every_path) {
   for (int i = 0; i < 21 * 18; i++) z.pixels[i] = 3.0f * one.filtered.pixels[i];
   bb_pyramid *p;
   bb_rayset rs;
-  cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  cr_assert_eq(bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
   cr_assert_eq(bb__rayset_make(12, 1.0, &d7, 0, &rs, NULL), BB_OK);
   bb_trace_options t;
-  bb_trace_options_init(&t);
+  bb__trace_options_init(&t);
   t.region = (bb_region){5, 4, 9, 7};
   bb_image region;
-  cr_assert_eq(bb_trace_occlusion(p, &rs, &t, &region, NULL, NULL), BB_OK);
+  cr_assert_eq(bb__trace_occlusion(p, &rs, &t, &region, NULL, NULL), BB_OK);
   for (int y = 0; y < 7; y++)
     for (int x = 0; x < 9; x++)
       cr_assert(memcmp(bb_image_texel(&region, x, y), bb_image_texel(&one.vis, 5 + x, 4 + y),
@@ -503,21 +508,21 @@ Test(basis, derive_takes_the_basis_or_defaults_to_hl2) {
   bb_image_free(&out);
   cr_assert_eq(bb_image_alloc(&vis, 2, 1, 6, NULL), BB_OK);
   for (int i = 0; i < 12; i++) vis.pixels[i] = 0.5f;
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &d5, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, &d5, &out, &err), BB_OK, "%s", err.message);
   cr_assert_eq(out.channels, 5);
   cr_assert_float_eq(out.pixels[0], 0.5 / sqrt(3.0), 1e-7);
   bb_image ssbump = out, bent = {0};
-  cr_assert_eq(bb_derive_bent(&ssbump, &d5, &bent, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__derive_bent_all_cores(&ssbump, &d5, &bent, &err), BB_OK, "%s", err.message);
   cr_assert_float_eq(bent.pixels[2], 1.0, 1e-7);
   bb_image_free(&bent);
   /* A count that does not match the basis, and NULL with 5 channels. */
-  cr_assert_eq(bb_derive_bent(&ssbump, NULL, &bent, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_bent_all_cores(&ssbump, NULL, &bent, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "3 (hl2) or 4 (hl2+z)"), "%s", err.message);
   const bb_basis d6 = named("dirs:6");
-  cr_assert_eq(bb_derive_bent(&ssbump, &d6, &bent, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_bent_all_cores(&ssbump, &d6, &bent, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "5 basis channels but the basis dirs:6 has 6"), "%s",
             err.message);
-  cr_assert_eq(bb_derive_ssbump(&n, &vis, &d6, &bent, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, &d6, &bent, &err), BB_ERR_ARGUMENT);
   bb_basis broken = d5;
   broken.vector[2][2] = 2.0;
   cr_assert_eq(bb_derive_weights(&n, &broken, &bent, &err), BB_ERR_ARGUMENT);
@@ -553,7 +558,7 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   bb_render_maps maps = {NULL, &s6, NULL, NULL, NULL, NULL};
   bb_image out = {0};
   bb_error err;
-  cr_assert_eq(bb_render(&maps, &ro, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__render(&maps, &ro, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "6 channels"), "%s", err.message);
   cr_assert_eq(bb_combine_detail(&s6, &s6, BB_MAP_SSBUMP, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb_combine_blend(&s6, &s6, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err), BB_OK,

@@ -9,6 +9,7 @@
 
 #include "bumpbake.h"
 #include "trace/integrate.h"
+#include "trace/basis.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -88,7 +89,7 @@ static void unit(double v[3]) {
  * elevation 0 up to the horizon, are of the order of the sector's width). */
 Test(integrate, tables_match_an_independent_quadrature) {
   double basis[4][3];
-  for (int c = 0; c < 3; c++) bb_basis_vector(c, basis[c]);
+  for (int c = 0; c < 3; c++) bb__basis_vector(c, basis[c]);
   basis[3][0] = 0.3, basis[3][1] = -0.8, basis[3][2] = 0.2;
   unit(basis[3]);
   const double powers[] = {1.0, 1.5, 4.0};
@@ -126,7 +127,7 @@ Test(integrate, tables_match_an_independent_quadrature) {
  * quarter-turn sectors, 1.4e-9 for 16 and 32 slices). */
 Test(integrate, interpolation_error_is_under_1e_7_of_the_share) {
   double basis[3][3];
-  for (int c = 0; c < 3; c++) bb_basis_vector(c, basis[c]);
+  for (int c = 0; c < 3; c++) bb__basis_vector(c, basis[c]);
   const int sector_counts[] = {4, 16, 32};
   for (size_t si = 0; si < 3; si++) {
     const double width = 2 * PI / sector_counts[si], lo = 1.1 - width / 2, hi = lo + width;
@@ -153,7 +154,7 @@ Test(integrate, interpolation_error_is_under_1e_7_of_the_share) {
  * horizon, and a horizon at or below 0 loses exactly nothing. */
 Test(integrate, ao_in_closed_form_and_nothing_lost_below_the_plane) {
   double basis[3][3];
-  for (int c = 0; c < 3; c++) bb_basis_vector(c, basis[c]);
+  for (int c = 0; c < 3; c++) bb__basis_vector(c, basis[c]);
   static double table[BB__TABLE_INTERVALS * 3 * 4];
   double share[3];
   bb__slice_table_build(0.0, 0.4, (const double(*)[3])basis, 3, 1.0, table, share);
@@ -179,7 +180,7 @@ Test(integrate, rayset_sectors_and_totals) {
     bb_rayset rs;
     bb_error err;
     bb_basis hl2z;
-    cr_assert_eq(bb_basis_parse("hl2+z", &hl2z, NULL), BB_OK);
+    cr_assert_eq(bb__basis_parse("hl2+z", &hl2z, NULL), BB_OK);
     cr_assert_eq(bb__rayset_make(counts[i], 1.0, &hl2z, 0, &rs, &err), BB_OK, "%s", err.message);
     double width = 0.0;
     for (int s = 0; s < rs.slice_count; s++) {
@@ -193,7 +194,7 @@ Test(integrate, rayset_sectors_and_totals) {
     cr_assert_float_eq(rs.total[0], PI, 1e-12);
     for (int c = 0; c < rs.basis_count; c++) {
       double b[3];
-      bb_basis_vector(c, b);
+      bb__basis_vector(c, b);
       const double whole = reference(0.0, 2 * PI, b, 1.0, 0.0);
       cr_assert_float_eq(rs.total[1 + c], whole, 1e-9, "%d slices, lobe %d", counts[i], c);
     }
@@ -211,12 +212,12 @@ Test(integrate, rayset_rejects_bad_arguments) {
 }
 
 Test(integrate, slices_for_rays_follow_valves_count) {
-  cr_assert_eq(bb_slices_for_rays(250), 16);
-  cr_assert_eq(bb_slices_for_rays(256), 16);
-  cr_assert_eq(bb_slices_for_rays(64), 8);
-  cr_assert_eq(bb_slices_for_rays(1024), 32);
-  cr_assert_eq(bb_slices_for_rays(1), 1);
-  cr_assert_eq(bb_slices_for_rays(65536), 256);
+  cr_assert_eq(bb__slices_for_rays(250), 16);
+  cr_assert_eq(bb__slices_for_rays(256), 16);
+  cr_assert_eq(bb__slices_for_rays(64), 8);
+  cr_assert_eq(bb__slices_for_rays(1024), 32);
+  cr_assert_eq(bb__slices_for_rays(1), 1);
+  cr_assert_eq(bb__slices_for_rays(65536), 256);
 }
 
 /* The four channels at once (three lobes, bb__slice_accumulate4, the
@@ -224,7 +225,7 @@ Test(integrate, slices_for_rays_follow_valves_count) {
  * march's path), over horizons from none to nearly vertical. */
 Test(integrate, four_channels_at_once_add_the_same_bits) {
   double basis[3][3];
-  for (int c = 0; c < 3; c++) bb_basis_vector(c, basis[c]);
+  for (int c = 0; c < 3; c++) bb__basis_vector(c, basis[c]);
   static double table[BB__TABLE_INTERVALS * 3 * 4];
   static bb__channels4 table4[BB__TABLE_INTERVALS * 4];
   double share[3];

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #include "bumpbake.h"
+#include "trace/pyramid.h"
 
 static bb_addressing modes[] = {BB_ADDRESS_PERIODIC, BB_ADDRESS_CLAMP};
 
@@ -38,7 +39,7 @@ Test(pyramid, nodes_equal_max_of_covered_cells) {
       cr_assert_eq(bb_image_alloc(&z, sizes[s][0], sizes[s][1], 1, NULL), BB_OK);
       for (int i = 0; i < z.width * z.height; i++) z.pixels[i] = (float)(rand() % 1000) / 10.0f;
       bb_pyramid *p = NULL;
-      cr_assert_eq(bb_pyramid_build(&z, modes[m], &p, NULL), BB_OK);
+      cr_assert_eq(bb__pyramid_build_all_cores(&z, modes[m], &p, NULL), BB_OK);
       int levels = bb__pyramid_levels(p);
       cr_assert_eq(1 << (levels - 1) >= z.width && 1 << (levels - 1) >= z.height, 1);
       for (int k = 0; k < levels; k++) {
@@ -61,7 +62,7 @@ Test(pyramid, rejects_non_finite_heights) {
   z.pixels[5] = 1.0f / 0.0f;
   bb_pyramid *p = (bb_pyramid *)1;
   bb_error err;
-  cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, &err), BB_ERR_VALUE);
+  cr_assert_eq(bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, &err), BB_ERR_VALUE);
   cr_assert_null(p);
   bb_image_free(&z);
 }

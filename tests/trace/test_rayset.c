@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "trace/basis.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -44,7 +45,7 @@ Test(rayset, slices_follow_lattice_steps_near_uniform_azimuths) {
 Test(rayset, id_names_the_scheme_and_its_parameters) {
   bb_rayset rs;
   bb_basis hl2z;
-  cr_assert_eq(bb_basis_parse("hl2+z", &hl2z, NULL), BB_OK);
+  cr_assert_eq(bb__basis_parse("hl2+z", &hl2z, NULL), BB_OK);
   cr_assert_eq(bb__rayset_make(16, 2.0, &hl2z, 0, &rs, NULL), BB_OK);
   cr_assert_str_eq(rs.id, "bb-horizon-v1:a16:p2:hl2+z");
   cr_assert_eq(rs.basis_count, 4);
@@ -77,13 +78,13 @@ Test(rayset, blocked_rises_with_the_horizon) {
 Test(rayset, public_handle) {
   bb_rayset *rs = NULL;
   bb_error err;
-  cr_assert_eq(bb_rayset_make(16, 2.0, NULL, &rs, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__rayset_new(16, 2.0, NULL, &rs, &err), BB_OK, "%s", err.message);
   cr_assert_not_null(rs);
   cr_assert_eq(bb_rayset_slice_count(rs), 16);
   cr_assert_eq(bb_rayset_lobe_count(rs), 3);
   cr_assert_str_eq(bb_rayset_id(rs), "bb-horizon-v1:a16:p2:hl2");
   bb_rayset_free(rs);
-  cr_assert_eq(bb_rayset_make(0, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__rayset_new(0, 1.0, NULL, &rs, &err), BB_ERR_ARGUMENT);
   cr_assert_null(rs);
   bb_rayset_free(NULL);
 }

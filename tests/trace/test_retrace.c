@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "core/internal.h"
 #include "trace/march.h"
 #include "trace/pyramid.h"
@@ -18,6 +19,7 @@
 #include "trace/retrace.h"
 #include "trace/sweep.h"
 #include "trace/testing.h"
+#include "trace/trace.h"
 
 static const bb_addressing modes[] = {BB_ADDRESS_PERIODIC, BB_ADDRESS_CLAMP};
 
@@ -83,7 +85,7 @@ Test(retrace, pyramid_update_equals_a_build) {
       const int w = sizes[s][0], h = sizes[s][1];
       bb_image z = field(w, h, 10.0);
       bb_pyramid *p = NULL;
-      cr_assert_eq(bb_pyramid_build(&z, modes[m], &p, NULL), BB_OK);
+      cr_assert_eq(bb__pyramid_build_all_cores(&z, modes[m], &p, NULL), BB_OK);
       for (int e = 0; e < 12; e++) {
         const rect r = some_rect(w, h, modes[m]);
         float old_min = INFINITY;
@@ -99,7 +101,7 @@ Test(retrace, pyramid_update_equals_a_build) {
         cr_assert_eq(bb__pyramid_update(p, r.x0, r.y0, r.width, r.height, old_min),
                      BB_OK);
         bb_pyramid *built = NULL;
-        cr_assert_eq(bb_pyramid_build(&z, modes[m], &built, NULL), BB_OK);
+        cr_assert_eq(bb__pyramid_build_all_cores(&z, modes[m], &built, NULL), BB_OK);
         char what[96];
         snprintf(what, sizeof what, "%dx%d %s, edit %d at (%d, %d) %dx%d", w, h,
                  m ? "clamped" : "periodic", e, r.x0, r.y0, r.width, r.height);
@@ -121,7 +123,7 @@ Test(retrace, line_seeds_are_the_trace_s) {
     const int w = sizes[s][0], h = sizes[s][1];
     bb_image z = field(w, h, 1.0);
     bb_pyramid *p = NULL;
-    cr_assert_eq(bb_pyramid_build(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+    cr_assert_eq(bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
     for (size_t d = 0; d < sizeof steps / sizeof steps[0]; d++) {
       const int a = steps[d][0], b = steps[d][1];
       const long period = bb__line_period(p, a, b), rows = h / bb__gcd(b, h);
@@ -153,7 +155,7 @@ static bb_image *horizons_of(const bb_pyramid *p, const bb_rayset *rs, double bi
   for (int s = 0; s < n; s++)
     slices[s] = s;
   bb_trace_options o;
-  bb_trace_options_init(&o);
+  bb__trace_options_init(&o);
   o.bias_texels = bias;
   o.threads = 2;
   bb_error err = {{0}};
@@ -168,9 +170,9 @@ static bb_image *horizons_of(const bb_pyramid *p, const bb_rayset *rs, double bi
 static void retrace_equals_trace(int w, int h, bb_addressing a, int slices, double bias) {
   bb_image z = field(w, h, 12.0);
   bb_pyramid *p = NULL;
-  cr_assert_eq(bb_pyramid_build(&z, a, &p, NULL), BB_OK);
+  cr_assert_eq(bb__pyramid_build_all_cores(&z, a, &p, NULL), BB_OK);
   bb_rayset *rs = NULL;
-  cr_assert_eq(bb_rayset_make(slices, 1.0, NULL, &rs, NULL), BB_OK);
+  cr_assert_eq(bb__rayset_new(slices, 1.0, NULL, &rs, NULL), BB_OK);
   const int n = bb_rayset_slice_count(rs);
   bb_image *kept = horizons_of(p, rs, bias);
   float *horizons[BB_MAX_SLICES];

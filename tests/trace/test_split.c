@@ -10,6 +10,11 @@
 #include <string.h>
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
+#include "trace/basis.h"
+#include "trace/pyramid.h"
+#include "trace/rayset.h"
+#include "trace/trace.h"
 
 static uint64_t rng_state;
 static double rnd(void) {
@@ -42,10 +47,10 @@ static setup make_setup(const bb_image *z, bb_addressing a, int slices, const ch
   setup s = {0};
   bb_error err;
   bb_basis b;
-  cr_assert_eq(bb_basis_parse(basis, &b, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_pyramid_build(z, a, &s.p, &err), BB_OK, "%s", err.message);
-  cr_assert_eq(bb_rayset_make(slices, 1.0, &b, &s.rs, &err), BB_OK, "%s", err.message);
-  bb_trace_options_init(&s.o);
+  cr_assert_eq(bb__basis_parse(basis, &b, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__pyramid_build_all_cores(z, a, &s.p, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__rayset_new(slices, 1.0, &b, &s.rs, &err), BB_OK, "%s", err.message);
+  bb__trace_options_init(&s.o);
   s.o.threads = 2;
   return s;
 }
@@ -123,7 +128,7 @@ Test(split, any_split_of_the_slices_gives_the_whole_trace_bit_for_bit) {
         setup s = make_setup(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC, slices[ni], basis);
         bb_image whole;
         bb_error err;
-        cr_assert_eq(bb_trace_occlusion(s.p, s.rs, &s.o, &whole, NULL, &err), BB_OK, "%s",
+        cr_assert_eq(bb__trace_occlusion(s.p, s.rs, &s.o, &whole, NULL, &err), BB_OK, "%s",
                      err.message);
         for (int deal = 0; deal < 3; deal++) {
           bb_image split = split_trace(&s, 1 + (deal + (int)ni) % 3, deal);

@@ -13,6 +13,7 @@
 #include "trace/pyramid.h"
 #include "trace/sweep.h"
 #include "trace/testing.h"
+#include "trace/trace.h"
 
 /* xorshift64*: a small deterministic generator for the property tests. */
 static uint64_t rng_state;
@@ -43,7 +44,7 @@ static bb_image random_field(int w, int h, float scale, int kind) {
 static bb_pyramid *pyramid_of(const bb_image *z, bb_addressing a) {
   bb_pyramid *p = NULL;
   bb_error err;
-  cr_assert_eq(bb_pyramid_build(z, a, &p, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__pyramid_build_all_cores(z, a, &p, &err), BB_OK, "%s", err.message);
   return p;
 }
 
@@ -248,11 +249,11 @@ static bb_image trace_field(const bb_image *z, bb_addressing a, int threads, int
   bb_pyramid *p = pyramid_of(z, a);
   bb_rayset rs = rayset_of(slices);
   bb_trace_options o;
-  bb_trace_options_init(&o);
+  bb__trace_options_init(&o);
   o.threads = threads;
   bb_image vis;
   bb_error err;
-  cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_OK, "%s", err.message);
   bb__rayset_release(&rs);
   bb_pyramid_free(p);
   return vis;
@@ -379,15 +380,15 @@ Test(trace, rejects_negative_bias_and_a_region_outside) {
   bb_pyramid *p = pyramid_of(&z, BB_ADDRESS_PERIODIC);
   bb_rayset rs = rayset_of(4);
   bb_trace_options o;
-  bb_trace_options_init(&o);
+  bb__trace_options_init(&o);
   o.bias_texels = -1.0;
   bb_image vis;
   bb_error err;
-  cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "bias") != NULL);
   o.bias_texels = 0.55;
   o.region = (bb_region){2, 1, 3, 2};
-  cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__trace_occlusion(p, &rs, &o, &vis, NULL, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "region") != NULL, "%s", err.message);
   bb__rayset_release(&rs);
   bb_pyramid_free(p);
@@ -405,7 +406,7 @@ Test(trace, sweeps_marches_and_regions_trace_the_same_bits) {
       bb_pyramid *p = pyramid_of(&z, a ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC);
       bb_rayset rs = rayset_of(si % 2 ? 7 : 16);
       bb_trace_options o;
-      bb_trace_options_init(&o);
+      bb__trace_options_init(&o);
       bb_image sweeps, marches, region;
       bb_error err;
       cr_assert_eq(bb__trace_occlusion_path(p, &rs, &o, BB__TRACE_SWEEP, &sweeps, &err), BB_OK, "%s",
@@ -418,7 +419,7 @@ Test(trace, sweeps_marches_and_regions_trace_the_same_bits) {
                      z.width, z.height, a ? "clamp" : "periodic", i / 4, i % 4);
       o.region = (bb_region){z.width / 3, z.height / 2, z.width - z.width / 3, z.height - z.height / 2};
       double found = 0;
-      cr_assert_eq(bb_trace_occlusion(p, &rs, &o, &region, &found, &err), BB_OK, "%s", err.message);
+      cr_assert_eq(bb__trace_occlusion(p, &rs, &o, &region, &found, &err), BB_OK, "%s", err.message);
       cr_assert_eq(region.width, o.region.width);
       cr_assert_eq(found, (double)o.region.width * o.region.height * rs.slice_count);
       for (int y = 0; y < region.height; y++)

@@ -22,6 +22,7 @@
  * one write at a time, every request that waited during a write answered
  * by the next one. */
 #include "serve.h"
+#include "../../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -166,10 +167,10 @@ static char *error_json(const char *msg) {
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return NULL;
-  bb_json j = {f, 0};
-  bb_json_open(&j, NULL, '{');
-  bb_json_string(&j, "error", msg);
-  bb_json_close(&j, '}');
+  bb__json j = {f, 0};
+  bb__json_open(&j, NULL, '{');
+  bb__json_string(&j, "error", msg);
+  bb__json_close(&j, '}');
   fclose(f);
   return text;
 }
@@ -550,11 +551,11 @@ static char *write_maps(serve_state *s, unsigned *status) {
   size_t reply_size = 0;
   FILE *f = text && text[0] == '{' ? open_memstream(&reply, &reply_size) : NULL;
   if (f) {
-    bb_json j = {f, 0};
-    bb_json_open(&j, NULL, '{');
-    bb_json_string(&j, "from", from);
+    bb__json j = {f, 0};
+    bb__json_open(&j, NULL, '{');
+    bb__json_string(&j, "from", from);
     if (strcmp(from, "memory"))
-      bb_json_string(&j, "reason", reason);
+      bb__json_string(&j, "reason", reason);
     fprintf(f, ",%s", text + 1);
     if (fclose(f) != 0) {
       free(reply);

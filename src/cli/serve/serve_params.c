@@ -6,6 +6,8 @@
  * the whole checked as the command line is (bb_command_check), whose
  * words a refusal shows. */
 #include "serve.h"
+#include "../../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
+#include "bumpbake_cluster.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -15,78 +17,78 @@
 
 /* ---------------------------------------------------------------- state */
 
-static void add_params(bb_json *j, const serve_state *s) {
+static void add_params(bb__json *j, const serve_state *s) {
   const bb_bake_options *b = &s->settings.bake;
-  bb_json_open(j, "params", '{');
-  bb_json_number(j, "scale", (double)b->height_scale);
-  bb_json_int(j, "rays", b->rays);
-  bb_json_int(j, "slices", b->slices);
-  bb_json_int(j, "slices_traced", bb_bake_slices(b));
-  bb_json_number(j, "bias", b->trace.bias_texels);
-  bb_json_number(j, "bounce", b->bounce_albedo);
-  bb_json_int(j, "bounces", b->bounces);
-  bb_json_string(j, "brightness_file", s->brightness_file);
-  bb_json_bool(j, "brightness", s->use_brightness);
-  bb_json_string(j, "albedo_file", s->albedo_file);
-  bb_json_open(j, "light_color", '[');
+  bb__json_open(j, "params", '{');
+  bb__json_number(j, "scale", (double)b->height_scale);
+  bb__json_int(j, "rays", b->rays);
+  bb__json_int(j, "slices", b->slices);
+  bb__json_int(j, "slices_traced", bb_bake_slices(b));
+  bb__json_number(j, "bias", b->trace.bias_texels);
+  bb__json_number(j, "bounce", b->bounce_albedo);
+  bb__json_int(j, "bounces", b->bounces);
+  bb__json_string(j, "brightness_file", s->brightness_file);
+  bb__json_bool(j, "brightness", s->use_brightness);
+  bb__json_string(j, "albedo_file", s->albedo_file);
+  bb__json_open(j, "light_color", '[');
   for (int k = 0; k < 3; k++)
-    bb_json_number(j, NULL, (double)s->light_color[k]);
-  bb_json_close(j, ']');
-  bb_json_close(j, '}');
+    bb__json_number(j, NULL, (double)s->light_color[k]);
+  bb__json_close(j, ']');
+  bb__json_close(j, '}');
 }
 
-static void add_bake(bb_json *j, serve_bake *b) {
-  bb_json_open(j, "bake", '{');
-  bb_json_int(j, "id", b->id);
+static void add_bake(bb__json *j, serve_bake *b) {
+  bb__json_open(j, "bake", '{');
+  bb__json_int(j, "id", b->id);
   /* an edit of bake "base": its maps outside "changed" are that bake's
    * (map/NAME?since=BASE gives the rectangle alone); 0 when it is not */
-  bb_json_int(j, "base", b->base_id);
-  bb_json_open(j, "changed", '[');
+  bb__json_int(j, "base", b->base_id);
+  bb__json_open(j, "changed", '[');
   const bb_region edit = b->base_id ? b->changed : (bb_region){0, 0, b->width, b->height};
   const int where[4] = {edit.x0, edit.y0, edit.width, edit.height};
   for (int k = 0; k < 4; k++)
-    bb_json_int(j, NULL, where[k]);
-  bb_json_close(j, ']');
-  bb_json_int(j, "width", b->width);
-  bb_json_int(j, "height", b->height);
-  bb_json_number(j, "seconds", b->seconds);
+    bb__json_int(j, NULL, where[k]);
+  bb__json_close(j, ']');
+  bb__json_int(j, "width", b->width);
+  bb__json_int(j, "height", b->height);
+  bb__json_number(j, "seconds", b->seconds);
   const bb_job_report *r = &b->report;
-  bb_json_number(j, "seconds_load", r->seconds_load);
-  bb_json_number(j, "seconds_smooth", r->seconds_smooth);
-  bb_json_number(j, "seconds_pyramid", r->seconds_pyramid);
-  bb_json_number(j, "seconds_trace", r->seconds_trace);
-  bb_json_number(j, "seconds_bounce", r->seconds_bounce);
-  bb_json_number(j, "seconds_derive", r->seconds_derive);
-  bb_json_number(j, "seconds_textures", b->seconds_textures);
-  bb_json_int(j, "threads", r->threads);
-  bb_json_int(j, "slices", r->slices);
-  bb_json_number(j, "scale", b->scale);
-  bb_json_bool(j, "normal_y_up", b->normal_y_up);
+  bb__json_number(j, "seconds_load", r->seconds_load);
+  bb__json_number(j, "seconds_smooth", r->seconds_smooth);
+  bb__json_number(j, "seconds_pyramid", r->seconds_pyramid);
+  bb__json_number(j, "seconds_trace", r->seconds_trace);
+  bb__json_number(j, "seconds_bounce", r->seconds_bounce);
+  bb__json_number(j, "seconds_derive", r->seconds_derive);
+  bb__json_number(j, "seconds_textures", b->seconds_textures);
+  bb__json_int(j, "threads", r->threads);
+  bb__json_int(j, "slices", r->slices);
+  bb__json_number(j, "scale", b->scale);
+  bb__json_bool(j, "normal_y_up", b->normal_y_up);
   /* the page lights the ssbump with these directions (sat(sum_c s_c l.B_c)) */
-  bb_json_string(j, "basis", b->basis.name);
-  bb_json_int(j, "basis_count", b->basis.count);
-  bb_json_open(j, "basis_vectors", '[');
+  bb__json_string(j, "basis", b->basis.name);
+  bb__json_int(j, "basis_count", b->basis.count);
+  bb__json_open(j, "basis_vectors", '[');
   for (int c = 0; c < b->basis.count; c++) {
-    bb_json_open(j, NULL, '[');
+    bb__json_open(j, NULL, '[');
     for (int k = 0; k < 3; k++)
-      bb_json_number(j, NULL, b->basis.vector[c][k]);
-    bb_json_close(j, ']');
+      bb__json_number(j, NULL, b->basis.vector[c][k]);
+    bb__json_close(j, ']');
   }
-  bb_json_close(j, ']');
-  bb_json_bool(j, "albedo", b->tex[SERVE_TEX_ALBEDO] != NULL);
-  bb_json_string(j, "command", b->command);
-  bb_json_string(j, "provenance", b->provenance);
-  bb_json_close(j, '}');
+  bb__json_close(j, ']');
+  bb__json_bool(j, "albedo", b->tex[SERVE_TEX_ALBEDO] != NULL);
+  bb__json_string(j, "command", b->command);
+  bb__json_string(j, "provenance", b->provenance);
+  bb__json_close(j, '}');
 }
 
 /* The JSON text write(j, arg) makes, malloc'd; NULL when out of memory. */
-static char *json_text(void (*write)(bb_json *j, void *arg), void *arg) {
+static char *json_text(void (*write)(bb__json *j, void *arg), void *arg) {
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
   if (!f)
     return NULL;
-  bb_json j = {f, 0};
+  bb__json j = {f, 0};
   write(&j, arg);
   if (fclose(f) != 0) {
     free(text);
@@ -95,25 +97,25 @@ static char *json_text(void (*write)(bb_json *j, void *arg), void *arg) {
   return text;
 }
 
-static void write_state(bb_json *j, void *arg) {
+static void write_state(bb__json *j, void *arg) {
   serve_state *s = arg;
   pthread_mutex_lock(&s->lock);
   bb_job_options o;
   serve_job_options(s, &o);
   char *command = bb_job_command_text(&o, s->height_path);
-  bb_json_open(j, NULL, '{');
-  bb_json_string(j, "height", s->height_path);
-  bb_json_bool(j, "baking", s->baking);
-  bb_json_string(j, "stage", s->baking ? s->stage : NULL);
-  bb_json_number(j, "progress", s->progress);
+  bb__json_open(j, NULL, '{');
+  bb__json_string(j, "height", s->height_path);
+  bb__json_bool(j, "baking", s->baking);
+  bb__json_string(j, "stage", s->baking ? s->stage : NULL);
+  bb__json_number(j, "progress", s->progress);
   /* a save or a control asked for a bake not yet begun or done */
-  bb_json_bool(j, "pending", atomic_load(&s->wanted) != s->done);
-  bb_json_string(j, "error", s->error);
-  bb_json_string(j, "command", command);
+  bb__json_bool(j, "pending", atomic_load(&s->wanted) != s->done);
+  bb__json_string(j, "error", s->error);
+  bb__json_string(j, "command", command);
   add_params(j, s);
   if (s->current)
     add_bake(j, s->current);
-  bb_json_close(j, '}');
+  bb__json_close(j, '}');
   pthread_mutex_unlock(&s->lock);
   free(command);
 }
@@ -266,25 +268,25 @@ int serve_apply_params(serve_state *s, const char *const *names,
 /* One input's range as the library describes its option: "min" and
  * "max" where finite, "min_exclusive" when the bottom is not allowed
  * ("scale > 0"). An option without a numeric range writes nothing. */
-static void add_range(bb_json *j, const char *key, const char *command,
+static void add_range(bb__json *j, const char *key, const char *command,
                       const char *option) {
   const bb_option_info *o = bb_option_find(bb_command_info_find(command), option, 0);
   double min, max;
   int min_exclusive;
   if (!bb_option_bounds(o, &min, &max, &min_exclusive))
     return;
-  bb_json_open(j, key, '{');
+  bb__json_open(j, key, '{');
   if (isfinite(min))
-    bb_json_number(j, "min", min);
+    bb__json_number(j, "min", min);
   if (isfinite(max))
-    bb_json_number(j, "max", max);
-  bb_json_bool(j, "min_exclusive", min_exclusive);
-  bb_json_close(j, '}');
+    bb__json_number(j, "max", max);
+  bb__json_bool(j, "min_exclusive", min_exclusive);
+  bb__json_close(j, '}');
 }
 
-static void write_ranges(bb_json *j, void *arg) {
+static void write_ranges(bb__json *j, void *arg) {
   (void)arg;
-  bb_json_open(j, NULL, '{');
+  bb__json_open(j, NULL, '{');
   /* the bake controls: bake's options of their names */
   for (size_t i = 0; i < CONTROL_COUNT; i++)
     add_range(j, controls[i].name, "bake", controls[i].name);
@@ -293,7 +295,7 @@ static void write_ranges(bb_json *j, void *arg) {
   add_range(j, "view_elevation", "render", "view");
   add_range(j, "light_elevation", "render", "light");
   add_range(j, "light_color", "render", "light-color");
-  bb_json_close(j, '}');
+  bb__json_close(j, '}');
 }
 
 char *serve_ranges_json(void) {
