@@ -1543,10 +1543,6 @@ bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
  * extension), malloc'd; NULL when out of memory. */
 char *bb_path_with_suffix(const char *path, const char *suffix);
 
-/* The file -o PREFIX (bb_job_options.prefix) names for kind:
- * "PREFIX_KIND.png" for the kinds of BB_JOB_DEFAULT_MAPS, malloc'd; NULL for
- * another kind, a NULL prefix or out of memory. */
-char *bb_job_prefix_path(const char *prefix, bb_map_kind kind);
 
 /* ------------------------------------------------------- writing outputs */
 
@@ -1897,7 +1893,7 @@ typedef struct bb_job_options {
 void bb_job_options_init(bb_job_options *o);
 
 /* The file a bake with options o writes for map kind, the one rule for
- * it: o->paths[kind] when named, else -o PREFIX's bb_job_prefix_path for
+ * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
  * the kinds of BB_JOB_DEFAULT_MAPS, else none. *path is a malloc'd copy,
  * or NULL for none; BB_ERR_MEMORY when out of memory. */
 bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err);

@@ -116,3 +116,4 @@ s/\bbb_vmt_text\b/bb__vmt_text/g
 # The JSON writer leaves the ABI (src/core/json.h; the CLI compiles json.c into itself).
 s/\bbb_json\b/bb__json/g
 s/\bbb_json_(open|close|string|number|int|bool)\b/bb__json_\1/g
+s/\bbb_job_prefix_path\b/bb__job_prefix_path/g

@@ -24,6 +24,11 @@ char *bb__job_valve_weights_name(const char *input);
  * "PATH: cannot write: ...". */
 bb_status bb__check_output_directory(const char *path, bb_error *err);
 
+/* The file -o PREFIX (bb_job_options.prefix) names for kind:
+ * "PREFIX_KIND.png" for the kinds of BB_JOB_DEFAULT_MAPS, malloc'd; NULL for
+ * another kind, a NULL prefix or out of memory (bb_job_map_file's rule). */
+char *bb__job_prefix_path(const char *prefix, bb_map_kind kind);
+
 /* ------------------------------------------------------------ the bounce */
 
 /* The rho a bake bounces with, the job's one rule for it: the rho asked,

@@ -30,7 +30,7 @@ char *bb_path_with_suffix(const char *path, const char *suffix) {
   return out;
 }
 
-char *bb_job_prefix_path(const char *prefix, bb_map_kind kind) {
+char *bb__job_prefix_path(const char *prefix, bb_map_kind kind) {
   if (!prefix || (unsigned)kind >= BB_MAP_BAKED_COUNT || !(BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(kind)))
     return NULL;
   const char *name = bb_map_kind_get(kind)->name;
@@ -48,7 +48,7 @@ bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path
   if (o->paths[kind])
     *path = strdup(o->paths[kind]);
   else if (o->prefix && (BB_JOB_DEFAULT_MAPS & BB_MAP_BIT(kind)))
-    *path = bb_job_prefix_path(o->prefix, kind);
+    *path = bb__job_prefix_path(o->prefix, kind);
   else
     return BB_OK;
   return *path ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");

@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "bake/bake_internal.h"
+#include "job/job_internal.h"
 #include "file_bytes.h"
 #include "trace/basis.h"
 
@@ -325,14 +326,14 @@ Test(job, prefix_and_suffix_names) {
                {BB_MAP_AO, "out/r_ao.png"},         {BB_MAP_BENT, NULL},
                {BB_MAP_FILTERED, NULL},             {BB_MAP_SLOPE, NULL}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    char *got = bb_job_prefix_path("out/r", cases[i].kind);
+    char *got = bb__job_prefix_path("out/r", cases[i].kind);
     if (cases[i].want)
       cr_expect_str_eq(got ? got : "(null)", cases[i].want);
     else
       cr_expect_null(got, "kind %d", (int)cases[i].kind);
     free(got);
   }
-  cr_expect_null(bb_job_prefix_path(NULL, BB_MAP_NORMAL));
+  cr_expect_null(bb__job_prefix_path(NULL, BB_MAP_NORMAL));
   static const char *const suffixed[][3] = {{"rock.png", "-ssbump.tga", "rock-ssbump.tga"},
                                             {"a.b/rock", "_x", "a.b/rock_x"},
                                             {"d/.png", "", "d/.png"},
