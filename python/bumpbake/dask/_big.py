@@ -457,7 +457,7 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
                 not os.fsdecode(basis).startswith("dirs:"):
             task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
         slices = _lib_slices(task_options)
-        task.update(scale=args["scale"], channel=args["channel"], options=task_options)
+        task.update(scale=args.get("scale"), channel=args.get("channel"), options=task_options)
     tasks = max(1, (slices + 1) // 2)
     if horizon_threads is None:
         horizon_threads = max(1, worker_threads(client) // tasks)
