@@ -1,5 +1,6 @@
-/* results.c: what a run wrote (bb_command_result). */
+/* results.c: what a run wrote or found (bb_command_result). */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +29,14 @@ void bb_command_result_free(bb_command_result *r) {
     free((char *)r->files[i].path);
   }
   free(r->files);
+  if (r->compare) {
+    bb__compare_report_free((bb_compare_report *)r->compare);
+    free((bb_compare_report *)r->compare);
+  }
+  bb__info_files_free((bb_info_file *)r->info, r->info_count);
+  for (int i = 0; i < r->print_count; i++)
+    free(r->prints[i].text);
+  free((bb_command_print *)r->prints);
   memset(r, 0, sizeof *r);
 }
 

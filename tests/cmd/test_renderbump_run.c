@@ -18,6 +18,7 @@
 #include "file_bytes.h"
 #include "scratch_dir.h"
 #include "image/image_write.h"
+#include "job/job_internal.h"
 #include "mesh/mesh_internal.h"
 
 static void setup(void) {
@@ -272,10 +273,10 @@ Test(renderbump_run, the_diff_is_float_in_exr_and_scaled_elsewhere) {
   for (int k = 0; k < 2; k++) {
     bb_compare_report r;
     bb_error err = {{0}};
-    cr_assert_eq(bb_compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s",
+    cr_assert_eq(bb__compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s",
                  err.message);
     cr_expect(r.diff_written, "%s", r.diff_error.message);
-    bb_compare_report_free(&r);
+    bb__compare_report_free(&r);
     bb_image img;
     bb_image_info info = {0};
     cr_assert_eq(bb_image_read(diffs[k], &img, &info, &err), BB_OK, "%s", err.message);
