@@ -188,8 +188,6 @@ bb_status bb__run_info(bb_command *c, const bb_command_hooks *hooks, bb_command_
                        bb_error *err);
 bb_status bb__compare_prints(const bb_command *c, bb_command_result *r, bb_error *err);
 bb_status bb__info_prints(const bb_command *c, bb_command_result *r, bb_error *err);
-/* Frees info's files (run_files.c). */
-void bb__info_files_free(bb_info_file *files, int count);
 /* printf to f and a newline, cut at 4095 bytes and made printable
  * (bb_text_printable), as the command line prints a line (report_files.c). */
 void bb__print_line(FILE *f, const char *fmt, ...)

@@ -21,6 +21,20 @@ bb_status bb__result_add(bb_command_result *r, const char *kind, const char *pat
   return BB_OK;
 }
 
+static void info_files_free(bb_info_file *files, int count) {
+  for (int i = 0; files && i < count; i++) {
+    bb_info_file *f = &files[i];
+    free((char *)f->error);
+    free((bb_provenance_entry *)f->provenance_entries);
+    bb_image_info_free(&f->image);
+    if (f->vtf)
+      bb_vtf_info_free((bb_vtf_info *)f->vtf);
+    free((bb_vtf_info *)f->vtf);
+    free((bb_dds_info *)f->dds);
+  }
+  free(files);
+}
+
 void bb_command_result_free(bb_command_result *r) {
   if (!r)
     return;
@@ -33,7 +47,7 @@ void bb_command_result_free(bb_command_result *r) {
     bb__compare_report_free((bb_compare_report *)r->compare);
     free((bb_compare_report *)r->compare);
   }
-  bb__info_files_free((bb_info_file *)r->info, r->info_count);
+  info_files_free((bb_info_file *)r->info, r->info_count);
   for (int i = 0; i < r->print_count; i++)
     free(r->prints[i].text);
   free((bb_command_print *)r->prints);

@@ -102,17 +102,3 @@ bb_status bb__run_info(bb_command *c, const bb_command_hooks *hooks, bb_command_
   }
   return bb__info_prints(c, r, err);
 }
-
-void bb__info_files_free(bb_info_file *files, int count) {
-  for (int i = 0; files && i < count; i++) {
-    bb_info_file *f = &files[i];
-    free((char *)f->error);
-    free((bb_provenance_entry *)f->provenance_entries);
-    bb_image_info_free(&f->image);
-    if (f->vtf)
-      bb_vtf_info_free((bb_vtf_info *)f->vtf);
-    free((bb_vtf_info *)f->vtf);
-    free((bb_dds_info *)f->dds);
-  }
-  free(files);
-}
