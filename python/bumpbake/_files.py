@@ -7,9 +7,9 @@ import typing
 
 from ._bake import _KINDS
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _check_notes, _depth,
-                      _dispatch_notes, _exception, _ffi, _lib, _note_text, _path, _shown,
-                      _text, _texture_options)
+from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _check,
+                      _check_notes, _depth, _dispatch_notes, _exception, _ffi, _lib, _path,
+                      _shown, _text, _texture_options)
 
 
 def read(path):
@@ -59,15 +59,11 @@ def _run_files(command, *inputs, options=None, notes="ignore", stacklevel=2):
     c.set_all(options or {}, skip_default=True)
     c.check()  # the limits by their one rule, a diff's path against the inputs
     _check_notes(notes)
-    heard = []
-    note = _ffi.callback("bb_note_fn",
-                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
-    hooks = _ffi.new("bb_command_hooks *")
-    hooks.note = note
+    hooks = _NoteHooks()
     result = _ffi.new("bb_command_result *")
     err = _ffi.new("bb_error *")
-    st = _lib.bb_command_run(c.handle, hooks, result, err)
-    _dispatch_notes(heard, notes, stacklevel=stacklevel + 1)
+    st = _lib.bb_command_run(c.handle, hooks.hooks, result, err)
+    _dispatch_notes(hooks.heard, notes, stacklevel=stacklevel + 1)
     _check(st, err)  # a file that cannot be read (the message names it)
     return result
 

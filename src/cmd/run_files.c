@@ -60,28 +60,25 @@ static bb_status info_file(const char *path, bb_info_file *f, bb_error *err) {
   }
   /* A texture whose own header cannot be read is described as the image
    * reader saw it. */
-  if (strcmp(f->image.format_name, "vtf") == 0) {
-    bb_vtf_info *v = calloc(1, sizeof *v);
-    if (!v)
-      return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-    if (bb_vtf_read_info(path, v, &e) == BB_OK) {
-      f->vtf = v;
-      for (int bit = 0; bit < 32; bit++)
-        f->flag_names[bit] = v->flags & (1u << bit) ? bb__vtf_flag_name(bit) : NULL;
-    } else
-      free(v);
+  const int vtf = !strcmp(f->image.format_name, "vtf"), dds = !strcmp(f->image.format_name, "dds");
+  if (!vtf && !dds)
+    return BB_OK;
+  void *header = calloc(1, vtf ? sizeof(bb_vtf_info) : sizeof(bb_dds_info));
+  if (!header)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  if ((vtf ? bb_vtf_read_info(path, header, &e) : bb_dds_read_info(path, header, &e)) != BB_OK) {
+    free(header);
+    return BB_OK;
   }
-  if (strcmp(f->image.format_name, "dds") == 0) {
-    bb_dds_info *d = calloc(1, sizeof *d);
-    if (!d)
-      return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-    if (bb_dds_read_info(path, d, &e) == BB_OK) {
-      f->dds = d;
-      for (int bit = 0; bit < 32; bit++)
-        f->flag_names[bit] = d->pixel_flags & (1u << bit) ? bb__dds_pixel_flag_name(bit) : NULL;
-    } else
-      free(d);
-  }
+  const uint32_t flags = vtf ? ((bb_vtf_info *)header)->flags : ((bb_dds_info *)header)->pixel_flags;
+  for (int bit = 0; bit < 32; bit++)
+    f->flag_names[bit] = !(flags & (1u << bit)) ? NULL
+                         : vtf                  ? bb__vtf_flag_name(bit)
+                                                : bb__dds_pixel_flag_name(bit);
+  if (vtf)
+    f->vtf = header;
+  else
+    f->dds = header;
   return BB_OK;
 }
 

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 
 #include "bumpbake.h"
+#include "command_words.h"
 #include "scratch_dir.h"
 
 static void setup(void) {
@@ -51,28 +52,21 @@ static const char *write_image(const char *name, int width, int height, int chan
   return path;
 }
 
-/* The command name with words: inputs, and "--option", "value" pairs (a
- * flag's value NULL), checked. */
-static bb_command *command(const char *name, const char *const *words, int count) {
-  bb_command *c = NULL;
+/* The command name with words (command_words.h), checked and run. */
+static bb_command *run(const char *name, const char *const *words, bb_command_result *r) {
+  bb_command *c = command(name, words);
   bb_error err = {{0}};
-  cr_assert_eq(bb_command_new(name, &c, &err), BB_OK, "%s", err.message);
-  for (int i = 0; i < count; i++) {
-    if (words[i][0] != '-') {
-      cr_assert_eq(bb_command_add_input(c, words[i], &err), BB_OK, "%s", err.message);
-      continue;
-    }
-    cr_assert_eq(bb_command_set(c, words[i] + 2, words[i + 1], &err), BB_OK, "%s: %s",
-                 words[i], err.message);
-    i++;
-  }
   cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_run(c, NULL, r, &err), BB_OK, "%s", err.message);
   return c;
 }
 
-static void run(bb_command *c, bb_command_result *r) {
-  bb_error err = {{0}};
-  cr_assert_eq(bb_command_run(c, NULL, r, &err), BB_OK, "%s", err.message);
+/* a.exr, 4 x 3 x 2 of 0.5, and b.exr of bw x bh x bc, 0.5 but for sample
+ * (2, 1, bc - 1) at 0.5 + bump. */
+static void pair(const char **a, const char **b, int bw, int bh, int bc, float bump) {
+  *a = write_image("a.exr", 4, 3, 2, 0.5f, 0, 0, 0, 0, "colour", NULL);
+  *b = write_image("b.exr", bw, bh, bc, 0.5f, bw > 2 ? 2 : 0, bh > 1 ? 1 : 0, bc - 1, bump,
+                   "colour", NULL);
 }
 
 static int starts_with(const char *s, const char *prefix) {
@@ -89,11 +83,10 @@ static int ends_with(const char *s, const char *suffix) {
 /* One sample of 4 x 3 x 2 off by 0.25: the statistics, idiff's verdict and
  * exit code as data, and the text the command line prints from them. */
 Test(run_files, compare_keeps_its_statistics_and_verdict_as_data) {
-  const char *a = write_image("a.exr", 4, 3, 2, 0.5f, 0, 0, 0, 0, "colour", NULL);
-  const char *b = write_image("b.exr", 4, 3, 2, 0.5f, 2, 1, 1, 0.25f, "colour", NULL);
-  bb_command *c = command("compare", (const char *const[]){a, b}, 2);
+  const char *a, *b;
+  pair(&a, &b, 4, 3, 2, 0.25f);
   bb_command_result r;
-  run(c, &r);
+  bb_command *c = run("compare", (const char *const[]){a, b, NULL}, &r);
   cr_assert_not_null(r.compare);
   const bb_compare_report *k = r.compare;
   cr_expect_eq(k->same_shape, 1);
@@ -131,15 +124,14 @@ Test(run_files, compare_keeps_its_statistics_and_verdict_as_data) {
 /* The same pair under -failpercent 10 passes (1 pixel of 12 fails), as one
  * JSON line; -q prints nothing; the diff is written and listed. */
 Test(run_files, compare_limits_json_quiet_and_diff) {
-  const char *a = write_image("a.exr", 4, 3, 2, 0.5f, 0, 0, 0, 0, "colour", NULL);
-  const char *b = write_image("b.exr", 4, 3, 2, 0.5f, 2, 1, 1, 0.25f, "colour", NULL);
+  const char *a, *b;
+  pair(&a, &b, 4, 3, 2, 0.25f);
   const char *diff = in_scratch_dir("d.exr");
-  bb_command *c = command("compare",
-                          (const char *const[]){a, b, "--failpercent", "10", "--warnpercent",
-                                                "10", "--json", NULL, "--diff", diff},
-                          10);
   bb_command_result r;
-  run(c, &r);
+  bb_command *c = run("compare",
+                      (const char *const[]){a, b, "--failpercent", "10", "--warnpercent", "10",
+                                            "--json", "1", "--diff", diff, NULL},
+                      &r);
   cr_expect_eq(r.compare->verdict, BB_COMPARE_PASS);
   cr_expect_str_eq(r.compare->result, "PASS");
   cr_expect_eq(r.exit_code, 0);
@@ -158,8 +150,7 @@ Test(run_files, compare_limits_json_quiet_and_diff) {
   bb_command_result_free(&r);
   bb_command_free(c);
 
-  c = command("compare", (const char *const[]){a, b, "--quiet", NULL}, 4);
-  run(c, &r);
+  c = run("compare", (const char *const[]){a, b, "--quiet", "1", NULL}, &r);
   cr_expect_eq(r.exit_code, 2);
   cr_expect_eq(r.print_count, 0);
   bb_command_result_free(&r);
@@ -169,11 +160,10 @@ Test(run_files, compare_limits_json_quiet_and_diff) {
 /* Different sizes are a report, not an error: exit 3, the error line
  * naming both sizes, and nothing else compared. */
 Test(run_files, compare_of_different_sizes_is_a_report) {
-  const char *a = write_image("a.exr", 4, 3, 2, 0.5f, 0, 0, 0, 0, "colour", NULL);
-  const char *b = write_image("b.exr", 2, 2, 1, 0.5f, 0, 0, 0, 0, "colour", NULL);
-  bb_command *c = command("compare", (const char *const[]){a, b}, 2);
+  const char *a, *b;
+  pair(&a, &b, 2, 2, 1, 0);
   bb_command_result r;
-  run(c, &r);
+  bb_command *c = run("compare", (const char *const[]){a, b, NULL}, &r);
   cr_expect_eq(r.compare->same_shape, 0);
   cr_expect_eq(r.compare->b_width, 2);
   cr_expect_eq(r.compare->b_channels, 1);
@@ -193,9 +183,10 @@ Test(run_files, compare_of_different_sizes_is_a_report) {
 Test(run_files, compare_of_an_unreadable_file_fails_naming_it) {
   const char *a = write_image("a.exr", 4, 3, 2, 0.5f, 0, 0, 0, 0, "colour", NULL);
   const char *missing = in_scratch_dir("missing.exr");
-  bb_command *c = command("compare", (const char *const[]){a, missing}, 2);
+  bb_command *c = command("compare", (const char *const[]){a, missing, NULL});
   bb_command_result r;
   bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
   cr_expect_eq(bb_command_run(c, NULL, &r, &err), BB_ERR_IO);
   cr_expect(strstr(err.message, missing), "%s", err.message);
   cr_expect_null(r.compare);
@@ -213,9 +204,8 @@ Test(run_files, info_keeps_each_files_header_and_provenance) {
                               "bumpbake_version=0.4.0\ncommand=x\nscale=8\nscale=9\n");
   const char *missing = in_scratch_dir("missing.png");
   const char *q = write_image("q.png", 2, 2, 3, 0.5f, 0, 0, 0, 0, "colour", "made elsewhere");
-  bb_command *c = command("info", (const char *const[]){p, missing, q}, 3);
   bb_command_result r;
-  run(c, &r);
+  bb_command *c = run("info", (const char *const[]){p, missing, q, NULL}, &r);
   cr_assert_eq(r.info_count, 3);
   const bb_info_file *f = &r.info[0];
   cr_expect_str_eq(f->path, p);
@@ -260,8 +250,7 @@ Test(run_files, info_keeps_each_files_header_and_provenance) {
   bb_command_free(c);
 
   /* --json: a line per file, the missing one's saying so */
-  c = command("info", (const char *const[]){missing, p, "--json", NULL}, 4);
-  run(c, &r);
+  c = run("info", (const char *const[]){missing, p, "--json", "1", NULL}, &r);
   cr_assert_eq(r.print_count, 3);
   cr_expect_eq(r.prints[0].error, 1);
   char line[1024];
@@ -277,9 +266,8 @@ Test(run_files, info_keeps_each_files_header_and_provenance) {
 /* A VTF's header and the names of its flags, by bit. */
 Test(run_files, info_names_a_vtfs_flags_by_bit) {
   const char *v = write_image("s.vtf", 4, 4, 3, 0.5f, 0, 0, 0, 0, "ssbump", NULL);
-  bb_command *c = command("info", (const char *const[]){v}, 1);
   bb_command_result r;
-  run(c, &r);
+  bb_command *c = run("info", (const char *const[]){v, NULL}, &r);
   const bb_info_file *f = &r.info[0];
   cr_assert_not_null(f->vtf);
   cr_expect_null(f->dds);
