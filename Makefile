@@ -141,8 +141,9 @@ TOOL_C   := $(filter-out tools/link_probe.c,$(wildcard tools/*.c))
 LIB_OBJ  := $(LIB_C:%.c=$(BUILD)/%.o) $(LIB_CXX:%.cpp=$(BUILD)/%.o)
 # The JSON writer is no part of the library's ABI: the CLI compiles its one
 # source, src/core/json.c (which includes nothing of the library), into
-# itself as cli/json.o; its compare, info and serve include src/core/json.h
-# by its relative path.
+# itself as cli/json.o for serve, which includes src/core/json.h by its
+# relative path (compare and info print the library's report, which the
+# library writes).
 CLI_JSON_OBJ := $(BUILD)/src/cli/json.o
 CLI_OBJ  := $(CLI_C:%.c=$(BUILD)/%.o) $(CLI_JSON_OBJ)
 TEST_OBJ := $(TEST_C:%.c=$(BUILD)/%.o)

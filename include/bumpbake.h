@@ -332,16 +332,6 @@ typedef struct bb_provenance_entry {
   size_t value_length;
 } bb_provenance_entry;
 
-/* The one reading of a provenance text, which every reader uses (the
- * values and diffs below, the up-to-date check, `bumpbake info --json`,
- * Python's bumpbake.info): a line ends at '\n', and a '\r' before it is
- * dropped (a text re-saved on Windows); its key is what comes before its
- * first '=', its value what follows; a line without '=' is skipped; a key
- * seen before keeps its first value (its later lines are skipped). Fills
- * entries with up to cap of them, in line order; returns how many there are
- * (which may exceed cap), or -1 when out of memory. Time O(n log n) in the
- * lines. */
-long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 
 /* =====================================================================
  * texture: engine textures (VTF, DDS) and Source materials, which
@@ -485,16 +475,6 @@ typedef struct bb_dds_info {
  * BB_ERR_FORMAT (not a DDS, truncated, a format bumpbake does not read),
  * BB_ERR_SIZE (zero or over BB_MAX_DIMENSION a side). Nothing to free. */
 bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
-
-/* The name of DDS_PIXELFORMAT flag bit `bit` (0..31) without its DDPF_
- * prefix ("ALPHAPIXELS", "FOURCC", "RGB", "LUMINANCE"; bit 31 NVIDIA's
- * "NORMAL"), or NULL for an unused bit or one out of range. */
-const char *bb_dds_pixel_flag_name(int bit);
-
-/* Valve's name of the TEXTUREFLAGS_* bit `bit` (0..31) as Source SDK 2013
- * spells it without the prefix ("CLAMPS", "NORMAL", "SSBUMP"), or NULL for
- * an unused bit or one out of range. */
-const char *bb_vtf_flag_name(int bit);
 
 /* ------------------------------------------------- Source materials */
 
@@ -1618,7 +1598,8 @@ const char *bb_height_source_channel(const bb_height_source *source);
 
 /* --------------------------------------------------------- comparing files */
 
-/* What comparing two image files found (bb_compare_files). */
+/* What comparing two image files found (compare's bb_command_run:
+ * bb_command_result.compare). */
 typedef struct bb_compare_report {
   int same_shape;             /* 0: sizes or channel counts differ; nothing
                                  else was compared (idiff's exit 3) */
@@ -1634,52 +1615,23 @@ typedef struct bb_compare_report {
                                  (bb__provenance_diff), malloc'd, or NULL */
   int diff_written;           /* 1 when diff_path was written */
   bb_error diff_error;        /* why it was not, when asked */
+  const char *result;         /* idiff's word for the outcome, as `bumpbake
+                                 compare` prints it: "PASS", "WARNING",
+                                 "FAILURE", or "DIFFERENT SIZE" (static) */
 } bb_compare_report;
 
-/* Compares the image files a and b channel by channel under limits (NULL:
- * idiff's defaults; checked by bb__compare_limits_check before any read),
- * as OpenImageIO's idiff does, and their provenance key
- * by key. With diff_path (may be NULL; check it first with
- * bb_outputs_check), writes |A - B| there: raw in .exr, scaled elsewhere so
- * the largest finite difference is white (NaN and infinite ones clip to
- * 1). A diff that cannot be written does not change the verdict: the
- * report says so. Errors: those of bb_image_read for either file (the
- * message names it), BB_ERR_MEMORY. Free the report with
- * bb_compare_report_free. */
-bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
-                           const char *diff_path, bb_compare_report *report, bb_error *err);
-
-/* What bb_compare_files(a, b, ..., diff_path) will take, from the two
- * headers alone, before a pixel is read: the memory at its peak (A held
- * while B is read, then, with a diff, both, |A - B| and its encoder's
- * copy), refused when it will not fit (BB_ERR_MEMORY: "A: comparing two
- * 16384 x 16384 images of 4 channels needs about 12.6 GiB of memory; 2.4
- * GiB is available (RLIMIT_AS)"), and said through note (may be NULL),
- * naming a, when it is over BB_MAX_READ_BYTES ("comparing ... takes about
- * 12.6 GiB of memory (20.1 GiB is available)"). bb_compare_files makes the
- * same check first, without the note. Errors: the header reads'. */
-bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
-                                 bb_note_fn note, void *note_user, bb_error *err);
-
-void bb_compare_report_free(bb_compare_report *report);
-
-/* idiff's exit code for a report, which `bumpbake compare` exits with: the
- * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
- * the sizes or channel counts differ. An unreadable file (bb_compare_files
- * failing) is no report: idiff's BB_COMPARE_CANNOT_READ, which compare's
- * usage errors exit with too (bb_command_info.usage_exit). */
+/* idiff's exit codes beside a comparison's verdicts (bb_compare_verdict):
+ * BB_COMPARE_DIFFERENT_SIZE when the sizes or channel counts differ (a
+ * report: bb_command_result.exit_code), BB_COMPARE_CANNOT_READ when a file
+ * cannot be read (no report: bb_command_run fails), which compare's usage
+ * errors exit with too (bb_command_info.usage_exit). */
 #define BB_COMPARE_DIFFERENT_SIZE 3
 #define BB_COMPARE_CANNOT_READ 4
-int bb_compare_report_exit_code(const bb_compare_report *report);
-
-/* idiff's word for a report's outcome, as `bumpbake compare` prints it:
- * "PASS", "WARNING", "FAILURE", or "DIFFERENT SIZE". Static text. */
-const char *bb_compare_report_result(const bb_compare_report *report);
 
 /* ---------------------------------------------------------- golden suites */
 
 /* A suite check (`bumpbake check`): every map of a suite compared with its
- * golden, as bb_compare_files compares two files, in one run: a tree of new
+ * golden, as compare compares two files, in one run: a tree of new
  * files against a tree of goldens by relative name, or a batch baked in
  * memory (bake --out-dir GOLDEN's maps, nothing written) against the files
  * it would write. Each map is a case with idiff's verdict under limits
@@ -2423,7 +2375,39 @@ bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 
-/* What a command's run wrote. */
+/* What `info` found of one file (bb_command_result.info): what its header
+ * says, or why it could not be read. Owned by the result. */
+typedef struct bb_info_file {
+  const char *path;            /* the input, as given */
+  bb_status status;            /* BB_OK, or why the header could not be read */
+  const char *error;           /* then the reason, naming the file; else NULL */
+  int width, height, channels;
+  bb_image_info image;         /* format, sample type, alpha channel; description:
+                                  the text stored (provenance or another tool's) */
+  bb_provenance_class provenance; /* of image.description */
+  int provenance_count;        /* intact provenance: its key=value lines, as
+                                  provenance is read (a key seen again keeps its
+                                  first value); else 0 */
+  const bb_provenance_entry *provenance_entries; /* into image.description */
+  const bb_vtf_info *vtf;      /* a VTF's header (bb_vtf_read_info), else NULL */
+  const bb_dds_info *dds;      /* a DDS's header (bb_dds_read_info), else NULL */
+  const char *flag_names[32];  /* of the VTF's flags or the DDS's pixel format
+                                  flags: each bit's name when set and named,
+                                  else NULL (static text) */
+} bb_info_file;
+
+/* A piece of what a command-line client prints of a run, in order
+ * (bb_command_result.prints). */
+typedef struct bb_command_print {
+  int error;        /* 0: lines for stdout, made printable (control characters
+                       escaped), each ending in '\n'; 1: a one-line message
+                       for stderr, after the client's name ("bumpbake: ") */
+  const char *path; /* an error about this file, which the client names
+                       before text unless text starts with it; or NULL */
+  char *text;
+} bb_command_print;
+
+/* What a command's run wrote, or found. */
 typedef struct bb_command_result {
   int file_count;
   bb_job_file *files;    /* what was written, in order: kind ("normal", "render",
@@ -2432,18 +2416,36 @@ typedef struct bb_command_result {
                             the one GIF); 0 for one picture */
   int labels_drawn;      /* 0 when a picture's labels could not be drawn (no font:
                             render --compare, sheet); else 1 */
+  int exit_code;         /* the command line's exit code for what was found:
+                            compare's idiff code (0 pass, 1 warning, 2 failure,
+                            BB_COMPARE_DIFFERENT_SIZE), info's 1 when a file
+                            could not be read; else 0 */
+  const bb_compare_report *compare; /* compare: what it found; else NULL */
+  int info_count;        /* info: a file each input, in order */
+  const bb_info_file *info;
+  int print_count;       /* compare, info: what the command line prints of the
+                            report, text or one JSON line (per file for info)
+                            as options.json says, none of it with quiet but
+                            the errors; owned by the result */
+  const bb_command_print *prints;
 } bb_command_result;
 
-/* Runs a checked command that writes files, as the command line runs it:
- * those through the job (bake, normal, height2ssbump) are planned and run
- * (stopping at the first failing input; bb_command_plan and bb_job_run for
- * each input's report); render, sheet, normal2ssbump, ssbump2normal,
- * combine, program and renderbumpflat read their inputs, make their
- * picture, map or render bump and write it all or nothing with provenance (its command the record, else
- * bb_command_text's). hooks may be NULL. Fills result (free it with
- * bb_command_result_free) on success. Errors name the file: those of the
- * reads, the bake and the writes; BB_ERR_ARGUMENT for an unchecked command
- * or one that writes nothing (compare, info). */
+/* Runs a checked command as the command line runs it: those through the
+ * job (bake, normal, height2ssbump) are planned and run (stopping at the
+ * first failing input; bb_command_plan and bb_job_run for each input's
+ * report); render, sheet, normal2ssbump, ssbump2normal, combine, program
+ * and renderbumpflat read their inputs, make their picture, map or render
+ * bump and write it all or nothing with provenance (its command the
+ * record, else bb_command_text's); compare compares A and B as idiff does
+ * (what it will take said first through hooks->note when that is much;
+ * result.compare, result.exit_code, its --diff in files), and info reads
+ * each file's header (result.info; a file that cannot be read is reported
+ * there, not an error): both with their report rendered as the command
+ * line prints it (result.prints). hooks may be NULL. Fills result (free it
+ * with bb_command_result_free) on success. Errors name the file: those of
+ * the reads, the bake and the writes (compare: a file that cannot be read,
+ * idiff's BB_COMPARE_CANNOT_READ); BB_ERR_ARGUMENT for an unchecked command
+ * or one that runs nothing (serve); BB_ERR_MEMORY. */
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,
                          bb_command_result *result, bb_error *err);
 void bb_command_result_free(bb_command_result *result);
@@ -2492,8 +2494,6 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
 bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 /* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
 const char *bb_job_outcome_name(bb_job_outcome outcome);
-/* "none", "intact", "damaged"; "unknown" else. */
-const char *bb_provenance_class_name(bb_provenance_class c);
 
 #ifdef __cplusplus
 }

@@ -451,6 +451,7 @@ typedef struct bb_compare_report {
   char *provenance_diff;
   int diff_written;
   bb_error diff_error;
+  const char *result;
 } bb_compare_report;
 
 typedef enum bb_check_status {
@@ -642,11 +643,37 @@ typedef struct bb_command_hooks {
   void *trace_user;
 } bb_command_hooks;
 
+typedef struct bb_info_file {
+  const char *path;
+  bb_status status;
+  const char *error;
+  int width, height, channels;
+  bb_image_info image;
+  bb_provenance_class provenance;
+  int provenance_count;
+  const bb_provenance_entry *provenance_entries;
+  const bb_vtf_info *vtf;
+  const bb_dds_info *dds;
+  const char *flag_names[32];
+} bb_info_file;
+
+typedef struct bb_command_print {
+  int error;
+  const char *path;
+  char *text;
+} bb_command_print;
+
 typedef struct bb_command_result {
   int file_count;
   bb_job_file *files;
   int frames;
   int labels_drawn;
+  int exit_code;
+  const bb_compare_report *compare;
+  int info_count;
+  const bb_info_file *info;
+  int print_count;
+  const bb_command_print *prints;
 } bb_command_result;
 """
 
@@ -661,19 +688,12 @@ void bb_image_free(bb_image *img);
 void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
-bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
-                             bb_image_info *info, bb_error *err);
 bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
 bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
 bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
 bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 void bb_texture_options_init(bb_texture_options *options);
-bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
-void bb_vtf_info_free(bb_vtf_info *info);
-bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
-const char *bb_dds_pixel_flag_name(int bit);
-const char *bb_vtf_flag_name(int bit);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
@@ -740,7 +760,6 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
 void bb_renderbump_result_free(bb_renderbump_result *r);
-bb_provenance_class bb_provenance_classify(const char *description);
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
@@ -748,13 +767,6 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
                               bb_note_fn note, void *note_user, bb_image *height,
                               bb_height_source *source, bb_error *err);
 const char *bb_height_source_channel(const bb_height_source *source);
-bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
-                           const char *diff_path, bb_compare_report *report, bb_error *err);
-bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
-                                 bb_note_fn note, void *note_user, bb_error *err);
-void bb_compare_report_free(bb_compare_report *report);
-int bb_compare_report_exit_code(const bb_compare_report *report);
-const char *bb_compare_report_result(const bb_compare_report *report);
 void bb_check_free(bb_check *check);
 int bb_check_input_count(const bb_check *check);
 const char *bb_check_input(const bb_check *check, int i);
@@ -823,7 +835,6 @@ bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
-long bb_provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
 /* what a job prints (bumpbake bake --scheduler) */
 char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
                           const char *extra_json);

@@ -60,6 +60,20 @@ def _dispatch_notes(notes, policy, stacklevel):
             policy(line)
 
 
+class _NoteHooks:
+    """bb_command_hooks whose notes gather in heard ("PATH: text"), for a
+    call that dispatches them after (_dispatch_notes); keep it alive for
+    the call (it holds its callback)."""
+
+    def __init__(self):
+        self.heard = []
+        self.note = _ffi.callback(
+            "bb_note_fn",
+            lambda user, p, text: self.heard.append(_note_text(_text(p), _text(text))))
+        self.hooks = _ffi.new("bb_command_hooks *")
+        self.hooks.note = self.note
+
+
 def _check_notes(notes):
     if notes not in ("warn", "ignore") and not callable(notes):
         raise _argument_error(f"notes must be 'warn', 'ignore' or a callable (got {_shown(notes)})")

@@ -7,9 +7,9 @@ import typing
 
 from ._bake import _KINDS
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _check_notes, _depth,
-                      _dispatch_notes, _ffi, _lib, _note_text, _path, _shown, _text,
-                      _texture_options)
+from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _check,
+                      _check_notes, _depth, _dispatch_notes, _exception, _ffi, _lib, _path,
+                      _shown, _text, _texture_options)
 
 
 def read(path):
@@ -47,14 +47,31 @@ _PROVENANCE_CLASSES = {_lib.BB_PROVENANCE_NONE: "none", _lib.BB_PROVENANCE_INTAC
                        _lib.BB_PROVENANCE_DAMAGED: "damaged"}
 
 
-def _provenance_dict(text):
-    """The key=value lines of intact provenance as {key: value}, values as
-    written (strings), by the library's one reading (bb_provenance_entries),
-    as `bumpbake info --json` prints them."""
-    raw = text.encode("utf-8", "surrogateescape")
-    count = _lib.bb_provenance_entries(raw, _ffi.NULL, 0)
-    entries = _ffi.new("bb_provenance_entry[]", max(count, 1))
-    count = _lib.bb_provenance_entries(raw, entries, count)
+def _run_files(command, *inputs, options=None, notes="ignore", stacklevel=2):
+    """Runs compare or info through the library as the command line runs
+    them (bb_command_run) and hands (command, result) to the caller, who
+    reads the report's data (result.compare, result.info) and frees the
+    result (bb_command_result_free). options: keywords checked by the
+    library; notes: what the run says first (bake_file()'s policy)."""
+    c = Command(command)
+    for p in inputs:
+        c.add_input(p)
+    c.set_all(options or {}, skip_default=True)
+    c.check()  # the limits by their one rule, a diff's path against the inputs
+    _check_notes(notes)
+    hooks = _NoteHooks()
+    result = _ffi.new("bb_command_result *")
+    err = _ffi.new("bb_error *")
+    st = _lib.bb_command_run(c.handle, hooks.hooks, result, err)
+    _dispatch_notes(hooks.heard, notes, stacklevel=stacklevel + 1)
+    _check(st, err)  # a file that cannot be read (the message names it)
+    return result
+
+
+def _provenance_dict(entries, count):
+    """The key=value lines of intact provenance (bb_provenance_entry
+    cdata) as {key: value}, values as written (strings), as `bumpbake info
+    --json` prints them."""
     def part(p, n):
         return _ffi.unpack(p, n).decode("utf-8", "surrogateescape")
     return {part(e.key, e.key_length): part(e.value, e.value_length)
@@ -82,8 +99,8 @@ class ImageInfo:
 
 @dataclasses.dataclass
 class VtfInfo:
-    """What a Source texture's (.vtf) header says (bb_vtf_read_info), as
-    `bumpbake info` prints it."""
+    """What a Source texture's (.vtf) header says, as `bumpbake info`
+    prints it."""
     version: str            # "7.2" ... "7.5"
     header_size: int        # bytes, the resource dictionary included
     width: int
@@ -107,8 +124,8 @@ class VtfInfo:
 
 @dataclasses.dataclass
 class DdsInfo:
-    """What a DirectDraw Surface's (.dds) header says (bb_dds_read_info), as
-    `bumpbake info` prints it."""
+    """What a DirectDraw Surface's (.dds) header says, as `bumpbake info`
+    prints it."""
     width: int
     height: int
     mip_count: int
@@ -121,31 +138,16 @@ class DdsInfo:
     caps2: int              # DDSCAPS2 (cube map, volume)
 
 
-def _flag_names(flags, name_of):
-    return [_text(name_of(bit)) for bit in range(32)
-            if flags >> bit & 1 and name_of(bit) != _ffi.NULL]
-
-
-def _dds_info(path):
-    d = _ffi.new("bb_dds_info *")
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_dds_read_info(path, d, err), err)
-    return DdsInfo(
-        width=d.width, height=d.height, mip_count=d.mip_count,
-        fourcc=_text(d.fourcc) or None, dxgi_format=d.dxgi_format,
-        format_name=_text(d.format_name), compression=_text(d.compression),
-        pixel_flags=d.pixel_flags,
-        pixel_flag_names=_flag_names(d.pixel_flags, _lib.bb_dds_pixel_flag_name),
-        caps2=d.caps2)
-
-
-def _vtf_info(path):
-    v = _ffi.new("bb_vtf_info *")
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_vtf_read_info(path, v, err), err)
-    try:
-        names = _flag_names(v.flags, _lib.bb_vtf_flag_name)
-        return VtfInfo(
+def _info_dict(f):
+    """The fields of ImageInfo from a file of info's report (bb_info_file
+    cdata): the data the library found, as a dict."""
+    i = f.image
+    klass = _PROVENANCE_CLASSES[f.provenance]
+    names = [_text(f.flag_names[bit]) for bit in range(32) if f.flag_names[bit] != _ffi.NULL]
+    vtf = dds = None
+    if f.vtf != _ffi.NULL:
+        v = f.vtf
+        vtf = VtfInfo(
             version=f"{v.version_major}.{v.version_minor}", header_size=v.header_size,
             width=v.width, height=v.height, depth=v.depth, frames=v.frames,
             first_frame=v.first_frame, flags=v.flags, flag_names=names,
@@ -154,8 +156,21 @@ def _vtf_info(path):
             low_res_format=v.low_res_format, low_res_width=v.low_res_width,
             low_res_height=v.low_res_height, resource_count=v.resource_count,
             data_size=v.data_size)
-    finally:
-        _lib.bb_vtf_info_free(v)
+    if f.dds != _ffi.NULL:
+        d = f.dds
+        dds = DdsInfo(
+            width=d.width, height=d.height, mip_count=d.mip_count,
+            fourcc=_text(d.fourcc) or None, dxgi_format=d.dxgi_format,
+            format_name=_text(d.format_name), compression=_text(d.compression),
+            pixel_flags=d.pixel_flags, pixel_flag_names=names, caps2=d.caps2)
+    return dict(
+        path=os.fsdecode(_ffi.string(f.path)),
+        width=f.width, height=f.height, channels=f.channels, format=_text(i.format_name),
+        bits_per_sample=i.bits_per_sample, is_float=bool(i.is_float),
+        alpha_channel=i.alpha_channel, provenance_class=klass,
+        provenance=(_provenance_dict(f.provenance_entries, f.provenance_count)
+                    if klass == "intact" else None),
+        description=_text(i.description), vtf=vtf, dds=dds)
 
 
 def info(path):
@@ -165,25 +180,14 @@ def info(path):
     VtfInfo), for a DirectDraw Surface its format and flags (.dds, a
     DdsInfo). Raises Error with the library's message when the file cannot
     be read."""
-    w, h, c = (_ffi.new("int *") for _ in range(3))
-    i = _ffi.new("bb_image_info *")
-    err = _ffi.new("bb_error *")
-    p = _path(path)
-    _check(_lib.bb_image_read_info(p, w, h, c, i, err), err)
+    result = _run_files("info", _path(path))
     try:
-        description = _text(i.description)
-        klass = _PROVENANCE_CLASSES[_lib.bb_provenance_classify(i.description)]
-        fmt = _text(i.format_name)
-        return ImageInfo(
-            path=os.fsdecode(p),
-            width=w[0], height=h[0], channels=c[0], format=fmt,
-            bits_per_sample=i.bits_per_sample, is_float=bool(i.is_float),
-            alpha_channel=i.alpha_channel, provenance_class=klass,
-            provenance=_provenance_dict(description) if klass == "intact" else None,
-            description=description, vtf=_vtf_info(p) if fmt == "vtf" else None,
-            dds=_dds_info(p) if fmt == "dds" else None)
+        f = result.info[0]
+        if f.status != _lib.BB_OK:
+            raise _exception(f.status, _ffi.string(f.error).decode("utf-8", "replace"))
+        return ImageInfo(**_info_dict(f))
     finally:
-        _lib.bb_image_info_free(i)
+        _lib.bb_command_result_free(result)
 
 
 # ----------------------------------------------------------------- write
@@ -322,9 +326,31 @@ def _diff_pairs(text, a, b):
     in text ("key: A -> B" lines), values taken from the files' own
     provenance (None where a file lacks the key), since a value may hold
     " -> " itself."""
-    va, vb = (_provenance_dict(info(p).description or "") for p in (a, b))
+    va, vb = (info(p).provenance or {} for p in (a, b))
     return [(key, va.get(key), vb.get(key))
             for key in (line.partition(": ")[0] for line in text.splitlines())]
+
+
+def _comparison_dict(result, diff):
+    """The fields of Comparison from compare's report (bb_command_result
+    cdata): the data the library found, as a dict."""
+    r = result.compare
+    s = r.stats
+    same = bool(r.same_shape)
+    lines = (_text(r.provenance_diff) or "") if r.provenance_differences >= 0 else None
+    return dict(
+        result=_text(r.result), exit_code=result.exit_code,
+        width=r.width, height=r.height, channels=r.channels,
+        b_shape=(r.b_height, r.b_width, r.b_channels),
+        pixels=s.pixels if same else 0, mean_abs=s.mean_abs, rms=s.rms, max_abs=s.max_abs,
+        worst=(s.worst_x, s.worst_y, s.worst_channel) if s.max_abs > 0 else None,
+        over_fail=s.over_fail, over_warn=s.over_warn,
+        provenance_a=_PROVENANCE_CLASSES[r.provenance_a],
+        provenance_b=_PROVENANCE_CLASSES[r.provenance_b],
+        provenance_lines=lines.splitlines() if lines is not None else None,
+        diff_written=bool(r.diff_written),
+        diff_error=(_text(r.diff_error.message) or None)
+        if diff is not None and not r.diff_written else None)
 
 
 def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=None,
@@ -350,47 +376,16 @@ def compare(a, b, *, fail=None, failpercent=None, hardfail=None, allowfailures=N
     a pixel is read), ArgumentError for a bad tolerance or diff path. A
     comparison over 1 GiB of memory says so first, as a note (notes: as
     bake_file()'s)."""
-    c = Command("compare")
     pa, pb = _path(a), _path(b)
-    c.add_input(pa)
-    c.add_input(pb)
-    c.set_all(dict(fail=fail, failpercent=failpercent, hardfail=hardfail,
-                   allowfailures=allowfailures, warn=warn, warnpercent=warnpercent,
-                   hardwarn=hardwarn, diff=diff), skip_default=True)  # inf: none
-    c.check()  # the limits by their one rule, the diff's path against the inputs
-    limits = _ffi.new("bb_compare_limits *")
-    limits[0] = c.options.limits
-    pd = _path(diff) if diff is not None else _ffi.NULL
-    err = _ffi.new("bb_error *")
-    _check_notes(notes)
-    heard = []
-    note = _ffi.callback("bb_note_fn",
-                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
-    _check(_lib.bb_compare_files_check(pa, pb, pd, note, _ffi.NULL, err), err)
-    _dispatch_notes(heard, notes, stacklevel=2)
-    r = _ffi.new("bb_compare_report *")
-    _check(_lib.bb_compare_files(pa, pb, limits, pd, r, err), err)
+    result = _run_files("compare", pa, pb, options=dict(
+        fail=fail, failpercent=failpercent, hardfail=hardfail, allowfailures=allowfailures,
+        warn=warn, warnpercent=warnpercent, hardwarn=hardwarn, diff=diff),  # inf: none
+        notes=notes, stacklevel=2)
     try:
-        s = r.stats
-        same = bool(r.same_shape)
-        differences = r.provenance_differences
-        return Comparison(
-            a=os.fsdecode(pa), b=os.fsdecode(pb),
-            result=_text(_lib.bb_compare_report_result(r)),
-            exit_code=_lib.bb_compare_report_exit_code(r),
-            width=r.width, height=r.height, channels=r.channels,
-            b_shape=(r.b_height, r.b_width, r.b_channels),
-            pixels=s.pixels if same else 0, mean_abs=s.mean_abs, rms=s.rms, max_abs=s.max_abs,
-            worst=(s.worst_x, s.worst_y, s.worst_channel) if s.max_abs > 0 else None,
-            over_fail=s.over_fail, over_warn=s.over_warn,
-            provenance_a=_PROVENANCE_CLASSES[r.provenance_a],
-            provenance_b=_PROVENANCE_CLASSES[r.provenance_b],
-            provenance_diff=(_diff_pairs(_text(r.provenance_diff) or "", pa, pb)
-                             if differences >= 0 else None),
-            provenance_lines=((_text(r.provenance_diff) or "").splitlines()
-                              if differences >= 0 else None),
-            diff_written=bool(r.diff_written),
-            diff_error=(_text(r.diff_error.message) or None)
-            if diff is not None and not r.diff_written else None)
+        fields = _comparison_dict(result, diff)
     finally:
-        _lib.bb_compare_report_free(r)
+        _lib.bb_command_result_free(result)
+    lines = fields["provenance_lines"]
+    return Comparison(a=os.fsdecode(pa), b=os.fsdecode(pb), **fields,
+                      provenance_diff=(_diff_pairs("\n".join(lines), pa, pb)
+                                       if lines is not None else None))

@@ -9,8 +9,8 @@ import numpy as np
 
 from ._bake import _IN_MEMORY, _height_field
 from ._command import Command
-from ._common import (_Image, _argument_error, _array, _c_text, _check, _check_notes,
-                      _dispatch_notes, _exception, _ffi, _lib, _message, _note_text, _path,
+from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _check,
+                      _check_notes, _dispatch_notes, _exception, _ffi, _lib, _message, _path,
                       _progress_hook, _shown, _take, _text)
 
 # The default light of bb_render_options_init: on, at this azimuth and
@@ -193,16 +193,14 @@ def run(command, *inputs, progress=None, notes="warn", **options):
         c.add_input(value)
     c.set_all(options)
     c.check()
-    heard = []
-    note = _ffi.callback("bb_note_fn",
-                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
+    hooks = _NoteHooks()
+    heard = hooks.heard
     raised = []
     cb = _progress_hook(progress, raised)
-    hooks = _ffi.new("bb_command_hooks *")
-    hooks.note, hooks.progress = note, cb
+    hooks.hooks.progress = cb
     result = _ffi.new("bb_command_result *")
     err = _ffi.new("bb_error *")
-    st = _lib.bb_command_run(c.handle, hooks, result, err)
+    st = _lib.bb_command_run(c.handle, hooks.hooks, result, err)
     if st != _lib.BB_OK:
         if raised:
             raise raised[0]
@@ -270,15 +268,12 @@ def renderbumpflat(model, size=None, samples=None, axis=None, face_normals=False
     if output is None and height is None:
         c.in_memory()  # nothing to write
     c.check()  # ranges, tile needs rect, the outputs apart and not over the model
-    heard = []
-    note = _ffi.callback("bb_note_fn",
-                         lambda user, p, text: heard.append(_note_text(_text(p), _text(text))))
-    hooks = _ffi.new("bb_command_hooks *")
-    hooks.note = note
+    hooks = _NoteHooks()
+    heard = hooks.heard
     err = _ffi.new("bb_error *")
     result = _ffi.new("bb_renderbump_result *")
     written = _ffi.new("bb_command_result *")
-    _check(_lib.bb_command_renderbump(c.handle, hooks, result, written, err), err)
+    _check(_lib.bb_command_renderbump(c.handle, hooks.hooks, result, written, err), err)
     try:
         _dispatch_notes(heard, notes, stacklevel=2)
         return RenderBump(

@@ -80,6 +80,22 @@ void cli_put_lines(char *text) {
   fflush(stdout);
 }
 
+void cli_put_report(const bb_command_result *result) {
+  for (int i = 0; i < result->print_count; i++) {
+    const bb_command_print *p = &result->prints[i];
+    if (!p->error) {
+      fputs(p->text, stdout);
+      continue;
+    }
+    fflush(stdout);
+    if (p->path)
+      cli_file_error(p->path, p->text);
+    else
+      cli_error_line(p->text);
+  }
+  fflush(stdout);
+}
+
 void cli_note(void *user, const char *path, const char *text) {
   (void)user;
   char line[2048], safe[4 * sizeof line];

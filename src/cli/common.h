@@ -51,6 +51,12 @@ void cli_printf_line(const char *fmt, ...)
  * nothing). */
 void cli_put_lines(char *text);
 
+/* A run's report as the library words it (bb_command_result.prints), in
+ * order: lines on stdout, errors on stderr as cli_file_error and
+ * cli_error_line print them (stdout flushed before each, and at the end,
+ * so the two streams keep their order). */
+void cli_put_report(const bb_command_result *result);
+
 /* The library's notes (bb_note_fn) as "bumpbake: PATH: note: TEXT" on
  * stderr. user is unused. */
 void cli_note(void *user, const char *path, const char *text);

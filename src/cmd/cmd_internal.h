@@ -10,6 +10,7 @@
 #include "job/bake_rows.h"
 
 #include <stddef.h>
+#include <stdio.h>
 
 typedef struct bb__option bb__option;
 
@@ -176,6 +177,24 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
                           bb_error *err);
 bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                           bb_error *err);
+/* The runs of the commands that look at files (run_files.c): compare
+ * (result->compare, its exit code, its diff in files) and info
+ * (result->info, exit code 1 when a file could not be read), each with
+ * what the command line prints of it (result->prints, report_files.c:
+ * bb__compare_prints, bb__info_prints). */
+bb_status bb__run_compare(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                          bb_error *err);
+bb_status bb__run_info(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
+                       bb_error *err);
+bb_status bb__compare_prints(const bb_command *c, bb_command_result *r, bb_error *err);
+bb_status bb__info_prints(const bb_command *c, bb_command_result *r, bb_error *err);
+/* printf to f and a newline, cut at 4095 bytes and made printable
+ * (bb_text_printable), as the command line prints a line (report_files.c). */
+void bb__print_line(FILE *f, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 /* renderbumpflat's run (run_renderbump.c): the model rendered, its files
  * written through the job (bb__renderbump_write). */
 bb_status bb__run_renderbumpflat(bb_command *c, const bb_command_hooks *hooks,

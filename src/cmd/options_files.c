@@ -111,7 +111,8 @@ const bb__command bb__command_compare = {
              .inputs = "A B", .min_inputs = 2, .max_inputs = 2,
              .usage_exit = BB_COMPARE_CANNOT_READ,
              .option_count = (int)(sizeof compare_options / sizeof compare_options[0]) - 1},
-    .options = compare_options, .init = compare_init, .check = compare_check};
+    .options = compare_options, .init = compare_init, .check = compare_check,
+    .run = bb__run_compare};
 
 /* --------------------------------------------------------------- check */
 
@@ -270,7 +271,7 @@ const bb__command bb__command_info = {
                  "the exit code is then 1.",
              .inputs = "FILE", .min_inputs = 1, .max_inputs = -1, .usage_exit = 2,
              .option_count = (int)(sizeof info_options / sizeof info_options[0]) - 1},
-    .options = info_options};
+    .options = info_options, .run = bb__run_info};
 
 /* ------------------------------------------------------ renderbumpflat */
 

@@ -7,6 +7,7 @@
 #include "bumpbake_cluster.h"
 #include "bake/bake_internal.h"
 #include "core/json.h"
+#include "cmd/cmd_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -107,9 +108,7 @@ static void short_json(FILE *f, const bb_job_report *r) {
 
 /* One line, control characters escaped (the command line's plain lines). */
 static void line(FILE *f, const char *verb, const bb_job_file *file) {
-  char text[4096], safe[4 * sizeof text];
-  snprintf(text, sizeof text, "%s %s %s", verb, file->kind, file->path);
-  fprintf(f, "%s\n", bb_text_printable(text, safe, sizeof safe));
+  bb__print_line(f, "%s %s %s", verb, file->kind, file->path);
 }
 
 /* The text of f, an open_memstream over *text (set by fclose), or NULL

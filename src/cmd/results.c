@@ -1,5 +1,6 @@
-/* results.c: what a run wrote (bb_command_result). */
+/* results.c: what a run wrote or found (bb_command_result). */
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +21,20 @@ bb_status bb__result_add(bb_command_result *r, const char *kind, const char *pat
   return BB_OK;
 }
 
+static void info_files_free(bb_info_file *files, int count) {
+  for (int i = 0; files && i < count; i++) {
+    bb_info_file *f = &files[i];
+    free((char *)f->error);
+    free((bb_provenance_entry *)f->provenance_entries);
+    bb_image_info_free(&f->image);
+    if (f->vtf)
+      bb_vtf_info_free((bb_vtf_info *)f->vtf);
+    free((bb_vtf_info *)f->vtf);
+    free((bb_dds_info *)f->dds);
+  }
+  free(files);
+}
+
 void bb_command_result_free(bb_command_result *r) {
   if (!r)
     return;
@@ -28,6 +43,14 @@ void bb_command_result_free(bb_command_result *r) {
     free((char *)r->files[i].path);
   }
   free(r->files);
+  if (r->compare) {
+    bb__compare_report_free((bb_compare_report *)r->compare);
+    free((bb_compare_report *)r->compare);
+  }
+  info_files_free((bb_info_file *)r->info, r->info_count);
+  for (int i = 0; i < r->print_count; i++)
+    free(r->prints[i].text);
+  free((bb_command_print *)r->prints);
   memset(r, 0, sizeof *r);
 }
 

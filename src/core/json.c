@@ -5,6 +5,8 @@
 #include "json.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 size_t bb__utf8_sequence(const char *text) {
   const unsigned char *s = (const unsigned char *)text;
@@ -112,4 +114,16 @@ void bb__json_int(bb__json *j, const char *key, long long value) {
 void bb__json_bool(bb__json *j, const char *key, int value) {
   json_begin_value(j, key);
   fputs(value ? "true" : "false", j->f);
+}
+
+void bb__json_lines(bb__json *j, const char *key, const char *text) {
+  bb__json_open(j, key, '[');
+  for (const char *line = text; line && *line;) {
+    const size_t n = strcspn(line, "\n");
+    char *one = strndup(line, n);
+    bb__json_string(j, NULL, one ? one : "");
+    free(one);
+    line += n + (line[n] == '\n');
+  }
+  bb__json_close(j, ']');
 }

@@ -47,6 +47,9 @@ void bb__json_number(bb__json *j, const char *key, double value);
 /* An integer, exactly (counts, sizes, exit codes). */
 void bb__json_int(bb__json *j, const char *key, long long value);
 void bb__json_bool(bb__json *j, const char *key, int value);
+/* An array of text's lines as strings (a last '\n' ends the last line);
+ * text NULL writes []. */
+void bb__json_lines(bb__json *j, const char *key, const char *text);
 
 #ifdef __cplusplus
 }

@@ -176,7 +176,7 @@ static int by_order(const void *p, const void *q) {
 
 /* Returns 0, or -1 when out of memory. kinds NULL: every key counts, as
  * written ("command", "output" and the keys the kind does not record, as
- * bb_provenance_entries reads them); else those a diff compares, the keys
+ * bb__provenance_entries reads them); else those a diff compares, the keys
  * either of kinds[0..1] records. */
 static int index_entries(const char *text_, entry_index *index, const text_kind *kinds) {
   size_t lines = 1;
@@ -257,7 +257,7 @@ int bb__provenance_diff(const char *a, const char *b, char *out, size_t cap) {
   return differing;
 }
 
-long bb_provenance_entries(const char *description, bb_provenance_entry *entries,
+long bb__provenance_entries(const char *description, bb_provenance_entry *entries,
                            size_t cap) {
   if (!description)
     return 0;
@@ -333,7 +333,7 @@ static int is_entry_line(const char *line, size_t n) {
   return n == 0 || (k > 0 && k < n && line[k] == '=');
 }
 
-const char *bb_provenance_class_name(bb_provenance_class c) {
+const char *bb__provenance_class_name(bb_provenance_class c) {
   switch (c) {
   case BB_PROVENANCE_NONE: return "none";
   case BB_PROVENANCE_INTACT: return "intact";

@@ -54,6 +54,20 @@ int bb__provenance_diff(const char *a, const char *b, char *out, size_t cap);
  * reader can ask which basis a map was baked with ("basis"). */
 int bb__provenance_value(const char *description, const char *key, char *out, size_t cap);
 
+/* The one reading of a provenance text, which every reader uses (the
+ * values and diffs above, the up-to-date check, info's report: `bumpbake
+ * info --json`, Python's bumpbake.info): a line ends at '\n', and a '\r'
+ * before it is dropped (a text re-saved on Windows); its key is what comes
+ * before its first '=', its value what follows; a line without '=' is
+ * skipped; a key seen before keeps its first value (its later lines are
+ * skipped). Fills entries with up to cap of them, in line order; returns
+ * how many there are (which may exceed cap), or -1 when out of memory.
+ * Time O(n log n) in the lines. */
+long bb__provenance_entries(const char *text, bb_provenance_entry *entries, size_t cap);
+
+/* "none", "intact", "damaged"; "unknown" else. */
+const char *bb__provenance_class_name(bb_provenance_class c);
+
 #ifdef __cplusplus
 }
 #endif

@@ -436,7 +436,6 @@ bb_status bb_check_run(bb_check *c, bb_progress_fn progress, void *progress_user
 
 static void json_case(FILE *f, const bb_check_case *k) {
   bb__json j = {f, 0};
-  const bb_compare_stats *s = &k->stats;
   bb__json_open(&j, NULL, '{');
   bb__json_string(&j, "name", k->name);
   bb__json_string(&j, "golden", k->golden);
@@ -447,37 +446,10 @@ static void json_case(FILE *f, const bb_check_case *k) {
   if (k->width)
     bb__json_int(&j, "width", k->width), bb__json_int(&j, "height", k->height),
         bb__json_int(&j, "channels", k->channels);
-  if (k->status <= BB_CHECK_FAILURE) {
-    bb__json_int(&j, "pixels", s->pixels);
-    bb__json_number(&j, "mean_abs", s->mean_abs);
-    bb__json_number(&j, "rms", s->rms);
-    bb__json_number(&j, "max_abs", s->max_abs);
-    bb__json_open(&j, "worst", '{');
-    bb__json_int(&j, "x", s->worst_x);
-    bb__json_int(&j, "y", s->worst_y);
-    bb__json_int(&j, "channel", s->worst_channel);
-    bb__json_close(&j, '}');
-    bb__json_number(&j, "fail", k->limits.fail);
-    bb__json_number(&j, "failpercent", k->limits.fail_percent);
-    bb__json_number(&j, "hardfail", k->limits.hard_fail);
-    bb__json_int(&j, "allowfailures", k->limits.allow_failures);
-    bb__json_int(&j, "over_fail", s->over_fail);
-    bb__json_number(&j, "warn", k->limits.warn);
-    bb__json_number(&j, "warnpercent", k->limits.warn_percent);
-    bb__json_number(&j, "hardwarn", k->limits.hard_warn);
-    bb__json_int(&j, "over_warn", s->over_warn);
-  }
-  if (k->provenance_diff) {
-    bb__json_open(&j, "provenance_diff", '[');
-    for (const char *line = k->provenance_diff; *line;) {
-      const size_t n = strcspn(line, "\n");
-      char *one = strndup(line, n);
-      bb__json_string(&j, NULL, one ? one : "");
-      free(one);
-      line += n + (line[n] == '\n');
-    }
-    bb__json_close(&j, ']');
-  }
+  if (k->status <= BB_CHECK_FAILURE)
+    bb__compare_json(&j, &k->stats, &k->limits);
+  if (k->provenance_diff)
+    bb__json_lines(&j, "provenance_diff", k->provenance_diff);
   if (k->message[0])
     bb__json_string(&j, "message", k->message);
   bb__json_bool(&j, "updated", k->updated);

@@ -5,6 +5,7 @@
 #include "job/job_internal.h"
 #include "files/provenance.h"
 #include "maps/maps_internal.h"
+#include "core/json.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -66,7 +67,7 @@ static double stored_bytes(int width, int height, int channels,
   return (double)width * height * channels * ((bits + 7) / 8);
 }
 
-bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_path,
+bb_status bb__compare_files_check(const char *a, const char *b, const char *diff_path,
                                  bb_note_fn note, void *note_user, bb_error *err) {
   if (!a || !b)
     return bb__fail(err, BB_ERR_ARGUMENT, "compare: bad arguments");
@@ -105,7 +106,19 @@ bb_status bb_compare_files_check(const char *a, const char *b, const char *diff_
   return st;
 }
 
-bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits *limits,
+/* idiff's word for a report's outcome (bb_compare_report.result). */
+static const char *result_word(const bb_compare_report *report) {
+  if (!report->same_shape)
+    return "DIFFERENT SIZE";
+  switch (report->verdict) {
+  case BB_COMPARE_PASS: return "PASS";
+  case BB_COMPARE_WARN: return "WARNING";
+  case BB_COMPARE_FAIL: return "FAILURE";
+  }
+  return "FAILURE";
+}
+
+bb_status bb__compare_files(const char *a, const char *b, const bb_compare_limits *limits,
                            const char *diff_path, bb_compare_report *report, bb_error *err) {
   if (!a || !b || !report)
     return bb__fail(err, BB_ERR_ARGUMENT, "compare: bad arguments");
@@ -121,7 +134,7 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
   bb_image x = {0}, y = {0};
   bb_image_info ix = {0}, iy = {0};
   /* what it will take, from the headers, before a pixel is read */
-  bb_status st = bb_compare_files_check(a, b, diff_path, NULL, NULL, err);
+  bb_status st = bb__compare_files_check(a, b, diff_path, NULL, NULL, err);
   if (st == BB_OK)
     st = bb_image_read(a, &x, &ix, err);
   if (st == BB_OK)
@@ -144,24 +157,26 @@ bb_status bb_compare_files(const char *a, const char *b, const bb_compare_limits
         report->diff_written = write_diff(diff_path, &diff, &report->diff_error) == BB_OK;
     }
   }
+  if (st == BB_OK)
+    report->result = result_word(report);
   bb_image_free(&diff);
   bb_image_free(&x);
   bb_image_free(&y);
   bb_image_info_free(&ix);
   bb_image_info_free(&iy);
   if (st != BB_OK)
-    bb_compare_report_free(report);
+    bb__compare_report_free(report);
   return st;
 }
 
-void bb_compare_report_free(bb_compare_report *report) {
+void bb__compare_report_free(bb_compare_report *report) {
   if (!report)
     return;
   free(report->provenance_diff);
   report->provenance_diff = NULL;
 }
 
-int bb_compare_report_exit_code(const bb_compare_report *report) {
+int bb__compare_report_exit_code(const bb_compare_report *report) {
   if (!report)
     return BB_COMPARE_FAIL;
   if (!report->same_shape)
@@ -169,15 +184,25 @@ int bb_compare_report_exit_code(const bb_compare_report *report) {
   return (int)report->verdict;
 }
 
-const char *bb_compare_report_result(const bb_compare_report *report) {
-  if (!report)
-    return "FAILURE";
-  if (!report->same_shape)
-    return "DIFFERENT SIZE";
-  switch (report->verdict) {
-  case BB_COMPARE_PASS: return "PASS";
-  case BB_COMPARE_WARN: return "WARNING";
-  case BB_COMPARE_FAIL: return "FAILURE";
-  }
-  return "FAILURE";
+
+void bb__compare_json(struct bb__json *j, const bb_compare_stats *s, const bb_compare_limits *l) {
+  bb__json_int(j, "pixels", s->pixels);
+  bb__json_number(j, "mean_abs", s->mean_abs);
+  bb__json_number(j, "rms", s->rms);
+  bb__json_number(j, "max_abs", s->max_abs); /* null when a NaN differs */
+  bb__json_open(j, "worst", '{');
+  bb__json_int(j, "x", s->worst_x);
+  bb__json_int(j, "y", s->worst_y);
+  bb__json_int(j, "channel", s->worst_channel);
+  bb__json_close(j, '}');
+  /* Limits under idiff's option names; infinite hard limits are null. */
+  bb__json_number(j, "fail", l->fail);
+  bb__json_number(j, "failpercent", l->fail_percent);
+  bb__json_number(j, "hardfail", l->hard_fail);
+  bb__json_int(j, "allowfailures", l->allow_failures);
+  bb__json_int(j, "over_fail", s->over_fail);
+  bb__json_number(j, "warn", l->warn);
+  bb__json_number(j, "warnpercent", l->warn_percent);
+  bb__json_number(j, "hardwarn", l->hard_warn);
+  bb__json_int(j, "over_warn", s->over_warn);
 }

@@ -312,6 +312,45 @@ int bb__renderbump_outputs(const char *normal_path, const char *height_path,
  * elsewhere (scaled to a maximum of 1); no provenance. */
 bb__job_output bb__compare_diff_output(const char *path);
 
+/* Compares the image files a and b channel by channel under limits (NULL:
+ * idiff's defaults; checked by bb__compare_limits_check before any read),
+ * as OpenImageIO's idiff does, and their provenance key by key
+ * (compare_files.c; compare's run). With diff_path (may be NULL; checked
+ * by the command first), writes |A - B| there: raw in .exr, scaled
+ * elsewhere so the largest finite difference is white (NaN and infinite
+ * ones clip to 1). A diff that cannot be written does not change the
+ * verdict: the report says so. Errors: those of bb_image_read for either
+ * file (the message names it), BB_ERR_MEMORY. Free the report with
+ * bb__compare_report_free. */
+bb_status bb__compare_files(const char *a, const char *b, const bb_compare_limits *limits,
+                            const char *diff_path, bb_compare_report *report, bb_error *err);
+
+/* What bb__compare_files(a, b, ..., diff_path) will take, from the two
+ * headers alone, before a pixel is read: the memory at its peak (A held
+ * while B is read, then, with a diff, both, |A - B| and its encoder's
+ * copy), refused when it will not fit (BB_ERR_MEMORY: "A: comparing two
+ * 16384 x 16384 images of 4 channels needs about 12.6 GiB of memory; 2.4
+ * GiB is available (RLIMIT_AS)"), and said through note (may be NULL),
+ * naming a, when it is over BB_MAX_READ_BYTES ("comparing ... takes about
+ * 12.6 GiB of memory (20.1 GiB is available)"). bb__compare_files makes
+ * the same check first, without the note. Errors: the header reads'. */
+bb_status bb__compare_files_check(const char *a, const char *b, const char *diff_path,
+                                  bb_note_fn note, void *note_user, bb_error *err);
+
+void bb__compare_report_free(bb_compare_report *report);
+
+/* idiff's exit code for a report, which `bumpbake compare` exits with: the
+ * verdict (0 pass, 1 warning, 2 failure), or BB_COMPARE_DIFFERENT_SIZE when
+ * the sizes or channel counts differ. */
+int bb__compare_report_exit_code(const bb_compare_report *report);
+
+/* A comparison's statistics and the limits it was judged by, as members of
+ * the JSON object j writes (compare --json, check --json, in one order):
+ * pixels, mean_abs, rms, max_abs, worst {x, y, channel}, then idiff's
+ * limits under its option names with the pixels over each threshold. */
+struct bb__json;
+void bb__compare_json(struct bb__json *j, const bb_compare_stats *s, const bb_compare_limits *l);
+
 /* Once in bumpbake.h, now internal (issue 41): no client of the
  * library calls these; the library, tests, tools and fuzz targets do. */
 

@@ -46,6 +46,12 @@ bb_status bb__dds_encode(bb_staged_file *f, const bb_image *levels, int count,
                          const bb_texture_options *options, bb_texture_format format,
                          bb_error *err);
 
+/* The name of DDS_PIXELFORMAT flag bit `bit` (0..31) without its DDPF_
+ * prefix ("ALPHAPIXELS", "FOURCC", "RGB", "LUMINANCE"; bit 31 NVIDIA's
+ * "NORMAL"), or NULL for an unused bit or one out of range (info's
+ * report). */
+const char *bb__dds_pixel_flag_name(int bit);
+
 #ifdef __cplusplus
 }
 #endif

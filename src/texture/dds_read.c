@@ -284,7 +284,7 @@ bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
   return BB_OK;
 }
 
-const char *bb_dds_pixel_flag_name(int bit) {
+const char *bb__dds_pixel_flag_name(int bit) {
   static const struct {
     uint32_t flag;
     const char *name;

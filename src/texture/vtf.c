@@ -595,7 +595,7 @@ bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
   return st;
 }
 
-const char *bb_vtf_flag_name(int bit) {
+const char *bb__vtf_flag_name(int bit) {
   /* Source SDK 2013, public/vtf/vtf.h, CompiledVtfFlags. */
   static const char *const names[32] = {
       "POINTSAMPLE", "TRILINEAR",   "CLAMPS",      "CLAMPT",         "ANISOTROPIC",

@@ -38,6 +38,11 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
 bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
                               uint64_t *image_offset, bb_error *err);
 
+/* Valve's name of the TEXTUREFLAGS_* bit `bit` (0..31) as Source SDK 2013
+ * spells it without the prefix ("CLAMPS", "NORMAL", "SSBUMP"), or NULL for
+ * an unused bit or one out of range (info's report). */
+const char *bb__vtf_flag_name(int bit);
+
 #ifdef __cplusplus
 }
 #endif

@@ -15,9 +15,11 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "command_words.h"
 #include "file_bytes.h"
 #include "scratch_dir.h"
 #include "image/image_write.h"
+#include "job/job_internal.h"
 #include "mesh/mesh_internal.h"
 
 static void setup(void) {
@@ -37,24 +39,6 @@ static const char *pyramid(void) {
                              "f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
   file_bytes_write(path, (const unsigned char *)text, sizeof text - 1);
   return path;
-}
-
-/* The command name with words: inputs, and "--option", "value" pairs;
- * not checked. */
-static bb_command *command(const char *name, const char *const *words) {
-  bb_command *c = NULL;
-  bb_error err = {{0}};
-  cr_assert_eq(bb_command_new(name, &c, &err), BB_OK, "%s", err.message);
-  for (int i = 0; words[i]; i++) {
-    if (words[i][0] != '-') {
-      cr_assert_eq(bb_command_add_input(c, words[i], &err), BB_OK, "%s", err.message);
-      continue;
-    }
-    cr_assert_eq(bb_command_set(c, words[i] + 2, words[i + 1], &err), BB_OK, "%s: %s",
-                 words[i], err.message);
-    i++;
-  }
-  return c;
 }
 
 /* c checked and run by bb_command_renderbump, which must succeed. */
@@ -272,10 +256,10 @@ Test(renderbump_run, the_diff_is_float_in_exr_and_scaled_elsewhere) {
   for (int k = 0; k < 2; k++) {
     bb_compare_report r;
     bb_error err = {{0}};
-    cr_assert_eq(bb_compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s",
+    cr_assert_eq(bb__compare_files(a, b, NULL, diffs[k], &r, &err), BB_OK, "%s",
                  err.message);
     cr_expect(r.diff_written, "%s", r.diff_error.message);
-    bb_compare_report_free(&r);
+    bb__compare_report_free(&r);
     bb_image img;
     bb_image_info info = {0};
     cr_assert_eq(bb_image_read(diffs[k], &img, &info, &err), BB_OK, "%s", err.message);

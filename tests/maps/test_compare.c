@@ -9,6 +9,7 @@
 #include "scratch_dir.h"
 #include "core/internal.h"
 #include "image/image_write.h"
+#include "job/job_internal.h"
 #include "maps/maps_internal.h"
 
 #include <criterion/criterion.h>
@@ -470,7 +471,7 @@ static void keep_note(void *user, const char *path, const char *text) {
 }
 
 static bb_status check_pair(const char *path, bb_error *err) {
-  return bb_compare_files_check(path, path, NULL, NULL, NULL, err);
+  return bb__compare_files_check(path, path, NULL, NULL, NULL, err);
 }
 
 Test(compare_cli, a_large_comparison_says_its_cost_before_it_starts) {
@@ -492,7 +493,7 @@ Test(compare_cli, a_large_comparison_says_its_cost_before_it_starts) {
   if ((double)room < 2.0 * (1 << 30))
     cr_skip_test("less than 2 GiB of memory available for the note's case");
   /* 4096 x 8192 RGBA floats: 512 MiB a file, 1.6 GiB to compare: said */
-  cr_assert_eq(bb_compare_files_check(big, big, NULL, keep_note, note, &err), BB_OK, "%s",
+  cr_assert_eq(bb__compare_files_check(big, big, NULL, keep_note, note, &err), BB_OK, "%s",
                err.message);
   cr_expect(strstr(note,
                    "big.dds: comparing two 4096 x 8192 images of 4 channels takes about "
@@ -501,7 +502,7 @@ Test(compare_cli, a_large_comparison_says_its_cost_before_it_starts) {
   /* a small one: nothing to say */
   note[0] = '\0';
   const char *a = ramp_with("a.exr", 0, 0);
-  cr_assert_eq(bb_compare_files_check(a, a, NULL, keep_note, note, &err), BB_OK);
+  cr_assert_eq(bb__compare_files_check(a, a, NULL, keep_note, note, &err), BB_OK);
   cr_expect_str_empty(note);
 }
 
@@ -735,7 +736,7 @@ Test(compare_cli, tga_provenance_is_compared_key_by_key) {
 
 /* ------------------------------------------------ a report's words and code */
 
-/* bb_compare_files on files, its report in idiff's words and exit code: the
+/* bb__compare_files on files, its report in idiff's words and exit code: the
  * one rule `bumpbake compare` and Python's bumpbake.compare both print. */
 Test(compare_cli, report_result_and_exit_code_are_idiffs) {
   const char *a = ramp_with("ra.exr", 0, 0), *same = ramp_with("rs.exr", 0, 0);
@@ -762,18 +763,18 @@ Test(compare_cli, report_result_and_exit_code_are_idiffs) {
     l.fail_percent = cases[i].fail_percent;
     bb_compare_report r;
     bb_error err = {{0}};
-    cr_assert_eq(bb_compare_files(a, cases[i].b, &l, NULL, &r, &err), BB_OK, "%s",
+    cr_assert_eq(bb__compare_files(a, cases[i].b, &l, NULL, &r, &err), BB_OK, "%s",
                  err.message);
-    cr_expect_str_eq(bb_compare_report_result(&r), cases[i].result, "case %zu", i);
-    cr_expect_eq(bb_compare_report_exit_code(&r), cases[i].code, "case %zu", i);
-    bb_compare_report_free(&r);
+    cr_expect_str_eq(r.result, cases[i].result, "case %zu", i);
+    cr_expect_eq(bb__compare_report_exit_code(&r), cases[i].code, "case %zu", i);
+    bb__compare_report_free(&r);
   }
   cr_assert_eq(BB_COMPARE_DIFFERENT_SIZE, 3, "idiff's exit code for a size mismatch");
 }
 
 /* Limits out of range are refused by the library, naming idiff's option,
  * so every caller (the CLI parses its own ranges; Python does not) gets
- * the same answer; bb_compare_files checks them before reading. */
+ * the same answer; bb__compare_files checks them before reading. */
 Test(compare_cli, limits_out_of_range_are_refused) {
   bb_compare_limits l;
   bb__compare_limits_init(&l);
@@ -806,7 +807,7 @@ Test(compare_cli, limits_out_of_range_are_refused) {
   cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
   /* Before any read: the files need not exist. */
   bb_compare_report r;
-  cr_expect_eq(bb_compare_files(in_scratch_dir("none1.png"), in_scratch_dir("none2.png"), &l, NULL, &r,
+  cr_expect_eq(bb__compare_files(in_scratch_dir("none1.png"), in_scratch_dir("none2.png"), &l, NULL, &r,
                                 &err),
                BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "compare: allowfailures must be >= 0 (got -1)");
