@@ -111,37 +111,45 @@ static int log_progress(void *user, long done, long total) {
   return 0;
 }
 
+static bb_image tiled(const bb_image *h, int times);
+
+/* On the map's level (96 x 80) and on the coarse one (576 x 80): the
+ * trace, then the coarse level's passes, one bar. */
 Test(bounce, progress_is_monotone_over_the_whole_bake) {
-  bb_image h = load_fixture("noise_96x80.png");
-  const int counts[] = {0, 3};
-  for (size_t c = 0; c < 2; c++) {
-    bb_bake_options o = options(8.0f, 256, 0.5);
-    o.bounces = counts[c];
-    progress_log l = {{0}, {0}, 0, 0};
-    o.trace.progress = log_progress;
-    o.trace.progress_user = &l;
-    bb_bake_result r = harness_bake(&h, &o);
-    /* a call after every sweep of every pass: at least the 8 sweeps of the
-     * trace's 16 slices, which the direct light and the texels' gathers share */
-    cr_assert(l.calls >= 8 && l.calls <= 256, "bounces %d: %d calls", counts[c], l.calls);
-    for (int i = 0; i < l.calls; i++) {
-      cr_assert_eq(l.total[i], l.total[0], "bounces %d: the whole changes at call %d (%ld, then %ld)",
-                   counts[c], i, l.total[0], l.total[i]);
-      cr_assert(l.done[i] >= 0 && l.done[i] <= l.total[i], "bounces %d: call %d: %ld of %ld",
-                counts[c], i, l.done[i], l.total[i]);
-      if (i)
-        cr_assert(l.done[i] >= l.done[i - 1], "bounces %d: back from %ld to %ld at call %d",
-                  counts[c], l.done[i - 1], l.done[i], i);
-      /* no sweep is a large part of the whole: the bar moves all along */
-      cr_expect_leq((l.done[i] - (i ? l.done[i - 1] : 0)) * 5, l.total[0],
-                    "bounces %d: call %d moves from %ld to %ld of %ld", counts[c], i,
-                    i ? l.done[i - 1] : 0, l.done[i], l.total[0]);
+  bb_image tile = load_fixture("noise_96x80.png");
+  for (int m = 0; m < 2; m++) {
+    bb_image h = m ? tiled(&tile, 6) : tile;
+    const int counts[] = {0, 3};
+    for (size_t c = 0; c < 2; c++) {
+      bb_bake_options o = options(8.0f, 256, 0.5);
+      o.bounces = counts[c];
+      progress_log l = {{0}, {0}, 0, 0};
+      o.trace.progress = log_progress;
+      o.trace.progress_user = &l;
+      bb_bake_result r = harness_bake(&h, &o);
+      /* a call after every sweep of every pass: at least the 8 sweeps of the
+       * trace's 16 slices, which the direct light and the texels' gathers share */
+      cr_assert(l.calls >= 8 && l.calls <= 256, "bounces %d: %d calls", counts[c], l.calls);
+      for (int i = 0; i < l.calls; i++) {
+        cr_assert_eq(l.total[i], l.total[0], "bounces %d: the whole changes at call %d (%ld, then %ld)",
+                     counts[c], i, l.total[0], l.total[i]);
+        cr_assert(l.done[i] >= 0 && l.done[i] <= l.total[i], "bounces %d: call %d: %ld of %ld",
+                  counts[c], i, l.done[i], l.total[i]);
+        if (i)
+          cr_assert(l.done[i] >= l.done[i - 1], "bounces %d: back from %ld to %ld at call %d",
+                    counts[c], l.done[i - 1], l.done[i], i);
+        /* no sweep is a large part of the whole: the bar moves all along */
+        cr_expect_leq((l.done[i] - (i ? l.done[i - 1] : 0)) * 5, l.total[0],
+                      "bounces %d: call %d moves from %ld to %ld of %ld", counts[c], i,
+                      i ? l.done[i - 1] : 0, l.done[i], l.total[0]);
+      }
+      cr_expect_eq(l.done[l.calls - 1], l.total[0], "bounces %d: ends at %ld of %ld", counts[c],
+                   l.done[l.calls - 1], l.total[0]);
+      bb_bake_result_free(&r);
     }
-    cr_expect_eq(l.done[l.calls - 1], l.total[0], "bounces %d: ends at %ld of %ld", counts[c],
-                 l.done[l.calls - 1], l.total[0]);
-    bb_bake_result_free(&r);
+    if (m) bb_image_free(&h);
   }
-  bb_image_free(&h);
+  bb_image_free(&tile);
 }
 
 /* The trace's part of the units is bb_bake_slices(o), one a slice, as
