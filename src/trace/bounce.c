@@ -54,6 +54,13 @@
  * every sample. Progress counts every pass's sweeps, weighted by what they
  * cost (pass_work); each sweep polls the caller's progress every 50 ms, so
  * a cancel is seen within a fraction of a second.
+ *
+ * The coarse level. On a map 512 texels or more on its longer side
+ * (bb__bounce_level) all of this runs on the heights at every f-th vertex
+ * (add_coarse), and each texel gets the light added there per unit of
+ * blocked visibility, bilinear, times its own blocked visibility from the
+ * map's trace (lift_row): the bounce then costs a quarter of the map's (or
+ * less), the map's occlusion stays exactly the bake's.
  */
 #include "trace/bounce.h"
 #include "core/internal.h"
