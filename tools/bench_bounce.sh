@@ -16,7 +16,9 @@
 #    its defaults (build/tools/bounce_bake, which calls bb_bake as `bake
 #    --bounce RHO` does); "horizon-pt", the same bake with the whole blocked
 #    band of each slice seeing the horizon's own point (the approximation the
-#    sweeps give for free); "no-bounce", the bake without it. Each pair of
+#    sweeps give for free); "no-bounce", the bake without it; "coarse-2",
+#    the bounce on the coarse level of every other vertex (--level 2, what
+#    a map of 512 to 2048 texels gets) on these 256 maps. Each pair of
 #    columns is mean |error| and bias (signed mean of bake - reference) of
 #    ao and each ssbump channel; the reference's own standard error per
 #    texel is printed above each map's rows (it adds to mean |error|).
@@ -126,10 +128,13 @@ while IFS=: read -r m path scale; do
       --small-band 1e6 --steep 0 >"$out/${m}_${rho}_hp.json" || { fail "bounce_bake $path"; continue; }
     "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_none" --rho 0 "${common[@]}" \
       >/dev/null || { fail "bounce_bake $path"; continue; }
+    "$tools/bounce_bake" "$path" "$scale" "$out/${m}_${rho}_c2" --rho "$rho" "${common[@]}" \
+      --level 2 >/dev/null || { fail "bounce_bake $path"; continue; }
     if "$tools/bounce_ref" compare "$ref" "$path" "$scale" \
       "bb=$out/${m}_${rho}_bb.ao.exr,$out/${m}_${rho}_bb.ss.exr" \
       "hp=$out/${m}_${rho}_hp.ao.exr,$out/${m}_${rho}_hp.ss.exr" \
       "none=$out/${m}_${rho}_none.ao.exr,$out/${m}_${rho}_none.ss.exr" \
+      "c2=$out/${m}_${rho}_c2.ao.exr,$out/${m}_${rho}_c2.ss.exr" \
       >"$out/cmp_${m}_$rho.json" 2>/dev/null; then
       se=$(grep -o '"reference_se":\[[^]]*\]' "$out/cmp_${m}_$rho.json" | grep -o '"texel":[^,]*' |
         sed 's/"texel"://' | tr '\n' ' ')
@@ -137,6 +142,7 @@ while IFS=: read -r m path scale; do
       row "$m" "$rho" bumpbake $(numbers "$out/cmp_${m}_$rho.json" bb)
       row "$m" "$rho" horizon-pt $(numbers "$out/cmp_${m}_$rho.json" hp)
       row "$m" "$rho" no-bounce $(numbers "$out/cmp_${m}_$rho.json" none)
+      row "$m" "$rho" coarse-2 $(numbers "$out/cmp_${m}_$rho.json" c2)
     else
       fail "bounce_ref compare on $path"
     fi

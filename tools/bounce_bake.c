@@ -7,7 +7,7 @@
  *               [--lift L] [--steep S] [--column-samples N]
  *               [--estimate-passes N] [--surface-slices N]
  *               [--texel-slopes T,T,...] [--surface-slopes T,T,...]
- *               [--small-band T] [--chain N]
+ *               [--small-band T] [--chain N] [--level F]
  *
  * Writes PREFIX.ao.exr and PREFIX.ss.exr. Without the settings of the last
  * line it is bb_bake with bounce_albedo = R (the library's own defaults,
@@ -16,7 +16,8 @@
  * with those settings, derive), so the bench can show what, say, fewer
  * fixed rays (--texel-slopes 0) or no columns (--steep 0) cost, or the
  * horizon-point approximation (--small-band 1e6 --steep 0: every band sees
- * its horizon point's light).
+ * its horizon point's light), or what a coarse level (--level 2: the bounce
+ * on a height field twice as coarse, lifted) does to a map of any size.
  * Defaults: 256 rays, rho 0.5, bounces 0, bias 0.55, filter radius 0 (no
  * smoothing, as README "Accuracy"), Valve's normal. Prints one JSON line
  * (seconds of the trace and of the bounce, bounces followed) on stdout;
@@ -45,7 +46,7 @@ static int usage(const char *reason) {
           "                   [--lift L] [--steep S] [--column-samples N]\n"
           "                   [--estimate-passes N] [--surface-slices N]\n"
           "                   [--texel-slopes T,T,...] [--surface-slopes T,T,...]\n"
-          "                   [--small-band T] [--chain N]\n",
+          "                   [--small-band T] [--chain N] [--level F]\n",
           reason);
   return 2;
 }
@@ -128,6 +129,8 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--small-band")) a->bounce.small_band = v, a->inner = 1;
     else if (!strcmp(o, "--estimate-passes")) a->bounce.estimate_passes = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-slices")) a->bounce.surface_slices = (int)v, a->inner = 1;
+    else if (!strcmp(o, "--level") && (v == 1 || v == 2 || v == 4 || v == 8))
+      a->bounce.level = (int)v, a->inner = 1;
     else return usage("unknown option");
   }
   bb_error err;

@@ -70,12 +70,15 @@ static bb_status albedo_grey(const bb_image *map, int width, int height, bb_imag
   return BB_OK;
 }
 
-/* The inter-reflection's options for a bake (its albedo map set apart). */
-static void bounce_options(const bb_bake_options *o, int threads, bb__bounce_options *bo) {
+/* The inter-reflection's options for a bake of the pyramid (its albedo map
+ * set apart), its coarse level chosen by the map's size. */
+static void bounce_options(const bb_bake_options *o, const bb_pyramid *p, int threads,
+                           bb__bounce_options *bo) {
   bb__bounce_options_init(bo);
   bo->rho = o->bounce_albedo;
   bo->bounces = o->bounces;
   bo->bias = o->trace.bias_texels;
+  bo->level = bb__bounce_level(bo, p->width, p->height, p->addressing);
   bo->threads = threads;
   bo->progress = o->trace.progress;
   bo->progress_user = o->trace.progress_user;
@@ -108,7 +111,7 @@ static bb_status bounce(const bb_bake_options *o, const bb_pyramid *pyramid,
   if (o->bounce_albedo_map)
     st = albedo_grey(o->bounce_albedo_map, pyramid->width, pyramid->height, &grey, err);
   bb__bounce_options bo;
-  bounce_options(o, threads, &bo);
+  bounce_options(o, pyramid, threads, &bo);
   bo.albedo = grey.pixels ? &grey : NULL;
   bo.progress_before = trace_work;
   if (st == BB_OK) st = bb__bounce_add(pyramid, rays, &bo, &r->vis, &r->bounces, err);
@@ -151,9 +154,11 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     bb_trace_options whole = o->trace;
     whole.region = (bb_region){0, 0, 0, 0}; /* a bake traces every texel */
     whole.threads = threads;
-    if (o->bounce_albedo > 0.0 && o->trace.progress && o->trace.trace) {
-      bb__bounce_options bo;
-      bounce_options(o, threads, &bo);
+    bb__bounce_options bo;
+    bounce_options(o, pyramid, threads, &bo);
+    /* on a coarse level, the bounce's passes are not the map's trace */
+    const int coarse = bo.level > 1;
+    if (o->bounce_albedo > 0.0 && o->trace.progress && (o->trace.trace || coarse)) {
       progress.span = (long)rays.slice_count * BB__BOUNCE_TRACE_WORK;
       progress.total = progress.span + bb__bounce_work(&rays, &bo);
       whole.progress = trace_progress_of;
@@ -164,7 +169,7 @@ static bb_status trace_and_derive(const bb_bake_options *o, int threads, int kee
     else if (keep)
       st = bb__trace_keeping_horizons(pyramid, &rays, &whole, keep->horizons, &r->vis,
                                       err);
-    else if (o->bounce_albedo > 0.0) /* the bounce's passes are the trace */
+    else if (o->bounce_albedo > 0.0 && !coarse) /* the bounce's passes are the trace */
       r->horizons_found = (double)pyramid->width * (double)pyramid->height * rays.slice_count;
     else
       st = bb__trace_occlusion(pyramid, &rays, &whole, &r->vis, &r->horizons_found, err);

@@ -33,6 +33,9 @@ typedef struct bb__bounce_options {
                         its horizon point's light only */
   int chain;         /* the hull vertices a gather knows at most, the
                         tangent among them (0: every one) */
+  int level;        /* 1: the bounce on the map's own texels; 2, 4, 8: on a
+                       height field that many times coarser, its added light
+                       lifted to the map (bb__bounce_level); 0: by size */
   int threads;
   bb_progress_fn progress; /* called after every sweep with the work done
                               and the whole (bb__bounce_work), plus
@@ -52,10 +55,21 @@ typedef struct bb__bounce_options {
  * vertices known (chain 0). docs/conventions.md "Inter-reflection" says why. */
 void bb__bounce_options_init(bb__bounce_options *o);
 
+/* The coarse level bb__bounce_add computes the bounce on for a map of
+ * width x height: o->level when set, else by size (1 under 512 texels on
+ * the longer side; from 512, 2, doubled while the coarse level's longer
+ * side would pass 1024, at most 8); halved until it tiles a periodic map.
+ * With f > 1 (and the visibility given, not made by the passes) the bounce
+ * is found on the heights at every f-th vertex, and the light it adds per
+ * unit of blocked visibility is lifted to the map's texels bilinearly,
+ * times each texel's own blocked visibility, and added to vis. */
+int bb__bounce_level(const bb__bounce_options *o, int width, int height,
+                     bb_addressing addressing);
+
 /* The work bb__bounce_add does with these options and ray set, in the
  * units its progress counts: a trace of the same slices is
  * BB__BOUNCE_TRACE_WORK per slice (what progress_before and _after are
- * measured in). */
+ * measured in); o->level scales it by the coarse level's texels. */
 enum { BB__BOUNCE_TRACE_WORK = 1 };
 long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o);
 
