@@ -37,3 +37,23 @@ def cli():
 
     run.start = start
     return run
+
+
+@pytest.fixture(scope="session")
+def client():
+    """A Dask client of a LocalCluster: two worker processes of one thread
+    each, started the way a user would (processes, nannies that restart a
+    worker that dies). One for the session: a cluster's start (a scheduler,
+    two nannies, two workers, each a Python importing Dask) is what a test
+    of a cluster need not repeat; a test that kills a worker waits until
+    its nanny brings it back."""
+    distributed = pytest.importorskip(
+        "distributed", reason="python3-distributed is not installed (make deps installs it)")
+    try:
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=40)
+    except Exception as e:  # pragma: no cover: what this machine cannot do
+        pytest.skip(f"dask cannot start a LocalCluster here: {e!r}")
+    with cluster, distributed.Client(cluster) as c:
+        c.wait_for_workers(2, timeout=60)
+        yield c

@@ -219,19 +219,12 @@ def test_the_assertion_takes_an_array_with_its_kind(tmp_path):
 
 # --------------------------------------------------------------- cluster
 
-def test_a_suite_on_a_dask_cluster_is_one_process_check(suite, tmp_path):
-    distributed = pytest.importorskip("distributed")
+def test_a_suite_on_a_dask_cluster_is_one_process_check(suite, tmp_path, client):
     import bumpbake.dask
-    try:
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, silence_logs=40)
-    except Exception as e:  # pragma: no cover
-        pytest.skip(f"dask cannot start a LocalCluster here: {e!r}")
-    with cluster, distributed.Client(cluster) as client:
-        options = dict(BAKE, scale=17)
-        r = bumpbake.dask.check_files(suite / "goldens", [suite / "heights"], client=client,
-                                      html=tmp_path / "report", junit=tmp_path / "c.xml",
-                                      chunk_size=1, **options)
+    options = dict(BAKE, scale=17)
+    r = bumpbake.dask.check_files(suite / "goldens", [suite / "heights"], client=client,
+                                  html=tmp_path / "report", junit=tmp_path / "c.xml",
+                                  chunk_size=1, **options)
     alone = bumpbake.check(suite / "goldens", heights=[suite / "heights"], **options)
     assert [(c.name, c.result, c.max_abs, c.provenance_diff) for c in r.cases] == [
         (c.name, c.result, c.max_abs, c.provenance_diff) for c in alone.cases]

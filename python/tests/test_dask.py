@@ -26,20 +26,6 @@ import bumpbake.dask  # noqa: E402
 SCALE = 16
 
 
-@pytest.fixture(scope="module")
-def client():
-    """Two worker processes of one thread each, started the way a user
-    would (processes, nannies that restart a worker that dies)."""
-    try:
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, silence_logs=40)
-    except Exception as e:  # pragma: no cover: what this machine cannot do
-        pytest.skip(f"dask cannot start a LocalCluster here: {e!r}")
-    with cluster, distributed.Client(cluster) as c:
-        c.wait_for_workers(2, timeout=60)
-        yield c
-
-
 def heights(directory, count, side=40, width=None):
     """count small, different height files (16-bit PNG) of side rows and
     width columns (side + 8 by default): smooth bumps with noise, so every

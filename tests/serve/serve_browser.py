@@ -11,6 +11,8 @@ import time
 
 CHROMIUM = shutil.which("chromium")
 CHROMEDRIVER = shutil.which("chromedriver")
+# Seconds a page's script may take: a hang guard, never a bound on speed.
+SCRIPT_SECONDS = 120
 
 
 def browser_missing():
@@ -63,6 +65,9 @@ def start_browser(width=1100, height=760):
                  "--window-size=%d,%d" % (width, height)):
         options.add_argument(flag)
     driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+    # A script may run as long as the tests wait for anything (their SLOW):
+    # WebDriver's 30 s failed a relief drawn on SwiftShader at load 16.
+    driver.set_script_timeout(SCRIPT_SECONDS)
     driver._bb_profile = profile
     return driver
 

@@ -50,6 +50,17 @@ def page(server):
     sb.stop_browser(driver)
 
 
+@pytest.fixture(scope="module")
+def browser():
+    """One browser for the tests that start a server of their own: each
+    loads its server's page afresh (a page keeps nothing across a load, and
+    serve's replies are never cached), so starting Chromium again for each
+    would prove nothing more."""
+    driver = sb.start_browser()
+    yield driver
+    sb.stop_browser(driver)
+
+
 def stats(driver):
     return driver.execute_script("return bbCanvasStats()")
 
@@ -456,7 +467,6 @@ def test_the_page_lights_as_render_does(page, server, work, mode, light):
     os.remove(out)
     st = state(server)["bake"]
     az, el = (float(v) for v in light.split(","))
-    page.set_script_timeout(60)
     diff = page.execute_async_script(COMPARE_JS, png, st["width"], st["height"], az, el, mode)
     print("page against render, mode %d light %s: %s" % (mode, light, diff))
     if mode == 8:
@@ -506,7 +516,7 @@ def light_vector(az, el):
     return [math.cos(e) * math.cos(a), -math.cos(e) * math.sin(a), math.sin(e)]
 
 
-def test_a_custom_basis_lights_the_ssbump_in_its_own_directions(tmp_path):
+def test_a_custom_basis_lights_the_ssbump_in_its_own_directions(tmp_path, browser):
     import base64
     import math
 
@@ -525,7 +535,7 @@ def test_a_custom_basis_lights_the_ssbump_in_its_own_directions(tmp_path):
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
     server = sb.Server(BIN, str(tmp_path / "height.png"),
                        ["--scale", "32", "--basis", str(basis), "--quiet"])
-    driver = sb.start_browser()
+    driver = browser
     try:
         driver.get(server.url)
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
@@ -557,15 +567,14 @@ def test_a_custom_basis_lights_the_ssbump_in_its_own_directions(tmp_path):
                               "light.azimuth = 135; light.elevation = 45; showLight(); draw();")
         shot(driver, "7-custom-basis")
     finally:
-        sb.stop_browser(driver)
         server.close()
 
 
-def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path):
+def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path, browser):
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
     server = sb.Server(BIN, str(tmp_path / "height.png"),
                        ["--scale", "32", "--basis", "hl2+z", "--quiet"])
-    driver = sb.start_browser()
+    driver = browser
     try:
         driver.get(server.url)
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
@@ -578,19 +587,18 @@ def test_a_basis_of_4_turns_the_lit_ssbump_off_saying_why(tmp_path):
         assert stats(driver)["mean"] > 20  # the normal map, lit
         shot(driver, "8-basis-of-4")
     finally:
-        sb.stop_browser(driver)
         server.close()
 
 
 # ------------------------------------------------------ a bake in flight
 
-def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path):
+def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path, browser):
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
     # 4096 rays: the bounce (which is the trace too) takes about a second
     # here, long enough to be seen in each of its stages
     server = sb.Server(BIN, str(tmp_path / "height.png"),
                        ["--scale", "16", "--rays", "4096", "--bounce", "0.5", "--quiet"])
-    driver = sb.start_browser()
+    driver = browser
     try:
         driver.get(server.url)
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1 and not is_stale(driver), 3 * SLOW,
@@ -619,13 +627,12 @@ def test_a_bake_in_flight_dims_the_picture_and_names_its_stage(tmp_path):
         # the bake's stages name the bounce, where its time went
         assert re.search(r"bounce \d+\.\d{3}, derive", driver.find_element("id", "times").text)
     finally:
-        sb.stop_browser(driver)
         server.close()
 
 
 # ------------------------------------------ a colour map and a light colour
 
-def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
+def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path, browser):
     import base64
 
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "height.png")
@@ -635,7 +642,7 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
     server = sb.Server(BIN, str(tmp_path / "height.png"),
                        ["--scale", "32", "--albedo", albedo, "--light-color", "1,0.8,0.6",
                         "--quiet"])
-    driver = sb.start_browser()
+    driver = browser
     try:
         driver.get(server.url)
         sb.wait_for(lambda: sb.drawn_bake(driver) >= 1, SLOW, "the first bake drawn")
@@ -661,7 +668,6 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
             with open(out, "rb") as f:
                 png = base64.b64encode(f.read()).decode()
             az, el = (float(v) for v in light.split(","))
-            driver.set_script_timeout(60)
             diff = driver.execute_async_script(COMPARE_JS, png, st["bake"]["width"],
                                                st["bake"]["height"], az, el, mode)
             print("page against render --albedo --light-color, mode %d: %s" % (mode, diff))
@@ -680,7 +686,6 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path):
                     state(server)["params"]["light_color"][0] < 0.3, 30, "the new colour")
         assert state(server)["bake"]["id"] == bake and refused is None
     finally:
-        sb.stop_browser(driver)
         server.close()
 
 
@@ -695,7 +700,7 @@ return out;
 """
 
 
-def test_an_edit_draws_what_a_fresh_page_draws(tmp_path):
+def test_an_edit_draws_what_a_fresh_page_draws(tmp_path, browser):
     import numpy as np
 
     def save_pgm(path, h):
@@ -708,7 +713,7 @@ def test_an_edit_draws_what_a_fresh_page_draws(tmp_path):
     save_pgm(height, h)
     save_pgm(albedo, np.round(65535 * (0.3 + 0.6 * (x / (2 * np.pi)))).astype(np.uint16))
     server = sb.Server(BIN, height, ["--scale", "16", "--albedo", albedo, "--quiet"])
-    driver = sb.start_browser()
+    driver = browser
     try:
         driver.get(server.url)
         sb.wait_for(lambda: sb.drawn_bake(driver) == 1 and
@@ -738,5 +743,4 @@ def test_an_edit_draws_what_a_fresh_page_draws(tmp_path):
                     driver.execute_script("return current.whole"), SLOW, "bake 2 loaded whole")
         assert driver.execute_script(MODES_JS) == edited
     finally:
-        sb.stop_browser(driver)
         server.close()
