@@ -66,8 +66,10 @@ void bb_mip_chain_free(bb_image *levels, int count) {
   free(levels);
 }
 
-bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
-                       int *count, bb_error *err) {
+/* bb_mip_chain's work; borrow: levels[0] is *img itself (its pixels
+ * not copied, and not the chain's to free). */
+static bb_status make_chain(const bb_image *img, bb_mip_filter filter, int borrow,
+                            bb_image **levels, int *count, bb_error *err) {
   if (!levels || !count)
     return bb__fail(err, BB_ERR_ARGUMENT, "mip chain: levels and count are required");
   *levels = NULL;
@@ -84,8 +86,11 @@ bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **lev
   bb_image *chain = calloc((size_t)n, sizeof *chain);
   if (!chain)
     return bb__fail(err, BB_ERR_MEMORY, "mip chain: out of memory");
-  st = bb_image_alloc(&chain[0], img->width, img->height, img->channels, err);
-  if (st == BB_OK)
+  if (borrow)
+    chain[0] = *img;
+  else
+    st = bb_image_alloc(&chain[0], img->width, img->height, img->channels, err);
+  if (st == BB_OK && !borrow)
     memcpy(chain[0].pixels, img->pixels,
            (size_t)img->width * (size_t)img->height * (size_t)img->channels *
                sizeof(float));
@@ -99,10 +104,31 @@ bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **lev
       renormalize(&chain[k]);
   }
   if (st != BB_OK) {
-    bb_mip_chain_free(chain, n);
+    if (borrow)
+      bb__mip_chain_borrowed_free(chain, n);
+    else
+      bb_mip_chain_free(chain, n);
     return st;
   }
   *levels = chain;
   *count = n;
   return BB_OK;
+}
+
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err) {
+  return make_chain(img, filter, 0, levels, count, err);
+}
+
+bb_status bb__mip_chain_borrowed(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                                 int *count, bb_error *err) {
+  return make_chain(img, filter, 1, levels, count, err);
+}
+
+void bb__mip_chain_borrowed_free(bb_image *levels, int count) {
+  if (!levels)
+    return;
+  for (int k = 1; k < count; k++)
+    bb_image_free(&levels[k]);
+  free(levels);
 }

@@ -17,10 +17,12 @@
 #include <string.h>
 
 /* The levels to write: bb_mip_chain of img by the map's rule (it also
- * rejects NaN and infinite texels). */
+ * rejects NaN and infinite texels), img itself its top level (freed by
+ * bb__mip_chain_borrowed_free). */
 static bb_status texture_chain(const bb_image *img, bb_map_kind map, bb_image **levels,
                                int *count, bb_error *err) {
-  return bb_mip_chain(img, bb__mip_filter(bb_map_kind_get(map)->unit_vectors), levels, count, err);
+  return bb__mip_chain_borrowed(img, bb__mip_filter(bb_map_kind_get(map)->unit_vectors), levels,
+                                count, err);
 }
 
 /* A caller's chain must be one bb_mip_chain could have made (each level
@@ -103,8 +105,8 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
     else
       st = bb__safe_finish(f, err);
   }
-  bb_mip_chain_free(made, made_count);
-  bb_mip_chain_free(extra, extra_count);
+  bb__mip_chain_borrowed_free(made, made_count);
+  bb__mip_chain_borrowed_free(extra, extra_count);
   return st;
 }
 
