@@ -74,12 +74,17 @@ bb_mip_filter bb__mip_filter(int normal_map) {
   return normal_map ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
 }
 
-void bb_mip_chain_free(bb_image *levels, int count) {
+/* Frees levels[first..count) and the array. */
+static void free_from(bb_image *levels, int first, int count) {
   if (!levels)
     return;
-  for (int k = 0; k < count; k++)
+  for (int k = first; k < count; k++)
     bb_image_free(&levels[k]);
   free(levels);
+}
+
+void bb_mip_chain_free(bb_image *levels, int count) {
+  free_from(levels, 0, count);
 }
 
 /* bb_mip_chain's work; borrow: levels[0] is *img itself (its pixels
@@ -143,9 +148,5 @@ bb_status bb__mip_chain_borrowed(const bb_image *img, bb_mip_filter filter, int 
 }
 
 void bb__mip_chain_borrowed_free(bb_image *levels, int count) {
-  if (!levels)
-    return;
-  for (int k = 1; k < count; k++)
-    bb_image_free(&levels[k]);
-  free(levels);
+  free_from(levels, 1, count);
 }
