@@ -35,39 +35,63 @@ static void renormalize(bb_image *img) {
  * d) / 4, which is what OpenImageIO's box resize gives at exactly half
  * (the same bits: tools' checks on rock06's maps, and the output matrix),
  * at a small part of its cost (its resize was 430 M instructions of a
- * 1024 x 1024 VTF write, about a whole PNG write). */
-static bb_status halve_even(const bb_image *up, bb_image *out, bb_error *err) {
-  const int w = up->width / 2, h = up->height / 2;
+ * 1024 x 1024 VTF write, about a whole PNG write). Bands of rows on
+ * threads (each texel its own sum: the same bits on any count). */
+typedef struct halving {
+  const bb_image *up;
+  bb_image *out;
+} halving;
+
+enum { HALVING_BAND = 32 }; /* rows of the level below an item */
+
+static void halve_band(void *user, int item) {
+  const halving *hv = user;
+  const bb_image *up = hv->up;
+  const int w = hv->out->width, h = hv->out->height;
   const size_t ch = (size_t)up->channels, row = (size_t)up->width * ch;
-  bb_status st = bb_image_alloc(out, w, h, up->channels, err);
-  if (st != BB_OK)
-    return st;
-  for (int y = 0; y < h; y++) {
+  const int y1 = (item + 1) * HALVING_BAND < h ? (item + 1) * HALVING_BAND : h;
+  for (int y = item * HALVING_BAND; y < y1; y++) {
     const float *p = up->pixels + (size_t)(2 * y) * row, *q = p + row;
-    float *o = out->pixels + (size_t)y * (size_t)w * ch;
+    float *o = hv->out->pixels + (size_t)y * (size_t)w * ch;
     for (size_t x = 0; x < (size_t)w; x++)
       for (size_t c = 0; c < ch; c++) {
         const size_t i = 2 * x * ch + c;
         o[x * ch + c] = (((p[i] + p[i + ch]) + q[i]) + q[i + ch]) / 4.0f;
       }
   }
-  return BB_OK;
+}
+
+static bb_status halve_even(const bb_image *up, bb_image *out, int threads, bb_error *err) {
+  bb_status st = bb_image_alloc(out, up->width / 2, up->height / 2, up->channels, err);
+  if (st != BB_OK)
+    return st;
+  halving hv = {up, out};
+  return bb__parallel_for((out->height + HALVING_BAND - 1) / HALVING_BAND, threads, halve_band,
+                          &hv, NULL, NULL, err);
 }
 
 bb_mip_filter bb__mip_filter(int normal_map) {
   return normal_map ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
 }
 
-void bb_mip_chain_free(bb_image *levels, int count) {
+/* Frees levels[first..count) and the array. */
+static void free_from(bb_image *levels, int first, int count) {
   if (!levels)
     return;
-  for (int k = 0; k < count; k++)
+  for (int k = first; k < count; k++)
     bb_image_free(&levels[k]);
   free(levels);
 }
 
-bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
-                       int *count, bb_error *err) {
+void bb_mip_chain_free(bb_image *levels, int count) {
+  free_from(levels, 0, count);
+}
+
+/* bb_mip_chain's work; borrow: levels[0] is *img itself (its pixels
+ * not copied, and not the chain's to free); even halvings on threads (0:
+ * all cores). */
+static bb_status make_chain(const bb_image *img, bb_mip_filter filter, int borrow,
+                            int threads, bb_image **levels, int *count, bb_error *err) {
   if (!levels || !count)
     return bb__fail(err, BB_ERR_ARGUMENT, "mip chain: levels and count are required");
   *levels = NULL;
@@ -84,25 +108,45 @@ bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **lev
   bb_image *chain = calloc((size_t)n, sizeof *chain);
   if (!chain)
     return bb__fail(err, BB_ERR_MEMORY, "mip chain: out of memory");
-  st = bb_image_alloc(&chain[0], img->width, img->height, img->channels, err);
-  if (st == BB_OK)
+  if (borrow)
+    chain[0] = *img;
+  else
+    st = bb_image_alloc(&chain[0], img->width, img->height, img->channels, err);
+  if (st == BB_OK && !borrow)
     memcpy(chain[0].pixels, img->pixels,
            (size_t)img->width * (size_t)img->height * (size_t)img->channels *
                sizeof(float));
   for (int k = 1; k < n && st == BB_OK; k++) {
     const bb_image *up = &chain[k - 1];
     st = up->width % 2 == 0 && up->height % 2 == 0
-             ? halve_even(up, &chain[k], err)
+             ? halve_even(up, &chain[k], threads, err)
              : bb__image_resize_box(up, half_of(up->width), half_of(up->height), &chain[k],
                                     err);
     if (st == BB_OK && filter == BB_MIP_RENORMALIZE)
       renormalize(&chain[k]);
   }
   if (st != BB_OK) {
-    bb_mip_chain_free(chain, n);
+    if (borrow)
+      bb__mip_chain_borrowed_free(chain, n);
+    else
+      bb_mip_chain_free(chain, n);
     return st;
   }
   *levels = chain;
   *count = n;
   return BB_OK;
+}
+
+bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
+                       int *count, bb_error *err) {
+  return make_chain(img, filter, 0, 1, levels, count, err);
+}
+
+bb_status bb__mip_chain_borrowed(const bb_image *img, bb_mip_filter filter, int threads,
+                                 bb_image **levels, int *count, bb_error *err) {
+  return make_chain(img, filter, 1, threads, levels, count, err);
+}
+
+void bb__mip_chain_borrowed_free(bb_image *levels, int count) {
+  free_from(levels, 1, count);
 }

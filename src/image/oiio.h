@@ -43,6 +43,16 @@ bb_status bb__image_as_read(const char *path, const bb_image *img, bb_depth dept
  * renormalised, any other's averaged. */
 bb_mip_filter bb__mip_filter(int normal_map);
 
+/* bb_mip_chain of img whose levels[0] is *img itself: its pixels are not
+ * copied (a 1024 x 1024 RGB map's 12 MB, cleared by calloc then copied:
+ * 18 M instructions and 3,000 page faults of a texture write), so img
+ * must outlive the chain. Its halvings run on threads (0: all cores; the
+ * same bits on any count). Freed by bb__mip_chain_borrowed_free, which
+ * leaves level 0 alone (mips.c). */
+bb_status bb__mip_chain_borrowed(const bb_image *img, bb_mip_filter filter, int threads,
+                                 bb_image **levels, int *count, bb_error *err);
+void bb__mip_chain_borrowed_free(bb_image *levels, int count);
+
 /* in, box-filtered by OpenImageIO's ImageBufAlgo::resize to width x height
  * (oiio_mips.cpp). Allocates out. */
 bb_status bb__image_resize_box(const bb_image *in, int width, int height, bb_image *out,

@@ -17,10 +17,12 @@
 #include <string.h>
 
 /* The levels to write: bb_mip_chain of img by the map's rule (it also
- * rejects NaN and infinite texels). */
-static bb_status texture_chain(const bb_image *img, bb_map_kind map, bb_image **levels,
-                               int *count, bb_error *err) {
-  return bb_mip_chain(img, bb__mip_filter(bb_map_kind_get(map)->unit_vectors), levels, count, err);
+ * rejects NaN and infinite texels), img itself its top level (freed by
+ * bb__mip_chain_borrowed_free). */
+static bb_status texture_chain(const bb_image *img, bb_map_kind map, int threads,
+                               bb_image **levels, int *count, bb_error *err) {
+  return bb__mip_chain_borrowed(img, bb__mip_filter(bb_map_kind_get(map)->unit_vectors), threads,
+                                levels, count, err);
 }
 
 /* A caller's chain must be one bb_mip_chain could have made (each level
@@ -75,7 +77,7 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
   const bb_image *chain = levels;
   int chain_count = count, write = count;
   if (!given) {
-    st = texture_chain(&levels[0], o->map, &made, &made_count, err);
+    st = texture_chain(&levels[0], o->map, o->threads, &made, &made_count, err);
     chain = made;
     chain_count = made_count;
     write = o->mips ? made_count : 1;
@@ -87,7 +89,7 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
     if (chain[k].width <= 16 && chain[k].height <= 16)
       low = &chain[k];
   if (st == BB_OK && !low && bb__texture_container(path) == BB__CONTAINER_VTF) {
-    st = texture_chain(&chain[chain_count - 1], o->map, &extra, &extra_count, err);
+    st = texture_chain(&chain[chain_count - 1], o->map, o->threads, &extra, &extra_count, err);
     for (int k = 0; st == BB_OK && k < extra_count && !low; k++)
       if (extra[k].width <= 16 && extra[k].height <= 16)
         low = &extra[k];
@@ -103,8 +105,8 @@ bb_status bb__texture_stage(const char *path, const bb_image *levels, int count,
     else
       st = bb__safe_finish(f, err);
   }
-  bb_mip_chain_free(made, made_count);
-  bb_mip_chain_free(extra, extra_count);
+  bb__mip_chain_borrowed_free(made, made_count);
+  bb__mip_chain_borrowed_free(extra, extra_count);
   return st;
 }
 

@@ -56,6 +56,20 @@ int bb__texture_format_has_alpha(bb_texture_format format);
 void bb__texture_texels(const bb_image *img, int unit_vectors, size_t i, size_t n,
                         float *rgba);
 
+/* A sample as an 8-bit code: rounded half up to 0..255, NaN to 0 (as
+ * 8-bit image files are written). Inline, so a loop over samples runs in
+ * lanes. */
+static inline unsigned char bb__texture_byte(float v) {
+  double u = v > 0.0f ? (double)v : 0.0;
+  u = u < 1.0 ? u : 1.0;
+  return (unsigned char)(u * 255.0 + 0.5);
+}
+
+/* bb__texture_byte of n samples, of 0.5f + 0.5f v when unit_vectors (a
+ * normal map's texels as the codec sees them): the same codes, four
+ * samples at a time where the compiler has SSE2. */
+void bb__texture_bytes(const float *v, size_t n, int unit_vectors, unsigned char *out);
+
 /* Encodes levels[0..count-1] into out[k], bb__texture_level_bytes(format,
  * levels[k]) bytes each, little-endian. Block formats compress all the
  * levels in one job on `threads` threads (0 = all cores), the same bytes on

@@ -83,25 +83,43 @@ static int vtf_code(bb_texture_format format) {
 }
 
 /* vtex's and VTFLib's reflectivity: per channel, the mean over the top
- * level of (code / 255)^2.2, code the texel's 8-bit value. */
-static void reflectivity(const bb_image *top, bb_map_kind map, float out[3]) {
+ * level of (code / 255)^2.2, code the texel's 8-bit value (as the block
+ * codec sees the texel: bb__texture_texels, a grey map's value in all
+ * three, a normal map's 0.5 + 0.5 n).
+ *
+ * A row's samples are turned into codes first, four at a time
+ * (bb__texture_bytes), then the codes' powers are summed texel by texel in
+ * the order the sums always took: the bits of the texel-at-a-time loop
+ * this replaces, which cost about 95 instructions a texel (100 M of a
+ * 1024 x 1024 VTF write, on one thread before the levels were
+ * compressed). 0, or -1 out of memory. */
+static int reflectivity(const bb_image *top, bb_map_kind map, float out[3]) {
   const int unit_vectors = bb_map_kind_get(map)->unit_vectors;
   double table[256];
   for (int i = 0; i < 256; i++)
     table[i] = pow(i / 255.0, 2.2);
+  const size_t ch = (size_t)top->channels, w = (size_t)top->width;
+  /* Texel x's channel c has its code at from[c] + step[c] x of the row's
+   * codes; a 2-channel map's third channel is a 0 (0.5 in a normal map),
+   * its code kept after the row's (at w ch). */
+  const size_t from[3] = {0, ch >= 2 ? 1 : 0, ch >= 3 ? 2 : ch == 2 ? w * ch : 0};
+  const size_t step[3] = {ch, ch, ch == 2 ? 0 : ch};
+  unsigned char *codes = malloc(w * ch + 1);
+  if (!codes)
+    return -1;
   double sum[3] = {0, 0, 0};
-  const size_t n = (size_t)top->width * (size_t)top->height;
-  for (size_t i = 0; i < n; i++) {
-    float t[4];
-    bb__texture_texels(top, unit_vectors, i, 1, t);
-    for (int c = 0; c < 3; c++) {
-      double u = t[c] > 0.0f ? (double)t[c] : 0.0;
-      u = u < 1.0 ? u : 1.0;
-      sum[c] += table[(int)(u * 255.0 + 0.5)];
-    }
+  codes[w * ch] = bb__texture_byte(unit_vectors ? 0.5f : 0.0f);
+  for (int y = 0; y < top->height; y++) {
+    bb__texture_bytes(top->pixels + (size_t)y * w * ch, w * ch, unit_vectors, codes);
+    for (size_t x = 0; x < w; x++)
+      for (int c = 0; c < 3; c++)
+        sum[c] += table[codes[from[c] + step[c] * x]];
   }
+  free(codes);
+  const double n = (double)w * (double)top->height;
   for (int c = 0; c < 3; c++)
-    out[c] = (float)(sum[c] / (double)n);
+    out[c] = (float)(sum[c] / n);
+  return 0;
 }
 
 /* The provenance as a KeyValues block, "bumpbake" { "key" "value" ... },
@@ -196,7 +214,10 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *chain, int levels,
   put_u16(header + 24, 1); /* frames */
   put_u16(header + 26, 0); /* first frame */
   float refl[3];
-  reflectivity(&chain[0], o->map, refl);
+  if (reflectivity(&chain[0], o->map, refl) != 0) {
+    free(kvd);
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
+  }
   for (int c = 0; c < 3; c++)
     put_f32(header + 32 + 4 * c, refl[c]);
   put_f32(header + 48, 1.0f); /* bump scale */

@@ -305,3 +305,38 @@ Test(mips, even_levels_have_the_bits_of_openimageios_box_resize) {
     bb_image_free(&img);
   }
 }
+
+/* The texture writer's chain: the map itself its top level (not a copy),
+ * the levels below the bits of bb_mip_chain's on any thread count (bands
+ * of rows on threads), an odd side included (OpenImageIO's resize there). */
+Test(mips, borrowed_chain_on_threads_has_the_bits_of_the_copied_one) {
+  const int sizes[][2] = {{256, 128}, {96, 200}, {8, 1}};
+  for (int s = 0; s < 3; s++)
+    for (int normal = 0; normal <= 1; normal++) {
+      bb_image img = normal ? noise_normals(sizes[s][0], sizes[s][1], 11u + (unsigned)s)
+                            : noise(sizes[s][0], sizes[s][1], 4, 5u + (unsigned)s, -0.5f, 1.5f);
+      const bb_mip_filter f = normal ? BB_MIP_RENORMALIZE : BB_MIP_AVERAGE;
+      int count = 0;
+      bb_image *want = chain(&img, f, &count);
+      for (int threads = 1; threads <= 3; threads++) {
+        bb_image *got = NULL;
+        int n = 0;
+        bb_error err = {{0}};
+        cr_assert_eq(bb__mip_chain_borrowed(&img, f, threads, &got, &n, &err), BB_OK, "%s",
+                     err.message);
+        cr_assert_eq(n, count);
+        cr_assert(got[0].pixels == img.pixels, "level 0 is the map itself");
+        for (int k = 1; k < n; k++) {
+          const size_t bytes = (size_t)got[k].width * (size_t)got[k].height *
+                               (size_t)got[k].channels * sizeof(float);
+          cr_assert(got[k].width == want[k].width && got[k].height == want[k].height &&
+                        memcmp(got[k].pixels, want[k].pixels, bytes) == 0,
+                    "%d x %d, normal %d, %d threads: level %d differs", sizes[s][0],
+                    sizes[s][1], normal, threads, k);
+        }
+        bb__mip_chain_borrowed_free(got, n);
+      }
+      bb_mip_chain_free(want, count);
+      bb_image_free(&img);
+    }
+}

@@ -484,6 +484,105 @@ Test(vtf, same_bytes_for_any_thread_count) {
   scratch_dir_remove();
 }
 
+/* Samples where the 8-bit codes change and around them: every (k + 0.5)
+ * / 255 and its float neighbours, the ends, past them, signed zeros,
+ * subnormals, infinities, NaN. */
+static size_t awkward_samples(float *v, size_t cap) {
+  size_t n = 0;
+  const float odd[] = {0.0f, -0.0f, 1.0f, -1.0f, 2.0f, 1e-45f, -1e-45f, 1e-38f,
+                       INFINITY, -INFINITY, NAN, -NAN, 0.5f, 1.0000001f, 0.99999994f};
+  for (size_t i = 0; i < sizeof odd / sizeof odd[0] && n < cap; i++)
+    v[n++] = odd[i];
+  for (int k = 0; k <= 256 && n + 3 <= cap; k++) {
+    const float m = (float)((k + 0.5) / 255.0);
+    v[n++] = nextafterf(m, -1.0f), v[n++] = m, v[n++] = nextafterf(m, 2.0f);
+  }
+  return n;
+}
+
+Test(vtf, texture_bytes_are_the_scalar_codes) {
+  enum { CAP = 1024 };
+  float v[CAP];
+  size_t n = awkward_samples(v, CAP);
+  for (uint32_t s = 7; n < CAP;) { /* and a spread over -0.5 .. 1.5 */
+    s ^= s << 13, s ^= s >> 17, s ^= s << 5;
+    v[n++] = (float)(s % 200000u) / 100000.0f - 0.5f;
+  }
+  for (int unit = 0; unit <= 1; unit++)
+    for (size_t start = 0; start < 4; start++) { /* every tail length */
+      unsigned char got[CAP];
+      bb__texture_bytes(v + start, n - start, unit, got);
+      for (size_t i = start; i < n; i++) {
+        const unsigned char want = bb__texture_byte(unit ? 0.5f + 0.5f * v[i] : v[i]);
+        cr_assert_eq(got[i - start], want, "sample %zu (%.9g, unit %d): %d, the scalar %d", i,
+                     (double)v[i], unit, got[i - start], want);
+      }
+    }
+}
+
+/* The reflectivity as the writer once summed it, a texel at a time
+ * through the codec's view (bb__texture_texels), each channel in texel
+ * order: the header's floats must be these bits. */
+static void texel_sum_reflectivity(const bb_image *img, int unit_vectors, float out[3]) {
+  double table[256], sum[3] = {0, 0, 0};
+  for (int i = 0; i < 256; i++)
+    table[i] = pow(i / 255.0, 2.2);
+  const size_t n = (size_t)img->width * (size_t)img->height;
+  for (size_t i = 0; i < n; i++) {
+    float t[4];
+    bb__texture_texels(img, unit_vectors, i, 1, t);
+    for (int c = 0; c < 3; c++) {
+      double u = t[c] > 0.0f ? (double)t[c] : 0.0;
+      u = u < 1.0 ? u : 1.0;
+      sum[c] += table[(int)(u * 255.0 + 0.5)];
+    }
+  }
+  for (int c = 0; c < 3; c++)
+    out[c] = (float)(sum[c] / (double)n);
+}
+
+Test(vtf, reflectivity_is_the_texel_by_texel_sum_bit_for_bit) {
+  scratch_dir_make("bb_vtf");
+  const struct {
+    int channels;
+    bb_map_kind map;
+  } cases[] = {{1, BB_MAP_PLAIN}, {2, BB_MAP_PLAIN}, {3, BB_MAP_SSBUMP},
+               {4, BB_MAP_PLAIN}, {3, BB_MAP_NORMAL}, {4, BB_MAP_NORMAL}};
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    const int ch = cases[k].channels;
+    const int unit = bb_map_kind_get(cases[k].map)->unit_vectors;
+    bb_image img = pattern(64, 32, ch, unit);
+    /* Samples on and beside the codes' edges, and out of range (finite:
+     * the mip chain refuses the rest), over a third of the map. */
+    float odd[1024];
+    const size_t m = awkward_samples(odd, 1024);
+    for (size_t i = 0, j = 0; i < (size_t)64 * 32 * (size_t)ch; i += 3)
+      if (isfinite(odd[j % m]))
+        img.pixels[i] = odd[j++ % m];
+      else
+        j++;
+    bb_texture_options o;
+    bb_texture_options_init(&o);
+    o.map = cases[k].map;
+    bb_error err = {{0}};
+    cr_assert_eq(bb__texture_write(in_scratch_dir("r.vtf"), &img, &o, &err), BB_OK, "%s",
+                 err.message);
+    size_t size;
+    unsigned char *f = file_bytes(in_scratch_dir("r.vtf"), &size);
+    float want[3];
+    texel_sum_reflectivity(&img, unit, want);
+    for (int c = 0; c < 3; c++) {
+      const float got = f32_at(f + 32 + 4 * c);
+      cr_assert_eq(memcmp(&got, &want[c], sizeof got), 0,
+                   "%d channels, map %d, channel %d: %.9g, the texel sum %.9g", ch,
+                   (int)cases[k].map, c, (double)got, (double)want[c]);
+    }
+    free(f);
+    bb_image_free(&img);
+  }
+  scratch_dir_remove();
+}
+
 static void expect_refused(const bb_image *img, bb_map_kind map, bb_texture_format format,
                            int version, uint32_t flags, const char *words) {
   bb_texture_options o;
