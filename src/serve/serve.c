@@ -1,9 +1,10 @@
 /* serve.c: `bumpbake serve`, a bake seen live: the height baked with
  * bake's options, watched, re-baked on every save, and shown lit in the
- * browser (src/cli/serve/). This file keeps the command line's words. */
-#include "serve/serve.h"
-#include "cli.h"
-#include "common.h"
+ * browser (src/serve/, a client beside the CLI, whose printing it
+ * shares). This file keeps the command line's words. */
+#include "serve.h"
+#include "../cli/cli.h"
+#include "../cli/common.h"
 #include "bumpbake_cluster.h"
 
 #include <arpa/inet.h>

@@ -22,7 +22,7 @@
  * one write at a time, every request that waited during a write answered
  * by the next one. */
 #include "serve.h"
-#include "../../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
+#include "../core/json.h" /* the JSON writer, compiled into the program (Makefile) */
 
 #include <arpa/inet.h>
 #include <errno.h>

@@ -6,7 +6,7 @@
  * the whole checked as the command line is (bb_command_check), whose
  * words a refusal shows. */
 #include "serve.h"
-#include "../../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
+#include "../core/json.h" /* the JSON writer, compiled into the program (Makefile) */
 #include "bumpbake_cluster.h"
 
 #include <math.h>

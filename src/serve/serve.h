@@ -1,11 +1,11 @@
-/* serve.h: what the parts of `bumpbake serve` share (src/cli/serve/): the
+/* serve.h: what the parts of `bumpbake serve` share (src/serve/): the
  * state one bake thread, one watch thread and the HTTP server's threads
  * (its polling thread, the writer and the ticker) read and change under
  * one lock. The bakes go through the
  * library's job (bb_job_bake_item, bb_job_run_item); nothing here is a
  * bake rule. */
-#ifndef BB_CLI_SERVE_H
-#define BB_CLI_SERVE_H
+#ifndef BB_SERVE_H
+#define BB_SERVE_H
 
 #include "bumpbake.h"
 
@@ -187,4 +187,4 @@ typedef struct serve_asset {
 } serve_asset;
 const serve_asset *serve_asset_find(const char *name);
 
-#endif /* BB_CLI_SERVE_H */
+#endif /* BB_SERVE_H */
