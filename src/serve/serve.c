@@ -111,7 +111,15 @@ int cli_run_serve(const cli_run *r) {
     cli_error_line(message);
     return BB_EXIT_FAILURE;
   }
-  serve_http_options http = {a->address, a->port, a->address != NULL};
+  /* where it listens: serve's own options, read through the command */
+  char port[16], address[128];
+  if (bb_command_value(r->command, "port", port, sizeof port, &err) != BB_OK ||
+      bb_command_value(r->command, "address", address, sizeof address, &err) != BB_OK) {
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
+    return cli_library_error("serve", BB_ERR_ARGUMENT, &err);
+  }
+  serve_http_options http = {address, atoi(port), bb_command_given(r->command, "address")};
   char url[256];
   if (serve_http_start(&s, &http, url, sizeof url) != 0) {
     serve_watch_stop(watch);

@@ -147,9 +147,10 @@ void serve_watch_stop(serve_watch *w);
 
 /* serve_http.c: the server. */
 typedef struct serve_http_options {
-  const char *address; /* NULL: 127.0.0.1 */
+  const char *address; /* --address's value (its default: 127.0.0.1) */
   int port;            /* 0: any free one */
-  int token;           /* 1: a random token in every path */
+  int token;           /* 1 (--address given): a random token in every path, and a
+                          share of the connections per client */
 } serve_http_options;
 /* Starts serving s; the URL of the page into url (capacity cap). Returns 0,
  * or -1 with a message in url. */

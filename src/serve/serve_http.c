@@ -869,7 +869,7 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
   sv.s = s;
   pthread_mutex_init(&sv.lock, NULL);
   pthread_cond_init(&sv.wake, NULL);
-  const char *address = o->address ? o->address : "127.0.0.1";
+  const char *address = o->address;
   struct sockaddr_storage addr;
   memset(&addr, 0, sizeof addr);
   struct sockaddr_in *v4 = (struct sockaddr_in *)&addr;
@@ -890,7 +890,7 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
   }
   /* Every local client is 127.0.0.1: a share per address only bounds
    * clients from elsewhere, which --address lets in. */
-  const unsigned per_client = o->address ? PER_CLIENT_LIMIT : 0;
+  const unsigned per_client = o->token ? PER_CLIENT_LIMIT : 0;
   sv.daemon = MHD_start_daemon(
       flags, (uint16_t)o->port, NULL, NULL, handle, &sv, MHD_OPTION_SOCK_ADDR,
       (struct sockaddr *)&addr, MHD_OPTION_CONNECTION_LIMIT, connection_limit(),
