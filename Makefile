@@ -474,7 +474,7 @@ check-python: $(BIN) lib
 # broken save, writes what `bumpbake bake` writes. Skipped, saying why,
 # without chromium, chromium-driver or python3-selenium. Screenshots:
 # build/serve-test/.
-check-serve: $(BIN)
+check-serve: $(BIN) lib
 	@echo "serve: the page in headless Chromium (tests/serve)"
 	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
 	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .

@@ -54,6 +54,7 @@ int cli_run_serve(const cli_run *r) {
   pthread_cond_init(&s.work, NULL);
   pthread_cond_init(&s.changed, NULL);
   s.height_path = height;
+  s.line = r->command; /* lives as long as the process */
   s.settings = a->job; /* the bake's parameters as parsed */
   s.job = named;
   s.brightness_file = a->job.brightness_file;

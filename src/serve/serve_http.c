@@ -1,6 +1,6 @@
 /* serve_http.c: `bumpbake serve`'s HTTP side, on libmicrohttpd: the page
- * and its files, the state as JSON and as server-sent events, the ranges of
- * the page's inputs (the library's), the textures of the last good bake as
+ * and its files, the state as JSON and as server-sent events, the page's
+ * controls (made from the library's option rows), the textures of the last good bake as
  * raw 8-bit RGBA, the controls and the "write" action. Every path is one of
  * a fixed few: no part of a request names a file. Requests must come for
  * the host they were served as (a page elsewhere cannot rebind a name to
@@ -687,8 +687,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
   }
   if (!strcmp(path, "state"))
     return send_json(c, MHD_HTTP_OK, serve_state_json(sv->s));
-  if (!strcmp(path, "ranges"))
-    return send_json(c, MHD_HTTP_OK, serve_ranges_json());
+  if (!strcmp(path, "controls"))
+    return send_json(c, MHD_HTTP_OK, serve_controls_json());
   if (!strcmp(path, "events"))
     return send_events(sv, c);
   if (!strncmp(path, "map/", 4))

@@ -1,10 +1,12 @@
-/* serve_params.c: the page's side of the options: the state it draws as
- * JSON, the ranges of its inputs as the library describes the options
- * (bb_option_bounds), and its controls (scale, rays, slices, bias, bounce,
- * bounces, brightness) applied to the bake options: each set on the page's
- * command as `bumpbake bake` sets its option of that name (bb_command_set),
- * the whole checked as the command line is (bb_command_check), whose
- * words a refusal shows. */
+/* serve_params.c: the page's side of the options: its controls, the state
+ * it draws as JSON, and its controls' values applied. The controls are
+ * options of serve's command, named once here (which rows the page shows,
+ * in order); everything else about them is the library's: the page builds
+ * its inputs from their rows (GET controls: name, type, help, default,
+ * range, bb_option_bounds), their values in the state are the command's
+ * (bb_command_value), and a value the page sends is set on the page's
+ * command by the option's name (bb_command_set), the whole checked as the
+ * command line is (bb_command_check), whose words a refusal shows. */
 #include "serve.h"
 #include "../core/json.h" /* the JSON writer, compiled into the program (Makefile) */
 #include "bumpbake_cluster.h"
@@ -15,25 +17,79 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* --------------------------------------------------------------- controls */
+
+/* The page's controls: serve's options of these names, in the page's
+ * order, each on the bake (a change bakes again) or on the light of the
+ * picture (render's --light-color: the picture is lit anew). A file
+ * option (--brightness FILE) is a switch of the file serve was given. */
+static const struct {
+  const char *name;
+  int light; /* 1: the picture's light, not the bake */
+} controls[] = {{"scale", 0},  {"rays", 0},    {"slices", 0},     {"bias", 0},
+                {"bounce", 0}, {"bounces", 0}, {"brightness", 0}, {"light-color", 1}};
+#define CONTROL_COUNT (sizeof controls / sizeof controls[0])
+
+/* The names of bb_option_type, as the controls' JSON gives them (Python's
+ * option_table names them so too). */
+static const char *const type_names[] = {"flag",    "integer", "number", "word",
+                                         "words",   "numbers", "text",   "path"};
+
+static const bb_option_info *row_of(const char *name) {
+  return bb_option_find(bb_command_info_find("serve"), name, 0);
+}
+
+/* A control's key in the JSON: its name with '_' for '-' (light_color). */
+static void key_of(const char *name, char *out, size_t cap) {
+  snprintf(out, cap, "%s", name);
+  for (char *c = out; *c; c++)
+    if (*c == '-')
+      *c = '_';
+}
+
 /* ---------------------------------------------------------------- state */
 
+/* The controls' values as the page's command holds them: numbers as
+ * numbers (several as an array), a file option as whether it is on, with
+ * the file serve was given ("brightness_file"). */
 static void add_params(bb__json *j, const serve_state *s) {
-  const bb_bake_options *b = &s->settings.bake;
   bb__json_open(j, "params", '{');
-  bb__json_number(j, "scale", (double)b->height_scale);
-  bb__json_int(j, "rays", b->rays);
-  bb__json_int(j, "slices", b->slices);
-  bb__json_int(j, "slices_traced", bb_bake_slices(b));
-  bb__json_number(j, "bias", b->trace.bias_texels);
-  bb__json_number(j, "bounce", b->bounce_albedo);
-  bb__json_int(j, "bounces", b->bounces);
-  bb__json_string(j, "brightness_file", s->brightness_file);
-  bb__json_bool(j, "brightness", s->use_brightness);
+  for (size_t i = 0; i < CONTROL_COUNT; i++) {
+    const bb_option_info *o = row_of(controls[i].name);
+    char key[64], value[256], file[80];
+    key_of(controls[i].name, key, sizeof key);
+    if (bb_command_value(s->command, controls[i].name, value, sizeof value, NULL) != BB_OK)
+      value[0] = '\0';
+    switch (o->type) {
+    case BB_OPTION_INT:
+    case BB_OPTION_NUMBER:
+      bb__json_number(j, key, strtod(value, NULL));
+      break;
+    case BB_OPTION_NUMBERS:
+      bb__json_open(j, key, '[');
+      for (const char *v = value; *v;) {
+        char *end = NULL;
+        bb__json_number(j, NULL, strtod(v, &end));
+        v = *end == ',' ? end + 1 : end + strlen(end);
+      }
+      bb__json_close(j, ']');
+      break;
+    case BB_OPTION_PATH: {
+      char given[4096];
+      const int has = bb_command_value(s->line, controls[i].name, given, sizeof given,
+                                       NULL) == BB_OK && given[0];
+      snprintf(file, sizeof file, "%s_file", key);
+      bb__json_bool(j, key, bb_command_given(s->command, controls[i].name));
+      bb__json_string(j, file, has ? given : NULL);
+      break;
+    }
+    default:
+      bb__json_string(j, key, value);
+      break;
+    }
+  }
+  bb__json_int(j, "slices_traced", bb_bake_slices(&s->settings.bake));
   bb__json_string(j, "albedo_file", s->albedo_file);
-  bb__json_open(j, "light_color", '[');
-  for (int k = 0; k < 3; k++)
-    bb__json_number(j, NULL, (double)s->light_color[k]);
-  bb__json_close(j, ']');
   bb__json_close(j, '}');
 }
 
@@ -124,23 +180,90 @@ char *serve_state_json(serve_state *s) {
   return json_text(write_state, s);
 }
 
-/* --------------------------------------------------------------- controls */
 
-/* The bake controls: bake's options of these names (parsed by the library,
- * bb_command_set, which refuses a value with the words every client prints:
- * "--rays needs an integer (got 'x')"), and where each lands in the bake
- * options. brightness is serve's switch of its --brightness FILE. */
-#define CONTROL(name, member)                                                            \
-  { name, offsetof(bb_bake_options, member), sizeof(((bb_bake_options *)0)->member) }
-static const struct {
-  const char *name;
-  size_t offset, size;
-} controls[] = {CONTROL("scale", height_scale),   CONTROL("rays", rays),
-                CONTROL("slices", slices),        CONTROL("bias", trace.bias_texels),
-                CONTROL("bounce", bounce_albedo), CONTROL("bounces", bounces)};
-#define CONTROL_COUNT (sizeof controls / sizeof controls[0])
+/* The controls as the page builds them (GET controls): each row's name,
+ * type, value words, help, default and range as help prints them, its
+ * numeric bounds (bb_option_bounds: "min" and "max" where finite,
+ * "min_exclusive" when the bottom is not allowed, "scale > 0"), and
+ * "unset": the value a command holds without it, which a control back at
+ * it leaves out (slices 0, "from rays", below --slices's range). */
+static void add_bounds(bb__json *j, const bb_option_info *o) {
+  double min, max;
+  int min_exclusive;
+  if (!bb_option_bounds(o, &min, &max, &min_exclusive))
+    return;
+  if (isfinite(min))
+    bb__json_number(j, "min", min);
+  if (isfinite(max))
+    bb__json_number(j, "max", max);
+  bb__json_bool(j, "min_exclusive", min_exclusive);
+}
 
-/* text of size bytes as a string, a NUL in it spelled "\0" (so the
+static void add_control(bb__json *j, const bb_command *fresh, size_t i) {
+  const bb_command_info *serve = bb_command_describe(fresh);
+  const bb_option_info *o = row_of(controls[i].name);
+  char key[64], text[256];
+  key_of(o->name, key, sizeof key);
+  bb__json_open(j, NULL, '{');
+  bb__json_string(j, "name", o->name);
+  bb__json_string(j, "key", key);
+  bb__json_string(j, "place", controls[i].light ? "light" : "bake");
+  bb__json_string(j, "type", type_names[o->type]);
+  bb__json_int(j, "count", o->count);
+  bb_option_value_text(o, text, sizeof text);
+  bb__json_string(j, "value_name", text);
+  bb__json_string(j, "help", o->help);
+  bb_option_default_text(serve, o, text, sizeof text);
+  bb__json_string(j, "default", text);
+  bb_option_range_text(o, text, sizeof text);
+  bb__json_string(j, "range", text);
+  if (bb_command_value(fresh, o->name, text, sizeof text, NULL) != BB_OK)
+    text[0] = '\0';
+  bb__json_string(j, "unset", text);
+  add_bounds(j, o);
+  bb__json_close(j, '}');
+}
+
+/* The range of an input of the picture, from render's option: its
+ * elevation's for --view AZ,EL and --light AZ,EL ("range EL 1..90"). */
+static void add_view_range(bb__json *j, const char *key, const char *option) {
+  const bb_option_info *o = bb_option_find(bb_command_info_find("render"), option, 0);
+  double min, max;
+  int min_exclusive;
+  if (!bb_option_bounds(o, &min, &max, &min_exclusive))
+    return;
+  bb__json_open(j, key, '{');
+  add_bounds(j, o);
+  bb__json_close(j, '}');
+}
+
+static void write_controls(bb__json *j, void *arg) {
+  const bb_command *fresh = arg;
+  bb__json_open(j, NULL, '{');
+  bb__json_open(j, "controls", '[');
+  for (size_t i = 0; i < CONTROL_COUNT; i++)
+    add_control(j, fresh, i);
+  bb__json_close(j, ']');
+  /* the picture's camera and light, as render's --view and --light take them */
+  bb__json_open(j, "view", '{');
+  add_view_range(j, "view_elevation", "view");
+  add_view_range(j, "light_elevation", "light");
+  bb__json_close(j, '}');
+  bb__json_close(j, '}');
+}
+
+char *serve_controls_json(void) {
+  bb_command *fresh = NULL;
+  if (bb_command_new("serve", &fresh, NULL) != BB_OK)
+    return NULL;
+  char *text = json_text(write_controls, fresh);
+  bb_command_free(fresh);
+  return text;
+}
+
+/* ------------------------------------------------------- values applied */
+
+/* text of size bytes as a string, a NUL in it spelled "\\0" (so the
  * parser refuses it as the text it is, not the part before it). malloc'd. */
 static char *spelled(const char *text, size_t size) {
   char *out = malloc(2 * size + 1), *o = out;
@@ -157,88 +280,77 @@ static char *spelled(const char *text, size_t size) {
   return out;
 }
 
-/* Sets control name to value on cmd (brightness: its file, or unset); a
- * bake control at its default is unset. 0, or -1 with the words in err. */
-static int apply_one(const serve_state *s, bb_command *cmd, const char *name,
-                     const char *value, int *rebake, char *err, size_t cap) {
+/* Sets control i to value on cmd, as the command line sets its option; a
+ * file option: "on" is the file serve was given, "off" none. A value at
+ * what a command holds without the option (fresh's) leaves it out, as the
+ * line the page shows does. 0, or -1 with the library's words in err. */
+static int apply_one(const serve_state *s, const bb_command *fresh, bb_command *cmd, size_t i,
+                     const char *value, char *err, size_t cap) {
+  const char *name = controls[i].name;
+  const bb_option_info *o = row_of(name);
   bb_error e = {{0}};
-  for (size_t i = 0; i < CONTROL_COUNT; i++) {
-    if (strcmp(name, controls[i].name))
-      continue;
-    *rebake = 1;
-    if (bb_command_set(cmd, name, value, &e) != BB_OK) {
-      snprintf(err, cap, "%s", e.message);
-      return -1;
-    }
-    bb_job_options d;
-    bb_job_options_init(&d);
-    const char *now =
-        (const char *)&bb_command_options_of(cmd)->job.bake + controls[i].offset;
-    if (!memcmp(now, (const char *)&d.bake + controls[i].offset, controls[i].size) &&
-        bb_command_unset(cmd, name, &e) != BB_OK) {
-      snprintf(err, cap, "%s", e.message);
-      return -1;
-    }
-    return 0;
-  }
-  if (!strcmp(name, "light-color")) { /* render's row: a light of the picture */
-    bb_render_options r;
-    bb_render_options_init(&r);
-    bb_status st = bb_command_set(cmd, name, value, &e);
-    const float *now = bb_command_options_of(cmd)->render.light_color;
-    if (st == BB_OK && !memcmp(now, r.light_color, sizeof r.light_color))
-      st = bb_command_unset(cmd, name, &e);
-    if (st != BB_OK) {
-      snprintf(err, cap, "%s", e.message);
-      return -1;
-    }
-    return 0;
-  }
-  *rebake = 1;
-  if (!strcmp(name, "brightness")) {
-    if (!s->brightness_file) {
-      snprintf(err, cap, "brightness: no --brightness FILE was given to serve");
+  bb_status st;
+  if (o->type == BB_OPTION_PATH) {
+    char given[4096];
+    if (bb_command_value(s->line, name, given, sizeof given, &e) != BB_OK || !given[0]) {
+      snprintf(err, cap, "%s: no --%s %s was given to serve", name, name, o->value_name);
       return -1;
     }
     if (strcmp(value, "on") && strcmp(value, "off")) {
-      snprintf(err, cap, "brightness: 'on' or 'off'");
+      snprintf(err, cap, "%s: 'on' or 'off'", name);
       return -1;
     }
-    const bb_status st = !strcmp(value, "on")
-                             ? bb_command_set(cmd, "brightness", s->brightness_file, &e)
-                             : bb_command_unset(cmd, "brightness", &e);
-    if (st != BB_OK) {
-      snprintf(err, cap, "%s", e.message);
-      return -1;
-    }
-    return 0;
+    st = !strcmp(value, "on") ? bb_command_set(cmd, name, given, &e)
+                              : bb_command_unset(cmd, name, &e);
+  } else {
+    char now[256], unset[256];
+    st = bb_command_set(cmd, name, value, &e);
+    if (st == BB_OK && bb_command_value(cmd, name, now, sizeof now, &e) == BB_OK &&
+        bb_command_value(fresh, name, unset, sizeof unset, &e) == BB_OK &&
+        !strcmp(now, unset))
+      st = bb_command_unset(cmd, name, &e);
   }
-  snprintf(err, cap, "unknown control '%.40s'", name);
-  return -1;
+  if (st != BB_OK) {
+    snprintf(err, cap, "%s", e.message);
+    return -1;
+  }
+  return 0;
 }
 
 int serve_apply_params(serve_state *s, const char *const *names,
                        const char *const *values, const size_t *sizes, int count,
                        int *rebake, char *err, size_t cap) {
   *rebake = 0;
-  bb_command *next = NULL;
+  bb_command *next = NULL, *fresh = NULL;
   bb_error e = {{0}};
   size_t size = 0;
   char *copy = bb_command_handover(s->command, &size);
-  if (!copy || bb_command_from_handover(copy, size, NULL, 0, &next, &e) != BB_OK) {
+  if (!copy || bb_command_from_handover(copy, size, NULL, 0, &next, &e) != BB_OK ||
+      bb_command_new("serve", &fresh, &e) != BB_OK) {
     free(copy);
+    bb_command_free(next);
     snprintf(err, cap, "%s", copy ? e.message : "out of memory");
     return -1;
   }
   free(copy);
   int rc = 0;
-  for (int i = 0; i < count && rc == 0; i++) {
-    char *value = spelled(values[i], sizes[i]);
-    rc = value ? apply_one(s, next, names[i], value, rebake, err, cap) : -1;
+  for (int k = 0; k < count && rc == 0; k++) {
+    size_t i = 0;
+    while (i < CONTROL_COUNT && strcmp(names[k], controls[i].name))
+      i++;
+    if (i == CONTROL_COUNT) {
+      snprintf(err, cap, "unknown control '%.40s'", names[k]);
+      rc = -1;
+      break;
+    }
+    *rebake |= !controls[i].light;
+    char *value = spelled(values[k], sizes[k]);
+    rc = value ? apply_one(s, fresh, next, i, value, err, cap) : -1;
     if (!value)
       snprintf(err, cap, "out of memory");
     free(value);
   }
+  bb_command_free(fresh);
   if (rc == 0 && bb_command_check(next, &e) != BB_OK) {
     snprintf(err, cap, "%s", e.message);
     rc = -1;
@@ -247,57 +359,17 @@ int serve_apply_params(serve_state *s, const char *const *names,
     bb_command_free(next);
     return -1;
   }
-  /* the controls' values, as checked; the rest of the settings (paths
-   * and files the command line named, owned by its command) stay */
-  const bb_bake_options *b = &bb_command_options_of(next)->job.bake;
-  for (size_t i = 0; i < CONTROL_COUNT; i++)
-    memcpy((char *)&s->settings.bake + controls[i].offset,
-           (const char *)b + controls[i].offset, controls[i].size);
+  /* the controls' values, as checked: the bake's parameters are the page's
+   * command's (no file named in them: the command line's files, which its
+   * command owns, stay in the rest of the settings), its brightness switch
+   * and its light */
+  const bb_command_options *now = bb_command_options_of(next);
+  s->settings.bake = now->job.bake;
   s->use_brightness = bb_command_given(next, "brightness");
-  memcpy(s->light_color, bb_command_options_of(next)->render.light_color,
-         sizeof s->light_color);
+  memcpy(s->light_color, now->render.light_color, sizeof s->light_color);
   bb_command_free(s->command);
   s->command = next;
   s->version++;
   pthread_cond_broadcast(&s->changed);
   return 0;
-}
-
-/* ----------------------------------------------------------------- ranges */
-
-/* One input's range as the library describes its option: "min" and
- * "max" where finite, "min_exclusive" when the bottom is not allowed
- * ("scale > 0"). An option without a numeric range writes nothing. */
-static void add_range(bb__json *j, const char *key, const char *command,
-                      const char *option) {
-  const bb_option_info *o = bb_option_find(bb_command_info_find(command), option, 0);
-  double min, max;
-  int min_exclusive;
-  if (!bb_option_bounds(o, &min, &max, &min_exclusive))
-    return;
-  bb__json_open(j, key, '{');
-  if (isfinite(min))
-    bb__json_number(j, "min", min);
-  if (isfinite(max))
-    bb__json_number(j, "max", max);
-  bb__json_bool(j, "min_exclusive", min_exclusive);
-  bb__json_close(j, '}');
-}
-
-static void write_ranges(bb__json *j, void *arg) {
-  (void)arg;
-  bb__json_open(j, NULL, '{');
-  /* the bake controls: bake's options of their names */
-  for (size_t i = 0; i < CONTROL_COUNT; i++)
-    add_range(j, controls[i].name, "bake", controls[i].name);
-  /* the picture's camera and light, as render's --view AZ,EL and --light
-   * AZ,EL take them: their range is the elevation's ("range EL 1..90") */
-  add_range(j, "view_elevation", "render", "view");
-  add_range(j, "light_elevation", "render", "light");
-  add_range(j, "light_color", "render", "light-color");
-  bb__json_close(j, '}');
-}
-
-char *serve_ranges_json(void) {
-  return json_text(write_ranges, NULL);
 }
