@@ -2351,9 +2351,9 @@ int bb_command_given(const bb_command *command, const char *name);
  * takes it and as bb_command_text spells it ("256", "0.55", "vertex",
  * "1,1,1"), into out (capacity cap): the value set, else the default a new
  * command holds; a flag "1" when given, else "0"; a file not given "".
- * The options a client keeps to itself, which land in no field of
- * bb_command_options (serve's --port and --address), are read here: the
- * text set, else their default (bb_option_info.default_text). Errors:
+ * The options a client keeps to itself (serve's --port and --address),
+ * which land in no field of the options struct, are read here: the text
+ * set, else their default (bb_option_info.default_text). Errors:
  * BB_ERR_ARGUMENT "unknown option ..." as bb_command_set words it, or a
  * value longer than cap - 1; BB_ERR_MEMORY. */
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,

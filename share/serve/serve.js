@@ -693,7 +693,7 @@ async function sendParams(query) {
 // given its file).
 function sendControls(place) {
   const query = controls.filter((c) => c.place === place &&
-                                       (c.type !== "path" || state.params[c.key + "_file"]))
+                                       (c.type !== "path" || (state && state.params[c.key + "_file"])))
     .map((c) => c.name + "=" + encodeURIComponent(controlValue(c)));
   sendParams(query);
 }
