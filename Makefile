@@ -28,6 +28,9 @@ CFLAGS  += -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(OPT) $(WARN)
 CXXFLAGS+= -std=c++17 -pthread $(OPT) -Wall -Wextra -Wshadow
 LIB_INCLUDES  := -Iinclude -Isrc
 CLI_INCLUDES  := -Iinclude -Isrc/cli
+# serve (src/serve/) sees the public header and its own folder; the CLI's
+# printing and the JSON writer by their relative paths ("../cli/common.h").
+SERVE_INCLUDES := -Iinclude
 TEST_INCLUDES := -Iinclude -Isrc -Itests
 # Library objects go into libbumpbake.so as well as libbumpbake.a, so they
 # are position-independent. -fno-semantic-interposition keeps GCC inlining
@@ -51,8 +54,8 @@ ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # Imath's half.h (C, header only) converts floats to half for VTF and DDS;
 # the blocks of both are bumpbake's own codec (src/texture/bc1.c, bc4.c).
-# libmicrohttpd: the HTTP server of `bumpbake serve` (src/cli/serve/ only,
-# linked into the CLI, not the library).
+# libmicrohttpd: the HTTP server of `bumpbake serve` (src/serve/ only,
+# linked into the program, not the library).
 MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
 MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
 # OpenEXR's IlmThread: bumpbake's provider for its pool (src/image/exr_pool.cpp).
@@ -137,10 +140,13 @@ comma := ,
 FAMILIES := core files texture image trace bake maps render mesh job cmd
 LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
 LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
-CLI_C    := $(wildcard src/cli/*.c) $(wildcard src/cli/serve/*.c)
-# `bumpbake serve` (src/cli/serve.c, src/cli/serve/): the CLI's only HTTP
-# server, left out of the test binary and the fuzz targets.
-SERVE_C  := src/cli/serve.c $(wildcard src/cli/serve/*.c)
+# `bumpbake serve` (src/serve/): a client of its own above the CLI (it
+# prints as the CLI does), the program's only HTTP server, linked into the
+# program by src/cli/main.c and left out of the test binary and the fuzz
+# targets.
+SERVE_C  := $(wildcard src/serve/*.c)
+# The program's sources: the CLI and serve.
+CLI_C    := $(wildcard src/cli/*.c) $(SERVE_C)
 # The page it serves, embedded into serve_page.o at build time.
 SERVE_ASSETS := $(wildcard share/serve/*) shaders/ssbump_relief.glsl
 TEST_C   := $(wildcard tests/*/test_*.c)
@@ -245,8 +251,8 @@ $(BUILD)/link.flags: FORCE
 
 $(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
-$(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(CLI_INCLUDES) $(MHD_CFLAGS)
-$(BUILD)/src/cli/serve/serve_page.o: $(SERVE_ASSETS)
+$(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(SERVE_INCLUDES) $(MHD_CFLAGS)
+$(BUILD)/src/serve/serve_page.o: $(SERVE_ASSETS)
 $(TEST_OBJ) $(TOOL_OBJ): EXTRA_CFLAGS := $(TEST_INCLUDES)
 
 $(CLI_JSON_OBJ): src/core/json.c $(BUILD)/compile.flags
@@ -477,7 +483,7 @@ check-python: $(BIN) lib
 # broken save, writes what `bumpbake bake` writes. Skipped, saying why,
 # without chromium, chromium-driver or python3-selenium. Screenshots:
 # build/serve-test/.
-check-serve: $(BIN)
+check-serve: $(BIN) lib
 	@echo "serve: the page in headless Chromium (tests/serve)"
 	@cd tests/serve && BB_BIN=$(abspath $(BIN)) BB_SERVE_SHOTS=$(abspath $(BUILD))/serve-test \
 	  PYTHONDONTWRITEBYTECODE=1 $(PYTHON) -m pytest -q -rs -p no:cacheprovider .

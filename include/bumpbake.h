@@ -2225,8 +2225,6 @@ typedef struct bb_command_options {
   int allow_outside_base;       /* program --allow-outside-base */
   int json, quiet;              /* how a command-line client prints */
   const char *scheduler;        /* bake --scheduler: a Dask scheduler's address */
-  int port;                     /* serve --port (0: any free one) */
-  const char *address;          /* serve --address: an IPv4 or IPv6 address, or NULL */
 } bb_command_options;
 
 /* ------------------------------------------------------------ commands */
@@ -2301,6 +2299,17 @@ void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 
 /* 1 when option name was set. */
 int bb_command_given(const bb_command *command, const char *name);
+/* The value of option name as command holds it, spelled as the option
+ * takes it and as bb_command_text spells it ("256", "0.55", "vertex",
+ * "1,1,1"), into out (capacity cap): the value set, else the default a new
+ * command holds; a flag "1" when given, else "0"; a file not given "".
+ * The options a client keeps to itself (serve's --port and --address),
+ * which land in no field of the options struct, are read here: the text
+ * set, else their default (bb_option_info.default_text). Errors:
+ * BB_ERR_ARGUMENT "unknown option ..." as bb_command_set words it, or a
+ * value longer than cap - 1; BB_ERR_MEMORY. */
+bb_status bb_command_value(const bb_command *command, const char *name, char *out,
+                           size_t cap, bb_error *err);
 /* The options as set (defaults elsewhere); owned by command. */
 const bb_command_options *bb_command_options_of(const bb_command *command);
 /* The inputs added, and how many. */

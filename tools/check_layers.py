@@ -3,16 +3,19 @@
 family of the library reaches up to a family above it.
 
 The families are the folders of src/, in the order written once in
-docs/how-it-works.md ("Layers": a line "core < files < ... < cli"). A family
-may use itself and the families before it, never one after it:
+docs/how-it-works.md ("Layers": a line "core < files < ... < cli < serve"). A
+family may use itself and the families before it, never one after it:
 - includes: every #include "FAMILY/..." of a file in src/FAMILY2/, and every
   relative one ("../FAMILY/x.h", or "x.h" found beside the file), must name
   FAMILY2 or a family before it;
 - calls: an object of src/FAMILY2/ may use a global symbol (nm) defined by
-  an object of FAMILY2 or of a family before it, not one after it.
+  an object of FAMILY2 or of a family before it, not one after it. The
+  program's entry (main.o) is no family's: it links the clients (the CLI
+  and serve, above it) into one program, and may call any of them.
+The clients (cli, serve) close the order; the library is the rest.
 It also fails when a folder of src/ holding sources is missing from the
 order, when --families (the Makefile's FAMILIES) or the sections of
-include/bumpbake.h are not the order without cli, or when the README's
+include/bumpbake.h are not the order without the clients, or when the README's
 "Layout" table lists the folders in another order.
 `make check-layers` runs it over the library's and the CLI's objects; it
 prints every offence and exits 1, or prints one line and exits 0.
@@ -27,6 +30,11 @@ from object_symbols import links
 ORDER_LINE = re.compile(r"^\s*(?:`|    )?([a-z]+(?:\s*<\s*[a-z]+)+)`?\s*$")
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
 SOURCE_EXT = (".c", ".cpp", ".h")
+# The families that are clients of the library (on its public header): the
+# last of the order, in neither the Makefile's FAMILIES nor the header.
+CLIENTS = ("cli", "serve")
+# The program's entry: it links the clients together, so it calls up.
+PROGRAM_ENTRY = "main.o"
 
 
 def family_order(root):
@@ -41,7 +49,7 @@ def family_order(root):
             m = ORDER_LINE.match(line.rstrip("\n")) if in_section else None
             if m:
                 return [w.strip() for w in m.group(1).split("<")]
-    raise SystemExit(f"check_layers: {path} has no line 'core < ... < cli' under '## Layers'")
+    raise SystemExit(f"check_layers: {path} has no line 'core < ... < cli < serve' under '## Layers'")
 
 
 def readme_order(root):
@@ -109,6 +117,8 @@ def call_offences(objects, rank):
     defined_by, uses = links(objects)
     offences = []
     for obj in objects:
+        if os.path.basename(obj) == PROGRAM_ENTRY:
+            continue
         for sym in sorted(uses[obj]):
             other = defined_by.get(sym)
             if not other:
@@ -139,17 +149,17 @@ def main(argv):
     for name in order:
         if not os.path.isdir(os.path.join(src, name)):
             offences.append(f"docs/how-it-works.md names {name}, which is not a folder of src/")
-    library = [f for f in order if f != "cli"]
+    library = [f for f in order if f not in CLIENTS]
     if args.families is not None and args.families.split() != library:
         offences.append(f"the Makefile's FAMILIES ({args.families}) are not the order of "
-                        f"docs/how-it-works.md without cli ({' '.join(order)})")
+                        f"docs/how-it-works.md without {' and '.join(CLIENTS)} ({' '.join(order)})")
     readme = readme_order(root)
     if readme and readme != order:
         offences.append(f"README.md's Layout lists {' '.join(readme)}, not {' '.join(order)}")
     header = header_order(root)
     if header != library:
         offences.append(f"include/bumpbake.h's sections are {' '.join(header)}, not the order "
-                        f"without cli ({' '.join(library)})")
+                        f"without {' and '.join(CLIENTS)} ({' '.join(library)})")
     includes, count = include_offences(src, rank)
     offences += includes
     offences += call_offences(args.objects, rank)

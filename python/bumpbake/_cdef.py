@@ -628,8 +628,6 @@ typedef struct bb_command_options {
   int allow_outside_base;
   int json, quiet;
   const char *scheduler;
-  int port;
-  const char *address;
 } bb_command_options;
 
 typedef struct bb_command bb_command;

@@ -4,8 +4,10 @@
 // the bake shown as the rectangle it changed, "map/NAME?since=ID"), draws them
 // with WebGL 2 (serve.frag.glsl after shaders/ssbump_relief.glsl), relights
 // as the light is dragged, and sends the controls ("params") and the write
-// action ("write"). The inputs' ranges are the library's ("ranges": the
-// options' descriptions), none of the page's own. The picture zooms and
+// action ("write"). The controls are the library's: the page builds them
+// from "controls" (the rows of the options serve offers: name, type, help,
+// default, range), their values are the state's, and nothing of them is
+// the page's own. The picture zooms and
 // pans, shows the bake before in turns with the last (A/B), and is dimmed,
 // saying why, whenever it is not the maps of now. Once a bake's maps are
 // drawn, <body data-drawn-bake> holds its id and data-drawn-at the time
@@ -33,7 +35,8 @@ const bakeBasis = {};      // each bake's basis directions by id: the ssbump's l
 const SSBUMP_MODES = [0, 8];  // the modes that light the ssbump with the basis
 const LIT_MODES = [0, 1, 2, 8];  // the modes a light (and a colour map) lights
 const RELIEF_MODE = 8;           // the one mode seen from a camera
-let ranges = {};          // the server's "ranges": {name: {min, max, min_exclusive}}
+let controls = [];        // the server's "controls": the options the page offers, as rows
+let ranges = {};          // the picture's ranges: {view_elevation, light_elevation: {min, max, ...}}
 // The camera on the picture: canvas pixels a texel (0: fit the maps), and
 // the texel at the picture's centre.
 const camera = { zoom: 0, cx: 0, cy: 0 };
@@ -195,10 +198,12 @@ function compile(type, source) {
 async function setup() {
   if (!gl) throw new Error("this browser has no WebGL 2");
   const [relief, frag, got] = await Promise.all(
-    ["ssbump_relief.glsl", "serve.frag.glsl", "ranges"].map((f) => fetch(f).then(
-      (r) => f === "ranges" ? r.json() : r.text())));
-  ranges = got;
-  showRanges();
+    ["ssbump_relief.glsl", "serve.frag.glsl", "controls"].map((f) => fetch(f).then(
+      (r) => f === "controls" ? r.json() : r.text())));
+  controls = got.controls;
+  ranges = got.view;
+  buildControls();
+  bound($("view-el"), ranges.view_elevation);
   const vs = "#version 300 es\nin vec2 aPos;\nvoid main() { gl_Position = vec4(aPos, 0.0, 1.0); }\n";
   const fs = "#version 300 es\nprecision highp float;\nprecision highp int;\n" +
              "precision highp sampler2D;\n" + relief + "\n" + frag;
@@ -484,8 +489,6 @@ window.bbCanvasStats = function () {
 
 // ---------------------------------------------------------------- state
 
-const PARAMS = ["scale", "rays", "slices", "bias", "bounce", "bounces"];
-
 // The library's range of an input as its min and max: a bottom the range
 // leaves out ("scale > 0") is no HTML min, which would let it in.
 function bound(input, r) {
@@ -494,12 +497,78 @@ function bound(input, r) {
   if (r.max !== undefined) input.max = String(r.max);
 }
 
-function showRanges() {
-  for (const p of PARAMS) {
-    // slices 0 is "from rays" (a bake's slices 0), below --slices's range
-    bound($("p-" + p), p === "slices" ? { max: ranges[p] && ranges[p].max } : ranges[p]);
+// The input of a control, by its row's type: a number box (its range as
+// min and max, but no min above the value the option holds unset, which
+// the control goes back to: slices 0, "from rays"), a box of several
+// numbers or of text, a list of words, a check box for a flag and for a
+// file option (on: the file serve was given).
+function controlInput(c) {
+  let input;
+  if (c.type === "integer" || c.type === "number") {
+    input = document.createElement("input");
+    input.type = "number";
+    input.step = c.type === "integer" ? "1" : "any";
+    const unset = Number(c.unset);
+    bound(input, { min: c.min !== undefined && unset < c.min ? undefined : c.min,
+                   max: c.max, min_exclusive: c.min_exclusive });
+  } else if (c.type === "word") {
+    input = document.createElement("select");
+    for (const word of c.value_name.split("|")) input.add(new Option(word, word));
+  } else if (c.type === "flag" || c.type === "path") {
+    input = document.createElement("input");
+    input.type = "checkbox";
+  } else {
+    input = document.createElement("input");
+    input.type = "text";
+    input.size = 11;
   }
-  bound($("view-el"), ranges.view_elevation);
+  input.id = "p-" + c.name;
+  const more = [c.default && "default " + c.default, c.range && "range " + c.range];
+  input.title = "--" + c.name + (c.value_name && c.type !== "word" ? " " + c.value_name : "") +
+                ": " + c.help + (more.some(Boolean) ? " (" + more.filter(Boolean).join("; ") + ")" : "");
+  return input;
+}
+
+function isSwitch(c) {
+  return c.type === "flag" || c.type === "path";
+}
+
+// Each control in its place ("bake" or "light"), labelled by its option.
+function buildControls() {
+  for (const c of controls) {
+    const input = controlInput(c), label = document.createElement("label");
+    label.id = "label-" + c.name;
+    if (isSwitch(c)) {
+      const file = document.createElement("span");
+      file.id = "file-" + c.name;
+      label.append(input, " " + c.name + " ", file);
+    } else {
+      label.append(c.name + " ", input);
+    }
+    $("controls-" + c.place).appendChild(label);
+    input.addEventListener("change", () => sendControls(c.place));
+  }
+}
+
+// A control's value as the state holds it, as its input shows it.
+function showControl(c, s) {
+  const input = $("p-" + c.name), value = s.params[c.key];
+  if (c.type === "path") {
+    const file = s.params[c.key + "_file"];
+    $("label-" + c.name).style.display = file ? "" : "none";
+    $("file-" + c.name).textContent = file ? "(" + file + ")" : "";
+  }
+  if (isSwitch(c)) input.checked = !!value;
+  else if (document.activeElement !== input)
+    input.value = Array.isArray(value) ? value.join(",") : String(value);
+}
+
+// The value a control sends: a file option "on" or "off", a flag 1 or 0.
+function controlValue(c) {
+  const input = $("p-" + c.name);
+  if (c.type === "path") return input.checked ? "on" : "off";
+  if (c.type === "flag") return input.checked ? "1" : "0";
+  return input.value;
 }
 
 // Why the picture is not the maps of now, or "" when it is.
@@ -558,15 +627,8 @@ function showState(s) {
                                        Math.round(100 * s.progress) + "%"
                                      : (s.bake ? "bake " + s.bake.id + " shown" : "no bake yet");
   $("error").textContent = s.error ? s.error + " (the last good maps stay shown)" : "";
-  for (const p of PARAMS) {
-    const input = $("p-" + p);
-    if (document.activeElement !== input) input.value = s.params[p];
-  }
-  if (document.activeElement !== $("light-color"))
-    $("light-color").value = s.params.light_color.map((x) => +x.toPrecision(7)).join(",");
+  for (const c of controls) showControl(c, s);
   $("albedo-name").textContent = s.params.albedo_file ? "(" + s.params.albedo_file + ")" : "";
-  $("brightness-label").style.display = s.params.brightness_file ? "" : "none";
-  $("p-brightness").checked = s.params.brightness;
   if (s.bake) {
     const b = s.bake;
     bakeScale[b.id] = b.scale;
@@ -626,18 +688,16 @@ async function sendParams(query) {
   }
 }
 
-function sendBakeControls() {
-  const query = PARAMS.map((p) => p + "=" + encodeURIComponent($("p-" + p).value));
-  if (state && state.params.brightness_file)
-    query.push("brightness=" + ($("p-brightness").checked ? "on" : "off"));
+// The controls of a place, all at once, each by its option's name: the
+// library parses and checks them (a file option only when serve was
+// given its file).
+function sendControls(place) {
+  const query = controls.filter((c) => c.place === place &&
+                                       (c.type !== "path" || (state && state.params[c.key + "_file"])))
+    .map((c) => c.name + "=" + encodeURIComponent(controlValue(c)));
   sendParams(query);
 }
 
-for (const p of PARAMS) $("p-" + p).addEventListener("change", sendBakeControls);
-$("p-brightness").addEventListener("change", sendBakeControls);
-// render's --light-color, parsed and checked by the library
-$("light-color").addEventListener("change", () =>
-  sendParams(["light-color=" + encodeURIComponent($("light-color").value)]));
 $("mode").addEventListener("input", () => {
   showControls();
   const m = current, need = texturesOf(Number($("mode").value));

@@ -50,7 +50,7 @@ int cli_run_compare(const cli_run *r);
 int cli_run_check(const cli_run *r);
 int cli_run_info(const cli_run *r);
 int cli_run_renderbumpflat(const cli_run *r);
-int cli_run_serve(const cli_run *r); /* serve.c */
+int cli_run_serve(const cli_run *r); /* src/serve/serve.c: main.c links it in */
 
 /* `bumpbake --help` and `bumpbake COMMAND --help` (help.c), from the
  * descriptions. */

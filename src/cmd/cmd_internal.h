@@ -70,6 +70,10 @@ struct bb__command {
   bb__run_fn run;
   /* notes said before run starts (what it will cost); NULL: none */
   void (*before_run)(const bb_command *c, const bb_command_hooks *hooks);
+  /* the maps it asks whatever its outputs name (BB_MAP_BIT(kind)s), for
+   * the rules that look at them: serve's page shows every map; 0: those
+   * its job asks (bb__job_maps_asked) */
+  unsigned maps_asked;
 };
 
 /* The most options one command has. */

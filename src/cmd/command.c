@@ -100,20 +100,65 @@ const char *bb_command_input(const bb_command *c, int i) {
   return c && i >= 0 && i < c->input_count ? c->inputs[i] : NULL;
 }
 
+/* The option's value as c holds it, spelled as it takes it: the text of an
+ * option kept as text (BB__FIELD_KEPT), else its field's, printed. */
+static void value_text(const bb_command *c, int i, bb__text *t) {
+  const bb__option *o = c->def->options[i];
+  if (o->info.type == BB_OPTION_FLAG)
+    bb__text_add(t, c->given[i] ? "1" : "0");
+  else if (bb__option_field(o) == BB__FIELD_KEPT && !c->given[i])
+    bb__text_add(t, o->info.default_text);
+  else if (o->print)
+    o->print(c, o, t);
+  else
+    bb__print_generic(c, o, t);
+}
+
+static bb_status unknown_option(const bb_command *c, const char *name, bb_error *err);
+
+bb_status bb_command_value(const bb_command *c, const char *name, char *out, size_t cap,
+                           bb_error *err) {
+  if (out && cap)
+    out[0] = '\0';
+  if (!c || !name || !out || !cap)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named, or no room for its value");
+  const int i = bb__option_find(c->def, name);
+  if (i < 0)
+    return bb__spelled(c, unknown_option(c, name, err), err);
+  bb__text t = {0};
+  value_text(c, i, &t);
+  char *text = bb__text_take(&t); /* "" for no value (a file not given) */
+  if (!text)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  const size_t n = strlen(text);
+  if (n >= cap) {
+    free(text);
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s: its value is longer than %zu bytes",
+                    c->def->options[i]->info.name, cap - 1);
+  }
+  memcpy(out, text, n + 1);
+  free(text);
+  return BB_OK;
+}
+
 /* --------------------------------------------------------------- setting */
+
+/* "unknown option '--rayz' (did you mean --rays?)" */
+static bb_status unknown_option(const bb_command *c, const char *name, bb_error *err) {
+  const bb_option_info *near = bb_option_nearest(&c->def->info, name, 0);
+  if (near)
+    return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (did you mean --%s?)",
+                    name, near->name);
+  return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (see --help)", name);
+}
 
 static bb_status set_option(bb_command *c, const char *name, const char *text,
                             bb_error *err) {
   if (!c || !name)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named");
   const int i = bb__option_find(c->def, name);
-  if (i < 0) {
-    const bb_option_info *near = bb_option_nearest(&c->def->info, name, 0);
-    if (near)
-      return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (did you mean --%s?)",
-                      name, near->name);
-    return bb__fail(err, BB_ERR_ARGUMENT, "unknown option '--%.64s' (see --help)", name);
-  }
+  if (i < 0)
+    return unknown_option(c, name, err);
   const bb__option *o = c->def->options[i];
   if (o->info.type != BB_OPTION_FLAG && !text)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s needs a value", o->info.name);
@@ -203,28 +248,31 @@ bb_status bb_command_unset(bb_command *c, const char *name, bb_error *err) {
   const bb__option *o = c->def->options[i];
   const size_t size = field_size(bb__option_field(o));
   const size_t offset = bb__option_offset(o);
-  if (o->set || bb__option_sets(o).field != BB__FIELD_NONE || !size)
+  const int kept = bb__option_field(o) == BB__FIELD_KEPT; /* its text alone */
+  if (o->set || bb__option_sets(o).field != BB__FIELD_NONE || (!size && !kept))
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s cannot be unset: leave it out",
                     o->info.name);
   if (!c->given[i])
     return BB_OK;
   /* the default is a fresh command's (its init included); a default
    * string is a constant, never one of that command's copies */
-  bb_command *fresh = NULL;
-  bb_status st = bb_command_new(c->def->info.name, &fresh, err);
-  if (st != BB_OK)
-    return st;
-  memcpy((char *)&c->options + offset, (const char *)&fresh->options + offset, size);
-  bb_command_free(fresh);
+  if (!kept) {
+    bb_command *fresh = NULL;
+    bb_status st = bb_command_new(c->def->info.name, &fresh, err);
+    if (st != BB_OK)
+      return st;
+    memcpy((char *)&c->options + offset, (const char *)&fresh->options + offset, size);
+    bb_command_free(fresh);
+  }
   c->given[i] = 0;
   c->texts[i] = NULL;
-  int kept = 0; /* its further files go too */
+  int more = 0; /* its further files go too */
   for (int m = 0; m < c->more_count; m++)
     if (c->more_option[m] != i) {
-      c->more_option[kept] = c->more_option[m];
-      c->more_path[kept++] = c->more_path[m];
+      c->more_option[more] = c->more_option[m];
+      c->more_path[more++] = c->more_path[m];
     }
-  c->more_count = kept;
+  c->more_count = more;
   c->value_count[i] = 0;
   memset(c->values[i], 0, sizeof c->values[i]);
   c->checked = 0;

@@ -822,30 +822,33 @@ const bb__option bb__opt_albedo = {
 
 /* --------------------------------------------------------------- serve */
 
+/* Where serve listens: serve's own options, in no field of the options
+ * (BB__FIELD_KEPT): serve reads them with bb_command_value. */
 static const bb__range range_port = {"port", 0, 65535, 0, 1};
 
 /* --address: an IPv4 or IPv6 address (not a name to look up). */
 static bb_status set_address(bb_command *c, const bb__option *o, const char *text,
                              double *values, int *count, bb_error *err) {
-  (void)values;
+  (void)c, (void)values;
   *count = 0;
   unsigned char any[sizeof(struct in6_addr)];
   if (inet_pton(AF_INET, text, any) != 1 && inet_pton(AF_INET6, text, any) != 1)
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s: '%.64s' is not an IPv4 or IPv6 address",
                     o->info.name, text);
-  return bb__set_generic(c, o, text, values, count, err);
+  return BB_OK; /* bb_command_set keeps the text */
 }
 
 static const bb__option opt_port = {
     .info = {.name = "port", .value_name = "N", .type = BB_OPTION_INT, .count = 1, .values = 1,
+             .default_text = "8077",
              .help = "the port to listen on, 0 = any free one (the URL printed says which)"},
-    .field = BB__FIELD_INT, .offset = AT(port), .range = &range_port};
+    .field = BB__FIELD_KEPT, .range = &range_port};
 static const bb__option opt_address = {
     .info = {.name = "address", .value_name = "A", .type = BB_OPTION_TEXT, .count = 1,
              .values = 1, .default_text = "127.0.0.1",
              .help = "listen on this IPv4 or IPv6 address instead: the URL then carries a "
                      "random token every request needs"},
-    .field = BB__FIELD_STRING, .offset = AT(address), .set = set_address};
+    .field = BB__FIELD_KEPT, .set = set_address};
 static const bb__option opt_serve_quiet = ROW_QUIET('q', "print only the URL, not each bake");
 
 static const bb__option *const serve_options[] = {
@@ -858,10 +861,6 @@ static const bb__option *const serve_options[] = {
     &bb__opt_texture_format, &bb__opt_vtf_version, &bb__opt_vtf_flags, &bb__opt_nomip,
     &bb__opt_fast_compression, &bb__opt_light_color, &bb__opt_albedo, &opt_port, &opt_address,
     &opt_serve_quiet, &bb__opt_help, NULL};
-
-static void serve_init(bb_command_options *o) {
-  o->port = 8077; /* the documented port serve listens on unless told */
-}
 
 const bb__command bb__command_serve = {
     .info = {.name = "serve",
@@ -880,4 +879,4 @@ const bb__command bb__command_serve = {
                  "Ctrl-C stops. See docs/commands/serve.md.",
              .inputs = "HEIGHT", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof serve_options / sizeof serve_options[0]) - 1},
-    .options = serve_options, .init = serve_init};
+    .options = serve_options, .maps_asked = BB_MAPS_BAKED /* its page shows every map */};

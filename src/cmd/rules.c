@@ -7,7 +7,6 @@
 #include "core/file_names.h"
 #include "job/job_internal.h"
 
-#include <string.h>
 #include <strings.h>
 
 /* The files c writes whose formats are known before it runs (a batch's
@@ -48,13 +47,14 @@ int bb__applies_vtf(const bb_command *c) {
   return any_output(c, "vtf", NULL);
 }
 
-/* The bake's maps c asks for: the job's rule (bb__job_maps_asked), or
- * those of a bake in memory, or serve's (its page shows every map). */
+/* The bake's maps c asks for: those of a bake in memory, or those the
+ * command always asks (serve's: its page shows every map), else the job's
+ * rule (bb__job_maps_asked). */
 static unsigned maps_asked(const bb_command *c) {
   if (c->in_memory)
     return c->memory_maps;
-  if (!strcmp(c->def->info.name, "serve"))
-    return BB_MAPS_BAKED;
+  if (c->def->maps_asked)
+    return c->def->maps_asked;
   return bb__job_maps_asked(&c->options.job);
 }
 

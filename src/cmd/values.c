@@ -202,7 +202,8 @@ static void set_flag_sets(bb_command *c, const bb__option *o) {
   case BB__FIELD_NONE:
   case BB__FIELD_FLOAT:
   case BB__FIELD_DOUBLE:
-  case BB__FIELD_ANGLES: break;
+  case BB__FIELD_ANGLES:
+  case BB__FIELD_KEPT: break;
   }
 }
 
@@ -266,6 +267,8 @@ bb_status bb__set_generic(bb_command *c, const bb__option *o, const char *text,
   case BB_OPTION_TEXT: {
     if (o->info.type == BB_OPTION_PATH && !*text)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s needs a path (got '')", name);
+    if (kind == BB__FIELD_KEPT)
+      return BB_OK; /* bb_command_set keeps the text */
     if (kind != BB__FIELD_STRING)
       return bb__fail(err, BB_ERR_ARGUMENT, "%s: no field to set", name);
     char *kept = bb__command_keep(c, text);
@@ -293,9 +296,14 @@ void bb__print_floats(bb__text *t, const float *v, int n) {
 }
 
 void bb__print_generic(const bb_command *c, const bb__option *o, bb__text *t) {
-  if (o->job)
+  if (o->job) {
     bb__bake_row_value(o->job, &c->options.job, t);
-  else
+  } else if (o->field == BB__FIELD_KEPT) {
+    /* an option of no field (a client's own, serve's --port): its text */
+    const int i = bb__option_find(c->def, o->info.name);
+    bb__text_add(t, i >= 0 ? c->texts[i] : NULL);
+  } else {
     bb__field_text(o->field, o->info.type == BB_OPTION_FLAG, o->names,
                    (const char *)&c->options + o->offset, t);
+  }
 }

@@ -226,6 +226,7 @@ int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
     return ((const double *)a)[0] != ((const double *)b)[0] ||
            ((const double *)a)[1] != ((const double *)b)[1];
   case BB__FIELD_NONE:
+  case BB__FIELD_KEPT:
     return 0;
   }
   return 0;
@@ -259,6 +260,7 @@ void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *va
     bb__text_printf(t, "%s,%s", buf, el);
     return;
   case BB__FIELD_NONE:
+  case BB__FIELD_KEPT:
     return;
   }
 }

@@ -23,8 +23,11 @@ typedef enum bb__field {
   BB__FIELD_DOUBLE,
   BB__FIELD_STRING, /* const char *, owned by the command */
   BB__FIELD_ENUM,   /* an enum, stored as int (enums of the API are int-sized) */
-  BB__FIELD_ANGLES  /* AZ,EL: double azimuth, then double elevation (the range's);
+  BB__FIELD_ANGLES, /* AZ,EL: double azimuth, then double elevation (the range's);
                        sets (bb__flag_sets) turns the light or camera on */
+  BB__FIELD_KEPT    /* in no field: the text given is its value, read with
+                       bb_command_value (a client's own option: serve's
+                       --port and --address); not given, its default_text */
 } bb__field;
 
 /* An enum's name for value i ("unknown" or NULL past the last), and its

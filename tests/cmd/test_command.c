@@ -555,10 +555,63 @@ Test(cmd, unset_puts_an_option_back_at_its_default) {
   cr_expect_eq(bb_command_unset(c, "basis", &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "--basis cannot be unset: leave it out");
   bb_command_free(c);
-  /* a command's own default (serve's port) comes back too */
-  const char *serve[] = {"h.png", "--scale", "8", "--port", "9000", NULL};
+  /* a command's own default (height2ssbump's 250 rays) comes back too */
+  const char *h2s[] = {"h.png", "8", "--rays", "64", NULL};
+  c = command("height2ssbump", h2s);
+  cr_expect_eq(bb_command_options_of(c)->job.bake.rays, 64);
+  cr_assert_eq(bb_command_unset(c, "rays", &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_options_of(c)->job.bake.rays, 250);
+  bb_command_free(c);
+}
+
+/* bb_command_value: an option's value as the command holds it, spelled as
+ * bb_command_text spells it, given or not; and serve's own options, which
+ * land in no field of the options (--port, --address): the text given,
+ * else the row's default, and back to it when unset. */
+Test(cmd, value_reads_an_option_given_or_not) {
+  const char *words[] = {"h.png", "--scale", "8", "--bias", "0.25", "--clamp", NULL};
+  bb_command *c = command("bake", words);
+  bb_error err = {{0}};
+  char v[64];
+  const struct {
+    const char *name, *value;
+  } want[] = {{"scale", "8"},  {"bias", "0.25"},     {"rays", "256"},   {"slices", "0"},
+              {"clamp", "1"},  {"mips", "0"},        {"normal-filter", "vertex"},
+              {"normal", ""},  {"filter_radius", "10"}};
+  for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+    cr_assert_eq(bb_command_value(c, want[i].name, v, sizeof v, &err), BB_OK, "%s",
+                 err.message);
+    cr_expect_str_eq(v, want[i].value, "%s", want[i].name);
+  }
+  cr_expect_eq(bb_command_value(c, "rayz", v, sizeof v, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "unknown option '--rayz' (did you mean --rays?)");
+  cr_expect_eq(bb_command_value(c, "normal-filter", v, 4, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(v, "");
+  bb_command_free(c);
+
+  const char *serve[] = {"h.png", "--scale", "8", "--port", "9000", "--address", "::1", NULL};
   c = command("serve", serve);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_value(c, "port", v, sizeof v, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(v, "9000");
+  cr_assert_eq(bb_command_value(c, "address", v, sizeof v, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(v, "::1");
+  char *text = bb_command_text(c, NULL, 0);
+  cr_expect_str_eq(text, "bumpbake serve h.png --scale 8 --port 9000 --address ::1");
+  free(text);
   cr_assert_eq(bb_command_unset(c, "port", &err), BB_OK, "%s", err.message);
-  cr_expect_eq(bb_command_options_of(c)->port, 8077);
+  cr_expect_not(bb_command_given(c, "port"));
+  cr_assert_eq(bb_command_value(c, "port", v, sizeof v, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(v, "8077");
+  /* the range is the row's, checked as any other */
+  cr_assert_eq(bb_command_set(c, "port", "65536", &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--port must be in 0..65535 (got 65536)");
+  bb_command_free(c);
+  const char *plain[] = {"h.png", "--scale", "8", NULL};
+  c = command("serve", plain);
+  cr_assert_eq(bb_command_value(c, "address", v, sizeof v, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(v, "127.0.0.1");
+  cr_expect_not(bb_command_given(c, "address"));
   bb_command_free(c);
 }

@@ -6,6 +6,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -116,18 +117,36 @@ def _bounds(text):
 
 
 def library_ranges(binary):
-    """The ranges of the page's inputs as `bumpbake bake --help` and
-    `bumpbake render --help` print them: the library's words, read apart
-    from the server's "ranges"."""
+    """The ranges of the picture's inputs as `bumpbake render --help` prints
+    them (its --view and --light elevations): the library's words, read
+    apart from the server's "controls"."""
     found = {}
-    for command, names in (("bake", {n: n for n in ("scale", "rays", "slices", "bias",
-                                                   "bounce", "bounces")}),
-                           ("render", {"view": "view_elevation", "light": "light_elevation",
-                                       "light-color": "light_color"})):
-        text = subprocess.run([binary, command, "--help"], capture_output=True, text=True,
-                              check=True).stdout
-        for line in text.splitlines():
-            m = re.match(r"\s+(?:-\w, )?--([\w-]+) .*; range (.*)$", line)
-            if m and m.group(1) in names:
-                found[names[m.group(1)]] = _bounds(m.group(2))
+    names = {"view": "view_elevation", "light": "light_elevation"}
+    text = subprocess.run([binary, "render", "--help"], capture_output=True, text=True,
+                          check=True).stdout
+    for line in text.splitlines():
+        m = re.match(r"\s+(?:-\w, )?--([\w-]+) .*; range (.*)$", line)
+        if m and m.group(1) in names:
+            found[names[m.group(1)]] = _bounds(m.group(2))
     return found
+
+
+def library_rows(command):
+    """The library's rows of command's options, read through the Python
+    package (bumpbake._command.option_table: bb_command_option,
+    bb_option_default_text, bb_option_range_text), apart from the server:
+    {name: {"type", "value_name", "default", "range", "help"} and, for a
+    range of numbers, its bounds ("min", "max", "min_exclusive")}."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    if os.path.join(root, "python") not in sys.path:
+        sys.path.insert(0, os.path.join(root, "python"))
+    from bumpbake import _command
+
+    rows = {}
+    for key, type_, value, default, range_text, help_ in _command.option_table(command):
+        row = {"type": type_, "value_name": value, "default": default, "range": range_text,
+               "help": help_}
+        if type_ in ("integer", "number", "numbers") and range_text:
+            row.update(_bounds(range_text))
+        rows[key.replace("_", "-")] = row
+    return rows

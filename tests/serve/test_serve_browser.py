@@ -199,27 +199,65 @@ def state_command(page):
 FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
 
 
-def test_the_inputs_carry_the_librarys_ranges(page):
+# The options serve offers on the page, in its order (serve_params.c).
+CONTROLS = ["scale", "rays", "slices", "bias", "bounce", "bounces", "brightness", "light-color"]
+# What each control's input is, by its row's type.
+INPUT_OF_TYPE = {"integer": ("INPUT", "number"), "number": ("INPUT", "number"),
+                 "numbers": ("INPUT", "text"), "path": ("INPUT", "checkbox")}
+
+
+def test_the_controls_are_the_librarys_rows(page, server):
+    """The page's controls, as it drew them, against the library's rows of
+    serve's options read apart, through the Python package: the same
+    options in the same order, each input of its row's type with its
+    range, its default and its help, showing the command's value. The page
+    makes its controls from the server's rows, so a row changed in the
+    library changes both; a page with a control or a range of its own
+    fails here."""
     sb.wait_for(lambda: sb.drawn_bake(page) >= 1, SLOW, "the first bake drawn")
+    rows = sb.library_rows("serve")
+    # the bake's controls, then the light's (in the "Show" box, above)
+    got = page.execute_script(
+        "return ['bake', 'light'].flatMap((place) => [...document.querySelectorAll("
+        "'#controls-' + place + ' :is(input, select)')]).map((i) => ({id: i.id,"
+        " tag: i.tagName, type: i.type, min: i.min, max: i.max, value: i.value,"
+        " checked: i.checked, title: i.title}))")
+    assert [g["id"] for g in got] == ["p-" + name for name in CONTROLS]
+    params = state(server)["params"]
+    for g, name in zip(got, CONTROLS):
+        row = rows[name]
+        assert (g["tag"], g["type"]) == INPUT_OF_TYPE[row["type"]], (name, g)
+        # its help and its default, as --help words them
+        assert g["title"].startswith("--%s %s: %s" % (name, row["value_name"], row["help"])), g
+        assert ("default " + row["default"] in g["title"]) == bool(row["default"]), g
+        assert ("range " + row["range"] in g["title"]) == bool(row["range"]), g
+        if g["type"] == "number":
+            # an excluded bottom ("scale > 0") is no HTML min, which would
+            # admit it; nor is a bottom above the value the option holds
+            # unset, which the control goes back to (slices 0, "from rays",
+            # below --slices's 1..256)
+            if row["min_exclusive"] or name == "slices":
+                assert g["min"] == "", (name, g)
+            else:
+                assert float(g["min"]) == row["min"], (name, g, row)
+            if "max" in row:
+                assert float(g["max"]) == row["max"], (name, g, row)
+            else:
+                assert g["max"] == "" or float(g["max"]) >= FLOAT_MAX, (name, g)
+            assert float(g["value"]) == params[name], (name, g, params)
+        elif g["type"] == "checkbox":
+            assert g["checked"] == params[name.replace("-", "_")], (name, g)
+        else:
+            want = ",".join("%g" % x for x in params[name.replace("-", "_")])
+            assert g["value"] == want, (name, g)
+    shot(page, "1d-controls")
     library = sb.library_ranges(BIN)
     got = page.execute_script(
         "return Object.fromEntries([...document.querySelectorAll('input[type=number]')]"
         ".map((i) => [i.id, [i.min, i.max]]))")
-    inputs = {"p-" + p: p for p in ("scale", "rays", "slices", "bias", "bounce", "bounces")}
-    inputs["view-el"] = "view_elevation"
-    for element, name in inputs.items():
-        want = library[name]
-        low, high = got[element]
-        # an excluded bottom ("scale > 0") is no HTML min, which would admit
-        # it; slices 0 is "from rays", below --slices's 1..256
-        if want["min_exclusive"] or name == "slices":
-            assert low == "", (element, low)
-        else:
-            assert float(low) == want["min"], (element, low, want)
-        if "max" in want:
-            assert float(high) == want["max"], (element, high, want)
-        else:
-            assert high == "" or float(high) >= FLOAT_MAX, (element, high)
+    low, high = got["view-el"]
+    assert float(low) == library["view_elevation"]["min"], got["view-el"]
+    assert float(high) == library["view_elevation"]["max"], got["view-el"]
     assert got["view-az"] == ["", ""]  # any azimuth
     # the light dragged past the rim stops at the library's lowest elevation,
     # at the centre it is overhead
@@ -652,7 +690,7 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path, br
         assert st["params"]["light_color"] == [1, 0.800000011920929, 0.6000000238418579] or \
             [round(x, 6) for x in st["params"]["light_color"]] == [1, 0.8, 0.6]
         assert st["bake"]["albedo"] is True
-        assert driver.find_element("id", "light-color").get_attribute("value") == "1,0.8,0.6"
+        assert driver.find_element("id", "p-light-color").get_attribute("value") == "1,0.8,0.6"
         shot(driver, "13-albedo-light-colour")
         status = urllib.request.urlopen(urllib.request.Request(
             server.url + "write", method="POST", headers={"X-Bumpbake": "1"}), timeout=SLOW).status
@@ -675,12 +713,12 @@ def test_an_albedo_and_a_light_colour_light_the_page_as_render_does(tmp_path, br
         # the light colour is render's row: checked by the library, no re-bake
         bake = st["bake"]["id"]
         refused = driver.execute_script(
-            "const c = document.getElementById('light-color'); c.value = '1,x,1';"
+            "const c = document.getElementById('p-light-color'); c.value = '1,x,1';"
             "c.dispatchEvent(new Event('change'));")
         sb.wait_for(lambda: driver.find_element("id", "controls-error").text, 30, "the refusal")
         assert "--light-color" in driver.find_element("id", "controls-error").text
         driver.execute_script(
-            "const c = document.getElementById('light-color'); c.value = '0.2,0.4,1';"
+            "const c = document.getElementById('p-light-color'); c.value = '0.2,0.4,1';"
             "c.dispatchEvent(new Event('change'));")
         sb.wait_for(lambda: state(server)["params"]["light_color"][2] == 1 and
                     state(server)["params"]["light_color"][0] < 0.3, 30, "the new colour")

@@ -117,7 +117,7 @@ def response_headers(url, method="GET", headers=None, path=""):
 def test_no_page_may_frame_it_and_it_loads_nothing_from_elsewhere(served):
     s, _ = served
     cases = [("GET", {}, ""), ("GET", {}, "index.html"), ("GET", {}, "serve.js"),
-             ("GET", {}, "serve.css"), ("GET", {}, "state"), ("GET", {}, "ranges"),
+             ("GET", {}, "serve.css"), ("GET", {}, "state"), ("GET", {}, "controls"),
              ("GET", {}, "map/ssbump_ao"), ("GET", {}, "events"), ("GET", {}, "nothing"),
              ("HEAD", {}, ""), ("GET", {"Host": "attacker.example:80"}, ""),
              ("DELETE", {}, ""), ("POST", {}, "write"),
@@ -138,33 +138,54 @@ def test_no_page_may_frame_it_and_it_loads_nothing_from_elsewhere(served):
 
 
 FLOAT_MAX = 3.40282347e38  # a float's largest: help prints no top for it ("> 0")
+# The options the page offers, in its order (serve_params.c names them once).
+CONTROLS = ["scale", "rays", "slices", "bias", "bounce", "bounces", "brightness", "light-color"]
 
 
-def test_the_page_takes_its_ranges_from_the_library(served):
+def test_the_page_takes_its_controls_from_the_library(served):
     s, _ = served
-    status, body = request(s.url, path="ranges")
+    status, body = request(s.url, path="controls")
     assert status == 200
-    served_ranges = json.loads(body)
-    library = sb.library_ranges(BIN)
-    assert sorted(served_ranges) == sorted(library) == sorted(
-        ["scale", "rays", "slices", "bias", "bounce", "bounces", "view_elevation",
-         "light_elevation", "light_color"])
-    for name, want in library.items():
-        got = served_ranges[name]
-        assert got["min"] == want["min"] and got["min_exclusive"] == want["min_exclusive"], name
+    served_controls = json.loads(body)
+    rows = sb.library_rows("serve")
+    assert [c["name"] for c in served_controls["controls"]] == CONTROLS
+    for c in served_controls["controls"]:
+        want = rows[c["name"]]
+        for field in ("type", "value_name", "default", "range", "help"):
+            assert c[field] == want[field], (c["name"], field, c[field], want[field])
+        assert c["key"] == c["name"].replace("-", "_")
+        assert c["place"] == ("light" if c["name"] == "light-color" else "bake")
+        if "min" not in want:
+            assert "min" not in c and "max" not in c, c
+            continue
+        assert c["min"] == want["min"] and c["min_exclusive"] == want["min_exclusive"], c
         if "max" in want:
-            assert got["max"] == want["max"], name
+            assert c["max"] == want["max"], c
         else:
-            assert got.get("max", FLOAT_MAX) >= FLOAT_MAX, name
-    # the page's files say none of their own (the progress bar's max is a fraction)
+            assert c.get("max", FLOAT_MAX) >= FLOAT_MAX, c
+    # what a control goes back to: the value a command holds without it
+    unset = {c["name"]: c["unset"] for c in served_controls["controls"]}
+    assert unset == {"scale": "0", "rays": "256", "slices": "0", "bias": "0.55", "bounce": "0",
+                     "bounces": "0", "brightness": "", "light-color": "1,1,1"}, unset
+    # the picture's ranges: render's --view and --light elevations
+    library = sb.library_ranges(BIN)
+    assert sorted(served_controls["view"]) == sorted(library) == ["light_elevation",
+                                                                   "view_elevation"]
+    for name, want in library.items():
+        assert served_controls["view"][name] == want, name
+    # the page's files say none of their own: no range (the progress bar's
+    # max is a fraction) and no control, in the page or its script
     status, html = request(s.url, path="index.html")
     assert status == 200
     inputs = re.findall(r"<input[^>]*>", html.decode())
     assert inputs and not [i for i in inputs if re.search(r"\b(min|max)=", i)], inputs
+    names = "|".join(re.escape(n) for n in CONTROLS)
+    assert not re.search(r"\b(%s)\b" % names, html.decode()), "a control in index.html"
     status, js = request(s.url, path="serve.js")
     assert status == 200
     code = re.sub(r"//.*", "", js.decode())  # the comments may say "90 = overhead"
     assert not re.search(r"\b90\b", code), "an elevation's top in serve.js"
+    assert not re.search(r"[\"'](%s)[\"'=]" % names, code), "a control named in serve.js"
 
 
 def test_with_address_every_path_needs_the_token(tmp_path):

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """test_check_layers.py: tools/check_layers.py passes this tree's sources and
 refuses, in a copy of them, an upward include (by folder and by relative
-path), an upward call between two objects, a folder missing from the order,
+path), an upward call between two objects (but not from the program's
+entry, main.o, which links the clients), a folder missing from the order,
 a Makefile order that differs and the public header's sections in another
 order. `make check-layers` runs it after the check itself; it prints one
 line, or what failed and exits 1."""
@@ -80,6 +81,10 @@ def main():
         expect("a call of a later family", tree, 1,
                ["calls bb__later", "core reaches up to job"], *objs)
         expect("the same objects the other way", tree, 0, ["point down"], objs[1])
+        # the program's entry links the families together: it may call up
+        main_o = os.path.join(os.path.dirname(objs[0]), "main.o")
+        shutil.copy(objs[0], main_o)
+        expect("the program's entry calling up", tree, 0, ["point down"], main_o, objs[1])
 
         os.makedirs(os.path.join(tree, "src", "extra"))
         append(os.path.join(tree, "src", "extra", "e.c"), "int e;\n")
@@ -104,7 +109,8 @@ def main():
     if failures:
         print("test_check_layers: FAILED\n" + "\n".join(failures))
         return 1
-    print("test_check_layers: upward includes (by folder, relative), an upward call, a folder "
+    print("test_check_layers: upward includes (by folder, relative), an upward call (the "
+          "program's entry's passes), a folder "
           "outside the order, another Makefile order and header sections out of order are refused")
     return 0
 

@@ -1,9 +1,10 @@
 /* serve.c: `bumpbake serve`, a bake seen live: the height baked with
  * bake's options, watched, re-baked on every save, and shown lit in the
- * browser (src/cli/serve/). This file keeps the command line's words. */
-#include "serve/serve.h"
-#include "cli.h"
-#include "common.h"
+ * browser (src/serve/, a client beside the CLI, whose printing it
+ * shares). This file keeps the command line's words. */
+#include "serve.h"
+#include "../cli/cli.h"
+#include "../cli/common.h"
 #include "bumpbake_cluster.h"
 
 #include <arpa/inet.h>
@@ -53,6 +54,7 @@ int cli_run_serve(const cli_run *r) {
   pthread_cond_init(&s.work, NULL);
   pthread_cond_init(&s.changed, NULL);
   s.height_path = height;
+  s.line = r->command; /* lives as long as the process */
   s.settings = a->job; /* the bake's parameters as parsed */
   s.job = named;
   s.brightness_file = a->job.brightness_file;
@@ -110,7 +112,15 @@ int cli_run_serve(const cli_run *r) {
     cli_error_line(message);
     return BB_EXIT_FAILURE;
   }
-  serve_http_options http = {a->address, a->port, a->address != NULL};
+  /* where it listens: serve's own options, read through the command */
+  char port[16], address[128];
+  if (bb_command_value(r->command, "port", port, sizeof port, &err) != BB_OK ||
+      bb_command_value(r->command, "address", address, sizeof address, &err) != BB_OK) {
+    serve_watch_stop(watch);
+    bb_bake_context_free(s.context);
+    return cli_library_error("serve", BB_ERR_ARGUMENT, &err);
+  }
+  serve_http_options http = {address, atoi(port), bb_command_given(r->command, "address")};
   char url[256];
   if (serve_http_start(&s, &http, url, sizeof url) != 0) {
     serve_watch_stop(watch);

@@ -1,6 +1,6 @@
 /* serve_http.c: `bumpbake serve`'s HTTP side, on libmicrohttpd: the page
- * and its files, the state as JSON and as server-sent events, the ranges of
- * the page's inputs (the library's), the textures of the last good bake as
+ * and its files, the state as JSON and as server-sent events, the page's
+ * controls (made from the library's option rows), the textures of the last good bake as
  * raw 8-bit RGBA, the controls and the "write" action. Every path is one of
  * a fixed few: no part of a request names a file. Requests must come for
  * the host they were served as (a page elsewhere cannot rebind a name to
@@ -22,7 +22,7 @@
  * one write at a time, every request that waited during a write answered
  * by the next one. */
 #include "serve.h"
-#include "../../core/json.h" /* the JSON writer, compiled into the CLI (Makefile) */
+#include "../core/json.h" /* the JSON writer, compiled into the program (Makefile) */
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -687,8 +687,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
   }
   if (!strcmp(path, "state"))
     return send_json(c, MHD_HTTP_OK, serve_state_json(sv->s));
-  if (!strcmp(path, "ranges"))
-    return send_json(c, MHD_HTTP_OK, serve_ranges_json());
+  if (!strcmp(path, "controls"))
+    return send_json(c, MHD_HTTP_OK, serve_controls_json());
   if (!strcmp(path, "events"))
     return send_events(sv, c);
   if (!strncmp(path, "map/", 4))
@@ -869,7 +869,7 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
   sv.s = s;
   pthread_mutex_init(&sv.lock, NULL);
   pthread_cond_init(&sv.wake, NULL);
-  const char *address = o->address ? o->address : "127.0.0.1";
+  const char *address = o->address;
   struct sockaddr_storage addr;
   memset(&addr, 0, sizeof addr);
   struct sockaddr_in *v4 = (struct sockaddr_in *)&addr;
@@ -890,7 +890,7 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
   }
   /* Every local client is 127.0.0.1: a share per address only bounds
    * clients from elsewhere, which --address lets in. */
-  const unsigned per_client = o->address ? PER_CLIENT_LIMIT : 0;
+  const unsigned per_client = o->token ? PER_CLIENT_LIMIT : 0;
   sv.daemon = MHD_start_daemon(
       flags, (uint16_t)o->port, NULL, NULL, handle, &sv, MHD_OPTION_SOCK_ADDR,
       (struct sockaddr *)&addr, MHD_OPTION_CONNECTION_LIMIT, connection_limit(),

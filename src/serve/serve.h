@@ -1,11 +1,11 @@
-/* serve.h: what the parts of `bumpbake serve` share (src/cli/serve/): the
+/* serve.h: what the parts of `bumpbake serve` share (src/serve/): the
  * state one bake thread, one watch thread and the HTTP server's threads
  * (its polling thread, the writer and the ticker) read and change under
  * one lock. The bakes go through the
  * library's job (bb_job_bake_item, bb_job_run_item); nothing here is a
  * bake rule. */
-#ifndef BB_CLI_SERVE_H
-#define BB_CLI_SERVE_H
+#ifndef BB_SERVE_H
+#define BB_SERVE_H
 
 #include "bumpbake.h"
 
@@ -76,6 +76,8 @@ typedef struct serve_state {
   const char *height_path;
   bb_job_options settings;     /* the bake's parameters: the command line's, then the
                                   page's controls' (from command) */
+  const bb_command *line;       /* the command line's command, as given (the files its
+                                  file controls switch on) */
   bb_command *command;         /* the page's command: serve's command line with the page's
                                   controls set, checked as the command line is */
   bb_job_options job;          /* paths of a "write"; bake filled from settings */
@@ -147,9 +149,10 @@ void serve_watch_stop(serve_watch *w);
 
 /* serve_http.c: the server. */
 typedef struct serve_http_options {
-  const char *address; /* NULL: 127.0.0.1 */
+  const char *address; /* --address's value (its default: 127.0.0.1) */
   int port;            /* 0: any free one */
-  int token;           /* 1: a random token in every path */
+  int token;           /* 1 (--address given): a random token in every path, and a
+                          share of the connections per client */
 } serve_http_options;
 /* Starts serving s; the URL of the page into url (capacity cap). Returns 0,
  * or -1 with a message in url. */
@@ -159,22 +162,25 @@ void serve_http_stop(serve_state *s);
 
 /* serve_params.c: the state as one JSON object (malloc'd), as the page reads it. */
 char *serve_state_json(serve_state *s);
-/* serve_params.c: the ranges of the page's inputs (JSON, malloc'd): each
- * bake control's ("scale", "rays", "slices", "bias", "bounce", "bounces"),
- * "view_elevation", "light_elevation" and "light_color", as {"min", "max",
- * "min_exclusive"} from the library's descriptions of the options
- * (bb_option_bounds). */
-char *serve_ranges_json(void);
-/* serve_params.c: applies the page's control values (name=value pairs:
- * scale, rays, slices, bias, bounce, bounces, brightness; sizes[i] the
- * bytes of values[i], which may hold a NUL) to the state, all or none:
- * each set on a copy of the page's command by bake's option of its name
- * (a value at the option's default leaves the option out, as the line the
- * page shows does), then the copy checked as the command line is
- * (bb_command_check: ranges and the rules between options); light-color
- * is render's --light-color, a light of the picture (*rebake 0 when
- * nothing else changed). 0, or -1 with the library's words in err. The
- * caller holds the lock. */
+/* serve_params.c: the page's controls (JSON, malloc'd; NULL when out of
+ * memory), made from the rows of serve's options it offers (scale, rays,
+ * slices, bias, bounce, bounces, brightness, light-color): {"controls":
+ * [{"name", "key", "place" ("bake" or "light"), "type", "count",
+ * "value_name", "help", "default", "range", "unset", "min", "max",
+ * "min_exclusive"}...], "view": {"view_elevation", "light_elevation":
+ * {"min", "max", "min_exclusive"}}}, the picture's ranges from render's
+ * --view and --light (bb_option_bounds). */
+char *serve_controls_json(void);
+/* serve_params.c: applies the page's control values (name=value pairs,
+ * the names those of serve_controls_json; sizes[i] the bytes of values[i],
+ * which may hold a NUL) to the state, all or none: each set on a copy of
+ * the page's command by the option of its name (a value at what a command
+ * holds without the option leaves it out, as the line the page shows
+ * does; a file option is "on", the file serve was given, or "off"), then
+ * the copy checked as the command line is (bb_command_check: ranges and
+ * the rules between options). *rebake is 1 when a control of the bake was
+ * among them (light-color is a light of the picture). 0, or -1 with the
+ * library's words in err. The caller holds the lock. */
 int serve_apply_params(serve_state *s, const char *const *names,
                        const char *const *values, const size_t *sizes, int count,
                        int *rebake, char *err, size_t cap);
@@ -187,4 +193,4 @@ typedef struct serve_asset {
 } serve_asset;
 const serve_asset *serve_asset_find(const char *name);
 
-#endif /* BB_CLI_SERVE_H */
+#endif /* BB_SERVE_H */

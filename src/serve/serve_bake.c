@@ -6,7 +6,7 @@
  * maps are kept for "write" (bb_job_write_item).
  * A newer request cancels the bake in flight through the progress
  * callback; a failure keeps the last good maps and shows why. */
-#include "common.h"
+#include "../cli/common.h"
 #include "serve.h"
 
 #include <math.h>
