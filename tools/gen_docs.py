@@ -129,7 +129,7 @@ def md_code(text):
 def options_block(name, usage, options):
     out = [BEGIN_OPTIONS,
            "<!-- from `bumpbake %s --help` by tools/gen_docs.py (`make docs-reference`); "
-           "edit the option table in src/cli/, not here -->" % name,
+           "edit the option rows in src/cmd/options_*.c, not here -->" % name,
            "",
            "```",
            usage,
