@@ -160,6 +160,11 @@ int serve_http_start(serve_state *s, const serve_http_options *o, char *url, siz
 /* Stops the server started for s: its threads end before it returns. */
 void serve_http_stop(serve_state *s);
 
+/* serve_params.c: the JSON text write(j, arg) makes, malloc'd; NULL when
+ * out of memory (src/core/json.h's writer, compiled into the program). */
+struct bb__json;
+char *serve_json_text(void (*write)(struct bb__json *j, void *arg), void *arg);
+
 /* serve_params.c: the state as one JSON object (malloc'd), as the page reads it. */
 char *serve_state_json(serve_state *s);
 /* serve_params.c: the page's controls (JSON, malloc'd; NULL when out of

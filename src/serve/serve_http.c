@@ -161,19 +161,13 @@ static enum MHD_Result send_json(struct MHD_Connection *c, unsigned status, char
 }
 
 /* {"error": message}, malloc'd; NULL when out of memory. */
-static char *error_json(const char *msg) {
-  char *text = NULL;
-  size_t size = 0;
-  FILE *f = open_memstream(&text, &size);
-  if (!f)
-    return NULL;
-  bb__json j = {f, 0};
-  bb__json_open(&j, NULL, '{');
-  bb__json_string(&j, "error", msg);
-  bb__json_close(&j, '}');
-  fclose(f);
-  return text;
+static void write_error(bb__json *j, void *msg) {
+  bb__json_open(j, NULL, '{');
+  bb__json_string(j, "error", msg);
+  bb__json_close(j, '}');
 }
+
+static char *error_json(const char *msg) { return serve_json_text(write_error, (void *)msg); }
 
 static enum MHD_Result send_error(struct MHD_Connection *c, unsigned status,
                                   const char *msg) {

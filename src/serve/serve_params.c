@@ -137,8 +137,7 @@ static void add_bake(bb__json *j, serve_bake *b) {
   bb__json_close(j, '}');
 }
 
-/* The JSON text write(j, arg) makes, malloc'd; NULL when out of memory. */
-static char *json_text(void (*write)(bb__json *j, void *arg), void *arg) {
+char *serve_json_text(void (*write)(bb__json *j, void *arg), void *arg) {
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
@@ -177,7 +176,7 @@ static void write_state(bb__json *j, void *arg) {
 }
 
 char *serve_state_json(serve_state *s) {
-  return json_text(write_state, s);
+  return serve_json_text(write_state, s);
 }
 
 
@@ -256,7 +255,7 @@ char *serve_controls_json(void) {
   bb_command *fresh = NULL;
   if (bb_command_new("serve", &fresh, NULL) != BB_OK)
     return NULL;
-  char *text = json_text(write_controls, fresh);
+  char *text = serve_json_text(write_controls, fresh);
   bb_command_free(fresh);
   return text;
 }
