@@ -15,7 +15,10 @@ state it publishes) and the cold pair of today, `bumpbake bake` then
 the saves (medians).
 
   tools/bench_serve.py build/bumpbake [--saves N] [--height PATH] [--scale S]
-                       [--edit SIDE]
+                       [--edit SIDE] [--bounce RHO]
+
+--bounce RHO: serve and the cold bake both bake with `--bounce RHO`
+(inter-reflection; its stage shows in the page's progress).
 
 --edit SIDE: each save changes a SIDE x SIDE region only (a soft brush of
 0.1 of the height at the map's middle, added and taken away in turns,
@@ -80,6 +83,7 @@ def main():
     ap.add_argument("--height", default=os.path.join(ROOT, "fixtures", "rock06_height.png"))
     ap.add_argument("--scale", default="64")
     ap.add_argument("--edit", type=int, default=0)
+    ap.add_argument("--bounce", default=None)
     a = ap.parse_args()
     binary = os.path.abspath(a.bin)
     why = sb.browser_missing()
@@ -104,7 +108,8 @@ def main():
         f.write(original)
 
     print("load before: %s" % load())
-    server = sb.Server(binary, served, ["--scale", a.scale, "--quiet"])
+    bake_options = ["--scale", a.scale] + (["--bounce", a.bounce] if a.bounce else [])
+    server = sb.Server(binary, served, bake_options + ["--quiet"])
     driver = sb.start_browser(1100, 800)
     latencies, bakes, cold = [], [], []
     prefix = os.path.join(work, "cold")
@@ -127,7 +132,7 @@ def main():
             latencies.append(drawn_at - t0)
             bakes.append(bake["seconds"])
             # the cold pair in turns with the saves, so both see the same load
-            t_bake = run([binary, "bake", served, "--scale", a.scale, "-o", prefix, "--quiet"])
+            t_bake = run([binary, "bake", served] + bake_options + ["-o", prefix, "--quiet"])
             t_render = run([binary, "render", "--ssbump", prefix + "_ssbump.png", "-o",
                             os.path.join(work, "cold_render.png"), "--quiet"])
             cold.append((t_bake, t_render))
