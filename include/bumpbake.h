@@ -318,10 +318,6 @@ typedef enum bb_provenance_class {
                              key-by-key diff would mislead */
 } bb_provenance_class;
 
-/* Classifies a description (NULL is NONE): bumpbake's when it has a
- * "bumpbake_version=" line; intact when each non-empty line is key=value
- * with a key of lower-case letters, digits and '_'. */
-bb_provenance_class bb_provenance_classify(const char *description);
 
 /* One "key=value" line of a provenance text, as pointers into it (not
  * terminated). */
@@ -419,7 +415,7 @@ typedef struct bb_texture_options {
  * extra flag, no description. */
 void bb_texture_options_init(bb_texture_options *options);
 
-/* What a VTF file's header says (bb_vtf_read_info). */
+/* What a VTF file's header says (info's bb_info_file.vtf). */
 typedef struct bb_vtf_info {
   int version_major, version_minor; /* 7 and 0..5 */
   int header_size;          /* bytes, resource dictionary included */
@@ -440,17 +436,8 @@ typedef struct bb_vtf_info {
                                bumpbake ("key=value" lines), malloc'd, or NULL */
 } bb_vtf_info;
 
-/* Reads the header (and resource dictionary) of the VTF file at path, an
- * untrusted file: every size and offset is checked against the file's
- * length. Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not a
- * VTF, a version other than 7.0..7.5, a header, resource or image data
- * that runs past the end of the file). Free with bb_vtf_info_free. */
-bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
 
-/* Frees info->description and clears it; safe on a zeroed struct. */
-void bb_vtf_info_free(bb_vtf_info *info);
-
-/* What a DDS file's header says (bb_dds_read_info), as bb_image_read reads
+/* What a DDS file's header says (info's bb_info_file.dds), as bb_image_read reads
  * it: the same checks, so a file this describes is one the reader takes. */
 typedef struct bb_dds_info {
   int width, height;     /* of the top level, in texels */
@@ -469,12 +456,6 @@ typedef struct bb_dds_info {
   uint32_t caps2;        /* DDSCAPS2 (0x200 cube map, 0x200000 volume) */
 } bb_dds_info;
 
-/* Reads the header of the DDS file at path, an untrusted file, with the
- * checks bb_image_read makes (every level within the file, mip count
- * within the chain). Errors: BB_ERR_IO (missing, unreadable),
- * BB_ERR_FORMAT (not a DDS, truncated, a format bumpbake does not read),
- * BB_ERR_SIZE (zero or over BB_MAX_DIMENSION a side). Nothing to free. */
-bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
 
 /* ------------------------------------------------- Source materials */
 
@@ -588,7 +569,7 @@ typedef struct bb_write_options {
                               TGA holds 4 rows of 80 characters: provenance
                               is fitted with whole key=value lines, keys that
                               affect pixels first, and what does not fit is
-                              left out (see bb_provenance_classify) */
+                              left out (see bb_provenance_class) */
   const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
                               chain, flags (see "engine textures"); NULL: the
                               defaults, the map NORMAL for BB_RANGE_SIGNED and
@@ -2030,7 +2011,7 @@ typedef enum bb_output_state {
  * no pixel is decoded) whether it is what writing the output described by
  * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
  * 1), would make now. CURRENT when its provenance is bumpbake's, intact
- * (bb_provenance_classify), and holds every key bb_provenance_format(expected)
+ * (bb_provenance_class), and holds every key bb_provenance_format(expected)
  * writes with the same value, and no key that text lacks, except "command"
  * and "input" (the command line and the input's name, which do not change a
  * pixel) and "input_hash" (the decoded height's hash, implied by
@@ -2398,8 +2379,8 @@ typedef struct bb_info_file {
                                   provenance is read (a key seen again keeps its
                                   first value); else 0 */
   const bb_provenance_entry *provenance_entries; /* into image.description */
-  const bb_vtf_info *vtf;      /* a VTF's header (bb_vtf_read_info), else NULL */
-  const bb_dds_info *dds;      /* a DDS's header (bb_dds_read_info), else NULL */
+  const bb_vtf_info *vtf;      /* a VTF's header, else NULL */
+  const bb_dds_info *dds;      /* a DDS's header, else NULL */
   const char *flag_names[32];  /* of the VTF's flags or the DDS's pixel format
                                   flags: each bit's name when set and named,
                                   else NULL (static text) */

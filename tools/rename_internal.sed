@@ -117,3 +117,8 @@ s/\bbb_vmt_text\b/bb__vmt_text/g
 s/\bbb_json\b/bb__json/g
 s/\bbb_json_(open|close|string|number|int|bool)\b/bb__json_\1/g
 s/\bbb_job_prefix_path\b/bb__job_prefix_path/g
+# Texture header readers and the provenance classifier: only the library and tests call them (info returns their data).
+s/\bbb_vtf_read_info\b/bb__vtf_read_info/g
+s/\bbb_vtf_info_free\b/bb__vtf_info_free/g
+s/\bbb_dds_read_info\b/bb__dds_read_info/g
+s/\bbb_provenance_classify\b/bb__provenance_classify/g

@@ -1,6 +1,6 @@
 """Engine textures from Python: write() and the bakes of files give .vtf
 and .dds files whose headers say what was asked (read back by info() and
-bb_vtf_read_info), whose pixels read() gives back within the block codec's
+bb__vtf_read_info), whose pixels read() gives back within the block codec's
 error (DDS through OpenImageIO, VTF and float DDS through bumpbake's own
 reader), the command line's bytes and up-to-date decisions, and the
 library's refusals."""

@@ -1,6 +1,7 @@
 /* results.c: what a run wrote or found (bb_command_result). */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "texture/vtf.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +29,7 @@ static void info_files_free(bb_info_file *files, int count) {
     free((bb_provenance_entry *)f->provenance_entries);
     bb_image_info_free(&f->image);
     if (f->vtf)
-      bb_vtf_info_free((bb_vtf_info *)f->vtf);
+      bb__vtf_info_free((bb_vtf_info *)f->vtf);
     free((bb_vtf_info *)f->vtf);
     free((bb_dds_info *)f->dds);
   }

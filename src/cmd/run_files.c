@@ -47,7 +47,7 @@ static bb_status info_file(const char *path, bb_info_file *f, bb_error *err) {
     f->error = strdup(e.message[0] ? e.message : bb_status_name(f->status));
     return f->error ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   }
-  f->provenance = bb_provenance_classify(f->image.description);
+  f->provenance = bb__provenance_classify(f->image.description);
   if (f->provenance == BB_PROVENANCE_INTACT) {
     const long count = bb__provenance_entries(f->image.description, NULL, 0);
     bb_provenance_entry *entries =
@@ -66,7 +66,7 @@ static bb_status info_file(const char *path, bb_info_file *f, bb_error *err) {
   void *header = calloc(1, vtf ? sizeof(bb_vtf_info) : sizeof(bb_dds_info));
   if (!header)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
-  if ((vtf ? bb_vtf_read_info(path, header, &e) : bb_dds_read_info(path, header, &e)) != BB_OK) {
+  if ((vtf ? bb__vtf_read_info(path, header, &e) : bb__dds_read_info(path, header, &e)) != BB_OK) {
     free(header);
     return BB_OK;
   }

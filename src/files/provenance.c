@@ -342,7 +342,7 @@ const char *bb__provenance_class_name(bb_provenance_class c) {
   return "unknown";
 }
 
-bb_provenance_class bb_provenance_classify(const char *description) {
+bb_provenance_class bb__provenance_classify(const char *description) {
   static const char marker[] = "bumpbake_version=";
   if (!description || (strncmp(description, marker, sizeof marker - 1) != 0 &&
                        !strstr(description, "\nbumpbake_version=")))

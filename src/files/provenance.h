@@ -72,4 +72,9 @@ const char *bb__provenance_class_name(bb_provenance_class c);
 }
 #endif
 
+/* Classifies a description (NULL is NONE): bumpbake's when it has a
+ * "bumpbake_version=" line; intact when each non-empty line is key=value
+ * with a key of lower-case letters, digits and '_'. */
+bb_provenance_class bb__provenance_classify(const char *description);
+
 #endif /* BB_FILES_PROVENANCE_H */

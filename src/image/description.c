@@ -31,7 +31,7 @@ static char *copy_of(const char *s) {
  * (a text that fits the first row is stored as it is). */
 static int is_fitted(const char *path, const char *description) {
   return bb__path_has_extension(path, "tga") && strlen(description) > TGA_COMMENT_CHARS &&
-         bb_provenance_classify(description) != BB_PROVENANCE_NONE;
+         bb__provenance_classify(description) != BB_PROVENANCE_NONE;
 }
 
 char *bb__description_to_store(const char *path, const char *description) {
@@ -81,7 +81,7 @@ static int all_entries(const char *text) {
 
 char *bb__description_join(const char *format_name, char *desc, const char *image_id) {
   if (strcmp(format_name, "targa") != 0 || !image_id || !image_id[0] ||
-      bb_provenance_classify(desc) == BB_PROVENANCE_NONE)
+      bb__provenance_classify(desc) == BB_PROVENANCE_NONE)
     return desc;
   /* only key=value lines join: any other image ID is another tool's */
   if (!all_entries(image_id))
@@ -98,7 +98,7 @@ char *bb__description_join(const char *format_name, char *desc, const char *imag
 void bb__description_as_read(const char *format_name, char *desc) {
   /* Padded rows always leave an empty line; a text stored as it was has none. */
   if (strcmp(format_name, "targa") != 0 || !strstr(desc, "\n\n") ||
-      bb_provenance_classify(desc) == BB_PROVENANCE_NONE)
+      bb__provenance_classify(desc) == BB_PROVENANCE_NONE)
     return;
   size_t n = 0;
   for (const char *c = desc; *c; c++)

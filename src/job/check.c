@@ -327,7 +327,7 @@ static int is_baked_map(const char *path) {
     return 0;
   char kind[64];
   int baked = 0;
-  if (bb_provenance_classify(info.description) == BB_PROVENANCE_INTACT &&
+  if (bb__provenance_classify(info.description) == BB_PROVENANCE_INTACT &&
       bb__provenance_value(info.description, "output", kind, sizeof kind))
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       baked |= strcmp(kind, bb__map_kind_name((bb_map_kind)k)) == 0;

@@ -223,8 +223,8 @@ static int same_shape(const bb_image *a, const bb_image *b) {
 /* "key: golden -> new" lines of two intact provenance texts (malloc'd), or
  * NULL when either is not intact or memory ran out. */
 static char *provenance_diff(const char *golden, const char *fresh) {
-  if (bb_provenance_classify(golden) != BB_PROVENANCE_INTACT ||
-      bb_provenance_classify(fresh) != BB_PROVENANCE_INTACT)
+  if (bb__provenance_classify(golden) != BB_PROVENANCE_INTACT ||
+      bb__provenance_classify(fresh) != BB_PROVENANCE_INTACT)
     return NULL;
   const size_t cap = strlen(golden) + strlen(fresh) + 1024;
   char *out = malloc(cap);

@@ -41,8 +41,8 @@ static bb_status write_diff(const char *path, bb_image *diff, bb_error *err) {
 
 static void compare_provenance(const bb_image_info *ia, const bb_image_info *ib,
                                bb_compare_report *r) {
-  r->provenance_a = bb_provenance_classify(ia->description);
-  r->provenance_b = bb_provenance_classify(ib->description);
+  r->provenance_a = bb__provenance_classify(ia->description);
+  r->provenance_b = bb__provenance_classify(ib->description);
   r->provenance_differences = -1;
   if (r->provenance_a != BB_PROVENANCE_INTACT || r->provenance_b != BB_PROVENANCE_INTACT)
     return;

@@ -121,7 +121,7 @@ static void say(char *reason, size_t cap, const char *fmt, ...) {
 static int provenance_matches(const bb_image_info *info, const char *want, char *reason,
                               size_t cap) {
   static const char *const ignored[] = {"command", "input", "input_hash", NULL};
-  switch (bb_provenance_classify(info->description)) {
+  switch (bb__provenance_classify(info->description)) {
   case BB_PROVENANCE_NONE:
     say(reason, cap, "no bumpbake provenance");
     return 0;

@@ -93,7 +93,7 @@ static int is_baked_map(const char *path) {
     return 0; /* not ours to judge: its bake will say what is wrong */
   char kind[64];
   int baked = 0;
-  if (bb_provenance_classify(info.description) != BB_PROVENANCE_NONE &&
+  if (bb__provenance_classify(info.description) != BB_PROVENANCE_NONE &&
       bb__provenance_value(info.description, "output", kind, sizeof kind))
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
       baked |= strcmp(kind, kind_name(k)) == 0;

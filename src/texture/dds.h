@@ -56,4 +56,11 @@ const char *bb__dds_pixel_flag_name(int bit);
 }
 #endif
 
+/* Reads the header of the DDS file at path, an untrusted file, with the
+ * checks bb_image_read makes (every level within the file, mip count
+ * within the chain). Errors: BB_ERR_IO (missing, unreadable),
+ * BB_ERR_FORMAT (not a DDS, truncated, a format bumpbake does not read),
+ * BB_ERR_SIZE (zero or over BB_MAX_DIMENSION a side). Nothing to free. */
+bb_status bb__dds_read_info(const char *path, bb_dds_info *info, bb_error *err);
+
 #endif /* BB_TEXTURE_DDS_H */

@@ -236,12 +236,12 @@ static void masked_name(const bb__texel_format *f, const char *letters, char *ou
   }
 }
 
-bb_status bb_dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
+bb_status bb__dds_read_info(const char *path, bb_dds_info *info, bb_error *err) {
   if (!info)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_dds_read_info: info is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__dds_read_info: info is NULL");
   memset(info, 0, sizeof *info);
   if (!path)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_dds_read_info: path is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__dds_read_info: path is NULL");
   int fd;
   bb_status st = bb__input_open(path, &fd, err);
   if (st != BB_OK)

@@ -324,7 +324,7 @@ static uint64_t level_bytes(int code, uint64_t w, uint64_t h, uint64_t d) {
   return w * h * d * (uint64_t)vtf_formats[code].bytes;
 }
 
-void bb_vtf_info_free(bb_vtf_info *info) {
+void bb__vtf_info_free(bb_vtf_info *info) {
   if (!info)
     return;
   free(info->description);
@@ -597,16 +597,16 @@ bb_status bb__vtf_read_header(int fd, const char *path, bb_vtf_info *info,
   }
 done:
   if (st != BB_OK)
-    bb_vtf_info_free(info);
+    bb__vtf_info_free(info);
   return st;
 }
 
-bb_status bb_vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
+bb_status bb__vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err) {
   if (!info)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: info is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__vtf_read_info: info is NULL");
   memset(info, 0, sizeof *info);
   if (!path)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_vtf_read_info: path is NULL");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__vtf_read_info: path is NULL");
   int fd;
   bb_status st = bb__input_open(path, &fd, err);
   if (st != BB_OK)

@@ -31,7 +31,7 @@ bb_status bb__vtf_encode(bb_staged_file *f, const bb_image *levels, int count,
                          const bb_image *low, const bb_texture_options *options,
                          bb_texture_format format, bb_error *err);
 
-/* bb_vtf_read_info on the file open at fd (path names it in messages; fd
+/* bb__vtf_read_info on the file open at fd (path names it in messages; fd
  * is left open): every size and offset checked against the file's length.
  * *image_offset (may be NULL) receives where the image data starts (every
  * level, smallest first). */
@@ -46,5 +46,15 @@ const char *bb__vtf_flag_name(int bit);
 #ifdef __cplusplus
 }
 #endif
+
+/* Reads the header (and resource dictionary) of the VTF file at path, an
+ * untrusted file: every size and offset is checked against the file's
+ * length. Errors: BB_ERR_IO (missing, unreadable), BB_ERR_FORMAT (not a
+ * VTF, a version other than 7.0..7.5, a header, resource or image data
+ * that runs past the end of the file). Free with bb__vtf_info_free. */
+bb_status bb__vtf_read_info(const char *path, bb_vtf_info *info, bb_error *err);
+
+/* Frees info->description and clears it; safe on a zeroed struct. */
+void bb__vtf_info_free(bb_vtf_info *info);
 
 #endif /* BB_TEXTURE_VTF_H */

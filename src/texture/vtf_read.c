@@ -95,7 +95,7 @@ bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, b
     st = bb__fail(err, BB_ERR_FORMAT, "%s: volume textures (VTF depth %d) are not supported",
                   path, v.depth);
   if (st != BB_OK) {
-    bb_vtf_info_free(&v);
+    bb__vtf_info_free(&v);
     return st;
   }
   /* A chain longer than the halvings down to 1 x 1 is not a VTF Valve's
@@ -107,7 +107,7 @@ bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, b
     st = bb__fail(err, BB_ERR_FORMAT,
                   "%s: VTF of %d x %d declares %d mip levels (1 to %d are possible)", path,
                   v.width, v.height, v.mip_count, chain);
-    bb_vtf_info_free(&v);
+    bb__vtf_info_free(&v);
     return st;
   }
   bb__texel_format f = VTF_TEXELS[v.format];
@@ -129,7 +129,7 @@ bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, b
     st = bb__fail(err, BB_ERR_FORMAT,
                   "%s: truncated VTF: its levels need %llu bytes, the file has %llu", path,
                   (unsigned long long)at, (unsigned long long)file_size);
-    bb_vtf_info_free(&v);
+    bb__vtf_info_free(&v);
     return st;
   }
   layout->container = "vtf";
@@ -144,6 +144,6 @@ bb_status bb__vtf_layout(int fd, const char *path, bb__texture_layout *layout, b
                                                                                       : 8;
   layout->description = v.description;
   v.description = NULL;
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
   return BB_OK;
 }

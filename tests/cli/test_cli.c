@@ -27,6 +27,7 @@
 
 #include "cli_harness.h"
 #include "image/image_write.h"
+#include "files/provenance.h" /* bb__provenance_classify */
 
 /* The whole content of a file (malloc'd), its size in *size. */
 static unsigned char *read_bytes(const char *path, size_t *size) {
@@ -835,7 +836,7 @@ Test(cli, height2ssbump_records_its_command) {
   cr_assert_eq(bb_image_read_info(tmp("wall-ssbump.tga"), NULL, NULL, NULL, &info, &err),
                BB_OK, "%s", err.message);
   cr_assert_not_null(info.description);
-  cr_expect_eq(bb_provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
+  cr_expect_eq(bb__provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
                info.description);
   cr_expect(strstr(info.description, "\ncommand=bumpbake height2ssbump -r 16 wall.tga 4"),
             "%s", info.description);

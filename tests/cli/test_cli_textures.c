@@ -11,6 +11,8 @@
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "job/job_internal.h"
+#include "texture/dds.h" /* bb__dds_read_info */
+#include "texture/vtf.h" /* bb__vtf_read_info */
 
 #include <math.h>
 
@@ -53,7 +55,7 @@ Test(cli_textures, one_command_makes_a_source_material_and_a_dds) {
   /* Valve ships ssbumps as DXT1 with the full chain and exactly the SSBUMP flag. */
   bb_vtf_info v;
   bb_error err;
-  cr_assert_eq(bb_vtf_read_info(ssbump, &v, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(ssbump, &v, &err), BB_OK, "%s", err.message);
   cr_expect_eq(v.version_minor, 3);
   cr_expect_eq(v.format, 13, "DXT1");
   cr_expect_eq(v.flags, BB_VTF_FLAG_SSBUMP);
@@ -62,7 +64,7 @@ Test(cli_textures, one_command_makes_a_source_material_and_a_dds) {
   cr_expect(v.description && strstr(v.description, "output=ssbump") &&
                 strstr(v.description, "texture_format=default"),
             "the KVD resource holds the provenance");
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
 
   char *material = slurp_text(vmt);
   cr_expect(strstr(material, "\"$bumpmap\" \"rock/rock-ssbump\"") &&
@@ -147,11 +149,11 @@ Test(cli_textures, valve_commands_write_vtf) {
   cli_result_free(&r);
   bb_vtf_info v;
   bb_error err;
-  cr_assert_eq(bb_vtf_read_info(tmp("materials/x/h-ssbump.vtf"), &v, &err), BB_OK, "%s",
+  cr_assert_eq(bb__vtf_read_info(tmp("materials/x/h-ssbump.vtf"), &v, &err), BB_OK, "%s",
                err.message);
   cr_expect_eq(v.format, 15, "DXT5");
   cr_expect_eq(v.flags, BB_VTF_FLAG_SSBUMP | BB_VTF_FLAG_EIGHTBITALPHA);
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
   char *material = slurp_text(tmp("materials/x/h.vmt"));
   cr_expect(strstr(material, "\"x/h-ssbump\"") != NULL, "%s", material);
   free(material);
@@ -163,18 +165,18 @@ Test(cli_textures, valve_commands_write_vtf) {
   r = RUN("normal2ssbump", tmp("n.png"), "-o", tmp("w.vtf"), "--nomip");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
-  cr_assert_eq(bb_vtf_read_info(tmp("w.vtf"), &v, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(tmp("w.vtf"), &v, &err), BB_OK, "%s", err.message);
   cr_expect_eq(v.flags, BB_VTF_FLAG_SSBUMP | BB_VTF_FLAG_NOMIP | BB_VTF_FLAG_NOLOD);
   cr_expect_eq(v.mip_count, 1);
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
 
   /* height2ssbump -n: a normal map already packed into codes, flagged NORMAL. */
   r = RUN("height2ssbump", "-n", tmp("h.png"), "4", "-o", tmp("b.vtf"), "--vtf-flags", "0xc");
   cr_assert_eq(r.code, 0, "%s", r.err);
   cli_result_free(&r);
-  cr_assert_eq(bb_vtf_read_info(tmp("b.vtf"), &v, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(tmp("b.vtf"), &v, &err), BB_OK, "%s", err.message);
   cr_expect_eq(v.flags, BB_VTF_FLAG_NORMAL | BB_VTF_FLAG_EIGHTBITALPHA | 0xcu);
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
 }
 
 Test(cli_textures, a_batch_of_vtf_is_judged_by_its_provenance) {
@@ -200,9 +202,9 @@ Test(cli_textures, a_batch_of_vtf_is_judged_by_its_provenance) {
   cr_expect(strstr(r.out, "1 baked"), "another texture format rebakes: %s", r.out);
   cli_result_free(&r);
   bb_vtf_info v;
-  cr_assert_eq(bb_vtf_read_info(tmp("out/a-ssbump.vtf"), &v, NULL), BB_OK);
+  cr_assert_eq(bb__vtf_read_info(tmp("out/a-ssbump.vtf"), &v, NULL), BB_OK);
   cr_expect_eq(v.format, 3, "BGR888");
-  bb_vtf_info_free(&v);
+  bb__vtf_info_free(&v);
 }
 
 Test(cli_textures, info_reads_a_vtf_header) {
@@ -258,7 +260,7 @@ Test(cli_textures, info_reads_a_dds_header) {
   /* the library's call refuses what its reader refuses, naming the file */
   bb_dds_info d;
   bb_error err = {{0}};
-  cr_expect_eq(bb_dds_read_info(tmp("h.png"), &d, &err), BB_ERR_FORMAT);
+  cr_expect_eq(bb__dds_read_info(tmp("h.png"), &d, &err), BB_ERR_FORMAT);
   cr_expect(strstr(err.message, "h.png"), "%s", err.message);
 }
 

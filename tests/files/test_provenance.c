@@ -260,20 +260,20 @@ Test(provenance, classify_tells_intact_from_damaged_and_foreign_text) {
   bb_bake_options_init(&o);
   bb_provenance p = sample_provenance(&o);
   char *text = bb_provenance_format(&p);
-  cr_assert_eq(bb_provenance_classify(text), BB_PROVENANCE_INTACT, "%s", text);
+  cr_assert_eq(bb__provenance_classify(text), BB_PROVENANCE_INTACT, "%s", text);
   free(text);
-  cr_assert_eq(bb_provenance_classify(NULL), BB_PROVENANCE_NONE);
-  cr_assert_eq(bb_provenance_classify(""), BB_PROVENANCE_NONE);
-  cr_assert_eq(bb_provenance_classify("made with GIMP"), BB_PROVENANCE_NONE);
+  cr_assert_eq(bb__provenance_classify(NULL), BB_PROVENANCE_NONE);
+  cr_assert_eq(bb__provenance_classify(""), BB_PROVENANCE_NONE);
+  cr_assert_eq(bb__provenance_classify("made with GIMP"), BB_PROVENANCE_NONE);
   /* Blank lines and CRLF do not damage it; a key may come after others. */
-  cr_assert_eq(bb_provenance_classify("scale=1\n\nbumpbake_version=0.1.0\r\nrays=3"),
+  cr_assert_eq(bb__provenance_classify("scale=1\n\nbumpbake_version=0.1.0\r\nrays=3"),
                BB_PROVENANCE_INTACT);
   /* A value split over two lines, as TGA's 80-column rows used to leave it. */
-  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\ninput=roc\nk.tga\n"),
+  cr_assert_eq(bb__provenance_classify("bumpbake_version=0.1.0\ninput=roc\nk.tga\n"),
                BB_PROVENANCE_DAMAGED);
-  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\n=x\n"),
+  cr_assert_eq(bb__provenance_classify("bumpbake_version=0.1.0\n=x\n"),
                BB_PROVENANCE_DAMAGED, "a line needs a key");
-  cr_assert_eq(bb_provenance_classify("bumpbake_version=0.1.0\nScale=1\n"),
+  cr_assert_eq(bb__provenance_classify("bumpbake_version=0.1.0\nScale=1\n"),
                BB_PROVENANCE_DAMAGED, "keys are lower case");
 }
 
@@ -358,7 +358,7 @@ Test(provenance, survives_a_tga_file_as_whole_lines) {
   bb_image_info info;
   cr_assert_eq(bb_image_read(path, &back, &info, &err), BB_OK, "%s", err.message);
   cr_assert_not_null(info.description);
-  cr_assert_eq(bb_provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
+  cr_assert_eq(bb__provenance_classify(info.description), BB_PROVENANCE_INTACT, "%s",
                info.description);
   /* Every line read is a line written, and every line written is back. */
   int lines = 0;

@@ -26,6 +26,7 @@
 #include "file_bytes.h"
 #include "image/image_write.h"
 #include "texture/texture.h"
+#include "texture/dds.h" /* bb__dds_read_info */
 
 static const char *golden(const char *name) {
   static char path[512];
@@ -472,7 +473,7 @@ Test(dds, a_normal_map_with_alpha_is_bc3) {
   bb_error err = {{0}};
   cr_assert_eq(bb__texture_write(path, &rgba, &o, &err), BB_OK, "%s", err.message);
   bb_dds_info d;
-  cr_assert_eq(bb_dds_read_info(path, &d, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__dds_read_info(path, &d, &err), BB_OK, "%s", err.message);
   cr_expect_str_eq(d.fourcc, "DXT5");
   bb_image back = {0};
   cr_assert_eq(bb_image_read(path, &back, NULL, &err), BB_OK, "%s", err.message);

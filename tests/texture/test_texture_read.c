@@ -30,6 +30,7 @@
 #include "file_bytes.h"
 #include "image/image_write.h"
 #include "image/oiio.h"
+#include "texture/vtf.h" /* bb__vtf_read_info */
 
 static void make_scratch_dir(void) { scratch_dir_make("bb_texread"); }
 
@@ -329,7 +330,7 @@ Test(texture_read, vtf_declared_size_product_does_not_wrap) {
   file_bytes_write(path, f, size);
   bb_vtf_info info;
   bb_error err = {{0}};
-  cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
   cr_assert_not_null(strstr(err.message, "truncated VTF"), "%s", err.message);
   cr_assert_not_null(strstr(err.message, path), "%s", err.message);
   cr_assert_null(strchr(err.message, '\n'), "%s", err.message);
@@ -337,7 +338,7 @@ Test(texture_read, vtf_declared_size_product_does_not_wrap) {
   /* one frame of the same is refused too, by the plain check */
   put_u16(f + 24, 1);
   file_bytes_write(path, f, size);
-  cr_assert_eq(bb_vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(path, &info, &err), BB_ERR_FORMAT, "%s", err.message);
   free(f);
 }
 

@@ -23,6 +23,7 @@
 #include "core/internal.h"
 #include "image/image_write.h"
 #include "texture/texture.h"
+#include "texture/vtf.h" /* bb__vtf_read_info */
 
 /* A map of w x h in [0, 1]: waves, different in each channel (normal 0);
  * a field of unit normals leaning with the waves (1); or waves whose
@@ -123,7 +124,7 @@ Test(vtf, header_byte_for_byte_7_2) {
   cr_assert(w == 1 && h == 1);
 
   bb_vtf_info info;
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("s.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("s.vtf"), &info, &err), BB_OK, "%s", err.message);
   cr_assert(info.version_major == 7 && info.version_minor == 2 && info.header_size == 80);
   cr_assert(info.width == 64 && info.height == 32 && info.depth == 1 && info.frames == 1);
   cr_assert_eq(info.flags, BB_VTF_FLAG_SSBUMP);
@@ -132,7 +133,7 @@ Test(vtf, header_byte_for_byte_7_2) {
             info.low_res_height == 8);
   cr_assert_eq(info.data_size, (long)(size - 144));
   cr_assert_null(info.description, "7.2 holds no provenance");
-  bb_vtf_info_free(&info);
+  bb__vtf_info_free(&info);
   free(f);
   bb_image_free(&img);
   scratch_dir_remove();
@@ -179,10 +180,10 @@ Test(vtf, resources_7_3_hold_the_provenance) {
   cr_assert_not_null(strstr(text, "\t\"command\" \"bumpbake bake \\\"a b.png\\\" --scale 64\"\n"),
                      "%s", text);
   bb_vtf_info info;
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("n.vtf"), &info, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("n.vtf"), &info, &err), BB_OK, "%s", err.message);
   cr_assert_eq(info.resource_count, 3);
   cr_assert_str_eq(info.description, provenance);
-  bb_vtf_info_free(&info);
+  bb__vtf_info_free(&info);
   free(f);
   bb_image_free(&img);
   scratch_dir_remove();
@@ -683,7 +684,7 @@ Test(vtf, read_info_refuses_broken_files) {
   bb_error err = {{0}};
   /* Truncated by one byte: the image data no longer fits. */
   file_bytes_write(in_scratch_dir("t.vtf"), good, size - 1);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("t.vtf"), &info, &err), BB_ERR_FORMAT);
   cr_assert_not_null(strstr(err.message, "truncated"), "%s", err.message);
   cr_assert_null(info.description);
   /* The low-resolution resource's offset past the end (the image data
@@ -696,7 +697,7 @@ Test(vtf, read_info_refuses_broken_files) {
   for (int i = 0; i < 4; i++)
     moved[84 + i] = (unsigned char)(past >> (8 * i));
   file_bytes_write(in_scratch_dir("l.vtf"), moved, size);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("l.vtf"), &info, &err), BB_ERR_FORMAT);
   char want[160];
   snprintf(want, sizeof want, "low-resolution image (128 bytes at offset %u) ends past the end "
            "of the file (%zu bytes)", past, size);
@@ -706,7 +707,7 @@ Test(vtf, read_info_refuses_broken_files) {
   for (int i = 0; i < 4; i++)
     moved[92 + i] = (unsigned char)(past >> (8 * i));
   file_bytes_write(in_scratch_dir("i.vtf"), moved, size);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("i.vtf"), &info, &err), BB_ERR_FORMAT);
   size_t data = 0; /* DXT1, 32 x 32 down to 1 x 1 */
   for (int side = 32; side >= 1; side /= 2)
     data += (size_t)((side + 3) / 4) * (size_t)((side + 3) / 4) * 8;
@@ -716,17 +717,17 @@ Test(vtf, read_info_refuses_broken_files) {
   free(moved);
   /* Not a VTF; a version from the future; a resource count past the header. */
   file_bytes_write(in_scratch_dir("p.vtf"), (const unsigned char *)"\x89PNG\r\n\x1a\n........", 16);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("p.vtf"), &info, &err), BB_ERR_FORMAT);
   unsigned char *bad = malloc(size);
   memcpy(bad, good, size);
   bad[8] = 9;
   file_bytes_write(in_scratch_dir("v.vtf"), bad, size);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("v.vtf"), &info, &err), BB_ERR_FORMAT);
   memcpy(bad, good, size);
   bad[68] = 200;
   file_bytes_write(in_scratch_dir("r.vtf"), bad, size);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
-  cr_assert_eq(bb_vtf_read_info(in_scratch_dir("missing.vtf"), &info, &err), BB_ERR_IO);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("r.vtf"), &info, &err), BB_ERR_FORMAT);
+  cr_assert_eq(bb__vtf_read_info(in_scratch_dir("missing.vtf"), &info, &err), BB_ERR_IO);
   /* Every byte of the header and dictionary set to each of 0, 1, 0x7f,
    * 0xff in turn: OK or FORMAT, never a crash or an out-of-bounds read
    * (the sanitized build checks). */
@@ -736,10 +737,10 @@ Test(vtf, read_info_refuses_broken_files) {
       memcpy(bad, good, size);
       bad[at] = values[v];
       file_bytes_write(in_scratch_dir("m.vtf"), bad, size);
-      bb_status st = bb_vtf_read_info(in_scratch_dir("m.vtf"), &info, &err);
+      bb_status st = bb__vtf_read_info(in_scratch_dir("m.vtf"), &info, &err);
       cr_assert(st == BB_OK || st == BB_ERR_FORMAT, "byte %zu = %d: %s", at, values[v],
                 err.message);
-      bb_vtf_info_free(&info);
+      bb__vtf_info_free(&info);
     }
   free(bad);
   free(good);
