@@ -2063,6 +2063,11 @@ typedef enum bb_option_type {
   BB_OPTION_PATH      /* a file or directory, not empty */
 } bb_option_type;
 
+/* The type's name, as the clients show it (Python's option table, serve's
+ * controls): "flag", "integer", "number", "word", "words", "numbers",
+ * "text", "path"; NULL outside the enum. Static text. */
+const char *bb_option_type_name(bb_option_type type);
+
 /* Which of a command's uses an option belongs to (for --help and the
  * reference pages). The job is where the rule lives: bb_job_plan refuses a
  * single bake's options in a batch and a batch's without out_dir, for

@@ -793,6 +793,7 @@ int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);
 const bb_command_info *bb_command_info_find(const char *name);
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);
+const char *bb_option_type_name(bb_option_type type);
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length);
 const bb_option_info *bb_option_nearest(const bb_command_info *command, const char *name,

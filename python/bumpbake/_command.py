@@ -22,7 +22,6 @@ import numpy as np
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
                       _message, _path, _shown, _text)
 
-_TYPE_NAMES = ("flag", "integer", "number", "word", "words", "numbers", "text", "path")
 
 # What Python offers for an option of the command line's own
 # (BB_OPTION_CLIENT) besides the reports and exceptions it returns.
@@ -313,7 +312,7 @@ def option_table(command):
         _lib.bb_option_default_text(info, o, buf, 512)
         default = _text(buf)
         _lib.bb_option_range_text(o, buf, 512)
-        rows.append((keyword(o), _TYPE_NAMES[o.type], value, default, _text(buf),
+        rows.append((keyword(o), _text(_lib.bb_option_type_name(o.type)), value, default, _text(buf),
                      _text(o.help)))
     return rows
 

@@ -49,6 +49,12 @@ const bb_option_info *bb_command_option(const bb_command_info *command, int inde
   return index >= 0 && index < option_total(c) ? &c->options[index]->info : NULL;
 }
 
+const char *bb_option_type_name(bb_option_type type) {
+  static const char *const names[] = {"flag",    "integer", "number", "word",
+                                      "words",   "numbers", "text",   "path"};
+  return (int)type >= 0 && (size_t)type < sizeof names / sizeof names[0] ? names[type] : NULL;
+}
+
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length) {
   if (!command || !name)

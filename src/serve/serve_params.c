@@ -30,11 +30,6 @@ static const struct {
                 {"bounce", 0}, {"bounces", 0}, {"brightness", 0}, {"light-color", 1}};
 #define CONTROL_COUNT (sizeof controls / sizeof controls[0])
 
-/* The names of bb_option_type, as the controls' JSON gives them (Python's
- * option_table names them so too). */
-static const char *const type_names[] = {"flag",    "integer", "number", "word",
-                                         "words",   "numbers", "text",   "path"};
-
 static const bb_option_info *row_of(const char *name) {
   return bb_option_find(bb_command_info_find("serve"), name, 0);
 }
@@ -207,7 +202,7 @@ static void add_control(bb__json *j, const bb_command *fresh, size_t i) {
   bb__json_string(j, "name", o->name);
   bb__json_string(j, "key", key);
   bb__json_string(j, "place", controls[i].light ? "light" : "bake");
-  bb__json_string(j, "type", type_names[o->type]);
+  bb__json_string(j, "type", bb_option_type_name(o->type));
   bb__json_int(j, "count", o->count);
   bb_option_value_text(o, text, sizeof text);
   bb__json_string(j, "value_name", text);

@@ -615,3 +615,13 @@ Test(cmd, value_reads_an_option_given_or_not) {
   cr_expect_not(bb_command_given(c, "address"));
   bb_command_free(c);
 }
+
+/* The type names every client shows (Python's option table, serve's
+ * controls) come from one function. */
+Test(cmd, option_type_names_are_the_librarys) {
+  const char *names[] = {"flag", "integer", "number", "word", "words", "numbers", "text", "path"};
+  for (int t = BB_OPTION_FLAG; t <= BB_OPTION_PATH; t++)
+    cr_assert_str_eq(bb_option_type_name((bb_option_type)t), names[t]);
+  cr_assert_null(bb_option_type_name((bb_option_type)(BB_OPTION_PATH + 1)));
+  cr_assert_null(bb_option_type_name((bb_option_type)-1));
+}
