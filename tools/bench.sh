@@ -6,7 +6,8 @@
 #
 # Sections: 1 trace benchmark (build/tools/bench_trace), 2 the peer
 # (valve-embree, built into build/peer/ from ../shared/peers/valve-embree),
-# 3 full bake (periodic and --clamp), 4 ratios against the targets, 5 accuracy
+# 3 full bake (periodic and --clamp; ao and ssbump at the peer's accuracy, its
+# slice count derived on rock06 as section 5 measures), 4 ratios against the targets, 5 accuracy
 # against converged references (the peer at 16384 rays, and bumpbake's own
 # dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps, at
 # 64, 256 and 1024 rays and at 6, 10 and 12 slices,
@@ -76,11 +77,12 @@ acc_size=256 acc_rock_scale=32 acc_noise_scale=16 acc_ref_rays=16384
 rock_scale=128 noise_scale=64
 noise_size=${BENCH_NOISE_SIZE:-1024}
 subset=${BENCH_SUBSET:-2000}
-target_trace=3 target_whole=20 target_brute=20
+target_trace=3 target_whole=20 target_peer_acc=25 target_brute=20
 failures=() # bumpbake-side failures: they make the bench exit 1
 peer_ok=0 peer_reason="not tried"
 bake_ok=0 clamp_ok=0 startup_ok=0 batch_ok=0 blocks_ok=0 bounce_ok=0
 ratio_rows=() acc_rows=() large_rows=()
+acc=$out/accuracy peer_slices="" peer_slices_ok=0
 start_all=$(date +%s.%N)
 
 # ------------------------------------------------------------------ helpers
@@ -182,6 +184,14 @@ runs_text() {
 mib() { calc "$1 / 1024" '%.0f'; }
 
 # ------------------------------------------------------------------- inputs
+
+# acc_map NAME SRC: SRC downsampled to acc_size square as $acc/NAME.png (kept
+# while newer than SRC), for the accuracy measurements.
+acc_map() {
+  mkdir -p "$acc"
+  [ -f "$acc/$1.png" ] && [ "$acc/$1.png" -nt "$2" ] ||
+    oiiotool "$2" --resize "${acc_size}x${acc_size}" -d uint16 -o "$acc/$1.png"
+}
 
 # find_fixture NAME [OVERRIDE]: fixtures/NAME, or the shared copy beside the
 # checkout (or beside the worktrees), as demo.sh.
@@ -388,6 +398,57 @@ stage_row() {
   printf '%-8s%-8s%-8s\n' "$(calc "$stage_sum")" "$(calc "$(med "$name" @wall)")" \
     "$(mib "$(med "$name" @rss)")"
 }
+# acc_errors JSON: accuracy_ref's results as "NAME AO SS" lines: mean |error|
+# of ao and the largest of the ssbump channels'.
+acc_errors() {
+  sed 's/.*"results":\[//; s/\]}$//; s/}\]},{/}]}\n{/g' "$1" | while IFS= read -r res; do
+    printf '%s ' "$(printf '%s' "$res" | sed 's/.*"name":"\([^"]*\)".*/\1/')"
+    printf '%s' "$res" | grep -o '"mean_abs":[^}]*' | sed 's/"mean_abs"://' |
+      awk 'NR == 1 { ao = $1 } NR > 1 && (NR == 2 || $1 > ss) { ss = $1 } END { print ao, ss }'
+  done
+}
+# derive_peer_slices: the peer's accuracy as a slice count, found as
+# docs/accuracy.md "Error by slice count" finds it: rock06 at 256 x 256
+# (section 5's map and settings), the peer at $rays rays and bumpbake at 6,
+# 8, 10, 12 and 16 slices against the dense reference (accuracy_ref); the
+# fewest slices whose mean |error| is at most the peer's for ao and for
+# ssbump (each its largest channel's). Sets peer_slices and peer_slices_ok;
+# kept in $acc/peer_slices.txt while newer than bumpbake, the peer and the map.
+derive_peer_slices() {
+  local d=$acc/peer_slices m=rock compare=() n name ao ss pao pss
+  command -v oiiotool >/dev/null && acc_map "$m" "$rock" || return 1
+  local path=$acc/$m.png
+  if ! { [ -f "$d.txt" ] && [ "$d.txt" -nt "$bin" ] && [ "$d.txt" -nt "$peer" ] &&
+    [ "$d.txt" -nt "$path" ]; }; then
+    mkdir -p "$d"
+    "$peer" "$path" --scale "$acc_rock_scale" --rays "$rays" --bias "$bias" --threads "$threads" \
+      --ao "$d/peer.ao.exr" --ssbump "$d/peer.ss.exr" >/dev/null 2>&1 || return 1
+    compare=("peer=$d/peer.ao.exr,$d/peer.ss.exr")
+    for n in 6 8 10 12 16; do
+      "$bin" bake "$path" --scale "$acc_rock_scale" --slices "$n" --filter-radius 0 \
+        --normal-filter valve --bias "$bias" --threads "$threads" -q --ao "$d/s$n.ao.exr" \
+        --ssbump "$d/s$n.ss.exr" || return 1
+      compare+=("$n=$d/s$n.ao.exr,$d/s$n.ss.exr")
+    done
+    "$tools/accuracy_ref" "$path" "$acc_rock_scale" --bias "$bias" "${compare[@]}" \
+      >"$d.json" 2>/dev/null || return 1
+    acc_errors "$d.json" >"$d.txt"
+  fi
+  read -r name pao pss < <(grep '^peer ' "$d.txt") || return 1
+  echo "the peer's accuracy: rock06 at ${acc_size} x ${acc_size}, scale $acc_rock_scale, mean |error|" \
+    "against the dense reference (ao, ssbump's largest channel; section 5's settings):"
+  printf '  peer %s rays: %s %s\n' "$rays" "$(calc "$pao" %.5f)" "$(calc "$pss" %.5f)"
+  while read -r name ao ss; do
+    [ "$name" != peer ] || continue
+    printf '  %2s slices:    %s %s\n' "$name" "$(calc "$ao" %.5f)" "$(calc "$ss" %.5f)"
+    if [ -z "$peer_slices" ] && [ "$(calc "($ao <= $pao && $ss <= $pss)" %d)" = 1 ]; then
+      peer_slices=$name
+    fi
+  done <"$d.txt"
+  [ -n "$peer_slices" ] || { echo "  no slice count up to 16 reaches it"; return 1; }
+  echo "  -> $peer_slices slices, the fewest at or below the peer on both"
+  peer_slices_ok=1
+}
 full_cmd periodic_cmd "$out/rock"
 full_cmd clamp_cmd "$out/rock_clamp" --clamp
 echo "${periodic_cmd[*]#"$root/"}"
@@ -401,6 +462,27 @@ echo
 [ "$bake_ok" = 1 ] && stage_row bake_rock periodic
 [ "$clamp_ok" = 1 ] && stage_row bake_rock_clamp --clamp
 echo "($(runs_text bake_rock); seconds; stages = their sum, wall = the whole process)"
+echo
+if [ "$peer_ok" != 1 ]; then
+  echo "the whole bake at the peer's accuracy: not measured, the peer is not available ($peer_reason)"
+elif ! derive_peer_slices; then
+  fail "the peer's accuracy in slices could not be derived (see $acc/peer_slices*)"
+else
+  # what the peer writes (ao and ssbump), at the slice count of its accuracy
+  peer_acc_cmd=("$bin" bake "$rock" --scale "$rock_scale" --slices "$peer_slices" --threads "$threads"
+    --json -q --ao "$out/rock_s${peer_slices}_ao.png" --ssbump "$out/rock_s${peer_slices}_ssbump.png")
+  echo "${peer_acc_cmd[*]#"$root/"}"
+  if measure bake_rock_peer_acc "${peer_acc_cmd[@]}"; then
+    printf '%-10s' ""
+    printf '%-8s' load smooth pyramid trace derive write stages wall MiB
+    echo
+    stage_row bake_rock_peer_acc "${peer_slices} slices"
+    echo "($(runs_text bake_rock_peer_acc); ao and ssbump, the peer's outputs, at the peer's accuracy)"
+  else
+    fail "bumpbake bake --slices $peer_slices exited non-zero"
+    peer_slices_ok=0
+  fi
+fi
 if [ "$bake_ok" = 1 ]; then
   if [ "$peer_ok" = 1 ]; then
     echo "peer, whole run on the same map (filtered, so it does no smoothing):" \
@@ -430,6 +512,10 @@ if [ "$peer_ok" = 1 ] && [ "$bake_ok" = 1 ]; then
   add_ratio "peer whole run / bumpbake whole bake, rock" \
     "$(ratio "$(med peer_rock @wall)" "$(med bake_rock @wall)")" "$target_whole"
 fi
+if [ "$peer_ok" = 1 ] && [ "$peer_slices_ok" = 1 ]; then
+  add_ratio "peer whole run / bumpbake at its accuracy ($peer_slices sl)" \
+    "$(ratio "$(med peer_rock @wall)" "$(med bake_rock_peer_acc @wall)")" "$target_peer_acc"
+fi
 for m in "${maps[@]}"; do
   for t in 1 "$threads"; do
     j=$out/trace_${m}_t$t.json
@@ -445,20 +531,16 @@ fi # section 4
 
 # ------------------------------------------------------------- 5. accuracy
 
-acc=$out/accuracy
 acc_ok=0
 
 # acc_maps: the 256 x 256 maps, as NAME:PATH:SCALE words.
 acc_maps() {
-  mkdir -p "$acc"
   local words=() m src
   for m in rock lava; do
     src=$rock
     [ "$m" = lava ] && src=$lava
     [ -n "$src" ] || continue
-    [ -f "$acc/$m.png" ] && [ "$acc/$m.png" -nt "$src" ] ||
-      oiiotool "$src" --resize "${acc_size}x${acc_size}" -d uint16 -o "$acc/$m.png" ||
-      continue
+    acc_map "$m" "$src" || continue
     words+=("$m:$acc/$m.png:$acc_rock_scale")
   done
   "$tools/genheight" noise "$acc_size" "$acc_size" "$acc/noise.png" &&
@@ -745,6 +827,10 @@ fi
 if [ "$clamp_ok" = 1 ]; then
   summary_row "bumpbake whole bake, rock, --clamp (s)" "$(calc "$(med bake_rock_clamp @wall)")" \
     "$(runs_text bake_rock_clamp), trace $(calc "$(med bake_rock_clamp trace)") s"
+fi
+if [ "$peer_slices_ok" = 1 ]; then
+  summary_row "bumpbake at the peer's accuracy, rock (s)" "$(calc "$(med bake_rock_peer_acc @wall)")" \
+    "$peer_slices slices, ao + ssbump, $(runs_text bake_rock_peer_acc)"
 fi
 if [ "$peer_ok" = 1 ]; then
   summary_row "peer whole run, rock (s)" "$(calc "$(med peer_rock @wall)")" \

@@ -273,6 +273,8 @@ static bb_status check_arguments(const bb_image *height, float height_scale,
   if (addressing != BB_ADDRESS_PERIODIC && addressing != BB_ADDRESS_CLAMP)
     return bb__fail(err, BB_ERR_ARGUMENT, "normals: unknown addressing mode %d",
                     (int)addressing);
+  if (bb__image_all_finite(height))
+    return BB_OK;
   for (int y = 0; y < height->height; y++)
     for (int x = 0; x < height->width; x++)
       if (!isfinite(*bb_image_texel(height, x, y)))

@@ -8,9 +8,10 @@
 
 bb_status bb__check_scaled_height(const bb_image *height, float height_scale,
                                   bb_error *err) {
-  for (int y = 0; y < height->height; y++)
+  for (int y = 0; y < height->height; y++) {
+    const float *row = bb_image_texel(height, 0, y);
     for (int x = 0; x < height->width; x++) {
-      double h = (double)*bb_image_texel(height, x, y);
+      double h = (double)row[(size_t)x * (size_t)height->channels];
       double z = (double)height_scale * h;
       if (!(fabs(z) <= BB_MAX_HEIGHT_TEXELS))
         return bb__fail(err, BB_ERR_VALUE,
@@ -19,5 +20,6 @@ bb_status bb__check_scaled_height(const bb_image *height, float height_scale,
                         "inside the float range)",
                         (double)height_scale, h, x, y, z, BB_MAX_HEIGHT_TEXELS);
     }
+  }
   return BB_OK;
 }

@@ -229,6 +229,8 @@ static bb_status check_arguments(const bb_image *in, const bb_image *guide,
 
 /* A NaN guide height would give the centre tap s = NaN and poison the sums. */
 static bb_status check_guide_finite(const bb_image *guide, bb_error *err) {
+  if (bb__image_all_finite(guide))
+    return BB_OK;
   for (int y = 0; y < guide->height; y++)
     for (int x = 0; x < guide->width; x++)
       if (!isfinite(*bb_image_texel(guide, x, y)))

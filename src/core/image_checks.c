@@ -29,13 +29,17 @@ static int all_finite(const float *v, size_t n) {
   return !bad;
 }
 
+int bb__image_all_finite(const bb_image *img) {
+  return all_finite(img->pixels,
+                    (size_t)img->width * (size_t)img->height * (size_t)img->channels);
+}
+
 bb_status bb__check_finite(const bb_image *img, int channels, const char *what,
                            bb_error *err) {
   /* Every sample finite (the usual case) passes in one quick sweep; else
    * the texel by texel walk below finds and names the first (the image's
    * non-finite samples may also all be in channels not checked). */
-  if (all_finite(img->pixels,
-                 (size_t)img->width * (size_t)img->height * (size_t)img->channels))
+  if (bb__image_all_finite(img))
     return BB_OK;
   for (int y = 0; y < img->height; y++)
     for (int x = 0; x < img->width; x++) {

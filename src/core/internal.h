@@ -196,6 +196,11 @@ void bb__text_add_word(bb__text *t, const char *word);
 bb_status bb__check_finite(const bb_image *img, int channels, const char *what,
                            bb_error *err);
 
+/* 1 when every sample of img is finite: one quick sweep, for the checks
+ * that name the first bad texel in words of their own to pass the usual
+ * case without walking texel by texel. */
+int bb__image_all_finite(const bb_image *img);
+
 /* BB_ERR_ARGUMENT unless a and b have the same width and height. */
 bb_status bb__check_same_size(const bb_image *a, const char *name_a, const bb_image *b,
                               const char *name_b, bb_error *err);

@@ -81,6 +81,8 @@ static float pick_value(const float *texel, pick p) {
 
 /* Fails with the first non-finite height of a 1-channel image. */
 static bb_status check_finite(const bb_image *height, bb_error *err) {
+  if (bb__image_all_finite(height))
+    return BB_OK;
   for (int y = 0; y < height->height; y++)
     for (int x = 0; x < height->width; x++) {
       float h = *bb_image_texel(height, x, y);

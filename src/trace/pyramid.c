@@ -39,8 +39,7 @@ static int ceil_shift(int n, int k) {
  * the order it is taken in, so neither does the pyramid. */
 typedef struct build_job {
   bb_pyramid *p;
-  int k;          /* the level being built */
-  float *row_max; /* level k's nodes along x, for every row of cells */
+  int k; /* the level being built */
 } build_job;
 
 /* Level 0, row y: the max of each cell's four corners. */
@@ -78,35 +77,27 @@ static float addressed_max(const float *row, size_t stride, int n, int start, in
   return m;
 }
 
-/* Level k straight from level 0, separably (rows, then columns): every level
- * costs O(W*H) and the wrapped last node needs no special case. */
-static void level_rows(void *user, int y) { /* cells of row y -> row_max */
+static void node_update(bb_pyramid *p, int k, int i, int j);
+
+/* Level k >= 1, node row j: each node from its children on level k - 1
+ * (node_update), so a level costs a quarter of the one below it. */
+static void level_row(void *user, int j) {
   const build_job *job = user;
-  const bb_pyramid *p = job->p;
-  const int w = p->width, lw = p->level_width[job->k], span = 1 << job->k;
-  const float *cells = p->level_max[0] + (size_t)y * (size_t)w;
-  for (int i = 0; i < lw; i++)
-    job->row_max[(size_t)y * (size_t)lw + (size_t)i] =
-        addressed_max(cells, 1, w, i * span, span, p->addressing);
+  for (int i = 0; i < job->p->level_width[job->k]; i++)
+    node_update(job->p, job->k, i, j);
 }
 
-static void level_columns(void *user, int j) { /* row_max -> node row j */
-  const build_job *job = user;
-  const bb_pyramid *p = job->p;
-  const int lw = p->level_width[job->k], span = 1 << job->k;
-  for (int i = 0; i < lw; i++)
-    p->level_max[job->k][(size_t)j * (size_t)lw + (size_t)i] =
-        addressed_max(job->row_max + i, (size_t)lw, p->height, j * span, span, p->addressing);
-}
+/* A level of fewer nodes than this is built on the calling thread: starting
+ * and joining the threads would cost more than its maxima. */
+enum { PARALLEL_LEVEL_NODES = 1 << 16 };
 
-static bb_status build_levels(bb_pyramid *p, float *row_max, int threads, bb_error *err) {
-  build_job job = {p, 0, row_max};
+static bb_status build_levels(bb_pyramid *p, int threads, bb_error *err) {
+  build_job job = {p, 0};
   bb_status st = bb__parallel_for(p->height, threads, build_cells_row, &job, NULL, NULL, err);
   for (job.k = 1; st == BB_OK && job.k < p->levels; job.k++) {
-    st = bb__parallel_for(p->height, threads, level_rows, &job, NULL, NULL, err);
-    if (st == BB_OK)
-      st = bb__parallel_for(p->level_height[job.k], threads, level_columns, &job, NULL, NULL,
-                            err);
+    const long nodes = (long)p->level_width[job.k] * (long)p->level_height[job.k];
+    st = bb__parallel_for(p->level_height[job.k], nodes < PARALLEL_LEVEL_NODES ? 1 : threads,
+                          level_row, &job, NULL, NULL, err);
   }
   return st;
 }
@@ -157,8 +148,7 @@ bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing address
   p->levels = levels;
   size_t n = (size_t)w * (size_t)h;
   p->z = malloc(n * sizeof(float));
-  float *row_max = malloc(n * sizeof(float));
-  int ok = p->z && row_max;
+  int ok = p->z != NULL;
   for (int k = 0; ok && k < levels; k++) {
     p->level_width[k] = ceil_shift(w, k);
     p->level_height[k] = ceil_shift(h, k);
@@ -166,13 +156,11 @@ bb_status bb__pyramid_build(const bb_image *height_texels, bb_addressing address
     ok = p->level_max[k] != NULL;
   }
   if (!ok) {
-    free(row_max);
     bb_pyramid_free(p);
     return bb__fail(err, BB_ERR_MEMORY, "pyramid: out of memory for %dx%d", w, h);
   }
   memcpy(p->z, height_texels->pixels, n * sizeof(float));
-  st = build_levels(p, row_max, threads, err);
-  free(row_max);
+  st = build_levels(p, threads, err);
   if (st != BB_OK) {
     bb_pyramid_free(p);
     return st;
@@ -221,10 +209,10 @@ static int nodes_of(const bb_pyramid *p, int k, int first, int count, int n, int
   return spans;
 }
 
-/* Node (i, j) of level k >= 1 again: the max of its four children when
- * all of them exist, which cover its cells exactly; otherwise (the last
- * node of an odd level, whose cells past the side are addressed) from the
- * cells, as the build takes it. */
+/* Node (i, j) of level k >= 1: the max of its four children when all of
+ * them exist, which cover its cells exactly; otherwise (the last node of an
+ * odd level, whose cells past the side are addressed) from the cells. The
+ * build and the updates both take every node here. */
 static void node_update(bb_pyramid *p, int k, int i, int j) {
   const int cw = p->level_width[k - 1], ch = p->level_height[k - 1];
   float m;
