@@ -348,7 +348,7 @@ typedef struct bb_provenance_entry {
  * and round to 8 bits first. Channels: 1 is grey (v, v, v), 2 are R and G,
  * 3 are R, G, B; alpha is 1 unless the image has a fourth channel. */
 
-/* Pixel format of an engine texture. Names for bb_texture_format_parse in
+/* Pixel format of an engine texture. Names for bb__texture_format_parse in
  * quotes. */
 typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_DEFAULT = 0, /* VTF: DXT1 (DXT5 for 4 channels), as Valve ships
@@ -365,15 +365,6 @@ typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_RGBA16F, /* "rgba16f" or "rgba16161616f": half floats; VTF, DDS */
   BB_TEXTURE_FORMAT_RGBA32F  /* "rgba32f": floats; DDS */
 } bb_texture_format;
-
-/* Parses a format name above (any case); "default" is BB_TEXTURE_FORMAT_DEFAULT. */
-bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-/* Parses a VTF version as --vtf-version takes it: "7.2" to "7.5", or the
- * minor number alone ("2" to "5"); *minor receives 2..5. */
-bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
-/* Parses VTF flags as --vtf-flags takes them: a 32-bit number, decimal,
- * 0x hexadecimal or 0 octal (strtoul's base 0), no sign. */
-bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 
 /* VTF header flags (Valve's TEXTUREFLAGS_*) the writer sets, for
  * bb_texture_options.vtf_flags and bb_vtf_info.flags. */
@@ -541,12 +532,6 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
-/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
- * reads level 0. level_count (may be NULL) receives the file's number of
- * levels; a level past the last is BB_ERR_ARGUMENT. */
-bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
-                            bb_image_info *info, int *level_count, bb_error *err);
-
 /* ------------------------------------------------------ writing images */
 
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
@@ -558,9 +543,6 @@ typedef enum bb_depth {
   BB_DEPTH_HALF,  /* exr */
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
-
-/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 
 typedef struct bb_write_options {
   bb_depth depth;
@@ -612,7 +594,7 @@ typedef struct bb_animation bb_animation;
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0, /* the grey, or the mean of R, G, B; alpha where the
-                          image shows Valve's convention (bb_height_channel) */
+                          image shows Valve's convention (bb__height_channel) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
@@ -622,22 +604,6 @@ typedef enum bb_channel {
   BB_CHANNEL_VALVE     /* Valve's height2ssbump: alpha when the image has
                           one, else the grey or the mean of R, G, B */
 } bb_channel;
-
-/* Parses "r", "g", "b", "a", "luma", "mean", "auto", "valve" (any case). */
-bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
-
-/* The channel the rule takes from img when asked for `channel`: channel
- * itself, except for two rules. BB_CHANNEL_AUTO reads img once and gives
- * BB_CHANNEL_A when img has an alpha channel (alpha_channel, or the last of
- * 2 or 4 channels) that varies while the colour (grey, or R, G and B) is the
- * same at every texel, or when the colour is a colour (R, G and B not all
- * equal) and alpha takes three values or more (a height, not a cutout
- * mask): Valve's convention, the height in alpha. Otherwise it gives
- * BB_CHANNEL_MEAN (for a grey image, the grey). BB_CHANNEL_VALVE gives
- * BB_CHANNEL_A whenever there is an alpha channel, else BB_CHANNEL_MEAN for
- * colour and BB_CHANNEL_AUTO (the grey) for grey. bb_height_file_read says
- * which was taken whenever the image left a choice. */
-bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 
 /* Extracts a 1-channel height field from a decoded image by the channel rule.
  * Rejects NaN or infinite heights (BB_ERR_VALUE, naming the first bad texel)
@@ -787,8 +753,6 @@ typedef enum bb_normal_filter {
                           i.e. Valve's sums at the 4 cell centres around the
                           vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
-
-const char *bb_normal_filter_name(bb_normal_filter f);
 
 typedef struct bb_normal_decode_options {
   int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
@@ -990,31 +954,6 @@ typedef struct bb_valve_options {
                       map, 0.5 + 0.5 N (-n, FILE-bump.tga). Default 0 */
   int ao_in_alpha; /* 0: A = the filtered height; 1: A = ao (-A). Default 0 */
 } bb_valve_options;
-
-void bb_valve_options_init(bb_valve_options *o);
-
-/* Packs a bake into Valve's RGBA layout: RGB = result->ssbump (its first
- * three channels) or result->normal encoded as 0.5 + 0.5 N, A =
- * result->filtered or result->ao. Every channel of out is then a unit value
- * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
- * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
- * the traced outputs) or has too few channels, or when the ssbump is of a basis
- * other than Half-Life 2's (result->basis, when set, or more than 4
- * channels); BB_ERR_SIZE when sizes differ. */
-bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
-                        bb_image *out, bb_error *err);
-
-/* Valve's detail variant (-d): multiplies R, G, B of rgba (4 channels, as
- * bb_valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
- * input colour smoothed like the height: colour is the decoded input (grey
- * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
- * ignored), smoothed by bb__smooth_bilateral_all_cores with smooth and guided by
- * height (the 1-channel height the bake started from), so the factor
- * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
- * input gives 0.5, the neutral value of a mod2x detail texture. All three
- * images must have the same size (BB_ERR_SIZE). */
-bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
-                          const bb_smooth_options *smooth, bb_error *err);
 
 /* ---------------------------------------------------- ssbump to normal */
 
@@ -1381,9 +1320,6 @@ typedef enum bb_axis {
   BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
 } bb_axis;
 
-/* "-y", "+z", ...; "unknown" for a value outside the enum. */
-const char *bb_axis_name(bb_axis a);
-
 typedef struct bb_renderbump_options {
   int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
   int samples;        /* samples per texel side, 1..16: samples^2 per texel on
@@ -1562,7 +1498,7 @@ typedef struct bb_height_source {
 } bb_height_source;
 
 /* Reads the height of the file at path by the channel rule (bb_channel,
- * bb_height_channel): the file's bytes are hashed first, then decoded, so
+ * bb__height_channel): the file's bytes are hashed first, then decoded, so
  * provenance never pairs a newer file's hash with older pixels. note (may
  * be NULL) hears which channel the rule took when it was not the obvious
  * one, and warnings about the input (lossy JPEG blocks, 8-bit codes that
@@ -1812,18 +1748,14 @@ typedef struct bb_job_options {
                                 "materials" above the bump map (bb_vmt_options) */
   const char *vmt_basetexture; /* the colour .vtf the material names, or NULL */
   /* Valve's height2ssbump file (one input, no out_dir): */
-  const char *valve_path;    /* the RGBA file bb_valve_pack makes of the bake (RGB
+  const char *valve_path;    /* the RGBA file bb__valve_pack makes of the bake (RGB
                                 ssbump or normal map, A filtered height or ao), written
                                 before the maps; NULL: none. Its provenance names the
                                 channel the height came from, as Valve's rule picks it */
   bb_valve_options valve;    /* what goes into it */
-  int valve_detail;          /* 1: Valve's detail variant (bb_valve_detail of the
+  int valve_detail;          /* 1: Valve's detail variant (bb__valve_detail of the
                                 input's colour); not with valve.normal_map */
 } bb_job_options;
-
-/* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
- * the texture defaults (bb_texture_options_init), no outputs. */
-void bb_job_options_init(bb_job_options *o);
 
 /* The file a bake with options o writes for map kind, the one rule for
  * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
@@ -1908,7 +1840,7 @@ const bb_job_report *bb_job_report_get(const bb_job *job, int i);
 const char *bb_job_stage(const bb_job *job);
 
 /* Whether every output of input i is what baking it now would write
- * (bb_output_check of each, from the files' headers; no pixel is decoded):
+ * (bb__output_check of each, from the files' headers; no pixel is decoded):
  * *current is 1 or 0, and the report's reason says why not. The input's
  * bytes are hashed, unless its header is refused: such an input is not
  * current (the reason is the refusal its bake gives). Errors: BB_ERR_IO
@@ -2006,31 +1938,6 @@ typedef enum bb_output_state {
   BB_OUTPUT_STALE        /* a file, but made otherwise, or not known to be
                             current (no or damaged provenance, unreadable) */
 } bb_output_state;
-
-/* Decides from the header of the file at path alone (bb_image_read_info;
- * no pixel is decoded) whether it is what writing the output described by
- * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
- * 1), would make now. CURRENT when its provenance is bumpbake's, intact
- * (bb_provenance_class), and holds every key bb_provenance_format(expected)
- * writes with the same value, and no key that text lacks, except "command"
- * and "input" (the command line and the input's name, which do not change a
- * pixel) and "input_hash" (the decoded height's hash, implied by
- * input_file_hash and channel), and keys the file's kind does not record
- * (bb__map_kind_records: a normal map written before the rule, with "rays",
- * is current): so the bumpbake version, the input file's bytes, the output
- * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
- * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
- * level exactly when mip_mapped. expected->input_file_hash must be set
- * (nonzero): without it nothing is CURRENT. A file that cannot be read is
- * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
- * may be NULL) receives why it is not CURRENT, one line ("no such file",
- * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
- * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
- * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
- * BB_ERR_MEMORY. */
-bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
-                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
-                          bb_error *err);
 
 /* =====================================================================
  * cmd: every command of `bumpbake`, its options and their rules,
@@ -2169,6 +2076,25 @@ int bb_option_bounds(const bb_option_info *option, double *min, double *max,
  * a path not given). */
 void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
                             char *out, size_t cap);
+/* Parses text as the option's value by the option's own parser, with no
+ * command to set: *value is what the word or number stands for (a word's
+ * enum value: bb_channel for bake's channel, bb_depth for depth,
+ * bb_texture_format, bb_normal_filter, bb_axis; normal-y's 0 down and 1
+ * up; vtf-version's minor number 2..5; vtf-flags' 32 bits). For the
+ * options that take words (BB_OPTION_WORD, one word of a BB_OPTION_WORDS
+ * list) and those integers read by a parser of their own (vtf-version,
+ * vtf-flags). Errors: BB_ERR_ARGUMENT in the value's own words, which name
+ * what the value is rather than the option ("channel must be one of auto,
+ * r, g, b, a, luma, mean, valve (got 'z')", "VTF version must be 7.2, 7.3,
+ * 7.4 or 7.5 (got '7.9')"), or "--NAME has no word or value of its own to
+ * parse" for any other option (bb_command_set reads those). */
+bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
+                          bb_error *err);
+/* The word the option takes for value (bb_option_parse's inverse: "vertex"
+ * for normal-filter's BB_NORMAL_VERTEX, "-y" for renderbumpflat's axis
+ * BB_AXIS_NEG_Y); NULL for a value without a word or an option without
+ * words. Static text. */
+const char *bb_option_word(const bb_option_info *option, long long value);
 
 /* ------------------------------------------------------------- options */
 
@@ -2298,8 +2224,7 @@ bb_status bb_command_value(const bb_command *command, const char *name, char *ou
                            size_t cap, bb_error *err);
 /* The options as set (defaults elsewhere); owned by command. */
 const bb_command_options *bb_command_options_of(const bb_command *command);
-/* The inputs added, and how many. */
-int bb_command_input_count(const bb_command *command);
+/* Input index of those added (bb_command_add_input), or NULL past the last. */
 const char *bb_command_input(const bb_command *command, int index);
 
 /* The command as text, through the descriptions: "bumpbake NAME INPUT...
@@ -2485,8 +2410,6 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
 
 /* ------------------------------------------------- names of enums printed */
 
-/* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
-bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 /* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 

@@ -686,19 +686,13 @@ void bb_image_free(bb_image *img);
 void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
-bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
-bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 void bb_texture_options_init(bb_texture_options *options);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
-bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-const char *bb_normal_filter_name(bb_normal_filter f);
 void bb_normal_decode_options_init(bb_normal_decode_options *o);
 bb_status bb_normal_map_decode(const bb_image *values, int is_float,
                                const bb_normal_decode_options *o, bb_image *normals,
@@ -802,6 +796,9 @@ void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
 void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
 void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
                             char *out, size_t cap);
+bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
+                          bb_error *err);
+const char *bb_option_word(const bb_option_info *option, long long value);
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
@@ -830,7 +827,6 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
-bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);

@@ -41,7 +41,7 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   c->def = def;
   bb_command_options *o = &c->options;
-  bb_job_options_init(&o->job);
+  bb__job_options_init(&o->job);
   bb_render_options_init(&o->render);
   bb__compare_limits_init(&o->limits);
   bb__renderbump_options_init(&o->renderbump);
@@ -92,7 +92,7 @@ const bb_command_options *bb_command_options_of(const bb_command *c) {
   return c ? &c->options : NULL;
 }
 
-int bb_command_input_count(const bb_command *c) {
+int bb__command_input_count(const bb_command *c) {
   return c ? c->input_count : 0;
 }
 
