@@ -1040,54 +1040,6 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
 bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
                                 bb_map_kind kind, bb_image *out, bb_error *err);
 
-/* ----------------------------------------------------- DOOM 3 programs */
-
-/* A parsed DOOM 3 image program, such as "addnormals(a_local.tga,
- * heightmap(a_h.tga, 4))": opaque, made by bb_program_parse. */
-typedef struct bb_program bb_program;
-
-/* Parses text in DOOM 3's image-program syntax: heightmap(img, scale),
- * addnormals(a, b), smoothnormals(a), add(a, b), scale(a, r, g, b, a),
- * invertAlpha(a), invertColor(a), makeIntensity(a), makeAlpha(a), _flat, and
- * image names (file paths; "double quotes" allow spaces and commas). Function
- * names are case-insensitive, as in id Tech 4. A syntax error is
- * BB_ERR_ARGUMENT with a message giving the 1-based column; an unknown
- * function's message lists the known ones. Free *out with bb_program_free. */
-bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
-
-void bb_program_free(bb_program *program);
-
-/* Reads the image a program names: fills img (any channel count) and info
- * (may be NULL) as bb_image_read does. */
-typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
-                                     bb_image_info *info, bb_error *err);
-
-typedef struct bb_program_options {
-  const char *base_dir;   /* image names are relative to it; NULL or "" = the
-                             current directory */
-  int allow_outside_base; /* 0 (default): an image name must stay inside the
-                             base directory, resolved (no absolute path, no
-                             "..", no symbolic link out: BB_ERR_ARGUMENT);
-                             1: any file may be read */
-  bb_image_loader loader; /* NULL = bb_image_read */
-  void *loader_user;
-} bb_program_options;
-
-void bb_program_options_init(bb_program_options *o);
-
-/* Evaluates a program as id Tech 4 does (docs/commands/program.md gives each
- * formula), in float rather than bytes. Inside, every image is RGBA in
- * [0, 1] standing for id's bytes / 255 (files are read as value / max code,
- * clamped; grey gives R = G = B, no alpha gives A = 1), and normal-map
- * operations decode N = (255 v - 128) / 127 and encode v = (127 N + 128) /
- * 255, id's own mapping (byte 128 is 0). When the program makes a normal map
- * (heightmap, addnormals, smoothnormals or _flat anywhere in it, as id marks
- * TD_BUMP), out holds its decoded N (3 channels, +Y down) and *is_normal_map
- * is 1; otherwise out holds RGBA colour (4 channels) and *is_normal_map is 0.
- * Errors name the file or the function and its column. */
-bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
-                         bb_image *out, int *is_normal_map, bb_error *err);
-
 /* -------------------------------------------------- flipcode slope map */
 
 /* ------------------------------------------------------------- compare */
@@ -2405,6 +2357,22 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
+
+/* program's run (bb_command_run's) in memory: the DOOM 3 image program of
+ * a checked `program` command (its input: "addnormals(a_local.tga,
+ * heightmap(a_h.tga, 4))", docs/commands/program.md gives each function)
+ * evaluated as id Tech 4 does, in float rather than bytes, its image names
+ * read relative to --base and kept inside it unless --allow-outside-base;
+ * nothing written. When the program makes a normal map (heightmap,
+ * addnormals, smoothnormals or _flat in it, as id marks TD_BUMP), out
+ * (allocated; free with bb_image_free) holds its decoded N (3 channels, +Y
+ * down) and *is_normal_map is 1; otherwise RGBA colour in [0, 1] (4
+ * channels) and 0. Errors: BB_ERR_ARGUMENT (not a checked program; a
+ * syntax error, giving the 1-based column; an unknown function, listing
+ * the known ones; an image name leaving the base), those of the reads
+ * naming the file. */
+bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
+                             bb_error *err);
 
 /* ----------------------------------------------------- what a job prints */
 

@@ -140,3 +140,11 @@ s/\bbb_valve_detail\b/bb__valve_detail/g
 s/\bbb_valve_pack\b/bb__valve_pack/g
 s/\bbb_command_input_count\b/bb__command_input_count/g
 s/\bbb_valve_options_init\b/bb__valve_options_init/g
+# api6: the DOOM 3 program family, run by a client through its command (bb_command_program).
+s/\bbb_program_parse\b/bb__program_parse/g
+s/\bbb_program_free\b/bb__program_free/g
+s/\bbb_program_options_init\b/bb__program_options_init/g
+s/\bbb_program_run\b/bb__program_run/g
+s/\bbb_program_options\b/bb__program_options/g
+s/\bbb_program\b/bb__program/g
+s/\bbb_image_loader\b/bb__image_loader/g

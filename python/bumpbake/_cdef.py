@@ -250,18 +250,6 @@ typedef struct bb_valve_options {
   int ao_in_alpha;
 } bb_valve_options;
 
-typedef struct bb_program bb_program;
-
-typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
-                                     bb_image_info *info, bb_error *err);
-
-typedef struct bb_program_options {
-  const char *base_dir;
-  int allow_outside_base;
-  bb_image_loader loader;
-  void *loader_user;
-} bb_program_options;
-
 typedef enum bb_mip_filter {
   BB_MIP_AVERAGE = 0,
   BB_MIP_RENORMALIZE
@@ -739,11 +727,6 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_error *err);
 bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
                                 bb_map_kind kind, bb_image *out, bb_error *err);
-bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
-void bb_program_free(bb_program *program);
-void bb_program_options_init(bb_program_options *o);
-bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
-                         bb_image *out, int *is_normal_map, bb_error *err);
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
@@ -827,6 +810,8 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
+bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
+                             bb_error *err);
 const char *bb_job_outcome_name(bb_job_outcome outcome);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);

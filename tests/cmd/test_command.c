@@ -720,3 +720,70 @@ Test(cmd, option_word_names_what_option_parse_reads) {
   }
   cr_expect_gt(words, 50, "the words of every command's word options (%d)", words);
 }
+
+/* bb_command_program: program's run in memory, the image bb_command_run
+ * writes (float EXR: the values as they are), bit for bit. */
+static void expect_program_as_run(const char *text, int expect_normal) {
+  char dir[] = "/tmp/bb_program_XXXXXX";
+  cr_assert_not_null(mkdtemp(dir));
+  char out_path[64];
+  snprintf(out_path, sizeof out_path, "%s/out.exr", dir);
+  const char *words[] = {text, "--base", "fixtures", "--output", out_path, NULL};
+  bb_command *c = command("program", words);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  bb_image mem = {0};
+  int is_normal = -1;
+  cr_assert_eq(bb_command_program(c, &mem, &is_normal, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(is_normal, expect_normal, "%s", text);
+  cr_expect_eq(mem.channels, expect_normal ? 3 : 4, "%s", text);
+  cr_expect_eq(access(out_path, F_OK), -1, "nothing written in memory");
+  bb_command_result r = {0};
+  cr_assert_eq(bb_command_run(c, NULL, &r, &err), BB_OK, "%s", err.message);
+  bb_image file = {0};
+  cr_assert_eq(bb_image_read(out_path, &file, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(file.width, mem.width);
+  cr_assert_eq(file.height, mem.height);
+  cr_assert_eq(file.channels, mem.channels);
+  const size_t n = (size_t)mem.width * (size_t)mem.height * (size_t)mem.channels;
+  cr_expect_eq(memcmp(file.pixels, mem.pixels, n * sizeof(float)), 0, "%s: the run's pixels",
+               text);
+  bb_image_free(&file);
+  bb_image_free(&mem);
+  bb_command_result_free(&r);
+  bb_command_free(c);
+  unlink(out_path);
+  rmdir(dir);
+}
+
+Test(cmd, program_in_memory_is_the_runs_image) {
+  expect_program_as_run("heightmap(pit_65x65.png, 4)", 1);
+  expect_program_as_run("invertColor(bricks_128x64.png)", 0);
+}
+
+Test(cmd, program_in_memory_refuses_in_the_programs_words) {
+  bb_error err = {{0}};
+  bb_image out = {0};
+  int is_normal = 0;
+  const char *missing[] = {"invertColor(nonexistent_image.png)", NULL};
+  bb_command *c = command("program", missing);
+  bb_command_set_in_memory(c, 0); /* Python's program(): no output file */
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT, "unchecked");
+  cr_expect_str_eq(err.message, "bb_command_program: not a checked program command");
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_IO);
+  cr_expect(strstr(err.message, "nonexistent_image.png"), "names the file: %s", err.message);
+  cr_expect_null(out.pixels);
+  bb_command_free(c);
+  const char *outside[] = {"heightmap(/nonexistent/h.tga, 4)", NULL};
+  c = command("program", outside);
+  bb_command_set_in_memory(c, 0);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "absolute"), "%s", err.message);
+  bb_command_free(c);
+  const char *bake[] = {"h.png", "--scale", "8", NULL};
+  c = command("bake", bake);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT, "not program");
+  bb_command_free(c);
+}
