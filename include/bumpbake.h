@@ -1182,8 +1182,6 @@ typedef struct bb_render_options {
                                    with relief) */
 } bb_render_options;
 
-void bb_render_options_init(bb_render_options *o);
-
 /* ------------------------------------------------------ rendering files */
 
 /* The maps a render can read from files instead of baking a height:
@@ -1998,9 +1996,8 @@ typedef struct bb_command_info {
   int option_count;
 } bb_command_info;
 
-/* The commands, in the order `bumpbake --help` lists them: index 0 ..
- * bb_command_count() - 1; NULL outside. Static data. */
-int bb_command_count(void);
+/* The commands, in the order `bumpbake --help` lists them: index 0, 1, ...
+ * until NULL (and NULL below 0). Static data. */
 const bb_command_info *bb_command_info_get(int index);
 /* The command named name, or NULL. */
 const bb_command_info *bb_command_info_find(const char *name);
@@ -2012,8 +2009,6 @@ const bb_option_info *bb_command_option(const bb_command_info *command, int inde
  * when none. */
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length);
-/* The option whose short name is c, or NULL. */
-const bb_option_info *bb_option_find_short(const bb_command_info *command, char c);
 /* For "did you mean": the option of command whose name is nearest to the
  * first length characters of name (at most 2 edits away, '_' read as '-'),
  * or NULL. */

@@ -148,3 +148,7 @@ s/\bbb_program_run\b/bb__program_run/g
 s/\bbb_program_options\b/bb__program_options/g
 s/\bbb_program\b/bb__program/g
 s/\bbb_image_loader\b/bb__image_loader/g
+# api6: defaults and lookups a client reads from the descriptions (a new command's options, bb_command_info_get's NULL, bb_command_option's short_name).
+s/\bbb_render_options_init\b/bb__render_options_init/g
+s/\bbb_command_count\b/bb__command_count/g
+s/\bbb_option_find_short\b/bb__option_find_short/g

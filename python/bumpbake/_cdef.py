@@ -2,8 +2,8 @@
 calls, for cffi.
 
 Every type and function the package uses, and nothing else but
-bb_command_count and bb_command_info_get, with which its tests walk the
-commands (tests/test_commands.py). The structs must
+bb_command_info_get, with which its tests walk the commands
+(tests/test_commands.py). The structs must
 match the header field for field, since cffi's ABI mode lays them out from
 these declarations: tests/test_cdef.py compiles a C program against the real
 header and checks every size, offset, enum value and function signature
@@ -730,7 +730,6 @@ bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
-void bb_render_options_init(bb_render_options *o);
 bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
@@ -766,7 +765,6 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
-int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);
 const bb_command_info *bb_command_info_find(const char *name);
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);

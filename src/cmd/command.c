@@ -7,6 +7,7 @@
  * parameter's one range and every rule between options, so a plan made
  * from a checked command checks nothing again. */
 #include "cmd/cmd_internal.h"
+#include "render/render_internal.h"
 #include "job/job_internal.h"
 #include "maps/maps_internal.h"
 #include "mesh/mesh_internal.h"
@@ -42,7 +43,7 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
   c->def = def;
   bb_command_options *o = &c->options;
   bb__job_options_init(&o->job);
-  bb_render_options_init(&o->render);
+  bb__render_options_init(&o->render);
   bb__compare_limits_init(&o->limits);
   bb__renderbump_options_init(&o->renderbump);
   o->map_kind = BB_MAP_SSBUMP;

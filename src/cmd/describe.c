@@ -25,10 +25,6 @@ static int option_total(const bb__command *c) {
   return n;
 }
 
-int bb_command_count(void) {
-  return bb__command_total;
-}
-
 const bb_command_info *bb_command_info_get(int index) {
   if (index < 0 || index >= bb__command_total)
     return NULL;
@@ -89,16 +85,6 @@ const bb_option_info *bb_option_find(const bb_command_info *command, const char 
   const size_t n = length ? length : strlen(name);
   for (int i = 0; c->options[i]; i++)
     if (bb__names_option(name, n, c->options[i]->info.name))
-      return &c->options[i]->info;
-  return NULL;
-}
-
-const bb_option_info *bb_option_find_short(const bb_command_info *command, char ch) {
-  if (!command || !ch)
-    return NULL;
-  const bb__command *c = command_of(command);
-  for (int i = 0; c->options[i]; i++)
-    if (c->options[i]->info.short_name == ch)
       return &c->options[i]->info;
   return NULL;
 }

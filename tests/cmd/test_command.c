@@ -701,8 +701,8 @@ Test(cmd, option_word_names_what_option_parse_reads) {
   cr_expect_null(bb_option_word(NULL, 0));
   /* every word of every option parses back to its value */
   int words = 0;
-  for (int i = 0; i < bb_command_count(); i++) {
-    const bb_command_info *c = bb_command_info_get(i);
+  const bb_command_info *c;
+  for (int i = 0; (c = bb_command_info_get(i)) != NULL; i++) {
     for (int k = 0; k < c->option_count; k++) {
       const bb_option_info *o = bb_command_option(c, k);
       for (long long v = 0; v < 64; v++) {
@@ -786,4 +786,15 @@ Test(cmd, program_in_memory_refuses_in_the_programs_words) {
   c = command("bake", bake);
   cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT, "not program");
   bb_command_free(c);
+}
+
+Test(cmd, the_commands_end_with_null) {
+  int n = 0;
+  while (bb_command_info_get(n))
+    n++;
+  cr_expect_gt(n, 10, "every command of bumpbake --help (%d)", n);
+  cr_expect_null(bb_command_info_get(-1));
+  cr_expect_str_eq(bb_command_info_get(0)->name, "normal", "the order of bumpbake --help");
+  cr_expect_str_eq(bb_command_info_get(n - 1)->name,
+                   bb_command_info_find(bb_command_info_get(n - 1)->name)->name);
 }

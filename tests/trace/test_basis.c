@@ -555,7 +555,7 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   cr_assert_eq(bb_image_alloc(&s6, 2, 2, 6, NULL), BB_OK);
   cr_assert_eq(bb_ssbump_to_normal(&s6, BB_MAP_SSBUMP, &n, NULL), BB_ERR_ARGUMENT);
   bb_render_options ro;
-  bb_render_options_init(&ro);
+  bb__render_options_init(&ro);
   bb_render_maps maps = {NULL, &s6, NULL, NULL, NULL, NULL};
   bb_image out = {0};
   bb_error err;
