@@ -1583,10 +1583,6 @@ bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
 bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
                             bb_error *err);
 
-/* bb_check_run_input of every input, then bb_check_run_rest. */
-bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
-                       bb_check_case_fn each, void *user, bb_error *err);
-
 /* The cases decided (and imported) so far, in order. */
 int bb_check_case_count(const bb_check *check);
 const bb_check_case *bb_check_case_get(const bb_check *check, int i);
@@ -1596,9 +1592,6 @@ const bb_check_case *bb_check_case_get(const bb_check *check, int i);
  * 0 when there is none. */
 int bb_check_exit_code(const bb_check *check);
 
-/* "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE", "UNREADABLE", "MISSING",
- * "EXTRA"; "unknown" else. Static text. */
-const char *bb_check_status_name(bb_check_status status);
 
 /* What the command line prints of a case, as the command's options (json,
  * quiet) ask: a case that does not pass as "STATUS NAME (KIND): what" and
@@ -2380,8 +2373,13 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
 
 /* ------------------------------------------------- names of enums printed */
 
-/* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
-const char *bb_job_outcome_name(bb_job_outcome outcome);
+/* The word a report gives a value of its field, as the command line, its
+ * JSON and Python print it: field "outcome" (bb_job_report.outcome:
+ * "pending", "baked", "up to date", "failed", "not run") or "result"
+ * (bb_check_case.status: "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE",
+ * "UNREADABLE", "MISSING", "EXTRA"); NULL for another field or a value
+ * outside its enum. Static text. */
+const char *bb_report_word(const char *field, int value);
 
 #ifdef __cplusplus
 }

@@ -152,3 +152,6 @@ s/\bbb_image_loader\b/bb__image_loader/g
 s/\bbb_render_options_init\b/bb__render_options_init/g
 s/\bbb_command_count\b/bb__command_count/g
 s/\bbb_option_find_short\b/bb__option_find_short/g
+# api6: the reports' words through one string-keyed call (bb_report_word).
+s/\bbb_job_outcome_name\b/bb__job_outcome_name/g
+s/\bbb_check_status_name\b/bb__check_status_name/g

@@ -752,7 +752,6 @@ bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
 int bb_check_case_count(const bb_check *check);
 const bb_check_case *bb_check_case_get(const bb_check *check, int i);
 int bb_check_exit_code(const bb_check *check);
-const char *bb_check_status_name(bb_check_status status);
 char *bb_check_case_lines(const bb_check *check, const bb_check_case *c);
 char *bb_check_summary_lines(const bb_check *check);
 bb_status bb_check_write_reports(bb_check *check, bb_error *err);
@@ -810,7 +809,7 @@ bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              bb_image *out, int *labels_drawn, bb_error *err);
 bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
                              bb_error *err);
-const char *bb_job_outcome_name(bb_job_outcome outcome);
+const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 /* what a job prints (bumpbake bake --scheduler) */

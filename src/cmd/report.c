@@ -98,7 +98,7 @@ static void short_json(FILE *f, const bb_job_report *r) {
   bb__json j = {f, 0};
   bb__json_open(&j, NULL, '{');
   bb__json_string(&j, "input", r->input);
-  bb__json_string(&j, "status", bb_job_outcome_name(r->outcome));
+  bb__json_string(&j, "status", bb__job_outcome_name(r->outcome));
   if (r->outcome == BB_JOB_FAILED)
     bb__json_int(&j, "exit_code", 1);
   outputs(&j, r, 0);

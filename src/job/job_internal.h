@@ -428,4 +428,9 @@ bb_status bb__output_check(const char *path, const bb_provenance *expected, bb_d
                           int mip_mapped, bb_output_state *state, char *reason, size_t cap,
                           bb_error *err);
 
+/* The words of bb_report_word's fields: "pending", ..., "not run" and
+ * "PASS", ..., "EXTRA"; "unknown" outside the enum. */
+const char *bb__job_outcome_name(bb_job_outcome outcome);
+const char *bb__check_status_name(bb_check_status status);
+
 #endif /* BB_JOB_INTERNAL_H */

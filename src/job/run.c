@@ -682,7 +682,7 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
   return first != BB_OK ? first : st;
 }
 
-const char *bb_job_outcome_name(bb_job_outcome outcome) {
+const char *bb__job_outcome_name(bb_job_outcome outcome) {
   switch (outcome) {
   case BB_JOB_PENDING: return "pending";
   case BB_JOB_BAKED: return "baked";
@@ -691,4 +691,13 @@ const char *bb_job_outcome_name(bb_job_outcome outcome) {
   case BB_JOB_NOT_RUN: return "not run";
   }
   return "unknown";
+}
+
+const char *bb_report_word(const char *field, int value) {
+  const char *w = NULL;
+  if (field && !strcmp(field, "outcome"))
+    w = bb__job_outcome_name((bb_job_outcome)value);
+  else if (field && !strcmp(field, "result"))
+    w = bb__check_status_name((bb_check_status)value);
+  return w && strcmp(w, "unknown") != 0 ? w : NULL;
 }

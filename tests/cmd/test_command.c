@@ -798,3 +798,27 @@ Test(cmd, the_commands_end_with_null) {
   cr_expect_str_eq(bb_command_info_get(n - 1)->name,
                    bb_command_info_find(bb_command_info_get(n - 1)->name)->name);
 }
+
+/* bb_report_word: the words of the reports' enums, as printed. */
+Test(cmd, report_words_are_the_printed_ones) {
+  cr_expect_str_eq(bb_report_word("outcome", BB_JOB_CURRENT), "up to date");
+  cr_expect_str_eq(bb_report_word("outcome", BB_JOB_NOT_RUN), "not run");
+  cr_expect_str_eq(bb_report_word("result", BB_CHECK_PASS), "PASS");
+  cr_expect_str_eq(bb_report_word("result", BB_CHECK_DIFFERENT_SIZE), "DIFFERENT SIZE");
+  cr_expect_null(bb_report_word("outcome", BB_JOB_NOT_RUN + 1));
+  cr_expect_null(bb_report_word("result", -1));
+  cr_expect_null(bb_report_word("status", 0));
+  cr_expect_null(bb_report_word(NULL, 0));
+  /* every value of each enum has its own word */
+  const char *seen[16] = {0};
+  int n = 0;
+  for (int v = BB_JOB_PENDING; v <= BB_JOB_NOT_RUN; v++)
+    seen[n++] = bb_report_word("outcome", v);
+  for (int v = BB_CHECK_PASS; v <= BB_CHECK_EXTRA; v++)
+    seen[n++] = bb_report_word("result", v);
+  for (int i = 0; i < n; i++) {
+    cr_assert_not_null(seen[i], "word %d", i);
+    for (int k = 0; k < i; k++)
+      cr_expect_str_neq(seen[i], seen[k]);
+  }
+}
