@@ -65,7 +65,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FUZZ_CHECK(err.message[0] != '\0' && strchr(err.message, '\n') == NULL);
   }
   bb_image level;
-  st = bb_image_read_mip(path, 1, &level, NULL, &levels, &err);
+  st = bb__image_read_mip(path, 1, &level, NULL, &levels, &err);
   FUZZ_CHECK((st == BB_OK) == (level.pixels != NULL));
   FUZZ_CHECK(st != BB_OK || levels >= 2);
   bb_image_free(&level);

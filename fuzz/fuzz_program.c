@@ -1,4 +1,4 @@
-/* fuzz_program.c: DOOM 3 image programs (bb_program_parse, bb_program_run)
+/* fuzz_program.c: DOOM 3 image programs (bb__program_parse, bb__program_run)
  * over real small image files: the text is the input; the images it can
  * name (a.png, b.tga, c.exr, d.tif, e.png of other sizes) are written once
  * into the scratch directory, its base. Properties: no crash, leak, hang or
@@ -6,6 +6,7 @@
  * map and 4 otherwise; a refusal is one of the documented statuses; no
  * name reads outside the base. */
 #include "bumpbake.h"
+#include "maps/program_internal.h"
 #include "fuzz_common.h"
 #include "image/image_write.h"
 
@@ -53,15 +54,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     abort();
   memcpy(text, data, size);
   text[size] = '\0';
-  bb_program *p = NULL;
+  bb__program *p = NULL;
   bb_error err = {{0}};
-  if (bb_program_parse(text, &p, &err) == BB_OK) {
-    bb_program_options o;
-    bb_program_options_init(&o);
+  if (bb__program_parse(text, &p, &err) == BB_OK) {
+    bb__program_options o;
+    bb__program_options_init(&o);
     o.base_dir = fuzz_scratch_dir();
     bb_image out = {0};
     int is_normal = 0;
-    bb_status st = bb_program_run(p, &o, &out, &is_normal, &err);
+    bb_status st = bb__program_run(p, &o, &out, &is_normal, &err);
     if (st == BB_OK) {
       FUZZ_CHECK(out.channels == (is_normal ? 3 : 4));
       const size_t n = (size_t)out.width * (size_t)out.height * (size_t)out.channels;
@@ -73,7 +74,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       FUZZ_CHECK(out.pixels == NULL);
     }
     bb_image_free(&out);
-    bb_program_free(p);
+    bb__program_free(p);
   }
   free(text);
   return 0;

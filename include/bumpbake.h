@@ -60,7 +60,7 @@ extern "C" {
  * most BB_MAX_PIXELS texels in all (32768 x 32768), checked before
  * allocating. What a machine can bake is less: reads and bakes estimate
  * their memory from the sizes first and refuse, naming the estimate and
- * what is available, what will not fit (bb__memory_available). */
+ * what is available (the machine's free memory), what will not fit. */
 #define BB_MAX_DIMENSION 65536
 #define BB_MAX_PIXELS (32768L * 32768L)
 
@@ -70,7 +70,7 @@ extern "C" {
  * file's own samples (texels x channels x bytes per sample, as its header
  * declares them) and the floats decoded (texels x channels read x 4) must
  * fit, checked before anything is allocated, and then what is available
- * (bb__memory_available) must hold them. What a reader allocates to open a
+ * (the machine's free memory) must hold them. What a reader allocates to open a
  * file at all (see bb_image_read_info) stays within BB_MAX_READ_BYTES
  * whatever the size. The first read or write also lowers OpenImageIO's
  * process-wide "limits:imagesize_MB" to BB_MAX_PIXELS x 16 bytes (16384)
@@ -80,7 +80,7 @@ extern "C" {
  * installs bumpbake's provider for OpenEXR's global pool, unless the
  * process set that pool up first: it compresses the chunks of the EXR files
  * bumpbake writes on the write's threads (bb_outputs_write's, all cores for
- * bb__image_write), and leaves every other read and write of OpenEXR on its
+ * any other image it writes), and leaves every other read and write of OpenEXR on its
  * own thread. */
 #define BB_MAX_READ_BYTES (1L << 30)
 #define BB_MAX_READ_BYTES_PER_TEXEL 16
@@ -92,8 +92,7 @@ extern "C" {
 /* Most threads a bake, render or renderbump accepts (0 = all cores). */
 #define BB_MAX_THREADS 4096
 /* Largest smoothing radius a bake accepts, in texels: beyond a few hundred
- * the window covers any texture anyway. (bb__smooth_bilateral_all_cores alone takes
- * more.) */
+ * the window covers any texture anyway. */
 #define BB_MAX_FILTER_RADIUS 4096
 /* Largest ray origin lift (texels) and lobe power a bake accepts. */
 #define BB_MAX_BIAS_TEXELS 1.0e6
@@ -108,10 +107,11 @@ extern "C" {
  * weights and the trace's sums (memory) and one table per slice (time). */
 #define BB_MAX_BASIS 16
 
-/* Largest mesh bb__mesh_alloc accepts: vertices and triangles each. */
+/* Largest mesh a model file may give renderbumpflat: vertices and triangles
+ * each. */
 #define BB_MAX_MESH_ELEMENTS (1UL << 27)
 
-/* What reading one model (bb__mesh_load) may take. Model files are untrusted,
+/* What reading one model (renderbumpflat's) may take. Model files are untrusted,
  * and Assimp's importers build their own structures before bumpbake sees a
  * triangle, so the import runs in a child process held to these limits:
  * - BB_MAX_MODEL_BYTES: the model file and every file it refers to (a glTF's
@@ -343,13 +343,13 @@ typedef struct bb_provenance_entry {
  *
  * Every format stores what the engine samples: values in [0, 1] as they
  * are and normal maps as 0.5 + 0.5 N, the float formats included (a shader
- * unpacks 2 t - 1 whatever the format; this differs from bb__image_write's
- * float files, which store N). Integer and block formats clamp to [0, 1]
+ * unpacks 2 t - 1 whatever the format; this differs from bumpbake's float
+ * image files (.exr), which store N). Integer and block formats clamp to [0, 1]
  * and round to 8 bits first. Channels: 1 is grey (v, v, v), 2 are R and G,
  * 3 are R, G, B; alpha is 1 unless the image has a fourth channel. */
 
-/* Pixel format of an engine texture. Names for bb_texture_format_parse in
- * quotes. */
+/* Pixel format of an engine texture. Names, as --texture-format takes them
+ * (bb_option_parse), in quotes. */
 typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_DEFAULT = 0, /* VTF: DXT1 (DXT5 for 4 channels), as Valve ships
                                     ssbump and normal maps. DDS: BC5 for a normal map,
@@ -365,15 +365,6 @@ typedef enum bb_texture_format {
   BB_TEXTURE_FORMAT_RGBA16F, /* "rgba16f" or "rgba16161616f": half floats; VTF, DDS */
   BB_TEXTURE_FORMAT_RGBA32F  /* "rgba32f": floats; DDS */
 } bb_texture_format;
-
-/* Parses a format name above (any case); "default" is BB_TEXTURE_FORMAT_DEFAULT. */
-bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-/* Parses a VTF version as --vtf-version takes it: "7.2" to "7.5", or the
- * minor number alone ("2" to "5"); *minor receives 2..5. */
-bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
-/* Parses VTF flags as --vtf-flags takes them: a 32-bit number, decimal,
- * 0x hexadecimal or 0 octal (strtoul's base 0), no sign. */
-bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 
 /* VTF header flags (Valve's TEXTUREFLAGS_*) the writer sets, for
  * bb_texture_options.vtf_flags and bb_vtf_info.flags. */
@@ -475,7 +466,7 @@ typedef struct bb_vmt_options {
  * without ".vtf", as Source looks textures up. Paths are compared as
  * written, made absolute against the working directory, "." and ".."
  * resolved, symbolic links not followed (the textures need not exist yet).
- * Written as bb__file_write writes. Errors: BB_ERR_ARGUMENT (no path or
+ * Written as every file of bumpbake's: to a temporary file renamed into place. Errors: BB_ERR_ARGUMENT (no path or
  * bumpmap; a path not ending in ".vmt" (any case), or naming the same file
  * as the bump map or base texture (a hard link), which would be
  * overwritten; no materials_dir and no "materials" folder above the bump map;
@@ -541,12 +532,6 @@ bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
 bb_status bb_image_read_info(const char *path, int *width, int *height, int *channels,
                              bb_image_info *info, bb_error *err);
 
-/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
- * reads level 0. level_count (may be NULL) receives the file's number of
- * levels; a level past the last is BB_ERR_ARGUMENT. */
-bb_status bb_image_read_mip(const char *path, int level, bb_image *out,
-                            bb_image_info *info, int *level_count, bb_error *err);
-
 /* ------------------------------------------------------ writing images */
 
 /* Sample depth of a written file. DEFAULT is 8-bit for png/tga/tif and
@@ -558,9 +543,6 @@ typedef enum bb_depth {
   BB_DEPTH_HALF,  /* exr */
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
-
-/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 
 typedef struct bb_write_options {
   bb_depth depth;
@@ -603,7 +585,7 @@ void bb_mip_chain_free(bb_image *levels, int count);
 
 /* An animated GIF being written (OpenImageIO's GIF writer: 8 bits per
  * channel, a palette per frame). Frames go to a temporary file in the
- * destination directory; bb__animation_close checks it and renames it into
+ * destination directory; closing the animation checks it and renames it into
  * place, so a failure leaves no partial file. GIF stores no provenance. */
 typedef struct bb_animation bb_animation;
 
@@ -612,7 +594,8 @@ typedef struct bb_animation bb_animation;
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0, /* the grey, or the mean of R, G, B; alpha where the
-                          image shows Valve's convention (bb_height_channel) */
+                          image shows Valve's convention (the rule under
+                          bb_height_file_read) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
@@ -622,22 +605,6 @@ typedef enum bb_channel {
   BB_CHANNEL_VALVE     /* Valve's height2ssbump: alpha when the image has
                           one, else the grey or the mean of R, G, B */
 } bb_channel;
-
-/* Parses "r", "g", "b", "a", "luma", "mean", "auto", "valve" (any case). */
-bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
-
-/* The channel the rule takes from img when asked for `channel`: channel
- * itself, except for two rules. BB_CHANNEL_AUTO reads img once and gives
- * BB_CHANNEL_A when img has an alpha channel (alpha_channel, or the last of
- * 2 or 4 channels) that varies while the colour (grey, or R, G and B) is the
- * same at every texel, or when the colour is a colour (R, G and B not all
- * equal) and alpha takes three values or more (a height, not a cutout
- * mask): Valve's convention, the height in alpha. Otherwise it gives
- * BB_CHANNEL_MEAN (for a grey image, the grey). BB_CHANNEL_VALVE gives
- * BB_CHANNEL_A whenever there is an alpha channel, else BB_CHANNEL_MEAN for
- * colour and BB_CHANNEL_AUTO (the grey) for grey. bb_height_file_read says
- * which was taken whenever the image left a choice. */
-bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 
 /* Extracts a 1-channel height field from a decoded image by the channel rule.
  * Rejects NaN or infinite heights (BB_ERR_VALUE, naming the first bad texel)
@@ -674,7 +641,7 @@ bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis 
 
 /* A basis as the command line names it: "hl2", "hl2+z" or "dirs:N" (a name
  * wins over a file of the same name, which ./NAME reaches), else the path
- * of a basis file (bb__basis_load). BB_ERR_ARGUMENT for a word that is
+ * of a basis file (docs/conventions.md). BB_ERR_ARGUMENT for a word that is
  * neither ("basis must be hl2, hl2+z, dirs:N (N in 3..16) or a file of
  * directions (got 'x': No such file or directory)") or a dirs:N out of
  * range; a file's own errors otherwise. *from_file (may be NULL) receives 1
@@ -692,7 +659,7 @@ void bb_pyramid_free(bb_pyramid *p);
 /* ------------------------------------------------------------- ray set */
 
 /* The directions the bake integrates over, and how; opaque, built by
- * bb__rayset_new, read-only afterwards and safe to share between threads.
+ * the library for a bake (bb_bake_trace_input), read-only afterwards and safe to share between threads.
  * ("Ray set" is the historical name: nothing is sampled in elevation.)
  * Slice s follows the integer lattice step (a, b) nearest to the azimuth
  * 2 pi (s + 1/2) / A and stands for the azimuth sector halfway to its
@@ -754,9 +721,9 @@ struct bb_trace_options {
                               theirs */
   void *progress_user;
   bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
-                           bb__trace_occlusion; else bb_bake calls
+                           the library's own tracer; else bb_bake calls
                            trace(trace_user, ...) in its place (bb_trace_fn).
-                           bb__trace_occlusion itself ignores it */
+                           the library's tracer itself ignores it */
   void *trace_user;
 };
 
@@ -787,8 +754,6 @@ typedef enum bb_normal_filter {
                           i.e. Valve's sums at the 4 cell centres around the
                           vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
-
-const char *bb_normal_filter_name(bb_normal_filter f);
 
 typedef struct bb_normal_decode_options {
   int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
@@ -837,7 +802,7 @@ typedef struct bb_bake_options {
                                  bake (smooth, normals, pyramid, trace,
                                  derive); progress, which may cancel */
   double power;               /* P in 1..BB_MAX_POWER, default 1 */
-  bb_basis basis;             /* default "hl2" (bb__basis_init); weights and
+  bb_basis basis;             /* default "hl2" (bb_bake_options_init); weights and
                                  ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
@@ -915,7 +880,11 @@ typedef struct bb_bake_result {
  * field (normalised h), making the maps o->outputs asks for and nothing
  * else (vis is made whenever a traced kind is asked). Results are
  * bit-identical for any o->trace.threads. Fills result; free it with
- * bb_bake_result_free. Errors: those of bb__bake_options_check, BB_ERR_VALUE
+ * bb_bake_result_free. Errors: BB_ERR_ARGUMENT (a value outside the range of
+ * bake's option for it, bb_option_bounds; no outputs or unknown ones, an
+ * unknown addressing or normal filter, a bounce albedo or brightness map
+ * without pixels, a basis of other than 3..BB_MAX_BASIS unit directions
+ * with z >= 0), BB_ERR_VALUE
  * (NaN heights, scale x height overflowing), BB_ERR_MEMORY, and
  * BB_ERR_CANCELLED when o->trace.progress returned nonzero: then nothing is
  * returned (result is zeroed). */
@@ -990,31 +959,6 @@ typedef struct bb_valve_options {
                       map, 0.5 + 0.5 N (-n, FILE-bump.tga). Default 0 */
   int ao_in_alpha; /* 0: A = the filtered height; 1: A = ao (-A). Default 0 */
 } bb_valve_options;
-
-void bb_valve_options_init(bb_valve_options *o);
-
-/* Packs a bake into Valve's RGBA layout: RGB = result->ssbump (its first
- * three channels) or result->normal encoded as 0.5 + 0.5 N, A =
- * result->filtered or result->ao. Every channel of out is then a unit value
- * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
- * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
- * the traced outputs) or has too few channels, or when the ssbump is of a basis
- * other than Half-Life 2's (result->basis, when set, or more than 4
- * channels); BB_ERR_SIZE when sizes differ. */
-bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
-                        bb_image *out, bb_error *err);
-
-/* Valve's detail variant (-d): multiplies R, G, B of rgba (4 channels, as
- * bb_valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
- * input colour smoothed like the height: colour is the decoded input (grey
- * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
- * ignored), smoothed by bb__smooth_bilateral_all_cores with smooth and guided by
- * height (the 1-channel height the bake started from), so the factor
- * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
- * input gives 0.5, the neutral value of a mod2x detail texture. All three
- * images must have the same size (BB_ERR_SIZE). */
-bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
-                          const bb_smooth_options *smooth, bb_error *err);
 
 /* ---------------------------------------------------- ssbump to normal */
 
@@ -1096,54 +1040,6 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
 bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
                                 bb_map_kind kind, bb_image *out, bb_error *err);
 
-/* ----------------------------------------------------- DOOM 3 programs */
-
-/* A parsed DOOM 3 image program, such as "addnormals(a_local.tga,
- * heightmap(a_h.tga, 4))": opaque, made by bb_program_parse. */
-typedef struct bb_program bb_program;
-
-/* Parses text in DOOM 3's image-program syntax: heightmap(img, scale),
- * addnormals(a, b), smoothnormals(a), add(a, b), scale(a, r, g, b, a),
- * invertAlpha(a), invertColor(a), makeIntensity(a), makeAlpha(a), _flat, and
- * image names (file paths; "double quotes" allow spaces and commas). Function
- * names are case-insensitive, as in id Tech 4. A syntax error is
- * BB_ERR_ARGUMENT with a message giving the 1-based column; an unknown
- * function's message lists the known ones. Free *out with bb_program_free. */
-bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
-
-void bb_program_free(bb_program *program);
-
-/* Reads the image a program names: fills img (any channel count) and info
- * (may be NULL) as bb_image_read does. */
-typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
-                                     bb_image_info *info, bb_error *err);
-
-typedef struct bb_program_options {
-  const char *base_dir;   /* image names are relative to it; NULL or "" = the
-                             current directory */
-  int allow_outside_base; /* 0 (default): an image name must stay inside the
-                             base directory, resolved (no absolute path, no
-                             "..", no symbolic link out: BB_ERR_ARGUMENT);
-                             1: any file may be read */
-  bb_image_loader loader; /* NULL = bb_image_read */
-  void *loader_user;
-} bb_program_options;
-
-void bb_program_options_init(bb_program_options *o);
-
-/* Evaluates a program as id Tech 4 does (docs/commands/program.md gives each
- * formula), in float rather than bytes. Inside, every image is RGBA in
- * [0, 1] standing for id's bytes / 255 (files are read as value / max code,
- * clamped; grey gives R = G = B, no alpha gives A = 1), and normal-map
- * operations decode N = (255 v - 128) / 127 and encode v = (127 N + 128) /
- * 255, id's own mapping (byte 128 is 0). When the program makes a normal map
- * (heightmap, addnormals, smoothnormals or _flat anywhere in it, as id marks
- * TD_BUMP), out holds its decoded N (3 channels, +Y down) and *is_normal_map
- * is 1; otherwise out holds RGBA colour (4 channels) and *is_normal_map is 0.
- * Errors name the file or the function and its column. */
-bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
-                         bb_image *out, int *is_normal_map, bb_error *err);
-
 /* -------------------------------------------------- flipcode slope map */
 
 /* ------------------------------------------------------------- compare */
@@ -1222,7 +1118,7 @@ typedef enum bb_render_mode {
   BB_RENDER_NORMAL,     /* plain normal mapping, no self-shadowing (needs normal) */
   BB_RENDER_NORMAL_AO,  /* normal mapping times ambient occlusion (normal, ao) */
   BB_RENDER_SLOPE       /* flipcode's 1999 slope map lit through its 16 x 16
-                           table (bb__slope_table; needs slope) */
+                           table (needs slope) */
 } bb_render_mode;
 
 /* The maps a mode reads, as BB_RENDER_NEEDS_* bits (0 for an unknown mode). */
@@ -1243,7 +1139,7 @@ typedef struct bb_render_maps {
   const bb_image *ao;     /* ao in channel 0 */
   const bb_image *bent;   /* Nb, >= 3 channels; NULL: computed from ssbump */
   const bb_image *albedo; /* NULL = white; 1 channel = grey, >= 3 = RGB */
-  const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bb__slope_map) */
+  const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bake's slope) */
 } bb_render_maps;
 
 typedef struct bb_render_options {
@@ -1286,8 +1182,6 @@ typedef struct bb_render_options {
                                    with relief) */
 } bb_render_options;
 
-void bb_render_options_init(bb_render_options *o);
-
 /* ------------------------------------------------------ rendering files */
 
 /* The maps a render can read from files instead of baking a height:
@@ -1297,10 +1191,11 @@ void bb_render_options_init(bb_render_options *o);
  * channel 0); their names are the command line's options and provenance's
  * map_KIND keys. */
 /* Reads a map file for a render and checks it for its kind: channels
- * enough, Half-Life 2's basis for an ssbump (bb__basis_map_check), and the
+ * enough, Half-Life 2's basis for an ssbump (as ssbump2normal checks it), and the
  * size of like when like is not NULL; normal and bent maps are decoded to
  * unit N (bb_normal_map_decode; normal_y_up 1: OpenGL-style files).
- * *hash (may be NULL) receives bb__image_hash of what the file decoded to.
+ * *hash (may be NULL) receives the hash of what the file decoded to (its
+ * pixels' hash, as provenance's input_hash records a decoded input).
  * Errors name the file: those of bb_image_read, BB_ERR_ARGUMENT for a map
  * that is not what its kind needs. */
 bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
@@ -1313,7 +1208,7 @@ typedef struct bb_render_sources {
   const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
   int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
   const char *albedo;   /* the albedo file, or NULL */
-  uint64_t albedo_hash; /* bb__image_hash of the albedo read */
+  uint64_t albedo_hash; /* the hash of the albedo's pixels, as read */
   int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
 } bb_render_sources;
 
@@ -1323,7 +1218,7 @@ typedef struct bb_render_sources {
 
 /* One picture of a panel grid and the label written under it (may be NULL). */
 typedef struct bb_panel {
-  const bb_image *image; /* 3-channel RGB in [0, 1] (bb__image_to_display) */
+  const bb_image *image; /* 3-channel RGB in [0, 1] (a map as an 8-bit file shows it) */
   const char *label;
 } bb_panel;
 
@@ -1338,7 +1233,7 @@ typedef struct bb_panel_layout {
   const char *font;   /* font file or name; NULL = look one up (default NULL) */
 } bb_panel_layout;
 
-/* The exponent bb__render_compare uses when o->specular_exponent is 0. */
+/* The exponent render --compare uses when o->specular_exponent is 0. */
 #define BB_COMPARE_SPECULAR_EXPONENT 64.0
 
 /* --------------------------------------------------------------- sheet */
@@ -1354,7 +1249,7 @@ typedef struct bb_sheet_options {
 
 /* -------------------------------------------------------------- meshes */
 
-/* A triangle mesh in model units. bb__mesh_load fills one from a file: every
+/* A triangle mesh in model units. renderbumpflat reads one from a file: every
  * mesh of the file merged, node transforms applied, polygons triangulated,
  * points and lines dropped. */
 typedef struct bb_mesh {
@@ -1380,9 +1275,6 @@ typedef enum bb_axis {
   BB_AXIS_POS_X,     /* right +Y, up +Z, out +X (Blender's right view) */
   BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
 } bb_axis;
-
-/* "-y", "+z", ...; "unknown" for a value outside the enum. */
-const char *bb_axis_name(bb_axis a);
 
 typedef struct bb_renderbump_options {
   int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
@@ -1422,7 +1314,7 @@ typedef struct bb_renderbump_result {
   int used_vertex_normals; /* 1 when some texel used interpolated normals */
   size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
   size_t triangles, vertices; /* the mesh's counts */
-  uint64_t model_hash;     /* bb__mesh_hash of the mesh, as its files record it */
+  uint64_t model_hash;     /* the hash of the mesh, as its files record it */
 } bb_renderbump_result;
 
 void bb_renderbump_result_free(bb_renderbump_result *r);
@@ -1437,7 +1329,7 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
 typedef struct bb_provenance {
   const char *command;        /* the command line, or NULL */
   const char *input_name;     /* input file name (no directory), or NULL */
-  uint64_t input_hash;        /* bb__image_hash of the decoded input pixels */
+  uint64_t input_hash;        /* the hash of the decoded input pixels */
   const char *output_kind;    /* "normal", "ssbump", "ao", ... */
   const bb_bake_options *options;
   bb_channel channel;         /* height channel rule used */
@@ -1453,14 +1345,14 @@ typedef struct bb_provenance {
  * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
  * channel), malloc'd; the caller
  * frees it. With options (a bake's map), only the parameters output_kind
- * records are written (bb__map_kind_records: a normal map has no rays,
+ * records are written (a normal map has no rays,
  * rayset, bias, power or basis; ao's rayset is its scheme and slices);
  * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
  * basis_vectors after basis: "x y z" per direction, joined by "; ".
  * Options in use add, after addressing: bounce (rho) and bounces when
- * bounce_albedo > 0, with bounce_albedo_map (bb__image_hash of the map, 16
- * hex digits) when it has one; brightness (the brightness map's
- * bb__image_hash) when there is one.
+ * bounce_albedo > 0, with bounce_albedo_map (the hash of the map's pixels, 16
+ * hex digits) when it has one; brightness (the hash of the
+ * brightness map's pixels) when there is one.
  * Returns NULL when out of memory. */
 char *bb_provenance_format(const bb_provenance *p);
 
@@ -1482,7 +1374,7 @@ typedef struct bb_output_spec {
 } bb_output_spec;
 
 /* Checks every output before any work, so a bad name costs no baking time:
- * BB_ERR_ARGUMENT (usage: an extension bb__image_write does not know, a
+ * BB_ERR_ARGUMENT (usage: an extension bumpbake does not write, a
  * depth, mip chain or channel count the format cannot hold, a .vtf or .dds
  * of a size or channels its format cannot take (with the texture options
  * of the map kind and range name), two outputs on
@@ -1493,8 +1385,8 @@ typedef struct bb_output_spec {
  * output that exists and is not a regular file: a directory, a device, a
  * FIFO, a socket or a symbolic link, which the rename that puts an output
  * in place would replace: "PATH: cannot write: is a FIFO, not a regular
- * file"). Messages start with the path. Every write (bb__file_write,
- * bb__image_write and the staged writes) refuses such a name too, at its
+ * file"). Messages start with the path. Every write of the library
+ * (texts, images and the staged writes) refuses such a name too, at its
  * start and again just before its rename. */
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
@@ -1522,7 +1414,7 @@ typedef struct bb_output_file {
   size_t text_size;
   const bb_texture_options *texture; /* a .vtf or .dds file's settings (NULL:
                                 the defaults); its map is set from kind and
-                                range (bb__texture_options_for), its mip chain by
+                                range, its mip chain by
                                 its own mips, not the file's */
 } bb_output_file;
 
@@ -1558,11 +1450,11 @@ typedef struct bb_height_source {
   int is_float;           /* 1: float or half samples */
   char format_name[32];   /* OpenImageIO's: "png", "openexr", ... */
   uint64_t file_hash;     /* bb_file_hash of the bytes that were decoded */
-  uint64_t height_hash;   /* bb__image_hash of the height */
+  uint64_t height_hash;   /* the hash of the height's pixels */
 } bb_height_source;
 
-/* Reads the height of the file at path by the channel rule (bb_channel,
- * bb_height_channel): the file's bytes are hashed first, then decoded, so
+/* Reads the height of the file at path by the channel rule
+ * (bb_channel): the file's bytes are hashed first, then decoded, so
  * provenance never pairs a newer file's hash with older pixels. note (may
  * be NULL) hears which channel the rule took when it was not the obvious
  * one, and warnings about the input (lossy JPEG blocks, 8-bit codes that
@@ -1574,7 +1466,7 @@ bb_status bb_height_file_read(const char *path, bb_channel channel, float height
                               bb_height_source *source, bb_error *err);
 
 /* The name of the channel a height came from: "grey" for a grey image
- * (whose mean is its grey), else bb__channel_name's. */
+ * (whose mean is its grey), else the channel's word as --channel takes it. */
 const char *bb_height_source_channel(const bb_height_source *source);
 
 /* --------------------------------------------------------- comparing files */
@@ -1586,14 +1478,14 @@ typedef struct bb_compare_report {
                                  else was compared (idiff's exit 3) */
   int width, height, channels;       /* of A */
   int b_width, b_height, b_channels; /* of B */
-  bb_compare_stats stats;     /* per pixel, as bb__compare_images */
-  bb_compare_verdict verdict; /* idiff's rule (bb__compare_judge); FAIL when
+  bb_compare_stats stats;     /* per pixel, as idiff computes them */
+  bb_compare_verdict verdict; /* idiff's rule; FAIL when
                                  the shapes differ */
   bb_provenance_class provenance_a, provenance_b;
   int provenance_differences; /* keys that differ, or -1 when not compared
                                  (either side not intact provenance) */
   char *provenance_diff;      /* "key: A-value -> B-value" lines
-                                 (bb__provenance_diff), malloc'd, or NULL */
+                                 of the provenance, malloc'd, or NULL */
   int diff_written;           /* 1 when diff_path was written */
   bb_error diff_error;        /* why it was not, when asked */
   const char *result;         /* idiff's word for the outcome, as `bumpbake
@@ -1645,8 +1537,8 @@ typedef struct bb_check_case {
   int width, height, channels;             /* of the golden (0: not read) */
   int new_width, new_height, new_channels; /* of the new map (0: not made) */
   bb_compare_stats stats;      /* when both were compared (same size) */
-  const char *provenance_diff; /* "key: golden -> new" lines (bb__provenance_diff;
-                                  "" when the same), NULL when not compared
+  const char *provenance_diff; /* "key: golden -> new" lines of the provenance
+                                  ("" when the same), NULL when not compared
                                   (either side without intact provenance) */
   const char *message;         /* why UNREADABLE, MISSING or EXTRA; else "" */
   int updated;                 /* 1: its golden was written by the update */
@@ -1691,10 +1583,6 @@ bb_status bb_check_run_input(bb_check *check, int i, bb_progress_fn progress,
 bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
                             bb_error *err);
 
-/* bb_check_run_input of every input, then bb_check_run_rest. */
-bb_status bb_check_run(bb_check *check, bb_progress_fn progress, void *progress_user,
-                       bb_check_case_fn each, void *user, bb_error *err);
-
 /* The cases decided (and imported) so far, in order. */
 int bb_check_case_count(const bb_check *check);
 const bb_check_case *bb_check_case_get(const bb_check *check, int i);
@@ -1704,9 +1592,6 @@ const bb_check_case *bb_check_case_get(const bb_check *check, int i);
  * 0 when there is none. */
 int bb_check_exit_code(const bb_check *check);
 
-/* "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE", "UNREADABLE", "MISSING",
- * "EXTRA"; "unknown" else. Static text. */
-const char *bb_check_status_name(bb_check_status status);
 
 /* What the command line prints of a case, as the command's options (json,
  * quiet) ask: a case that does not pass as "STATUS NAME (KIND): what" and
@@ -1762,7 +1647,7 @@ typedef struct bb_job_options {
   bb_channel channel;        /* the height channel rule (default AUTO) */
   bb_depth depth;            /* every map's depth; BB_DEPTH_DEFAULT: the
                                 format's, and the filtered height keeps the
-                                input's (bb__depth_like_input) */
+                                input's */
   int mips;                  /* 1: mip-mapped files (.tif, .tiff, .exr) */
   const char *basis_file;    /* the file bake.basis came from, or NULL: a
                                 prerequisite in the depfile */
@@ -1778,7 +1663,7 @@ typedef struct bb_job_options {
   const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
   int slope_lit;             /* 1: also slope_path with "_lit" before its
                                 extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as bb__light_direction;
+  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as render's --light;
                                 azimuth finite, elevation 0..90 */
   /* A batch (out_dir set): */
   const char *out_dir;       /* outputs go to out_dir/name; created when missing */
@@ -1802,7 +1687,7 @@ typedef struct bb_job_options {
   bb_texture_options texture; /* the settings of every .vtf and .dds output
                                 (format, mips, VTF version and flags); each
                                 one's map follows its kind
-                                (bb__texture_options_for); threads 0: the bake's. Sizes and channels are
+                                and range; threads 0: the bake's. Sizes and channels are
                                 checked against the input's header when planned */
   const char *vmt;           /* one input: a Source material (.vmt) written with
                                 the maps, its $bumpmap the ssbump .vtf (with
@@ -1812,18 +1697,14 @@ typedef struct bb_job_options {
                                 "materials" above the bump map (bb_vmt_options) */
   const char *vmt_basetexture; /* the colour .vtf the material names, or NULL */
   /* Valve's height2ssbump file (one input, no out_dir): */
-  const char *valve_path;    /* the RGBA file bb_valve_pack makes of the bake (RGB
+  const char *valve_path;    /* the RGBA file Valve's tool makes of the bake (RGB
                                 ssbump or normal map, A filtered height or ao), written
                                 before the maps; NULL: none. Its provenance names the
                                 channel the height came from, as Valve's rule picks it */
   bb_valve_options valve;    /* what goes into it */
-  int valve_detail;          /* 1: Valve's detail variant (bb_valve_detail of the
-                                input's colour); not with valve.normal_map */
+  int valve_detail;          /* 1: Valve's detail variant (RGB times the
+                                input's smoothed colour); not with valve.normal_map */
 } bb_job_options;
-
-/* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
- * the texture defaults (bb_texture_options_init), no outputs. */
-void bb_job_options_init(bb_job_options *o);
 
 /* The file a bake with options o writes for map kind, the one rule for
  * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
@@ -1908,7 +1789,8 @@ const bb_job_report *bb_job_report_get(const bb_job *job, int i);
 const char *bb_job_stage(const bb_job *job);
 
 /* Whether every output of input i is what baking it now would write
- * (bb_output_check of each, from the files' headers; no pixel is decoded):
+ * (each output's provenance, depth and mip levels, from the files' headers;
+ * no pixel is decoded):
  * *current is 1 or 0, and the report's reason says why not. The input's
  * bytes are hashed, unless its header is refused: such an input is not
  * current (the reason is the refusal its bake gives). Errors: BB_ERR_IO
@@ -2006,31 +1888,6 @@ typedef enum bb_output_state {
   BB_OUTPUT_STALE        /* a file, but made otherwise, or not known to be
                             current (no or damaged provenance, unreadable) */
 } bb_output_state;
-
-/* Decides from the header of the file at path alone (bb_image_read_info;
- * no pixel is decoded) whether it is what writing the output described by
- * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
- * 1), would make now. CURRENT when its provenance is bumpbake's, intact
- * (bb_provenance_class), and holds every key bb_provenance_format(expected)
- * writes with the same value, and no key that text lacks, except "command"
- * and "input" (the command line and the input's name, which do not change a
- * pixel) and "input_hash" (the decoded height's hash, implied by
- * input_file_hash and channel), and keys the file's kind does not record
- * (bb__map_kind_records: a normal map written before the rule, with "rays",
- * is current): so the bumpbake version, the input file's bytes, the output
- * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
- * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
- * level exactly when mip_mapped. expected->input_file_hash must be set
- * (nonzero): without it nothing is CURRENT. A file that cannot be read is
- * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
- * may be NULL) receives why it is not CURRENT, one line ("no such file",
- * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
- * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
- * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
- * BB_ERR_MEMORY. */
-bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
-                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
-                          bb_error *err);
 
 /* =====================================================================
  * cmd: every command of `bumpbake`, its options and their rules,
@@ -2132,9 +1989,8 @@ typedef struct bb_command_info {
   int option_count;
 } bb_command_info;
 
-/* The commands, in the order `bumpbake --help` lists them: index 0 ..
- * bb_command_count() - 1; NULL outside. Static data. */
-int bb_command_count(void);
+/* The commands, in the order `bumpbake --help` lists them: index 0, 1, ...
+ * until NULL (and NULL below 0). Static data. */
 const bb_command_info *bb_command_info_get(int index);
 /* The command named name, or NULL. */
 const bb_command_info *bb_command_info_find(const char *name);
@@ -2146,8 +2002,6 @@ const bb_option_info *bb_command_option(const bb_command_info *command, int inde
  * when none. */
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length);
-/* The option whose short name is c, or NULL. */
-const bb_option_info *bb_option_find_short(const bb_command_info *command, char c);
 /* For "did you mean": the option of command whose name is nearest to the
  * first length characters of name (at most 2 edits away, '_' read as '-'),
  * or NULL. */
@@ -2169,6 +2023,25 @@ int bb_option_bounds(const bb_option_info *option, double *min, double *max,
  * a path not given). */
 void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
                             char *out, size_t cap);
+/* Parses text as the option's value by the option's own parser, with no
+ * command to set: *value is what the word or number stands for (a word's
+ * enum value: bb_channel for bake's channel, bb_depth for depth,
+ * bb_texture_format, bb_normal_filter, bb_axis; normal-y's 0 down and 1
+ * up; vtf-version's minor number 2..5; vtf-flags' 32 bits). For the
+ * options that take words (BB_OPTION_WORD, one word of a BB_OPTION_WORDS
+ * list) and those integers read by a parser of their own (vtf-version,
+ * vtf-flags). Errors: BB_ERR_ARGUMENT in the value's own words, which name
+ * what the value is rather than the option ("channel must be one of auto,
+ * r, g, b, a, luma, mean, valve (got 'z')", "VTF version must be 7.2, 7.3,
+ * 7.4 or 7.5 (got '7.9')"), or "--NAME has no word or value of its own to
+ * parse" for any other option (bb_command_set reads those). */
+bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
+                          bb_error *err);
+/* The word the option takes for value (bb_option_parse's inverse: "vertex"
+ * for normal-filter's BB_NORMAL_VERTEX, "-y" for renderbumpflat's axis
+ * BB_AXIS_NEG_Y); NULL for a value without a word or an option without
+ * words. Static text. */
+const char *bb_option_word(const bb_option_info *option, long long value);
 
 /* ------------------------------------------------------------- options */
 
@@ -2298,8 +2171,7 @@ bb_status bb_command_value(const bb_command *command, const char *name, char *ou
                            size_t cap, bb_error *err);
 /* The options as set (defaults elsewhere); owned by command. */
 const bb_command_options *bb_command_options_of(const bb_command *command);
-/* The inputs added, and how many. */
-int bb_command_input_count(const bb_command *command);
+/* Input index of those added (bb_command_add_input), or NULL past the last. */
 const char *bb_command_input(const bb_command *command, int index);
 
 /* The command as text, through the descriptions: "bumpbake NAME INPUT...
@@ -2450,7 +2322,7 @@ void bb_command_result_free(bb_command_result *result);
  * hooks->note), rendered flat (its notes to
  * hooks->note, naming the model) into render (allocated; free with
  * bb_renderbump_result_free), and its files written by
- * bb__renderbump_write with the command's record, listed in result (free
+ * the job with the command's record, listed in result (free
  * with bb_command_result_free): "normal", then "height" when asked. A
  * command set in memory (bb_command_set_in_memory, before its check)
  * writes nothing. Errors: BB_ERR_ARGUMENT (not a checked renderbumpflat),
@@ -2469,10 +2341,26 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
  * (allocated) receives render's picture (with the light as given: an
  * orbit's first frame) or sheet's contact sheet; *labels_drawn (may be
  * NULL) is 0 when the labels could not be drawn (no font). Errors as
- * bb_bake's, bb__render's, bb__sheet_make's. */
+ * bb_bake's, and render's or sheet's. */
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
+
+/* program's run (bb_command_run's) in memory: the DOOM 3 image program of
+ * a checked `program` command (its input: "addnormals(a_local.tga,
+ * heightmap(a_h.tga, 4))", docs/commands/program.md gives each function)
+ * evaluated as id Tech 4 does, in float rather than bytes, its image names
+ * read relative to --base and kept inside it unless --allow-outside-base;
+ * nothing written. When the program makes a normal map (heightmap,
+ * addnormals, smoothnormals or _flat in it, as id marks TD_BUMP), out
+ * (allocated; free with bb_image_free) holds its decoded N (3 channels, +Y
+ * down) and *is_normal_map is 1; otherwise RGBA colour in [0, 1] (4
+ * channels) and 0. Errors: BB_ERR_ARGUMENT (not a checked program; a
+ * syntax error, giving the 1-based column; an unknown function, listing
+ * the known ones; an image name leaving the base), those of the reads
+ * naming the file. */
+bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
+                             bb_error *err);
 
 /* ----------------------------------------------------- what a job prints */
 
@@ -2485,10 +2373,13 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
 
 /* ------------------------------------------------- names of enums printed */
 
-/* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
-bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
-/* "pending", "baked", "up to date", "failed", "not run"; "unknown" else. */
-const char *bb_job_outcome_name(bb_job_outcome outcome);
+/* The word a report gives a value of its field, as the command line, its
+ * JSON and Python print it: field "outcome" (bb_job_report.outcome:
+ * "pending", "baked", "up to date", "failed", "not run") or "result"
+ * (bb_check_case.status: "PASS", "WARNING", "FAILURE", "DIFFERENT SIZE",
+ * "UNREADABLE", "MISSING", "EXTRA"); NULL for another field or a value
+ * outside its enum. Static text. */
+const char *bb_report_word(const char *field, int value);
 
 #ifdef __cplusplus
 }

@@ -127,6 +127,16 @@ else
   diff "$tmp/header.sym" "$tmp/so.sym" | grep '^[<>]' >&2 || true
 fi
 
+# The installed headers name no internal (bb__): a reader of them cannot
+# call one, so their comments say what it does or name the public call.
+internal=$(grep -n '\bbb__[a-z0-9_]*' "$prefix/include/bumpbake.h" "$prefix/include/bumpbake_cluster.h" || true)
+if [ -z "$internal" ]; then
+  pass "bumpbake.h and bumpbake_cluster.h name no internal (bb__)"
+else
+  fail "the installed headers name internals (bb__), which their readers cannot call:"
+  printf '%s\n' "$internal" >&2
+fi
+
 # ----------------------------------------------------------- 4. man page
 man_page=$prefix/share/man/man1/bumpbake.1
 if command -v groff >/dev/null 2>&1; then

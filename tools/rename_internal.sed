@@ -122,3 +122,36 @@ s/\bbb_vtf_read_info\b/bb__vtf_read_info/g
 s/\bbb_vtf_info_free\b/bb__vtf_info_free/g
 s/\bbb_dds_read_info\b/bb__dds_read_info/g
 s/\bbb_provenance_classify\b/bb__provenance_classify/g
+# api6 (issue 41): enum parsers and names a client reads through the option rows (bb_option_parse,
+# bb_option_word), and the exports no client used.
+s/\bbb_channel_parse\b/bb__channel_parse/g
+s/\bbb_depth_parse\b/bb__depth_parse/g
+s/\bbb_normal_y_parse\b/bb__normal_y_parse/g
+s/\bbb_texture_format_parse\b/bb__texture_format_parse/g
+s/\bbb_vtf_flags_parse\b/bb__vtf_flags_parse/g
+s/\bbb_vtf_version_parse\b/bb__vtf_version_parse/g
+s/\bbb_normal_filter_name\b/bb__normal_filter_name/g
+s/\bbb_axis_name\b/bb__axis_name/g
+s/\bbb_height_channel\b/bb__height_channel/g
+s/\bbb_image_read_mip\b/bb__image_read_mip/g
+s/\bbb_job_options_init\b/bb__job_options_init/g
+s/\bbb_output_check\b/bb__output_check/g
+s/\bbb_valve_detail\b/bb__valve_detail/g
+s/\bbb_valve_pack\b/bb__valve_pack/g
+s/\bbb_command_input_count\b/bb__command_input_count/g
+s/\bbb_valve_options_init\b/bb__valve_options_init/g
+# api6: the DOOM 3 program family, run by a client through its command (bb_command_program).
+s/\bbb_program_parse\b/bb__program_parse/g
+s/\bbb_program_free\b/bb__program_free/g
+s/\bbb_program_options_init\b/bb__program_options_init/g
+s/\bbb_program_run\b/bb__program_run/g
+s/\bbb_program_options\b/bb__program_options/g
+s/\bbb_program\b/bb__program/g
+s/\bbb_image_loader\b/bb__image_loader/g
+# api6: defaults and lookups a client reads from the descriptions (a new command's options, bb_command_info_get's NULL, bb_command_option's short_name).
+s/\bbb_render_options_init\b/bb__render_options_init/g
+s/\bbb_command_count\b/bb__command_count/g
+s/\bbb_option_find_short\b/bb__option_find_short/g
+# api6: the reports' words through one string-keyed call (bb_report_word).
+s/\bbb_job_outcome_name\b/bb__job_outcome_name/g
+s/\bbb_check_status_name\b/bb__check_status_name/g

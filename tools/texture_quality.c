@@ -26,6 +26,7 @@
 #include "texture/texture_oracle.h"
 #include "core/internal.h"
 #include "image/image_write.h"
+#include "image/oiio.h"
 #include "texture/texture.h"
 
 #include <math.h>
@@ -113,7 +114,7 @@ static int read_any(const char *path, int level, bb_image *out) {
   if (strcasecmp(ext_of(path), ".vtf") == 0)
     return read_vtf(path, level, out);
   bb_error err;
-  if (bb_image_read_mip(path, level, out, NULL, NULL, &err) != BB_OK)
+  if (bb__image_read_mip(path, level, out, NULL, NULL, &err) != BB_OK)
     return fail(path, &err);
   return 0;
 }
@@ -131,7 +132,7 @@ static int cmd_write(int argc, char **argv) {
   bb_error err;
   for (int i = 2; i < argc; i++) {
     if (strcmp(argv[i], "--format") == 0 && i + 1 < argc) {
-      if (bb_texture_format_parse(argv[++i], &o.format, &err) != BB_OK)
+      if (bb__texture_format_parse(argv[++i], &o.format, &err) != BB_OK)
         return fail("--format", &err);
     } else if (strcmp(argv[i], "--map") == 0 && i + 1 < argc) {
       if (parse_map(argv[++i], &o.map) != 0)

@@ -7,8 +7,9 @@ import os
 import numpy as np
 
 from . import _command
-from ._common import (_argument_error, _array, _c_text, _check, _exception, _ffi, _Image, _lib,
-                      _message, _parse, _path, _progress_hook, _shown, _text)
+from ._common import (_argument_error, _array, _bake_option, _check, _exception, _ffi,
+                      _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hook, _shown,
+                      _text)
 
 
 def _output_kind_table():
@@ -40,7 +41,8 @@ def _library_defaults():
         "bias": o.trace.bias_texels,
         "power": o.power,
         "basis": _text(o.basis.name),
-        "normal_filter": _text(_lib.bb_normal_filter_name(o.normal_filter)),
+        "normal_filter": _text(_lib.bb_option_word(_bake_option("normal-filter"),
+                                                   o.normal_filter)),
         "normal_y": "up" if o.normal_y_up else "down",
         "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP,
         "threads": o.trace.threads,
@@ -59,15 +61,14 @@ BAKE_PARAMETERS = tuple(k for k in _command.keywords("bake", files=False)
 
 
 def _normal_y_up(command, normal_y):
-    """normal_y ("down" or "up") by the library's parser (bb_normal_y_parse)."""
+    """normal_y ("down" or "up") by the library's parser of --normal-y
+    (bb_option_parse)."""
     if not isinstance(normal_y, str):
         raise TypeError(f"{command}: normal_y must be a str (got {_shown(normal_y)})")
-    out = _ffi.new("int *")
-    err = _ffi.new("bb_error *")
-    st = _lib.bb_normal_y_parse(_c_text(normal_y, "normal_y"), out, err)
+    st, up, err = _parse_raw("normal-y", normal_y, "normal_y")
     if st != _lib.BB_OK:
         raise _exception(st, f"{command}: {_message(err, st)}")
-    return bool(out[0])
+    return bool(up)
 
 
 def _basis(spec):
@@ -186,7 +187,7 @@ def _kinds_mask(command, kinds, what="outputs", noun="output"):
 def _channel(channel):
     if channel is None:
         return _lib.BB_CHANNEL_AUTO
-    return _parse("bb_channel_parse", "bb_channel", channel, "channel")
+    return _parse("channel", channel, "channel")
 
 
 def _height_field(command, height, channel):

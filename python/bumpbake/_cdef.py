@@ -2,8 +2,8 @@
 calls, for cffi.
 
 Every type and function the package uses, and nothing else but
-bb_command_count and bb_command_info_get, with which its tests walk the
-commands (tests/test_commands.py). The structs must
+bb_command_info_get, with which its tests walk the commands
+(tests/test_commands.py). The structs must
 match the header field for field, since cffi's ABI mode lays them out from
 these declarations: tests/test_cdef.py compiles a C program against the real
 header and checks every size, offset, enum value and function signature
@@ -249,18 +249,6 @@ typedef struct bb_valve_options {
   int normal_map;
   int ao_in_alpha;
 } bb_valve_options;
-
-typedef struct bb_program bb_program;
-
-typedef bb_status (*bb_image_loader)(void *user, const char *path, bb_image *img,
-                                     bb_image_info *info, bb_error *err);
-
-typedef struct bb_program_options {
-  const char *base_dir;
-  int allow_outside_base;
-  bb_image_loader loader;
-  void *loader_user;
-} bb_program_options;
 
 typedef enum bb_mip_filter {
   BB_MIP_AVERAGE = 0,
@@ -686,19 +674,13 @@ void bb_image_free(bb_image *img);
 void bb_image_info_free(bb_image_info *info);
 bb_status bb_image_read(const char *path, bb_image *out, bb_image_info *info,
                         bb_error *err);
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err);
 const bb_map_kind_info *bb_map_kind_get(bb_map_kind kind);
-bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
-bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err);
-bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
 void bb_texture_options_init(bb_texture_options *options);
 bb_status bb_vmt_write(const char *path, const bb_vmt_options *options, bb_error *err);
 bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
-bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-const char *bb_normal_filter_name(bb_normal_filter f);
 void bb_normal_decode_options_init(bb_normal_decode_options *o);
 bb_status bb_normal_map_decode(const bb_image *values, int is_float,
                                const bb_normal_decode_options *o, bb_image *normals,
@@ -745,15 +727,9 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
                             bb_error *err);
 bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
                                 bb_map_kind kind, bb_image *out, bb_error *err);
-bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err);
-void bb_program_free(bb_program *program);
-void bb_program_options_init(bb_program_options *o);
-bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
-                         bb_image *out, int *is_normal_map, bb_error *err);
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
-void bb_render_options_init(bb_render_options *o);
 bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up,
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
@@ -776,7 +752,6 @@ bb_status bb_check_run_rest(bb_check *check, bb_check_case_fn each, void *user,
 int bb_check_case_count(const bb_check *check);
 const bb_check_case *bb_check_case_get(const bb_check *check, int i);
 int bb_check_exit_code(const bb_check *check);
-const char *bb_check_status_name(bb_check_status status);
 char *bb_check_case_lines(const bb_check *check, const bb_check_case *c);
 char *bb_check_summary_lines(const bb_check *check);
 bb_status bb_check_write_reports(bb_check *check, bb_error *err);
@@ -789,7 +764,6 @@ bb_status bb_job_check_current(bb_job *job, int i, int *current, bb_error *err);
 bb_status bb_job_run_item(bb_job *job, int i, bb_progress_fn progress, void *progress_user);
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 bb_status bb_file_hash(const char *path, uint64_t *hash, bb_error *err);
-int bb_command_count(void);
 const bb_command_info *bb_command_info_get(int index);
 const bb_command_info *bb_command_info_find(const char *name);
 const bb_option_info *bb_command_option(const bb_command_info *command, int index);
@@ -802,6 +776,9 @@ void bb_option_range_text(const bb_option_info *option, char *out, size_t cap);
 void bb_option_value_text(const bb_option_info *option, char *out, size_t cap);
 void bb_option_default_text(const bb_command_info *command, const bb_option_info *option,
                             char *out, size_t cap);
+bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
+                          bb_error *err);
+const char *bb_option_word(const bb_option_info *option, long long value);
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
@@ -830,8 +807,9 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
-bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
-const char *bb_job_outcome_name(bb_job_outcome outcome);
+bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
+                             bb_error *err);
+const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 /* what a job prints (bumpbake bake --scheduler) */

@@ -78,7 +78,7 @@ def _case(k):
     return CheckCase(
         name=_text(k.name), golden=_text(k.golden),
         new=_text(k.fresh) if k.fresh != _ffi.NULL else None, kind=_text(k.kind),
-        result=_text(_lib.bb_check_status_name(k.status)), exit_code=k.exit_code,
+        result=_text(_lib.bb_report_word(b"result", k.status)), exit_code=k.exit_code,
         limits=dict(zip(_LIMITS, (lim.fail, lim.fail_percent, lim.hard_fail,
                                   lim.allow_failures, lim.warn, lim.warn_percent,
                                   lim.hard_warn))),

@@ -172,14 +172,28 @@ def _path(value, what="path"):
     return _c_bytes(os.fsencode(value), what)
 
 
-def _parse(parser, ctype, text, what):
-    """An enum value by the library's own parser; its message when refused."""
+def _bake_option(name):
+    """`bumpbake bake`'s option name (bb_option_info), whose words and parser
+    the package's enum arguments share (bb_option_parse, bb_option_word)."""
+    return _lib.bb_option_find(_lib.bb_command_info_find(b"bake"), name.encode(), 0)
+
+
+def _parse_raw(option, text, what):
+    """(status, value, err) of text as bake's option reads it (bb_option_parse)."""
+    out = _ffi.new("long long *")
+    err = _ffi.new("bb_error *")
+    st = _lib.bb_option_parse(_bake_option(option), _c_text(text, what), out, err)
+    return st, out[0], err
+
+
+def _parse(option, text, what):
+    """The value text stands for as bake's option reads it (its enum's
+    value), by the library's parser of the option; its message when refused."""
     if not isinstance(text, str):
         raise TypeError(f"{what} must be a str (got {_shown(text)})")
-    out = _ffi.new(f"{ctype} *")
-    err = _ffi.new("bb_error *")
-    _check(getattr(_lib, parser)(_c_text(text, what), out, err), err)
-    return out[0]
+    st, value, err = _parse_raw(option, text, what)
+    _check(st, err)
+    return value
 
 
 def _depth(depth):
@@ -188,7 +202,7 @@ def _depth(depth):
         return _lib.BB_DEPTH_DEFAULT
     if isinstance(depth, int) and not isinstance(depth, bool):
         depth = str(depth)
-    return _parse("bb_depth_parse", "bb_depth", depth, "depth")
+    return _parse("depth", depth, "depth")
 
 
 # -------------------------------------------------------- engine textures
@@ -209,26 +223,23 @@ def _vtf_text(command, name, value):
 
 def _vtf_version(command, value):
     """The VTF minor version of 3, "7.3", "3" or 7.3, as --vtf-version
-    reads it (bb_vtf_version_parse)."""
-    out = _ffi.new("int *")
-    err = _ffi.new("bb_error *")
-    if _lib.bb_vtf_version_parse(_c_text(_vtf_text(command, "vtf_version", value), "vtf_version"), out,
-                                 err) != _lib.BB_OK:
+    reads it (bb_option_parse)."""
+    st, minor, err = _parse_raw("vtf-version", _vtf_text(command, "vtf_version", value),
+                                "vtf_version")
+    if st != _lib.BB_OK:
         raise _argument_error(f"{command}: vtf_version: {_text(err.message)}")
-    return out[0]
+    return minor
 
 
 def _vtf_flags(command, value):
     """TEXTUREFLAGS_* bits: an int, or text as --vtf-flags takes it ("0x4")
-    (bb_vtf_flags_parse)."""
+    (bb_option_parse)."""
     if isinstance(value, float):
         raise TypeError(f"{command}: vtf_flags must be an int or a str (got {_shown(value)})")
-    out = _ffi.new("uint32_t *")
-    err = _ffi.new("bb_error *")
-    if _lib.bb_vtf_flags_parse(_c_text(_vtf_text(command, "vtf_flags", value), "vtf_flags"), out,
-                               err) != _lib.BB_OK:
+    st, flags, err = _parse_raw("vtf-flags", _vtf_text(command, "vtf_flags", value), "vtf_flags")
+    if st != _lib.BB_OK:
         raise _argument_error(f"{command}: vtf_flags: {_text(err.message)}")
-    return out[0]
+    return flags
 
 
 def _texture_options(command, texture_format=None, vtf_version=None, vtf_flags=None,
@@ -240,8 +251,7 @@ def _texture_options(command, texture_format=None, vtf_version=None, vtf_flags=N
     o = out if out is not None else _ffi.new("bb_texture_options *")
     _lib.bb_texture_options_init(o)
     if texture_format is not None:
-        o.format = _parse("bb_texture_format_parse", "bb_texture_format", texture_format,
-                          "texture_format")
+        o.format = _parse("texture-format", texture_format, "texture_format")
     if vtf_version is not None:
         o.vtf_version = _vtf_version(command, vtf_version)
     if vtf_flags is not None:

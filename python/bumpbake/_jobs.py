@@ -12,7 +12,7 @@ from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _e
                       _lib, _message, _note_text, _path, _progress_hook, _status_name, _shown, _text)
 
 # A report's status: the library's name of its outcome ("up to date", ...).
-_OUTCOMES = {k: _text(_lib.bb_job_outcome_name(k))
+_OUTCOMES = {k: _text(_lib.bb_report_word(b"outcome", k))
              for k in (_lib.BB_JOB_PENDING, _lib.BB_JOB_BAKED, _lib.BB_JOB_CURRENT,
                        _lib.BB_JOB_FAILED, _lib.BB_JOB_NOT_RUN)}
 

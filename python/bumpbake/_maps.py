@@ -186,16 +186,9 @@ def program(text, base=None, allow_outside_base=False, **options):
     c.in_memory()
     c.check()
     err = _ffi.new("bb_error *")
-    prog = _ffi.new("bb_program **")
-    _check(_lib.bb_program_parse(_c_text(text, "program"), prog, err), err)
-    prog = _ffi.gc(prog[0], _lib.bb_program_free)
-    o = _ffi.new("bb_program_options *")
-    _lib.bb_program_options_init(o)
-    o.base_dir = c.options.base_dir
-    o.allow_outside_base = c.options.allow_outside_base
     out = _ffi.new("bb_image *")
     is_normal = _ffi.new("int *")
-    _check(_lib.bb_program_run(prog, o, out, is_normal, err), err)
+    _check(_lib.bb_command_program(c.handle, out, is_normal, err), err)
     return _take(out, squeeze=False), bool(is_normal[0])
 
 

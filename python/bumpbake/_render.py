@@ -13,11 +13,15 @@ from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _che
                       _check_notes, _dispatch_notes, _exception, _ffi, _lib, _message, _path,
                       _progress_hook, _shown, _take, _text)
 
-# The default light of bb_render_options_init: on, at this azimuth and
-# elevation (degrees).
-_DEFAULT_RENDER = _ffi.new("bb_render_options *")
-_lib.bb_render_options_init(_DEFAULT_RENDER)
-DEFAULT_LIGHT = (_DEFAULT_RENDER.light_azimuth, _DEFAULT_RENDER.light_elevation)
+# The default light of render: on, at this azimuth and elevation (degrees),
+# as a new render command holds it.
+def _default_light():
+    render = Command("render")  # owns its options while they are read
+    o = render.options.render
+    return (o.light_azimuth, o.light_elevation)
+
+
+DEFAULT_LIGHT = _default_light()
 
 _AUTO = object()  # light not given: on, unless lightmaps are
 

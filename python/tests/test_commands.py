@@ -15,7 +15,7 @@ import pytest
 import bumpbake
 from bumpbake import _command
 from test_jobs import files_of
-from bumpbake._common import _lib, _text
+from bumpbake._common import _ffi, _lib, _text
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BIN = os.environ.get("BB_BIN", os.path.join(ROOT, "build", "bumpbake"))
@@ -53,7 +53,10 @@ NOT_IN_PYTHON = {
 
 
 def commands():
-    return [_text(_lib.bb_command_info_get(i).name) for i in range(_lib.bb_command_count())]
+    names = []
+    while _lib.bb_command_info_get(len(names)) != _ffi.NULL:
+        names.append(_text(_lib.bb_command_info_get(len(names)).name))
+    return names
 
 
 def call_with(name, command, key, value):

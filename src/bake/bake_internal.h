@@ -213,4 +213,10 @@ const char *bb__addressing_name(bb_addressing addressing);
 bb_status bb__normal_filter_parse(const char *name, bb_normal_filter *out, bb_error *err);
 const char *bb__normal_y_name(int normal_y_up);
 
+/* The words of --normal-filter and --normal-y (once public: a client
+ * reads them through the option rows, bb_option_word and bb_option_parse). */
+const char *bb__normal_filter_name(bb_normal_filter f);
+/* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
+bb_status bb__normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
+
 #endif /* BB_BAKE_INTERNAL_H */

@@ -22,7 +22,7 @@ bb_status bb__normal_filter_parse(const char *name, bb_normal_filter *out, bb_er
   return st;
 }
 
-const char *bb_normal_filter_name(bb_normal_filter f) {
+const char *bb__normal_filter_name(bb_normal_filter f) {
   switch (f) {
   case BB_NORMAL_VERTEX:
     return "vertex";

@@ -75,7 +75,7 @@ bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err) {
     st = bb__fail(err, BB_ERR_ARGUMENT, "bake: the bounce albedo map has no pixels");
   if (st == BB_OK && o->brightness && (!o->brightness->pixels || o->brightness->channels < 1))
     st = bb__fail(err, BB_ERR_ARGUMENT, "bake: the brightness map has no pixels");
-  if (st == BB_OK && strcmp(bb_normal_filter_name(o->normal_filter), "unknown") == 0)
+  if (st == BB_OK && strcmp(bb__normal_filter_name(o->normal_filter), "unknown") == 0)
     st = bb__fail(err, BB_ERR_ARGUMENT, "bake: unknown normal filter %d",
                   (int)o->normal_filter);
   return st == BB_OK ? bb__basis_check(&o->basis, "bake", err) : st;
@@ -97,7 +97,7 @@ bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_e
 
 static const char *const normal_y_names[2] = {"down", "up"};
 
-bb_status bb_normal_y_parse(const char *name, int *normal_y_up, bb_error *err) {
+bb_status bb__normal_y_parse(const char *name, int *normal_y_up, bb_error *err) {
   int i = 0;
   bb_status st = bb__parse_name("normal y", name, normal_y_names, 2, 0, &i, err);
   if (st == BB_OK && normal_y_up)

@@ -1,5 +1,6 @@
 /* check.c: `bumpbake check`, a suite of maps against their goldens: the
- * library plans and runs the check (bb_check_plan, bb_check_run) and
+ * library plans and runs the check (bb_check_plan; bb_check_run_input of
+ * each input, then bb_check_run_rest, as Python runs it) and
  * writes its reports; this prints each map that does not pass as it is
  * decided and the summary, and exits as idiff does for the worst map
  * (0 pass, 1 warning, 2 failure, 3 different size, 4 unreadable or a usage
@@ -39,7 +40,11 @@ int cli_run_check(const cli_run *r) {
     return BB_COMPARE_CANNOT_READ;
   }
   printer p = {check, &progress};
-  st = bb_check_run(check, cli_progress_fn(&progress), &progress, print_case, &p, &err);
+  for (int i = 0; i < bb_check_input_count(check) && st == BB_OK; i++)
+    st = bb_check_run_input(check, i, cli_progress_fn(&progress), &progress, print_case, &p,
+                            &err);
+  if (st == BB_OK)
+    st = bb_check_run_rest(check, print_case, &p, &err);
   cli_progress_finish(&progress);
   int rc = bb_check_exit_code(check);
   if (st != BB_OK) {

@@ -10,10 +10,9 @@ void cli_print_usage(FILE *f) {
   fprintf(f, "usage: bumpbake COMMAND [OPTIONS] ...\n"
              "Bakes normal maps, self-shadowed bump maps (Valve ssbump) and ambient\n"
              "occlusion from height maps.\n\ncommands:\n");
-  for (int i = 0; i < bb_command_count(); i++) {
-    const bb_command_info *c = bb_command_info_get(i);
+  const bb_command_info *c;
+  for (int i = 0; (c = bb_command_info_get(i)) != NULL; i++)
     fprintf(f, "  %-14s %s\n", c->name, c->summary);
-  }
   fprintf(f, "\n'bumpbake COMMAND --help' lists a command's options.\n"
              "  --help       print this help\n"
              "  --version    print the version\n"

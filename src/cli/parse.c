@@ -41,6 +41,15 @@ typedef struct parse {
   int usage;     /* the command's usage exit code */
 } parse;
 
+/* The option of command whose short name is c ('o' for -o), or NULL. */
+static const bb_option_info *option_short(const bb_command_info *command, char c) {
+  const bb_option_info *o;
+  for (int k = 0; c && (o = bb_command_option(command, k)) != NULL; k++)
+    if (o->short_name == c)
+      return o;
+  return NULL;
+}
+
 static int usage_error(const parse *p, const char *fmt, const char *a, const char *b) {
   char line[1024];
   snprintf(line, sizeof line, fmt, a, b);
@@ -246,7 +255,7 @@ static int run_getopt(parse *p, int argc, char **argv, const int *map) {
     if (c == '?' || c == ':') {
       const bb_option_info *known =
           optopt >= 256 ? bb_command_option(p->info, optopt - 256)
-                        : optopt > 0 ? bb_option_find_short(p->info, (char)optopt) : NULL;
+                        : optopt > 0 ? option_short(p->info, (char)optopt) : NULL;
       char name[80] = "";
       if (known && optopt < 256)
         snprintf(name, sizeof name, "-%c", known->short_name);
@@ -264,7 +273,7 @@ static int run_getopt(parse *p, int argc, char **argv, const int *map) {
                          argv[optind - 1], "");
     }
     const bb_option_info *o =
-        c >= 256 ? bb_command_option(p->info, c - 256) : bb_option_find_short(p->info, (char)c);
+        c >= 256 ? bb_command_option(p->info, c - 256) : option_short(p->info, (char)c);
     if (!o)
       return usage_error(p, "internal: unhandled option %s%s", "", "");
     if (!strcmp(o->name, "help")) {

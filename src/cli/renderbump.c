@@ -8,12 +8,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The axis as renderbumpflat's --axis spells it ("-y"). */
+static const char *axis_word(bb_axis axis) {
+  const char *w = bb_option_word(
+      bb_option_find(bb_command_info_find("renderbumpflat"), "axis", 0), axis);
+  return w ? w : "unknown";
+}
+
 static void print_summary(const char *model, const bb_renderbump_options *o,
                           const bb_renderbump_result *r) {
   cli_printf_line("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
                   "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each",
                   model, r->triangles, r->used_vertex_normals ? "vertex" : "face",
-                  bb_axis_name(o->axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
+                  axis_word(o->axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
                   o->width, o->height, o->samples * o->samples);
 }
 
@@ -27,7 +34,7 @@ static void print_height_scale(const char *height, bb_axis axis,
   else
     cli_printf_line("height scale 0: the model is flat along %s, so its height is 0 "
                     "everywhere and a bake of it would trace nothing",
-                    bb_axis_name(axis));
+                    axis_word(axis));
   free(word);
 }
 

@@ -37,7 +37,8 @@ struct bb__option {
   const bb__range *range;    /* INT, NUMBER(S): each number's range */
   const char *range_of;      /* what of the value the range is of ("elevation"), or NULL */
   bb__name_fn names;         /* WORD(S): the enum's names */
-  bb__parse_fn parse;        /* WORD(S): the enum's parser */
+  bb__parse_fn parse;        /* WORD(S): the enum's parser; an INT read by a parser of
+                                its own (--vtf-version): that parser (bb_option_parse) */
   bb__set_fn set;            /* NULL: by type and field */
   bb__print_fn print;        /* NULL: by type and field */
   bb__applies_fn applies;    /* NULL: always applies */
@@ -283,5 +284,8 @@ const bb_command_info *bb__command_info_nearest(const char *name);
  * ("valve|central|sobel|vertex", the names of the library's enum), into out
  * (capacity cap); "" for other types. */
 void bb__option_choices(const bb_option_info *option, char *out, size_t cap);
+
+/* How many inputs were added (bb_command_input reads them). */
+int bb__command_input_count(const bb_command *command);
 
 #endif /* BB_CMD_INTERNAL_H */

@@ -7,6 +7,7 @@
  * parameter's one range and every rule between options, so a plan made
  * from a checked command checks nothing again. */
 #include "cmd/cmd_internal.h"
+#include "render/render_internal.h"
 #include "job/job_internal.h"
 #include "maps/maps_internal.h"
 #include "mesh/mesh_internal.h"
@@ -41,8 +42,8 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err) {
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
   c->def = def;
   bb_command_options *o = &c->options;
-  bb_job_options_init(&o->job);
-  bb_render_options_init(&o->render);
+  bb__job_options_init(&o->job);
+  bb__render_options_init(&o->render);
   bb__compare_limits_init(&o->limits);
   bb__renderbump_options_init(&o->renderbump);
   o->map_kind = BB_MAP_SSBUMP;
@@ -92,7 +93,7 @@ const bb_command_options *bb_command_options_of(const bb_command *c) {
   return c ? &c->options : NULL;
 }
 
-int bb_command_input_count(const bb_command *c) {
+int bb__command_input_count(const bb_command *c) {
   return c ? c->input_count : 0;
 }
 

@@ -3,6 +3,7 @@
  * and the reference pages. */
 #include "cmd/cmd_internal.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,10 +23,6 @@ static int option_total(const bb__command *c) {
   while (c->options[n])
     n++;
   return n;
-}
-
-int bb_command_count(void) {
-  return bb__command_total;
 }
 
 const bb_command_info *bb_command_info_get(int index) {
@@ -55,6 +52,31 @@ const char *bb_option_type_name(bb_option_type type) {
   return (int)type >= 0 && (size_t)type < sizeof names / sizeof names[0] ? names[type] : NULL;
 }
 
+bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
+                          bb_error *err) {
+  const bb__option *o = (const bb__option *)option;
+  if (!o || !text || !value)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_option_parse: NULL argument");
+  if (!o->parse) {
+    char name[80];
+    bb__option_spelling(o, name, sizeof name);
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s has no word or value of its own to parse", name);
+  }
+  return o->parse(text, value, err);
+}
+
+const char *bb_option_word(const bb_option_info *option, long long value) {
+  const bb__option *o = (const bb__option *)option;
+  const bb__name_fn names = o ? bb__option_names(o) : NULL;
+  if (!names || value < 0 || value > INT_MAX)
+    return NULL;
+  /* only a word the option reads back as value: not "unknown", nor
+   * depth's "default" (BB_DEPTH_DEFAULT is no word a user types) */
+  const char *w = names((int)value);
+  long long back = -1;
+  return w && *w && o->parse && o->parse(w, &back, NULL) == BB_OK && back == value ? w : NULL;
+}
+
 const bb_option_info *bb_option_find(const bb_command_info *command, const char *name,
                                      size_t length) {
   if (!command || !name)
@@ -63,16 +85,6 @@ const bb_option_info *bb_option_find(const bb_command_info *command, const char 
   const size_t n = length ? length : strlen(name);
   for (int i = 0; c->options[i]; i++)
     if (bb__names_option(name, n, c->options[i]->info.name))
-      return &c->options[i]->info;
-  return NULL;
-}
-
-const bb_option_info *bb_option_find_short(const bb_command_info *command, char ch) {
-  if (!command || !ch)
-    return NULL;
-  const bb__command *c = command_of(command);
-  for (int i = 0; c->options[i]; i++)
-    if (c->options[i]->info.short_name == ch)
       return &c->options[i]->info;
   return NULL;
 }

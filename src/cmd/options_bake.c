@@ -4,6 +4,7 @@
  * rules and their job. */
 #include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
+#include "texture/texture.h"
 #include "render/render_internal.h"
 
 #include <arpa/inet.h>
@@ -75,7 +76,7 @@ static bb_status set_vtf_version(bb_command *c, const bb__option *o, const char 
   *count = 0;
   (void)o, (void)values;
   bb_error e = {{0}};
-  if (bb_vtf_version_parse(text, &c->options.job.texture.vtf_version, &e) != BB_OK)
+  if (bb__vtf_version_parse(text, &c->options.job.texture.vtf_version, &e) != BB_OK)
     return bb__fail(err, BB_ERR_ARGUMENT, "--vtf-version: %s", e.message);
   return BB_OK;
 }
@@ -85,9 +86,27 @@ static bb_status set_vtf_flags(bb_command *c, const bb__option *o, const char *t
   *count = 0;
   (void)o, (void)values;
   bb_error e = {{0}};
-  if (bb_vtf_flags_parse(text, &c->options.job.texture.vtf_flags, &e) != BB_OK)
+  if (bb__vtf_flags_parse(text, &c->options.job.texture.vtf_flags, &e) != BB_OK)
     return bb__fail(err, BB_ERR_ARGUMENT, "--vtf-flags: %s", e.message);
   return BB_OK;
+}
+
+/* The same parsers in the value's own words, for bb_option_parse ("VTF
+ * version must be 7.2, 7.3, 7.4 or 7.5 (got '7.9')"). */
+static bb_status parse_vtf_version(const char *text, long long *value, bb_error *err) {
+  int minor = 0;
+  const bb_status st = bb__vtf_version_parse(text, &minor, err);
+  if (st == BB_OK)
+    *value = minor;
+  return st;
+}
+
+static bb_status parse_vtf_flags(const char *text, long long *value, bb_error *err) {
+  uint32_t flags = 0;
+  const bb_status st = bb__vtf_flags_parse(text, &flags, err);
+  if (st == BB_OK)
+    *value = flags;
+  return st;
 }
 
 /* --maps LIST: the bake's map names, comma-separated. */
@@ -99,9 +118,9 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
   for (const char *s = text; *s;) {
     const size_t n = strcspn(s, ",");
     char name[32];
-    int kind = 0;
+    long long kind = 0;
     snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), s);
-    if (n >= sizeof name || !o->parse(name, &kind)) {
+    if (n >= sizeof name || o->parse(name, &kind, NULL) != BB_OK) {
       char choices[128];
       bb__choices(o, choices, sizeof choices);
       for (char *bar = strchr(choices, '|'); bar; bar = strchr(bar, '|'))
@@ -109,7 +128,7 @@ static bb_status set_maps(bb_command *c, const bb__option *o, const char *text,
       return bb__fail(err, BB_ERR_ARGUMENT, "--maps: unknown map '%.*s' (one of %s)",
                       (int)(n < 64 ? n : 64), s, choices);
     }
-    maps |= BB_MAP_BIT(kind);
+    maps |= BB_MAP_BIT((int)kind);
     s += n + (s[n] == ',');
   }
   if (!maps)
@@ -409,7 +428,8 @@ const bb__option bb__opt_vtf_version = {
              .applies = "a .vtf output",
              .help = "VTF version: 7.2 loads in every Source branch; 7.3 and up keep "
                      "provenance"},
-    .job = &bb__row_vtf_version, .set = set_vtf_version, .applies = bb__applies_vtf};
+    .job = &bb__row_vtf_version, .parse = parse_vtf_version, .set = set_vtf_version,
+    .applies = bb__applies_vtf};
 
 const bb__option bb__opt_vtf_flags = {
     .info = {.name = bb__row_vtf_flags.name,
@@ -418,7 +438,8 @@ const bb__option bb__opt_vtf_flags = {
              .applies = "a .vtf output",
              .help = "TEXTUREFLAGS_* bits added to the map's own (SSBUMP, NORMAL), e.g. 0x4 "
                      "= CLAMPS"},
-    .job = &bb__row_vtf_flags, .set = set_vtf_flags, .applies = bb__applies_vtf};
+    .job = &bb__row_vtf_flags, .parse = parse_vtf_flags, .set = set_vtf_flags,
+    .applies = bb__applies_vtf};
 
 const bb__option bb__opt_nomip = {
     .info = {.name = bb__row_nomip.name,
@@ -615,7 +636,7 @@ static const bb__option *const bake_options[] = {
     &opt_basetexture, &opt_scheduler, &bb__opt_help, NULL};
 
 static void bake_init(bb_command_options *o) {
-  (void)o; /* the library's defaults (bb_job_options_init) */
+  (void)o; /* the library's defaults (bb__job_options_init) */
 }
 
 /* A single bake always bakes; a batch skips what is up to date unless

@@ -224,14 +224,14 @@ static const bb__option *const program_options[] = {
 /* The program parses (a syntax error is a usage error), and the output
  * must not replace any image it reads: every one of them, however many. */
 static bb_status program_check(bb_command *c, bb_error *err) {
-  bb_program *program = NULL;
-  bb_status st = bb_program_parse(c->inputs[0], &program, err);
+  bb__program *program = NULL;
+  bb_status st = bb__program_parse(c->inputs[0], &program, err);
   if (st != BB_OK) {
-    bb_program_free(program);
+    bb__program_free(program);
     return BB_ERR_ARGUMENT;
   }
   if (!c->options.output) {
-    bb_program_free(program);
+    bb__program_free(program);
     return BB_OK;
   }
   const size_t count = bb__program_images(program, NULL, 0);
@@ -256,7 +256,7 @@ static bb_status program_check(bb_command *c, bb_error *err) {
   free(names);
   free(paths);
   free(reads);
-  bb_program_free(program);
+  bb__program_free(program);
   return st;
 }
 

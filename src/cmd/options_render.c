@@ -259,7 +259,7 @@ static const bb__option *const render_options[] = {
     &bb__opt_depth, &bb__opt_quiet, &bb__opt_help, NULL};
 
 static void render_init(bb_command_options *o) {
-  (void)o; /* bb_render_options_init's defaults */
+  (void)o; /* bb__render_options_init's defaults */
 }
 
 /* The maps the picture reads: the mode's, or all three for --compare. */

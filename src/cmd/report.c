@@ -60,7 +60,7 @@ void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *
   bb__json_number(&j, "bias", b->trace.bias_texels);
   bb__json_number(&j, "power", b->power);
   bb__json_string(&j, "basis", b->basis.name);
-  bb__json_string(&j, "normal_filter", bb_normal_filter_name(b->normal_filter));
+  bb__json_string(&j, "normal_filter", bb__normal_filter_name(b->normal_filter));
   bb__json_string(&j, "normal_y", bb__normal_y_name(b->normal_y_up));
   bb__json_string(&j, "addressing", bb__addressing_name(b->smooth.addressing));
   bb__json_string(&j, "channel", bb_height_source_channel(&r->source));
@@ -98,7 +98,7 @@ static void short_json(FILE *f, const bb_job_report *r) {
   bb__json j = {f, 0};
   bb__json_open(&j, NULL, '{');
   bb__json_string(&j, "input", r->input);
-  bb__json_string(&j, "status", bb_job_outcome_name(r->outcome));
+  bb__json_string(&j, "status", bb__job_outcome_name(r->outcome));
   if (r->outcome == BB_JOB_FAILED)
     bb__json_int(&j, "exit_code", 1);
   outputs(&j, r, 0);

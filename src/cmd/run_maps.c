@@ -5,6 +5,7 @@
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
 #include "core/internal.h"
+#include "maps/program_internal.h"
 #include "trace/basis.h"
 
 #include <stdlib.h>
@@ -231,27 +232,43 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
 
 /* -------------------------------------------------------------- program */
 
+/* The program's image: its text (the command's input) parsed and run
+ * from --base. */
+static bb_status program_image(const bb_command *c, bb_image *out, int *is_normal,
+                               bb_error *err) {
+  const bb_command_options *o = &c->options;
+  bb__program *program = NULL;
+  bb_status st = bb__program_parse(c->inputs[0], &program, err);
+  if (st != BB_OK)
+    return st;
+  bb__program_options po;
+  bb__program_options_init(&po);
+  po.base_dir = o->base_dir;
+  po.allow_outside_base = o->allow_outside_base;
+  /* the message names the image file or the function at fault */
+  st = bb__program_run(program, &po, out, is_normal, err);
+  bb__program_free(program);
+  return st;
+}
+
 bb_status bb__run_program(bb_command *c, const bb_command_hooks *hooks, bb_command_result *r,
                           bb_error *err) {
   (void)hooks;
-  const bb_command_options *o = &c->options;
   const char *text = c->inputs[0];
-  bb_program *program = NULL;
-  bb_status st = bb_program_parse(text, &program, err);
-  if (st != BB_OK)
-    return st;
-  bb_program_options po;
-  bb_program_options_init(&po);
-  po.base_dir = o->base_dir;
-  po.allow_outside_base = o->allow_outside_base;
   bb_image out = {0};
   int is_normal = 0;
-  /* the message names the image file or the function at fault */
-  st = bb_program_run(program, &po, &out, &is_normal, err);
-  bb_program_free(program);
+  bb_status st = program_image(c, &out, &is_normal, err);
   if (st == BB_OK)
     st = write_map(c, NULL, text, NULL, NULL, is_normal ? "normal" : "colour", &out,
                    is_normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, r, err);
   bb_image_free(&out);
   return st;
+}
+
+bb_status bb_command_program(bb_command *c, bb_image *out, int *is_normal_map, bb_error *err) {
+  if (!out || !is_normal_map)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_command_program: NULL argument");
+  if (!c || strcmp(c->def->info.name, "program") != 0 || !c->checked || c->input_count < 1)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_command_program: not a checked program command");
+  return bb__spelled(c, program_image(c, out, is_normal_map, err), err);
 }

@@ -158,8 +158,11 @@ bb_status bb__parse_numbers(const bb__option *o, const char *text, int count, in
 }
 
 static bb_status parse_word(const bb__option *o, const char *text, int *value, bb_error *err) {
-  if (o->parse(text, value))
+  long long v = 0;
+  if (o->parse(text, &v, NULL) == BB_OK) {
+    *value = (int)v;
     return BB_OK;
+  }
   char name[80], choices[256];
   bb__option_spelling(o, name, sizeof name);
   char listed[320] = "";

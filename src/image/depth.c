@@ -9,7 +9,7 @@
 static const char *const DEPTH_NAMES[] = {NULL, "8", "16", "half", "float"};
 #define DEPTH_COUNT ((int)(sizeof DEPTH_NAMES / sizeof DEPTH_NAMES[0]))
 
-bb_status bb_depth_parse(const char *name, bb_depth *out, bb_error *err) {
+bb_status bb__depth_parse(const char *name, bb_depth *out, bb_error *err) {
   int i;
   bb_status st = bb__parse_name("depth", name, DEPTH_NAMES, DEPTH_COUNT, 0, &i, err);
   if (st == BB_OK)

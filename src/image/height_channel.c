@@ -15,7 +15,7 @@ static const char *const CHANNEL_NAMES[] = {
 };
 #define CHANNEL_COUNT ((int)(sizeof CHANNEL_NAMES / sizeof CHANNEL_NAMES[0]))
 
-bb_status bb_channel_parse(const char *name, bb_channel *out, bb_error *err) {
+bb_status bb__channel_parse(const char *name, bb_channel *out, bb_error *err) {
   int i;
   bb_status st = bb__parse_name("channel", name, CHANNEL_NAMES, CHANNEL_COUNT, 1, &i, err);
   if (st == BB_OK) *out = (bb_channel)i;
@@ -120,7 +120,7 @@ bb_channel bb__height_channel_noted(const bb_image *img, int alpha_channel, bb_c
   return BB_CHANNEL_MEAN;
 }
 
-bb_channel bb_height_channel(const bb_image *img, int alpha_channel, bb_channel channel) {
+bb_channel bb__height_channel(const bb_image *img, int alpha_channel, bb_channel channel) {
   const char *note;
   return bb__height_channel_noted(img, alpha_channel, channel, &note);
 }

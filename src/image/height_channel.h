@@ -5,7 +5,7 @@
 
 #include "bumpbake.h"
 
-/* bb_height_channel, and in *note a line saying what it took when the image
+/* bb__height_channel, and in *note a line saying what it took when the image
  * left a choice (a colour image, an alpha that varies, no alpha for Valve's
  * rule), or NULL. The text is static. */
 bb_channel bb__height_channel_noted(const bb_image *img, int alpha_channel, bb_channel channel,
@@ -26,8 +26,24 @@ typedef struct bb__height_loaded {
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err);
 
+/* Parses "r", "g", "b", "a", "luma", "mean", "auto", "valve" (any case). */
+bb_status bb__channel_parse(const char *name, bb_channel *out, bb_error *err);
+
+/* The channel the rule takes from img when asked for `channel`: channel
+ * itself, except for two rules. BB_CHANNEL_AUTO reads img once and gives
+ * BB_CHANNEL_A when img has an alpha channel (alpha_channel, or the last of
+ * 2 or 4 channels) that varies while the colour (grey, or R, G and B) is the
+ * same at every texel, or when the colour is a colour (R, G and B not all
+ * equal) and alpha takes three values or more (a height, not a cutout
+ * mask): Valve's convention, the height in alpha. Otherwise it gives
+ * BB_CHANNEL_MEAN (for a grey image, the grey). BB_CHANNEL_VALVE gives
+ * BB_CHANNEL_A whenever there is an alpha channel, else BB_CHANNEL_MEAN for
+ * colour and BB_CHANNEL_AUTO (the grey) for grey. bb_height_file_read says
+ * which was taken whenever the image left a choice. */
+bb_channel bb__height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
+
 /* Once in bumpbake.h beside the functions that stay public there. */
-/* The name bb_channel_parse accepts; "unknown" for other values. */
+/* The name bb__channel_parse accepts; "unknown" for other values. */
 const char *bb__channel_name(bb_channel c);
 
 #endif /* BB_IMAGE_HEIGHT_CHANNEL_H */

@@ -39,7 +39,7 @@ static bb_status resolve_pick(int channels, int alpha_channel, bb_channel channe
   p->index = 0;
   switch (channel) {
   case BB_CHANNEL_AUTO:
-  case BB_CHANNEL_VALVE: /* resolved by bb_height_channel before this */
+  case BB_CHANNEL_VALVE: /* resolved by bb__height_channel before this */
   case BB_CHANNEL_MEAN:
     if (colour) p->kind = PICK_MEAN;
     return BB_OK;
@@ -103,7 +103,7 @@ bb_status bb_height_from_image(const bb_image *img, int alpha_channel, bb_channe
     return bb__fail(err, BB_ERR_ARGUMENT, "alpha channel %d of a %d-channel image",
                     alpha_channel, img->channels);
   pick p;
-  channel = bb_height_channel(img, alpha_channel, channel); /* auto: mean or alpha */
+  channel = bb__height_channel(img, alpha_channel, channel); /* auto: mean or alpha */
   bb_status st = resolve_pick(img->channels, alpha_channel, channel, &p, err);
   if (st != BB_OK) return st;
   st = bb_image_alloc(height, img->width, img->height, 1, err);
@@ -159,7 +159,7 @@ static bb_status load_picked(const char *path, pick p, bb_image *height, int *gr
 }
 
 /* The height of the whole decoded image: for the cases where the rule
- * looks at the pixels (bb_height_channel). */
+ * looks at the pixels (bb__height_channel). */
 static bb_status load_whole(const char *path, bb_channel channel, bb_image *height,
                             bb__height_loaded *loaded, bb_error *err) {
   bb_image img;

@@ -58,13 +58,13 @@ bb_status bb__image_read_channels(const char *path, int first_channel, int chann
                      out, info);
 }
 
-bb_status bb_image_read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
+bb_status bb__image_read_mip(const char *path, int level, bb_image *out, bb_image_info *info,
                             int *level_count, bb_error *err) {
-  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: out is NULL");
+  if (!out) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_mip: out is NULL");
   memset(out, 0, sizeof *out);
   clear_info(info);
   if (level_count) *level_count = 0;
-  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb_image_read_mip: path is NULL");
+  if (!path) return bb__fail(err, BB_ERR_ARGUMENT, "bb__image_read_mip: path is NULL");
   int levels = 0; /* counted whatever the caller asks: a level past the last is an error */
   bb_status st = bb__texture_read_applies(path)
                      ? bb__texture_read(path, 0, -1, level, out, info, &levels, err)

@@ -10,7 +10,7 @@
 extern "C" {
 #endif
 
-/* Image headers for bb_output_check: the depth bb__image_write stores for
+/* Image headers for bb__output_check: the depth bb__image_write stores for
  * `depth` in path's format (BB_DEPTH_DEFAULT resolved), or -1 for an
  * unknown extension (formats.c); and the number of mip levels of subimage 0
  * of the file at path, from its headers (image_read.c). */
@@ -88,8 +88,18 @@ bb_status bb__animation_close(bb_animation *a, bb_error *err);
 /* Removes the temporary file and frees a; safe on NULL. */
 void bb__animation_abort(bb_animation *a);
 
+/* Parses "8", "16", "half", "float" (exact case), the words of --depth. */
+bb_status bb__depth_parse(const char *name, bb_depth *out, bb_error *err);
+
+/* Once public (bumpbake.h); no client read a level of its own. */
+/* Reads mip level `level` (0 = full size) of subimage 0, as bb_image_read
+ * reads level 0. level_count (may be NULL) receives the file's number of
+ * levels; a level past the last is BB_ERR_ARGUMENT. */
+bb_status bb__image_read_mip(const char *path, int level, bb_image *out,
+                            bb_image_info *info, int *level_count, bb_error *err);
+
 /* Once in bumpbake.h beside the functions that stay public there. */
-/* The word bb_depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
+/* The word bb__depth_parse accepts; "default" for BB_DEPTH_DEFAULT, "unknown"
  * for values outside the enum. */
 const char *bb__depth_name(bb_depth depth);
 

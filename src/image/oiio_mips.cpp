@@ -123,7 +123,7 @@ std::string verify_chain(const std::string &name, const bb_image *levels, int co
     bb_image level;
     bb_error why;
     int file_levels = 0;
-    if (bb_image_read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK) {
+    if (bb__image_read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK) {
       // The reason, without the temporary's name the read gave it.
       std::string reason = why.message;
       if (reason.compare(0, name.size() + 2, name + ": ") == 0) reason.erase(0, name.size() + 2);

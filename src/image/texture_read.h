@@ -14,7 +14,7 @@ extern "C" {
  * name or a file starting with "VTF\0" or "DDS ". */
 int bb__texture_read_applies(const char *path);
 
-/* bb_image_read_mip's read (channels [first, first + count), count < 0: all)
+/* bb__image_read_mip's read (channels [first, first + count), count < 0: all)
  * of a texture bb__texture_read_applies to, and its header alone. */
 bb_status bb__texture_read(const char *path, int first, int count, int level, bb_image *out,
                            bb_image_info *info, int *level_count, bb_error *err);

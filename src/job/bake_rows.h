@@ -1,7 +1,7 @@
 /* bake_rows.h: the bake's options described once, below the commands (not
  * public): each row is an option's name, where its value is in
  * bb_job_options, how the value is written as the command line takes it,
- * and when it differs from bb_job_options_init's. bb_job_command_text
+ * and when it differs from bb__job_options_init's. bb_job_command_text
  * walks bb__bake_rows to spell a job as `bumpbake bake`; the commands
  * family's rows of these options (cmd/options_bake.c) point at them for
  * their name, field, words and printing, and add what only a command needs
@@ -31,9 +31,12 @@ typedef enum bb__field {
 } bb__field;
 
 /* An enum's name for value i ("unknown" or NULL past the last), and its
- * parser (with the enum's aliases and case rules): 1 and *value, or 0. */
+ * parser (with the enum's aliases and case rules): BB_OK and *value, or
+ * BB_ERR_ARGUMENT with the value's own words in err (may be NULL: "channel
+ * must be one of auto, r, ... (got 'z')"), which bb_option_parse gives a
+ * client; the command line's parser words it by the option instead. */
 typedef const char *(*bb__name_fn)(int i);
-typedef int (*bb__parse_fn)(const char *text, int *value);
+typedef bb_status (*bb__parse_fn)(const char *text, long long *value, bb_error *err);
 
 /* What a FLAG sets when given besides its own field (if any): the field at
  * offset to value (INT, ENUM) or to text (STRING, a constant). field NONE:
@@ -88,7 +91,7 @@ extern const bb__bake_row bb__row_scale, bb__row_rays, bb__row_slices,
 extern const bb__bake_row *const bb__bake_rows[];
 
 /* 1 when row r is written for o: o is a bake of the row's kind and its
- * value differs from d's (bb_job_options_init's). */
+ * value differs from d's (bb__job_options_init's). */
 int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
                          const bb_job_options *d);
 
@@ -104,7 +107,7 @@ void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *at
 /* Enums as words (enums.c): bb__name_X and bb__parse_X of each. */
 #define BB__ENUM_WORDS(stem)                                                             \
   const char *bb__name_##stem(int i);                                                    \
-  int bb__parse_##stem(const char *text, int *value);
+  bb_status bb__parse_##stem(const char *text, long long *value, bb_error *err);
 BB__ENUM_WORDS(normal_filter)
 BB__ENUM_WORDS(channel)
 BB__ENUM_WORDS(texture_format)
@@ -116,5 +119,9 @@ BB__ENUM_WORDS(depth)
 BB__ENUM_WORDS(normal_y)
 BB__ENUM_WORDS(ssbump_kind)
 BB__ENUM_WORDS(output_kind)
+
+/* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
+ * the texture defaults (bb_texture_options_init), no outputs. */
+void bb__job_options_init(bb_job_options *o);
 
 #endif /* BB_JOB_BAKE_ROWS_H */

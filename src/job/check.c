@@ -422,16 +422,6 @@ const char *bb_check_input(const bb_check *c, int i) {
   return r ? r->input : NULL;
 }
 
-bb_status bb_check_run(bb_check *c, bb_progress_fn progress, void *progress_user,
-                       bb_check_case_fn each, void *user, bb_error *err) {
-  if (!c)
-    return bb__fail(err, BB_ERR_ARGUMENT, "check: no check");
-  bb_status st = BB_OK;
-  for (int i = 0; i < bb_check_input_count(c) && st == BB_OK; i++)
-    st = bb_check_run_input(c, i, progress, progress_user, each, user, err);
-  return st == BB_OK ? bb_check_run_rest(c, each, user, err) : st;
-}
-
 /* ------------------------------------------------------- what is printed */
 
 static void json_case(FILE *f, const bb_check_case *k) {
@@ -441,7 +431,7 @@ static void json_case(FILE *f, const bb_check_case *k) {
   bb__json_string(&j, "golden", k->golden);
   bb__json_string(&j, "new", k->fresh);
   bb__json_string(&j, "kind", k->kind);
-  bb__json_string(&j, "result", bb_check_status_name(k->status));
+  bb__json_string(&j, "result", bb__check_status_name(k->status));
   bb__json_int(&j, "exit", k->exit_code);
   if (k->width)
     bb__json_int(&j, "width", k->width), bb__json_int(&j, "height", k->height),
@@ -518,7 +508,7 @@ char *bb_check_case_lines(const bb_check *c, const bb_check_case *k) {
      * first indented; every line made printable (names and provenance
      * values come from files) */
     bb__text head = {0};
-    bb__text_printf(&head, "%s %s", bb_check_status_name(k->status), k->name);
+    bb__text_printf(&head, "%s %s", bb__check_status_name(k->status), k->name);
     if (k->kind[0])
       bb__text_printf(&head, " (%s)", k->kind);
     bb__text_add(&head, ": ");

@@ -151,7 +151,7 @@ static int exit_code_of(bb_check_status s) {
   return BB_COMPARE_CANNOT_READ;
 }
 
-const char *bb_check_status_name(bb_check_status s) {
+const char *bb__check_status_name(bb_check_status s) {
   switch (s) {
   case BB_CHECK_PASS:
     return "PASS";

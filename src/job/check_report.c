@@ -11,6 +11,7 @@
  * nothing. */
 #include "core/internal.h"
 #include "job/check.h"
+#include "job/job_internal.h"
 #include "files/safe_file.h"
 
 #include <math.h>
@@ -144,13 +145,13 @@ bb_status bb__check_junit(const char *path, const char *suite,
       t.failed = 1;
     } else if (element) {
       bb__text_printf(&t, "<%s type=\"%s\" message=\"", element,
-                      bb_check_status_name(k->status));
+                      bb__check_status_name(k->status));
       put_escaped(&t, line);
       bb__text_add(&t, "\">");
       put_lines(&t, text);
       bb__text_printf(&t, "</%s>\n", element);
     } else { /* a warning passes; what it found goes with it */
-      bb__text_printf(&t, "<system-out>%s: ", bb_check_status_name(k->status));
+      bb__text_printf(&t, "<system-out>%s: ", bb__check_status_name(k->status));
       put_lines(&t, text);
       bb__text_add(&t, "</system-out>\n");
     }
@@ -312,7 +313,7 @@ static void put_case(bb__text *t, const bb__check_case *k, int index) {
   const bb_check_case *p = &k->pub;
   bb__text_printf(t, "<section class=\"case %s\" id=\"case-%d\">",
                   status_class(p->status), index);
-  bb__text_printf(t, "<h2>%s ", bb_check_status_name(p->status));
+  bb__text_printf(t, "<h2>%s ", bb__check_status_name(p->status));
   put_escaped(t, p->name);
   if (p->kind[0]) {
     bb__text_add(t, " (");
@@ -357,7 +358,7 @@ static void put_thumb(bb__text *t, const bb__check_case *k, int index) {
   else
     bb__text_printf(t, "<a class=\"thumb %s\" href=\"#case-%d\" title=\"",
                     status_class(p->status), index);
-  bb__text_printf(t, "%s ", bb_check_status_name(p->status));
+  bb__text_printf(t, "%s ", bb__check_status_name(p->status));
   put_escaped(t, p->name);
   bb__text_add(t, "\">");
   if (k->thumbs)

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The bake's options that differ from bb_job_options_init's, in the order
+/* The bake's options that differ from bb__job_options_init's, in the order
  * of `bumpbake bake --help` (bb__bake_rows: each row says when it is
  * written and how). threads is no row: the bytes are the same for any
  * count. */
@@ -19,7 +19,7 @@ char *bb_job_command_text(const bb_job_options *o, const char *input) {
   if (!o || !input)
     return NULL;
   bb_job_options d;
-  bb_job_options_init(&d);
+  bb__job_options_init(&d);
   bb__text t = {0};
   bb__text_add(&t, "bumpbake bake ");
   bb__text_add_word(&t, input);

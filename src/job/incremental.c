@@ -157,15 +157,15 @@ static int layout_matches(const char *path, const bb_image_info *info, bb_depth 
   return 1;
 }
 
-bb_status bb_output_check(const char *path, const bb_provenance *expected, bb_depth depth,
+bb_status bb__output_check(const char *path, const bb_provenance *expected, bb_depth depth,
                           int mip_mapped, bb_output_state *state, char *reason, size_t cap,
                           bb_error *err) {
   if (reason && cap)
     reason[0] = '\0';
   if (!path || !expected || !state)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_output_check: NULL argument");
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__output_check: NULL argument");
   if (depth < BB_DEPTH_DEFAULT || depth > BB_DEPTH_FLOAT)
-    return bb__fail(err, BB_ERR_ARGUMENT, "bb_output_check: unknown depth %d", (int)depth);
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb__output_check: unknown depth %d", (int)depth);
   *state = BB_OUTPUT_STALE;
   struct stat st;
   if (stat(path, &st) != 0 && errno == ENOENT) {

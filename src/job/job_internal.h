@@ -402,4 +402,35 @@ bb_depth bb__depth_like_input(int bits_per_sample, int is_float, const char *pat
  * then, and provenance says rayset=none. */
 void bb__bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
 
+
+/* Decides from the header of the file at path alone (bb_image_read_info;
+ * no pixel is decoded) whether it is what writing the output described by
+ * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
+ * 1), would make now. CURRENT when its provenance is bumpbake's, intact
+ * (bb_provenance_class), and holds every key bb_provenance_format(expected)
+ * writes with the same value, and no key that text lacks, except "command"
+ * and "input" (the command line and the input's name, which do not change a
+ * pixel) and "input_hash" (the decoded height's hash, implied by
+ * input_file_hash and channel), and keys the file's kind does not record
+ * (bb__map_kind_records: a normal map written before the rule, with "rays",
+ * is current): so the bumpbake version, the input file's bytes, the output
+ * kind and every parameter that affects its pixels must match; and when its samples have the depth `depth` gives in path's format
+ * (BB_DEPTH_DEFAULT: the format's default) and it has more than one mip
+ * level exactly when mip_mapped. expected->input_file_hash must be set
+ * (nonzero): without it nothing is CURRENT. A file that cannot be read is
+ * STALE, not an error: rewriting it is the remedy. reason (capacity cap;
+ * may be NULL) receives why it is not CURRENT, one line ("no such file",
+ * "scale: 8 -> 16", "bumpbake_version: 0.1.0 -> 0.2.0", "16-bit samples;
+ * 8-bit asked"), or "" when it is. Returns BB_OK with *state set, or
+ * BB_ERR_ARGUMENT (NULL path, expected or state; depth out of range) or
+ * BB_ERR_MEMORY. */
+bb_status bb__output_check(const char *path, const bb_provenance *expected, bb_depth depth,
+                          int mip_mapped, bb_output_state *state, char *reason, size_t cap,
+                          bb_error *err);
+
+/* The words of bb_report_word's fields: "pending", ..., "not run" and
+ * "PASS", ..., "EXTRA"; "unknown" outside the enum. */
+const char *bb__job_outcome_name(bb_job_outcome outcome);
+const char *bb__check_status_name(bb_check_status status);
+
 #endif /* BB_JOB_INTERNAL_H */

@@ -8,6 +8,7 @@
 #include "files/safe_file.h"
 #include "image/formats.h"
 #include "job/job_internal.h"
+#include "job/bake_rows.h"
 #include "render/render_internal.h"
 #include "files/provenance.h"
 #include "image/height_channel.h"
@@ -32,7 +33,7 @@ static char *copy(const char *s) {
   return s ? strdup(s) : NULL;
 }
 
-void bb_job_options_init(bb_job_options *o) {
+void bb__job_options_init(bb_job_options *o) {
   memset(o, 0, sizeof *o);
   bb_bake_options_init(&o->bake);
   o->channel = BB_CHANNEL_AUTO;

@@ -10,6 +10,7 @@
 
 #include "core/internal.h"
 #include "image/height_channel.h"
+#include "bake/bake_internal.h"
 
 #include <inttypes.h>
 #include <stdio.h>
@@ -127,7 +128,7 @@ static void put_smoothing_and_tracing(const bake_keys *k, const bb_bake_options 
   put_bake_double(k, "bias", o->trace.bias_texels);
   put_bake_double(k, "power", o->power);
   put_basis(k, &o->basis);
-  put_bake(k, "normal_filter", bb_normal_filter_name(o->normal_filter));
+  put_bake(k, "normal_filter", bb__normal_filter_name(o->normal_filter));
   put_bake(k, "normal_y", o->normal_y_up ? "up" : "down");
   put_bake(k, "addressing",
            o->smooth.addressing == BB_ADDRESS_CLAMP ? "clamp" : "periodic");

@@ -96,7 +96,7 @@ static int item_is_current(const bb_job *job, bb__job_item *item, char *reason, 
     bb_output_state state;
     const bb_depth depth = output_depth(job, k, item->paths[k], bits, is_float);
     char why[200] = "";
-    const bb_status checked = bb_output_check(item->paths[k], &want, depth, job->options.mips,
+    const bb_status checked = bb__output_check(item->paths[k], &want, depth, job->options.mips,
                                               &state, why, sizeof why, NULL);
     free(texture);
     if (checked != BB_OK) {
@@ -225,18 +225,18 @@ static bb_status fail_input(const bb__job_item *item, bb_status st, const bb_err
   return bb__fail(err, st, "%s: %s", item->input, e->message);
 }
 
-/* Valve's RGBA file of the bake (bb_valve_pack), and for its detail
+/* Valve's RGBA file of the bake (bb__valve_pack), and for its detail
  * variant the input's colour read again (the height reader kept only the
- * height) to scale it by (bb_valve_detail). */
+ * height) to scale it by (bb__valve_detail). */
 static bb_status make_valve(const bb_job *job, const bb__job_item *item, baked *b,
                             bb_error *err) {
   bb_error e = {{0}};
-  bb_status st = bb_valve_pack(&b->result, &job->options.valve, &b->valve, &e);
+  bb_status st = bb__valve_pack(&b->result, &job->options.valve, &b->valve, &e);
   if (st == BB_OK && job->options.valve_detail) {
     bb_image colour = {0};
     st = bb_image_read(item->input, &colour, NULL, &e);
     if (st == BB_OK)
-      st = bb_valve_detail(&b->valve, &colour, &b->height, &job->options.bake.smooth, &e);
+      st = bb__valve_detail(&b->valve, &colour, &b->height, &job->options.bake.smooth, &e);
     bb_image_free(&colour);
   }
   return st == BB_OK ? BB_OK : fail_input(item, st, &e, err);
@@ -682,7 +682,7 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
   return first != BB_OK ? first : st;
 }
 
-const char *bb_job_outcome_name(bb_job_outcome outcome) {
+const char *bb__job_outcome_name(bb_job_outcome outcome) {
   switch (outcome) {
   case BB_JOB_PENDING: return "pending";
   case BB_JOB_BAKED: return "baked";
@@ -691,4 +691,13 @@ const char *bb_job_outcome_name(bb_job_outcome outcome) {
   case BB_JOB_NOT_RUN: return "not run";
   }
   return "unknown";
+}
+
+const char *bb_report_word(const char *field, int value) {
+  const char *w = NULL;
+  if (field && !strcmp(field, "outcome"))
+    w = bb__job_outcome_name((bb_job_outcome)value);
+  else if (field && !strcmp(field, "result"))
+    w = bb__check_status_name((bb_check_status)value);
+  return w && strcmp(w, "unknown") != 0 ? w : NULL;
 }

@@ -86,6 +86,33 @@ bb_status bb__compare_limits_check(const bb_compare_limits *limits, bb_error *er
 bb_compare_verdict bb__compare_judge(const bb_compare_stats *stats,
                                     const bb_compare_limits *limits);
 
+/* Valve's RGBA file (height2ssbump), as the job writes it (once public;
+ * a client asks for it through the bake's options). */
+void bb__valve_options_init(bb_valve_options *o);
+
+/* Packs a bake into Valve's RGBA layout: RGB = result->ssbump (its first
+ * three channels) or result->normal encoded as 0.5 + 0.5 N, A =
+ * result->filtered or result->ao. Every channel of out is then a unit value
+ * (write it with BB_RANGE_UNIT). Allocates out: 4 channels, the bake's size.
+ * BB_ERR_ARGUMENT when an image it needs was not baked (ssbump and ao need
+ * the traced outputs) or has too few channels, or when the ssbump is of a basis
+ * other than Half-Life 2's (result->basis, when set, or more than 4
+ * channels); BB_ERR_SIZE when sizes differ. */
+bb_status bb__valve_pack(const bb_bake_result *result, const bb_valve_options *o,
+                        bb_image *out, bb_error *err);
+
+/* Valve's detail variant (-d): multiplies R, G, B of rgba (4 channels, as
+ * bb__valve_pack makes it; alpha untouched) by (R + G + B) / sqrt(3) of the
+ * input colour smoothed like the height: colour is the decoded input (grey
+ * and grey + alpha: grey is replicated; 3+ channels: R, G, B; alpha is
+ * ignored), smoothed by bb__smooth_bilateral_all_cores with smooth and guided by
+ * height (the 1-channel height the bake started from), so the factor
+ * follows the same edges. A flat, unoccluded texel (0.57735) of mid-grey
+ * input gives 0.5, the neutral value of a mod2x detail texture. All three
+ * images must have the same size (BB_ERR_SIZE). */
+bb_status bb__valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
+                          const bb_smooth_options *smooth, bb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-void bb_program_options_init(bb_program_options *o) {
+void bb__program_options_init(bb__program_options *o) {
   memset(o, 0, sizeof *o);
 }
 
@@ -31,7 +31,7 @@ typedef struct value {
 } value;
 
 typedef struct evaluator {
-  const bb_program_options *o;
+  const bb__program_options *o;
   bb_error *err;
 } evaluator;
 
@@ -87,7 +87,7 @@ int bb__program_image_path(const char *base_dir, const char *name, char *out, si
 /* A program's images are untrusted text (a material from a mod): unless
  * allowed, an image must resolve to a file inside the base directory. A
  * name that resolves to nothing is left to the read, which says so. */
-static bb_status check_inside_base(const bb_program_options *o, const char *name,
+static bb_status check_inside_base(const bb__program_options *o, const char *name,
                                    const char *path, bb_error *err) {
   if (o->allow_outside_base)
     return BB_OK;
@@ -109,7 +109,7 @@ static bb_status check_inside_base(const bb_program_options *o, const char *name
 }
 
 static bb_status load_image(evaluator *ev, const prog_node *n, value *out) {
-  const bb_program_options *o = ev->o;
+  const bb__program_options *o = ev->o;
   char path[4096];
   int len = bb__program_image_path(o->base_dir, n->name, path, sizeof path);
   /* A cut path would name another file (even an existing one). */
@@ -412,7 +412,7 @@ static bb_status decode_result(const bb_image *rgba, bb_image *out, bb_error *er
   return BB_OK;
 }
 
-bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
+bb_status bb__program_run(const bb__program *program, const bb__program_options *o,
                          bb_image *out, int *is_normal_map, bb_error *err) {
   if (!out || !is_normal_map)
     return bb__fail(err, BB_ERR_ARGUMENT, "program: out and is_normal_map are required");
@@ -420,8 +420,8 @@ bb_status bb_program_run(const bb_program *program, const bb_program_options *o,
   *is_normal_map = 0;
   if (!program || !program->root)
     return bb__fail(err, BB_ERR_ARGUMENT, "program: no program");
-  bb_program_options defaults;
-  bb_program_options_init(&defaults);
+  bb__program_options defaults;
+  bb__program_options_init(&defaults);
   evaluator ev = {o ? o : &defaults, err};
   value v;
   bb_status st = eval(&ev, program->root, &v);

@@ -310,7 +310,7 @@ static prog_node *parse_expr(parser *ps, int depth) {
   return parse_image(ps, &t);
 }
 
-bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err) {
+bb_status bb__program_parse(const char *text, bb__program **out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "program parse: out is NULL");
   *out = NULL;
@@ -331,7 +331,7 @@ bb_status bb_program_parse(const char *text, bb_program **out, bb_error *err) {
     free_node(root);
     return ps.status;
   }
-  bb_program *p = malloc(sizeof *p);
+  bb__program *p = malloc(sizeof *p);
   if (!p) {
     free_node(root);
     return bb__fail(err, BB_ERR_MEMORY, "out of memory parsing the program");
@@ -354,13 +354,13 @@ static size_t collect_images(const prog_node *n, const char **names, size_t cap,
   return collect_images(n->args[1], names, cap, count);
 }
 
-size_t bb__program_images(const bb_program *program, const char **names, size_t cap) {
+size_t bb__program_images(const bb__program *program, const char **names, size_t cap) {
   if (!program)
     return 0;
   return collect_images(program->root, names, names ? cap : 0, 0);
 }
 
-void bb_program_free(bb_program *program) {
+void bb__program_free(bb__program *program) {
   if (!program)
     return;
   free_node(program->root);

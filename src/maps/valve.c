@@ -5,10 +5,11 @@
 #include "trace/basis.h"
 #include "core/internal.h"
 #include "bake/bake_internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 
-void bb_valve_options_init(bb_valve_options *o) {
+void bb__valve_options_init(bb_valve_options *o) {
   memset(o, 0, sizeof *o);
 }
 
@@ -29,7 +30,7 @@ static bb_status check_part(const bb_image *img, const char *what, int channels,
   return BB_OK;
 }
 
-bb_status bb_valve_pack(const bb_bake_result *result, const bb_valve_options *o,
+bb_status bb__valve_pack(const bb_bake_result *result, const bb_valve_options *o,
                         bb_image *out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "valve pack: out is NULL");
@@ -103,7 +104,7 @@ static bb_status check_detail_inputs(const bb_image *rgba, const bb_image *colou
   return BB_OK;
 }
 
-bb_status bb_valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
+bb_status bb__valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
                           const bb_smooth_options *smooth, bb_error *err) {
   bb_status st = check_detail_inputs(rgba, colour, height, smooth, err);
   if (st != BB_OK)

@@ -86,7 +86,7 @@ bb_status bb__axis_parse(const char *name, bb_axis *out, bb_error *err) {
   return st;
 }
 
-const char *bb_axis_name(bb_axis a) {
+const char *bb__axis_name(bb_axis a) {
   return (int)a >= 0 && (int)a < AXIS_COUNT ? axes[a].name : "unknown";
 }
 

@@ -93,6 +93,9 @@ void bb__axis_frame(bb_axis a, double right[3], double up[3], double out[3]);
 /* Parses "-y", "+y", "+z", "-z", "+x", "-x" ("y" means "+y"). */
 bb_status bb__axis_parse(const char *name, bb_axis *out, bb_error *err);
 
+/* "-y", "+z", ...; "unknown" for a value outside the enum. */
+const char *bb__axis_name(bb_axis a);
+
 #ifdef __cplusplus
 }
 #endif

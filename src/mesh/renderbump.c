@@ -534,7 +534,7 @@ static bb_status normalise_height(rb_job *job, bb_error *err) {
   if (!(lo <= hi))
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "renderbump: no surface faces the viewer inside the rectangle along %s",
-                    bb_axis_name(job->o->axis));
+                    bb__axis_name(job->o->axis));
   const double range = (double)hi - (double)lo;
   for (size_t i = 0; i < texels; i++) {
     float *h = &r->height.pixels[i];
@@ -569,7 +569,7 @@ static bb_status choose_rect(rb_job *job, bb_error *err) {
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "renderbump: the bounding rectangle seen along %s is degenerate "
                     "(%g x %g model units); try another axis",
-                    bb_axis_name(job->o->axis), w, h);
+                    bb__axis_name(job->o->axis), w, h);
   const double tu = w / job->o->width, tv = h / job->o->height;
   r->texel_size = sqrt(tu * tv);
   r->texel_aspect = tu / tv;
@@ -655,7 +655,7 @@ char *bb__renderbump_describe(const bb_renderbump_options *o, const bb_renderbum
            "axis=%s\nsize=%dx%d\nsamples=%d\nnormals=%s\n"
            "rect=%.17g,%.17g,%.17g,%.17g\ntile=%s\n"
            "depth_min=%.17g\ndepth_max=%.17g\nscale=%.9g\n",
-           bb_axis_name(o->axis), o->width, o->height, o->samples,
+           bb__axis_name(o->axis), o->width, o->height, o->samples,
            r->used_vertex_normals ? "vertex" : "face", r->rect[0], r->rect[1], r->rect[2],
            r->rect[3], o->tile ? "on" : "off", r->depth_min, r->depth_max,
            r->height_scale);

@@ -236,7 +236,7 @@ void bb__light_direction(double azimuth_degrees, double elevation_degrees, doubl
 
 /* -------------------------------------------------------------- options */
 
-void bb_render_options_init(bb_render_options *o) {
+void bb__render_options_init(bb_render_options *o) {
   memset(o, 0, sizeof *o);
   o->mode = BB_RENDER_SSBUMP;
   o->dynamic_light = 1;

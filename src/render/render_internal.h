@@ -162,4 +162,8 @@ bb_status bb__sheet_make(const bb_image *height, const bb_bake_result *r,
 const char *bb__render_mode_name(bb_render_mode mode);
 unsigned bb__render_mode_needs(bb_render_mode mode);
 
+/* render's defaults: ssbump, the light at 135, 45 (once public: a client
+ * reads them from a new render command's options, bb_command_options_of). */
+void bb__render_options_init(bb_render_options *o);
+
 #endif /* BB_RENDER_INTERNAL_H */

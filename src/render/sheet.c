@@ -14,7 +14,7 @@ void bb__sheet_options_init(bb_sheet_options *o) {
   memset(o, 0, sizeof *o);
   bb__panel_layout_init(&o->layout);
   o->layout.panel_width = SHEET_PANEL_WIDTH;
-  bb_render_options_init(&o->lit);
+  bb__render_options_init(&o->lit);
 }
 
 /* The range heights are stretched over: the input's, so the filtered height

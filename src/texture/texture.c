@@ -49,7 +49,7 @@ static const format_info formats[] = {
 };
 enum { FORMAT_COUNT = (int)(sizeof formats / sizeof formats[0]) };
 
-/* Every name bb_texture_format_parse takes, and the format it names. */
+/* Every name bb__texture_format_parse takes, and the format it names. */
 static const struct {
   const char *name;
   bb_texture_format format;
@@ -74,7 +74,7 @@ static const char *name_in(const format_info *f, bb__container c) {
   return c == BB__CONTAINER_VTF && f->vtf_name ? f->vtf_name : f->name;
 }
 
-bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_error *err) {
+bb_status bb__texture_format_parse(const char *name, bb_texture_format *out, bb_error *err) {
   const char *names[NAME_COUNT];
   for (int k = 0; k < NAME_COUNT; k++)
     names[k] = format_names[k].name;
@@ -85,7 +85,7 @@ bb_status bb_texture_format_parse(const char *name, bb_texture_format *out, bb_e
   return st;
 }
 
-bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err) {
+bb_status bb__vtf_version_parse(const char *text, int *minor, bb_error *err) {
   /* "7.3" as Valve writes it, or the minor number alone. */
   const char *m = text && strncmp(text, "7.", 2) == 0 ? text + 2 : text;
   char *end = NULL;
@@ -99,7 +99,7 @@ bb_status bb_vtf_version_parse(const char *text, int *minor, bb_error *err) {
   return BB_OK;
 }
 
-bb_status bb_vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err) {
+bb_status bb__vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err) {
   char *end = NULL;
   errno = 0;
   /* A digit first: strtoul would also take spaces and a sign. */

@@ -136,6 +136,17 @@ bb_status bb__vmt_text(const char *path, const bb_vmt_options *options, char **t
 /* The first name of format ("bc1", ...), "default", or "unknown". */
 const char *bb__texture_format_name(bb_texture_format format);
 
+/* Once public (bumpbake.h); a client parses these as options do
+ * (bb_option_parse on --texture-format, --vtf-version, --vtf-flags). */
+/* Parses a format name above (any case); "default" is BB_TEXTURE_FORMAT_DEFAULT. */
+bb_status bb__texture_format_parse(const char *name, bb_texture_format *out, bb_error *err);
+/* Parses a VTF version as --vtf-version takes it: "7.2" to "7.5", or the
+ * minor number alone ("2" to "5"); *minor receives 2..5. */
+bb_status bb__vtf_version_parse(const char *text, int *minor, bb_error *err);
+/* Parses VTF flags as --vtf-flags takes them: a 32-bit number, decimal,
+ * 0x hexadecimal or 0 octal (strtoul's base 0), no sign. */
+bb_status bb__vtf_flags_parse(const char *text, uint32_t *flags, bb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -32,14 +32,14 @@ static void compute(const bb_image *h, float scale, bb_normal_filter f, bb_addre
 Test(normal, filter_names_round_trip) {
   for (size_t i = 0; i < FILTER_COUNT; i++) {
     bb_normal_filter parsed = (bb_normal_filter)-1;
-    cr_assert_eq(bb__normal_filter_parse(bb_normal_filter_name(all_filters[i]), &parsed, NULL),
+    cr_assert_eq(bb__normal_filter_parse(bb__normal_filter_name(all_filters[i]), &parsed, NULL),
                  0);
     cr_assert_eq(parsed, all_filters[i]);
   }
-  cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_VERTEX), "vertex");
-  cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_VALVE), "valve");
-  cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_CENTRAL), "central");
-  cr_assert_str_eq(bb_normal_filter_name(BB_NORMAL_SOBEL), "sobel");
+  cr_assert_str_eq(bb__normal_filter_name(BB_NORMAL_VERTEX), "vertex");
+  cr_assert_str_eq(bb__normal_filter_name(BB_NORMAL_VALVE), "valve");
+  cr_assert_str_eq(bb__normal_filter_name(BB_NORMAL_CENTRAL), "central");
+  cr_assert_str_eq(bb__normal_filter_name(BB_NORMAL_SOBEL), "sobel");
   bb_normal_filter f = BB_NORMAL_SOBEL;
   cr_assert_neq(bb__normal_filter_parse("Valve", &f, NULL), 0);
   cr_assert_neq(bb__normal_filter_parse("", &f, NULL), 0);
@@ -56,7 +56,7 @@ Test(normal, flat_is_straight_up_exactly) {
       for (int k = 0; k < 9 * 7; k++) {
         cr_assert(n.pixels[3 * k] == 0.0f && n.pixels[3 * k + 1] == 0.0f &&
                       n.pixels[3 * k + 2] == 1.0f,
-                  "%s texel %d: (%g, %g, %g)", bb_normal_filter_name(all_filters[i]), k,
+                  "%s texel %d: (%g, %g, %g)", bb__normal_filter_name(all_filters[i]), k,
                   (double)n.pixels[3 * k], (double)n.pixels[3 * k + 1],
                   (double)n.pixels[3 * k + 2]);
       }
@@ -91,7 +91,7 @@ static void check_sine(bb_normal_filter f, int along_y, double tolerance) {
       const float *got = bb_image_texel(&n, x, y);
       for (int c = 0; c < 3; c++)
         cr_assert(fabs(got[c] - want[c] / len) < tolerance,
-                  "%s (%d,%d) c%d: got %.5f want %.5f", bb_normal_filter_name(f), x, y, c,
+                  "%s (%d,%d) c%d: got %.5f want %.5f", bb__normal_filter_name(f), x, y, c,
                   (double)got[c], want[c] / len);
     }
   bb_image_free(&h);
@@ -139,11 +139,11 @@ static void check_plane(double gx, double gy) {
       for (int x = 2; x < 6; x++) {
         const float *got = bb_image_texel(&n, x, y);
         cr_assert_float_eq(got[0], sx / len, 1e-6, "%s",
-                           bb_normal_filter_name(all_filters[i]));
+                           bb__normal_filter_name(all_filters[i]));
         cr_assert_float_eq(got[1], sy / len, 1e-6, "%s",
-                           bb_normal_filter_name(all_filters[i]));
+                           bb__normal_filter_name(all_filters[i]));
         cr_assert_float_eq(got[2], 1.0 / len, 1e-6, "%s",
-                           bb_normal_filter_name(all_filters[i]));
+                           bb__normal_filter_name(all_filters[i]));
       }
     bb_image_free(&n);
   }
@@ -234,7 +234,7 @@ Test(normal, periodic_shift_is_exact) {
         cr_assert_eq(memcmp(bb_image_texel(&a, x, y),
                             bb_image_texel(&b, (x + dx) % w, (y + dy) % hgt),
                             3 * sizeof(float)),
-                     0, "%s (%d,%d)", bb_normal_filter_name(all_filters[i]), x, y);
+                     0, "%s (%d,%d)", bb__normal_filter_name(all_filters[i]), x, y);
     bb_image_free(&a);
     bb_image_free(&b);
   }
@@ -334,7 +334,7 @@ Test(normal, matches_direct_sums_bit_for_bit) {
             ref_normal(&h, 40.0, all_filters[f], a, x, y, want);
             cr_assert_eq(memcmp(bb_image_texel(&n, x, y), want, sizeof want), 0,
                          "%dx%d %s %s (%d,%d)", w, hgt,
-                         bb_normal_filter_name(all_filters[f]),
+                         bb__normal_filter_name(all_filters[f]),
                          clamp ? "clamp" : "periodic", x, y);
           }
         bb_image_free(&n);

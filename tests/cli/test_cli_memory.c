@@ -4,6 +4,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath (cli_harness.h) */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
+#include "job/bake_rows.h"
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "job/job_internal.h"
@@ -35,7 +36,7 @@ static void write_height(const char *path, int side) {
 /* The job's estimate for `bake input args...` as planned by the library. */
 static double job_estimate(const char *input, unsigned outputs, int side) {
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 32.0f;
   o.bake.slices = 2;
   o.bake.trace.threads = 2;

@@ -3,6 +3,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
+#include "image/oiio.h"
 #include "bumpbake.h"
 #include "cli_harness.h"
 
@@ -33,7 +34,7 @@ static void write_height(const char *path) {
 static bb_image read_level(const char *path, int level, int *count) {
   bb_image img;
   bb_error err;
-  cr_assert_eq(bb_image_read_mip(path, level, &img, NULL, count, &err), BB_OK, "%s",
+  cr_assert_eq(bb__image_read_mip(path, level, &img, NULL, count, &err), BB_OK, "%s",
                err.message);
   return img;
 }

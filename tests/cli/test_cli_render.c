@@ -304,7 +304,7 @@ Test(cli_render, a_picture_too_large_is_refused_before_any_pixel_is_read) {
  * alone (render, tiles, crop and the encoder's copy). */
 Test(cli_render, the_render_estimate) {
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   o.tile_x = o.tile_y = 8;
   int w = 0, h = 0;
   double bytes = 0.0;

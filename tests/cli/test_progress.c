@@ -3,6 +3,7 @@
  * (the bar's final clear before "wrote" is test_cli_bounce.c's). */
 #define _DEFAULT_SOURCE /* forkpty */
 
+#include "job/bake_rows.h"
 #include "cli/common.h"
 #include "cli/progress.h"
 #include "image/image_write.h"
@@ -68,7 +69,7 @@ Test(progress, a_jobs_block_compression_has_its_own_bar) {
     if (bb__image_write(height, &h, NULL, NULL) != BB_OK)
       _exit(4);
     bb_job_options o;
-    bb_job_options_init(&o);
+    bb__job_options_init(&o);
     o.bake.height_scale = 4.0f;
     o.bake.rays = 16;
     o.paths[BB_MAP_SSBUMP] = vtf;

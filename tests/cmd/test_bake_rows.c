@@ -131,7 +131,7 @@ static bb_command *read_back(const char *line) {
 /* Each row: set, spelled, read back the same. */
 Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
   bb_job_options defaults;
-  bb_job_options_init(&defaults);
+  bb__job_options_init(&defaults);
   for (int i = 0; bb__bake_rows[i]; i++) {
     const bb__bake_row *row = bb__bake_rows[i];
     const sample *s = sample_of(row->name);

@@ -625,3 +625,200 @@ Test(cmd, option_type_names_are_the_librarys) {
   cr_assert_null(bb_option_type_name((bb_option_type)(BB_OPTION_PATH + 1)));
   cr_assert_null(bb_option_type_name((bb_option_type)-1));
 }
+
+/* bb_option_parse and bb_option_word: a client parses and names an
+ * option's value through the option rows, with no command to set. */
+static const bb_option_info *option_of(const char *command, const char *name) {
+  const bb_option_info *o = bb_option_find(bb_command_info_find(command), name, 0);
+  cr_assert_not_null(o, "%s --%s", command, name);
+  return o;
+}
+
+static void expect_parsed(const char *command, const char *name, const char *text,
+                          long long expected) {
+  bb_error err = {{0}};
+  long long v = -12345;
+  cr_expect_eq(bb_option_parse(option_of(command, name), text, &v, &err), BB_OK,
+               "%s --%s %s: %s", command, name, text, err.message);
+  cr_expect_eq(v, expected, "%s --%s %s: %lld", command, name, text, v);
+}
+
+static void expect_refused(const char *command, const char *name, const char *text,
+                           const char *message) {
+  bb_error err = {{0}};
+  long long v = -12345;
+  cr_expect_eq(bb_option_parse(option_of(command, name), text, &v, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, message);
+  cr_expect_eq(v, -12345, "a refused value leaves *value alone");
+}
+
+Test(cmd, option_parse_reads_a_value_by_the_options_parser) {
+  expect_parsed("bake", "channel", "LUMA", BB_CHANNEL_LUMA);
+  expect_parsed("bake", "depth", "16", BB_DEPTH_16);
+  expect_parsed("bake", "normal-y", "up", 1);
+  expect_parsed("bake", "normal_y", "down", 0);
+  expect_parsed("bake", "normal-filter", "sobel", BB_NORMAL_SOBEL);
+  expect_parsed("bake", "texture-format", "DXT5", BB_TEXTURE_FORMAT_BC3);
+  expect_parsed("bake", "vtf-version", "7.3", 3);
+  expect_parsed("bake", "vtf-version", "5", 5);
+  expect_parsed("bake", "vtf-flags", "0xffffffff", 0xffffffffLL);
+  expect_parsed("renderbumpflat", "axis", "z", BB_AXIS_POS_Z);
+  expect_parsed("ssbump2normal", "kind", "weights", BB_MAP_WEIGHTS);
+}
+
+Test(cmd, option_parse_refuses_in_the_values_own_words) {
+  expect_refused("bake", "channel", "z",
+                 "channel must be one of auto, r, g, b, a, luma, mean, valve (got 'z')");
+  expect_refused("bake", "depth", "12", "depth must be one of 8, 16, half, float (got '12')");
+  expect_refused("bake", "normal-y", "left", "normal y must be one of down, up (got 'left')");
+  expect_refused("bake", "vtf-version", "7.9",
+                 "VTF version must be 7.2, 7.3, 7.4 or 7.5 (got '7.9')");
+  expect_refused("bake", "vtf-flags", "-1",
+                 "VTF flags must be a 32-bit number, e.g. 0x4 (got '-1')");
+  expect_refused("ssbump2normal", "kind", "ao",
+                 "map kind must be one of weights, ssbump (got 'ao')");
+  /* options bb_command_set reads: nothing of their own to parse */
+  expect_refused("bake", "rays", "256", "--rays has no word or value of its own to parse");
+  expect_refused("bake", "normal", "n.png", "--normal has no word or value of its own to parse");
+  bb_error err = {{0}};
+  long long v = 0;
+  cr_expect_eq(bb_option_parse(NULL, "x", &v, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_option_parse(option_of("bake", "channel"), NULL, &v, &err), BB_ERR_ARGUMENT);
+}
+
+Test(cmd, option_word_names_what_option_parse_reads) {
+  cr_expect_str_eq(bb_option_word(option_of("bake", "normal-filter"), BB_NORMAL_VERTEX),
+                   "vertex");
+  cr_expect_str_eq(bb_option_word(option_of("renderbumpflat", "axis"), BB_AXIS_NEG_Y), "-y");
+  cr_expect_str_eq(bb_option_word(option_of("bake", "normal-y"), 1), "up");
+  /* no word: a value outside the enum, depth's DEFAULT (no word a user
+   * types), a kind the option does not take, an option without words */
+  cr_expect_null(bb_option_word(option_of("bake", "normal-filter"), 99));
+  cr_expect_null(bb_option_word(option_of("bake", "normal-filter"), -1));
+  cr_expect_null(bb_option_word(option_of("bake", "depth"), BB_DEPTH_DEFAULT));
+  cr_expect_null(bb_option_word(option_of("ssbump2normal", "kind"), BB_MAP_AO));
+  cr_expect_null(bb_option_word(option_of("bake", "rays"), 0));
+  cr_expect_null(bb_option_word(NULL, 0));
+  /* every word of every option parses back to its value */
+  int words = 0;
+  const bb_command_info *c;
+  for (int i = 0; (c = bb_command_info_get(i)) != NULL; i++) {
+    for (int k = 0; k < c->option_count; k++) {
+      const bb_option_info *o = bb_command_option(c, k);
+      for (long long v = 0; v < 64; v++) {
+        const char *w = bb_option_word(o, v);
+        if (!w)
+          continue;
+        long long back = -1;
+        bb_error err = {{0}};
+        cr_expect_eq(bb_option_parse(o, w, &back, &err), BB_OK, "%s --%s %s", c->name,
+                     o->name, w);
+        cr_expect_eq(back, v, "%s --%s %s", c->name, o->name, w);
+        words++;
+      }
+    }
+  }
+  cr_expect_gt(words, 50, "the words of every command's word options (%d)", words);
+}
+
+/* bb_command_program: program's run in memory, the image bb_command_run
+ * writes (float EXR: the values as they are), bit for bit. */
+static void expect_program_as_run(const char *text, int expect_normal) {
+  char dir[] = "/tmp/bb_program_XXXXXX";
+  cr_assert_not_null(mkdtemp(dir));
+  char out_path[64];
+  snprintf(out_path, sizeof out_path, "%s/out.exr", dir);
+  const char *words[] = {text, "--base", "fixtures", "--output", out_path, NULL};
+  bb_command *c = command("program", words);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  bb_image mem = {0};
+  int is_normal = -1;
+  cr_assert_eq(bb_command_program(c, &mem, &is_normal, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(is_normal, expect_normal, "%s", text);
+  cr_expect_eq(mem.channels, expect_normal ? 3 : 4, "%s", text);
+  cr_expect_eq(access(out_path, F_OK), -1, "nothing written in memory");
+  bb_command_result r = {0};
+  cr_assert_eq(bb_command_run(c, NULL, &r, &err), BB_OK, "%s", err.message);
+  bb_image file = {0};
+  cr_assert_eq(bb_image_read(out_path, &file, NULL, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(file.width, mem.width);
+  cr_assert_eq(file.height, mem.height);
+  cr_assert_eq(file.channels, mem.channels);
+  const size_t n = (size_t)mem.width * (size_t)mem.height * (size_t)mem.channels;
+  cr_expect_eq(memcmp(file.pixels, mem.pixels, n * sizeof(float)), 0, "%s: the run's pixels",
+               text);
+  bb_image_free(&file);
+  bb_image_free(&mem);
+  bb_command_result_free(&r);
+  bb_command_free(c);
+  unlink(out_path);
+  rmdir(dir);
+}
+
+Test(cmd, program_in_memory_is_the_runs_image) {
+  expect_program_as_run("heightmap(pit_65x65.png, 4)", 1);
+  expect_program_as_run("invertColor(bricks_128x64.png)", 0);
+}
+
+Test(cmd, program_in_memory_refuses_in_the_programs_words) {
+  bb_error err = {{0}};
+  bb_image out = {0};
+  int is_normal = 0;
+  const char *missing[] = {"invertColor(nonexistent_image.png)", NULL};
+  bb_command *c = command("program", missing);
+  bb_command_set_in_memory(c, 0); /* Python's program(): no output file */
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT, "unchecked");
+  cr_expect_str_eq(err.message, "bb_command_program: not a checked program command");
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_IO);
+  cr_expect(strstr(err.message, "nonexistent_image.png"), "names the file: %s", err.message);
+  cr_expect_null(out.pixels);
+  bb_command_free(c);
+  const char *outside[] = {"heightmap(/nonexistent/h.tga, 4)", NULL};
+  c = command("program", outside);
+  bb_command_set_in_memory(c, 0);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT);
+  cr_expect(strstr(err.message, "absolute"), "%s", err.message);
+  bb_command_free(c);
+  const char *bake[] = {"h.png", "--scale", "8", NULL};
+  c = command("bake", bake);
+  cr_expect_eq(bb_command_program(c, &out, &is_normal, &err), BB_ERR_ARGUMENT, "not program");
+  bb_command_free(c);
+}
+
+Test(cmd, the_commands_end_with_null) {
+  int n = 0;
+  while (bb_command_info_get(n))
+    n++;
+  cr_expect_gt(n, 10, "every command of bumpbake --help (%d)", n);
+  cr_expect_null(bb_command_info_get(-1));
+  cr_expect_str_eq(bb_command_info_get(0)->name, "normal", "the order of bumpbake --help");
+  cr_expect_str_eq(bb_command_info_get(n - 1)->name,
+                   bb_command_info_find(bb_command_info_get(n - 1)->name)->name);
+}
+
+/* bb_report_word: the words of the reports' enums, as printed. */
+Test(cmd, report_words_are_the_printed_ones) {
+  cr_expect_str_eq(bb_report_word("outcome", BB_JOB_CURRENT), "up to date");
+  cr_expect_str_eq(bb_report_word("outcome", BB_JOB_NOT_RUN), "not run");
+  cr_expect_str_eq(bb_report_word("result", BB_CHECK_PASS), "PASS");
+  cr_expect_str_eq(bb_report_word("result", BB_CHECK_DIFFERENT_SIZE), "DIFFERENT SIZE");
+  cr_expect_null(bb_report_word("outcome", BB_JOB_NOT_RUN + 1));
+  cr_expect_null(bb_report_word("result", -1));
+  cr_expect_null(bb_report_word("status", 0));
+  cr_expect_null(bb_report_word(NULL, 0));
+  /* every value of each enum has its own word */
+  const char *seen[16] = {0};
+  int n = 0;
+  for (int v = BB_JOB_PENDING; v <= BB_JOB_NOT_RUN; v++)
+    seen[n++] = bb_report_word("outcome", v);
+  for (int v = BB_CHECK_PASS; v <= BB_CHECK_EXTRA; v++)
+    seen[n++] = bb_report_word("result", v);
+  for (int i = 0; i < n; i++) {
+    cr_assert_not_null(seen[i], "word %d", i);
+    for (int k = 0; k < i; k++)
+      cr_expect_str_neq(seen[i], seen[k]);
+  }
+}

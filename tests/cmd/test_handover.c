@@ -3,6 +3,7 @@
  * up there again from the texts its options were set from: the same
  * command, words with blanks included; a chunk's inputs replace the
  * batch's; what is not a hand-over of this version is refused. */
+#include "cmd/cmd_internal.h"
 #include "bumpbake.h"
 #include "bumpbake_cluster.h"
 
@@ -51,7 +52,7 @@ Test(handover, gives_the_same_command) {
                err.message);
   char *a = spelled(c), *b = spelled(back);
   cr_expect_str_eq(b, a);
-  cr_expect_eq(bb_command_input_count(back), 2);
+  cr_expect_eq(bb__command_input_count(back), 2);
   cr_expect_str_eq(bb_command_input(back, 0), "my heights");
   const bb_command_options *o = bb_command_options_of(back);
   cr_expect(o->json && o->quiet, "the client's own options travel too");
@@ -64,7 +65,7 @@ Test(handover, gives_the_same_command) {
   /* a chunk of the batch: its inputs in place of the batch's */
   const char *chunk[] = {"b.png"};
   cr_assert_eq(bb_command_from_handover(data, size, chunk, 1, &back, &err), BB_OK);
-  cr_expect_eq(bb_command_input_count(back), 1);
+  cr_expect_eq(bb__command_input_count(back), 1);
   cr_expect_str_eq(bb_command_input(back, 0), "b.png");
   bb_command_free(back);
   free(a);

@@ -1,4 +1,6 @@
 /* test_provenance.c: image hash, provenance text and its key-by-key diff. */
+#include "image/height_channel.h"
+#include "bake/bake_internal.h"
 #include "files/provenance.h"
 #include "bumpbake.h"
 #include "core/internal.h" /* bb__provenance_pack */
@@ -143,7 +145,7 @@ Test(provenance, format_lists_every_key_in_order) {
   cr_assert_str_eq(value_of(text, "channel", buf, sizeof buf), "auto");
   cr_assert_str_eq(value_of(text, "basis", buf, sizeof buf), "hl2");
   cr_assert_str_eq(value_of(text, "normal_filter", buf, sizeof buf),
-                   bb_normal_filter_name(BB_NORMAL_VALVE));
+                   bb__normal_filter_name(BB_NORMAL_VALVE));
   free(text);
 }
 
@@ -196,7 +198,7 @@ Test(provenance, channel_line_parses_back_to_the_rule) {
     char *text = bb_provenance_format(&p);
     char buf[64];
     bb_channel parsed;
-    cr_assert_eq(bb_channel_parse(value_of(text, "channel", buf, sizeof buf), &parsed, NULL), 0,
+    cr_assert_eq(bb__channel_parse(value_of(text, "channel", buf, sizeof buf), &parsed, NULL), 0,
                  "channel=%s", buf);
     cr_assert_eq((int)parsed, c);
     free(text);

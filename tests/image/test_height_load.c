@@ -113,7 +113,7 @@ Test(load, parse_every_name_and_back) {
                                BB_CHANNEL_A, BB_CHANNEL_LUMA, BB_CHANNEL_MEAN};
   for (int i = 0; i < 7; i++) {
     bb_channel c = (bb_channel)99;
-    cr_assert_eq(bb_channel_parse(names[i], &c, NULL), 0, "%s", names[i]);
+    cr_assert_eq(bb__channel_parse(names[i], &c, NULL), 0, "%s", names[i]);
     cr_assert_eq(c, values[i]);
     cr_assert_str_eq(bb__channel_name(values[i]), names[i]);
   }
@@ -121,13 +121,13 @@ Test(load, parse_every_name_and_back) {
 
 Test(load, parse_ignores_case_and_rejects_others) {
   bb_channel c = BB_CHANNEL_AUTO;
-  cr_assert_eq(bb_channel_parse("LUMA", &c, NULL), 0);
+  cr_assert_eq(bb__channel_parse("LUMA", &c, NULL), 0);
   cr_assert_eq(c, BB_CHANNEL_LUMA);
   c = BB_CHANNEL_R;
-  cr_assert_neq(bb_channel_parse("alpha", &c, NULL), 0);
-  cr_assert_neq(bb_channel_parse("", &c, NULL), 0);
-  cr_assert_neq(bb_channel_parse(NULL, &c, NULL), 0);
-  cr_assert_neq(bb_channel_parse("r ", &c, NULL), 0);
+  cr_assert_neq(bb__channel_parse("alpha", &c, NULL), 0);
+  cr_assert_neq(bb__channel_parse("", &c, NULL), 0);
+  cr_assert_neq(bb__channel_parse(NULL, &c, NULL), 0);
+  cr_assert_neq(bb__channel_parse("r ", &c, NULL), 0);
   cr_assert_eq(c, BB_CHANNEL_R, "a failed parse changed the output");
   cr_assert_str_eq(bb__channel_name((bb_channel)42), "unknown");
 }
@@ -214,7 +214,7 @@ Test(load, rgba_colour_with_a_mask_keeps_the_colour) {
     t[1] = t[2] = t[0];
     t[3] = 0.1f + 0.05f * (float)i;
   }
-  cr_assert_eq(bb_height_channel(&img, 3, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, 3, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   bb_image_free(&img);
 }
 
@@ -252,8 +252,8 @@ static bb_image height_in_alpha(int w, int h, int channels) {
 Test(load, auto_takes_alpha_when_only_alpha_varies) {
   for (int channels = 2; channels <= 4; channels += 2) {
     bb_image img = height_in_alpha(4, 3, channels);
-    cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
-    cr_assert_eq(bb_height_channel(&img, channels - 1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+    cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+    cr_assert_eq(bb__height_channel(&img, channels - 1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
     check_rule(&img, -1, BB_CHANNEL_A);
     bb_image h;
     cr_assert_eq(bb_height_from_image(&img, -1, BB_CHANNEL_AUTO, &h, NULL), BB_OK);
@@ -263,7 +263,7 @@ Test(load, auto_takes_alpha_when_only_alpha_varies) {
                      "%d channels, texel (%d, %d): auto should read alpha", channels, x, y);
     bb_image_free(&h);
     /* An explicit request is kept: the mean of the constant colour is flat. */
-    cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_MEAN), BB_CHANNEL_MEAN);
+    cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_MEAN), BB_CHANNEL_MEAN);
     cr_assert_eq(bb_height_from_image(&img, -1, BB_CHANNEL_MEAN, &h, NULL), BB_OK);
     cr_assert_eq(*bb_image_texel(&h, 3, 2), 0.75f);
     bb_image_free(&h);
@@ -275,30 +275,30 @@ Test(load, auto_keeps_the_colour_otherwise) {
   bb_image img = height_in_alpha(4, 3, 4);
   /* The last texel's green differs: a colour, and alpha a graded height. */
   bb_image_texel(&img, 3, 2)[1] = 0.5f;
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+  cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_A);
   /* A constant alpha too: nothing varies, nothing to prefer. */
   bb_image_texel(&img, 3, 2)[1] = 0.75f;
   for (int i = 0; i < 12; i++)
     img.pixels[i * 4 + 3] = 0.5f;
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   /* Alpha flagged inside the colour channels, or outside the image. */
-  cr_assert_eq(bb_height_channel(&img, 1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
-  cr_assert_eq(bb_height_channel(&img, 7, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, 1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, 7, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   bb_image_free(&img);
   /* No alpha: a constant RGB image stays the mean. */
   img = height_in_alpha(4, 3, 3);
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   bb_image_free(&img);
   /* Five channels: only a flagged alpha counts. */
   img = height_in_alpha(4, 3, 5);
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
-  cr_assert_eq(bb_height_channel(&img, 4, BB_CHANNEL_AUTO), BB_CHANNEL_A);
+  cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, 4, BB_CHANNEL_AUTO), BB_CHANNEL_A);
   bb_image_free(&img);
   /* One texel cannot vary. */
   img = height_in_alpha(1, 1, 4);
-  cr_assert_eq(bb_height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(&img, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
   bb_image_free(&img);
-  cr_assert_eq(bb_height_channel(NULL, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
+  cr_assert_eq(bb__height_channel(NULL, -1, BB_CHANNEL_AUTO), BB_CHANNEL_MEAN);
 }
 
 Test(load, nan_height_names_the_first_bad_texel) {

@@ -1327,7 +1327,7 @@ Test(image_files, depth_names_round_trip_and_others_are_refused) {
   const bb_depth depths[] = {BB_DEPTH_8, BB_DEPTH_16, BB_DEPTH_HALF, BB_DEPTH_FLOAT};
   for (int i = 0; i < 4; i++) {
     bb_depth d = BB_DEPTH_DEFAULT;
-    cr_assert_eq(bb_depth_parse(names[i], &d, NULL), BB_OK, "%s", names[i]);
+    cr_assert_eq(bb__depth_parse(names[i], &d, NULL), BB_OK, "%s", names[i]);
     cr_expect_eq(d, depths[i], "%s", names[i]);
     cr_expect_str_eq(bb__depth_name(d), names[i]);
   }
@@ -1335,9 +1335,9 @@ Test(image_files, depth_names_round_trip_and_others_are_refused) {
   cr_expect_str_eq(bb__depth_name((bb_depth)99), "unknown");
   bb_depth d = BB_DEPTH_16;
   bb_error err = {{0}};
-  cr_assert_eq(bb_depth_parse("32", &d, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__depth_parse("32", &d, &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "depth must be one of 8, 16, half, float (got '32')");
   cr_expect_eq(d, BB_DEPTH_16, "left untouched");
-  cr_expect_eq(bb_depth_parse("default", &d, NULL), BB_ERR_ARGUMENT);
-  cr_expect_eq(bb_depth_parse("HALF", &d, NULL), BB_ERR_ARGUMENT, "exact case");
+  cr_expect_eq(bb__depth_parse("default", &d, NULL), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb__depth_parse("HALF", &d, NULL), BB_ERR_ARGUMENT, "exact case");
 }

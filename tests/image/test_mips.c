@@ -227,7 +227,7 @@ Test(mips, files_hold_every_level) {
     for (int k = 0; k < count; k++) {
       bb_image got;
       int file_levels = 0;
-      cr_assert_eq(bb_image_read_mip(path, k, &got, NULL, &file_levels, &err), BB_OK,
+      cr_assert_eq(bb__image_read_mip(path, k, &got, NULL, &file_levels, &err), BB_OK,
                    "%s", err.message);
       cr_assert_eq(file_levels, count, "%s", path);
       cr_assert(got.width == levels[k].width && got.height == levels[k].height);
@@ -237,7 +237,7 @@ Test(mips, files_hold_every_level) {
       bb_image_free(&got);
     }
     bb_image extra;
-    cr_assert_eq(bb_image_read_mip(path, count, &extra, NULL, NULL, &err),
+    cr_assert_eq(bb__image_read_mip(path, count, &extra, NULL, NULL, &err),
                  BB_ERR_ARGUMENT);
     cr_assert(strstr(err.message, "no mip level"), "%s", err.message);
     unlink(path);

@@ -53,7 +53,7 @@ static bb_status call_read_info(const char *path, bb_error *err) {
 static bb_status call_read_mip(const char *path, bb_error *err) {
   bb_image img;
   int levels;
-  bb_status st = bb_image_read_mip(path, 0, &img, NULL, &levels, err);
+  bb_status st = bb__image_read_mip(path, 0, &img, NULL, &levels, err);
   bb_image_free(&img);
   return st;
 }
@@ -78,7 +78,7 @@ static const struct {
   child_call_fn fn;
 } READERS[] = {
     {"bb_image_read", call_read},       {"bb_image_read_info", call_read_info},
-    {"bb_image_read_mip", call_read_mip}, {"bb__image_frame_count", call_frame_count},
+    {"bb__image_read_mip", call_read_mip}, {"bb__image_frame_count", call_frame_count},
     {"bb__basis_load", call_basis_load}, {"bb_file_hash", call_file_hash},
 };
 
@@ -153,7 +153,7 @@ Test(untrusted, a_large_file_no_reader_knows_is_refused_at_once) {
   } readers[] = {
       {"bb_image_read", call_read},
       {"bb_image_read_info", call_read_info},
-      {"bb_image_read_mip", call_read_mip},
+      {"bb__image_read_mip", call_read_mip},
       {"bb__image_frame_count", call_frame_count},
       {"bb_height_file_read", call_height_file_read},
   };
@@ -400,7 +400,7 @@ Test(untrusted, a_link_planted_at_a_temporary_is_not_written_through) {
       written++;
       int count = 0;
       bb_image back;
-      cr_assert_eq(bb_image_read_mip(out, 3, &back, NULL, &count, &err), BB_OK, "%s",
+      cr_assert_eq(bb__image_read_mip(out, 3, &back, NULL, &count, &err), BB_OK, "%s",
                    err.message);
       cr_expect(count == 9 && back.width == 32 && back.height == 16);
       bb_image_free(&back);

@@ -1,9 +1,10 @@
-/* test_incremental.c: bb_file_hash, bb__bake_rayset_id and bb_output_check:
+/* test_incremental.c: bb_file_hash, bb__bake_rayset_id and bb__output_check:
  * an output is current only when its provenance, depth and mip levels are
  * what writing it now would give. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
+#include "job/bake_rows.h"
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "image/image_write.h"
@@ -135,7 +136,7 @@ static bb_output_state check(const char *path, const bb_provenance *p, bb_depth 
                              int mips, char *reason, size_t cap) {
   bb_output_state state = BB_OUTPUT_CURRENT;
   bb_error err;
-  cr_assert_eq(bb_output_check(path, p, depth, mips, &state, reason, cap, &err), BB_OK, "%s",
+  cr_assert_eq(bb__output_check(path, p, depth, mips, &state, reason, cap, &err), BB_OK, "%s",
                err.message);
   return state;
 }
@@ -265,11 +266,11 @@ Test(incremental, bad_arguments) {
   fixture_init(&f);
   bb_output_state state;
   bb_error err;
-  cr_expect_eq(bb_output_check(NULL, &f.p, BB_DEPTH_DEFAULT, 0, &state, NULL, 0, &err),
+  cr_expect_eq(bb__output_check(NULL, &f.p, BB_DEPTH_DEFAULT, 0, &state, NULL, 0, &err),
                BB_ERR_ARGUMENT);
-  cr_expect_eq(bb_output_check(tmp("x.png"), NULL, BB_DEPTH_DEFAULT, 0, &state, NULL, 0, &err),
+  cr_expect_eq(bb__output_check(tmp("x.png"), NULL, BB_DEPTH_DEFAULT, 0, &state, NULL, 0, &err),
                BB_ERR_ARGUMENT);
-  cr_expect_eq(bb_output_check(tmp("x.png"), &f.p, (bb_depth)9, 0, &state, NULL, 0, &err),
+  cr_expect_eq(bb__output_check(tmp("x.png"), &f.p, (bb_depth)9, 0, &state, NULL, 0, &err),
                BB_ERR_ARGUMENT);
 }
 
@@ -296,7 +297,7 @@ Test(incremental, an_input_that_is_no_image_is_not_current) {
   harness_write(tmp("in/good.png"), &h, BB_DEPTH_8, BB_RANGE_UNIT);
   bb_image_free(&h);
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.out_dir = tmp("out");
   o.maps = BB_MAP_BIT(BB_MAP_NORMAL);

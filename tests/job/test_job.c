@@ -3,6 +3,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
 
+#include "job/bake_rows.h"
 #include "bumpbake.h"
 #include "cli_harness.h"
 #include "bake/bake_internal.h"
@@ -32,7 +33,7 @@ static const char *height_file(void) {
 Test(job, slope_lit_light_is_checked_when_planned) {
   const char *input = height_file();
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.slope_path = tmp("s.png");
   o.slope_lit = 1;
@@ -67,7 +68,7 @@ Test(job, slope_lit_light_is_checked_when_planned) {
  * their defaults, in --help's order, spelled as typed. */
 Test(job, command_text_spells_the_options_as_typed) {
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 16.0f;
   o.out_dir = "out";
   o.maps = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_AO);
@@ -91,7 +92,7 @@ Test(job, command_text_spells_the_options_as_typed) {
  * one, a name with a blank or a ';' is one word, and runs nothing. */
 Test(job, command_text_is_quoted_for_a_shell) {
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 8.0f;
   o.paths[BB_MAP_NORMAL] = "out dir/n.png";
   o.brightness_file = "it's.png";
@@ -105,7 +106,7 @@ Test(job, command_text_is_quoted_for_a_shell) {
  * spelled as the CLI reads them back; threads are not recorded. */
 Test(job, command_text_spells_the_texture_options) {
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 64.0f;
   o.paths[BB_MAP_SSBUMP] = "m/rock-ssbump.vtf";
   o.texture.threads = 1;
@@ -133,7 +134,7 @@ Test(job, command_text_spells_the_texture_options) {
 Test(job, bake_item_keeps_the_maps_run_item_writes) {
   const char *input = height_file();
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
   o.paths[BB_MAP_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
@@ -175,7 +176,7 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
 Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   const char *input = height_file();
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
@@ -226,7 +227,7 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
 static bb_bake_result bake_with(const char *input, int slices, const char *basis,
                                 bb_bake_context *context) {
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.slices = slices;
   o.bake.bounce_albedo = 0.5; /* the bounce reads the ray set too */
@@ -301,7 +302,7 @@ static int cancel_at_once(void *user, long done, long total) {
 Test(job, bake_item_cancelled_keeps_nothing) {
   const char *input = height_file();
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
@@ -378,7 +379,7 @@ Test(job, block_compression_is_a_stage_of_its_own) {
   const char *input = height_file();
   for (int textures = 1; textures >= 0; textures--) {
     bb_job_options o;
-    bb_job_options_init(&o);
+    bb__job_options_init(&o);
     o.bake.height_scale = 4.0f;
     o.bake.rays = 16;
     o.paths[BB_MAP_SSBUMP] = textures ? tmp("s.vtf") : tmp("s.png");
@@ -428,7 +429,7 @@ Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
   const char *input = tmp("edited.png");
   bump_file(input, 48, 40, 10, 10);
   bb_job_options o;
-  bb_job_options_init(&o);
+  bb__job_options_init(&o);
   o.bake.height_scale = 16.0f;
   o.paths[BB_MAP_SSBUMP] = tmp("e_ssbump.exr");
   o.force = 1;

@@ -3,6 +3,7 @@
  * recorded exactly when the kind's pixels change; and the rule followed by
  * the writer, the up-to-date check and the diff, also against a text
  * written before the rule (every key recorded). */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "files/provenance.h"
@@ -326,7 +327,7 @@ Test(map_records, a_file_with_every_key_is_current_when_only_those_differ) {
       "x",    "h.png", 0x1234, "normal", &o, BB_CHANNEL_AUTO, "bb-horizon-v1:a3:p3:hl2",
       0xfeed, NULL};
   bb_output_state state;
-  cr_assert_eq(bb_output_check(path, &want, BB_DEPTH_DEFAULT, 0, &state, reason,
+  cr_assert_eq(bb__output_check(path, &want, BB_DEPTH_DEFAULT, 0, &state, reason,
                                sizeof reason, NULL),
                BB_OK);
   if (strcmp(BB_VERSION_STRING, "0.4.0") == 0)
@@ -335,7 +336,7 @@ Test(map_records, a_file_with_every_key_is_current_when_only_those_differ) {
     cr_expect(state == BB_OUTPUT_STALE && strstr(reason, "bumpbake_version"), "%s",
               reason);
   o.normal_filter = BB_NORMAL_VALVE;
-  cr_assert_eq(bb_output_check(path, &want, BB_DEPTH_DEFAULT, 0, &state, reason,
+  cr_assert_eq(bb__output_check(path, &want, BB_DEPTH_DEFAULT, 0, &state, reason,
                                sizeof reason, NULL),
                BB_OK);
   cr_expect_eq(state, BB_OUTPUT_STALE);

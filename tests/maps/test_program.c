@@ -64,17 +64,17 @@ static void free_library(library *lib) {
 
 /* Runs text against lib; fails the test on any error. */
 static bb_image run(library *lib, const char *text, int *is_normal) {
-  bb_program *p = NULL;
+  bb__program *p = NULL;
   bb_error err;
-  cr_assert_eq(bb_program_parse(text, &p, &err), BB_OK, "%s: %s", text, err.message);
-  bb_program_options o;
-  bb_program_options_init(&o);
+  cr_assert_eq(bb__program_parse(text, &p, &err), BB_OK, "%s: %s", text, err.message);
+  bb__program_options o;
+  bb__program_options_init(&o);
   o.loader = load_from;
   o.loader_user = lib;
   bb_image out;
-  cr_assert_eq(bb_program_run(p, &o, &out, is_normal, &err), BB_OK, "%s: %s", text,
+  cr_assert_eq(bb__program_run(p, &o, &out, is_normal, &err), BB_OK, "%s: %s", text,
                err.message);
-  bb_program_free(p);
+  bb__program_free(p);
   return out;
 }
 
@@ -319,9 +319,9 @@ Test(program, syntax_errors_give_the_column) {
        "makeIntensity, makeAlpha, and the image _flat)"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    bb_program *p = (bb_program *)1;
+    bb__program *p = (bb__program *)1;
     bb_error err = {{0}};
-    cr_expect_eq(bb_program_parse(cases[i].text, &p, &err), BB_ERR_ARGUMENT, "%s",
+    cr_expect_eq(bb__program_parse(cases[i].text, &p, &err), BB_ERR_ARGUMENT, "%s",
                  cases[i].text);
     cr_expect_null(p);
     cr_expect(strstr(err.message, cases[i].message_part), "'%s': '%s' lacks '%s'",
@@ -337,9 +337,9 @@ Test(program, nesting_is_bounded) {
   strcat(text, "a.tga");
   for (int i = 0; i < 70; i++)
     strcat(text, ")");
-  bb_program *p = NULL;
+  bb__program *p = NULL;
   bb_error err;
-  cr_assert_eq(bb_program_parse(text, &p, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__program_parse(text, &p, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "at most 64"), "%s", err.message);
 }
 
@@ -357,21 +357,21 @@ Test(program, a_path_too_long_is_an_error_not_cut) {
   library lib = {0};
   float one[1] = {0.5f};
   add_image(&lib, cut, 1, 1, 1, one);
-  bb_program *p = NULL;
+  bb__program *p = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_program_parse("invertColor(h.png.missing)", &p, &err), BB_OK);
-  bb_program_options o;
-  bb_program_options_init(&o);
+  cr_assert_eq(bb__program_parse("invertColor(h.png.missing)", &p, &err), BB_OK);
+  bb__program_options o;
+  bb__program_options_init(&o);
   o.loader = load_from;
   o.loader_user = &lib;
   o.base_dir = base;
   bb_image out;
   int is_normal;
-  cr_assert_eq(bb_program_run(p, &o, &out, &is_normal, &err), BB_ERR_ARGUMENT, "read %s",
+  cr_assert_eq(bb__program_run(p, &o, &out, &is_normal, &err), BB_ERR_ARGUMENT, "read %s",
                lib.last_path);
   cr_assert(strstr(err.message, "h.png.missing: path too long"), "%s", err.message);
   cr_assert_null(out.pixels);
-  bb_program_free(p);
+  bb__program_free(p);
   free_library(&lib);
 }
 
@@ -379,37 +379,37 @@ Test(program, names_quotes_base_directory_and_missing_files) {
   library lib = {0};
   float one[1] = {0.5f};
   add_image(&lib, "base/a b,c.png", 1, 1, 1, one);
-  bb_program *p = NULL;
+  bb__program *p = NULL;
   bb_error err;
-  cr_assert_eq(bb_program_parse("INVERTCOLOR( \"a b,c.png\" )", &p, &err), BB_OK, "%s",
+  cr_assert_eq(bb__program_parse("INVERTCOLOR( \"a b,c.png\" )", &p, &err), BB_OK, "%s",
                err.message);
-  bb_program_options o;
-  bb_program_options_init(&o);
+  bb__program_options o;
+  bb__program_options_init(&o);
   o.loader = load_from;
   o.loader_user = &lib;
   o.base_dir = "base";
   bb_image out;
   int is_normal;
-  cr_assert_eq(bb_program_run(p, &o, &out, &is_normal, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__program_run(p, &o, &out, &is_normal, &err), BB_OK, "%s", err.message);
   cr_assert_float_eq(out.pixels[0], 0.5, 1e-7);
   cr_assert_eq(out.pixels[3], 1.0f, "no alpha reads as opaque");
   bb_image_free(&out);
-  bb_program_free(p);
+  bb__program_free(p);
 
   /* The default loader reads files; a missing one is named. */
-  cr_assert_eq(bb_program_parse("heightmap(nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
-  cr_assert_eq(bb_program_run(p, NULL, &out, &is_normal, &err), BB_ERR_IO);
+  cr_assert_eq(bb__program_parse("heightmap(nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
+  cr_assert_eq(bb__program_run(p, NULL, &out, &is_normal, &err), BB_ERR_IO);
   cr_assert(strstr(err.message, "nonexistent/h_bmp.tga"), "%s", err.message);
   cr_assert_null(out.pixels);
-  bb_program_free(p);
+  bb__program_free(p);
   /* An absolute name is refused unless allowed; allowed, it is read. */
-  cr_assert_eq(bb_program_parse("heightmap(/nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
-  cr_assert_eq(bb_program_run(p, NULL, &out, &is_normal, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__program_parse("heightmap(/nonexistent/h_bmp.tga, 4)", &p, NULL), BB_OK);
+  cr_assert_eq(bb__program_run(p, NULL, &out, &is_normal, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "absolute"), "%s", err.message);
-  bb_program_options_init(&o);
+  bb__program_options_init(&o);
   o.allow_outside_base = 1;
-  cr_assert_eq(bb_program_run(p, &o, &out, &is_normal, &err), BB_ERR_IO);
-  bb_program_free(p);
+  cr_assert_eq(bb__program_run(p, &o, &out, &is_normal, &err), BB_ERR_IO);
+  bb__program_free(p);
   free_library(&lib);
 }
 

@@ -1,5 +1,6 @@
-/* test_valve.c: Valve's RGBA packing (bb_valve_pack) and detail variant
- * (bb_valve_detail). */
+/* test_valve.c: Valve's RGBA packing (bb__valve_pack) and detail variant
+ * (bb__valve_detail). */
+#include "maps/maps_internal.h"
 #include "bumpbake.h"
 #include "bake/bake_internal.h"
 
@@ -43,9 +44,9 @@ static void expect_texel(const bb_image *img, int x, int y, const float *want) {
 Test(valve, pack_ssbump_with_height_in_alpha_by_default) {
   bb_bake_result r = hand_result();
   bb_valve_options o;
-  bb_valve_options_init(&o);
+  bb__valve_options_init(&o);
   bb_image out = {0};
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, NULL), BB_OK);
   cr_assert(out.width == 3 && out.height == 2 && out.channels == 4);
   expect_texel(&out, 0, 0, (float[]){0.1f, 0.2f, 0.3f, 0.7f});
   expect_texel(&out, 1, 1, (float[]){0.5f, 0.25f, 1.0f, 0.125f});
@@ -57,7 +58,7 @@ Test(valve, pack_normal_map_encoded_and_ao_in_alpha) {
   bb_bake_result r = hand_result();
   bb_valve_options o = {.normal_map = 1, .ao_in_alpha = 1};
   bb_image out = {0};
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, NULL), BB_OK);
   /* 0.5 + 0.5 N: (0, 0, 1) -> (0.5, 0.5, 1); (-1, 0.5, 0) -> (0, 0.75, 0.5). */
   expect_texel(&out, 0, 0, (float[]){0.5f, 0.5f, 1.0f, 0.9f});
   expect_texel(&out, 1, 1, (float[]){0.0f, 0.75f, 0.5f, 0.375f});
@@ -70,9 +71,9 @@ Test(valve, pack_takes_three_of_four_ssbump_channels) {
   bb_image_free(&r.ssbump);
   r.ssbump = filled(3, 2, 4, (float[]){0.1f, 0.2f, 0.3f, 0.4f}); /* hl2+z */
   bb_valve_options o;
-  bb_valve_options_init(&o);
+  bb__valve_options_init(&o);
   bb_image out = {0};
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, NULL), BB_OK);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, NULL), BB_OK);
   expect_texel(&out, 2, 1, (float[]){0.1f, 0.2f, 0.3f, 0.7f});
   bb_image_free(&out);
   bb_bake_result_free(&r);
@@ -85,18 +86,18 @@ Test(valve, pack_refuses_what_was_not_baked) {
   bb_valve_options o = {.normal_map = 1, .ao_in_alpha = 1};
   bb_image out = {0};
   bb_error err = {{0}};
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "ao"), "%s", err.message);
   cr_assert_null(out.pixels);
   o.ao_in_alpha = 0, o.normal_map = 0;
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "ssbump"), "%s", err.message);
   o.normal_map = 1; /* -n with the height in alpha needs no trace */
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, &err), BB_OK, "%s", err.message);
   bb_image_free(&out);
   bb_image_free(&r.filtered);
   r.filtered = filled(2, 2, 1, (float[]){0.5f});
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, &err), BB_ERR_SIZE);
   bb_bake_result_free(&r);
 }
 
@@ -110,9 +111,9 @@ Test(valve, pack_of_a_real_flat_bake) {
   bb_error err = {{0}};
   cr_assert_eq(bb_bake(&height, &bo, &r, &err), BB_OK, "%s", err.message);
   bb_valve_options o;
-  bb_valve_options_init(&o);
+  bb__valve_options_init(&o);
   bb_image out = {0};
-  cr_assert_eq(bb_valve_pack(&r, &o, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__valve_pack(&r, &o, &out, &err), BB_OK, "%s", err.message);
   const float flat = (float)(1.0 / sqrt(3.0));
   expect_texel(&out, 3, 5, (float[]){flat, flat, flat, 0.5f});
   bb_image_free(&out);
@@ -134,7 +135,7 @@ Test(valve, detail_of_mid_grey_flat_is_the_mod2x_neutral_half) {
   bb_image grey = filled(6, 6, 2, (float[]){0.5f, 0.8f}); /* grey + alpha */
   bb_image height = filled(6, 6, 1, (float[]){0.8f});
   bb_smooth_options s = smoothing();
-  cr_assert_eq(bb_valve_detail(&rgba, &grey, &height, &s, NULL), BB_OK);
+  cr_assert_eq(bb__valve_detail(&rgba, &grey, &height, &s, NULL), BB_OK);
   expect_texel(&rgba, 2, 4, (float[]){0.5f, 0.5f, 0.5f, 0.3f});
   bb_image_free(&rgba);
   bb_image_free(&grey);
@@ -147,7 +148,7 @@ Test(valve, detail_factor_is_the_colour_sum_over_sqrt3) {
       filled(5, 4, 4, (float[]){0.1f, 0.3f, 0.8f, 0.0f}); /* alpha ignored */
   bb_image height = filled(5, 4, 1, (float[]){0.0f});
   bb_smooth_options s = smoothing();
-  cr_assert_eq(bb_valve_detail(&rgba, &colour, &height, &s, NULL), BB_OK);
+  cr_assert_eq(bb__valve_detail(&rgba, &colour, &height, &s, NULL), BB_OK);
   const float f = 1.2f / sqrtf(3.0f);
   expect_texel(&rgba, 4, 3, (float[]){0.2f * f, 0.4f * f, 0.6f * f, 1.0f});
   bb_image_free(&rgba);
@@ -166,7 +167,7 @@ Test(valve, detail_colour_is_smoothed_with_the_height_edges) {
     for (int x = 8; x < 16; x++)
       *bb_image_texel(&colour, x, y) = 0.6f, *bb_image_texel(&height, x, y) = 1.0f;
   bb_smooth_options s = smoothing();
-  cr_assert_eq(bb_valve_detail(&rgba, &colour, &height, &s, NULL), BB_OK);
+  cr_assert_eq(bb__valve_detail(&rgba, &colour, &height, &s, NULL), BB_OK);
   const float lo = 0.6f / sqrtf(3.0f), hi = 1.8f / sqrtf(3.0f);
   expect_texel(&rgba, 7, 5, (float[]){lo, lo, lo, 1.0f});
   expect_texel(&rgba, 8, 5, (float[]){hi, hi, hi, 1.0f});
@@ -181,9 +182,9 @@ Test(valve, detail_refuses_mismatched_images) {
   bb_image height = filled(4, 4, 1, (float[]){0});
   bb_smooth_options s = smoothing();
   bb_error err = {{0}};
-  cr_assert_eq(bb_valve_detail(&rgba, &colour, &height, &s, &err), BB_ERR_SIZE);
-  cr_assert_eq(bb_valve_detail(&rgba, &height, &colour, &s, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_valve_detail(&rgba, NULL, &height, &s, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__valve_detail(&rgba, &colour, &height, &s, &err), BB_ERR_SIZE);
+  cr_assert_eq(bb__valve_detail(&rgba, &height, &colour, &s, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__valve_detail(&rgba, NULL, &height, &s, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(*bb_image_texel(&rgba, 0, 0), 1.0f, "left alone on error");
   bb_image_free(&rgba);
   bb_image_free(&colour);

@@ -162,12 +162,12 @@ static void expect_estimator(const bb_renderbump_result *r, bb_normal_filter mat
   double max_deg, mean_deg, max_other, mean_other;
   angle_to_estimator(r, match, &max_deg, &mean_deg);
   angle_to_estimator(r, other, &max_other, &mean_other);
-  cr_assert_lt(max_deg, max_bound, "%s: max %.3f degrees", bb_normal_filter_name(match),
+  cr_assert_lt(max_deg, max_bound, "%s: max %.3f degrees", bb__normal_filter_name(match),
                max_deg);
-  cr_assert_lt(mean_deg, mean_bound, "%s: mean %.3f degrees", bb_normal_filter_name(match),
+  cr_assert_lt(mean_deg, mean_bound, "%s: mean %.3f degrees", bb__normal_filter_name(match),
                mean_deg);
-  cr_assert_gt(mean_other, 3.0 * mean_deg, "%s %.3f vs %s %.3f", bb_normal_filter_name(other),
-               mean_other, bb_normal_filter_name(match), mean_deg);
+  cr_assert_gt(mean_other, 3.0 * mean_deg, "%s %.3f vs %s %.3f", bb__normal_filter_name(other),
+               mean_other, bb__normal_filter_name(match), mean_deg);
 }
 
 /* Face normals, texels on the cells: each texel averages the two triangles
@@ -454,7 +454,7 @@ Test(renderbump, axis_names_and_frames) {
     bb_axis parsed;
     cr_assert_eq(bb__axis_parse(names[a], &parsed, NULL), 0);
     cr_assert_eq((int)parsed, a);
-    cr_assert_str_eq(bb_axis_name((bb_axis)a), names[a]);
+    cr_assert_str_eq(bb__axis_name((bb_axis)a), names[a]);
     double r[3], u[3], o[3];
     bb__axis_frame((bb_axis)a, r, u, o);
     /* right x up = out: a right-handed frame, so no view is a mirror. */
@@ -504,8 +504,8 @@ Test(renderbump, every_axis_sees_the_turned_model_alike) {
     o.axis = (bb_axis)a;
     bb_renderbump_result rt;
     render(&t, &o, &rt);
-    cr_assert(same_pixels(&rt.normal, &base.normal), "axis %s", bb_axis_name((bb_axis)a));
-    cr_assert(same_pixels(&rt.height, &base.height), "axis %s", bb_axis_name((bb_axis)a));
+    cr_assert(same_pixels(&rt.normal, &base.normal), "axis %s", bb__axis_name((bb_axis)a));
+    cr_assert(same_pixels(&rt.height, &base.height), "axis %s", bb__axis_name((bb_axis)a));
     bb_renderbump_result_free(&rt);
     bb__mesh_free(&t);
   }

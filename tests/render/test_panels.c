@@ -254,7 +254,7 @@ Test(panels, compare_is_four_renders) {
   cr_assert_eq(bb_bake(&h, &bo, &r, NULL), BB_OK);
   bb_render_maps m = {&r.normal, &r.ssbump, &r.ao, &r.bent, NULL, NULL};
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   bb_panel_layout l;
   bb__panel_layout_init(&l);
   bb_image out;

@@ -143,7 +143,7 @@ Test(relief, the_preview_evaluates_the_shader_formulas) {
   scene s;
   scene_make(&s, 6.0f);
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   o.view = 1, o.view_azimuth = 300.0, o.view_elevation = 25.0;
   o.relief = 1, o.relief_height = &s.height, o.relief_depth = 6.0;
   o.static_light = 1;
@@ -180,7 +180,7 @@ Test(relief, overhead_view_is_the_plain_render) {
   scene s;
   scene_make(&s, 6.0f);
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   o.specular_exponent = 16.0;
   bb_image plain = render(&s.maps, &o);
   o.view = 1, o.view_azimuth = 270.0, o.view_elevation = 90.0;
@@ -206,7 +206,7 @@ Test(relief, same_bits_on_any_thread_count_and_cropped) {
   scene s;
   scene_make(&s, 6.0f);
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   o.view = 1, o.view_azimuth = 200.0, o.view_elevation = 15.0;
   o.relief = 1, o.relief_height = &s.height, o.relief_depth = 6.0;
   o.tile_x = 2;
@@ -233,7 +233,7 @@ Test(relief, refuses_what_it_cannot_draw) {
   scene s;
   scene_make(&s, 6.0f);
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   bb_image out;
   bb_error err;
   o.relief = 1, o.relief_height = &s.height, o.relief_depth = 6.0;

@@ -99,7 +99,7 @@ static void assert_uniform(const bb_image *img, const double rgb[3], double tol,
 }
 
 static void options(bb_render_options *o, bb_render_mode mode, double az, double el) {
-  bb_render_options_init(o);
+  bb__render_options_init(o);
   o->mode = mode;
   o->light_azimuth = az;
   o->light_elevation = el;
@@ -456,7 +456,7 @@ Test(render, bad_arguments_are_refused) {
   cr_assert_eq(bb_image_alloc(&s1, 4, 4, 1, NULL), BB_OK);
   cr_assert_eq(bb_image_alloc(&ao_small, 3, 4, 1, NULL), BB_OK);
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   bb_error err = {{0}};
 
   bb_render_maps m = {&n3, NULL, NULL, NULL, NULL, NULL};
@@ -540,7 +540,7 @@ Test(render, a_light_too_bright_for_a_float_says_so) {
 
 Test(render, describe_names_every_option) {
   bb_render_options o;
-  bb_render_options_init(&o);
+  bb__render_options_init(&o);
   char *text = bb__render_options_describe(&o);
   cr_assert_not_null(text);
   cr_assert_str_eq(

@@ -20,6 +20,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "image/oiio.h"
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
@@ -146,7 +147,7 @@ Test(dds, round_trip_through_the_reader) {
     for (int k = 0; k < count; k++) {
       bb_image dec = {0};
       int levels = 0;
-      cr_assert_eq(bb_image_read_mip(path, k, &dec, NULL, &levels, &err), BB_OK,
+      cr_assert_eq(bb__image_read_mip(path, k, &dec, NULL, &levels, &err), BB_OK,
                    "%s level %d: %s", t->golden, k, err.message);
       cr_assert_eq(levels, count, "%s: %d levels in the file, %d in the chain", t->golden,
                    levels, count);
@@ -385,7 +386,7 @@ Test(dds, non_power_of_two_mips) {
   for (int k = 0; k < 7; k++) {
     bb_image dec = {0};
     int levels = 0;
-    cr_assert_eq(bb_image_read_mip(path, k, &dec, NULL, &levels, &err), BB_OK, "%s",
+    cr_assert_eq(bb__image_read_mip(path, k, &dec, NULL, &levels, &err), BB_OK, "%s",
                  err.message);
     cr_assert_eq(levels, 7);
     cr_assert(dec.width == want[k][0] && dec.height == want[k][1], "level %d: %d x %d", k,

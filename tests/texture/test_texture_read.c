@@ -3,7 +3,7 @@
  * bumpbake writes).
  *
  * - Every format and version bumpbake writes, with and without mips: each
- *   level read (bb_image_read_mip) against the tests' own decoding of the
+ *   level read (bb__image_read_mip) against the tests' own decoding of the
  *   same bytes (texture_oracle.h, exact arithmetic): texel formats bit for
  *   bit (8-bit codes / 255, half floats), block formats too (the reader
  *   decodes blocks by the same exact rules).
@@ -116,7 +116,7 @@ Test(texture_read, vtf_every_format_version_and_level) {
           bb_image got;
           bb_image_info info;
           int levels = 0;
-          cr_assert_eq(bb_image_read_mip(path, level, &got, &info, &levels, &err), BB_OK,
+          cr_assert_eq(bb__image_read_mip(path, level, &got, &info, &levels, &err), BB_OK,
                        "format %d 7.%d mips %d level %d: %s", t->code, version, mips, level,
                        err.message);
           cr_assert_eq(levels, want_levels);
@@ -149,7 +149,7 @@ Test(texture_read, vtf_every_format_version_and_level) {
         /* A level past the last is an argument error, the count still told. */
         bb_image none;
         int levels = 0;
-        cr_assert_eq(bb_image_read_mip(path, want_levels, &none, NULL, &levels, &err),
+        cr_assert_eq(bb__image_read_mip(path, want_levels, &none, NULL, &levels, &err),
                      BB_ERR_ARGUMENT);
         cr_assert_eq(levels, want_levels);
         cr_assert_null(none.pixels);
@@ -203,7 +203,7 @@ Test(texture_read, dds_with_a_dx10_header) {
       bb_image got;
       bb_image_info info;
       int levels = 0;
-      cr_assert_eq(bb_image_read_mip(path, level, &got, &info, &levels, &err), BB_OK, "%s",
+      cr_assert_eq(bb__image_read_mip(path, level, &got, &info, &levels, &err), BB_OK, "%s",
                    err.message);
       cr_assert_eq(levels, count);
       cr_assert_str_eq(info.format_name, "dds");
@@ -239,7 +239,7 @@ static void expect_refused(const char *path, const char *what) {
   cr_assert_not_null(strstr(err.message, path), "%s: %s", what, err.message);
   cr_assert_null(strchr(err.message, '\n'), "%s: %s", what, err.message);
   int levels = 0;
-  st = bb_image_read_mip(path, 0, &img, NULL, &levels, &err);
+  st = bb__image_read_mip(path, 0, &img, NULL, &levels, &err);
   cr_assert_neq(st, BB_OK, "%s: read_mip", what);
   cr_assert_not_null(strstr(err.message, path), "%s: %s", what, err.message);
 }
@@ -438,7 +438,7 @@ Test(texture_read, legacy_dds_mip_count_past_its_size) {
   unsigned char *f = file_bytes(path, &size);
   int levels = 0;
   bb_image level;
-  cr_assert_eq(bb_image_read_mip(path, 4, &level, NULL, &levels, &err), BB_OK, "%s",
+  cr_assert_eq(bb__image_read_mip(path, 4, &level, NULL, &levels, &err), BB_OK, "%s",
                err.message);
   cr_assert(levels == 5 && level.width == 1 && level.height == 1);
   bb_image_free(&level);
@@ -499,7 +499,7 @@ Test(texture_read, frame_0_of_every_level_of_an_animated_vtf) {
         bb_image img;
         int levels = 0;
         bb_error err = {{0}};
-        cr_assert_eq(bb_image_read_mip(path, k, &img, NULL, &levels, &err), BB_OK,
+        cr_assert_eq(bb__image_read_mip(path, k, &img, NULL, &levels, &err), BB_OK,
                      "7.%d, %d frames, level %d: %s", minor, frames, k, err.message);
         cr_assert(levels == 4 && img.width == 8 >> k && img.channels == 3);
         for (int i = 0; i < img.width * img.height; i++) {

@@ -653,12 +653,12 @@ Test(vtf, usage_errors) {
   cr_assert_eq(bb__texture_write(in_scratch_dir("tiny.vtf"), &tiny, &o, NULL), BB_OK);
   cr_assert_eq(bb__texture_write(in_scratch_dir("ao.vtf"), &ao, NULL, NULL), BB_OK);
   bb_texture_format fmt;
-  cr_assert_eq(bb_texture_format_parse("DXT5", &fmt, NULL), BB_OK);
+  cr_assert_eq(bb__texture_format_parse("DXT5", &fmt, NULL), BB_OK);
   cr_assert_eq(fmt, BB_TEXTURE_FORMAT_BC3);
-  cr_assert_eq(bb_texture_format_parse("rgba16161616f", &fmt, NULL), BB_OK);
+  cr_assert_eq(bb__texture_format_parse("rgba16161616f", &fmt, NULL), BB_OK);
   cr_assert_eq(fmt, BB_TEXTURE_FORMAT_RGBA16F);
   bb_error err = {{0}};
-  cr_assert_eq(bb_texture_format_parse("dxt9", &fmt, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__texture_format_parse("dxt9", &fmt, &err), BB_ERR_ARGUMENT);
   cr_assert_not_null(strstr(err.message, "bc1"), "%s", err.message);
   cr_assert(bb__path_is_texture_format("a/B.VTF") && bb__path_is_texture_format("x.dds") &&
             !bb__path_is_texture_format("x.vtf.png") && !bb__path_is_texture_format("vtf"));
@@ -827,26 +827,26 @@ Test(vtf, version_and_flags_parse_as_the_options_take_them) {
   const char *good[] = {"7.2", "7.5", "3", "4"};
   const int want[] = {2, 5, 3, 4};
   for (int k = 0; k < 4; k++) {
-    cr_expect_eq(bb_vtf_version_parse(good[k], &minor, &err), BB_OK, "%s", good[k]);
+    cr_expect_eq(bb__vtf_version_parse(good[k], &minor, &err), BB_OK, "%s", good[k]);
     cr_expect_eq(minor, want[k], "%s", good[k]);
   }
   const char *bad[] = {"7.9", "7.1", "8.2", "", "7.", "3x", "seven", " 3", "+3", NULL};
   for (int k = 0; k < 10; k++) {
-    cr_expect_eq(bb_vtf_version_parse(bad[k], &minor, &err), BB_ERR_ARGUMENT, "%s",
+    cr_expect_eq(bb__vtf_version_parse(bad[k], &minor, &err), BB_ERR_ARGUMENT, "%s",
                  bad[k] ? bad[k] : "NULL");
     cr_expect(strstr(err.message, "VTF version must be 7.2, 7.3, 7.4 or 7.5"), "%s", err.message);
   }
   uint32_t flags = 0;
-  cr_expect_eq(bb_vtf_flags_parse("0x08000000", &flags, &err), BB_OK);
+  cr_expect_eq(bb__vtf_flags_parse("0x08000000", &flags, &err), BB_OK);
   cr_expect_eq(flags, BB_VTF_FLAG_SSBUMP);
-  cr_expect_eq(bb_vtf_flags_parse("12", &flags, &err), BB_OK);
+  cr_expect_eq(bb__vtf_flags_parse("12", &flags, &err), BB_OK);
   cr_expect_eq(flags, 12u);
-  cr_expect_eq(bb_vtf_flags_parse("010", &flags, &err), BB_OK, "octal, as strtoul reads it");
+  cr_expect_eq(bb__vtf_flags_parse("010", &flags, &err), BB_OK, "octal, as strtoul reads it");
   cr_expect_eq(flags, 8u);
-  cr_expect_eq(bb_vtf_flags_parse("0xffffffff", &flags, &err), BB_OK);
+  cr_expect_eq(bb__vtf_flags_parse("0xffffffff", &flags, &err), BB_OK);
   const char *bad_flags[] = {"-1", " -1", "+4", "0x100000000", "4k", "", NULL};
   for (int k = 0; k < 7; k++) {
-    cr_expect_eq(bb_vtf_flags_parse(bad_flags[k], &flags, &err), BB_ERR_ARGUMENT, "%s",
+    cr_expect_eq(bb__vtf_flags_parse(bad_flags[k], &flags, &err), BB_ERR_ARGUMENT, "%s",
                  bad_flags[k] ? bad_flags[k] : "NULL");
     cr_expect(strstr(err.message, "VTF flags must be a 32-bit number"), "%s", err.message);
   }

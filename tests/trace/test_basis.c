@@ -1,6 +1,7 @@
 /* test_basis.c: bases (named, dirs:N, a caller's vectors, basis files) and
  * what every stage that reads one makes of it: the lobes' totals, the
  * trace's channels, derive and the whole bake. */
+#include "maps/maps_internal.h"
 #include "trace/rayset.h"
 #include <criterion/criterion.h>
 
@@ -554,7 +555,7 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   cr_assert_eq(bb_image_alloc(&s6, 2, 2, 6, NULL), BB_OK);
   cr_assert_eq(bb_ssbump_to_normal(&s6, BB_MAP_SSBUMP, &n, NULL), BB_ERR_ARGUMENT);
   bb_render_options ro;
-  bb_render_options_init(&ro);
+  bb__render_options_init(&ro);
   bb_render_maps maps = {NULL, &s6, NULL, NULL, NULL, NULL};
   bb_image out = {0};
   bb_error err;
@@ -574,11 +575,11 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   bb_bake_options o = options(&mine, 1.0f, 4);
   bb_bake_result r = harness_bake(&h, &o);
   bb_valve_options vo;
-  bb_valve_options_init(&vo);
-  cr_assert_eq(bb_valve_pack(&r, &vo, &out, &err), BB_ERR_ARGUMENT);
+  bb__valve_options_init(&vo);
+  cr_assert_eq(bb__valve_pack(&r, &vo, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "--basis vectors:"), "%s", err.message);
   vo.normal_map = 1; /* the normal map is the same in any basis */
-  cr_assert_eq(bb_valve_pack(&r, &vo, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__valve_pack(&r, &vo, &out, &err), BB_OK, "%s", err.message);
   bb_image_free(&out);
   bb_bake_result_free(&r);
   bb_image_free(&h);
