@@ -342,6 +342,7 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 # finds the Python package (src/cli/cluster.c); build/bumpbake finds its
 # source tree instead. Relinked when PYTHONDIR changes.
 INSTALL_BIN := $(BUILD)/install/bumpbake
+INSTALL_LIB := $(BUILD)/install/libbumpbake.a
 $(BUILD)/install/dirs.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(PYTHONDIR)' | cmp -s - $@ || echo '$(PYTHONDIR)' >$@
@@ -354,7 +355,6 @@ $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
 # The installed archive: the build's with the module's folder LIBDIR
 # (src/image/oiio_module_dir.c), for the installed program and for programs
 # linking it (pkg-config --static). Remade when LIBDIR changes.
-INSTALL_LIB := $(BUILD)/install/libbumpbake.a
 $(BUILD)/install/libdir.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LIBDIR)' | cmp -s - $@ || echo '$(LIBDIR)' >$@

@@ -141,8 +141,8 @@ if [ -f "$module" ]; then
     pass "the installed bumpbake reads an image through lib/$(basename "$module")" ||
     { cat "$tmp/info.out" >&2; fail "the installed bumpbake info of a PNG"; }
   mv "$module" "$module.aside"
-  "$prefix/bin/bumpbake" info fixtures/bricks_128x64.png >/dev/null 2>"$tmp/info.err"
-  code=$?
+  code=0
+  "$prefix/bin/bumpbake" info fixtures/bricks_128x64.png >/dev/null 2>"$tmp/info.err" || code=$?
   mv "$module.aside" "$module"
   if [ "$code" -ne 0 ] && [ "$(wc -l <"$tmp/info.err")" -eq 1 ] && grep -qF "$module" "$tmp/info.err"; then
     pass "without its module the installed bumpbake says so in one line: $(cat "$tmp/info.err")"
