@@ -143,12 +143,6 @@ const bb__oiio_table *bb__oiio_module(void) {
 
 bb_status bb__oiio_failed(bb_error *err) { return bb__fail(err, BB_ERR_IO, "%s", failure); }
 
-#define BB__OIIO_WRAPPER(ret, name, params, args, fallback)                                   \
-  ret name params {                                                                           \
-    const bb__oiio_table *t = bb__oiio_module();                                              \
-    if (!t) fallback;                                                                         \
-    return t->name args;                                                                      \
-  }
 BB__OIIO_IMAGE_CALLS(BB__OIIO_WRAPPER)
 
 void bb__oiio_gif_abort(bb_animation *a) {

@@ -182,6 +182,15 @@ typedef struct bb__oiio_table {
   void (*bb__oiio_gif_abort)(bb_animation *a); /* a exists: the module is loaded */
 } bb__oiio_table;
 
+/* The library's definition of a call of the lists: the module's, loaded on
+ * first use, or the list's fallback when it cannot be loaded. */
+#define BB__OIIO_WRAPPER(ret, name, params, args, fallback)                                   \
+  ret name params {                                                                           \
+    const bb__oiio_table *t = bb__oiio_module();                                              \
+    if (!t) fallback;                                                                         \
+    return t->name args;                                                                      \
+  }
+
 /* The module's entry (BB__OIIO_ENTRY): keeps host, returns the calls. */
 const bb__oiio_table *bb__oiio_module_entry(const bb__oiio_host *host);
 

@@ -6,10 +6,4 @@
 
 #include <stddef.h>
 
-#define BB__TEXT_WRAPPER(ret, name, params, args, fallback)                                   \
-  ret name params {                                                                           \
-    const bb__oiio_table *t = bb__oiio_module();                                              \
-    if (!t) fallback;                                                                         \
-    return t->name args;                                                                      \
-  }
-BB__OIIO_TEXT_CALLS(BB__TEXT_WRAPPER)
+BB__OIIO_TEXT_CALLS(BB__OIIO_WRAPPER)
