@@ -60,7 +60,11 @@ MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
 MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
 # OpenEXR's IlmThread: bumpbake's provider for its pool (src/image/exr_pool.cpp).
 EXR_POOL_LIBS := $(filter -lIlmThread%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
-LDLIBS  := $(OIIO_LIBS) $(ASSIMP_LIBS) $(PNG_LIBS) $(PROBE_LIBS) $(EXR_POOL_LIBS) -lm -pthread
+# The library's and the programs' libraries: OpenImageIO is not one of them.
+# The module that calls it (libbumpbake-oiio.so, below) links it and
+# OpenEXR's pool, and the library loads the module on its first image call.
+LDLIBS  := $(ASSIMP_LIBS) $(PNG_LIBS) $(PROBE_LIBS) -lm -pthread
+MODULE_LIBS := $(OIIO_LIBS) $(EXR_POOL_LIBS) -lm -pthread
 ifeq ($(DEBUG),1)
 LDFLAGS += -fsanitize=address,undefined
 endif
@@ -107,30 +111,30 @@ PC_LIBS_PRIVATE = $(LDLIBS) -lstdc++
 # `make install LDCONFIG=:` skips it (the install check does).
 LDCONFIG   ?= ldconfig
 
-# ---- start-up: the early link ------------------------------------------------
-# OpenImageIO on Debian 12 loads about 260 shared libraries, and most of a
-# bumpbake process's start-up is the dynamic linker looking up their
-# symbols: each lookup walks the libraries in load order up to the one
+# ---- start-up: the OpenImageIO module and its early link ---------------------
+# OpenImageIO on Debian 12 loads about 260 shared libraries, and loading
+# them was most of a bumpbake process's start-up (bumpbake --version: 0.2 s
+# of CPU; each Criterion test, a process of its own: 0.33 s). Its calls are
+# built into a module of their own, $(MODULE) (src/image/oiio_module.h),
+# which the library dlopen()s on the first call that reads or writes an
+# image or draws text (src/image/oiio_load.c): a process that does neither
+# never loads OpenImageIO. libbumpbake.so finds the module in its own folder,
+# a program linking libbumpbake.a in the folder compiled into it
+# (src/image/oiio_module_dir.c: $(BUILD) for the build's, LIBDIR for the
+# installed ones); `make install` puts the module beside the library.
+#
+# When the module is loaded, most of that time is the dynamic linker looking
+# up symbols: each lookup walks the libraries in load order up to the one
 # defining it, and a few large C++ libraries deep in that order (OpenVDB,
-# Xerces, GDAL...) look up tens of thousands of their own symbols. The CLI
-# and the test binary name every library the probe loads first on their
-# link line, the one the most lookups end in first ($(BUILD)/link-order.txt,
-# written by tools/link_order.sh at build time): they are loaded anyway,
-# and the walks are short (bumpbake --version: half the CPU; each Criterion
-# test is a process of its own). The shared library names them the same
-# way: a program that dlopen()s it (Python's cffi) looks its libraries'
-# symbols up in the library's own scope, its DT_NEEDED in that order
-# (python3 loading it: 641 M instructions against 1,125 M). `make
-# EARLY_LINK=0` links them plainly; `make bench` measures start-up both ways.
+# Xerces, GDAL...) look up tens of thousands of their own symbols. The
+# module names every library the probe loads first on its link line, the
+# one the most lookups end in first ($(BUILD)/link-order.txt, written by
+# tools/link_order.sh at build time): they are loaded anyway, and the walks
+# are short. `make EARLY_LINK=0` links them plainly.
 EARLY_LINK ?= 1
 LINK_ORDER := $(BUILD)/link-order.txt
-EARLY_LINK_FLAGS = -Wl$(comma)--push-state$(comma)--no-as-needed $$(cat $(LINK_ORDER)) -Wl$(comma)--pop-state
-CLI_EARLY = $(if $(filter 1,$(EARLY_LINK)),$(EARLY_LINK_FLAGS))
-# The shared library's: the same less serve's HTTP library (the probe
-# links it; the library does not use it).
-MHD_LIB_NAMES := $(patsubst -l%,-e lib%.so,$(filter -l%,$(MHD_LIBS)))
-SHLIB_EARLY = $(if $(filter 1,$(EARLY_LINK)),-Wl$(comma)--push-state$(comma)--no-as-needed \
-  $$(grep -v $(if $(MHD_LIB_NAMES),$(MHD_LIB_NAMES),-e '^$$') $(LINK_ORDER)) -Wl$(comma)--pop-state)
+MODULE_EARLY = $(if $(filter 1,$(EARLY_LINK)),-Wl$(comma)--push-state$(comma)--no-as-needed \
+  $$(cat $(LINK_ORDER)) -Wl$(comma)--pop-state)
 EARLY_DEPS = $(if $(filter 1,$(EARLY_LINK)),$(LINK_ORDER))
 comma := ,
 
@@ -138,8 +142,15 @@ comma := ,
 # The library's families, each using only the ones before it: the order of
 # docs/how-it-works.md ("Layers"), which `make check-layers` holds them to.
 FAMILIES := core files texture image trace bake maps render mesh job cmd
-LIB_C    := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c))
-LIB_CXX  := $(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp))
+# The OpenImageIO module's sources (src/image/oiio_module.h): every file
+# that calls OpenImageIO, OpenEXR's pool, its entry and its calls back into
+# the library; the library's side is src/image/oiio_load.c.
+MODULE_CXX := $(addprefix src/image/,oiio_read.cpp oiio_write.cpp oiio_mips.cpp oiio_gif.cpp \
+                oiio_guard.cpp exr_pool.cpp) src/render/oiio_text.cpp
+MODULE_C   := src/image/oiio_host.c src/image/oiio_host_table.c src/render/oiio_entry.c
+MODULE_DIR_C := src/image/oiio_module_dir.c
+LIB_C    := $(filter-out $(MODULE_C),$(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.c)))
+LIB_CXX  := $(filter-out $(MODULE_CXX),$(foreach f,$(FAMILIES),$(wildcard src/$(f)/*.cpp)))
 # `bumpbake serve` (src/serve/): a client of its own above the CLI (it
 # prints as the CLI does), the program's only HTTP server, linked into the
 # program by src/cli/main.c and left out of the test binary and the fuzz
@@ -166,7 +177,11 @@ TOOL_OBJ := $(TOOL_C:%.c=$(BUILD)/%.o)
 # regression inputs (tests/test_fuzz.c), with the CLI minus main().
 FUZZ_REPLAY_OBJ := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%.o,$(wildcard fuzz/fuzz_*.c))
 CLI_LIB_OBJ := $(filter-out $(BUILD)/src/cli/main.o $(SERVE_C:%.c=$(BUILD)/%.o),$(CLI_OBJ))
-ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ)
+MODULE_OBJ := $(MODULE_C:%.c=$(BUILD)/%.o) $(MODULE_CXX:%.cpp=$(BUILD)/%.o)
+MODULE   := $(BUILD)/libbumpbake-oiio.so.$(VERSION)
+# The module exports its entry only (src/image/oiio_module.map).
+MODULE_MAP := src/image/oiio_module.map
+ALL_OBJ  := $(LIB_OBJ) $(CLI_OBJ) $(TEST_OBJ) $(TOOL_OBJ) $(FUZZ_REPLAY_OBJ) $(MODULE_OBJ)
 LIB      := $(BUILD)/libbumpbake.a
 SHLIB    := $(BUILD)/$(SHLIB_REAL)
 # The symbols libbumpbake.so exports: bb_* (the public API) and nothing else.
@@ -176,15 +191,15 @@ TESTBIN  := $(BUILD)/bb_tests
 TOOLS    := $(TOOL_C:tools/%.c=$(BUILD)/tools/%)
 # The CLI linked other ways, for `make bench`'s start-up comparison, and the
 # Criterion suite, whose trench test section 10 (tools/bench_bounce.sh) reads.
-BENCH_BINS := $(BUILD)/bench/bumpbake-plain $(BUILD)/bench/bumpbake-shared $(TESTBIN)
+BENCH_BINS := $(BUILD)/bench/bumpbake-shared $(TESTBIN)
 
 .PHONY: all lib deps ensure-deps demo test check check-unit check-install \
         check-python check-serve check-report check-circles check-layers check-docs check-abi abi-dump api-report \
         bench bench-cluster bench-check goldens docs docs-reference install check-others \
         uninstall clean format FORCE \
         fuzz fuzz-long fuzz-deps ensure-fuzz-deps hostile
-all: $(BIN) lib $(TOOLS)
-lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so
+all: $(BIN) lib $(TOOLS) $(MODULE)
+lib: $(LIB) $(SHLIB) $(BUILD)/$(SONAME) $(BUILD)/libbumpbake.so $(MODULE)
 
 # ---- dependencies (Debian packages) ----------------------------------------
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
@@ -241,7 +256,7 @@ ensure-fuzz-deps: ensure-deps
 # EARLY_LINK rebuilds what it affects, and stale objects from before a
 # Makefile change (non-PIC ones, say) are never linked into the .so.
 COMPILE_FLAGS := $(CC) $(CFLAGS) $(DEPFLAGS) | $(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) $(ASSIMP_CFLAGS) | $(LIB_CFLAGS) $(PNG_CFLAGS) $(PROBE_CFLAGS)
-LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
+LINK_FLAGS    := $(CXX) $(LDFLAGS) $(LDLIBS) $(MODULE_LIBS) $(CRIT_LIBS) EARLY_LINK=$(EARLY_LINK) $(SONAME)
 $(BUILD)/compile.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(COMPILE_FLAGS)' | cmp -s - $@ || echo '$(COMPILE_FLAGS)' >$@
@@ -249,7 +264,9 @@ $(BUILD)/link.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(LINK_FLAGS)' | cmp -s - $@ || echo '$(LINK_FLAGS)' >$@
 
-$(LIB_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
+$(LIB_OBJ) $(MODULE_OBJ): EXTRA_CFLAGS := $(LIB_CFLAGS) $(LIB_INCLUDES) $(PNG_CFLAGS) $(PROBE_CFLAGS)
+# The folder a static link finds the module in: this build's.
+$(BUILD)/$(MODULE_DIR_C:.c=.o): EXTRA_CFLAGS += -DBB_OIIO_MODULE_DIR='"$(abspath $(BUILD))"'
 $(CLI_OBJ): EXTRA_CFLAGS := $(CLI_INCLUDES)
 $(SERVE_C:%.c=$(BUILD)/%.o): EXTRA_CFLAGS := $(SERVE_INCLUDES) $(MHD_CFLAGS)
 $(BUILD)/src/serve/serve_page.o: $(SERVE_ASSETS)
@@ -275,9 +292,15 @@ $(LIB): $(LIB_OBJ)
 
 # The shared library: soname libbumpbake.so.MAJOR[.MINOR], the real file
 # carries the full version, symlinks as ldconfig and -lbumpbake expect.
-$(SHLIB): $(LIB_OBJ) $(LIB_MAP) $(BUILD)/link.flags $(EARLY_DEPS)
+$(SHLIB): $(LIB_OBJ) $(LIB_MAP) $(BUILD)/link.flags | $(MODULE)
 	$(CXX) -shared $(LDFLAGS) -Wl,-soname,$(SONAME) -Wl,--version-script=$(LIB_MAP) \
-	  -Wl,-z,defs -Wl,-Bsymbolic-functions -o $@ $(LIB_OBJ) $(SHLIB_EARLY) $(LDLIBS)
+	  -Wl,-z,defs -Wl,-Bsymbolic-functions -o $@ $(LIB_OBJ) $(LDLIBS)
+# The OpenImageIO module: loaded by file name, no soname; the library's own
+# functions it calls come through the table the library hands it
+# (src/image/oiio_host.c), so it needs nothing of the library at link time.
+$(MODULE): $(MODULE_OBJ) $(MODULE_MAP) $(BUILD)/link.flags $(EARLY_DEPS)
+	$(CXX) -shared $(LDFLAGS) -Wl,--version-script=$(MODULE_MAP) -Wl,-z,defs \
+	  -o $@ $(MODULE_OBJ) $(MODULE_EARLY) $(MODULE_LIBS)
 $(BUILD)/$(SONAME): $(SHLIB)
 	ln -sf $(SHLIB_REAL) $@
 $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
@@ -286,35 +309,32 @@ $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
 # The CLI links the static library: it starts as fast as with the shared one
 # (`make bench` measures both) and the installed binary finds no library at
 # run time but OpenImageIO's.
-$(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
+$(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags | $(MODULE)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS) $(MHD_LIBS)
 
 # The probe and the order it gives (tools/link_order.sh; empty where the
 # loader ignores LD_DEBUG, and the link is then the plain one).
 $(BUILD)/tools/link_probe: tools/link_probe.c $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ -x c $< -Wl,--no-as-needed $(LDLIBS) $(MHD_LIBS)
+	$(CXX) $(LDFLAGS) -o $@ -x c $< -Wl,--no-as-needed $(MODULE_LIBS)
 $(LINK_ORDER): $(BUILD)/tools/link_probe tools/link_order.sh
 	tools/link_order.sh $< >$@.tmp && mv $@.tmp $@
 
-$(BUILD)/bench/bumpbake-plain: $(CLI_OBJ) $(LIB) $(BUILD)/link.flags
-	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS) $(MHD_LIBS)
 $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
 	@mkdir -p $(@D)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
 
 # The tools print JSON with the library's one writer (bb__json, src/core/json.h).
-$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags
+$(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags | $(MODULE)
 	$(CXX) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
 
 $(FUZZ_REPLAY_OBJ): $(BUILD)/fuzz/%.o: fuzz/%.c $(BUILD)/compile.flags
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) $(TEST_INCLUDES) $(DEPFLAGS) -DLLVMFuzzerTestOneInput=bb_$* -c $< -o $@
 
-$(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
+$(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.flags | $(MODULE)
 	$(CXX) $(LDFLAGS) -o $@ $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) \
-	  $(CLI_EARLY) $(CRIT_LIBS) $(LDLIBS)
+	  $(CRIT_LIBS) $(LDLIBS)
 
 # ---- install ----------------------------------------------------------------
 # The installed program: the CLI with src/cli/installed_dirs.c compiled
@@ -322,6 +342,7 @@ $(TESTBIN): $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(CLI_LIB_OBJ) $(LIB) $(BUILD)/link.f
 # finds the Python package (src/cli/cluster.c); build/bumpbake finds its
 # source tree instead. Relinked when PYTHONDIR changes.
 INSTALL_BIN := $(BUILD)/install/bumpbake
+INSTALL_LIB := $(BUILD)/install/libbumpbake.a
 $(BUILD)/install/dirs.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(PYTHONDIR)' | cmp -s - $@ || echo '$(PYTHONDIR)' >$@
@@ -329,8 +350,19 @@ $(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dir
                                    $(BUILD)/compile.flags
 	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
 $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
-                $(BUILD)/install/installed_dirs.o $(LIB) $(BUILD)/link.flags $(EARLY_DEPS)
-	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(LIB) $(CLI_EARLY) $(LDLIBS) $(MHD_LIBS)
+                $(BUILD)/install/installed_dirs.o $(INSTALL_LIB) $(BUILD)/link.flags
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(INSTALL_LIB) $(LDLIBS) $(MHD_LIBS)
+# The installed archive: the build's with the module's folder LIBDIR
+# (src/image/oiio_module_dir.c), for the installed program and for programs
+# linking it (pkg-config --static). Remade when LIBDIR changes.
+$(BUILD)/install/libdir.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(LIBDIR)' | cmp -s - $@ || echo '$(LIBDIR)' >$@
+$(BUILD)/install/oiio_module_dir.o: $(MODULE_DIR_C) $(BUILD)/install/libdir.flags \
+                                    $(BUILD)/compile.flags
+	$(CC) $(CFLAGS) $(LIB_CFLAGS) -DBB_OIIO_MODULE_DIR='"$(LIBDIR)"' -c $< -o $@
+$(INSTALL_LIB): $(LIB) $(BUILD)/install/oiio_module_dir.o
+	cp $(LIB) $@.tmp && ar rs $@.tmp $(BUILD)/install/oiio_module_dir.o && mv $@.tmp $@
 
 # The public headers: bumpbake.h, and bumpbake_cluster.h beside it (the
 # advanced calls of drivers that spread the work over machines).
@@ -338,14 +370,15 @@ PUBLIC_HEADERS := include/bumpbake.h include/bumpbake_cluster.h
 # bumpbake.pc is made from bumpbake.pc.in with the install's own paths; the
 # Python package gets bumpbake/_install.py, the path of the library it loads
 # (LIBDIR's, where it will be at run time, also when staged with DESTDIR).
-install: $(INSTALL_BIN) lib
+install: $(INSTALL_BIN) $(INSTALL_LIB) lib
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) \
 	  $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PKGCONFIGDIR)
 	install -m 755 $(INSTALL_BIN) $(DESTDIR)$(BINDIR)/bumpbake
 	install -m 755 $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL)
 	ln -sf $(SHLIB_REAL) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so
-	install -m 644 $(LIB) $(DESTDIR)$(LIBDIR)/libbumpbake.a
+	install -m 755 $(MODULE) $(DESTDIR)$(LIBDIR)/$(notdir $(MODULE))
+	install -m 644 $(INSTALL_LIB) $(DESTDIR)$(LIBDIR)/libbumpbake.a
 	install -m 644 $(PUBLIC_HEADERS) $(DESTDIR)$(INCLUDEDIR)/
 	install -m 644 docs/bumpbake.1 $(DESTDIR)$(MANDIR)/man1/bumpbake.1
 	sed -e 's|@PREFIX@|$(PREFIX)|; s|@LIBDIR@|$(LIBDIR)|; s|@INCLUDEDIR@|$(INCLUDEDIR)|' \
@@ -362,7 +395,7 @@ install: $(INSTALL_BIN) lib
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/bumpbake $(DESTDIR)$(LIBDIR)/$(SHLIB_REAL) \
 	  $(DESTDIR)$(LIBDIR)/$(SONAME) $(DESTDIR)$(LIBDIR)/libbumpbake.so \
-	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(addprefix $(DESTDIR)$(INCLUDEDIR)/,$(notdir $(PUBLIC_HEADERS))) \
+	  $(DESTDIR)$(LIBDIR)/libbumpbake.a $(DESTDIR)$(LIBDIR)/$(notdir $(MODULE)) $(addprefix $(DESTDIR)$(INCLUDEDIR)/,$(notdir $(PUBLIC_HEADERS))) \
 	  $(DESTDIR)$(MANDIR)/man1/bumpbake.1 $(DESTDIR)$(PKGCONFIGDIR)/bumpbake.pc
 	rm -rf $(DESTDIR)$(PYTHONDIR)/bumpbake
 
@@ -415,15 +448,19 @@ check-docs: $(BIN)
 
 # Object files that use each other's symbols in a circle fail the build's
 # checks (tools/check_circles.py): one of them has two jobs.
-check-circles: $(LIB_OBJ) $(CLI_OBJ)
+# The OpenImageIO module is a link of its own (the library's functions it
+# calls are its own calls through the host table): checked apart.
+check-circles: $(LIB_OBJ) $(MODULE_OBJ) $(CLI_OBJ)
 	@./tools/check_circles.py $(LIB_OBJ) $(CLI_OBJ)
+	@./tools/check_circles.py $(MODULE_OBJ)
 
 # Families that include or call a later family in the order of
 # docs/how-it-works.md ("Layers") fail (tools/check_layers.py); its test
 # (tests/tools/test_check_layers.py) shows it refuses an upward include,
 # a relative one and an upward call in a tree of its own.
-check-layers: $(LIB_OBJ) $(CLI_OBJ)
+check-layers: $(LIB_OBJ) $(MODULE_OBJ) $(CLI_OBJ)
 	@$(PYTHON) tools/check_layers.py --families '$(FAMILIES)' $(LIB_OBJ) $(CLI_OBJ)
+	@$(PYTHON) tools/check_layers.py --families '$(FAMILIES)' $(MODULE_OBJ)
 	@$(PYTHON) tests/tools/test_check_layers.py
 
 # The shared library's ABI against the last release's, stored in abi/
@@ -565,7 +602,14 @@ FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
 FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) $(TEST_INCLUDES) -Isrc/cli
 FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
 FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
-FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
+# The targets link the OpenImageIO module's objects with the library's
+# (src/image/oiio_load.c built with BB_OIIO_LINKED calls its entry), less
+# its calls back through the host table (oiio_host.c).
+FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o) \
+                $(FUZZ_BUILD)/src/image/oiio_host_table.o $(FUZZ_BUILD)/src/render/oiio_entry.o \
+                $(MODULE_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
+$(FUZZ_BUILD)/src/image/oiio_load.o: FUZZ_CFLAGS += -DBB_OIIO_LINKED
+$(FUZZ_BUILD)/src/image/oiio_module_dir.o: FUZZ_CFLAGS += -DBB_OIIO_MODULE_DIR='""'
 FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c $(SERVE_C),$(CLI_C)))
 # Per target: libFuzzer options beyond time and corpus.
 FUZZ_ARGS_fuzz_cli        := -dict=fuzz/cli.dict
@@ -590,7 +634,7 @@ $(FUZZ_BUILD)/src/%.o: src/%.cpp
 $(FUZZ_BUILD)/%: fuzz/%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	@mkdir -p $(@D)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< -x none $(FUZZ_CLI_OBJ) \
-	  $(FUZZ_LIB_OBJ) $(LDLIBS)
+	  $(FUZZ_LIB_OBJ) $(LDLIBS) $(MODULE_LIBS)
 
 $(FUZZ_BUILD)/seed_formats.o: fuzz/seed_formats.cpp
 	@mkdir -p $(@D)
@@ -598,7 +642,7 @@ $(FUZZ_BUILD)/seed_formats.o: fuzz/seed_formats.cpp
 
 $(FUZZ_BUILD)/make_seeds: fuzz/make_seeds.c $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ)
 	clang++ -x c $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -o $@ $< -x none \
-	  $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ) $(LDLIBS)
+	  $(FUZZ_BUILD)/seed_formats.o $(FUZZ_LIB_OBJ) $(LDLIBS) $(MODULE_LIBS)
 
 fuzz: ensure-fuzz-deps
 	@$(MAKE) --no-print-directory $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds

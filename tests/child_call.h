@@ -8,6 +8,7 @@
 #include <criterion/criterion.h>
 
 #include "bumpbake.h"
+#include "image/oiio_module.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -44,6 +45,10 @@ static inline child_outcome child_call(child_call_fn fn, const char *path,
                                        unsigned alarm_seconds, long address_space_bytes) {
   child_outcome o;
   memset(&o, 0, sizeof o);
+  /* The OpenImageIO module loaded once here (src/image/oiio_module.h), so
+   * each child inherits it, as it inherited OpenImageIO when the binary
+   * linked it, rather than loading it again (and inside its limits). */
+  cr_assert_not_null(bb__oiio_module());
   int fds[2];
   cr_assert_eq(pipe(fds), 0);
   fflush(NULL);

@@ -34,6 +34,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "image/image_write.h"
+#include "image/oiio_module.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 /* The leak check of a called CLI, in the forked child. LeakSanitizer there
@@ -338,6 +339,13 @@ static inline int harness_remove(const char *path, const struct stat *st, int fl
 }
 
 static inline void harness_setup(void) {
+  /* A called CLI reads and writes images through the OpenImageIO module,
+   * which the library loads on first use (src/image/oiio_module.h): loaded
+   * before the threads are counted (its libraries may start some) and
+   * before the first fork, each child of the test inherits it rather than
+   * loading it again, as it inherited OpenImageIO when the binary linked
+   * it. */
+  (void)bb__oiio_module();
   harness_threads_at_setup = harness_threads();
   snprintf(harness_dir, sizeof harness_dir, "/tmp/bb_cli_XXXXXX");
   cr_assert_not_null(mkdtemp(harness_dir));

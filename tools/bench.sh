@@ -12,8 +12,7 @@
 # dense-azimuth reference, build/tools/accuracy_ref) on 256 x 256 maps, at
 # 64, 256 and 1024 rays and at 6, 10 and 12 slices,
 # 6 large sizes (rock06 tiled 4 x 4 and 8 x 8), 7 start-up
-# (tools/bench_startup.sh: the CLI as built, with EARLY_LINK=0 and linked to
-# libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
+# (tools/bench_startup.sh: the CLI as built and linked to libbumpbake.so), 8 batches (tools/bench_batch.sh: 20 bakes of 256 x 256 in
 # one process against one process each), 9 engine textures (tools/bench_blocks.sh:
 # block compression's PSNR and worst error per format and map, bumpbake's codec
 # against nvcompress, and the time of a 2048 x 2048 VTF DXT1 with mips against
@@ -682,13 +681,13 @@ fi
 # ------------------------------------------------------------- 7. start-up
 
 if want 7; then
-section "7. Start-up: bumpbake --version, the CLI linked three ways"
-echo "static: build/bumpbake as built (libbumpbake.a, OpenImageIO's libraries named first in the"
-echo "order of tools/link_order.sh); plain: the same linked plainly (make EARLY_LINK=0);"
-echo "shared: linked to libbumpbake.so."
+section "7. Start-up: bumpbake --version, the CLI linked two ways"
+echo "static: build/bumpbake as built (libbumpbake.a); shared: linked to libbumpbake.so. Neither"
+echo "loads OpenImageIO for --version: the library loads it with its image module on the first"
+echo "image read or write (the module names OpenImageIO's libraries first, tools/link_order.sh)."
 startup_ok=0
 startup_bins=(static="$bin")
-for variant in plain shared; do
+for variant in shared; do
   b=$(dirname "$bin")/bench/bumpbake-$variant
   [ -x "$b" ] && startup_bins+=("$variant=$b")
 done
@@ -839,7 +838,7 @@ elif want 2; then
   summary_row "peer" "not available" "$peer_reason"
 fi
 if [ "$startup_ok" = 1 ]; then
-  for variant in static plain shared; do
+  for variant in static shared; do
     [ -n "$(startup_field "$variant" 2)" ] || continue
     summary_row "start-up, $variant (s)" "$(startup_field "$variant" 2)" \
       "x$(startup_field "$variant" 5) of static; $(startup_field "$variant" 6) M instructions"

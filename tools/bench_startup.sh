@@ -4,13 +4,12 @@
 # 41); with -i also the instructions one run executes (valgrind's callgrind,
 # dynamic loader included), which machine load does not move.
 #
-#   tools/bench_startup.sh static=build/bumpbake plain=build/bench/bumpbake-plain
+#   tools/bench_startup.sh static=build/bumpbake shared=build/bench/bumpbake-shared
 #
 # The builds are run in turn (A B C A B C ...), so load on this shared
 # machine falls on all of them alike; each line gives the median, the
 # quartiles and the ratio to the first build. `make bench` runs it on the
-# default CLI (static library, early link), the plain link (make EARLY_LINK=0) and
-# the CLI linked to libbumpbake.so.
+# default CLI (static library) and the CLI linked to libbumpbake.so.
 set -euo pipefail
 
 runs=41 instructions=0

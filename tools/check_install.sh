@@ -137,6 +137,33 @@ else
   printf '%s\n' "$internal" >&2
 fi
 
+# The OpenImageIO module (src/image/oiio_module.h): beside the library,
+# exporting its entry only; the installed program (libbumpbake.a with
+# LIBDIR compiled in) loads it for its first image, and without it says so
+# in one line naming it.
+module=$prefix/lib/libbumpbake-oiio.so.${version#bumpbake }
+if [ -f "$module" ]; then
+  exports=$(nm -D --defined-only "$module" | awk '$2 ~ /^[A-Ziu]$/ { print $3 }' | sort -u)
+  [ "$exports" = bb__oiio_module_entry ] &&
+    pass "lib/$(basename "$module") exports its entry only" ||
+    fail "lib/$(basename "$module") exports more than bb__oiio_module_entry: $exports"
+  "$prefix/bin/bumpbake" info fixtures/bricks_128x64.png >"$tmp/info.out" 2>&1 &&
+    pass "the installed bumpbake reads an image through lib/$(basename "$module")" ||
+    { cat "$tmp/info.out" >&2; fail "the installed bumpbake info of a PNG"; }
+  mv "$module" "$module.aside"
+  code=0
+  "$prefix/bin/bumpbake" info fixtures/bricks_128x64.png >/dev/null 2>"$tmp/info.err" || code=$?
+  mv "$module.aside" "$module"
+  if [ "$code" -ne 0 ] && [ "$(wc -l <"$tmp/info.err")" -eq 1 ] && grep -qF "$module" "$tmp/info.err"; then
+    pass "without its module the installed bumpbake says so in one line: $(cat "$tmp/info.err")"
+  else
+    cat "$tmp/info.err" >&2
+    fail "without its module the installed bumpbake did not fail in one line naming $module"
+  fi
+else
+  fail "make install did not install lib/$(basename "$module") beside the library"
+fi
+
 # ----------------------------------------------------------- 4. man page
 man_page=$prefix/share/man/man1/bumpbake.1
 if command -v groff >/dev/null 2>&1; then

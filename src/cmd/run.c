@@ -3,6 +3,7 @@
  * run and written through the job (run_render.c, run_maps.c); what it
  * wrote, for the caller to report. */
 #include "cmd/cmd_internal.h"
+#include "image/oiio_module.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +36,11 @@ static bb_status run(bb_command *c, const bb_command_hooks *hooks, bb_command_re
   if (!c->checked)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s: the command is not checked (bb_command_check)",
                     c->def->info.name);
+  /* A command reads or writes images: the OpenImageIO module is loaded
+   * before any work (image/oiio_module.h), so that a process short of
+   * memory fails here, in one line, and the estimates count what it maps. */
+  if (!bb__oiio_module())
+    return bb__oiio_failed(err);
   bb_status st;
   if (c->def->job)
     st = run_job(c, hooks, r, err);

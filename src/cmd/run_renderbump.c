@@ -4,6 +4,7 @@
  * (job/renderbump_files.c: both or neither, provenance, the height's
  * depth), their paths checked against the model before (bb_command_check). */
 #include "cmd/cmd_internal.h"
+#include "image/oiio_module.h"
 #include "job/job_internal.h"
 #include "mesh/mesh_internal.h"
 
@@ -83,6 +84,9 @@ static bb_status renderbump(bb_command *c, const bb_command_hooks *hooks,
     return bb__fail(err, BB_ERR_ARGUMENT, "renderbump: bad arguments");
   if (c->def->run != bb__run_renderbumpflat)
     return bb__fail(err, BB_ERR_ARGUMENT, "%s is not renderbumpflat", c->def->info.name);
+  /* The OpenImageIO module before any work, as bb_command_run loads it. */
+  if (!bb__oiio_module())
+    return bb__oiio_failed(err);
   if (!c->checked)
     return bb__fail(err, BB_ERR_ARGUMENT,
                     "%s: the command is not checked (bb_command_check)",

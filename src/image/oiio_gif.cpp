@@ -106,7 +106,8 @@ bb_status animation_close(bb_animation *a, bb_error *err) {
   if (st != BB_OK) return st;
   int frames = 0;
   bb_error read_err;
-  if (bb__image_frame_count(a->file.temp_path, &frames, &read_err) != BB_OK ||
+  // A GIF: counted by this module's read, as bb__image_frame_count would.
+  if (bb__oiio_frame_count(a->file.temp_path, &frames, &read_err) != BB_OK ||
       frames != a->frames)
     return bb__fail(err, BB_ERR_IO, "%s: cannot write: the file holds %d of %d frames", path,
                     frames, a->frames);

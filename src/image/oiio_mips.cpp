@@ -118,12 +118,15 @@ std::string encode_mips(const std::string &file_name, OIIO::Filesystem::IOProxy 
 }
 
 // Reads a finished file back; "" when it holds the chain, else why not.
+// The file is one of OpenImageIO's formats (never a VTF or DDS): read by
+// this module's own read, as the library's read of a mip level would pass it on.
 std::string verify_chain(const std::string &name, const bb_image *levels, int count) {
   for (int k = 0; k < count; k++) {
-    bb_image level;
+    bb_image level{};
     bb_error why;
     int file_levels = 0;
-    if (bb__image_read_mip(name.c_str(), k, &level, nullptr, &file_levels, &why) != BB_OK) {
+    if (bb__oiio_read(name.c_str(), 0, -1, k, &level, nullptr, &file_levels, &why) != BB_OK) {
+      bb_image_free(&level);
       // The reason, without the temporary's name the read gave it.
       std::string reason = why.message;
       if (reason.compare(0, name.size() + 2, name + ": ") == 0) reason.erase(0, name.size() + 2);

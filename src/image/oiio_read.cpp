@@ -14,7 +14,6 @@
 #include "image/oiio_calls.h"
 #include "image/oiio_guard.h"
 #include "image/oiio_setup.h"
-#include "image/png_hooks.h"
 #include "image/read_limits.h"
 #include "image/signatures.h"
 
@@ -227,7 +226,6 @@ opened_input open_input(const char *path, bool reading, bb_status *st, bb_error 
   if (!opened.file)
     return opened;
   bb::oiio_setup();
-  (void)bb__png_hooks_set(); // links the hooks on libpng (png_hooks.c)
   opened.png = OiioPngLeakScope::applies_to(path);
   const std::string promised = format_of_extension(path);
   const std::string content = format_of_content(*opened.file);

@@ -8,6 +8,7 @@
 #include "job/job_internal.h"
 #include "texture/blocks.h"
 #include "maps/maps_internal.h"
+#include "image/oiio_module.h"
 #include "render/render_internal.h"
 #include "texture/texture.h"
 
@@ -660,6 +661,10 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
                      bb_job_report_fn each, void *user, bb_error *err) {
   if (!job)
     return bb__fail(err, BB_ERR_ARGUMENT, "job run: no job");
+  /* The OpenImageIO module before any work, as bb_command_run loads it
+   * (image/oiio_module.h): short of memory, the run fails here. */
+  if (!bb__oiio_module())
+    return bb__oiio_failed(err);
   bb_status first = BB_OK;
   int stopped = 0;
   for (int i = 0; i < job->count; i++) {

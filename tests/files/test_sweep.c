@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "bumpbake.h"
+#include "image/oiio_module.h"
 #include "bumpbake_cluster.h"
 #include "files/safe_file.h"
 #include "image/image_write.h"
@@ -63,6 +64,10 @@ static bb_image small(void) {
  * a worker's loss does): its temporary stays behind, unlocked. Returns
  * when it is dead. */
 static void killed_writer(const char *path) {
+  /* The OpenImageIO module loaded once here (src/image/oiio_module.h), so
+   * each child inherits it, as it inherited OpenImageIO when the binary
+   * linked it, rather than loading it again (and inside its limits). */
+  cr_assert_not_null(bb__oiio_module());
   const pid_t pid = fork();
   cr_assert(pid >= 0);
   if (pid == 0) {
@@ -92,6 +97,10 @@ static bb_status stage_tiff_mips(const char *path, bb_staged_file **f) {
 /* A child that stages a mip-mapped TIFF and dies by SIGKILL: its private
  * directory, with the file in it, stays behind. */
 static void killed_private_writer(const char *path) {
+  /* The OpenImageIO module loaded once here (src/image/oiio_module.h), so
+   * each child inherits it, as it inherited OpenImageIO when the binary
+   * linked it, rather than loading it again (and inside its limits). */
+  cr_assert_not_null(bb__oiio_module());
   const pid_t pid = fork();
   cr_assert(pid >= 0);
   if (pid == 0) {
@@ -108,6 +117,10 @@ static void killed_private_writer(const char *path) {
 /* A child that stages a file and waits on a pipe before committing it: a
  * writer alive in another process. */
 static pid_t live_writer(const char *path, int *go) {
+  /* The OpenImageIO module loaded once here (src/image/oiio_module.h), so
+   * each child inherits it, as it inherited OpenImageIO when the binary
+   * linked it, rather than loading it again (and inside its limits). */
+  cr_assert_not_null(bb__oiio_module());
   int up[2], down[2];
   cr_assert_eq(pipe(up), 0);
   cr_assert_eq(pipe(down), 0);

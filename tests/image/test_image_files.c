@@ -7,6 +7,7 @@
 #include "image/formats.h"
 #include "image/image_write.h"
 #include "image/oiio.h"
+#include "image/oiio_module.h"
 #include "mesh/mesh_internal.h"
 
 #include <dirent.h>
@@ -824,6 +825,10 @@ static const format_case every_format[] = {
 typedef bb_status (*child_fn)(const void *arg, bb_error *err);
 
 static bb_status run_in_child(child_fn fn, const void *arg, char *msg, size_t cap) {
+  /* The OpenImageIO module loaded once here (src/image/oiio_module.h), so
+   * each child inherits it, as it inherited OpenImageIO when the binary
+   * linked it, rather than loading it again (and inside its limits). */
+  cr_assert_not_null(bb__oiio_module());
   int fds[2];
   cr_assert_eq(pipe(fds), 0);
   fflush(NULL);
