@@ -602,13 +602,15 @@ FUZZ_OPT     := -O1 -g -fno-omit-frame-pointer $(FUZZ_SAN)
 FUZZ_CFLAGS  := -std=c11 -D_POSIX_C_SOURCE=200809L -pthread $(FUZZ_OPT) $(TEST_INCLUDES) -Isrc/cli
 FUZZ_CXXFLAGS:= -std=c++17 -pthread $(FUZZ_OPT) -Iinclude -Isrc
 FUZZ_TARGETS := $(patsubst fuzz/%.c,$(FUZZ_BUILD)/%,$(wildcard fuzz/fuzz_*.c))
-# The targets link the OpenImageIO module's objects with the library's
-# (src/image/oiio_load.c built with BB_OIIO_LINKED calls its entry), less
-# its calls back through the host table (oiio_host.c).
+# The targets link the OpenImageIO module's objects with the library's,
+# less its calls back through the host table (oiio_host.c): built with
+# BB_OIIO_LINKED, src/image/oiio_load.c calls the module's entry itself, and
+# it and src/render/text_calls.c define no wrappers (the module's own
+# definitions are the program's).
 FUZZ_LIB_OBJ := $(LIB_C:%.c=$(FUZZ_BUILD)/%.o) $(LIB_CXX:%.cpp=$(FUZZ_BUILD)/%.o) \
                 $(FUZZ_BUILD)/src/image/oiio_host_table.o $(FUZZ_BUILD)/src/render/oiio_entry.o \
                 $(MODULE_CXX:%.cpp=$(FUZZ_BUILD)/%.o)
-$(FUZZ_BUILD)/src/image/oiio_load.o: FUZZ_CFLAGS += -DBB_OIIO_LINKED
+$(FUZZ_BUILD)/src/image/oiio_load.o $(FUZZ_BUILD)/src/render/text_calls.o: FUZZ_CFLAGS += -DBB_OIIO_LINKED
 $(FUZZ_BUILD)/src/image/oiio_module_dir.o: FUZZ_CFLAGS += -DBB_OIIO_MODULE_DIR='""'
 FUZZ_CLI_OBJ := $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(filter-out src/cli/main.c $(SERVE_C),$(CLI_C)))
 # Per target: libFuzzer options beyond time and corpus.

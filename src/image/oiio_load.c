@@ -143,9 +143,13 @@ const bb__oiio_table *bb__oiio_module(void) {
 
 bb_status bb__oiio_failed(bb_error *err) { return bb__fail(err, BB_ERR_IO, "%s", failure); }
 
+/* Linked into the program (the fuzz targets), the module's own definitions
+ * of these calls are the program's: no wrapper. */
+#ifndef BB_OIIO_LINKED
 BB__OIIO_IMAGE_CALLS(BB__OIIO_WRAPPER)
 
 void bb__oiio_gif_abort(bb_animation *a) {
   const bb__oiio_table *t = bb__oiio_module();
   if (t) t->bb__oiio_gif_abort(a);
 }
+#endif

@@ -6,4 +6,8 @@
 
 #include <stddef.h>
 
+/* Linked into the program (the fuzz targets: BB_OIIO_LINKED), the module's
+ * own definitions are the program's: no wrapper. */
+#ifndef BB_OIIO_LINKED
 BB__OIIO_TEXT_CALLS(BB__OIIO_WRAPPER)
+#endif
