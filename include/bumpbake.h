@@ -206,9 +206,6 @@ void bb_image_free(bb_image *img);
 /* Pointer to texel (x, y), channel 0. No bounds check beyond debug asserts. */
 float *bb_image_texel(const bb_image *img, int x, int y);
 
-/* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
-void bb_image_flip_green(bb_image *img);
-
 /* Addressing of texels outside the image. */
 typedef enum bb_addressing {
   BB_ADDRESS_PERIODIC = 0, /* the texture tiles: h(x + W, y) = h(x, y) */
@@ -774,19 +771,6 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float,
                                const bb_normal_decode_options *o, bb_image *normals,
                                bb_error *err);
 
-/* -------------------------------------------------------------- derive */
-
-/* The maps of docs/conventions.md "Derived maps", for any basis: channel c belongs
- * to basis->vector[c]. basis NULL means Half-Life 2's B0, B1, B2, and for
- * ssbump and bent also hl2+z when the input has a fourth basis channel. */
-
-/* weights w_c = sat(N.B_c)^2 / sum_k sat(N.B_k)^2 over the basis' count
- * directions (Valve's normal2ssbump for "hl2"); a normal facing away from
- * every direction gets 1 / count in each. normals: 3 channels; out
- * (allocated): count channels. */
-bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
-                            bb_error *err);
-
 /* ---------------------------------------------------------------- bake */
 
 typedef struct bb_bake_options {
@@ -840,7 +824,7 @@ typedef struct bb_bake_options {
                                  height's size: ssbump and weights are
                                  multiplied by its grey, the paper's
                                  "brightness modulation factor in the normal
-                                 map", as bb_combine_brightness does (a
+                                 map", as combine --brightness does (a
                                  texel that would exceed 1 is scaled down,
                                  its channels' ratios kept); ao and bent do
                                  not change. Not owned */
@@ -959,86 +943,6 @@ typedef struct bb_valve_options {
                       map, 0.5 + 0.5 N (-n, FILE-bump.tga). Default 0 */
   int ao_in_alpha; /* 0: A = the filtered height; 1: A = ao (-A). Default 0 */
 } bb_valve_options;
-
-/* ---------------------------------------------------- ssbump to normal */
-
-/* The kind of a map a conversion or combine works on; it fixes the
- * operators and the flat, unoccluded texel (ssbump 1/sqrt(3), weights 1/3,
- * ao 1, normal (0, 0, 1)). What a three-channel basis map holds is
- * BB_MAP_SSBUMP (s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump)
- * or BB_MAP_WEIGHTS (w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake
- * --weights). */
-/* The normal of a basis map, the paper's "sum of the basis vectors weighted
- * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
- * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
- * f(s) = s for BB_MAP_SSBUMP and sqrt(max(0, s)) for BB_MAP_WEIGHTS (the
- * square root undoes normal2ssbump's square, so both kinds give back N
- * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
- * A map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
- * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
-                              bb_image *normals, bb_error *err);
-
-/* ------------------------------------------------------------- combine */
-
-/* combine works on BB_MAP_SSBUMP, BB_MAP_WEIGHTS, BB_MAP_AO and
- * BB_MAP_NORMAL; other kinds are BB_ERR_ARGUMENT. Its operators act on the
- * kind's bb_map_kind_info.file_channels: 3, or 1 for ao. */
-
-/* The flat, unoccluded texel of kind (channels 0..file_channels-1 of
- * texel) as it reads back from a file of that sample depth: an integer file
- * of bits_per_sample bits stores it rounded to a code (an 8-bit ssbump holds
- * 147/255, an 8-bit normal map 128/255, which decodes to x = y = 1/255), a
- * half-float file (is_float, 16 bits) to 11 significant bits, a float file
- * exactly (as float). Normals are returned decoded. */
-void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
-                       float texel[3]);
-
-/* Blends two maps of the same size: t = (1 - m) a + m b, m = mask channel 0
- * at the texel (clamped to [0, 1]) or the constant mix when mask is NULL.
- * ssbump, weights, ao: every channel, linearly (a and b need the same channel
- * count). normal: normalize(t) on channels 0..2. m = 0 gives a and m = 1
- * gives b bit for bit. Allocates out with a's channels (3 for normals). */
-bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
-                           float mix, bb_map_kind kind, bb_image *out, bb_error *err);
-
-/* Overlays a detail map on a base of the same size. flat is the detail's own
- * flat texel (bb_map_flat_texel of the detail file's depth), or NULL for the
- * exact flat of the kind; a detail texel equal to it (within 1e-6, far
- * under one 16-bit code) leaves the base texel unchanged bit for bit.
- * ssbump, weights, ao: out_c = base_c * detail_c / flat_c on the kind's
- * channels (visibilities multiply; a flat detail is the identity, on either
- * side); further base channels (Valve's alpha) are copied, so an ssbump or
- * weights map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
- * normal: DOOM 3's addnormals: n = base (z rebuilt as sqrt(1 - x^2 - y^2)
- * when |n| < 1), n.xy += detail.xy - flat.xy, out = normalize(n).
- * Allocates out with base's channels. */
-bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
-                            bb_map_kind kind, const float *flat, bb_image *out,
-                            bb_error *err);
-
-/* Multiplies a map by a grey brightness map of the same size: the paper's
- * "brightness modulation factor in the normal map, for free", which lets a
- * low-resolution colour map and a high-resolution ssbump share the work.
- * The engine multiplies the stored weights by its lightmaps, so scaling the
- * weights scales the light. b is the brightness map's grey at the texel (1
- * channel: it; 2: the first; 3 or more: Rec. 709 luma of R, G, B; a
- * negative grey counts as 0).
- *   ssbump, weights: channels 0..2 times b. A channel holds at most 1: where
- *     the largest of the three would exceed it, the texel is scaled so that
- *     the largest is 1 instead, which keeps the channels' ratios (the
- *     direction the engine derives from them, the paper's bent normal): what
- *     clips is the brightness, never the direction. A flat, unoccluded
- *     ssbump texel (1/sqrt(3)) takes brightness up to sqrt(3) unclipped.
- *     Further channels (Valve's alpha) are copied; a map of more than 4
- *     channels (another basis) is BB_ERR_ARGUMENT.
- *   ao: times b, at most 1.
- *   normal: BB_ERR_ARGUMENT: a unit normal has no room for a brightness.
- * A brightness of 1 gives the map back bit for bit. Allocates out with the
- * map's channels. Errors: BB_ERR_ARGUMENT, BB_ERR_SIZE (another size),
- * BB_ERR_VALUE (a NaN or infinite value in either map). */
-bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
-                                bb_map_kind kind, bb_image *out, bb_error *err);
 
 /* -------------------------------------------------- flipcode slope map */
 
@@ -2361,6 +2265,30 @@ bb_status bb_command_picture(bb_command *command, const bb_image *height,
  * naming the file. */
 bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
                              bb_error *err);
+
+/* The map of normal2ssbump, ssbump2normal or combine (bb_command_run's) of
+ * images in memory, with the options of a command checked for them
+ * (bb_command_set_in_memory; combine's --mask or --brightness given as any
+ * text, the images being these): nothing read or written. a holds the
+ * values a file's map decodes to: normal2ssbump's unit normals (3
+ * channels), the basis map ssbump2normal turns back into normals, or
+ * combine's A (normals decoded, as bb_normal_map_decode gives them). b:
+ * combine's B, or with --brightness the brightness map (grey, or luma of
+ * R, G, B); NULL otherwise. mask: combine --mask's T per texel (1 channel,
+ * clamped to 0..1), else NULL. b_depth: the depth of the file combine
+ * --detail's B would be read from, whose flat texel it leaves A unchanged
+ * at (an 8-bit ssbump holds 147/255); BB_DEPTH_DEFAULT: the exact flat.
+ * basis: the directions normal2ssbump's weights are of (NULL: Half-Life
+ * 2's, the command line's). Normals in and out follow --normal-y. out
+ * (allocated; free with bb_image_free): normal2ssbump's weights (a channel
+ * per direction), ssbump2normal's normals (3 channels), combine's map
+ * (A's channels). Errors: BB_ERR_ARGUMENT (not a checked command of the
+ * three set in memory; a or combine's b missing; a size, channel count,
+ * or basis the operator refuses), BB_ERR_SIZE (maps of two sizes),
+ * BB_ERR_VALUE (a NaN or infinite value, naming the texel). */
+bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
+                         const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
+                         bb_image *out, bb_error *err);
 
 /* ----------------------------------------------------- what a job prints */
 

@@ -155,3 +155,11 @@ s/\bbb_option_find_short\b/bb__option_find_short/g
 # api6: the reports' words through one string-keyed call (bb_report_word).
 s/\bbb_job_outcome_name\b/bb__job_outcome_name/g
 s/\bbb_check_status_name\b/bb__check_status_name/g
+# api8: the map operators of normal2ssbump, ssbump2normal and combine, run by a client through their commands (bb_command_map).
+s/\bbb_combine_blend\b/bb__combine_blend/g
+s/\bbb_combine_detail\b/bb__combine_detail/g
+s/\bbb_combine_brightness\b/bb__combine_brightness/g
+s/\bbb_map_flat_texel\b/bb__map_flat_texel/g
+s/\bbb_derive_weights\b/bb__derive_weights_all_cores/g
+s/\bbb_ssbump_to_normal\b/bb__ssbump_to_normal/g
+s/\bbb_image_flip_green\b/bb__image_flip_green/g

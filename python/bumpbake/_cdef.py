@@ -667,7 +667,6 @@ typedef struct bb_command_result {
 FUNCTIONS = """
 const char *bb_status_name(bb_status status);
 bb_status bb_image_size_check(int width, int height, int channels, bb_error *err);
-void bb_image_flip_green(bb_image *img);
 bb_status bb_image_alloc(bb_image *img, int width, int height, int channels,
                          bb_error *err);
 void bb_image_free(bb_image *img);
@@ -700,8 +699,6 @@ bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
 bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
                               bb_image *sums, int threads, bb_error *err);
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
-bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
-                            bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
 int bb_bake_slices(const bb_bake_options *o);
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
@@ -716,17 +713,6 @@ void bb_bake_context_keep(bb_bake_context *context, int keep);
 bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
                                const bb_bake_options *o, bb_bake_result *result,
                                bb_region *changed, bb_error *err);
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
-                              bb_image *normals, bb_error *err);
-void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
-                       float texel[3]);
-bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
-                           float mix, bb_map_kind kind, bb_image *out, bb_error *err);
-bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
-                            bb_map_kind kind, const float *flat, bb_image *out,
-                            bb_error *err);
-bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
-                                bb_map_kind kind, bb_image *out, bb_error *err);
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
@@ -809,6 +795,9 @@ bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              bb_image *out, int *labels_drawn, bb_error *err);
 bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_map,
                              bb_error *err);
+bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
+                         const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
+                         bb_image *out, bb_error *err);
 const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);

@@ -28,14 +28,18 @@ def decode_normals(values, is_float=False, normal_y="down", normalize=True):
     return _take(out)
 
 
-def _green_up(array, what):
-    """An _Image of a copy of array with its green negated: an OpenGL-style
-    (normal_y="up") array of normals in the library's +Y down (the
-    caller's array is left alone)."""
-    src = _Image(what, array)  # the shape checked before the copy
-    flipped = src.array.copy()
-    flipped[..., 1] *= -1
-    return _Image(what, flipped)
+def _map(c, a, b=None, mask=None, depth=None, basis=None):
+    """bb_command_map of a checked command: the float32 map of images in
+    memory (_Image's; b, mask, basis may be None; depth a bb_depth)."""
+    out = _ffi.new("bb_image *")
+    err = _ffi.new("bb_error *")
+    null = _ffi.NULL
+    _check(_lib.bb_command_map(c.handle, a.image, b.image if b is not None else null,
+                               mask if mask is not None else null,
+                               depth if depth is not None else _lib.BB_DEPTH_DEFAULT,
+                               basis if basis is not None else null, out, err),
+           err, arrays=True)
+    return _take(out)
 
 
 def normal2ssbump(normals, basis="hl2", *, normal_y=None):
@@ -51,13 +55,8 @@ def normal2ssbump(normals, basis="hl2", *, normal_y=None):
     c.in_memory()
     c.check()
     src = _Image("normal2ssbump: normals", normals, channels=(3,))
-    if c.options.maps_normal_y_up:
-        src = _green_up(normals, "normal2ssbump: normals")
     b, _ = _basis(basis)
-    out = _ffi.new("bb_image *")
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_derive_weights(src.image, b, out, err), err, arrays=True)
-    return _take(out)
+    return _map(c, src, basis=b)
 
 
 def ssbump2normal(ssbump, kind=None, *, normal_y=None):
@@ -73,19 +72,13 @@ def ssbump2normal(ssbump, kind=None, *, normal_y=None):
     c.set("normal_y", normal_y)
     c.in_memory()
     c.check()
-    src = _Image("ssbump2normal: ssbump", ssbump)
-    out = _ffi.new("bb_image *")
-    err = _ffi.new("bb_error *")
-    _check(_lib.bb_ssbump_to_normal(src.image, c.options.ssbump_kind, out, err), err,
-           arrays=True)
-    if c.options.maps_normal_y_up:
-        _lib.bb_image_flip_green(out)
-    return _take(out)
+    return _map(c, _Image("ssbump2normal: ssbump", ssbump))
 
 
 def _mask_field(mask):
     """A blend mask as the command line reads one: a 2-D array as it is, else
-    its grey (or the mean of R, G, B) by the height channel rule."""
+    its grey (or the mean of R, G, B) by the height channel rule. Returns
+    (the _Image kept, or None; the bb_image * of the field made, or None)."""
     src = _Image("combine: mask", mask)
     if src.image.channels == 1:
         return src, None
@@ -109,12 +102,13 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
     detail=True overlays b on a: a * b / flat for ssbump, weights and ao,
     DOOM 3's addnormals for normals; flat is the kind's flat, unoccluded
     texel, exact (detail_depth None) or as a file of detail_depth (8, 16,
-    "half", "float") stores it (bb_map_flat_texel: 147/255 in an 8-bit
-    ssbump), so a flat detail read from such a file leaves a unchanged bit
-    for bit. brightness (an (H, W) grey array; b not given): a times it,
-    the paper's brightness modulation (bb_combine_brightness). kind:
-    "ssbump" (default), "weights", "ao" or "normal"; normal_y="up": normals
-    in and out have +Y up (OpenGL), as the command line's --normal-y.
+    "half", "float") stores it (147/255 in an 8-bit ssbump, as the command
+    line reads such a file), so a flat detail read from such a file leaves a
+    unchanged bit for bit. brightness (an (H, W) grey array; b not given): a
+    times it, the paper's brightness modulation (combine --brightness).
+    kind: "ssbump" (default), "weights", "ao" or "normal"; normal_y="up":
+    normals in and out have +Y up (OpenGL), as the command line's
+    --normal-y. Each runs through the command in memory (bb_command_map).
     Returns float32 with a's channels (3 for normals)."""
     c = Command("combine")
     c.set_all(dict(mix=mix, detail=detail, kind=kind, normal_y=normal_y))
@@ -125,44 +119,20 @@ def combine(a, b=None, mix=None, mask=None, detail=False, kind=None, detail_dept
     c.check()
     if brightness is None and b is None:
         raise TypeError("combine: b is required (the second map) unless brightness is given")
-    k = c.options.map_kind
-    up = c.options.maps_normal_y_up and k == _lib.BB_MAP_NORMAL
-    if up:
-        a = _green_up(a, "combine: a").array
-        b = _green_up(b, "combine: b").array if b is not None else None
     ia = _Image("combine: a", a)
-    out = _ffi.new("bb_image *")
-    err = _ffi.new("bb_error *")
     if brightness is not None:
-        ib = _Image("combine: brightness", brightness)
-        st = _lib.bb_combine_brightness(ia.image, ib.image, k, out, err)
-    elif detail:
-        ib = _Image("combine: b", b)
-        flat = _ffi.NULL
-        if detail_depth is not None:
-            d = _depth(detail_depth)
-            bits = {_lib.BB_DEPTH_8: 8, _lib.BB_DEPTH_16: 16, _lib.BB_DEPTH_HALF: 16,
-                    _lib.BB_DEPTH_FLOAT: 32}[d]
-            is_float = d in (_lib.BB_DEPTH_HALF, _lib.BB_DEPTH_FLOAT)
-            flat = _ffi.new("float[3]")
-            _lib.bb_map_flat_texel(k, bits, int(is_float), flat)
-        st = _lib.bb_combine_detail(ia.image, ib.image, k, flat, out, err)
-    else:
-        ib = _Image("combine: b", b)
-        keep, field = (None, None)
-        m = _ffi.NULL
-        if mask is not None:
-            keep, field = _mask_field(mask)
-            m = keep.image if keep is not None else field
-        try:
-            st = _lib.bb_combine_blend(ia.image, ib.image, m, c.options.mix, k, out, err)
-        finally:
-            if field is not None:
-                _lib.bb_image_free(field)
-    _check(st, err, arrays=True)
-    if up:
-        _lib.bb_image_flip_green(out)
-    return _take(out)
+        return _map(c, ia, _Image("combine: brightness", brightness))
+    ib = _Image("combine: b", b)
+    if detail:
+        return _map(c, ia, ib, depth=_depth(detail_depth) if detail_depth is not None else None)
+    keep, field = (None, None)
+    if mask is not None:
+        keep, field = _mask_field(mask)
+    try:
+        return _map(c, ia, ib, mask=keep.image if keep is not None else field)
+    finally:
+        if field is not None:
+            _lib.bb_image_free(field)
 
 
 def program(text, base=None, allow_outside_base=False, **options):

@@ -342,8 +342,8 @@ static bb_status bake_stages(const bb_image *height, const bb_bake_options *o,
         trace_and_derive(o, threads, !(flags & BB__BAKE_DROP_VIS), context, keep, r, err);
   if (st == BB_OK && o->brightness) st = brightness(o, threads, r, err);
   if (st == BB_OK && o->normal_y_up) {
-    if (wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb_image_flip_green(&r->normal);
-    if (r->bent.pixels) bb_image_flip_green(&r->bent);
+    if (wants(o, BB_MAP_BIT(BB_MAP_NORMAL))) bb__image_flip_green(&r->normal);
+    if (r->bent.pixels) bb__image_flip_green(&r->bent);
   }
   if (st == BB_ERR_CANCELLED)
     bb__fail(err, st, "bake: cancelled by the progress callback");

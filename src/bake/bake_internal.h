@@ -206,6 +206,17 @@ bb_status bb__derive_bent_all_cores(const bb_image *ssbump, const bb_basis *basi
  * options before loading anything. */
 bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err);
 
+/* The maps of docs/conventions.md "Derived maps", for any basis: channel c belongs
+ * to basis->vector[c]. basis NULL means Half-Life 2's B0, B1, B2, and for
+ * ssbump and bent also hl2+z when the input has a fourth basis channel. */
+
+/* weights w_c = sat(N.B_c)^2 / sum_k sat(N.B_k)^2 over the basis' count
+ * directions (Valve's normal2ssbump for "hl2"); a normal facing away from
+ * every direction gets 1 / count in each. normals: 3 channels; out
+ * (allocated): count channels. */
+bb_status bb__derive_weights_all_cores(const bb_image *normals, const bb_basis *basis,
+                                      bb_image *out, bb_error *err);
+
 /* Once in bumpbake.h beside the functions that stay public there. */
 /* "periodic" or "clamp"; "unknown" for other values. */
 const char *bb__addressing_name(bb_addressing addressing);

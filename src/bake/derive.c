@@ -162,8 +162,8 @@ static void weights_row(void *user, int y) {
                   job->out->pixels + (size_t)job->count * i);
 }
 
-bb_status bb_derive_weights(const bb_image *normals, const bb_basis *basis, bb_image *out,
-                            bb_error *err) {
+bb_status bb__derive_weights_all_cores(const bb_image *normals, const bb_basis *basis,
+                                      bb_image *out, bb_error *err) {
   /* A caller's normals may hold NaN (a bake's never do: its heights are
    * checked), which would come out as 1 / count in every channel. */
   bb_status st = check_image(normals, "normal", 3, 3, err);

@@ -364,7 +364,7 @@ static void derive_texel(const derive_job *job, size_t t, unsigned m) {
     float *out = maps->normal.pixels + 3 * t;
     memcpy(out, n, 3 * sizeof(float));
     if (o->normal_y_up)
-      out[1] *= -1.0f; /* bb_image_flip_green */
+      out[1] *= -1.0f; /* bb__image_flip_green */
   }
   if (maps->weights.pixels && (m & (MARK_NORMAL | MARK_BRIGHTNESS))) {
     float *out = maps->weights.pixels + (size_t)count * t, w[BB_MAX_BASIS];

@@ -1,10 +1,14 @@
 /* run_maps.c: the runs of the commands that turn maps into maps
  * (normal2ssbump, ssbump2normal, combine, program): read, convert, and
  * the result written by the job (job/output.c: depth, provenance, staged
- * write), its path checked against the inputs before (bb_command_check). */
+ * write), its path checked against the inputs before (bb_command_check);
+ * or, in memory, the same operators on a client's images (bb_command_map,
+ * bb_command_program). */
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
+#include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "maps/maps_internal.h"
 #include "maps/program_internal.h"
 #include "trace/basis.h"
 
@@ -88,7 +92,7 @@ bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
     bb_error e = {{0}};
     st = bb_normal_map_decode(&values, info.is_float, &d, &normals, &e);
     if (st == BB_OK)
-      st = bb_derive_weights(&normals, NULL, &weights, &e);
+      st = bb__derive_weights_all_cores(&normals, NULL, &weights, &e);
     if (st == BB_OK)
       st = with_alpha(&values, &info, &weights, &e);
     if (st != BB_OK)
@@ -105,6 +109,15 @@ bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
 
 /* -------------------------------------------------------- ssbump2normal */
 
+/* The normal a basis map stands for, by --kind, +Y as --normal-y says. */
+static bb_status ssbump_normal(const bb_command_options *o, const bb_image *ssbump,
+                               bb_image *normals, bb_error *err) {
+  bb_status st = bb__ssbump_to_normal(ssbump, o->ssbump_kind, normals, err);
+  if (st == BB_OK && o->maps_normal_y_up)
+    bb__image_flip_green(normals);
+  return st;
+}
+
 bb_status bb__run_ssbump2normal(bb_command *c, const bb_command_hooks *hooks,
                                 bb_command_result *r, bb_error *err) {
   (void)hooks;
@@ -117,14 +130,11 @@ bb_status bb__run_ssbump2normal(bb_command *c, const bb_command_hooks *hooks,
     st = check_hl2(input, &ssbump, &info, err);
   if (st == BB_OK) {
     bb_error e = {{0}};
-    if ((st = bb_ssbump_to_normal(&ssbump, o->ssbump_kind, &normals, &e)) != BB_OK)
+    if ((st = ssbump_normal(o, &ssbump, &normals, &e)) != BB_OK)
       bb__fail_at(err, st, input, &e);
   }
-  if (st == BB_OK) {
-    if (o->maps_normal_y_up)
-      bb_image_flip_green(&normals);
+  if (st == BB_OK)
     st = write_map(c, input, NULL, &ssbump, &info, "normal", &normals, BB_RANGE_SIGNED, r, err);
-  }
   bb_image_free(&normals);
   bb_image_free(&ssbump);
   bb_image_info_free(&info);
@@ -181,22 +191,35 @@ static bb_status load_mask(const char *path, bb_image *mask, bb_error *err) {
   return st;
 }
 
+/* combine's operator on the values of A and B (normals decoded, +Y down;
+ * B is the brightness map with --brightness): mask the T field of --mask
+ * (NULL: --mix), flat B's flat texel with --detail (NULL: the exact one).
+ * A normal map comes out in --normal-y's convention. */
+static bb_status combine_values(const bb_command_options *a, const bb_image *va,
+                                const bb_image *vb, const bb_image *mask, const float *flat,
+                                bb_image *out, bb_error *err) {
+  bb_status st;
+  if (a->brightness)
+    st = bb__combine_brightness(va, vb, a->map_kind, out, err);
+  else if (a->detail)
+    st = bb__combine_detail(va, vb, a->map_kind, flat, out, err);
+  else
+    st = bb__combine_blend(va, vb, mask, (float)a->mix, a->map_kind, out, err);
+  if (st == BB_OK && a->map_kind == BB_MAP_NORMAL && a->maps_normal_y_up)
+    bb__image_flip_green(out); /* back to the inputs' convention */
+  return st;
+}
+
 /* Runs the library; errors about two images name the first input. */
 static bb_status combine_maps(const bb_command_options *a, const char *first,
                               const map_input *m, const bb_image *mask, bb_image *out,
                               bb_error *err) {
   bb_error e = {{0}};
-  bb_status st;
-  if (a->brightness) {
-    st = bb_combine_brightness(values_of(&m[0]), &m[1].file, a->map_kind, out, &e);
-  } else if (a->detail) {
-    float flat[3];
-    bb_map_flat_texel(a->map_kind, m[1].info.bits_per_sample, m[1].info.is_float, flat);
-    st = bb_combine_detail(values_of(&m[0]), values_of(&m[1]), a->map_kind, flat, out, &e);
-  } else {
-    st = bb_combine_blend(values_of(&m[0]), values_of(&m[1]), mask->pixels ? mask : NULL,
-                          (float)a->mix, a->map_kind, out, &e);
-  }
+  float flat[3]; /* B's own flat: as its file holds it */
+  if (a->detail)
+    bb__map_flat_texel(a->map_kind, m[1].info.bits_per_sample, m[1].info.is_float, flat);
+  bb_status st = combine_values(a, values_of(&m[0]), values_of(&m[1]),
+                                mask->pixels ? mask : NULL, flat, out, &e);
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, first, &e);
 }
 
@@ -218,8 +241,6 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
     st = combine_maps(a, in[0], m, &mask, &out, err);
   if (st == BB_OK) {
     const int normal = a->map_kind == BB_MAP_NORMAL;
-    if (normal && a->maps_normal_y_up)
-      bb_image_flip_green(&out); /* back to the inputs' convention */
     st = write_map(c, in[0], NULL, &m[0].file, &m[0].info, bb__map_kind_name(a->map_kind), &out,
                    normal ? BB_RANGE_SIGNED : BB_RANGE_UNIT, r, err);
   }
@@ -228,6 +249,86 @@ bb_status bb__run_combine(bb_command *c, const bb_command_hooks *hooks, bb_comma
   map_input_free(&m[0]);
   map_input_free(&m[1]);
   return st;
+}
+
+/* ------------------------------------------------------------ in memory */
+
+/* *use: in, or (up, and in has a green) a copy of it with its green
+ * negated: OpenGL's +Y up read as the library's +Y down, as decoding a
+ * file with --normal-y up reads it. */
+static bb_status green_down(const bb_image *in, int up, bb_image *copy, const bb_image **use,
+                            bb_error *err) {
+  *use = in;
+  if (!up || !in || !in->pixels || in->channels < 2)
+    return BB_OK;
+  bb_status st = bb_image_alloc(copy, in->width, in->height, in->channels, err);
+  if (st != BB_OK)
+    return st;
+  memcpy(copy->pixels, in->pixels,
+         (size_t)in->width * (size_t)in->height * (size_t)in->channels * sizeof(float));
+  bb__image_flip_green(copy);
+  *use = copy;
+  return BB_OK;
+}
+
+/* The texel a flat detail holds as a file of depth d stores it (8 and 16
+ * bits: a code; half: 11 significant bits; float: as float); NULL for
+ * BB_DEPTH_DEFAULT, the exact flat. */
+static const float *flat_of_depth(bb_map_kind kind, bb_depth d, float flat[3]) {
+  if (d == BB_DEPTH_DEFAULT)
+    return NULL;
+  const int bits = d == BB_DEPTH_8 ? 8 : d == BB_DEPTH_FLOAT ? 32 : 16;
+  bb__map_flat_texel(kind, bits, d == BB_DEPTH_HALF || d == BB_DEPTH_FLOAT, flat);
+  return flat;
+}
+
+static bb_status map(bb_command *c, const bb_image *a, const bb_image *b, const bb_image *mask,
+                     bb_depth b_depth, const bb_basis *basis, bb_image *out, bb_error *err) {
+  if (!out)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_command_map: NULL argument");
+  memset(out, 0, sizeof *out);
+  if (!c || !c->checked || !c->in_memory)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: the command is not checked for images in memory",
+                    c ? c->def->info.name : "bb_command_map");
+  const bb_command_options *o = &c->options;
+  const char *name = c->def->info.name;
+  if (!a)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: no map given", name);
+  const int up = o->maps_normal_y_up;
+  bb_image copies[2] = {{0}, {0}};
+  const bb_image *va = a, *vb = b;
+  bb_status st;
+  if (c->def->run == bb__run_normal2ssbump) {
+    st = green_down(a, up, &copies[0], &va, err);
+    if (st == BB_OK)
+      st = bb__derive_weights_all_cores(va, basis, out, err);
+  } else if (c->def->run == bb__run_ssbump2normal) {
+    st = ssbump_normal(o, a, out, err);
+  } else if (c->def->run == bb__run_combine) {
+    const int normal = o->map_kind == BB_MAP_NORMAL;
+    float flat[3];
+    st = b ? BB_OK
+           : bb__fail(err, BB_ERR_ARGUMENT, "combine: %s", o->brightness
+                                                              ? "the brightness map is needed"
+                                                              : "B, the second map, is needed");
+    if (st == BB_OK)
+      st = green_down(a, normal && up, &copies[0], &va, err);
+    if (st == BB_OK)
+      st = green_down(b, normal && up, &copies[1], &vb, err);
+    if (st == BB_OK)
+      st = combine_values(o, va, vb, mask, flat_of_depth(o->map_kind, b_depth, flat), out, err);
+  } else {
+    st = bb__fail(err, BB_ERR_ARGUMENT, "%s makes no map of images in memory", name);
+  }
+  bb_image_free(&copies[0]);
+  bb_image_free(&copies[1]);
+  return st;
+}
+
+bb_status bb_command_map(bb_command *c, const bb_image *a, const bb_image *b,
+                         const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
+                         bb_image *out, bb_error *err) {
+  return bb__spelled(c, map(c, a, b, mask, b_depth, basis, out, err), err);
 }
 
 /* -------------------------------------------------------------- program */

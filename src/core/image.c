@@ -97,7 +97,7 @@ float *bb_image_texel(const bb_image *img, int x, int y) {
   return img->pixels + ((size_t)y * (size_t)img->width + (size_t)x) * (size_t)img->channels;
 }
 
-void bb_image_flip_green(bb_image *img) {
+void bb__image_flip_green(bb_image *img) {
   assert(img->channels >= 2);
   size_t n = (size_t)img->width * (size_t)img->height;
   for (size_t i = 0; i < n; i++) img->pixels[i * (size_t)img->channels + 1] *= -1.0f;

@@ -303,6 +303,9 @@ const char *bb__map_kind_name(bb_map_kind kind);
  * that are not a bake's maps ("render", "normal+coverage"). */
 int bb__map_kind_records(const char *kind, const char *key, int bounce);
 
+/* Negates channel 1 of a 3-channel vector image in place (+Y down <-> up). */
+void bb__image_flip_green(bb_image *img);
+
 #ifdef __cplusplus
 }
 #endif

@@ -60,7 +60,7 @@ static double round_to_half(double v) {
   return ldexp(floor(m * 2048.0 + 0.5) / 2048.0, e);
 }
 
-void bb_map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
+void bb__map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
                        float texel[3]) {
   for (int c = 0; c < combine_channels(kind); c++) {
     double v = flat_encoded(kind, c);
@@ -142,7 +142,7 @@ static void blend_normal_texel(const float *a, const float *b, double m, float *
     out[k] = (float)t[k];
 }
 
-bb_status bb_combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
+bb_status bb__combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
                            float mix, bb_map_kind kind, bb_image *out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "blend: out is NULL");
@@ -227,7 +227,7 @@ static void detail_normal_texel(const float *base, const float *detail, const fl
     out[k] = (float)sum[k];
 }
 
-bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
+bb_status bb__combine_detail(const bb_image *base, const bb_image *detail,
                             bb_map_kind kind, const float *flat, bb_image *out,
                             bb_error *err) {
   if (!out)
@@ -239,7 +239,7 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
   if (st != BB_OK)
     return st;
   float exact[3];
-  bb_map_flat_texel(kind, 32, 1, exact);
+  bb__map_flat_texel(kind, 32, 1, exact);
   if (!flat)
     flat = exact;
   const int need = combine_channels(kind), channels = base->channels;
@@ -258,7 +258,7 @@ bb_status bb_combine_detail(const bb_image *base, const bb_image *detail,
 
 /* --------------------------------------------------------- brightness */
 
-bb_status bb_combine_brightness(const bb_image *map, const bb_image *brightness,
+bb_status bb__combine_brightness(const bb_image *map, const bb_image *brightness,
                                 bb_map_kind kind, bb_image *out, bb_error *err) {
   if (!out)
     return bb__fail(err, BB_ERR_ARGUMENT, "brightness: out is NULL");

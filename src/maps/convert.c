@@ -4,6 +4,7 @@
 #include "trace/basis.h"
 #include "core/internal.h"
 #include "bake/bake_internal.h"
+#include "maps/maps_internal.h"
 #include <math.h>
 #include <string.h>
 
@@ -47,7 +48,7 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float,
   return BB_OK;
 }
 
-bb_status bb_ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
+bb_status bb__ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
                               bb_image *normals, bb_error *err) {
   if (!normals)
     return bb__fail(err, BB_ERR_ARGUMENT, "ssbump to normal: normals is NULL");

@@ -113,6 +113,86 @@ bb_status bb__valve_pack(const bb_bake_result *result, const bb_valve_options *o
 bb_status bb__valve_detail(bb_image *rgba, const bb_image *colour, const bb_image *height,
                           const bb_smooth_options *smooth, bb_error *err);
 
+/* Once in bumpbake.h, now internal (issue 41): the operators of
+ * normal2ssbump, ssbump2normal and combine, which a client runs through
+ * their commands (bb_command_map, bb_command_run). */
+
+/* The kind of a map a conversion or combine works on; it fixes the
+ * operators and the flat, unoccluded texel (ssbump 1/sqrt(3), weights 1/3,
+ * ao 1, normal (0, 0, 1)). What a three-channel basis map holds is
+ * BB_MAP_SSBUMP (s_c = max(0, N.B_c) vis_c: height2ssbump, bake --ssbump)
+ * or BB_MAP_WEIGHTS (w_c = sat(N.B_c)^2 / sum: normal2ssbump, bake
+ * --weights). */
+/* The normal of a basis map, the paper's "sum of the basis vectors weighted
+ * by the bumpmap texture, normalized": N = normalize(sum_c f(s_c) B_c) over
+ * channels 0..2 (further channels, such as Valve's alpha, are ignored), with
+ * f(s) = s for BB_MAP_SSBUMP and sqrt(max(0, s)) for BB_MAP_WEIGHTS (the
+ * square root undoes normal2ssbump's square, so both kinds give back N
+ * wherever every N.B_c >= 0). A texel with no weight gives (0, 0, 1).
+ * A map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
+ * Allocates normals: 3 channels, +Y down. Non-finite values: BB_ERR_VALUE. */
+bb_status bb__ssbump_to_normal(const bb_image *ssbump, bb_map_kind kind,
+                              bb_image *normals, bb_error *err);
+
+/* combine works on BB_MAP_SSBUMP, BB_MAP_WEIGHTS, BB_MAP_AO and
+ * BB_MAP_NORMAL; other kinds are BB_ERR_ARGUMENT. Its operators act on the
+ * kind's bb_map_kind_info.file_channels: 3, or 1 for ao. */
+
+/* The flat, unoccluded texel of kind (channels 0..file_channels-1 of
+ * texel) as it reads back from a file of that sample depth: an integer file
+ * of bits_per_sample bits stores it rounded to a code (an 8-bit ssbump holds
+ * 147/255, an 8-bit normal map 128/255, which decodes to x = y = 1/255), a
+ * half-float file (is_float, 16 bits) to 11 significant bits, a float file
+ * exactly (as float). Normals are returned decoded. */
+void bb__map_flat_texel(bb_map_kind kind, int bits_per_sample, int is_float,
+                       float texel[3]);
+
+/* Blends two maps of the same size: t = (1 - m) a + m b, m = mask channel 0
+ * at the texel (clamped to [0, 1]) or the constant mix when mask is NULL.
+ * ssbump, weights, ao: every channel, linearly (a and b need the same channel
+ * count). normal: normalize(t) on channels 0..2. m = 0 gives a and m = 1
+ * gives b bit for bit. Allocates out with a's channels (3 for normals). */
+bb_status bb__combine_blend(const bb_image *a, const bb_image *b, const bb_image *mask,
+                           float mix, bb_map_kind kind, bb_image *out, bb_error *err);
+
+/* Overlays a detail map on a base of the same size. flat is the detail's own
+ * flat texel (bb__map_flat_texel of the detail file's depth), or NULL for the
+ * exact flat of the kind; a detail texel equal to it (within 1e-6, far
+ * under one 16-bit code) leaves the base texel unchanged bit for bit.
+ * ssbump, weights, ao: out_c = base_c * detail_c / flat_c on the kind's
+ * channels (visibilities multiply; a flat detail is the identity, on either
+ * side); further base channels (Valve's alpha) are copied, so an ssbump or
+ * weights map of more than 4 channels (another basis) is BB_ERR_ARGUMENT.
+ * normal: DOOM 3's addnormals: n = base (z rebuilt as sqrt(1 - x^2 - y^2)
+ * when |n| < 1), n.xy += detail.xy - flat.xy, out = normalize(n).
+ * Allocates out with base's channels. */
+bb_status bb__combine_detail(const bb_image *base, const bb_image *detail,
+                            bb_map_kind kind, const float *flat, bb_image *out,
+                            bb_error *err);
+
+/* Multiplies a map by a grey brightness map of the same size: the paper's
+ * "brightness modulation factor in the normal map, for free", which lets a
+ * low-resolution colour map and a high-resolution ssbump share the work.
+ * The engine multiplies the stored weights by its lightmaps, so scaling the
+ * weights scales the light. b is the brightness map's grey at the texel (1
+ * channel: it; 2: the first; 3 or more: Rec. 709 luma of R, G, B; a
+ * negative grey counts as 0).
+ *   ssbump, weights: channels 0..2 times b. A channel holds at most 1: where
+ *     the largest of the three would exceed it, the texel is scaled so that
+ *     the largest is 1 instead, which keeps the channels' ratios (the
+ *     direction the engine derives from them, the paper's bent normal): what
+ *     clips is the brightness, never the direction. A flat, unoccluded
+ *     ssbump texel (1/sqrt(3)) takes brightness up to sqrt(3) unclipped.
+ *     Further channels (Valve's alpha) are copied; a map of more than 4
+ *     channels (another basis) is BB_ERR_ARGUMENT.
+ *   ao: times b, at most 1.
+ *   normal: BB_ERR_ARGUMENT: a unit normal has no room for a brightness.
+ * A brightness of 1 gives the map back bit for bit. Allocates out with the
+ * map's channels. Errors: BB_ERR_ARGUMENT, BB_ERR_SIZE (another size),
+ * BB_ERR_VALUE (a NaN or infinite value in either map). */
+bb_status bb__combine_brightness(const bb_image *map, const bb_image *brightness,
+                                bb_map_kind kind, bb_image *out, bb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -55,7 +55,7 @@ Test(derive, flat_unoccluded_texel) {
   bb_image n = {0}, vis = {0}, w = {0}, s = {0}, ao = {0}, bent = {0};
   make_uniform(&n, 4, 3, up);
   make_uniform(&vis, 4, 4, all_visible);
-  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &w, NULL), BB_OK);
   cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
   cr_assert_eq(bb__derive_ao_all_cores(&vis, &ao, NULL), BB_OK);
   cr_assert_eq(bb__derive_bent_all_cores(&s, NULL, &bent, NULL), BB_OK);
@@ -97,7 +97,7 @@ Test(derive, normal_along_a_basis_vector_takes_all_weight) {
     bb__basis_vector(c, b);
     set_normal(&n, c, b[0], b[1], b[2]);
   }
-  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &w, NULL), BB_OK);
   for (int i = 0; i < 3; i++)
     for (int c = 0; c < 3; c++)
       cr_assert_float_eq(w.pixels[3 * i + c], i == c ? 1.0f : 0.0f, 1e-6f,
@@ -115,7 +115,7 @@ Test(derive, weights_between_and_beyond) {
   cr_assert_eq(bb_image_alloc(&n, 2, 1, 3, NULL), BB_OK);
   set_normal(&n, 0, b0[0] + b1[0], b0[1] + b1[1], b0[2] + b1[2]);
   set_normal(&n, 1, 0.0, 0.0, -1.0);
-  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &w, NULL), BB_OK);
   cr_assert_float_eq(w.pixels[0], 0.5f, 1e-6f);
   cr_assert_float_eq(w.pixels[1], 0.5f, 1e-6f);
   cr_assert_float_eq(w.pixels[2], 0.0f, 1e-6f);
@@ -194,7 +194,7 @@ static int same_bits(float a, float b) {
 
 /* The maps on many rows (they run row by row on all cores) against direct
  * per-texel formulas, bit for bit; one normal is NaN, which ssbump maps to 0
- * as fmax does (a bake's normals never are; bb_derive_weights refuses a
+ * as fmax does (a bake's normals never are; bb__derive_weights_all_cores refuses a
  * caller's, so its weights are derived before the NaN is put in). */
 static void check_maps_against_formulas(int count) {
   const int w = 37, h = 29, texels = w * h;
@@ -208,12 +208,12 @@ static void check_maps_against_formulas(int count) {
     for (int c = 0; c <= count; c++)
       vis.pixels[(1 + count) * i + c] = (float)next_random(&state);
   }
-  cr_assert_eq(bb_derive_weights(&n, NULL, &wt, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &wt, NULL), BB_OK);
   const float normal_x_100 = n.pixels[3 * 100];
   n.pixels[3 * 100] = NAN;
   bb_image refused = {0};
   bb_error e = {{0}};
-  cr_assert_eq(bb_derive_weights(&n, NULL, &refused, &e), BB_ERR_VALUE);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &refused, &e), BB_ERR_VALUE);
   cr_assert(strstr(e.message, "texel (26, 2) channel 0 is NaN") != NULL, "%s", e.message);
   cr_assert_null(refused.pixels);
   cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, NULL, &s, NULL), BB_OK);
@@ -275,8 +275,8 @@ Test(derive, rejects_mismatched_inputs) {
   cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis2, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb__derive_ssbump_all_cores(&vis, &vis, NULL, &out, &err), BB_ERR_ARGUMENT,
                "normals need 3 channels");
-  cr_assert_eq(bb_derive_weights(&vis, NULL, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_derive_weights(&n, NULL, &n, &err), BB_ERR_ARGUMENT, "output aliases input");
+  cr_assert_eq(bb__derive_weights_all_cores(&vis, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &n, &err), BB_ERR_ARGUMENT, "output aliases input");
   cr_assert_eq(bb__derive_bent_all_cores(&s2, NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_eq(bb__derive_ao_all_cores(NULL, &out, &err), BB_ERR_ARGUMENT);
   cr_assert_null(out.pixels);

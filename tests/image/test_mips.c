@@ -14,6 +14,7 @@
 #include "image/oiio.h"
 #include "image/formats.h"
 #include "image/image_write.h"
+#include "bake/bake_internal.h"
 
 static bb_image noise(int w, int h, int channels, unsigned seed, float lo, float hi) {
   bb_image img;
@@ -166,12 +167,12 @@ Test(mips, mip_of_an_ssbump_lights_like_the_mean_of_the_lit_texels) {
   bb_image n = noise_normals(16, 16, 5), w;
   levels = chain(&n, BB_MIP_RENORMALIZE, &count);
   bb_image w1;
-  cr_assert_eq(bb_derive_weights(&n, NULL, &w, NULL), BB_OK);
-  cr_assert_eq(bb_derive_weights(&levels[1], NULL, &w1, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &w, NULL), BB_OK);
+  cr_assert_eq(bb__derive_weights_all_cores(&levels[1], NULL, &w1, NULL), BB_OK);
   double worst = 0.0;
   for (int y = 0; y < 8; y++)
     for (int x = 0; x < 8; x++) {
-      /* bb_derive_weights normalises by the sum: compare the weight shares. */
+      /* bb__derive_weights_all_cores normalises by the sum: compare the weight shares. */
       for (int c = 0; c < 3; c++)
         worst = fmax(worst, fabs(bb_image_texel(&w1, x, y)[c] - block_mean(&w, x, y, c)));
     }

@@ -1,5 +1,5 @@
 /* test_brightness.c: the brightness modulation stored in the ssbump and
- * weights (bb_combine_brightness, bb_bake_options.brightness) and its
+ * weights (bb__combine_brightness, bb_bake_options.brightness) and its
  * provenance. */
 #include <criterion/criterion.h>
 
@@ -12,6 +12,7 @@
 #include "bake_harness.h"
 #include "bake/bake_internal.h"
 #include "core/internal.h"
+#include "maps/maps_internal.h"
 #include "files/provenance.h"
 #include "trace/basis.h"
 
@@ -25,7 +26,7 @@ static bb_image image(int w, int h, int channels, const float *texel) {
 static bb_image brightened(const bb_image *map, const bb_image *b, bb_map_kind kind) {
   bb_image out;
   bb_error err;
-  cr_assert_eq(bb_combine_brightness(map, b, kind, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__combine_brightness(map, b, kind, &out, &err), BB_OK, "%s", err.message);
   return out;
 }
 
@@ -103,21 +104,21 @@ Test(brightness, refuses_what_it_cannot_do) {
   bb_image normal = image(2, 2, 3, n), b = harness_field(2, 2, 0.5f), small = harness_field(1, 1, 0.5f);
   bb_image out;
   bb_error err;
-  cr_expect_eq(bb_combine_brightness(&normal, &b, BB_MAP_NORMAL, &out, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb__combine_brightness(&normal, &b, BB_MAP_NORMAL, &out, &err), BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "normal") != NULL, "%s", err.message);
-  cr_expect_eq(bb_combine_brightness(&normal, &small, BB_MAP_SSBUMP, &out, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__combine_brightness(&normal, &small, BB_MAP_SSBUMP, &out, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "brightness") != NULL, "%s", err.message);
   b.pixels[3] = NAN;
-  cr_expect_eq(bb_combine_brightness(&normal, &b, BB_MAP_SSBUMP, &out, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb__combine_brightness(&normal, &b, BB_MAP_SSBUMP, &out, &err), BB_ERR_VALUE);
   const float five[5] = {0.1f, 0.1f, 0.1f, 0.1f, 0.1f};
   bb_image wide = image(2, 2, 5, five), ok = harness_field(2, 2, 0.5f);
-  cr_expect_eq(bb_combine_brightness(&wide, &ok, BB_MAP_SSBUMP, &out, &err), BB_ERR_ARGUMENT,
+  cr_expect_eq(bb__combine_brightness(&wide, &ok, BB_MAP_SSBUMP, &out, &err), BB_ERR_ARGUMENT,
                "a basis of 5 directions is not Half-Life 2's");
   bb_image_free(&wide), bb_image_free(&ok), bb_image_free(&normal), bb_image_free(&b);
   bb_image_free(&small);
 }
 
-/* The bake's option is bb_combine_brightness on its ssbump and weights,
+/* The bake's option is bb__combine_brightness on its ssbump and weights,
  * over every basis channel; ao and bent stay as without it. */
 Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
   const int W = 32, H = 24;

@@ -500,7 +500,7 @@ Test(basis, derive_takes_the_basis_or_defaults_to_hl2) {
   n.pixels[3] = 0.0f, n.pixels[4] = 0.0f, n.pixels[5] = -1.0f; /* faces away from all */
   const bb_basis d5 = named("dirs:5");
   bb_error err;
-  cr_assert_eq(bb_derive_weights(&n, &d5, &out, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, &d5, &out, &err), BB_OK, "%s", err.message);
   cr_assert_eq(out.channels, 5);
   for (int c = 0; c < 5; c++) {
     cr_assert_float_eq(out.pixels[c], 0.2, 1e-7);
@@ -526,7 +526,7 @@ Test(basis, derive_takes_the_basis_or_defaults_to_hl2) {
   cr_assert_eq(bb__derive_ssbump_all_cores(&n, &vis, &d6, &bent, &err), BB_ERR_ARGUMENT);
   bb_basis broken = d5;
   broken.vector[2][2] = 2.0;
-  cr_assert_eq(bb_derive_weights(&n, &broken, &bent, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__derive_weights_all_cores(&n, &broken, &bent, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "basis vector 2 is not a unit vector"), "%s", err.message);
   bb_image_free(&ssbump);
   bb_image_free(&vis);
@@ -553,7 +553,7 @@ Test(basis, bake_refuses_a_broken_basis) {
 Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   bb_image s6, n;
   cr_assert_eq(bb_image_alloc(&s6, 2, 2, 6, NULL), BB_OK);
-  cr_assert_eq(bb_ssbump_to_normal(&s6, BB_MAP_SSBUMP, &n, NULL), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__ssbump_to_normal(&s6, BB_MAP_SSBUMP, &n, NULL), BB_ERR_ARGUMENT);
   bb_render_options ro;
   bb__render_options_init(&ro);
   bb_render_maps maps = {NULL, &s6, NULL, NULL, NULL, NULL};
@@ -561,8 +561,8 @@ Test(basis, hl2_readers_refuse_maps_of_other_bases) {
   bb_error err;
   cr_assert_eq(bb__render(&maps, &ro, &out, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "6 channels"), "%s", err.message);
-  cr_assert_eq(bb_combine_detail(&s6, &s6, BB_MAP_SSBUMP, NULL, &out, &err), BB_ERR_ARGUMENT);
-  cr_assert_eq(bb_combine_blend(&s6, &s6, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err), BB_OK,
+  cr_assert_eq(bb__combine_detail(&s6, &s6, BB_MAP_SSBUMP, NULL, &out, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__combine_blend(&s6, &s6, NULL, 0.5f, BB_MAP_SSBUMP, &out, &err), BB_OK,
                "a blend is linear in every channel: %s", err.message);
   bb_image_free(&out);
   bb_image_free(&s6);
