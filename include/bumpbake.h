@@ -2091,22 +2091,21 @@ char *bb_command_text(const bb_command *command, const char *input, unsigned fla
 /* The command line the outputs record as their provenance's "command",
  * when it is not the one bb_command_text spells: a command-line client
  * gives the words as typed with those of options that are not
- * BB_OPTION_RECORDED left out. line: the whole command ("bumpbake bake
- * h.png --scale 8 --normal n.png"); options: the words of the options
- * alone, which a batch's outputs record after "bumpbake bake INPUT".
- * Either may be NULL. Errors: BB_ERR_MEMORY. */
-bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
-                                bb_error *err);
-
-/* The command line the file path records when the command writes its map
+ * BB_OPTION_RECORDED left out.
+ * path NULL: every output's. line: the whole command ("bumpbake bake h.png
+ * --scale 8 --normal n.png"); options: the words of the options alone,
+ * which a batch's outputs record after "bumpbake bake INPUT". Either may
+ * be NULL.
+ * path a file: the line that file records when the command writes its map
  * to several files (bake --ssbump s.png --ssbump s.vtf: one bake, each file
  * in its format): a command-line client gives the words as typed less
  * those of the map's other files, so each file records what a bake of it
- * alone records. Without one, such a file records the command as
- * bb_command_text spells it with only that file for its map. Errors:
- * BB_ERR_MEMORY. */
-bb_status bb_command_set_record_of(bb_command *command, const char *path,
-                                   const char *line, bb_error *err);
+ * alone records (options NULL). Without one, such a file records the
+ * command as bb_command_text spells it with only that file for its map.
+ * Errors: BB_ERR_MEMORY; BB_ERR_ARGUMENT (a file without its line, or
+ * with options; more files than a command writes). */
+bb_status bb_command_set_record(bb_command *command, const char *path, const char *line,
+                                const char *options, bb_error *err);
 
 /* What a caller hooks into a command's run; every field may be NULL. */
 typedef struct bb_command_hooks {

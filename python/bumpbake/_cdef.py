@@ -780,8 +780,8 @@ char *bb_command_text(const bb_command *command, const char *input, unsigned fla
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
                                    int input_count, bb_command **out, bb_error *err);
-bb_status bb_command_set_record(bb_command *command, const char *line, const char *options,
-                                bb_error *err);
+bb_status bb_command_set_record(bb_command *command, const char *path, const char *line,
+                                const char *options, bb_error *err);
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
                           bb_error *err);
 bb_status bb_command_run(bb_command *command, const bb_command_hooks *hooks,

@@ -291,7 +291,7 @@ class Command:
             if value is not None and not isinstance(value, str):
                 raise TypeError(f"{self.function}: {what} must be a str (got {_shown(value)})")
         _check(_lib.bb_command_set_record(
-            self._c, _c_text(line, "command") if line is not None else _ffi.NULL,
+            self._c, _ffi.NULL, _c_text(line, "command") if line is not None else _ffi.NULL,
             _c_text(options, "command_options") if options is not None else _ffi.NULL, err),
             err)
 

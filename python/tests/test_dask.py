@@ -392,8 +392,8 @@ def test_a_handed_over_command_is_the_command(tmp_path, monkeypatch):
         _check(_lib.bb_command_set(c, name.encode(), text.encode() if text else _ffi.NULL,
                                    err), err)
     _check(_lib.bb_command_add_input(c, b"heights", err), err)
-    _check(_lib.bb_command_set_record(c, b"bumpbake bake heights ...", b"--scale 12.5", err),
-           err)
+    _check(_lib.bb_command_set_record(c, _ffi.NULL, b"bumpbake bake heights ...",
+                                      b"--scale 12.5", err), err)
     _check(_lib.bb_command_check(c, err), err)
     size = _ffi.new("size_t *")
     data = _lib.bb_command_handover(c, size)
@@ -572,7 +572,7 @@ def test_the_command_lines_forced_batch_with_a_depfile_is_baked_once(tmp_path, m
         _check(_lib.bb_command_set(c, name.encode(), text.encode() if text else _ffi.NULL,
                                    err), err)
     _check(_lib.bb_command_add_input(c, b"heights", err), err)
-    _check(_lib.bb_command_set_record(c, b"bumpbake bake heights", b"", err), err)
+    _check(_lib.bb_command_set_record(c, _ffi.NULL, b"bumpbake bake heights", b"", err), err)
     _check(_lib.bb_command_check(c, err), err)
     size = _ffi.new("size_t *")
     data = _lib.bb_command_handover(c, size)

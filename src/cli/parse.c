@@ -353,7 +353,7 @@ static bb_status record_files(const parse *p, bb_error *err) {
     char *line = recorded_of(p, 0, o, p->file_value[w]);
     if (!line)
       return BB_ERR_MEMORY;
-    bb_status st = bb_command_set_record_of(p->command, p->file_value[w], line, err);
+    bb_status st = bb_command_set_record(p->command, p->file_value[w], line, NULL, err);
     free(line);
     if (st != BB_OK)
       return st;
@@ -388,7 +388,7 @@ static int parse_and_run(parse *p, int (*run)(const cli_run *r)) {
   if (st != BB_OK)
     return refused(p, st, &err);
   char *line = recorded(p, 0), *options = recorded(p, 1);
-  st = line && options ? bb_command_set_record(p->command, line, options, &err)
+  st = line && options ? bb_command_set_record(p->command, NULL, line, options, &err)
                        : BB_ERR_MEMORY;
   if (st == BB_OK)
     st = record_files(p, &err);

@@ -99,7 +99,7 @@ struct bb_command {
   int more_count;
   int more_option[BB_JOB_MAX_OUTPUTS];
   const char *more_path[BB_JOB_MAX_OUTPUTS]; /* owned: strings */
-  /* The command line each such file records (bb_command_set_record_of). */
+  /* The command line each such file records (bb_command_set_record of a path). */
   int file_record_count;
   char *file_record_path[BB_JOB_MAX_OUTPUTS], *file_record_line[BB_JOB_MAX_OUTPUTS];
   int in_memory;                     /* images in memory, not files */

@@ -387,10 +387,15 @@ static bb_status check(bb_command *c, bb_error *err) {
   return st;
 }
 
-bb_status bb_command_set_record(bb_command *c, const char *line, const char *options,
-                                bb_error *err) {
+static bb_status record_of(bb_command *c, const char *path, const char *line, bb_error *err);
+
+bb_status bb_command_set_record(bb_command *c, const char *path, const char *line,
+                                const char *options, bb_error *err) {
   if (!c)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: none to record");
+  if (path)
+    return options ? bb__fail(err, BB_ERR_ARGUMENT, "command: a file records a line alone")
+                   : record_of(c, path, line, err);
   char *l = line ? strdup(line) : NULL, *o = options ? strdup(options) : NULL;
   if ((line && !l) || (options && !o)) {
     free(l);
@@ -404,9 +409,9 @@ bb_status bb_command_set_record(bb_command *c, const char *line, const char *opt
   return BB_OK;
 }
 
-bb_status bb_command_set_record_of(bb_command *c, const char *path, const char *line,
-                                   bb_error *err) {
-  if (!c || !path || !line)
+/* The line one of the files of a map written to several records. */
+static bb_status record_of(bb_command *c, const char *path, const char *line, bb_error *err) {
+  if (!line)
     return bb__fail(err, BB_ERR_ARGUMENT, "command: no file record");
   int r = 0;
   while (r < c->file_record_count && strcmp(c->file_record_path[r], path))

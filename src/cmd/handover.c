@@ -103,14 +103,14 @@ static bb_status replay(bb_command *c, const char *data, size_t size, size_t at,
       options = (char *)a;
     } else if (!strcmp(tag, "record-of")) {
       st = next(data, size, &at, &b)
-               ? bb_command_set_record_of(c, a, b, err)
+               ? bb_command_set_record(c, a, b, NULL, err)
                : bb__fail(err, BB_ERR_ARGUMENT, "command hand-over: cut short");
     } else {
       st = bb__fail(err, BB_ERR_ARGUMENT, "command hand-over: unknown field '%.32s'", tag);
     }
   }
   if (st == BB_OK && (line || options))
-    st = bb_command_set_record(c, line, options, err);
+    st = bb_command_set_record(c, NULL, line, options, err);
   if (st == BB_OK)
     st = bb_command_check(c, err);
   return st;

@@ -41,7 +41,7 @@ Test(handover, gives_the_same_command) {
       {NULL, NULL}};
   bb_command *c = bake(inputs, options);
   bb_error err = {{0}};
-  cr_assert_eq(bb_command_set_record(c, "bumpbake bake my heights ...", "--scale 36.8083", &err),
+  cr_assert_eq(bb_command_set_record(c, NULL, "bumpbake bake my heights ...", "--scale 36.8083", &err),
                BB_OK);
   size_t size = 0;
   char *data = bb_command_handover(c, &size);
@@ -117,11 +117,16 @@ Test(handover, carries_a_map_written_to_several_files) {
   bb_command *c = bake(inputs, options);
   bb_error err = {{0}};
   cr_assert_eq(
-      bb_command_set_record(c, "bumpbake bake h.png --scale 8 ...", "--scale 8", &err),
+      bb_command_set_record(c, NULL, "bumpbake bake h.png --scale 8 ...", "--scale 8", &err),
       BB_OK);
   cr_assert_eq(
-      bb_command_set_record_of(c, "s.tga", "bumpbake bake h.png --scale 8 s.tga", &err),
+      bb_command_set_record(c, "s.tga", "bumpbake bake h.png --scale 8 s.tga", NULL, &err),
       BB_OK);
+  /* a file records a line, and nothing else */
+  cr_expect_eq(bb_command_set_record(c, "s.tga", "bumpbake bake h.png", "--scale 8", &err),
+               BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "command: a file records a line alone");
+  cr_expect_eq(bb_command_set_record(c, "s.tga", NULL, NULL, &err), BB_ERR_ARGUMENT);
   size_t size = 0;
   char *data = bb_command_handover(c, &size);
   cr_assert(data && size > 0);
