@@ -2282,9 +2282,9 @@ bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_
  * (allocated; free with bb_image_free): normal2ssbump's weights (a channel
  * per direction), ssbump2normal's normals (3 channels), combine's map
  * (A's channels). Errors: BB_ERR_ARGUMENT (not a checked command of the
- * three set in memory; a or combine's b missing; a size, channel count,
- * or basis the operator refuses), BB_ERR_SIZE (maps of two sizes),
- * BB_ERR_VALUE (a NaN or infinite value, naming the texel). */
+ * three set in memory; a or combine's b missing or empty; maps of two
+ * sizes; a channel count or basis the operator refuses), BB_ERR_VALUE (a
+ * NaN or infinite value, naming the texel), BB_ERR_MEMORY. */
 bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
                          const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
                          bb_image *out, bb_error *err);

@@ -307,16 +307,20 @@ static bb_status map(bb_command *c, const bb_image *a, const bb_image *b, const 
   } else if (c->def->run == bb__run_combine) {
     const int normal = o->map_kind == BB_MAP_NORMAL;
     float flat[3];
-    st = b ? BB_OK
-           : bb__fail(err, BB_ERR_ARGUMENT, "combine: %s", o->brightness
-                                                              ? "the brightness map is needed"
-                                                              : "B, the second map, is needed");
-    if (st == BB_OK)
+    if (!b)
+      st = bb__fail(err, BB_ERR_ARGUMENT, "combine: %s",
+                    o->brightness ? "the brightness map is needed" : "B, the second map, is needed");
+    else if (o->mask && !mask)
+      st = bb__fail(err, BB_ERR_ARGUMENT, "combine: the mask is needed");
+    else if (b_depth < BB_DEPTH_DEFAULT || b_depth > BB_DEPTH_FLOAT)
+      st = bb__fail(err, BB_ERR_ARGUMENT, "combine: no depth %d", (int)b_depth);
+    else
       st = green_down(a, normal && up, &copies[0], &va, err);
     if (st == BB_OK)
       st = green_down(b, normal && up, &copies[1], &vb, err);
-    if (st == BB_OK)
-      st = combine_values(o, va, vb, mask, flat_of_depth(o->map_kind, b_depth, flat), out, err);
+    if (st == BB_OK) /* a mask only with --mask */
+      st = combine_values(o, va, vb, o->mask ? mask : NULL,
+                          flat_of_depth(o->map_kind, b_depth, flat), out, err);
   } else {
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s makes no map of images in memory", name);
   }

@@ -5,6 +5,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp */
 
 #include "bumpbake.h"
+#include "command_words.h"
 #include "image/image_write.h"
 
 #include <criterion/criterion.h>
@@ -35,25 +36,6 @@ static void teardown(void) {
     unlink(p);
   }
   rmdir(dir);
-}
-
-/* A command of words (options as --name value, a flag alone, the rest
- * inputs), not checked. */
-static bb_command *command(const char *name, const char *const *words) {
-  bb_command *c = NULL;
-  bb_error err = {{0}};
-  cr_assert_eq(bb_command_new(name, &c, &err), BB_OK, "%s", err.message);
-  for (int i = 0; words && words[i]; i++) {
-    if (words[i][0] != '-') {
-      cr_assert_eq(bb_command_add_input(c, words[i], &err), BB_OK, "%s", err.message);
-      continue;
-    }
-    const bb_option_info *o = bb_option_find(bb_command_describe(c), words[i] + 2, 0);
-    cr_assert_not_null(o, "%s", words[i]);
-    const char *value = o->type == BB_OPTION_FLAG ? NULL : words[++i];
-    cr_assert_eq(bb_command_set(c, o->name, value, &err), BB_OK, "%s", err.message);
-  }
-  return c;
 }
 
 /* An image of w x h x channels whose texels vary smoothly in (lo, hi). */
@@ -146,7 +128,8 @@ Test(cmd_map, normal2ssbump_in_memory_is_the_runs_weights) {
   expect_run_writes("normal2ssbump", run, &mem);
   /* the green read as +Y up: not the weights of the same normals +Y down */
   bb_command_free(c);
-  c = in_memory("normal2ssbump", NULL);
+  const char *none[] = {NULL};
+  c = in_memory("normal2ssbump", none);
   bb_image down = {0};
   cr_assert_eq(bb_command_map(c, &normals, NULL, NULL, BB_DEPTH_DEFAULT, NULL, &down, &err),
                BB_OK);
@@ -189,7 +172,7 @@ Test(cmd_map, combine_detail_in_memory_takes_Bs_depth) {
     flat.pixels[i] = 1.0f / sqrtf(3.0f); /* stored as 147 of 255 */
   write_file(at(1, "b.png"), &flat, BB_DEPTH_8);
   bb_image va = read_back(paths[0], NULL), vb = read_back(paths[1], NULL);
-  const char *words[] = {"--detail", NULL};
+  const char *words[] = {"--detail", "1", NULL};
   bb_command *c = in_memory("combine", words);
   bb_image mem = {0}, exact = {0};
   bb_error err = {{0}};
@@ -200,7 +183,7 @@ Test(cmd_map, combine_detail_in_memory_takes_Bs_depth) {
   cr_assert_eq(bb_command_map(c, &va, &vb, NULL, BB_DEPTH_DEFAULT, NULL, &exact, &err), BB_OK);
   cr_expect_neq(memcmp(exact.pixels, va.pixels, 16 * 16 * 3 * sizeof(float)), 0,
                 "147/255 is not the exact flat");
-  const char *run[] = {paths[0], paths[1], "--detail", NULL};
+  const char *run[] = {paths[0], paths[1], "--detail", "1", NULL};
   expect_run_writes("combine", run, &mem);
   bb_image_free(&exact);
   bb_image_free(&mem);
@@ -254,6 +237,7 @@ Test(cmd_map, combine_mask_of_normals_in_memory_is_the_runs_map) {
 Test(cmd_map, refusals_name_what_is_wrong) {
   bb_image a = pattern(8, 8, 3, 0.1f, 0.9f), out = {0};
   bb_error err = {{0}};
+  const char *none[] = {NULL};
   const char *mix[] = {"--mix", "0.5", NULL};
   bb_command *c = command("combine", mix);
   bb_command_set_in_memory(c, 0);
@@ -264,6 +248,28 @@ Test(cmd_map, refusals_name_what_is_wrong) {
   cr_expect_eq(bb_command_map(c, &a, NULL, NULL, BB_DEPTH_DEFAULT, NULL, &out, &err),
                BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "combine: B, the second map, is needed");
+  /* --mix: a mask given is not used (all 1 would give B) */
+  bb_image ones = pattern(8, 8, 1, 0.0f, 0.0f), mixed = {0}, masked = {0};
+  for (size_t i = 0; i < 8 * 8; i++)
+    ones.pixels[i] = 1.0f;
+  bb_image other = pattern(8, 8, 3, 0.9f, 0.2f);
+  cr_assert_eq(bb_command_map(c, &a, &other, NULL, BB_DEPTH_DEFAULT, NULL, &mixed, &err), BB_OK);
+  cr_assert_eq(bb_command_map(c, &a, &other, &ones, BB_DEPTH_DEFAULT, NULL, &masked, &err),
+               BB_OK);
+  cr_expect_eq(memcmp(mixed.pixels, masked.pixels, 8 * 8 * 3 * sizeof(float)), 0);
+  bb_image_free(&mixed);
+  bb_image_free(&masked);
+  cr_expect_eq(bb_command_map(c, &a, &other, NULL, (bb_depth)9, NULL, &mixed, &err),
+               BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "combine: no depth 9");
+  bb_command_free(c);
+  const char *masking[] = {"--mask", "(array)", NULL};
+  c = in_memory("combine", masking);
+  cr_expect_eq(bb_command_map(c, &a, &other, NULL, BB_DEPTH_DEFAULT, NULL, &mixed, &err),
+               BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "combine: the mask is needed");
+  bb_image_free(&other);
+  bb_image_free(&ones);
   cr_expect_eq(bb_command_map(c, &a, &a, NULL, BB_DEPTH_DEFAULT, NULL, NULL, &err),
                BB_ERR_ARGUMENT);
   cr_expect_null(out.pixels);
@@ -284,7 +290,7 @@ Test(cmd_map, refusals_name_what_is_wrong) {
   bb_command_free(c);
   /* the operator's own refusal: another basis' map */
   bb_image six = pattern(8, 8, 6, 0.1f, 0.9f);
-  c = in_memory("ssbump2normal", NULL);
+  c = in_memory("ssbump2normal", none);
   cr_expect_eq(bb_command_map(c, &six, NULL, NULL, BB_DEPTH_DEFAULT, NULL, &out, &err),
                BB_ERR_ARGUMENT);
   cr_expect(strstr(err.message, "6 channels"), "%s", err.message);
