@@ -752,24 +752,19 @@ typedef enum bb_normal_filter {
                           vertex added; a symmetric bump's peak gives (0,0,1) */
 } bb_normal_filter;
 
-typedef struct bb_normal_decode_options {
-  int normal_y_up; /* 1: the map's green is +Y up (OpenGL); it is negated to +Y down */
-  int normalize;   /* 1: each texel is scaled to unit length; (0, 0, 0) becomes (0, 0, 1) */
-} bb_normal_decode_options;
-
-/* Defaults: +Y down, normalize on. */
-void bb_normal_decode_options_init(bb_normal_decode_options *o);
-
 /* The normals a normal-map file holds, from the values bb_image_read
  * returns for it. Integer files hold 0.5 + 0.5 N, so N = 2 v - 1 with
  * v = code / max code: code 127.5 of 255 is 0, and code 128 (DOOM 3's zero)
  * reads as +1/255 (Valve's normal2ssbump decodes the same way). Float files
  * (is_float 1, from bb_image_info) hold N as it is. Uses channels 0..2
- * (values needs 3 or more). Non-finite values are BB_ERR_VALUE, naming the
- * texel. Allocates normals: 3 channels, same size. */
-bb_status bb_normal_map_decode(const bb_image *values, int is_float,
-                               const bb_normal_decode_options *o, bb_image *normals,
-                               bb_error *err);
+ * (values needs 3 or more). normal_y_up 1: the map's green is +Y up
+ * (OpenGL), negated to the library's +Y down (the command line's
+ * --normal-y up). normalize 1: each texel scaled to unit length, (0, 0, 0)
+ * becoming (0, 0, 1) (0: as decoded, so a texel an operator copies keeps
+ * its code). Non-finite values are BB_ERR_VALUE, naming the texel.
+ * Allocates normals: 3 channels, same size. */
+bb_status bb_normal_map_decode(const bb_image *values, int is_float, int normal_y_up,
+                               int normalize, bb_image *normals, bb_error *err);
 
 /* ---------------------------------------------------------------- bake */
 

@@ -179,10 +179,6 @@ typedef enum bb_normal_filter {
   BB_NORMAL_VERTEX
 } bb_normal_filter;
 
-typedef struct bb_normal_decode_options {
-  int normal_y_up;
-  int normalize;
-} bb_normal_decode_options;
 
 typedef struct bb_basis {
   int count;
@@ -680,10 +676,8 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_height_from_image(const bb_image *img, int alpha_channel,
                                bb_channel channel, bb_image *height,
                                bb_error *err);
-void bb_normal_decode_options_init(bb_normal_decode_options *o);
-bb_status bb_normal_map_decode(const bb_image *values, int is_float,
-                               const bb_normal_decode_options *o, bb_image *normals,
-                               bb_error *err);
+bb_status bb_normal_map_decode(const bb_image *values, int is_float, int normal_y_up,
+                               int normalize, bb_image *normals, bb_error *err);
 bb_status bb_basis_from_vectors(const double (*vectors)[3], int count, bb_basis *out,
                                 bb_error *err);
 bb_status bb_basis_resolve(const char *spec, bb_basis *out, int *from_file, bb_error *err);

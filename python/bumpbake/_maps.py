@@ -17,14 +17,11 @@ def decode_normals(values, is_float=False, normal_y="down", normalize=True):
     (0, 0, 1)). values: (H, W, C), C >= 3 (channels past 3 are ignored).
     Returns float32 (H, W, 3)."""
     src = _Image("decode_normals: values", values)
-    o = _ffi.new("bb_normal_decode_options *")
-    _lib.bb_normal_decode_options_init(o)
-    o.normal_y_up = _normal_y_up("decode_normals", normal_y)
-    o.normalize = int(bool(normalize))
+    up = _normal_y_up("decode_normals", normal_y)
     out = _ffi.new("bb_image *")
     err = _ffi.new("bb_error *")
-    _check(_lib.bb_normal_map_decode(src.image, int(bool(is_float)), o, out, err), err,
-           arrays=True)
+    _check(_lib.bb_normal_map_decode(src.image, int(bool(is_float)), up, int(bool(normalize)),
+                                     out, err), err, arrays=True)
     return _take(out)
 
 

@@ -86,11 +86,8 @@ bb_status bb__run_normal2ssbump(bb_command *c, const bb_command_hooks *hooks,
   bb_image_info info = {0};
   bb_status st = read_map(input, &values, &info, err);
   if (st == BB_OK) {
-    bb_normal_decode_options d;
-    bb_normal_decode_options_init(&d);
-    d.normal_y_up = o->maps_normal_y_up;
     bb_error e = {{0}};
-    st = bb_normal_map_decode(&values, info.is_float, &d, &normals, &e);
+    st = bb_normal_map_decode(&values, info.is_float, o->maps_normal_y_up, 1, &normals, &e);
     if (st == BB_OK)
       st = bb__derive_weights_all_cores(&normals, NULL, &weights, &e);
     if (st == BB_OK)
@@ -165,12 +162,8 @@ static bb_status load_map(const bb_command_options *a, const char *path, map_inp
   if (st != BB_OK || a->map_kind != BB_MAP_NORMAL)
     return st;
   /* Not renormalised: a texel the operators copy must keep its code. */
-  bb_normal_decode_options o;
-  bb_normal_decode_options_init(&o);
-  o.normal_y_up = a->maps_normal_y_up;
-  o.normalize = 0;
   bb_error e = {{0}};
-  st = bb_normal_map_decode(&m->file, m->info.is_float, &o, &m->values, &e);
+  st = bb_normal_map_decode(&m->file, m->info.is_float, a->maps_normal_y_up, 0, &m->values, &e);
   return st == BB_OK ? BB_OK : bb__fail_at(err, st, path, &e);
 }
 

@@ -8,22 +8,11 @@
 #include <math.h>
 #include <string.h>
 
-void bb_normal_decode_options_init(bb_normal_decode_options *o) {
-  memset(o, 0, sizeof *o);
-  o->normal_y_up = 0;
-  o->normalize = 1;
-}
-
-bb_status bb_normal_map_decode(const bb_image *values, int is_float,
-                               const bb_normal_decode_options *o, bb_image *normals,
-                               bb_error *err) {
+bb_status bb_normal_map_decode(const bb_image *values, int is_float, int normal_y_up,
+                               int normalize, bb_image *normals, bb_error *err) {
   if (!normals)
     return bb__fail(err, BB_ERR_ARGUMENT, "normal map decode: normals is NULL");
   memset(normals, 0, sizeof *normals);
-  bb_normal_decode_options defaults;
-  bb_normal_decode_options_init(&defaults);
-  if (!o)
-    o = &defaults;
   bb_status st = bb__check_channels(values, 3, "normal map", err);
   if (st == BB_OK)
     st = bb__check_finite(values, 3, "normal map", err);
@@ -38,9 +27,9 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float,
     double N[3];
     for (int k = 0; k < 3; k++)
       N[k] = is_float ? (double)v[k] : 2.0 * (double)v[k] - 1.0;
-    if (o->normal_y_up)
+    if (normal_y_up)
       N[1] = -N[1];
-    if (o->normalize)
+    if (normalize)
       bb__normalize3(N);
     for (int k = 0; k < 3; k++)
       normals->pixels[3 * i + (size_t)k] = (float)N[k];

@@ -50,10 +50,7 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
     st = bb__fail(err, BB_ERR_ARGUMENT, "%s: %dx%d, but the other maps are %dx%d", path,
                   raw.width, raw.height, like->width, like->height);
   if (st == BB_OK && k->unit_vectors) {
-    bb_normal_decode_options decode;
-    bb_normal_decode_options_init(&decode);
-    decode.normal_y_up = normal_y_up;
-    st = bb_normal_map_decode(&raw, is_float, &decode, out, &why);
+    st = bb_normal_map_decode(&raw, is_float, normal_y_up, 1, out, &why);
     if (st != BB_OK)
       bb__fail(err, st, "%s: %s", path, why.message);
     bb_image_free(&raw);

@@ -113,11 +113,9 @@ Test(cmd_map, normal2ssbump_in_memory_is_the_runs_weights) {
   write_file(at(0, "n.exr"), &n, BB_DEPTH_FLOAT);
   bb_image_info info = {0};
   bb_image values = read_back(paths[0], &info);
-  bb_normal_decode_options d;
-  bb_normal_decode_options_init(&d); /* as the run decodes, but +Y left up */
   bb_image normals = {0};
-  bb_error err = {{0}};
-  cr_assert_eq(bb_normal_map_decode(&values, info.is_float, &d, &normals, &err), BB_OK);
+  bb_error err = {{0}}; /* as the run decodes, but +Y left up */
+  cr_assert_eq(bb_normal_map_decode(&values, info.is_float, 0, 1, &normals, &err), BB_OK);
   const char *words[] = {"--normal-y", "up", NULL};
   bb_command *c = in_memory("normal2ssbump", words);
   bb_image mem = {0};
@@ -205,13 +203,10 @@ Test(cmd_map, combine_mask_of_normals_in_memory_is_the_runs_map) {
   bb_image_info i1 = {0}, i2 = {0};
   bb_image v1 = read_back(paths[0], &i1), v2 = read_back(paths[1], &i2);
   bb_image mask = read_back(paths[2], NULL);
-  bb_normal_decode_options d;
-  bb_normal_decode_options_init(&d);
-  d.normalize = 0; /* as the run decodes them */
   bb_image d1 = {0}, d2 = {0};
-  bb_error err = {{0}};
-  cr_assert_eq(bb_normal_map_decode(&v1, i1.is_float, &d, &d1, &err), BB_OK);
-  cr_assert_eq(bb_normal_map_decode(&v2, i2.is_float, &d, &d2, &err), BB_OK);
+  bb_error err = {{0}}; /* as the run decodes them, not renormalised (+Y left up) */
+  cr_assert_eq(bb_normal_map_decode(&v1, i1.is_float, 0, 0, &d1, &err), BB_OK);
+  cr_assert_eq(bb_normal_map_decode(&v2, i2.is_float, 0, 0, &d2, &err), BB_OK);
   const char *words[] = {"--mask", "(array)", "--kind", "normal", "--normal-y", "up", NULL};
   bb_command *c = in_memory("combine", words);
   bb_image mem = {0};

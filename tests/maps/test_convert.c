@@ -60,12 +60,9 @@ Test(convert, integer_codes_decode_with_127_5_as_zero) {
   set3(&v, 1, 0, 128.0f / 255, 128.0f / 255, 1.0f); /* DOOM 3's zero */
   set3(&v, 2, 0, 1.0f, 0.5f, 0.5f);                 /* +x */
   set3(&v, 3, 0, 0.0f, 0.0f, 0.0f);                 /* (-1, -1, -1) */
-  bb_normal_decode_options o;
-  bb_normal_decode_options_init(&o);
-  o.normalize = 0;
   bb_image n;
   bb_error err;
-  cr_assert_eq(bb_normal_map_decode(&v, 0, &o, &n, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_normal_map_decode(&v, 0, 0, 0, &n, &err), BB_OK, "%s", err.message);
   cr_assert_eq(n.channels, 3);
   const float *t = bb_image_texel(&n, 0, 0);
   cr_assert(t[0] == 0.0f && t[1] == 0.0f && t[2] == 1.0f);
@@ -83,11 +80,8 @@ Test(convert, float_files_hold_n_and_options_apply) {
   bb_image v = image(2, 1, 4); /* an alpha channel is dropped */
   set3(&v, 0, 0, 0.0f, 0.6f, 0.8f);
   set3(&v, 1, 0, 0.0f, 0.0f, 0.0f);
-  bb_normal_decode_options o;
-  bb_normal_decode_options_init(&o);
-  o.normal_y_up = 1;
   bb_image n;
-  cr_assert_eq(bb_normal_map_decode(&v, 1, &o, &n, NULL), BB_OK);
+  cr_assert_eq(bb_normal_map_decode(&v, 1, 1, 1, &n, NULL), BB_OK);
   cr_assert_eq(n.channels, 3);
   const float *t = bb_image_texel(&n, 0, 0);
   cr_assert_float_eq(t[1], -0.6, 1e-7, "--normal-y up negates green");
@@ -98,8 +92,7 @@ Test(convert, float_files_hold_n_and_options_apply) {
 
   /* Normalisation rescales a short vector. */
   set3(&v, 0, 0, 0.0f, 0.3f, 0.4f);
-  o.normal_y_up = 0;
-  cr_assert_eq(bb_normal_map_decode(&v, 1, &o, &n, NULL), BB_OK);
+  cr_assert_eq(bb_normal_map_decode(&v, 1, 0, 1, &n, NULL), BB_OK);
   cr_assert_float_eq(bb_image_texel(&n, 0, 0)[1], 0.6, 1e-7);
   bb_image_free(&n);
   bb_image_free(&v);
@@ -108,12 +101,12 @@ Test(convert, float_files_hold_n_and_options_apply) {
 Test(convert, bad_inputs_are_refused) {
   bb_image grey = image(3, 3, 1), v = image(3, 3, 3), n;
   bb_error err;
-  cr_assert_eq(bb_normal_map_decode(&grey, 0, NULL, &n, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_normal_map_decode(&grey, 0, 0, 1, &n, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "1 channel"), "%s", err.message);
   cr_assert_null(n.pixels);
   cr_assert_eq(bb__ssbump_to_normal(&grey, BB_MAP_SSBUMP, &n, &err), BB_ERR_ARGUMENT);
   bb_image_texel(&v, 2, 1)[1] = NAN;
-  cr_assert_eq(bb_normal_map_decode(&v, 1, NULL, &n, &err), BB_ERR_VALUE);
+  cr_assert_eq(bb_normal_map_decode(&v, 1, 0, 1, &n, &err), BB_ERR_VALUE);
   cr_assert(strstr(err.message, "(2, 1)"), "%s", err.message);
   cr_assert_eq(bb__ssbump_to_normal(&v, BB_MAP_SSBUMP, &n, &err), BB_ERR_VALUE);
   cr_assert_eq(bb__ssbump_to_normal(&v, (bb_map_kind)7, &n, &err), BB_ERR_ARGUMENT);
@@ -129,7 +122,7 @@ Test(convert, normal2ssbump_of_a_baked_normal_is_the_baked_weights) {
     h.pixels[i] = (float)(h.pixels[i] + 0.3 * sin(i * 0.7));
   bb_bake_result r = bake(&h, 24.0f);
   bb_image n, w;
-  cr_assert_eq(bb_normal_map_decode(&r.normal, 1, NULL, &n, NULL), BB_OK);
+  cr_assert_eq(bb_normal_map_decode(&r.normal, 1, 0, 1, &n, NULL), BB_OK);
   cr_assert_eq(bb__derive_weights_all_cores(&n, NULL, &w, NULL), BB_OK);
   double d = max_difference(&w, &r.weights);
   cr_assert_lt(d, 1e-5, "weights differ by %g", d);

@@ -560,10 +560,7 @@ Test(render, describe_names_every_option) {
 
 /* Decodes as render reads a normal map: renormalised, green_up flips y. */
 static bb_status decode(const bb_image *img, int is_float, int green_up, bb_image *n) {
-  bb_normal_decode_options o;
-  bb_normal_decode_options_init(&o);
-  o.normal_y_up = green_up;
-  return bb_normal_map_decode(img, is_float, &o, n, NULL);
+  return bb_normal_map_decode(img, is_float, green_up, 1, n, NULL);
 }
 
 Test(render, normals_decode) {
