@@ -1903,9 +1903,9 @@ typedef enum bb_output_state {
  * descriptions: a value is parsed and checked by the library's one
  * function for its rule (bb_command_set), the rules between options by
  * the library's (bb_command_check), and every client prints the library's
- * words. A command's options land in one typed struct
- * (bb_command_options); the commands that write files through the job
- * are planned from it in one call (bb_command_plan). */
+ * words. A command's options are held by the command (opaque) and read
+ * back by name (bb_command_value); the commands that write files through
+ * the job are planned from them in one call (bb_command_plan). */
 
 /* What an option's value is. */
 typedef enum bb_option_type {
@@ -2043,49 +2043,6 @@ bb_status bb_option_parse(const bb_option_info *option, const char *text, long l
  * words. Static text. */
 const char *bb_option_word(const bb_option_info *option, long long value);
 
-/* ------------------------------------------------------------- options */
-
-/* Every option of every command lands here, typed: the command's own
- * structs (a bake's bb_job_options, a render's bb_render_options...) and
- * what has no struct of its own yet. A command uses the fields its options
- * name. Strings point into the bb_command, which owns them. */
-typedef struct bb_command_options {
-  bb_job_options job;           /* bake, normal, height2ssbump; the bake of render's
-                                   and sheet's HEIGHT; depth, mips and texture settings
-                                   of every command writing maps */
-  const char *output;           /* -o of the commands writing one named file (render,
-                                   sheet, combine, ...: the default filled in by
-                                   bb_command_check where the command has one) */
-  bb_render_options render;     /* render's picture; sheet's lit panel */
-  const char *render_maps[BB_MAP_KIND_COUNT]; /* render --normal, --ssbump, --ao,
-                                   --bent, --slope (by bb_map_kind) */
-  const char *albedo;           /* render --albedo */
-  int render_compare;           /* render --compare */
-  int orbit;                    /* render --orbit: frames, 0: one picture */
-  int maps_normal_y_up;         /* --normal-y up of render, normal2ssbump, combine
-                                   (the maps read), ssbump2normal and renderbumpflat
-                                   (the map written) */
-  int panel_size;               /* sheet --panel-size */
-  bb_compare_limits limits;     /* compare */
-  const char *diff;             /* compare --diff */
-  const char *limit_rules;      /* check --limits: "KIND|PATTERN: -fail T ...; ..." */
-  int check_bake;               /* check --bake: the inputs after GOLDEN are heights */
-  int update;                   /* check --update */
-  const char *junit, *html;     /* check --junit FILE, --html DIR */
-  bb_renderbump_options renderbump; /* renderbumpflat */
-  const char *height_output;    /* renderbumpflat --height */
-  bb_map_kind map_kind;         /* combine --kind */
-  bb_map_kind ssbump_kind;      /* ssbump2normal --kind: BB_MAP_SSBUMP or _WEIGHTS */
-  double mix;                   /* combine --mix */
-  const char *mask;             /* combine --mask */
-  int detail;                   /* combine --detail */
-  const char *brightness;       /* combine --brightness */
-  const char *base_dir;         /* program --base */
-  int allow_outside_base;       /* program --allow-outside-base */
-  int json, quiet;              /* how a command-line client prints */
-  const char *scheduler;        /* bake --scheduler: a Dask scheduler's address */
-} bb_command_options;
-
 /* ------------------------------------------------------------ commands */
 
 /* One use of a command: its options and inputs as set, checked, then run.
@@ -2163,14 +2120,22 @@ int bb_command_given(const bb_command *command, const char *name);
  * "1,1,1"), into out (capacity cap): the value set, else the default a new
  * command holds; a flag "1" when given, else "0"; a file not given "".
  * The options a client keeps to itself (serve's --port and --address),
- * which land in no field of the options struct, are read here: the text
- * set, else their default (bb_option_info.default_text). Errors:
+ * which the library does not use, are read here too: the text set, else
+ * their default (bb_option_info.default_text). Errors:
  * BB_ERR_ARGUMENT "unknown option ..." as bb_command_set words it, or a
  * value longer than cap - 1; BB_ERR_MEMORY. */
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,
                            size_t cap, bb_error *err);
-/* The options as set (defaults elsewhere); owned by command. */
-const bb_command_options *bb_command_options_of(const bb_command *command);
+/* The options of the command's bake as set and checked (bake, normal,
+ * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
+ * and texture settings of every command writing maps): what a client that
+ * bakes through the stage API (bb_bake) or plans its own jobs (bb_job_plan)
+ * hands on. Owned by command; NULL for NULL. Every other option is read by
+ * name (bb_command_value). */
+const bb_job_options *bb_command_job_options(const bb_command *command);
+/* The options of render's picture and of sheet's lit panel as set and
+ * checked; owned by command; NULL for NULL. */
+const bb_render_options *bb_command_render_options(const bb_command *command);
 /* Input index of those added (bb_command_add_input), or NULL past the last. */
 const char *bb_command_input(const bb_command *command, int index);
 

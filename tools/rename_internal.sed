@@ -155,3 +155,6 @@ s/\bbb_option_find_short\b/bb__option_find_short/g
 # api6: the reports' words through one string-keyed call (bb_report_word).
 s/\bbb_job_outcome_name\b/bb__job_outcome_name/g
 s/\bbb_check_status_name\b/bb__check_status_name/g
+# api7: a command's options struct leaves the ABI (clients read options by name,
+# or the stage structs through bb_command_job_options / _render_options).
+s/\bbb_command_options_of\b/bb__command_options_of/g

@@ -588,36 +588,6 @@ typedef struct bb_command_info {
   int option_count;
 } bb_command_info;
 
-typedef struct bb_command_options {
-  bb_job_options job;
-  const char *output;
-  bb_render_options render;
-  const char *render_maps[8];
-  const char *albedo;
-  int render_compare;
-  int orbit;
-  int maps_normal_y_up;
-  int panel_size;
-  bb_compare_limits limits;
-  const char *diff;
-  const char *limit_rules;
-  int check_bake;
-  int update;
-  const char *junit, *html;
-  bb_renderbump_options renderbump;
-  const char *height_output;
-  bb_map_kind map_kind;
-  bb_map_kind ssbump_kind;
-  double mix;
-  const char *mask;
-  int detail;
-  const char *brightness;
-  const char *base_dir;
-  int allow_outside_base;
-  int json, quiet;
-  const char *scheduler;
-} bb_command_options;
-
 typedef struct bb_command bb_command;
 
 typedef struct bb_command_hooks {
@@ -789,7 +759,10 @@ bb_status bb_command_check(bb_command *command, bb_error *err);
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
 void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
-const bb_command_options *bb_command_options_of(const bb_command *command);
+bb_status bb_command_value(const bb_command *command, const char *name, char *out,
+                           size_t cap, bb_error *err);
+const bb_job_options *bb_command_job_options(const bb_command *command);
+const bb_render_options *bb_command_render_options(const bb_command *command);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
@@ -813,10 +786,9 @@ const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 /* what a job prints (bumpbake bake --scheduler) */
-char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json);
-char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
-                           int files);
+char *bb_job_summary_lines(const bb_command *command, const int *counts, int files);
 """
 
 # Constants of the header (#define), by value: cffi reads only literals.

@@ -48,8 +48,9 @@ def _set_lighting(c, light, lightmap):
 
 def _writable(c):
     """The command's options, for what Python adds to them after the
-    library's check (no spelling on the command line)."""
-    return _ffi.cast("bb_command_options *", c.options)
+    library's check (no spelling on the command line): its picture's
+    (c.options.render)."""
+    return c.options
 
 
 def _picture(c, height, maps, progress):

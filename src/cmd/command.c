@@ -89,8 +89,16 @@ int bb_command_given(const bb_command *c, const char *name) {
   return c && name && bb__given(c, name);
 }
 
-const bb_command_options *bb_command_options_of(const bb_command *c) {
+const bb_command_options *bb__command_options_of(const bb_command *c) {
   return c ? &c->options : NULL;
+}
+
+const bb_job_options *bb_command_job_options(const bb_command *c) {
+  return c ? &c->options.job : NULL;
+}
+
+const bb_render_options *bb_command_render_options(const bb_command *c) {
+  return c ? &c->options.render : NULL;
 }
 
 int bb__command_input_count(const bb_command *c) {

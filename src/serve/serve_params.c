@@ -357,10 +357,10 @@ int serve_apply_params(serve_state *s, const char *const *names,
    * command's (no file named in them: the command line's files, which its
    * command owns, stay in the rest of the settings), its brightness switch
    * and its light */
-  const bb_command_options *now = bb_command_options_of(next);
-  s->settings.bake = now->job.bake;
+  s->settings.bake = bb_command_job_options(next)->bake;
   s->use_brightness = bb_command_given(next, "brightness");
-  memcpy(s->light_color, now->render.light_color, sizeof s->light_color);
+  memcpy(s->light_color, bb_command_render_options(next)->light_color,
+         sizeof s->light_color);
   bb_command_free(s->command);
   s->command = next;
   s->version++;
