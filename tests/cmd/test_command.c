@@ -5,6 +5,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp */
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "cmd/cmd_internal.h"
 #include "hostile_headers.h"
 
@@ -821,4 +822,41 @@ Test(cmd, report_words_are_the_printed_ones) {
     for (int k = 0; k < i; k++)
       cr_expect_str_neq(seen[i], seen[k]);
   }
+}
+
+/* The stage structs a client takes are the command's options as set: the
+ * bake's and the picture's (the rest is read by name, bb_command_value). */
+Test(cmd, the_stage_structs_are_the_commands_options) {
+  bb_command *c = command("render", (const char *const[]){"h.png", "--rays", "64", "--light",
+                                                         "10,20", NULL});
+  cr_expect_eq(bb_command_job_options(c)->bake.rays, 64);
+  cr_expect_eq(bb_command_render_options(c)->light_azimuth, 10.0);
+  cr_expect_eq(bb_command_render_options(c)->light_elevation, 20.0);
+  char light[32];
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_value(c, "light", light, sizeof light, &err), BB_OK);
+  cr_expect_str_eq(light, "10,20");
+  cr_expect_null(bb_command_job_options(NULL));
+  cr_expect_null(bb_command_render_options(NULL));
+  bb_command_free(c);
+}
+
+/* A batch's summary as the command's --json and --quiet ask, named by it. */
+Test(cmd, the_summary_lines_follow_the_commands_flags) {
+  const int counts[5] = {0, 2, 1, 0, 0}; /* by bb_job_outcome */
+  bb_command *plain = command("normal", NULL);
+  bb_command *quiet = command("normal", (const char *const[]){"--quiet", NULL});
+  bb_command *json = command("normal", (const char *const[]){"--json", NULL});
+  char *a = bb_job_summary_lines(plain, counts, 3), *b = bb_job_summary_lines(quiet, counts, 3),
+       *j = bb_job_summary_lines(json, counts, 3);
+  cr_assert(a && b && j);
+  cr_expect_str_eq(a, "normal: 3 files: 2 baked, 1 up to date, 0 failed\n");
+  cr_expect_str_eq(b, "");
+  cr_expect_eq(strncmp(j, "{\"summary\":{\"files\":3,", 22), 0, "%s", j);
+  free(a);
+  free(b);
+  free(j);
+  bb_command_free(plain);
+  bb_command_free(quiet);
+  bb_command_free(json);
 }
