@@ -544,20 +544,6 @@ typedef enum bb_depth {
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
 
-typedef struct bb_write_options {
-  bb_depth depth;
-  bb_range range;
-  const char *description; /* provenance text stored in the file, or NULL.
-                              TGA holds 4 rows of 80 characters: provenance
-                              is fitted with whole key=value lines, keys that
-                              affect pixels first, and what does not fit is
-                              left out (see bb_provenance_class) */
-  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
-                              chain, flags (see "engine textures"); NULL: the
-                              defaults, the map NORMAL for BB_RANGE_SIGNED and
-                              PLAIN otherwise. description overrides its own */
-} bb_write_options;
-
 /* ------------------------------------------------------- texture files */
 
 /* ---------------------------------------------------------- mip chains */
@@ -1202,64 +1188,9 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
 
-/* What a render lit, for its provenance. */
-typedef struct bb_render_sources {
-  const char *height;   /* the height file baked for it, or NULL: maps read */
-  const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
-  int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
-  const char *albedo;   /* the albedo file, or NULL */
-  uint64_t albedo_hash; /* the hash of the albedo's pixels, as read */
-  int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
-} bb_render_sources;
-
-/* ---------------------------------------------------- image operations */
-
-/* -------------------------------------------------------------- panels */
-
-/* One picture of a panel grid and the label written under it (may be NULL). */
-typedef struct bb_panel {
-  const bb_image *image; /* 3-channel RGB in [0, 1] (a map as an 8-bit file shows it) */
-  const char *label;
-} bb_panel;
-
-typedef struct bb_panel_layout {
-  int columns;        /* panels per row, >= 1 (default 4) */
-  int panel_width;    /* texels; each panel is resampled to this width keeping its
-                         aspect; 0 = the widest panel's width (default 0) */
-  int gap;            /* texels between panels and around the grid (default 8) */
-  int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
-                         panel width, 12..48 (default 0). Made smaller, down to 6,
-                         until the widest label fits a panel */
-  const char *font;   /* font file or name; NULL = look one up (default NULL) */
-} bb_panel_layout;
-
-/* The exponent render --compare uses when o->specular_exponent is 0. */
-#define BB_COMPARE_SPECULAR_EXPONENT 64.0
-
-/* --------------------------------------------------------------- sheet */
-
-typedef struct bb_sheet_options {
-  bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
-  bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
-} bb_sheet_options;
-
 /* =====================================================================
  * mesh: models and DOOM 3's flat render bump
  * ===================================================================== */
-
-/* -------------------------------------------------------------- meshes */
-
-/* A triangle mesh in model units. renderbumpflat reads one from a file: every
- * mesh of the file merged, node transforms applied, polygons triangulated,
- * points and lines dropped. */
-typedef struct bb_mesh {
-  size_t vertex_count;
-  size_t triangle_count;
-  float *positions;  /* 3 floats per vertex: x, y, z in model units */
-  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
-                        a vertex whose normal is zero or not finite has none */
-  uint32_t *indices; /* 3 per triangle, each < vertex_count */
-} bb_mesh;
 
 /* ---------------------------------------------------- flat render bump */
 
@@ -1276,25 +1207,6 @@ typedef enum bb_axis {
   BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
 } bb_axis;
 
-typedef struct bb_renderbump_options {
-  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
-  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
-                         a regular grid; default 4 (DOOM 3's 16x) */
-  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
-  int face_normals;   /* 1: every triangle's own plane normal, even when the
-                         mesh has vertex normals; default 0 */
-  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
-  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
-                         the image, in model units along right and up */
-  int tile;           /* 1: geometry outside the rectangle wraps around into
-                         it (the sculpt tiles with the rectangle as period) */
-  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
-                         same for any count */
-  bb_note_fn note;    /* told when the texels come out not square, with the
-                         size or rectangle that keeps them square (may be
-                         NULL) */
-  void *note_user;
-} bb_renderbump_options;
 
 /* What a flat render bump makes. */
 typedef struct bb_renderbump_result {

@@ -322,49 +322,6 @@ typedef struct bb_render_options {
   double relief_depth;
 } bb_render_options;
 
-typedef struct bb_panel_layout {
-  int columns;
-  int panel_width;
-  int gap;
-  int font_size;
-  const char *font;
-} bb_panel_layout;
-
-typedef struct bb_sheet_options {
-  bb_panel_layout layout;
-  bb_render_options lit;
-} bb_sheet_options;
-
-typedef struct bb_mesh {
-  size_t vertex_count;
-  size_t triangle_count;
-  float *positions;
-  float *normals;
-  uint32_t *indices;
-} bb_mesh;
-
-typedef enum bb_axis {
-  BB_AXIS_NEG_Y = 0,
-  BB_AXIS_POS_Y,
-  BB_AXIS_POS_Z,
-  BB_AXIS_NEG_Z,
-  BB_AXIS_POS_X,
-  BB_AXIS_NEG_X
-} bb_axis;
-
-typedef struct bb_renderbump_options {
-  int width, height;
-  int samples;
-  bb_axis axis;
-  int face_normals;
-  int rect_given;
-  double rect[4];
-  int tile;
-  int threads;
-  bb_note_fn note;
-  void *note_user;
-} bb_renderbump_options;
-
 typedef struct bb_renderbump_result {
   bb_image normal;
   bb_image height;

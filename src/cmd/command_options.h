@@ -6,6 +6,7 @@
 #define BB_CMD_COMMAND_OPTIONS_H
 
 #include "bumpbake.h"
+#include "mesh/mesh_internal.h" /* bb_renderbump_options */
 
 /* Every option of every command lands here, typed: the command's own
  * structs (a bake's bb_job_options, a render's bb_render_options...) and

@@ -7,6 +7,45 @@
 
 #include "core/internal.h"
 
+/* Once in bumpbake.h (issue 41): no public function takes them; the
+ * render, sheet and job families do. */
+
+/* What a render lit, for its provenance. */
+typedef struct bb_render_sources {
+  const char *height;   /* the height file baked for it, or NULL: maps read */
+  const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
+  int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
+  const char *albedo;   /* the albedo file, or NULL */
+  uint64_t albedo_hash; /* the hash of the albedo's pixels, as read */
+  int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
+} bb_render_sources;
+
+/* One picture of a panel grid and the label written under it (may be NULL). */
+typedef struct bb_panel {
+  const bb_image *image; /* 3-channel RGB in [0, 1] (a map as an 8-bit file shows it) */
+  const char *label;
+} bb_panel;
+
+typedef struct bb_panel_layout {
+  int columns;        /* panels per row, >= 1 (default 4) */
+  int panel_width;    /* texels; each panel is resampled to this width keeping its
+                         aspect; 0 = the widest panel's width (default 0) */
+  int gap;            /* texels between panels and around the grid (default 8) */
+  int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
+                         panel width, 12..48 (default 0). Made smaller, down to 6,
+                         until the widest label fits a panel */
+  const char *font;   /* font file or name; NULL = look one up (default NULL) */
+} bb_panel_layout;
+
+/* The exponent render --compare uses when o->specular_exponent is 0. */
+#define BB_COMPARE_SPECULAR_EXPONENT 64.0
+
+/* sheet's options: its grid and its lit panel. */
+typedef struct bb_sheet_options {
+  bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
+  bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
+} bb_sheet_options;
+
 extern const bb__range bb__range_light_elevation, bb__range_view_elevation,
     bb__range_colour, bb__range_specular_exponent, bb__range_specular_strength,
     bb__range_tile;
