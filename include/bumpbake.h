@@ -1128,46 +1128,6 @@ typedef struct bb_render_maps {
   const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bake's slope) */
 } bb_render_maps;
 
-typedef struct bb_render_options {
-  bb_render_mode mode;          /* default BB_RENDER_SSBUMP */
-  int dynamic_light;            /* 1: the dynamic light is on (default 1) */
-  double light_azimuth;         /* degrees, any finite value (default 135) */
-  double light_elevation;       /* degrees, 0..90 (default 45) */
-  float light_color[3];         /* C, >= 0 (default 1, 1, 1) */
-  int static_light;             /* 1: the lightmaps are on (default 0) */
-  float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
-                                   three basis directions in three colours */
-  double specular_exponent;     /* k in 0..BB_MAX_SPECULAR_EXPONENT, 0 = no specular
-                                   (default 0) */
-  double specular_strength;     /* ks, 0..1000: the highlight's scale, a
-                                   material's specular intensity (default 1) */
-  bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
-                                   default BB_ALBEDO_MULTIPLY */
-  int tile_x, tile_y;           /* repeat the render nx x ny, 1..64 (default 1, 1) */
-  int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
-                                   texels; crop_width 0 = no crop */
-  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
-                                   are identical */
-  int view;                     /* 1: an orthographic camera at view_azimuth,
-                                   view_elevation looks at the surface (the
-                                   texture tiling on for ever); 0 (default):
-                                   straight down, texel for pixel */
-  double view_azimuth;          /* degrees, as the light's (default 270: from the
-                                   bottom of the image, which then recedes up
-                                   the picture) */
-  double view_elevation;        /* degrees, 1..90 (default 30) */
-  int relief;                   /* 1: parallax occlusion mapping of
-                                   relief_height as shaders/ssbump_relief.glsl
-                                   does it: each pixel's view ray is followed
-                                   into the relief and the maps are read where
-                                   it meets it; needs view */
-  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
-                                   the bake's filtered height. Not owned */
-  double relief_depth;          /* texels of relief per unit of h, > 0: the
-                                   bake's height_scale (default 0: must be set
-                                   with relief) */
-} bb_render_options;
-
 /* ------------------------------------------------------ rendering files */
 
 /* The maps a render can read from files instead of baking a height:
@@ -2045,9 +2005,13 @@ bb_status bb_command_value(const bb_command *command, const char *name, char *ou
  * hands on. Owned by command; NULL for NULL. Every other option is read by
  * name (bb_command_value). */
 const bb_job_options *bb_command_job_options(const bb_command *command);
-/* The options of render's picture and of sheet's lit panel as set and
- * checked; owned by command; NULL for NULL. */
-const bb_render_options *bb_command_render_options(const bb_command *command);
+/* What a client that takes its options as keywords asks of render's and
+ * sheet's picture and no option spells (Python's light=None and tile=(NX,
+ * NY)): dynamic_light 0 turns the dynamic light off, 1 leaves it as the
+ * options set it; tile_y > 0 repeats the picture tile_y times down, --tile
+ * NX times across (the render checks it against --tile's range), 0 leaves
+ * it. Call after bb_command_check. */
+void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 /* Input index of those added (bb_command_add_input), or NULL past the last. */
 const char *bb_command_input(const bb_command *command, int index);
 

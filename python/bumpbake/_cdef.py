@@ -278,19 +278,6 @@ typedef enum bb_compare_verdict {
   BB_COMPARE_FAIL = 2
 } bb_compare_verdict;
 
-typedef enum bb_albedo_mode {
-  BB_ALBEDO_MULTIPLY = 0,
-  BB_ALBEDO_MOD2X,
-  BB_ALBEDO_SSBUMP
-} bb_albedo_mode;
-
-typedef enum bb_render_mode {
-  BB_RENDER_SSBUMP = 0,
-  BB_RENDER_NORMAL,
-  BB_RENDER_NORMAL_AO,
-  BB_RENDER_SLOPE
-} bb_render_mode;
-
 typedef struct bb_render_maps {
   const bb_image *normal;
   const bb_image *ssbump;
@@ -299,28 +286,6 @@ typedef struct bb_render_maps {
   const bb_image *albedo;
   const bb_image *slope;
 } bb_render_maps;
-
-typedef struct bb_render_options {
-  bb_render_mode mode;
-  int dynamic_light;
-  double light_azimuth;
-  double light_elevation;
-  float light_color[3];
-  int static_light;
-  float lightmap[3][3];
-  double specular_exponent;
-  double specular_strength;
-  bb_albedo_mode albedo_mode;
-  int tile_x, tile_y;
-  int crop_x, crop_y, crop_width, crop_height;
-  int threads;
-  int view;
-  double view_azimuth;
-  double view_elevation;
-  int relief;
-  const bb_image *relief_height;
-  double relief_depth;
-} bb_render_options;
 
 typedef struct bb_renderbump_result {
   bb_image normal;
@@ -719,7 +684,7 @@ int bb_command_given(const bb_command *command, const char *name);
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,
                            size_t cap, bb_error *err);
 const bb_job_options *bb_command_job_options(const bb_command *command);
-const bb_render_options *bb_command_render_options(const bb_command *command);
+void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,

@@ -357,10 +357,9 @@ def doc(command, files=True, skip=()):
 
 class _Options:
     """What the runs read of a checked command after bb_command_check: the
-    bake's options (job: bb_job_options, the stage API's) and the picture's
-    (render: bb_render_options), owned by the command and writable for what
-    has no spelling as an option (a basis of vectors, no dynamic light, a
-    tile of NX x NY); the other options by name through the library."""
+    bake's options (job: bb_job_options, the stage API's), owned by the
+    command and writable for what has no spelling as an option (a basis of
+    vectors); the other options by name through the library."""
 
     def __init__(self, command):
         self._command = command
@@ -368,11 +367,6 @@ class _Options:
     @property
     def job(self):
         return _ffi.cast("bb_job_options *", _lib.bb_command_job_options(self._command.handle))
-
-    @property
-    def render(self):
-        return _ffi.cast("bb_render_options *",
-                         _lib.bb_command_render_options(self._command.handle))
 
     @property
     def maps_normal_y_up(self):

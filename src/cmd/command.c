@@ -97,8 +97,13 @@ const bb_job_options *bb_command_job_options(const bb_command *c) {
   return c ? &c->options.job : NULL;
 }
 
-const bb_render_options *bb_command_render_options(const bb_command *c) {
-  return c ? &c->options.render : NULL;
+void bb_command_set_picture(bb_command *c, int dynamic_light, int tile_y) {
+  if (!c)
+    return;
+  if (!dynamic_light)
+    c->options.render.dynamic_light = 0;
+  if (tile_y > 0)
+    c->options.render.tile_y = tile_y;
 }
 
 int bb__command_input_count(const bb_command *c) {

@@ -1,12 +1,13 @@
 /* command_options.h: where a command's options land, typed (not public:
- * clients read them by name, bb_command_value, or as the stage structs
- * bb_command_job_options and bb_command_render_options hand out), so a
- * command or an option added changes no public struct. */
+ * clients read them by name, bb_command_value, or the bake's as the stage
+ * API's struct, bb_command_job_options), so a command or an option added
+ * changes no public struct. */
 #ifndef BB_CMD_COMMAND_OPTIONS_H
 #define BB_CMD_COMMAND_OPTIONS_H
 
 #include "bumpbake.h"
 #include "mesh/mesh_internal.h" /* bb_renderbump_options */
+#include "render/render_internal.h" /* bb_render_options */
 
 /* Every option of every command lands here, typed: the command's own
  * structs (a bake's bb_job_options, a render's bb_render_options...) and

@@ -10,6 +10,48 @@
 /* Once in bumpbake.h (issue 41): no public function takes them; the
  * render, sheet and job families do. */
 
+/* What one render shows and how it is lit (the command's options: render's
+ * and sheet's picture; bb_command_set_picture for what no option spells). */
+typedef struct bb_render_options {
+  bb_render_mode mode;          /* default BB_RENDER_SSBUMP */
+  int dynamic_light;            /* 1: the dynamic light is on (default 1) */
+  double light_azimuth;         /* degrees, any finite value (default 135) */
+  double light_elevation;       /* degrees, 0..90 (default 45) */
+  float light_color[3];         /* C, >= 0 (default 1, 1, 1) */
+  int static_light;             /* 1: the lightmaps are on (default 0) */
+  float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
+                                   three basis directions in three colours */
+  double specular_exponent;     /* k in 0..BB_MAX_SPECULAR_EXPONENT, 0 = no specular
+                                   (default 0) */
+  double specular_strength;     /* ks, 0..1000: the highlight's scale, a
+                                   material's specular intensity (default 1) */
+  bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
+                                   default BB_ALBEDO_MULTIPLY */
+  int tile_x, tile_y;           /* repeat the render nx x ny, 1..64 (default 1, 1) */
+  int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
+                                   texels; crop_width 0 = no crop */
+  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
+                                   are identical */
+  int view;                     /* 1: an orthographic camera at view_azimuth,
+                                   view_elevation looks at the surface (the
+                                   texture tiling on for ever); 0 (default):
+                                   straight down, texel for pixel */
+  double view_azimuth;          /* degrees, as the light's (default 270: from the
+                                   bottom of the image, which then recedes up
+                                   the picture) */
+  double view_elevation;        /* degrees, 1..90 (default 30) */
+  int relief;                   /* 1: parallax occlusion mapping of
+                                   relief_height as shaders/ssbump_relief.glsl
+                                   does it: each pixel's view ray is followed
+                                   into the relief and the maps are read where
+                                   it meets it; needs view */
+  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
+                                   the bake's filtered height. Not owned */
+  double relief_depth;          /* texels of relief per unit of h, > 0: the
+                                   bake's height_scale (default 0: must be set
+                                   with relief) */
+} bb_render_options;
+
 /* What a render lit, for its provenance. */
 typedef struct bb_render_sources {
   const char *height;   /* the height file baked for it, or NULL: maps read */

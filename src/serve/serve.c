@@ -68,8 +68,7 @@ int cli_run_serve(const cli_run *r) {
   s.use_brightness = s.brightness_file != NULL;
   s.albedo_file = kept_path(r, "albedo"); /* render's --albedo and --light-color light
                                              the picture */
-  memcpy(s.light_color, bb_command_render_options(r->command)->light_color,
-         sizeof s.light_color);
+  serve_light_color(r->command, s.light_color);
   s.quiet = r->quiet;
   /* the page's controls change a copy of the command line's command */
   size_t handover_size = 0;

@@ -359,11 +359,20 @@ int serve_apply_params(serve_state *s, const char *const *names,
    * and its light */
   s->settings.bake = bb_command_job_options(next)->bake;
   s->use_brightness = bb_command_given(next, "brightness");
-  memcpy(s->light_color, bb_command_render_options(next)->light_color,
-         sizeof s->light_color);
+  serve_light_color(next, s->light_color);
   bb_command_free(s->command);
   s->command = next;
   s->version++;
   pthread_cond_broadcast(&s->changed);
   return 0;
+}
+
+void serve_light_color(const bb_command *command, float rgb[3]) {
+  char text[128] = "";
+  bb_command_value(command, "light-color", text, sizeof text, NULL);
+  char *p = text;
+  for (int k = 0; k < 3; k++) {
+    rgb[k] = strtof(p, &p);
+    p += *p == ',';
+  }
 }

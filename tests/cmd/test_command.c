@@ -824,20 +824,24 @@ Test(cmd, report_words_are_the_printed_ones) {
   }
 }
 
-/* The stage structs a client takes are the command's options as set: the
- * bake's and the picture's (the rest is read by name, bb_command_value). */
-Test(cmd, the_stage_structs_are_the_commands_options) {
+/* The stage struct a client takes is the command's bake as set; the rest
+ * is read by name (bb_command_value), and what no option spells is set by
+ * its own call (bb_command_set_picture). */
+Test(cmd, the_stage_struct_is_the_commands_bake) {
   bb_command *c = command("render", (const char *const[]){"h.png", "--rays", "64", "--light",
-                                                         "10,20", NULL});
+                                                         "10,20", "--tile", "3", NULL});
   cr_expect_eq(bb_command_job_options(c)->bake.rays, 64);
-  cr_expect_eq(bb_command_render_options(c)->light_azimuth, 10.0);
-  cr_expect_eq(bb_command_render_options(c)->light_elevation, 20.0);
   char light[32];
   bb_error err = {{0}};
   cr_assert_eq(bb_command_value(c, "light", light, sizeof light, &err), BB_OK);
   cr_expect_str_eq(light, "10,20");
   cr_expect_null(bb_command_job_options(NULL));
-  cr_expect_null(bb_command_render_options(NULL));
+  const bb_render_options *o = &bb__command_options_of(c)->render;
+  bb_command_set_picture(c, 1, 0); /* leaves both */
+  cr_expect(o->dynamic_light && o->tile_x == 3 && o->tile_y == 3);
+  bb_command_set_picture(c, 0, 5);
+  cr_expect(!o->dynamic_light && o->tile_x == 3 && o->tile_y == 5);
+  bb_command_set_picture(NULL, 0, 5);
   bb_command_free(c);
 }
 
