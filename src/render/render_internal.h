@@ -244,7 +244,7 @@ const char *bb__render_mode_name(bb_render_mode mode);
 unsigned bb__render_mode_needs(bb_render_mode mode);
 
 /* render's defaults: ssbump, the light at 135, 45 (once public: a client
- * reads them from a new render command, bb_command_render_options). */
+ * reads them by name from a new render command, bb_command_value). */
 void bb__render_options_init(bb_render_options *o);
 
 #endif /* BB_RENDER_INTERNAL_H */
