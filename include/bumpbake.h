@@ -541,20 +541,6 @@ typedef enum bb_depth {
   BB_DEPTH_FLOAT  /* exr, tif */
 } bb_depth;
 
-typedef struct bb_write_options {
-  bb_depth depth;
-  bb_range range;
-  const char *description; /* provenance text stored in the file, or NULL.
-                              TGA holds 4 rows of 80 characters: provenance
-                              is fitted with whole key=value lines, keys that
-                              affect pixels first, and what does not fit is
-                              left out (see bb_provenance_class) */
-  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
-                              chain, flags (see "engine textures"); NULL: the
-                              defaults, the map NORMAL for BB_RANGE_SIGNED and
-                              PLAIN otherwise. description overrides its own */
-} bb_write_options;
-
 /* ------------------------------------------------------- texture files */
 
 /* ---------------------------------------------------------- mip chains */
@@ -1041,46 +1027,6 @@ typedef struct bb_render_maps {
   const bb_image *slope;  /* flipcode slope bytes / 255 in channel 0 (bake's slope) */
 } bb_render_maps;
 
-typedef struct bb_render_options {
-  bb_render_mode mode;          /* default BB_RENDER_SSBUMP */
-  int dynamic_light;            /* 1: the dynamic light is on (default 1) */
-  double light_azimuth;         /* degrees, any finite value (default 135) */
-  double light_elevation;       /* degrees, 0..90 (default 45) */
-  float light_color[3];         /* C, >= 0 (default 1, 1, 1) */
-  int static_light;             /* 1: the lightmaps are on (default 0) */
-  float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
-                                   three basis directions in three colours */
-  double specular_exponent;     /* k in 0..BB_MAX_SPECULAR_EXPONENT, 0 = no specular
-                                   (default 0) */
-  double specular_strength;     /* ks, 0..1000: the highlight's scale, a
-                                   material's specular intensity (default 1) */
-  bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
-                                   default BB_ALBEDO_MULTIPLY */
-  int tile_x, tile_y;           /* repeat the render nx x ny, 1..64 (default 1, 1) */
-  int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
-                                   texels; crop_width 0 = no crop */
-  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
-                                   are identical */
-  int view;                     /* 1: an orthographic camera at view_azimuth,
-                                   view_elevation looks at the surface (the
-                                   texture tiling on for ever); 0 (default):
-                                   straight down, texel for pixel */
-  double view_azimuth;          /* degrees, as the light's (default 270: from the
-                                   bottom of the image, which then recedes up
-                                   the picture) */
-  double view_elevation;        /* degrees, 1..90 (default 30) */
-  int relief;                   /* 1: parallax occlusion mapping of
-                                   relief_height as shaders/ssbump_relief.glsl
-                                   does it: each pixel's view ray is followed
-                                   into the relief and the maps are read where
-                                   it meets it; needs view */
-  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
-                                   the bake's filtered height. Not owned */
-  double relief_depth;          /* texels of relief per unit of h, > 0: the
-                                   bake's height_scale (default 0: must be set
-                                   with relief) */
-} bb_render_options;
-
 /* ------------------------------------------------------ rendering files */
 
 /* The maps a render can read from files instead of baking a height:
@@ -1101,64 +1047,9 @@ bb_status bb_render_map_read(const char *path, bb_map_kind kind, int normal_y_up
                              const bb_image *like, bb_image *out, uint64_t *hash,
                              bb_error *err);
 
-/* What a render lit, for its provenance. */
-typedef struct bb_render_sources {
-  const char *height;   /* the height file baked for it, or NULL: maps read */
-  const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
-  int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
-  const char *albedo;   /* the albedo file, or NULL */
-  uint64_t albedo_hash; /* the hash of the albedo's pixels, as read */
-  int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
-} bb_render_sources;
-
-/* ---------------------------------------------------- image operations */
-
-/* -------------------------------------------------------------- panels */
-
-/* One picture of a panel grid and the label written under it (may be NULL). */
-typedef struct bb_panel {
-  const bb_image *image; /* 3-channel RGB in [0, 1] (a map as an 8-bit file shows it) */
-  const char *label;
-} bb_panel;
-
-typedef struct bb_panel_layout {
-  int columns;        /* panels per row, >= 1 (default 4) */
-  int panel_width;    /* texels; each panel is resampled to this width keeping its
-                         aspect; 0 = the widest panel's width (default 0) */
-  int gap;            /* texels between panels and around the grid (default 8) */
-  int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
-                         panel width, 12..48 (default 0). Made smaller, down to 6,
-                         until the widest label fits a panel */
-  const char *font;   /* font file or name; NULL = look one up (default NULL) */
-} bb_panel_layout;
-
-/* The exponent render --compare uses when o->specular_exponent is 0. */
-#define BB_COMPARE_SPECULAR_EXPONENT 64.0
-
-/* --------------------------------------------------------------- sheet */
-
-typedef struct bb_sheet_options {
-  bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
-  bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
-} bb_sheet_options;
-
 /* =====================================================================
  * mesh: models and DOOM 3's flat render bump
  * ===================================================================== */
-
-/* -------------------------------------------------------------- meshes */
-
-/* A triangle mesh in model units. renderbumpflat reads one from a file: every
- * mesh of the file merged, node transforms applied, polygons triangulated,
- * points and lines dropped. */
-typedef struct bb_mesh {
-  size_t vertex_count;
-  size_t triangle_count;
-  float *positions;  /* 3 floats per vertex: x, y, z in model units */
-  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
-                        a vertex whose normal is zero or not finite has none */
-  uint32_t *indices; /* 3 per triangle, each < vertex_count */
-} bb_mesh;
 
 /* ---------------------------------------------------- flat render bump */
 
@@ -1175,25 +1066,6 @@ typedef enum bb_axis {
   BB_AXIS_NEG_X      /* right -Y, up +Z, out -X (Blender's left view) */
 } bb_axis;
 
-typedef struct bb_renderbump_options {
-  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
-  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
-                         a regular grid; default 4 (DOOM 3's 16x) */
-  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
-  int face_normals;   /* 1: every triangle's own plane normal, even when the
-                         mesh has vertex normals; default 0 */
-  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
-  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
-                         the image, in model units along right and up */
-  int tile;           /* 1: geometry outside the rectangle wraps around into
-                         it (the sculpt tiles with the rectangle as period) */
-  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
-                         same for any count */
-  bb_note_fn note;    /* told when the texels come out not square, with the
-                         size or rectangle that keeps them square (may be
-                         NULL) */
-  void *note_user;
-} bb_renderbump_options;
 
 /* What a flat render bump makes. */
 typedef struct bb_renderbump_result {
@@ -1802,9 +1674,9 @@ typedef enum bb_output_state {
  * descriptions: a value is parsed and checked by the library's one
  * function for its rule (bb_command_set), the rules between options by
  * the library's (bb_command_check), and every client prints the library's
- * words. A command's options land in one typed struct
- * (bb_command_options); the commands that write files through the job
- * are planned from it in one call (bb_command_plan). */
+ * words. A command's options are held by the command (opaque) and read
+ * back by name (bb_command_value); the commands that write files through
+ * the job are planned from them in one call (bb_command_plan). */
 
 /* What an option's value is. */
 typedef enum bb_option_type {
@@ -1942,49 +1814,6 @@ bb_status bb_option_parse(const bb_option_info *option, const char *text, long l
  * words. Static text. */
 const char *bb_option_word(const bb_option_info *option, long long value);
 
-/* ------------------------------------------------------------- options */
-
-/* Every option of every command lands here, typed: the command's own
- * structs (a bake's bb_job_options, a render's bb_render_options...) and
- * what has no struct of its own yet. A command uses the fields its options
- * name. Strings point into the bb_command, which owns them. */
-typedef struct bb_command_options {
-  bb_job_options job;           /* bake, normal, height2ssbump; the bake of render's
-                                   and sheet's HEIGHT; depth, mips and texture settings
-                                   of every command writing maps */
-  const char *output;           /* -o of the commands writing one named file (render,
-                                   sheet, combine, ...: the default filled in by
-                                   bb_command_check where the command has one) */
-  bb_render_options render;     /* render's picture; sheet's lit panel */
-  const char *render_maps[BB_MAP_KIND_COUNT]; /* render --normal, --ssbump, --ao,
-                                   --bent, --slope (by bb_map_kind) */
-  const char *albedo;           /* render --albedo */
-  int render_compare;           /* render --compare */
-  int orbit;                    /* render --orbit: frames, 0: one picture */
-  int maps_normal_y_up;         /* --normal-y up of render, normal2ssbump, combine
-                                   (the maps read), ssbump2normal and renderbumpflat
-                                   (the map written) */
-  int panel_size;               /* sheet --panel-size */
-  bb_compare_limits limits;     /* compare */
-  const char *diff;             /* compare --diff */
-  const char *limit_rules;      /* check --limits: "KIND|PATTERN: -fail T ...; ..." */
-  int check_bake;               /* check --bake: the inputs after GOLDEN are heights */
-  int update;                   /* check --update */
-  const char *junit, *html;     /* check --junit FILE, --html DIR */
-  bb_renderbump_options renderbump; /* renderbumpflat */
-  const char *height_output;    /* renderbumpflat --height */
-  bb_map_kind map_kind;         /* combine --kind */
-  bb_map_kind ssbump_kind;      /* ssbump2normal --kind: BB_MAP_SSBUMP or _WEIGHTS */
-  double mix;                   /* combine --mix */
-  const char *mask;             /* combine --mask */
-  int detail;                   /* combine --detail */
-  const char *brightness;       /* combine --brightness */
-  const char *base_dir;         /* program --base */
-  int allow_outside_base;       /* program --allow-outside-base */
-  int json, quiet;              /* how a command-line client prints */
-  const char *scheduler;        /* bake --scheduler: a Dask scheduler's address */
-} bb_command_options;
-
 /* ------------------------------------------------------------ commands */
 
 /* One use of a command: its options and inputs as set, checked, then run.
@@ -2062,14 +1891,26 @@ int bb_command_given(const bb_command *command, const char *name);
  * "1,1,1"), into out (capacity cap): the value set, else the default a new
  * command holds; a flag "1" when given, else "0"; a file not given "".
  * The options a client keeps to itself (serve's --port and --address),
- * which land in no field of the options struct, are read here: the text
- * set, else their default (bb_option_info.default_text). Errors:
+ * which the library does not use, are read here too: the text set, else
+ * their default (bb_option_info.default_text). Errors:
  * BB_ERR_ARGUMENT "unknown option ..." as bb_command_set words it, or a
  * value longer than cap - 1; BB_ERR_MEMORY. */
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,
                            size_t cap, bb_error *err);
-/* The options as set (defaults elsewhere); owned by command. */
-const bb_command_options *bb_command_options_of(const bb_command *command);
+/* The options of the command's bake as set and checked (bake, normal,
+ * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
+ * and texture settings of every command writing maps): what a client that
+ * bakes through the stage API (bb_bake) or plans its own jobs (bb_job_plan)
+ * hands on. Owned by command; NULL for NULL. Every other option is read by
+ * name (bb_command_value). */
+const bb_job_options *bb_command_job_options(const bb_command *command);
+/* What a client that takes its options as keywords asks of render's and
+ * sheet's picture and no option spells (Python's light=None and tile=(NX,
+ * NY)): dynamic_light 0 turns the dynamic light off, 1 leaves it as the
+ * options set it; tile_y > 0 repeats the picture tile_y times down, --tile
+ * NX times across (the render checks it against --tile's range), 0 leaves
+ * it. Call after bb_command_check. */
+void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 /* Input index of those added (bb_command_add_input), or NULL past the last. */
 const char *bb_command_input(const bb_command *command, int index);
 

@@ -115,24 +115,23 @@ bb_status bb_command_from_handover(const char *data, size_t size, const char *co
 /* ------------------------------ cmd: the command line's report lines */
 
 /* The lines `bumpbake bake` (bake, normal, height2ssbump) prints on stdout
- * of one input's report r, as o (json, quiet) asks, the command line's
- * and its --scheduler run's alike: "wrote KIND PATH" or "up to date KIND
- * PATH" per file (control characters escaped, bb_text_printable), or with
- * json the input's JSON line (bb_job_report_json; with batch a "status"
- * and, for an input not baked, the short line: input, status, exit_code
- * when it failed, every output). Nothing for an input not run, nor for a
- * failure without json (its error is the caller's line on stderr).
- * extra_json (may be NULL): members written before "outputs" of a baked
- * input's line ("\"cluster\":{...}"). Returns the text, "" when none, to
- * free(); NULL when out of memory. */
-char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+ * of one input's report r, as command's --json and --quiet ask, the command
+ * line's and its --scheduler run's alike: "wrote KIND PATH" or "up to date
+ * KIND PATH" per file (control characters escaped, bb_text_printable), or
+ * with json the input's JSON line (bb_job_report_json; with batch a
+ * "status" and, for an input not baked, the short line: input, status,
+ * exit_code when it failed, every output). Nothing for an input not run,
+ * nor for a failure without json (its error is the caller's line on
+ * stderr). extra_json (may be NULL): members written before "outputs" of a
+ * baked input's line ("\"cluster\":{...}"). Returns the text, "" when none,
+ * to free(); NULL when out of memory. */
+char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json);
-/* A batch's summary line of command (its name) over files inputs, with
- * counts[k] the inputs whose outcome is k (a bb_job_outcome, 5 of them):
- * "COMMAND: N files: B baked, C up to date, F failed[, R not run (...)]",
- * or its JSON line; "" with quiet. To free(); NULL when out of memory. */
-char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
-                           int files);
+/* A batch's summary line of command over files inputs, with counts[k] the
+ * inputs whose outcome is k (a bb_job_outcome, 5 of them): "NAME: N files:
+ * B baked, C up to date, F failed[, R not run (...)]", or its JSON line
+ * with --json; "" with --quiet. To free(); NULL when out of memory. */
+char *bb_job_summary_lines(const bb_command *command, const int *counts, int files);
 
 #ifdef __cplusplus
 }

@@ -140,7 +140,7 @@ s/\bbb_valve_detail\b/bb__valve_detail/g
 s/\bbb_valve_pack\b/bb__valve_pack/g
 s/\bbb_command_input_count\b/bb__command_input_count/g
 s/\bbb_valve_options_init\b/bb__valve_options_init/g
-# api6: the DOOM 3 program family, run by a client through its command (bb_command_program).
+# the DOOM 3 program family, run by a client through its command (bb_command_program).
 s/\bbb_program_parse\b/bb__program_parse/g
 s/\bbb_program_free\b/bb__program_free/g
 s/\bbb_program_options_init\b/bb__program_options_init/g
@@ -148,14 +148,14 @@ s/\bbb_program_run\b/bb__program_run/g
 s/\bbb_program_options\b/bb__program_options/g
 s/\bbb_program\b/bb__program/g
 s/\bbb_image_loader\b/bb__image_loader/g
-# api6: defaults and lookups a client reads from the descriptions (a new command's options, bb_command_info_get's NULL, bb_command_option's short_name).
+# defaults and lookups a client reads from the descriptions (a new command's options, bb_command_info_get's NULL, bb_command_option's short_name).
 s/\bbb_render_options_init\b/bb__render_options_init/g
 s/\bbb_command_count\b/bb__command_count/g
 s/\bbb_option_find_short\b/bb__option_find_short/g
-# api6: the reports' words through one string-keyed call (bb_report_word).
+# the reports' words through one string-keyed call (bb_report_word).
 s/\bbb_job_outcome_name\b/bb__job_outcome_name/g
 s/\bbb_check_status_name\b/bb__check_status_name/g
-# api8: the map operators of normal2ssbump, ssbump2normal and combine, run by a client through their commands (bb_command_map).
+# the map operators of normal2ssbump, ssbump2normal and combine, run by a client through their commands (bb_command_map).
 s/\bbb_combine_blend\b/bb__combine_blend/g
 s/\bbb_combine_detail\b/bb__combine_detail/g
 s/\bbb_combine_brightness\b/bb__combine_brightness/g
@@ -163,3 +163,6 @@ s/\bbb_map_flat_texel\b/bb__map_flat_texel/g
 s/\bbb_derive_weights\b/bb__derive_weights_all_cores/g
 s/\bbb_ssbump_to_normal\b/bb__ssbump_to_normal/g
 s/\bbb_image_flip_green\b/bb__image_flip_green/g
+# a command's options struct leaves the ABI (clients read options by name,
+# or the stage structs through bb_command_job_options / _render_options).
+s/\bbb_command_options_of\b/bb__command_options_of/g

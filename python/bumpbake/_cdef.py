@@ -274,19 +274,6 @@ typedef enum bb_compare_verdict {
   BB_COMPARE_FAIL = 2
 } bb_compare_verdict;
 
-typedef enum bb_albedo_mode {
-  BB_ALBEDO_MULTIPLY = 0,
-  BB_ALBEDO_MOD2X,
-  BB_ALBEDO_SSBUMP
-} bb_albedo_mode;
-
-typedef enum bb_render_mode {
-  BB_RENDER_SSBUMP = 0,
-  BB_RENDER_NORMAL,
-  BB_RENDER_NORMAL_AO,
-  BB_RENDER_SLOPE
-} bb_render_mode;
-
 typedef struct bb_render_maps {
   const bb_image *normal;
   const bb_image *ssbump;
@@ -295,71 +282,6 @@ typedef struct bb_render_maps {
   const bb_image *albedo;
   const bb_image *slope;
 } bb_render_maps;
-
-typedef struct bb_render_options {
-  bb_render_mode mode;
-  int dynamic_light;
-  double light_azimuth;
-  double light_elevation;
-  float light_color[3];
-  int static_light;
-  float lightmap[3][3];
-  double specular_exponent;
-  double specular_strength;
-  bb_albedo_mode albedo_mode;
-  int tile_x, tile_y;
-  int crop_x, crop_y, crop_width, crop_height;
-  int threads;
-  int view;
-  double view_azimuth;
-  double view_elevation;
-  int relief;
-  const bb_image *relief_height;
-  double relief_depth;
-} bb_render_options;
-
-typedef struct bb_panel_layout {
-  int columns;
-  int panel_width;
-  int gap;
-  int font_size;
-  const char *font;
-} bb_panel_layout;
-
-typedef struct bb_sheet_options {
-  bb_panel_layout layout;
-  bb_render_options lit;
-} bb_sheet_options;
-
-typedef struct bb_mesh {
-  size_t vertex_count;
-  size_t triangle_count;
-  float *positions;
-  float *normals;
-  uint32_t *indices;
-} bb_mesh;
-
-typedef enum bb_axis {
-  BB_AXIS_NEG_Y = 0,
-  BB_AXIS_POS_Y,
-  BB_AXIS_POS_Z,
-  BB_AXIS_NEG_Z,
-  BB_AXIS_POS_X,
-  BB_AXIS_NEG_X
-} bb_axis;
-
-typedef struct bb_renderbump_options {
-  int width, height;
-  int samples;
-  bb_axis axis;
-  int face_normals;
-  int rect_given;
-  double rect[4];
-  int tile;
-  int threads;
-  bb_note_fn note;
-  void *note_user;
-} bb_renderbump_options;
 
 typedef struct bb_renderbump_result {
   bb_image normal;
@@ -584,36 +506,6 @@ typedef struct bb_command_info {
   int option_count;
 } bb_command_info;
 
-typedef struct bb_command_options {
-  bb_job_options job;
-  const char *output;
-  bb_render_options render;
-  const char *render_maps[8];
-  const char *albedo;
-  int render_compare;
-  int orbit;
-  int maps_normal_y_up;
-  int panel_size;
-  bb_compare_limits limits;
-  const char *diff;
-  const char *limit_rules;
-  int check_bake;
-  int update;
-  const char *junit, *html;
-  bb_renderbump_options renderbump;
-  const char *height_output;
-  bb_map_kind map_kind;
-  bb_map_kind ssbump_kind;
-  double mix;
-  const char *mask;
-  int detail;
-  const char *brightness;
-  const char *base_dir;
-  int allow_outside_base;
-  int json, quiet;
-  const char *scheduler;
-} bb_command_options;
-
 typedef struct bb_command bb_command;
 
 typedef struct bb_command_hooks {
@@ -769,7 +661,10 @@ bb_status bb_command_check(bb_command *command, bb_error *err);
 void bb_command_set_in_memory(bb_command *command, unsigned maps);
 void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
-const bb_command_options *bb_command_options_of(const bb_command *command);
+bb_status bb_command_value(const bb_command *command, const char *name, char *out,
+                           size_t cap, bb_error *err);
+const bb_job_options *bb_command_job_options(const bb_command *command);
+void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
@@ -796,10 +691,9 @@ const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
 /* what a job prints (bumpbake bake --scheduler) */
-char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json);
-char *bb_job_summary_lines(const bb_command_options *o, const char *command, const int *counts,
-                           int files);
+char *bb_job_summary_lines(const bb_command *command, const int *counts, int files);
 """
 
 # Constants of the header (#define), by value: cffi reads only literals.

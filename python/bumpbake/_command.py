@@ -173,9 +173,9 @@ class Command:
             _check(_lib.bb_command_check(self._c, err), err)
 
     def job_text(self, name):
-        """The text of a string option of the job's (out_dir), or None."""
-        value = getattr(self.options.job, name)
-        return None if value == _ffi.NULL else _text(value)
+        """The text of a file option of the job's (out-dir), or None when
+        not given."""
+        return self.value(name) or None
 
     def option(self, key):
         """The option of keyword key; TypeError naming the nearest when none."""
@@ -268,8 +268,26 @@ class Command:
 
     @property
     def options(self):
-        """The checked options (bb_command_options cdata, owned by the command)."""
-        return _lib.bb_command_options_of(self._c)
+        """The checked options, as the runs read them (_Options)."""
+        return _Options(self)
+
+    def value(self, name):
+        """The value of option name (its long name) as the command holds it,
+        spelled as the option takes it (bb_command_value): "" for a file
+        not given, "0" or "1" for a flag."""
+        out = _ffi.new("char[]", 4096)
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_command_value(self._c, name.encode(), out, len(out), err), err)
+        return _text(out)
+
+    def word(self, name):
+        """The value of word option name as the library's enum value
+        (bb_option_parse of its value: bb_map_kind for --kind)."""
+        option = _lib.bb_option_find(self._info, name.encode(), 0)
+        value = _ffi.new("long long *")
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_option_parse(option, self.value(name).encode(), value, err), err)
+        return value[0]
 
     def text(self, input=None, recorded=True):
         """The command as bb_command_text spells it (recorded: the options
@@ -335,3 +353,37 @@ def doc(command, files=True, skip=()):
         text = f"{key}: {help}" + (f" ({extra})" if extra else "")
         lines += textwrap.wrap(text, 76, initial_indent="    ", subsequent_indent="        ")
     return "\n".join(lines) + "\n"
+
+
+class _Options:
+    """What the runs read of a checked command after bb_command_check: the
+    bake's options (job: bb_job_options, the stage API's), owned by the
+    command and writable for what has no spelling as an option (a basis of
+    vectors); the other options by name through the library."""
+
+    def __init__(self, command):
+        self._command = command
+
+    @property
+    def job(self):
+        return _ffi.cast("bb_job_options *", _lib.bb_command_job_options(self._command.handle))
+
+    @property
+    def maps_normal_y_up(self):
+        """--normal-y up: the normal maps read (or written) are OpenGL-style."""
+        return int(self._command.value("normal-y") == "up")
+
+    @property
+    def map_kind(self):
+        """combine's --kind, a bb_map_kind."""
+        return self._command.word("kind")
+
+    @property
+    def ssbump_kind(self):
+        """ssbump2normal's --kind: BB_MAP_SSBUMP or BB_MAP_WEIGHTS."""
+        return self._command.word("kind")
+
+    @property
+    def mix(self):
+        """combine's --mix (the value spelled exactly: the same double)."""
+        return float(self._command.value("mix"))

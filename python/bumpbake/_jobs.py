@@ -146,7 +146,7 @@ class BakeJob:
         c.record(a["command"], a["command_options"])
         c.check()
         if vectors is not None:
-            _ffi.cast("bb_command_options *", c.options).job.bake.basis = vectors[0]
+            c.options.job.bake.basis = vectors[0]
         return c
 
     def _plan(self, inputs, a):

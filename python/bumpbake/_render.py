@@ -16,9 +16,8 @@ from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _che
 # The default light of render: on, at this azimuth and elevation (degrees),
 # as a new render command holds it.
 def _default_light():
-    render = Command("render")  # owns its options while they are read
-    o = render.options.render
-    return (o.light_azimuth, o.light_elevation)
+    azimuth, elevation = Command("render").value("light").split(",")
+    return (float(azimuth), float(elevation))
 
 
 DEFAULT_LIGHT = _default_light()
@@ -44,12 +43,6 @@ def _set_lighting(c, light, lightmap):
                                   f"shape (3, 3) (got {_shown(lightmap)})")
         lightmap = ",".join(repr(float(v)) for v in values.reshape(-1))
     c.set("lightmap", lightmap)
-
-
-def _writable(c):
-    """The command's options, for what Python adds to them after the
-    library's check (no spelling on the command line)."""
-    return _ffi.cast("bb_command_options *", c.options)
 
 
 def _picture(c, height, maps, progress):
@@ -113,11 +106,9 @@ def render(normal=None, ssbump=None, ao=None, bent=None, slope=None, albedo=None
     c.set_all(options)
     c.in_memory()
     c.check()
-    o = _writable(c)
-    if light is None:
-        o.render.dynamic_light = 0
-    if ny is not None:
-        o.render.tile_y = int(ny)
+    # what the command line cannot spell, after the library's check
+    _lib.bb_command_set_picture(c.handle, int(light is not None),
+                                int(ny) if ny is not None else 0)
     green_up = c.options.maps_normal_y_up
     keep, read = [], []
     maps = _ffi.new("bb_render_maps *")
@@ -171,8 +162,8 @@ def sheet(height, scale, *, light=_AUTO, lightmap=None, progress=None, **options
     c.set_all(options)
     c.in_memory()
     c.check()
-    if light is None:
-        _writable(c).render.dynamic_light = 0
+    if light is None:  # no spelling on the command line
+        _lib.bb_command_set_picture(c.handle, 0, 0)
     return _picture(c, height, _ffi.NULL, progress)
 
 

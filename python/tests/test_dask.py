@@ -410,8 +410,8 @@ def test_a_handed_over_command_is_the_command(tmp_path, monkeypatch):
     back = Command.from_handover(handed)
     assert spelled(back.handle) == spelled(c)
     assert all(_lib.bb_command_given(back.handle, n.encode()) for n in given)
-    assert back.options.json == 1 and back.options.quiet == 1  # the printer's, too
-    assert _text(back.options.scheduler) == "tcp://h:1"
+    assert back.value("json") == "1" and back.value("quiet") == "1"  # the printer's, too
+    assert back.value("scheduler") == "tcp://h:1"
     chunk = Command.from_handover(handed, ["heights/h01.png"])
     assert spelled(chunk.handle).startswith("bumpbake bake heights/h01.png --scale 12.5")
     job = CommandJob(handed, ["heights/h01.png"], notes="ignore")

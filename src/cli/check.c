@@ -9,6 +9,7 @@
 #include "common.h"
 #include "progress.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -24,9 +25,8 @@ static void print_case(void *user, const bb_check_case *c) {
 }
 
 int cli_run_check(const cli_run *r) {
-  const bb_command_options *o = r->options;
   cli_progress progress;
-  cli_progress_start(&progress, "check", o->quiet);
+  cli_progress_start(&progress, "check", r->quiet);
   const bb_command_hooks hooks = {cli_progress_note, &progress, NULL, NULL, NULL, NULL};
   bb_check *check = NULL;
   bb_error err = {{0}};
@@ -56,11 +56,12 @@ int cli_run_check(const cli_run *r) {
   if (bb_check_write_reports(check, &report_err) != BB_OK) {
     cli_error_line(report_err.message);
     rc = BB_COMPARE_CANNOT_READ;
-  } else if (!o->quiet && !o->json) {
-    if (o->junit)
-      cli_printf_line("wrote junit %s", o->junit);
-    if (o->html)
-      cli_printf_line("wrote report %s/index.html", o->html);
+  } else if (!r->quiet && !r->json) {
+    char junit[PATH_MAX], html[PATH_MAX];
+    if (cli_text(r, "junit", junit, sizeof junit))
+      cli_printf_line("wrote junit %s", junit);
+    if (cli_text(r, "html", html, sizeof html))
+      cli_printf_line("wrote report %s/index.html", html);
   }
   cli_put_lines(bb_check_summary_lines(check));
   bb_check_free(check);

@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 
+#include <stddef.h>
 #include <stdio.h>
 
 /* Exit codes of every subcommand except compare and check (which follow
@@ -32,10 +33,18 @@ int bb_cli_command_with(int argc, char **argv, int (*run)(const cli_run *r));
 
 struct cli_run {
   bb_command *command;
-  const bb_command_options *options; /* bb_command_options_of(command) */
+  int quiet, json;      /* --quiet, --json (cli_flag) */
   const char *record;   /* the command line its outputs record: the words as typed,
                            less those of options that do not change the output */
 };
+
+/* 1 when the flag name of r's command is on (given); 0 when off or not
+ * an option of the command. */
+int cli_flag(const cli_run *r, const char *name);
+/* The value of option name of r's command, as bb_command_value spells it,
+ * in out (capacity cap); NULL when it has none (a file not given) or does
+ * not fit. */
+const char *cli_text(const cli_run *r, const char *name, char *out, size_t cap);
 
 /* Each command's run: what it does with the library and what it prints;
  * returns the exit code. */

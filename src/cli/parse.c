@@ -399,7 +399,9 @@ static int parse_and_run(parse *p, int (*run)(const cli_run *r)) {
       cli_error_line("out of memory");
     return st == BB_ERR_MEMORY ? BB_EXIT_FAILURE : refused(p, st, &err);
   }
-  cli_run r = {p->command, bb_command_options_of(p->command), line};
+  cli_run r = {p->command, 0, 0, line};
+  r.quiet = cli_flag(&r, "quiet");
+  r.json = cli_flag(&r, "json");
   rc = BB_EXIT_FAILURE;
   for (size_t i = 0; !run && i < sizeof runners / sizeof runners[0]; i++)
     if (!strcmp(runners[i].name, p->info->name))

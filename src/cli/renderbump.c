@@ -5,41 +5,44 @@
 #include "cli.h"
 #include "common.h"
 
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* The axis as renderbumpflat's --axis spells it ("-y"). */
-static const char *axis_word(bb_axis axis) {
-  const char *w = bb_option_word(
-      bb_option_find(bb_command_info_find("renderbumpflat"), "axis", 0), axis);
-  return w ? w : "unknown";
-}
-
-static void print_summary(const char *model, const bb_renderbump_options *o,
+/* size ("W H"), samples and axis ("-y") as the checked command holds them. */
+static void print_summary(const cli_run *run, const char *model,
                           const bb_renderbump_result *r) {
+  char size[64] = "", samples[16] = "", axis[8] = "";
+  cli_text(run, "size", size, sizeof size);
+  cli_text(run, "samples", samples, sizeof samples);
+  cli_text(run, "axis", axis, sizeof axis);
+  int width = 0, height = 0;
+  sscanf(size, "%d %d", &width, &height);
+  const int n = atoi(samples);
   cli_printf_line("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
                   "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each",
-                  model, r->triangles, r->used_vertex_normals ? "vertex" : "face",
-                  axis_word(o->axis), r->rect[0], r->rect[2], r->rect[1], r->rect[3],
-                  o->width, o->height, o->samples * o->samples);
+                  model, r->triangles, r->used_vertex_normals ? "vertex" : "face", axis,
+                  r->rect[0], r->rect[2], r->rect[1], r->rect[3], width, height, n * n);
 }
 
 /* The one number the height is useless without: printed even with -q. */
-static void print_height_scale(const char *height, bb_axis axis,
+static void print_height_scale(const cli_run *run, const char *height,
                                const bb_renderbump_result *r) {
   char *word = bb_text_shell_quoted(height); /* the line, typed in a shell */
+  char axis[8] = "";
+  cli_text(run, "axis", axis, sizeof axis);
   if (r->height_scale > 0.0)
     cli_printf_line("height scale %.6g texels per unit (bumpbake bake %s --scale %.6g ...)",
                     r->height_scale, word ? word : height, r->height_scale);
   else
     cli_printf_line("height scale 0: the model is flat along %s, so its height is 0 "
                     "everywhere and a bake of it would trace nothing",
-                    axis_word(axis));
+                    axis);
   free(word);
 }
 
 int cli_run_renderbumpflat(const cli_run *r) {
-  const bb_command_options *o = r->options;
   const char *model = bb_command_input(r->command, 0);
   const bb_command_hooks hooks = {cli_note, NULL, NULL, NULL, NULL, NULL};
   bb_renderbump_result render;
@@ -50,13 +53,14 @@ int cli_run_renderbumpflat(const cli_run *r) {
     cli_error_line(err.message[0] ? err.message : bb_status_name(st));
     return BB_EXIT_FAILURE;
   }
-  if (!o->quiet) {
-    print_summary(model, &o->renderbump, &render);
+  if (!r->quiet) {
+    print_summary(r, model, &render);
     for (int i = 0; i < written.file_count; i++)
       cli_printf_line("wrote %s %s", written.files[i].kind, written.files[i].path);
   }
-  if (o->height_output)
-    print_height_scale(o->height_output, o->renderbump.axis, &render);
+  char height[PATH_MAX];
+  if (cli_text(r, "height", height, sizeof height))
+    print_height_scale(r, height, &render);
   bb_command_result_free(&written);
   bb_renderbump_result_free(&render);
   return BB_EXIT_OK;

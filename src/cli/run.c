@@ -11,7 +11,7 @@
 static int run_and_report(const cli_run *r) {
   const char *name = bb_command_describe(r->command)->name;
   cli_progress progress;
-  cli_progress_start(&progress, name, r->options->quiet);
+  cli_progress_start(&progress, name, r->quiet);
   const bb_command_hooks hooks = {cli_progress_note, &progress, cli_progress_fn(&progress), &progress,
                                   NULL, NULL};
   bb_command_result result;
@@ -25,7 +25,7 @@ static int run_and_report(const cli_run *r) {
   if (!result.labels_drawn)
     cli_no_font_note(name);
   const int n = result.file_count;
-  if (r->options->quiet || !n) {
+  if (r->quiet || !n) {
     /* the exit code says it */
   } else if (result.frames && n == 1) { /* an animation */
     cli_printf_line("wrote %s %s (%d frames)", result.files[0].kind, result.files[0].path,

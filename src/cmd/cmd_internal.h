@@ -6,6 +6,7 @@
 #define BB_CMD_INTERNAL_H
 
 #include "bumpbake.h"
+#include "cmd/command_options.h"
 #include "core/internal.h"
 #include "job/bake_rows.h"
 

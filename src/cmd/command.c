@@ -89,8 +89,21 @@ int bb_command_given(const bb_command *c, const char *name) {
   return c && name && bb__given(c, name);
 }
 
-const bb_command_options *bb_command_options_of(const bb_command *c) {
+const bb_command_options *bb__command_options_of(const bb_command *c) {
   return c ? &c->options : NULL;
+}
+
+const bb_job_options *bb_command_job_options(const bb_command *c) {
+  return c ? &c->options.job : NULL;
+}
+
+void bb_command_set_picture(bb_command *c, int dynamic_light, int tile_y) {
+  if (!c)
+    return;
+  if (!dynamic_light)
+    c->options.render.dynamic_light = 0;
+  if (tile_y > 0)
+    c->options.render.tile_y = tile_y;
 }
 
 int bb__command_input_count(const bb_command *c) {

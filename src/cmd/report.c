@@ -124,8 +124,9 @@ static char *closed(FILE *f, char **text) {
   return *text;
 }
 
-char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, int batch,
+char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json) {
+  const bb_command_options *o = bb__command_options_of(command);
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
@@ -147,8 +148,9 @@ char *bb_job_report_lines(const bb_command_options *o, const bb_job_report *r, i
   return closed(f, &text);
 }
 
-char *bb_job_summary_lines(const bb_command_options *o, const char *command,
-                           const int *counts, int files) {
+char *bb_job_summary_lines(const bb_command *c, const int *counts, int files) {
+  const bb_command_options *o = bb__command_options_of(c);
+  const char *command = bb_command_describe(c)->name;
   char *text = NULL;
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);

@@ -111,7 +111,7 @@ static bb_status parse_rule(const char *text, bb__check_rule *r, bb_error *err) 
   if (st == BB_OK && (st = bb_command_check(scratch, &e)) != BB_OK)
     bb__fail(err, st, "--limits '%.200s': %s", text, e.message);
   if (st == BB_OK)
-    r->limits = bb_command_options_of(scratch)->limits;
+    r->limits = bb__command_options_of(scratch)->limits;
   bb_command_free(scratch);
   return st;
 }

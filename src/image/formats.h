@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 #include "core/file_names.h" /* bb__path_has_extension */
+#include "image/image_write.h" /* bb_write_options */
 
 #include <stddef.h>
 

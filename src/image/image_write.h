@@ -12,6 +12,22 @@
 extern "C" {
 #endif
 
+/* How a file is written: its depth, range, provenance text and texture
+ * settings (once in bumpbake.h, issue 41: no public function takes it). */
+typedef struct bb_write_options {
+  bb_depth depth;
+  bb_range range;
+  const char *description; /* provenance text stored in the file, or NULL.
+                              TGA holds 4 rows of 80 characters: provenance
+                              is fitted with whole key=value lines, keys that
+                              affect pixels first, and what does not fit is
+                              left out (see bb_provenance_class) */
+  const struct bb_texture_options *texture; /* .vtf and .dds only: format, mip
+                              chain, flags (see "engine textures"); NULL: the
+                              defaults, the map NORMAL for BB_RANGE_SIGNED and
+                              PLAIN otherwise. description overrides its own */
+} bb_write_options;
+
 bb_status bb__image_write_staged(const char *path, const bb_image *img,
                                  const bb_write_options *options, int threads,
                                  bb_staged_file **staged, bb_error *err);

@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 #include "core/file_names.h" /* bb__file_name, bb__file_extension */
 #include "files/file_identity.h"
+#include "mesh/mesh_internal.h" /* bb_renderbump_options */
 
 #include <stddef.h>
 #include <sys/types.h>

@@ -7,6 +7,7 @@
 #define BB_MESH_IMPORT_H
 
 #include "bumpbake.h"
+#include "mesh/mesh_internal.h" /* bb_mesh */
 
 #ifdef __cplusplus
 extern "C" {

@@ -12,6 +12,41 @@ extern "C" {
 
 extern const bb__range bb__range_renderbump_samples;
 
+/* Once in bumpbake.h (issue 41): no public function takes them; the
+ * mesh family and the commands above it do. */
+
+/* A triangle mesh in model units. renderbumpflat reads one from a file: every
+ * mesh of the file merged, node transforms applied, polygons triangulated,
+ * points and lines dropped. */
+typedef struct bb_mesh {
+  size_t vertex_count;
+  size_t triangle_count;
+  float *positions;  /* 3 floats per vertex: x, y, z in model units */
+  float *normals;    /* 3 floats per vertex, or NULL when the model has none;
+                        a vertex whose normal is zero or not finite has none */
+  uint32_t *indices; /* 3 per triangle, each < vertex_count */
+} bb_mesh;
+
+typedef struct bb_renderbump_options {
+  int width, height;  /* output size in texels; default 256 x 256 (DOOM 3) */
+  int samples;        /* samples per texel side, 1..16: samples^2 per texel on
+                         a regular grid; default 4 (DOOM 3's 16x) */
+  bb_axis axis;       /* the side the sculpt faces; default BB_AXIS_NEG_Y */
+  int face_normals;   /* 1: every triangle's own plane normal, even when the
+                         mesh has vertex normals; default 0 */
+  int rect_given;     /* 1: rect below, 0: the mesh's bounding rectangle */
+  double rect[4];     /* left, bottom, right, top: the rectangle mapped onto
+                         the image, in model units along right and up */
+  int tile;           /* 1: geometry outside the rectangle wraps around into
+                         it (the sculpt tiles with the rectangle as period) */
+  int threads;        /* 0..BB_MAX_THREADS, 0 = all cores; the result is the
+                         same for any count */
+  bb_note_fn note;    /* told when the texels come out not square, with the
+                         size or rectangle that keeps them square (may be
+                         NULL) */
+  void *note_user;
+} bb_renderbump_options;
+
 /* Once in bumpbake.h, now internal (issue 41): no client of the
  * library calls these; the library, tests, tools and fuzz targets do. */
 

@@ -4,6 +4,7 @@
 #define BB_MESH_RENDERBUMP_NOTES_H
 
 #include "bumpbake.h"
+#include "mesh/mesh_internal.h" /* bb_renderbump_options */
 
 /* Tells o->note (when set) that r's texels are not square, with the size
  * and the rectangle that would make them so. */

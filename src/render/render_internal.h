@@ -7,6 +7,87 @@
 
 #include "core/internal.h"
 
+/* Once in bumpbake.h (issue 41): no public function takes them; the
+ * render, sheet and job families do. */
+
+/* What one render shows and how it is lit (the command's options: render's
+ * and sheet's picture; bb_command_set_picture for what no option spells). */
+typedef struct bb_render_options {
+  bb_render_mode mode;          /* default BB_RENDER_SSBUMP */
+  int dynamic_light;            /* 1: the dynamic light is on (default 1) */
+  double light_azimuth;         /* degrees, any finite value (default 135) */
+  double light_elevation;       /* degrees, 0..90 (default 45) */
+  float light_color[3];         /* C, >= 0 (default 1, 1, 1) */
+  int static_light;             /* 1: the lightmaps are on (default 0) */
+  float lightmap[3][3];         /* L_c, >= 0; default red, green, blue: the
+                                   three basis directions in three colours */
+  double specular_exponent;     /* k in 0..BB_MAX_SPECULAR_EXPONENT, 0 = no specular
+                                   (default 0) */
+  double specular_strength;     /* ks, 0..1000: the highlight's scale, a
+                                   material's specular intensity (default 1) */
+  bb_albedo_mode albedo_mode;   /* how maps->albedo multiplies the diffuse light;
+                                   default BB_ALBEDO_MULTIPLY */
+  int tile_x, tile_y;           /* repeat the render nx x ny, 1..64 (default 1, 1) */
+  int crop_x, crop_y, crop_width, crop_height; /* window of the tiled render,
+                                   texels; crop_width 0 = no crop */
+  int threads;                  /* 0..BB_MAX_THREADS, 0 = all cores; results
+                                   are identical */
+  int view;                     /* 1: an orthographic camera at view_azimuth,
+                                   view_elevation looks at the surface (the
+                                   texture tiling on for ever); 0 (default):
+                                   straight down, texel for pixel */
+  double view_azimuth;          /* degrees, as the light's (default 270: from the
+                                   bottom of the image, which then recedes up
+                                   the picture) */
+  double view_elevation;        /* degrees, 1..90 (default 30) */
+  int relief;                   /* 1: parallax occlusion mapping of
+                                   relief_height as shaders/ssbump_relief.glsl
+                                   does it: each pixel's view ray is followed
+                                   into the relief and the maps are read where
+                                   it meets it; needs view */
+  const bb_image *relief_height; /* h in [0, 1] in channel 0, the maps' size:
+                                   the bake's filtered height. Not owned */
+  double relief_depth;          /* texels of relief per unit of h, > 0: the
+                                   bake's height_scale (default 0: must be set
+                                   with relief) */
+} bb_render_options;
+
+/* What a render lit, for its provenance. */
+typedef struct bb_render_sources {
+  const char *height;   /* the height file baked for it, or NULL: maps read */
+  const char *maps[BB_MAP_KIND_COUNT]; /* the map files read, by kind; NULL when not */
+  int maps_normal_y_up; /* the normal and bent files were OpenGL-style */
+  const char *albedo;   /* the albedo file, or NULL */
+  uint64_t albedo_hash; /* the hash of the albedo's pixels, as read */
+  int frame, frames;    /* frame of an orbit of frames; frames 0: one picture */
+} bb_render_sources;
+
+/* One picture of a panel grid and the label written under it (may be NULL). */
+typedef struct bb_panel {
+  const bb_image *image; /* 3-channel RGB in [0, 1] (a map as an 8-bit file shows it) */
+  const char *label;
+} bb_panel;
+
+typedef struct bb_panel_layout {
+  int columns;        /* panels per row, >= 1 (default 4) */
+  int panel_width;    /* texels; each panel is resampled to this width keeping its
+                         aspect; 0 = the widest panel's width (default 0) */
+  int gap;            /* texels between panels and around the grid (default 8) */
+  int font_size;      /* label height in pixels, 6..512; 0 = a sixteenth of the
+                         panel width, 12..48 (default 0). Made smaller, down to 6,
+                         until the widest label fits a panel */
+  const char *font;   /* font file or name; NULL = look one up (default NULL) */
+} bb_panel_layout;
+
+/* The exponent render --compare uses when o->specular_exponent is 0. */
+#define BB_COMPARE_SPECULAR_EXPONENT 64.0
+
+/* sheet's options: its grid and its lit panel. */
+typedef struct bb_sheet_options {
+  bb_panel_layout layout; /* default 4 columns, panels 256 texels wide */
+  bb_render_options lit;  /* the lit panel (default: ssbump, light 135, 45) */
+} bb_sheet_options;
+
 extern const bb__range bb__range_light_elevation, bb__range_view_elevation,
     bb__range_colour, bb__range_specular_exponent, bb__range_specular_strength,
     bb__range_tile;
@@ -163,7 +244,7 @@ const char *bb__render_mode_name(bb_render_mode mode);
 unsigned bb__render_mode_needs(bb_render_mode mode);
 
 /* render's defaults: ssbump, the light at 135, 45 (once public: a client
- * reads them from a new render command's options, bb_command_options_of). */
+ * reads them by name from a new render command, bb_command_value). */
 void bb__render_options_init(bb_render_options *o);
 
 #endif /* BB_RENDER_INTERNAL_H */

@@ -40,10 +40,17 @@ static int name_outputs(bb_job_options *job, const char *height) {
   return rc;
 }
 
+/* The file option name of command names, kept for the process's life
+ * (serve's state holds it), or NULL when not given. */
+static const char *kept_path(const cli_run *r, const char *name) {
+  char path[PATH_MAX];
+  return cli_text(r, name, path, sizeof path) ? strdup(path) : NULL;
+}
+
 int cli_run_serve(const cli_run *r) {
-  const bb_command_options *a = r->options;
+  const bb_job_options *bake = bb_command_job_options(r->command);
   const char *height = bb_command_input(r->command, 0);
-  bb_job_options named = a->job;
+  bb_job_options named = *bake;
   if (name_outputs(&named, height) != 0) {
     cli_error_line("out of memory");
     return BB_EXIT_FAILURE;
@@ -55,13 +62,14 @@ int cli_run_serve(const cli_run *r) {
   pthread_cond_init(&s.changed, NULL);
   s.height_path = height;
   s.line = r->command; /* lives as long as the process */
-  s.settings = a->job; /* the bake's parameters as parsed */
+  s.settings = *bake; /* the bake's parameters as parsed */
   s.job = named;
-  s.brightness_file = a->job.brightness_file;
+  s.brightness_file = bake->brightness_file;
   s.use_brightness = s.brightness_file != NULL;
-  s.albedo_file = a->albedo; /* render's --albedo and --light-color light the picture */
-  memcpy(s.light_color, a->render.light_color, sizeof s.light_color);
-  s.quiet = a->quiet;
+  s.albedo_file = kept_path(r, "albedo"); /* render's --albedo and --light-color light
+                                             the picture */
+  serve_light_color(r->command, s.light_color);
+  s.quiet = r->quiet;
   /* the page's controls change a copy of the command line's command */
   size_t handover_size = 0;
   char *handover = bb_command_handover(r->command, &handover_size);
@@ -73,8 +81,8 @@ int cli_run_serve(const cli_run *r) {
   if (copied != BB_OK)
     return cli_library_error("serve", copied, &copy_err);
   s.watched[s.watched_count++] = height;
-  const char *also[] = {a->job.brightness_file, a->job.bounce_albedo_file,
-                        a->job.basis_file, a->albedo};
+  const char *also[] = {bake->brightness_file, bake->bounce_albedo_file, bake->basis_file,
+                        s.albedo_file};
   for (size_t i = 0; i < sizeof also / sizeof also[0]; i++)
     if (also[i])
       s.watched[s.watched_count++] = also[i];

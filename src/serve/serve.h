@@ -190,6 +190,11 @@ int serve_apply_params(serve_state *s, const char *const *names,
                        const char *const *values, const size_t *sizes, int count,
                        int *rebake, char *err, size_t cap);
 
+/* serve_params.c: command's --light-color (render's row, which serve
+ * takes) as the picture's light, read by name: bb_command_value's "R,G,B"
+ * (the value set, else the default), each float spelled exactly. */
+void serve_light_color(const bb_command *command, float rgb[3]);
+
 /* serve_page.c: the page's files, embedded at build time. */
 typedef struct serve_asset {
   const char *name, *type;

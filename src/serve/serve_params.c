@@ -357,13 +357,22 @@ int serve_apply_params(serve_state *s, const char *const *names,
    * command's (no file named in them: the command line's files, which its
    * command owns, stay in the rest of the settings), its brightness switch
    * and its light */
-  const bb_command_options *now = bb_command_options_of(next);
-  s->settings.bake = now->job.bake;
+  s->settings.bake = bb_command_job_options(next)->bake;
   s->use_brightness = bb_command_given(next, "brightness");
-  memcpy(s->light_color, now->render.light_color, sizeof s->light_color);
+  serve_light_color(next, s->light_color);
   bb_command_free(s->command);
   s->command = next;
   s->version++;
   pthread_cond_broadcast(&s->changed);
   return 0;
+}
+
+void serve_light_color(const bb_command *command, float rgb[3]) {
+  char text[128] = "";
+  bb_command_value(command, "light-color", text, sizeof text, NULL);
+  char *p = text;
+  for (int k = 0; k < 3; k++) {
+    rgb[k] = strtof(p, &p);
+    p += *p == ',';
+  }
 }

@@ -143,7 +143,7 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
     if (s->needs)
       set(c, s->needs, s->needs_value);
     set(c, s->name, s->value);
-    const bb_job_options *o = &bb_command_options_of(c)->job;
+    const bb_job_options *o = &bb__command_options_of(c)->job;
     cr_expect(bb__bake_row_differs(row, o, &defaults), "--%s %s is its default", s->name,
               s->value ? s->value : "");
     char *text = bb_job_command_text(o, "h.png");
@@ -166,7 +166,7 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
 
     /* read back: the same job, so the same line */
     bb_command *back = read_back(text);
-    const bb_job_options *b = &bb_command_options_of(back)->job;
+    const bb_job_options *b = &bb__command_options_of(back)->job;
     cr_expect(bb__bake_row_differs(row, b, &defaults), "'%s' read back lost --%s", text,
               s->name);
     char *again = bb_job_command_text(b, "h.png");

@@ -5,6 +5,7 @@
 #define _XOPEN_SOURCE 700 /* mkdtemp */
 
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "cmd/cmd_internal.h"
 #include "hostile_headers.h"
 
@@ -134,7 +135,7 @@ Test(cmd, text_reads_back_the_same) {
   bb_command *back = command("bake", (const char *const *)argv + 2);
   char *again = bb_command_text(back, NULL, 0);
   cr_expect_str_eq(again, text);
-  const bb_command_options *a = bb_command_options_of(c), *b = bb_command_options_of(back);
+  const bb_command_options *a = bb__command_options_of(c), *b = bb__command_options_of(back);
   cr_expect_eq(a->job.bake.height_scale, b->job.bake.height_scale);
   cr_expect_eq(a->job.slope_lit_elevation, b->job.slope_lit_elevation);
   cr_expect_eq(a->job.bake.basis.count, 6);
@@ -285,7 +286,7 @@ Test(cmd, a_file_option_given_twice_is_refused_but_a_map_takes_several) {
                         NULL};
   bb_command *c = command("bake", same);
   cr_expect_eq(bb_command_check(c, NULL), BB_OK);
-  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
+  cr_expect_str_eq(bb__command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
   char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
   cr_expect(text && strstr(text, " --ssbump s.png") && !strstr(text, "--ssbump s.png --"),
             "%s", text);
@@ -295,7 +296,7 @@ Test(cmd, a_file_option_given_twice_is_refused_but_a_map_takes_several) {
                        "s.png", "--ssbump", "s.vtf", NULL};
   c = command("bake", two);
   cr_expect_eq(bb_command_check(c, NULL), BB_OK);
-  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
+  cr_expect_str_eq(bb__command_options_of(c)->job.paths[BB_MAP_SSBUMP], "s.png");
   text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
   cr_expect(text && strstr(text, " --ssbump s.png --ssbump s.vtf"), "%s", text);
   free(text);
@@ -326,7 +327,7 @@ Test(cmd, names_and_did_you_mean) {
   cr_expect_eq(bb_command_set(c, "filter_radus", "3", &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "unknown option '--filter_radus' (did you mean --filter-radius?)");
   cr_expect_eq(bb_command_set(c, "filter_radius", "3", &err), BB_OK);
-  cr_expect_eq(bb_command_options_of(c)->job.bake.smooth.radius_texels, 3);
+  cr_expect_eq(bb__command_options_of(c)->job.bake.smooth.radius_texels, 3);
   cr_expect_eq(bb_command_set(c, "normal-filter", "fancy", &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message,
                    "--normal-filter must be one of valve, central, sobel, vertex (got 'fancy')");
@@ -350,7 +351,7 @@ Test(cmd, height2ssbump_plans_a_job) {
   cr_expect_str_eq(err.message, "BUMPSCALE must be > 0 (got 0)");
   cr_assert_eq(bb_command_add_input(c, "16", &err), BB_OK);
   cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
-  const bb_command_options *o = bb_command_options_of(c);
+  const bb_command_options *o = bb__command_options_of(c);
   cr_expect_eq(o->job.bake.height_scale, 16.0f);
   cr_expect_eq(o->job.bake.rays, 250);
   cr_expect_eq(o->job.channel, BB_CHANNEL_VALVE);
@@ -368,7 +369,7 @@ Test(cmd, a_flag_set_to_0_is_unset) {
   cr_assert(bb_command_given(c, "force"));
   cr_assert_eq(bb_command_set(c, "force", "0", &err), BB_OK, "%s", err.message);
   cr_expect_not(bb_command_given(c, "force"));
-  cr_expect_eq(bb_command_options_of(c)->job.force, 0);
+  cr_expect_eq(bb__command_options_of(c)->job.force, 0);
   cr_expect_eq(bb_command_set(c, "clamp", "0", &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "--clamp cannot be unset: leave it out");
   cr_expect_eq(bb_command_set(c, "force", "2", &err), BB_ERR_ARGUMENT);
@@ -380,11 +381,11 @@ Test(cmd, a_flag_set_to_0_is_unset) {
 Test(cmd, kind_options_take_the_librarys_words) {
   const char *s2n[] = {"--kind", "Weights", NULL};
   bb_command *c = command("ssbump2normal", s2n);
-  cr_expect_eq(bb_command_options_of(c)->ssbump_kind, BB_MAP_WEIGHTS);
+  cr_expect_eq(bb__command_options_of(c)->ssbump_kind, BB_MAP_WEIGHTS);
   bb_command_free(c);
   const char *comb[] = {"--kind", "WEIGHTS", NULL};
   c = command("combine", comb);
-  cr_expect_eq(bb_command_options_of(c)->map_kind, BB_MAP_WEIGHTS);
+  cr_expect_eq(bb__command_options_of(c)->map_kind, BB_MAP_WEIGHTS);
   bb_command_free(c);
   const char *kinds[] = {"normal", "ao", "bent", "slope"};
   for (int i = 0; i < 4; i++) {
@@ -401,7 +402,7 @@ Test(cmd, kind_options_take_the_librarys_words) {
 Test(cmd, flags_set_their_field) {
   const char *bake[] = {"--scale", "2", "--clamp", "--nomip", "--fast-compression", NULL};
   bb_command *c = command("bake", bake);
-  const bb_command_options *o = bb_command_options_of(c);
+  const bb_command_options *o = bb__command_options_of(c);
   cr_expect_eq(o->job.bake.smooth.addressing, BB_ADDRESS_CLAMP);
   cr_expect_eq(o->job.texture.mips, 0);
   cr_expect_eq(o->job.texture.fast, 1);
@@ -411,7 +412,7 @@ Test(cmd, flags_set_their_field) {
   bb_command_free(c);
   cr_assert_eq(bb_command_new("height2ssbump", &c, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_command_set(c, "dump-filtered", NULL, &err), BB_OK, "%s", err.message);
-  cr_expect_str_eq(bb_command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
+  cr_expect_str_eq(bb__command_options_of(c)->job.paths[BB_MAP_FILTERED], "filtered.tga");
   bb_command_free(c);
 }
 
@@ -535,13 +536,13 @@ Test(cmd, unset_puts_an_option_back_at_its_default) {
   cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_command_unset(c, "bounce", &err), BB_OK, "%s", err.message);
   cr_expect_not(bb_command_given(c, "bounce"));
-  cr_expect_eq(bb_command_options_of(c)->job.bake.bounce_albedo, 0.0);
+  cr_expect_eq(bb__command_options_of(c)->job.bake.bounce_albedo, 0.0);
   /* the line without --bounce is the CLI's refusal */
   cr_expect_eq(bb_command_check(c, &err), BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "--bounces does nothing without --bounce RHO or --bounce-albedo FILE");
   cr_assert_eq(bb_command_unset(c, "bounces", &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_command_unset(c, "slices", &err), BB_OK, "%s", err.message);
-  cr_expect_eq(bb_command_options_of(c)->job.bake.slices, 0);
+  cr_expect_eq(bb__command_options_of(c)->job.bake.slices, 0);
   cr_expect_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
   char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
   cr_expect_str_eq(text, "bumpbake bake h.png --scale 8 --ssbump s.png");
@@ -558,9 +559,9 @@ Test(cmd, unset_puts_an_option_back_at_its_default) {
   /* a command's own default (height2ssbump's 250 rays) comes back too */
   const char *h2s[] = {"h.png", "8", "--rays", "64", NULL};
   c = command("height2ssbump", h2s);
-  cr_expect_eq(bb_command_options_of(c)->job.bake.rays, 64);
+  cr_expect_eq(bb__command_options_of(c)->job.bake.rays, 64);
   cr_assert_eq(bb_command_unset(c, "rays", &err), BB_OK, "%s", err.message);
-  cr_expect_eq(bb_command_options_of(c)->job.bake.rays, 250);
+  cr_expect_eq(bb__command_options_of(c)->job.bake.rays, 250);
   bb_command_free(c);
 }
 
@@ -821,4 +822,45 @@ Test(cmd, report_words_are_the_printed_ones) {
     for (int k = 0; k < i; k++)
       cr_expect_str_neq(seen[i], seen[k]);
   }
+}
+
+/* The stage struct a client takes is the command's bake as set; the rest
+ * is read by name (bb_command_value), and what no option spells is set by
+ * its own call (bb_command_set_picture). */
+Test(cmd, the_stage_struct_is_the_commands_bake) {
+  bb_command *c = command("render", (const char *const[]){"h.png", "--rays", "64", "--light",
+                                                         "10,20", "--tile", "3", NULL});
+  cr_expect_eq(bb_command_job_options(c)->bake.rays, 64);
+  char light[32];
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_value(c, "light", light, sizeof light, &err), BB_OK);
+  cr_expect_str_eq(light, "10,20");
+  cr_expect_null(bb_command_job_options(NULL));
+  const bb_render_options *o = &bb__command_options_of(c)->render;
+  bb_command_set_picture(c, 1, 0); /* leaves both */
+  cr_expect(o->dynamic_light && o->tile_x == 3 && o->tile_y == 3);
+  bb_command_set_picture(c, 0, 5);
+  cr_expect(!o->dynamic_light && o->tile_x == 3 && o->tile_y == 5);
+  bb_command_set_picture(NULL, 0, 5);
+  bb_command_free(c);
+}
+
+/* A batch's summary as the command's --json and --quiet ask, named by it. */
+Test(cmd, the_summary_lines_follow_the_commands_flags) {
+  const int counts[5] = {0, 2, 1, 0, 0}; /* by bb_job_outcome */
+  bb_command *plain = command("normal", NULL);
+  bb_command *quiet = command("normal", (const char *const[]){"--quiet", NULL});
+  bb_command *json = command("normal", (const char *const[]){"--json", NULL});
+  char *a = bb_job_summary_lines(plain, counts, 3), *b = bb_job_summary_lines(quiet, counts, 3),
+       *j = bb_job_summary_lines(json, counts, 3);
+  cr_assert(a && b && j);
+  cr_expect_str_eq(a, "normal: 3 files: 2 baked, 1 up to date, 0 failed\n");
+  cr_expect_str_eq(b, "");
+  cr_expect_eq(strncmp(j, "{\"summary\":{\"files\":3,", 22), 0, "%s", j);
+  free(a);
+  free(b);
+  free(j);
+  bb_command_free(plain);
+  bb_command_free(quiet);
+  bb_command_free(json);
 }

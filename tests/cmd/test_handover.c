@@ -54,11 +54,11 @@ Test(handover, gives_the_same_command) {
   cr_expect_str_eq(b, a);
   cr_expect_eq(bb__command_input_count(back), 2);
   cr_expect_str_eq(bb_command_input(back, 0), "my heights");
-  const bb_command_options *o = bb_command_options_of(back);
+  const bb_command_options *o = bb__command_options_of(back);
   cr_expect(o->json && o->quiet, "the client's own options travel too");
   cr_expect_str_eq(o->scheduler, "tcp://h:8786");
   cr_expect_str_eq(o->job.out_dir, "out dir");
-  cr_expect_eq(o->job.bake.smooth.threshold, bb_command_options_of(c)->job.bake.smooth.threshold);
+  cr_expect_eq(o->job.bake.smooth.threshold, bb__command_options_of(c)->job.bake.smooth.threshold);
   free(b);
   bb_command_free(back);
 

@@ -89,15 +89,14 @@ def _print_report(command, report, batch):
     extra = _ffi.NULL
     if report.cluster:  # where bake_big's trace ran
         extra = b'"cluster":' + json.dumps(report.cluster, separators=(",", ":")).encode()
-    _printed(_lib.bb_job_report_lines(command.options, r, batch, extra))
+    _printed(_lib.bb_job_report_lines(command.handle, r, batch, extra))
 
 
 def _summary(command, reports):
     counts = _ffi.new("int[5]")
     for r in reports:
         counts[_OUTCOME[r.status]] += 1
-    _printed(_lib.bb_job_summary_lines(command.options, command.name.encode(), counts,
-                                       len(reports)))
+    _printed(_lib.bb_job_summary_lines(command.handle, counts, len(reports)))
 
 
 def _note(line):
@@ -110,7 +109,7 @@ def run(command):
     """Runs a handed-over bake command on its cluster; the exit code."""
     from . import bake_big, bake_files
     from ._connect import connect
-    with connect(_text(command.options.scheduler), quiet=True) as client:
+    with connect(command.value("scheduler"), quiet=True) as client:
         if command.job_text("out_dir") is not None:
             reports = bake_files(None, None, client=client, check=False, notes=_note,
                                  _command=command, _ask_notes=False)
