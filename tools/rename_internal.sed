@@ -122,7 +122,7 @@ s/\bbb_vtf_read_info\b/bb__vtf_read_info/g
 s/\bbb_vtf_info_free\b/bb__vtf_info_free/g
 s/\bbb_dds_read_info\b/bb__dds_read_info/g
 s/\bbb_provenance_classify\b/bb__provenance_classify/g
-# api6 (issue 41): enum parsers and names a client reads through the option rows (bb_option_parse,
+# enum parsers and names a client reads through the option rows (bb_option_parse,
 # bb_option_word), and the exports no client used.
 s/\bbb_channel_parse\b/bb__channel_parse/g
 s/\bbb_depth_parse\b/bb__depth_parse/g
