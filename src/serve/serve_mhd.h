@@ -1,8 +1,9 @@
 /* serve_mhd.h: libmicrohttpd, loaded when `bumpbake serve` starts
  * (serve_mhd.c) instead of linked into the program.
  *
- * Why: linked, it and GnuTLS's eight libraries joined every bumpbake
- * process's global scope, which each of the ~168,000 symbol lookups made
+ * Why: linked, it, GnuTLS and the eight libraries GnuTLS needs (10 in all)
+ * joined every bumpbake process's global scope, which each of the ~168,000
+ * symbol lookups made
  * when the OpenImageIO module is loaded walks first: 60 M instructions of a
  * bake's start-up (docs/performance.md, 2026-12-08). Only serve needs it.
  *
