@@ -3,12 +3,12 @@
  *
  * Why: linked, it, GnuTLS and the eight libraries GnuTLS needs (10 in all)
  * joined every bumpbake process's global scope, which each of the ~168,000
- * symbol lookups made
- * when the OpenImageIO module is loaded walks first: 60 M instructions of a
- * bake's start-up (docs/performance.md, 2026-12-08). Only serve needs it.
+ * symbol lookups made when the OpenImageIO module is loaded walks first:
+ * 60 M instructions of a bake's start-up (docs/performance.md, 2026-12-08).
+ * Only serve needs it.
  *
- * serve_http.c includes this after <microhttpd.h>: each call it makes is
- * then a call through serve_mhd, filled by serve_mhd_load. */
+ * serve_http.c includes this (it includes <microhttpd.h>): each call it
+ * makes is then a call through serve_mhd, filled by serve_mhd_load. */
 #ifndef BB_SERVE_MHD_H
 #define BB_SERVE_MHD_H
 
