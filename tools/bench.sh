@@ -412,13 +412,14 @@ acc_errors() {
 # every count from 6 to 16 slices against the dense reference (accuracy_ref); the
 # fewest slices whose mean |error| is at most the peer's for ao and for
 # ssbump (each its largest channel's). Sets peer_slices and peer_slices_ok;
-# kept in $acc/peer_slices.txt while newer than bumpbake, the peer and the map.
+# kept in $acc/peer_slices.txt while newer than bumpbake, the peer, the map
+# and this script (whose counts it holds).
 derive_peer_slices() {
   local d=$acc/peer_slices m=rock compare=() n name ao ss pao pss
   command -v oiiotool >/dev/null && acc_map "$m" "$rock" || return 1
   local path=$acc/$m.png
   if ! { [ -f "$d.txt" ] && [ "$d.txt" -nt "$bin" ] && [ "$d.txt" -nt "$peer" ] &&
-    [ "$d.txt" -nt "$path" ]; }; then
+    [ "$d.txt" -nt "$path" ] && [ "$d.txt" -nt "$root/tools/bench.sh" ]; }; then
     mkdir -p "$d"
     "$peer" "$path" --scale "$acc_rock_scale" --rays "$rays" --bias "$bias" --threads "$threads" \
       --ao "$d/peer.ao.exr" --ssbump "$d/peer.ss.exr" >/dev/null 2>&1 || return 1
