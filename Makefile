@@ -54,10 +54,13 @@ ASSIMP_CFLAGS := $(shell pkg-config --cflags assimp 2>/dev/null)
 ASSIMP_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 # Imath's half.h (C, header only) converts floats to half for VTF and DDS;
 # the blocks of both are bumpbake's own codec (src/texture/bc1.c, bc4.c).
-# libmicrohttpd: the HTTP server of `bumpbake serve` (src/serve/ only,
-# linked into the program, not the library).
-MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null)
-MHD_LIBS   := $(shell pkg-config --libs libmicrohttpd 2>/dev/null)
+# libmicrohttpd: the HTTP server of `bumpbake serve` (src/serve/ only), not
+# linked: serve loads it by its soname when it starts (src/serve/serve_mhd.h),
+# so that it and GnuTLS's libraries are not in every process's global scope.
+MHD_SONAME := $(shell objdump -p $$(pkg-config --variable=libdir libmicrohttpd 2>/dev/null)/libmicrohttpd.so \
+                2>/dev/null | awk '/SONAME/ { print $$2 }')
+MHD_CFLAGS := $(shell pkg-config --cflags libmicrohttpd 2>/dev/null) \
+              $(if $(MHD_SONAME),-DBB_MHD_SONAME='"$(MHD_SONAME)"')
 # OpenEXR's IlmThread: bumpbake's provider for its pool (src/image/exr_pool.cpp).
 EXR_POOL_LIBS := $(filter -lIlmThread%,$(shell pkg-config --libs OpenEXR 2>/dev/null))
 # The library's and the programs' libraries: OpenImageIO is not one of them.
@@ -310,7 +313,7 @@ $(BUILD)/libbumpbake.so: $(BUILD)/$(SONAME)
 # (`make bench` measures both) and the installed binary finds no library at
 # run time but OpenImageIO's.
 $(BIN): $(CLI_OBJ) $(LIB) $(BUILD)/link.flags | $(MODULE)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS) $(MHD_LIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(LDLIBS)
 
 # The probe and the order it gives (tools/link_order.sh; empty where the
 # loader ignores LD_DEBUG, and the link is then the plain one).
@@ -322,7 +325,7 @@ $(LINK_ORDER): $(BUILD)/tools/link_probe tools/link_order.sh
 
 $(BUILD)/bench/bumpbake-shared: $(CLI_OBJ) $(BUILD)/libbumpbake.so $(BUILD)/link.flags
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS) $(MHD_LIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) -L$(BUILD) -lbumpbake -Wl,-rpath,'$$ORIGIN/..' $(LDLIBS)
 
 # The tools print JSON with the library's one writer (bb__json, src/core/json.h).
 $(TOOLS): $(BUILD)/tools/%: $(BUILD)/tools/%.o $(LIB) $(BUILD)/link.flags | $(MODULE)
@@ -351,7 +354,7 @@ $(BUILD)/install/installed_dirs.o: src/cli/installed_dirs.c $(BUILD)/install/dir
 	$(CC) $(CFLAGS) $(CLI_INCLUDES) -DBB_PYTHONDIR='"$(PYTHONDIR)"' -c $< -o $@
 $(INSTALL_BIN): $(filter-out $(BUILD)/src/cli/installed_dirs.o,$(CLI_OBJ)) \
                 $(BUILD)/install/installed_dirs.o $(INSTALL_LIB) $(BUILD)/link.flags
-	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(INSTALL_LIB) $(LDLIBS) $(MHD_LIBS)
+	$(CXX) $(LDFLAGS) -o $@ $(filter %.o,$^) $(INSTALL_LIB) $(LDLIBS)
 # The installed archive: the build's with the module's folder LIBDIR
 # (src/image/oiio_module_dir.c), for the installed program and for programs
 # linking it (pkg-config --static). Remade when LIBDIR changes.

@@ -408,22 +408,23 @@ acc_errors() {
 }
 # derive_peer_slices: the peer's accuracy as a slice count, found as
 # docs/accuracy.md "Error by slice count" finds it: rock06 at 256 x 256
-# (section 5's map and settings), the peer at $rays rays and bumpbake at 6,
-# 8, 10, 12 and 16 slices against the dense reference (accuracy_ref); the
+# (section 5's map and settings), the peer at $rays rays and bumpbake at
+# every count from 6 to 16 slices against the dense reference (accuracy_ref); the
 # fewest slices whose mean |error| is at most the peer's for ao and for
 # ssbump (each its largest channel's). Sets peer_slices and peer_slices_ok;
-# kept in $acc/peer_slices.txt while newer than bumpbake, the peer and the map.
+# kept in $acc/peer_slices.txt while newer than bumpbake, the peer, the map
+# and this script (whose counts it holds).
 derive_peer_slices() {
   local d=$acc/peer_slices m=rock compare=() n name ao ss pao pss
   command -v oiiotool >/dev/null && acc_map "$m" "$rock" || return 1
   local path=$acc/$m.png
   if ! { [ -f "$d.txt" ] && [ "$d.txt" -nt "$bin" ] && [ "$d.txt" -nt "$peer" ] &&
-    [ "$d.txt" -nt "$path" ]; }; then
+    [ "$d.txt" -nt "$path" ] && [ "$d.txt" -nt "$root/tools/bench.sh" ]; }; then
     mkdir -p "$d"
     "$peer" "$path" --scale "$acc_rock_scale" --rays "$rays" --bias "$bias" --threads "$threads" \
       --ao "$d/peer.ao.exr" --ssbump "$d/peer.ss.exr" >/dev/null 2>&1 || return 1
     compare=("peer=$d/peer.ao.exr,$d/peer.ss.exr")
-    for n in 6 8 10 12 16; do
+    for n in $(seq 6 16); do
       "$bin" bake "$path" --scale "$acc_rock_scale" --slices "$n" --filter-radius 0 \
         --normal-filter valve --bias "$bias" --threads "$threads" -q --ao "$d/s$n.ao.exr" \
         --ssbump "$d/s$n.ss.exr" || return 1

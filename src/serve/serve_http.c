@@ -23,6 +23,7 @@
  * by the next one. */
 #include "serve.h"
 #include "../core/json.h" /* the JSON writer, compiled into the program (Makefile) */
+#include "serve_mhd.h" /* libmicrohttpd's calls, through the library loaded at start */
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -859,6 +860,7 @@ static unsigned connection_limit(void) {
 }
 
 int serve_http_start(serve_state *s, const serve_http_options *o, char *url, size_t cap) {
+  if (!serve_mhd_load(url, cap)) return -1;
   memset(&sv, 0, sizeof sv);
   sv.s = s;
   pthread_mutex_init(&sv.lock, NULL);
