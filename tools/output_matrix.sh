@@ -10,7 +10,8 @@
 # inside DIR with relative names, so the command lines recorded in the
 # provenance are the same whatever DIR is. The matrix: the golden cases,
 # rock06 at scale 64 (periodic and --clamp, 1 and 2 threads, --basis dirs:6,
-# every output kind, PNG/TGA/EXR/TIFF, 16-bit and mips), a batch with a
+# every output kind, PNG/TGA/EXR/TIFF, 16-bit and mips), inter-reflection
+# (the map's own level and the coarse one), a batch with a
 # depfile, and every other command once or twice.
 set -uo pipefail
 
@@ -94,6 +95,14 @@ oiiotool $rock --cut 1024x16+0+0 --resize 4096x16 -o in/strip.png
 run tex_strip bake in/strip.png --scale 64 --ssbump out/tex_strip_ssbump.vtf \
   --bent out/tex_strip_bent.dds --texture-format bc1
 run rock_slope bake in/rock06_128.png --scale 16 --slope out/rock_slope.png --lit 135,45
+# Inter-reflection: on the map's own level (under 512 texels; converged,
+# then one bounce with an albedo map) and on the coarse level (1024).
+run bounce_own bake in/rock06_128.png --scale 32 --bounce 0.5 --ao out/bounce_own_ao.exr \
+  --ssbump out/bounce_own_ssbump.exr --bent out/bounce_own_bent.exr
+run bounce_one bake in/noise_96x80.png --scale 16 --bounce 0.6 --bounces 1 --threads 1 \
+  --bounce-albedo in/noise_96x80.png --ao out/bounce_one_ao.exr
+run bounce_coarse bake $rock --scale 64 --bounce 0.5 --ao out/bounce_coarse_ao.exr \
+  --ssbump out/bounce_coarse_ssbump.exr
 run normal normal in/rock06_128.png --scale 16 -o out/normal.png --normal-filter valve
 run normal_up normal in/noise_96x80.png --scale 8 -o out/normal_up.tga --normal-y up
 
