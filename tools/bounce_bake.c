@@ -5,7 +5,7 @@
  *               [--bias B] [--filter-radius R] [--normal-filter NAME]
  *               [--clamp] [--threads T]
  *               [--lift L] [--steep S] [--column-samples N]
- *               [--estimate-passes N] [--surface-slices N]
+ *               [--estimate-passes N] [--surface-slices N] [--surface-turns N]
  *               [--texel-slopes T,T,...] [--surface-slopes T,T,...]
  *               [--small-band T] [--chain N] [--level F]
  *
@@ -44,7 +44,7 @@ static int usage(const char *reason) {
           "usage: bounce_bake MAP SCALE PREFIX [--rays N] [--rho R] [--bounces N] [--bias B]\n"
           "                   [--filter-radius R] [--normal-filter NAME] [--clamp] [--threads T]\n"
           "                   [--lift L] [--steep S] [--column-samples N]\n"
-          "                   [--estimate-passes N] [--surface-slices N]\n"
+          "                   [--estimate-passes N] [--surface-slices N] [--surface-turns N]\n"
           "                   [--texel-slopes T,T,...] [--surface-slopes T,T,...]\n"
           "                   [--small-band T] [--chain N] [--level F]\n",
           reason);
@@ -129,6 +129,7 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--small-band")) a->bounce.small_band = v, a->inner = 1;
     else if (!strcmp(o, "--estimate-passes")) a->bounce.estimate_passes = (int)v, a->inner = 1;
     else if (!strcmp(o, "--surface-slices")) a->bounce.surface_slices = (int)v, a->inner = 1;
+    else if (!strcmp(o, "--surface-turns") && v >= 1) a->bounce.surface_turns = (int)v, a->inner = 1;
     else if (!strcmp(o, "--level") && (v == 1 || v == 2 || v == 4 || v == 8))
       a->bounce.level = (int)v, a->inner = 1;
     else return usage("unknown option");

@@ -614,6 +614,8 @@ typedef struct bounce_ctx {
   int corner_hull; /* DIRECT: the sweep is the trace's, at the texels' bias; the
                       corners' horizons are asked of its hulls at their lift */
   double corner_lift;
+  int turns; /* SURFACE: a line of a sweep is walked when its class is the
+                sweep's (surface_line_wanted), its gathers weighed turns times */
   const float
       *radiance; /* FACES x channels per vertex, by cell: what each corner reflects */
   scratch *slots;
@@ -1389,8 +1391,9 @@ static void on_origin(void *state, int side, int j, double u0, double oz,
                                    fmax((double)horizon / inv, low), pool, q);
   gather_bands(ls, g, q, count, low, &(origin_at){u0, oz, side});
   gather_share(g);
+  const double gain = (double)ctx->turns;
   for (int i = 0; i < FACES * channels; i++)
-    acc[i] += (float)g->acc[i];
+    acc[i] += (float)(gain * g->acc[i]);
   for (int c = first; c < last; c++) {
     const int col = cols->list[c];
     const double(*cn)[3] = (const double(*)[3])(cols->normal + 3 * (size_t)col);
@@ -1406,7 +1409,7 @@ static void on_origin(void *state, int side, int j, double u0, double oz,
       gather_bands(ls, g, q, count, lo, &(origin_at){u0, z, side});
       gather_share(g);
       for (int k = 0; k < channels; k++)
-        col_acc[k] += (float)g->acc[k];
+        col_acc[k] += (float)(gain * g->acc[k]);
       col_acc += channels;
     }
   }
@@ -1610,6 +1613,20 @@ static int slice_set(const bb_rayset *rs, int wanted, int divide) {
   return n >= 4 ? n : (rs->slice_count < 4 ? rs->slice_count : 4);
 }
 
+/* The turns of the surface passes' slices (bounce.h): o's, while the
+ * trace has as many slices as they sweep; else 1. */
+static int surface_turns(const bb_rayset *rs, const bb__bounce_options *o) {
+  const int turns = o->surface_turns > 1 ? o->surface_turns : 1;
+  return (long)slice_set(rs, o->surface_slices, 4) * turns <= rs->slice_count ? turns : 1;
+}
+
+/* What a slice the surface passes sweep costs: each sample gathers in one
+ * of `turns` of them. */
+static int surface_work(int turns) {
+  const int w = pass_work(PASS_SURFACE) / turns;
+  return w > 0 ? w : 1;
+}
+
 /* Whether the slice of rank k and the next share a sweep (opposite steps). */
 static int sweep_pairs(const bb_rayset *rs, const int *order, int k) {
   return k + 1 < rs->slice_count &&
@@ -1629,7 +1646,7 @@ long bb__bounce_work(const bb_rayset *rs, const bb__bounce_options *o) {
   const long texel = split_slices(rs) ? rs->slice_count - direct : rs->slice_count;
   const long work = direct * pass_work(PASS_DIRECT) + texel * pass_work(PASS_TEXEL) +
                     (long)surface_passes(o) * slice_set(rs, o->surface_slices, 4) *
-                        pass_work(PASS_SURFACE);
+                        surface_turns(rs, o) * surface_work(surface_turns(rs, o));
   const long f = o->level > 1 ? o->level : 1; /* a coarse level: f^2 times fewer texels */
   return work / (f * f) > 0 ? work / (f * f) : 1;
 }
@@ -1678,10 +1695,26 @@ static int pass_sequence(const bb_rayset *rs, const int *order, int parity, int 
   return count;
 }
 
+/* PASS_SURFACE with turns: whether a sweep walks the line, its class
+ * (b x0 - a y0 mod turns, the same for every texel of the line) the
+ * sweep's (its slice's rank in azimuth within the half circle, mod turns).
+ * With 8 slices, 2 turns (steps (5, 2), (2, 5), (-2, 5), (-5, 2)) a texel
+ * is on a walked line of exactly one of the first and last sweeps (y's
+ * parity decides both) and of the middle two (x's): 4 of the 8 slices. */
+static int surface_line_wanted(void *user, const bb__line_view *line) {
+  const bounce_ctx *ctx = user;
+  if (ctx->mode != PASS_SURFACE || ctx->turns <= 1)
+    return 1;
+  const int t = ctx->turns, half = (ctx->rs->slice_count + 1) / 2;
+  const long c = ((long)line->b * line->x0 - (long)line->a * line->y0) % t;
+  const bb__sweep_dir *dir = line->dir[0] ? line->dir[0] : line->dir[1];
+  return (c + t) % t == (dir->slice % half) % t;
+}
+
 static const bb__walk_visitor gather_visitor = {on_line_begin, on_push, on_origin,
-                                                on_line_end};
+                                                on_line_end, surface_line_wanted};
 static const bb__walk_visitor direct_visitor = {on_line_begin, NULL, on_origin,
-                                                on_line_end};
+                                                on_line_end, NULL};
 
 /* The sweeps of a pass, in the order of its ray set's slices: every one
  * (parity -1), or those of even or odd rank (0, 1): the trace's halves. */
@@ -1717,6 +1750,7 @@ static bb_status run_pass(driver *d, pass_mode mode, int parity, bb_error *err) 
   }
   const bb__walk_visitor *visitor =
       mode == PASS_DIRECT ? &direct_visitor : &gather_visitor;
+  const int work = mode == PASS_SURFACE ? surface_work(ctx->turns) : pass_work(mode);
   int swept = 0; /* slices so far */
   for (int k = 0, rank = 0; st == BB_OK && k < rs->slice_count; rank++) {
     const int s = order[k];
@@ -1734,14 +1768,14 @@ static bb_status run_pass(driver *d, pass_mode mode, int parity, bb_error *err) 
       st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for a line");
     /* monotone over the whole: what the passes before this one did, and
      * this one's slices so far */
-    const long done = o->progress_before + d->work_done + (long)swept * pass_work(mode);
+    const long done = o->progress_before + d->work_done + (long)swept * work;
     const long total = o->progress_before + d->work + o->progress_after;
     if (st == BB_OK && o->progress && o->progress(o->progress_user, done, total))
       st = bb__fail(err, BB_ERR_CANCELLED, "bounce: cancelled by the progress callback");
   }
   if (st == BB_ERR_CANCELLED)
     bb__fail(err, st, "bounce: cancelled by the progress callback");
-  d->work_done += (long)swept * pass_work(mode);
+  d->work_done += (long)swept * work;
   return st;
 }
 
@@ -2058,6 +2092,7 @@ void bb__bounce_options_init(bb__bounce_options *o) {
   o->steep = 2.0;
   o->small_band = 0.25;
   o->column_samples = 5;
+  o->surface_turns = 1;
   static const double texel[] = {0.0, 1.0};
   static const double surface[] = {-1.0, 0.0};
   for (int k = 0; k < BB__BOUNCE_MAX_SLOPES; k++) {
@@ -2111,6 +2146,7 @@ static bb_status add_on_level(const bb_pyramid *p, const bb_rayset *rs,
   ctx->p = p, ctx->rs = rs, ctx->vt = &d.vt, ctx->channels = channels,
   ctx->cols = &d.cols, ctx->texels = texels;
   ctx->corner_lift = o->lift;
+  ctx->turns = surface_turns(rs, o);
   atomic_init(&ctx->out_of_memory, 0);
   int *order = malloc((size_t)rs->slice_count * sizeof(int));
   double *sector = malloc((size_t)rs->slice_count * 2 * sizeof(double));
@@ -2152,8 +2188,8 @@ static bb_status add_on_level(const bb_pyramid *p, const bb_rayset *rs,
   d.fine = rs;
   d.work = bb__bounce_work(rs, o);
   if (st == BB_OK)
-    st = pass_set(rs, slice_set(rs, o->surface_slices, 4), o->threads, &d.surface_set,
-                  &d.surface_order, err);
+    st = pass_set(rs, slice_set(rs, o->surface_slices, 4) * surface_turns(rs, o), o->threads,
+                  &d.surface_set, &d.surface_order, err);
   if (st == BB_OK &&
       columns_build(p, o->steep, o->column_samples, o->lift, channels, &d.cols))
     st = bb__fail(err, BB_ERR_MEMORY, "bounce: out of memory for the columns");

@@ -25,6 +25,13 @@ typedef struct bb__bounce_options {
   int surface_slices;     /* slices of the bounces after the first, whose
                              light is smooth; 0: a quarter of the trace's,
                              at least 4 (or the trace's, when fewer) */
+  int surface_turns;      /* 1 (the default): every sample gathers in each
+                             of the surface passes' slices; T > 1: they sweep
+                             T times as many, each line walked in one sweep
+                             of T (by its class, b x - a y mod T) and its
+                             gathers weighed T times, when the trace has
+                             that many slices (else 1). docs/accuracy.md
+                             "The surface passes' slices turned, tried" */
   /* the tangents of elevation of the fixed rays the gathers follow, rising,
    * NAN after the last: the texels' (from 0 up) and the samples' (below
    * their horizontal too) */

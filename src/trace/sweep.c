@@ -1065,6 +1065,8 @@ static void walk_and_integrate(sweep_job *job, profile *pr, int x0, int y0, poin
   void *state = NULL;
   if (job->visitor) {
     const bb__line_view line = line_view_of(job, pr, x0, y0);
+    if (job->visitor->line_wanted && !job->visitor->line_wanted(job->visitor_ctx, &line))
+      return;
     state = job->visitor->line_begin(job->visitor_ctx, &line);
     if (!state) {
       atomic_store(&job->out_of_memory, 1);

@@ -128,6 +128,9 @@ typedef struct bb__walk_visitor {
   /* After the walks, with every horizon found (line->found, tangent_key);
    * the state is not used again after it. */
   void (*line_end)(void *state, const bb__line_view *line);
+  /* Whether a line is walked at all (before line_begin; NULL: every one).
+   * A line left out has no calls and its horizons are not found. */
+  int (*line_wanted)(void *ctx, const bb__line_view *line);
 } bb__walk_visitor;
 
 /* bb__sweep_lines with a visitor of its walks in place of the sums (the

@@ -18,6 +18,8 @@
 #include "image/image_write.h"
 #include "trace/basis.h"
 #include "trace/bounce.h"
+#include "trace/pyramid.h"
+#include "trace/rayset.h"
 #include "trace/trace.h"
 
 static const double PI = 3.14159265358979323846;
@@ -290,6 +292,64 @@ Test(bounce, any_thread_count_gives_the_same_bits_and_a_periodic_shift_close_one
   bb_bake_result_free(&one);
   bb_bake_result_free(&s);
   bb_image_free(&shifted);
+  bb_image_free(&h);
+}
+
+/* The surface pass over turned slices (bb__bounce_options.surface_turns 2,
+ * not the default): 8 slices swept for 4, each line walked in one sweep of
+ * two, its gathers weighed twice. The same bits for any thread count, and
+ * close to the 4 slices every texel gathers in, but not the same (they
+ * differ by the azimuths' placing, docs/accuracy.md "The surface passes'
+ * slices turned, tried"): measured 0.000031 in mean |difference| of ao,
+ * 0.00085 at most, of 0.0067 added on average. */
+Test(bounce, turned_surface_slices_give_the_same_bits_for_any_thread_count) {
+  bb_image h = load_fixture("noise_96x80.png");
+  const size_t n = (size_t)h.width * (size_t)h.height;
+  bb_image z = harness_field(h.width, h.height, 0.0f);
+  for (size_t i = 0; i < n; i++) z.pixels[i] = 8.0f * h.pixels[i];
+  bb_pyramid *p = NULL;
+  bb_rayset *rs = NULL;
+  cr_assert_eq(bb__pyramid_build_all_cores(&z, BB_ADDRESS_PERIODIC, &p, NULL), BB_OK);
+  cr_assert_eq(bb__rayset_new(16, 1.0, NULL, &rs, NULL), BB_OK);
+  bb_trace_options to;
+  bb__trace_options_init(&to);
+  bb_image vis = {0};
+  cr_assert_eq(bb__trace_occlusion(p, rs, &to, &vis, NULL, NULL), BB_OK);
+  const size_t floats = n * (size_t)vis.channels;
+  float *added[3]; /* the visibility with the bounce added */
+  for (int run = 0; run < 3; run++) { /* turns 2 on 1 and 3 threads, turns 1 */
+    bb__bounce_options o;
+    bb__bounce_options_init(&o);
+    o.rho = 0.5, o.bias = to.bias_texels, o.level = 1;
+    o.surface_turns = run < 2 ? 2 : 1;
+    o.threads = run == 1 ? 3 : 1;
+    bb_image out = vis;
+    out.pixels = added[run] = malloc(floats * sizeof(float));
+    cr_assert(added[run]);
+    memcpy(added[run], vis.pixels, floats * sizeof(float));
+    bb_error err;
+    cr_assert_eq(bb__bounce_add(p, rs, &o, &out, NULL, &err), BB_OK, "%s", err.message);
+  }
+  cr_expect(memcmp(added[0], added[1], floats * sizeof(float)) == 0,
+            "turned slices: 3 threads against 1 differ");
+  double most = 0.0, sum = 0.0, turned = 0.0;
+  for (size_t v = 0; v < n; v++) {
+    const size_t i = v * (size_t)vis.channels; /* ao */
+    most = fmax(most, fabs((double)added[0][i] - (double)added[2][i]));
+    sum += fabs((double)added[0][i] - (double)added[2][i]);
+    turned += (double)added[0][i] - (double)vis.pixels[i];
+  }
+  cr_log_info("turned against not: ao added %.5f on average, mean |difference| %.6f, "
+              "largest %.5f", turned / (double)n, sum / (double)n, most);
+  cr_expect(sum > 0.0, "the turned slices change nothing");
+  cr_expect(sum / (double)n <= 0.0001 && most <= 0.003,
+            "turned against not: mean |difference| %.6f, largest %.5f in ao", sum / (double)n,
+            most);
+  for (int run = 0; run < 3; run++) free(added[run]);
+  bb_image_free(&vis);
+  bb_rayset_free(rs);
+  bb_pyramid_free(p);
+  bb_image_free(&z);
   bb_image_free(&h);
 }
 
