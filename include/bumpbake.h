@@ -2284,6 +2284,31 @@ bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image 
                          const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
                          bb_image *out, bb_error *err);
 
+/* bake's or normal's bake (bb_command_run's) of a height in memory, with
+ * the options of a command checked for it (bb_command_set_in_memory with
+ * the maps asked; --bounce-albedo or --brightness given as any text, the
+ * images being these): nothing read or written. height: a 1-channel
+ * height field (bb_height_from_image by the command's --channel), baked as
+ * the command line bakes a HEIGHT. bounce_albedo, brightness: the images
+ * those options name, NULL when not given. basis: the directions of the
+ * weights, ssbump and bent (NULL: the command's --basis). hooks (may be
+ * NULL): progress follows the bake and may cancel it. context (may be
+ * NULL): the bake runs through it (bb_bake_context_new; warm, and
+ * edit-local after bb_bake_context_keep), with the same bits. maps: an
+ * array of BB_MAP_BAKED_COUNT images, by bb_map_kind: each map asked is
+ * allocated (free with bb_image_free), the others are left empty.
+ * changed (may be NULL): the texels whose maps may differ from the
+ * context's bake before (bb_bake_context_changed); the whole image
+ * without a context. Errors: BB_ERR_ARGUMENT (not a checked bake or
+ * normal set in memory; no height; an image for a file option not given,
+ * or none for one given), those of bb_bake, and BB_ERR_CANCELLED when
+ * progress cancelled it: then every map is empty. */
+bb_status bb_command_bake(bb_command *command, const bb_image *height,
+                          const bb_image *bounce_albedo, const bb_image *brightness,
+                          const bb_basis *basis, const bb_command_hooks *hooks,
+                          bb_bake_context *context, bb_image *maps, bb_region *changed,
+                          bb_error *err);
+
 /* ----------------------------------------------------- what a job prints */
 
 /* The JSON object of r (an input baked with options b), without a

@@ -792,6 +792,11 @@ bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_
 bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
                          const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
                          bb_image *out, bb_error *err);
+bb_status bb_command_bake(bb_command *command, const bb_image *height,
+                          const bb_image *bounce_albedo, const bb_image *brightness,
+                          const bb_basis *basis, const bb_command_hooks *hooks,
+                          bb_bake_context *context, bb_image *maps, bb_region *changed,
+                          bb_error *err);
 const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);
