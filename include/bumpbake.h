@@ -870,10 +870,6 @@ typedef struct bb_bake_result {
 bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
                   bb_bake_result *result, bb_error *err);
 
-/* The image of kind in r (NULL for an unknown kind); its pixels are NULL
- * when the bake did not make it. Owned by r. */
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
-
 void bb_bake_result_free(bb_bake_result *r);
 
 /* ------------------------------------------------------- bake contexts */
@@ -891,7 +887,7 @@ bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
 void bb_bake_context_free(bb_bake_context *context);
 
 /* Edit-local bakes. With keep 1 the bakes through context
- * (bb_bake_context_bake, and a job's after bb_job_use_context) keep what
+ * (bb_command_bake's with it, and a job's after bb_job_use_context) keep what
  * they made: the height, its smoothing and max-mip pyramid, each texel's
  * horizon in every slice, its visibility and normal, and the maps; about
  * 4 x slices + 70 bytes a texel for the default maps and basis (134 at 16
@@ -908,20 +904,12 @@ void bb_bake_context_free(bb_bake_context *context);
  * keep 0 (the default) lets what was kept go. */
 void bb_bake_context_keep(bb_bake_context *context, int keep);
 
-/* bb_bake of height with o through context: the same checks, maps and
- * bits; result as bb_bake fills it (free it with bb_bake_result_free),
- * its seconds and horizons_found those of the work done. changed (may be
- * NULL) receives the texels whose maps may differ from those of the
- * context's bake before: a rectangle inside the image, the whole image
- * after a whole bake, width 0 when nothing changed; texels across the
- * edge of a periodic map make it span the whole width (or height). */
-bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
-                               const bb_bake_options *o, bb_bake_result *result,
-                               bb_region *changed, bb_error *err);
-
-/* The changed rectangle of the context's last bake, as
- * bb_bake_context_bake gives it (for a bake made through a job); width 0
- * before any. */
+/* The changed rectangle of the context's last bake, as bb_command_bake
+ * gives it (for a bake made through a job): the texels whose maps may
+ * differ from those of the context's bake before, a rectangle inside the
+ * image, the whole image after a whole bake, width 0 when nothing
+ * changed; texels across the edge of a periodic map make it span the
+ * whole width (or height). Width 0 before any. */
 bb_region bb_bake_context_changed(const bb_bake_context *context);
 
 /* =====================================================================

@@ -20,6 +20,7 @@
  *   valgrind --tool=callgrind --collect-atstart=no --toggle-collect=edit_bake \
  *     build/tools/bench_rebake MAP 64 --runs 1 --threads 1
  * and --toggle-collect=whole_bake for the whole bakes. */
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 
 #include <math.h>
@@ -110,7 +111,7 @@ static void brush(bb_image *h, const args *a, int sign) {
 __attribute__((noinline)) static bb_status
 edit_bake(bb_bake_context *c, const bb_image *h, const bb_bake_options *o,
           bb_bake_result *r, bb_region *changed, bb_error *err) {
-  return bb_bake_context_bake(c, h, o, r, changed, err);
+  return bb__bake_context_bake(c, h, o, r, changed, err);
 }
 
 __attribute__((noinline)) static bb_status whole_bake(const bb_image *h,
@@ -121,8 +122,8 @@ __attribute__((noinline)) static bb_status whole_bake(const bb_image *h,
 
 static int same_maps(const bb_bake_result *a, const bb_bake_result *b) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *x = bb_bake_result_image(a, (bb_map_kind)k);
-    const bb_image *y = bb_bake_result_image(b, (bb_map_kind)k);
+    const bb_image *x = bb__bake_result_image(a, (bb_map_kind)k);
+    const bb_image *y = bb__bake_result_image(b, (bb_map_kind)k);
     if ((x->pixels == NULL) != (y->pixels == NULL))
       return 0;
     if (x->pixels &&

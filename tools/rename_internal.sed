@@ -163,3 +163,5 @@ s/\bbb_map_flat_texel\b/bb__map_flat_texel/g
 s/\bbb_derive_weights\b/bb__derive_weights_all_cores/g
 s/\bbb_ssbump_to_normal\b/bb__ssbump_to_normal/g
 s/\bbb_image_flip_green\b/bb__image_flip_green/g
+s/\bbb_bake_result_image\b/bb__bake_result_image/g
+s/\bbb_bake_context_bake\b/bb__bake_context_bake/g

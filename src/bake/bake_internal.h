@@ -104,7 +104,7 @@ bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
  * (bb_bake_context_keep): again only where the height changed since the
  * context's last bake of the same size and options, else whole; r as
  * bb__bake fills it (flags as there, but height is not freed). changed
- * (may be NULL) receives bb_bake_context_bake's rectangle. */
+ * (may be NULL) receives bb__bake_context_bake's rectangle. */
 bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
                            const bb_bake_options *o, unsigned flags, bb_bake_result *r,
                            bb_region *changed, bb_error *err);
@@ -229,5 +229,18 @@ const char *bb__normal_y_name(int normal_y_up);
 const char *bb__normal_filter_name(bb_normal_filter f);
 /* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
 bb_status bb__normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
+
+/* The image of kind in r (NULL for an unknown kind); its pixels are NULL
+ * when the bake did not make it. Owned by r. */
+const bb_image *bb__bake_result_image(const bb_bake_result *r, bb_map_kind kind);
+
+/* bb_bake of height with o through context: the same checks, maps and
+ * bits; result as bb_bake fills it (free it with bb_bake_result_free),
+ * its seconds and horizons_found those of the work done. changed (may be
+ * NULL) receives the texels whose maps may differ from those of the
+ * context's bake before (bb_bake_context_changed's rectangle). */
+bb_status bb__bake_context_bake(bb_bake_context *context, const bb_image *height,
+                                const bb_bake_options *o, bb_bake_result *result,
+                                bb_region *changed, bb_error *err);
 
 #endif /* BB_BAKE_INTERNAL_H */

@@ -3,6 +3,7 @@
  * the images its file options would read given by the caller, the maps
  * asked handed back as images; a warm (or edit-local) bake through a
  * context when one is given. */
+#include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
 #include "core/internal.h"
 
@@ -23,7 +24,7 @@ static bb_status image_of(const char *command, const char *option, const char *f
 /* The maps asked moved from result into maps (the others left empty). */
 static void hand_over(bb_bake_result *result, unsigned asked, bb_image *maps) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    bb_image *img = (bb_image *)(void *)bb_bake_result_image(result, (bb_map_kind)k);
+    bb_image *img = (bb_image *)(void *)bb__bake_result_image(result, (bb_map_kind)k);
     if ((asked & BB_MAP_BIT(k)) && img && img->pixels) {
       maps[k] = *img;
       memset(img, 0, sizeof *img);
@@ -63,7 +64,7 @@ static bb_status bake(bb_command *c, const bb_image *height, const bb_image *bou
   memset(&result, 0, sizeof result);
   bb_region whole = {0, 0, height->width, height->height};
   if (context) {
-    st = bb_bake_context_bake(context, height, &o, &result, &whole, err);
+    st = bb__bake_context_bake(context, height, &o, &result, &whole, err);
   } else {
     st = bb_bake(height, &o, &result, err);
   }

@@ -316,12 +316,12 @@ Test(bake, output_mask_makes_only_what_was_asked) {
     bb_bake_result one = harness_bake(&h, &o);
     const int traced = bb_map_kind_get((bb_map_kind)k)->needs_trace;
     for (int j = 0; j < BB_MAP_BAKED_COUNT; j++) {
-      const bb_image *img = bb_bake_result_image(&one, (bb_map_kind)j);
+      const bb_image *img = bb__bake_result_image(&one, (bb_map_kind)j);
       if (j != k) {
         cr_assert_null(img->pixels, "asked %d, made %d", k, j);
         continue;
       }
-      const bb_image *ref = bb_bake_result_image(&all, (bb_map_kind)j);
+      const bb_image *ref = bb__bake_result_image(&all, (bb_map_kind)j);
       cr_assert_eq(img->channels, ref->channels);
       cr_assert_eq(memcmp(img->pixels, ref->pixels, image_bytes(ref)), 0, "kind %d", k);
     }
@@ -378,7 +378,7 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
     cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
     cr_assert_str_eq(bb_status_name(BB_ERR_CANCELLED), "cancelled");
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      cr_assert_null(bb_bake_result_image(&r, (bb_map_kind)k)->pixels, "kind %d", k);
+      cr_assert_null(bb__bake_result_image(&r, (bb_map_kind)k)->pixels, "kind %d", k);
     cr_assert_null(r.vis.pixels);
     bb_bake_result_free(&r);
   }

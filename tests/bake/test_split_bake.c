@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "bumpbake_cluster.h"
 #include "trace/basis.h"
@@ -103,8 +104,8 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     cr_assert_eq(u.calls, 1);
     cr_assert_eq(plain.bounces > 0, cases[c].bounce > 0.0, "bounces %d", plain.bounces);
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      assert_same(bb_bake_result_image(&plain, (bb_map_kind)k),
-                  bb_bake_result_image(&split, (bb_map_kind)k),
+      assert_same(bb__bake_result_image(&plain, (bb_map_kind)k),
+                  bb__bake_result_image(&split, (bb_map_kind)k),
                   bb_map_kind_get((bb_map_kind)k)->name);
     assert_same(&plain.vis, &split.vis, "vis");
     cr_assert_eq(plain.horizons_found, split.horizons_found);

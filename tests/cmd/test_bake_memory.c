@@ -2,6 +2,7 @@
  * in memory: the bits of bb_bake with the command's options (and the
  * images and basis handed over), the same through a context (warm and
  * edit-local), only the maps asked handed back; and its refusals. */
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "command_words.h"
 
@@ -49,7 +50,7 @@ static void maps_free(bb_image *maps) {
 static void expect_maps(const bb_image *maps, unsigned asked, const bb_bake_result *r) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     if (asked & BB_MAP_BIT(k))
-      cr_expect(same(&maps[k], bb_bake_result_image(r, (bb_map_kind)k)), "map %d differs", k);
+      cr_expect(same(&maps[k], bb__bake_result_image(r, (bb_map_kind)k)), "map %d differs", k);
     else
       cr_expect_null(maps[k].pixels, "map %d was not asked", k);
   }
