@@ -2280,7 +2280,8 @@ bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image 
  * the command line bakes a HEIGHT. bounce_albedo, brightness: the images
  * those options name, NULL when not given. basis: the directions of the
  * weights, ssbump and bent (NULL: the command's --basis). hooks (may be
- * NULL): progress follows the bake and may cancel it. context (may be
+ * NULL): progress follows the bake and may cancel it; trace, a trace of
+ * the caller's in place of the bake's own (bb_trace_fn). context (may be
  * NULL): the bake runs through it (bb_bake_context_new; warm, and
  * edit-local after bb_bake_context_keep), with the same bits. maps: an
  * array of BB_MAP_BAKED_COUNT images, by bb_map_kind: each map asked is

@@ -60,6 +60,8 @@ static bb_status bake(bb_command *c, const bb_image *height, const bb_image *bou
   o.brightness = brightness;
   o.trace.progress = hooks ? hooks->progress : NULL;
   o.trace.progress_user = hooks ? hooks->progress_user : NULL;
+  o.trace.trace = hooks ? hooks->trace : NULL;
+  o.trace.trace_user = hooks ? hooks->trace_user : NULL;
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   bb_region whole = {0, 0, height->width, height->height};

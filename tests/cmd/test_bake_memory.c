@@ -8,6 +8,7 @@
 
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* An image of w x h x channels whose texels vary smoothly in (lo, hi). */
@@ -186,6 +187,33 @@ Test(cmd_bake, cancelled_hands_back_nothing) {
                BB_ERR_CANCELLED);
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     cr_expect_null(maps[k].pixels);
+  bb_image_free(&h);
+  bb_command_free(c);
+}
+
+/* A trace of the caller's that fails: the bake stops there. */
+static bb_status failing_trace(void *user, const bb_pyramid *p, const bb_rayset *rs,
+                               const bb_trace_options *o, bb_image *vis, bb_error *err) {
+  (void)p, (void)rs, (void)o, (void)vis;
+  ++*(int *)user;
+  snprintf(err->message, sizeof err->message, "the split trace failed");
+  return BB_ERR_IO;
+}
+
+Test(cmd_bake, the_callers_trace_in_place_of_its_own) {
+  const char *words[] = {"--scale", "3", "--rays", "16", NULL};
+  bb_command *c = checked("bake", words, traced);
+  bb_image h = pattern(16, 16, 1, 0.f, 1.f, 0.f);
+  bb_image maps[BB_MAP_BAKED_COUNT];
+  int calls = 0;
+  bb_command_hooks hooks = {0};
+  hooks.trace = failing_trace;
+  hooks.trace_user = &calls;
+  bb_error err = {{0}};
+  cr_expect_eq(bb_command_bake(c, &h, NULL, NULL, NULL, &hooks, NULL, maps, NULL, &err),
+               BB_ERR_IO);
+  cr_expect_eq(calls, 1);
+  cr_expect(strstr(err.message, "the split trace failed") != NULL, "%s", err.message);
   bb_image_free(&h);
   bb_command_free(c);
 }
