@@ -11,7 +11,7 @@
  * (default 32) at X,Y (default the middle), A (default 0.1) of normalised
  * height at its centre, added and taken away in turns so that every bake
  * sees a change. Each edited height is baked through the context and whole
- * (bb_bake), each timed in CPU seconds (the process's, all threads) and
+ * (bb__bake_checked), each timed in CPU seconds (the process's, all threads) and
  * wall seconds; every map must be the same bits, else it exits 1. Prints
  * the medians, their ratio and one JSON line.
  *
@@ -117,7 +117,7 @@ edit_bake(bb_bake_context *c, const bb_image *h, const bb_bake_options *o,
 __attribute__((noinline)) static bb_status whole_bake(const bb_image *h,
                                                       const bb_bake_options *o,
                                                       bb_bake_result *r, bb_error *err) {
-  return bb_bake(h, o, r, err);
+  return bb__bake_checked(h, o, r, err);
 }
 
 static int same_maps(const bb_bake_result *a, const bb_bake_result *b) {

@@ -165,3 +165,4 @@ s/\bbb_ssbump_to_normal\b/bb__ssbump_to_normal/g
 s/\bbb_image_flip_green\b/bb__image_flip_green/g
 s/\bbb_bake_result_image\b/bb__bake_result_image/g
 s/\bbb_bake_context_bake\b/bb__bake_context_bake/g
+s/\bbb_bake\b/bb__bake_checked/g

@@ -1,4 +1,4 @@
-"""Bakes of numpy height arrays (bb_bake) and the bake options every baking
+"""Bakes of numpy height arrays (bb_command_bake) and the bake options every baking
 call shares, made from keyword arguments the way `bumpbake bake` makes them
 from its options."""
 

@@ -68,7 +68,7 @@ static bb_status bake(bb_command *c, const bb_image *height, const bb_image *bou
   if (context) {
     st = bb__bake_context_bake(context, height, &o, &result, &whole, err);
   } else {
-    st = bb_bake(height, &o, &result, err);
+    st = bb__bake_checked(height, &o, &result, err);
   }
   if (st == BB_OK) {
     hand_over(&result, c->memory_maps ? c->memory_maps : o.outputs, maps);

@@ -311,13 +311,13 @@ Test(bounce, options_are_checked) {
   o.bounces = 0;
   o.bounce_albedo_map = &small;
   bb_bake_result r;
-  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "albedo") != NULL, "%s", err.message);
   small.pixels[5] = NAN;
   bb_image nan_map = harness_field(8, 8, 1.0f);
   nan_map.pixels[9] = NAN;
   o.bounce_albedo_map = &nan_map;
-  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_VALUE);
   bb_image_free(&nan_map);
   bb_image_free(&small);
   bb_image_free(&h);

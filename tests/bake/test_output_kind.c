@@ -69,7 +69,7 @@ Test(output_kind, result_images_match_the_table) {
   cr_assert_eq(bb__basis_parse("dirs:5", &o.basis, NULL), BB_OK);
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   const bb_image *fields[] = {&r.normal, &r.weights, &r.ssbump, &r.ao, &r.bent, &r.filtered};
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
     const bb_image *img = bb__bake_result_image(&r, (bb_map_kind)k);

@@ -167,7 +167,7 @@ static void edits_equal_whole_with(int w, int h, const bb_bake_options *base,
     cr_assert_eq(bb__bake_context_bake(context, &height, &o, &got, &changed, &err), BB_OK,
                  "%s", err.message);
     local += bb__context_last_local(context);
-    cr_assert_eq(bb_bake(&height, &o, &want, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__bake_checked(&height, &o, &want, &err), BB_OK, "%s", err.message);
     char label[160];
     snprintf(label, sizeof label, "%dx%d %s%s, edit %d (%s), %d threads", w, h,
              addressing == BB_ADDRESS_CLAMP ? "clamped" : "periodic",
@@ -267,7 +267,7 @@ static void equals_whole(const bb_bake_result *got, const bb_image *h,
                          const bb_bake_options *o, const char *what) {
   bb_bake_result want;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(h, o, &want, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(h, o, &want, &err), BB_OK, "%s", err.message);
   maps_equal(got, &want, what);
   bb_bake_result_free(&want);
 }
@@ -377,7 +377,7 @@ Test(rebake, bad_height_refused_then_baked) {
   bb_error err = {{0}}, whole = {{0}};
   bb_bake_result none;
   cr_expect_eq(bb__bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
-  cr_expect_eq(bb_bake(&h, &o, &none, &whole), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &none, &whole), BB_ERR_VALUE);
   cr_expect_str_eq(err.message, whole.message);
   cr_expect_null(got.ssbump.pixels, "nothing is returned");
   h.pixels[5 * 40 + 5] = good + 0.2f;
@@ -394,7 +394,7 @@ Test(rebake, bad_height_refused_then_baked) {
   bb_bake_result_free(&got);
   bright.pixels[77] = INFINITY;
   cr_expect_eq(bb__bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
-  cr_expect_eq(bb_bake(&h, &o, &none, &whole), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &none, &whole), BB_ERR_VALUE);
   cr_expect_str_eq(err.message, whole.message);
   bright.pixels[77] = 0.5f;
   got = context_bake(c, &h, &o, NULL);

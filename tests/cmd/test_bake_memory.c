@@ -1,5 +1,5 @@
 /* test_bake_memory.c: bb_command_bake, bake's and normal's bake of a height
- * in memory: the bits of bb_bake with the command's options (and the
+ * in memory: the bits of bb__bake_checked with the command's options (and the
  * images and basis handed over), the same through a context (warm and
  * edit-local), only the maps asked handed back; and its refusals. */
 #include "bake/bake_internal.h"
@@ -73,7 +73,7 @@ Test(cmd_bake, bits_of_the_stage_bake_with_the_commands_options) {
   bb_bake_options o = bb_command_options_of(c)->job.bake;
   cr_assert_eq(o.basis.count, 6);
   bb_bake_result r;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   expect_maps(maps, traced, &r);
   cr_expect_eq(maps[BB_MAP_SSBUMP].channels, 6);
   cr_expect(changed.x0 == 0 && changed.y0 == 0 && changed.width == 24 && changed.height == 20);
@@ -102,13 +102,13 @@ Test(cmd_bake, the_images_and_basis_handed_over) {
   o.brightness = &bright;
   o.bounce_albedo_map = &albedo;
   bb_bake_result r;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   expect_maps(maps, traced, &r);
   cr_expect_eq(maps[BB_MAP_SSBUMP].channels, 4);
   /* without the brightness map the ssbump differs: it was used */
   bb_bake_result plain;
   o.brightness = NULL;
-  cr_assert_eq(bb_bake(&h, &o, &plain, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &plain, &err), BB_OK, "%s", err.message);
   cr_expect_not(same(&maps[BB_MAP_SSBUMP], &plain.ssbump));
   bb_bake_result_free(&plain);
   bb_bake_result_free(&r);
@@ -162,7 +162,7 @@ Test(cmd_bake, normal_bakes_the_normal_alone) {
   bb_bake_options o = bb_command_options_of(c)->job.bake;
   cr_expect(o.normal_y_up);
   bb_bake_result r;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   expect_maps(maps, BB_MAP_BIT(BB_MAP_NORMAL), &r);
   bb_bake_result_free(&r);
   maps_free(maps);

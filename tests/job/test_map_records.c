@@ -58,7 +58,7 @@ typedef struct maps {
 
 static void bake(const bb_image *h, const bb_bake_options *o, maps *m) {
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(h, o, &m->r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(h, o, &m->r, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb__slope_map(&m->r.filtered, o->height_scale, o->smooth.addressing,
                             &m->slope, &err),
                BB_OK, "%s", err.message);
