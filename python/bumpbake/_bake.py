@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _command
 from ._common import (_argument_error, _array, _bake_option, _check, _exception, _ffi,
-                      _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hook, _shown,
+                      _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hooks, _shown,
                       _text)
 
 
@@ -213,9 +213,7 @@ def _bake_maps(function, height, scale, options, mask, progress, command="bake",
     try:
         field = _height_field(function, height, c.options.job.channel)
         raised = []
-        hooks = _ffi.new("bb_command_hooks *")
-        cb = _progress_hook(progress, raised)
-        hooks.progress = cb
+        hooks, _keep = _progress_hooks(progress, raised)
         changed = _ffi.new("bb_region *")
         err = _ffi.new("bb_error *")
         st = _lib.bb_command_bake(c.handle, field, maps.image("bounce_albedo"),

@@ -5,26 +5,12 @@
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "command_words.h"
+#include "pattern_image.h"
 
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-/* An image of w x h x channels whose texels vary smoothly in (lo, hi). */
-static bb_image pattern(int w, int h, int channels, float lo, float hi, float phase) {
-  bb_image img = {0};
-  bb_error err = {{0}};
-  cr_assert_eq(bb_image_alloc(&img, w, h, channels, &err), BB_OK, "%s", err.message);
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++)
-      for (int k = 0; k < channels; k++) {
-        const float t =
-            0.5f + 0.5f * sinf(0.37f * (float)x + 0.23f * (float)y + 1.3f * (float)k + phase);
-        bb_image_texel(&img, x, y)[k] = lo + (hi - lo) * t;
-      }
-  return img;
-}
 
 /* words checked for images in memory with the maps asked. */
 static bb_command *checked(const char *name, const char *const *words, unsigned maps) {
@@ -64,7 +50,7 @@ Test(cmd_bake, bits_of_the_stage_bake_with_the_commands_options) {
   const char *words[] = {"--scale", "6", "--rays", "16", "--basis", "dirs:6", "--filter-radius",
                          "1", "--normal-filter", "sobel", NULL};
   bb_command *c = checked("bake", words, traced);
-  bb_image h = pattern(24, 20, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(24, 20, 1, 0.f, 1.f, 0.f);
   bb_image maps[BB_MAP_BAKED_COUNT];
   bb_region changed = {-1, -1, -1, -1};
   bb_error err = {{0}};
@@ -87,9 +73,9 @@ Test(cmd_bake, the_images_and_basis_handed_over) {
   const char *words[] = {"--scale", "4", "--rays", "16", "--brightness", "(array)",
                          "--bounce-albedo", "(array)", NULL};
   bb_command *c = checked("bake", words, traced);
-  bb_image h = pattern(16, 16, 1, 0.f, 1.f, 0.f);
-  bb_image bright = pattern(16, 16, 1, 0.2f, 0.9f, 0.5f);
-  bb_image albedo = pattern(16, 16, 3, 0.1f, 0.8f, 1.0f);
+  bb_image h = pattern_image(16, 16, 1, 0.f, 1.f, 0.f);
+  bb_image bright = pattern_image(16, 16, 1, 0.2f, 0.9f, 0.5f);
+  bb_image albedo = pattern_image(16, 16, 3, 0.1f, 0.8f, 1.0f);
   const double dirs[4][3] = {{0.5, 0.1, 0.8}, {-0.4, 0.4, 0.8}, {0.1, -0.6, 0.7}, {0, 0, 1}};
   bb_basis basis;
   bb_error err = {{0}};
@@ -126,7 +112,7 @@ Test(cmd_bake, through_a_context_the_bits_of_a_cold_bake) {
   bb_error err = {{0}};
   cr_assert_eq(bb_bake_context_new(&context, &err), BB_OK, "%s", err.message);
   bb_bake_context_keep(context, 1);
-  bb_image h = pattern(32, 32, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(32, 32, 1, 0.f, 1.f, 0.f);
   bb_image maps[BB_MAP_BAKED_COUNT];
   bb_region changed;
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, context, maps, &changed, &err),
@@ -154,7 +140,7 @@ Test(cmd_bake, through_a_context_the_bits_of_a_cold_bake) {
 Test(cmd_bake, normal_bakes_the_normal_alone) {
   const char *words[] = {"--scale", "3", "--normal-y", "up", NULL};
   bb_command *c = checked("normal", words, BB_MAP_BIT(BB_MAP_NORMAL));
-  bb_image h = pattern(12, 10, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(12, 10, 1, 0.f, 1.f, 0.f);
   bb_image maps[BB_MAP_BAKED_COUNT];
   bb_error err = {{0}};
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, NULL, maps, NULL, &err), BB_OK,
@@ -178,7 +164,7 @@ static int cancel(void *user, long done, long total) {
 Test(cmd_bake, cancelled_hands_back_nothing) {
   const char *words[] = {"--scale", "3", "--rays", "16", NULL};
   bb_command *c = checked("bake", words, traced);
-  bb_image h = pattern(16, 16, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(16, 16, 1, 0.f, 1.f, 0.f);
   bb_image maps[BB_MAP_BAKED_COUNT];
   bb_command_hooks hooks = {0};
   hooks.progress = cancel;
@@ -203,7 +189,7 @@ static bb_status failing_trace(void *user, const bb_pyramid *p, const bb_rayset 
 Test(cmd_bake, the_callers_trace_in_place_of_its_own) {
   const char *words[] = {"--scale", "3", "--rays", "16", NULL};
   bb_command *c = checked("bake", words, traced);
-  bb_image h = pattern(16, 16, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(16, 16, 1, 0.f, 1.f, 0.f);
   bb_image maps[BB_MAP_BAKED_COUNT];
   int calls = 0;
   bb_command_hooks hooks = {0};
@@ -231,7 +217,7 @@ static void expect_refused(bb_command *c, const bb_image *h, const bb_image *bri
 }
 
 Test(cmd_bake, refusals) {
-  bb_image h = pattern(8, 8, 1, 0.f, 1.f, 0.f);
+  bb_image h = pattern_image(8, 8, 1, 0.f, 1.f, 0.f);
   const char *words[] = {"--scale", "3", NULL};
   bb_command *unchecked = command("bake", words);
   expect_refused(unchecked, &h, NULL, "bake: the command is not checked for images in memory");
