@@ -672,14 +672,14 @@ const char *bb_rayset_id(const bb_rayset *rs);
 
 typedef struct bb_trace_options bb_trace_options;
 
-/* A trace of the caller's, which bb_bake calls in place of its own
- * (bb_trace_options.trace): for the pyramid and ray set the bake built, it
+/* A trace of the caller's, which a bake calls in place of its own
+ * (bb_command_hooks.trace, bb_trace_options.trace): for the pyramid and ray set the bake built, it
  * fills vis exactly as the bake's own trace of them with o would: allocated (bb_image_alloc), the pyramid's size, 1 +
  * bb_rayset_lobe_count(rs) channels. A trace split over machines does this
  * with bb_trace_horizons, bb_trace_accumulate and bb_trace_finish, so the
  * bake's maps are a single bake's bits. Returns BB_OK, or an error with err
- * filled (vis then left unallocated). Called on the thread that called
- * bb_bake. */
+ * filled (vis then left unallocated). Called on the thread that runs
+ * the bake. */
 typedef bb_status (*bb_trace_fn)(void *user, const bb_pyramid *p, const bb_rayset *rs,
                                  const bb_trace_options *o, bb_image *vis, bb_error *err);
 
@@ -690,7 +690,7 @@ struct bb_trace_options {
                            else only these texels, by max-mip marches */
   bb_progress_fn progress; /* may be NULL; called from one thread as the
                               work goes (per slice, or every 50 ms); a
-                              nonzero return cancels. In bb_bake also
+                              nonzero return cancels. In a bake also
                               with done 0 and total 0 (a checkpoint, no
                               progress) every 50 ms while it smooths and
                               makes normals, so those stages cancel too;
@@ -703,8 +703,8 @@ struct bb_trace_options {
                               find the horizons too and every unit is
                               theirs */
   void *progress_user;
-  bb_trace_fn trace;    /* bb_bake only: NULL (default) traces with
-                           the library's own tracer; else bb_bake calls
+  bb_trace_fn trace;    /* a bake's only: NULL (default) traces with
+                           the library's own tracer; else the bake calls
                            trace(trace_user, ...) in its place (bb_trace_fn).
                            the library's tracer itself ignores it */
   void *trace_user;
@@ -841,25 +841,6 @@ typedef struct bb_bake_result {
   double seconds_bounce;   /* the inter-reflection's part, after seconds_trace */
 } bb_bake_result;
 
-/* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
- * field (normalised h), making the maps o->outputs asks for and nothing
- * else (vis is made whenever a traced kind is asked). Results are
- * bit-identical for any o->trace.threads. Fills result; free it with
- * bb_bake_result_free. Errors: BB_ERR_ARGUMENT (a value outside the range of
- * bake's option for it, bb_option_bounds; no outputs or unknown ones, an
- * unknown addressing or normal filter, a bounce albedo or brightness map
- * without pixels, a basis of other than 3..BB_MAX_BASIS unit directions
- * with z >= 0), BB_ERR_VALUE
- * (NaN heights, scale x height overflowing), BB_ERR_MEMORY, and
- * BB_ERR_CANCELLED when o->trace.progress returned nonzero: then nothing is
- * returned (result is zeroed). */
-bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
-                  bb_bake_result *result, bb_error *err);
-
-/* The image of kind in r (NULL for an unknown kind); its pixels are NULL
- * when the bake did not make it. Owned by r. */
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
-
 void bb_bake_result_free(bb_bake_result *r);
 
 /* ------------------------------------------------------- bake contexts */
@@ -877,7 +858,7 @@ bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
 void bb_bake_context_free(bb_bake_context *context);
 
 /* Edit-local bakes. With keep 1 the bakes through context
- * (bb_bake_context_bake, and a job's after bb_job_use_context) keep what
+ * (bb_command_bake's with it, and a job's after bb_job_use_context) keep what
  * they made: the height, its smoothing and max-mip pyramid, each texel's
  * horizon in every slice, its visibility and normal, and the maps; about
  * 4 x slices + 70 bytes a texel for the default maps and basis (134 at 16
@@ -894,20 +875,12 @@ void bb_bake_context_free(bb_bake_context *context);
  * keep 0 (the default) lets what was kept go. */
 void bb_bake_context_keep(bb_bake_context *context, int keep);
 
-/* bb_bake of height with o through context: the same checks, maps and
- * bits; result as bb_bake fills it (free it with bb_bake_result_free),
- * its seconds and horizons_found those of the work done. changed (may be
- * NULL) receives the texels whose maps may differ from those of the
- * context's bake before: a rectangle inside the image, the whole image
- * after a whole bake, width 0 when nothing changed; texels across the
- * edge of a periodic map make it span the whole width (or height). */
-bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
-                               const bb_bake_options *o, bb_bake_result *result,
-                               bb_region *changed, bb_error *err);
-
-/* The changed rectangle of the context's last bake, as
- * bb_bake_context_bake gives it (for a bake made through a job); width 0
- * before any. */
+/* The changed rectangle of the context's last bake, as bb_command_bake
+ * gives it (for a bake made through a job): the texels whose maps may
+ * differ from those of the context's bake before, a rectangle inside the
+ * image, the whole image after a whole bake, width 0 when nothing
+ * changed; texels across the edge of a periodic map make it span the
+ * whole width (or height). Width 0 before any. */
 bb_region bb_bake_context_changed(const bb_bake_context *context);
 
 /* =====================================================================
@@ -1080,7 +1053,7 @@ typedef struct bb_renderbump_result {
   double texel_size; /* model units per texel: sqrt(texel width * height) */
   double texel_aspect; /* texel width / texel height (1 = square texels) */
   double height_scale; /* texels of height per unit of h, (depth_max -
-                          depth_min) / texel_size: bb_bake's height_scale
+                          depth_min) / texel_size: the bake's height_scale
                           for this height; 0 when the surface is flat */
   int used_vertex_normals; /* 1 when some texel used interpolated normals */
   size_t triangles_drawn;  /* triangle copies rasterised (with tile copies) */
@@ -2080,7 +2053,7 @@ bb_status bb_command_renderbump(bb_command *command, const bb_command_hooks *hoo
  * (allocated) receives render's picture (with the light as given: an
  * orbit's first frame) or sheet's contact sheet; *labels_drawn (may be
  * NULL) is 0 when the labels could not be drawn (no font). Errors as
- * bb_bake's, and render's or sheet's. */
+ * bb_command_bake's, and render's or sheet's. */
 bb_status bb_command_picture(bb_command *command, const bb_image *height,
                              const bb_render_maps *maps, const bb_command_hooks *hooks,
                              bb_image *out, int *labels_drawn, bb_error *err);
@@ -2124,6 +2097,37 @@ bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_
 bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
                          const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
                          bb_image *out, bb_error *err);
+
+/* bake's or normal's bake (bb_command_run's) of a height in memory, with
+ * the options of a command checked for it (bb_command_set_in_memory with
+ * the maps asked; --bounce-albedo or --brightness given as any text, the
+ * images being these): nothing read or written. height: a 1-channel
+ * height field (bb_height_from_image by the command's --channel), baked as
+ * the command line bakes a HEIGHT. bounce_albedo, brightness: the images
+ * those options name, NULL when not given. basis: the directions of the
+ * weights, ssbump and bent (NULL: the command's --basis). hooks (may be
+ * NULL): progress follows the bake and may cancel it; trace, a trace of
+ * the caller's in place of the bake's own (bb_trace_fn). context (may be
+ * NULL): the bake runs through it (bb_bake_context_new; warm, and
+ * edit-local after bb_bake_context_keep), with the same bits. maps: an
+ * array of BB_MAP_BAKED_COUNT images, by bb_map_kind: each map asked is
+ * allocated (free with bb_image_free), the others are left empty.
+ * changed (may be NULL): the texels whose maps may differ from the
+ * context's bake before (bb_bake_context_changed); the whole image
+ * without a context. Errors: BB_ERR_ARGUMENT (not a checked bake or
+ * normal set in memory; no height; an image for a file option not given,
+ * or none for one given; a value outside the range of bake's option for
+ * it, bb_option_bounds; a bounce albedo or brightness map without pixels
+ * or of another size; a basis of other than 3..BB_MAX_BASIS unit
+ * directions with z >= 0), BB_ERR_VALUE (NaN heights, scale x height
+ * overflowing), BB_ERR_MEMORY, and BB_ERR_CANCELLED when progress
+ * cancelled it: then every map is empty. Results are bit-identical for
+ * any --threads. */
+bb_status bb_command_bake(bb_command *command, const bb_image *height,
+                          const bb_image *bounce_albedo, const bb_image *brightness,
+                          const bb_basis *basis, const bb_command_hooks *hooks,
+                          bb_bake_context *context, bb_image *maps, bb_region *changed,
+                          bb_error *err);
 
 /* ----------------------------------------------------- what a job prints */
 

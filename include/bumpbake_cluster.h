@@ -38,7 +38,7 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
  * big maps so): each finds the horizons of some of the slices
  * (bb_trace_horizons), and one adds them up (bb_trace_accumulate) in the
  * order every trace adds them (bb_trace_slice_order) and turns the sums into
- * visibilities (bb_trace_finish). The result is bb_bake's trace's, bit
+ * visibilities (bb_trace_finish). The result is a bake's trace's, bit
  * for bit: the same horizons, the same losses, added in the same order. */
 
 /* The order in which every trace adds its slices' losses to a texel's sums:
@@ -49,13 +49,13 @@ bb_status bb_tempfiles_sweep(const char *dir, int *removed, bb_error *err);
 bb_status bb_trace_slice_order(const bb_rayset *rs, int *order, bb_error *err);
 
 /* The horizon of every texel in count distinct slices of rs, found by the
- * line sweeps bb_bake's trace runs: horizons[k] (allocated here: 1
+ * line sweeps a bake's trace runs: horizons[k] (allocated here: 1
  * channel, the pyramid's size) holds slice slices[k]'s horizons, tangents of
  * elevation >= 0 (rise per texel of horizontal distance; 0 where nothing
  * rises above the origin), the floats the whole trace adds up. A slice and
  * its opposite asked together share one sweep, as they do in the whole
  * trace. o->region must be empty (the whole pyramid); o->bias_texels,
- * o->threads and o->progress (once per sweep) as for bb_bake's trace.
+ * o->threads and o->progress (once per sweep) as for a bake's trace.
  * Memory: 4 bytes per texel per slice, plus a line's profile per thread.
  * Errors: BB_ERR_ARGUMENT (a slice out of range or asked twice, a region),
  * BB_ERR_MEMORY, BB_ERR_CANCELLED; then no image is left allocated. */
@@ -68,7 +68,7 @@ bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
  * 1 + bb_rayset_lobe_count(rs) channels (ao first, then each lobe), the
  * horizons' size, all zeros before rank 0 (bb_image_alloc makes them so).
  * Called for ranks 0, 1, ..., slice count - 1 in turn, each once, it adds
- * what bb_bake's trace adds in the order it adds it, so the sums are the
+ * what a bake's trace adds in the order it adds it, so the sums are the
  * same bits; the caller keeps to that order. threads: 0 = all cores (the
  * same bits for any). Errors: BB_ERR_ARGUMENT (rank out of range, sizes or
  * channels that do not match). */
@@ -76,17 +76,17 @@ bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *hor
                               bb_image *sums, int threads, bb_error *err);
 
 /* Turns sums, once every rank is added, into visibilities in place: ao,
- * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as bb_bake's trace
+ * vis_0, vis_1, ... in [0, 1], 1 - lost / total, as a bake's trace
  * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 
 /* ----------------------------------- bake: what a split trace traces */
 
-/* What bb_bake traces, built alone for a trace split over processes: the
+/* What a bake traces, built alone for a trace split over processes: the
  * max-mip pyramid of the smoothed height scaled to texels, and the ray set
- * of o's slices, power and basis, built by bb_bake's own stages (the same
+ * of o's slices, power and basis, built by the bake's own stages (the same
  * bits), so the horizons found from them (bb_trace_horizons) are those of
- * bb_bake's trace of height with o. Checks o and the height as bb_bake does;
+ * a bake's trace of height with o. Checks o and the height as the bake does;
  * o->outputs must ask for a traced kind. On success *pyramid and *rays
  * receive them (free with bb_pyramid_free and bb_rayset_free). Memory:
  * about 13 bytes per texel while building, 5.4 once built. */

@@ -3,6 +3,8 @@
 #ifndef BB_BAKE_HARNESS_H
 #define BB_BAKE_HARNESS_H
 
+#include "bake/bake_internal.h"
+
 /* A w x h one-channel image, every texel value. */
 static inline bb_image harness_field(int w, int h, float value) {
   bb_image img;
@@ -12,11 +14,11 @@ static inline bb_image harness_field(int w, int h, float value) {
   return img;
 }
 
-/* bb_bake that must succeed; the test fails with the library's message. */
+/* bb__bake_checked that must succeed; the test fails with the library's message. */
 static inline bb_bake_result harness_bake(const bb_image *h, const bb_bake_options *o) {
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(h, o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(h, o, &r, &err), BB_OK, "%s", err.message);
   return r;
 }
 

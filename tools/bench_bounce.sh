@@ -13,7 +13,7 @@
 #    reference: build/tools/bounce_ref with 65536 paths at every 8th texel
 #    of every 8th row (1024 texels), kept in build/bench/bounce/ and reused
 #    while newer than the map and tools/bounce_ref.c. Rows: "bumpbake", the bake at
-#    its defaults (build/tools/bounce_bake, which calls bb_bake as `bake
+#    its defaults (build/tools/bounce_bake, which calls bb__bake_checked as `bake
 #    --bounce RHO` does); "horizon-pt", the same bake with the whole blocked
 #    band of each slice seeing the horizon's own point (the approximation the
 #    sweeps give for free); "no-bounce", the bake without it; "coarse-2",

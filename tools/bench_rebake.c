@@ -11,7 +11,7 @@
  * (default 32) at X,Y (default the middle), A (default 0.1) of normalised
  * height at its centre, added and taken away in turns so that every bake
  * sees a change. Each edited height is baked through the context and whole
- * (bb_bake), each timed in CPU seconds (the process's, all threads) and
+ * (bb__bake_checked), each timed in CPU seconds (the process's, all threads) and
  * wall seconds; every map must be the same bits, else it exits 1. Prints
  * the medians, their ratio and one JSON line.
  *
@@ -20,6 +20,7 @@
  *   valgrind --tool=callgrind --collect-atstart=no --toggle-collect=edit_bake \
  *     build/tools/bench_rebake MAP 64 --runs 1 --threads 1
  * and --toggle-collect=whole_bake for the whole bakes. */
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 
 #include <math.h>
@@ -110,19 +111,19 @@ static void brush(bb_image *h, const args *a, int sign) {
 __attribute__((noinline)) static bb_status
 edit_bake(bb_bake_context *c, const bb_image *h, const bb_bake_options *o,
           bb_bake_result *r, bb_region *changed, bb_error *err) {
-  return bb_bake_context_bake(c, h, o, r, changed, err);
+  return bb__bake_context_bake(c, h, o, r, changed, err);
 }
 
 __attribute__((noinline)) static bb_status whole_bake(const bb_image *h,
                                                       const bb_bake_options *o,
                                                       bb_bake_result *r, bb_error *err) {
-  return bb_bake(h, o, r, err);
+  return bb__bake_checked(h, o, r, err);
 }
 
 static int same_maps(const bb_bake_result *a, const bb_bake_result *b) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *x = bb_bake_result_image(a, (bb_map_kind)k);
-    const bb_image *y = bb_bake_result_image(b, (bb_map_kind)k);
+    const bb_image *x = bb__bake_result_image(a, (bb_map_kind)k);
+    const bb_image *y = bb__bake_result_image(b, (bb_map_kind)k);
     if ((x->pixels == NULL) != (y->pixels == NULL))
       return 0;
     if (x->pixels &&

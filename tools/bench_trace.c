@@ -144,7 +144,7 @@ static double median_seconds(timed_fn f, void *ctx, int *runs) {
 
 /* ----------------------------------------------------------- preparing */
 
-/* Load -> smooth -> scale -> pyramid -> slices, as bb_bake does them. */
+/* Load -> smooth -> scale -> pyramid -> slices, as bb__bake_checked does them. */
 static bb_status prepare(const args *a, field *f, bb_error *err) {
   bb_status st = bb_height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &f->height, NULL, err);
   if (st != BB_OK) return st;

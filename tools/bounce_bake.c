@@ -10,7 +10,7 @@
  *               [--small-band T] [--chain N] [--level F]
  *
  * Writes PREFIX.ao.exr and PREFIX.ss.exr. Without the settings of the last
- * line it is bb_bake with bounce_albedo = R (the library's own defaults,
+ * line it is bb__bake_checked with bounce_albedo = R (the library's own defaults,
  * what `bumpbake bake --bounce R` makes); with any of them, the same
  * stages run one by one (smooth, normals, pyramid, trace, bb__bounce_add
  * with those settings, derive), so the bench can show what, say, fewer
@@ -190,7 +190,7 @@ int main(int argc, char **argv) {
   bb_bake_result r = {0};
   bb_error err = {{0}};
   bb_status st = bb_height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &height, NULL, &err);
-  if (st == BB_OK) st = a.inner ? staged_bake(&a, &height, &r, &err) : bb_bake(&height, &a.bake, &r, &err);
+  if (st == BB_OK) st = a.inner ? staged_bake(&a, &height, &r, &err) : bb__bake_checked(&height, &a.bake, &r, &err);
   char path[4200];
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};
   if (st == BB_OK) {

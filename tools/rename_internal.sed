@@ -164,5 +164,10 @@ s/\bbb_derive_weights\b/bb__derive_weights_all_cores/g
 s/\bbb_ssbump_to_normal\b/bb__ssbump_to_normal/g
 s/\bbb_image_flip_green\b/bb__image_flip_green/g
 # a command's options struct leaves the ABI (clients read options by name,
-# or the stage structs through bb_command_job_options / _render_options).
+# or the bake's settings through bb_command_job_options).
 s/\bbb_command_options_of\b/bb__command_options_of/g
+# the bake's stage calls only Python and the install check used; both bake
+# through the command now (bb_command_bake).
+s/\bbb_bake_result_image\b/bb__bake_result_image/g
+s/\bbb_bake_context_bake\b/bb__bake_context_bake/g
+s/\bbb_bake\b/bb__bake_checked/g

@@ -1,4 +1,4 @@
-"""Bakes of numpy height arrays (bb_bake) and the bake options every baking
+"""Bakes of numpy height arrays (bb_command_bake) and the bake options every baking
 call shares, made from keyword arguments the way `bumpbake bake` makes them
 from its options."""
 
@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _command
 from ._common import (_argument_error, _array, _bake_option, _check, _exception, _ffi,
-                      _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hook, _shown,
+                      _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hooks, _shown,
                       _text)
 
 
@@ -105,7 +105,7 @@ _IN_MEMORY = b"(array)"  # what an option naming a file reads when an array is g
 class _BakeMaps:
     """The maps a bake of arrays multiplies by (bounce_albedo, brightness),
     each an array or a file's path: the option is set for the library's
-    rules, the image handed to bb_bake. Keeps the images alive."""
+    rules, the image handed to bb_command_bake. Keeps the images alive."""
 
     def __init__(self, command, values):
         self.images = {}
@@ -128,17 +128,14 @@ class _BakeMaps:
             self.images[key] = img
 
         # An (N, 3) array of directions has no command-line spelling: the
-        # library makes the basis of it (bb_basis_from_vectors), set after.
+        # library makes the basis of it (bb_basis_from_vectors), handed over.
         spec = values.get("basis")
         self.basis = None
         if spec is not None and not isinstance(spec, (str, bytes, os.PathLike)):
             self.basis = _basis(values.pop("basis"))[0]
 
-    def fill(self, o):
-        if self.basis is not None:
-            o.basis = self.basis[0]
-        o.bounce_albedo_map = self.images.get("bounce_albedo", _ffi.NULL)
-        o.brightness = self.images.get("brightness", _ffi.NULL)
+    def image(self, key):
+        return self.images.get(key, _ffi.NULL)
 
     def free(self):
         for img in self._read:
@@ -202,40 +199,40 @@ def _height_field(command, height, channel):
     return field
 
 
-def _run_bake(command, height, channel, options, progress=None):
-    """bb_bake of an array: the result, to free with bb_bake_result_free, and
-    the height field baked (to free with bb_image_free). progress(done,
-    total) may return True to cancel; an exception it raises (Ctrl-C's
-    KeyboardInterrupt included: the callback always runs, on this thread)
-    cancels the bake and is raised once the library has stopped."""
-    field = _height_field(command, height, channel)
-    raised = []
-    cb = _progress_hook(progress, raised)
-    options.trace.progress = cb
-    result = _ffi.new("bb_bake_result *")
-    err = _ffi.new("bb_error *")
-    try:
-        st = _lib.bb_bake(field, options, result, err)  # cffi releases the GIL here
-    finally:
-        options.trace.progress = _ffi.NULL
-    if st != _lib.BB_OK:
-        _lib.bb_image_free(field)
-        if raised:
-            raise raised[0]
-        _check(st, err, arrays=True)
-    return result, field
-
-
-def _bake_arrays(function, height, scale, options, mask, progress, command="bake"):
+def _bake_maps(function, height, scale, options, mask, progress, command="bake",
+               context=_ffi.NULL):
+    """The maps asked (mask) of a height array, by bb_command_bake of the
+    library's command: ({bb_map_kind: float32 array}, the changed
+    (x, y, width, height)). progress(done, total) may return True to
+    cancel; an exception it raises (Ctrl-C's KeyboardInterrupt included: the
+    callback always runs, on this thread) cancels the bake and is raised once
+    the library has stopped."""
     c, maps = _bake_command(function, scale, options, mask, command)
+    field = None
+    out = _ffi.new("bb_image[]", _lib.BB_MAP_BAKED_COUNT)
     try:
-        o = _ffi.new("bb_bake_options *")
-        o[0] = c.options.job.bake
-        maps.fill(o)
-        channel = c.options.job.channel
-        return _run_bake(function, height, channel, o, progress)
+        field = _height_field(function, height, c.options.job.channel)
+        raised = []
+        hooks, _keep = _progress_hooks(progress, raised)
+        changed = _ffi.new("bb_region *")
+        err = _ffi.new("bb_error *")
+        st = _lib.bb_command_bake(c.handle, field, maps.image("bounce_albedo"),
+                                  maps.image("brightness"),
+                                  _ffi.NULL if maps.basis is None else maps.basis,
+                                  hooks, context, out, changed, err)  # cffi releases the GIL
+        if st != _lib.BB_OK:
+            if raised:
+                raise raised[0]
+            _check(st, err, arrays=True)
+        arrays = {k: _array(out[k]) for k in range(_lib.BB_MAP_BAKED_COUNT)
+                  if mask & (1 << k)}
+        return arrays, (changed.x0, changed.y0, changed.width, changed.height)
     finally:
+        for k in range(_lib.BB_MAP_BAKED_COUNT):
+            _lib.bb_image_free(_ffi.addressof(out, k))
         maps.free()
+        if field is not None:
+            _lib.bb_image_free(field)
 
 
 def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
@@ -244,12 +241,8 @@ def bake(height, scale, *, outputs=DEFAULT_OUTPUTS, progress=None, **options):
     Options: `bumpbake bake`'s that are not about files (BAKE_PARAMETERS,
     channel), named as its long options with '_' for '-'."""
     kinds, mask = _kinds_mask("bake", outputs)
-    result, field = _bake_arrays("bake", height, scale, options, mask, progress)
-    try:
-        return {k: _array(_lib.bb_bake_result_image(result, _KINDS[k][0])) for k in kinds}
-    finally:
-        _lib.bb_bake_result_free(result)
-        _lib.bb_image_free(field)
+    arrays, _ = _bake_maps("bake", height, scale, options, mask, progress)
+    return {k: arrays[_KINDS[k][0]] for k in kinds}
 
 
 class BakeContext:
@@ -279,33 +272,9 @@ class BakeContext:
         if self._context is None:
             raise ValueError("BakeContext.bake: the context is closed")
         kinds, mask = _kinds_mask("BakeContext.bake", outputs)
-        c, maps = _bake_command("BakeContext.bake", scale, options, mask)
-        field = None
-        try:
-            o = _ffi.new("bb_bake_options *")
-            o[0] = c.options.job.bake
-            maps.fill(o)
-            field = _height_field("BakeContext.bake", height, c.options.job.channel)
-            raised = []
-            cb = _progress_hook(progress, raised)
-            o.trace.progress = cb
-            result = _ffi.new("bb_bake_result *")
-            changed = _ffi.new("bb_region *")
-            err = _ffi.new("bb_error *")
-            st = _lib.bb_bake_context_bake(self._context, field, o, result, changed, err)
-            if st != _lib.BB_OK:
-                if raised:
-                    raise raised[0]
-                _check(st, err, arrays=True)
-            try:
-                self.changed = (changed.x0, changed.y0, changed.width, changed.height)
-                return {k: _array(_lib.bb_bake_result_image(result, _KINDS[k][0])) for k in kinds}
-            finally:
-                _lib.bb_bake_result_free(result)
-        finally:
-            maps.free()
-            if field is not None:
-                _lib.bb_image_free(field)
+        arrays, self.changed = _bake_maps("BakeContext.bake", height, scale, options, mask,
+                                          progress, context=self._context)
+        return {k: arrays[_KINDS[k][0]] for k in kinds}
 
     def close(self):
         if self._context is not None:
@@ -326,13 +295,9 @@ def normal(height, scale, *, progress=None, **options):
     """Smooths the height and returns its unit normals, float32 (H, W, 3),
     as `bumpbake normal` makes them (nothing is traced). Options: `bumpbake
     normal`'s that are not about files."""
-    result, field = _bake_arrays("normal", height, scale, options,
-                                 1 << _lib.BB_MAP_NORMAL, progress, command="normal")
-    try:
-        return _array(result.normal)
-    finally:
-        _lib.bb_bake_result_free(result)
-        _lib.bb_image_free(field)
+    arrays, _ = _bake_maps("normal", height, scale, options, 1 << _lib.BB_MAP_NORMAL,
+                           progress, command="normal")
+    return arrays[_lib.BB_MAP_NORMAL]
 
 
 _PARAMETERS = f"""

@@ -587,18 +587,11 @@ bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *hor
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 void bb_bake_options_init(bb_bake_options *o);
 int bb_bake_slices(const bb_bake_options *o);
-bb_status bb_bake(const bb_image *height, const bb_bake_options *o,
-                  bb_bake_result *result, bb_error *err);
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind);
-void bb_bake_result_free(bb_bake_result *r);
 bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
 void bb_bake_context_free(bb_bake_context *context);
 void bb_bake_context_keep(bb_bake_context *context, int keep);
-bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
-                               const bb_bake_options *o, bb_bake_result *result,
-                               bb_region *changed, bb_error *err);
 bb_status bb_mip_chain(const bb_image *img, bb_mip_filter filter, bb_image **levels,
                        int *count, bb_error *err);
 void bb_mip_chain_free(bb_image *levels, int count);
@@ -687,6 +680,11 @@ bb_status bb_command_program(bb_command *command, bb_image *out, int *is_normal_
 bb_status bb_command_map(bb_command *command, const bb_image *a, const bb_image *b,
                          const bb_image *mask, bb_depth b_depth, const bb_basis *basis,
                          bb_image *out, bb_error *err);
+bb_status bb_command_bake(bb_command *command, const bb_image *height,
+                          const bb_image *bounce_albedo, const bb_image *brightness,
+                          const bb_basis *basis, const bb_command_hooks *hooks,
+                          bb_bake_context *context, bb_image *maps, bb_region *changed,
+                          bb_error *err);
 const char *bb_report_word(const char *field, int value);
 bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_check **out,
                         bb_error *err);

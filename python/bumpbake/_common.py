@@ -102,6 +102,15 @@ def _progress_hook(progress, raised, stop=None):
     return _ffi.callback("bb_progress_fn", on_progress, onerror=on_error)
 
 
+def _progress_hooks(progress, raised):
+    """(bb_command_hooks * whose progress is _progress_hook(progress,
+    raised), the callback): keep both alive for the call."""
+    hooks = _ffi.new("bb_command_hooks *")
+    cb = _progress_hook(progress, raised)
+    hooks.progress = cb
+    return hooks, cb
+
+
 def _status_name(status):
     return _ffi.string(_lib.bb_status_name(status)).decode()
 

@@ -11,7 +11,7 @@ from ._bake import _IN_MEMORY, _height_field
 from ._command import Command
 from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _check,
                       _check_notes, _dispatch_notes, _exception, _ffi, _lib, _message, _path,
-                      _progress_hook, _shown, _take, _text)
+                      _progress_hook, _progress_hooks, _shown, _take, _text)
 
 # The default light of render: on, at this azimuth and elevation (degrees),
 # as a new render command holds it.
@@ -51,9 +51,7 @@ def _picture(c, height, maps, progress):
     if height is not None:
         field = _height_field(c.function, height, c.options.job.channel)
     raised = []
-    hooks = _ffi.new("bb_command_hooks *")
-    cb = _progress_hook(progress, raised)
-    hooks.progress = cb
+    hooks, _keep = _progress_hooks(progress, raised)
     out = _ffi.new("bb_image *")
     labels = _ffi.new("int *")
     err = _ffi.new("bb_error *")

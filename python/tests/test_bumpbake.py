@@ -239,7 +239,7 @@ def test_read_errors_carry_the_library_message(tmp_path):
 # -------------------------------------------------------------- threading
 
 def test_the_gil_is_released_while_baking():
-    """A Python thread keeps running while another thread is inside bb_bake:
+    """A Python thread keeps running while another thread is inside bb_command_bake:
     cffi drops the GIL for the call. Were it held, the main loop below would
     get no CPU for the whole bake. Measured in each thread's CPU time, which
     a busy machine shares out alike, not in wall-clock gaps, which it

@@ -275,8 +275,8 @@ static void drop_unasked(const bb_bake_options *o, const bb__bake_keep *keep,
   if (!wants(o, BB_MAP_BIT(BB_MAP_SSBUMP))) bb_image_free(&r->ssbump);
 }
 
-bb_status bb_bake(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
-                  bb_error *err) {
+bb_status bb__bake_checked(const bb_image *height, const bb_bake_options *o, bb_bake_result *r,
+                           bb_error *err) {
   bb_bake_options prepared;
   if (r)
     memset(r, 0, sizeof *r);

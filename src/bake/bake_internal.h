@@ -75,7 +75,7 @@ bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_e
  * command's, cmd/): the one place rays become slices. */
 void bb__bake_resolve(bb_bake_options *o);
 
-/* bb_bake for a caller that only writes the maps (the job), which lets go
+/* bb__bake_checked for a caller that only writes the maps (the job), which lets go
  * of what it will not use as soon as the bake is done with it:
  * BB__BAKE_DROP_VIS: r->vis goes once ssbump and ao are made (4 bytes a
  * texel per lobe and one); BB__BAKE_TAKE_HEIGHT: the bake frees height's
@@ -104,7 +104,7 @@ bb_status bb__bake_keeping(const bb_image *height, const bb_bake_options *o,
  * (bb_bake_context_keep): again only where the height changed since the
  * context's last bake of the same size and options, else whole; r as
  * bb__bake fills it (flags as there, but height is not freed). changed
- * (may be NULL) receives bb_bake_context_bake's rectangle. */
+ * (may be NULL) receives bb__bake_context_bake's rectangle. */
 bb_status bb__context_bake(bb_bake_context *context, const bb_image *height,
                            const bb_bake_options *o, unsigned flags, bb_bake_result *r,
                            bb_region *changed, bb_error *err);
@@ -200,7 +200,7 @@ bb_status bb__derive_ao_all_cores(const bb_image *vis, bb_image *out, bb_error *
 bb_status bb__derive_bent_all_cores(const bb_image *ssbump, const bb_basis *basis, bb_image *out,
                          bb_error *err);
 
-/* Checks every field of o as bb_bake does before it starts (ranges in the
+/* Checks every field of o as bb__bake_checked does before it starts (ranges in the
  * field comments): BB_OK, or BB_ERR_ARGUMENT with a message such as "bake:
  * filter radius must be in 0..4096 (got 5000)". So a caller can refuse bad
  * options before loading anything. */
@@ -229,5 +229,33 @@ const char *bb__normal_y_name(int normal_y_up);
 const char *bb__normal_filter_name(bb_normal_filter f);
 /* "down" or "up", the words of --normal-y (normal_y_up 0 or 1). */
 bb_status bb__normal_y_parse(const char *name, int *normal_y_up, bb_error *err);
+
+/* Runs smooth -> normals -> pyramid -> trace -> derive on a 1-channel height
+ * field (normalised h), making the maps o->outputs asks for and nothing
+ * else (vis is made whenever a traced kind is asked), o checked and
+ * prepared first (bb__bake_prepare). Results are bit-identical for any
+ * o->trace.threads. Fills result; free it with bb_bake_result_free.
+ * Errors: BB_ERR_ARGUMENT (a value outside the range of bake's option for
+ * it, bb_option_bounds; no outputs or unknown ones, an unknown addressing
+ * or normal filter, a bounce albedo or brightness map without pixels, a
+ * basis of other than 3..BB_MAX_BASIS unit directions with z >= 0),
+ * BB_ERR_VALUE (NaN heights, scale x height overflowing), BB_ERR_MEMORY,
+ * and BB_ERR_CANCELLED when o->trace.progress returned nonzero: then
+ * nothing is returned (result is zeroed). */
+bb_status bb__bake_checked(const bb_image *height, const bb_bake_options *o,
+                           bb_bake_result *result, bb_error *err);
+
+/* The image of kind in r (NULL for an unknown kind); its pixels are NULL
+ * when the bake did not make it. Owned by r. */
+const bb_image *bb__bake_result_image(const bb_bake_result *r, bb_map_kind kind);
+
+/* bb__bake_checked of height with o through context: the same checks, maps and
+ * bits; result as bb__bake_checked fills it (free it with bb_bake_result_free),
+ * its seconds and horizons_found those of the work done. changed (may be
+ * NULL) receives the texels whose maps may differ from those of the
+ * context's bake before (bb_bake_context_changed's rectangle). */
+bb_status bb__bake_context_bake(bb_bake_context *context, const bb_image *height,
+                                const bb_bake_options *o, bb_bake_result *result,
+                                bb_region *changed, bb_error *err);
 
 #endif /* BB_BAKE_INTERNAL_H */

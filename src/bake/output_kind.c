@@ -1,5 +1,6 @@
 /* output_kind.c: where a bake's result keeps each map it makes, so a
  * kind's image is found without a switch per client. */
+#include "bake/bake_internal.h"
 #include "core/internal.h"
 
 #include <stddef.h>
@@ -14,7 +15,7 @@ static const size_t result_offset[BB_MAP_BAKED_COUNT] = {
     [BB_MAP_FILTERED] = offsetof(bb_bake_result, filtered),
 };
 
-const bb_image *bb_bake_result_image(const bb_bake_result *r, bb_map_kind kind) {
+const bb_image *bb__bake_result_image(const bb_bake_result *r, bb_map_kind kind) {
   if (!r || (int)kind < 0 || kind >= BB_MAP_BAKED_COUNT)
     return NULL;
   return (const bb_image *)(const void *)((const char *)r + result_offset[kind]);

@@ -728,7 +728,7 @@ bb_status bb__bake_through(bb_bake_context *context, bb_image *height,
   return st;
 }
 
-bb_status bb_bake_context_bake(bb_bake_context *context, const bb_image *height,
+bb_status bb__bake_context_bake(bb_bake_context *context, const bb_image *height,
                                const bb_bake_options *o, bb_bake_result *result,
                                bb_region *changed, bb_error *err) {
   if (result)

@@ -1,6 +1,6 @@
 /* trace_input.c: what a bake traces (the pyramid of its smoothed, scaled
  * height and its ray set), built alone, for a trace split over processes
- * whose horizons must be those of bb_bake's own trace. */
+ * whose horizons must be those of bb__bake_checked's own trace. */
 
 #include "bake/bake_internal.h"
 #include "core/internal.h"
@@ -26,7 +26,7 @@ bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *giv
   if (st == BB_OK) st = bb__check_scaled_height(height, o->height_scale, err);
   if (st != BB_OK) return st;
   const int threads = bb__thread_count(o->trace.threads);
-  /* bb_bake's stages, with its operations: smooth, then z = scale * h in
+  /* bb__bake_checked's stages, with its operations: smooth, then z = scale * h in
    * float, then the pyramid of z */
   bb_image filtered = {0}, z = {0};
   st = bb__smooth_bilateral(height, height, &o->smooth, threads, NULL, &filtered, err);

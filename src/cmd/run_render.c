@@ -3,6 +3,7 @@
  * made, and written by the job (job/output.c: frame names, provenance,
  * staged all-or-nothing writes), the paths checked against the inputs
  * before (bb_command_check). */
+#include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
 #include "core/internal.h"
@@ -127,7 +128,7 @@ static bb_status bake_for_picture(render_args *a, const bb_image *height, const 
   a->bake.trace.progress = hooks ? hooks->progress : NULL;
   a->bake.trace.progress_user = hooks ? hooks->progress_user : NULL;
   bb_error e = {{0}};
-  st = bb_bake(height, &a->bake, &in->bake, &e);
+  st = bb__bake_checked(height, &a->bake, &in->bake, &e);
   if (st != BB_OK)
     return bb__fail_at(err, st, what, &e);
   bb_bake_result *r = &in->bake;
@@ -300,7 +301,7 @@ static bb_status sheet_picture(const bb_command_options *a, const bb_command_hoo
   bake.trace.progress = hooks ? hooks->progress : NULL;
   bake.trace.progress_user = hooks ? hooks->progress_user : NULL;
   bb_error e = {{0}};
-  bb_status st = bb_bake(height, &bake, result, &e);
+  bb_status st = bb__bake_checked(height, &bake, result, &e);
   if (st != BB_OK)
     return bb__fail_at(err, st, what, &e);
   st = bb__sheet_make(height, result, &sheet, picture, labels, &e);

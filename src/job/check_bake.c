@@ -4,6 +4,7 @@
  * the same floats), compared with the golden there, with the provenance
  * the batch would record; with an update, the maps that did not pass
  * written as the batch writes them, and no other file touched. */
+#include "bake/bake_internal.h"
 #include "core/internal.h"
 #include "image/oiio.h"
 #include "job/check.h"
@@ -98,7 +99,7 @@ static bb_status map_case(bb_check *c, int i, int kind, const bb_bake_result *re
   bb_image_info golden_info = {0};
   bb_error e = {{0}};
   char why[sizeof e.message + 64] = "";
-  const bb_image *map = bb_bake_result_image(result, (bb_map_kind)kind);
+  const bb_image *map = bb__bake_result_image(result, (bb_map_kind)kind);
   bb_status made = bb__path_is_texture_format(path)
                        ? texture_as_read(job, path, info->name, map, info->range, depth,
                                          description, &fresh, &e)

@@ -34,7 +34,7 @@ char *bb__job_prefix_path(const char *prefix, bb_map_kind kind);
 
 /* The rho a bake bounces with, the job's one rule for it: the rho asked,
  * or 1 when none is (0) and an albedo map is given (bake --bounce-albedo
- * FILE without --bounce: the map bounces as it is). bb_bake itself ignores
+ * FILE without --bounce: the map bounces as it is). bb__bake_checked itself ignores
  * a map while rho is 0, as bumpbake.h says. */
 double bb__bounce_rho(double asked, int albedo_map);
 
@@ -396,7 +396,7 @@ bb_status bb__renderbump_write(const bb_renderbump_result *r, const bb_renderbum
  * for an 8-bit input or when the format holds nothing deeper (TGA). */
 bb_depth bb__depth_like_input(int bits_per_sample, int is_float, const char *path);
 
-/* The rayset id bb_bake records in result->rayset_id for options o (slices
+/* The rayset id bb__bake_checked records in result->rayset_id for options o (slices
  * from o->slices, or from o->rays; power; basis), computed without building
  * the rayset, into out (capacity cap, NUL-terminated, cut to fit; 64 holds
  * any id). "" when o->outputs asks for no traced kind: nothing is traced

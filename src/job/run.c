@@ -330,7 +330,7 @@ static bb_status write_item(bb_job *job, bb__job_item *item, baked *b,
     files[n] = (bb_output_file){
         paths[f],
         kind_info(k)->name,
-        bb_bake_result_image(&b->result, (bb_map_kind)k),
+        bb__bake_result_image(&b->result, (bb_map_kind)k),
         kind_info(k)->range,
         output_depth(job, k, paths[f], r->source.bits_per_sample, r->source.is_float),
         job->options.mips,
@@ -531,7 +531,7 @@ static bb_status write_maps(bb_job *job, int i, const bb_bake_result *result, un
                     "(bb_job_run_item writes it)",
                     item->input);
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *m = bb_bake_result_image(result, (bb_map_kind)k);
+    const bb_image *m = bb__bake_result_image(result, (bb_map_kind)k);
     const int needed = item->paths[k] || (k == BB_MAP_FILTERED && job->slope_path);
     if (needed && (!m || !m->pixels || m->width != r->width || m->height != r->height))
       return bb__fail(err, BB_ERR_ARGUMENT,

@@ -173,7 +173,7 @@ char *bb__render_provenance(const bb_render_sources *s, const bb_render_options 
  * (files->albedo, may be NULL); the maps share one size (*width x *height,
  * may be NULL, set as soon as the first header is read); the picture fits
  * (bb__render_estimate, with output and depth); and reading them as
- * floats (for a height, its read and the bake, as bb_bake estimates it),
+ * floats (for a height, its read and the bake, as bb__bake_checked estimates it),
  * with the picture, fits in bb__memory_available. A file whose header is over the
  * read's limits is left to the read to refuse. Errors: those of
  * bb_image_read_info and bb__render_estimate, BB_ERR_ARGUMENT (maps of two

@@ -1,5 +1,5 @@
 /* trace.h: the whole trace of a pyramid and ray set (trace.c), which
- * bb_bake runs and the tests and tools call alone; not public. */
+ * bb__bake_checked runs and the tests and tools call alone; not public. */
 #ifndef BB_TRACE_TRACE_H
 #define BB_TRACE_TRACE_H
 

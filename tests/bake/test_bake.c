@@ -316,12 +316,12 @@ Test(bake, output_mask_makes_only_what_was_asked) {
     bb_bake_result one = harness_bake(&h, &o);
     const int traced = bb_map_kind_get((bb_map_kind)k)->needs_trace;
     for (int j = 0; j < BB_MAP_BAKED_COUNT; j++) {
-      const bb_image *img = bb_bake_result_image(&one, (bb_map_kind)j);
+      const bb_image *img = bb__bake_result_image(&one, (bb_map_kind)j);
       if (j != k) {
         cr_assert_null(img->pixels, "asked %d, made %d", k, j);
         continue;
       }
-      const bb_image *ref = bb_bake_result_image(&all, (bb_map_kind)j);
+      const bb_image *ref = bb__bake_result_image(&all, (bb_map_kind)j);
       cr_assert_eq(img->channels, ref->channels);
       cr_assert_eq(memcmp(img->pixels, ref->pixels, image_bytes(ref)), 0, "kind %d", k);
     }
@@ -374,11 +374,11 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
     o.trace.progress_user = &stop;
     bb_error err;
     memset(&r, 0xff, sizeof r); /* every field must be cleared */
-    cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_CANCELLED);
+    cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_CANCELLED);
     cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
     cr_assert_str_eq(bb_status_name(BB_ERR_CANCELLED), "cancelled");
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      cr_assert_null(bb_bake_result_image(&r, (bb_map_kind)k)->pixels, "kind %d", k);
+      cr_assert_null(bb__bake_result_image(&r, (bb_map_kind)k)->pixels, "kind %d", k);
     cr_assert_null(r.vis.pixels);
     bb_bake_result_free(&r);
   }
@@ -405,7 +405,7 @@ Test(bake, smoothing_and_normals_are_cancel_points) {
   cancel_state stop = {0, 0, -1, -1};
   o.trace.progress_user = &stop;
   bb_error err;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_CANCELLED);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_CANCELLED);
   cr_assert_str_eq(err.message, "bake: cancelled by the progress callback");
   cr_assert_null(r.normal.pixels);
   bb_image_free(&h);
@@ -482,11 +482,11 @@ Test(bake, options_check_holds_every_limit) {
       cr_assert_eq(st, BB_ERR_ARGUMENT, "case %zu", i);
       cr_assert(strncmp(err.message, cases[i].message, strlen(cases[i].message)) == 0,
                 "case %zu: %s", i, err.message);
-      /* bb_bake refuses them the same way, before any work. */
+      /* bb__bake_checked refuses them the same way, before any work. */
       bb_image h = harness_field(4, 4, 0.0f);
       bb_bake_result r;
       bb_error err2;
-      cr_assert_eq(bb_bake(&h, &c, &r, &err2), BB_ERR_ARGUMENT);
+      cr_assert_eq(bb__bake_checked(&h, &c, &r, &err2), BB_ERR_ARGUMENT);
       cr_assert_str_eq(err2.message, err.message);
       bb_image_free(&h);
     }
@@ -498,16 +498,16 @@ Test(bake, rejects_bad_options) {
   bb_bake_options_init(&o);
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT, "scale 0 must be refused");
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_ARGUMENT, "scale 0 must be refused");
   o.height_scale = 1.0f;
   o.power = 0.5;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_ARGUMENT);
   o.power = 1.0;
   o.trace.bias_texels = -0.1;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_ARGUMENT);
   o.trace.bias_texels = 0.55;
   o.slices = BB_MAX_SLICES + 1;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "slices") != NULL, "%s", err.message);
   bb_image_free(&h);
 }
@@ -524,14 +524,14 @@ Test(bake, scale_times_height_overflow_is_named) {
   o.rays = 4;
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_ERR_VALUE);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_VALUE);
   cr_assert(strstr(err.message, "height scale 2") && strstr(err.message, "(2, 1)") &&
                 strstr(err.message, "3e+38"),
             "%s", err.message);
   cr_assert_null(r.normal.pixels);
   /* At the limit itself the bake runs. */
   *bb_image_texel(&h, 2, 1) = (float)(BB_MAX_HEIGHT_TEXELS / 4.0);
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   bb_bake_result_free(&r);
   bb_image_free(&h);
 }

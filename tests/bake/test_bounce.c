@@ -47,8 +47,8 @@ static int same_image(const bb_image *a, const bb_image *b) {
 
 static void expect_same_bake(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    cr_expect(same_image(bb_bake_result_image(a, (bb_map_kind)k),
-                         bb_bake_result_image(b, (bb_map_kind)k)),
+    cr_expect(same_image(bb__bake_result_image(a, (bb_map_kind)k),
+                         bb__bake_result_image(b, (bb_map_kind)k)),
               "%s: %s differs", what, bb_map_kind_get((bb_map_kind)k)->name);
   cr_expect(same_image(&a->vis, &b->vis), "%s: vis differs", what);
 }
@@ -272,8 +272,8 @@ Test(bounce, any_thread_count_gives_the_same_bits_and_a_periodic_shift_close_one
   bb_bake_result s = harness_bake(&shifted, &o);
   cr_expect_eq(s.bounces, one.bounces);
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *a = bb_bake_result_image(&one, (bb_map_kind)k);
-    const bb_image *b = bb_bake_result_image(&s, (bb_map_kind)k);
+    const bb_image *a = bb__bake_result_image(&one, (bb_map_kind)k);
+    const bb_image *b = bb__bake_result_image(&s, (bb_map_kind)k);
     int differ = 0;
     double most = 0.0;
     for (int y = 0; y < H; y++)
@@ -371,13 +371,13 @@ Test(bounce, options_are_checked) {
   o.bounces = 0;
   o.bounce_albedo_map = &small;
   bb_bake_result r;
-  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "albedo") != NULL, "%s", err.message);
   small.pixels[5] = NAN;
   bb_image nan_map = harness_field(8, 8, 1.0f);
   nan_map.pixels[9] = NAN;
   o.bounce_albedo_map = &nan_map;
-  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_VALUE);
   bb_image_free(&nan_map);
   bb_image_free(&small);
   bb_image_free(&h);
@@ -816,8 +816,8 @@ Test(bounce, the_coarse_level_agrees_with_the_maps_own, .timeout = 120) {
   const bb_map_kind kinds[2] = {BB_MAP_AO, BB_MAP_SSBUMP};
   const double mean_within[2] = {0.0002, 0.0025}, most_within[2] = {0.01, 0.06};
   for (int m = 0; m < 2; m++) {
-    const bb_image *a0 = bb_bake_result_image(&tile0, kinds[m]), *a = bb_bake_result_image(&tile, kinds[m]);
-    const bb_image *b0 = bb_bake_result_image(&tiling0, kinds[m]), *b = bb_bake_result_image(&tiling, kinds[m]);
+    const bb_image *a0 = bb__bake_result_image(&tile0, kinds[m]), *a = bb__bake_result_image(&tile, kinds[m]);
+    const bb_image *b0 = bb__bake_result_image(&tiling0, kinds[m]), *b = bb__bake_result_image(&tiling, kinds[m]);
     for (int c = 0; c < a->channels; c++) {
       double abs_sum = 0.0, sum = 0.0, most = 0.0, open_added = 0.0;
       for (int y = 0; y < t.height; y++)
@@ -841,8 +841,8 @@ Test(bounce, the_coarse_level_agrees_with_the_maps_own, .timeout = 120) {
   /* the direct maps: the bake's without the bounce, bit for bit */
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
     if (!(BB_MAPS_TRACED & BB_MAP_BIT(k)))
-      cr_expect(same_image(bb_bake_result_image(&tiling0, (bb_map_kind)k),
-                           bb_bake_result_image(&tiling, (bb_map_kind)k)),
+      cr_expect(same_image(bb__bake_result_image(&tiling0, (bb_map_kind)k),
+                           bb__bake_result_image(&tiling, (bb_map_kind)k)),
                 "%s differs with the bounce", bb_map_kind_get((bb_map_kind)k)->name);
   bb_bake_result_free(&tile0), bb_bake_result_free(&tiling0);
   bb_bake_result_free(&tile), bb_bake_result_free(&tiling);
@@ -876,8 +876,8 @@ Test(bounce, the_coarse_level_is_deterministic_and_close_under_a_shift, .timeout
         *bb_image_texel(&shifted, (x + sx) % W, (y + sy) % H) = at(&t, x, y)[0];
     bb_bake_result s = harness_bake(&shifted, &o);
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-      const bb_image *a = bb_bake_result_image(&one, (bb_map_kind)k);
-      const bb_image *b = bb_bake_result_image(&s, (bb_map_kind)k);
+      const bb_image *a = bb__bake_result_image(&one, (bb_map_kind)k);
+      const bb_image *b = bb__bake_result_image(&s, (bb_map_kind)k);
       if (!a->pixels) continue;
       double most = 0.0;
       for (int y = 0; y < H; y++)

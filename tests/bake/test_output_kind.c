@@ -4,6 +4,7 @@
 
 #include <string.h>
 
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/basis.h"
@@ -68,16 +69,16 @@ Test(output_kind, result_images_match_the_table) {
   cr_assert_eq(bb__basis_parse("dirs:5", &o.basis, NULL), BB_OK);
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(&h, &o, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
   const bb_image *fields[] = {&r.normal, &r.weights, &r.ssbump, &r.ao, &r.bent, &r.filtered};
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *img = bb_bake_result_image(&r, (bb_map_kind)k);
+    const bb_image *img = bb__bake_result_image(&r, (bb_map_kind)k);
     cr_assert_eq(img, fields[k], "kind %d", k);
     const int want = bb_map_kind_get((bb_map_kind)k)->channels;
     cr_assert_eq(img->channels, want ? want : 5, "kind %d", k);
   }
-  cr_assert_null(bb_bake_result_image(&r, BB_MAP_BAKED_COUNT));
-  cr_assert_null(bb_bake_result_image(NULL, BB_MAP_NORMAL));
+  cr_assert_null(bb__bake_result_image(&r, BB_MAP_BAKED_COUNT));
+  cr_assert_null(bb__bake_result_image(NULL, BB_MAP_NORMAL));
   bb_bake_result_free(&r);
   bb_image_free(&h);
 }

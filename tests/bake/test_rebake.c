@@ -151,7 +151,7 @@ static void edits_equal_whole_with(int w, int h, const bb_bake_options *base,
   bb_bake_context_keep(context, 1);
   bb_bake_result got, want;
   bb_region changed;
-  cr_assert_eq(bb_bake_context_bake(context, &height, &o, &got, &changed, &err), BB_OK,
+  cr_assert_eq(bb__bake_context_bake(context, &height, &o, &got, &changed, &err), BB_OK,
                "%s", err.message);
   cr_assert(changed.width == w && changed.height == h, "the first bake is whole");
   bb_bake_result_free(&got);
@@ -164,10 +164,10 @@ static void edits_equal_whole_with(int w, int h, const bb_bake_options *base,
       for (int j = 0; j < 4; j++)
         bright.pixels[3 * (size_t)below(&r, w * h)] = (float)uniform(&r);
     o.trace.threads = threads[e % 4];
-    cr_assert_eq(bb_bake_context_bake(context, &height, &o, &got, &changed, &err), BB_OK,
+    cr_assert_eq(bb__bake_context_bake(context, &height, &o, &got, &changed, &err), BB_OK,
                  "%s", err.message);
     local += bb__context_last_local(context);
-    cr_assert_eq(bb_bake(&height, &o, &want, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__bake_checked(&height, &o, &want, &err), BB_OK, "%s", err.message);
     char label[160];
     snprintf(label, sizeof label, "%dx%d %s%s, edit %d (%s), %d threads", w, h,
              addressing == BB_ADDRESS_CLAMP ? "clamped" : "periodic",
@@ -258,7 +258,7 @@ static bb_bake_result context_bake(bb_bake_context *c, const bb_image *h,
                                    const bb_bake_options *o, bb_region *changed) {
   bb_bake_result r;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake_context_bake(c, h, o, &r, changed, &err), BB_OK, "%s",
+  cr_assert_eq(bb__bake_context_bake(c, h, o, &r, changed, &err), BB_OK, "%s",
                err.message);
   return r;
 }
@@ -267,7 +267,7 @@ static void equals_whole(const bb_bake_result *got, const bb_image *h,
                          const bb_bake_options *o, const char *what) {
   bb_bake_result want;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(h, o, &want, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(h, o, &want, &err), BB_OK, "%s", err.message);
   maps_equal(got, &want, what);
   bb_bake_result_free(&want);
 }
@@ -376,8 +376,8 @@ Test(rebake, bad_height_refused_then_baked) {
   h.pixels[5 * 40 + 5] = NAN;
   bb_error err = {{0}}, whole = {{0}};
   bb_bake_result none;
-  cr_expect_eq(bb_bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
-  cr_expect_eq(bb_bake(&h, &o, &none, &whole), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &none, &whole), BB_ERR_VALUE);
   cr_expect_str_eq(err.message, whole.message);
   cr_expect_null(got.ssbump.pixels, "nothing is returned");
   h.pixels[5 * 40 + 5] = good + 0.2f;
@@ -393,8 +393,8 @@ Test(rebake, bad_height_refused_then_baked) {
   got = context_bake(c, &h, &o, NULL);
   bb_bake_result_free(&got);
   bright.pixels[77] = INFINITY;
-  cr_expect_eq(bb_bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
-  cr_expect_eq(bb_bake(&h, &o, &none, &whole), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_VALUE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &none, &whole), BB_ERR_VALUE);
   cr_expect_str_eq(err.message, whole.message);
   bright.pixels[77] = 0.5f;
   got = context_bake(c, &h, &o, NULL);
@@ -424,7 +424,7 @@ Test(rebake, cancelled_edit_then_whole) {
   o.trace.progress = cancel_at;
   o.trace.progress_user = &calls;
   bb_error err = {{0}};
-  cr_expect_eq(bb_bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_CANCELLED);
+  cr_expect_eq(bb__bake_context_bake(c, &h, &o, &got, NULL, &err), BB_ERR_CANCELLED);
   cr_expect_null(got.normal.pixels);
   cr_expect_geq(calls, 2);
   o.trace.progress = NULL;

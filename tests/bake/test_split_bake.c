@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "bumpbake_cluster.h"
 #include "trace/basis.h"
@@ -94,17 +95,17 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
     cr_assert_eq(bb__basis_parse(cases[c].basis, &o.basis, NULL), BB_OK);
     bb_bake_result plain, split;
     bb_error err;
-    cr_assert_eq(bb_bake(&height, &o, &plain, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__bake_checked(&height, &o, &plain, &err), BB_OK, "%s", err.message);
     split_user u = {&height, &o, 0};
     bb_bake_options with_hook = o;
     with_hook.trace.trace = split_trace;
     with_hook.trace.trace_user = &u;
-    cr_assert_eq(bb_bake(&height, &with_hook, &split, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__bake_checked(&height, &with_hook, &split, &err), BB_OK, "%s", err.message);
     cr_assert_eq(u.calls, 1);
     cr_assert_eq(plain.bounces > 0, cases[c].bounce > 0.0, "bounces %d", plain.bounces);
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-      assert_same(bb_bake_result_image(&plain, (bb_map_kind)k),
-                  bb_bake_result_image(&split, (bb_map_kind)k),
+      assert_same(bb__bake_result_image(&plain, (bb_map_kind)k),
+                  bb__bake_result_image(&split, (bb_map_kind)k),
                   bb_map_kind_get((bb_map_kind)k)->name);
     assert_same(&plain.vis, &split.vis, "vis");
     cr_assert_eq(plain.horizons_found, split.horizons_found);
@@ -136,11 +137,11 @@ Test(split_bake, a_trace_that_fails_or_makes_the_wrong_image_fails_the_bake) {
   o.trace.trace = wrong_size;
   bb_bake_result r;
   bb_error err;
-  cr_assert_eq(bb_bake(&height, &o, &r, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb__bake_checked(&height, &o, &r, &err), BB_ERR_ARGUMENT);
   cr_assert(strstr(err.message, "made no 20x20 image of 4 channels"), "%s", err.message);
   cr_assert_null(r.normal.pixels);
   o.trace.trace = failing;
-  cr_assert_eq(bb_bake(&height, &o, &r, &err), BB_ERR_IO);
+  cr_assert_eq(bb__bake_checked(&height, &o, &r, &err), BB_ERR_IO);
   cr_assert(strstr(err.message, "worker tcp://10.0.0.2 lost"), "%s", err.message);
   o.trace.trace = NULL;
   o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);

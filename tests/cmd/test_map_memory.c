@@ -6,6 +6,7 @@
 
 #include "bumpbake.h"
 #include "command_words.h"
+#include "pattern_image.h"
 #include "image/image_write.h"
 
 #include <criterion/criterion.h>
@@ -36,20 +37,6 @@ static void teardown(void) {
     unlink(p);
   }
   rmdir(dir);
-}
-
-/* An image of w x h x channels whose texels vary smoothly in (lo, hi). */
-static bb_image pattern(int w, int h, int channels, float lo, float hi) {
-  bb_image img = {0};
-  bb_error err = {{0}};
-  cr_assert_eq(bb_image_alloc(&img, w, h, channels, &err), BB_OK, "%s", err.message);
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++)
-      for (int k = 0; k < channels; k++) {
-        const float t = 0.5f + 0.5f * sinf(0.37f * (float)x + 0.23f * (float)y + 1.3f * (float)k);
-        bb_image_texel(&img, x, y)[k] = lo + (hi - lo) * t;
-      }
-  return img;
 }
 
 static void write_file(const char *path, const bb_image *img, bb_depth depth) {
@@ -107,7 +94,7 @@ TestSuite(cmd_map, .init = setup, .fini = teardown);
 /* normal2ssbump --normal-y up: OpenGL normals, flipped in memory as the
  * run's decode flips them. */
 Test(cmd_map, normal2ssbump_in_memory_is_the_runs_weights) {
-  bb_image n = pattern(24, 16, 3, -0.6f, 0.6f);
+  bb_image n = pattern_image(24, 16, 3, -0.6f, 0.6f, 0.f);
   for (size_t i = 0; i < 24 * 16; i++)
     n.pixels[3 * i + 2] = 0.8f;
   write_file(at(0, "n.exr"), &n, BB_DEPTH_FLOAT);
@@ -142,7 +129,7 @@ Test(cmd_map, normal2ssbump_in_memory_is_the_runs_weights) {
 }
 
 Test(cmd_map, ssbump2normal_in_memory_is_the_runs_normals) {
-  bb_image w = pattern(20, 12, 3, 0.05f, 0.6f);
+  bb_image w = pattern_image(20, 12, 3, 0.05f, 0.6f, 0.f);
   write_file(at(0, "a.exr"), &w, BB_DEPTH_FLOAT);
   bb_image ssbump = read_back(paths[0], NULL);
   const char *words[] = {"--kind", "weights", "--normal-y", "up", NULL};
@@ -163,9 +150,9 @@ Test(cmd_map, ssbump2normal_in_memory_is_the_runs_normals) {
 /* combine --detail with an 8-bit B: its flat texel as the file stores it
  * (b_depth 8), so a flat B leaves A unchanged; the exact flat would not. */
 Test(cmd_map, combine_detail_in_memory_takes_Bs_depth) {
-  bb_image a = pattern(16, 16, 3, 0.1f, 0.9f);
+  bb_image a = pattern_image(16, 16, 3, 0.1f, 0.9f, 0.f);
   write_file(at(0, "a.exr"), &a, BB_DEPTH_FLOAT);
-  bb_image flat = pattern(16, 16, 3, 0.0f, 0.0f);
+  bb_image flat = pattern_image(16, 16, 3, 0.0f, 0.0f, 0.f);
   for (size_t i = 0; i < 16 * 16 * 3; i++)
     flat.pixels[i] = 1.0f / sqrtf(3.0f); /* stored as 147 of 255 */
   write_file(at(1, "b.png"), &flat, BB_DEPTH_8);
@@ -195,8 +182,9 @@ Test(cmd_map, combine_detail_in_memory_takes_Bs_depth) {
 /* combine --mask of normals +Y up: the mask's T, the normals flipped in
  * and out as the run decodes and writes them. */
 Test(cmd_map, combine_mask_of_normals_in_memory_is_the_runs_map) {
-  bb_image n1 = pattern(16, 8, 3, -0.5f, 0.5f), n2 = pattern(16, 8, 3, -0.3f, 0.7f);
-  bb_image t = pattern(16, 8, 1, -0.2f, 1.2f);
+  bb_image n1 = pattern_image(16, 8, 3, -0.5f, 0.5f, 0.f),
+           n2 = pattern_image(16, 8, 3, -0.3f, 0.7f, 0.f);
+  bb_image t = pattern_image(16, 8, 1, -0.2f, 1.2f, 0.f);
   write_file(at(0, "n.exr"), &n1, BB_DEPTH_FLOAT);
   write_file(at(1, "a.exr"), &n2, BB_DEPTH_FLOAT);
   write_file(at(2, "m.exr"), &t, BB_DEPTH_FLOAT);
@@ -230,7 +218,7 @@ Test(cmd_map, combine_mask_of_normals_in_memory_is_the_runs_map) {
 }
 
 Test(cmd_map, refusals_name_what_is_wrong) {
-  bb_image a = pattern(8, 8, 3, 0.1f, 0.9f), out = {0};
+  bb_image a = pattern_image(8, 8, 3, 0.1f, 0.9f, 0.f), out = {0};
   bb_error err = {{0}};
   const char *none[] = {NULL};
   const char *mix[] = {"--mix", "0.5", NULL};
@@ -244,10 +232,10 @@ Test(cmd_map, refusals_name_what_is_wrong) {
                BB_ERR_ARGUMENT);
   cr_expect_str_eq(err.message, "combine: B, the second map, is needed");
   /* --mix: a mask given is not used (all 1 would give B) */
-  bb_image ones = pattern(8, 8, 1, 0.0f, 0.0f), mixed = {0}, masked = {0};
+  bb_image ones = pattern_image(8, 8, 1, 0.0f, 0.0f, 0.f), mixed = {0}, masked = {0};
   for (size_t i = 0; i < 8 * 8; i++)
     ones.pixels[i] = 1.0f;
-  bb_image other = pattern(8, 8, 3, 0.9f, 0.2f);
+  bb_image other = pattern_image(8, 8, 3, 0.9f, 0.2f, 0.f);
   cr_assert_eq(bb_command_map(c, &a, &other, NULL, BB_DEPTH_DEFAULT, NULL, &mixed, &err), BB_OK);
   cr_assert_eq(bb_command_map(c, &a, &other, &ones, BB_DEPTH_DEFAULT, NULL, &masked, &err),
                BB_OK);
@@ -284,7 +272,7 @@ Test(cmd_map, refusals_name_what_is_wrong) {
   cr_expect_str_eq(err.message, "program makes no map of images in memory");
   bb_command_free(c);
   /* the operator's own refusal: another basis' map */
-  bb_image six = pattern(8, 8, 6, 0.1f, 0.9f);
+  bb_image six = pattern_image(8, 8, 6, 0.1f, 0.9f, 0.f);
   c = in_memory("ssbump2normal", none);
   cr_expect_eq(bb_command_map(c, &six, NULL, NULL, BB_DEPTH_DEFAULT, NULL, &out, &err),
                BB_ERR_ARGUMENT);

@@ -247,8 +247,8 @@ static bb_bake_result bake_with(const char *input, int slices, const char *basis
 
 static void expect_same_maps(const bb_bake_result *a, const bb_bake_result *b, const char *what) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    const bb_image *x = bb_bake_result_image(a, (bb_map_kind)k);
-    const bb_image *y = bb_bake_result_image(b, (bb_map_kind)k);
+    const bb_image *x = bb__bake_result_image(a, (bb_map_kind)k);
+    const bb_image *y = bb__bake_result_image(b, (bb_map_kind)k);
     if (!x || !x->pixels) {
       cr_expect(!y || !y->pixels, "%s: kind %d", what, k);
       continue;
@@ -458,8 +458,8 @@ Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
                 changed.x0, changed.y0);
     }
     for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-      const bb_image *a = bb_bake_result_image(&kept, (bb_map_kind)k);
-      const bb_image *b = bb_bake_result_image(&whole, (bb_map_kind)k);
+      const bb_image *a = bb__bake_result_image(&kept, (bb_map_kind)k);
+      const bb_image *b = bb__bake_result_image(&whole, (bb_map_kind)k);
       cr_assert_eq(a->pixels != NULL, b->pixels != NULL);
       if (a->pixels)
         cr_expect(

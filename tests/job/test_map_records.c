@@ -3,6 +3,7 @@
  * recorded exactly when the kind's pixels change; and the rule followed by
  * the writer, the up-to-date check and the diff, also against a text
  * written before the rule (every key recorded). */
+#include "bake/bake_internal.h"
 #include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
@@ -57,14 +58,14 @@ typedef struct maps {
 
 static void bake(const bb_image *h, const bb_bake_options *o, maps *m) {
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(h, o, &m->r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(h, o, &m->r, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb__slope_map(&m->r.filtered, o->height_scale, o->smooth.addressing,
                             &m->slope, &err),
                BB_OK, "%s", err.message);
 }
 
 static const bb_image *image_of(const maps *m, bb_map_kind k) {
-  return k == BB_MAP_SLOPE ? &m->slope : bb_bake_result_image(&m->r, k);
+  return k == BB_MAP_SLOPE ? &m->slope : bb__bake_result_image(&m->r, k);
 }
 
 static void maps_free(maps *m) {

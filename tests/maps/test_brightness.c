@@ -157,7 +157,7 @@ Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
   o.brightness = &small;
   bb_bake_result r;
   bb_error err;
-  cr_expect_eq(bb_bake(&h, &o, &r, &err), BB_ERR_SIZE);
+  cr_expect_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_SIZE);
   cr_expect(strstr(err.message, "brightness") != NULL, "%s", err.message);
   bb_image_free(&small), bb_image_free(&ss), bb_image_free(&wt);
   bb_bake_result_free(&plain), bb_bake_result_free(&lit);

@@ -109,7 +109,7 @@ Test(valve, pack_of_a_real_flat_bake) {
   bo.rays = 16;
   bb_bake_result r;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(&height, &bo, &r, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&height, &bo, &r, &err), BB_OK, "%s", err.message);
   bb_valve_options o;
   bb__valve_options_init(&o);
   bb_image out = {0};

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "maps/maps_internal.h"
 #include "render/render_internal.h"
@@ -59,7 +60,7 @@ static void scene_make(scene *s, int width, int height, double (*f)(int, int, in
   o.height_scale = scale;
   o.rays = rays;
   bb_error err = {{0}};
-  cr_assert_eq(bb_bake(&s->height, &o, &s->bake, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__bake_checked(&s->height, &o, &s->bake, &err), BB_OK, "%s", err.message);
   const bb_bake_result *r = &s->bake;
   s->maps = (bb_render_maps){&r->normal, &r->ssbump, &r->ao, &r->bent, NULL, NULL};
 }
