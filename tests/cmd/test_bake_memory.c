@@ -56,7 +56,7 @@ Test(cmd_bake, bits_of_the_stage_bake_with_the_commands_options) {
   bb_error err = {{0}};
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, NULL, maps, &changed, &err),
                BB_OK, "%s", err.message);
-  bb_bake_options o = bb_command_options_of(c)->job.bake;
+  bb_bake_options o = bb_command_job_options(c)->bake;
   cr_assert_eq(o.basis.count, 6);
   bb_bake_result r;
   cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
@@ -83,7 +83,7 @@ Test(cmd_bake, the_images_and_basis_handed_over) {
   bb_image maps[BB_MAP_BAKED_COUNT];
   cr_assert_eq(bb_command_bake(c, &h, &albedo, &bright, &basis, NULL, NULL, maps, NULL, &err),
                BB_OK, "%s", err.message);
-  bb_bake_options o = bb_command_options_of(c)->job.bake;
+  bb_bake_options o = bb_command_job_options(c)->bake;
   o.basis = basis;
   o.brightness = &bright;
   o.bounce_albedo_map = &albedo;
@@ -145,7 +145,7 @@ Test(cmd_bake, normal_bakes_the_normal_alone) {
   bb_error err = {{0}};
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, NULL, maps, NULL, &err), BB_OK,
                "%s", err.message);
-  bb_bake_options o = bb_command_options_of(c)->job.bake;
+  bb_bake_options o = bb_command_job_options(c)->bake;
   cr_expect(o.normal_y_up);
   bb_bake_result r;
   cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
