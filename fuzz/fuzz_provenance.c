@@ -5,6 +5,7 @@
  * NUL-terminated inside its capacity, one line per difference when it fits,
  * a text never differs from itself, and formatting two option sets that
  * differ in the scale alone gives exactly the "scale" difference. */
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "fuzz_common.h"
 #include "files/provenance.h"
@@ -54,7 +55,7 @@ static void check_diff(const char *a, const char *b, size_t cap) {
  * line, input name, kind) must not bleed into other keys. */
 static void check_round_trip(const char *a, const char *b) {
   bb_bake_options o1, o2;
-  bb_bake_options_init(&o1);
+  bb__bake_options_init(&o1);
   o1.height_scale = 2.0f;
   o2 = o1;
   o2.height_scale = 3.0f;

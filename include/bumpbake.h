@@ -754,6 +754,8 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float, int normal_
 
 /* ---------------------------------------------------------------- bake */
 
+/* A bake's options; a client has them, its defaults filled in, from a
+ * bake command (bb_command_job_options). */
 typedef struct bb_bake_options {
   float height_scale;         /* S, texels per unit of h, > 0 */
   int rays;                   /* ray budget, 1..BB_MAX_RAYS, default 256:
@@ -767,7 +769,7 @@ typedef struct bb_bake_options {
                                  bake (smooth, normals, pyramid, trace,
                                  derive); progress, which may cancel */
   double power;               /* P in 1..BB_MAX_POWER, default 1 */
-  bb_basis basis;             /* default "hl2" (bb_bake_options_init); weights and
+  bb_basis basis;             /* default "hl2"; weights and
                                  ssbump get one channel per direction */
   bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
   int normal_y_up;            /* 1 flips green of normal and bent */
@@ -813,8 +815,6 @@ typedef struct bb_bake_options {
 
 /* Most bounces a bake's inter-reflection follows. */
 #define BB_MAX_BOUNCES 64
-
-void bb_bake_options_init(bb_bake_options *o);
 
 /* The azimuth slices o traces with: o->slices when set, else
  * the slices o->rays asks for (round(sqrt(rays)), at least 1). The one rule; provenance, JSON and the

@@ -160,7 +160,7 @@ int main(int argc, char **argv) {
     a.x = h.width / 2 - a.side / 2, a.y = h.height / 2 - a.side / 2;
   a.x %= h.width, a.y %= h.height;
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = (float)a.scale;
   o.outputs = BB_JOB_DEFAULT_MAPS;
   o.trace.threads = a.threads;

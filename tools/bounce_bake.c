@@ -87,7 +87,7 @@ static int parse_args(int argc, char **argv, args *a) {
   if (argc < 4) return usage("MAP, SCALE and PREFIX are needed");
   memset(a, 0, sizeof *a);
   a->map = argv[1], a->prefix = argv[3];
-  bb_bake_options_init(&a->bake);
+  bb__bake_options_init(&a->bake);
   bb__bounce_options_init(&a->bounce);
   a->bake.smooth.radius_texels = 0;
   a->bake.normal_filter = BB_NORMAL_VALVE;

@@ -171,3 +171,4 @@ s/\bbb_command_options_of\b/bb__command_options_of/g
 s/\bbb_bake_result_image\b/bb__bake_result_image/g
 s/\bbb_bake_context_bake\b/bb__bake_context_bake/g
 s/\bbb_bake\b/bb__bake_checked/g
+s/\bbb_bake_options_init\b/bb__bake_options_init/g

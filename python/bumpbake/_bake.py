@@ -7,7 +7,7 @@ import os
 import numpy as np
 
 from . import _command
-from ._common import (_argument_error, _array, _bake_option, _check, _exception, _ffi,
+from ._common import (_argument_error, _array, _check, _exception, _ffi,
                       _Image, _lib, _message, _parse, _parse_raw, _path, _progress_hooks, _shown,
                       _text)
 
@@ -32,24 +32,25 @@ DEFAULT_OUTPUTS = tuple(k for k, (i, _, _) in _KINDS.items() if (1 << i) & _lib.
 
 
 def _library_defaults():
-    o = _ffi.new("bb_bake_options *")
-    _lib.bb_bake_options_init(o)
+    """The defaults of bake's options, read by name from a new bake command
+    (bb_command_value): what the command holds before anything is set."""
+    c = _command.Command("bake", "bake")
     return {
-        "rays": o.rays,
-        "filter_radius": o.smooth.radius_texels,
-        "filter_threshold": o.smooth.threshold,
-        "bias": o.trace.bias_texels,
-        "power": o.power,
-        "basis": _text(o.basis.name),
-        "normal_filter": _text(_lib.bb_option_word(_bake_option("normal-filter"),
-                                                   o.normal_filter)),
-        "normal_y": "up" if o.normal_y_up else "down",
-        "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP,
-        "threads": o.trace.threads,
+        "rays": int(c.value("rays")),
+        "filter_radius": int(c.value("filter-radius")),
+        # held as a C float: its text (9 digits) is that float's exactly
+        "filter_threshold": float(np.float32(c.value("filter-threshold"))),
+        "bias": float(c.value("bias")),
+        "power": float(c.value("power")),
+        "basis": c.value("basis"),
+        "normal_filter": c.value("normal-filter"),
+        "normal_y": c.value("normal-y"),
+        "clamp": c.value("clamp") == "1",
+        "threads": int(c.value("threads")),
     }
 
 
-# The library's defaults (bb_bake_options_init), which the CLI uses too; a
+# The library's defaults (a bake command's values), which the CLI uses too; a
 # parameter left at None keeps them.
 DEFAULTS = _library_defaults()
 
@@ -211,7 +212,7 @@ def _bake_maps(function, height, scale, options, mask, progress, command="bake",
     field = None
     out = _ffi.new("bb_image[]", _lib.BB_MAP_BAKED_COUNT)
     try:
-        field = _height_field(function, height, c.options.job.channel)
+        field = _height_field(function, height, c.word("channel"))  # its bb_channel
         raised = []
         hooks, _keep = _progress_hooks(progress, raised)
         changed = _ffi.new("bb_region *")

@@ -585,7 +585,6 @@ bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
 bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
                               bb_image *sums, int threads, bb_error *err);
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
-void bb_bake_options_init(bb_bake_options *o);
 int bb_bake_slices(const bb_bake_options *o);
 bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);

@@ -183,7 +183,7 @@ def _path(value, what="path"):
 
 def _bake_option(name):
     """`bumpbake bake`'s option name (bb_option_info), whose words and parser
-    the package's enum arguments share (bb_option_parse, bb_option_word)."""
+    the package's enum arguments share (bb_option_parse)."""
     return _lib.bb_option_find(_lib.bb_command_info_find(b"bake"), name.encode(), 0)
 
 

@@ -393,6 +393,26 @@ def test_the_option_table_is_the_librarys():
     assert "bounce" in bumpbake.BAKE_PARAMETERS and "brightness" in bumpbake.BAKE_PARAMETERS
 
 
+def test_defaults_are_exactly_the_bake_a_command_checks():
+    """DEFAULTS, read by name from a bake command, hold the very values
+    (same type, same double) of the bake options a checked command with
+    nothing set but the scale hands on."""
+    c = _command.Command("bake", "bake")
+    c.set("scale", 1.0)
+    c.in_memory(0)
+    c.check()
+    o = c.options.job.bake
+    assert bumpbake.DEFAULTS == {
+        "rays": o.rays, "filter_radius": o.smooth.radius_texels,
+        "filter_threshold": o.smooth.threshold, "bias": o.trace.bias_texels,
+        "power": o.power, "basis": _text(o.basis.name),
+        "normal_filter": "vertex" if o.normal_filter == _lib.BB_NORMAL_VERTEX else "other",
+        "normal_y": "up" if o.normal_y_up else "down",
+        "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP, "threads": o.trace.threads}
+    assert [type(v) for v in bumpbake.DEFAULTS.values()] == [int, int, float, float, float,
+                                                             str, str, str, bool, int]
+
+
 def test_the_python_reference_names_every_command_and_bake_keyword():
     """docs/python.md's table of which function takes which command's
     options names every command (serve aside, as it says), and its bake()

@@ -206,6 +206,10 @@ bb_status bb__derive_bent_all_cores(const bb_image *ssbump, const bb_basis *basi
  * options before loading anything. */
 bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err);
 
+/* The defaults of a bake's options (height_scale 0: it must be set); a
+ * command's bake starts from them (bb__job_options_init). */
+void bb__bake_options_init(bb_bake_options *o);
+
 /* The maps of docs/conventions.md "Derived maps", for any basis: channel c belongs
  * to basis->vector[c]. basis NULL means Half-Life 2's B0, B1, B2, and for
  * ssbump and bent also hl2+z when the input has a fourth basis channel. */

@@ -22,7 +22,7 @@ const bb__range bb__range_power = {"power", 1.0, BB_MAX_POWER, 0, 0};
 const bb__range bb__range_bounce_albedo = {"bounce", 0.0, 1.0, 0, 0};
 const bb__range bb__range_bounces = {"bounces", 0, BB_MAX_BOUNCES, 0, 1};
 
-void bb_bake_options_init(bb_bake_options *o) {
+void bb__bake_options_init(bb_bake_options *o) {
   memset(o, 0, sizeof *o);
   o->height_scale = 0.0f; /* must be set: there is no meaningful default */
   o->rays = 256;

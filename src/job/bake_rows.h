@@ -120,7 +120,7 @@ BB__ENUM_WORDS(normal_y)
 BB__ENUM_WORDS(ssbump_kind)
 BB__ENUM_WORDS(output_kind)
 
-/* The defaults of bake (bb_bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
+/* The defaults of bake (bb__bake_options_init), channel AUTO, BB_DEPTH_DEFAULT,
  * the texture defaults (bb_texture_options_init), no outputs. */
 void bb__job_options_init(bb_job_options *o);
 

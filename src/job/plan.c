@@ -35,7 +35,7 @@ static char *copy(const char *s) {
 
 void bb__job_options_init(bb_job_options *o) {
   memset(o, 0, sizeof *o);
-  bb_bake_options_init(&o->bake);
+  bb__bake_options_init(&o->bake);
   o->channel = BB_CHANNEL_AUTO;
   o->depth = BB_DEPTH_DEFAULT;
   bb_texture_options_init(&o->texture);

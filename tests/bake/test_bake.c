@@ -19,7 +19,7 @@ static const double PI = 3.14159265358979323846;
 
 static bb_bake_options sharp_options(float scale, int rays) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.rays = rays;
   o.smooth.radius_texels = 0;
@@ -35,7 +35,7 @@ Test(bake, flat_map_is_neutral_everywhere) {
   bb_image h = harness_field(13, 9, 0.0f);
   for (int i = 0; i < 13 * 9; i++) h.pixels[i] = 0.5f;
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 32.0f;
   bb_bake_result r = harness_bake(&h, &o);
   for (int y = 0; y < 9; y++)
@@ -244,7 +244,7 @@ Test(bake, periodic_shift_shifts_every_output) {
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) b.pixels[((y + sy) % h) * w + (x + sx) % w] = a.pixels[y * w + x];
     bb_bake_options o;
-    bb_bake_options_init(&o);
+    bb__bake_options_init(&o);
     o.height_scale = 6.0f;
     o.slices = 8;
     o.smooth.radius_texels = radii[ri];
@@ -281,7 +281,7 @@ Test(bake, bit_identical_for_any_thread_count) {
   bb_bake_result r[RUNS];
   for (int t = 0; t < RUNS; t++) {
     bb_bake_options o;
-    bb_bake_options_init(&o);
+    bb__bake_options_init(&o);
     o.height_scale = 8.0f;
     o.slices = 10;
     o.smooth.radius_texels = 4;
@@ -306,7 +306,7 @@ Test(bake, output_mask_makes_only_what_was_asked) {
   bb_image h = harness_field(24, 17, 0.0f);
   noise_field(&h, 5);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 6.0f;
   o.slices = 6;
   o.normal_y_up = 1; /* the flip applies to what is kept, once */
@@ -357,7 +357,7 @@ Test(bake, progress_callback_cancels_and_nothing_is_returned) {
   bb_image h = harness_field(40, 30, 0.0f);
   noise_field(&h, 9);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 8.0f;
   o.slices = 16;
   /* Going on: every slice reported, the bake whole. */
@@ -392,7 +392,7 @@ Test(bake, smoothing_and_normals_are_cancel_points) {
   bb_image h = harness_field(64, 48, 0.0f);
   noise_field(&h, 5);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 8.0f;
   o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
   cancel_state go = {0, -1, -1, -1};
@@ -442,7 +442,7 @@ Test(bake, progress_callback_cancels_a_region_trace) {
 /* The ranges the command line used to check alone are the library's. */
 Test(bake, options_check_holds_every_limit) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 4.0f;
   bb_error err;
   cr_assert_eq(bb__bake_options_check(&o, &err), BB_OK, "%s", err.message);
@@ -495,7 +495,7 @@ Test(bake, options_check_holds_every_limit) {
 Test(bake, rejects_bad_options) {
   bb_image h = harness_field(4, 4, 0.0f);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   bb_bake_result r;
   bb_error err;
   cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_ERR_ARGUMENT, "scale 0 must be refused");
@@ -519,7 +519,7 @@ Test(bake, scale_times_height_overflow_is_named) {
   bb_image h = harness_field(4, 4, 0.0f);
   *bb_image_texel(&h, 2, 1) = 3.0e38f;
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 2.0f;
   o.rays = 4;
   bb_bake_result r;

@@ -26,7 +26,7 @@ static const double PI = 3.14159265358979323846;
 
 static bb_bake_options options(float scale, int rays, double rho) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.rays = rays;
   o.smooth.radius_texels = 0;
@@ -73,7 +73,7 @@ Test(bounce, rho_zero_is_the_bake_without_it) {
     bb_image h = load_fixture(maps[m]);
     for (int threads = 1; threads <= 3; threads++) {
       bb_bake_options plain;
-      bb_bake_options_init(&plain);
+      bb__bake_options_init(&plain);
       plain.height_scale = 8.0f;
       plain.trace.threads = threads;
       bb_bake_options zero = plain;

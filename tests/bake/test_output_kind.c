@@ -63,7 +63,7 @@ Test(output_kind, result_images_match_the_table) {
   for (int i = 0; i < 63; i++)
     h.pixels[i] = (float)(i % 5) / 5.0f;
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 3.0f;
   o.slices = 4;
   cr_assert_eq(bb__basis_parse("dirs:5", &o.basis, NULL), BB_OK);

@@ -188,7 +188,7 @@ static void edits_equal_whole_with(int w, int h, const bb_bake_options *base,
 
 static bb_bake_options options_of(bb_addressing addressing, unsigned outputs) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 24.0f;
   o.outputs = outputs;
   o.smooth.addressing = addressing;

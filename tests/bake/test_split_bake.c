@@ -87,7 +87,7 @@ Test(split_bake, the_callers_split_trace_makes_the_bakes_bits) {
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     bb_image height = bumps(cases[c].w, cases[c].h);
     bb_bake_options o;
-    bb_bake_options_init(&o);
+    bb__bake_options_init(&o);
     o.height_scale = 9.0f;
     o.slices = cases[c].slices;
     o.smooth.addressing = cases[c].a;
@@ -132,7 +132,7 @@ static bb_status failing(void *user, const bb_pyramid *p, const bb_rayset *rs,
 Test(split_bake, a_trace_that_fails_or_makes_the_wrong_image_fails_the_bake) {
   bb_image height = bumps(20, 20);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 4.0f;
   o.trace.trace = wrong_size;
   bb_bake_result r;

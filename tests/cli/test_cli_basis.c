@@ -63,7 +63,7 @@ Test(cli_basis, dirs_writes_a_channel_per_direction_to_exr_and_tiff) {
   cr_assert_eq(s.channels, 6);
   cr_assert_eq(w.channels, 6);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 6.0f;
   o.slices = 8;
   cr_assert_eq(bb__basis_parse("dirs:6", &o.basis, NULL), BB_OK);
@@ -162,7 +162,7 @@ Test(cli_basis, a_basis_file_is_recorded_by_its_vectors) {
   expect_ok(&r, "a basis file");
   const double v[5][3] = {{1, 0, 1}, {0, 1, 1}, {-1, 0, 1}, {0, -1, 1}, {0, 0, 1}};
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 5.0f;
   o.slices = 6;
   cr_assert_eq(bb_basis_from_vectors(v, 5, &o.basis, NULL), BB_OK);

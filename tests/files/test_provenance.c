@@ -259,7 +259,7 @@ Test(provenance, diff_with_null_text_or_tiny_buffer) {
 
 Test(provenance, classify_tells_intact_from_damaged_and_foreign_text) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   bb_provenance p = sample_provenance(&o);
   char *text = bb_provenance_format(&p);
   cr_assert_eq(bb__provenance_classify(text), BB_PROVENANCE_INTACT, "%s", text);

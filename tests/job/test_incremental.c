@@ -81,7 +81,7 @@ Test(incremental, rayset_id_is_the_bakes) {
   bb_image h;
   cr_assert_eq(bb_image_alloc(&h, 8, 8, 1, NULL), BB_OK);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 2.0f;
   o.rays = 40;
   o.power = 2.5;
@@ -109,7 +109,7 @@ typedef struct fixture {
 } fixture;
 
 static void fixture_init(fixture *f) {
-  bb_bake_options_init(&f->options);
+  bb__bake_options_init(&f->options);
   f->options.height_scale = 8.0f;
   f->p = (bb_provenance){"bumpbake bake a.png --scale 8", "a.png", 0x1234, "normal",
                          &f->options, BB_CHANNEL_AUTO, "bb-horizon-v1:a16:p1:hl2",

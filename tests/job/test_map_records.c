@@ -41,7 +41,7 @@ static void make_grey(bb_image *g, float base) {
 
 static bb_bake_options base_options(void) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 12.0f;
   o.rays = 64;
   o.trace.threads = 2;

@@ -129,7 +129,7 @@ Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
       *bb_image_texel(&b, x, y) = (float)(0.25 + 1.5 * x / (W - 1)); /* 0.25 .. 1.75 */
     }
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 6.0f;
   bb_bake_result plain = harness_bake(&h, &o);
   o.brightness = &b;
@@ -166,7 +166,7 @@ Test(brightness, the_bake_option_modulates_ssbump_and_weights) {
 
 Test(brightness, provenance_names_the_maps_it_was_made_with) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 4.0f;
   bb_provenance p = {.output_kind = "ssbump", .options = &o};
   char *text = bb_provenance_format(&p), value[64];

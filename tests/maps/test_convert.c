@@ -34,7 +34,7 @@ static bb_image gentle_height(int w, int h) {
 
 static bb_bake_result bake(const bb_image *h, float scale) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.outputs = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_WEIGHTS);
   bb_bake_result r;
@@ -138,7 +138,7 @@ Test(convert, ssbump2normal_of_an_unoccluded_bake_is_its_normal) {
   /* Exact horizons see any crest above the ray origin, however low: with a
    * bias over the field's 1-texel relief nothing is. */
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 2.0f;
   o.rays = 64;
   o.trace.bias_texels = 1.5;

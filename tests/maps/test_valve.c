@@ -104,7 +104,7 @@ Test(valve, pack_refuses_what_was_not_baked) {
 Test(valve, pack_of_a_real_flat_bake) {
   bb_image height = filled(8, 8, 1, (float[]){0.5f});
   bb_bake_options bo;
-  bb_bake_options_init(&bo);
+  bb__bake_options_init(&bo);
   bo.height_scale = 8.0f;
   bo.rays = 16;
   bb_bake_result r;

@@ -248,7 +248,7 @@ Test(panels, compare_is_four_renders) {
   for (int i = 0; i < 24 * 20; i++)
     h.pixels[i] = (float)(0.5 + 0.4 * sin(i * 0.37) * cos(i * 0.11));
   bb_bake_options bo;
-  bb_bake_options_init(&bo);
+  bb__bake_options_init(&bo);
   bo.height_scale = 4;
   bo.rays = 16;
   bb_bake_result r;

@@ -34,7 +34,7 @@ typedef struct scene {
 static void scene_make(scene *s, float scale) {
   s->height = bumpy(48, 40);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.smooth.radius_texels = 0;
   s->bake = harness_bake(&s->height, &o);

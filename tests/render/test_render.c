@@ -56,7 +56,7 @@ static void scene_make(scene *s, int width, int height, double (*f)(int, int, in
                        float scale, int rays) {
   make_height(&s->height, width, height, f);
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.rays = rays;
   bb_error err = {{0}};

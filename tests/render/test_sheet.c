@@ -15,7 +15,7 @@ static void bake_small(bb_image *h, bb_bake_result *r, int trace) {
     for (int x = 0; x < 32; x++)
       h->pixels[y * 32 + x] = (float)(0.3 + 0.2 * sin(x * 0.39) * cos(y * 0.52));
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = 6;
   o.rays = 16;
   o.outputs = trace ? BB_MAPS_BAKED : BB_MAPS_BAKED & ~BB_MAPS_TRACED;

@@ -306,7 +306,7 @@ Test(basis, each_lobes_total_is_its_closed_form) {
 
 static bb_bake_options options(const bb_basis *basis, float scale, int slices) {
   bb_bake_options o;
-  bb_bake_options_init(&o);
+  bb__bake_options_init(&o);
   o.height_scale = scale;
   o.slices = slices;
   o.basis = *basis;
