@@ -642,7 +642,6 @@ void bb_option_default_text(const bb_command_info *command, const bb_option_info
                             char *out, size_t cap);
 bb_status bb_option_parse(const bb_option_info *option, const char *text, long long *value,
                           bb_error *err);
-const char *bb_option_word(const bb_option_info *option, long long value);
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
