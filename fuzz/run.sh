@@ -7,7 +7,9 @@
 # target. Exits 1 when a target crashed, leaked, failed a property, took
 # longer than FUZZ_TIMEOUT seconds on one input, allocated more than
 # FUZZ_MALLOC_MB at once or grew past FUZZ_RSS_MB; the input is saved in
-# BUILD_DIR/crashes/ (crash-, leak-, timeout- or oom-HASH).
+# BUILD_DIR/crashes/ (crash-, leak-, timeout- or oom-HASH). Inputs libFuzzer
+# saves there without the target failing (slow units; a child process's own
+# report) are named on the target's line as saved without failing.
 #
 # The limits (environment, `make fuzz` passes them on):
 #   FUZZ_TIMEOUT   (10)   seconds one input may take (ASan and UBSan on)
@@ -44,6 +46,7 @@ for spec in "$@"; do
       continue
     fi
   fi
+  before=$(find "$build/crashes" -name "$name-*" | sort)
   start=$(date +%s.%N)
   "$build/$target" $options -max_total_time="$seconds" -close_fd_mask=3 \
     "${limits[@]}" -print_final_stats=1 \
@@ -53,9 +56,17 @@ for spec in "$@"; do
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   units=$(find "$corpus" -type f | wc -l)
   line=$(printf '%-16s %10s executions in %6.1f s, corpus %5d inputs' "$name" "${execs:-?}" "$elapsed" "$units")
+  # Inputs libFuzzer saved although the target passed: slow units (over
+  # -report_slow_units), or the report of a child process the target waited
+  # for (the model loader's, whose failure the target takes as a refused
+  # model). Named, so that a passing run's crashes/ is not read as failures.
+  saved=$(comm -13 <(printf '%s\n' "$before") <(find "$build/crashes" -name "$name-*" | sort) |
+    sed '/^$/d')
   if [ "$status" -ne 0 ]; then
     line="$line: FAILED (see $log)"
     failed=1
+  elif [ -n "$saved" ]; then
+    line="$line; saved without failing: $(echo "$saved" | xargs -n1 basename | paste -sd' ')"
   fi
   echo "$line"
   summary="$summary$line"$'\n'
