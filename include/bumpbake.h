@@ -1870,6 +1870,17 @@ int bb_command_given(const bb_command *command, const char *name);
  * value longer than cap - 1; BB_ERR_MEMORY. */
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,
                            size_t cap, bb_error *err);
+/* The numbers option name of command holds (an option of type
+ * BB_OPTION_INT, _NUMBER or _NUMBERS: render's --light "135,45",
+ * renderbumpflat's --size "256 128"), the value as bb_command_value gives
+ * it read back by the option's own parser: bb_option_info.count numbers
+ * (1 but for _NUMBERS) into values (room for cap), their count into *count
+ * (may be NULL). A float the command holds comes back as a double that
+ * converts to the same float. Errors: BB_ERR_ARGUMENT for an unknown
+ * option (as bb_command_set words it), one of another type, or cap too
+ * small; BB_ERR_MEMORY. */
+bb_status bb_command_numbers(const bb_command *command, const char *name, double *values,
+                             int cap, int *count, bb_error *err);
 /* The options of the command's bake as set and checked (bake, normal,
  * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
  * and texture settings of every command writing maps): what a client that

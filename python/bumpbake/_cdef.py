@@ -654,6 +654,8 @@ void bb_command_set_spelling(bb_command *command, bb_spelling spelling);
 int bb_command_given(const bb_command *command, const char *name);
 bb_status bb_command_value(const bb_command *command, const char *name, char *out,
                            size_t cap, bb_error *err);
+bb_status bb_command_numbers(const bb_command *command, const char *name, double *values,
+                             int cap, int *count, bb_error *err);
 const bb_job_options *bb_command_job_options(const bb_command *command);
 void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);

@@ -280,6 +280,17 @@ class Command:
         _check(_lib.bb_command_value(self._c, name.encode(), out, len(out), err), err)
         return _text(out)
 
+    def numbers(self, name):
+        """The numbers of option name as the command holds them, read back by
+        the option's own parser (bb_command_numbers): a tuple of floats."""
+        option = _lib.bb_option_find(self._info, name.encode(), 0)
+        n = option.count if option != _ffi.NULL else 1
+        out = _ffi.new("double[]", max(n, 1))
+        count = _ffi.new("int *")
+        err = _ffi.new("bb_error *")
+        _check(_lib.bb_command_numbers(self._c, name.encode(), out, len(out), count, err), err)
+        return tuple(out[k] for k in range(count[0]))
+
     def word(self, name):
         """The value of word option name as the library's enum value
         (bb_option_parse of its value: bb_map_kind for --kind)."""

@@ -16,8 +16,8 @@ from ._common import (_Image, _NoteHooks, _argument_error, _array, _c_text, _che
 # The default light of render: on, at this azimuth and elevation (degrees),
 # as a new render command holds it.
 def _default_light():
-    azimuth, elevation = Command("render").value("light").split(",")
-    return (float(azimuth), float(elevation))
+    azimuth, elevation = Command("render").numbers("light")
+    return (azimuth, elevation)
 
 
 DEFAULT_LIGHT = _default_light()

@@ -6,20 +6,18 @@
 #include "common.h"
 
 #include <limits.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* size ("W H"), samples and axis ("-y") as the checked command holds them. */
 static void print_summary(const cli_run *run, const char *model,
                           const bb_renderbump_result *r) {
-  char size[64] = "", samples[16] = "", axis[8] = "";
-  cli_text(run, "size", size, sizeof size);
-  cli_text(run, "samples", samples, sizeof samples);
+  double size[2] = {0.0, 0.0}, samples = 0.0;
+  char axis[8] = "";
+  bb_command_numbers(run->command, "size", size, 2, NULL, NULL);
+  bb_command_numbers(run->command, "samples", &samples, 1, NULL, NULL);
   cli_text(run, "axis", axis, sizeof axis);
-  int width = 0, height = 0;
-  sscanf(size, "%d %d", &width, &height);
-  const int n = atoi(samples);
+  const int width = (int)size[0], height = (int)size[1], n = (int)samples;
   cli_printf_line("renderbumpflat: %s: %zu triangles, %s normals, seen along %s; rectangle "
                   "[%g, %g] x [%g, %g]; %d x %d texels, %d samples each",
                   model, r->triangles, r->used_vertex_normals ? "vertex" : "face", axis,

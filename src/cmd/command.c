@@ -155,6 +155,35 @@ bb_status bb_command_value(const bb_command *c, const char *name, char *out, siz
   return BB_OK;
 }
 
+bb_status bb_command_numbers(const bb_command *c, const char *name, double *values, int cap,
+                             int *count, bb_error *err) {
+  if (count)
+    *count = 0;
+  if (!c || !name || !values)
+    return bb__fail(err, BB_ERR_ARGUMENT, "command: no option named, or no room for its numbers");
+  const int i = bb__option_find(c->def, name);
+  if (i < 0)
+    return bb__spelled(c, unknown_option(c, name, err), err);
+  const bb__option *o = c->def->options[i];
+  const bb_option_type type = o->info.type;
+  if (type != BB_OPTION_INT && type != BB_OPTION_NUMBER && type != BB_OPTION_NUMBERS)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s takes no numbers", o->info.name);
+  const int n = type == BB_OPTION_NUMBERS ? o->info.count : 1;
+  if (n > cap)
+    return bb__fail(err, BB_ERR_ARGUMENT, "--%s holds %d numbers, room for %d", o->info.name,
+                    n, cap);
+  bb__text t = {0};
+  value_text(c, i, &t);
+  char *text = bb__text_take(&t);
+  if (!text)
+    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  bb_status st = bb__parse_numbers(o, text, n, type == BB_OPTION_INT, values, err);
+  free(text);
+  if (st == BB_OK && count)
+    *count = n;
+  return st;
+}
+
 /* --------------------------------------------------------------- setting */
 
 /* "unknown option '--rayz' (did you mean --rays?)" */

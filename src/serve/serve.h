@@ -191,8 +191,8 @@ int serve_apply_params(serve_state *s, const char *const *names,
                        int *rebake, char *err, size_t cap);
 
 /* serve_params.c: command's --light-color (render's row, which serve
- * takes) as the picture's light, read by name: bb_command_value's "R,G,B"
- * (the value set, else the default), each float spelled exactly. */
+ * takes) as the picture's light, read by name (bb_command_numbers: the
+ * value set, else the default). */
 void serve_light_color(const bb_command *command, float rgb[3]);
 
 /* serve_page.c: the page's files, embedded at build time. */

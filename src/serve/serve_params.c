@@ -368,11 +368,8 @@ int serve_apply_params(serve_state *s, const char *const *names,
 }
 
 void serve_light_color(const bb_command *command, float rgb[3]) {
-  char text[128] = "";
-  bb_command_value(command, "light-color", text, sizeof text, NULL);
-  char *p = text;
-  for (int k = 0; k < 3; k++) {
-    rgb[k] = strtof(p, &p);
-    p += *p == ',';
-  }
+  double v[3] = {1.0, 1.0, 1.0};
+  bb_command_numbers(command, "light-color", v, 3, NULL, NULL);
+  for (int k = 0; k < 3; k++)
+    rgb[k] = (float)v[k]; /* the float the command holds */
 }

@@ -565,6 +565,55 @@ Test(cmd, unset_puts_an_option_back_at_its_default) {
   bb_command_free(c);
 }
 
+/* bb_command_numbers: a numbers option read back by its own parser, the
+ * value set or the default; a float held comes back as that float. */
+Test(cmd, numbers_read_an_option_back_by_its_parser) {
+  bb_error err = {{0}};
+  const char *render_words[] = {"--normal", "n.png", "--light-color", "0.8,0.9,1", NULL};
+  bb_command *c = command("render", render_words);
+  double v[4] = {0};
+  int n = 0;
+  cr_assert_eq(bb_command_numbers(c, "light", v, 4, &n, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(n, 2);
+  cr_expect(v[0] == 135.0 && v[1] == 45.0, "%g %g", v[0], v[1]);
+  cr_assert_eq(bb_command_numbers(c, "light-color", v, 3, &n, &err), BB_OK, "%s", err.message);
+  const float *held = bb__command_options_of(c)->render.light_color;
+  for (int k = 0; k < 3; k++)
+    cr_expect((float)v[k] == held[k], "%d: %.9g against %.9g", k, v[k], (double)held[k]);
+  cr_expect_eq(bb_command_numbers(c, "light-color", v, 2, &n, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--light-color holds 3 numbers, room for 2");
+  cr_expect_eq(n, 0);
+  cr_expect_eq(bb_command_numbers(c, "normal", v, 4, NULL, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--normal takes no numbers");
+  cr_expect_eq(bb_command_numbers(c, "lihgt", v, 4, NULL, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "unknown option '--lihgt' (did you mean --light?)");
+  /* floats of every size held come back as themselves */
+  char text[64];
+  unsigned seed = 12345;
+  for (int i = 0; i < 2000; i++) {
+    float f[3];
+    for (int k = 0; k < 3; k++) {
+      seed = seed * 1103515245u + 12345u;
+      f[k] = (float)ldexp((double)(seed >> 8) / 16777216.0, (int)(seed % 9) - 6);
+    }
+    snprintf(text, sizeof text, "%.9g,%.9g,%.9g", (double)f[0], (double)f[1], (double)f[2]);
+    cr_assert_eq(bb_command_set(c, "light-color", text, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb_command_numbers(c, "light-color", v, 3, NULL, &err), BB_OK, "%s",
+                 err.message);
+    for (int k = 0; k < 3; k++)
+      cr_assert((float)v[k] == held[k], "%s: %.9g against %.9g", text, v[k], (double)held[k]);
+  }
+  bb_command_free(c);
+
+  const char *rbf[] = {"m.obj", "--size", "256 128", "--samples", "3", NULL};
+  c = command("renderbumpflat", rbf);
+  cr_assert_eq(bb_command_numbers(c, "size", v, 4, &n, &err), BB_OK, "%s", err.message);
+  cr_expect(n == 2 && v[0] == 256.0 && v[1] == 128.0, "%d: %g %g", n, v[0], v[1]);
+  cr_assert_eq(bb_command_numbers(c, "samples", v, 1, &n, &err), BB_OK, "%s", err.message);
+  cr_expect(n == 1 && v[0] == 3.0, "%g", v[0]);
+  bb_command_free(c);
+}
+
 /* bb_command_value: an option's value as the command holds it, spelled as
  * bb_command_text spells it, given or not; and serve's own options, which
  * land in no field of the options (--port, --address): the text given,
