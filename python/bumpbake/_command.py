@@ -383,18 +383,3 @@ class _Options:
     def maps_normal_y_up(self):
         """--normal-y up: the normal maps read (or written) are OpenGL-style."""
         return int(self._command.value("normal-y") == "up")
-
-    @property
-    def map_kind(self):
-        """combine's --kind, a bb_map_kind."""
-        return self._command.word("kind")
-
-    @property
-    def ssbump_kind(self):
-        """ssbump2normal's --kind: BB_MAP_SSBUMP or BB_MAP_WEIGHTS."""
-        return self._command.word("kind")
-
-    @property
-    def mix(self):
-        """combine's --mix (the value spelled exactly: the same double)."""
-        return float(self._command.value("mix"))
