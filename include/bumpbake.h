@@ -1968,7 +1968,7 @@ bb_status bb_check_plan(bb_command *command, const bb_command_hooks *hooks, bb_c
 /* What `info` found of one file (bb_command_result.info): what its header
  * says, or why it could not be read. Owned by the result. */
 typedef struct bb_info_file {
-  const char *path;            /* the input, as given */
+  const char *path;            /* the input, as given (a copy the result owns) */
   bb_status status;            /* BB_OK, or why the header could not be read */
   const char *error;           /* then the reason, naming the file; else NULL */
   int width, height, channels;
@@ -1993,7 +1993,8 @@ typedef struct bb_command_print {
                        escaped), each ending in '\n'; 1: a one-line message
                        for stderr, after the client's name ("bumpbake: ") */
   const char *path; /* an error about this file, which the client names
-                       before text unless text starts with it; or NULL */
+                       before text unless text starts with it (a copy the
+                       result owns); or NULL */
   char *text;
 } bb_command_print;
 

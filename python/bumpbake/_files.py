@@ -49,9 +49,10 @@ _PROVENANCE_CLASSES = {_lib.BB_PROVENANCE_NONE: "none", _lib.BB_PROVENANCE_INTAC
 
 def _run_files(command, *inputs, options=None, notes="ignore", stacklevel=2):
     """Runs compare or info through the library as the command line runs
-    them (bb_command_run) and hands (command, result) to the caller, who
-    reads the report's data (result.compare, result.info) and frees the
-    result (bb_command_result_free). options: keywords checked by the
+    them (bb_command_run) and hands the result to the caller, who reads the
+    report's data (result.compare, result.info) and frees it
+    (bb_command_result_free); the result owns its strings, so the command
+    may be freed first. options: keywords checked by the
     library; notes: what the run says first (bake_file()'s policy)."""
     c = Command(command)
     for p in inputs:

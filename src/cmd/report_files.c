@@ -36,17 +36,21 @@ typedef struct printer {
   int failed; /* out of memory */
 } printer;
 
+/* The result keeps its own copy of path: the command that named it may be
+ * freed before the result is read. */
 static bb_status add_piece(printer *p, int error, const char *path, char *text) {
   bb_command_print *grown =
       realloc((bb_command_print *)p->r->prints, ((size_t)p->r->print_count + 1) * sizeof *grown);
-  if (!grown || !text) {
+  char *kept = path ? strdup(path) : NULL;
+  if (!grown || !text || (path && !kept)) {
     free(text);
+    free(kept);
     p->failed = 1;
     if (grown)
       p->r->prints = grown;
     return BB_ERR_MEMORY;
   }
-  grown[p->r->print_count++] = (bb_command_print){error, path, text};
+  grown[p->r->print_count++] = (bb_command_print){error, kept, text};
   p->r->prints = grown;
   return BB_OK;
 }

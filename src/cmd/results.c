@@ -25,6 +25,7 @@ bb_status bb__result_add(bb_command_result *r, const char *kind, const char *pat
 static void info_files_free(bb_info_file *files, int count) {
   for (int i = 0; files && i < count; i++) {
     bb_info_file *f = &files[i];
+    free((char *)f->path);
     free((char *)f->error);
     free((bb_provenance_entry *)f->provenance_entries);
     bb_image_info_free(&f->image);
@@ -49,8 +50,10 @@ void bb_command_result_free(bb_command_result *r) {
     free((bb_compare_report *)r->compare);
   }
   info_files_free((bb_info_file *)r->info, r->info_count);
-  for (int i = 0; i < r->print_count; i++)
+  for (int i = 0; i < r->print_count; i++) {
+    free((char *)r->prints[i].path);
     free(r->prints[i].text);
+  }
   free((bb_command_print *)r->prints);
   memset(r, 0, sizeof *r);
 }

@@ -41,7 +41,9 @@ bb_status bb__run_compare(bb_command *c, const bb_command_hooks *hooks, bb_comma
  * status and message. BB_ERR_MEMORY alone fails. */
 static bb_status info_file(const char *path, bb_info_file *f, bb_error *err) {
   bb_error e = {{0}};
-  f->path = path;
+  f->path = strdup(path); /* the result's own: the command may go first */
+  if (!f->path)
+    return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   f->status = bb_image_read_info(path, &f->width, &f->height, &f->channels, &f->image, &e);
   if (f->status != BB_OK) {
     f->error = strdup(e.message[0] ? e.message : bb_status_name(f->status));

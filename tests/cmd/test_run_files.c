@@ -207,6 +207,11 @@ Test(run_files, info_keeps_each_files_header_and_provenance) {
   bb_command_result r;
   bb_command *c = run("info", (const char *const[]){p, missing, q, NULL}, &r);
   cr_assert_eq(r.info_count, 3);
+  /* the result owns its strings: read after the command is freed, as a
+   * client that lets its command go first (Python's info) reads it */
+  cr_expect(r.info[0].path != bb_command_input(c, 0));
+  cr_expect(r.prints[1].path != bb_command_input(c, 1));
+  bb_command_free(c);
   const bb_info_file *f = &r.info[0];
   cr_expect_str_eq(f->path, p);
   cr_expect_eq(f->status, BB_OK);
@@ -247,7 +252,6 @@ Test(run_files, info_keeps_each_files_header_and_provenance) {
   cr_expect(ends_with(r.prints[2].text, "no bumpbake provenance\ndescription: made elsewhere\n"),
             "%s", r.prints[2].text);
   bb_command_result_free(&r);
-  bb_command_free(c);
 
   /* --json: a line per file, the missing one's saying so */
   c = run("info", (const char *const[]){missing, p, "--json", "1", NULL}, &r);
