@@ -86,7 +86,7 @@ def _basis(spec):
     v = np.asarray(spec, dtype=np.float64)
     if v.ndim != 2 or v.shape[1] != 3:
         raise _argument_error(f"basis vectors must be an (N, 3) array (got shape {v.shape})")
-    v = np.ascontiguousarray(v)
+    v = np.require(v, requirements=("C", "A"))
     _check(_lib.bb_basis_from_vectors(_ffi.cast("const double (*)[3]", _ffi.from_buffer(v)),
                                       v.shape[0], out, err), err)
     return out, None

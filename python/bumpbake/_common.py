@@ -297,7 +297,9 @@ class _Image:
         if channels is not None and a.shape[2] not in channels:
             raise _argument_error(f"{what} must have {' or '.join(map(str, channels))} "
                                   f"channels (got shape {a.shape[:2] + (a.shape[2],)})")
-        self.array = np.ascontiguousarray(a, dtype=np.float32)
+        # contiguous and aligned: an array on an odd offset of a buffer (numpy
+        # allows it) would be read by the library through misaligned floats
+        self.array = np.require(a, dtype=np.float32, requirements=("C", "A"))
         rows, cols, chans = self.array.shape
         self.image = _ffi.new("bb_image *")
         self.image.width, self.image.height, self.image.channels = cols, rows, chans

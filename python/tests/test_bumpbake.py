@@ -81,6 +81,23 @@ def test_integer_heights_are_value_over_max_code():
     assert abs(a[16, 19, 0]) > 0.3
 
 
+def test_a_misaligned_array_is_handed_over_aligned():
+    """numpy lets an array start at any byte of a buffer; the library reads
+    floats, so what it is given is an aligned copy, and the bake the same."""
+    rng = np.random.default_rng(7)
+    h = rng.random((24, 20), dtype=np.float32)
+    raw = bytearray(h.nbytes + 1)
+    odd = np.frombuffer(raw, dtype=np.float32, count=h.size, offset=1).reshape(h.shape)
+    odd[...] = h
+    assert not odd.flags.aligned
+    from bumpbake._common import _Image
+    assert _Image("height", odd).array.flags.aligned
+    a = bumpbake.bake(odd, 4.0, outputs=("normal", "ao"), rays=16)
+    b = bumpbake.bake(h, 4.0, outputs=("normal", "ao"), rays=16)
+    for k in a:
+        assert np.array_equal(a[k], b[k])
+
+
 def test_rgba_heights_follow_the_channel_rule():
     h = bump()
     rgba = np.zeros((32, 32, 4), np.float32)

@@ -340,7 +340,9 @@ class _SplitTrace:
     def _accumulate(self, rays, rank, horizon, vis, err):
         img = _ffi.new("bb_image *")
         img.width, img.height, img.channels = horizon.shape[1], horizon.shape[0], 1
-        keep = _ffi.from_buffer("float[]", np.ascontiguousarray(horizon, dtype=np.float32))
+        # aligned: what comes back from a worker may sit at any offset of its frame
+        keep = _ffi.from_buffer("float[]", np.require(horizon, dtype=np.float32,
+                                                      requirements=("C", "A")))
         img.pixels = keep
         _check(_lib.bb_trace_accumulate(rays, rank, img, vis, _DRIVER_THREADS, err), err)
 
