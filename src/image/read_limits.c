@@ -34,17 +34,18 @@ static bb_status check_texels(const char *path, int width, int height, bb_error 
 bb_status bb__read_check_probe(const char *path, const bb__probe *p, int reading,
                                bb_error *err) {
   if (!p->format) return BB_OK;
+  /* Tables the file cannot hold: corrupt, whatever their size. */
+  if (p->table_bytes > p->file_bytes)
+    return bb__fail(err, BB_ERR_FORMAT,
+                    "%s: corrupt image: its header declares %.0f %s, more than the file "
+                    "of %.0f bytes can list",
+                    path, p->table_bytes / 8.0, p->table_entries, p->file_bytes);
   if (p->open_bytes > (double)BB_MAX_READ_BYTES)
     return bb__fail(err, BB_ERR_SIZE,
                     "%s: too large to read: a %s of %dx%d needs %.0f MiB to open (bumpbake "
                     "reads at most %ld MiB of samples)",
                     path, p->format, p->width, p->height, p->open_bytes / (double)MiB,
                     BB_MAX_READ_BYTES / MiB);
-  if (p->table_bytes > p->file_bytes)
-    return bb__fail(err, BB_ERR_FORMAT,
-                    "%s: corrupt image: its header declares %.0f chunks, more than the file "
-                    "of %.0f bytes can list",
-                    path, p->table_bytes / 8.0, p->file_bytes);
   if (p->chunk_bytes > (double)BB__MAX_CHUNK_BYTES)
     return bb__fail(err, BB_ERR_SIZE,
                     "%s: too large to read: %s blocks of %.0f MiB each (bumpbake decodes at "

@@ -3,7 +3,8 @@
  * progressive JPEG of 65500 x 65500 (8.5 GB and 21 s for `info`), a 1 x 1
  * TIFF of 16384 x 16384 tiles (8.5 GB for `bake`), a 91-byte EXR with a
  * 2 GB string attribute (2.2 GB for `info`), GIFs of 65535 x 65535
- * ("vector::_M_default_append"). Each read says what is wrong in one line,
+ * ("vector::_M_default_append"), an RLE SGI declaring 6.6 GB of offset
+ * tables in 109 bytes. Each read says what is wrong in one line,
  * at once, with bounded memory; the CLI does too under `ulimit -v
  * 2000000`. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw, realpath (cli_harness.h) */
@@ -135,6 +136,28 @@ Test(hostile_headers, a_gif_screen_too_large_to_open_says_so) {
 #endif
 }
 
+/* An RLE SGI's offset tables lie in the file: a header declaring more
+ * rows and channels than the file can list is refused before OpenImageIO
+ * zeroes 8 bytes for each (65535 x 65535 of them: 34 GB), and the same
+ * file declaring what it holds reads. */
+Test(hostile_headers, sgi_offset_tables_longer_than_the_file_are_refused) {
+  const char *path = tmp("r.sgi");
+  cr_assert_eq(write_sgi_rle(path, 65535, 65535), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "declares 4294836225 RLE rows, more than the file of 544 bytes");
+  const char *fine = tmp("f.sgi");
+  cr_assert_eq(write_sgi_rle(fine, 2, 1), 0);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(fine, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 1);
+  /* SGI's rows run bottom to top: the file's first row is the image's last. */
+  const float want[4] = {90 / 255.f, 30 / 255.f, 10 / 255.f, 200 / 255.f};
+  for (int i = 0; i < 4; i++)
+    cr_expect_float_eq(img.pixels[i], want[i], 1e-6, "texel %d: %g", i, img.pixels[i]);
+  bb_image_free(&img);
+}
+
 /* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
  * extension index, then the file): each made OpenImageIO's reader allocate
  * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
@@ -150,6 +173,8 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
       {"exr-header-two-parsers-read-differently", ".exr", "'compression' attribute not found"},
       {"gif-of-another-version-with-a-huge-screen", ".gif", "a GIF of 14616x29285 needs 1633 MiB"},
       {"png-text-chunk-of-1.7-gb", ".png", "Read error: hit end of file"},
+      {"sgi-rle-offset-tables-of-6.6-gb", ".sgi",
+       "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
   };
   for (size_t i = 0; i < sizeof finds / sizeof finds[0]; i++) {
     char from[256];
