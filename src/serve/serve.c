@@ -94,11 +94,15 @@ int cli_run_serve(const cli_run *r) {
   if (st != BB_OK)
     return cli_status_exit(height, st, &err);
   /* The options and files checked once by the library before serving. */
-  bb_job_options o;
-  serve_job_options(&s, &o);
+  bb_command *planned = NULL;
   bb_job *job = NULL;
-  st = bb_job_plan(&height, 1, &o, &job, &err);
+  char *planned_line = NULL;
+  st = serve_bake_command(&s, &planned, &planned_line, &err);
+  if (st == BB_OK)
+    st = bb_command_plan(planned, NULL, &job, &err);
   bb_job_free(job);
+  bb_command_free(planned);
+  free(planned_line);
   if (st != BB_OK)
     return cli_library_error("serve", st, &err);
 

@@ -134,8 +134,18 @@ bb_region serve_part_region(const serve_bake *b, int t);
  * baked from, or -1 when every one is as baked. Reads the files; the
  * caller does not hold the lock (watched is set before any thread runs). */
 int serve_inputs_changed(const serve_state *s, const serve_bake *b);
-/* The job options a bake or a write uses now (the caller holds the lock). */
-void serve_job_options(const serve_state *s, bb_job_options *o);
+
+/* serve_command.c: the `bumpbake bake` command of the options now (the
+ * caller holds the lock): the page's command's options that bake takes at
+ * other values than bake's defaults, and the write action's files
+ * (job.paths), checked, into *out (free with bb_command_free); and *line,
+ * the line its files record and the page shows (malloc'd): the options
+ * as bb_command_text spells them, less --rays under --slices and --bounce
+ * 1 under --bounce-albedo, which the bake takes but the line has never
+ * named. A bake or a write plans through it (bb_command_plan). err not
+ * NULL. */
+bb_status serve_bake_command(const serve_state *s, bb_command **out, char **line,
+                             bb_error *err);
 
 /* serve_watch.c: watches the directories of s->watched with inotify and
  * asks for a bake when one of the files is saved (renamed over, or written

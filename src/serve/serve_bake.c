@@ -78,21 +78,6 @@ int serve_inputs_changed(const serve_state *s, const serve_bake *b) {
   return -1;
 }
 
-void serve_job_options(const serve_state *s, bb_job_options *o) {
-  *o = s->job;
-  /* the parameters, as bake takes them */
-  o->bake = s->settings.bake;
-  o->channel = s->settings.channel;
-  o->depth = s->settings.depth;
-  o->mips = s->settings.mips;
-  o->texture = s->settings.texture;
-  o->basis_file = s->settings.basis_file;
-  o->brightness_file = s->use_brightness ? s->brightness_file : NULL;
-  o->force = 1;      /* a single bake always bakes */
-  o->command = NULL; /* provenance: bb_job_command_text, the line the page shows */
-  o->note = NULL;
-}
-
 /* ------------------------------------------------------------- progress */
 
 typedef struct progress_ctx {
@@ -360,9 +345,11 @@ static int is_edit_of(const serve_bake *b, const serve_bake *shown, long context
 
 /* One bake of the options as they are now; publishes it or the error. */
 static void bake_once(serve_state *s, long wanted) {
-  bb_job_options o;
+  bb_error err = {{0}};
+  bb_command *command = NULL;
+  char *spelled = NULL; /* the line its files record */
   pthread_mutex_lock(&s->lock);
-  serve_job_options(s, &o);
+  bb_status st = serve_bake_command(s, &command, &spelled, &err);
   const char *input = s->height_path;
   s->baking = 1;
   s->stage = "load and smooth";
@@ -380,16 +367,16 @@ static void bake_once(serve_state *s, long wanted) {
   for (int i = 1; i < s->watched_count; i++)
     if (bb_file_hash(s->watched[i], &hashes[i], NULL) != BB_OK)
       hashes[i] = 0;
-  bb_error err = {{0}};
   bb_job *job = NULL;
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   serve_bake *b = NULL;
-  bb_status st =
-      folder_gone(&o, input, &err) ? BB_ERR_IO : bb_job_plan(&input, 1, &o, &job, &err);
+  const bb_job_options *o = bb_command_job_options(command); /* NULL for NULL */
+  if (st == BB_OK)
+    st = folder_gone(o, input, &err) ? BB_ERR_IO : bb_command_plan(command, NULL, &job, &err);
   if (st == BB_OK) {
-    const int bounces = o.bake.bounce_albedo > 0.0 || o.bounce_albedo_file;
-    progress_ctx p = {s, wanted, bounces ? bb_bake_slices(&o.bake) : 0, 0, 0};
+    const int bounces = o->bake.bounce_albedo > 0.0 || o->bounce_albedo_file;
+    progress_ctx p = {s, wanted, bounces ? bb_bake_slices(&o->bake) : 0, 0, 0};
     st = bake_maps(s, job, &p, &result, &err);
   }
   const int context_baked = st == BB_OK; /* the context's last bake is this one now */
@@ -413,10 +400,11 @@ static void bake_once(serve_state *s, long wanted) {
       b->basis = b->maps.basis;
       b->report = *rep;
       b->report.input = NULL;
-      b->command = bb_job_command_text(&o, input);
-      b->provenance = provenance_of(&o, rep, &b->maps, b->command, input);
-      b->normal_y_up = o.bake.normal_y_up;
-      b->scale = (double)o.bake.height_scale;
+      b->command = spelled;
+      spelled = NULL;
+      b->provenance = provenance_of(o, rep, &b->maps, b->command, input);
+      b->normal_y_up = o->bake.normal_y_up;
+      b->scale = (double)o->bake.height_scale;
       b->tex[SERVE_TEX_ALBEDO] = albedo;
       albedo = NULL;
       b->seconds = now_seconds() - t0;
@@ -430,6 +418,8 @@ static void bake_once(serve_state *s, long wanted) {
   }
   bb_bake_result_free(&result);
   bb_job_free(job);
+  bb_command_free(command);
+  free(spelled);
   free(albedo);
 
   pthread_mutex_lock(&s->lock);

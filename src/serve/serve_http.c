@@ -450,14 +450,12 @@ static enum MHD_Result apply_params(server *sv, struct MHD_Connection *c) {
  * control came after it (nothing pending, in flight or failed since), and
  * its command line is the one of the options now. Else NULL. The caller
  * holds the lock. */
-static serve_bake *bake_of_now(serve_state *s, const bb_job_options *o) {
+static serve_bake *bake_of_now(serve_state *s, const char *command) {
   serve_bake *b = s->current;
   if (!b || !b->job || s->baking || s->error[0] || atomic_load(&s->wanted) != s->done ||
       b->wanted != s->done)
     return NULL;
-  char *command = bb_job_command_text(o, s->height_path);
-  const int same = command && b->command && strcmp(command, b->command) == 0;
-  free(command);
+  const int same = b->command && strcmp(command, b->command) == 0;
   return same ? serve_maps_use(s) : NULL;
 }
 
@@ -468,13 +466,19 @@ static serve_bake *bake_of_now(serve_state *s, const bb_job_options *o) {
  * save or control still pending, or Valve's detail variant). The reply is
  * the line `bake --json` prints, with "from" saying which (malloc'd). */
 static char *write_maps(serve_state *s, unsigned *status) {
-  bb_job_options o;
-  pthread_mutex_lock(&s->lock);
-  serve_job_options(s, &o);
-  const char *input = s->height_path;
-  serve_bake *b = bake_of_now(s, &o);
-  pthread_mutex_unlock(&s->lock);
   bb_error err = {{0}};
+  bb_command *command = NULL;
+  char *line = NULL;
+  pthread_mutex_lock(&s->lock);
+  const bb_status made = serve_bake_command(s, &command, &line, &err);
+  serve_bake *b = made == BB_OK ? bake_of_now(s, line) : NULL;
+  free(line);
+  pthread_mutex_unlock(&s->lock);
+  if (made != BB_OK) {
+    *status = 422;
+    return error_json(err.message[0] ? err.message : bb_status_name(made));
+  }
+  const bb_job_options *o = bb_command_job_options(command);
   bb_status st = BB_ERR_ARGUMENT;
   const char *from = "memory";
   char reason[PATH_MAX + 64] = "a save or a control came after the bake shown";
@@ -499,7 +503,7 @@ static char *write_maps(serve_state *s, unsigned *status) {
     if (st == BB_OK) {
       FILE *f = open_memstream(&text, &size);
       if (f) {
-        bb_job_report_json(f, &o.bake, bb_job_report_get(b->job, 0), "written", NULL);
+        bb_job_report_json(f, &o->bake, bb_job_report_get(b->job, 0), "written", NULL);
         fclose(f);
       }
     }
@@ -511,7 +515,7 @@ static char *write_maps(serve_state *s, unsigned *status) {
     free(text);
     text = NULL;
     memset(&err, 0, sizeof err);
-    st = bb_job_plan(&input, 1, &o, &job, &err);
+    st = bb_command_plan(command, NULL, &job, &err);
     if (st == BB_OK) {
       st = bb_job_run_item(job, 0, NULL, NULL);
       if (st != BB_OK)
@@ -520,7 +524,7 @@ static char *write_maps(serve_state *s, unsigned *status) {
     if (st == BB_OK) {
       FILE *f = open_memstream(&text, &size);
       if (f) {
-        bb_job_report_json(f, &o.bake, bb_job_report_get(job, 0), "written", NULL);
+        bb_job_report_json(f, &o->bake, bb_job_report_get(job, 0), "written", NULL);
         fclose(f);
       }
     }
@@ -535,6 +539,7 @@ static char *write_maps(serve_state *s, unsigned *status) {
   if (!s->quiet && st == BB_OK)
     fprintf(stderr, "serve: wrote the maps (%s)\n",
             strcmp(from, "memory") ? "baked again" : "from the bake shown");
+  bb_command_free(command);
   if (st != BB_OK) {
     free(text);
     *status = 422;

@@ -150,9 +150,11 @@ char *serve_json_text(void (*write)(bb__json *j, void *arg), void *arg) {
 static void write_state(bb__json *j, void *arg) {
   serve_state *s = arg;
   pthread_mutex_lock(&s->lock);
-  bb_job_options o;
-  serve_job_options(s, &o);
-  char *command = bb_job_command_text(&o, s->height_path);
+  bb_command *bake = NULL;
+  char *command = NULL;
+  bb_error err = {{0}};
+  serve_bake_command(s, &bake, &command, &err); /* NULL on failure: no line */
+  bb_command_free(bake);
   bb__json_open(j, NULL, '{');
   bb__json_string(j, "height", s->height_path);
   bb__json_bool(j, "baking", s->baking);
