@@ -174,9 +174,9 @@ const char *bb_text_printable(const char *s, char *out, size_t cap);
  * paths and values keep their bytes), else in single quotes with each
  * quote in it given as '\'' ("my rock.png" -> 'my rock.png', "" -> '').
  * sh reads back the word itself, whatever its bytes. Every command line
- * the library spells (the provenance's command, bb_job_command_text,
- * bb_command_text) quotes its words so; a client that records the words
- * typed (bb_command_set_record) quotes them with this. malloc'd; NULL
+ * the library spells (the provenance's command, bb_command_text) quotes
+ * its words so; a client that records the words typed
+ * (bb_command_set_record) quotes them with this. malloc'd; NULL
  * when word is NULL or out of memory. */
 char *bb_text_shell_quoted(const char *word);
 
@@ -1423,8 +1423,8 @@ typedef struct bb_job_options {
   const char *command_options; /* what follows "bumpbake bake INPUT" in each
                                 output's command (a batch's, or a single input's
                                 when command is NULL); NULL for both: the options
-                                written out by bb_job_command_text.
-                                bb_command_plan sets them */
+                                that differ from their defaults, as `bumpbake
+                                bake` spells them. bb_command_plan sets them */
   bb_note_fn note;           /* notes about inputs (may be NULL) */
   void *note_user;
   /* Engine textures and a Source material: */
@@ -1501,23 +1501,6 @@ typedef struct bb_job_report {
   double seconds_compress;    /* the engine textures' block compression (.vtf,
                                  .dds), a part of seconds_write; 0 when none */
 } bb_job_report;
-
-/* Plans a job over inputs[0..input_count-1]: files, and directories, which
- * give the image files in them (not below), sorted by name, leaving out
- * names starting with '.' and files whose provenance says bumpbake baked
- * them as maps (so a directory can be its own out_dir); a file named twice
- * counts once. Every option and every output path is checked here, before
- * any bake (bb_outputs_check for each input's outputs against every input;
- * clashes across the whole batch; the depfile against every input and
- * output); out_dir and the template's subfolders, or a single input's
- * output folders (not the depfile's), are created. A directory as the one
- * input without out_dir is BB_ERR_ARGUMENT. Errors:
- * BB_ERR_ARGUMENT (a usage error: bad option, template or map name, a
- * clash, no output), BB_ERR_IO (an output over an input, a directory that
- * cannot be made or read), BB_ERR_MEMORY. On success *out receives the
- * job; free it with bb_job_free. */
-bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
-                      bb_job **out, bb_error *err);
 
 void bb_job_free(bb_job *job);
 
@@ -1598,18 +1581,6 @@ bb_status bb_job_run(bb_job *job, bb_progress_fn progress, void *progress_user,
  * end. BB_OK when the job has no depfile. */
 bb_status bb_job_write_depfile(bb_job *job, bb_error *err);
 
-/* The command line of options o, as the provenance of a job without
- * command or command_options records it: "bumpbake bake INPUT" and then
- * every option that differs from its default, in the order of `bumpbake
- * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
- * --maps normal,ao --name T ... --texture-format bc3 --vtf-version 7.3
- * --nomip --vmt FILE; the threads are left out). A CLI invocation typed
- * this way records the same text, so the same job through the CLI and
- * through Python writes the same bytes. (Python's jobs still plan with it;
- * bb_command_text spells any command through the descriptions.) malloc'd;
- * NULL when out of memory. */
-char *bb_job_command_text(const bb_job_options *o, const char *input);
-
 /* --------------------------------------------------- up-to-date checks */
 
 /* What a build tool needs to skip a bake whose outputs are already what it
@@ -1670,9 +1641,9 @@ typedef enum bb_option_type {
 const char *bb_option_type_name(bb_option_type type);
 
 /* Which of a command's uses an option belongs to (for --help and the
- * reference pages). The job is where the rule lives: bb_job_plan refuses a
+ * reference pages). The job is where the rule lives: its plan refuses a
  * single bake's options in a batch and a batch's without out_dir, for
- * every client (bb_command_plan, and callers of the job API). */
+ * every client (bb_command_plan). */
 typedef enum bb_option_mode {
   BB_MODE_ANY = 0,    /* every use */
   BB_MODE_SINGLE,     /* one input, outputs named one by one */
@@ -1884,8 +1855,8 @@ bb_status bb_command_numbers(const bb_command *command, const char *name, double
 /* The options of the command's bake as set and checked (bake, normal,
  * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
  * and texture settings of every command writing maps): what a client that
- * bakes through the stage API (bb_bake) or plans its own jobs (bb_job_plan)
- * hands on. Owned by command; NULL for NULL. Every other option is read by
+ * reads the bake's settings (bb_bake_slices, bb_job_report_json) hands
+ * on. Owned by command; NULL for NULL. Every other option is read by
  * name (bb_command_value). */
 const bb_job_options *bb_command_job_options(const bb_command *command);
 /* What a client that takes its options as keywords asks of render's and
@@ -1939,14 +1910,14 @@ typedef struct bb_command_hooks {
 } bb_command_hooks;
 
 /* Plans a checked command that writes through the job (bake, normal,
- * height2ssbump): its options as a bb_job_options, planned by bb_job_plan
+ * height2ssbump): its options as a bb_job_options, planned by the job
  * (every output named and checked against every input, provenance,
  * depths, staged all-or-nothing writes, up-to-date checks), without
  * checking again what bb_command_check checked. A single input is baked
  * even when its outputs are current, as the command line does (run it with
  * bb_job_run_item after bb_job_check_current to skip it). Run it with
  * bb_job_run; free it with bb_job_free. hooks may be NULL. Errors: those of
- * bb_job_plan; BB_ERR_ARGUMENT for an unchecked command or one that has no
+ * the job's plan; BB_ERR_ARGUMENT for an unchecked command or one that has no
  * job. */
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,
                           bb_error *err);

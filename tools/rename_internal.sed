@@ -172,3 +172,8 @@ s/\bbb_bake_result_image\b/bb__bake_result_image/g
 s/\bbb_bake_context_bake\b/bb__bake_context_bake/g
 s/\bbb_bake\b/bb__bake_checked/g
 s/\bbb_bake_options_init\b/bb__bake_options_init/g
+# a job planned from the caller's own options, and the line such a job
+# records: serve, their last client, plans through its bake command
+# (bb_command_plan) now.
+s/\bbb_job_plan\b/bb__job_plan_options/g
+s/\bbb_job_command_text\b/bb__job_command_text/g

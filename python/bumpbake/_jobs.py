@@ -76,7 +76,7 @@ def _report(r, status=None):
 
 
 class BakeJob:
-    """A planned bake of files (bb_job_plan): every option, input and output
+    """A planned bake of files (bb_command_plan): every option, input and output
     path checked, out_dir and its subfolders made, nothing baked yet.
 
         job = bumpbake.BakeJob(["heights/"], out_dir="maps", scale=16)

@@ -50,7 +50,7 @@ def cli_statuses(out):
 
 def test_a_batch_is_the_cli_batch_byte_for_byte(tmp_path, monkeypatch, fixtures, cli):
     """bake_files and `bumpbake bake DIR ... --out-dir OUT` typed as
-    bb_job_command_text spells the options, from one directory with the
+    the library spells the options, from one directory with the
     same relative names: the same files, byte for byte, and the same
     up-to-date decisions on a re-run and after an input changed."""
     monkeypatch.chdir(tmp_path)

@@ -1,7 +1,7 @@
 /* bake_rows.h: the bake's options described once, below the commands (not
  * public): each row is an option's name, where its value is in
  * bb_job_options, how the value is written as the command line takes it,
- * and when it differs from bb__job_options_init's. bb_job_command_text
+ * and when it differs from bb__job_options_init's. bb__job_command_text
  * walks bb__bake_rows to spell a job as `bumpbake bake`; the commands
  * family's rows of these options (cmd/options_bake.c) point at them for
  * their name, field, words and printing, and add what only a command needs

@@ -15,7 +15,7 @@
  * of `bumpbake bake --help` (bb__bake_rows: each row says when it is
  * written and how). threads is no row: the bytes are the same for any
  * count. */
-char *bb_job_command_text(const bb_job_options *o, const char *input) {
+char *bb__job_command_text(const bb_job_options *o, const char *input) {
   if (!o || !input)
     return NULL;
   bb_job_options d;
@@ -46,7 +46,7 @@ char *bb__job_command_of(const bb_job *job, const bb__job_item *item) {
   if (!job->command_options) {
     bb_job_options as_given = job->options; /* rays spelled as asked, not resolved */
     as_given.bake.slices = job->asked_slices;
-    return bb_job_command_text(&as_given, item->input);
+    return bb__job_command_text(&as_given, item->input);
   }
   /* "bumpbake bake INPUT OPTIONS", as a batch run by hand records it (the
    * options as the caller's record quoted them, or as bb__add_options

@@ -158,7 +158,40 @@ typedef struct bb__job_more {
   const char *first_commands[BB_MAP_BAKED_COUNT];
 } bb__job_more;
 
-/* bb_job_plan; flags: BB__PLAN_CHECKED: o's bake options were checked
+/* Once in bumpbake.h, now internal (issue 41): no client of the library
+ * plans a job of its own options since serve plans through its bake
+ * command (bb_command_plan); the tests and the command's plan do. */
+
+/* Plans a job over inputs[0..input_count-1]: files, and directories, which
+ * give the image files in them (not below), sorted by name, leaving out
+ * names starting with '.' and files whose provenance says bumpbake baked
+ * them as maps (so a directory can be its own out_dir); a file named twice
+ * counts once. Every option and every output path is checked here, before
+ * any bake (bb_outputs_check for each input's outputs against every input;
+ * clashes across the whole batch; the depfile against every input and
+ * output); out_dir and the template's subfolders, or a single input's
+ * output folders (not the depfile's), are created. A directory as the one
+ * input without out_dir is BB_ERR_ARGUMENT. Errors:
+ * BB_ERR_ARGUMENT (a usage error: bad option, template or map name, a
+ * clash, no output), BB_ERR_IO (an output over an input, a directory that
+ * cannot be made or read), BB_ERR_MEMORY. On success *out receives the
+ * job; free it with bb_job_free. */
+bb_status bb__job_plan_options(const char *const *inputs, int input_count,
+                               const bb_job_options *o, bb_job **out, bb_error *err);
+
+/* The command line of options o, as the provenance of a job without
+ * command or command_options records it: "bumpbake bake INPUT" and then
+ * every option that differs from its default, in the order of `bumpbake
+ * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
+ * --maps normal,ao --name T ... --texture-format bc3 --vtf-version 7.3
+ * --nomip --vmt FILE; the threads are left out). A CLI invocation typed
+ * this way records the same text, so the same job through the CLI and
+ * through Python writes the same bytes. (bb_command_text spells any
+ * command through the descriptions.) malloc'd;
+ * NULL when out of memory. */
+char *bb__job_command_text(const bb_job_options *o, const char *input);
+
+/* bb__job_plan_options; flags: BB__PLAN_CHECKED: o's bake options were checked
  * already (a command's, cmd/plan.c) and are only resolved
  * (bb__bake_resolve); BB__PLAN_READ_ONLY: a plan whose outputs are read,
  * not written (a golden check): no directory is made, and none need exist;

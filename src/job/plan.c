@@ -908,7 +908,7 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
   return BB_OK;
 }
 
-bb_status bb_job_plan(const char *const *inputs, int input_count, const bb_job_options *o,
+bb_status bb__job_plan_options(const char *const *inputs, int input_count, const bb_job_options *o,
                       bb_job **out, bb_error *err) {
   return bb__job_plan(inputs, input_count, o, 0, NULL, out, err);
 }

@@ -45,7 +45,7 @@ static double job_estimate(const char *input, unsigned outputs, int side) {
     if (outputs & BB_MAP_BIT(k)) o.paths[k] = tmp(names[k]);
   bb_job *job = NULL;
   bb_error err;
-  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   const double bytes = bb__job_memory(job, &job->items[0], side, side, 1);
   bb_job_free(job);
   return bytes;

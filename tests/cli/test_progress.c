@@ -4,6 +4,7 @@
 #define _DEFAULT_SOURCE /* forkpty */
 
 #include "job/bake_rows.h"
+#include "job/job_internal.h"
 #include "cli/common.h"
 #include "cli/progress.h"
 #include "image/image_write.h"
@@ -75,7 +76,7 @@ Test(progress, a_jobs_block_compression_has_its_own_bar) {
     o.paths[BB_MAP_SSBUMP] = vtf;
     const char *input = height;
     bb_job *job = NULL;
-    if (bb_job_plan(&input, 1, &o, &job, NULL) != BB_OK)
+    if (bb__job_plan_options(&input, 1, &o, &job, NULL) != BB_OK)
       _exit(5);
     cli_progress p;
     cli_progress_start(&p, "bake", 0);

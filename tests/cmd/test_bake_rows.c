@@ -1,12 +1,13 @@
 /* test_bake_rows.c: the bake's options described once (job/bake_rows.h).
  * For every row: a value other than the default, set through bake's
- * parser, is spelled by the job's command (bb_job_command_text) as the
+ * parser, is spelled by the job's command (bb__job_command_text) as the
  * option the command line reads, and that command read back through the
  * command API (bb_command_*) is the same job. A row without a sample here,
  * or a recorded option of bake without a row, fails: a new option cannot
  * be left out of the job's command. */
 #include "bumpbake.h"
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 
 #include <criterion/criterion.h>
 #include <stdlib.h>
@@ -103,7 +104,7 @@ static int split_words(const char *line, char **words, int cap) {
   return n;
 }
 
-/* The command bb_job_command_text's line reads back as: "bumpbake bake
+/* The command bb__job_command_text's line reads back as: "bumpbake bake
  * INPUT --option [value] ...". */
 static bb_command *read_back(const char *line) {
   char *words[128];
@@ -146,7 +147,7 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
     const bb_job_options *o = &bb__command_options_of(c)->job;
     cr_expect(bb__bake_row_differs(row, o, &defaults), "--%s %s is its default", s->name,
               s->value ? s->value : "");
-    char *text = bb_job_command_text(o, "h.png");
+    char *text = bb__job_command_text(o, "h.png");
     cr_assert_not_null(text);
 
     /* the option spelled as it was typed */
@@ -169,7 +170,7 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
     const bb_job_options *b = &bb__command_options_of(back)->job;
     cr_expect(bb__bake_row_differs(row, b, &defaults), "'%s' read back lost --%s", text,
               s->name);
-    char *again = bb_job_command_text(b, "h.png");
+    char *again = bb__job_command_text(b, "h.png");
     cr_expect_str_eq(again, text);
     free(again);
     bb_command_free(back);

@@ -192,7 +192,7 @@ Test(cmd, ranges_are_the_library_constants) {
 }
 
 /* An option of the other use refused by the command or its plan (the
- * job's rule, bb_job_plan), in words naming it or --out-dir. */
+ * job's rule, bb__job_plan_options), in words naming it or --out-dir. */
 static void refused_in_use(const char *const *base, const bb_option_info *o) {
   static const char *const values[] = {[BB_OPTION_PATH] = "x.png",
                                        [BB_OPTION_WORDS] = "normal",

@@ -305,7 +305,7 @@ Test(incremental, an_input_that_is_no_image_is_not_current) {
   const char *inputs[] = {tmp("in")};
   bb_job *job = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_job_plan(inputs, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(inputs, 1, &o, &job, &err), BB_OK, "%s", err.message);
   cr_assert_eq(bb_job_count(job), 2);
   int current = 1;
   cr_expect_eq(bb_job_check_current(job, 0, &current, &err), BB_OK, "%s", err.message);

@@ -1,4 +1,4 @@
-/* test_job.c: a bake job's plan (bb_job_plan) refusing bad options before
+/* test_job.c: a bake job's plan (bb__job_plan_options) refusing bad options before
  * any bake. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 #define _DEFAULT_SOURCE    /* wait4 (cli_harness.h) */
@@ -50,7 +50,7 @@ Test(job, slope_lit_light_is_checked_when_planned) {
     o.slope_lit_elevation = bad[i].elevation;
     bb_job *job = NULL;
     bb_error err = {{0}};
-    cr_expect_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_ERR_ARGUMENT, "case %zu", i);
+    cr_expect_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_ERR_ARGUMENT, "case %zu", i);
     cr_expect_str_eq(err.message, bad[i].message);
     cr_expect_null(job);
   }
@@ -59,7 +59,7 @@ Test(job, slope_lit_light_is_checked_when_planned) {
     o.slope_lit_elevation = el;
     bb_job *job = NULL;
     bb_error err = {{0}};
-    cr_expect_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%g: %s", el, err.message);
+    cr_expect_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%g: %s", el, err.message);
     bb_job_free(job);
   }
 }
@@ -72,7 +72,7 @@ Test(job, command_text_spells_the_options_as_typed) {
   o.bake.height_scale = 16.0f;
   o.out_dir = "out";
   o.maps = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_AO);
-  char *text = bb_job_command_text(&o, "heights/a.png");
+  char *text = bb__job_command_text(&o, "heights/a.png");
   cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
   free(text);
   o.bake.height_scale = 0.1f;
@@ -82,7 +82,7 @@ Test(job, command_text_spells_the_options_as_typed) {
   o.channel = BB_CHANNEL_A;
   o.maps = 0;
   o.name_template = "{kind}/{stem}.tif";
-  text = bb_job_command_text(&o, "a.png");
+  text = bb__job_command_text(&o, "a.png");
   cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
                          "--mips --out-dir out --name '{kind}/{stem}.tif'");
   free(text);
@@ -96,7 +96,7 @@ Test(job, command_text_is_quoted_for_a_shell) {
   o.bake.height_scale = 8.0f;
   o.paths[BB_MAP_NORMAL] = "out dir/n.png";
   o.brightness_file = "it's.png";
-  char *text = bb_job_command_text(&o, "x;touch PWNED;y.png");
+  char *text = bb__job_command_text(&o, "x;touch PWNED;y.png");
   cr_expect_str_eq(text, "bumpbake bake 'x;touch PWNED;y.png' --scale 8 --brightness "
                          "'it'\\''s.png' --normal 'out dir/n.png'");
   free(text);
@@ -110,7 +110,7 @@ Test(job, command_text_spells_the_texture_options) {
   o.bake.height_scale = 64.0f;
   o.paths[BB_MAP_SSBUMP] = "m/rock-ssbump.vtf";
   o.texture.threads = 1;
-  char *text = bb_job_command_text(&o, "h.png");
+  char *text = bb__job_command_text(&o, "h.png");
   cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
   free(text);
   o.texture.format = BB_TEXTURE_FORMAT_BC3;
@@ -121,7 +121,7 @@ Test(job, command_text_spells_the_texture_options) {
   o.vmt = "m/rock.vmt";
   o.vmt_materials = "m";
   o.vmt_basetexture = "m/rock.vtf";
-  text = bb_job_command_text(&o, "h.png");
+  text = bb__job_command_text(&o, "h.png");
   cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
                          "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
                          "--fast-compression --vmt m/rock.vmt --materials m "
@@ -142,7 +142,7 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
   o.force = 1;
   bb_job *job = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_bake_result kept;
   cr_assert_eq(bb_job_bake_item(job, 0, BB_MAP_BIT(BB_MAP_BENT), NULL, NULL, &kept, &err),
                BB_OK, "%s", err.message);
@@ -191,7 +191,7 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   enum { FILES = sizeof files / sizeof files[0] };
   bb_job *job = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_bake_result kept;
   cr_expect_eq(bb_job_write_item(job, 0, &(bb_bake_result){0}, &err), BB_ERR_ARGUMENT,
                "not baked yet");
@@ -236,7 +236,7 @@ static bb_bake_result bake_with(const char *input, int slices, const char *basis
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_job_use_context(job, context);
   bb_bake_result r;
   cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &r, &err), BB_OK, "%s",
@@ -307,7 +307,7 @@ Test(job, bake_item_cancelled_keeps_nothing) {
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
   bb_error err = {{0}};
-  cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
   bb_bake_result kept;
   cr_expect_eq(bb_job_bake_item(job, 0, 0u, cancel_at_once, NULL, &kept, &err),
                BB_ERR_CANCELLED);
@@ -387,7 +387,7 @@ Test(job, block_compression_is_a_stage_of_its_own) {
     o.force = 1;
     bb_job *job = NULL;
     bb_error err = {{0}};
-    cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
     stage_log l = {job, 0, 0, 0, 0, 0, 0};
     cr_assert_eq(bb_job_run_item(job, 0, log_stage, &l), BB_OK);
     cr_expect_null(bb_job_stage(job), "no stage once run");
@@ -441,8 +441,8 @@ Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
     if (edit > 0)
       bump_file(input, 48, 40, 10 + 3 * edit, 10 + edit);
     bb_job *job = NULL, *cold = NULL;
-    cr_assert_eq(bb_job_plan(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
-    cr_assert_eq(bb_job_plan(&input, 1, &o, &cold, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+    cr_assert_eq(bb__job_plan_options(&input, 1, &o, &cold, &err), BB_OK, "%s", err.message);
     bb_job_use_context(job, context);
     bb_bake_result kept, whole;
     cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &kept, &err), BB_OK,
