@@ -1771,6 +1771,17 @@ bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
 
+/* A new command `name` made of from's settings: from's inputs, and each
+ * option `name` takes that from holds at a value other than a new `name`
+ * command's, as text; not the files it writes (-o, a map's file), which
+ * the caller names. For a client that holds one command and runs another
+ * of its settings (bumpbake serve's page holds a `serve` command and bakes
+ * the `bake` command it is). Unchecked: set more, then bb_command_check.
+ * Errors: those of bb_command_new, bb_command_add_input and
+ * bb_command_set, BB_ERR_MEMORY. Free with bb_command_free. */
+bb_status bb_command_derive(const bb_command *from, const char *name, bb_command **out,
+                            bb_error *err);
+
 /* Sets option name (as bb_option_find finds it) from text, through the
  * option's parser, into the command's options: a flag takes text NULL (or
  * "1"/"0": Python's True/False); an option of several values takes them

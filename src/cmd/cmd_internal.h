@@ -85,6 +85,9 @@ struct bb_command {
   const bb__command *def;
   bb_command_options options;
   unsigned char given[BB__MAX_OPTIONS];
+  unsigned char derived[BB__MAX_OPTIONS]; /* taken from another command's settings
+                                            (bb_command_derive), not set by the caller:
+                                            where it does nothing, the check drops it */
   double values[BB__MAX_OPTIONS][BB__MAX_NUMBERS]; /* the numbers each option set */
   int value_count[BB__MAX_OPTIONS];
   const char *texts[BB__MAX_OPTIONS]; /* the text each option was set from (NULL: a
@@ -127,6 +130,9 @@ int bb__names_option(const char *name, size_t length, const char *option);
 int bb__option_find(const bb__command *c, const char *name);
 /* 1 when option name of c was set. */
 int bb__given(const bb_command *c, const char *name);
+/* Option i's value as bb_command_value gives it ("1"/"0" for a flag, ""
+ * for a file not given). */
+void bb__command_value_text(const bb_command *c, int i, bb__text *t);
 
 /* A copy of text owned by c (NULL when out of memory). */
 char *bb__command_keep(bb_command *c, const char *text);

@@ -116,7 +116,7 @@ const char *bb_command_input(const bb_command *c, int i) {
 
 /* The option's value as c holds it, spelled as it takes it: the text of an
  * option kept as text (BB__FIELD_KEPT), else its field's, printed. */
-static void value_text(const bb_command *c, int i, bb__text *t) {
+void bb__command_value_text(const bb_command *c, int i, bb__text *t) {
   const bb__option *o = c->def->options[i];
   if (o->info.type == BB_OPTION_FLAG)
     bb__text_add(t, c->given[i] ? "1" : "0");
@@ -140,7 +140,7 @@ bb_status bb_command_value(const bb_command *c, const char *name, char *out, siz
   if (i < 0)
     return bb__spelled(c, unknown_option(c, name, err), err);
   bb__text t = {0};
-  value_text(c, i, &t);
+  bb__command_value_text(c, i, &t);
   char *text = bb__text_take(&t); /* "" for no value (a file not given) */
   if (!text)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
@@ -173,7 +173,7 @@ bb_status bb_command_numbers(const bb_command *c, const char *name, double *valu
     return bb__fail(err, BB_ERR_ARGUMENT, "--%s holds %d numbers, room for %d", o->info.name,
                     n, cap);
   bb__text t = {0};
-  value_text(c, i, &t);
+  bb__command_value_text(c, i, &t);
   char *text = bb__text_take(&t);
   if (!text)
     return bb__fail(err, BB_ERR_MEMORY, "out of memory");
@@ -255,6 +255,7 @@ static bb_status set_option(bb_command *c, const char *name, const char *text,
   if (!text)
     c->texts[i] = NULL;
   c->given[i] = !(o->info.type == BB_OPTION_FLAG && text && !strcmp(text, "0"));
+  c->derived[i] = 0; /* the caller's own now: checked as given */
   if (!c->given[i])
     c->texts[i] = NULL;
   c->value_count[i] = count < BB__MAX_NUMBERS ? count : BB__MAX_NUMBERS;
@@ -402,13 +403,25 @@ static bb_status check_ranges(const bb_command *c, bb_error *err) {
   return BB_OK;
 }
 
-/* An option given where it would do nothing. */
-static bb_status check_applies(const bb_command *c, bb_error *err) {
-  for (int i = 0; c->def->options[i]; i++) {
-    const bb__option *o = c->def->options[i];
-    if (c->given[i] && o->applies && !o->applies(c))
-      return bb__fail(err, BB_ERR_ARGUMENT, "--%s does nothing without %s", o->info.name,
-                      o->info.applies);
+/* An option given where it would do nothing: refused; one a derived
+ * command took from its source's settings (serve's --brightness, when the
+ * write names no ssbump) is dropped instead, as if never given: its value
+ * does nothing, and the command's text no longer names it. Dropping one
+ * can make another do nothing: until none is left. */
+static bb_status check_applies(bb_command *c, bb_error *err) {
+  for (int dropped = 1; dropped;) {
+    dropped = 0;
+    for (int i = 0; c->def->options[i]; i++) {
+      const bb__option *o = c->def->options[i];
+      if (!c->given[i] || !o->applies || o->applies(c))
+        continue;
+      if (!c->derived[i])
+        return bb__fail(err, BB_ERR_ARGUMENT, "--%s does nothing without %s", o->info.name,
+                        o->info.applies);
+      c->given[i] = c->derived[i] = 0;
+      c->texts[i] = NULL;
+      dropped = 1;
+    }
   }
   return BB_OK;
 }

@@ -136,14 +136,12 @@ bb_region serve_part_region(const serve_bake *b, int t);
 int serve_inputs_changed(const serve_state *s, const serve_bake *b);
 
 /* serve_command.c: the `bumpbake bake` command of the options now (the
- * caller holds the lock): the page's command's options that bake takes at
- * other values than bake's defaults, and the write action's files
- * (job.paths), checked, into *out (free with bb_command_free); and *line,
- * the line its files record and the page shows (malloc'd): the options
- * as bb_command_text spells them, less --rays under --slices and --bounce
- * 1 under --bounce-albedo, which the bake takes but the line has never
- * named. A bake or a write plans through it (bb_command_plan). err not
- * NULL. */
+ * caller holds the lock): the page's command as a bake (bb_command_derive:
+ * the options bake takes at other values than bake's defaults) with the
+ * write action's files (job.paths), checked, into *out (free with
+ * bb_command_free); and *line, the line its files record and the page
+ * shows (malloc'd), as bb_command_text spells the command. A bake or a
+ * write plans through it (bb_command_plan). err not NULL. */
 bb_status serve_bake_command(const serve_state *s, bb_command **out, char **line,
                              bb_error *err);
 

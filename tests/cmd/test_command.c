@@ -270,6 +270,50 @@ Test(cmd, options_that_do_nothing_are_refused) {
   bb_command_free(c);
 }
 
+/* A command made of another's settings (serve's page's, as the bake of
+ * the files a write names): the inputs, the options at other values than
+ * the new command's defaults (--rays under --slices too: the files record
+ * it), not the files the source writes; one that does nothing in it is
+ * dropped by the check where the caller's own is refused. */
+Test(cmd, derive_takes_the_settings_and_drops_what_does_nothing) {
+  const char *words[] = {"h.png", "--scale", "8", "--rays", "32", "--slices", "8",
+                         "--bias", "0.25", "--power", "1", "--brightness", "b.png",
+                         "--normal", "n.png", "--ssbump", "s.png", NULL};
+  bb_command *from = command("serve", words);
+  bb_command *bake = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_derive(from, "bake", &bake, &err), BB_OK, "%s", err.message);
+  cr_expect_str_eq(bb_command_describe(bake)->name, "bake");
+  cr_expect_str_eq(bb_command_input(bake, 0), "h.png");
+  cr_expect(bb_command_given(bake, "scale") && bb_command_given(bake, "rays") &&
+            bb_command_given(bake, "slices") && bb_command_given(bake, "bias"));
+  cr_expect(!bb_command_given(bake, "power"), "--power 1 is bake's default");
+  cr_expect(!bb_command_given(bake, "normal") && !bb_command_given(bake, "ssbump"),
+            "the files the source writes are not taken");
+  cr_assert_eq(bb_command_set(bake, "ao", "a.png", &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_check(bake, &err), BB_OK, "%s", err.message);
+  cr_expect(!bb_command_given(bake, "brightness"), "an ao alone: --brightness dropped");
+  char *text = bb_command_text(bake, NULL, BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake h.png --scale 8 --rays 32 --slices 8 --bias 0.25 "
+                         "--ao a.png");
+  free(text);
+  /* set by the caller, the same option is refused as on a command line */
+  cr_assert_eq(bb_command_set(bake, "brightness", "b.png", &err), BB_OK);
+  cr_expect_eq(bb_command_check(bake, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "--brightness does nothing without an ssbump or weights map");
+  bb_command_free(bake);
+  /* an ssbump named: it does something, and is kept */
+  cr_assert_eq(bb_command_derive(from, "bake", &bake, &err), BB_OK);
+  cr_assert_eq(bb_command_set(bake, "ssbump", "s2.png", &err), BB_OK);
+  cr_assert_eq(bb_command_check(bake, &err), BB_OK, "%s", err.message);
+  cr_expect(bb_command_given(bake, "brightness"));
+  bb_command_free(bake);
+  cr_expect_eq(bb_command_derive(from, "bak", &bake, &err), BB_ERR_ARGUMENT);
+  cr_expect_null(bake);
+  cr_expect(strstr(err.message, "unknown command 'bak'"), "%s", err.message);
+  bb_command_free(from);
+}
+
 /* A file option names one file: given again with another name, the first
  * would be dropped without a word. A map's file is the exception: given
  * again, a further file of the same bake (--ssbump s.png --ssbump s.vtf),
