@@ -328,6 +328,45 @@ def test_write_writes_the_maps_shown_as_bake_would(served):
     assert status == 200 and json.loads(body)["from"] == "memory", body
 
 
+@pytest.mark.parametrize("args,params", [
+    # --slices override --rays, but the files record the rays asked: the
+    # line names them, or typing it would make other bytes
+    (["--slices", "8", "--rays", "32", "--ao", "a.png"], ["rays=64"]),
+    # the page lights the ssbump with the brightness; the write names only
+    # an ao, which it does nothing for: the line leaves it out (bake would
+    # refuse it), and serve starts
+    (["--rays", "16", "--ao", "a.png", "--brightness", "b.png"], []),
+    (["--rays", "16", "--ssbump", "s.vtf", "--texture-format", "bc3",
+      "--bounce-albedo", "b.png", "--bounce", "1"], ["scale=12"]),
+], ids=["rays-under-slices", "brightness-without-ssbump", "vtf-bounce-albedo"])
+def test_the_line_recorded_is_a_bake_of_the_same_bytes(tmp_path, args, params):
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
+    shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "b.png")
+    s = sb.Server(BIN, "h.png", ["--scale", "8", "--quiet", *args], cwd=str(tmp_path))
+    try:
+        last = wait_bake(s, 0, "the first bake")["bake"]["id"]
+        for p in params:
+            status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "params?" + p)
+            assert status == 200, body
+            last = wait_bake(s, last, "the bake of " + p)["bake"]["id"]
+        status, body = request(s.url, "POST", {"X-Bumpbake": "1"}, "write")
+        assert status == 200, body
+        line = state(s)["command"]
+    finally:
+        s.close()
+    paths = [os.path.join(tmp_path, o["path"]) for o in json.loads(body)["outputs"]]
+    written = {p: open(p, "rb").read() for p in paths}
+    for p in paths:
+        os.remove(p)
+    words = shlex.split(line)
+    assert words[:2] == ["bumpbake", "bake"]
+    r = subprocess.run([BIN, *words[1:], "--quiet"], cwd=str(tmp_path), capture_output=True,
+                       text=True, timeout=SLOW)
+    assert r.returncode == 0, line + ": " + r.stderr
+    for p in paths:
+        assert open(p, "rb").read() == written[p], p + " differs from " + line
+
+
 # ------------------------------------------------------ slow and many clients
 
 def slow_sockets(url, count, first=b"GET / HTTP/1.1\r\n"):
