@@ -1422,9 +1422,8 @@ typedef struct bb_job_options {
   const char *command;       /* one input: the whole command line as typed */
   const char *command_options; /* what follows "bumpbake bake INPUT" in each
                                 output's command (a batch's, or a single input's
-                                when command is NULL); NULL for both: the options
-                                that differ from their defaults, as `bumpbake
-                                bake` spells them. bb_command_plan sets them */
+                                when command is NULL); bb_command_plan sets
+                                them (a plan without either is refused) */
   bb_note_fn note;           /* notes about inputs (may be NULL) */
   void *note_user;
   /* Engine textures and a Source material: */

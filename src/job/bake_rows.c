@@ -1,9 +1,8 @@
 /* bake_rows.c: the bake's options as rows (bake_rows.h): each option's
- * name, field and default rule written once, here, for the job's recorded
- * command and for the commands that read them. The special cases are the
- * rows' own: --slices overrides --rays, --bounce 1 goes without saying with
- * --bounce-albedo, --lit needs --slope, a batch writes --out-dir, --maps
- * and --name and a single bake its map files. */
+ * name, field and spelling written once, here, for the commands that read
+ * and spell them (cmd/options_bake.c points at them). The special cases
+ * are the rows' own printers: --basis (a file as named, else its name),
+ * --maps (comma-separated), --vtf-version (7.N), --vtf-flags (hex). */
 #include "job/bake_rows.h"
 #include "job/job_internal.h"
 
@@ -12,38 +11,11 @@
 
 #define AT(member) offsetof(bb_job_options, member)
 
-/* ------------------------------------------------------------ special rules */
-
-static int always(const bb_job_options *o, const bb_job_options *d) {
-  (void)o, (void)d;
-  return 1;
-}
-
-/* --slices overrides --rays: the budget is spelled only without slices. */
-static int rays_differ(const bb_job_options *o, const bb_job_options *d) {
-  return !o->bake.slices && o->bake.rays != d->bake.rays;
-}
+/* ------------------------------------------------------------ special printers */
 
 /* --basis: a file as named, else the basis's name. */
 static void print_basis(const bb_job_options *o, bb__text *t) {
   bb__text_add(t, o->basis_file ? o->basis_file : o->bake.basis.name);
-}
-
-static int basis_differs(const bb_job_options *o, const bb_job_options *d) {
-  return o->basis_file || strcmp(o->bake.basis.name, d->bake.basis.name) != 0;
-}
-
-/* --bounce is written when the rho it gives differs from the one the
- * command means without it (bb__bounce_rho: 1 with --bounce-albedo). */
-static int bounce_differs(const bb_job_options *o, const bb_job_options *d) {
-  const int map = o->bounce_albedo_file != NULL;
-  return bb__bounce_rho(o->bake.bounce_albedo, map) != bb__bounce_rho(d->bake.bounce_albedo, map);
-}
-
-/* --lit lights the slope map: nothing without one. */
-static int lit_differs(const bb_job_options *o, const bb_job_options *d) {
-  (void)d;
-  return o->slope_path && o->slope_lit;
 }
 
 /* --maps: the batch's maps (0: the default ones), comma-separated. */
@@ -61,10 +33,6 @@ static void print_maps(const bb_job_options *o, bb__text *t) {
     }
 }
 
-static int maps_differ(const bb_job_options *o, const bb_job_options *d) {
-  return maps_of(o) != maps_of(d);
-}
-
 static void print_vtf_version(const bb_job_options *o, bb__text *t) {
   bb__text_printf(t, "7.%d", o->texture.vtf_version);
 }
@@ -78,14 +46,13 @@ static void print_vtf_flags(const bb_job_options *o, bb__text *t) {
 #define ROW(name_, field_, member)                                                       \
   .name = name_, .field = BB__FIELD_##field_, .offset = AT(member)
 #define MAP_FILE(name_, kind_)                                                           \
-  { ROW(name_, STRING, paths[kind_]), .when = BB__ROW_SINGLE }
+  { ROW(name_, STRING, paths[kind_]) }
 
 _Static_assert(sizeof(((bb_job_options *)0)->texture.vtf_flags) == sizeof(int),
                "--vtf-flags is read as an int");
 
-const bb__bake_row bb__row_scale = {ROW("scale", FLOAT, bake.height_scale),
-                                    .differs = always};
-const bb__bake_row bb__row_rays = {ROW("rays", INT, bake.rays), .differs = rays_differ};
+const bb__bake_row bb__row_scale = {ROW("scale", FLOAT, bake.height_scale)};
+const bb__bake_row bb__row_rays = {ROW("rays", INT, bake.rays)};
 const bb__bake_row bb__row_slices = {ROW("slices", INT, bake.slices)};
 const bb__bake_row bb__row_filter_radius = {
     ROW("filter-radius", INT, bake.smooth.radius_texels)};
@@ -94,7 +61,7 @@ const bb__bake_row bb__row_filter_threshold = {
 const bb__bake_row bb__row_bias = {ROW("bias", DOUBLE, bake.trace.bias_texels)};
 const bb__bake_row bb__row_power = {ROW("power", DOUBLE, bake.power)};
 const bb__bake_row bb__row_basis = {
-    .name = "basis", .print = print_basis, .differs = basis_differs};
+    .name = "basis", .print = print_basis};
 const bb__bake_row bb__row_normal_filter = {
     ROW("normal-filter", ENUM, bake.normal_filter), .names = bb__name_normal_filter};
 const bb__bake_row bb__row_normal_y = {ROW("normal-y", INT, bake.normal_y_up),
@@ -107,8 +74,7 @@ const bb__bake_row bb__row_channel = {ROW("channel", ENUM, channel),
                                       .names = bb__name_channel};
 const bb__bake_row bb__row_depth = {ROW("depth", ENUM, depth), .names = bb__name_depth};
 const bb__bake_row bb__row_mips = {ROW("mips", INT, mips), .flag = 1};
-const bb__bake_row bb__row_bounce = {ROW("bounce", DOUBLE, bake.bounce_albedo),
-                                     .differs = bounce_differs};
+const bb__bake_row bb__row_bounce = {ROW("bounce", DOUBLE, bake.bounce_albedo)};
 const bb__bake_row bb__row_bounces = {ROW("bounces", INT, bake.bounces)};
 const bb__bake_row bb__row_bounce_albedo = {
     ROW("bounce-albedo", STRING, bounce_albedo_file)};
@@ -119,20 +85,15 @@ const bb__bake_row bb__row_ssbump = MAP_FILE("ssbump", BB_MAP_SSBUMP);
 const bb__bake_row bb__row_ao = MAP_FILE("ao", BB_MAP_AO);
 const bb__bake_row bb__row_bent = MAP_FILE("bent", BB_MAP_BENT);
 const bb__bake_row bb__row_filtered = MAP_FILE("filtered", BB_MAP_FILTERED);
-const bb__bake_row bb__row_slope = {ROW("slope", STRING, slope_path),
-                                    .when = BB__ROW_SINGLE};
+const bb__bake_row bb__row_slope = {ROW("slope", STRING, slope_path)};
 const bb__bake_row bb__row_lit = {ROW("lit", ANGLES, slope_lit_azimuth),
-                                  .sets = {BB__FIELD_INT, AT(slope_lit), 1, NULL},
-                                  .differs = lit_differs, .when = BB__ROW_SINGLE};
+                                  .sets = {BB__FIELD_INT, AT(slope_lit), 1, NULL}};
 /* --out-dir is what makes a batch: any bake may give it. */
 const bb__bake_row bb__row_out_dir = {ROW("out-dir", STRING, out_dir)};
 const bb__bake_row bb__row_maps = {.name = "maps",
                                    .names = bb__name_output_kind,
-                                   .print = print_maps,
-                                   .differs = maps_differ,
-                                   .when = BB__ROW_BATCH};
-const bb__bake_row bb__row_name = {ROW("name", STRING, name_template),
-                                   .when = BB__ROW_BATCH};
+                                   .print = print_maps};
+const bb__bake_row bb__row_name = {ROW("name", STRING, name_template)};
 const bb__bake_row bb__row_texture_format = {ROW("texture-format", ENUM, texture.format),
                                              .names = bb__name_texture_format};
 const bb__bake_row bb__row_vtf_version = {ROW("vtf-version", INT, texture.vtf_version),
@@ -146,90 +107,14 @@ const bb__bake_row bb__row_fast_compression = {
     .flag = 1,
     .sets = {BB__FIELD_INT, AT(texture.fast), 1, NULL}};
 /* One material for one bake: a batch refuses them (plan.c). */
-const bb__bake_row bb__row_vmt = {ROW("vmt", STRING, vmt), .when = BB__ROW_SINGLE};
-const bb__bake_row bb__row_materials = {ROW("materials", STRING, vmt_materials),
-                                        .when = BB__ROW_SINGLE};
-const bb__bake_row bb__row_basetexture = {ROW("basetexture", STRING, vmt_basetexture),
-                                          .when = BB__ROW_SINGLE};
-
-const bb__bake_row *const bb__bake_rows[] = {&bb__row_scale,
-                                             &bb__row_rays,
-                                             &bb__row_slices,
-                                             &bb__row_filter_radius,
-                                             &bb__row_filter_threshold,
-                                             &bb__row_bias,
-                                             &bb__row_power,
-                                             &bb__row_basis,
-                                             &bb__row_normal_filter,
-                                             &bb__row_normal_y,
-                                             &bb__row_clamp,
-                                             &bb__row_channel,
-                                             &bb__row_depth,
-                                             &bb__row_mips,
-                                             &bb__row_bounce,
-                                             &bb__row_bounces,
-                                             &bb__row_bounce_albedo,
-                                             &bb__row_brightness,
-                                             &bb__row_normal,
-                                             &bb__row_weights,
-                                             &bb__row_ssbump,
-                                             &bb__row_ao,
-                                             &bb__row_bent,
-                                             &bb__row_filtered,
-                                             &bb__row_slope,
-                                             &bb__row_lit,
-                                             &bb__row_out_dir,
-                                             &bb__row_maps,
-                                             &bb__row_name,
-                                             &bb__row_texture_format,
-                                             &bb__row_vtf_version,
-                                             &bb__row_vtf_flags,
-                                             &bb__row_nomip,
-                                             &bb__row_fast_compression,
-                                             &bb__row_vmt,
-                                             &bb__row_materials,
-                                             &bb__row_basetexture,
-                                             NULL};
+const bb__bake_row bb__row_vmt = {ROW("vmt", STRING, vmt)};
+const bb__bake_row bb__row_materials = {ROW("materials", STRING, vmt_materials)};
+const bb__bake_row bb__row_basetexture = {ROW("basetexture", STRING, vmt_basetexture)};
 
 /* --------------------------------------------------------------- reading */
 
 static const void *at(const bb_job_options *o, size_t offset) {
   return (const char *)o + offset;
-}
-
-static int strings_differ(const char *a, const char *b) {
-  return a && (!b || strcmp(a, b) != 0);
-}
-
-int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
-                         const bb_job_options *d) {
-  const int batch = o->out_dir != NULL;
-  if ((r->when == BB__ROW_SINGLE && batch) || (r->when == BB__ROW_BATCH && !batch))
-    return 0;
-  if (r->differs)
-    return r->differs(o, d);
-  if (r->sets.field == BB__FIELD_INT || r->sets.field == BB__FIELD_ENUM)
-    return *(const int *)at(o, r->sets.offset) == r->sets.value &&
-           *(const int *)at(d, r->sets.offset) != r->sets.value;
-  const void *a = at(o, r->offset), *b = at(d, r->offset);
-  switch (r->field) {
-  case BB__FIELD_INT:
-  case BB__FIELD_ENUM:
-    return *(const int *)a != *(const int *)b;
-  case BB__FIELD_FLOAT:
-    return *(const float *)a != *(const float *)b;
-  case BB__FIELD_DOUBLE:
-    return *(const double *)a != *(const double *)b;
-  case BB__FIELD_STRING:
-    return strings_differ(*(const char *const *)a, *(const char *const *)b);
-  case BB__FIELD_ANGLES:
-    return ((const double *)a)[0] != ((const double *)b)[0] ||
-           ((const double *)a)[1] != ((const double *)b)[1];
-  case BB__FIELD_NONE:
-  case BB__FIELD_KEPT:
-    return 0;
-  }
-  return 0;
 }
 
 void bb__field_text(bb__field field, int flag, bb__name_fn names, const void *value,

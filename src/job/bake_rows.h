@@ -1,12 +1,12 @@
 /* bake_rows.h: the bake's options described once, below the commands (not
  * public): each row is an option's name, where its value is in
- * bb_job_options, how the value is written as the command line takes it,
- * and when it differs from bb__job_options_init's. bb__job_command_text
- * walks bb__bake_rows to spell a job as `bumpbake bake`; the commands
- * family's rows of these options (cmd/options_bake.c) point at them for
- * their name, field, words and printing, and add what only a command needs
- * (help, ranges, parsers, rules). Also the kinds of field a value is and
- * the library's enums as words (enums.c), which both families use. */
+ * bb_job_options and how the value is written as the command line takes
+ * it. The commands family's rows of these options (cmd/options_bake.c)
+ * point at them for their name, field, words and printing, and add what
+ * only a command needs (help, ranges, parsers, rules); a command is
+ * spelled back through them by bb_command_text, the library's one
+ * speller of command lines. Also the kinds of field a value is and the
+ * library's enums as words (enums.c), which both families use. */
 #ifndef BB_JOB_BAKE_ROWS_H
 #define BB_JOB_BAKE_ROWS_H
 
@@ -50,14 +50,6 @@ typedef struct bb__flag_sets {
   const char *text;
 } bb__flag_sets;
 
-/* Which bakes write a row: every one, a single bake's (no out_dir), or a
- * batch's (out_dir). */
-typedef enum bb__row_when {
-  BB__ROW_ALWAYS = 0,
-  BB__ROW_SINGLE,
-  BB__ROW_BATCH
-} bb__row_when;
-
 typedef struct bb__bake_row {
   char name[24];   /* the option without "--": its one spelling (an array,
                       so a command's row can name it in a constant) */
@@ -68,10 +60,6 @@ typedef struct bb__bake_row {
   bb__flag_sets sets; /* a flag's other field, in bb_job_options */
   /* the value as the option takes it; NULL: by field */
   void (*print)(const bb_job_options *o, bb__text *t);
-  /* 1 when o's value is not d's (the defaults'); NULL: the field differs,
-   * or for a flag that sets a field, that field holds the flag's value */
-  int (*differs)(const bb_job_options *o, const bb_job_options *d);
-  bb__row_when when;
 } bb__bake_row;
 
 /* The rows, one per option of `bumpbake bake` that determines the output,
@@ -85,15 +73,6 @@ extern const bb__bake_row bb__row_scale, bb__row_rays, bb__row_slices,
     bb__row_lit, bb__row_out_dir, bb__row_maps, bb__row_name, bb__row_texture_format,
     bb__row_vtf_version, bb__row_vtf_flags, bb__row_nomip, bb__row_fast_compression,
     bb__row_vmt, bb__row_materials, bb__row_basetexture;
-
-/* The rows in the order of `bumpbake bake --help`, NULL-terminated: the
- * order a job's command spells them in. */
-extern const bb__bake_row *const bb__bake_rows[];
-
-/* 1 when row r is written for o: o is a bake of the row's kind and its
- * value differs from d's (bb__job_options_init's). */
-int bb__bake_row_differs(const bb__bake_row *r, const bb_job_options *o,
-                         const bb_job_options *d);
 
 /* Row r's value in o as the option takes it (nothing for a flag), a
  * number as a user types it (bb__float_text: "30", "36.8083"). */

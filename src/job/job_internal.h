@@ -87,8 +87,6 @@ struct bb_job {
   char *bounce_albedo_file, *brightness_file;
   char *vmt, *vmt_materials, *vmt_basetexture;
   char *valve_path;         /* Valve's packed file (height2ssbump), or NULL */
-  int asked_slices;         /* options.bake.slices as given (0: from rays), before the
-                               plan resolved it: what the command text spells */
   char *vmt_text;           /* the material's bytes, made by the plan */
   size_t vmt_size;
   bb_image bounce_albedo_map, brightness_map; /* read once by the plan */
@@ -166,7 +164,8 @@ typedef struct bb__job_more {
  * give the image files in them (not below), sorted by name, leaving out
  * names starting with '.' and files whose provenance says bumpbake baked
  * them as maps (so a directory can be its own out_dir); a file named twice
- * counts once. Every option and every output path is checked here, before
+ * counts once. o->command or o->command_options names the line its
+ * outputs record (neither: BB_ERR_ARGUMENT). Every option and every output path is checked here, before
  * any bake (bb_outputs_check for each input's outputs against every input;
  * clashes across the whole batch; the depfile against every input and
  * output); out_dir and the template's subfolders, or a single input's
@@ -178,18 +177,6 @@ typedef struct bb__job_more {
  * job; free it with bb_job_free. */
 bb_status bb__job_plan_options(const char *const *inputs, int input_count,
                                const bb_job_options *o, bb_job **out, bb_error *err);
-
-/* The command line of options o, as the provenance of a job without
- * command or command_options records it: "bumpbake bake INPUT" and then
- * every option that differs from its default, in the order of `bumpbake
- * bake --help`, spelled as there (--scale 16 --rays 64 ... --out-dir DIR
- * --maps normal,ao --name T ... --texture-format bc3 --vtf-version 7.3
- * --nomip --vmt FILE; the threads are left out). A CLI invocation typed
- * this way records the same text, so the same job through the CLI and
- * through Python writes the same bytes. (bb_command_text spells any
- * command through the descriptions.) malloc'd;
- * NULL when out of memory. */
-char *bb__job_command_text(const bb_job_options *o, const char *input);
 
 /* bb__job_plan_options; flags: BB__PLAN_CHECKED: o's bake options were checked
  * already (a command's, cmd/plan.c) and are only resolved

@@ -623,7 +623,6 @@ static bb_status check_options(const bb_job_options *o, const char *const *input
 /* The options' strings, copied: a job outlives its caller's buffers. */
 static bb_status copy_options(bb_job *job, const bb_job_options *o, bb_error *err) {
   job->options = *o;
-  job->asked_slices = o->bake.slices;
   job->options.bake.outputs = bb__job_maps_asked(o);
   job->batch = o->out_dir != NULL;
   job->basis_file = copy(o->basis_file);
@@ -860,6 +859,11 @@ bb_status bb__job_plan(const char *const *inputs, int input_count, const bb_job_
   if (!out || !o || (input_count > 0 && !inputs))
     return bb__fail(err, BB_ERR_ARGUMENT, "job plan: bad arguments");
   *out = NULL;
+  /* Its outputs record the command line that made them: the command's
+   * (bb__command_plan), spelled by the one speller, bb_command_text. */
+  if (!o->command && !o->command_options)
+    return bb__fail(err, BB_ERR_ARGUMENT,
+                    "job plan: no command line to record (plan it through its command)");
   bb_status st = check_options(o, inputs, input_count, err);
   if (st != BB_OK)
     return st;

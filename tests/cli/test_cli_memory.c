@@ -37,6 +37,7 @@ static void write_height(const char *path, int side) {
 static double job_estimate(const char *input, unsigned outputs, int side) {
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 32.0f;
   o.bake.slices = 2;
   o.bake.trace.threads = 2;

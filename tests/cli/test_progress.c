@@ -71,6 +71,7 @@ Test(progress, a_jobs_block_compression_has_its_own_bar) {
       _exit(4);
     bb_job_options o;
     bb__job_options_init(&o);
+    o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
     o.bake.height_scale = 4.0f;
     o.bake.rays = 16;
     o.paths[BB_MAP_SSBUMP] = vtf;

@@ -1,10 +1,10 @@
 /* test_bake_rows.c: the bake's options described once (job/bake_rows.h).
  * For every row: a value other than the default, set through bake's
- * parser, is spelled by the job's command (bb__job_command_text) as the
- * option the command line reads, and that command read back through the
- * command API (bb_command_*) is the same job. A row without a sample here,
- * or a recorded option of bake without a row, fails: a new option cannot
- * be left out of the job's command. */
+ * parser, is spelled by the command's text (bb_command_text, the one
+ * speller of the lines outputs record) as the option the command line
+ * reads, and that line read back through the command API (bb_command_*)
+ * spells the same. A row without a sample here, or a recorded option of
+ * bake without a row, fails: a new option cannot be left out. */
 #include "bumpbake.h"
 #include "cmd/cmd_internal.h"
 #include "job/job_internal.h"
@@ -104,7 +104,7 @@ static int split_words(const char *line, char **words, int cap) {
   return n;
 }
 
-/* The command bb__job_command_text's line reads back as: "bumpbake bake
+/* The command a recorded line reads back as: "bumpbake bake
  * INPUT --option [value] ...". */
 static bb_command *read_back(const char *line) {
   char *words[128];
@@ -131,23 +131,24 @@ static bb_command *read_back(const char *line) {
 
 /* Each row: set, spelled, read back the same. */
 Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
-  bb_job_options defaults;
-  bb__job_options_init(&defaults);
-  for (int i = 0; bb__bake_rows[i]; i++) {
-    const bb__bake_row *row = bb__bake_rows[i];
+  const bb_command_info *bake = bb_command_info_find("bake");
+  cr_assert_not_null(bake);
+  for (int i = 0; i < bake->option_count; i++) {
+    const bb__option *option = (const bb__option *)bb_command_option(bake, i);
+    const bb__bake_row *row = option->job;
+    if (!row)
+      continue;
     const sample *s = sample_of(row->name);
     cr_assert_not_null(s, "the row --%s has no sample in this test", row->name);
     bb_command *c = NULL;
     cr_assert_eq(bb_command_new("bake", &c, NULL), BB_OK);
+    cr_assert_eq(bb_command_add_input(c, "h.png", NULL), BB_OK);
     if (strcmp(row->name, "scale") != 0)
       set(c, "scale", "8");
     if (s->needs)
       set(c, s->needs, s->needs_value);
     set(c, s->name, s->value);
-    const bb_job_options *o = &bb__command_options_of(c)->job;
-    cr_expect(bb__bake_row_differs(row, o, &defaults), "--%s %s is its default", s->name,
-              s->value ? s->value : "");
-    char *text = bb__job_command_text(o, "h.png");
+    char *text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
     cr_assert_not_null(text);
 
     /* the option spelled as it was typed */
@@ -165,12 +166,10 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
     }
     free(quoted);
 
-    /* read back: the same job, so the same line */
+    /* read back: the same command, so the same line */
     bb_command *back = read_back(text);
-    const bb_job_options *b = &bb__command_options_of(back)->job;
-    cr_expect(bb__bake_row_differs(row, b, &defaults), "'%s' read back lost --%s", text,
-              s->name);
-    char *again = bb__job_command_text(b, "h.png");
+    cr_expect(bb_command_given(back, s->name), "'%s' read back lost --%s", text, s->name);
+    char *again = bb_command_text(back, NULL, BB_OPTION_RECORDED);
     cr_expect_str_eq(again, text);
     free(again);
     bb_command_free(back);
@@ -179,13 +178,13 @@ Test(bake_rows, every_row_is_spelled_as_the_command_line_reads_it_back) {
   }
 }
 
-/* bake's options and the rows: each row is a bake option's (its flag, its
- * place in --help's order), and each recorded option of bake but -o PREFIX
- * (its maps' files are what a job records) has a row. */
-Test(bake_rows, bakes_recorded_options_are_the_rows_in_help_order) {
+/* bake's options and the rows: each recorded option of bake but -o PREFIX
+ * (its maps' files are what a bake records) has a row, named as the
+ * option, a flag where the option is. */
+Test(bake_rows, bakes_recorded_options_each_have_a_row) {
   const bb_command_info *bake = bb_command_info_find("bake");
   cr_assert_not_null(bake);
-  int next = 0;
+  int rows = 0;
   for (int i = 0; i < bake->option_count; i++) {
     const bb_option_info *info = bb_command_option(bake, i);
     const bb__option *o = (const bb__option *)info;
@@ -194,21 +193,10 @@ Test(bake_rows, bakes_recorded_options_are_the_rows_in_help_order) {
                 "bake's recorded option --%s has no row (job/bake_rows.c)", info->name);
       continue;
     }
-    cr_assert_not_null(bb__bake_rows[next], "--%s is past the rows", info->name);
-    cr_expect_eq(o->job, bb__bake_rows[next],
-                 "--%s is not the row --%s of the same place", info->name,
-                 bb__bake_rows[next]->name);
+    rows++;
     cr_expect_str_eq(info->name, o->job->name);
     cr_expect_eq(o->job->flag, info->type == BB_OPTION_FLAG, "--%s", info->name);
-    /* The use an option belongs to, as --help says it and as the job's
-     * command writes it, is one: a single bake's, a batch's or any. */
-    static const bb_option_mode mode_of_when[] = {
-        [BB__ROW_ALWAYS] = BB_MODE_ANY, [BB__ROW_SINGLE] = BB_MODE_SINGLE,
-        [BB__ROW_BATCH] = BB_MODE_BATCH};
-    cr_expect_eq(info->mode, mode_of_when[o->job->when],
-                 "--%s: --help gives it to one use, the job's row to another", info->name);
-    next++;
   }
-  cr_expect_null(bb__bake_rows[next], "the row --%s is no option of bake",
-                 bb__bake_rows[next] ? bb__bake_rows[next]->name : "");
+  cr_expect_eq(rows, (int)(sizeof samples / sizeof samples[0]),
+               "every sample is a row of bake's, and every row has one");
 }

@@ -85,13 +85,16 @@ Test(cmd, recorded_text_spells_what_changes_the_output) {
   bb_command_free(c);
 
   /* quoted for a POSIX shell, inputs and values alike */
-  const char *odd[] = {"my rock.png", "--scale", "8", "--normal", "$HOME/n.png", NULL};
+  const char *odd[] = {"my rock.png", "--scale", "8", "--brightness", "it's.png", "--normal",
+                       "$HOME/n.png", NULL};
   c = command("bake", odd);
   text = bb_command_text(c, NULL, BB_OPTION_RECORDED);
-  cr_expect_str_eq(text, "bumpbake bake 'my rock.png' --scale 8 --normal '$HOME/n.png'");
+  cr_expect_str_eq(text, "bumpbake bake 'my rock.png' --scale 8 --brightness 'it'\\''s.png' "
+                         "--normal '$HOME/n.png'");
   free(text);
-  text = bb_command_text(c, "a;b.png", BB_OPTION_RECORDED);
-  cr_expect_str_eq(text, "bumpbake bake 'a;b.png' --scale 8 --normal '$HOME/n.png'");
+  text = bb_command_text(c, "x;touch PWNED;y.png", BB_OPTION_RECORDED);
+  cr_expect_str_eq(text, "bumpbake bake 'x;touch PWNED;y.png' --scale 8 --brightness "
+                         "'it'\\''s.png' --normal '$HOME/n.png'");
   free(text);
   bb_command_free(c);
 }

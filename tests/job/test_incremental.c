@@ -299,6 +299,7 @@ Test(incremental, an_input_that_is_no_image_is_not_current) {
   bb_image_free(&h);
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.out_dir = tmp("out");
   o.maps = BB_MAP_BIT(BB_MAP_NORMAL);

@@ -28,12 +28,32 @@ static const char *height_file(void) {
   return tmp("h.png");
 }
 
+/* Every job records the command line that made it (a command's plan
+ * names it, spelled by bb_command_text): a plan of options alone, with no
+ * line to record, is refused. */
+Test(job, a_plan_without_its_command_line_is_refused) {
+  const char *input = height_file();
+  bb_job_options o;
+  bb__job_options_init(&o);
+  o.bake.height_scale = 4.0f;
+  o.paths[BB_MAP_NORMAL] = tmp("n.png");
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_expect_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_ERR_ARGUMENT);
+  cr_expect_str_eq(err.message, "job plan: no command line to record (plan it through its command)");
+  cr_expect_null(job);
+  o.command_options = "--scale 4"; /* a batch's options alone: a line */
+  cr_expect_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_job_free(job);
+}
+
 /* The slope map's lit preview takes a light as render's --light does:
  * elevation 0..90, a finite azimuth; refused when planned, not baked. */
 Test(job, slope_lit_light_is_checked_when_planned) {
   const char *input = height_file();
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.slope_path = tmp("s.png");
   o.slope_lit = 1;
@@ -64,77 +84,13 @@ Test(job, slope_lit_light_is_checked_when_planned) {
   }
 }
 
-/* The command recorded in provenance: bake's options that differ from
- * their defaults, in --help's order, spelled as typed. */
-Test(job, command_text_spells_the_options_as_typed) {
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.bake.height_scale = 16.0f;
-  o.out_dir = "out";
-  o.maps = BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_AO);
-  char *text = bb__job_command_text(&o, "heights/a.png");
-  cr_expect_str_eq(text, "bumpbake bake heights/a.png --scale 16 --out-dir out --maps normal,ao");
-  free(text);
-  o.bake.height_scale = 0.1f;
-  o.bake.rays = 64;
-  o.depth = BB_DEPTH_16;
-  o.mips = 1;
-  o.channel = BB_CHANNEL_A;
-  o.maps = 0;
-  o.name_template = "{kind}/{stem}.tif";
-  text = bb__job_command_text(&o, "a.png");
-  cr_expect_str_eq(text, "bumpbake bake a.png --scale 0.1 --rays 64 --channel a --depth 16 "
-                         "--mips --out-dir out --name '{kind}/{stem}.tif'");
-  free(text);
-}
-
-/* The line is quoted for a POSIX shell (bb_text_shell_quoted): typed in
- * one, a name with a blank or a ';' is one word, and runs nothing. */
-Test(job, command_text_is_quoted_for_a_shell) {
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.bake.height_scale = 8.0f;
-  o.paths[BB_MAP_NORMAL] = "out dir/n.png";
-  o.brightness_file = "it's.png";
-  char *text = bb__job_command_text(&o, "x;touch PWNED;y.png");
-  cr_expect_str_eq(text, "bumpbake bake 'x;touch PWNED;y.png' --scale 8 --brightness "
-                         "'it'\\''s.png' --normal 'out dir/n.png'");
-  free(text);
-}
-
-/* The engine textures' settings and the material come last, as in --help,
- * spelled as the CLI reads them back; threads are not recorded. */
-Test(job, command_text_spells_the_texture_options) {
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.bake.height_scale = 64.0f;
-  o.paths[BB_MAP_SSBUMP] = "m/rock-ssbump.vtf";
-  o.texture.threads = 1;
-  char *text = bb__job_command_text(&o, "h.png");
-  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf");
-  free(text);
-  o.texture.format = BB_TEXTURE_FORMAT_BC3;
-  o.texture.vtf_version = 3;
-  o.texture.vtf_flags = 0x4;
-  o.texture.mips = 0;
-  o.texture.fast = 1;
-  o.vmt = "m/rock.vmt";
-  o.vmt_materials = "m";
-  o.vmt_basetexture = "m/rock.vtf";
-  text = bb__job_command_text(&o, "h.png");
-  cr_expect_str_eq(text, "bumpbake bake h.png --scale 64 --ssbump m/rock-ssbump.vtf "
-                         "--texture-format bc3 --vtf-version 7.3 --vtf-flags 0x4 --nomip "
-                         "--fast-compression --vmt m/rock.vmt --materials m "
-                         "--basetexture m/rock.vtf");
-  free(text);
-}
-
 /* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
  * would write, kept instead, with the kinds asked besides; nothing written. */
 Test(job, bake_item_keeps_the_maps_run_item_writes) {
   const char *input = height_file();
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
   o.paths[BB_MAP_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
@@ -177,6 +133,7 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   const char *input = height_file();
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
@@ -228,6 +185,7 @@ static bb_bake_result bake_with(const char *input, int slices, const char *basis
                                 bb_bake_context *context) {
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.bake.slices = slices;
   o.bake.bounce_albedo = 0.5; /* the bounce reads the ray set too */
@@ -303,6 +261,7 @@ Test(job, bake_item_cancelled_keeps_nothing) {
   const char *input = height_file();
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   bb_job *job = NULL;
@@ -380,6 +339,7 @@ Test(job, block_compression_is_a_stage_of_its_own) {
   for (int textures = 1; textures >= 0; textures--) {
     bb_job_options o;
     bb__job_options_init(&o);
+    o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
     o.bake.height_scale = 4.0f;
     o.bake.rays = 16;
     o.paths[BB_MAP_SSBUMP] = textures ? tmp("s.vtf") : tmp("s.png");
@@ -430,6 +390,7 @@ Test(job, bake_item_through_a_keeping_context_is_the_whole_bake) {
   bump_file(input, 48, 40, 10, 10);
   bb_job_options o;
   bb__job_options_init(&o);
+  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 16.0f;
   o.paths[BB_MAP_SSBUMP] = tmp("e_ssbump.exr");
   o.force = 1;
