@@ -338,7 +338,10 @@ def test_write_writes_the_maps_shown_as_bake_would(served):
     (["--rays", "16", "--ao", "a.png", "--brightness", "b.png"], []),
     (["--rays", "16", "--ssbump", "s.vtf", "--texture-format", "bc3",
       "--bounce-albedo", "b.png", "--bounce", "1"], ["scale=12"]),
-], ids=["rays-under-slices", "brightness-without-ssbump", "vtf-bounce-albedo"])
+    # a bounce set on the page does nothing for a normal map alone
+    (["--rays", "16", "--normal", "n.png"], ["bounce=0.5"]),
+], ids=["rays-under-slices", "brightness-without-ssbump", "vtf-bounce-albedo",
+        "bounce-without-traced-map"])
 def test_the_line_recorded_is_a_bake_of_the_same_bytes(tmp_path, args, params):
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "h.png")
     shutil.copy(os.path.join(FIXTURES, "rock06_128.png"), tmp_path / "b.png")
