@@ -133,6 +133,25 @@ char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int
  * with --json; "" with --quiet. To free(); NULL when out of memory. */
 char *bb_job_summary_lines(const bb_command *command, const int *counts, int files);
 
+/* ------------------------- cmd: what a handed-over command's bake traces */
+
+/* What a split trace's worker traces of a checked command's bake (bake or
+ * height2ssbump, one input file; a hand-over, bb_command_from_handover):
+ * the input height read as the bake reads it (bb_height_file_read, with
+ * the command's --channel and --scale), which must be the bytes the bake
+ * read (file_hash: its report's source.file_hash), then smoothed, scaled,
+ * its max-mip pyramid and the ray set of the command's slices, power and
+ * basis (bb_command_set_basis's when set), built by the bake's own stages
+ * on threads threads (0: all cores; the same bits for any), as
+ * bb_bake_trace_input builds them. On success *pyramid and *rays receive
+ * them (free with bb_pyramid_free and bb_rayset_free); the slices to trace
+ * are bb_rayset_slice_count(*rays). Errors: BB_ERR_ARGUMENT (not a checked
+ * bake of one file; a threads count out of range), those of the read, BB_ERR_IO
+ * "PATH: the file changed while it was baked ..." when the bytes hash to
+ * another file_hash, BB_ERR_MEMORY; then nothing is left allocated. */
+bb_status bb_command_trace_input(const bb_command *command, int threads, uint64_t file_hash,
+                                 bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
+
 #ifdef __cplusplus
 }
 #endif
