@@ -642,7 +642,7 @@ void bb_pyramid_free(bb_pyramid *p);
 /* ------------------------------------------------------------- ray set */
 
 /* The directions the bake integrates over, and how; opaque, built by
- * the library for a bake (bb_bake_trace_input), read-only afterwards and safe to share between threads.
+ * the library for a bake (bb_command_trace_input), read-only afterwards and safe to share between threads.
  * ("Ray set" is the historical name: nothing is sampled in elevation.)
  * Slice s follows the integer lattice step (a, b) nearest to the azimuth
  * 2 pi (s + 1/2) / A and stands for the azimuth sector halfway to its

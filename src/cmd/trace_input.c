@@ -42,7 +42,7 @@ static bb_status trace_input(const bb_command *c, int threads, uint64_t file_has
   bb_bake_options o = job->bake;
   o.outputs = BB_MAPS_TRACED;
   o.trace.threads = threads;
-  st = bb_bake_trace_input(&height, &o, pyramid, rays, err);
+  st = bb__bake_trace_input(&height, &o, pyramid, rays, err);
   bb_image_free(&height);
   return st;
 }

@@ -6,6 +6,7 @@
  * the one traced. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 
+#include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "bumpbake_cluster.h"
 #include "cmd/cmd_internal.h"
@@ -87,7 +88,7 @@ static void assert_the_bakes_input(const bb_command *c, const char *path,
   o.trace.threads = 1;
   if (basis)
     o.basis = *basis;
-  cr_assert_eq(bb_bake_trace_input(&height, &o, &ref_p, &ref_rs, &err), BB_OK, "%s",
+  cr_assert_eq(bb__bake_trace_input(&height, &o, &ref_p, &ref_rs, &err), BB_OK, "%s",
                err.message);
   bb_image_free(&height);
   cr_assert_str_eq(bb_rayset_id(rs), bb_rayset_id(ref_rs));
