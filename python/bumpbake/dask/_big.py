@@ -9,7 +9,8 @@ what comes back in the order the single machine adds it
 (bb_trace_accumulate by rank), as each group arrives. A horizon task builds
 what the bake traces from the bake's command, handed over
 (bb_command_trace_input: read, smooth, scale, pyramid), once per worker
-process and bake, and finds its slices' horizons (bb_trace_horizons). The driver's own worker uses the driver's pyramid.
+process and bake, and finds its slices' horizons (bb_trace_horizons). The
+driver's own worker uses the driver's pyramid.
 """
 
 import collections
@@ -437,8 +438,8 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
             "command": handed, "directory": directory}
     basis = options.get("basis")
-    if _command is None and basis is not None and not isinstance(basis, (str, bytes,
-                                                                         os.PathLike)):
+    if _command is None and basis is not None and \
+            not isinstance(basis, (str, bytes, os.PathLike)):
         task["basis"] = np.asarray(basis, dtype=np.float64)  # vectors: no option spells them
     # (None: the driver's trace gives each task the cluster's threads over the tasks)
     task["horizon_threads"] = None if horizon_threads is None else int(horizon_threads)
