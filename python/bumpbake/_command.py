@@ -20,7 +20,7 @@ import os
 import numpy as np
 
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
-                      _message, _path, _shown, _text)
+                      _message, _path, _shown, _taken_bytes, _text)
 
 
 # What Python offers for an option of the command line's own
@@ -337,12 +337,7 @@ class Command:
         (bb_command_handover; from_handover reads them)."""
         size = _ffi.new("size_t *")
         raw = _lib.bb_command_handover(self._c, size)
-        if raw == _ffi.NULL:
-            raise MemoryError("bb_command_handover")
-        try:
-            return bytes(_ffi.buffer(raw, size[0]))
-        finally:
-            _lib.free(raw)
+        return _taken_bytes(raw, size[0], "bb_command_handover")
 
     @property
     def handle(self):
