@@ -642,7 +642,7 @@ void bb_pyramid_free(bb_pyramid *p);
 /* ------------------------------------------------------------- ray set */
 
 /* The directions the bake integrates over, and how; opaque, built by
- * the library for a bake (bb_bake_trace_input), read-only afterwards and safe to share between threads.
+ * the library for a bake (bb_command_trace_input), read-only afterwards and safe to share between threads.
  * ("Ray set" is the historical name: nothing is sampled in elevation.)
  * Slice s follows the integer lattice step (a, b) nearest to the azimuth
  * 2 pi (s + 1/2) / A and stands for the azimuth sector halfway to its
@@ -1769,6 +1769,17 @@ typedef struct bb_command bb_command;
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
+
+/* The directions of the weights, ssbump and bent a checked command bakes,
+ * where no --basis names them (Python's basis= array of vectors, made by
+ * bb_basis_from_vectors): the bake planned (bb_command_plan) and a split
+ * trace's input (bb_command_trace_input) use them as --basis's. Call after
+ * bb_command_check, with --basis not given; a command set or checked
+ * again keeps them. The text (bb_command_text) and the hand-over spell no
+ * basis. Errors: BB_ERR_ARGUMENT (no command or basis; a command taking
+ * no --basis, not checked, or given --basis; a basis of other than
+ * 3..BB_MAX_BASIS unit directions with z >= 0). */
+bb_status bb_command_set_basis(bb_command *command, const bb_basis *basis, bb_error *err);
 
 /* A new command `name` made of from's settings: from's inputs, and each
  * option `name` takes that from holds at a value other than a new `name`

@@ -80,19 +80,6 @@ bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *hor
  * makes them. Errors: BB_ERR_ARGUMENT (channels other than 1 + lobes). */
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
 
-/* ----------------------------------- bake: what a split trace traces */
-
-/* What a bake traces, built alone for a trace split over processes: the
- * max-mip pyramid of the smoothed height scaled to texels, and the ray set
- * of o's slices, power and basis, built by the bake's own stages (the same
- * bits), so the horizons found from them (bb_trace_horizons) are those of
- * a bake's trace of height with o. Checks o and the height as the bake does;
- * o->outputs must ask for a traced kind. On success *pyramid and *rays
- * receive them (free with bb_pyramid_free and bb_rayset_free). Memory:
- * about 13 bytes per texel while building, 5.4 once built. */
-bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
-                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
-
 /* -------------------------------- cmd: a checked command handed over */
 
 /* The hand-over of a checked command to another process (bake
@@ -132,6 +119,27 @@ char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int
  * B baked, C up to date, F failed[, R not run (...)]", or its JSON line
  * with --json; "" with --quiet. To free(); NULL when out of memory. */
 char *bb_job_summary_lines(const bb_command *command, const int *counts, int files);
+
+/* ------------------------- cmd: what a handed-over command's bake traces */
+
+/* What a split trace's worker traces of a checked command's bake (bake or
+ * height2ssbump, one input file; a hand-over, bb_command_from_handover):
+ * the input height read as the bake reads it (bb_height_file_read, with
+ * the command's --channel and --scale), which must be the bytes the bake
+ * read (file_hash: its report's source.file_hash), then smoothed, scaled,
+ * its max-mip pyramid and the ray set of the command's slices, power and
+ * basis (bb_command_set_basis's when set), built by the bake's own stages
+ * on threads threads (0: all cores; the same bits for any), so the
+ * horizons found from them (bb_trace_horizons) are those of the bake's
+ * trace. Memory: about 13 bytes per texel while building, 5.4 once
+ * built, besides the height read (4). On success *pyramid and *rays receive
+ * them (free with bb_pyramid_free and bb_rayset_free); the slices to trace
+ * are bb_rayset_slice_count(*rays). Errors: BB_ERR_ARGUMENT (not a checked
+ * bake of one file; a threads count out of range), those of the read, BB_ERR_IO
+ * "PATH: the file changed while it was baked ..." when the bytes hash to
+ * another file_hash, BB_ERR_MEMORY; then nothing is left allocated. */
+bb_status bb_command_trace_input(const bb_command *command, int threads, uint64_t file_hash,
+                                 bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 
 #ifdef __cplusplus
 }

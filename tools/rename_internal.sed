@@ -177,3 +177,6 @@ s/\bbb_bake_options_init\b/bb__bake_options_init/g
 # (bb_command_plan) now.
 s/\bbb_job_plan\b/bb__job_plan_options/g
 s/\bbb_job_command_text\b/bb__job_command_text/g
+# what a split trace traces, built of a height and bake options: Python's
+# workers build it of the handed-over command now (bb_command_trace_input).
+s/\bbb_bake_trace_input\b/bb__bake_trace_input/g

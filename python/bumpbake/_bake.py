@@ -157,19 +157,6 @@ def _bake_command(function, scale, options, mask, command="bake"):
     return c, maps
 
 
-def _bake_options(command, scale, **options):
-    """(bb_bake_options *, basis file or None) of bake's keyword arguments,
-    through the library's command (parsed and checked there)."""
-    traced = sum(1 << _KINDS[k][0] for k in TRACED_OUTPUTS)
-    c, maps = _bake_command(command, scale, options, traced)
-    o = _ffi.new("bb_bake_options *")
-    o[0] = c.options.job.bake
-    if maps.basis is not None:
-        o.basis = maps.basis[0]
-    maps.free()
-    return o, _text(c.options.job.basis_file)
-
-
 def _kinds_mask(command, kinds, what="outputs", noun="output"):
     kinds = (kinds,) if isinstance(kinds, str) else tuple(kinds)
     for k in kinds:

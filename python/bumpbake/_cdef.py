@@ -38,10 +38,6 @@ typedef struct bb_image {
   float *pixels;
 } bb_image;
 
-typedef enum bb_addressing {
-  BB_ADDRESS_PERIODIC = 0,
-  BB_ADDRESS_CLAMP
-} bb_addressing;
 
 typedef int (*bb_progress_fn)(void *user, long done, long total);
 
@@ -166,18 +162,6 @@ typedef enum bb_channel {
   BB_CHANNEL_VALVE
 } bb_channel;
 
-typedef struct bb_smooth_options {
-  int radius_texels;
-  float threshold;
-  bb_addressing addressing;
-} bb_smooth_options;
-
-typedef enum bb_normal_filter {
-  BB_NORMAL_VALVE = 0,
-  BB_NORMAL_CENTRAL,
-  BB_NORMAL_SOBEL,
-  BB_NORMAL_VERTEX
-} bb_normal_filter;
 
 
 typedef struct bb_basis {
@@ -205,22 +189,6 @@ struct bb_trace_options {
   void *trace_user;
 };
 
-typedef struct bb_bake_options {
-  float height_scale;
-  int rays;
-  int slices;
-  bb_smooth_options smooth;
-  bb_trace_options trace;
-  double power;
-  bb_basis basis;
-  bb_normal_filter normal_filter;
-  int normal_y_up;
-  unsigned outputs;
-  double bounce_albedo;
-  const bb_image *bounce_albedo_map;
-  int bounces;
-  const bb_image *brightness;
-} bb_bake_options;
 
 typedef struct bb_bake_result {
   bb_image filtered;
@@ -241,10 +209,6 @@ typedef struct bb_bake_result {
 
 typedef struct bb_bake_context bb_bake_context;
 
-typedef struct bb_valve_options {
-  int normal_map;
-  int ao_in_alpha;
-} bb_valve_options;
 
 typedef enum bb_mip_filter {
   BB_MIP_AVERAGE = 0,
@@ -391,37 +355,6 @@ typedef struct bb_check_case {
 typedef struct bb_check bb_check;
 typedef void (*bb_check_case_fn)(void *user, const bb_check_case *c);
 
-typedef struct bb_job_options {
-  bb_bake_options bake;
-  bb_channel channel;
-  bb_depth depth;
-  int mips;
-  const char *basis_file;
-  const char *bounce_albedo_file;
-  const char *brightness_file;
-  const char *paths[6];
-  const char *prefix;
-  const char *slope_path;
-  int slope_lit;
-  double slope_lit_azimuth, slope_lit_elevation;
-  const char *out_dir;
-  const char *name_template;
-  unsigned maps;
-  int force;
-  int keep_going;
-  const char *depfile;
-  const char *command;
-  const char *command_options;
-  bb_note_fn note;
-  void *note_user;
-  bb_texture_options texture;
-  const char *vmt;
-  const char *vmt_materials;
-  const char *vmt_basetexture;
-  const char *valve_path;
-  bb_valve_options valve;
-  int valve_detail;
-} bb_job_options;
 
 typedef struct bb_job bb_job;
 
@@ -585,9 +518,6 @@ bb_status bb_trace_horizons(const bb_pyramid *p, const bb_rayset *rs,
 bb_status bb_trace_accumulate(const bb_rayset *rs, int rank, const bb_image *horizon,
                               bb_image *sums, int threads, bb_error *err);
 bb_status bb_trace_finish(const bb_rayset *rs, bb_image *sums, int threads, bb_error *err);
-int bb_bake_slices(const bb_bake_options *o);
-bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *o,
-                              bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 bb_status bb_bake_context_new(bb_bake_context **out, bb_error *err);
 void bb_bake_context_free(bb_bake_context *context);
 void bb_bake_context_keep(bb_bake_context *context, int keep);
@@ -601,9 +531,6 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 bb_status bb_outputs_write(const bb_output_file *files, int count, int threads, bb_error *err);
-bb_status bb_height_file_read(const char *path, bb_channel channel, float height_scale,
-                              bb_note_fn note, void *note_user, bb_image *height,
-                              bb_height_source *source, bb_error *err);
 const char *bb_height_source_channel(const bb_height_source *source);
 void bb_check_free(bb_check *check);
 int bb_check_input_count(const bb_check *check);
@@ -645,6 +572,7 @@ bb_status bb_option_parse(const bb_option_info *option, const char *text, long l
 bb_status bb_command_new(const char *name, bb_command **out, bb_error *err);
 void bb_command_free(bb_command *command);
 const bb_command_info *bb_command_describe(const bb_command *command);
+bb_status bb_command_set_basis(bb_command *command, const bb_basis *basis, bb_error *err);
 bb_status bb_command_set(bb_command *command, const char *name, const char *text,
                          bb_error *err);
 bb_status bb_command_add_input(bb_command *command, const char *text, bb_error *err);
@@ -656,12 +584,13 @@ bb_status bb_command_value(const bb_command *command, const char *name, char *ou
                            size_t cap, bb_error *err);
 bb_status bb_command_numbers(const bb_command *command, const char *name, double *values,
                              int cap, int *count, bb_error *err);
-const bb_job_options *bb_command_job_options(const bb_command *command);
 void bb_command_set_picture(bb_command *command, int dynamic_light, int tile_y);
 char *bb_command_text(const bb_command *command, const char *input, unsigned flags);
 char *bb_command_handover(const bb_command *command, size_t *size);
 bb_status bb_command_from_handover(const char *data, size_t size, const char *const *inputs,
                                    int input_count, bb_command **out, bb_error *err);
+bb_status bb_command_trace_input(const bb_command *command, int threads, uint64_t file_hash,
+                                 bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
 bb_status bb_command_set_record(bb_command *command, const char *path, const char *line,
                                 const char *options, bb_error *err);
 bb_status bb_command_plan(bb_command *command, const bb_command_hooks *hooks, bb_job **job,

@@ -9,7 +9,7 @@ import typing
 
 from ._command import Command
 from ._common import (_argument_error, _check, _check_notes, _dispatch_notes, _ffi, _lib,
-                      _note_text, _path, _progress_hook, _text)
+                      _note_text, _path, _progress_hook, _taken_bytes, _text)
 
 # The keywords of limits in a rule, as idiff's options are named.
 _LIMITS = ("fail", "failpercent", "hardfail", "allowfailures", "warn", "warnpercent",
@@ -200,12 +200,7 @@ class Check:
         """The cases from first on as bytes (bb_check_export)."""
         size = _ffi.new("size_t *")
         raw = _lib.bb_check_export(self._c, first, size)
-        if raw == _ffi.NULL:
-            raise MemoryError("bb_check_export")
-        try:
-            return bytes(_ffi.buffer(raw, size[0]))
-        finally:
-            _lib.free(raw)
+        return _taken_bytes(raw, size[0], "bb_check_export")
 
     def import_cases(self, data):
         err = _ffi.new("bb_error *")

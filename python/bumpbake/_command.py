@@ -20,7 +20,7 @@ import os
 import numpy as np
 
 from ._common import (_argument_error, _c_bytes, _c_text, _check, _exception, _ffi, _lib,
-                      _message, _path, _shown, _text)
+                      _message, _path, _shown, _taken_bytes, _text)
 
 
 # What Python offers for an option of the command line's own
@@ -324,6 +324,21 @@ class Command:
             _c_text(options, "command_options") if options is not None else _ffi.NULL, err),
             err)
 
+    def set_basis(self, basis):
+        """A basis of vectors (a bb_basis *, bb_basis_from_vectors), which no
+        --basis spells, for the checked command's bake (bb_command_set_basis)."""
+        err = _ffi.new("bb_error *")
+        st = _lib.bb_command_set_basis(self._c, basis, err)
+        if st != _lib.BB_OK:
+            raise _exception(st, self.prefixed(_message(err, st)))
+
+    def handover(self):
+        """The command as bytes another process sets up again
+        (bb_command_handover; from_handover reads them)."""
+        size = _ffi.new("size_t *")
+        raw = _lib.bb_command_handover(self._c, size)
+        return _taken_bytes(raw, size[0], "bb_command_handover")
+
     @property
     def handle(self):
         return self._c
@@ -367,17 +382,12 @@ def doc(command, files=True, skip=()):
 
 
 class _Options:
-    """What the runs read of a checked command after bb_command_check: the
-    bake's options (job: bb_job_options, the stage API's), owned by the
-    command and writable for what has no spelling as an option (a basis of
-    vectors); the other options by name through the library."""
+    """What the runs read of a checked command after bb_command_check that
+    no keyword's value gives as it is; every option is read by name through
+    the library (value, numbers, word)."""
 
     def __init__(self, command):
         self._command = command
-
-    @property
-    def job(self):
-        return _ffi.cast("bb_job_options *", _lib.bb_command_job_options(self._command.handle))
 
     @property
     def maps_normal_y_up(self):

@@ -146,6 +146,17 @@ def _text(value):
     return _ffi.string(value).decode("utf-8", "surrogateescape")
 
 
+def _taken_bytes(raw, size, call):
+    """The size bytes at raw, which call malloc'd (freed here), as bytes;
+    MemoryError naming call when raw is NULL."""
+    if raw == _ffi.NULL:
+        raise MemoryError(call)
+    try:
+        return bytes(_ffi.buffer(raw, size))
+    finally:
+        _lib.free(raw)
+
+
 def _c_bytes(value, what):
     """value (bytes) for a C string: an embedded NUL, where C would end it
     (a.png\\0.exr read as a.png), is ValueError, as os gives."""

@@ -146,7 +146,7 @@ class BakeJob:
         c.record(a["command"], a["command_options"])
         c.check()
         if vectors is not None:
-            c.options.job.bake.basis = vectors[0]
+            c.set_basis(vectors)
         return c
 
     def _plan(self, inputs, a):

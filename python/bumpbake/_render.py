@@ -49,7 +49,7 @@ def _picture(c, height, maps, progress):
     """bb_command_picture of a checked command: the float32 picture."""
     field = None
     if height is not None:
-        field = _height_field(c.function, height, c.options.job.channel)
+        field = _height_field(c.function, height, c.word("channel"))  # its bb_channel
     raised = []
     hooks, _keep = _progress_hooks(progress, raised)
     out = _ffi.new("bb_image *")

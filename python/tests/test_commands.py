@@ -394,21 +394,29 @@ def test_the_option_table_is_the_librarys():
 
 
 def test_defaults_are_exactly_the_bake_a_command_checks():
-    """DEFAULTS, read by name from a bake command, hold the very values
-    (same type, same double) of the bake options a checked command with
-    nothing set but the scale hands on."""
+    """DEFAULTS, read by name from a bake command, are the very values a
+    bake with nothing set bakes with: given as keywords, the same maps bit
+    for bit; each one changed, other maps (the test can fail); the floats
+    the numbers the checked command holds (filter_threshold a C float's)."""
+    y, x = np.mgrid[0:23, 0:29]
+    h = (0.5 + 0.3 * np.sin(0.7 * x) * np.cos(0.45 * y)).astype(np.float32)
+    plain = bumpbake.bake(h, 9, outputs=bumpbake.OUTPUTS)
+    given = bumpbake.bake(h, 9, outputs=bumpbake.OUTPUTS, **bumpbake.DEFAULTS)
+    assert all(np.array_equal(plain[k], given[k]) for k in bumpbake.OUTPUTS)
+    changed = dict(rays=64, filter_radius=3, filter_threshold=0.05, bias=0.1, power=2.0,
+                   basis="hl2+z", normal_filter="valve", normal_y="up", clamp=True)
+    for key, value in changed.items():
+        other = bumpbake.bake(h, 9, outputs=bumpbake.OUTPUTS,
+                              **dict(bumpbake.DEFAULTS, **{key: value}))
+        assert any(plain[k].shape != other[k].shape or not np.array_equal(plain[k], other[k])
+                   for k in bumpbake.OUTPUTS), key
     c = _command.Command("bake", "bake")
     c.set("scale", 1.0)
     c.in_memory(0)
     c.check()
-    o = c.options.job.bake
-    assert bumpbake.DEFAULTS == {
-        "rays": o.rays, "filter_radius": o.smooth.radius_texels,
-        "filter_threshold": o.smooth.threshold, "bias": o.trace.bias_texels,
-        "power": o.power, "basis": _text(o.basis.name),
-        "normal_filter": "vertex" if o.normal_filter == _lib.BB_NORMAL_VERTEX else "other",
-        "normal_y": "up" if o.normal_y_up else "down",
-        "clamp": o.smooth.addressing == _lib.BB_ADDRESS_CLAMP, "threads": o.trace.threads}
+    assert bumpbake.DEFAULTS["filter_threshold"] == float(np.float32(
+        c.numbers("filter-threshold")[0]))
+    assert bumpbake.DEFAULTS["bias"] == c.numbers("bias")[0]
     assert [type(v) for v in bumpbake.DEFAULTS.values()] == [int, int, float, float, float,
                                                              str, str, str, bool, int]
 

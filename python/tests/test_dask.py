@@ -161,6 +161,8 @@ CASES = [  # (addressing, slices, basis): each at a size that is no power of two
     ("clamp", 16, "dirs:6"),
     ("periodic", 16, "dirs:6"),
     ("clamp", 8, "hl2"),
+    # vectors, which no option spells: set on each worker's command too
+    ("clamp", 6, ((0.6, 0.0, 0.8), (0.0, 0.6, 0.8), (-0.6, 0.0, 0.8), (0.0, -0.6, 0.8))),
 ]
 
 

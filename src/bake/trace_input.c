@@ -6,11 +6,10 @@
 #include "core/internal.h"
 #include "trace/pyramid.h"
 #include "trace/rayset.h"
-#include "bumpbake_cluster.h"
 
 #include <stdlib.h>
 
-bb_status bb_bake_trace_input(const bb_image *height, const bb_bake_options *given,
+bb_status bb__bake_trace_input(const bb_image *height, const bb_bake_options *given,
                               bb_pyramid **pyramid, bb_rayset **rays, bb_error *err) {
   if (!pyramid || !rays)
     return bb__fail(err, BB_ERR_ARGUMENT, "bake: missing pyramid or ray set");

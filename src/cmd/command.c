@@ -7,6 +7,7 @@
  * parameter's one range and every rule between options, so a plan made
  * from a checked command checks nothing again. */
 #include "cmd/cmd_internal.h"
+#include "trace/basis.h"
 #include "render/render_internal.h"
 #include "job/job_internal.h"
 #include "maps/maps_internal.h"
@@ -104,6 +105,27 @@ void bb_command_set_picture(bb_command *c, int dynamic_light, int tile_y) {
     c->options.render.dynamic_light = 0;
   if (tile_y > 0)
     c->options.render.tile_y = tile_y;
+}
+
+bb_status bb_command_set_basis(bb_command *c, const bb_basis *basis, bb_error *err) {
+  if (!c || !basis)
+    return bb__fail(err, BB_ERR_ARGUMENT, "bb_command_set_basis: bad arguments");
+  const char *name = c->def->info.name;
+  if (bb__option_find(c->def, "basis") < 0)
+    return bb__spelled(c, bb__fail(err, BB_ERR_ARGUMENT, "%s takes no --basis", name), err);
+  if (!c->checked)
+    return bb__fail(err, BB_ERR_ARGUMENT, "%s: set a basis of vectors after the check",
+                    name);
+  if (bb__given(c, "basis"))
+    return bb__spelled(c,
+                       bb__fail(err, BB_ERR_ARGUMENT,
+                                "%s: --basis is given: a basis of vectors goes in its place",
+                                name),
+                       err);
+  bb_status st = bb__basis_check(basis, name, err);
+  if (st == BB_OK)
+    c->options.job.bake.basis = *basis;
+  return st;
 }
 
 int bb__command_input_count(const bb_command *c) {

@@ -1,6 +1,6 @@
 /* test_split_bake.c: a bake whose trace is the caller's (bb_trace_options.trace)
  * and done by a split trace over its own copy of the trace's input
- * (bb_bake_trace_input) makes every map of a plain bake, bit for bit. */
+ * (bb__bake_trace_input) makes every map of a plain bake, bit for bit. */
 #include <criterion/criterion.h>
 
 #include <math.h>
@@ -40,7 +40,7 @@ static bb_status split_trace(void *user, const bb_pyramid *p, const bb_rayset *r
   (void)p;
   bb_pyramid *mine = NULL;
   bb_rayset *my_rays = NULL;
-  bb_status st = bb_bake_trace_input(u->height, u->options, &mine, &my_rays, err);
+  bb_status st = bb__bake_trace_input(u->height, u->options, &mine, &my_rays, err);
   if (st != BB_OK) return st;
   cr_assert_str_eq(bb_rayset_id(my_rays), bb_rayset_id(rs));
   const int n = bb_rayset_slice_count(my_rays);
@@ -147,7 +147,7 @@ Test(split_bake, a_trace_that_fails_or_makes_the_wrong_image_fails_the_bake) {
   o.outputs = BB_MAP_BIT(BB_MAP_NORMAL);
   bb_pyramid *p;
   bb_rayset *rs;
-  cr_assert_eq(bb_bake_trace_input(&height, &o, &p, &rs, &err), BB_ERR_ARGUMENT,
+  cr_assert_eq(bb__bake_trace_input(&height, &o, &p, &rs, &err), BB_ERR_ARGUMENT,
                "a bake of normals alone traces nothing");
   bb_image_free(&height);
 }

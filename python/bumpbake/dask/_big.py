@@ -7,9 +7,10 @@ is a hook (bb_trace_options.trace) that sends the slices to horizon tasks,
 two slices each (a slice and its opposite share their sweeps), and adds
 what comes back in the order the single machine adds it
 (bb_trace_accumulate by rank), as each group arrives. A horizon task builds
-what the bake traces (bb_bake_trace_input: read, smooth, scale, pyramid)
-once per worker process and bake, and finds its slices' horizons
-(bb_trace_horizons). The driver's own worker uses the driver's pyramid.
+what the bake traces from the bake's command, handed over
+(bb_command_trace_input: read, smooth, scale, pyramid), once per worker
+process and bake, and finds its slices' horizons (bb_trace_horizons). The
+driver's own worker uses the driver's pyramid.
 """
 
 import collections
@@ -23,8 +24,8 @@ import uuid
 import distributed
 import numpy as np
 
-from .._bake import BAKE_PARAMETERS, TRACED_OUTPUTS, _bake_options, _channel, _kinds_mask
-from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _path, _text
+from .._bake import _basis
+from .._common import Error, _check, _dispatch_notes, _exception, _ffi, _lib, _text
 from .._jobs import BakeJob, _raise_failures
 from ._batch import sweep_temporaries
 from .._command import Command
@@ -149,44 +150,29 @@ def _take_back(key, entry):
             _inputs_changed.wait()
 
 
-def _bake_options_of(task):
-    """(bb_bake_options * of task's bake, its bb_channel, what must stay
-    alive while they are used): from bake_big's keyword arguments, or from
-    the command the CLI handed over, set up again by the library in the
-    client's directory (a basis file named relative to it)."""
-    if "command" in task:
-        with client_directory(task["directory"]):
-            command = Command.from_handover(task["command"])
-        o = _ffi.new("bb_bake_options *")
-        o[0] = command.options.job.bake
-        channel = command.options.job.channel
-    else:
-        o, _ = _bake_options("bake", task["scale"], **task["options"])
-        channel, command = _channel(task["channel"]), None
-    o.outputs = _kinds_mask("bake", TRACED_OUTPUTS)[1]
-    return o, channel, command
+def _task_command(task):
+    """task's bake command, handed over and set up again by the library in
+    the client's directory (a basis file is named relative to it), reading
+    the input the driver planned; with the basis of vectors it was given
+    (which no option spells)."""
+    with client_directory(task["directory"]):
+        command = Command.from_handover(task["command"], [task["path"]])
+    if task.get("basis") is not None:
+        command.set_basis(_basis(task["basis"])[0])
+    return command
 
 
 def _build(task, threads):
-    """The trace's input of task's bake on this worker: the height read as
-    the driver read it (the same bytes: their hash is checked), smoothed,
-    scaled, its pyramid, and the ray set."""
+    """The trace's input of task's bake on this worker, built by the
+    library from the bake's command (bb_command_trace_input): the height
+    read as the driver read it (the same bytes: their hash is checked),
+    smoothed, scaled, its pyramid, and the ray set."""
+    command = _task_command(task)
+    pyramid = _ffi.new("bb_pyramid **")
+    rays = _ffi.new("bb_rayset **")
     err = _ffi.new("bb_error *")
-    height = _ffi.new("bb_image *")
-    source = _ffi.new("bb_height_source *")
-    o, channel, keep = _bake_options_of(task)
-    _check(_lib.bb_height_file_read(_path(task["path"]), channel, o.height_scale, _ffi.NULL,
-                                    _ffi.NULL, height, source, err), err)
-    try:
-        if source.file_hash != task["file_hash"]:
-            raise Error(f"{task['path']}: the file changed while it was baked (a worker read "
-                        "other bytes than the bake's)", "i/o error")
-        o.trace.threads = threads
-        pyramid = _ffi.new("bb_pyramid **")
-        rays = _ffi.new("bb_rayset **")
-        _check(_lib.bb_bake_trace_input(height, o, pyramid, rays, err), err)
-    finally:
-        _lib.bb_image_free(height)
+    _check(_lib.bb_command_trace_input(command.handle, threads, task["file_hash"], pyramid,
+                                       rays, err), err)
     if _text(_lib.bb_rayset_id(rays[0])) != task["rayset"]:
         _lib.bb_pyramid_free(pyramid[0])
         _lib.bb_rayset_free(rays[0])
@@ -209,9 +195,8 @@ def _horizons(task, slices, threads):
     (H, W)}) of task's bake, found by the sweeps the single machine runs."""
     entry = _acquire(task["key"], lambda: _build(task, threads))
     try:
-        o = _ffi.new("bb_trace_options *")
-        bake, _, keep = _bake_options_of(task)
-        o[0] = bake.trace
+        o = _ffi.new("bb_trace_options *")  # the bake's, as the driver's trace has them
+        o.bias_texels = task["bias"]
         o.threads = threads
         c_slices = _ffi.new("int[]", slices)
         images = _ffi.new("bb_image[]", len(slices))
@@ -258,7 +243,7 @@ class _SplitTrace:
         order = _ffi.new("int[]", n)
         _check(_lib.bb_trace_slice_order(rays, order, err), err)
         task = dict(self.task, rayset=_text(_lib.bb_rayset_id(rays)),
-                    file_hash=self.job._raw(0).source.file_hash)
+                    file_hash=self.job._raw(0).source.file_hash, bias=options.bias_texels)
         # A slice and the next in the order (its opposite, when it has one)
         # go together: bb_trace_horizons sweeps them once.
         groups = [list(range(k, min(k + 2, n))) for k in range(0, n, 2)]
@@ -273,7 +258,10 @@ class _SplitTrace:
         cpu0 = _cpu()
         try:
             with distributed.worker_client() as client:
-                futures = [client.submit(_horizons, task, [order[r] for r in g], self.lib_threads,
+                lib_threads = self.lib_threads
+                if lib_threads is None:  # the cluster's threads over the tasks
+                    lib_threads = max(1, worker_threads(client) // len(groups))
+                futures = [client.submit(_horizons, task, [order[r] for r in g], lib_threads,
                                          key=f"bumpbake-horizons-{task['key']}-{k}", pure=False)
                            for k, g in enumerate(groups)]
                 # The next groups' horizons come over (and who ran them is
@@ -436,34 +424,25 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     directory = os.getcwd()
     if _command is not None:  # the CLI's command (bumpbake bake --scheduler): always baked
         job = CommandJob(_command.data, notes=notes)
-        args, force = _command, True
-        slices = _lib.bb_bake_slices(_ffi.addressof(_command.options.job, "bake"))
+        args, force, handed = _command, True, _command.data
     else:
         job = BakeJob(input, None, outputs=outputs, prefix=prefix, slope=slope, lit=lit,
                       depfile=depfile, force=force, notes=notes, command=command, **options)
         args = dict(job._args, force=True)
+        handed = job._cmd.handover()  # the command the workers' trace inputs are built of
     if not force and job.check_current(0):
         report = job.report(0)
         report.status = "up to date"
         return report
     planned = job.inputs[0]
-    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned)}
-    if _command is not None:
-        task.update(command=_command.data, directory=directory)
-    else:
-        basis = options.get("basis")
-        task_options = {k: v for k, v in options.items()
-                        if k in BAKE_PARAMETERS and k != "threads"}
-        if isinstance(basis, (str, bytes, os.PathLike)) and os.path.exists(basis) and \
-                os.fsdecode(basis) not in ("hl2", "hl2+z") and \
-                not os.fsdecode(basis).startswith("dirs:"):
-            task_options["basis"] = os.path.abspath(basis)  # a basis file, for any directory
-        slices = _lib_slices(task_options)
-        task.update(scale=args.get("scale"), channel=args.get("channel"), options=task_options)
-    tasks = max(1, (slices + 1) // 2)
-    if horizon_threads is None:
-        horizon_threads = max(1, worker_threads(client) // tasks)
-    task["horizon_threads"] = int(horizon_threads)
+    task = {"key": uuid.uuid4().hex, "path": os.path.join(directory, planned),
+            "command": handed, "directory": directory}
+    basis = options.get("basis")
+    if _command is None and basis is not None and \
+            not isinstance(basis, (str, bytes, os.PathLike)):
+        task["basis"] = np.asarray(basis, dtype=np.float64)  # vectors: no option spells them
+    # (None: the driver's trace gives each task the cluster's threads over the tasks)
+    task["horizon_threads"] = None if horizon_threads is None else int(horizon_threads)
     # Set when the client gives up (Ctrl-C): the driver stops at the next
     # group of slices, writing nothing (a running task cannot be killed).
     task["stop"] = f"bumpbake-big-stop-{task['key']}"
@@ -501,12 +480,6 @@ def bake_big(input, outputs=None, *, client=None, prefix=None, slope=None, lit=N
     if check:
         _raise_failures([report], None)
     return report
-
-
-def _lib_slices(options):
-    o, _ = _bake_options("bake", 1.0, **{k: v for k, v in options.items()
-                                         if k in ("rays", "slices")})
-    return _lib.bb_bake_slices(o)
 
 
 # bb_status by name ("i/o error", ...), for an exception's .status.

@@ -6,21 +6,10 @@ import uuid
 
 from .. import _check as check_module
 from .._command import Command
-from .._common import _argument_error, _ffi, _lib
+from .._common import _argument_error
 from ._batch import chunk_size_for
 from ._connect import completed, settle
 from ._shared import client_directory, client_of, worker_threads
-
-
-def _handover(cmd):
-    size = _ffi.new("size_t *")
-    raw = _lib.bb_command_handover(cmd.handle, size)
-    if raw == _ffi.NULL:
-        raise MemoryError("bb_command_handover")
-    try:
-        return bytes(_ffi.buffer(raw, size[0]))
-    finally:
-        _lib.free(raw)
 
 
 def _check_chunk(directory, data, golden, heights):
@@ -62,7 +51,7 @@ def check_files(golden, heights, *, client=None, limits=None, update=False, juni
     if not isinstance(size, int) or size < 1:
         raise _argument_error(f"bumpbake.dask: chunk_size must be a positive integer "
                               f"(got {chunk_size!r})")
-    data = _handover(cmd)
+    data = cmd.handover()
     token = uuid.uuid4().hex
     chunks = [inputs[i:i + size] for i in range(0, len(inputs), size)]
     futures = {}

@@ -38,9 +38,10 @@ class CommandJob(BakeJob):
             err = _ffi.new("bb_error *")
             _check(_lib.bb_command_set(command.handle, b"force", b"0", err), err)
             _check(_lib.bb_command_check(command.handle, err), err)
-        job = command.options.job
-        self._args = dict(out_dir=command.job_text("out_dir"), keep_going=bool(job.keep_going),
-                          force=bool(job.force), depfile=command.job_text("depfile"))
+        self._args = dict(out_dir=command.job_text("out_dir"),
+                          keep_going=command.value("keep-going") == "1",
+                          force=command.value("force") == "1",
+                          depfile=command.job_text("depfile"))
         self._single = False  # the command line's single bake always bakes
         hooks = _ffi.new("bb_command_hooks *")
         if _trace is not None:
