@@ -216,12 +216,15 @@ static inline int write_gif_screen(const char *path, unsigned width, unsigned he
 /* An 8-bit RLE SGI of 2 x 2 texels, one channel, whose header declares
  * `rows` rows of `channels` channels (2 and 1 make it a valid file of 544
  * bytes): OpenImageIO zeroes offset tables of 8 bytes a row and channel
- * to open it. SGI's numbers are big-endian; the header is 512 bytes. */
+ * to open it. Its second row's length is `second_row_length` (4 is the
+ * row's; reading a row allocates its length). SGI's numbers are
+ * big-endian; the header is 512 bytes. */
 static inline void hostile_put_be(unsigned char *p, unsigned v, int bytes) {
   for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * (bytes - 1 - i)));
 }
 
-static inline int write_sgi_rle(const char *path, unsigned rows, unsigned channels) {
+static inline int write_sgi_rle_rows(const char *path, unsigned rows, unsigned channels,
+                                     unsigned second_row_length) {
   unsigned char b[544] = {0};
   hostile_put_be(b, 0x01DA, 2);    /* magic */
   b[2] = 1, b[3] = 1;              /* RLE, one byte a sample */
@@ -233,10 +236,14 @@ static inline int write_sgi_rle(const char *path, unsigned rows, unsigned channe
   /* The row starts, the row lengths, then two rows of 4 bytes each: a
    * run of two literal samples, then the end. */
   hostile_put_be(b + 512, 528, 4), hostile_put_be(b + 516, 532, 4);
-  hostile_put_be(b + 520, 4, 4), hostile_put_be(b + 524, 4, 4);
+  hostile_put_be(b + 520, 4, 4), hostile_put_be(b + 524, second_row_length, 4);
   const unsigned char rows_rle[8] = {0x82, 10, 200, 0, 0x82, 90, 30, 0};
   memcpy(b + 528, rows_rle, sizeof rows_rle);
   return hostile_write(path, b, sizeof b);
+}
+
+static inline int write_sgi_rle(const char *path, unsigned rows, unsigned channels) {
+  return write_sgi_rle_rows(path, rows, channels, 4);
 }
 
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -16,7 +16,7 @@ extern "C" {
  * or a header the format's library cannot read: the reader then fails on
  * its own, allocating nothing large). */
 typedef struct bb__probe {
-  const char *format;  /* "JPEG", "GIF", "OpenEXR", "SGI" or NULL */
+  const char *format;  /* "JPEG", "GIF", "OpenEXR", "SGI", ... or NULL */
   int width, height;   /* the declared image (subimage 0), 0 when unknown */
   double open_bytes;   /* what the reader allocates in open() */
   double chunk_bytes;  /* OpenEXR: the largest chunk (tile or scanline block) decoded */
@@ -24,6 +24,8 @@ typedef struct bb__probe {
                         * entry (a chunk; an RLE row of one channel) */
   const char *table_entries; /* what an entry is, for messages: "chunks", "RLE rows" */
   double file_bytes;   /* the file's size */
+  char corrupt[240];   /* set when the header declares what the file cannot hold (a length
+                        * running past its end): why, after "corrupt image: " */
 } bb__probe;
 
 /* Reads the header of the regular file open at fd (path names it in

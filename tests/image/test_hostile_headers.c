@@ -158,6 +158,22 @@ Test(hostile_headers, sgi_offset_tables_longer_than_the_file_are_refused) {
   bb_image_free(&img);
 }
 
+/* Reading an RLE SGI's row allocates the length its table gives, an int:
+ * a row running past the end of the file is refused from the header
+ * (0xFFFFFFFF asked for 4 GB at the first row read; 0x7FFFFFF0 for 2 GB),
+ * and the same file whose row lies in it reads (above). */
+Test(hostile_headers, sgi_rle_rows_past_the_end_of_the_file_are_refused) {
+  const char *path = tmp("l.sgi");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 0xFFFFFFFFu), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: SGI RLE row 1 of channel 0 declares 4294967295 "
+                            "bytes at byte 532, past the end of the file of 544 bytes");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 0x7FFFFFF0u), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "declares 2147483632 bytes at byte 532");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 13), 0); /* one byte past the end */
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "declares 13 bytes at byte 532");
+}
+
 /* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
  * extension index, then the file): each made OpenImageIO's reader allocate
  * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
@@ -175,6 +191,8 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
       {"png-text-chunk-of-1.7-gb", ".png", "Read error: hit end of file"},
       {"sgi-rle-offset-tables-of-6.6-gb", ".sgi",
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
+      {"sgi-rle-row-length-of-4-gb", ".sgi",
+       "SGI RLE row 0 of channel 0 declares 4294967295 bytes at byte 1870300560"},
   };
   for (size_t i = 0; i < sizeof finds / sizeof finds[0]; i++) {
     char from[256];
