@@ -246,4 +246,59 @@ static inline int write_sgi_rle(const char *path, unsigned rows, unsigned channe
   return write_sgi_rle_rows(path, rows, channels, 4);
 }
 
+/* A DPX of 1 x 1 RGB texel, 8 bits (4 bytes of data after the 2048-byte
+ * header and `user_bytes` bytes of user data), whose header declares
+ * `user_size` bytes of user data (user_bytes makes it a valid file),
+ * big-endian ("SDPX") or little-endian ("XPDS"): OpenImageIO's reader
+ * allocates the declared size, zeroed, in open(). */
+static inline void hostile_put_order(unsigned char *p, unsigned v, int bytes, int little) {
+  for (int i = 0; i < bytes; i++)
+    p[i] = (unsigned char)(v >> (8 * (little ? i : bytes - 1 - i)));
+}
+
+static inline int write_dpx_user(const char *path, uint32_t user_size, unsigned user_bytes,
+                                 int little) {
+  unsigned char b[2048 + 64 + 4];
+  if (user_bytes > 64) return -1;
+  const unsigned data = 2048 + user_bytes, total = data + 4;
+  memset(b, 0, sizeof b);
+  memcpy(b, little ? "XPDS" : "SDPX", 4);
+  hostile_put_order(b + 4, data, 4, little);   /* image data offset */
+  memcpy(b + 8, "V2.0", 4);
+  hostile_put_order(b + 16, total, 4, little); /* file size */
+  hostile_put_order(b + 24, 1664, 4, little);  /* generic header */
+  hostile_put_order(b + 28, 384, 4, little);   /* industry header */
+  hostile_put_order(b + 32, user_size, 4, little);
+  hostile_put_order(b + 770, 1, 2, little);    /* one element */
+  hostile_put_order(b + 772, 1, 4, little);    /* 1 pixel a line */
+  hostile_put_order(b + 776, 1, 4, little);    /* 1 line */
+  b[800] = 50, b[803] = 8;                     /* RGB, 8 bits */
+  hostile_put_order(b + 808, data, 4, little); /* the element's data */
+  memset(b + 2048, 'u', user_bytes);
+  b[data] = 200, b[data + 1] = 100, b[data + 2] = 50;
+  return hostile_write(path, b, total);
+}
+
+/* A Cineon file of 1 x 1 texel, one 8-bit channel, laid out as
+ * write_dpx_user's (the user data size at 16, big-endian). */
+static inline int write_cineon_user(const char *path, uint32_t user_size, unsigned user_bytes) {
+  unsigned char b[2048 + 64 + 4];
+  if (user_bytes > 64) return -1;
+  const unsigned data = 2048 + user_bytes, total = data + 4;
+  memset(b, 0, sizeof b);
+  hostile_put_be(b, 0x802A5FD7u, 4);
+  hostile_put_be(b + 4, data, 4);   /* image data offset */
+  hostile_put_be(b + 8, 1024, 4);   /* generic header */
+  hostile_put_be(b + 12, 1024, 4);  /* industry header */
+  hostile_put_be(b + 16, user_size, 4);
+  hostile_put_be(b + 20, total, 4); /* file size */
+  b[193] = 1;                       /* one element: */
+  b[198] = 8;                       /* 8 bits, */
+  hostile_put_be(b + 200, 1, 4);    /* 1 pixel a line, */
+  hostile_put_be(b + 204, 1, 4);    /* 1 line */
+  memset(b + 2048, 'u', user_bytes);
+  b[data] = 200;
+  return hostile_write(path, b, total);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -31,6 +31,11 @@
  *   the file (header_walk.c reads the sizes at their fixed offsets, then
  *   the tables).
  *
+ * - DPX, Cineon: open() allocates the user data the header declares,
+ *   zeroed, and copies it into the image's attributes twice, whether or
+ *   not the file holds it (a 2 KB DPX declaring 768 MiB took 2.5 GB and
+ *   opened): it must lie in the file (header_walk.c).
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -41,6 +46,7 @@
 #include "image/header_probe.h"
 #include "core/internal.h"
 #include "image/header_walk.h"
+#include "image/signatures.h"
 
 #include <setjmp.h>
 #include <stdio.h>
@@ -254,6 +260,12 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     if (got == sizeof magic) bb__probe_sgi(fd, magic, p); /* shorter: the reader fails its header read */
     return BB_OK;
   }
-  probe_gif(fd, magic, p);
+  const char *format = bb__format_by_content(magic, (unsigned long)got);
+  if (format && strcmp(format, "dpx") == 0)
+    bb__probe_dpx(fd, magic, p);
+  else if (format && strcmp(format, "cineon") == 0)
+    bb__probe_cineon(fd, magic, p);
+  else
+    probe_gif(fd, magic, p);
   return BB_OK;
 }

@@ -94,3 +94,31 @@ void bb__probe_sgi(int fd, const unsigned char *head, bb__probe *p) {
     }
   }
 }
+
+/* ----------------------------------------------------------- DPX, Cineon */
+
+/* Both readers allocate the user data the header declares (a 32-bit size,
+ * 0 and 0xFFFFFFFF meaning none), zeroed, inside open(), read it from the
+ * end of the 2048-byte header without looking at the result, and copy it
+ * into the image's attributes twice: a 2048-byte DPX declaring 768 MiB took
+ * 2.5 GB and opened (the load fuzzer's took 2.2 GB). The user data lies in
+ * the file. The size's byte order is the magic number's: "SDPX" and
+ * 802A5FD7 are big-endian, "XPDS" and D75F2A80 little-endian. */
+static void probe_user_data(int fd, const char *format, double at, int little, bb__probe *p) {
+  p->format = format;
+  bb__walk w = {fd, p->file_bytes, at, 1};
+  const uint64_t user = bb__walk_number(&w, 4, little);
+  if (w.ok && user != 0 && user != 0xFFFFFFFFu && 2048.0 + (double)user > p->file_bytes)
+    bb__probe_corrupt(p,
+                      "its %s user data of %.0f bytes after the 2048-byte header runs past "
+                      "the end of the file of %.0f bytes",
+                      format, (double)user, p->file_bytes);
+}
+
+void bb__probe_dpx(int fd, const unsigned char *head, bb__probe *p) {
+  probe_user_data(fd, "DPX", 32, head[0] == 'X', p);
+}
+
+void bb__probe_cineon(int fd, const unsigned char *head, bb__probe *p) {
+  probe_user_data(fd, "Cineon", 16, head[0] == 0xD7, p);
+}

@@ -174,6 +174,43 @@ Test(hostile_headers, sgi_rle_rows_past_the_end_of_the_file_are_refused) {
   expect_every_read_refuses(path, BB_ERR_FORMAT, "declares 13 bytes at byte 532");
 }
 
+/* DPX and Cineon readers allocate the user data their header declares,
+ * zeroed, in open(), and copy it twice (a 2 KB DPX declaring 768 MiB took
+ * 2.5 GB and opened): user data running past the end of the file is
+ * refused from the header, in either byte order, and the same files whose
+ * 16 bytes of user data lie in them read. */
+Test(hostile_headers, dpx_and_cineon_user_data_past_the_end_of_the_file_is_refused) {
+  const char *dpx = tmp("u.dpx"), *cin = tmp("u.cin");
+  for (int little = 0; little <= 1; little++) {
+    cr_assert_eq(write_dpx_user(dpx, 0xC0000000u, 16, little), 0);
+    expect_every_read_refuses(dpx, BB_ERR_FORMAT,
+                              "corrupt image: its DPX user data of 3221225472 bytes after the "
+                              "2048-byte header runs past the end of the file of 2068 bytes");
+    cr_assert_eq(write_dpx_user(dpx, 21, 16, little), 0); /* one byte past the end */
+    expect_every_read_refuses(dpx, BB_ERR_FORMAT, "user data of 21 bytes");
+  }
+  cr_assert_eq(write_cineon_user(cin, 0x80000000u, 16), 0);
+  expect_every_read_refuses(cin, BB_ERR_FORMAT,
+                            "corrupt image: its Cineon user data of 2147483648 bytes after "
+                            "the 2048-byte header runs past the end of the file of 2068 bytes");
+  for (int little = 0; little <= 1; little++) {
+    cr_assert_eq(write_dpx_user(dpx, 16, 16, little), 0);
+    bb_image img;
+    bb_error err;
+    cr_assert_eq(bb_image_read(dpx, &img, NULL, &err), BB_OK, "%s", err.message);
+    cr_expect(img.width == 1 && img.height == 1 && img.channels == 3);
+    const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+    for (int i = 0; i < 3; i++)
+      cr_expect_float_eq(img.pixels[i], want[i], 1e-6, "sample %d: %g", i, img.pixels[i]);
+    bb_image_free(&img);
+  }
+  cr_assert_eq(write_cineon_user(cin, 16, 16), 0);
+  int w = 0, h = 0, c = 0;
+  bb_error err;
+  cr_assert_eq(bb_image_read_info(cin, &w, &h, &c, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(w == 1 && h == 1 && c == 1);
+}
+
 /* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
  * extension index, then the file): each made OpenImageIO's reader allocate
  * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
@@ -191,6 +228,8 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
       {"png-text-chunk-of-1.7-gb", ".png", "Read error: hit end of file"},
       {"sgi-rle-offset-tables-of-6.6-gb", ".sgi",
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
+      {"dpx-user-data-of-2.2-gb", ".dpx",
+       "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
       {"sgi-rle-row-length-of-4-gb", ".sgi",
        "SGI RLE row 0 of channel 0 declares 4294967295 bytes at byte 1870300560"},
   };
