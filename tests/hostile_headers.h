@@ -301,4 +301,29 @@ static inline int write_cineon_user(const char *path, uint32_t user_size, unsign
   return hostile_write(path, b, total);
 }
 
+/* An RLE8 BMP (Windows' 40-byte header) declaring width x height (a
+ * negative height: rows top to bottom), two palette colours (black and
+ * white), and for its first two rows from the bottom: two white texels,
+ * then two black (76 bytes; 2 x 2 makes it a valid file). OpenImageIO
+ * decodes an RLE BMP into width x height bytes, zeroed first, in open(). */
+static inline int write_bmp_rle8(const char *path, int32_t width, int32_t height) {
+  unsigned char b[76];
+  memset(b, 0, sizeof b);
+  memcpy(b, "BM", 2);
+  hostile_put32(b + 2, sizeof b);
+  hostile_put32(b + 10, 14 + 40 + 8); /* the pixels' offset */
+  hostile_put32(b + 14, 40);
+  hostile_put32(b + 18, (uint32_t)width);
+  hostile_put32(b + 22, (uint32_t)height);
+  hostile_put16(b + 26, 1);           /* planes */
+  hostile_put16(b + 28, 8);           /* bits a texel */
+  hostile_put32(b + 30, 1);           /* RLE8 */
+  hostile_put32(b + 34, 14);          /* the RLE bytes */
+  hostile_put32(b + 46, 2);           /* colours used */
+  memset(b + 58, 0xFF, 3);            /* colour 1: white */
+  const unsigned char rle[8] = {2, 1, 0, 0, 2, 0, 0, 1}; /* rows, then the end */
+  memcpy(b + 62, rle, sizeof rle);
+  return hostile_write(path, b, sizeof b);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

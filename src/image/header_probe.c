@@ -36,6 +36,10 @@
  *   not the file holds it (a 2 KB DPX declaring 768 MiB took 2.5 GB and
  *   opened): it must lie in the file (header_walk.c).
  *
+ * - BMP: for an RLE file, open() decodes the whole image into width x
+ *   height bytes, zeroed first (a 54-byte file of 40000 x 40000 took 1.7
+ *   GB): the size and compression are at fixed offsets (header_walk.c).
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -265,6 +269,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_dpx(fd, magic, p);
   else if (format && strcmp(format, "cineon") == 0)
     bb__probe_cineon(fd, magic, p);
+  else if (format && strcmp(format, "bmp") == 0)
+    bb__probe_bmp(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

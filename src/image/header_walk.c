@@ -122,3 +122,31 @@ void bb__probe_dpx(int fd, const unsigned char *head, bb__probe *p) {
 void bb__probe_cineon(int fd, const unsigned char *head, bb__probe *p) {
   probe_user_data(fd, "Cineon", 16, head[0] == 0xD7, p);
 }
+
+/* -------------------------------------------------------------------- BMP */
+
+/* For RLE compression (1: RLE8, 2: RLE4), open() decodes the whole image
+ * into a buffer of width x height bytes, zeroed before the first RLE byte
+ * is read: a 54-byte file of 40000 x 40000 took 1.7 GB. The product is an
+ * int there (past INT_MAX it wraps), which BB_MAX_READ_BYTES, 1 GiB, stays
+ * below. The Windows headers (40, 52, 56, 108 or 124 bytes, their size at
+ * 14) hold the width and height as 32-bit little-endian numbers at 18 and
+ * 22 (a negative height: rows top to bottom) and the compression at 30;
+ * OS/2's 12-byte header has no compression. */
+void bb__probe_bmp(int fd, bb__probe *p) {
+  bb__walk w = {fd, p->file_bytes, 14, 1};
+  const uint64_t size = bb__walk_number(&w, 4, 1);
+  const int32_t width = (int32_t)(uint32_t)bb__walk_number(&w, 4, 1);
+  const int32_t height = (int32_t)(uint32_t)bb__walk_number(&w, 4, 1);
+  w.pos = 30;
+  const uint64_t compression = bb__walk_number(&w, 4, 1);
+  if (!w.ok || (size != 40 && size != 52 && size != 56 && size != 108 && size != 124) ||
+      (compression != 1 && compression != 2))
+    return;
+  const double rows = height < 0 ? -(double)height : (double)height;
+  if (width <= 0 || rows < 1 || rows > 2147483647.0) return; /* the reader refuses it */
+  p->format = "BMP";
+  p->width = width;
+  p->height = (int)rows;
+  p->open_bytes = (double)width * rows;
+}

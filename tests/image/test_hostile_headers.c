@@ -211,6 +211,27 @@ Test(hostile_headers, dpx_and_cineon_user_data_past_the_end_of_the_file_is_refus
   cr_expect(w == 1 && h == 1 && c == 1);
 }
 
+/* OpenImageIO decodes an RLE BMP whole into width x height bytes, zeroed,
+ * in open() (a 54-byte file of 40000 x 40000 took 1.7 GB): that is held to
+ * BB_MAX_READ_BYTES from the header, and a small one reads. */
+Test(hostile_headers, an_rle_bmp_too_large_to_open_says_so) {
+  const char *path = tmp("r.bmp");
+  cr_assert_eq(write_bmp_rle8(path, 50000, -50000), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a BMP of 50000x50000 needs 2384 MiB to open");
+  cr_assert_eq(write_bmp_rle8(path, 65536, 65536), 0); /* past INT_MAX bytes */
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a BMP of 65536x65536 needs 4096 MiB to open");
+  cr_assert_eq(write_bmp_rle8(path, 2, 2), 0);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 1);
+  /* BMP's rows run bottom to top: the white row is the image's last. */
+  const float want[4] = {0, 0, 1, 1};
+  for (int i = 0; i < 4; i++)
+    cr_expect_float_eq(img.pixels[i], want[i], 1e-6, "texel %d: %g", i, img.pixels[i]);
+  bb_image_free(&img);
+}
+
 /* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
  * extension index, then the file): each made OpenImageIO's reader allocate
  * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
