@@ -326,4 +326,53 @@ static inline int write_bmp_rle8(const char *path, int32_t width, int32_t height
   return hostile_write(path, b, sizeof b);
 }
 
+/* A 2 x 2 grayscale PSD, 8 bits, of one layer (one channel, raw): its
+ * colour mode data declares `colour_length` bytes (none are there), its
+ * one image resource `resource_id` declares `resource_length` bytes (2
+ * are there: a name of `name_length` bytes, then "A"), and its layer runs
+ * from row 0 to `layer_bottom` (0, `id`, 2, 1, 2 make it a valid file of
+ * 126 bytes; resource 1006 holds alpha channel names). Its layer's texels
+ * are 10, 20, 30, 40; the merged image's 50, 60, 70, 80. OpenImageIO
+ * allocates each length, and a table of 8 bytes for each of a layer
+ * channel's rows, zeroed, in open(). PSD's numbers are big-endian. */
+static inline int write_psd(const char *path, uint32_t colour_length, unsigned resource_id,
+                            uint32_t resource_length, unsigned name_length,
+                            uint32_t layer_bottom) {
+  unsigned char b[256];
+  size_t n = 0;
+  memset(b, 0, sizeof b);
+  memcpy(b, "8BPS", 4), n = 4;
+  hostile_put_be(b + n, 1, 2), n += 2 + 6;       /* version 1, reserved */
+  hostile_put_be(b + n, 1, 2), n += 2;           /* one channel */
+  hostile_put_be(b + n, 2, 4), n += 4;           /* height */
+  hostile_put_be(b + n, 2, 4), n += 4;           /* width */
+  hostile_put_be(b + n, 8, 2), n += 2;           /* bits */
+  hostile_put_be(b + n, 1, 2), n += 2;           /* grayscale */
+  hostile_put_be(b + n, colour_length, 4), n += 4;
+  hostile_put_be(b + n, 14, 4), n += 4;          /* the image resources: */
+  memcpy(b + n, "8BIM", 4), n += 4;
+  hostile_put_be(b + n, resource_id, 2), n += 2;
+  n += 2;                                        /* no name, padded */
+  hostile_put_be(b + n, resource_length, 4), n += 4;
+  b[n++] = (unsigned char)name_length, b[n++] = 'A';
+  hostile_put_be(b + n, 68, 4), n += 4;          /* layer and mask information */
+  hostile_put_be(b + n, 60, 4), n += 4;          /* layer information */
+  hostile_put_be(b + n, 1, 2), n += 2;           /* one layer */
+  hostile_put_be(b + n, 0, 4), hostile_put_be(b + n + 4, 0, 4), n += 8; /* top, left */
+  hostile_put_be(b + n, layer_bottom, 4), hostile_put_be(b + n + 4, 2, 4), n += 8;
+  hostile_put_be(b + n, 1, 2), n += 2;           /* one channel: */
+  hostile_put_be(b + n, 0, 2), hostile_put_be(b + n + 2, 6, 4), n += 6; /* 0, 6 bytes */
+  memcpy(b + n, "8BIMnorm", 8), n += 8;          /* blend mode */
+  b[n] = 255, n += 4;                            /* opacity, clipping, flags, filler */
+  hostile_put_be(b + n, 12, 4), n += 4;          /* extra data: */
+  n += 4 + 4 + 4;                                /* no mask, no ranges, no name */
+  n += 2;                                        /* the channel: raw, */
+  const unsigned char layer[4] = {10, 20, 30, 40}, merged[4] = {50, 60, 70, 80};
+  memcpy(b + n, layer, 4), n += 4;
+  n += 4;                                        /* no global mask */
+  n += 2;                                        /* the merged image: raw */
+  memcpy(b + n, merged, 4), n += 4;
+  return hostile_write(path, b, n);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -40,6 +40,12 @@
  *   height bytes, zeroed first (a 54-byte file of 40000 x 40000 took 1.7
  *   GB): the size and compression are at fixed offsets (header_walk.c).
  *
+ * - PSD: open() allocates, zeroed, the colour mode data, image resources
+ *   and each layer channel's row tables its lengths declare, and reads
+ *   alpha channel names until a resource's length is used up, forever
+ *   past the end of the file (OpenImageIO aborts): header_walk_psd.c
+ *   walks the sections and checks each length against the file.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -271,6 +277,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_cineon(fd, magic, p);
   else if (format && strcmp(format, "bmp") == 0)
     bb__probe_bmp(fd, p);
+  else if (format && strcmp(format, "psd") == 0)
+    bb__probe_psd(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

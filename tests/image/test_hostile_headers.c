@@ -232,9 +232,54 @@ Test(hostile_headers, an_rle_bmp_too_large_to_open_says_so) {
   bb_image_free(&img);
 }
 
-/* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
- * extension index, then the file): each made OpenImageIO's reader allocate
- * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
+/* OpenImageIO's PSD reader allocates, zeroed, in open(): the colour mode
+ * data's length (4 GiB took 4.3 GB), each image resource's, a thumbnail's
+ * less its 28-byte header, and 8 bytes for each row of each layer
+ * channel; it reads alpha channel names until a block's length is used
+ * up, forever past the end of the file. Each length must lie in the file,
+ * a layer within 300000 a side, its rows within its channel's data; and
+ * the same file declaring what it holds reads. */
+Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
+  const char *path = tmp("h.psd");
+  const struct {
+    uint32_t colour, id, length, name, bottom;
+    const char *reason;
+  } files[] = {
+      {0xFFFFFFFFu, 1006, 2, 1, 2,
+       "corrupt image: its PSD colour mode data of 4294967295 bytes runs past the end of the "
+       "file of 126 bytes"},
+      {0, 1058, 0x60000000u, 1, 2,
+       "corrupt image: PSD image resource 1058 declares 1610612736 bytes at byte 46, past the "
+       "end of the file of 126 bytes"},
+      {0, 1006, 2, 255, 2,
+       "corrupt image: PSD alpha channel names (resource 1006) run past the end of the file"},
+      {0, 1036, 2, 1, 2, "corrupt image: PSD thumbnail resource 1036 of 2 bytes is shorter"},
+      {0, 1006, 2, 1, 0x08000000u,
+       "corrupt image: PSD layer 0's channel 0 is 2x134217728, past the largest a PSB may be"},
+      {0, 1006, 2, 1, 200000, "corrupt image: PSD layer 0's channel 0 declares 200000 rows in 6 "
+                              "bytes"},
+  };
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    cr_assert_eq(write_psd(path, files[i].colour, files[i].id, files[i].length, files[i].name,
+                           files[i].bottom),
+                 0);
+    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
+  }
+  cr_assert_eq(write_psd(path, 0, 1006, 2, 1, 2), 0);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 1);
+  for (int i = 0; i < 4; i++)
+    cr_expect_float_eq(img.pixels[i], (float)(50 + 10 * i) / 255.f, 1e-6, "texel %d: %g", i,
+                       img.pixels[i]);
+  bb_image_free(&img);
+}
+
+/* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
+ * byte for the extension index, then the file): each made OpenImageIO's
+ * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
+ * (zeroed, most of them), or abort (PSD's alpha names),
  * and now is refused from its header, saying why, at once and in little
  * memory. (libpng skips a chunk it cannot allocate: the PNG's read then
  * ends at the end of the file, as before, but without the 1.8 GB.) */
@@ -251,6 +296,10 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
       {"dpx-user-data-of-2.2-gb", ".dpx",
        "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
+      {"psd-alpha-names-block-past-the-end-aborts", ".psd",
+       "PSD image resource 1006 declares 16 bytes at byte 46, past the end of the file"},
+      {"psd-colour-data-of-4-gib", ".psd", "its PSD colour mode data of 4294967295 bytes"},
+      {"psd-layer-of-134217728-rows", ".psd", "PSD layer 0's channel 0 is 1x134217728"},
       {"sgi-rle-row-length-of-4-gb", ".sgi",
        "SGI RLE row 0 of channel 0 declares 4294967295 bytes at byte 1870300560"},
   };
