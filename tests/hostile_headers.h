@@ -375,4 +375,34 @@ static inline int write_psd(const char *path, uint32_t colour_length, unsigned r
   return hostile_write(path, b, n);
 }
 
+/* A Maya IFF of 2 x 2 RGB texels, 8 bits, in one uncompressed tile, all
+ * (200, 100, 50): FOR4 CIMG, its table header TBHD with `flags` and
+ * `bytes`, an AUTH chunk declaring `auth_size` bytes (4 are there), then
+ * FOR4 TBMP and the tile's RGBA chunk declaring `rgba_size` bytes (1, 0, 2
+ * and 20 make it a valid file of 96 bytes). OpenImageIO allocates the
+ * AUTH chunk's size in open(), the RGBA chunk's less 8 at the first read,
+ * and asserts (abort()) on some flags. IFF's numbers are big-endian. */
+static inline int write_iff(const char *path, uint32_t flags, unsigned bytes,
+                            uint32_t auth_size, uint32_t rgba_size) {
+  unsigned char b[96];
+  size_t n = 0;
+  memset(b, 0, sizeof b);
+  memcpy(b, "FOR4", 4), hostile_put_be(b + 4, 88, 4), memcpy(b + 8, "CIMG", 4), n = 12;
+  memcpy(b + n, "TBHD", 4), hostile_put_be(b + n + 4, 24, 4), n += 8;
+  hostile_put_be(b + n, 2, 4), hostile_put_be(b + n + 4, 2, 4), n += 8; /* width, height */
+  hostile_put_be(b + n, 1, 2), hostile_put_be(b + n + 2, 1, 2), n += 4; /* aspect ratio */
+  hostile_put_be(b + n, flags, 4), n += 4;
+  hostile_put_be(b + n, bytes, 2), hostile_put_be(b + n + 2, 1, 2), n += 4; /* one tile */
+  n += 4;                                                                 /* uncompressed */
+  memcpy(b + n, "AUTH", 4), hostile_put_be(b + n + 4, auth_size, 4), memcpy(b + n + 8, "bb", 2);
+  n += 12;
+  memcpy(b + n, "FOR4", 4), hostile_put_be(b + n + 4, 32, 4), memcpy(b + n + 8, "TBMP", 4);
+  n += 12;
+  memcpy(b + n, "RGBA", 4), hostile_put_be(b + n + 4, rgba_size, 4), n += 8;
+  hostile_put_be(b + n + 4, 1, 2), hostile_put_be(b + n + 6, 1, 2), n += 8; /* 0, 0 to 1, 1 */
+  for (int i = 0; i < 4; i++) /* blue, green, red */
+    b[n++] = 50, b[n++] = 100, b[n++] = 200;
+  return hostile_write(path, b, n);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

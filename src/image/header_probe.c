@@ -46,6 +46,11 @@
  *   past the end of the file (OpenImageIO aborts): header_walk_psd.c
  *   walks the sections and checks each length against the file.
  *
+ * - IFF: open() allocates an AUTH or DATE chunk's size, zeroed, and
+ *   asserts on two table header flag combinations (Debian's build keeps
+ *   the assertions: abort()); the first read allocates each tile's size:
+ *   header_walk.c walks the chunks, each within the file.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -279,6 +284,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_bmp(fd, p);
   else if (format && strcmp(format, "psd") == 0)
     bb__probe_psd(fd, p);
+  else if (format && strcmp(format, "iff") == 0)
+    bb__probe_iff(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -149,4 +150,111 @@ void bb__probe_bmp(int fd, bb__probe *p) {
   p->width = width;
   p->height = (int)rows;
   p->open_bytes = (double)width * rows;
+}
+
+/* -------------------------------------------------------------------- IFF */
+
+/* Maya IFF, walked as open() walks it (iffinput.cpp read_header): chunks
+ * of a 4-byte type and a 32-bit big-endian size (rounded up to 4 bytes)
+ * up to FOR4 CIMG's TBHD, the table header, then AUTH, DATE and other
+ * chunks up to FOR4 TBMP. open() allocates an AUTH or DATE chunk's size,
+ * zeroed, before reading it (a 52-byte file declaring 1.5 GiB took 1.7
+ * GB; a size that rounds up past 32 bits reads 4 GiB through an empty
+ * buffer): it must lie in the file. And it asserts on two flag combinations of
+ * TBHD, which Debian's build keeps: RGB or alpha with "black" (0x10), and
+ * a Z buffer (0x04, without RGB or alpha) with a non-zero byte count,
+ * which abort() the process. Each step reads 8 bytes or more, so the walk
+ * ends at the end of the file. The first read of a tile then allocates
+ * every tile's RGBA chunk (its size less 8, zeroed; a size below 8 wraps
+ * to 4 GiB): each must lie in the file. */
+static int is_type(const unsigned char *t, const char *name) { return memcmp(t, name, 4) == 0; }
+
+static int read_type(bb__walk *w, unsigned char type[4]) {
+  if (!w->ok || bb__probe_read(w->fd, type, 4, w->pos) != 4) return w->ok = 0;
+  w->pos += 4;
+  return 1;
+}
+
+/* The flags of TBHD's table header at w->pos, and its tile count: 0 when
+ * the probe is corrupt. */
+static int check_tbhd(bb__walk *w, uint32_t size, unsigned *tile_count, bb__probe *p) {
+  if (size != 24 && size != 32) return 1; /* the reader refuses it */
+  w->pos += 12;                           /* width, height, aspect ratio */
+  const uint32_t flags = (uint32_t)bb__walk_number(w, 4, 0);
+  const uint64_t bytes = bb__walk_number(w, 2, 0), tiles = bb__walk_number(w, 2, 0);
+  const uint64_t compression = bb__walk_number(w, 4, 0);
+  if (!w->ok || tiles == 0 || compression > 1) return 1; /* the reader refuses it */
+  if ((flags & 0x3) && (flags & 0x10)) {
+    bb__probe_corrupt(p, "IFF table header flags 0x%x set RGB or alpha with black", flags);
+    return 0;
+  }
+  if (!(flags & 0x3) && (flags & 0x4) && bytes != 0) {
+    bb__probe_corrupt(p, "IFF table header flags a Z buffer with a byte count of %u, not 0",
+                      (unsigned)bytes);
+    return 0;
+  }
+  w->pos += size - 24; /* x and y when the header is 32 bytes */
+  *tile_count = (unsigned)tiles;
+  return 1;
+}
+
+/* TBMP's tiles: the first read allocates each RGBA chunk's size less 8
+ * (its tile's corners), zeroed, before reading it. */
+static void check_tiles(bb__walk *w, unsigned tiles, bb__probe *p) {
+  unsigned char type[4];
+  for (unsigned t = 0; t < tiles && read_type(w, type);) {
+    const uint32_t size = (uint32_t)bb__walk_number(w, 4, 0);
+    const uint32_t chunk = (size + 3u) & ~3u;
+    if (!w->ok) return;
+    if (is_type(type, "RGBA")) {
+      if (chunk < 8 || w->pos + (double)size > p->file_bytes || w->pos + chunk > p->file_bytes) {
+        bb__probe_corrupt(p,
+                          "IFF tile %u's RGBA chunk of %u bytes at byte %.0f runs past the "
+                          "end of the file of %.0f bytes",
+                          t, size, w->pos, p->file_bytes);
+        return;
+      }
+      t++;
+    }
+    w->pos += chunk;
+  }
+}
+
+void bb__probe_iff(int fd, bb__probe *p) {
+  p->format = "IFF";
+  bb__walk w = {fd, p->file_bytes, 0, 1};
+  int in_cimg = 0, past_tbhd = 0;
+  unsigned tiles = 0;
+  unsigned char type[4];
+  while (read_type(&w, type)) {
+    const uint32_t size = (uint32_t)bb__walk_number(&w, 4, 0);
+    const uint32_t chunk = (size + 3u) & ~3u;
+    if (!w.ok) return;
+    if (!in_cimg && is_type(type, "FOR4")) {
+      if (!read_type(&w, type)) return;
+      if (is_type(type, "CIMG")) {
+        in_cimg = 1;
+        continue;
+      }
+    } else if (in_cimg && !past_tbhd && is_type(type, "TBHD")) {
+      if (!check_tbhd(&w, size, &tiles, p) || !w.ok || tiles == 0) return;
+      past_tbhd = 1;
+      continue;
+    } else if (past_tbhd && (is_type(type, "AUTH") || is_type(type, "DATE"))) {
+      if (w.pos + (double)size > p->file_bytes || w.pos + chunk > p->file_bytes) {
+        bb__probe_corrupt(p,
+                          "IFF %.4s chunk of %u bytes at byte %.0f runs past the end of the "
+                          "file of %.0f bytes",
+                          (const char *)type, size, w.pos, p->file_bytes);
+        return;
+      }
+    } else if (past_tbhd && is_type(type, "FOR4")) {
+      if (!read_type(&w, type)) return;
+      if (is_type(type, "TBMP")) { /* the header ends: the tiles follow */
+        check_tiles(&w, tiles, p);
+        return;
+      }
+    }
+    w.pos += chunk;
+  }
 }

@@ -276,6 +276,44 @@ Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
   bb_image_free(&img);
 }
 
+/* OpenImageIO's IFF reader allocates an AUTH or DATE chunk's size, zeroed,
+ * in open() (a 52-byte file declaring 1.5 GiB took 1.7 GB), and each tile's
+ * RGBA chunk's at the first read; and Debian's build keeps two assertions
+ * on the table header's flags, which abort() the process. Each is refused
+ * from the header, and the same file without them reads. */
+Test(hostile_headers, iff_chunks_past_the_end_and_aborting_flags_are_refused) {
+  const char *path = tmp("h.iff");
+  const struct {
+    uint32_t flags;
+    unsigned bytes;
+    uint32_t auth, rgba;
+    const char *reason;
+  } files[] = {
+      {1, 0, 0x60000000u, 20,
+       "corrupt image: IFF AUTH chunk of 1610612736 bytes at byte 52 runs past the end of the "
+       "file of 96 bytes"},
+      {1, 0, 0xFFFFFFFEu, 20, "IFF AUTH chunk of 4294967294 bytes"}, /* rounds up to 0 */
+      {1, 0, 2, 0x60000000u, "corrupt image: IFF tile 0's RGBA chunk of 1610612736 bytes"},
+      {1, 0, 2, 4, "corrupt image: IFF tile 0's RGBA chunk of 4 bytes"}, /* less 8: 4 GiB */
+      {0x11, 0, 2, 20, "corrupt image: IFF table header flags 0x11 set RGB or alpha with black"},
+      {0x04, 1, 2, 20, "corrupt image: IFF table header flags a Z buffer with a byte count of 1"},
+  };
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    cr_assert_eq(write_iff(path, files[i].flags, files[i].bytes, files[i].auth, files[i].rgba),
+                 0);
+    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
+  }
+  cr_assert_eq(write_iff(path, 1, 0, 2, 20), 0);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 3);
+  const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+  for (int i = 0; i < 12; i++)
+    cr_expect_float_eq(img.pixels[i], want[i % 3], 1e-6, "sample %d: %g", i, img.pixels[i]);
+  bb_image_free(&img);
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
@@ -296,6 +334,8 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
       {"dpx-user-data-of-2.2-gb", ".dpx",
        "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
+      {"iff-auth-chunk-of-1.5-gib", ".iff", "IFF AUTH chunk of 1610612736 bytes at byte 52"},
+      {"iff-rgb-flags-with-black-abort", ".iff", "IFF table header flags 0x11 set RGB or alpha"},
       {"psd-alpha-names-block-past-the-end-aborts", ".psd",
        "PSD image resource 1006 declares 16 bytes at byte 46, past the end of the file"},
       {"psd-colour-data-of-4-gib", ".psd", "its PSD colour mode data of 4294967295 bytes"},
