@@ -405,4 +405,33 @@ static inline int write_iff(const char *path, uint32_t flags, unsigned bytes,
   return hostile_write(path, b, n);
 }
 
+/* A FITS image of 2 x 2 8-bit texels, all 200, whose NAXIS card reads
+ * `naxis` ("2" makes it a valid file of two 2880-byte blocks), its END
+ * card after `blank_blocks` blocks of blank cards (negative: no END at
+ * all, and that many blocks). OpenImageIO's reader sizes a vector by
+ * NAXIS in open() and calls itself for each block up to END. */
+static inline int write_fits(const char *path, const char *naxis, int blank_blocks) {
+  const int blocks = blank_blocks < 0 ? -blank_blocks : blank_blocks + 2;
+  FILE *f = fopen(path, "wb");
+  if (!f) return -1;
+  char block[2880];
+  int ok = 1;
+  for (int i = 0; i < blocks && ok; i++) {
+    memset(block, ' ', sizeof block);
+    if (i == 0) {
+      char cards[5][81];
+      snprintf(cards[0], 81, "%-80s", "SIMPLE  =                    T");
+      snprintf(cards[1], 81, "%-80s", "BITPIX  =                    8");
+      snprintf(cards[2], 81, "NAXIS   = %20s%50s", naxis, "");
+      snprintf(cards[3], 81, "%-80s", "NAXIS1  =                    2");
+      snprintf(cards[4], 81, "%-80s", "NAXIS2  =                    2");
+      for (int c = 0; c < 5; c++) memcpy(block + 80 * c, cards[c], 80);
+    }
+    if (blank_blocks >= 0 && i == blank_blocks) memcpy(block + (i == 0 ? 400 : 0), "END", 3);
+    if (blank_blocks >= 0 && i == blocks - 1) memset(block, 200, sizeof block); /* the data */
+    ok = fwrite(block, 1, sizeof block, f) == sizeof block;
+  }
+  return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -51,6 +51,11 @@
  *   the assertions: abort()); the first read allocates each tile's size:
  *   header_walk.c walks the chunks, each within the file.
  *
+ * - FITS: open() sizes a vector by the NAXIS card, zeroed, before
+ *   checking it, and reads a header block by block through a recursion
+ *   (11000 blank blocks overflowed the stack): header_walk.c reads the
+ *   cards, NAXIS within 0 to 999 and END within 1000 blocks.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -286,6 +291,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_psd(fd, p);
   else if (format && strcmp(format, "iff") == 0)
     bb__probe_iff(fd, p);
+  else if (format && strcmp(format, "fits") == 0)
+    bb__probe_fits(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

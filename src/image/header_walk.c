@@ -5,9 +5,11 @@
  * the descriptor the read checked. */
 #include "image/header_walk.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -257,4 +259,86 @@ void bb__probe_iff(int fd, bb__probe *p) {
     }
     w.pos += chunk;
   }
+}
+
+/* ------------------------------------------------------------------- FITS */
+
+/* FITS headers are 2880-byte blocks of 36 cards of 80 characters, up to
+ * one holding the END card. Every block that starts "SIMPLE" or
+ * "XTENSION= 'IMAGE   '" starts an image (OpenImageIO's reader looks at
+ * every block of the file for them in open()), whose header the reader
+ * reads when the image is opened:
+ * - it sizes a vector of ints by the NAXIS card's value, zeroed, before it
+ *   checks it (a 2880-byte file of NAXIS = 400000000 took 1.7 GB; a
+ *   negative one throws): the FITS standard allows 0 to 999 axes;
+ * - it reads a block, then calls itself for the next until END, a stack
+ *   frame a block: 11000 blocks of spaces (32 MB, which compresses to
+ *   almost nothing) overflowed the 8 MB main stack (SIGSEGV). A header is
+ *   refused when no END comes within FITS_MAX_HEADER_BLOCKS blocks of its
+ *   start: 1000 blocks are 36000 cards (real headers take a few blocks,
+ *   long histories a few dozen), and take well under 1 MB of stack. */
+#define FITS_BLOCK 2880
+#define FITS_MAX_HEADER_BLOCKS 1000
+
+/* A card's keyword: its first 8 characters, blanks stripped at both ends
+ * (as OpenImageIO's Strutil::strip). */
+static int fits_keyword_is(const unsigned char *card, const char *word) {
+  size_t from = 0, to = 8;
+  while (from < to && isspace(card[from])) from++;
+  while (to > from && isspace(card[to - 1])) to--;
+  return to - from == strlen(word) && memcmp(card + from, word, to - from) == 0;
+}
+
+/* The value of a NAXIS card from its 11th character, read as OpenImageIO's
+ * Strutil::stoi reads it (blanks, a sign, decimal digits; past an int it
+ * saturates). */
+static double fits_integer(const unsigned char *card) {
+  size_t i = 10;
+  while (i < 80 && isspace(card[i])) i++;
+  const int negative = i < 80 && card[i] == '-';
+  if (i < 80 && (card[i] == '-' || card[i] == '+')) i++;
+  double value = 0;
+  for (; i < 80 && isdigit(card[i]) && value < 1e10; i++) value = value * 10 + (card[i] - '0');
+  return negative ? -value : value;
+}
+
+void bb__probe_fits(int fd, bb__probe *p) {
+  p->format = "FITS";
+  enum { BATCH = 32 };
+  unsigned char *blocks = malloc((size_t)BATCH * FITS_BLOCK);
+  if (!blocks) return; /* the reader reads it unprobed, as before */
+  double header = -1; /* the block the header without END so far starts at, or -1 */
+  double index = 0;
+  for (;;) {
+    const size_t got = bb__probe_read(fd, blocks, (size_t)BATCH * FITS_BLOCK, index * FITS_BLOCK);
+    const size_t whole = got / FITS_BLOCK;
+    for (size_t b = 0; b < whole; b++, index++) {
+      const unsigned char *block = blocks + b * FITS_BLOCK;
+      if (header < 0 && (memcmp(block, "SIMPLE", 6) == 0 ||
+                         memcmp(block, "XTENSION= 'IMAGE   '", 20) == 0))
+        header = index;
+      if (header < 0) continue;
+      for (int c = 0; c < FITS_BLOCK / 80; c++) {
+        const unsigned char *card = block + 80 * c;
+        if (fits_keyword_is(card, "END")) {
+          header = -1;
+          break;
+        }
+        const double axes = fits_keyword_is(card, "NAXIS") ? fits_integer(card) : 0;
+        if (axes < 0 || axes > 999) {
+          bb__probe_corrupt(p, "FITS header declares %.0f axes (NAXIS is 0 to 999)", axes);
+          free(blocks);
+          return;
+        }
+      }
+      if (header >= 0 && index - header + 1 >= FITS_MAX_HEADER_BLOCKS) {
+        bb__probe_corrupt(p, "FITS header at byte %.0f has no END card in its first %d blocks",
+                          header * FITS_BLOCK, FITS_MAX_HEADER_BLOCKS);
+        free(blocks);
+        return;
+      }
+    }
+    if (whole < BATCH) break;
+  }
+  free(blocks);
 }

@@ -314,6 +314,37 @@ Test(hostile_headers, iff_chunks_past_the_end_and_aborting_flags_are_refused) {
   bb_image_free(&img);
 }
 
+/* OpenImageIO's FITS reader sizes a vector of ints by NAXIS, zeroed, in
+ * open() (400000000 took 1.7 GB), and recurses once a 2880-byte block
+ * until END (11000 blank blocks overflowed the stack): NAXIS outside 0 to
+ * 999 and a header of 1000 blocks without END are refused; a header whose
+ * END is in its 1000th block, and a small image, read. */
+Test(hostile_headers, fits_axes_and_endless_headers_are_refused) {
+  const char *path = tmp("h.fits");
+  cr_assert_eq(write_fits(path, "400000000", 0), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: FITS header declares 400000000 axes (NAXIS is 0 to "
+                            "999)");
+  cr_assert_eq(write_fits(path, "-1", 0), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "FITS header declares -1 axes");
+  cr_assert_eq(write_fits(path, "2", -1000), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: FITS header at byte 0 has no END card in its first "
+                            "1000 blocks");
+  int w = 0, h = 0, c = 0;
+  bb_error err;
+  cr_assert_eq(write_fits(path, "2", 999), 0);
+  cr_assert_eq(bb_image_read_info(path, &w, &h, &c, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(w == 2 && h == 2 && c == 1);
+  cr_assert_eq(write_fits(path, "2", 0), 0);
+  bb_image img;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 1);
+  for (int i = 0; i < 4; i++)
+    cr_expect_float_eq(img.pixels[i], 200 / 255.f, 1e-6, "texel %d: %g", i, img.pixels[i]);
+  bb_image_free(&img);
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
@@ -334,6 +365,7 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
       {"dpx-user-data-of-2.2-gb", ".dpx",
        "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
+      {"fits-naxis-of-400000000", ".fits", "FITS header declares 400000000 axes"},
       {"iff-auth-chunk-of-1.5-gib", ".iff", "IFF AUTH chunk of 1610612736 bytes at byte 52"},
       {"iff-rgb-flags-with-black-abort", ".iff", "IFF table header flags 0x11 set RGB or alpha"},
       {"psd-alpha-names-block-past-the-end-aborts", ".psd",
