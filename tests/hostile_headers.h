@@ -434,4 +434,45 @@ static inline int write_fits(const char *path, const char *naxis, int blank_bloc
   return fclose(f) == 0 && ok ? 0 : -1;
 }
 
+/* A JPEG 2000 codestream of one 8-bit component declaring width x height
+ * in one tile, whose one tile holds nothing (82 bytes: SOC, SIZ, COD, QCD,
+ * SOT, SOD, a zero byte, EOC; 4 x 4 makes it a valid file), raw or, with
+ * `jp2`, in a JP2 file's boxes (signature, ftyp, jp2h with ihdr and colr,
+ * jp2c). OpenImageIO's reader decodes the whole image, 4 bytes a sample,
+ * in open(). */
+static inline int write_jpeg2000(const char *path, uint32_t width, uint32_t height, int jp2) {
+  unsigned char b[256];
+  size_t n = 0;
+  memset(b, 0, sizeof b);
+  if (jp2) {
+    const unsigned char signature[12] = {0, 0, 0, 12, 'j', 'P', ' ', ' ', 0x0D, 0x0A, 0x87, 0x0A};
+    memcpy(b, signature, 12), n = 12;
+    hostile_put_be(b + n, 20, 4), memcpy(b + n + 4, "ftypjp2 ", 8), n += 16;
+    memcpy(b + n, "jp2 ", 4), n += 4;
+    hostile_put_be(b + n, 8 + 22 + 15, 4), memcpy(b + n + 4, "jp2h", 4), n += 8;
+    hostile_put_be(b + n, 22, 4), memcpy(b + n + 4, "ihdr", 4), n += 8;
+    hostile_put_be(b + n, height, 4), hostile_put_be(b + n + 4, width, 4), n += 8;
+    hostile_put_be(b + n, 1, 2), b[n + 2] = 7, b[n + 3] = 7, n += 6; /* 1 component, 8 bits */
+    hostile_put_be(b + n, 15, 4), memcpy(b + n + 4, "colr", 4), n += 8;
+    b[n] = 1, hostile_put_be(b + n + 3, 17, 4), n += 7; /* enumerated: greyscale */
+    hostile_put_be(b + n, 8 + 82, 4), memcpy(b + n + 4, "jp2c", 4), n += 8;
+  }
+  const unsigned char soc_siz[4] = {0xFF, 0x4F, 0xFF, 0x51};
+  memcpy(b + n, soc_siz, 4), n += 4;
+  hostile_put_be(b + n, 41, 2), n += 4;                                  /* Lsiz, Rsiz */
+  hostile_put_be(b + n, width, 4), hostile_put_be(b + n + 4, height, 4), n += 8;
+  n += 8;                                                                /* the origin */
+  hostile_put_be(b + n, width, 4), hostile_put_be(b + n + 4, height, 4), n += 8; /* tiles */
+  n += 8;                                                                /* their origin */
+  hostile_put_be(b + n, 1, 2), b[n + 2] = 7, b[n + 3] = 1, b[n + 4] = 1, n += 5;
+  const unsigned char rest[] = {
+      0xFF, 0x52, 0, 12, 0, 0, 0, 1, 0, 0, 4, 4, 0, 1, /* COD: no levels, 5-3 wavelet */
+      0xFF, 0x5C, 0, 4, 0, 0x40,                       /* QCD: no quantisation */
+      0xFF, 0x90, 0, 10, 0, 0, 0, 0, 0, 15, 0, 1,            /* SOT: tile 0, 15 bytes */
+      0xFF, 0x93, 0,                                         /* SOD, an empty packet */
+      0xFF, 0xD9};                                           /* EOC */
+  memcpy(b + n, rest, sizeof rest), n += sizeof rest;
+  return hostile_write(path, b, n);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -56,6 +56,10 @@
  *   (11000 blank blocks overflowed the stack): header_walk.c reads the
  *   cards, NAXIS within 0 to 999 and END within 1000 blocks.
  *
+ * - JPEG 2000: open() decodes the whole image, 4 bytes a sample, however
+ *   little the file holds (82 bytes declaring 12000 x 12000 took 707 MB):
+ *   header_walk.c reads the SIZ marker's fixed fields.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -293,6 +297,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_iff(fd, p);
   else if (format && strcmp(format, "fits") == 0)
     bb__probe_fits(fd, p);
+  else if (format && strcmp(format, "jpeg2000") == 0)
+    bb__probe_jpeg2000(fd, magic, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

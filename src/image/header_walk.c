@@ -7,6 +7,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -341,4 +342,65 @@ void bb__probe_fits(int fd, bb__probe *p) {
     if (whole < BATCH) break;
   }
   free(blocks);
+}
+
+/* --------------------------------------------------------------- JPEG 2000 */
+
+/* open() decodes the whole image (OpenJPEG's opj_decode), into 4 bytes a
+ * sample of every component, whatever the file holds: an 82-byte
+ * codestream declaring 12000 x 12000 took 707 MB and opened (empty code
+ * blocks decode to zeros). OpenJPEG's own header reader (opj_read_header)
+ * is not among bumpbake's build dependencies (libopenjp2-7-dev), so this
+ * reads the SIZ marker segment's fixed fields, which follow the
+ * codestream's first marker (SOC, FF4F) in every JPEG 2000 codestream:
+ * Xsiz, Ysiz, XOsiz, YOsiz (32-bit big-endian at 6, 10, 14 and 18 of
+ * SIZ), Csiz at 38, then each component's subsampling XRsiz, YRsiz. A raw
+ * codestream starts with it; a JP2 file holds it in its jp2c box, found
+ * by walking the top-level boxes (a length, a type; length 1: a 64-bit
+ * length follows; 0: the box runs to the end of the file). */
+#define JP2_MAX_BOXES 1000
+
+static void probe_codestream(int fd, double at, bb__probe *p) {
+  bb__walk w = {fd, p->file_bytes, at, 1};
+  if (bb__walk_number(&w, 2, 0) != 0xFF4F || bb__walk_number(&w, 2, 0) != 0xFF51) return;
+  w.pos += 4; /* Lsiz, Rsiz */
+  const double xsiz = (double)bb__walk_number(&w, 4, 0), ysiz = (double)bb__walk_number(&w, 4, 0);
+  const double x0 = (double)bb__walk_number(&w, 4, 0), y0 = (double)bb__walk_number(&w, 4, 0);
+  w.pos += 16; /* the tiles */
+  const unsigned components = (unsigned)bb__walk_number(&w, 2, 0);
+  if (!w.ok || xsiz <= x0 || ysiz <= y0 || components == 0) return; /* OpenJPEG refuses it */
+  double samples = 0;
+  for (unsigned c = 0; c < components && w.ok; c++) {
+    w.pos += 1; /* Ssiz: the sample's bits */
+    const double dx = (double)bb__walk_number(&w, 1, 0), dy = (double)bb__walk_number(&w, 1, 0);
+    if (!w.ok || dx == 0 || dy == 0) return; /* OpenJPEG refuses it */
+    samples += (ceil(xsiz / dx) - ceil(x0 / dx)) * (ceil(ysiz / dy) - ceil(y0 / dy));
+  }
+  if (!w.ok) return;
+  p->format = "JPEG 2000";
+  p->width = xsiz - x0 > 2147483647.0 ? 2147483647 : (int)(xsiz - x0);
+  p->height = ysiz - y0 > 2147483647.0 ? 2147483647 : (int)(ysiz - y0);
+  p->open_bytes = 4.0 * samples;
+}
+
+void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p) {
+  if (head[0] == 0xFF) {
+    probe_codestream(fd, 0, p);
+    return;
+  }
+  bb__walk w = {fd, p->file_bytes, 0, 1};
+  for (int box = 0; box < JP2_MAX_BOXES && w.ok && w.pos < p->file_bytes; box++) {
+    const double start = w.pos;
+    double length = (double)bb__walk_number(&w, 4, 0);
+    unsigned char type[4];
+    if (!read_type(&w, type)) return;
+    if (length == 1) length = (double)bb__walk_number(&w, 8, 0);
+    if (!w.ok) return;
+    if (is_type(type, "jp2c")) {
+      probe_codestream(fd, w.pos, p);
+      return;
+    }
+    if (length < 8) return; /* to the end of the file, or not a box: no codestream */
+    w.pos = start + length;
+  }
 }

@@ -345,6 +345,28 @@ Test(hostile_headers, fits_axes_and_endless_headers_are_refused) {
   bb_image_free(&img);
 }
 
+/* OpenImageIO's JPEG 2000 reader decodes the whole image in open(), 4
+ * bytes a sample, however little the file holds (82 bytes declaring
+ * 12000 x 12000 took 707 MB and opened): held to BB_MAX_READ_BYTES from
+ * the SIZ marker, raw or in a JP2 file's jp2c box; the same small files
+ * read. */
+Test(hostile_headers, a_jpeg2000_too_large_to_open_says_so) {
+  const char *j2k = tmp("h.j2k"), *jp2 = tmp("h.jp2");
+  cr_assert_eq(write_jpeg2000(j2k, 30000, 30000, 0), 0);
+  expect_every_read_refuses(j2k, BB_ERR_SIZE, "a JPEG 2000 of 30000x30000 needs 3433 MiB to open");
+  cr_assert_eq(write_jpeg2000(jp2, 30000, 30000, 1), 0);
+  expect_every_read_refuses(jp2, BB_ERR_SIZE, "a JPEG 2000 of 30000x30000 needs 3433 MiB to open");
+  for (int wrapped = 0; wrapped <= 1; wrapped++) {
+    const char *path = wrapped ? jp2 : j2k;
+    cr_assert_eq(write_jpeg2000(path, 4, 4, wrapped), 0);
+    bb_image img;
+    bb_error err;
+    cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+    cr_expect(img.width == 4 && img.height == 4 && img.channels == 1);
+    bb_image_free(&img);
+  }
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
@@ -366,6 +388,7 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
       {"dpx-user-data-of-2.2-gb", ".dpx",
        "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
       {"fits-naxis-of-400000000", ".fits", "FITS header declares 400000000 axes"},
+      {"jpeg2000-of-30000-x-30000-in-82-bytes", ".jp2", "a JPEG 2000 of 30000x30000 needs 3433"},
       {"iff-auth-chunk-of-1.5-gib", ".iff", "IFF AUTH chunk of 1610612736 bytes at byte 52"},
       {"iff-rgb-flags-with-black-abort", ".iff", "IFF table header flags 0x11 set RGB or alpha"},
       {"psd-alpha-names-block-past-the-end-aborts", ".psd",
