@@ -475,4 +475,31 @@ static inline int write_jpeg2000(const char *path, uint32_t width, uint32_t heig
   return hostile_write(path, b, n);
 }
 
+/* An animated WebP (the extended format: VP8X, ANIM, one ANMF frame)
+ * whose canvas is width x height and whose one frame, at its top left, is
+ * 2 x 2 texels of (204, 103, 50) in lossless VP8L (88 bytes; 2 x 2 makes
+ * it a valid file). OpenImageIO allocates the canvas, 3 bytes a texel, in
+ * open(). */
+static inline void hostile_put_le(unsigned char *p, uint32_t v, int bytes) {
+  for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static inline int write_webp_canvas(const char *path, uint32_t width, uint32_t height) {
+  static const unsigned char vp8l[12] = {0x2f, 0x01, 0x40, 0x00, 0x00, 0xe8,
+                                         0x59, 0x99, 0x2b, 0xd3, 0xff, 0x00};
+  unsigned char b[88];
+  memset(b, 0, sizeof b);
+  memcpy(b, "RIFF", 4), hostile_put_le(b + 4, 80, 4), memcpy(b + 8, "WEBP", 4);
+  memcpy(b + 12, "VP8X", 4), hostile_put_le(b + 16, 10, 4);
+  b[20] = 0x02;                                   /* animated */
+  hostile_put_le(b + 24, width - 1, 3), hostile_put_le(b + 27, height - 1, 3);
+  memcpy(b + 30, "ANIM", 4), hostile_put_le(b + 34, 6, 4); /* no background, no loops */
+  memcpy(b + 44, "ANMF", 4), hostile_put_le(b + 48, 36, 4);
+  hostile_put_le(b + 58, 1, 3), hostile_put_le(b + 61, 1, 3); /* at 0, 0, 2 x 2 */
+  hostile_put_le(b + 64, 100, 3);                 /* 100 ms */
+  memcpy(b + 68, "VP8L", 4), hostile_put_le(b + 72, sizeof vp8l, 4);
+  memcpy(b + 76, vp8l, sizeof vp8l);
+  return hostile_write(path, b, sizeof b);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -60,6 +60,10 @@
  *   little the file holds (82 bytes declaring 12000 x 12000 took 707 MB):
  *   header_walk.c reads the SIZ marker's fixed fields.
  *
+ * - WebP: open() allocates the canvas a VP8X chunk declares, 3 or 4
+ *   bytes a texel, up to 2^24 a side (address space only: it is not
+ *   written until a frame is read): header_walk.c reads its size.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -299,6 +303,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_fits(fd, p);
   else if (format && strcmp(format, "jpeg2000") == 0)
     bb__probe_jpeg2000(fd, magic, p);
+  else if (format && strcmp(format, "webp") == 0)
+    bb__probe_webp(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

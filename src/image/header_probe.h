@@ -31,10 +31,12 @@ typedef struct bb__probe {
 /* Reads the header of the regular file open at fd (path names it in
  * messages), through pread only, with the format's own Debian library
  * (libjpeg's jpeg_read_header, OpenEXRCore's exr_start_read) or, for GIF
- * and SGI, the sizes at their fixed offsets. BB_ERR_FORMAT when OpenEXRCore
- * refuses the header (an attribute larger than the file, say), which
- * OpenImageIO's reader would first have allocated, and for any DDS, which
- * bumpbake reads itself (texture_read.h). */
+ * and the formats of header_walk.h (SGI, DPX, Cineon, BMP, PSD, IFF, FITS,
+ * JPEG 2000, WebP), by hand: sizes at their fixed offsets, and lengths
+ * walked within the file. BB_ERR_FORMAT when OpenEXRCore refuses the
+ * header (an attribute larger than the file, say), which OpenImageIO's
+ * reader would first have allocated, and for any DDS, which bumpbake reads
+ * itself (texture_read.h). */
 bb_status bb__probe_header(int fd, const char *path, bb__probe *probe, bb_error *err);
 
 #ifdef __cplusplus

@@ -404,3 +404,22 @@ void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p) {
     w.pos = start + length;
   }
 }
+
+/* ------------------------------------------------------------------- WebP */
+
+/* open() allocates the canvas, width x height x 3 bytes (4 with alpha),
+ * uninitialised, before decoding any frame: the extended format's VP8X
+ * chunk declares it, up to 2^24 a side (24-bit little-endian numbers less
+ * one at 24 and 27, the alpha flag 0x10 at 20), whatever the frames hold.
+ * It takes no memory until written, but counts against a process's
+ * address space limit, and it is the size of every frame read. */
+void bb__probe_webp(int fd, bb__probe *p) {
+  unsigned char h[30];
+  if (bb__probe_read(fd, h, sizeof h, 0) != sizeof h || memcmp(h + 12, "VP8X", 4) != 0) return;
+  const double width = 1.0 + (h[24] | h[25] << 8 | h[26] << 16);
+  const double height = 1.0 + (h[27] | h[28] << 8 | h[29] << 16);
+  p->format = "WebP";
+  p->width = (int)width;
+  p->height = (int)height;
+  p->open_bytes = width * height * ((h[20] & 0x10) ? 4.0 : 3.0);
+}

@@ -46,6 +46,7 @@ void bb__probe_bmp(int fd, bb__probe *p);
 void bb__probe_iff(int fd, bb__probe *p);
 void bb__probe_fits(int fd, bb__probe *p);
 void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_webp(int fd, bb__probe *p);
 void bb__probe_psd(int fd, bb__probe *p);
 
 #ifdef __cplusplus

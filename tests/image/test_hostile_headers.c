@@ -367,6 +367,26 @@ Test(hostile_headers, a_jpeg2000_too_large_to_open_says_so) {
   }
 }
 
+/* OpenImageIO's WebP reader allocates the canvas an animated WebP's VP8X
+ * chunk declares, 3 bytes a texel, in open(), whatever its frames hold
+ * (up to 2^24 a side; under `ulimit -v` an 88-byte file of 30000 x 30000
+ * ran out of memory): held to BB_MAX_READ_BYTES from the header, and the
+ * same file of a 2 x 2 canvas reads. */
+Test(hostile_headers, a_webp_canvas_too_large_to_open_says_so) {
+  const char *path = tmp("c.webp");
+  cr_assert_eq(write_webp_canvas(path, 30000, 30000), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a WebP of 30000x30000 needs 2575 MiB to open");
+  cr_assert_eq(write_webp_canvas(path, 2, 2), 0);
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == 2 && img.height == 2 && img.channels == 3);
+  const float want[3] = {204 / 255.f, 103 / 255.f, 50 / 255.f};
+  for (int i = 0; i < 12; i++)
+    cr_expect_float_eq(img.pixels[i], want[i % 3], 1e-6, "sample %d: %g", i, img.pixels[i]);
+  bb_image_free(&img);
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
