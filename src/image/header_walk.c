@@ -72,8 +72,8 @@ void bb__probe_sgi(int fd, const unsigned char *head, bb__probe *p) {
   const unsigned height = (unsigned)p->height, channels = dimension == 3 ? zsize : 1;
   const unsigned entries = ysize * zsize, used = height * channels;
   if (used > entries) {
-    bb__probe_corrupt(p, "its SGI RLE tables list %u rows, not the %u of %u rows of %u channels",
-                      entries, used, height, channels);
+    bb__probe_corrupt(p, "its SGI RLE tables list %u rows, fewer than its %u rows of %u channels",
+                      entries, height, channels);
     return;
   }
   enum { CHUNK = 1024 };
