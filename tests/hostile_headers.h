@@ -502,4 +502,29 @@ static inline int write_webp_canvas(const char *path, uint32_t width, uint32_t h
   return hostile_write(path, b, sizeof b);
 }
 
+/* A Softimage PIC of 2 x 2 texels, all (200, 100, 50): one channel packet
+ * of 8 bits a channel, encoding `type` (2: mixed run-length) and channels
+ * `code` (0xE0: red, green, blue), each scanline one repeated run of
+ * `run` - 127 pixels (129: the scanline's 2); `cut` bytes short of its
+ * end (2, 0xE0, 129, 0 make it a valid file of 116 bytes). OpenImageIO's
+ * reader writes runs and channels where they say, and a scanline it
+ * cannot read makes it use the FILE it closed. Big-endian. */
+static inline int write_softimage(const char *path, unsigned type, unsigned code, unsigned run,
+                                  unsigned cut) {
+  unsigned char b[116];
+  memset(b, 0, sizeof b);
+  hostile_put_be(b, 0x5380F634u, 4);
+  hostile_put_be(b + 4, 0x406D70A4u, 4); /* version 3.71 */
+  memcpy(b + 88, "PICT", 4);
+  hostile_put_be(b + 92, 2, 2), hostile_put_be(b + 94, 2, 2);
+  hostile_put_be(b + 96, 0x3F800000u, 4); /* aspect ratio 1 */
+  hostile_put_be(b + 100, 3, 2);          /* every scanline */
+  b[104] = 0, b[105] = 8, b[106] = (unsigned char)type, b[107] = (unsigned char)code;
+  for (int y = 0; y < 2; y++) {
+    unsigned char *row = b + 108 + 4 * y;
+    row[0] = (unsigned char)run, row[1] = 200, row[2] = 100, row[3] = 50;
+  }
+  return hostile_write(path, b, sizeof b - cut);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

@@ -64,6 +64,10 @@
  *   bytes a texel, up to 2^24 a side (address space only: it is not
  *   written until a frame is read): header_walk.c reads its size.
  *
+ * - Softimage PIC: the reader uses the FILE it closed after a scanline it
+ *   cannot read (SIGSEGV), and writes runs and channels past its buffer
+ *   where the file says: header_walk_pic.c walks every scanline first.
+ *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
  *   OpenImageIO (image_read.c looks at the first bytes). A DDS reaching
@@ -305,6 +309,8 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     bb__probe_jpeg2000(fd, magic, p);
   else if (format && strcmp(format, "webp") == 0)
     bb__probe_webp(fd, p);
+  else if (format && strcmp(format, "softimage") == 0)
+    bb__probe_softimage(fd, p);
   else
     probe_gif(fd, magic, p);
   return BB_OK;

@@ -2,8 +2,9 @@
  * readers with no Debian library of their own to read them: fixed fields
  * at their offsets, and short walks over length-prefixed records, every
  * length checked against the file before it is followed (header_walk.c,
- * and header_walk_psd.c for PSD). Each fills the probe: what the open
- * allocates, or `corrupt`, a length that runs past the end of the file. */
+ * header_walk_psd.c for PSD, header_walk_pic.c for Softimage PIC). Each
+ * fills the probe: what the open allocates, or `corrupt`, a length that
+ * runs past the end of the file or what the reader cannot read safely. */
 #ifndef BB_IMAGE_HEADER_WALK_H
 #define BB_IMAGE_HEADER_WALK_H
 
@@ -47,6 +48,7 @@ void bb__probe_iff(int fd, bb__probe *p);
 void bb__probe_fits(int fd, bb__probe *p);
 void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_webp(int fd, bb__probe *p);
+void bb__probe_softimage(int fd, bb__probe *p);
 void bb__probe_psd(int fd, bb__probe *p);
 
 #ifdef __cplusplus

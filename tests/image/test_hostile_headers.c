@@ -353,6 +353,33 @@ Test(hostile_headers, a_webp_canvas_too_large_to_open_says_so) {
   expect_reads(path, 2, 2, 3, want, 3);
 }
 
+/* OpenImageIO's Softimage PIC reader, given a scanline it cannot read
+ * (the file ends early; a pure run-length packet of RGB), asks the FILE it
+ * has closed for its position (SIGSEGV: the load fuzzer's find), and
+ * writes a run longer than its scanline, or alpha alone, past its buffer:
+ * each is refused from a walk of the scanlines, and the file read whole
+ * reads. */
+Test(hostile_headers, softimage_scanlines_the_reader_cannot_read_are_refused) {
+  const char *path = tmp("h.pic");
+  const struct {
+    unsigned type, code, run, cut;
+    const char *reason;
+  } files[] = {
+      {2, 0xE0, 129, 1, "corrupt image: Softimage PIC scanline 1: it runs past the end of the file"},
+      {2, 0xE0, 130, 0, "Softimage PIC scanline 0: a run runs past the end of its scanline"},
+      {2, 0x10, 129, 0, "corrupt image: its Softimage PIC packets name channel 4 of 1"},
+      {1, 0xE0, 2, 0, "a pure run-length packet of more than one byte a pixel"},
+  };
+  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+    cr_assert_eq(write_softimage(path, files[i].type, files[i].code, files[i].run, files[i].cut),
+                 0);
+    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
+  }
+  cr_assert_eq(write_softimage(path, 2, 0xE0, 129, 0), 0);
+  const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+  expect_reads(path, 2, 2, 3, want, 3);
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
@@ -381,6 +408,8 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
        "PSD image resource 1006 declares 16 bytes at byte 46, past the end of the file"},
       {"psd-colour-data-of-4-gib", ".psd", "its PSD colour mode data of 4294967295 bytes"},
       {"psd-layer-of-134217728-rows", ".psd", "PSD layer 0's channel 0 is 1x134217728"},
+      {"softimage-unreadable-scanline-segv", ".pic",
+       "its Softimage PIC channel packets differ in size (248 and 8 bits)"},
       {"sgi-rle-row-length-of-4-gb", ".sgi",
        "SGI RLE row 0 of channel 0 declares 4294967295 bytes at byte 1870300560"},
   };
