@@ -271,6 +271,17 @@ static bb_status probe_exr(int fd, const char *path, bb__probe *p, bb_error *err
 
 /* ------------------------------------------------------------------ probe */
 
+/* The formats header_walk.h reads by hand, by OpenImageIO's name for them
+ * (signatures.h: the reader a file's first bytes name). */
+static const struct {
+  const char *format;
+  void (*probe)(int fd, const unsigned char *head, bb__probe *p);
+} WALKS[] = {
+    {"dpx", bb__probe_dpx},   {"cineon", bb__probe_cineon},     {"bmp", bb__probe_bmp},
+    {"psd", bb__probe_psd},   {"iff", bb__probe_iff},           {"fits", bb__probe_fits},
+    {"webp", bb__probe_webp}, {"jpeg2000", bb__probe_jpeg2000}, {"softimage", bb__probe_softimage},
+};
+
 bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err) {
   memset(p, 0, sizeof *p);
   struct stat st;
@@ -293,25 +304,11 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     return BB_OK;
   }
   const char *format = bb__format_by_content(magic, (unsigned long)got);
-  if (format && strcmp(format, "dpx") == 0)
-    bb__probe_dpx(fd, magic, p);
-  else if (format && strcmp(format, "cineon") == 0)
-    bb__probe_cineon(fd, magic, p);
-  else if (format && strcmp(format, "bmp") == 0)
-    bb__probe_bmp(fd, p);
-  else if (format && strcmp(format, "psd") == 0)
-    bb__probe_psd(fd, p);
-  else if (format && strcmp(format, "iff") == 0)
-    bb__probe_iff(fd, p);
-  else if (format && strcmp(format, "fits") == 0)
-    bb__probe_fits(fd, p);
-  else if (format && strcmp(format, "jpeg2000") == 0)
-    bb__probe_jpeg2000(fd, magic, p);
-  else if (format && strcmp(format, "webp") == 0)
-    bb__probe_webp(fd, p);
-  else if (format && strcmp(format, "softimage") == 0)
-    bb__probe_softimage(fd, p);
-  else
-    probe_gif(fd, magic, p);
+  for (size_t i = 0; format && i < sizeof WALKS / sizeof WALKS[0]; i++)
+    if (strcmp(format, WALKS[i].format) == 0) {
+      WALKS[i].probe(fd, magic, p);
+      return BB_OK;
+    }
+  probe_gif(fd, magic, p);
   return BB_OK;
 }

@@ -137,7 +137,8 @@ void bb__probe_cineon(int fd, const unsigned char *head, bb__probe *p) {
  * 14) hold the width and height as 32-bit little-endian numbers at 18 and
  * 22 (a negative height: rows top to bottom) and the compression at 30;
  * OS/2's 12-byte header has no compression. */
-void bb__probe_bmp(int fd, bb__probe *p) {
+void bb__probe_bmp(int fd, const unsigned char *head, bb__probe *p) {
+  (void)head;
   bb__walk w = {fd, p->file_bytes, 14, 1};
   const uint64_t size = bb__walk_number(&w, 4, 1);
   const int32_t width = (int32_t)(uint32_t)bb__walk_number(&w, 4, 1);
@@ -223,7 +224,8 @@ static void check_tiles(bb__walk *w, unsigned tiles, bb__probe *p) {
   }
 }
 
-void bb__probe_iff(int fd, bb__probe *p) {
+void bb__probe_iff(int fd, const unsigned char *head, bb__probe *p) {
+  (void)head;
   p->format = "IFF";
   bb__walk w = {fd, p->file_bytes, 0, 1};
   int in_cimg = 0, past_tbhd = 0;
@@ -303,7 +305,8 @@ static double fits_integer(const unsigned char *card) {
   return negative ? -value : value;
 }
 
-void bb__probe_fits(int fd, bb__probe *p) {
+void bb__probe_fits(int fd, const unsigned char *head, bb__probe *p) {
+  (void)head;
   p->format = "FITS";
   enum { BATCH = 32 };
   unsigned char *blocks = malloc((size_t)BATCH * FITS_BLOCK);
@@ -413,7 +416,8 @@ void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p) {
  * one at 24 and 27, the alpha flag 0x10 at 20), whatever the frames hold.
  * It takes no memory until written, but counts against a process's
  * address space limit, and it is the size of every frame read. */
-void bb__probe_webp(int fd, bb__probe *p) {
+void bb__probe_webp(int fd, const unsigned char *head, bb__probe *p) {
+  (void)head;
   unsigned char h[30];
   if (bb__probe_read(fd, h, sizeof h, 0) != sizeof h || memcmp(h + 12, "VP8X", 4) != 0) return;
   const double width = 1.0 + (h[24] | h[25] << 8 | h[26] << 16);

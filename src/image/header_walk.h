@@ -43,13 +43,13 @@ void bb__probe_corrupt(bb__probe *p, const char *fmt, ...) __attribute__((format
 void bb__probe_sgi(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_dpx(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_cineon(int fd, const unsigned char *head, bb__probe *p);
-void bb__probe_bmp(int fd, bb__probe *p);
-void bb__probe_iff(int fd, bb__probe *p);
-void bb__probe_fits(int fd, bb__probe *p);
+void bb__probe_bmp(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_iff(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_fits(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p);
-void bb__probe_webp(int fd, bb__probe *p);
-void bb__probe_softimage(int fd, bb__probe *p);
-void bb__probe_psd(int fd, bb__probe *p);
+void bb__probe_webp(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_softimage(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_psd(int fd, const unsigned char *head, bb__probe *p);
 
 #ifdef __cplusplus
 }

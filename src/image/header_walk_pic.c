@@ -98,7 +98,8 @@ static const char *pic_scanline(pic_reader *r, const pic_packet *k, unsigned wid
   return NULL;
 }
 
-void bb__probe_softimage(int fd, bb__probe *p) {
+void bb__probe_softimage(int fd, const unsigned char *first, bb__probe *p) {
+  (void)first;
   unsigned char head[104];
   if (bb__probe_read(fd, head, sizeof head, 0) != sizeof head) return; /* the reader fails */
   p->format = "Softimage PIC";

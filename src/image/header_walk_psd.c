@@ -192,7 +192,8 @@ static int walk_layer(bb__walk *w, int psb, int layer, double *data, bb__probe *
   return fine;
 }
 
-void bb__probe_psd(int fd, bb__probe *p) {
+void bb__probe_psd(int fd, const unsigned char *head, bb__probe *p) {
+  (void)head;
   p->format = "PSD";
   const double file = p->file_bytes;
   bb__walk w = {fd, file, 4, 1};

@@ -18,6 +18,7 @@
 #include "cli_harness.h"
 #include "hostile_headers.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,6 +67,18 @@ static void expect_every_read_refuses(const char *path, bb_status want, const ch
   expect_refusal(read_info, "bb_image_read_info", path, want, part);
   expect_refusal(read_pixels, "bb_image_read", path, want, part);
   expect_refusal(load_height, "bb__height_load", path, want, part);
+}
+
+/* Each of `count` cases (`size` bytes apart, a reason `reason_at` bytes
+ * into each), written to path by `write`, is refused by every read,
+ * saying its reason. */
+static void expect_each_refused(const char *path, const void *cases, size_t size, size_t count,
+                                size_t reason_at, int (*write)(const char *, const void *)) {
+  for (size_t i = 0; i < count; i++) {
+    const char *c = (const char *)cases + i * size;
+    cr_assert_eq(write(path, c), 0, "%s: case %zu", path, i);
+    expect_every_read_refuses(path, BB_ERR_FORMAT, *(const char *const *)(c + reason_at));
+  }
 }
 
 /* A valid file reads: its size, and each sample the `count` values of
@@ -227,6 +240,16 @@ Test(hostile_headers, an_rle_bmp_too_large_to_open_says_so) {
   expect_reads(path, 2, 2, 1, want, 4);
 }
 
+typedef struct psd_case {
+  uint32_t colour, id, length, name, bottom;
+  const char *reason;
+} psd_case;
+
+static int write_psd_case(const char *path, const void *c) {
+  const psd_case *k = c;
+  return write_psd(path, k->colour, k->id, k->length, k->name, k->bottom);
+}
+
 /* OpenImageIO's PSD reader allocates, zeroed, in open(): the colour mode
  * data's length (4 GiB took 4.3 GB), each image resource's, a thumbnail's
  * less its 28-byte header, and 8 bytes for each row of each layer
@@ -236,10 +259,7 @@ Test(hostile_headers, an_rle_bmp_too_large_to_open_says_so) {
  * the same file declaring what it holds reads. */
 Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
   const char *path = tmp("h.psd");
-  const struct {
-    uint32_t colour, id, length, name, bottom;
-    const char *reason;
-  } files[] = {
+  static const psd_case files[] = {
       {0xFFFFFFFFu, 1006, 2, 1, 2,
        "corrupt image: its PSD colour mode data of 4294967295 bytes runs past the end of the "
        "file of 126 bytes"},
@@ -254,15 +274,23 @@ Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
       {0, 1006, 2, 1, 200000, "corrupt image: PSD layer 0's channel 0 declares 200000 rows in 6 "
                               "bytes"},
   };
-  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-    cr_assert_eq(write_psd(path, files[i].colour, files[i].id, files[i].length, files[i].name,
-                           files[i].bottom),
-                 0);
-    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
-  }
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(psd_case, reason), write_psd_case);
   cr_assert_eq(write_psd(path, 0, 1006, 2, 1, 2), 0);
   const float want[4] = {50 / 255.f, 60 / 255.f, 70 / 255.f, 80 / 255.f}; /* the merged image */
   expect_reads(path, 2, 2, 1, want, 4);
+}
+
+typedef struct iff_case {
+  uint32_t flags;
+  unsigned bytes;
+  uint32_t auth, rgba;
+  const char *reason;
+} iff_case;
+
+static int write_iff_case(const char *path, const void *c) {
+  const iff_case *k = c;
+  return write_iff(path, k->flags, k->bytes, k->auth, k->rgba);
 }
 
 /* OpenImageIO's IFF reader allocates an AUTH or DATE chunk's size, zeroed,
@@ -272,12 +300,7 @@ Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
  * from the header, and the same file without them reads. */
 Test(hostile_headers, iff_chunks_past_the_end_and_aborting_flags_are_refused) {
   const char *path = tmp("h.iff");
-  const struct {
-    uint32_t flags;
-    unsigned bytes;
-    uint32_t auth, rgba;
-    const char *reason;
-  } files[] = {
+  static const iff_case files[] = {
       {1, 0, 0x60000000u, 20,
        "corrupt image: IFF AUTH chunk of 1610612736 bytes at byte 52 runs past the end of the "
        "file of 96 bytes"},
@@ -287,11 +310,8 @@ Test(hostile_headers, iff_chunks_past_the_end_and_aborting_flags_are_refused) {
       {0x11, 0, 2, 20, "corrupt image: IFF table header flags 0x11 set RGB or alpha with black"},
       {0x04, 1, 2, 20, "corrupt image: IFF table header flags a Z buffer with a byte count of 1"},
   };
-  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-    cr_assert_eq(write_iff(path, files[i].flags, files[i].bytes, files[i].auth, files[i].rgba),
-                 0);
-    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
-  }
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(iff_case, reason), write_iff_case);
   cr_assert_eq(write_iff(path, 1, 0, 2, 20), 0);
   const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
   expect_reads(path, 2, 2, 3, want, 3);
@@ -353,6 +373,16 @@ Test(hostile_headers, a_webp_canvas_too_large_to_open_says_so) {
   expect_reads(path, 2, 2, 3, want, 3);
 }
 
+typedef struct pic_case {
+  unsigned type, code, run, cut;
+  const char *reason;
+} pic_case;
+
+static int write_pic_case(const char *path, const void *c) {
+  const pic_case *k = c;
+  return write_softimage(path, k->type, k->code, k->run, k->cut);
+}
+
 /* OpenImageIO's Softimage PIC reader, given a scanline it cannot read
  * (the file ends early; a pure run-length packet of RGB), asks the FILE it
  * has closed for its position (SIGSEGV: the load fuzzer's find), and
@@ -361,20 +391,14 @@ Test(hostile_headers, a_webp_canvas_too_large_to_open_says_so) {
  * reads. */
 Test(hostile_headers, softimage_scanlines_the_reader_cannot_read_are_refused) {
   const char *path = tmp("h.pic");
-  const struct {
-    unsigned type, code, run, cut;
-    const char *reason;
-  } files[] = {
+  static const pic_case files[] = {
       {2, 0xE0, 129, 1, "corrupt image: Softimage PIC scanline 1: it runs past the end of the file"},
       {2, 0xE0, 130, 0, "Softimage PIC scanline 0: a run runs past the end of its scanline"},
       {2, 0x10, 129, 0, "corrupt image: its Softimage PIC packets name channel 4 of 1"},
       {1, 0xE0, 2, 0, "a pure run-length packet of more than one byte a pixel"},
   };
-  for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-    cr_assert_eq(write_softimage(path, files[i].type, files[i].code, files[i].run, files[i].cut),
-                 0);
-    expect_every_read_refuses(path, BB_ERR_FORMAT, files[i].reason);
-  }
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(pic_case, reason), write_pic_case);
   cr_assert_eq(write_softimage(path, 2, 0xE0, 129, 0), 0);
   const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
   expect_reads(path, 2, 2, 3, want, 3);
