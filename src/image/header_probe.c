@@ -1,6 +1,7 @@
 /* header_probe.c: a file's header read before OpenImageIO opens it, for
- * the readers that allocate what a header declares inside open(), where no
- * ImageSpec, limit or hook of OpenImageIO 2.4 can stop them:
+ * the readers that allocate what a header declares inside open() (or at
+ * the first read), where no ImageSpec, limit or hook of OpenImageIO 2.4
+ * can stop them, and those that crash on what a header declares:
  *
  * - JPEG: open() runs jpeg_start_decompress, which for a progressive (or
  *   any multi-scan) file allocates and zeroes the coefficients of the whole
