@@ -1,6 +1,7 @@
 /* header_probe.c: a file's header read before OpenImageIO opens it, for
- * the readers that allocate what a header declares inside open(), where no
- * ImageSpec, limit or hook of OpenImageIO 2.4 can stop them:
+ * the readers that allocate what a header declares inside open() (or at
+ * the first read), where no ImageSpec, limit or hook of OpenImageIO 2.4
+ * can stop them, and those that crash on what a header declares:
  *
  * - JPEG: open() runs jpeg_start_decompress, which for a progressive (or
  *   any multi-scan) file allocates and zeroes the coefficients of the whole
@@ -25,10 +26,48 @@
  * - SGI: for an RLE file, open() sizes its two offset tables, 4 bytes for
  *   each row of each channel, from the header's ysize and zsize and zeroes
  *   them before reading them from the file: a 109-byte file declaring
- *   65292 rows of 25447 channels asked for 6.6 GB. The sizes are 16-bit
- *   big-endian numbers at fixed offsets of the 512-byte header (storage at
- *   2, ysize at 8, zsize at 10): read at a fixed place, not a parse. The
- *   tables lie in the file, so they can be no larger than it.
+ *   65292 rows of 25447 channels asked for 6.6 GB. The tables lie in the
+ *   file, so they can be no larger than it; and reading a row allocates
+ *   the length its table gives (0xFFFFFFFF: 4 GB), so each row must lie in
+ *   the file (header_walk.c reads the sizes at their fixed offsets, then
+ *   the tables).
+ *
+ * - DPX, Cineon: open() allocates the user data the header declares,
+ *   zeroed, and copies it into the image's attributes twice, whether or
+ *   not the file holds it (a 2 KB DPX declaring 768 MiB took 2.5 GB and
+ *   opened): it must lie in the file (header_walk.c).
+ *
+ * - BMP: for an RLE file, open() decodes the whole image into width x
+ *   height bytes, zeroed first (a 54-byte file of 40000 x 40000 took 1.7
+ *   GB): the size and compression are at fixed offsets (header_walk.c).
+ *
+ * - PSD: open() allocates, zeroed, the colour mode data, image resources
+ *   and each layer channel's row tables its lengths declare, and reads
+ *   alpha channel names until a resource's length is used up, forever
+ *   past the end of the file (OpenImageIO aborts): header_walk_psd.c
+ *   walks the sections and checks each length against the file.
+ *
+ * - IFF: open() allocates an AUTH or DATE chunk's size, zeroed, and
+ *   asserts on two table header flag combinations (Debian's build keeps
+ *   the assertions: abort()); the first read allocates each tile's size:
+ *   header_walk.c walks the chunks, each within the file.
+ *
+ * - FITS: open() sizes a vector by the NAXIS card, zeroed, before
+ *   checking it, and reads a header block by block through a recursion
+ *   (11000 blank blocks overflowed the stack): header_walk.c reads the
+ *   cards, NAXIS within 0 to 999 and END within 1000 blocks.
+ *
+ * - JPEG 2000: open() decodes the whole image, 4 bytes a sample, however
+ *   little the file holds (82 bytes declaring 12000 x 12000 took 707 MB):
+ *   header_walk.c reads the SIZ marker's fixed fields.
+ *
+ * - WebP: open() allocates the canvas a VP8X chunk declares, 3 or 4
+ *   bytes a texel, up to 2^24 a side (address space only: it is not
+ *   written until a frame is read): header_walk.c reads its size.
+ *
+ * - Softimage PIC: the reader uses the FILE it closed after a scanline it
+ *   cannot read (SIGSEGV), and writes runs and channels past its buffer
+ *   where the file says: header_walk_pic.c walks every scanline first.
  *
  * - DDS: OpenImageIO 2.4.7's reader crashes or hangs on hostile headers
  *   (dds_read.c lists how), so bumpbake reads DDS itself and hands none to
@@ -39,29 +78,16 @@
  * (core/input_file.h), so the file probed is the file read. */
 #include "image/header_probe.h"
 #include "core/internal.h"
+#include "image/header_walk.h"
+#include "image/signatures.h"
 
-#include <errno.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <jpeglib.h>
 #include <openexr.h>
-
-/* pread of up to n bytes at offset; the bytes read (0 at the end or on an
- * error). */
-static size_t read_at(int fd, void *buf, size_t n, off_t offset) {
-  size_t done = 0;
-  while (done < n) {
-    ssize_t got = pread(fd, (unsigned char *)buf + done, n - done, offset + (off_t)done);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) break;
-    done += (size_t)got;
-  }
-  return done;
-}
 
 /* -------------------------------------------------------------------- GIF */
 
@@ -73,22 +99,6 @@ static void probe_gif(int fd, const unsigned char *magic, bb__probe *p) {
   p->width = magic[6] | magic[7] << 8;
   p->height = magic[8] | magic[9] << 8;
   p->open_bytes = (double)p->width * (double)p->height * 4.0;
-}
-
-/* -------------------------------------------------------------------- SGI */
-
-static unsigned big16(const unsigned char *b) { return (unsigned)b[0] << 8 | b[1]; }
-
-static void probe_sgi(const unsigned char *head, bb__probe *p) {
-  p->format = "SGI";
-  const unsigned dimension = big16(head + 4);
-  p->width = (int)big16(head + 6);
-  p->height = dimension == 1 ? 1 : (int)big16(head + 8);
-  if (head[2] == 1) { /* RLE: the reader reads ysize x zsize starts and as many lengths */
-    p->table_bytes = 8.0 * big16(head + 8) * big16(head + 10);
-    p->table_entries = "RLE rows";
-    p->open_bytes = p->table_bytes;
-  }
 }
 
 /* ------------------------------------------------------------------- JPEG */
@@ -104,7 +114,7 @@ static void source_init(j_decompress_ptr cinfo) { (void)cinfo; }
 
 static boolean source_fill(j_decompress_ptr cinfo) {
   fd_source *src = (fd_source *)cinfo->src;
-  size_t n = read_at(src->fd, src->buffer, sizeof src->buffer, src->offset);
+  size_t n = bb__probe_read(src->fd, src->buffer, sizeof src->buffer, (double)src->offset);
   if (n == 0) { /* the file ends: an end-of-image marker, as libjpeg's own source does */
     src->buffer[0] = 0xFF;
     src->buffer[1] = JPEG_EOI;
@@ -193,7 +203,7 @@ static int64_t exr_read(exr_const_context_t ctxt, void *user, void *buffer, uint
   (void)ctxt, (void)error;
   const exr_stream *s = user;
   if (offset > (uint64_t)s->size) return 0;
-  return (int64_t)read_at(s->fd, buffer, size, (off_t)offset);
+  return (int64_t)bb__probe_read(s->fd, buffer, size, (double)offset);
 }
 
 static int64_t exr_size(exr_const_context_t ctxt, void *user) {
@@ -262,13 +272,24 @@ static bb_status probe_exr(int fd, const char *path, bb__probe *p, bb_error *err
 
 /* ------------------------------------------------------------------ probe */
 
+/* The formats header_walk.h reads by hand, by OpenImageIO's name for them
+ * (signatures.h: the reader a file's first bytes name). */
+static const struct {
+  const char *format;
+  void (*probe)(int fd, const unsigned char *head, bb__probe *p);
+} WALKS[] = {
+    {"dpx", bb__probe_dpx},   {"cineon", bb__probe_cineon},     {"bmp", bb__probe_bmp},
+    {"psd", bb__probe_psd},   {"iff", bb__probe_iff},           {"fits", bb__probe_fits},
+    {"webp", bb__probe_webp}, {"jpeg2000", bb__probe_jpeg2000}, {"softimage", bb__probe_softimage},
+};
+
 bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err) {
   memset(p, 0, sizeof *p);
   struct stat st;
   if (fstat(fd, &st) != 0) return BB_OK; /* the reader will say what is wrong */
   p->file_bytes = (double)st.st_size;
   unsigned char magic[12] = {0};
-  const size_t got = read_at(fd, magic, sizeof magic, 0);
+  const size_t got = bb__probe_read(fd, magic, sizeof magic, 0);
   if (got < 4) return BB_OK;
   if (magic[0] == 0xFF && magic[1] == 0xD8 && magic[2] == 0xFF) {
     probe_jpeg(fd, p);
@@ -280,9 +301,15 @@ bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err
     return bb__fail(err, BB_ERR_FORMAT, "%s: a DDS file swapped in while it was being opened",
                     path);
   if (magic[0] == 0x01 && magic[1] == 0xDA) {
-    if (got == sizeof magic) probe_sgi(magic, p); /* shorter: the reader fails its header read */
+    if (got == sizeof magic) bb__probe_sgi(fd, magic, p); /* shorter: the reader fails its header read */
     return BB_OK;
   }
+  const char *format = bb__format_by_content(magic, (unsigned long)got);
+  for (size_t i = 0; format && i < sizeof WALKS / sizeof WALKS[0]; i++)
+    if (strcmp(format, WALKS[i].format) == 0) {
+      WALKS[i].probe(fd, magic, p);
+      return BB_OK;
+    }
   probe_gif(fd, magic, p);
   return BB_OK;
 }

@@ -113,11 +113,19 @@ Test(fuzz, cli_regressions) {
  * png-text-chunk-of-1.7-gb: libpng allocated and zeroed a tEXt chunk's
  * declared 1.7 GB (its 8 MB chunk limit is only a warning on read);
  * png_hooks.c bounds libpng's allocations on OpenImageIO's structs.
+ * sgi-rle-row-length-of-4-gb: an RLE row length of 0xFFFFFFFF, allocated
+ * at the first row read (AddressSanitizer: allocation size too big).
+ * dpx-user-data-of-2.2-gb: the DPX reader allocated the declared user data
+ * (past -malloc_limit_mb). softimage-unreadable-scanline-segv: the
+ * Softimage reader, failing a scanline, used the FILE it had closed
+ * (SIGSEGV). The PSD, IFF, FITS and JPEG 2000
+ * inputs are an audit's files of the same kind (the header probe refuses
+ * each: header_walk.h).
  * Replayed here without libFuzzer's memory limits: the messages and the
  * crashes are checked here, the allocations by `make fuzz`, which replays
  * them under its limits, and by tests/image/test_hostile_headers.c. */
 Test(fuzz, load_regressions) {
-  replay("load", bb_fuzz_load, 8);
+  replay("load", bb_fuzz_load, 20);
 }
 
 /* Models that read outside their directory or crashed Assimp: an OBJ whose

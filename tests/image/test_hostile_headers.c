@@ -18,6 +18,7 @@
 #include "cli_harness.h"
 #include "hostile_headers.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,6 +67,34 @@ static void expect_every_read_refuses(const char *path, bb_status want, const ch
   expect_refusal(read_info, "bb_image_read_info", path, want, part);
   expect_refusal(read_pixels, "bb_image_read", path, want, part);
   expect_refusal(load_height, "bb__height_load", path, want, part);
+}
+
+/* Each of `count` cases (`size` bytes apart, a reason `reason_at` bytes
+ * into each), written to path by `write`, is refused by every read,
+ * saying its reason. */
+static void expect_each_refused(const char *path, const void *cases, size_t size, size_t count,
+                                size_t reason_at, int (*write)(const char *, const void *)) {
+  for (size_t i = 0; i < count; i++) {
+    const char *c = (const char *)cases + i * size;
+    cr_assert_eq(write(path, c), 0, "%s: case %zu", path, i);
+    expect_every_read_refuses(path, BB_ERR_FORMAT, *(const char *const *)(c + reason_at));
+  }
+}
+
+/* A valid file reads: its size, and each sample the `count` values of
+ * `want` in turn (none checked when want is NULL). */
+static void expect_reads(const char *path, int width, int height, int channels,
+                         const float *want, int count) {
+  bb_image img;
+  bb_error err;
+  cr_assert_eq(bb_image_read(path, &img, NULL, &err), BB_OK, "%s", err.message);
+  cr_expect(img.width == width && img.height == height && img.channels == channels,
+            "%s: %dx%d, %d channels", path, img.width, img.height, img.channels);
+  const int samples = img.width * img.height * img.channels;
+  for (int i = 0; want && i < samples; i++)
+    cr_expect_float_eq(img.pixels[i], want[i % count], 1e-6, "%s: sample %d: %g", path, i,
+                       img.pixels[i]);
+  bb_image_free(&img);
 }
 
 Test(hostile_headers, a_progressive_jpeg_is_refused_from_its_header) {
@@ -147,20 +176,238 @@ Test(hostile_headers, sgi_offset_tables_longer_than_the_file_are_refused) {
                             "declares 4294836225 RLE rows, more than the file of 544 bytes");
   const char *fine = tmp("f.sgi");
   cr_assert_eq(write_sgi_rle(fine, 2, 1), 0);
-  bb_image img;
-  bb_error err;
-  cr_assert_eq(bb_image_read(fine, &img, NULL, &err), BB_OK, "%s", err.message);
-  cr_expect(img.width == 2 && img.height == 2 && img.channels == 1);
   /* SGI's rows run bottom to top: the file's first row is the image's last. */
   const float want[4] = {90 / 255.f, 30 / 255.f, 10 / 255.f, 200 / 255.f};
-  for (int i = 0; i < 4; i++)
-    cr_expect_float_eq(img.pixels[i], want[i], 1e-6, "texel %d: %g", i, img.pixels[i]);
-  bb_image_free(&img);
+  expect_reads(fine, 2, 2, 1, want, 4);
 }
 
-/* The load fuzzer's finds (fuzz/regressions/load/, a byte for the
- * extension index, then the file): each made OpenImageIO's reader allocate
- * 1.6 to 1.8 GB at once in open() (the GIF and PNG ones zeroed it too),
+/* Reading an RLE SGI's row allocates the length its table gives, an int:
+ * a row running past the end of the file is refused from the header
+ * (0xFFFFFFFF asked for 4 GB at the first row read; 0x7FFFFFF0 for 2 GB),
+ * and the same file whose row lies in it reads (above). */
+Test(hostile_headers, sgi_rle_rows_past_the_end_of_the_file_are_refused) {
+  const char *path = tmp("l.sgi");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 0xFFFFFFFFu), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: SGI RLE row 1 of channel 0 declares 4294967295 "
+                            "bytes at byte 532, past the end of the file of 544 bytes");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 0x7FFFFFF0u), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "declares 2147483632 bytes at byte 532");
+  cr_assert_eq(write_sgi_rle_rows(path, 2, 1, 13), 0); /* one byte past the end */
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "declares 13 bytes at byte 532");
+}
+
+/* DPX and Cineon readers allocate the user data their header declares,
+ * zeroed, in open(), and copy it twice (a 2 KB DPX declaring 768 MiB took
+ * 2.5 GB and opened): user data running past the end of the file is
+ * refused from the header, in either byte order, and the same files whose
+ * 16 bytes of user data lie in them read. */
+Test(hostile_headers, dpx_and_cineon_user_data_past_the_end_of_the_file_is_refused) {
+  const char *dpx = tmp("u.dpx"), *cin = tmp("u.cin");
+  for (int little = 0; little <= 1; little++) {
+    cr_assert_eq(write_dpx_user(dpx, 0xC0000000u, 16, little), 0);
+    expect_every_read_refuses(dpx, BB_ERR_FORMAT,
+                              "corrupt image: its DPX user data of 3221225472 bytes after the "
+                              "2048-byte header runs past the end of the file of 2068 bytes");
+    cr_assert_eq(write_dpx_user(dpx, 21, 16, little), 0); /* one byte past the end */
+    expect_every_read_refuses(dpx, BB_ERR_FORMAT, "user data of 21 bytes");
+  }
+  cr_assert_eq(write_cineon_user(cin, 0x80000000u, 16), 0);
+  expect_every_read_refuses(cin, BB_ERR_FORMAT,
+                            "corrupt image: its Cineon user data of 2147483648 bytes after "
+                            "the 2048-byte header runs past the end of the file of 2068 bytes");
+  for (int little = 0; little <= 1; little++) {
+    cr_assert_eq(write_dpx_user(dpx, 16, 16, little), 0);
+    const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+    expect_reads(dpx, 1, 1, 3, want, 3);
+  }
+  cr_assert_eq(write_cineon_user(cin, 16, 16), 0);
+  expect_reads(cin, 1, 1, 1, NULL, 0); /* Cineon's samples are log: not checked */
+}
+
+/* OpenImageIO decodes an RLE BMP whole into width x height bytes, zeroed,
+ * in open() (a 54-byte file of 40000 x 40000 took 1.7 GB): that is held to
+ * BB_MAX_READ_BYTES from the header, and a small one reads. */
+Test(hostile_headers, an_rle_bmp_too_large_to_open_says_so) {
+  const char *path = tmp("r.bmp");
+  cr_assert_eq(write_bmp_rle8(path, 50000, -50000), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a BMP of 50000x50000 needs 2384 MiB to open");
+  cr_assert_eq(write_bmp_rle8(path, 65536, 65536), 0); /* past INT_MAX bytes */
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a BMP of 65536x65536 needs 4096 MiB to open");
+  cr_assert_eq(write_bmp_rle8(path, 2, 2), 0);
+  /* BMP's rows run bottom to top: the white row is the image's last. */
+  const float want[4] = {0, 0, 1, 1};
+  expect_reads(path, 2, 2, 1, want, 4);
+}
+
+typedef struct psd_case {
+  uint32_t colour, id, length, name, bottom;
+  const char *reason;
+} psd_case;
+
+static int write_psd_case(const char *path, const void *c) {
+  const psd_case *k = c;
+  return write_psd(path, k->colour, k->id, k->length, k->name, k->bottom);
+}
+
+/* OpenImageIO's PSD reader allocates, zeroed, in open(): the colour mode
+ * data's length (4 GiB took 4.3 GB), each image resource's, a thumbnail's
+ * less its 28-byte header, and 8 bytes for each row of each layer
+ * channel; it reads alpha channel names until a block's length is used
+ * up, forever past the end of the file. Each length must lie in the file,
+ * a layer within 300000 a side, its rows within its channel's data; and
+ * the same file declaring what it holds reads. */
+Test(hostile_headers, psd_lengths_past_the_end_of_the_file_are_refused) {
+  const char *path = tmp("h.psd");
+  static const psd_case files[] = {
+      {0xFFFFFFFFu, 1006, 2, 1, 2,
+       "corrupt image: its PSD colour mode data of 4294967295 bytes runs past the end of the "
+       "file of 126 bytes"},
+      {0, 1058, 0x60000000u, 1, 2,
+       "corrupt image: PSD image resource 1058 declares 1610612736 bytes at byte 46, past the "
+       "end of the file of 126 bytes"},
+      {0, 1006, 2, 255, 2,
+       "corrupt image: PSD alpha channel names (resource 1006) run past the end of the file"},
+      {0, 1036, 2, 1, 2, "corrupt image: PSD thumbnail resource 1036 of 2 bytes is shorter"},
+      {0, 1006, 2, 1, 0x08000000u,
+       "corrupt image: PSD layer 0's channel 0 is 2x134217728, past the largest a PSB may be"},
+      {0, 1006, 2, 1, 200000, "corrupt image: PSD layer 0's channel 0 declares 200000 rows in 6 "
+                              "bytes"},
+  };
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(psd_case, reason), write_psd_case);
+  cr_assert_eq(write_psd(path, 0, 1006, 2, 1, 2), 0);
+  const float want[4] = {50 / 255.f, 60 / 255.f, 70 / 255.f, 80 / 255.f}; /* the merged image */
+  expect_reads(path, 2, 2, 1, want, 4);
+}
+
+typedef struct iff_case {
+  uint32_t flags;
+  unsigned bytes;
+  uint32_t auth, rgba;
+  const char *reason;
+} iff_case;
+
+static int write_iff_case(const char *path, const void *c) {
+  const iff_case *k = c;
+  return write_iff(path, k->flags, k->bytes, k->auth, k->rgba);
+}
+
+/* OpenImageIO's IFF reader allocates an AUTH or DATE chunk's size, zeroed,
+ * in open() (a 52-byte file declaring 1.5 GiB took 1.7 GB), and each tile's
+ * RGBA chunk's at the first read; and Debian's build keeps two assertions
+ * on the table header's flags, which abort() the process. Each is refused
+ * from the header, and the same file without them reads. */
+Test(hostile_headers, iff_chunks_past_the_end_and_aborting_flags_are_refused) {
+  const char *path = tmp("h.iff");
+  static const iff_case files[] = {
+      {1, 0, 0x60000000u, 20,
+       "corrupt image: IFF AUTH chunk of 1610612736 bytes at byte 52 runs past the end of the "
+       "file of 96 bytes"},
+      {1, 0, 0xFFFFFFFEu, 20, "IFF AUTH chunk of 4294967294 bytes"}, /* rounds up to 0 */
+      {1, 0, 2, 0x60000000u, "corrupt image: IFF tile 0's RGBA chunk of 1610612736 bytes"},
+      {1, 0, 2, 4, "corrupt image: IFF tile 0's RGBA chunk of 4 bytes"}, /* less 8: 4 GiB */
+      {0x11, 0, 2, 20, "corrupt image: IFF table header flags 0x11 set RGB or alpha with black"},
+      {0x04, 1, 2, 20, "corrupt image: IFF table header flags a Z buffer with a byte count of 1"},
+  };
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(iff_case, reason), write_iff_case);
+  cr_assert_eq(write_iff(path, 1, 0, 2, 20), 0);
+  const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+  expect_reads(path, 2, 2, 3, want, 3);
+}
+
+/* OpenImageIO's FITS reader sizes a vector of ints by NAXIS, zeroed, in
+ * open() (400000000 took 1.7 GB), and recurses once a 2880-byte block
+ * until END (11000 blank blocks overflowed the stack): NAXIS outside 0 to
+ * 999 and a header of 1000 blocks without END are refused; a header whose
+ * END is in its 1000th block, and a small image, read. */
+Test(hostile_headers, fits_axes_and_endless_headers_are_refused) {
+  const char *path = tmp("h.fits");
+  cr_assert_eq(write_fits(path, "400000000", 0), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: FITS header declares 400000000 axes (NAXIS is 0 to "
+                            "999)");
+  cr_assert_eq(write_fits(path, "-1", 0), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT, "FITS header declares -1 axes");
+  cr_assert_eq(write_fits(path, "2", -1000), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "corrupt image: FITS header at byte 0 has no END card in its first "
+                            "1000 blocks");
+  const float want = 200 / 255.f;
+  for (int blank = 0; blank <= 999; blank += 999) {
+    cr_assert_eq(write_fits(path, "2", blank), 0);
+    expect_reads(path, 2, 2, 1, &want, 1);
+  }
+}
+
+/* OpenImageIO's JPEG 2000 reader decodes the whole image in open(), 4
+ * bytes a sample, however little the file holds (82 bytes declaring
+ * 12000 x 12000 took 707 MB and opened): held to BB_MAX_READ_BYTES from
+ * the SIZ marker, raw or in a JP2 file's jp2c box; the same small files
+ * read. */
+Test(hostile_headers, a_jpeg2000_too_large_to_open_says_so) {
+  const char *j2k = tmp("h.j2k"), *jp2 = tmp("h.jp2");
+  cr_assert_eq(write_jpeg2000(j2k, 30000, 30000, 0), 0);
+  expect_every_read_refuses(j2k, BB_ERR_SIZE, "a JPEG 2000 of 30000x30000 needs 3433 MiB to open");
+  cr_assert_eq(write_jpeg2000(jp2, 30000, 30000, 1), 0);
+  expect_every_read_refuses(jp2, BB_ERR_SIZE, "a JPEG 2000 of 30000x30000 needs 3433 MiB to open");
+  for (int wrapped = 0; wrapped <= 1; wrapped++) {
+    const char *path = wrapped ? jp2 : j2k;
+    cr_assert_eq(write_jpeg2000(path, 4, 4, wrapped), 0);
+    expect_reads(path, 4, 4, 1, NULL, 0); /* empty code blocks: no value to check */
+  }
+}
+
+/* OpenImageIO's WebP reader allocates the canvas an animated WebP's VP8X
+ * chunk declares, 3 bytes a texel, in open(), whatever its frames hold
+ * (up to 2^24 a side; under `ulimit -v` an 88-byte file of 30000 x 30000
+ * ran out of memory): held to BB_MAX_READ_BYTES from the header, and the
+ * same file of a 2 x 2 canvas reads. */
+Test(hostile_headers, a_webp_canvas_too_large_to_open_says_so) {
+  const char *path = tmp("c.webp");
+  cr_assert_eq(write_webp_canvas(path, 30000, 30000), 0);
+  expect_every_read_refuses(path, BB_ERR_SIZE, "a WebP of 30000x30000 needs 2575 MiB to open");
+  cr_assert_eq(write_webp_canvas(path, 2, 2), 0);
+  const float want[3] = {204 / 255.f, 103 / 255.f, 50 / 255.f};
+  expect_reads(path, 2, 2, 3, want, 3);
+}
+
+typedef struct pic_case {
+  unsigned type, code, run, cut;
+  const char *reason;
+} pic_case;
+
+static int write_pic_case(const char *path, const void *c) {
+  const pic_case *k = c;
+  return write_softimage(path, k->type, k->code, k->run, k->cut);
+}
+
+/* OpenImageIO's Softimage PIC reader, given a scanline it cannot read
+ * (the file ends early; a pure run-length packet of RGB), asks the FILE it
+ * has closed for its position (SIGSEGV: the load fuzzer's find), and
+ * writes a run longer than its scanline, or alpha alone, past its buffer:
+ * each is refused from a walk of the scanlines, and the file read whole
+ * reads. */
+Test(hostile_headers, softimage_scanlines_the_reader_cannot_read_are_refused) {
+  const char *path = tmp("h.pic");
+  static const pic_case files[] = {
+      {2, 0xE0, 129, 1, "corrupt image: Softimage PIC scanline 1: it runs past the end of the file"},
+      {2, 0xE0, 130, 0, "Softimage PIC scanline 0: a run runs past the end of its scanline"},
+      {2, 0x10, 129, 0, "corrupt image: its Softimage PIC packets name channel 4 of 1"},
+      {1, 0xE0, 2, 0, "a pure run-length packet of more than one byte a pixel"},
+  };
+  expect_each_refused(path, files, sizeof files[0], sizeof files / sizeof files[0],
+                      offsetof(pic_case, reason), write_pic_case);
+  cr_assert_eq(write_softimage(path, 2, 0xE0, 129, 0), 0);
+  const float want[3] = {200 / 255.f, 100 / 255.f, 50 / 255.f};
+  expect_reads(path, 2, 2, 3, want, 3);
+}
+
+/* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
+ * byte for the extension index, then the file): each made OpenImageIO's
+ * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
+ * (zeroed, most of them), or abort (PSD's alpha names),
  * and now is refused from its header, saying why, at once and in little
  * memory. (libpng skips a chunk it cannot allocate: the PNG's read then
  * ends at the end of the file, as before, but without the 1.8 GB.) */
@@ -175,6 +422,20 @@ Test(hostile_headers, the_load_fuzzers_finds_are_refused_from_their_headers) {
       {"png-text-chunk-of-1.7-gb", ".png", "Read error: hit end of file"},
       {"sgi-rle-offset-tables-of-6.6-gb", ".sgi",
        "declares 1661485524 RLE rows, more than the file of 108 bytes can list"},
+      {"dpx-user-data-of-2.2-gb", ".dpx",
+       "its DPX user data of 2196890670 bytes after the 2048-byte header runs past"},
+      {"fits-naxis-of-400000000", ".fits", "FITS header declares 400000000 axes"},
+      {"jpeg2000-of-30000-x-30000-in-82-bytes", ".jp2", "a JPEG 2000 of 30000x30000 needs 3433"},
+      {"iff-auth-chunk-of-1.5-gib", ".iff", "IFF AUTH chunk of 1610612736 bytes at byte 52"},
+      {"iff-rgb-flags-with-black-abort", ".iff", "IFF table header flags 0x11 set RGB or alpha"},
+      {"psd-alpha-names-block-past-the-end-aborts", ".psd",
+       "PSD image resource 1006 declares 16 bytes at byte 46, past the end of the file"},
+      {"psd-colour-data-of-4-gib", ".psd", "its PSD colour mode data of 4294967295 bytes"},
+      {"psd-layer-of-134217728-rows", ".psd", "PSD layer 0's channel 0 is 1x134217728"},
+      {"softimage-unreadable-scanline-segv", ".pic",
+       "its Softimage PIC channel packets differ in size (248 and 8 bits)"},
+      {"sgi-rle-row-length-of-4-gb", ".sgi",
+       "SGI RLE row 0 of channel 0 declares 4294967295 bytes at byte 1870300560"},
   };
   for (size_t i = 0; i < sizeof finds / sizeof finds[0]; i++) {
     char from[256];
