@@ -527,4 +527,27 @@ static inline int write_softimage(const char *path, unsigned type, unsigned code
   return hostile_write(path, b, sizeof b - cut);
 }
 
+/* A one-icon ICO holding a 24-bit bitmap of width x height (at most 16 x
+ * 4) of one colour (B, G, R = 50, 100, 200), opaque: rows of 3 bytes a
+ * texel and a 1-bit mask, each row padded to 4 bytes, bottom up, after a
+ * 40-byte bitmap header that counts both (height twice). */
+static inline int write_ico_bitmap(const char *path, unsigned width, unsigned height) {
+  unsigned char b[512] = {0};
+  const unsigned row = (width * 3 + 3) / 4 * 4, mask = ((width + 7) / 8 + 3) / 4 * 4;
+  const unsigned bitmap = 40 + height * (row + mask);
+  hostile_put16(b + 2, 1), hostile_put16(b + 4, 1); /* an icon; one image */
+  b[6] = (unsigned char)width, b[7] = (unsigned char)height;
+  hostile_put16(b + 10, 1), hostile_put16(b + 12, 24); /* planes, bits */
+  hostile_put32(b + 14, bitmap), hostile_put32(b + 18, 22); /* its size, where */
+  unsigned char *h = b + 22;
+  hostile_put32(h, 40), hostile_put32(h + 4, width), hostile_put32(h + 8, 2 * height);
+  hostile_put16(h + 12, 1), hostile_put16(h + 14, 24);
+  for (unsigned y = 0; y < height; y++)
+    for (unsigned x = 0; x < width; x++) {
+      unsigned char *t = h + 40 + y * row + 3 * x;
+      t[0] = 50, t[1] = 100, t[2] = 200;
+    }
+  return hostile_write(path, b, 22 + bitmap);
+}
+
 #endif /* BB_TESTS_HOSTILE_HEADERS_H */

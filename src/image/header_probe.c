@@ -281,6 +281,7 @@ static const struct {
     {"dpx", bb__probe_dpx},   {"cineon", bb__probe_cineon},     {"bmp", bb__probe_bmp},
     {"psd", bb__probe_psd},   {"iff", bb__probe_iff},           {"fits", bb__probe_fits},
     {"webp", bb__probe_webp}, {"jpeg2000", bb__probe_jpeg2000}, {"softimage", bb__probe_softimage},
+    {"ico", bb__probe_ico},
 };
 
 bb_status bb__probe_header(int fd, const char *path, bb__probe *p, bb_error *err) {

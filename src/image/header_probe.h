@@ -26,6 +26,8 @@ typedef struct bb__probe {
   double file_bytes;   /* the file's size */
   char corrupt[240];   /* set when the header declares what the file cannot hold (a length
                         * running past its end): why, after "corrupt image: " */
+  char unsafe[240];    /* set for a valid file OpenImageIO's reader mishandles (writes
+                        * past its buffer): why, after "not a readable image: " */
 } bb__probe;
 
 /* Reads the header of the regular file open at fd (path names it in

@@ -156,6 +156,43 @@ void bb__probe_bmp(int fd, const unsigned char *head, bb__probe *p) {
   p->open_bytes = (double)width * rows;
 }
 
+/* -------------------------------------------------------------------- ICO */
+
+/* ICO: OpenImageIO 2.4.7's reader fills a bitmap icon's 1-bit
+ * transparency mask 8 texels at a time (icoinput.cpp readimg), so in an
+ * icon of fewer than 32 bits a texel whose width (the directory entry's
+ * byte) is not a multiple of 8 has the mask's padding bits written into
+ * the next row's first alpha bytes and, in its top row, up to 28 bytes
+ * past the reader's buffer (valgrind: an invalid write reading a valid
+ * 1 x 3 icon; the load fuzzer's heap overflow). Nothing of the reader's
+ * catches it, and the file is valid: refused, saying why. A PNG icon is
+ * read by libpng. Every entry is looked at, since every frame can be
+ * read; an entry or bitmap header past the end of the file fails the
+ * reader's own read. */
+void bb__probe_ico(int fd, const unsigned char *head, bb__probe *p) {
+  const int count = (int16_t)(uint16_t)(head[4] | head[5] << 8);
+  for (int i = 0; i < count; i++) {
+    bb__walk w = {fd, p->file_bytes, 6.0 + 16.0 * i, 1};
+    const unsigned width = (unsigned)bb__walk_number(&w, 1, 1);
+    w.pos += 11; /* height, colours, reserved, planes, bits, size */
+    const double at = (double)bb__walk_number(&w, 4, 1);
+    if (!w.ok) return;
+    unsigned char dib[16];
+    if (bb__probe_read(fd, dib, sizeof dib, at) != sizeof dib) continue;
+    if (dib[1] == 'P' && dib[2] == 'N' && dib[3] == 'G') continue;
+    const int bits = (int16_t)(uint16_t)(dib[14] | dib[15] << 8);
+    if ((bits == 1 || bits == 4 || bits == 8 || bits == 24) && width % 8 != 0) {
+      snprintf(p->unsafe, sizeof p->unsafe,
+               "icon %d is a %d-bit bitmap %u texel%s wide, which OpenImageIO 2.4's ICO "
+               "reader writes past its buffer (a width not a multiple of 8); save it as a "
+               "32-bit or PNG icon",
+               i, bits, width, width == 1 ? "" : "s");
+      p->format = "ICO";
+      return;
+    }
+  }
+}
+
 /* -------------------------------------------------------------------- IFF */
 
 /* Maya IFF, walked as open() walks it (iffinput.cpp read_header): chunks

@@ -50,6 +50,7 @@ void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_webp(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_softimage(int fd, const unsigned char *head, bb__probe *p);
 void bb__probe_psd(int fd, const unsigned char *head, bb__probe *p);
+void bb__probe_ico(int fd, const unsigned char *head, bb__probe *p);
 
 #ifdef __cplusplus
 }

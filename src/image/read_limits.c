@@ -35,6 +35,8 @@ bb_status bb__read_check_probe(const char *path, const bb__probe *p, int reading
                                bb_error *err) {
   if (!p->format) return BB_OK;
   if (p->corrupt[0]) return bb__fail(err, BB_ERR_FORMAT, "%s: corrupt image: %s", path, p->corrupt);
+  if (p->unsafe[0])
+    return bb__fail(err, BB_ERR_FORMAT, "%s: not a readable image: %s", path, p->unsafe);
   /* Tables the file cannot hold: corrupt, whatever their size. */
   if (p->table_bytes > p->file_bytes)
     return bb__fail(err, BB_ERR_FORMAT,

@@ -404,6 +404,22 @@ Test(hostile_headers, softimage_scanlines_the_reader_cannot_read_are_refused) {
   expect_reads(path, 2, 2, 3, want, 3);
 }
 
+/* OpenImageIO 2.4's ICO reader fills a bitmap icon's 1-bit mask 8 texels
+ * at a time: in an icon under 32 bits whose width is not a multiple of 8
+ * it writes past its buffer (the load fuzzer's heap overflow, on a valid
+ * file). Refused, saying why; the same icon 8 texels wide reads. */
+Test(hostile_headers, an_icon_its_reader_would_overrun_is_refused) {
+  const char *path = tmp("three.ico");
+  cr_assert_eq(write_ico_bitmap(path, 3, 2), 0);
+  expect_every_read_refuses(path, BB_ERR_FORMAT,
+                            "icon 0 is a 24-bit bitmap 3 texels wide, which OpenImageIO 2.4's "
+                            "ICO reader writes past its buffer");
+  const char *fine = tmp("eight.ico");
+  cr_assert_eq(write_ico_bitmap(fine, 8, 2), 0);
+  const float want[4] = {200 / 255.f, 100 / 255.f, 50 / 255.f, 1.f};
+  expect_reads(fine, 8, 2, 4, want, 4);
+}
+
 /* The load fuzzer's finds and an audit's files (fuzz/regressions/load/, a
  * byte for the extension index, then the file): each made OpenImageIO's
  * reader allocate 1.6 to 4.3 GB at once in open() or at the first read
