@@ -1782,6 +1782,38 @@ const bb_command_info *bb_command_describe(const bb_command *command);
 bb_status bb_command_derive(const bb_command *from, const char *name, bb_command **out,
                             bb_error *err);
 
+/* What a client that holds a command reads of its bake beyond one
+ * option's value (bumpbake serve's page): the library's rules, applied.
+ * The azimuth slices the bake traces: --slices, else those --rays makes
+ * (round(sqrt(rays))); 0 for NULL. */
+int bb_command_slices(const bb_command *command);
+/* The albedo (rho) the bake bounces light with: --bounce, or 1 for
+ * --bounce-albedo FILE alone (the map bounces as it is); 0 when it adds
+ * no inter-reflection, and for NULL. With one, the first
+ * bb_command_slices(command) units of a bake's progress are the trace's. */
+double bb_command_bounce(const bb_command *command);
+/* The file a checked command writes map kind to: the map's own option
+ * (--normal FILE) when given, else -o PREFIX's "PREFIX_KIND.png" for the
+ * maps -o writes (normal, ssbump, ao); serve's write, with neither given,
+ * takes HEIGHT without its extension for PREFIX. *path malloc'd, NULL for
+ * none. Errors: BB_ERR_ARGUMENT (no command or path), BB_ERR_MEMORY. */
+bb_status bb_command_map_file(const bb_command *command, bb_map_kind kind, char **path,
+                              bb_error *err);
+/* The JSON object `bake --json` prints of r, an input baked by command's
+ * job (bb_command_plan), without a newline: input, status (when not NULL:
+ * "written"), size, the parameters used, seconds per stage, horizons and
+ * the maps written. malloc'd; NULL when out of memory or for NULL. */
+char *bb_command_report_json(const bb_command *command, const bb_job_report *r,
+                             const char *status);
+/* The provenance ("key=value" lines) job's file of map kind ("ssbump")
+ * records for input i once baked (bb_job_bake_item, bb_job_run_item),
+ * whether or not the job writes that map: the command it records, the
+ * input's hashes, the parameters the kind depends on (the maps the bake
+ * read named by their hashes) and the ray set traced; without the texture
+ * settings a .vtf or .dds adds. malloc'd; NULL when out of memory, for an
+ * input not baked or out of range. */
+char *bb_job_provenance(const bb_job *job, int i, const char *kind);
+
 /* Sets option name (as bb_option_find finds it) from text, through the
  * option's parser, into the command's options: a flag takes text NULL (or
  * "1"/"0": Python's True/False); an option of several values takes them

@@ -124,6 +124,18 @@ static char *closed(FILE *f, char **text) {
   return *text;
 }
 
+char *bb_command_report_json(const bb_command *command, const bb_job_report *r,
+                             const char *status) {
+  if (!command || !r)
+    return NULL;
+  char *text = NULL;
+  size_t size = 0;
+  FILE *f = open_memstream(&text, &size);
+  if (f)
+    bb_job_report_json(f, &bb__command_options_of(command)->job.bake, r, status, NULL);
+  return closed(f, &text);
+}
+
 char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json) {
   const bb_command_options *o = bb__command_options_of(command);
