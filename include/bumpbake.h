@@ -1135,12 +1135,6 @@ typedef struct bb_output_spec {
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 
-/* path without the extension of its last component, plus suffix ("rock.png",
- * "-ssbump.tga" -> "rock-ssbump.tga"; a name's leading dot starts no
- * extension), malloc'd; NULL when out of memory. */
-char *bb_path_with_suffix(const char *path, const char *suffix);
-
-
 /* ------------------------------------------------------- writing outputs */
 
 /* One file of a set written all or nothing: an image (with its provenance)
@@ -1449,12 +1443,6 @@ typedef struct bb_job_options {
   int valve_detail;          /* 1: Valve's detail variant (RGB times the
                                 input's smoothed colour); not with valve.normal_map */
 } bb_job_options;
-
-/* The file a bake with options o writes for map kind, the one rule for
- * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
- * the kinds of BB_JOB_DEFAULT_MAPS, else none. *path is a malloc'd copy,
- * or NULL for none; BB_ERR_MEMORY when out of memory. */
-bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err);
 
 /* A planned job: opaque. */
 typedef struct bb_job bb_job;
@@ -1898,7 +1886,7 @@ bb_status bb_command_numbers(const bb_command *command, const char *name, double
 /* The options of the command's bake as set and checked (bake, normal,
  * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
  * and texture settings of every command writing maps): what a client that
- * reads the bake's settings (bb_bake_slices, bb_job_report_json) hands
+ * reads the bake's settings (bb_bake_slices) hands
  * on. Owned by command; NULL for NULL. Every other option is read by
  * name (bb_command_value). */
 const bb_job_options *bb_command_job_options(const bb_command *command);
@@ -2154,15 +2142,6 @@ bb_status bb_command_bake(bb_command *command, const bb_image *height,
                           const bb_basis *basis, const bb_command_hooks *hooks,
                           bb_bake_context *context, bb_image *maps, bb_region *changed,
                           bb_error *err);
-
-/* ----------------------------------------------------- what a job prints */
-
-/* The JSON object of r (an input baked with options b), without a
- * newline: input, status (when not NULL), size, the parameters used (the
- * channel the rule took, the threads that ran), seconds per stage,
- * horizons, extra_json's members (may be NULL) and the maps written. */
-void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
-                        const char *status, const char *extra_json);
 
 /* ------------------------------------------------- names of enums printed */
 

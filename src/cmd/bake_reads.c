@@ -21,5 +21,5 @@ bb_status bb_command_map_file(const bb_command *c, bb_map_kind kind, char **path
     *path = NULL;
   if (!c || !path)
     return bb__fail(err, BB_ERR_ARGUMENT, "command map file: bad arguments");
-  return bb_job_map_file(&c->options.job, kind, path, err);
+  return bb__job_map_file(&c->options.job, kind, path, err);
 }

@@ -4,6 +4,7 @@
  * rules and their job. */
 #include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "texture/texture.h"
 #include "render/render_internal.h"
 
@@ -789,8 +790,8 @@ static bb_status h2s_job(bb_command *c, bb_job_options *o, bb_error *err) {
   *o = c->options.job;
   o->force = 1;
   if (!o->valve_path) {
-    char *path = bb_path_with_suffix(c->inputs[0], o->valve.normal_map ? "-bump.tga"
-                                                                      : "-ssbump.tga");
+    char *path = bb__path_with_suffix(c->inputs[0], o->valve.normal_map ? "-bump.tga"
+                                                                       : "-ssbump.tga");
     if (!path || !(o->valve_path = bb__command_keep(c, path))) {
       free(path);
       return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);
@@ -886,7 +887,7 @@ static bb_status serve_check(bb_command *c, bb_error *err) {
   o->prefix = NULL;
   if (named)
     return BB_OK;
-  char *stem = bb_path_with_suffix(c->inputs[0], "");
+  char *stem = bb__path_with_suffix(c->inputs[0], "");
   o->prefix = stem ? bb__command_keep(c, stem) : NULL;
   free(stem);
   return o->prefix ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);

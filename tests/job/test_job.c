@@ -426,7 +426,7 @@ Test(job, prefix_and_suffix_names) {
                                             {"d/.hidden.png", "", "d/.hidden"},
                                             {"rock.tar.png", "", "rock.tar"}};
   for (size_t i = 0; i < sizeof suffixed / sizeof suffixed[0]; i++) {
-    char *got = bb_path_with_suffix(suffixed[i][0], suffixed[i][1]);
+    char *got = bb__path_with_suffix(suffixed[i][0], suffixed[i][1]);
     cr_expect_str_eq(got ? got : "(null)", suffixed[i][2], "%s", suffixed[i][0]);
     free(got);
   }
