@@ -130,17 +130,24 @@ Test(job, command_text_spells_the_texture_options) {
   free(text);
 }
 
-/* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
- * would write, kept instead, with the kinds asked besides; nothing written. */
-Test(job, bake_item_keeps_the_maps_run_item_writes) {
-  const char *input = height_file();
+/* A bake of height_file() at scale 4 with 16 rays, forced, its outputs
+ * to name. */
+static bb_job_options small_bake(void) {
   bb_job_options o;
   bb__job_options_init(&o);
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
+  o.force = 1;
+  return o;
+}
+
+/* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
+ * would write, kept instead, with the kinds asked besides; nothing written. */
+Test(job, bake_item_keeps_the_maps_run_item_writes) {
+  const char *input = height_file();
+  bb_job_options o = small_bake();
   o.paths[BB_MAP_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
   o.paths[BB_MAP_AO] = tmp("ao.exr");
-  o.force = 1;
   bb_job *job = NULL;
   bb_error err = {{0}};
   cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
@@ -176,16 +183,12 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
  * in each), with kinds asked besides in the maps given. */
 Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   const char *input = height_file();
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.bake.height_scale = 4.0f;
-  o.bake.rays = 16;
+  bb_job_options o = small_bake();
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   o.paths[BB_MAP_NORMAL] = tmp("n.png");
   o.paths[BB_MAP_AO] = tmp("ao.exr");
   o.slope_path = tmp("slope.png");
   o.slope_lit = 1;
-  o.force = 1;
   o.command = "bumpbake bake h.png --scale 4 --rays 16 ...";
   const char *files[] = {tmp("s.png"), tmp("n.png"), tmp("ao.exr"), tmp("slope.png"),
                          tmp("slope_lit.png")};
@@ -229,13 +232,9 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
  * its bake traced besides. NULL before the bake and for no input. */
 Test(job, provenance_is_what_the_file_records) {
   const char *input = height_file();
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.bake.height_scale = 4.0f;
-  o.bake.rays = 16;
+  bb_job_options o = small_bake();
   o.brightness_file = input; /* a map of the maps' size */
   o.paths[BB_MAP_SSBUMP] = tmp("p.png");
-  o.force = 1;
   o.command = "bumpbake bake h.png --scale 4 --rays 16 --brightness h.png --ssbump p.png";
   bb_job *job = NULL;
   bb_error err = {{0}};
