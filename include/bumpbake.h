@@ -1135,12 +1135,6 @@ typedef struct bb_output_spec {
 bb_status bb_outputs_check(const bb_output_spec *outputs, int count,
                            const char *const *reads, int read_count, bb_error *err);
 
-/* path without the extension of its last component, plus suffix ("rock.png",
- * "-ssbump.tga" -> "rock-ssbump.tga"; a name's leading dot starts no
- * extension), malloc'd; NULL when out of memory. */
-char *bb_path_with_suffix(const char *path, const char *suffix);
-
-
 /* ------------------------------------------------------- writing outputs */
 
 /* One file of a set written all or nothing: an image (with its provenance)
@@ -1448,12 +1442,6 @@ typedef struct bb_job_options {
   int valve_detail;          /* 1: Valve's detail variant (RGB times the
                                 input's smoothed colour); not with valve.normal_map */
 } bb_job_options;
-
-/* The file a bake with options o writes for map kind, the one rule for
- * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
- * the kinds of BB_JOB_DEFAULT_MAPS, else none. *path is a malloc'd copy,
- * or NULL for none; BB_ERR_MEMORY when out of memory. */
-bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err);
 
 /* A planned job: opaque. */
 typedef struct bb_job bb_job;
@@ -1792,6 +1780,38 @@ bb_status bb_command_set_basis(bb_command *command, const bb_basis *basis, bb_er
 bb_status bb_command_derive(const bb_command *from, const char *name, bb_command **out,
                             bb_error *err);
 
+/* What a client that holds a command reads of its bake beyond one
+ * option's value (bumpbake serve's page): the library's rules, applied.
+ * The azimuth slices the bake traces: --slices, else those --rays makes
+ * (round(sqrt(rays))); 0 for NULL. */
+int bb_command_slices(const bb_command *command);
+/* The albedo (rho) the bake bounces light with: --bounce, or 1 for
+ * --bounce-albedo FILE alone (the map bounces as it is); 0 when it adds
+ * no inter-reflection, and for NULL. With one, the first
+ * bb_command_slices(command) units of a bake's progress are the trace's. */
+double bb_command_bounce(const bb_command *command);
+/* The file a checked command writes map kind to: the map's own option
+ * (--normal FILE) when given, else -o PREFIX's "PREFIX_KIND.png" for the
+ * maps -o writes (normal, ssbump, ao); serve's write, with neither given,
+ * takes HEIGHT without its extension for PREFIX. *path malloc'd, NULL for
+ * none. Errors: BB_ERR_ARGUMENT (no command or path), BB_ERR_MEMORY. */
+bb_status bb_command_map_file(const bb_command *command, bb_map_kind kind, char **path,
+                              bb_error *err);
+/* The JSON object `bake --json` prints of r, an input baked by command's
+ * job (bb_command_plan), without a newline: input, status (when not NULL:
+ * "written"), size, the parameters used, seconds per stage, horizons and
+ * the maps written. malloc'd; NULL when out of memory or for NULL. */
+char *bb_command_report_json(const bb_command *command, const bb_job_report *r,
+                             const char *status);
+/* The provenance ("key=value" lines) job's file of map kind ("ssbump")
+ * records for input i once baked (bb_job_bake_item, bb_job_run_item),
+ * whether or not the job writes that map: the command it records, the
+ * input's hashes, the parameters the kind depends on (the maps the bake
+ * read named by their hashes) and the ray set traced; without the texture
+ * settings a .vtf or .dds adds. malloc'd; NULL when out of memory, for an
+ * input not baked or out of range. */
+char *bb_job_provenance(const bb_job *job, int i, const char *kind);
+
 /* Sets option name (as bb_option_find finds it) from text, through the
  * option's parser, into the command's options: a flag takes text NULL (or
  * "1"/"0": Python's True/False); an option of several values takes them
@@ -1876,7 +1896,7 @@ bb_status bb_command_numbers(const bb_command *command, const char *name, double
 /* The options of the command's bake as set and checked (bake, normal,
  * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
  * and texture settings of every command writing maps): what a client that
- * reads the bake's settings (bb_bake_slices, bb_job_report_json) hands
+ * reads the bake's settings (bb_bake_slices) hands
  * on. Owned by command; NULL for NULL. Every other option is read by
  * name (bb_command_value). */
 const bb_job_options *bb_command_job_options(const bb_command *command);
@@ -2132,15 +2152,6 @@ bb_status bb_command_bake(bb_command *command, const bb_image *height,
                           const bb_basis *basis, const bb_command_hooks *hooks,
                           bb_bake_context *context, bb_image *maps, bb_region *changed,
                           bb_error *err);
-
-/* ----------------------------------------------------- what a job prints */
-
-/* The JSON object of r (an input baked with options b), without a
- * newline: input, status (when not NULL), size, the parameters used (the
- * channel the rule took, the threads that ran), seconds per stage,
- * horizons, extra_json's members (may be NULL) and the maps written. */
-void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
-                        const char *status, const char *extra_json);
 
 /* ------------------------------------------------- names of enums printed */
 

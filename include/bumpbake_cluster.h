@@ -105,7 +105,7 @@ bb_status bb_command_from_handover(const char *data, size_t size, const char *co
  * of one input's report r, as command's --json and --quiet ask, the command
  * line's and its --scheduler run's alike: "wrote KIND PATH" or "up to date
  * KIND PATH" per file (control characters escaped, bb_text_printable), or
- * with json the input's JSON line (bb_job_report_json; with batch a
+ * with json the input's JSON line (bb_command_report_json's; with batch a
  * "status" and, for an input not baked, the short line: input, status,
  * exit_code when it failed, every output). Nothing for an input not run,
  * nor for a failure without json (its error is the caller's line on

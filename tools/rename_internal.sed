@@ -180,3 +180,10 @@ s/\bbb_job_command_text\b/bb__job_command_text/g
 # what a split trace traces, built of a height and bake options: Python's
 # workers build it of the handed-over command now (bb_command_trace_input).
 s/\bbb_bake_trace_input\b/bb__bake_trace_input/g
+# serve, their last client, reads its write's files (bb_command_map_file)
+# and a written report's JSON (bb_command_report_json) through its command:
+# the rule for a map's file, the JSON of a report and the path helper under
+# them are the library's own.
+s/\bbb_job_map_file\b/bb__job_map_file/g
+s/\bbb_job_report_json\b/bb__job_report_json/g
+s/\bbb_path_with_suffix\b/bb__path_with_suffix/g

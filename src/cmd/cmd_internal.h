@@ -295,4 +295,12 @@ void bb__option_choices(const bb_option_info *option, char *out, size_t cap);
 /* How many inputs were added (bb_command_input reads them). */
 int bb__command_input_count(const bb_command *command);
 
+/* The JSON object of r (an input baked with options b), without a
+ * newline: input, status (when not NULL), size, the parameters used (the
+ * channel the rule took, the threads that ran), seconds per stage,
+ * horizons, extra_json's members (may be NULL) and the maps written
+ * (report.c; bb_command_report_json's text). */
+void bb__job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
+                         const char *status, const char *extra_json);
+
 #endif /* BB_CMD_INTERNAL_H */

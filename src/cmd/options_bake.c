@@ -4,6 +4,7 @@
  * rules and their job. */
 #include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "texture/texture.h"
 #include "render/render_internal.h"
 
@@ -789,8 +790,8 @@ static bb_status h2s_job(bb_command *c, bb_job_options *o, bb_error *err) {
   *o = c->options.job;
   o->force = 1;
   if (!o->valve_path) {
-    char *path = bb_path_with_suffix(c->inputs[0], o->valve.normal_map ? "-bump.tga"
-                                                                      : "-ssbump.tga");
+    char *path = bb__path_with_suffix(c->inputs[0], o->valve.normal_map ? "-bump.tga"
+                                                                       : "-ssbump.tga");
     if (!path || !(o->valve_path = bb__command_keep(c, path))) {
       free(path);
       return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);
@@ -872,6 +873,26 @@ static const bb__option opt_address = {
     .field = BB__FIELD_KEPT, .set = set_address};
 static const bb__option opt_serve_quiet = ROW_QUIET('q', "print only the URL, not each bake");
 
+/* The maps serve's write names: -o PREFIX's, or each map's file given;
+ * with neither, PREFIX is HEIGHT without its extension (the default
+ * output names, filled in as the check fills every command's). */
+static bb_status serve_check(bb_command *c, bb_error *err) {
+  bb_job_options *o = &c->options.job;
+  const int prefix = bb__option_find(c->def, opt_prefix.info.name);
+  if (c->in_memory || c->input_count < 1 || c->given[prefix])
+    return BB_OK;
+  int named = 0;
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
+    named |= o->paths[k] != NULL;
+  o->prefix = NULL;
+  if (named)
+    return BB_OK;
+  char *stem = bb__path_with_suffix(c->inputs[0], "");
+  o->prefix = stem ? bb__command_keep(c, stem) : NULL;
+  free(stem);
+  return o->prefix ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", c->inputs[0]);
+}
+
 static const bb__option *const serve_options[] = {
     &bb__opt_scale, &bb__opt_rays, &bb__opt_slices, &bb__opt_filter_radius,
     &bb__opt_filter_threshold, &bb__opt_bias, &bb__opt_power, &bb__opt_basis,
@@ -900,4 +921,5 @@ const bb__command bb__command_serve = {
                  "Ctrl-C stops. See docs/commands/serve.md.",
              .inputs = "HEIGHT", .min_inputs = 1, .max_inputs = 1, .usage_exit = 2,
              .option_count = (int)(sizeof serve_options / sizeof serve_options[0]) - 1},
-    .options = serve_options, .maps_asked = BB_MAPS_BAKED /* its page shows every map */};
+    .options = serve_options, .check = serve_check,
+    .maps_asked = BB_MAPS_BAKED /* its page shows every map */};

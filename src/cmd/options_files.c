@@ -401,7 +401,7 @@ static bb_status rbf_check(bb_command *c, bb_error *err) {
   if (c->in_memory)
     return BB_OK;
   if (!o->output) {
-    char *name = bb_path_with_suffix(c->inputs[0], "_local.tga");
+    char *name = bb__path_with_suffix(c->inputs[0], "_local.tga");
     o->output = name ? bb__command_keep(c, name) : NULL;
     free(name);
     if (!o->output)

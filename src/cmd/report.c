@@ -39,8 +39,8 @@ static void members(bb__json *j, const char *text) {
 
 /* Parameters are those used: the channel the rule took and the threads
  * that ran, not "auto" and 0. */
-void bb_job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
-                        const char *status, const char *extra_json) {
+void bb__job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
+                         const char *status, const char *extra_json) {
   const int traced = r->rayset_id[0] != '\0';
   bb__json j = {f, 0};
   bb__json_open(&j, NULL, '{');
@@ -124,6 +124,18 @@ static char *closed(FILE *f, char **text) {
   return *text;
 }
 
+char *bb_command_report_json(const bb_command *command, const bb_job_report *r,
+                             const char *status) {
+  if (!command || !r)
+    return NULL;
+  char *text = NULL;
+  size_t size = 0;
+  FILE *f = open_memstream(&text, &size);
+  if (f)
+    bb__job_report_json(f, &bb__command_options_of(command)->job.bake, r, status, NULL);
+  return closed(f, &text);
+}
+
 char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int batch,
                           const char *extra_json) {
   const bb_command_options *o = bb__command_options_of(command);
@@ -134,7 +146,7 @@ char *bb_job_report_lines(const bb_command *command, const bb_job_report *r, int
     return closed(f, &text);
   if (o->json) {
     if (r->outcome == BB_JOB_BAKED) {
-      bb_job_report_json(f, &o->job.bake, r, batch ? "baked" : NULL, extra_json);
+      bb__job_report_json(f, &o->job.bake, r, batch ? "baked" : NULL, extra_json);
       fputc('\n', f);
     } else if (batch)
       short_json(f, r);

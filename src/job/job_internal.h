@@ -25,9 +25,20 @@ char *bb__job_valve_weights_name(const char *input);
  * "PATH: cannot write: ...". */
 bb_status bb__check_output_directory(const char *path, bb_error *err);
 
+/* path without the extension of its last component, plus suffix ("rock.png",
+ * "-ssbump.tga" -> "rock-ssbump.tga"; a name's leading dot starts no
+ * extension), malloc'd; NULL when out of memory. */
+char *bb__path_with_suffix(const char *path, const char *suffix);
+
+/* The file a bake with options o writes for map kind, the one rule for
+ * it: o->paths[kind] when named, else -o PREFIX's "PREFIX_KIND.png" for
+ * the kinds of BB_JOB_DEFAULT_MAPS, else none. *path is a malloc'd copy,
+ * or NULL for none; BB_ERR_MEMORY when out of memory. */
+bb_status bb__job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err);
+
 /* The file -o PREFIX (bb_job_options.prefix) names for kind:
  * "PREFIX_KIND.png" for the kinds of BB_JOB_DEFAULT_MAPS, malloc'd; NULL for
- * another kind, a NULL prefix or out of memory (bb_job_map_file's rule). */
+ * another kind, a NULL prefix or out of memory (bb__job_map_file's rule). */
 char *bb__job_prefix_path(const char *prefix, bb_map_kind kind);
 
 /* ------------------------------------------------------------ the bounce */

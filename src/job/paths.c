@@ -18,7 +18,7 @@
 
 /* ------------------------------------------------------------ path parts */
 
-char *bb_path_with_suffix(const char *path, const char *suffix) {
+char *bb__path_with_suffix(const char *path, const char *suffix) {
   if (!path || !suffix)
     return NULL;
   const char *dot = bb__file_extension(path);
@@ -41,7 +41,7 @@ char *bb__job_prefix_path(const char *prefix, bb_map_kind kind) {
   return path;
 }
 
-bb_status bb_job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err) {
+bb_status bb__job_map_file(const bb_job_options *o, bb_map_kind kind, char **path, bb_error *err) {
   *path = NULL;
   if ((unsigned)kind >= BB_MAP_BAKED_COUNT)
     return BB_OK;

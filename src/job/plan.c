@@ -740,7 +740,7 @@ static bb_status name_more(bb_job *job, const bb_job_options *o, const bb__job_m
 static bb_status name_single(bb_job *job, const bb_job_options *o, bb_error *err) {
   bb__job_item *item = &job->items[0];
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
-    bb_status st = bb_job_map_file(o, (bb_map_kind)k, &item->paths[k], err);
+    bb_status st = bb__job_map_file(o, (bb_map_kind)k, &item->paths[k], err);
     if (st != BB_OK)
       return st;
   }

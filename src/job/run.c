@@ -243,10 +243,10 @@ static bb_status make_valve(const bb_job *job, const bb__job_item *item, baked *
   return st == BB_OK ? BB_OK : fail_input(item, st, &e, err);
 }
 
-/* The provenance text of one output of item. */
-static char *describe(const bb_job *job, const char *command, const bb_bake_result *result,
-                      const bb_job_report *r, const char *kind) {
-  const int traced = (job->options.bake.outputs & BB_MAPS_TRACED) != 0;
+/* The provenance text of an output of kind of the input r reports, its
+ * bake's ray set rayset_id (NULL: none traced). */
+static char *provenance(const bb_job *job, const char *command, const char *rayset_id,
+                        const bb_job_report *r, const char *kind) {
   /* Valve's file names the channel its rule took (alpha, or the grey) */
   const bb_channel channel = job->valve_path ? r->source.channel : job->options.channel;
   const bb__job_source s = {.command = command,
@@ -255,8 +255,31 @@ static char *describe(const bb_job *job, const char *command, const bb_bake_resu
                             .input_file_hash = r->source.file_hash,
                             .bake = &job->options.bake,
                             .channel = channel,
-                            .rayset_id = traced ? result->rayset_id : NULL};
+                            .rayset_id = rayset_id};
   return bb__job_describe(&s, kind);
+}
+
+/* The provenance text of one output of item: the ray set when the job
+ * writes a traced map. */
+static char *describe(const bb_job *job, const char *command, const bb_bake_result *result,
+                      const bb_job_report *r, const char *kind) {
+  const int traced = (job->options.bake.outputs & BB_MAPS_TRACED) != 0;
+  return provenance(job, command, traced ? result->rayset_id : NULL, r, kind);
+}
+
+char *bb_job_provenance(const bb_job *job, int i, const char *kind) {
+  if (!job || i < 0 || i >= job->count || !kind)
+    return NULL;
+  const bb__job_item *item = &job->items[i];
+  const bb_job_report *r = &item->report;
+  if (r->width <= 0)
+    return NULL; /* not baked */
+  char *command = bb__job_command_of(job, item);
+  if (!command && (job->command || job->command_options))
+    return NULL;
+  char *text = provenance(job, command, r->rayset_id[0] ? r->rayset_id : NULL, r, kind);
+  free(command);
+  return text;
 }
 
 /* The depfile rule of one input: its outputs depend on it (and on the basis

@@ -15,29 +15,28 @@
 #include <string.h>
 #include <unistd.h>
 
-/* The write action's files: as bake names them (bb_job_map_file), spelled
- * out one by one (--normal P_normal.png ...) so that the command line the
- * page shows is the whole job; with no output named, -o PREFIX defaults to
- * HEIGHT without its extension. */
-static int name_outputs(bb_job_options *job, const char *height) {
-  int named = 0;
+/* The write action's files: as the command line names them
+ * (bb_command_map_file: -o PREFIX's, HEIGHT's without its extension when
+ * no output is named, or each map's own), spelled out one by one
+ * (--normal P_normal.png ...) so that the command line the page shows is
+ * the whole job. 0, or -1 when out of memory. */
+static int name_outputs(serve_state *s, const bb_command *line) {
   for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    named |= job->paths[k] != NULL;
-  if (named && !job->prefix)
-    return 0; /* the outputs the command line named, and only those */
-  char *stem = job->prefix ? NULL : bb_path_with_suffix(height, "");
-  bb_job_options with = *job;
-  with.prefix = job->prefix ? job->prefix : stem;
-  int rc = with.prefix ? 0 : -1;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT && rc == 0; k++) {
-    char *path = NULL;
-    if (bb_job_map_file(&with, (bb_map_kind)k, &path, NULL) != BB_OK)
-      rc = -1;
-    job->paths[k] = path; /* kept */
-  }
-  free(stem);
-  job->prefix = NULL;
-  return rc;
+    if (bb_command_map_file(line, (bb_map_kind)k, &s->write_files[k], NULL) != BB_OK)
+      return -1;
+  return 0;
+}
+
+/* The file of basis option name, or NULL when it names none (a basis of
+ * the library's, by its name: bb_basis_resolve's rule). */
+static const char *basis_file(const cli_run *r, const char *name) {
+  char text[PATH_MAX];
+  int from_file = 0;
+  bb_basis basis;
+  if (!cli_text(r, name, text, sizeof text) ||
+      bb_basis_resolve(text, &basis, &from_file, NULL) != BB_OK || !from_file)
+    return NULL;
+  return strdup(text);
 }
 
 /* The file option name of command names, kept for the process's life
@@ -48,24 +47,17 @@ static const char *kept_path(const cli_run *r, const char *name) {
 }
 
 int cli_run_serve(const cli_run *r) {
-  const bb_job_options *bake = bb_command_job_options(r->command);
   const char *height = bb_command_input(r->command, 0);
-  bb_job_options named = *bake;
-  if (name_outputs(&named, height) != 0) {
+  static serve_state s; /* the threads use it until the process ends */
+  if (name_outputs(&s, r->command) != 0) {
     cli_error_line("out of memory");
     return BB_EXIT_FAILURE;
   }
-
-  static serve_state s; /* the threads use it until the process ends */
   pthread_mutex_init(&s.lock, NULL);
   pthread_cond_init(&s.work, NULL);
   pthread_cond_init(&s.changed, NULL);
   s.height_path = height;
   s.line = r->command; /* lives as long as the process */
-  s.settings = *bake; /* the bake's parameters as parsed */
-  s.job = named;
-  s.brightness_file = bake->brightness_file;
-  s.use_brightness = s.brightness_file != NULL;
   s.albedo_file = kept_path(r, "albedo"); /* render's --albedo and --light-color light
                                              the picture */
   serve_light_color(r->command, s.light_color);
@@ -81,8 +73,9 @@ int cli_run_serve(const cli_run *r) {
   if (copied != BB_OK)
     return cli_library_error("serve", copied, &copy_err);
   s.watched[s.watched_count++] = height;
-  const char *also[] = {bake->brightness_file, bake->bounce_albedo_file, bake->basis_file,
-                        s.albedo_file};
+  /* the files the bake reads beside the height, by their options */
+  const char *also[] = {kept_path(r, "brightness"), kept_path(r, "bounce-albedo"),
+                        basis_file(r, "basis"), s.albedo_file};
   for (size_t i = 0; i < sizeof also / sizeof also[0]; i++)
     if (also[i])
       s.watched[s.watched_count++] = also[i];

@@ -74,15 +74,13 @@ typedef struct serve_state {
   long version;           /* bumped on every change a page shows */
   /* what to bake: the command line's options, changed by the page's controls */
   const char *height_path;
-  bb_job_options settings;     /* the bake's parameters: the command line's, then the
-                                  page's controls' (from command) */
   const bb_command *line;       /* the command line's command, as given (the files its
                                   file controls switch on) */
   bb_command *command;         /* the page's command: serve's command line with the page's
                                   controls set, checked as the command line is */
-  bb_job_options job;          /* paths of a "write"; bake filled from settings */
-  const char *brightness_file; /* the command line's --brightness, or NULL */
-  int use_brightness;          /* the page's switch (1 when given) */
+  char *write_files[BB_MAP_BAKED_COUNT]; /* the file a "write" writes each map to, NULL
+                                            for none: the command line's
+                                            (bb_command_map_file) */
   atomic_long wanted;          /* bumped by a save or a control: the bake in flight
                                   for an older value is cancelled */
   long done;                   /* the wanted value last baked (or failed) */
@@ -138,7 +136,7 @@ int serve_inputs_changed(const serve_state *s, const serve_bake *b);
 /* serve_command.c: the `bumpbake bake` command of the options now (the
  * caller holds the lock): the page's command as a bake (bb_command_derive:
  * the options bake takes at other values than bake's defaults) with the
- * write action's files (job.paths), checked, into *out (free with
+ * write action's files (write_files), checked, into *out (free with
  * bb_command_free); and *line, the line its files record and the page
  * shows (malloc'd), as bb_command_text spells the command. A bake or a
  * write plans through it (bb_command_plan). err not NULL. */

@@ -84,7 +84,7 @@ typedef struct progress_ctx {
   serve_state *s;
   long wanted;      /* the request this bake answers */
   long slices;      /* with inter-reflection, the trace's units of the whole (bumpbake.h:
-                       bb_bake_slices); 0 without */
+                       bb_command_slices); 0 without */
   long most, total; /* the furthest done seen, and the whole */
 } progress_ctx;
 
@@ -235,23 +235,6 @@ const unsigned char *serve_bake_part(serve_state *s, serve_bake *b, int t) {
   return texture_in(s, b, t, serve_part_region(b, t), &b->part[t]);
 }
 
-/* The ssbump's provenance as the job records it in the file it writes. */
-static char *provenance_of(const bb_job_options *o, const bb_job_report *rep,
-                           const bb_bake_result *r, const char *command,
-                           const char *input) {
-  const char *name = strrchr(input, '/');
-  bb_provenance p = {command,
-                     name ? name + 1 : input,
-                     rep->source.height_hash,
-                     "ssbump",
-                     &o->bake,
-                     o->channel,
-                     r->rayset_id[0] ? r->rayset_id : NULL,
-                     rep->source.file_hash,
-                     NULL};
-  return bb_provenance_format(&p);
-}
-
 /* ----------------------------------------------------------------- bake */
 
 /* Planning a job creates its outputs' folders; a bake writes nothing, not
@@ -260,16 +243,17 @@ static char *provenance_of(const bb_job_options *o, const bb_job_report *rep,
  * with the height's own error when the height is gone too (the library's
  * words, read without a plan), else saying which folder is missing. 1 when
  * it fails so (message in err). */
-static int folder_gone(const bb_job_options *o, const char *input, bb_error *err) {
-  const char *paths[BB_MAP_BAKED_COUNT + 3];
+static int folder_gone(const bb_command *bake, const char *input, bb_error *err) {
+  char paths[BB_MAP_BAKED_COUNT + 1][4096];
   int n = 0;
-  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++)
-    if (o->paths[k])
-      paths[n++] = o->paths[k];
-  const char *single[] = {o->slope_path, o->valve_path, o->vmt};
-  for (size_t i = 0; i < sizeof single / sizeof *single; i++)
-    if (single[i])
-      paths[n++] = single[i];
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    char *path = NULL;
+    if (bb_command_map_file(bake, (bb_map_kind)k, &path, NULL) == BB_OK && path)
+      snprintf(paths[n++], sizeof paths[0], "%s", path);
+    free(path);
+  }
+  if (bb_command_value(bake, "slope", paths[n], sizeof paths[0], NULL) == BB_OK && paths[n][0])
+    n++;
   for (int i = 0; i < n; i++) {
     const char *slash = strrchr(paths[i], '/');
     if (!slash || slash == paths[i])
@@ -371,12 +355,12 @@ static void bake_once(serve_state *s, long wanted) {
   bb_bake_result result;
   memset(&result, 0, sizeof result);
   serve_bake *b = NULL;
-  const bb_job_options *o = bb_command_job_options(command); /* NULL for NULL */
   if (st == BB_OK)
-    st = folder_gone(o, input, &err) ? BB_ERR_IO : bb_command_plan(command, NULL, &job, &err);
+    st = folder_gone(command, input, &err) ? BB_ERR_IO
+                                           : bb_command_plan(command, NULL, &job, &err);
   if (st == BB_OK) {
-    const int bounces = o->bake.bounce_albedo > 0.0 || o->bounce_albedo_file;
-    progress_ctx p = {s, wanted, bounces ? bb_bake_slices(&o->bake) : 0, 0, 0};
+    const int bounces = bb_command_bounce(command) > 0.0;
+    progress_ctx p = {s, wanted, bounces ? bb_command_slices(command) : 0, 0, 0};
     st = bake_maps(s, job, &p, &result, &err);
   }
   const int context_baked = st == BB_OK; /* the context's last bake is this one now */
@@ -402,9 +386,13 @@ static void bake_once(serve_state *s, long wanted) {
       b->report.input = NULL;
       b->command = spelled;
       spelled = NULL;
-      b->provenance = provenance_of(o, rep, &b->maps, b->command, input);
-      b->normal_y_up = o->bake.normal_y_up;
-      b->scale = (double)o->bake.height_scale;
+      b->provenance = bb_job_provenance(job, 0, "ssbump");
+      char normal_y[8];
+      b->normal_y_up = bb_command_value(command, "normal-y", normal_y, sizeof normal_y,
+                                        NULL) == BB_OK && !strcmp(normal_y, "up");
+      double scale = 0.0;
+      bb_command_numbers(command, "scale", &scale, 1, NULL, NULL);
+      b->scale = (double)(float)scale; /* the float the bake took */
       b->tex[SERVE_TEX_ALBEDO] = albedo;
       albedo = NULL;
       b->seconds = now_seconds() - t0;

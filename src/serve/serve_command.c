@@ -14,8 +14,8 @@ bb_status serve_bake_command(const serve_state *s, bb_command **out, char **line
   bb_command *bake = NULL;
   bb_status st = bb_command_derive(s->command, "bake", &bake, err);
   for (int k = 0; st == BB_OK && k < BB_MAP_BAKED_COUNT; k++)
-    if (s->job.paths[k])
-      st = bb_command_set(bake, bb_map_kind_get((bb_map_kind)k)->name, s->job.paths[k], err);
+    if (s->write_files[k])
+      st = bb_command_set(bake, bb_map_kind_get((bb_map_kind)k)->name, s->write_files[k], err);
   if (st == BB_OK)
     st = bb_command_check(bake, err);
   char *spelled = st == BB_OK ? bb_command_text(bake, NULL, BB_OPTION_RECORDED) : NULL;

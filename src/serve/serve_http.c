@@ -478,13 +478,11 @@ static char *write_maps(serve_state *s, unsigned *status) {
     *status = 422;
     return error_json(err.message[0] ? err.message : bb_status_name(made));
   }
-  const bb_job_options *o = bb_command_job_options(command);
   bb_status st = BB_ERR_ARGUMENT;
   const char *from = "memory";
   char reason[PATH_MAX + 64] = "a save or a control came after the bake shown";
   bb_job *job = NULL;
   char *text = NULL;
-  size_t size = 0;
   /* the maps shown are only the file's while the file is the one baked:
    * a change the watch did not see (a second name of the file elsewhere,
    * a network file system) bakes again */
@@ -500,13 +498,8 @@ static char *write_maps(serve_state *s, unsigned *status) {
   }
   if (b) {
     st = bb_job_write_item(b->job, 0, &b->maps, &err);
-    if (st == BB_OK) {
-      FILE *f = open_memstream(&text, &size);
-      if (f) {
-        bb_job_report_json(f, &o->bake, bb_job_report_get(b->job, 0), "written", NULL);
-        fclose(f);
-      }
-    }
+    if (st == BB_OK)
+      text = bb_command_report_json(command, bb_job_report_get(b->job, 0), "written");
   }
   if (b && st == BB_ERR_ARGUMENT)
     snprintf(reason, sizeof reason, "the line reads the height again to write its maps");
@@ -521,13 +514,8 @@ static char *write_maps(serve_state *s, unsigned *status) {
       if (st != BB_OK)
         err = bb_job_report_get(job, 0)->error;
     }
-    if (st == BB_OK) {
-      FILE *f = open_memstream(&text, &size);
-      if (f) {
-        bb_job_report_json(f, &o->bake, bb_job_report_get(job, 0), "written", NULL);
-        fclose(f);
-      }
-    }
+    if (st == BB_OK)
+      text = bb_command_report_json(command, bb_job_report_get(job, 0), "written");
     bb_job_free(job);
   }
   if (b) {

@@ -83,7 +83,7 @@ static void add_params(bb__json *j, const serve_state *s) {
       break;
     }
   }
-  bb__json_int(j, "slices_traced", bb_bake_slices(&s->settings.bake));
+  bb__json_int(j, "slices_traced", bb_command_slices(s->command));
   bb__json_string(j, "albedo_file", s->albedo_file);
   bb__json_close(j, '}');
 }
@@ -355,12 +355,8 @@ int serve_apply_params(serve_state *s, const char *const *names,
     bb_command_free(next);
     return -1;
   }
-  /* the controls' values, as checked: the bake's parameters are the page's
-   * command's (no file named in them: the command line's files, which its
-   * command owns, stay in the rest of the settings), its brightness switch
-   * and its light */
-  s->settings.bake = bb_command_job_options(next)->bake;
-  s->use_brightness = bb_command_given(next, "brightness");
+  /* the controls' values, as checked: the page's command, which the bakes
+   * derive theirs from, and its light */
   serve_light_color(next, s->light_color);
   bb_command_free(s->command);
   s->command = next;

@@ -317,6 +317,88 @@ Test(cmd, derive_takes_the_settings_and_drops_what_does_nothing) {
   bb_command_free(from);
 }
 
+/* The file each map goes to, by -o PREFIX's rule (bb_command_map_file):
+ * a map's own file, else PREFIX_KIND.png for the maps -o writes; serve's
+ * write, with no output named, takes HEIGHT without its extension for
+ * PREFIX (filled in by the check, as other commands' default names). */
+static void expect_map_files(const char *name, const char *const *words,
+                             const char *const want[BB_MAP_BAKED_COUNT]) {
+  bb_command *c = command(name, words);
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  for (int k = 0; k < BB_MAP_BAKED_COUNT; k++) {
+    char *path = (char *)"unset";
+    cr_assert_eq(bb_command_map_file(c, (bb_map_kind)k, &path, &err), BB_OK, "%s",
+                 err.message);
+    if (want[k])
+      cr_expect_str_eq(path ? path : "(null)", want[k], "%s %s: map %d", name, words[2], k);
+    else
+      cr_expect_null(path, "%s %s: map %d: %s", name, words[2], k, path);
+    free(path);
+  }
+  bb_command_free(c);
+}
+
+Test(cmd, map_files_follow_the_prefix_rule) {
+  const char *stem[BB_MAP_BAKED_COUNT] = {[BB_MAP_NORMAL] = "d/rock_normal.png",
+                                          [BB_MAP_SSBUMP] = "d/rock_ssbump.png",
+                                          [BB_MAP_AO] = "d/rock_ao.png"};
+  expect_map_files("serve", (const char *[]){"d/rock.png", "--scale", "8", NULL}, stem);
+  const char *named[BB_MAP_BAKED_COUNT] = {[BB_MAP_NORMAL] = "n.png"};
+  expect_map_files("serve", (const char *[]){"d/rock.png", "--scale", "8", "--normal", "n.png",
+                                             NULL},
+                   named);
+  const char *prefixed[BB_MAP_BAKED_COUNT] = {[BB_MAP_NORMAL] = "o/p_normal.png",
+                                              [BB_MAP_SSBUMP] = "o/p_ssbump.png",
+                                              [BB_MAP_AO] = "o/p_ao.png",
+                                              [BB_MAP_BENT] = "b.png"};
+  expect_map_files("serve", (const char *[]){"rock.png", "--scale", "8", "--bent", "b.png",
+                                             "--output", "o/p", NULL},
+                   prefixed);
+  expect_map_files("bake", (const char *[]){"rock.png", "--scale", "8", "--output", "o/p",
+                                            "--bent", "b.png", NULL},
+                   prefixed);
+  /* bake has no default prefix: a map named is the only one */
+  const char *ao[BB_MAP_BAKED_COUNT] = {[BB_MAP_AO] = "a.png"};
+  expect_map_files("bake", (const char *[]){"rock.png", "--scale", "8", "--ao", "a.png", NULL},
+                   ao);
+  bb_command *c = command("serve", (const char *[]){"rock.png", "--scale", "8", NULL});
+  char *path = NULL;
+  bb_error err = {{0}};
+  cr_expect_eq(bb_command_map_file(c, BB_MAP_NORMAL, &path, &err), BB_OK);
+  cr_expect_null(path, "not checked: no default yet");
+  cr_expect_eq(bb_command_map_file(NULL, BB_MAP_NORMAL, &path, &err), BB_ERR_ARGUMENT);
+  cr_expect_eq(bb_command_map_file(c, BB_MAP_NORMAL, NULL, &err), BB_ERR_ARGUMENT);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  cr_expect_eq(bb_command_map_file(c, (bb_map_kind)BB_MAP_BAKED_COUNT, &path, &err), BB_OK);
+  cr_expect_null(path, "no such map");
+  bb_command_free(c);
+}
+
+/* The slices a bake traces and the albedo it bounces with, the bake's and
+ * the job's rules (bumpbake serve's page reads them so). */
+Test(cmd, slices_and_bounce_are_the_bakes_rules) {
+  static const struct {
+    const char *words[9];
+    int slices;
+    double bounce;
+  } cases[] = {
+      {{"h.png", "--scale", "8", "--ao", "a.png", NULL}, 16, 0.0},
+      {{"h.png", "--scale", "8", "--rays", "300", "--ao", "a.png", NULL}, 17, 0.0},
+      {{"h.png", "--scale", "8", "--rays", "64", "--slices", "6", NULL}, 6, 0.0},
+      {{"h.png", "--scale", "8", "--bounce", "0.5", "--ao", "a.png", NULL}, 16, 0.5},
+      {{"h.png", "--scale", "8", "--bounce-albedo", "b.png", "--ao", "a.png", NULL}, 16, 1.0},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    bb_command *c = command("bake", cases[i].words);
+    cr_expect_eq(bb_command_slices(c), cases[i].slices, "case %zu", i);
+    cr_expect_eq(bb_command_bounce(c), cases[i].bounce, "case %zu", i);
+    bb_command_free(c);
+  }
+  cr_expect_eq(bb_command_slices(NULL), 0);
+  cr_expect_eq(bb_command_bounce(NULL), 0.0);
+}
+
 /* A file option names one file: given again with another name, the first
  * would be dropped without a word. A map's file is the exception: given
  * again, a further file of the same bake (--ssbump s.png --ssbump s.vtf),

@@ -5,6 +5,7 @@
 
 #include "job/bake_rows.h"
 #include "bumpbake.h"
+#include "bumpbake_cluster.h"
 #include "cli_harness.h"
 #include "bake/bake_internal.h"
 #include "job/job_internal.h"
@@ -84,18 +85,25 @@ Test(job, slope_lit_light_is_checked_when_planned) {
   }
 }
 
-/* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
- * would write, kept instead, with the kinds asked besides; nothing written. */
-Test(job, bake_item_keeps_the_maps_run_item_writes) {
-  const char *input = height_file();
+/* A bake of height_file() at scale 4 with 16 rays, forced, its outputs
+ * to name. */
+static bb_job_options small_bake(void) {
   bb_job_options o;
   bb__job_options_init(&o);
   o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
   o.bake.height_scale = 4.0f;
   o.bake.rays = 16;
+  o.force = 1;
+  return o;
+}
+
+/* bb_job_bake_item (bumpbake serve's bake): the maps bb_job_run_item
+ * would write, kept instead, with the kinds asked besides; nothing written. */
+Test(job, bake_item_keeps_the_maps_run_item_writes) {
+  const char *input = height_file();
+  bb_job_options o = small_bake();
   o.paths[BB_MAP_SSBUMP] = tmp("s.exr"); /* float: the bits themselves */
   o.paths[BB_MAP_AO] = tmp("ao.exr");
-  o.force = 1;
   bb_job *job = NULL;
   bb_error err = {{0}};
   cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
@@ -131,17 +139,12 @@ Test(job, bake_item_keeps_the_maps_run_item_writes) {
  * in each), with kinds asked besides in the maps given. */
 Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
   const char *input = height_file();
-  bb_job_options o;
-  bb__job_options_init(&o);
-  o.command = "bumpbake bake (a test of the job)"; /* a plan records a line */
-  o.bake.height_scale = 4.0f;
-  o.bake.rays = 16;
+  bb_job_options o = small_bake();
   o.paths[BB_MAP_SSBUMP] = tmp("s.png");
   o.paths[BB_MAP_NORMAL] = tmp("n.png");
   o.paths[BB_MAP_AO] = tmp("ao.exr");
   o.slope_path = tmp("slope.png");
   o.slope_lit = 1;
-  o.force = 1;
   o.command = "bumpbake bake h.png --scale 4 --rays 16 ...";
   const char *files[] = {tmp("s.png"), tmp("n.png"), tmp("ao.exr"), tmp("slope.png"),
                          tmp("slope_lit.png")};
@@ -177,6 +180,86 @@ Test(job, write_item_writes_run_items_bytes_from_the_maps_kept) {
     free(written[k]);
   }
   bb_job_free(job);
+}
+
+/* bb_job_provenance (the provenance bumpbake serve's page shows): the
+ * text the file of that kind records, the maps the bake read (brightness)
+ * named by their hashes; for a kind the job does not write, the ray set
+ * its bake traced besides. NULL before the bake and for no input. */
+Test(job, provenance_is_what_the_file_records) {
+  const char *input = height_file();
+  bb_job_options o = small_bake();
+  o.brightness_file = input; /* a map of the maps' size */
+  o.paths[BB_MAP_SSBUMP] = tmp("p.png");
+  o.command = "bumpbake bake h.png --scale 4 --rays 16 --brightness h.png --ssbump p.png";
+  bb_job *job = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  cr_expect_null(bb_job_provenance(job, 0, "ssbump"), "not baked yet");
+  cr_assert_eq(bb_job_run_item(job, 0, NULL, NULL), BB_OK);
+  char *text = bb_job_provenance(job, 0, "ssbump");
+  cr_assert_not_null(text);
+  bb_image_info info = {0};
+  cr_assert_eq(bb_image_read_info(tmp("p.png"), NULL, NULL, NULL, &info, &err), BB_OK, "%s",
+               err.message);
+  cr_expect_str_eq(text, info.description ? info.description : "(none)");
+  cr_expect(strstr(text, "\nbrightness=") != NULL, "%s", text);
+  bb_image_info_free(&info);
+  free(text);
+  cr_expect_null(bb_job_provenance(job, 1, "ssbump"));
+  cr_expect_null(bb_job_provenance(NULL, 0, "ssbump"));
+  bb_job_free(job);
+
+  o.brightness_file = NULL;
+  o.paths[BB_MAP_SSBUMP] = NULL;
+  o.paths[BB_MAP_NORMAL] = tmp("n.png");
+  cr_assert_eq(bb__job_plan_options(&input, 1, &o, &job, &err), BB_OK, "%s", err.message);
+  bb_bake_result kept;
+  cr_assert_eq(bb_job_bake_item(job, 0, BB_MAPS_BAKED, NULL, NULL, &kept, &err), BB_OK, "%s",
+               err.message);
+  text = bb_job_provenance(job, 0, "ssbump");
+  cr_assert_not_null(text);
+  char rayset[96];
+  snprintf(rayset, sizeof rayset, "\nrayset=%s\n", kept.rayset_id);
+  cr_expect(kept.rayset_id[0] && strstr(text, rayset), "%s", text);
+  cr_expect(strstr(text, "\noutput=ssbump\n") && !strstr(text, "brightness="), "%s", text);
+  free(text);
+  bb_bake_result_free(&kept);
+  bb_job_free(job);
+}
+
+/* bb_command_report_json: the object `bake --json` prints of an input (its
+ * line, bb_job_report_lines), with a status when asked (serve's
+ * "written"). */
+Test(job, report_json_is_the_lines_object) {
+  bb_command *c = NULL;
+  bb_error err = {{0}};
+  cr_assert_eq(bb_command_new("bake", &c, &err), BB_OK);
+  cr_assert_eq(bb_command_add_input(c, height_file(), &err), BB_OK);
+  const char *set[][2] = {{"scale", "4"}, {"rays", "16"}, {"ssbump", tmp("j.png")},
+                          {"json", NULL}};
+  for (size_t i = 0; i < sizeof set / sizeof set[0]; i++)
+    cr_assert_eq(bb_command_set(c, set[i][0], set[i][1], &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_command_check(c, &err), BB_OK, "%s", err.message);
+  bb_job *job = NULL;
+  cr_assert_eq(bb_command_plan(c, NULL, &job, &err), BB_OK, "%s", err.message);
+  cr_assert_eq(bb_job_run_item(job, 0, NULL, NULL), BB_OK);
+  const bb_job_report *r = bb_job_report_get(job, 0);
+  char *json = bb_command_report_json(c, r, NULL);
+  char *lines = bb_job_report_lines(c, r, 0, NULL);
+  cr_assert(json && lines);
+  cr_expect_eq(strlen(lines), strlen(json) + 1);
+  cr_expect_eq(strncmp(lines, json, strlen(json)), 0, "%s\n%s", json, lines);
+  free(json);
+  json = bb_command_report_json(c, r, "written");
+  char head[4200];
+  snprintf(head, sizeof head, "{\"input\":\"%s\",\"status\":\"written\",\"width\":8,", r->input);
+  cr_expect_eq(strncmp(json, head, strlen(head)), 0, "%s", json);
+  cr_expect_null(bb_command_report_json(NULL, r, NULL));
+  free(json);
+  free(lines);
+  bb_job_free(job);
+  bb_command_free(c);
 }
 
 /* The maps of input 0 of a job of these slices and basis, baked through
@@ -300,7 +383,7 @@ Test(job, prefix_and_suffix_names) {
                                             {"d/.hidden.png", "", "d/.hidden"},
                                             {"rock.tar.png", "", "rock.tar"}};
   for (size_t i = 0; i < sizeof suffixed / sizeof suffixed[0]; i++) {
-    char *got = bb_path_with_suffix(suffixed[i][0], suffixed[i][1]);
+    char *got = bb__path_with_suffix(suffixed[i][0], suffixed[i][1]);
     cr_expect_str_eq(got ? got : "(null)", suffixed[i][2], "%s", suffixed[i][0]);
     free(got);
   }
