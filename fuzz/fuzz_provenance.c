@@ -1,10 +1,11 @@
 /* fuzz_provenance.c: the provenance parser, bb__provenance_diff, on two
  * texts (split at the first NUL) and an output capacity taken from the
  * first byte (0, tiny and large), plus the round trip through
- * bb_provenance_format. Properties: no crash or overflow, the output always
+ * bb__provenance_format. Properties: no crash or overflow, the output always
  * NUL-terminated inside its capacity, one line per difference when it fits,
  * a text never differs from itself, and formatting two option sets that
  * differ in the scale alone gives exactly the "scale" difference. */
+#include "job/job_internal.h"
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "fuzz_common.h"
@@ -60,9 +61,9 @@ static void check_round_trip(const char *a, const char *b) {
   o2 = o1;
   o2.height_scale = 3.0f;
   bb_provenance p = {a, b, 0x1234, a, &o1, BB_CHANNEL_AUTO, b, 0x5678, NULL};
-  char *t1 = bb_provenance_format(&p);
+  char *t1 = bb__provenance_format(&p);
   p.options = &o2;
-  char *t2 = bb_provenance_format(&p);
+  char *t2 = bb__provenance_format(&p);
   FUZZ_CHECK(t1 && t2);
   char out[4096];
   FUZZ_CHECK(bb__provenance_diff(t1, t1, out, sizeof out) == 0 && out[0] == '\0');

@@ -98,7 +98,7 @@ extern "C" {
 #define BB_MAX_BIAS_TEXELS 1.0e6
 #define BB_MAX_POWER 1.0e6
 
-/* Most rays a bake's budget may name (bb_bake_options.rays), and most
+/* Most rays a bake's budget may name (--rays), and most
  * azimuth slices: round(sqrt(65536)) = 256. */
 #define BB_MAX_RAYS 65536
 #define BB_MAX_SLICES 256
@@ -238,7 +238,7 @@ typedef enum bb_range {
 /* Every kind of map bumpbake makes, reads or writes, named once. The first
  * BB_MAP_BAKED_COUNT are the maps a bake makes, in the order of this enum
  * everywhere (the command line's options, JSON, Python's bumpbake.OUTPUTS,
- * the bits of bb_bake_options.outputs). New kinds are appended. */
+ * the bits of a bake's outputs). New kinds are appended. */
 typedef enum bb_map_kind {
   BB_MAP_NORMAL = 0, /* unit N, 3 channels */
   BB_MAP_WEIGHTS,    /* w_c = sat(N.B_c)^2 / sum (normal2ssbump), one channel per
@@ -255,9 +255,9 @@ typedef enum bb_map_kind {
 
 /* The kinds a bake makes: BB_MAP_NORMAL .. BB_MAP_FILTERED. */
 #define BB_MAP_BAKED_COUNT 6
-/* Bit of a kind in bb_bake_options.outputs and other masks of maps. */
+/* Bit of a kind in masks of maps (a bake's outputs, bb_command_set_in_memory's). */
 #define BB_MAP_BIT(kind) (1u << (unsigned)(kind))
-/* Every kind a bake makes (the default of bb_bake_options.outputs). */
+/* Every kind a bake makes. */
 #define BB_MAPS_BAKED ((1u << (unsigned)BB_MAP_BAKED_COUNT) - 1u)
 /* The kinds that need the tracer: ssbump, ao and bent. */
 #define BB_MAPS_TRACED \
@@ -577,8 +577,8 @@ typedef struct bb_animation bb_animation;
 /* Which channel of a colour image becomes the height. */
 typedef enum bb_channel {
   BB_CHANNEL_AUTO = 0, /* the grey, or the mean of R, G, B; alpha where the
-                          image shows Valve's convention (the rule under
-                          bb_height_file_read) */
+                          image shows Valve's convention (bake's --channel
+                          in docs/commands/bake.md) */
   BB_CHANNEL_R,
   BB_CHANNEL_G,
   BB_CHANNEL_B,
@@ -697,7 +697,7 @@ struct bb_trace_options {
                               with inter-reflection (bounce_albedo > 0) the
                               units run once over the trace and the
                               bounces: with a trace function of the
-                              caller's, the first bb_bake_slices(o) are
+                              caller's, the first bb_command_slices are
                               the trace's (one a slice), the rest the
                               bounces'; without one, the bounces' sweeps
                               find the horizons too and every unit is
@@ -718,11 +718,6 @@ struct bb_trace_options {
 
 /* ----------------------------------------------------------- smoothing */
 
-typedef struct bb_smooth_options {
-  int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
-  float threshold;       /* T in normalised height units, > 0. Default 2/255 */
-  bb_addressing addressing;
-} bb_smooth_options;
 
 /* ------------------------------------------------------------- normals */
 
@@ -754,72 +749,10 @@ bb_status bb_normal_map_decode(const bb_image *values, int is_float, int normal_
 
 /* ---------------------------------------------------------------- bake */
 
-/* A bake's options; a client has them, its defaults filled in, from a
- * bake command (bb_command_job_options). */
-typedef struct bb_bake_options {
-  float height_scale;         /* S, texels per unit of h, > 0 */
-  int rays;                   /* ray budget, 1..BB_MAX_RAYS, default 256:
-                                 round(sqrt(rays)) slices (bb_bake_slices) */
-  int slices;                 /* azimuth slices, 1..BB_MAX_SLICES; 0 (default):
-                                 from rays */
-  bb_smooth_options smooth;   /* filter radius 0..BB_MAX_FILTER_RADIUS,
-                                 threshold > 0, addressing */
-  bb_trace_options trace;     /* bias 0..BB_MAX_BIAS_TEXELS; threads
-                                 0..BB_MAX_THREADS, used by EVERY stage of the
-                                 bake (smooth, normals, pyramid, trace,
-                                 derive); progress, which may cancel */
-  double power;               /* P in 1..BB_MAX_POWER, default 1 */
-  bb_basis basis;             /* default "hl2"; weights and
-                                 ssbump get one channel per direction */
-  bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
-  int normal_y_up;            /* 1 flips green of normal and bent */
-  unsigned outputs;           /* the maps to make: BB_MAP_BIT(kind)s,
-                                 default BB_MAPS_BAKED, not 0. Nothing else
-                                 is computed: no trace without a traced kind
-                                 (then rays and slices are not checked); a map
-                                 another needs is made and freed (bent needs
-                                 ssbump, both need the normal) */
-  double bounce_albedo;       /* rho in [0, 1]: inter-reflection. ao, ssbump
-                                 and bent then include the light the
-                                 surrounding height field reflects,
-                                 Lambertian with albedo rho (times
-                                 bounce_albedo_map), normalised as without it
-                                 (docs/conventions.md "Inter-reflection"; the
-                                 weights hold no visibility and do not change).
-                                 Default 0: none, and the bake is bit for bit
-                                 the one without these fields. Costs about 3
-                                 traces per bounce, and 72 (1 + basis count)
-                                 bytes per texel */
-  const bb_image *bounce_albedo_map; /* NULL (default), or an image of the
-                                 height's size whose grey (1 channel: it; 2:
-                                 the first; 3 or more: Rec. 709 luma of R, G,
-                                 B), clamped to [0, 1], multiplies rho at each
-                                 vertex, linear over each triangle. Not owned;
-                                 ignored while bounce_albedo is 0 (a job given
-                                 only bounce_albedo_file bounces with rho 1) */
-  int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
-                                 times; 0 (default): converged (each
-                                 triangle's light estimated from what it
-                                 blocks, one bounce gathered from that
-                                 estimate, the rest of the series then
-                                 added as geometric) */
-  const bb_image *brightness; /* NULL (default), or a brightness map of the
-                                 height's size: ssbump and weights are
-                                 multiplied by its grey, the paper's
-                                 "brightness modulation factor in the normal
-                                 map", as combine --brightness does (a
-                                 texel that would exceed 1 is scaled down,
-                                 its channels' ratios kept); ao and bent do
-                                 not change. Not owned */
-} bb_bake_options;
 
 /* Most bounces a bake's inter-reflection follows. */
 #define BB_MAX_BOUNCES 64
 
-/* The azimuth slices o traces with: o->slices when set, else
- * the slices o->rays asks for (round(sqrt(rays)), at least 1). The one rule; provenance, JSON and the
- * up-to-date check all report it. */
-int bb_bake_slices(const bb_bake_options *o);
 
 /* Everything one bake makes. Images not made are zeroed (pixels NULL). */
 typedef struct bb_bake_result {
@@ -1069,36 +1002,7 @@ void bb_renderbump_result_free(bb_renderbump_result *r);
 
 /* ------------------------------------------------ provenance of a bake */
 
-/* How an output was made. Every field that affects pixels is here. */
-typedef struct bb_provenance {
-  const char *command;        /* the command line, or NULL */
-  const char *input_name;     /* input file name (no directory), or NULL */
-  uint64_t input_hash;        /* the hash of the decoded input pixels */
-  const char *output_kind;    /* "normal", "ssbump", "ao", ... */
-  const bb_bake_options *options;
-  bb_channel channel;         /* height channel rule used */
-  const char *rayset_id;      /* bb_rayset_id, or NULL when nothing was traced */
-  uint64_t input_file_hash;   /* bb_file_hash of the input file's bytes, or 0:
-                                 unknown (the key is then left out) */
-  const char *extra;          /* "key=value" lines appended as they are (a
-                                 render's or a render bump's own keys), or NULL */
-} bb_provenance;
 
-/* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
- * input_file_hash when known, output, scale, rays, rayset, filter_radius,
- * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
- * channel), malloc'd; the caller
- * frees it. With options (a bake's map), only the parameters output_kind
- * records are written (a normal map has no rays,
- * rayset, bias, power or basis; ao's rayset is its scheme and slices);
- * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
- * basis_vectors after basis: "x y z" per direction, joined by "; ".
- * Options in use add, after addressing: bounce (rho) and bounces when
- * bounce_albedo > 0, with bounce_albedo_map (the hash of the map's pixels, 16
- * hex digits) when it has one; brightness (the hash of the
- * brightness map's pixels) when there is one.
- * Returns NULL when out of memory. */
-char *bb_provenance_format(const bb_provenance *p);
 
 /* ----------------------------------------------------------- output paths */
 
@@ -1179,7 +1083,7 @@ void bb_signal_cleanup(int signal_number);
 
 /* ----------------------------------------------------------- height files */
 
-/* What bb_height_file_read found out about a height file. */
+/* What a bake found out about its height file (bb_job_report.source). */
 typedef struct bb_height_source {
   bb_channel channel;     /* the channel rule's choice (never AUTO or VALVE) */
   int grey;               /* 1: one colour channel (grey, or grey + alpha) */
@@ -1191,17 +1095,6 @@ typedef struct bb_height_source {
   uint64_t height_hash;   /* the hash of the height's pixels */
 } bb_height_source;
 
-/* Reads the height of the file at path by the channel rule
- * (bb_channel): the file's bytes are hashed first, then decoded, so
- * provenance never pairs a newer file's hash with older pixels. note (may
- * be NULL) hears which channel the rule took when it was not the obvious
- * one, and warnings about the input (lossy JPEG blocks, 8-bit codes that
- * terrace at the scale asked). height_scale (0: not known) is the bake's,
- * for the terracing note. source may be NULL. Errors as bb_image_read and
- * bb_height_from_image, each naming path. */
-bb_status bb_height_file_read(const char *path, bb_channel channel, float height_scale,
-                              bb_note_fn note, void *note_user, bb_image *height,
-                              bb_height_source *source, bb_error *err);
 
 /* The name of the channel a height came from: "grey" for a grey image
  * (whose mean is its grey), else the channel's word as --channel takes it. */
@@ -1379,69 +1272,6 @@ bb_status bb_check_import(bb_check *check, const char *data, size_t size, bb_err
 #define BB_JOB_DEFAULT_MAPS \
   (BB_MAP_BIT(BB_MAP_NORMAL) | BB_MAP_BIT(BB_MAP_SSBUMP) | BB_MAP_BIT(BB_MAP_AO))
 
-typedef struct bb_job_options {
-  bb_bake_options bake;      /* every bake parameter; .outputs is set from
-                                the maps asked */
-  bb_channel channel;        /* the height channel rule (default AUTO) */
-  bb_depth depth;            /* every map's depth; BB_DEPTH_DEFAULT: the
-                                format's, and the filtered height keeps the
-                                input's */
-  int mips;                  /* 1: mip-mapped files (.tif, .tiff, .exr) */
-  const char *basis_file;    /* the file bake.basis came from, or NULL: a
-                                prerequisite in the depfile */
-  const char *bounce_albedo_file; /* an albedo map for inter-reflection
-                                (bake.bounce_albedo_map), read once by the plan.
-                                NULL: none */
-  const char *brightness_file; /* a brightness map (bake.brightness), read once
-                                by the plan, or NULL */
-  /* One input, outputs named one by one (out_dir NULL): */
-  const char *paths[BB_MAP_BAKED_COUNT]; /* by bb_map_kind; NULL = not written */
-  const char *prefix;        /* also PREFIX_KIND.png for each of
-                                BB_JOB_DEFAULT_MAPS not named in paths, or NULL */
-  const char *slope_path;    /* flipcode's slope map (8-bit .png .tga .tif), or NULL */
-  int slope_lit;             /* 1: also slope_path with "_lit" before its
-                                extension, the map lit through its table */
-  double slope_lit_azimuth, slope_lit_elevation; /* degrees, as render's --light;
-                                azimuth finite, elevation 0..90 */
-  /* A batch (out_dir set): */
-  const char *out_dir;       /* outputs go to out_dir/name; created when missing */
-  const char *name_template; /* NULL: BB_JOB_DEFAULT_NAME; "{kind}/{stem}.png"
-                                makes subfolders, created as needed; a name
-                                must stay inside out_dir */
-  unsigned maps;             /* BB_MAP_BIT(kind)s; 0: BB_JOB_DEFAULT_MAPS */
-  int force;                 /* 1: bake inputs whose outputs are up to date too */
-  int keep_going;            /* 1: go on after an input fails (bb_job_run) */
-  const char *depfile;       /* a Make/Ninja depfile to write, or NULL */
-  /* Provenance: the "command" key. */
-  const char *command;       /* one input: the whole command line as typed */
-  const char *command_options; /* what follows "bumpbake bake INPUT" in each
-                                output's command (a batch's, or a single input's
-                                when command is NULL); bb_command_plan sets
-                                them (a plan without either is refused) */
-  bb_note_fn note;           /* notes about inputs (may be NULL) */
-  void *note_user;
-  /* Engine textures and a Source material: */
-  bb_texture_options texture; /* the settings of every .vtf and .dds output
-                                (format, mips, VTF version and flags); each
-                                one's map follows its kind
-                                and range; threads 0: the bake's. Sizes and channels are
-                                checked against the input's header when planned */
-  const char *vmt;           /* one input: a Source material (.vmt) written with
-                                the maps, its $bumpmap the ssbump .vtf (with
-                                $ssbump 1), else the normal map's .vtf; NULL: none */
-  const char *vmt_materials; /* the game's materials folder the material's paths
-                                are relative to; NULL: the nearest folder named
-                                "materials" above the bump map (bb_vmt_options) */
-  const char *vmt_basetexture; /* the colour .vtf the material names, or NULL */
-  /* Valve's height2ssbump file (one input, no out_dir): */
-  const char *valve_path;    /* the RGBA file Valve's tool makes of the bake (RGB
-                                ssbump or normal map, A filtered height or ao), written
-                                before the maps; NULL: none. Its provenance names the
-                                channel the height came from, as Valve's rule picks it */
-  bb_valve_options valve;    /* what goes into it */
-  int valve_detail;          /* 1: Valve's detail variant (RGB times the
-                                input's smoothed colour); not with valve.normal_map */
-} bb_job_options;
 
 /* A planned job: opaque. */
 typedef struct bb_job bb_job;
@@ -1893,13 +1723,6 @@ bb_status bb_command_value(const bb_command *command, const char *name, char *ou
  * small; BB_ERR_MEMORY. */
 bb_status bb_command_numbers(const bb_command *command, const char *name, double *values,
                              int cap, int *count, bb_error *err);
-/* The options of the command's bake as set and checked (bake, normal,
- * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
- * and texture settings of every command writing maps): what a client that
- * reads the bake's settings (bb_bake_slices) hands
- * on. Owned by command; NULL for NULL. Every other option is read by
- * name (bb_command_value). */
-const bb_job_options *bb_command_job_options(const bb_command *command);
 /* What a client that takes its options as keywords asks of render's and
  * sheet's picture and no option spells (Python's light=None and tile=(NX,
  * NY)): dynamic_light 0 turns the dynamic light off, 1 leaves it as the
@@ -1951,7 +1774,7 @@ typedef struct bb_command_hooks {
 } bb_command_hooks;
 
 /* Plans a checked command that writes through the job (bake, normal,
- * height2ssbump): its options as a bb_job_options, planned by the job
+ * height2ssbump): its options as a job's, planned by the job
  * (every output named and checked against every input, provenance,
  * depths, staged all-or-nothing writes, up-to-date checks), without
  * checking again what bb_command_check checked. A single input is baked

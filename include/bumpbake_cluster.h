@@ -124,7 +124,7 @@ char *bb_job_summary_lines(const bb_command *command, const int *counts, int fil
 
 /* What a split trace's worker traces of a checked command's bake (bake or
  * height2ssbump, one input file; a hand-over, bb_command_from_handover):
- * the input height read as the bake reads it (bb_height_file_read, with
+ * the input height read as the bake reads it (the channel rule, with
  * the command's --channel and --scale), which must be the bytes the bake
  * read (file_hash: its report's source.file_hash), then smoothed, scaled,
  * its max-mip pyramid and the ray set of the command's slices, power and

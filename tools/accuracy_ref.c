@@ -24,6 +24,7 @@
  * Exits 1 when a file cannot be read or does not match, 2 on a bad command
  * line.
  */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/rayset.h"
@@ -473,7 +474,7 @@ int main(int argc, char **argv) {
   bb_image h = {0}, z = {0}, normal = {0};
   bb_pyramid *p = NULL;
   bb_error err = {{0}};
-  bb_status st = bb_height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err);
+  bb_status st = bb__height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err);
   if (st == BB_OK) st = bb_image_alloc(&z, h.width, h.height, 1, &err);
   if (st == BB_OK) {
     const float scale = (float)a.scale; /* float times float, as the bake scales */

@@ -5,7 +5,7 @@
  *   bench_rebake MAP SCALE [--edit SIDE] [--at X,Y] [--amount A] [--runs N]
  *                [--threads N] [--clamp]
  *
- * Reads MAP as a bake does (bb_height_file_read), bakes it whole through a
+ * Reads MAP as a bake does (bb__height_file_read), bakes it whole through a
  * keeping context (the default maps and options of `bumpbake bake`), then
  * N times (default 10) edits it: a soft brush of SIDE x SIDE texels
  * (default 32) at X,Y (default the middle), A (default 0.1) of normalised
@@ -20,6 +20,7 @@
  *   valgrind --tool=callgrind --collect-atstart=no --toggle-collect=edit_bake \
  *     build/tools/bench_rebake MAP 64 --runs 1 --threads 1
  * and --toggle-collect=whole_bake for the whole bakes. */
+#include "job/job_internal.h"
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
 
@@ -151,7 +152,7 @@ int main(int argc, char **argv) {
     return st;
   bb_error err = {{0}};
   bb_image h;
-  if (bb_height_file_read(a.map, BB_CHANNEL_AUTO, (float)a.scale, NULL, NULL, &h, NULL,
+  if (bb__height_file_read(a.map, BB_CHANNEL_AUTO, (float)a.scale, NULL, NULL, &h, NULL,
                           &err)) {
     fprintf(stderr, "bench_rebake: %s\n", err.message);
     return 1;
@@ -218,7 +219,7 @@ int main(int argc, char **argv) {
           "again "
           "%.0f of %.0f; the same bits\n",
           h.width, h.height, a.side, a.side, a.amount, a.x, a.y, a.runs, ec, ew, wc, ww,
-          100.0 * ec / wc, hf, (double)h.width * h.height * bb_bake_slices(&o));
+          100.0 * ec / wc, hf, (double)h.width * h.height * bb__bake_slices(&o));
   printf("{\"map\":\"%s\",\"width\":%d,\"height\":%d,\"edit\":%d,\"amount\":%g,\"x\":%d,"
          "\"y\":%d,"
          "\"runs\":%d,\"threads\":%d,\"addressing\":\"%s\",\"edit_cpu_s\":%.6f,"

@@ -5,7 +5,7 @@
  *   bench_trace MAP SCALE RAYS THREADS [--subset N] [--bias B] [--slices A]
  *               [--clamp]
  *
- * Prepares the map as a bake does (bb_height_file_read, the default bilateral
+ * Prepares the map as a bake does (bb__height_file_read, the default bilateral
  * smoothing, times SCALE, max-mip pyramid, round(sqrt(RAYS)) slices of power
  * 1 on the HL2 basis, or A slices), times bb__trace_occlusion on THREADS
  * threads, then finds every slice's horizon at N deterministic texels
@@ -18,6 +18,7 @@
  * trace in any bit (a benchmark that disagrees is measuring a bug), 2 on a
  * bad command line.
  */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "trace/march.h"
 #include "trace/rayset.h"
@@ -146,7 +147,7 @@ static double median_seconds(timed_fn f, void *ctx, int *runs) {
 
 /* Load -> smooth -> scale -> pyramid -> slices, as bb__bake_checked does them. */
 static bb_status prepare(const args *a, field *f, bb_error *err) {
-  bb_status st = bb_height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &f->height, NULL, err);
+  bb_status st = bb__height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &f->height, NULL, err);
   if (st != BB_OK) return st;
   bb_smooth_options so;
   bb__smooth_options_init(&so);

@@ -23,6 +23,7 @@
  * (seconds of the trace and of the bounce, bounces followed) on stdout;
  * exits 1 on a failure, 2 on a bad command line.
  */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/bounce.h"
@@ -157,7 +158,7 @@ static bb_status staged_bake(const args *a, const bb_image *height, bb_bake_resu
       z.pixels[i] = o->height_scale * r->filtered.pixels[i];
     st = bb__pyramid_build_all_cores(&z, o->smooth.addressing, &pyramid, err);
   }
-  if (st == BB_OK) st = bb__rayset_new(bb_bake_slices(o), o->power, &o->basis, &rays, err);
+  if (st == BB_OK) st = bb__rayset_new(bb__bake_slices(o), o->power, &o->basis, &rays, err);
   const double t0 = bb__now_seconds();
   bb_trace_options to = o->trace;
   if (st == BB_OK) st = bb__trace_occlusion(pyramid, rays, &to, &r->vis, NULL, err);
@@ -189,7 +190,7 @@ int main(int argc, char **argv) {
   bb_image height = {0};
   bb_bake_result r = {0};
   bb_error err = {{0}};
-  bb_status st = bb_height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &height, NULL, &err);
+  bb_status st = bb__height_file_read(a.map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &height, NULL, &err);
   if (st == BB_OK) st = a.inner ? staged_bake(&a, &height, &r, &err) : bb__bake_checked(&height, &a.bake, &r, &err);
   char path[4200];
   const bb_write_options wo = {BB_DEPTH_FLOAT, BB_RANGE_UNIT, NULL, NULL};

@@ -54,6 +54,7 @@
  * units. Exits 1 when a file cannot be read or does not match, 2 on a bad
  * command line.
  */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "bake/bake_internal.h"
@@ -561,7 +562,7 @@ static int load_albedo(const char *path, int w, int h, float **out) {
 
 static int load_scaled(const char *map, double scale, bb_image *h, bb_image *z) {
   bb_error err;
-  if (bb_height_file_read(map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, h, NULL, &err) != BB_OK ||
+  if (bb__height_file_read(map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, h, NULL, &err) != BB_OK ||
       bb_image_alloc(z, h->width, h->height, 1, &err) != BB_OK) {
     fprintf(stderr, "bounce_ref: %s\n", err.message);
     return 1;
@@ -741,7 +742,7 @@ static int run_compare(int argc, char **argv) {
     return 1;
   }
   const int stride = (int)stride_d, lobes = basis.count, channels = 1 + lobes;
-  if (bb_height_file_read(map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err) != BB_OK ||
+  if (bb__height_file_read(map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, &h, NULL, &err) != BB_OK ||
       bb__normals_compute_all_cores(&h, (float)scale, filter,
                          clamp_flag ? BB_ADDRESS_CLAMP : BB_ADDRESS_PERIODIC, &normal,
                          &err) != BB_OK) {

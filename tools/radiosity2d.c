@@ -9,7 +9,7 @@
  * --basis NAME (hl2), --power P (1), --strip L (0.1), --normal-filter NAME
  * (vertex), --texels (compare: every column's figures on stderr).
  *
- * MAP is read as a bake reads it (bb_height_file_read, heights times SCALE
+ * MAP is read as a bake reads it (bb__height_file_read, heights times SCALE
  * in float); every row must be the same, and the bake it is compared with
  * must be a clamped one (`bake --clamp --filter-radius 0`): then the bake's
  * surface, two triangles per cell, is exactly the profile's polyline
@@ -52,6 +52,7 @@
  * whose ssbump reaches 1 are left out and counted). Exits 1 when a file
  * cannot be read or is not such a profile, 2 on a bad command line.
  */
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "core/internal.h"
 #include "trace/integrate.h"
@@ -638,7 +639,7 @@ static int parse_options(int argc, char **argv, int first, args *a, const char *
 static int model_make(const args *a, const sky *k, bb_image *h, model *m) {
   bb_error err;
   memset(m, 0, sizeof *m);
-  if (bb_height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, h, NULL, &err) !=
+  if (bb__height_file_read(a->map, BB_CHANNEL_AUTO, 0.0f, NULL, NULL, h, NULL, &err) !=
       BB_OK) {
     fprintf(stderr, "radiosity2d: %s\n", err.message);
     return 1;

@@ -187,3 +187,11 @@ s/\bbb_bake_trace_input\b/bb__bake_trace_input/g
 s/\bbb_job_map_file\b/bb__job_map_file/g
 s/\bbb_job_report_json\b/bb__job_report_json/g
 s/\bbb_path_with_suffix\b/bb__path_with_suffix/g
+# no client reads a bake's or a job's options since serve and Python read
+# through their commands: the calls that took or gave them are the
+# library's own, and so are the structs (src/bake/bake_internal.h,
+# src/job/job_options.h).
+s/\bbb_bake_slices\b/bb__bake_slices/g
+s/\bbb_height_file_read\b/bb__height_file_read/g
+s/\bbb_provenance_format\b/bb__provenance_format/g
+s/\bbb_command_job_options\b/bb__command_job_options/g

@@ -6,6 +6,75 @@
 #include "bumpbake.h"
 #include "core/internal.h"
 
+/* Once in bumpbake.h, now internal (issue 41): a bake's options, which
+ * change with every feature; clients set them through a command
+ * (bb_command_set) and read them by name (bb_command_value) */
+typedef struct bb_smooth_options {
+  int radius_texels;     /* R, window |ix|,|iy| <= R; 0 = off (copy). Default 10 */
+  float threshold;       /* T in normalised height units, > 0. Default 2/255 */
+  bb_addressing addressing;
+} bb_smooth_options;
+
+/* A bake's options; a client has them, its defaults filled in, from a
+ * bake command (bb__command_job_options). */
+typedef struct bb_bake_options {
+  float height_scale;         /* S, texels per unit of h, > 0 */
+  int rays;                   /* ray budget, 1..BB_MAX_RAYS, default 256:
+                                 round(sqrt(rays)) slices (bb__bake_slices) */
+  int slices;                 /* azimuth slices, 1..BB_MAX_SLICES; 0 (default):
+                                 from rays */
+  bb_smooth_options smooth;   /* filter radius 0..BB_MAX_FILTER_RADIUS,
+                                 threshold > 0, addressing */
+  bb_trace_options trace;     /* bias 0..BB_MAX_BIAS_TEXELS; threads
+                                 0..BB_MAX_THREADS, used by EVERY stage of the
+                                 bake (smooth, normals, pyramid, trace,
+                                 derive); progress, which may cancel */
+  double power;               /* P in 1..BB_MAX_POWER, default 1 */
+  bb_basis basis;             /* default "hl2"; weights and
+                                 ssbump get one channel per direction */
+  bb_normal_filter normal_filter; /* default BB_NORMAL_VERTEX */
+  int normal_y_up;            /* 1 flips green of normal and bent */
+  unsigned outputs;           /* the maps to make: BB_MAP_BIT(kind)s,
+                                 default BB_MAPS_BAKED, not 0. Nothing else
+                                 is computed: no trace without a traced kind
+                                 (then rays and slices are not checked); a map
+                                 another needs is made and freed (bent needs
+                                 ssbump, both need the normal) */
+  double bounce_albedo;       /* rho in [0, 1]: inter-reflection. ao, ssbump
+                                 and bent then include the light the
+                                 surrounding height field reflects,
+                                 Lambertian with albedo rho (times
+                                 bounce_albedo_map), normalised as without it
+                                 (docs/conventions.md "Inter-reflection"; the
+                                 weights hold no visibility and do not change).
+                                 Default 0: none, and the bake is bit for bit
+                                 the one without these fields. Costs about 3
+                                 traces per bounce, and 72 (1 + basis count)
+                                 bytes per texel */
+  const bb_image *bounce_albedo_map; /* NULL (default), or an image of the
+                                 height's size whose grey (1 channel: it; 2:
+                                 the first; 3 or more: Rec. 709 luma of R, G,
+                                 B), clamped to [0, 1], multiplies rho at each
+                                 vertex, linear over each triangle. Not owned;
+                                 ignored while bounce_albedo is 0 (a job given
+                                 only bounce_albedo_file bounces with rho 1) */
+  int bounces;                /* 1..BB_MAX_BOUNCES: light reflected that many
+                                 times; 0 (default): converged (each
+                                 triangle's light estimated from what it
+                                 blocks, one bounce gathered from that
+                                 estimate, the rest of the series then
+                                 added as geometric) */
+  const bb_image *brightness; /* NULL (default), or a brightness map of the
+                                 height's size: ssbump and weights are
+                                 multiplied by its grey, the paper's
+                                 "brightness modulation factor in the normal
+                                 map", as combine --brightness does (a
+                                 texel that would exceed 1 is scaled down,
+                                 its channels' ratios kept); ao and bent do
+                                 not change. Not owned */
+} bb_bake_options;
+
+
 /* The stages of a bake with the bake's thread count (0 = all cores); the
  * public functions of the same name without "bb__" call them with 0.
  * Every stage splits its work into items whose results do not depend on
@@ -67,7 +136,7 @@ extern const bb__range bb__range_height_scale, bb__range_rays, bb__range_slices,
 
 /* The one check of a bake's options (bb__bake_options_check) and the one
  * place its ray budget becomes azimuth slices: out is in with slices set
- * (bb_bake_slices) when a traced map is asked. Every entry point taking
+ * (bb__bake_slices) when a traced map is asked. Every entry point taking
  * bb_bake_options prepares them once; what runs after (bb__bake, the
  * memory estimate, the ray set) reads out->slices and checks nothing. */
 bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err);
@@ -273,5 +342,12 @@ bb_status bb__bake_context_bake(bb_bake_context *context, const bb_image *height
  * about 13 bytes per texel while building, 5.4 once built. */
 bb_status bb__bake_trace_input(const bb_image *height, const bb_bake_options *o,
                                bb_pyramid **pyramid, bb_rayset **rays, bb_error *err);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the library
+ * calls it; the library, tests and tools do. */
+/* The azimuth slices o traces with: o->slices when set, else
+ * the slices o->rays asks for (round(sqrt(rays)), at least 1). The one rule; provenance, JSON and the
+ * up-to-date check all report it. */
+int bb__bake_slices(const bb_bake_options *o);
 
 #endif /* BB_BAKE_INTERNAL_H */

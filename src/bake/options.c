@@ -34,7 +34,7 @@ void bb__bake_options_init(bb_bake_options *o) {
   o->outputs = BB_MAPS_BAKED;
 }
 
-int bb_bake_slices(const bb_bake_options *o) {
+int bb__bake_slices(const bb_bake_options *o) {
   return o->slices ? o->slices : bb__slices_for_rays(o->rays);
 }
 
@@ -83,7 +83,7 @@ bb_status bb__bake_options_check(const bb_bake_options *o, bb_error *err) {
 
 void bb__bake_resolve(bb_bake_options *o) {
   if (o->outputs & BB_MAPS_TRACED)
-    o->slices = bb_bake_slices(o);
+    o->slices = bb__bake_slices(o);
 }
 
 bb_status bb__bake_prepare(const bb_bake_options *in, bb_bake_options *out, bb_error *err) {

@@ -6,7 +6,7 @@
 #include "job/job_internal.h"
 
 int bb_command_slices(const bb_command *c) {
-  return c ? bb_bake_slices(&c->options.job.bake) : 0;
+  return c ? bb__bake_slices(&c->options.job.bake) : 0;
 }
 
 double bb_command_bounce(const bb_command *c) {

@@ -303,4 +303,14 @@ int bb__command_input_count(const bb_command *command);
 void bb__job_report_json(FILE *f, const bb_bake_options *b, const bb_job_report *r,
                          const char *status, const char *extra_json);
 
+/* Once in bumpbake.h, now internal (issue 41): no client of the library
+ * calls it; the library, tests and tools do. */
+/* The options of the command's bake as set and checked (bake, normal,
+ * height2ssbump; the bake of render's and sheet's HEIGHT; the depth, mips
+ * and texture settings of every command writing maps): what a client that
+ * reads the bake's settings (bb__bake_slices) hands
+ * on. Owned by command; NULL for NULL. Every other option is read by
+ * name (bb_command_value). */
+const bb_job_options *bb__command_job_options(const bb_command *command);
+
 #endif /* BB_CMD_INTERNAL_H */

@@ -94,7 +94,7 @@ const bb_command_options *bb__command_options_of(const bb_command *c) {
   return c ? &c->options : NULL;
 }
 
-const bb_job_options *bb_command_job_options(const bb_command *c) {
+const bb_job_options *bb__command_job_options(const bb_command *c) {
   return c ? &c->options.job : NULL;
 }
 

@@ -1,11 +1,12 @@
 /* command_options.h: where a command's options land, typed (not public:
  * clients read them by name, bb_command_value, or the bake's as the stage
- * API's struct, bb_command_job_options), so a command or an option added
+ * API's struct, bb__command_job_options), so a command or an option added
  * changes no public struct. */
 #ifndef BB_CMD_COMMAND_OPTIONS_H
 #define BB_CMD_COMMAND_OPTIONS_H
 
 #include "bumpbake.h"
+#include "job/job_options.h"  /* bb_job_options */
 #include "mesh/mesh_internal.h" /* bb_renderbump_options */
 #include "render/render_internal.h" /* bb_render_options */
 

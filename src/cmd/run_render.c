@@ -151,7 +151,7 @@ static bb_status bake_for_picture(render_args *a, const bb_image *height, const 
 static bb_status bake_height(render_args *a, render_inputs *in, bb_error *err) {
   const bb_command_hooks *hooks = a->hooks;
   bb_error e = {{0}};
-  bb_status st = bb_height_file_read(a->height_path, a->o->job.channel, a->bake.height_scale,
+  bb_status st = bb__height_file_read(a->height_path, a->o->job.channel, a->bake.height_scale,
                                      hooks ? hooks->note : NULL, hooks ? hooks->note_user : NULL,
                                      &in->height, &in->source, &e);
   if (st != BB_OK)
@@ -372,7 +372,7 @@ bb_status bb__run_sheet(bb_command *c, const bb_command_hooks *hooks, bb_command
   char *extra = NULL, *record = bb__command_record(c);
   bb_status st = record ? BB_OK : bb__fail(err, BB_ERR_MEMORY, "out of memory");
   if (st == BB_OK &&
-      (st = bb_height_file_read(input, a->job.channel, a->job.bake.height_scale,
+      (st = bb__height_file_read(input, a->job.channel, a->job.bake.height_scale,
                                 hooks ? hooks->note : NULL, hooks ? hooks->note_user : NULL,
                                 &height, &source, &e)) != BB_OK)
     bb__fail_at(err, st, input, &e);

@@ -2,6 +2,7 @@
  * of a trace split over processes (bb_command_trace_input): its input read
  * as the bake reads it, with the command's own options, so a client hands
  * over the command and reads none of the bake's settings itself. */
+#include "job/job_internal.h"
 #include "bake/bake_internal.h"
 #include "cmd/cmd_internal.h"
 #include "core/internal.h"
@@ -27,7 +28,7 @@ static bb_status trace_input(const bb_command *c, int threads, uint64_t file_has
   const bb_job_options *job = &c->options.job;
   bb_image height;
   bb_height_source source;
-  bb_status st = bb_height_file_read(path, job->channel, job->bake.height_scale, NULL, NULL,
+  bb_status st = bb__height_file_read(path, job->channel, job->bake.height_scale, NULL, NULL,
                                      &height, &source, err);
   if (st != BB_OK)
     return st;

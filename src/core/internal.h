@@ -294,7 +294,7 @@ const char *bb__map_kind_name(bb_map_kind kind);
  * "normal_y", and ao on "power" and "basis" only with inter-reflection
  * (bounce nonzero: the text has a "bounce" key); without it, ao's "rayset"
  * is recorded as the ray set's scheme and slices only ("bb-horizon-v1:a16").
- * A bake's outputs record only such keys (bb_provenance_format), the
+ * A bake's outputs record only such keys (bb__provenance_format), the
  * up-to-date check (bb__output_check) and bb__provenance_diff compare only
  * them, so a parameter that does not change a map neither makes it stale
  * nor shows in its diff, also against a file written before the rule that

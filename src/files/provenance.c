@@ -286,7 +286,7 @@ static int is_listed(const entry *e, const char *const *keys) {
 /* The first key of `from` (not ignored) that `other` does not hold with
  * the same value, reported as "key: have -> want"; 0 when there is none.
  * Linear in the size of each text times the lines of the other, and `want`
- * is the short text bb_provenance_format made. */
+ * is the short text bb__provenance_format made. */
 static int first_missing(const char *from, const char *other, int from_is_have,
                          const char *const *ignored, char *reason, size_t cap) {
   entry e, o;

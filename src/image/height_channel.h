@@ -22,7 +22,7 @@ typedef struct bb__height_loaded {
 /* The height of the image file at path by the channel rule, telling which
  * channel it took and why (height_load.c): the header decides where it
  * can, and only the channels needed are decoded. Messages name the file.
- * bb_height_file_read's loader; tests call it alone. */
+ * bb__height_file_read's loader; tests call it alone. */
 bb_status bb__height_load(const char *path, bb_channel channel, bb_image *height,
                           bb__height_loaded *loaded, bb_error *err);
 
@@ -38,7 +38,7 @@ bb_status bb__channel_parse(const char *name, bb_channel *out, bb_error *err);
  * mask): Valve's convention, the height in alpha. Otherwise it gives
  * BB_CHANNEL_MEAN (for a grey image, the grey). BB_CHANNEL_VALVE gives
  * BB_CHANNEL_A whenever there is an alpha channel, else BB_CHANNEL_MEAN for
- * colour and BB_CHANNEL_AUTO (the grey) for grey. bb_height_file_read says
+ * colour and BB_CHANNEL_AUTO (the grey) for grey. bb__height_file_read says
  * which was taken whenever the image left a choice. */
 bb_channel bb__height_channel(const bb_image *img, int alpha_channel, bb_channel channel);
 

@@ -12,6 +12,7 @@
 
 #include "bumpbake.h"
 #include "core/internal.h"
+#include "job/job_options.h"
 
 #include <stddef.h>
 

@@ -45,7 +45,7 @@ static void note_input(const bb__height_loaded *info, float height_scale, bb_not
   }
 }
 
-bb_status bb_height_file_read(const char *path, bb_channel channel, float height_scale,
+bb_status bb__height_file_read(const char *path, bb_channel channel, float height_scale,
                               bb_note_fn note, void *note_user, bb_image *height,
                               bb_height_source *source, bb_error *err) {
   if (!height)

@@ -177,7 +177,7 @@ bb_status bb__output_check(const char *path, const bb_provenance *expected, bb_d
     say(reason, cap, "the input file's hash is not known");
     return BB_OK;
   }
-  char *want = bb_provenance_format(expected);
+  char *want = bb__provenance_format(expected);
   if (!want)
     return bb__fail(err, BB_ERR_MEMORY, "%s: out of memory", path);
   bb_image_info info;

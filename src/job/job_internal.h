@@ -6,6 +6,7 @@
 #include "bumpbake.h"
 #include "core/file_names.h" /* bb__file_name, bb__file_extension */
 #include "files/file_identity.h"
+#include "job/job_options.h"
 #include "mesh/mesh_internal.h" /* bb_renderbump_options */
 
 #include <stddef.h>
@@ -237,7 +238,7 @@ char *bb__job_command_of(const bb_job *job, const bb__job_item *item);
 /* ------------------------------------------- one map or picture (output.c) */
 
 /* Where an output came from, as its provenance records it
- * (bb_provenance_format). */
+ * (bb__provenance_format). */
 typedef struct bb__job_source {
   const char *command;          /* the command line the output records */
   const char *input;            /* the input's path (its file name is recorded), or NULL */
@@ -439,7 +440,7 @@ void bb__bake_rayset_id(const bb_bake_options *o, char *out, size_t cap);
  * no pixel is decoded) whether it is what writing the output described by
  * expected, at sample depth `depth` and mip-mapped or not (mip_mapped 0 or
  * 1), would make now. CURRENT when its provenance is bumpbake's, intact
- * (bb_provenance_class), and holds every key bb_provenance_format(expected)
+ * (bb_provenance_class), and holds every key bb__provenance_format(expected)
  * writes with the same value, and no key that text lacks, except "command"
  * and "input" (the command line and the input's name, which do not change a
  * pixel) and "input_hash" (the decoded height's hash, implied by
@@ -464,5 +465,37 @@ bb_status bb__output_check(const char *path, const bb_provenance *expected, bb_d
  * "PASS", ..., "EXTRA"; "unknown" outside the enum. */
 const char *bb__job_outcome_name(bb_job_outcome outcome);
 const char *bb__check_status_name(bb_check_status status);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the library
+ * calls it; the library, tests and tools do. */
+/* Reads the height of the file at path by the channel rule
+ * (bb_channel): the file's bytes are hashed first, then decoded, so
+ * provenance never pairs a newer file's hash with older pixels. note (may
+ * be NULL) hears which channel the rule took when it was not the obvious
+ * one, and warnings about the input (lossy JPEG blocks, 8-bit codes that
+ * terrace at the scale asked). height_scale (0: not known) is the bake's,
+ * for the terracing note. source may be NULL. Errors as bb_image_read and
+ * bb_height_from_image, each naming path. */
+bb_status bb__height_file_read(const char *path, bb_channel channel, float height_scale,
+                              bb_note_fn note, void *note_user, bb_image *height,
+                              bb_height_source *source, bb_error *err);
+
+/* Once in bumpbake.h, now internal (issue 41): no client of the library
+ * calls it; the library, tests and tools do. */
+/* Formats p as "key=value" lines (bumpbake_version, command, input, input_hash,
+ * input_file_hash when known, output, scale, rays, rayset, filter_radius,
+ * filter_threshold, bias, power, basis, normal_filter, normal_y, addressing,
+ * channel), malloc'd; the caller
+ * frees it. With options (a bake's map), only the parameters output_kind
+ * records are written (a normal map has no rays,
+ * rayset, bias, power or basis; ao's rayset is its scheme and slices);
+ * without, rayset is written as given ("none" when NULL). A basis of the caller's vectors ("vectors:HASH") adds
+ * basis_vectors after basis: "x y z" per direction, joined by "; ".
+ * Options in use add, after addressing: bounce (rho) and bounces when
+ * bounce_albedo > 0, with bounce_albedo_map (the hash of the map's pixels, 16
+ * hex digits) when it has one; brightness (the hash of the
+ * brightness map's pixels) when there is one.
+ * Returns NULL when out of memory. */
+char *bb__provenance_format(const bb_provenance *p);
 
 #endif /* BB_JOB_INTERNAL_H */

@@ -33,7 +33,7 @@ bb_provenance bb__job_provenance(const bb__job_source *s, const char *kind) {
 
 char *bb__job_describe(const bb__job_source *s, const char *kind) {
   const bb_provenance p = bb__job_provenance(s, kind);
-  return bb_provenance_format(&p);
+  return bb__provenance_format(&p);
 }
 
 bb_depth bb__job_depth(bb_depth asked, int bits_per_sample, int is_float, const char *path) {

@@ -1,5 +1,5 @@
 /* provenance_format.c: how an output was made, as "key=value" lines stored
- * in the file (bb_provenance_format).
+ * in the file (bb__provenance_format).
  *
  * The text is the contract between a bake and a later `bumpbake compare`: a
  * golden that no longer matches names the parameters that changed. So every
@@ -8,6 +8,7 @@
  * them back is files/provenance.c's.
  */
 
+#include "job/job_internal.h"
 #include "core/internal.h"
 #include "image/height_channel.h"
 #include "bake/bake_internal.h"
@@ -150,7 +151,7 @@ static void put_smoothing_and_tracing(const bake_keys *k, const bb_bake_options 
   }
 }
 
-char *bb_provenance_format(const bb_provenance *p) {
+char *bb__provenance_format(const bb_provenance *p) {
   if (!p)
     return NULL;
   bb__text t = {0};

@@ -428,7 +428,7 @@ static bb_status read_and_bake(bb_job *job, bb__job_item *item, unsigned also,
   job->stage = "bake";
   bb_status st = bb__job_memory_check(job, item, err);
   if (st == BB_OK)
-    st = bb_height_file_read(item->input, job->options.channel,
+    st = bb__height_file_read(item->input, job->options.channel,
                              job->options.bake.height_scale, job->options.note,
                              job->options.note_user, &b->height, &r->source, err);
   r->seconds_load = bb__now_seconds() - t0;

@@ -5,6 +5,7 @@
 #define BB_MAPS_INTERNAL_H
 
 #include "bumpbake.h"
+#include "bake/bake_internal.h"
 #include "core/internal.h"
 
 

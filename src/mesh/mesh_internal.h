@@ -118,7 +118,7 @@ bb_status bb__renderbump_flat(const bb_mesh *mesh, const bb_renderbump_options *
 
 /* The "key=value" provenance lines of a render (axis, size, samples,
  * normals, rect, tile, depth_min, depth_max, scale), malloc'd, to follow
- * bb_provenance_format's lines; NULL when out of memory. */
+ * bb__provenance_format's lines; NULL when out of memory. */
 char *bb__renderbump_describe(const bb_renderbump_options *o,
                              const bb_renderbump_result *r);
 

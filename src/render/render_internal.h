@@ -5,6 +5,7 @@
 #ifndef BB_RENDER_INTERNAL_H
 #define BB_RENDER_INTERNAL_H
 
+#include "bake/bake_internal.h"
 #include "core/internal.h"
 
 /* Once in bumpbake.h (issue 41): no public function takes them; the
@@ -161,7 +162,7 @@ bb_status bb__render_estimate(int width, int height, const bb_render_options *o,
  * provenance; malloc'd, the caller frees it. NULL when out of memory. */
 char *bb__render_options_describe(const bb_render_options *o);
 
-/* The "key=value" lines a render adds to bb_provenance_format's (as its
+/* The "key=value" lines a render adds to bb__provenance_format's (as its
  * extra): render_from (height or maps), map_normal_y, map_KIND (file
  * names), albedo and albedo_hash, then bb__render_options_describe's, then
  * frame=F/N for an orbit's frame. malloc'd; NULL when out of memory. */

@@ -154,7 +154,7 @@ Test(bounce, progress_is_monotone_over_the_whole_bake) {
   bb_image_free(&tile);
 }
 
-/* The trace's part of the units is bb_bake_slices(o), one a slice, as
+/* The trace's part of the units is bb__bake_slices(o), one a slice, as
  * bumpbake.h says (a client names the stage from it: bumpbake serve): a
  * trace of the caller's, counting the calls made while it runs, sees them
  * end at exactly that; the inter-reflection's calls come after, beyond it. */
@@ -182,7 +182,7 @@ Test(bounce, the_trace_is_the_first_slices_units) {
   o.trace.trace = counting_trace;
   o.trace.trace_user = &t;
   bb_bake_result r = harness_bake(&h, &o);
-  const long slices = bb_bake_slices(&o);
+  const long slices = bb__bake_slices(&o);
   cr_assert(t.calls_in_trace > 0 && t.calls_in_trace < l.calls, "%d of %d calls",
             t.calls_in_trace, l.calls);
   cr_expect_eq(l.done[t.calls_in_trace - 1], slices, "the trace ends at %ld, not %ld",

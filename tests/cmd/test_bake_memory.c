@@ -2,6 +2,8 @@
  * in memory: the bits of bb__bake_checked with the command's options (and the
  * images and basis handed over), the same through a context (warm and
  * edit-local), only the maps asked handed back; and its refusals. */
+#include "cmd/cmd_internal.h"
+#include "job/job_internal.h"
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "command_words.h"
@@ -56,7 +58,7 @@ Test(cmd_bake, bits_of_the_stage_bake_with_the_commands_options) {
   bb_error err = {{0}};
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, NULL, maps, &changed, &err),
                BB_OK, "%s", err.message);
-  bb_bake_options o = bb_command_job_options(c)->bake;
+  bb_bake_options o = bb__command_job_options(c)->bake;
   cr_assert_eq(o.basis.count, 6);
   bb_bake_result r;
   cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);
@@ -83,7 +85,7 @@ Test(cmd_bake, the_images_and_basis_handed_over) {
   bb_image maps[BB_MAP_BAKED_COUNT];
   cr_assert_eq(bb_command_bake(c, &h, &albedo, &bright, &basis, NULL, NULL, maps, NULL, &err),
                BB_OK, "%s", err.message);
-  bb_bake_options o = bb_command_job_options(c)->bake;
+  bb_bake_options o = bb__command_job_options(c)->bake;
   o.basis = basis;
   o.brightness = &bright;
   o.bounce_albedo_map = &albedo;
@@ -145,7 +147,7 @@ Test(cmd_bake, normal_bakes_the_normal_alone) {
   bb_error err = {{0}};
   cr_assert_eq(bb_command_bake(c, &h, NULL, NULL, NULL, NULL, NULL, maps, NULL, &err), BB_OK,
                "%s", err.message);
-  bb_bake_options o = bb_command_job_options(c)->bake;
+  bb_bake_options o = bb__command_job_options(c)->bake;
   cr_expect(o.normal_y_up);
   bb_bake_result r;
   cr_assert_eq(bb__bake_checked(&h, &o, &r, &err), BB_OK, "%s", err.message);

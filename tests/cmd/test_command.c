@@ -1008,12 +1008,12 @@ Test(cmd, report_words_are_the_printed_ones) {
 Test(cmd, the_stage_struct_is_the_commands_bake) {
   bb_command *c = command("render", (const char *const[]){"h.png", "--rays", "64", "--light",
                                                          "10,20", "--tile", "3", NULL});
-  cr_expect_eq(bb_command_job_options(c)->bake.rays, 64);
+  cr_expect_eq(bb__command_job_options(c)->bake.rays, 64);
   char light[32];
   bb_error err = {{0}};
   cr_assert_eq(bb_command_value(c, "light", light, sizeof light, &err), BB_OK);
   cr_expect_str_eq(light, "10,20");
-  cr_expect_null(bb_command_job_options(NULL));
+  cr_expect_null(bb__command_job_options(NULL));
   const bb_render_options *o = &bb__command_options_of(c)->render;
   bb_command_set_picture(c, 1, 0); /* leaves both */
   cr_expect(o->dynamic_light && o->tile_x == 3 && o->tile_y == 3);

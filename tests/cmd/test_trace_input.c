@@ -6,6 +6,7 @@
  * the one traced. */
 #define _XOPEN_SOURCE 700 /* mkdtemp, nftw */
 
+#include "job/job_internal.h"
 #include "bake/bake_internal.h"
 #include "bumpbake.h"
 #include "bumpbake_cluster.h"
@@ -79,7 +80,7 @@ static void assert_the_bakes_input(const bb_command *c, const char *path,
   cr_assert_eq(bb_command_trace_input(c, 2, hash_of(path), &p, &rs, &err), BB_OK, "%s",
                err.message);
   bb_image height;
-  cr_assert_eq(bb_height_file_read(path, c->options.job.channel,
+  cr_assert_eq(bb__height_file_read(path, c->options.job.channel,
                                    c->options.job.bake.height_scale, NULL, NULL, &height, NULL,
                                    &err),
                BB_OK, "%s", err.message);

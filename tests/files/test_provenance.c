@@ -1,4 +1,5 @@
 /* test_provenance.c: image hash, provenance text and its key-by-key diff. */
+#include "job/job_internal.h"
 #include "image/height_channel.h"
 #include "bake/bake_internal.h"
 #include "files/provenance.h"
@@ -102,7 +103,7 @@ Test(provenance, hash_changes_with_a_pixel_or_the_shape) {
 Test(provenance, format_lists_every_key_in_order) {
   bb_bake_options o = sample_options();
   bb_provenance p = sample_provenance(&o);
-  char *text = bb_provenance_format(&p);
+  char *text = bb__provenance_format(&p);
   cr_assert_not_null(text);
   static const char *const keys[] = {"bumpbake_version",
                                      "command",
@@ -156,7 +157,7 @@ Test(provenance, floats_round_trip_exactly) {
   o.trace.bias_texels = 0.1 + 0.2; /* not the double nearest 0.3 */
   o.power = 2.5;
   bb_provenance p = sample_provenance(&o);
-  char *text = bb_provenance_format(&p);
+  char *text = bb__provenance_format(&p);
   cr_assert_not_null(text);
   char buf[256];
   cr_assert_eq(strtof(value_of(text, "scale", buf, sizeof buf), NULL), o.height_scale);
@@ -177,7 +178,7 @@ Test(provenance, format_names_modes_and_missing_fields) {
   p.input_name = NULL;
   p.rayset_id = NULL;
   p.channel = BB_CHANNEL_LUMA;
-  char *text = bb_provenance_format(&p);
+  char *text = bb__provenance_format(&p);
   cr_assert_not_null(text);
   char buf[256];
   cr_assert_str_eq(value_of(text, "normal_y", buf, sizeof buf), "up");
@@ -195,7 +196,7 @@ Test(provenance, channel_line_parses_back_to_the_rule) {
   for (int c = BB_CHANNEL_AUTO; c <= BB_CHANNEL_MEAN; c++) {
     bb_provenance p = sample_provenance(&o);
     p.channel = (bb_channel)c;
-    char *text = bb_provenance_format(&p);
+    char *text = bb__provenance_format(&p);
     char buf[64];
     bb_channel parsed;
     cr_assert_eq(bb__channel_parse(value_of(text, "channel", buf, sizeof buf), &parsed, NULL), 0,
@@ -208,7 +209,7 @@ Test(provenance, channel_line_parses_back_to_the_rule) {
 Test(provenance, diff_of_identical_texts_is_empty) {
   bb_bake_options o = sample_options();
   bb_provenance p = sample_provenance(&o);
-  char *a = bb_provenance_format(&p);
+  char *a = bb__provenance_format(&p);
   char out[512] = "junk";
   cr_assert_eq(bb__provenance_diff(a, a, out, sizeof out), 0);
   cr_assert_str_eq(out, "");
@@ -224,8 +225,8 @@ Test(provenance, diff_names_changed_keys_and_ignores_command_and_output) {
   /* kinds that record the same keys (an ssbump and height2ssbump -d's) */
   pa.output_kind = "ssbump";
   pb.output_kind = "detail-ssbump+height";
-  char *a = bb_provenance_format(&pa);
-  char *b = bb_provenance_format(&pb);
+  char *a = bb__provenance_format(&pa);
+  char *b = bb__provenance_format(&pb);
   char out[1024];
   int n = bb__provenance_diff(a, b, out, sizeof out);
   cr_assert_eq(n, 2, "scale and basis differ; got:\n%s", out);
@@ -261,7 +262,7 @@ Test(provenance, classify_tells_intact_from_damaged_and_foreign_text) {
   bb_bake_options o;
   bb__bake_options_init(&o);
   bb_provenance p = sample_provenance(&o);
-  char *text = bb_provenance_format(&p);
+  char *text = bb__provenance_format(&p);
   cr_assert_eq(bb__provenance_classify(text), BB_PROVENANCE_INTACT, "%s", text);
   free(text);
   cr_assert_eq(bb__provenance_classify(NULL), BB_PROVENANCE_NONE);
@@ -300,7 +301,7 @@ static char *long_provenance(void) {
   p.input_name = "rock_height_2048.tga";
   p.output_kind = "ssbump+height";
   p.rayset_id = "bb-latslices-v1:n250:a16:p1:hl2";
-  return bb_provenance_format(&p);
+  return bb__provenance_format(&p);
 }
 
 Test(provenance, pack_keeps_whole_lines_pixel_keys_first) {

@@ -7,6 +7,7 @@
 
 #include <criterion/criterion.h>
 
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "image/height_channel.h"
 #include "child_call.h"
@@ -119,7 +120,7 @@ Test(untrusted, a_device_is_refused_by_every_reader) {
 static bb_status call_height_file_read(const char *path, bb_error *err) {
   bb_image h;
   bb_status st =
-      bb_height_file_read(path, BB_CHANNEL_AUTO, 8.0f, NULL, NULL, &h, NULL, err);
+      bb__height_file_read(path, BB_CHANNEL_AUTO, 8.0f, NULL, NULL, &h, NULL, err);
   bb_image_free(&h);
   return st;
 }
@@ -156,7 +157,7 @@ Test(untrusted, a_large_file_no_reader_knows_is_refused_at_once) {
       {"bb_image_read_info", call_read_info},
       {"bb__image_read_mip", call_read_mip},
       {"bb__image_frame_count", call_frame_count},
-      {"bb_height_file_read", call_height_file_read},
+      {"bb__height_file_read", call_height_file_read},
   };
   for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
     const char *path = in_scratch_dir(files[f].name);

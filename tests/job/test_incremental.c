@@ -127,7 +127,7 @@ static void write_output(const char *path, const char *description, bb_depth dep
 }
 
 static void write_described(const char *path, const bb_provenance *p, bb_depth depth) {
-  char *text = bb_provenance_format(p);
+  char *text = bb__provenance_format(p);
   cr_assert_not_null(text);
   write_output(path, text, depth);
   free(text);
@@ -215,7 +215,7 @@ Test(incremental, a_changed_parameter_input_or_kind_is_stale) {
 Test(incremental, other_versions_extra_keys_and_missing_files_are_not_current) {
   fixture f;
   fixture_init(&f);
-  char *text = bb_provenance_format(&f.p), reason[256];
+  char *text = bb__provenance_format(&f.p), reason[256];
   cr_assert_not_null(text);
   char old[2048];
   snprintf(old, sizeof old, "bumpbake_version=0.0.1\n%s", strchr(text, '\n') + 1);

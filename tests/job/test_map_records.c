@@ -226,7 +226,7 @@ Test(map_records, kinds_of_parts_and_unknown_kinds) {
 static char *describe(const char *kind, const bb_bake_options *o, const char *rayset) {
   const bb_provenance p = {"bumpbake bake h.png", "h.png", 0x1234, kind, o,
                            BB_CHANNEL_AUTO,       rayset,  0xfeed, NULL};
-  char *text = bb_provenance_format(&p);
+  char *text = bb__provenance_format(&p);
   cr_assert_not_null(text);
   return text;
 }
@@ -257,7 +257,7 @@ Test(map_records, a_normal_map_records_no_trace_and_ao_its_slices) {
                                NULL,
                                0,
                                NULL};
-  char *text = bb_provenance_format(&other);
+  char *text = bb__provenance_format(&other);
   cr_expect_not_null(strstr(text, "\nrayset=none\n"), "%s", text);
   free(text);
   free(normal);

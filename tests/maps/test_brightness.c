@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "bake_harness.h"
 #include "bake/bake_internal.h"
@@ -169,7 +170,7 @@ Test(brightness, provenance_names_the_maps_it_was_made_with) {
   bb__bake_options_init(&o);
   o.height_scale = 4.0f;
   bb_provenance p = {.output_kind = "ssbump", .options = &o};
-  char *text = bb_provenance_format(&p), value[64];
+  char *text = bb__provenance_format(&p), value[64];
   cr_assert_not_null(text);
   cr_expect_eq(bb__provenance_value(text, "brightness", value, sizeof value), 0);
   cr_expect_eq(bb__provenance_value(text, "bounce", value, sizeof value), 0);
@@ -178,7 +179,7 @@ Test(brightness, provenance_names_the_maps_it_was_made_with) {
   o.brightness = &b;
   o.bounce_albedo = 0.4;
   o.bounce_albedo_map = &albedo;
-  text = bb_provenance_format(&p);
+  text = bb__provenance_format(&p);
   char want[32];
   snprintf(want, sizeof want, "%016llx", (unsigned long long)bb__image_hash(&b));
   cr_expect_eq(bb__provenance_value(text, "brightness", value, sizeof value), 1);

@@ -563,7 +563,7 @@ static char *provenance_with_scale(float scale) {
                      .output_kind = "normal",
                      .options = &o,
                      .rayset_id = "test"};
-  return bb_provenance_format(&p);
+  return bb__provenance_format(&p);
 }
 
 Test(compare_cli, differing_provenance_is_listed) {

@@ -24,6 +24,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "job/job_internal.h"
 #include "bumpbake.h"
 #include "texture/texture_oracle.h"
 #include "scratch_dir.h"
@@ -177,7 +178,7 @@ Test(texture_read, vtf_header_agrees_with_the_pixels_and_channels_can_be_picked)
   cr_assert_eq(frames, 1);
   /* A height read by the channel rule: the alpha channel alone. */
   bb_image a;
-  cr_assert_eq(bb_height_file_read(path, BB_CHANNEL_A, 0, NULL, NULL, &a, NULL, &err), BB_OK,
+  cr_assert_eq(bb__height_file_read(path, BB_CHANNEL_A, 0, NULL, NULL, &a, NULL, &err), BB_OK,
                "%s", err.message);
   cr_assert_eq(a.channels, 1);
   for (int i = 0; i < 256; i++)
