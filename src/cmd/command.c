@@ -427,23 +427,22 @@ static bb_status check_ranges(const bb_command *c, bb_error *err) {
 
 /* An option given where it would do nothing: refused; one a derived
  * command took from its source's settings (serve's --brightness, when the
- * write names no ssbump) is dropped instead, as if never given: its value
- * does nothing, and the command's text no longer names it. Dropping one
- * can make another do nothing: until none is left. */
+ * write names no ssbump) is dropped instead, as if never given, so the
+ * command's text no longer names it. Its field is left as it was: it does
+ * nothing for the files the command writes, and a client baking more maps
+ * than those (serve's page, bb_job_bake_item's `also`) still bakes them
+ * with it. The rules read fields, not what was given, so one pass drops
+ * them all. */
 static bb_status check_applies(bb_command *c, bb_error *err) {
-  for (int dropped = 1; dropped;) {
-    dropped = 0;
-    for (int i = 0; c->def->options[i]; i++) {
-      const bb__option *o = c->def->options[i];
-      if (!c->given[i] || !o->applies || o->applies(c))
-        continue;
-      if (!c->derived[i])
-        return bb__fail(err, BB_ERR_ARGUMENT, "--%s does nothing without %s", o->info.name,
-                        o->info.applies);
-      c->given[i] = c->derived[i] = 0;
-      c->texts[i] = NULL;
-      dropped = 1;
-    }
+  for (int i = 0; c->def->options[i]; i++) {
+    const bb__option *o = c->def->options[i];
+    if (!c->given[i] || !o->applies || o->applies(c))
+      continue;
+    if (!c->derived[i])
+      return bb__fail(err, BB_ERR_ARGUMENT, "--%s does nothing without %s", o->info.name,
+                      o->info.applies);
+    c->given[i] = c->derived[i] = 0;
+    c->texts[i] = NULL;
   }
   return BB_OK;
 }

@@ -12,44 +12,29 @@ static int names_an_output(const bb__option *o) {
   return o->repeats || !strcmp(o->info.name, "output");
 }
 
-/* 1 when from holds option i at another value than fresh (a new command
- * of the derived one's name) holds its option j, by their text: every
- * value that reaches the outputs (the provenance records --rays also
- * under --slices, which override it) is then named, so that the derived
- * command's text, run again, makes the same bytes. -1 when out of memory. */
-static int differs(const bb_command *from, int i, const bb_command *fresh, int j) {
-  bb__text value = {0}, unset = {0};
-  bb__command_value_text(from, i, &value);
-  bb__command_value_text(fresh, j, &unset);
-  const int d = value.failed || unset.failed
-                    ? -1
-                    : strcmp(value.data ? value.data : "", unset.data ? unset.data : "") != 0;
-  bb__text_free(&value);
-  bb__text_free(&unset);
-  return d;
-}
-
 /* Option i of from onto to, when to takes it, it names no output and from
- * holds it at another value than fresh does; marked derived (the check
- * drops it where it does nothing). */
+ * holds it at another value than fresh (a new command of to's name) does,
+ * by their text: every value that reaches the outputs is then named (the
+ * provenance records --rays also under --slices, which override it), so
+ * that the derived command's text, run again, makes the same bytes.
+ * Marked derived: the check drops it where it does nothing. */
 static bb_status copy_option(const bb_command *from, int i, const bb_command *fresh,
                              bb_command *to, bb_error *err) {
   const bb__option *o = from->def->options[i];
   const int j = bb__option_find(to->def, o->info.name);
   if (j < 0 || names_an_output(to->def->options[j]))
     return BB_OK;
-  const int d = differs(from, i, fresh, j);
-  if (d < 0)
-    return bb__fail(err, BB_ERR_MEMORY, "out of memory");
-  if (!d)
-    return BB_OK;
-  bb__text value = {0};
+  bb__text value = {0}, unset = {0};
   bb__command_value_text(from, i, &value);
-  bb_status st = value.failed ? bb__fail(err, BB_ERR_MEMORY, "out of memory")
-                              : bb_command_set(to, o->info.name, value.data ? value.data : "", err);
-  bb__text_free(&value);
-  if (st == BB_OK)
+  bb__command_value_text(fresh, j, &unset);
+  const char *v = value.data ? value.data : "", *u = unset.data ? unset.data : "";
+  bb_status st = BB_OK;
+  if (value.failed || unset.failed)
+    st = bb__fail(err, BB_ERR_MEMORY, "out of memory");
+  else if (strcmp(v, u) != 0 && (st = bb_command_set(to, o->info.name, v, err)) == BB_OK)
     to->derived[j] = 1;
+  bb__text_free(&value);
+  bb__text_free(&unset);
   return st;
 }
 
