@@ -39,6 +39,12 @@ uint64_t bb__walk_number(bb__walk *w, int n, int little) {
   return v;
 }
 
+int bb__walk_tag(bb__walk *w, unsigned char tag[4]) {
+  if (!w->ok || bb__probe_read(w->fd, tag, 4, w->pos) != 4) return w->ok = 0;
+  w->pos += 4;
+  return 1;
+}
+
 void bb__probe_corrupt(bb__probe *p, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -210,12 +216,6 @@ void bb__probe_ico(int fd, const unsigned char *head, bb__probe *p) {
  * to 4 GiB): each must lie in the file. */
 static int is_type(const unsigned char *t, const char *name) { return memcmp(t, name, 4) == 0; }
 
-static int read_type(bb__walk *w, unsigned char type[4]) {
-  if (!w->ok || bb__probe_read(w->fd, type, 4, w->pos) != 4) return w->ok = 0;
-  w->pos += 4;
-  return 1;
-}
-
 /* The flags of TBHD's table header at w->pos, and its tile count: 0 when
  * the probe is corrupt. */
 static int check_tbhd(bb__walk *w, uint32_t size, unsigned *tile_count, bb__probe *p) {
@@ -243,7 +243,7 @@ static int check_tbhd(bb__walk *w, uint32_t size, unsigned *tile_count, bb__prob
  * (its tile's corners), zeroed, before reading it. */
 static void check_tiles(bb__walk *w, unsigned tiles, bb__probe *p) {
   unsigned char type[4];
-  for (unsigned t = 0; t < tiles && read_type(w, type);) {
+  for (unsigned t = 0; t < tiles && bb__walk_tag(w, type);) {
     const uint32_t size = (uint32_t)bb__walk_number(w, 4, 0);
     const uint32_t chunk = (size + 3u) & ~3u;
     if (!w->ok) return;
@@ -268,12 +268,12 @@ void bb__probe_iff(int fd, const unsigned char *head, bb__probe *p) {
   int in_cimg = 0, past_tbhd = 0;
   unsigned tiles = 0;
   unsigned char type[4];
-  while (read_type(&w, type)) {
+  while (bb__walk_tag(&w, type)) {
     const uint32_t size = (uint32_t)bb__walk_number(&w, 4, 0);
     const uint32_t chunk = (size + 3u) & ~3u;
     if (!w.ok) return;
     if (!in_cimg && is_type(type, "FOR4")) {
-      if (!read_type(&w, type)) return;
+      if (!bb__walk_tag(&w, type)) return;
       if (is_type(type, "CIMG")) {
         in_cimg = 1;
         continue;
@@ -291,7 +291,7 @@ void bb__probe_iff(int fd, const unsigned char *head, bb__probe *p) {
         return;
       }
     } else if (past_tbhd && is_type(type, "FOR4")) {
-      if (!read_type(&w, type)) return;
+      if (!bb__walk_tag(&w, type)) return;
       if (is_type(type, "TBMP")) { /* the header ends: the tiles follow */
         check_tiles(&w, tiles, p);
         return;
@@ -433,7 +433,7 @@ void bb__probe_jpeg2000(int fd, const unsigned char *head, bb__probe *p) {
     const double start = w.pos;
     double length = (double)bb__walk_number(&w, 4, 0);
     unsigned char type[4];
-    if (!read_type(&w, type)) return;
+    if (!bb__walk_tag(&w, type)) return;
     if (length == 1) length = (double)bb__walk_number(&w, 8, 0);
     if (!w.ok) return;
     if (is_type(type, "jp2c")) {

@@ -35,6 +35,10 @@ typedef struct bb__walk {
  * `little`) number; 0 and ok cleared past the end. */
 uint64_t bb__walk_number(bb__walk *w, int n, int little);
 
+/* The next 4 bytes (a chunk's type, a block's signature) into tag: 1, or
+ * 0 and ok cleared past the end. */
+int bb__walk_tag(bb__walk *w, unsigned char tag[4]);
+
 /* Sets the probe's `corrupt` (printf-style): the read refuses the file as
  * "corrupt image: ...". */
 void bb__probe_corrupt(bb__probe *p, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

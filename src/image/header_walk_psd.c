@@ -35,12 +35,6 @@ static int psb_long_key(const unsigned char key[4]) {
   return 0;
 }
 
-static int read_tag(bb__walk *w, unsigned char tag[4]) {
-  if (!w->ok || bb__probe_read(w->fd, tag, 4, w->pos) != 4) return w->ok = 0;
-  w->pos += 4;
-  return 1;
-}
-
 /* A Pascal string padded to a multiple of `pad` (its length byte
  * included), as the reader skips it. */
 static void skip_name(bb__walk *w, unsigned pad) {
@@ -54,7 +48,7 @@ static void skip_name(bb__walk *w, unsigned pad) {
 static int walk_resources(bb__walk *w, double end, bb__probe *p) {
   while (w->ok && w->pos < end) {
     unsigned char tag[4];
-    if (!read_tag(w, tag) || memcmp(tag, "8BIM", 4) != 0) return 1;
+    if (!bb__walk_tag(w, tag) || memcmp(tag, "8BIM", 4) != 0) return 1;
     const unsigned id = (unsigned)bb__walk_number(w, 2, 0);
     skip_name(w, 2);
     const double length = (double)bb__walk_number(w, 4, 0);
@@ -146,7 +140,7 @@ static int walk_layer(bb__walk *w, int psb, int layer, double *data, bb__probe *
   }
   w->pos += (double)records;
   unsigned char tag[4];
-  if (!read_tag(w, tag) || memcmp(tag, "8BIM", 4) != 0) {
+  if (!bb__walk_tag(w, tag) || memcmp(tag, "8BIM", 4) != 0) {
     free(r);
     w->ok = 0;
     return 1;
@@ -173,7 +167,7 @@ static int walk_layer(bb__walk *w, int psb, int layer, double *data, bb__probe *
   extra -= (uint32_t)(w->pos - name_at);
   while (w->ok && extra >= 12) { /* additional layer information */
     unsigned char key[4];
-    if (!read_tag(w, tag) || !read_tag(w, key) ||
+    if (!bb__walk_tag(w, tag) || !bb__walk_tag(w, key) ||
         (memcmp(tag, "8BIM", 4) != 0 && memcmp(tag, "8B64", 4) != 0)) {
       w->ok = 0;
       break;
